@@ -1,0 +1,48 @@
+"""bidmp — one-shot Learning from Demonstration with DMPs, extended demonstrations and Bi-DMP.
+
+The public names of SPEC §10 are imported lazily (PEP 562), so ``import bidmp`` and
+``bidmp --help`` do not pay for NumPy/SciPy until a name is used.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
+__version__ = "0.1.0"
+
+# public name -> (module, attribute)
+_LAZY = {
+    "DMP": ("bidmp.dmp", "DMP"),
+    "save": ("bidmp.io", "save_model"),
+    "load": ("bidmp.io", "load_model"),
+    "ModelFileError": ("bidmp.io", "ModelFileError"),
+    "NotFittedError": ("bidmp._checks", "NotFittedError"),
+}
+_SUBMODULES = ("dmp", "datasets", "io", "plotting")
+
+__all__ = ["__version__", *_LAZY, *_SUBMODULES]
+
+if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+    from . import datasets, dmp, io, plotting  # noqa: F401
+    from ._checks import NotFittedError  # noqa: F401
+    from .dmp import DMP  # noqa: F401
+    from .io import ModelFileError  # noqa: F401
+    from .io import load_model as load  # noqa: F401
+    from .io import save_model as save  # noqa: F401
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        module_name, attribute = _LAZY[name]
+        value = getattr(importlib.import_module(module_name), attribute)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(f"bidmp.{name}")
+    else:
+        raise AttributeError(f"module 'bidmp' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -1,0 +1,223 @@
+"""The ``bidmp`` command line: a thin shell over the library.
+
+Parse, call the library, print, exit. Bad input of any kind ends with a one-line message on
+stderr and exit code 2, never a traceback (``--debug`` shows it). NumPy and the library are
+imported inside the command handlers so that ``bidmp --help`` starts fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import sys
+from collections.abc import Sequence
+
+from . import __version__
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_BAD_INPUT = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but usage errors are one line (plus a pointer to --help), exit code 2."""
+
+    def error(self, message: str):  # noqa: D401 - argparse API
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _print_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
+    widths = [max(len(str(cell)) for cell in column) for column in zip(header, *rows)]
+    line = "  ".join(f"{{:>{w}}}" for w in widths)
+    print(line.format(*header))
+    print("  ".join("-" * w for w in widths))
+    for row in rows:
+        print(line.format(*row))
+
+
+def _parse_K(text: str):
+    if text in ("paper", "pastor"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be 'paper', 'pastor' or a number, got {text!r}") from None
+
+
+# ---------------------------------------------------------------------------------------------
+# Command handlers
+# ---------------------------------------------------------------------------------------------
+def _cmd_fit(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .dmp import DMP
+    from .evaluation import path_extent, rmse
+    from .io import load_trajectory, save_model
+
+    demonstration = load_trajectory(args.demo)
+    dmp = DMP(
+        n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K,
+        alpha_phase=args.alpha_phase, tau=args.tau, fit=args.fit,
+    ).fit(demonstration)
+    path = save_model(dmp, args.output)
+    error = rmse(dmp.rollout(), demonstration)
+    extent = path_extent(demonstration)
+    print(f"fitted a DMP on {args.demo}: T = {dmp.n_steps_} samples, D = {dmp.n_dims_}")
+    print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
+    print(f"  reproduction RMSE {error:.4g} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
+    print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after T steps")
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _cmd_rollout(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .io import load_model, save_trajectory
+
+    model = load_model(args.model)
+    trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
+    times = np.arange(trajectory.shape[0]) * model.dt_ * model.tau
+    path = save_trajectory(args.output, trajectory, times=times if args.output.lower().endswith(".csv") else None)
+    goal = model.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
+    print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")
+    print(f"  end point {np.array2string(trajectory[-1], precision=4)}, distance to goal {np.linalg.norm(trajectory[-1] - goal):.4g}")
+    print(f"wrote {path}")
+    if args.plot:
+        from .plotting import plot_trajectories
+
+        reference = model.rollout()
+        figure = plot_trajectories(args.plot, reference, [trajectory], ["rollout"], goals=goal[None], title="DMP rollout")
+        print(f"wrote {figure}")
+    return EXIT_OK
+
+
+def _cmd_lasa(args: argparse.Namespace) -> int:
+    from .datasets import lasa, lasa_names
+
+    if args.lasa_command == "list":
+        for name in lasa_names():
+            print(name)
+        return EXIT_OK
+    from .io import save_trajectory
+
+    demos = lasa(args.name)
+    if not 0 <= args.demo < demos.shape[0]:
+        raise ValueError(f"--demo must be 0-{demos.shape[0] - 1}, got {args.demo}")
+    path = save_trajectory(args.output, demos[args.demo])
+    print(f"wrote {args.name} demonstration {args.demo} ({demos.shape[1]} x {demos.shape[2]}) to {path}")
+    return EXIT_OK
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .evaluation import lasa_generalisation
+    from .io import atomic_write
+    from .plotting import plot_generalisation
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    result = lasa_generalisation(args.shape)
+    summary = result.to_dict()
+    print(f"bidmp demo: one LASA '{result.shape}' demonstration ({summary['n_samples']} samples, 2-D), DMP with defaults")
+    print(f"  reproduction RMSE {summary['reproduction_rmse']:.3f} mm = {summary['reproduction_rmse_percent']:.2f} % of the extent")
+    print(f"  end-point gain c = {result.endpoint_gain:.4f} after T steps, {result.endpoint_gain_converged:.2e} after "
+          f"{summary['n_steps_converged']} steps")
+    print(f"  end-point error at the demonstrated goal after T steps: e0 = {result.goal_error:.3f} mm")
+    print()
+    rows = [
+        [str(i + 1), f"{shift:.2f}", f"{fixed:.3f}", f"{result.endpoint_gain * shift:.3f}", f"{conv:.2e}"]
+        for i, (shift, fixed, conv) in enumerate(zip(result.goal_shifts, result.errors_fixed, result.errors_converged))
+    ]
+    _print_table(["goal", "shift [mm]", "error, T steps", "c * shift", f"error, {summary['n_steps_converged']} steps"], rows)
+    print()
+    print("Stopped after the demonstration's T steps (the paper's protocol), a DMP misses a moved goal by")
+    print("c * shift on top of e0 (the error vector is e0 + (B - 1) * shift, exactly); run to convergence it")
+    print("reaches every goal.")
+    with atomic_write(out / "results.json", "w") as handle:
+        json.dump(summary, handle, indent=2)
+    figure = plot_generalisation(out / "lasa_generalisation.png", result)
+    print(f"wrote {out / 'results.json'} and {figure}")
+    return EXIT_OK
+
+
+# ---------------------------------------------------------------------------------------------
+# Parser
+# ---------------------------------------------------------------------------------------------
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="bidmp",
+        description="Learn robot movements from one demonstration: DMP, extended demonstrations, Bi-DMP.",
+        epilog="Trajectory files are .csv (optional header x,y[,z] or t,x,y[,z]) or .npy of shape (T, D).",
+    )
+    parser.add_argument("--version", action="version", version=f"bidmp {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logging")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+
+    fit = commands.add_parser("fit", help="learn a DMP from a demonstration", description="Learn a DMP from one demonstration and save it as a model file (.npz).")
+    fit.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy)")
+    fit.add_argument("-o", "--output", required=True, metavar="MODEL", help="model file to write (.npz)")
+    fit.add_argument("--n-kernels", type=int, default=50, help="kernels per dimension (default 50)")
+    fit.add_argument("--alpha", type=float, default=25.0, help="spring-damper gain alpha (default 25)")
+    fit.add_argument("--beta", type=float, default=None, help="spring ratio beta (default alpha/4)")
+    fit.add_argument("--K", type=_parse_K, default="paper", help="forcing gain: paper (K=alpha), pastor (K=alpha*beta) or a number")
+    fit.add_argument("--alpha-phase", type=float, default=1.0, help="phase decay alpha_phase (default 1)")
+    fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling tau (default 1)")
+    fit.add_argument("--fit", choices=("lwr", "ridge"), default="lwr", help="weight regression (default lwr)")
+    fit.set_defaults(handler=_cmd_fit)
+
+    rollout = commands.add_parser("rollout", help="generate a trajectory from a model", description="Roll a saved model out to a goal and write the trajectory.")
+    rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit'")
+    rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates (default: the demonstrated goal)")
+    rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
+    rollout.add_argument("--n-steps", type=int, default=None, help="number of samples (default: the demonstration's T)")
+    rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy)")
+    rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
+    rollout.set_defaults(handler=_cmd_rollout)
+
+    lasa = commands.add_parser("lasa", help="the bundled LASA handwriting data", description="List or export the LASA handwriting shapes.")
+    lasa_commands = lasa.add_subparsers(dest="lasa_command", metavar="{list,export}", required=True, parser_class=_Parser)
+    lasa_commands.add_parser("list", help="list the shape names")
+    export = lasa_commands.add_parser("export", help="write one demonstration of a shape")
+    export.add_argument("name", metavar="NAME", help="shape name, e.g. Sshape")
+    export.add_argument("--demo", type=int, default=0, help="which of the 7 demonstrations (0-6, default 0)")
+    export.add_argument("-o", "--output", required=True, metavar="OUT", help="file to write (.csv or .npy)")
+    lasa.set_defaults(handler=_cmd_lasa)
+
+    demo = commands.add_parser("demo", help="run the built-in example", description="Fit a DMP to a LASA shape, generalise it to moved goals, print the errors and write results.json and a figure.")
+    demo.add_argument("--shape", default="Sshape", help="LASA shape (default Sshape)")
+    demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    demo.set_defaults(handler=_cmd_demo)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; return the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    if args.command is None:
+        parser.print_help()
+        return EXIT_BAD_INPUT
+    try:
+        return args.handler(args)
+    except (ValueError, TypeError, OSError) as exc:
+        if args.debug:
+            raise
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"bidmp {args.command}: error: {message}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("bidmp: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - the CLI promises no tracebacks
+        if args.debug:
+            raise
+        print(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())

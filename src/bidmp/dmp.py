@@ -1,0 +1,519 @@
+"""Discrete Dynamic Movement Primitive (SPEC §1, paper Eq. 10–14).
+
+Transformation system (Pastor/Park form, no ``(g - y0)`` factor on the forcing term)::
+
+    tau² ÿ = alpha (beta (g - y) - tau ẏ) + K f(phase) - K phase (g - y0)
+    tau phase' = -alpha_phase phase,  phase(0) = 1
+    f(phase) = phase · Σ_i w_i ψ_i(phase) / Σ_i ψ_i(phase),  ψ_i = exp(-h_i (phase - c_i)²)
+
+It is integrated with explicit Euler on the grid ``dt = 1/T`` for exactly ``T`` steps (the
+paper's protocol), with ``z = tau ẏ``::
+
+    z[l+1] = z[l] + dt/tau · (alpha (beta (g - y[l]) - z[l]) + u[l]),   y[l+1] = y[l] + dt/tau · z[l]
+
+For ``tau = 1`` this is SPEC Eq. 14 to the letter.
+
+**Why this module is fast.** For fixed weights the rollout is a linear time-invariant system
+driven by ``u[l] = alpha beta g + K f(phase[l]) - K phase[l] (g - y0)``, so the trajectory is
+affine in the goal and the start::
+
+    y(g, y0) = a + B g + C y0        (a: (n, D);  B, C: (n,), the same for every dimension)
+
+Eliminating ``z`` turns the two Euler updates into one second-order recursion in ``y``, which
+:func:`scipy.signal.lfilter` integrates in C for all dimensions and the three unit responses at
+once. Rollouts to many goals then cost one integration plus an outer product
+(:meth:`DMP.rollout_many`).
+
+**Why a plain DMP misses far goals.** After a finite horizon the phase is still ``≈ e⁻¹``, the
+system has not converged, and the end point misses a shifted goal ``g'`` by exactly
+``c · ‖g' - g‖`` with ``c = |1 - B[-1]|`` depending only on ``(alpha, K, alpha_phase, tau, T)``
+(:meth:`DMP.endpoint_gain`). Run longer (``rollout(n_steps=...)``) or raise ``alpha_phase`` and
+``c → 0``.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from scipy.signal import lfilter
+
+from ._checks import (
+    as_point,
+    as_points,
+    as_trajectory,
+    check_choice,
+    check_fitted,
+    check_int,
+    check_real,
+)
+
+__all__ = [
+    "DMP",
+    "phase_grid",
+    "kernel_centres",
+    "kernel_widths",
+    "basis_functions",
+    "forcing_target",
+]
+
+logger = logging.getLogger(__name__)
+
+_K_CHOICES = ("paper", "pastor")
+_FIT_CHOICES = ("lwr", "ridge")
+_DERIVATIVE_CHOICES = ("gradient", "forward")
+_WIDTH_CHOICES = ("spacing", "pydmps")
+
+
+# ---------------------------------------------------------------------------------------------
+# Pure functions: phase, kernels, forcing target, integration
+# ---------------------------------------------------------------------------------------------
+def _phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
+    """Per-step factor of the Euler-discretised canonical system (Eq. 13)."""
+    decay = 1.0 - alpha_phase * dt / tau
+    if not 0.0 < decay < 1.0:
+        raise ValueError(
+            f"alpha_phase * dt / tau must lie in (0, 1) for a decaying phase, got "
+            f"{alpha_phase * dt / tau:g} (alpha_phase={alpha_phase:g}, dt={dt:g}, tau={tau:g})"
+        )
+    return decay
+
+
+def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
+    """Phase at every step, ``phase[l] = (1 - alpha_phase dt / tau) ** l`` (shape ``(n_steps,)``)."""
+    return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
+
+
+def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
+    """Kernel centres at the phase of ``n_kernels`` equally spaced times over the horizon.
+
+    They span exactly the visited phase range ``[phase[n_steps - 1], 1]``: a centre outside it
+    belongs to a kernel that never fires, and its LWR weight blows up.
+    """
+    steps = np.linspace(0.0, n_steps - 1, n_kernels)
+    return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
+
+
+def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing") -> np.ndarray:
+    """Kernel widths ``h_i`` of ``ψ_i = exp(-h_i (phase - c_i)²)``.
+
+    ``"spacing"`` (default): ``h_i = 1 / (c_{i+1} - c_i)²``, so neighbouring kernels overlap at
+    ``e⁻¹``; LWR then reproduces LASA shapes to < 1 % of their extent.
+    ``"pydmps"``: ``h_i = N^1.5 / (c_i alpha_phase)`` (SPEC §1 as printed, the pydmps convention);
+    neighbours overlap at ≈ 0.9 and LWR smooths the forcing term noticeably (2–5 % on LASA).
+    """
+    n_kernels = len(centres)
+    if method == "pydmps":
+        return n_kernels**1.5 / (centres * alpha_phase)
+    if n_kernels == 1:
+        return np.ones(1)  # a single normalised kernel is constant whatever its width
+    spacing = np.abs(np.diff(centres))
+    spacing = np.append(spacing, spacing[-1])
+    return 1.0 / spacing**2
+
+
+def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+    """The DMP basis rows ``phi(phase) = phase · ψ(phase) / Σ ψ(phase)``.
+
+    Parameters
+    ----------
+    phase : array, shape (L,)
+    centres, widths : array, shape (N,)
+
+    Returns
+    -------
+    phi : array, shape (L, N)
+        Each row sums to its phase. The normalisation is a softmax of ``-h (phase - c)²``,
+        computed after subtracting the row maximum, so it never underflows to 0/0 however far
+        the phase is from the centres.
+    """
+    phase = np.asarray(phase, dtype=np.float64).reshape(-1)
+    log_psi = -widths * (phase[:, None] - centres) ** 2
+    log_psi -= log_psi.max(axis=1, keepdims=True)
+    psi = np.exp(log_psi)
+    psi /= psi.sum(axis=1, keepdims=True)
+    return psi * phase[:, None]
+
+
+def _derivatives(y: np.ndarray, dt: float, method: str) -> tuple[np.ndarray, np.ndarray]:
+    if method == "gradient":
+        velocity = np.gradient(y, dt, axis=0)
+        return velocity, np.gradient(velocity, dt, axis=0)
+    # Forward differences: exactly the quantities the explicit Euler rollout integrates, padded
+    # at the end by holding the last value (the rollout never reads the last two entries).
+    velocity = np.empty_like(y)
+    velocity[:-1] = np.diff(y, axis=0) / dt
+    velocity[-1] = velocity[-2]
+    acceleration = np.empty_like(y)
+    acceleration[:-1] = np.diff(velocity, axis=0) / dt
+    acceleration[-1] = acceleration[-2]
+    return velocity, acceleration
+
+
+def forcing_target(
+    y: np.ndarray,
+    phase: np.ndarray,
+    *,
+    dt: float,
+    tau: float,
+    alpha: float,
+    beta: float,
+    K: float,
+    derivatives: str = "gradient",
+) -> np.ndarray:
+    """The forcing term that makes Eq. 10 reproduce ``y`` (SPEC §1, "forcing target").
+
+    ``f*[l] = (tau² ÿ[l] - alpha (beta (g - y[l]) - tau ẏ[l])) / K + phase[l] (g - y0)`` with
+    ``g = y[-1]`` and ``y0 = y[0]``.
+
+    Parameters
+    ----------
+    y : array, shape (T, D)
+        Demonstration (positions, any length unit).
+    phase : array, shape (T,)
+        Phase at each sample.
+    dt : float
+        Time step of ``y`` in seconds.
+    derivatives : {"gradient", "forward"}
+        ``np.gradient`` (central differences) or forward differences.
+
+    Returns
+    -------
+    f_target : array, shape (T, D)
+    """
+    velocity, acceleration = _derivatives(y, dt, derivatives)
+    start, goal = y[0], y[-1]
+    spring = alpha * (beta * (goal - y) - tau * velocity)
+    return (tau**2 * acceleration - spring) / K + phase[:, None] * (goal - start)
+
+
+def _euler_unit_responses(
+    drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, *, h: float, alpha: float, beta: float
+) -> np.ndarray:
+    """Integrate the Euler-discretised spring-damper for several input signals at once.
+
+    With ``z = (y[n+1] - y[n]) / h`` the two Euler updates become
+    ``y[n+2] = (2 - h alpha) y[n+1] - (1 - h alpha + h² alpha beta) y[n] + h² u[n]``, an IIR filter
+    that :func:`scipy.signal.lfilter` runs in C.
+
+    Parameters
+    ----------
+    drives : array, shape (S, n - 2)
+        Input ``u[n]`` of each signal for ``n = 0 … n-3``.
+    y_first, y_second : array, shape (S,)
+        ``y[0]`` and ``y[1]`` of each signal.
+
+    Returns
+    -------
+    y : array, shape (S, n)
+    """
+    n_signals = drives.shape[0]
+    out = np.empty((n_signals, drives.shape[1] + 2))
+    out[:, 0] = y_first
+    out[:, 1] = y_second
+    if drives.shape[1] == 0:
+        return out
+    a1 = -(2.0 - h * alpha)
+    a2 = 1.0 - h * alpha + h * h * alpha * beta
+    # Initial state of lfilter's transposed direct form II for past outputs y[1], y[0].
+    zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
+    out[:, 2:], _ = lfilter([h * h, 0.0, 0.0], [1.0, a1, a2], drives, axis=1, zi=zi)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# The estimator
+# ---------------------------------------------------------------------------------------------
+class DMP:
+    """Discrete DMP learned from one demonstration (SPEC §1).
+
+    Parameters
+    ----------
+    n_kernels : int, default 50
+        Number of Gaussian kernels ``N_k`` per dimension.
+    alpha : float, default 25
+        Spring-damper gain ``alpha`` (1/s).
+    beta : float or None, default None
+        Spring gain ratio; ``None`` means ``alpha / 4`` (critical damping).
+    K : {"paper", "pastor"} or float, default "paper"
+        Forcing-term gain: ``"paper"`` is ``K = alpha``; ``"pastor"`` is ``K = alpha beta`` (Pastor
+        2009, movement_primitives' ``smooth_scaling``), which starts with zero acceleration when
+        ``f ≡ 0``; a number sets ``K`` directly.
+    alpha_phase : float, default 1
+        Canonical-system decay ``alpha_phase`` (1/s).
+    tau : float, default 1
+        Temporal scaling (s); larger is slower.
+    fit : {"lwr", "ridge"}, default "lwr"
+        Locally weighted regression per kernel (paper) or global ridge least squares. Stored as
+        ``fit_method`` because ``fit`` is the method.
+    derivatives : {"gradient", "forward"}, default "gradient"
+        How the demonstration is differentiated for the forcing target.
+    ridge : float, default 1e-8
+        Ridge regulariser for ``fit="ridge"``, relative to the mean diagonal of ``ΦᵀΦ``.
+    widths : {"spacing", "pydmps"}, default "spacing"
+        Kernel-width rule, see :func:`kernel_widths`.
+
+    Attributes
+    ----------
+    weights_ : array, shape (n_kernels, D)
+    start_, goal_ : array, shape (D,)
+        First and last point of the demonstration.
+    n_steps_ : int
+        Length T of the demonstration = default rollout length.
+    dt_ : float
+        ``1 / T`` (s).
+    centres_, widths_ : array, shape (n_kernels,)
+        Kernel centres (phase) and widths.
+    """
+
+    def __init__(
+        self,
+        n_kernels: int = 50,
+        alpha: float = 25.0,
+        beta: float | None = None,
+        K: str | float = "paper",
+        alpha_phase: float = 1.0,
+        tau: float = 1.0,
+        fit: str = "lwr",
+        derivatives: str = "gradient",
+        ridge: float = 1e-8,
+        widths: str = "spacing",
+    ) -> None:
+        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=1)
+        self.alpha = check_real(alpha, "alpha", positive=True)
+        self.beta = None if beta is None else check_real(beta, "beta", positive=True)
+        if isinstance(K, str):
+            check_choice(K, "K", _K_CHOICES)
+        else:
+            K = check_real(K, "K", positive=True)
+        self.K = K
+        self.alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True)
+        self.tau = check_real(tau, "tau", positive=True)
+        self.fit_method = check_choice(fit, "fit", _FIT_CHOICES)
+        self.derivatives = check_choice(derivatives, "derivatives", _DERIVATIVE_CHOICES)
+        self.ridge = check_real(ridge, "ridge", nonnegative=True)
+        self.widths = check_choice(widths, "widths", _WIDTH_CHOICES)
+        self.weights_: np.ndarray | None = None
+
+    # -- parameters ----------------------------------------------------------------------------
+    def get_params(self) -> dict:
+        """Constructor parameters (JSON-serialisable), as accepted by ``DMP(**params)``."""
+        return {
+            "n_kernels": self.n_kernels,
+            "alpha": self.alpha,
+            "beta": self.beta,
+            "K": self.K,
+            "alpha_phase": self.alpha_phase,
+            "tau": self.tau,
+            "fit": self.fit_method,
+            "derivatives": self.derivatives,
+            "ridge": self.ridge,
+            "widths": self.widths,
+        }
+
+    @property
+    def beta_value(self) -> float:
+        """The spring gain ratio in use (``alpha / 4`` when ``beta`` is None)."""
+        return self.alpha / 4.0 if self.beta is None else self.beta
+
+    @property
+    def K_value(self) -> float:
+        """The forcing-term gain in use."""
+        if self.K == "paper":
+            return self.alpha
+        if self.K == "pastor":
+            return self.alpha * self.beta_value
+        return float(self.K)
+
+    def __repr__(self) -> str:
+        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        return f"DMP({params})"
+
+    # -- learning ------------------------------------------------------------------------------
+    def fit(self, y) -> "DMP":
+        """Learn the forcing-term weights from one demonstration.
+
+        Parameters
+        ----------
+        y : array-like, shape (T, D)
+            Demonstration sampled uniformly in time, T ≥ 3, any D ≥ 1, any length unit. Its
+            duration is taken as 1 s (``dt = 1/T``, the paper's protocol).
+
+        Returns
+        -------
+        self
+        """
+        y = as_trajectory(y, "y")
+        n_steps = y.shape[0]
+        dt = 1.0 / n_steps
+        phase = phase_grid(n_steps, dt, self.tau, self.alpha_phase)
+        centres = kernel_centres(self.n_kernels, n_steps, dt, self.tau, self.alpha_phase)
+        widths = kernel_widths(centres, self.alpha_phase, self.widths)
+        target = forcing_target(
+            y, phase, dt=dt, tau=self.tau, alpha=self.alpha, beta=self.beta_value, K=self.K_value,
+            derivatives=self.derivatives,
+        )
+        phi = basis_functions(phase, centres, widths)
+        if self.fit_method == "lwr":
+            # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
+            denominator = phi.T @ phase
+            weights = (phi.T @ target) / np.maximum(denominator, np.finfo(float).tiny)[:, None]
+        else:
+            gram = phi.T @ phi
+            reg = self.ridge * max(np.trace(gram) / self.n_kernels, np.finfo(float).tiny)
+            weights = np.linalg.solve(gram + reg * np.eye(self.n_kernels), phi.T @ target)
+        self.weights_ = weights
+        self.start_ = y[0].copy()
+        self.goal_ = y[-1].copy()
+        self.n_steps_ = n_steps
+        self.dt_ = dt
+        self.centres_ = centres
+        self.widths_ = widths
+        logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
+        return self
+
+    @property
+    def n_dims_(self) -> int:
+        """Number of dimensions D of the learned demonstration."""
+        check_fitted(self, "weights_")
+        return self.weights_.shape[1]
+
+    # -- evaluation ----------------------------------------------------------------------------
+    def phase(self, n_steps: int | None = None) -> np.ndarray:
+        """Phase at each rollout step, shape ``(n_steps,)`` (default ``n_steps_``)."""
+        check_fitted(self, "weights_")
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        return phase_grid(n_steps, self.dt_, self.tau, self.alpha_phase)
+
+    def basis(self, phase) -> np.ndarray:
+        """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
+        check_fitted(self, "weights_")
+        return basis_functions(np.asarray(phase, dtype=np.float64), self.centres_, self.widths_)
+
+    def forcing_term(self, phase) -> np.ndarray:
+        """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
+        return self.basis(phase) @ self.weights_
+
+    def _unit_responses(self, n_steps: int, forcing: np.ndarray) -> np.ndarray:
+        """Responses that compose every rollout: rows are [a_1 … a_D, B, C, V], shape (D+3, n).
+
+        ``y = a + B g + C y0 + V v0`` where ``a`` is driven by ``K f`` from rest at 0, ``B`` by the
+        goal's share of the input, ``C`` by the start's (with ``y[0] = y[1] = 1``), and ``V`` is
+        the free response to a unit start velocity (``y[1] = dt``).
+        """
+        alpha, beta, K = self.alpha, self.beta_value, self.K_value
+        h = self.dt_ / self.tau
+        phase = self.phase(n_steps)[: max(n_steps - 2, 0)]
+        n_dims = forcing.shape[1]
+        drives = np.empty((n_dims + 3, phase.shape[0]))
+        drives[:n_dims] = K * forcing[: phase.shape[0]].T
+        drives[n_dims] = alpha * beta - K * phase
+        drives[n_dims + 1] = K * phase
+        drives[n_dims + 2] = 0.0
+        y_first = np.zeros(n_dims + 3)
+        y_second = np.zeros(n_dims + 3)
+        y_first[n_dims + 1] = y_second[n_dims + 1] = 1.0
+        y_second[n_dims + 2] = self.dt_
+        return _euler_unit_responses(drives, y_first, y_second, h=h, alpha=alpha, beta=beta)
+
+    def _prepare(self, start, start_velocity, n_steps):
+        check_fitted(self, "weights_")
+        n_dims = self.n_dims_
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        start = self.start_ if start is None else as_point(start, n_dims, "start")
+        velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        forcing = self.forcing_term(self.phase(n_steps))
+        responses = self._unit_responses(n_steps, forcing)
+        free = responses[:n_dims].T + np.outer(responses[n_dims + 1], start) + np.outer(responses[n_dims + 2], velocity)
+        return free, responses[n_dims]
+
+    def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None) -> np.ndarray:
+        """Generate a trajectory (explicit Euler, Eq. 14).
+
+        Parameters
+        ----------
+        goal : array-like, shape (D,), optional
+            Goal position; default the demonstration's last point.
+        start : array-like, shape (D,), optional
+            Start position; default the demonstration's first point.
+        n_steps : int, optional
+            Number of samples, including the start; default ``n_steps_`` (the paper's fixed
+            horizon: the phase ends at ≈ e⁻¹). Use more steps to let the system converge.
+        start_velocity : array-like, shape (D,), optional
+            Initial velocity (units/s); default at rest.
+
+        Returns
+        -------
+        y : array, shape (n_steps, D)
+        """
+        free, goal_response = self._prepare(start, start_velocity, n_steps)
+        goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+        return free + np.outer(goal_response, goal)
+
+    def rollout_many(self, goals, start=None, n_steps: int | None = None, start_velocity=None) -> np.ndarray:
+        """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
+
+        Parameters
+        ----------
+        goals : array-like, shape (G, D)
+        start, n_steps, start_velocity
+            As in :meth:`rollout`, shared by every goal.
+
+        Returns
+        -------
+        y : array, shape (G, n_steps, D)
+            ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding.
+        """
+        free, goal_response = self._prepare(start, start_velocity, n_steps)
+        goals = as_points(goals, free.shape[1], "goals")
+        out = np.multiply(goal_response[None, :, None], goals[:, None, :])
+        out += free[None]
+        return out
+
+    def endpoint_gain(self, n_steps: int | None = None) -> float:
+        """End-point gain ``c``: the final error for a shifted goal is ``c · ‖g' - g‖``.
+
+        ``c = |1 - B[n_steps - 1]|`` where ``B`` is the goal's share of the affine rollout; it
+        depends only on ``(alpha, K, alpha_phase, tau, T, n_steps)``, not on the weights. With the
+        paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0153); run to
+        convergence and it tends to 0.
+        """
+        check_fitted(self, "weights_")
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        goal_response = self._unit_responses(n_steps, np.zeros((n_steps, 0)))[0]
+        return float(abs(1.0 - goal_response[-1]))
+
+    # -- persistence (used by bidmp.io) --------------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        check_fitted(self, "weights_")
+        arrays = {
+            "weights_": self.weights_,
+            "start_": self.start_,
+            "goal_": self.goal_,
+            "centres_": self.centres_,
+            "widths_": self.widths_,
+        }
+        return {"params": self.get_params(), "n_steps_": self.n_steps_}, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays: dict) -> "DMP":
+        model = cls(**meta["params"])
+        n_steps = check_int(meta["n_steps_"], "n_steps_", minimum=3)
+        weights = np.asarray(arrays["weights_"], dtype=np.float64)
+        if weights.ndim != 2 or weights.shape[0] != model.n_kernels:
+            raise ValueError(f"weights_ has shape {weights.shape}, expected ({model.n_kernels}, D)")
+        n_dims = weights.shape[1]
+        for name in ("start_", "goal_"):
+            if np.shape(arrays[name]) != (n_dims,):
+                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({n_dims},)")
+        for name in ("centres_", "widths_"):
+            if np.shape(arrays[name]) != (model.n_kernels,):
+                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({model.n_kernels},)")
+        model.weights_ = weights
+        model.start_ = np.asarray(arrays["start_"], dtype=np.float64)
+        model.goal_ = np.asarray(arrays["goal_"], dtype=np.float64)
+        model.centres_ = np.asarray(arrays["centres_"], dtype=np.float64)
+        model.widths_ = np.asarray(arrays["widths_"], dtype=np.float64)
+        model.n_steps_ = n_steps
+        model.dt_ = 1.0 / n_steps
+        return model

@@ -1,0 +1,129 @@
+"""Evaluation of learned skills: metrics and worked examples.
+
+For now this holds the LASA fit-and-generalise example behind ``bidmp demo``; the battery
+scenarios of SPEC §9 build on it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .datasets import lasa
+from .dmp import DMP
+
+__all__ = ["rmse", "path_extent", "GeneralisationResult", "lasa_generalisation"]
+
+
+def rmse(a: np.ndarray, b: np.ndarray) -> float:
+    """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if a.shape != b.shape:
+        raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
+    return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
+
+
+def path_extent(y: np.ndarray) -> float:
+    """Diagonal of the axis-aligned bounding box of a trajectory (same unit as ``y``)."""
+    return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=float), axis=0)))
+
+
+@dataclass
+class GeneralisationResult:
+    """Outcome of :func:`lasa_generalisation` (lengths in the data set's unit, mm)."""
+
+    shape: str
+    demonstration: np.ndarray  # (T, D)
+    reproduction: np.ndarray  # (T, D)
+    goals: np.ndarray  # (G, D)
+    fixed_horizon: np.ndarray  # (G, T, D): the paper's protocol, T steps
+    converged: np.ndarray  # (G, n_converged, D)
+    endpoint_gain: float
+    endpoint_gain_converged: float
+    dmp_params: dict = field(default_factory=dict)
+
+    @property
+    def extent(self) -> float:
+        return path_extent(self.demonstration)
+
+    @property
+    def reproduction_rmse(self) -> float:
+        return rmse(self.reproduction, self.demonstration)
+
+    @property
+    def goal_shifts(self) -> np.ndarray:
+        return np.linalg.norm(self.goals - self.demonstration[-1], axis=1)
+
+    @property
+    def goal_error(self) -> float:
+        """End-point error of the reproduction at the demonstrated goal (T steps)."""
+        return float(np.linalg.norm(self.reproduction[-1] - self.demonstration[-1]))
+
+    @property
+    def errors_fixed(self) -> np.ndarray:
+        return np.linalg.norm(self.fixed_horizon[:, -1] - self.goals, axis=1)
+
+    @property
+    def errors_converged(self) -> np.ndarray:
+        return np.linalg.norm(self.converged[:, -1] - self.goals, axis=1)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary."""
+        return {
+            "shape": self.shape,
+            "dmp": self.dmp_params,
+            "n_samples": int(self.demonstration.shape[0]),
+            "extent": self.extent,
+            "reproduction_rmse": self.reproduction_rmse,
+            "reproduction_rmse_percent": 100.0 * self.reproduction_rmse / self.extent,
+            "endpoint_gain": self.endpoint_gain,
+            "endpoint_gain_converged": self.endpoint_gain_converged,
+            "n_steps_converged": int(self.converged.shape[1]),
+            "goal_error": self.goal_error,
+            "goals": self.goals.tolist(),
+            "goal_shifts": self.goal_shifts.tolist(),
+            "endpoint_errors_fixed_horizon": self.errors_fixed.tolist(),
+            "endpoint_errors_converged": self.errors_converged.tolist(),
+        }
+
+
+def lasa_generalisation(
+    name: str = "Sshape",
+    *,
+    demo_index: int = 0,
+    n_goals: int = 6,
+    shift: float = 0.3,
+    convergence_factor: int = 10,
+    **dmp_params,
+) -> GeneralisationResult:
+    """Fit a DMP to one LASA demonstration and roll it out to shifted goals.
+
+    The goals lie on a circle of radius ``shift × extent`` around the demonstrated goal. Each is
+    reached twice: with the paper's fixed horizon (T steps; the end-point error is
+    ``endpoint_gain · shift``) and run ``convergence_factor`` times longer (error → 0).
+    """
+    if not 0 <= demo_index < 7:
+        raise ValueError(f"demo_index must be 0-6 (LASA has 7 demonstrations per shape), got {demo_index}")
+    if n_goals < 1:
+        raise ValueError(f"n_goals must be >= 1, got {n_goals}")
+    if convergence_factor < 1:
+        raise ValueError(f"convergence_factor must be >= 1, got {convergence_factor}")
+    demonstration = lasa(name)[demo_index]
+    dmp = DMP(**dmp_params).fit(demonstration)
+    angles = np.linspace(0.0, 2.0 * np.pi, n_goals, endpoint=False)
+    radius = shift * path_extent(demonstration)
+    goals = demonstration[-1] + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    n_converged = convergence_factor * dmp.n_steps_
+    return GeneralisationResult(
+        shape=name,
+        demonstration=demonstration,
+        reproduction=dmp.rollout(),
+        goals=goals,
+        fixed_horizon=dmp.rollout_many(goals),
+        converged=dmp.rollout_many(goals, n_steps=n_converged),
+        endpoint_gain=dmp.endpoint_gain(),
+        endpoint_gain_converged=dmp.endpoint_gain(n_converged),
+        dmp_params=dmp.get_params(),
+    )
