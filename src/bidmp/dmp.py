@@ -414,7 +414,7 @@ class DMP:
         y_second = np.zeros(n_dims + 3)
         y_first[n_dims + 1] = y_second[n_dims + 1] = 1.0
         y_second[n_dims + 2] = self.dt_
-        return _euler_unit_responses(drives, y_first, y_second, h=h, alpha=alpha, beta=beta)
+        return _euler_unit_responses(drives, y_first, y_second, h=h, alpha=alpha, beta=beta)[:, :n_steps]
 
     def _prepare(self, start, start_velocity, n_steps):
         check_fitted(self, "weights_")

@@ -136,9 +136,10 @@ def load_model(path: str | os.PathLike):
     if not path.is_file():
         raise ModelFileError(f"model file {path} does not exist")
     try:
-        with np.load(path, allow_pickle=False) as archive:
-            if not isinstance(archive, np.lib.npyio.NpzFile):
-                raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
+        archive = np.load(path, allow_pickle=False)
+        if not isinstance(archive, np.lib.npyio.NpzFile):
+            raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
+        with archive:
             if _META_KEY not in archive.files:
                 raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
             meta = json.loads(archive[_META_KEY].tobytes().decode("utf-8"))

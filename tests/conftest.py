@@ -1,0 +1,32 @@
+"""Shared fixtures: smooth demonstrations that start and end at rest."""
+
+import numpy as np
+import pytest
+
+
+def minimum_jerk(start, end, n_steps):
+    """Minimum-jerk straight line from start to end (rest to rest), shape (n_steps, D)."""
+    s = np.linspace(0.0, 1.0, n_steps)[:, None]
+    blend = 10 * s**3 - 15 * s**4 + 6 * s**5
+    return np.asarray(start, float) + blend * (np.asarray(end, float) - np.asarray(start, float))
+
+
+def curved_demo(n_steps=300, n_dims=3, seed=0):
+    """A curved rest-to-rest demonstration: a minimum-jerk line plus a smooth bump per axis."""
+    rng = np.random.default_rng(seed)
+    start = rng.uniform(-1, 1, n_dims)
+    end = rng.uniform(-1, 1, n_dims)
+    line = minimum_jerk(start, end, n_steps)
+    s = np.linspace(0.0, 1.0, n_steps)[:, None]
+    bump = np.sin(np.pi * s) ** 4 * np.sin(2 * np.pi * s * rng.uniform(0.5, 1.5, n_dims))
+    return line + 0.4 * bump
+
+
+@pytest.fixture
+def demo3d():
+    return curved_demo(300, 3)
+
+
+@pytest.fixture
+def demo2d():
+    return curved_demo(400, 2, seed=1)

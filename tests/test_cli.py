@@ -1,0 +1,125 @@
+"""The bidmp command line: happy paths end to end, and one-line errors with exit code 2."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import curved_demo
+
+import bidmp
+from bidmp.cli import main
+from bidmp.io import load_trajectory, save_trajectory
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def demo_csv(tmp_path):
+    return save_trajectory(tmp_path / "demo.csv", curved_demo(200, 3))
+
+
+def test_fit_then_rollout_round_trip(tmp_path, demo_csv, capsys):
+    model = tmp_path / "model.npz"
+    code, out, err = run(["fit", str(demo_csv), "-o", str(model), "--alpha", "100"], capsys)
+    assert code == 0 and err == ""
+    assert "T = 200" in out and "end-point gain" in out and model.is_file()
+    dmp = bidmp.load(model)
+    assert dmp.alpha == 100.0
+
+    goal = [0.5, -0.25, 1.0]
+    out_csv = tmp_path / "out.csv"
+    code, out, err = run(["rollout", str(model), "--goal", *map(str, goal), "-o", str(out_csv), "--plot", str(tmp_path / "r.png")], capsys)
+    assert code == 0, err
+    np.testing.assert_allclose(load_trajectory(out_csv), dmp.rollout(goal=goal), rtol=1e-12, atol=1e-12)
+    assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+    code, _, _ = run(["rollout", str(model), "-o", str(tmp_path / "out.npy"), "--n-steps", "600"], capsys)
+    assert code == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "out.npy"), dmp.rollout(n_steps=600))
+
+
+def test_lasa_list_and_export(tmp_path, capsys):
+    code, out, _ = run(["lasa", "list"], capsys)
+    assert code == 0 and len(out.split()) == 30 and "Sshape" in out.split()
+    code, _, _ = run(["lasa", "export", "WShape", "--demo", "2", "-o", str(tmp_path / "w.npy")], capsys)
+    assert code == 0
+    np.testing.assert_array_equal(np.load(tmp_path / "w.npy"), bidmp.datasets.lasa("WShape")[2])
+
+
+def test_demo_prints_a_table_and_writes_results(tmp_path, capsys):
+    code, out, err = run(["demo", "--out", str(tmp_path / "out")], capsys)
+    assert code == 0, err
+    assert "reproduction RMSE" in out and "c * shift" in out
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["shape"] == "Sshape"
+    assert results["reproduction_rmse_percent"] < 1.0
+    # The fixed-horizon error departs from the demonstrated goal's error by exactly c * shift.
+    shifts = np.array(results["goal_shifts"])
+    errors = np.array(results["endpoint_errors_fixed_horizon"])
+    assert np.all(np.abs(errors - results["endpoint_gain"] * shifts) <= results["goal_error"] + 1e-9)
+    assert max(results["endpoint_errors_converged"]) < 0.1 * min(errors)
+    assert (tmp_path / "out" / "lasa_generalisation.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["fit", "{tmp}/missing.csv", "-o", "{tmp}/m.npz"], "does not exist"),
+        (["fit", "{tmp}/bad.csv", "-o", "{tmp}/m.npz"], "line 3: 'oops' is not a number"),
+        (["fit", "{tmp}/nan.csv", "-o", "{tmp}/m.npz"], "contains NaN"),
+        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/m.npz", "--n-kernels", "0"], "n_kernels must be >= 1"),
+        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/no/such/dir/m.npz"], "does not exist"),
+        (["rollout", "{tmp}/corrupt.npz", "-o", "{tmp}/o.csv"], "not a readable bidmp model file"),
+        (["rollout", "{tmp}/model.npz", "--goal", "1", "2", "-o", "{tmp}/o.csv"], "goal must have 3 coordinate"),
+        (["rollout", "{tmp}/model.npz", "-o", "{tmp}/o.txt"], "unsupported file type .txt"),
+        (["lasa", "export", "Banana", "-o", "{tmp}/b.csv"], "unknown LASA shape 'Banana'"),
+        (["lasa", "export", "Sshape", "--demo", "9", "-o", "{tmp}/b.csv"], "--demo must be 0-6"),
+        (["fit", "{tmp}/demo.csv"], "required: -o/--output"),
+        (["rollout", "{tmp}/model.npz", "--goal", "x", "-o", "{tmp}/o.csv"], "invalid float value"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_input_gives_one_line_and_exit_code_2(tmp_path, demo_csv, argv, match, capsys):
+    (tmp_path / "bad.csv").write_text("x,y\n0,0\n1,oops\n2,2\n")
+    (tmp_path / "nan.csv").write_text("x,y\n0,0\nnan,1\n2,2\n")
+    (tmp_path / "corrupt.npz").write_bytes(b"PK\x03\x04 broken")
+    bidmp.save(bidmp.DMP().fit(curved_demo(100, 3)), tmp_path / "model.npz")
+    code = exit_code([arg.format(tmp=tmp_path) for arg in argv])
+    _, err = capsys.readouterr()
+    assert code == 2
+    assert match in err
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err
+
+
+def exit_code(argv):
+    """main()'s return value, or the code argparse exits with on a usage error."""
+    try:
+        return main(argv)
+    except SystemExit as exc:
+        return exc.code
+
+
+def test_real_process_error_has_no_traceback_and_exit_2(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "-m", "bidmp", "fit", str(tmp_path / "none.csv"), "-o", str(tmp_path / "m.npz")],
+        capture_output=True, text=True,
+    )
+    assert result.returncode == 2
+    assert result.stderr.startswith("bidmp fit: error:") and "Traceback" not in result.stderr
+
+
+def test_version_and_help(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert bidmp.__version__ in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["fit", "--help"])
+    assert "--n-kernels" in capsys.readouterr().out

@@ -1,0 +1,295 @@
+"""DMP (SPEC §1): checked against a plain Euler loop, closed-form properties and movement_primitives."""
+
+import numpy as np
+import pytest
+from conftest import curved_demo, minimum_jerk
+
+from bidmp import DMP, NotFittedError
+from bidmp.datasets import lasa
+from bidmp.dmp import basis_functions, forcing_target, kernel_centres, kernel_widths, phase_grid
+
+
+def euler_reference(dmp, goal, start, n_steps, start_velocity=None):
+    """Slow, literal explicit-Euler integration of Eq. 10-11 (independent of the lfilter path)."""
+    goal = np.asarray(goal, float)
+    start = np.asarray(start, float)
+    h = dmp.dt_ / dmp.tau
+    y = start.copy()
+    z = dmp.tau * (np.zeros_like(start) if start_velocity is None else np.asarray(start_velocity, float))
+    phase = 1.0
+    out = []
+    for _ in range(n_steps):
+        out.append(y.copy())
+        exponent = -dmp.widths_ * (phase - dmp.centres_) ** 2
+        psi = np.exp(exponent - exponent.max())  # same ratio, no 0/0 far outside the kernels
+        f = phase * (psi @ dmp.weights_) / psi.sum()
+        acceleration = (
+            dmp.alpha * (dmp.beta_value * (goal - y) - z) + dmp.K_value * f - dmp.K_value * phase * (goal - start)
+        )
+        y, z = y + h * z, z + h * acceleration
+        phase *= 1.0 - dmp.alpha_phase * dmp.dt_ / dmp.tau
+    return np.array(out)
+
+
+def rel_rmse(a, b):
+    return np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1))) / np.linalg.norm(np.ptp(b, axis=0))
+
+
+# --- correctness against an independent integration -----------------------------------------
+@pytest.mark.parametrize(
+    "params",
+    [
+        {},
+        {"K": "pastor"},
+        {"alpha": 100.0, "tau": 1.7},
+        {"alpha": 40.0, "beta": 3.0, "alpha_phase": 3.0, "fit": "ridge"},
+        {"K": 12.5, "n_kernels": 7, "widths": "pydmps"},
+    ],
+)
+def test_rollout_equals_plain_euler_loop(params, demo3d):
+    dmp = DMP(**params).fit(demo3d)
+    rng = np.random.default_rng(3)
+    goal, start, velocity = rng.normal(size=(3, 3))
+    for n_steps in (1, 2, 3, 50, dmp.n_steps_, 3 * dmp.n_steps_):
+        fast = dmp.rollout(goal, start, n_steps=n_steps, start_velocity=velocity)
+        slow = euler_reference(dmp, goal, start, n_steps, velocity)
+        assert fast.shape == (n_steps, 3)
+        np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-9 * (1 + np.abs(slow).max()))
+
+
+def test_default_rollout_starts_at_demo_and_uses_its_goal(demo3d):
+    dmp = DMP().fit(demo3d)
+    y = dmp.rollout()
+    assert y.shape == demo3d.shape
+    np.testing.assert_array_equal(y[0], demo3d[0])
+    np.testing.assert_array_equal(dmp.rollout(goal=demo3d[-1], start=demo3d[0]), y)
+
+
+@pytest.mark.parametrize("name", ["Sshape", "WShape", "NShape", "GShape", "Angle", "heee"])
+def test_lasa_reproduction_below_one_percent(name):
+    demos = lasa(name)
+    # Demonstration 0 of these shapes starts at rest: a rollout from rest reproduces it.
+    assert rel_rmse(DMP().fit(demos[0]).rollout(), demos[0]) < 0.01
+    # Some LASA recordings start in motion; given their first velocity, all seven reproduce.
+    for demo in demos:
+        start_velocity = (demo[1] - demo[0]) * len(demo)
+        assert rel_rmse(DMP().fit(demo).rollout(start_velocity=start_velocity), demo) < 0.01
+
+
+def test_ridge_fit_reproduces_better_than_lwr_on_lasa():
+    demo = lasa("Sshape")[0]
+    lwr = rel_rmse(DMP(fit="lwr").fit(demo).rollout(), demo)
+    ridge = rel_rmse(DMP(fit="ridge").fit(demo).rollout(), demo)
+    assert ridge < lwr < 0.01
+
+
+def test_forward_differences_reproduce_almost_exactly_with_enough_kernels():
+    demo = minimum_jerk([0, 0], [1, 2], 100)
+    dmp = DMP(n_kernels=100, fit="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    assert rel_rmse(dmp.rollout(), demo) < 1e-4
+
+
+def test_works_for_any_dimension():
+    for n_dims in (1, 2, 5):
+        demo = curved_demo(200, n_dims, seed=n_dims)
+        dmp = DMP().fit(demo)
+        assert dmp.rollout().shape == (200, n_dims)
+        assert rel_rmse(dmp.rollout(), demo) < 0.01
+
+
+# --- affine structure, rollout_many, end-point gain -------------------------------------------
+def test_rollout_is_affine_in_goal_and_start(demo2d):
+    dmp = DMP().fit(demo2d)
+    rng = np.random.default_rng(0)
+    g1, g2, s1, s2 = rng.normal(size=(4, 2))
+    lam = 0.3
+    mixed = dmp.rollout(lam * g1 + (1 - lam) * g2, lam * s1 + (1 - lam) * s2)
+    np.testing.assert_allclose(mixed, lam * dmp.rollout(g1, s1) + (1 - lam) * dmp.rollout(g2, s2), atol=1e-12)
+
+
+@pytest.mark.parametrize("n_steps", [None, 37, 2000])
+def test_rollout_many_equals_looped_rollout(demo3d, n_steps):
+    dmp = DMP(alpha=60.0).fit(demo3d)
+    rng = np.random.default_rng(1)
+    goals = rng.normal(scale=2.0, size=(25, 3))
+    start = rng.normal(size=3)
+    many = dmp.rollout_many(goals, start=start, n_steps=n_steps)
+    looped = np.stack([dmp.rollout(g, start, n_steps=n_steps) for g in goals])
+    assert many.shape == looped.shape
+    np.testing.assert_allclose(many, looped, rtol=0, atol=1e-9)
+
+
+def scalar_goal_response(alpha, beta, K, alpha_phase, tau, dt, n_steps):
+    """y[n_steps-1] of the 1-D system with f = 0, y0 = 0, g = 1, integrated by a scalar loop."""
+    y, z, phase = 0.0, 0.0, 1.0
+    h = dt / tau
+    for _ in range(n_steps - 1):
+        acceleration = alpha * (beta * (1.0 - y) - z) - K * phase * 1.0
+        y, z = y + h * z, z + h * acceleration
+        phase *= 1.0 - alpha_phase * dt / tau
+    return y
+
+
+@pytest.mark.parametrize("alpha, K", [(25.0, "paper"), (100.0, "paper"), (25.0, "pastor"), (50.0, 10.0)])
+def test_endpoint_gain_matches_scalar_recursion_and_rollout(alpha, K):
+    demo = curved_demo(200, 3, seed=5)
+    dmp = DMP(alpha=alpha, K=K).fit(demo)
+    c = dmp.endpoint_gain()
+    expected = abs(1.0 - scalar_goal_response(alpha, dmp.beta_value, dmp.K_value, 1.0, 1.0, 1 / 200, 200))
+    assert c == pytest.approx(expected, rel=1e-9)
+    # Measured by rollouts: the change of the final error per unit goal shift.
+    shift = np.array([3.0, -4.0, 12.0])
+    base_error = dmp.rollout()[-1] - dmp.goal_
+    moved_error = dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift)
+    assert np.linalg.norm(moved_error - base_error) / np.linalg.norm(shift) == pytest.approx(c, rel=1e-8)
+
+
+def test_endpoint_gain_spec_values_and_convergence():
+    # SPEC §1: T = 200, alpha_phase = 1, K = alpha: c = 0.0695 at alpha = 25, 0.0153 at alpha = 100.
+    demo = minimum_jerk([0.0], [1.0], 200)
+    assert DMP(alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(0.0695, abs=5e-4)
+    assert DMP(alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(0.0153, abs=2e-4)
+    dmp = DMP(alpha=25.0).fit(demo)
+    gains = [dmp.endpoint_gain(n) for n in (200, 400, 1000, 4000)]
+    assert all(a > b for a, b in zip(gains, gains[1:]))
+    assert gains[-1] < 1e-4
+    # A faster phase (phase(T) ~ 0.01) shrinks c too.
+    assert DMP(alpha=25.0, alpha_phase=4.6).fit(demo).endpoint_gain() < 0.5 * gains[0]
+
+
+def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
+    # Fit with forward differences and many kernels so the demonstrated goal is hit almost exactly.
+    demo = minimum_jerk([0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 200)
+    dmp = DMP(alpha=100.0, n_kernels=200, fit="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    shift = np.array([150.0, 25.0, 0.0])
+    error = np.linalg.norm(dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift))
+    assert error == pytest.approx(dmp.endpoint_gain() * np.linalg.norm(shift), rel=1e-3)
+
+
+# --- kernels and the phase grid ----------------------------------------------------------------
+@pytest.mark.parametrize("n_steps", [3, 4, 10, 57, 1000, 20000])
+def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
+    demo = curved_demo(n_steps, 2, seed=2) if n_steps >= 10 else minimum_jerk([0, 0], [1, 1], n_steps)
+    for fit in ("lwr", "ridge"):
+        dmp = DMP(fit=fit).fit(demo)
+        phase = dmp.phase()
+        assert phase[0] == 1.0 and phase.shape == (n_steps,)
+        assert np.all(dmp.centres_ <= 1.0) and np.all(dmp.centres_ >= phase[-1] - 1e-15)
+        assert np.all(np.isfinite(dmp.weights_))
+        target = forcing_target(demo, phase, dt=dmp.dt_, tau=1.0, alpha=dmp.alpha, beta=dmp.beta_value, K=dmp.K_value)
+        if fit == "lwr":  # each LWR weight is a weighted mean of f*/phase: it cannot exceed their range
+            assert np.abs(dmp.weights_).max() <= np.abs(target / phase[:, None]).max() * (1 + 1e-9)
+        rollout = dmp.rollout(n_steps=50 * n_steps)
+        assert np.all(np.isfinite(rollout))
+
+
+def test_basis_rows_sum_to_phase_and_never_nan():
+    centres = kernel_centres(50, 1000, 1e-3)
+    widths = kernel_widths(centres)
+    phase = np.array([1.0, 0.5, 0.37, 1e-3, 0.0, 5.0])
+    phi = basis_functions(phase, centres, widths)
+    assert np.all(np.isfinite(phi))
+    np.testing.assert_allclose(phi.sum(axis=1), phase, rtol=1e-12)
+
+
+def test_phase_grid_is_the_euler_canonical_system():
+    np.testing.assert_allclose(phase_grid(5, 0.1, 2.0, 4.0), 0.8 ** np.arange(5))
+    assert phase_grid(200, 1 / 200)[-1] == pytest.approx(np.exp(-1), rel=0.01)
+
+
+def test_pastor_with_zero_weights_starts_with_zero_acceleration():
+    demo = minimum_jerk([0.0, 0.0], [1.0, -2.0], 100)
+    for K, zero_start in (("pastor", True), ("paper", False)):
+        dmp = DMP(K=K).fit(demo)
+        dmp.weights_ = np.zeros_like(dmp.weights_)
+        y = dmp.rollout(goal=[3.0, 4.0])
+        second_difference = y[2] - 2 * y[1] + y[0]  # = h² · acceleration at step 0 (explicit Euler)
+        if zero_start:
+            np.testing.assert_allclose(second_difference, 0.0, atol=1e-15)
+        else:
+            assert np.linalg.norm(second_difference) > 1e-6
+
+
+# --- agreement with movement_primitives ----------------------------------------------------------
+def test_pastor_variant_matches_movement_primitives_smooth_scaling():
+    dmp_module = pytest.importorskip("movement_primitives.dmp")
+    n_steps = 500
+    demo = curved_demo(n_steps, 2, seed=4)
+    times = np.arange(n_steps) / n_steps  # our protocol: dt = 1/T
+    theirs = dmp_module.DMP(
+        n_dims=2, execution_time=times[-1], dt=1 / n_steps, n_weights_per_dim=50, smooth_scaling=True
+    )
+    theirs.imitate(times, demo)
+    # movement_primitives lets the phase decay to 0.01 over the movement; use the same decay.
+    alpha_phase = theirs.forcing_term.alpha_z * times[-1]
+    ours = DMP(K="pastor", alpha_phase=alpha_phase).fit(demo)
+    new_goal = demo[-1] + np.array([0.3, -0.2])
+    theirs.configure(start_y=demo[0], goal_y=new_goal)
+    _, their_path = theirs.open_loop(step_function="euler")
+    # Kernels, phase discretisation and Euler variant differ: same path within 1 % of the extent.
+    assert their_path.shape == (n_steps, 2)
+    assert rel_rmse(ours.rollout(goal=new_goal), their_path) < 0.01
+    # ... while the paper's K = alpha scales goal changes differently: the check can tell them apart.
+    plain = DMP(K="paper", alpha_phase=alpha_phase).fit(demo)
+    assert rel_rmse(plain.rollout(goal=new_goal), their_path) > 2 * rel_rmse(ours.rollout(goal=new_goal), their_path)
+
+
+# --- bad input --------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "y, error, match",
+    [
+        (np.array([[0.0, 0.0], [np.nan, 1.0], [2.0, 2.0]]), ValueError, "NaN.*row 1"),
+        (np.array([[0.0, 0.0], [np.inf, 1.0], [2.0, 2.0]]), ValueError, "inf"),
+        (np.linspace(0, 1, 10), ValueError, r"shape \(T, D\)"),
+        (np.zeros((4, 3, 2)), ValueError, r"shape \(T, D\)"),
+        (np.array([[0.0, 0.0], [1.0, 1.0]]), ValueError, "at least 3 points"),
+        (np.ones((20, 3)), ValueError, "identical"),
+        ([["a", "b"], ["c", "d"], ["e", "f"]], TypeError, "numbers"),
+        ("not an array", TypeError, "string"),
+    ],
+)
+def test_fit_rejects_bad_demonstrations(y, error, match):
+    with pytest.raises(error, match=match):
+        DMP().fit(y)
+
+
+def test_rollout_rejects_bad_goal_start_and_steps(demo3d):
+    dmp = DMP().fit(demo3d)
+    with pytest.raises(ValueError, match="goal must have 3 coordinate"):
+        dmp.rollout(goal=[1.0, 2.0])
+    with pytest.raises(ValueError, match="start must have 3"):
+        dmp.rollout(start=[1.0, 2.0, 3.0, 4.0])
+    with pytest.raises(ValueError, match="goal contains NaN"):
+        dmp.rollout(goal=[1.0, np.nan, 0.0])
+    with pytest.raises(ValueError, match=r"goals must have shape \(G, 3\)"):
+        dmp.rollout_many(np.zeros((5, 2)))
+    with pytest.raises(ValueError, match="n_steps must be >= 1"):
+        dmp.rollout(n_steps=0)
+    with pytest.raises(TypeError, match="n_steps must be an integer"):
+        dmp.rollout(n_steps=2.5)
+
+
+@pytest.mark.parametrize(
+    "params, match",
+    [
+        ({"n_kernels": 0}, "n_kernels must be >= 1"),
+        ({"alpha": -1.0}, "alpha must be > 0"),
+        ({"K": "huge"}, "K must be one of"),
+        ({"fit": "gpr"}, "fit must be one of"),
+        ({"tau": float("nan")}, "tau must be finite"),
+        ({"widths": "wide"}, "widths must be one of"),
+    ],
+)
+def test_bad_parameters_are_named(params, match):
+    with pytest.raises(ValueError, match=match):
+        DMP(**params)
+
+
+def test_too_fast_phase_is_rejected_at_fit():
+    with pytest.raises(ValueError, match="alpha_phase"):
+        DMP(alpha_phase=50.0).fit(minimum_jerk([0.0], [1.0], 10))
+
+
+def test_unfitted_model_says_so():
+    with pytest.raises(NotFittedError, match="not fitted"):
+        DMP().rollout()

@@ -1,0 +1,185 @@
+"""Trajectory files and model files: round trips, atomic writes and every kind of bad file."""
+
+import json
+import zipfile
+
+import numpy as np
+import pytest
+from conftest import curved_demo
+
+import bidmp
+from bidmp import DMP, ModelFileError
+from bidmp.io import FORMAT_VERSION, load_trajectory, save_trajectory
+
+
+@pytest.fixture
+def fitted():
+    return DMP(alpha=40.0, K="pastor", n_kernels=30).fit(curved_demo(250, 3))
+
+
+# --- trajectories ------------------------------------------------------------------------------
+def write(path, text):
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("x,y\n0,0\n1,2\n2,3\n", [[0, 0], [1, 2], [2, 3]]),
+        ("0,0,0\n1,2,3\n2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),  # header-less 3 columns: x,y,z
+        ("t,x,y\n0,0,0\n0.5,1,2\n1,2,3\n", [[0, 0], [1, 2], [2, 3]]),
+        ("time,x,y,z\n0,0,0,0\n1,1,2,3\n2,2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),
+        ("0,0,0,0\n1,1,2,3\n2,2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),  # 4 columns: t,x,y,z
+        ("# recorded by hand\nX;Y\n0;0\n\n1;2\n2;3\n", [[0, 0], [1, 2], [2, 3]]),
+    ],
+)
+def test_csv_variants(tmp_path, text, expected):
+    np.testing.assert_array_equal(load_trajectory(write(tmp_path / "demo.csv", text)), expected)
+
+
+def test_nonuniform_time_is_resampled_to_uniform_steps(tmp_path):
+    times = np.array([0.0, 0.1, 0.5, 0.6, 1.0])
+    positions = np.column_stack([times * 2.0, times**2])
+    save_trajectory(tmp_path / "demo.csv", positions, times=times)
+    y = load_trajectory(tmp_path / "demo.csv")
+    grid = np.linspace(0.0, 1.0, 5)
+    np.testing.assert_allclose(y[:, 0], 2.0 * grid)  # linear in time: exact after resampling
+    np.testing.assert_allclose(y[:, 1], np.interp(grid, times, times**2))
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npy"])
+def test_trajectory_round_trip_is_exact(tmp_path, suffix):
+    y = curved_demo(50, 3)
+    path = save_trajectory(tmp_path / f"traj{suffix}", y)
+    np.testing.assert_array_equal(load_trajectory(path), y)
+
+
+@pytest.mark.parametrize(
+    "name, text, match",
+    [
+        ("empty.csv", "", "empty"),
+        ("header_only.csv", "x,y\n", "no data rows"),
+        ("words.csv", "x,y\n0,0\n1,abc\n2,2\n", "line 3: 'abc' is not a number"),
+        ("ragged.csv", "x,y\n0,0\n1\n2,2\n", "line 3: expected 2 columns"),
+        ("nan.csv", "x,y\n0,0\nnan,1\n2,2\n", "NaN"),
+        ("short.csv", "x,y\n0,0\n1,1\n", "at least 3 points"),
+        ("same.csv", "x,y\n1,1\n1,1\n1,1\n", "identical"),
+        ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b not understood"),
+        ("onecol.csv", "1\n2\n3\n", "expected 2-4 columns"),
+        ("time.csv", "t,x,y\n0,0,0\n0,1,1\n1,2,2\n", "time must increase strictly"),
+        ("demo.json", "{}", "unsupported file type .json"),
+    ],
+)
+def test_bad_trajectory_files(tmp_path, name, text, match):
+    with pytest.raises(ValueError, match=match):
+        load_trajectory(write(tmp_path / name, text))
+
+
+def test_missing_and_bad_npy_files(tmp_path):
+    with pytest.raises(ValueError, match="does not exist"):
+        load_trajectory(tmp_path / "nope.csv")
+    (tmp_path / "junk.npy").write_bytes(b"definitely not numpy")
+    with pytest.raises(ValueError, match="not a readable .npy"):
+        load_trajectory(tmp_path / "junk.npy")
+    np.save(tmp_path / "obj.npy", np.array([{"a": 1}], dtype=object), allow_pickle=True)
+    with pytest.raises(ValueError, match="not a readable .npy"):
+        load_trajectory(tmp_path / "obj.npy")
+    np.save(tmp_path / "flat.npy", np.arange(10.0))
+    with pytest.raises(ValueError, match=r"shape \(T, D\)"):
+        load_trajectory(tmp_path / "flat.npy")
+
+
+# --- model files -----------------------------------------------------------------------------
+def test_save_load_is_bit_exact(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "model.npz")
+    loaded = bidmp.load(path)
+    assert isinstance(loaded, DMP)
+    assert loaded.get_params() == fitted.get_params()
+    for name in ("weights_", "start_", "goal_", "centres_", "widths_"):
+        np.testing.assert_array_equal(getattr(loaded, name), getattr(fitted, name))
+    goals = np.random.default_rng(0).normal(size=(4, 3))
+    np.testing.assert_array_equal(loaded.rollout_many(goals), fitted.rollout_many(goals))
+    assert loaded.endpoint_gain() == fitted.endpoint_gain()
+
+
+def test_suffix_is_added_and_no_temp_files_are_left(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "model")
+    assert path.name == "model.npz"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.npz"]
+
+
+def test_failed_write_keeps_the_old_file(tmp_path, fitted, monkeypatch):
+    path = bidmp.save(fitted, tmp_path / "model.npz")
+    before = path.read_bytes()
+
+    def broken_savez(*args, **kwargs):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(np, "savez", broken_savez)
+    with pytest.raises(OSError, match="disk full"):
+        bidmp.save(DMP().fit(curved_demo(100, 2)), path)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.npz"]
+
+
+def test_file_has_no_pickles_and_versioned_json_metadata(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "model.npz")
+    with np.load(path, allow_pickle=False) as archive:
+        meta = json.loads(archive["__bidmp__"].tobytes())
+        assert all(archive[name].dtype != object for name in archive.files)
+    assert meta["format_version"] == FORMAT_VERSION
+    assert meta["class"] == "DMP"
+    assert meta["state"]["params"]["K"] == "pastor"
+
+
+def rewrite_meta(path, change):
+    with np.load(path, allow_pickle=False) as archive:
+        arrays = {name: archive[name] for name in archive.files}
+    meta = json.loads(arrays["__bidmp__"].tobytes())
+    change(meta, arrays)
+    arrays["__bidmp__"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    np.savez(path, **arrays)
+
+
+@pytest.mark.parametrize(
+    "corrupt, match",
+    [
+        (lambda p: p.write_bytes(b"\x00garbage" * 50), "not a readable bidmp model file"),
+        (lambda p: p.write_bytes(p.read_bytes()[: len(p.read_bytes()) // 2]), "not a readable bidmp model file"),
+        (lambda p: np.savez(p, weights=np.ones(3)), "without bidmp metadata"),
+        (lambda p: np.save(p.with_suffix(".npy"), np.ones(3)) or p.with_suffix(".npy").rename(p), "plain .npy"),
+        (lambda p: rewrite_meta(p, lambda m, a: m.update(format_version=FORMAT_VERSION + 1)), "newer|upgrade bidmp"),
+        (lambda p: rewrite_meta(p, lambda m, a: m.update(format="something-else")), "unknown metadata format"),
+        (lambda p: rewrite_meta(p, lambda m, a: m.update({"class": "Pickle"})), "unknown model class 'Pickle'"),
+        (lambda p: rewrite_meta(p, lambda m, a: a.pop("weights_")), "corrupt"),
+        (lambda p: rewrite_meta(p, lambda m, a: a.update(weights_=np.ones((3, 3)))), "corrupt.*weights_"),
+        (lambda p: rewrite_meta(p, lambda m, a: m["state"]["params"].update(alpha=-1)), "corrupt.*alpha"),
+    ],
+)
+def test_bad_model_files_give_clear_errors(tmp_path, fitted, corrupt, match):
+    path = bidmp.save(fitted, tmp_path / "model.npz")
+    corrupt(path)
+    with pytest.raises(ModelFileError, match=match):
+        bidmp.load(path)
+
+
+def test_object_arrays_are_refused_not_unpickled(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "model.npz")
+    with zipfile.ZipFile(path, "a") as archive:
+        import io
+
+        buffer = io.BytesIO()
+        np.save(buffer, np.array([object()], dtype=object), allow_pickle=True)
+        archive.writestr("evil.npy", buffer.getvalue())
+    with pytest.raises(ModelFileError, match="not a readable"):
+        bidmp.load(path)
+
+
+def test_missing_model_file_and_unsupported_objects(tmp_path):
+    with pytest.raises(ModelFileError, match="does not exist"):
+        bidmp.load(tmp_path / "absent.npz")
+    with pytest.raises(TypeError, match="model must be one of"):
+        bidmp.save(object(), tmp_path / "x.npz")
+    with pytest.raises(bidmp.NotFittedError):
+        bidmp.save(DMP(), tmp_path / "x.npz")

@@ -1,0 +1,68 @@
+"""The package surface: public names, lazy imports, no import cycles in the layers."""
+
+import ast
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+import bidmp
+
+SRC = pathlib.Path(bidmp.__file__).parent
+
+
+def test_public_names_resolve():
+    for name in bidmp.__all__:
+        assert getattr(bidmp, name) is not None
+    assert bidmp.save.__name__ == "save_model" and bidmp.load.__name__ == "load_model"
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        bidmp.nothing  # noqa: B018
+
+
+def test_import_and_cli_help_do_not_import_numpy():
+    code = "import sys, bidmp, bidmp.cli; bidmp.cli.build_parser(); print('numpy' in sys.modules)"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.strip() == "False"
+
+
+# Layers of ARCHITECTURE.md: a module may import only from its own or lower-numbered layers.
+LAYERS = {
+    "_checks": 1, "dmp": 1, "segmentation": 1, "similarity": 1, "roadmap": 1, "bls": 1, "baselines": 1,
+    "extension": 2, "incremental": 2,
+    "datasets": 3, "io": 3, "scenarios": 3, "evaluation": 3, "plotting": 3,
+    "cli": 4, "__main__": 4,
+}
+
+
+def bidmp_imports(path):
+    tree = ast.parse(path.read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level >= 1 and node.module:
+            yield node.module.split(".")[0]
+        elif isinstance(node, ast.ImportFrom) and node.level == 1 and node.module is None:
+            yield from (alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("bidmp."):
+            yield node.module.split(".")[1]
+
+
+def test_modules_respect_the_layers():
+    for path in SRC.glob("*.py"):
+        module = path.stem
+        if module == "__init__":
+            continue
+        assert module in LAYERS, f"{module}.py is not placed in a layer of ARCHITECTURE.md"
+        for imported in bidmp_imports(path):
+            if imported in LAYERS and imported != "__init__":
+                assert LAYERS[imported] <= LAYERS[module], f"{module} (layer {LAYERS[module]}) imports {imported}"
+
+
+def test_library_code_never_prints():
+    for path in SRC.glob("*.py"):
+        if path.stem in ("cli", "__main__"):
+            continue
+        calls = [
+            node for node in ast.walk(ast.parse(path.read_text()))
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "print"
+        ]
+        assert not calls, f"{path.name} calls print()"
