@@ -67,7 +67,7 @@ def as_trajectory(y, name: str = "y", min_points: int = 3) -> np.ndarray:
     if n_points < min_points:
         raise ValueError(f"{name} needs at least {min_points} points, got {n_points}")
     _check_finite(array, name)
-    if np.all(np.ptp(array, axis=0) == 0.0):
+    if not np.any(array != array[0]):
         raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
     return np.ascontiguousarray(array)
 

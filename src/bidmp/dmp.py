@@ -63,6 +63,7 @@ _K_CHOICES = ("paper", "pastor")
 _FIT_CHOICES = ("lwr", "ridge")
 _DERIVATIVE_CHOICES = ("gradient", "forward")
 _WIDTH_CHOICES = ("spacing", "pydmps")
+_LOG_PSI_FLOOR = -40.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -128,11 +129,27 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
         the phase is from the centres.
     """
     phase = np.asarray(phase, dtype=np.float64).reshape(-1)
-    log_psi = -widths * (phase[:, None] - centres) ** 2
-    log_psi -= log_psi.max(axis=1, keepdims=True)
-    psi = np.exp(log_psi)
-    psi /= psi.sum(axis=1, keepdims=True)
-    return psi * phase[:, None]
+    # In place in one (L, N) buffer, with no per-row reductions: this is the hot loop of fit().
+    log_psi = phase[:, None] - centres
+    log_psi *= log_psi
+    log_psi *= -widths
+    # Shift each row by the exponent of the kernel nearest in phase (or its neighbours): a value
+    # that is one of the row's entries, hence <= its maximum (no overflow) and close to it (the
+    # largest term survives). It replaces an exact row maximum, which costs more than exp here.
+    order = np.argsort(centres)
+    nearest = np.searchsorted(centres[order], phase)
+    rows = np.arange(phase.shape[0])
+    shift = np.full(phase.shape[0], -np.inf)
+    for offset in (-1, 0):
+        columns = order[np.clip(nearest + offset, 0, len(centres) - 1)]
+        np.maximum(shift, log_psi[rows, columns], out=shift)
+    log_psi -= shift[:, None]
+    # Terms below e^-40 of the row maximum cannot change a float64 sum; clipping them keeps exp
+    # out of the (slow) subnormal range.
+    np.maximum(log_psi, _LOG_PSI_FLOOR, out=log_psi)
+    psi = np.exp(log_psi, out=log_psi)
+    psi *= (phase / (psi @ np.ones(psi.shape[1])))[:, None]
+    return psi
 
 
 def _derivatives(y: np.ndarray, dt: float, method: str) -> tuple[np.ndarray, np.ndarray]:
@@ -369,6 +386,7 @@ class DMP:
         self.dt_ = dt
         self.centres_ = centres
         self.widths_ = widths
+        self._grid_cache = (n_steps, phase, phi, self._unit_responses(phase, None))
         logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
         return self
 
@@ -385,6 +403,20 @@ class DMP:
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
         return phase_grid(n_steps, self.dt_, self.tau, self.alpha_phase)
 
+    def _grid(self, n_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Phase, basis rows and unit responses [B, C, V] on the grid of ``n_steps`` samples.
+
+        None of them depends on the weights, only on what ``fit`` fixed, so the last grid used is
+        cached: repeated rollouts then cost one small filter for the forcing term.
+        """
+        cached = self.__dict__.get("_grid_cache")
+        if cached is None or cached[0] != n_steps:
+            phase = self.phase(n_steps)
+            basis = basis_functions(phase, self.centres_, self.widths_)
+            cached = (n_steps, phase, basis, self._unit_responses(phase, None))
+            self._grid_cache = cached
+        return cached[1:]
+
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
         check_fitted(self, "weights_")
@@ -394,38 +426,39 @@ class DMP:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
         return self.basis(phase) @ self.weights_
 
-    def _unit_responses(self, n_steps: int, forcing: np.ndarray) -> np.ndarray:
-        """Responses that compose every rollout: rows are [a_1 … a_D, B, C, V], shape (D+3, n).
+    def _unit_responses(self, phase: np.ndarray, forcing: np.ndarray | None) -> np.ndarray:
+        """Responses that compose every rollout on the grid ``phase`` (n samples).
 
-        ``y = a + B g + C y0 + V v0`` where ``a`` is driven by ``K f`` from rest at 0, ``B`` by the
-        goal's share of the input, ``C`` by the start's (with ``y[0] = y[1] = 1``), and ``V`` is
-        the free response to a unit start velocity (``y[1] = dt``).
+        ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
+        dimension, returned when ``forcing`` (n, D) is given); otherwise the rows are ``B`` (the
+        goal's share of the input), ``C`` (the start's, with ``y[0] = y[1] = 1``) and ``V`` (the
+        free response to a unit start velocity, ``y[1] = dt``), shape (3, n).
         """
         alpha, beta, K = self.alpha, self.beta_value, self.K_value
-        h = self.dt_ / self.tau
-        phase = self.phase(n_steps)[: max(n_steps - 2, 0)]
-        n_dims = forcing.shape[1]
-        drives = np.empty((n_dims + 3, phase.shape[0]))
-        drives[:n_dims] = K * forcing[: phase.shape[0]].T
-        drives[n_dims] = alpha * beta - K * phase
-        drives[n_dims + 1] = K * phase
-        drives[n_dims + 2] = 0.0
-        y_first = np.zeros(n_dims + 3)
-        y_second = np.zeros(n_dims + 3)
-        y_first[n_dims + 1] = y_second[n_dims + 1] = 1.0
-        y_second[n_dims + 2] = self.dt_
-        return _euler_unit_responses(drives, y_first, y_second, h=h, alpha=alpha, beta=beta)[:, :n_steps]
+        n_steps = phase.shape[0]
+        inputs = phase[: max(n_steps - 2, 0)]
+        if forcing is not None:
+            drives = K * forcing[: inputs.shape[0]].T
+            y_first = y_second = np.zeros(drives.shape[0])
+        else:
+            drives = np.stack([alpha * beta - K * inputs, K * inputs, np.zeros_like(inputs)])
+            y_first = np.array([0.0, 1.0, 0.0])
+            y_second = np.array([0.0, 1.0, self.dt_])
+        responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / self.tau, alpha=alpha, beta=beta)
+        return responses[:, :n_steps]
 
     def _prepare(self, start, start_velocity, n_steps):
         check_fitted(self, "weights_")
         n_dims = self.n_dims_
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
-        velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        forcing = self.forcing_term(self.phase(n_steps))
-        responses = self._unit_responses(n_steps, forcing)
-        free = responses[:n_dims].T + np.outer(responses[n_dims + 1], start) + np.outer(responses[n_dims + 2], velocity)
-        return free, responses[n_dims]
+        velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        phase, basis, (goal_response, start_response, velocity_response) = self._grid(n_steps)
+        free = self._unit_responses(phase, basis @ self.weights_).T
+        free += np.outer(start_response, start)
+        if start_velocity is not None:
+            free += np.outer(velocity_response, velocity)
+        return free, goal_response
 
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None) -> np.ndarray:
         """Generate a trajectory (explicit Euler, Eq. 14).
@@ -480,7 +513,7 @@ class DMP:
         """
         check_fitted(self, "weights_")
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
-        goal_response = self._unit_responses(n_steps, np.zeros((n_steps, 0)))[0]
+        goal_response = self._grid(n_steps)[2][0]
         return float(abs(1.0 - goal_response[-1]))
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
