@@ -102,7 +102,7 @@ def bench_many_goals(n_goals: int, repeats: int) -> dict:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=21, help="timed repetitions per measurement (median)")
+    parser.add_argument("--repeats", type=int, default=61, help="timed repetitions per measurement (median)")
     parser.add_argument("--goals", type=int, default=10_000, help="number of goals for rollout_many")
     args = parser.parse_args()
 

@@ -192,6 +192,18 @@ def test_basis_rows_sum_to_phase_and_never_nan():
     np.testing.assert_allclose(phi.sum(axis=1), phase, rtol=1e-12)
 
 
+@pytest.mark.parametrize("n_kernels", [1, 2, 50, 400])
+@pytest.mark.parametrize("rule", ["spacing", "pydmps"])
+def test_basis_matches_the_plain_formula(n_kernels, rule):
+    centres = kernel_centres(n_kernels, 1000, 1e-3)
+    widths = kernel_widths(centres, 1.0, rule)
+    phase = np.concatenate([phase_grid(5000, 1e-3), [0.0, 0.999, 1.0]])
+    psi = np.exp(-widths * (phase[:, None] - centres) ** 2)
+    keep = psi.sum(axis=1) > 1e-250  # the plain formula is 0/0 beyond; checked separately above
+    expected = phase[keep, None] * psi[keep] / psi[keep].sum(axis=1, keepdims=True)
+    np.testing.assert_allclose(basis_functions(phase, centres, widths)[keep], expected, rtol=0, atol=1e-10)
+
+
 def test_phase_grid_is_the_euler_canonical_system():
     np.testing.assert_allclose(phase_grid(5, 0.1, 2.0, 4.0), 0.8 ** np.arange(5))
     assert phase_grid(200, 1 / 200)[-1] == pytest.approx(np.exp(-1), rel=0.01)
