@@ -78,7 +78,7 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
 
     model = load_model(args.model)
     trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
-    times = np.arange(trajectory.shape[0]) * model.dt_ * model.tau
+    times = np.arange(trajectory.shape[0]) * model.dt_  # one Euler step is dt seconds
     path = save_trajectory(args.output, trajectory, times=times if args.output.lower().endswith(".csv") else None)
     goal = model.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
     print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")

@@ -387,7 +387,7 @@ class DMP:
         self.dt_ = dt
         self.centres_ = centres
         self.widths_ = widths
-        self._grid_cache = (n_steps, phase, phi, self._unit_responses(phase, None))
+        self._cache_grid(phase, phi)
         logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
         return self
 
@@ -405,7 +405,8 @@ class DMP:
         return phase_grid(n_steps, self.dt_, self.tau, self.alpha_phase)
 
     def _grid(self, n_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Phase, basis rows and unit responses [B, C, V] on the grid of ``n_steps`` samples.
+        """Phase (n,), basis rows (n, N) and unit responses ``[B, C, V]`` (3, n) on the grid of
+        ``n_steps`` samples.
 
         None of them depends on the weights, only on what ``fit`` fixed, so the last grid used is
         cached: repeated rollouts then cost one small filter for the forcing term.
@@ -413,10 +414,12 @@ class DMP:
         cached = self.__dict__.get("_grid_cache")
         if cached is None or cached[0] != n_steps:
             phase = self.phase(n_steps)
-            basis = basis_functions(phase, self.centres_, self.widths_)
-            cached = (n_steps, phase, basis, self._unit_responses(phase, None))
-            self._grid_cache = cached
+            cached = self._cache_grid(phase, basis_functions(phase, self.centres_, self.widths_))
         return cached[1:]
+
+    def _cache_grid(self, phase: np.ndarray, basis: np.ndarray) -> tuple:
+        self._grid_cache = (phase.shape[0], phase, basis, self._unit_responses(phase, None))
+        return self._grid_cache
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
@@ -509,7 +512,7 @@ class DMP:
 
         ``c = |1 - B[n_steps - 1]|`` where ``B`` is the goal's share of the affine rollout; it
         depends only on ``(alpha, K, alpha_phase, tau, T, n_steps)``, not on the weights. With the
-        paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0153); run to
+        paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
         convergence and it tends to 0.
         """
         check_fitted(self, "weights_")
