@@ -46,7 +46,7 @@ def _check_finite(array: np.ndarray, name: str) -> None:
         raise ValueError(f"{name} contains {kind} (first at {where})")
 
 
-def as_trajectory(y, name: str = "y", min_points: int = 3) -> np.ndarray:
+def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = False) -> np.ndarray:
     """Validate a trajectory and return it as a C-contiguous float64 array of shape (T, D).
 
     Raises
@@ -55,7 +55,7 @@ def as_trajectory(y, name: str = "y", min_points: int = 3) -> np.ndarray:
         If ``y`` is not numeric.
     ValueError
         If ``y`` is not 2-D, has fewer than ``min_points`` samples, contains NaN/inf, or all its
-        points are identical (there is no motion to learn).
+        points are identical (there is no motion to learn; allowed with ``allow_static``).
     """
     array = _as_float_array(y, name)
     if array.ndim != 2:
@@ -67,7 +67,7 @@ def as_trajectory(y, name: str = "y", min_points: int = 3) -> np.ndarray:
     if n_points < min_points:
         raise ValueError(f"{name} needs at least {min_points} points, got {n_points}")
     _check_finite(array, name)
-    if not np.any(array != array[0]):
+    if not allow_static and not np.any(array != array[0]):
         raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
     return np.ascontiguousarray(array)
 

