@@ -23,6 +23,7 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
+	$(PY) benchmarks/bench_extension.py
 
 clean:
 	rm -rf $(VENV) bidmp-out .pytest_cache

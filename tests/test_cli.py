@@ -123,3 +123,70 @@ def test_version_and_help(capsys):
     with pytest.raises(SystemExit):
         main(["fit", "--help"])
     assert "--n-kernels" in capsys.readouterr().out
+
+
+@pytest.fixture
+def battery_files(tmp_path, capsys):
+    from bidmp.datasets import minimum_jerk
+    from bidmp.evaluation import BATTERY_APPROACH_VIA
+
+    demo = save_trajectory(tmp_path / "approach.csv", minimum_jerk(BATTERY_APPROACH_VIA, 200))
+    model = tmp_path / "approach.npz"
+    assert main(["fit", str(demo), "-o", str(model), "--alpha", "100"]) == 0
+    capsys.readouterr()
+    return demo, model
+
+
+def test_segment_prints_points_and_plots(tmp_path, battery_files, capsys):
+    demo, _ = battery_files
+    code, out, err = run(["segment", str(demo), "--plot", str(tmp_path / "seg.png")], capsys)
+    assert code == 0, err
+    assert "segmentation point" in out and "max" in out
+    assert (tmp_path / "seg.png").stat().st_size > 10_000
+    expected = bidmp.segment(load_trajectory(demo))
+    for index in expected:
+        assert f"{index} " in out
+
+
+def test_extend_writes_the_extended_demonstration(tmp_path, battery_files, capsys):
+    demo, model = battery_files
+    out_file = tmp_path / "extended.npy"
+    code, out, err = run(["extend", str(model), str(demo), "--target", "150", "25", "0", "-o", str(out_file),
+                          "--seed", "3", "--plot", str(tmp_path / "ext.png")], capsys)
+    assert code == 0, err
+    assert "G-PRM similarity per iteration" in out and "plain DMP to the new target ends" in out
+    extended = np.load(out_file)
+    expected = bidmp.extend_demonstration(load_trajectory(demo), [150, 25, 0], seed=3).complete
+    np.testing.assert_array_equal(extended, expected)
+    assert (tmp_path / "ext.png").stat().st_size > 10_000
+
+
+def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
+    code, out, err = run(["reproduce", "table5", "--out", str(tmp_path / "t5"), "--seeds", "2"], capsys)
+    assert code == 0, err
+    assert "G-PRM" in out and "PRM" in out and "battery approach" in out
+    summary = json.loads((tmp_path / "t5" / "table5.json").read_text())
+    assert summary["n_seeds"] == 2 and len(summary["cases"]) == 5
+    case = summary["cases"][0]
+    assert len(case["gprm_per_iteration"]) == 10
+    assert case["gprm_final"]["mean"] >= case["gprm_first"]["mean"]
+    assert (tmp_path / "t5" / "table5.png").stat().st_size > 50_000
+    assert "| case |" in (tmp_path / "t5" / "table5.md").read_text()
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["segment", "{demo}", "--eps-frac", "1.5"], "eps_frac must lie in (0, 1)"),
+        (["extend", "{model}", "{demo}", "--target", "1", "2", "-o", "{tmp}/x.csv"], "new_target must have 3"),
+        (["extend", "{model}", "{tmp}/flat.csv", "--target", "1", "2", "-o", "{tmp}/x.csv"], "has D = 2 but the model"),
+        (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.csv"], "NaN"),
+        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "n_seeds must be >= 1"),
+    ],
+)
+def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, match, capsys):
+    demo, model = battery_files
+    save_trajectory(tmp_path / "flat.csv", curved_demo(50, 2))
+    code = exit_code([a.format(demo=demo, model=model, tmp=tmp_path) for a in argv])
+    _, err = capsys.readouterr()
+    assert code == 2 and match in err and len(err.strip().splitlines()) == 1, err

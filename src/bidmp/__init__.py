@@ -14,19 +14,26 @@ __version__ = "0.1.0"
 # public name -> (module, attribute)
 _LAZY = {
     "DMP": ("bidmp.dmp", "DMP"),
+    "segment": ("bidmp.segmentation", "segment"),
+    "frechet_distance": ("bidmp.similarity", "frechet_distance"),
+    "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
+    "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
     "save": ("bidmp.io", "save_model"),
     "load": ("bidmp.io", "load_model"),
     "ModelFileError": ("bidmp.io", "ModelFileError"),
     "NotFittedError": ("bidmp._checks", "NotFittedError"),
 }
-_SUBMODULES = ("dmp", "datasets", "io", "plotting")
+_SUBMODULES = ("dmp", "segmentation", "similarity", "roadmap", "extension", "datasets", "io", "evaluation", "plotting")
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from . import datasets, dmp, io, plotting  # noqa: F401
+    from . import datasets, dmp, evaluation, extension, io, plotting, roadmap, segmentation, similarity  # noqa: F401
     from ._checks import NotFittedError  # noqa: F401
     from .dmp import DMP  # noqa: F401
+    from .extension import extend_demonstration  # noqa: F401
+    from .segmentation import segment  # noqa: F401
+    from .similarity import frechet_distance, frechet_similarity  # noqa: F401
     from .io import ModelFileError  # noqa: F401
     from .io import load_model as load  # noqa: F401
     from .io import save_model as save  # noqa: F401

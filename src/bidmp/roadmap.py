@@ -17,6 +17,7 @@ The best iteration is returned, with the similarity history.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -30,6 +31,8 @@ from .segmentation import resample_arclength
 from .similarity import frechet_similarity
 
 __all__ = ["RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path"]
+
+logger = logging.getLogger(__name__)
 
 CollisionCallback = Callable[[np.ndarray], np.ndarray]
 """``is_free(points (M, D)) -> bool (M,)``: True where a point is collision-free."""
@@ -198,7 +201,10 @@ def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, 
         nodes, order = nodes[keep], order[keep[1:-1]]
     indices = shortest_path(nodes, n_neighbours, is_free)
     if indices is None:
-        # Unreachable even with 32 neighbours: chain the samples in their sampling order.
+        # Unreachable even with 32 neighbours: chain the samples in their sampling order (SPEC
+        # §5). That chain is not collision-checked, so say so.
+        logger.warning("new target unreachable on the roadmap even with %d neighbours: chaining the samples "
+                       "in order%s", _MAX_NEIGHBOURS, " (not collision-free)" if is_free is not None else "")
         inner = nodes[1:-1][np.argsort(order, kind="stable")]
         return np.vstack([seg, inner, new_target])
     return nodes[indices]
@@ -285,8 +291,9 @@ def gaussian_prm(
     select : {"best", "last"}
         Which iteration to return.
     is_free : callable, optional
-        Collision callback ``is_free(points (M, D)) -> bool (M,)``; nodes and edges (checked at 5
-        points each) where it is False are left out of the roadmap.
+        Collision callback ``is_free(points (M, D)) -> bool (M,)``; nodes and edges where it is
+        False are left out of the roadmap. Edges are checked at 5 interior points, so an obstacle
+        thinner than a fifth of an edge can slip between them: inflate thin obstacles.
     seed : int or numpy.random.Generator
     """
     piece, target = _validate(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter)

@@ -1,0 +1,89 @@
+"""extend_demonstration: the whole chain 1D-SEG → piece → G-PRM → complete demonstration."""
+
+import numpy as np
+import pytest
+
+from bidmp import extend_demonstration
+from bidmp.datasets import lasa, minimum_jerk
+from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+
+
+@pytest.fixture(scope="module")
+def battery():
+    return minimum_jerk(BATTERY_APPROACH_VIA, 200)
+
+
+def step_lengths(y):
+    return np.linalg.norm(np.diff(y, axis=0), axis=1)
+
+
+def test_complete_demonstration_shape_ends_and_parts(battery):
+    result = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
+    assert result.complete.shape == battery.shape
+    assert np.array_equal(result.complete[0], battery[0])
+    assert np.array_equal(result.complete[-1], BATTERY_EXTENSION_TARGET)
+    np.testing.assert_array_equal(result.tra_imi, battery[result.piece.start : result.piece.end + 1])
+    assert result.seg_index == result.piece.start
+    assert np.array_equal(result.tra_gen[0], battery[result.seg_index])
+    assert np.array_equal(result.tra_gen[-1], BATTERY_EXTENSION_TARGET)
+    assert result.similarity_history.shape == (10,)
+    # The battery approach is cut at the end of the lateral move; the descent is imitated.
+    np.testing.assert_allclose(battery[result.seg_index], [0.0, 0.0, 40.0], atol=2.0)
+
+
+@pytest.mark.parametrize("name, offset", [("Sshape", [15.0, -10.0]), ("WShape", [-8.0, 12.0])])
+def test_junction_is_continuous_in_position_and_speed(name, offset):
+    y = lasa(name)[0]
+    result = extend_demonstration(y, y[-1] + offset, seed=2)
+    complete = result.complete
+    # The complete demonstration passes through seg, where the prefix hands over to Tra_gen.
+    seg = y[result.seg_index]
+    junction = int(np.argmin(np.linalg.norm(complete - seg, axis=1)))
+    assert np.linalg.norm(complete[junction] - seg) < 2 * step_lengths(complete).max()
+    speeds = step_lengths(complete)
+    before, after = speeds[junction - 3 : junction].mean(), speeds[junction : junction + 3].mean()
+    assert after == pytest.approx(before, rel=0.15)
+    # No jumps anywhere: neighbouring steps differ smoothly, and it ends at rest.
+    assert np.max(np.abs(np.diff(speeds))) < 0.1 * speeds.max()
+    assert speeds[-1] < 0.05 * speeds.max()
+
+
+def test_same_seed_same_extension_and_options_pass_through(battery):
+    first = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4)
+    again = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4)
+    assert np.array_equal(first.complete, again.complete)
+    fewer = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4, n_iter=3, n_samples=100, eps_frac=0.2)
+    assert fewer.similarity_history.shape == (3,)
+    with pytest.raises(TypeError, match="unknown option.*n_iterations"):
+        extend_demonstration(battery, BATTERY_EXTENSION_TARGET, n_iterations=3)
+
+
+def test_target_at_seg_skips_gprm(battery):
+    result = extend_demonstration(battery, battery[-1], seed=0)  # the demonstrated end: nearest piece end
+    assert np.array_equal(result.complete[-1], battery[-1])
+    seg_target = extend_demonstration(battery, battery[0], seed=0)  # coincides with seg of piece 0
+    assert seg_target.similarity_history.size == 0
+    assert np.array_equal(seg_target.complete[-1], battery[0])
+
+
+@pytest.mark.parametrize(
+    "y, target, match",
+    [
+        (minimum_jerk(BATTERY_APPROACH_VIA, 200), [1.0, 2.0], "new_target must have 3"),
+        (minimum_jerk(BATTERY_APPROACH_VIA, 200), [1.0, np.nan, 0.0], "NaN"),
+        (minimum_jerk(BATTERY_APPROACH_VIA, 5), [1.0, 2.0, 0.0], "at least 10 points"),
+        (np.zeros((50, 3)), [1.0, 2.0, 0.0], "identical"),
+    ],
+)
+def test_bad_input(y, target, match):
+    with pytest.raises(ValueError, match=match):
+        extend_demonstration(y, target)
+
+
+def test_extension_is_fast_enough_to_stay_out_of_the_way(battery):
+    # Not a speed test (those live in benchmarks/): just that defaults do not explode.
+    import time
+
+    start = time.perf_counter()
+    extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
+    assert time.perf_counter() - start < 5.0
