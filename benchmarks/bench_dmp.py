@@ -14,27 +14,17 @@ alone; 10 000 goals in <= 0.5 s.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 import warnings
 
 import numpy as np
+
+from _timing import median_time
 
 from bidmp import DMP
 
 N_STEPS = 1000
 N_KERNELS = 50
-
-
-def median_time(function, repeats: int) -> float:
-    function()  # warm-up (imports, caches, JIT)
-    samples = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        samples.append(time.perf_counter() - start)
-    return statistics.median(samples)
 
 
 def demonstration(n_dims: int) -> np.ndarray:

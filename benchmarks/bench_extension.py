@@ -13,29 +13,19 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
+
+from _timing import median_time
 
 from bidmp import extend_demonstration, frechet_distance
 from bidmp.datasets import minimum_jerk
 from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 from bidmp.roadmap import classic_prm, gaussian_prm
 from bidmp.similarity import frechet_distance_reference
-
-
-def median_time(function, repeats: int) -> float:
-    function()
-    samples = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        samples.append(time.perf_counter() - start)
-    return statistics.median(samples)
 
 
 def jit_compile_seconds() -> float:

@@ -235,16 +235,47 @@ class _Comparison:
         return frechet_similarity(path, self.target_shape, self.denom), self.reference - path
 
 
-def _validate(piece, new_target, n_samples, n_neighbours, n_compare, n_iter):
-    piece = as_trajectory(piece, "tra_imi", min_points=2)
+def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scaling, compare, select, denom):
+    """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
+    piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target")
     check_int(n_samples, "n_samples", minimum=2)
     check_int(n_neighbours, "n_neighbours", minimum=1)
     check_int(n_compare, "n_compare", minimum=3)
     check_int(n_iter, "n_iter", minimum=1)
+    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
+    check_choice(compare, "compare", ("template", "raw"))
+    check_choice(select, "select", ("best", "last"))
     if np.linalg.norm(target - piece[0]) == 0.0:
         raise ValueError("new_target coincides with the start of the piece (seg): nothing to generate")
-    return piece, target
+    comparison = _Comparison(resample_arclength(piece, n_compare), target, scaling, compare, denom)
+    return piece, target, comparison
+
+
+def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select) -> RoadmapResult:
+    """The loop both roadmaps share: draw samples, shortest path, score, learn (G-PRM only).
+
+    ``draw(iteration) -> (samples (n, D), order (n,))``; ``learn(iteration, similarity,
+    direction)`` or None.
+    """
+    seg, target = comparison.piece[0], comparison.new_target
+    n_compare = comparison.piece.shape[0]
+    history, paths, all_samples = [], [], []
+    for iteration in range(1, n_iter + 1):
+        samples, order = draw(iteration)
+        path = resample_arclength(_path_through(samples, seg, target, order, n_neighbours, is_free), n_compare)
+        similarity, direction = comparison.score(path)
+        if learn is not None:
+            learn(iteration, similarity, direction)
+        history.append(similarity)
+        paths.append(path)
+        all_samples.append(samples)
+    history = np.asarray(history)
+    chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
+    return RoadmapResult(
+        path=paths[chosen], similarity=float(history[chosen]), history=history, iteration=chosen,
+        template=comparison.reference, samples=all_samples[chosen], paths=paths,
+    )
 
 
 def gaussian_prm(
@@ -296,37 +327,30 @@ def gaussian_prm(
         thinner than a fifth of an edge can slip between them: inflate thin obstacles.
     seed : int or numpy.random.Generator
     """
-    piece, target = _validate(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter)
+    piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
+                                       scaling, compare, select, denom)
     sigma_rel = check_real(sigma_rel, "sigma_rel", nonnegative=True)
     rho = check_real(rho, "rho", positive=True)
     check_choice(schedule, "schedule", ("geometric", "harmonic"))
-    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
-    check_choice(compare, "compare", ("template", "raw"))
-    check_choice(select, "select", ("best", "last"))
     rng = np.random.default_rng(seed)
-
-    resampled = resample_arclength(piece, n_compare)
-    comparison = _Comparison(resampled, target, scaling, compare, denom)
     seg = piece[0]
     sigma = sigma_rel * np.linalg.norm(target - seg)
     t = np.linspace(0.0, 1.0, n_samples)
-    line = seg + t[:, None] * (target - seg)
+    line = seg + t[:, None] * (target - seg)  # Eq. 1-2: samples spread along the chord seg -> n_tar
     lam = np.linspace(0.0, 1.0, n_compare)
     bias = np.zeros((n_compare, piece.shape[1]))
     order = np.arange(n_samples)
 
-    history, paths, all_samples = [], [], []
-    for iteration in range(1, n_iter + 1):
-        bias_at_samples = np.column_stack([np.interp(t, lam, column) for column in bias.T])
-        samples = line + rng.normal(scale=sigma, size=line.shape) + bias_at_samples
-        path = resample_arclength(_path_through(samples, seg, target, order, n_neighbours, is_free), n_compare)
-        similarity, direction = comparison.score(path)
+    def draw(iteration):
+        bias_at_samples = np.column_stack([np.interp(t, lam, column) for column in bias.T])  # Eq. 9
+        return line + rng.normal(scale=sigma, size=line.shape) + bias_at_samples, order
+
+    def learn(iteration, similarity, direction):  # Eq. 8
+        nonlocal bias
         rate = rho**iteration if schedule == "geometric" else rho / iteration
         bias = bias + (1.0 - similarity) * rate * direction
-        history.append(similarity)
-        paths.append(path)
-        all_samples.append(samples)
-    return _result(history, paths, all_samples, comparison.reference, select)
+
+    return _iterate(comparison, n_iter, draw, learn, n_neighbours, is_free, select)
 
 
 def classic_prm(
@@ -348,35 +372,18 @@ def classic_prm(
     """Classic PRM baseline (paper Table 5): uniform samples in the bounding box of seg and
     ``new_target`` padded by ``padding · ‖n_tar − seg‖``, no bias; each iteration only redraws.
     Scored exactly like :func:`gaussian_prm`."""
-    piece, target = _validate(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter)
+    piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
+                                       scaling, compare, select, denom)
     padding = check_real(padding, "padding", nonnegative=True)
-    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
-    check_choice(compare, "compare", ("template", "raw"))
-    check_choice(select, "select", ("best", "last"))
     rng = np.random.default_rng(seed)
-    resampled = resample_arclength(piece, n_compare)
-    comparison = _Comparison(resampled, target, scaling, compare, denom)
     seg = piece[0]
     margin = padding * np.linalg.norm(target - seg)
     low, high = np.minimum(seg, target) - margin, np.maximum(seg, target) + margin
-    order = np.arange(n_samples)
-    history, paths, all_samples = [], [], []
-    for _ in range(n_iter):
+
+    def draw(iteration):
         samples = rng.uniform(low, high, size=(n_samples, piece.shape[1]))
-        # Uniform samples have no natural order: the fallback chain sorts them along the chord.
-        order = np.argsort((samples - seg) @ (target - seg), kind="stable")
-        order = np.argsort(order, kind="stable")
-        path = resample_arclength(_path_through(samples, seg, target, order, n_neighbours, is_free), n_compare)
-        history.append(comparison.score(path)[0])
-        paths.append(path)
-        all_samples.append(samples)
-    return _result(history, paths, all_samples, comparison.reference, select)
+        # Uniform samples have no order of their own: the fallback chain follows the chord.
+        order = np.argsort(np.argsort((samples - seg) @ (target - seg), kind="stable"), kind="stable")
+        return samples, order
 
-
-def _result(history, paths, samples, reference, select) -> RoadmapResult:
-    history = np.asarray(history)
-    chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
-    return RoadmapResult(
-        path=paths[chosen], similarity=float(history[chosen]), history=history, iteration=chosen,
-        template=reference, samples=samples[chosen], paths=paths,
-    )
+    return _iterate(comparison, n_iter, draw, None, n_neighbours, is_free, select)
