@@ -24,6 +24,7 @@ test: $(STAMP)
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
 	$(PY) benchmarks/bench_extension.py
+	$(PY) benchmarks/bench_incremental.py
 
 clean:
 	rm -rf $(VENV) bidmp-out .pytest_cache

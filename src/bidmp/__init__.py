@@ -18,17 +18,25 @@ _LAZY = {
     "frechet_distance": ("bidmp.similarity", "frechet_distance"),
     "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
     "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
+    "BLS": ("bidmp.bls", "BLS"),
+    "BiDMP": ("bidmp.incremental", "BiDMP"),
+    "forgetting": ("bidmp.incremental", "forgetting"),
     "save": ("bidmp.io", "save_model"),
     "load": ("bidmp.io", "load_model"),
     "ModelFileError": ("bidmp.io", "ModelFileError"),
     "NotFittedError": ("bidmp._checks", "NotFittedError"),
 }
-_SUBMODULES = ("dmp", "segmentation", "similarity", "roadmap", "extension", "datasets", "io", "evaluation", "plotting")
+_SUBMODULES = (
+    "dmp", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
+    "datasets", "io", "evaluation", "plotting",
+)
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from . import datasets, dmp, evaluation, extension, io, plotting, roadmap, segmentation, similarity  # noqa: F401
+    from . import bls, datasets, dmp, evaluation, extension, incremental, io, plotting, roadmap, segmentation, similarity  # noqa: F401
+    from .bls import BLS  # noqa: F401
+    from .incremental import BiDMP, forgetting  # noqa: F401
     from ._checks import NotFittedError  # noqa: F401
     from .dmp import DMP  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401

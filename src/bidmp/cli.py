@@ -76,19 +76,35 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
 
     from .io import load_model, save_trajectory
 
+    from .dmp import DMP
+
     model = load_model(args.model)
-    trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
-    times = np.arange(trajectory.shape[0]) * model.dt_  # one Euler step is dt seconds
+    if isinstance(model, DMP):
+        if args.skill is not None:
+            raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a plain DMP")
+        trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
+        dmp = model
+    elif hasattr(model, "skill_goals_"):
+        skill = "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
+        goal = model.skill_goals_[-1] if args.goal is None else args.goal
+        index = model.select_skill(goal, skill)
+        trajectory = model.rollout(goal=goal, skill=skill, start=args.start, n_steps=args.n_steps)
+        print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal "
+              f"{np.array2string(model.skill_goals_[index], precision=3)})")
+        dmp = model.dmp
+        args.goal = goal
+    else:
+        raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
+    times = np.arange(trajectory.shape[0]) * dmp.dt_  # one Euler step is dt seconds
     path = save_trajectory(args.output, trajectory, times=times if args.output.lower().endswith(".csv") else None)
-    goal = model.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
+    goal = dmp.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
     print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")
     print(f"  end point {np.array2string(trajectory[-1], precision=4)}, distance to goal {np.linalg.norm(trajectory[-1] - goal):.4g}")
     print(f"wrote {path}")
     if args.plot:
         from .plotting import plot_trajectories
 
-        reference = model.rollout()
-        figure = plot_trajectories(args.plot, reference, [trajectory], ["rollout"], goals=goal[None], title="DMP rollout")
+        figure = plot_trajectories(args.plot, dmp.rollout(), [trajectory], ["rollout"], goals=goal[None], title="rollout")
         print(f"wrote {figure}")
     return EXIT_OK
 
@@ -170,25 +186,40 @@ def _cmd_segment(args: argparse.Namespace) -> int:
 def _cmd_extend(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from .dmp import DMP
     from .extension import extend_demonstration
-    from .io import load_model, load_trajectory, save_trajectory
+    from .incremental import BiDMP
+    from .io import load_model, load_trajectory, save_model, save_trajectory
 
+    if not args.output.lower().endswith(".npz"):
+        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}; "
+                         "use --save-demo to write the extended demonstration")
     model = load_model(args.model)
+    if isinstance(model, DMP):
+        model = BiDMP(model)
+    elif not isinstance(model, BiDMP):
+        raise ValueError(f"{args.model} holds a {type(model).__name__}; extend needs a DMP or a Bi-DMP model")
     y = load_trajectory(args.demo)
-    if y.shape[1] != model.n_dims_:
-        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    if y.shape[1] != model.dmp.n_dims_:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.dmp.n_dims_}")
     extension = extend_demonstration(y, args.target, seed=args.seed)
     target = extension.new_target
     history = extension.similarity_history
-    plain_end = model.rollout(goal=target)[-1]
     print(f"segmentation points {extension.segmentation_points.tolist()}; imitating piece {extension.piece.index} "
           f"(samples {extension.piece.start}-{extension.piece.end}) from seg = {np.array2string(y[extension.seg_index], precision=3)}")
     if len(history):
         print(f"G-PRM similarity per iteration: {' '.join(f'{v:.3f}' for v in history)} (best {extension.similarity:.3f})")
-    print(f"plain DMP to the new target ends {np.linalg.norm(plain_end - target):.4g} away (end-point gain {model.endpoint_gain():.4g}); "
-          f"the extended demonstration ends on it")
-    path = save_trajectory(args.output, extension.complete)
-    print(f"wrote the extended demonstration ({extension.complete.shape[0]} x {extension.complete.shape[1]}) to {path}")
+    before = np.linalg.norm(model.rollout(target)[-1] - target)
+    model.learn(extension.complete)
+    rollout = model.rollout(target)
+    scale = float(np.linalg.norm(np.ptp(extension.complete, axis=0)))
+    error = float(np.sqrt(np.mean(np.sum((rollout - extension.complete) ** 2, axis=1))))
+    print(f"learned skill {model.n_skills - 1}: rollout to the target reproduces the extended demonstration with "
+          f"RMSE {error:.4g} ({100 * error / scale:.3g} % of its extent)")
+    print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1] - target):.4g} after")
+    print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
+    if args.save_demo:
+        print(f"wrote the extended demonstration to {save_trajectory(args.save_demo, extension.complete)}")
     if args.plot:
         from .plotting import plot_extension
 
@@ -197,6 +228,40 @@ def _cmd_extend(args: argparse.Namespace) -> int:
 
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
+    if args.what == "figures":
+        return _reproduce_figures(args)
+    return _reproduce_table5(args)
+
+
+def _reproduce_figures(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from .evaluation import lasa_incremental
+    from .io import atomic_write
+    from .plotting import plot_incremental
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    results = [lasa_incremental(name) for name in tqdm(("Sshape", "WShape", "NShape"), desc="figures", unit="shape", disable=None)]
+    print("Bi-DMP on LASA shapes: three extended demonstrations learned in turn (errors in mm)")
+    rows = []
+    for result in results:
+        for index, (bidmp_error, dmp_error) in enumerate(zip(result.reproduction_errors(), result.dmp_errors()), start=1):
+            rows.append([result.shape, str(index), f"{bidmp_error:.3f}", f"{dmp_error:.3f}",
+                         f"{result.forgetting_nearest.forgetting[index]:.3f}", f"{result.forgetting_latest.forgetting[index]:.3f}"])
+        rows.append([result.shape, "0 (demo)", "-", "-", f"{result.forgetting_nearest.forgetting[0]:.3f}",
+                     f"{result.forgetting_latest.forgetting[0]:.3f}"])
+    _print_table(["shape", "skill", "Bi-DMP RMSE", "plain DMP RMSE", "forgetting nearest", "forgetting latest"], rows)
+    print("forgetting = error of a skill after all learning minus its error when it was learned")
+    with atomic_write(out / "figures.json", "w") as handle:
+        json.dump({"results": [result.to_dict() for result in results]}, handle, indent=2)
+    print(f"wrote {out / 'figures.json'} and {plot_incremental(out / 'bidmp_lasa.png', results)}")
+    return EXIT_OK
+
+
+def _reproduce_table5(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from tqdm import tqdm
@@ -259,11 +324,12 @@ def build_parser() -> argparse.ArgumentParser:
     fit.set_defaults(handler=_cmd_fit)
 
     rollout = commands.add_parser("rollout", help="generate a trajectory from a model", description="Roll a saved model out to a goal and write the trajectory.")
-    rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit'")
+    rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
     rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates (default: the demonstrated goal)")
     rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
     rollout.add_argument("--n-steps", type=int, default=None, help="number of samples (default: the demonstration's T)")
     rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy)")
+    rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
     rollout.set_defaults(handler=_cmd_rollout)
 
@@ -275,21 +341,24 @@ def build_parser() -> argparse.ArgumentParser:
     seg.add_argument("--plot", metavar="PNG", help="also write a figure with the points and the curvature")
     seg.set_defaults(handler=_cmd_segment)
 
-    extend = commands.add_parser("extend", help="grow an extended demonstration to a new target (1D-SEG + G-PRM)",
-                                 description="Segment DEMO, pick the piece nearest the new target and grow an extended "
-                                             "demonstration to it with G-PRM. Writes the extended demonstration (.csv or .npy).")
-    extend.add_argument("model", metavar="MODEL", help="the DMP model file (.npz) learned from DEMO")
-    extend.add_argument("demo", metavar="DEMO", help="the demonstration (.csv or .npy)")
+    extend = commands.add_parser("extend", help="learn a new target incrementally (1D-SEG + G-PRM + Bi-DMP)",
+                                 description="Segment DEMO, grow an extended demonstration to the new target with G-PRM, "
+                                             "and learn it incrementally on top of MODEL (a DMP or a Bi-DMP) as a new skill.")
+    extend.add_argument("model", metavar="MODEL", help="a DMP (from 'bidmp fit') or Bi-DMP (from 'bidmp extend') model file")
+    extend.add_argument("demo", metavar="DEMO", help="the demonstration to extend (.csv or .npy)")
     extend.add_argument("--target", type=float, nargs="+", required=True, metavar="X", help="new target coordinates")
-    extend.add_argument("-o", "--output", required=True, metavar="OUT", help="extended demonstration to write (.csv or .npy)")
+    extend.add_argument("-o", "--output", required=True, metavar="MODEL2", help="Bi-DMP model file to write (.npz)")
+    extend.add_argument("--save-demo", metavar="OUT", help="also write the extended demonstration (.csv or .npy)")
     extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
     extend.add_argument("--plot", metavar="PNG", help="also write a figure")
     extend.set_defaults(handler=_cmd_extend)
 
     reproduce = commands.add_parser("reproduce", help="reproduce a table of the paper",
                                     description="Reproduce the paper's comparisons. table5: G-PRM vs classic PRM similarity "
-                                                "per iteration over many seeds (LASA shapes and the battery approach path).")
-    reproduce.add_argument("what", choices=("table5",), help="which result")
+                                                "per iteration over many seeds (LASA shapes and the battery approach path). "
+                                                "figures: Bi-DMP on LASA shapes, three new targets each (Fig. 11), "
+                                                "with reproduction errors and forgetting.")
+    reproduce.add_argument("what", choices=("table5", "figures"), help="which result")
     reproduce.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
     reproduce.add_argument("--seeds", type=int, default=20, help="number of seeds (default 20)")
     reproduce.set_defaults(handler=_cmd_reproduce)

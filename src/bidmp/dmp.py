@@ -380,7 +380,7 @@ class DMP:
             gram = phi.T @ phi
             reg = self.ridge * max(np.trace(gram) / self.n_kernels, np.finfo(float).tiny)
             weights = np.linalg.solve(gram + reg * np.eye(self.n_kernels), phi.T @ target)
-        self.weights_ = weights
+        self.weights_ = np.ascontiguousarray(weights)
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
         self.n_steps_ = n_steps
@@ -451,20 +451,24 @@ class DMP:
         responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / self.tau, alpha=alpha, beta=beta)
         return responses[:, :n_steps]
 
-    def _prepare(self, start, start_velocity, n_steps):
+    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
         check_fitted(self, "weights_")
         n_dims = self.n_dims_
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
         phase, basis, (goal_response, start_response, velocity_response) = self._grid(n_steps)
-        free = self._unit_responses(phase, basis @ self.weights_).T
+        forcing = basis @ self.weights_
+        if forcing_increment is not None:
+            forcing = forcing + forcing_increment(phase, basis)
+        free = self._unit_responses(phase, forcing).T
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
         return free, goal_response
 
-    def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None) -> np.ndarray:
+    def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
+                forcing_increment=None) -> np.ndarray:
         """Generate a trajectory (explicit Euler, Eq. 14).
 
         Parameters
@@ -478,22 +482,26 @@ class DMP:
             horizon: the phase ends at ≈ e⁻¹). Use more steps to let the system converge.
         start_velocity : array-like, shape (D,), optional
             Initial velocity (units/s); default at rest.
+        forcing_increment : callable, optional
+            ``forcing_increment(phase (n,), basis (n, N)) -> (n, D)`` added to the learned forcing
+            term on the rollout grid (how :class:`bidmp.BiDMP` adds its learned increments).
 
         Returns
         -------
         y : array, shape (n_steps, D)
         """
-        free, goal_response = self._prepare(start, start_velocity, n_steps)
+        free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         return free + np.outer(goal_response, goal)
 
-    def rollout_many(self, goals, start=None, n_steps: int | None = None, start_velocity=None) -> np.ndarray:
+    def rollout_many(self, goals, start=None, n_steps: int | None = None, start_velocity=None, *,
+                     forcing_increment=None) -> np.ndarray:
         """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
 
         Parameters
         ----------
         goals : array-like, shape (G, D)
-        start, n_steps, start_velocity
+        start, n_steps, start_velocity, forcing_increment
             As in :meth:`rollout`, shared by every goal.
 
         Returns
@@ -501,7 +509,7 @@ class DMP:
         y : array, shape (G, n_steps, D)
             ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding.
         """
-        free, goal_response = self._prepare(start, start_velocity, n_steps)
+        free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goals = as_points(goals, free.shape[1], "goals")
         out = np.multiply(goal_response[None, :, None], goals[:, None, :])
         out += free[None]

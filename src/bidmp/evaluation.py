@@ -14,6 +14,7 @@ import numpy as np
 from .datasets import lasa, minimum_jerk
 from .dmp import DMP
 from .extension import ExtendedDemonstration, extend_demonstration
+from .incremental import BiDMP, ForgettingResult, forgetting, resample_time
 from .roadmap import RoadmapResult, classic_prm, gaussian_prm
 
 __all__ = [
@@ -24,6 +25,8 @@ __all__ = [
     "PRMComparison",
     "table5_cases",
     "compare_prm",
+    "IncrementalResult",
+    "lasa_incremental",
 ]
 
 
@@ -208,3 +211,69 @@ def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int 
         example_prm = example_prm or result
     return PRMComparison(name=name, units=units, gprm=np.array(gprm), prm=np.array(prm),
                          extension=extension, example_prm=example_prm)
+
+
+# ---------------------------------------------------------------------------------------------
+# Paper Fig. 11: Bi-DMP on LASA shapes
+# ---------------------------------------------------------------------------------------------
+LASA_TARGET_OFFSETS = ((0.3, -0.2), (-0.25, -0.3), (0.15, 0.35))  # × extent, from the demonstrated end
+
+
+@dataclass
+class IncrementalResult:
+    """One LASA shape: extended demonstrations to several targets, learned in turn by a Bi-DMP."""
+
+    shape: str
+    demonstration: np.ndarray
+    targets: np.ndarray  # (P, 2)
+    extensions: list  # ExtendedDemonstration per target
+    bidmp_rollouts: np.ndarray  # (P, T, 2), skill="nearest"
+    dmp_rollouts: np.ndarray  # (P, T, 2), the plain DMP to the same targets
+    forgetting_nearest: ForgettingResult
+    forgetting_latest: ForgettingResult
+
+    def reproduction_errors(self) -> np.ndarray:
+        """RMSE of each Bi-DMP rollout against its extended demonstration (mm)."""
+        return np.array([
+            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
+            for rollout, extension in zip(self.bidmp_rollouts, self.extensions)
+        ])
+
+    def dmp_errors(self) -> np.ndarray:
+        return np.array([
+            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
+            for rollout, extension in zip(self.dmp_rollouts, self.extensions)
+        ])
+
+    def to_dict(self) -> dict:
+        return {
+            "shape": self.shape,
+            "targets": self.targets.tolist(),
+            "bidmp_rmse": self.reproduction_errors().tolist(),
+            "dmp_rmse": self.dmp_errors().tolist(),
+            "forgetting_nearest": self.forgetting_nearest.to_dict(),
+            "forgetting_latest": self.forgetting_latest.to_dict(),
+        }
+
+
+def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET_OFFSETS, **bidmp_params) -> IncrementalResult:
+    """Fit a DMP to LASA demonstration 0, extend it to several new targets (1D-SEG + G-PRM) and
+    learn the extensions in turn with a Bi-DMP; measure reproduction and forgetting."""
+    demonstration = lasa(name)[0]
+    dmp = DMP().fit(demonstration)
+    targets = demonstration[-1] + np.asarray(offsets, dtype=float) * path_extent(demonstration)
+    extensions = [extend_demonstration(demonstration, target, seed=seed + index) for index, target in enumerate(targets)]
+    model = BiDMP(dmp, **bidmp_params)
+    for extension in extensions:
+        model.learn(extension.complete)
+    completes = [extension.complete for extension in extensions]
+    return IncrementalResult(
+        shape=name,
+        demonstration=demonstration,
+        targets=targets,
+        extensions=extensions,
+        bidmp_rollouts=np.stack([model.rollout(target) for target in targets]),
+        dmp_rollouts=dmp.rollout_many(targets),
+        forgetting_nearest=forgetting(dmp, completes, skill="nearest", **bidmp_params),
+        forgetting_latest=forgetting(dmp, completes, skill="latest", **bidmp_params),
+    )

@@ -45,7 +45,11 @@ _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
 # Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
 # reading a DMP does not import the whole pipeline.
-_MODEL_CLASSES = {"DMP": ("bidmp.dmp", "DMP")}
+_MODEL_CLASSES = {
+    "DMP": ("bidmp.dmp", "DMP"),
+    "BLS": ("bidmp.bls", "BLS"),
+    "BiDMP": ("bidmp.incremental", "BiDMP"),
+}
 
 
 class ModelFileError(ValueError):
@@ -143,7 +147,9 @@ def load_model(path: str | os.PathLike):
             if _META_KEY not in archive.files:
                 raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
             meta = json.loads(archive[_META_KEY].tobytes().decode("utf-8"))
-            arrays = {name: archive[name] for name in archive.files if name != _META_KEY}
+            # Fresh C-contiguous copies: computing with them then takes the same BLAS paths as
+            # the saved model did, so rollouts after loading are bit-identical.
+            arrays = {name: np.array(archive[name], order="C") for name in archive.files if name != _META_KEY}
     except ModelFileError:
         raise
     except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError, ValueError, KeyError, UnicodeDecodeError) as exc:

@@ -1,0 +1,442 @@
+"""Broad Learning System with incremental enhancement nodes (SPEC §6, paper Eq. 16–26).
+
+Hidden layer for inputs X (N × d), with ``X̃ = [X, 0.1]``:
+
+* **Mapped features**, windows i = 1…u of q nodes: ``F_i = X̃ W_e,i`` (random, seeded) is
+  min–max scaled, a sparse autoencoder ``β_i = argmin ½‖F_i β − X̃‖² + λ₁‖β‖₁`` (ADMM) gives
+  ``W_Z,i = β_iᵀ``, and ``Z_i = X̃ W_Z,i`` is min–max normalised with stored constants.
+* **Enhancement nodes**: ``H = tanh(s_H · [Z, 0.1] W_H)``: ``W_H`` is orthonormal (seeded),
+  ``s_H = shrink / max|[Z, 0.1] W_H|`` is stored, and ``tansig(x) = 2/(1 + e^{−2x}) − 1`` is
+  exactly ``tanh(x)``.
+* **Output**: ``A = [Z | H]``, ``W = A⁺ Y`` with the ridge pseudo-inverse
+  ``A⁺ = (AᵀA + λI)⁻¹Aᵀ`` (``reg = λ``; ``reg = 0`` gives the Moore–Penrose pseudo-inverse).
+  The paper prints ``(λI + AAᵀ)⁻¹Aᵀ``, which has the wrong dimensions.
+
+**Adding enhancement nodes E** without retraining (Eq. 23–26): ``D = A⁺E``, ``C = E − AD``,
+``[A | E]⁺ = [A⁺ − D Bᵀ ; Bᵀ]`` and ``W_new = [W − D BᵀY ; BᵀY]``, with ``Bᵀ = C⁺`` when C has
+full column rank and ``Bᵀ = (I + DᵀD)⁻¹DᵀA⁺`` when ``C = 0``. In between, the general Cline
+(1964) block formula is exact in every case. The rank of C is decided with an *absolute*
+tolerance (singular values below ``1e-10 · ‖E‖₂``), not NumPy's relative default. The widely
+circulated BLS code gets both of these wrong: its zero test (``C.all() == 0``) is wrong, and its
+C = 0 branch has ``I − DᵀD``.
+With ``update="exact_ridge"`` the model keeps the Cholesky factor of ``AᵀA + λI`` and grows it
+by a block Cholesky step, so that the result equals a ridge fit from scratch with the same nodes.
+(An explicit block inverse via the Schur complement loses all accuracy here, because the hidden
+matrix is rank-deficient by construction; see ``PINV_RCOND``.)
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
+
+from ._checks import check_choice, check_fitted, check_int, check_real
+from ._threads import single_threaded_blas
+
+__all__ = ["BLS", "sparse_autoencoder", "block_pinv_update"]
+
+logger = logging.getLogger(__name__)
+
+_BIAS = 0.1  # the constant appended to inputs and to Z (paper Eq. 17-18)
+_RANK_TOLERANCE = 1e-10  # singular values of C below this times ‖E‖₂ count as zero
+# Mapped features are linear in [X, 0.1], so the hidden matrix is rank-deficient by construction
+# (rank(Z) <= d + 2): its Moore–Penrose inverse needs a clean cut. Singular values below this
+# fraction of the largest count as zero.
+PINV_RCOND = 1e-10
+
+
+def _with_bias(X: np.ndarray) -> np.ndarray:
+    return np.hstack([X, np.full((X.shape[0], 1), _BIAS)])
+
+
+def _affine(X: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """``[X, 0.1] @ weights`` without building ``[X, 0.1]`` (a full copy of X)."""
+    return X @ weights[:-1] + _BIAS * weights[-1]
+
+
+def _orthonormal(rng: np.random.Generator, n_rows: int, n_cols: int) -> np.ndarray:
+    """A seeded matrix with orthonormal columns (or rows, when it is wide)."""
+    if n_cols <= n_rows:
+        q, r = np.linalg.qr(rng.standard_normal((n_rows, n_cols)))
+        return q * np.sign(np.diag(r))  # fix QR's sign ambiguity: reproducible across LAPACKs
+    q, r = np.linalg.qr(rng.standard_normal((n_cols, n_rows)))
+    return (q * np.sign(np.diag(r))).T
+
+
+def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_iter: int = 50, rho: float = 1.0) -> np.ndarray:
+    """Lasso ``argmin_β ½‖F β − target‖² + l1 ‖β‖₁`` by ADMM (Boyd et al. 2011, §6.4).
+
+    Parameters
+    ----------
+    F : array (N, q)
+    target : array (N, m)
+
+    Returns
+    -------
+    beta : array (q, m), the sparse iterate ``z``.
+    """
+    q = F.shape[1]
+    factor = cho_factor(F.T @ F + rho * np.eye(q))
+    rhs = F.T @ target
+    z = np.zeros((q, target.shape[1]))
+    u = np.zeros_like(z)
+    threshold = l1 / rho
+    for _ in range(n_iter):
+        x = cho_solve(factor, rhs + rho * (z - u))
+        v = x + u
+        z = np.sign(v) * np.maximum(np.abs(v) - threshold, 0.0)  # soft thresholding
+        u = v - z
+    return z
+
+
+def _ridge_pinv(A: np.ndarray, reg: float) -> np.ndarray:
+    if reg == 0.0:
+        return np.linalg.pinv(A, rcond=PINV_RCOND)
+    n_rows, n_cols = A.shape
+    if n_rows >= n_cols:
+        return np.linalg.solve(A.T @ A + reg * np.eye(n_cols), A.T)
+    return A.T @ np.linalg.solve(A @ A.T + reg * np.eye(n_rows), np.eye(n_rows))
+
+
+def _pinv_absolute(C: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
+    """Pseudo-inverse of C, treating singular values <= ``tolerance`` as zero; also its rank."""
+    u, s, vt = np.linalg.svd(C, full_matrices=False)
+    keep = s > tolerance
+    rank = int(np.count_nonzero(keep))
+    return (vt[keep].T / s[keep]) @ u[:, keep].T, rank
+
+
+def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+    """Pseudo-inverse of ``[A | E]`` from that of A (Eq. 23–26, Cline 1964).
+
+    Parameters
+    ----------
+    A : array (N, c)
+    A_pinv : array (c, N), the pseudo-inverse of A
+    E : array (N, m), the new columns
+
+    Returns
+    -------
+    (D, Bt, case) with ``[A | E]⁺ = [A⁺ − D Bt ; Bt]`` and case ``"zero"`` (C = 0),
+    ``"full-rank"`` or ``"general"``.
+    """
+    D = A_pinv @ E
+    C = E - A @ D
+    tolerance = _RANK_TOLERANCE * max(np.linalg.norm(E, 2), np.finfo(float).tiny)
+    C_pinv, rank = _pinv_absolute(C, tolerance)
+    m = E.shape[1]
+    if rank == 0:
+        # C = 0: the new columns lie in span(A). Note the plus sign.
+        Bt = np.linalg.solve(np.eye(m) + D.T @ D, D.T @ A_pinv)
+        return D, Bt, "zero"
+    if rank == m:
+        return D, C_pinv, "full-rank"
+    # General case: L = C⁺ + (I − C⁺C) K Dᵀ A⁺ (I − E C⁺)... written with D = A⁺E:
+    # K = (I + (I − C⁺C) DᵀD (I − C⁺C))⁻¹, L = C⁺ + (I − C⁺C) K Dᵀ A⁺ (I − E C⁺).
+    projector = np.eye(m) - C_pinv @ C
+    K = np.linalg.inv(np.eye(m) + projector @ D.T @ D @ projector)
+    Bt = C_pinv + projector @ K @ D.T @ A_pinv @ (np.eye(E.shape[0]) - E @ C_pinv)
+    return D, Bt, "general"
+
+
+class BLS:
+    """Broad Learning System regressor with incremental enhancement nodes (SPEC §6).
+
+    Parameters
+    ----------
+    n_windows : int, default 10
+        Mapped-feature windows u.
+    n_mapped : int, default 10
+        Nodes per window q.
+    n_enhance : int, default 100
+        Enhancement nodes of the first block.
+    shrink : float, default 0.8
+        Target maximum of the enhancement pre-activation (s_H = shrink / max|·|).
+    reg : float, default 1e-8
+        Ridge λ of the output weights; 0 means the Moore–Penrose pseudo-inverse.
+    l1 : float, default 1e-3
+        Sparsity weight λ₁ of the autoencoder.
+    admm_iterations : int, default 50
+    update : {"auto", "pinv", "exact_ridge"}, default "auto"
+        How :meth:`add_enhancement_nodes` updates: ``"pinv"`` is the block pseudo-inverse
+        (Eq. 23–26), exact when ``reg = 0``; ``"exact_ridge"`` is a block Cholesky step of the ridge
+        Gram matrix, equal to a ridge fit from scratch for any ``reg > 0``. ``"auto"`` picks
+        ``"pinv"`` for ``reg = 0`` and ``"exact_ridge"`` otherwise. Eq. 23–26 applied to a *ridge*
+        A⁺ (the paper's combination) is not exact: on these rank-deficient hidden matrices its
+        training residual can even rise as nodes are added, so it is not offered.
+    seed : int, default 0
+        Every random matrix is drawn from ``numpy.random.default_rng([seed, kind, index])``, so a
+        model is reproducible from its seed, whatever order blocks are added in.
+
+    Attributes
+    ----------
+    mapping_weights_ : array (u, d+1, q)
+        ``W_Z,i``.
+    mapping_min_, mapping_range_ : array (u·q,)
+        Min–max constants of Z.
+    enhancement_weights_ : list of arrays (u·q+1, m_k)
+        One array per block (the first, then each addition).
+    enhancement_scales_ : list of float
+        Shrink factors ``s`` per block.
+    output_weights_ : array (u·q + Σ m_k, n_outputs)
+    """
+
+    def __init__(
+        self,
+        n_windows: int = 10,
+        n_mapped: int = 10,
+        n_enhance: int = 100,
+        shrink: float = 0.8,
+        reg: float = 1e-8,
+        l1: float = 1e-3,
+        admm_iterations: int = 50,
+        update: str = "auto",
+        seed: int = 0,
+    ) -> None:
+        self.n_windows = check_int(n_windows, "n_windows", minimum=1)
+        self.n_mapped = check_int(n_mapped, "n_mapped", minimum=1)
+        self.n_enhance = check_int(n_enhance, "n_enhance", minimum=1)
+        self.shrink = check_real(shrink, "shrink", positive=True)
+        self.reg = check_real(reg, "reg", nonnegative=True)
+        self.l1 = check_real(l1, "l1", nonnegative=True)
+        self.admm_iterations = check_int(admm_iterations, "admm_iterations", minimum=1)
+        self.update = check_choice(update, "update", ("auto", "pinv", "exact_ridge"))
+        if self.update == "pinv" and self.reg > 0:
+            raise ValueError("update='pinv' (Eq. 23-26) is exact only with reg=0; use update='exact_ridge' for reg > 0")
+        self.seed = check_int(seed, "seed", minimum=0)
+        self.output_weights_: np.ndarray | None = None
+
+    def get_params(self) -> dict:
+        return {
+            "n_windows": self.n_windows, "n_mapped": self.n_mapped, "n_enhance": self.n_enhance,
+            "shrink": self.shrink, "reg": self.reg, "l1": self.l1, "admm_iterations": self.admm_iterations,
+            "update": self.update, "seed": self.seed,
+        }
+
+    def __repr__(self) -> str:
+        return f"BLS({', '.join(f'{k}={v!r}' for k, v in self.get_params().items())})"
+
+    # -- hidden layer ----------------------------------------------------------------------------
+    def _rng(self, kind: int, index: int) -> np.random.Generator:
+        return np.random.default_rng([self.seed, kind, index])
+
+    def _mapped(self, X: np.ndarray) -> np.ndarray:
+        # All windows side by side, (d+1, u·q): one matrix product.
+        weights = np.ascontiguousarray(self.mapping_weights_.transpose(1, 0, 2).reshape(self.mapping_weights_.shape[1], -1))
+        return (_affine(X, weights) - self.mapping_min_) / self.mapping_range_
+
+    def _enhancement(self, Z: np.ndarray, block: int) -> np.ndarray:
+        return np.tanh(self.enhancement_scales_[block] * _affine(Z, self.enhancement_weights_[block]))
+
+    def _new_enhancement_block(self, Z: np.ndarray, n_nodes: int) -> np.ndarray:
+        """Draw block number len(enhancement_weights_), store its weights and scale, return H."""
+        block = len(self.enhancement_weights_)
+        weights = np.ascontiguousarray(_orthonormal(self._rng(1, block), Z.shape[1] + 1, n_nodes))
+        pre_activation = _affine(Z, weights)
+        scale = self.shrink / max(float(np.max(np.abs(pre_activation))), np.finfo(float).tiny)
+        self.enhancement_weights_.append(weights)
+        self.enhancement_scales_.append(scale)
+        return np.tanh(scale * pre_activation)
+
+    def hidden(self, X) -> np.ndarray:
+        """The hidden-layer matrix ``[Z | H | E_1 | …]`` for inputs X, shape (N, n_hidden)."""
+        check_fitted(self, "output_weights_")
+        X = self._check_X(X)
+        Z = self._mapped(X)
+        return np.hstack([Z] + [self._enhancement(Z, block) for block in range(len(self.enhancement_weights_))])
+
+    @property
+    def n_hidden_(self) -> int:
+        check_fitted(self, "output_weights_")
+        return self.output_weights_.shape[0]
+
+    def _check_X(self, X) -> np.ndarray:
+        from ._checks import _as_float_array, _check_finite
+
+        X = _as_float_array(X, "X")
+        if X.ndim != 2:
+            raise ValueError(f"X must have shape (N, d), got shape {X.shape}")
+        expected = getattr(self, "n_features_", None)
+        if expected is not None and X.shape[1] != expected:
+            raise ValueError(f"X must have {expected} columns (as in fit), got {X.shape[1]}")
+        if X.shape[0] == 0:
+            raise ValueError("X is empty")
+        _check_finite(X, "X")
+        return X
+
+    # -- learning --------------------------------------------------------------------------------
+    @single_threaded_blas
+    def fit(self, X, Y) -> "BLS":
+        """Fit mapped features, the first enhancement block and the output weights.
+
+        Parameters
+        ----------
+        X : array (N, d)
+        Y : array (N, n_outputs) or (N,)
+        """
+        self.n_features_ = None
+        X = self._check_X(X)
+        Y = self._check_Y(Y, X.shape[0])
+        self.n_features_ = X.shape[1]
+        X_bias = _with_bias(X)
+        windows, mins, ranges = [], [], []
+        for window in range(self.n_windows):
+            F = X_bias @ self._rng(0, window).uniform(-1.0, 1.0, size=(X_bias.shape[1], self.n_mapped))
+            F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
+            F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
+            W_Z = np.ascontiguousarray(sparse_autoencoder(F, X_bias, self.l1, self.admm_iterations).T)  # (d+1, q)
+            Z = X_bias @ W_Z
+            low, span = Z.min(axis=0), np.ptp(Z, axis=0)
+            windows.append(W_Z)
+            mins.append(low)
+            ranges.append(np.where(span > 0, span, 1.0))  # a constant node stays finite
+        self.mapping_weights_ = np.stack(windows)
+        self.mapping_min_ = np.concatenate(mins)
+        self.mapping_range_ = np.concatenate(ranges)
+        self.enhancement_weights_, self.enhancement_scales_ = [], []
+        Z = self._mapped(X)
+        A = np.hstack([Z, self._new_enhancement_block(Z, self.n_enhance)])
+        self._solve_output(A, Y)
+        return self
+
+    def _check_Y(self, Y, n_rows: int) -> np.ndarray:
+        from ._checks import _as_float_array, _check_finite
+
+        Y = _as_float_array(Y, "Y")
+        self._y_was_1d = Y.ndim == 1
+        Y = Y.reshape(-1, 1) if Y.ndim == 1 else Y
+        if Y.ndim != 2 or Y.shape[0] != n_rows:
+            raise ValueError(f"Y must have shape ({n_rows}, n_outputs), got shape {Y.shape}")
+        _check_finite(Y, "Y")
+        return Y
+
+    @property
+    def update_rule_(self) -> str:
+        """The update in use: ``"pinv"`` or ``"exact_ridge"`` (``update="auto"`` resolved)."""
+        if self.update == "auto":
+            return "pinv" if self.reg == 0.0 else "exact_ridge"
+        return self.update
+
+    @property
+    def train_hidden_(self) -> np.ndarray:
+        """Hidden matrix of the training inputs, (N, n_hidden): a view into a buffer with spare
+        columns, so that adding nodes does not copy the whole matrix each time."""
+        return self._hidden_buffer[:, : self._n_hidden]
+
+    def _set_train_hidden(self, A: np.ndarray) -> None:
+        self._hidden_buffer = np.array(A, order="C")
+        self._n_hidden = A.shape[1]
+
+    def _append_train_hidden(self, E: np.ndarray) -> None:
+        used, added = self._n_hidden, E.shape[1]
+        if self._hidden_buffer.shape[1] < used + added:
+            grown = np.empty((E.shape[0], max(2 * self._hidden_buffer.shape[1], used + added)))
+            grown[:, :used] = self.train_hidden_
+            self._hidden_buffer = grown
+        self._hidden_buffer[:, used : used + added] = E
+        self._n_hidden = used + added
+
+    def _solve_output(self, A: np.ndarray, Y: np.ndarray) -> None:
+        self._set_train_hidden(A)
+        self.train_targets_ = Y
+        if self.update_rule_ == "exact_ridge":
+            if self.reg <= 0.0:
+                raise ValueError("update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)")
+            # Upper Cholesky factor R of the ridge Gram matrix: AᵀA + λI = RᵀR, kept in Fortran
+            # order (LAPACK's) so that triangular solves never copy it. z = R⁻ᵀAᵀY, W = R⁻¹z.
+            self.gram_factor_ = np.asfortranarray(cholesky(A.T @ A + self.reg * np.eye(A.shape[1]), lower=False))
+            self.hidden_pinv_ = None
+            self._projected_targets = solve_triangular(self.gram_factor_, A.T @ Y, trans="T")
+            self.output_weights_ = np.ascontiguousarray(solve_triangular(self.gram_factor_, self._projected_targets))
+        else:
+            self.hidden_pinv_ = np.ascontiguousarray(_ridge_pinv(A, self.reg))
+            self.gram_factor_ = None
+            self.output_weights_ = self.hidden_pinv_ @ Y
+
+    @single_threaded_blas
+    def add_enhancement_nodes(self, n: int) -> "BLS":
+        """Add a block of ``n`` enhancement nodes and update the output weights without
+        retraining (Eq. 23–26, or the exact ridge block inverse). Returns self."""
+        check_fitted(self, "output_weights_")
+        n = check_int(n, "n", minimum=1)
+        A, Y = self.train_hidden_, self.train_targets_
+        Z = A[:, : self.n_windows * self.n_mapped]
+        E = self._new_enhancement_block(Z, n)
+        if self.update_rule_ == "exact_ridge":
+            # Block Cholesky: R_new = [[R, R12], [0, R22]] with R12 = R⁻ᵀAᵀE and
+            # R22 = chol(EᵀE + λI − R12ᵀR12); then block forward/back substitution reuses
+            # z = R⁻ᵀAᵀY and the old weights: O(N·c·m + c²·(m + D)), no refactorisation.
+            # (Inputs are our own finite arrays: skip SciPy's O(c²) finiteness scans.)
+            R = self.gram_factor_
+            c = R.shape[0]
+            R12 = solve_triangular(R, A.T @ E, trans="T", check_finite=False)
+            R22 = cholesky(E.T @ E + self.reg * np.eye(n) - R12.T @ R12, lower=False, check_finite=False)
+            z_new = solve_triangular(R22, E.T @ Y - R12.T @ self._projected_targets, trans="T", check_finite=False)
+            W_new = solve_triangular(R22, z_new, check_finite=False)
+            W_old = self.output_weights_ - solve_triangular(R, R12 @ W_new, check_finite=False)
+            grown = np.zeros((c + n, c + n), order="F")
+            grown[:c, :c], grown[:c, c:], grown[c:, c:] = R, R12, R22
+            self.gram_factor_ = grown
+            self._projected_targets = np.vstack([self._projected_targets, z_new])
+            self.output_weights_ = np.ascontiguousarray(np.vstack([W_old, W_new]))
+            self._append_train_hidden(E)
+        else:
+            D, Bt, case = block_pinv_update(A, self.hidden_pinv_, E)
+            logger.debug("added %d enhancement nodes (C case: %s)", n, case)
+            self.hidden_pinv_ = np.vstack([self.hidden_pinv_ - D @ Bt, Bt])
+            BtY = Bt @ Y
+            self.output_weights_ = np.vstack([self.output_weights_ - D @ BtY, BtY])
+            self._append_train_hidden(E)
+        return self
+
+    def predict(self, X) -> np.ndarray:
+        """Outputs for inputs X: ``hidden(X) @ output_weights_``, shape (N, n_outputs)."""
+        out = self.hidden(X) @ self.output_weights_
+        return out[:, 0] if getattr(self, "_y_was_1d", False) else out
+
+    # -- persistence -----------------------------------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        check_fitted(self, "output_weights_")
+        arrays = {
+            "mapping_weights_": self.mapping_weights_,
+            "mapping_min_": self.mapping_min_,
+            "mapping_range_": self.mapping_range_,
+            "enhancement_scales_": np.asarray(self.enhancement_scales_),
+            "output_weights_": self.output_weights_,
+            "train_hidden_": np.ascontiguousarray(self.train_hidden_),
+            "train_targets_": self.train_targets_,
+        }
+        for block, weights in enumerate(self.enhancement_weights_):
+            arrays[f"enhancement_weights_{block}"] = weights
+        arrays["pinv_or_gram"] = self.hidden_pinv_ if self.update_rule_ == "pinv" else self.gram_factor_
+        meta = {"params": self.get_params(), "n_features_": self.n_features_,
+                "n_blocks": len(self.enhancement_weights_), "y_was_1d": bool(self._y_was_1d)}
+        return meta, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays: dict) -> "BLS":
+        model = cls(**meta["params"])
+        model.n_features_ = check_int(meta["n_features_"], "n_features_", minimum=1)
+        n_blocks = check_int(meta["n_blocks"], "n_blocks", minimum=1)
+        model._y_was_1d = bool(meta["y_was_1d"])
+        for name in ("mapping_weights_", "mapping_min_", "mapping_range_", "output_weights_", "train_targets_"):
+            setattr(model, name, np.asarray(arrays[name], dtype=np.float64))
+        model._set_train_hidden(np.asarray(arrays["train_hidden_"], dtype=np.float64))
+        model.enhancement_weights_ = [np.asarray(arrays[f"enhancement_weights_{b}"], dtype=np.float64) for b in range(n_blocks)]
+        model.enhancement_scales_ = [float(v) for v in np.asarray(arrays["enhancement_scales_"]).reshape(-1)]
+        if len(model.enhancement_scales_) != n_blocks:
+            raise ValueError("enhancement_scales_ does not match the number of blocks")
+        expected = (model.n_windows, model.n_features_ + 1, model.n_mapped)
+        if model.mapping_weights_.shape != expected:
+            raise ValueError(f"mapping_weights_ has shape {model.mapping_weights_.shape}, expected {expected}")
+        n_hidden = model.n_windows * model.n_mapped + sum(w.shape[1] for w in model.enhancement_weights_)
+        if model.output_weights_.shape[0] != n_hidden or model.train_hidden_.shape[1] != n_hidden:
+            raise ValueError("output weights do not match the hidden layer")
+        companion = np.asarray(arrays["pinv_or_gram"], dtype=np.float64)
+        model.hidden_pinv_ = companion if model.update_rule_ == "pinv" else None
+        model.gram_factor_ = np.asfortranarray(companion) if model.update_rule_ == "exact_ridge" else None
+        if model.gram_factor_ is not None:
+            model._projected_targets = solve_triangular(model.gram_factor_, model.train_hidden_.T @ model.train_targets_, trans="T")
+        return model

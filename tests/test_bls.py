@@ -1,0 +1,153 @@
+"""Broad Learning System (SPEC §6): incremental updates against from-scratch pinv / ridge."""
+
+import numpy as np
+import pytest
+
+import bidmp
+from bidmp import BLS
+from bidmp.bls import PINV_RCOND, block_pinv_update, sparse_autoencoder
+
+
+def random_problem(seed=0, n_rows=300, n_inputs=5):
+    rng = np.random.default_rng(seed)
+    X = rng.uniform(-1, 1, (n_rows, n_inputs))
+    Y = np.column_stack([np.sin(3 * X[:, 0]) + X[:, 1] ** 2, np.cos(X[:, 2] * X[:, 3])])
+    return X, Y
+
+
+def full_rank(rng, n_rows, n_cols):
+    return rng.normal(size=(n_rows, n_cols))
+
+
+def rank_deficient(rng, n_rows, n_cols, rank):
+    return rng.normal(size=(n_rows, rank)) @ rng.normal(size=(rank, n_cols))
+
+
+@pytest.mark.parametrize("base", ["full", "deficient"])
+@pytest.mark.parametrize("kind, expected_case", [("random", "full-rank"), ("span", "zero"), ("mixed", "general")])
+def test_block_update_equals_pinv_from_scratch(base, kind, expected_case):
+    rng = np.random.default_rng(7)
+    A = full_rank(rng, 120, 25) if base == "full" else rank_deficient(rng, 120, 25, 15)
+    A_pinv = np.linalg.pinv(A, rcond=PINV_RCOND)
+    if kind == "random":
+        E = rng.normal(size=(120, 6))
+    elif kind == "span":
+        E = A @ rng.normal(size=(25, 6))
+    else:
+        E = np.hstack([rng.normal(size=(120, 2)), A @ rng.normal(size=(25, 4))])
+    D, Bt, case = block_pinv_update(A, A_pinv, E)
+    assert case == expected_case
+    updated = np.vstack([A_pinv - D @ Bt, Bt])
+    reference = np.linalg.pinv(np.hstack([A, E]), rcond=PINV_RCOND)
+    np.testing.assert_allclose(updated, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+    Y = rng.normal(size=(120, 3))
+    np.testing.assert_allclose(updated @ Y, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max())
+
+
+def test_zero_case_uses_plus_sign_not_the_circulating_minus():
+    # E inside span(A): the correct (I + DᵀD)⁻¹ gives pinv; the circulating (I − DᵀD) does not.
+    rng = np.random.default_rng(1)
+    A = rng.normal(size=(50, 8))
+    A_pinv = np.linalg.pinv(A)
+    E = A @ rng.normal(size=(8, 3))
+    D = A_pinv @ E
+    wrong = np.linalg.solve(np.eye(3) - D.T @ D, D.T @ A_pinv)
+    _, Bt, case = block_pinv_update(A, A_pinv, E)
+    reference = np.linalg.pinv(np.hstack([A, E]))[8:]
+    assert case == "zero"
+    np.testing.assert_allclose(Bt, reference, atol=1e-10)
+    assert not np.allclose(wrong, reference, atol=1e-3)
+
+
+def test_exact_ridge_update_equals_ridge_from_scratch():
+    X, Y = random_problem()
+    reg = 1e-3
+    model = BLS(n_enhance=40, reg=reg, update="exact_ridge", seed=1).fit(X, Y)
+    for n_nodes in (20, 35, 5):
+        model.add_enhancement_nodes(n_nodes)
+        A = model.hidden(X)
+        reference = np.linalg.solve(A.T @ A + reg * np.eye(A.shape[1]), A.T @ Y)
+        np.testing.assert_allclose(model.output_weights_, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+
+
+def test_pinv_update_matches_pinv_from_scratch_up_to_conditioning():
+    # Tanh nodes of the same inputs are nearly collinear: compare what conditioning allows.
+    X, Y = random_problem(2)
+    model = BLS(n_windows=2, n_mapped=4, n_enhance=30, shrink=3.0, reg=0.0, seed=3).fit(X, Y)
+    for n_nodes in (10, 10):
+        model.add_enhancement_nodes(n_nodes)
+        A = model.hidden(X)
+        reference = np.linalg.pinv(A, rcond=PINV_RCOND) @ Y
+        np.testing.assert_allclose(A @ model.output_weights_, A @ reference, atol=1e-6)
+        np.testing.assert_allclose(model.output_weights_, model.hidden_pinv_ @ Y, atol=1e-8 * np.abs(model.output_weights_).max())
+
+
+@pytest.mark.parametrize("params", [{}, {"reg": 0.0}, {"reg": 1e-3}, {"n_windows": 3, "n_mapped": 7}])
+def test_training_residual_never_rises_as_nodes_are_added(params):
+    X, Y = random_problem(4)
+    model = BLS(n_enhance=30, seed=5, **params).fit(X, Y)
+    residuals = [np.sqrt(np.mean((model.predict(X) - Y) ** 2))]
+    for _ in range(4):
+        model.add_enhancement_nodes(15)
+        residuals.append(np.sqrt(np.mean((model.predict(X) - Y) ** 2)))
+    assert all(later <= earlier * (1 + 1e-9) for earlier, later in zip(residuals, residuals[1:])), residuals
+    assert residuals[-1] < residuals[0]
+
+
+def test_same_seed_same_model_and_hidden_layer_layout():
+    X, Y = random_problem(6)
+    first = BLS(seed=9).fit(X, Y).add_enhancement_nodes(12)
+    again = BLS(seed=9).fit(X, Y).add_enhancement_nodes(12)
+    other = BLS(seed=10).fit(X, Y).add_enhancement_nodes(12)
+    np.testing.assert_array_equal(first.predict(X), again.predict(X))
+    assert not np.array_equal(first.predict(X), other.predict(X))
+    assert first.hidden(X).shape == (300, 10 * 10 + 100 + 12)
+    # Enhancement weights are orthonormal; the stored shrink factors reproduce max |pre| = shrink.
+    W = first.enhancement_weights_[1]
+    np.testing.assert_allclose(W.T @ W, np.eye(12), atol=1e-12)
+    Z = first.hidden(X)[:, :100]
+    pre = np.hstack([Z, np.full((300, 1), 0.1)]) @ W
+    assert np.max(np.abs(first.enhancement_scales_[1] * pre)) == pytest.approx(0.8)
+
+
+def test_sparse_autoencoder_solves_the_lasso():
+    rng = np.random.default_rng(0)
+    F = rng.normal(size=(200, 6))
+    truth = np.array([[1.5], [0.0], [-2.0], [0.0], [0.0], [0.7]])
+    target = F @ truth
+    beta = sparse_autoencoder(F, target, l1=1e-3, n_iter=500)
+    np.testing.assert_allclose(beta, truth, atol=1e-3)
+    heavy = sparse_autoencoder(F, target, l1=200.0, n_iter=500)
+    assert np.count_nonzero(np.abs(heavy) > 1e-12) < 3  # a large l1 zeroes the weak weights
+
+
+def test_save_load_reproduces_predictions_and_continues_learning(tmp_path):
+    X, Y = random_problem(8)
+    for params in ({}, {"reg": 0.0}):
+        model = BLS(n_enhance=30, seed=2, **params).fit(X, Y).add_enhancement_nodes(10)
+        path = bidmp.save(model, tmp_path / "bls.npz")
+        loaded = bidmp.load(path)
+        np.testing.assert_array_equal(loaded.predict(X), model.predict(X))
+        # Learning continues after loading (equal up to BLAS rounding, which depends on memory layout).
+        np.testing.assert_allclose(loaded.add_enhancement_nodes(7).predict(X), model.add_enhancement_nodes(7).predict(X), atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "call, error, match",
+    [
+        (lambda m, X, Y: m.add_enhancement_nodes(0), ValueError, "n must be >= 1"),
+        (lambda m, X, Y: m.add_enhancement_nodes(-3), ValueError, "n must be >= 1"),
+        (lambda m, X, Y: m.add_enhancement_nodes(2.5), TypeError, "n must be an integer"),
+        (lambda m, X, Y: m.predict(X[:, :3]), ValueError, "X must have 5 columns"),
+        (lambda m, X, Y: m.predict(np.full_like(X, np.nan)), ValueError, "NaN"),
+        (lambda m, X, Y: BLS().fit(X, Y[:10]), ValueError, "Y must have shape"),
+        (lambda m, X, Y: BLS(update="pinv", reg=1e-3), ValueError, "exact only with reg=0"),
+        (lambda m, X, Y: BLS(n_windows=0), ValueError, "n_windows must be >= 1"),
+        (lambda m, X, Y: BLS().predict(X), bidmp.NotFittedError, "not fitted"),
+    ],
+)
+def test_bad_input(call, error, match):
+    X, Y = random_problem(0, n_rows=60)
+    model = BLS(n_enhance=10).fit(X, Y)
+    with pytest.raises(error, match=match):
+        call(model, X, Y)

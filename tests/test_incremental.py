@@ -1,0 +1,137 @@
+"""Bi-DMP (SPEC §7): incremental forcing term, skill library, forgetting, persistence."""
+
+import numpy as np
+import pytest
+
+import bidmp
+from bidmp import BiDMP, DMP, extend_demonstration, forgetting
+from bidmp.datasets import lasa, minimum_jerk
+from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.incremental import resample_time
+
+
+def relative_rmse(a, b):
+    return np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1))) / np.linalg.norm(np.ptp(b, axis=0))
+
+
+@pytest.fixture(scope="module")
+def battery():
+    demo = minimum_jerk(BATTERY_APPROACH_VIA, 200)
+    dmp = DMP(alpha=100.0).fit(demo)
+    extension = extend_demonstration(demo, BATTERY_EXTENSION_TARGET, seed=0)
+    return demo, dmp, extension
+
+
+def test_learned_demonstration_is_reproduced_at_its_goal(battery):
+    demo, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    assert model.n_skills == 2
+    rollout = model.rollout(BATTERY_EXTENSION_TARGET)
+    assert relative_rmse(rollout, extension.complete) < 0.01
+    # ... which the plain DMP cannot do.
+    assert relative_rmse(dmp.rollout(BATTERY_EXTENSION_TARGET), extension.complete) > 0.05
+
+
+@pytest.mark.parametrize("name", ["Sshape", "WShape"])
+def test_lasa_extension_reproduced(name):
+    demo = lasa(name)[0]
+    dmp = DMP().fit(demo)
+    extension = extend_demonstration(demo, demo[-1] + [12.0, -9.0], seed=1)
+    model = BiDMP(dmp).learn(extension.complete)
+    assert relative_rmse(model.rollout(extension.complete[-1]), extension.complete) < 0.01
+
+
+def test_skill_zero_is_the_plain_dmp_bit_for_bit(battery):
+    demo, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    goals = [demo[-1], [60.0, 50.0, 0.0], [180.0, 0.0, 0.0]]
+    for goal in goals:
+        np.testing.assert_array_equal(model.rollout(goal, skill=0), dmp.rollout(goal))
+    np.testing.assert_array_equal(model.rollout(demo[-1]), dmp.rollout())  # nearest picks skill 0
+
+
+def test_zero_forcing_increment_leaves_the_dmp_unchanged(battery):
+    demo, dmp, _ = battery
+    model = BiDMP(dmp).learn_increment(np.zeros((dmp.n_steps_, 3)), goal=[150.0, 25.0, 0.0])
+    for goal in ([150.0, 25.0, 0.0], [30.0, 50.0, 0.0]):
+        np.testing.assert_allclose(model.rollout(goal, skill=1), dmp.rollout(goal), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(model.forcing_term(dmp.phase()), dmp.forcing_term(dmp.phase()), atol=1e-12)
+
+
+def three_operator_demonstrations(n_steps=200):
+    """Pick-and-place by three operators: same task, different height and reach (seeded)."""
+    demonstrations = []
+    for index, (height, reach) in enumerate([(150.0, 300.0), (190.0, 340.0), (120.0, 260.0)]):
+        via = [[0.0, 0.0, 0.0], [0.4 * reach, 20.0, height], [reach, 60.0, 30.0]]
+        demonstrations.append(minimum_jerk(via, n_steps, noise=0.5, seed=index))
+    return demonstrations
+
+
+def test_forgetting_nearest_is_zero_latest_forgets():
+    demonstrations = three_operator_demonstrations()
+    dmp = DMP(alpha=40.0).fit(demonstrations[0])
+    nearest = forgetting(dmp, demonstrations[1:], skill="nearest")
+    latest = forgetting(dmp, demonstrations[1:], skill="latest")
+    np.testing.assert_allclose(nearest.forgetting, 0.0, atol=1e-9)
+    assert np.all(latest.forgetting[:-1] > 1.0)  # mm: the earlier skills are overwritten
+    assert latest.forgetting[-1] == pytest.approx(0.0, abs=1e-9)
+    # Every learned skill is reproduced when it is learned.
+    extent = np.linalg.norm(np.ptp(demonstrations[1], axis=0))
+    assert np.all(np.diag(nearest.errors)[1:] < 0.01 * extent)
+
+
+def test_several_demonstrations_stack_blocks(battery):
+    demo, dmp, extension = battery
+    second = extend_demonstration(extension.complete, [60.0, 100.0, -20.0], seed=3)
+    model = BiDMP(dmp).learn(extension.complete).learn(second.complete)
+    assert model.n_skills == 3 and len(model.blocks_) == 2
+    assert relative_rmse(model.rollout([60.0, 100.0, -20.0]), second.complete) < 0.01
+    assert relative_rmse(model.rollout(BATTERY_EXTENSION_TARGET), extension.complete) < 0.01
+    assert model.select_skill([60.0, 100.0, -20.0]) == 2 and model.select_skill(demo[-1]) == 0
+    assert model.select_skill(demo[-1], "latest") == 2 and model.select_skill(demo[-1], 1) == 1
+
+
+def test_same_seed_same_model(battery):
+    _, dmp, extension = battery
+    first = BiDMP(dmp, seed=4).learn(extension.complete).rollout(BATTERY_EXTENSION_TARGET)
+    again = BiDMP(dmp, seed=4).learn(extension.complete).rollout(BATTERY_EXTENSION_TARGET)
+    np.testing.assert_array_equal(first, again)
+
+
+def test_save_load_reproduces_rollouts_bit_for_bit(tmp_path, battery):
+    demo, dmp, extension = battery
+    model = BiDMP(dmp, increments=(10, 15)).learn(extension.complete)
+    loaded = bidmp.load(bidmp.save(model, tmp_path / "bidmp.npz"))
+    assert isinstance(loaded, BiDMP) and loaded.n_skills == 2 and loaded.increments == (10, 15)
+    for goal in (BATTERY_EXTENSION_TARGET, demo[-1], [90.0, 50.0, 0.0]):
+        for skill in ("nearest", "latest", 0, 1):
+            np.testing.assert_array_equal(loaded.rollout(goal, skill=skill), model.rollout(goal, skill=skill))
+
+
+@pytest.mark.parametrize(
+    "call, error, match",
+    [
+        (lambda m: m.learn(np.zeros((50, 2)) + np.arange(50)[:, None]), ValueError, "y_dn has D = 2"),
+        (lambda m: m.learn(np.full((50, 3), np.nan)), ValueError, "NaN"),
+        (lambda m: m.learn(np.ones((2, 3))), ValueError, "at least 3 points"),
+        (lambda m: m.rollout([1.0, 2.0, 3.0], skill="favourite"), ValueError, "skill must be 'nearest', 'latest'"),
+        (lambda m: m.rollout([1.0, 2.0, 3.0], skill=5), ValueError, "skill must be between 0 and 1"),
+        (lambda m: m.rollout([1.0, 2.0]), ValueError, "goal must have 3"),
+        (lambda m: BiDMP(DMP()), bidmp.NotFittedError, "not fitted"),
+        (lambda m: BiDMP("dmp"), TypeError, "dmp must be a bidmp.DMP"),
+        (lambda m: BiDMP(m.dmp, increments=(0,)), ValueError, "increments must be >= 1"),
+    ],
+)
+def test_bad_input(battery, call, error, match):
+    _, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    with pytest.raises(error, match=match):
+        call(model)
+
+
+def test_resample_time_keeps_ends_and_uniform_sampling():
+    y = np.column_stack([np.linspace(0.0, 1.0, 7), np.linspace(2.0, 3.0, 7) ** 2])
+    out = resample_time(y, 13)
+    assert out.shape == (13, 2)
+    np.testing.assert_array_equal(out[[0, -1]], y[[0, -1]])
+    np.testing.assert_allclose(out[:, 0], np.linspace(0.0, 1.0, 13))
