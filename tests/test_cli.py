@@ -148,17 +148,47 @@ def test_segment_prints_points_and_plots(tmp_path, battery_files, capsys):
         assert f"{index} " in out
 
 
-def test_extend_writes_the_extended_demonstration(tmp_path, battery_files, capsys):
+def test_extend_learns_a_bidmp_and_rollout_uses_its_skills(tmp_path, battery_files, capsys):
     demo, model = battery_files
-    out_file = tmp_path / "extended.npy"
-    code, out, err = run(["extend", str(model), str(demo), "--target", "150", "25", "0", "-o", str(out_file),
-                          "--seed", "3", "--plot", str(tmp_path / "ext.png")], capsys)
+    bidmp_file, demo_out = tmp_path / "bidmp.npz", tmp_path / "extended.npy"
+    code, out, err = run(["extend", str(model), str(demo), "--target", "150", "25", "0", "-o", str(bidmp_file),
+                          "--seed", "3", "--save-demo", str(demo_out), "--plot", str(tmp_path / "ext.png")], capsys)
     assert code == 0, err
-    assert "G-PRM similarity per iteration" in out and "plain DMP to the new target ends" in out
-    extended = np.load(out_file)
-    expected = bidmp.extend_demonstration(load_trajectory(demo), [150, 25, 0], seed=3).complete
-    np.testing.assert_array_equal(extended, expected)
+    assert "G-PRM similarity per iteration" in out and "learned skill 1" in out
+    extension = bidmp.extend_demonstration(load_trajectory(demo), [150, 25, 0], seed=3)
+    np.testing.assert_array_equal(np.load(demo_out), extension.complete)
+    learned = bidmp.load(bidmp_file)
+    assert isinstance(learned, bidmp.BiDMP) and learned.n_skills == 2
+    expected = bidmp.BiDMP(bidmp.load(model)).learn(extension.complete)
+    np.testing.assert_array_equal(learned.rollout([150, 25, 0]), expected.rollout([150, 25, 0]))
     assert (tmp_path / "ext.png").stat().st_size > 10_000
+
+    # A second extension stacks a skill on the Bi-DMP model.
+    second = tmp_path / "bidmp2.npz"
+    assert main(["extend", str(bidmp_file), str(demo), "--target", "60", "50", "0", "-o", str(second)]) == 0
+    assert bidmp.load(second).n_skills == 3
+    capsys.readouterr()
+
+    for skill, expected_rollout in (("0", learned.dmp.rollout([150, 25, 0])), ("latest", learned.rollout([150, 25, 0], skill="latest"))):
+        out_file = tmp_path / f"r{skill}.npy"
+        code, out, err = run(["rollout", str(bidmp_file), "--goal", "150", "25", "0", "--skill", skill, "-o", str(out_file)], capsys)
+        assert code == 0, err
+        np.testing.assert_array_equal(np.load(out_file), expected_rollout)
+    code, out, _ = run(["rollout", str(bidmp_file), "-o", str(tmp_path / "default.npy")], capsys)
+    assert code == 0 and "using skill 1" in out
+
+
+def test_reproduce_figures_prints_forgetting_and_writes_figure(tmp_path, capsys):
+    code, out, err = run(["reproduce", "figures", "--out", str(tmp_path / "f")], capsys)
+    assert code == 0, err
+    assert "forgetting nearest" in out
+    results = json.loads((tmp_path / "f" / "figures.json").read_text())["results"]
+    assert [r["shape"] for r in results] == ["Sshape", "WShape", "NShape"]
+    for result in results:
+        assert max(result["bidmp_rmse"]) < 0.05 * min(result["dmp_rmse"])  # far below the plain DMP
+        assert np.allclose(result["forgetting_nearest"]["forgetting"], 0.0, atol=1e-9)
+        assert min(result["forgetting_latest"]["forgetting"][:-1]) > 1.0
+    assert (tmp_path / "f" / "bidmp_lasa.png").stat().st_size > 30_000
 
 
 def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
@@ -178,9 +208,11 @@ def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
     "argv, match",
     [
         (["segment", "{demo}", "--eps-frac", "1.5"], "eps_frac must lie in (0, 1)"),
-        (["extend", "{model}", "{demo}", "--target", "1", "2", "-o", "{tmp}/x.csv"], "new_target must have 3"),
-        (["extend", "{model}", "{tmp}/flat.csv", "--target", "1", "2", "-o", "{tmp}/x.csv"], "has D = 2 but the model"),
-        (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.csv"], "NaN"),
+        (["extend", "{model}", "{demo}", "--target", "1", "2", "-o", "{tmp}/x.npz"], "new_target must have 3"),
+        (["extend", "{model}", "{tmp}/flat.csv", "--target", "1", "2", "-o", "{tmp}/x.npz"], "has D = 2 but the model"),
+        (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.npz"], "NaN"),
+        (["extend", "{model}", "{demo}", "--target", "1", "2", "0", "-o", "{tmp}/x.csv"], "-o must be the Bi-DMP model file"),
+        (["rollout", "{model}", "--skill", "1", "-o", "{tmp}/x.csv"], "--skill needs a Bi-DMP model"),
         (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "n_seeds must be >= 1"),
     ],
 )
