@@ -25,6 +25,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
 	$(PY) benchmarks/bench_extension.py
 	$(PY) benchmarks/bench_incremental.py
+	$(PY) benchmarks/bench_scenario.py
 
 clean:
 	rm -rf $(VENV) bidmp-out .pytest_cache

@@ -52,11 +52,11 @@ def test_lasa_list_and_export(tmp_path, capsys):
     np.testing.assert_array_equal(np.load(tmp_path / "w.npy"), bidmp.datasets.lasa("WShape")[2])
 
 
-def test_demo_prints_a_table_and_writes_results(tmp_path, capsys):
-    code, out, err = run(["demo", "--out", str(tmp_path / "out")], capsys)
+def test_lasa_demo_prints_a_table_and_writes_results(tmp_path, capsys):
+    code, out, err = run(["demo", "--lasa", "Sshape", "--out", str(tmp_path / "out")], capsys)
     assert code == 0, err
     assert "reproduction RMSE" in out and "c * shift" in out
-    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    results = json.loads((tmp_path / "out" / "lasa_generalisation.json").read_text())
     assert results["shape"] == "Sshape"
     assert results["reproduction_rmse_percent"] < 1.0
     # The fixed-horizon error departs from the demonstrated goal's error by exactly c * shift.
@@ -65,6 +65,37 @@ def test_demo_prints_a_table_and_writes_results(tmp_path, capsys):
     assert np.all(np.abs(errors - results["endpoint_gain"] * shifts) <= results["goal_error"] + 1e-9)
     assert max(results["endpoint_errors_converged"]) < 0.1 * min(errors)
     assert (tmp_path / "out" / "lasa_generalisation.png").stat().st_size > 10_000
+
+
+def test_demo_runs_the_nut_scenario_prints_tables_and_writes_results(tmp_path, capsys):
+    code, out, err = run(["demo", "--out", str(tmp_path / "out")], capsys)
+    assert code == 0, err
+    assert "Table 4 analogue" in out and "Tables 1 and 2 analogue" in out
+    assert "57.14 %" in out and "100.00 %" in out
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert results["scenario"] == "nut-unscrewing"
+    assert results["methods"]["dmp"]["successes"] == 8 and results["methods"]["bidmp"]["successes"] == 14
+    for figure in ("targets_top_view.png", "error_vs_distance.png", "scenario_3d.png"):
+        assert (tmp_path / "out" / figure).stat().st_size > 20_000
+
+
+def test_demo_with_a_method_subset_and_scenario_list(tmp_path, capsys):
+    code, out, err = run(["demo", "--scenario", "pick-and-place", "--methods", "dmp,bidmp", "--out", str(tmp_path / "o")], capsys)
+    assert code == 0, err
+    assert set(json.loads((tmp_path / "o" / "results.json").read_text())["methods"]) == {"dmp", "bidmp"}
+    assert "forgetting" in out
+    code, out, _ = run(["scenario", "list"], capsys)
+    assert code == 0 and "nut-unscrewing" in out and "cell-removal" in out and "pick-and-place" in out
+
+
+def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
+    code, out, err = run(["reproduce", "table4", "--out", str(tmp_path / "t4")], capsys)
+    assert code == 0, err
+    summary = json.loads((tmp_path / "t4" / "table4.json").read_text())
+    assert {"nut-unscrewing", "cell-removal", "pick-and-place", "case_studies"} <= set(summary)
+    cells = summary["case_studies"]["cell_removal"]
+    assert cells["after"]["B6"] < cells["before"]["B6"]
+    assert "end error before" in out
 
 
 @pytest.mark.parametrize(
@@ -83,6 +114,9 @@ def test_demo_prints_a_table_and_writes_results(tmp_path, capsys):
         (["fit", "{tmp}/demo.csv"], "required: -o/--output"),
         (["rollout", "{tmp}/model.npz", "--goal", "x", "-o", "{tmp}/o.csv"], "invalid float value"),
         (["frobnicate"], "invalid choice"),
+        (["demo", "--scenario", "nowhere", "--out", "{tmp}/o"], "no such file, and not a built-in"),
+        (["demo", "--methods", "dmp,magic", "--out", "{tmp}/o"], "unknown method 'magic'"),
+        (["scenario", "show", "nope"], "unknown built-in scenario"),
     ],
 )
 def test_bad_input_gives_one_line_and_exit_code_2(tmp_path, demo_csv, argv, match, capsys):

@@ -21,6 +21,7 @@ _LAZY = {
     "BLS": ("bidmp.bls", "BLS"),
     "BiDMP": ("bidmp.incremental", "BiDMP"),
     "forgetting": ("bidmp.incremental", "forgetting"),
+    "evaluate": ("bidmp.evaluation", "evaluate"),
     "save": ("bidmp.io", "save_model"),
     "load": ("bidmp.io", "load_model"),
     "ModelFileError": ("bidmp.io", "ModelFileError"),
@@ -28,7 +29,7 @@ _LAZY = {
 }
 _SUBMODULES = (
     "dmp", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
-    "datasets", "io", "evaluation", "plotting",
+    "baselines", "datasets", "io", "scenarios", "evaluation", "plotting",
 )
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]

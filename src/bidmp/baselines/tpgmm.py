@@ -1,0 +1,86 @@
+"""Task-parameterised GMM (Calinon 2016, "A tutorial on task-parameterized movement learning and
+retrieval"), SPEC §8. No maintained Python 3 library under a permissive licence exists, so it is
+written here.
+
+Two frames ``(A_j, b_j)``: the start and the target. Each (augmented) demonstration is expressed
+in every frame, ``x⁽ʲ⁾ = A_j⁻¹ (x − b_j)``, and one GMM is fitted by EM on the stacked
+``[t, x⁽¹⁾, x⁽²⁾]``. For new frames, each component's per-frame Gaussian is mapped back
+(``μ̂ = A μ + b``, ``Σ̂ = A Σ Aᵀ``, t unchanged). The frames' Gaussians are multiplied, and GMR
+on t gives the trajectory.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import as_point, check_int, check_real
+from .gmm import augment, gmr
+
+__all__ = ["TPGMM"]
+
+
+class TPGMM:
+    """TP-GMM with a start frame and a target frame (identity orientation by default).
+
+    Parameters
+    ----------
+    n_components : int, default 16
+    reg_covar : float, default 1e-4
+        Regularisation of every covariance (and of each frame's Gaussian before the product). The
+        stacked frame coordinates are collinear for copies that share their frames; 1e-3 (mm²)
+        already biases the end point by 3–4 mm, 1e-4 does not.
+    n_copies, noise, seed : augmentation of a single demonstration.
+    """
+
+    def __init__(self, n_components: int = 16, reg_covar: float = 1e-4, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
+        self.n_components = check_int(n_components, "n_components", minimum=1)
+        self.reg_covar = check_real(reg_covar, "reg_covar", positive=True)
+        self.n_copies = check_int(n_copies, "n_copies", minimum=0)
+        self.noise = check_real(noise, "noise", nonnegative=True)
+        self.seed = check_int(seed, "seed", minimum=0)
+
+    def fit(self, y) -> "TPGMM":
+        """Fit on one demonstration (T, D); frames at each copy's own start and end."""
+        from sklearn.mixture import GaussianMixture
+
+        demos = augment(y, self.n_copies, self.noise, self.seed)
+        n_steps, n_dims = demos.shape[1], demos.shape[2]
+        t = np.linspace(0.0, 1.0, n_steps)[:, None]
+        # Identity orientations: local coordinates are translations (A_j⁻¹ = I).
+        data = np.concatenate([np.hstack([t, demo - demo[0], demo - demo[-1]]) for demo in demos])
+        mixture = GaussianMixture(self.n_components, covariance_type="full", reg_covar=self.reg_covar,
+                                  random_state=self.seed).fit(data)
+        self.weights_, self.means_, self.covariances_ = mixture.weights_, mixture.means_, mixture.covariances_
+        self.n_steps_, self.n_dims_ = n_steps, n_dims
+        return self
+
+    def _frame_gaussian(self, frame: int, A: np.ndarray, b: np.ndarray):
+        """Every component's [t, x] Gaussian of one frame, mapped to the global frame."""
+        d = self.n_dims_
+        index = np.r_[0, 1 + frame * d : 1 + (frame + 1) * d]
+        mu = self.means_[:, index]
+        sigma = self.covariances_[:, index][:, :, index]
+        transform = np.eye(d + 1)
+        transform[1:, 1:] = A
+        offset = np.r_[0.0, b]
+        mu_global = mu @ transform.T + offset
+        sigma_global = transform @ sigma @ transform.T + self.reg_covar * np.eye(d + 1)
+        return mu_global, sigma_global
+
+    def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
+        """Mean trajectory (n, D) and covariances for new start and target frames."""
+        d = self.n_dims_
+        start = as_point(start, d, "start")
+        target = as_point(target, d, "target")
+        rotations = [np.eye(d) if r is None else np.asarray(r, float) for r in (start_rotation, target_rotation)]
+        precision_sum = 0.0
+        weighted_mean = 0.0
+        for frame, (A, b) in enumerate(zip(rotations, (start, target))):
+            mu, sigma = self._frame_gaussian(frame, A, b)
+            precision = np.linalg.inv(sigma)
+            precision_sum = precision_sum + precision
+            weighted_mean = weighted_mean + np.einsum("kij,kj->ki", precision, mu)
+        covariance = np.linalg.inv(precision_sum)  # product of Gaussians
+        mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2)
+        return gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))

@@ -1,0 +1,303 @@
+"""Scenario files: a task as JSON (SPEC §9–10), validated strictly, with built-in scenarios.
+
+A scenario names the targets (labelled points), the demonstration and which target it shows, the
+success threshold, the DMP parameters and how Bi-DMP extends the skill. Unknown keys, wrong types,
+missing targets, or a demonstrated label that is not a target are errors naming the key.
+
+Keys (units: millimetres for the battery scenarios)::
+
+    name                 str, required
+    description          str
+    units                str, default "mm"
+    targets              {label: [x, y(, z)]}, required, at least one
+    demonstrated         label of the demonstrated target, required
+    demonstration        exactly one of {"minimum_jerk": {"via", "n_steps", "noise", "seed"}},
+                         {"points": [[x, y(, z)], ...]} or {"file": "demo.csv"} (relative to the file)
+    success_threshold    end-point error for success, default 1.75
+    approach_height      height band above a target for the approach error, default 28.5;
+                         null turns the approach metric off
+    dmp                  DMP parameters (alpha, beta, K, alpha_phase, tau, n_kernels, fit, widths,
+                         derivatives)
+    extension_target     "centre_of_failed" (default), a target label, or a point
+    extensions           list of {"target": as extension_target, "from": "demonstration" |
+                         "previous"}: chained extended demonstrations (overrides extension_target)
+    demonstrations       {label: demonstration}: further demonstrations learned directly by Bi-DMP
+                         (several operators); a target with the same label uses it as reference
+    methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
+    seed                 int, default 0 (G-PRM and the baselines)
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+from dataclasses import dataclass, field
+from importlib import resources
+from numbers import Integral, Real
+from pathlib import Path
+
+import numpy as np
+
+from .datasets import minimum_jerk
+from .io import load_trajectory
+
+__all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
+
+METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
+_KEYS = {
+    "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
+    "approach_height", "dmp", "extension_target", "extensions", "demonstrations", "methods", "seed",
+}
+_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "fit", "widths", "derivatives"}
+_MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
+
+
+class ScenarioError(ValueError):
+    """A scenario file is malformed; the message names the key."""
+
+
+@dataclass
+class Scenario:
+    """A validated scenario. ``spec`` is the JSON form (``to_dict``); arrays are resolved."""
+
+    name: str
+    targets: dict[str, np.ndarray]
+    demonstrated: str
+    demonstration: np.ndarray
+    success_threshold: float
+    approach_height: float | None
+    dmp: dict
+    extensions: list[dict]
+    demonstrations: dict[str, np.ndarray]
+    methods: list[str]
+    seed: int
+    units: str = "mm"
+    description: str = ""
+    spec: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def labels(self) -> list[str]:
+        return list(self.targets)
+
+    @property
+    def target_array(self) -> np.ndarray:
+        return np.stack(list(self.targets.values()))
+
+    def to_dict(self) -> dict:
+        """The scenario as JSON-ready data (round-trips through :func:`from_dict`)."""
+        return copy.deepcopy(self.spec)
+
+    def reference(self, label: str) -> np.ndarray:
+        """A reference demonstration to target ``label`` "produced by the same generator"
+        (SPEC §9): its own demonstration if one is given, else the demonstration generator with
+        its via points moved by the target offset, else the demonstration translated."""
+        if label in self.demonstrations:
+            return self.demonstrations[label]
+        offset = self.targets[label] - self.targets[self.demonstrated]
+        generator = self.spec["demonstration"].get("minimum_jerk")
+        if generator is not None:
+            via = np.asarray(generator["via"], dtype=float) + offset
+            return minimum_jerk(via, generator.get("n_steps", 200), generator.get("noise", 0.0), generator.get("seed", 0))
+        return self.demonstration + offset
+
+
+# ---------------------------------------------------------------------------------------------
+# Validation
+# ---------------------------------------------------------------------------------------------
+def _fail(source: str, key: str, message: str):
+    raise ScenarioError(f"scenario {source}: {key}: {message}")
+
+
+def _number(value, source, key, positive=False):
+    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value):
+        _fail(source, key, f"expected a number, got {json.dumps(value)}")
+    if positive and value <= 0:
+        _fail(source, key, f"must be > 0, got {value}")
+    return float(value)
+
+
+def _point(value, source, key, n_dims=None):
+    if not isinstance(value, list) or not value or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value):
+        _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {json.dumps(value)}")
+    point = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(point)):
+        _fail(source, key, "contains a non-finite number")
+    if n_dims is not None and point.shape[0] != n_dims:
+        _fail(source, key, f"has {point.shape[0]} coordinates, expected {n_dims}")
+    return point
+
+
+def _points(value, source, key, n_dims=None):
+    if not isinstance(value, list) or len(value) < 2:
+        _fail(source, key, "expected a list of at least 2 points")
+    points = [_point(p, source, f"{key}[{i}]", n_dims) for i, p in enumerate(value)]
+    if len({p.shape[0] for p in points}) != 1:
+        _fail(source, key, "points have different numbers of coordinates")
+    return np.stack(points)
+
+
+def _demonstration(value, source, key, base_dir):
+    if not isinstance(value, dict) or len(value) != 1:
+        _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
+    (kind, body), = value.items()
+    if kind == "minimum_jerk":
+        if not isinstance(body, dict):
+            _fail(source, f"{key}.minimum_jerk", "expected an object")
+        unknown = sorted(set(body) - _MINIMUM_JERK_KEYS)
+        if unknown:
+            _fail(source, f"{key}.minimum_jerk.{unknown[0]}", f"unknown key (known: {', '.join(sorted(_MINIMUM_JERK_KEYS))})")
+        if "via" not in body:
+            _fail(source, f"{key}.minimum_jerk.via", "missing")
+        via = _points(body["via"], source, f"{key}.minimum_jerk.via")
+        n_steps = body.get("n_steps", 200)
+        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < 10:
+            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= 10, got {json.dumps(n_steps)}")
+        noise = _number(body.get("noise", 0.0), source, f"{key}.minimum_jerk.noise")
+        if noise < 0:
+            _fail(source, f"{key}.minimum_jerk.noise", "must be >= 0")
+        seed = body.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, Integral) or seed < 0:
+            _fail(source, f"{key}.minimum_jerk.seed", f"expected a non-negative integer, got {json.dumps(seed)}")
+        return minimum_jerk(via, int(n_steps), noise, int(seed))
+    if kind == "points":
+        return _points(body, source, f"{key}.points")
+    if kind == "file":
+        if not isinstance(body, str) or not body:
+            _fail(source, f"{key}.file", "expected a file name")
+        path = Path(body) if os.path.isabs(body) else Path(base_dir) / body
+        try:
+            return load_trajectory(path)
+        except ValueError as exc:
+            _fail(source, f"{key}.file", str(exc))
+    _fail(source, key, f"unknown demonstration kind {kind!r} (expected minimum_jerk, points or file)")
+
+
+def _extension_target(value, source, key, targets, n_dims):
+    if value == "centre_of_failed":
+        return value
+    if isinstance(value, str):
+        if value not in targets:
+            _fail(source, key, f"{value!r} is neither 'centre_of_failed' nor a target label")
+        return value
+    return _point(value, source, key, n_dims).tolist()
+
+
+def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -> Scenario:
+    """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`."""
+    if not isinstance(data, dict):
+        raise ScenarioError(f"scenario {source}: expected a JSON object at the top level")
+    unknown = sorted(set(data) - _KEYS)
+    if unknown:
+        _fail(source, unknown[0], f"unknown key (known: {', '.join(sorted(_KEYS))})")
+    for key in ("name", "targets", "demonstrated", "demonstration"):
+        if key not in data:
+            _fail(source, key, "missing (required)")
+    if not isinstance(data["name"], str) or not data["name"]:
+        _fail(source, "name", "expected a non-empty string")
+    for key in ("description", "units"):
+        if key in data and not isinstance(data[key], str):
+            _fail(source, key, "expected a string")
+
+    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir)
+    n_dims = demonstration.shape[1]
+    if not isinstance(data["targets"], dict) or not data["targets"]:
+        _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
+    targets = {str(label): _point(point, source, f"targets.{label}", n_dims) for label, point in data["targets"].items()}
+    demonstrated = data["demonstrated"]
+    if not isinstance(demonstrated, str) or demonstrated not in targets:
+        _fail(source, "demonstrated", f"{json.dumps(demonstrated)} is not among the targets ({', '.join(targets)})")
+
+    threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
+    approach = data.get("approach_height", 28.5)
+    approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
+
+    dmp = data.get("dmp", {})
+    if not isinstance(dmp, dict):
+        _fail(source, "dmp", "expected an object of DMP parameters")
+    bad = sorted(set(dmp) - _DMP_KEYS)
+    if bad:
+        _fail(source, f"dmp.{bad[0]}", f"unknown DMP parameter (known: {', '.join(sorted(_DMP_KEYS))})")
+    try:
+        from .dmp import DMP
+
+        DMP(**dmp)
+    except (TypeError, ValueError) as exc:
+        _fail(source, "dmp", str(exc))
+
+    if "extensions" in data:
+        if not isinstance(data["extensions"], list) or not data["extensions"]:
+            _fail(source, "extensions", "expected a non-empty list of {target, from}")
+        extensions = []
+        for index, stage in enumerate(data["extensions"]):
+            key = f"extensions[{index}]"
+            if not isinstance(stage, dict) or set(stage) - {"target", "from"} or "target" not in stage:
+                _fail(source, key, 'expected {"target": ..., "from": "demonstration" | "previous"}')
+            origin = stage.get("from", "demonstration" if index == 0 else "previous")
+            if origin not in ("demonstration", "previous") or (index == 0 and origin == "previous"):
+                _fail(source, f"{key}.from", f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}")
+            extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims), "from": origin})
+    else:
+        target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
+        extensions = [{"target": target, "from": "demonstration"}]
+
+    extra = data.get("demonstrations", {})
+    if not isinstance(extra, dict):
+        _fail(source, "demonstrations", "expected an object {label: demonstration}")
+    demonstrations = {}
+    for label, spec in extra.items():
+        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir)
+        if trajectory.shape[1] != n_dims:
+            _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
+        demonstrations[str(label)] = trajectory
+
+    methods = data.get("methods", list(METHODS))
+    if not isinstance(methods, list) or not methods or not all(isinstance(m, str) for m in methods):
+        _fail(source, "methods", "expected a non-empty list of method names")
+    for method in methods:
+        if method not in METHODS:
+            _fail(source, "methods", f"unknown method {method!r} (known: {', '.join(METHODS)})")
+    seed = data.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, Integral) or seed < 0:
+        _fail(source, "seed", f"expected a non-negative integer, got {json.dumps(seed)}")
+
+    return Scenario(
+        name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
+        success_threshold=threshold, approach_height=approach, dmp=dict(dmp), extensions=extensions,
+        demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
+        units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Built-ins and loading
+# ---------------------------------------------------------------------------------------------
+def _builtin_dir():
+    return resources.files("bidmp").joinpath("data", "scenarios")
+
+
+def builtin_names() -> list[str]:
+    """Names of the built-in scenarios (nut-unscrewing, cell-removal, pick-and-place)."""
+    return sorted(entry.name[:-5] for entry in _builtin_dir().iterdir() if entry.name.endswith(".json"))
+
+
+def builtin_text(name: str) -> str:
+    """The JSON text of a built-in scenario (for ``bidmp scenario show NAME > my.json``)."""
+    if name not in builtin_names():
+        raise ScenarioError(f"unknown built-in scenario {name!r}; built-ins: {', '.join(builtin_names())}")
+    return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
+
+
+def load(path_or_name: str | os.PathLike) -> Scenario:
+    """Load a scenario from a JSON file, or a built-in by name."""
+    text_name = str(path_or_name)
+    if not text_name.endswith(".json") and text_name in builtin_names():
+        return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")
+    path = Path(path_or_name)
+    if not path.is_file():
+        raise ScenarioError(f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})")
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ScenarioError(f"scenario {path}: not valid JSON ({exc})") from None
+    return from_dict(data, source=str(path), base_dir=path.parent)
