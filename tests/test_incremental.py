@@ -7,7 +7,7 @@ import bidmp
 from bidmp import BiDMP, DMP, extend_demonstration, forgetting
 from bidmp.datasets import lasa, minimum_jerk
 from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
-from bidmp.incremental import resample_time
+from bidmp.segmentation import resample_time
 
 
 def relative_rmse(a, b):

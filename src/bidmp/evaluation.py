@@ -14,7 +14,8 @@ import numpy as np
 from .datasets import lasa, minimum_jerk
 from .dmp import DMP
 from .extension import ExtendedDemonstration, extend_demonstration
-from .incremental import BiDMP, ForgettingResult, forgetting, resample_time
+from .incremental import BiDMP, ForgettingResult, forgetting
+from .segmentation import resample_time
 from .roadmap import RoadmapResult, classic_prm, gaussian_prm
 
 __all__ = [

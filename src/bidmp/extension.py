@@ -21,7 +21,7 @@ from scipy.signal import savgol_filter
 
 from ._checks import as_point, as_trajectory
 from .roadmap import gaussian_prm
-from .segmentation import Piece, arclength, choose_piece, segment
+from .segmentation import Piece, arclength, choose_piece, resample_time, segment
 
 __all__ = ["ExtendedDemonstration", "extend_demonstration", "time_path"]
 
@@ -112,15 +112,6 @@ def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float
     return positions, n_steps * dt
 
 
-def _resample_time(points: np.ndarray, n_samples: int) -> np.ndarray:
-    """Resample samples that are uniform in time to ``n_samples`` uniform samples (same span)."""
-    source = np.linspace(0.0, 1.0, points.shape[0])
-    target = np.linspace(0.0, 1.0, n_samples)
-    out = np.column_stack([np.interp(target, source, column) for column in points.T])
-    out[0], out[-1] = points[0], points[-1]
-    return out
-
-
 def extend_demonstration(y, new_target, *, seed: int | np.random.Generator | None = 0, **options) -> ExtendedDemonstration:
     """Grow an extended demonstration from ``y`` to ``new_target`` (1D-SEG + G-PRM).
 
@@ -172,7 +163,7 @@ def extend_demonstration(y, new_target, *, seed: int | np.random.Generator | Non
     if mean_speed <= 0.0:
         mean_speed = arclength(y)[-1]  # the piece does not move: use the demonstration's mean speed
     timed, _ = time_path(tra_gen, start_speed, mean_speed, dt)
-    complete = _resample_time(np.vstack([prefix, timed]), n_steps)
+    complete = resample_time(np.vstack([prefix, timed]), n_steps)
     complete[-1] = target
     logger.debug("extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
                  piece.index, piece.start, piece.end, len(history))

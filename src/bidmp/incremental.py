@@ -27,22 +27,11 @@ import numpy as np
 from ._checks import as_point, as_trajectory, check_choice, check_fitted, check_int, check_real
 from .bls import BLS
 from .dmp import DMP, forcing_target
+from .segmentation import resample_time
 
 __all__ = ["BiDMP", "ForgettingResult", "forgetting", "resample_time"]
 
 logger = logging.getLogger(__name__)
-
-
-def resample_time(y: np.ndarray, n_samples: int) -> np.ndarray:
-    """Resample a trajectory that is uniform in time to ``n_samples`` uniform samples (ends kept)."""
-    y = np.asarray(y, dtype=np.float64)
-    if y.shape[0] == n_samples:
-        return y.copy()
-    source = np.linspace(0.0, 1.0, y.shape[0])
-    target = np.linspace(0.0, 1.0, n_samples)
-    out = np.column_stack([np.interp(target, source, column) for column in y.T])
-    out[0], out[-1] = y[0], y[-1]
-    return out
 
 
 class BiDMP:

@@ -16,12 +16,17 @@ __all__ = ["plot_trajectories", "plot_generalisation", "plot_segmentation", "plo
            "plot_error_vs_distance", "plot_scenario_3d"]
 
 
-def _figure(projection_3d: bool):
+def _pyplot():
     import matplotlib
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
+    return plt
+
+
+def _figure(projection_3d: bool):
+    plt = _pyplot()
     fig = plt.figure(figsize=(7.0, 6.0), dpi=110)
     ax = fig.add_subplot(projection="3d" if projection_3d else None)
     return plt, fig, ax
@@ -98,11 +103,7 @@ def plot_trajectories(
 def plot_generalisation(path: str | os.PathLike, result) -> Path:
     """Two panels for a :class:`bidmp.evaluation.GeneralisationResult` (2-D): the rollouts to moved
     goals with the paper's fixed horizon (left) and run to convergence (right)."""
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
+    plt = _pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
     panels = (
         (result.fixed_horizon, f"T = {result.demonstration.shape[0]} steps (paper): end-point gain c = {result.endpoint_gain:.3f}"),
@@ -128,15 +129,6 @@ def plot_generalisation(path: str | os.PathLike, result) -> Path:
     axes[0].legend(loc="best", fontsize=8)
     fig.suptitle(f"LASA {result.shape}: one demonstration, DMP rollouts to moved goals")
     return _save(plt, fig, path)
-
-
-def _pyplot():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _axes_for(fig, n_dims: int, *grid):

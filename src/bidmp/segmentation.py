@@ -23,6 +23,7 @@ from ._checks import as_point, as_trajectory, check_choice, check_real
 
 __all__ = [
     "resample_arclength",
+    "resample_time",
     "arclength",
     "curvature",
     "segment",
@@ -52,6 +53,18 @@ def resample_arclength(y, n_points: int) -> np.ndarray:
         return np.repeat(y[:1], n_points, axis=0)
     grid = np.linspace(0.0, s[-1], n_points)
     out = np.column_stack([np.interp(grid, s, column) for column in y.T])
+    out[0], out[-1] = y[0], y[-1]
+    return out
+
+
+def resample_time(y: np.ndarray, n_samples: int) -> np.ndarray:
+    """Resample a trajectory that is uniform in time to ``n_samples`` uniform samples (ends kept)."""
+    y = np.asarray(y, dtype=np.float64)
+    if y.shape[0] == n_samples:
+        return y.copy()
+    source = np.linspace(0.0, 1.0, y.shape[0])
+    target = np.linspace(0.0, 1.0, n_samples)
+    out = np.column_stack([np.interp(target, source, column) for column in y.T])
     out[0], out[-1] = y[0], y[-1]
     return out
 

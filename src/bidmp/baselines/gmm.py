@@ -12,7 +12,7 @@ import numpy as np
 from .._checks import as_trajectory, check_int, check_real
 from .._noise import perturb
 
-__all__ = ["gmr", "augment", "GMMRegressor"]
+__all__ = ["gmr", "augment", "fit_mixture", "GMMRegressor"]
 
 
 def gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1):
@@ -65,7 +65,26 @@ def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0)
     return np.stack([y] + [perturb(y, noise, rng) for _ in range(n_copies)])
 
 
-class GMMRegressor:
+def fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int):
+    """EM for a full-covariance Gaussian mixture (scikit-learn): (weights, means, covariances)."""
+    from sklearn.mixture import GaussianMixture
+
+    mixture = GaussianMixture(n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed).fit(data)
+    return mixture.weights_, mixture.means_, mixture.covariances_
+
+
+class _AugmentedMixture:
+    """Parameters shared by the baselines: mixture size, regularisation, augmentation, seed."""
+
+    def __init__(self, n_components: int, reg_covar: float, n_copies: int, noise: float, seed: int):
+        self.n_components = check_int(n_components, "n_components", minimum=1)
+        self.reg_covar = check_real(reg_covar, "reg_covar", positive=True)
+        self.n_copies = check_int(n_copies, "n_copies", minimum=0)
+        self.noise = check_real(noise, "noise", nonnegative=True)
+        self.seed = check_int(seed, "seed", minimum=0)
+
+
+class GMMRegressor(_AugmentedMixture):
     """Time-driven GMM/GMR on one (augmented) demonstration.
 
     Parameters
@@ -80,23 +99,15 @@ class GMMRegressor:
     """
 
     def __init__(self, n_components: int = 16, reg_covar: float = 1e-6, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
-        self.n_components = check_int(n_components, "n_components", minimum=1)
-        self.reg_covar = check_real(reg_covar, "reg_covar", positive=True)
-        self.n_copies = check_int(n_copies, "n_copies", minimum=0)
-        self.noise = check_real(noise, "noise", nonnegative=True)
-        self.seed = check_int(seed, "seed", minimum=0)
+        super().__init__(n_components, reg_covar, n_copies, noise, seed)
 
     def fit(self, y) -> "GMMRegressor":
         """Fit on one demonstration (T, D), time scaled to [0, 1]."""
-        from sklearn.mixture import GaussianMixture
-
         demos = augment(y, self.n_copies, self.noise, self.seed)
         n_steps = demos.shape[1]
         t = np.linspace(0.0, 1.0, n_steps)
         data = np.concatenate([np.column_stack([t, demo]) for demo in demos])
-        mixture = GaussianMixture(self.n_components, covariance_type="full", reg_covar=self.reg_covar,
-                                  random_state=self.seed).fit(data)
-        self.weights_, self.means_, self.covariances_ = mixture.weights_, mixture.means_, mixture.covariances_
+        self.weights_, self.means_, self.covariances_ = fit_mixture(data, self.n_components, self.reg_covar, self.seed)
         self.n_steps_ = n_steps
         return self
 

@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_point, check_int, check_real
-from .gmm import augment, gmr
+from .._checks import as_point, check_int
+from .gmm import _AugmentedMixture, augment, fit_mixture, gmr
 
 __all__ = ["TPGMM"]
 
 
-class TPGMM:
+class TPGMM(_AugmentedMixture):
     """TP-GMM with a start frame and a target frame (identity orientation by default).
 
     Parameters
@@ -33,24 +33,16 @@ class TPGMM:
     """
 
     def __init__(self, n_components: int = 16, reg_covar: float = 1e-4, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
-        self.n_components = check_int(n_components, "n_components", minimum=1)
-        self.reg_covar = check_real(reg_covar, "reg_covar", positive=True)
-        self.n_copies = check_int(n_copies, "n_copies", minimum=0)
-        self.noise = check_real(noise, "noise", nonnegative=True)
-        self.seed = check_int(seed, "seed", minimum=0)
+        super().__init__(n_components, reg_covar, n_copies, noise, seed)
 
     def fit(self, y) -> "TPGMM":
         """Fit on one demonstration (T, D); frames at each copy's own start and end."""
-        from sklearn.mixture import GaussianMixture
-
         demos = augment(y, self.n_copies, self.noise, self.seed)
         n_steps, n_dims = demos.shape[1], demos.shape[2]
         t = np.linspace(0.0, 1.0, n_steps)[:, None]
         # Identity orientations: local coordinates are translations (A_j⁻¹ = I).
         data = np.concatenate([np.hstack([t, demo - demo[0], demo - demo[-1]]) for demo in demos])
-        mixture = GaussianMixture(self.n_components, covariance_type="full", reg_covar=self.reg_covar,
-                                  random_state=self.seed).fit(data)
-        self.weights_, self.means_, self.covariances_ = mixture.weights_, mixture.means_, mixture.covariances_
+        self.weights_, self.means_, self.covariances_ = fit_mixture(data, self.n_components, self.reg_covar, self.seed)
         self.n_steps_, self.n_dims_ = n_steps, n_dims
         return self
 
