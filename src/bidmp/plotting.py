@@ -323,6 +323,7 @@ def plot_error_vs_distance(path, report) -> Path:
                     color=_METHOD_COLOURS.get(name), label=name, markersize=4)
         ax.axhline(scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold")
         ax.set_yscale("symlog", linthresh=1.0)
+        ax.set_ylim(bottom=0.0)
         ax.set_xlabel(f"distance from the demonstrated target [{scenario.units}]")
         ax.set_ylabel(f"{title} [{scenario.units}]")
         ax.grid(True, alpha=0.3)
