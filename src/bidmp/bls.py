@@ -32,7 +32,7 @@ import logging
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
-from ._checks import check_choice, check_fitted, check_int, check_real
+from ._checks import _as_float_array, _check_finite, check_choice, check_fitted, check_int, check_real
 from ._threads import single_threaded_blas
 
 __all__ = ["BLS", "sparse_autoencoder", "block_pinv_update"]
@@ -253,8 +253,6 @@ class BLS:
         return self.output_weights_.shape[0]
 
     def _check_X(self, X) -> np.ndarray:
-        from ._checks import _as_float_array, _check_finite
-
         X = _as_float_array(X, "X")
         if X.ndim != 2:
             raise ValueError(f"X must have shape (N, d), got shape {X.shape}")
@@ -302,8 +300,6 @@ class BLS:
         return self
 
     def _check_Y(self, Y, n_rows: int) -> np.ndarray:
-        from ._checks import _as_float_array, _check_finite
-
         Y = _as_float_array(Y, "Y")
         self._y_was_1d = Y.ndim == 1
         Y = Y.reshape(-1, 1) if Y.ndim == 1 else Y

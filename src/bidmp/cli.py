@@ -71,6 +71,13 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _rollout_goal(model, goal):
+    """The goal a rollout went to: the one given, else the model's default (a Bi-DMP's latest skill)."""
+    if goal is not None:
+        return goal
+    return model.skill_goals_[-1] if hasattr(model, "skill_goals_") else model.goal_
+
+
 def _cmd_rollout(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -86,18 +93,17 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
         dmp = model
     elif hasattr(model, "skill_goals_"):
         skill = "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
-        goal = model.skill_goals_[-1] if args.goal is None else args.goal
-        index = model.select_skill(goal, skill)
-        trajectory = model.rollout(goal=goal, skill=skill, start=args.start, n_steps=args.n_steps)
+        query = _rollout_goal(model, args.goal)
+        index = model.select_skill(query, skill)
+        trajectory = model.rollout(goal=query, skill=skill, start=args.start, n_steps=args.n_steps)
         print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal "
               f"{np.array2string(model.skill_goals_[index], precision=3)})")
         dmp = model.dmp
-        args.goal = goal
     else:
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     times = np.arange(trajectory.shape[0]) * dmp.dt_  # one Euler step is dt seconds
     path = save_trajectory(args.output, trajectory, times=times if args.output.lower().endswith(".csv") else None)
-    goal = dmp.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
+    goal = np.asarray(_rollout_goal(model, args.goal), dtype=float)
     print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")
     print(f"  end point {np.array2string(trajectory[-1], precision=4)}, distance to goal {np.linalg.norm(trajectory[-1] - goal):.4g}")
     print(f"wrote {path}")
@@ -128,6 +134,7 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
 
 def _run_scenario(scenario, out, methods=None, quiet_progress=False):
     """Evaluate a scenario with a progress bar, print Tables 4 and 1/2, write results and figures."""
+    import numpy as np
     from tqdm import tqdm
 
     from .evaluation import evaluate
@@ -147,8 +154,6 @@ def _run_scenario(scenario, out, methods=None, quiet_progress=False):
     print(f"\n{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
           f"success = end-point error <= {scenario.success_threshold:g} {units}")
     if report.extension_targets:
-        import numpy as np
-
         print(f"plain DMP misses {len(report.failed_targets)} target(s) ({', '.join(report.failed_targets)}); "
               f"Bi-DMP extended to {', '.join(np.array2string(np.asarray(t), precision=1) for t in report.extension_targets)}")
     rows = []
@@ -163,8 +168,6 @@ def _run_scenario(scenario, out, methods=None, quiet_progress=False):
     origin = scenario.targets[scenario.demonstrated]
     per_target = []
     for label, target in scenario.targets.items():
-        import numpy as np
-
         cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
         for result in data["methods"].values():
             error = result["errors"][label]

@@ -421,6 +421,13 @@ class DMP:
         self._grid_cache = (phase.shape[0], phase, basis, self._unit_responses(phase, None))
         return self._grid_cache
 
+    def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Phase (n,) and basis rows (n, N) on the rollout grid (default ``n_steps_``), cached."""
+        check_fitted(self, "weights_")
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        phase, basis, _ = self._grid(n_steps)
+        return phase, basis
+
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
         check_fitted(self, "weights_")
@@ -525,7 +532,11 @@ class DMP:
         """
         check_fitted(self, "weights_")
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
-        goal_response = self._grid(n_steps)[2][0]
+        cached = self.__dict__.get("_grid_cache")
+        if cached is not None and cached[0] == n_steps:
+            goal_response = cached[3][0]
+        else:  # B needs no basis matrix, and other horizons should not evict the cached grid
+            goal_response = self._unit_responses(self.phase(n_steps), None)[0]
         return float(abs(1.0 - goal_response[-1]))
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------

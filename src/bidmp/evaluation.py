@@ -7,6 +7,7 @@ on it.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -14,7 +15,7 @@ import numpy as np
 from .datasets import lasa, minimum_jerk
 from .dmp import DMP
 from .extension import ExtendedDemonstration, extend_demonstration
-from .incremental import BiDMP, ForgettingResult, forgetting
+from .incremental import BiDMP, ForgettingResult, forgetting_runs
 from .segmentation import resample_time
 from .roadmap import RoadmapResult, classic_prm, gaussian_prm
 
@@ -211,7 +212,10 @@ def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int 
     prm_options = {k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")}
     gprm, prm, example_prm = [], [], None
     for seed in range(n_seeds):
-        gprm.append(gaussian_prm(extension.tra_imi, extension.new_target, seed=seed, **roadmap_options).history)
+        if seed == 0 and len(extension.similarity_history):
+            gprm.append(extension.similarity_history)  # the extension already ran G-PRM with seed 0
+        else:
+            gprm.append(gaussian_prm(extension.tra_imi, extension.new_target, seed=seed, **roadmap_options).history)
         result = classic_prm(extension.tra_imi, extension.new_target, seed=seed, **prm_options)
         prm.append(result.history)
         example_prm = example_prm or result
@@ -273,6 +277,7 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
     for extension in extensions:
         model.learn(extension.complete)
     completes = [extension.complete for extension in extensions]
+    runs = forgetting_runs(dmp, completes, ("nearest", "latest"), **bidmp_params)
     return IncrementalResult(
         shape=name,
         demonstration=demonstration,
@@ -280,8 +285,8 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
         extensions=extensions,
         bidmp_rollouts=np.stack([model.rollout(target) for target in targets]),
         dmp_rollouts=dmp.rollout_many(targets),
-        forgetting_nearest=forgetting(dmp, completes, skill="nearest", **bidmp_params),
-        forgetting_latest=forgetting(dmp, completes, skill="latest", **bidmp_params),
+        forgetting_nearest=runs["nearest"],
+        forgetting_latest=runs["latest"],
     )
 
 
@@ -374,14 +379,10 @@ class Report:
 
 class _Timer:
     def __enter__(self):
-        import time
-
         self._start = time.perf_counter()
         return self
 
     def __exit__(self, *exc):
-        import time
-
         self.seconds = time.perf_counter() - self._start
         return False
 
@@ -504,7 +505,7 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
             report.methods[method] = result(method, trajectories, timer.seconds)
     if scenario.demonstrations:
         demos = list(scenario.demonstrations.values())
-        report.forgetting = {skill: forgetting(dmp, demos, skill=skill) for skill in ("nearest", "latest")}
+        report.forgetting = forgetting_runs(dmp, demos, ("nearest", "latest"))
     return report
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import inspect
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.signal import savgol_filter
@@ -65,7 +65,6 @@ class ExtendedDemonstration:
     similarity: float = float("nan")
     template: np.ndarray | None = None
     samples: np.ndarray | None = None
-    options: dict = field(default_factory=dict)
 
     @property
     def prefix(self) -> np.ndarray:
@@ -174,5 +173,4 @@ def extend_demonstration(y, new_target, *, seed: int | np.random.Generator | Non
         similarity=float("nan") if result is None else result.similarity,
         template=None if result is None else result.template,
         samples=None if result is None else result.samples,
-        options={"seed": seed if isinstance(seed, (int, type(None))) else "generator", **options},
     )

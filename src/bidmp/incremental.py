@@ -29,7 +29,7 @@ from .bls import BLS
 from .dmp import DMP, forcing_target
 from .segmentation import resample_time
 
-__all__ = ["BiDMP", "ForgettingResult", "forgetting", "resample_time"]
+__all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
 
 logger = logging.getLogger(__name__)
 
@@ -106,11 +106,6 @@ class BiDMP:
         return f"BiDMP(n_skills={self.n_skills}, {', '.join(f'{k}={v!r}' for k, v in self.get_params().items())})"
 
     # -- learning --------------------------------------------------------------------------------
-    def _grid(self):
-        dmp = self.dmp
-        phase = dmp.phase()
-        return phase, dmp.basis(phase)
-
     def forcing_term(self, phase, skill: int | None = None) -> np.ndarray:
         """``f_in`` of a skill (default: all blocks) at the given phases, shape (L, D)."""
         phase = np.asarray(phase, dtype=np.float64).reshape(-1)
@@ -137,7 +132,7 @@ class BiDMP:
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"y_dn has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
         y = resample_time(y, dmp.n_steps_)
-        phase, basis = self._grid()
+        phase, basis = dmp.grid_basis()
         target = forcing_target(
             y, phase, dt=dmp.dt_, tau=dmp.tau, alpha=dmp.alpha, beta=dmp.beta_value, K=dmp.K_value,
             derivatives=dmp.derivatives if self.derivatives == "dmp" else self.derivatives,
@@ -163,7 +158,7 @@ class BiDMP:
             raise ValueError("forcing_increment contains NaN or inf")
         goal = as_point(goal, dmp.n_dims_, "goal")
         start = dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start")
-        _, basis = self._grid()
+        _, basis = dmp.grid_basis()
         block = BLS(
             n_windows=self.n_windows, n_mapped=self.n_mapped, n_enhance=self.n_enhance, shrink=self.shrink,
             reg=self.reg, seed=self.seed + len(self.blocks_) + 1,
@@ -281,26 +276,34 @@ class ForgettingResult:
                 "forgetting": self.forgetting.tolist()}
 
 
-def forgetting(dmp: DMP, demonstrations, skill="nearest", **bidmp_params) -> ForgettingResult:
-    """Learn ``demonstrations`` (each (T', D)) in turn into a fresh Bi-DMP and measure forgetting.
-
-    The reference of skill 0 is the DMP's own rollout; of skill p, demonstration p resampled to
-    the DMP's T. Each skill is queried at its training goal and start with ``skill``.
-    """
+def forgetting_runs(dmp: DMP, demonstrations, skills=("nearest", "latest"), **bidmp_params) -> dict:
+    """:func:`forgetting` for several skill rules from one learning pass: {skill: ForgettingResult}."""
     model = BiDMP(dmp, **bidmp_params)
     references = [dmp.rollout()]
     n_skills = len(demonstrations) + 1
-    errors = np.full((n_skills, n_skills), np.nan)
+    errors = {skill: np.full((n_skills, n_skills), np.nan) for skill in skills}
 
     def measure(column: int) -> None:
-        for p in range(column + 1):
-            rollout = model.rollout(model.skill_goals_[p], skill=skill, start=model.skill_starts_[p])
-            errors[p, column] = float(np.sqrt(np.mean(np.sum((rollout - references[p]) ** 2, axis=1))))
+        for skill in skills:
+            for p in range(column + 1):
+                rollout = model.rollout(model.skill_goals_[p], skill=skill, start=model.skill_starts_[p])
+                errors[skill][p, column] = float(np.sqrt(np.mean(np.sum((rollout - references[p]) ** 2, axis=1))))
 
     measure(0)
     for index, demonstration in enumerate(demonstrations, start=1):
         model.learn(demonstration)
         references.append(resample_time(as_trajectory(demonstration, "demonstration"), dmp.n_steps_))
         measure(index)
-    result = errors[:, -1] - np.diag(errors)
-    return ForgettingResult(skill=str(skill), errors=errors, forgetting=result)
+    return {
+        skill: ForgettingResult(skill=str(skill), errors=matrix, forgetting=matrix[:, -1] - np.diag(matrix))
+        for skill, matrix in errors.items()
+    }
+
+
+def forgetting(dmp: DMP, demonstrations, skill="nearest", **bidmp_params) -> ForgettingResult:
+    """Learn ``demonstrations`` (each (T', D)) in turn into a fresh Bi-DMP and measure forgetting.
+
+    The reference of skill 0 is the DMP's own rollout; of skill p, demonstration p resampled to
+    the DMP's T. Each skill is queried at its training goal and start with ``skill``.
+    """
+    return forgetting_runs(dmp, demonstrations, (skill,), **bidmp_params)[skill]
