@@ -141,8 +141,8 @@ def test_save_load_reproduces_predictions_and_continues_learning(tmp_path):
         (lambda m, X, Y: m.predict(X[:, :3]), ValueError, "X must have 5 columns"),
         (lambda m, X, Y: m.predict(np.full_like(X, np.nan)), ValueError, "NaN"),
         (lambda m, X, Y: BLS().fit(X, Y[:10]), ValueError, "Y must have shape"),
-        (lambda m, X, Y: BLS(update="pinv", reg=1e-3), ValueError, "exact only with reg=0"),
-        (lambda m, X, Y: BLS(n_windows=0), ValueError, "n_windows must be >= 1"),
+        (lambda m, X, Y: BLS(update="pinv", reg=1e-3).fit(X, Y), ValueError, "exact only with reg=0"),
+        (lambda m, X, Y: BLS(n_windows=0).fit(X, Y), ValueError, "n_windows must be >= 1"),
         (lambda m, X, Y: BLS().predict(X), bidmp.NotFittedError, "not fitted"),
     ],
 )
@@ -151,3 +151,38 @@ def test_bad_input(call, error, match):
     model = BLS(n_enhance=10).fit(X, Y)
     with pytest.raises(error, match=match):
         call(model, X, Y)
+
+
+@pytest.mark.parametrize(
+    "bad_fit",
+    [
+        lambda m, X, Y: m.fit(X, Y[:10]),  # bad data
+        lambda m, X, Y: m.fit(X[:, :2], np.full_like(Y, np.nan)),
+        lambda m, X, Y: m.set_params(n_windows=0).fit(X, Y),  # bad parameter
+        lambda m, X, Y: m.set_params(update="pinv", reg=1e-3).fit(X, Y),
+    ],
+)
+def test_failed_fit_leaves_predictions_unchanged(bad_fit):
+    X, Y = random_problem(0, n_rows=80)
+    model = BLS(n_enhance=15).fit(X, Y).add_enhancement_nodes(5)
+    before = model.predict(X)
+    params = model.get_params()
+    with pytest.raises((ValueError, TypeError)):
+        bad_fit(model, X, Y)
+    model.set_params(**params)
+    np.testing.assert_array_equal(model.predict(X), before)
+    assert model.predict(X).shape == Y.shape
+    model.add_enhancement_nodes(3)  # and it still learns
+    assert model.n_hidden_ == 10 * 10 + 15 + 5 + 3
+
+
+def test_estimator_conventions():
+    from sklearn.base import clone
+
+    X, Y = random_problem(1, n_rows=60)
+    model = BLS(n_enhance=12, seed=4)
+    assert not hasattr(model, "output_weights_") and repr(model) == "BLS(n_enhance=12, seed=4)"
+    fitted = clone(model).fit(X, Y)
+    again = clone(fitted)
+    assert again.get_params() == model.get_params() and not hasattr(again, "output_weights_")
+    np.testing.assert_array_equal(again.fit(X, Y).predict(X), fitted.predict(X))

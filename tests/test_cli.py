@@ -21,7 +21,7 @@ def run(argv, capsys):
 
 @pytest.fixture
 def demo_csv(tmp_path):
-    return save_trajectory(tmp_path / "demo.csv", curved_demo(200, 3))
+    return save_trajectory(curved_demo(200, 3), tmp_path / "demo.csv")
 
 
 def test_fit_then_rollout_round_trip(tmp_path, demo_csv, capsys):
@@ -162,9 +162,9 @@ def test_version_and_help(capsys):
 @pytest.fixture
 def battery_files(tmp_path, capsys):
     from bidmp.datasets import minimum_jerk
-    from bidmp.evaluation import BATTERY_APPROACH_VIA
+    from bidmp.reproduce import BATTERY_APPROACH_VIA
 
-    demo = save_trajectory(tmp_path / "approach.csv", minimum_jerk(BATTERY_APPROACH_VIA, 200))
+    demo = save_trajectory(minimum_jerk(BATTERY_APPROACH_VIA, 200), tmp_path / "approach.csv")
     model = tmp_path / "approach.npz"
     assert main(["fit", str(demo), "-o", str(model), "--alpha", "100"]) == 0
     capsys.readouterr()
@@ -177,7 +177,7 @@ def test_segment_prints_points_and_plots(tmp_path, battery_files, capsys):
     assert code == 0, err
     assert "segmentation point" in out and "max" in out
     assert (tmp_path / "seg.png").stat().st_size > 10_000
-    expected = bidmp.segment(load_trajectory(demo))
+    expected = bidmp.segment(load_trajectory(demo)).points
     for index in expected:
         assert f"{index} " in out
 
@@ -247,12 +247,12 @@ def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
         (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.npz"], "NaN"),
         (["extend", "{model}", "{demo}", "--target", "1", "2", "0", "-o", "{tmp}/x.csv"], "-o must be the Bi-DMP model file"),
         (["rollout", "{model}", "--skill", "1", "-o", "{tmp}/x.csv"], "--skill needs a Bi-DMP model"),
-        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "n_seeds must be >= 1"),
+        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be >= 1"),
     ],
 )
 def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, match, capsys):
     demo, model = battery_files
-    save_trajectory(tmp_path / "flat.csv", curved_demo(50, 2))
+    save_trajectory(curved_demo(50, 2), tmp_path / "flat.csv")
     code = exit_code([a.format(demo=demo, model=model, tmp=tmp_path) for a in argv])
     _, err = capsys.readouterr()
     assert code == 2 and match in err and len(err.strip().splitlines()) == 1, err

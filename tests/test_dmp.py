@@ -42,7 +42,7 @@ def rel_rmse(a, b):
         {},
         {"K": "pastor"},
         {"alpha": 100.0, "tau": 1.7},
-        {"alpha": 40.0, "beta": 3.0, "alpha_phase": 3.0, "fit": "ridge"},
+        {"alpha": 40.0, "beta": 3.0, "alpha_phase": 3.0, "regression": "ridge"},
         {"K": 12.5, "n_kernels": 7, "widths": "pydmps"},
     ],
 )
@@ -78,14 +78,14 @@ def test_lasa_reproduction_below_one_percent(name):
 
 def test_ridge_fit_reproduces_better_than_lwr_on_lasa():
     demo = lasa("Sshape")[0]
-    lwr = rel_rmse(DMP(fit="lwr").fit(demo).rollout(), demo)
-    ridge = rel_rmse(DMP(fit="ridge").fit(demo).rollout(), demo)
+    lwr = rel_rmse(DMP(regression="lwr").fit(demo).rollout(), demo)
+    ridge = rel_rmse(DMP(regression="ridge").fit(demo).rollout(), demo)
     assert ridge < lwr < 0.01
 
 
 def test_forward_differences_reproduce_almost_exactly_with_enough_kernels():
     demo = minimum_jerk([0, 0], [1, 2], 100)
-    dmp = DMP(n_kernels=100, fit="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(n_kernels=100, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
     assert rel_rmse(dmp.rollout(), demo) < 1e-4
 
 
@@ -160,7 +160,7 @@ def test_endpoint_gain_spec_values_and_convergence():
 def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
     # Fit with forward differences and many kernels so the demonstrated goal is hit almost exactly.
     demo = minimum_jerk([0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 200)
-    dmp = DMP(alpha=100.0, n_kernels=200, fit="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(alpha=100.0, n_kernels=200, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
     shift = np.array([150.0, 25.0, 0.0])
     error = np.linalg.norm(dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift))
     assert error == pytest.approx(dmp.endpoint_gain() * np.linalg.norm(shift), rel=1e-3)
@@ -171,7 +171,7 @@ def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
 def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
     demo = curved_demo(n_steps, 2, seed=2) if n_steps >= 10 else minimum_jerk([0, 0], [1, 1], n_steps)
     for fit in ("lwr", "ridge"):
-        dmp = DMP(fit=fit).fit(demo)
+        dmp = DMP(regression=fit).fit(demo)
         phase = dmp.phase()
         assert phase[0] == 1.0 and phase.shape == (n_steps,)
         assert np.all(dmp.centres_ <= 1.0) and np.all(dmp.centres_ >= phase[-1] - 1e-15)
@@ -287,14 +287,15 @@ def test_rollout_rejects_bad_goal_start_and_steps(demo3d):
         ({"n_kernels": 0}, "n_kernels must be >= 1"),
         ({"alpha": -1.0}, "alpha must be > 0"),
         ({"K": "huge"}, "K must be one of"),
-        ({"fit": "gpr"}, "fit must be one of"),
+        ({"regression": "gpr"}, "regression must be one of"),
         ({"tau": float("nan")}, "tau must be finite"),
         ({"widths": "wide"}, "widths must be one of"),
     ],
 )
-def test_bad_parameters_are_named(params, match):
+def test_bad_parameters_are_named_at_fit(params, match):
+    model = DMP(**params)  # scikit-learn convention: the constructor only stores
     with pytest.raises(ValueError, match=match):
-        DMP(**params)
+        model.fit(minimum_jerk([0.0], [1.0], 20))
 
 
 def test_too_fast_phase_is_rejected_at_fit():
@@ -305,3 +306,69 @@ def test_too_fast_phase_is_rejected_at_fit():
 def test_unfitted_model_says_so():
     with pytest.raises(NotFittedError, match="not fitted"):
         DMP().rollout()
+
+
+# --- hyperparameters after fit, temporal scaling, estimator conventions ------------------------
+@pytest.mark.parametrize(
+    "name, value",
+    [("tau", 1.6), ("alpha", 31.0), ("beta", 5.0), ("K", "pastor"), ("K", 40.0), ("alpha_phase", 2.5)],
+)
+@pytest.mark.parametrize("how", ["attribute", "set_params"])
+def test_parameter_change_after_fit_equals_a_fresh_model_with_that_parameter(name, value, how, demo3d):
+    from sklearn.base import clone
+
+    dmp = DMP().fit(demo3d)
+    goal = demo3d[-1] + 0.3
+    before = dmp.rollout(goal)  # fills the cache with the old parameters
+    if how == "attribute":
+        setattr(dmp, name, value)
+    else:
+        dmp.set_params(**{name: value})
+    fresh = clone(dmp)  # the new parameter, no learned state ...
+    fresh.__dict__.update({k: v for k, v in dmp.__dict__.items() if k.endswith("_") and not k.startswith("_")})
+    after = dmp.rollout(goal)
+    np.testing.assert_array_equal(after, fresh.rollout(goal))  # ... given the same weights
+    np.testing.assert_allclose(after, euler_reference(dmp, goal, demo3d[0], after.shape[0]), atol=1e-9)
+    assert dmp.endpoint_gain() == fresh.endpoint_gain()
+    assert after.shape != before.shape or not np.allclose(after, before)
+
+
+def test_tau_is_temporal_scaling_same_path_slower(demo3d):
+    nominal = DMP().fit(demo3d)
+    slow = DMP(tau=2.0).fit(demo3d)
+    np.testing.assert_array_equal(slow.weights_, nominal.weights_)  # learned at the demo's own time scale
+    y1, y2 = nominal.rollout(), slow.rollout()
+    assert y2.shape == (2 * demo3d.shape[0], 3)  # default horizon: tau · T samples of dt
+    extent = np.linalg.norm(np.ptp(demo3d, axis=0))
+    # Same path in twice the time: every second sample of the slow rollout is the nominal one
+    # (up to the Euler step, which halves).
+    assert np.sqrt(np.mean(np.sum((y2[1::2] - y1) ** 2, axis=1))) / extent < 5e-3
+    speed1 = np.linalg.norm(np.diff(y1, axis=0), axis=1).max() / nominal.dt_
+    speed2 = np.linalg.norm(np.diff(y2, axis=0), axis=1).max() / slow.dt_
+    assert speed2 / speed1 == pytest.approx(0.5, rel=0.02)
+
+
+def test_estimator_conventions(demo2d):
+    from sklearn.base import clone
+
+    dmp = DMP(alpha=30.0, K="pastor", regression="ridge")
+    assert "weights_" not in vars(dmp) and not hasattr(dmp, "weights_")
+    assert repr(dmp) == "DMP(K='pastor', alpha=30.0, regression='ridge')"
+    copy = clone(dmp)
+    assert copy.get_params() == dmp.get_params() and copy is not dmp
+    fitted = clone(dmp).fit(demo2d)
+    np.testing.assert_array_equal(clone(fitted).fit(demo2d).rollout(), fitted.rollout())
+    assert not hasattr(clone(fitted), "weights_")
+    assert dmp.set_params(alpha=50.0) is dmp and dmp.alpha == 50.0
+
+
+def test_failed_fit_leaves_the_model_as_it_was(demo2d):
+    dmp = DMP().fit(demo2d)
+    before = dmp.rollout()
+    with pytest.raises(ValueError, match="y contains NaN"):
+        dmp.fit(np.full((50, 2), np.nan))
+    dmp.alpha = -1.0
+    with pytest.raises(ValueError, match="alpha must be > 0"):
+        dmp.fit(demo2d)
+    dmp.alpha = 25.0
+    np.testing.assert_array_equal(dmp.rollout(), before)

@@ -8,7 +8,8 @@ from scipy.stats import spearmanr
 
 import bidmp
 from bidmp import DMP, scenarios
-from bidmp.evaluation import approach_error, evaluate
+from bidmp.evaluation import evaluate
+from bidmp.metrics import approach_error
 
 NUT_COLUMNS_FAILED = ["9", "10", "11", "12", "13", "14"]
 
@@ -33,8 +34,13 @@ def test_bidmp_succeeds_everywhere_with_the_two_level_pattern(nut):
     assert nut.methods["bidmp"].successes == 14
     middle = [errors[label] for label in ("10", "13")]  # the column of the extension target
     outer = [errors[label] for label in ("9", "11", "12", "14")]  # 39 mm from it
-    assert np.ptp(middle) < 0.05 and np.ptp(outer) < 0.1
-    assert max(middle) + 0.1 < min(outer) < 0.8
+    # Each level spreads by at most twice the skill's own end-point error (a vector added to the
+    # horizon term c·(g − g_n), whose direction differs per nut).
+    target = np.asarray(nut.extension_targets[0])
+    own = np.linalg.norm(nut.model.rollout(target)[-1] - target)
+    assert own < 0.15
+    assert np.ptp(middle) <= 2 * own + 0.02 and np.ptp(outer) <= 2 * own + 0.02
+    assert max(middle) + 0.05 < min(outer) < 0.8
     # The two levels are the horizon artefact around the new skill's goal: c · ‖g − g_n‖.
     gain = DMP(**nut.scenario.dmp).fit(nut.scenario.demonstration).endpoint_gain()
     assert np.mean(outer) == pytest.approx(gain * np.hypot(30, 25), abs=0.05)

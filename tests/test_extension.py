@@ -3,9 +3,11 @@
 import numpy as np
 import pytest
 
+import bidmp
+
 from bidmp import extend_demonstration
 from bidmp.datasets import lasa, minimum_jerk
-from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 
 @pytest.fixture(scope="module")
@@ -54,7 +56,7 @@ def test_same_seed_same_extension_and_options_pass_through(battery):
     assert np.array_equal(first.complete, again.complete)
     fewer = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4, n_iter=3, n_samples=100, eps_frac=0.2)
     assert fewer.similarity_history.shape == (3,)
-    with pytest.raises(TypeError, match="unknown option.*n_iterations"):
+    with pytest.raises(TypeError, match="unexpected keyword argument 'n_iterations'"):
         extend_demonstration(battery, BATTERY_EXTENSION_TARGET, n_iterations=3)
 
 
@@ -87,3 +89,16 @@ def test_extension_is_fast_enough_to_stay_out_of_the_way(battery):
     start = time.perf_counter()
     extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
     assert time.perf_counter() - start < 5.0
+
+
+def test_options_are_listed_in_the_signature():
+    import inspect
+
+    from bidmp.roadmap import gaussian_prm
+
+    signature = inspect.signature(extend_demonstration).parameters
+    for name, parameter in inspect.signature(gaussian_prm).parameters.items():
+        if parameter.kind is inspect.Parameter.KEYWORD_ONLY:
+            assert signature[name].default == parameter.default, name  # same defaults as G-PRM
+    assert signature["eps_frac"].default == inspect.signature(bidmp.segment).parameters["eps_frac"].default
+    assert not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in signature.values())

@@ -6,8 +6,8 @@ import pytest
 import bidmp
 from bidmp import BiDMP, DMP, extend_demonstration, forgetting
 from bidmp.datasets import lasa, minimum_jerk
-from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
-from bidmp.segmentation import resample_time
+from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp._trajectory import resample_time
 
 
 def relative_rmse(a, b):
@@ -117,9 +117,10 @@ def test_save_load_reproduces_rollouts_bit_for_bit(tmp_path, battery):
         (lambda m: m.rollout([1.0, 2.0, 3.0], skill="favourite"), ValueError, "skill must be 'nearest', 'latest'"),
         (lambda m: m.rollout([1.0, 2.0, 3.0], skill=5), ValueError, "skill must be between 0 and 1"),
         (lambda m: m.rollout([1.0, 2.0]), ValueError, "goal must have 3"),
-        (lambda m: BiDMP(DMP()), bidmp.NotFittedError, "not fitted"),
-        (lambda m: BiDMP("dmp"), TypeError, "dmp must be a bidmp.DMP"),
-        (lambda m: BiDMP(m.dmp, increments=(0,)), ValueError, "increments must be >= 1"),
+        (lambda m: BiDMP(DMP()).learn(np.ones((5, 3))), bidmp.NotFittedError, "not fitted"),
+        (lambda m: BiDMP(DMP()).rollout(), bidmp.NotFittedError, "not fitted"),
+        (lambda m: BiDMP("dmp").fit(np.eye(3)), TypeError, "dmp must be a bidmp.DMP"),
+        (lambda m: BiDMP(m.dmp_, increments=(0,)).learn(np.eye(3)), ValueError, "increments must be >= 1"),
     ],
 )
 def test_bad_input(battery, call, error, match):
@@ -135,3 +136,64 @@ def test_resample_time_keeps_ends_and_uniform_sampling():
     assert out.shape == (13, 2)
     np.testing.assert_array_equal(out[[0, -1]], y[[0, -1]])
     np.testing.assert_allclose(out[:, 0], np.linspace(0.0, 1.0, 13))
+
+
+# --- convergence: the increment vanishes with the phase ----------------------------------------
+def test_every_skill_rolled_out_ten_times_longer_reaches_its_goal(battery):
+    demo, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    second = extend_demonstration(extension.complete, [60.0, 50.0, 0.0], seed=3)
+    model.learn(second.complete)
+    long = 10 * dmp.n_steps_
+    plain = np.linalg.norm(dmp.rollout(n_steps=long)[-1] - demo[-1])
+    for skill in range(model.n_skills):
+        for goal in (model.skill_goals_[skill], model.skill_goals_[skill] + [20.0, -10.0, 5.0]):
+            error = np.linalg.norm(model.rollout(goal, skill=skill, n_steps=long)[-1] - goal)
+            assert error <= 0.01, (skill, goal, error)  # mm
+    assert plain <= 0.01
+    # Longer still, the Bi-DMP keeps converging like the plain DMP (no drift past the horizon).
+    goal = model.skill_goals_[1]
+    assert np.linalg.norm(model.rollout(goal, skill=1, n_steps=40 * dmp.n_steps_)[-1] - goal) < 1e-6
+
+
+def test_increment_vanishes_with_the_phase_and_is_held_below_the_trained_range(battery):
+    _, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    phase = np.array([1.0, 0.6, model.phase_min_, 0.2, 1e-3, 0.0])
+    increment = model.forcing_term(phase) - dmp.forcing_term(phase)
+    np.testing.assert_array_equal(increment[-1], 0.0)
+    # Below the trained range the BLS input is held: increment = phase · BLS(φ(phase_min)).
+    held = model.blocks_[0].predict(dmp.basis([model.phase_min_]))[0]
+    np.testing.assert_allclose(increment[3:], phase[3:, None] * held[None], rtol=1e-12, atol=1e-12)
+    assert np.abs(increment[-2]).max() < 1e-2 * np.abs(increment[:3]).max()
+
+
+def test_output_weights_stay_moderate(battery):
+    _, dmp, extension = battery
+    model = BiDMP(dmp).learn(extension.complete)
+    increment = model.forcing_term(dmp.phase()) - dmp.forcing_term(dmp.phase())
+    target_scale = np.abs(increment / dmp.phase()[:, None]).max()
+    weights = max(np.abs(block.output_weights_).max() for block in model.blocks_)
+    assert weights < 10 * target_scale  # was 450× with reg = 1e-8 (7.5e5 on the nut task)
+
+
+# --- estimator conventions ------------------------------------------------------------------------
+def test_estimator_conventions_and_clone(battery):
+    from sklearn.base import clone
+
+    demo, dmp, extension = battery
+    model = BiDMP(dmp, n_enhance=60, increments=(10,))
+    params = model.get_params(deep=True)
+    assert params["dmp__alpha"] == 100.0 and params["n_enhance"] == 60  # the DMP's parameters too
+    assert not hasattr(model, "blocks_") and not hasattr(model, "dmp_")
+    copy = clone(model)
+    assert copy.get_params()["dmp__alpha"] == 100.0 and copy.dmp is not dmp
+    assert not hasattr(copy.dmp, "weights_")  # clone drops learned state, as in scikit-learn
+    with pytest.raises(bidmp.NotFittedError, match="not fitted"):
+        copy.learn(extension.complete)
+    copy.fit(demo).learn(extension.complete)  # fit() fits a copy of the DMP on the demonstration
+    model.learn(extension.complete)
+    np.testing.assert_array_equal(copy.rollout(), model.rollout())
+    assert not hasattr(copy.dmp, "weights_")  # the parameter itself is never fitted
+    model.set_params(dmp__alpha=100.0, reg=1e-4)
+    assert "BiDMP(" in repr(model)

@@ -41,7 +41,7 @@ def test_csv_variants(tmp_path, text, expected):
 def test_nonuniform_time_is_resampled_to_uniform_steps(tmp_path):
     times = np.array([0.0, 0.1, 0.5, 0.6, 1.0])
     positions = np.column_stack([times * 2.0, times**2])
-    save_trajectory(tmp_path / "demo.csv", positions, times=times)
+    save_trajectory(positions, tmp_path / "demo.csv", times=times)
     y = load_trajectory(tmp_path / "demo.csv")
     grid = np.linspace(0.0, 1.0, 5)
     np.testing.assert_allclose(y[:, 0], 2.0 * grid)  # linear in time: exact after resampling
@@ -51,7 +51,7 @@ def test_nonuniform_time_is_resampled_to_uniform_steps(tmp_path):
 @pytest.mark.parametrize("suffix", [".csv", ".npy"])
 def test_trajectory_round_trip_is_exact(tmp_path, suffix):
     y = curved_demo(50, 3)
-    path = save_trajectory(tmp_path / f"traj{suffix}", y)
+    path = save_trajectory(y, tmp_path / f"traj{suffix}")
     np.testing.assert_array_equal(load_trajectory(path), y)
 
 

@@ -28,9 +28,10 @@ def test_import_and_cli_help_do_not_import_numpy():
 
 # Layers of ARCHITECTURE.md: a module may import only from its own or lower-numbered layers.
 LAYERS = {
-    "_checks": 1, "_threads": 1, "_noise": 1, "dmp": 1, "segmentation": 1, "similarity": 1, "roadmap": 1, "bls": 1, "baselines": 1,
+    "_checks": 1, "_threads": 1, "_noise": 1, "_trajectory": 1, "dmp": 1, "segmentation": 1, "similarity": 1,
+    "roadmap": 1, "bls": 1, "baselines": 1,
     "extension": 2, "incremental": 2,
-    "datasets": 3, "io": 3, "scenarios": 3, "evaluation": 3, "plotting": 3,
+    "datasets": 3, "io": 3, "scenarios": 3, "metrics": 3, "evaluation": 3, "reproduce": 3, "plotting": 3, "_tables": 3,
     "cli": 4, "__main__": 4,
 }
 
@@ -65,6 +66,38 @@ def test_modules_respect_the_layers():
         for imported in bidmp_imports(path):
             if imported in LAYERS and imported not in ("__init__", module):
                 assert LAYERS[imported] <= LAYERS[module], f"{path.name} ({module}, layer {LAYERS[module]}) imports {imported}"
+
+
+def test_no_import_cycles():
+    graph = {}
+    for path in SRC.rglob("*.py"):
+        module = module_of(path)
+        if module != "__init__":
+            graph.setdefault(module, set()).update(m for m in bidmp_imports(path) if m in LAYERS and m != module)
+    state = {}
+
+    def visit(module, trail):
+        if state.get(module) == "done":
+            return
+        assert state.get(module) != "active", f"import cycle: {' -> '.join(trail + [module])}"
+        state[module] = "active"
+        for imported in sorted(graph.get(module, ())):
+            visit(imported, trail + [module])
+        state[module] = "done"
+
+    for module in sorted(graph):
+        visit(module, [])
+
+
+def test_plotting_never_switches_the_matplotlib_backend(tmp_path):
+    code = (
+        "import matplotlib; matplotlib.use('svg'); import numpy as np; from bidmp.plotting import plot_trajectories;"
+        f"plot_trajectories({str(tmp_path / 'p.png')!r}, np.random.default_rng(0).normal(size=(20, 3)));"
+        "import sys; print(matplotlib.get_backend(), 'matplotlib.pyplot' in sys.modules)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert result.stdout.split() == ["svg", "False"]
+    assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_library_code_never_prints():

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from bidmp.datasets import minimum_jerk
-from bidmp.evaluation import compare_prm, table5_cases
+from bidmp.reproduce import compare_prm, table5_cases
 from bidmp.roadmap import classic_prm, gaussian_prm, shortest_path, template
-from bidmp.segmentation import resample_arclength
+from bidmp._trajectory import resample_arclength
 from bidmp.similarity import frechet_similarity
 
 

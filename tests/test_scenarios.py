@@ -45,7 +45,7 @@ def test_copy_a_builtin_to_a_file_and_edit_it(tmp_path, capsys):
 
 def test_demonstration_from_points_and_from_a_csv_file(tmp_path):
     demo = scenarios.load("nut-unscrewing").demonstration
-    save_trajectory(tmp_path / "demo.csv", demo)
+    save_trajectory(demo, tmp_path / "demo.csv")
     data = nut_spec()
     data["demonstration"] = {"file": "demo.csv"}
     (tmp_path / "s.json").write_text(json.dumps(data))
@@ -71,7 +71,7 @@ MALFORMED = [
     (lambda d: d.update(success_threshold=-1), "success_threshold: must be > 0"),
     (lambda d: d.update(success_threshold="tight"), "success_threshold: expected a number"),
     (lambda d: d.update(approach_height=0), "approach_height: must be > 0"),
-    (lambda d: d["dmp"].update(alpah=3), "dmp.alpah: unknown DMP parameter"),
+    (lambda d: d["dmp"].update(alpah=3), "dmp.alpah: unknown parameter"),
     (lambda d: d["dmp"].update(alpha=-5), "dmp: alpha must be > 0"),
     (lambda d: d.update(methods=["dmp", "magic"]), "methods: unknown method 'magic'"),
     (lambda d: d.update(extension_target="middle"), "extension_target: 'middle' is neither"),
@@ -81,6 +81,10 @@ MALFORMED = [
     (lambda d: d.update(demonstration={"file": "missing.csv"}), "demonstration.file:"),
     (lambda d: d.update(extensions=[{"target": "3", "from": "previous"}]), "extensions[0].from"),
     (lambda d: d.update(seed=-2), "seed: expected a non-negative integer"),
+    (lambda d: d["dmp"].update(fit="ridge"), "dmp.fit: renamed to 'regression'"),
+    (lambda d: d.update(bidmp={"reg": -1.0}), "bidmp: reg must be >= 0"),
+    (lambda d: d.update(bidmp={"n_nodes": 3}), "bidmp.n_nodes: unknown parameter"),
+    (lambda d: d.update(extension={"n_iterations": 3}), "extension.n_iterations: unknown parameter"),
 ]
 
 
@@ -109,3 +113,15 @@ def test_not_json_and_unknown_builtin(tmp_path):
         scenarios.load("nuts-unscrewing")
     with pytest.raises(ScenarioError, match="unknown built-in scenario"):
         scenarios.builtin_text("nope")
+
+
+def test_scenario_sets_bidmp_and_extension_parameters():
+    from bidmp.evaluation import evaluate
+
+    data = mutate(lambda d: d.update(bidmp={"reg": 1e-2, "increments": [5]}, extension={"n_iter": 3, "n_samples": 120}))
+    scenario = scenarios.from_dict(data)
+    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension == {"n_iter": 3, "n_samples": 120}
+    report = evaluate(scenario, ["bidmp"])
+    assert report.model.reg == 1e-2 and report.model.increments == (5,)
+    assert report.extensions[0].similarity_history.shape == (3,)
+    assert report.model.blocks_[0].n_hidden_ == 10 * 10 + 100 + 5

@@ -5,7 +5,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from bidmp import segment
-from bidmp.segmentation import arclength, choose_piece, curvature, resample_arclength
+from bidmp._trajectory import arclength, resample_arclength
+from bidmp.segmentation import choose_piece, curvature
 
 POLYLINES = {
     "L": [[0, 0], [0, 1], [1, 1]],
@@ -32,7 +33,8 @@ def corner_fractions(vertices):
 
 def corners_recovered(y, vertices):
     """Every corner has a point within ±2 % of arc length, and the maxima are the corners."""
-    points, kinds = segment(y, return_kinds=True)
+    result = segment(y)
+    points, kinds = result.points, result.kinds
     s = arclength(y)
     found = s[points] / s[-1]
     corners = corner_fractions(vertices)
@@ -67,16 +69,17 @@ def test_curvature_of_a_circle_is_one_over_radius():
 
 def test_straight_line_has_no_segmentation_points():
     line = np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 200)
-    assert segment(line).size == 0
+    result = segment(line)
+    assert result.points.size == 0 and result.kinds.size == 0 and len(result) == 0
 
 
 def test_invariant_to_rigid_motion_and_uniform_scale():
     y = noisy_polyline(POLYLINES["S"], n_dims=3, seed=5)
-    reference = segment(y)
+    reference = segment(y).points
     rotation = Rotation.from_euler("xyz", [30, -50, 110], degrees=True).as_matrix()
     moved = y @ rotation.T + [10.0, -4.0, 7.0]
-    assert np.array_equal(segment(moved), reference)
-    assert np.array_equal(segment(250.0 * y), reference)
+    assert np.array_equal(segment(moved).points, reference)
+    assert np.array_equal(segment(250.0 * y).points, reference)
 
 
 def test_invariant_to_doubled_sampling():
@@ -85,14 +88,14 @@ def test_invariant_to_doubled_sampling():
     doubled[0::2] = y
     doubled[1::2] = 0.5 * (y[:-1] + y[1:])
     s, s2 = arclength(y), arclength(doubled)
-    base = s[segment(y)] / s[-1]
-    dense = s2[segment(doubled)] / s2[-1]
+    base = s[segment(y).points] / s[-1]
+    dense = s2[segment(doubled).points] / s2[-1]
     corners = corner_fractions(POLYLINES["Z"])
     for fractions in (base, dense):
         for corner in corners:
             assert np.min(np.abs(fractions - corner)) <= 0.02
-    maxima_base = base[segment(y, return_kinds=True)[1] == 1]
-    maxima_dense = dense[segment(doubled, return_kinds=True)[1] == 1]
+    maxima_base = base[segment(y).kinds == 1]
+    maxima_dense = dense[segment(doubled).kinds == 1]
     np.testing.assert_allclose(maxima_base, maxima_dense, atol=0.01)
 
 
@@ -100,7 +103,7 @@ def test_persistence_results_are_nested_in_eps():
     y = noisy_polyline(POLYLINES["S"], seed=7, noise=0.004)
     previous = None
     for eps in (0.01, 0.03, 0.1, 0.3, 0.6, 0.9):
-        points = set(segment(y, eps_frac=eps).tolist())
+        points = set(segment(y, eps_frac=eps).points.tolist())
         if previous is not None:
             assert points <= previous
         previous = points
@@ -109,7 +112,8 @@ def test_persistence_results_are_nested_in_eps():
 
 def test_paper_method_finds_the_corners_too():
     y = noisy_polyline(POLYLINES["Z"], seed=1)
-    points, kinds = segment(y, method="paper", return_kinds=True)
+    result = segment(y, method="paper")
+    points, kinds = result.points, result.kinds
     s = arclength(y)
     for corner in corner_fractions(POLYLINES["Z"]):
         assert np.min(np.abs(s[points[kinds == 1]] / s[-1] - corner)) <= 0.02

@@ -9,12 +9,13 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 # public name -> (module, attribute)
 _LAZY = {
     "DMP": ("bidmp.dmp", "DMP"),
     "segment": ("bidmp.segmentation", "segment"),
+    "Segmentation": ("bidmp.segmentation", "Segmentation"),
     "frechet_distance": ("bidmp.similarity", "frechet_distance"),
     "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
     "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
@@ -29,19 +30,19 @@ _LAZY = {
 }
 _SUBMODULES = (
     "dmp", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
-    "baselines", "datasets", "io", "scenarios", "evaluation", "plotting",
+    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting",
 )
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from . import bls, datasets, dmp, evaluation, extension, incremental, io, plotting, roadmap, segmentation, similarity  # noqa: F401
+    from . import bls, datasets, dmp, evaluation, extension, incremental, io, metrics, plotting, reproduce, roadmap, segmentation, similarity  # noqa: F401
     from .bls import BLS  # noqa: F401
     from .incremental import BiDMP, forgetting  # noqa: F401
     from ._checks import NotFittedError  # noqa: F401
     from .dmp import DMP  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401
-    from .segmentation import segment  # noqa: F401
+    from .segmentation import Segmentation, segment  # noqa: F401
     from .similarity import frechet_distance, frechet_similarity  # noqa: F401
     from .io import ModelFileError  # noqa: F401
     from .io import load_model as load  # noqa: F401

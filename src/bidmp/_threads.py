@@ -1,10 +1,11 @@
-"""Single-threaded BLAS for the small dense algebra of the Broad Learning System.
+"""Single-threaded BLAS and OpenMP for small dense algebra (the BLS, the baselines' EM).
 
-NumPy and SciPy each load their own OpenBLAS, each with a thread pool. When calls alternate
-between the two (``@`` here, ``scipy.linalg`` there), the idle pool's threads spin and steal the
-cores from the busy one: on a 2-core machine a BLS node addition took 24 ms instead of 4 ms.
-Matrices of a few hundred columns gain nothing from BLAS threads, so the BLS hot paths run with
-one thread, scoped (the caller's settings are restored; nothing global changes).
+NumPy and SciPy each load their own OpenBLAS, each with a thread pool, and scikit-learn adds an
+OpenMP pool. When calls alternate between them (``@`` here, ``scipy.linalg`` there), the idle
+pools' threads spin and steal the cores from the busy one: on a 2-core machine a BLS node
+addition took 24 ms instead of 4 ms, and ``GaussianMixture`` 3–7.5 s instead of 0.35–0.5 s.
+Matrices of a few hundred columns gain nothing from threads, so these hot paths run with one
+thread, scoped (the caller's settings are restored; nothing global changes).
 """
 
 from __future__ import annotations
@@ -14,8 +15,18 @@ import functools
 _controller = None
 
 
-def single_threaded_blas(function):
-    """Decorator: run ``function`` with every loaded BLAS limited to one thread."""
+def thread_limits() -> dict[str, int]:
+    """The current thread count of every loaded pool, by user API (``"blas"``, ``"openmp"``)."""
+    from threadpoolctl import threadpool_info
+
+    limits: dict[str, int] = {}
+    for pool in threadpool_info():
+        limits[pool["user_api"]] = max(limits.get(pool["user_api"], 0), pool["num_threads"])
+    return limits
+
+
+def single_threaded(function):
+    """Decorator: run ``function`` with every loaded BLAS and OpenMP pool limited to one thread."""
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
@@ -24,7 +35,7 @@ def single_threaded_blas(function):
             from threadpoolctl import ThreadpoolController
 
             _controller = ThreadpoolController()  # inspects the loaded libraries once (~7 ms)
-        with _controller.limit(limits=1, user_api="blas"):
+        with _controller.limit(limits=1):
             return function(*args, **kwargs)
 
     return wrapper

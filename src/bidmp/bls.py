@@ -28,12 +28,14 @@ matrix is rank-deficient by construction; see ``PINV_RCOND``.)
 from __future__ import annotations
 
 import logging
+from typing import NamedTuple
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
+from sklearn.base import BaseEstimator
 
 from ._checks import _as_float_array, _check_finite, check_choice, check_fitted, check_int, check_real
-from ._threads import single_threaded_blas
+from ._threads import single_threaded
 
 __all__ = ["BLS", "sparse_autoencoder", "block_pinv_update"]
 
@@ -141,8 +143,35 @@ def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple
     return D, Bt, "general"
 
 
-class BLS:
+class _BLSParams(NamedTuple):
+    n_windows: int
+    n_mapped: int
+    n_enhance: int
+    shrink: float
+    reg: float
+    l1: float
+    admm_iterations: int
+    update: str  # "auto" resolved to "pinv" or "exact_ridge"
+    seed: int
+
+
+def _rng(seed: int, kind: int, index: int) -> np.random.Generator:
+    return np.random.default_rng([seed, kind, index])
+
+
+def _enhancement_block(Z: np.ndarray, seed: int, block: int, n_nodes: int, shrink: float) -> tuple[np.ndarray, float, np.ndarray]:
+    """Draw enhancement block number ``block``: (weights (c+1, n), scale s, H = tanh(s·[Z, 0.1]W))."""
+    weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))
+    pre_activation = _affine(Z, weights)
+    scale = shrink / max(float(np.max(np.abs(pre_activation))), np.finfo(float).tiny)
+    return weights, scale, np.tanh(scale * pre_activation)
+
+
+class BLS(BaseEstimator):
     """Broad Learning System regressor with incremental enhancement nodes (SPEC §6).
+
+    A scikit-learn style estimator: the constructor only stores its parameters; ``fit``
+    validates them and learns; a failed ``fit`` leaves the model as it was.
 
     Parameters
     ----------
@@ -172,6 +201,8 @@ class BLS:
 
     Attributes
     ----------
+    n_features_ : int
+        Input dimension d seen in ``fit``.
     mapping_weights_ : array (u, d+1, q)
         ``W_Z,i``.
     mapping_min_, mapping_range_ : array (u·q,)
@@ -195,33 +226,42 @@ class BLS:
         update: str = "auto",
         seed: int = 0,
     ) -> None:
-        self.n_windows = check_int(n_windows, "n_windows", minimum=1)
-        self.n_mapped = check_int(n_mapped, "n_mapped", minimum=1)
-        self.n_enhance = check_int(n_enhance, "n_enhance", minimum=1)
-        self.shrink = check_real(shrink, "shrink", positive=True)
-        self.reg = check_real(reg, "reg", nonnegative=True)
-        self.l1 = check_real(l1, "l1", nonnegative=True)
-        self.admm_iterations = check_int(admm_iterations, "admm_iterations", minimum=1)
-        self.update = check_choice(update, "update", ("auto", "pinv", "exact_ridge"))
-        if self.update == "pinv" and self.reg > 0:
+        self.n_windows = n_windows
+        self.n_mapped = n_mapped
+        self.n_enhance = n_enhance
+        self.shrink = shrink
+        self.reg = reg
+        self.l1 = l1
+        self.admm_iterations = admm_iterations
+        self.update = update
+        self.seed = seed
+
+    def _params(self) -> _BLSParams:
+        """Validate the hyperparameters; raise naming the first bad one."""
+        reg = check_real(self.reg, "reg", nonnegative=True)
+        update = check_choice(self.update, "update", ("auto", "pinv", "exact_ridge"))
+        if update == "pinv" and reg > 0:
             raise ValueError("update='pinv' (Eq. 23-26) is exact only with reg=0; use update='exact_ridge' for reg > 0")
-        self.seed = check_int(seed, "seed", minimum=0)
-        self.output_weights_: np.ndarray | None = None
+        if update == "exact_ridge" and reg <= 0:
+            raise ValueError("update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)")
+        if update == "auto":
+            update = "pinv" if reg == 0.0 else "exact_ridge"
+        return _BLSParams(
+            n_windows=check_int(self.n_windows, "n_windows", minimum=1),
+            n_mapped=check_int(self.n_mapped, "n_mapped", minimum=1),
+            n_enhance=check_int(self.n_enhance, "n_enhance", minimum=1),
+            shrink=check_real(self.shrink, "shrink", positive=True),
+            reg=reg,
+            l1=check_real(self.l1, "l1", nonnegative=True),
+            admm_iterations=check_int(self.admm_iterations, "admm_iterations", minimum=1),
+            update=update,
+            seed=check_int(self.seed, "seed", minimum=0),
+        )
 
-    def get_params(self) -> dict:
-        return {
-            "n_windows": self.n_windows, "n_mapped": self.n_mapped, "n_enhance": self.n_enhance,
-            "shrink": self.shrink, "reg": self.reg, "l1": self.l1, "admm_iterations": self.admm_iterations,
-            "update": self.update, "seed": self.seed,
-        }
-
-    def __repr__(self) -> str:
-        return f"BLS({', '.join(f'{k}={v!r}' for k, v in self.get_params().items())})"
+    def __sklearn_is_fitted__(self) -> bool:
+        return "output_weights_" in self.__dict__
 
     # -- hidden layer ----------------------------------------------------------------------------
-    def _rng(self, kind: int, index: int) -> np.random.Generator:
-        return np.random.default_rng([self.seed, kind, index])
-
     def _mapped(self, X: np.ndarray) -> np.ndarray:
         # All windows side by side, (d+1, u·q): one matrix product.
         weights = np.ascontiguousarray(self.mapping_weights_.transpose(1, 0, 2).reshape(self.mapping_weights_.shape[1], -1))
@@ -230,20 +270,10 @@ class BLS:
     def _enhancement(self, Z: np.ndarray, block: int) -> np.ndarray:
         return np.tanh(self.enhancement_scales_[block] * _affine(Z, self.enhancement_weights_[block]))
 
-    def _new_enhancement_block(self, Z: np.ndarray, n_nodes: int) -> np.ndarray:
-        """Draw block number len(enhancement_weights_), store its weights and scale, return H."""
-        block = len(self.enhancement_weights_)
-        weights = np.ascontiguousarray(_orthonormal(self._rng(1, block), Z.shape[1] + 1, n_nodes))
-        pre_activation = _affine(Z, weights)
-        scale = self.shrink / max(float(np.max(np.abs(pre_activation))), np.finfo(float).tiny)
-        self.enhancement_weights_.append(weights)
-        self.enhancement_scales_.append(scale)
-        return np.tanh(scale * pre_activation)
-
     def hidden(self, X) -> np.ndarray:
         """The hidden-layer matrix ``[Z | H | E_1 | …]`` for inputs X, shape (N, n_hidden)."""
         check_fitted(self, "output_weights_")
-        X = self._check_X(X)
+        X = self._check_X(X, self.n_features_)
         Z = self._mapped(X)
         return np.hstack([Z] + [self._enhancement(Z, block) for block in range(len(self.enhancement_weights_))])
 
@@ -252,11 +282,11 @@ class BLS:
         check_fitted(self, "output_weights_")
         return self.output_weights_.shape[0]
 
-    def _check_X(self, X) -> np.ndarray:
+    @staticmethod
+    def _check_X(X, expected: int | None = None) -> np.ndarray:
         X = _as_float_array(X, "X")
         if X.ndim != 2:
             raise ValueError(f"X must have shape (N, d), got shape {X.shape}")
-        expected = getattr(self, "n_features_", None)
         if expected is not None and X.shape[1] != expected:
             raise ValueError(f"X must have {expected} columns (as in fit), got {X.shape[1]}")
         if X.shape[0] == 0:
@@ -264,8 +294,18 @@ class BLS:
         _check_finite(X, "X")
         return X
 
+    @staticmethod
+    def _check_Y(Y, n_rows: int) -> tuple[np.ndarray, bool]:
+        Y = _as_float_array(Y, "Y")
+        was_1d = Y.ndim == 1
+        Y = Y.reshape(-1, 1) if was_1d else Y
+        if Y.ndim != 2 or Y.shape[0] != n_rows:
+            raise ValueError(f"Y must have shape ({n_rows}, n_outputs), got shape {Y.shape}")
+        _check_finite(Y, "Y")
+        return Y, was_1d
+
     # -- learning --------------------------------------------------------------------------------
-    @single_threaded_blas
+    @single_threaded
     def fit(self, X, Y) -> "BLS":
         """Fit mapped features, the first enhancement block and the output weights.
 
@@ -273,47 +313,50 @@ class BLS:
         ----------
         X : array (N, d)
         Y : array (N, n_outputs) or (N,)
+
+        Returns
+        -------
+        self
+
+        Everything is computed first and stored at the end, so a failed ``fit`` (bad parameters,
+        bad data, a numerical failure) leaves a fitted model exactly as it was.
         """
-        self.n_features_ = None
+        params = self._params()
         X = self._check_X(X)
-        Y = self._check_Y(Y, X.shape[0])
-        self.n_features_ = X.shape[1]
+        Y, y_was_1d = self._check_Y(Y, X.shape[0])
         X_bias = _with_bias(X)
         windows, mins, ranges = [], [], []
-        for window in range(self.n_windows):
-            F = X_bias @ self._rng(0, window).uniform(-1.0, 1.0, size=(X_bias.shape[1], self.n_mapped))
+        for window in range(params.n_windows):
+            F = X_bias @ _rng(params.seed, 0, window).uniform(-1.0, 1.0, size=(X_bias.shape[1], params.n_mapped))
             F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
             F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
-            W_Z = np.ascontiguousarray(sparse_autoencoder(F, X_bias, self.l1, self.admm_iterations).T)  # (d+1, q)
+            W_Z = np.ascontiguousarray(sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T)  # (d+1, q)
             Z = X_bias @ W_Z
             low, span = Z.min(axis=0), np.ptp(Z, axis=0)
             windows.append(W_Z)
             mins.append(low)
             ranges.append(np.where(span > 0, span, 1.0))  # a constant node stays finite
-        self.mapping_weights_ = np.stack(windows)
-        self.mapping_min_ = np.concatenate(mins)
-        self.mapping_range_ = np.concatenate(ranges)
-        self.enhancement_weights_, self.enhancement_scales_ = [], []
-        Z = self._mapped(X)
-        A = np.hstack([Z, self._new_enhancement_block(Z, self.n_enhance)])
-        self._solve_output(A, Y)
+        mapping_weights = np.stack(windows)
+        mapping_min, mapping_range = np.concatenate(mins), np.concatenate(ranges)
+        all_windows = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))
+        Z = (_affine(X, all_windows) - mapping_min) / mapping_range
+        weights, scale, H = _enhancement_block(Z, params.seed, 0, params.n_enhance, params.shrink)
+        A = np.hstack([Z, H])
+        solution = _solve_output(A, Y, params)
+        # Nothing above touched the model: commit the new state in one go.
+        self.n_features_ = X.shape[1]
+        self._y_was_1d = y_was_1d
+        self.mapping_weights_, self.mapping_min_, self.mapping_range_ = mapping_weights, mapping_min, mapping_range
+        self.enhancement_weights_, self.enhancement_scales_ = [weights], [scale]
+        self._set_train_hidden(A)
+        self.train_targets_ = Y
+        self._set_solution(*solution)
         return self
-
-    def _check_Y(self, Y, n_rows: int) -> np.ndarray:
-        Y = _as_float_array(Y, "Y")
-        self._y_was_1d = Y.ndim == 1
-        Y = Y.reshape(-1, 1) if Y.ndim == 1 else Y
-        if Y.ndim != 2 or Y.shape[0] != n_rows:
-            raise ValueError(f"Y must have shape ({n_rows}, n_outputs), got shape {Y.shape}")
-        _check_finite(Y, "Y")
-        return Y
 
     @property
     def update_rule_(self) -> str:
         """The update in use: ``"pinv"`` or ``"exact_ridge"`` (``update="auto"`` resolved)."""
-        if self.update == "auto":
-            return "pinv" if self.reg == 0.0 else "exact_ridge"
-        return self.update
+        return self._params().update
 
     @property
     def train_hidden_(self) -> np.ndarray:
@@ -334,33 +377,27 @@ class BLS:
         self._hidden_buffer[:, used : used + added] = E
         self._n_hidden = used + added
 
-    def _solve_output(self, A: np.ndarray, Y: np.ndarray) -> None:
-        self._set_train_hidden(A)
-        self.train_targets_ = Y
-        if self.update_rule_ == "exact_ridge":
-            if self.reg <= 0.0:
-                raise ValueError("update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)")
-            # Upper Cholesky factor R of the ridge Gram matrix: AᵀA + λI = RᵀR, kept in Fortran
-            # order (LAPACK's) so that triangular solves never copy it. z = R⁻ᵀAᵀY, W = R⁻¹z.
-            self.gram_factor_ = np.asfortranarray(cholesky(A.T @ A + self.reg * np.eye(A.shape[1]), lower=False))
-            self.hidden_pinv_ = None
-            self._projected_targets = solve_triangular(self.gram_factor_, A.T @ Y, trans="T")
-            self.output_weights_ = np.ascontiguousarray(solve_triangular(self.gram_factor_, self._projected_targets))
-        else:
-            self.hidden_pinv_ = np.ascontiguousarray(_ridge_pinv(A, self.reg))
-            self.gram_factor_ = None
-            self.output_weights_ = self.hidden_pinv_ @ Y
+    def _set_solution(self, output_weights, hidden_pinv, gram_factor, projected_targets) -> None:
+        self.output_weights_ = output_weights
+        self.hidden_pinv_ = hidden_pinv
+        self.gram_factor_ = gram_factor
+        self._projected_targets = projected_targets
 
-    @single_threaded_blas
+    @single_threaded
     def add_enhancement_nodes(self, n: int) -> "BLS":
         """Add a block of ``n`` enhancement nodes and update the output weights without
-        retraining (Eq. 23–26, or the exact ridge block inverse). Returns self."""
+        retraining (Eq. 23–26, or the exact ridge block inverse). Returns self.
+
+        As with ``fit``, the model is only changed once the update has succeeded.
+        """
         check_fitted(self, "output_weights_")
         n = check_int(n, "n", minimum=1)
+        params = self._params()
         A, Y = self.train_hidden_, self.train_targets_
-        Z = A[:, : self.n_windows * self.n_mapped]
-        E = self._new_enhancement_block(Z, n)
-        if self.update_rule_ == "exact_ridge":
+        Z = A[:, : self.mapping_min_.shape[0]]
+        block = len(self.enhancement_weights_)
+        weights, scale, E = _enhancement_block(Z, params.seed, block, n, params.shrink)
+        if params.update == "exact_ridge":
             # Block Cholesky: R_new = [[R, R12], [0, R22]] with R12 = R⁻ᵀAᵀE and
             # R22 = chol(EᵀE + λI − R12ᵀR12); then block forward/back substitution reuses
             # z = R⁻ᵀAᵀY and the old weights: O(N·c·m + c²·(m + D)), no refactorisation.
@@ -368,29 +405,30 @@ class BLS:
             R = self.gram_factor_
             c = R.shape[0]
             R12 = solve_triangular(R, A.T @ E, trans="T", check_finite=False)
-            R22 = cholesky(E.T @ E + self.reg * np.eye(n) - R12.T @ R12, lower=False, check_finite=False)
+            R22 = cholesky(E.T @ E + params.reg * np.eye(n) - R12.T @ R12, lower=False, check_finite=False)
             z_new = solve_triangular(R22, E.T @ Y - R12.T @ self._projected_targets, trans="T", check_finite=False)
             W_new = solve_triangular(R22, z_new, check_finite=False)
             W_old = self.output_weights_ - solve_triangular(R, R12 @ W_new, check_finite=False)
             grown = np.zeros((c + n, c + n), order="F")
             grown[:c, :c], grown[:c, c:], grown[c:, c:] = R, R12, R22
-            self.gram_factor_ = grown
-            self._projected_targets = np.vstack([self._projected_targets, z_new])
-            self.output_weights_ = np.ascontiguousarray(np.vstack([W_old, W_new]))
-            self._append_train_hidden(E)
+            solution = (np.ascontiguousarray(np.vstack([W_old, W_new])), None, grown,
+                        np.vstack([self._projected_targets, z_new]))
         else:
             D, Bt, case = block_pinv_update(A, self.hidden_pinv_, E)
             logger.debug("added %d enhancement nodes (C case: %s)", n, case)
-            self.hidden_pinv_ = np.vstack([self.hidden_pinv_ - D @ Bt, Bt])
             BtY = Bt @ Y
-            self.output_weights_ = np.vstack([self.output_weights_ - D @ BtY, BtY])
-            self._append_train_hidden(E)
+            solution = (np.vstack([self.output_weights_ - D @ BtY, BtY]),
+                        np.vstack([self.hidden_pinv_ - D @ Bt, Bt]), None, None)
+        self.enhancement_weights_.append(weights)
+        self.enhancement_scales_.append(scale)
+        self._append_train_hidden(E)
+        self._set_solution(*solution)
         return self
 
     def predict(self, X) -> np.ndarray:
         """Outputs for inputs X: ``hidden(X) @ output_weights_``, shape (N, n_outputs)."""
         out = self.hidden(X) @ self.output_weights_
-        return out[:, 0] if getattr(self, "_y_was_1d", False) else out
+        return out[:, 0] if self._y_was_1d else out
 
     # -- persistence -----------------------------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
@@ -414,6 +452,7 @@ class BLS:
     @classmethod
     def _from_state(cls, meta: dict, arrays: dict) -> "BLS":
         model = cls(**meta["params"])
+        params = model._params()
         model.n_features_ = check_int(meta["n_features_"], "n_features_", minimum=1)
         n_blocks = check_int(meta["n_blocks"], "n_blocks", minimum=1)
         model._y_was_1d = bool(meta["y_was_1d"])
@@ -424,15 +463,28 @@ class BLS:
         model.enhancement_scales_ = [float(v) for v in np.asarray(arrays["enhancement_scales_"]).reshape(-1)]
         if len(model.enhancement_scales_) != n_blocks:
             raise ValueError("enhancement_scales_ does not match the number of blocks")
-        expected = (model.n_windows, model.n_features_ + 1, model.n_mapped)
+        expected = (params.n_windows, model.n_features_ + 1, params.n_mapped)
         if model.mapping_weights_.shape != expected:
             raise ValueError(f"mapping_weights_ has shape {model.mapping_weights_.shape}, expected {expected}")
-        n_hidden = model.n_windows * model.n_mapped + sum(w.shape[1] for w in model.enhancement_weights_)
+        n_hidden = params.n_windows * params.n_mapped + sum(w.shape[1] for w in model.enhancement_weights_)
         if model.output_weights_.shape[0] != n_hidden or model.train_hidden_.shape[1] != n_hidden:
             raise ValueError("output weights do not match the hidden layer")
         companion = np.asarray(arrays["pinv_or_gram"], dtype=np.float64)
-        model.hidden_pinv_ = companion if model.update_rule_ == "pinv" else None
-        model.gram_factor_ = np.asfortranarray(companion) if model.update_rule_ == "exact_ridge" else None
-        if model.gram_factor_ is not None:
+        if params.update == "pinv":
+            model.hidden_pinv_, model.gram_factor_, model._projected_targets = companion, None, None
+        else:
+            model.hidden_pinv_, model.gram_factor_ = None, np.asfortranarray(companion)
             model._projected_targets = solve_triangular(model.gram_factor_, model.train_hidden_.T @ model.train_targets_, trans="T")
         return model
+
+
+def _solve_output(A: np.ndarray, Y: np.ndarray, params: _BLSParams) -> tuple:
+    """Output weights for hidden matrix A and targets Y: (W, A⁺ or None, R or None, z or None)."""
+    if params.update == "exact_ridge":
+        # Upper Cholesky factor R of the ridge Gram matrix: AᵀA + λI = RᵀR, kept in Fortran
+        # order (LAPACK's) so that triangular solves never copy it. z = R⁻ᵀAᵀY, W = R⁻¹z.
+        R = np.asfortranarray(cholesky(A.T @ A + params.reg * np.eye(A.shape[1]), lower=False))
+        projected = solve_triangular(R, A.T @ Y, trans="T")
+        return np.ascontiguousarray(solve_triangular(R, projected)), None, R, projected
+    pinv = np.ascontiguousarray(_ridge_pinv(A, params.reg))
+    return pinv @ Y, pinv, None, None

@@ -27,15 +27,6 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
-def _print_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
-    widths = [max(len(str(cell)) for cell in column) for column in zip(header, *rows)]
-    line = "  ".join(f"{{:>{w}}}" for w in widths)
-    print(line.format(*header))
-    print("  ".join("-" * w for w in widths))
-    for row in rows:
-        print(line.format(*row))
-
-
 def _parse_K(text: str):
     if text in ("paper", "pastor"):
         return text
@@ -52,21 +43,24 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .dmp import DMP
-    from .evaluation import path_extent, rmse
+    from ._trajectory import resample_time
     from .io import load_trajectory, save_model
+    from .metrics import path_extent, rmse
 
     demonstration = load_trajectory(args.demo)
     dmp = DMP(
         n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K,
-        alpha_phase=args.alpha_phase, tau=args.tau, fit=args.fit,
+        alpha_phase=args.alpha_phase, tau=args.tau, regression=args.regression,
     ).fit(demonstration)
     path = save_model(dmp, args.output)
-    error = rmse(dmp.rollout(), demonstration)
+    reproduction = dmp.rollout()  # round(tau * T) samples: with tau != 1 the same path, slower
+    error = rmse(reproduction, resample_time(demonstration, reproduction.shape[0]))
     extent = path_extent(demonstration)
-    print(f"fitted a DMP on {args.demo}: T = {dmp.n_steps_} samples, D = {dmp.n_dims_}")
+    print(f"fitted a DMP on {args.demo}: T = {dmp.n_steps_} samples, D = {dmp.n_dims_}, "
+          f"rollouts take {reproduction.shape[0]} samples of {dmp.dt_:.4g} s (tau = {dmp.tau:g})")
     print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
     print(f"  reproduction RMSE {error:.4g} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
-    print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after T steps")
+    print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {reproduction.shape[0]} samples")
     print(f"wrote {path}")
     return EXIT_OK
 
@@ -81,9 +75,9 @@ def _rollout_goal(model, goal):
 def _cmd_rollout(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .io import load_model, save_trajectory
-
     from .dmp import DMP
+    from .incremental import BiDMP
+    from .io import load_model, save_trajectory
 
     model = load_model(args.model)
     if isinstance(model, DMP):
@@ -91,18 +85,18 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
             raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a plain DMP")
         trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
         dmp = model
-    elif hasattr(model, "skill_goals_"):
+    elif isinstance(model, BiDMP):
         skill = "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
         query = _rollout_goal(model, args.goal)
         index = model.select_skill(query, skill)
         trajectory = model.rollout(goal=query, skill=skill, start=args.start, n_steps=args.n_steps)
         print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal "
               f"{np.array2string(model.skill_goals_[index], precision=3)})")
-        dmp = model.dmp
+        dmp = model.dmp_
     else:
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     times = np.arange(trajectory.shape[0]) * dmp.dt_  # one Euler step is dt seconds
-    path = save_trajectory(args.output, trajectory, times=times if args.output.lower().endswith(".csv") else None)
+    path = save_trajectory(trajectory, args.output, times=times if args.output.lower().endswith(".csv") else None)
     goal = np.asarray(_rollout_goal(model, args.goal), dtype=float)
     print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")
     print(f"  end point {np.array2string(trajectory[-1], precision=4)}, distance to goal {np.linalg.norm(trajectory[-1] - goal):.4g}")
@@ -127,64 +121,28 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
     demos = lasa(args.name)
     if not 0 <= args.demo < demos.shape[0]:
         raise ValueError(f"--demo must be 0-{demos.shape[0] - 1}, got {args.demo}")
-    path = save_trajectory(args.output, demos[args.demo])
+    path = save_trajectory(demos[args.demo], args.output)
     print(f"wrote {args.name} demonstration {args.demo} ({demos.shape[1]} x {demos.shape[2]}) to {path}")
     return EXIT_OK
 
 
-def _run_scenario(scenario, out, methods=None, quiet_progress=False):
-    """Evaluate a scenario with a progress bar, print Tables 4 and 1/2, write results and figures."""
-    import numpy as np
+def _run_scenario(scenario, out, methods=None):
+    """Evaluate a scenario with a progress bar, print its report, write results and figures."""
     from tqdm import tqdm
 
-    from .evaluation import evaluate
-    from .io import atomic_write
-    from .plotting import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+    from .evaluation import evaluate, write_report
 
-    out.mkdir(parents=True, exist_ok=True)
     names = list(scenario.methods if methods is None else methods)
-    with tqdm(total=len(names), desc=scenario.name, unit="method", disable=True if quiet_progress else None) as bar:
+    with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
         def progress(method):  # called as each method starts
             bar.set_postfix_str(method)
             bar.update(1)
 
         report = evaluate(scenario, names, progress=progress)
-    data = report.to_dict()
-    units = scenario.units
-    print(f"\n{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
-          f"success = end-point error <= {scenario.success_threshold:g} {units}")
-    if report.extension_targets:
-        print(f"plain DMP misses {len(report.failed_targets)} target(s) ({', '.join(report.failed_targets)}); "
-              f"Bi-DMP extended to {', '.join(np.array2string(np.asarray(t), precision=1) for t in report.extension_targets)}")
-    rows = []
-    for name, result in data["methods"].items():
-        approach = "-" if result["approach_errors"] is None else f"{result['approach_successes']}/{result['n_targets']}"
-        rows.append([name, f"{100 * result['success_rate']:.2f} %", f"{result['successes']}/{result['n_targets']}", approach,
-                     f"{result['max_error']:.3f}", f"{result['difference_range'][0]:.1f}-{result['difference_range'][1]:.1f}",
-                     f"{result['runtime_s']:.4f}"])
-    print("\nTable 4 analogue (errors in " + units + "; run time in s, first run in this process: includes one-time imports)")
-    _print_table(["method", "success rate", "successes", "+ approach", "max error", "difference range", "run time"], rows)
-    header = ["target", "distance"] + list(data["methods"])
-    origin = scenario.targets[scenario.demonstrated]
-    per_target = []
-    for label, target in scenario.targets.items():
-        cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
-        for result in data["methods"].values():
-            error = result["errors"][label]
-            cells.append(f"{error:.3f}{'' if error <= scenario.success_threshold else ' x'}")
-        per_target.append(cells)
-    print(f"\nTables 1 and 2 analogue: end-point error per target ({units}; x = failure)")
-    _print_table(header, per_target)
-    if report.forgetting:
-        print("\nforgetting (error after learning every demonstration minus error when learned, " + units + "):")
-        for skill, result in report.forgetting.items():
-            print(f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting))
-    with atomic_write(out / "results.json", "w") as handle:
-        json.dump(data, handle, indent=2)
-    figures = [plot_targets_top_view(out / "targets_top_view.png", report),
-               plot_error_vs_distance(out / "error_vs_distance.png", report),
-               plot_scenario_3d(out / "scenario_3d.png", report)]
-    print(f"\nwrote {out / 'results.json'} and {', '.join(str(f) for f in figures)}")
+    print()
+    print(report.summary())
+    written = write_report(report, out)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
     return report
 
 
@@ -197,36 +155,25 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .scenarios import load
 
     scenario = load(args.scenario)
-    methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
+    methods = None
+    if args.methods is not None:
+        methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        if not methods:
+            raise ValueError(f"--methods names no method: {args.methods!r}")
     _run_scenario(scenario, out, methods)
     return EXIT_OK
 
 
 def _lasa_demo(shape: str, out) -> int:
-    from .evaluation import lasa_generalisation
     from .io import atomic_write
     from .plotting import plot_generalisation
+    from .reproduce import lasa_generalisation
 
     out.mkdir(parents=True, exist_ok=True)
     result = lasa_generalisation(shape)
-    summary = result.to_dict()
-    print(f"bidmp demo --lasa: one LASA '{result.shape}' demonstration ({summary['n_samples']} samples, 2-D), DMP with defaults")
-    print(f"  reproduction RMSE {summary['reproduction_rmse']:.3f} mm = {summary['reproduction_rmse_percent']:.2f} % of the extent")
-    print(f"  end-point gain c = {result.endpoint_gain:.4f} after T steps, {result.endpoint_gain_converged:.2e} after "
-          f"{summary['n_steps_converged']} steps")
-    print(f"  end-point error at the demonstrated goal after T steps: e0 = {result.goal_error:.3f} mm")
-    print()
-    rows = [
-        [str(i + 1), f"{shift:.2f}", f"{fixed:.3f}", f"{result.endpoint_gain * shift:.3f}", f"{conv:.2e}"]
-        for i, (shift, fixed, conv) in enumerate(zip(result.goal_shifts, result.errors_fixed, result.errors_converged))
-    ]
-    _print_table(["goal", "shift [mm]", "error, T steps", "c * shift", f"error, {summary['n_steps_converged']} steps"], rows)
-    print()
-    print("Stopped after the demonstration's T steps (the paper's protocol), a DMP misses a moved goal by")
-    print("c * shift on top of e0 (the error vector is e0 + (B - 1) * shift, exactly); run to convergence it")
-    print("reaches every goal.")
+    print("bidmp demo --lasa: " + result.summary())
     with atomic_write(out / "lasa_generalisation.json", "w") as handle:
-        json.dump(summary, handle, indent=2)
+        json.dump(result.to_dict(), handle, indent=2)
     figure = plot_generalisation(out / "lasa_generalisation.png", result)
     print(f"wrote {out / 'lasa_generalisation.json'} and {figure}")
     return EXIT_OK
@@ -252,11 +199,14 @@ def _cmd_scenario(args: argparse.Namespace) -> int:
 def _cmd_segment(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from ._tables import text_table
+    from ._trajectory import arclength, resample_arclength
     from .io import load_trajectory
-    from .segmentation import arclength, curvature, resample_arclength, segment
+    from .segmentation import curvature, segment
 
     y = load_trajectory(args.demo)
-    points, kinds = segment(y, eps_frac=args.eps_frac, method=args.method, return_kinds=True)
+    result = segment(y, eps_frac=args.eps_frac, method=args.method)
+    points, kinds = result.points, result.kinds
     s = arclength(y)
     print(f"{args.demo}: {y.shape[0]} samples, D = {y.shape[1]}, {len(points)} segmentation point(s)")
     if len(points):
@@ -264,7 +214,7 @@ def _cmd_segment(args: argparse.Namespace) -> int:
             [str(point), "max" if kind > 0 else "min", f"{100 * s[point] / s[-1]:.1f}", np.array2string(y[point], precision=3)]
             for point, kind in zip(points, kinds)
         ]
-        _print_table(["index", "curvature", "arc length %", "position"], rows)
+        print(text_table(["index", "curvature", "arc length %", "position"], rows))
     if args.plot:
         from .plotting import plot_segmentation
 
@@ -278,8 +228,10 @@ def _cmd_extend(args: argparse.Namespace) -> int:
 
     from .dmp import DMP
     from .extension import extend_demonstration
+    from ._trajectory import resample_time
     from .incremental import BiDMP
     from .io import load_model, load_trajectory, save_model, save_trajectory
+    from .metrics import path_extent, rmse
 
     if not args.output.lower().endswith(".npz"):
         raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}; "
@@ -290,8 +242,9 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     elif not isinstance(model, BiDMP):
         raise ValueError(f"{args.model} holds a {type(model).__name__}; extend needs a DMP or a Bi-DMP model")
     y = load_trajectory(args.demo)
-    if y.shape[1] != model.dmp.n_dims_:
-        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.dmp.n_dims_}")
+    n_dims = model.n_dims_
+    if y.shape[1] != n_dims:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {n_dims}")
     extension = extend_demonstration(y, args.target, seed=args.seed)
     target = extension.new_target
     history = extension.similarity_history
@@ -302,14 +255,14 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     before = np.linalg.norm(model.rollout(target)[-1] - target)
     model.learn(extension.complete)
     rollout = model.rollout(target)
-    scale = float(np.linalg.norm(np.ptp(extension.complete, axis=0)))
-    error = float(np.sqrt(np.mean(np.sum((rollout - extension.complete) ** 2, axis=1))))
+    scale = path_extent(extension.complete)
+    error = rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
     print(f"learned skill {model.n_skills - 1}: rollout to the target reproduces the extended demonstration with "
           f"RMSE {error:.4g} ({100 * error / scale:.3g} % of its extent)")
     print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1] - target):.4g} after")
     print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
     if args.save_demo:
-        print(f"wrote the extended demonstration to {save_trajectory(args.save_demo, extension.complete)}")
+        print(f"wrote the extended demonstration to {save_trajectory(extension.complete, args.save_demo)}")
     if args.plot:
         from .plotting import plot_extension
 
@@ -318,103 +271,26 @@ def _cmd_extend(args: argparse.Namespace) -> int:
 
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
-    if args.what == "figures":
-        return _reproduce_figures(args)
+    from functools import partial
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from . import reproduce
+
+    out = Path(args.out)
+    if args.seeds < 1:
+        raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
     if args.what == "table4":
-        return _reproduce_table4(args)
-    return _reproduce_table5(args)
-
-
-def _reproduce_table4(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from .evaluation import case_studies
-    from .io import atomic_write
-
-    out = Path(args.out)
-    summary = {}
-    for name in ("nut-unscrewing", "cell-removal", "pick-and-place"):
-        print(f"\n==================== {name} ====================")
-        from .scenarios import load
-
-        report = _run_scenario(load(name), out / name)
-        summary[name] = report.to_dict()
-    studies = case_studies()
-    print("\ncell removal, Bi-DMP before (nut skill only) and after the second extended demonstration to B6:")
-    rows = [[label, f"{studies['cell_removal']['before'][label]:.3f}", f"{studies['cell_removal']['after'][label]:.3f}"]
-            for label in studies["cell_removal"]["before"]]
-    _print_table(["target", "end error before", "end error after"], rows)
-    print(f"  difference (path deviation from the reference) at B6: before {studies['cell_removal']['difference_before']:.1f}, "
-          f"after {studies['cell_removal']['difference_after']:.1f}")
-    summary["case_studies"] = studies
-    with atomic_write(out / "table4.json", "w") as handle:
-        json.dump(summary, handle, indent=2)
-    print(f"\nwrote {out / 'table4.json'}")
-    return EXIT_OK
-
-
-def _reproduce_figures(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from tqdm import tqdm
-
-    from .evaluation import lasa_incremental
-    from .io import atomic_write
-    from .plotting import plot_incremental
-
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    results = [lasa_incremental(name) for name in tqdm(("Sshape", "WShape", "NShape"), desc="figures", unit="shape", disable=None)]
-    print("Bi-DMP on LASA shapes: three extended demonstrations learned in turn (errors in mm)")
-    rows = []
-    for result in results:
-        for index, (bidmp_error, dmp_error) in enumerate(zip(result.reproduction_errors(), result.dmp_errors()), start=1):
-            rows.append([result.shape, str(index), f"{bidmp_error:.3f}", f"{dmp_error:.3f}",
-                         f"{result.forgetting_nearest.forgetting[index]:.3f}", f"{result.forgetting_latest.forgetting[index]:.3f}"])
-        rows.append([result.shape, "0 (demo)", "-", "-", f"{result.forgetting_nearest.forgetting[0]:.3f}",
-                     f"{result.forgetting_latest.forgetting[0]:.3f}"])
-    _print_table(["shape", "skill", "Bi-DMP RMSE", "plain DMP RMSE", "forgetting nearest", "forgetting latest"], rows)
-    print("forgetting = error of a skill after all learning minus its error when it was learned")
-    with atomic_write(out / "figures.json", "w") as handle:
-        json.dump({"results": [result.to_dict() for result in results]}, handle, indent=2)
-    print(f"wrote {out / 'figures.json'} and {plot_incremental(out / 'bidmp_lasa.png', results)}")
-    return EXIT_OK
-
-
-def _reproduce_table5(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
-    from tqdm import tqdm
-
-    from .evaluation import compare_prm, table5_cases
-    from .io import atomic_write
-    from .plotting import plot_prm_comparison
-
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    cases = table5_cases()
-    comparisons = [
-        compare_prm(y, target, name=name, units=units, n_seeds=args.seeds)
-        for name, (y, target, units) in tqdm(cases.items(), desc="table5", unit="case", disable=None)
-    ]
-    n_iter = comparisons[0].gprm.shape[1]
-    print(f"Table 5 analogue: Fréchet similarity of the generated path, mean ± std over {args.seeds} seeds")
-    header = ["case", "method"] + [f"it {i}" for i in range(1, n_iter + 1)] + ["best-of"]
-    rows = []
-    for comparison in comparisons:
-        for label, data in (("G-PRM", comparison.gprm), ("PRM", comparison.prm)):
-            rows.append([comparison.name, label]
-                        + [f"{m:.3f}±{sd:.3f}" for m, sd in zip(data.mean(axis=0), data.std(axis=0))]
-                        + [f"{data.max(axis=1).mean():.3f}±{data.max(axis=1).std():.3f}"])
-    _print_table(header, rows)
-    summary = [comparison.to_dict() for comparison in comparisons]
-    with atomic_write(out / "table5.json", "w") as handle:
-        json.dump({"table": "5", "n_seeds": args.seeds, "cases": summary}, handle, indent=2)
-    with atomic_write(out / "table5.md", "w") as handle:
-        handle.write("| " + " | ".join(header) + " |\n|" + "---|" * len(header) + "\n")
-        handle.writelines("| " + " | ".join(row) + " |\n" for row in rows)
-    figure = plot_prm_comparison(out / "table5.png", comparisons)
-    print(f"wrote {out / 'table5.json'}, {out / 'table5.md'} and {figure}")
+        with tqdm(total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None) as bar:
+            result = reproduce.run_table4(progress=lambda name: (bar.set_postfix_str(name), bar.update(1)))
+    elif args.what == "figures":
+        result = reproduce.run_figures(progress=partial(tqdm, desc="figures", unit="shape", disable=None))
+    else:
+        result = reproduce.run_table5(args.seeds, progress=partial(tqdm, desc="table5", unit="case", disable=None))
+    print(result.summary())
+    written = reproduce.write_results(result, args.what, out)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
     return EXIT_OK
 
 
@@ -439,15 +315,15 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--beta", type=float, default=None, help="spring ratio beta (default alpha/4)")
     fit.add_argument("--K", type=_parse_K, default="paper", help="forcing gain: paper (K=alpha), pastor (K=alpha*beta) or a number")
     fit.add_argument("--alpha-phase", type=float, default=1.0, help="phase decay alpha_phase (default 1)")
-    fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling tau (default 1)")
-    fit.add_argument("--fit", choices=("lwr", "ridge"), default="lwr", help="weight regression (default lwr)")
+    fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling: rollouts take tau times the demonstration's duration (default 1)")
+    fit.add_argument("--regression", "--fit", dest="regression", choices=("lwr", "ridge"), default="lwr", help="weight regression (default lwr)")
     fit.set_defaults(handler=_cmd_fit)
 
     rollout = commands.add_parser("rollout", help="generate a trajectory from a model", description="Roll a saved model out to a goal and write the trajectory.")
     rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
     rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates (default: the demonstrated goal)")
     rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
-    rollout.add_argument("--n-steps", type=int, default=None, help="number of samples (default: the demonstration's T)")
+    rollout.add_argument("--n-steps", type=int, default=None, help="number of samples (default: round(tau * T), T = the demonstration's)")
     rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy)")
     rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")

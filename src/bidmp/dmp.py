@@ -34,9 +34,11 @@ system has not converged, and the end point misses a shifted goal ``g'`` by exac
 from __future__ import annotations
 
 import logging
+from typing import NamedTuple
 
 import numpy as np
 from scipy.signal import lfilter
+from sklearn.base import BaseEstimator
 
 from ._checks import (
     as_point,
@@ -60,7 +62,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 _K_CHOICES = ("paper", "pastor")
-_FIT_CHOICES = ("lwr", "ridge")
+_REGRESSION_CHOICES = ("lwr", "ridge")
 _DERIVATIVE_CHOICES = ("gradient", "forward")
 _WIDTH_CHOICES = ("spacing", "pydmps")
 _LOG_PSI_FLOOR = -40.0
@@ -242,8 +244,29 @@ def _euler_unit_responses(
 # ---------------------------------------------------------------------------------------------
 # The estimator
 # ---------------------------------------------------------------------------------------------
-class DMP:
+class _Params(NamedTuple):
+    """The validated hyperparameters of a :class:`DMP` (``beta`` and ``K`` resolved to numbers)."""
+
+    n_kernels: int
+    alpha: float
+    beta: float
+    K: float
+    alpha_phase: float
+    tau: float
+    regression: str
+    derivatives: str
+    ridge: float
+    widths: str
+
+
+class DMP(BaseEstimator):
     """Discrete DMP learned from one demonstration (SPEC §1).
+
+    A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
+    them and learns, ``get_params``/``set_params``/``sklearn.base.clone`` work, and learned state
+    ends in ``_``. Changing a parameter after ``fit`` (attribute or ``set_params``) takes effect at
+    the next rollout: the model then behaves as a fresh one with that parameter and the same
+    learned weights.
 
     Parameters
     ----------
@@ -260,14 +283,16 @@ class DMP:
     alpha_phase : float, default 1
         Canonical-system decay ``alpha_phase`` (1/s).
     tau : float, default 1
-        Temporal scaling (s); larger is slower.
-    fit : {"lwr", "ridge"}, default "lwr"
-        Locally weighted regression per kernel (paper) or global ridge least squares. Stored as
-        ``fit_method`` because ``fit`` is the method.
+        Temporal scaling: a rollout takes ``tau`` times the demonstration's duration, with the same
+        shape (larger is slower). The weights are always learned for the demonstration's own
+        duration (``tau = 1``), so ``tau`` may be changed after ``fit``. The default rollout length
+        is ``round(tau · T)`` samples of ``dt_`` seconds.
+    regression : {"lwr", "ridge"}, default "lwr"
+        Locally weighted regression per kernel (paper) or global ridge least squares.
     derivatives : {"gradient", "forward"}, default "gradient"
         How the demonstration is differentiated for the forcing target.
     ridge : float, default 1e-8
-        Ridge regulariser for ``fit="ridge"``, relative to the mean diagonal of ``ΦᵀΦ``.
+        Ridge regulariser for ``regression="ridge"``, relative to the mean diagonal of ``ΦᵀΦ``.
     widths : {"spacing", "pydmps"}, default "spacing"
         Kernel-width rule, see :func:`kernel_widths`.
 
@@ -277,9 +302,9 @@ class DMP:
     start_, goal_ : array, shape (D,)
         First and last point of the demonstration.
     n_steps_ : int
-        Length T of the demonstration = default rollout length.
+        Length T of the demonstration.
     dt_ : float
-        ``1 / T`` (s).
+        ``1 / T`` (s): the demonstration lasts 1 s (the paper's protocol).
     centres_, widths_ : array, shape (n_kernels,)
         Kernel centres (phase) and widths.
     """
@@ -292,60 +317,54 @@ class DMP:
         K: str | float = "paper",
         alpha_phase: float = 1.0,
         tau: float = 1.0,
-        fit: str = "lwr",
+        regression: str = "lwr",
         derivatives: str = "gradient",
         ridge: float = 1e-8,
         widths: str = "spacing",
     ) -> None:
-        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=1)
-        self.alpha = check_real(alpha, "alpha", positive=True)
-        self.beta = None if beta is None else check_real(beta, "beta", positive=True)
-        if isinstance(K, str):
-            check_choice(K, "K", _K_CHOICES)
-        else:
-            K = check_real(K, "K", positive=True)
+        self.n_kernels = n_kernels
+        self.alpha = alpha
+        self.beta = beta
         self.K = K
-        self.alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True)
-        self.tau = check_real(tau, "tau", positive=True)
-        self.fit_method = check_choice(fit, "fit", _FIT_CHOICES)
-        self.derivatives = check_choice(derivatives, "derivatives", _DERIVATIVE_CHOICES)
-        self.ridge = check_real(ridge, "ridge", nonnegative=True)
-        self.widths = check_choice(widths, "widths", _WIDTH_CHOICES)
-        self.weights_: np.ndarray | None = None
+        self.alpha_phase = alpha_phase
+        self.tau = tau
+        self.regression = regression
+        self.derivatives = derivatives
+        self.ridge = ridge
+        self.widths = widths
 
     # -- parameters ----------------------------------------------------------------------------
-    def get_params(self) -> dict:
-        """Constructor parameters (JSON-serialisable), as accepted by ``DMP(**params)``."""
-        return {
-            "n_kernels": self.n_kernels,
-            "alpha": self.alpha,
-            "beta": self.beta,
-            "K": self.K,
-            "alpha_phase": self.alpha_phase,
-            "tau": self.tau,
-            "fit": self.fit_method,
-            "derivatives": self.derivatives,
-            "ridge": self.ridge,
-            "widths": self.widths,
-        }
+    def _params(self) -> _Params:
+        """Validate the hyperparameters as they are now; raise naming the first bad one."""
+        alpha = check_real(self.alpha, "alpha", positive=True)
+        beta = alpha / 4.0 if self.beta is None else check_real(self.beta, "beta", positive=True)
+        if isinstance(self.K, str):
+            check_choice(self.K, "K", _K_CHOICES)
+            K = alpha if self.K == "paper" else alpha * beta
+        else:
+            K = check_real(self.K, "K", positive=True)
+        return _Params(
+            n_kernels=check_int(self.n_kernels, "n_kernels", minimum=1),
+            alpha=alpha,
+            beta=beta,
+            K=K,
+            alpha_phase=check_real(self.alpha_phase, "alpha_phase", positive=True),
+            tau=check_real(self.tau, "tau", positive=True),
+            regression=check_choice(self.regression, "regression", _REGRESSION_CHOICES),
+            derivatives=check_choice(self.derivatives, "derivatives", _DERIVATIVE_CHOICES),
+            ridge=check_real(self.ridge, "ridge", nonnegative=True),
+            widths=check_choice(self.widths, "widths", _WIDTH_CHOICES),
+        )
 
     @property
     def beta_value(self) -> float:
         """The spring gain ratio in use (``alpha / 4`` when ``beta`` is None)."""
-        return self.alpha / 4.0 if self.beta is None else self.beta
+        return self._params().beta
 
     @property
     def K_value(self) -> float:
         """The forcing-term gain in use."""
-        if self.K == "paper":
-            return self.alpha
-        if self.K == "pastor":
-            return self.alpha * self.beta_value
-        return float(self.K)
-
-    def __repr__(self) -> str:
-        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        return f"DMP({params})"
+        return self._params().K
 
     # -- learning ------------------------------------------------------------------------------
     def fit(self, y) -> "DMP":
@@ -360,26 +379,31 @@ class DMP:
         Returns
         -------
         self
+
+        A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
+        params = self._params()
         y = as_trajectory(y, "y")
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
-        phase = phase_grid(n_steps, dt, self.tau, self.alpha_phase)
-        centres = kernel_centres(self.n_kernels, n_steps, dt, self.tau, self.alpha_phase)
-        widths = kernel_widths(centres, self.alpha_phase, self.widths)
+        # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
+        # rollouts, so it is not used here.
+        phase = phase_grid(n_steps, dt, 1.0, params.alpha_phase)
+        centres = kernel_centres(params.n_kernels, n_steps, dt, 1.0, params.alpha_phase)
+        widths = kernel_widths(centres, params.alpha_phase, params.widths)
         target = forcing_target(
-            y, phase, dt=dt, tau=self.tau, alpha=self.alpha, beta=self.beta_value, K=self.K_value,
-            derivatives=self.derivatives,
+            y, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
+            derivatives=params.derivatives,
         )
         phi = basis_functions(phase, centres, widths)
-        if self.fit_method == "lwr":
+        if params.regression == "lwr":
             # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
             denominator = phi.T @ phase
             weights = (phi.T @ target) / np.maximum(denominator, np.finfo(float).tiny)[:, None]
         else:
             gram = phi.T @ phi
-            reg = self.ridge * max(np.trace(gram) / self.n_kernels, np.finfo(float).tiny)
-            weights = np.linalg.solve(gram + reg * np.eye(self.n_kernels), phi.T @ target)
+            reg = params.ridge * max(np.trace(gram) / params.n_kernels, np.finfo(float).tiny)
+            weights = np.linalg.solve(gram + reg * np.eye(params.n_kernels), phi.T @ target)
         self.weights_ = np.ascontiguousarray(weights)
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
@@ -387,57 +411,83 @@ class DMP:
         self.dt_ = dt
         self.centres_ = centres
         self.widths_ = widths
-        self._cache_grid(phase, phi)
+        self.__dict__.pop("_grid_cache", None)
         logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
         return self
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "weights_" in self.__dict__
+
+    def _check_fitted(self) -> None:
+        check_fitted(self, "weights_")
 
     @property
     def n_dims_(self) -> int:
         """Number of dimensions D of the learned demonstration."""
-        check_fitted(self, "weights_")
+        self._check_fitted()
         return self.weights_.shape[1]
 
     # -- evaluation ----------------------------------------------------------------------------
+    def default_n_steps(self) -> int:
+        """The default rollout length: ``round(tau · T)`` samples (the demonstration's duration
+        scaled by ``tau``; T for ``tau = 1``, the paper's protocol)."""
+        self._check_fitted()
+        return max(int(round(self._params().tau * self.n_steps_)), 1)
+
+    def _n_steps(self, n_steps) -> int:
+        return self.default_n_steps() if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+
     def phase(self, n_steps: int | None = None) -> np.ndarray:
-        """Phase at each rollout step, shape ``(n_steps,)`` (default ``n_steps_``)."""
-        check_fitted(self, "weights_")
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
-        return phase_grid(n_steps, self.dt_, self.tau, self.alpha_phase)
+        """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
+        self._check_fitted()
+        params = self._params()
+        return phase_grid(self._n_steps(n_steps), self.dt_, params.tau, params.alpha_phase)
 
-    def _grid(self, n_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _grid(self, n_steps: int, tau: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Phase (n,), basis rows (n, N) and unit responses ``[B, C, V]`` (3, n) on the grid of
-        ``n_steps`` samples.
+        ``n_steps`` samples at temporal scale ``tau`` (default: the parameter).
 
-        None of them depends on the weights, only on what ``fit`` fixed, so the last grid used is
-        cached: repeated rollouts then cost one small filter for the forcing term.
+        None of them depends on the weights, so the last grid used is cached. The cache key holds
+        every hyperparameter the grid depends on and the learned kernels, so changing any of them
+        after ``fit`` can never roll out with stale responses.
         """
+        params = self._params()
+        if tau is not None:
+            params = params._replace(tau=tau)
+        key = (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
         cached = self.__dict__.get("_grid_cache")
-        if cached is None or cached[0] != n_steps:
-            phase = self.phase(n_steps)
-            cached = self._cache_grid(phase, basis_functions(phase, self.centres_, self.widths_))
-        return cached[1:]
-
-    def _cache_grid(self, phase: np.ndarray, basis: np.ndarray) -> tuple:
-        self._grid_cache = (phase.shape[0], phase, basis, self._unit_responses(phase, None))
-        return self._grid_cache
+        if cached is None or cached[0] != key or cached[1] is not self.centres_ or cached[2] is not self.widths_:
+            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
+            basis = basis_functions(phase, self.centres_, self.widths_)
+            responses = self._unit_responses(params, phase, None)
+            cached = (key, self.centres_, self.widths_, phase, basis, responses)
+            self._grid_cache = cached
+        return cached[3:]
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Phase (n,) and basis rows (n, N) on the rollout grid (default ``n_steps_``), cached."""
-        check_fitted(self, "weights_")
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
-        phase, basis, _ = self._grid(n_steps)
+        """Phase (n,) and basis rows (n, N) on the rollout grid (default length
+        :meth:`default_n_steps`), cached."""
+        self._check_fitted()
+        phase, basis, _ = self._grid(self._n_steps(n_steps))
+        return phase, basis
+
+    def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """Phase (T,) and basis rows (T, N) of the grid the weights were learned on (the
+        demonstration's T samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
+        self._check_fitted()
+        phase, basis, _ = self._grid(self.n_steps_, tau=1.0)
         return phase, basis
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
-        check_fitted(self, "weights_")
-        return basis_functions(np.asarray(phase, dtype=np.float64), self.centres_, self.widths_)
+        self._check_fitted()
+        return basis_functions(np.asarray(phase, dtype=np.float64).reshape(-1), self.centres_, self.widths_)
 
     def forcing_term(self, phase) -> np.ndarray:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
         return self.basis(phase) @ self.weights_
 
-    def _unit_responses(self, phase: np.ndarray, forcing: np.ndarray | None) -> np.ndarray:
+    def _unit_responses(self, params: _Params, phase: np.ndarray, forcing: np.ndarray | None) -> np.ndarray:
         """Responses that compose every rollout on the grid ``phase`` (n samples).
 
         ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
@@ -445,7 +495,7 @@ class DMP:
         goal's share of the input), ``C`` (the start's, with ``y[0] = y[1] = 1``) and ``V`` (the
         free response to a unit start velocity, ``y[1] = dt``), shape (3, n).
         """
-        alpha, beta, K = self.alpha, self.beta_value, self.K_value
+        alpha, beta, K = params.alpha, params.beta, params.K
         n_steps = phase.shape[0]
         inputs = phase[: max(n_steps - 2, 0)]
         if forcing is not None:
@@ -455,20 +505,20 @@ class DMP:
             drives = np.stack([alpha * beta - K * inputs, K * inputs, np.zeros_like(inputs)])
             y_first = np.array([0.0, 1.0, 0.0])
             y_second = np.array([0.0, 1.0, self.dt_])
-        responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / self.tau, alpha=alpha, beta=beta)
+        responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / params.tau, alpha=alpha, beta=beta)
         return responses[:, :n_steps]
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
-        check_fitted(self, "weights_")
+        self._check_fitted()
         n_dims = self.n_dims_
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        n_steps = self._n_steps(n_steps)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
         phase, basis, (goal_response, start_response, velocity_response) = self._grid(n_steps)
         forcing = basis @ self.weights_
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
-        free = self._unit_responses(phase, forcing).T
+        free = self._unit_responses(self._params(), phase, forcing).T
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
@@ -476,7 +526,7 @@ class DMP:
 
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
                 forcing_increment=None) -> np.ndarray:
-        """Generate a trajectory (explicit Euler, Eq. 14).
+        """Generate a trajectory (explicit Euler, Eq. 14), one sample every ``dt_`` seconds.
 
         Parameters
         ----------
@@ -485,8 +535,9 @@ class DMP:
         start : array-like, shape (D,), optional
             Start position; default the demonstration's first point.
         n_steps : int, optional
-            Number of samples, including the start; default ``n_steps_`` (the paper's fixed
-            horizon: the phase ends at ≈ e⁻¹). Use more steps to let the system converge.
+            Number of samples, including the start; default :meth:`default_n_steps`
+            (``round(tau · T)``: the paper's fixed horizon, the phase ends at ≈ e⁻¹). Use more
+            steps to let the system converge.
         start_velocity : array-like, shape (D,), optional
             Initial velocity (units/s); default at rest.
         forcing_increment : callable, optional
@@ -530,18 +581,21 @@ class DMP:
         paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
         convergence and it tends to 0.
         """
-        check_fitted(self, "weights_")
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+        self._check_fitted()
+        n_steps = self._n_steps(n_steps)
+        params = self._params()
+        key = (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
         cached = self.__dict__.get("_grid_cache")
-        if cached is not None and cached[0] == n_steps:
-            goal_response = cached[3][0]
+        if cached is not None and cached[0] == key:
+            goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
-            goal_response = self._unit_responses(self.phase(n_steps), None)[0]
+            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
+            goal_response = self._unit_responses(params, phase, None)[0]
         return float(abs(1.0 - goal_response[-1]))
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        check_fitted(self, "weights_")
+        self._check_fitted()
         arrays = {
             "weights_": self.weights_,
             "start_": self.start_,
@@ -553,18 +607,22 @@ class DMP:
 
     @classmethod
     def _from_state(cls, meta: dict, arrays: dict) -> "DMP":
-        model = cls(**meta["params"])
+        params = dict(meta["params"])
+        if "fit" in params:  # format 1 stored the regression under the name "fit"
+            params["regression"] = params.pop("fit")
+        model = cls(**params)
+        n_kernels = model._params().n_kernels
         n_steps = check_int(meta["n_steps_"], "n_steps_", minimum=3)
         weights = np.asarray(arrays["weights_"], dtype=np.float64)
-        if weights.ndim != 2 or weights.shape[0] != model.n_kernels:
-            raise ValueError(f"weights_ has shape {weights.shape}, expected ({model.n_kernels}, D)")
+        if weights.ndim != 2 or weights.shape[0] != n_kernels:
+            raise ValueError(f"weights_ has shape {weights.shape}, expected ({n_kernels}, D)")
         n_dims = weights.shape[1]
         for name in ("start_", "goal_"):
             if np.shape(arrays[name]) != (n_dims,):
                 raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({n_dims},)")
         for name in ("centres_", "widths_"):
-            if np.shape(arrays[name]) != (model.n_kernels,):
-                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({model.n_kernels},)")
+            if np.shape(arrays[name]) != (n_kernels,):
+                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({n_kernels},)")
         model.weights_ = weights
         model.start_ = np.asarray(arrays["start_"], dtype=np.float64)
         model.goal_ = np.asarray(arrays["goal_"], dtype=np.float64)

@@ -1,313 +1,35 @@
-"""Evaluation of learned skills: metrics and worked examples.
+"""Scenario evaluation: every method on every target of a scenario (SPEC §9, report JSON of §10).
 
-For now this holds the LASA fit-and-generalise example behind ``bidmp demo`` and the G-PRM vs
-classic PRM comparison behind ``bidmp reproduce table5``; the battery scenarios of SPEC §9 build
-on it.
+``evaluate(scenario, methods)`` returns a :class:`Report`; ``report.to_dict()`` is the JSON the
+CLI writes, ``report.summary()`` the tables it prints, and :func:`write_report` writes the
+results and figures. The paper's experiments built on it live in :mod:`bidmp.reproduce`.
 """
 
 from __future__ import annotations
 
+import json
+import os
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from .datasets import lasa, minimum_jerk
+from ._tables import markdown_table, text_table
+from ._trajectory import resample_time
 from .dmp import DMP
-from .extension import ExtendedDemonstration, extend_demonstration
-from .incremental import BiDMP, ForgettingResult, forgetting_runs
-from .segmentation import resample_time
-from .roadmap import RoadmapResult, classic_prm, gaussian_prm
+from .extension import extend_demonstration
+from .incremental import BiDMP, forgetting_runs
+from .metrics import approach_error, endpoint_error, path_difference
 
-__all__ = [
-    "rmse",
-    "path_extent",
-    "GeneralisationResult",
-    "lasa_generalisation",
-    "PRMComparison",
-    "table5_cases",
-    "compare_prm",
-    "IncrementalResult",
-    "lasa_incremental",
-    "approach_error",
-    "MethodResult",
-    "Report",
-    "evaluate",
-    "case_studies",
-]
+__all__ = ["CONVERGED_GAIN", "MethodResult", "Report", "evaluate", "write_report"]
 
-
-def rmse(a: np.ndarray, b: np.ndarray) -> float:
-    """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
-    a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    if a.shape != b.shape:
-        raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
-    return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
-
-
-def path_extent(y: np.ndarray) -> float:
-    """Diagonal of the axis-aligned bounding box of a trajectory (same unit as ``y``)."""
-    return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=float), axis=0)))
-
-
-@dataclass
-class GeneralisationResult:
-    """Outcome of :func:`lasa_generalisation` (lengths in the data set's unit, mm)."""
-
-    shape: str
-    demonstration: np.ndarray  # (T, D)
-    reproduction: np.ndarray  # (T, D)
-    goals: np.ndarray  # (G, D)
-    fixed_horizon: np.ndarray  # (G, T, D): the paper's protocol, T steps
-    converged: np.ndarray  # (G, n_converged, D)
-    endpoint_gain: float
-    endpoint_gain_converged: float
-    dmp_params: dict = field(default_factory=dict)
-
-    @property
-    def extent(self) -> float:
-        return path_extent(self.demonstration)
-
-    @property
-    def reproduction_rmse(self) -> float:
-        return rmse(self.reproduction, self.demonstration)
-
-    @property
-    def goal_shifts(self) -> np.ndarray:
-        return np.linalg.norm(self.goals - self.demonstration[-1], axis=1)
-
-    @property
-    def goal_error(self) -> float:
-        """End-point error of the reproduction at the demonstrated goal (T steps)."""
-        return float(np.linalg.norm(self.reproduction[-1] - self.demonstration[-1]))
-
-    @property
-    def errors_fixed(self) -> np.ndarray:
-        return np.linalg.norm(self.fixed_horizon[:, -1] - self.goals, axis=1)
-
-    @property
-    def errors_converged(self) -> np.ndarray:
-        return np.linalg.norm(self.converged[:, -1] - self.goals, axis=1)
-
-    def to_dict(self) -> dict:
-        """JSON-ready summary."""
-        return {
-            "shape": self.shape,
-            "dmp": self.dmp_params,
-            "n_samples": int(self.demonstration.shape[0]),
-            "extent": self.extent,
-            "reproduction_rmse": self.reproduction_rmse,
-            "reproduction_rmse_percent": 100.0 * self.reproduction_rmse / self.extent,
-            "endpoint_gain": self.endpoint_gain,
-            "endpoint_gain_converged": self.endpoint_gain_converged,
-            "n_steps_converged": int(self.converged.shape[1]),
-            "goal_error": self.goal_error,
-            "goals": self.goals.tolist(),
-            "goal_shifts": self.goal_shifts.tolist(),
-            "endpoint_errors_fixed_horizon": self.errors_fixed.tolist(),
-            "endpoint_errors_converged": self.errors_converged.tolist(),
-        }
-
-
-def lasa_generalisation(
-    name: str = "Sshape",
-    *,
-    demo_index: int = 0,
-    n_goals: int = 6,
-    shift: float = 0.3,
-    convergence_factor: int = 10,
-    **dmp_params,
-) -> GeneralisationResult:
-    """Fit a DMP to one LASA demonstration and roll it out to shifted goals.
-
-    The goals lie on a circle of radius ``shift × extent`` around the demonstrated goal. Each is
-    reached twice: with the paper's fixed horizon (T steps; the end-point error is
-    ``endpoint_gain · shift``) and run ``convergence_factor`` times longer (error → 0).
-    """
-    if not 0 <= demo_index < 7:
-        raise ValueError(f"demo_index must be 0-6 (LASA has 7 demonstrations per shape), got {demo_index}")
-    if n_goals < 1:
-        raise ValueError(f"n_goals must be >= 1, got {n_goals}")
-    if convergence_factor < 1:
-        raise ValueError(f"convergence_factor must be >= 1, got {convergence_factor}")
-    demonstration = lasa(name)[demo_index]
-    dmp = DMP(**dmp_params).fit(demonstration)
-    angles = np.linspace(0.0, 2.0 * np.pi, n_goals, endpoint=False)
-    radius = shift * path_extent(demonstration)
-    goals = demonstration[-1] + radius * np.column_stack([np.cos(angles), np.sin(angles)])
-    n_converged = convergence_factor * dmp.n_steps_
-    return GeneralisationResult(
-        shape=name,
-        demonstration=demonstration,
-        reproduction=dmp.rollout(),
-        goals=goals,
-        fixed_horizon=dmp.rollout_many(goals),
-        converged=dmp.rollout_many(goals, n_steps=n_converged),
-        endpoint_gain=dmp.endpoint_gain(),
-        endpoint_gain_converged=dmp.endpoint_gain(n_converged),
-        dmp_params=dmp.get_params(),
-    )
-
-
-# ---------------------------------------------------------------------------------------------
-# Paper Table 5: G-PRM vs classic PRM
-# ---------------------------------------------------------------------------------------------
-BATTERY_APPROACH_VIA = ((-80.0, -120.0, 200.0), (0.0, 0.0, 40.0), (0.0, 0.0, 0.0))  # SPEC §9, mm
-BATTERY_EXTENSION_TARGET = (150.0, 25.0, 0.0)  # centre of the nuts the plain DMP misses
-
-
-def table5_cases() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
-    """The cases of ``bidmp reproduce table5``: name -> (demonstration, new target, unit).
-
-    Four LASA shapes (demonstration 0; new target = end + (0.3, −0.2) × extent) and the battery
-    approach path of SPEC §9 (T = 200) extended to (150, 25, 0) mm.
-    """
-    cases = {}
-    for name in ("Sshape", "WShape", "NShape", "Angle"):
-        y = lasa(name)[0]
-        cases[f"LASA {name}"] = (y, y[-1] + np.array([0.3, -0.2]) * path_extent(y), "mm")
-    battery = minimum_jerk(BATTERY_APPROACH_VIA, 200)
-    cases["battery approach"] = (battery, np.array(BATTERY_EXTENSION_TARGET), "mm")
-    return cases
-
-
-@dataclass
-class PRMComparison:
-    """G-PRM vs classic PRM on one case over many seeds (similarities per seed and iteration)."""
-
-    name: str
-    units: str
-    gprm: np.ndarray  # (n_seeds, n_iter)
-    prm: np.ndarray  # (n_seeds, n_iter)
-    extension: ExtendedDemonstration  # seed 0, for figures
-    example_prm: RoadmapResult  # seed 0, for figures
-
-    def to_dict(self) -> dict:
-        def stats(values):
-            return {"mean": float(np.mean(values)), "std": float(np.std(values))}
-
-        return {
-            "case": self.name,
-            "n_seeds": int(self.gprm.shape[0]),
-            "gprm_per_iteration": [stats(column) for column in self.gprm.T],
-            "prm_per_iteration": [stats(column) for column in self.prm.T],
-            "gprm_first": stats(self.gprm[:, 0]),
-            "gprm_final": stats(self.gprm.max(axis=1)),
-            "prm_all": stats(self.prm),
-            "prm_final": stats(self.prm.max(axis=1)),
-        }
-
-
-def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int = 20, **options) -> PRMComparison:
-    """Run G-PRM and classic PRM on the piece that :func:`extend_demonstration` imitates.
-
-    Seeds ``0 … n_seeds − 1``; ``options`` go to :func:`extend_demonstration` (segmentation and
-    roadmap options shared by both methods).
-    """
-    if n_seeds < 1:
-        raise ValueError(f"n_seeds must be >= 1, got {n_seeds}")
-    extension = extend_demonstration(y, new_target, seed=0, **options)
-    roadmap_options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
-    prm_options = {k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")}
-    gprm, prm, example_prm = [], [], None
-    for seed in range(n_seeds):
-        if seed == 0 and len(extension.similarity_history):
-            gprm.append(extension.similarity_history)  # the extension already ran G-PRM with seed 0
-        else:
-            gprm.append(gaussian_prm(extension.tra_imi, extension.new_target, seed=seed, **roadmap_options).history)
-        result = classic_prm(extension.tra_imi, extension.new_target, seed=seed, **prm_options)
-        prm.append(result.history)
-        example_prm = example_prm or result
-    return PRMComparison(name=name, units=units, gprm=np.array(gprm), prm=np.array(prm),
-                         extension=extension, example_prm=example_prm)
-
-
-# ---------------------------------------------------------------------------------------------
-# Paper Fig. 11: Bi-DMP on LASA shapes
-# ---------------------------------------------------------------------------------------------
-LASA_TARGET_OFFSETS = ((0.3, -0.2), (-0.25, -0.3), (0.15, 0.35))  # × extent, from the demonstrated end
-
-
-@dataclass
-class IncrementalResult:
-    """One LASA shape: extended demonstrations to several targets, learned in turn by a Bi-DMP."""
-
-    shape: str
-    demonstration: np.ndarray
-    targets: np.ndarray  # (P, 2)
-    extensions: list  # ExtendedDemonstration per target
-    bidmp_rollouts: np.ndarray  # (P, T, 2), skill="nearest"
-    dmp_rollouts: np.ndarray  # (P, T, 2), the plain DMP to the same targets
-    forgetting_nearest: ForgettingResult
-    forgetting_latest: ForgettingResult
-
-    def reproduction_errors(self) -> np.ndarray:
-        """RMSE of each Bi-DMP rollout against its extended demonstration (mm)."""
-        return np.array([
-            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
-            for rollout, extension in zip(self.bidmp_rollouts, self.extensions)
-        ])
-
-    def dmp_errors(self) -> np.ndarray:
-        return np.array([
-            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
-            for rollout, extension in zip(self.dmp_rollouts, self.extensions)
-        ])
-
-    def to_dict(self) -> dict:
-        return {
-            "shape": self.shape,
-            "targets": self.targets.tolist(),
-            "bidmp_rmse": self.reproduction_errors().tolist(),
-            "dmp_rmse": self.dmp_errors().tolist(),
-            "forgetting_nearest": self.forgetting_nearest.to_dict(),
-            "forgetting_latest": self.forgetting_latest.to_dict(),
-        }
-
-
-def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET_OFFSETS, **bidmp_params) -> IncrementalResult:
-    """Fit a DMP to LASA demonstration 0, extend it to several new targets (1D-SEG + G-PRM) and
-    learn the extensions in turn with a Bi-DMP; measure reproduction and forgetting."""
-    demonstration = lasa(name)[0]
-    dmp = DMP().fit(demonstration)
-    targets = demonstration[-1] + np.asarray(offsets, dtype=float) * path_extent(demonstration)
-    extensions = [extend_demonstration(demonstration, target, seed=seed + index) for index, target in enumerate(targets)]
-    model = BiDMP(dmp, **bidmp_params)
-    for extension in extensions:
-        model.learn(extension.complete)
-    completes = [extension.complete for extension in extensions]
-    runs = forgetting_runs(dmp, completes, ("nearest", "latest"), **bidmp_params)
-    return IncrementalResult(
-        shape=name,
-        demonstration=demonstration,
-        targets=targets,
-        extensions=extensions,
-        bidmp_rollouts=np.stack([model.rollout(target) for target in targets]),
-        dmp_rollouts=dmp.rollout_many(targets),
-        forgetting_nearest=runs["nearest"],
-        forgetting_latest=runs["latest"],
-    )
-
-
-# ---------------------------------------------------------------------------------------------
-# Scenarios: evaluate every method on every target (SPEC §9, report JSON of §10)
-# ---------------------------------------------------------------------------------------------
 CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
-
-
-def approach_error(trajectory: np.ndarray, target: np.ndarray, height: float) -> float:
-    """Largest horizontal distance from the target's vertical axis while the trajectory is less
-    than ``height`` above the target (SPEC §9). 0 if it never comes that low."""
-    low = trajectory[:, 2] - target[2] < height
-    if not np.any(low):
-        return 0.0
-    return float(np.max(np.linalg.norm(trajectory[low, :2] - target[:2], axis=1)))
 
 
 @dataclass
 class MethodResult:
-    """One method on one scenario."""
+    """One method on one scenario (lengths in the scenario's unit, times in s)."""
 
     name: str
     rollouts: dict  # label -> (n, D)
@@ -376,6 +98,58 @@ class Report:
             out["forgetting"] = {skill: result.to_dict() for skill, result in self.forgetting.items()}
         return out
 
+    # -- tables ------------------------------------------------------------------------------
+    def method_rows(self, runtimes: bool = True) -> tuple[list[str], list[list[str]]]:
+        """The Table 4 analogue: header and one row per method."""
+        header = ["method", "success rate", "successes", "+ approach", "max error", "difference range"]
+        if runtimes:
+            header.append("run time [s]")
+        rows = []
+        for name, result in self.methods.items():
+            data = result.to_dict()
+            approach = "-" if data["approach_errors"] is None else f"{data['approach_successes']}/{data['n_targets']}"
+            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{data['n_targets']}", approach,
+                   f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
+            if runtimes:
+                row.append(f"{data['runtime_s']:.4f}")
+            rows.append(row)
+        return header, rows
+
+    def target_rows(self) -> tuple[list[str], list[list[str]]]:
+        """Tables 1 and 2 analogue: end-point error per target and method (x = failure)."""
+        scenario = self.scenario
+        origin = scenario.targets[scenario.demonstrated]
+        header = ["target", "distance"] + list(self.methods)
+        rows = []
+        for label, target in scenario.targets.items():
+            cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
+            for result in self.methods.values():
+                error = result.errors[label]
+                cells.append(f"{error:.3f}{'' if error <= scenario.success_threshold else ' x'}")
+            rows.append(cells)
+        return header, rows
+
+    def summary(self) -> str:
+        """The plain-text report ``bidmp demo`` prints (run times include one-time imports when
+        this is the first run in the process)."""
+        scenario = self.scenario
+        units = scenario.units
+        lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
+                 f"success = end-point error <= {scenario.success_threshold:g} {units}"]
+        if self.extension_targets:
+            lines.append(f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
+                         + ", ".join(np.array2string(np.asarray(t), precision=1) for t in self.extension_targets))
+        lines += ["", f"Table 4 analogue (errors in {units}; run time in s, measured in this run)", text_table(*self.method_rows())]
+        lines += ["", f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)", text_table(*self.target_rows())]
+        if self.forgetting:
+            lines += ["", f"forgetting (error after learning every demonstration minus error when learned, {units}):"]
+            lines += [f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting) for skill, result in self.forgetting.items()]
+        return "\n".join(lines)
+
+    def markdown(self) -> str:
+        """The deterministic part of the report as Markdown (no run times)."""
+        return "\n\n".join([markdown_table(*self.method_rows(runtimes=False)), markdown_table(*self.target_rows())])
+
 
 class _Timer:
     def __enter__(self):
@@ -399,7 +173,7 @@ def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
 
 def _bidmp_model(scenario, dmp, failed):
     """Build the scenario's Bi-DMP: chained extensions, then further demonstrations."""
-    model = BiDMP(dmp)
+    model = BiDMP(dmp, **scenario.bidmp)
     extensions, targets = [], []
     previous = None
     for stage in scenario.extensions:
@@ -407,13 +181,18 @@ def _bidmp_model(scenario, dmp, failed):
         if target is None:
             continue  # nothing failed: no extension needed
         source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
-        previous = extend_demonstration(source, target, seed=scenario.seed)
+        previous = extend_demonstration(source, target, seed=scenario.seed, **scenario.extension)
         model.learn(previous.complete)
         extensions.append(previous)
         targets.append(target)
-    for demonstration in scenario.demonstrations.values():
-        model.learn(demonstration)
-    return model, extensions, targets
+    forgetting = {}
+    if scenario.demonstrations:
+        if model.n_skills == 1:  # learn the operators' demonstrations and measure forgetting in one pass
+            forgetting = forgetting_runs(model, list(scenario.demonstrations.values()), ("nearest", "latest"))
+        else:
+            for demonstration in scenario.demonstrations.values():
+                model.learn(demonstration)
+    return model, extensions, targets, forgetting
 
 
 def evaluate(scenario, methods=None, progress=None) -> Report:
@@ -434,11 +213,13 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
         ``report.to_dict()`` is the JSON of SPEC §10.
     """
     from . import scenarios as scenario_module
-    from .baselines import GMMRegressor, TPGMM
+    from .baselines import TPGMM, GMMRegressor
 
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
     methods = list(scenario.methods if methods is None else methods)
+    if not methods:
+        raise ValueError("methods is empty: name at least one of " + ", ".join(scenario_module.METHODS))
     for method in methods:
         if method not in scenario_module.METHODS:
             raise ValueError(f"unknown method {method!r}; known: {', '.join(scenario_module.METHODS)}")
@@ -450,16 +231,11 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
 
     def result(name, trajectories, seconds):
         trajectories = dict(zip(labels, trajectories))
-        errors = {label: float(np.linalg.norm(trajectories[label][-1] - scenario.targets[label])) for label in labels}
+        errors = {label: endpoint_error(trajectories[label], scenario.targets[label]) for label in labels}
         approach = None
         if scenario.approach_height is not None and demo.shape[1] == 3:
             approach = {label: approach_error(trajectories[label], scenario.targets[label], scenario.approach_height) for label in labels}
-        # Over the demonstration's duration: the first T samples (a run to convergence goes on
-        # afterwards; squeezing it into T samples would compare different times).
-        differences = {
-            label: float(np.sum(np.linalg.norm(trajectories[label][:n_steps] - references[label], axis=1)))
-            for label in labels
-        }
+        differences = {label: path_difference(trajectories[label], references[label]) for label in labels}
         return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
                             next(iter(trajectories.values())).shape[0])
 
@@ -486,7 +262,7 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
         elif method in ("bidmp", "bidmp-latest"):
             if model is None:
                 with _Timer() as timer:
-                    model, report.extensions, report.extension_targets = _bidmp_model(scenario, dmp, failed)
+                    model, report.extensions, report.extension_targets, report.forgetting = _bidmp_model(scenario, dmp, failed)
                 model_seconds = dmp_time.seconds + timer.seconds
                 report.model = model
             skill = "nearest" if method == "bidmp" else "latest"
@@ -503,33 +279,23 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
                 tpgmm = TPGMM(seed=scenario.seed).fit(demo)
                 trajectories = [tpgmm.generate(demo[0], goal)[0] for goal in goals]
             report.methods[method] = result(method, trajectories, timer.seconds)
-    if scenario.demonstrations:
-        demos = list(scenario.demonstrations.values())
-        report.forgetting = forgetting_runs(dmp, demos, ("nearest", "latest"))
+    if scenario.demonstrations and not report.forgetting:
+        report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
+                                            **scenario.bidmp)
     return report
 
 
-def case_studies() -> dict:
-    """The case-study numbers of ``bidmp reproduce table4`` beyond the per-method tables.
+def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
+    """Write ``results.json`` and the three figures of a report into folder ``out`` (created if
+    needed); return the paths written."""
+    from .io import atomic_write
+    from .plotting import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
 
-    Cell removal: Bi-DMP end-point errors at the cells with the nut skill only ("before") and
-    after the second extended demonstration to B6 is learned on top ("after"), plus the path
-    difference at B6. Pick-and-place: forgetting of each operator's skill.
-    """
-    from . import scenarios as scenario_module
-
-    cells = scenario_module.load("cell-removal")
-    before_spec = cells.to_dict()
-    before_spec["extensions"] = before_spec["extensions"][:1]
-    before = evaluate(scenario_module.from_dict(before_spec, source="cell-removal (nut skill only)"), ["bidmp"])
-    after = evaluate(cells, ["bidmp"])
-    picking = evaluate("pick-and-place", ["bidmp"])
-    return {
-        "cell_removal": {
-            "before": before.methods["bidmp"].errors,
-            "after": after.methods["bidmp"].errors,
-            "difference_before": before.methods["bidmp"].differences["B6"],
-            "difference_after": after.methods["bidmp"].differences["B6"],
-        },
-        "pick_and_place": {skill: result.to_dict() for skill, result in picking.forgetting.items()},
-    }
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_write(out / "results.json", "w") as handle:
+        json.dump(report.to_dict(), handle, indent=2)
+    return [out / "results.json",
+            plot_targets_top_view(out / "targets_top_view.png", report),
+            plot_error_vs_distance(out / "error_vs_distance.png", report),
+            plot_scenario_3d(out / "scenario_3d.png", report)]

@@ -12,7 +12,6 @@ ends at rest at the new target.
 
 from __future__ import annotations
 
-import inspect
 import logging
 from dataclasses import dataclass
 
@@ -20,19 +19,13 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ._checks import as_point, as_trajectory
-from .roadmap import gaussian_prm
-from .segmentation import Piece, arclength, choose_piece, resample_time, segment
+from ._trajectory import arclength, interp_columns, path_extent, resample_time
+from .roadmap import CollisionCallback, gaussian_prm
+from .segmentation import Piece, choose_piece, segment
 
 __all__ = ["ExtendedDemonstration", "extend_demonstration", "time_path"]
 
 logger = logging.getLogger(__name__)
-
-_SEGMENT_OPTIONS = ("eps_frac", "method")
-_ROADMAP_OPTIONS = tuple(
-    name for name, parameter in inspect.signature(gaussian_prm).parameters.items()
-    if parameter.kind is inspect.Parameter.KEYWORD_ONLY and name != "seed"
-)
-
 
 @dataclass
 class ExtendedDemonstration:
@@ -106,12 +99,31 @@ def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float
     u = np.arange(1, n_steps + 1) / n_steps
     a = start_speed * duration
     arc = length * (3 * u**2 - 2 * u**3) + a * (u - 2 * u**2 + u**3)
-    positions = np.column_stack([np.interp(arc, s, column) for column in path.T])
+    positions = interp_columns(arc, s, path)
     positions[-1] = path[-1]
     return positions, n_steps * dt
 
 
-def extend_demonstration(y, new_target, *, seed: int | np.random.Generator | None = 0, **options) -> ExtendedDemonstration:
+def extend_demonstration(
+    y,
+    new_target,
+    *,
+    seed: int | np.random.Generator | None = 0,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
+    n_samples: int = 300,
+    sigma_rel: float = 0.03,
+    n_neighbours: int = 8,
+    n_compare: int = 100,
+    n_iter: int = 10,
+    rho: float = 0.9,
+    schedule: str = "geometric",
+    scaling: str = "axis",
+    compare: str = "template",
+    select: str = "best",
+    denom: str = "sqrt2",
+    is_free: CollisionCallback | None = None,
+) -> ExtendedDemonstration:
     """Grow an extended demonstration from ``y`` to ``new_target`` (1D-SEG + G-PRM).
 
     Parameters
@@ -121,30 +133,31 @@ def extend_demonstration(y, new_target, *, seed: int | np.random.Generator | Non
     new_target : array (D,)
     seed : int or numpy.random.Generator
         Seed of the G-PRM sampling: same seed, same result.
-    **options
-        ``eps_frac``, ``method`` go to :func:`bidmp.segment`; ``n_samples``, ``sigma_rel``,
-        ``n_neighbours``, ``n_compare``, ``n_iter``, ``rho``, ``schedule``, ``scaling``,
-        ``compare``, ``select``, ``denom``, ``is_free`` go to :func:`bidmp.roadmap.gaussian_prm`.
+    eps_frac, method
+        Segmentation options, see :func:`bidmp.segment`.
+    n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare, select, denom, is_free
+        G-PRM options, see :func:`bidmp.roadmap.gaussian_prm` (same defaults).
 
     Returns
     -------
     ExtendedDemonstration
     """
-    unknown = sorted(set(options) - set(_SEGMENT_OPTIONS) - set(_ROADMAP_OPTIONS))
-    if unknown:
-        raise TypeError(f"unknown option(s) {', '.join(unknown)}; known: {', '.join(_SEGMENT_OPTIONS + _ROADMAP_OPTIONS)}")
     y = as_trajectory(y, "y", min_points=10)
     target = as_point(new_target, y.shape[1], "new_target")
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
 
-    points = segment(y, **{k: options[k] for k in _SEGMENT_OPTIONS if k in options})
+    points = segment(y, eps_frac=eps_frac, method=method).points
     piece = choose_piece(y, points, target)
     tra_imi = y[piece.start : piece.end + 1]
     seg = y[piece.start]
-    roadmap_options = {k: options[k] for k in _ROADMAP_OPTIONS if k in options}
+    roadmap_options = {
+        "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
+        "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
+        "select": select, "denom": denom, "is_free": is_free,
+    }
 
-    extent = float(np.linalg.norm(np.ptp(y, axis=0)))
+    extent = path_extent(y)
     if np.linalg.norm(target - seg) <= 1e-9 * extent:
         logger.info("new target coincides with seg: G-PRM skipped")
         tra_gen = np.vstack([seg, target])

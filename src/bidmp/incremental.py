@@ -23,26 +23,44 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+from sklearn.base import BaseEstimator, clone
 
-from ._checks import as_point, as_trajectory, check_choice, check_fitted, check_int, check_real
+from ._checks import NotFittedError, as_point, as_trajectory, check_choice, check_int, check_real
+from ._trajectory import resample_time, rmse
 from .bls import BLS
 from .dmp import DMP, forcing_target
-from .segmentation import resample_time
 
 __all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
 
 logger = logging.getLogger(__name__)
 
 
-class BiDMP:
+class BiDMP(BaseEstimator):
     """A DMP with incrementally learned forcing-term blocks and a skill library (SPEC §7).
+
+    A scikit-learn style estimator: ``BiDMP(dmp)`` only stores its parameters (``get_params``
+    includes the DMP's as ``dmp__alpha`` …). The model starts from a fitted ``dmp`` at the first
+    :meth:`learn` (the DMP is used as skill 0 and never modified), or from a demonstration with
+    :meth:`fit`, which fits a copy of ``dmp``.
+
+    **The increments vanish with the phase.** Block p is a BLS trained on
+    ``FI_p(ϑ) / ϑ`` over the phases of the DMP's training grid, and the increment is
+    ``ϑ · BLS_p(φ(clip(ϑ)))`` with ``ϑ`` clipped to that range. Like the DMP's own forcing term
+    (``f = ϑ Σ w ψ / Σ ψ``) it therefore decays to 0 as the phase does, and the BLS is never
+    evaluated outside the phases it was trained on. Every skill, rolled out long enough,
+    converges to its goal exactly as the plain DMP does.
 
     Parameters
     ----------
-    dmp : DMP
-        A fitted DMP (skill 0). It is never modified.
-    n_windows, n_mapped, n_enhance, shrink, reg
+    dmp : DMP, default None
+        Skill 0. ``None`` means ``DMP()`` (then call :meth:`fit`).
+    n_windows, n_mapped, n_enhance, shrink
         Parameters of each BLS block (see :class:`bidmp.BLS`).
+    reg : float, default 1e-4
+        Ridge λ of each block's output weights. The hidden nodes are nearly collinear, so a
+        smaller λ buys little accuracy with huge, cancelling weights: on the nut task λ = 1e-8
+        gave weights up to 1.6e6 and a reproduction RMSE of 0.11 mm, λ = 1e-4 weights up to 1.3e4
+        and 0.25 mm (λ does not depend on the length unit: the ridge solution is linear in FI).
     increments : tuple of int, default (20, 20)
         Enhancement nodes added, one block after another, after each BLS is fitted (the
         incremental step of Eq. 23–26).
@@ -56,66 +74,117 @@ class BiDMP:
 
     Attributes
     ----------
+    dmp_ : DMP
+        The fitted DMP in use (skill 0).
     blocks_ : list of BLS
         One per learned demonstration.
     skill_goals_, skill_starts_ : array (n_skills, D)
         Training goal and start of every skill (row 0: the plain DMP's).
+    phase_min_ : float
+        The smallest phase of the training grid; below it the BLS input is held at this phase.
     """
 
     def __init__(
         self,
-        dmp: DMP,
+        dmp: DMP | None = None,
         n_windows: int = 10,
         n_mapped: int = 10,
         n_enhance: int = 100,
         increments: tuple[int, ...] = (20, 20),
         shrink: float = 0.8,
-        reg: float = 1e-8,
+        reg: float = 1e-4,
         seed: int = 0,
         derivatives: str = "forward",
     ) -> None:
-        if not isinstance(dmp, DMP):
-            raise TypeError(f"dmp must be a bidmp.DMP, got {type(dmp).__name__}")
-        check_fitted(dmp, "weights_")
         self.dmp = dmp
-        self.n_windows = check_int(n_windows, "n_windows", minimum=1)
-        self.n_mapped = check_int(n_mapped, "n_mapped", minimum=1)
-        self.n_enhance = check_int(n_enhance, "n_enhance", minimum=1)
-        self.increments = tuple(check_int(n, "increments", minimum=1) for n in increments)
-        self.shrink = check_real(shrink, "shrink", positive=True)
-        self.reg = check_real(reg, "reg", nonnegative=True)
-        self.seed = check_int(seed, "seed", minimum=0)
-        self.derivatives = check_choice(derivatives, "derivatives", ("forward", "gradient", "dmp"))
-        self.blocks_: list[BLS] = []
+        self.n_windows = n_windows
+        self.n_mapped = n_mapped
+        self.n_enhance = n_enhance
+        self.increments = increments
+        self.shrink = shrink
+        self.reg = reg
+        self.seed = seed
+        self.derivatives = derivatives
+
+    def _check_params(self) -> tuple[tuple[int, ...], str]:
+        """Validate the parameters; return the increments and the derivative rule."""
+        if self.dmp is not None and not isinstance(self.dmp, DMP):
+            raise TypeError(f"dmp must be a bidmp.DMP, got {type(self.dmp).__name__}")
+        check_int(self.n_windows, "n_windows", minimum=1)
+        check_int(self.n_mapped, "n_mapped", minimum=1)
+        check_int(self.n_enhance, "n_enhance", minimum=1)
+        check_real(self.shrink, "shrink", positive=True)
+        check_real(self.reg, "reg", nonnegative=True)
+        check_int(self.seed, "seed", minimum=0)
+        if isinstance(self.increments, (str, bytes)) or not hasattr(self.increments, "__iter__"):
+            raise TypeError(f"increments must be a sequence of integers, got {self.increments!r}")
+        increments = tuple(check_int(n, "increments", minimum=1) for n in self.increments)
+        derivatives = check_choice(self.derivatives, "derivatives", ("forward", "gradient", "dmp"))
+        return increments, derivatives
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "dmp_" in self.__dict__ or (isinstance(self.dmp, DMP) and self.dmp.__sklearn_is_fitted__())
+
+    def _start(self, dmp: DMP) -> None:
+        """Skill 0 only: the plain DMP."""
+        phase, _ = dmp.training_grid()
+        self.dmp_ = dmp
+        self.blocks_ = []
         self.skill_goals_ = dmp.goal_[None].copy()
         self.skill_starts_ = dmp.start_[None].copy()
+        self.phase_min_ = float(phase.min())
 
-    def get_params(self) -> dict:
-        return {
-            "n_windows": self.n_windows, "n_mapped": self.n_mapped, "n_enhance": self.n_enhance,
-            "increments": list(self.increments), "shrink": self.shrink, "reg": self.reg, "seed": self.seed,
-            "derivatives": self.derivatives,
-        }
+    def _ensure_started(self) -> None:
+        if "dmp_" in self.__dict__:
+            return
+        if not isinstance(self.dmp, DMP) or not self.dmp.__sklearn_is_fitted__():
+            raise NotFittedError(
+                "this BiDMP is not fitted yet: pass a fitted DMP (BiDMP(DMP().fit(y))) or call fit(y) first"
+            )
+        self._check_params()
+        self._start(self.dmp)
+
+    def fit(self, y) -> "BiDMP":
+        """Fit a copy of ``dmp`` (default ``DMP()``) on the demonstration ``y`` (T, D) as skill 0,
+        forgetting every learned skill. Returns self."""
+        self._check_params()
+        dmp = clone(self.dmp) if self.dmp is not None else DMP()
+        self._start(dmp.fit(y))
+        return self
 
     @property
     def n_skills(self) -> int:
         """Number of skills: 1 (the plain DMP) + one per learned demonstration."""
+        self._ensure_started()
         return 1 + len(self.blocks_)
 
-    def __repr__(self) -> str:
-        return f"BiDMP(n_skills={self.n_skills}, {', '.join(f'{k}={v!r}' for k, v in self.get_params().items())})"
+    @property
+    def n_dims_(self) -> int:
+        """Number of dimensions D of the skills."""
+        self._ensure_started()
+        return self.dmp_.n_dims_
 
     # -- learning --------------------------------------------------------------------------------
     def forcing_term(self, phase, skill: int | None = None) -> np.ndarray:
         """``f_in`` of a skill (default: all blocks) at the given phases, shape (L, D)."""
+        self._ensure_started()
         phase = np.asarray(phase, dtype=np.float64).reshape(-1)
-        basis = self.dmp.basis(phase)
-        return basis @ self.dmp.weights_ + self._increment(basis, self._check_skill_index(skill))
+        basis = self.dmp_.basis(phase)
+        return basis @ self.dmp_.weights_ + self._increment(phase, basis, self._check_skill_index(skill))
 
-    def _increment(self, basis: np.ndarray, skill: int) -> np.ndarray:
-        total = np.zeros((basis.shape[0], self.dmp.n_dims_))
+    def _increment(self, phase: np.ndarray, basis: np.ndarray, skill: int) -> np.ndarray:
+        """Sum of the first ``skill`` blocks' increments, ``ϑ · BLS(φ(clip(ϑ)))``, shape (L, D)."""
+        total = np.zeros((phase.shape[0], self.dmp_.n_dims_))
+        if skill == 0:
+            return total
+        clipped = np.clip(phase, self.phase_min_, 1.0)
+        outside = clipped != phase
+        if np.any(outside):  # never extrapolate in phase: hold the BLS input at the trained range
+            basis = basis.copy()
+            basis[outside] = self.dmp_.basis(clipped[outside])
         for block in self.blocks_[:skill]:
             total += block.predict(basis)
+        total *= phase[:, None]
         return total
 
     def learn(self, y_dn) -> "BiDMP":
@@ -127,17 +196,20 @@ class BiDMP:
             Uniform in time, same D as the DMP; resampled to the DMP's T samples. Its last point
             is the skill's goal, its first the skill's start.
         """
-        dmp = self.dmp
+        self._ensure_started()
+        _, derivatives = self._check_params()
+        dmp = self.dmp_
+        params = dmp._params()
         y = as_trajectory(y_dn, "y_dn")
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"y_dn has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
         y = resample_time(y, dmp.n_steps_)
-        phase, basis = dmp.grid_basis()
+        phase, basis = dmp.training_grid()
         target = forcing_target(
-            y, phase, dt=dmp.dt_, tau=dmp.tau, alpha=dmp.alpha, beta=dmp.beta_value, K=dmp.K_value,
-            derivatives=dmp.derivatives if self.derivatives == "dmp" else self.derivatives,
+            y, phase, dt=dmp.dt_, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
+            derivatives=params.derivatives if derivatives == "dmp" else derivatives,
         )
-        current = basis @ dmp.weights_ + self._increment(basis, len(self.blocks_))
+        current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
         return self.learn_increment(target - current, goal=y[-1], start=y[0])
 
     def learn_increment(self, forcing_increment, goal, start=None) -> "BiDMP":
@@ -146,11 +218,13 @@ class BiDMP:
         Parameters
         ----------
         forcing_increment : array (T, D)
-            FI on the DMP's phase grid.
+            FI on the DMP's training grid (:meth:`DMP.training_grid`).
         goal, start : array (D,)
             The new skill's training goal and start (start defaults to the DMP's).
         """
-        dmp = self.dmp
+        self._ensure_started()
+        increments, _ = self._check_params()
+        dmp = self.dmp_
         increment = np.asarray(forcing_increment, dtype=np.float64)
         if increment.shape != (dmp.n_steps_, dmp.n_dims_):
             raise ValueError(f"forcing_increment must have shape {(dmp.n_steps_, dmp.n_dims_)}, got {increment.shape}")
@@ -158,12 +232,12 @@ class BiDMP:
             raise ValueError("forcing_increment contains NaN or inf")
         goal = as_point(goal, dmp.n_dims_, "goal")
         start = dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start")
-        _, basis = dmp.grid_basis()
+        phase, basis = dmp.training_grid()
         block = BLS(
             n_windows=self.n_windows, n_mapped=self.n_mapped, n_enhance=self.n_enhance, shrink=self.shrink,
             reg=self.reg, seed=self.seed + len(self.blocks_) + 1,
-        ).fit(basis, increment)
-        for n_nodes in self.increments:
+        ).fit(basis, increment / phase[:, None])  # the increment is ϑ · BLS: learn FI / ϑ
+        for n_nodes in increments:
             block.add_enhancement_nodes(n_nodes)
         self.blocks_.append(block)
         self.skill_goals_ = np.vstack([self.skill_goals_, goal])
@@ -184,11 +258,12 @@ class BiDMP:
     def select_skill(self, goal, skill="nearest") -> int:
         """The skill index used for a query: ``"nearest"`` (training goal nearest ``goal``; ties:
         the later skill), ``"latest"`` or an explicit integer."""
+        self._ensure_started()
         if isinstance(skill, str):
             if skill == "latest":
                 return len(self.blocks_)
             if skill == "nearest":
-                goal = as_point(goal, self.dmp.n_dims_, "goal")
+                goal = as_point(goal, self.dmp_.n_dims_, "goal")
                 distances = np.linalg.norm(self.skill_goals_ - goal, axis=1)
                 return int(len(distances) - 1 - np.argmin(distances[::-1]))
             raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {skill!r}")
@@ -205,26 +280,28 @@ class BiDMP:
         start : array (D,), optional
             Default: the selected skill's training start.
         n_steps : int, optional
-            Default: the DMP's T.
+            Default: the DMP's default horizon (:meth:`DMP.default_n_steps`).
 
         Returns
         -------
-        y : array (n_steps, D). Skill 0 is exactly ``dmp.rollout`` (bit for bit).
+        y : array (n_steps, D). Skill 0 is exactly ``dmp_.rollout`` (bit for bit).
         """
-        query = self.skill_goals_[-1] if goal is None else as_point(goal, self.dmp.n_dims_, "goal")
+        self._ensure_started()
+        query = self.skill_goals_[-1] if goal is None else as_point(goal, self.dmp_.n_dims_, "goal")
         index = self.select_skill(query, skill)
         goal = self.skill_goals_[index] if goal is None else query
         start = self.skill_starts_[index] if start is None else start
         if index == 0:
-            return self.dmp.rollout(goal=goal, start=start, n_steps=n_steps)
-        return self.dmp.rollout(
+            return self.dmp_.rollout(goal=goal, start=start, n_steps=n_steps)
+        return self.dmp_.rollout(
             goal=goal, start=start, n_steps=n_steps,
-            forcing_increment=lambda phase, basis: self._increment(basis, index),
+            forcing_increment=lambda phase, basis: self._increment(phase, basis, index),
         )
 
     # -- persistence -----------------------------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        dmp_meta, dmp_arrays = self.dmp._get_state()
+        self._ensure_started()
+        dmp_meta, dmp_arrays = self.dmp_._get_state()
         arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
         arrays["skill_goals_"] = self.skill_goals_
         arrays["skill_starts_"] = self.skill_starts_
@@ -233,7 +310,9 @@ class BiDMP:
             meta, block_arrays = block._get_state()
             blocks_meta.append(meta)
             arrays.update({f"block{index}/{k}": v for k, v in block_arrays.items()})
-        return {"params": self.get_params(), "dmp": dmp_meta, "blocks": blocks_meta}, arrays
+        params = {k: v for k, v in self.get_params(deep=False).items() if k != "dmp"}
+        params["increments"] = list(self.increments)
+        return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": self.phase_min_}, arrays
 
     @classmethod
     def _from_state(cls, meta: dict, arrays: dict) -> "BiDMP":
@@ -244,6 +323,9 @@ class BiDMP:
         params = dict(meta["params"])
         params["increments"] = tuple(params["increments"])
         model = cls(dmp, **params)
+        model._check_params()
+        model._start(dmp)
+        model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True)
         model.blocks_ = [BLS._from_state(block_meta, part(f"block{index}/")) for index, block_meta in enumerate(meta["blocks"])]
         goals = np.asarray(arrays["skill_goals_"], dtype=np.float64)
         starts = np.asarray(arrays["skill_starts_"], dtype=np.float64)
@@ -276,9 +358,23 @@ class ForgettingResult:
                 "forgetting": self.forgetting.tolist()}
 
 
-def forgetting_runs(dmp: DMP, demonstrations, skills=("nearest", "latest"), **bidmp_params) -> dict:
-    """:func:`forgetting` for several skill rules from one learning pass: {skill: ForgettingResult}."""
-    model = BiDMP(dmp, **bidmp_params)
+def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest"), **bidmp_params) -> dict:
+    """:func:`forgetting` for several skill rules from one learning pass: {skill: ForgettingResult}.
+
+    ``dmp`` may also be a :class:`BiDMP` with no learned skill yet: the demonstrations are then
+    learned into it (so the caller keeps the model; ``bidmp_params`` must be empty).
+    """
+    if isinstance(dmp, BiDMP):
+        if bidmp_params:
+            raise TypeError("bidmp_params cannot be combined with a BiDMP model (set them on the model)")
+        model = dmp
+        model._ensure_started()
+        if model.blocks_:
+            raise ValueError(f"the BiDMP given already has {len(model.blocks_)} learned skill(s); forgetting starts from none")
+        dmp = model.dmp_
+    else:
+        model = BiDMP(dmp, **bidmp_params)
+        model._ensure_started()
     references = [dmp.rollout()]
     n_skills = len(demonstrations) + 1
     errors = {skill: np.full((n_skills, n_skills), np.nan) for skill in skills}
@@ -287,7 +383,7 @@ def forgetting_runs(dmp: DMP, demonstrations, skills=("nearest", "latest"), **bi
         for skill in skills:
             for p in range(column + 1):
                 rollout = model.rollout(model.skill_goals_[p], skill=skill, start=model.skill_starts_[p])
-                errors[skill][p, column] = float(np.sqrt(np.mean(np.sum((rollout - references[p]) ** 2, axis=1))))
+                errors[skill][p, column] = rmse(rollout, references[p])
 
     measure(0)
     for index, demonstration in enumerate(demonstrations, start=1):

@@ -40,7 +40,11 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+# Format 2 (bidmp 0.2): Bi-DMP increments are gated by the phase and the DMP's regression is stored
+# as "regression". Format-1 DMP and BLS files still load; format-1 Bi-DMP files do not, because
+# their blocks were trained on the ungated increment and would roll out wrongly.
+_MIN_VERSION = {"BiDMP": 2}
 _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
 # Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
@@ -168,6 +172,11 @@ def load_model(path: str | os.PathLike):
     class_name = meta.get("class")
     if class_name not in _MODEL_CLASSES:
         raise ModelFileError(f"{path} holds an unknown model class {class_name!r}")
+    if version < _MIN_VERSION.get(class_name, 1):
+        raise ModelFileError(
+            f"{path} holds a {class_name} in model format {version} (bidmp {meta.get('bidmp_version', '?')}), whose "
+            f"learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
+        )
     try:
         model = _model_class(class_name)._from_state(meta["state"], arrays)
     except (KeyError, TypeError, ValueError) as exc:
@@ -289,8 +298,14 @@ def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     return as_trajectory(positions, name=str(path))
 
 
-def save_trajectory(path: str | os.PathLike, y, times=None) -> Path:
-    """Write a trajectory (T, D) to ``.csv`` (header ``[t,]x,y[,z]``) or ``.npy``, atomically."""
+def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
+    """Write a trajectory ``y`` (T, D) to ``path``: ``.csv`` (header ``[t,]x,y[,z]``; ``times``
+    (T,) in seconds adds the ``t`` column) or ``.npy``, atomically.
+
+    The argument order is the same as :func:`save_model` (what, then where).
+    """
+    if isinstance(y, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
+        raise TypeError("save_trajectory takes (y, path): the trajectory first, then the file (as save_model)")
     path = Path(path)
     y = np.asarray(y, dtype=np.float64)
     if y.ndim != 2:

@@ -1,5 +1,9 @@
-"""Figures (matplotlib, Agg backend; nothing is shown on screen). Every function writes a PNG
-atomically and returns its path."""
+"""Figures. Every function writes a PNG atomically and returns its path.
+
+Figures are built as :class:`matplotlib.figure.Figure` objects, never through ``pyplot``: nothing
+is shown, no global figure registry fills up, and the process-wide backend is left alone, so a
+notebook user keeps theirs.
+"""
 
 from __future__ import annotations
 
@@ -16,26 +20,43 @@ __all__ = ["plot_trajectories", "plot_generalisation", "plot_segmentation", "plo
            "plot_error_vs_distance", "plot_scenario_3d"]
 
 
-def _pyplot():
-    import matplotlib
+class _Matplotlib:
+    """The parts of matplotlib the figures use, without ``pyplot`` (which would pick a backend)."""
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
+    def __init__(self):
+        from types import SimpleNamespace
 
-    return plt
+        import mpl_toolkits.mplot3d  # noqa: F401 - registers the "3d" projection
+        from matplotlib import colormaps
+        from matplotlib.figure import Figure
+        from matplotlib.patches import Circle
+
+        self._figure_class = Figure
+        self.Circle = Circle
+        self.cm = SimpleNamespace(viridis=colormaps["viridis"], tab10=colormaps["tab10"])
+
+    def figure(self, figsize, dpi):
+        return self._figure_class(figsize=figsize, dpi=dpi)
+
+    def subplots(self, *grid, figsize, dpi, **kwargs):
+        fig = self._figure_class(figsize=figsize, dpi=dpi)
+        return fig, fig.subplots(*grid, **kwargs)
+
+
+def _matplotlib() -> _Matplotlib:
+    return _Matplotlib()
 
 
 def _figure(projection_3d: bool):
-    plt = _pyplot()
-    fig = plt.figure(figsize=(7.0, 6.0), dpi=110)
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(7.0, 6.0), dpi=110)
     ax = fig.add_subplot(projection="3d" if projection_3d else None)
-    return plt, fig, ax
+    return mpl, fig, ax
 
 
-def _save(plt, fig, path: str | os.PathLike) -> Path:
+def _save(fig, path: str | os.PathLike) -> Path:
     buffer = _io.BytesIO()
     fig.savefig(buffer, format="png", bbox_inches="tight")
-    plt.close(fig)
     path = Path(path)
     with atomic_write(path, "wb") as handle:
         handle.write(buffer.getvalue())
@@ -65,7 +86,7 @@ def plot_trajectories(
     n_dims = demonstration.shape[1]
     if n_dims not in (1, 2, 3):
         raise ValueError(f"can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
-    plt, fig, ax = _figure(n_dims == 3)
+    mpl, fig, ax = _figure(n_dims == 3)
 
     def coords(points: np.ndarray):
         points = np.asarray(points, dtype=float)
@@ -75,7 +96,7 @@ def plot_trajectories(
 
     ax.plot(*coords(demonstration), color="0.55", linewidth=4, alpha=0.6, label="demonstration")
     ax.scatter(*[[c[0]] for c in coords(demonstration)], color="k", marker="o", zorder=5, label="start")
-    colours = plt.cm.viridis(np.linspace(0.0, 0.9, max(len(trajectories), 1)))
+    colours = mpl.cm.viridis(np.linspace(0.0, 0.9, max(len(trajectories), 1)))
     for index, trajectory in enumerate(trajectories):
         label = labels[index] if labels is not None and index < len(labels) else None
         ax.plot(*coords(trajectory), color=colours[index], linewidth=1.5, label=label)
@@ -97,19 +118,19 @@ def plot_trajectories(
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def plot_generalisation(path: str | os.PathLike, result) -> Path:
     """Two panels for a :class:`bidmp.evaluation.GeneralisationResult` (2-D): the rollouts to moved
     goals with the paper's fixed horizon (left) and run to convergence (right)."""
-    plt = _pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
+    mpl = _matplotlib()
+    fig, axes = mpl.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
     panels = (
         (result.fixed_horizon, f"T = {result.demonstration.shape[0]} steps (paper): end-point gain c = {result.endpoint_gain:.3f}"),
         (result.converged, f"{result.converged.shape[1]} steps (run to convergence): c = {result.endpoint_gain_converged:.1e}"),
     )
-    colours = plt.cm.viridis(np.linspace(0.0, 0.85, len(result.goals)))
+    colours = mpl.cm.viridis(np.linspace(0.0, 0.85, len(result.goals)))
     for ax, (rollouts, title) in zip(axes, panels):
         demo = result.demonstration
         ax.plot(demo[:, 0], demo[:, 1], color="0.55", linewidth=4, alpha=0.6, label="demonstration")
@@ -128,7 +149,7 @@ def plot_generalisation(path: str | os.PathLike, result) -> Path:
     axes[0].set_ylabel("y [mm]")
     axes[0].legend(loc="best", fontsize=8)
     fig.suptitle(f"LASA {result.shape}: one demonstration, DMP rollouts to moved goals")
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def _axes_for(fig, n_dims: int, *grid):
@@ -157,10 +178,10 @@ def plot_segmentation(path, y: np.ndarray, points: np.ndarray, kinds: np.ndarray
                       curvature: np.ndarray | None = None, units: str = "", title: str = "1D-SEG") -> Path:
     """The demonstration with its segmentation points (maxima ▲, minima ▼) and, if given, the
     curvature along the normalised arc length with the same points."""
-    plt = _pyplot()
+    mpl = _matplotlib()
     y = np.asarray(y, dtype=float)
     n_dims = y.shape[1]
-    fig = plt.figure(figsize=(12.0 if curvature is not None else 6.5, 5.5), dpi=110)
+    fig = mpl.figure(figsize=(12.0 if curvature is not None else 6.5, 5.5), dpi=110)
     ax = _axes_for(fig, n_dims, 1, 2 if curvature is not None else 1, 1)
     _draw(ax, y, color="0.4", linewidth=2, label="demonstration")
     _draw(ax, y[:1], "ko", label="start")
@@ -182,7 +203,7 @@ def plot_segmentation(path, y: np.ndarray, points: np.ndarray, kinds: np.ndarray
         ax2.set_ylabel("curvature" + (f" [1/{units}]" if units else ""))
         ax2.grid(True, alpha=0.3)
         ax2.set_title("curvature and segmentation points", fontsize=10)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def _draw_extension(ax, extension, prm_path: np.ndarray | None = None, show_samples: bool = True) -> None:
@@ -205,23 +226,23 @@ def _draw_extension(ax, extension, prm_path: np.ndarray | None = None, show_samp
 def plot_extension(path, extension, units: str = "", title: str = "Extended demonstration (1D-SEG + G-PRM)") -> Path:
     """An :class:`bidmp.extension.ExtendedDemonstration`: demonstration, segmentation points,
     sampling points, Tra_imi, Tra_gen and the complete extended demonstration."""
-    plt = _pyplot()
+    mpl = _matplotlib()
     n_dims = extension.demonstration.shape[1]
-    fig = plt.figure(figsize=(7.5, 6.5), dpi=110)
+    fig = mpl.figure(figsize=(7.5, 6.5), dpi=110)
     ax = _axes_for(fig, n_dims, 1, 1, 1)
     _draw_extension(ax, extension)
     history = extension.similarity_history
     subtitle = f"\nG-PRM similarity {history[0]:.3f} → best {np.max(history):.3f}" if len(history) else ""
     _finish(ax, n_dims, units, title + subtitle)
     ax.legend(fontsize=7, loc="best")
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def plot_prm_comparison(path, comparisons) -> Path:
     """Paper Table 5 / Fig. 9 analogue: per case, the example paths (left) and the similarity
     per iteration, mean ± std over seeds, G-PRM vs classic PRM (right)."""
-    plt = _pyplot()
-    fig = plt.figure(figsize=(12.0, 4.2 * len(comparisons)), dpi=100)
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(12.0, 4.2 * len(comparisons)), dpi=100)
     for row, comparison in enumerate(comparisons):
         n_dims = comparison.extension.demonstration.shape[1]
         ax = _axes_for(fig, n_dims, len(comparisons), 2, 2 * row + 1)
@@ -242,18 +263,18 @@ def plot_prm_comparison(path, comparisons) -> Path:
         ax2.set_title(f"{comparison.name}: mean ± std over {comparison.gprm.shape[0]} seeds", fontsize=10)
         ax2.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def plot_incremental(path, results) -> Path:
     """Paper Fig. 11 analogue: per LASA shape, the demonstration, the extended demonstrations,
     the Bi-DMP rollouts to their targets and the plain DMP's rollouts to the same targets."""
-    plt = _pyplot()
-    fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 5.2), dpi=100, squeeze=False)
+    mpl = _matplotlib()
+    fig, axes = mpl.subplots(1, len(results), figsize=(5.5 * len(results), 5.2), dpi=100, squeeze=False)
     for ax, result in zip(axes[0], results):
         demo = result.demonstration
         ax.plot(demo[:, 0], demo[:, 1], color="0.6", linewidth=3, alpha=0.6, label="demonstration")
-        colours = plt.cm.tab10(np.arange(len(result.targets)))
+        colours = mpl.cm.tab10(np.arange(len(result.targets)))
         for index, (colour, extension) in enumerate(zip(colours, result.extensions)):
             first = index == 0
             ax.plot(*extension.complete.T, "--", color=colour, linewidth=2.5, alpha=0.5, label="extended demonstration" if first else None)
@@ -266,7 +287,7 @@ def plot_incremental(path, results) -> Path:
         _finish(ax, 2, "mm")
     axes[0][0].legend(fontsize=7, loc="best")
     fig.tight_layout()
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 _METHOD_COLOURS = {"dmp": "tab:blue", "dmp-converged": "tab:cyan", "bidmp": "tab:red", "bidmp-latest": "tab:orange",
@@ -276,18 +297,18 @@ _METHOD_COLOURS = {"dmp": "tab:blue", "dmp-converged": "tab:cyan", "bidmp": "tab
 def plot_targets_top_view(path, report) -> Path:
     """Top view of the targets, one panel per method: green = success, red = failure (paper
     Fig. 16c analogue), with the end point of each rollout."""
-    plt = _pyplot()
+    mpl = _matplotlib()
     scenario = report.scenario
     names = list(report.methods)
     n_cols = min(3, len(names))
     n_rows = int(np.ceil(len(names) / n_cols))
-    fig, axes = plt.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
+    fig, axes = mpl.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
     targets = scenario.target_array
     for ax, name in zip(axes.ravel(), names):
         result = report.methods[name]
         for label, target in scenario.targets.items():
             ok = result.errors[label] <= scenario.success_threshold
-            ax.add_patch(plt.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
+            ax.add_patch(mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
             ax.text(target[0], target[1], label, ha="center", va="center", fontsize=8)
             end = result.rollouts[label][-1]
             ax.plot(end[0], end[1], "k.", markersize=3)
@@ -301,18 +322,18 @@ def plot_targets_top_view(path, report) -> Path:
         ax.axis("off")
     fig.suptitle(f"{scenario.name}: success per target (green) and failure (red)")
     fig.tight_layout()
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def plot_error_vs_distance(path, report) -> Path:
     """End-point error (and approach error) against the distance from the demonstrated target."""
-    plt = _pyplot()
+    mpl = _matplotlib()
     scenario = report.scenario
     origin = scenario.targets[scenario.demonstrated]
     distance = {label: float(np.linalg.norm(target - origin)) for label, target in scenario.targets.items()}
     order = sorted(distance, key=distance.get)
     has_approach = any(r.approach_errors is not None for r in report.methods.values())
-    fig, axes = plt.subplots(1, 2 if has_approach else 1, figsize=(12 if has_approach else 6.5, 4.8), dpi=100, squeeze=False)
+    fig, axes = mpl.subplots(1, 2 if has_approach else 1, figsize=(12 if has_approach else 6.5, 4.8), dpi=100, squeeze=False)
     panels = [("errors", "end-point error")] + ([("approach_errors", "approach error")] if has_approach else [])
     for ax, (attribute, title) in zip(axes[0], panels):
         for name, result in report.methods.items():
@@ -331,17 +352,17 @@ def plot_error_vs_distance(path, report) -> Path:
     axes[0][0].legend(fontsize=8)
     fig.suptitle(f"{scenario.name}: error against distance (symlog scale)")
     fig.tight_layout()
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 def plot_scenario_3d(path, report) -> Path:
     """3-D view: demonstration, segmentation points, extended demonstration(s), Bi-DMP rollouts
     and the plain DMP's rollouts to the targets it misses (paper Fig. 17 / 19 analogue)."""
-    plt = _pyplot()
+    mpl = _matplotlib()
     scenario = report.scenario
     demo = scenario.demonstration
     n_dims = demo.shape[1]
-    fig = plt.figure(figsize=(8.0, 6.8), dpi=100)
+    fig = mpl.figure(figsize=(8.0, 6.8), dpi=100)
     ax = _axes_for(fig, n_dims, 1, 1, 1)
     _draw(ax, demo, color="0.4", linewidth=3, label="demonstration")
     for index, extension in enumerate(report.extensions):
@@ -361,4 +382,4 @@ def plot_scenario_3d(path, report) -> Path:
     _draw(ax, scenario.target_array, "o", color="tab:green", markersize=4, linestyle="none", label="targets")
     _finish(ax, n_dims, scenario.units, f"{scenario.name}")
     ax.legend(fontsize=7, loc="upper left")
-    return _save(plt, fig, path)
+    return _save(fig, path)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from ._checks import as_point, as_trajectory, check_choice, check_int, check_real
-from .segmentation import resample_arclength
+from ._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
 __all__ = ["RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path"]
@@ -70,7 +70,6 @@ class RoadmapResult:
     iteration: int
     template: np.ndarray
     samples: np.ndarray
-    paths: list = field(default_factory=list, repr=False)  # Tra_gen of every iteration
 
 
 def template(piece: np.ndarray, new_target: np.ndarray, scaling: str = "axis") -> np.ndarray:
@@ -274,7 +273,7 @@ def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is
     chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
     return RoadmapResult(
         path=paths[chosen], similarity=float(history[chosen]), history=history, iteration=chosen,
-        template=comparison.reference, samples=all_samples[chosen], paths=paths,
+        template=comparison.reference, samples=all_samples[chosen],
     )
 
 
@@ -342,7 +341,7 @@ def gaussian_prm(
     order = np.arange(n_samples)
 
     def draw(iteration):
-        bias_at_samples = np.column_stack([np.interp(t, lam, column) for column in bias.T])  # Eq. 9
+        bias_at_samples = interp_columns(t, lam, bias)  # Eq. 9
         return line + rng.normal(scale=sigma, size=line.shape) + bias_at_samples, order
 
     def learn(iteration, similarity, direction):  # Eq. 8

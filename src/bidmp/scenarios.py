@@ -16,8 +16,13 @@ Keys (units: millimetres for the battery scenarios)::
     success_threshold    end-point error for success, default 1.75
     approach_height      height band above a target for the approach error, default 28.5;
                          null turns the approach metric off
-    dmp                  DMP parameters (alpha, beta, K, alpha_phase, tau, n_kernels, fit, widths,
-                         derivatives)
+    dmp                  DMP parameters (alpha, beta, K, alpha_phase, tau, n_kernels, regression,
+                         widths, derivatives)
+    bidmp                Bi-DMP parameters (n_windows, n_mapped, n_enhance, increments, shrink, reg,
+                         seed, derivatives)
+    extension            extended-demonstration options of bidmp.extend_demonstration (eps_frac,
+                         method, n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho,
+                         schedule, scaling, compare, select, denom)
     extension_target     "centre_of_failed" (default), a target label, or a point
     extensions           list of {"target": as extension_target, "from": "demonstration" |
                          "previous"}: chained extended demonstrations (overrides extension_target)
@@ -47,9 +52,15 @@ __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "bui
 METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
-    "approach_height", "dmp", "extension_target", "extensions", "demonstrations", "methods", "seed",
+    "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
+    "seed",
 }
-_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "fit", "widths", "derivatives"}
+_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives"}
+_BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
+_EXTENSION_KEYS = {
+    "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
+    "scaling", "compare", "select", "denom",
+}
 _MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
 
 
@@ -68,6 +79,8 @@ class Scenario:
     success_threshold: float
     approach_height: float | None
     dmp: dict
+    bidmp: dict
+    extension: dict
     extensions: list[dict]
     demonstrations: dict[str, np.ndarray]
     methods: list[str]
@@ -183,6 +196,28 @@ def _extension_target(value, source, key, targets, n_dims):
     return _point(value, source, key, n_dims).tolist()
 
 
+def _parameters(data, key, known, source, check) -> dict:
+    """A parameter object (``dmp``, ``bidmp``, ``extension``): known names only, checked by
+    ``check(params)`` where given."""
+    params = data.get(key, {})
+    if not isinstance(params, dict):
+        _fail(source, key, "expected an object of parameters")
+    if key == "dmp" and "fit" in params:
+        _fail(source, "dmp.fit", "renamed to 'regression' (\"lwr\" or \"ridge\")")
+    bad = sorted(set(params) - known)
+    if bad:
+        _fail(source, f"{key}.{bad[0]}", f"unknown parameter (known: {', '.join(sorted(known))})")
+    params = dict(params)
+    if "increments" in params and isinstance(params["increments"], list):
+        params["increments"] = tuple(params["increments"])
+    if check is not None:
+        try:
+            check(params)
+        except (TypeError, ValueError) as exc:
+            _fail(source, key, str(exc))
+    return params
+
+
 def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -> Scenario:
     """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`."""
     if not isinstance(data, dict):
@@ -212,18 +247,12 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
     approach = data.get("approach_height", 28.5)
     approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
 
-    dmp = data.get("dmp", {})
-    if not isinstance(dmp, dict):
-        _fail(source, "dmp", "expected an object of DMP parameters")
-    bad = sorted(set(dmp) - _DMP_KEYS)
-    if bad:
-        _fail(source, f"dmp.{bad[0]}", f"unknown DMP parameter (known: {', '.join(sorted(_DMP_KEYS))})")
-    try:
-        from .dmp import DMP
+    from .dmp import DMP
+    from .incremental import BiDMP
 
-        DMP(**dmp)
-    except (TypeError, ValueError) as exc:
-        _fail(source, "dmp", str(exc))
+    dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
+    bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
+    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, None)
 
     if "extensions" in data:
         if not isinstance(data["extensions"], list) or not data["extensions"]:
@@ -263,7 +292,8 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
 
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
-        success_threshold=threshold, approach_height=approach, dmp=dict(dmp), extensions=extensions,
+        success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
+        extensions=extensions,
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
     )

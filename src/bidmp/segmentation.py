@@ -20,53 +20,17 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ._checks import as_point, as_trajectory, check_choice, check_real
+from ._trajectory import arclength, resample_arclength
 
 __all__ = [
-    "resample_arclength",
-    "resample_time",
-    "arclength",
     "curvature",
     "segment",
+    "Segmentation",
     "Piece",
     "choose_piece",
 ]
 
 _INTERIOR = (0.05, 0.95)
-
-
-def arclength(y: np.ndarray) -> np.ndarray:
-    """Cumulative arc length at each sample, shape (T,), starting at 0."""
-    steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
-    return np.concatenate([[0.0], np.cumsum(steps)])
-
-
-def resample_arclength(y, n_points: int) -> np.ndarray:
-    """Resample a polyline to ``n_points`` points equally spaced in arc length (ends kept exactly).
-
-    Repeated points (zero-length steps) are skipped, so a robot that paused is not a problem.
-    """
-    y = np.asarray(y, dtype=np.float64)
-    s = arclength(y)
-    moving = np.concatenate([[True], np.diff(s) > 0])
-    y, s = y[moving], s[moving]
-    if s[-1] <= 0.0:
-        return np.repeat(y[:1], n_points, axis=0)
-    grid = np.linspace(0.0, s[-1], n_points)
-    out = np.column_stack([np.interp(grid, s, column) for column in y.T])
-    out[0], out[-1] = y[0], y[-1]
-    return out
-
-
-def resample_time(y: np.ndarray, n_samples: int) -> np.ndarray:
-    """Resample a trajectory that is uniform in time to ``n_samples`` uniform samples (ends kept)."""
-    y = np.asarray(y, dtype=np.float64)
-    if y.shape[0] == n_samples:
-        return y.copy()
-    source = np.linspace(0.0, 1.0, y.shape[0])
-    target = np.linspace(0.0, 1.0, n_samples)
-    out = np.column_stack([np.interp(target, source, column) for column in y.T])
-    out[0], out[-1] = y[0], y[-1]
-    return out
 
 
 def _odd_window(fraction: float, n_points: int, minimum: int) -> int:
@@ -162,7 +126,32 @@ def _prune_paper(indices, types, kappa, epsilon):
     return np.asarray(indices, int)[keep], np.asarray(types, int)[keep]
 
 
-def segment(y, eps_frac: float = 0.1, method: str = "persistence", return_kinds: bool = False):
+@dataclass(frozen=True)
+class Segmentation:
+    """Result of :func:`segment`: the segmentation points of a demonstration.
+
+    Attributes
+    ----------
+    points : int array (m,)
+        Sorted sample indices into the demonstration. Empty for a straight demonstration.
+    kinds : int array (m,)
+        +1 where the point is a curvature maximum (a corner), -1 where it is a minimum (the
+        straightest part between corners).
+    """
+
+    points: np.ndarray
+    kinds: np.ndarray
+
+    @property
+    def corners(self) -> np.ndarray:
+        """The points that are curvature maxima."""
+        return self.points[self.kinds > 0]
+
+    def __len__(self) -> int:
+        return int(self.points.shape[0])
+
+
+def segment(y, eps_frac: float = 0.1, method: str = "persistence") -> Segmentation:
     """Segmentation points of a demonstration (1D-SEG, SPEC §2).
 
     Parameters
@@ -173,16 +162,13 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence", return_kinds:
         Pruning threshold as a fraction of the curvature range.
     method : {"persistence", "paper"}
         Pruning rule (see the module docstring).
-    return_kinds : bool, default False
-        Also return the kind of each point: +1 for a curvature maximum (a corner), -1 for a
-        minimum (the straightest part between corners).
 
     Returns
     -------
-    indices : int array, sorted
-        Sample indices into ``y`` (each extremum found on the arc-length resampled curve is mapped
-        to the original sample nearest in arc length). Empty for a straight demonstration.
-    kinds : int array, same length (only with ``return_kinds``)
+    Segmentation
+        ``points`` (sorted sample indices into ``y``; each extremum found on the arc-length
+        resampled curve is mapped to the original sample nearest in arc length) and ``kinds``
+        (+1 maximum, -1 minimum).
     """
     y = as_trajectory(y, "y", min_points=10)
     if y.shape[1] not in (2, 3):
@@ -201,8 +187,7 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence", return_kinds:
     interior = kappa[low:high]
     # Dimensionless curvature κ·L below 1e-6 everywhere: a straight line, nothing to cut.
     if interior.size == 0 or np.max(interior) * total < 1e-6:
-        empty = np.empty(0, int)
-        return (empty, empty) if return_kinds else empty
+        return Segmentation(np.empty(0, int), np.empty(0, int))
     indices, types = _alternating_extrema(kappa, low, high)
     epsilon = eps_frac * (np.max(interior) - np.min(interior))
     prune = _prune_persistence if method == "persistence" else _prune_paper
@@ -213,7 +198,7 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence", return_kinds:
     nearer_left = (positions - s[original - 1]) < (s[original] - positions)
     original = np.where(nearer_left, original - 1, original)
     original, first = np.unique(original, return_index=True)
-    return (original, kinds[first]) if return_kinds else original
+    return Segmentation(original, kinds[first])
 
 
 @dataclass(frozen=True)
@@ -232,11 +217,15 @@ class Piece:
 def choose_piece(y, segmentation_points, new_target) -> Piece:
     """Pick the piece whose end point is nearest the new target (ties: the later piece).
 
+    ``segmentation_points`` is a :class:`Segmentation` or an int array of sample indices.
+
     Breakpoints ``0 = b_0 < s_1 < … < s_m < b_end = T − 1`` split ``y`` into pieces; piece ``j``
     runs from ``b_j`` to ``b_{j+1}``.
     """
     y = as_trajectory(y, "y")
     target = as_point(new_target, y.shape[1], "new_target")
+    if isinstance(segmentation_points, Segmentation):
+        segmentation_points = segmentation_points.points
     points = np.asarray(segmentation_points, dtype=int).reshape(-1)
     last = y.shape[0] - 1
     if np.any((points < 0) | (points > last)):

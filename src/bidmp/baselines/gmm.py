@@ -8,8 +8,9 @@ which is the point of the comparison in the paper's Table 4.
 from __future__ import annotations
 
 import numpy as np
+from sklearn.base import BaseEstimator
 
-from .._checks import as_trajectory, check_int, check_real
+from .._checks import as_trajectory, check_fitted, check_int, check_real
 from .._noise import perturb
 
 __all__ = ["gmr", "augment", "fit_mixture", "GMMRegressor"]
@@ -66,22 +67,37 @@ def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0)
 
 
 def fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int):
-    """EM for a full-covariance Gaussian mixture (scikit-learn): (weights, means, covariances)."""
-    from sklearn.mixture import GaussianMixture
+    """EM for a full-covariance Gaussian mixture (scikit-learn): (weights, means, covariances).
 
-    mixture = GaussianMixture(n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed).fit(data)
+    Runs with one BLAS thread, as the BLS does: EM on a few thousand 4–7-D points gains nothing
+    from threads, and on 2 cores the thread pools made ``GaussianMixture`` 7–15× slower
+    (3–7.5 s instead of 0.35–0.5 s), so the baselines' run times measured contention.
+    """
+    from sklearn.mixture import GaussianMixture
+    from threadpoolctl import threadpool_limits
+
+    # A fresh limiter (not the BLS's cached one): it must see the OpenMP runtime that
+    # scikit-learn's k-means initialisation loads, which may not have been loaded before.
+    with threadpool_limits(limits=1):
+        mixture = GaussianMixture(n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed).fit(data)
     return mixture.weights_, mixture.means_, mixture.covariances_
 
 
-class _AugmentedMixture:
-    """Parameters shared by the baselines: mixture size, regularisation, augmentation, seed."""
+class _AugmentedMixture(BaseEstimator):
+    """Parameters shared by the baselines: mixture size, regularisation, augmentation, seed.
 
-    def __init__(self, n_components: int, reg_covar: float, n_copies: int, noise: float, seed: int):
-        self.n_components = check_int(n_components, "n_components", minimum=1)
-        self.reg_covar = check_real(reg_covar, "reg_covar", positive=True)
-        self.n_copies = check_int(n_copies, "n_copies", minimum=0)
-        self.noise = check_real(noise, "noise", nonnegative=True)
-        self.seed = check_int(seed, "seed", minimum=0)
+    scikit-learn conventions: the constructor stores, ``fit`` validates (:meth:`_check_params`).
+    """
+
+    def _check_params(self) -> None:
+        check_int(self.n_components, "n_components", minimum=1)
+        check_real(self.reg_covar, "reg_covar", positive=True)
+        check_int(self.n_copies, "n_copies", minimum=0)
+        check_real(self.noise, "noise", nonnegative=True)
+        check_int(self.seed, "seed", minimum=0)
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "weights_" in self.__dict__
 
 
 class GMMRegressor(_AugmentedMixture):
@@ -96,13 +112,23 @@ class GMMRegressor(_AugmentedMixture):
         Added to the covariance diagonals (SPEC §8: ≥ 1e-6).
     n_copies, noise : augmentation of a single demonstration (see :func:`augment`).
     seed : int
+
+    Attributes
+    ----------
+    weights_, means_, covariances_ : the mixture on ``[t, y]``.
+    n_steps_ : int
     """
 
     def __init__(self, n_components: int = 16, reg_covar: float = 1e-6, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
-        super().__init__(n_components, reg_covar, n_copies, noise, seed)
+        self.n_components = n_components
+        self.reg_covar = reg_covar
+        self.n_copies = n_copies
+        self.noise = noise
+        self.seed = seed
 
     def fit(self, y) -> "GMMRegressor":
         """Fit on one demonstration (T, D), time scaled to [0, 1]."""
+        self._check_params()
         demos = augment(y, self.n_copies, self.noise, self.seed)
         n_steps = demos.shape[1]
         t = np.linspace(0.0, 1.0, n_steps)
@@ -113,5 +139,6 @@ class GMMRegressor(_AugmentedMixture):
 
     def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Mean trajectory (n, D) and covariances (n, D, D) by GMR on t ∈ [0, 1]."""
-        n_steps = self.n_steps_ if n_steps is None else n_steps
+        check_fitted(self, "weights_")
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2)
         return gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))

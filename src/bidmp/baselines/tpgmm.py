@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_point, check_int
+from .._checks import as_point, check_fitted, check_int
 from .gmm import _AugmentedMixture, augment, fit_mixture, gmr
 
 __all__ = ["TPGMM"]
@@ -30,13 +30,23 @@ class TPGMM(_AugmentedMixture):
         stacked frame coordinates are collinear for copies that share their frames; 1e-3 (mm²)
         already biases the end point by 3–4 mm, 1e-4 does not.
     n_copies, noise, seed : augmentation of a single demonstration.
+
+    Attributes
+    ----------
+    weights_, means_, covariances_ : the mixture on ``[t, x⁽start⁾, x⁽target⁾]``.
+    n_steps_, n_dims_ : int
     """
 
     def __init__(self, n_components: int = 16, reg_covar: float = 1e-4, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
-        super().__init__(n_components, reg_covar, n_copies, noise, seed)
+        self.n_components = n_components
+        self.reg_covar = reg_covar
+        self.n_copies = n_copies
+        self.noise = noise
+        self.seed = seed
 
     def fit(self, y) -> "TPGMM":
         """Fit on one demonstration (T, D); frames at each copy's own start and end."""
+        self._check_params()
         demos = augment(y, self.n_copies, self.noise, self.seed)
         n_steps, n_dims = demos.shape[1], demos.shape[2]
         t = np.linspace(0.0, 1.0, n_steps)[:, None]
@@ -61,6 +71,7 @@ class TPGMM(_AugmentedMixture):
 
     def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
         """Mean trajectory (n, D) and covariances for new start and target frames."""
+        check_fitted(self, "weights_")
         d = self.n_dims_
         start = as_point(start, d, "start")
         target = as_point(target, d, "target")

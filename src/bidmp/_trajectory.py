@@ -1,0 +1,63 @@
+"""Small trajectory helpers used across the library, in one place.
+
+Arc length, resampling (by time or by arc length), column-wise interpolation, RMSE and extent.
+Arrays are float64 of shape (T, D); lengths are in the trajectory's own unit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent"]
+
+
+def arclength(y: np.ndarray) -> np.ndarray:
+    """Cumulative arc length at each sample, shape (T,), starting at 0."""
+    steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def interp_columns(x_new: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Piecewise-linear interpolation of every column of ``y`` (n, D) from ``x`` (n,) to
+    ``x_new`` (m,); returns (m, D). ``x`` must be increasing."""
+    return np.column_stack([np.interp(x_new, x, column) for column in np.asarray(y).T])
+
+
+def resample_arclength(y, n_points: int) -> np.ndarray:
+    """Resample a polyline to ``n_points`` points equally spaced in arc length (ends kept exactly).
+
+    Repeated points (zero-length steps) are skipped, so a robot that paused is not a problem.
+    """
+    y = np.asarray(y, dtype=np.float64)
+    s = arclength(y)
+    moving = np.concatenate([[True], np.diff(s) > 0])
+    y, s = y[moving], s[moving]
+    if s[-1] <= 0.0:
+        return np.repeat(y[:1], n_points, axis=0)
+    out = interp_columns(np.linspace(0.0, s[-1], n_points), s, y)
+    out[0], out[-1] = y[0], y[-1]
+    return out
+
+
+def resample_time(y, n_samples: int) -> np.ndarray:
+    """Resample a trajectory that is uniform in time to ``n_samples`` uniform samples (ends kept)."""
+    y = np.asarray(y, dtype=np.float64)
+    if y.shape[0] == n_samples:
+        return y.copy()
+    out = interp_columns(np.linspace(0.0, 1.0, n_samples), np.linspace(0.0, 1.0, y.shape[0]), y)
+    out[0], out[-1] = y[0], y[-1]
+    return out
+
+
+def rmse(a, b) -> float:
+    """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    if a.shape != b.shape:
+        raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
+    return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
+
+
+def path_extent(y) -> float:
+    """Diagonal of the axis-aligned bounding box of a trajectory (same unit as ``y``)."""
+    return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=np.float64), axis=0)))
