@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean
+.PHONY: demo test bench install clean readme
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -26,6 +26,17 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_extension.py
 	$(PY) benchmarks/bench_incremental.py
 	$(PY) benchmarks/bench_scenario.py
+
+# Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
+# then copy them into README.md (tests/test_readme.py checks the two agree).
+readme: $(STAMP)
+	rm -rf .readme-out
+	$(VENV)/bin/bidmp reproduce table4 --out .readme-out > /dev/null
+	$(VENV)/bin/bidmp reproduce table5 --out .readme-out > /dev/null
+	$(VENV)/bin/bidmp reproduce figures --out .readme-out > /dev/null
+	cp .readme-out/table4.md .readme-out/table5.md .readme-out/figures.md docs/results/
+	rm -rf .readme-out
+	$(PY) tools/readme.py
 
 clean:
 	rm -rf $(VENV) bidmp-out .pytest_cache

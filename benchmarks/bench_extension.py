@@ -23,7 +23,7 @@ from _timing import median_time
 
 from bidmp import extend_demonstration, frechet_distance
 from bidmp.datasets import minimum_jerk
-from bidmp.evaluation import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 from bidmp.roadmap import classic_prm, gaussian_prm
 from bidmp.similarity import frechet_distance_reference
 

@@ -6,15 +6,22 @@
 dmp + bidmp: DMP fit, 14 rollouts, segmentation, G-PRM, BLS learning and 14 Bi-DMP rollouts.
 Target (issue #5): <= 100 ms in-process (after a warm-up run, so one-time imports and the numba
 cache load are excluded). GMM and TP-GMM are timed beside them, as in the paper.
+
+Fair timings (issue #8): the baselines' EM runs with one BLAS/OpenMP thread. The last lines time
+scikit-learn's ``GaussianMixture`` on the same data with the machine's default thread pools and
+with one thread, and print the ratio (thread contention on a 2-core machine).
 """
 
 from __future__ import annotations
 
 import argparse
 
+import numpy as np
 from _timing import median_time
+from threadpoolctl import threadpool_limits
 
 from bidmp import scenarios
+from bidmp.baselines import augment
 from bidmp.evaluation import evaluate
 
 
@@ -31,6 +38,22 @@ def main() -> int:
         print(f"  {name:32s} {result.runtime_s * 1e3:8.1f} ms   {result.successes}/14 within 1.75 mm")
     gmm, bidmp = report.methods["gmm"].runtime_s, report.methods["bidmp"].runtime_s
     print(f"  GMM / Bi-DMP run time ratio: {gmm / bidmp:.1f}  (paper Table 4: GMM-based methods are slower)")
+
+    from sklearn.mixture import GaussianMixture
+
+    demos = augment(scenario.demonstration, 5, 1.5, 0)
+    t = np.linspace(0.0, 1.0, demos.shape[1])
+    data = np.concatenate([np.column_stack([t, demo]) for demo in demos])
+
+    def em():
+        GaussianMixture(16, covariance_type="full", reg_covar=1e-6, random_state=0).fit(data)
+
+    repeats = max(3, args.repeats // 3)
+    default = median_time(em, repeats)
+    with threadpool_limits(limits=1):
+        single = median_time(em, repeats)
+    print(f"  GaussianMixture EM (16 components, {data.shape[0]} points): default threads {default * 1e3:.0f} ms, "
+          f"one thread {single * 1e3:.0f} ms, ratio {default / single:.1f}")
     return 0
 
 

@@ -1,6 +1,7 @@
 """The bidmp command line: happy paths end to end, and one-line errors with exit code 2."""
 
 import json
+import pathlib
 import subprocess
 import sys
 
@@ -88,6 +89,15 @@ def test_demo_with_a_method_subset_and_scenario_list(tmp_path, capsys):
     assert code == 0 and "nut-unscrewing" in out and "cell-removal" in out and "pick-and-place" in out
 
 
+RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+
+
+def assert_committed(produced):
+    """The command's Markdown equals the committed copy the README embeds (make readme)."""
+    committed = (RESULTS / produced.name).read_text(encoding="utf-8")
+    assert produced.read_text(encoding="utf-8") == committed, f"{produced.name} changed: run 'make readme'"
+
+
 def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
     code, out, err = run(["reproduce", "table4", "--out", str(tmp_path / "t4")], capsys)
     assert code == 0, err
@@ -96,6 +106,7 @@ def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
     cells = summary["case_studies"]["cell_removal"]
     assert cells["after"]["B6"] < cells["before"]["B6"]
     assert "end error before" in out
+    assert_committed(tmp_path / "t4" / "table4.md")
 
 
 @pytest.mark.parametrize(
@@ -223,14 +234,16 @@ def test_reproduce_figures_prints_forgetting_and_writes_figure(tmp_path, capsys)
         assert np.allclose(result["forgetting_nearest"]["forgetting"], 0.0, atol=1e-9)
         assert min(result["forgetting_latest"]["forgetting"][:-1]) > 1.0
     assert (tmp_path / "f" / "bidmp_lasa.png").stat().st_size > 30_000
+    assert_committed(tmp_path / "f" / "figures.md")
 
 
 def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
-    code, out, err = run(["reproduce", "table5", "--out", str(tmp_path / "t5"), "--seeds", "2"], capsys)
+    code, out, err = run(["reproduce", "table5", "--out", str(tmp_path / "t5")], capsys)  # 20 seeds, as the README
     assert code == 0, err
     assert "G-PRM" in out and "PRM" in out and "battery approach" in out
     summary = json.loads((tmp_path / "t5" / "table5.json").read_text())
-    assert summary["n_seeds"] == 2 and len(summary["cases"]) == 5
+    assert summary["n_seeds"] == 20 and len(summary["cases"]) == 5
+    assert_committed(tmp_path / "t5" / "table5.md")
     case = summary["cases"][0]
     assert len(case["gprm_per_iteration"]) == 10
     assert case["gprm_final"]["mean"] >= case["gprm_first"]["mean"]
@@ -256,3 +269,14 @@ def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, matc
     code = exit_code([a.format(demo=demo, model=model, tmp=tmp_path) for a in argv])
     _, err = capsys.readouterr()
     assert code == 2 and match in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_fit_tau_makes_rollouts_slower_in_real_time(tmp_path, demo_csv, capsys):
+    for tau in ("1", "2"):
+        assert main(["fit", str(demo_csv), "-o", str(tmp_path / f"m{tau}.npz"), "--tau", tau]) == 0
+        assert main(["rollout", str(tmp_path / f"m{tau}.npz"), "-o", str(tmp_path / f"r{tau}.csv")]) == 0
+    capsys.readouterr()
+    one = np.loadtxt(tmp_path / "r1.csv", delimiter=",", skiprows=1)
+    two = np.loadtxt(tmp_path / "r2.csv", delimiter=",", skiprows=1)
+    assert two.shape[0] == 2 * one.shape[0] and two[-1, 0] == pytest.approx(2 * one[-1, 0], rel=0.01)
+    np.testing.assert_allclose(two[1::2, 1:], one[:, 1:], atol=0.01 * np.ptp(one[:, 1:], axis=0).max())

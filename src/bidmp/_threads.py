@@ -3,7 +3,8 @@
 NumPy and SciPy each load their own OpenBLAS, each with a thread pool, and scikit-learn adds an
 OpenMP pool. When calls alternate between them (``@`` here, ``scipy.linalg`` there), the idle
 pools' threads spin and steal the cores from the busy one: on a 2-core machine a BLS node
-addition took 24 ms instead of 4 ms, and ``GaussianMixture`` 3–7.5 s instead of 0.35–0.5 s.
+addition took 24 ms instead of 4 ms, and a review measured ``GaussianMixture`` at 3–7.5 s instead
+of 0.35–0.5 s (``benchmarks/bench_scenario.py`` prints the ratio on the machine at hand).
 Matrices of a few hundred columns gain nothing from threads, so these hot paths run with one
 thread, scoped (the caller's settings are restored; nothing global changes).
 """

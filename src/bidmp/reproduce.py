@@ -478,7 +478,7 @@ class Table4:
         for method, name in (("dmp", "DMP"), ("bidmp", "Bi-DMP")):
             errors = report.methods[method].errors
             paper = PAPER_NUT_ERRORS[method]
-            rows.append([name] + [f"{errors[label]:.2f} ({paper[label]:g})" if label in paper else "" for label in labels])
+            rows.append([name] + [f"{errors[label]:.2f} ({paper[label]:.2f})" if label in paper else "" for label in labels])
         return ["nut"] + labels, rows
 
     def markdown(self) -> str:

@@ -69,9 +69,10 @@ def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0)
 def fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int):
     """EM for a full-covariance Gaussian mixture (scikit-learn): (weights, means, covariances).
 
-    Runs with one BLAS thread, as the BLS does: EM on a few thousand 4–7-D points gains nothing
-    from threads, and on 2 cores the thread pools made ``GaussianMixture`` 7–15× slower
-    (3–7.5 s instead of 0.35–0.5 s), so the baselines' run times measured contention.
+    Runs with one BLAS/OpenMP thread, as the BLS does: EM on a few thousand 4–7-D points gains
+    nothing from threads, and on 2 cores contention between the thread pools made
+    ``GaussianMixture`` up to 15× slower in a review (3–7.5 s instead of 0.35–0.5 s), so the
+    baselines' run times measured contention rather than the method.
     """
     from sklearn.mixture import GaussianMixture
     from threadpoolctl import threadpool_limits
