@@ -214,7 +214,7 @@ def test_extend_learns_a_bidmp_and_rollout_uses_its_skills(tmp_path, battery_fil
     assert bidmp.load(second).n_skills == 3
     capsys.readouterr()
 
-    for skill, expected_rollout in (("0", learned.dmp.rollout([150, 25, 0])), ("latest", learned.rollout([150, 25, 0], skill="latest"))):
+    for skill, expected_rollout in (("0", learned.dmp_.rollout([150, 25, 0])), ("latest", learned.rollout([150, 25, 0], skill="latest"))):
         out_file = tmp_path / f"r{skill}.npy"
         code, out, err = run(["rollout", str(bidmp_file), "--goal", "150", "25", "0", "--skill", skill, "-o", str(out_file)], capsys)
         assert code == 0, err

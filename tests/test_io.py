@@ -183,3 +183,29 @@ def test_missing_model_file_and_unsupported_objects(tmp_path):
         bidmp.save(object(), tmp_path / "x.npz")
     with pytest.raises(bidmp.NotFittedError):
         bidmp.save(DMP(), tmp_path / "x.npz")
+
+
+def test_format_1_dmp_files_still_load(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "old.npz")
+
+    def to_format_1(meta, arrays):
+        meta["format_version"] = 1
+        meta["state"]["params"]["fit"] = meta["state"]["params"].pop("regression")  # its old name
+
+    rewrite_meta(path, to_format_1)
+    old = bidmp.load(path)
+    assert old.regression == fitted.regression
+    np.testing.assert_array_equal(old.rollout(), fitted.rollout())
+
+
+def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
+    from bidmp.datasets import minimum_jerk
+
+    demo = minimum_jerk([[0, 0, 1], [1, 1, 0], [2, 0, 0]], 60)
+    model = bidmp.BiDMP(DMP().fit(demo)).learn(demo + np.linspace(0, 1, 60)[:, None])
+    path = bidmp.save(model, tmp_path / "old.npz")
+    assert bidmp.load(path).n_skills == 2
+    rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))
+    with pytest.raises(ModelFileError, match="did not vanish with the phase"):
+        bidmp.load(path)
+    assert FORMAT_VERSION == 2

@@ -411,7 +411,10 @@ class DMP(BaseEstimator):
         self.dt_ = dt
         self.centres_ = centres
         self.widths_ = widths
-        self.__dict__.pop("_grid_cache", None)
+        # The training grid is the default rollout grid for tau = 1: cache what fit computed.
+        nominal = params._replace(tau=1.0)
+        key = (n_steps, 1.0, params.alpha, params.beta, params.K, params.alpha_phase, dt)
+        self._grid_cache = (key, centres, widths, phase, phi, self._unit_responses(nominal, phase, None))
         logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
         return self
 
