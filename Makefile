@@ -26,6 +26,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_extension.py
 	$(PY) benchmarks/bench_incremental.py
 	$(PY) benchmarks/bench_scenario.py
+	$(PY) benchmarks/bidmp_convergence.py
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).
