@@ -159,6 +159,12 @@ def _rng(seed: int, kind: int, index: int) -> np.random.Generator:
     return np.random.default_rng([seed, kind, index])
 
 
+def _mapped_features(X: np.ndarray, mapping_weights: np.ndarray, low: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """Min–max normalised mapped features Z of inputs X; every window in one matrix product."""
+    weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))  # (d+1, u·q)
+    return (_affine(X, weights) - low) / span
+
+
 def _enhancement_block(Z: np.ndarray, seed: int, block: int, n_nodes: int, shrink: float) -> tuple[np.ndarray, float, np.ndarray]:
     """Draw enhancement block number ``block``: (weights (c+1, n), scale s, H = tanh(s·[Z, 0.1]W))."""
     weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))
@@ -263,9 +269,7 @@ class BLS(BaseEstimator):
 
     # -- hidden layer ----------------------------------------------------------------------------
     def _mapped(self, X: np.ndarray) -> np.ndarray:
-        # All windows side by side, (d+1, u·q): one matrix product.
-        weights = np.ascontiguousarray(self.mapping_weights_.transpose(1, 0, 2).reshape(self.mapping_weights_.shape[1], -1))
-        return (_affine(X, weights) - self.mapping_min_) / self.mapping_range_
+        return _mapped_features(X, self.mapping_weights_, self.mapping_min_, self.mapping_range_)
 
     def _enhancement(self, Z: np.ndarray, block: int) -> np.ndarray:
         return np.tanh(self.enhancement_scales_[block] * _affine(Z, self.enhancement_weights_[block]))
@@ -338,8 +342,7 @@ class BLS(BaseEstimator):
             ranges.append(np.where(span > 0, span, 1.0))  # a constant node stays finite
         mapping_weights = np.stack(windows)
         mapping_min, mapping_range = np.concatenate(mins), np.concatenate(ranges)
-        all_windows = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))
-        Z = (_affine(X, all_windows) - mapping_min) / mapping_range
+        Z = _mapped_features(X, mapping_weights, mapping_min, mapping_range)
         weights, scale, H = _enhancement_block(Z, params.seed, 0, params.n_enhance, params.shrink)
         A = np.hstack([Z, H])
         solution = _solve_output(A, Y, params)

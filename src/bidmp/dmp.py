@@ -412,9 +412,7 @@ class DMP(BaseEstimator):
         self.centres_ = centres
         self.widths_ = widths
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
-        nominal = params._replace(tau=1.0)
-        key = (n_steps, 1.0, params.alpha, params.beta, params.K, params.alpha_phase, dt)
-        self._grid_cache = (key, centres, widths, phase, phi, self._unit_responses(nominal, phase, None))
+        self._store_grid(params._replace(tau=1.0), phase, phi)
         logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
         return self
 
@@ -435,50 +433,63 @@ class DMP(BaseEstimator):
         """The default rollout length: ``round(tau · T)`` samples (the demonstration's duration
         scaled by ``tau``; T for ``tau = 1``, the paper's protocol)."""
         self._check_fitted()
-        return max(int(round(self._params().tau * self.n_steps_)), 1)
+        return self._n_steps(None, self._params())
 
-    def _n_steps(self, n_steps) -> int:
-        return self.default_n_steps() if n_steps is None else check_int(n_steps, "n_steps", minimum=1)
+    def _n_steps(self, n_steps, params: _Params) -> int:
+        if n_steps is None:
+            return max(int(round(params.tau * self.n_steps_)), 1)
+        return check_int(n_steps, "n_steps", minimum=1)
 
     def phase(self, n_steps: int | None = None) -> np.ndarray:
         """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
         self._check_fitted()
         params = self._params()
-        return phase_grid(self._n_steps(n_steps), self.dt_, params.tau, params.alpha_phase)
+        return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase)
 
-    def _grid(self, n_steps: int, tau: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _grid_key(self, params: _Params, n_steps: int) -> tuple:
+        """Everything a rollout grid depends on besides the learned kernels."""
+        return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
+
+    def _store_grid(self, params: _Params, phase: np.ndarray, basis: np.ndarray) -> tuple:
+        cached = (self._grid_key(params, phase.shape[0]), self.centres_, self.widths_, phase, basis,
+                  self._unit_responses(params, phase, None))
+        self._grid_cache = cached
+        return cached
+
+    def _cached_grid(self, params: _Params, n_steps: int) -> tuple | None:
+        cached = self.__dict__.get("_grid_cache")
+        if (cached is None or cached[0] != self._grid_key(params, n_steps)
+                or cached[1] is not self.centres_ or cached[2] is not self.widths_):
+            return None
+        return cached
+
+    def _grid(self, params: _Params, n_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Phase (n,), basis rows (n, N) and unit responses ``[B, C, V]`` (3, n) on the grid of
-        ``n_steps`` samples at temporal scale ``tau`` (default: the parameter).
+        ``n_steps`` samples for the validated ``params``.
 
         None of them depends on the weights, so the last grid used is cached. The cache key holds
         every hyperparameter the grid depends on and the learned kernels, so changing any of them
         after ``fit`` can never roll out with stale responses.
         """
-        params = self._params()
-        if tau is not None:
-            params = params._replace(tau=tau)
-        key = (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
-        cached = self.__dict__.get("_grid_cache")
-        if cached is None or cached[0] != key or cached[1] is not self.centres_ or cached[2] is not self.widths_:
+        cached = self._cached_grid(params, n_steps)
+        if cached is None:
             phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
-            basis = basis_functions(phase, self.centres_, self.widths_)
-            responses = self._unit_responses(params, phase, None)
-            cached = (key, self.centres_, self.widths_, phase, basis, responses)
-            self._grid_cache = cached
+            cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_))
         return cached[3:]
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Phase (n,) and basis rows (n, N) on the rollout grid (default length
         :meth:`default_n_steps`), cached."""
         self._check_fitted()
-        phase, basis, _ = self._grid(self._n_steps(n_steps))
+        params = self._params()
+        phase, basis, _ = self._grid(params, self._n_steps(n_steps, params))
         return phase, basis
 
     def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
         """Phase (T,) and basis rows (T, N) of the grid the weights were learned on (the
         demonstration's T samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
         self._check_fitted()
-        phase, basis, _ = self._grid(self.n_steps_, tau=1.0)
+        phase, basis, _ = self._grid(self._params()._replace(tau=1.0), self.n_steps_)
         return phase, basis
 
     def basis(self, phase) -> np.ndarray:
@@ -513,15 +524,16 @@ class DMP(BaseEstimator):
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
         self._check_fitted()
-        n_dims = self.n_dims_
-        n_steps = self._n_steps(n_steps)
+        params = self._params()  # validated once per rollout
+        n_dims = self.weights_.shape[1]
+        n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response) = self._grid(n_steps)
+        phase, basis, (goal_response, start_response, velocity_response) = self._grid(params, n_steps)
         forcing = basis @ self.weights_
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
-        free = self._unit_responses(self._params(), phase, forcing).T
+        free = self._unit_responses(params, phase, forcing).T
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
@@ -585,11 +597,10 @@ class DMP(BaseEstimator):
         convergence and it tends to 0.
         """
         self._check_fitted()
-        n_steps = self._n_steps(n_steps)
         params = self._params()
-        key = (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
-        cached = self.__dict__.get("_grid_cache")
-        if cached is not None and cached[0] == key:
+        n_steps = self._n_steps(n_steps, params)
+        cached = self._cached_grid(params, n_steps)
+        if cached is not None:
             goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
             phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)

@@ -197,7 +197,7 @@ class BiDMP(BaseEstimator):
             is the skill's goal, its first the skill's start.
         """
         self._ensure_started()
-        _, derivatives = self._check_params()
+        increments, derivatives = self._check_params()
         dmp = self.dmp_
         params = dmp._params()
         y = as_trajectory(y_dn, "y_dn")
@@ -210,7 +210,7 @@ class BiDMP(BaseEstimator):
             derivatives=params.derivatives if derivatives == "dmp" else derivatives,
         )
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
-        return self.learn_increment(target - current, goal=y[-1], start=y[0])
+        return self._learn_block(target - current, y[-1], y[0], increments)
 
     def learn_increment(self, forcing_increment, goal, start=None) -> "BiDMP":
         """Lower level of :meth:`learn`: fit one BLS block to a given forcing increment FI.
@@ -223,7 +223,6 @@ class BiDMP(BaseEstimator):
             The new skill's training goal and start (start defaults to the DMP's).
         """
         self._ensure_started()
-        increments, _ = self._check_params()
         dmp = self.dmp_
         increment = np.asarray(forcing_increment, dtype=np.float64)
         if increment.shape != (dmp.n_steps_, dmp.n_dims_):
@@ -232,6 +231,13 @@ class BiDMP(BaseEstimator):
             raise ValueError("forcing_increment contains NaN or inf")
         goal = as_point(goal, dmp.n_dims_, "goal")
         start = dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start")
+        increments, _ = self._check_params()
+        return self._learn_block(increment, goal, start, increments)
+
+    def _learn_block(self, increment: np.ndarray, goal: np.ndarray, start: np.ndarray, increments: tuple[int, ...]) -> "BiDMP":
+        """Fit one BLS block to a validated FI (T, D), grow it by ``increments`` nodes and add
+        the skill (goal, start)."""
+        dmp = self.dmp_
         phase, basis = dmp.training_grid()
         block = BLS(
             n_windows=self.n_windows, n_mapped=self.n_mapped, n_enhance=self.n_enhance, shrink=self.shrink,
