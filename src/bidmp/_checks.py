@@ -1,12 +1,20 @@
-"""Input validation shared by every public entry point.
+"""Input validation and resource bounds shared by every public entry point.
 
 Every check raises ``TypeError`` (wrong kind of object) or ``ValueError`` (right kind, bad value)
 with a message that names the argument and says what was wrong, so that the CLI can show it as a
 one-line error.
+
+**Limits.** Sizes and magnitudes that would exhaust memory, run for minutes or overflow float64
+are refused up front, before anything is allocated, with a message that names the limit. The
+limits are process-wide settings (:class:`Limits`): read them with :func:`get_limits`, change
+them with :func:`set_limits` (which also works as a context manager that restores them).
 """
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import functools
 from collections.abc import Iterable
 from numbers import Integral, Real
 
@@ -14,6 +22,11 @@ import numpy as np
 
 __all__ = [
     "NotFittedError",
+    "Limits",
+    "get_limits",
+    "set_limits",
+    "check_limit",
+    "check_bytes",
     "as_trajectory",
     "as_point",
     "as_points",
@@ -21,7 +34,124 @@ __all__ = [
     "check_real",
     "check_choice",
     "check_fitted",
+    "check_seed",
+    "check_loaded",
+    "numerically_guarded",
+    "short_token",
 ]
+
+
+@dataclasses.dataclass
+class Limits:
+    """Resource and magnitude bounds every entry point enforces (change with :func:`set_limits`).
+
+    Attributes
+    ----------
+    max_samples : int
+        Samples in one trajectory or training set (T, or the rows of a BLS input).
+    max_dims : int
+        Dimensions D of a trajectory.
+    max_steps : int
+        Samples of one rollout (``n_steps``).
+    max_kernels : int
+        DMP kernels ``n_kernels``.
+    max_hidden_nodes : int
+        Hidden nodes of one Broad Learning System (mapped + enhancement, all blocks).
+    max_array_bytes : int
+        Bytes of any one array the library allocates or reads from a file (default 1 GiB).
+    max_work : float
+        Multiply-adds of one dense step: a BLS solve (samples × hidden²), a Fréchet table
+        (n × m) or a roadmap run (samples × iterations × neighbours); about a second per 1e9.
+    max_abs_value : float
+        Largest coordinate magnitude (any unit): beyond it squares and spring forces overflow.
+    min_extent : float
+        Smallest bounding-box diagonal of a demonstration (below it motion is rounding noise).
+    max_targets : int
+        Targets of one scenario.
+    max_file_bytes : int
+        Size of a trajectory, scenario or model file read.
+    max_json_bytes : int
+        Size of a JSON document (model metadata, scenario) before parsing.
+    max_json_depth : int
+        Nesting depth of a JSON document.
+    """
+
+    max_samples: int = 1_000_000
+    max_dims: int = 256
+    max_steps: int = 2_000_000
+    max_kernels: int = 1_000
+    max_hidden_nodes: int = 3_000
+    max_array_bytes: int = 1 << 30
+    max_work: float = 1e10
+    max_abs_value: float = 1e9
+    min_extent: float = 1e-9
+    max_targets: int = 1_000
+    max_file_bytes: int = 1 << 31
+    max_json_bytes: int = 64 << 20
+    max_json_depth: int = 64
+
+
+_LIMITS = Limits()
+_LIMIT_NAMES = tuple(f.name for f in dataclasses.fields(Limits))
+
+
+def get_limits() -> Limits:
+    """A copy of the limits in force."""
+    return dataclasses.replace(_LIMITS)
+
+
+class _Restore(contextlib.AbstractContextManager):
+    """What :func:`set_limits` returns: the previous limits; as a context manager it restores them."""
+
+    def __init__(self, previous: Limits) -> None:
+        self.previous = previous
+
+    def __exit__(self, *exc) -> None:
+        set_limits(**dataclasses.asdict(self.previous))
+
+
+def set_limits(**changes) -> _Restore:
+    """Change limits by name, e.g. ``bidmp.set_limits(max_steps=10_000_000)``.
+
+    Returns an object holding the previous limits (``.previous``); used as a context manager
+    (``with bidmp.set_limits(max_samples=5_000_000): ...``) it restores them on exit.
+    """
+    previous = get_limits()
+    for name, value in changes.items():
+        if name not in _LIMIT_NAMES:
+            raise TypeError(f"set_limits: unknown limit {name!r}; known: {', '.join(_LIMIT_NAMES)}")
+        current = getattr(_LIMITS, name)
+        if isinstance(current, int) and not isinstance(current, bool):
+            value = check_int(value, name, minimum=1)
+        else:
+            value = check_real(value, name, positive=True)
+        setattr(_LIMITS, name, value)
+    return _Restore(previous)
+
+
+def _limit_hint(limit: str) -> str:
+    return f"the limit {limit} = {getattr(_LIMITS, limit):,}; raise it with bidmp.set_limits({limit}=...)"
+
+
+def check_limit(value, limit: str, what: str) -> None:
+    """Raise ``ValueError`` if ``value`` exceeds the limit named ``limit`` (a :class:`Limits` field)."""
+    if value > getattr(_LIMITS, limit):
+        shown = f"{value:,}" if isinstance(value, (int, np.integer)) else f"{value:.3g}"
+        raise ValueError(f"{what} = {shown} exceeds {_limit_hint(limit)}")
+
+
+def check_bytes(n_elements, what: str, itemsize: int = 8) -> None:
+    """Refuse an array of ``n_elements`` (of ``itemsize`` bytes) over ``max_array_bytes``."""
+    n_bytes = int(n_elements) * int(itemsize)
+    if n_bytes > _LIMITS.max_array_bytes:
+        raise ValueError(f"{what} would take {n_bytes / 2**30:.3g} GiB, over {_limit_hint('max_array_bytes')}")
+
+
+def short_token(value, width: int = 10) -> str:
+    """A rejected value quoted for an error message: at most ``width`` characters, printable only
+    (a file read by mistake must not be echoed into a terminal or a log)."""
+    text = "".join(c if c.isprintable() else "?" for c in str(value)[: width + 1])
+    return repr(text[:width] + "…") if len(text) > width else repr(text)
 
 
 class NotFittedError(ValueError, AttributeError):
@@ -46,6 +176,27 @@ def _check_finite(array: np.ndarray, name: str) -> None:
         raise ValueError(f"{name} contains {kind} (first at {where})")
 
 
+def _check_magnitude(array: np.ndarray, name: str) -> None:
+    """Refuse coordinates beyond ``max_abs_value`` (finite, but their squares or spring forces overflow)."""
+    if array.size and float(np.max(np.abs(array))) > _LIMITS.max_abs_value:
+        raise ValueError(f"{name} has a coordinate of magnitude {float(np.max(np.abs(array))):.3g}, beyond "
+                         f"{_limit_hint('max_abs_value')} (or rescale the data to another unit)")
+
+
+def _as_bounded_array(value, name: str, max_ndim: int) -> np.ndarray:
+    """``_as_float_array`` that refuses oversized inputs before converting them."""
+    if isinstance(value, np.ndarray):
+        if value.ndim > max_ndim:
+            raise ValueError(f"{name} must have at most {max_ndim} dimension(s), got {value.ndim}")
+        check_bytes(value.size, name)
+        if np.iscomplexobj(value):
+            raise TypeError(f"{name} must be real numbers, got complex")
+    array = _as_float_array(value, name)
+    if np.iscomplexobj(array):
+        raise TypeError(f"{name} must be real numbers, got complex")
+    return array
+
+
 def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = False) -> np.ndarray:
     """Validate a trajectory and return it as a C-contiguous float64 array of shape (T, D).
 
@@ -57,7 +208,7 @@ def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = 
         If ``y`` is not 2-D, has fewer than ``min_points`` samples, contains NaN/inf, or all its
         points are identical (there is no motion to learn; allowed with ``allow_static``).
     """
-    array = _as_float_array(y, name)
+    array = _as_bounded_array(y, name, 3)
     if array.ndim != 2:
         hint = " (for a 1-D signal use shape (T, 1))" if array.ndim == 1 else ""
         raise ValueError(f"{name} must have shape (T, D), got an array with {array.ndim} dimension(s){hint}")
@@ -66,26 +217,37 @@ def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = 
         raise ValueError(f"{name} must have at least one column (D >= 1), got shape {array.shape}")
     if n_points < min_points:
         raise ValueError(f"{name} needs at least {min_points} points, got {n_points}")
+    check_limit(n_points, "max_samples", f"{name}: the number of samples T")
+    check_limit(n_dims, "max_dims", f"{name}: the number of dimensions D")
     _check_finite(array, name)
-    if not allow_static and not np.any(array != array[0]):
-        raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
+    _check_magnitude(array, name)
+    if not allow_static:
+        if not np.any(array != array[0]):
+            raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
+        extent = float(np.linalg.norm(np.ptp(array, axis=0)))
+        scale = float(np.max(np.abs(array)))
+        if extent < _LIMITS.min_extent or extent < 1e-12 * scale:
+            raise ValueError(f"{name} barely moves: its extent {extent:.3g} is below the smallest supported motion "
+                             f"(min_extent = {_LIMITS.min_extent:g}, or 1e-12 of its coordinates' magnitude "
+                             f"{scale:.3g}); rescale the data")
     return np.ascontiguousarray(array)
 
 
 def as_point(p, n_dims: int, name: str = "point") -> np.ndarray:
     """Validate one point of dimension ``n_dims`` and return it as a float64 array (n_dims,)."""
-    array = _as_float_array(p, name)
+    array = _as_bounded_array(p, name, 2)
     if array.ndim == 0:
         array = array.reshape(1)
     if array.ndim != 1 or array.shape[0] != n_dims:
         raise ValueError(f"{name} must have {n_dims} coordinate(s) to match the model, got shape {array.shape}")
     _check_finite(array, name)
+    _check_magnitude(array, name)
     return array
 
 
 def as_points(points, n_dims: int, name: str = "points") -> np.ndarray:
     """Validate a set of points and return them as a float64 array (G, n_dims)."""
-    array = _as_float_array(points, name)
+    array = _as_bounded_array(points, name, 3)
     if array.ndim == 1 and array.shape[0] == n_dims:
         array = array.reshape(1, n_dims)
     if array.ndim != 2 or array.shape[1] != n_dims:
@@ -93,30 +255,58 @@ def as_points(points, n_dims: int, name: str = "points") -> np.ndarray:
     if array.shape[0] == 0:
         raise ValueError(f"{name} is empty")
     _check_finite(array, name)
+    _check_magnitude(array, name)
     return np.ascontiguousarray(array)
 
 
-def check_int(value, name: str, minimum: int | None = None) -> int:
-    """Return ``value`` as an ``int`` after checking it is an integer >= ``minimum``."""
+def check_int(value, name: str, minimum: int | None = None, limit: str | None = None, maximum: int | None = None) -> int:
+    """Return ``value`` as an ``int`` after checking it is an integer >= ``minimum``, at most
+    ``maximum`` and within the :class:`Limits` field ``limit``."""
     if isinstance(value, bool) or not isinstance(value, Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {value!r}")
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {short_token(value, 40)}")
     if minimum is not None and value < minimum:
         raise ValueError(f"{name} must be >= {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ValueError(f"{name} must be <= {maximum:,}, got {value:,}")
+    if limit is not None:
+        check_limit(int(value), limit, name)
     return int(value)
 
 
-def check_real(value, name: str, *, positive: bool = False, nonnegative: bool = False) -> float:
-    """Return ``value`` as a finite ``float`` (optionally > 0 or >= 0)."""
+def check_real(value, name: str, *, positive: bool = False, nonnegative: bool = False,
+               minimum: float | None = None, maximum: float | None = None) -> float:
+    """Return ``value`` as a finite ``float`` (optionally > 0, >= 0, or within [minimum, maximum])."""
     if isinstance(value, bool) or not isinstance(value, Real):
-        raise TypeError(f"{name} must be a number, got {type(value).__name__} {value!r}")
-    value = float(value)
+        raise TypeError(f"{name} must be a number, got {type(value).__name__} {short_token(value, 40)}")
+    try:
+        value = float(value)
+    except OverflowError:
+        raise ValueError(f"{name} is too large for a float") from None
     if not np.isfinite(value):
         raise ValueError(f"{name} must be finite, got {value}")
     if positive and value <= 0:
         raise ValueError(f"{name} must be > 0, got {value}")
     if nonnegative and value < 0:
         raise ValueError(f"{name} must be >= 0, got {value}")
+    if minimum is not None and value < minimum:
+        raise ValueError(f"{name} must be >= {minimum:g}, got {value:g}")
+    if maximum is not None and value > maximum:
+        raise ValueError(f"{name} must be <= {maximum:g}, got {value:g}")
     return value
+
+
+def check_seed(seed, name: str = "seed") -> np.random.Generator:
+    """A ``numpy.random.Generator`` from ``seed``: a non-negative integer (< 2**128), a
+    ``Generator`` (used as is) or a ``SeedSequence``. ``None`` is refused: results must be
+    reproducible."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, np.random.SeedSequence):
+        return np.random.default_rng(seed)
+    if seed is None:
+        raise TypeError(f"{name} must be an integer or a numpy.random.Generator (None would make results irreproducible)")
+    seed = check_int(seed, name, minimum=0, maximum=2**128 - 1)
+    return np.random.default_rng(seed)
 
 
 def check_choice(value, name: str, choices: Iterable[str]) -> str:
@@ -125,6 +315,47 @@ def check_choice(value, name: str, choices: Iterable[str]) -> str:
     if not isinstance(value, str) or value not in choices:
         raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}; got {value!r}")
     return value
+
+
+def check_loaded(value, name: str, shape: tuple, *, positive: bool = False) -> np.ndarray:
+    """Validate an array read from a model file: real numbers, the expected ``shape`` (``None``
+    for a free axis), finite (and > 0 with ``positive``). Returns it as float64."""
+    array = np.asarray(value)
+    if array.dtype.kind not in "fiub":
+        raise ValueError(f"member {name} holds {array.dtype} data, expected float64")
+    array = array.astype(np.float64, copy=False)
+    if array.ndim != len(shape) or any(s is not None and a != s for a, s in zip(array.shape, shape)):
+        expected = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+        raise ValueError(f"member {name} has shape {array.shape}, expected {expected}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"member {name} contains NaN or inf")
+    if positive and array.size and not np.all(array > 0):
+        raise ValueError(f"member {name} must be > 0 everywhere")
+    return np.ascontiguousarray(array)
+
+
+def numerically_guarded(function):
+    """Decorator for the math entry points: floating-point overflow, invalid operations and
+    division by zero raise instead of warning, and surface as one ``ValueError``; a singular
+    matrix (``LinAlgError``) or an allocation failure (``MemoryError``) likewise. Underflow to 0
+    is harmless and ignored. No call returns NaN/inf silently."""
+
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        try:
+            with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+                return function(*args, **kwargs)
+        except FloatingPointError as exc:
+            raise ValueError(f"{function.__qualname__}: the computation overflowed ({exc}): the inputs' scale or the "
+                             f"parameters are out of the range float64 can represent") from None
+        except np.linalg.LinAlgError as exc:
+            raise ValueError(f"{function.__qualname__}: a linear system is singular ({exc}); "
+                             f"increase the regularisation or check the inputs") from None
+        except MemoryError:
+            raise ValueError(f"{function.__qualname__}: out of memory; lower the sizes or "
+                             f"bidmp.set_limits(max_array_bytes=...)") from None
+
+    return wrapper
 
 
 def check_fitted(model, attribute: str) -> None:

@@ -44,10 +44,14 @@ from ._checks import (
     as_point,
     as_points,
     as_trajectory,
+    check_bytes,
     check_choice,
     check_fitted,
     check_int,
+    check_loaded,
     check_real,
+    get_limits,
+    numerically_guarded,
 )
 
 __all__ = [
@@ -57,6 +61,8 @@ __all__ = [
     "kernel_widths",
     "basis_functions",
     "forcing_target",
+    "euler_spectral_radius",
+    "check_euler_stable",
 ]
 
 logger = logging.getLogger(__name__)
@@ -66,6 +72,10 @@ _REGRESSION_CHOICES = ("lwr", "ridge")
 _DERIVATIVE_CHOICES = ("gradient", "forward")
 _WIDTH_CHOICES = ("spacing", "pydmps")
 _LOG_PSI_FLOOR = -40.0
+# Gains (alpha, beta, alpha_phase in 1/s; K) and tau (s) outside these ranges have no physical use
+# and take float64 out of its range in the forcing target (division by K) or the integration.
+_GAIN_RANGE = (1e-6, 1e6)
+_TAU_RANGE = (1e-6, 1e6)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -80,6 +90,45 @@ def _phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
             f"{alpha_phase * dt / tau:g} (alpha_phase={alpha_phase:g}, dt={dt:g}, tau={tau:g})"
         )
     return decay
+
+
+def euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
+    """Spectral radius of one explicit-Euler step of the spring-damper (step ``h = dt/tau``).
+
+    The homogeneous update ``[y, z] ← [[1, h], [−h α β, 1 − h α]] [y, z]`` has characteristic
+    polynomial ``r² − (2 − hα) r + (1 − hα + h²αβ)``; the integration is stable iff both roots lie
+    inside the unit circle (for ``β = α/4``: iff ``h α < 4``).
+    """
+    roots = np.roots([1.0, -(2.0 - step * alpha), 1.0 - step * alpha + step * step * alpha * beta])
+    return float(np.max(np.abs(roots)))
+
+
+def _max_stable_step(alpha: float, beta: float, step: float) -> float:
+    """The largest ``h`` below ``step`` for which :func:`euler_spectral_radius` stays < 1 (bisection)."""
+    low, high = 0.0, step
+    for _ in range(60):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
+    return low
+
+
+def check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None:
+    """Refuse an explicit-Euler step ``dt/tau`` for which the transformation system diverges.
+
+    Raises
+    ------
+    ValueError
+        Naming the bound on ``dt/tau`` (s) for these gains.
+    """
+    step = dt / tau
+    radius = euler_spectral_radius(step, alpha, beta)
+    if not radius < 1.0:
+        bound = _max_stable_step(alpha, beta, step)
+        raise ValueError(
+            f"explicit Euler integration is unstable for alpha = {alpha:g}, beta = {beta:g} with the step dt/tau = "
+            f"{step:.4g} s (spectral radius {radius:.4g} >= 1): it needs dt/tau < {bound:.4g} s "
+            f"(alpha * dt/tau = {alpha * step:.4g}, below {alpha * bound:.4g}); lower alpha, raise tau or use more samples"
+        )
 
 
 def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
@@ -336,23 +385,23 @@ class DMP(BaseEstimator):
     # -- parameters ----------------------------------------------------------------------------
     def _params(self) -> _Params:
         """Validate the hyperparameters as they are now; raise naming the first bad one."""
-        alpha = check_real(self.alpha, "alpha", positive=True)
-        beta = alpha / 4.0 if self.beta is None else check_real(self.beta, "beta", positive=True)
+        alpha = check_real(self.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+        beta = alpha / 4.0 if self.beta is None else check_real(self.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
         if isinstance(self.K, str):
             check_choice(self.K, "K", _K_CHOICES)
             K = alpha if self.K == "paper" else alpha * beta
         else:
-            K = check_real(self.K, "K", positive=True)
+            K = check_real(self.K, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2)
         return _Params(
-            n_kernels=check_int(self.n_kernels, "n_kernels", minimum=1),
+            n_kernels=check_int(self.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
             alpha=alpha,
             beta=beta,
             K=K,
-            alpha_phase=check_real(self.alpha_phase, "alpha_phase", positive=True),
-            tau=check_real(self.tau, "tau", positive=True),
+            alpha_phase=check_real(self.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]),
+            tau=check_real(self.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]),
             regression=check_choice(self.regression, "regression", _REGRESSION_CHOICES),
             derivatives=check_choice(self.derivatives, "derivatives", _DERIVATIVE_CHOICES),
-            ridge=check_real(self.ridge, "ridge", nonnegative=True),
+            ridge=check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6),
             widths=check_choice(self.widths, "widths", _WIDTH_CHOICES),
         )
 
@@ -367,6 +416,7 @@ class DMP(BaseEstimator):
         return self._params().K
 
     # -- learning ------------------------------------------------------------------------------
+    @numerically_guarded
     def fit(self, y) -> "DMP":
         """Learn the forcing-term weights from one demonstration.
 
@@ -386,6 +436,11 @@ class DMP(BaseEstimator):
         y = as_trajectory(y, "y")
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
+        check_bytes(n_steps * params.n_kernels, "the basis matrix (T samples x n_kernels)")
+        # Refuse now rather than return a model whose every rollout diverges.
+        check_euler_stable(dt, 1.0, params.alpha, params.beta)
+        check_euler_stable(dt, params.tau, params.alpha, params.beta)
+        _phase_decay(dt, params.tau, params.alpha_phase)
         # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
         # rollouts, so it is not used here.
         phase = phase_grid(n_steps, dt, 1.0, params.alpha_phase)
@@ -404,6 +459,8 @@ class DMP(BaseEstimator):
             gram = phi.T @ phi
             reg = params.ridge * max(np.trace(gram) / params.n_kernels, np.finfo(float).tiny)
             weights = np.linalg.solve(gram + reg * np.eye(params.n_kernels), phi.T @ target)
+        if not np.all(np.isfinite(weights)):
+            raise ValueError("fit: the learned weights are not finite; the demonstration's scale or the gains are out of range")
         self.weights_ = np.ascontiguousarray(weights)
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
@@ -437,8 +494,12 @@ class DMP(BaseEstimator):
 
     def _n_steps(self, n_steps, params: _Params) -> int:
         if n_steps is None:
-            return max(int(round(params.tau * self.n_steps_)), 1)
-        return check_int(n_steps, "n_steps", minimum=1)
+            n_steps = max(int(round(params.tau * self.n_steps_)), 1)
+            check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
+        else:
+            n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+        check_bytes(n_steps * self.centres_.shape[0], "the rollout basis (n_steps x n_kernels)")
+        return n_steps
 
     def phase(self, n_steps: int | None = None) -> np.ndarray:
         """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
@@ -522,9 +583,15 @@ class DMP(BaseEstimator):
         responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / params.tau, alpha=alpha, beta=beta)
         return responses[:, :n_steps]
 
-    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
+    def _rollout_params(self) -> _Params:
+        """The validated parameters, with the rollout's integration checked for stability."""
         self._check_fitted()
         params = self._params()  # validated once per rollout
+        check_euler_stable(self.dt_, params.tau, params.alpha, params.beta)
+        return params
+
+    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
+        params = self._rollout_params()
         n_dims = self.weights_.shape[1]
         n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
@@ -537,8 +604,13 @@ class DMP(BaseEstimator):
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
+        # lfilter runs in C, outside NumPy's floating-point checks: check its output once. With
+        # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
+        if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
+            raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
         return free, goal_response
 
+    @numerically_guarded
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
                 forcing_increment=None) -> np.ndarray:
         """Generate a trajectory (explicit Euler, Eq. 14), one sample every ``dt_`` seconds.
@@ -567,8 +639,9 @@ class DMP(BaseEstimator):
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         return free + np.outer(goal_response, goal)
 
+    @numerically_guarded
     def rollout_many(self, goals, start=None, n_steps: int | None = None, start_velocity=None, *,
-                     forcing_increment=None) -> np.ndarray:
+                     forcing_increment=None, out: np.ndarray | None = None) -> np.ndarray:
         """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
 
         Parameters
@@ -576,18 +649,72 @@ class DMP(BaseEstimator):
         goals : array-like, shape (G, D)
         start, n_steps, start_velocity, forcing_increment
             As in :meth:`rollout`, shared by every goal.
+        out : array, shape (G, n_steps, D), optional
+            Where to write the rollouts (float64, writable), e.g. a ``numpy.memmap`` from
+            ``numpy.lib.format.open_memmap`` for more rollouts than fit in memory; it is filled a
+            chunk of goals at a time. Without ``out`` the result is one array, refused over
+            ``max_array_bytes`` (see :func:`bidmp.set_limits`); :meth:`iter_rollouts` yields chunks
+            instead.
 
         Returns
         -------
         y : array, shape (G, n_steps, D)
-            ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding.
+            ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
         """
         free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goals = as_points(goals, free.shape[1], "goals")
-        out = np.multiply(goal_response[None, :, None], goals[:, None, :])
-        out += free[None]
+        shape = (goals.shape[0], *free.shape)
+        if out is None:
+            n_bytes = 8 * goals.shape[0] * free.size
+            budget = get_limits().max_array_bytes
+            if n_bytes > budget:
+                chunk = max(budget // (8 * free.size), 1)
+                raise ValueError(
+                    f"rollout_many: {goals.shape[0]:,} goals x {free.shape[0]:,} steps x {free.shape[1]} dims would take "
+                    f"{n_bytes / 2**30:.3g} GiB in one array, over the limit max_array_bytes = {budget / 2**30:.3g} GiB; "
+                    f"write into a file with out=numpy.lib.format.open_memmap(path, mode='w+', dtype='float64', "
+                    f"shape={shape}), iterate with iter_rollouts(goals, chunk_size={chunk:,}), or raise the limit "
+                    f"with bidmp.set_limits(max_array_bytes=...)"
+                )
+            out = np.multiply(goal_response[None, :, None], goals[:, None, :])
+            out += free[None]
+            return out
+        if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
+            described = f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
+            raise ValueError(f"out must be a writable float64 array of shape {shape}, got {described}")
+        for first, chunk in self._chunks(goals, free):
+            last = first + chunk.shape[0]
+            np.multiply(goal_response[None, :, None], chunk[:, None, :], out=out[first:last])
+            out[first:last] += free[None]
         return out
 
+    @staticmethod
+    def _chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
+        if chunk_size is None:
+            chunk_size = max((64 << 20) // (8 * free.size), 1)  # about 64 MiB per chunk
+        for first in range(0, goals.shape[0], chunk_size):
+            yield first, goals[first : first + chunk_size]
+
+    def iter_rollouts(self, goals, chunk_size: int = 1024, start=None, n_steps: int | None = None,
+                      start_velocity=None, *, forcing_increment=None):
+        """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
+
+        Yields
+        ------
+        (first, y) : int and array (g, n_steps, D)
+            ``y[i]`` is the rollout to ``goals[first + i]``; ``g <= chunk_size``.
+        """
+        chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
+        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+            free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
+        goals = as_points(goals, free.shape[1], "goals")
+        check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
+        for first, chunk in self._chunks(goals, free, chunk_size):
+            block = np.multiply(goal_response[None, :, None], chunk[:, None, :])
+            block += free[None]
+            yield first, block
+
+    @numerically_guarded
     def endpoint_gain(self, n_steps: int | None = None) -> float:
         """End-point gain ``c``: the final error for a shifted goal is ``c · ‖g' - g‖``.
 
@@ -596,8 +723,7 @@ class DMP(BaseEstimator):
         paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
         convergence and it tends to 0.
         """
-        self._check_fitted()
-        params = self._params()
+        params = self._rollout_params()
         n_steps = self._n_steps(n_steps, params)
         cached = self._cached_grid(params, n_steps)
         if cached is not None:
@@ -625,23 +751,24 @@ class DMP(BaseEstimator):
         if "fit" in params:  # format 1 stored the regression under the name "fit"
             params["regression"] = params.pop("fit")
         model = cls(**params)
-        n_kernels = model._params().n_kernels
-        n_steps = check_int(meta["n_steps_"], "n_steps_", minimum=3)
-        weights = np.asarray(arrays["weights_"], dtype=np.float64)
-        if weights.ndim != 2 or weights.shape[0] != n_kernels:
-            raise ValueError(f"weights_ has shape {weights.shape}, expected ({n_kernels}, D)")
+        params = model._params()
+        n_kernels = params.n_kernels
+        n_steps = check_int(meta["n_steps_"], "n_steps_", minimum=3, limit="max_samples")
+        weights = check_loaded(arrays["weights_"], "weights_", (n_kernels, None))
         n_dims = weights.shape[1]
-        for name in ("start_", "goal_"):
-            if np.shape(arrays[name]) != (n_dims,):
-                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({n_dims},)")
-        for name in ("centres_", "widths_"):
-            if np.shape(arrays[name]) != (n_kernels,):
-                raise ValueError(f"{name} has shape {np.shape(arrays[name])}, expected ({n_kernels},)")
+        check_int(n_dims, "the model's number of dimensions D", minimum=1, limit="max_dims")
         model.weights_ = weights
-        model.start_ = np.asarray(arrays["start_"], dtype=np.float64)
-        model.goal_ = np.asarray(arrays["goal_"], dtype=np.float64)
-        model.centres_ = np.asarray(arrays["centres_"], dtype=np.float64)
-        model.widths_ = np.asarray(arrays["widths_"], dtype=np.float64)
+        model.start_ = check_loaded(arrays["start_"], "start_", (n_dims,))
+        model.goal_ = check_loaded(arrays["goal_"], "goal_", (n_dims,))
+        model.centres_ = check_loaded(arrays["centres_"], "centres_", (n_kernels,), positive=True)
+        model.widths_ = check_loaded(arrays["widths_"], "widths_", (n_kernels,), positive=True)
+        for name in ("weights_", "start_", "goal_"):
+            limit = 1e3 * get_limits().max_abs_value if name == "weights_" else get_limits().max_abs_value
+            if np.max(np.abs(getattr(model, name))) > limit:
+                raise ValueError(f"member {name} has values beyond {limit:.3g}, which no fit produces")
+        if np.any(model.centres_ > 1.0):
+            raise ValueError("member centres_ must lie in (0, 1] (they are phases)")
         model.n_steps_ = n_steps
         model.dt_ = 1.0 / n_steps
+        check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
         return model
