@@ -113,7 +113,7 @@ def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
     "argv, match",
     [
         (["fit", "{tmp}/missing.csv", "-o", "{tmp}/m.npz"], "does not exist"),
-        (["fit", "{tmp}/bad.csv", "-o", "{tmp}/m.npz"], "line 3: 'oops' is not a number"),
+        (["fit", "{tmp}/bad.csv", "-o", "{tmp}/m.npz"], "line 3, column 2: 'oops' is not a number"),
         (["fit", "{tmp}/nan.csv", "-o", "{tmp}/m.npz"], "contains NaN"),
         (["fit", "{tmp}/demo.csv", "-o", "{tmp}/m.npz", "--n-kernels", "0"], "n_kernels must be >= 1"),
         (["fit", "{tmp}/demo.csv", "-o", "{tmp}/no/such/dir/m.npz"], "does not exist"),

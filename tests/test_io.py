@@ -60,7 +60,7 @@ def test_trajectory_round_trip_is_exact(tmp_path, suffix):
     [
         ("empty.csv", "", "empty"),
         ("header_only.csv", "x,y\n", "no data rows"),
-        ("words.csv", "x,y\n0,0\n1,abc\n2,2\n", "line 3: 'abc' is not a number"),
+        ("words.csv", "x,y\n0,0\n1,abc\n2,2\n", "line 3, column 2: 'abc' is not a number"),
         ("ragged.csv", "x,y\n0,0\n1\n2,2\n", "line 3: expected 2 columns"),
         ("nan.csv", "x,y\n0,0\nnan,1\n2,2\n", "NaN"),
         ("short.csv", "x,y\n0,0\n1,1\n", "at least 3 points"),
@@ -80,10 +80,10 @@ def test_missing_and_bad_npy_files(tmp_path):
     with pytest.raises(ValueError, match="does not exist"):
         load_trajectory(tmp_path / "nope.csv")
     (tmp_path / "junk.npy").write_bytes(b"definitely not numpy")
-    with pytest.raises(ValueError, match="not a readable .npy"):
+    with pytest.raises(ValueError, match="not an .npy array"):
         load_trajectory(tmp_path / "junk.npy")
     np.save(tmp_path / "obj.npy", np.array([{"a": 1}], dtype=object), allow_pickle=True)
-    with pytest.raises(ValueError, match="not a readable .npy"):
+    with pytest.raises(ValueError, match="holds object data"):
         load_trajectory(tmp_path / "obj.npy")
     np.save(tmp_path / "flat.npy", np.arange(10.0))
     with pytest.raises(ValueError, match=r"shape \(T, D\)"):
@@ -145,7 +145,7 @@ def rewrite_meta(path, change):
 @pytest.mark.parametrize(
     "corrupt, match",
     [
-        (lambda p: p.write_bytes(b"\x00garbage" * 50), "not a readable bidmp model file"),
+        (lambda p: p.write_bytes(b"\x00garbage" * 50), "not a bidmp model file"),
         (lambda p: p.write_bytes(p.read_bytes()[: len(p.read_bytes()) // 2]), "not a readable bidmp model file"),
         (lambda p: np.savez(p, weights=np.ones(3)), "without bidmp metadata"),
         (lambda p: np.save(p.with_suffix(".npy"), np.ones(3)) or p.with_suffix(".npy").rename(p), "plain .npy"),
@@ -172,7 +172,7 @@ def test_object_arrays_are_refused_not_unpickled(tmp_path, fitted):
         buffer = io.BytesIO()
         np.save(buffer, np.array([object()], dtype=object), allow_pickle=True)
         archive.writestr("evil.npy", buffer.getvalue())
-    with pytest.raises(ModelFileError, match="not a readable"):
+    with pytest.raises(ModelFileError, match="not a bidmp model file .member 'evil' holds object"):
         bidmp.load(path)
 
 

@@ -27,6 +27,9 @@ _LAZY = {
     "load": ("bidmp.io", "load_model"),
     "ModelFileError": ("bidmp.io", "ModelFileError"),
     "NotFittedError": ("bidmp._checks", "NotFittedError"),
+    "Limits": ("bidmp._checks", "Limits"),
+    "get_limits": ("bidmp._checks", "get_limits"),
+    "set_limits": ("bidmp._checks", "set_limits"),
 }
 _SUBMODULES = (
     "dmp", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
@@ -39,7 +42,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from . import bls, datasets, dmp, evaluation, extension, incremental, io, metrics, plotting, reproduce, roadmap, segmentation, similarity  # noqa: F401
     from .bls import BLS  # noqa: F401
     from .incremental import BiDMP, forgetting  # noqa: F401
-    from ._checks import NotFittedError  # noqa: F401
+    from ._checks import Limits, NotFittedError, get_limits, set_limits  # noqa: F401
     from .dmp import DMP  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401
     from .segmentation import Segmentation, segment  # noqa: F401

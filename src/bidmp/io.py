@@ -1,32 +1,45 @@
 """Files: trajectories (CSV / NPY) and model files (``.npz`` + JSON metadata, never pickles).
 
-Every write goes to a temporary file in the target folder and is then renamed over the target,
-so an interrupted write never leaves a half-written file behind.
+**Writes** go to a temporary file beside the target (``.NAME.PID.XXXX.bidmp-tmp``) that is then
+renamed over it, so an interrupted write never leaves a half-written file; temporaries left by a
+killed writer are removed by the next write of the same file. New files get the mode the umask
+allows (``0666 & ~umask``); an overwritten file keeps its mode. An output that is a symlink is
+written through (its target is replaced); a folder or a device is refused.
 
-Model file layout (format version 1): an uncompressed ``.npz`` archive holding the model's arrays
-under their attribute names plus ``__bidmp__``, a uint8 array with UTF-8 JSON::
+**Reads** never trust a file: sizes are checked from the headers before anything is allocated
+(:class:`bidmp.Limits`), JSON is parsed with a depth and size cap and without NaN/Infinity, and
+every array read from a model file is checked for dtype, shape and finiteness by the model class.
 
-    {"format": "bidmp-model", "format_version": 1, "class": "DMP",
-     "bidmp_version": "0.1.0", "state": {...class-specific, e.g. constructor params...}}
+Model file layout (format version 2): an ``.npz`` archive (a zip of ``.npy`` members, stored or
+deflated) holding the model's arrays under their attribute names plus ``__bidmp__``, a uint8
+array with UTF-8 JSON::
 
-It is read with ``allow_pickle=False``, so loading a file can never execute code.
+    {"format": "bidmp-model", "format_version": 2, "class": "DMP",
+     "bidmp_version": "0.2.0", "state": {...class-specific, e.g. constructor params...}}
+
+It is read member by member with ``allow_pickle=False``, so loading a file can never execute
+code, and a member the model does not ask for is never read.
 """
 
 from __future__ import annotations
 
 import contextlib
 import csv
+import glob
 import json
 import logging
 import os
+import re
+import stat
 import tempfile
+import time
 import zipfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import numpy as np
 
-from ._checks import as_trajectory
+from ._checks import as_trajectory, check_bytes, check_limit, get_limits, short_token
 
 __all__ = [
     "ModelFileError",
@@ -36,6 +49,7 @@ __all__ = [
     "load_trajectory",
     "save_trajectory",
     "atomic_write",
+    "load_json",
 ]
 
 logger = logging.getLogger(__name__)
@@ -47,6 +61,8 @@ FORMAT_VERSION = 2
 _MIN_VERSION = {"BiDMP": 2}
 _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
+_META_MAX_BYTES = 16 << 20
+_MAX_MEMBERS = 100_000
 # Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
 # reading a DMP does not import the whole pipeline.
 _MODEL_CLASSES = {
@@ -54,6 +70,9 @@ _MODEL_CLASSES = {
     "BLS": ("bidmp.bls", "BLS"),
     "BiDMP": ("bidmp.incremental", "BiDMP"),
 }
+_ZIP_MAGIC = b"PK\x03\x04"
+_EMPTY_ZIP_MAGIC = b"PK\x05\x06"
+_NPY_MAGIC = b"\x93NUMPY"
 
 
 class ModelFileError(ValueError):
@@ -63,27 +82,189 @@ class ModelFileError(ValueError):
 # ---------------------------------------------------------------------------------------------
 # Atomic writes
 # ---------------------------------------------------------------------------------------------
+_TMP_SUFFIX = ".bidmp-tmp"
+_STALE_AFTER_S = 24 * 3600.0  # a temporary this old is stale even if its writer's PID was reused
+
+
+def _umask() -> int:
+    """The process umask, read without changing it where the OS allows (Linux /proc)."""
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/self/status", encoding="ascii") as handle:
+            for line in handle:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True  # exists, owned by someone else
+    return True
+
+
+def _clear_stale_temporaries(directory: Path, name: str) -> None:
+    """Remove temporaries of ``name`` whose writer is gone (killed mid-write) or that are old.
+
+    A temporary of a live writer (another process writing the same file right now) is kept.
+    """
+    pattern = re.compile(rf"^\.{re.escape(name)}\.(\d+)\.[^.]+{re.escape(_TMP_SUFFIX)}$")
+    for entry in directory.glob(f".{glob.escape(name)}.*{_TMP_SUFFIX}"):
+        match = pattern.match(entry.name)
+        if match is None:
+            continue
+        with contextlib.suppress(OSError):
+            age = time.time() - entry.lstat().st_mtime
+            if not _pid_alive(int(match.group(1))) or age > _STALE_AFTER_S:
+                entry.unlink()
+                logger.info("removed a stale temporary file %s", entry)
+
+
+def _destination(path: str | os.PathLike) -> Path:
+    """The file a write to ``path`` replaces: the path itself, or a symlink's target (written
+    through). Folders, devices, pipes and sockets are refused."""
+    path = Path(path)
+    if str(path) in ("", "."):
+        raise ValueError("the output path is empty")
+    target = Path(os.path.realpath(path)) if path.is_symlink() else path
+    if target.exists():
+        if target.is_dir():
+            raise ValueError(f"cannot write {path}: it is a folder; give a file name")
+        if not stat.S_ISREG(target.stat().st_mode):
+            raise ValueError(f"cannot write {path}: it is not a regular file (a device, pipe or socket)")
+    directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise ValueError(f"cannot write {path}: folder {directory} does not exist")
+    return target
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator:
     """Open a temporary file beside ``path``; on success fsync it and rename it onto ``path``.
 
-    On any exception the temporary file is removed and ``path`` is left as it was.
+    On any exception the temporary file is removed and ``path`` is left as it was. The file gets
+    the existing file's mode, or ``0666 & ~umask`` if it is new. A symlink is written through.
     """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    if not directory.is_dir():
-        raise ValueError(f"cannot write {path}: folder {directory} does not exist")
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
+    target = _destination(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    _clear_stale_temporaries(directory, target.name)
     try:
+        file_mode = stat.S_IMODE(target.stat().st_mode)
+    except FileNotFoundError:
+        file_mode = 0o666 & ~_umask()
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory)
+    try:
+        os.fchmod(fd, file_mode)
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as handle:
             yield handle
             handle.flush()
             os.fsync(handle.fileno())
-        os.replace(tmp_name, path)
+        os.replace(tmp_name, target)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)
         raise
+    with contextlib.suppress(OSError):  # make the rename itself durable
+        dir_fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(dir_fd)
+        finally:
+            os.close(dir_fd)
+
+
+# ---------------------------------------------------------------------------------------------
+# JSON with bounds
+# ---------------------------------------------------------------------------------------------
+_JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"')
+
+
+def _json_depth(data: bytes) -> int:
+    """Maximum nesting depth of ``[``/``{`` in a JSON text, strings excluded (no parsing)."""
+    codes = np.frombuffer(_JSON_STRING.sub(b'""', data), dtype=np.uint8)
+    steps = (np.isin(codes, (ord("["), ord("{")))).astype(np.int64) - np.isin(codes, (ord("]"), ord("}")))
+    return int(np.max(np.cumsum(steps), initial=0))
+
+
+def _finite_float(text: str) -> float:
+    value = float(text)
+    if not np.isfinite(value):
+        raise ValueError(f"number {short_token(text)} is out of the float64 range")
+    return value
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not allowed (JSON numbers must be finite)")
+
+
+def load_json(data: bytes | str, source: str):
+    """Parse JSON text from an untrusted file with bounded size and depth, finite numbers only.
+
+    Raises
+    ------
+    ValueError
+        Naming ``source`` and what was wrong (too large, too deep, not UTF-8, not JSON).
+    """
+    if isinstance(data, str):
+        data = data.encode("utf-8", "surrogatepass")
+    limits = get_limits()
+    if len(data) > limits.max_json_bytes:
+        raise ValueError(f"{source}: JSON of {len(data):,} bytes exceeds the limit max_json_bytes = "
+                         f"{limits.max_json_bytes:,}; raise it with bidmp.set_limits(max_json_bytes=...)")
+    depth = _json_depth(data)
+    if depth > limits.max_json_depth:
+        raise ValueError(f"{source}: JSON nested {depth} levels deep exceeds the limit max_json_depth = "
+                         f"{limits.max_json_depth}; raise it with bidmp.set_limits(max_json_depth=...)")
+    try:
+        text = data.decode("utf-8-sig")
+        return json.loads(text, parse_float=_finite_float, parse_constant=_no_constant)
+    except UnicodeDecodeError:
+        raise ValueError(f"{source}: not UTF-8 text") from None
+    except RecursionError:  # pragma: no cover - the depth cap comes first
+        raise ValueError(f"{source}: JSON nested too deeply") from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})") from None
+    except ValueError as exc:  # a non-finite number, an integer of too many digits
+        raise ValueError(f"{source}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------------------------
+# .npy headers: check before allocating
+# ---------------------------------------------------------------------------------------------
+def _read_npy_header(stream, what: str) -> tuple[tuple, np.dtype]:
+    """Read an ``.npy`` header from ``stream``; refuse object dtypes and sizes over the limits."""
+    magic = stream.read(len(_NPY_MAGIC))
+    if magic != _NPY_MAGIC:
+        raise ValueError(f"{what} is not an .npy array")
+    version = tuple(stream.read(2))
+    if version == (1, 0):
+        shape, _, dtype = np.lib.format.read_array_header_1_0(stream)
+    elif version in ((2, 0), (3, 0)):
+        shape, _, dtype = np.lib.format.read_array_header_2_0(stream)
+    else:
+        raise ValueError(f"{what} has an unknown .npy format version {version}")
+    if dtype.hasobject or dtype.kind not in "fiub":
+        raise ValueError(f"{what} holds {dtype} data, not real numbers")
+    if len(shape) > 8:
+        raise ValueError(f"{what} has {len(shape)} dimensions")
+    n_elements = int(np.prod(shape, dtype=object))
+    check_bytes(n_elements, what, dtype.itemsize)
+    return shape, dtype
+
+
+def _read_npy(open_stream, what: str, check=None) -> np.ndarray:
+    """Read an array from the stream factory ``open_stream`` after checking its header
+    (``check(shape, dtype)`` may refuse more)."""
+    with open_stream() as stream:
+        shape, dtype = _read_npy_header(stream, what)
+    if check is not None:
+        check(shape, dtype)
+    with open_stream() as stream:
+        return np.lib.format.read_array(stream, allow_pickle=False)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -94,6 +275,17 @@ def _model_class(name: str):
 
     module_name, attribute = _MODEL_CLASSES[name]
     return getattr(importlib.import_module(module_name), attribute)
+
+
+def _model_path(path: str | os.PathLike) -> Path:
+    """The model file to write: ``path`` with ``.npz`` added when missing. The given path is
+    checked first, so ``-o somefolder`` or ``-o /dev/null`` are refused, not turned into
+    ``somefolder.npz``."""
+    path = Path(path)
+    _destination(path)
+    if path.suffix != ".npz":
+        path = path.with_name(path.name + ".npz")
+    return path
 
 
 def save_model(model, path: str | os.PathLike) -> Path:
@@ -109,6 +301,9 @@ def save_model(model, path: str | os.PathLike) -> Path:
     class_name = type(model).__name__
     if class_name not in _MODEL_CLASSES or not hasattr(model, "_get_state"):
         raise TypeError(f"model must be one of {', '.join(sorted(_MODEL_CLASSES))}, got {class_name}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = _model_path(path)
     state, arrays = model._get_state()
     if _META_KEY in arrays:
         raise ValueError(f"array name {_META_KEY!r} is reserved")
@@ -121,123 +316,223 @@ def save_model(model, path: str | os.PathLike) -> Path:
     }
     payload = {name: np.asarray(value) for name, value in arrays.items()}
     payload[_META_KEY] = np.frombuffer(json.dumps(meta, allow_nan=False).encode("utf-8"), dtype=np.uint8)
-    path = Path(path)
-    if path.suffix != ".npz":
-        path = path.with_name(path.name + ".npz")
     with atomic_write(path, "wb") as handle:
         np.savez(handle, **payload)
     logger.debug("saved %s to %s", class_name, path)
     return path
 
 
+class _Members(Mapping):
+    """The arrays of an open model archive, read lazily: a member is decompressed and parsed
+    only when a model class asks for it, after its ``.npy`` header passed the size limits."""
+
+    def __init__(self, archive: zipfile.ZipFile, source: str) -> None:
+        self._archive = archive
+        self._source = source
+        self._infos = {info.filename[:-4]: info for info in archive.infolist() if info.filename.endswith(".npy")}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        info = self._infos.get(name)
+        if info is None:
+            raise KeyError(f"missing member {name}")
+        try:
+            return _read_npy(lambda: self._archive.open(info), f"member {name}")
+        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+            message = str(exc) if str(exc).startswith("member ") else f"member {name} is unreadable ({type(exc).__name__}: {exc})"
+            raise ValueError(message) from None
+
+    def __iter__(self):
+        return (name for name in self._infos if name != _META_KEY)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+def _check_archive(archive: zipfile.ZipFile, path: Path) -> None:
+    """Refuse archives numpy wrote no part of: encrypted or unusually compressed members,
+    declared sizes over the limits, absurd member counts."""
+    infos = archive.infolist()
+    if len(infos) > _MAX_MEMBERS:
+        raise ModelFileError(f"{path} is not a bidmp model file ({len(infos):,} archive members)")
+    budget = get_limits().max_array_bytes + (64 << 10)
+    for info in infos:
+        if info.flag_bits & 0x1:
+            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} is encrypted)")
+        if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} uses an unsupported "
+                                 f"compression, method {info.compress_type})")
+        if info.file_size > budget:
+            raise ModelFileError(f"{path}: member {info.filename} declares {info.file_size / 2**30:.3g} GiB, over the limit "
+                                 f"max_array_bytes = {get_limits().max_array_bytes:,}; raise it with "
+                                 f"bidmp.set_limits(max_array_bytes=...)")
+        if not info.filename.endswith(".npy"):
+            raise ModelFileError(f"{path} is not a bidmp model file (member {short_token(info.filename, 40)} is not an .npy array)")
+        # Every member's header (a few hundred bytes) is checked, so that a pickled or oversized
+        # member is refused even if the model would never ask for it; the data are not read.
+        try:
+            with archive.open(info) as stream:
+                _read_npy_header(stream, f"member {short_token(info.filename[:-4], 40)}")
+        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+            raise ModelFileError(f"{path} is not a bidmp model file ({exc})") from None
+
+
+def _read_meta(members: _Members, path: Path) -> dict:
+    if _META_KEY not in members._infos:
+        raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
+
+    def check(shape, dtype):
+        if dtype != np.uint8 or len(shape) != 1 or shape[0] > _META_MAX_BYTES:
+            raise ValueError(f"{path} is not a bidmp model file (its metadata member is not UTF-8 JSON bytes)")
+
+    try:
+        raw = _read_npy(lambda: members._archive.open(members._infos[_META_KEY]), "the metadata member", check)
+        meta = load_json(raw.tobytes(), f"{path} metadata")
+    except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+        raise ModelFileError(f"{path} is not a readable bidmp model file ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != _FORMAT_NAME:
+        raise ModelFileError(f"{path} is not a bidmp model file (unknown metadata format)")
+    return meta
+
+
 def load_model(path: str | os.PathLike):
     """Load a model written by :func:`save_model`.
+
+    Only the members the model needs are read, each after its header passed the size limits, and
+    the model class validates every array (dtype, shape, finite) before it is used.
 
     Raises
     ------
     ModelFileError
         If the file is missing, not an ``.npz`` archive, truncated or corrupt, has no bidmp
         metadata (a foreign file), was written by a newer format version, or its contents are
-        inconsistent.
+        inconsistent (the message names the member).
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
     if not path.is_file():
-        raise ModelFileError(f"model file {path} does not exist")
+        raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
     try:
-        archive = np.load(path, allow_pickle=False)
-        if not isinstance(archive, np.lib.npyio.NpzFile):
-            raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
-        with archive:
-            if _META_KEY not in archive.files:
-                raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
-            meta = json.loads(archive[_META_KEY].tobytes().decode("utf-8"))
-            # Fresh C-contiguous copies: computing with them then takes the same BLAS paths as
-            # the saved model did, so rollouts after loading are bit-identical.
-            arrays = {name: np.array(archive[name], order="C") for name in archive.files if name != _META_KEY}
-    except ModelFileError:
-        raise
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, OSError, ValueError, KeyError, UnicodeDecodeError) as exc:
-        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from exc
-
-    if not isinstance(meta, dict) or meta.get("format") != _FORMAT_NAME:
-        raise ModelFileError(f"{path} is not a bidmp model file (unknown metadata format)")
-    version = meta.get("format_version")
-    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise ModelFileError(f"{path} has an invalid format_version {version!r}")
-    if version > FORMAT_VERSION:
-        raise ModelFileError(
-            f"{path} was written in model format {version} by bidmp {meta.get('bidmp_version', '?')}; "
-            f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
-        )
-    class_name = meta.get("class")
-    if class_name not in _MODEL_CLASSES:
-        raise ModelFileError(f"{path} holds an unknown model class {class_name!r}")
-    if version < _MIN_VERSION.get(class_name, 1):
-        raise ModelFileError(
-            f"{path} holds a {class_name} in model format {version} (bidmp {meta.get('bidmp_version', '?')}), whose "
-            f"learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
-        )
+        with open(path, "rb") as handle:
+            magic = handle.read(4)
+    except OSError as exc:
+        raise ModelFileError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if magic == _NPY_MAGIC[:4]:
+        raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
+    if magic not in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+        raise ModelFileError(f"{path} is not a bidmp model file (not an .npz archive)")
     try:
-        model = _model_class(class_name)._from_state(meta["state"], arrays)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from exc
-    return model
+        archive = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
+        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from None
+    with archive:
+        _check_archive(archive, path)
+        members = _Members(archive, str(path))
+        meta = _read_meta(members, path)
+        version = meta.get("format_version")
+        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+            raise ModelFileError(f"{path} has an invalid format_version {short_token(version)}")
+        if version > FORMAT_VERSION:
+            raise ModelFileError(
+                f"{path} was written in model format {version} by bidmp {short_token(meta.get('bidmp_version', '?'), 20)}; "
+                f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
+            )
+        class_name = meta.get("class")
+        if not isinstance(class_name, str) or class_name not in _MODEL_CLASSES:
+            raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
+        if version < _MIN_VERSION.get(class_name, 1):
+            raise ModelFileError(
+                f"{path} holds a {class_name} in model format {version} (bidmp {short_token(meta.get('bidmp_version', '?'), 20)}), "
+                f"whose learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
+            )
+        state = meta.get("state")
+        if not isinstance(state, dict):
+            raise ModelFileError(f"{path} is corrupt: its metadata has no state object")
+        try:
+            return _model_class(class_name)._from_state(state, members)
+        except MemoryError:
+            raise ModelFileError(f"{path}: a member is too large to load") from None
+        except KeyError as exc:
+            detail = exc.args[0] if exc.args and str(exc.args[0]).startswith("missing member") else f"missing key {exc}"
+            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({detail})") from None
+        except (TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError,
+                zipfile.BadZipFile, EOFError, OSError) as exc:
+            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from None
 
 
 # ---------------------------------------------------------------------------------------------
 # Trajectories
 # ---------------------------------------------------------------------------------------------
 _TIME_NAMES = ("t", "time")
+_MAX_TIME_S = 1e12  # time stamps are seconds: epoch-like stamps are ~1.7e9
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
 
 def _parse_float(text: str) -> float | None:
     try:
         return float(text)
-    except ValueError:
+    except (ValueError, OverflowError):
         return None
+
+
+def _check_file(path: Path, what: str) -> None:
+    if not path.exists():
+        raise ValueError(f"{what} {path} does not exist")
+    if path.is_dir():
+        raise ValueError(f"{what} {path} is a folder, not a file")
+    if not path.is_file():
+        raise ValueError(f"{what} {path} is not a regular file")
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
 
 
 def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a CSV trajectory; return (positions (T, D), times (T,) or None)."""
+    limits = get_limits()
+    max_rows = limits.max_samples + 1  # + a header
+    max_columns = limits.max_dims + 1  # + a time column
+    rows: list[tuple[int, list[str]]] = []
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
+        # utf-8-sig: Excel writes a byte-order mark at the start of UTF-8 files.
+        with open(path, newline="", encoding="utf-8-sig") as handle:
             sample = handle.read(4096)
             handle.seek(0)
             delimiter = ";" if sample.count(";") > sample.count(",") else ","
-            rows = [(number, [cell.strip() for cell in row]) for number, row in enumerate(csv.reader(handle, delimiter=delimiter), 1)]
+            reader = csv.reader(handle, delimiter=delimiter)
+            try:
+                for row in reader:
+                    if not any(row) or row[0].lstrip().startswith("#"):
+                        continue
+                    if len(row) > max_columns:
+                        raise ValueError(f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
+                                         f"max_dims = {limits.max_dims} allows (plus a time column)")
+                    rows.append((reader.line_num, [cell.strip() for cell in row]))
+                    if len(rows) > max_rows:
+                        raise ValueError(f"{path}: more than {limits.max_samples:,} rows, the limit max_samples; "
+                                         f"raise it with bidmp.set_limits(max_samples=...)")
+            except csv.Error as exc:
+                raise ValueError(f"{path} line {reader.line_num}: not a CSV row ({exc})") from None
     except UnicodeDecodeError:
-        raise ValueError(f"{path} is not a text CSV file") from None
-    rows = [(number, row) for number, row in rows if any(row) and not row[0].startswith("#")]
+        raise ValueError(f"{path} is not a UTF-8 text CSV file") from None
     if not rows:
         raise ValueError(f"{path} is empty: no data rows")
 
     columns: tuple[str, ...] | None = None
-    first_number, first_row = rows[0]
+    _, first_row = rows[0]
     if any(_parse_float(cell) is None for cell in first_row):
         columns = tuple(cell.lower() for cell in first_row)
         rows = rows[1:]
         if not rows:
             raise ValueError(f"{path} has a header but no data rows")
     n_columns = len(columns) if columns else len(rows[0][1])
-
-    values = np.empty((len(rows), n_columns))
-    for index, (number, row) in enumerate(rows):
-        if len(row) != n_columns:
-            raise ValueError(f"{path} line {number}: expected {n_columns} columns, found {len(row)}")
-        for column, cell in enumerate(row):
-            value = _parse_float(cell)
-            if value is None:
-                raise ValueError(f"{path} line {number}: {cell!r} is not a number")
-            values[index, column] = value
+    values = _csv_values(rows, n_columns, path)
 
     if columns is not None:
         has_time = columns[0] in _TIME_NAMES
         names = columns[1:] if has_time else columns
         if names not in _POSITION_HEADERS:
-            raise ValueError(
-                f"{path}: header {','.join(columns)} not understood; expected x,y[,z] or t,x,y[,z]"
-            )
+            shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:6]) + (",…" if len(columns) > 6 else "")
+            raise ValueError(f"{path}: header {shown} not understood; expected x,y[,z] or t,x,y[,z]")
     elif n_columns in (2, 3):
         has_time = False  # header-less: positions only (add a header "t,x,y" to mark a time column)
     elif n_columns == 4:
@@ -249,10 +544,29 @@ def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     return values, None
 
 
+def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path) -> np.ndarray:
+    """The numbers of the data rows (T, n_columns): NumPy's parser first (fast), and on failure a
+    row-by-row pass that names the first bad line (quoting at most a short token of it)."""
+    cells = [row for _, row in rows]
+    with contextlib.suppress(ValueError, TypeError, OverflowError):
+        values = np.array(cells, dtype=np.float64)
+        if values.ndim == 2 and values.shape[1] == n_columns:
+            return values
+    for number, row in rows:
+        if len(row) != n_columns:
+            raise ValueError(f"{path} line {number}: expected {n_columns} columns, found {len(row)}")
+        for column, cell in enumerate(row, 1):
+            if _parse_float(cell) is None:
+                raise ValueError(f"{path} line {number}, column {column}: {short_token(cell)} is not a number")
+    raise ValueError(f"{path}: the data rows could not be read as numbers")  # pragma: no cover
+
+
 def _resample_uniform(positions: np.ndarray, times: np.ndarray, source: str) -> np.ndarray:
     """Resample positions given at ``times`` onto a uniform grid with the same number of samples."""
     if not np.all(np.isfinite(times)):
         raise ValueError(f"{source}: the time column contains NaN or inf")
+    if np.max(np.abs(times)) > _MAX_TIME_S:
+        raise ValueError(f"{source}: the time column has values beyond {_MAX_TIME_S:g} s; expected seconds")
     steps = np.diff(times)
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
@@ -264,37 +578,62 @@ def _resample_uniform(positions: np.ndarray, times: np.ndarray, source: str) -> 
     return np.column_stack([np.interp(grid, times, column) for column in positions.T])
 
 
+def _check_npy_trajectory(path: Path):
+    limits = get_limits()
+
+    def check(shape, dtype):
+        if dtype.kind not in "fiu":
+            raise ValueError(f"{path} holds {dtype} data, not numbers")
+        if len(shape) != 2:
+            raise ValueError(f"{path} must hold an array of shape (T, D), got shape {shape}")
+        if shape[0] > limits.max_samples:
+            raise ValueError(f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}; "
+                             f"raise it with bidmp.set_limits(max_samples=...)")
+        if shape[1] > limits.max_dims:
+            raise ValueError(f"{path} has {shape[1]:,} columns, over the limit max_dims = {limits.max_dims}")
+
+    return check
+
+
 def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     """Read a demonstration from ``.csv`` or ``.npy``.
 
-    CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed. An optional
-    header names the columns ``x,y[,z]`` or ``t,x,y[,z]`` (``time`` also works). Without a header
-    2 or 3 columns are positions and 4 columns are ``t,x,y,z``. With a time column the samples are
-    resampled to uniform time steps (a DMP assumes them).
-    NPY: a float array of shape (T, D), read with ``allow_pickle=False``.
+    CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed, UTF-8 with
+    or without a byte-order mark. An optional header names the columns ``x,y[,z]`` or
+    ``t,x,y[,z]`` (``time`` also works). Without a header 2 or 3 columns are positions and 4
+    columns are ``t,x,y,z``. With a time column (seconds) the samples are resampled to uniform
+    time steps (a DMP assumes them).
+    NPY: a float array of shape (T, D), read with ``allow_pickle=False`` after its header passed
+    the size limits.
 
     Returns
     -------
     y : array, shape (T, D)
-        Validated: finite, at least 3 points, not all identical.
+        Validated: finite, at least 3 points, not all identical, within the limits.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"demonstration file {path} does not exist")
+    _check_file(path, "demonstration file")
     suffix = path.suffix.lower()
     if suffix == ".npy":
+        with open(path, "rb") as handle:
+            magic = handle.read(4)
+        if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+            raise ValueError(f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)")
         try:
-            positions = np.load(path, allow_pickle=False)
-        except (ValueError, OSError, EOFError) as exc:
-            raise ValueError(f"{path} is not a readable .npy array ({exc})") from None
-        if not np.issubdtype(positions.dtype, np.number):
-            raise ValueError(f"{path} holds {positions.dtype} data, not numbers")
+            positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
+        except (EOFError, OSError) as exc:
+            raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
+        except ValueError as exc:
+            message = str(exc)
+            raise ValueError(message if str(path) in message else f"{path} is not a readable .npy array ({message})") from None
     elif suffix in (".csv", ".txt"):
         positions, times = _read_csv(path)
         if times is not None:
             positions = _resample_uniform(positions, times, str(path))
     else:
-        raise ValueError(f"{path}: unsupported file type {suffix or '(none)'}; use .csv or .npy")
+        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
     return as_trajectory(positions, name=str(path))
 
 
@@ -302,27 +641,31 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
     """Write a trajectory ``y`` (T, D) to ``path``: ``.csv`` (header ``[t,]x,y[,z]``; ``times``
     (T,) in seconds adds the ``t`` column) or ``.npy``, atomically.
 
-    The argument order is the same as :func:`save_model` (what, then where).
+    The argument order is the same as :func:`save_model` (what, then where). Non-finite values
+    are refused: a file a robot may execute never holds NaN or inf.
     """
     if isinstance(y, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
         raise TypeError("save_trajectory takes (y, path): the trajectory first, then the file (as save_model)")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
-    y = np.asarray(y, dtype=np.float64)
-    if y.ndim != 2:
-        raise ValueError(f"y must have shape (T, D), got {y.shape}")
+    y = as_trajectory(y, "y", min_points=1, allow_static=True)
     suffix = path.suffix.lower()
+    if suffix not in (".npy", ".csv"):
+        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+    _destination(path)
     if suffix == ".npy":
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
         return path
-    if suffix != ".csv":
-        raise ValueError(f"{path}: unsupported file type {suffix or '(none)'}; use .csv or .npy")
     names = ["x", "y", "z"][: y.shape[1]] if y.shape[1] <= 3 else [f"x{i}" for i in range(y.shape[1])]
     data = y
     if times is not None:
         times = np.asarray(times, dtype=np.float64).reshape(-1)
         if times.shape[0] != y.shape[0]:
             raise ValueError(f"times has {times.shape[0]} entries for {y.shape[0]} samples")
+        if not np.all(np.isfinite(times)):
+            raise ValueError("times contains NaN or inf")
         names = ["t", *names]
         data = np.column_stack([times, y])
     with atomic_write(path, "w") as handle:
