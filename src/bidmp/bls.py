@@ -34,7 +34,19 @@ import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 from sklearn.base import BaseEstimator
 
-from ._checks import _as_float_array, _check_finite, check_choice, check_fitted, check_int, check_real
+from ._checks import (
+    _as_bounded_array,
+    _check_finite,
+    _check_magnitude,
+    check_bytes,
+    check_choice,
+    check_fitted,
+    check_int,
+    check_limit,
+    check_loaded,
+    check_real,
+    numerically_guarded,
+)
 from ._threads import single_threaded
 
 __all__ = ["BLS", "sparse_autoencoder", "block_pinv_update"]
@@ -47,6 +59,13 @@ _RANK_TOLERANCE = 1e-10  # singular values of C below this times ‖E‖₂ coun
 # (rank(Z) <= d + 2): its Moore–Penrose inverse needs a clean cut. Singular values below this
 # fraction of the largest count as zero.
 PINV_RCOND = 1e-10
+_MAX_ADMM_ITERATIONS = 10_000
+
+
+def _check_work(n_samples: int, n_hidden: int, n_inputs: int = 0) -> None:
+    """Refuse a fit whose dense algebra (N·h² for the output solve) would run for minutes."""
+    check_bytes(n_samples * max(n_hidden, n_inputs + 1), "the BLS hidden matrix (samples x hidden nodes)")
+    check_limit(float(n_samples) * n_hidden * n_hidden, "max_work", "the BLS solve's work (samples x hidden nodes^2)")
 
 
 def _with_bias(X: np.ndarray) -> np.ndarray:
@@ -252,17 +271,20 @@ class BLS(BaseEstimator):
             raise ValueError("update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)")
         if update == "auto":
             update = "pinv" if reg == 0.0 else "exact_ridge"
-        return _BLSParams(
-            n_windows=check_int(self.n_windows, "n_windows", minimum=1),
-            n_mapped=check_int(self.n_mapped, "n_mapped", minimum=1),
-            n_enhance=check_int(self.n_enhance, "n_enhance", minimum=1),
-            shrink=check_real(self.shrink, "shrink", positive=True),
-            reg=reg,
-            l1=check_real(self.l1, "l1", nonnegative=True),
-            admm_iterations=check_int(self.admm_iterations, "admm_iterations", minimum=1),
+        params = _BLSParams(
+            n_windows=check_int(self.n_windows, "n_windows", minimum=1, limit="max_hidden_nodes"),
+            n_mapped=check_int(self.n_mapped, "n_mapped", minimum=1, limit="max_hidden_nodes"),
+            n_enhance=check_int(self.n_enhance, "n_enhance", minimum=1, limit="max_hidden_nodes"),
+            shrink=check_real(self.shrink, "shrink", positive=True, maximum=1e6),
+            reg=check_real(reg, "reg", maximum=1e6),
+            l1=check_real(self.l1, "l1", nonnegative=True, maximum=1e6),
+            admm_iterations=check_int(self.admm_iterations, "admm_iterations", minimum=1, maximum=_MAX_ADMM_ITERATIONS),
             update=update,
-            seed=check_int(self.seed, "seed", minimum=0),
+            seed=check_int(self.seed, "seed", minimum=0, maximum=2**63 - 1),
         )
+        check_limit(params.n_windows * params.n_mapped + params.n_enhance, "max_hidden_nodes",
+                    "the hidden nodes n_windows * n_mapped + n_enhance")
+        return params
 
     def __sklearn_is_fitted__(self) -> bool:
         return "output_weights_" in self.__dict__
@@ -288,27 +310,33 @@ class BLS(BaseEstimator):
 
     @staticmethod
     def _check_X(X, expected: int | None = None) -> np.ndarray:
-        X = _as_float_array(X, "X")
+        X = _as_bounded_array(X, "X", 3)
         if X.ndim != 2:
             raise ValueError(f"X must have shape (N, d), got shape {X.shape}")
         if expected is not None and X.shape[1] != expected:
             raise ValueError(f"X must have {expected} columns (as in fit), got {X.shape[1]}")
-        if X.shape[0] == 0:
-            raise ValueError("X is empty")
+        if X.shape[0] == 0 or X.shape[1] == 0:
+            raise ValueError(f"X is empty (shape {X.shape})")
+        check_limit(X.shape[0], "max_samples", "X: the number of samples N")
+        check_limit(X.shape[1], "max_hidden_nodes", "X: the number of features d")
         _check_finite(X, "X")
+        _check_magnitude(X, "X")
         return X
 
     @staticmethod
     def _check_Y(Y, n_rows: int) -> tuple[np.ndarray, bool]:
-        Y = _as_float_array(Y, "Y")
+        Y = _as_bounded_array(Y, "Y", 3)
         was_1d = Y.ndim == 1
         Y = Y.reshape(-1, 1) if was_1d else Y
-        if Y.ndim != 2 or Y.shape[0] != n_rows:
+        if Y.ndim != 2 or Y.shape[0] != n_rows or Y.shape[1] == 0:
             raise ValueError(f"Y must have shape ({n_rows}, n_outputs), got shape {Y.shape}")
+        check_limit(Y.shape[1], "max_hidden_nodes", "Y: the number of outputs")
         _check_finite(Y, "Y")
+        _check_magnitude(Y, "Y")
         return Y, was_1d
 
     # -- learning --------------------------------------------------------------------------------
+    @numerically_guarded
     @single_threaded
     def fit(self, X, Y) -> "BLS":
         """Fit mapped features, the first enhancement block and the output weights.
@@ -328,6 +356,7 @@ class BLS(BaseEstimator):
         params = self._params()
         X = self._check_X(X)
         Y, y_was_1d = self._check_Y(Y, X.shape[0])
+        _check_work(X.shape[0], params.n_windows * params.n_mapped + params.n_enhance, X.shape[1])
         X_bias = _with_bias(X)
         windows, mins, ranges = [], [], []
         for window in range(params.n_windows):
@@ -386,6 +415,7 @@ class BLS(BaseEstimator):
         self.gram_factor_ = gram_factor
         self._projected_targets = projected_targets
 
+    @numerically_guarded
     @single_threaded
     def add_enhancement_nodes(self, n: int) -> "BLS":
         """Add a block of ``n`` enhancement nodes and update the output weights without
@@ -394,9 +424,11 @@ class BLS(BaseEstimator):
         As with ``fit``, the model is only changed once the update has succeeded.
         """
         check_fitted(self, "output_weights_")
-        n = check_int(n, "n", minimum=1)
+        n = check_int(n, "n", minimum=1, limit="max_hidden_nodes")
         params = self._params()
         A, Y = self.train_hidden_, self.train_targets_
+        check_limit(A.shape[1] + n, "max_hidden_nodes", "the hidden nodes after adding n")
+        _check_work(A.shape[0], A.shape[1] + n)
         Z = A[:, : self.mapping_min_.shape[0]]
         block = len(self.enhancement_weights_)
         weights, scale, E = _enhancement_block(Z, params.seed, block, n, params.shrink)
@@ -408,7 +440,11 @@ class BLS(BaseEstimator):
             R = self.gram_factor_
             c = R.shape[0]
             R12 = solve_triangular(R, A.T @ E, trans="T", check_finite=False)
-            R22 = cholesky(E.T @ E + params.reg * np.eye(n) - R12.T @ R12, lower=False, check_finite=False)
+            try:
+                R22 = cholesky(E.T @ E + params.reg * np.eye(n) - R12.T @ R12, lower=False, check_finite=False)
+            except np.linalg.LinAlgError:
+                raise ValueError(f"add_enhancement_nodes: the ridge Gram matrix lost positive definiteness in "
+                                 f"float64 (reg = {params.reg:g} is too small for these nodes); use a larger reg") from None
             z_new = solve_triangular(R22, E.T @ Y - R12.T @ self._projected_targets, trans="T", check_finite=False)
             W_new = solve_triangular(R22, z_new, check_finite=False)
             W_old = self.output_weights_ - solve_triangular(R, R12 @ W_new, check_finite=False)
@@ -428,8 +464,11 @@ class BLS(BaseEstimator):
         self._set_solution(*solution)
         return self
 
+    @numerically_guarded
     def predict(self, X) -> np.ndarray:
         """Outputs for inputs X: ``hidden(X) @ output_weights_``, shape (N, n_outputs)."""
+        check_fitted(self, "output_weights_")
+        check_bytes(np.shape(X)[0] * self.n_hidden_ if np.ndim(X) == 2 else 0, "the hidden matrix of X (N x hidden nodes)")
         out = self.hidden(X) @ self.output_weights_
         return out[:, 0] if self._y_was_1d else out
 
@@ -454,28 +493,41 @@ class BLS(BaseEstimator):
 
     @classmethod
     def _from_state(cls, meta: dict, arrays: dict) -> "BLS":
+        if not isinstance(meta.get("params"), dict):
+            raise ValueError("the BLS state has no params object")
         model = cls(**meta["params"])
         params = model._params()
-        model.n_features_ = check_int(meta["n_features_"], "n_features_", minimum=1)
-        n_blocks = check_int(meta["n_blocks"], "n_blocks", minimum=1)
-        model._y_was_1d = bool(meta["y_was_1d"])
-        for name in ("mapping_weights_", "mapping_min_", "mapping_range_", "output_weights_", "train_targets_"):
-            setattr(model, name, np.asarray(arrays[name], dtype=np.float64))
-        model._set_train_hidden(np.asarray(arrays["train_hidden_"], dtype=np.float64))
-        model.enhancement_weights_ = [np.asarray(arrays[f"enhancement_weights_{b}"], dtype=np.float64) for b in range(n_blocks)]
-        model.enhancement_scales_ = [float(v) for v in np.asarray(arrays["enhancement_scales_"]).reshape(-1)]
-        if len(model.enhancement_scales_) != n_blocks:
-            raise ValueError("enhancement_scales_ does not match the number of blocks")
-        expected = (params.n_windows, model.n_features_ + 1, params.n_mapped)
-        if model.mapping_weights_.shape != expected:
-            raise ValueError(f"mapping_weights_ has shape {model.mapping_weights_.shape}, expected {expected}")
-        n_hidden = params.n_windows * params.n_mapped + sum(w.shape[1] for w in model.enhancement_weights_)
-        if model.output_weights_.shape[0] != n_hidden or model.train_hidden_.shape[1] != n_hidden:
-            raise ValueError("output weights do not match the hidden layer")
-        companion = np.asarray(arrays["pinv_or_gram"], dtype=np.float64)
+        model.n_features_ = check_int(meta["n_features_"], "n_features_", minimum=1, limit="max_hidden_nodes")
+        n_blocks = check_int(meta["n_blocks"], "n_blocks", minimum=1, limit="max_hidden_nodes")
+        if not isinstance(meta["y_was_1d"], bool):
+            raise ValueError("y_was_1d must be true or false")
+        model._y_was_1d = meta["y_was_1d"]
+        n_mapped = params.n_windows * params.n_mapped
+        model.mapping_weights_ = check_loaded(arrays["mapping_weights_"], "mapping_weights_",
+                                              (params.n_windows, model.n_features_ + 1, params.n_mapped))
+        model.mapping_min_ = check_loaded(arrays["mapping_min_"], "mapping_min_", (n_mapped,))
+        model.mapping_range_ = check_loaded(arrays["mapping_range_"], "mapping_range_", (n_mapped,), positive=True)
+        model.enhancement_weights_ = [check_loaded(arrays[f"enhancement_weights_{b}"], f"enhancement_weights_{b}", (n_mapped + 1, None))
+                                      for b in range(n_blocks)]
+        scales = check_loaded(arrays["enhancement_scales_"], "enhancement_scales_", (n_blocks,), positive=True)
+        model.enhancement_scales_ = [float(v) for v in scales]
+        n_hidden = n_mapped + sum(w.shape[1] for w in model.enhancement_weights_)
+        check_limit(n_hidden, "max_hidden_nodes", "the model's hidden nodes")
+        model.output_weights_ = check_loaded(arrays["output_weights_"], "output_weights_", (n_hidden, None))
+        n_outputs = model.output_weights_.shape[1]
+        if model._y_was_1d and n_outputs != 1:
+            raise ValueError("member output_weights_ must have one column for a 1-D target")
+        train_hidden = check_loaded(arrays["train_hidden_"], "train_hidden_", (None, n_hidden))
+        n_samples = train_hidden.shape[0]
+        model.train_targets_ = check_loaded(arrays["train_targets_"], "train_targets_", (n_samples, n_outputs))
+        model._set_train_hidden(train_hidden)
         if params.update == "pinv":
+            companion = check_loaded(arrays["pinv_or_gram"], "pinv_or_gram", (n_hidden, n_samples))
             model.hidden_pinv_, model.gram_factor_, model._projected_targets = companion, None, None
         else:
+            companion = check_loaded(arrays["pinv_or_gram"], "pinv_or_gram", (n_hidden, n_hidden))
+            if not np.all(np.diag(companion) > 0) or np.any(np.tril(companion, -1) != 0):
+                raise ValueError("member pinv_or_gram is not an upper Cholesky factor (positive diagonal, zero below)")
             model.hidden_pinv_, model.gram_factor_ = None, np.asfortranarray(companion)
             model._projected_targets = solve_triangular(model.gram_factor_, model.train_hidden_.T @ model.train_targets_, trans="T")
         return model
@@ -486,7 +538,11 @@ def _solve_output(A: np.ndarray, Y: np.ndarray, params: _BLSParams) -> tuple:
     if params.update == "exact_ridge":
         # Upper Cholesky factor R of the ridge Gram matrix: AᵀA + λI = RᵀR, kept in Fortran
         # order (LAPACK's) so that triangular solves never copy it. z = R⁻ᵀAᵀY, W = R⁻¹z.
-        R = np.asfortranarray(cholesky(A.T @ A + params.reg * np.eye(A.shape[1]), lower=False))
+        try:
+            R = np.asfortranarray(cholesky(A.T @ A + params.reg * np.eye(A.shape[1]), lower=False))
+        except np.linalg.LinAlgError:
+            raise ValueError(f"fit: the ridge Gram matrix is not positive definite in float64 (reg = {params.reg:g} is "
+                             f"too small for this hidden layer); use a larger reg") from None
         projected = solve_triangular(R, A.T @ Y, trans="T")
         return np.ascontiguousarray(solve_triangular(R, projected)), None, R, projected
     pinv = np.ascontiguousarray(_ridge_pinv(A, params.reg))

@@ -20,12 +20,24 @@ the query says which one to use. Skill p (0 = the plain DMP … P) uses the sum 
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
-from ._checks import NotFittedError, as_point, as_trajectory, check_choice, check_int, check_real
+from ._checks import (
+    NotFittedError,
+    _check_magnitude,
+    as_point,
+    as_trajectory,
+    check_choice,
+    check_int,
+    check_limit,
+    check_loaded,
+    check_real,
+    numerically_guarded,
+)
 from ._trajectory import resample_time, rmse
 from .bls import BLS
 from .dmp import DMP, forcing_target
@@ -110,15 +122,19 @@ class BiDMP(BaseEstimator):
         """Validate the parameters; return the increments and the derivative rule."""
         if self.dmp is not None and not isinstance(self.dmp, DMP):
             raise TypeError(f"dmp must be a bidmp.DMP, got {type(self.dmp).__name__}")
-        check_int(self.n_windows, "n_windows", minimum=1)
-        check_int(self.n_mapped, "n_mapped", minimum=1)
-        check_int(self.n_enhance, "n_enhance", minimum=1)
-        check_real(self.shrink, "shrink", positive=True)
-        check_real(self.reg, "reg", nonnegative=True)
-        check_int(self.seed, "seed", minimum=0)
+        n_windows = check_int(self.n_windows, "n_windows", minimum=1, limit="max_hidden_nodes")
+        n_mapped = check_int(self.n_mapped, "n_mapped", minimum=1, limit="max_hidden_nodes")
+        n_enhance = check_int(self.n_enhance, "n_enhance", minimum=1, limit="max_hidden_nodes")
+        check_real(self.shrink, "shrink", positive=True, maximum=1e6)
+        check_real(self.reg, "reg", nonnegative=True, maximum=1e6)
+        check_int(self.seed, "seed", minimum=0, maximum=2**62)
         if isinstance(self.increments, (str, bytes)) or not hasattr(self.increments, "__iter__"):
-            raise TypeError(f"increments must be a sequence of integers, got {self.increments!r}")
-        increments = tuple(check_int(n, "increments", minimum=1) for n in self.increments)
+            raise TypeError(f"increments must be a sequence of integers, got {type(self.increments).__name__}")
+        increments = tuple(self.increments)
+        check_limit(len(increments), "max_hidden_nodes", "the number of increments")
+        increments = tuple(check_int(n, "increments", minimum=1, limit="max_hidden_nodes") for n in increments)
+        check_limit(n_windows * n_mapped + n_enhance + sum(increments), "max_hidden_nodes",
+                    "the hidden nodes of one block, n_windows * n_mapped + n_enhance + sum(increments)")
         derivatives = check_choice(self.derivatives, "derivatives", ("forward", "gradient", "dmp"))
         return increments, derivatives
 
@@ -187,6 +203,7 @@ class BiDMP(BaseEstimator):
         total *= phase[:, None]
         return total
 
+    @numerically_guarded
     def learn(self, y_dn) -> "BiDMP":
         """Learn an extended demonstration as a new skill (Eq. 15, 27, 28). Returns self.
 
@@ -275,6 +292,7 @@ class BiDMP(BaseEstimator):
             raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {skill!r}")
         return self._check_skill_index(skill)
 
+    @numerically_guarded
     def rollout(self, goal=None, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Generate a trajectory with one skill of the library.
 
@@ -321,25 +339,51 @@ class BiDMP(BaseEstimator):
         return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": self.phase_min_}, arrays
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays: dict) -> "BiDMP":
-        def part(prefix: str) -> dict:
-            return {k[len(prefix):]: v for k, v in arrays.items() if k.startswith(prefix)}
-
-        dmp = DMP._from_state(meta["dmp"], part("dmp/"))
+    def _from_state(cls, meta: dict, arrays: Mapping) -> "BiDMP":
+        for key, kind in (("dmp", dict), ("params", dict), ("blocks", list)):
+            if not isinstance(meta.get(key), kind):
+                raise ValueError(f"the Bi-DMP state has no {key} {kind.__name__}")
+        dmp = DMP._from_state(meta["dmp"], _Prefixed(arrays, "dmp/"))
         params = dict(meta["params"])
+        if not isinstance(params.get("increments"), list):
+            raise ValueError("params.increments must be a list of integers")
         params["increments"] = tuple(params["increments"])
         model = cls(dmp, **params)
         model._check_params()
         model._start(dmp)
-        model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True)
-        model.blocks_ = [BLS._from_state(block_meta, part(f"block{index}/")) for index, block_meta in enumerate(meta["blocks"])]
-        goals = np.asarray(arrays["skill_goals_"], dtype=np.float64)
-        starts = np.asarray(arrays["skill_starts_"], dtype=np.float64)
+        model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
+        model.blocks_ = [BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
+                         for index, block_meta in enumerate(meta["blocks"])]
+        for index, block in enumerate(model.blocks_):
+            if block.n_features_ != dmp.weights_.shape[0] or block.output_weights_.shape[1] != dmp.n_dims_:
+                raise ValueError(f"block {index} maps {block.n_features_} inputs to {block.output_weights_.shape[1]} outputs; "
+                                 f"the DMP has {dmp.weights_.shape[0]} kernels and D = {dmp.n_dims_}")
         expected = (len(model.blocks_) + 1, dmp.n_dims_)
-        if goals.shape != expected or starts.shape != expected:
-            raise ValueError(f"skill goals/starts have shapes {goals.shape}/{starts.shape}, expected {expected}")
-        model.skill_goals_, model.skill_starts_ = goals, starts
+        model.skill_goals_ = check_loaded(arrays["skill_goals_"], "skill_goals_", expected)
+        model.skill_starts_ = check_loaded(arrays["skill_starts_"], "skill_starts_", expected)
+        for name in ("skill_goals_", "skill_starts_"):
+            _check_magnitude(getattr(model, name), f"member {name}")
         return model
+
+
+class _Prefixed(Mapping):
+    """The members of ``arrays`` whose names start with ``prefix``, without it; lazy, so that
+    loading a model reads only the members a part asks for."""
+
+    def __init__(self, arrays: Mapping, prefix: str) -> None:
+        self._arrays, self._prefix = arrays, prefix
+
+    def __getitem__(self, name: str):
+        try:
+            return self._arrays[self._prefix + name]
+        except KeyError:
+            raise KeyError(f"missing member {self._prefix + name}") from None
+
+    def __iter__(self):
+        return (name[len(self._prefix):] for name in self._arrays if name.startswith(self._prefix))
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
 
 
 # ---------------------------------------------------------------------------------------------
