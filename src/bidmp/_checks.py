@@ -60,8 +60,14 @@ class Limits:
     max_array_bytes : int
         Bytes of any one array the library allocates or reads from a file (default 1 GiB).
     max_work : float
-        Multiply-adds of one dense step: a BLS solve (samples × hidden²), a Fréchet table
-        (n × m) or a roadmap run (samples × iterations × neighbours); about a second per 1e9.
+        Multiply-adds of one dense step: a BLS solve (samples × hidden²), a curvature smoothing
+        (samples × window) or a roadmap run (samples × neighbours × iterations); about a second
+        per 1e9 on one core.
+    max_frechet_cells : int
+        Cells n × m of one discrete Fréchet table (about 1 s per 1e8), and n_compare² × n_iter
+        of one roadmap run.
+    max_roadmap_nodes : int
+        Nodes one G-PRM / classic PRM run draws (n_samples × n_iter; about 5 s per 1e6).
     max_abs_value : float
         Largest coordinate magnitude (any unit): beyond it squares and spring forces overflow.
     min_extent : float
@@ -82,7 +88,9 @@ class Limits:
     max_kernels: int = 1_000
     max_hidden_nodes: int = 3_000
     max_array_bytes: int = 1 << 30
-    max_work: float = 1e10
+    max_work: float = 5e9
+    max_frechet_cells: int = 200_000_000
+    max_roadmap_nodes: int = 1_000_000
     max_abs_value: float = 1e9
     min_extent: float = 1e-9
     max_targets: int = 1_000

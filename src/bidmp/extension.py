@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ._checks import as_point, as_trajectory
+from ._checks import as_point, as_trajectory, check_choice, check_int, check_real, numerically_guarded
 from ._trajectory import arclength, interp_columns, path_extent, resample_time
-from .roadmap import CollisionCallback, gaussian_prm
+from .roadmap import CollisionCallback, check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
 
-__all__ = ["ExtendedDemonstration", "extend_demonstration", "time_path"]
+__all__ = ["ExtendedDemonstration", "extend_demonstration", "time_path", "check_extension_options"]
 
 logger = logging.getLogger(__name__)
 
@@ -96,6 +96,8 @@ def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float
     if start_speed > 0.0:
         duration = min(duration, 3.0 * length / start_speed)
     n_steps = max(int(round(duration / dt)), 1)
+    check_int(n_steps, "the generated transfer's samples (its length at the demonstrated piece's speed)",
+              limit="max_steps")
     u = np.arange(1, n_steps + 1) / n_steps
     a = start_speed * duration
     arc = length * (3 * u**2 - 2 * u**3) + a * (u - 2 * u**2 + u**3)
@@ -104,6 +106,18 @@ def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float
     return positions, n_steps * dt
 
 
+def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, **roadmap_options) -> None:
+    """Validate the options of :func:`extend_demonstration` without running it (what ``bidmp
+    scenario check`` runs on a scenario's ``"extension"`` key); raise naming the first bad one."""
+    eps_frac = check_real(eps_frac, "eps_frac")
+    if not 0.0 < eps_frac < 1.0:
+        raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
+    check_choice(method, "method", ("persistence", "paper"))
+    roadmap_options.pop("is_free", None)
+    check_options(seed=seed, **roadmap_options)
+
+
+@numerically_guarded
 def extend_demonstration(
     y,
     new_target,
@@ -144,6 +158,11 @@ def extend_demonstration(
     """
     y = as_trajectory(y, "y", min_points=10)
     target = as_point(new_target, y.shape[1], "new_target")
+    check_extension_options(
+        eps_frac=eps_frac, method=method, seed=seed, n_samples=n_samples, sigma_rel=sigma_rel, n_neighbours=n_neighbours,
+        n_compare=n_compare, n_iter=n_iter, rho=rho, schedule=schedule, scaling=scaling, compare=compare, select=select,
+        denom=denom,
+    )
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
 

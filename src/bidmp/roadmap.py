@@ -26,11 +26,20 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from ._checks import as_point, as_trajectory, check_choice, check_int, check_real
+from ._checks import (
+    as_point,
+    as_trajectory,
+    check_choice,
+    check_int,
+    check_limit,
+    check_real,
+    check_seed,
+    numerically_guarded,
+)
 from ._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
-__all__ = ["RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path"]
+__all__ = ["RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path", "check_options"]
 
 logger = logging.getLogger(__name__)
 
@@ -40,6 +49,7 @@ CollisionCallback = Callable[[np.ndarray], np.ndarray]
 _DEGENERATE_AXIS = 1e-3  # |tar_j - seg_j| below this fraction of ‖tar - seg‖: ramp that axis
 _MAX_AXIS_FACTOR = 10.0  # |sf_j| above this: ramp that axis too
 _MAX_NEIGHBOURS = 32
+_MAX_NEIGHBOURS_OPTION = 256  # k beyond this makes the roadmap dense (n·k edges) for no gain
 _EDGE_CHECKS = 5  # points tested along each edge when a collision callback is given
 
 
@@ -238,17 +248,37 @@ def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scal
     """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target")
-    check_int(n_samples, "n_samples", minimum=2)
-    check_int(n_neighbours, "n_neighbours", minimum=1)
-    check_int(n_compare, "n_compare", minimum=3)
-    check_int(n_iter, "n_iter", minimum=1)
-    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
-    check_choice(compare, "compare", ("template", "raw"))
-    check_choice(select, "select", ("best", "last"))
+    check_options(n_samples=n_samples, n_neighbours=n_neighbours, n_compare=n_compare, n_iter=n_iter,
+                  scaling=scaling, compare=compare, select=select, denom=denom)
     if np.linalg.norm(target - piece[0]) == 0.0:
         raise ValueError("new_target coincides with the start of the piece (seg): nothing to generate")
     comparison = _Comparison(resample_arclength(piece, n_compare), target, scaling, compare, denom)
     return piece, target, comparison
+
+
+def check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100,
+                  n_iter: int = 10, rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis",
+                  compare: str = "template", select: str = "best", denom: str = "sqrt2", padding: float = 0.3,
+                  seed=0) -> None:
+    """Validate roadmap options (those of :func:`gaussian_prm` and :func:`classic_prm`) without
+    running anything; raise naming the first bad one. Sizes are bounded so that one run stays
+    within seconds: ``n_samples · n_iter <= max_roadmap_nodes`` and ``n_compare² · n_iter <=
+    max_frechet_cells`` (:func:`bidmp.set_limits`)."""
+    check_int(n_samples, "n_samples", minimum=2)
+    check_int(n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS_OPTION)
+    check_int(n_compare, "n_compare", minimum=3)
+    check_int(n_iter, "n_iter", minimum=1)
+    check_limit(n_samples * n_iter, "max_roadmap_nodes", "the roadmap nodes drawn, n_samples * n_iter")
+    check_limit(n_compare * n_compare * n_iter, "max_frechet_cells", "the similarity work, n_compare² * n_iter")
+    check_real(sigma_rel, "sigma_rel", nonnegative=True, maximum=10.0)
+    check_real(rho, "rho", positive=True, maximum=2.0)
+    check_real(padding, "padding", nonnegative=True, maximum=100.0)
+    check_choice(schedule, "schedule", ("geometric", "harmonic"))
+    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
+    check_choice(compare, "compare", ("template", "raw"))
+    check_choice(select, "select", ("best", "last"))
+    check_choice(denom, "denom", ("sqrt2", "2"))
+    check_seed(seed)
 
 
 def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select) -> RoadmapResult:
@@ -277,6 +307,7 @@ def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is
     )
 
 
+@numerically_guarded
 def gaussian_prm(
     tra_imi,
     new_target,
@@ -328,10 +359,8 @@ def gaussian_prm(
     """
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    sigma_rel = check_real(sigma_rel, "sigma_rel", nonnegative=True)
-    rho = check_real(rho, "rho", positive=True)
-    check_choice(schedule, "schedule", ("geometric", "harmonic"))
-    rng = np.random.default_rng(seed)
+    check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule)
+    rng = check_seed(seed)
     seg = piece[0]
     sigma = sigma_rel * np.linalg.norm(target - seg)
     t = np.linspace(0.0, 1.0, n_samples)
@@ -352,6 +381,7 @@ def gaussian_prm(
     return _iterate(comparison, n_iter, draw, learn, n_neighbours, is_free, select)
 
 
+@numerically_guarded
 def classic_prm(
     tra_imi,
     new_target,
@@ -373,8 +403,8 @@ def classic_prm(
     Scored exactly like :func:`gaussian_prm`."""
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    padding = check_real(padding, "padding", nonnegative=True)
-    rng = np.random.default_rng(seed)
+    check_options(padding=padding)
+    rng = check_seed(seed)
     seg = piece[0]
     margin = padding * np.linalg.norm(target - seg)
     low, high = np.minimum(seg, target) - margin, np.maximum(seg, target) + margin

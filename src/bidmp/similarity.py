@@ -18,47 +18,68 @@ import logging
 
 import numpy as np
 
-from ._checks import as_trajectory, check_choice
+from ._checks import as_trajectory, check_choice, check_limit, numerically_guarded
 
 __all__ = ["frechet_distance", "frechet_distance_reference", "frechet_similarity", "polyline_length"]
 
 logger = logging.getLogger(__name__)
 
 
-def _squared_distance(p: np.ndarray, i: int, q: np.ndarray, j: int) -> float:  # pragma: no cover - numba
-    total = 0.0
-    for k in range(p.shape[1]):
-        delta = p[i, k] - q[j, k]
-        total += delta * delta
-    return total
-
-
 def _frechet_rows(p: np.ndarray, q: np.ndarray) -> float:  # pragma: no cover - compiled by numba
     # The recursion only takes max/min of distances, which commute with the monotone sqrt: work
-    # in squared distances and take one root at the end.
-    n, m = p.shape[0], q.shape[0]
+    # in squared distances and take one root at the end. (The squared distance is written out
+    # in place, not as a helper, so that one function is all numba has to compile and cache.)
+    n, m, n_dims = p.shape[0], q.shape[0], p.shape[1]
     row = np.empty(m)  # row[j] = ca[i, j] for the current i
-    row[0] = _squared_distance(p, 0, q, 0)
-    for j in range(1, m):
-        row[j] = max(row[j - 1], _squared_distance(p, 0, q, j))
+    for j in range(m):
+        total = 0.0
+        for k in range(n_dims):
+            delta = p[0, k] - q[j, k]
+            total += delta * delta
+        row[j] = total if j == 0 else max(row[j - 1], total)
     for i in range(1, n):
         diagonal = row[0]  # ca[i-1, j-1] for the next j
-        row[0] = max(row[0], _squared_distance(p, i, q, 0))
-        for j in range(1, m):
+        for j in range(m):
+            total = 0.0
+            for k in range(n_dims):
+                delta = p[i, k] - q[j, k]
+                total += delta * delta
+            if j == 0:
+                row[0] = max(row[0], total)
+                continue
             up = row[j]
             best = min(up, row[j - 1], diagonal)
             diagonal = up
-            row[j] = max(best, _squared_distance(p, i, q, j))
+            row[j] = max(best, total)
     return np.sqrt(row[m - 1])
 
 
-try:
-    import numba
+_kernel_state: dict = {}
 
-    _squared_distance = numba.njit(cache=True, inline="always")(_squared_distance)
-    _frechet_kernel = numba.njit(cache=True, nogil=True)(_frechet_rows)
-except ImportError:  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
-    _frechet_kernel = None
+
+def _frechet_kernel():
+    """The compiled kernel, or None without numba.
+
+    numba caches compiled code on disk beside the package or in the user's cache folder; where
+    neither is writable (a read-only install, a service user without a home) it cannot cache and
+    raises at the first call. Then the kernel is compiled in memory instead, once per process.
+    """
+    if "kernel" not in _kernel_state:
+        try:
+            import numba
+        except ImportError:  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
+            _kernel_state["kernel"] = None
+            return None
+        probe = (np.zeros((1, 1)), np.zeros((1, 1)))
+        kernel = numba.njit(cache=True, nogil=True)(_frechet_rows)
+        try:
+            kernel(*probe)
+        except Exception as exc:  # noqa: BLE001 - numba's caching errors have no common class
+            logger.info("numba cannot cache the Fréchet kernel here (%s); compiling it in memory", exc)
+            kernel = numba.njit(cache=False, nogil=True)(_frechet_rows)
+            kernel(*probe)
+        _kernel_state["kernel"] = kernel
+    return _kernel_state["kernel"]
 
 
 def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
@@ -109,9 +130,12 @@ def frechet_distance(a, b) -> float:
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape[1] != b.shape[1]:
         raise ValueError(f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}")
-    if _frechet_kernel is None:
+    check_limit(a.shape[0] * b.shape[0], "max_frechet_cells",
+                "the Fréchet table's size n x m; resample the curves to fewer points")
+    kernel = _frechet_kernel()
+    if kernel is None:  # pragma: no cover
         return frechet_distance_reference(a, b)
-    return float(_frechet_kernel(a, b))
+    return float(kernel(a, b))
 
 
 def polyline_length(y: np.ndarray) -> float:
@@ -120,6 +144,7 @@ def polyline_length(y: np.ndarray) -> float:
     return float(np.sum(np.linalg.norm(np.diff(y, axis=0), axis=1)))
 
 
+@numerically_guarded
 def frechet_similarity(a, b, denom: str = "sqrt2") -> float:
     """Fréchet similarity ``max(1 - Fré(a, b) / (sqrt(len(a) len(b)) / r), 0)`` (paper Eq. 5).
 

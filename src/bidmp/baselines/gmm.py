@@ -10,10 +10,16 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._checks import as_trajectory, check_fitted, check_int, check_real
+import logging
+import warnings
+
+from .._checks import as_trajectory, check_fitted, check_int, check_limit, check_real, numerically_guarded
 from .._noise import perturb
 
 __all__ = ["gmr", "augment", "fit_mixture", "GMMRegressor"]
+
+logger = logging.getLogger(__name__)
+_EM_ITERATIONS = 100  # scikit-learn's max_iter default, used for the work bound
 
 
 def gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1):
@@ -54,15 +60,23 @@ def gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.n
     return mean, covariance
 
 
+def _check_gmr_size(n_steps: int, means_shape: tuple) -> None:
+    from .._checks import check_bytes
+
+    n_components, n_dims = means_shape
+    check_bytes(n_steps * n_components * n_dims * n_dims, "GMR's intermediate arrays (steps x components x dims²)")
+
+
 def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0) -> np.ndarray:
     """The single-demonstration augmentation of SPEC §8: ``y`` plus smooth noisy copies.
 
     Returns (n_copies + 1, T, D); the copies keep the start and the end exact.
     """
     y = as_trajectory(y, "y")
-    check_int(n_copies, "n_copies", minimum=0)
-    check_real(noise, "noise", nonnegative=True)
-    rng = np.random.default_rng(seed)
+    check_int(n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
+    check_real(noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
+    check_limit(y.size * (n_copies + 1), "max_samples", "the augmented data's values, T * D * (n_copies + 1)")
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0, maximum=2**63 - 1))
     return np.stack([y] + [perturb(y, noise, rng) for _ in range(n_copies)])
 
 
@@ -74,14 +88,33 @@ def fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int
     ``GaussianMixture`` up to 15× slower in a review (3–7.5 s instead of 0.35–0.5 s), so the
     baselines' run times measured contention rather than the method.
     """
+    from sklearn.exceptions import ConvergenceWarning
     from sklearn.mixture import GaussianMixture
     from threadpoolctl import threadpool_limits
 
+    n_samples, n_dims = data.shape
+    if n_samples < n_components:
+        raise ValueError(f"n_components = {n_components} needs at least as many samples, got {n_samples}")
+    check_limit(float(n_samples) * n_components * n_dims * n_dims * _EM_ITERATIONS, "max_work",
+                "EM's work (samples x components x dims² x iterations)")
     # A fresh limiter (not the BLS's cached one): it must see the OpenMP runtime that
     # scikit-learn's k-means initialisation loads, which may not have been loaded before.
-    with threadpool_limits(limits=1):
+    with threadpool_limits(limits=1), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ConvergenceWarning)
         mixture = GaussianMixture(n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed).fit(data)
+    for warning in caught:  # library code never prints: report EM's convergence through logging
+        logger.warning("GaussianMixture: %s", warning.message)
     return mixture.weights_, mixture.means_, mixture.covariances_
+
+
+_MAX_COMPONENTS = 1_000
+_MAX_COPIES = 1_000
+
+
+def _max_abs() -> float:
+    from .._checks import get_limits
+
+    return get_limits().max_abs_value
 
 
 class _AugmentedMixture(BaseEstimator):
@@ -91,11 +124,11 @@ class _AugmentedMixture(BaseEstimator):
     """
 
     def _check_params(self) -> None:
-        check_int(self.n_components, "n_components", minimum=1)
-        check_real(self.reg_covar, "reg_covar", positive=True)
-        check_int(self.n_copies, "n_copies", minimum=0)
-        check_real(self.noise, "noise", nonnegative=True)
-        check_int(self.seed, "seed", minimum=0)
+        check_int(self.n_components, "n_components", minimum=1, maximum=_MAX_COMPONENTS)
+        check_real(self.reg_covar, "reg_covar", positive=True, maximum=1e6)
+        check_int(self.n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
+        check_real(self.noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
+        check_int(self.seed, "seed", minimum=0, maximum=2**32 - 1)  # scikit-learn's random_state range
 
     def __sklearn_is_fitted__(self) -> bool:
         return "weights_" in self.__dict__
@@ -127,6 +160,7 @@ class GMMRegressor(_AugmentedMixture):
         self.noise = noise
         self.seed = seed
 
+    @numerically_guarded
     def fit(self, y) -> "GMMRegressor":
         """Fit on one demonstration (T, D), time scaled to [0, 1]."""
         self._check_params()
@@ -138,8 +172,10 @@ class GMMRegressor(_AugmentedMixture):
         self.n_steps_ = n_steps
         return self
 
+    @numerically_guarded
     def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Mean trajectory (n, D) and covariances (n, D, D) by GMR on t ∈ [0, 1]."""
         check_fitted(self, "weights_")
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2)
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+        _check_gmr_size(n_steps, self.means_.shape)
         return gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))

@@ -13,10 +13,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_point, check_fitted, check_int
-from .gmm import _AugmentedMixture, augment, fit_mixture, gmr
+from .._checks import as_point, check_fitted, check_int, numerically_guarded
+from .gmm import _AugmentedMixture, _check_gmr_size, augment, fit_mixture, gmr
 
 __all__ = ["TPGMM"]
+
+
+def _rotation(value, n_dims: int, name: str) -> np.ndarray:
+    """A frame orientation: an orthonormal (D, D) matrix."""
+    matrix = np.asarray(value, dtype=np.float64)
+    if matrix.shape != (n_dims, n_dims) or not np.all(np.isfinite(matrix)):
+        raise ValueError(f"{name} must be a finite ({n_dims}, {n_dims}) rotation matrix, got shape {matrix.shape}")
+    if not np.allclose(matrix @ matrix.T, np.eye(n_dims), atol=1e-6):
+        raise ValueError(f"{name} must be orthonormal (R Rᵀ = I)")
+    return matrix
 
 
 class TPGMM(_AugmentedMixture):
@@ -44,6 +54,7 @@ class TPGMM(_AugmentedMixture):
         self.noise = noise
         self.seed = seed
 
+    @numerically_guarded
     def fit(self, y) -> "TPGMM":
         """Fit on one demonstration (T, D); frames at each copy's own start and end."""
         self._check_params()
@@ -69,13 +80,17 @@ class TPGMM(_AugmentedMixture):
         sigma_global = transform @ sigma @ transform.T + self.reg_covar * np.eye(d + 1)
         return mu_global, sigma_global
 
+    @numerically_guarded
     def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
         """Mean trajectory (n, D) and covariances for new start and target frames."""
         check_fitted(self, "weights_")
         d = self.n_dims_
         start = as_point(start, d, "start")
         target = as_point(target, d, "target")
-        rotations = [np.eye(d) if r is None else np.asarray(r, float) for r in (start_rotation, target_rotation)]
+        rotations = [np.eye(d) if r is None else _rotation(r, d, name)
+                     for r, name in ((start_rotation, "start_rotation"), (target_rotation, "target_rotation"))]
+        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+        _check_gmr_size(n_steps, self.means_.shape)
         precision_sum = 0.0
         weighted_mean = 0.0
         for frame, (A, b) in enumerate(zip(rotations, (start, target))):
@@ -85,5 +100,4 @@ class TPGMM(_AugmentedMixture):
             weighted_mean = weighted_mean + np.einsum("kij,kj->ki", precision, mu)
         covariance = np.linalg.inv(precision_sum)  # product of Gaussians
         mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2)
         return gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
