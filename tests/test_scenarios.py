@@ -80,7 +80,7 @@ MALFORMED = [
     (lambda d: d.update(demonstration={"points": [[0, 0, 0], [1, 1, 1]], "file": "x.csv"}), "demonstration: expected exactly one of"),
     (lambda d: d.update(demonstration={"file": "missing.csv"}), "demonstration.file:"),
     (lambda d: d.update(extensions=[{"target": "3", "from": "previous"}]), "extensions[0].from"),
-    (lambda d: d.update(seed=-2), "seed: expected a non-negative integer"),
+    (lambda d: d.update(seed=-2), "seed: expected an integer in [0, 2**32)"),
     (lambda d: d["dmp"].update(fit="ridge"), "dmp.fit: renamed to 'regression'"),
     (lambda d: d.update(bidmp={"reg": -1.0}), "bidmp: reg must be >= 0"),
     (lambda d: d.update(bidmp={"n_nodes": 3}), "bidmp.n_nodes: unknown parameter"),

@@ -98,11 +98,12 @@ def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.ran
     -------
     y : array (n_steps, D)
     """
-    from ._checks import as_trajectory, check_int, check_real
+    from ._checks import as_trajectory, check_int, check_real, check_seed, get_limits
 
     via = as_trajectory(via, "via", min_points=2)
-    n_steps = check_int(n_steps, "n_steps", minimum=3)
-    noise = check_real(noise, "noise", nonnegative=True)
+    n_steps = check_int(n_steps, "n_steps", minimum=3, limit="max_samples")
+    noise = check_real(noise, "noise", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
+    seed = check_seed(seed)
     lengths = np.linalg.norm(np.diff(via, axis=0), axis=1)
     moving = lengths > 0
     via = np.vstack([via[:1], via[1:][moving]])

@@ -12,7 +12,9 @@ Keys (units: millimetres for the battery scenarios)::
     targets              {label: [x, y(, z)]}, required, at least one
     demonstrated         label of the demonstrated target, required
     demonstration        exactly one of {"minimum_jerk": {"via", "n_steps", "noise", "seed"}},
-                         {"points": [[x, y(, z)], ...]} or {"file": "demo.csv"} (relative to the file)
+                         {"points": [[x, y(, z)], ...]} (at least 10) or {"file": "demo.csv"}
+                         (relative to the scenario file, and inside its folder unless
+                         ``allow_outside_files``)
     success_threshold    end-point error for success, default 1.75
     approach_height      height band above a target for the approach error, default 28.5;
                          null turns the approach metric off
@@ -29,7 +31,12 @@ Keys (units: millimetres for the battery scenarios)::
     demonstrations       {label: demonstration}: further demonstrations learned directly by Bi-DMP
                          (several operators); a target with the same label uses it as reference
     methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
-    seed                 int, default 0 (G-PRM and the baselines)
+    seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
+
+Loading validates everything ``evaluate`` will need, so a scenario that loads also runs: the DMP
+is fitted on the demonstration (unstable integration, oversized settings and degenerate
+demonstrations are refused), rolled out to every target, and the Bi-DMP and extension options
+are checked.
 """
 
 from __future__ import annotations
@@ -44,8 +51,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ._checks import check_limit, get_limits, short_token
 from .datasets import minimum_jerk
-from .io import load_trajectory
+from .io import load_json, load_trajectory
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
@@ -118,39 +126,73 @@ class Scenario:
 # ---------------------------------------------------------------------------------------------
 # Validation
 # ---------------------------------------------------------------------------------------------
+_MIN_DEMONSTRATION = 10  # samples: what segmentation (and so the extension) needs
+
+
 def _fail(source: str, key: str, message: str):
     raise ScenarioError(f"scenario {source}: {key}: {message}")
 
 
+def _shown(value) -> str:
+    """A rejected JSON value, quoted short (never a whole file's worth)."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = type(value).__name__
+    return text if len(text) <= 24 else short_token(text, 20)
+
+
 def _number(value, source, key, positive=False):
     if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value):
-        _fail(source, key, f"expected a number, got {json.dumps(value)}")
+        _fail(source, key, f"expected a number, got {_shown(value)}")
     if positive and value <= 0:
         _fail(source, key, f"must be > 0, got {value}")
+    if abs(value) > get_limits().max_abs_value:
+        _fail(source, key, f"{value:.3g} is beyond the limit max_abs_value = {get_limits().max_abs_value:g}")
     return float(value)
 
 
 def _point(value, source, key, n_dims=None):
     if not isinstance(value, list) or not value or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value):
-        _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {json.dumps(value)}")
+        _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {_shown(value)}")
+    if len(value) > get_limits().max_dims:
+        _fail(source, key, f"has {len(value)} coordinates, more than the limit max_dims = {get_limits().max_dims}")
     point = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(point)):
         _fail(source, key, "contains a non-finite number")
+    if np.max(np.abs(point)) > get_limits().max_abs_value:
+        _fail(source, key, f"has a coordinate beyond the limit max_abs_value = {get_limits().max_abs_value:g} "
+                           f"(raise it with bidmp.set_limits(max_abs_value=...))")
     if n_dims is not None and point.shape[0] != n_dims:
         _fail(source, key, f"has {point.shape[0]} coordinates, expected {n_dims}")
     return point
 
 
-def _points(value, source, key, n_dims=None):
-    if not isinstance(value, list) or len(value) < 2:
-        _fail(source, key, "expected a list of at least 2 points")
+def _points(value, source, key, n_dims=None, minimum=2):
+    if not isinstance(value, list) or len(value) < minimum:
+        _fail(source, key, f"expected a list of at least {minimum} points")
+    if len(value) > get_limits().max_samples:
+        _fail(source, key, f"{len(value):,} points exceed the limit max_samples = {get_limits().max_samples:,}")
     points = [_point(p, source, f"{key}[{i}]", n_dims) for i, p in enumerate(value)]
     if len({p.shape[0] for p in points}) != 1:
         _fail(source, key, "points have different numbers of coordinates")
     return np.stack(points)
 
 
-def _demonstration(value, source, key, base_dir):
+def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outside: bool) -> Path:
+    """Resolve a file named in a scenario; unless allowed, it must lie inside the scenario's
+    folder once ``..`` and symlinks are resolved."""
+    if allow_outside:
+        return path
+    base = Path(os.path.realpath(base_dir))
+    resolved = Path(os.path.realpath(path))
+    if os.path.isabs(body) or os.path.commonpath([base, resolved]) != str(base):
+        _fail(source, key, f"{short_token(body, 40)} lies outside the scenario's folder {base}; files are read from "
+                           f"there only (allow_outside_files=True, or 'bidmp ... --allow-outside-files', lifts this)")
+    return resolved
+
+
+def _demonstration(value, source, key, base_dir, allow_outside=False):
     if not isinstance(value, dict) or len(value) != 1:
         _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
     (kind, body), = value.items()
@@ -164,26 +206,38 @@ def _demonstration(value, source, key, base_dir):
             _fail(source, f"{key}.minimum_jerk.via", "missing")
         via = _points(body["via"], source, f"{key}.minimum_jerk.via")
         n_steps = body.get("n_steps", 200)
-        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < 10:
-            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= 10, got {json.dumps(n_steps)}")
+        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < _MIN_DEMONSTRATION:
+            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= {_MIN_DEMONSTRATION}, got {_shown(n_steps)}")
+        if n_steps > get_limits().max_samples:
+            _fail(source, f"{key}.minimum_jerk.n_steps", f"{n_steps:,} exceeds the limit max_samples = {get_limits().max_samples:,}")
         noise = _number(body.get("noise", 0.0), source, f"{key}.minimum_jerk.noise")
         if noise < 0:
             _fail(source, f"{key}.minimum_jerk.noise", "must be >= 0")
         seed = body.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, Integral) or seed < 0:
-            _fail(source, f"{key}.minimum_jerk.seed", f"expected a non-negative integer, got {json.dumps(seed)}")
-        return minimum_jerk(via, int(n_steps), noise, int(seed))
-    if kind == "points":
-        return _points(body, source, f"{key}.points")
-    if kind == "file":
-        if not isinstance(body, str) or not body:
-            _fail(source, f"{key}.file", "expected a file name")
-        path = Path(body) if os.path.isabs(body) else Path(base_dir) / body
+        if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**63:
+            _fail(source, f"{key}.minimum_jerk.seed", f"expected an integer in [0, 2**63), got {_shown(seed)}")
         try:
-            return load_trajectory(path)
-        except ValueError as exc:
+            return minimum_jerk(via, int(n_steps), noise, int(seed))
+        except (TypeError, ValueError) as exc:
+            _fail(source, f"{key}.minimum_jerk", str(exc))
+    if kind == "points":
+        points = _points(body, source, f"{key}.points", minimum=_MIN_DEMONSTRATION)
+        if not np.any(points != points[0]):
+            _fail(source, f"{key}.points", "all points are identical: there is no motion to learn")
+        return points
+    if kind == "file":
+        if not isinstance(body, str) or not body or "\x00" in body:
+            _fail(source, f"{key}.file", "expected a file name")
+        path = _inside(Path(body) if os.path.isabs(body) else Path(base_dir) / body, base_dir, source, f"{key}.file",
+                       body, allow_outside)
+        try:
+            trajectory = load_trajectory(path)
+        except (TypeError, ValueError, OSError) as exc:
             _fail(source, f"{key}.file", str(exc))
-    _fail(source, key, f"unknown demonstration kind {kind!r} (expected minimum_jerk, points or file)")
+        if trajectory.shape[0] < _MIN_DEMONSTRATION:
+            _fail(source, f"{key}.file", f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}")
+        return trajectory
+    _fail(source, key, f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)")
 
 
 def _extension_target(value, source, key, targets, n_dims):
@@ -218,13 +272,18 @@ def _parameters(data, key, known, source, check) -> dict:
     return params
 
 
-def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -> Scenario:
-    """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`."""
+def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *,
+              allow_outside_files: bool = False) -> Scenario:
+    """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`.
+
+    ``"file"`` demonstrations are read relative to ``base_dir`` and must lie inside it (after
+    resolving ``..`` and symlinks) unless ``allow_outside_files`` is true.
+    """
     if not isinstance(data, dict):
         raise ScenarioError(f"scenario {source}: expected a JSON object at the top level")
     unknown = sorted(set(data) - _KEYS)
     if unknown:
-        _fail(source, unknown[0], f"unknown key (known: {', '.join(sorted(_KEYS))})")
+        _fail(source, short_token(unknown[0], 30)[1:-1], f"unknown key (known: {', '.join(sorted(_KEYS))})")
     for key in ("name", "targets", "demonstrated", "demonstration"):
         if key not in data:
             _fail(source, key, "missing (required)")
@@ -234,14 +293,17 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
         if key in data and not isinstance(data[key], str):
             _fail(source, key, "expected a string")
 
-    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir)
+    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files)
     n_dims = demonstration.shape[1]
     if not isinstance(data["targets"], dict) or not data["targets"]:
         _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
+    if len(data["targets"]) > get_limits().max_targets:
+        _fail(source, "targets", f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}")
     targets = {str(label): _point(point, source, f"targets.{label}", n_dims) for label, point in data["targets"].items()}
     demonstrated = data["demonstrated"]
     if not isinstance(demonstrated, str) or demonstrated not in targets:
-        _fail(source, "demonstrated", f"{json.dumps(demonstrated)} is not among the targets ({', '.join(targets)})")
+        _fail(source, "demonstrated", f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
+                                      f"{', …' if len(targets) > 10 else ''})")
 
     threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
     approach = data.get("approach_height", 28.5)
@@ -252,7 +314,9 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
 
     dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
     bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
-    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, None)
+    from .extension import check_extension_options
+
+    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: check_extension_options(**params))
 
     if "extensions" in data:
         if not isinstance(data["extensions"], list) or not data["extensions"]:
@@ -266,6 +330,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
             if origin not in ("demonstration", "previous") or (index == 0 and origin == "previous"):
                 _fail(source, f"{key}.from", f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}")
             extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims), "from": origin})
+        check_limit(len(extensions), "max_targets", "the number of extensions")
     else:
         target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
         extensions = [{"target": target, "from": "demonstration"}]
@@ -274,8 +339,9 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
     if not isinstance(extra, dict):
         _fail(source, "demonstrations", "expected an object {label: demonstration}")
     demonstrations = {}
+    check_limit(len(extra), "max_targets", "the number of further demonstrations")
     for label, spec in extra.items():
-        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir)
+        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir, allow_outside_files)
         if trajectory.shape[1] != n_dims:
             _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
         demonstrations[str(label)] = trajectory
@@ -285,11 +351,12 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
         _fail(source, "methods", "expected a non-empty list of method names")
     for method in methods:
         if method not in METHODS:
-            _fail(source, "methods", f"unknown method {method!r} (known: {', '.join(METHODS)})")
+            _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(METHODS)})")
     seed = data.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, Integral) or seed < 0:
-        _fail(source, "seed", f"expected a non-negative integer, got {json.dumps(seed)}")
+    if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
+        _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
 
+    _check_runs(source, demonstration, targets, dmp)
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
         success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
@@ -297,6 +364,17 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".") -
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
     )
+
+
+def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_params: dict) -> None:
+    """What ``evaluate`` does first, so that a scenario that loads also runs: fit the DMP on
+    the demonstration and roll it out to every target (about a millisecond)."""
+    from .dmp import DMP
+
+    try:
+        DMP(**dmp_params).fit(demonstration).rollout_many(np.stack(list(targets.values())))
+    except (TypeError, ValueError) as exc:
+        _fail(source, "dmp", f"the DMP cannot run on this demonstration: {exc}")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -318,8 +396,14 @@ def builtin_text(name: str) -> str:
     return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
 
 
-def load(path_or_name: str | os.PathLike) -> Scenario:
-    """Load a scenario from a JSON file, or a built-in by name."""
+def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) -> Scenario:
+    """Load a scenario from a JSON file, or a built-in by name, and validate it completely.
+
+    ``allow_outside_files``: let ``"file"`` demonstrations name files outside the scenario's
+    folder (absolute paths, ``..``, symlinks out of it); off by default.
+    """
+    if not isinstance(path_or_name, (str, os.PathLike)):
+        raise TypeError(f"path_or_name must be a file name or a built-in name, got {type(path_or_name).__name__}")
     text_name = str(path_or_name)
     if not text_name.endswith(".json") and text_name in builtin_names():
         return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")
@@ -327,7 +411,8 @@ def load(path_or_name: str | os.PathLike) -> Scenario:
     if not path.is_file():
         raise ScenarioError(f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ScenarioError(f"scenario {path}: not valid JSON ({exc})") from None
-    return from_dict(data, source=str(path), base_dir=path.parent)
+        check_limit(path.stat().st_size, "max_json_bytes", f"the size of scenario {path} in bytes")
+        data = load_json(path.read_bytes(), f"scenario {path}")
+    except (OSError, ValueError) as exc:
+        raise ScenarioError(str(exc) if str(exc).startswith("scenario") else f"scenario {path}: {exc}") from None
+    return from_dict(data, source=str(path), base_dir=path.parent, allow_outside_files=allow_outside_files)
