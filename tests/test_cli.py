@@ -260,7 +260,7 @@ def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
         (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.npz"], "NaN"),
         (["extend", "{model}", "{demo}", "--target", "1", "2", "0", "-o", "{tmp}/x.csv"], "-o must be the Bi-DMP model file"),
         (["rollout", "{model}", "--skill", "1", "-o", "{tmp}/x.csv"], "--skill needs a Bi-DMP model"),
-        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be >= 1"),
+        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be 1-1000"),
     ],
 )
 def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, match, capsys):

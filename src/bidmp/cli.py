@@ -18,6 +18,7 @@ from . import __version__
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
+_MAX_SEEDS = 1000
 
 
 class _Parser(argparse.ArgumentParser):
@@ -56,6 +57,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     reproduction = dmp.rollout()  # round(tau * T) samples: with tau != 1 the same path, slower
     error = rmse(reproduction, resample_time(demonstration, reproduction.shape[0]))
     extent = path_extent(demonstration)
+    if not np.isfinite(error):  # never print a non-finite result as a success
+        raise ValueError(f"the fitted DMP does not reproduce {args.demo} (RMSE {error}); the settings are out of range")
     print(f"fitted a DMP on {args.demo}: T = {dmp.n_steps_} samples, D = {dmp.n_dims_}, "
           f"rollouts take {reproduction.shape[0]} samples of {dmp.dt_:.4g} s (tau = {dmp.tau:g})")
     print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
@@ -154,7 +157,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         return _lasa_demo(args.lasa, out)
     from .scenarios import load
 
-    scenario = load(args.scenario)
+    scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     methods = None
     if args.methods is not None:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -190,7 +193,7 @@ def _cmd_scenario(args: argparse.Namespace) -> int:
     if args.scenario_command == "show":
         sys.stdout.write(builtin_text(args.name))
         return EXIT_OK
-    scenario = load(args.file)  # validate
+    scenario = load(args.file, allow_outside_files=args.allow_outside_files)  # what demo validates
     print(f"{args.file}: valid scenario '{scenario.name}' with {len(scenario.targets)} targets, "
           f"demonstration of {scenario.demonstration.shape[0]} samples in {scenario.demonstration.shape[1]}-D")
     return EXIT_OK
@@ -218,7 +221,9 @@ def _cmd_segment(args: argparse.Namespace) -> int:
     if args.plot:
         from .plotting import plot_segmentation
 
-        kappa = curvature(resample_arclength(y, y.shape[0]))
+        from .segmentation import MAX_ANALYSIS_POINTS
+
+        kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
         print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
     return EXIT_OK
 
@@ -279,8 +284,8 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     from . import reproduce
 
     out = Path(args.out)
-    if args.seeds < 1:
-        raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+    if not 1 <= args.seeds <= _MAX_SEEDS:
+        raise ValueError(f"--seeds must be 1-{_MAX_SEEDS}, got {args.seeds}")
     if args.what == "table4":
         with tqdm(total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None) as bar:
             result = reproduce.run_table4(progress=lambda name: (bar.set_postfix_str(name), bar.update(1)))
@@ -377,6 +382,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--methods", default=None, help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm")
     demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
     demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
+    demo.add_argument("--allow-outside-files", action="store_true",
+                      help="let the scenario read demonstration files outside its own folder")
     demo.set_defaults(handler=_cmd_demo)
 
     scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
@@ -388,34 +395,116 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("name", metavar="NAME")
     check = scenario_commands.add_parser("check", help="validate a scenario file")
     check.add_argument("file", metavar="FILE")
+    check.add_argument("--allow-outside-files", action="store_true",
+                       help="let the scenario read demonstration files outside its own folder")
     scenario.set_defaults(handler=_cmd_scenario)
     return parser
 
 
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a tool killed by a closed pipe reports
+_MAX_MESSAGE = 600  # characters of one error line
+
+
+class _BufferedLog(logging.Handler):
+    """Holds the library's log records while a command runs: they are printed (one line each)
+    if it succeeds and dropped if it fails, so that a failure is exactly one line on stderr."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.records: list[logging.LogRecord] = []
+        self.setFormatter(logging.Formatter("bidmp: %(levelname)s: %(message)s"))
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+    def flush_to(self, stream) -> None:
+        for record in self.records:
+            stream.write(" ".join(self.format(record).split())[:_MAX_MESSAGE] + "\n")
+        self.records.clear()
+
+
+def _one_line(text: str) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= _MAX_MESSAGE else text[: _MAX_MESSAGE - 1] + "…"
+
+
+def _quiet_stdout() -> None:
+    """After a closed pipe: point stdout at /dev/null so that Python's final flush is silent."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # a replaced sys.stdout (tests) has no file number
+        pass
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; return the exit code."""
+    """Run the command line; return the exit code.
+
+    Every failure is one line on stderr: exit 2 for bad input of any kind (including sizes over
+    the limits and settings that would overflow), 1 for an internal error, 130 on Ctrl-C, 141
+    when stdout is a closed pipe (``bidmp lasa list | head -1``), silently.
+    """
+    import warnings
+
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
     if args.command is None:
         parser.print_help()
         return EXIT_BAD_INPUT
+    buffered = _BufferedLog()
+    root = logging.getLogger()
+    debug_handler = None
+    if args.debug:
+        debug_handler = logging.StreamHandler(sys.stderr)
+        debug_handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+        root.addHandler(debug_handler)
+        root.setLevel(logging.DEBUG)
+    else:
+        root.addHandler(buffered)
     try:
-        return args.handler(args)
-    except (ValueError, TypeError, OSError) as exc:
-        if args.debug:
-            raise
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        print(f"bidmp {args.command}: error: {message}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        with warnings.catch_warnings():
+            # A numerical warning means a non-finite result is on its way: never report it as a
+            # success. Other warnings go to the log (one line each, printed on success).
+            warnings.simplefilter("error", RuntimeWarning)
+            logging.captureWarnings(True)
+            code = args.handler(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
     except KeyboardInterrupt:
         print("bidmp: interrupted", file=sys.stderr)
         return 130
+    except (ValueError, TypeError, OSError, ArithmeticError, RuntimeWarning, RecursionError, MemoryError) as exc:
+        if args.debug:
+            raise
+        if isinstance(exc, MemoryError):
+            message = "out of memory; lower the sizes (see the limits in the README)"
+        elif isinstance(exc, RecursionError):
+            message = "input nested too deeply"
+        elif isinstance(exc, (ArithmeticError, RuntimeWarning)):
+            message = f"numerical failure ({exc}): the input's scale or the settings are out of range"
+        elif isinstance(exc, OSError) and exc.strerror:
+            message = f"{exc.strerror}: {exc.filename}" if exc.filename else exc.strerror
+        else:
+            message = str(exc) or type(exc).__name__
+        print(f"bidmp {args.command}: error: {_one_line(message)}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except Exception as exc:  # noqa: BLE001 - the CLI promises no tracebacks
         if args.debug:
             raise
-        print(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)", file=sys.stderr)
+        print(_one_line(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)"),
+              file=sys.stderr)
         return EXIT_INTERNAL
+    finally:
+        logging.captureWarnings(False)
+        root.removeHandler(buffered)
+        if debug_handler is not None:
+            root.removeHandler(debug_handler)
+    buffered.flush_to(sys.stderr)
+    return code
 
 
 if __name__ == "__main__":  # pragma: no cover

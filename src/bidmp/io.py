@@ -650,10 +650,10 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
     y = as_trajectory(y, "y", min_points=1, allow_static=True)
+    _destination(path)
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv"):
         raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
-    _destination(path)
     if suffix == ".npy":
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
