@@ -235,7 +235,7 @@ def load_json(data: bytes | str, source: str):
 # ---------------------------------------------------------------------------------------------
 # .npy headers: check before allocating
 # ---------------------------------------------------------------------------------------------
-def _read_npy_header(stream, what: str) -> tuple[tuple, np.dtype]:
+def _read_npy_header(stream, what: str, check=None) -> tuple[tuple, np.dtype]:
     """Read an ``.npy`` header from ``stream``; refuse object dtypes and sizes over the limits."""
     magic = stream.read(len(_NPY_MAGIC))
     if magic != _NPY_MAGIC:
@@ -251,6 +251,8 @@ def _read_npy_header(stream, what: str) -> tuple[tuple, np.dtype]:
         raise ValueError(f"{what} holds {dtype} data, not real numbers")
     if len(shape) > 8:
         raise ValueError(f"{what} has {len(shape)} dimensions")
+    if check is not None:  # the caller's own expectations first: they give the clearer message
+        check(shape, dtype)
     n_elements = int(np.prod(shape, dtype=object))
     check_bytes(n_elements, what, dtype.itemsize)
     return shape, dtype
@@ -260,9 +262,7 @@ def _read_npy(open_stream, what: str, check=None) -> np.ndarray:
     """Read an array from the stream factory ``open_stream`` after checking its header
     (``check(shape, dtype)`` may refuse more)."""
     with open_stream() as stream:
-        shape, dtype = _read_npy_header(stream, what)
-    if check is not None:
-        check(shape, dtype)
+        _read_npy_header(stream, what, check)
     with open_stream() as stream:
         return np.lib.format.read_array(stream, allow_pickle=False)
 

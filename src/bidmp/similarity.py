@@ -71,8 +71,8 @@ def _frechet_kernel():
             _kernel_state["kernel"] = None
             return None
         probe = (np.zeros((1, 1)), np.zeros((1, 1)))
-        kernel = numba.njit(cache=True, nogil=True)(_frechet_rows)
-        try:
+        try:  # numba looks for a cache folder when decorating, and writes it at the first call
+            kernel = numba.njit(cache=True, nogil=True)(_frechet_rows)
             kernel(*probe)
         except Exception as exc:  # noqa: BLE001 - numba's caching errors have no common class
             logger.info("numba cannot cache the Fréchet kernel here (%s); compiling it in memory", exc)
