@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean readme
+.PHONY: demo test bench install clean readme fuzz
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -20,6 +20,11 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q
+
+# The long hypothesis campaign (tests/test_fuzz.py x20: over 10 000 generated inputs); writes
+# the outcome counts to fuzz-report.json.
+fuzz: $(STAMP)
+	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py -p no:cacheprovider
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
@@ -40,4 +45,4 @@ readme: $(STAMP)
 	$(PY) tools/readme.py
 
 clean:
-	rm -rf $(VENV) bidmp-out .pytest_cache
+	rm -rf $(VENV) bidmp-out .pytest_cache fuzz-report.json

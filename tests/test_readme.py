@@ -36,3 +36,15 @@ def test_every_python_block_runs_alone(index, tmp_path):
     result = subprocess.run([sys.executable, "-c", PYTHON_BLOCKS[index]], cwd=tmp_path, capture_output=True, text=True,
                             timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
+
+
+def test_the_readme_limits_table_states_the_defaults_in_force():
+    import dataclasses
+
+    import bidmp
+
+    rows = dict(re.findall(r"^\| `(max_\w+|min_\w+)` \| ([^|]+) \|", README, re.MULTILINE))
+    defaults = dataclasses.asdict(bidmp.Limits())
+    assert set(rows) == set(defaults), "document every limit in the README table"
+    for name, value in defaults.items():
+        assert float(rows[name]) == float(value), name

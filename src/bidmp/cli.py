@@ -452,6 +452,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command is None:
         parser.print_help()
+        print("bidmp: error: no command given (see 'bidmp --help')", file=sys.stderr)
         return EXIT_BAD_INPUT
     buffered = _BufferedLog()
     root = logging.getLogger()

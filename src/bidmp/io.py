@@ -241,12 +241,19 @@ def _read_npy_header(stream, what: str, check=None) -> tuple[tuple, np.dtype]:
     if magic != _NPY_MAGIC:
         raise ValueError(f"{what} is not an .npy array")
     version = tuple(stream.read(2))
-    if version == (1, 0):
-        shape, _, dtype = np.lib.format.read_array_header_1_0(stream)
-    elif version in ((2, 0), (3, 0)):
-        shape, _, dtype = np.lib.format.read_array_header_2_0(stream)
-    else:
-        raise ValueError(f"{what} has an unknown .npy format version {version}")
+    try:  # the header is a Python literal: a corrupt one can fail in many ways
+        if version == (1, 0):
+            shape, _, dtype = np.lib.format.read_array_header_1_0(stream)
+        elif version in ((2, 0), (3, 0)):
+            shape, _, dtype = np.lib.format.read_array_header_2_0(stream)
+        else:
+            raise ValueError(f"{what} has an unknown .npy format version {version}")
+    except ValueError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - numpy parses the header with ast/tokenize, which fail in many ways
+        raise ValueError(f"{what} has a corrupt .npy header ({type(exc).__name__})") from None
+    if not (isinstance(shape, tuple) and all(isinstance(n, int) and n >= 0 for n in shape)):
+        raise ValueError(f"{what} has a corrupt .npy header (shape {short_token(shape, 30)})")
     if dtype.hasobject or dtype.kind not in "fiub":
         raise ValueError(f"{what} holds {dtype} data, not real numbers")
     if len(shape) > 8:
@@ -264,7 +271,12 @@ def _read_npy(open_stream, what: str, check=None) -> np.ndarray:
     with open_stream() as stream:
         _read_npy_header(stream, what, check)
     with open_stream() as stream:
-        return np.lib.format.read_array(stream, allow_pickle=False)
+        try:
+            return np.lib.format.read_array(stream, allow_pickle=False)
+        except (ValueError, EOFError, OSError):
+            raise
+        except Exception as exc:  # noqa: BLE001 - as above: a corrupt header or body
+            raise ValueError(f"{what} is not a readable .npy array ({type(exc).__name__})") from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,0 +1,498 @@
+"""Fuzzing every public entry point and every CLI command (issue 9).
+
+Contract checked on every generated input:
+
+* library: the call returns a result without NaN/inf, or raises ``ValueError``/``TypeError``;
+* CLI: exit 0, or exit 2 with exactly one line on stderr (no traceback, no "internal error");
+* both: no warning of any kind, at most 10 s per call, and the process stays below 2 GB.
+
+In CI every test runs a small number of examples (the whole module takes well under a minute);
+``make fuzz`` sets ``BIDMP_FUZZ=full`` for the long campaign (over 10 000 examples in all) and
+writes the outcome counts to ``fuzz-report.json``.
+"""
+
+import contextlib
+import dataclasses
+import io
+import json
+import os
+import resource
+import shutil
+import tempfile
+import time
+import warnings
+import zipfile
+from collections import Counter
+
+import numpy as np
+import pytest
+from conftest import curved_demo
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+import bidmp  # noqa: E402
+from bidmp.cli import main  # noqa: E402
+
+FULL = os.environ.get("BIDMP_FUZZ") == "full"
+SCALE = 20 if FULL else 1
+MAX_SECONDS = 10.0
+MAX_RSS_BYTES = 2 << 30
+OUTCOMES: Counter = Counter()
+
+
+def examples(n_ci: int) -> settings:
+    return settings(max_examples=n_ci * SCALE, deadline=None, derandomize=not FULL, database=None,
+                    suppress_health_check=list(HealthCheck))
+
+
+def _check_finite(value, where="result"):
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind in "fc":
+            assert np.all(np.isfinite(value)), f"{where} contains NaN/inf"
+    elif isinstance(value, float):
+        assert np.isfinite(value), f"{where} is {value}"
+    elif isinstance(value, (tuple, list)):
+        for index, item in enumerate(value):
+            _check_finite(item, f"{where}[{index}]")
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for field in dataclasses.fields(value):
+            # Documented NaN: an extension's similarity when G-PRM was skipped; forgetting errors of
+            # a skill before it was learned (upper triangle of the error matrix).
+            if (field.name, type(value).__name__) not in (("similarity", "ExtendedDemonstration"), ("errors", "ForgettingResult")):
+                _check_finite(getattr(value, field.name), f"{where}.{field.name}")
+
+
+def _rss_ok():
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
+    assert peak < MAX_RSS_BYTES, f"peak memory {peak / 2**30:.2f} GiB"
+
+
+def outcome(name, function, *args, **kwargs):
+    """Call a library entry point under the contract; return its result or None."""
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            result = function(*args, **kwargs)
+        except (ValueError, TypeError) as exc:
+            assert str(exc), f"{name}: an empty error message"
+            OUTCOMES[f"{name}: {type(exc).__name__}"] += 1
+            result = None
+        else:
+            _check_finite(result, name)
+            OUTCOMES[f"{name}: result"] += 1
+    elapsed = time.perf_counter() - start
+    assert elapsed < MAX_SECONDS, f"{name} took {elapsed:.1f} s"
+    return result
+
+
+def run_cli(argv, cwd):
+    out, err = io.StringIO(), io.StringIO()
+    start = time.perf_counter()
+    with warnings.catch_warnings(), contextlib.chdir(cwd):
+        warnings.simplefilter("error")
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main([str(a) for a in argv])
+            except SystemExit as exc:  # argparse: usage errors, --help
+                code = exc.code
+    elapsed = time.perf_counter() - start
+    err = err.getvalue()
+    assert elapsed < MAX_SECONDS, f"{argv} took {elapsed:.1f} s"
+    assert "Traceback" not in err and "internal error" not in err, (argv, err)
+    assert code in (0, 2), (argv, code, err)
+    if code == 2:
+        assert len(err.strip().splitlines()) == 1, (argv, err)
+    else:
+        assert "Warning" not in err, (argv, err)
+    OUTCOMES[f"cli {argv[0] if argv else '-'}: exit {code}"] += 1
+    return code
+
+
+@pytest.fixture(scope="module", autouse=True)
+def report():
+    yield
+    _rss_ok()
+    if FULL:
+        with open("fuzz-report.json", "w", encoding="utf-8") as handle:
+            json.dump({"examples": sum(OUTCOMES.values()), "outcomes": dict(sorted(OUTCOMES.items()))}, handle, indent=2)
+
+
+# ---------------------------------------------------------------------------------------------
+# Strategies
+# ---------------------------------------------------------------------------------------------
+nasty_floats = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True, width=64),
+    st.sampled_from([0.0, -0.0, 1e-300, 5e-324, 1e300, -1e300, 1e12, 1e9, 1e-9, 1.0, -1.0, 0.5, 25.0, 5000.0]),
+)
+nasty_ints = st.one_of(st.integers(-5, 5), st.sampled_from([0, 1, 2, 3, 9, 10, 50, 10**6, 10**9, 10**12, 2**63, -(2**63)]),
+                       st.integers(-(2**70), 2**70))
+anything = st.one_of(nasty_floats, nasty_ints, st.booleans(), st.none(), st.text(max_size=5),
+                     st.lists(st.floats(-10, 10), max_size=4))
+
+
+@st.composite
+def trajectories(draw, min_points=0, max_points=400, dims=(1, 2, 3, 4)):
+    """Smooth, noisy, degenerate, scaled and poisoned trajectories."""
+    kind = draw(st.sampled_from(["curve", "curve", "line", "static", "random", "tiny", "huge", "poisoned", "ragged"]))
+    n_points = draw(st.integers(min_points, max_points))
+    n_dims = draw(st.sampled_from(dims))
+    seed = draw(st.integers(0, 2**16))
+    rng = np.random.default_rng(seed)
+    if kind == "ragged":
+        return [[1.0] * draw(st.integers(1, 3)) for _ in range(max(n_points, 1))]
+    if n_points == 0:
+        return np.empty((0, n_dims))
+    y = curved_demo(max(n_points, 2), n_dims, seed)[:n_points] if n_points >= 2 else rng.normal(size=(1, n_dims))
+    if kind == "line":
+        y = np.linspace(0, 1, n_points)[:, None] * rng.normal(size=n_dims)
+    elif kind == "static":
+        y = np.ones((n_points, n_dims)) * rng.normal()
+    elif kind == "random":
+        y = rng.normal(size=(n_points, n_dims))
+    y = y * draw(st.sampled_from([1.0, 1000.0, 1e-3])) + draw(st.sampled_from([0.0, 1e3, -50.0]))
+    if kind == "tiny":
+        y = y * draw(st.sampled_from([1e-12, 1e-200, 1e-310]))
+    elif kind == "huge":
+        y = y * draw(st.sampled_from([1e10, 1e150, 1e300]))
+    elif kind == "poisoned":
+        y = y.copy()
+        y.flat[draw(st.integers(0, y.size - 1))] = draw(st.sampled_from([np.nan, np.inf, -np.inf, 1e308]))
+    return y
+
+
+points = st.one_of(st.lists(nasty_floats, min_size=0, max_size=5), st.none(), st.just("goal"),
+                   st.lists(st.floats(-5, 5), min_size=1, max_size=4))
+dmp_params = st.fixed_dictionaries({}, optional={
+    "n_kernels": nasty_ints, "alpha": nasty_floats, "beta": st.one_of(st.none(), nasty_floats),
+    "K": st.one_of(st.sampled_from(["paper", "pastor", "other"]), nasty_floats), "alpha_phase": nasty_floats,
+    "tau": nasty_floats, "regression": st.sampled_from(["lwr", "ridge", "x"]),
+    "derivatives": st.sampled_from(["gradient", "forward"]), "ridge": nasty_floats,
+    "widths": st.sampled_from(["spacing", "pydmps"]),
+})
+small_floats = st.floats(-3, 3)
+
+
+def good_demo(n_points=150, n_dims=3, seed=0):
+    return curved_demo(n_points, n_dims, seed)
+
+
+# ---------------------------------------------------------------------------------------------
+# Library entry points
+# ---------------------------------------------------------------------------------------------
+@given(trajectories(), dmp_params, points, points, st.one_of(st.none(), nasty_ints))
+@examples(60)
+def test_fuzz_dmp(y, params, goal, start, n_steps):
+    dmp = outcome("DMP.fit", bidmp.DMP(**params).fit, y)
+    if dmp is None:
+        dmp = bidmp.DMP().fit(good_demo(100, 3))
+    outcome("DMP.rollout", dmp.rollout, goal=goal, start=start, n_steps=n_steps)
+    outcome("DMP.rollout_many", dmp.rollout_many, [goal, goal] if isinstance(goal, list) else goal, n_steps=n_steps)
+    outcome("DMP.endpoint_gain", dmp.endpoint_gain, n_steps)
+
+
+@given(trajectories(), st.one_of(nasty_floats, st.floats(0.01, 0.9)), st.sampled_from(["persistence", "paper", "x"]))
+@examples(60)
+def test_fuzz_segment(y, eps_frac, method):
+    outcome("segment", bidmp.segment, y, eps_frac=eps_frac, method=method)
+    outcome("curvature", bidmp.segmentation.curvature, y)
+
+
+@given(trajectories(max_points=200), trajectories(max_points=200), st.sampled_from(["sqrt2", "2", "3"]))
+@examples(60)
+def test_fuzz_frechet(a, b, denom):
+    outcome("frechet_distance", bidmp.frechet_distance, a, b)
+    outcome("frechet_similarity", bidmp.frechet_similarity, a, b, denom=denom)
+
+
+extension_options = st.fixed_dictionaries({}, optional={
+    "eps_frac": nasty_floats, "n_samples": st.one_of(nasty_ints, st.integers(2, 400)),
+    "sigma_rel": nasty_floats, "n_neighbours": st.one_of(nasty_ints, st.integers(1, 20)),
+    "n_compare": st.one_of(nasty_ints, st.integers(3, 150)), "n_iter": st.one_of(nasty_ints, st.integers(1, 12)),
+    "rho": nasty_floats, "schedule": st.sampled_from(["geometric", "harmonic", "x"]),
+    "scaling": st.sampled_from(["axis", "similarity", "paper", "x"]), "compare": st.sampled_from(["template", "raw"]),
+    "select": st.sampled_from(["best", "last"]), "denom": st.sampled_from(["sqrt2", "2"]),
+    "method": st.sampled_from(["persistence", "paper"]),
+})
+
+
+@given(trajectories(max_points=300, dims=(2, 3)), points, st.one_of(nasty_ints, anything), extension_options)
+@examples(30)
+def test_fuzz_extend_demonstration(y, target, seed, options):
+    outcome("extend_demonstration", bidmp.extend_demonstration, y, target, seed=seed, **options)
+
+
+@given(trajectories(max_points=200, dims=(2, 3)), points, st.one_of(nasty_ints, st.integers(0, 99)),
+       st.sampled_from(["gaussian", "classic"]), extension_options)
+@examples(30)
+def test_fuzz_roadmaps(piece, target, seed, which, options):
+    from bidmp.roadmap import classic_prm, gaussian_prm
+
+    options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
+    if which == "classic":
+        options = {k: v for k, v in options.items() if k not in ("sigma_rel", "rho", "schedule")}
+        outcome("classic_prm", classic_prm, piece, target, seed=seed, **options)
+    else:
+        outcome("gaussian_prm", gaussian_prm, piece, target, seed=seed, **options)
+
+
+bls_params = st.fixed_dictionaries({}, optional={
+    "n_windows": nasty_ints, "n_mapped": nasty_ints, "n_enhance": nasty_ints, "shrink": nasty_floats, "reg": nasty_floats,
+    "l1": nasty_floats, "admm_iterations": nasty_ints, "update": st.sampled_from(["auto", "pinv", "exact_ridge", "x"]),
+    "seed": nasty_ints,
+})
+
+
+@given(trajectories(max_points=300), trajectories(max_points=300), bls_params, nasty_ints)
+@examples(50)
+def test_fuzz_bls(X, Y, params, n_nodes):
+    if isinstance(X, np.ndarray) and isinstance(Y, np.ndarray) and X.ndim == 2 and Y.ndim == 2:
+        Y = Y[: X.shape[0]] if Y.shape[0] >= X.shape[0] else Y
+    model = outcome("BLS.fit", bidmp.BLS(**params).fit, X, Y)
+    if model is not None:
+        outcome("BLS.add_enhancement_nodes", model.add_enhancement_nodes, n_nodes)
+        outcome("BLS.predict", model.predict, X)
+
+
+bidmp_params = st.fixed_dictionaries({}, optional={
+    "n_windows": st.one_of(nasty_ints, st.integers(1, 12)), "n_mapped": st.one_of(nasty_ints, st.integers(1, 12)),
+    "n_enhance": st.one_of(nasty_ints, st.integers(1, 120)), "shrink": nasty_floats, "reg": nasty_floats,
+    "increments": st.one_of(st.lists(st.one_of(nasty_ints, st.integers(1, 30)), max_size=3).map(tuple), anything),
+    "seed": nasty_ints, "derivatives": st.sampled_from(["forward", "gradient", "dmp", "x"]),
+})
+
+
+@given(trajectories(max_points=300), bidmp_params, points, st.one_of(st.sampled_from(["nearest", "latest", "x"]), nasty_ints))
+@examples(40)
+def test_fuzz_bidmp(y_dn, params, goal, skill):
+    model = bidmp.BiDMP(bidmp.DMP().fit(good_demo(120, 3)), **params)
+    outcome("BiDMP.learn", model.learn, y_dn)
+    outcome("BiDMP.rollout", model.rollout, goal=goal, skill=skill)
+
+
+@given(st.lists(trajectories(max_points=200, dims=(3,)), max_size=3))
+@examples(15)
+def test_fuzz_forgetting(demonstrations):
+    outcome("forgetting", bidmp.forgetting, bidmp.DMP().fit(good_demo(120, 3)), demonstrations, increments=(5,))
+
+
+mixture_params = st.fixed_dictionaries({}, optional={
+    "n_components": st.one_of(nasty_ints, st.integers(1, 8)), "reg_covar": nasty_floats,
+    "n_copies": st.one_of(nasty_ints, st.integers(0, 3)), "noise": nasty_floats, "seed": nasty_ints,
+})
+
+
+@given(trajectories(max_points=150), mixture_params, points, st.one_of(st.none(), nasty_ints), st.booleans())
+@examples(15)
+def test_fuzz_baselines(y, params, target, n_steps, task_parameterised):
+    from bidmp.baselines import TPGMM, GMMRegressor
+
+    if task_parameterised:
+        model = outcome("TPGMM.fit", TPGMM(**params).fit, y)
+        if model is not None:
+            outcome("TPGMM.generate", model.generate, model.means_[0, 1 : 1 + model.n_dims_] * 0, target, n_steps=n_steps)
+    else:
+        model = outcome("GMMRegressor.fit", GMMRegressor(**params).fit, y)
+        if model is not None:
+            outcome("GMMRegressor.generate", model.generate, n_steps)
+
+
+@given(st.one_of(st.text(max_size=12), anything), st.lists(st.lists(nasty_floats, min_size=1, max_size=3), max_size=6),
+       nasty_ints, nasty_floats, st.one_of(nasty_ints, anything))
+@examples(40)
+def test_fuzz_datasets(name, via, n_steps, noise, seed):
+    outcome("lasa", bidmp.datasets.lasa, name)
+    outcome("minimum_jerk", bidmp.datasets.minimum_jerk, via, n_steps, noise, seed)
+
+
+# ---------------------------------------------------------------------------------------------
+# Files: trajectories, models, scenarios
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fuzz")
+    demo = bidmp.io.save_trajectory(good_demo(150, 3), folder / "demo.csv")
+    model = bidmp.save(bidmp.DMP().fit(good_demo(150, 3)), folder / "model.npz")
+    two_d = bidmp.io.save_trajectory(good_demo(150, 2, seed=3), folder / "demo2.npy")
+    bi = bidmp.BiDMP(bidmp.DMP().fit(good_demo(150, 3)), increments=(5,))
+    bi.learn(good_demo(150, 3) + 0.2)
+    bimodel = bidmp.save(bi, folder / "bidmp.npz")
+    (folder / "dir").mkdir()
+    return {"folder": folder, "demo": demo, "model": model, "demo2": two_d, "bidmp": bimodel}
+
+
+def mutate_bytes(data: bytes, draw_ops) -> bytes:
+    data = bytearray(data)
+    for kind, position, value in draw_ops:
+        if not data:
+            break
+        position %= len(data)
+        if kind == "flip":
+            data[position] ^= value & 0xFF
+        elif kind == "cut":
+            del data[position:]
+        elif kind == "insert":
+            data[position:position] = bytes([value & 0xFF]) * (value % 7 + 1)
+        else:
+            data[position : position + 8] = b"\x00" * 8
+    return bytes(data)
+
+
+byte_ops = st.lists(st.tuples(st.sampled_from(["flip", "cut", "insert", "zero"]), st.integers(0, 2**20), st.integers(0, 2**16)),
+                    max_size=4)
+
+
+@given(st.sampled_from(["demo", "demo2", "model"]), byte_ops, st.sampled_from([".csv", ".npy", ".txt", ".npz"]))
+@examples(80)
+def test_fuzz_trajectory_files(files, source, ops, suffix):
+    data = mutate_bytes(files[source].read_bytes(), ops)
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "f" + suffix)
+        with open(path, "wb") as handle:
+            handle.write(data)
+        outcome("load_trajectory", bidmp.io.load_trajectory, path)
+
+
+csv_cell = st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr), st.text(max_size=6), st.just(""),
+                     st.sampled_from(["1e999", "0x10", "1_000", "\ufeff1", "nan", "-inf", "1e300", " 3 ", "#", "t", "x"]))
+
+
+@given(st.lists(st.lists(csv_cell, min_size=1, max_size=5), max_size=30),
+       st.sampled_from(["", "x,y\n", "t,x,y,z\n", "x,y,z\n", "\ufefft,x,y\n", "time,x,y\n", "a,b\n"]),
+       st.sampled_from([",", ";", "\t"]))
+@examples(80)
+def test_fuzz_csv_text(files, rows, header, delimiter):
+    text = header + "\n".join(delimiter.join(row) for row in rows) + "\n"
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "f.csv")
+        with open(path, "w", encoding="utf-8", errors="surrogatepass") as handle:
+            handle.write(text)
+        outcome("load_trajectory(csv)", bidmp.io.load_trajectory, path)
+
+
+@given(st.sampled_from(["model", "bidmp"]), byte_ops, st.data())
+@examples(80)
+def test_fuzz_model_files(files, source, ops, data):
+    original = files[source].read_bytes()
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "m.npz")
+        mode = data.draw(st.sampled_from(["bytes", "member", "meta"]))
+        if mode == "bytes":
+            payload = mutate_bytes(original, ops)
+            with open(path, "wb") as handle:
+                handle.write(payload)
+        else:
+            with zipfile.ZipFile(io.BytesIO(original)) as archive:
+                members = {info.filename: archive.read(info) for info in archive.infolist()}
+            if mode == "member":
+                name = data.draw(st.sampled_from(sorted(members)))
+                replacement = data.draw(st.sampled_from(["nan", "shape", "dtype", "raw", "bytes"]))
+                array = np.load(io.BytesIO(members[name])) if name != "__bidmp__.npy" else np.zeros(3)
+                if replacement == "nan":
+                    array = np.array(array, dtype=float)
+                    array.flat[0] = np.nan
+                elif replacement == "shape":
+                    array = np.ones(data.draw(st.sampled_from([(1,), (2, 2), (0,), (3, 1, 1)])))
+                elif replacement == "dtype":
+                    array = np.array(["a"] * max(array.size, 1))
+                buffer = io.BytesIO()
+                np.save(buffer, array, allow_pickle=False)
+                members[name] = (b"raw" * 10 if replacement == "raw" else mutate_bytes(buffer.getvalue(), ops)
+                                 if replacement == "bytes" else buffer.getvalue())
+            else:
+                meta = json.loads(np.load(io.BytesIO(members["__bidmp__.npy"])).tobytes())
+                path_keys = data.draw(st.lists(st.sampled_from(["state", "params", "dmp", "blocks", "n_steps_", "format_version",
+                                                                "class", "alpha", "n_kernels", "increments", "phase_min_",
+                                                                "n_blocks", "n_features_", "y_was_1d"]), min_size=1, max_size=3))
+                target = meta
+                for key in path_keys[:-1]:
+                    target = target.get(key, {}) if isinstance(target, dict) else {}
+                if isinstance(target, dict):
+                    target[path_keys[-1]] = data.draw(anything)
+                text = json.dumps(meta, allow_nan=True)
+                members["__bidmp__.npy"] = _npy(np.frombuffer(text.encode(), np.uint8))
+            with zipfile.ZipFile(path, "w") as archive:
+                for name, payload in members.items():
+                    archive.writestr(name, payload)
+        model = outcome("load", bidmp.load, path)
+        if model is not None:
+            outcome("loaded.rollout", model.rollout)
+
+
+def _npy(array):
+    buffer = io.BytesIO()
+    np.save(buffer, array, allow_pickle=False)
+    return buffer.getvalue()
+
+
+scenario_values = st.one_of(anything, st.dictionaries(st.text(max_size=4), anything, max_size=3),
+                            st.lists(st.lists(nasty_floats, min_size=3, max_size=3), max_size=4))
+scenario_keys = st.sampled_from(["name", "targets", "demonstrated", "demonstration", "success_threshold", "approach_height",
+                                 "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
+                                 "seed", "units", "colour"])
+inner_keys = {"dmp": ["alpha", "tau", "n_kernels", "alpha_phase", "K", "beta", "regression"],
+              "bidmp": ["n_enhance", "increments", "reg", "seed", "n_windows"],
+              "extension": ["n_samples", "n_iter", "rho", "sigma_rel", "n_compare", "scaling"],
+              "targets": ["nut1", "nut2", "zz"]}
+
+
+@given(st.lists(st.tuples(scenario_keys, st.one_of(st.none(), st.sampled_from(sorted({k for v in inner_keys.values() for k in v}))),
+                          scenario_values), min_size=1, max_size=3))
+@examples(60)
+def test_fuzz_scenarios(files, changes):
+    from bidmp import scenarios
+
+    data = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    for key, inner, value in changes:
+        if inner is not None and key in inner_keys and isinstance(data.get(key, {}), dict):
+            data.setdefault(key, {})[inner] = value
+        else:
+            data[key] = value
+    scenario = outcome("scenarios.from_dict", scenarios.from_dict, data, "fuzz", str(files["folder"]))
+    if scenario is not None:
+        outcome("evaluate(dmp)", bidmp.evaluate, scenario, ["dmp"])
+
+
+# ---------------------------------------------------------------------------------------------
+# The command line
+# ---------------------------------------------------------------------------------------------
+def cli_tokens(files):
+    folder = files["folder"]
+    paths = [files["demo"], files["demo2"], files["model"], files["bidmp"], folder / "dir", folder / "missing.csv",
+             "/dev/null", folder / "out.csv", folder / "out.npy", folder / "out.npz", folder / "out", folder / "dir" / "x.png",
+             "nut-unscrewing", "cell-removal", "Sshape", "nope"]
+    numbers = ["0", "1", "-1", "2", "3", "10", "25", "1e300", "-1e300", "nan", "inf", "1e-300", str(2**63), "1e12",
+               "5000", "0.001", "abc", "", ","]
+    flags = ["-o", "--goal", "--start", "--n-steps", "--skill", "--plot", "--n-kernels", "--alpha", "--beta", "--K",
+             "--alpha-phase", "--tau", "--regression", "--eps-frac", "--method", "--target", "--save-demo", "--seed",
+             "--methods", "--out", "--scenario", "--demo", "--seeds", "--allow-outside-files", "--debug-not", "--help"]
+    return [str(p) for p in paths], numbers, flags
+
+
+commands = st.sampled_from([
+    ["fit"], ["rollout"], ["segment"], ["extend"], ["lasa", "list"], ["lasa", "export"], ["scenario", "list"],
+    ["scenario", "show"], ["scenario", "check"], ["demo", "--methods", "dmp"], ["reproduce"], ["frobnicate"], [],
+])
+
+
+@given(commands, st.data())
+@examples(150)
+def test_fuzz_cli(files, command, data):
+    paths, numbers, flags = cli_tokens(files)
+    token = st.one_of(st.sampled_from(paths), st.sampled_from(numbers), st.sampled_from(flags),
+                      st.text(max_size=8).filter(lambda t: "\x00" not in t))
+    argv = list(command)
+    if command and command[0] == "reproduce":
+        # Valid reproduce runs take longer than a fuzz call may; fuzz their argument checks.
+        argv += [data.draw(st.sampled_from(["table4", "table6", "x", ""])), "--seeds",
+                 data.draw(st.sampled_from(["0", "-1", "1001", "1e9", "abc"])), "--out", str(files["folder"] / "r")]
+    else:
+        argv += data.draw(st.lists(token, max_size=7))
+        if command and command[0] in ("fit", "rollout", "segment", "extend") and data.draw(st.booleans()):
+            argv = [command[0], data.draw(st.sampled_from(paths))] + argv[1:]
+    if "--help" in argv or "-h" in argv:
+        argv.remove("--help") if "--help" in argv else argv.remove("-h")
+    run_cli(argv, files["folder"] / "dir")
+    shutil.rmtree(files["folder"] / "out", ignore_errors=True)
