@@ -25,7 +25,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse, but usage errors are one line (plus a pointer to --help), exit code 2."""
 
     def error(self, message: str):  # noqa: D401 - argparse API
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+        self.exit(EXIT_BAD_INPUT, _one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
 
 
 def _parse_K(text: str):
@@ -424,7 +424,9 @@ class _BufferedLog(logging.Handler):
 
 
 def _one_line(text: str) -> str:
-    text = " ".join(str(text).split())
+    """One printable line: whitespace runs collapsed, control characters (a file name or argument
+    may carry terminal escapes) shown as '?', at most _MAX_MESSAGE characters."""
+    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))
     return text if len(text) <= _MAX_MESSAGE else text[: _MAX_MESSAGE - 1] + "…"
 
 

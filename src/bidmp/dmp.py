@@ -33,6 +33,7 @@ system has not converged, and the end point misses a shifted goal ``g'`` by exac
 
 from __future__ import annotations
 
+import cmath
 import logging
 from typing import NamedTuple
 
@@ -99,8 +100,10 @@ def euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
     polynomial ``r² − (2 − hα) r + (1 − hα + h²αβ)``; the integration is stable iff both roots lie
     inside the unit circle (for ``β = α/4``: iff ``h α < 4``).
     """
-    roots = np.roots([1.0, -(2.0 - step * alpha), 1.0 - step * alpha + step * step * alpha * beta])
-    return float(np.max(np.abs(roots)))
+    trace = 2.0 - step * alpha
+    determinant = 1.0 - step * alpha + step * step * alpha * beta
+    root = cmath.sqrt(trace * trace / 4.0 - determinant)  # closed form: this runs on every rollout
+    return max(abs(trace / 2.0 + root), abs(trace / 2.0 - root))
 
 
 def _max_stable_step(alpha: float, beta: float, step: float) -> float:
