@@ -88,7 +88,7 @@ def outcome(name, function, *args, **kwargs):
     return result
 
 
-def run_cli(argv, cwd):
+def run_cli(argv, cwd, label=None):
     out, err = io.StringIO(), io.StringIO()
     start = time.perf_counter()
     with warnings.catch_warnings(), contextlib.chdir(cwd):
@@ -107,7 +107,7 @@ def run_cli(argv, cwd):
         assert len(err.strip().splitlines()) == 1, (argv, err)
     else:
         assert "Warning" not in err, (argv, err)
-    OUTCOMES[f"cli {argv[0] if argv else '-'}: exit {code}"] += 1
+    OUTCOMES[f"cli {label or (argv[0] if argv else '-')}: exit {code}"] += 1
     return code
 
 
@@ -129,6 +129,11 @@ nasty_floats = st.one_of(
 )
 nasty_ints = st.one_of(st.integers(-5, 5), st.sampled_from([0, 1, 2, 3, 9, 10, 50, 10**6, 10**9, 10**12, 2**63, -(2**63)]),
                        st.integers(-(2**70), 2**70))
+def maybe(valid, nasty=None):
+    """Mostly valid values, sometimes nasty ones: both paths get exercised."""
+    return st.one_of(valid, valid, valid, nasty if nasty is not None else nasty_floats)
+
+
 anything = st.one_of(nasty_floats, nasty_ints, st.booleans(), st.none(), st.text(max_size=5),
                      st.lists(st.floats(-10, 10), max_size=4))
 
@@ -136,7 +141,7 @@ anything = st.one_of(nasty_floats, nasty_ints, st.booleans(), st.none(), st.text
 @st.composite
 def trajectories(draw, min_points=0, max_points=400, dims=(1, 2, 3, 4)):
     """Smooth, noisy, degenerate, scaled and poisoned trajectories."""
-    kind = draw(st.sampled_from(["curve", "curve", "line", "static", "random", "tiny", "huge", "poisoned", "ragged"]))
+    kind = draw(st.sampled_from(["curve"] * 6 + ["line", "static", "random", "tiny", "huge", "poisoned", "ragged"]))
     n_points = draw(st.integers(min_points, max_points))
     n_dims = draw(st.sampled_from(dims))
     seed = draw(st.integers(0, 2**16))
@@ -164,13 +169,15 @@ def trajectories(draw, min_points=0, max_points=400, dims=(1, 2, 3, 4)):
 
 
 points = st.one_of(st.lists(nasty_floats, min_size=0, max_size=5), st.none(), st.just("goal"),
-                   st.lists(st.floats(-5, 5), min_size=1, max_size=4))
+                   st.lists(st.floats(-5, 5), min_size=1, max_size=4), st.lists(st.floats(-5, 5), min_size=3, max_size=3),
+                   st.lists(st.floats(-5, 5), min_size=3, max_size=3), st.lists(st.floats(-5, 5), min_size=2, max_size=2))
 dmp_params = st.fixed_dictionaries({}, optional={
-    "n_kernels": nasty_ints, "alpha": nasty_floats, "beta": st.one_of(st.none(), nasty_floats),
-    "K": st.one_of(st.sampled_from(["paper", "pastor", "other"]), nasty_floats), "alpha_phase": nasty_floats,
-    "tau": nasty_floats, "regression": st.sampled_from(["lwr", "ridge", "x"]),
-    "derivatives": st.sampled_from(["gradient", "forward"]), "ridge": nasty_floats,
-    "widths": st.sampled_from(["spacing", "pydmps"]),
+    "n_kernels": maybe(st.integers(1, 200), nasty_ints), "alpha": maybe(st.floats(1.0, 200.0)),
+    "beta": st.one_of(st.none(), maybe(st.floats(0.5, 50.0))),
+    "K": st.one_of(st.sampled_from(["paper", "pastor", "other"]), maybe(st.floats(1.0, 1e3))),
+    "alpha_phase": maybe(st.floats(0.1, 5.0)), "tau": maybe(st.floats(0.2, 5.0)),
+    "regression": st.sampled_from(["lwr", "ridge", "x"]), "derivatives": st.sampled_from(["gradient", "forward"]),
+    "ridge": maybe(st.floats(0.0, 1e-3)), "widths": st.sampled_from(["spacing", "pydmps"]),
 })
 small_floats = st.floats(-3, 3)
 
@@ -208,23 +215,24 @@ def test_fuzz_frechet(a, b, denom):
 
 
 extension_options = st.fixed_dictionaries({}, optional={
-    "eps_frac": nasty_floats, "n_samples": st.one_of(nasty_ints, st.integers(2, 400)),
-    "sigma_rel": nasty_floats, "n_neighbours": st.one_of(nasty_ints, st.integers(1, 20)),
-    "n_compare": st.one_of(nasty_ints, st.integers(3, 150)), "n_iter": st.one_of(nasty_ints, st.integers(1, 12)),
-    "rho": nasty_floats, "schedule": st.sampled_from(["geometric", "harmonic", "x"]),
+    "eps_frac": maybe(st.floats(0.01, 0.5)), "n_samples": maybe(st.integers(2, 400), nasty_ints),
+    "sigma_rel": maybe(st.floats(0.0, 0.2)), "n_neighbours": maybe(st.integers(1, 20), nasty_ints),
+    "n_compare": maybe(st.integers(3, 150), nasty_ints), "n_iter": maybe(st.integers(1, 12), nasty_ints),
+    "rho": maybe(st.floats(0.1, 1.0)), "schedule": st.sampled_from(["geometric", "harmonic", "x"]),
     "scaling": st.sampled_from(["axis", "similarity", "paper", "x"]), "compare": st.sampled_from(["template", "raw"]),
     "select": st.sampled_from(["best", "last"]), "denom": st.sampled_from(["sqrt2", "2"]),
     "method": st.sampled_from(["persistence", "paper"]),
 })
 
 
-@given(trajectories(max_points=300, dims=(2, 3)), points, st.one_of(nasty_ints, anything), extension_options)
+@given(trajectories(max_points=300, dims=(2, 3)), points, maybe(st.integers(0, 2**32), st.one_of(nasty_ints, anything)),
+       extension_options)
 @examples(30)
 def test_fuzz_extend_demonstration(y, target, seed, options):
     outcome("extend_demonstration", bidmp.extend_demonstration, y, target, seed=seed, **options)
 
 
-@given(trajectories(max_points=200, dims=(2, 3)), points, st.one_of(nasty_ints, st.integers(0, 99)),
+@given(trajectories(max_points=200, dims=(2, 3)), points, maybe(st.integers(0, 99), nasty_ints),
        st.sampled_from(["gaussian", "classic"]), extension_options)
 @examples(30)
 def test_fuzz_roadmaps(piece, target, seed, which, options):
@@ -239,13 +247,15 @@ def test_fuzz_roadmaps(piece, target, seed, which, options):
 
 
 bls_params = st.fixed_dictionaries({}, optional={
-    "n_windows": nasty_ints, "n_mapped": nasty_ints, "n_enhance": nasty_ints, "shrink": nasty_floats, "reg": nasty_floats,
-    "l1": nasty_floats, "admm_iterations": nasty_ints, "update": st.sampled_from(["auto", "pinv", "exact_ridge", "x"]),
-    "seed": nasty_ints,
+    "n_windows": maybe(st.integers(1, 12), nasty_ints), "n_mapped": maybe(st.integers(1, 12), nasty_ints),
+    "n_enhance": maybe(st.integers(1, 150), nasty_ints), "shrink": maybe(st.floats(0.1, 2.0)),
+    "reg": maybe(st.sampled_from([0.0, 1e-8, 1e-4, 1e-2])), "l1": maybe(st.floats(0.0, 0.1)),
+    "admm_iterations": maybe(st.integers(1, 60), nasty_ints), "update": st.sampled_from(["auto", "pinv", "exact_ridge", "x"]),
+    "seed": maybe(st.integers(0, 100), nasty_ints),
 })
 
 
-@given(trajectories(max_points=300), trajectories(max_points=300), bls_params, nasty_ints)
+@given(trajectories(max_points=300), trajectories(max_points=300), bls_params, maybe(st.integers(1, 50), nasty_ints))
 @examples(50)
 def test_fuzz_bls(X, Y, params, n_nodes):
     if isinstance(X, np.ndarray) and isinstance(Y, np.ndarray) and X.ndim == 2 and Y.ndim == 2:
@@ -258,13 +268,16 @@ def test_fuzz_bls(X, Y, params, n_nodes):
 
 bidmp_params = st.fixed_dictionaries({}, optional={
     "n_windows": st.one_of(nasty_ints, st.integers(1, 12)), "n_mapped": st.one_of(nasty_ints, st.integers(1, 12)),
-    "n_enhance": st.one_of(nasty_ints, st.integers(1, 120)), "shrink": nasty_floats, "reg": nasty_floats,
-    "increments": st.one_of(st.lists(st.one_of(nasty_ints, st.integers(1, 30)), max_size=3).map(tuple), anything),
-    "seed": nasty_ints, "derivatives": st.sampled_from(["forward", "gradient", "dmp", "x"]),
+    "n_enhance": st.one_of(nasty_ints, st.integers(1, 120)), "shrink": maybe(st.floats(0.1, 2.0)),
+    "reg": maybe(st.sampled_from([1e-6, 1e-4, 1e-2])),
+    "increments": st.one_of(st.lists(st.integers(1, 30), max_size=3).map(tuple),
+                            st.lists(st.one_of(nasty_ints, st.integers(1, 30)), max_size=3).map(tuple), anything),
+    "seed": maybe(st.integers(0, 100), nasty_ints), "derivatives": st.sampled_from(["forward", "gradient", "dmp", "x"]),
 })
 
 
-@given(trajectories(max_points=300), bidmp_params, points, st.one_of(st.sampled_from(["nearest", "latest", "x"]), nasty_ints))
+@given(trajectories(max_points=300, dims=(3,)), bidmp_params, points,
+       st.one_of(st.sampled_from(["nearest", "latest", "nearest", "x"]), nasty_ints))
 @examples(40)
 def test_fuzz_bidmp(y_dn, params, goal, skill):
     model = bidmp.BiDMP(bidmp.DMP().fit(good_demo(120, 3)), **params)
@@ -279,8 +292,9 @@ def test_fuzz_forgetting(demonstrations):
 
 
 mixture_params = st.fixed_dictionaries({}, optional={
-    "n_components": st.one_of(nasty_ints, st.integers(1, 8)), "reg_covar": nasty_floats,
-    "n_copies": st.one_of(nasty_ints, st.integers(0, 3)), "noise": nasty_floats, "seed": nasty_ints,
+    "n_components": maybe(st.integers(1, 8), nasty_ints), "reg_covar": maybe(st.floats(1e-6, 1e-2)),
+    "n_copies": maybe(st.integers(0, 3), nasty_ints), "noise": maybe(st.floats(0.0, 2.0)),
+    "seed": maybe(st.integers(0, 100), nasty_ints),
 })
 
 
@@ -292,15 +306,17 @@ def test_fuzz_baselines(y, params, target, n_steps, task_parameterised):
     if task_parameterised:
         model = outcome("TPGMM.fit", TPGMM(**params).fit, y)
         if model is not None:
-            outcome("TPGMM.generate", model.generate, model.means_[0, 1 : 1 + model.n_dims_] * 0, target, n_steps=n_steps)
+            outcome("TPGMM.generate", model.generate, np.zeros(model.n_dims_), target, n_steps=n_steps)
     else:
         model = outcome("GMMRegressor.fit", GMMRegressor(**params).fit, y)
         if model is not None:
             outcome("GMMRegressor.generate", model.generate, n_steps)
 
 
-@given(st.one_of(st.text(max_size=12), anything), st.lists(st.lists(nasty_floats, min_size=1, max_size=3), max_size=6),
-       nasty_ints, nasty_floats, st.one_of(nasty_ints, anything))
+@given(maybe(st.sampled_from(["Sshape", "WShape", "Angle", "heee"]), st.one_of(st.text(max_size=12), anything)),
+       maybe(st.lists(st.lists(st.floats(-100, 100), min_size=3, max_size=3), min_size=2, max_size=6),
+             st.lists(st.lists(nasty_floats, min_size=1, max_size=3), max_size=6)),
+       maybe(st.integers(3, 3000), nasty_ints), maybe(st.floats(0.0, 3.0)), maybe(st.integers(0, 2**32), anything))
 @examples(40)
 def test_fuzz_datasets(name, via, n_steps, noise, seed):
     outcome("lasa", bidmp.datasets.lasa, name)
@@ -320,6 +336,7 @@ def files(tmp_path_factory):
     bi.learn(good_demo(150, 3) + 0.2)
     bimodel = bidmp.save(bi, folder / "bidmp.npz")
     (folder / "dir").mkdir()
+    (folder / "out").mkdir()
     return {"folder": folder, "demo": demo, "model": model, "demo2": two_d, "bidmp": bimodel}
 
 
@@ -359,11 +376,23 @@ csv_cell = st.one_of(st.floats(allow_nan=True, allow_infinity=True).map(repr), s
                      st.sampled_from(["1e999", "0x10", "1_000", "\ufeff1", "nan", "-inf", "1e300", " 3 ", "#", "t", "x"]))
 
 
-@given(st.lists(st.lists(csv_cell, min_size=1, max_size=5), max_size=30),
-       st.sampled_from(["", "x,y\n", "t,x,y,z\n", "x,y,z\n", "\ufefft,x,y\n", "time,x,y\n", "a,b\n"]),
-       st.sampled_from([",", ";", "\t"]))
+@given(st.data(), st.sampled_from(["", "x,y\n", "t,x,y,z\n", "x,y,z\n", "\ufefft,x,y\n", "time,x,y\n", "a,b\n"]),
+       st.sampled_from([",", ",", ";", "\t"]))
 @examples(80)
-def test_fuzz_csv_text(files, rows, header, delimiter):
+def test_fuzz_csv_text(files, data, header, delimiter):
+    n_columns = data.draw(st.integers(1, 5))
+    n_rows = data.draw(st.integers(0, 40))
+    values = curved_demo(max(n_rows, 2), n_columns, data.draw(st.integers(0, 99)))[:n_rows]
+    if header.startswith(("t,", "\ufefft", "time")):
+        values[:, 0] = np.sort(np.abs(values[:, 0])) * 10 + np.arange(n_rows) * 0.004 + 1.7e9 * data.draw(st.booleans())
+    rows = [[repr(float(v)) for v in row] for row in values]
+    for _ in range(data.draw(st.integers(0, 3))):  # a few broken cells or rows
+        if rows:
+            row = rows[data.draw(st.integers(0, len(rows) - 1))]
+            if data.draw(st.booleans()):
+                row[data.draw(st.integers(0, len(row) - 1))] = data.draw(csv_cell)
+            else:
+                row.append(data.draw(csv_cell))
     text = header + "\n".join(delimiter.join(row) for row in rows) + "\n"
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, "f.csv")
@@ -471,28 +500,60 @@ def cli_tokens(files):
     return [str(p) for p in paths], numbers, flags
 
 
-commands = st.sampled_from([
-    ["fit"], ["rollout"], ["segment"], ["extend"], ["lasa", "list"], ["lasa", "export"], ["scenario", "list"],
-    ["scenario", "show"], ["scenario", "check"], ["demo", "--methods", "dmp"], ["reproduce"], ["frobnicate"], [],
-])
+def cli_templates(files):
+    """A valid command line per command (the mutations below break them in every way)."""
+    folder = files["folder"]
+    scenario = folder / "scenario.json"
+    if not scenario.exists():
+        data = json.loads(bidmp.scenarios.builtin_text("pick-and-place"))
+        data["methods"] = ["dmp", "bidmp"]
+        scenario.write_text(json.dumps(data))
+    out = folder / "out"
+    return {
+        "fit": ["fit", files["demo"], "-o", out / "m.npz", "--alpha", "25", "--n-kernels", "30"],
+        "rollout": ["rollout", files["model"], "-o", out / "r.csv", "--goal", "0.5", "0.2", "0.1", "--n-steps", "300"],
+        "rollout-bidmp": ["rollout", files["bidmp"], "-o", out / "r.npy", "--skill", "nearest", "--goal", "0.1", "0", "0"],
+        "segment": ["segment", files["demo"], "--eps-frac", "0.1", "--method", "persistence"],
+        "extend": ["extend", files["model"], files["demo"], "--target", "1.2", "0.9", "-0.4", "-o", out / "e.npz"],
+        "lasa-list": ["lasa", "list"],
+        "lasa-export": ["lasa", "export", "Sshape", "--demo", "2", "-o", out / "s.csv"],
+        "scenario-list": ["scenario", "list"],
+        "scenario-show": ["scenario", "show", "cell-removal"],
+        "scenario-check": ["scenario", "check", scenario],
+        "demo": ["demo", "--scenario", scenario, "--methods", "dmp", "--out", out / "demo"],
+        "reproduce": ["reproduce", "table6", "--seeds", "3", "--out", out / "rep"],  # invalid: a valid run is too long
+        "none": [],
+    }
 
 
-@given(commands, st.data())
+@given(st.data())
 @examples(150)
-def test_fuzz_cli(files, command, data):
+def test_fuzz_cli(files, data):
     paths, numbers, flags = cli_tokens(files)
+    templates = cli_templates(files)
+    name = data.draw(st.sampled_from(sorted(templates)))
+    argv = [str(token) for token in templates[name]]
     token = st.one_of(st.sampled_from(paths), st.sampled_from(numbers), st.sampled_from(flags),
                       st.text(max_size=8).filter(lambda t: "\x00" not in t))
-    argv = list(command)
-    if command and command[0] == "reproduce":
-        # Valid reproduce runs take longer than a fuzz call may; fuzz their argument checks.
-        argv += [data.draw(st.sampled_from(["table4", "table6", "x", ""])), "--seeds",
-                 data.draw(st.sampled_from(["0", "-1", "1001", "1e9", "abc"])), "--out", str(files["folder"] / "r")]
-    else:
-        argv += data.draw(st.lists(token, max_size=7))
-        if command and command[0] in ("fit", "rollout", "segment", "extend") and data.draw(st.booleans()):
-            argv = [command[0], data.draw(st.sampled_from(paths))] + argv[1:]
-    if "--help" in argv or "-h" in argv:
-        argv.remove("--help") if "--help" in argv else argv.remove("-h")
-    run_cli(argv, files["folder"] / "dir")
+    for _ in range(data.draw(st.integers(0, 3))):
+        action = data.draw(st.sampled_from(["replace", "replace", "delete", "insert"]))
+        if action == "insert" or not argv:
+            argv.insert(data.draw(st.integers(0, len(argv))), data.draw(token))
+        elif action == "replace":
+            argv[data.draw(st.integers(0, len(argv) - 1))] = data.draw(token)
+        elif len(argv) > 1:
+            del argv[data.draw(st.integers(1, len(argv) - 1))]
+    argv = [a for a in argv if a not in ("--help", "-h")]
+    if "reproduce" in argv[:1] and "--seeds" not in argv:
+        return  # a real reproduce run takes longer than a fuzz call may (tests/test_cli.py runs them)
+    if argv[:1] == ["reproduce"] and any(a in argv for a in ("table4", "table5", "figures")):
+        seeds = argv[argv.index("--seeds") + 1] if argv.index("--seeds") + 1 < len(argv) else ""
+        if seeds.isdigit() and 1 <= int(seeds) <= 1000:
+            return
+    code = run_cli(argv, files["folder"] / "dir", label=name)
+    if not argv[1:] or name == "none":
+        return
+    if code == 0 and name in ("fit", "extend"):
+        assert np.all(np.isfinite(bidmp.load(argv[argv.index("-o") + 1]).rollout())) if "-o" in argv else True
     shutil.rmtree(files["folder"] / "out", ignore_errors=True)
+    (files["folder"] / "out").mkdir()
