@@ -323,6 +323,39 @@ def test_fuzz_datasets(name, via, n_steps, noise, seed):
     outcome("minimum_jerk", bidmp.datasets.minimum_jerk, via, n_steps, noise, seed)
 
 
+@given(trajectories(max_points=100), trajectories(max_points=100), points, maybe(st.floats(0.1, 50.0)))
+@examples(40)
+def test_fuzz_metrics(a, b, target, height):
+    from bidmp import metrics
+
+    outcome("metrics.endpoint_error", metrics.endpoint_error, a, target)
+    outcome("metrics.approach_error", metrics.approach_error, a, target, height)
+    outcome("metrics.path_difference", metrics.path_difference, a, b)
+    outcome("metrics.rmse", metrics.rmse, a, b)
+    outcome("metrics.path_extent", metrics.path_extent, a)
+
+
+@given(maybe(st.sampled_from(["Sshape", "Angle"]), st.text(max_size=6)), maybe(st.integers(0, 6), nasty_ints),
+       maybe(st.integers(1, 4), nasty_ints), maybe(st.floats(0.0, 1.0)), maybe(st.integers(1, 3), nasty_ints))
+@examples(10)
+def test_fuzz_reproduce_entry_points(name, demo_index, n_goals, shift, factor):
+    from bidmp import reproduce
+
+    outcome("reproduce.lasa_generalisation", reproduce.lasa_generalisation, name, demo_index=demo_index,
+            n_goals=n_goals, shift=shift, convergence_factor=factor)
+    outcome("reproduce.compare_prm", reproduce.compare_prm, good_demo(100, 2), [1.5, 1.5], n_seeds=n_goals)
+
+
+@given(trajectories(max_points=120, dims=(2, 3)), st.lists(trajectories(max_points=120, dims=(2, 3)), max_size=2), points)
+@examples(8)
+def test_fuzz_plot_trajectories(demo, rollouts, goal):
+    from bidmp.plotting import plot_trajectories
+
+    with tempfile.TemporaryDirectory() as folder:
+        outcome("plot_trajectories", plot_trajectories, os.path.join(folder, "p.png"), demo, rollouts,
+                [f"r{i}" for i in range(len(rollouts))], goals=None if goal is None or goal == "goal" else [goal])
+
+
 # ---------------------------------------------------------------------------------------------
 # Files: trajectories, models, scenarios
 # ---------------------------------------------------------------------------------------------

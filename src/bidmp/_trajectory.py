@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._checks import numerically_guarded
+
 __all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent"]
 
 
@@ -49,15 +51,24 @@ def resample_time(y, n_samples: int) -> np.ndarray:
     return out
 
 
+@numerically_guarded
 def rmse(a, b) -> float:
     """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     if a.shape != b.shape:
         raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
+    if a.size == 0:
+        raise ValueError("rmse of empty trajectories")
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ValueError("rmse: the trajectories contain NaN or inf")
     return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
 
 
+@numerically_guarded
 def path_extent(y) -> float:
     """Diagonal of the axis-aligned bounding box of a trajectory (same unit as ``y``)."""
+    y = np.asarray(y, dtype=np.float64)
+    if y.ndim != 2 or y.shape[0] == 0 or not np.all(np.isfinite(y)):
+        raise ValueError(f"path_extent needs a finite, non-empty (T, D) trajectory, got shape {y.shape}")
     return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=np.float64), axis=0)))

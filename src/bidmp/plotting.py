@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._checks import as_points, as_trajectory
 from .io import atomic_write
 
 __all__ = ["plot_trajectories", "plot_generalisation", "plot_segmentation", "plot_extension", "plot_prm_comparison", "plot_incremental", "plot_targets_top_view",
@@ -82,10 +83,16 @@ def plot_trajectories(
     labels : one legend entry per trajectory (optional).
     goals : array, shape (G, D), optional; drawn as stars.
     """
-    demonstration = np.asarray(demonstration, dtype=float)
+    demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
     n_dims = demonstration.shape[1]
     if n_dims not in (1, 2, 3):
         raise ValueError(f"can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
+    trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True) for i, t in enumerate(trajectories)]
+    for index, trajectory in enumerate(trajectories):
+        if trajectory.shape[1] != n_dims:
+            raise ValueError(f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}")
+    if goals is not None:
+        goals = as_points(goals, n_dims, "goals")
     mpl, fig, ax = _figure(n_dims == 3)
 
     def coords(points: np.ndarray):
@@ -101,7 +108,6 @@ def plot_trajectories(
         label = labels[index] if labels is not None and index < len(labels) else None
         ax.plot(*coords(trajectory), color=colours[index], linewidth=1.5, label=label)
     if goals is not None and n_dims > 1:
-        goals = np.asarray(goals, dtype=float).reshape(-1, n_dims)
         ax.scatter(*[goals[:, i] for i in range(n_dims)], marker="*", s=140, color="crimson", zorder=6, label="goals")
     suffix = f" [{units}]" if units else ""
     names = ("x", "y", "z")

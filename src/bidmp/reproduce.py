@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._checks import as_points, check_int, check_real
 from ._tables import markdown_table, text_table
 from ._trajectory import path_extent, resample_time, rmse
 from .datasets import lasa, minimum_jerk
@@ -26,6 +27,8 @@ from .extension import ExtendedDemonstration, extend_demonstration
 from .incremental import BiDMP, ForgettingResult, forgetting_runs
 from .io import atomic_write
 from .roadmap import RoadmapResult, classic_prm, gaussian_prm
+
+MAX_SEEDS = 1000  # seeds of one G-PRM vs PRM comparison (each seed runs both roadmaps)
 
 __all__ = [
     "GeneralisationResult",
@@ -152,12 +155,10 @@ def lasa_generalisation(
     reached twice: with the paper's fixed horizon (T steps; the end-point error is
     ``endpoint_gain · shift``) and run ``convergence_factor`` times longer (error → 0).
     """
-    if not 0 <= demo_index < 7:
-        raise ValueError(f"demo_index must be 0-6 (LASA has 7 demonstrations per shape), got {demo_index}")
-    if n_goals < 1:
-        raise ValueError(f"n_goals must be >= 1, got {n_goals}")
-    if convergence_factor < 1:
-        raise ValueError(f"convergence_factor must be >= 1, got {convergence_factor}")
+    demo_index = check_int(demo_index, "demo_index", minimum=0, maximum=6)  # LASA has 7 demonstrations per shape
+    n_goals = check_int(n_goals, "n_goals", minimum=1, limit="max_targets")
+    convergence_factor = check_int(convergence_factor, "convergence_factor", minimum=1, maximum=1000)
+    shift = check_real(shift, "shift", nonnegative=True, maximum=1e3)
     demonstration = lasa(name)[demo_index]
     dmp = DMP(**dmp_params).fit(demonstration)
     angles = np.linspace(0.0, 2.0 * np.pi, n_goals, endpoint=False)
@@ -232,8 +233,7 @@ def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int 
     Seeds ``0 … n_seeds − 1``; ``options`` go to :func:`extend_demonstration` (segmentation and
     roadmap options shared by both methods).
     """
-    if n_seeds < 1:
-        raise ValueError(f"n_seeds must be >= 1, got {n_seeds}")
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1, maximum=MAX_SEEDS)
     extension = extend_demonstration(y, new_target, seed=0, **options)
     roadmap_options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
     prm_options = {k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")}
@@ -295,6 +295,7 @@ class Table5:
 def run_table5(n_seeds: int = 20, progress: Callable | None = None) -> Table5:
     """G-PRM vs classic PRM on every case of :func:`table5_cases`. ``progress`` wraps the case
     iterator (e.g. ``tqdm``)."""
+    n_seeds = check_int(n_seeds, "n_seeds", minimum=1, maximum=MAX_SEEDS)
     cases = table5_cases().items()
     iterator = progress(cases) if progress is not None else cases
     return Table5([compare_prm(y, target, name=name, units=units, n_seeds=n_seeds) for name, (y, target, units) in iterator],
@@ -350,8 +351,11 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
     learn the extensions in turn with a Bi-DMP; measure reproduction and forgetting (one
     learning pass: the forgetting measurement learns into the model that is then rolled out)."""
     demonstration = lasa(name)[0]
+    offsets = as_points(offsets, 2, "offsets")
+    check_int(offsets.shape[0], "the number of offsets", limit="max_targets")
+    seed = check_int(seed, "seed", minimum=0, maximum=2**32)
     dmp = DMP().fit(demonstration)
-    targets = demonstration[-1] + np.asarray(offsets, dtype=float) * path_extent(demonstration)
+    targets = demonstration[-1] + offsets * path_extent(demonstration)
     extensions = [extend_demonstration(demonstration, target, seed=seed + index) for index, target in enumerate(targets)]
     model = BiDMP(dmp, **bidmp_params)
     runs = forgetting_runs(model, [extension.complete for extension in extensions], ("nearest", "latest"))
