@@ -98,8 +98,10 @@ def set_meta(path, change):
 # --- 1. CLI: huge or malformed files and sizes are one line, exit 2, within seconds --------------
 def test_csv_field_over_the_csv_module_limit(tmp_path):
     path = tmp_path / "long.csv"
-    path.write_text("x,y\n0,0\n" + "1" * 200_000 + ",1\n2,2\n")
+    path.write_text("x,y\n0,0\n" + "a" * 200_000 + ",1\n2,2\n")
     assert_one_line_error(["fit", path, "-o", tmp_path / "m.npz"], "not a CSV row")
+    path.write_text("x,y\n0,0\n" + "1" * 200_000 + ",1\n2,2\n")  # a number beyond float64
+    assert_one_line_error(["fit", path, "-o", tmp_path / "m.npz"], "contains inf")
 
 
 def test_npz_renamed_npy_and_raw_members(tmp_path, model_file):
@@ -164,6 +166,10 @@ def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
     code, out, err = cli(["segment", path], seconds=20.0)
     assert code == 0, err
     assert "1000000 samples" in out
+    csv_path = tmp_path / "long.csv"
+    np.savetxt(csv_path, np.column_stack([1.7e9 + t * 4000.0, y]), delimiter=",", header="t,x,y,z", comments="", fmt="%.6f")
+    code, out, err = cli(["segment", csv_path], seconds=20.0)
+    assert code == 0 and "1000000 samples" in out, err
     started = time.perf_counter()
     points = bidmp.segment(y).points
     assert time.perf_counter() - started < 5.0

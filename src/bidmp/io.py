@@ -26,6 +26,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import glob
+import itertools
 import json
 import logging
 import os
@@ -33,6 +34,7 @@ import re
 import stat
 import tempfile
 import time
+import warnings
 import zipfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -477,7 +479,8 @@ def load_model(path: str | os.PathLike):
 # Trajectories
 # ---------------------------------------------------------------------------------------------
 _TIME_NAMES = ("t", "time")
-_MAX_TIME_S = 1e12  # time stamps are seconds: epoch-like stamps are ~1.7e9
+_MAX_TIME_S = 1e12
+_SLOW_CSV_BYTES = 256 << 20  # time stamps are seconds: epoch-like stamps are ~1.7e9
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
 
@@ -500,45 +503,9 @@ def _check_file(path: Path, what: str) -> None:
 
 def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a CSV trajectory; return (positions (T, D), times (T,) or None)."""
-    limits = get_limits()
-    max_rows = limits.max_samples + 1  # + a header
-    max_columns = limits.max_dims + 1  # + a time column
-    rows: list[tuple[int, list[str]]] = []
-    try:
-        # utf-8-sig: Excel writes a byte-order mark at the start of UTF-8 files.
-        with open(path, newline="", encoding="utf-8-sig") as handle:
-            sample = handle.read(4096)
-            handle.seek(0)
-            delimiter = ";" if sample.count(";") > sample.count(",") else ","
-            reader = csv.reader(handle, delimiter=delimiter)
-            try:
-                for row in reader:
-                    if not any(row) or row[0].lstrip().startswith("#"):
-                        continue
-                    if len(row) > max_columns:
-                        raise ValueError(f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
-                                         f"max_dims = {limits.max_dims} allows (plus a time column)")
-                    rows.append((reader.line_num, [cell.strip() for cell in row]))
-                    if len(rows) > max_rows:
-                        raise ValueError(f"{path}: more than {limits.max_samples:,} rows, the limit max_samples; "
-                                         f"raise it with bidmp.set_limits(max_samples=...)")
-            except csv.Error as exc:
-                raise ValueError(f"{path} line {reader.line_num}: not a CSV row ({exc})") from None
-    except UnicodeDecodeError:
-        raise ValueError(f"{path} is not a UTF-8 text CSV file") from None
-    if not rows:
-        raise ValueError(f"{path} is empty: no data rows")
-
-    columns: tuple[str, ...] | None = None
-    _, first_row = rows[0]
-    if any(_parse_float(cell) is None for cell in first_row):
-        columns = tuple(cell.lower() for cell in first_row)
-        rows = rows[1:]
-        if not rows:
-            raise ValueError(f"{path} has a header but no data rows")
-    n_columns = len(columns) if columns else len(rows[0][1])
-    values = _csv_values(rows, n_columns, path)
-
+    parsed = _csv_fast(path)
+    columns, values = parsed if parsed is not None else _csv_rows(path)
+    n_columns = values.shape[1]
     if columns is not None:
         has_time = columns[0] in _TIME_NAMES
         names = columns[1:] if has_time else columns
@@ -554,6 +521,98 @@ def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     if has_time:
         return values[:, 1:], values[:, 0]
     return values, None
+
+
+def _csv_delimiter(sample: str) -> str:
+    return ";" if sample.count(";") > sample.count(",") else ","
+
+
+def _row_limit_error(path: Path) -> ValueError:
+    limit = get_limits().max_samples
+    return ValueError(f"{path}: more than {limit:,} rows, the limit max_samples; raise it with bidmp.set_limits(max_samples=...)")
+
+
+def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray] | None:
+    """The common case, parsed by NumPy's C reader (a 1e6-row recording in about a second):
+    an optional header line, then plain numbers. Returns None for anything else (quotes, ragged or
+    bad rows, odd text), which :func:`_csv_rows` then reads row by row to name the problem."""
+    limits = get_limits()
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:
+            delimiter = _csv_delimiter(handle.read(4096))
+            handle.seek(0)
+            columns, first = None, None
+            while True:
+                line = handle.readline(1 << 16)
+                if not line or not line.endswith(("\n", "\r")) and len(line) >= 1 << 16:
+                    return None  # empty, or a line too long for a plain row
+                stripped = line.strip()
+                if stripped and not stripped.startswith("#"):
+                    break
+            cells = [cell.strip() for cell in stripped.split(delimiter)]
+            if any(_parse_float(cell) is None for cell in cells):
+                columns = tuple(cell.lower() for cell in cells)
+            else:
+                first = line
+            lines = itertools.chain([first], handle) if first is not None else handle
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "empty input": the slow path words it
+                values = np.loadtxt(lines, delimiter=delimiter, comments="#", ndmin=2, dtype=np.float64,
+                                    max_rows=limits.max_samples + 1, encoding=None)
+    except (ValueError, TypeError, OSError, UnicodeDecodeError, OverflowError, MemoryError):
+        return None
+    if values.shape[0] == 0 or values.shape[1] > limits.max_dims + 1:
+        return None
+    if columns is not None and values.shape[1] != len(columns):
+        return None
+    if values.shape[0] > limits.max_samples:
+        raise _row_limit_error(path)
+    return columns, values
+
+
+def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray]:
+    """Row-by-row CSV reading with the csv module: quotes, comments, and an error that names the
+    first bad line (quoting at most a short token of it)."""
+    limits = get_limits()
+    max_rows = limits.max_samples + 1  # + a header
+    max_columns = limits.max_dims + 1  # + a time column
+    if path.stat().st_size > _SLOW_CSV_BYTES:  # Python rows take ~6x the file's size in memory
+        raise ValueError(f"{path} is not a plain numeric CSV (one optional header line, then numbers in every row), "
+                         f"and at {path.stat().st_size / 2**20:.0f} MiB it is too large to read row by row to find the "
+                         f"bad line (limit {_SLOW_CSV_BYTES >> 20} MiB)")
+    rows: list[tuple[int, list[str]]] = []
+    try:
+        # utf-8-sig: Excel writes a byte-order mark at the start of UTF-8 files.
+        with open(path, newline="", encoding="utf-8-sig") as handle:
+            delimiter = _csv_delimiter(handle.read(4096))
+            handle.seek(0)
+            reader = csv.reader(handle, delimiter=delimiter)
+            try:
+                for row in reader:
+                    if not any(row) or row[0].lstrip().startswith("#"):
+                        continue
+                    if len(row) > max_columns:
+                        raise ValueError(f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
+                                         f"max_dims = {limits.max_dims} allows (plus a time column)")
+                    rows.append((reader.line_num, [cell.strip() for cell in row]))
+                    if len(rows) > max_rows:
+                        raise _row_limit_error(path)
+            except csv.Error as exc:
+                raise ValueError(f"{path} line {reader.line_num}: not a CSV row ({exc})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path} is not a UTF-8 text CSV file") from None
+    if not rows:
+        raise ValueError(f"{path} is empty: no data rows")
+
+    columns: tuple[str, ...] | None = None
+    _, first_row = rows[0]
+    if any(_parse_float(cell) is None for cell in first_row):
+        columns = tuple(cell.lower() for cell in first_row)
+        rows = rows[1:]
+        if not rows:
+            raise ValueError(f"{path} has a header but no data rows")
+    n_columns = len(columns) if columns else len(rows[0][1])
+    return columns, _csv_values(rows, n_columns, path)
 
 
 def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path) -> np.ndarray:
