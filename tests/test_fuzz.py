@@ -587,7 +587,7 @@ def test_fuzz_cli(files, data):
     if code == 0:  # every model a successful command wrote loads and rolls out finitely
         import re
 
-        for written in re.findall(r"^wrote (\S+\.npz)", out, re.MULTILINE):
+        for written in re.findall(r"^wrote (\S+\.npz)(?=\s|$)", out, re.MULTILINE):
             written = os.path.join(files["folder"] / "dir", written)  # relative to the command's folder
             assert np.all(np.isfinite(bidmp.load(written).rollout()))
     shutil.rmtree(files["folder"] / "out", ignore_errors=True)

@@ -570,3 +570,15 @@ def test_real_recordings_survive_the_whole_cli(tmp_path):
         assert code == 0 and "RMSE" in out, err
         code, out, err = cli(["segment", recording])
         assert code == 0, err
+
+
+def test_long_noisy_minimum_jerk_is_fast_and_equals_the_direct_filter():
+    from scipy.ndimage import gaussian_filter1d
+
+    from bidmp._noise import _low_pass
+
+    noise = np.random.default_rng(1).normal(size=(30_000, 3))
+    np.testing.assert_allclose(_low_pass(noise, 600.0), gaussian_filter1d(noise, 600.0, axis=0), atol=1e-12)
+    started = time.perf_counter()
+    y = bidmp.datasets.minimum_jerk([[0, 0, 0], [100, 50, 20]], 1_000_000, noise=1.0)
+    assert time.perf_counter() - started < 5.0 and np.all(np.isfinite(y))
