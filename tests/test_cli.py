@@ -260,7 +260,7 @@ def test_reproduce_table5_writes_table_json_and_figure(tmp_path, capsys):
         (["extend", "{model}", "{demo}", "--target", "1", "nan", "0", "-o", "{tmp}/x.npz"], "NaN"),
         (["extend", "{model}", "{demo}", "--target", "1", "2", "0", "-o", "{tmp}/x.csv"], "-o must be the Bi-DMP model file"),
         (["rollout", "{model}", "--skill", "1", "-o", "{tmp}/x.csv"], "--skill needs a Bi-DMP model"),
-        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be 1-1000"),
+        (["reproduce", "table5", "--seeds", "0", "--out", "{tmp}/o"], "--seeds must be 1-200"),
     ],
 )
 def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, match, capsys):
@@ -280,3 +280,9 @@ def test_fit_tau_makes_rollouts_slower_in_real_time(tmp_path, demo_csv, capsys):
     two = np.loadtxt(tmp_path / "r2.csv", delimiter=",", skiprows=1)
     assert two.shape[0] == 2 * one.shape[0] and two[-1, 0] == pytest.approx(2 * one[-1, 0], rel=0.01)
     np.testing.assert_allclose(two[1::2, 1:], one[:, 1:], atol=0.01 * np.ptp(one[:, 1:], axis=0).max())
+
+
+def test_the_cli_seed_bound_is_the_library_one():
+    from bidmp import cli, reproduce
+
+    assert cli._MAX_SEEDS == reproduce.MAX_SEEDS

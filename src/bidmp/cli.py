@@ -18,7 +18,7 @@ from . import __version__
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
-_MAX_SEEDS = 1000  # = bidmp.reproduce.MAX_SEEDS (not imported: --help must not load NumPy)
+_MAX_SEEDS = 200  # = bidmp.reproduce.MAX_SEEDS (not imported: --help must not load NumPy)
 
 
 class _Parser(argparse.ArgumentParser):
