@@ -31,7 +31,7 @@ def test_fit_then_rollout_round_trip(tmp_path, demo_csv, capsys):
     assert code == 0 and err == ""
     assert "T = 200" in out and "end-point gain" in out and model.is_file()
     dmp = bidmp.load(model)
-    assert dmp.alpha == 100.0
+    assert dmp.alpha_value == 100.0
 
     goal = [0.5, -0.25, 1.0]
     out_csv = tmp_path / "out.csv"
@@ -134,7 +134,7 @@ def test_bad_input_gives_one_line_and_exit_code_2(tmp_path, demo_csv, argv, matc
     (tmp_path / "bad.csv").write_text("x,y\n0,0\n1,oops\n2,2\n")
     (tmp_path / "nan.csv").write_text("x,y\n0,0\nnan,1\n2,2\n")
     (tmp_path / "corrupt.npz").write_bytes(b"PK\x03\x04 broken")
-    bidmp.save(bidmp.DMP().fit(curved_demo(100, 3)), tmp_path / "model.npz")
+    bidmp.save(bidmp.DMP(protocol="paper").fit(curved_demo(100, 3)), tmp_path / "model.npz")
     code = exit_code([arg.format(tmp=tmp_path) for arg in argv])
     _, err = capsys.readouterr()
     assert code == 2

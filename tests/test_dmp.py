@@ -24,10 +24,10 @@ def euler_reference(dmp, goal, start, n_steps, start_velocity=None):
         psi = np.exp(exponent - exponent.max())  # same ratio, no 0/0 far outside the kernels
         f = phase * (psi @ dmp.weights_) / psi.sum()
         acceleration = (
-            dmp.alpha * (dmp.beta_value * (goal - y) - z) + dmp.K_value * f - dmp.K_value * phase * (goal - start)
+            dmp.alpha_value * (dmp.beta_value * (goal - y) - z) + dmp.K_value * f - dmp.K_value * phase * (goal - start)
         )
         y, z = y + h * z, z + h * acceleration
-        phase *= 1.0 - dmp.alpha_phase * dmp.dt_ / dmp.tau
+        phase *= 1.0 - dmp.alpha_phase_value * dmp.dt_ / dmp.tau
     return np.array(out)
 
 
@@ -47,7 +47,7 @@ def rel_rmse(a, b):
     ],
 )
 def test_rollout_equals_plain_euler_loop(params, demo3d):
-    dmp = DMP(**params).fit(demo3d)
+    dmp = DMP(protocol="paper", **params).fit(demo3d)
     rng = np.random.default_rng(3)
     goal, start, velocity = rng.normal(size=(3, 3))
     for n_steps in (1, 2, 3, 50, dmp.n_steps_, 3 * dmp.n_steps_):
@@ -58,7 +58,7 @@ def test_rollout_equals_plain_euler_loop(params, demo3d):
 
 
 def test_default_rollout_starts_at_demo_and_uses_its_goal(demo3d):
-    dmp = DMP().fit(demo3d)
+    dmp = DMP(protocol="paper").fit(demo3d)
     y = dmp.rollout()
     assert y.shape == demo3d.shape
     np.testing.assert_array_equal(y[0], demo3d[0])
@@ -69,37 +69,37 @@ def test_default_rollout_starts_at_demo_and_uses_its_goal(demo3d):
 def test_lasa_reproduction_below_one_percent(name):
     demos = lasa(name)
     # Demonstration 0 of these shapes starts at rest: a rollout from rest reproduces it.
-    assert rel_rmse(DMP().fit(demos[0]).rollout(), demos[0]) < 0.01
+    assert rel_rmse(DMP(protocol="paper").fit(demos[0]).rollout(), demos[0]) < 0.01
     # Some LASA recordings start in motion; given their first velocity, all seven reproduce.
     for demo in demos:
         start_velocity = (demo[1] - demo[0]) * len(demo)
-        assert rel_rmse(DMP().fit(demo).rollout(start_velocity=start_velocity), demo) < 0.01
+        assert rel_rmse(DMP(protocol="paper").fit(demo).rollout(start_velocity=start_velocity), demo) < 0.01
 
 
 def test_ridge_fit_reproduces_better_than_lwr_on_lasa():
     demo = lasa("Sshape")[0]
-    lwr = rel_rmse(DMP(regression="lwr").fit(demo).rollout(), demo)
-    ridge = rel_rmse(DMP(regression="ridge").fit(demo).rollout(), demo)
+    lwr = rel_rmse(DMP(protocol="paper", regression="lwr").fit(demo).rollout(), demo)
+    ridge = rel_rmse(DMP(protocol="paper", regression="ridge").fit(demo).rollout(), demo)
     assert ridge < lwr < 0.01
 
 
 def test_forward_differences_reproduce_almost_exactly_with_enough_kernels():
     demo = minimum_jerk([0, 0], [1, 2], 100)
-    dmp = DMP(n_kernels=100, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(protocol="paper", n_kernels=100, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
     assert rel_rmse(dmp.rollout(), demo) < 1e-4
 
 
 def test_works_for_any_dimension():
     for n_dims in (1, 2, 5):
         demo = curved_demo(200, n_dims, seed=n_dims)
-        dmp = DMP().fit(demo)
+        dmp = DMP(protocol="paper").fit(demo)
         assert dmp.rollout().shape == (200, n_dims)
         assert rel_rmse(dmp.rollout(), demo) < 0.01
 
 
 # --- affine structure, rollout_many, end-point gain -------------------------------------------
 def test_rollout_is_affine_in_goal_and_start(demo2d):
-    dmp = DMP().fit(demo2d)
+    dmp = DMP(protocol="paper").fit(demo2d)
     rng = np.random.default_rng(0)
     g1, g2, s1, s2 = rng.normal(size=(4, 2))
     lam = 0.3
@@ -109,7 +109,7 @@ def test_rollout_is_affine_in_goal_and_start(demo2d):
 
 @pytest.mark.parametrize("n_steps", [None, 37, 2000])
 def test_rollout_many_equals_looped_rollout(demo3d, n_steps):
-    dmp = DMP(alpha=60.0).fit(demo3d)
+    dmp = DMP(protocol="paper", alpha=60.0).fit(demo3d)
     rng = np.random.default_rng(1)
     goals = rng.normal(scale=2.0, size=(25, 3))
     start = rng.normal(size=3)
@@ -133,7 +133,7 @@ def scalar_goal_response(alpha, beta, K, alpha_phase, tau, dt, n_steps):
 @pytest.mark.parametrize("alpha, K", [(25.0, "paper"), (100.0, "paper"), (25.0, "pastor"), (50.0, 10.0)])
 def test_endpoint_gain_matches_scalar_recursion_and_rollout(alpha, K):
     demo = curved_demo(200, 3, seed=5)
-    dmp = DMP(alpha=alpha, K=K).fit(demo)
+    dmp = DMP(protocol="paper", alpha=alpha, K=K).fit(demo)
     c = dmp.endpoint_gain()
     expected = abs(1.0 - scalar_goal_response(alpha, dmp.beta_value, dmp.K_value, 1.0, 1.0, 1 / 200, 200))
     assert c == pytest.approx(expected, rel=1e-9)
@@ -147,20 +147,20 @@ def test_endpoint_gain_matches_scalar_recursion_and_rollout(alpha, K):
 def test_endpoint_gain_spec_values_and_convergence():
     # SPEC §1: T = 200, alpha_phase = 1, K = alpha: c = 0.0695 at alpha = 25, 0.0153 at alpha = 100.
     demo = minimum_jerk([0.0], [1.0], 200)
-    assert DMP(alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(0.0695, abs=5e-4)
-    assert DMP(alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(0.0153, abs=2e-4)
-    dmp = DMP(alpha=25.0).fit(demo)
+    assert DMP(protocol="paper", alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(0.0695, abs=5e-4)
+    assert DMP(protocol="paper", alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(0.0153, abs=2e-4)
+    dmp = DMP(protocol="paper", alpha=25.0).fit(demo)
     gains = [dmp.endpoint_gain(n) for n in (200, 400, 1000, 4000)]
     assert all(a > b for a, b in zip(gains, gains[1:]))
     assert gains[-1] < 1e-4
     # A faster phase (phase(T) ~ 0.01) shrinks c too.
-    assert DMP(alpha=25.0, alpha_phase=4.6).fit(demo).endpoint_gain() < 0.5 * gains[0]
+    assert DMP(protocol="paper", alpha=25.0, alpha_phase=4.6).fit(demo).endpoint_gain() < 0.5 * gains[0]
 
 
 def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
     # Fit with forward differences and many kernels so the demonstrated goal is hit almost exactly.
     demo = minimum_jerk([0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 200)
-    dmp = DMP(alpha=100.0, n_kernels=200, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(protocol="paper", alpha=100.0, n_kernels=200, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
     shift = np.array([150.0, 25.0, 0.0])
     error = np.linalg.norm(dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift))
     assert error == pytest.approx(dmp.endpoint_gain() * np.linalg.norm(shift), rel=1e-3)
@@ -174,12 +174,12 @@ def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
     # (and is refused, see test_unstable_euler_settings_are_refused), so those use alpha = 8.
     alpha = 25.0 if n_steps >= 10 else 8.0
     for fit in ("lwr", "ridge"):
-        dmp = DMP(regression=fit, alpha=alpha).fit(demo)
+        dmp = DMP(protocol="paper", regression=fit, alpha=alpha).fit(demo)
         phase = dmp.phase()
         assert phase[0] == 1.0 and phase.shape == (n_steps,)
         assert np.all(dmp.centres_ <= 1.0) and np.all(dmp.centres_ >= phase[-1] - 1e-15)
         assert np.all(np.isfinite(dmp.weights_))
-        target = forcing_target(demo, phase, dt=dmp.dt_, tau=1.0, alpha=dmp.alpha, beta=dmp.beta_value, K=dmp.K_value)
+        target = forcing_target(demo, phase, dt=dmp.dt_, tau=1.0, alpha=dmp.alpha_value, beta=dmp.beta_value, K=dmp.K_value)
         if fit == "lwr":  # each LWR weight is a weighted mean of f*/phase: it cannot exceed their range
             assert np.abs(dmp.weights_).max() <= np.abs(target / phase[:, None]).max() * (1 + 1e-9)
         rollout = dmp.rollout(n_steps=50 * n_steps)
@@ -215,7 +215,7 @@ def test_phase_grid_is_the_euler_canonical_system():
 def test_pastor_with_zero_weights_starts_with_zero_acceleration():
     demo = minimum_jerk([0.0, 0.0], [1.0, -2.0], 100)
     for K, zero_start in (("pastor", True), ("paper", False)):
-        dmp = DMP(K=K).fit(demo)
+        dmp = DMP(protocol="paper", K=K).fit(demo)
         dmp.weights_ = np.zeros_like(dmp.weights_)
         y = dmp.rollout(goal=[3.0, 4.0])
         second_difference = y[2] - 2 * y[1] + y[0]  # = h² · acceleration at step 0 (explicit Euler)
@@ -237,7 +237,7 @@ def test_pastor_variant_matches_movement_primitives_smooth_scaling():
     theirs.imitate(times, demo)
     # movement_primitives lets the phase decay to 0.01 over the movement; use the same decay.
     alpha_phase = theirs.forcing_term.alpha_z * times[-1]
-    ours = DMP(K="pastor", alpha_phase=alpha_phase).fit(demo)
+    ours = DMP(protocol="paper", K="pastor", alpha_phase=alpha_phase).fit(demo)
     new_goal = demo[-1] + np.array([0.3, -0.2])
     theirs.configure(start_y=demo[0], goal_y=new_goal)
     _, their_path = theirs.open_loop(step_function="euler")
@@ -245,7 +245,7 @@ def test_pastor_variant_matches_movement_primitives_smooth_scaling():
     assert their_path.shape == (n_steps, 2)
     assert rel_rmse(ours.rollout(goal=new_goal), their_path) < 0.01
     # ... while the paper's K = alpha scales goal changes differently: the check can tell them apart.
-    plain = DMP(K="paper", alpha_phase=alpha_phase).fit(demo)
+    plain = DMP(protocol="paper", K="paper", alpha_phase=alpha_phase).fit(demo)
     assert rel_rmse(plain.rollout(goal=new_goal), their_path) > 2 * rel_rmse(ours.rollout(goal=new_goal), their_path)
 
 
@@ -265,11 +265,11 @@ def test_pastor_variant_matches_movement_primitives_smooth_scaling():
 )
 def test_fit_rejects_bad_demonstrations(y, error, match):
     with pytest.raises(error, match=match):
-        DMP().fit(y)
+        DMP(protocol="paper").fit(y)
 
 
 def test_rollout_rejects_bad_goal_start_and_steps(demo3d):
-    dmp = DMP().fit(demo3d)
+    dmp = DMP(protocol="paper").fit(demo3d)
     with pytest.raises(ValueError, match="goal must have 3 coordinate"):
         dmp.rollout(goal=[1.0, 2.0])
     with pytest.raises(ValueError, match="start must have 3"):
@@ -299,19 +299,19 @@ def test_rollout_rejects_bad_goal_start_and_steps(demo3d):
     ],
 )
 def test_bad_parameters_are_named_at_fit(params, match):
-    model = DMP(**params)  # scikit-learn convention: the constructor only stores
+    model = DMP(protocol="paper", **params)  # scikit-learn convention: the constructor only stores
     with pytest.raises(ValueError, match=match):
         model.fit(minimum_jerk([0.0], [1.0], 20))
 
 
 def test_too_fast_phase_is_rejected_at_fit():
     with pytest.raises(ValueError, match="alpha_phase"):
-        DMP(alpha_phase=50.0).fit(minimum_jerk([0.0], [1.0], 10))
+        DMP(protocol="paper", alpha_phase=50.0).fit(minimum_jerk([0.0], [1.0], 10))
 
 
 def test_unfitted_model_says_so():
     with pytest.raises(NotFittedError, match="not fitted"):
-        DMP().rollout()
+        DMP(protocol="paper").rollout()
 
 
 # --- hyperparameters after fit, temporal scaling, estimator conventions ------------------------
@@ -323,7 +323,7 @@ def test_unfitted_model_says_so():
 def test_parameter_change_after_fit_equals_a_fresh_model_with_that_parameter(name, value, how, demo3d):
     from sklearn.base import clone
 
-    dmp = DMP().fit(demo3d)
+    dmp = DMP(protocol="paper").fit(demo3d)
     goal = demo3d[-1] + 0.3
     before = dmp.rollout(goal)  # fills the cache with the old parameters
     if how == "attribute":
@@ -340,8 +340,8 @@ def test_parameter_change_after_fit_equals_a_fresh_model_with_that_parameter(nam
 
 
 def test_tau_is_temporal_scaling_same_path_slower(demo3d):
-    nominal = DMP().fit(demo3d)
-    slow = DMP(tau=2.0).fit(demo3d)
+    nominal = DMP(protocol="paper").fit(demo3d)
+    slow = DMP(protocol="paper", tau=2.0).fit(demo3d)
     np.testing.assert_array_equal(slow.weights_, nominal.weights_)  # learned at the demo's own time scale
     y1, y2 = nominal.rollout(), slow.rollout()
     assert y2.shape == (2 * demo3d.shape[0], 3)  # default horizon: tau · T samples of dt
@@ -357,19 +357,19 @@ def test_tau_is_temporal_scaling_same_path_slower(demo3d):
 def test_estimator_conventions(demo2d):
     from sklearn.base import clone
 
-    dmp = DMP(alpha=30.0, K="pastor", regression="ridge")
+    dmp = DMP(protocol="paper", alpha=30.0, K="pastor", regression="ridge")
     assert "weights_" not in vars(dmp) and not hasattr(dmp, "weights_")
-    assert repr(dmp) == "DMP(K='pastor', alpha=30.0, regression='ridge')"
+    assert repr(dmp) == "DMP(K='pastor', alpha=30.0, protocol='paper', regression='ridge')"
     copy = clone(dmp)
     assert copy.get_params() == dmp.get_params() and copy is not dmp
     fitted = clone(dmp).fit(demo2d)
     np.testing.assert_array_equal(clone(fitted).fit(demo2d).rollout(), fitted.rollout())
     assert not hasattr(clone(fitted), "weights_")
-    assert dmp.set_params(alpha=50.0) is dmp and dmp.alpha == 50.0
+    assert dmp.set_params(alpha=50.0) is dmp and dmp.alpha_value == 50.0
 
 
 def test_failed_fit_leaves_the_model_as_it_was(demo2d):
-    dmp = DMP().fit(demo2d)
+    dmp = DMP(protocol="paper").fit(demo2d)
     before = dmp.rollout()
     with pytest.raises(ValueError, match="y contains NaN"):
         dmp.fit(np.full((50, 2), np.nan))

@@ -17,7 +17,7 @@ def relative_rmse(a, b):
 @pytest.fixture(scope="module")
 def battery():
     demo = minimum_jerk(BATTERY_APPROACH_VIA, 200)
-    dmp = DMP(alpha=100.0).fit(demo)
+    dmp = DMP(protocol="paper", alpha=100.0).fit(demo)
     extension = extend_demonstration(demo, BATTERY_EXTENSION_TARGET, seed=0)
     return demo, dmp, extension
 
@@ -35,7 +35,7 @@ def test_learned_demonstration_is_reproduced_at_its_goal(battery):
 @pytest.mark.parametrize("name", ["Sshape", "WShape"])
 def test_lasa_extension_reproduced(name):
     demo = lasa(name)[0]
-    dmp = DMP().fit(demo)
+    dmp = DMP(protocol="paper").fit(demo)
     extension = extend_demonstration(demo, demo[-1] + [12.0, -9.0], seed=1)
     model = BiDMP(dmp).learn(extension.complete)
     assert relative_rmse(model.rollout(extension.complete[-1]), extension.complete) < 0.01
@@ -69,7 +69,7 @@ def three_operator_demonstrations(n_steps=200):
 
 def test_forgetting_nearest_is_zero_latest_forgets():
     demonstrations = three_operator_demonstrations()
-    dmp = DMP(alpha=40.0).fit(demonstrations[0])
+    dmp = DMP(protocol="paper", alpha=40.0).fit(demonstrations[0])
     nearest = forgetting(dmp, demonstrations[1:], skill="nearest")
     latest = forgetting(dmp, demonstrations[1:], skill="latest")
     np.testing.assert_allclose(nearest.forgetting, 0.0, atol=1e-9)
@@ -117,8 +117,8 @@ def test_save_load_reproduces_rollouts_bit_for_bit(tmp_path, battery):
         (lambda m: m.rollout([1.0, 2.0, 3.0], skill="favourite"), ValueError, "skill must be 'nearest', 'latest'"),
         (lambda m: m.rollout([1.0, 2.0, 3.0], skill=5), ValueError, "skill must be between 0 and 1"),
         (lambda m: m.rollout([1.0, 2.0]), ValueError, "goal must have 3"),
-        (lambda m: BiDMP(DMP()).learn(np.ones((5, 3))), bidmp.NotFittedError, "not fitted"),
-        (lambda m: BiDMP(DMP()).rollout(), bidmp.NotFittedError, "not fitted"),
+        (lambda m: BiDMP(DMP(protocol="paper")).learn(np.ones((5, 3))), bidmp.NotFittedError, "not fitted"),
+        (lambda m: BiDMP(DMP(protocol="paper")).rollout(), bidmp.NotFittedError, "not fitted"),
         (lambda m: BiDMP("dmp").fit(np.eye(3)), TypeError, "dmp must be a bidmp.DMP"),
         (lambda m: BiDMP(m.dmp_, increments=(0,)).learn(np.eye(3)), ValueError, "increments must be >= 1"),
     ],

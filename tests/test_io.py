@@ -14,7 +14,7 @@ from bidmp.io import FORMAT_VERSION, load_trajectory, save_trajectory
 
 @pytest.fixture
 def fitted():
-    return DMP(alpha=40.0, K="pastor", n_kernels=30).fit(curved_demo(250, 3))
+    return DMP(protocol="paper", alpha=40.0, K="pastor", n_kernels=30).fit(curved_demo(250, 3))
 
 
 # --- trajectories ------------------------------------------------------------------------------
@@ -118,7 +118,7 @@ def test_failed_write_keeps_the_old_file(tmp_path, fitted, monkeypatch):
 
     monkeypatch.setattr(np, "savez", broken_savez)
     with pytest.raises(OSError, match="disk full"):
-        bidmp.save(DMP().fit(curved_demo(100, 2)), path)
+        bidmp.save(DMP(protocol="paper").fit(curved_demo(100, 2)), path)
     assert path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.npz"]
 
@@ -182,7 +182,7 @@ def test_missing_model_file_and_unsupported_objects(tmp_path):
     with pytest.raises(TypeError, match="model must be one of"):
         bidmp.save(object(), tmp_path / "x.npz")
     with pytest.raises(bidmp.NotFittedError):
-        bidmp.save(DMP(), tmp_path / "x.npz")
+        bidmp.save(DMP(protocol="paper"), tmp_path / "x.npz")
 
 
 def test_format_1_dmp_files_still_load(tmp_path, fitted):
@@ -202,7 +202,7 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
     from bidmp.datasets import minimum_jerk
 
     demo = minimum_jerk([[0, 0, 1], [1, 1, 0], [2, 0, 0]], 60)
-    model = bidmp.BiDMP(DMP().fit(demo)).learn(demo + np.linspace(0, 1, 60)[:, None])
+    model = bidmp.BiDMP(DMP(protocol="paper").fit(demo)).learn(demo + np.linspace(0, 1, 60)[:, None])
     path = bidmp.save(model, tmp_path / "old.npz")
     assert bidmp.load(path).n_skills == 2
     rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))

@@ -51,7 +51,7 @@ def assert_one_line_error(argv, match=None, seconds=10.0):
 
 @pytest.fixture
 def model_file(tmp_path):
-    return save_model(bidmp.DMP().fit(curved_demo(200, 3)), tmp_path / "model.npz")
+    return save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / "model.npz")
 
 
 def rewrite_archive(path, change):
@@ -209,12 +209,12 @@ def test_huge_inputs_are_refused_without_warnings(scale, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         with pytest.raises(ValueError, match="max_abs_value"):
-            bidmp.DMP().fit(demo)
+            bidmp.DMP(protocol="paper").fit(demo)
         with pytest.raises(ValueError, match="max_abs_value"):
             bidmp.frechet_distance(demo, demo[::-1])
         with pytest.raises(ValueError, match="max_abs_value"):
             bidmp.extend_demonstration(curved_demo(100, 3), [scale, 0, 0])
-        dmp = bidmp.DMP().fit(curved_demo(100, 3))
+        dmp = bidmp.DMP(protocol="paper").fit(curved_demo(100, 3))
         with pytest.raises(ValueError, match="max_abs_value"):
             dmp.rollout(goal=[scale, 0.0, 0.0])
     path = tmp_path / "huge.csv"
@@ -227,7 +227,7 @@ def test_huge_inputs_are_refused_without_warnings(scale, tmp_path):
 
 def test_tiny_motions_are_refused_not_divided_by():
     with pytest.raises(ValueError, match="barely moves"):
-        bidmp.DMP().fit(curved_demo(100, 3) * 1e-300)
+        bidmp.DMP(protocol="paper").fit(curved_demo(100, 3) * 1e-300)
     with pytest.raises(ValueError, match="barely moves"):
         bidmp.segment(1e6 + curved_demo(100, 3) * 1e-8)
 
@@ -235,10 +235,10 @@ def test_tiny_motions_are_refused_not_divided_by():
 def test_limits_can_be_raised_in_the_library_and_are_restored():
     demo = curved_demo(100, 3) * 1e10
     with pytest.raises(ValueError, match="max_abs_value"):
-        bidmp.DMP().fit(demo)
+        bidmp.DMP(protocol="paper").fit(demo)
     with bidmp.set_limits(max_abs_value=1e12):
         assert bidmp.get_limits().max_abs_value == 1e12
-        assert np.all(np.isfinite(bidmp.DMP().fit(demo).rollout()))
+        assert np.all(np.isfinite(bidmp.DMP(protocol="paper").fit(demo).rollout()))
     assert bidmp.get_limits().max_abs_value == 1e9
     with pytest.raises(TypeError, match="unknown limit"):
         bidmp.set_limits(max_bananas=3)
@@ -277,7 +277,7 @@ def test_load_never_leaks_attribute_index_or_recursion_errors(tmp_path, model_fi
         lambda meta: meta.pop("state"),
     ]
     for index, change in enumerate(cases):
-        path = save_model(bidmp.DMP().fit(curved_demo(200, 3)), tmp_path / f"m{index}.npz")
+        path = save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / f"m{index}.npz")
         set_meta(path, change)
         with pytest.raises(ModelFileError):
             load_model(path)
@@ -288,7 +288,7 @@ def test_load_never_leaks_attribute_index_or_recursion_errors(tmp_path, model_fi
 def test_outputs_honour_the_umask(tmp_path, umask, expected):
     old = os.umask(umask)
     try:
-        paths = [save_model(bidmp.DMP().fit(curved_demo(50, 2)), tmp_path / "m.npz"),
+        paths = [save_model(bidmp.DMP(protocol="paper").fit(curved_demo(50, 2)), tmp_path / "m.npz"),
                  save_trajectory(curved_demo(50, 2), tmp_path / "t.csv"),
                  save_trajectory(curved_demo(50, 2), tmp_path / "t.npy")]
     finally:
@@ -312,7 +312,7 @@ def test_a_csv_given_as_a_model_is_not_answered_with_pickle_advice(tmp_path):
 
 
 def test_extend_with_a_demonstration_of_another_length(tmp_path):
-    model = save_model(bidmp.DMP().fit(curved_demo(200, 3)), tmp_path / "m.npz")
+    model = save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / "m.npz")
     demo = save_trajectory(curved_demo(333, 3), tmp_path / "d.csv")
     code, out, err = cli(["extend", model, demo, "--target", 1.5, 1.5, 1.5, "-o", tmp_path / "e.npz"], seconds=30)
     assert code == 0, err
@@ -382,7 +382,7 @@ def test_wrong_shapes_and_dtypes_are_refused_by_name(tmp_path, model_file):
 @pytest.fixture(scope="module")
 def bidmp_model_bytes(tmp_path_factory):
     demo = curved_demo(150, 3)
-    model = bidmp.BiDMP(bidmp.DMP().fit(demo), increments=(5,))
+    model = bidmp.BiDMP(bidmp.DMP(protocol="paper").fit(demo), increments=(5,))
     model.learn(demo + np.linspace(0, 1, 150)[:, None] * [0.3, 0.2, 0.0])
     return save_model(model, tmp_path_factory.mktemp("bidmp") / "b.npz").read_bytes()
 
@@ -425,8 +425,8 @@ def test_unstable_euler_settings_are_refused(tmp_path):
     assert_one_line_error(["fit", demo, "-o", tmp_path / "m.npz", "--alpha", 5000], "dt/tau <")
     assert not (tmp_path / "m.npz").exists()
     with pytest.raises(ValueError, match="unstable|alpha_phase"):
-        bidmp.DMP(tau=0.001, alpha_phase=0.001, K="pastor").fit(curved_demo(1000, 3))
-    dmp = bidmp.DMP().fit(curved_demo(1000, 3))
+        bidmp.DMP(protocol="paper", tau=0.001, alpha_phase=0.001, K="pastor").fit(curved_demo(1000, 3))
+    dmp = bidmp.DMP(protocol="paper").fit(curved_demo(1000, 3))
     dmp.tau = 0.001  # changed after fit: refused at the rollout
     with pytest.raises(ValueError, match="unstable"):
         dmp.rollout()
@@ -442,9 +442,9 @@ def test_the_euler_stability_bound_is_the_closed_form_one():
         assert radius == pytest.approx(abs(1 - h_alpha / 2), abs=1e-6)
     # Rollouts grow exactly where the radius says so.
     demo = curved_demo(100, 2)
-    assert np.all(np.isfinite(bidmp.DMP(alpha=390.0).fit(demo).rollout(n_steps=5000)))  # h alpha = 3.9
+    assert np.all(np.isfinite(bidmp.DMP(protocol="paper", alpha=390.0).fit(demo).rollout(n_steps=5000)))  # h alpha = 3.9
     with pytest.raises(ValueError, match="unstable"):
-        bidmp.DMP(alpha=410.0).fit(demo)  # h alpha = 4.1
+        bidmp.DMP(protocol="paper", alpha=410.0).fit(demo)  # h alpha = 4.1
 
 
 BASE_SCENARIO = {
@@ -476,7 +476,7 @@ def test_scenario_check_runs_what_demo_runs(tmp_path, change, match):
 
 # --- 7. rollout_many: chunked output instead of one huge block -------------------------------
 def test_rollout_many_refuses_a_huge_block_and_says_how_to_chunk(tmp_path):
-    dmp = bidmp.DMP().fit(curved_demo(1000, 2))
+    dmp = bidmp.DMP(protocol="paper").fit(curved_demo(1000, 2))
     goals = np.zeros((1_000_000, 2))
     started = time.perf_counter()
     with pytest.raises(ValueError, match="14.9 GiB.*open_memmap.*iter_rollouts"):
@@ -554,7 +554,7 @@ def test_utf8_bom_csv_is_read(tmp_path):
 
 
 def test_huge_n_steps_in_the_library_and_empty_methods(tmp_path):
-    dmp = bidmp.DMP().fit(curved_demo(100, 2))
+    dmp = bidmp.DMP(protocol="paper").fit(curved_demo(100, 2))
     for n_steps in (2**63, 10**12):
         with pytest.raises(ValueError, match="max_steps"):
             dmp.rollout(n_steps=n_steps)

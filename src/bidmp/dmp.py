@@ -41,6 +41,7 @@ import numpy as np
 from scipy.signal import lfilter
 from sklearn.base import BaseEstimator
 
+from ._trajectory import resample_time
 from ._checks import (
     as_point,
     as_points,
@@ -62,6 +63,8 @@ __all__ = [
     "kernel_widths",
     "basis_functions",
     "forcing_target",
+    "DMPStepper",
+    "PROTOCOLS",
     "euler_spectral_radius",
     "check_euler_stable",
 ]
@@ -232,11 +235,13 @@ def forcing_target(
     beta: float,
     K: float,
     derivatives: str = "gradient",
+    gate: np.ndarray | None = None,
 ) -> np.ndarray:
     """The forcing term that makes Eq. 10 reproduce ``y`` (SPEC §1, "forcing target").
 
-    ``f*[l] = (tau² ÿ[l] - alpha (beta (g - y[l]) - tau ẏ[l])) / K + phase[l] (g - y0)`` with
-    ``g = y[-1]`` and ``y0 = y[0]``.
+    ``f*[l] = (tau² ÿ[l] - alpha (beta (g - y[l]) - tau ẏ[l])) / K + gate[l] (g - y0)`` with
+    ``g = y[-1]``, ``y0 = y[0]`` and the goal gate ``gate`` (default: the phase, Eq. 10; the
+    delayed goal of the robot protocol otherwise).
 
     Parameters
     ----------
@@ -256,7 +261,8 @@ def forcing_target(
     velocity, acceleration = _derivatives(y, dt, derivatives)
     start, goal = y[0], y[-1]
     spring = alpha * (beta * (goal - y) - tau * velocity)
-    return (tau**2 * acceleration - spring) / K + phase[:, None] * (goal - start)
+    gate = phase if gate is None else gate
+    return (tau**2 * acceleration - spring) / K + gate[:, None] * (goal - start)
 
 
 def _euler_unit_responses(
@@ -297,7 +303,8 @@ def _euler_unit_responses(
 # The estimator
 # ---------------------------------------------------------------------------------------------
 class _Params(NamedTuple):
-    """The validated hyperparameters of a :class:`DMP` (``beta`` and ``K`` resolved to numbers)."""
+    """The validated hyperparameters of a :class:`DMP` (``beta``, ``K``, ``alpha_phase`` and
+    ``goal_rate`` resolved to numbers for the protocol)."""
 
     n_kernels: int
     alpha: float
@@ -309,10 +316,30 @@ class _Params(NamedTuple):
     derivatives: str
     ridge: float
     widths: str
+    protocol: str
+    goal_rate: float
+    settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
+
+
+# The two protocols (README "Protocols"): what the unset parameters resolve to.
+PROTOCOLS = ("robot", "paper")
+# robot: K = alpha beta (Pastor 2009: the initial acceleration does not depend on the goal or the
+# start), a delayed goal (Kulvicius 2012) that moves from the start to the goal at rate
+# goal_rate, a phase that decays to e^-4 over the demonstration, 100 kernels and a stiffer spring
+# (alpha = 50), and a horizon of 1.1x the demonstrated duration. The weights are learned on the
+# demonstration followed by rest at its goal for that extra 0.1: the learned forcing term then
+# holds the goal at the end instead of extrapolating the last kernel. On the shared recordings
+# these settings reproduce to 0.25 mm RMS, end at the goal within 0.01 mm and reach a goal moved
+# by 150 mm within 0.01 mm (tests/test_timing.py; the measurements are in the README).
+ROBOT_ALPHA = 50.0
+ROBOT_KERNELS = 100
+ROBOT_ALPHA_PHASE = 4.0
+ROBOT_GOAL_RATE = 10.0
+ROBOT_SETTLE = 1.1
 
 
 class DMP(BaseEstimator):
-    """Discrete DMP learned from one demonstration (SPEC §1).
+    """Discrete DMP learned from one demonstration (SPEC §1), in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
     them and learns, ``get_params``/``set_params``/``sklearn.base.clone`` work, and learned state
@@ -320,25 +347,38 @@ class DMP(BaseEstimator):
     the next rollout: the model then behaves as a fresh one with that parameter and the same
     learned weights.
 
+    **Time.** Internally the demonstration's T samples lie on the grid ``dt_ = 1/T`` (the paper's
+    normalised time). ``fit(y, t)`` with timestamps (s) also stores the real duration
+    (``duration_``), and :meth:`trajectory` returns positions, velocities and accelerations in
+    seconds at any rate; :meth:`rollout` keeps the normalised grid.
+
+    **Protocols.** ``protocol="robot"`` (default) resolves the unset parameters to a DMP a robot
+    can run: ``K = alpha beta`` (the initial acceleration does not depend on the goal or the
+    start: no jump when either moves), a delayed goal that moves from the start to the goal at
+    ``goal_rate`` (Kulvicius 2012; no overshoot for nearer goals), ``alpha_phase = 4`` and a default
+    horizon of 1.1x the demonstration, within which any goal is reached and the motion comes to
+    rest. ``protocol="paper"`` is the paper's: ``K = alpha``, ``alpha_phase = 1``, the goal gated by
+    the phase, exactly T samples (a shifted goal is missed by :meth:`endpoint_gain` times the shift).
+
     Parameters
     ----------
-    n_kernels : int, default 50
-        Number of Gaussian kernels ``N_k`` per dimension.
-    alpha : float, default 25
-        Spring-damper gain ``alpha`` (1/s).
+    n_kernels : int or None, default None
+        Number of Gaussian kernels ``N_k`` per dimension; ``None``: robot 100, paper 50.
+    alpha : float or None, default None
+        Spring-damper gain ``alpha`` (per unit of normalised time: 1/duration); ``None``: robot
+        50, paper 25.
     beta : float or None, default None
         Spring gain ratio; ``None`` means ``alpha / 4`` (critical damping).
-    K : {"paper", "pastor"} or float, default "paper"
+    K : {"paper", "pastor"}, float or None, default None
         Forcing-term gain: ``"paper"`` is ``K = alpha``; ``"pastor"`` is ``K = alpha beta`` (Pastor
-        2009, movement_primitives' ``smooth_scaling``), which starts with zero acceleration when
-        ``f ≡ 0``; a number sets ``K`` directly.
-    alpha_phase : float, default 1
-        Canonical-system decay ``alpha_phase`` (1/s).
+        2009, movement_primitives' ``smooth_scaling``); a number sets ``K`` directly; ``None`` is
+        the protocol's (robot: ``"pastor"``, paper: ``"paper"``).
+    alpha_phase : float or None, default None
+        Canonical-system decay ``alpha_phase``; ``None``: robot 4, paper 1.
     tau : float, default 1
         Temporal scaling: a rollout takes ``tau`` times the demonstration's duration, with the same
         shape (larger is slower). The weights are always learned for the demonstration's own
-        duration (``tau = 1``), so ``tau`` may be changed after ``fit``. The default rollout length
-        is ``round(tau · T)`` samples of ``dt_`` seconds.
+        duration (``tau = 1``), so ``tau`` may be changed after ``fit``.
     regression : {"lwr", "ridge"}, default "lwr"
         Locally weighted regression per kernel (paper) or global ridge least squares.
     derivatives : {"gradient", "forward"}, default "gradient"
@@ -347,6 +387,11 @@ class DMP(BaseEstimator):
         Ridge regulariser for ``regression="ridge"``, relative to the mean diagonal of ``ΦᵀΦ``.
     widths : {"spacing", "pydmps"}, default "spacing"
         Kernel-width rule, see :func:`kernel_widths`.
+    protocol : {"robot", "paper"}, default "robot"
+        See above.
+    goal_rate : float or None, default None
+        Rate of the delayed goal (per normalised time). ``None``: robot 10; paper: equal to
+        ``alpha_phase``, which is exactly Eq. 10's ``-K phase (g - y0)`` term.
 
     Attributes
     ----------
@@ -356,23 +401,30 @@ class DMP(BaseEstimator):
     n_steps_ : int
         Length T of the demonstration.
     dt_ : float
-        ``1 / T`` (s): the demonstration lasts 1 s (the paper's protocol).
+        ``1 / T``: the normalised time step.
+    duration_ : float
+        The demonstration's duration in seconds (``(T - 1) / T`` without timestamps: the paper's
+        convention of one second per T samples).
+    units_ : str
+        Length unit of the demonstration ("" if not given).
     centres_, widths_ : array, shape (n_kernels,)
         Kernel centres (phase) and widths.
     """
 
     def __init__(
         self,
-        n_kernels: int = 50,
-        alpha: float = 25.0,
+        n_kernels: int | None = None,
+        alpha: float | None = None,
         beta: float | None = None,
-        K: str | float = "paper",
-        alpha_phase: float = 1.0,
+        K: str | float | None = None,
+        alpha_phase: float | None = None,
         tau: float = 1.0,
         regression: str = "lwr",
         derivatives: str = "gradient",
         ridge: float = 1e-8,
         widths: str = "spacing",
+        protocol: str = "robot",
+        goal_rate: float | None = None,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
@@ -384,29 +436,57 @@ class DMP(BaseEstimator):
         self.derivatives = derivatives
         self.ridge = ridge
         self.widths = widths
+        self.protocol = protocol
+        self.goal_rate = goal_rate
 
     # -- parameters ----------------------------------------------------------------------------
     def _params(self) -> _Params:
         """Validate the hyperparameters as they are now; raise naming the first bad one."""
-        alpha = check_real(self.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+        protocol = check_choice(self.protocol, "protocol", PROTOCOLS)
+        robot = protocol == "robot"
+        alpha = (ROBOT_ALPHA if robot else 25.0) if self.alpha is None else \
+            check_real(self.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
         beta = alpha / 4.0 if self.beta is None else check_real(self.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
-        if isinstance(self.K, str):
-            check_choice(self.K, "K", _K_CHOICES)
-            K = alpha if self.K == "paper" else alpha * beta
+        K_choice = ("pastor" if robot else "paper") if self.K is None else self.K
+        if isinstance(K_choice, str):
+            check_choice(K_choice, "K", _K_CHOICES)
+            K = alpha if K_choice == "paper" else alpha * beta
         else:
-            K = check_real(self.K, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2)
+            K = check_real(K_choice, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2)
+        if self.alpha_phase is None:
+            alpha_phase = ROBOT_ALPHA_PHASE if robot else 1.0
+        else:
+            alpha_phase = check_real(self.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+        if self.goal_rate is None:
+            goal_rate = ROBOT_GOAL_RATE if robot else alpha_phase
+        else:
+            goal_rate = check_real(self.goal_rate, "goal_rate", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
         return _Params(
-            n_kernels=check_int(self.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
+            n_kernels=(ROBOT_KERNELS if robot else 50) if self.n_kernels is None else
+            check_int(self.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
             alpha=alpha,
             beta=beta,
             K=K,
-            alpha_phase=check_real(self.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]),
+            alpha_phase=alpha_phase,
             tau=check_real(self.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]),
             regression=check_choice(self.regression, "regression", _REGRESSION_CHOICES),
             derivatives=check_choice(self.derivatives, "derivatives", _DERIVATIVE_CHOICES),
             ridge=check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6),
             widths=check_choice(self.widths, "widths", _WIDTH_CHOICES),
+            protocol=protocol,
+            goal_rate=goal_rate,
+            settle=ROBOT_SETTLE if robot else 1.0,
         )
+
+    @property
+    def alpha_value(self) -> float:
+        """The spring gain in use (the protocol's when ``alpha`` is None)."""
+        return self._params().alpha
+
+    @property
+    def n_kernels_value(self) -> int:
+        """The number of kernels in use (the protocol's when ``n_kernels`` is None)."""
+        return self._params().n_kernels
 
     @property
     def beta_value(self) -> float:
@@ -418,16 +498,27 @@ class DMP(BaseEstimator):
         """The forcing-term gain in use."""
         return self._params().K
 
+    @property
+    def alpha_phase_value(self) -> float:
+        """The phase decay in use (the protocol's when ``alpha_phase`` is None)."""
+        return self._params().alpha_phase
+
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
-    def fit(self, y) -> "DMP":
+    def fit(self, y, t=None, units: str | None = None) -> "DMP":
         """Learn the forcing-term weights from one demonstration.
 
         Parameters
         ----------
         y : array-like, shape (T, D)
-            Demonstration sampled uniformly in time, T ≥ 3, any D ≥ 1, any length unit. Its
-            duration is taken as 1 s (``dt = 1/T``, the paper's protocol).
+            Demonstration, T ≥ 3, any D ≥ 1, in ``units``.
+        t : array-like, shape (T,), optional
+            Timestamps in seconds: any strictly increasing stamps (jittered, epoch-like); the
+            samples are resampled to uniform time over the same span, whose length becomes
+            ``duration_``. Without them the samples are taken as uniform over 1 s (the paper's
+            protocol).
+        units : str, optional
+            The length unit of ``y`` (e.g. ``"mm"``), kept in model files.
 
         Returns
         -------
@@ -435,23 +526,36 @@ class DMP(BaseEstimator):
 
         A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
+        from .timing import check_timestamps, uniform_time
+
         params = self._params()
         y = as_trajectory(y, "y")
+        units = "" if units is None else _check_units(units)
         n_steps = y.shape[0]
+        if t is None:
+            duration = (n_steps - 1) / n_steps
+        else:
+            stamps = check_timestamps(t, n_steps)
+            y, grid = uniform_time(y, stamps)
+            duration = float(grid[-1])
         dt = 1.0 / n_steps
-        check_bytes(n_steps * params.n_kernels, "the basis matrix (T samples x n_kernels)")
+        train = _with_rest(y, params)
+        check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
         check_euler_stable(dt, 1.0, params.alpha, params.beta)
         check_euler_stable(dt, params.tau, params.alpha, params.beta)
         _phase_decay(dt, params.tau, params.alpha_phase)
+        _phase_decay(dt, params.tau, params.goal_rate)
         # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
         # rollouts, so it is not used here.
-        phase = phase_grid(n_steps, dt, 1.0, params.alpha_phase)
-        centres = kernel_centres(params.n_kernels, n_steps, dt, 1.0, params.alpha_phase)
+        n_train = train.shape[0]
+        phase = phase_grid(n_train, dt, 1.0, params.alpha_phase)
+        gate = phase_grid(n_train, dt, 1.0, params.goal_rate)
+        centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase)
         widths = kernel_widths(centres, params.alpha_phase, params.widths)
         target = forcing_target(
-            y, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
-            derivatives=params.derivatives,
+            train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
+            derivatives=params.derivatives, gate=gate,
         )
         phi = basis_functions(phase, centres, widths)
         if params.regression == "lwr":
@@ -469,11 +573,13 @@ class DMP(BaseEstimator):
         self.goal_ = y[-1].copy()
         self.n_steps_ = n_steps
         self.dt_ = dt
+        self.duration_ = duration
+        self.units_ = units
         self.centres_ = centres
         self.widths_ = widths
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
-        self._store_grid(params._replace(tau=1.0), phase, phi)
-        logger.debug("fitted DMP on %d samples in %d dimension(s)", n_steps, y.shape[1])
+        self._store_grid(params._replace(tau=1.0), phase, phi, dt)
+        logger.debug("fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration)
         return self
 
     def __sklearn_is_fitted__(self) -> bool:
@@ -488,16 +594,28 @@ class DMP(BaseEstimator):
         self._check_fitted()
         return self.weights_.shape[1]
 
+    @property
+    def sample_rate_(self) -> float:
+        """The demonstration's sample rate in Hz, ``(T - 1) / duration_``."""
+        self._check_fitted()
+        return (self.n_steps_ - 1) / self.duration_
+
+    @property
+    def time_unit_(self) -> float:
+        """Seconds per unit of normalised time: ``duration_ · T / (T - 1)`` (1 without timestamps)."""
+        self._check_fitted()
+        return self.duration_ * self.n_steps_ / (self.n_steps_ - 1)
+
     # -- evaluation ----------------------------------------------------------------------------
     def default_n_steps(self) -> int:
-        """The default rollout length: ``round(tau · T)`` samples (the demonstration's duration
-        scaled by ``tau``; T for ``tau = 1``, the paper's protocol)."""
+        """The default rollout length on the normalised grid: ``round(settle · tau · T)`` samples
+        (paper: T for ``tau = 1``; robot: 1.1 T, time for any goal to be reached)."""
         self._check_fitted()
         return self._n_steps(None, self._params())
 
     def _n_steps(self, n_steps, params: _Params) -> int:
         if n_steps is None:
-            n_steps = max(int(round(params.tau * self.n_steps_)), 1)
+            n_steps = max(int(round(params.settle * params.tau * self.n_steps_)), 1)
             check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
         else:
             n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
@@ -510,35 +628,37 @@ class DMP(BaseEstimator):
         params = self._params()
         return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase)
 
-    def _grid_key(self, params: _Params, n_steps: int) -> tuple:
+    def _grid_key(self, params: _Params, n_steps: int, step: float) -> tuple:
         """Everything a rollout grid depends on besides the learned kernels."""
-        return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, self.dt_)
+        return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, params.goal_rate, step)
 
-    def _store_grid(self, params: _Params, phase: np.ndarray, basis: np.ndarray) -> tuple:
-        cached = (self._grid_key(params, phase.shape[0]), self.centres_, self.widths_, phase, basis,
-                  self._unit_responses(params, phase, None))
+    def _store_grid(self, params: _Params, phase: np.ndarray, basis: np.ndarray, step: float) -> tuple:
+        cached = (self._grid_key(params, phase.shape[0], step), self.centres_, self.widths_, phase, basis,
+                  self._unit_responses(params, phase, None, step))
         self._grid_cache = cached
         return cached
 
-    def _cached_grid(self, params: _Params, n_steps: int) -> tuple | None:
+    def _cached_grid(self, params: _Params, n_steps: int, step: float) -> tuple | None:
         cached = self.__dict__.get("_grid_cache")
-        if (cached is None or cached[0] != self._grid_key(params, n_steps)
+        if (cached is None or cached[0] != self._grid_key(params, n_steps, step)
                 or cached[1] is not self.centres_ or cached[2] is not self.widths_):
             return None
         return cached
 
-    def _grid(self, params: _Params, n_steps: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _grid(self, params: _Params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Phase (n,), basis rows (n, N) and unit responses ``[B, C, V]`` (3, n) on the grid of
-        ``n_steps`` samples for the validated ``params``.
+        ``n_steps`` samples ``step`` apart in normalised time (default ``dt_``) for the validated
+        ``params``.
 
         None of them depends on the weights, so the last grid used is cached. The cache key holds
         every hyperparameter the grid depends on and the learned kernels, so changing any of them
         after ``fit`` can never roll out with stale responses.
         """
-        cached = self._cached_grid(params, n_steps)
+        step = self.dt_ if step is None else step
+        cached = self._cached_grid(params, n_steps, step)
         if cached is None:
-            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
-            cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_))
+            phase = phase_grid(n_steps, step, params.tau, params.alpha_phase)
+            cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_), step)
         return cached[3:]
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -549,12 +669,30 @@ class DMP(BaseEstimator):
         phase, basis, _ = self._grid(params, self._n_steps(n_steps, params))
         return phase, basis
 
-    def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
-        """Phase (T,) and basis rows (T, N) of the grid the weights were learned on (the
-        demonstration's T samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
+    @property
+    def n_train_(self) -> int:
+        """Samples of the training grid: T (paper), or T followed by rest up to 1.1 T (robot)."""
         self._check_fitted()
-        phase, basis, _ = self._grid(self._params()._replace(tau=1.0), self.n_steps_)
+        return max(int(round(self._params().settle * self.n_steps_)), self.n_steps_)
+
+    def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """Phase and basis rows (N columns) of the grid the weights were learned on
+        (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
+        self._check_fitted()
+        phase, basis, _ = self._grid(self._params()._replace(tau=1.0), self.n_train_)
         return phase, basis
+
+    def training_gate(self) -> np.ndarray:
+        """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
+        fraction (robot); the forcing target of :func:`forcing_target` uses it."""
+        self._check_fitted()
+        return phase_grid(self.n_train_, self.dt_, 1.0, self._params().goal_rate)
+
+    def training_trajectory(self, y) -> np.ndarray:
+        """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
+        for the robot protocol, followed by rest at its last point up to :attr:`n_train_`."""
+        self._check_fitted()
+        return _with_rest(resample_time(np.asarray(y, dtype=np.float64), self.n_steps_), self._params())
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
@@ -565,45 +703,53 @@ class DMP(BaseEstimator):
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
         return self.basis(phase) @ self.weights_
 
-    def _unit_responses(self, params: _Params, phase: np.ndarray, forcing: np.ndarray | None) -> np.ndarray:
-        """Responses that compose every rollout on the grid ``phase`` (n samples).
+    def _unit_responses(self, params: _Params, phase: np.ndarray, forcing: np.ndarray | None, step: float) -> np.ndarray:
+        """Responses that compose every rollout on the grid ``phase`` (n samples ``step`` apart).
 
         ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
         dimension, returned when ``forcing`` (n, D) is given); otherwise the rows are ``B`` (the
         goal's share of the input), ``C`` (the start's, with ``y[0] = y[1] = 1``) and ``V`` (the
-        free response to a unit start velocity, ``y[1] = dt``), shape (3, n).
+        free response to a unit start velocity, ``y[1] = step``), shape (3, n).
         """
         alpha, beta, K = params.alpha, params.beta, params.K
         n_steps = phase.shape[0]
-        inputs = phase[: max(n_steps - 2, 0)]
+        n_inputs = max(n_steps - 2, 0)
         if forcing is not None:
-            drives = K * forcing[: inputs.shape[0]].T
+            drives = K * forcing[:n_inputs].T
             y_first = y_second = np.zeros(drives.shape[0])
         else:
-            drives = np.stack([alpha * beta - K * inputs, K * inputs, np.zeros_like(inputs)])
+            # The goal enters through alpha beta g - K gate (g - y0): the gate is the phase
+            # (Eq. 10) or the delayed goal's remaining fraction (robot protocol).
+            gate = phase[:n_inputs] if params.goal_rate == params.alpha_phase else \
+                phase_grid(n_inputs, step, params.tau, params.goal_rate)
+            drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
             y_first = np.array([0.0, 1.0, 0.0])
-            y_second = np.array([0.0, 1.0, self.dt_])
-        responses = _euler_unit_responses(drives, y_first, y_second, h=self.dt_ / params.tau, alpha=alpha, beta=beta)
+            y_second = np.array([0.0, 1.0, step])
+        responses = _euler_unit_responses(drives, y_first, y_second, h=step / params.tau, alpha=alpha, beta=beta)
         return responses[:, :n_steps]
 
-    def _rollout_params(self) -> _Params:
+    def _rollout_params(self, step: float | None = None, params: _Params | None = None) -> _Params:
         """The validated parameters, with the rollout's integration checked for stability."""
         self._check_fitted()
-        params = self._params()  # validated once per rollout
-        check_euler_stable(self.dt_, params.tau, params.alpha, params.beta)
+        params = self._params() if params is None else params  # validated once per rollout
+        step = self.dt_ if step is None else step
+        check_euler_stable(step, params.tau, params.alpha, params.beta)
+        _phase_decay(step, params.tau, params.alpha_phase)
+        _phase_decay(step, params.tau, params.goal_rate)
         return params
 
-    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None):
-        params = self._rollout_params()
+    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
+        params = self._rollout_params(step) if params is None else params
+        step = self.dt_ if step is None else step
         n_dims = self.weights_.shape[1]
         n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response) = self._grid(params, n_steps)
+        phase, basis, (goal_response, start_response, velocity_response) = self._grid(params, n_steps, step)
         forcing = basis @ self.weights_
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
-        free = self._unit_responses(params, phase, forcing).T
+        free = self._unit_responses(params, phase, forcing, step).T
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
@@ -728,13 +874,112 @@ class DMP(BaseEstimator):
         """
         params = self._rollout_params()
         n_steps = self._n_steps(n_steps, params)
-        cached = self._cached_grid(params, n_steps)
+        cached = self._cached_grid(params, n_steps, self.dt_)
         if cached is not None:
             goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
             phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
-            goal_response = self._unit_responses(params, phase, None)[0]
+            goal_response = self._unit_responses(params, phase, None, self.dt_)[0]
         return float(abs(1.0 - goal_response[-1]))
+
+    # -- real time -------------------------------------------------------------------------------
+    def _time_grid(self, duration, dt, params: _Params) -> tuple[float, float, int, float]:
+        """(motion duration s, sample period s, number of samples, normalised step) of a timed
+        rollout; the motion's duration defaults to ``tau · duration_``, the period to the
+        demonstration's."""
+        motion = params.tau * self.duration_ if duration is None else check_real(duration, "duration", positive=True)
+        period = self.duration_ / (self.n_steps_ - 1)
+        dt = period if dt is None else check_real(dt, "dt", positive=True)
+        if dt > motion:
+            raise ValueError(f"dt = {dt:g} s is longer than the motion ({motion:g} s)")
+        scale = motion / self.duration_  # temporal scaling: the shape is kept, time stretched
+        check_real(scale, "duration / duration_ (the temporal scaling)", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
+        if params.protocol == "paper" and duration is None and dt == period:
+            n_samples = max(int(round(params.tau * self.n_steps_)), 1)  # the rollout's own samples
+        else:
+            n_samples = int(round(params.settle * motion / dt)) + 1
+        check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
+        step = self.dt_ if dt == period else dt / self.time_unit_
+        return motion, dt, n_samples, step
+
+    @numerically_guarded
+    def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
+                   limits: dict | None = None, start_velocity=None, forcing_increment=None):
+        """A timed rollout: positions, velocities and accelerations in seconds.
+
+        Parameters
+        ----------
+        goal, start : array (D,), optional
+            Default: the demonstration's goal and start (in ``units_``).
+        duration : float, optional
+            Duration of the motion in seconds (temporal scaling: the shape is kept and time
+            stretched, like ``execution_time`` in movement_primitives); default ``tau ·
+            duration_``. With ``protocol="robot"`` the trajectory runs 1.1x this long, so that it
+            reaches its goal and comes to rest.
+        dt : float, optional
+            Sample period in seconds; default the demonstration's (``duration_ / (T - 1)``).
+        limits : dict, optional
+            ``{"max_velocity": ..., "max_acceleration": ..., "max_jerk": ..., "norm": "norm" |
+            "axis"}`` (units/s, /s², /s³): the duration is chosen as the shortest that meets them
+            (see :func:`bidmp.time_scale`); ``duration`` is then ignored.
+        start_velocity : array (D,), optional
+            Initial velocity in units/s (default at rest).
+        forcing_increment : callable, optional
+            As in :meth:`rollout` (how :class:`bidmp.BiDMP` adds its increments).
+
+        Returns
+        -------
+        bidmp.Trajectory
+            ``t`` from 0 (s), ``y`` (units), ``yd`` (units/s), ``ydd`` (units/s²), each (n, D).
+            ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
+        """
+        from .timing import Trajectory
+
+        self._check_fitted()
+        if limits is not None:
+            return self._limited_trajectory(goal, start, dt, limits, start_velocity, forcing_increment)
+        params = self._params()
+        motion, dt, n_samples, step = self._time_grid(duration, dt, params)
+        params = self._rollout_params(step, params._replace(tau=motion / self.duration_))
+        velocity = None if start_velocity is None else as_point(start_velocity, self.n_dims_, "start_velocity") * self.time_unit_
+        # Two extra samples give the last velocity and acceleration as forward differences.
+        free, goal_response = self._prepare(start, velocity, n_samples + 2, forcing_increment, params=params, step=step)
+        goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+        positions = free + np.outer(goal_response, goal)
+        velocities = np.diff(positions, axis=0) / dt
+        accelerations = np.diff(velocities, axis=0) / dt
+        return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
+                          accelerations[:n_samples], self.units_)
+
+    def _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment):
+        """The shortest duration whose trajectory meets ``limits``: scale by the exact factor of
+        :func:`bidmp.timing.scale_factor`, then correct for the discretisation (a few passes)."""
+        from .timing import scale_factor
+
+        if not isinstance(limits, dict):
+            raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm, got {type(limits).__name__}")
+        unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm"}
+        if unknown:
+            raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, max_jerk, norm")
+        duration = self._params().tau * self.duration_
+        for _ in range(8):
+            trajectory = self.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
+                                         forcing_increment=forcing_increment)
+            factor = scale_factor(trajectory, **limits)
+            if 1.0 - 1e-3 <= factor <= 1.0:
+                return trajectory
+            duration *= factor * (1.0 + 2e-4)  # a hair slower than exact: the check above is one-sided
+        return trajectory
+
+    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling: float = 0.0,
+                start_velocity=None, forcing_increment=None) -> "DMPStepper":
+        """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).
+
+        ``coupling`` is ``alpha_e`` of phase stopping (Ijspeert et al. 2013) in 1/units²: the
+        system's time runs ``1 + alpha_e ‖y_measured - y‖²`` times slower while the robot lags, so
+        a held robot makes the motion pause rather than run away. 0 turns it off.
+        """
+        return DMPStepper(self, goal, start, duration, coupling, start_velocity, forcing_increment)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
@@ -746,13 +991,15 @@ class DMP(BaseEstimator):
             "centres_": self.centres_,
             "widths_": self.widths_,
         }
-        return {"params": self.get_params(), "n_steps_": self.n_steps_}, arrays
+        return {"params": self.get_params(), "n_steps_": self.n_steps_, "duration_": self.duration_,
+                "units_": self.units_}, arrays
 
     @classmethod
     def _from_state(cls, meta: dict, arrays: dict) -> "DMP":
         params = dict(meta["params"])
         if "fit" in params:  # format 1 stored the regression under the name "fit"
             params["regression"] = params.pop("fit")
+        params.setdefault("protocol", "paper")  # formats 1-2 knew only the paper's protocol
         model = cls(**params)
         params = model._params()
         n_kernels = params.n_kernels
@@ -773,5 +1020,107 @@ class DMP(BaseEstimator):
             raise ValueError("member centres_ must lie in (0, 1] (they are phases)")
         model.n_steps_ = n_steps
         model.dt_ = 1.0 / n_steps
+        model.duration_ = check_real(meta.get("duration_", (n_steps - 1) / n_steps), "duration_", positive=True, maximum=1e7)
+        if (n_steps - 1) / model.duration_ > 1e5 or (n_steps - 1) / model.duration_ < 1e-3:
+            raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
+        model.units_ = _check_units(meta.get("units_", ""))
         check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
         return model
+
+
+def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
+    """``y`` followed by rest at its last point for the protocol's settle time (robot: 0.1 T)."""
+    n_rest = int(round(params.settle * y.shape[0])) - y.shape[0]
+    if n_rest <= 0:
+        return y
+    return np.vstack([y, np.repeat(y[-1:], n_rest, axis=0)])
+
+
+def _check_units(units) -> str:
+    """A length unit: a short printable string such as "mm" or "m" ("" = unknown)."""
+    if not isinstance(units, str):
+        raise TypeError(f"units must be a string such as 'mm', got {type(units).__name__}")
+    if len(units) > 16 or not all(c.isprintable() and not c.isspace() for c in units):
+        raise ValueError(f"units must be a short unit name such as 'mm' or 'm', got {units[:20]!r}")
+    return units
+
+
+class DMPStepper:
+    """Integrates a DMP (or a Bi-DMP skill) one control step at a time.
+
+    ``step(dt, y_measured=None)`` returns the command ``(y, yd, ydd)`` for the current sample (units,
+    units/s, units/s²) and advances the state by ``dt`` seconds. Without a measurement (or with
+    ``coupling = 0``) the commands equal :meth:`DMP.trajectory` sample for sample (same explicit
+    Euler steps). With a measurement the system's time runs ``1 + coupling ‖y_measured - y‖²`` times
+    slower (phase stopping, Ijspeert et al. 2013, applied to the whole system so that the spring
+    waits too): a robot held back makes the command pause where it is, and the motion resumes once
+    it catches up.
+
+    Attributes
+    ----------
+    phase : float
+        The canonical state ``ϑ``.
+    time : float
+        The motion's own time in seconds (slower than the wall clock while paused).
+    """
+
+    def __init__(self, dmp: DMP, goal, start, duration, coupling, start_velocity, forcing_increment) -> None:
+        dmp._check_fitted()
+        params = dmp._params()
+        self._dmp = dmp
+        n_dims = dmp.n_dims_
+        self.goal = dmp.goal_.copy() if goal is None else as_point(goal, n_dims, "goal")
+        self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
+        motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
+        self._scale = motion / dmp.duration_  # tau of the normalised system
+        self._params = params._replace(tau=self._scale)
+        self.coupling = check_real(coupling, "coupling", nonnegative=True)
+        self._forcing_increment = forcing_increment
+        self.y = self.start.copy()
+        velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
+        self.phase = 1.0
+        self._gate = 1.0
+        self.time = 0.0
+        self._checked_step = None
+
+    def _drive(self) -> np.ndarray:
+        params = self._params
+        phase = np.array([self.phase])
+        basis = self._dmp.basis(phase)
+        forcing = basis @ self._dmp.weights_
+        if self._forcing_increment is not None:
+            forcing = forcing + self._forcing_increment(phase, basis)
+        return (params.alpha * (params.beta * (self.goal - self.y) - self._z) + params.K * forcing[0]
+                - params.K * self._gate * (self.goal - self.start))
+
+    def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The command for now, then advance ``dt`` seconds (less while the robot lags).
+
+        Returns
+        -------
+        (y, yd, ydd) : arrays (D,)
+            Position (units), velocity (units/s) and acceleration (units/s²) to command.
+        """
+        dt = check_real(dt, "dt", positive=True)
+        params = self._params
+        time_unit = self._dmp.time_unit_
+        slowdown = 1.0
+        if y_measured is not None and self.coupling > 0.0:
+            error = as_point(y_measured, self.y.shape[0], "y_measured") - self.y
+            slowdown = 1.0 + self.coupling * float(error @ error)
+        h = dt / time_unit / slowdown / params.tau  # normalised Euler step of this control step
+        if h != self._checked_step:
+            check_euler_stable(h * params.tau, params.tau, params.alpha, params.beta)
+            self._checked_step = h
+        z_next = self._z + h * self._drive()
+        position = self.y.copy()
+        # The command's velocity and acceleration, as trajectory() reports them: the Euler state.
+        velocity = self._z / (params.tau * time_unit) / slowdown
+        acceleration = (z_next - self._z) / (params.tau * time_unit) / dt / slowdown
+        self.y = self.y + h * self._z
+        self._z = z_next
+        self.phase *= 1.0 - params.alpha_phase * h
+        self._gate *= 1.0 - params.goal_rate * h
+        self.time += dt / slowdown
+        return position, velocity, acceleration

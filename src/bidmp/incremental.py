@@ -220,11 +220,11 @@ class BiDMP(BaseEstimator):
         y = as_trajectory(y_dn, "y_dn")
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"y_dn has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
-        y = resample_time(y, dmp.n_steps_)
+        y = dmp.training_trajectory(y)  # T samples (and, robot protocol, rest at the goal after them)
         phase, basis = dmp.training_grid()
         target = forcing_target(
             y, phase, dt=dmp.dt_, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
-            derivatives=params.derivatives if derivatives == "dmp" else derivatives,
+            derivatives=params.derivatives if derivatives == "dmp" else derivatives, gate=dmp.training_gate(),
         )
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
         return self._learn_block(target - current, y[-1], y[0], increments)
@@ -242,8 +242,8 @@ class BiDMP(BaseEstimator):
         self._ensure_started()
         dmp = self.dmp_
         increment = np.asarray(forcing_increment, dtype=np.float64)
-        if increment.shape != (dmp.n_steps_, dmp.n_dims_):
-            raise ValueError(f"forcing_increment must have shape {(dmp.n_steps_, dmp.n_dims_)}, got {increment.shape}")
+        if increment.shape != (dmp.n_train_, dmp.n_dims_):
+            raise ValueError(f"forcing_increment must have shape {(dmp.n_train_, dmp.n_dims_)}, got {increment.shape}")
         if not np.all(np.isfinite(increment)):
             raise ValueError("forcing_increment contains NaN or inf")
         goal = as_point(goal, dmp.n_dims_, "goal")
@@ -425,7 +425,8 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
     else:
         model = BiDMP(dmp, **bidmp_params)
         model._ensure_started()
-    references = [dmp.rollout()]
+    # Compared over the demonstration's T samples (a robot-protocol rollout rests 0.1 T longer).
+    references = [dmp.rollout()[: dmp.n_steps_]]
     n_skills = len(demonstrations) + 1
     errors = {skill: np.full((n_skills, n_skills), np.nan) for skill in skills}
 
@@ -433,7 +434,7 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
         for skill in skills:
             for p in range(column + 1):
                 rollout = model.rollout(model.skill_goals_[p], skill=skill, start=model.skill_starts_[p])
-                errors[skill][p, column] = rmse(rollout, references[p])
+                errors[skill][p, column] = rmse(rollout[: dmp.n_steps_], references[p])
 
     measure(0)
     for index, demonstration in enumerate(demonstrations, start=1):

@@ -160,7 +160,7 @@ def lasa_generalisation(
     convergence_factor = check_int(convergence_factor, "convergence_factor", minimum=1, maximum=1000)
     shift = check_real(shift, "shift", nonnegative=True, maximum=1e3)
     demonstration = lasa(name)[demo_index]
-    dmp = DMP(**dmp_params).fit(demonstration)
+    dmp = DMP(**{"protocol": "paper", **dmp_params}).fit(demonstration)
     angles = np.linspace(0.0, 2.0 * np.pi, n_goals, endpoint=False)
     radius = shift * path_extent(demonstration)
     goals = demonstration[-1] + radius * np.column_stack([np.cos(angles), np.sin(angles)])
@@ -354,7 +354,7 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
     offsets = as_points(offsets, 2, "offsets")
     check_int(offsets.shape[0], "the number of offsets", limit="max_targets")
     seed = check_int(seed, "seed", minimum=0, maximum=2**32)
-    dmp = DMP().fit(demonstration)
+    dmp = DMP(protocol="paper").fit(demonstration)
     targets = demonstration[-1] + offsets * path_extent(demonstration)
     extensions = [extend_demonstration(demonstration, target, seed=seed + index) for index, target in enumerate(targets)]
     model = BiDMP(dmp, **bidmp_params)

@@ -63,7 +63,8 @@ _KEYS = {
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
     "seed",
 }
-_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives"}
+_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
+             "goal_rate"}
 _BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
 _EXTENSION_KEYS = {
     "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",

@@ -1,0 +1,289 @@
+"""Real time: timed trajectories, timestamps, preparing recordings, time scaling to limits.
+
+* :class:`Trajectory` — ``t`` (s) and ``y``, ``yd``, ``ydd`` (units, units/s, units/s²).
+* :func:`check_timestamps` — monotone, finite, a plausible sample rate (1 Hz … 100 kHz).
+* :func:`prepare` — a kinesthetic recording made usable: uniform time, zero-phase low-pass
+  filtered, idle start and end trimmed.
+* :func:`time_scale` — the shortest uniformly time-scaled copy of a trajectory within velocity,
+  acceleration (and jerk) limits.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._checks import as_trajectory, check_choice, check_real, numerically_guarded
+
+__all__ = ["Trajectory", "check_timestamps", "uniform_time", "prepare", "time_scale", "PrepareInfo"]
+
+logger = logging.getLogger(__name__)
+
+MIN_RATE_HZ = 1.0
+MAX_RATE_HZ = 100_000.0
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A timed trajectory: what a robot controller consumes.
+
+    Attributes
+    ----------
+    t : array (n,)
+        Time in seconds, starting at 0, increasing.
+    y, yd, ydd : array (n, D)
+        Position (units), velocity (units/s), acceleration (units/s²).
+    units : str
+        Length unit of ``y`` ("" if unknown).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    yd: np.ndarray
+    ydd: np.ndarray
+    units: str = ""
+
+    def __post_init__(self) -> None:
+        n = self.t.shape[0]
+        for name in ("y", "yd", "ydd"):
+            if getattr(self, name).shape[0] != n or getattr(self, name).ndim != 2:
+                raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {getattr(self, name).shape}")
+
+    @property
+    def duration(self) -> float:
+        """``t[-1] - t[0]`` in seconds."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def n_dims(self) -> int:
+        return int(self.y.shape[1])
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def columns(self) -> tuple[list[str], np.ndarray]:
+        """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the
+        matching (n, 1 + 3D) array: the layout of timed CSV and ``.npy`` files."""
+        names = ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)]
+        header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
+        return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
+
+    def peak_speed(self) -> float:
+        """Largest ‖yd‖ (units/s)."""
+        return float(np.max(np.linalg.norm(self.yd, axis=1)))
+
+    def peak_acceleration(self) -> float:
+        """Largest ‖ydd‖ (units/s²)."""
+        return float(np.max(np.linalg.norm(self.ydd, axis=1)))
+
+
+def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
+    """Validate timestamps (s) for ``n_samples`` samples and return them as float64 (n,).
+
+    Any monotone stamps are accepted: jittered, starting anywhere (epoch seconds included).
+
+    Raises
+    ------
+    ValueError
+        If they are not finite, not strictly increasing (duplicates are named), or imply a mean
+        sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
+    """
+    if isinstance(t, (str, bytes)):
+        raise TypeError(f"{name} must be an array of times in seconds, got a string")
+    try:
+        stamps = np.asarray(t, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of times in seconds") from None
+    if stamps.ndim != 1 or stamps.shape[0] != n_samples:
+        raise ValueError(f"{name} must have shape ({n_samples},) (one time per sample), got {stamps.shape}")
+    if not np.all(np.isfinite(stamps)):
+        raise ValueError(f"{name} contains NaN or inf")
+    if np.max(np.abs(stamps)) > 1e12:
+        raise ValueError(f"{name} has values beyond 1e12 s: timestamps must be seconds")
+    steps = np.diff(stamps)
+    if np.any(steps <= 0):
+        row = int(np.argmax(steps <= 0)) + 1
+        kind = "duplicate timestamp" if steps[row - 1] == 0 else "timestamp going back"
+        raise ValueError(f"{name} must increase strictly: {kind} at sample {row} ({stamps[row]!r} s after {stamps[row - 1]!r} s)")
+    rate = (n_samples - 1) / (stamps[-1] - stamps[0])
+    if rate < MIN_RATE_HZ:
+        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
+                         f"seconds (these look like milliseconds, microseconds or nanoseconds)")
+    if rate > MAX_RATE_HZ:
+        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, above {MAX_RATE_HZ:g} Hz: timestamps must be "
+                         f"seconds (these look like minutes or hours, or the samples are not a recording)")
+    return stamps
+
+
+def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``y`` sampled at stamps ``t`` resampled to as many uniform samples over the same span;
+    returns (y_uniform (n, D), t_uniform (n,) starting at 0)."""
+    t = t - t[0]
+    grid = np.linspace(0.0, t[-1], t.shape[0])
+    steps = np.diff(t)
+    if np.ptp(steps) <= 1e-9 * np.mean(steps):
+        return y.copy(), grid
+    return np.column_stack([np.interp(grid, t, column) for column in y.T]), grid
+
+
+@dataclass(frozen=True)
+class PrepareInfo:
+    """What :func:`prepare` did: the kept span of the recording (s, from its first stamp), the
+    filter cutoff (Hz), the sample rate (Hz) and the peak speed (units/s)."""
+
+    start_s: float
+    end_s: float
+    cutoff_hz: float
+    rate_hz: float
+    peak_speed: float
+
+
+def _moving_span(speed: np.ndarray, rate: float, fraction: float) -> tuple[int, int]:
+    """First and last sample of the motion: the speed exceeds ``fraction`` of its peak for at
+    least 0.1 s (shorter excursions are noise), extended outwards down the acceleration ramps to
+    where the speed stops falling (the rest the motion starts from and comes to)."""
+    threshold = fraction * np.max(speed)
+    moving = speed > threshold
+    minimum_run = max(int(round(0.1 * rate)), 1)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], moving.astype(np.int8), [0]])))
+    runs = [(start, stop) for start, stop in zip(edges[::2], edges[1::2]) if stop - start >= minimum_run]
+    if not runs:
+        raise ValueError("the recording never moves: its speed stays below "
+                         f"{fraction:g} of its peak for 0.1 s or longer")
+    first, last = runs[0][0], runs[-1][1] - 1
+    floor = np.median(speed[~moving]) if np.any(~moving) else 0.0
+    while first > 0 and speed[first - 1] < speed[first] and speed[first - 1] > floor:
+        first -= 1
+    while last < speed.shape[0] - 1 and speed[last + 1] < speed[last] and speed[last + 1] > floor:
+        last += 1
+    return int(first), int(last)
+
+
+@numerically_guarded
+def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = "") -> tuple[Trajectory, PrepareInfo]:
+    """Make a kinesthetic recording usable for learning.
+
+    1. Uniform time: the samples are resampled to their mean rate over the same span.
+    2. Zero-phase low-pass filter: a 4th-order Butterworth run forwards and backwards
+       (:func:`scipy.signal.sosfiltfilt`) at ``cutoff_hz`` (default 6 Hz: hand-guided motions
+       have no content above ~3 Hz; sensor noise is white).
+    3. Idle ends trimmed: the motion is where the filtered speed exceeds ``idle_fraction`` of its
+       peak for at least 0.1 s, extended down the acceleration ramps to rest.
+
+    Parameters
+    ----------
+    y : array (T, D)
+        Positions in ``units`` (e.g. mm).
+    t : array (T,)
+        Timestamps in seconds (see :func:`check_timestamps`).
+
+    Returns
+    -------
+    (Trajectory, PrepareInfo)
+        The trimmed motion, time from 0 s, with filtered velocities and accelerations.
+    """
+    from scipy.signal import butter, sosfiltfilt
+
+    y = as_trajectory(y, "y", min_points=10)
+    t = check_timestamps(t, y.shape[0])
+    cutoff_hz = check_real(cutoff_hz, "cutoff_hz", positive=True)
+    idle_fraction = check_real(idle_fraction, "idle_fraction", positive=True, maximum=0.5)
+    uniform, grid = uniform_time(y, t)
+    rate = (grid.shape[0] - 1) / grid[-1]
+    if cutoff_hz >= 0.5 * rate:
+        raise ValueError(f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate ({0.5 * rate:.4g} Hz)")
+    sos = butter(4, cutoff_hz, fs=rate, output="sos")
+    # Pad with the signal's even reflection (a resting end stays at rest) over ~3 filter periods.
+    padlen = min(3 * int(np.ceil(rate / cutoff_hz)), uniform.shape[0] - 1)
+    filtered = sosfiltfilt(sos, uniform, axis=0, padtype="even", padlen=padlen)
+    dt = grid[1] - grid[0]
+    velocity = np.gradient(filtered, dt, axis=0)
+    speed = np.linalg.norm(velocity, axis=1)
+    first, last = _moving_span(speed, rate, idle_fraction)
+    if last - first + 1 < 10:
+        raise ValueError(f"the recording moves for only {last - first + 1} samples ({(last - first) * dt:.3g} s)")
+    kept = filtered[first : last + 1]
+    kept_velocity = velocity[first : last + 1]
+    acceleration = np.gradient(kept_velocity, dt, axis=0)
+    times = grid[first : last + 1] - grid[first]
+    logger.info("prepare: kept %.3f-%.3f s of %.3f s (%d samples at %.1f Hz)", grid[first], grid[last], grid[-1],
+                last - first + 1, rate)
+    info = PrepareInfo(start_s=float(grid[first]), end_s=float(grid[last]), cutoff_hz=cutoff_hz, rate_hz=float(rate),
+                       peak_speed=float(np.max(speed)))
+    return Trajectory(times, kept, kept_velocity, acceleration, units), info
+
+
+def _peaks(values: np.ndarray, norm: str) -> np.ndarray:
+    """Peak magnitude of (n, D) values: one number ('norm') or one per axis ('axis')."""
+    if norm == "norm":
+        return np.array([np.max(np.linalg.norm(values, axis=1))])
+    return np.max(np.abs(values), axis=0)
+
+
+def _limit_array(limit, n_dims: int, norm: str, name: str) -> np.ndarray | None:
+    if limit is None:
+        return None
+    array = np.asarray(limit, dtype=np.float64).reshape(-1)
+    expected = 1 if norm == "norm" else n_dims
+    if array.shape[0] == 1 and expected > 1:
+        array = np.repeat(array, expected)
+    if array.shape[0] != expected or not np.all(np.isfinite(array)) or np.any(array <= 0):
+        raise ValueError(f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, got {limit!r}")
+    return array
+
+
+def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
+                 norm: str = "norm") -> float:
+    """The factor ``k`` by which a uniform time scaling ``t → k t`` makes ``trajectory`` meet
+    the limits with the binding one met exactly (``k < 1`` speeds up a slow trajectory).
+
+    Velocity scales as 1/k, acceleration as 1/k², jerk as 1/k³.
+    """
+    check_choice(norm, "norm", ("norm", "axis"))
+    n_dims = trajectory.n_dims
+    factors = []
+    for limit, values, power, name in (
+        (max_velocity, trajectory.yd, 1, "max_velocity"),
+        (max_acceleration, trajectory.ydd, 2, "max_acceleration"),
+        (max_jerk, None, 3, "max_jerk"),
+    ):
+        limits = _limit_array(limit, n_dims, norm, name)
+        if limits is None:
+            continue
+        if values is None:
+            values = np.gradient(trajectory.ydd, trajectory.t, axis=0)
+        peaks = _peaks(values, norm)
+        factors.append(float(np.max((peaks / limits) ** (1.0 / power))))
+    if not factors:
+        raise ValueError("time_scale needs at least one of max_velocity, max_acceleration, max_jerk")
+    factor = max(factors)
+    if factor <= 0.0:
+        raise ValueError("the trajectory does not move: there is no time scaling that touches a limit")
+    return factor
+
+
+@numerically_guarded
+def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
+               norm: str = "norm") -> Trajectory:
+    """The shortest uniformly time-scaled copy of ``trajectory`` within the limits.
+
+    The path is unchanged; time is stretched (or shrunk) by one factor ``k`` so that the binding
+    limit is met exactly: ``t' = k t``, ``yd' = yd / k``, ``ydd' = ydd / k²``. Limits are never
+    met by clipping: a clipped DMP state loses the system's stability and its goal.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+    max_velocity, max_acceleration, max_jerk : float or array (D,), optional
+        Limits in units/s, units/s², units/s³; at least one.
+    norm : {"norm", "axis"}
+        Limit the Euclidean norm of the vectors (Cartesian speed) or every axis on its own
+        (joint limits; then a limit may be one number or one per axis).
+    """
+    if not isinstance(trajectory, Trajectory):
+        raise TypeError(f"trajectory must be a bidmp.Trajectory, got {type(trajectory).__name__}")
+    factor = scale_factor(trajectory, max_velocity, max_acceleration, max_jerk, norm)
+    return Trajectory(trajectory.t * factor, trajectory.y.copy(), trajectory.yd / factor, trajectory.ydd / factor**2,
+                      trajectory.units)
