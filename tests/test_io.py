@@ -67,7 +67,7 @@ def test_trajectory_round_trip_is_exact(tmp_path, suffix):
         ("same.csv", "x,y\n1,1\n1,1\n1,1\n", "identical"),
         ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b not understood"),
         ("onecol.csv", "1\n2\n3\n", "expected 2-4 columns"),
-        ("time.csv", "t,x,y\n0,0,0\n0,1,1\n1,2,2\n", "time must increase strictly"),
+        ("time.csv", "t,x,y\n0,0,0\n0,1,1\n1,2,2\n", "must increase strictly"),
         ("demo.json", "{}", "unsupported file type .json"),
     ],
 )
@@ -208,4 +208,20 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
     rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))
     with pytest.raises(ModelFileError, match="did not vanish with the phase"):
         bidmp.load(path)
-    assert FORMAT_VERSION == 2
+    assert FORMAT_VERSION == 3
+
+
+def test_format_2_dmp_files_load_as_the_paper_protocol(tmp_path, fitted):
+    path = bidmp.save(fitted, tmp_path / "m.npz")
+
+    def to_format_2(meta, arrays):
+        meta["format_version"] = 2
+        for key in ("protocol", "goal_rate"):
+            meta["state"]["params"].pop(key)
+        meta["state"].pop("duration_")
+        meta["state"].pop("units_")
+
+    rewrite_meta(path, to_format_2)
+    old = bidmp.load(path)
+    assert old.protocol == "paper" and old.duration_ == pytest.approx((fitted.n_steps_ - 1) / fitted.n_steps_)
+    np.testing.assert_array_equal(old.rollout(), fitted.rollout())

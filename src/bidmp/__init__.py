@@ -14,6 +14,9 @@ __version__ = "0.2.0"
 # public name -> (module, attribute)
 _LAZY = {
     "DMP": ("bidmp.dmp", "DMP"),
+    "Trajectory": ("bidmp.timing", "Trajectory"),
+    "prepare": ("bidmp.timing", "prepare"),
+    "time_scale": ("bidmp.timing", "time_scale"),
     "segment": ("bidmp.segmentation", "segment"),
     "Segmentation": ("bidmp.segmentation", "Segmentation"),
     "frechet_distance": ("bidmp.similarity", "frechet_distance"),
@@ -32,7 +35,7 @@ _LAZY = {
     "set_limits": ("bidmp._checks", "set_limits"),
 }
 _SUBMODULES = (
-    "dmp", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
+    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
     "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting",
 )
 
@@ -44,6 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from .incremental import BiDMP, forgetting  # noqa: F401
     from ._checks import Limits, NotFittedError, get_limits, set_limits  # noqa: F401
     from .dmp import DMP  # noqa: F401
+    from .timing import Trajectory, prepare, time_scale  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401
     from .segmentation import Segmentation, segment  # noqa: F401
     from .similarity import frechet_distance, frechet_similarity  # noqa: F401

@@ -40,30 +40,55 @@ def _parse_K(text: str):
 # ---------------------------------------------------------------------------------------------
 # Command handlers
 # ---------------------------------------------------------------------------------------------
+def _read_demo(path: str, args: argparse.Namespace):
+    """A demonstration file as the library wants it: (y, t or None, how it was read). Timed input
+    is prepared (idle ends trimmed, noise filtered, uniform time) unless ``--raw``."""
+    from .io import read_trajectory
+    from .timing import prepare
+
+    y, t = read_trajectory(path)
+    if t is None or args.raw:
+        how = "as recorded" if t is None else f"as recorded ({t[-1] - t[0]:.3f} s)"
+        return y, t, how
+    prepared, info = prepare(y, t, cutoff_hz=args.cutoff)
+    how = (f"prepared: kept {info.start_s:.2f}-{info.end_s:.2f} s of {t[-1] - t[0]:.2f} s, low-pass {info.cutoff_hz:g} Hz "
+           f"at {info.rate_hz:.1f} Hz, peak speed {info.peak_speed:.4g} {args.units or 'units'}/s")
+    return prepared.y, prepared.t, how
+
+
 def _cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .dmp import DMP
-    from ._trajectory import resample_time
-    from .io import load_trajectory, save_model
-    from .metrics import path_extent, rmse
+    from .io import save_model
+    from .metrics import path_extent
 
-    demonstration = load_trajectory(args.demo)
+    demonstration, times, how = _read_demo(args.demo, args)
     dmp = DMP(
         n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K,
-        alpha_phase=args.alpha_phase, tau=args.tau, regression=args.regression,
-    ).fit(demonstration)
+        alpha_phase=args.alpha_phase, tau=args.tau, regression=args.regression, protocol=args.protocol,
+    ).fit(demonstration, times, units=args.units)
     path = save_model(dmp, args.output)
-    reproduction = dmp.rollout()  # round(tau * T) samples: with tau != 1 the same path, slower
-    error = rmse(reproduction, resample_time(demonstration, reproduction.shape[0]))
+    reproduction = dmp.trajectory()
+    n = min(reproduction.y.shape[0], demonstration.shape[0])
+    from ._trajectory import resample_time
+
+    reference = resample_time(demonstration, dmp.n_steps_)
+    error = float(np.sqrt(np.mean(np.sum((dmp.rollout()[: dmp.n_steps_] - reference) ** 2, axis=1))))
     extent = path_extent(demonstration)
     if not np.isfinite(error):  # never print a non-finite result as a success
         raise ValueError(f"the fitted DMP does not reproduce {args.demo} (RMSE {error}); the settings are out of range")
-    print(f"fitted a DMP on {args.demo}: T = {dmp.n_steps_} samples, D = {dmp.n_dims_}, "
-          f"rollouts take {reproduction.shape[0]} samples of {dmp.dt_:.4g} s (tau = {dmp.tau:g})")
+    unit = dmp.units_ or "units"
+    print(f"fitted a DMP ({dmp.protocol} protocol) on {args.demo}, {how}")
+    print(f"  T = {dmp.n_steps_} samples over {dmp.duration_:.4g} s ({dmp.sample_rate_:.4g} Hz), D = {dmp.n_dims_}, "
+          f"units {dmp.units_ or '(not given)'}")
     print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
-    print(f"  reproduction RMSE {error:.4g} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
-    print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {reproduction.shape[0]} samples")
+    print(f"  reproduction RMSE {error:.4g} {unit} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
+    print(f"  rollouts last {reproduction.duration:.4g} s (tau = {dmp.tau:g}; peak speed {reproduction.peak_speed():.4g} {unit}/s, "
+          f"peak acceleration {reproduction.peak_acceleration():.4g} {unit}/s^2)")
+    if dmp.protocol == "paper":
+        print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {dmp.default_n_steps()} samples")
+    del n
     print(f"wrote {path}")
     return EXIT_OK
 
@@ -73,6 +98,27 @@ def _rollout_goal(model, goal):
     if goal is not None:
         return goal
     return model.skill_goals_[-1] if hasattr(model, "skill_goals_") else model.goal_
+
+
+def _timing_options(args: argparse.Namespace, dmp) -> dict:
+    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc."""
+    options = {"duration": args.duration}
+    if args.rate is not None and args.n_steps is not None:
+        raise ValueError("give --rate or --n-steps, not both")
+    if args.rate is not None:
+        if not 0 < args.rate <= 100_000:
+            raise ValueError(f"--rate must be in (0, 100000] Hz, got {args.rate:g}")
+        options["dt"] = 1.0 / args.rate
+    elif args.n_steps is not None:
+        if args.n_steps < 2:
+            raise ValueError(f"--n-steps must be >= 2, got {args.n_steps}")
+        motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
+        settle = dmp._params().settle
+        options["dt"] = settle * motion / (args.n_steps - 1)  # the same motion, sampled more finely
+    if args.max_speed is not None or args.max_acc is not None:
+        options["limits"] = {"max_velocity": args.max_speed, "max_acceleration": args.max_acc}
+        options.pop("duration")
+    return options
 
 
 def _cmd_rollout(args: argparse.Namespace) -> int:
@@ -86,28 +132,34 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
     if isinstance(model, DMP):
         if args.skill is not None:
             raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a plain DMP")
-        trajectory = model.rollout(goal=args.goal, start=args.start, n_steps=args.n_steps)
         dmp = model
+        trajectory = model.trajectory(goal=args.goal, start=args.start, **_timing_options(args, dmp))
     elif isinstance(model, BiDMP):
         skill = "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
         query = _rollout_goal(model, args.goal)
         index = model.select_skill(query, skill)
-        trajectory = model.rollout(goal=query, skill=skill, start=args.start, n_steps=args.n_steps)
+        dmp = model.dmp_
+        trajectory = model.trajectory(goal=query, skill=skill, start=args.start, **_timing_options(args, dmp))
         print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal "
               f"{np.array2string(model.skill_goals_[index], precision=3)})")
-        dmp = model.dmp_
     else:
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
-    times = np.arange(trajectory.shape[0]) * dmp.dt_  # one Euler step is dt seconds
-    path = save_trajectory(trajectory, args.output, times=times if args.output.lower().endswith(".csv") else None)
+    path = save_trajectory(trajectory, args.output)
     goal = np.asarray(_rollout_goal(model, args.goal), dtype=float)
-    print(f"rolled out {trajectory.shape[0]} steps to goal {np.array2string(goal, precision=4)}")
-    print(f"  end point {np.array2string(trajectory[-1], precision=4)}, distance to goal {np.linalg.norm(trajectory[-1] - goal):.4g}")
-    print(f"wrote {path}")
+    unit = dmp.units_ or "units"
+    rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
+    print(f"rolled out {len(trajectory)} samples over {trajectory.duration:.4g} s ({rate:.4g} Hz) to goal "
+          f"{np.array2string(goal, precision=4)}")
+    print(f"  end point {np.array2string(trajectory.y[-1], precision=4)}, distance to goal "
+          f"{np.linalg.norm(trajectory.y[-1] - goal):.4g} {unit}")
+    print(f"  peak speed {trajectory.peak_speed():.4g} {unit}/s, peak acceleration {trajectory.peak_acceleration():.4g} "
+          f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
+    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
         from .plotting import plot_trajectories
 
-        figure = plot_trajectories(args.plot, dmp.rollout(), [trajectory], ["rollout"], goals=goal[None], title="rollout")
+        figure = plot_trajectories(args.plot, dmp.rollout(), [trajectory.y], ["rollout"], goals=goal[None], title="rollout",
+                                   units=dmp.units_)
         print(f"wrote {figure}")
     return EXIT_OK
 
@@ -231,12 +283,13 @@ def _cmd_segment(args: argparse.Namespace) -> int:
 def _cmd_extend(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from ._trajectory import resample_time
     from .dmp import DMP
     from .extension import extend_demonstration
-    from ._trajectory import resample_time
     from .incremental import BiDMP
-    from .io import load_model, load_trajectory, save_model, save_trajectory
+    from .io import load_model, save_model, save_trajectory
     from .metrics import path_extent, rmse
+    from .timing import Trajectory
 
     if not args.output.lower().endswith(".npz"):
         raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}; "
@@ -246,13 +299,18 @@ def _cmd_extend(args: argparse.Namespace) -> int:
         model = BiDMP(model)
     elif not isinstance(model, BiDMP):
         raise ValueError(f"{args.model} holds a {type(model).__name__}; extend needs a DMP or a Bi-DMP model")
-    y = load_trajectory(args.demo)
+    dmp = model.dmp if model.dmp is not None else model.dmp_
+    if args.units and dmp.units_ and args.units != dmp.units_:
+        raise ValueError(f"{args.demo} is in {args.units} but the model {args.model} is in {dmp.units_}: "
+                         f"convert one of them first")
+    y, _, how = _read_demo(args.demo, args)
     n_dims = model.n_dims_
     if y.shape[1] != n_dims:
         raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {n_dims}")
     extension = extend_demonstration(y, args.target, seed=args.seed)
     target = extension.new_target
     history = extension.similarity_history
+    print(f"{args.demo}: {how}")
     print(f"segmentation points {extension.segmentation_points.tolist()}; imitating piece {extension.piece.index} "
           f"(samples {extension.piece.start}-{extension.piece.end}) from seg = {np.array2string(y[extension.seg_index], precision=3)}")
     if len(history):
@@ -260,18 +318,25 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     before = np.linalg.norm(model.rollout(target)[-1] - target)
     model.learn(extension.complete)
     rollout = model.rollout(target)
+    dmp = model.dmp_
     scale = path_extent(extension.complete)
-    error = rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
+    error = rmse(rollout[: dmp.n_steps_], resample_time(extension.complete, dmp.n_steps_))
+    unit = dmp.units_ or "units"
     print(f"learned skill {model.n_skills - 1}: rollout to the target reproduces the extended demonstration with "
-          f"RMSE {error:.4g} ({100 * error / scale:.3g} % of its extent)")
-    print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1] - target):.4g} after")
+          f"RMSE {error:.4g} {unit} ({100 * error / scale:.3g} % of its extent)")
+    print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1] - target):.4g} {unit} after")
     print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
     if args.save_demo:
-        print(f"wrote the extended demonstration to {save_trajectory(extension.complete, args.save_demo)}")
+        complete = resample_time(extension.complete, dmp.n_steps_)
+        period = dmp.duration_ / (dmp.n_steps_ - 1)
+        velocity = np.gradient(complete, period, axis=0)
+        timed = Trajectory(np.arange(dmp.n_steps_) * period, complete, velocity, np.gradient(velocity, period, axis=0),
+                           dmp.units_)
+        print(f"wrote the extended demonstration ({timed.duration:.4g} s) to {save_trajectory(timed, args.save_demo)}")
     if args.plot:
         from .plotting import plot_extension
 
-        print(f"wrote {plot_extension(args.plot, extension)}")
+        print(f"wrote {plot_extension(args.plot, extension, units=dmp.units_)}")
     return EXIT_OK
 
 
@@ -302,6 +367,17 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 # ---------------------------------------------------------------------------------------------
 # Parser
 # ---------------------------------------------------------------------------------------------
+_TIMED_INPUT = ("A timed DEMO (a CSV t column in seconds, or a timed .npy) is prepared unless --raw: the idle start "
+                "and end are trimmed (speed below 5 %% of the peak), the noise is removed by a zero-phase low-pass "
+                "filter (--cutoff, default 6 Hz) and the samples are resampled to uniform time.")
+
+
+def _demo_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--units", default="", metavar="UNIT", help="length unit of the demonstration, e.g. mm (kept in the model)")
+    parser.add_argument("--raw", action="store_true", help="use a timed demonstration as recorded (no trimming or filtering)")
+    parser.add_argument("--cutoff", type=float, default=6.0, metavar="HZ", help="low-pass cutoff for timed input in Hz (default 6)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bidmp",
@@ -312,23 +388,42 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logging")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    fit = commands.add_parser("fit", help="learn a DMP from a demonstration", description="Learn a DMP from one demonstration and save it as a model file (.npz).")
+    fit = commands.add_parser(
+        "fit", help="learn a DMP from a demonstration",
+        description="Learn a DMP from one demonstration and save it as a model file (.npz). Time is in seconds: a CSV "
+                    "with a t column (or a timed .npy) gives the motion its real duration; without one the samples "
+                    "are taken as 1 s in all (the paper's convention). Lengths are in the demonstration's unit "
+                    "(--units names it, e.g. mm); velocities are units/s, accelerations units/s^2.",
+        epilog=_TIMED_INPUT)
     fit.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy)")
     fit.add_argument("-o", "--output", required=True, metavar="MODEL", help="model file to write (.npz)")
-    fit.add_argument("--n-kernels", type=int, default=50, help="kernels per dimension (default 50)")
-    fit.add_argument("--alpha", type=float, default=25.0, help="spring-damper gain alpha (default 25)")
+    _demo_options(fit)
+    fit.add_argument("--protocol", choices=("robot", "paper"), default="robot",
+                     help="robot (default: goals reached, smooth starts, real time) or paper (the paper's fixed horizon)")
+    fit.add_argument("--n-kernels", type=int, default=None, help="kernels per dimension (default: robot 100, paper 50)")
+    fit.add_argument("--alpha", type=float, default=None, help="spring-damper gain alpha (default: robot 50, paper 25)")
     fit.add_argument("--beta", type=float, default=None, help="spring ratio beta (default alpha/4)")
-    fit.add_argument("--K", type=_parse_K, default="paper", help="forcing gain: paper (K=alpha), pastor (K=alpha*beta) or a number")
-    fit.add_argument("--alpha-phase", type=float, default=1.0, help="phase decay alpha_phase (default 1)")
+    fit.add_argument("--K", type=_parse_K, default=None,
+                     help="forcing gain: paper (K=alpha), pastor (K=alpha*beta) or a number (default: robot pastor, paper paper)")
+    fit.add_argument("--alpha-phase", type=float, default=None, help="phase decay alpha_phase (default: robot 4, paper 1)")
     fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling: rollouts take tau times the demonstration's duration (default 1)")
     fit.add_argument("--regression", "--fit", dest="regression", choices=("lwr", "ridge"), default="lwr", help="weight regression (default lwr)")
     fit.set_defaults(handler=_cmd_fit)
 
-    rollout = commands.add_parser("rollout", help="generate a trajectory from a model", description="Roll a saved model out to a goal and write the trajectory.")
+    rollout = commands.add_parser(
+        "rollout", help="generate a timed trajectory from a model",
+        description="Roll a saved model out to a goal and write the timed trajectory: t (s), positions (the model's "
+                    "units), velocities (units/s) and accelerations (units/s^2), as CSV columns t,x,y,z,vx,vy,vz,ax,ay,az "
+                    "or a .npy structured array with those fields. The motion lasts the demonstration's duration "
+                    "(times tau, or --duration) plus 10 %% to come to rest (robot protocol).")
     rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
-    rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates (default: the demonstrated goal)")
+    rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates in the model's units (default: the demonstrated goal)")
     rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
-    rollout.add_argument("--n-steps", type=int, default=None, help="number of samples (default: round(tau * T), T = the demonstration's)")
+    rollout.add_argument("--duration", type=float, default=None, metavar="S", help="duration of the motion in seconds (temporal scaling; default: the demonstration's)")
+    rollout.add_argument("--rate", type=float, default=None, metavar="HZ", help="sample rate in Hz (default: the demonstration's)")
+    rollout.add_argument("--n-steps", type=int, default=None, help="instead of --rate: this many samples over the same motion")
+    rollout.add_argument("--max-speed", type=float, default=None, metavar="V", help="slow the motion (uniformly) to keep the speed <= V units/s")
+    rollout.add_argument("--max-acc", type=float, default=None, metavar="A", help="slow the motion (uniformly) to keep the acceleration <= A units/s^2")
     rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy)")
     rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
@@ -344,12 +439,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     extend = commands.add_parser("extend", help="learn a new target incrementally (1D-SEG + G-PRM + Bi-DMP)",
                                  description="Segment DEMO, grow an extended demonstration to the new target with G-PRM, "
-                                             "and learn it incrementally on top of MODEL (a DMP or a Bi-DMP) as a new skill.")
+                                             "and learn it incrementally on top of MODEL (a DMP or a Bi-DMP) as a new skill. "
+                                             "Coordinates are in the model's units.",
+                                 epilog=_TIMED_INPUT)
     extend.add_argument("model", metavar="MODEL", help="a DMP (from 'bidmp fit') or Bi-DMP (from 'bidmp extend') model file")
     extend.add_argument("demo", metavar="DEMO", help="the demonstration to extend (.csv or .npy)")
     extend.add_argument("--target", type=float, nargs="+", required=True, metavar="X", help="new target coordinates")
     extend.add_argument("-o", "--output", required=True, metavar="MODEL2", help="Bi-DMP model file to write (.npz)")
-    extend.add_argument("--save-demo", metavar="OUT", help="also write the extended demonstration (.csv or .npy)")
+    extend.add_argument("--save-demo", metavar="OUT", help="also write the extended demonstration, timed like a rollout (.csv or .npy)")
+    _demo_options(extend)
     extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
     extend.add_argument("--plot", metavar="PNG", help="also write a figure")
     extend.set_defaults(handler=_cmd_extend)

@@ -322,6 +322,30 @@ class BiDMP(BaseEstimator):
             forcing_increment=lambda phase, basis: self._increment(phase, basis, index),
         )
 
+    def _skill_query(self, goal, skill, start):
+        """(skill index, goal, start, forcing increment) of a query, as :meth:`rollout` resolves it."""
+        self._ensure_started()
+        query = self.skill_goals_[-1] if goal is None else as_point(goal, self.dmp_.n_dims_, "goal")
+        index = self.select_skill(query, skill)
+        goal = self.skill_goals_[index] if goal is None else query
+        start = self.skill_starts_[index] if start is None else start
+        increment = None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
+        return index, goal, start, increment
+
+    @numerically_guarded
+    def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
+                   *, limits: dict | None = None):
+        """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
+        with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²)."""
+        _, goal, start, increment = self._skill_query(goal, skill, start)
+        return self.dmp_.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
+                                    forcing_increment=increment)
+
+    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *, coupling: float = 0.0):
+        """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
+        _, goal, start, increment = self._skill_query(goal, skill, start)
+        return self.dmp_.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)
+
     # -- persistence -----------------------------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
         self._ensure_started()

@@ -49,6 +49,7 @@ __all__ = [
     "save_model",
     "load_model",
     "load_trajectory",
+    "read_trajectory",
     "save_trajectory",
     "atomic_write",
     "load_json",
@@ -56,10 +57,11 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-FORMAT_VERSION = 2
-# Format 2 (bidmp 0.2): Bi-DMP increments are gated by the phase and the DMP's regression is stored
-# as "regression". Format-1 DMP and BLS files still load; format-1 Bi-DMP files do not, because
-# their blocks were trained on the ungated increment and would roll out wrongly.
+FORMAT_VERSION = 3
+# Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
+# Bi-DMP increments are gated by the phase and the DMP's regression is stored as "regression".
+# Format-1 and -2 DMP and BLS files still load (as protocol "paper", 1 s, no units); format-1
+# Bi-DMP files do not, because their blocks were trained on the ungated increment.
 _MIN_VERSION = {"BiDMP": 2}
 _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
@@ -479,8 +481,8 @@ def load_model(path: str | os.PathLike):
 # Trajectories
 # ---------------------------------------------------------------------------------------------
 _TIME_NAMES = ("t", "time")
-_MAX_TIME_S = 1e12
-_SLOW_CSV_BYTES = 256 << 20  # time stamps are seconds: epoch-like stamps are ~1.7e9
+
+_SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
 
@@ -501,17 +503,32 @@ def _check_file(path: Path, what: str) -> None:
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
 
 
+def _timed_columns(columns: tuple[str, ...]) -> int | None:
+    """For a header ``t,x,y[,z],vx,…,ax,…`` (what :func:`save_trajectory` writes for a
+    :class:`bidmp.Trajectory`): the number of position columns; None for other headers."""
+    if not columns or columns[0] not in _TIME_NAMES:
+        return None
+    for names in _POSITION_HEADERS:
+        if columns[1:] == (*names, *(f"v{n}" for n in names), *(f"a{n}" for n in names)):
+            return len(names)
+    return None
+
+
 def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a CSV trajectory; return (positions (T, D), times (T,) or None)."""
     parsed = _csv_fast(path)
     columns, values = parsed if parsed is not None else _csv_rows(path)
     n_columns = values.shape[1]
     if columns is not None:
+        n_positions = _timed_columns(columns)
+        if n_positions is not None:  # a timed trajectory written by bidmp: positions and time only
+            return values[:, 1 : 1 + n_positions], values[:, 0]
         has_time = columns[0] in _TIME_NAMES
         names = columns[1:] if has_time else columns
         if names not in _POSITION_HEADERS:
             shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:6]) + (",…" if len(columns) > 6 else "")
-            raise ValueError(f"{path}: header {shown} not understood; expected x,y[,z] or t,x,y[,z]")
+            raise ValueError(f"{path}: header {shown} not understood; expected x,y[,z], t,x,y[,z] or "
+                             f"t,x,y[,z],vx,vy[,vz],ax,ay[,az]")
     elif n_columns in (2, 3):
         has_time = False  # header-less: positions only (add a header "t,x,y" to mark a time column)
     elif n_columns == 4:
@@ -632,27 +649,17 @@ def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path) -
     raise ValueError(f"{path}: the data rows could not be read as numbers")  # pragma: no cover
 
 
-def _resample_uniform(positions: np.ndarray, times: np.ndarray, source: str) -> np.ndarray:
-    """Resample positions given at ``times`` onto a uniform grid with the same number of samples."""
-    if not np.all(np.isfinite(times)):
-        raise ValueError(f"{source}: the time column contains NaN or inf")
-    if np.max(np.abs(times)) > _MAX_TIME_S:
-        raise ValueError(f"{source}: the time column has values beyond {_MAX_TIME_S:g} s; expected seconds")
-    steps = np.diff(times)
-    if np.any(steps <= 0):
-        row = int(np.argmax(steps <= 0)) + 1
-        raise ValueError(f"{source}: time must increase strictly (row {row} does not)")
-    if np.ptp(steps) <= 1e-9 * np.mean(steps):
-        return positions
-    logger.info("%s: time stamps are not uniform; resampling to %d uniform samples", source, len(times))
-    grid = np.linspace(times[0], times[-1], len(times))
-    return np.column_stack([np.interp(grid, times, column) for column in positions.T])
-
-
 def _check_npy_trajectory(path: Path):
     limits = get_limits()
 
     def check(shape, dtype):
+        if dtype.names is not None:  # a timed trajectory: one record per sample
+            if len(shape) != 1 or not _timed_fields(dtype):
+                raise ValueError(f"{path} holds records with fields {', '.join(dtype.names[:8])}; expected t, x, y[, z] "
+                                 f"(and optionally vx, … ax, …) in shape (T,)")
+            if shape[0] > limits.max_samples:
+                raise ValueError(f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}")
+            return
         if dtype.kind not in "fiu":
             raise ValueError(f"{path} holds {dtype} data, not numbers")
         if len(shape) != 2:
@@ -666,22 +673,58 @@ def _check_npy_trajectory(path: Path):
     return check
 
 
-def load_trajectory(path: str | os.PathLike) -> np.ndarray:
-    """Read a demonstration from ``.csv`` or ``.npy``.
+def _timed_fields(dtype: np.dtype) -> tuple[str, ...] | None:
+    """The position fields of a structured timed-trajectory dtype (``t`` plus x, y[, z]; real
+    numbers), or None."""
+    names = dtype.names or ()
+    if "t" not in names:
+        return None
+    for positions in reversed(_POSITION_HEADERS):
+        if all(name in names for name in positions) and all(dtype[n].kind in "fiu" and dtype[n].shape == () for n in ("t", *positions)):
+            return positions
+    return None
 
-    CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed, UTF-8 with
-    or without a byte-order mark. An optional header names the columns ``x,y[,z]`` or
-    ``t,x,y[,z]`` (``time`` also works). Without a header 2 or 3 columns are positions and 4
-    columns are ``t,x,y,z``. With a time column (seconds) the samples are resampled to uniform
-    time steps (a DMP assumes them).
-    NPY: a float array of shape (T, D), read with ``allow_pickle=False`` after its header passed
-    the size limits.
+
+def load_trajectory(path: str | os.PathLike) -> np.ndarray:
+    """Read a demonstration from ``.csv`` or ``.npy`` as positions on a uniform time grid.
+
+    See :func:`read_trajectory` for the formats; with timestamps the samples are resampled to
+    uniform time steps over the same span (a DMP assumes them). Use :func:`read_trajectory` to
+    keep the stamps (``bidmp.DMP.fit(y, t)`` and :func:`bidmp.prepare` take them).
 
     Returns
     -------
     y : array, shape (T, D)
         Validated: finite, at least 3 points, not all identical, within the limits.
     """
+    from .timing import check_timestamps, uniform_time
+
+    y, times = read_trajectory(path)
+    if times is not None:
+        y, _ = uniform_time(y, check_timestamps(times, y.shape[0], f"{path}: the time column"))
+    return y
+
+
+def read_trajectory(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
+    """Read a demonstration from ``.csv`` or ``.npy``: positions and, if the file has them,
+    timestamps in seconds (as recorded: any monotone stamps, epoch-like or jittered).
+
+    CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed, UTF-8 with
+    or without a byte-order mark. An optional header names the columns ``x,y[,z]``,
+    ``t,x,y[,z]`` (``time`` also works) or ``t,x,y[,z],vx,…,ax,…`` (a timed trajectory written by
+    bidmp; velocities and accelerations are ignored). Without a header 2 or 3 columns are
+    positions and 4 columns are ``t,x,y,z``.
+    NPY: a float array of shape (T, D) (positions), or a structured array of shape (T,) with
+    fields ``t, x, y[, z]`` (and optionally ``vx … az``), as :func:`save_trajectory` writes a
+    :class:`bidmp.Trajectory`; read with ``allow_pickle=False`` after its header passed the
+    size limits.
+
+    Returns
+    -------
+    (y, t) : array (T, D) and array (T,) or None
+    """
+    from .timing import check_timestamps
+
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
@@ -699,33 +742,57 @@ def load_trajectory(path: str | os.PathLike) -> np.ndarray:
         except ValueError as exc:
             message = str(exc)
             raise ValueError(message if str(path) in message else f"{path} is not a readable .npy array ({message})") from None
+        times = None
+        if positions.dtype.names is not None:
+            fields = _timed_fields(positions.dtype)
+            times = np.asarray(positions["t"], dtype=np.float64)
+            positions = np.column_stack([np.asarray(positions[name], dtype=np.float64) for name in fields])
     elif suffix in (".csv", ".txt"):
         positions, times = _read_csv(path)
-        if times is not None:
-            positions = _resample_uniform(positions, times, str(path))
     else:
         raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
-    return as_trajectory(positions, name=str(path))
+    positions = as_trajectory(positions, name=str(path))
+    if times is not None:
+        times = check_timestamps(times, positions.shape[0], f"{path}: the time column")
+    return positions, times
 
 
 def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
-    """Write a trajectory ``y`` (T, D) to ``path``: ``.csv`` (header ``[t,]x,y[,z]``; ``times``
-    (T,) in seconds adds the ``t`` column) or ``.npy``, atomically.
+    """Write a trajectory to ``path`` (``.csv`` or ``.npy``), atomically.
+
+    ``y`` is positions (T, D), optionally with ``times`` (T,) in seconds, or a
+    :class:`bidmp.Trajectory`:
+
+    * CSV: header ``x,y[,z]``, ``t,x,y[,z]`` (with times) or ``t,x,y,z,vx,vy,vz,ax,ay,az`` (a
+      Trajectory: s, units, units/s, units/s²);
+    * NPY: a float array (T, D) of positions, or with times or a Trajectory a structured array
+      of shape (T,) with the same named fields (``np.load(path)["t"]``, ``["vx"]``, …), still
+      without pickles.
 
     The argument order is the same as :func:`save_model` (what, then where). Non-finite values
     are refused: a file a robot may execute never holds NaN or inf.
     """
+    from .timing import Trajectory
+
     if isinstance(y, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
         raise TypeError("save_trajectory takes (y, path): the trajectory first, then the file (as save_model)")
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
+    if isinstance(y, Trajectory):
+        if times is not None:
+            raise TypeError("times is given by the Trajectory itself")
+        names, data = y.columns()
+        for name, column in (("t", y.t), ("yd", y.yd), ("ydd", y.ydd)):
+            if not np.all(np.isfinite(column)):
+                raise ValueError(f"the trajectory's {name} contains NaN or inf")
+        return _write_columns(as_trajectory(y.y, "y", min_points=1, allow_static=True), names, data, path)
     y = as_trajectory(y, "y", min_points=1, allow_static=True)
     _destination(path)
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv"):
         raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
-    if suffix == ".npy":
+    if suffix == ".npy" and times is None:
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
         return path
@@ -739,6 +806,22 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
             raise ValueError("times contains NaN or inf")
         names = ["t", *names]
         data = np.column_stack([times, y])
+    return _write_columns(y, names, data, path)
+
+
+def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path) -> Path:
+    """Write named columns as CSV (header row) or as a structured ``.npy`` (one field each)."""
+    _destination(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".npy", ".csv"):
+        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+    if suffix == ".npy":
+        records = np.empty(data.shape[0], dtype=[(name, np.float64) for name in names])
+        for index, name in enumerate(names):
+            records[name] = data[:, index]
+        with atomic_write(path, "wb") as handle:
+            np.save(handle, records, allow_pickle=False)
+        return path
     with atomic_write(path, "w") as handle:
         writer = csv.writer(handle, lineterminator="\n")
         writer.writerow(names)

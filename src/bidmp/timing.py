@@ -106,7 +106,7 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
         kind = "duplicate timestamp" if steps[row - 1] == 0 else "timestamp going back"
-        raise ValueError(f"{name} must increase strictly: {kind} at sample {row} ({stamps[row]!r} s after {stamps[row - 1]!r} s)")
+        raise ValueError(f"{name} must increase strictly: {kind} at sample {row} ({float(stamps[row]):.9g} s after {float(stamps[row - 1]):.9g} s)")
     rate = (n_samples - 1) / (stamps[-1] - stamps[0])
     if rate < MIN_RATE_HZ:
         raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
