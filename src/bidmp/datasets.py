@@ -116,3 +116,40 @@ def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.ran
     y = via[leg] + blend * (via[leg + 1] - via[leg])
     y[-1] = via[-1]
     return perturb(y, noise, seed) if noise > 0.0 else y
+
+
+def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate_hz: float = 250.0,
+                          jitter: float = 0.3, noise: float = 0.2, wobble: float = 0.3, seed: int = 0,
+                          epoch: float = 1.732e9) -> tuple[np.ndarray, np.ndarray]:
+    """A synthetic kinesthetic-teaching recording, as a robot's logger writes one.
+
+    A minimum-jerk motion through ``via`` (coming to rest at each via point) lasting ``duration``
+    seconds, with a hand-guided wobble (standard deviation ``wobble``), ``idle`` seconds of
+    standing still before and after, timestamps at ``rate_hz`` with a uniform jitter of ``jitter``
+    sample periods, epoch-like (starting at ``epoch`` s), and white sensor noise of standard
+    deviation ``noise`` (same unit as ``via``, e.g. mm).
+
+    Returns
+    -------
+    (y, t) : array (T, D), array (T,) in seconds
+    """
+    from ._checks import as_trajectory, check_real, check_seed
+
+    via = as_trajectory(via, "via", min_points=2)
+    duration = check_real(duration, "duration", positive=True, maximum=1e4)
+    idle = check_real(idle, "idle", nonnegative=True, maximum=1e4)
+    rate_hz = check_real(rate_hz, "rate_hz", minimum=1.0, maximum=1e5)
+    jitter = check_real(jitter, "jitter", nonnegative=True, maximum=0.45)
+    noise = check_real(noise, "noise", nonnegative=True)
+    wobble = check_real(wobble, "wobble", nonnegative=True)
+    rng = check_seed(seed)
+    total = duration + 2 * idle
+    n_samples = int(round(total * rate_hz)) + 1
+    t = np.arange(n_samples) / rate_hz
+    t[1:-1] += rng.uniform(-jitter, jitter, n_samples - 2) / rate_hz
+    n_motion = max(int(round(duration * rate_hz)), 10)
+    motion = minimum_jerk(via, n_motion, wobble, rng)
+    progress = np.clip((t - idle) / duration, 0.0, 1.0) * (n_motion - 1)
+    y = np.column_stack([np.interp(progress, np.arange(n_motion), column) for column in motion.T])
+    y += rng.normal(scale=noise, size=y.shape) if noise > 0 else 0.0
+    return y, t + epoch

@@ -41,7 +41,7 @@ import numpy as np
 from scipy.signal import lfilter
 from sklearn.base import BaseEstimator
 
-from ._trajectory import resample_time
+from ._trajectory import arclength, resample_time
 from ._checks import (
     as_point,
     as_points,
@@ -317,7 +317,7 @@ class _Params(NamedTuple):
     ridge: float
     widths: str
     protocol: str
-    goal_rate: float
+    goal_rate: float | None  # None: the goal follows the demonstration's progress (robot default)
     settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
 
 
@@ -334,7 +334,6 @@ PROTOCOLS = ("robot", "paper")
 ROBOT_ALPHA = 50.0
 ROBOT_KERNELS = 100
 ROBOT_ALPHA_PHASE = 4.0
-ROBOT_GOAL_RATE = 10.0
 ROBOT_SETTLE = 1.1
 
 
@@ -355,7 +354,8 @@ class DMP(BaseEstimator):
     **Protocols.** ``protocol="robot"`` (default) resolves the unset parameters to a DMP a robot
     can run: ``K = alpha beta`` (the initial acceleration does not depend on the goal or the
     start: no jump when either moves), a delayed goal that moves from the start to the goal at
-    ``goal_rate`` (Kulvicius 2012; no overshoot for nearer goals), ``alpha_phase = 4`` and a default
+    the demonstration's own progress along its path (a delayed goal, Kulvicius 2012, timed by
+    the demonstration: no overshoot or backwards motion for nearer goals), ``alpha_phase = 4`` and a default
     horizon of 1.1x the demonstration, within which any goal is reached and the motion comes to
     rest. ``protocol="paper"`` is the paper's: ``K = alpha``, ``alpha_phase = 1``, the goal gated by
     the phase, exactly T samples (a shifted goal is missed by :meth:`endpoint_gain` times the shift).
@@ -390,7 +390,8 @@ class DMP(BaseEstimator):
     protocol : {"robot", "paper"}, default "robot"
         See above.
     goal_rate : float or None, default None
-        Rate of the delayed goal (per normalised time). ``None``: robot 10; paper: equal to
+        Rate of an exponentially delayed goal (per normalised time). ``None``: robot, the goal
+        follows the demonstration's progress along its path (``goal_gate_``); paper, equal to
         ``alpha_phase``, which is exactly Eq. 10's ``-K phase (g - y0)`` term.
 
     Attributes
@@ -407,6 +408,9 @@ class DMP(BaseEstimator):
         convention of one second per T samples).
     units_ : str
         Length unit of the demonstration ("" if not given).
+    goal_gate_ : array (n_train_,) or None
+        The goal gate on the training grid when the goal follows the demonstration's progress
+        (``1 - arc length so far / total``), else None.
     centres_, widths_ : array, shape (n_kernels,)
         Kernel centres (phase) and widths.
     """
@@ -458,7 +462,7 @@ class DMP(BaseEstimator):
         else:
             alpha_phase = check_real(self.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
         if self.goal_rate is None:
-            goal_rate = ROBOT_GOAL_RATE if robot else alpha_phase
+            goal_rate = None if robot else alpha_phase
         else:
             goal_rate = check_real(self.goal_rate, "goal_rate", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
         return _Params(
@@ -545,12 +549,16 @@ class DMP(BaseEstimator):
         check_euler_stable(dt, 1.0, params.alpha, params.beta)
         check_euler_stable(dt, params.tau, params.alpha, params.beta)
         _phase_decay(dt, params.tau, params.alpha_phase)
-        _phase_decay(dt, params.tau, params.goal_rate)
+        if params.goal_rate is not None:
+            _phase_decay(dt, params.tau, params.goal_rate)
         # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
         # rollouts, so it is not used here.
         n_train = train.shape[0]
         phase = phase_grid(n_train, dt, 1.0, params.alpha_phase)
-        gate = phase_grid(n_train, dt, 1.0, params.goal_rate)
+        if params.goal_rate is None:
+            gate = _progress_gate(train, dt, params)
+        else:
+            gate = phase_grid(n_train, dt, 1.0, params.goal_rate)
         centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase)
         widths = kernel_widths(centres, params.alpha_phase, params.widths)
         target = forcing_target(
@@ -575,6 +583,7 @@ class DMP(BaseEstimator):
         self.dt_ = dt
         self.duration_ = duration
         self.units_ = units
+        self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
@@ -686,7 +695,29 @@ class DMP(BaseEstimator):
         """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
         fraction (robot); the forcing target of :func:`forcing_target` uses it."""
         self._check_fitted()
-        return phase_grid(self.n_train_, self.dt_, 1.0, self._params().goal_rate)
+        params = self._params()
+        if params.goal_rate is None:
+            return self._progress_gate()
+        return phase_grid(self.n_train_, self.dt_, 1.0, params.goal_rate)
+
+    def _progress_gate(self) -> np.ndarray:
+        gate = self.__dict__.get("goal_gate_")
+        if gate is None or gate.shape[0] != self.n_train_:
+            raise ValueError("this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
+                             "set goal_rate to a number or fit it again")
+        return gate
+
+    def goal_gate(self, phase) -> np.ndarray:
+        """The goal gate at the given phases: the share of a goal change still to come (1 at
+        the start, 0 once the demonstration is done); see :func:`_progress_gate`."""
+        self._check_fitted()
+        params = self._params()
+        phase = np.asarray(phase, dtype=np.float64)
+        if params.goal_rate is None:
+            training_phase = phase_grid(self.n_train_, self.dt_, 1.0, params.alpha_phase)
+            return np.interp(phase, training_phase[::-1], self._progress_gate()[::-1])
+        # gate = (decay of goal_rate)^l = phase^(ln decay_g / ln decay_phase) on the same grid
+        return np.power(phase, params.goal_rate / params.alpha_phase)
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
@@ -720,8 +751,12 @@ class DMP(BaseEstimator):
         else:
             # The goal enters through alpha beta g - K gate (g - y0): the gate is the phase
             # (Eq. 10) or the delayed goal's remaining fraction (robot protocol).
-            gate = phase[:n_inputs] if params.goal_rate == params.alpha_phase else \
-                phase_grid(n_inputs, step, params.tau, params.goal_rate)
+            if params.goal_rate == params.alpha_phase:
+                gate = phase[:n_inputs]
+            elif params.goal_rate is None:
+                gate = self.goal_gate(phase[:n_inputs])
+            else:
+                gate = phase_grid(n_inputs, step, params.tau, params.goal_rate)
             drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
             y_first = np.array([0.0, 1.0, 0.0])
             y_second = np.array([0.0, 1.0, step])
@@ -735,7 +770,8 @@ class DMP(BaseEstimator):
         step = self.dt_ if step is None else step
         check_euler_stable(step, params.tau, params.alpha, params.beta)
         _phase_decay(step, params.tau, params.alpha_phase)
-        _phase_decay(step, params.tau, params.goal_rate)
+        if params.goal_rate is not None:
+            _phase_decay(step, params.tau, params.goal_rate)
         return params
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
@@ -897,7 +933,7 @@ class DMP(BaseEstimator):
         if params.protocol == "paper" and duration is None and dt == period:
             n_samples = max(int(round(params.tau * self.n_steps_)), 1)  # the rollout's own samples
         else:
-            n_samples = int(round(params.settle * motion / dt)) + 1
+            n_samples = int(np.floor(params.settle * motion / dt * (1 + 1e-12))) + 1  # never past settle x motion
         check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
         step = self.dt_ if dt == period else dt / self.time_unit_
         return motion, dt, n_samples, step
@@ -961,15 +997,30 @@ class DMP(BaseEstimator):
         unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm"}
         if unknown:
             raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, max_jerk, norm")
-        duration = self._params().tau * self.duration_
-        for _ in range(8):
+        def attempt(duration):
             trajectory = self.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
                                          forcing_increment=forcing_increment)
-            factor = scale_factor(trajectory, **limits)
+            return trajectory, scale_factor(trajectory, **limits)
+
+        # The exact factor first (speed ~ 1/k, acceleration ~ 1/k²), then a bisection in log
+        # duration for what re-integrating at another step changes: the result meets every
+        # limit and touches the binding one within 0.1 %.
+        duration = self._params().tau * self.duration_
+        trajectory, factor = attempt(duration)
+        low = high = best = None  # durations known to break / to meet the limits
+        for _ in range(60):
             if 1.0 - 1e-3 <= factor <= 1.0:
                 return trajectory
-            duration *= factor * (1.0 + 2e-4)  # a hair slower than exact: the check above is one-sided
-        return trajectory
+            if factor > 1.0:
+                low = duration
+            else:
+                high, best = duration, trajectory
+            if low is not None and high is not None:
+                duration = float(np.sqrt(low * high))
+            else:
+                duration *= factor * (1.0 + 1e-4) if factor > 1.0 else factor
+            trajectory, factor = attempt(duration)
+        return trajectory if factor <= 1.0 or best is None else best
 
     def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling: float = 0.0,
                 start_velocity=None, forcing_increment=None) -> "DMPStepper":
@@ -991,6 +1042,8 @@ class DMP(BaseEstimator):
             "centres_": self.centres_,
             "widths_": self.widths_,
         }
+        if self.__dict__.get("goal_gate_") is not None:
+            arrays["goal_gate_"] = self.goal_gate_
         return {"params": self.get_params(), "n_steps_": self.n_steps_, "duration_": self.duration_,
                 "units_": self.units_}, arrays
 
@@ -1024,8 +1077,38 @@ class DMP(BaseEstimator):
         if (n_steps - 1) / model.duration_ > 1e5 or (n_steps - 1) / model.duration_ < 1e-3:
             raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
         model.units_ = _check_units(meta.get("units_", ""))
+        model.goal_gate_ = None
+        if params.goal_rate is None:
+            gate = check_loaded(arrays["goal_gate_"], "goal_gate_", (model.n_train_,))
+            if np.max(np.abs(gate)) > 1e6:
+                raise ValueError("member goal_gate_ has values beyond 1e6, which no fit produces")
+            model.goal_gate_ = gate
         check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
         return model
+
+
+def _progress_gate(train: np.ndarray, dt: float, params: _Params) -> np.ndarray:
+    """The robot protocol's goal gate: the share of a goal change still to come, such that the
+    rollout's response to a moved goal follows the demonstration's own progress along its path.
+
+    With ``σ`` the demonstration's arc-length progress (0 → 1), the gate is the exact inverse of
+    the Euler-discretised spring for the target response ``σ`` delayed by two samples: the
+    spring cannot respond before then (``y[1] = y[0]``), and the delay makes ``gate[0] = 1``, so
+    the initial acceleration does not depend on the goal (nor on the start). A moved goal is
+    thus approached in step with the demonstrated motion: a straight demonstration to a nearer
+    goal becomes the same motion scaled down, without overshoot or moving backwards.
+    """
+    arc = arclength(train)
+    progress = arc / arc[-1]
+    response = np.concatenate([np.zeros(2), progress[:-2]])  # σ delayed by two samples
+    h = dt
+    a1 = -(2.0 - h * params.alpha)
+    a2 = 1.0 - h * params.alpha + h * h * params.alpha * params.beta
+    drive = (response[2:] + a1 * response[1:-1] + a2 * response[:-2]) / (h * h)  # = αβ − K gate
+    gate = np.empty_like(progress)
+    gate[:-2] = (params.alpha * params.beta - drive) / params.K
+    gate[-2:] = gate[-3]  # the last two drives never reach the rollout (y[n] depends on u[n-2])
+    return gate
 
 
 def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
@@ -1121,6 +1204,9 @@ class DMPStepper:
         self.y = self.y + h * self._z
         self._z = z_next
         self.phase *= 1.0 - params.alpha_phase * h
-        self._gate *= 1.0 - params.goal_rate * h
+        if params.goal_rate is None:
+            self._gate = float(self._dmp.goal_gate(self.phase))
+        else:
+            self._gate *= 1.0 - params.goal_rate * h
         self.time += dt / slowdown
         return position, velocity, acceleration

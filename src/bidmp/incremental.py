@@ -92,6 +92,12 @@ class BiDMP(BaseEstimator):
         One per learned demonstration.
     skill_goals_, skill_starts_ : array (n_skills, D)
         Training goal and start of every skill (row 0: the plain DMP's).
+    gate_phase_ : float
+        The increments are ``min(ϑ / gate_phase_, 1) · BLS(...)``: 1 for the paper protocol (the
+        increment is ``ϑ · BLS``), the phase at the end of the demonstrated motion for the robot
+        protocol (whose phase decays to e^-4: dividing FI by it would amplify the end of the
+        motion 50-fold and ruin the fit; with this gate the increment is learned as it is during
+        the motion and still vanishes with the phase during the rest after it).
     phase_min_ : float
         The smallest phase of the training grid; below it the BLS input is held at this phase.
     """
@@ -149,6 +155,9 @@ class BiDMP(BaseEstimator):
         self.skill_goals_ = dmp.goal_[None].copy()
         self.skill_starts_ = dmp.start_[None].copy()
         self.phase_min_ = float(phase.min())
+        # 1 for the paper protocol (bit for bit the ϑ-gated increment), else the phase at the last
+        # sample of the demonstrated motion.
+        self.gate_phase_ = 1.0 if dmp._params().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
 
     def _ensure_started(self) -> None:
         if "dmp_" in self.__dict__:
@@ -188,6 +197,12 @@ class BiDMP(BaseEstimator):
         basis = self.dmp_.basis(phase)
         return basis @ self.dmp_.weights_ + self._increment(phase, basis, self._check_skill_index(skill))
 
+    def _gate(self, phase: np.ndarray) -> np.ndarray:
+        """``min(ϑ / gate_phase_, 1)``: ϑ itself for the paper protocol (gate_phase_ = 1)."""
+        if self.gate_phase_ == 1.0:
+            return phase
+        return np.minimum(phase / self.gate_phase_, 1.0)
+
     def _increment(self, phase: np.ndarray, basis: np.ndarray, skill: int) -> np.ndarray:
         """Sum of the first ``skill`` blocks' increments, ``ϑ · BLS(φ(clip(ϑ)))``, shape (L, D)."""
         total = np.zeros((phase.shape[0], self.dmp_.n_dims_))
@@ -198,10 +213,19 @@ class BiDMP(BaseEstimator):
         if np.any(outside):  # never extrapolate in phase: hold the BLS input at the trained range
             basis = basis.copy()
             basis[outside] = self.dmp_.basis(clipped[outside])
+        inputs = self._bls_input(np.maximum(phase, self.phase_min_), basis)
         for block in self.blocks_[:skill]:
-            total += block.predict(basis)
-        total *= phase[:, None]
+            total += block.predict(inputs)
+        total *= self._gate(phase)[:, None]
         return total
+
+    def _bls_input(self, phase: np.ndarray, basis: np.ndarray) -> np.ndarray:
+        """The BLS input rows: the DMP basis ``φ = ϑ ψ̄`` (paper), or the normalised kernels
+        ``ψ̄ = φ / ϑ`` (robot): with the phase decaying to e^-4 the rows ``φ`` shrink towards 0 at
+        the end of the motion and the BLS could no longer tell those phases apart."""
+        if self.gate_phase_ == 1.0:
+            return basis
+        return basis / phase[:, None]
 
     @numerically_guarded
     def learn(self, y_dn) -> "BiDMP":
@@ -256,10 +280,11 @@ class BiDMP(BaseEstimator):
         the skill (goal, start)."""
         dmp = self.dmp_
         phase, basis = dmp.training_grid()
+        inputs = self._bls_input(phase, basis)
         block = BLS(
             n_windows=self.n_windows, n_mapped=self.n_mapped, n_enhance=self.n_enhance, shrink=self.shrink,
             reg=self.reg, seed=self.seed + len(self.blocks_) + 1,
-        ).fit(basis, increment / phase[:, None])  # the increment is ϑ · BLS: learn FI / ϑ
+        ).fit(inputs, increment / self._gate(phase)[:, None])  # the increment is gate · BLS: learn FI / gate
         for n_nodes in increments:
             block.add_enhancement_nodes(n_nodes)
         self.blocks_.append(block)
@@ -360,7 +385,8 @@ class BiDMP(BaseEstimator):
             arrays.update({f"block{index}/{k}": v for k, v in block_arrays.items()})
         params = {k: v for k, v in self.get_params(deep=False).items() if k != "dmp"}
         params["increments"] = list(self.increments)
-        return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": self.phase_min_}, arrays
+        return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": self.phase_min_,
+                "gate_phase_": self.gate_phase_}, arrays
 
     @classmethod
     def _from_state(cls, meta: dict, arrays: Mapping) -> "BiDMP":
@@ -376,6 +402,7 @@ class BiDMP(BaseEstimator):
         model._check_params()
         model._start(dmp)
         model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
+        model.gate_phase_ = check_real(meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0)
         model.blocks_ = [BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
                          for index, block_meta in enumerate(meta["blocks"])]
         for index, block in enumerate(model.blocks_):

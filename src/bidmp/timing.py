@@ -198,6 +198,13 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
     # Pad with the signal's even reflection (a resting end stays at rest) over ~3 filter periods.
     padlen = min(3 * int(np.ceil(rate / cutoff_hz)), uniform.shape[0] - 1)
     filtered = sosfiltfilt(sos, uniform, axis=0, padtype="even", padlen=padlen)
+    # A recording that only shows sensor noise has nothing to trim to: its filtered extent stays
+    # within a few noise standard deviations (estimated from what the filter removed).
+    noise = float(np.sqrt(np.mean(np.sum((uniform - filtered) ** 2, axis=1))))
+    extent = float(np.linalg.norm(np.ptp(filtered, axis=0)))
+    if extent <= 20.0 * noise:
+        raise ValueError(f"the recording never moves: its extent {extent:.3g} is within the sensor noise "
+                         f"({noise:.3g} RMS after the {cutoff_hz:g} Hz filter)")
     dt = grid[1] - grid[0]
     velocity = np.gradient(filtered, dt, axis=0)
     speed = np.linalg.norm(velocity, axis=1)
