@@ -32,6 +32,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_incremental.py
 	$(PY) benchmarks/bench_scenario.py
 	$(PY) benchmarks/bidmp_convergence.py
+	$(PY) benchmarks/bench_timing.py
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).
@@ -42,6 +43,7 @@ readme: $(STAMP)
 	$(VENV)/bin/bidmp reproduce figures --out .readme-out > /dev/null
 	cp .readme-out/table4.md .readme-out/table5.md .readme-out/figures.md docs/results/
 	rm -rf .readme-out
+	$(PY) tools/recordings_figure.py
 	$(PY) tools/readme.py
 
 clean:

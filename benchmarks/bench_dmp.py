@@ -40,7 +40,7 @@ def bench_fit_rollout(n_dims: int, repeats: int) -> dict:
     y = demonstration(n_dims)
     times = np.arange(N_STEPS) / N_STEPS
     results = {}
-    results["bidmp fit+rollout"] = median_time(lambda: DMP(n_kernels=N_KERNELS).fit(y).rollout(), repeats)
+    results["bidmp fit+rollout"] = median_time(lambda: DMP(protocol="paper", n_kernels=N_KERNELS).fit(y).rollout(), repeats)
 
     try:
         from movement_primitives.dmp import DMP as MPDMP
@@ -80,7 +80,7 @@ def bench_fit_rollout(n_dims: int, repeats: int) -> dict:
 
 def bench_many_goals(n_goals: int, repeats: int) -> dict:
     y = demonstration(3)
-    dmp = DMP(n_kernels=N_KERNELS).fit(y)
+    dmp = DMP(protocol="paper", n_kernels=N_KERNELS).fit(y)
     goals = y[-1] + np.random.default_rng(0).uniform(-200, 200, size=(n_goals, 3))
     many = median_time(lambda: dmp.rollout_many(goals), repeats)
     loop = median_time(lambda: [dmp.rollout(goal) for goal in goals], 1)

@@ -26,7 +26,7 @@ from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 def bidmp_like_problem(n_rows: int = 1000):
     """BLS input and target as in Bi-DMP: DMP basis rows -> a forcing increment."""
     demo = minimum_jerk(BATTERY_APPROACH_VIA, n_rows)
-    dmp = DMP(alpha=100.0).fit(demo)
+    dmp = DMP(protocol="paper", alpha=100.0).fit(demo)
     phase = dmp.phase()
     basis = dmp.basis(phase)
     target = np.column_stack([np.sin(3 * phase), np.cos(5 * phase), phase**2]) * 100.0
@@ -83,7 +83,7 @@ def bench_block_pinv(n_nodes: int, repeats: int) -> None:
 
 def bench_bidmp(repeats: int) -> None:
     demo = minimum_jerk(BATTERY_APPROACH_VIA, 200)
-    dmp = DMP(alpha=100.0).fit(demo)
+    dmp = DMP(protocol="paper", alpha=100.0).fit(demo)
     extension = extend_demonstration(demo, BATTERY_EXTENSION_TARGET, seed=0)
     learn = median_time(lambda: BiDMP(dmp).learn(extension.complete), repeats)
     model = BiDMP(dmp).learn(extension.complete)

@@ -19,7 +19,7 @@ from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 def main() -> int:
     demo = minimum_jerk(BATTERY_APPROACH_VIA, 200)
-    dmp = DMP(alpha=100.0).fit(demo)
+    dmp = DMP(protocol="paper", alpha=100.0).fit(demo)
     extension = extend_demonstration(demo, BATTERY_EXTENSION_TARGET, seed=0)
     goal = np.asarray(BATTERY_EXTENSION_TARGET)
     model = BiDMP(dmp).learn(extension.complete)

@@ -24,7 +24,7 @@ from bidmp.cli import main
 from bidmp.io import ModelFileError, atomic_write, load_model, load_trajectory, save_model, save_trajectory
 
 PYTHON = sys.executable
-RECORDINGS = os.path.join(os.path.dirname(__file__), "data", "recordings")  # copies of shared/data/recordings
+from bidmp.datasets import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)
 
 
 def cli(argv, seconds=10.0):
@@ -564,8 +564,8 @@ def test_huge_n_steps_in_the_library_and_empty_methods(tmp_path):
 
 
 def test_real_recordings_survive_the_whole_cli(tmp_path):
-    for name in ("operator1_nut3.csv", "operator2_nut5.csv"):
-        recording = os.path.join(RECORDINGS, name)
+    for name in ("operator1_nut3", "operator2_nut5"):
+        recording = recording_path(name)
         code, out, err = cli(["fit", recording, "-o", tmp_path / "m.npz"])
         assert code == 0 and "RMSE" in out, err
         code, out, err = cli(["segment", recording])

@@ -11,13 +11,16 @@ from bidmp.datasets import kinesthetic_recording, minimum_jerk
 from bidmp.io import read_trajectory
 from bidmp.timing import Trajectory, check_timestamps, scale_factor
 
-RECORDINGS = os.path.join(os.path.dirname(__file__), "data", "recordings")
 NUT_VIA = [[-80.0, -120.0, 200.0], [0.0, 0.0, 40.0], [0.0, 0.0, 0.0]]
 SHIFT = np.array([150.0, 25.0, 0.0]) * 150.0 / np.hypot(150.0, 25.0)  # a nut 150 mm away
 
 
 def recording(name):
-    return read_trajectory(os.path.join(RECORDINGS, name))
+    return bidmp.datasets.recording(name.removesuffix(".csv"))
+
+
+def recording_file(name):
+    return bidmp.datasets.recording_path(name.removesuffix(".csv"))
 
 
 def recordings():
@@ -257,10 +260,10 @@ def test_units_are_kept_and_mismatches_refused(tmp_path):
     from bidmp.cli import main
 
     model = tmp_path / "m.npz"
-    assert main(["fit", os.path.join(RECORDINGS, "operator1_nut3.csv"), "-o", str(model), "--units", "mm"]) == 0
+    assert main(["fit", recording_file("operator1_nut3.csv"), "-o", str(model), "--units", "mm"]) == 0
     loaded = bidmp.load(model)
     assert loaded.units_ == "mm" and loaded.duration_ == pytest.approx(4.513, abs=0.05)
-    assert main(["extend", str(model), os.path.join(RECORDINGS, "operator2_nut5.csv"), "--units", "m",
+    assert main(["extend", str(model), recording_file("operator2_nut5.csv"), "--units", "m",
                  "--target", "0.15", "0", "0", "-o", str(tmp_path / "e.npz")]) == 2
     with pytest.raises(ValueError, match="units must be"):
         bidmp.DMP().fit(minimum_jerk(NUT_VIA, 100), units="milli metres")
@@ -270,7 +273,7 @@ def test_the_cli_writes_timed_rollouts_from_a_recording(tmp_path, capsys):
     from bidmp.cli import main
 
     model, out = tmp_path / "m.npz", tmp_path / "r.csv"
-    assert main(["fit", os.path.join(RECORDINGS, "operator1_nut3.csv"), "-o", str(model), "--units", "mm"]) == 0
+    assert main(["fit", recording_file("operator1_nut3.csv"), "-o", str(model), "--units", "mm"]) == 0
     assert main(["rollout", str(model), "--goal", *map(str, SHIFT), "--rate", "1000", "--max-speed", "100",
                  "--max-acc", "400", "-o", str(out)]) == 0
     text = capsys.readouterr().out

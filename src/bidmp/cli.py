@@ -340,6 +340,38 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_learn(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._trajectory import resample_time, rmse
+    from .dmp import DMP
+    from .incremental import BiDMP
+    from .io import load_model, save_model
+
+    if not args.output.lower().endswith(".npz"):
+        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}")
+    model = load_model(args.model)
+    if isinstance(model, DMP):
+        model = BiDMP(model)
+    elif not isinstance(model, BiDMP):
+        raise ValueError(f"{args.model} holds a {type(model).__name__}; learn needs a DMP or a Bi-DMP model")
+    dmp = model.dmp if model.dmp is not None else model.dmp_
+    if args.units and dmp.units_ and args.units != dmp.units_:
+        raise ValueError(f"{args.demo} is in {args.units} but the model {args.model} is in {dmp.units_}: convert one of them first")
+    y, _, how = _read_demo(args.demo, args)
+    if y.shape[1] != model.n_dims_:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    model.learn(y)
+    dmp = model.dmp_
+    rollout = model.rollout(y[-1], start=y[0])
+    error = rmse(rollout[: dmp.n_steps_], resample_time(y, dmp.n_steps_))
+    print(f"{args.demo}: {how}")
+    print(f"learned it as skill {model.n_skills - 1} (goal {np.array2string(y[-1], precision=3)}): reproduction RMSE "
+          f"{error:.4g} {dmp.units_ or 'units'}")
+    print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
+    return EXIT_OK
+
+
 def _cmd_reproduce(args: argparse.Namespace) -> int:
     from functools import partial
     from pathlib import Path
@@ -451,6 +483,16 @@ def build_parser() -> argparse.ArgumentParser:
     extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
     extend.add_argument("--plot", metavar="PNG", help="also write a figure")
     extend.set_defaults(handler=_cmd_extend)
+
+    learn = commands.add_parser("learn", help="learn a further demonstration as a new skill (Bi-DMP)",
+                                description="Learn DEMO (e.g. another operator's recording) directly as a new skill on top "
+                                            "of MODEL (a DMP or a Bi-DMP), without retraining. Coordinates in the model's units.",
+                                epilog=_TIMED_INPUT)
+    learn.add_argument("model", metavar="MODEL", help="a DMP or Bi-DMP model file")
+    learn.add_argument("demo", metavar="DEMO", help="the demonstration to learn (.csv or .npy)")
+    learn.add_argument("-o", "--output", required=True, metavar="MODEL2", help="Bi-DMP model file to write (.npz)")
+    _demo_options(learn)
+    learn.set_defaults(handler=_cmd_learn)
 
     reproduce = commands.add_parser("reproduce", help="reproduce a table of the paper",
                                     description="Reproduce the paper's comparisons. table4: the three case studies (nut "

@@ -153,3 +153,35 @@ def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate
     y = np.column_stack([np.interp(progress, np.arange(n_motion), column) for column in motion.T])
     y += rng.normal(scale=noise, size=y.shape) if noise > 0 else 0.0
     return y, t + epoch
+
+
+def recording_names() -> list[str]:
+    """Names of the bundled kinesthetic-teaching recordings (``operator1_nut3``, ``operator2_nut5``)."""
+    from importlib import resources
+
+    folder = resources.files("bidmp").joinpath("data", "recordings")
+    return sorted(entry.name[:-4] for entry in folder.iterdir() if entry.name.endswith(".csv"))
+
+
+def recording_path(name: str) -> str:
+    """File path of a bundled recording (a CSV with columns ``t,x,y,z``: epoch seconds, mm)."""
+    from importlib import resources
+
+    names = recording_names()
+    if not isinstance(name, str) or name not in names:
+        raise ValueError(f"unknown recording {str(name)[:40]!r}; bundled: {', '.join(names)}")
+    return str(resources.files("bidmp").joinpath("data", "recordings", f"{name}.csv"))
+
+
+def recording(name: str) -> tuple[np.ndarray, np.ndarray]:
+    """A bundled kinesthetic recording of a nut approach on the battery pack, as the robot's
+    logger wrote it: ~250 Hz jittered epoch timestamps (s), about 2 s of standing still at each
+    end, 0.2 mm sensor noise, positions in mm.
+
+    Returns
+    -------
+    (y, t) : array (T, 3) in mm, array (T,) in seconds
+    """
+    from .io import read_trajectory
+
+    return read_trajectory(recording_path(name))

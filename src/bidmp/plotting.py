@@ -389,3 +389,45 @@ def plot_scenario_3d(path, report) -> Path:
     _finish(ax, n_dims, scenario.units, f"{scenario.name}")
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)
+
+
+def plot_recordings(path, recordings, goal_shift=None) -> Path:
+    """Kinesthetic recordings raw and prepared, the DMP's rollout to a moved goal, and the speed
+    profiles in real time (top view, side view, speed).
+
+    Parameters
+    ----------
+    recordings : list of (name, y, t, prepared, info, moved)
+        ``y``, ``t``: the recording; ``prepared``, ``info``: :func:`bidmp.prepare`'s result;
+        ``moved``: a :class:`bidmp.Trajectory` (the rollout to the moved goal), or None.
+    """
+    mpl = _matplotlib()
+    fig, (top, side, speed) = mpl.subplots(1, 3, figsize=(12.0, 4.6), dpi=110)
+    colours = mpl.cm.tab10(np.arange(10))
+    for index, (name, y, t, prepared, info, moved) in enumerate(recordings):
+        colour = colours[index % 10]
+        top.plot(y[:, 0], y[:, 1], color=colour, alpha=0.35, linewidth=3, label=f"{name} (raw)")
+        side.plot(y[:, 0], y[:, 2], color=colour, alpha=0.35, linewidth=3)
+        raw_speed = np.linalg.norm(np.gradient(y, t, axis=0), axis=1)
+        speed.plot(t - t[0], raw_speed, color=colour, alpha=0.25, linewidth=0.6)
+        speed.plot(prepared.t + info.start_s, np.linalg.norm(prepared.yd, axis=1), color=colour, linewidth=2,
+                   label=f"{name}: prepared, kept {info.start_s:.2f}-{info.end_s:.2f} s")
+        if moved is not None:
+            top.plot(moved.y[:, 0], moved.y[:, 1], color=colour, linewidth=1.2, label="DMP to the moved goal")
+            side.plot(moved.y[:, 0], moved.y[:, 2], color=colour, linewidth=1.2)
+            speed.plot(moved.t + info.start_s, np.linalg.norm(moved.yd, axis=1), color=colour, linestyle="--", linewidth=1)
+            top.plot(moved.y[-1, 0], moved.y[-1, 1], marker="*", markersize=12, color="crimson")
+            side.plot(moved.y[-1, 0], moved.y[-1, 2], marker="*", markersize=12, color="crimson")
+    units = recordings[0][3].units if recordings else ""
+    suffix = f" [{units}]" if units else ""
+    top.set(xlabel="x" + suffix, ylabel="y" + suffix, title="top view")
+    side.set(xlabel="x" + suffix, ylabel="z" + suffix, title="side view")
+    speed.set(xlabel="time in the recording [s]", ylabel=f"speed [{units or 'units'}/s]",
+              title="speed: raw (thin), prepared, rollout (dashed)")
+    speed.set_ylim(0.0, 1.3 * max(float(np.max(np.linalg.norm(r[3].yd, axis=1))) for r in recordings))
+    top.legend(fontsize=7, loc="lower right")
+    speed.legend(fontsize=7, loc="upper right")
+    for axes in (top, side, speed):
+        axes.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, path)
