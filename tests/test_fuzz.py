@@ -207,6 +207,48 @@ def test_fuzz_segment(y, eps_frac, method):
     outcome("curvature", bidmp.segmentation.curvature, y)
 
 
+timestamps = st.one_of(st.none(), st.sampled_from(["uniform", "jitter", "epoch", "ms", "duplicate", "reverse", "nan", "short"]))
+
+
+def _stamps(kind, n):
+    base = np.arange(n) / 250.0
+    return {None: None, "uniform": base, "jitter": base + np.r_[0, np.full(max(n - 2, 0), 1e-3), 0][:n],
+            "epoch": base + 1.7e9, "ms": base * 1000.0, "duplicate": np.r_[base[:1], base[:-1]],
+            "reverse": base[::-1], "nan": np.r_[base[:-1], np.nan], "short": base[:-1]}[kind]
+
+
+@given(trajectories(min_points=3, max_points=300, dims=(2, 3)), timestamps, dmp_params, points, points,
+       st.one_of(st.none(), maybe(st.floats(0.05, 20.0))), st.one_of(st.none(), maybe(st.floats(1e-4, 0.05))),
+       st.one_of(st.none(), st.fixed_dictionaries({}, optional={"max_velocity": maybe(st.floats(0.1, 1e3)),
+                                                              "max_acceleration": maybe(st.floats(0.1, 1e4)),
+                                                              "norm": st.sampled_from(["norm", "axis", "x"])})))
+@examples(50)
+def test_fuzz_timed_dmp(y, stamps, params, goal, start, duration, dt, limits):
+    n = len(y) if hasattr(y, "__len__") else 0
+    dmp = outcome("DMP.fit(t)", bidmp.DMP(**params).fit, y, _stamps(stamps, n))
+    if dmp is None:
+        dmp = bidmp.DMP().fit(good_demo(100, 3), np.arange(100) / 100.0)
+    trajectory = outcome("DMP.trajectory", dmp.trajectory, goal=goal, start=start, duration=duration, dt=dt, limits=limits)
+    if trajectory is not None:
+        outcome("time_scale", bidmp.time_scale, trajectory, max_velocity=duration, max_acceleration=dt)
+    stepper = outcome("DMP.stepper", dmp.stepper, goal=goal, start=start, duration=duration, coupling=1.0)
+    if stepper is not None:
+        for _ in range(3):
+            outcome("stepper.step", stepper.step, dt if dt is not None else 0.004, goal)
+
+
+@given(trajectories(min_points=0, max_points=600, dims=(2, 3)), timestamps, maybe(st.floats(0.5, 20.0)),
+       maybe(st.floats(0.01, 0.3)), maybe(st.integers(0, 50), nasty_ints))
+@examples(40)
+def test_fuzz_prepare_and_recordings(y, stamps, cutoff, fraction, seed):
+    n = len(y) if hasattr(y, "__len__") else 0
+    outcome("prepare", bidmp.prepare, y, _stamps(stamps, n), cutoff_hz=cutoff, idle_fraction=fraction)
+    recording = outcome("kinesthetic_recording", bidmp.datasets.kinesthetic_recording, [[0, 0, 0], [50, 20, 10]],
+                        seed=seed, duration=cutoff, idle=fraction)
+    if recording is not None:
+        outcome("prepare(recording)", bidmp.prepare, *recording)
+
+
 @given(trajectories(max_points=200), trajectories(max_points=200), st.sampled_from(["sqrt2", "2", "3"]))
 @examples(60)
 def test_fuzz_frechet(a, b, denom):
@@ -370,7 +412,10 @@ def files(tmp_path_factory):
     bimodel = bidmp.save(bi, folder / "bidmp.npz")
     (folder / "dir").mkdir()
     (folder / "out").mkdir()
-    return {"folder": folder, "demo": demo, "model": model, "demo2": two_d, "bidmp": bimodel}
+    recording = bidmp.io.save_trajectory(bidmp.datasets.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[0],
+                                         folder / "recording.csv",
+                                         times=bidmp.datasets.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[1])
+    return {"folder": folder, "demo": demo, "model": model, "demo2": two_d, "bidmp": bimodel, "recording": recording}
 
 
 def mutate_bytes(data: bytes, draw_ops) -> bytes:
@@ -528,6 +573,7 @@ def cli_tokens(files):
     numbers = ["0", "1", "-1", "2", "3", "10", "25", "1e300", "-1e300", "nan", "inf", "1e-300", str(2**63), "1e12",
                "5000", "0.001", "abc", "", ","]
     flags = ["-o", "--goal", "--start", "--n-steps", "--skill", "--plot", "--n-kernels", "--alpha", "--beta", "--K",
+             "--rate", "--duration", "--max-speed", "--max-acc", "--units", "--raw", "--cutoff", "--protocol",
              "--alpha-phase", "--tau", "--regression", "--eps-frac", "--method", "--target", "--save-demo", "--seed",
              "--methods", "--out", "--scenario", "--demo", "--seeds", "--allow-outside-files", "--debug-not", "--help"]
     return [str(p) for p in paths], numbers, flags
@@ -546,6 +592,10 @@ def cli_templates(files):
         "fit": ["fit", files["demo"], "-o", out / "m.npz", "--alpha", "25", "--n-kernels", "30"],
         "rollout": ["rollout", files["model"], "-o", out / "r.csv", "--goal", "0.5", "0.2", "0.1", "--n-steps", "300"],
         "rollout-bidmp": ["rollout", files["bidmp"], "-o", out / "r.npy", "--skill", "nearest", "--goal", "0.1", "0", "0"],
+        "rollout-timed": ["rollout", files["model"], "-o", out / "r.csv", "--rate", "1000", "--max-speed", "5", "--max-acc", "50",
+                          "--duration", "2"],
+        "fit-recording": ["fit", files["recording"], "-o", out / "m.npz", "--units", "mm", "--cutoff", "6"],
+        "learn": ["learn", files["model"], files["demo"], "-o", out / "l.npz"],
         "segment": ["segment", files["demo"], "--eps-frac", "0.1", "--method", "persistence"],
         "extend": ["extend", files["model"], files["demo"], "--target", "1.2", "0.9", "-0.4", "-o", out / "e.npz"],
         "lasa-list": ["lasa", "list"],

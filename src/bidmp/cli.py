@@ -59,6 +59,7 @@ def _read_demo(path: str, args: argparse.Namespace):
 def _cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from ._trajectory import resample_time
     from .dmp import DMP
     from .io import save_model
     from .metrics import path_extent
@@ -70,9 +71,6 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     ).fit(demonstration, times, units=args.units)
     path = save_model(dmp, args.output)
     reproduction = dmp.trajectory()
-    n = min(reproduction.y.shape[0], demonstration.shape[0])
-    from ._trajectory import resample_time
-
     reference = resample_time(demonstration, dmp.n_steps_)
     error = float(np.sqrt(np.mean(np.sum((dmp.rollout()[: dmp.n_steps_] - reference) ** 2, axis=1))))
     extent = path_extent(demonstration)
@@ -88,7 +86,6 @@ def _cmd_fit(args: argparse.Namespace) -> int:
           f"peak acceleration {reproduction.peak_acceleration():.4g} {unit}/s^2)")
     if dmp.protocol == "paper":
         print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {dmp.default_n_steps()} samples")
-    del n
     print(f"wrote {path}")
     return EXIT_OK
 
@@ -110,8 +107,9 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
             raise ValueError(f"--rate must be in (0, 100000] Hz, got {args.rate:g}")
         options["dt"] = 1.0 / args.rate
     elif args.n_steps is not None:
-        if args.n_steps < 2:
-            raise ValueError(f"--n-steps must be >= 2, got {args.n_steps}")
+        from ._checks import check_int
+
+        check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
         motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
         settle = dmp._params().settle
         options["dt"] = settle * motion / (args.n_steps - 1)  # the same motion, sampled more finely

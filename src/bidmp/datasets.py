@@ -133,12 +133,14 @@ def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate
     -------
     (y, t) : array (T, D), array (T,) in seconds
     """
-    from ._checks import as_trajectory, check_real, check_seed
+    from ._checks import as_trajectory, check_real, check_seed, get_limits
 
     via = as_trajectory(via, "via", min_points=2)
-    duration = check_real(duration, "duration", positive=True, maximum=1e4)
+    duration = check_real(duration, "duration", minimum=1e-2, maximum=1e4)
     idle = check_real(idle, "idle", nonnegative=True, maximum=1e4)
     rate_hz = check_real(rate_hz, "rate_hz", minimum=1.0, maximum=1e5)
+    check_real((duration + 2 * idle) * rate_hz, "the recording's samples (duration + 2 idle) * rate_hz",
+               maximum=get_limits().max_samples)
     jitter = check_real(jitter, "jitter", nonnegative=True, maximum=0.45)
     noise = check_real(noise, "noise", nonnegative=True)
     wobble = check_real(wobble, "wobble", nonnegative=True)

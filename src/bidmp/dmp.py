@@ -798,7 +798,8 @@ class DMP(BaseEstimator):
     @numerically_guarded
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
                 forcing_increment=None) -> np.ndarray:
-        """Generate a trajectory (explicit Euler, Eq. 14), one sample every ``dt_`` seconds.
+        """Generate a trajectory (explicit Euler, Eq. 14) on the normalised grid, one sample every
+        ``dt_`` (``duration_ / (T - 1)`` seconds at ``tau = 1``).
 
         Parameters
         ----------
@@ -808,10 +809,11 @@ class DMP(BaseEstimator):
             Start position; default the demonstration's first point.
         n_steps : int, optional
             Number of samples, including the start; default :meth:`default_n_steps`
-            (``round(tau · T)``: the paper's fixed horizon, the phase ends at ≈ e⁻¹). Use more
-            steps to let the system converge.
+            (paper: ``round(tau · T)``, the fixed horizon, the phase ends at ≈ e⁻¹; robot:
+            ``round(1.1 · tau · T)``, converged). Use more steps to let a paper DMP converge.
+            For samples in seconds use :meth:`trajectory`.
         start_velocity : array-like, shape (D,), optional
-            Initial velocity (units/s); default at rest.
+            Initial velocity in units per unit of normalised time (:meth:`trajectory` takes units/s); default at rest.
         forcing_increment : callable, optional
             ``forcing_increment(phase (n,), basis (n, N)) -> (n, D)`` added to the learned forcing
             term on the rollout grid (how :class:`bidmp.BiDMP` adds its learned increments).
@@ -925,7 +927,7 @@ class DMP(BaseEstimator):
         demonstration's."""
         motion = params.tau * self.duration_ if duration is None else check_real(duration, "duration", positive=True)
         period = self.duration_ / (self.n_steps_ - 1)
-        dt = period if dt is None else check_real(dt, "dt", positive=True)
+        dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)  # 1 MHz at most
         if dt > motion:
             raise ValueError(f"dt = {dt:g} s is longer than the motion ({motion:g} s)")
         scale = motion / self.duration_  # temporal scaling: the shape is kept, time stretched
@@ -933,7 +935,9 @@ class DMP(BaseEstimator):
         if params.protocol == "paper" and duration is None and dt == period:
             n_samples = max(int(round(params.tau * self.n_steps_)), 1)  # the rollout's own samples
         else:
-            n_samples = int(np.floor(params.settle * motion / dt * (1 + 1e-12))) + 1  # never past settle x motion
+            samples = params.settle * motion / dt * (1 + 1e-12)
+            check_real(samples, "the trajectory's samples (duration / dt)", maximum=get_limits().max_steps)
+            n_samples = int(np.floor(samples)) + 1  # never past settle x motion
         check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
         step = self.dt_ if dt == period else dt / self.time_unit_
         return motion, dt, n_samples, step
@@ -1157,7 +1161,7 @@ class DMPStepper:
         motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
         self._scale = motion / dmp.duration_  # tau of the normalised system
         self._params = params._replace(tau=self._scale)
-        self.coupling = check_real(coupling, "coupling", nonnegative=True)
+        self.coupling = check_real(coupling, "coupling", nonnegative=True, maximum=1e6)
         self._forcing_increment = forcing_increment
         self.y = self.start.copy()
         velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
@@ -1185,7 +1189,7 @@ class DMPStepper:
         (y, yd, ydd) : arrays (D,)
             Position (units), velocity (units/s) and acceleration (units/s²) to command.
         """
-        dt = check_real(dt, "dt", positive=True)
+        dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
         params = self._params
         time_unit = self._dmp.time_unit_
         slowdown = 1.0
