@@ -404,7 +404,9 @@ _TIMED_INPUT = ("A timed DEMO (a CSV t column in seconds, or a timed .npy) is pr
 
 def _demo_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--units", default="", metavar="UNIT", help="length unit of the demonstration, e.g. mm (kept in the model)")
-    parser.add_argument("--raw", action="store_true", help="use a timed demonstration as recorded (no trimming or filtering)")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--prepare", action="store_true", help="prepare timed input: trim idle ends, filter, uniform time (the default)")
+    mode.add_argument("--raw", action="store_true", help="use a timed demonstration as recorded (no trimming or filtering)")
     parser.add_argument("--cutoff", type=float, default=6.0, metavar="HZ", help="low-pass cutoff for timed input in Hz (default 6)")
 
 
