@@ -21,7 +21,7 @@ from conftest import curved_demo
 
 import bidmp
 from bidmp.cli import main
-from bidmp.io import ModelFileError, atomic_write, load_model, load_trajectory, save_model, save_trajectory
+from bidmp.io import ModelFileError, load_model, load_trajectory, save_model, save_trajectory
 
 PYTHON = sys.executable
 from bidmp.datasets import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)

@@ -1,14 +1,12 @@
 """Issue 10: robot-ready motion. Real time, goals reached by default, smooth starts, limits by
 time scaling, a control-loop stepper with phase stopping, and real recordings prepared."""
 
-import os
 
 import numpy as np
 import pytest
 
 import bidmp
 from bidmp.datasets import kinesthetic_recording, minimum_jerk
-from bidmp.io import read_trajectory
 from bidmp.timing import Trajectory, check_timestamps, scale_factor
 
 NUT_VIA = [[-80.0, -120.0, 200.0], [0.0, 0.0, 40.0], [0.0, 0.0, 0.0]]

@@ -56,6 +56,32 @@ def _read_demo(path: str, args: argparse.Namespace):
     return prepared.y, prepared.t, how
 
 
+def _bidmp_and_demo(args: argparse.Namespace, command: str):
+    """What ``extend`` and ``learn`` start from: the model as a Bi-DMP (a DMP becomes its skill
+    0) and the demonstration read as ``fit`` reads it, checked against the model's units and D.
+    Returns (model, y, how it was read)."""
+    from .dmp import DMP
+    from .incremental import BiDMP
+    from .io import load_model
+
+    if not args.output.lower().endswith(".npz"):
+        hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
+        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}{hint}")
+    model = load_model(args.model)
+    if isinstance(model, DMP):
+        model = BiDMP(model)
+    elif not isinstance(model, BiDMP):
+        raise ValueError(f"{args.model} holds a {type(model).__name__}; {command} needs a DMP or a Bi-DMP model")
+    dmp = model.dmp if model.dmp is not None else model.dmp_
+    if args.units and dmp.units_ and args.units != dmp.units_:
+        raise ValueError(f"{args.demo} is in {args.units} but the model {args.model} is in {dmp.units_}: "
+                         f"convert one of them first")
+    y, _, how = _read_demo(args.demo, args)
+    if y.shape[1] != model.n_dims_:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    return model, y, how
+
+
 def _cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -282,29 +308,12 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ._trajectory import resample_time
-    from .dmp import DMP
     from .extension import extend_demonstration
-    from .incremental import BiDMP
-    from .io import load_model, save_model, save_trajectory
+    from .io import save_model, save_trajectory
     from .metrics import path_extent, rmse
     from .timing import Trajectory
 
-    if not args.output.lower().endswith(".npz"):
-        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}; "
-                         "use --save-demo to write the extended demonstration")
-    model = load_model(args.model)
-    if isinstance(model, DMP):
-        model = BiDMP(model)
-    elif not isinstance(model, BiDMP):
-        raise ValueError(f"{args.model} holds a {type(model).__name__}; extend needs a DMP or a Bi-DMP model")
-    dmp = model.dmp if model.dmp is not None else model.dmp_
-    if args.units and dmp.units_ and args.units != dmp.units_:
-        raise ValueError(f"{args.demo} is in {args.units} but the model {args.model} is in {dmp.units_}: "
-                         f"convert one of them first")
-    y, _, how = _read_demo(args.demo, args)
-    n_dims = model.n_dims_
-    if y.shape[1] != n_dims:
-        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {n_dims}")
+    model, y, how = _bidmp_and_demo(args, "extend")
     extension = extend_demonstration(y, args.target, seed=args.seed)
     target = extension.new_target
     history = extension.similarity_history
@@ -342,23 +351,9 @@ def _cmd_learn(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ._trajectory import resample_time, rmse
-    from .dmp import DMP
-    from .incremental import BiDMP
-    from .io import load_model, save_model
+    from .io import save_model
 
-    if not args.output.lower().endswith(".npz"):
-        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}")
-    model = load_model(args.model)
-    if isinstance(model, DMP):
-        model = BiDMP(model)
-    elif not isinstance(model, BiDMP):
-        raise ValueError(f"{args.model} holds a {type(model).__name__}; learn needs a DMP or a Bi-DMP model")
-    dmp = model.dmp if model.dmp is not None else model.dmp_
-    if args.units and dmp.units_ and args.units != dmp.units_:
-        raise ValueError(f"{args.demo} is in {args.units} but the model {args.model} is in {dmp.units_}: convert one of them first")
-    y, _, how = _read_demo(args.demo, args)
-    if y.shape[1] != model.n_dims_:
-        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    model, y, how = _bidmp_and_demo(args, "learn")
     model.learn(y)
     dmp = model.dmp_
     rollout = model.rollout(y[-1], start=y[0])

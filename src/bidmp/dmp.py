@@ -137,6 +137,15 @@ def check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None
         )
 
 
+def _check_integration(step: float, params) -> None:
+    """Refuse a normalised step for which the spring diverges or the phase (or an exponentially
+    delayed goal) does not decay."""
+    check_euler_stable(step, params.tau, params.alpha, params.beta)
+    _phase_decay(step, params.tau, params.alpha_phase)
+    if params.goal_rate is not None:
+        _phase_decay(step, params.tau, params.goal_rate)
+
+
 def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
     """Phase at every step, ``phase[l] = (1 - alpha_phase dt / tau) ** l`` (shape ``(n_steps,)``)."""
     return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
@@ -324,13 +333,13 @@ class _Params(NamedTuple):
 # The two protocols (README "Protocols"): what the unset parameters resolve to.
 PROTOCOLS = ("robot", "paper")
 # robot: K = alpha beta (Pastor 2009: the initial acceleration does not depend on the goal or the
-# start), a delayed goal (Kulvicius 2012) that moves from the start to the goal at rate
-# goal_rate, a phase that decays to e^-4 over the demonstration, 100 kernels and a stiffer spring
-# (alpha = 50), and a horizon of 1.1x the demonstrated duration. The weights are learned on the
-# demonstration followed by rest at its goal for that extra 0.1: the learned forcing term then
-# holds the goal at the end instead of extrapolating the last kernel. On the shared recordings
-# these settings reproduce to 0.25 mm RMS, end at the goal within 0.01 mm and reach a goal moved
-# by 150 mm within 0.01 mm (tests/test_timing.py; the measurements are in the README).
+# start), a delayed goal that follows the demonstration's progress (_progress_gate), a phase that
+# decays to e^-4 over the demonstration, 100 kernels and a stiffer spring (alpha = 50), and a
+# horizon of 1.1x the demonstrated duration. The weights are learned on the demonstration
+# followed by rest at its goal for that extra 0.1: the learned forcing term then holds the goal
+# at the end instead of extrapolating the last kernel. On the shared recordings these settings
+# reproduce to 0.13-0.15 mm RMS and reach a goal moved by 150 mm within 0.01 mm
+# (tests/test_timing.py; the measurements are in the README).
 ROBOT_ALPHA = 50.0
 ROBOT_KERNELS = 100
 ROBOT_ALPHA_PHASE = 4.0
@@ -546,11 +555,8 @@ class DMP(BaseEstimator):
         train = _with_rest(y, params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
-        check_euler_stable(dt, 1.0, params.alpha, params.beta)
-        check_euler_stable(dt, params.tau, params.alpha, params.beta)
-        _phase_decay(dt, params.tau, params.alpha_phase)
-        if params.goal_rate is not None:
-            _phase_decay(dt, params.tau, params.goal_rate)
+        _check_integration(dt, params._replace(tau=1.0))
+        _check_integration(dt, params)
         # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
         # rollouts, so it is not used here.
         n_train = train.shape[0]
@@ -707,17 +713,17 @@ class DMP(BaseEstimator):
                              "set goal_rate to a number or fit it again")
         return gate
 
-    def goal_gate(self, phase) -> np.ndarray:
-        """The goal gate at the given phases: the share of a goal change still to come (1 at
-        the start, 0 once the demonstration is done); see :func:`_progress_gate`."""
-        self._check_fitted()
-        params = self._params()
-        phase = np.asarray(phase, dtype=np.float64)
-        if params.goal_rate is None:
+    def _progress_gate_at(self, phase, params: _Params) -> np.ndarray:
+        """The progress gate (see :func:`_progress_gate`) at the given phases: the share of a
+        goal change still to come, interpolated in phase on the training grid. The reversed
+        training grid is kept, as the stepper asks for one phase per control step."""
+        key = (self.n_train_, self.dt_, params.alpha_phase)
+        cached = self.__dict__.get("_gate_lookup")
+        if cached is None or cached[0] != key or cached[2] is not self.goal_gate_:
             training_phase = phase_grid(self.n_train_, self.dt_, 1.0, params.alpha_phase)
-            return np.interp(phase, training_phase[::-1], self._progress_gate()[::-1])
-        # gate = (decay of goal_rate)^l = phase^(ln decay_g / ln decay_phase) on the same grid
-        return np.power(phase, params.goal_rate / params.alpha_phase)
+            cached = (key, training_phase[::-1], self._progress_gate(), self._progress_gate()[::-1])
+            self._gate_lookup = cached
+        return np.interp(phase, cached[1], cached[3])
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
@@ -754,7 +760,7 @@ class DMP(BaseEstimator):
             if params.goal_rate == params.alpha_phase:
                 gate = phase[:n_inputs]
             elif params.goal_rate is None:
-                gate = self.goal_gate(phase[:n_inputs])
+                gate = self._progress_gate_at(phase[:n_inputs], params)
             else:
                 gate = phase_grid(n_inputs, step, params.tau, params.goal_rate)
             drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
@@ -767,11 +773,7 @@ class DMP(BaseEstimator):
         """The validated parameters, with the rollout's integration checked for stability."""
         self._check_fitted()
         params = self._params() if params is None else params  # validated once per rollout
-        step = self.dt_ if step is None else step
-        check_euler_stable(step, params.tau, params.alpha, params.beta)
-        _phase_decay(step, params.tau, params.alpha_phase)
-        if params.goal_rate is not None:
-            _phase_decay(step, params.tau, params.goal_rate)
+        _check_integration(self.dt_ if step is None else step, params)
         return params
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
@@ -863,16 +865,12 @@ class DMP(BaseEstimator):
                     f"shape={shape}), iterate with iter_rollouts(goals, chunk_size={chunk:,}), or raise the limit "
                     f"with bidmp.set_limits(max_array_bytes=...)"
                 )
-            out = np.multiply(goal_response[None, :, None], goals[:, None, :])
-            out += free[None]
-            return out
+            return _affine_rollouts(goal_response, goals, free)
         if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
             described = f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
             raise ValueError(f"out must be a writable float64 array of shape {shape}, got {described}")
         for first, chunk in self._chunks(goals, free):
-            last = first + chunk.shape[0]
-            np.multiply(goal_response[None, :, None], chunk[:, None, :], out=out[first:last])
-            out[first:last] += free[None]
+            _affine_rollouts(goal_response, chunk, free, out[first : first + chunk.shape[0]])
         return out
 
     @staticmethod
@@ -897,9 +895,7 @@ class DMP(BaseEstimator):
         goals = as_points(goals, free.shape[1], "goals")
         check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
         for first, chunk in self._chunks(goals, free, chunk_size):
-            block = np.multiply(goal_response[None, :, None], chunk[:, None, :])
-            block += free[None]
-            yield first, block
+            yield first, _affine_rollouts(goal_response, chunk, free)
 
     @numerically_guarded
     def endpoint_gain(self, n_steps: int | None = None) -> float:
@@ -993,7 +989,7 @@ class DMP(BaseEstimator):
 
     def _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment):
         """The shortest duration whose trajectory meets ``limits``: scale by the exact factor of
-        :func:`bidmp.timing.scale_factor`, then correct for the discretisation (a few passes)."""
+        :func:`bidmp.timing.scale_factor`, then bisect for what the discretisation changes."""
         from .timing import scale_factor
 
         if not isinstance(limits, dict):
@@ -1001,6 +997,7 @@ class DMP(BaseEstimator):
         unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm"}
         if unknown:
             raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, max_jerk, norm")
+
         def attempt(duration):
             trajectory = self.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
                                          forcing_increment=forcing_increment)
@@ -1115,6 +1112,13 @@ def _progress_gate(train: np.ndarray, dt: float, params: _Params) -> np.ndarray:
     return gate
 
 
+def _affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """``y[i] = free + B goals[i]`` for every goal at once, (G, n, D), written into ``out`` if given."""
+    out = np.multiply(goal_response[None, :, None], goals[:, None, :], out=out)
+    out += free[None]
+    return out
+
+
 def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
     """``y`` followed by rest at its last point for the protocol's settle time (robot: 0.1 T)."""
     n_rest = int(round(params.settle * y.shape[0])) - y.shape[0]
@@ -1209,7 +1213,7 @@ class DMPStepper:
         self._z = z_next
         self.phase *= 1.0 - params.alpha_phase * h
         if params.goal_rate is None:
-            self._gate = float(self._dmp.goal_gate(self.phase))
+            self._gate = float(self._dmp._progress_gate_at(self.phase, params))
         else:
             self._gate *= 1.0 - params.goal_rate * h
         self.time += dt / slowdown

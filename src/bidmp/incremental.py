@@ -213,7 +213,7 @@ class BiDMP(BaseEstimator):
         if np.any(outside):  # never extrapolate in phase: hold the BLS input at the trained range
             basis = basis.copy()
             basis[outside] = self.dmp_.basis(clipped[outside])
-        inputs = self._bls_input(np.maximum(phase, self.phase_min_), basis)
+        inputs = self._bls_input(clipped, basis)
         for block in self.blocks_[:skill]:
             total += block.predict(inputs)
         total *= self._gate(phase)[:, None]
