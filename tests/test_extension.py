@@ -20,7 +20,7 @@ def step_lengths(y):
 
 
 def test_complete_demonstration_shape_ends_and_parts(battery):
-    result = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
+    result = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0, approach="paper")
     assert result.complete.shape == battery.shape
     assert np.array_equal(result.complete[0], battery[0])
     assert np.array_equal(result.complete[-1], BATTERY_EXTENSION_TARGET)
@@ -34,9 +34,10 @@ def test_complete_demonstration_shape_ends_and_parts(battery):
 
 
 @pytest.mark.parametrize("name, offset", [("Sshape", [15.0, -10.0]), ("WShape", [-8.0, 12.0])])
-def test_junction_is_continuous_in_position_and_speed(name, offset):
+@pytest.mark.parametrize("approach", ["paper", "keep"])
+def test_junction_is_continuous_in_position_and_speed(name, offset, approach):
     y = lasa(name)[0]
-    result = extend_demonstration(y, y[-1] + offset, seed=2)
+    result = extend_demonstration(y, y[-1] + offset, seed=2, approach=approach)
     complete = result.complete
     # The complete demonstration passes through seg, where the prefix hands over to Tra_gen.
     seg = y[result.seg_index]
@@ -47,7 +48,10 @@ def test_junction_is_continuous_in_position_and_speed(name, offset):
     assert after == pytest.approx(before, rel=0.15)
     # No jumps anywhere: neighbouring steps differ smoothly, and it ends at rest.
     assert np.max(np.abs(np.diff(speeds))) < 0.1 * speeds.max()
-    assert speeds[-1] < 0.05 * speeds.max()
+    if approach == "paper":
+        assert speeds[-1] < 0.05 * speeds.max()
+    else:  # the kept approach arrives as the demonstration does
+        assert speeds[-1] == pytest.approx(step_lengths(y)[-1], rel=1e-9)
 
 
 def test_same_seed_same_extension_and_options_pass_through(battery):
@@ -61,9 +65,9 @@ def test_same_seed_same_extension_and_options_pass_through(battery):
 
 
 def test_target_at_seg_skips_gprm(battery):
-    result = extend_demonstration(battery, battery[-1], seed=0)  # the demonstrated end: nearest piece end
+    result = extend_demonstration(battery, battery[-1], seed=0, approach="paper")  # the demonstrated end: nearest piece end
     assert np.array_equal(result.complete[-1], battery[-1])
-    seg_target = extend_demonstration(battery, battery[0], seed=0)  # coincides with seg of piece 0
+    seg_target = extend_demonstration(battery, battery[0], seed=0, approach="paper")  # coincides with seg of piece 0
     assert seg_target.similarity_history.size == 0
     assert np.array_equal(seg_target.complete[-1], battery[0])
 

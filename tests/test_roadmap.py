@@ -5,7 +5,7 @@ import pytest
 
 from bidmp.datasets import minimum_jerk
 from bidmp.reproduce import compare_prm, table5_cases
-from bidmp.roadmap import classic_prm, gaussian_prm, shortest_path, template
+from bidmp.roadmap import NoFreeRouteError, classic_prm, gaussian_prm, shortest_path, template
 from bidmp._trajectory import resample_arclength
 from bidmp.similarity import frechet_similarity
 
@@ -112,12 +112,19 @@ def test_collision_callback_keeps_the_path_out_of_an_obstacle():
         gaussian_prm(piece, centre + [0.5, 0.0], is_free=is_free)
 
 
-def test_unreachable_target_falls_back_to_the_sample_chain():
+def test_a_wall_that_blocks_every_route_is_an_error_never_a_path_through_it():
     nodes = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0]])
     assert shortest_path(nodes, 1).tolist() == [0, 1, 2, 3]
     wall = lambda points: np.abs(points[:, 0] - 1.5) > 0.4  # noqa: E731 - a wall at x = 1.5
     assert shortest_path(nodes, 1, is_free=wall) is None
-    result = gaussian_prm(np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=20, is_free=wall, seed=0)
+    with pytest.raises(NoFreeRouteError, match="no collision-free route"):
+        gaussian_prm(np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=20, is_free=wall, seed=0)
+
+
+def test_unreachable_target_without_a_callback_falls_back_to_the_sample_chain():
+    # Far apart samples and one neighbour: the kNN graph is disconnected, nothing is in the way.
+    result = gaussian_prm(np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=2, n_neighbours=1,
+                          sigma_rel=5.0, seed=0)
     assert np.array_equal(result.path[0], [0.0, 0.0]) and np.array_equal(result.path[-1], [3.0, 0.0])
 
 

@@ -223,11 +223,16 @@ def test_shared_recordings_after_prepare(name):
     points = bidmp.segment(prepared.y).points
     speed = np.linalg.norm(prepared.yd, axis=1)
     assert len(points) >= 2 and np.all(speed[points] > 0.005 * speed.max())  # corners of the motion, not idle noise
-    extension = bidmp.extend_demonstration(prepared.y, prepared.y[-1] + SHIFT, seed=0)
+    extension = bidmp.extend_demonstration(prepared.y, prepared.y[-1] + SHIFT, seed=0, approach="paper")
     piece = extension.tra_imi
     # The imitated piece is the real final approach: the descent onto the nut, not sensor noise.
     assert np.ptp(piece[:, 2]) > 20.0 and np.hypot(*np.ptp(piece[:, :2], axis=0)) < 5.0
-    raw = bidmp.extend_demonstration(y, y[-1] + SHIFT, seed=0)  # without prepare: noise at the goal
+    # approach="keep" finds that descent and keeps it, translated, sample for sample.
+    kept = bidmp.extend_demonstration(prepared.y, prepared.y[-1] + SHIFT, seed=0)
+    approach = prepared.y[kept.approach_index :]
+    assert np.ptp(approach[:, 2]) > 20.0 and np.hypot(*np.ptp(approach[:, :2], axis=0)) < 5.0
+    np.testing.assert_allclose(kept.complete[-len(approach):], approach + SHIFT, rtol=0, atol=1e-9)
+    raw = bidmp.extend_demonstration(y, y[-1] + SHIFT, seed=0, approach="paper")  # without prepare: noise at the goal
     assert np.ptp(raw.tra_imi[:, 2]) < 5.0
 
 

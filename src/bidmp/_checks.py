@@ -22,6 +22,8 @@ import numpy as np
 
 __all__ = [
     "NotFittedError",
+    "MissingExtraError",
+    "require_extra",
     "Limits",
     "get_limits",
     "set_limits",
@@ -161,6 +163,21 @@ def short_token(value, width: int = 10) -> str:
     (a file read by mistake must not be echoed into a terminal or a log)."""
     text = "".join(c if c.isprintable() else "?" for c in str(value)[: width + 1])
     return repr(text[:width] + "…") if len(text) > width else repr(text)
+
+
+class MissingExtraError(ImportError):
+    """An optional dependency is not installed; the message says which extra installs it."""
+
+
+def require_extra(module: str, extra: str, what: str):
+    """Import ``module`` from the optional extra ``extra`` or raise :class:`MissingExtraError`
+    with the one-line install command."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MissingExtraError(f"{what} need {module}, which is not installed: pip install 'bidmp[{extra}]'") from None
 
 
 class NotFittedError(ValueError, AttributeError):

@@ -234,6 +234,13 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .scenarios import load
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
+    if args.approach is not None:
+        from .scenarios import from_dict
+
+        spec = scenario.to_dict()
+        spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
+        scenario = from_dict(spec, source=args.scenario, base_dir=scenario.base_dir,
+                             allow_outside_files=args.allow_outside_files)
     methods = None
     if args.methods is not None:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -313,8 +320,15 @@ def _cmd_extend(args: argparse.Namespace) -> int:
     from .metrics import path_extent, rmse
     from .timing import Trajectory
 
+    scene = None
+    if args.scene is not None:
+        from .scenarios import load
+
+        scene = load(args.scene, allow_outside_files=args.allow_outside_files).scene
+        if scene is None:
+            raise ValueError(f"--scene: scenario {args.scene} has no \"scene\" key")
     model, y, how = _bidmp_and_demo(args, "extend")
-    extension = extend_demonstration(y, args.target, seed=args.seed)
+    extension = extend_demonstration(y, args.target, seed=args.seed, approach=args.approach, scene=scene)
     target = extension.new_target
     history = extension.similarity_history
     print(f"{args.demo}: {how}")
@@ -476,6 +490,11 @@ def build_parser() -> argparse.ArgumentParser:
     extend.add_argument("--save-demo", metavar="OUT", help="also write the extended demonstration, timed like a rollout (.csv or .npy)")
     _demo_options(extend)
     extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
+    extend.add_argument("--approach", choices=("keep", "paper"), default="keep",
+                        help="keep: keep the demonstrated final approach, translated, and grow only the transfer (default); "
+                             "paper: imitate the nearest piece down to the target (the paper's protocol)")
+    extend.add_argument("--scene", metavar="FILE|NAME", help="grow the extension around the parts of this scenario's scene")
+    extend.add_argument("--allow-outside-files", action="store_true", help=argparse.SUPPRESS)
     extend.add_argument("--plot", metavar="PNG", help="also write a figure")
     extend.set_defaults(handler=_cmd_extend)
 
@@ -516,6 +535,8 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario file or built-in name (see 'bidmp scenario list')")
     demo.add_argument("--methods", default=None, help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm")
     demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    demo.add_argument("--approach", choices=("keep", "paper"), default=None,
+                      help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
     demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
     demo.add_argument("--allow-outside-files", action="store_true",
                       help="let the scenario read demonstration files outside its own folder")
@@ -591,6 +612,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         print("bidmp: error: no command given (see 'bidmp --help')", file=sys.stderr)
         return EXIT_BAD_INPUT
+    from ._checks import MissingExtraError
+
     buffered = _BufferedLog()
     root = logging.getLogger()
     debug_handler = None
@@ -615,7 +638,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("bidmp: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, OSError, ArithmeticError, RuntimeWarning, RecursionError, MemoryError) as exc:
+    except (ValueError, TypeError, OSError, ArithmeticError, RuntimeWarning, RecursionError, MemoryError,
+            MissingExtraError) as exc:
         if args.debug:
             raise
         if isinstance(exc, MemoryError):

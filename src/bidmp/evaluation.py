@@ -39,10 +39,51 @@ class MethodResult:
     differences: dict
     success_threshold: float
     n_steps: int
+    clearances: dict | None = None  # label -> Clearance, or None where the scene does not apply; None without a scene
 
     @property
     def successes(self) -> int:
         return sum(error <= self.success_threshold for error in self.errors.values())
+
+    def engaged_at(self, label: str) -> bool | None:
+        """Whether the tool stayed within the threshold of the target's axis over the approach
+        height (None when the scenario has no approach height)."""
+        if self.approach_errors is None:
+            return None
+        return bool(self.approach_errors[label] <= self.success_threshold)
+
+    def clearance_at(self, label: str):
+        return None if self.clearances is None else self.clearances.get(label)
+
+    def task_success_at(self, label: str) -> bool:
+        """End point within the threshold, engaged (where measured) and collision-free (where
+        the scene applies)."""
+        clearance = self.clearance_at(label)
+        return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
+                    and (clearance is None or clearance.collision_free))
+
+    @property
+    def task_successes(self) -> int:
+        return sum(self.task_success_at(label) for label in self.errors)
+
+    @property
+    def engaged(self) -> int | None:
+        return None if self.approach_errors is None else sum(bool(self.engaged_at(label)) for label in self.errors)
+
+    @property
+    def checked(self) -> list[str]:
+        """Labels whose motion was checked against the scene."""
+        return [] if self.clearances is None else [label for label, c in self.clearances.items() if c is not None]
+
+    @property
+    def collision_free(self) -> int | None:
+        return None if self.clearances is None else sum(self.clearances[label].collision_free for label in self.checked)
+
+    @property
+    def worst_clearance(self):
+        """The smallest Clearance over the checked targets (None without a scene)."""
+        checked = [self.clearances[label] for label in self.checked]
+        return min(checked, key=lambda c: c.distance) if checked else None
 
     @property
     def approach_successes(self) -> int | None:
@@ -67,7 +108,33 @@ class MethodResult:
         if self.approach_errors is not None:
             out["approach_successes"] = self.approach_successes
             out["approach_success_rate"] = round(self.approach_successes / n_targets, 4)
+        worst = self.worst_clearance
+        out.update({
+            "task_successes": self.task_successes,
+            "engaged": self.engaged,
+            "collision_free": self.collision_free,
+            "n_checked": None if self.clearances is None else len(self.checked),
+            "min_clearance": None if worst is None else _rounded(worst.distance),
+            "min_clearance_part": None if worst is None else worst.part,
+        })
+        targets = {}
+        for label, error in self.errors.items():
+            clearance = self.clearance_at(label)
+            targets[label] = {
+                "error": round(float(error), 4),
+                "approach_error": None if self.approach_errors is None else round(float(self.approach_errors[label]), 4),
+                "engaged": self.engaged_at(label),
+                "clearance": None if clearance is None else _rounded(clearance.distance),
+                "clearance_part": None if clearance is None else clearance.part,
+                "collision_part": None if clearance is None else clearance.collision_part,
+                "task_success": self.task_success_at(label),
+            }
+        out["targets"] = targets
         return out
+
+
+def _rounded(distance: float) -> float | None:
+    return None if not np.isfinite(distance) else round(float(distance), 4)
 
 
 @dataclass
@@ -100,16 +167,25 @@ class Report:
 
     # -- tables ------------------------------------------------------------------------------
     def method_rows(self, runtimes: bool = True) -> tuple[list[str], list[list[str]]]:
-        """The Table 4 analogue: header and one row per method."""
-        header = ["method", "success rate", "successes", "+ approach", "max error", "difference range"]
+        """The Table 4 analogue: header and one row per method. With a scene: engaged,
+        collision-free (of the targets the scene applies to), worst clearance and task success
+        (end point ∧ engaged ∧ collision-free) beside the paper's end-point success."""
+        geometry = self.scenario.scene is not None
+        header = ["method", "success rate", "successes", "engaged", "max error", "difference range"]
+        if geometry:
+            header += ["collision-free", "min clearance (part)", "task success"]
         if runtimes:
             header.append("run time [s]")
         rows = []
         for name, result in self.methods.items():
             data = result.to_dict()
-            approach = "-" if data["approach_errors"] is None else f"{data['approach_successes']}/{data['n_targets']}"
-            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{data['n_targets']}", approach,
+            n = data["n_targets"]
+            engaged = "-" if data["engaged"] is None else f"{data['engaged']}/{n}"
+            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{n}", engaged,
                    f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
+            if geometry:
+                worst = "-" if data["min_clearance"] is None else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
+                row += [f"{data['collision_free']}/{data['n_checked']}", worst, f"{data['task_successes']}/{n}"]
             if runtimes:
                 row.append(f"{data['runtime_s']:.4f}")
             rows.append(row)
@@ -136,6 +212,11 @@ class Report:
         units = scenario.units
         lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
                  f"success = end-point error <= {scenario.success_threshold:g} {units}"]
+        if scenario.scene is not None:
+            engaged = (f"engaged (within {scenario.success_threshold:g} {units} of the target's axis over the last "
+                       f"{scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
+            lines.append(f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "
+                         f"{units}, clearance to every part but the target)")
         if self.extension_targets:
             lines.append(f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
                          + ", ".join(np.array2string(np.asarray(t), precision=1) for t in self.extension_targets))
@@ -176,12 +257,15 @@ def _bidmp_model(scenario, dmp, failed):
     model = BiDMP(dmp, **scenario.bidmp)
     extensions, targets = [], []
     previous = None
+    # The paper's protocol knows no battery geometry: approach "paper" grows the extension blind.
+    keep = scenario.extension.get("approach", "keep") == "keep"
     for stage in scenario.extensions:
         target = _resolve_target(stage["target"], scenario, failed)
         if target is None:
             continue  # nothing failed: no extension needed
         source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
-        previous = extend_demonstration(source, target, seed=scenario.seed, **scenario.extension)
+        scene = scenario.scene if keep and stage.get("in_scene", True) else None
+        previous = extend_demonstration(source, target, seed=scenario.seed, scene=scene, **scenario.extension)
         model.learn(previous.complete)
         extensions.append(previous)
         targets.append(target)
@@ -195,7 +279,7 @@ def _bidmp_model(scenario, dmp, failed):
     return model, extensions, targets, forgetting
 
 
-def evaluate(scenario, methods=None, progress=None) -> Report:
+def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Report:
     """Run ``methods`` (default: the scenario's) on every target of ``scenario``.
 
     Parameters
@@ -206,6 +290,10 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
         From dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm.
     progress : callable, optional
         Called with each method name before it runs (the CLI hooks a progress bar here).
+    geometry : bool, default True
+        Check every rollout against the scenario's scene (clearance, collisions, task success).
+        False skips the checks (the extensions are still grown around the parts); the report
+        then has no geometry columns.
 
     Returns
     -------
@@ -228,6 +316,11 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
     demo = scenario.demonstration
     n_steps = demo.shape[0]
     references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
+    scene = scenario.scene if geometry else None
+    # The target's own part enters the tool: its label, or (a target not on a labelled part)
+    # whatever the tool would take into its mouth there.
+    excluded = {} if scene is None else {
+        label: [label] if label in scene.labels else scene.parts_at(scenario.targets[label]) for label in labels}
 
     def result(name, trajectories, seconds):
         trajectories = dict(zip(labels, trajectories))
@@ -236,8 +329,12 @@ def evaluate(scenario, methods=None, progress=None) -> Report:
         if scenario.approach_height is not None and demo.shape[1] == 3:
             approach = {label: approach_error(trajectories[label], scenario.targets[label], scenario.approach_height) for label in labels}
         differences = {label: path_difference(trajectories[label], references[label]) for label in labels}
+        clearances = None
+        if scene is not None:
+            clearances = {label: scene.clearance(trajectories[label], exclude=excluded[label]) if scene.applies_to(label)
+                          else None for label in labels}
         return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
-                            next(iter(trajectories.values())).shape[0])
+                            next(iter(trajectories.values())).shape[0], clearances)
 
     report = Report(scenario=scenario, methods={})
     with _Timer() as dmp_time:

@@ -30,10 +30,11 @@ class _Matplotlib:
         import mpl_toolkits.mplot3d  # noqa: F401 - registers the "3d" projection
         from matplotlib import colormaps
         from matplotlib.figure import Figure
-        from matplotlib.patches import Circle
+        from matplotlib.patches import Circle, Rectangle
 
         self._figure_class = Figure
         self.Circle = Circle
+        self.Rectangle = Rectangle
         self.cm = SimpleNamespace(viridis=colormaps["viridis"], tab10=colormaps["tab10"])
 
     def figure(self, figsize, dpi):
@@ -310,15 +311,28 @@ def plot_targets_top_view(path, report) -> Path:
     n_rows = int(np.ceil(len(names) / n_cols))
     fig, axes = mpl.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
     targets = scenario.target_array
+    scene = scenario.scene
     for ax, name in zip(axes.ravel(), names):
         result = report.methods[name]
+        if scene is not None:  # the parts' footprints, under everything else
+            for solid in scene.solids:
+                ax.add_patch(mpl.Rectangle(solid.lower[:2], *(solid.upper[:2] - solid.lower[:2]), fill=False,
+                                           edgecolor="0.75", linewidth=0.6, zorder=0))
         for label, target in scenario.targets.items():
-            ok = result.errors[label] <= scenario.success_threshold
+            ok = result.task_success_at(label) if scene is not None else result.errors[label] <= scenario.success_threshold
             ax.add_patch(mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
             ax.text(target[0], target[1], label, ha="center", va="center", fontsize=8)
             end = result.rollouts[label][-1]
             ax.plot(end[0], end[1], "k.", markersize=3)
-        ax.set_title(f"{name}: {result.successes}/{len(targets)} within {scenario.success_threshold:g} {scenario.units}", fontsize=10)
+            clearance = result.clearance_at(label)
+            if clearance is not None and not clearance.collision_free:
+                ax.plot(clearance.point[0], clearance.point[1], "x", color="darkred", markersize=7, markeredgewidth=2)
+        if scene is not None:
+            title = (f"{name}: task success {result.task_successes}/{len(targets)}, "
+                     f"{result.collision_free}/{len(result.checked)} collision-free (x = hit)")
+        else:
+            title = f"{name}: {result.successes}/{len(targets)} within {scenario.success_threshold:g} {scenario.units}"
+        ax.set_title(title, fontsize=9)
         pad = 20.0
         ax.set_xlim(targets[:, 0].min() - pad, targets[:, 0].max() + pad)
         ax.set_ylim(targets[:, 1].min() - pad, targets[:, 1].max() + pad)
@@ -326,7 +340,7 @@ def plot_targets_top_view(path, report) -> Path:
         ax.grid(True, alpha=0.3)
     for ax in axes.ravel()[len(names):]:
         ax.axis("off")
-    fig.suptitle(f"{scenario.name}: success per target (green) and failure (red)")
+    fig.suptitle(f"{scenario.name}: {'task ' if scene is not None else ''}success per target (green) and failure (red)")
     fig.tight_layout()
     return _save(fig, path)
 
@@ -386,6 +400,15 @@ def plot_scenario_3d(path, report) -> Path:
             _draw(ax, report.methods["dmp"].rollouts[label], "--", color="tab:blue", linewidth=0.8,
                   label="plain DMP, missed targets" if index == 0 else None)
     _draw(ax, scenario.target_array, "o", color="tab:green", markersize=4, linestyle="none", label="targets")
+    hits = [clearance.point for result in report.methods.values() if result.clearances is not None
+            for clearance in result.clearances.values() if clearance is not None and not clearance.collision_free]
+    if scenario.scene is not None and n_dims == 3:
+        for solid in scenario.scene.solids:  # each part as the vertical edges of its box
+            for x, y in ((solid.lower[0], solid.lower[1]), (solid.upper[0], solid.lower[1]),
+                         (solid.upper[0], solid.upper[1]), (solid.lower[0], solid.upper[1])):
+                ax.plot([x, x], [y, y], [solid.lower[2], solid.upper[2]], color="0.7", linewidth=0.5)
+    if hits:
+        _draw(ax, np.array(hits), "X", color="darkred", markersize=7, linestyle="none", label="collisions")
     _finish(ax, n_dims, scenario.units, f"{scenario.name}")
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)

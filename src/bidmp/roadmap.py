@@ -39,9 +39,13 @@ from ._checks import (
 from ._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
-__all__ = ["RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path", "check_options"]
+__all__ = ["NoFreeRouteError", "RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path", "check_options"]
 
 logger = logging.getLogger(__name__)
+
+class NoFreeRouteError(ValueError):
+    """The roadmap found no collision-free route (never a path through an obstacle)."""
+
 
 CollisionCallback = Callable[[np.ndarray], np.ndarray]
 """``is_free(points (M, D)) -> bool (M,)``: True where a point is collision-free."""
@@ -193,6 +197,11 @@ def shortest_path(
 
 
 def _edges_free(a: np.ndarray, b: np.ndarray, is_free: CollisionCallback) -> np.ndarray:
+    # A callback that can check straight moves continuously (bidmp.geometry.SceneChecker) does;
+    # a plain point callback is asked at _EDGE_CHECKS points along each edge.
+    segments_free = getattr(is_free, "segments_free", None)
+    if segments_free is not None:
+        return np.asarray(segments_free(a, b), dtype=bool)
     t = np.linspace(0.0, 1.0, _EDGE_CHECKS + 2)[1:-1]
     points = a[:, None, :] + t[None, :, None] * (b - a)[:, None, :]
     free = np.asarray(is_free(points.reshape(-1, a.shape[1])), dtype=bool).reshape(a.shape[0], -1)
@@ -205,15 +214,21 @@ def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, 
     if is_free is not None:
         free = np.asarray(is_free(nodes), dtype=bool)
         if not (free[0] and free[-1]):
-            raise ValueError("the start (seg) or the new target is inside an obstacle according to is_free")
+            raise NoFreeRouteError(f"the {'start (seg)' if not free[0] else 'new target'} "
+                                   f"{np.round(nodes[0] if not free[0] else nodes[-1], 3).tolist()} is inside an "
+                                   f"obstacle according to is_free")
         keep = free.copy()
         nodes, order = nodes[keep], order[keep[1:-1]]
     indices = shortest_path(nodes, n_neighbours, is_free)
     if indices is None:
-        # Unreachable even with 32 neighbours: chain the samples in their sampling order (SPEC
-        # §5). That chain is not collision-checked, so say so.
-        logger.warning("new target unreachable on the roadmap even with %d neighbours: chaining the samples "
-                       "in order%s", _MAX_NEIGHBOURS, " (not collision-free)" if is_free is not None else "")
+        if is_free is not None:
+            raise NoFreeRouteError(f"no collision-free route from seg {np.round(seg, 3).tolist()} to "
+                                   f"{np.round(new_target, 3).tolist()}: the roadmap's {nodes.shape[0] - 2} free samples "
+                                   f"do not connect them even with {_MAX_NEIGHBOURS} neighbours (the parts block the "
+                                   f"way, or sigma_rel / n_samples are too small to go around them)")
+        # Unreachable even with 32 neighbours: chain the samples in their sampling order (SPEC §5).
+        logger.warning("new target unreachable on the roadmap even with %d neighbours: chaining the samples in order",
+                       _MAX_NEIGHBOURS)
         inner = nodes[1:-1][np.argsort(order, kind="stable")]
         return np.vstack([seg, inner, new_target])
     return nodes[indices]
@@ -353,8 +368,11 @@ def gaussian_prm(
         Which iteration to return.
     is_free : callable, optional
         Collision callback ``is_free(points (M, D)) -> bool (M,)``; nodes and edges where it is
-        False are left out of the roadmap. Edges are checked at 5 interior points, so an obstacle
-        thinner than a fifth of an edge can slip between them: inflate thin obstacles.
+        False are left out of the roadmap. An ``is_free.segments_free(a, b)`` method, when the
+        callback has one (:meth:`bidmp.Scene.checker`), checks the edges continuously; otherwise
+        edges are checked at 5 interior points, so an obstacle thinner than a fifth of an edge can
+        slip between them: inflate thin obstacles. When no free route joins seg and the target,
+        :class:`NoFreeRouteError` (a ``ValueError``) is raised: never a path through an obstacle.
     seed : int or numpy.random.Generator
     """
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,

@@ -22,9 +22,10 @@ Keys (units: millimetres for the battery scenarios)::
                          widths, derivatives)
     bidmp                Bi-DMP parameters (n_windows, n_mapped, n_enhance, increments, shrink, reg,
                          seed, derivatives)
-    extension            extended-demonstration options of bidmp.extend_demonstration (eps_frac,
-                         method, n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho,
-                         schedule, scaling, compare, select, denom)
+    extension            extended-demonstration options of bidmp.extend_demonstration (approach
+                         "keep" (default) or "paper", eps_frac, method, n_samples, sigma_rel,
+                         n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare,
+                         select, denom)
     extension_target     "centre_of_failed" (default), a target label, or a point
     extensions           list of {"target": as extension_target, "from": "demonstration" |
                          "previous"}: chained extended demonstrations (overrides extension_target)
@@ -32,6 +33,11 @@ Keys (units: millimetres for the battery scenarios)::
                          (several operators); a target with the same label uses it as reference
     methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
     seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
+    scene                geometry of the work cell: tool and parts (see bidmp.geometry); with it
+                         the evaluation reports clearance, collisions and task success, and the
+                         extensions (approach "keep") are grown around the parts. A stage of
+                         "extensions" with "in_scene": false is grown without it (a skill of an
+                         earlier task, before these parts were there).
 
 Loading validates everything ``evaluate`` will need, so a scenario that loads also runs: the DMP
 is fitted on the demonstration (unstable integration, oversized settings and degenerate
@@ -53,6 +59,7 @@ import numpy as np
 
 from ._checks import check_limit, get_limits, short_token
 from .datasets import minimum_jerk
+from .geometry import Scene, SceneError
 from .io import load_json, load_trajectory
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
@@ -61,13 +68,13 @@ METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-    "seed",
+    "seed", "scene",
 }
 _DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
              "goal_rate"}
 _BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
 _EXTENSION_KEYS = {
-    "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
+    "approach", "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
     "scaling", "compare", "select", "denom",
 }
 _MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
@@ -97,6 +104,8 @@ class Scenario:
     units: str = "mm"
     description: str = ""
     spec: dict = field(default_factory=dict, repr=False)
+    scene: Scene | None = None
+    base_dir: str = "."  # where "file" demonstrations were read from
 
     @property
     def labels(self) -> list[str]:
@@ -325,16 +334,20 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         extensions = []
         for index, stage in enumerate(data["extensions"]):
             key = f"extensions[{index}]"
-            if not isinstance(stage, dict) or set(stage) - {"target", "from"} or "target" not in stage:
-                _fail(source, key, 'expected {"target": ..., "from": "demonstration" | "previous"}')
+            if not isinstance(stage, dict) or set(stage) - {"target", "from", "in_scene"} or "target" not in stage:
+                _fail(source, key, 'expected {"target": ..., "from": "demonstration" | "previous", "in_scene": true | false}')
             origin = stage.get("from", "demonstration" if index == 0 else "previous")
             if origin not in ("demonstration", "previous") or (index == 0 and origin == "previous"):
                 _fail(source, f"{key}.from", f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}")
-            extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims), "from": origin})
+            in_scene = stage.get("in_scene", True)
+            if not isinstance(in_scene, bool):
+                _fail(source, f"{key}.in_scene", f"expected true or false, got {_shown(in_scene)}")
+            extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims),
+                               "from": origin, "in_scene": in_scene})
         check_limit(len(extensions), "max_targets", "the number of extensions")
     else:
         target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
-        extensions = [{"target": target, "from": "demonstration"}]
+        extensions = [{"target": target, "from": "demonstration", "in_scene": True}]
 
     extra = data.get("demonstrations", {})
     if not isinstance(extra, dict):
@@ -357,6 +370,17 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
 
+    scene = None
+    if "scene" in data:
+        if n_dims != 3:
+            _fail(source, "scene", f"needs 3-D targets and demonstrations, these have D = {n_dims}")
+        try:
+            scene = Scene.from_dict(data["scene"], targets)
+        except SceneError as exc:
+            raise ScenarioError(f"scenario {source}: {exc}") from None
+        except ImportError as exc:
+            raise type(exc)(f"scenario {source}: {exc}") from None
+
     _check_runs(source, demonstration, targets, dmp)
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
@@ -364,6 +388,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         extensions=extensions,
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
+        scene=scene, base_dir=str(base_dir),
     )
 
 
