@@ -41,7 +41,7 @@ readme: $(STAMP)
 	$(VENV)/bin/bidmp reproduce table4 --out .readme-out > /dev/null
 	$(VENV)/bin/bidmp reproduce table5 --out .readme-out > /dev/null
 	$(VENV)/bin/bidmp reproduce figures --out .readme-out > /dev/null
-	cp .readme-out/table4.md .readme-out/table5.md .readme-out/figures.md docs/results/
+	cp .readme-out/table4.md .readme-out/tasks.md .readme-out/table5.md .readme-out/figures.md docs/results/
 	rm -rf .readme-out
 	$(PY) tools/recordings_figure.py
 	$(PY) tools/readme.py

@@ -116,6 +116,9 @@ def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
     assert cells["after"]["B6"] < cells["before"]["B6"]
     assert "end error before" in out
     assert_committed(tmp_path / "t4" / "table4.md")
+    assert_committed(tmp_path / "t4" / "tasks.md")
+    keep = summary["approach_keep"]["nut-unscrewing"]["methods"]["bidmp"]
+    assert keep["task_successes"] == 14 and summary["nut-unscrewing"]["methods"]["bidmp"]["engaged"] == 6
 
 
 @pytest.mark.parametrize(

@@ -22,6 +22,10 @@ _LAZY = {
     "frechet_distance": ("bidmp.similarity", "frechet_distance"),
     "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
     "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
+    "Scene": ("bidmp.geometry", "Scene"),
+    "Tool": ("bidmp.geometry", "Tool"),
+    "Clearance": ("bidmp.geometry", "Clearance"),
+    "MissingExtraError": ("bidmp._checks", "MissingExtraError"),
     "BLS": ("bidmp.bls", "BLS"),
     "BiDMP": ("bidmp.incremental", "BiDMP"),
     "forgetting": ("bidmp.incremental", "forgetting"),
@@ -35,20 +39,21 @@ _LAZY = {
     "set_limits": ("bidmp._checks", "set_limits"),
 }
 _SUBMODULES = (
-    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental",
+    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry",
     "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting",
 )
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from . import bls, datasets, dmp, evaluation, extension, incremental, io, metrics, plotting, reproduce, roadmap, segmentation, similarity  # noqa: F401
+    from . import bls, datasets, dmp, evaluation, extension, geometry, incremental, io, metrics, plotting, reproduce, roadmap, segmentation, similarity  # noqa: F401
     from .bls import BLS  # noqa: F401
     from .incremental import BiDMP, forgetting  # noqa: F401
     from ._checks import Limits, NotFittedError, get_limits, set_limits  # noqa: F401
     from .dmp import DMP  # noqa: F401
     from .timing import Trajectory, prepare, time_scale  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401
+    from .geometry import Clearance, Scene, Tool  # noqa: F401
     from .segmentation import Segmentation, segment  # noqa: F401
     from .similarity import frechet_distance, frechet_similarity  # noqa: F401
     from .io import ModelFileError  # noqa: F401

@@ -341,18 +341,30 @@ class _Distances:
         return self._checked(float(self.coal.distance(a, pose_a, b, pose_b, self.request, self.result)))
 
 
-def _densify(points: np.ndarray, step: float) -> np.ndarray:
-    """The polyline through ``points`` with extra points so that none are more than ``step`` apart."""
-    lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    pieces = np.maximum(np.ceil(lengths / step).astype(np.int64), 1)
+def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None) -> np.ndarray:
+    """Points along the polyline through ``points`` no more than ``step`` apart: of every segment
+    (``segments`` None), or of the segments whose indices are given (each with both its ends)."""
+    if points.shape[0] == 1:
+        return points.copy()
+    if segments is None:
+        segments = np.arange(points.shape[0] - 1)
+    if segments.size == 0:
+        return points[:0]
+    starts, ends = points[segments], points[segments + 1]
+    pieces = np.maximum(np.ceil(np.linalg.norm(ends - starts, axis=1) / step).astype(np.int64), 1) + 1
     total = int(pieces.sum())
     if total > get_limits().max_samples * 4:
         raise ValueError(f"the trajectory needs {total:,} checks at steps of {step:g}; use a larger step")
-    segment = np.repeat(np.arange(len(lengths)), pieces)
-    start = np.concatenate([[0], np.cumsum(pieces)[:-1]])
-    fraction = (np.arange(total) - np.repeat(start, pieces)) / np.repeat(pieces, pieces)
-    dense = points[segment] + fraction[:, None] * (points[segment + 1] - points[segment])
-    return np.vstack([dense, points[-1:]])
+    which = np.repeat(np.arange(segments.size), pieces)
+    first = np.concatenate([[0], np.cumsum(pieces)[:-1]])
+    fraction = (np.arange(total) - np.repeat(first, pieces)) / np.repeat(pieces - 1, pieces)
+    return starts[which] + fraction[:, None] * (ends[which] - starts[which])
+
+
+def _box_distance(lower_a: np.ndarray, upper_a: np.ndarray, lower_b: np.ndarray, upper_b: np.ndarray) -> np.ndarray:
+    """Distance between axis-aligned boxes, broadcast over leading axes."""
+    gap = np.maximum(np.maximum(lower_b - upper_a, lower_a - upper_b), 0.0)
+    return np.sqrt(np.sum(gap * gap, axis=-1))
 
 
 class Scene:
@@ -395,7 +407,7 @@ class Scene:
         tool_data = data.get("tool")
         if not isinstance(tool_data, dict) or set(tool_data) != {"radius", "length"}:
             _fail("scene.tool", 'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)')
-        tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}", positive=False) for k in ("radius", "length")))
+        tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}") for k in ("radius", "length")))
         parts = _parse_parts(data.get("parts"), targets)
         chosen = data.get("targets", "all")
         if chosen == "all":
@@ -516,20 +528,27 @@ class Scene:
         chosen = self._selected(exclude)
         if chosen.size == 0:
             return Clearance(math.inf, None, None)
-        dense = _densify(points, step) if points.shape[0] > 1 else points
         lower, upper = self._lower[chosen], self._upper[chosen]
         engine = self._engine()
         radius, length = self.tool.radius, self.tool.length
-        # First cull: the box around every checked part bounds each sample's distance from below;
-        # the exact distance of the most promising pair bounds the minimum from above. Most of a
-        # motion is far from everything and never reaches the per-part bounds.
-        whole = _cylinder_box_bounds(dense, radius, length, lower.min(axis=0)[None], upper.max(axis=0)[None])[:, 0]
-        row = int(np.argmin(whole))
-        first = _cylinder_box_bounds(dense[row : row + 1], radius, length, lower, upper)[0]
+        # Culling: the box around every checked part bounds each sample's distance from below,
+        # and the exact distance of the most promising pair bounds the minimum from above. Only
+        # the segments whose swept tool box could come closer than that are densified and
+        # bounded part by part; most of a motion is far from everything.
+        whole_lower, whole_upper = lower.min(axis=0), upper.max(axis=0)
+        at_samples = _cylinder_box_bounds(points, radius, length, whole_lower[None], whole_upper[None])[:, 0]
+        row = int(np.argmin(at_samples))
+        first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]
         col = int(np.argmin(first))
-        best = engine.tool_to(dense[row], int(chosen[col]))
-        best_part, best_point = self.solids[chosen[col]].label, dense[row]
-        dense = dense[(whole < best) | (whole <= 0.0)]
+        best = engine.tool_to(points[row], int(chosen[col]))
+        best_part, best_point = self.solids[chosen[col]].label, points[row]
+        if points.shape[0] > 1:
+            swept_lower = np.minimum(points[:-1], points[1:]) - [radius, radius, 0.0]
+            swept_upper = np.maximum(points[:-1], points[1:]) + [radius, radius, length]
+            near = _box_distance(swept_lower, swept_upper, whole_lower, whole_upper)
+            dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))
+        else:
+            dense = points
         for start in range(0, dense.shape[0], _CHUNK):
             block = dense[start : start + _CHUNK]
             bounds = _cylinder_box_bounds(block, radius, length, lower, upper)

@@ -426,6 +426,20 @@ PAPER_NUT_ERRORS = {
 }
 
 
+def _neighbour_clearance(scenario, result) -> str:
+    """Worst clearance of a method's checked motions to the parts of the other targets only (the
+    neighbouring nuts and studs, cells), leaving out supports such as the plate."""
+    scene = scenario.scene
+    others = [label for label in scenario.labels if label in scene.labels]
+    worst = None
+    for label in result.checked:
+        exclude = [part for part in scene.labels if part not in others or part == label]
+        clearance = scene.clearance(result.rollouts[label], exclude=exclude)
+        if worst is None or clearance.distance < worst.distance:
+            worst = clearance
+    return "-" if worst is None else f"{worst.distance:.2f} ({worst.part})"
+
+
 @dataclass
 class Table4:
     """The three case studies plus the cell-removal before/after comparison."""
@@ -437,7 +451,8 @@ class Table4:
     def task_rows(self) -> tuple[list[str], list[list[str]]]:
         """Task success with the battery geometry: end point ∧ engaged ∧ collision-free, for the
         defaults (approach "keep") beside the paper-literal extension (approach "paper")."""
-        header = ["task", "method", "end point", "engaged", "collision-free", "worst clearance mm (part)", "task success"]
+        header = ["task", "method", "end point", "engaged", "collision-free", "worst clearance mm (part)",
+                  "to the other targets' parts", "task success"]
         rows = []
         for name, report in self.keep.items():
             variants = [("dmp", report.methods["dmp"]), ('bidmp, approach "keep" (default)', report.methods["bidmp"]),
@@ -447,7 +462,8 @@ class Table4:
                 n = data["n_targets"]
                 rows.append([name, method, f"{data['successes']}/{n}", f"{data['engaged']}/{n}",
                              f"{data['collision_free']}/{data['n_checked']}",
-                             f"{data['min_clearance']:.2f} ({data['min_clearance_part']})", f"{data['task_successes']}/{n}"])
+                             f"{data['min_clearance']:.2f} ({data['min_clearance_part']})",
+                             _neighbour_clearance(report.scenario, result), f"{data['task_successes']}/{n}"])
         return header, rows
 
     def case_studies(self) -> dict:
@@ -516,7 +532,11 @@ class Table4:
             markdown_table(["cell removal, Bi-DMP end error (mm)", "nut skill only", "after the second extension to B6"], cells),
             markdown_table(["pick-and-place forgetting (mm)", "demonstrated operator", "operator 2", "operator 3"],
                            [[f'`skill="{skill}"`'] + [f"{v:.3f}" for v in result["forgetting"]] for skill, result in picking.items()]),
-        ] + ([markdown_table(*self.task_rows())] if self.keep else []))
+        ])
+
+    def task_markdown(self) -> str:
+        """The task-success table (``tasks.md``): defaults beside the paper-literal extension."""
+        return markdown_table(*self.task_rows())
 
 
 def run_table4(progress: Callable | None = None) -> Table4:
@@ -554,6 +574,9 @@ def write_results(result, name: str, out: str | os.PathLike) -> list[Path]:
     _write_json(written[0], result.to_dict())
     _write_text(written[1], result.markdown())
     if isinstance(result, Table4):
+        if result.keep:
+            written.append(out / "tasks.md")
+            _write_text(written[-1], result.task_markdown())
         for scenario_name, report in result.reports.items():
             written += write_report(report, out / scenario_name)
     elif isinstance(result, Figures):

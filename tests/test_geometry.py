@@ -1,0 +1,309 @@
+"""Scene geometry: clearance against closed forms, collisions named by part, the scene-aware and
+approach-preserving extension, the battery tasks' task success, and bad scene data."""
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+import bidmp
+from bidmp import scenarios
+from bidmp.cli import main
+from bidmp.evaluation import evaluate
+from bidmp.extension import extend_demonstration, final_approach
+from bidmp.geometry import Scene, SceneError, Tool
+from bidmp.roadmap import NoFreeRouteError
+
+TOOL = {"radius": 12.5, "length": 100.0}
+NUT = {"across_flats": 13, "height": 6.5, "stud": {"radius": 4, "above": 10}}
+
+
+def scene_of(*parts, tool=TOOL, targets=None, **options):
+    return Scene.from_dict({"tool": dict(tool), "parts": list(parts), **options}, targets)
+
+
+def vertical(x, y, z_from, z_to, n=201):
+    return np.column_stack([np.full(n, x), np.full(n, y), np.linspace(z_from, z_to, n)])
+
+
+# ---------------------------------------------------------------------------------------------
+# Closed forms
+# ---------------------------------------------------------------------------------------------
+def cylinder_closed_form(point, tool_radius, tool_length, base, radius, height):
+    """Signed distance between two vertical cylinders (a product of a disc and an interval)."""
+    lateral = np.hypot(*(point[:2] - base[:2])) - tool_radius - radius
+    below, above = base[2] - (point[2] + tool_length), point[2] - (base[2] + height)
+    vertical_gap = max(below, above)
+    if lateral > 0 or vertical_gap > 0:
+        return float(np.hypot(max(lateral, 0.0), max(vertical_gap, 0.0)))
+    return -min(-lateral, -vertical_gap)  # penetration: the shorter way out, sideways or up/down
+
+
+def box_closed_form(point, tool_radius, tool_length, lower, upper):
+    """Distance (> 0 cases) from a vertical cylinder to an axis-aligned box."""
+    to_rectangle = np.linalg.norm(np.maximum(np.maximum(lower[:2] - point[:2], point[:2] - upper[:2]), 0.0))
+    vertical_gap = max(lower[2] - (point[2] + tool_length), point[2] - upper[2], 0.0)
+    return float(np.hypot(max(to_rectangle - tool_radius, 0.0), vertical_gap))
+
+
+def test_clearance_to_a_cylinder_matches_the_closed_form_for_parallel_axes():
+    rng = np.random.default_rng(0)
+    base = np.array([10.0, -5.0, 0.0])
+    scene = scene_of({"type": "cylinder", "label": "post", "at": base.tolist(), "radius": 4.0, "height": 16.5})
+    checked = 0
+    for point in rng.uniform([-60, -60, -140], [60, 60, 60], size=(400, 3)):
+        expected = cylinder_closed_form(point, 12.5, 100.0, base, 4.0, 16.5)
+        got = scene.clearance(point[None], step=1.0)
+        if expected > 0:
+            assert got.distance == pytest.approx(expected, abs=1e-6)
+            assert got.part == "post" and got.collision_free
+            checked += 1
+        else:
+            assert got.distance == pytest.approx(expected, abs=1e-4)  # EPA's penetration depth
+            assert got.collision_part == "post"
+    assert checked > 200
+
+
+def test_clearance_to_a_box_matches_the_closed_form():
+    rng = np.random.default_rng(1)
+    scene = scene_of({"type": "box", "label": "cell", "at": [0, 0, -10], "size": [20, 40, 30]})
+    lower, upper = np.array([-10.0, -20.0, -10.0]), np.array([10.0, 20.0, 20.0])
+    errors = []
+    for point in rng.uniform([-70, -80, -150], [70, 80, 80], size=(400, 3)):
+        expected = box_closed_form(point, 12.5, 100.0, lower, upper)
+        if expected > 0:
+            errors.append(scene.clearance(point[None]).distance - expected)
+    assert len(errors) > 200 and np.max(np.abs(errors)) <= 1e-6
+
+
+def test_hex_nut_clearance_at_its_corners_and_flats():
+    scene = scene_of({"type": "nut", "label": "4", "at": [30, 0, -2], **NUT})
+    corner = 13 / np.sqrt(3)  # yaw 0: a corner on +x and -x, flats facing +y and -y
+    assert scene.clearance([[0.0, 0.0, 0.0]]).distance == pytest.approx(30 - corner - 12.5, abs=1e-6)
+    assert scene.clearance([[30.0, 50.0, 0.0]]).distance == pytest.approx(50 - 6.5 - 12.5, abs=1e-6)
+    # Above the nut, the stud (4 mm radius up to 14.5 mm) is what the tool meets.
+    over = scene.clearance([[30.0, 18.0, 10.0]])  # 5.5 mm above the nut, beside the stud
+    assert over.part == "4/stud" and over.distance == pytest.approx(18 - 4 - 12.5, abs=1e-6)
+
+
+def test_clearance_along_a_trajectory_is_the_minimum_over_a_brute_force_check():
+    data = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    scene = scenarios.load("nut-unscrewing").scene
+    rng = np.random.default_rng(3)
+    engine = scene._engine()
+    for _ in range(3):
+        path = np.cumsum(rng.normal(0.0, 6.0, size=(30, 3)), axis=0) + [60.0, 20.0, 25.0]
+        got = scene.clearance(path, exclude="3", step=0.5)
+        # The plain way: every part at every sample of the same densified path.
+        from bidmp.geometry import _densify
+
+        dense = _densify(path, 0.5)
+        chosen = [i for i, solid in enumerate(scene.solids) if solid.part != "3"]
+        distances = np.array([[engine.tool_to(p, i) for i in chosen] for p in dense])
+        row, col = np.unravel_index(np.argmin(distances), distances.shape)
+        assert got.distance == pytest.approx(distances[row, col], abs=1e-9)
+        assert got.part == scene.solids[chosen[col]].label
+    assert data["scene"]["tool"] == TOOL | {"length": 100}
+
+
+def test_a_trajectory_through_a_stud_is_reported_with_the_studs_label():
+    targets = {"3": [0, 0, 0], "4": [30, 0, 0]}
+    scene = scene_of({"type": "nut", "at_targets": "all", "offset": [0, 0, -2], **NUT}, targets=targets)
+    sweep = np.column_stack([np.linspace(0, 30, 50), np.zeros(50), np.full(50, 8.0)])  # above the nut, into the stud
+    hit = scene.clearance(sweep, exclude="3")
+    assert not hit.collision_free and hit.collision_part == "4/stud"
+    assert hit.distance == pytest.approx(-(14.5 - 8.0), abs=1e-4)  # pushed up out of the stud
+    descent = scene.clearance(vertical(0, 0, 40, 0), exclude="3")
+    assert descent.collision_free and descent.part == "4"
+    assert descent.distance == pytest.approx(30 - 13 / np.sqrt(3) - 12.5, abs=1e-6)
+
+
+def test_the_checker_and_straight_moves_agree_with_dense_placements():
+    scene = scenarios.load("nut-unscrewing").scene
+    checker = scene.checker()
+    rng = np.random.default_rng(5)
+    a = rng.uniform([-30, -30, 0], [210, 80, 40], size=(60, 3))
+    b = a + rng.normal(0.0, 15.0, size=a.shape)
+    moves = checker.segments_free(a, b)
+    dense = np.array([np.all(checker(np.linspace(p, q, 2000))) for p, q in zip(a, b)])
+    assert moves.any() and not moves.all()
+    assert np.array_equal(moves, dense)
+
+
+# ---------------------------------------------------------------------------------------------
+# The extension
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def nut():
+    return scenarios.load("nut-unscrewing")
+
+
+def test_the_kept_approach_is_the_demonstrated_one_translated(nut):
+    demo = nut.demonstration
+    target = np.array([150.0, 25.0, 0.0])
+    extension = extend_demonstration(demo, target, seed=0, scene=nut.scene)
+    start = extension.approach_index
+    assert start == final_approach(demo, extension.segmentation_points)
+    n = demo.shape[0] - start
+    np.testing.assert_allclose(extension.complete[-n:], demo[start:] + (target - demo[-1]), rtol=0, atol=1e-9)
+    assert extension.complete.shape == demo.shape and np.array_equal(extension.complete[0], demo[0])
+    # The kept approach is the straight vertical descent from 40 mm onto the nut.
+    np.testing.assert_allclose(demo[start], [0.0, 0.0, 40.0], atol=0.5)
+    assert nut.scene.clearance(extension.complete, exclude=nut.scene.parts_at(target)).collision_free
+    paper = extend_demonstration(demo, target, seed=0, approach="paper")
+    assert paper.approach == "paper" and paper.approach_index is None
+
+
+def test_gprm_routes_the_transfer_around_a_part_in_its_way(nut):
+    demo = nut.demonstration
+    target = np.array([150.0, 25.0, 0.0])
+    blind = extend_demonstration(demo, target, seed=0)
+    # A block on the blind transfer's way, half-way along it, with room around it.
+    middle = blind.complete[(blind.seg_index + blind.approach_index) // 2]
+    block = {"type": "cylinder", "label": "block", "at": (middle - [0, 0, 10]).tolist(), "radius": 3, "height": 20}
+    scene = scene_of(block)
+    assert not scene.clearance(blind.complete).collision_free
+    routed = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+    assert scene.clearance(routed.complete).collision_free
+
+
+def test_a_wall_that_blocks_every_route_is_a_clear_error(nut):
+    wall = {"type": "box", "label": "wall", "at": [40, 0, -500], "size": [10, 4000, 4000]}
+    with pytest.raises(NoFreeRouteError, match="no collision-free route"):
+        extend_demonstration(nut.demonstration, [150.0, 25.0, 0.0], seed=0, scene=scene_of(wall))
+
+
+def test_a_part_in_the_translated_approach_is_a_clear_error(nut):
+    shelf = {"type": "box", "label": "shelf", "at": [170, 25, 20], "size": [24, 40, 5]}  # overhangs the descent
+    with pytest.raises(NoFreeRouteError, match="approach.*hits part 'shelf'"):
+        extend_demonstration(nut.demonstration, [150.0, 25.0, 0.0], seed=0, scene=scene_of(shelf))
+
+
+# ---------------------------------------------------------------------------------------------
+# The battery tasks
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def nut_report(nut):
+    return evaluate(nut, ["dmp", "bidmp"])
+
+
+def test_nut_task_bidmp_defaults_succeed_on_every_nut(nut_report):
+    bidmp_result = nut_report.methods["bidmp"]
+    assert bidmp_result.task_successes == 14 and bidmp_result.collision_free == 14 and bidmp_result.engaged == 14
+    assert bidmp_result.worst_clearance.distance >= 0.0
+    assert nut_report.methods["dmp"].task_successes == 8
+    data = nut_report.to_dict()["methods"]["bidmp"]
+    for key in ("task_successes", "collision_free", "engaged", "min_clearance", "min_clearance_part"):
+        assert key in data
+    assert set(data["targets"]["12"]) >= {"clearance", "engaged", "collision_part"}
+    assert data["targets"]["12"]["collision_part"] is None
+
+
+def test_nut_task_with_the_paper_approach_keeps_todays_numbers(nut):
+    spec = nut.to_dict()
+    spec["extension"] = {"approach": "paper"}
+    report = evaluate(scenarios.from_dict(spec), ["bidmp"])
+    result = report.methods["bidmp"]
+    assert result.successes == 14 and result.engaged == 6  # ends on every nut, engages 6
+    data = result.to_dict()
+    hits = {label: t["collision_part"] for label, t in data["targets"].items() if t["collision_part"]}
+    assert hits and all(part.endswith("/stud") for part in hits.values())  # through the neighbours' studs
+    assert data["min_clearance"] < 0
+
+
+def test_cell_removal_reaches_every_cell_without_touching_a_neighbour():
+    report = evaluate("cell-removal", ["bidmp"])
+    result = report.methods["bidmp"]
+    cells = [label for label in report.scenario.labels if label.startswith("B")]
+    assert result.checked == cells
+    assert all(result.task_success_at(label) for label in cells)
+    assert result.clearance_at("N3") is None  # the nut under the cells is the earlier task
+
+
+def test_a_layout_read_from_a_file_behaves_the_same(tmp_path, nut):
+    spec = nut.to_dict()
+    spec["targets"] = {f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)}
+    spec["demonstrated"] = "r0c0"
+    spec["scene"]["parts"][0] = {"type": "plate", "label": "plate", "at": [70, 45, -2], "size": [240, 160, 5]}
+    spec["scene"]["parts"][1]["stud"]["above"] = 14
+    spec["methods"] = ["dmp", "bidmp"]
+    path = tmp_path / "grid.json"
+    path.write_text(json.dumps(spec))
+    report = evaluate(scenarios.load(path))
+    assert report.failed_targets  # the plain DMP misses some: Bi-DMP is extended for them
+    result = report.methods["bidmp"]
+    assert all(result.task_success_at(label) for label in report.scenario.labels)
+
+
+# ---------------------------------------------------------------------------------------------
+# Bad input
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "data, targets, match",
+    [
+        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [10, 10, 10]},
+                                  {"type": "box", "label": "b", "at": [5, 0, 0], "size": [10, 10, 10]}]}, None, "overlap by 5"),
+        ({"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]}, {"3": [0, 0, 0], "9": [90, 0, 0]},
+         "target '9' has no part"),
+        ({"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]}, {"3": [60, 0, 0]},
+         "target '3' .* is not on part '3'"),
+        ({"tool": {"radius": 0, "length": 100}, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]}]},
+         None, "tool.radius: must be > 0"),
+        ({"tool": TOOL, "parts": [{"type": "sphere", "label": "a", "at": [0, 0, 0]}]}, None,
+         "unknown part type 'sphere' .known: box, cell, cylinder, nut, plate"),
+        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1], "colour": "red"}]}, None,
+         "unknown key for a box"),
+        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0]}]}, None, "size: expected a list of 3"),
+        ({"tool": TOOL, "parts": [{"type": "nut", "label": "a", "at": [0, 0, 0], "across_flats": 13, "height": 6.5,
+                                   "stud": {"radius": 7, "above": 10}}]}, None, "does not fit inside the nut"),
+        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]},
+                                  {"type": "box", "label": "a", "at": [9, 0, 0], "size": [1, 1, 1]}]}, None, "two parts are labelled 'a'"),
+        ({"tool": TOOL, "parts": []}, None, "non-empty list of parts"),
+        ({"tool": TOOL, "parts": [{"type": "box", "at_targets": ["x"], "size": [1, 1, 1]}]}, {"3": [0, 0, 0]}, "'x' is not a target"),
+    ],
+)
+def test_bad_scene_data_is_a_clear_error(data, targets, match):
+    with pytest.raises(SceneError, match=match):
+        Scene.from_dict(data, targets)
+
+
+def test_a_tool_of_zero_size_is_refused_directly():
+    with pytest.raises(ValueError, match="tool.length must be a positive number"):
+        Tool(12.5, 0.0)
+
+
+def test_bad_scene_in_a_scenario_file_is_one_line_from_the_cli(tmp_path, capsys, nut):
+    spec = nut.to_dict()
+    spec["scene"]["parts"].append({"type": "box", "label": "intruder", "at": [0, 0, -2], "size": [5, 5, 5]})
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(spec))
+    assert main(["scenario", "check", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "scene.parts: parts '3' and 'intruder' overlap" in err
+
+
+def test_without_coal_the_geometry_says_how_to_install_it(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "coal", None)  # import coal now raises ImportError
+    with pytest.raises(bidmp.MissingExtraError, match=r"pip install 'bidmp\[collision\]'"):
+        scenarios.load("nut-unscrewing")
+    assert main(["demo", "--out", "unused"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "pip install 'bidmp[collision]'" in err
+
+
+def test_final_approach_is_the_straight_tail_of_the_last_piece():
+    angles = np.linspace(0.0, np.pi / 2, 50)
+    arc = np.column_stack([40 * np.cos(angles), 40 * np.sin(angles), np.zeros(50)])  # ends at (0, 40, 0) heading -x
+    line = np.column_stack([np.linspace(0, -60, 31)[1:], np.full(30, 40.0), np.zeros(30)])
+    y = np.vstack([arc, line])
+    start = final_approach(y, np.array([], dtype=int))
+    assert 36 <= start <= 49  # the join, give or take arc samples within 2 % of the chord
+    chord = (y[-1] - y[start]) / np.linalg.norm(y[-1] - y[start])
+    offsets = y[start:] - y[start]
+    deviation = np.linalg.norm(offsets - np.outer(offsets @ chord, chord), axis=1)
+    assert deviation.max() <= 0.02 * np.linalg.norm(y[-1] - y[start])
+    assert final_approach(y, np.array([], dtype=int), straightness=0.001) >= 47  # stricter: closer to the join
+    assert final_approach(line, np.array([], dtype=int)) == 0  # all straight: all of it
+    wiggle = np.column_stack([np.linspace(0, 10, 40), np.sin(np.linspace(0, 12 * np.pi, 40)), np.zeros(40)])
+    assert final_approach(wiggle, np.array([], dtype=int)) >= 37  # no straight approach to speak of
