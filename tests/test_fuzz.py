@@ -538,7 +538,7 @@ scenario_values = st.one_of(anything, st.dictionaries(st.text(max_size=4), anyth
                             st.lists(st.lists(nasty_floats, min_size=3, max_size=3), max_size=4))
 scenario_keys = st.sampled_from(["name", "targets", "demonstrated", "demonstration", "success_threshold", "approach_height",
                                  "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-                                 "seed", "units", "colour"])
+                                 "seed", "units", "colour", "scene"])
 inner_keys = {"dmp": ["alpha", "tau", "n_kernels", "alpha_phase", "K", "beta", "regression"],
               "bidmp": ["n_enhance", "increments", "reg", "seed", "n_windows"],
               "extension": ["n_samples", "n_iter", "rho", "sigma_rel", "n_compare", "scaling"],
@@ -560,6 +560,35 @@ def test_fuzz_scenarios(files, changes):
     scenario = outcome("scenarios.from_dict", scenarios.from_dict, data, "fuzz", str(files["folder"]))
     if scenario is not None:
         outcome("evaluate(dmp)", bidmp.evaluate, scenario, ["dmp"])
+
+
+scene_part_keys = st.sampled_from(["type", "label", "at", "at_targets", "offset", "size", "radius", "height",
+                                   "across_flats", "stud", "yaw", "colour"])
+
+
+@given(st.lists(st.tuples(st.sampled_from(["tool", "parts", "targets", "targets_on_parts", "colour", "part", "plate"]),
+                          scene_part_keys, st.one_of(scenario_values, st.sampled_from(["all", "nut", "box", "3", [], {}]))),
+                min_size=1, max_size=3),
+       trajectories(max_points=60, dims=(3,)))
+@examples(60)
+def test_fuzz_scene(changes, trajectory):
+    from bidmp import scenarios
+    from bidmp.geometry import Scene
+
+    data = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    scene, targets = data["scene"], data["targets"]
+    for key, inner, value in changes:
+        parts = scene.get("parts")
+        if key in ("part", "plate") and isinstance(parts, list) and len(parts) == 2 and isinstance(parts[-1], dict):
+            parts[0 if key == "plate" else 1][inner] = value
+        elif key == "tool" and isinstance(scene.get("tool"), dict):
+            scene["tool"]["radius" if inner < "m" else "length"] = value
+        else:
+            scene[key] = value
+    result = outcome("Scene.from_dict", Scene.from_dict, scene, targets)
+    if result is not None:
+        outcome("Scene.clearance", result.clearance, trajectory, exclude=[p for p in ("3",) if p in result.labels])
+        outcome("Scene.checker", result.checker(), trajectory)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -170,7 +170,7 @@ class Report:
         """The Table 4 analogue: header and one row per method. With a scene: engaged,
         collision-free (of the targets the scene applies to), worst clearance and task success
         (end point ∧ engaged ∧ collision-free) beside the paper's end-point success."""
-        geometry = self.scenario.scene is not None
+        geometry = any(result.clearances is not None for result in self.methods.values())
         header = ["method", "success rate", "successes", "engaged", "max error", "difference range"]
         if geometry:
             header += ["collision-free", "min clearance (part)", "task success"]
@@ -212,7 +212,7 @@ class Report:
         units = scenario.units
         lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
                  f"success = end-point error <= {scenario.success_threshold:g} {units}"]
-        if scenario.scene is not None:
+        if any(result.clearances is not None for result in self.methods.values()):
             engaged = (f"engaged (within {scenario.success_threshold:g} {units} of the target's axis over the last "
                        f"{scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
             lines.append(f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "

@@ -311,7 +311,8 @@ def plot_targets_top_view(path, report) -> Path:
     n_rows = int(np.ceil(len(names) / n_cols))
     fig, axes = mpl.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
     targets = scenario.target_array
-    scene = scenario.scene
+    checked = any(result.clearances is not None for result in report.methods.values())
+    scene = scenario.scene if checked else None
     for ax, name in zip(axes.ravel(), names):
         result = report.methods[name]
         if scene is not None:  # the parts' footprints, under everything else
