@@ -40,7 +40,7 @@ _LAZY = {
 }
 _SUBMODULES = (
     "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry",
-    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting",
+    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting", "sim",
 )
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]

@@ -177,7 +177,7 @@ def require_extra(module: str, extra: str, what: str):
     try:
         return importlib.import_module(module)
     except ImportError:
-        raise MissingExtraError(f"{what} need {module}, which is not installed: pip install 'bidmp[{extra}]'") from None
+        raise MissingExtraError(f"{module}, needed for {what}, is not installed: pip install 'bidmp[{extra}]'") from None
 
 
 class NotFittedError(ValueError, AttributeError):

@@ -225,6 +225,59 @@ def _run_scenario(scenario, out, methods=None):
     return report
 
 
+def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=None, pictures=True, targets=None,
+             report=None):
+    """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
+    from tqdm import tqdm
+
+    from .sim import simulate, write_sim_report
+
+    methods = list(methods)
+    labels = scenario.labels if targets is None else targets
+    frames = {}
+    if pictures:
+        origin = scenario.targets[scenario.demonstrated]
+        far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
+        frames = {(method, far): 30 for method in methods}
+    with tqdm(total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None) as bar:
+        def progress(method, label):
+            bar.set_postfix_str(f"{method} {label}")
+            bar.update(1)
+
+        result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
+                          frames=frames, progress=progress, report=report)
+    print()
+    print(result.summary())
+    written = write_sim_report(result, out)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
+    return result
+
+
+def _cmd_sim(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .scenarios import load
+    from .sim import Hold, _pybullet
+
+    _pybullet()  # without the extra: the install command, before any work
+    scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods:
+        raise ValueError(f"--methods names no method: {args.methods!r}")
+    hold = None
+    if args.hold is not None:
+        joint, start, duration = args.hold
+        if joint != int(joint) or not 1 <= joint <= 7:
+            raise ValueError(f"--hold: the joint must be 1-7, got {joint:g}")
+        if not (start >= 0 and duration > 0):
+            raise ValueError("--hold: START must be >= 0 s and DURATION > 0 s")
+        hold = Hold(int(joint) - 1, start, duration)
+    targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
+             pictures=not args.no_pictures, targets=targets)
+    return EXIT_OK
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -246,7 +299,14 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
-    _run_scenario(scenario, out, methods)
+    if args.sim:
+        from .sim import _pybullet
+
+        _pybullet()
+    report = _run_scenario(scenario, out, methods)
+    if args.sim:
+        sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
+        _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None)
     return EXIT_OK
 
 
@@ -537,10 +597,32 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
     demo.add_argument("--approach", choices=("keep", "paper"), default=None,
                       help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
+    demo.add_argument("--sim", action="store_true",
+                      help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
     demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
     demo.add_argument("--allow-outside-files", action="store_true",
                       help="let the scenario read demonstration files outside its own folder")
     demo.set_defaults(handler=_cmd_demo)
+
+    sim = commands.add_parser("sim", help="execute a scenario on a simulated Franka Panda (PyBullet)",
+                              description="Execute every method's motion to every target of a scenario on a simulated "
+                                          "Franka Panda (PyBullet, headless): inverse kinematics, timing to the Panda's joint "
+                                          "limits, 1 kHz position control, contacts with the parts. Prints the Table 4 analogue "
+                                          "in simulation and writes sim_results.json, keyframe strips and a GIF. Needs the "
+                                          "sim extra: pip install 'bidmp[sim]'.")
+    sim.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario with a \"scene\" (default nut-unscrewing)")
+    sim.add_argument("--methods", default="dmp,bidmp", help="comma-separated methods to execute (default dmp,bidmp)")
+    sim.add_argument("--targets", default=None, help="comma-separated subset of the targets (default all)")
+    sim.add_argument("--closed-loop", action="store_true",
+                     help="run the DMP/Bi-DMP stepper on the measured tool position with phase stopping (dmp, bidmp)")
+    sim.add_argument("--hold", type=float, nargs=3, metavar=("JOINT", "START", "DURATION"),
+                     help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds")
+    sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
+    sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
+    sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
+    sim.add_argument("--allow-outside-files", action="store_true",
+                     help="let the scenario read demonstration files outside its own folder")
+    sim.set_defaults(handler=_cmd_sim)
 
     scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
                                    description="List the built-in scenarios, print one as JSON to copy and edit "

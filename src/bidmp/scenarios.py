@@ -33,6 +33,7 @@ Keys (units: millimetres for the battery scenarios)::
                          (several operators); a target with the same label uses it as reference
     methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
     seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
+    robot                {"base": [x, y, z], "yaw": degrees}: where bidmp sim puts the Panda
     scene                geometry of the work cell: tool and parts (see bidmp.geometry); with it
                          the evaluation reports clearance, collisions and task success, and the
                          extensions (approach "keep") are grown around the parts. A stage of
@@ -68,7 +69,7 @@ METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-    "seed", "scene",
+    "seed", "scene", "robot",
 }
 _DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
              "goal_rate"}
@@ -105,6 +106,7 @@ class Scenario:
     description: str = ""
     spec: dict = field(default_factory=dict, repr=False)
     scene: Scene | None = None
+    robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
     base_dir: str = "."  # where "file" demonstrations were read from
 
     @property
@@ -381,6 +383,15 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         except ImportError as exc:
             raise type(exc)(f"scenario {source}: {exc}") from None
 
+    robot = data.get("robot", {})
+    if not isinstance(robot, dict) or set(robot) - {"base", "yaw"}:
+        _fail(source, "robot", 'expected {"base": [x, y, z], "yaw": degrees} (where bidmp sim puts the arm)')
+    robot = dict(robot)
+    if "base" in robot:
+        robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
+    if "yaw" in robot:
+        robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
+
     _check_runs(source, demonstration, targets, dmp)
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
@@ -388,7 +399,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         extensions=extensions,
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
-        scene=scene, base_dir=str(base_dir),
+        scene=scene, robot=robot, base_dir=str(base_dir),
     )
 
 
