@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean readme fuzz
+.PHONY: demo test bench install clean readme fuzz sim
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -26,6 +26,11 @@ test: $(STAMP)
 fuzz: $(STAMP)
 	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py -p no:cacheprovider
 
+# The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/).
+sim: $(STAMP)
+	$(VENV)/bin/bidmp sim --out bidmp-sim
+	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim/closed-loop-hold
+
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
 	$(PY) benchmarks/bench_extension.py
@@ -33,6 +38,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_scenario.py
 	$(PY) benchmarks/bidmp_convergence.py
 	$(PY) benchmarks/bench_timing.py
+	$(PY) benchmarks/bench_sim.py
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).
@@ -41,10 +47,12 @@ readme: $(STAMP)
 	$(VENV)/bin/bidmp reproduce table4 --out .readme-out > /dev/null
 	$(VENV)/bin/bidmp reproduce table5 --out .readme-out > /dev/null
 	$(VENV)/bin/bidmp reproduce figures --out .readme-out > /dev/null
-	cp .readme-out/table4.md .readme-out/tasks.md .readme-out/table5.md .readme-out/figures.md docs/results/
+	$(VENV)/bin/bidmp sim --out .readme-out/sim > /dev/null
+	cp .readme-out/table4.md .readme-out/tasks.md .readme-out/table5.md .readme-out/figures.md .readme-out/sim/sim.md docs/results/
+	cp .readme-out/sim/sim_keyframes_bidmp.png docs/sim_keyframes_bidmp.png
 	rm -rf .readme-out
 	$(PY) tools/recordings_figure.py
 	$(PY) tools/readme.py
 
 clean:
-	rm -rf $(VENV) bidmp-out .pytest_cache fuzz-report.json
+	rm -rf $(VENV) bidmp-out bidmp-sim .pytest_cache fuzz-report.json

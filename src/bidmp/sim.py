@@ -212,7 +212,9 @@ class Execution:
         clock's pace (closed loop; 0 otherwise)."""
         if self.motion_clock is None or len(self.motion_clock) < 2:
             return 0.0
-        return float(np.sum(np.diff(self.motion_clock) < 0.2 * np.diff(self.command_times)) * CONTROL_STEP)
+        running = self.motion_clock[1:] < self.motion_clock[-1]  # not the settling at the end
+        slow = np.diff(self.motion_clock) < 0.2 * np.diff(self.command_times)
+        return float(np.sum(slow & running) * CONTROL_STEP)
 
 
 class PandaCell:
@@ -473,6 +475,11 @@ class PandaCell:
         self._ignore(exclude, False)
         command, previous, held, settle_from = q, q, None, None
         times, commands, clock = [], [], []
+        # A rate limiter on the joint command, as the Panda's own interface has: the stepper's
+        # command changes pace abruptly when phase stopping engages or lets go, and the joints
+        # must not follow that jump faster than their limits allow.
+        speed, max_speed = np.zeros(7), LIMIT_MARGIN * np.asarray(PANDA.velocity)
+        max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
         step = 0
         try:
             for step in range(n_steps):
@@ -482,7 +489,10 @@ class PandaCell:
                     if settle_from is None:
                         measured = self.tcp_position() / self.unit
                         y, _, _ = stepper.step(CONTROL_STEP, measured)
-                        command, _ = self.solve_ik(np.asarray(y) * self.unit, command)
+                        wanted, _ = self.solve_ik(np.asarray(y) * self.unit, command)
+                        speed = np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change)
+                        speed = np.clip(speed, -max_speed, max_speed)
+                        command = command + speed * CONTROL_STEP
                         times.append(t)
                         commands.append(command)
                         clock.append(stepper.time)
@@ -490,10 +500,17 @@ class PandaCell:
                             settle_from = step
                     elif step - settle_from >= SETTLE / SIM_STEP:
                         break
+                    else:  # settling: the limiter brings the joints to rest at the last command
+                        speed = np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change)
+                        speed = np.clip(speed, -max_speed, max_speed)
+                        command = command + speed * CONTROL_STEP
+                        times.append(t)
+                        commands.append(command)
+                        clock.append(stepper.time)
                 share = (step % every + 1) / every
                 wanted = previous + share * (command - previous)
                 q = wanted.tolist()
-                qd = ((command - previous) / CONTROL_STEP).tolist() if settle_from is None else [0.0] * 7
+                qd = ((command - previous) / CONTROL_STEP).tolist()
                 if hold is not None and hold.start <= t < hold.start + hold.duration:
                     if held is None:
                         held = p.getJointState(self.robot, hold.joint, physicsClientId=self.client)[0]

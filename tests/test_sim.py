@@ -1,0 +1,145 @@
+"""The simulated Franka Panda (bidmp.sim): kinematics against the commanded path, contacts named
+by part, unreachable targets, the closed loop under a held joint, workers, the CLI."""
+
+import json
+import pathlib
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+
+from bidmp import scenarios, sim  # noqa: E402
+from bidmp.cli import main  # noqa: E402
+from bidmp.evaluation import evaluate  # noqa: E402
+
+RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+
+
+@pytest.fixture(scope="module")
+def nut():
+    return scenarios.load("nut-unscrewing")
+
+
+@pytest.fixture(scope="module")
+def nut_report(nut):
+    return evaluate(nut, ["dmp", "bidmp"], geometry=False)
+
+
+@pytest.fixture(scope="module")
+def cell(nut):
+    base, yaw = sim.robot_placement(nut)
+    with sim.PandaCell(nut.scene, nut.units, base, yaw) as panda:
+        yield panda
+
+
+def point_to_path(points, path):
+    """Distance from each point to the polyline ``path`` (both (n, 3))."""
+    a, b = path[:-1], path[1:]
+    ab = b - a
+    t = np.clip(np.einsum("pkd,kd->pk", points[:, None] - a[None], ab) / np.maximum((ab * ab).sum(1), 1e-30), 0.0, 1.0)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.min(np.linalg.norm(points[:, None] - nearest, axis=2), axis=1)
+
+
+def test_forward_kinematics_of_the_executed_joints_follows_the_commanded_path(cell, nut, nut_report):
+    rollout = nut_report.methods["bidmp"].rollouts["12"]
+    plan = cell.plan(rollout, "12")
+    run = cell.execute(plan, exclude=["12"])
+    executed = np.array([cell.forward(q) for q in run.joints[::25]]) / cell.unit  # mm
+    # The executed joints put the tool on the commanded Cartesian path ...
+    assert np.max(point_to_path(executed, rollout)) <= 0.5
+    # ... at the commanded time (the command's own TCP at the same instants) ...
+    assert np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / cell.unit <= 0.5
+    # ... and the measured TCP is the forward kinematics of the measured joints.
+    np.testing.assert_allclose(executed, run.tcp[::25] / cell.unit, atol=1e-6)
+    assert np.linalg.norm(run.tcp[-1] / cell.unit - rollout[-1]) <= 0.1
+    assert not run.contacts
+    assert plan.peak_velocity <= 1.0 and plan.peak_acceleration == pytest.approx(sim.LIMIT_MARGIN, rel=1e-6)
+
+
+def test_a_motion_through_a_stud_is_a_contact_with_that_stud(cell):
+    sweep = np.column_stack([np.linspace(0, 30, 60), np.zeros(60), np.full(60, 8.0)])  # 8 mm up, into stud 4
+    run = cell.execute(cell.plan(sweep, "sweep"), exclude=["3"])
+    assert "4/stud" in run.contacts and run.contacts["4/stud"] > 0
+
+
+def test_an_unreachable_target_is_a_clear_error_naming_it(nut, capsys, tmp_path):
+    spec = nut.to_dict()
+    spec["targets"]["far"] = [1500.0, 0.0, 0.0]
+    spec["methods"] = ["dmp"]
+    far = scenarios.from_dict(spec)
+    with pytest.raises(sim.SimError, match="target 'far'.*unreachable"):
+        sim.simulate(far, ["dmp"], targets=["far"], workers=1)
+    path = tmp_path / "far.json"
+    path.write_text(json.dumps(spec))
+    assert main(["sim", "--scenario", str(path), "--methods", "dmp", "--targets", "far", "--workers", "1",
+                 "--no-pictures", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len([line for line in err if "error" in line]) == 1 and "target 'far'" in err[-1]
+
+
+def test_closed_loop_pauses_for_a_held_joint_and_still_engages(nut, nut_report):
+    hold = sim.Hold(joint=1, start=3.5, duration=0.5)  # joint 2 held while the socket comes down
+    runs = {closed: sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, closed_loop=closed,
+                                 hold=hold).methods["bidmp"].targets["12"] for closed in (False, True)}
+    open_loop, closed_loop = runs[False], runs[True]
+    # Open loop the command runs on: the held arm falls behind, then lunges and misses the axis.
+    assert open_loop.tracking_error > 20.0 and (not open_loop.engaged or open_loop.contacts)
+    assert open_loop.paused == 0.0
+    # Closed loop the motion's time stands still while the joint is held, then it engages.
+    assert closed_loop.paused >= 0.3
+    assert closed_loop.engaged and not closed_loop.contacts and closed_loop.measured_error <= 1.75
+    assert closed_loop.within_limits and closed_loop.task_success(1.75)  # the command's rate limiter
+    assert closed_loop.tracking_error < open_loop.tracking_error / 3
+
+
+def test_workers_do_not_change_the_results(nut, nut_report):
+    serial = sim.simulate(nut, ["dmp", "bidmp"], targets=["4", "11"], report=nut_report, workers=1).to_dict()
+    parallel = sim.simulate(nut, ["dmp", "bidmp"], targets=["4", "11"], report=nut_report, workers=2).to_dict()
+    assert serial["methods"] == parallel["methods"]
+
+
+def test_a_layout_from_a_file_with_another_robot_base(tmp_path, nut):
+    spec = nut.to_dict()
+    spec["targets"] = {f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)}
+    spec["demonstrated"] = "r0c0"
+    spec["scene"]["parts"][0] = {"type": "plate", "label": "plate", "at": [70, 45, -2], "size": [240, 160, 5]}
+    spec["robot"] = {"base": [200.0, -380.0, 0.0], "yaw": 100.0}
+    spec["methods"] = ["dmp", "bidmp"]
+    path = tmp_path / "grid.json"
+    path.write_text(json.dumps(spec))
+    layout = scenarios.load(path)
+    result = sim.simulate(layout, ["bidmp"], targets=["r2c4", "r1c2"], workers=1)
+    assert result.to_dict()["robot"]["base"] == [200.0, -380.0, 0.0]
+    assert result.methods["bidmp"].task_successes == 2
+
+
+def test_the_committed_nut_task_table_is_what_bidmp_sim_measures(tmp_path, capsys):
+    # The whole built-in nut task, dmp and bidmp (about 15 s on 2 cores): README = sim.md = JSON.
+    assert main(["sim", "--no-pictures", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "sim.md").read_text() == (RESULTS / "sim.md").read_text()
+    results = json.loads((tmp_path / "sim_results.json").read_text())["methods"]
+    assert results["bidmp"]["task_successes"] == 14 and results["bidmp"]["contacts"] == 0
+    assert results["bidmp"]["within_limits"] == 14 and results["dmp"]["task_successes"] == 8
+    assert "x real time" in capsys.readouterr().out
+
+
+def test_without_pybullet_bidmp_sim_says_how_to_install_it(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "pybullet", None)
+    assert main(["sim", "--out", "unused"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "pip install 'bidmp[sim]'" in err
+
+
+def test_pictures_are_written(tmp_path, nut, nut_report):
+    result = sim.simulate(nut, ["dmp", "bidmp"], targets=["12"], report=nut_report, workers=1,
+                          frames={("dmp", "12"): 4, ("bidmp", "12"): 4})
+    written = {path.name for path in sim.write_sim_report(result, tmp_path)}
+    assert {"sim_results.json", "sim.md", "sim_keyframes_dmp.png", "sim_keyframes_bidmp.png",
+            "sim_12_dmp_vs_bidmp.gif"} <= written
+    from PIL import Image
+
+    with Image.open(tmp_path / "sim_12_dmp_vs_bidmp.gif") as gif:
+        assert gif.n_frames == 4 and gif.size == (2 * 320 + 6, 240)
