@@ -23,6 +23,8 @@ _LAZY = {
     "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
     "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
     "Scene": ("bidmp.geometry", "Scene"),
+    "CartesianDMP": ("bidmp.cartesian", "CartesianDMP"),
+    "CartesianBiDMP": ("bidmp.cartesian", "CartesianBiDMP"),
     "Tool": ("bidmp.geometry", "Tool"),
     "Clearance": ("bidmp.geometry", "Clearance"),
     "MissingExtraError": ("bidmp._checks", "MissingExtraError"),
@@ -39,7 +41,7 @@ _LAZY = {
     "set_limits": ("bidmp._checks", "set_limits"),
 }
 _SUBMODULES = (
-    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry",
+    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry", "cartesian",
     "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting", "sim",
 )
 
@@ -54,6 +56,7 @@ if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
     from .timing import Trajectory, prepare, time_scale  # noqa: F401
     from .extension import extend_demonstration  # noqa: F401
     from .geometry import Clearance, Scene, Tool  # noqa: F401
+    from .cartesian import CartesianBiDMP, CartesianDMP  # noqa: F401
     from .segmentation import Segmentation, segment  # noqa: F401
     from .similarity import frechet_distance, frechet_similarity  # noqa: F401
     from .io import ModelFileError  # noqa: F401

@@ -50,6 +50,8 @@ __all__ = [
     "load_model",
     "load_trajectory",
     "read_trajectory",
+    "read_poses",
+    "save_poses",
     "save_trajectory",
     "atomic_write",
     "load_json",
@@ -73,6 +75,7 @@ _MODEL_CLASSES = {
     "DMP": ("bidmp.dmp", "DMP"),
     "BLS": ("bidmp.bls", "BLS"),
     "BiDMP": ("bidmp.incremental", "BiDMP"),
+    "CartesianDMP": ("bidmp.cartesian", "CartesianDMP"),
 }
 _ZIP_MAGIC = b"PK\x03\x04"
 _EMPTY_ZIP_MAGIC = b"PK\x05\x06"
@@ -484,6 +487,9 @@ _TIME_NAMES = ("t", "time")
 
 _SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
+# Pose headers: the quaternion's order is read from the names, never guessed.
+_POSE_HEADERS = {("x", "y", "z", "qw", "qx", "qy", "qz"): (3, 4, 5, 6), ("x", "y", "z", "qx", "qy", "qz", "qw"): (3, 4, 5, 6)}
+_POSE_ORDER = {("x", "y", "z", "qw", "qx", "qy", "qz"): [0, 1, 2, 4, 5, 6, 3], ("x", "y", "z", "qx", "qy", "qz", "qw"): list(range(7))}
 
 
 def _parse_float(text: str) -> float | None:
@@ -526,8 +532,9 @@ def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
         has_time = columns[0] in _TIME_NAMES
         names = columns[1:] if has_time else columns
         if names not in _POSITION_HEADERS:
-            shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:6]) + (",…" if len(columns) > 6 else "")
-            raise ValueError(f"{path}: header {shown} not understood; expected x,y[,z], t,x,y[,z] or "
+            shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:8]) + (",…" if len(columns) > 8 else "")
+            pose = " (a pose recording: read it with bidmp.io.read_poses / bidmp.CartesianDMP)" if names in _POSE_HEADERS else ""
+            raise ValueError(f"{path}: header {shown} not understood{pose}; expected x,y[,z], t,x,y[,z] or "
                              f"t,x,y[,z],vx,vy[,vz],ax,ay[,az]")
     elif n_columns in (2, 3):
         has_time = False  # header-less: positions only (add a header "t,x,y" to mark a time column)
@@ -827,3 +834,67 @@ def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path
         writer.writerow(names)
         writer.writerows([[repr(float(v)) for v in row] for row in data])
     return path
+
+
+def read_poses(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
+    """Read a pose recording (CSV with a header): poses ``(T, 7)`` as ``x, y, z, qx, qy, qz,
+    qw`` (scalar last) and timestamps (s) or None.
+
+    The header must name the columns: ``[t,]x,y,z,qw,qx,qy,qz`` or ``[t,]x,y,z,qx,qy,qz,qw``
+    (``time`` for ``t``; a timed pose trajectory written by :func:`save_poses` also reads). The
+    quaternion's order is taken from the names, never guessed from the numbers. Quaternions are
+    checked by :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them.
+    """
+    from .timing import check_timestamps
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = Path(path)
+    _check_file(path, "pose file")
+    if path.suffix.lower() not in (".csv", ".txt"):
+        raise ValueError(f"{path}: pose recordings are read from .csv files with a header")
+    parsed = _csv_fast(path)
+    columns, values = parsed if parsed is not None else _csv_rows(path)
+    accepted = "t,x,y,z,qw,qx,qy,qz or t,x,y,z,qx,qy,qz,qw (t optional)"
+    if columns is None:
+        raise ValueError(f"{path}: a pose file needs a header naming the columns ({accepted})")
+    has_time = columns[0] in _TIME_NAMES
+    names = columns[1:] if has_time else columns
+    names = names[:7] if has_time and len(names) > 7 and names[7:8] == ("vx",) else names
+    if names not in _POSE_ORDER:
+        shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:8]) + (",…" if len(columns) > 8 else "")
+        raise ValueError(f"{path}: header {shown} does not name a pose; accepted headers: {accepted}")
+    first = 1 if has_time else 0
+    poses = values[:, first : first + 7][:, _POSE_ORDER[names]]
+    poses = as_trajectory(poses, name=str(path), allow_static=True)
+    times = check_timestamps(values[:, 0], poses.shape[0], f"{path}: the time column") if has_time else None
+    return poses, times
+
+
+def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
+    """Write poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) or a :class:`bidmp.cartesian.PoseTrajectory`
+    to a CSV with the header ``[t,]x,y,z,qx,qy,qz,qw`` (a trajectory adds ``vx..vz, wx..wz``:
+    units/s, rad/s), atomically."""
+    from .cartesian import PoseTrajectory
+
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = Path(path)
+    names = ["x", "y", "z", "qx", "qy", "qz", "qw"]
+    if isinstance(poses, PoseTrajectory):
+        data = np.column_stack([poses.t, poses.poses, poses.velocity, poses.angular_velocity])
+        names = ["t", *names, "vx", "vy", "vz", "wx", "wy", "wz"]
+    else:
+        data = as_trajectory(poses, "poses", min_points=1, allow_static=True)
+        if data.shape[1] != 7:
+            raise ValueError(f"poses must have 7 columns (x, y, z, qx, qy, qz, qw), got {data.shape[1]}")
+        if times is not None:
+            times = np.asarray(times, dtype=np.float64).reshape(-1)
+            if times.shape[0] != data.shape[0] or not np.all(np.isfinite(times)):
+                raise ValueError(f"times must be {data.shape[0]} finite numbers")
+            data, names = np.column_stack([times, data]), ["t", *names]
+    if not np.all(np.isfinite(data)):
+        raise ValueError("the poses contain NaN or inf")
+    if path.suffix.lower() != ".csv":
+        raise ValueError(f"{path}: poses are written as .csv")
+    return _write_columns(data, names, data, path)
