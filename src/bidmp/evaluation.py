@@ -40,6 +40,9 @@ class MethodResult:
     success_threshold: float
     n_steps: int
     clearances: dict | None = None  # label -> Clearance, or None where the scene does not apply; None without a scene
+    orientations: dict | None = None  # pose scenarios: label -> (n, 4) quaternions of the rollout
+    axis_deviations: dict | None = None  # pose scenarios: label -> degrees between tool and target axes
+    alignment_threshold: float = 2.0
 
     @property
     def successes(self) -> int:
@@ -60,7 +63,18 @@ class MethodResult:
         the scene applies)."""
         clearance = self.clearance_at(label)
         return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
-                    and (clearance is None or clearance.collision_free))
+                    and (clearance is None or clearance.collision_free) and self.aligned_at(label) is not False)
+
+    def aligned_at(self, label: str) -> bool | None:
+        """Pose scenarios: the tool's axis within the alignment threshold of the target's over
+        the approach height (None otherwise)."""
+        if self.axis_deviations is None:
+            return None
+        return bool(self.axis_deviations[label] <= self.alignment_threshold)
+
+    @property
+    def aligned(self) -> int | None:
+        return None if self.axis_deviations is None else sum(bool(self.aligned_at(label)) for label in self.errors)
 
     @property
     def task_successes(self) -> int:
@@ -116,6 +130,7 @@ class MethodResult:
             "n_checked": None if self.clearances is None else len(self.checked),
             "min_clearance": None if worst is None else _rounded(worst.distance),
             "min_clearance_part": None if worst is None else worst.part,
+            "aligned": self.aligned,
         })
         targets = {}
         for label, error in self.errors.items():
@@ -128,6 +143,7 @@ class MethodResult:
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
+                "axis_deviation": None if self.axis_deviations is None else round(float(self.axis_deviations[label]), 4),
             }
         out["targets"] = targets
         return out
@@ -171,7 +187,9 @@ class Report:
         collision-free (of the targets the scene applies to), worst clearance and task success
         (end point ∧ engaged ∧ collision-free) beside the paper's end-point success."""
         geometry = any(result.clearances is not None for result in self.methods.values())
-        header = ["method", "success rate", "successes", "engaged", "max error", "difference range"]
+        poses = any(result.axis_deviations is not None for result in self.methods.values())
+        header = ["method", "success rate", "successes", "engaged"] + (["aligned"] if poses else []) + \
+            ["max error", "difference range"]
         if geometry:
             header += ["collision-free", "min clearance (part)", "task success"]
         if runtimes:
@@ -181,8 +199,10 @@ class Report:
             data = result.to_dict()
             n = data["n_targets"]
             engaged = "-" if data["engaged"] is None else f"{data['engaged']}/{n}"
-            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{n}", engaged,
-                   f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
+            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{n}", engaged]
+            if poses:
+                row.append(f"{data['aligned']}/{n}")
+            row += [f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
             if geometry:
                 worst = "-" if data["min_clearance"] is None else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
                 row += [f"{data['collision_free']}/{data['n_checked']}", worst, f"{data['task_successes']}/{n}"]
@@ -305,6 +325,8 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
 
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
+    if scenario.is_pose:
+        return _evaluate_poses(scenario, methods, progress, geometry)
     methods = list(scenario.methods if methods is None else methods)
     if not methods:
         raise ValueError("methods is empty: name at least one of " + ", ".join(scenario_module.METHODS))
@@ -379,6 +401,104 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     if scenario.demonstrations and not report.forgetting:
         report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
                                             **scenario.bidmp)
+    return report
+
+
+def _pose_target(target, scenario, failed: list[str]) -> np.ndarray | None:
+    """A pose extension target: a label, a pose, or the centre of the failed targets (their mean
+    position and mean orientation)."""
+    from scipy.spatial.transform import Rotation
+
+    if isinstance(target, str) and target == "centre_of_failed":
+        if not failed:
+            return None
+        poses = np.array([scenario.targets[label] for label in failed])
+        return np.concatenate([poses[:, :3].mean(axis=0), Rotation.from_quat(poses[:, 3:]).mean().as_quat()])
+    if isinstance(target, str):
+        return scenario.targets[target]
+    return np.asarray(target, dtype=float)
+
+
+def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
+    """:func:`evaluate` for a pose scenario: CartesianDMP and its Bi-DMP, with the extension on
+    poses; metrics on positions, the engagement along each target's axis, and the tool's axis
+    alignment (task success needs it too)."""
+    from .cartesian import CartesianBiDMP, CartesianDMP
+    from .extension import extend_pose_demonstration
+    from .metrics import axis_deviation
+    from .scenarios import POSE_METHODS
+
+    methods = list(scenario.methods if methods is None else methods)
+    for method in methods:
+        if method not in POSE_METHODS:
+            raise ValueError(f"method {method!r} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
+    labels = scenario.labels
+    demo = scenario.demonstration
+    n_steps = demo.shape[0]
+    scene = scenario.scene if geometry else None
+    references = {label: resample_time(scenario.reference(label)[:, :3], n_steps) for label in labels}
+    excluded = {} if scenario.scene is None else {
+        label: [label] if label in scenario.scene.labels else scenario.scene.parts_at(scenario.targets[label])
+        for label in labels}
+
+    def result(name, rollouts, seconds):
+        positions = {label: rollout[:, :3] for label, rollout in zip(labels, rollouts)}
+        orientations = {label: rollout[:, 3:] for label, rollout in zip(labels, rollouts)}
+        targets = {label: scenario.targets[label][:3] for label in labels}
+        errors = {label: endpoint_error(positions[label], targets[label]) for label in labels}
+        approach = deviations = None
+        if scenario.approach_height is not None:
+            approach = {label: approach_error(positions[label], targets[label], scenario.approach_height,
+                                              scenario.target_axis(label)) for label in labels}
+            deviations = {label: axis_deviation(positions[label], orientations[label], targets[label],
+                                                scenario.approach_height, scenario.target_axis(label)) for label in labels}
+        differences = {label: path_difference(positions[label], references[label]) for label in labels}
+        clearances = None
+        if scene is not None:
+            clearances = {label: scene.clearance(positions[label], exclude=excluded[label], orientations=orientations[label])
+                          if scene.applies_to(label) else None for label in labels}
+        return MethodResult(name, positions, seconds, errors, approach, differences, scenario.success_threshold,
+                            n_steps, clearances, orientations, deviations, scenario.alignment_threshold)
+
+    report = Report(scenario=scenario, methods={})
+    with _Timer() as dmp_time:
+        cartesian = CartesianDMP(**scenario.dmp).fit(demo)
+        plain = [cartesian.rollout(scenario.targets[label]) for label in labels]
+    failed = [label for label, rollout in zip(labels, plain)
+              if np.linalg.norm(rollout[-1, :3] - scenario.targets[label][:3]) > scenario.success_threshold]
+    report.failed_targets = failed
+    model = None
+    for method in methods:
+        if progress is not None:
+            progress(method)
+        if method == "dmp":
+            report.methods[method] = result(method, plain, dmp_time.seconds)
+            continue
+        if model is None:
+            with _Timer() as timer:
+                model = CartesianBiDMP(cartesian, **scenario.bidmp)
+                previous = None
+                options = {k: v for k, v in scenario.extension.items() if k != "approach"}
+                for stage in scenario.extensions:
+                    target = _pose_target(stage["target"], scenario, failed)
+                    if target is None:
+                        continue
+                    source = demo if stage["from"] == "demonstration" or previous is None else previous
+                    stage_scene = scenario.scene if stage.get("in_scene", True) else None
+                    extension, orientations = extend_pose_demonstration(source, target, seed=scenario.seed,
+                                                                        scene=stage_scene, **options)
+                    previous = np.hstack([extension.complete, orientations])
+                    model.learn(previous)
+                    report.extensions.append(extension)
+                    report.extension_targets.append(target[:3])
+                for demonstration in scenario.demonstrations.values():
+                    model.learn(demonstration)
+            model_seconds = dmp_time.seconds + timer.seconds
+            report.model = model
+        skill = "nearest" if method == "bidmp" else "latest"
+        with _Timer() as timer:
+            rollouts = [model.rollout(scenario.targets[label], skill=skill) for label in labels]
+        report.methods[method] = result(method, rollouts, model_seconds + timer.seconds)
     return report
 
 

@@ -37,8 +37,8 @@ from ._trajectory import arclength, interp_columns, path_extent, resample_time
 from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
 
-__all__ = ["ExtendedDemonstration", "extend_demonstration", "final_approach", "time_path", "check_extension_options",
-           "APPROACHES"]
+__all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
+           "check_extension_options", "APPROACHES"]
 
 APPROACHES = ("keep", "paper")
 _STRAIGHTNESS = 0.02  # an approach deviates from its chord by at most this fraction of the chord
@@ -329,13 +329,15 @@ def extend_demonstration(
     )
 
 
-def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude) -> ExtendedDemonstration:
-    """``approach="keep"``: transfer by G-PRM to the translated approach's start, then the approach."""
+def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude,
+                             approach_rotation=None) -> ExtendedDemonstration:
+    """``approach="keep"``: transfer by G-PRM to the translated approach's start, then the approach
+    (rotated about the target by ``approach_rotation`` (D, D) when the target turns too)."""
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
     start = final_approach(y, points)
-    offset = target - y[-1]
-    hover = y[start] + offset
+    rotation = np.eye(y.shape[1]) if approach_rotation is None else np.asarray(approach_rotation, dtype=float)
+    hover = target + (y[start] - y[-1]) @ rotation.T
     if start == 0:
         # The whole demonstration is one straight approach: translate all of it but its start.
         piece = Piece(index=0, start=0, end=0, breakpoints=np.array([0, n_steps - 1]))
@@ -344,7 +346,8 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
         piece = choose_piece(y[: start + 1], head_points, hover)
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
-    approach_tail = y[start + 1 :] + offset
+    approach_tail = target + (y[start + 1 :] - y[-1]) @ rotation.T if approach_rotation is not None else \
+        y[start + 1 :] + (target - y[-1])
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
         tra_gen, history, result = np.vstack([seg, hover]), np.empty(0), None
     else:
@@ -375,3 +378,58 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
         samples=None if result is None else result.samples,
         approach="keep", approach_index=start,
     )
+
+
+@numerically_guarded
+def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Generator | None = 0, scene=None,
+                              eps_frac: float = 0.1, method: str = "persistence", **roadmap_options):
+    """Grow an extended pose demonstration (``approach="keep"``) from ``poses`` (T, 7) to the
+    pose ``new_target`` (7,) (x, y, z, qx, qy, qz, qw).
+
+    The final approach keeps its pose relative to the target: with ``R = g' g⁻¹`` (new and
+    demonstrated target orientations) it is rotated about the target by ``R`` and moved onto the
+    new one, positions and orientations alike (a pure translation when the target does not turn).
+    The transfer's positions come from G-PRM as in :func:`extend_demonstration`; its orientation
+    is slerped from the demonstration's at seg to the kept approach's first, by arc length.
+
+    Returns
+    -------
+    (ExtendedDemonstration, orientations (T, 4))
+        The positional extension (``complete`` (T, 3)) and the orientation at each of its samples.
+    """
+    from scipy.spatial.transform import Rotation, Slerp
+
+    from .cartesian import as_poses, as_quaternions
+
+    positions, quaternions = as_poses(poses, "poses", min_points=10)
+    target = as_point(new_target, 7, "new_target")
+    target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
+    turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
+    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
+    exclude = ()
+    if scene is not None:
+        exclude = scene.parts_at(target[:3])
+        roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
+    options = {"n_samples": 300, "sigma_rel": 0.03, "n_neighbours": 8, "n_compare": 100, "n_iter": 10, "rho": 0.9,
+               "schedule": "geometric", "scaling": "axis", "compare": "template", "select": "best", "denom": "sqrt2",
+               "is_free": None, **roadmap_options}
+    points = segment(positions, eps_frac=eps_frac, method=method).points
+    extension = _extend_keeping_approach(positions, target[:3], points, seed, options, None, exclude,
+                                         approach_rotation=turn.as_matrix())
+    start, seg = extension.approach_index, extension.seg_index
+    kept = (turn * Rotation.from_quat(quaternions[start:])).as_quat()
+    transfer = extension.complete[seg : start + 1]
+    arc = arclength(transfer)
+    fraction = arc / arc[-1] if arc[-1] > 0 else np.linspace(0.0, 1.0, len(transfer))
+    ends = Rotation.from_quat(np.vstack([quaternions[seg], kept[0]]))
+    slerped = Slerp([0.0, 1.0], ends)(fraction).as_quat()
+    orientations = np.vstack([quaternions[:seg], slerped, kept[1:]])
+    from .cartesian import continuous_quaternions
+
+    orientations = continuous_quaternions(orientations)
+    if scene is not None:
+        hit = scene.clearance(extension.complete, exclude=exclude, orientations=orientations)
+        if not hit.collision_free:
+            raise NoFreeRouteError(f"the extended pose demonstration to {np.round(target[:3], 3).tolist()} hits part "
+                                   f"{hit.part!r} ({-hit.distance:.3g} deep) with the tool as it is turned")
+    return extension, orientations

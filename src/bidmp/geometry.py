@@ -55,8 +55,9 @@ PART_TYPES = ("box", "cell", "cylinder", "nut", "plate")
 _PART_KEYS = {
     "box": {"size", "yaw"}, "cell": {"size", "yaw"}, "plate": {"size", "yaw"},
     "cylinder": {"radius", "height"}, "nut": {"across_flats", "height", "stud", "yaw"},
+
 }
-_COMMON_KEYS = {"type", "label", "at", "at_targets", "offset"}
+_COMMON_KEYS = {"type", "label", "at", "at_targets", "offset", "rotation"}
 _SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts"}
 _GJK_TOLERANCE = 1e-12  # coal's default (1e-6 relative) leaves clearances ~1e-4 off; see the module docstring
 _EPA_TOLERANCE = 1e-6  # penetration depths (coal's default): tighter, its EPA stops early on cylinders and over-reports
@@ -103,13 +104,13 @@ class Tool:
 
 @dataclass(frozen=True)
 class Solid:
-    """One convex primitive of a part: ``kind`` in box/cylinder/convex, pose by centre and yaw."""
+    """One convex primitive of a part: ``kind`` in box/cylinder/convex, pose by centre and rotation."""
 
     label: str  # what a hit reports: the part's label, or "<nut>/stud"
     part: str  # the part it belongs to (excluded together)
     kind: str
     centre: np.ndarray  # (3,)
-    yaw: float  # radians about z
+    rotation: np.ndarray  # (3, 3): the solid's frame in the scene
     params: tuple  # box: (sx, sy, sz); cylinder: (radius, height); convex: vertices (n, 3) in the solid frame
     lower: np.ndarray  # axis-aligned bounding box
     upper: np.ndarray
@@ -130,25 +131,32 @@ def _rotation_z(yaw: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def _box_solid(label, part, centre, size, yaw) -> Solid:
+def _bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return points.min(axis=0), points.max(axis=0)
+
+
+def _box_solid(label, part, centre, size, rotation) -> Solid:
     half = np.asarray(size, dtype=float) / 2.0
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
-    world = corners @ _rotation_z(yaw).T + centre
-    return Solid(label, part, "box", centre, yaw, tuple(float(v) for v in size), world.min(axis=0), world.max(axis=0))
+    return Solid(label, part, "box", centre, rotation, tuple(float(v) for v in size), *_bounds(corners @ rotation.T + centre))
 
 
-def _cylinder_solid(label, part, centre, radius, height) -> Solid:
-    extent = np.array([radius, radius, height / 2.0])
-    return Solid(label, part, "cylinder", centre, 0.0, (float(radius), float(height)), centre - extent, centre + extent)
+def _cylinder_extent(axis: np.ndarray, radius: float, half_height: float) -> np.ndarray:
+    """Half-extents of the axis-aligned box around a cylinder with unit ``axis``."""
+    return np.abs(axis) * half_height + radius * np.sqrt(np.clip(1.0 - axis**2, 0.0, 1.0))
 
 
-def _hex_solid(label, part, centre, across_flats, height, yaw) -> Solid:
+def _cylinder_solid(label, part, centre, radius, height, rotation) -> Solid:
+    extent = _cylinder_extent(rotation[:, 2], radius, height / 2.0)
+    return Solid(label, part, "cylinder", centre, rotation, (float(radius), float(height)), centre - extent, centre + extent)
+
+
+def _hex_solid(label, part, centre, across_flats, height, rotation) -> Solid:
     corner = across_flats / math.sqrt(3.0)  # circumradius of the hexagon
     angles = np.deg2rad(np.arange(6) * 60.0)
     ring = np.column_stack([corner * np.cos(angles), corner * np.sin(angles), np.zeros(6)])
     vertices = np.vstack([ring + [0, 0, -height / 2.0], ring + [0, 0, height / 2.0]])
-    world = vertices @ _rotation_z(yaw).T + centre
-    return Solid(label, part, "convex", centre, yaw, (vertices,), world.min(axis=0), world.max(axis=0))
+    return Solid(label, part, "convex", centre, rotation, (vertices,), *_bounds(vertices @ rotation.T + centre))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -174,22 +182,33 @@ def _vector(value, key, n=3, positive=False) -> np.ndarray:
     return np.array([_number(v, f"{key}[{i}]", positive=positive) for i, v in enumerate(value)])
 
 
-def _part_solids(label: str, kind: str, at: np.ndarray, spec: dict, key: str) -> tuple:
-    yaw = math.radians(_number(spec.get("yaw", 0.0), f"{key}.yaw", positive=False))
+def _part_rotation(spec: dict, key: str) -> np.ndarray:
+    """A part's orientation: ``"rotation": [rx, ry, rz]`` (degrees, extrinsic x-y-z) or ``"yaw"``."""
+    if "rotation" in spec and "yaw" in spec:
+        _fail(key, 'give either "rotation" [rx, ry, rz] or "yaw", not both')
+    if "rotation" in spec:
+        from scipy.spatial.transform import Rotation
+
+        return Rotation.from_euler("xyz", _vector(spec["rotation"], f"{key}.rotation"), degrees=True).as_matrix()
+    return _rotation_z(math.radians(_number(spec.get("yaw", 0.0), f"{key}.yaw", positive=False)))
+
+
+def _part_solids(label: str, kind: str, at: np.ndarray, spec: dict, key: str, rotation: np.ndarray) -> tuple:
+    up = rotation[:, 2]  # the part's own z axis: "bottom" and "top" are along it
     if kind in ("box", "cell"):
         size = _vector(spec.get("size"), f"{key}.size", positive=True)
-        return (_box_solid(label, label, at + [0, 0, size[2] / 2.0], size, yaw),)
+        return (_box_solid(label, label, at + up * size[2] / 2.0, size, rotation),)
     if kind == "plate":
         size = _vector(spec.get("size"), f"{key}.size", positive=True)
-        return (_box_solid(label, label, at - [0, 0, size[2] / 2.0], size, yaw),)
+        return (_box_solid(label, label, at - up * size[2] / 2.0, size, rotation),)
     if kind == "cylinder":
         radius = _number(spec.get("radius"), f"{key}.radius")
         height = _number(spec.get("height"), f"{key}.height")
-        return (_cylinder_solid(label, label, at + [0, 0, height / 2.0], radius, height),)
+        return (_cylinder_solid(label, label, at + up * height / 2.0, radius, height, rotation),)
     # nut
     across = _number(spec.get("across_flats"), f"{key}.across_flats")
     height = _number(spec.get("height"), f"{key}.height")
-    solids = [_hex_solid(label, label, at + [0, 0, height / 2.0], across, height, yaw)]
+    solids = [_hex_solid(label, label, at + up * height / 2.0, across, height, rotation)]
     stud = spec.get("stud")
     if stud is not None:
         if not isinstance(stud, dict) or set(stud) - {"radius", "above"} or not {"radius", "above"} <= set(stud):
@@ -199,7 +218,7 @@ def _part_solids(label: str, kind: str, at: np.ndarray, spec: dict, key: str) ->
         if radius >= across / 2.0:
             _fail(f"{key}.stud.radius", f"{radius:g} does not fit inside the nut ({across:g} across flats)")
         total = height + above
-        solids.append(_cylinder_solid(f"{label}/stud", label, at + [0, 0, total / 2.0], radius, total))
+        solids.append(_cylinder_solid(f"{label}/stud", label, at + up * total / 2.0, radius, total, rotation))
     return tuple(solids)
 
 
@@ -214,6 +233,7 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:
         kind = item.get("type")
         if kind not in PART_TYPES:
             _fail(f"{key}.type", f"unknown part type {short_token(kind, 20)} (known: {', '.join(PART_TYPES)})")
+        rotation = _part_rotation(item, key)
         unknown = sorted(set(item) - _COMMON_KEYS - _PART_KEYS[kind])
         if unknown:
             _fail(f"{key}.{short_token(unknown[0], 20)[1:-1]}",
@@ -231,8 +251,8 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:
             for name in names:
                 if name not in targets:
                     _fail(f"{key}.at_targets", f"{short_token(name, 20)} is not a target label")
-            offset = _vector(item.get("offset", [0, 0, 0]), f"{key}.offset")
-            placements = [(name, np.asarray(targets[name], dtype=float) + offset) for name in names]
+            offset = rotation @ _vector(item.get("offset", [0, 0, 0]), f"{key}.offset")  # in the part's frame
+            placements = [(name, np.asarray(targets[name], dtype=float)[:3] + offset) for name in names]
         else:
             if "offset" in item:
                 _fail(f"{key}.offset", "only with at_targets")
@@ -242,8 +262,9 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:
             placements = [(label, _vector(item.get("at"), f"{key}.at"))]
         spec = {k: v for k, v in item.items() if k not in _COMMON_KEYS}
         for label, at in placements:
-            parts.append(Part(label, kind, {"type": kind, "label": label, "at": at.tolist(), **spec},
-                              _part_solids(label, kind, at, spec, key)))
+            extra = {"rotation": item["rotation"]} if "rotation" in item else {}
+            parts.append(Part(label, kind, {"type": kind, "label": label, "at": at.tolist(), **extra, **spec},
+                              _part_solids(label, kind, at, spec, key, rotation)))
     seen = set()
     for part in parts:
         if part.label in seen:
@@ -318,14 +339,19 @@ class _Distances:
                 for vertex in solid.params[0]:
                     vertices.append(np.asarray(vertex, dtype=float))
                 shape = coal.Convex.convexHull(vertices, False, "")
-            self.shapes.append((shape, coal.Transform3s(_rotation_z(solid.yaw), np.asarray(solid.centre, dtype=float))))
+            self.shapes.append((shape, coal.Transform3s(np.asarray(solid.rotation, dtype=float), np.asarray(solid.centre, dtype=float))))
         self.identity = np.eye(3)
 
-    def tool_to(self, point: np.ndarray, index: int) -> float:
-        """Signed distance from the tool at ``point`` to solid ``index``."""
+    def tool_to(self, point: np.ndarray, index: int, rotation: np.ndarray | None = None) -> float:
+        """Signed distance from the tool at ``point`` to solid ``index``; ``rotation`` (3, 3) is
+        the tool frame (its z axis the approach direction; default pointing down)."""
         shape, pose = self.shapes[index]
         self.result.clear()
-        tool_pose = self.coal.Transform3s(self.identity, np.asarray(point, dtype=float) + self.tool_offset)
+        if rotation is None:
+            tool_pose = self.coal.Transform3s(self.identity, np.asarray(point, dtype=float) + self.tool_offset)
+        else:  # the body extends from the mouth against the approach direction
+            centre = np.asarray(point, dtype=float) - rotation[:, 2] * self.tool_offset[2]
+            tool_pose = self.coal.Transform3s(np.asarray(rotation, dtype=float), centre)
         return self._checked(float(self.coal.distance(self.tool, tool_pose, shape, pose, self.request, self.result)))
 
     def _checked(self, distance: float) -> float:
@@ -456,7 +482,7 @@ class Scene:
     def parts_at(self, point) -> list[str]:
         """Labels of the parts the tool would take into its mouth at ``point``: those whose
         bounding box is within the tool radius of the point."""
-        point = np.asarray(point, dtype=float)
+        point = np.asarray(point, dtype=float)[:3]
         gap = np.maximum(np.maximum(self._lower - point, point - self._upper), 0.0)
         near = np.linalg.norm(gap, axis=1) <= self.tool.radius
         return list(dict.fromkeys(self._owner[near]))
@@ -478,6 +504,7 @@ class Scene:
         """Raise when a target the scene applies to has no part with its label, or does not lie
         on it (more than the tool radius from the part's bounding box)."""
         for label, point in targets.items():
+            point = np.asarray(point, dtype=float)[:3]  # a pose target: its position
             if not self.applies_to(label):
                 continue
             if label not in self.labels:
@@ -503,8 +530,56 @@ class Scene:
             raise ValueError(f"exclude names {sorted(unknown)[0]!r}, which is not a part of the scene")
         return np.flatnonzero([owner not in exclude for owner in self._owner])
 
+    def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
+        """:meth:`clearance` for a tool whose orientation changes along the motion."""
+        from scipy.spatial.transform import Rotation
+
+        q = np.asarray(quaternions, dtype=float)
+        if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
+            raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
+        q = q / np.linalg.norm(q, axis=1, keepdims=True)
+        if q.shape[0] > 1:  # q and -q are one rotation: keep neighbours in one hemisphere to interpolate
+            flips = np.cumsum(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0) % 2
+            q[1:][flips == 1] *= -1.0
+        dense, dense_q = _densify(points, step), None
+        if points.shape[0] > 1:
+            lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
+            pieces = np.maximum(np.ceil(lengths / step).astype(np.int64), 1) + 1
+            which = np.repeat(np.arange(len(lengths)), pieces)
+            first = np.concatenate([[0], np.cumsum(pieces)[:-1]])
+            fraction = (np.arange(int(pieces.sum())) - np.repeat(first, pieces)) / np.repeat(pieces - 1, pieces)
+            dense_q = q[which] + fraction[:, None] * (q[which + 1] - q[which])  # nlerp: ≤ 0.2 mm apart
+            dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)
+        else:
+            dense_q = q
+        rotations = Rotation.from_quat(dense_q).as_matrix()
+        axes = rotations[:, :, 2]
+        radius, length = self.tool.radius, self.tool.length
+        centres = dense - axes * length / 2.0
+        extent = _cylinder_extent(axes, radius, length / 2.0)
+        lower, upper = self._lower[chosen], self._upper[chosen]
+        engine = self._engine()
+        best, best_part, best_point = math.inf, None, None
+        for start in range(0, dense.shape[0], _CHUNK):
+            block = slice(start, start + _CHUNK)
+            bounds = _box_distance((centres[block] - extent[block])[:, None], (centres[block] + extent[block])[:, None],
+                                   lower[None], upper[None])
+            if best == math.inf:
+                row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])
+                best = engine.tool_to(dense[block][row], int(chosen[col]), rotations[block][row])
+                best_part, best_point = self.solids[chosen[col]].label, dense[block][row]
+            rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
+            for at in np.argsort(bounds[rows, cols], kind="stable"):
+                row, col = rows[at], cols[at]
+                if bounds[row, col] > 0.0 and bounds[row, col] >= best:
+                    break
+                distance = engine.tool_to(dense[block][row], int(chosen[col]), rotations[block][row])
+                if distance < best:
+                    best, best_part, best_point = distance, self.solids[chosen[col]].label, dense[block][row]
+        return Clearance(float(best), best_part, None if best_point is None else np.array(best_point))
+
     @numerically_guarded
-    def clearance(self, trajectory, exclude=(), step: float = _DEFAULT_STEP) -> Clearance:
+    def clearance(self, trajectory, exclude=(), step: float = _DEFAULT_STEP, orientations=None) -> Clearance:
         """Smallest signed distance between the tool and the parts along ``trajectory``.
 
         Parameters
@@ -515,6 +590,9 @@ class Scene:
             Part labels not checked (the target: it enters the socket).
         step : float, default 0.2
             The tool is placed at least every ``step`` along the path (scene unit).
+        orientations : array (n, 4), optional
+            The tool frame at each point (quaternions x, y, z, w; the frame's z axis is the
+            approach direction, the tool's body extends against it). Default: pointing down.
 
         Returns
         -------
@@ -528,6 +606,8 @@ class Scene:
         chosen = self._selected(exclude)
         if chosen.size == 0:
             return Clearance(math.inf, None, None)
+        if orientations is not None:
+            return self._clearance_oriented(points, orientations, chosen, step)
         lower, upper = self._lower[chosen], self._upper[chosen]
         engine = self._engine()
         radius, length = self.tool.radius, self.tool.length

@@ -11,7 +11,7 @@ import numpy as np
 from ._checks import as_point, as_trajectory, check_real
 from ._trajectory import path_extent, rmse
 
-__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "path_difference"]
+__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference"]
 
 
 def endpoint_error(trajectory, target) -> float:
@@ -20,7 +20,7 @@ def endpoint_error(trajectory, target) -> float:
     return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
 
 
-def approach_error(trajectory, target, height: float) -> float:
+def approach_error(trajectory, target, height: float, axis=None) -> float:
     """Largest horizontal distance from the target's vertical axis while the trajectory is less
     than ``height`` above the target (SPEC §9). 0 if it never comes that low.
 
@@ -30,16 +30,57 @@ def approach_error(trajectory, target, height: float) -> float:
     target : array (3,)
     height : float
         Height of the band above the target (e.g. the socket's 28.5 mm groove).
+    axis : array (3,), optional
+        The target's axis, pointing out of it (a tilted nut's); default +z. Height is measured
+        along it and the distance across it.
     """
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     if trajectory.shape[1] != 3:
         raise ValueError(f"approach_error needs a 3-D trajectory (z is the height), got D = {trajectory.shape[1]}")
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
-    low = trajectory[:, 2] - target[2] < height
+    if axis is None:
+        low = trajectory[:, 2] - target[2] < height
+        if not np.any(low):
+            return 0.0
+        return float(np.max(np.linalg.norm(trajectory[low, :2] - target[:2], axis=1)))
+    axis = _unit_axis(axis)
+    offsets = trajectory - target
+    along = offsets @ axis
+    low = along < height
     if not np.any(low):
         return 0.0
-    return float(np.max(np.linalg.norm(trajectory[low, :2] - target[:2], axis=1)))
+    return float(np.max(np.linalg.norm(offsets[low] - np.outer(along[low], axis), axis=1)))
+
+
+def _unit_axis(axis) -> np.ndarray:
+    axis = as_point(axis, 3, "axis")
+    norm = np.linalg.norm(axis)
+    if norm < 1e-12:
+        raise ValueError("axis must not be zero")
+    return axis / norm
+
+
+def axis_deviation(trajectory, orientations, target, height: float, axis=None) -> float:
+    """Largest angle (degrees) between the tool's axis and the target's axis while the tool is
+    less than ``height`` above the target (along ``axis``, default +z); 0 if it never comes
+    that low. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
+    pointing into the target, so a perfect approach has it opposite ``axis``."""
+    from scipy.spatial.transform import Rotation
+
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+    q = np.asarray(orientations, dtype=float)
+    if q.shape != (trajectory.shape[0], 4):
+        raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), got {q.shape}")
+    target = as_point(target, 3, "target")
+    height = check_real(height, "height", positive=True)
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
+    low = (trajectory - target) @ axis < height
+    if not np.any(low):
+        return 0.0
+    tool_axes = Rotation.from_quat(q[low]).apply([0.0, 0.0, 1.0])
+    cosines = np.clip(tool_axes @ -axis, -1.0, 1.0)
+    return float(np.degrees(np.max(np.arccos(cosines))))
 
 
 def path_difference(trajectory, reference) -> float:

@@ -18,6 +18,9 @@ Keys (units: millimetres for the battery scenarios)::
     success_threshold    end-point error for success, default 1.75
     approach_height      height band above a target for the approach error, default 28.5;
                          null turns the approach metric off
+    alignment_threshold  pose scenarios (targets and demonstration x, y, z, qx, qy, qz, qw):
+                         the largest angle in degrees between the tool's axis and the target's
+                         over the approach height, default 2
     dmp                  DMP parameters (alpha, beta, K, alpha_phase, tau, n_kernels, regression,
                          widths, derivatives)
     bidmp                Bi-DMP parameters (n_windows, n_mapped, n_enhance, increments, shrink, reg,
@@ -66,10 +69,12 @@ from .io import load_json, load_trajectory
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
 METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
+POSE_METHODS = ("dmp", "bidmp", "bidmp-latest")  # what a pose scenario (D = 7) can run
+POSE_DIMS = 7  # x, y, z, qx, qy, qz, qw
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-    "seed", "scene", "robot",
+    "seed", "scene", "robot", "alignment_threshold",
 }
 _DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
              "goal_rate"}
@@ -106,12 +111,27 @@ class Scenario:
     description: str = ""
     spec: dict = field(default_factory=dict, repr=False)
     scene: Scene | None = None
+    alignment_threshold: float = 2.0  # degrees: a pose scenario's tool axis vs the target's over the approach
     robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
     base_dir: str = "."  # where "file" demonstrations were read from
 
     @property
     def labels(self) -> list[str]:
         return list(self.targets)
+
+    @property
+    def is_pose(self) -> bool:
+        """Whether targets and demonstration are poses (x, y, z, qx, qy, qz, qw)."""
+        return self.demonstration.shape[1] == POSE_DIMS
+
+    def target_axis(self, label: str) -> np.ndarray | None:
+        """A pose target's axis, pointing out of it (the tool comes in along minus it); None for
+        position targets (the evaluation then uses +z)."""
+        if not self.is_pose:
+            return None
+        from scipy.spatial.transform import Rotation
+
+        return -Rotation.from_quat(self.targets[label][3:]).apply([0.0, 0.0, 1.0])
 
     @property
     def target_array(self) -> np.ndarray:
@@ -128,6 +148,10 @@ class Scenario:
         if label in self.demonstrations:
             return self.demonstrations[label]
         offset = self.targets[label] - self.targets[self.demonstrated]
+        if self.is_pose:  # positions moved, orientations kept (only positions are compared)
+            moved = self.demonstration.copy()
+            moved[:, :3] += offset[:3]
+            return moved
         generator = self.spec["demonstration"].get("minimum_jerk")
         if generator is not None:
             via = np.asarray(generator["via"], dtype=float) + offset
@@ -307,17 +331,23 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
 
     demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files)
     n_dims = demonstration.shape[1]
+    if n_dims == POSE_DIMS:
+        demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
     if not isinstance(data["targets"], dict) or not data["targets"]:
         _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
     if len(data["targets"]) > get_limits().max_targets:
         _fail(source, "targets", f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}")
     targets = {str(label): _point(point, source, f"targets.{label}", n_dims) for label, point in data["targets"].items()}
+    if n_dims == POSE_DIMS:
+        targets = {label: _pose_points(point[None], source, f"targets.{label}", generated=False)[0]
+                   for label, point in targets.items()}
     demonstrated = data["demonstrated"]
     if not isinstance(demonstrated, str) or demonstrated not in targets:
         _fail(source, "demonstrated", f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
                                       f"{', …' if len(targets) > 10 else ''})")
 
     threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
+    alignment = _number(data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True)
     approach = data.get("approach_height", 28.5)
     approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
 
@@ -368,14 +398,16 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     for method in methods:
         if method not in METHODS:
             _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(METHODS)})")
+        if n_dims == POSE_DIMS and method not in POSE_METHODS:
+            _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
 
     scene = None
     if "scene" in data:
-        if n_dims != 3:
-            _fail(source, "scene", f"needs 3-D targets and demonstrations, these have D = {n_dims}")
+        if n_dims not in (3, POSE_DIMS):
+            _fail(source, "scene", f"needs 3-D positions or poses (D = 7), these have D = {n_dims}")
         try:
             scene = Scene.from_dict(data["scene"], targets)
         except SceneError as exc:
@@ -399,7 +431,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         extensions=extensions,
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
-        scene=scene, robot=robot, base_dir=str(base_dir),
+        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment,
     )
 
 
@@ -409,9 +441,31 @@ def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_param
     from .dmp import DMP
 
     try:
-        DMP(**dmp_params).fit(demonstration).rollout_many(np.stack(list(targets.values())))
+        if demonstration.shape[1] == POSE_DIMS:
+            from .cartesian import CartesianDMP
+
+            model = CartesianDMP(**dmp_params).fit(demonstration)
+            for goal in targets.values():
+                model.rollout(goal)
+        else:
+            DMP(**dmp_params).fit(demonstration).rollout_many(np.stack(list(targets.values())))
     except (TypeError, ValueError) as exc:
         _fail(source, "dmp", f"the DMP cannot run on this demonstration: {exc}")
+
+
+def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> np.ndarray:
+    """Pose rows (x, y, z, qx, qy, qz, qw): quaternions must be unit (a generator's are
+    normalised: it interpolates them component by component)."""
+    quaternions = points[:, 3:]
+    norms = np.linalg.norm(quaternions, axis=1)
+    if np.any(norms < 1e-9):
+        _fail(source, key, "a quaternion is zero, which is no rotation")
+    if generated:
+        points = points.copy()
+        points[:, 3:] = quaternions / norms[:, None]
+    elif np.any(np.abs(norms - 1.0) > 1e-6):
+        _fail(source, key, f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})")
+    return points
 
 
 # ---------------------------------------------------------------------------------------------

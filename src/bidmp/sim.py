@@ -44,7 +44,7 @@ from scipy.interpolate import CubicSpline
 
 from ._checks import as_trajectory, check_int, check_real, require_extra
 from ._tables import markdown_table, text_table
-from .metrics import approach_error
+from .metrics import approach_error, axis_deviation
 from .timing import Trajectory, time_scale
 
 __all__ = ["PANDA", "JointLimits", "Hold", "PandaCell", "MotionPlan", "Execution", "SimTarget", "SimMethod",
@@ -60,7 +60,7 @@ COUPLING = 5e5  # 1/m²: phase stopping's default gain in closed loop (0.5 /mm²
 RECORD_EVERY = 2  # physics steps per recorded sample (500 Hz); contacts are checked every step
 SETTLE = 0.3  # s held at the end before the end point is measured
 MAX_SAMPLE_SPACING = 5e-3  # m: the Cartesian path is subdivided so that IK points are at most this far apart
-IK_TOLERANCE = 1e-5  # m: a sample whose IK leaves more than this is unreachable
+IK_TOLERANCE = 5e-5  # m: a sample whose IK leaves more than this (0.05 mm) is unreachable
 IK_ACCURACY = 5e-6  # m: IK stops refining below this (tracking errors are ~100x larger)
 _UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
 _DOWN = (1.0, 0.0, 0.0, 0.0)  # quaternion (x, y, z, w): the flange's z axis pointing down
@@ -183,6 +183,7 @@ class MotionPlan:
     spline: CubicSpline  # q(u), u in [0, 1]
     peak_velocity: float  # fraction of the limit, the largest over joints
     peak_acceleration: float
+    orientations: np.ndarray | None = None  # (n, 4) the tool frame at the IK samples (pose skills)
 
     def command(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Joint positions and velocities commanded at time(s) ``t`` (s): (7,) or (n, 7)."""
@@ -205,6 +206,7 @@ class Execution:
     command_times: np.ndarray | None = None  # closed loop: the control steps (s) ...
     command_joints: np.ndarray | None = None  # ... the joints commanded there (rad) ...
     motion_clock: np.ndarray | None = None  # ... and the stepper's own time (s; stands still while paused)
+    tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
 
     @property
     def paused(self) -> float:
@@ -288,7 +290,9 @@ class PandaCell:
             extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
             visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
                                          rgbaColor=self._colour(solid), physicsClientId=self.client)
-        orientation = p.getQuaternionFromEuler([0.0, 0.0, solid.yaw])
+        from scipy.spatial.transform import Rotation
+
+        orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
         return p.createMultiBody(0.0, shape, visual, (np.asarray(solid.centre) * unit).tolist(), orientation,
                                  physicsClientId=self.client)
 
@@ -332,40 +336,69 @@ class PandaCell:
                                             physicsClientId=self.ik_client)[4])
 
     # -- planning --------------------------------------------------------------------------
-    def solve_ik(self, point_m: np.ndarray, seed) -> tuple[np.ndarray, float]:
-        """Joint positions that put the TCP at ``point_m`` (m) with the tool pointing down,
-        started from ``seed``; and the position error left (m)."""
+    def solve_ik(self, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
+        """Joint positions that put the TCP at ``point_m`` (m) with the tool's frame at
+        ``orientation`` (quaternion x, y, z, w; default pointing down), started from ``seed``;
+        and the position error left (m)."""
         p = self.p
         q = np.asarray(seed, dtype=float)
+        target_orientation = _DOWN if orientation is None else [float(v) for v in orientation]
+        axis = None
+        if orientation is not None:
+            # The tool is a socket, symmetric about its axis: only the axis is prescribed. Each
+            # burst aims at the orientation nearest the current one with that axis, so the arm
+            # keeps its own turn about the axis (a full orientation made the wrist fight it).
+            from scipy.spatial.transform import Rotation
+
+            axis = Rotation.from_quat(target_orientation).apply([0.0, 0.0, 1.0])
         limits = PANDA
         ranges = [u - l for l, u in zip(limits.lower, limits.upper)]
         error = math.inf
         # Short bursts from the previous solution, checked by forward kinematics: a few dozen
         # iterations reach 1 µm from a seed a few millimetres away (one long call costs 10x).
-        for _ in range(12):
+        for _ in range(20):
             self._set_joints(q, kinematic=True)
+            if axis is not None:
+                current = Rotation.from_quat(p.getLinkState(self.ik_robot, self.tcp, computeForwardKinematics=1,
+                                                            physicsClientId=self.ik_client)[5])
+                swing, _ = Rotation.align_vectors([axis], [current.apply([0.0, 0.0, 1.0])])
+                target_orientation = (swing * current).as_quat().tolist()
             q = np.array(p.calculateInverseKinematics(
-                self.ik_robot, self.tcp, point_m.tolist(), _DOWN, lowerLimits=list(limits.lower),
+                self.ik_robot, self.tcp, point_m.tolist(), target_orientation, lowerLimits=list(limits.lower),
                 upperLimits=list(limits.upper), jointRanges=ranges, restPoses=q.tolist(), maxNumIterations=40,
                 residualThreshold=1e-9, physicsClientId=self.ik_client)[:7])
+            if axis is not None:
+                # Joint 7 turns the flange about the tool's axis, which moves neither the tool's
+                # mouth nor its axis: park it mid-range instead of letting it drift to a limit.
+                q[6] = _REST[6]
             error = float(np.linalg.norm(self.forward(q) - point_m))
             if error <= IK_ACCURACY:
                 break
         return q, error
 
-    def plan(self, path, label: str = "", fractions=None, seed=None) -> MotionPlan:
+    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
         """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
         within :data:`LIMIT_MARGIN` of the joint limits. ``fractions``: normalised time of each
-        sample (default: uniform, as a DMP rollout is)."""
+        sample (default: uniform, as a DMP rollout is). ``orientations`` (n, 4): the tool frame
+        along the path (a pose skill's); default pointing down."""
         path = as_trajectory(path, "path", min_points=2, allow_static=True)
         if path.shape[1] != 3:
             raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
-        u = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else np.asarray(fractions, dtype=float)
-        points, u = _subdivide(path * self.unit, u, MAX_SAMPLE_SPACING)
+        given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else np.asarray(fractions, dtype=float)
+        points, u = _subdivide(path * self.unit, given, MAX_SAMPLE_SPACING)
+        turns = None
+        if orientations is not None:
+            from scipy.spatial.transform import Rotation, Slerp
+
+            q = np.asarray(orientations, dtype=float)
+            if q.shape != (path.shape[0], 4):
+                raise ValueError(f"orientations must have shape ({path.shape[0]}, 4), got {q.shape}")
+            keep = np.concatenate([[True], np.diff(given) > 1e-12])
+            turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
         q = np.array(_REST if seed is None else seed, dtype=float)
         joints = np.empty((points.shape[0], 7))
         for index, point in enumerate(points):
-            q, error = self.solve_ik(point, q)
+            q, error = self.solve_ik(point, q, None if turns is None else turns[index])
             if error > IK_TOLERANCE:
                 raise SimError(f"target {label!r}: the point {np.round(point / self.unit, 2).tolist()} of its motion is "
                                f"unreachable for the Panda at base {np.round(self.base, 1).tolist()} "
@@ -386,7 +419,7 @@ class PandaCell:
         duration = float(timed.t[-1])
         return MotionPlan(label, points, u, joints, duration, spline,
                           float(np.max(np.abs(timed.yd) / np.asarray(PANDA.velocity))),
-                          float(np.max(np.abs(timed.ydd) / np.asarray(PANDA.acceleration))))
+                          float(np.max(np.abs(timed.ydd) / np.asarray(PANDA.acceleration))), turns)
 
     # -- execution -------------------------------------------------------------------------
     def _ignore(self, exclude, enable: bool) -> None:
@@ -553,6 +586,7 @@ class _Recorder:
         n_records = (n_steps - 1) // RECORD_EVERY + 1
         self.times = np.empty(n_records)
         self.tcp = np.empty((n_records, 3))
+        self.tcp_orientation = np.empty((n_records, 4))
         self.joints = np.empty((n_records, 7))
         self.velocities = np.empty((n_records, 7))
         self.commanded = []
@@ -574,7 +608,8 @@ class _Recorder:
         row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
         self.filled = row + 1
         self.times[row] = t
-        self.tcp[row] = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client)[4]
+        state = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client)
+        self.tcp[row], self.tcp_orientation[row] = state[4], state[5]
         states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
         self.joints[row] = [s[0] for s in states]
         self.velocities[row] = [s[1] for s in states]
@@ -588,8 +623,10 @@ class _Recorder:
         rows = [r for r, _ in self.commanded if r < n_rows]
         commanded = np.array([cell.forward(q) for r, q in self.commanded if r < n_rows])
         full = np.column_stack([np.interp(np.arange(n_rows), rows, commanded[:, k]) for k in range(3)])
-        return Execution(self.times[:n_rows], self.tcp[:n_rows], self.joints[:n_rows], self.velocities[:n_rows], full,
-                         self.contacts, self.frames)
+        run = Execution(self.times[:n_rows], self.tcp[:n_rows], self.joints[:n_rows], self.velocities[:n_rows], full,
+                        self.contacts, self.frames)
+        run.tcp_orientation = self.tcp_orientation[:n_rows]
+        return run
 
 
 def _unit_name(unit: float) -> str:
@@ -640,10 +677,12 @@ class SimTarget:
     tracking_error: float  # largest distance between the commanded and the measured TCP
     within_limits: bool  # the commanded joint motion within the velocity and acceleration limits
     paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
+    axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
+    aligned: bool | None = None
 
     def task_success(self, threshold: float) -> bool:
         return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
-                    and self.within_limits)
+                    and self.within_limits and self.aligned is not False)
 
     def to_dict(self, threshold: float) -> dict:
         return {
@@ -656,6 +695,8 @@ class SimTarget:
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4), "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
+            "axis_deviation_deg": None if self.axis_deviation is None else round(self.axis_deviation, 4),
+            "aligned": self.aligned,
         }
 
 
@@ -687,8 +728,14 @@ class SimMethod:
     def within_limits(self) -> int:
         return sum(t.within_limits for t in self.targets.values())
 
+    @property
+    def aligned(self) -> int | None:
+        values = [t.aligned for t in self.targets.values()]
+        return None if any(v is None for v in values) else sum(values)
+
     def to_dict(self) -> dict:
         return {"task_successes": self.task_successes, "end_successes": self.end_successes, "engaged": self.engaged,
+                "aligned": self.aligned,
                 "contacts": self.contacts, "within_limits": self.within_limits, "n_targets": len(self.targets),
                 "targets": {label: t.to_dict(self.threshold) for label, t in self.targets.items()}}
 
@@ -714,22 +761,27 @@ class SimReport:
                 "methods": {name: method.to_dict() for name, method in self.methods.items()}}
 
     def rows(self) -> tuple[list[str], list[list[str]]]:
-        header = ["method", "end point", "engaged", "contacts", "within limits", "task success", "motion time s"]
+        poses = any(method.aligned is not None for method in self.methods.values())
+        header = ["method", "end point", "engaged"] + (["aligned"] if poses else []) + \
+            ["contacts", "within limits", "task success", "motion time s"]
         rows = []
         for name, method in self.methods.items():
             n = len(method.targets)
             times = [t.motion_time for t in method.targets.values()]
-            rows.append([name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}",
-                         f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{method.task_successes}/{n}",
-                         f"{min(times):.1f}-{max(times):.1f}"])
+            row = [name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}"]
+            if poses:
+                row.append("-" if method.aligned is None else f"{method.aligned}/{n}")
+            rows.append(row + [f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{method.task_successes}/{n}",
+                               f"{min(times):.1f}-{max(times):.1f}"])
         return header, rows
 
     def summary(self) -> str:
         scenario = self.scenario
+        aligned = (f", tool axis within {scenario.alignment_threshold:g} deg of the nut's" if scenario.is_pose else "")
         lines = [f"{scenario.name} on a simulated Franka Panda (PyBullet, 1 kHz position control), robot base "
                  f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
-                 f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged, no contact "
-                 f"with another part, joints within the Panda's velocity and acceleration limits", "",
+                 f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
+                 f"no contact with another part, joints within the Panda's velocity and acceleration limits", "",
                  text_table(*self.rows())]
         if self.wall_s > 0:
             lines.append(f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
@@ -747,9 +799,12 @@ def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, r
     tcp = run.tcp / unit
     measured_error = float(np.linalg.norm(tcp[-1] - target))
     commanded_error = float(np.linalg.norm(plan.points[-1] / unit - target))
-    approach = None
+    approach = deviation = None
+    axis = scenario.get("axes", {}).get(label)
     if scenario["approach_height"] is not None:
-        approach = approach_error(tcp, target, scenario["approach_height"])
+        approach = approach_error(tcp, target, scenario["approach_height"], axis)
+        if scenario.get("alignment_threshold") is not None:
+            deviation = axis_deviation(tcp, run.tcp_orientation, target, scenario["approach_height"], axis)
     velocity = float(np.max(np.abs(run.joint_velocities) / np.asarray(PANDA.velocity)))
     if closed_loop:  # no plan timed it: the commands the stepper produced, 100 Hz
         command_velocity = np.diff(run.command_joints, axis=0) / CONTROL_STEP
@@ -766,7 +821,9 @@ def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, r
         peak_acceleration=peak_acceleration, measured_peak_velocity=velocity,
         measured_peak_acceleration=_measured_acceleration(run), motion_time=motion_time,
         tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
-        within_limits=bool(peak_velocity <= 1.0 + 1e-9 and peak_acceleration <= 1.0 + 1e-9), paused=run.paused)
+        within_limits=bool(peak_velocity <= 1.0 + 1e-9 and peak_acceleration <= 1.0 + 1e-9), paused=run.paused,
+        axis_deviation=deviation,
+        aligned=None if deviation is None else bool(deviation <= scenario["alignment_threshold"]))
 
 
 def _measured_acceleration(run: Execution) -> float:
@@ -786,6 +843,7 @@ class _Job:
     rollout: np.ndarray  # (n, 3) scenario units
     exclude: list
     frames: int
+    orientations: np.ndarray | None = None  # (n, 4) a pose skill's tool frames
 
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
@@ -799,8 +857,10 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
         for job in jobs:
             if progress is not None:
                 progress(job.method, job.label)
-            plan = cell.plan(job.rollout, job.label)
-            target = np.asarray(scenario["targets"][job.label], dtype=float)
+            plan = cell.plan(job.rollout, job.label, orientations=job.orientations)
+            if setup["closed_loop"] and job.orientations is not None:
+                raise ValueError("closed_loop runs position skills; this scenario's are poses")
+            target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
             if setup["closed_loop"]:
                 stepper = _stepper(setup["models"], job.method, target, plan.duration, setup["coupling"])
                 run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
@@ -875,14 +935,18 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     frames = frames or {}
     jobs = [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
                  [label] if label in scene.labels else scene.parts_at(scenario.targets[label]),
-                 int(frames.get((method, label), 0)))
+                 int(frames.get((method, label), 0)),
+                 None if report.methods[method].orientations is None else report.methods[method].orientations[label])
             for method in methods for label in labels]
     models = None
     if closed_loop:
         models = {"bidmp": report.model,
                   "dmp": report.model.dmp_ if report.model is not None else _plain_dmp(scenario)}
     setup = {"scenario": {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
-                          "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold},
+                          "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold,
+                          "axes": {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
+                                   for label in labels},
+                          "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None},
              "scene": scene.to_dict(), "base": base.tolist(), "yaw": yaw, "closed_loop": closed_loop, "hold": hold,
              "coupling": coupling, "models": models}
     n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
