@@ -39,6 +39,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bidmp_convergence.py
 	$(PY) benchmarks/bench_timing.py
 	$(PY) benchmarks/bench_sim.py
+	$(PY) benchmarks/bench_cartesian.py
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).

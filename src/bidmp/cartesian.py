@@ -33,7 +33,7 @@ from sklearn.base import BaseEstimator
 from ._checks import as_point, as_trajectory, check_fitted, numerically_guarded
 from .dmp import DMP
 
-__all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "PoseStepper", "PoseTrajectory", "as_quaternions", "as_poses", "continuous_quaternions",
+__all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "prepare_poses", "PoseStepper", "PoseTrajectory", "as_quaternions", "as_poses", "continuous_quaternions",
            "orientation_error", "left_jacobian", "angle_between"]
 
 logger = logging.getLogger(__name__)
@@ -138,6 +138,31 @@ class PoseTrajectory:
 def _orientation_from_error(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
     q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat()
     return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
+
+
+_ORIENTATION_WEIGHT = 1e-6  # rad -> "units" while prepare() filters: the idle ends are found from positions
+
+
+def prepare_poses(poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = ""):
+    """:func:`bidmp.prepare` for a pose recording: uniform time, the same zero-phase low-pass on
+    positions and on the orientation (in the tangent space at the last sample), idle ends
+    trimmed by the positions' speed.
+
+    Returns
+    -------
+    (poses (n, 7), t (n,), PrepareInfo)
+        Uniform samples from 0 s; ``info.start_s`` is where they begin in the recording.
+    """
+    from .timing import prepare
+
+    positions, quaternions = as_poses(poses, "poses", min_points=10)
+    goal = quaternions[-1]
+    # Scaled down, the orientation rides along through the same linear filter and resampling
+    # without moving the speed threshold that finds the motion.
+    stacked = np.hstack([positions, orientation_error(quaternions, goal) * _ORIENTATION_WEIGHT])
+    trajectory, info = prepare(stacked, t, cutoff_hz=cutoff_hz, idle_fraction=idle_fraction, units=units)
+    orientation = _orientation_from_error(trajectory.y[:, 3:] / _ORIENTATION_WEIGHT, goal)
+    return np.hstack([trajectory.y[:, :3], orientation]), trajectory.t, info
 
 
 class CartesianDMP(BaseEstimator):

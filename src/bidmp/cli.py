@@ -68,6 +68,10 @@ def _bidmp_and_demo(args: argparse.Namespace, command: str):
         hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
         raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}{hint}")
     model = load_model(args.model)
+    from .cartesian import CartesianDMP
+
+    if isinstance(model, CartesianDMP):
+        return _rollout_poses(model, args)
     if isinstance(model, DMP):
         model = BiDMP(model)
     elif not isinstance(model, BiDMP):
@@ -90,6 +94,8 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     from .io import save_model
     from .metrics import path_extent
 
+    if _is_pose_file(args.demo):
+        return _fit_poses(args)
     demonstration, times, how = _read_demo(args.demo, args)
     dmp = DMP(
         n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K,
@@ -113,6 +119,73 @@ def _cmd_fit(args: argparse.Namespace) -> int:
     if dmp.protocol == "paper":
         print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {dmp.default_n_steps()} samples")
     print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _is_pose_file(path) -> bool:
+    """Whether ``path`` is a CSV whose header names a pose (``...,qx,qy,qz,qw``)."""
+    if not str(path).lower().endswith((".csv", ".txt")):
+        return False
+    try:
+        with open(path, encoding="utf-8-sig") as handle:
+            header = handle.readline(4096)
+    except OSError:
+        return False
+    names = {name.strip().lower() for name in header.replace(";", ",").split(",")}
+    return {"qx", "qy", "qz", "qw"} <= names
+
+
+def _fit_poses(args: argparse.Namespace) -> int:
+    """``bidmp fit`` on a pose recording: a CartesianDMP (prepared like positions unless --raw)."""
+    import numpy as np
+
+    from .cartesian import CartesianDMP, angle_between, prepare_poses
+    from .io import read_poses, save_model
+
+    poses, times = read_poses(args.demo)
+    how = "raw samples" if times is None else "timestamps as recorded"
+    if times is not None and not args.raw:
+        poses, times, info = prepare_poses(poses, times, cutoff_hz=args.cutoff, units=args.units or "")
+        how = (f"prepared: {info.rate_hz:.4g} Hz, low-pass {info.cutoff_hz:g} Hz, motion {info.start_s:.3g}-{info.end_s:.3g} s "
+               f"of the recording")
+    model = CartesianDMP(
+        n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K,
+        alpha_phase=args.alpha_phase, tau=args.tau, regression=args.regression, protocol=args.protocol,
+    ).fit(poses, times, units=args.units)
+    path = save_model(model, args.output)
+    reproduction = model.rollout()[: len(poses)]
+    n = len(reproduction)
+    angles = np.degrees(angle_between(reproduction[:, 3:], poses[:n, 3:]))
+    unit = model.units_ or "units"
+    print(f"fitted a pose DMP (CartesianDMP, {model.protocol} protocol) on {args.demo}, {how}")
+    print(f"  T = {len(poses)} samples over {model.duration_:.4g} s; units {model.units_ or '(not given)'}")
+    print(f"  reproduction: position RMSE {np.sqrt(np.mean(np.sum((reproduction[:, :3] - poses[:n, :3]) ** 2, axis=1))):.4g} "
+          f"{unit}, orientation RMS {np.sqrt(np.mean(angles ** 2)):.3g} deg")
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _rollout_poses(model, args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .cartesian import angle_between
+    from .io import save_poses
+
+    if args.skill is not None:
+        raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a pose DMP")
+    if args.max_speed is not None or args.max_acc is not None:
+        limits = {"max_velocity": args.max_speed, "max_acceleration": args.max_acc}
+    else:
+        limits = None
+    dt = None if args.rate is None else 1.0 / args.rate
+    trajectory = model.trajectory(goal=args.goal, start=args.start, duration=args.duration, dt=dt, limits=limits)
+    path = save_poses(trajectory, args.output)
+    goal = model.goal_pose_ if args.goal is None else np.asarray(args.goal, dtype=float)
+    print(f"rolled out {len(trajectory.t)} poses over {trajectory.t[-1]:.4g} s to goal {np.array2string(goal, precision=4)}")
+    print(f"  end point {np.linalg.norm(trajectory.position[-1] - goal[:3]):.4g} {model.units_ or 'units'} and "
+          f"{np.degrees(angle_between(trajectory.orientation[-1:], goal[None, 3:] / np.linalg.norm(goal[3:])))[0]:.3g} deg "
+          f"from the goal")
+    print(f"wrote {path} (columns t,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz)")
     return EXIT_OK
 
 
@@ -153,6 +226,10 @@ def _cmd_rollout(args: argparse.Namespace) -> int:
     from .io import load_model, save_trajectory
 
     model = load_model(args.model)
+    from .cartesian import CartesianDMP
+
+    if isinstance(model, CartesianDMP):
+        return _rollout_poses(model, args)
     if isinstance(model, DMP):
         if args.skill is not None:
             raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a plain DMP")
