@@ -155,6 +155,13 @@ def test_pose_bidmp_learns_both_forcing_terms_and_forgets_nothing(demo):
         assert np.degrees(angle_between(rollout[-1:, 3:], skill_demo[-1:, 3:]))[0] <= 0.05
     forgetting = pose_forgetting(CartesianDMP().fit(base), [demo, second], skill="nearest")
     assert np.all(forgetting == 0.0)
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        bidmp.save(model, f"{folder}/poses.npz")
+        again = bidmp.load(f"{folder}/poses.npz")
+    for query in (demo[-1], second[-1], base[-1]):
+        np.testing.assert_array_equal(again.rollout(query), model.rollout(query))
 
 
 def test_the_kept_approach_keeps_its_pose_relative_to_the_target():

@@ -354,6 +354,46 @@ class CartesianBiDMP:
         error = self.orientation_.rollout(np.zeros(3), skill=index, start=start_e, n_steps=n_steps)
         return np.hstack([position, _orientation_from_error(error, goal_q)])
 
+    # -- persistence (used by bidmp.io) --------------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        meta = {"params": self.cartesian_.get_params()}
+        arrays = {"start_pose_": self.cartesian_.start_pose_, "goal_pose_": self.cartesian_.goal_pose_,
+                  "skill_goal_orientations_": np.array(self.skill_goal_orientations_),
+                  "skill_start_orientations_": np.array(self.skill_start_orientations_)}
+        for part in ("position", "orientation"):
+            part_meta, part_arrays = getattr(self, f"{part}_")._get_state()
+            meta[part] = part_meta
+            arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
+        return meta, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> "CartesianBiDMP":
+        from ._checks import check_loaded
+        from .incremental import BiDMP, _Prefixed
+
+        for key in ("params", "position", "orientation"):
+            if not isinstance(meta.get(key), dict):
+                raise ValueError(f"the CartesianBiDMP state has no {key} object")
+        position = BiDMP._from_state(meta["position"], _Prefixed(arrays, "position/"))
+        orientation = BiDMP._from_state(meta["orientation"], _Prefixed(arrays, "orientation/"))
+        if position.n_skills != orientation.n_skills or position.dmp_.n_dims_ != 3 or orientation.dmp_.n_dims_ != 3:
+            raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
+        cartesian = CartesianDMP(**meta["params"])
+        cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
+        cartesian.start_pose_ = check_loaded(arrays["start_pose_"], "start_pose_", (7,))
+        cartesian.goal_pose_ = check_loaded(arrays["goal_pose_"], "goal_pose_", (7,))
+        cartesian.units_ = position.dmp_.units_
+        model = cls.__new__(cls)
+        model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation
+        shape = (position.n_skills, 4)
+        goals = check_loaded(arrays["skill_goal_orientations_"], "skill_goal_orientations_", shape)
+        starts = check_loaded(arrays["skill_start_orientations_"], "skill_start_orientations_", shape)
+        for name, values in (("skill_goal_orientations_", goals), ("skill_start_orientations_", starts)):
+            if np.any(np.abs(np.linalg.norm(values, axis=1) - 1.0) > 1e-6):
+                raise ValueError(f"member {name} does not hold unit quaternions")
+        model.skill_goal_orientations_, model.skill_start_orientations_ = list(goals), list(starts)
+        return model
+
     def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
                 coupling: float = 0.0) -> "PoseStepper":
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)

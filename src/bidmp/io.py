@@ -76,6 +76,7 @@ _MODEL_CLASSES = {
     "BLS": ("bidmp.bls", "BLS"),
     "BiDMP": ("bidmp.incremental", "BiDMP"),
     "CartesianDMP": ("bidmp.cartesian", "CartesianDMP"),
+    "CartesianBiDMP": ("bidmp.cartesian", "CartesianBiDMP"),
 }
 _ZIP_MAGIC = b"PK\x03\x04"
 _EMPTY_ZIP_MAGIC = b"PK\x05\x06"
