@@ -476,7 +476,7 @@ def _builtin_dir():
 
 
 def builtin_names() -> list[str]:
-    """Names of the built-in scenarios (nut-unscrewing, cell-removal, pick-and-place)."""
+    """Names of the built-in scenarios (nut-unscrewing, nut-unscrewing-tilted, cell-removal, pick-and-place)."""
     return sorted(entry.name[:-5] for entry in _builtin_dir().iterdir() if entry.name.endswith(".json"))
 
 
