@@ -4,13 +4,13 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean readme fuzz sim
+.PHONY: demo test bench install clean readme fuzz sim lasa
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,test,bench]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,benchmark,test,bench]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -31,6 +31,12 @@ sim: $(STAMP)
 	$(VENV)/bin/bidmp sim --out bidmp-sim
 	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim/closed-loop-hold
 
+# The full LASA benchmark (30 shapes x 7 demonstrations, every method) on the embedded Dask
+# cluster, into bidmp-lasa/ (resumable: rerun to finish an interrupted sweep).
+lasa: $(STAMP)
+	$(VENV)/bin/bidmp benchmark lasa --resume --out bidmp-lasa
+	cp bidmp-lasa/lasa.md docs/results/lasa.md
+
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py
 	$(PY) benchmarks/bench_extension.py
@@ -40,6 +46,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_timing.py
 	$(PY) benchmarks/bench_sim.py
 	$(PY) benchmarks/bench_cartesian.py
+	$(PY) benchmarks/bench_lasa.py
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).
@@ -56,4 +63,4 @@ readme: $(STAMP)
 	$(PY) tools/readme.py
 
 clean:
-	rm -rf $(VENV) bidmp-out bidmp-sim .pytest_cache fuzz-report.json
+	rm -rf $(VENV) bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json

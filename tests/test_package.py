@@ -32,7 +32,7 @@ LAYERS = {
     "roadmap": 1, "bls": 1, "baselines": 1, "geometry": 1,
     "extension": 2, "incremental": 2, "cartesian": 2,
     "datasets": 3, "io": 3, "scenarios": 3, "metrics": 3, "evaluation": 3, "reproduce": 3, "plotting": 3, "_tables": 3,
-    "sim": 3,
+    "sim": 3, "benchmark": 3,
     "cli": 4, "__main__": 4,
 }
 

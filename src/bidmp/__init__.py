@@ -42,7 +42,7 @@ _LAZY = {
 }
 _SUBMODULES = (
     "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry", "cartesian",
-    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting", "sim",
+    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting", "sim", "benchmark",
 )
 
 __all__ = ["__version__", *_LAZY, *_SUBMODULES]

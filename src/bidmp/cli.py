@@ -355,6 +355,29 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_benchmark(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from .benchmark import _validate, lasa
+
+    shapes = None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
+    methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
+    shapes_checked, _, indices = _validate(shapes, methods, args.demos, args.every)  # before starting a cluster
+    if args.workers is not None and not 1 <= args.workers <= 256:
+        raise ValueError(f"--workers must be 1-256, got {args.workers}")
+    with tqdm(total=len(shapes_checked) * len(indices), desc="LASA", unit="cell", disable=None) as bar:
+        result = lasa(Path(args.out), shapes=shapes, methods=methods, demos=args.demos, every=args.every,
+                      workers=args.workers, scheduler=args.scheduler, resume=args.resume, output_format=args.format,
+                      progress=lambda key: bar.update(1))
+    print(f"LASA benchmark: {len(result.computed)} cells computed, {len(result.resumed)} resumed, "
+          f"{result.workers} worker(s), {result.wall_s:.1f} s")
+    print((Path(args.out) / "lasa.md").read_text())
+    print(f"wrote {', '.join(str(path) for path in result.written)}")
+    return EXIT_OK
+
+
 def _cmd_demo(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -700,6 +723,24 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--allow-outside-files", action="store_true",
                      help="let the scenario read demonstration files outside its own folder")
     sim.set_defaults(handler=_cmd_sim)
+
+    benchmark = commands.add_parser("benchmark", help="the full LASA benchmark with the standard metrics, on Dask",
+                                    description="Sweep every LASA shape x demonstration with every method (reproduction, "
+                                                "near and far goals): RMSE, DTW, swept area, Fréchet, end-point error, "
+                                                "times. Runs on an embedded Dask LocalCluster (one worker per core) or on "
+                                                "--scheduler ADDRESS. Needs bidmp[benchmark].")
+    bench_commands = benchmark.add_subparsers(dest="benchmark_command", metavar="{lasa}", required=True, parser_class=_Parser)
+    bench = bench_commands.add_parser("lasa", help="the LASA handwriting benchmark")
+    bench.add_argument("--shapes", default=None, help="comma-separated shapes (default all 30)")
+    bench.add_argument("--methods", default=None, help="comma-separated methods (default dmp-paper,dmp-robot,bidmp,gmm,tpgmm,mp-dmp)")
+    bench.add_argument("--demos", choices=("all", "first3"), default="all", help="all 7 demonstrations or the first 3")
+    bench.add_argument("--every", type=int, default=1, metavar="K", help="use every K-th sample (papers use 1 or 10)")
+    bench.add_argument("--workers", type=int, default=None, help="worker processes of the embedded cluster (default: one per core)")
+    bench.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run on an existing Dask scheduler (tcp://host:8786)")
+    bench.add_argument("--resume", action="store_true", help="skip the cells a previous run into --out finished")
+    bench.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="results table format (default parquet)")
+    bench.add_argument("--out", default="bidmp-lasa", help="output folder (default ./bidmp-lasa)")
+    benchmark.set_defaults(handler=_cmd_benchmark)
 
     scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
                                    description="List the built-in scenarios, print one as JSON to copy and edit "

@@ -11,7 +11,7 @@ import numpy as np
 from ._checks import as_point, as_trajectory, check_real
 from ._trajectory import path_extent, rmse
 
-__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference"]
+__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area"]
 
 
 def endpoint_error(trajectory, target) -> float:
@@ -95,3 +95,19 @@ def path_difference(trajectory, reference) -> float:
         raise ValueError(f"trajectory {trajectory.shape} must cover reference {reference.shape}: at least as many "
                          f"samples, the same D")
     return float(np.sum(np.linalg.norm(trajectory[: reference.shape[0]] - reference, axis=1)))
+
+
+def swept_area(trajectory, reference) -> float:
+    """Swept error area (Khansari-Zadeh & Billard's CLF-DM benchmark): the sum over
+    time-aligned steps of the areas of the quadrilaterals ``r_l, r_{l+1}, y_{l+1}, y_l`` between a
+    2-D trajectory and its reference (shoelace formula, absolute value per quadrilateral).
+    Both (T, 2), same T; in the trajectories' unit squared."""
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=2, allow_static=True)
+    reference = as_trajectory(reference, "reference", min_points=2, allow_static=True)
+    if trajectory.shape != reference.shape or trajectory.shape[1] != 2:
+        raise ValueError(f"swept_area needs two 2-D trajectories of the same length, got {trajectory.shape} and "
+                         f"{reference.shape}")
+    corners = np.stack([reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1)  # (T-1, 4, 2)
+    x, y = corners[..., 0], corners[..., 1]
+    twice = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    return float(np.sum(np.abs(twice)) / 2.0)

@@ -20,7 +20,7 @@ import numpy as np
 
 from ._checks import as_trajectory, check_choice, check_limit, numerically_guarded
 
-__all__ = ["frechet_distance", "frechet_distance_reference", "frechet_similarity", "polyline_length"]
+__all__ = ["frechet_distance", "frechet_distance_reference", "frechet_similarity", "polyline_length", "dtw_distance"]
 
 logger = logging.getLogger(__name__)
 
@@ -54,32 +54,87 @@ def _frechet_rows(p: np.ndarray, q: np.ndarray) -> float:  # pragma: no cover - 
     return np.sqrt(row[m - 1])
 
 
+def _dtw_rows(p: np.ndarray, q: np.ndarray) -> float:  # pragma: no cover - compiled by numba
+    # D[i, j] = d(P_i, Q_j) + min(D[i-1, j], D[i, j-1], D[i-1, j-1]), one row at a time.
+    n, m, n_dims = p.shape[0], q.shape[0], p.shape[1]
+    row = np.empty(m)
+    for i in range(n):
+        diagonal = 0.0
+        for j in range(m):
+            total = 0.0
+            for k in range(n_dims):
+                delta = p[i, k] - q[j, k]
+                total += delta * delta
+            cost = np.sqrt(total)
+            if i == 0 and j == 0:
+                best = 0.0
+            elif i == 0:
+                best = row[j - 1]
+            elif j == 0:
+                best = row[0]
+            else:
+                best = min(row[j], row[j - 1], diagonal)
+            diagonal = row[j] if i > 0 else 0.0
+            row[j] = cost + best
+    return row[m - 1]
+
+
 _kernel_state: dict = {}
 
 
-def _frechet_kernel():
-    """The compiled kernel, or None without numba.
+def _compiled(name: str, function):
+    """The numba-compiled ``function`` (cached per process), or None without numba.
 
     numba caches compiled code on disk beside the package or in the user's cache folder; where
     neither is writable (a read-only install, a service user without a home) it cannot cache and
     raises at the first call. Then the kernel is compiled in memory instead, once per process.
     """
-    if "kernel" not in _kernel_state:
+    if name not in _kernel_state:
         try:
             import numba
         except ImportError:  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
-            _kernel_state["kernel"] = None
+            _kernel_state[name] = None
             return None
         probe = (np.zeros((1, 1)), np.zeros((1, 1)))
         try:  # numba looks for a cache folder when decorating, and writes it at the first call
-            kernel = numba.njit(cache=True, nogil=True)(_frechet_rows)
+            kernel = numba.njit(cache=True, nogil=True)(function)
             kernel(*probe)
         except Exception as exc:  # noqa: BLE001 - numba's caching errors have no common class
-            logger.info("numba cannot cache the Fréchet kernel here (%s); compiling it in memory", exc)
-            kernel = numba.njit(cache=False, nogil=True)(_frechet_rows)
+            logger.info("numba cannot cache the %s kernel here (%s); compiling it in memory", name, exc)
+            kernel = numba.njit(cache=False, nogil=True)(function)
             kernel(*probe)
-        _kernel_state["kernel"] = kernel
-    return _kernel_state["kernel"]
+        _kernel_state[name] = kernel
+    return _kernel_state[name]
+
+
+def _frechet_kernel():
+    return _compiled("Fréchet", _frechet_rows)
+
+
+def dtw_distance(a, b) -> float:
+    """Dynamic-time-warping distance: the smallest sum of Euclidean distances over monotone
+    alignments of the two curves (Sakoe & Chiba, no window), O(n m) time, O(m) memory.
+
+    Parameters
+    ----------
+    a : array-like (n, D)
+    b : array-like (m, D)
+
+    Returns
+    -------
+    float
+        In the curves' length unit (a sum over aligned pairs: divide by the alignment's length,
+        or by n, for a per-sample figure).
+    """
+    a = as_trajectory(a, "a", min_points=1, allow_static=True)
+    b = as_trajectory(b, "b", min_points=1, allow_static=True)
+    if a.shape[1] != b.shape[1]:
+        raise ValueError(f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}")
+    check_limit(a.shape[0] * b.shape[0], "max_frechet_cells", "the DTW table's size n x m; resample the curves")
+    kernel = _compiled("DTW", _dtw_rows)
+    if kernel is None:  # pragma: no cover
+        return float(_dtw_rows(a, b))
+    return float(kernel(a, b))
 
 
 def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:

@@ -1,0 +1,129 @@
+"""The LASA benchmark (issue 14): metrics against independent references, Dask runs that agree
+with the serial one, survive a killed worker and resume, and bad input that fails fast."""
+
+import functools
+import json
+import sys
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("distributed")
+
+from bidmp import benchmark  # noqa: E402
+from bidmp.cli import main  # noqa: E402
+from bidmp.metrics import swept_area  # noqa: E402
+from bidmp.similarity import dtw_distance  # noqa: E402
+
+SMALL = {"shapes": ["Sshape", "WShape"], "demos": "first3", "every": 10, "methods": ["dmp-paper", "bidmp", "tpgmm"]}
+TIMING = set(benchmark.TIMES)
+
+
+def plain_dtw(a, b):
+    """The textbook recursion, memoised: D(i, j) = d(i, j) + min(D(i-1, j), D(i, j-1), D(i-1, j-1))."""
+    sys.setrecursionlimit(10_000)
+
+    @functools.lru_cache(maxsize=None)
+    def cost(i, j):
+        here = float(np.linalg.norm(a[i] - b[j]))
+        if i == 0 and j == 0:
+            return here
+        if i == 0:
+            return here + cost(0, j - 1)
+        if j == 0:
+            return here + cost(i - 1, 0)
+        return here + min(cost(i - 1, j), cost(i, j - 1), cost(i - 1, j - 1))
+
+    return cost(len(a) - 1, len(b) - 1)
+
+
+def test_dtw_against_the_plain_recursion():
+    rng = np.random.default_rng(0)
+    for n, m, d in [(1, 1, 2), (1, 6, 2), (9, 4, 3), (40, 33, 2)]:
+        a, b = rng.normal(size=(n, d)), rng.normal(size=(m, d))
+        assert dtw_distance(a, b) == pytest.approx(plain_dtw(a, b), rel=1e-12)
+    line = np.column_stack([np.arange(5.0), np.zeros(5)])
+    assert dtw_distance(line, line) == 0.0
+
+
+def test_swept_area_against_hand_computed_polygons():
+    reference = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    assert swept_area(reference + [0.0, 1.0], reference) == pytest.approx(2.0)  # two unit squares
+    # One step: reference (0,0)->(2,0), trajectory (0,1)->(2,3): a trapezoid of heights 1 and 3.
+    assert swept_area(np.array([[0.0, 1.0], [2.0, 3.0]]), np.array([[0.0, 0.0], [2.0, 0.0]])) == pytest.approx(4.0)
+    assert swept_area(reference, reference) == 0.0
+
+
+def table(rows):
+    return [{k: v for k, v in row.items() if k not in TIMING} for row in rows]
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    return benchmark.lasa(tmp_path_factory.mktemp("serial"), synchronous=True, **SMALL)
+
+
+def test_serial_and_two_workers_give_identical_tables(serial, tmp_path):
+    parallel = benchmark.lasa(tmp_path, workers=2, **SMALL)
+    assert parallel.workers == 2
+    assert table(parallel.rows) == table(serial.rows)
+    assert len(serial.rows) == 2 * 3 * 3 * 3  # cells x methods x cases
+    import pyarrow.parquet as pq
+
+    stored = pq.read_table(tmp_path / "lasa.parquet").to_pylist()
+    assert table(stored) == table(parallel.rows)
+    assert {"demos", "every"} <= set(stored[0]) and stored[0]["every"] == 10
+
+
+def test_a_worker_killed_mid_run_still_gives_the_complete_table(serial, tmp_path):
+    marker = tmp_path / "kill-one-worker"
+    marker.write_text("the first cell to see this file kills its worker process")
+    result = benchmark.lasa(tmp_path / "out", workers=2, _kill_once=str(marker), **SMALL)
+    assert not marker.exists()  # a worker did die
+    assert table(result.rows) == table(serial.rows)
+
+
+def test_an_interrupted_run_resumes_with_only_the_missing_cells(serial, tmp_path):
+    first = benchmark.lasa(tmp_path, synchronous=True, **SMALL)
+    assert len(first.computed) == 6 and not first.resumed
+    # An interruption: two cells never finished, one was cut off mid-write.
+    (tmp_path / "cells" / "WShape__1.json").unlink()
+    (tmp_path / "cells" / "Sshape__2.json").unlink()
+    cut = tmp_path / "cells" / "WShape__2.json"
+    cut.write_text(cut.read_text()[:50])
+    again = benchmark.lasa(tmp_path, synchronous=True, resume=True, **SMALL)
+    assert sorted(again.computed) == ["Sshape__2", "WShape__1", "WShape__2"]
+    assert len(again.resumed) == 3
+    assert table(again.rows) == table(serial.rows)
+    # Another protocol is never mistaken for this one.
+    other = benchmark.lasa(tmp_path, synchronous=True, resume=True, **{**SMALL, "every": 20})
+    assert len(other.computed) == 6
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--shapes", "Sshape,Nope"], "unknown LASA shape 'Nope'"),
+    (["--methods", "dmp-paper,magic"], "unknown method 'magic'"),
+    (["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+])
+def test_bad_input_is_one_line_within_ten_seconds_and_leaves_nothing(argv, match, tmp_path, capsys):
+    start = time.perf_counter()
+    code = main(["benchmark", "lasa", "--shapes", "Sshape", "--every", "10", "--out", str(tmp_path / "o"), *argv])
+    elapsed = time.perf_counter() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and elapsed < 10.0
+    assert match in err[-1] and sum("error" in line for line in err) == 1
+    assert not list((tmp_path / "o").glob("cells/*.json"))  # nothing --resume would trust
+
+
+def test_csv_output_and_the_summary(serial, tmp_path):
+    result = benchmark.lasa(tmp_path, synchronous=True, output_format="csv", **SMALL)
+    lines = (tmp_path / "lasa.csv").read_text().splitlines()
+    assert lines[0].startswith("shape,demo,method,case,seed") and len(lines) == 1 + len(result.rows)
+    summary = (tmp_path / "lasa.md").read_text()
+    assert "median (IQR)" in summary and "| bidmp |" in summary
+    header, rows = benchmark.summary_rows(result.rows, "endpoint_error")
+    values = [r["endpoint_error"] for r in result.rows if r["method"] == "bidmp" and r["case"] == "far"]
+    assert rows[[r[0] for r in rows].index("bidmp")][3].startswith(f"{np.median(values):.3g}")
+    cell = json.loads((tmp_path / "cells" / "Sshape__0.json").read_text())
+    assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == benchmark._cell_seed("Sshape", 0)
