@@ -12,7 +12,6 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import numpy as np
 from scipy.spatial.transform import Rotation
 
 TILT = 30.0  # degrees about x

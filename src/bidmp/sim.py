@@ -1014,7 +1014,7 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
     by_method = {}
     for method, label, frames in report.pictures:
         by_method.setdefault(method, (label, frames))
-    for method, (label, frames) in by_method.items():
+    for method, (_, frames) in by_method.items():
         written.append(_write_strip(out / f"sim_keyframes_{method}.png", frames[:: max(1, len(frames) // 6)][:6]))
     if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
         written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1]))
