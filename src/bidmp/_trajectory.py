@@ -10,7 +10,8 @@ import numpy as np
 
 from ._checks import numerically_guarded
 
-__all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent"]
+__all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent",
+           "continuous_quaternions"]
 
 
 def arclength(y: np.ndarray) -> np.ndarray:
@@ -72,3 +73,14 @@ def path_extent(y) -> float:
     if y.ndim != 2 or y.shape[0] == 0 or not np.all(np.isfinite(y)):
         raise ValueError(f"path_extent needs a finite, non-empty (T, D) trajectory, got shape {y.shape}")
     return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=np.float64), axis=0)))
+
+
+def continuous_quaternions(q: np.ndarray) -> np.ndarray:
+    """Flip signs so that neighbouring quaternions (n, 4) lie in the same hemisphere (``q`` and
+    ``-q`` are the same rotation; a recording that jumps between them would make ``Log`` jump,
+    and interpolating across a flip would pass through zero)."""
+    q = np.array(q, dtype=float)
+    if q.shape[0] > 1:
+        flips = np.cumsum(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0) % 2
+        q[1:][flips == 1] *= -1.0
+    return q

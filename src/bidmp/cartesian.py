@@ -31,6 +31,7 @@ from scipy.spatial.transform import Rotation
 from sklearn.base import BaseEstimator
 
 from ._checks import as_point, as_trajectory, check_fitted, numerically_guarded
+from ._trajectory import continuous_quaternions
 from .dmp import DMP
 
 __all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "prepare_poses", "PoseStepper", "PoseTrajectory", "as_quaternions", "as_poses", "continuous_quaternions",
@@ -39,16 +40,6 @@ __all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "prepare_poses",
 logger = logging.getLogger(__name__)
 
 _NORM_TOLERANCE = 1e-6  # a quaternion further than this from unit length is normalised, with a warning
-
-
-def continuous_quaternions(q: np.ndarray) -> np.ndarray:
-    """Flip signs so that neighbouring quaternions lie in the same hemisphere (``q`` and ``-q``
-    are the same rotation; a recording that jumps between them would make ``Log`` jump)."""
-    q = np.array(q, dtype=float)
-    if q.shape[0] > 1:
-        flips = np.cumsum(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0) % 2
-        q[1:][flips == 1] *= -1.0
-    return q
 
 
 def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
@@ -240,9 +231,9 @@ class CartesianDMP(BaseEstimator):
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         position = self.position_.trajectory(goal_p, start_p, duration, dt, limits=limits,
                                              forcing_increment=position_increment)
-        motion = position.t[-1] / (1.1 if self.position_._params().protocol == "robot" else 1.0) if limits else duration
-        error = self.orientation_.trajectory(np.zeros(3), start_e, motion if limits else duration, dt,
-                                             forcing_increment=orientation_increment)
+        if limits:  # the orientation follows the motion time the position's limits chose
+            duration = position.t[-1] / self.position_._params().settle
+        error = self.orientation_.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment)
         n = min(len(position.t), len(error.t))
         orientation = _orientation_from_error(error.y[:n], goal_q)
         omega = np.einsum("nij,nj->ni", left_jacobian(error.y[:n]), error.yd[:n])
@@ -267,24 +258,16 @@ class CartesianDMP(BaseEstimator):
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
         check_fitted(self, "position_")
-        meta, arrays = {"params": self.get_params()}, {"start_pose_": self.start_pose_, "goal_pose_": self.goal_pose_}
-        for part in ("position", "orientation"):
-            part_meta, part_arrays = getattr(self, f"{part}_")._get_state()
-            meta[part] = part_meta
-            arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
-        return meta, arrays
+        return _parts_state(self, {"params": self.get_params()},
+                            {"start_pose_": self.start_pose_, "goal_pose_": self.goal_pose_})
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "CartesianDMP":
         from ._checks import check_loaded
-        from .incremental import _Prefixed
 
-        for key in ("params", "position", "orientation"):
-            if not isinstance(meta.get(key), dict):
-                raise ValueError(f"the CartesianDMP state has no {key} object")
+        position, orientation = _parts_from_state(DMP, "CartesianDMP", meta, arrays)
         model = cls(**meta["params"])
-        model.position_ = DMP._from_state(meta["position"], _Prefixed(arrays, "position/"))
-        model.orientation_ = DMP._from_state(meta["orientation"], _Prefixed(arrays, "orientation/"))
+        model.position_, model.orientation_ = position, orientation
         for part in (model.position_, model.orientation_):
             if part.n_dims_ != 3:
                 raise ValueError(f"a CartesianDMP's parts are 3-D; the file has D = {part.n_dims_}")
@@ -356,26 +339,17 @@ class CartesianBiDMP:
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        meta = {"params": self.cartesian_.get_params()}
-        arrays = {"start_pose_": self.cartesian_.start_pose_, "goal_pose_": self.cartesian_.goal_pose_,
-                  "skill_goal_orientations_": np.array(self.skill_goal_orientations_),
-                  "skill_start_orientations_": np.array(self.skill_start_orientations_)}
-        for part in ("position", "orientation"):
-            part_meta, part_arrays = getattr(self, f"{part}_")._get_state()
-            meta[part] = part_meta
-            arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
-        return meta, arrays
+        return _parts_state(self, {"params": self.cartesian_.get_params()},
+                            {"start_pose_": self.cartesian_.start_pose_, "goal_pose_": self.cartesian_.goal_pose_,
+                             "skill_goal_orientations_": np.array(self.skill_goal_orientations_),
+                             "skill_start_orientations_": np.array(self.skill_start_orientations_)})
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "CartesianBiDMP":
         from ._checks import check_loaded
-        from .incremental import BiDMP, _Prefixed
+        from .incremental import BiDMP
 
-        for key in ("params", "position", "orientation"):
-            if not isinstance(meta.get(key), dict):
-                raise ValueError(f"the CartesianBiDMP state has no {key} object")
-        position = BiDMP._from_state(meta["position"], _Prefixed(arrays, "position/"))
-        orientation = BiDMP._from_state(meta["orientation"], _Prefixed(arrays, "orientation/"))
+        position, orientation = _parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
         if position.n_skills != orientation.n_skills or position.dmp_.n_dims_ != 3 or orientation.dmp_.n_dims_ != 3:
             raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
         cartesian = CartesianDMP(**meta["params"])
@@ -399,6 +373,26 @@ class CartesianBiDMP:
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
                            self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)
+
+
+def _parts_state(model, meta: dict, arrays: dict) -> tuple[dict, dict]:
+    """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
+    ``orientation_`` parts, the parts' members prefixed with their names."""
+    for part in ("position", "orientation"):
+        part_meta, part_arrays = getattr(model, f"{part}_")._get_state()
+        meta[part] = part_meta
+        arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
+    return meta, arrays
+
+
+def _parts_from_state(part_class, name: str, meta: dict, arrays) -> tuple:
+    """The (position, orientation) parts of a stored pose model, each read lazily from its prefix."""
+    from .incremental import _Prefixed
+
+    for key in ("params", "position", "orientation"):
+        if not isinstance(meta.get(key), dict):
+            raise ValueError(f"the {name} state has no {key} object")
+    return tuple(part_class._from_state(meta[part], _Prefixed(arrays, f"{part}/")) for part in ("position", "orientation"))
 
 
 def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "nearest", **bidmp_params) -> np.ndarray:

@@ -579,6 +579,12 @@ def _demo_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cutoff", type=float, default=6.0, metavar="HZ", help="low-pass cutoff for timed input in Hz (default 6)")
 
 
+def _allow_outside_files(parser, shown: bool = True) -> None:
+    """The --allow-outside-files flag of every command that reads a scenario file."""
+    parser.add_argument("--allow-outside-files", action="store_true",
+                        help="let the scenario read demonstration files outside its own folder" if shown else argparse.SUPPRESS)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="bidmp",
@@ -654,7 +660,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help="keep: keep the demonstrated final approach, translated, and grow only the transfer (default); "
                              "paper: imitate the nearest piece down to the target (the paper's protocol)")
     extend.add_argument("--scene", metavar="FILE|NAME", help="grow the extension around the parts of this scenario's scene")
-    extend.add_argument("--allow-outside-files", action="store_true", help=argparse.SUPPRESS)
+    _allow_outside_files(extend, shown=False)
     extend.add_argument("--plot", metavar="PNG", help="also write a figure")
     extend.set_defaults(handler=_cmd_extend)
 
@@ -700,8 +706,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--sim", action="store_true",
                       help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
     demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
-    demo.add_argument("--allow-outside-files", action="store_true",
-                      help="let the scenario read demonstration files outside its own folder")
+    _allow_outside_files(demo)
     demo.set_defaults(handler=_cmd_demo)
 
     sim = commands.add_parser("sim", help="execute a scenario on a simulated Franka Panda (PyBullet)",
@@ -720,8 +725,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
     sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
     sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
-    sim.add_argument("--allow-outside-files", action="store_true",
-                     help="let the scenario read demonstration files outside its own folder")
+    _allow_outside_files(sim)
     sim.set_defaults(handler=_cmd_sim)
 
     benchmark = commands.add_parser("benchmark", help="the full LASA benchmark with the standard metrics, on Dask",
@@ -751,8 +755,7 @@ def build_parser() -> argparse.ArgumentParser:
     show.add_argument("name", metavar="NAME")
     check = scenario_commands.add_parser("check", help="validate a scenario file")
     check.add_argument("file", metavar="FILE")
-    check.add_argument("--allow-outside-files", action="store_true",
-                       help="let the scenario read demonstration files outside its own folder")
+    _allow_outside_files(check)
     scenario.set_defaults(handler=_cmd_scenario)
     return parser
 

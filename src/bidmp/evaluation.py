@@ -263,10 +263,17 @@ class _Timer:
 
 
 def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
+    """An extension target: a label, a point (or pose), or the centre of the failed targets (for
+    poses: their mean position and mean orientation)."""
     if isinstance(target, str) and target == "centre_of_failed":
         if not failed:
             return None
-        return np.mean([scenario.targets[label] for label in failed], axis=0)
+        points = np.array([scenario.targets[label] for label in failed])
+        if scenario.is_pose:
+            from scipy.spatial.transform import Rotation
+
+            return np.concatenate([points[:, :3].mean(axis=0), Rotation.from_quat(points[:, 3:]).mean().as_quat()])
+        return points.mean(axis=0)
     if isinstance(target, str):
         return scenario.targets[target]
     return np.asarray(target, dtype=float)
@@ -339,10 +346,7 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     n_steps = demo.shape[0]
     references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
     scene = scenario.scene if geometry else None
-    # The target's own part enters the tool: its label, or (a target not on a labelled part)
-    # whatever the tool would take into its mouth there.
-    excluded = {} if scene is None else {
-        label: [label] if label in scene.labels else scene.parts_at(scenario.targets[label]) for label in labels}
+    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
 
     def result(name, trajectories, seconds):
         trajectories = dict(zip(labels, trajectories))
@@ -404,21 +408,6 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     return report
 
 
-def _pose_target(target, scenario, failed: list[str]) -> np.ndarray | None:
-    """A pose extension target: a label, a pose, or the centre of the failed targets (their mean
-    position and mean orientation)."""
-    from scipy.spatial.transform import Rotation
-
-    if isinstance(target, str) and target == "centre_of_failed":
-        if not failed:
-            return None
-        poses = np.array([scenario.targets[label] for label in failed])
-        return np.concatenate([poses[:, :3].mean(axis=0), Rotation.from_quat(poses[:, 3:]).mean().as_quat()])
-    if isinstance(target, str):
-        return scenario.targets[target]
-    return np.asarray(target, dtype=float)
-
-
 def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
     """:func:`evaluate` for a pose scenario: CartesianDMP and its Bi-DMP, with the extension on
     poses; metrics on positions, the engagement along each target's axis, and the tool's axis
@@ -437,9 +426,7 @@ def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
     n_steps = demo.shape[0]
     scene = scenario.scene if geometry else None
     references = {label: resample_time(scenario.reference(label)[:, :3], n_steps) for label in labels}
-    excluded = {} if scenario.scene is None else {
-        label: [label] if label in scenario.scene.labels else scenario.scene.parts_at(scenario.targets[label])
-        for label in labels}
+    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
 
     def result(name, rollouts, seconds):
         positions = {label: rollout[:, :3] for label, rollout in zip(labels, rollouts)}
@@ -480,7 +467,7 @@ def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
                 previous = None
                 options = {k: v for k, v in scenario.extension.items() if k != "approach"}
                 for stage in scenario.extensions:
-                    target = _pose_target(stage["target"], scenario, failed)
+                    target = _resolve_target(stage["target"], scenario, failed)
                     if target is None:
                         continue
                     source = demo if stage["from"] == "demonstration" or previous is None else previous

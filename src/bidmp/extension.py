@@ -319,13 +319,20 @@ def extend_demonstration(
     complete[-1] = target
     logger.debug("extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
                  piece.index, piece.start, piece.end, len(history))
+    return _extension(complete, y, target, points, piece, tra_gen, history, result)
+
+
+def _extension(complete, y, target, points, piece, tra_gen, history, result, **approach) -> ExtendedDemonstration:
+    """The :class:`ExtendedDemonstration` both ways build (``result``: G-PRM's, or None when it
+    was skipped)."""
     return ExtendedDemonstration(
-        complete=complete, tra_imi=tra_imi.copy(), tra_gen=tra_gen, seg_index=piece.start,
+        complete=complete, tra_imi=y[piece.start : piece.end + 1].copy(), tra_gen=tra_gen, seg_index=piece.start,
         similarity_history=np.asarray(history), demonstration=y, new_target=target,
         segmentation_points=points, piece=piece,
         similarity=float("nan") if result is None else result.similarity,
         template=None if result is None else result.template,
         samples=None if result is None else result.samples,
+        **approach,
     )
 
 
@@ -336,8 +343,11 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
     start = final_approach(y, points)
-    rotation = np.eye(y.shape[1]) if approach_rotation is None else np.asarray(approach_rotation, dtype=float)
-    hover = target + (y[start] - y[-1]) @ rotation.T
+    # The approach relative to the demonstrated target, moved (and turned) onto the new one.
+    offsets = y[start:] - y[-1]
+    if approach_rotation is not None:
+        offsets = offsets @ np.asarray(approach_rotation, dtype=float).T
+    hover, approach_tail = target + offsets[0], target + offsets[1:]
     if start == 0:
         # The whole demonstration is one straight approach: translate all of it but its start.
         piece = Piece(index=0, start=0, end=0, breakpoints=np.array([0, n_steps - 1]))
@@ -346,8 +356,6 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
         piece = choose_piece(y[: start + 1], head_points, hover)
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
-    approach_tail = target + (y[start + 1 :] - y[-1]) @ rotation.T if approach_rotation is not None else \
-        y[start + 1 :] + (target - y[-1])
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
         tra_gen, history, result = np.vstack([seg, hover]), np.empty(0), None
     else:
@@ -369,15 +377,17 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
     logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
                  "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
-    return ExtendedDemonstration(
-        complete=complete, tra_imi=tra_imi.copy(), tra_gen=tra_gen, seg_index=piece.start,
-        similarity_history=np.asarray(history), demonstration=y, new_target=target,
-        segmentation_points=points, piece=piece,
-        similarity=float("nan") if result is None else result.similarity,
-        template=None if result is None else result.template,
-        samples=None if result is None else result.samples,
-        approach="keep", approach_index=start,
-    )
+    return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start)
+
+
+def _roadmap_defaults() -> dict:
+    """The G-PRM options of :func:`extend_demonstration` with their defaults (its signature is
+    where they are written)."""
+    import inspect
+
+    skip = {"y", "new_target", "seed", "eps_frac", "method", "approach", "scene"}
+    parameters = inspect.signature(extend_demonstration).parameters
+    return {name: p.default for name, p in parameters.items() if name not in skip}
 
 
 @numerically_guarded
@@ -410,9 +420,7 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
     if scene is not None:
         exclude = scene.parts_at(target[:3])
         roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
-    options = {"n_samples": 300, "sigma_rel": 0.03, "n_neighbours": 8, "n_compare": 100, "n_iter": 10, "rho": 0.9,
-               "schedule": "geometric", "scaling": "axis", "compare": "template", "select": "best", "denom": "sqrt2",
-               "is_free": None, **roadmap_options}
+    options = {**_roadmap_defaults(), **roadmap_options}
     points = segment(positions, eps_frac=eps_frac, method=method).points
     extension = _extend_keeping_approach(positions, target[:3], points, seed, options, None, exclude,
                                          approach_rotation=turn.as_matrix())

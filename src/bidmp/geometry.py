@@ -33,7 +33,9 @@ unit, angles in degrees::
 ``at`` is the centre of a part's bottom face (a plate's top face). ``at_targets`` places one part
 on each named target (at the target plus ``offset``) labelled like the target. A nut's stud is a
 cylinder from the nut's base to ``above`` over its top, labelled ``"<nut>/stud"``; ``yaw`` 0 puts
-a corner of the hexagon on +x.
+a corner of the hexagon on +x. ``"rotation": [rx, ry, rz]`` (degrees, extrinsic x-y-z) turns a
+part fully instead of ``yaw`` (a tilted pack); "bottom", "top" and ``offset`` are then in the
+part's own frame.
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ from numbers import Real
 import numpy as np
 
 from ._checks import as_trajectory, check_real, get_limits, numerically_guarded, require_extra, short_token
+from ._trajectory import continuous_quaternions
 
 __all__ = ["Tool", "Part", "Solid", "Scene", "Clearance", "SceneChecker", "PART_TYPES"]
 
@@ -367,15 +370,16 @@ class _Distances:
         return self._checked(float(self.coal.distance(a, pose_a, b, pose_b, self.request, self.result)))
 
 
-def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None) -> np.ndarray:
+def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False):
     """Points along the polyline through ``points`` no more than ``step`` apart: of every segment
-    (``segments`` None), or of the segments whose indices are given (each with both its ends)."""
-    if points.shape[0] == 1:
-        return points.copy()
+    (``segments`` None), or of the segments whose indices are given (each with both its ends).
+    ``weights``: also return each point's segment index and fraction along it (to interpolate
+    anything else given at ``points`` the same way)."""
+    if points.shape[0] == 1 or (segments is not None and segments.size == 0):
+        dense = points.copy() if points.shape[0] == 1 else points[:0]
+        return (dense, np.zeros(len(dense), dtype=np.int64), np.zeros(len(dense))) if weights else dense
     if segments is None:
         segments = np.arange(points.shape[0] - 1)
-    if segments.size == 0:
-        return points[:0]
     starts, ends = points[segments], points[segments + 1]
     pieces = np.maximum(np.ceil(np.linalg.norm(ends - starts, axis=1) / step).astype(np.int64), 1) + 1
     total = int(pieces.sum())
@@ -384,7 +388,8 @@ def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None
     which = np.repeat(np.arange(segments.size), pieces)
     first = np.concatenate([[0], np.cumsum(pieces)[:-1]])
     fraction = (np.arange(total) - np.repeat(first, pieces)) / np.repeat(pieces - 1, pieces)
-    return starts[which] + fraction[:, None] * (ends[which] - starts[which])
+    dense = starts[which] + fraction[:, None] * (ends[which] - starts[which])
+    return (dense, segments[which], fraction) if weights else dense
 
 
 def _box_distance(lower_a: np.ndarray, upper_a: np.ndarray, lower_b: np.ndarray, upper_b: np.ndarray) -> np.ndarray:
@@ -479,6 +484,11 @@ class Scene:
         mask = self._owner == part
         return self._lower[mask].min(axis=0), self._upper[mask].max(axis=0)
 
+    def target_parts(self, label: str, point) -> list[str]:
+        """The parts that enter the tool at target ``label`` (excepted from its clearance): the
+        part labelled like it, else whatever the tool takes into its mouth at ``point``."""
+        return [label] if label in self.labels else self.parts_at(point)
+
     def parts_at(self, point) -> list[str]:
         """Labels of the parts the tool would take into its mouth at ``point``: those whose
         bounding box is within the tool radius of the point."""
@@ -530,6 +540,29 @@ class Scene:
             raise ValueError(f"exclude names {sorted(unknown)[0]!r}, which is not a part of the scene")
         return np.flatnonzero([owner not in exclude for owner in self._owner])
 
+    def _minimum(self, samples: np.ndarray, chosen: np.ndarray, bounds_of, exact, best: float = math.inf,
+                 part: str | None = None, point=None) -> Clearance:
+        """Branch and bound over (sample, part) pairs: ``bounds_of(rows)`` bounds the distances of
+        ``samples[rows]`` to the chosen parts from below, (m, k); ``exact(row, solid)`` is coal's
+        distance. Pairs are evaluated in ascending bound until no bound can beat the best."""
+        for start in range(0, samples.shape[0], _CHUNK):
+            block = np.arange(start, min(start + _CHUNK, samples.shape[0]))
+            bounds = bounds_of(block)
+            if best == math.inf:  # seed the bound with the most promising pair
+                row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])
+                best, part, point = exact(block[row], int(chosen[col])), self.solids[chosen[col]].label, samples[block[row]]
+            # The bounds are >= 0, so a pair whose bound is 0 may penetrate to any depth: while the
+            # best is a collision, every overlapping pair is evaluated to find the deepest one.
+            rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
+            for at in np.argsort(bounds[rows, cols], kind="stable"):
+                row, col = rows[at], cols[at]
+                if bounds[row, col] > 0.0 and bounds[row, col] >= best:
+                    break  # every remaining pair is bounded below by at least the best so far
+                distance = exact(block[row], int(chosen[col]))
+                if distance < best:
+                    best, part, point = distance, self.solids[chosen[col]].label, samples[block[row]]
+        return Clearance(float(best), part, None if point is None else np.array(point))
+
     def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
         """:meth:`clearance` for a tool whose orientation changes along the motion."""
         from scipy.spatial.transform import Rotation
@@ -537,46 +570,24 @@ class Scene:
         q = np.asarray(quaternions, dtype=float)
         if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
             raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
-        q = q / np.linalg.norm(q, axis=1, keepdims=True)
-        if q.shape[0] > 1:  # q and -q are one rotation: keep neighbours in one hemisphere to interpolate
-            flips = np.cumsum(np.einsum("ij,ij->i", q[1:], q[:-1]) < 0.0) % 2
-            q[1:][flips == 1] *= -1.0
-        dense, dense_q = _densify(points, step), None
-        if points.shape[0] > 1:
-            lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
-            pieces = np.maximum(np.ceil(lengths / step).astype(np.int64), 1) + 1
-            which = np.repeat(np.arange(len(lengths)), pieces)
-            first = np.concatenate([[0], np.cumsum(pieces)[:-1]])
-            fraction = (np.arange(int(pieces.sum())) - np.repeat(first, pieces)) / np.repeat(pieces - 1, pieces)
-            dense_q = q[which] + fraction[:, None] * (q[which + 1] - q[which])  # nlerp: ≤ 0.2 mm apart
+        q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
+        dense, segment, fraction = _densify(points, step, weights=True)
+        if points.shape[0] > 1:  # nlerp between samples at most ``step`` apart
+            dense_q = q[segment] + fraction[:, None] * (q[segment + 1] - q[segment])
             dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)
         else:
             dense_q = q
         rotations = Rotation.from_quat(dense_q).as_matrix()
         axes = rotations[:, :, 2]
-        radius, length = self.tool.radius, self.tool.length
-        centres = dense - axes * length / 2.0
-        extent = _cylinder_extent(axes, radius, length / 2.0)
+        centres = dense - axes * self.tool.length / 2.0
+        extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)
         lower, upper = self._lower[chosen], self._upper[chosen]
         engine = self._engine()
-        best, best_part, best_point = math.inf, None, None
-        for start in range(0, dense.shape[0], _CHUNK):
-            block = slice(start, start + _CHUNK)
-            bounds = _box_distance((centres[block] - extent[block])[:, None], (centres[block] + extent[block])[:, None],
-                                   lower[None], upper[None])
-            if best == math.inf:
-                row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])
-                best = engine.tool_to(dense[block][row], int(chosen[col]), rotations[block][row])
-                best_part, best_point = self.solids[chosen[col]].label, dense[block][row]
-            rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
-            for at in np.argsort(bounds[rows, cols], kind="stable"):
-                row, col = rows[at], cols[at]
-                if bounds[row, col] > 0.0 and bounds[row, col] >= best:
-                    break
-                distance = engine.tool_to(dense[block][row], int(chosen[col]), rotations[block][row])
-                if distance < best:
-                    best, best_part, best_point = distance, self.solids[chosen[col]].label, dense[block][row]
-        return Clearance(float(best), best_part, None if best_point is None else np.array(best_point))
+        return self._minimum(
+            dense, chosen,
+            lambda rows: _box_distance((centres[rows] - extent[rows])[:, None], (centres[rows] + extent[rows])[:, None],
+                                       lower[None], upper[None]),
+            lambda row, solid: engine.tool_to(dense[row], solid, rotations[row]))
 
     @numerically_guarded
     def clearance(self, trajectory, exclude=(), step: float = _DEFAULT_STEP, orientations=None) -> Clearance:
@@ -629,20 +640,8 @@ class Scene:
             dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))
         else:
             dense = points
-        for start in range(0, dense.shape[0], _CHUNK):
-            block = dense[start : start + _CHUNK]
-            bounds = _cylinder_box_bounds(block, radius, length, lower, upper)
-            # The bounds are >= 0, so a pair whose bound is 0 may penetrate to any depth: while the
-            # best is a collision, every overlapping pair is evaluated to find the deepest one.
-            rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
-            for at in np.argsort(bounds[rows, cols], kind="stable"):
-                row, col = rows[at], cols[at]
-                if bounds[row, col] > 0.0 and bounds[row, col] >= best:
-                    break  # every remaining pair is bounded below by at least the best so far
-                distance = engine.tool_to(block[row], int(chosen[col]))
-                if distance < best:
-                    best, best_part, best_point = distance, self.solids[chosen[col]].label, block[row]
-        return Clearance(float(best), best_part, None if best_point is None else np.array(best_point))
+        return self._minimum(dense, chosen, lambda rows: _cylinder_box_bounds(dense[rows], radius, length, lower, upper),
+                             lambda row, solid: engine.tool_to(dense[row], solid), best, best_part, best_point)
 
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""

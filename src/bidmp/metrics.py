@@ -39,12 +39,7 @@ def approach_error(trajectory, target, height: float, axis=None) -> float:
         raise ValueError(f"approach_error needs a 3-D trajectory (z is the height), got D = {trajectory.shape[1]}")
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
-    if axis is None:
-        low = trajectory[:, 2] - target[2] < height
-        if not np.any(low):
-            return 0.0
-        return float(np.max(np.linalg.norm(trajectory[low, :2] - target[:2], axis=1)))
-    axis = _unit_axis(axis)
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
     offsets = trajectory - target
     along = offsets @ axis
     low = along < height

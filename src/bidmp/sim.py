@@ -513,36 +513,34 @@ class PandaCell:
         # must not follow that jump faster than their limits allow.
         speed, max_speed = np.zeros(7), LIMIT_MARGIN * np.asarray(PANDA.velocity)
         max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
+
+        def limited(wanted, command, speed):
+            """The next command towards ``wanted`` and its joint speed, within the limits."""
+            speed = np.clip(np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change),
+                            -max_speed, max_speed)
+            return command + speed * CONTROL_STEP, speed
+
         step = 0
         try:
             for step in range(n_steps):
                 t = step * SIM_STEP
                 if step % every == 0:
                     previous = command
-                    if settle_from is None:
+                    if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
+                        break
+                    if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
                         measured = self.tcp_position() / self.unit
                         y, _, _ = stepper.step(CONTROL_STEP, measured)
                         wanted, _ = self.solve_ik(np.asarray(y) * self.unit, command)
-                        speed = np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change)
-                        speed = np.clip(speed, -max_speed, max_speed)
-                        command = command + speed * CONTROL_STEP
-                        times.append(t)
-                        commands.append(command)
-                        clock.append(stepper.time)
-                        if stepper.time >= duration:
-                            settle_from = step
-                    elif step - settle_from >= SETTLE / SIM_STEP:
-                        break
-                    else:  # settling: the limiter brings the joints to rest at the last command
-                        speed = np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change)
-                        speed = np.clip(speed, -max_speed, max_speed)
-                        command = command + speed * CONTROL_STEP
-                        times.append(t)
-                        commands.append(command)
-                        clock.append(stepper.time)
+                    command, speed = limited(wanted, command, speed)
+                    times.append(t)
+                    commands.append(command)
+                    clock.append(stepper.time)
+                    if settle_from is None and stepper.time >= duration:
+                        settle_from = step
                 share = (step % every + 1) / every
-                wanted = previous + share * (command - previous)
-                q = wanted.tolist()
+                between = previous + share * (command - previous)  # linear over the 10 ms
+                q = between.tolist()
                 qd = ((command - previous) / CONTROL_STEP).tolist()
                 if hold is not None and hold.start <= t < hold.start + hold.duration:
                     if held is None:
@@ -550,7 +548,7 @@ class PandaCell:
                     q[hold.joint], qd[hold.joint] = held, 0.0
                 self._drive(q, qd)
                 p.stepSimulation(physicsClientId=self.client)
-                record.sample(step, t + SIM_STEP, wanted, contacts=True, every_step=True)
+                record.sample(step, t + SIM_STEP, between, contacts=True, every_step=True)
         finally:
             self._ignore(exclude, True)
         run = record.finish()
@@ -934,7 +932,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     scene = scenario.scene
     frames = frames or {}
     jobs = [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
-                 [label] if label in scene.labels else scene.parts_at(scenario.targets[label]),
+                 scene.target_parts(label, scenario.targets[label]),
                  int(frames.get((method, label), 0)),
                  None if report.methods[method].orientations is None else report.methods[method].orientations[label])
             for method in methods for label in labels]
