@@ -59,7 +59,10 @@ def test_left_jacobian_against_finite_differences():
 def test_a_recorded_pose_demonstration_is_reproduced_within_half_a_degree(tmp_path):
     positions, t = kinesthetic_recording([[0, 0, 120], [60, -40, 60], [120, 10, 0]], seed=3)
     rng = np.random.default_rng(3)
-    s = (t - t[0]) / (t[-1] - t[0])
+    # The wrist turns while the arm moves (a minimum-jerk turn over the span prepare() finds the
+    # hand moving in), and rests with it.
+    _, moving = bidmp.prepare(positions, t)
+    s = np.clip((t - t[0] - moving.start_s) / (moving.end_s - moving.start_s), 0.0, 1.0)
     s = 10 * s**3 - 15 * s**4 + 6 * s**5
     rotations = Rotation.from_rotvec(np.outer(s, [0.5, 0.2, -0.9])) * DOWN
     noisy = rotations * Rotation.from_rotvec(rng.normal(0.0, np.radians(0.05), size=(len(t), 3)))

@@ -315,28 +315,74 @@ def test_unfitted_model_says_so():
 
 
 # --- hyperparameters after fit, temporal scaling, estimator conventions ------------------------
-@pytest.mark.parametrize(
-    "name, value",
-    [("tau", 1.6), ("alpha", 31.0), ("beta", 5.0), ("K", "pastor"), ("K", 40.0), ("alpha_phase", 2.5)],
-)
 @pytest.mark.parametrize("how", ["attribute", "set_params"])
-def test_parameter_change_after_fit_equals_a_fresh_model_with_that_parameter(name, value, how, demo3d):
+def test_tau_may_change_after_fit_and_equals_a_fresh_model_with_it(how, demo3d):
+    """tau is an execution parameter: the weights are learned at tau = 1 whatever it is."""
     from sklearn.base import clone
 
     dmp = DMP(protocol="paper").fit(demo3d)
     goal = demo3d[-1] + 0.3
     before = dmp.rollout(goal)  # fills the cache with the old parameters
     if how == "attribute":
+        dmp.tau = 1.6
+    else:
+        dmp.set_params(tau=1.6)
+    fresh = clone(dmp).fit(demo3d)  # fitted from scratch with the new tau
+    after = dmp.rollout(goal)
+    np.testing.assert_array_equal(after, fresh.rollout(goal))
+    np.testing.assert_allclose(after, euler_reference(dmp, goal, demo3d[0], after.shape[0]), atol=1e-9)
+    assert after.shape != before.shape
+
+
+@pytest.mark.parametrize(
+    "name, value",
+    [("alpha", 31.0), ("beta", 5.0), ("K", "pastor"), ("K", 40.0), ("alpha_phase", 2.5), ("n_kernels", 20),
+     ("regression", "ridge"), ("goal_rate", 3.0), ("integrator", "exact"), ("protocol", "robot")],
+)
+@pytest.mark.parametrize("how", ["attribute", "set_params"])
+def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how, demo3d):
+    """Issue 19.4: on today's main, set_params(alpha=...) kept the weights learned for the old
+    gains (LASA Sshape: 0.50 % -> 44.6 % RMSE). Now the model says it must be fitted again."""
+    from sklearn.utils.validation import check_is_fitted
+
+    dmp = DMP(protocol="paper").fit(demo3d)
+    if how == "attribute":
         setattr(dmp, name, value)
     else:
         dmp.set_params(**{name: value})
-    fresh = clone(dmp)  # the new parameter, no learned state ...
+    for use in (dmp.rollout, dmp.trajectory, dmp.endpoint_gain, lambda: dmp.rollout_many(demo3d[-1:])):
+        with pytest.raises(NotFittedError, match=f"{name} \\(fitted with .*fitted again"):
+            use()
+    with pytest.raises(ValueError, match="not fitted"):  # scikit-learn's own check agrees
+        check_is_fitted(dmp)
+    refitted = dmp.fit(demo3d)  # fitting again with the new value is the remedy
+    np.testing.assert_array_equal(refitted.rollout(), DMP(**dmp.get_params()).fit(demo3d).rollout())
+
+
+def test_changing_alpha_after_fit_on_lasa_would_have_ruined_the_reproduction():
+    """The measurement behind issue 19.4: the old weights under new gains reproduce Sshape badly,
+    a refit reproduces it well; so reusing them silently was wrong."""
+    demo = lasa("Sshape")[0]
+    dmp = DMP(protocol="paper").fit(demo)
+    extent = np.linalg.norm(np.ptp(demo, axis=0))
+    good = np.sqrt(np.mean(np.sum((dmp.rollout() - demo) ** 2, axis=1))) / extent
+    stale = clone_with_weights(dmp, alpha=100.0).rollout()
+    bad = np.sqrt(np.mean(np.sum((stale - demo) ** 2, axis=1))) / extent
+    assert good < 0.01 and bad > 0.2
+    dmp.set_params(alpha=100.0)
+    with pytest.raises(NotFittedError):
+        dmp.rollout()
+    refit = np.sqrt(np.mean(np.sum((dmp.fit(demo).rollout() - demo) ** 2, axis=1))) / extent
+    assert refit < 0.01
+
+
+def clone_with_weights(dmp, **params):
+    """A model with new parameters and the old learned state: what main silently did."""
+    from sklearn.base import clone
+
+    fresh = clone(dmp).set_params(**params)
     fresh.__dict__.update({k: v for k, v in dmp.__dict__.items() if k.endswith("_") and not k.startswith("_")})
-    after = dmp.rollout(goal)
-    np.testing.assert_array_equal(after, fresh.rollout(goal))  # ... given the same weights
-    np.testing.assert_allclose(after, euler_reference(dmp, goal, demo3d[0], after.shape[0]), atol=1e-9)
-    assert dmp.endpoint_gain() == fresh.endpoint_gain()
-    assert after.shape != before.shape or not np.allclose(after, before)
+    return fresh
 
 
 def test_tau_is_temporal_scaling_same_path_slower(demo3d):

@@ -3,6 +3,8 @@
 import json
 import zipfile
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from conftest import curved_demo
@@ -208,7 +210,21 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
     rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))
     with pytest.raises(ModelFileError, match="did not vanish with the phase"):
         bidmp.load(path)
-    assert FORMAT_VERSION == 3
+    assert FORMAT_VERSION == 4
+
+
+def test_a_format_3_robot_model_rolls_out_as_it_did():
+    """tests/data/format3_robot_dmp.npz and its rollouts (to its goal and to a goal 150 mm away)
+    were written by bidmp 0.3 (the main before issue 19). Format 3 knew only explicit Euler, so
+    the file loads with integrator="euler" and its rollouts are unchanged."""
+    data = Path(__file__).parent / "data"
+    model = bidmp.load(data / "format3_robot_dmp.npz")
+    assert model.protocol == "robot" and model.integrator == "euler"
+    expected = np.load(data / "format3_robot_rollout.npy")
+    np.testing.assert_allclose(model.rollout(), expected[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(model.rollout(model.goal_ + [150, 25, 0]), expected[1], rtol=0, atol=1e-9)
+    fresh = bidmp.DMP().fit(model.rollout())  # a model fitted today has the exact integrator
+    assert fresh.integrator is None and fresh._params().integrator == "exact"
 
 
 def test_format_2_dmp_files_load_as_the_paper_protocol(tmp_path, fitted):

@@ -422,8 +422,11 @@ def test_loading_never_materialises_a_member_it_does_not_need(tmp_path, model_fi
 # --- 6. unstable settings are refused, naming the bound --------------------------------------
 def test_unstable_euler_settings_are_refused(tmp_path):
     demo = save_trajectory(curved_demo(1000, 3), tmp_path / "demo.csv")
-    assert_one_line_error(["fit", demo, "-o", tmp_path / "m.npz", "--alpha", 5000], "dt/tau <")
+    assert_one_line_error(["fit", demo, "-o", tmp_path / "m.npz", "--alpha", 5000, "--protocol", "paper"], "dt/tau <")
     assert not (tmp_path / "m.npz").exists()
+    # The robot protocol integrates exactly: stable at any step, so the same gains run.
+    stiff = bidmp.DMP(alpha=5000.0).fit(curved_demo(1000, 3))
+    assert np.all(np.isfinite(stiff.rollout())) and np.all(np.isfinite(stiff.trajectory(dt=0.1).y))
     with pytest.raises(ValueError, match="unstable|alpha_phase"):
         bidmp.DMP(protocol="paper", tau=0.001, alpha_phase=0.001, K="pastor").fit(curved_demo(1000, 3))
     dmp = bidmp.DMP(protocol="paper").fit(curved_demo(1000, 3))

@@ -41,16 +41,23 @@ def fitted(request):
 
 
 # --- 1. time ---------------------------------------------------------------------------------------
-def test_duration_is_kept_and_velocities_are_the_positions_differences(fitted):
+def test_duration_is_kept_and_velocities_are_the_motions_derivatives(fitted):
     name, y, t, prepared, info, dmp = fitted
     assert dmp.duration_ == pytest.approx(info.end_s - info.start_s, rel=1e-9)
     raw = bidmp.DMP().fit(y, t)
     assert raw.duration_ == pytest.approx(t[-1] - t[0], rel=0.01)  # jittered epoch stamps
     trajectory = dmp.trajectory()
     assert trajectory.t[0] == 0.0 and trajectory.t[-1] == pytest.approx(1.1 * dmp.duration_, rel=0.01)
-    dt = np.diff(trajectory.t)
-    np.testing.assert_allclose(np.diff(trajectory.y, axis=0) / dt[:, None], trajectory.yd[:-1], rtol=1e-7, atol=1e-7)
-    np.testing.assert_allclose(np.diff(trajectory.yd, axis=0) / dt[:, None], trajectory.ydd[:-1], rtol=1e-6, atol=1e-6)
+    # The exact integrator reports the system's own velocity and acceleration: sampled 20 times
+    # finer, the same motion's finite differences converge to them (a check against the
+    # positions alone, not against the code's formula).
+    fine = dmp.trajectory(dt=trajectory.t[1] / 20)
+    scale = trajectory.peak_speed()
+    velocity = np.gradient(fine.y, fine.t, axis=0)[::20][: len(trajectory)]
+    np.testing.assert_allclose(velocity[1:-1], trajectory.yd[1 : len(velocity) - 1], atol=1e-3 * scale)
+    acceleration = np.gradient(fine.yd, fine.t, axis=0)[::20][: len(trajectory)]
+    np.testing.assert_allclose(acceleration[1:-1], trajectory.ydd[1 : len(acceleration) - 1],
+                               atol=1e-3 * trajectory.peak_acceleration())
     # The real peak speed, not the 1-s-per-recording one of the paper's convention.
     assert trajectory.peak_speed() == pytest.approx(info.peak_speed, rel=0.1)
 
@@ -83,12 +90,152 @@ def test_a_goal_moved_by_150_mm_is_reached_by_default_and_the_motion_rests(fitte
 
 
 def test_the_initial_acceleration_does_not_depend_on_the_goal_or_the_start(fitted):
+    """A structural guard (it holds by the design of the gate: R, R', R'' start at 0); the
+    measured start is tested below against the demonstration itself."""
     *_, dmp = fitted
     reference = dmp.trajectory().ydd[0]
     scale = max(np.linalg.norm(reference), 1.0)
     for goal, start in ((dmp.goal_ + SHIFT, None), (dmp.goal_ - 2 * SHIFT, None), (None, dmp.start_ + [30.0, -20.0, 10.0])):
         moved = dmp.trajectory(goal, start)
         assert np.linalg.norm(moved.ydd[0] - reference) <= 1e-9 * scale
+
+
+def at_speed(via, n_samples, speed, rate=250.0):
+    """A minimum-jerk demonstration cut where it first moves at ``speed`` (units/s): it starts
+    moving, as a trimmed recording does."""
+    demo = minimum_jerk(via, n_samples)
+    t = np.arange(n_samples) / rate
+    first = int(np.argmax(np.linalg.norm(np.gradient(demo, t, axis=0), axis=1) >= speed)) if speed > 0 else 0
+    return demo[first:], t[first:] - t[first]
+
+
+def start_peaks(t, ydd):
+    """Peak |acceleration| and |jerk| over the first 50 ms."""
+    early = t <= 0.05 + 1e-12
+    jerk = np.gradient(ydd, t, axis=0)
+    return np.linalg.norm(ydd, axis=1)[early].max(), np.linalg.norm(jerk, axis=1)[early].max()
+
+
+def start_cases():
+    cases = []
+    for name in ("operator1_nut3.csv", "operator2_nut5.csv"):
+        prepared, _ = bidmp.prepare(*recording(name))
+        cases.append((name, prepared.y, prepared.t))
+    for speed in (0.0, 1.9, 5.0):
+        for via, n in ((NUT_VIA, 2000), ([[0, 0, 0], [100, 50, 20]], 1000), ([[0, 0, 0], [0, 0, -60]], 600)):
+            cases.append((f"min-jerk {n} at {speed} mm/s", *at_speed(via, n, speed)))
+    return cases
+
+
+@pytest.mark.parametrize("case", start_cases(), ids=lambda case: case[0])
+def test_the_first_50_ms_move_as_the_demonstration_does(case):
+    """Issue 19.1. On today's main a min-jerk demonstration starting at 1.9 mm/s gave |ydd|
+    33.9 -> 443 -> 10.4 mm/s² (a one-sample velocity step of the delayed goal): 34x the
+    demonstration here. The acceptance: over the first 50 ms the peak acceleration and jerk are
+    within 1.2x the demonstration's own, at 250 Hz and 1 kHz, for its goal and goals 150 mm away."""
+    name, y, t = case
+    demonstrated = np.gradient(np.gradient(y, t, axis=0), t, axis=0)
+    acceleration, jerk = start_peaks(t, demonstrated)
+    dmp = bidmp.DMP().fit(y, t)
+    for goal in (None, dmp.goal_ + SHIFT, dmp.goal_ - SHIFT, dmp.goal_ + [0.0, 0.0, 150.0]):
+        for dt in (1 / 250, 1e-3):
+            motion = dmp.trajectory(goal, dt=dt)
+            assert np.linalg.norm(motion.yd[0]) == 0.0  # it starts at rest
+            peak_acceleration, peak_jerk = start_peaks(motion.t, motion.ydd)
+            assert peak_acceleration <= 1.2 * acceleration, (goal, dt, peak_acceleration / acceleration)
+            assert peak_jerk <= 1.2 * jerk, (goal, dt, peak_jerk / jerk)
+
+
+def hundred_hertz_demonstration():
+    y, t = kinesthetic_recording(NUT_VIA, seed=21, rate_hz=100.0, duration=3.0)
+    prepared, _ = bidmp.prepare(y, t)
+    return prepared
+
+
+def test_the_motion_is_the_same_at_any_controller_rate():
+    """Issue 19.2. On today's main a 100 Hz demonstration reproduced at 1 kHz moved by 1.00 mm
+    RMS (2.26 mm at most) against its own-rate reproduction. The acceptance: within 0.05 % of the
+    extent at 1 kHz and 10 kHz, for the demonstrated and a moved goal."""
+    prepared = hundred_hertz_demonstration()
+    dmp = bidmp.DMP().fit(prepared.y, prepared.t)
+    extent = np.linalg.norm(np.ptp(prepared.y, axis=0))
+    for goal in (None, dmp.goal_ + SHIFT):
+        native = dmp.trajectory(goal)
+        assert native.t[1] == pytest.approx(0.01, rel=0.02)
+        for dt in (1e-3, 1e-4):
+            fast = dmp.trajectory(goal, dt=dt)
+            resampled = np.column_stack([np.interp(native.t, fast.t, column) for column in fast.y.T])
+            assert np.max(np.linalg.norm(resampled - native.y, axis=1)) <= 5e-4 * extent, dt
+
+
+def test_the_exact_integrator_is_the_continuous_system():
+    """An independent reference: SciPy's adaptive ODE solver on the continuous transformation
+    system, with the learned forcing term and goal gate as functions of the continuous phase."""
+    from scipy.integrate import solve_ivp
+
+    prepared = hundred_hertz_demonstration()
+    dmp = bidmp.DMP().fit(prepared.y, prepared.t)
+    params = dmp._params()
+    goal, start = dmp.goal_ + SHIFT, dmp.start_
+    motion = dmp.trajectory(goal, dt=1e-3)
+    unit = dmp.time_unit_  # seconds per normalised time
+
+    def system(time, state):
+        y, z = state[:3], state[3:]
+        phase = np.exp(-params.alpha_phase * time / unit)
+        gate = dmp._progress_gate_at(np.array([phase]), params)[0]
+        forcing = dmp.forcing_term(np.array([phase]))[0]
+        drive = params.alpha * (params.beta * (goal - y) - z) + params.K * (forcing - gate * (goal - start))
+        return np.concatenate([z, drive]) / unit
+
+    solution = solve_ivp(system, (0.0, motion.t[-1]), np.concatenate([start, np.zeros(3)]), t_eval=motion.t[::50],
+                         rtol=1e-9, atol=1e-9, max_step=2e-3)
+    extent = np.linalg.norm(np.ptp(motion.y, axis=0))
+    assert np.max(np.abs(solution.y[:3].T - motion.y[::50])) <= 2e-5 * extent
+    np.testing.assert_allclose(solution.y[3:].T / unit, motion.yd[::50], atol=1e-4 * motion.peak_speed())
+
+
+def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
+    """Issue 19.3, the bound the README states: a goal moved by Δ changes the whole motion by
+    R(t) Δ, R rising monotonically from 0 to 1, and |R - σ| stays within the demonstration's own
+    progress σ over the first and last 15 % of its duration (σ: arc length so far / total, of the
+    demonstration as learned). Checked on random demonstrations, each against its own σ."""
+    rng = np.random.default_rng(19)
+    for case in range(6):
+        via = rng.uniform(-150, 150, size=(int(rng.integers(2, 5)), 3))
+        y, t = kinesthetic_recording(via, seed=100 + case, duration=float(rng.uniform(2.0, 6.0)),
+                                     rate_hz=float(rng.choice([100.0, 250.0, 500.0])))
+        prepared, _ = bidmp.prepare(y, t)
+        dmp = bidmp.DMP().fit(prepared.y, prepared.t)
+        home = dmp.trajectory()
+        delta = rng.normal(size=3) * 100.0
+        moved = dmp.trajectory(dmp.goal_ + delta)
+        share = (moved.y - home.y) @ delta / (delta @ delta)
+        np.testing.assert_allclose(moved.y - home.y, np.outer(share, delta), atol=1e-9 * np.linalg.norm(delta))
+        # Monotone from 0 to 1, up to a trace of the discretised gate (1e-5 of the shift: 1 µm here).
+        assert share[0] == 0.0 and share[-1] == pytest.approx(1.0, abs=1e-4)
+        assert np.all(np.diff(share) >= -1e-5) and share.max() <= 1.0 + 1e-5
+        learned = dmp.training_trajectory(prepared.y)
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(learned, axis=0), axis=1))])
+        sigma = np.interp(home.t, np.arange(len(arc)) * dmp.duration_ / (dmp.n_steps_ - 1), arc / arc[-1])
+        window = 0.15 * dmp.duration_
+        bound = max(np.interp(window, home.t, sigma), 1.0 - np.interp(dmp.duration_ - window, home.t, sigma))
+        assert np.max(np.abs(share - sigma)) <= bound + 1e-3
+
+
+def test_a_near_goal_on_a_straight_recording_barely_overshoots():
+    """Issue 19.3. On today's main a goal 1 % along a straight 113 mm recording was overshot by
+    0.295 mm (26 % of the 1.1 mm move; "two samples of demonstrated travel"). Now it is a few
+    hundredths of a millimetre: the goal's share starts flat while the recording accelerates."""
+    y, t = kinesthetic_recording([[0, 0, 0], [100, 50, 20]], seed=13, duration=3.0)
+    prepared, _ = bidmp.prepare(y, t)
+    dmp = bidmp.DMP().fit(prepared.y, prepared.t)
+    length = np.linalg.norm(prepared.y[-1] - prepared.y[0])
+    direction = (prepared.y[-1] - prepared.y[0]) / length
+    for fraction in (0.01, 0.1, 0.5):
+        goal = prepared.y[0] + fraction * (prepared.y[-1] - prepared.y[0])
+        along = (dmp.trajectory(goal).y - prepared.y[0]) @ direction
+        assert along.max() - fraction * length <= 0.05 * max(fraction * length, 1.0), fraction
 
 
 def test_the_paper_form_jumps_by_alpha_beta_minus_one_times_the_shift():

@@ -33,16 +33,25 @@ system has not converged, and the end point misses a shifted goal ``g'`` by exac
 
 from __future__ import annotations
 
-import cmath
 import logging
 from typing import NamedTuple
 
 import numpy as np
-from scipy.signal import lfilter
 from sklearn.base import BaseEstimator
 
+from . import _goals
+from ._integrate import (
+    _max_stable_step,  # noqa: F401  (kept importable from here)
+    check_euler_stable,
+    euler_responses,
+    euler_spectral_radius,
+    exact_responses,
+    exact_state,
+    foh_step,
+)
 from ._trajectory import arclength, resample_time
 from ._checks import (
+    NotFittedError,
     as_point,
     as_points,
     as_trajectory,
@@ -96,68 +105,49 @@ def _phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
     return decay
 
 
-def euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
-    """Spectral radius of one explicit-Euler step of the spring-damper (step ``h = dt/tau``).
-
-    The homogeneous update ``[y, z] ← [[1, h], [−h α β, 1 − h α]] [y, z]`` has characteristic
-    polynomial ``r² − (2 − hα) r + (1 − hα + h²αβ)``; the integration is stable iff both roots lie
-    inside the unit circle (for ``β = α/4``: iff ``h α < 4``).
-    """
-    trace = 2.0 - step * alpha
-    determinant = 1.0 - step * alpha + step * step * alpha * beta
-    root = cmath.sqrt(trace * trace / 4.0 - determinant)  # closed form: this runs on every rollout
-    return max(abs(trace / 2.0 + root), abs(trace / 2.0 - root))
-
-
-def _max_stable_step(alpha: float, beta: float, step: float) -> float:
-    """The largest ``h`` below ``step`` for which :func:`euler_spectral_radius` stays < 1 (bisection)."""
-    low, high = 0.0, step
-    for _ in range(60):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
-    return low
-
-
-def check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None:
-    """Refuse an explicit-Euler step ``dt/tau`` for which the transformation system diverges.
-
-    Raises
-    ------
-    ValueError
-        Naming the bound on ``dt/tau`` (s) for these gains.
-    """
-    step = dt / tau
-    radius = euler_spectral_radius(step, alpha, beta)
-    if not radius < 1.0:
-        bound = _max_stable_step(alpha, beta, step)
-        raise ValueError(
-            f"explicit Euler integration is unstable for alpha = {alpha:g}, beta = {beta:g} with the step dt/tau = "
-            f"{step:.4g} s (spectral radius {radius:.4g} >= 1): it needs dt/tau < {bound:.4g} s "
-            f"(alpha * dt/tau = {alpha * step:.4g}, below {alpha * bound:.4g}); lower alpha, raise tau or use more samples"
-        )
-
-
 def _check_integration(step: float, params) -> None:
-    """Refuse a normalised step for which the spring diverges or the phase (or an exponentially
-    delayed goal) does not decay."""
+    """Refuse a normalised step for which the Euler spring diverges or the Euler phase (or an
+    exponentially delayed goal) does not decay. The exact integrator is stable at any step."""
+    if params.integrator != "euler":
+        return
     check_euler_stable(step, params.tau, params.alpha, params.beta)
     _phase_decay(step, params.tau, params.alpha_phase)
     if params.goal_rate is not None:
         _phase_decay(step, params.tau, params.goal_rate)
 
 
-def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
-    """Phase at every step, ``phase[l] = (1 - alpha_phase dt / tau) ** l`` (shape ``(n_steps,)``)."""
+# Kernels need distinct, representable phases over the training grid: e^-27.6 = 1e-12.
+_MIN_TRAINING_PHASE_LOG = -27.6
+
+
+def _check_phase_span(span: float, params) -> None:
+    """Refuse an ``alpha_phase`` that decays the phase below 1e-12 over the training grid (of
+    ``span`` normalised time): its kernels' widths and weights would leave float64's range."""
+    if -params.alpha_phase * span < _MIN_TRAINING_PHASE_LOG:
+        raise ValueError(f"alpha_phase = {params.alpha_phase:g} decays the phase to e^{-params.alpha_phase * span:.4g} over "
+                         f"the demonstration; the kernels need at least e^{_MIN_TRAINING_PHASE_LOG:g}: lower alpha_phase")
+
+
+def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *, exact: bool = False) -> np.ndarray:
+    """Phase at every step (shape ``(n_steps,)``): ``(1 - alpha_phase dt / tau) ** l``, the
+    Euler-discretised canonical system (Eq. 13), or with ``exact`` its solution
+    ``exp(-alpha_phase l dt / tau)``, which does not depend on the step."""
+    if exact:
+        return np.exp(-alpha_phase * dt / tau * np.arange(n_steps))
     return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
 
 
-def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0) -> np.ndarray:
+def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *,
+                   exact: bool = False) -> np.ndarray:
     """Kernel centres at the phase of ``n_kernels`` equally spaced times over the horizon.
 
     They span exactly the visited phase range ``[phase[n_steps - 1], 1]``: a centre outside it
-    belongs to a kernel that never fires, and its LWR weight blows up.
+    belongs to a kernel that never fires, and its LWR weight blows up. ``exact`` as in
+    :func:`phase_grid`.
     """
     steps = np.linspace(0.0, n_steps - 1, n_kernels)
+    if exact:
+        return np.exp(-alpha_phase * dt / tau * steps)
     return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
 
 
@@ -274,40 +264,6 @@ def forcing_target(
     return (tau**2 * acceleration - spring) / K + gate[:, None] * (goal - start)
 
 
-def _euler_unit_responses(
-    drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, *, h: float, alpha: float, beta: float
-) -> np.ndarray:
-    """Integrate the Euler-discretised spring-damper for several input signals at once.
-
-    With ``z = (y[n+1] - y[n]) / h`` the two Euler updates become
-    ``y[n+2] = (2 - h alpha) y[n+1] - (1 - h alpha + h² alpha beta) y[n] + h² u[n]``, an IIR filter
-    that :func:`scipy.signal.lfilter` runs in C.
-
-    Parameters
-    ----------
-    drives : array, shape (S, n - 2)
-        Input ``u[n]`` of each signal for ``n = 0 … n-3``.
-    y_first, y_second : array, shape (S,)
-        ``y[0]`` and ``y[1]`` of each signal.
-
-    Returns
-    -------
-    y : array, shape (S, n)
-    """
-    n_signals = drives.shape[0]
-    out = np.empty((n_signals, drives.shape[1] + 2))
-    out[:, 0] = y_first
-    out[:, 1] = y_second
-    if drives.shape[1] == 0:
-        return out
-    a1 = -(2.0 - h * alpha)
-    a2 = 1.0 - h * alpha + h * h * alpha * beta
-    # Initial state of lfilter's transposed direct form II for past outputs y[1], y[0].
-    zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
-    out[:, 2:], _ = lfilter([h * h, 0.0, 0.0], [1.0, a1, a2], drives, axis=1, zi=zi)
-    return out
-
-
 # ---------------------------------------------------------------------------------------------
 # The estimator
 # ---------------------------------------------------------------------------------------------
@@ -327,19 +283,32 @@ class _Params(NamedTuple):
     widths: str
     protocol: str
     goal_rate: float | None  # None: the goal follows the demonstration's progress (robot default)
+    integrator: str  # "exact" (first-order hold, any rate) or "euler" (the paper's Eq. 14)
     settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
+
+    @property
+    def exact(self) -> bool:
+        return self.integrator == "exact"
+
+    @property
+    def rest_start(self) -> bool:
+        """Whether the demonstration is learned with its start and end velocity blended out
+        (:func:`bidmp._goals.rest_started`): the robot protocol with the exact integrator."""
+        return self.integrator == "exact" and self.protocol == "robot"
 
 
 # The two protocols (README "Protocols"): what the unset parameters resolve to.
 PROTOCOLS = ("robot", "paper")
+_INTEGRATOR_CHOICES = ("exact", "euler")
 # robot: K = alpha beta (Pastor 2009: the initial acceleration does not depend on the goal or the
-# start), a delayed goal that follows the demonstration's progress (_progress_gate), a phase that
-# decays to e^-4 over the demonstration, 100 kernels and a stiffer spring (alpha = 50), and a
+# start), a goal share that follows the demonstration's progress with smooth ends
+# (bidmp._goals), the exact integrator (the same motion at any control rate), the demonstration
+# learned from rest (its start velocity blended out), a phase that decays to e^-4 over the
+# demonstration, 100 kernels fitted by ridge regression, a stiffer spring (alpha = 50), and a
 # horizon of 1.1x the demonstrated duration. The weights are learned on the demonstration
 # followed by rest at its goal for that extra 0.1: the learned forcing term then holds the goal
-# at the end instead of extrapolating the last kernel. On the shared recordings these settings
-# reproduce to 0.13-0.15 mm RMS and reach a goal moved by 150 mm within 0.01 mm
-# (tests/test_timing.py; the measurements are in the README).
+# at the end instead of extrapolating the last kernel. The README's "Robot protocol" section
+# has the measurements (tests/test_timing.py holds them).
 ROBOT_ALPHA = 50.0
 ROBOT_KERNELS = 100
 ROBOT_ALPHA_PHASE = 4.0
@@ -351,9 +320,10 @@ class DMP(BaseEstimator):
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
     them and learns, ``get_params``/``set_params``/``sklearn.base.clone`` work, and learned state
-    ends in ``_``. Changing a parameter after ``fit`` (attribute or ``set_params``) takes effect at
-    the next rollout: the model then behaves as a fresh one with that parameter and the same
-    learned weights.
+    ends in ``_``. Only ``tau`` (an execution parameter: temporal scaling) may change after
+    ``fit``; every other parameter shapes what was learned, so changing it (attribute or
+    ``set_params``) makes the model unfitted until it is fitted again (a
+    :class:`bidmp.NotFittedError` names the parameter).
 
     **Time.** Internally the demonstration's T samples lie on the grid ``dt_ = 1/T`` (the paper's
     normalised time). ``fit(y, t)`` with timestamps (s) also stores the real duration
@@ -361,13 +331,17 @@ class DMP(BaseEstimator):
     seconds at any rate; :meth:`rollout` keeps the normalised grid.
 
     **Protocols.** ``protocol="robot"`` (default) resolves the unset parameters to a DMP a robot
-    can run: ``K = alpha beta`` (the initial acceleration does not depend on the goal or the
-    start: no jump when either moves), a delayed goal that moves from the start to the goal at
-    the demonstration's own progress along its path (a delayed goal, Kulvicius 2012, timed by
-    the demonstration: no overshoot or backwards motion for nearer goals), ``alpha_phase = 4`` and a default
-    horizon of 1.1x the demonstration, within which any goal is reached and the motion comes to
-    rest. ``protocol="paper"`` is the paper's: ``K = alpha``, ``alpha_phase = 1``, the goal gated by
-    the phase, exactly T samples (a shifted goal is missed by :meth:`endpoint_gain` times the shift).
+    can run: ``K = alpha beta`` and a goal share that follows the demonstration's own progress
+    along its path with smooth ends (a delayed goal, Kulvicius 2012, timed by the demonstration;
+    :mod:`bidmp._goals`): the first ~50 ms and the initial acceleration do not depend on the goal
+    or the start, and a moved goal changes the motion by ``R(t) (g' - g)`` with no overshoot
+    beyond the stated bound; the exact integrator (the same motion at any control rate); the
+    demonstration learned from rest (a start velocity blended out, so the rollout starts at rest
+    with the demonstrated acceleration); ridge weights; ``alpha_phase = 4`` and a default horizon
+    of 1.1x the demonstration, within which any goal is reached and the motion comes to rest.
+    ``protocol="paper"`` is the paper's: ``K = alpha``, ``alpha_phase = 1``, LWR, explicit Euler, the
+    goal gated by the phase, exactly T samples (a shifted goal is missed by :meth:`endpoint_gain`
+    times the shift).
 
     Parameters
     ----------
@@ -388,8 +362,10 @@ class DMP(BaseEstimator):
         Temporal scaling: a rollout takes ``tau`` times the demonstration's duration, with the same
         shape (larger is slower). The weights are always learned for the demonstration's own
         duration (``tau = 1``), so ``tau`` may be changed after ``fit``.
-    regression : {"lwr", "ridge"}, default "lwr"
-        Locally weighted regression per kernel (paper) or global ridge least squares.
+    regression : {"lwr", "ridge"} or None, default None
+        Locally weighted regression per kernel or global ridge least squares; ``None``: robot
+        ridge (LWR's one-sided first kernel biases the start's acceleration by up to 40 %), paper
+        LWR.
     derivatives : {"gradient", "forward"}, default "gradient"
         How the demonstration is differentiated for the forcing target.
     ridge : float, default 1e-8
@@ -402,6 +378,12 @@ class DMP(BaseEstimator):
         Rate of an exponentially delayed goal (per normalised time). ``None``: robot, the goal
         follows the demonstration's progress along its path (``goal_gate_``); paper, equal to
         ``alpha_phase``, which is exactly Eq. 10's ``-K phase (g - y0)`` term.
+    integrator : {"exact", "euler"} or None, default None
+        ``"exact"``: the transformation system integrated exactly with the input linear between
+        samples (:mod:`bidmp._integrate`): stable at any step, the same motion at any control
+        rate. ``"euler"``: explicit Euler, Eq. 14 (its motion depends on the step). ``None``:
+        robot exact, paper Euler. A robot-protocol model with ``"euler"`` is bidmp's robot
+        protocol of model format 3 (such files load with it).
 
     Attributes
     ----------
@@ -432,12 +414,13 @@ class DMP(BaseEstimator):
         K: str | float | None = None,
         alpha_phase: float | None = None,
         tau: float = 1.0,
-        regression: str = "lwr",
+        regression: str | None = None,
         derivatives: str = "gradient",
         ridge: float = 1e-8,
         widths: str = "spacing",
         protocol: str = "robot",
         goal_rate: float | None = None,
+        integrator: str | None = None,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
@@ -451,6 +434,7 @@ class DMP(BaseEstimator):
         self.widths = widths
         self.protocol = protocol
         self.goal_rate = goal_rate
+        self.integrator = integrator
 
     # -- parameters ----------------------------------------------------------------------------
     def _params(self) -> _Params:
@@ -482,12 +466,15 @@ class DMP(BaseEstimator):
             K=K,
             alpha_phase=alpha_phase,
             tau=check_real(self.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]),
-            regression=check_choice(self.regression, "regression", _REGRESSION_CHOICES),
+            regression=("ridge" if robot else "lwr") if self.regression is None else
+            check_choice(self.regression, "regression", _REGRESSION_CHOICES),
             derivatives=check_choice(self.derivatives, "derivatives", _DERIVATIVE_CHOICES),
             ridge=check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6),
             widths=check_choice(self.widths, "widths", _WIDTH_CHOICES),
             protocol=protocol,
             goal_rate=goal_rate,
+            integrator=("exact" if robot else "euler") if self.integrator is None else
+            check_choice(self.integrator, "integrator", _INTEGRATOR_CHOICES),
             settle=ROBOT_SETTLE if robot else 1.0,
         )
 
@@ -539,10 +526,16 @@ class DMP(BaseEstimator):
 
         A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
+        return self._fit(y, t, units)
+
+    def _fit(self, y, t=None, units: str | None = None, *, progress: np.ndarray | None = None,
+             name: str = "y") -> "DMP":
+        """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
+        move on its own: then ``y`` may be static)."""
         from .timing import check_timestamps, uniform_time
 
         params = self._params()
-        y = as_trajectory(y, "y")
+        y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else _check_units(units)
         n_steps = y.shape[0]
         if t is None:
@@ -552,36 +545,26 @@ class DMP(BaseEstimator):
             y, grid = uniform_time(y, stamps)
             duration = float(grid[-1])
         dt = 1.0 / n_steps
-        train = _with_rest(y, params)
+        train = _with_rest(_goals.rest_started(y, dt, duration * n_steps / (n_steps - 1)) if params.rest_start else y,
+                           params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
         _check_integration(dt, params._replace(tau=1.0))
         _check_integration(dt, params)
+        _check_phase_span(train.shape[0] * dt, params)
         # The weights belong to the demonstration's own time scale (tau = 1); tau only scales
         # rollouts, so it is not used here.
         n_train = train.shape[0]
-        phase = phase_grid(n_train, dt, 1.0, params.alpha_phase)
-        if params.goal_rate is None:
-            gate = _progress_gate(train, dt, params)
-        else:
-            gate = phase_grid(n_train, dt, 1.0, params.goal_rate)
-        centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase)
+        phase = phase_grid(n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
+        gate = _training_gate(train, n_steps, dt, params, progress)
+        centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
         widths = kernel_widths(centres, params.alpha_phase, params.widths)
         target = forcing_target(
             train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
             derivatives=params.derivatives, gate=gate,
         )
         phi = basis_functions(phase, centres, widths)
-        if params.regression == "lwr":
-            # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
-            denominator = phi.T @ phase
-            weights = (phi.T @ target) / np.maximum(denominator, np.finfo(float).tiny)[:, None]
-        else:
-            gram = phi.T @ phi
-            reg = params.ridge * max(np.trace(gram) / params.n_kernels, np.finfo(float).tiny)
-            weights = np.linalg.solve(gram + reg * np.eye(params.n_kernels), phi.T @ target)
-        if not np.all(np.isfinite(weights)):
-            raise ValueError("fit: the learned weights are not finite; the demonstration's scale or the gains are out of range")
+        weights = _regress(phi, phase, target, params)
         self.weights_ = np.ascontiguousarray(weights)
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
@@ -592,16 +575,36 @@ class DMP(BaseEstimator):
         self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths
+        self._learned_with = self._learned_params()
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
         self._store_grid(params._replace(tau=1.0), phase, phi, dt)
         logger.debug("fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration)
         return self
 
+    def _learned_params(self) -> _Params:
+        """The resolved parameters the weights depend on (all but tau, which only scales time)."""
+        return self._params()._replace(tau=1.0)
+
+    def _stale_params(self) -> list[str]:
+        """The learned-with parameters that have changed since ``fit`` (with their values)."""
+        learned = self.__dict__.get("_learned_with")
+        if learned is None:
+            return []
+        now = self._learned_params()
+        return [f"{name} (fitted with {before!r}, now {after!r})" for name, before, after in zip(now._fields, learned, now)
+                if before != after]
+
     def __sklearn_is_fitted__(self) -> bool:
-        return "weights_" in self.__dict__
+        return "weights_" in self.__dict__ and not self._stale_params()
 
     def _check_fitted(self) -> None:
         check_fitted(self, "weights_")
+        stale = self._stale_params()
+        if stale:
+            raise NotFittedError(
+                f"this DMP's {', '.join(stale)} changed after fit: the weights were learned with the old value, "
+                f"so the model must be fitted again (only tau may change after fit)"
+            )
 
     @property
     def n_dims_(self) -> int:
@@ -641,11 +644,12 @@ class DMP(BaseEstimator):
         """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
         self._check_fitted()
         params = self._params()
-        return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase)
+        return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase, exact=params.exact)
 
     def _grid_key(self, params: _Params, n_steps: int, step: float) -> tuple:
         """Everything a rollout grid depends on besides the learned kernels."""
-        return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, params.goal_rate, step)
+        return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, params.goal_rate,
+                params.integrator, step)
 
     def _store_grid(self, params: _Params, phase: np.ndarray, basis: np.ndarray, step: float) -> tuple:
         cached = (self._grid_key(params, phase.shape[0], step), self.centres_, self.widths_, phase, basis,
@@ -672,7 +676,7 @@ class DMP(BaseEstimator):
         step = self.dt_ if step is None else step
         cached = self._cached_grid(params, n_steps, step)
         if cached is None:
-            phase = phase_grid(n_steps, step, params.tau, params.alpha_phase)
+            phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
             cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_), step)
         return cached[3:]
 
@@ -704,7 +708,7 @@ class DMP(BaseEstimator):
         params = self._params()
         if params.goal_rate is None:
             return self._progress_gate()
-        return phase_grid(self.n_train_, self.dt_, 1.0, params.goal_rate)
+        return phase_grid(self.n_train_, self.dt_, 1.0, params.goal_rate, exact=params.exact)
 
     def _progress_gate(self) -> np.ndarray:
         gate = self.__dict__.get("goal_gate_")
@@ -717,19 +721,24 @@ class DMP(BaseEstimator):
         """The progress gate (see :func:`_progress_gate`) at the given phases: the share of a
         goal change still to come, interpolated in phase on the training grid. The reversed
         training grid is kept, as the stepper asks for one phase per control step."""
-        key = (self.n_train_, self.dt_, params.alpha_phase)
+        key = (self.n_train_, self.dt_, params.alpha_phase, params.exact)
         cached = self.__dict__.get("_gate_lookup")
         if cached is None or cached[0] != key or cached[2] is not self.goal_gate_:
-            training_phase = phase_grid(self.n_train_, self.dt_, 1.0, params.alpha_phase)
+            training_phase = phase_grid(self.n_train_, self.dt_, 1.0, params.alpha_phase, exact=params.exact)
             cached = (key, training_phase[::-1], self._progress_gate(), self._progress_gate()[::-1])
             self._gate_lookup = cached
         return np.interp(phase, cached[1], cached[3])
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
-        for the robot protocol, followed by rest at its last point up to :attr:`n_train_`."""
+        for the robot protocol, started and ended at rest (:func:`bidmp._goals.rest_started`) and
+        followed by rest at its last point up to :attr:`n_train_`."""
         self._check_fitted()
-        return _with_rest(resample_time(np.asarray(y, dtype=np.float64), self.n_steps_), self._params())
+        params = self._params()
+        y = resample_time(np.asarray(y, dtype=np.float64), self.n_steps_)
+        if params.rest_start:
+            y = _goals.rest_started(y, self.dt_, self.time_unit_)
+        return _with_rest(y, params)
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
@@ -750,24 +759,32 @@ class DMP(BaseEstimator):
         """
         alpha, beta, K = params.alpha, params.beta, params.K
         n_steps = phase.shape[0]
-        n_inputs = max(n_steps - 2, 0)
+        # Euler's y[n] depends on u[n-2] at the latest; the exact step uses u[n] too.
+        n_inputs = n_steps if params.exact else max(n_steps - 2, 0)
         if forcing is not None:
             drives = K * forcing[:n_inputs].T
-            y_first = y_second = np.zeros(drives.shape[0])
+            y_first = second = np.zeros(drives.shape[0])
         else:
-            # The goal enters through alpha beta g - K gate (g - y0): the gate is the phase
-            # (Eq. 10) or the delayed goal's remaining fraction (robot protocol).
-            if params.goal_rate == params.alpha_phase:
-                gate = phase[:n_inputs]
-            elif params.goal_rate is None:
-                gate = self._progress_gate_at(phase[:n_inputs], params)
-            else:
-                gate = phase_grid(n_inputs, step, params.tau, params.goal_rate)
+            # The goal enters through alpha beta g - K gate (g - y0).
+            gate = self._gate_on(params, phase[:n_inputs], step)
             drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
             y_first = np.array([0.0, 1.0, 0.0])
-            y_second = np.array([0.0, 1.0, step])
-        responses = _euler_unit_responses(drives, y_first, y_second, h=step / params.tau, alpha=alpha, beta=beta)
+            # The second state: Euler's y[1] (a unit start velocity moves it by one step), or
+            # the exact integrator's z = tau dy/ds.
+            second = np.array([0.0, 0.0, params.tau]) if params.exact else np.array([0.0, 1.0, step])
+        if params.exact:
+            return exact_responses(drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau)
+        responses = euler_responses(drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta)
         return responses[:, :n_steps]
+
+    def _gate_on(self, params: _Params, phase: np.ndarray, step: float) -> np.ndarray:
+        """The goal gate at the grid's phases: the phase itself (Eq. 10), the robot protocol's
+        progress gate, or an exponentially delayed goal at ``goal_rate``."""
+        if params.goal_rate == params.alpha_phase:
+            return phase
+        if params.goal_rate is None:
+            return self._progress_gate_at(phase, params)
+        return phase_grid(phase.shape[0], step, params.tau, params.goal_rate, exact=params.exact)
 
     def _rollout_params(self, step: float | None = None, params: _Params | None = None) -> _Params:
         """The validated parameters, with the rollout's integration checked for stability."""
@@ -795,13 +812,14 @@ class DMP(BaseEstimator):
         # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
         if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
             raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
-        return free, goal_response
+        return free, goal_response, forcing, phase
 
     @numerically_guarded
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
                 forcing_increment=None) -> np.ndarray:
-        """Generate a trajectory (explicit Euler, Eq. 14) on the normalised grid, one sample every
-        ``dt_`` (``duration_ / (T - 1)`` seconds at ``tau = 1``).
+        """Generate a trajectory on the normalised grid, one sample every ``dt_`` (``duration_ /
+        (T - 1)`` seconds at ``tau = 1``), with the protocol's integrator (robot: exact; paper:
+        explicit Euler, Eq. 14).
 
         Parameters
         ----------
@@ -824,7 +842,7 @@ class DMP(BaseEstimator):
         -------
         y : array, shape (n_steps, D)
         """
-        free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
+        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         return free + np.outer(goal_response, goal)
 
@@ -850,7 +868,7 @@ class DMP(BaseEstimator):
         y : array, shape (G, n_steps, D)
             ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
         """
-        free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
+        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goals = as_points(goals, free.shape[1], "goals")
         shape = (goals.shape[0], *free.shape)
         if out is None:
@@ -891,7 +909,7 @@ class DMP(BaseEstimator):
         """
         chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
         with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
-            free, goal_response = self._prepare(start, start_velocity, n_steps, forcing_increment)
+            free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         goals = as_points(goals, free.shape[1], "goals")
         check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
         for first, chunk in self._chunks(goals, free, chunk_size):
@@ -967,6 +985,8 @@ class DMP(BaseEstimator):
         -------
         bidmp.Trajectory
             ``t`` from 0 (s), ``y`` (units), ``yd`` (units/s), ``ydd`` (units/s²), each (n, D).
+            Exact integrator (robot): ``yd`` and ``ydd`` are the system's own state and
+            acceleration at each sample (the same continuous motion at any ``dt``). Euler (paper):
             ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
         """
         from .timing import Trajectory
@@ -978,12 +998,26 @@ class DMP(BaseEstimator):
         motion, dt, n_samples, step = self._time_grid(duration, dt, params)
         params = self._rollout_params(step, params._replace(tau=motion / self.duration_))
         velocity = None if start_velocity is None else as_point(start_velocity, self.n_dims_, "start_velocity") * self.time_unit_
-        # Two extra samples give the last velocity and acceleration as forward differences.
-        free, goal_response = self._prepare(start, velocity, n_samples + 2, forcing_increment, params=params, step=step)
+        # Two extra samples give the last velocity and acceleration as forward differences (Euler),
+        # one the last exact state.
+        free, goal_response, forcing, phase = self._prepare(start, velocity, n_samples + 2, forcing_increment,
+                                                            params=params, step=step)
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         positions = free + np.outer(goal_response, goal)
-        velocities = np.diff(positions, axis=0) / dt
-        accelerations = np.diff(velocities, axis=0) / dt
+        if params.exact:
+            start = self.start_ if start is None else as_point(start, free.shape[1], "start")
+            gate = self._gate_on(params, phase, step)
+            inputs = params.alpha * params.beta * goal + params.K * (forcing - np.outer(gate, goal - start))
+            z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta,
+                                          tau=params.tau)
+            # The first state is given, not solved for: a rest start is exactly at rest.
+            z[0] = 0.0 if velocity is None else params.tau * velocity
+            acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
+            velocities = z / (params.tau * self.time_unit_)
+            accelerations = acceleration / self.time_unit_**2
+        else:
+            velocities = np.diff(positions, axis=0) / dt
+            accelerations = np.diff(velocities, axis=0) / dt
         return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
                           accelerations[:n_samples], self.units_)
 
@@ -1054,6 +1088,8 @@ class DMP(BaseEstimator):
         if "fit" in params:  # format 1 stored the regression under the name "fit"
             params["regression"] = params.pop("fit")
         params.setdefault("protocol", "paper")  # formats 1-2 knew only the paper's protocol
+        if "integrator" not in params:  # formats 1-3 integrated with explicit Euler
+            params["integrator"] = "euler"
         model = cls(**params)
         params = model._params()
         n_kernels = params.n_kernels
@@ -1084,13 +1120,16 @@ class DMP(BaseEstimator):
             if np.max(np.abs(gate)) > 1e6:
                 raise ValueError("member goal_gate_ has values beyond 1e6, which no fit produces")
             model.goal_gate_ = gate
-        check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
+        if params.integrator == "euler":
+            check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
+        model._learned_with = model._learned_params()
         return model
 
 
-def _progress_gate(train: np.ndarray, dt: float, params: _Params) -> np.ndarray:
-    """The robot protocol's goal gate: the share of a goal change still to come, such that the
-    rollout's response to a moved goal follows the demonstration's own progress along its path.
+def _progress_gate(progress: np.ndarray, dt: float, params: _Params) -> np.ndarray:
+    """The goal gate of the robot protocol of model format 3 (``integrator="euler"``): the share
+    of a goal change still to come, such that the Euler rollout's response to a moved goal follows
+    the demonstration's own progress along its path.
 
     With ``σ`` the demonstration's arc-length progress (0 → 1), the gate is the exact inverse of
     the Euler-discretised spring for the target response ``σ`` delayed by two samples: the
@@ -1099,8 +1138,6 @@ def _progress_gate(train: np.ndarray, dt: float, params: _Params) -> np.ndarray:
     thus approached in step with the demonstrated motion: a straight demonstration to a nearer
     goal becomes the same motion scaled down, without overshoot or moving backwards.
     """
-    arc = arclength(train)
-    progress = arc / arc[-1]
     response = np.concatenate([np.zeros(2), progress[:-2]])  # σ delayed by two samples
     h = dt
     a1 = -(2.0 - h * params.alpha)
@@ -1110,6 +1147,43 @@ def _progress_gate(train: np.ndarray, dt: float, params: _Params) -> np.ndarray:
     gate[:-2] = (params.alpha * params.beta - drive) / params.K
     gate[-2:] = gate[-3]  # the last two drives never reach the rollout (y[n] depends on u[n-2])
     return gate
+
+
+def arclength_progress(y: np.ndarray) -> np.ndarray:
+    """Arc-length progress ``σ`` (0 → 1) of a trajectory (n, D); a static one has none (zeros)."""
+    arc = arclength(y)
+    return arc / arc[-1] if arc[-1] > 0.0 else np.zeros_like(arc)
+
+
+def _training_gate(train: np.ndarray, n_motion: int, dt: float, params: _Params, progress) -> np.ndarray:
+    """The goal gate on the training grid: the progress gate of the protocol (exact: the smooth
+    goal share of :mod:`bidmp._goals`; Euler: the legacy discrete inverse) or an exponentially
+    delayed goal at ``goal_rate``."""
+    n_train = train.shape[0]
+    if params.goal_rate is not None:
+        return phase_grid(n_train, dt, 1.0, params.goal_rate, exact=params.exact)
+    progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+    if progress.shape != (n_train,):
+        raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+    if not params.exact:
+        return _progress_gate(progress, dt, params)
+    share = _goals.goal_share(progress, n_motion, dt)
+    return _goals.goal_gate(share, dt, alpha=params.alpha, beta=params.beta, K=params.K)
+
+
+def _regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, params: _Params) -> np.ndarray:
+    """Forcing-term weights (N, D): LWR per kernel or ridge least squares on the basis rows."""
+    if params.regression == "lwr":
+        # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
+        denominator = phi.T @ phase
+        weights = (phi.T @ target) / np.maximum(denominator, np.finfo(float).tiny)[:, None]
+    else:
+        gram = phi.T @ phi
+        reg = params.ridge * max(np.trace(gram) / params.n_kernels, np.finfo(float).tiny)
+        weights = np.linalg.solve(gram + reg * np.eye(params.n_kernels), phi.T @ target)
+    if not np.all(np.isfinite(weights)):
+        raise ValueError("fit: the learned weights are not finite; the demonstration's scale or the gains are out of range")
+    return weights
 
 
 def _affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
@@ -1141,8 +1215,8 @@ class DMPStepper:
 
     ``step(dt, y_measured=None)`` returns the command ``(y, yd, ydd)`` for the current sample (units,
     units/s, units/s²) and advances the state by ``dt`` seconds. Without a measurement (or with
-    ``coupling = 0``) the commands equal :meth:`DMP.trajectory` sample for sample (same explicit
-    Euler steps). With a measurement the system's time runs ``1 + coupling ‖y_measured - y‖²`` times
+    ``coupling = 0``) the commands equal :meth:`DMP.trajectory` sample for sample (the same
+    integration steps, exact or Euler). With a measurement the system's time runs ``1 + coupling ‖y_measured - y‖²`` times
     slower (phase stopping, Ijspeert et al. 2013, applied to the whole system so that the spring
     waits too): a robot held back makes the command pause where it is, and the motion resumes once
     it catches up.
@@ -1172,18 +1246,27 @@ class DMPStepper:
         self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
         self.phase = 1.0
         self._gate = 1.0
+        self._gate = self._next_gate(1.0, 1.0)
         self.time = 0.0
         self._checked_step = None
 
-    def _drive(self) -> np.ndarray:
+    def _input(self, phase: float, gate: float) -> np.ndarray:
+        """The system's input ``u = αβ g + K f(phase) - K gate (g - y0)`` (D,)."""
         params = self._params
-        phase = np.array([self.phase])
-        basis = self._dmp.basis(phase)
+        phases = np.array([phase])
+        basis = self._dmp.basis(phases)
         forcing = basis @ self._dmp.weights_
         if self._forcing_increment is not None:
-            forcing = forcing + self._forcing_increment(phase, basis)
-        return (params.alpha * (params.beta * (self.goal - self.y) - self._z) + params.K * forcing[0]
-                - params.K * self._gate * (self.goal - self.start))
+            forcing = forcing + self._forcing_increment(phases, basis)
+        return params.alpha * params.beta * self.goal + params.K * (forcing[0] - gate * (self.goal - self.start))
+
+    def _next_gate(self, phase: float, decay: float) -> float:
+        params = self._params
+        if params.goal_rate is None:
+            return float(self._dmp._progress_gate_at(phase, params))
+        if params.goal_rate == params.alpha_phase:
+            return phase
+        return self._gate * decay
 
     def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The command for now, then advance ``dt`` seconds (less while the robot lags).
@@ -1200,21 +1283,31 @@ class DMPStepper:
         if y_measured is not None and self.coupling > 0.0:
             error = as_point(y_measured, self.y.shape[0], "y_measured") - self.y
             slowdown = 1.0 + self.coupling * float(error @ error)
-        h = dt / time_unit / slowdown / params.tau  # normalised Euler step of this control step
-        if h != self._checked_step:
-            check_euler_stable(h * params.tau, params.tau, params.alpha, params.beta)
-            self._checked_step = h
-        z_next = self._z + h * self._drive()
+        step = dt / time_unit / slowdown  # the normalised time this control step advances
+        alpha, beta, tau = params.alpha, params.beta, params.tau
+        input_now = self._input(self.phase, self._gate)  # not cached: goal and start are public
         position = self.y.copy()
-        # The command's velocity and acceleration, as trajectory() reports them: the Euler state.
-        velocity = self._z / (params.tau * time_unit) / slowdown
-        acceleration = (z_next - self._z) / (params.tau * time_unit) / dt / slowdown
-        self.y = self.y + h * self._z
-        self._z = z_next
-        self.phase *= 1.0 - params.alpha_phase * h
-        if params.goal_rate is None:
-            self._gate = float(self._dmp._progress_gate_at(self.phase, params))
+        # The command's velocity and acceleration, as trajectory() reports them: the system's own.
+        velocity = self._z / (tau * time_unit) / slowdown
+        acceleration = (input_now - alpha * beta * self.y - alpha * self._z) / (tau * time_unit * slowdown) ** 2
+        if params.exact:
+            decay = float(np.exp(-params.alpha_phase * step / tau))
+            phase = self.phase * decay
+            gate = self._next_gate(phase, float(np.exp(-(params.goal_rate or 0.0) * step / tau)))
+            input_next = self._input(phase, gate)
+            transition, now, after = foh_step(step, alpha, beta, tau)
+            state = transition @ np.stack([self.y, self._z]) + np.outer(now, input_now) + np.outer(after, input_next)
+            self.y, self._z = state[0], state[1]
         else:
-            self._gate *= 1.0 - params.goal_rate * h
+            h = step / tau
+            if h != self._checked_step:
+                check_euler_stable(step, tau, alpha, beta)
+                self._checked_step = h
+            z_next = self._z + h * (input_now - alpha * beta * self.y - alpha * self._z)
+            self.y = self.y + h * self._z
+            self._z = z_next
+            phase = self.phase * (1.0 - params.alpha_phase * h)
+            gate = self._next_gate(phase, 1.0 - (params.goal_rate or 0.0) * h)
+        self.phase, self._gate = phase, gate
         self.time += dt / slowdown
         return position, velocity, acceleration

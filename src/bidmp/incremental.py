@@ -47,6 +47,14 @@ __all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
 logger = logging.getLogger(__name__)
 
 
+def _derivative_rule(derivatives: str, params) -> str:
+    """How y_dn is differentiated: ``"auto"`` is what the DMP's integrator integrates (forward
+    differences for explicit Euler; the DMP's own, central by default, for the exact one)."""
+    if derivatives == "auto":
+        return "forward" if params.integrator == "euler" else params.derivatives
+    return params.derivatives if derivatives == "dmp" else derivatives
+
+
 class BiDMP(BaseEstimator):
     """A DMP with incrementally learned forcing-term blocks and a skill library (SPEC §7).
 
@@ -78,11 +86,13 @@ class BiDMP(BaseEstimator):
         incremental step of Eq. 23–26).
     seed : int, default 0
         Block p uses BLS seed ``seed + p``.
-    derivatives : {"forward", "gradient", "dmp"}, default "forward"
-        How y_dn is differentiated for F_target. Forward differences are what the explicit-Euler
-        rollout integrates, so the learned skill reproduces its demonstration up to the BLS fit,
-        end point included. ``np.gradient`` leaves a discretisation error at the goal (0.5 mm on
-        the battery approach). ``"dmp"`` uses the DMP's own setting.
+    derivatives : {"auto", "forward", "gradient", "dmp"}, default "auto"
+        How y_dn is differentiated for F_target. ``"auto"``: what the DMP's integrator integrates.
+        Forward differences for explicit Euler (paper), so the learned skill reproduces its
+        demonstration up to the BLS fit, end point included (``np.gradient`` there leaves a
+        discretisation error at the goal: 0.5 mm on the battery approach); for the exact
+        integrator (robot) the DMP's own rule, central differences, the continuous system's
+        derivatives. ``"dmp"`` always uses the DMP's own setting.
 
     Attributes
     ----------
@@ -112,7 +122,7 @@ class BiDMP(BaseEstimator):
         shrink: float = 0.8,
         reg: float = 1e-4,
         seed: int = 0,
-        derivatives: str = "forward",
+        derivatives: str = "auto",
     ) -> None:
         self.dmp = dmp
         self.n_windows = n_windows
@@ -141,7 +151,7 @@ class BiDMP(BaseEstimator):
         increments = tuple(check_int(n, "increments", minimum=1, limit="max_hidden_nodes") for n in increments)
         check_limit(n_windows * n_mapped + n_enhance + sum(increments), "max_hidden_nodes",
                     "the hidden nodes of one block, n_windows * n_mapped + n_enhance + sum(increments)")
-        derivatives = check_choice(self.derivatives, "derivatives", ("forward", "gradient", "dmp"))
+        derivatives = check_choice(self.derivatives, "derivatives", ("auto", "forward", "gradient", "dmp"))
         return increments, derivatives
 
     def __sklearn_is_fitted__(self) -> bool:
@@ -248,7 +258,7 @@ class BiDMP(BaseEstimator):
         phase, basis = dmp.training_grid()
         target = forcing_target(
             y, phase, dt=dmp.dt_, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
-            derivatives=params.derivatives if derivatives == "dmp" else derivatives, gate=dmp.training_gate(),
+            derivatives=_derivative_rule(derivatives, params), gate=dmp.training_gate(),
         )
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
         return self._learn_block(target - current, y[-1], y[0], increments)

@@ -59,8 +59,9 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-FORMAT_VERSION = 3
-# Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
+FORMAT_VERSION = 4
+# Format 4 (bidmp 0.4): a DMP stores its integrator ("exact" for the robot protocol); files without
+# one load with explicit Euler, so a format-3 robot model rolls out as it did. Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
 # Bi-DMP increments are gated by the phase and the DMP's regression is stored as "regression".
 # Format-1 and -2 DMP and BLS files still load (as protocol "paper", 1 s, no units); format-1
 # Bi-DMP files do not, because their blocks were trained on the ungated increment.
