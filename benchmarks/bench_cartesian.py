@@ -54,7 +54,7 @@ def main() -> int:
     peer_s = median_time(peer, args.repeats)
     mine, theirs = ours(), peer()
     n = min(len(poses), len(mine.t))
-    ours_error = np.degrees(angle_between(mine.orientation[:n], poses[:n, 3:]).max())
+    ours_error = np.degrees(angle_between(mine.q[:n], poses[:n, 3:]).max())
     peer_error = np.degrees(angle_between(theirs[: len(poses), [4, 5, 6, 3]], poses[: len(theirs), 3:]).max())
     print(f"pose DMP, T = {len(poses)}, 50 weights per dimension (median of {args.repeats} runs)")
     print(f"  bidmp CartesianDMP fit + trajectory:            {ours_s * 1e3:7.2f} ms   (max orientation error {ours_error:.3f} deg)")

@@ -35,15 +35,15 @@ def test_orientation_rollouts_stay_unit_and_reach_a_goal_turned_90_degrees(demo)
     goal[3:] = (Rotation.from_euler("z", 90, degrees=True) * Rotation.from_quat(demo[-1, 3:])).as_quat()
     for query in (None, goal):
         trajectory = model.trajectory(goal=query)
-        assert np.max(np.abs(np.linalg.norm(trajectory.orientation, axis=1) - 1.0)) <= 1e-12
-    assert np.degrees(angle_between(trajectory.orientation[-1:], goal[None, 3:]))[0] <= 0.1
-    assert np.linalg.norm(trajectory.position[-1] - goal[:3]) <= 0.15
+        assert np.max(np.abs(np.linalg.norm(trajectory.q, axis=1) - 1.0)) <= 1e-12
+    assert np.degrees(angle_between(trajectory.q[-1:], goal[None, 3:]))[0] <= 0.1
+    assert np.linalg.norm(trajectory.y[-1] - goal[:3]) <= 0.15
     # The angular velocity is the derivative of the orientation (world frame): the explicit-Euler
     # step from sample l to l + 1, to first order in dt.
     dt = trajectory.t[1] - trajectory.t[0]
-    step = Rotation.from_quat(trajectory.orientation[1:]) * Rotation.from_quat(trajectory.orientation[:-1]).inv()
+    step = Rotation.from_quat(trajectory.q[1:]) * Rotation.from_quat(trajectory.q[:-1]).inv()
     numeric = step.as_rotvec() / dt
-    assert np.max(np.linalg.norm(numeric - trajectory.angular_velocity[:-1], axis=1)) <= \
+    assert np.max(np.linalg.norm(numeric - trajectory.omega[:-1], axis=1)) <= \
         0.01 * np.max(np.linalg.norm(numeric, axis=1))
 
 
@@ -82,31 +82,50 @@ def test_a_recorded_pose_demonstration_is_reproduced_within_half_a_degree(tmp_pa
     reproduction = model.trajectory()  # the motion, then 10 % at rest (robot protocol)
     motion = reproduction.t <= prepared_t[-1]
     truth = Slerp(t - t[0], rotations)(reproduction.t[motion] + info.start_s)
-    rms = np.sqrt(np.mean(np.degrees(angle_between(reproduction.orientation[motion], truth.as_quat())) ** 2))
+    rms = np.sqrt(np.mean(np.degrees(angle_between(reproduction.q[motion], truth.as_quat())) ** 2))
     assert rms <= 0.5
     # Fitted raw, the sensor noise (0.05 degrees per sample) is differentiated twice: far worse.
     with pytest.warns(UserWarning, match="not of unit length"):
         raw = CartesianDMP().fit(poses, stamps).trajectory()
     raw_truth = Slerp(t - t[0], rotations)(np.clip(raw.t, 0, t[-1] - t[0]))
-    assert np.sqrt(np.mean(np.degrees(angle_between(raw.orientation, raw_truth.as_quat())) ** 2)) > 2 * rms
+    assert np.sqrt(np.mean(np.degrees(angle_between(raw.q, raw_truth.as_quat())) ** 2)) > 2 * rms
 
 
-def test_agreement_with_movement_primitives_cartesian_dmp(demo):
+@pytest.mark.parametrize("goal_turn, rate, bound", [
+    (0.0, "demo", (0.0, 0.01)),  # 0.32 % of the rotation, measured
+    (0.0, 1000.0, (0.0, 0.012)),  # 0.82 %: each side integrates Euler at its own step
+    (30.0, "demo", (0.05, 0.10)),  # 8.4 %: Ude's quaternion error and the log at the goal differ by design
+    (30.0, 1000.0, (0.05, 0.10)),
+])
+def test_agreement_with_movement_primitives_cartesian_dmp(demo, goal_turn, rate, bound):
+    """The same gains (alpha_y = 25, beta_y = 6.25), 50 weights and the phase decaying to 0.01 as
+    movement_primitives' CartesianDMP (Ude 2014), at the demonstration's rate and at 1 kHz, to
+    its goal and to one turned by 30 degrees. The difference, as a share of the demonstrated
+    rotation, stays in the stated band: small for the demonstrated goal; for a turned goal the two
+    formulations differ (by about 7 degrees), and both reach it."""
     mp = pytest.importorskip("movement_primitives.dmp")
     t = np.linspace(0.0, 2.0, len(demo))
+    dt = t[1] if rate == "demo" else 1.0 / rate
     metres = demo.copy()
     metres[:, :3] /= 1000.0
-    scalar_first = np.hstack([metres[:, :3], metres[:, [6, 3, 4, 5]]])
-    peer = mp.CartesianDMP(execution_time=2.0, dt=t[1], n_weights_per_dim=50, int_dt=0.001)
-    peer.imitate(t, scalar_first)
-    peer.configure(start_y=scalar_first[0], goal_y=scalar_first[-1])
+    goal = metres[-1].copy()
+    goal[3:] = (Rotation.from_euler("z", goal_turn, degrees=True) * Rotation.from_quat(metres[-1, 3:])).as_quat()
+
+    def scalar_first(poses):
+        return np.hstack([poses[..., :3], poses[..., [6, 3, 4, 5]]])
+
+    peer = mp.CartesianDMP(execution_time=2.0, dt=dt, n_weights_per_dim=50, int_dt=0.001)
+    peer.imitate(t, scalar_first(metres))
+    peer.configure(start_y=scalar_first(metres)[0], goal_y=scalar_first(goal))
     theirs = peer.open_loop()[1][:, [4, 5, 6, 3]]
-    # The same gains (alpha_y = 25, beta_y = 6.25), 50 weights, and the phase decaying to 0.01.
     ours = CartesianDMP(protocol="paper", alpha=25.0, beta=6.25, K="paper", n_kernels=50,
-                        alpha_phase=-np.log(0.01)).fit(metres, t).trajectory(dt=t[1])
+                        alpha_phase=-np.log(0.01)).fit(metres, t).trajectory(goal, dt=dt)
     n = min(len(theirs), len(ours.t))
     extent = angle_between(demo[:1, 3:], demo[-1:, 3:])[0]
-    assert np.max(angle_between(ours.orientation[:n], theirs[:n])) <= 0.01 * extent
+    difference = np.max(angle_between(ours.q[:n], theirs[:n])) / extent
+    assert bound[0] <= difference <= bound[1]
+    for end in (ours.q[-1:], theirs[-1:]):
+        assert np.degrees(angle_between(end, goal[None, 3:]))[0] <= 0.2
 
 
 def test_quaternions_are_made_continuous_normalised_or_refused(demo):
@@ -171,7 +190,9 @@ def test_the_kept_approach_keeps_its_pose_relative_to_the_target():
     flat = pose_demo([[-80, -120, 200], [0, 0, 40], [0, 0, 0]], [0.0, 0.0, 0.0])
     tilt = Rotation.from_euler("x", 30, degrees=True)
     target = np.concatenate([[150.0, 25.0, 20.0], (tilt * Rotation.from_quat(flat[-1, 3:])).as_quat()])
-    extension, orientations = extend_pose_demonstration(flat, target, seed=0)
+    extension = extend_pose_demonstration(flat, target, seed=0)
+    orientations = extension.orientations
+    np.testing.assert_array_equal(extension.poses, np.hstack([extension.complete, orientations]))
     start = extension.approach_index
     kept = extension.complete[start:]
     expected = target[:3] + tilt.apply(flat[start:, :3] - flat[-1, :3])
@@ -219,3 +240,148 @@ def test_cli_fits_and_rolls_out_a_pose_recording(tmp_path, capsys):
     assert np.linalg.norm(poses[-1, :3] - goal[:3]) <= 0.15
     assert np.degrees(angle_between(poses[-1:, 3:], np.array(goal[3:])[None]))[0] <= 0.1
     assert main(["rollout", str(tmp_path / "m.npz"), "--goal", "1", "2", "-o", str(tmp_path / "x.csv")]) == 2
+
+
+# --- issue 19: turns past 180 degrees, still parts, one pose API --------------------------------
+def screw_turn(degrees, n_steps=400, pitch=1.25):
+    """A nutrunner's demonstration: the socket turns ``degrees`` about its own (vertical) axis,
+    minimum jerk, and rises by the M8 thread's pitch per turn (mm)."""
+    s = minimum_jerk([[0.0], [1.0]], n_steps)[:, 0]
+    axis = DOWN.apply([0.0, 0.0, 1.0])
+    rotations = Rotation.from_rotvec(np.outer(s * np.radians(degrees), axis)) * DOWN
+    positions = np.column_stack([np.zeros(n_steps), np.zeros(n_steps), s * pitch * degrees / 360.0])
+    return np.column_stack([positions, rotations.as_quat()]), np.linspace(0.0, 4.0, n_steps)
+
+
+def turned_angle(quaternions):
+    """The whole angle (deg) turned from the first to the last orientation, several turns included."""
+    from bidmp.cartesian import orientation_error
+
+    return np.degrees(np.linalg.norm(orientation_error(quaternions, quaternions[-1])[0]))
+
+
+@pytest.mark.parametrize("degrees", [190, 270, 360, 720])
+@pytest.mark.parametrize("protocol", ["robot", "paper"])
+def test_turns_past_180_degrees_are_reproduced(degrees, protocol):
+    """Issue 19.5: on today's main SciPy's principal rotation vector wrapped at 180 degrees, and
+    190 / 270 / 360 degree turns reproduced 155 / 178 / 171 degrees off."""
+    poses, t = screw_turn(degrees)
+    model = CartesianDMP(protocol=protocol).fit(poses, t, units="mm")
+    reproduction = model.rollout()[: len(poses)]
+    assert np.degrees(angle_between(reproduction[:, 3:], poses[:, 3:])).max() <= 0.5
+    assert turned_angle(reproduction[:, 3:]) == pytest.approx(degrees, abs=0.5)
+    timed = model.trajectory()
+    # The angular velocity integrates to the whole turn (an independent check of omega).
+    turned = np.sum(0.5 * (timed.omega[1:] + timed.omega[:-1]) * np.diff(timed.t)[:, None], axis=0)
+    assert np.degrees(np.linalg.norm(turned)) == pytest.approx(degrees, rel=0.01)
+
+
+def test_a_multi_turn_skill_keeps_its_turns_for_a_new_start_and_goal():
+    poses, t = screw_turn(720)
+    model = CartesianDMP().fit(poses, t)
+    axis = DOWN.apply([0.0, 0.0, 1.0])  # the tool axis the demonstration turns about
+    goal = poses[-1].copy()
+    goal[3:] = (Rotation.from_rotvec(np.radians(20) * axis) * Rotation.from_quat(poses[-1, 3:])).as_quat()
+    start = poses[0].copy()
+    start[3:] = (Rotation.from_rotvec(np.radians(-15) * axis) * Rotation.from_quat(poses[0, 3:])).as_quat()
+    moved = model.trajectory(goal, start)
+    assert np.degrees(angle_between(moved.q[-1:], goal[None, 3:]))[0] <= 0.1
+    assert turned_angle(moved.q) == pytest.approx(720 + 20 + 15, abs=1.0)  # the same two turns, plus the offsets
+
+
+def test_movement_primitives_agrees_on_a_270_degree_turn():
+    mp = pytest.importorskip("movement_primitives.dmp")
+    poses, t = screw_turn(270)
+    metres = poses.copy()
+    metres[:, :3] /= 1000.0
+    scalar_first = np.hstack([metres[:, :3], metres[:, [6, 3, 4, 5]]])
+    peer = mp.CartesianDMP(execution_time=t[-1], dt=t[1], n_weights_per_dim=50, int_dt=0.001)
+    peer.imitate(t, scalar_first)
+    peer.configure(start_y=scalar_first[0], goal_y=scalar_first[-1])
+    theirs = peer.open_loop()[1][:, [4, 5, 6, 3]]
+    ours = CartesianDMP().fit(metres, t).rollout()[: len(theirs)]
+    # Both follow the whole turn: within 2 degrees of each other (movement_primitives itself is
+    # 1.3 degrees off the demonstration here; bidmp 0.002).
+    assert np.degrees(angle_between(ours[:, 3:], theirs)).max() <= 2.0
+    assert np.degrees(angle_between(ours[:, 3:], poses[: len(ours), 3:])).max() <= 0.1
+
+
+def test_a_constant_orientation_and_a_rotation_in_place_fit_and_reproduce():
+    """Issue 19.6: on today's main both were refused with "y is degenerate: all 200 points are
+    identical", about the part that does not move."""
+    positions = minimum_jerk([[0, 0, 100], [80, 20, 40], [150, 25, 0]], 300)
+    t = np.linspace(0.0, 3.0, 300)
+    straight_down = np.column_stack([positions, np.repeat(DOWN.as_quat()[None], 300, axis=0)])
+    model = CartesianDMP().fit(straight_down, t, units="mm")
+    reproduction = model.rollout()[:300]
+    assert np.abs(reproduction[:, :3] - positions).max() <= 0.05
+    assert np.degrees(angle_between(reproduction[:, 3:], straight_down[:, 3:])).max() <= 1e-9
+    # A turned goal for a part that did not move: it turns in step with the motion's progress.
+    goal = straight_down[-1].copy()
+    goal[3:] = (Rotation.from_euler("z", 40, degrees=True) * DOWN).as_quat()
+    moved = model.trajectory(goal)
+    turned = np.degrees(angle_between(moved.q, np.repeat(DOWN.as_quat()[None], len(moved), axis=0)))
+    assert turned[-1] == pytest.approx(40.0, abs=0.01)
+    assert np.all(np.diff(turned) >= -1e-4 * 40) and turned.max() <= 40.0 * (1 + 1e-4)  # monotone, to 1e-4 of the turn
+    progress = np.linalg.norm(moved.y - moved.y[0], axis=1) > 0.5 * np.linalg.norm(goal[:3] - moved.y[0])
+    assert 5.0 < turned[np.argmax(progress)] < 35.0  # half-way along the path, part of the turn
+
+    in_place, t = screw_turn(90)
+    in_place[:, :3] = [10.0, 20.0, 30.0]
+    model = CartesianDMP().fit(in_place, t)
+    reproduction = model.rollout()[: len(in_place)]
+    assert np.abs(reproduction[:, :3] - in_place[:, :3]).max() <= 1e-9
+    assert np.degrees(angle_between(reproduction[:, 3:], in_place[:, 3:])).max() <= 0.05
+    moved = model.trajectory(np.r_[40.0, 20.0, 30.0, in_place[-1, 3:]])
+    assert np.linalg.norm(moved.y[-1] - [40.0, 20.0, 30.0]) <= 0.01
+    with pytest.raises(ValueError, match="poses: the demonstration does not move: all 400 poses are the same"):
+        CartesianDMP().fit(np.repeat(in_place[:1], 400, axis=0))
+
+
+def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
+    """Issue 19.7: PoseTrajectory mirrors Trajectory, the steppers return the same triple, goal_
+    is named alike, CartesianBiDMP is an estimator with trajectory(), the pose extension returns
+    one object and the pose CSV carries accelerations."""
+    import dataclasses
+
+    from sklearn.base import clone
+
+    t = np.linspace(0.0, 2.0, len(demo))
+    model = CartesianDMP().fit(demo, t, units="mm")
+    assert model.goal_.shape == (7,) and model.start_.shape == (7,)
+    motion = model.trajectory()
+    position = model.position_.trajectory()
+    for name in ("t", "y", "yd", "ydd", "units"):
+        np.testing.assert_array_equal(getattr(motion, name), getattr(position, name))
+    assert motion.duration == position.duration and len(motion) == len(position)
+    assert motion.peak_speed() == position.peak_speed()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        motion.t = None
+    names, data = motion.columns()
+    assert names[:8] == ["t", "x", "y", "z", "qx", "qy", "qz", "qw"] and data.shape == (len(motion), len(names))
+    assert {"ax", "ay", "az", "dwx", "dwy", "dwz"} <= set(names)
+    save_poses(motion, tmp_path / "m.csv")
+    header = (tmp_path / "m.csv").read_text().splitlines()[0].split(",")
+    assert header == names
+    np.testing.assert_allclose(read_poses(tmp_path / "m.csv")[0], motion.poses, atol=1e-12)
+    # The angular acceleration is the derivative of the angular velocity.
+    np.testing.assert_allclose(np.gradient(motion.omega, motion.t, axis=0)[2:-2], motion.omega_dot[2:-2],
+                               atol=0.02 * np.abs(motion.omega_dot).max())
+    # Steppers: (command, velocity, acceleration), the pose ones 7 / 6 / 6 wide, equal to trajectory().
+    stepper = model.stepper()
+    commands = [stepper.step(motion.t[1]) for _ in range(len(motion))]
+    assert [c.shape for c in commands[0]] == [(7,), (6,), (6,)]
+    np.testing.assert_allclose(np.array([c[0] for c in commands]), motion.poses, atol=1e-8)
+    np.testing.assert_allclose(np.array([c[1] for c in commands]), np.hstack([motion.yd, motion.omega]), atol=1e-6)
+    np.testing.assert_allclose(np.array([c[2] for c in commands]), np.hstack([motion.ydd, motion.omega_dot]),
+                               atol=1e-4 * np.abs(motion.ydd).max())
+    # CartesianBiDMP: parameters in __init__, clone, fit, trajectory.
+    skills = CartesianBiDMP(model, increments=(10,))
+    assert clone(skills).get_params()["increments"] == (10,)
+    fitted = CartesianBiDMP(increments=(10,)).fit(demo, t, units="mm")
+    np.testing.assert_allclose(fitted.trajectory().poses, motion.poses, atol=1e-9)
+    extension = extend_pose_demonstration(demo, np.r_[demo[-1, :3] + [60.0, 30.0, 0.0], demo[-1, 3:]], seed=0)
+    skills.learn(extension.poses)
+    learned = skills.trajectory(extension.poses[-1])
+    assert np.linalg.norm(learned.y[-1] - extension.poses[-1, :3]) <= 0.1
+    assert isinstance(learned, type(motion))

@@ -212,9 +212,9 @@ def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
         moved = dmp.trajectory(dmp.goal_ + delta)
         share = (moved.y - home.y) @ delta / (delta @ delta)
         np.testing.assert_allclose(moved.y - home.y, np.outer(share, delta), atol=1e-9 * np.linalg.norm(delta))
-        # Monotone from 0 to 1, up to a trace of the discretised gate (1e-5 of the shift: 1 µm here).
+        # Monotone from 0 to 1, up to a trace of the finite-difference gate (1e-4 of the shift).
         assert share[0] == 0.0 and share[-1] == pytest.approx(1.0, abs=1e-4)
-        assert np.all(np.diff(share) >= -1e-5) and share.max() <= 1.0 + 1e-5
+        assert np.all(np.diff(share) >= -1e-4) and share.max() <= 1.0 + 1e-4
         learned = dmp.training_trajectory(prepared.y)
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(learned, axis=0), axis=1))])
         sigma = np.interp(home.t, np.arange(len(arc)) * dmp.duration_ / (dmp.n_steps_ - 1), arc / arc[-1])

@@ -1,20 +1,23 @@
-"""Pose skills: position + unit quaternion DMPs, and their Bi-DMP (issue 13).
+"""Pose skills: position + unit quaternion DMPs, and their Bi-DMP (issues 13 and 19).
 
 Orientation is learned in the tangent space at the goal. A demonstrated orientation ``q(t)`` is
 mapped to the rotation vector of its error to the goal,
 
     e(t) = Log(q(t) ⊗ g⁻¹) ∈ R³            (radians; e(T) = 0)
 
-and a position DMP with goal 0 is fitted on ``e``. A rollout to a new goal orientation ``g'``
-from a start ``q₀`` runs that DMP from ``Log(q₀ ⊗ g'⁻¹)`` to 0 and maps back,
-``q(t) = Exp(e(t)) ⊗ g'``. This is the formulation of Koutras & Doulgeri (2020, "A correct
-formulation for the orientation dynamic movement primitives for robot control in the Cartesian
-space"): unlike the quaternion DMP of Ude et al. (2014) it is a plain DMP in R³. So it converges
-to any goal orientation with the position DMP's guarantees, keeps the quaternion unit by
-construction, and inherits everything bidmp's DMP has: both protocols, the progress gate's smooth
-starts, temporal scaling, limits, the stepper, and the Bi-DMP increments. Ude's DMP
-(movement_primitives' ``CartesianDMP``) and this one agree where they should. A test compares the
-two on the same data with the same gains and phase.
+taken *continuous along the demonstration* (:func:`bidmp._so3.continuous_log`), so a turn of
+several revolutions keeps its whole angle, and a position DMP with goal 0 is fitted on ``e``. A
+rollout to a new goal orientation ``g'`` from a start ``q₀`` runs that DMP from ``Log(q₀ ⊗ g'⁻¹)``
+(the equivalent nearest the demonstrated start's, so it turns the same way, as many times) to 0
+and maps back, ``q(t) = Exp(e(t)) ⊗ g'``. This is the formulation of Koutras & Doulgeri (2020,
+"A correct formulation for the orientation dynamic movement primitives for robot control in the
+Cartesian space"): unlike the quaternion DMP of Ude et al. (2014) it is a plain DMP in R³. So it
+converges to any goal orientation with the position DMP's guarantees, keeps the quaternion unit
+by construction, and inherits everything bidmp's DMP has: both protocols, the smooth goal share,
+temporal scaling, limits, the stepper, and the Bi-DMP increments.
+
+A part that does not move (a socket held straight down while the tool travels, or a rotation in
+place) is fitted all the same: its goal share follows the other part's progress.
 
 Quaternions are ``(x, y, z, w)``, scalar last, as in SciPy and PyBullet. Poses are ``(T, 7)``
 arrays ``x, y, z, qx, qy, qz, qw``. Angular velocities are in the world frame, in rad/s.
@@ -23,43 +26,32 @@ arrays ``x, y, z, qx, qy, qz, qw``. Angular velocities are in the world frame, i
 from __future__ import annotations
 
 import logging
-import warnings
-from dataclasses import dataclass
-
 import numpy as np
-from scipy.spatial.transform import Rotation
-from sklearn.base import BaseEstimator
+from sklearn.base import BaseEstimator, clone
 
-from ._checks import as_point, as_trajectory, check_fitted, numerically_guarded
+from ._checks import as_point, as_trajectory, check_fitted, check_loaded, numerically_guarded
+from ._so3 import (
+    angle_between,
+    as_quaternions,
+    continuous_log,
+    left_jacobian,
+    nearest_turn,
+    orientation_from_log,
+)
+from ._pose_time import PoseStepper, PoseTrajectory, pose_trajectory
 from ._trajectory import continuous_quaternions
-from .dmp import DMP
+from .dmp import DMP, arclength_progress
 
-__all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "prepare_poses", "PoseStepper", "PoseTrajectory", "as_quaternions", "as_poses", "continuous_quaternions",
-           "orientation_error", "left_jacobian", "angle_between"]
+__all__ = ["CartesianDMP", "CartesianBiDMP", "pose_forgetting", "prepare_poses", "PoseStepper", "PoseTrajectory",
+           "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "left_jacobian", "angle_between"]
 
 logger = logging.getLogger(__name__)
 
-_NORM_TOLERANCE = 1e-6  # a quaternion further than this from unit length is normalised, with a warning
 
-
-def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
-    """Validate quaternions ``(n, 4)`` (x, y, z, w): finite, not zero; non-unit ones are
-    normalised with a warning; signs made continuous."""
-    array = np.asarray(q, dtype=float)
-    if array.ndim == 1:
-        array = array[None]
-    if array.ndim != 2 or array.shape[1] != 4:
-        raise ValueError(f"{name} must have shape (n, 4) (qx, qy, qz, qw), got {np.shape(q)}")
-    if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} contain NaN or inf")
-    norms = np.linalg.norm(array, axis=1)
-    if np.any(norms < 1e-9):
-        raise ValueError(f"{name}: row {int(np.argmax(norms < 1e-9))} is a zero quaternion, which is no rotation")
-    off = np.abs(norms - 1.0) > _NORM_TOLERANCE
-    if np.any(off):
-        warnings.warn(f"{name}: {int(off.sum())} quaternion(s) were not of unit length (up to {np.max(np.abs(norms - 1)):.3g} off) "
-                      f"and were normalised", UserWarning, stacklevel=3)
-    return continuous_quaternions(array / norms[:, None])
+def orientation_error(q, goal) -> np.ndarray:
+    """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3), radians, continuous along ``q`` (several
+    turns keep their whole angle; see :func:`bidmp._so3.continuous_log`)."""
+    return continuous_log(q, goal)
 
 
 def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarray, np.ndarray]:
@@ -70,74 +62,13 @@ def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarra
     return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
 
 
-def orientation_error(q, goal) -> np.ndarray:
-    """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3), radians."""
-    return (Rotation.from_quat(q) * Rotation.from_quat(goal).inv()).as_rotvec()
-
-
-def angle_between(q, p) -> np.ndarray:
-    """The angle (rad) of the rotation between orientations ``q`` and ``p`` (n,)."""
-    return np.linalg.norm(orientation_error(q, p), axis=-1)
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    out = np.zeros(v.shape[:-1] + (3, 3))
-    out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = -v[..., 2], v[..., 1], -v[..., 0]
-    out[..., 1, 0], out[..., 2, 0], out[..., 2, 1] = v[..., 2], -v[..., 1], v[..., 0]
-    return out
-
-
-def left_jacobian(r: np.ndarray) -> np.ndarray:
-    """Left Jacobian of SO(3), (n, 3, 3): ``ω = J_l(r) ṙ`` for ``R = Exp(r) G`` (world-frame ω)."""
-    r = np.atleast_2d(r)
-    theta = np.linalg.norm(r, axis=1)
-    small = theta < 1e-6
-    safe = np.where(small, 1.0, theta)
-    a = np.where(small, 0.5 - theta**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
-    b = np.where(small, 1.0 / 6.0 - theta**2 / 120.0, (safe - np.sin(safe)) / safe**3)
-    k = _skew(r)
-    return np.eye(3) + a[:, None, None] * k + b[:, None, None] * (k @ k)
-
-
-@dataclass
-class PoseTrajectory:
-    """A timed pose trajectory (lengths in ``units``, angles in rad, time in s).
-
-    Attributes
-    ----------
-    t : (n,)
-    position, velocity, acceleration : (n, 3)
-    orientation : (n, 4) unit quaternions (x, y, z, w)
-    angular_velocity, angular_acceleration : (n, 3), world frame
-    """
-
-    t: np.ndarray
-    position: np.ndarray
-    orientation: np.ndarray
-    velocity: np.ndarray
-    angular_velocity: np.ndarray
-    acceleration: np.ndarray
-    angular_acceleration: np.ndarray
-    units: str = ""
-
-    @property
-    def poses(self) -> np.ndarray:
-        """(n, 7): x, y, z, qx, qy, qz, qw."""
-        return np.hstack([self.position, self.orientation])
-
-
-def _orientation_from_error(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
-    q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat()
-    return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
-
-
 _ORIENTATION_WEIGHT = 1e-6  # rad -> "units" while prepare() filters: the idle ends are found from positions
 
 
 def prepare_poses(poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = ""):
     """:func:`bidmp.prepare` for a pose recording: uniform time, the same zero-phase low-pass on
-    positions and on the orientation (in the tangent space at the last sample), idle ends
-    trimmed by the positions' speed.
+    positions and on the orientation (its continuous log at the last sample), idle ends trimmed
+    by the positions' speed.
 
     Returns
     -------
@@ -150,22 +81,57 @@ def prepare_poses(poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.
     goal = quaternions[-1]
     # Scaled down, the orientation rides along through the same linear filter and resampling
     # without moving the speed threshold that finds the motion.
-    stacked = np.hstack([positions, orientation_error(quaternions, goal) * _ORIENTATION_WEIGHT])
+    stacked = np.hstack([positions, continuous_log(quaternions, goal) * _ORIENTATION_WEIGHT])
     trajectory, info = prepare(stacked, t, cutoff_hz=cutoff_hz, idle_fraction=idle_fraction, units=units)
-    orientation = _orientation_from_error(trajectory.y[:, 3:] / _ORIENTATION_WEIGHT, goal)
+    orientation = orientation_from_log(trajectory.y[:, 3:] / _ORIENTATION_WEIGHT, goal)
     return np.hstack([trajectory.y[:, :3], orientation]), trajectory.t, info
+
+
+def _pose_parts(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions (T, 3), quaternions (T, 4) and the continuous orientation log (T, 3) of a pose
+    demonstration; refused if neither part moves."""
+    positions, quaternions = as_poses(poses)
+    log = continuous_log(quaternions, quaternions[-1])
+    if np.ptp(positions, axis=0).max() == 0.0 and np.ptp(log, axis=0).max() <= 1e-12:
+        raise ValueError(f"poses: the demonstration does not move: all {len(positions)} poses are the same "
+                         f"(position {np.round(positions[0], 6).tolist()}, one orientation)")
+    return positions, quaternions, log
+
+
+def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: str = "poses") -> None:
+    """Fit the two parts; a part that does not move follows the other's progress."""
+    position_still = np.ptp(positions, axis=0).max() == 0.0
+    orientation_still = np.ptp(log, axis=0).max() <= 1e-12
+    if position_still:
+        orientation._fit(log, t, name=f"{name}' orientation")
+        position._fit(positions, t, units, progress=arclength_progress(orientation.training_trajectory(log)))
+        return
+    position._fit(positions, t, units, name=f"{name}' positions")
+    progress = arclength_progress(position.training_trajectory(positions)) if orientation_still else None
+    orientation._fit(log, t, progress=progress, name=f"{name}' orientation")
 
 
 class CartesianDMP(BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
-    Parameters are those of :class:`bidmp.DMP` (the same for both parts). After ``fit``:
-    ``position_``, ``orientation_`` (the two DMPs), ``start_pose_``, ``goal_pose_``.
+    Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``
+    may change after ``fit``.
+
+    Attributes
+    ----------
+    position_, orientation_ : DMP
+        The two parts (the orientation part's unit is the radian).
+    start_, goal_ : array (7,)
+        The demonstration's first and last pose (x, y, z, qx, qy, qz, qw).
+    start_log_ : array (3,)
+        The demonstrated start orientation's continuous log at the goal (rad; several turns
+        included).
+    units_ : str
     """
 
     def __init__(self, n_kernels=None, alpha=None, beta=None, K=None, alpha_phase=None, tau: float = 1.0,
-                 regression: str = "lwr", derivatives: str = "gradient", ridge: float = 1e-8, widths: str = "spacing",
-                 protocol: str = "robot", goal_rate=None) -> None:
+                 regression=None, derivatives: str = "gradient", ridge: float = 1e-8, widths: str = "spacing",
+                 protocol: str = "robot", goal_rate=None, integrator=None) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
         self.beta = beta
@@ -178,6 +144,7 @@ class CartesianDMP(BaseEstimator):
         self.widths = widths
         self.protocol = protocol
         self.goal_rate = goal_rate
+        self.integrator = integrator
 
     def _dmp(self) -> DMP:
         return DMP(**self.get_params())
@@ -187,18 +154,27 @@ class CartesianDMP(BaseEstimator):
         """Learn from one pose demonstration ``(T, 7)`` (x, y, z, qx, qy, qz, qw), with optional
         timestamps ``t`` (s) as :meth:`bidmp.DMP.fit`. Quaternion sign flips are made continuous;
         non-unit quaternions are normalised with a warning; zero ones refused."""
-        positions, quaternions = as_poses(poses)
-        goal = quaternions[-1]
-        position = self._dmp().fit(positions, t, units)
-        orientation = self._dmp().fit(orientation_error(quaternions, goal), t)
+        positions, quaternions, log = _pose_parts(poses)
+        position, orientation = self._dmp(), self._dmp()
+        _fit_parts(position, orientation, positions, log, t, units)
         self.position_, self.orientation_ = position, orientation
-        self.start_pose_ = np.concatenate([positions[0], quaternions[0]])
-        self.goal_pose_ = np.concatenate([positions[-1], goal])
+        self.start_ = np.concatenate([positions[0], quaternions[0]])
+        self.goal_ = np.concatenate([positions[-1], quaternions[-1]])
+        self.start_log_ = log[0].copy()
         self.units_ = position.units_
         return self
 
     def __sklearn_is_fitted__(self) -> bool:
-        return hasattr(self, "position_")
+        return "position_" in self.__dict__ and self.position_.__sklearn_is_fitted__()
+
+    def _parts(self) -> tuple[DMP, DMP]:
+        """The fitted parts, with this model's parameters (a changed tau is passed on; a changed
+        learned parameter makes them refuse, naming it)."""
+        check_fitted(self, "position_")
+        for part in (self.position_, self.orientation_):
+            part.set_params(**self.get_params())
+            part._check_fitted()
+        return self.position_, self.orientation_
 
     @property
     def duration_(self) -> float:
@@ -206,12 +182,12 @@ class CartesianDMP(BaseEstimator):
         return self.position_.duration_
 
     def _query(self, goal, start):
-        check_fitted(self, "position_")
-        goal = self.goal_pose_ if goal is None else as_point(goal, 7, "goal")
-        start = self.start_pose_ if start is None else as_point(start, 7, "start")
+        self._parts()
+        goal = self.goal_ if goal is None else as_point(goal, 7, "goal")
+        start = self.start_ if start is None else as_point(start, 7, "start")
         goal_q = as_quaternions(goal[3:], "goal's quaternion")[0]
         start_q = as_quaternions(start[3:], "start's quaternion")[0]
-        return goal[:3], goal_q, start[:3], orientation_error(start_q[None], goal_q)[0]
+        return goal[:3], goal_q, start[:3], nearest_turn(start_q, goal_q, self.start_log_)
 
     @numerically_guarded
     def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
@@ -229,24 +205,15 @@ class CartesianDMP(BaseEstimator):
             the orientation follows the same timing.
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
-        position = self.position_.trajectory(goal_p, start_p, duration, dt, limits=limits,
-                                             forcing_increment=position_increment)
-        if limits:  # the orientation follows the motion time the position's limits chose
-            duration = position.t[-1] / self.position_._params().settle
-        error = self.orientation_.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment)
-        n = min(len(position.t), len(error.t))
-        orientation = _orientation_from_error(error.y[:n], goal_q)
-        omega = np.einsum("nij,nj->ni", left_jacobian(error.y[:n]), error.yd[:n])
-        alpha = np.gradient(omega, position.t[:n], axis=0) if n > 1 else np.zeros_like(omega)
-        return PoseTrajectory(position.t[:n], position.y[:n], orientation, position.yd[:n], omega, position.ydd[:n],
-                              alpha, self.units_)
+        return pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
+                                limits, position_increment, orientation_increment, self.units_)
 
     def rollout(self, goal=None, start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) on the DMP's sample grid (as :meth:`bidmp.DMP.rollout`)."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         position = self.position_.rollout(goal_p, start_p, n_steps)
         error = self.orientation_.rollout(np.zeros(3), start_e, n_steps)
-        return np.hstack([position, _orientation_from_error(error, goal_q)])
+        return np.hstack([position, orientation_from_log(error, goal_q)])
 
     def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling: float = 0.0) -> "PoseStepper":
         """A step-by-step integrator for a control loop; phase stopping on the position error."""
@@ -254,34 +221,59 @@ class CartesianDMP(BaseEstimator):
         return PoseStepper(self.position_.stepper(goal_p, start_p, duration, coupling=coupling),
                            self.orientation_.stepper(np.zeros(3), start_e, duration), goal_q)
 
-
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        check_fitted(self, "position_")
+        self._parts()
         return _parts_state(self, {"params": self.get_params()},
-                            {"start_pose_": self.start_pose_, "goal_pose_": self.goal_pose_})
+                            {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_})
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "CartesianDMP":
-        from ._checks import check_loaded
-
         position, orientation = _parts_from_state(DMP, "CartesianDMP", meta, arrays)
-        model = cls(**meta["params"])
+        model = cls(**_pose_params(meta["params"]))
         model.position_, model.orientation_ = position, orientation
         for part in (model.position_, model.orientation_):
             if part.n_dims_ != 3:
                 raise ValueError(f"a CartesianDMP's parts are 3-D; the file has D = {part.n_dims_}")
-        model.start_pose_ = check_loaded(arrays["start_pose_"], "start_pose_", (7,))
-        model.goal_pose_ = check_loaded(arrays["goal_pose_"], "goal_pose_", (7,))
-        for name in ("start_pose_", "goal_pose_"):
-            if abs(np.linalg.norm(getattr(model, name)[3:]) - 1.0) > 1e-6:
-                raise ValueError(f"member {name} does not hold a unit quaternion")
+        _read_poses_state(model, arrays)
         model.units_ = model.position_.units_
         return model
 
 
-class CartesianBiDMP:
+def _pose_params(params: dict) -> dict:
+    """A stored pose model's parameters; format 1-3 files integrated with explicit Euler."""
+    params = dict(params)
+    params.setdefault("integrator", "euler")
+    return params
+
+
+def _read_poses_state(model: CartesianDMP, arrays) -> None:
+    """``start_``, ``goal_`` and ``start_log_`` of a stored pose model (format 3: ``start_pose_``
+    and ``goal_pose_``, and the principal log at the start)."""
+    from ._so3 import principal_log
+
+    old = "start_" not in arrays
+    model.start_ = check_loaded(arrays["start_pose_" if old else "start_"], "start_", (7,))
+    model.goal_ = check_loaded(arrays["goal_pose_" if old else "goal_"], "goal_", (7,))
+    for name in ("start_", "goal_"):
+        if abs(np.linalg.norm(getattr(model, name)[3:]) - 1.0) > 1e-6:
+            raise ValueError(f"member {name} does not hold a unit quaternion")
+    if old:
+        model.start_log_ = principal_log(model.start_[None, 3:], model.goal_[3:])[0]
+    else:
+        model.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
+
+
+_BIDMP_PARAMS = ("n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives")
+
+
+class CartesianBiDMP(BaseEstimator):
     """Bi-DMP on poses: the increment is learned on both forcing terms, position and orientation.
+
+    A scikit-learn style estimator like :class:`bidmp.BiDMP`: ``CartesianBiDMP(cartesian)``
+    only stores its parameters; the model starts from the fitted ``cartesian`` at the first
+    :meth:`learn` (used as skill 0, never modified), or from a pose demonstration with
+    :meth:`fit`, which fits a copy of ``cartesian`` (default ``CartesianDMP()``).
 
     Two :class:`bidmp.BiDMP` share the skill library: a query's skill is chosen on the position
     goal (``"nearest"``, ``"latest"`` or an index, as for positions), and the orientation part
@@ -290,74 +282,147 @@ class CartesianBiDMP:
 
     Parameters
     ----------
-    cartesian : CartesianDMP
-        Fitted.
-    **bidmp_params
-        As :class:`bidmp.BiDMP` (n_windows, n_mapped, n_enhance, increments, shrink, reg, seed).
+    cartesian : CartesianDMP, default None
+    n_windows, n_mapped, n_enhance, increments, shrink, reg, seed, derivatives
+        As :class:`bidmp.BiDMP`, for both parts.
+
+    Attributes
+    ----------
+    cartesian_ : CartesianDMP
+    position_, orientation_ : BiDMP
+    skill_goal_orientations_, skill_start_orientations_ : array (n_skills, 4)
+    skill_start_logs_ : array (n_skills, 3)
     """
 
-    def __init__(self, cartesian: CartesianDMP, **bidmp_params):
+    def __init__(self, cartesian: CartesianDMP | None = None, n_windows: int = 10, n_mapped: int = 10,
+                 n_enhance: int = 100, increments: tuple[int, ...] = (20, 20), shrink: float = 0.8, reg: float = 1e-4,
+                 seed: int = 0, derivatives: str = "auto") -> None:
+        self.cartesian = cartesian
+        self.n_windows = n_windows
+        self.n_mapped = n_mapped
+        self.n_enhance = n_enhance
+        self.increments = increments
+        self.shrink = shrink
+        self.reg = reg
+        self.seed = seed
+        self.derivatives = derivatives
+
+    def _bidmp_params(self) -> dict:
+        return {name: getattr(self, name) for name in _BIDMP_PARAMS}
+
+    def _start(self, cartesian: CartesianDMP) -> None:
         from .incremental import BiDMP
 
-        check_fitted(cartesian, "position_")
+        cartesian._parts()
         self.cartesian_ = cartesian
-        self.position_ = BiDMP(cartesian.position_, **bidmp_params)
-        self.orientation_ = BiDMP(cartesian.orientation_, **bidmp_params)
-        self.skill_goal_orientations_ = [cartesian.goal_pose_[3:].copy()]
-        self.skill_start_orientations_ = [cartesian.start_pose_[3:].copy()]
+        self.position_ = BiDMP(cartesian.position_, **self._bidmp_params())
+        self.orientation_ = BiDMP(cartesian.orientation_, **self._bidmp_params())
+        self.position_._check_params()
+        self.skill_goal_orientations_ = cartesian.goal_[None, 3:].copy()
+        self.skill_start_orientations_ = cartesian.start_[None, 3:].copy()
+        self.skill_start_logs_ = cartesian.start_log_[None].copy()
+
+    def _ensure_started(self) -> None:
+        if "cartesian_" in self.__dict__:
+            return
+        if self.cartesian is None or not isinstance(self.cartesian, CartesianDMP):
+            raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(self.cartesian).__name__}")
+        check_fitted(self.cartesian, "position_")
+        self._start(self.cartesian)
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "cartesian_" in self.__dict__
+
+    @numerically_guarded
+    def fit(self, poses, t=None, units: str | None = None) -> "CartesianBiDMP":
+        """Fit a copy of ``cartesian`` (default ``CartesianDMP()``) on one pose demonstration as
+        skill 0, with no learned skills yet. Returns self."""
+        cartesian = clone(self.cartesian) if isinstance(self.cartesian, CartesianDMP) else CartesianDMP()
+        self._start(cartesian.fit(poses, t, units))
+        return self
 
     @property
     def n_skills(self) -> int:
+        self._ensure_started()
         return self.position_.n_skills
 
+    @numerically_guarded
     def learn(self, poses) -> "CartesianBiDMP":
         """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts). Returns self."""
-        positions, quaternions = as_poses(poses, "poses")
-        goal = quaternions[-1]
+        self._ensure_started()
+        positions, quaternions, log = _pose_parts(poses)
         self.position_.learn(positions)
-        self.orientation_.learn(orientation_error(quaternions, goal))
-        self.skill_goal_orientations_.append(goal.copy())
-        self.skill_start_orientations_.append(quaternions[0].copy())
+        self.orientation_.learn(log)
+        self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
+        self.skill_start_orientations_ = np.vstack([self.skill_start_orientations_, quaternions[0]])
+        self.skill_start_logs_ = np.vstack([self.skill_start_logs_, log[0]])
         return self
 
+    def select_skill(self, goal=None, skill="nearest") -> int:
+        """The skill a query uses (chosen on the position goal, as :meth:`bidmp.BiDMP.select_skill`)."""
+        self._ensure_started()
+        if goal is None and skill == "nearest":
+            return self.n_skills - 1
+        goal = None if goal is None else as_point(goal, 7, "goal")[:3]
+        return self.position_.select_skill(goal, skill)
+
     def _query(self, goal, skill, start):
+        self._ensure_started()
+        self.cartesian_._parts()
+        index = self.select_skill(goal, skill)
         goal = None if goal is None else as_point(goal, 7, "goal")
-        index = self.position_.select_skill(None if goal is None else goal[:3], skill) if goal is not None or skill != "nearest" \
-            else self.n_skills - 1
         goal_q = self.skill_goal_orientations_[index] if goal is None else as_quaternions(goal[3:], "goal's quaternion")[0]
         start = None if start is None else as_point(start, 7, "start")
         start_q = self.skill_start_orientations_[index] if start is None else as_quaternions(start[3:], "start's quaternion")[0]
-        return (index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q,
-                orientation_error(start_q[None], goal_q)[0])
+        start_e = nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
+        return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
 
     def rollout(self, goal=None, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) with one skill (chosen on the position goal)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         position = self.position_.rollout(goal_p, skill=index, start=start_p, n_steps=n_steps)
         error = self.orientation_.rollout(np.zeros(3), skill=index, start=start_e, n_steps=n_steps)
-        return np.hstack([position, _orientation_from_error(error, goal_q)])
+        return np.hstack([position, orientation_from_log(error, goal_q)])
+
+    @numerically_guarded
+    def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None,
+                   dt: float | None = None, *, limits: dict | None = None) -> PoseTrajectory:
+        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
+        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
+        _, goal_p, start_p, position_increment = self.position_._skill_query(goal_p, index, start_p)
+        _, _, start_e, orientation_increment = self.orientation_._skill_query(np.zeros(3), index, start_e)
+        return pose_trajectory(self.position_.dmp_, self.orientation_.dmp_, goal_p, start_p, goal_q, start_e,
+                                duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_)
+
+    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
+                coupling: float = 0.0) -> "PoseStepper":
+        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
+        return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
+                           self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        return _parts_state(self, {"params": self.cartesian_.get_params()},
-                            {"start_pose_": self.cartesian_.start_pose_, "goal_pose_": self.cartesian_.goal_pose_,
-                             "skill_goal_orientations_": np.array(self.skill_goal_orientations_),
-                             "skill_start_orientations_": np.array(self.skill_start_orientations_)})
+        self._ensure_started()
+        cartesian = self.cartesian_
+        return _parts_state(self, {"params": cartesian.get_params()},
+                            {"start_": cartesian.start_, "goal_": cartesian.goal_, "start_log_": cartesian.start_log_,
+                             "skill_goal_orientations_": self.skill_goal_orientations_,
+                             "skill_start_orientations_": self.skill_start_orientations_,
+                             "skill_start_logs_": self.skill_start_logs_})
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "CartesianBiDMP":
-        from ._checks import check_loaded
+        from ._so3 import principal_log
         from .incremental import BiDMP
 
         position, orientation = _parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
         if position.n_skills != orientation.n_skills or position.dmp_.n_dims_ != 3 or orientation.dmp_.n_dims_ != 3:
             raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
-        cartesian = CartesianDMP(**meta["params"])
+        cartesian = CartesianDMP(**_pose_params(meta["params"]))
         cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
-        cartesian.start_pose_ = check_loaded(arrays["start_pose_"], "start_pose_", (7,))
-        cartesian.goal_pose_ = check_loaded(arrays["goal_pose_"], "goal_pose_", (7,))
+        _read_poses_state(cartesian, arrays)
         cartesian.units_ = position.dmp_.units_
-        model = cls.__new__(cls)
+        model = cls(cartesian, **{name: getattr(position, name) for name in _BIDMP_PARAMS})
         model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation
         shape = (position.n_skills, 4)
         goals = check_loaded(arrays["skill_goal_orientations_"], "skill_goal_orientations_", shape)
@@ -365,14 +430,12 @@ class CartesianBiDMP:
         for name, values in (("skill_goal_orientations_", goals), ("skill_start_orientations_", starts)):
             if np.any(np.abs(np.linalg.norm(values, axis=1) - 1.0) > 1e-6):
                 raise ValueError(f"member {name} does not hold unit quaternions")
-        model.skill_goal_orientations_, model.skill_start_orientations_ = list(goals), list(starts)
+        model.skill_goal_orientations_, model.skill_start_orientations_ = goals, starts
+        if "skill_start_logs_" in arrays:
+            model.skill_start_logs_ = check_loaded(arrays["skill_start_logs_"], "skill_start_logs_", (position.n_skills, 3))
+        else:  # format 3
+            model.skill_start_logs_ = np.array([principal_log(s[None], g)[0] for s, g in zip(starts, goals)])
         return model
-
-    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
-                coupling: float = 0.0) -> "PoseStepper":
-        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
-        return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
-                           self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)
 
 
 def _parts_state(model, meta: dict, arrays: dict) -> tuple[dict, dict]:
@@ -400,8 +463,8 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
     position error (units) and orientation error (rad) between its rollout after all were learned
     and right after it was learned, (n_skills, 2)."""
     model = CartesianBiDMP(cartesian, **bidmp_params)
-    queries = [cartesian.goal_pose_]
-    when_learned = [model.rollout(cartesian.goal_pose_, skill=skill)]
+    queries = [cartesian.goal_]
+    when_learned = [model.rollout(cartesian.goal_, skill=skill)]
     for poses in demonstrations:
         model.learn(poses)
         goal = np.asarray(poses, dtype=float)[-1]
@@ -413,34 +476,3 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
         out[index] = (np.max(np.linalg.norm(after[:, :3] - before[:, :3], axis=1)),
                       np.max(angle_between(after[:, 3:], before[:, 3:])))
     return out
-
-
-class PoseStepper:
-    """Steps a :class:`CartesianDMP`'s two parts together; the position part's phase stopping
-    paces the orientation part too, so the two stay on the same motion time."""
-
-    def __init__(self, position, orientation, goal_orientation):
-        self.position = position
-        self.orientation = orientation
-        self.goal_orientation = goal_orientation
-
-    @property
-    def time(self) -> float:
-        return self.position.time
-
-    @property
-    def y(self) -> np.ndarray:
-        return np.concatenate([self.position.y, _orientation_from_error(self.orientation.y[None], self.goal_orientation)[0]])
-
-    def step(self, dt: float, position_measured=None):
-        """Command pose (7,), velocity (3,) and angular velocity (3,) now; advance ``dt`` s
-        (less while the measured position lags)."""
-        before = self.position.time
-        y, yd, _ = self.position.step(dt, position_measured)
-        advanced = self.position.time - before
-        e, ed, _ = self.orientation.step(max(advanced, 1e-6))
-        pace = advanced / dt if dt > 0 else 1.0
-        q = _orientation_from_error(e[None], self.goal_orientation)[0]
-        omega = left_jacobian(e)[0] @ ed * pace
-        return np.concatenate([y, q]), yd, omega
-

@@ -180,12 +180,12 @@ def _rollout_poses(model, args: argparse.Namespace) -> int:
     dt = None if args.rate is None else 1.0 / args.rate
     trajectory = model.trajectory(goal=args.goal, start=args.start, duration=args.duration, dt=dt, limits=limits)
     path = save_poses(trajectory, args.output)
-    goal = model.goal_pose_ if args.goal is None else np.asarray(args.goal, dtype=float)
+    goal = model.goal_ if args.goal is None else np.asarray(args.goal, dtype=float)
     print(f"rolled out {len(trajectory.t)} poses over {trajectory.t[-1]:.4g} s to goal {np.array2string(goal, precision=4)}")
-    print(f"  end point {np.linalg.norm(trajectory.position[-1] - goal[:3]):.4g} {model.units_ or 'units'} and "
-          f"{np.degrees(angle_between(trajectory.orientation[-1:], goal[None, 3:] / np.linalg.norm(goal[3:])))[0]:.3g} deg "
+    print(f"  end point {np.linalg.norm(trajectory.y[-1] - goal[:3]):.4g} {model.units_ or 'units'} and "
+          f"{np.degrees(angle_between(trajectory.q[-1:], goal[None, 3:] / np.linalg.norm(goal[3:])))[0]:.3g} deg "
           f"from the goal")
-    print(f"wrote {path} (columns t,x,y,z,qx,qy,qz,qw,vx,vy,vz,wx,wy,wz)")
+    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
     return EXIT_OK
 
 

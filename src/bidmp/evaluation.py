@@ -472,9 +472,9 @@ def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
                         continue
                     source = demo if stage["from"] == "demonstration" or previous is None else previous
                     stage_scene = scenario.scene if stage.get("in_scene", True) else None
-                    extension, orientations = extend_pose_demonstration(source, target, seed=scenario.seed,
-                                                                        scene=stage_scene, **options)
-                    previous = np.hstack([extension.complete, orientations])
+                    extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene,
+                                                          **options)
+                    previous = extension.poses
                     model.learn(previous)
                     report.extensions.append(extension)
                     report.extension_targets.append(target[:3])

@@ -26,6 +26,7 @@ on (rest at the new target in ``"paper"``), so position and speed are continuous
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass
 
@@ -68,6 +69,9 @@ class ExtendedDemonstration:
         demonstration[-1])`` for ``n = T − approach_index``.
     approach_index : int or None
         First sample of the kept approach in the demonstration (``"keep"`` only).
+    orientations : array (T, 4) or None
+        For :func:`extend_pose_demonstration`: the orientation (x, y, z, w) at each sample of
+        ``complete``; :attr:`poses` is then the extended pose demonstration.
     """
 
     complete: np.ndarray
@@ -84,6 +88,14 @@ class ExtendedDemonstration:
     samples: np.ndarray | None = None
     approach: str = "paper"
     approach_index: int | None = None  # "keep": where the kept approach starts in the demonstration
+    orientations: np.ndarray | None = None  # pose extensions: (T, 4) quaternions along complete
+
+    @property
+    def poses(self) -> np.ndarray:
+        """The extended pose demonstration (T, 7) of :func:`extend_pose_demonstration`."""
+        if self.orientations is None:
+            raise AttributeError("this extension has no orientations: it was grown from positions (see complete)")
+        return np.hstack([self.complete, self.orientations])
 
     @property
     def prefix(self) -> np.ndarray:
@@ -404,8 +416,9 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
 
     Returns
     -------
-    (ExtendedDemonstration, orientations (T, 4))
-        The positional extension (``complete`` (T, 3)) and the orientation at each of its samples.
+    ExtendedDemonstration
+        As :func:`extend_demonstration` (``complete`` (T, 3) holds the positions), with
+        ``orientations`` (T, 4) and ``poses`` (T, 7), the extended pose demonstration to learn.
     """
     from scipy.spatial.transform import Rotation, Slerp
 
@@ -440,4 +453,4 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
         if not hit.collision_free:
             raise NoFreeRouteError(f"the extended pose demonstration to {np.round(target[:3], 3).tolist()} hits part "
                                    f"{hit.part!r} ({-hit.distance:.3g} deep) with the tool as it is turned")
-    return extension, orientations
+    return dataclasses.replace(extension, orientations=orientations)

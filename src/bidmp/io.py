@@ -875,8 +875,9 @@ def read_poses(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
 
 def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
     """Write poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) or a :class:`bidmp.cartesian.PoseTrajectory`
-    to a CSV with the header ``[t,]x,y,z,qx,qy,qz,qw`` (a trajectory adds ``vx..vz, wx..wz``:
-    units/s, rad/s), atomically."""
+    to a CSV with the header ``[t,]x,y,z,qx,qy,qz,qw`` (a trajectory adds ``vx..vz, wx..wz,
+    ax..az, dwx..dwz``: units/s, rad/s, units/s², rad/s², as :meth:`PoseTrajectory.columns`),
+    atomically."""
     from .cartesian import PoseTrajectory
 
     if not isinstance(path, (str, os.PathLike)):
@@ -884,8 +885,7 @@ def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
     path = Path(path)
     names = ["x", "y", "z", "qx", "qy", "qz", "qw"]
     if isinstance(poses, PoseTrajectory):
-        data = np.column_stack([poses.t, poses.poses, poses.velocity, poses.angular_velocity])
-        names = ["t", *names, "vx", "vy", "vz", "wx", "wy", "wz"]
+        names, data = poses.columns()
     else:
         data = as_trajectory(poses, "poses", min_points=1, allow_static=True)
         if data.shape[1] != 7:
