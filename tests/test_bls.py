@@ -70,16 +70,65 @@ def test_exact_ridge_update_equals_ridge_from_scratch():
         np.testing.assert_allclose(model.output_weights_, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
 
 
-def test_pinv_update_matches_pinv_from_scratch_up_to_conditioning():
-    # Tanh nodes of the same inputs are nearly collinear: compare what conditioning allows.
+def test_pinv_update_equals_numpy_pinv_from_scratch_on_random_problems():
+    """Against the independent reference, weights included (not the model's own A⁺ @ Y)."""
     X, Y = random_problem(2)
     model = BLS(n_windows=2, n_mapped=4, n_enhance=30, shrink=3.0, reg=0.0, seed=3).fit(X, Y)
-    for n_nodes in (10, 10):
+    for n_nodes in (10, 10, 25):
         model.add_enhancement_nodes(n_nodes)
         A = model.hidden(X)
-        reference = np.linalg.pinv(A, rcond=PINV_RCOND) @ Y
-        np.testing.assert_allclose(A @ model.output_weights_, A @ reference, atol=1e-6)
-        np.testing.assert_allclose(model.output_weights_, model.hidden_pinv_ @ Y, atol=1e-8 * np.abs(model.output_weights_).max())
+        reference = np.linalg.pinv(A, rcond=PINV_RCOND)
+        np.testing.assert_allclose(model.output_weights_, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max())
+        np.testing.assert_allclose(model.hidden_pinv_, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+
+
+def bidmp_hidden_problem(model):
+    """The BLS inputs and targets a Bi-DMP's first block was trained on: its own matrices."""
+    phase, basis = model.dmp_.training_grid()
+    return model._bls_input(phase, basis), model.blocks_[0].train_targets_
+
+
+@pytest.fixture(scope="module")
+def nut_bidmp():
+    from bidmp.evaluation import evaluate
+
+    return evaluate(bidmp.scenarios.load("nut-unscrewing"), ["bidmp"]).model
+
+
+def test_pinv_update_on_a_recordings_bidmp_matrices_equals_numpy_pinv():
+    """Issue 19.9 on the project's own matrices: a Bi-DMP learned from a bundled recording."""
+    y, t = bidmp.datasets.recording("operator1_nut3")
+    prepared, _ = bidmp.prepare(y, t)
+    dmp = bidmp.DMP().fit(prepared.y, prepared.t)
+    model = bidmp.BiDMP(dmp).learn(bidmp.extend_demonstration(prepared.y, dmp.goal_ + [150.0, 25.0, 0.0], seed=0).complete)
+    X, Y = bidmp_hidden_problem(model)
+    bls = BLS(reg=0.0, seed=model.blocks_[0].seed).fit(X, Y)
+    for _ in range(2):
+        bls.add_enhancement_nodes(20)
+        reference = np.linalg.pinv(bls.train_hidden_, rcond=PINV_RCOND) @ Y
+        assert np.linalg.norm(bls.output_weights_ - reference) <= 1e-6 * np.linalg.norm(reference)
+
+
+def test_pinv_update_on_the_nut_tasks_bidmp_matrices_is_refused_with_the_reason(nut_bidmp):
+    """Issue 19.9: on today's main add_enhancement_nodes(20) raised the training residual from
+    322 to 27 570 (a from-scratch pinv: 307) and BiDMP(reg=0) rolled out 108 mm off. The
+    pseudo-inverse of these matrices is ill-posed (shown here with NumPy alone): the update is
+    refused, saying why; reg > 0 is exact on the same matrices."""
+    X, Y = bidmp_hidden_problem(nut_bidmp)
+    bls = BLS(reg=0.0, seed=1).fit(X, Y)
+    A = np.hstack([bls.train_hidden_, np.tanh(np.random.default_rng(0).normal(size=(X.shape[0], 20)))])
+    weights = np.linalg.pinv(A, rcond=PINV_RCOND) @ Y
+    nudged = np.linalg.pinv(A * (1.0 + 1e-15 * np.random.default_rng(1).normal(size=A.shape)), rcond=PINV_RCOND) @ Y
+    assert np.linalg.norm(nudged - weights) > 1e-8 * np.linalg.norm(weights)  # rounding moves NumPy's own answer
+    with pytest.raises(ValueError, match="ill-posed.*decay through the rank cut.*use reg > 0"):
+        bls.add_enhancement_nodes(20)
+    assert bls.n_hidden_ == 200  # refused before anything changed
+    with pytest.raises(ValueError, match="ill-posed"):
+        bidmp.BiDMP(nut_bidmp.dmp_, reg=0.0).learn(nut_bidmp.rollout(nut_bidmp.skill_goals_[1]))
+    ridge = BLS(reg=1e-4, seed=1).fit(X, Y).add_enhancement_nodes(20)
+    A = ridge.train_hidden_
+    reference = np.linalg.solve(A.T @ A + 1e-4 * np.eye(A.shape[1]), A.T @ Y)
+    assert np.linalg.norm(ridge.output_weights_ - reference) <= 1e-6 * np.linalg.norm(reference)
 
 
 @pytest.mark.parametrize("params", [{}, {"reg": 0.0}, {"reg": 1e-3}, {"n_windows": 3, "n_mapped": 7}])

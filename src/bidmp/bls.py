@@ -15,10 +15,22 @@ Hidden layer for inputs X (N × d), with ``X̃ = [X, 0.1]``:
 **Adding enhancement nodes E** without retraining (Eq. 23–26): ``D = A⁺E``, ``C = E − AD``,
 ``[A | E]⁺ = [A⁺ − D Bᵀ ; Bᵀ]`` and ``W_new = [W − D BᵀY ; BᵀY]``, with ``Bᵀ = C⁺`` when C has
 full column rank and ``Bᵀ = (I + DᵀD)⁻¹DᵀA⁺`` when ``C = 0``. In between, the general Cline
-(1964) block formula is exact in every case. The rank of C is decided with an *absolute*
-tolerance (singular values below ``1e-10 · ‖E‖₂``), not NumPy's relative default. The widely
-circulated BLS code gets both of these wrong: its zero test (``C.all() == 0``) is wrong, and its
-C = 0 branch has ``I − DᵀD``.
+(1964) block formula is exact in every case (:func:`block_pinv_update`). The widely circulated
+BLS code gets two of these wrong: its zero test (``C.all() == 0``) is wrong, and its C = 0
+branch has ``I − DᵀD``.
+
+That formula is exact for the exact pseudo-inverse; a numerical one is truncated at a rank cut
+(``PINV_RCOND`` of the largest singular value), and Cline's C then keeps the directions A's
+truncation dropped. So ``BLS(reg=0)`` updates the *thin SVD* of the hidden matrix instead
+(the SVD of ``[U S | E]``, ``N × (r + m)``), truncated at the same relative cut as
+``numpy.linalg.pinv``. That equals a from-scratch pinv whenever the pseudo-inverse is well posed:
+when the cut falls in a gap of the spectrum (the smallest kept singular value at least ``1e4``
+times the largest dropped one; on a Bi-DMP learned from a bundled recording it then equals
+``numpy.linalg.pinv`` to 1e-7). Where it is not — the nut task's Bi-DMP hidden matrix has
+singular values decaying continuously through the cut, kept and dropped ones meeting at about
+1e-10 of the largest, so that a 1e-15 relative change of the matrix moves NumPy's own weights by
+more than 1e-8 and no update reproduces them — the update is refused with that reason; ``reg > 0``
+is exact there (``update="exact_ridge"``). ``tests/test_bls.py`` measures both.
 With ``update="exact_ridge"`` the model keeps the Cholesky factor of ``AᵀA + λI`` and grows it
 by a block Cholesky step, so that the result equals a ridge fit from scratch with the same nodes.
 (An explicit block inverse via the Schur complement loses all accuracy here, because the hidden
@@ -49,12 +61,14 @@ from ._checks import (
 )
 from ._threads import single_threaded
 
-__all__ = ["BLS", "sparse_autoencoder", "block_pinv_update"]
+__all__ = ["BLS", "sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update"]
 
 logger = logging.getLogger(__name__)
 
 _BIAS = 0.1  # the constant appended to inputs and to Z (paper Eq. 17-18)
-_RANK_TOLERANCE = 1e-10  # singular values of C below this times ‖E‖₂ count as zero
+_RANK_TOLERANCE = 1e-10  # block_pinv_update: singular values of C below this times ‖E‖₂ count as zero
+# The truncated pseudo-inverse is well posed when its cut falls in a spectral gap this wide.
+PINV_GAP = 1e4
 # Mapped features are linear in [X, 0.1], so the hidden matrix is rank-deficient by construction
 # (rank(Z) <= d + 2): its Moore–Penrose inverse needs a clean cut. Singular values below this
 # fraction of the largest count as zero.
@@ -112,13 +126,40 @@ def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_it
     return z
 
 
-def _ridge_pinv(A: np.ndarray, reg: float) -> np.ndarray:
-    if reg == 0.0:
-        return np.linalg.pinv(A, rcond=PINV_RCOND)
-    n_rows, n_cols = A.shape
-    if n_rows >= n_cols:
-        return np.linalg.solve(A.T @ A + reg * np.eye(n_cols), A.T)
-    return A.T @ np.linalg.solve(A @ A.T + reg * np.eye(n_rows), np.eye(n_rows))
+def truncated_svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Thin SVD of A cut as ``numpy.linalg.pinv(A, rcond=PINV_RCOND)`` cuts it:
+    ``(U (N, r), s (r,), V (c, r), dropped singular values)``."""
+    u, s, vt = np.linalg.svd(A, full_matrices=False)
+    keep = s > PINV_RCOND * (s[0] if s.size else 0.0)
+    return np.ascontiguousarray(u[:, keep]), s[keep], np.ascontiguousarray(vt[keep].T), s[~keep]
+
+
+def _check_gap(kept: np.ndarray, dropped: np.ndarray) -> None:
+    """Refuse a pseudo-inverse whose rank cut does not fall in a spectral gap (see the module
+    docstring): its weights then depend on rounding, and no update can reproduce them."""
+    if kept.size == 0 or dropped.size == 0 or dropped[0] * PINV_GAP <= kept[-1]:
+        return
+    raise ValueError(
+        f"add_enhancement_nodes: with reg = 0 the output weights are the pseudo-inverse's, and for this hidden matrix "
+        f"it is ill-posed: its singular values decay through the rank cut ({PINV_RCOND:g} of the largest) without a gap "
+        f"(kept down to {kept[-1] / kept[0]:.3g}, dropped from {dropped[0] / kept[0]:.3g} of the largest), so rounding "
+        f"alone moves the weights and no update can match a from-scratch pinv; use reg > 0 (for which the update is "
+        f"exact, update='exact_ridge'; Bi-DMP's default is 1e-4)"
+    )
+
+
+def svd_update(U: np.ndarray, s: np.ndarray, V: np.ndarray, E: np.ndarray):
+    """The truncated thin SVD of ``[A | E]`` from that of ``A = U diag(s) Vᵀ`` (r kept values):
+    the SVD of ``K = [U diag(s) | E]`` (N × (r + m)), whose right factor maps back through
+    ``blockdiag(V, I)``. Returns ``(U', s', V', dropped)`` like :func:`truncated_svd`."""
+    K = np.hstack([U * s, E])
+    u, values, vt = np.linalg.svd(K, full_matrices=False)
+    keep = values > PINV_RCOND * values[0]
+    c, r, m = V.shape[0], V.shape[1], E.shape[1]
+    right = np.zeros((c + m, r + m))
+    right[:c, :r] = V
+    right[c:, r:] = np.eye(m)
+    return np.ascontiguousarray(u[:, keep]), values[keep], right @ vt[keep].T, values[~keep]
 
 
 def _pinv_absolute(C: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
@@ -209,7 +250,8 @@ class BLS(BaseEstimator):
     shrink : float, default 0.8
         Target maximum of the enhancement pre-activation (s_H = shrink / max|·|).
     reg : float, default 1e-8
-        Ridge λ of the output weights; 0 means the Moore–Penrose pseudo-inverse.
+        Ridge λ of the output weights; 0 means the Moore–Penrose pseudo-inverse (truncated at
+        ``PINV_RCOND``; adding nodes is refused where it is ill-posed, see the module docstring).
     l1 : float, default 1e-3
         Sparsity weight λ₁ of the autoencoder.
     admm_iterations : int, default 50
@@ -399,6 +441,7 @@ class BLS(BaseEstimator):
     def _set_train_hidden(self, A: np.ndarray) -> None:
         self._hidden_buffer = np.array(A, order="C")
         self._n_hidden = A.shape[1]
+        self._svd = None  # of another matrix
 
     def _append_train_hidden(self, E: np.ndarray) -> None:
         used, added = self._n_hidden, E.shape[1]
@@ -408,6 +451,16 @@ class BLS(BaseEstimator):
             self._hidden_buffer = grown
         self._hidden_buffer[:, used : used + added] = E
         self._n_hidden = used + added
+
+    def _hidden_svd(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The truncated thin SVD of the training hidden matrix (``reg = 0``), checked for a gap
+        at its cut; computed once (after ``fit`` or loading) and then updated block by block."""
+        svd = self.__dict__.get("_svd")
+        if svd is None or svd[2].shape[0] != self._n_hidden:
+            U, values, V, dropped = truncated_svd(self.train_hidden_)
+            _check_gap(values, dropped)
+            svd = self._svd = (U, values, V)
+        return svd
 
     def _set_solution(self, output_weights, hidden_pinv, gram_factor, projected_targets) -> None:
         self.output_weights_ = output_weights
@@ -453,11 +506,11 @@ class BLS(BaseEstimator):
             solution = (np.ascontiguousarray(np.vstack([W_old, W_new])), None, grown,
                         np.vstack([self._projected_targets, z_new]))
         else:
-            D, Bt, case = block_pinv_update(A, self.hidden_pinv_, E)
-            logger.debug("added %d enhancement nodes (C case: %s)", n, case)
-            BtY = Bt @ Y
-            solution = (np.vstack([self.output_weights_ - D @ BtY, BtY]),
-                        np.vstack([self.hidden_pinv_ - D @ Bt, Bt]), None, None)
+            U, values, V, dropped = svd_update(*self._hidden_svd(), E)
+            _check_gap(values, dropped)
+            pinv = np.ascontiguousarray((V / values) @ U.T)
+            solution = (pinv @ Y, pinv, None, None)
+            self._svd = (U, values, V)
         self.enhancement_weights_.append(weights)
         self.enhancement_scales_.append(scale)
         self._append_train_hidden(E)
@@ -545,5 +598,6 @@ def _solve_output(A: np.ndarray, Y: np.ndarray, params: _BLSParams) -> tuple:
                              f"too small for this hidden layer); use a larger reg") from None
         projected = solve_triangular(R, A.T @ Y, trans="T")
         return np.ascontiguousarray(solve_triangular(R, projected)), None, R, projected
-    pinv = np.ascontiguousarray(_ridge_pinv(A, params.reg))
+    U, values, V, _ = truncated_svd(A)
+    pinv = np.ascontiguousarray((V / values) @ U.T)  # numpy.linalg.pinv(A, rcond=PINV_RCOND)
     return pinv @ Y, pinv, None, None
