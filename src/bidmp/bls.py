@@ -256,8 +256,8 @@ class BLS(BaseEstimator):
         Sparsity weight λ₁ of the autoencoder.
     admm_iterations : int, default 50
     update : {"auto", "pinv", "exact_ridge"}, default "auto"
-        How :meth:`add_enhancement_nodes` updates: ``"pinv"`` is the block pseudo-inverse
-        (Eq. 23–26), exact when ``reg = 0``; ``"exact_ridge"`` is a block Cholesky step of the ridge
+        How :meth:`add_enhancement_nodes` updates: ``"pinv"`` is the pseudo-inverse of the grown
+        hidden matrix (Eq. 23–26's result, computed by a thin-SVD update), for ``reg = 0``; ``"exact_ridge"`` is a block Cholesky step of the ridge
         Gram matrix, equal to a ridge fit from scratch for any ``reg > 0``. ``"auto"`` picks
         ``"pinv"`` for ``reg = 0`` and ``"exact_ridge"`` otherwise. Eq. 23–26 applied to a *ridge*
         A⁺ (the paper's combination) is not exact: on these rank-deficient hidden matrices its
