@@ -361,8 +361,9 @@ def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
     assert names[:8] == ["t", "x", "y", "z", "qx", "qy", "qz", "qw"] and data.shape == (len(motion), len(names))
     assert {"ax", "ay", "az", "dwx", "dwy", "dwz"} <= set(names)
     save_poses(motion, tmp_path / "m.csv")
-    header = (tmp_path / "m.csv").read_text().splitlines()[0].split(",")
-    assert header == names
+    first, header = (tmp_path / "m.csv").read_text().splitlines()[:2]
+    assert first == "# units: mm" and header.split(",") == names
+    assert bidmp.io.declared_units(tmp_path / "m.csv") == "mm"
     np.testing.assert_allclose(read_poses(tmp_path / "m.csv")[0], motion.poses, atol=1e-12)
     # The angular acceleration is the derivative of the angular velocity.
     np.testing.assert_allclose(np.gradient(motion.omega, motion.t, axis=0)[2:-2], motion.omega_dot[2:-2],

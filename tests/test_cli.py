@@ -303,3 +303,110 @@ def test_the_cli_seed_bound_is_the_library_one():
     from bidmp import cli, reproduce
 
     assert cli._MAX_SEEDS == reproduce.MAX_SEEDS
+
+
+# --- issue 19: the pose commands, units, loggers' files, limits as caps ---------------------------
+@pytest.fixture
+def pose_recording(tmp_path):
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.datasets import kinesthetic_recording
+    from bidmp.io import save_poses
+
+    positions, t = kinesthetic_recording([[0, 0, 120], [60, -40, 60], [120, 10, 0]], seed=4)
+    _, moving = bidmp.prepare(positions, t)
+    s = np.clip((t - t[0] - moving.start_s) / (moving.end_s - moving.start_s), 0.0, 1.0)
+    down = Rotation.from_euler("x", 180, degrees=True)
+    quaternions = (Rotation.from_rotvec(np.outer(s, [0.2, 0.1, 0.6])) * down).as_quat()
+    return save_poses(np.hstack([positions, quaternions]), tmp_path / "poses.csv", times=t)
+
+
+def test_the_pose_commands_extend_learn_and_roll_out_a_pose_bidmp(tmp_path, pose_recording, capsys):
+    """Issue 19.8: on today's main extend and learn on a pose model ended with 'internal error:
+    AttributeError: Namespace object has no attribute skill', and rollout --plot wrote nothing."""
+    model, grown, more = tmp_path / "pose.npz", tmp_path / "grown.npz", tmp_path / "more.npz"
+    assert run(["fit", str(pose_recording), "-o", str(model), "--units", "mm"], capsys)[0] == 0
+    code, out, err = run(["extend", str(model), str(pose_recording), "--target", "170", "30", "0", "-o", str(grown),
+                          "--save-demo", str(tmp_path / "extended.csv"), "--plot", str(tmp_path / "x.png")], capsys)
+    assert code == 0, err
+    assert "learned skill 1" in out and (tmp_path / "x.png").is_file()
+    skills = bidmp.load(grown)
+    assert isinstance(skills, bidmp.CartesianBiDMP) and skills.n_skills == 2
+    extended, _ = bidmp.io.read_poses(tmp_path / "extended.csv")
+    np.testing.assert_allclose(extended[-1, :3], [170.0, 30.0, 0.0], atol=1e-6)
+    code, out, err = run(["learn", str(grown), str(pose_recording), "-o", str(more)], capsys)
+    assert code == 0, err
+    assert bidmp.load(more).n_skills == 3
+    figure = tmp_path / "r.png"
+    code, out, err = run(["rollout", str(more), "--skill", "1", "-o", str(tmp_path / "r.csv"), "--plot", str(figure)], capsys)
+    assert code == 0, err
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and "using skill 1" in out
+    poses, _ = bidmp.io.read_poses(tmp_path / "r.csv")
+    assert np.linalg.norm(poses[-1, :3] - [170.0, 30.0, 0.0]) <= 0.1
+    # A pose demonstration for a position model (and the reverse) is one clear line.
+    positions = save_trajectory(bidmp.io.read_poses(pose_recording)[0][:, :3], tmp_path / "positions.csv")
+    assert run(["learn", str(grown), str(positions), "-o", str(more)], capsys)[2].count("\n") == 1
+
+
+def test_units_are_a_known_set_checked_against_the_model_and_converted_on_request(tmp_path, capsys):
+    """Issue 19.10: on today's main --units took any text, a mm recording learned into a metre
+    model silently, and a mm goal on a metre model wrote a 458 m/s trajectory without a word."""
+    y, t = bidmp.datasets.recording("operator1_nut3")
+    in_metres = save_trajectory(y / 1000.0, tmp_path / "m.csv", times=t, units="m")
+    undeclared_mm = save_trajectory(y, tmp_path / "mm.csv", times=t)
+    assert in_metres.read_text().startswith("# units: m\n")
+    with pytest.raises(SystemExit) as exited:
+        main(["fit", str(undeclared_mm), "-o", str(tmp_path / "x.npz"), "--units", "furlong"])
+    assert exited.value.code == 2 and "--units: invalid choice: 'furlong'" in capsys.readouterr().err
+    assert run(["fit", str(in_metres), "-o", str(tmp_path / "m.npz")], capsys)[0] == 0  # the declared unit is kept
+    assert bidmp.load(tmp_path / "m.npz").units_ == "m"
+    code, _, err = run(["learn", str(tmp_path / "m.npz"), str(undeclared_mm), "-o", str(tmp_path / "y.npz")], capsys)
+    assert code == 2 and "declares no units" in err and "times the model's" in err
+    assert run(["fit", str(undeclared_mm), "-o", str(tmp_path / "mm.npz"), "--units", "mm"], capsys)[0] == 0
+    code, _, err = run(["learn", str(tmp_path / "mm.npz"), str(in_metres), "-o", str(tmp_path / "y.npz")], capsys)
+    assert code == 2 and "is in m but the model" in err and "in mm: pass --units mm" in err
+    code, out, err = run(["learn", str(tmp_path / "mm.npz"), str(in_metres), "-o", str(tmp_path / "y.npz"), "--units", "mm"],
+                         capsys)
+    assert code == 0 and "converted from m (declared in the file) to mm" in out
+    assert bidmp.load(tmp_path / "y.npz").skill_goals_[1] == pytest.approx(y[-1], abs=1.0)  # learned in mm
+    code, out, err = run(["rollout", str(tmp_path / "m.npz"), "--goal", "150", "20", "0", "-o", str(tmp_path / "g.csv")], capsys)
+    assert code == 0 and "beyond any robot's reach" in err and "is it in cm or mm?" in err
+    code, _, err = run(["extend", str(tmp_path / "m.npz"), str(in_metres), "--target", "0.1", "0.1", "0",
+                        "--scene", "nut-unscrewing", "-o", str(tmp_path / "z.npz")], capsys)
+    assert code == 2 and "the scene of nut-unscrewing is in mm but the model is in m" in err
+
+
+def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
+    """Issue 19.11: other column names, extra columns and a repeated stamp, as loggers write them."""
+    y, t = bidmp.datasets.recording("operator2_nut5")
+    t = t.copy()
+    t[300] = t[299]
+    rows = np.column_stack([t, y[:, 2], np.ones(len(t)), y[:, 0], y[:, 1]])
+    path = tmp_path / "log.csv"
+    path.write_text("stamp,ee_z,grip,ee_x,ee_y\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n")
+    code, out, err = run(["fit", str(path), "-o", str(tmp_path / "m.npz"), "--units", "mm",
+                          "--columns", "t=stamp,x=ee_x,y=ee_y,z=ee_z"], capsys)
+    assert code == 0, err
+    assert "ignored 1 column(s) that are not time or positions: grip" in err
+    assert "dropped 1 sample(s) whose timestamp repeats" in err
+    expected = bidmp.prepare(y, bidmp.datasets.recording("operator2_nut5")[1])[0].y[-1]  # the file without a dropped sample
+    np.testing.assert_allclose(bidmp.load(tmp_path / "m.npz").goal_, expected, atol=0.1)
+    code, _, err = run(["fit", str(path), "-o", str(tmp_path / "m.npz")], capsys)
+    assert code == 2 and "names no positions" in err and "--columns" in err
+
+
+def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys):
+    """Issue 19.12: on today's main --max-speed above the demonstrated speed shortened the motion."""
+    y, t = bidmp.datasets.recording("operator1_nut3")
+    recording = save_trajectory(y, tmp_path / "r.csv", times=t)
+    assert run(["fit", str(recording), "-o", str(tmp_path / "m.npz"), "--units", "mm"], capsys)[0] == 0
+    durations = {}
+    for name, extra in (("plain", []), ("cap", ["--max-speed", "1000"]), ("fastest", ["--max-speed", "1000", "--fastest"]),
+                        ("slow", ["--max-speed", "50"])):
+        code, _, err = run(["rollout", str(tmp_path / "m.npz"), "-o", str(tmp_path / f"{name}.csv"), *extra], capsys)
+        assert code == 0, err
+        durations[name] = bidmp.io.read_trajectory(tmp_path / f"{name}.csv")[1][-1]
+    assert durations["cap"] == durations["plain"]
+    assert durations["fastest"] < 0.5 * durations["plain"] and durations["slow"] > 2 * durations["plain"]
+    code, _, err = run(["rollout", str(tmp_path / "m.npz"), "-o", str(tmp_path / "x.csv"), "--fastest"], capsys)
+    assert code == 2 and "--fastest needs --max-speed or --max-acc" in err

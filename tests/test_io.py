@@ -67,15 +67,64 @@ def test_trajectory_round_trip_is_exact(tmp_path, suffix):
         ("nan.csv", "x,y\n0,0\nnan,1\n2,2\n", "NaN"),
         ("short.csv", "x,y\n0,0\n1,1\n", "at least 3 points"),
         ("same.csv", "x,y\n1,1\n1,1\n1,1\n", "identical"),
-        ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b not understood"),
+        ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b names no positions.*--columns"),
         ("onecol.csv", "1\n2\n3\n", "expected 2-4 columns"),
-        ("time.csv", "t,x,y\n0,0,0\n0,1,1\n1,2,2\n", "must increase strictly"),
+        ("time.csv", "t,x,y\n0,0,0\n1,1,1\n0.5,2,2\n", "must increase strictly: timestamp going back at sample 2"),
         ("demo.json", "{}", "unsupported file type .json"),
     ],
 )
 def test_bad_trajectory_files(tmp_path, name, text, match):
     with pytest.raises(ValueError, match=match):
         load_trajectory(write(tmp_path / name, text))
+
+
+# --- recordings as loggers write them (issue 19.11) -------------------------------------------
+def logger_file(tmp_path, header, rows, name="log.csv"):
+    path = tmp_path / name
+    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n")
+    return path
+
+
+def test_a_repeated_timestamp_is_dropped_with_a_warning(tmp_path, caplog):
+    """On today's main one repeated stamp refused the whole recording."""
+    y, t = bidmp.datasets.recording("operator1_nut3")
+    t = t.copy()
+    t[100] = t[99]  # the logger wrote one stamp twice
+    path = logger_file(tmp_path, "t,x,y,z", np.column_stack([t, y]))
+    with caplog.at_level("WARNING"):
+        positions, stamps = bidmp.io.read_trajectory(path)
+    assert len(positions) == len(y) - 1 and np.all(np.diff(stamps) > 0)
+    np.testing.assert_array_equal(positions[:100], y[:100])
+    assert "dropped 1 sample(s) whose timestamp repeats the one before (the first at sample 100" in caplog.text
+    prepared, _ = bidmp.prepare(y, t)  # prepare() and fit() take such stamps too
+    assert bidmp.DMP().fit(y, t).n_steps_ == len(y) - 1 and prepared.t[0] == 0.0
+
+
+def test_a_stamp_going_back_is_refused_with_values_that_can_be_told_apart():
+    """On today's main the message printed 1.7330868e+09 twice."""
+    t = 1733086800.0 + np.arange(10) * 0.004
+    t[5] = t[4] - 0.001
+    with pytest.raises(ValueError, match=r"going back at sample 5: 1733086800\.015 s after 1733086800\.016 s \(-0\.9999 ms"):
+        bidmp.timing.check_timestamps(t, 10)
+
+
+def test_logger_headers_extra_columns_and_a_column_mapping(tmp_path, caplog):
+    y, t = bidmp.datasets.recording("operator2_nut5")
+    force = np.sin(np.arange(len(t)))
+    plain = logger_file(tmp_path, "timestamp,x,y,z,force,gripper", np.column_stack([t, y, force, force > 0]), "a.csv")
+    with caplog.at_level("WARNING"):
+        positions, stamps = bidmp.io.read_trajectory(plain)
+    np.testing.assert_array_equal(positions, y)
+    np.testing.assert_array_equal(stamps, t)
+    assert "ignored 2 column(s) that are not time or positions: force, gripper" in caplog.text
+    named = logger_file(tmp_path, "stamp,ee_z,force,ee_x,ee_y", np.column_stack([t, y[:, 2], force, y[:, 0], y[:, 1]]), "b.csv")
+    positions, stamps = bidmp.io.read_trajectory(named, columns="t=stamp,x=ee_x,y=ee_y,z=ee_z")
+    np.testing.assert_array_equal(positions, y)
+    np.testing.assert_array_equal(stamps, t)
+    with pytest.raises(ValueError, match="no column 'ee_q' for z .*the header has stamp,ee_z,force,ee_x,ee_y"):
+        bidmp.io.read_trajectory(named, columns="t=stamp,x=ee_x,y=ee_y,z=ee_q")
+    with pytest.raises(ValueError, match="unknown role 'w'"):
+        bidmp.io.read_trajectory(named, columns="t=stamp,w=ee_x")
 
 
 def test_missing_and_bad_npy_files(tmp_path):

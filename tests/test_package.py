@@ -28,12 +28,13 @@ def test_import_and_cli_help_do_not_import_numpy():
 
 # Layers of ARCHITECTURE.md: a module may import only from its own or lower-numbered layers.
 LAYERS = {
-    "_checks": 1, "_threads": 1, "_noise": 1, "_trajectory": 1, "_integrate": 1, "_goals": 1, "_so3": 1, "_pose_time": 1, "timing": 1, "dmp": 1, "segmentation": 1, "similarity": 1,
+    "_checks": 1, "_threads": 1, "_noise": 1, "_trajectory": 1, "_integrate": 1, "_goals": 1, "_so3": 1,
+    "_pose_time": 1, "_columns": 1, "_units": 1, "timing": 1, "dmp": 1, "segmentation": 1, "similarity": 1,
     "roadmap": 1, "bls": 1, "baselines": 1, "geometry": 1,
     "extension": 2, "incremental": 2, "cartesian": 2,
     "datasets": 3, "io": 3, "scenarios": 3, "metrics": 3, "evaluation": 3, "reproduce": 3, "plotting": 3, "_tables": 3,
     "sim": 3, "benchmark": 3,
-    "cli": 4, "__main__": 4,
+    "cli": 4, "_cli_input": 4, "_cli_skills": 4, "__main__": 4,
 }
 
 
@@ -103,7 +104,7 @@ def test_plotting_never_switches_the_matplotlib_backend(tmp_path):
 
 def test_library_code_never_prints():
     for path in SRC.glob("*.py"):
-        if path.stem in ("cli", "__main__"):
+        if path.stem in ("cli", "__main__") or path.stem.startswith("_cli"):
             continue
         calls = [
             node for node in ast.walk(ast.parse(path.read_text()))

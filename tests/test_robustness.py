@@ -168,8 +168,10 @@ def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
     assert "1000000 samples" in out
     csv_path = tmp_path / "long.csv"
     np.savetxt(csv_path, np.column_stack([1.7e9 + t * 4000.0, y]), delimiter=",", header="t,x,y,z", comments="", fmt="%.6f")
-    code, out, err = cli(["segment", csv_path], seconds=20.0)
+    code, out, err = cli(["segment", csv_path, "--raw"], seconds=20.0)
     assert code == 0 and "1000000 samples" in out, err
+    code, out, err = cli(["segment", csv_path], seconds=20.0)  # timed input is prepared, as by fit
+    assert code == 0 and "prepared: kept" in out, err
     started = time.perf_counter()
     points = bidmp.segment(y).points
     assert time.perf_counter() - started < 5.0

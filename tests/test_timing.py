@@ -280,11 +280,33 @@ def test_time_scale_meets_every_limit_and_touches_one(fitted, limits):
     *_, dmp = fitted
     trajectory = dmp.trajectory(dmp.goal_ + SHIFT)
     scaled = bidmp.time_scale(trajectory, **limits)
-    np.testing.assert_array_equal(scaled.y, trajectory.y)
     assert scale_factor(scaled, **limits) == pytest.approx(1.0, abs=1e-9)  # binding limit met exactly
-    limited = dmp.trajectory(dmp.goal_ + SHIFT, limits=limits)  # re-integrated at the scaled duration
-    assert 0.99 <= scale_factor(limited, **limits) <= 1.0
-    assert np.linalg.norm(limited.y[-1] - dmp.goal_ - SHIFT) < 0.15
+    # The scaled copy (velocities / k, accelerations / k²) is the motion the DMP integrates at
+    # tau = k, sampled at the same instants: the time scaling against the dynamics.
+    k = scaled.t[1] / trajectory.t[1]
+    again = dmp.trajectory(dmp.goal_ + SHIFT, duration=k * dmp.duration_, dt=k * trajectory.t[1])
+    n = min(len(again), len(scaled))
+    for name in ("y", "yd", "ydd"):
+        scale = np.abs(getattr(scaled, name)).max()
+        np.testing.assert_allclose(getattr(again, name)[:n], getattr(scaled, name)[:n], atol=1e-9 * scale)
+    fastest = dmp.trajectory(dmp.goal_ + SHIFT, limits={**limits, "fastest": True})  # the shortest within them
+    assert 0.99 <= scale_factor(fastest, **limits) <= 1.0
+    assert np.linalg.norm(fastest.y[-1] - dmp.goal_ - SHIFT) < 0.15
+    capped = dmp.trajectory(dmp.goal_ + SHIFT, limits=limits)  # caps: never faster than demonstrated
+    assert scale_factor(capped, **limits) <= 1.0 and capped.t[-1] >= trajectory.t[-1] - 1e-9
+
+
+def test_limits_are_caps_that_never_hurry_a_motion(fitted):
+    """Issue 19.12: on today's main --max-speed above the demonstrated speed shortened a 4.5 s
+    motion to 3.78 s. A cap that the motion already keeps leaves it as demonstrated."""
+    *_, dmp = fitted
+    nominal = dmp.trajectory()
+    loose = {"max_velocity": 2.0 * nominal.peak_speed(), "max_acceleration": 2.0 * nominal.peak_acceleration()}
+    capped = dmp.trajectory(limits=loose)
+    np.testing.assert_array_equal(capped.y, nominal.y)
+    assert dmp.trajectory(limits={**loose, "fastest": True}).t[-1] < 0.9 * nominal.t[-1]
+    tight = {"max_velocity": 0.5 * nominal.peak_speed()}
+    assert dmp.trajectory(limits=tight).t[-1] > 1.9 * nominal.t[-1]
 
 
 def test_time_scale_on_a_closed_form_trajectory():
@@ -402,6 +424,9 @@ def test_bad_timestamps_are_named(stamps, match):
     t = np.arange(300) / 250.0
     with pytest.raises(ValueError, match=match):
         check_timestamps(stamps(t), 300)
+    if "duplicate" in match:  # a recording with a repeated stamp loses that sample, with a warning
+        assert bidmp.DMP().fit(minimum_jerk(NUT_VIA, 300), stamps(t)).n_steps_ == 299
+        return
     with pytest.raises(ValueError, match=match):
         bidmp.DMP().fit(minimum_jerk(NUT_VIA, 300), stamps(t))
 
@@ -428,8 +453,8 @@ def test_the_cli_writes_timed_rollouts_from_a_recording(tmp_path, capsys):
                  "--max-acc", "400", "-o", str(out)]) == 0
     text = capsys.readouterr().out
     assert "mm/s" in text
-    data = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert out.read_text().startswith("t,x,y,z,vx,vy,vz,ax,ay,az\n")
+    data = np.loadtxt(out, delimiter=",", skiprows=2)
+    assert out.read_text().startswith("# units: mm\nt,x,y,z,vx,vy,vz,ax,ay,az\n")
     np.testing.assert_allclose(np.diff(data[:, 0]), 1e-3, rtol=1e-9)
     assert np.linalg.norm(data[:, 4:7], axis=1).max() <= 100.0 + 1e-6
     assert np.linalg.norm(data[:, 7:10], axis=1).max() <= 400.0 + 1e-6

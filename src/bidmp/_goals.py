@@ -115,7 +115,8 @@ def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float,
     return float(REST_BLEND_MAX)
 
 
-def rest_started(y: np.ndarray, dt: float, duration_s: float) -> np.ndarray:
+def rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
+                 unit: str = "units") -> np.ndarray:
     """``y`` (T, D) with its start and end velocity blended out (module docstring).
 
     Parameters
@@ -126,6 +127,8 @@ def rest_started(y: np.ndarray, dt: float, duration_s: float) -> np.ndarray:
         Normalised step (``1 / T``).
     duration_s : float
         Seconds per unit of normalised time (for the log message).
+    what, unit : str
+        What the trajectory is and its length unit, for the log message.
     """
     velocity = np.gradient(y, dt, axis=0)
     acceleration = np.gradient(velocity, dt, axis=0)
@@ -141,7 +144,7 @@ def rest_started(y: np.ndarray, dt: float, duration_s: float) -> np.ndarray:
         out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
         speed = float(np.linalg.norm(speed_vector))
         level = logging.WARNING if speed > 0.05 * peak else logging.DEBUG
-        logger.log(level, "the demonstration %s at %.3g units/s (%.1f %% of its peak speed); the DMP %s at rest, "
-                   "blended over %.3g s", "ends" if end else "starts", speed / duration_s, 100 * speed / peak,
+        logger.log(level, "%s %s at %.3g %s/s (%.1f %% of its peak speed); the DMP %s at rest, blended over %.3g s",
+                   what, "ends" if end else "starts", speed / duration_s, unit, 100 * speed / peak,
                    "ends" if end else "starts", width * duration_s)
     return out

@@ -103,12 +103,13 @@ def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: 
     position_still = np.ptp(positions, axis=0).max() == 0.0
     orientation_still = np.ptp(log, axis=0).max() <= 1e-12
     if position_still:
-        orientation._fit(log, t, name=f"{name}' orientation")
-        position._fit(positions, t, units, progress=arclength_progress(orientation.training_trajectory(log)))
+        orientation._fit(log, t, name=f"{name}' orientation", unit_label="rad")
+        position._fit(positions, t, units, progress=arclength_progress(orientation.training_trajectory(log)),
+                      name=f"{name}' positions")
         return
     position._fit(positions, t, units, name=f"{name}' positions")
     progress = arclength_progress(position.training_trajectory(positions)) if orientation_still else None
-    orientation._fit(log, t, progress=progress, name=f"{name}' orientation")
+    orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
 class CartesianDMP(BaseEstimator):

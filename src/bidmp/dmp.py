@@ -50,6 +50,7 @@ from ._integrate import (
     foh_step,
 )
 from ._trajectory import arclength, resample_time
+from ._units import check_reach, check_units
 from ._checks import (
     NotFittedError,
     as_point,
@@ -517,8 +518,8 @@ class DMP(BaseEstimator):
             samples are resampled to uniform time over the same span, whose length becomes
             ``duration_``. Without them the samples are taken as uniform over 1 s (the paper's
             protocol).
-        units : str, optional
-            The length unit of ``y`` (e.g. ``"mm"``), kept in model files.
+        units : {"m", "cm", "mm"}, optional
+            The length unit of ``y``, kept in model files (anything else is refused).
 
         Returns
         -------
@@ -529,24 +530,26 @@ class DMP(BaseEstimator):
         return self._fit(y, t, units)
 
     def _fit(self, y, t=None, units: str | None = None, *, progress: np.ndarray | None = None,
-             name: str = "y") -> "DMP":
+             name: str = "y", unit_label: str | None = None) -> "DMP":
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
         move on its own: then ``y`` may be static)."""
-        from .timing import check_timestamps, uniform_time
+        from .timing import drop_duplicate_stamps, uniform_time
 
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else _check_units(units)
-        n_steps = y.shape[0]
         if t is None:
-            duration = (n_steps - 1) / n_steps
+            duration = (y.shape[0] - 1) / y.shape[0]
         else:
-            stamps = check_timestamps(t, n_steps)
+            y, stamps = drop_duplicate_stamps(y, t)
             y, grid = uniform_time(y, stamps)
             duration = float(grid[-1])
+        n_steps = y.shape[0]
         dt = 1.0 / n_steps
-        train = _with_rest(_goals.rest_started(y, dt, duration * n_steps / (n_steps - 1)) if params.rest_start else y,
-                           params)
+        if params.rest_start:
+            y_rest = _goals.rest_started(y, dt, duration * n_steps / (n_steps - 1), what="the demonstration" if name == "y"
+                                         else name, unit=unit_label or units or "units")
+        train = _with_rest(y_rest if params.rest_start else y, params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
         _check_integration(dt, params._replace(tau=1.0))
@@ -974,8 +977,10 @@ class DMP(BaseEstimator):
             Sample period in seconds; default the demonstration's (``duration_ / (T - 1)``).
         limits : dict, optional
             ``{"max_velocity": ..., "max_acceleration": ..., "max_jerk": ..., "norm": "norm" |
-            "axis"}`` (units/s, /s², /s³): the duration is chosen as the shortest that meets them
-            (see :func:`bidmp.time_scale`); ``duration`` is then ignored.
+            "axis", "fastest": False}`` (units/s, /s², /s³). Caps: a motion that breaks one is
+            slowed (uniformly) to the shortest duration that meets them all; one within them runs
+            as demonstrated, unless ``"fastest": True`` asks for the shortest duration within the
+            limits, faster than demonstrated. ``duration`` is then ignored.
         start_velocity : array (D,), optional
             Initial velocity in units/s (default at rest).
         forcing_increment : callable, optional
@@ -1003,6 +1008,9 @@ class DMP(BaseEstimator):
         free, goal_response, forcing, phase = self._prepare(start, velocity, n_samples + 2, forcing_increment,
                                                             params=params, step=step)
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+        if self.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
+            check_reach(float(min(np.linalg.norm(goal - self.goal_), np.linalg.norm(goal - self.start_))), self.units_,
+                        "the goal")
         positions = free + np.outer(goal_response, goal)
         if params.exact:
             start = self.start_ if start is None else as_point(start, free.shape[1], "start")
@@ -1022,15 +1030,23 @@ class DMP(BaseEstimator):
                           accelerations[:n_samples], self.units_)
 
     def _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment):
-        """The shortest duration whose trajectory meets ``limits``: scale by the exact factor of
+        """The trajectory within ``limits``: at the nominal duration if that meets them (limits
+        are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
+        shortest duration that does: scale by the exact factor of
         :func:`bidmp.timing.scale_factor`, then bisect for what the discretisation changes."""
         from .timing import scale_factor
 
         if not isinstance(limits, dict):
-            raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm, got {type(limits).__name__}")
-        unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm"}
+            raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
+                            f"got {type(limits).__name__}")
+        unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm", "fastest"}
         if unknown:
-            raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, max_jerk, norm")
+            raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, "
+                             f"max_jerk, norm, fastest")
+        limits = dict(limits)
+        fastest = limits.pop("fastest", False)
+        if not isinstance(fastest, (bool, np.bool_)):
+            raise TypeError(f"limits['fastest'] must be True or False, got {type(fastest).__name__}")
 
         def attempt(duration):
             trajectory = self.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
@@ -1042,6 +1058,8 @@ class DMP(BaseEstimator):
         # limit and touches the binding one within 0.1 %.
         duration = self._params().tau * self.duration_
         trajectory, factor = attempt(duration)
+        if factor <= 1.0 and not fastest:
+            return trajectory  # within the limits as demonstrated: a cap does not hurry it
         low = high = best = None  # durations known to break / to meet the limits
         for _ in range(60):
             if 1.0 - 1e-3 <= factor <= 1.0:
@@ -1202,12 +1220,8 @@ def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
 
 
 def _check_units(units) -> str:
-    """A length unit: a short printable string such as "mm" or "m" ("" = unknown)."""
-    if not isinstance(units, str):
-        raise TypeError(f"units must be a string such as 'mm', got {type(units).__name__}")
-    if len(units) > 16 or not all(c.isprintable() and not c.isspace() for c in units):
-        raise ValueError(f"units must be a short unit name such as 'mm' or 'm', got {units[:20]!r}")
-    return units
+    """A length unit: "m", "cm", "mm" or "" (unknown); see :mod:`bidmp._units`."""
+    return check_units(units)
 
 
 class DMPStepper:

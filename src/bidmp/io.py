@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ._checks import as_trajectory, check_bytes, check_limit, get_limits, short_token
+from ._columns import TIME_NAMES, parse_columns
 
 __all__ = [
     "ModelFileError",
@@ -485,13 +486,10 @@ def load_model(path: str | os.PathLike):
 # ---------------------------------------------------------------------------------------------
 # Trajectories
 # ---------------------------------------------------------------------------------------------
-_TIME_NAMES = ("t", "time")
+_TIME_NAMES = TIME_NAMES
 
 _SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
-# Pose headers: the quaternion's order is read from the names, never guessed.
-_POSE_HEADERS = {("x", "y", "z", "qw", "qx", "qy", "qz"): (3, 4, 5, 6), ("x", "y", "z", "qx", "qy", "qz", "qw"): (3, 4, 5, 6)}
-_POSE_ORDER = {("x", "y", "z", "qw", "qx", "qy", "qz"): [0, 1, 2, 4, 5, 6, 3], ("x", "y", "z", "qx", "qy", "qz", "qw"): list(range(7))}
 
 
 def _parse_float(text: str) -> float | None:
@@ -522,31 +520,61 @@ def _timed_columns(columns: tuple[str, ...]) -> int | None:
     return None
 
 
-def _read_csv(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    """Read a CSV trajectory; return (positions (T, D), times (T,) or None)."""
+def _note_ignored(path: Path, ignored: tuple[str, ...]) -> None:
+    if ignored:
+        shown = ", ".join(short_token(name, 16)[1:-1] for name in ignored[:8]) + (", …" if len(ignored) > 8 else "")
+        logger.warning("%s: ignored %d column(s) that are not time or positions: %s", path, len(ignored), shown)
+
+
+def _read_csv(path: Path, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
+    """Read a CSV trajectory; return (positions (T, D), times (T,) or None). ``columns``: a
+    column mapping (:func:`bidmp._columns.parse_columns`)."""
+    from ._columns import select_poses, select_positions
+
+    mapping = parse_columns(columns)
     parsed = _csv_fast(path)
-    columns, values = parsed if parsed is not None else _csv_rows(path)
+    header, values = parsed if parsed is not None else _csv_rows(path)
     n_columns = values.shape[1]
-    if columns is not None:
-        n_positions = _timed_columns(columns)
-        if n_positions is not None:  # a timed trajectory written by bidmp: positions and time only
-            return values[:, 1 : 1 + n_positions], values[:, 0]
-        has_time = columns[0] in _TIME_NAMES
-        names = columns[1:] if has_time else columns
-        if names not in _POSITION_HEADERS:
-            shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:8]) + (",…" if len(columns) > 8 else "")
-            pose = " (a pose recording: read it with bidmp.io.read_poses / bidmp.CartesianDMP)" if names in _POSE_HEADERS else ""
-            raise ValueError(f"{path}: header {shown} not understood{pose}; expected x,y[,z], t,x,y[,z] or "
-                             f"t,x,y[,z],vx,vy[,vz],ax,ay[,az]")
-    elif n_columns in (2, 3):
-        has_time = False  # header-less: positions only (add a header "t,x,y" to mark a time column)
-    elif n_columns == 4:
-        has_time = True
-    else:
-        raise ValueError(f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z), found {n_columns}")
-    if has_time:
-        return values[:, 1:], values[:, 0]
-    return values, None
+    if header is None:
+        if mapping is not None:
+            raise ValueError(f"{path} has no header, so --columns / columns= cannot name its columns")
+        if n_columns in (2, 3):  # header-less: positions only (add a header "t,x,y" to mark a time column)
+            return values, None
+        if n_columns == 4:
+            return values[:, 1:], values[:, 0]
+        raise ValueError(f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z) without a header, found {n_columns}")
+    n_positions = _timed_columns(header)
+    if n_positions is not None and mapping is None:  # a timed trajectory written by bidmp
+        return values[:, 1 : 1 + n_positions], values[:, 0]
+    if mapping is None and select_poses(header, None, path).values:
+        raise ValueError(f"{path}: a pose recording: read it with bidmp.io.read_poses / bidmp.CartesianDMP (its header "
+                         f"names qx, qy, qz, qw)")
+    selection = select_positions(header, mapping, path)
+    if not selection.values:
+        shown = ",".join(short_token(c, 12)[1:-1] for c in header[:8]) + (",…" if len(header) > 8 else "")
+        raise ValueError(f"{path}: header {shown} names no positions; expected x,y[,z] with an optional t/time/timestamp "
+                         f"column, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)")
+    _note_ignored(path, selection.ignored)
+    times = None if selection.time is None else values[:, selection.time]
+    return values[:, list(selection.values)], times
+
+
+def declared_units(path) -> str:
+    """The unit a CSV declares in a leading comment line ``# units: mm`` ("" if none)."""
+    from ._units import check_units
+
+    try:
+        with open(path, encoding="utf-8-sig") as handle:
+            for _ in range(16):
+                line = handle.readline(4096).strip()
+                if not line.startswith("#"):
+                    break
+                key, _, value = line[1:].partition(":")
+                if key.strip().lower() == "units":
+                    return check_units(value.strip(), f"{path}: the declared units")
+    except (OSError, UnicodeDecodeError):
+        return ""
+    return ""
 
 
 def _csv_delimiter(sample: str) -> str:
@@ -706,23 +734,25 @@ def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     y : array, shape (T, D)
         Validated: finite, at least 3 points, not all identical, within the limits.
     """
-    from .timing import check_timestamps, uniform_time
+    from .timing import uniform_time
 
     y, times = read_trajectory(path)
     if times is not None:
-        y, _ = uniform_time(y, check_timestamps(times, y.shape[0], f"{path}: the time column"))
+        y, _ = uniform_time(y, times)
     return y
 
 
-def read_trajectory(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
+def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a demonstration from ``.csv`` or ``.npy``: positions and, if the file has them,
     timestamps in seconds (as recorded: any monotone stamps, epoch-like or jittered).
 
     CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed, UTF-8 with
-    or without a byte-order mark. An optional header names the columns ``x,y[,z]``,
-    ``t,x,y[,z]`` (``time`` also works) or ``t,x,y[,z],vx,…,ax,…`` (a timed trajectory written by
-    bidmp; velocities and accelerations are ignored). Without a header 2 or 3 columns are
-    positions and 4 columns are ``t,x,y,z``.
+    or without a byte-order mark. An optional header names the columns: ``x,y[,z]`` with an
+    optional time column ``t`` (or ``time``, ``timestamp``), other columns ignored with a
+    warning that names them; ``columns`` maps other names, e.g. ``"t=stamp,x=ee_x,y=ee_y,z=ee_z"``
+    (see :mod:`bidmp._columns`). A timed trajectory written by bidmp (``t,x,y[,z],vx,…,ax,…``)
+    reads its positions and times. Without a header 2 or 3 columns are positions and 4 columns
+    are ``t,x,y,z``. Samples whose timestamp repeats the one before are dropped, with a warning.
     NPY: a float array of shape (T, D) (positions), or a structured array of shape (T,) with
     fields ``t, x, y[, z]`` (and optionally ``vx … az``), as :func:`save_trajectory` writes a
     :class:`bidmp.Trajectory`; read with ``allow_pickle=False`` after its header passed the
@@ -732,7 +762,7 @@ def read_trajectory(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | N
     -------
     (y, t) : array (T, D) and array (T,) or None
     """
-    from .timing import check_timestamps
+    from .timing import drop_duplicate_stamps
 
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
@@ -757,16 +787,18 @@ def read_trajectory(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | N
             times = np.asarray(positions["t"], dtype=np.float64)
             positions = np.column_stack([np.asarray(positions[name], dtype=np.float64) for name in fields])
     elif suffix in (".csv", ".txt"):
-        positions, times = _read_csv(path)
+        positions, times = _read_csv(path, columns)
     else:
         raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+    if columns is not None and suffix == ".npy":
+        raise ValueError(f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays")
     positions = as_trajectory(positions, name=str(path))
     if times is not None:
-        times = check_timestamps(times, positions.shape[0], f"{path}: the time column")
+        positions, times = drop_duplicate_stamps(positions, times, f"{path}: the time column")
     return positions, times
 
 
-def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
+def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:
     """Write a trajectory to ``path`` (``.csv`` or ``.npy``), atomically.
 
     ``y`` is positions (T, D), optionally with ``times`` (T,) in seconds, or a
@@ -778,8 +810,10 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
       of shape (T,) with the same named fields (``np.load(path)["t"]``, ``["vx"]``, …), still
       without pickles.
 
-    The argument order is the same as :func:`save_model` (what, then where). Non-finite values
-    are refused: a file a robot may execute never holds NaN or inf.
+    A CSV starts with a comment ``# units: mm`` when the unit is known (``units``, or the
+    Trajectory's), which :func:`declared_units` reads back. The argument order is the same as
+    :func:`save_model` (what, then where). Non-finite values are refused: a file a robot may
+    execute never holds NaN or inf.
     """
     from .timing import Trajectory
 
@@ -795,7 +829,8 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
         for name, column in (("t", y.t), ("yd", y.yd), ("ydd", y.ydd)):
             if not np.all(np.isfinite(column)):
                 raise ValueError(f"the trajectory's {name} contains NaN or inf")
-        return _write_columns(as_trajectory(y.y, "y", min_points=1, allow_static=True), names, data, path)
+        return _write_columns(as_trajectory(y.y, "y", min_points=1, allow_static=True), names, data, path,
+                              y.units if units is None else units)
     y = as_trajectory(y, "y", min_points=1, allow_static=True)
     _destination(path)
     suffix = path.suffix.lower()
@@ -805,6 +840,7 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
         return path
+    units = units or ""
     names = ["x", "y", "z"][: y.shape[1]] if y.shape[1] <= 3 else [f"x{i}" for i in range(y.shape[1])]
     data = y
     if times is not None:
@@ -815,11 +851,15 @@ def save_trajectory(y, path: str | os.PathLike, times=None) -> Path:
             raise ValueError("times contains NaN or inf")
         names = ["t", *names]
         data = np.column_stack([times, y])
-    return _write_columns(y, names, data, path)
+    return _write_columns(y, names, data, path, units)
 
 
-def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path) -> Path:
-    """Write named columns as CSV (header row) or as a structured ``.npy`` (one field each)."""
+def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path, units: str = "") -> Path:
+    """Write named columns as CSV (a ``# units:`` comment when known, a header row) or as a
+    structured ``.npy`` (one field each)."""
+    from ._units import check_units
+
+    units = check_units(units)
     _destination(path)
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv"):
@@ -832,22 +872,28 @@ def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path
             np.save(handle, records, allow_pickle=False)
         return path
     with atomic_write(path, "w") as handle:
+        if units:
+            handle.write(f"# units: {units}\n")
         writer = csv.writer(handle, lineterminator="\n")
         writer.writerow(names)
         writer.writerows([[repr(float(v)) for v in row] for row in data])
     return path
 
 
-def read_poses(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
+def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a pose recording (CSV with a header): poses ``(T, 7)`` as ``x, y, z, qx, qy, qz,
     qw`` (scalar last) and timestamps (s) or None.
 
-    The header must name the columns: ``[t,]x,y,z,qw,qx,qy,qz`` or ``[t,]x,y,z,qx,qy,qz,qw``
-    (``time`` for ``t``; a timed pose trajectory written by :func:`save_poses` also reads). The
-    quaternion's order is taken from the names, never guessed from the numbers. Quaternions are
-    checked by :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them.
+    The header must name the columns ``x, y, z, qx, qy, qz, qw`` in any order, and optionally a
+    time column ``t`` (``time``, ``timestamp``); other columns are ignored with a warning (a
+    timed pose trajectory written by :func:`save_poses` reads too). ``columns`` maps other names
+    (as :func:`read_trajectory`). The quaternion's order is taken from the names, never guessed
+    from the numbers; ``qw`` first or last both read. Quaternions are checked by
+    :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them. Samples whose
+    timestamp repeats the one before are dropped, with a warning.
     """
-    from .timing import check_timestamps
+    from ._columns import select_poses
+    from .timing import drop_duplicate_stamps
 
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
@@ -855,29 +901,30 @@ def read_poses(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray | None]:
     _check_file(path, "pose file")
     if path.suffix.lower() not in (".csv", ".txt"):
         raise ValueError(f"{path}: pose recordings are read from .csv files with a header")
+    mapping = parse_columns(columns)
     parsed = _csv_fast(path)
-    columns, values = parsed if parsed is not None else _csv_rows(path)
+    header, values = parsed if parsed is not None else _csv_rows(path)
     accepted = "t,x,y,z,qw,qx,qy,qz or t,x,y,z,qx,qy,qz,qw (t optional)"
-    if columns is None:
+    if header is None:
         raise ValueError(f"{path}: a pose file needs a header naming the columns ({accepted})")
-    has_time = columns[0] in _TIME_NAMES
-    names = columns[1:] if has_time else columns
-    names = names[:7] if has_time and len(names) > 7 and names[7:8] == ("vx",) else names
-    if names not in _POSE_ORDER:
-        shown = ",".join(short_token(c, 12)[1:-1] for c in columns[:8]) + (",…" if len(columns) > 8 else "")
+    selection = select_poses(header, mapping, path)
+    if not selection.values:
+        shown = ",".join(short_token(c, 12)[1:-1] for c in header[:8]) + (",…" if len(header) > 8 else "")
         raise ValueError(f"{path}: header {shown} does not name a pose; accepted headers: {accepted}")
-    first = 1 if has_time else 0
-    poses = values[:, first : first + 7][:, _POSE_ORDER[names]]
-    poses = as_trajectory(poses, name=str(path), allow_static=True)
-    times = check_timestamps(values[:, 0], poses.shape[0], f"{path}: the time column") if has_time else None
-    return poses, times
+    written = {"vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az", "dwx", "dwy", "dwz"}  # save_poses' own columns
+    if not set(selection.ignored) <= written:
+        _note_ignored(path, selection.ignored)
+    poses = as_trajectory(values[:, list(selection.values)], name=str(path), allow_static=True)
+    if selection.time is None:
+        return poses, None
+    return drop_duplicate_stamps(poses, values[:, selection.time], f"{path}: the time column")
 
 
-def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
+def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:
     """Write poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) or a :class:`bidmp.cartesian.PoseTrajectory`
     to a CSV with the header ``[t,]x,y,z,qx,qy,qz,qw`` (a trajectory adds ``vx..vz, wx..wz,
     ax..az, dwx..dwz``: units/s, rad/s, units/s², rad/s², as :meth:`PoseTrajectory.columns`),
-    atomically."""
+    atomically; with a known unit (``units`` or the trajectory's) a first line ``# units: mm``."""
     from .cartesian import PoseTrajectory
 
     if not isinstance(path, (str, os.PathLike)):
@@ -886,6 +933,7 @@ def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
     names = ["x", "y", "z", "qx", "qy", "qz", "qw"]
     if isinstance(poses, PoseTrajectory):
         names, data = poses.columns()
+        units = poses.units if units is None else units
     else:
         data = as_trajectory(poses, "poses", min_points=1, allow_static=True)
         if data.shape[1] != 7:
@@ -899,4 +947,4 @@ def save_poses(poses, path: str | os.PathLike, times=None) -> Path:
         raise ValueError("the poses contain NaN or inf")
     if path.suffix.lower() != ".csv":
         raise ValueError(f"{path}: poses are written as .csv")
-    return _write_columns(data, names, data, path)
+    return _write_columns(data, names, data, path, units or "")

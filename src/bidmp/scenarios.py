@@ -64,7 +64,7 @@ import numpy as np
 from ._checks import check_limit, get_limits, short_token
 from .datasets import minimum_jerk
 from .geometry import Scene, SceneError
-from .io import load_json, load_trajectory
+from .io import load_json, read_trajectory
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
@@ -228,7 +228,20 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
     return resolved
 
 
-def _demonstration(value, source, key, base_dir, allow_outside=False):
+def _prepared_file(path, units: str) -> np.ndarray:
+    """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
+    trimmed, filtered, uniform time); a declared unit must be the scenario's."""
+    from .io import declared_units
+    from .timing import prepare
+
+    declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
+    if declared and units and declared != units:
+        raise ValueError(f"{path} is in {declared} (declared in the file) but the scenario is in {units}")
+    y, t = read_trajectory(path)
+    return y if t is None else prepare(y, t)[0].y
+
+
+def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):
     if not isinstance(value, dict) or len(value) != 1:
         _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
     (kind, body), = value.items()
@@ -267,7 +280,7 @@ def _demonstration(value, source, key, base_dir, allow_outside=False):
         path = _inside(Path(body) if os.path.isabs(body) else Path(base_dir) / body, base_dir, source, f"{key}.file",
                        body, allow_outside)
         try:
-            trajectory = load_trajectory(path)
+            trajectory = _prepared_file(path, units)
         except (TypeError, ValueError, OSError) as exc:
             _fail(source, f"{key}.file", str(exc))
         if trajectory.shape[0] < _MIN_DEMONSTRATION:
@@ -328,8 +341,13 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     for key in ("description", "units"):
         if key in data and not isinstance(data[key], str):
             _fail(source, key, "expected a string")
+    from ._units import UNITS
 
-    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files)
+    units = data.get("units", "mm")
+    if units not in UNITS:
+        _fail(source, "units", f"expected one of {', '.join(UNITS)}, got {_shown(units)}")
+
+    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
     n_dims = demonstration.shape[1]
     if n_dims == POSE_DIMS:
         demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
@@ -387,7 +405,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     demonstrations = {}
     check_limit(len(extra), "max_targets", "the number of further demonstrations")
     for label, spec in extra.items():
-        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir, allow_outside_files)
+        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir, allow_outside_files, units)
         if trajectory.shape[1] != n_dims:
             _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
         demonstrations[str(label)] = trajectory

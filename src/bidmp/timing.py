@@ -17,7 +17,8 @@ import numpy as np
 
 from ._checks import as_trajectory, check_choice, check_real, numerically_guarded
 
-__all__ = ["Trajectory", "check_timestamps", "uniform_time", "prepare", "time_scale", "PrepareInfo"]
+__all__ = ["Trajectory", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "prepare", "time_scale",
+           "PrepareInfo"]
 
 logger = logging.getLogger(__name__)
 
@@ -106,7 +107,9 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
         kind = "duplicate timestamp" if steps[row - 1] == 0 else "timestamp going back"
-        raise ValueError(f"{name} must increase strictly: {kind} at sample {row} ({float(stamps[row]):.9g} s after {float(stamps[row - 1]):.9g} s)")
+        raise ValueError(f"{name} must increase strictly: {kind} at sample {row}: {_stamp(stamps[row])} s after "
+                         f"{_stamp(stamps[row - 1])} s ({1e3 * float(steps[row - 1]):+.4g} ms; "
+                         f"{float(stamps[row] - stamps[0]):.6g} s into the recording)")
     rate = (n_samples - 1) / (stamps[-1] - stamps[0])
     if rate < MIN_RATE_HZ:
         raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
@@ -115,6 +118,34 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
         raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, above {MAX_RATE_HZ:g} Hz: timestamps must be "
                          f"seconds (these look like minutes or hours, or the samples are not a recording)")
     return stamps
+
+
+def _stamp(value: float) -> str:
+    """A timestamp as the shortest text that tells it from its neighbours (all its digits)."""
+    return np.format_float_positional(float(value), unique=True, trim="-")
+
+
+def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
+    """``y`` (T, D) and stamps ``t`` (T,) without the samples whose stamp repeats the previous
+    one, as loggers write them (the first of each run is kept); a warning says how many.
+
+    Stamps going back are still refused (:func:`check_timestamps`).
+    """
+    y = np.asarray(y, dtype=np.float64)
+    if isinstance(t, (str, bytes)):
+        raise TypeError(f"{name} must be an array of times in seconds, got a string")
+    try:
+        stamps = np.asarray(t, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of times in seconds") from None
+    if stamps.ndim == 1 and y.ndim >= 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1:
+        repeated = np.concatenate([[False], np.diff(stamps) == 0])
+        if np.any(repeated):
+            first = int(np.argmax(repeated))
+            logger.warning("%s: dropped %d sample(s) whose timestamp repeats the one before (the first at sample %d, "
+                           "%s s)", name, int(repeated.sum()), first, _stamp(stamps[first]))
+            y, stamps = y[~repeated], stamps[~repeated]
+    return y, check_timestamps(stamps, y.shape[0] if y.ndim else 0, name)
 
 
 def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -186,8 +217,11 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
     """
     from scipy.signal import butter, sosfiltfilt
 
+    from ._units import check_units
+
+    units = check_units(units)
     y = as_trajectory(y, "y", min_points=10)
-    t = check_timestamps(t, y.shape[0])
+    y, t = drop_duplicate_stamps(y, t)
     cutoff_hz = check_real(cutoff_hz, "cutoff_hz", positive=True)
     idle_fraction = check_real(idle_fraction, "idle_fraction", positive=True, maximum=0.5)
     uniform, grid = uniform_time(y, t)

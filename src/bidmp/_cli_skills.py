@@ -1,0 +1,411 @@
+"""The skill commands of the ``bidmp`` command line: fit, rollout, segment, extend, learn, for
+positions and poses alike. Thin: read the files, call the library, print. (``bidmp.cli`` holds
+the parser's other commands and the error handling.)"""
+
+from __future__ import annotations
+
+import argparse
+
+from ._cli_input import TIMED_INPUT, demo_options, is_pose_file, model_dmp, read_input
+
+EXIT_OK = 0
+
+
+def _skills_model(args: argparse.Namespace, command: str):
+    """The model ``extend`` and ``learn`` grow, as a Bi-DMP (a DMP becomes its skill 0): a
+    :class:`bidmp.BiDMP` or, for pose models, a :class:`bidmp.CartesianBiDMP`."""
+    from .cartesian import CartesianBiDMP, CartesianDMP
+    from .dmp import DMP
+    from .incremental import BiDMP
+    from .io import load_model
+
+    if not args.output.lower().endswith(".npz"):
+        hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
+        raise ValueError(f"-o must be the Bi-DMP model file to write (.npz), got {args.output}{hint}")
+    model = load_model(args.model)
+    if isinstance(model, DMP):
+        return BiDMP(model)
+    if isinstance(model, CartesianDMP):
+        return CartesianBiDMP(model)
+    if isinstance(model, (BiDMP, CartesianBiDMP)):
+        return model
+    raise ValueError(f"{args.model} holds a {type(model).__name__}; {command} needs a DMP, a Bi-DMP or a pose model")
+
+
+def _demo_for(model, args: argparse.Namespace):
+    """The demonstration for ``model`` (poses for a pose model), checked against its D."""
+    from .cartesian import CartesianBiDMP
+
+    poses = isinstance(model, CartesianBiDMP)
+    if poses and not is_pose_file(args.demo):
+        raise ValueError(f"{args.model} holds a pose model; {args.demo} is not a pose file (a CSV header with qx,qy,qz,qw)")
+    if not poses and is_pose_file(args.demo):
+        raise ValueError(f"{args.demo} holds poses; {args.model} holds a position model: fit a pose model on it first")
+    y, _, units, how = read_input(args.demo, args, poses=poses, model=model, what=args.model)
+    if not poses and y.shape[1] != model.n_dims_:
+        raise ValueError(f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}")
+    return y, units, how
+
+
+# -- fit ------------------------------------------------------------------------------------------
+def _dmp_params(args: argparse.Namespace) -> dict:
+    return dict(n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K, alpha_phase=args.alpha_phase,
+                tau=args.tau, regression=args.regression, protocol=args.protocol)
+
+
+def cmd_fit(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._trajectory import resample_time
+    from .dmp import DMP
+    from .io import save_model
+    from .metrics import path_extent
+
+    if is_pose_file(args.demo):
+        return _fit_poses(args)
+    demonstration, times, units, how = read_input(args.demo, args)
+    dmp = DMP(**_dmp_params(args)).fit(demonstration, times, units=units)
+    path = save_model(dmp, args.output)
+    reproduction = dmp.trajectory()
+    reference = resample_time(demonstration, dmp.n_steps_)
+    error = float(np.sqrt(np.mean(np.sum((dmp.rollout()[: dmp.n_steps_] - reference) ** 2, axis=1))))
+    extent = path_extent(demonstration)
+    if not np.isfinite(error):  # never print a non-finite result as a success
+        raise ValueError(f"the fitted DMP does not reproduce {args.demo} (RMSE {error}); the settings are out of range")
+    unit = dmp.units_ or "units"
+    print(f"fitted a DMP ({dmp.protocol} protocol) on {args.demo}, {how}")
+    print(f"  T = {dmp.n_steps_} samples over {dmp.duration_:.4g} s ({dmp.sample_rate_:.4g} Hz), D = {dmp.n_dims_}, "
+          f"units {dmp.units_ or '(not given)'}")
+    print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
+    print(f"  reproduction RMSE {error:.4g} {unit} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
+    print(f"  rollouts last {reproduction.duration:.4g} s (tau = {dmp.tau:g}; peak speed {reproduction.peak_speed():.4g} {unit}/s, "
+          f"peak acceleration {reproduction.peak_acceleration():.4g} {unit}/s^2)")
+    if dmp.protocol == "paper":
+        print(f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {dmp.default_n_steps()} samples")
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+def _fit_poses(args: argparse.Namespace) -> int:
+    """``bidmp fit`` on a pose recording: a CartesianDMP (prepared like positions unless --raw)."""
+    import numpy as np
+
+    from .cartesian import CartesianDMP, angle_between
+    from .io import save_model
+
+    poses, times, units, how = read_input(args.demo, args, poses=True)
+    model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
+    path = save_model(model, args.output)
+    reproduction = model.rollout()[: len(poses)]
+    n = len(reproduction)
+    angles = np.degrees(angle_between(reproduction[:, 3:], poses[:n, 3:]))
+    unit = model.units_ or "units"
+    print(f"fitted a pose DMP (CartesianDMP, {model.protocol} protocol) on {args.demo}, {how}")
+    print(f"  T = {len(poses)} samples over {model.duration_:.4g} s; units {model.units_ or '(not given)'}")
+    print(f"  reproduction: position RMSE {np.sqrt(np.mean(np.sum((reproduction[:, :3] - poses[:n, :3]) ** 2, axis=1))):.4g} "
+          f"{unit}, orientation RMS {np.sqrt(np.mean(angles ** 2)):.3g} deg")
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+# -- rollout --------------------------------------------------------------------------------------
+def _timing_options(args: argparse.Namespace, dmp) -> dict:
+    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc/--fastest."""
+    options = {"duration": args.duration}
+    if args.rate is not None and args.n_steps is not None:
+        raise ValueError("give --rate or --n-steps, not both")
+    if args.rate is not None:
+        if not 0 < args.rate <= 100_000:
+            raise ValueError(f"--rate must be in (0, 100000] Hz, got {args.rate:g}")
+        options["dt"] = 1.0 / args.rate
+    elif args.n_steps is not None:
+        from ._checks import check_int
+
+        check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
+        motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
+        options["dt"] = dmp._params().settle * motion / (args.n_steps - 1)  # the same motion, sampled more finely
+    if args.max_speed is not None or args.max_acc is not None:
+        options["limits"] = {"max_velocity": args.max_speed, "max_acceleration": args.max_acc, "fastest": args.fastest}
+        if args.duration is not None:
+            raise ValueError("give --duration or --max-speed/--max-acc, not both (the limits choose the duration)")
+        options.pop("duration")
+    elif args.fastest:
+        raise ValueError("--fastest needs --max-speed or --max-acc (the limits it may run up to)")
+    return options
+
+
+def _skill_choice(args: argparse.Namespace, model):
+    from .cartesian import CartesianBiDMP
+    from .incremental import BiDMP
+
+    if not isinstance(model, (BiDMP, CartesianBiDMP)):
+        if args.skill is not None:
+            raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a {type(model).__name__}")
+        return None
+    return "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
+
+
+def cmd_rollout(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .cartesian import CartesianBiDMP, CartesianDMP, angle_between
+    from .dmp import DMP
+    from .incremental import BiDMP
+    from .io import load_model, save_poses, save_trajectory
+
+    model = load_model(args.model)
+    if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
+        raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
+    dmp = model_dmp(model)
+    poses = isinstance(model, (CartesianDMP, CartesianBiDMP))
+    skill = _skill_choice(args, model)
+    options = {"goal": args.goal, "start": args.start, **_timing_options(args, dmp)}
+    if skill is not None:
+        options["skill"] = skill
+        goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
+        index = model.select_skill(goals[-1] if args.goal is None and isinstance(model, BiDMP) else args.goal, skill)
+        print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})")
+    trajectory = model.trajectory(**options)
+    path = (save_poses if poses else save_trajectory)(trajectory, args.output)
+    unit = dmp.units_ or "units"
+    rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
+    goal = trajectory.y[-1] if args.goal is None else np.asarray(args.goal, dtype=float)
+    print(f"rolled out {len(trajectory)} samples over {trajectory.duration:.4g} s ({rate:.4g} Hz) to goal "
+          f"{np.array2string(goal, precision=4)}")
+    print(f"  end point {np.array2string(trajectory.y[-1], precision=4)}, distance to goal "
+          f"{np.linalg.norm(trajectory.y[-1] - goal[:3 if poses else None]):.4g} {unit}"
+          + (f", {np.degrees(angle_between(trajectory.q[-1:], goal[None, 3:]))[0]:.3g} deg" if poses and goal.size == 7 else ""))
+    print(f"  peak speed {trajectory.peak_speed():.4g} {unit}/s, peak acceleration {trajectory.peak_acceleration():.4g} "
+          f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
+    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
+    if args.plot:
+        from .plotting import plot_trajectories
+
+        reference = dmp.rollout()
+        figure = plot_trajectories(args.plot, reference, [trajectory.y], ["rollout"], goals=trajectory.y[-1:],
+                                   title="rollout", units=dmp.units_)
+        print(f"wrote {figure}")
+    return EXIT_OK
+
+
+# -- segment, extend, learn -----------------------------------------------------------------------
+def cmd_segment(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._tables import text_table
+    from ._trajectory import arclength, resample_arclength
+    from .segmentation import curvature, segment
+
+    y, _, units, how = read_input(args.demo, args, poses=is_pose_file(args.demo))
+    y = y[:, :3] if is_pose_file(args.demo) else y
+    result = segment(y, eps_frac=args.eps_frac, method=args.method)
+    points, kinds = result.points, result.kinds
+    s = arclength(y)
+    print(f"{args.demo}: {y.shape[0]} samples, D = {y.shape[1]}, {how}; {len(points)} segmentation point(s)")
+    if len(points):
+        rows = [
+            [str(point), "max" if kind > 0 else "min", f"{100 * s[point] / s[-1]:.1f}", np.array2string(y[point], precision=3)]
+            for point, kind in zip(points, kinds)
+        ]
+        print(text_table(["index", "curvature", "arc length %", f"position ({units or 'units'})"], rows))
+    if args.plot:
+        from .plotting import plot_segmentation
+        from .segmentation import MAX_ANALYSIS_POINTS
+
+        kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
+        print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
+    return EXIT_OK
+
+
+def _extension_scene(args: argparse.Namespace, units: str):
+    """The scene of ``--scene``, in the model's units (refused in another)."""
+    if args.scene is None:
+        return None
+    from .scenarios import load
+
+    scenario = load(args.scene, allow_outside_files=args.allow_outside_files)
+    if scenario.scene is None:
+        raise ValueError(f"--scene: scenario {args.scene} has no \"scene\" key")
+    if units and scenario.units and scenario.units != units:
+        raise ValueError(f"--scene: the scene of {args.scene} is in {scenario.units} but the model is in {units}; "
+                         f"use a scene in {units}")
+    return scenario.scene
+
+
+def _pose_target(target, demonstration):
+    """A pose target (7,) from --target: x y z (the demonstrated goal's orientation) or all 7."""
+    import numpy as np
+
+    target = np.asarray(target, dtype=float)
+    if target.shape == (3,):
+        return np.concatenate([target, demonstration[-1, 3:]])
+    if target.shape != (7,):
+        raise ValueError(f"--target for a pose model takes x y z or x y z qx qy qz qw, got {target.size} numbers")
+    return target
+
+
+def cmd_extend(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._trajectory import resample_time
+    from .cartesian import CartesianBiDMP
+    from .extension import extend_demonstration, extend_pose_demonstration
+    from .io import save_model, save_poses, save_trajectory
+    from .metrics import path_extent, rmse
+
+    model = _skills_model(args, "extend")
+    y, units, how = _demo_for(model, args)
+    scene = _extension_scene(args, units)
+    poses = isinstance(model, CartesianBiDMP)
+    if poses:
+        if args.approach != "keep":
+            raise ValueError("--approach paper is for positions; a pose extension keeps the approach")
+        extension = extend_pose_demonstration(y, _pose_target(args.target, y), seed=args.seed, scene=scene)
+        learned = extension.poses
+    else:
+        extension = extend_demonstration(y, args.target, seed=args.seed, approach=args.approach, scene=scene)
+        learned = extension.complete
+    target = learned[-1]
+    history = extension.similarity_history
+    print(f"{args.demo}: {how}")
+    print(f"segmentation points {extension.segmentation_points.tolist()}; imitating piece {extension.piece.index} "
+          f"(samples {extension.piece.start}-{extension.piece.end}) from seg = "
+          f"{np.array2string(y[extension.seg_index, :3], precision=3)}")
+    if len(history):
+        print(f"G-PRM similarity per iteration: {' '.join(f'{v:.3f}' for v in history)} (best {extension.similarity:.3f})")
+    before = np.linalg.norm(model.rollout(target)[-1, :3] - target[:3])
+    model.learn(learned)
+    rollout = model.rollout(target)
+    dmp = model_dmp(model)
+    error = rmse(rollout[: dmp.n_steps_, :3], resample_time(extension.complete, dmp.n_steps_))
+    unit = dmp.units_ or "units"
+    print(f"learned skill {model.n_skills - 1}: rollout to the target reproduces the extended demonstration with "
+          f"RMSE {error:.4g} {unit} ({100 * error / path_extent(extension.complete):.3g} % of its extent)")
+    print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1, :3] - target[:3]):.4g} {unit} after")
+    print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
+    if args.save_demo:
+        complete = resample_time(learned, dmp.n_steps_)
+        stamps = np.arange(dmp.n_steps_) * dmp.duration_ / (dmp.n_steps_ - 1)
+        if poses:
+            written = save_poses(complete, args.save_demo, times=stamps, units=dmp.units_)
+        else:
+            from .timing import Trajectory
+
+            velocity = np.gradient(complete, stamps, axis=0)
+            written = save_trajectory(Trajectory(stamps, complete, velocity, np.gradient(velocity, stamps, axis=0),
+                                                 dmp.units_), args.save_demo)
+        print(f"wrote the extended demonstration ({stamps[-1]:.4g} s) to {written}")
+    if args.plot:
+        from .plotting import plot_extension
+
+        print(f"wrote {plot_extension(args.plot, extension, units=dmp.units_)}")
+    return EXIT_OK
+
+
+def cmd_learn(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ._trajectory import resample_time, rmse
+    from .io import save_model
+
+    model = _skills_model(args, "learn")
+    y, _, how = _demo_for(model, args)
+    model.learn(y)
+    dmp = model_dmp(model)
+    rollout = model.rollout(y[-1], start=y[0])
+    error = rmse(rollout[: dmp.n_steps_, :3], resample_time(y[:, :3], dmp.n_steps_))
+    print(f"{args.demo}: {how}")
+    print(f"learned it as skill {model.n_skills - 1} (goal {np.array2string(y[-1], precision=3)}): reproduction RMSE "
+          f"{error:.4g} {dmp.units_ or 'units'}")
+    print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
+    return EXIT_OK
+
+
+# -- the parser -----------------------------------------------------------------------------------
+def add_commands(commands, parse_K, allow_outside_files) -> None:
+    """The subcommands fit, rollout, segment, extend and learn of ``bidmp``'s parser."""
+    fit = commands.add_parser(
+        "fit", help="learn a DMP from a demonstration",
+        description="Learn a DMP from one demonstration and save it as a model file (.npz). Time is in seconds: a CSV "
+                    "with a t column (or a timed .npy) gives the motion its real duration; without one the samples "
+                    "are taken as 1 s in all (the paper's convention). Lengths are in the demonstration's unit "
+                    "(--units names it, e.g. mm); velocities are units/s, accelerations units/s^2.",
+        epilog=TIMED_INPUT)
+    fit.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy)")
+    fit.add_argument("-o", "--output", required=True, metavar="MODEL", help="model file to write (.npz)")
+    demo_options(fit)
+    fit.add_argument("--protocol", choices=("robot", "paper"), default="robot",
+                     help="robot (default: goals reached, smooth starts, real time) or paper (the paper's fixed horizon)")
+    fit.add_argument("--n-kernels", type=int, default=None, help="kernels per dimension (default: robot 100, paper 50)")
+    fit.add_argument("--alpha", type=float, default=None, help="spring-damper gain alpha (default: robot 50, paper 25)")
+    fit.add_argument("--beta", type=float, default=None, help="spring ratio beta (default alpha/4)")
+    fit.add_argument("--K", type=parse_K, default=None,
+                     help="forcing gain: paper (K=alpha), pastor (K=alpha*beta) or a number (default: robot pastor, paper paper)")
+    fit.add_argument("--alpha-phase", type=float, default=None, help="phase decay alpha_phase (default: robot 4, paper 1)")
+    fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling: rollouts take tau times the demonstration's duration (default 1)")
+    fit.add_argument("--regression", "--fit", dest="regression", choices=("lwr", "ridge"), default=None,
+                     help="weight regression (default: robot ridge, paper lwr)")
+    fit.set_defaults(handler=cmd_fit)
+
+    rollout = commands.add_parser(
+        "rollout", help="generate a timed trajectory from a model",
+        description="Roll a saved model out to a goal and write the timed trajectory: t (s), positions (the model's "
+                    "units), velocities (units/s) and accelerations (units/s^2), as CSV columns t,x,y,z,vx,vy,vz,ax,ay,az "
+                    "or a .npy structured array with those fields. The motion lasts the demonstration's duration "
+                    "(times tau, or --duration) plus 10 %% to come to rest (robot protocol).")
+    rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
+    rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates in the model's units (default: the demonstrated goal)")
+    rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
+    rollout.add_argument("--duration", type=float, default=None, metavar="S", help="duration of the motion in seconds (temporal scaling; default: the demonstration's)")
+    rollout.add_argument("--rate", type=float, default=None, metavar="HZ", help="sample rate in Hz (default: the demonstration's)")
+    rollout.add_argument("--n-steps", type=int, default=None, help="instead of --rate: this many samples over the same motion")
+    rollout.add_argument("--max-speed", type=float, default=None, metavar="V", help="cap: slow the motion (uniformly) if its speed exceeds V units/s")
+    rollout.add_argument("--max-acc", type=float, default=None, metavar="A", help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2")
+    rollout.add_argument("--fastest", action="store_true",
+                         help="with --max-speed/--max-acc: the shortest motion within them, even faster than demonstrated "
+                              "(without it they are caps that only ever slow a motion)")
+    rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy; poses: .csv)")
+    rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
+    rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
+    rollout.set_defaults(handler=cmd_rollout)
+
+    seg = commands.add_parser("segment", help="find the segmentation points of a demonstration (1D-SEG)",
+                              description="Cut a 2-D or 3-D demonstration at its curvature extrema (1D-SEG).", epilog=TIMED_INPUT)
+    seg.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy; a pose file is segmented by its positions)")
+    demo_options(seg)
+    seg.add_argument("--eps-frac", type=float, default=0.1, help="pruning threshold, fraction of the curvature range (default 0.1)")
+    seg.add_argument("--method", choices=("persistence", "paper"), default="persistence", help="pruning rule (default persistence)")
+    seg.add_argument("--plot", metavar="PNG", help="also write a figure with the points and the curvature")
+    seg.set_defaults(handler=cmd_segment)
+
+    extend = commands.add_parser("extend", help="learn a new target incrementally (1D-SEG + G-PRM + Bi-DMP)",
+                                 description="Segment DEMO, grow an extended demonstration to the new target with G-PRM, "
+                                             "and learn it incrementally on top of MODEL (a DMP or a Bi-DMP) as a new skill. "
+                                             "Coordinates are in the model's units.",
+                                 epilog=TIMED_INPUT)
+    extend.add_argument("model", metavar="MODEL", help="a DMP (from 'bidmp fit') or Bi-DMP (from 'bidmp extend') model file")
+    extend.add_argument("demo", metavar="DEMO", help="the demonstration to extend (.csv or .npy)")
+    extend.add_argument("--target", type=float, nargs="+", required=True, metavar="X",
+                        help="new target coordinates (pose models: x y z, or x y z qx qy qz qw)")
+    extend.add_argument("-o", "--output", required=True, metavar="MODEL2", help="Bi-DMP model file to write (.npz)")
+    extend.add_argument("--save-demo", metavar="OUT", help="also write the extended demonstration, timed like a rollout (.csv or .npy)")
+    demo_options(extend)
+    extend.add_argument("--seed", type=int, default=0, help="G-PRM random seed (default 0)")
+    extend.add_argument("--approach", choices=("keep", "paper"), default="keep",
+                        help="keep: keep the demonstrated final approach, translated, and grow only the transfer (default); "
+                             "paper: imitate the nearest piece down to the target (the paper's protocol)")
+    extend.add_argument("--scene", metavar="FILE|NAME", help="grow the extension around the parts of this scenario's scene")
+    allow_outside_files(extend, shown=False)
+    extend.add_argument("--plot", metavar="PNG", help="also write a figure")
+    extend.set_defaults(handler=cmd_extend)
+
+    learn = commands.add_parser("learn", help="learn a further demonstration as a new skill (Bi-DMP)",
+                                description="Learn DEMO (e.g. another operator's recording) directly as a new skill on top "
+                                            "of MODEL (a DMP or a Bi-DMP), without retraining. Coordinates in the model's units.",
+                                epilog=TIMED_INPUT)
+    learn.add_argument("model", metavar="MODEL", help="a DMP or Bi-DMP model file")
+    learn.add_argument("demo", metavar="DEMO", help="the demonstration to learn (.csv or .npy)")
+    learn.add_argument("-o", "--output", required=True, metavar="MODEL2", help="Bi-DMP model file to write (.npz)")
+    demo_options(learn)
+    learn.set_defaults(handler=cmd_learn)
+
