@@ -9,12 +9,16 @@ import time
 import numpy as np
 import pytest
 
-pytest.importorskip("distributed")
+from bidmp import benchmark
+from bidmp.cli import main
+from bidmp.metrics import swept_area
+from bidmp.similarity import dtw_distance
 
-from bidmp import benchmark  # noqa: E402
-from bidmp.cli import main  # noqa: E402
-from bidmp.metrics import swept_area  # noqa: E402
-from bidmp.similarity import dtw_distance  # noqa: E402
+# Only what runs on Dask or writes Parquet needs the benchmark extra; the metrics do not.
+needs_dask = pytest.mark.skipif(__import__("importlib").util.find_spec("distributed") is None,
+                                reason="the benchmark extra (dask[distributed]) is not installed")
+needs_parquet = pytest.mark.skipif(__import__("importlib").util.find_spec("pyarrow") is None,
+                                   reason="the benchmark extra (pyarrow) is not installed")
 
 SMALL = {"shapes": ["Sshape", "WShape"], "demos": "first3", "every": 10, "methods": ["dmp-paper", "bidmp"]}
 TIMING = set(benchmark.TIMES)
@@ -61,9 +65,12 @@ def table(rows):
 
 @pytest.fixture(scope="module")
 def serial(tmp_path_factory):
+    pytest.importorskip("pyarrow")  # the table is written as Parquet
     return benchmark.lasa(tmp_path_factory.mktemp("serial"), synchronous=True, **SMALL)
 
 
+@needs_dask
+@needs_parquet
 def test_serial_and_two_workers_give_identical_tables(serial, tmp_path):
     parallel = benchmark.lasa(tmp_path, workers=2, **SMALL)
     assert parallel.workers == 2
@@ -76,6 +83,8 @@ def test_serial_and_two_workers_give_identical_tables(serial, tmp_path):
     assert {"demos", "every"} <= set(stored[0]) and stored[0]["every"] == 10
 
 
+@needs_dask
+@needs_parquet
 def test_a_worker_killed_mid_run_still_gives_the_complete_table(serial, tmp_path):
     marker = tmp_path / "kill-one-worker"
     marker.write_text("the first cell to see this file kills its worker process")
@@ -104,7 +113,7 @@ def test_an_interrupted_run_resumes_with_only_the_missing_cells(serial, tmp_path
 @pytest.mark.parametrize("argv, match", [
     (["--shapes", "Sshape,Nope"], "unknown LASA shape 'Nope'"),
     (["--methods", "dmp-paper,magic"], "unknown method 'magic'"),
-    (["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9"),
+    pytest.param(["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9", marks=needs_dask),
 ])
 def test_bad_input_is_one_line_within_ten_seconds_and_leaves_nothing(argv, match, tmp_path, capsys):
     start = time.perf_counter()

@@ -248,8 +248,7 @@ def test_reproduce_figures_prints_forgetting_and_writes_figure(tmp_path, capsys)
     assert [r["shape"] for r in results] == ["Sshape", "WShape", "NShape"]
     for result in results:
         assert max(result["bidmp_rmse"]) < 0.05 * min(result["dmp_rmse"])  # far below the plain DMP
-        assert np.allclose(result["forgetting_nearest"]["forgetting"], 0.0, atol=1e-9)
-        assert min(result["forgetting_latest"]["forgetting"][:-1]) > 1.0
+        assert min(result["forgetting_latest"]["forgetting"][:-1]) > 1.0  # "latest" overwrites earlier skills
     assert (tmp_path / "f" / "bidmp_lasa.png").stat().st_size > 30_000
     assert_committed(tmp_path / "f" / "figures.md")
 

@@ -68,6 +68,9 @@ def three_operator_demonstrations(n_steps=200):
 
 
 def test_forgetting_nearest_is_zero_latest_forgets():
+    """An architecture guard: skill p uses the blocks up to p only, so "nearest" cannot forget
+    by construction. It guards the skill library's structure; whether learning is faithful is
+    the test after it."""
     demonstrations = three_operator_demonstrations()
     dmp = DMP(protocol="paper", alpha=40.0).fit(demonstrations[0])
     nearest = forgetting(dmp, demonstrations[1:], skill="nearest")
@@ -78,6 +81,24 @@ def test_forgetting_nearest_is_zero_latest_forgets():
     # Every learned skill is reproduced when it is learned.
     extent = np.linalg.norm(np.ptp(demonstrations[1], axis=0))
     assert np.all(np.diag(nearest.errors)[1:] < 0.01 * extent)
+
+
+@pytest.mark.parametrize("protocol, params", [("paper", {"alpha": 40.0}), ("robot", {})])
+def test_every_skill_reproduces_its_demonstration_as_well_as_a_dmp_fitted_on_it(protocol, params):
+    """Learning is faithful: after all demonstrations are learned, each skill reproduces its own
+    demonstration at least as well (5 % margin) as a DMP fitted from scratch on it alone."""
+    from bidmp._trajectory import rmse
+
+    demonstrations = three_operator_demonstrations()
+    t = np.arange(200) / 100.0
+    model = BiDMP(DMP(protocol=protocol, **params).fit(demonstrations[0], t))
+    for demonstration in demonstrations[1:]:
+        model.learn(demonstration)
+    for skill, demonstration in enumerate(demonstrations):
+        learned = model.rollout(demonstration[-1], skill=skill, start=demonstration[0])[:200]
+        scratch = DMP(protocol=protocol, **params).fit(demonstration, t).rollout()[:200]
+        assert rmse(learned, demonstration) <= 1.05 * rmse(scratch, demonstration), skill
+        assert model.select_skill(demonstration[-1]) == skill  # "nearest" finds it
 
 
 def test_several_demonstrations_stack_blocks(battery):

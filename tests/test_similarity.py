@@ -9,7 +9,6 @@ from hypothesis.extra.numpy import arrays
 from bidmp import frechet_distance, frechet_similarity
 from bidmp.similarity import frechet_distance_reference, polyline_length
 
-similaritymeasures = pytest.importorskip("similaritymeasures")
 
 
 def test_spec_reference_case():
@@ -20,6 +19,7 @@ def test_spec_reference_case():
 
 
 def test_equals_similaritymeasures_on_random_unequal_curves():
+    similaritymeasures = pytest.importorskip("similaritymeasures")  # only this test needs it
     rng = np.random.default_rng(42)
     for trial in range(60):
         n_dims = (1, 2, 3)[trial % 3]
