@@ -374,6 +374,14 @@ def test_bidmp_trajectory_and_stepper_use_the_skill():
     model.learn(extension.complete)
     trajectory = model.trajectory(dmp.goal_ + SHIFT)
     assert np.linalg.norm(trajectory.y[-1] - dmp.goal_ - SHIFT) < 0.15
+    # The skill, timed, is the extended demonstration it learned (an independent reference: the
+    # demonstration, not another code path), within 0.5 mm RMS...
+    learned = dmp.training_trajectory(extension.complete)[: dmp.n_steps_]
+    assert np.sqrt(np.mean(np.sum((trajectory.y[: dmp.n_steps_] - learned) ** 2, axis=1))) <= 0.5
+    # ... and the plain DMP, the same query without the skill, is far from it.
+    plain = dmp.trajectory(dmp.goal_ + SHIFT).y[: dmp.n_steps_]
+    assert np.sqrt(np.mean(np.sum((plain - learned) ** 2, axis=1))) > 10.0
+    # Structural guards: the timed, the sampled and the stepped rollouts share one skill.
     np.testing.assert_allclose(trajectory.y[: dmp.n_steps_], model.rollout(dmp.goal_ + SHIFT)[: dmp.n_steps_], atol=1e-9)
     stepper = model.stepper(dmp.goal_ + SHIFT)
     commands = np.array([stepper.step(trajectory.t[1])[0] for _ in range(len(trajectory))])
