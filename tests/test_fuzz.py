@@ -1,4 +1,6 @@
-"""Fuzzing every public entry point and every CLI command (issue 9).
+"""Fuzzing every public entry point and every CLI command (issues 9 and 19): DMP, pose DMP and
+Bi-DMP, BLS, extension and roadmaps, baselines, datasets, metrics, plotting, scenarios, scene
+geometry, the simulator's IK and planning, the LASA benchmark, every file reader.
 
 Contract checked on every generated input:
 
@@ -74,6 +76,8 @@ def outcome(name, function, *args, **kwargs):
     start = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        # The one documented warning: quaternions off unit length are normalised, and said so.
+        warnings.filterwarnings("ignore", message=".*not of unit length.*normalised", category=UserWarning)
         try:
             result = function(*args, **kwargs)
         except (ValueError, TypeError) as exc:
@@ -589,6 +593,122 @@ def test_fuzz_scene(changes, trajectory):
     if result is not None:
         outcome("Scene.clearance", result.clearance, trajectory, exclude=[p for p in ("3",) if p in result.labels])
         outcome("Scene.checker", result.checker(), trajectory)
+
+
+@st.composite
+def pose_arrays(draw, max_points=200):
+    """Pose demonstrations (T, 7): positions from :func:`trajectories` with quaternions that
+    turn (several times, or not at all), flip sign, leave unit length, vanish or are poisoned."""
+    from scipy.spatial.transform import Rotation
+
+    positions = draw(trajectories(max_points=max_points, dims=(3,)))
+    if not isinstance(positions, np.ndarray) or positions.ndim != 2 or positions.shape[1] != 3 or len(positions) == 0:
+        return positions
+    n = len(positions)
+    turn = draw(st.sampled_from([0.0, 0.5, 3.0, 7.0, 13.0]))  # rad: none, small, past pi, two turns
+    axis = np.random.default_rng(draw(st.integers(0, 99))).normal(size=3)
+    quaternions = Rotation.from_rotvec(np.outer(np.linspace(0, turn, n), axis / np.linalg.norm(axis))).as_quat()
+    kind = draw(st.sampled_from(["plain"] * 4 + ["flips", "scaled", "zero", "poisoned", "huge"]))
+    if kind == "flips":
+        quaternions[::3] *= -1.0
+    elif kind == "scaled":
+        quaternions *= draw(st.sampled_from([1.001, 3.0, 1e-200, 1e200]))
+    elif kind == "zero":
+        quaternions[draw(st.integers(0, n - 1))] = 0.0
+    elif kind == "poisoned":
+        quaternions.flat[draw(st.integers(0, quaternions.size - 1))] = draw(st.sampled_from([np.nan, np.inf]))
+    elif kind == "huge":
+        quaternions = quaternions * 1e308
+    return np.hstack([positions, quaternions])
+
+
+pose_points = st.one_of(points, st.lists(st.floats(-5, 5), min_size=7, max_size=7),
+                        st.just([1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0]), st.just([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
+
+
+def good_poses(n_points=120):
+    from scipy.spatial.transform import Rotation
+
+    quaternions = Rotation.from_rotvec(np.outer(np.linspace(0, 4.0, n_points), [0.0, 0.0, 1.0])).as_quat()
+    return np.hstack([good_demo(n_points, 3), quaternions])
+
+
+@given(pose_arrays(), dmp_params, pose_points, pose_points, st.one_of(st.none(), st.floats(0.2, 5.0), nasty_floats))
+@examples(40)
+def test_fuzz_cartesian(poses, params, goal, start, duration):
+    model = outcome("CartesianDMP.fit", bidmp.CartesianDMP(**params).fit, poses)
+    if model is None:
+        model = bidmp.CartesianDMP().fit(good_poses())
+    outcome("CartesianDMP.rollout", model.rollout, goal, start)
+    motion = outcome("CartesianDMP.trajectory", model.trajectory, goal, start, duration)
+    if motion is not None:
+        assert np.all(np.abs(np.linalg.norm(motion.q, axis=1) - 1.0) < 1e-9)
+    stepper = outcome("CartesianDMP.stepper", model.stepper, goal, start)
+    if stepper is not None:
+        outcome("PoseStepper.step", stepper.step, 0.01)
+
+
+@given(pose_arrays(), maybe(st.fixed_dictionaries({}, optional={"increments": st.sampled_from([(5,), (), (3, 3)]),
+                                                               "reg": st.floats(1e-6, 1.0)})), pose_points,
+       st.sampled_from(["nearest", "latest", 0, 1, 2, -1, "x"]))
+@examples(30)
+def test_fuzz_cartesian_bidmp(poses, params, goal, skill):
+    params = params if isinstance(params, dict) else {"reg": params}
+    model = outcome("CartesianBiDMP", bidmp.CartesianBiDMP, bidmp.CartesianDMP().fit(good_poses()), **params)
+    if model is None:
+        return
+    outcome("CartesianBiDMP.learn", model.learn, poses)
+    outcome("CartesianBiDMP.rollout", model.rollout, goal, skill)
+    outcome("CartesianBiDMP.trajectory", model.trajectory, goal, skill)
+
+
+@given(st.sampled_from(["t,x,y,z,qx,qy,qz,qw", "x,y,z,qw,qx,qy,qz", "timestamp,x,y,z,qx,qy,qz,qw,grip",
+                        "t,x,y,z,qx,qy,qz", "t,x,y,z,qx,qy,qz,qw,qw", "qx,qy,qz,qw", ""]),
+       pose_arrays(max_points=60), st.sampled_from([None, "t=t,x=x,y=y,z=z,qx=qx,qy=qy,qz=qz,qw=qw", "w=x", "t=nope"]))
+@examples(40)
+def test_fuzz_pose_files(files, header, poses, columns):
+    path = files["folder"] / "poses.csv"
+    rows = np.asarray(poses, dtype=float) if isinstance(poses, np.ndarray) else np.zeros((0, 7))
+    width = len(header.split(",")) if header else 7
+    table = np.column_stack([np.arange(len(rows)) * 0.01, rows])[:, :width] if len(rows) else rows
+    text = (header + "\n" if header else "") + "\n".join(",".join(repr(float(v)) for v in row) for row in table)
+    path.write_text(text)
+    outcome("io.read_poses", bidmp.io.read_poses, path, columns=columns)
+
+
+@pytest.fixture(scope="module")
+def panda():
+    pytest.importorskip("pybullet")
+    from bidmp import scenarios
+    from bidmp.sim import PandaCell, robot_placement
+
+    scenario = scenarios.load("nut-unscrewing")
+    cell = PandaCell(scenario.scene, scenario.units, *robot_placement(scenario))
+    yield cell
+    cell.close()
+
+
+@given(st.one_of(points, st.just([0.05, -0.1, 0.3])), st.one_of(points, st.just([0.0] * 7)),
+       st.one_of(trajectories(max_points=20, dims=(3,)), st.just(np.array([[0.0, 0.0, 40.0], [10.0, 0.0, 20.0]]))))
+@examples(15)
+def test_fuzz_sim(panda, target, seed, path):
+    outcome("PandaCell.solve_ik", panda.solve_ik, target, seed)
+    outcome("PandaCell.plan", panda.plan, path, seed=seed)
+
+
+@given(maybe(st.lists(st.sampled_from(["Sshape", "Angle", "Nope", ""]), max_size=2), anything),
+       maybe(st.lists(st.sampled_from(["dmp-paper", "gmm", "magic"]), max_size=2), anything),
+       maybe(st.sampled_from(["first3", "all"]), anything), maybe(st.sampled_from([200, 500]), nasty_ints))
+@examples(12)
+def test_fuzz_benchmark(files, shapes, methods, demos, every):
+    from bidmp import benchmark
+
+    if every in (200, 500) and demos in ("first3", "all") and isinstance(shapes, list) and isinstance(methods, list):
+        demos = "first3"  # a valid sweep stays small: 1-2 shapes x 3 demonstrations of a few samples
+    out = files["folder"] / "bench"
+    outcome("benchmark.lasa", benchmark.lasa, out, shapes=shapes, methods=methods, demos=demos, every=every,
+            synchronous=True, output_format="csv")
+    shutil.rmtree(out, ignore_errors=True)
 
 
 # ---------------------------------------------------------------------------------------------

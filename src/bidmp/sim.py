@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ._checks import as_trajectory, check_int, check_real, require_extra
+from ._checks import as_point, as_trajectory, check_int, check_real, require_extra
 from ._tables import markdown_table, text_table
 from .metrics import approach_error, axis_deviation
 from .timing import Trajectory, time_scale
@@ -219,6 +219,30 @@ class Execution:
         return float(np.sum(slow & running) * CONTROL_STEP)
 
 
+_REACH_M = 2.0  # m from the base: far beyond the Panda's 0.855 m, so a path past it is a mistake
+
+
+def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray:
+    """Refuse a point (m) further than any Panda reaches from its base (a unit mistake, or a
+    path that IK would chase for ever)."""
+    distance = float(np.linalg.norm(point_m - base_m))
+    if not distance <= _REACH_M:
+        raise SimError(f"{name}: a point {distance:.3g} m from the robot's base, beyond the Panda's reach "
+                       f"(0.855 m); check the units and the base")
+    return point_m
+
+
+def _joint_seed(seed) -> np.ndarray:
+    """Seven finite joint angles (rad) within the Panda's limits, to start IK from."""
+    q = as_point(seed, 7, "seed")
+    outside = (q < np.array(PANDA.lower) - 1e-6) | (q > np.array(PANDA.upper) + 1e-6)
+    if outside.any():
+        joint = int(np.argmax(outside))
+        raise ValueError(f"seed: joint {joint + 1} at {q[joint]:.4g} rad is outside its limits "
+                         f"[{PANDA.lower[joint]}, {PANDA.upper[joint]}]")
+    return q
+
+
 class PandaCell:
     """A headless PyBullet world with a scene's parts and a Panda carrying the scene's tool.
 
@@ -341,7 +365,12 @@ class PandaCell:
         ``orientation`` (quaternion x, y, z, w; default pointing down), started from ``seed``;
         and the position error left (m)."""
         p = self.p
-        q = np.asarray(seed, dtype=float)
+        point_m = _reachable(as_point(point_m, 3, "point_m"), self.base * self.unit, "point_m")
+        q = _joint_seed(seed)
+        if orientation is not None:
+            from ._so3 import as_quaternions
+
+            orientation = as_quaternions(orientation, "orientation")[0]
         target_orientation = _DOWN if orientation is None else [float(v) for v in orientation]
         axis = None
         if orientation is not None:
@@ -384,7 +413,12 @@ class PandaCell:
         path = as_trajectory(path, "path", min_points=2, allow_static=True)
         if path.shape[1] != 3:
             raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
+        for point in (path.min(axis=0), path.max(axis=0)):  # before subdividing it into 5 mm steps
+            _reachable(point * self.unit, self.base * self.unit, "path")
         given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else np.asarray(fractions, dtype=float)
+        if given.shape != (path.shape[0],) or not np.all(np.isfinite(given)) or np.any(np.diff(given) < 0) \
+                or given[0] < 0 or given[-1] > 1:
+            raise ValueError(f"fractions must be {path.shape[0]} non-decreasing times in [0, 1]")
         points, u = _subdivide(path * self.unit, given, MAX_SAMPLE_SPACING)
         turns = None
         if orientations is not None:
@@ -395,7 +429,7 @@ class PandaCell:
                 raise ValueError(f"orientations must have shape ({path.shape[0]}, 4), got {q.shape}")
             keep = np.concatenate([[True], np.diff(given) > 1e-12])
             turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
-        q = np.array(_REST if seed is None else seed, dtype=float)
+        q = np.array(_REST, dtype=float) if seed is None else _joint_seed(seed)
         joints = np.empty((points.shape[0], 7))
         for index, point in enumerate(points):
             q, error = self.solve_ik(point, q, None if turns is None else turns[index])
