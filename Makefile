@@ -60,6 +60,7 @@ readme: $(STAMP)
 	cp .readme-out/sim/sim_keyframes_bidmp.png docs/sim_keyframes_bidmp.png
 	rm -rf .readme-out
 	$(PY) tools/recordings_figure.py
+	$(PY) tools/robot_protocol.py > /dev/null
 	$(PY) tools/readme.py
 
 clean:

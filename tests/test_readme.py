@@ -24,7 +24,7 @@ def test_readme_tables_equal_the_committed_command_outputs():
     blocks = readme_tool().blocks(README)
     assert {path for path, _ in blocks} == {"docs/results/table4.md", "docs/results/tasks.md", "docs/results/table5.md",
                                        "docs/results/figures.md", "docs/results/sim.md",
-                                       "docs/results/lasa.md"}
+                                       "docs/results/lasa.md", "docs/results/robot.md"}
     for path, body in blocks:
         committed = (ROOT / path).read_text(encoding="utf-8")
         assert body.strip() == committed.strip(), f"README block {path} is stale: run 'make readme'"
@@ -50,3 +50,21 @@ def test_the_readme_limits_table_states_the_defaults_in_force():
     assert set(rows) == set(defaults), "document every limit in the README table"
     for name, value in defaults.items():
         assert float(rows[name]) == float(value), name
+
+
+def test_the_robot_protocol_table_is_what_its_tool_measures(tmp_path):
+    """docs/results/robot.md (the README's robot-protocol numbers) against a fresh run of
+    tools/robot_protocol.py (about 6 s)."""
+    out = tmp_path / "robot.md"
+    subprocess.run([sys.executable, str(ROOT / "tools" / "robot_protocol.py"), "--out", str(out)], check=True,
+                   capture_output=True, timeout=120)
+    assert out.read_text() == (ROOT / "docs" / "results" / "robot.md").read_text()
+
+
+def test_the_readme_cites_only_files_in_the_repository():
+    """Issue 19.14: the README cited SPEC.md and ARCHITECTURE.md, which live outside it. Every
+    repository path it names (docs/, tools/, benchmarks/, tests/, src/) exists."""
+    for outside in ("SPEC.md", "ARCHITECTURE.md", "../shared"):
+        assert outside not in README, outside
+    for name in re.findall(r"\b((?:docs|tools|benchmarks|tests|src)/[\w./-]*\w)", README):
+        assert (ROOT / name).exists(), name

@@ -199,6 +199,15 @@ def _validate(shapes, methods, demos: str, every: int) -> tuple[list, list, list
     from .datasets import lasa_names
 
     names = lasa_names()
+    for given, what in ((shapes, "shapes"), (methods, "methods")):
+        if given is None:
+            continue
+        if isinstance(given, (str, bytes)) or not hasattr(given, "__iter__"):
+            raise TypeError(f"{what} must be a list of names, got {type(given).__name__}")
+        if not list(given):
+            raise ValueError(f"{what} names none; give at least one (or None for all)")
+        if not all(isinstance(name, str) for name in given):
+            raise TypeError(f"{what} must be a list of names (strings)")
     shapes = names if shapes is None else list(shapes)
     for shape in shapes:
         if shape not in names:

@@ -1251,7 +1251,8 @@ class DMPStepper:
         self.goal = dmp.goal_.copy() if goal is None else as_point(goal, n_dims, "goal")
         self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
         motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
-        self._scale = motion / dmp.duration_  # tau of the normalised system
+        self._scale = check_real(motion / dmp.duration_, "duration / duration_ (the temporal scaling)",
+                                 minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])  # tau of the normalised system
         self._params = params._replace(tau=self._scale)
         self.coupling = check_real(coupling, "coupling", nonnegative=True, maximum=1e6)
         self._forcing_increment = forcing_increment

@@ -79,8 +79,9 @@ class BiDMP(BaseEstimator):
     reg : float, default 1e-4
         Ridge λ of each block's output weights. The hidden nodes are nearly collinear, so a
         smaller λ buys little accuracy with huge, cancelling weights: on the nut task λ = 1e-8
-        gave weights up to 1.6e6 and a reproduction RMSE of 0.11 mm, λ = 1e-4 weights up to 1.3e4
-        and 0.25 mm (λ does not depend on the length unit: the ridge solution is linear in FI).
+        gave weights up to 1.7e5 and a reproduction RMSE of 0.025 mm, λ = 1e-4 weights up to 3.7e3
+        and 0.068 mm (``benchmarks/bidmp_convergence.py``; λ does not depend on the length unit:
+        the ridge solution is linear in FI).
     increments : tuple of int, default (20, 20)
         Enhancement nodes added, one block after another, after each BLS is fitted (the
         incremental step of Eq. 23–26).
