@@ -396,3 +396,21 @@ def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
     learned = skills.trajectory(extension.poses[-1])
     assert np.linalg.norm(learned.y[-1] - extension.poses[-1, :3]) <= 0.1
     assert isinstance(learned, type(motion))
+
+
+def test_pose_parameters_after_fit_follow_the_position_rules(demo):
+    """Only tau may change after fit (it slows both parts); a learned parameter unfits the model."""
+    from bidmp.cartesian import _PART_PARAMS
+
+    assert set(_PART_PARAMS) == set(CartesianDMP().get_params())
+    t = np.linspace(0.0, 2.0, len(demo))
+    model = CartesianDMP().fit(demo, t)
+    nominal = model.trajectory()
+    model.set_params(tau=2.0)
+    slow = model.trajectory()
+    assert slow.duration == pytest.approx(2 * nominal.duration, abs=slow.t[1])  # within one sample
+    n = min(len(slow.q[::2]), len(nominal))
+    np.testing.assert_allclose(slow.q[::2][:n], nominal.q[:n], atol=1e-4)  # the same turn, twice as slow
+    model.alpha = 80.0
+    with pytest.raises(bidmp.NotFittedError, match="alpha"):
+        model.rollout()

@@ -76,19 +76,24 @@ def continuous_log(q, goal) -> np.ndarray:
     rotation is within 1e-6 rad of a whole number of turns its axis is undefined, and the axis
     of the sample after it is kept. Sequential by nature; a scalar loop (about 1 µs a sample).
     """
-    angles, axes = _angles_and_axes(principal_log(q, goal))
+    principal = principal_log(q, goal)
+    if principal.shape[0] < 2 or np.max(np.linalg.norm(np.diff(principal, axis=0), axis=1)) < 0.5 * math.pi:
+        return principal  # no jump anywhere: the principal values are already continuous
+    angles, axes = _angles_and_axes(principal)
     n = angles.shape[0]
-    signed = np.empty(n)
-    out_axes = axes.copy()
-    signed[-1] = angles[-1]
+    signed = [0.0] * n
+    out_axes = axes.tolist()
+    angle_list = angles.tolist()
+    signed[-1] = angle_list[-1]
     for index in range(n - 2, -1, -1):
         after = out_axes[index + 1]
-        if angles[index] <= _AXIS_FLOOR:
+        if angle_list[index] <= _AXIS_FLOOR:
             out_axes[index] = after
-        alignment = float(out_axes[index] @ after)
+        axis = out_axes[index]
+        alignment = axis[0] * after[0] + axis[1] * after[1] + axis[2] * after[2]
         wanted = signed[index + 1] * alignment  # the neighbour's vector projected on this axis
-        signed[index] = angles[index] + _TWO_PI * round((wanted - angles[index]) / _TWO_PI)
-    return signed[:, None] * out_axes
+        signed[index] = angle_list[index] + _TWO_PI * math.floor((wanted - angle_list[index]) / _TWO_PI + 0.5)
+    return np.asarray(signed)[:, None] * np.asarray(out_axes)
 
 
 def nearest_turn(q, goal, reference: np.ndarray) -> np.ndarray:

@@ -112,6 +112,10 @@ def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: 
     orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
+_PART_PARAMS = ("n_kernels", "alpha", "beta", "K", "alpha_phase", "tau", "regression", "derivatives", "ridge", "widths",
+                "protocol", "goal_rate", "integrator")
+
+
 class CartesianDMP(BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
@@ -173,7 +177,10 @@ class CartesianDMP(BaseEstimator):
         learned parameter makes them refuse, naming it)."""
         check_fitted(self, "position_")
         for part in (self.position_, self.orientation_):
-            part.set_params(**self.get_params())
+            for name in _PART_PARAMS:  # attribute access, not get_params(): this runs on every query
+                value = getattr(self, name)
+                if getattr(part, name) is not value:
+                    setattr(part, name, value)
             part._check_fitted()
         return self.position_, self.orientation_
 
