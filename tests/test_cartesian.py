@@ -83,7 +83,7 @@ def test_a_recorded_pose_demonstration_is_reproduced_within_half_a_degree(tmp_pa
     motion = reproduction.t <= prepared_t[-1]
     truth = Slerp(t - t[0], rotations)(reproduction.t[motion] + info.start_s)
     rms = np.sqrt(np.mean(np.degrees(angle_between(reproduction.q[motion], truth.as_quat())) ** 2))
-    assert rms <= 0.5
+    assert rms <= 0.1  # the README states 0.07 degrees
     # Fitted raw, the sensor noise (0.05 degrees per sample) is differentiated twice: far worse.
     with pytest.warns(UserWarning, match="not of unit length"):
         raw = CartesianDMP().fit(poses, stamps).trajectory()
@@ -92,10 +92,10 @@ def test_a_recorded_pose_demonstration_is_reproduced_within_half_a_degree(tmp_pa
 
 
 @pytest.mark.parametrize("goal_turn, rate, bound", [
-    (0.0, "demo", (0.0, 0.01)),  # 0.32 % of the rotation, measured
-    (0.0, 1000.0, (0.0, 0.012)),  # 0.82 %: each side integrates Euler at its own step
-    (30.0, "demo", (0.05, 0.10)),  # 8.4 %: Ude's quaternion error and the log at the goal differ by design
-    (30.0, 1000.0, (0.05, 0.10)),
+    (0.0, "demo", (0.0, 0.004)),  # the README: 0.32 % of the rotation
+    (0.0, 1000.0, (0.0, 0.01)),  # 0.82 %: each side integrates Euler at its own step
+    (30.0, "demo", (0.075, 0.095)),  # 8.4-8.5 %: Ude's quaternion error and the log at the goal differ by design
+    (30.0, 1000.0, (0.075, 0.095)),
 ])
 def test_agreement_with_movement_primitives_cartesian_dmp(demo, goal_turn, rate, bound):
     """The same gains (alpha_y = 25, beta_y = 6.25), 50 weights and the phase decaying to 0.01 as
@@ -278,7 +278,8 @@ def test_turns_past_180_degrees_are_reproduced(degrees, protocol):
     poses, t = screw_turn(degrees)
     model = CartesianDMP(protocol=protocol).fit(poses, t, units="mm")
     reproduction = model.rollout()[: len(poses)]
-    assert np.degrees(angle_between(reproduction[:, 3:], poses[:, 3:])).max() <= 0.5
+    # The README: robot 0.001-0.004 degrees, paper (explicit Euler) 0.1-0.4 degrees.
+    assert np.degrees(angle_between(reproduction[:, 3:], poses[:, 3:])).max() <= (0.01 if protocol == "robot" else 0.5)
     assert turned_angle(reproduction[:, 3:]) == pytest.approx(degrees, abs=0.5)
     timed = model.trajectory()
     # The angular velocity integrates to the whole turn (an independent check of omega).

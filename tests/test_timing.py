@@ -396,7 +396,11 @@ def test_shared_recordings_after_prepare(name):
     assert 1.0 < info.start_s < 2.5 and 5.5 < info.end_s < t[-1] - t[0] - 1.0  # ~2 s idle at each end trimmed
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
     reproduction = dmp.rollout()[: dmp.n_steps_]
-    assert np.sqrt(np.mean(np.sum((reproduction - prepared.y) ** 2, axis=1))) <= 0.5  # mm, on the moving part
+    # The README states 0.088 / 0.105 mm (docs/results/robot.md); the test allows 20 % more.
+    assert np.sqrt(np.mean(np.sum((reproduction - prepared.y) ** 2, axis=1))) <= {"operator1_nut3.csv": 0.088,
+                                                                                   "operator2_nut5.csv": 0.105}[name] * 1.2
+    moved = dmp.trajectory(dmp.goal_ + SHIFT)  # README: 5.1e-05 / 2.5e-05 mm; allowed: 1e-4 mm
+    assert np.linalg.norm(moved.y[-1] - dmp.goal_ - SHIFT) <= 1e-4
     points = bidmp.segment(prepared.y).points
     speed = np.linalg.norm(prepared.yd, axis=1)
     assert len(points) >= 2 and np.all(speed[points] > 0.005 * speed.max())  # corners of the motion, not idle noise

@@ -2,27 +2,32 @@
 
 Transformation system (Pastor/Park form, no ``(g - y0)`` factor on the forcing term)::
 
-    tau² ÿ = alpha (beta (g - y) - tau ẏ) + K f(phase) - K phase (g - y0)
+    tau² ÿ = alpha (beta (g - y) - tau ẏ) + K f(phase) - K gate(phase) (g - y0)
     tau phase' = -alpha_phase phase,  phase(0) = 1
     f(phase) = phase · Σ_i w_i ψ_i(phase) / Σ_i ψ_i(phase),  ψ_i = exp(-h_i (phase - c_i)²)
 
-It is integrated with explicit Euler on the grid ``dt = 1/T`` for exactly ``T`` steps (the
-paper's protocol), with ``z = tau ẏ``::
+on the normalised grid ``dt = 1/T`` (the demonstration's T samples span one unit of time), with
+``z = tau ẏ``. Two integrators (:mod:`bidmp._integrate`):
 
-    z[l+1] = z[l] + dt/tau · (alpha (beta (g - y[l]) - z[l]) + u[l]),   y[l+1] = y[l] + dt/tau · z[l]
+* ``integrator="euler"`` (the paper's protocol): explicit Euler for exactly ``T`` steps,
+  ``z[l+1] = z[l] + dt/tau · (alpha (beta (g - y[l]) - z[l]) + u[l])``, ``y[l+1] = y[l] + dt/tau · z[l]``
+  — for ``tau = 1`` SPEC Eq. 14 to the letter, with the phase ``(1 - alpha_phase dt)^l``;
+* ``integrator="exact"`` (the robot protocol): the continuous system integrated exactly with the
+  input linear between samples and the phase ``exp(-alpha_phase t)``, so the same weights give
+  the same motion at any control rate.
 
-For ``tau = 1`` this is SPEC Eq. 14 to the letter.
+The goal gate is the phase (Eq. 10), an exponentially delayed goal, or the robot protocol's
+progress gate (:mod:`bidmp._goals`).
 
 **Why this module is fast.** For fixed weights the rollout is a linear time-invariant system
-driven by ``u[l] = alpha beta g + K f(phase[l]) - K phase[l] (g - y0)``, so the trajectory is
+driven by ``u[l] = alpha beta g + K f(phase[l]) - K gate[l] (g - y0)``, so the trajectory is
 affine in the goal and the start::
 
     y(g, y0) = a + B g + C y0        (a: (n, D);  B, C: (n,), the same for every dimension)
 
-Eliminating ``z`` turns the two Euler updates into one second-order recursion in ``y``, which
-:func:`scipy.signal.lfilter` integrates in C for all dimensions and the three unit responses at
-once. Rollouts to many goals then cost one integration plus an outer product
-(:meth:`DMP.rollout_many`).
+Either integrator is a second-order recursion in ``y``, which :func:`scipy.signal.lfilter` runs in
+C for all dimensions and the three unit responses at once. Rollouts to many goals then cost one
+integration plus an outer product (:meth:`DMP.rollout_many`).
 
 **Why a plain DMP misses far goals.** After a finite horizon the phase is still ``≈ e⁻¹``, the
 system has not converged, and the end point misses a shifted goal ``g'`` by exactly
