@@ -117,7 +117,11 @@ def run_cli(argv, cwd, label=None):
 
 @pytest.fixture(scope="module", autouse=True)
 def report():
-    yield
+    # A valid input may allocate arrays up to max_array_bytes (1 GiB by default), several at a
+    # time: the campaign runs with a quarter of it, so that one process of many examples stays
+    # within MAX_RSS_BYTES while the limits themselves are exercised.
+    with bidmp.set_limits(max_array_bytes=256 << 20):
+        yield
     _rss_ok()
     if FULL:
         with open("fuzz-report.json", "w", encoding="utf-8") as handle:
