@@ -35,7 +35,7 @@ sim: $(STAMP)
 # cluster, into bidmp-lasa/ (resumable: rerun to finish an interrupted sweep).
 lasa: $(STAMP)
 	$(VENV)/bin/bidmp benchmark lasa --resume --out bidmp-lasa
-	cp bidmp-lasa/lasa.md docs/results/lasa.md
+	cp bidmp-lasa/lasa.md bidmp-lasa/lasa.parquet docs/results/
 
 bench: $(STAMP)
 	$(PY) benchmarks/bench_dmp.py

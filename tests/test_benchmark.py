@@ -3,6 +3,7 @@ with the serial one, survive a killed worker and resume, and bad input that fail
 
 import functools
 import json
+import pathlib
 import sys
 import time
 
@@ -136,3 +137,23 @@ def test_csv_output_and_the_summary(serial, tmp_path):
     assert rows[[r[0] for r in rows].index("bidmp")][3].startswith(f"{np.median(values):.3g}")
     cell = json.loads((tmp_path / "cells" / "Sshape__0.json").read_text())
     assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == benchmark._cell_seed("Sshape", 0)
+
+
+def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
+    """Issue 19.14: docs/results/lasa.md (the README's LASA tables, from `make lasa`) is the
+    summary of the committed per-cell table docs/results/lasa.parquet, and a fresh run of two of
+    its cells gives the same rows (every metric; the times aside)."""
+    pq = pytest.importorskip("pyarrow.parquet")
+    pytest.importorskip("movement_primitives")  # the committed table has the mp-dmp rows
+    root = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+    rows = pq.read_table(root / "lasa.parquet").to_pylist()
+    protocol = {"demos": rows[0]["demos"], "every": rows[0]["every"]}
+    assert benchmark.summary_markdown(rows, protocol).strip() == (root / "lasa.md").read_text().strip()
+    methods = list(dict.fromkeys(row["method"] for row in rows))
+    for shape, demo in (("Sshape", 0), ("WShape", 4)):
+        fresh = benchmark.run_cell(shape, demo, methods, protocol["every"])["rows"]
+        committed = [row for row in rows if row["shape"] == shape and row["demo"] == demo]
+        assert len(fresh) == len(committed)
+        for new, old in zip(fresh, committed):
+            for name in benchmark.METRICS:
+                assert new[name] == pytest.approx(old[name], rel=1e-6, abs=1e-9), (shape, demo, new["method"], name)

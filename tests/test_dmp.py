@@ -359,6 +359,12 @@ def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how
     np.testing.assert_array_equal(refitted.rollout(), DMP(**dmp.get_params()).fit(demo3d).rollout())
 
 
+def test_every_parameter_but_tau_is_checked_after_fit():
+    from bidmp.dmp import _RAW_PARAMS
+
+    assert set(_RAW_PARAMS) | {"tau"} == set(DMP().get_params())  # a new parameter must be checked too
+
+
 def test_changing_alpha_after_fit_on_lasa_would_have_ruined_the_reproduction():
     """The measurement behind issue 19.4: the old weights under new gains reproduce Sshape badly,
     a refit reproduces it well; so reusing them silently was wrong."""

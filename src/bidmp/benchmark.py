@@ -51,7 +51,7 @@ LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
 CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
 TIMES = ("fit_s", "rollout_s")
-FORMAT = 1  # of the cell files; a different protocol or format is recomputed
+FORMAT = 2  # of the cell files (2: the robot protocol of issue 19); a different protocol or format is recomputed
 
 
 def cell_key(shape: str, demo: int) -> str:

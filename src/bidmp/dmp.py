@@ -583,7 +583,7 @@ class DMP(BaseEstimator):
         self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths
-        self._learned_with = self._learned_params()
+        self._remember_params()
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
         self._store_grid(params._replace(tau=1.0), phase, phi, dt)
         logger.debug("fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration)
@@ -593,13 +593,25 @@ class DMP(BaseEstimator):
         """The resolved parameters the weights depend on (all but tau, which only scales time)."""
         return self._params()._replace(tau=1.0)
 
+    def _raw_params(self) -> tuple:
+        return tuple(getattr(self, name) for name in _RAW_PARAMS)
+
+    def _remember_params(self) -> None:
+        self._learned_with = (self._raw_params(), self._learned_params())
+
     def _stale_params(self) -> list[str]:
         """The learned-with parameters that have changed since ``fit`` (with their values)."""
         learned = self.__dict__.get("_learned_with")
         if learned is None:
             return []
+        raw, resolved = learned
+        try:
+            if self._raw_params() == raw:  # the common case, without resolving the protocol's defaults
+                return []
+        except (TypeError, ValueError):  # an array set by mistake: resolving names it
+            pass
         now = self._learned_params()
-        return [f"{name} (fitted with {before!r}, now {after!r})" for name, before, after in zip(now._fields, learned, now)
+        return [f"{name} (fitted with {before!r}, now {after!r})" for name, before, after in zip(now._fields, resolved, now)
                 if before != after]
 
     def __sklearn_is_fitted__(self) -> bool:
@@ -1145,8 +1157,13 @@ class DMP(BaseEstimator):
             model.goal_gate_ = gate
         if params.integrator == "euler":
             check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
-        model._learned_with = model._learned_params()
+        model._remember_params()
         return model
+
+
+# The constructor's parameters but tau, as given (compared first: cheap), see DMP._stale_params.
+_RAW_PARAMS = ("n_kernels", "alpha", "beta", "K", "alpha_phase", "regression", "derivatives", "ridge", "widths", "protocol",
+               "goal_rate", "integrator")
 
 
 def _progress_gate(progress: np.ndarray, dt: float, params: _Params) -> np.ndarray:
