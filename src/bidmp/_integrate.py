@@ -195,6 +195,11 @@ def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float,
         ``z[l]``; the acceleration is the system's own, ``(u - αβ y - α z) / tau²``.
     """
     transition, now, after = foh_step(step, alpha, beta, tau)
-    z = (y[1:] - transition[0, 0] * y[:-1] - now[0] * inputs[:-1] - after[0] * inputs[1:]) / transition[0, 1]
-    acceleration = (inputs[:-1] - alpha * beta * y[:-1] - alpha * z) / tau**2
+    z = y[1:] - transition[0, 0] * y[:-1]
+    z -= now[0] * inputs[:-1]
+    z -= after[0] * inputs[1:]
+    z /= transition[0, 1]
+    acceleration = inputs[:-1] - alpha * beta * y[:-1]
+    acceleration -= alpha * z
+    acceleration /= tau**2
     return z, acceleration

@@ -672,8 +672,9 @@ class DMP(BaseEstimator):
                 params.integrator, step)
 
     def _store_grid(self, params: _Params, phase: np.ndarray, basis: np.ndarray, step: float) -> tuple:
+        gate = self._gate_on(params, phase, step)
         cached = (self._grid_key(params, phase.shape[0], step), self.centres_, self.widths_, phase, basis,
-                  self._unit_responses(params, phase, None, step))
+                  self._unit_responses(params, phase, None, step, gate=gate), gate)
         self._grid_cache = cached
         return cached
 
@@ -698,7 +699,7 @@ class DMP(BaseEstimator):
         if cached is None:
             phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
             cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_), step)
-        return cached[3:]
+        return cached[3:6]
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Phase (n,) and basis rows (n, N) on the rollout grid (default length
@@ -769,7 +770,8 @@ class DMP(BaseEstimator):
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
         return self.basis(phase) @ self.weights_
 
-    def _unit_responses(self, params: _Params, phase: np.ndarray, forcing: np.ndarray | None, step: float) -> np.ndarray:
+    def _unit_responses(self, params: _Params, phase: np.ndarray, forcing: np.ndarray | None, step: float, *,
+                        gate: np.ndarray | None = None) -> np.ndarray:
         """Responses that compose every rollout on the grid ``phase`` (n samples ``step`` apart).
 
         ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
@@ -786,7 +788,8 @@ class DMP(BaseEstimator):
             y_first = second = np.zeros(drives.shape[0])
         else:
             # The goal enters through alpha beta g - K gate (g - y0).
-            gate = self._gate_on(params, phase[:n_inputs], step)
+            gate = self._gate_on(params, phase, step) if gate is None else gate
+            gate = gate[:n_inputs]
             drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
             y_first = np.array([0.0, 1.0, 0.0])
             # The second state: Euler's y[1] (a unit start velocity moves it by one step), or
@@ -1031,8 +1034,10 @@ class DMP(BaseEstimator):
         positions = free + np.outer(goal_response, goal)
         if params.exact:
             start = self.start_ if start is None else as_point(start, free.shape[1], "start")
-            gate = self._gate_on(params, phase, step)
-            inputs = params.alpha * params.beta * goal + params.K * (forcing - np.outer(gate, goal - start))
+            gate = self._grid_cache[6]  # the grid _prepare just used
+            inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
+            inputs -= np.multiply.outer(gate, params.K * (goal - start))
+            inputs += params.alpha * params.beta * goal
             z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta,
                                           tau=params.tau)
             # The first state is given, not solved for: a rest start is exactly at rest.
