@@ -97,6 +97,12 @@ def goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: flo
     return gate
 
 
+# The rest blend's acceleration is -v₀ q''(t/w) / w with q(u) = u (1 - S(u)), q'' = -2S' - u S'':
+# its shape on [0, 1] does not depend on the window, so it is tabulated once.
+_BLEND_U = np.linspace(0.0, 1.0, 65)
+_BLEND_SHAPE = np.abs(2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1])
+
+
 def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float) -> float:
     """The shortest window (normalised time) over which blending ``speed_vector`` out adds at most
     ``REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
@@ -104,15 +110,11 @@ def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float,
     if speed <= 1e-12 * max(peak, 1e-300):
         return 0.0
     running = np.maximum.accumulate(np.linalg.norm(acceleration, axis=1))
-    for width in _REST_CANDIDATES:
-        # The blend's acceleration is -v₀ q''(t/w) / w with q(u) = u (1 - S(u)), q'' = -2S' - u S''.
-        u = np.linspace(0.0, 1.0, 65)
-        first, second = _smoothstep_derivatives(u)
-        added = speed * np.abs(2.0 * first + u * second) / width
-        reached = running[np.minimum((u * width / dt).astype(int), running.shape[0] - 1)]
-        if np.all(added <= REST_BLEND_SHARE * np.maximum(reached, 1e-300)):
-            return float(width)
-    return float(REST_BLEND_MAX)
+    # All candidate windows at once: (candidates, 65) added accelerations against the running peak.
+    added = speed * _BLEND_SHAPE[None, :] / _REST_CANDIDATES[:, None]
+    index = np.minimum((_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1)
+    within = np.all(added <= REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
+    return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(REST_BLEND_MAX)
 
 
 def rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
