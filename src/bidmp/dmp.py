@@ -1286,26 +1286,45 @@ class DMPStepper:
         self.y = self.start.copy()
         velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
         self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
+        # What every step reads, taken once: a control loop should not revalidate the model.
+        self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
+        self._gate_lookup = None
+        if params.goal_rate is None:
+            dmp._progress_gate_at(1.0, params)  # builds the reversed training grid
+            self._gate_lookup = dmp._gate_lookup[1], dmp._gate_lookup[3]
+        self._last_input = None  # (phase, gate, goal, start, u): the end of one step starts the next
         self.phase = 1.0
         self._gate = 1.0
         self._gate = self._next_gate(1.0, 1.0)
         self.time = 0.0
         self._checked_step = None
 
+    def _basis_row(self, phase: float) -> np.ndarray:
+        """``phi(phase)`` (1, N) for one phase: :func:`basis_functions` without its batching."""
+        log_psi = -self._widths * (phase - self._centres) ** 2
+        log_psi -= log_psi.max()
+        psi = np.exp(np.maximum(log_psi, _LOG_PSI_FLOOR))
+        return (psi * (phase / psi.sum()))[None]
+
     def _input(self, phase: float, gate: float) -> np.ndarray:
         """The system's input ``u = αβ g + K f(phase) - K gate (g - y0)`` (D,)."""
+        last = self._last_input
+        if (last is not None and last[0] == phase and last[1] == gate and np.array_equal(last[2], self.goal)
+                and np.array_equal(last[3], self.start)):
+            return last[4]
         params = self._params
-        phases = np.array([phase])
-        basis = self._dmp.basis(phases)
-        forcing = basis @ self._dmp.weights_
+        basis = self._basis_row(phase)
+        forcing = basis @ self._weights
         if self._forcing_increment is not None:
-            forcing = forcing + self._forcing_increment(phases, basis)
-        return params.alpha * params.beta * self.goal + params.K * (forcing[0] - gate * (self.goal - self.start))
+            forcing = forcing + self._forcing_increment(np.array([phase]), basis)
+        value = params.alpha * params.beta * self.goal + params.K * (forcing[0] - gate * (self.goal - self.start))
+        self._last_input = (phase, gate, self.goal.copy(), self.start.copy(), value)
+        return value
 
     def _next_gate(self, phase: float, decay: float) -> float:
         params = self._params
         if params.goal_rate is None:
-            return float(self._dmp._progress_gate_at(phase, params))
+            return float(np.interp(phase, *self._gate_lookup))
         if params.goal_rate == params.alpha_phase:
             return phase
         return self._gate * decay
