@@ -80,6 +80,15 @@ class Trajectory:
         return float(np.max(np.linalg.norm(self.ydd, axis=1)))
 
 
+def _as_stamps(t, name: str) -> np.ndarray:
+    if isinstance(t, (str, bytes)):
+        raise TypeError(f"{name} must be an array of times in seconds, got a string")
+    try:
+        return np.asarray(t, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of times in seconds") from None
+
+
 def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
     """Validate timestamps (s) for ``n_samples`` samples and return them as float64 (n,).
 
@@ -91,12 +100,7 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
         If they are not finite, not strictly increasing (duplicates are named), or imply a mean
         sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
     """
-    if isinstance(t, (str, bytes)):
-        raise TypeError(f"{name} must be an array of times in seconds, got a string")
-    try:
-        stamps = np.asarray(t, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of times in seconds") from None
+    stamps = _as_stamps(t, name)
     if stamps.ndim != 1 or stamps.shape[0] != n_samples:
         raise ValueError(f"{name} must have shape ({n_samples},) (one time per sample), got {stamps.shape}")
     if not np.all(np.isfinite(stamps)):
@@ -132,12 +136,7 @@ def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray
     Stamps going back are still refused (:func:`check_timestamps`).
     """
     y = np.asarray(y, dtype=np.float64)
-    if isinstance(t, (str, bytes)):
-        raise TypeError(f"{name} must be an array of times in seconds, got a string")
-    try:
-        stamps = np.asarray(t, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of times in seconds") from None
+    stamps = _as_stamps(t, name)
     if stamps.ndim == 1 and y.ndim >= 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1:
         repeated = np.concatenate([[False], np.diff(stamps) == 0])
         if np.any(repeated):

@@ -13,7 +13,7 @@ import logging
 import sys
 from collections.abc import Sequence
 
-from . import __version__
+from .. import __version__
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -41,13 +41,13 @@ def _parse_K(text: str):
 # Command handlers
 # ---------------------------------------------------------------------------------------------
 def _cmd_lasa(args: argparse.Namespace) -> int:
-    from .datasets import lasa, lasa_names
+    from ..datasets import lasa, lasa_names
 
     if args.lasa_command == "list":
         for name in lasa_names():
             print(name)
         return EXIT_OK
-    from .io import save_trajectory
+    from ..io import save_trajectory
 
     demos = lasa(args.name)
     if not 0 <= args.demo < demos.shape[0]:
@@ -61,7 +61,7 @@ def _run_scenario(scenario, out, methods=None):
     """Evaluate a scenario with a progress bar, print its report, write results and figures."""
     from tqdm import tqdm
 
-    from .evaluation import evaluate, write_report
+    from ..evaluation import evaluate, write_report
 
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
@@ -82,7 +82,7 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
     """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
     from tqdm import tqdm
 
-    from .sim import simulate, write_sim_report
+    from ..sim import simulate, write_sim_report
 
     methods = list(methods)
     labels = scenario.labels if targets is None else targets
@@ -108,8 +108,8 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from .scenarios import load
-    from .sim import Hold, _pybullet
+    from ..scenarios import load
+    from ..sim import Hold, _pybullet
 
     _pybullet()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
@@ -135,7 +135,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from .benchmark import _validate, lasa
+    from ..benchmark import _validate, lasa
 
     shapes = None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
     methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -159,11 +159,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if args.lasa:
         return _lasa_demo(args.lasa, out)
-    from .scenarios import load
+    from ..scenarios import load
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     if args.approach is not None:
-        from .scenarios import from_dict
+        from ..scenarios import from_dict
 
         spec = scenario.to_dict()
         spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
@@ -175,7 +175,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
     if args.sim:
-        from .sim import _pybullet
+        from ..sim import _pybullet
 
         _pybullet()
     report = _run_scenario(scenario, out, methods)
@@ -186,9 +186,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _lasa_demo(shape: str, out) -> int:
-    from .io import atomic_write
-    from .plotting import plot_generalisation
-    from .reproduce import lasa_generalisation
+    from ..io import atomic_write
+    from ..plotting import plot_generalisation
+    from ..reproduce import lasa_generalisation
 
     out.mkdir(parents=True, exist_ok=True)
     result = lasa_generalisation(shape)
@@ -201,7 +201,7 @@ def _lasa_demo(shape: str, out) -> int:
 
 
 def _cmd_scenario(args: argparse.Namespace) -> int:
-    from .scenarios import builtin_names, builtin_text, load
+    from ..scenarios import builtin_names, builtin_text, load
 
     if args.scenario_command == "list":
         for name in builtin_names():
@@ -223,7 +223,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from . import reproduce
+    from .. import reproduce
 
     out = Path(args.out)
     if not 1 <= args.seeds <= _MAX_SEEDS:
@@ -260,7 +260,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logging")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
-    from ._cli_skills import add_commands
+    from .skills import add_commands
 
     add_commands(commands, _parse_K, _allow_outside_files)
 
@@ -405,7 +405,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         print("bidmp: error: no command given (see 'bidmp --help')", file=sys.stderr)
         return EXIT_BAD_INPUT
-    from ._checks import MissingExtraError
+    from .._checks import MissingExtraError
 
     buffered = _BufferedLog()
     root = logging.getLogger()
