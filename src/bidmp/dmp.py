@@ -1034,22 +1034,25 @@ class DMP(BaseEstimator):
         positions = free + np.outer(goal_response, goal)
         if params.exact:
             start = self.start_ if start is None else as_point(start, free.shape[1], "start")
-            gate = self._grid_cache[6]  # the grid _prepare just used
-            inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
-            inputs -= np.multiply.outer(gate, params.K * (goal - start))
-            inputs += params.alpha * params.beta * goal
-            z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta,
-                                          tau=params.tau)
-            # The first state is given, not solved for: a rest start is exactly at rest.
-            z[0] = 0.0 if velocity is None else params.tau * velocity
-            acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
-            velocities = z / (params.tau * self.time_unit_)
-            accelerations = acceleration / self.time_unit_**2
+            velocities, accelerations = self._exact_rates(params, positions, forcing, goal, start, velocity, step)
         else:
             velocities = np.diff(positions, axis=0) / dt
             accelerations = np.diff(velocities, axis=0) / dt
         return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
                           accelerations[:n_samples], self.units_)
+
+    def _exact_rates(self, params: _Params, positions, forcing, goal, start, velocity, step) -> tuple:
+        """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
+        n out): the system's own state and acceleration, from the positions and the input."""
+        gate = self._grid_cache[6]  # the grid _prepare just used
+        inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
+        inputs -= np.multiply.outer(gate, params.K * (goal - start))
+        inputs += params.alpha * params.beta * goal
+        z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau)
+        # The first state is given, not solved for: a rest start is exactly at rest.
+        z[0] = 0.0 if velocity is None else params.tau * velocity
+        acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
+        return z / (params.tau * self.time_unit_), acceleration / self.time_unit_**2
 
     def _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment):
         """The trajectory within ``limits``: at the nominal duration if that meets them (limits

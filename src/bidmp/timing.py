@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._checks import as_trajectory, check_choice, check_real, numerically_guarded
+from ._units import check_units
 
 __all__ = ["Trajectory", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "prepare", "time_scale",
            "PrepareInfo"]
@@ -215,8 +216,6 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
         The trimmed motion, time from 0 s, with filtered velocities and accelerations.
     """
     from scipy.signal import butter, sosfiltfilt
-
-    from ._units import check_units
 
     units = check_units(units)
     y = as_trajectory(y, "y", min_points=10)

@@ -369,6 +369,11 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
     rollout.set_defaults(handler=cmd_rollout)
 
+    _add_extension_commands(commands, allow_outside_files)
+
+
+def _add_extension_commands(commands, allow_outside_files) -> None:
+    """The subcommands segment, extend and learn."""
     seg = commands.add_parser("segment", help="find the segmentation points of a demonstration (1D-SEG)",
                               description="Cut a 2-D or 3-D demonstration at its curvature extrema (1D-SEG).", epilog=TIMED_INPUT)
     seg.add_argument("demo", metavar="DEMO", help="demonstration (.csv or .npy; a pose file is segmented by its positions)")
