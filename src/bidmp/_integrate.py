@@ -166,16 +166,10 @@ def exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray
     b0 = after[0]
     b1 = now[0] - p22 * after[0] + p12 * after[1]
     b2 = -p22 * now[0] + p12 * now[1]
-    out = np.empty((inputs.shape[0], n))
-    out[:, 0] = y_first
-    if n == 1:
-        return out
-    out[:, 1] = y_second
-    if n == 2:
-        return out
+    if n < 3:
+        return np.column_stack([y_first, y_second])[:, :n]
     drives = b0 * inputs[:, 2:] + b1 * inputs[:, 1:-1] + b2 * inputs[:, :-2]
-    out[:, 2:] = _second_order(drives, y_first, y_second, [1.0, 0.0, 0.0], a1, a2)[:, 2:]
-    return out
+    return _second_order(drives, y_first, y_second, [1.0, 0.0, 0.0], a1, a2)
 
 
 def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float, beta: float,

@@ -9,12 +9,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._so3 import left_jacobian, orientation_from_log
+from .timing import TimedMotion
 
 __all__ = ["PoseTrajectory", "PoseStepper", "pose_trajectory"]
 
 
 @dataclass(frozen=True)
-class PoseTrajectory:
+class PoseTrajectory(TimedMotion):
     """A timed pose trajectory, the pose counterpart of :class:`bidmp.Trajectory` (lengths in
     ``units``, angles in rad, time in s).
 
@@ -45,18 +46,6 @@ class PoseTrajectory:
                 raise ValueError(f"PoseTrajectory.{name} must have shape ({n}, {width}), got {getattr(self, name).shape}")
 
     @property
-    def duration(self) -> float:
-        """``t[-1] - t[0]`` in seconds."""
-        return float(self.t[-1] - self.t[0])
-
-    @property
-    def n_dims(self) -> int:
-        return 3
-
-    def __len__(self) -> int:
-        return int(self.t.shape[0])
-
-    @property
     def poses(self) -> np.ndarray:
         """(n, 7): x, y, z, qx, qy, qz, qw."""
         return np.hstack([self.y, self.q])
@@ -67,14 +56,6 @@ class PoseTrajectory:
         header = ["t", "x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az",
                   "dwx", "dwy", "dwz"]
         return header, np.column_stack([self.t, self.y, self.q, self.yd, self.omega, self.ydd, self.omega_dot])
-
-    def peak_speed(self) -> float:
-        """Largest ‖yd‖ (units/s)."""
-        return float(np.max(np.linalg.norm(self.yd, axis=1)))
-
-    def peak_acceleration(self) -> float:
-        """Largest ‖ydd‖ (units/s²)."""
-        return float(np.max(np.linalg.norm(self.ydd, axis=1)))
 
     def peak_angular_speed(self) -> float:
         """Largest ‖omega‖ (rad/s)."""

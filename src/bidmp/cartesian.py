@@ -112,8 +112,7 @@ def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: 
     orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
-_PART_PARAMS = ("n_kernels", "alpha", "beta", "K", "alpha_phase", "tau", "regression", "derivatives", "ridge", "widths",
-                "protocol", "goal_rate", "integrator")
+_PART_PARAMS = tuple(DMP._get_param_names())  # a pose model's parameters are its parts' own
 
 
 class CartesianDMP(BaseEstimator):

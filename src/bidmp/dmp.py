@@ -46,7 +46,6 @@ from sklearn.base import BaseEstimator
 
 from . import _goals
 from ._integrate import (
-    _max_stable_step,  # noqa: F401  (kept importable from here)
     check_euler_stable,
     euler_responses,
     euler_spectral_radius,
@@ -542,7 +541,7 @@ class DMP(BaseEstimator):
 
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
-        units = "" if units is None else _check_units(units)
+        units = "" if units is None else check_units(units)
         if t is None:
             duration = (y.shape[0] - 1) / y.shape[0]
         else:
@@ -685,8 +684,8 @@ class DMP(BaseEstimator):
             return None
         return cached
 
-    def _grid(self, params: _Params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Phase (n,), basis rows (n, N) and unit responses ``[B, C, V]`` (3, n) on the grid of
+    def _grid(self, params: _Params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, ...]:
+        """Phase (n,), basis rows (n, N), unit responses ``[B, C, V]`` (3, n) and goal gate (n,) on the grid of
         ``n_steps`` samples ``step`` apart in normalised time (default ``dt_``) for the validated
         ``params``.
 
@@ -699,14 +698,14 @@ class DMP(BaseEstimator):
         if cached is None:
             phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
             cached = self._store_grid(params, phase, basis_functions(phase, self.centres_, self.widths_), step)
-        return cached[3:6]
+        return cached[3:]
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Phase (n,) and basis rows (n, N) on the rollout grid (default length
         :meth:`default_n_steps`), cached."""
         self._check_fitted()
         params = self._params()
-        phase, basis, _ = self._grid(params, self._n_steps(n_steps, params))
+        phase, basis, *_ = self._grid(params, self._n_steps(n_steps, params))
         return phase, basis
 
     @property
@@ -719,7 +718,7 @@ class DMP(BaseEstimator):
         """Phase and basis rows (N columns) of the grid the weights were learned on
         (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
         self._check_fitted()
-        phase, basis, _ = self._grid(self._params()._replace(tau=1.0), self.n_train_)
+        phase, basis, *_ = self._grid(self._params()._replace(tau=1.0), self.n_train_)
         return phase, basis
 
     def training_gate(self) -> np.ndarray:
@@ -823,7 +822,7 @@ class DMP(BaseEstimator):
         n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response) = self._grid(params, n_steps, step)
+        phase, basis, (goal_response, start_response, velocity_response), gate = self._grid(params, n_steps, step)
         forcing = basis @ self.weights_
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
@@ -835,7 +834,7 @@ class DMP(BaseEstimator):
         # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
         if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
             raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
-        return free, goal_response, forcing, phase
+        return free, goal_response, forcing, gate
 
     @numerically_guarded
     def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
@@ -953,7 +952,7 @@ class DMP(BaseEstimator):
         if cached is not None:
             goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
-            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase)
+            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase, exact=params.exact)
             goal_response = self._unit_responses(params, phase, None, self.dt_)[0]
         return float(abs(1.0 - goal_response[-1]))
 
@@ -1025,8 +1024,8 @@ class DMP(BaseEstimator):
         velocity = None if start_velocity is None else as_point(start_velocity, self.n_dims_, "start_velocity") * self.time_unit_
         # Two extra samples give the last velocity and acceleration as forward differences (Euler),
         # one the last exact state.
-        free, goal_response, forcing, phase = self._prepare(start, velocity, n_samples + 2, forcing_increment,
-                                                            params=params, step=step)
+        free, goal_response, forcing, gate = self._prepare(start, velocity, n_samples + 2, forcing_increment,
+                                                           params=params, step=step)
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         if self.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
             check_reach(float(min(np.linalg.norm(goal - self.goal_), np.linalg.norm(goal - self.start_))), self.units_,
@@ -1034,17 +1033,16 @@ class DMP(BaseEstimator):
         positions = free + np.outer(goal_response, goal)
         if params.exact:
             start = self.start_ if start is None else as_point(start, free.shape[1], "start")
-            velocities, accelerations = self._exact_rates(params, positions, forcing, goal, start, velocity, step)
+            velocities, accelerations = self._exact_rates(params, positions, forcing, gate, goal, start, velocity, step)
         else:
             velocities = np.diff(positions, axis=0) / dt
             accelerations = np.diff(velocities, axis=0) / dt
         return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
                           accelerations[:n_samples], self.units_)
 
-    def _exact_rates(self, params: _Params, positions, forcing, goal, start, velocity, step) -> tuple:
+    def _exact_rates(self, params: _Params, positions, forcing, gate, goal, start, velocity, step) -> tuple:
         """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
         n out): the system's own state and acceleration, from the positions and the input."""
-        gate = self._grid_cache[6]  # the grid _prepare just used
         inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
         inputs -= np.multiply.outer(gate, params.K * (goal - start))
         inputs += params.alpha * params.beta * goal
@@ -1156,7 +1154,7 @@ class DMP(BaseEstimator):
         model.duration_ = check_real(meta.get("duration_", (n_steps - 1) / n_steps), "duration_", positive=True, maximum=1e7)
         if (n_steps - 1) / model.duration_ > 1e5 or (n_steps - 1) / model.duration_ < 1e-3:
             raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
-        model.units_ = _check_units(meta.get("units_", ""))
+        model.units_ = check_units(meta.get("units_", ""))
         model.goal_gate_ = None
         if params.goal_rate is None:
             gate = check_loaded(arrays["goal_gate_"], "goal_gate_", (model.n_train_,))
@@ -1170,8 +1168,7 @@ class DMP(BaseEstimator):
 
 
 # The constructor's parameters but tau, as given (compared first: cheap), see DMP._stale_params.
-_RAW_PARAMS = ("n_kernels", "alpha", "beta", "K", "alpha_phase", "regression", "derivatives", "ridge", "widths", "protocol",
-               "goal_rate", "integrator")
+_RAW_PARAMS = tuple(name for name in DMP._get_param_names() if name != "tau")
 
 
 def _progress_gate(progress: np.ndarray, dt: float, params: _Params) -> np.ndarray:
@@ -1247,11 +1244,6 @@ def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
     if n_rest <= 0:
         return y
     return np.vstack([y, np.repeat(y[-1:], n_rest, axis=0)])
-
-
-def _check_units(units) -> str:
-    """A length unit: "m", "cm", "mm" or "" (unknown); see :mod:`bidmp._units`."""
-    return check_units(units)
 
 
 class DMPStepper:

@@ -27,8 +27,33 @@ MIN_RATE_HZ = 1.0
 MAX_RATE_HZ = 100_000.0
 
 
+class TimedMotion:
+    """What a timed trajectory of positions (``t``, ``y``, ``yd``, ``ydd``) answers: its duration,
+    length, dimensions and peaks. :class:`Trajectory` and the pose trajectory share it."""
+
+    @property
+    def duration(self) -> float:
+        """``t[-1] - t[0]`` in seconds."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def n_dims(self) -> int:
+        return int(self.y.shape[1])
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def peak_speed(self) -> float:
+        """Largest ‖yd‖ (units/s)."""
+        return float(np.max(np.linalg.norm(self.yd, axis=1)))
+
+    def peak_acceleration(self) -> float:
+        """Largest ‖ydd‖ (units/s²)."""
+        return float(np.max(np.linalg.norm(self.ydd, axis=1)))
+
+
 @dataclass(frozen=True)
-class Trajectory:
+class Trajectory(TimedMotion):
     """A timed trajectory: what a robot controller consumes.
 
     Attributes
@@ -53,32 +78,12 @@ class Trajectory:
             if getattr(self, name).shape[0] != n or getattr(self, name).ndim != 2:
                 raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {getattr(self, name).shape}")
 
-    @property
-    def duration(self) -> float:
-        """``t[-1] - t[0]`` in seconds."""
-        return float(self.t[-1] - self.t[0])
-
-    @property
-    def n_dims(self) -> int:
-        return int(self.y.shape[1])
-
-    def __len__(self) -> int:
-        return int(self.t.shape[0])
-
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the
         matching (n, 1 + 3D) array: the layout of timed CSV and ``.npy`` files."""
         names = ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)]
         header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
         return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
-
-    def peak_speed(self) -> float:
-        """Largest ‖yd‖ (units/s)."""
-        return float(np.max(np.linalg.norm(self.yd, axis=1)))
-
-    def peak_acceleration(self) -> float:
-        """Largest ‖ydd‖ (units/s²)."""
-        return float(np.max(np.linalg.norm(self.ydd, axis=1)))
 
 
 def _as_stamps(t, name: str) -> np.ndarray:
