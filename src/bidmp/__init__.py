@@ -2,79 +2,100 @@
 
 The public names of SPEC §10 are imported lazily (PEP 562), so ``import bidmp`` and
 ``bidmp --help`` do not pay for NumPy/SciPy until a name is used.
+
+The subpackages, in layers (each imports only from the layers above it; ``tests/test_package.py``
+checks it):
+
+1. the math — ``primitives`` (DMPs, goal systems, integrators, coupling terms, timing),
+   ``extension`` (segmentation, Fréchet similarity, G-PRM, extended demonstrations),
+   ``incremental`` (BLS, Bi-DMP), ``baselines`` (GMM/GMR, TP-GMM), ``scene`` (parts, clearance);
+2. data and tasks — ``demonstrations`` (prepare, datasets), ``io`` (files), ``tasks`` (scenarios,
+   methods, evaluation, metrics);
+3. the application — ``sim`` (simulator backends), ``experiments`` (the paper's tables, LASA),
+   ``plotting``;
+4. the shell — ``cli``.
+
+The flat module paths of bidmp ≤ 0.4 (``bidmp.dmp``, ``bidmp.geometry``, …) still import
+(:mod:`bidmp._old_paths`).
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
-__version__ = "0.4.0"
+from . import _old_paths
+from ._lazy import exports
 
-# public name -> (module, attribute)
+__version__ = "0.5.0"
+
+_old_paths.install()
+
+# public name -> "module[:attribute]" relative to bidmp
 _LAZY = {
-    "DMP": ("bidmp.dmp", "DMP"),
-    "Trajectory": ("bidmp.timing", "Trajectory"),
-    "prepare": ("bidmp.timing", "prepare"),
-    "time_scale": ("bidmp.timing", "time_scale"),
-    "segment": ("bidmp.segmentation", "segment"),
-    "Segmentation": ("bidmp.segmentation", "Segmentation"),
-    "frechet_distance": ("bidmp.similarity", "frechet_distance"),
-    "frechet_similarity": ("bidmp.similarity", "frechet_similarity"),
-    "extend_demonstration": ("bidmp.extension", "extend_demonstration"),
-    "Scene": ("bidmp.geometry", "Scene"),
-    "CartesianDMP": ("bidmp.cartesian", "CartesianDMP"),
-    "CartesianBiDMP": ("bidmp.cartesian", "CartesianBiDMP"),
-    "Tool": ("bidmp.geometry", "Tool"),
-    "Clearance": ("bidmp.geometry", "Clearance"),
-    "MissingExtraError": ("bidmp._checks", "MissingExtraError"),
-    "BLS": ("bidmp.bls", "BLS"),
-    "BiDMP": ("bidmp.incremental", "BiDMP"),
-    "forgetting": ("bidmp.incremental", "forgetting"),
-    "evaluate": ("bidmp.evaluation", "evaluate"),
-    "save": ("bidmp.io", "save_model"),
-    "load": ("bidmp.io", "load_model"),
-    "ModelFileError": ("bidmp.io", "ModelFileError"),
-    "NotFittedError": ("bidmp._checks", "NotFittedError"),
-    "Limits": ("bidmp._checks", "Limits"),
-    "get_limits": ("bidmp._checks", "get_limits"),
-    "set_limits": ("bidmp._checks", "set_limits"),
+    "DMP": "primitives.dmp",
+    "Trajectory": "primitives.timing",
+    "prepare": "demonstrations.prepare",
+    "time_scale": "primitives.timing",
+    "segment": "extension.segmentation",
+    "Segmentation": "extension.segmentation",
+    "frechet_distance": "extension.similarity",
+    "frechet_similarity": "extension.similarity",
+    "extend_demonstration": "extension.extend",
+    "Scene": "scene",
+    "CartesianDMP": "primitives.cartesian",
+    "CartesianBiDMP": "incremental.cartesian",
+    "Tool": "scene",
+    "Clearance": "scene",
+    "MissingExtraError": "_checks",
+    "BLS": "incremental.bls",
+    "BiDMP": "incremental.bidmp",
+    "forgetting": "incremental.bidmp",
+    "evaluate": "tasks.evaluation",
+    "save": "io:save_model",
+    "load": "io:load_model",
+    "ModelFileError": "io",
+    "NotFittedError": "_checks",
+    "Limits": "_checks",
+    "get_limits": "_checks",
+    "set_limits": "_checks",
 }
-_SUBMODULES = (
-    "dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "extension", "incremental", "geometry", "cartesian",
-    "baselines", "datasets", "io", "scenarios", "metrics", "evaluation", "reproduce", "plotting", "sim", "benchmark",
-)
+# subpackages of the layout, and the flat modules of bidmp <= 0.4 (bidmp._old_paths)
+_SUBPACKAGES = ("primitives", "demonstrations", "extension", "incremental", "baselines", "scene", "tasks", "sim",
+                "experiments", "io", "plotting")
+_OLD_MODULES = ("dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "geometry", "cartesian", "datasets",
+                "scenarios", "metrics", "evaluation", "reproduce", "benchmark")
 
-__all__ = ["__version__", *_LAZY, *_SUBMODULES]
+__all__ = ["__version__", *_LAZY, *_SUBPACKAGES, *_OLD_MODULES]
 
-if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from . import bls, datasets, dmp, evaluation, extension, geometry, incremental, io, metrics, plotting, reproduce, roadmap, segmentation, similarity  # noqa: F401
-    from .bls import BLS  # noqa: F401
-    from .incremental import BiDMP, forgetting  # noqa: F401
-    from ._checks import Limits, NotFittedError, get_limits, set_limits  # noqa: F401
-    from .dmp import DMP  # noqa: F401
-    from .timing import Trajectory, prepare, time_scale  # noqa: F401
-    from .extension import extend_demonstration  # noqa: F401
-    from .geometry import Clearance, Scene, Tool  # noqa: F401
-    from .cartesian import CartesianBiDMP, CartesianDMP  # noqa: F401
-    from .segmentation import Segmentation, segment  # noqa: F401
-    from .similarity import frechet_distance, frechet_similarity  # noqa: F401
-    from .io import ModelFileError  # noqa: F401
-    from .io import load_model as load  # noqa: F401
-    from .io import save_model as save  # noqa: F401
+_getattr, __dir__ = exports(__name__, _LAZY, globals())
 
 
 def __getattr__(name: str):
-    if name in _LAZY:
-        module_name, attribute = _LAZY[name]
-        value = getattr(importlib.import_module(module_name), attribute)
-    elif name in _SUBMODULES:
-        value = importlib.import_module(f"bidmp.{name}")
-    else:
-        raise AttributeError(f"module 'bidmp' has no attribute {name!r}")
-    globals()[name] = value
-    return value
+    if name in _SUBPACKAGES or name in _OLD_MODULES:
+        import importlib
+
+        value = importlib.import_module(f"{__name__}.{name}")
+        globals()[name] = value
+        return value
+    try:
+        return _getattr(name)
+    except AttributeError:
+        raise AttributeError(f"module 'bidmp' has no attribute {name!r}") from None
 
 
-def __dir__() -> list[str]:
-    return sorted(__all__)
+if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
+    from ._checks import Limits, MissingExtraError, NotFittedError, get_limits, set_limits  # noqa: F401
+    from .demonstrations.prepare import prepare  # noqa: F401
+    from .extension.extend import extend_demonstration  # noqa: F401
+    from .extension.segmentation import Segmentation, segment  # noqa: F401
+    from .extension.similarity import frechet_distance, frechet_similarity  # noqa: F401
+    from .incremental.bidmp import BiDMP, forgetting  # noqa: F401
+    from .incremental.bls import BLS  # noqa: F401
+    from .incremental.cartesian import CartesianBiDMP  # noqa: F401
+    from .io import ModelFileError  # noqa: F401
+    from .io import load_model as load  # noqa: F401
+    from .io import save_model as save  # noqa: F401
+    from .primitives.cartesian import CartesianDMP  # noqa: F401
+    from .primitives.dmp import DMP  # noqa: F401
+    from .primitives.timing import Trajectory, time_scale  # noqa: F401
+    from .scene import Clearance, Scene, Tool  # noqa: F401

@@ -41,13 +41,13 @@ def _parse_K(text: str):
 # Command handlers
 # ---------------------------------------------------------------------------------------------
 def _cmd_lasa(args: argparse.Namespace) -> int:
-    from ..datasets import lasa, lasa_names
+    from ..demonstrations.datasets import lasa, lasa_names
 
     if args.lasa_command == "list":
         for name in lasa_names():
             print(name)
         return EXIT_OK
-    from ..io import save_trajectory
+    from ..io.files import save_trajectory
 
     demos = lasa(args.name)
     if not 0 <= args.demo < demos.shape[0]:
@@ -61,7 +61,7 @@ def _run_scenario(scenario, out, methods=None):
     """Evaluate a scenario with a progress bar, print its report, write results and figures."""
     from tqdm import tqdm
 
-    from ..evaluation import evaluate, write_report
+    from ..tasks.evaluation import evaluate, write_report
 
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
@@ -82,7 +82,7 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
     """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
     from tqdm import tqdm
 
-    from ..sim import simulate, write_sim_report
+    from ..sim.panda import simulate, write_sim_report
 
     methods = list(methods)
     labels = scenario.labels if targets is None else targets
@@ -108,8 +108,8 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..scenarios import load
-    from ..sim import Hold, _pybullet
+    from ..tasks.scenarios import load
+    from ..sim.panda import Hold, _pybullet
 
     _pybullet()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
@@ -135,7 +135,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from ..benchmark import _validate, lasa
+    from ..experiments.lasa import _validate, lasa
 
     shapes = None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
     methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -159,11 +159,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if args.lasa:
         return _lasa_demo(args.lasa, out)
-    from ..scenarios import load
+    from ..tasks.scenarios import load
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     if args.approach is not None:
-        from ..scenarios import from_dict
+        from ..tasks.scenarios import from_dict
 
         spec = scenario.to_dict()
         spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
@@ -175,7 +175,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
     if args.sim:
-        from ..sim import _pybullet
+        from ..sim.panda import _pybullet
 
         _pybullet()
     report = _run_scenario(scenario, out, methods)
@@ -186,9 +186,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _lasa_demo(shape: str, out) -> int:
-    from ..io import atomic_write
-    from ..plotting import plot_generalisation
-    from ..reproduce import lasa_generalisation
+    from ..io.files import atomic_write
+    from ..plotting.figures import plot_generalisation
+    from ..experiments.reproduce import lasa_generalisation
 
     out.mkdir(parents=True, exist_ok=True)
     result = lasa_generalisation(shape)
@@ -201,7 +201,7 @@ def _lasa_demo(shape: str, out) -> int:
 
 
 def _cmd_scenario(args: argparse.Namespace) -> int:
-    from ..scenarios import builtin_names, builtin_text, load
+    from ..tasks.scenarios import builtin_names, builtin_text, load
 
     if args.scenario_command == "list":
         for name in builtin_names():
@@ -223,7 +223,7 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from .. import reproduce
+    from ..experiments import reproduce
 
     out = Path(args.out)
     if not 1 <= args.seeds <= _MAX_SEEDS:

@@ -45,8 +45,9 @@ def is_pose_file(path) -> bool:
 
 def model_dmp(model):
     """The position DMP of any model class (its units and workspace)."""
-    from ..cartesian import CartesianBiDMP, CartesianDMP
-    from ..incremental import BiDMP
+    from ..primitives.cartesian import CartesianDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..incremental.bidmp import BiDMP
 
     if isinstance(model, CartesianBiDMP):
         return model_dmp(model.__dict__.get("cartesian_", model.cartesian))
@@ -62,7 +63,7 @@ def _match_units(path, positions, units: str, model, what: str) -> str:
     refused naming both; unknown units are judged by the size of the motion."""
     import numpy as np
 
-    from ..metrics import path_extent
+    from ..tasks.metrics import path_extent
 
     dmp = model_dmp(model)
     model_units = dmp.units_
@@ -86,7 +87,7 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     it has another), checked against ``model``'s units; timed input prepared unless ``--raw``.
     """
     from .._units import check_units, conversion
-    from ..io import declared_units, read_poses, read_trajectory
+    from ..io.files import declared_units, read_poses, read_trajectory
 
     requested = check_units(args.units or "", "--units")
     values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)
@@ -102,13 +103,13 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     if times is None or args.raw:
         how = "as recorded" if times is None else f"as recorded ({times[-1] - times[0]:.3f} s)"
     elif poses:
-        from ..cartesian import prepare_poses
+        from ..demonstrations.prepare import prepare_poses
 
         values, times, info = prepare_poses(values, times, cutoff_hz=args.cutoff, units=units)
         how = (f"prepared: {info.rate_hz:.4g} Hz, low-pass {info.cutoff_hz:g} Hz, motion {info.start_s:.3g}-"
                f"{info.end_s:.3g} s of the recording")
     else:
-        from ..timing import prepare
+        from ..demonstrations.prepare import prepare
 
         prepared, info = prepare(values, times, cutoff_hz=args.cutoff, units=units)
         values, times = prepared.y, prepared.t

@@ -14,10 +14,11 @@ EXIT_OK = 0
 def _skills_model(args: argparse.Namespace, command: str):
     """The model ``extend`` and ``learn`` grow, as a Bi-DMP (a DMP becomes its skill 0): a
     :class:`bidmp.BiDMP` or, for pose models, a :class:`bidmp.CartesianBiDMP`."""
-    from ..cartesian import CartesianBiDMP, CartesianDMP
-    from ..dmp import DMP
-    from ..incremental import BiDMP
-    from ..io import load_model
+    from ..primitives.cartesian import CartesianDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.dmp import DMP
+    from ..incremental.bidmp import BiDMP
+    from ..io.files import load_model
 
     if not args.output.lower().endswith(".npz"):
         hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
@@ -34,7 +35,7 @@ def _skills_model(args: argparse.Namespace, command: str):
 
 def _demo_for(model, args: argparse.Namespace):
     """The demonstration for ``model`` (poses for a pose model), checked against its D."""
-    from ..cartesian import CartesianBiDMP
+    from ..incremental.cartesian import CartesianBiDMP
 
     poses = isinstance(model, CartesianBiDMP)
     if poses and not is_pose_file(args.demo):
@@ -57,9 +58,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time
-    from ..dmp import DMP
-    from ..io import save_model
-    from ..metrics import path_extent
+    from ..primitives.dmp import DMP
+    from ..io.files import save_model
+    from ..tasks.metrics import path_extent
 
     if is_pose_file(args.demo):
         return _fit_poses(args)
@@ -90,8 +91,8 @@ def _fit_poses(args: argparse.Namespace) -> int:
     """``bidmp fit`` on a pose recording: a CartesianDMP (prepared like positions unless --raw)."""
     import numpy as np
 
-    from ..cartesian import CartesianDMP, angle_between
-    from ..io import save_model
+    from ..primitives.cartesian import CartesianDMP, angle_between
+    from ..io.files import save_model
 
     poses, times, units, how = read_input(args.demo, args, poses=True)
     model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
@@ -135,8 +136,8 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
 
 
 def _skill_choice(args: argparse.Namespace, model):
-    from ..cartesian import CartesianBiDMP
-    from ..incremental import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..incremental.bidmp import BiDMP
 
     if not isinstance(model, (BiDMP, CartesianBiDMP)):
         if args.skill is not None:
@@ -148,10 +149,11 @@ def _skill_choice(args: argparse.Namespace, model):
 def cmd_rollout(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from ..cartesian import CartesianBiDMP, CartesianDMP, angle_between
-    from ..dmp import DMP
-    from ..incremental import BiDMP
-    from ..io import load_model, save_poses, save_trajectory
+    from ..primitives.cartesian import CartesianDMP, angle_between
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.dmp import DMP
+    from ..incremental.bidmp import BiDMP
+    from ..io.files import load_model, save_poses, save_trajectory
 
     model = load_model(args.model)
     if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
@@ -179,7 +181,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
           f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
     print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
-        from ..plotting import plot_trajectories
+        from ..plotting.figures import plot_trajectories
 
         reference = dmp.rollout()
         figure = plot_trajectories(args.plot, reference, [trajectory.y], ["rollout"], goals=trajectory.y[-1:],
@@ -192,9 +194,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
 def cmd_segment(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .._tables import text_table
+    from ..tasks._tables import text_table
     from .._trajectory import arclength, resample_arclength
-    from ..segmentation import curvature, segment
+    from ..extension.segmentation import curvature, segment
 
     y, _, units, how = read_input(args.demo, args, poses=is_pose_file(args.demo))
     y = y[:, :3] if is_pose_file(args.demo) else y
@@ -209,8 +211,8 @@ def cmd_segment(args: argparse.Namespace) -> int:
         ]
         print(text_table(["index", "curvature", "arc length %", f"position ({units or 'units'})"], rows))
     if args.plot:
-        from ..plotting import plot_segmentation
-        from ..segmentation import MAX_ANALYSIS_POINTS
+        from ..plotting.figures import plot_segmentation
+        from ..extension.segmentation import MAX_ANALYSIS_POINTS
 
         kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
         print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
@@ -221,7 +223,7 @@ def _extension_scene(args: argparse.Namespace, units: str):
     """The scene of ``--scene``, in the model's units (refused in another)."""
     if args.scene is None:
         return None
-    from ..scenarios import load
+    from ..tasks.scenarios import load
 
     scenario = load(args.scene, allow_outside_files=args.allow_outside_files)
     if scenario.scene is None:
@@ -248,10 +250,10 @@ def cmd_extend(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time
-    from ..cartesian import CartesianBiDMP
-    from ..extension import extend_demonstration, extend_pose_demonstration
-    from ..io import save_model, save_poses, save_trajectory
-    from ..metrics import path_extent, rmse
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..extension.extend import extend_demonstration, extend_pose_demonstration
+    from ..io.files import save_model, save_poses, save_trajectory
+    from ..tasks.metrics import path_extent, rmse
 
     model = _skills_model(args, "extend")
     y, units, how = _demo_for(model, args)
@@ -289,14 +291,14 @@ def cmd_extend(args: argparse.Namespace) -> int:
         if poses:
             written = save_poses(complete, args.save_demo, times=stamps, units=dmp.units_)
         else:
-            from ..timing import Trajectory
+            from ..primitives.timing import Trajectory
 
             velocity = np.gradient(complete, stamps, axis=0)
             written = save_trajectory(Trajectory(stamps, complete, velocity, np.gradient(velocity, stamps, axis=0),
                                                  dmp.units_), args.save_demo)
         print(f"wrote the extended demonstration ({stamps[-1]:.4g} s) to {written}")
     if args.plot:
-        from ..plotting import plot_extension
+        from ..plotting.figures import plot_extension
 
         print(f"wrote {plot_extension(args.plot, extension, units=dmp.units_)}")
     return EXIT_OK
@@ -306,7 +308,7 @@ def cmd_learn(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time, rmse
-    from ..io import save_model
+    from ..io.files import save_model
 
     model = _skills_model(args, "learn")
     y, _, how = _demo_for(model, args)

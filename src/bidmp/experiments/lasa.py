@@ -1,0 +1,455 @@
+"""The LASA handwriting benchmark with the LfD literature's metrics, swept on Dask (issue 14).
+
+``lasa(out, ...)`` evaluates every method on every (shape, demonstration) cell of the LASA set:
+the reproduction of the demonstration, and generalisation to two shifted goals. ``near`` moves
+the goal by 10 % of the shape's extent, inside the plain DMP's reach; ``far`` moves it by 60 %,
+beyond it. The direction comes from the cell's seed. Metrics per (cell, method, case):
+
+* ``rmse``: time-aligned RMSE against the reference (the demonstration, or for a shifted goal the
+  demonstration with the goal offset blended in linearly over time, so that it starts where the
+  demonstration starts and ends at the new goal);
+* ``dtw`` and ``dtw_per_sample``: DTW distance (:func:`bidmp.similarity.dtw_distance`), raw and
+  divided by the reference's length;
+* ``swept_area``: CLF-DM's swept error area (:func:`bidmp.metrics.swept_area`);
+* ``frechet``: discrete Fréchet distance;
+* ``endpoint_error``: to the (shifted) goal;
+* ``fit_s`` and ``rollout_s``: wall times, which are not reproducible.
+
+The protocol is explicit and recorded with every row: ``demos`` ("all" 7 or "first3"), ``every``
+(use every k-th sample: 1 or 10, as papers do).
+
+**Dask.** The sweep is one task per cell. The default is an embedded ``distributed.LocalCluster``
+with one single-threaded worker process per core, started and stopped here. ``scheduler=ADDRESS``
+runs on an existing cluster instead. Each finished cell is written at once to
+``cells/<shape>__<demo>.json`` (atomically), so a partial run is kept. ``resume=True`` skips the
+cells already written with the same protocol. Seeds come from the cell's key, so results do not
+depend on scheduling. The final table (``lasa.parquet``, or ``lasa.csv``), ``lasa.md`` (median
+and IQR per method and case) and the figures are written only when every cell is done.
+
+Needs the ``benchmark`` extra (dask[distributed], pyarrow): ``pip install 'bidmp[benchmark]'``.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import time
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._checks import check_choice, check_int, require_extra
+
+__all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key"]
+
+logger = logging.getLogger(__name__)
+
+LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
+CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
+METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
+TIMES = ("fit_s", "rollout_s")
+FORMAT = 2  # of the cell files (2: the robot protocol of issue 19); a different protocol or format is recomputed
+
+
+def cell_key(shape: str, demo: int) -> str:
+    return f"{shape}__{demo}"
+
+
+def _cell_seed(shape: str, demo: int) -> int:
+    return zlib.crc32(cell_key(shape, demo).encode())
+
+
+def _methods_available(methods) -> list[str]:
+    out = []
+    for method in methods:
+        if method == "mp-dmp":
+            try:
+                import movement_primitives  # noqa: F401
+            except ImportError:
+                logger.info("movement_primitives is not installed: mp-dmp skipped")
+                continue
+        out.append(method)
+    return out
+
+
+def _reference(demo: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    """The demonstration with the goal offset blended in over time (starts unchanged)."""
+    blend = np.linspace(0.0, 1.0, demo.shape[0])[:, None]
+    return demo + blend * offset
+
+
+def _metrics(rollout: np.ndarray, reference: np.ndarray, goal: np.ndarray) -> dict:
+    from .._trajectory import resample_time, rmse
+    from ..tasks.metrics import swept_area
+    from ..extension.similarity import dtw_distance, frechet_distance
+
+    aligned = resample_time(rollout, reference.shape[0])
+    dtw = dtw_distance(aligned, reference)
+    return {"rmse": rmse(aligned, reference), "dtw": dtw, "dtw_per_sample": dtw / reference.shape[0],
+            "swept_area": swept_area(aligned, reference), "frechet": frechet_distance(aligned, reference),
+            "endpoint_error": float(np.linalg.norm(rollout[-1] - goal))}
+
+
+def _timed(function):
+    start = time.perf_counter()
+    value = function()
+    return value, time.perf_counter() - start
+
+
+def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_once: str | None = None) -> dict:
+    """All methods on one (shape, demonstration): ``{"key", "rows": [...], "rollouts": {...}}``.
+
+    ``rollouts`` keeps the reproductions (for the per-shape figure). ``_kill_once`` is for
+    tests: if that file exists, it is removed and this worker process kills itself.
+    """
+    if _kill_once is not None and os.path.exists(_kill_once):
+        os.remove(_kill_once)
+        os.kill(os.getpid(), 9)
+    from ..baselines import TPGMM, GMMRegressor
+    from ..demonstrations.datasets import lasa as lasa_data
+    from ..primitives.dmp import DMP
+    from ..extension.extend import extend_demonstration
+    from ..incremental.bidmp import BiDMP
+    from ..tasks.metrics import path_extent
+
+    y = lasa_data(shape)[demo][::every]
+    seed = _cell_seed(shape, demo)
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0.0, 2.0 * np.pi)
+    direction = np.array([np.cos(angle), np.sin(angle)])
+    extent = path_extent(y)
+    cases = [(name, y[-1] + fraction * extent * direction) for name, fraction in CASES]
+    rows, rollouts = [], {}
+
+    def record(method, case, goal, rollout, fit_s, rollout_s, end=None):
+        reference = _reference(y, goal - y[-1])
+        metrics = _metrics(rollout, reference, goal)
+        if end is not None:  # where the motion comes to rest, after the time-aligned part
+            metrics["endpoint_error"] = float(np.linalg.norm(end - goal))
+        rows.append({"shape": shape, "demo": demo, "method": method, "case": case, "seed": seed,
+                     "goal_x": float(goal[0]), "goal_y": float(goal[1]), **metrics,
+                     "fit_s": fit_s, "rollout_s": rollout_s})
+        if case == "reproduction":
+            rollouts[method] = np.asarray(rollout[:: max(1, len(rollout) // 200)]).round(4).tolist()
+
+    for method in methods:
+        if method in ("dmp-paper", "dmp-robot", "bidmp"):
+            protocol = "robot" if method == "dmp-robot" else "paper"
+            dmp, fit_s = _timed(lambda: DMP(protocol=protocol).fit(y))
+            for case, goal in cases:
+                # The first T samples are the motion's time (the robot protocol then rests at
+                # the goal for 10 % longer): what is time-aligned with the demonstration.
+                if method == "bidmp" and case != "reproduction":
+                    def learn_and_roll(goal=goal):
+                        extension = extend_demonstration(y, goal, seed=seed)
+                        return BiDMP(dmp).learn(extension.complete).rollout(goal)
+                    rollout, seconds = _timed(learn_and_roll)
+                else:
+                    rollout, seconds = _timed(lambda goal=goal: dmp.rollout(goal))
+                record(method, case, goal, rollout[: len(y)], fit_s, seconds, end=rollout[-1])
+        elif method == "gmm":
+            model, fit_s = _timed(lambda: GMMRegressor(seed=seed % (2**31)).fit(y))
+            mean, seconds = _timed(lambda: model.generate()[0])
+            for case, goal in cases:  # GMM/GMR has no notion of a new goal
+                record(method, case, goal, mean, fit_s, seconds)
+        elif method == "tpgmm":
+            model, fit_s = _timed(lambda: TPGMM(seed=seed % (2**31)).fit(y))
+            for case, goal in cases:
+                rollout, seconds = _timed(lambda goal=goal: model.generate(y[0], goal)[0])
+                record(method, case, goal, rollout, fit_s, seconds)
+        elif method == "mp-dmp":
+            from movement_primitives.dmp import DMP as PeerDMP
+
+            t = np.linspace(0.0, 1.0, len(y))
+
+            def fit_peer():
+                peer = PeerDMP(n_dims=2, execution_time=1.0, dt=t[1], n_weights_per_dim=50)
+                peer.imitate(t, y)
+                return peer
+            peer, fit_s = _timed(fit_peer)
+            for case, goal in cases:
+                def roll(goal=goal):
+                    peer.configure(start_y=y[0], goal_y=goal)
+                    return peer.open_loop()[1]
+                rollout, seconds = _timed(roll)
+                record(method, case, goal, rollout, fit_s, seconds)
+    return {"key": cell_key(shape, demo), "rows": rows, "rollouts": rollouts}
+
+
+# ---------------------------------------------------------------------------------------------
+# The sweep
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class BenchmarkResult:
+    """What :func:`lasa` did: the tidy rows, the cells computed now and those resumed."""
+
+    rows: list
+    protocol: dict
+    computed: list = field(default_factory=list)
+    resumed: list = field(default_factory=list)
+    written: list = field(default_factory=list)
+    wall_s: float = 0.0
+    workers: int = 0
+
+
+def _validate(shapes, methods, demos: str, every: int) -> tuple[list, list, list]:
+    from ..demonstrations.datasets import lasa_names
+
+    names = lasa_names()
+    for given, what in ((shapes, "shapes"), (methods, "methods")):
+        if given is None:
+            continue
+        if isinstance(given, (str, bytes)) or not hasattr(given, "__iter__"):
+            raise TypeError(f"{what} must be a list of names, got {type(given).__name__}")
+        if not list(given):
+            raise ValueError(f"{what} names none; give at least one (or None for all)")
+        if not all(isinstance(name, str) for name in given):
+            raise TypeError(f"{what} must be a list of names (strings)")
+    shapes = names if shapes is None else list(shapes)
+    for shape in shapes:
+        if shape not in names:
+            raise ValueError(f"unknown LASA shape {shape!r}; see 'bidmp lasa list'")
+    methods = list(LASA_METHODS if methods is None else methods)
+    for method in methods:
+        if method not in LASA_METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(LASA_METHODS)}")
+    check_choice(demos, "demos", ("all", "first3"))
+    every = check_int(every, "every", minimum=1, maximum=100)
+    indices = list(range(7)) if demos == "all" else [0, 1, 2]
+    return shapes, _methods_available(methods), indices
+
+
+def _cell_path(out: Path, key: str) -> Path:
+    return out / "cells" / f"{key}.json"
+
+
+def _load_cell(path: Path, protocol: dict) -> dict | None:
+    """A finished cell file, if it holds this protocol's results (else it is recomputed)."""
+    from ..io.files import load_json
+
+    try:
+        data = load_json(path.read_bytes(), str(path))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("protocol") != protocol:
+        return None
+    if not isinstance(data.get("rows"), list) or not data["rows"]:
+        return None
+    return data
+
+
+def _write_cell(out: Path, protocol: dict, result: dict) -> None:
+    from ..io.files import atomic_write
+
+    path = _cell_path(out, result["key"])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_write(path, "w") as handle:
+        json.dump({"format": FORMAT, "protocol": protocol, **result}, handle)
+
+
+def _client(scheduler: str | None, workers: int):
+    require_extra("distributed", "benchmark", "the LASA benchmark on Dask")
+    from distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        try:
+            return Client(scheduler, timeout="3s"), None
+        except (OSError, TimeoutError) as exc:
+            raise ValueError(f"cannot reach the Dask scheduler at {scheduler} within 3 s ({type(exc).__name__})") from None
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, workers: int | None = None,
+         scheduler: str | None = None, resume: bool = False, output_format: str = "parquet", progress=None,
+         synchronous: bool = False, dask: bool = False, _kill_once: str | None = None) -> BenchmarkResult:
+    """Run the LASA benchmark into folder ``out``.
+
+    Parameters
+    ----------
+    shapes : list of str, optional
+        Default all 30.
+    methods : list of str, optional
+        From :data:`LASA_METHODS` (default all; ``mp-dmp`` needs movement_primitives).
+    demos : {"all", "first3"}
+    every : int
+        Use every k-th sample (1 or 10 in the literature).
+    workers : int, optional
+        Worker processes of the embedded cluster (default: one per core).
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``) instead.
+    resume : bool
+        Skip cells already in ``out/cells`` for this protocol.
+    output_format : {"parquet", "csv"}
+    synchronous : bool
+        Run the cells in this process, one after another (no Dask): the serial reference; also
+        what ``workers=1`` does unless ``dask`` is true.
+    dask : bool
+        Use a LocalCluster even for ``workers=1`` (to time Dask against itself).
+    progress : callable, optional
+        Called with the cell key as each cell finishes.
+    """
+    from ..io.files import atomic_write
+
+    shapes, methods, indices = _validate(shapes, methods, demos, every)
+    check_choice(output_format, "output_format", ("parquet", "csv"))
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"out {out} exists and is not a folder")
+    protocol = {"demos": demos, "every": every, "methods": methods, "cases": [list(c) for c in CASES]}
+    cells = [(shape, demo) for shape in shapes for demo in indices]
+    done, todo = {}, []
+    for shape, demo in cells:
+        key = cell_key(shape, demo)
+        cached = _load_cell(_cell_path(out, key), protocol) if resume else None
+        if cached is not None:
+            done[key] = cached
+        else:
+            todo.append((shape, demo))
+    result = BenchmarkResult([], protocol, computed=[cell_key(*c) for c in todo], resumed=sorted(done))
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
+    if todo and (synchronous or workers == 1 and scheduler is None and not dask):
+        for shape, demo in todo:
+            cell = run_cell(shape, demo, methods, every)
+            _write_cell(out, protocol, cell)
+            done[cell["key"]] = cell
+            if progress is not None:
+                progress(cell["key"])
+        result.workers = 1
+    elif todo:
+        n_workers = workers or (os.cpu_count() or 1)
+        client, cluster = _client(scheduler, n_workers)
+        try:
+            from distributed import as_completed
+
+            result.workers = len(client.scheduler_info().get("workers", {})) or n_workers
+            futures = [client.submit(run_cell, shape, demo, methods, every, _kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
+                                     pure=False, retries=2)
+                       for shape, demo in todo]
+            for future in as_completed(futures):
+                cell = future.result()
+                _write_cell(out, protocol, cell)
+                done[cell["key"]] = cell
+                if progress is not None:
+                    progress(cell["key"])
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    result.wall_s = time.perf_counter() - start
+    # The table: every row of every cell in a fixed order (shape, demo, method, case).
+    order = {cell_key(*c): i for i, c in enumerate(cells)}
+    rows = [row for key in sorted(done, key=order.get) for row in done[key]["rows"]]
+    for row in rows:
+        row.update({"demos": demos, "every": every})
+    result.rows = rows
+    table = out / ("lasa.parquet" if output_format == "parquet" else "lasa.csv")
+    _write_table(rows, table, output_format)
+    with atomic_write(out / "lasa.md", "w") as handle:
+        handle.write(summary_markdown(rows, protocol) + "\n")
+    result.written = [table, out / "lasa.md"] + _figures(out, rows, done, shapes)
+    return result
+
+
+_COLUMNS = ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES, "demos", "every")
+
+
+def _write_table(rows: list, path: Path, output_format: str) -> None:
+    from ..io.files import atomic_write
+
+    columns = {name: [row[name] for row in rows] for name in _COLUMNS}
+    if output_format == "csv":
+        import csv
+
+        with atomic_write(path, "w") as handle:
+            writer = csv.writer(handle, lineterminator="\n")
+            writer.writerow(_COLUMNS)
+            writer.writerows(zip(*(columns[name] for name in _COLUMNS)))
+        return
+    require_extra("pyarrow", "benchmark", "Parquet output (or use --format csv)")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    with atomic_write(path, "wb") as handle:
+        pq.write_table(pa.Table.from_pydict(columns), handle)
+
+
+def summary_rows(rows: list, metric: str) -> tuple[list[str], list[list[str]]]:
+    """Median (IQR) of ``metric`` per method (rows) and case (columns)."""
+    methods = list(dict.fromkeys(row["method"] for row in rows))
+    header = ["method"] + [name for name, _ in CASES]
+    table = []
+    for method in methods:
+        cells = [method]
+        for case, _ in CASES:
+            values = np.array([row[metric] for row in rows if row["method"] == method and row["case"] == case])
+            if values.size == 0:
+                cells.append("-")
+                continue
+            q1, median, q3 = np.percentile(values, [25, 50, 75])
+            cells.append(f"{median:.3g} ({q1:.3g}-{q3:.3g})")
+        table.append(cells)
+    return header, table
+
+
+def summary_markdown(rows: list, protocol: dict) -> str:
+    from ..tasks._tables import markdown_table
+
+    n_cells = len({(row["shape"], row["demo"]) for row in rows})
+    parts = [f"LASA benchmark: {n_cells} cells (shape x demonstration), demos {protocol['demos']}, every "
+             f"{protocol['every']} sample(s); median (IQR) per method; goal shifted by 0, 10 % and 60 % of the "
+             f"shape's extent (reproduction, near, far)."]
+    for metric in ("rmse", "dtw_per_sample", "swept_area", "frechet", "endpoint_error"):
+        parts.append(f"**{metric}**\n\n" + markdown_table(*summary_rows(rows, metric)))
+    return "\n\n".join(parts)
+
+
+def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
+    """A per-shape grid (demonstration 0's reproductions) and metric box plots."""
+    from ..demonstrations.datasets import lasa as lasa_data
+    from ..io.files import atomic_write
+    from ..plotting.figures import _matplotlib
+
+    mpl = _matplotlib()
+    written = []
+    n_cols = min(6, len(shapes))
+    n_rows = int(np.ceil(len(shapes) / n_cols))
+    fig, axes = mpl.subplots(n_rows, n_cols, figsize=(2.6 * n_cols, 2.4 * n_rows), dpi=90, squeeze=False)
+    colours = mpl.cm.tab10
+    for ax, shape in zip(axes.ravel(), shapes):
+        key = next((k for k in cells if k.startswith(f"{shape}__")), None)
+        demo = int(key.split("__")[1]) if key else 0
+        ax.plot(*lasa_data(shape)[demo].T, color="0.6", linewidth=2.5)
+        if key is not None:
+            for index, (method, rollout) in enumerate(cells[key].get("rollouts", {}).items()):
+                ax.plot(*np.asarray(rollout).T, color=colours(index % 10), linewidth=0.9, label=method)
+        ax.set_title(shape, fontsize=8)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in axes.ravel()[len(shapes):]:
+        ax.axis("off")
+    handles, labels = axes.ravel()[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8)
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    written.append(out / "lasa_shapes.png")
+    with atomic_write(written[-1], "wb") as handle:
+        fig.savefig(handle, format="png")
+    methods = list(dict.fromkeys(row["method"] for row in rows))
+    fig, axes = mpl.subplots(1, 3, figsize=(15, 4.2), dpi=90, squeeze=False)
+    for ax, metric in zip(axes[0], ("rmse", "dtw_per_sample", "endpoint_error")):
+        data = [[row[metric] for row in rows if row["method"] == method and row["case"] == "far"] for method in methods]
+        ax.boxplot(data, tick_labels=methods, showfliers=False)
+        ax.set_yscale("log")
+        ax.set_title(f"{metric}, far goals", fontsize=10)
+        ax.tick_params(axis="x", labelrotation=30, labelsize=8)
+    fig.tight_layout()
+    written.append(out / "lasa_metrics.png")
+    with atomic_write(written[-1], "wb") as handle:
+        fig.savefig(handle, format="png")
+    return written

@@ -1,0 +1,456 @@
+"""Extended demonstrations: segment → pick the piece → G-PRM → complete demonstration (SPEC §2–5).
+
+``extend_demonstration(y, new_target)`` returns the complete extended demonstration, T samples
+uniform in time like the demonstration. Two ways (``approach``):
+
+``"keep"`` (default): the demonstration's final approach, the straight last piece into its target
+(:func:`final_approach`), is kept sample for sample and translated to the new target; G-PRM
+grows only the transfer from seg to the start of that translated approach::
+
+    y_dn = prefix ⊕ Tra_gen(seg → hover) ⊕ (approach + n_tar − tar)
+
+With a ``scene`` (:class:`bidmp.Scene`) the roadmap's samples and edges are checked against the
+parts for the tool, the parts at the new target excepted (it enters the tool), and a transfer
+or approach that would touch a part is an error (:class:`bidmp.roadmap.NoFreeRouteError`).
+
+``"paper"``: the paper's protocol: the whole nearest piece is imitated down to the new target,
+
+    y_dn = prefix ⊕ Tra_gen(seg → n_tar)
+
+resampled to the demonstration's T samples.
+
+Tra_gen is the G-PRM path, smoothed (it is a polyline) with its ends pinned. It is timed with a
+cubic arc-length profile from the demonstration's speed at seg to its speed where the path goes
+on (rest at the new target in ``"paper"``), so position and speed are continuous at the joints.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from .._checks import as_point, as_trajectory, check_choice, check_int, check_real, numerically_guarded
+from .._trajectory import arclength, interp_columns, path_extent, resample_time
+from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
+from .segmentation import Piece, choose_piece, segment
+
+__all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
+           "check_extension_options", "APPROACHES"]
+
+APPROACHES = ("keep", "paper")
+_STRAIGHTNESS = 0.02  # an approach deviates from its chord by at most this fraction of the chord
+_MAX_TAIL_CANDIDATES = 256  # start indices tried when only the tail of the last piece is straight
+
+logger = logging.getLogger(__name__)
+
+@dataclass
+class ExtendedDemonstration:
+    """Result of :func:`extend_demonstration` (lengths in the demonstration's unit).
+
+    Attributes
+    ----------
+    complete : array (T, D)
+        The extended demonstration y_dn: starts at the demonstration's start, ends exactly at the
+        new target, T samples uniform in time.
+    tra_imi : array (n, D)
+        The demonstrated piece that was imitated (seg → tar), original samples.
+    tra_gen : array (k, D)
+        The generated path (seg → new target), smoothed, k = ``n_compare`` points.
+    seg_index : int
+        Index of seg in the demonstration.
+    similarity_history : array (n_iter,)
+        G-PRM similarity per iteration (empty when G-PRM was skipped).
+    approach : {"keep", "paper"}
+        How it was grown; with ``"keep"``, ``complete[-n:] == demonstration[-n:] + (new_target −
+        demonstration[-1])`` for ``n = T − approach_index``.
+    approach_index : int or None
+        First sample of the kept approach in the demonstration (``"keep"`` only).
+    orientations : array (T, 4) or None
+        For :func:`extend_pose_demonstration`: the orientation (x, y, z, w) at each sample of
+        ``complete``; :attr:`poses` is then the extended pose demonstration.
+    """
+
+    complete: np.ndarray
+    tra_imi: np.ndarray
+    tra_gen: np.ndarray
+    seg_index: int
+    similarity_history: np.ndarray
+    demonstration: np.ndarray
+    new_target: np.ndarray
+    segmentation_points: np.ndarray
+    piece: Piece
+    similarity: float = float("nan")
+    template: np.ndarray | None = None
+    samples: np.ndarray | None = None
+    approach: str = "paper"
+    approach_index: int | None = None  # "keep": where the kept approach starts in the demonstration
+    orientations: np.ndarray | None = None  # pose extensions: (T, 4) quaternions along complete
+
+    @property
+    def poses(self) -> np.ndarray:
+        """The extended pose demonstration (T, 7) of :func:`extend_pose_demonstration`."""
+        if self.orientations is None:
+            raise AttributeError("this extension has no orientations: it was grown from positions (see complete)")
+        return np.hstack([self.complete, self.orientations])
+
+    @property
+    def prefix(self) -> np.ndarray:
+        """The demonstration before seg, (seg_index, D)."""
+        return self.demonstration[: self.seg_index]
+
+
+def _smooth_path(path: np.ndarray) -> np.ndarray:
+    """Savitzky–Golay smoothing of a polyline with its two ends kept exactly."""
+    n_points = path.shape[0]
+    window = min(11, n_points - (1 - n_points % 2))
+    if window < 5:
+        return path.copy()
+    smooth = savgol_filter(path, window, 3, axis=0, mode="interp")
+    lam = np.linspace(0.0, 1.0, n_points)[:, None]
+    smooth += (1.0 - lam) * (path[0] - smooth[0]) + lam * (path[-1] - smooth[-1])
+    return smooth
+
+
+def _arc_profile(length: float, start_speed: float, end_speed: float, duration: float, n_steps: int) -> np.ndarray:
+    """Cubic Hermite arc length at ``u = k / n_steps``, k = 1..n_steps, from 0 to ``length`` with
+    speeds ``start_speed`` and ``end_speed`` at the ends. Speeds that would make the profile run
+    back (outside the Fritsch–Carlson disc α² + β² <= 9) are scaled down together."""
+    alpha, beta = start_speed * duration / length, end_speed * duration / length
+    radius = float(np.hypot(alpha, beta))
+    if radius > 3.0:
+        logger.debug("transfer end speeds scaled by %.3f to keep the arc-length profile monotone", 3.0 / radius)
+        alpha, beta = 3.0 * alpha / radius, 3.0 * beta / radius
+    u = np.arange(1, n_steps + 1) / n_steps
+    return length * (3 * u**2 - 2 * u**3 + alpha * (u - 2 * u**2 + u**3) + beta * (u**3 - u**2))
+
+
+def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float) -> tuple[np.ndarray, float]:
+    """Time a geometric path: a cubic arc-length profile from ``start_speed`` to rest.
+
+    ``s(u) = L (3u² − 2u³) + a (u − 2u² + u³)`` on ``u ∈ [0, 1]`` with ``a = start_speed · D``;
+    ``D = L / mean_speed``, shortened if needed so that ``a ≤ 3L`` (then ``s`` never runs back).
+
+    Returns
+    -------
+    (positions, duration) : positions sampled every ``dt`` from u = 0 (excluded) to u = 1
+    (included), shape (n, D), and the duration D.
+    """
+    s = arclength(path)
+    length = s[-1]
+    if length <= 0.0:
+        return path[-1:].copy(), dt
+    duration = length / max(mean_speed, 1e-300)
+    if start_speed > 0.0:
+        duration = min(duration, 3.0 * length / start_speed)
+    n_steps = max(int(round(duration / dt)), 1)
+    check_int(n_steps, "the generated transfer's samples (its length at the demonstrated piece's speed)",
+              limit="max_steps")
+    arc = _arc_profile(length, start_speed, 0.0, duration, n_steps)
+    positions = interp_columns(arc, s, path)
+    positions[-1] = path[-1]
+    return positions, n_steps * dt
+
+
+def _time_transfer(path: np.ndarray, start_speed: float, end_speed: float, n_steps: int, dt: float) -> np.ndarray:
+    """``n_steps`` samples along ``path`` (excluding its start, ending exactly at its end) over a
+    fixed duration ``n_steps · dt``, leaving at ``start_speed`` and arriving at ``end_speed``."""
+    s = arclength(path)
+    if s[-1] <= 0.0:
+        return np.repeat(path[-1:], n_steps, axis=0)
+    positions = interp_columns(_arc_profile(s[-1], start_speed, end_speed, n_steps * dt, n_steps), s, path)
+    positions[-1] = path[-1]
+    return positions
+
+
+def _straight(points: np.ndarray, tolerance: float) -> bool:
+    chord = points[-1] - points[0]
+    length = float(np.linalg.norm(chord))
+    if length == 0.0:
+        return False
+    offsets = points - points[0]
+    along = offsets @ (chord / length)
+    deviation = np.linalg.norm(offsets - along[:, None] * (chord / length), axis=1)
+    return bool(deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length))
+
+
+def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) -> int:
+    """Index where the demonstration's final approach starts: the straight last piece into its
+    target.
+
+    The last piece of the segmentation (from the last segmentation point to the end) is the
+    approach when it is straight: no sample further than ``straightness`` × its chord from the
+    chord, and never moving back along it. Otherwise the longest straight tail of that piece is.
+    A demonstration whose end is not approached in a straight line (a tail shorter than 2
+    samples) has no approach: the last index is returned, and the whole motion is the transfer.
+
+    Parameters
+    ----------
+    y : array (T, D)
+    segmentation_points : array of int or Segmentation
+    straightness : float, default 0.02
+
+    Returns
+    -------
+    int in [0, T − 1]
+    """
+    y = as_trajectory(y, "y")
+    straightness = check_real(straightness, "straightness", positive=True, maximum=1.0)
+    points = getattr(segmentation_points, "points", segmentation_points)
+    points = np.asarray(points, dtype=int).reshape(-1)
+    last = y.shape[0] - 1
+    start = int(points[points < last].max()) if np.any(points < last) else 0
+    if _straight(y[start:], straightness):
+        return start
+    # Only a tail is straight: the earliest start (on a grid of at most 256) from which it is.
+    candidates = np.unique(np.linspace(start, last - 1, min(_MAX_TAIL_CANDIDATES, last - start)).astype(int))
+    for candidate in candidates:
+        if _straight(y[candidate:], straightness):
+            return int(candidate)
+    return last
+
+
+def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, approach: str = "keep",
+                            **roadmap_options) -> None:
+    """Validate the options of :func:`extend_demonstration` without running it (what ``bidmp
+    scenario check`` runs on a scenario's ``"extension"`` key); raise naming the first bad one."""
+    eps_frac = check_real(eps_frac, "eps_frac")
+    if not 0.0 < eps_frac < 1.0:
+        raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
+    check_choice(method, "method", ("persistence", "paper"))
+    check_choice(approach, "approach", APPROACHES)
+    roadmap_options.pop("is_free", None)
+    check_options(seed=seed, **roadmap_options)
+
+
+@numerically_guarded
+def extend_demonstration(
+    y,
+    new_target,
+    *,
+    seed: int | np.random.Generator | None = 0,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
+    n_samples: int = 300,
+    sigma_rel: float = 0.03,
+    n_neighbours: int = 8,
+    n_compare: int = 100,
+    n_iter: int = 10,
+    rho: float = 0.9,
+    schedule: str = "geometric",
+    scaling: str = "axis",
+    compare: str = "template",
+    select: str = "best",
+    denom: str = "sqrt2",
+    is_free: CollisionCallback | None = None,
+    approach: str = "keep",
+    scene=None,
+) -> ExtendedDemonstration:
+    """Grow an extended demonstration from ``y`` to ``new_target`` (1D-SEG + G-PRM).
+
+    Parameters
+    ----------
+    y : array (T, D), D = 2 or 3
+        The demonstration, uniform in time.
+    new_target : array (D,)
+    seed : int or numpy.random.Generator
+        Seed of the G-PRM sampling: same seed, same result.
+    eps_frac, method
+        Segmentation options, see :func:`bidmp.segment`.
+    n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare, select, denom, is_free
+        G-PRM options, see :func:`bidmp.roadmap.gaussian_prm` (same defaults).
+    approach : {"keep", "paper"}, default "keep"
+        ``"keep"``: keep the demonstration's final approach (:func:`final_approach`), translated
+        to the new target, and grow only the transfer to its start. ``"paper"``: the paper's
+        protocol, the nearest piece imitated down to the new target.
+    scene : bidmp.Scene, optional
+        Parts to keep the tool away from (3-D only): the roadmap is checked against them (unless
+        ``is_free`` is given) and the finished transfer and approach must not touch them; the
+        parts at the new target are excepted.
+
+    Returns
+    -------
+    ExtendedDemonstration
+
+    Raises
+    ------
+    bidmp.roadmap.NoFreeRouteError
+        With a scene or ``is_free``: no collision-free route exists on the roadmap, or the kept
+        approach, translated, would touch a part.
+    """
+    y = as_trajectory(y, "y", min_points=10)
+    target = as_point(new_target, y.shape[1], "new_target")
+    check_extension_options(
+        eps_frac=eps_frac, method=method, seed=seed, n_samples=n_samples, sigma_rel=sigma_rel, n_neighbours=n_neighbours,
+        n_compare=n_compare, n_iter=n_iter, rho=rho, schedule=schedule, scaling=scaling, compare=compare, select=select,
+        denom=denom, approach=approach,
+    )
+    exclude = ()
+    if scene is not None:
+        if y.shape[1] != 3:
+            raise ValueError(f"scene needs a 3-D demonstration, got D = {y.shape[1]}")
+        exclude = scene.parts_at(target)
+        if is_free is None:
+            is_free = scene.checker(exclude=exclude)
+    roadmap_options = {
+        "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
+        "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
+        "select": select, "denom": denom, "is_free": is_free,
+    }
+    points = segment(y, eps_frac=eps_frac, method=method).points
+    if approach == "keep":
+        return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
+    n_steps = y.shape[0]
+    dt = 1.0 / n_steps
+    piece = choose_piece(y, points, target)
+    tra_imi = y[piece.start : piece.end + 1]
+    seg = y[piece.start]
+
+    extent = path_extent(y)
+    if np.linalg.norm(target - seg) <= 1e-9 * extent:
+        logger.info("new target coincides with seg: G-PRM skipped")
+        tra_gen = np.vstack([seg, target])
+        history = np.empty(0)
+        result = None
+    else:
+        result = gaussian_prm(tra_imi, target, seed=seed, **roadmap_options)
+        tra_gen = _smooth_path(result.path)
+        history = result.history
+
+    prefix = y[: piece.start + 1]  # includes seg
+    start_speed = float(np.linalg.norm(y[piece.start] - y[piece.start - 1]) / dt) if piece.start > 0 else 0.0
+    imi_duration = max(piece.end - piece.start, 1) * dt
+    mean_speed = arclength(tra_imi)[-1] / imi_duration
+    if mean_speed <= 0.0:
+        mean_speed = arclength(y)[-1]  # the piece does not move: use the demonstration's mean speed
+    timed, _ = time_path(tra_gen, start_speed, mean_speed, dt)
+    complete = resample_time(np.vstack([prefix, timed]), n_steps)
+    complete[-1] = target
+    logger.debug("extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
+                 piece.index, piece.start, piece.end, len(history))
+    return _extension(complete, y, target, points, piece, tra_gen, history, result)
+
+
+def _extension(complete, y, target, points, piece, tra_gen, history, result, **approach) -> ExtendedDemonstration:
+    """The :class:`ExtendedDemonstration` both ways build (``result``: G-PRM's, or None when it
+    was skipped)."""
+    return ExtendedDemonstration(
+        complete=complete, tra_imi=y[piece.start : piece.end + 1].copy(), tra_gen=tra_gen, seg_index=piece.start,
+        similarity_history=np.asarray(history), demonstration=y, new_target=target,
+        segmentation_points=points, piece=piece,
+        similarity=float("nan") if result is None else result.similarity,
+        template=None if result is None else result.template,
+        samples=None if result is None else result.samples,
+        **approach,
+    )
+
+
+def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude,
+                             approach_rotation=None) -> ExtendedDemonstration:
+    """``approach="keep"``: transfer by G-PRM to the translated approach's start, then the approach
+    (rotated about the target by ``approach_rotation`` (D, D) when the target turns too)."""
+    n_steps = y.shape[0]
+    dt = 1.0 / n_steps
+    start = final_approach(y, points)
+    # The approach relative to the demonstrated target, moved (and turned) onto the new one.
+    offsets = y[start:] - y[-1]
+    if approach_rotation is not None:
+        offsets = offsets @ np.asarray(approach_rotation, dtype=float).T
+    hover, approach_tail = target + offsets[0], target + offsets[1:]
+    if start == 0:
+        # The whole demonstration is one straight approach: translate all of it but its start.
+        piece = Piece(index=0, start=0, end=0, breakpoints=np.array([0, n_steps - 1]))
+    else:
+        head_points = points[points < start]
+        piece = choose_piece(y[: start + 1], head_points, hover)
+    seg = y[piece.start]
+    tra_imi = y[piece.start : piece.end + 1]
+    if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
+        tra_gen, history, result = np.vstack([seg, hover]), np.empty(0), None
+    else:
+        result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
+        history = result.history
+        tra_gen = _smooth_path(result.path)
+        if scene is not None and not scene.clearance(tra_gen, exclude=exclude).collision_free:
+            logger.debug("the smoothed transfer cuts a part: the roadmap's polyline is used as it is")
+            tra_gen = result.path
+    if scene is not None:
+        hit = scene.clearance(np.vstack([hover, approach_tail]), exclude=exclude)
+        if not hit.collision_free:
+            raise NoFreeRouteError(f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
+                                   f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
+                                   f"keeps it; choose another target, or approach='paper'")
+    start_speed = float(np.linalg.norm(y[piece.start] - y[piece.start - 1]) / dt) if piece.start > 0 else 0.0
+    end_speed = float(np.linalg.norm(y[start + 1] - y[start]) / dt) if start + 1 < n_steps else 0.0
+    transfer = _time_transfer(tra_gen, start_speed, end_speed, start - piece.start, dt)
+    complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
+    logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
+                 "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
+    return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start)
+
+
+def _roadmap_defaults() -> dict:
+    """The G-PRM options of :func:`extend_demonstration` with their defaults (its signature is
+    where they are written)."""
+    import inspect
+
+    skip = {"y", "new_target", "seed", "eps_frac", "method", "approach", "scene"}
+    parameters = inspect.signature(extend_demonstration).parameters
+    return {name: p.default for name, p in parameters.items() if name not in skip}
+
+
+@numerically_guarded
+def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Generator | None = 0, scene=None,
+                              eps_frac: float = 0.1, method: str = "persistence", **roadmap_options):
+    """Grow an extended pose demonstration (``approach="keep"``) from ``poses`` (T, 7) to the
+    pose ``new_target`` (7,) (x, y, z, qx, qy, qz, qw).
+
+    The final approach keeps its pose relative to the target: with ``R = g' g⁻¹`` (new and
+    demonstrated target orientations) it is rotated about the target by ``R`` and moved onto the
+    new one, positions and orientations alike (a pure translation when the target does not turn).
+    The transfer's positions come from G-PRM as in :func:`extend_demonstration`; its orientation
+    is slerped from the demonstration's at seg to the kept approach's first, by arc length.
+
+    Returns
+    -------
+    ExtendedDemonstration
+        As :func:`extend_demonstration` (``complete`` (T, 3) holds the positions), with
+        ``orientations`` (T, 4) and ``poses`` (T, 7), the extended pose demonstration to learn.
+    """
+    from scipy.spatial.transform import Rotation, Slerp
+
+    from ..primitives.cartesian import as_poses, as_quaternions
+
+    positions, quaternions = as_poses(poses, "poses", min_points=10)
+    target = as_point(new_target, 7, "new_target")
+    target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
+    turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
+    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
+    exclude = ()
+    if scene is not None:
+        exclude = scene.parts_at(target[:3])
+        roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
+    options = {**_roadmap_defaults(), **roadmap_options}
+    points = segment(positions, eps_frac=eps_frac, method=method).points
+    extension = _extend_keeping_approach(positions, target[:3], points, seed, options, None, exclude,
+                                         approach_rotation=turn.as_matrix())
+    start, seg = extension.approach_index, extension.seg_index
+    kept = (turn * Rotation.from_quat(quaternions[start:])).as_quat()
+    transfer = extension.complete[seg : start + 1]
+    arc = arclength(transfer)
+    fraction = arc / arc[-1] if arc[-1] > 0 else np.linspace(0.0, 1.0, len(transfer))
+    ends = Rotation.from_quat(np.vstack([quaternions[seg], kept[0]]))
+    slerped = Slerp([0.0, 1.0], ends)(fraction).as_quat()
+    orientations = np.vstack([quaternions[:seg], slerped, kept[1:]])
+    from ..primitives.cartesian import continuous_quaternions
+
+    orientations = continuous_quaternions(orientations)
+    if scene is not None:
+        hit = scene.clearance(extension.complete, exclude=exclude, orientations=orientations)
+        if not hit.collision_free:
+            raise NoFreeRouteError(f"the extended pose demonstration to {np.round(target[:3], 3).tolist()} hits part "
+                                   f"{hit.part!r} ({-hit.distance:.3g} deep) with the tool as it is turned")
+    return dataclasses.replace(extension, orientations=orientations)

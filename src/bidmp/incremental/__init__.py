@@ -1,0 +1,28 @@
+"""Incremental learning (paper Eq. 15–28): the exact incremental Broad Learning System (``bls``),
+the Bi-DMP skill library on a DMP's forcing term with forgetting measures (``bidmp``), and its
+pose version (``cartesian``).
+
+Layer 1 (the math): imports ``bidmp.primitives`` and the package root's private helpers only.
+"""
+
+from __future__ import annotations
+
+from .._lazy import exports
+
+# public name -> the module that holds it (imported on first use)
+_EXPORTS = {
+    "BiDMP": "bidmp",
+    "ForgettingResult": "bidmp",
+    "forgetting": "bidmp",
+    "forgetting_runs": "bidmp",
+    "BLS": "bls",
+    "sparse_autoencoder": "bls",
+    "block_pinv_update": "bls",
+    "truncated_svd": "bls",
+    "svd_update": "bls",
+    "CartesianBiDMP": "cartesian",
+    "pose_forgetting": "cartesian",
+}
+__all__ = list(_EXPORTS)
+# what the flat module bidmp.incremental of bidmp <= 0.4 held, for code written against it
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("bidmp",))

@@ -1,0 +1,209 @@
+"""Bi-DMP on poses: incremental skills on both forcing terms of a :class:`bidmp.CartesianDMP`
+(position and orientation), and the forgetting measure for pose skills.
+
+Layer 1 (the math): imports ``bidmp.primitives`` and ``bidmp.incremental.bidmp`` only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from sklearn.base import BaseEstimator, clone
+
+from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
+from ..primitives.cartesian import CartesianDMP, _parts_from_state, _parts_state, _pose_parts, _pose_params, _read_poses_state
+from .bidmp import BiDMP
+from ..primitives.so3 import principal_log, angle_between, as_quaternions, continuous_log, nearest_turn, orientation_from_log
+from ..primitives.pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
+
+__all__ = ["CartesianBiDMP", "pose_forgetting"]
+
+
+def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "nearest", **bidmp_params) -> np.ndarray:
+    """Learn pose ``demonstrations`` in turn and measure forgetting: for each skill, the largest
+    position error (units) and orientation error (rad) between its rollout after all were learned
+    and right after it was learned, (n_skills, 2)."""
+    model = CartesianBiDMP(cartesian, **bidmp_params)
+    queries = [cartesian.goal_]
+    when_learned = [model.rollout(cartesian.goal_, skill=skill)]
+    for poses in demonstrations:
+        model.learn(poses)
+        goal = np.asarray(poses, dtype=float)[-1]
+        queries.append(goal)
+        when_learned.append(model.rollout(goal, skill=skill))
+    out = np.zeros((len(queries), 2))
+    for index, (goal, before) in enumerate(zip(queries, when_learned)):
+        after = model.rollout(goal, skill=skill)
+        out[index] = (np.max(np.linalg.norm(after[:, :3] - before[:, :3], axis=1)),
+                      np.max(angle_between(after[:, 3:], before[:, 3:])))
+    return out
+
+
+_BIDMP_PARAMS = ("n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives")
+
+
+class CartesianBiDMP(BaseEstimator):
+    """Bi-DMP on poses: the increment is learned on both forcing terms, position and orientation.
+
+    A scikit-learn style estimator like :class:`bidmp.BiDMP`: ``CartesianBiDMP(cartesian)``
+    only stores its parameters; the model starts from the fitted ``cartesian`` at the first
+    :meth:`learn` (used as skill 0, never modified), or from a pose demonstration with
+    :meth:`fit`, which fits a copy of ``cartesian`` (default ``CartesianDMP()``).
+
+    Two :class:`bidmp.BiDMP` share the skill library: a query's skill is chosen on the position
+    goal (``"nearest"``, ``"latest"`` or an index, as for positions), and the orientation part
+    uses the same skill. Each skill keeps its own training start and goal orientation, so an
+    extended pose demonstration is reproduced exactly where it was taught.
+
+    Parameters
+    ----------
+    cartesian : CartesianDMP, default None
+    n_windows, n_mapped, n_enhance, increments, shrink, reg, seed, derivatives
+        As :class:`bidmp.BiDMP`, for both parts.
+
+    Attributes
+    ----------
+    cartesian_ : CartesianDMP
+    position_, orientation_ : BiDMP
+    skill_goal_orientations_, skill_start_orientations_ : array (n_skills, 4)
+    skill_start_logs_ : array (n_skills, 3)
+    """
+
+    def __init__(self, cartesian: CartesianDMP | None = None, n_windows: int = 10, n_mapped: int = 10,
+                 n_enhance: int = 100, increments: tuple[int, ...] = (20, 20), shrink: float = 0.8, reg: float = 1e-4,
+                 seed: int = 0, derivatives: str = "auto") -> None:
+        self.cartesian = cartesian
+        self.n_windows = n_windows
+        self.n_mapped = n_mapped
+        self.n_enhance = n_enhance
+        self.increments = increments
+        self.shrink = shrink
+        self.reg = reg
+        self.seed = seed
+        self.derivatives = derivatives
+
+    def _bidmp_params(self) -> dict:
+        return {name: getattr(self, name) for name in _BIDMP_PARAMS}
+
+    def _start(self, cartesian: CartesianDMP) -> None:
+
+        cartesian._parts()
+        self.cartesian_ = cartesian
+        self.position_ = BiDMP(cartesian.position_, **self._bidmp_params())
+        self.orientation_ = BiDMP(cartesian.orientation_, **self._bidmp_params())
+        self.position_._check_params()
+        self.skill_goal_orientations_ = cartesian.goal_[None, 3:].copy()
+        self.skill_start_orientations_ = cartesian.start_[None, 3:].copy()
+        self.skill_start_logs_ = cartesian.start_log_[None].copy()
+
+    def _ensure_started(self) -> None:
+        if "cartesian_" in self.__dict__:
+            return
+        if self.cartesian is None or not isinstance(self.cartesian, CartesianDMP):
+            raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(self.cartesian).__name__}")
+        check_fitted(self.cartesian, "position_")
+        self._start(self.cartesian)
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "cartesian_" in self.__dict__
+
+    @numerically_guarded
+    def fit(self, poses, t=None, units: str | None = None) -> "CartesianBiDMP":
+        """Fit a copy of ``cartesian`` (default ``CartesianDMP()``) on one pose demonstration as
+        skill 0, with no learned skills yet. Returns self."""
+        cartesian = clone(self.cartesian) if isinstance(self.cartesian, CartesianDMP) else CartesianDMP()
+        self._start(cartesian.fit(poses, t, units))
+        return self
+
+    @property
+    def n_skills(self) -> int:
+        self._ensure_started()
+        return self.position_.n_skills
+
+    @numerically_guarded
+    def learn(self, poses) -> "CartesianBiDMP":
+        """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts). Returns self."""
+        self._ensure_started()
+        positions, quaternions, log = _pose_parts(poses)
+        self.position_.learn(positions)
+        self.orientation_.learn(log)
+        self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
+        self.skill_start_orientations_ = np.vstack([self.skill_start_orientations_, quaternions[0]])
+        self.skill_start_logs_ = np.vstack([self.skill_start_logs_, log[0]])
+        return self
+
+    def select_skill(self, goal=None, skill="nearest") -> int:
+        """The skill a query uses (chosen on the position goal, as :meth:`bidmp.BiDMP.select_skill`)."""
+        self._ensure_started()
+        if goal is None and skill == "nearest":
+            return self.n_skills - 1
+        goal = None if goal is None else as_point(goal, 7, "goal")[:3]
+        return self.position_.select_skill(goal, skill)
+
+    def _query(self, goal, skill, start):
+        self._ensure_started()
+        self.cartesian_._parts()
+        index = self.select_skill(goal, skill)
+        goal = None if goal is None else as_point(goal, 7, "goal")
+        goal_q = self.skill_goal_orientations_[index] if goal is None else as_quaternions(goal[3:], "goal's quaternion")[0]
+        start = None if start is None else as_point(start, 7, "start")
+        start_q = self.skill_start_orientations_[index] if start is None else as_quaternions(start[3:], "start's quaternion")[0]
+        start_e = nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
+        return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
+
+    def rollout(self, goal=None, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
+        """Poses (n, 7) with one skill (chosen on the position goal)."""
+        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
+        position = self.position_.rollout(goal_p, skill=index, start=start_p, n_steps=n_steps)
+        error = self.orientation_.rollout(np.zeros(3), skill=index, start=start_e, n_steps=n_steps)
+        return np.hstack([position, orientation_from_log(error, goal_q)])
+
+    @numerically_guarded
+    def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None,
+                   dt: float | None = None, *, limits: dict | None = None) -> PoseTrajectory:
+        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
+        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
+        _, goal_p, start_p, position_increment = self.position_._skill_query(goal_p, index, start_p)
+        _, _, start_e, orientation_increment = self.orientation_._skill_query(np.zeros(3), index, start_e)
+        return pose_trajectory(self.position_.dmp_, self.orientation_.dmp_, goal_p, start_p, goal_q, start_e,
+                                duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_)
+
+    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
+                coupling: float = 0.0) -> "PoseStepper":
+        index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
+        return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
+                           self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)
+
+    # -- persistence (used by bidmp.io) --------------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        self._ensure_started()
+        cartesian = self.cartesian_
+        return _parts_state(self, {"params": cartesian.get_params()},
+                            {"start_": cartesian.start_, "goal_": cartesian.goal_, "start_log_": cartesian.start_log_,
+                             "skill_goal_orientations_": self.skill_goal_orientations_,
+                             "skill_start_orientations_": self.skill_start_orientations_,
+                             "skill_start_logs_": self.skill_start_logs_})
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> "CartesianBiDMP":
+
+        position, orientation = _parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
+        if position.n_skills != orientation.n_skills or position.dmp_.n_dims_ != 3 or orientation.dmp_.n_dims_ != 3:
+            raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
+        cartesian = CartesianDMP(**_pose_params(meta["params"]))
+        cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
+        _read_poses_state(cartesian, arrays)
+        cartesian.units_ = position.dmp_.units_
+        model = cls(cartesian, **{name: getattr(position, name) for name in _BIDMP_PARAMS})
+        model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation
+        shape = (position.n_skills, 4)
+        goals = check_loaded(arrays["skill_goal_orientations_"], "skill_goal_orientations_", shape)
+        starts = check_loaded(arrays["skill_start_orientations_"], "skill_start_orientations_", shape)
+        for name, values in (("skill_goal_orientations_", goals), ("skill_start_orientations_", starts)):
+            if np.any(np.abs(np.linalg.norm(values, axis=1) - 1.0) > 1e-6):
+                raise ValueError(f"member {name} does not hold unit quaternions")
+        model.skill_goal_orientations_, model.skill_start_orientations_ = goals, starts
+        if "skill_start_logs_" in arrays:
+            model.skill_start_logs_ = check_loaded(arrays["skill_start_logs_"], "skill_start_logs_", (position.n_skills, 3))
+        else:  # format 3
+            model.skill_start_logs_ = np.array([principal_log(s[None], g)[0] for s, g in zip(starts, goals)])
+        return model

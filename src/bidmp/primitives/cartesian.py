@@ -1,0 +1,269 @@
+"""Pose skills: position + unit quaternion DMPs, and their Bi-DMP (issues 13 and 19).
+
+Orientation is learned in the tangent space at the goal. A demonstrated orientation ``q(t)`` is
+mapped to the rotation vector of its error to the goal,
+
+    e(t) = Log(q(t) ⊗ g⁻¹) ∈ R³            (radians; e(T) = 0)
+
+taken *continuous along the demonstration* (:func:`bidmp._so3.continuous_log`), so a turn of
+several revolutions keeps its whole angle, and a position DMP with goal 0 is fitted on ``e``. A
+rollout to a new goal orientation ``g'`` from a start ``q₀`` runs that DMP from ``Log(q₀ ⊗ g'⁻¹)``
+(the equivalent nearest the demonstrated start's, so it turns the same way, as many times) to 0
+and maps back, ``q(t) = Exp(e(t)) ⊗ g'``. This is the formulation of Koutras & Doulgeri (2020,
+"A correct formulation for the orientation dynamic movement primitives for robot control in the
+Cartesian space"): unlike the quaternion DMP of Ude et al. (2014) it is a plain DMP in R³. So it
+converges to any goal orientation with the position DMP's guarantees, keeps the quaternion unit
+by construction, and inherits everything bidmp's DMP has: both protocols, the smooth goal share,
+temporal scaling, limits, the stepper, and the Bi-DMP increments.
+
+A part that does not move (a socket held straight down while the tool travels, or a rotation in
+place) is fitted all the same: its goal share follows the other part's progress.
+
+Quaternions are ``(x, y, z, w)``, scalar last, as in SciPy and PyBullet. Poses are ``(T, 7)``
+arrays ``x, y, z, qx, qy, qz, qw``. Angular velocities are in the world frame, in rad/s.
+"""
+
+from __future__ import annotations
+
+import logging
+import numpy as np
+from sklearn.base import BaseEstimator, clone
+
+from .._state import Prefixed
+from .._checks import as_point, as_trajectory, check_fitted, check_loaded, numerically_guarded
+from .so3 import (
+    angle_between,
+    as_quaternions,
+    continuous_log,
+    left_jacobian,
+    nearest_turn,
+    orientation_from_log,
+)
+from .pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
+from .._trajectory import continuous_quaternions
+from .dmp import DMP, arclength_progress
+
+__all__ = ["CartesianDMP", "PoseStepper", "PoseTrajectory",
+           "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "left_jacobian", "angle_between"]
+
+logger = logging.getLogger(__name__)
+
+
+def orientation_error(q, goal) -> np.ndarray:
+    """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3), radians, continuous along ``q`` (several
+    turns keep their whole angle; see :func:`bidmp._so3.continuous_log`)."""
+    return continuous_log(q, goal)
+
+
+def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """Split ``(T, 7)`` poses into positions ``(T, 3)`` and validated quaternions ``(T, 4)``."""
+    array = as_trajectory(poses, name, min_points=min_points, allow_static=True)
+    if array.shape[1] != 7:
+        raise ValueError(f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}")
+    return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
+
+
+
+def _pose_parts(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Positions (T, 3), quaternions (T, 4) and the continuous orientation log (T, 3) of a pose
+    demonstration; refused if neither part moves."""
+    positions, quaternions = as_poses(poses)
+    log = continuous_log(quaternions, quaternions[-1])
+    if np.ptp(positions, axis=0).max() == 0.0 and np.ptp(log, axis=0).max() <= 1e-12:
+        raise ValueError(f"poses: the demonstration does not move: all {len(positions)} poses are the same "
+                         f"(position {np.round(positions[0], 6).tolist()}, one orientation)")
+    return positions, quaternions, log
+
+
+def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: str = "poses") -> None:
+    """Fit the two parts; a part that does not move follows the other's progress."""
+    position_still = np.ptp(positions, axis=0).max() == 0.0
+    orientation_still = np.ptp(log, axis=0).max() <= 1e-12
+    if position_still:
+        orientation._fit(log, t, name=f"{name}' orientation", unit_label="rad")
+        position._fit(positions, t, units, progress=arclength_progress(orientation.training_trajectory(log)),
+                      name=f"{name}' positions")
+        return
+    position._fit(positions, t, units, name=f"{name}' positions")
+    progress = arclength_progress(position.training_trajectory(positions)) if orientation_still else None
+    orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
+
+
+_PART_PARAMS = tuple(DMP._get_param_names())  # a pose model's parameters are its parts' own
+
+
+class CartesianDMP(BaseEstimator):
+    """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
+
+    Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``
+    may change after ``fit``.
+
+    Attributes
+    ----------
+    position_, orientation_ : DMP
+        The two parts (the orientation part's unit is the radian).
+    start_, goal_ : array (7,)
+        The demonstration's first and last pose (x, y, z, qx, qy, qz, qw).
+    start_log_ : array (3,)
+        The demonstrated start orientation's continuous log at the goal (rad; several turns
+        included).
+    units_ : str
+    """
+
+    def __init__(self, n_kernels=None, alpha=None, beta=None, K=None, alpha_phase=None, tau: float = 1.0,
+                 regression=None, derivatives: str = "gradient", ridge: float = 1e-8, widths: str = "spacing",
+                 protocol: str = "robot", goal_rate=None, integrator=None) -> None:
+        self.n_kernels = n_kernels
+        self.alpha = alpha
+        self.beta = beta
+        self.K = K
+        self.alpha_phase = alpha_phase
+        self.tau = tau
+        self.regression = regression
+        self.derivatives = derivatives
+        self.ridge = ridge
+        self.widths = widths
+        self.protocol = protocol
+        self.goal_rate = goal_rate
+        self.integrator = integrator
+
+    def _dmp(self) -> DMP:
+        return DMP(**self.get_params())
+
+    @numerically_guarded
+    def fit(self, poses, t=None, units: str | None = None) -> "CartesianDMP":
+        """Learn from one pose demonstration ``(T, 7)`` (x, y, z, qx, qy, qz, qw), with optional
+        timestamps ``t`` (s) as :meth:`bidmp.DMP.fit`. Quaternion sign flips are made continuous;
+        non-unit quaternions are normalised with a warning; zero ones refused."""
+        positions, quaternions, log = _pose_parts(poses)
+        position, orientation = self._dmp(), self._dmp()
+        _fit_parts(position, orientation, positions, log, t, units)
+        self.position_, self.orientation_ = position, orientation
+        self.start_ = np.concatenate([positions[0], quaternions[0]])
+        self.goal_ = np.concatenate([positions[-1], quaternions[-1]])
+        self.start_log_ = log[0].copy()
+        self.units_ = position.units_
+        return self
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return "position_" in self.__dict__ and self.position_.__sklearn_is_fitted__()
+
+    def _parts(self) -> tuple[DMP, DMP]:
+        """The fitted parts, with this model's parameters (a changed tau is passed on; a changed
+        learned parameter makes them refuse, naming it)."""
+        check_fitted(self, "position_")
+        for part in (self.position_, self.orientation_):
+            for name in _PART_PARAMS:  # attribute access, not get_params(): this runs on every query
+                value = getattr(self, name)
+                if getattr(part, name) is not value:
+                    setattr(part, name, value)
+            part._check_fitted()
+        return self.position_, self.orientation_
+
+    @property
+    def duration_(self) -> float:
+        check_fitted(self, "position_")
+        return self.position_.duration_
+
+    def _query(self, goal, start):
+        self._parts()
+        goal = self.goal_ if goal is None else as_point(goal, 7, "goal")
+        start = self.start_ if start is None else as_point(start, 7, "start")
+        goal_q = as_quaternions(goal[3:], "goal's quaternion")[0]
+        start_q = as_quaternions(start[3:], "start's quaternion")[0]
+        return goal[:3], goal_q, start[:3], nearest_turn(start_q, goal_q, self.start_log_)
+
+    @numerically_guarded
+    def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
+                   limits: dict | None = None, position_increment=None, orientation_increment=None) -> PoseTrajectory:
+        """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
+
+        Parameters
+        ----------
+        goal, start : array (7,), optional
+            Poses (x, y, z, qx, qy, qz, qw); default the demonstration's.
+        duration, dt : float, optional
+            Seconds; temporal scaling as for positions.
+        limits : dict, optional
+            Position limits as :meth:`bidmp.DMP.trajectory` (``max_velocity`` ... in units/s);
+            the orientation follows the same timing.
+        """
+        goal_p, goal_q, start_p, start_e = self._query(goal, start)
+        return pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
+                                limits, position_increment, orientation_increment, self.units_)
+
+    def rollout(self, goal=None, start=None, n_steps: int | None = None) -> np.ndarray:
+        """Poses (n, 7) on the DMP's sample grid (as :meth:`bidmp.DMP.rollout`)."""
+        goal_p, goal_q, start_p, start_e = self._query(goal, start)
+        position = self.position_.rollout(goal_p, start_p, n_steps)
+        error = self.orientation_.rollout(np.zeros(3), start_e, n_steps)
+        return np.hstack([position, orientation_from_log(error, goal_q)])
+
+    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling: float = 0.0) -> "PoseStepper":
+        """A step-by-step integrator for a control loop; phase stopping on the position error."""
+        goal_p, goal_q, start_p, start_e = self._query(goal, start)
+        return PoseStepper(self.position_.stepper(goal_p, start_p, duration, coupling=coupling),
+                           self.orientation_.stepper(np.zeros(3), start_e, duration), goal_q)
+
+    # -- persistence (used by bidmp.io) --------------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        self._parts()
+        return _parts_state(self, {"params": self.get_params()},
+                            {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_})
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> "CartesianDMP":
+        position, orientation = _parts_from_state(DMP, "CartesianDMP", meta, arrays)
+        model = cls(**_pose_params(meta["params"]))
+        model.position_, model.orientation_ = position, orientation
+        for part in (model.position_, model.orientation_):
+            if part.n_dims_ != 3:
+                raise ValueError(f"a CartesianDMP's parts are 3-D; the file has D = {part.n_dims_}")
+        _read_poses_state(model, arrays)
+        model.units_ = model.position_.units_
+        return model
+
+
+def _pose_params(params: dict) -> dict:
+    """A stored pose model's parameters; format 1-3 files integrated with explicit Euler."""
+    params = dict(params)
+    params.setdefault("integrator", "euler")
+    return params
+
+
+def _read_poses_state(model: CartesianDMP, arrays) -> None:
+    """``start_``, ``goal_`` and ``start_log_`` of a stored pose model (format 3: ``start_pose_``
+    and ``goal_pose_``, and the principal log at the start)."""
+    from .so3 import principal_log
+
+    old = "start_" not in arrays
+    model.start_ = check_loaded(arrays["start_pose_" if old else "start_"], "start_", (7,))
+    model.goal_ = check_loaded(arrays["goal_pose_" if old else "goal_"], "goal_", (7,))
+    for name in ("start_", "goal_"):
+        if abs(np.linalg.norm(getattr(model, name)[3:]) - 1.0) > 1e-6:
+            raise ValueError(f"member {name} does not hold a unit quaternion")
+    if old:
+        model.start_log_ = principal_log(model.start_[None, 3:], model.goal_[3:])[0]
+    else:
+        model.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
+
+
+
+def _parts_state(model, meta: dict, arrays: dict) -> tuple[dict, dict]:
+    """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
+    ``orientation_`` parts, the parts' members prefixed with their names."""
+    for part in ("position", "orientation"):
+        part_meta, part_arrays = getattr(model, f"{part}_")._get_state()
+        meta[part] = part_meta
+        arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
+    return meta, arrays
+
+
+def _parts_from_state(part_class, name: str, meta: dict, arrays) -> tuple:
+    """The (position, orientation) parts of a stored pose model, each read lazily from its prefix."""
+    for key in ("params", "position", "orientation"):
+        if not isinstance(meta.get(key), dict):
+            raise ValueError(f"the {name} state has no {key} object")
+    return tuple(part_class._from_state(meta[part], Prefixed(arrays, f"{part}/")) for part in ("position", "orientation"))
+
+

@@ -1,0 +1,124 @@
+"""Timed pose motion: :class:`PoseTrajectory` (the pose counterpart of :class:`bidmp.Trajectory`),
+the timed rollout of a pose skill's two parts, and :class:`PoseStepper` for a control loop.
+Public through :mod:`bidmp.cartesian`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .so3 import left_jacobian, orientation_from_log
+from .timing import TimedMotion
+
+__all__ = ["PoseTrajectory", "PoseStepper", "pose_trajectory"]
+
+
+@dataclass(frozen=True)
+class PoseTrajectory(TimedMotion):
+    """A timed pose trajectory, the pose counterpart of :class:`bidmp.Trajectory` (lengths in
+    ``units``, angles in rad, time in s).
+
+    Attributes
+    ----------
+    t : (n,)
+    y, yd, ydd : (n, 3)
+        Position, velocity, acceleration (as :class:`bidmp.Trajectory`).
+    q : (n, 4)
+        Unit quaternions (x, y, z, w).
+    omega, omega_dot : (n, 3)
+        Angular velocity and acceleration, world frame (rad/s, rad/s²).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    yd: np.ndarray
+    ydd: np.ndarray
+    q: np.ndarray
+    omega: np.ndarray
+    omega_dot: np.ndarray
+    units: str = ""
+
+    def __post_init__(self) -> None:
+        n = self.t.shape[0]
+        for name, width in (("y", 3), ("yd", 3), ("ydd", 3), ("q", 4), ("omega", 3), ("omega_dot", 3)):
+            if getattr(self, name).shape != (n, width):
+                raise ValueError(f"PoseTrajectory.{name} must have shape ({n}, {width}), got {getattr(self, name).shape}")
+
+    @property
+    def poses(self) -> np.ndarray:
+        """(n, 7): x, y, z, qx, qy, qz, qw."""
+        return np.hstack([self.y, self.q])
+
+    def columns(self) -> tuple[list[str], np.ndarray]:
+        """Column names ``t, x, y, z, qx, qy, qz, qw, vx, vy, vz, wx, wy, wz, ax, ay, az, dwx, dwy,
+        dwz`` and the matching (n, 20) array: the layout of timed pose CSV files."""
+        header = ["t", "x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az",
+                  "dwx", "dwy", "dwz"]
+        return header, np.column_stack([self.t, self.y, self.q, self.yd, self.omega, self.ydd, self.omega_dot])
+
+    def peak_angular_speed(self) -> float:
+        """Largest ‖omega‖ (rad/s)."""
+        return float(np.max(np.linalg.norm(self.omega, axis=1)))
+
+
+_JACOBIAN_STEP = 1e-7  # s: the left Jacobian's change along ė, by a forward difference
+
+
+def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """World-frame angular velocity ``ω = J_l(e) ė`` and acceleration ``ω̇ = J_l(e) ë + (d/dt J_l) ė``
+    (n, 3) from the orientation log and its derivatives."""
+    jacobian = left_jacobian(e)
+    omega = np.einsum("nij,nj->ni", jacobian, ed)
+    change = (left_jacobian(e + ed * _JACOBIAN_STEP) - jacobian) / _JACOBIAN_STEP
+    omega_dot = np.einsum("nij,nj->ni", jacobian, edd) + np.einsum("nij,nj->ni", change, ed)
+    return omega, omega_dot
+
+
+def pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
+                     position_increment, orientation_increment, units) -> PoseTrajectory:
+    """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise)."""
+    position = position_model.trajectory(goal_p, start_p, duration, dt, limits=limits, forcing_increment=position_increment)
+    if limits:  # the orientation follows the motion time the position's limits chose
+        duration = position.t[-1] / position_model._params().settle
+    error = orientation_model.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment)
+    n = min(len(position.t), len(error.t))
+    orientation = orientation_from_log(error.y[:n], goal_q)
+    omega, omega_dot = _angular_rates(error.y[:n], error.yd[:n], error.ydd[:n])
+    return PoseTrajectory(position.t[:n], position.y[:n], position.yd[:n], position.ydd[:n], orientation, omega,
+                          omega_dot, units)
+
+
+class PoseStepper:
+    """Steps a :class:`CartesianDMP`'s two parts together; the position part's phase stopping
+    paces the orientation part too, so the two stay on the same motion time.
+
+    ``step(dt, y_measured=None)`` returns what :meth:`bidmp.dmp.DMPStepper.step` returns, for a
+    pose: ``(pose (7,), velocity (6,), acceleration (6,))`` with the velocity ``[vx, vy, vz, wx,
+    wy, wz]`` (units/s, rad/s, world frame) and the acceleration likewise (units/s², rad/s²).
+    """
+
+    def __init__(self, position, orientation, goal_orientation):
+        self.position = position
+        self.orientation = orientation
+        self.goal_orientation = goal_orientation
+
+    @property
+    def time(self) -> float:
+        return self.position.time
+
+    @property
+    def y(self) -> np.ndarray:
+        return np.concatenate([self.position.y, orientation_from_log(self.orientation.y[None], self.goal_orientation)[0]])
+
+    def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Command pose, velocity and acceleration now; advance ``dt`` s (less while the measured
+        position lags)."""
+        before = self.position.time
+        y, yd, ydd = self.position.step(dt, None if y_measured is None else np.asarray(y_measured, dtype=float)[:3])
+        advanced = self.position.time - before
+        e, ed, edd = self.orientation.step(max(advanced, 1e-6))
+        pace = advanced / dt if dt > 0 else 1.0
+        q = orientation_from_log(e[None], self.goal_orientation)[0]
+        omega, omega_dot = _angular_rates(e[None], ed[None], edd[None])
+        return np.concatenate([y, q]), np.concatenate([yd, omega[0] * pace]), np.concatenate([ydd, omega_dot[0] * pace**2])

@@ -1,0 +1,238 @@
+"""Real time: timed trajectories, timestamps, time scaling to limits.
+
+* :class:`Trajectory` — ``t`` (s) and ``y``, ``yd``, ``ydd`` (units, units/s, units/s²).
+* :func:`check_timestamps` — monotone, finite, a plausible sample rate (1 Hz … 100 kHz).
+* :func:`time_scale` — the shortest uniformly time-scaled copy of a trajectory within velocity,
+  acceleration (and jerk) limits.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import as_trajectory, check_choice, check_real, numerically_guarded
+from .._units import check_units
+
+__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "scale_factor",
+           "time_scale"]
+
+logger = logging.getLogger(__name__)
+
+MIN_RATE_HZ = 1.0
+MAX_RATE_HZ = 100_000.0
+
+
+class TimedMotion:
+    """What a timed trajectory of positions (``t``, ``y``, ``yd``, ``ydd``) answers: its duration,
+    length, dimensions and peaks. :class:`Trajectory` and the pose trajectory share it."""
+
+    @property
+    def duration(self) -> float:
+        """``t[-1] - t[0]`` in seconds."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def n_dims(self) -> int:
+        return int(self.y.shape[1])
+
+    def __len__(self) -> int:
+        return int(self.t.shape[0])
+
+    def peak_speed(self) -> float:
+        """Largest ‖yd‖ (units/s)."""
+        return float(np.max(np.linalg.norm(self.yd, axis=1)))
+
+    def peak_acceleration(self) -> float:
+        """Largest ‖ydd‖ (units/s²)."""
+        return float(np.max(np.linalg.norm(self.ydd, axis=1)))
+
+
+@dataclass(frozen=True)
+class Trajectory(TimedMotion):
+    """A timed trajectory: what a robot controller consumes.
+
+    Attributes
+    ----------
+    t : array (n,)
+        Time in seconds, starting at 0, increasing.
+    y, yd, ydd : array (n, D)
+        Position (units), velocity (units/s), acceleration (units/s²).
+    units : str
+        Length unit of ``y`` ("" if unknown).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    yd: np.ndarray
+    ydd: np.ndarray
+    units: str = ""
+
+    def __post_init__(self) -> None:
+        n = self.t.shape[0]
+        for name in ("y", "yd", "ydd"):
+            if getattr(self, name).shape[0] != n or getattr(self, name).ndim != 2:
+                raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {getattr(self, name).shape}")
+
+    def columns(self) -> tuple[list[str], np.ndarray]:
+        """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the
+        matching (n, 1 + 3D) array: the layout of timed CSV and ``.npy`` files."""
+        names = ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)]
+        header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
+        return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
+
+
+def _as_stamps(t, name: str) -> np.ndarray:
+    if isinstance(t, (str, bytes)):
+        raise TypeError(f"{name} must be an array of times in seconds, got a string")
+    try:
+        return np.asarray(t, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"{name} must be an array of times in seconds") from None
+
+
+def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
+    """Validate timestamps (s) for ``n_samples`` samples and return them as float64 (n,).
+
+    Any monotone stamps are accepted: jittered, starting anywhere (epoch seconds included).
+
+    Raises
+    ------
+    ValueError
+        If they are not finite, not strictly increasing (duplicates are named), or imply a mean
+        sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
+    """
+    stamps = _as_stamps(t, name)
+    if stamps.ndim != 1 or stamps.shape[0] != n_samples:
+        raise ValueError(f"{name} must have shape ({n_samples},) (one time per sample), got {stamps.shape}")
+    if not np.all(np.isfinite(stamps)):
+        raise ValueError(f"{name} contains NaN or inf")
+    if np.max(np.abs(stamps)) > 1e12:
+        raise ValueError(f"{name} has values beyond 1e12 s: timestamps must be seconds")
+    steps = np.diff(stamps)
+    if np.any(steps <= 0):
+        row = int(np.argmax(steps <= 0)) + 1
+        kind = "duplicate timestamp" if steps[row - 1] == 0 else "timestamp going back"
+        raise ValueError(f"{name} must increase strictly: {kind} at sample {row}: {_stamp(stamps[row])} s after "
+                         f"{_stamp(stamps[row - 1])} s ({1e3 * float(steps[row - 1]):+.4g} ms; "
+                         f"{float(stamps[row] - stamps[0]):.6g} s into the recording)")
+    rate = (n_samples - 1) / (stamps[-1] - stamps[0])
+    if rate < MIN_RATE_HZ:
+        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
+                         f"seconds (these look like milliseconds, microseconds or nanoseconds)")
+    if rate > MAX_RATE_HZ:
+        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, above {MAX_RATE_HZ:g} Hz: timestamps must be "
+                         f"seconds (these look like minutes or hours, or the samples are not a recording)")
+    return stamps
+
+
+def _stamp(value: float) -> str:
+    """A timestamp as the shortest text that tells it from its neighbours (all its digits)."""
+    return np.format_float_positional(float(value), unique=True, trim="-")
+
+
+def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
+    """``y`` (T, D) and stamps ``t`` (T,) without the samples whose stamp repeats the previous
+    one, as loggers write them (the first of each run is kept); a warning says how many.
+
+    Stamps going back are still refused (:func:`check_timestamps`).
+    """
+    y = np.asarray(y, dtype=np.float64)
+    stamps = _as_stamps(t, name)
+    if stamps.ndim == 1 and y.ndim >= 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1:
+        repeated = np.concatenate([[False], np.diff(stamps) == 0])
+        if np.any(repeated):
+            first = int(np.argmax(repeated))
+            logger.warning("%s: dropped %d sample(s) whose timestamp repeats the one before (the first at sample %d, "
+                           "%s s)", name, int(repeated.sum()), first, _stamp(stamps[first]))
+            y, stamps = y[~repeated], stamps[~repeated]
+    return y, check_timestamps(stamps, y.shape[0] if y.ndim else 0, name)
+
+
+def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``y`` sampled at stamps ``t`` resampled to as many uniform samples over the same span;
+    returns (y_uniform (n, D), t_uniform (n,) starting at 0)."""
+    t = t - t[0]
+    grid = np.linspace(0.0, t[-1], t.shape[0])
+    steps = np.diff(t)
+    if np.ptp(steps) <= 1e-9 * np.mean(steps):
+        return y.copy(), grid
+    return np.column_stack([np.interp(grid, t, column) for column in y.T]), grid
+
+
+
+
+def _peaks(values: np.ndarray, norm: str) -> np.ndarray:
+    """Peak magnitude of (n, D) values: one number ('norm') or one per axis ('axis')."""
+    if norm == "norm":
+        return np.array([np.max(np.linalg.norm(values, axis=1))])
+    return np.max(np.abs(values), axis=0)
+
+
+def _limit_array(limit, n_dims: int, norm: str, name: str) -> np.ndarray | None:
+    if limit is None:
+        return None
+    array = np.asarray(limit, dtype=np.float64).reshape(-1)
+    expected = 1 if norm == "norm" else n_dims
+    if array.shape[0] == 1 and expected > 1:
+        array = np.repeat(array, expected)
+    if array.shape[0] != expected or not np.all(np.isfinite(array)) or np.any(array <= 0):
+        raise ValueError(f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, got {limit!r}")
+    return array
+
+
+def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
+                 norm: str = "norm") -> float:
+    """The factor ``k`` by which a uniform time scaling ``t → k t`` makes ``trajectory`` meet
+    the limits with the binding one met exactly (``k < 1`` speeds up a slow trajectory).
+
+    Velocity scales as 1/k, acceleration as 1/k², jerk as 1/k³.
+    """
+    check_choice(norm, "norm", ("norm", "axis"))
+    n_dims = trajectory.n_dims
+    factors = []
+    for limit, values, power, name in (
+        (max_velocity, trajectory.yd, 1, "max_velocity"),
+        (max_acceleration, trajectory.ydd, 2, "max_acceleration"),
+        (max_jerk, None, 3, "max_jerk"),
+    ):
+        limits = _limit_array(limit, n_dims, norm, name)
+        if limits is None:
+            continue
+        if values is None:
+            values = np.gradient(trajectory.ydd, trajectory.t, axis=0)
+        peaks = _peaks(values, norm)
+        factors.append(float(np.max((peaks / limits) ** (1.0 / power))))
+    if not factors:
+        raise ValueError("time_scale needs at least one of max_velocity, max_acceleration, max_jerk")
+    factor = max(factors)
+    if factor <= 0.0:
+        raise ValueError("the trajectory does not move: there is no time scaling that touches a limit")
+    return factor
+
+
+@numerically_guarded
+def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
+               norm: str = "norm") -> Trajectory:
+    """The shortest uniformly time-scaled copy of ``trajectory`` within the limits.
+
+    The path is unchanged; time is stretched (or shrunk) by one factor ``k`` so that the binding
+    limit is met exactly: ``t' = k t``, ``yd' = yd / k``, ``ydd' = ydd / k²``. Limits are never
+    met by clipping: a clipped DMP state loses the system's stability and its goal.
+
+    Parameters
+    ----------
+    trajectory : Trajectory
+    max_velocity, max_acceleration, max_jerk : float or array (D,), optional
+        Limits in units/s, units/s², units/s³; at least one.
+    norm : {"norm", "axis"}
+        Limit the Euclidean norm of the vectors (Cartesian speed) or every axis on its own
+        (joint limits; then a limit may be one number or one per axis).
+    """
+    if not isinstance(trajectory, Trajectory):
+        raise TypeError(f"trajectory must be a bidmp.Trajectory, got {type(trajectory).__name__}")
+    factor = scale_factor(trajectory, max_velocity, max_acceleration, max_jerk, norm)
+    return Trajectory(trajectory.t * factor, trajectory.y.copy(), trajectory.yd / factor, trajectory.ydd / factor**2,
+                      trajectory.units)

@@ -1,0 +1,35 @@
+"""Tasks: scenario files (``scenarios``), the methods registry (``methods``), evaluation of every
+method on every target (``evaluation``) and the metrics it reports (``metrics``).
+
+Layer 2 (data and tasks): imports the math and ``bidmp.io``; never ``sim``, ``experiments``,
+``plotting`` at import time (figures are drawn on request) or ``cli``.
+"""
+
+from __future__ import annotations
+
+from .._lazy import exports
+
+# public name -> the module that holds it (imported on first use)
+_EXPORTS = {
+    "CONVERGED_GAIN": "evaluation",
+    "MethodResult": "evaluation",
+    "Report": "evaluation",
+    "evaluate": "evaluation",
+    "write_report": "evaluation",
+    "Scenario": "scenarios",
+    "ScenarioError": "scenarios",
+    "METHODS": "scenarios",
+    "load": "scenarios",
+    "builtin_names": "scenarios",
+    "builtin_text": "scenarios",
+    "from_dict": "scenarios",
+    "rmse": "metrics",
+    "path_extent": "metrics",
+    "endpoint_error": "metrics",
+    "approach_error": "metrics",
+    "axis_deviation": "metrics",
+    "path_difference": "metrics",
+    "swept_area": "metrics",
+}
+__all__ = list(_EXPORTS)
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -1,0 +1,506 @@
+"""Scenario evaluation: every method on every target of a scenario (SPEC §9, report JSON of §10).
+
+``evaluate(scenario, methods)`` returns a :class:`Report`; ``report.to_dict()`` is the JSON the
+CLI writes, ``report.summary()`` the tables it prints, and :func:`write_report` writes the
+results and figures. The paper's experiments built on it live in :mod:`bidmp.reproduce`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._tables import markdown_table, text_table
+from .._trajectory import resample_time
+from ..primitives.dmp import DMP
+from ..extension.extend import extend_demonstration
+from ..incremental.bidmp import BiDMP, forgetting_runs
+from .metrics import approach_error, endpoint_error, path_difference
+
+__all__ = ["CONVERGED_GAIN", "MethodResult", "Report", "evaluate", "write_report"]
+
+CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
+
+
+@dataclass
+class MethodResult:
+    """One method on one scenario (lengths in the scenario's unit, times in s)."""
+
+    name: str
+    rollouts: dict  # label -> (n, D)
+    runtime_s: float
+    errors: dict
+    approach_errors: dict | None
+    differences: dict
+    success_threshold: float
+    n_steps: int
+    clearances: dict | None = None  # label -> Clearance, or None where the scene does not apply; None without a scene
+    orientations: dict | None = None  # pose scenarios: label -> (n, 4) quaternions of the rollout
+    axis_deviations: dict | None = None  # pose scenarios: label -> degrees between tool and target axes
+    alignment_threshold: float = 2.0
+
+    @property
+    def successes(self) -> int:
+        return sum(error <= self.success_threshold for error in self.errors.values())
+
+    def engaged_at(self, label: str) -> bool | None:
+        """Whether the tool stayed within the threshold of the target's axis over the approach
+        height (None when the scenario has no approach height)."""
+        if self.approach_errors is None:
+            return None
+        return bool(self.approach_errors[label] <= self.success_threshold)
+
+    def clearance_at(self, label: str):
+        return None if self.clearances is None else self.clearances.get(label)
+
+    def task_success_at(self, label: str) -> bool:
+        """End point within the threshold, engaged (where measured) and collision-free (where
+        the scene applies)."""
+        clearance = self.clearance_at(label)
+        return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
+                    and (clearance is None or clearance.collision_free) and self.aligned_at(label) is not False)
+
+    def aligned_at(self, label: str) -> bool | None:
+        """Pose scenarios: the tool's axis within the alignment threshold of the target's over
+        the approach height (None otherwise)."""
+        if self.axis_deviations is None:
+            return None
+        return bool(self.axis_deviations[label] <= self.alignment_threshold)
+
+    @property
+    def aligned(self) -> int | None:
+        return None if self.axis_deviations is None else sum(bool(self.aligned_at(label)) for label in self.errors)
+
+    @property
+    def task_successes(self) -> int:
+        return sum(self.task_success_at(label) for label in self.errors)
+
+    @property
+    def engaged(self) -> int | None:
+        return None if self.approach_errors is None else sum(bool(self.engaged_at(label)) for label in self.errors)
+
+    @property
+    def checked(self) -> list[str]:
+        """Labels whose motion was checked against the scene."""
+        return [] if self.clearances is None else [label for label, c in self.clearances.items() if c is not None]
+
+    @property
+    def collision_free(self) -> int | None:
+        return None if self.clearances is None else sum(self.clearances[label].collision_free for label in self.checked)
+
+    @property
+    def worst_clearance(self):
+        """The smallest Clearance over the checked targets (None without a scene)."""
+        checked = [self.clearances[label] for label in self.checked]
+        return min(checked, key=lambda c: c.distance) if checked else None
+
+    @property
+    def approach_successes(self) -> int | None:
+        if self.approach_errors is None:
+            return None
+        return sum(self.errors[label] <= self.success_threshold and self.approach_errors[label] <= self.success_threshold
+                   for label in self.errors)
+
+    def to_dict(self) -> dict:
+        n_targets = len(self.errors)
+        out = {
+            "success_rate": round(self.successes / n_targets, 4),
+            "successes": self.successes,
+            "n_targets": n_targets,
+            "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
+            "approach_errors": None if self.approach_errors is None else {label: round(float(e), 4) for label, e in self.approach_errors.items()},
+            "max_error": round(float(max(self.errors.values())), 4),
+            "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
+            "runtime_s": round(self.runtime_s, 5),
+            "n_steps": self.n_steps,
+        }
+        if self.approach_errors is not None:
+            out["approach_successes"] = self.approach_successes
+            out["approach_success_rate"] = round(self.approach_successes / n_targets, 4)
+        worst = self.worst_clearance
+        out.update({
+            "task_successes": self.task_successes,
+            "engaged": self.engaged,
+            "collision_free": self.collision_free,
+            "n_checked": None if self.clearances is None else len(self.checked),
+            "min_clearance": None if worst is None else _rounded(worst.distance),
+            "min_clearance_part": None if worst is None else worst.part,
+            "aligned": self.aligned,
+        })
+        targets = {}
+        for label, error in self.errors.items():
+            clearance = self.clearance_at(label)
+            targets[label] = {
+                "error": round(float(error), 4),
+                "approach_error": None if self.approach_errors is None else round(float(self.approach_errors[label]), 4),
+                "engaged": self.engaged_at(label),
+                "clearance": None if clearance is None else _rounded(clearance.distance),
+                "clearance_part": None if clearance is None else clearance.part,
+                "collision_part": None if clearance is None else clearance.collision_part,
+                "task_success": self.task_success_at(label),
+                "axis_deviation": None if self.axis_deviations is None else round(float(self.axis_deviations[label]), 4),
+            }
+        out["targets"] = targets
+        return out
+
+
+def _rounded(distance: float) -> float | None:
+    return None if not np.isfinite(distance) else round(float(distance), 4)
+
+
+@dataclass
+class Report:
+    """Result of :func:`evaluate`: per-method metrics plus what the figures need."""
+
+    scenario: object
+    methods: dict  # name -> MethodResult
+    extensions: list = field(default_factory=list)  # ExtendedDemonstration per stage
+    extension_targets: list = field(default_factory=list)
+    failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
+    model: object = None  # the Bi-DMP
+    forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
+
+    def to_dict(self) -> dict:
+        """The report JSON of SPEC §10 (plus the extension and forgetting details)."""
+        out = {
+            "scenario": self.scenario.name,
+            "units": self.scenario.units,
+            "success_threshold": self.scenario.success_threshold,
+            "approach_height": self.scenario.approach_height,
+            "methods": {name: result.to_dict() for name, result in self.methods.items()},
+        }
+        if self.extension_targets:
+            out["extension_targets"] = [np.asarray(t).round(4).tolist() for t in self.extension_targets]
+            out["failed_targets"] = list(self.failed_targets)
+        if self.forgetting:
+            out["forgetting"] = {skill: result.to_dict() for skill, result in self.forgetting.items()}
+        return out
+
+    # -- tables ------------------------------------------------------------------------------
+    def method_rows(self, runtimes: bool = True) -> tuple[list[str], list[list[str]]]:
+        """The Table 4 analogue: header and one row per method. With a scene: engaged,
+        collision-free (of the targets the scene applies to), worst clearance and task success
+        (end point ∧ engaged ∧ collision-free) beside the paper's end-point success."""
+        geometry = any(result.clearances is not None for result in self.methods.values())
+        poses = any(result.axis_deviations is not None for result in self.methods.values())
+        header = ["method", "success rate", "successes", "engaged"] + (["aligned"] if poses else []) + \
+            ["max error", "difference range"]
+        if geometry:
+            header += ["collision-free", "min clearance (part)", "task success"]
+        if runtimes:
+            header.append("run time [s]")
+        rows = []
+        for name, result in self.methods.items():
+            data = result.to_dict()
+            n = data["n_targets"]
+            engaged = "-" if data["engaged"] is None else f"{data['engaged']}/{n}"
+            row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{n}", engaged]
+            if poses:
+                row.append(f"{data['aligned']}/{n}")
+            row += [f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
+            if geometry:
+                worst = "-" if data["min_clearance"] is None else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
+                row += [f"{data['collision_free']}/{data['n_checked']}", worst, f"{data['task_successes']}/{n}"]
+            if runtimes:
+                row.append(f"{data['runtime_s']:.4f}")
+            rows.append(row)
+        return header, rows
+
+    def target_rows(self) -> tuple[list[str], list[list[str]]]:
+        """Tables 1 and 2 analogue: end-point error per target and method (x = failure)."""
+        scenario = self.scenario
+        origin = scenario.targets[scenario.demonstrated]
+        header = ["target", "distance"] + list(self.methods)
+        rows = []
+        for label, target in scenario.targets.items():
+            cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
+            for result in self.methods.values():
+                error = result.errors[label]
+                cells.append(f"{error:.3f}{'' if error <= scenario.success_threshold else ' x'}")
+            rows.append(cells)
+        return header, rows
+
+    def summary(self) -> str:
+        """The plain-text report ``bidmp demo`` prints (run times include one-time imports when
+        this is the first run in the process)."""
+        scenario = self.scenario
+        units = scenario.units
+        lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
+                 f"success = end-point error <= {scenario.success_threshold:g} {units}"]
+        if any(result.clearances is not None for result in self.methods.values()):
+            engaged = (f"engaged (within {scenario.success_threshold:g} {units} of the target's axis over the last "
+                       f"{scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
+            lines.append(f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "
+                         f"{units}, clearance to every part but the target)")
+        if self.extension_targets:
+            lines.append(f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
+                         + ", ".join(np.array2string(np.asarray(t), precision=1) for t in self.extension_targets))
+        lines += ["", f"Table 4 analogue (errors in {units}; run time in s, measured in this run)", text_table(*self.method_rows())]
+        lines += ["", f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)", text_table(*self.target_rows())]
+        if self.forgetting:
+            lines += ["", f"forgetting (error after learning every demonstration minus error when learned, {units}):"]
+            lines += [f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting) for skill, result in self.forgetting.items()]
+        return "\n".join(lines)
+
+    def markdown(self) -> str:
+        """The deterministic part of the report as Markdown (no run times)."""
+        return "\n\n".join([markdown_table(*self.method_rows(runtimes=False)), markdown_table(*self.target_rows())])
+
+
+class _Timer:
+    def __enter__(self):
+        self._start = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        self.seconds = time.perf_counter() - self._start
+        return False
+
+
+def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
+    """An extension target: a label, a point (or pose), or the centre of the failed targets (for
+    poses: their mean position and mean orientation)."""
+    if isinstance(target, str) and target == "centre_of_failed":
+        if not failed:
+            return None
+        points = np.array([scenario.targets[label] for label in failed])
+        if scenario.is_pose:
+            from scipy.spatial.transform import Rotation
+
+            return np.concatenate([points[:, :3].mean(axis=0), Rotation.from_quat(points[:, 3:]).mean().as_quat()])
+        return points.mean(axis=0)
+    if isinstance(target, str):
+        return scenario.targets[target]
+    return np.asarray(target, dtype=float)
+
+
+def _bidmp_model(scenario, dmp, failed):
+    """Build the scenario's Bi-DMP: chained extensions, then further demonstrations."""
+    model = BiDMP(dmp, **scenario.bidmp)
+    extensions, targets = [], []
+    previous = None
+    # The paper's protocol knows no battery geometry: approach "paper" grows the extension blind.
+    keep = scenario.extension.get("approach", "keep") == "keep"
+    for stage in scenario.extensions:
+        target = _resolve_target(stage["target"], scenario, failed)
+        if target is None:
+            continue  # nothing failed: no extension needed
+        source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
+        scene = scenario.scene if keep and stage.get("in_scene", True) else None
+        previous = extend_demonstration(source, target, seed=scenario.seed, scene=scene, **scenario.extension)
+        model.learn(previous.complete)
+        extensions.append(previous)
+        targets.append(target)
+    forgetting = {}
+    if scenario.demonstrations:
+        if model.n_skills == 1:  # learn the operators' demonstrations and measure forgetting in one pass
+            forgetting = forgetting_runs(model, list(scenario.demonstrations.values()), ("nearest", "latest"))
+        else:
+            for demonstration in scenario.demonstrations.values():
+                model.learn(demonstration)
+    return model, extensions, targets, forgetting
+
+
+def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Report:
+    """Run ``methods`` (default: the scenario's) on every target of ``scenario``.
+
+    Parameters
+    ----------
+    scenario : Scenario or str
+        A scenario, a scenario file, or a built-in name.
+    methods : list of str, optional
+        From dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm.
+    progress : callable, optional
+        Called with each method name before it runs (the CLI hooks a progress bar here).
+    geometry : bool, default True
+        Check every rollout against the scenario's scene (clearance, collisions, task success).
+        False skips the checks (the extensions are still grown around the parts); the report
+        then has no geometry columns.
+
+    Returns
+    -------
+    Report
+        ``report.to_dict()`` is the JSON of SPEC §10.
+    """
+    from . import scenarios as scenario_module
+    from ..baselines import TPGMM, GMMRegressor
+
+    if not isinstance(scenario, scenario_module.Scenario):
+        scenario = scenario_module.load(scenario)
+    if scenario.is_pose:
+        return _evaluate_poses(scenario, methods, progress, geometry)
+    methods = list(scenario.methods if methods is None else methods)
+    if not methods:
+        raise ValueError("methods is empty: name at least one of " + ", ".join(scenario_module.METHODS))
+    for method in methods:
+        if method not in scenario_module.METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(scenario_module.METHODS)}")
+    labels = scenario.labels
+    goals = scenario.target_array
+    demo = scenario.demonstration
+    n_steps = demo.shape[0]
+    references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
+    scene = scenario.scene if geometry else None
+    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
+
+    def result(name, trajectories, seconds):
+        trajectories = dict(zip(labels, trajectories))
+        errors = {label: endpoint_error(trajectories[label], scenario.targets[label]) for label in labels}
+        approach = None
+        if scenario.approach_height is not None and demo.shape[1] == 3:
+            approach = {label: approach_error(trajectories[label], scenario.targets[label], scenario.approach_height) for label in labels}
+        differences = {label: path_difference(trajectories[label], references[label]) for label in labels}
+        clearances = None
+        if scene is not None:
+            clearances = {label: scene.clearance(trajectories[label], exclude=excluded[label]) if scene.applies_to(label)
+                          else None for label in labels}
+        return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
+                            next(iter(trajectories.values())).shape[0], clearances)
+
+    report = Report(scenario=scenario, methods={})
+    with _Timer() as dmp_time:
+        dmp = DMP(**scenario.dmp).fit(demo)
+        plain = dmp.rollout_many(goals)
+    plain_errors = np.linalg.norm(plain[:, -1] - goals, axis=1)
+    failed = [label for label, error in zip(labels, plain_errors) if error > scenario.success_threshold]
+    report.failed_targets = failed
+    model = None
+    model_seconds = 0.0
+
+    for method in methods:
+        if progress is not None:
+            progress(method)
+        if method == "dmp":
+            report.methods[method] = result(method, plain, dmp_time.seconds)
+        elif method == "dmp-converged":
+            with _Timer() as timer:
+                factor = next((k for k in range(2, 101) if dmp.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100)
+                trajectories = dmp.rollout_many(goals, n_steps=factor * n_steps)
+            report.methods[method] = result(method, trajectories, dmp_time.seconds + timer.seconds)
+        elif method in ("bidmp", "bidmp-latest"):
+            if model is None:
+                with _Timer() as timer:
+                    model, report.extensions, report.extension_targets, report.forgetting = _bidmp_model(scenario, dmp, failed)
+                model_seconds = dmp_time.seconds + timer.seconds
+                report.model = model
+            skill = "nearest" if method == "bidmp" else "latest"
+            with _Timer() as timer:
+                trajectories = [model.rollout(goal, skill=skill) for goal in goals]
+            report.methods[method] = result(method, trajectories, model_seconds + timer.seconds)
+        elif method == "gmm":
+            with _Timer() as timer:
+                mean, _ = GMMRegressor(seed=scenario.seed).fit(demo).generate()
+                trajectories = [mean] * len(labels)  # GMM has no notion of a new target
+            report.methods[method] = result(method, trajectories, timer.seconds)
+        elif method == "tpgmm":
+            with _Timer() as timer:
+                tpgmm = TPGMM(seed=scenario.seed).fit(demo)
+                trajectories = [tpgmm.generate(demo[0], goal)[0] for goal in goals]
+            report.methods[method] = result(method, trajectories, timer.seconds)
+    if scenario.demonstrations and not report.forgetting:
+        report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
+                                            **scenario.bidmp)
+    return report
+
+
+def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
+    """:func:`evaluate` for a pose scenario: CartesianDMP and its Bi-DMP, with the extension on
+    poses; metrics on positions, the engagement along each target's axis, and the tool's axis
+    alignment (task success needs it too)."""
+    from ..primitives.cartesian import CartesianDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..extension.extend import extend_pose_demonstration
+    from .metrics import axis_deviation
+    from .scenarios import POSE_METHODS
+
+    methods = list(scenario.methods if methods is None else methods)
+    for method in methods:
+        if method not in POSE_METHODS:
+            raise ValueError(f"method {method!r} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
+    labels = scenario.labels
+    demo = scenario.demonstration
+    n_steps = demo.shape[0]
+    scene = scenario.scene if geometry else None
+    references = {label: resample_time(scenario.reference(label)[:, :3], n_steps) for label in labels}
+    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
+
+    def result(name, rollouts, seconds):
+        positions = {label: rollout[:, :3] for label, rollout in zip(labels, rollouts)}
+        orientations = {label: rollout[:, 3:] for label, rollout in zip(labels, rollouts)}
+        targets = {label: scenario.targets[label][:3] for label in labels}
+        errors = {label: endpoint_error(positions[label], targets[label]) for label in labels}
+        approach = deviations = None
+        if scenario.approach_height is not None:
+            approach = {label: approach_error(positions[label], targets[label], scenario.approach_height,
+                                              scenario.target_axis(label)) for label in labels}
+            deviations = {label: axis_deviation(positions[label], orientations[label], targets[label],
+                                                scenario.approach_height, scenario.target_axis(label)) for label in labels}
+        differences = {label: path_difference(positions[label], references[label]) for label in labels}
+        clearances = None
+        if scene is not None:
+            clearances = {label: scene.clearance(positions[label], exclude=excluded[label], orientations=orientations[label])
+                          if scene.applies_to(label) else None for label in labels}
+        return MethodResult(name, positions, seconds, errors, approach, differences, scenario.success_threshold,
+                            n_steps, clearances, orientations, deviations, scenario.alignment_threshold)
+
+    report = Report(scenario=scenario, methods={})
+    with _Timer() as dmp_time:
+        cartesian = CartesianDMP(**scenario.dmp).fit(demo)
+        plain = [cartesian.rollout(scenario.targets[label]) for label in labels]
+    failed = [label for label, rollout in zip(labels, plain)
+              if np.linalg.norm(rollout[-1, :3] - scenario.targets[label][:3]) > scenario.success_threshold]
+    report.failed_targets = failed
+    model = None
+    for method in methods:
+        if progress is not None:
+            progress(method)
+        if method == "dmp":
+            report.methods[method] = result(method, plain, dmp_time.seconds)
+            continue
+        if model is None:
+            with _Timer() as timer:
+                model = CartesianBiDMP(cartesian, **scenario.bidmp)
+                previous = None
+                options = {k: v for k, v in scenario.extension.items() if k != "approach"}
+                for stage in scenario.extensions:
+                    target = _resolve_target(stage["target"], scenario, failed)
+                    if target is None:
+                        continue
+                    source = demo if stage["from"] == "demonstration" or previous is None else previous
+                    stage_scene = scenario.scene if stage.get("in_scene", True) else None
+                    extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene,
+                                                          **options)
+                    previous = extension.poses
+                    model.learn(previous)
+                    report.extensions.append(extension)
+                    report.extension_targets.append(target[:3])
+                for demonstration in scenario.demonstrations.values():
+                    model.learn(demonstration)
+            model_seconds = dmp_time.seconds + timer.seconds
+            report.model = model
+        skill = "nearest" if method == "bidmp" else "latest"
+        with _Timer() as timer:
+            rollouts = [model.rollout(scenario.targets[label], skill=skill) for label in labels]
+        report.methods[method] = result(method, rollouts, model_seconds + timer.seconds)
+    return report
+
+
+def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
+    """Write ``results.json`` and the three figures of a report into folder ``out`` (created if
+    needed); return the paths written."""
+    from ..io.files import atomic_write
+    from ..plotting.figures import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with atomic_write(out / "results.json", "w") as handle:
+        json.dump(report.to_dict(), handle, indent=2)
+    return [out / "results.json",
+            plot_targets_top_view(out / "targets_top_view.png", report),
+            plot_error_vs_distance(out / "error_vs_distance.png", report),
+            plot_scenario_3d(out / "scenario_3d.png", report)]

@@ -1,0 +1,108 @@
+"""Metrics of generated trajectories (SPEC §9), in the trajectories' own length unit.
+
+RMSE and extent live in the private helper module ``bidmp._trajectory`` and are re-exported here
+for users.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import as_point, as_trajectory, check_real
+from .._trajectory import path_extent, rmse
+
+__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area"]
+
+
+def endpoint_error(trajectory, target) -> float:
+    """Distance between the last point of ``trajectory`` (n, D) and ``target`` (D,)."""
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+    return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
+
+
+def approach_error(trajectory, target, height: float, axis=None) -> float:
+    """Largest horizontal distance from the target's vertical axis while the trajectory is less
+    than ``height`` above the target (SPEC §9). 0 if it never comes that low.
+
+    Parameters
+    ----------
+    trajectory : array (n, 3)
+    target : array (3,)
+    height : float
+        Height of the band above the target (e.g. the socket's 28.5 mm groove).
+    axis : array (3,), optional
+        The target's axis, pointing out of it (a tilted nut's); default +z. Height is measured
+        along it and the distance across it.
+    """
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+    if trajectory.shape[1] != 3:
+        raise ValueError(f"approach_error needs a 3-D trajectory (z is the height), got D = {trajectory.shape[1]}")
+    target = as_point(target, 3, "target")
+    height = check_real(height, "height", positive=True)
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
+    offsets = trajectory - target
+    along = offsets @ axis
+    low = along < height
+    if not np.any(low):
+        return 0.0
+    return float(np.max(np.linalg.norm(offsets[low] - np.outer(along[low], axis), axis=1)))
+
+
+def _unit_axis(axis) -> np.ndarray:
+    axis = as_point(axis, 3, "axis")
+    norm = np.linalg.norm(axis)
+    if norm < 1e-12:
+        raise ValueError("axis must not be zero")
+    return axis / norm
+
+
+def axis_deviation(trajectory, orientations, target, height: float, axis=None) -> float:
+    """Largest angle (degrees) between the tool's axis and the target's axis while the tool is
+    less than ``height`` above the target (along ``axis``, default +z); 0 if it never comes
+    that low. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
+    pointing into the target, so a perfect approach has it opposite ``axis``."""
+    from scipy.spatial.transform import Rotation
+
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+    q = np.asarray(orientations, dtype=float)
+    if q.shape != (trajectory.shape[0], 4):
+        raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), got {q.shape}")
+    target = as_point(target, 3, "target")
+    height = check_real(height, "height", positive=True)
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
+    low = (trajectory - target) @ axis < height
+    if not np.any(low):
+        return 0.0
+    tool_axes = Rotation.from_quat(q[low]).apply([0.0, 0.0, 1.0])
+    cosines = np.clip(tool_axes @ -axis, -1.0, 1.0)
+    return float(np.degrees(np.max(np.arccos(cosines))))
+
+
+def path_difference(trajectory, reference) -> float:
+    """The paper's "difference": ``Σ_l ‖y_l − ref_l‖`` over the reference's samples.
+
+    Only the first ``len(reference)`` samples of ``trajectory`` are compared (a run to
+    convergence goes on afterwards; squeezing it into T samples would compare different times).
+    """
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+    reference = as_trajectory(reference, "reference", min_points=1, allow_static=True)
+    if trajectory.shape[0] < reference.shape[0] or trajectory.shape[1] != reference.shape[1]:
+        raise ValueError(f"trajectory {trajectory.shape} must cover reference {reference.shape}: at least as many "
+                         f"samples, the same D")
+    return float(np.sum(np.linalg.norm(trajectory[: reference.shape[0]] - reference, axis=1)))
+
+
+def swept_area(trajectory, reference) -> float:
+    """Swept error area (Khansari-Zadeh & Billard's CLF-DM benchmark): the sum over
+    time-aligned steps of the areas of the quadrilaterals ``r_l, r_{l+1}, y_{l+1}, y_l`` between a
+    2-D trajectory and its reference (shoelace formula, absolute value per quadrilateral).
+    Both (T, 2), same T; in the trajectories' unit squared."""
+    trajectory = as_trajectory(trajectory, "trajectory", min_points=2, allow_static=True)
+    reference = as_trajectory(reference, "reference", min_points=2, allow_static=True)
+    if trajectory.shape != reference.shape or trajectory.shape[1] != 2:
+        raise ValueError(f"swept_area needs two 2-D trajectories of the same length, got {trajectory.shape} and "
+                         f"{reference.shape}")
+    corners = np.stack([reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1)  # (T-1, 4, 2)
+    x, y = corners[..., 0], corners[..., 1]
+    twice = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+    return float(np.sum(np.abs(twice)) / 2.0)

@@ -1,0 +1,527 @@
+"""Scenario files: a task as JSON (SPEC §9–10), validated strictly, with built-in scenarios.
+
+A scenario names the targets (labelled points), the demonstration and which target it shows, the
+success threshold, the DMP parameters and how Bi-DMP extends the skill. Unknown keys, wrong types,
+missing targets, or a demonstrated label that is not a target are errors naming the key.
+
+Keys (units: millimetres for the battery scenarios)::
+
+    name                 str, required
+    description          str
+    units                str, default "mm"
+    targets              {label: [x, y(, z)]}, required, at least one
+    demonstrated         label of the demonstrated target, required
+    demonstration        exactly one of {"minimum_jerk": {"via", "n_steps", "noise", "seed"}},
+                         {"points": [[x, y(, z)], ...]} (at least 10) or {"file": "demo.csv"}
+                         (relative to the scenario file, and inside its folder unless
+                         ``allow_outside_files``)
+    success_threshold    end-point error for success, default 1.75
+    approach_height      height band above a target for the approach error, default 28.5;
+                         null turns the approach metric off
+    alignment_threshold  pose scenarios (targets and demonstration x, y, z, qx, qy, qz, qw):
+                         the largest angle in degrees between the tool's axis and the target's
+                         over the approach height, default 2
+    dmp                  DMP parameters (alpha, beta, K, alpha_phase, tau, n_kernels, regression,
+                         widths, derivatives)
+    bidmp                Bi-DMP parameters (n_windows, n_mapped, n_enhance, increments, shrink, reg,
+                         seed, derivatives)
+    extension            extended-demonstration options of bidmp.extend_demonstration (approach
+                         "keep" (default) or "paper", eps_frac, method, n_samples, sigma_rel,
+                         n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare,
+                         select, denom)
+    extension_target     "centre_of_failed" (default), a target label, or a point
+    extensions           list of {"target": as extension_target, "from": "demonstration" |
+                         "previous"}: chained extended demonstrations (overrides extension_target)
+    demonstrations       {label: demonstration}: further demonstrations learned directly by Bi-DMP
+                         (several operators); a target with the same label uses it as reference
+    methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
+    seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
+    robot                {"base": [x, y, z], "yaw": degrees}: where bidmp sim puts the Panda
+    scene                geometry of the work cell: tool and parts (see bidmp.geometry); with it
+                         the evaluation reports clearance, collisions and task success, and the
+                         extensions (approach "keep") are grown around the parts. A stage of
+                         "extensions" with "in_scene": false is grown without it (a skill of an
+                         earlier task, before these parts were there).
+
+Loading validates everything ``evaluate`` will need, so a scenario that loads also runs: the DMP
+is fitted on the demonstration (unstable integration, oversized settings and degenerate
+demonstrations are refused), rolled out to every target, and the Bi-DMP and extension options
+are checked.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+from dataclasses import dataclass, field
+from importlib import resources
+from numbers import Integral, Real
+from pathlib import Path
+
+import numpy as np
+
+from .._checks import check_limit, get_limits, short_token
+from ..demonstrations.datasets import minimum_jerk
+from ..scene.geometry import Scene, SceneError
+from ..io.files import load_json, read_trajectory
+
+__all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
+
+METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
+POSE_METHODS = ("dmp", "bidmp", "bidmp-latest")  # what a pose scenario (D = 7) can run
+POSE_DIMS = 7  # x, y, z, qx, qy, qz, qw
+_KEYS = {
+    "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
+    "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
+    "seed", "scene", "robot", "alignment_threshold",
+}
+_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
+             "goal_rate"}
+_BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
+_EXTENSION_KEYS = {
+    "approach", "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
+    "scaling", "compare", "select", "denom",
+}
+_MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
+
+
+class ScenarioError(ValueError):
+    """A scenario file is malformed; the message names the key."""
+
+
+@dataclass
+class Scenario:
+    """A validated scenario. ``spec`` is the JSON form (``to_dict``); arrays are resolved."""
+
+    name: str
+    targets: dict[str, np.ndarray]
+    demonstrated: str
+    demonstration: np.ndarray
+    success_threshold: float
+    approach_height: float | None
+    dmp: dict
+    bidmp: dict
+    extension: dict
+    extensions: list[dict]
+    demonstrations: dict[str, np.ndarray]
+    methods: list[str]
+    seed: int
+    units: str = "mm"
+    description: str = ""
+    spec: dict = field(default_factory=dict, repr=False)
+    scene: Scene | None = None
+    alignment_threshold: float = 2.0  # degrees: a pose scenario's tool axis vs the target's over the approach
+    robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
+    base_dir: str = "."  # where "file" demonstrations were read from
+
+    @property
+    def labels(self) -> list[str]:
+        return list(self.targets)
+
+    @property
+    def is_pose(self) -> bool:
+        """Whether targets and demonstration are poses (x, y, z, qx, qy, qz, qw)."""
+        return self.demonstration.shape[1] == POSE_DIMS
+
+    def target_axis(self, label: str) -> np.ndarray | None:
+        """A pose target's axis, pointing out of it (the tool comes in along minus it); None for
+        position targets (the evaluation then uses +z)."""
+        if not self.is_pose:
+            return None
+        from scipy.spatial.transform import Rotation
+
+        return -Rotation.from_quat(self.targets[label][3:]).apply([0.0, 0.0, 1.0])
+
+    @property
+    def target_array(self) -> np.ndarray:
+        return np.stack(list(self.targets.values()))
+
+    def to_dict(self) -> dict:
+        """The scenario as JSON-ready data (round-trips through :func:`from_dict`)."""
+        return copy.deepcopy(self.spec)
+
+    def reference(self, label: str) -> np.ndarray:
+        """A reference demonstration to target ``label`` "produced by the same generator"
+        (SPEC §9): its own demonstration if one is given, else the demonstration generator with
+        its via points moved by the target offset, else the demonstration translated."""
+        if label in self.demonstrations:
+            return self.demonstrations[label]
+        offset = self.targets[label] - self.targets[self.demonstrated]
+        if self.is_pose:  # positions moved, orientations kept (only positions are compared)
+            moved = self.demonstration.copy()
+            moved[:, :3] += offset[:3]
+            return moved
+        generator = self.spec["demonstration"].get("minimum_jerk")
+        if generator is not None:
+            via = np.asarray(generator["via"], dtype=float) + offset
+            return minimum_jerk(via, generator.get("n_steps", 200), generator.get("noise", 0.0), generator.get("seed", 0))
+        return self.demonstration + offset
+
+
+# ---------------------------------------------------------------------------------------------
+# Validation
+# ---------------------------------------------------------------------------------------------
+_MIN_DEMONSTRATION = 10  # samples: what segmentation (and so the extension) needs
+
+
+def _fail(source: str, key: str, message: str):
+    raise ScenarioError(f"scenario {source}: {key}: {message}")
+
+
+def _shown(value) -> str:
+    """A rejected JSON value, quoted short (never a whole file's worth)."""
+    try:
+        text = json.dumps(value)
+    except (TypeError, ValueError):
+        text = type(value).__name__
+    return text if len(text) <= 24 else short_token(text, 20)
+
+
+def _number(value, source, key, positive=False):
+    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value):
+        _fail(source, key, f"expected a number, got {_shown(value)}")
+    if positive and value <= 0:
+        _fail(source, key, f"must be > 0, got {value}")
+    if abs(value) > get_limits().max_abs_value:
+        _fail(source, key, f"{value:.3g} is beyond the limit max_abs_value = {get_limits().max_abs_value:g}")
+    return float(value)
+
+
+def _point(value, source, key, n_dims=None):
+    if not isinstance(value, list) or not value or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value):
+        _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {_shown(value)}")
+    if len(value) > get_limits().max_dims:
+        _fail(source, key, f"has {len(value)} coordinates, more than the limit max_dims = {get_limits().max_dims}")
+    point = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(point)):
+        _fail(source, key, "contains a non-finite number")
+    if np.max(np.abs(point)) > get_limits().max_abs_value:
+        _fail(source, key, f"has a coordinate beyond the limit max_abs_value = {get_limits().max_abs_value:g} "
+                           f"(raise it with bidmp.set_limits(max_abs_value=...))")
+    if n_dims is not None and point.shape[0] != n_dims:
+        _fail(source, key, f"has {point.shape[0]} coordinates, expected {n_dims}")
+    return point
+
+
+def _points(value, source, key, n_dims=None, minimum=2):
+    if not isinstance(value, list) or len(value) < minimum:
+        _fail(source, key, f"expected a list of at least {minimum} points")
+    if len(value) > get_limits().max_samples:
+        _fail(source, key, f"{len(value):,} points exceed the limit max_samples = {get_limits().max_samples:,}")
+    points = [_point(p, source, f"{key}[{i}]", n_dims) for i, p in enumerate(value)]
+    if len({p.shape[0] for p in points}) != 1:
+        _fail(source, key, "points have different numbers of coordinates")
+    return np.stack(points)
+
+
+def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outside: bool) -> Path:
+    """Resolve a file named in a scenario; unless allowed, it must lie inside the scenario's
+    folder once ``..`` and symlinks are resolved."""
+    if allow_outside:
+        return path
+    base = Path(os.path.realpath(base_dir))
+    resolved = Path(os.path.realpath(path))
+    if os.path.isabs(body) or os.path.commonpath([base, resolved]) != str(base):
+        _fail(source, key, f"{short_token(body, 40)} lies outside the scenario's folder {base}; files are read from "
+                           f"there only (allow_outside_files=True, or 'bidmp ... --allow-outside-files', lifts this)")
+    return resolved
+
+
+def _prepared_file(path, units: str) -> np.ndarray:
+    """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
+    trimmed, filtered, uniform time); a declared unit must be the scenario's."""
+    from ..io.files import declared_units
+    from ..demonstrations.prepare import prepare
+
+    declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
+    if declared and units and declared != units:
+        raise ValueError(f"{path} is in {declared} (declared in the file) but the scenario is in {units}")
+    y, t = read_trajectory(path)
+    return y if t is None else prepare(y, t)[0].y
+
+
+def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):
+    if not isinstance(value, dict) or len(value) != 1:
+        _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
+    (kind, body), = value.items()
+    if kind == "minimum_jerk":
+        if not isinstance(body, dict):
+            _fail(source, f"{key}.minimum_jerk", "expected an object")
+        unknown = sorted(set(body) - _MINIMUM_JERK_KEYS)
+        if unknown:
+            _fail(source, f"{key}.minimum_jerk.{unknown[0]}", f"unknown key (known: {', '.join(sorted(_MINIMUM_JERK_KEYS))})")
+        if "via" not in body:
+            _fail(source, f"{key}.minimum_jerk.via", "missing")
+        via = _points(body["via"], source, f"{key}.minimum_jerk.via")
+        n_steps = body.get("n_steps", 200)
+        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < _MIN_DEMONSTRATION:
+            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= {_MIN_DEMONSTRATION}, got {_shown(n_steps)}")
+        if n_steps > get_limits().max_samples:
+            _fail(source, f"{key}.minimum_jerk.n_steps", f"{n_steps:,} exceeds the limit max_samples = {get_limits().max_samples:,}")
+        noise = _number(body.get("noise", 0.0), source, f"{key}.minimum_jerk.noise")
+        if noise < 0:
+            _fail(source, f"{key}.minimum_jerk.noise", "must be >= 0")
+        seed = body.get("seed", 0)
+        if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**63:
+            _fail(source, f"{key}.minimum_jerk.seed", f"expected an integer in [0, 2**63), got {_shown(seed)}")
+        try:
+            return minimum_jerk(via, int(n_steps), noise, int(seed))
+        except (TypeError, ValueError) as exc:
+            _fail(source, f"{key}.minimum_jerk", str(exc))
+    if kind == "points":
+        points = _points(body, source, f"{key}.points", minimum=_MIN_DEMONSTRATION)
+        if not np.any(points != points[0]):
+            _fail(source, f"{key}.points", "all points are identical: there is no motion to learn")
+        return points
+    if kind == "file":
+        if not isinstance(body, str) or not body or "\x00" in body:
+            _fail(source, f"{key}.file", "expected a file name")
+        path = _inside(Path(body) if os.path.isabs(body) else Path(base_dir) / body, base_dir, source, f"{key}.file",
+                       body, allow_outside)
+        try:
+            trajectory = _prepared_file(path, units)
+        except (TypeError, ValueError, OSError) as exc:
+            _fail(source, f"{key}.file", str(exc))
+        if trajectory.shape[0] < _MIN_DEMONSTRATION:
+            _fail(source, f"{key}.file", f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}")
+        return trajectory
+    _fail(source, key, f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)")
+
+
+def _extension_target(value, source, key, targets, n_dims):
+    if value == "centre_of_failed":
+        return value
+    if isinstance(value, str):
+        if value not in targets:
+            _fail(source, key, f"{value!r} is neither 'centre_of_failed' nor a target label")
+        return value
+    return _point(value, source, key, n_dims).tolist()
+
+
+def _parameters(data, key, known, source, check) -> dict:
+    """A parameter object (``dmp``, ``bidmp``, ``extension``): known names only, checked by
+    ``check(params)`` where given."""
+    params = data.get(key, {})
+    if not isinstance(params, dict):
+        _fail(source, key, "expected an object of parameters")
+    if key == "dmp" and "fit" in params:
+        _fail(source, "dmp.fit", "renamed to 'regression' (\"lwr\" or \"ridge\")")
+    bad = sorted(set(params) - known)
+    if bad:
+        _fail(source, f"{key}.{bad[0]}", f"unknown parameter (known: {', '.join(sorted(known))})")
+    params = dict(params)
+    if "increments" in params and isinstance(params["increments"], list):
+        params["increments"] = tuple(params["increments"])
+    if check is not None:
+        try:
+            check(params)
+        except (TypeError, ValueError) as exc:
+            _fail(source, key, str(exc))
+    return params
+
+
+def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *,
+              allow_outside_files: bool = False) -> Scenario:
+    """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`.
+
+    ``"file"`` demonstrations are read relative to ``base_dir`` and must lie inside it (after
+    resolving ``..`` and symlinks) unless ``allow_outside_files`` is true.
+    """
+    if not isinstance(data, dict):
+        raise ScenarioError(f"scenario {source}: expected a JSON object at the top level")
+    unknown = sorted(set(data) - _KEYS)
+    if unknown:
+        _fail(source, short_token(unknown[0], 30)[1:-1], f"unknown key (known: {', '.join(sorted(_KEYS))})")
+    for key in ("name", "targets", "demonstrated", "demonstration"):
+        if key not in data:
+            _fail(source, key, "missing (required)")
+    if not isinstance(data["name"], str) or not data["name"]:
+        _fail(source, "name", "expected a non-empty string")
+    for key in ("description", "units"):
+        if key in data and not isinstance(data[key], str):
+            _fail(source, key, "expected a string")
+    from .._units import UNITS
+
+    units = data.get("units", "mm")
+    if units not in UNITS:
+        _fail(source, "units", f"expected one of {', '.join(UNITS)}, got {_shown(units)}")
+
+    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
+    n_dims = demonstration.shape[1]
+    if n_dims == POSE_DIMS:
+        demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
+    if not isinstance(data["targets"], dict) or not data["targets"]:
+        _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
+    if len(data["targets"]) > get_limits().max_targets:
+        _fail(source, "targets", f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}")
+    targets = {str(label): _point(point, source, f"targets.{label}", n_dims) for label, point in data["targets"].items()}
+    if n_dims == POSE_DIMS:
+        targets = {label: _pose_points(point[None], source, f"targets.{label}", generated=False)[0]
+                   for label, point in targets.items()}
+    demonstrated = data["demonstrated"]
+    if not isinstance(demonstrated, str) or demonstrated not in targets:
+        _fail(source, "demonstrated", f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
+                                      f"{', …' if len(targets) > 10 else ''})")
+
+    threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
+    alignment = _number(data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True)
+    approach = data.get("approach_height", 28.5)
+    approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
+
+    from ..primitives.dmp import DMP
+    from ..incremental.bidmp import BiDMP
+
+    dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
+    bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
+    from ..extension.extend import check_extension_options
+
+    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: check_extension_options(**params))
+
+    if "extensions" in data:
+        if not isinstance(data["extensions"], list) or not data["extensions"]:
+            _fail(source, "extensions", "expected a non-empty list of {target, from}")
+        extensions = []
+        for index, stage in enumerate(data["extensions"]):
+            key = f"extensions[{index}]"
+            if not isinstance(stage, dict) or set(stage) - {"target", "from", "in_scene"} or "target" not in stage:
+                _fail(source, key, 'expected {"target": ..., "from": "demonstration" | "previous", "in_scene": true | false}')
+            origin = stage.get("from", "demonstration" if index == 0 else "previous")
+            if origin not in ("demonstration", "previous") or (index == 0 and origin == "previous"):
+                _fail(source, f"{key}.from", f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}")
+            in_scene = stage.get("in_scene", True)
+            if not isinstance(in_scene, bool):
+                _fail(source, f"{key}.in_scene", f"expected true or false, got {_shown(in_scene)}")
+            extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims),
+                               "from": origin, "in_scene": in_scene})
+        check_limit(len(extensions), "max_targets", "the number of extensions")
+    else:
+        target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
+        extensions = [{"target": target, "from": "demonstration", "in_scene": True}]
+
+    extra = data.get("demonstrations", {})
+    if not isinstance(extra, dict):
+        _fail(source, "demonstrations", "expected an object {label: demonstration}")
+    demonstrations = {}
+    check_limit(len(extra), "max_targets", "the number of further demonstrations")
+    for label, spec in extra.items():
+        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir, allow_outside_files, units)
+        if trajectory.shape[1] != n_dims:
+            _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
+        demonstrations[str(label)] = trajectory
+
+    methods = data.get("methods", list(METHODS))
+    if not isinstance(methods, list) or not methods or not all(isinstance(m, str) for m in methods):
+        _fail(source, "methods", "expected a non-empty list of method names")
+    for method in methods:
+        if method not in METHODS:
+            _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(METHODS)})")
+        if n_dims == POSE_DIMS and method not in POSE_METHODS:
+            _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
+    seed = data.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
+        _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
+
+    scene = None
+    if "scene" in data:
+        if n_dims not in (3, POSE_DIMS):
+            _fail(source, "scene", f"needs 3-D positions or poses (D = 7), these have D = {n_dims}")
+        try:
+            scene = Scene.from_dict(data["scene"], targets)
+        except SceneError as exc:
+            raise ScenarioError(f"scenario {source}: {exc}") from None
+        except ImportError as exc:
+            raise type(exc)(f"scenario {source}: {exc}") from None
+
+    robot = data.get("robot", {})
+    if not isinstance(robot, dict) or set(robot) - {"base", "yaw"}:
+        _fail(source, "robot", 'expected {"base": [x, y, z], "yaw": degrees} (where bidmp sim puts the arm)')
+    robot = dict(robot)
+    if "base" in robot:
+        robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
+    if "yaw" in robot:
+        robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
+
+    _check_runs(source, demonstration, targets, dmp)
+    return Scenario(
+        name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
+        success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
+        extensions=extensions,
+        demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
+        units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
+        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment,
+    )
+
+
+def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_params: dict) -> None:
+    """What ``evaluate`` does first, so that a scenario that loads also runs: fit the DMP on
+    the demonstration and roll it out to every target (about a millisecond)."""
+    from ..primitives.dmp import DMP
+
+    try:
+        if demonstration.shape[1] == POSE_DIMS:
+            from ..primitives.cartesian import CartesianDMP
+
+            model = CartesianDMP(**dmp_params).fit(demonstration)
+            for goal in targets.values():
+                model.rollout(goal)
+        else:
+            DMP(**dmp_params).fit(demonstration).rollout_many(np.stack(list(targets.values())))
+    except (TypeError, ValueError) as exc:
+        _fail(source, "dmp", f"the DMP cannot run on this demonstration: {exc}")
+
+
+def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> np.ndarray:
+    """Pose rows (x, y, z, qx, qy, qz, qw): quaternions must be unit (a generator's are
+    normalised: it interpolates them component by component)."""
+    quaternions = points[:, 3:]
+    norms = np.linalg.norm(quaternions, axis=1)
+    if np.any(norms < 1e-9):
+        _fail(source, key, "a quaternion is zero, which is no rotation")
+    if generated:
+        points = points.copy()
+        points[:, 3:] = quaternions / norms[:, None]
+    elif np.any(np.abs(norms - 1.0) > 1e-6):
+        _fail(source, key, f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})")
+    return points
+
+
+# ---------------------------------------------------------------------------------------------
+# Built-ins and loading
+# ---------------------------------------------------------------------------------------------
+def _builtin_dir():
+    return resources.files("bidmp").joinpath("data", "scenarios")
+
+
+def builtin_names() -> list[str]:
+    """Names of the built-in scenarios (nut-unscrewing, nut-unscrewing-tilted, cell-removal, pick-and-place)."""
+    return sorted(entry.name[:-5] for entry in _builtin_dir().iterdir() if entry.name.endswith(".json"))
+
+
+def builtin_text(name: str) -> str:
+    """The JSON text of a built-in scenario (for ``bidmp scenario show NAME > my.json``)."""
+    if name not in builtin_names():
+        raise ScenarioError(f"unknown built-in scenario {name!r}; built-ins: {', '.join(builtin_names())}")
+    return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
+
+
+def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) -> Scenario:
+    """Load a scenario from a JSON file, or a built-in by name, and validate it completely.
+
+    ``allow_outside_files``: let ``"file"`` demonstrations name files outside the scenario's
+    folder (absolute paths, ``..``, symlinks out of it); off by default.
+    """
+    if not isinstance(path_or_name, (str, os.PathLike)):
+        raise TypeError(f"path_or_name must be a file name or a built-in name, got {type(path_or_name).__name__}")
+    text_name = str(path_or_name)
+    if not text_name.endswith(".json") and text_name in builtin_names():
+        return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")
+    path = Path(path_or_name)
+    if not path.is_file():
+        raise ScenarioError(f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})")
+    try:
+        check_limit(path.stat().st_size, "max_json_bytes", f"the size of scenario {path} in bytes")
+        data = load_json(path.read_bytes(), f"scenario {path}")
+    except (OSError, ValueError) as exc:
+        raise ScenarioError(str(exc) if str(exc).startswith("scenario") else f"scenario {path}: {exc}") from None
+    return from_dict(data, source=str(path), base_dir=path.parent, allow_outside_files=allow_outside_files)
