@@ -183,7 +183,7 @@ def test_the_exact_integrator_is_the_continuous_system():
     def system(time, state):
         y, z = state[:3], state[3:]
         phase = np.exp(-params.alpha_phase * time / unit)
-        gate = dmp._progress_gate_at(np.array([phase]), params)[0]
+        gate = dmp.goal_system(params).on_grid(np.array([phase]), 0.0, params.tau, params.exact)[0]
         forcing = dmp.forcing_term(np.array([phase]))[0]
         drive = params.alpha * (params.beta * (goal - y) - z) + params.K * (forcing - gate * (goal - start))
         return np.concatenate([z, drive]) / unit

@@ -17,7 +17,9 @@ import types
 
 # old module path -> the new modules that hold its names, searched in order
 OLD_PATHS: dict[str, tuple[str, ...]] = {
-    "bidmp.dmp": ("bidmp.primitives.dmp", "bidmp.primitives.integrate"),
+    "bidmp.dmp": ("bidmp.primitives.dmp", "bidmp.primitives.canonical", "bidmp.primitives.forcing",
+                  "bidmp.primitives.integrate", "bidmp.primitives.stepper", "bidmp.primitives.protocols",
+                  "bidmp.primitives.goals"),
     "bidmp.timing": ("bidmp.primitives.timing", "bidmp.demonstrations.prepare"),
     "bidmp.cartesian": ("bidmp.primitives.cartesian", "bidmp.incremental.cartesian", "bidmp.demonstrations.prepare",
                         "bidmp.primitives.so3", "bidmp.primitives.pose_timing"),

@@ -41,7 +41,8 @@ from .._checks import (
 from .._trajectory import resample_time, rmse
 from .._state import Prefixed as _Prefixed
 from .bls import BLS
-from ..primitives.dmp import DMP, forcing_target
+from ..primitives.dmp import DMP
+from ..primitives.forcing import forcing_target
 
 __all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
 
@@ -371,14 +372,14 @@ class BiDMP(BaseEstimator):
 
     @numerically_guarded
     def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
-                   *, limits: dict | None = None):
+                   *, limits: dict | None = None, coupling=None):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
-        with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²)."""
+        with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms as there."""
         _, goal, start, increment = self._skill_query(goal, skill, start)
         return self.dmp_.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
-                                    forcing_increment=increment)
+                                    forcing_increment=increment, coupling=coupling)
 
-    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *, coupling: float = 0.0):
+    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *, coupling=0.0):
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
         _, goal, start, increment = self._skill_query(goal, skill, start)
         return self.dmp_.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)

@@ -12,7 +12,7 @@ from sklearn.base import BaseEstimator, clone
 from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
 from ..primitives.cartesian import CartesianDMP, _parts_from_state, _parts_state, _pose_parts, _pose_params, _read_poses_state
 from .bidmp import BiDMP
-from ..primitives.so3 import principal_log, angle_between, as_quaternions, continuous_log, nearest_turn, orientation_from_log
+from ..primitives.so3 import principal_log, angle_between, as_quaternions, nearest_turn, orientation_from_log
 from ..primitives.pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
 
 __all__ = ["CartesianBiDMP", "pose_forgetting"]
@@ -159,16 +159,17 @@ class CartesianBiDMP(BaseEstimator):
 
     @numerically_guarded
     def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None,
-                   dt: float | None = None, *, limits: dict | None = None) -> PoseTrajectory:
+                   dt: float | None = None, *, limits: dict | None = None, coupling=None) -> PoseTrajectory:
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment = self.position_._skill_query(goal_p, index, start_p)
         _, _, start_e, orientation_increment = self.orientation_._skill_query(np.zeros(3), index, start_e)
         return pose_trajectory(self.position_.dmp_, self.orientation_.dmp_, goal_p, start_p, goal_q, start_e,
-                                duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_)
+                                duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
+                                coupling)
 
     def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
-                coupling: float = 0.0) -> "PoseStepper":
+                coupling=0.0) -> PoseStepper:
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
                            self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)

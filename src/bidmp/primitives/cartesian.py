@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import logging
 import numpy as np
-from sklearn.base import BaseEstimator, clone
+from sklearn.base import BaseEstimator
 
 from .._state import Prefixed
 from .._checks import as_point, as_trajectory, check_fitted, check_loaded, numerically_guarded
@@ -41,7 +41,8 @@ from .so3 import (
 )
 from .pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
 from .._trajectory import continuous_quaternions
-from .dmp import DMP, arclength_progress
+from .dmp import DMP
+from .goals import arclength_progress
 
 __all__ = ["CartesianDMP", "PoseStepper", "PoseTrajectory",
            "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "left_jacobian", "angle_between"]
@@ -175,7 +176,8 @@ class CartesianDMP(BaseEstimator):
 
     @numerically_guarded
     def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
-                   limits: dict | None = None, position_increment=None, orientation_increment=None) -> PoseTrajectory:
+                   limits: dict | None = None, position_increment=None, orientation_increment=None,
+                   coupling=None) -> PoseTrajectory:
         """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
 
         Parameters
@@ -187,10 +189,13 @@ class CartesianDMP(BaseEstimator):
         limits : dict, optional
             Position limits as :meth:`bidmp.DMP.trajectory` (``max_velocity`` ... in units/s);
             the orientation follows the same timing.
+        coupling : list of coupling terms, optional
+            Added to the position part's acceleration (units/s², see :meth:`bidmp.DMP.trajectory`);
+            both parts then run the step integrator.
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         return pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
-                                limits, position_increment, orientation_increment, self.units_)
+                                limits, position_increment, orientation_increment, self.units_, coupling)
 
     def rollout(self, goal=None, start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) on the DMP's sample grid (as :meth:`bidmp.DMP.rollout`)."""
@@ -199,7 +204,7 @@ class CartesianDMP(BaseEstimator):
         error = self.orientation_.rollout(np.zeros(3), start_e, n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
-    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling: float = 0.0) -> "PoseStepper":
+    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling=0.0) -> PoseStepper:
         """A step-by-step integrator for a control loop; phase stopping on the position error."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         return PoseStepper(self.position_.stepper(goal_p, start_p, duration, coupling=coupling),

@@ -1,4 +1,19 @@
-"""The robot protocol's goal system and rest start (issue 19).
+"""Goal systems: how a DMP's goal enters its input, as small objects a DMP composes.
+
+A goal system gives the goal gate ``G`` of ``u = αβ g + K f - K G (g - y0)`` on a rollout grid
+(:meth:`on_grid`), one control step at a time (:meth:`follow`), and on the training grid (what
+the forcing target subtracts):
+
+* :class:`PhaseGate` — ``G = ϑ``: the paper's Eq. 10 (``K = α``) and, with ``K = αβ``, Pastor's
+  smooth scaling (movement_primitives' ``smooth_scaling=True``);
+* :class:`DelayedGoal` — ``G`` decays at its own rate (Kulvicius 2012's delayed goal);
+* :class:`ProgressGate` — the robot protocol's: the goal's share follows the demonstration's own
+  progress along its path (below), learned at ``fit``.
+
+A new goal system is one more class with these three methods, chosen in
+``bidmp.primitives.dmp.goal_system``.
+
+**The robot protocol's progress gate.**
 
 A DMP's goal enters its input through the goal gate ``G``: ``u = αβ g + K f - K G (g - y0)``. The
 motion's response to a change of goal is then ``R(t) (g' - g)``, a scalar *goal share* ``R``
@@ -22,30 +37,21 @@ the last ``w``. Against the demonstration scaled to the new goal, ``y_g + σ (g'
 differs by at most that share of ``‖g' - g‖``: for a straight demonstration and a nearer goal
 this is the largest overshoot; a minimum-jerk start makes ``σ(w) ≈ 10 (0.15)³ = 3 %`` and the
 overshoot itself is far smaller (``σ (1 - S)`` peaks near ``w/2``).
-
-**Rest start.** A robot starts at rest; a prepared recording starts at the sensor's noise floor
-(1.6 mm/s for the bundled ones) and a user's demonstration may start at speed. The learned
-trajectory is the demonstration with its start (and end) velocity blended out,
-``y - v₀ t (1 - S(t / w₀))``, over the shortest window ``w₀`` in which the blend's acceleration
-stays within 10 % of the demonstration's own peak acceleration so far (at most a quarter of the
-motion). Its acceleration and jerk at the start are the demonstration's (``S`` is flat to third
-order), so the rollout starts at rest with the demonstrated acceleration and without ringing.
 """
 
 from __future__ import annotations
 
-import logging
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["GOAL_BLEND", "smoothstep", "goal_share", "goal_gate", "rest_started"]
+from .._trajectory import arclength
+from .canonical import phase_grid
 
-logger = logging.getLogger(__name__)
+__all__ = ["GOAL_BLEND", "smoothstep", "smoothstep_derivatives", "goal_share", "goal_gate", "euler_progress_gate",
+           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate"]
 
 GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
-REST_BLEND_SHARE = 0.1  # the rest blend adds at most this share of the demonstration's acceleration
-REST_BLEND_MAX = 0.25  # the rest blend never spans more than this share of the demonstration
-_REST_CANDIDATES = np.geomspace(0.01, REST_BLEND_MAX, 32)
 
 
 def smoothstep(u: np.ndarray) -> np.ndarray:
@@ -55,7 +61,7 @@ def smoothstep(u: np.ndarray) -> np.ndarray:
     return u**4 * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)))
 
 
-def _smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """First and second derivative of :func:`smoothstep` (0 outside [0, 1])."""
     inside = (u > 0.0) & (u < 1.0)
     first = np.where(inside, 140.0 * u**3 * (1.0 - u) ** 3, 0.0)
@@ -97,56 +103,99 @@ def goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: flo
     return gate
 
 
-# The rest blend's acceleration is -v₀ q''(t/w) / w with q(u) = u (1 - S(u)), q'' = -2S' - u S'':
-# its shape on [0, 1] does not depend on the window, so it is tabulated once.
-_BLEND_U = np.linspace(0.0, 1.0, 65)
-_BLEND_SHAPE = np.abs(2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1])
+def euler_progress_gate(progress: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
+    """The progress gate of model format 3's robot protocol (``integrator="euler"``): the exact
+    inverse of the Euler-discretised spring for the target response ``σ`` delayed by two samples.
 
-
-def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float) -> float:
-    """The shortest window (normalised time) over which blending ``speed_vector`` out adds at most
-    ``REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
-    speed = float(np.linalg.norm(speed_vector))
-    if speed <= 1e-12 * max(peak, 1e-300):
-        return 0.0
-    running = np.maximum.accumulate(np.linalg.norm(acceleration, axis=1))
-    # All candidate windows at once: (candidates, 65) added accelerations against the running peak.
-    added = speed * _BLEND_SHAPE[None, :] / _REST_CANDIDATES[:, None]
-    index = np.minimum((_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1)
-    within = np.all(added <= REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
-    return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(REST_BLEND_MAX)
-
-
-def rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
-                 unit: str = "units") -> np.ndarray:
-    """``y`` (T, D) with its start and end velocity blended out (module docstring).
-
-    Parameters
-    ----------
-    y : array (T, D)
-        The demonstration on its uniform grid.
-    dt : float
-        Normalised step (``1 / T``).
-    duration_s : float
-        Seconds per unit of normalised time (for the log message).
-    what, unit : str
-        What the trajectory is and its length unit, for the log message.
+    The spring cannot respond before then (``y[1] = y[0]``), and the delay makes ``gate[0] = 1``,
+    so the initial acceleration does not depend on the goal (nor on the start).
     """
-    velocity = np.gradient(y, dt, axis=0)
-    acceleration = np.gradient(velocity, dt, axis=0)
-    peak = float(np.max(np.linalg.norm(velocity, axis=1)))
-    s = np.arange(y.shape[0]) * dt
-    out = y.copy()
-    for end, speed_vector, forward in ((False, velocity[0], acceleration), (True, velocity[-1], acceleration[::-1])):
-        width = _blend_window(speed_vector, forward, dt, peak)
-        if width == 0.0:
-            continue
-        elapsed = (s[-1] - s) if end else s
-        blend = elapsed * (1.0 - smoothstep(elapsed / width))
-        out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
-        speed = float(np.linalg.norm(speed_vector))
-        level = logging.WARNING if speed > 0.05 * peak else logging.DEBUG
-        logger.log(level, "%s %s at %.3g %s/s (%.1f %% of its peak speed); the DMP %s at rest, blended over %.3g s",
-                   what, "ends" if end else "starts", speed / duration_s, unit, 100 * speed / peak,
-                   "ends" if end else "starts", width * duration_s)
-    return out
+    response = np.concatenate([np.zeros(2), progress[:-2]])  # σ delayed by two samples
+    h = dt
+    a1 = -(2.0 - h * alpha)
+    a2 = 1.0 - h * alpha + h * h * alpha * beta
+    drive = (response[2:] + a1 * response[1:-1] + a2 * response[:-2]) / (h * h)  # = αβ − K gate
+    gate = np.empty_like(progress)
+    gate[:-2] = (alpha * beta - drive) / K
+    gate[-2:] = gate[-3]  # the last two drives never reach the rollout (y[n] depends on u[n-2])
+    return gate
+
+
+def arclength_progress(y: np.ndarray) -> np.ndarray:
+    """Arc-length progress ``σ`` (0 → 1) of a trajectory (n, D); a static one has none (zeros)."""
+    arc = arclength(y)
+    return arc / arc[-1] if arc[-1] > 0.0 else np.zeros_like(arc)
+
+
+# -- goal systems ----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class DelayedGoal:
+    """``G`` decays at ``rate`` (per normalised time), like the phase does at ``alpha_phase``."""
+
+    rate: float
+
+    def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
+        """The gate at a rollout grid's samples (``step`` apart in normalised time)."""
+        return phase_grid(phase.shape[0], step, tau, self.rate, exact=exact)
+
+    def training_gate(self, n_train: int, dt: float, exact: bool) -> np.ndarray:
+        """The gate on the training grid (``tau = 1``)."""
+        return phase_grid(n_train, dt, 1.0, self.rate, exact=exact)
+
+    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        """The gate one control step of ``step`` (normalised time) after ``gate``."""
+        return gate * (float(np.exp(-self.rate * step / tau)) if exact else 1.0 - self.rate * (step / tau))
+
+
+@dataclass(frozen=True)
+class PhaseGate(DelayedGoal):
+    """``G = ϑ``: a delayed goal whose rate is the phase's own (Eq. 10; Pastor's smooth scaling with
+    ``K = αβ``). It is the phase itself, so it costs nothing."""
+
+    def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
+        return phase
+
+    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        return phase
+
+
+@dataclass(frozen=True, eq=False)
+class ProgressGate:
+    """The robot protocol's gate, learned at ``fit``: ``gate`` (n_train,) on the training grid of
+    phases ``training_phase`` (n_train,), decreasing), looked up by phase at any other grid."""
+
+    training_phase: np.ndarray
+    gate: np.ndarray
+    _lookup: tuple = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # np.interp wants increasing abscissae: the reversed grid, built once (a control loop
+        # asks for one phase per step).
+        object.__setattr__(self, "_lookup", (self.training_phase[::-1], self.gate[::-1]))
+
+    @staticmethod
+    def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
+              progress: np.ndarray | None = None) -> np.ndarray:
+        """The gate on the training grid for a demonstration as learned, ``train`` (n_train, D)
+        (exact: the smooth goal share's continuous inverse; Euler: :func:`euler_progress_gate`).
+        ``progress`` replaces the demonstration's own arc-length progress (a part that does not
+        move follows another's)."""
+        n_train = train.shape[0]
+        progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+        if progress.shape != (n_train,):
+            raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+        if not exact:
+            return euler_progress_gate(progress, dt, alpha=alpha, beta=beta, K=K)
+        return goal_gate(goal_share(progress, n_motion, dt), dt, alpha=alpha, beta=beta, K=K)
+
+    def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
+        return np.interp(phase, *self._lookup)
+
+    def training_gate(self, n_train: int, dt: float, exact: bool) -> np.ndarray:
+        """The learned gate itself (the training grid is the one it was learned on)."""
+        if n_train != self.gate.shape[0]:
+            raise ValueError(f"the progress gate was learned on {self.gate.shape[0]} samples, not {n_train}")
+        return self.gate
+
+    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        return float(np.interp(phase, *self._lookup))

@@ -13,7 +13,12 @@ an input ``u``. In normalised time ``s`` with ``z = tau dy/ds``::
   agrees with its own-rate rollout to about 1e-6 of its extent).
 
 Both run as a second-order recursion in ``y`` through :func:`scipy.signal.lfilter` (C), for many
-input signals at once: this is what makes rollouts to many goals cost one integration.
+input signals at once: this is what makes rollouts to many goals cost one integration (the *fast
+path*: :func:`unit_responses`, :func:`affine_rollouts`).
+
+State feedback (a coupling term that depends on where the system is) cannot go through a filter:
+:class:`StepIntegrator` takes the same exact (or Euler) steps one at a time and adds coupling
+accelerations. With no coupling term it equals the fast path to rounding (``tests/test_dmp.py``).
 """
 
 from __future__ import annotations
@@ -25,8 +30,10 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.signal import lfilter
 
-__all__ = ["euler_spectral_radius", "check_euler_stable", "euler_responses", "foh_step", "exact_responses",
-           "exact_state"]
+from .canonical import phase_decay
+
+__all__ = ["euler_spectral_radius", "check_euler_stable", "check_integration", "euler_responses", "foh_step",
+           "exact_responses", "exact_state", "unit_responses", "affine_rollouts", "StepIntegrator"]
 
 
 # -- explicit Euler --------------------------------------------------------------------------------
@@ -197,3 +204,99 @@ def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float,
     acceleration -= alpha * z
     acceleration /= tau**2
     return z, acceleration
+
+
+# -- the fast path: unit responses and affine rollouts ---------------------------------------------
+def check_integration(step: float, params) -> None:
+    """Refuse a normalised step for which the Euler spring diverges or the Euler phase (or an
+    exponentially delayed goal) does not decay; ``params`` a DMP's resolved parameters. The exact
+    integrator is stable at any step."""
+    if params.integrator != "euler":
+        return
+    check_euler_stable(step, params.tau, params.alpha, params.beta)
+    phase_decay(step, params.tau, params.alpha_phase)
+    if params.goal_rate is not None:
+        phase_decay(step, params.tau, params.goal_rate)
+
+
+def unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step: float,
+                   gate: np.ndarray | None = None) -> np.ndarray:
+    """Responses that compose every rollout on the grid ``phase`` (n samples ``step`` apart).
+
+    ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
+    dimension, returned when ``forcing`` (n, D) is given); otherwise the rows are ``B`` (the
+    goal's share of the input, through the goal gate ``gate`` (n,)), ``C`` (the start's, with
+    ``y[0] = y[1] = 1``) and ``V`` (the free response to a unit start velocity, ``y[1] = step``),
+    shape (3, n). ``params`` are a DMP's resolved parameters.
+    """
+    alpha, beta, K = params.alpha, params.beta, params.K
+    exact = params.integrator == "exact"
+    n_steps = phase.shape[0]
+    # Euler's y[n] depends on u[n-2] at the latest; the exact step uses u[n] too.
+    n_inputs = n_steps if exact else max(n_steps - 2, 0)
+    if forcing is not None:
+        drives = K * forcing[:n_inputs].T
+        y_first = second = np.zeros(drives.shape[0])
+    else:
+        # The goal enters through alpha beta g - K gate (g - y0).
+        gate = gate[:n_inputs]
+        drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
+        y_first = np.array([0.0, 1.0, 0.0])
+        # The second state: Euler's y[1] (a unit start velocity moves it by one step), or
+        # the exact integrator's z = tau dy/ds.
+        second = np.array([0.0, 0.0, params.tau]) if exact else np.array([0.0, 1.0, step])
+    if exact:
+        return exact_responses(drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau)
+    responses = euler_responses(drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta)
+    return responses[:, :n_steps]
+
+
+def affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray,
+                    out: np.ndarray | None = None) -> np.ndarray:
+    """``y[i] = free + B goals[i]`` for every goal at once, (G, n, D), written into ``out`` if given."""
+    out = np.multiply(goal_response[None, :, None], goals[:, None, :], out=out)
+    out += free[None]
+    return out
+
+
+# -- one step at a time --------------------------------------------------------------------------
+class StepIntegrator:
+    """The transformation system ``tau dz/ds = u - αβ y - α z``, ``tau dy/ds = z``, one step at a time.
+
+    The same steps as the fast path: exact with the input linear over the step
+    (:func:`foh_step`), or explicit Euler. What the fast path cannot take is an input that depends
+    on the state: here the caller adds it to ``u`` before each step (coupling terms, see
+    :mod:`bidmp.primitives.coupling`).
+
+    Parameters
+    ----------
+    alpha, beta, tau : float
+        Gains and temporal scaling of the system.
+    exact : bool
+        First-order-hold exact steps (any step is stable) or explicit Euler (refused beyond its
+        stability bound).
+    """
+
+    def __init__(self, alpha: float, beta: float, tau: float, exact: bool) -> None:
+        self.alpha, self.beta, self.tau, self.exact = alpha, beta, tau, exact
+        self._checked_step = None
+
+    def acceleration(self, y: np.ndarray, z: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """``d²y/ds²`` (normalised time) of the state ``(y, z)`` under the input ``u``."""
+        return (u - self.alpha * self.beta * y - self.alpha * z) / self.tau**2
+
+    def step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
+             step: float) -> tuple[np.ndarray, np.ndarray]:
+        """The state ``step`` (normalised time) later; ``u_next`` (the input at the step's end) is
+        read by the exact step only."""
+        alpha, beta, tau = self.alpha, self.beta, self.tau
+        if self.exact:
+            transition, now, after = foh_step(step, alpha, beta, tau)
+            state = transition @ np.stack([y, z]) + np.outer(now, u_now) + np.outer(after, u_next)
+            return state[0], state[1]
+        h = step / tau
+        if h != self._checked_step:
+            check_euler_stable(step, tau, alpha, beta)
+            self._checked_step = h
+        z_next = z + h * (u_now - alpha * beta * y - alpha * z)
+        return y + h * z, z_next

@@ -76,12 +76,15 @@ def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.n
 
 
 def pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
-                     position_increment, orientation_increment, units) -> PoseTrajectory:
-    """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise)."""
-    position = position_model.trajectory(goal_p, start_p, duration, dt, limits=limits, forcing_increment=position_increment)
+                     position_increment, orientation_increment, units, coupling=None) -> PoseTrajectory:
+    """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
+    ``coupling`` terms act on the position part, and both parts then run the step integrator."""
+    position = position_model.trajectory(goal_p, start_p, duration, dt, limits=limits, forcing_increment=position_increment,
+                                         coupling=coupling)
     if limits:  # the orientation follows the motion time the position's limits chose
         duration = position.t[-1] / position_model._params().settle
-    error = orientation_model.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment)
+    error = orientation_model.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment,
+                                         coupling=None if coupling is None else [])
     n = min(len(position.t), len(error.t))
     orientation = orientation_from_log(error.y[:n], goal_q)
     omega, omega_dot = _angular_rates(error.y[:n], error.yd[:n], error.ydd[:n])

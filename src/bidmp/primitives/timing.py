@@ -13,8 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_trajectory, check_choice, check_real, numerically_guarded
-from .._units import check_units
+from .._checks import check_choice, numerically_guarded
 
 __all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "scale_factor",
            "time_scale"]

@@ -1,0 +1,177 @@
+"""The DMP's parameters and its two protocols (README "Protocols"): what the unset parameters
+resolve to, validated in one place.
+
+* ``robot`` (default): a DMP a robot can run — ``K = αβ``, the progress gate, the exact
+  integrator, the demonstration learned from rest, ridge weights, ``alpha_phase = 4``, 100 kernels,
+  ``alpha = 50`` and a horizon of 1.1x the demonstration;
+* ``paper``: the paper's — ``K = α``, the phase gate, explicit Euler, LWR, ``alpha_phase = 1``,
+  50 kernels, ``alpha = 25``, exactly T samples.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from .._checks import NotFittedError, check_choice, check_fitted, check_int, check_real
+
+__all__ = ["Params", "FittedParams", "resolve_params", "with_rest", "PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
+           "ROBOT_SETTLE", "GAIN_RANGE", "TAU_RANGE"]
+
+K_CHOICES = ("paper", "pastor")
+REGRESSION_CHOICES = ("lwr", "ridge")
+DERIVATIVE_CHOICES = ("gradient", "forward")
+WIDTH_CHOICES = ("spacing", "pydmps")
+# Gains (alpha, beta, alpha_phase in 1/s; K) and tau (s) outside these ranges have no physical use
+# and take float64 out of its range in the forcing target (division by K) or the integration.
+GAIN_RANGE = (1e-6, 1e6)
+TAU_RANGE = (1e-6, 1e6)
+
+
+class Params(NamedTuple):
+    """The validated hyperparameters of a :class:`DMP` (``beta``, ``K``, ``alpha_phase`` and
+    ``goal_rate`` resolved to numbers for the protocol)."""
+
+    n_kernels: int
+    alpha: float
+    beta: float
+    K: float
+    alpha_phase: float
+    tau: float
+    regression: str
+    derivatives: str
+    ridge: float
+    widths: str
+    protocol: str
+    goal_rate: float | None  # None: the goal follows the demonstration's progress (robot default)
+    integrator: str  # "exact" (first-order hold, any rate) or "euler" (the paper's Eq. 14)
+    settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
+
+    @property
+    def exact(self) -> bool:
+        return self.integrator == "exact"
+
+    @property
+    def rest_start(self) -> bool:
+        """Whether the demonstration is learned with its start and end velocity blended out
+        (:func:`bidmp.primitives.rest.rest_started`): the robot protocol with the exact integrator."""
+        return self.integrator == "exact" and self.protocol == "robot"
+
+
+# The two protocols (README "Protocols"): what the unset parameters resolve to.
+PROTOCOLS = ("robot", "paper")
+INTEGRATOR_CHOICES = ("exact", "euler")
+# robot: K = alpha beta (Pastor 2009: the initial acceleration does not depend on the goal or the
+# start), a goal share that follows the demonstration's progress with smooth ends
+# (bidmp._goals), the exact integrator (the same motion at any control rate), the demonstration
+# learned from rest (its start velocity blended out), a phase that decays to e^-4 over the
+# demonstration, 100 kernels fitted by ridge regression, a stiffer spring (alpha = 50), and a
+# horizon of 1.1x the demonstrated duration. The weights are learned on the demonstration
+# followed by rest at its goal for that extra 0.1: the learned forcing term then holds the goal
+# at the end instead of extrapolating the last kernel. The README's "Robot protocol" section
+# has the measurements (tests/test_timing.py holds them).
+ROBOT_ALPHA = 50.0
+ROBOT_KERNELS = 100
+ROBOT_ALPHA_PHASE = 4.0
+ROBOT_SETTLE = 1.1
+
+
+def resolve_params(estimator) -> Params:
+    """The validated parameters of a :class:`bidmp.DMP` (or anything with its constructor's
+    parameters) as they are now, the protocol's defaults filled in; raise naming the first bad one."""
+    protocol = check_choice(estimator.protocol, "protocol", PROTOCOLS)
+    robot = protocol == "robot"
+    alpha = (ROBOT_ALPHA if robot else 25.0) if estimator.alpha is None else \
+        check_real(estimator.alpha, "alpha", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+    beta = alpha / 4.0 if estimator.beta is None else check_real(estimator.beta, "beta", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+    K_choice = ("pastor" if robot else "paper") if estimator.K is None else estimator.K
+    if isinstance(K_choice, str):
+        check_choice(K_choice, "K", K_CHOICES)
+        K = alpha if K_choice == "paper" else alpha * beta
+    else:
+        K = check_real(K_choice, "K", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1] ** 2)
+    if estimator.alpha_phase is None:
+        alpha_phase = ROBOT_ALPHA_PHASE if robot else 1.0
+    else:
+        alpha_phase = check_real(estimator.alpha_phase, "alpha_phase", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+    if estimator.goal_rate is None:
+        goal_rate = None if robot else alpha_phase
+    else:
+        goal_rate = check_real(estimator.goal_rate, "goal_rate", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+    return Params(
+        n_kernels=(ROBOT_KERNELS if robot else 50) if estimator.n_kernels is None else
+        check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
+        alpha=alpha,
+        beta=beta,
+        K=K,
+        alpha_phase=alpha_phase,
+        tau=check_real(estimator.tau, "tau", positive=True, minimum=TAU_RANGE[0], maximum=TAU_RANGE[1]),
+        regression=("ridge" if robot else "lwr") if estimator.regression is None else
+        check_choice(estimator.regression, "regression", REGRESSION_CHOICES),
+        derivatives=check_choice(estimator.derivatives, "derivatives", DERIVATIVE_CHOICES),
+        ridge=check_real(estimator.ridge, "ridge", nonnegative=True, maximum=1e6),
+        widths=check_choice(estimator.widths, "widths", WIDTH_CHOICES),
+        protocol=protocol,
+        goal_rate=goal_rate,
+        integrator=("exact" if robot else "euler") if estimator.integrator is None else
+        check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES),
+        settle=ROBOT_SETTLE if robot else 1.0,
+    )
+
+
+def with_rest(y: np.ndarray, params: Params) -> np.ndarray:
+    """``y`` followed by rest at its last point for the protocol's settle time (robot: 0.1 T)."""
+    n_rest = int(round(params.settle * y.shape[0])) - y.shape[0]
+    if n_rest <= 0:
+        return y
+    return np.vstack([y, np.repeat(y[-1:], n_rest, axis=0)])
+
+
+class FittedParams:
+    """Mixin of an estimator whose learned state depends on its parameters (all but ``tau``):
+    a parameter changed after ``fit`` makes it unfitted (:class:`bidmp.NotFittedError` names it)."""
+
+    _fitted_attribute = "weights_"
+
+    @classmethod
+    def _raw_param_names(cls) -> tuple[str, ...]:
+        """The constructor's parameters but tau, as given (compared first: cheap)."""
+        return tuple(name for name in cls._get_param_names() if name != "tau")
+
+    def _learned_params(self) -> Params:
+        """The resolved parameters the weights depend on (all but tau, which only scales time)."""
+        return self._params()._replace(tau=1.0)
+
+    def _raw_params(self) -> tuple:
+        return tuple(getattr(self, name) for name in self._raw_param_names())
+
+    def _remember_params(self) -> None:
+        self._learned_with = (self._raw_params(), self._learned_params())
+
+    def _stale_params(self) -> list[str]:
+        """The learned-with parameters that have changed since ``fit`` (with their values)."""
+        learned = self.__dict__.get("_learned_with")
+        if learned is None:
+            return []
+        raw, resolved = learned
+        try:
+            if self._raw_params() == raw:  # the common case, without resolving the protocol's defaults
+                return []
+        except (TypeError, ValueError):  # an array set by mistake: resolving names it
+            pass
+        now = self._learned_params()
+        return [f"{name} (fitted with {before!r}, now {after!r})" for name, before, after in zip(now._fields, resolved, now)
+                if before != after]
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return self._fitted_attribute in self.__dict__ and not self._stale_params()
+
+    def _check_fitted(self) -> None:
+        check_fitted(self, self._fitted_attribute)
+        stale = self._stale_params()
+        if stale:
+            raise NotFittedError(
+                f"this DMP's {', '.join(stale)} changed after fit: the weights were learned with the old value, "
+                f"so the model must be fitted again (only tau may change after fit)"
+            )

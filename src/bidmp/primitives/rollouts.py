@@ -1,0 +1,55 @@
+"""Rollouts to many goals at once: the rollout is affine in the goal, ``y = free + B g``, so G goals
+cost one integration and one outer product (:meth:`bidmp.DMP.rollout_many`,
+:meth:`bidmp.DMP.iter_rollouts`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import as_points, check_bytes, get_limits
+from .integrate import affine_rollouts
+
+__all__ = ["rollouts_to", "iter_rollouts_to", "chunks"]
+
+
+def rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """The rollouts ``free + B goals[i]`` (G, n, D) of a model's free response ``free`` (n, D) and
+    goal response ``goal_response`` (n,), into ``out`` if given (else refused over the limit
+    ``max_array_bytes``)."""
+    goals = as_points(goals, free.shape[1], "goals")
+    shape = (goals.shape[0], *free.shape)
+    if out is None:
+        n_bytes = 8 * goals.shape[0] * free.size
+        budget = get_limits().max_array_bytes
+        if n_bytes > budget:
+            chunk = max(budget // (8 * free.size), 1)
+            raise ValueError(
+                f"rollout_many: {goals.shape[0]:,} goals x {free.shape[0]:,} steps x {free.shape[1]} dims would take "
+                f"{n_bytes / 2**30:.3g} GiB in one array, over the limit max_array_bytes = {budget / 2**30:.3g} GiB; "
+                f"write into a file with out=numpy.lib.format.open_memmap(path, mode='w+', dtype='float64', "
+                f"shape={shape}), iterate with iter_rollouts(goals, chunk_size={chunk:,}), or raise the limit "
+                f"with bidmp.set_limits(max_array_bytes=...)"
+            )
+        return affine_rollouts(goal_response, goals, free)
+    if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
+        described = f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
+        raise ValueError(f"out must be a writable float64 array of shape {shape}, got {described}")
+    for first, chunk in chunks(goals, free):
+        affine_rollouts(goal_response, chunk, free, out[first : first + chunk.shape[0]])
+    return out
+
+
+def chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
+    """``(first, goals[first : first + chunk_size])``; by default about 64 MiB of rollouts a chunk."""
+    if chunk_size is None:
+        chunk_size = max((64 << 20) // (8 * free.size), 1)  # about 64 MiB per chunk
+    for first in range(0, goals.shape[0], chunk_size):
+        yield first, goals[first : first + chunk_size]
+
+
+def iter_rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, chunk_size: int):
+    """:func:`rollouts_to`, ``chunk_size`` goals at a time: yields ``(first, y (g, n, D))``."""
+    goals = as_points(goals, free.shape[1], "goals")
+    check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
+    for first, chunk in chunks(goals, free, chunk_size):
+        yield first, affine_rollouts(goal_response, chunk, free)

@@ -1,0 +1,121 @@
+"""The control-loop stepper: a DMP (or a Bi-DMP skill) integrated one control step at a time,
+with coupling terms (:mod:`bidmp.primitives.coupling`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import as_point, check_real
+from .coupling import as_couplings
+from .forcing import basis_row
+from .integrate import StepIntegrator
+from .protocols import TAU_RANGE
+
+__all__ = ["DMPStepper"]
+
+
+class DMPStepper:
+    """Integrates a DMP (or a Bi-DMP skill) one control step at a time.
+
+    ``step(dt, y_measured=None)`` returns the command ``(y, yd, ydd)`` for the current sample (units,
+    units/s, units/s²) and advances the state by ``dt`` seconds. Without coupling terms the
+    commands equal :meth:`DMP.trajectory` sample for sample (the same integration steps, exact or
+    Euler). Coupling terms (``coupling``: a list of ``coupling(t, y, yd, phase) -> acceleration``)
+    add their acceleration over each step. A number as ``coupling`` is the gain of phase
+    stopping (:class:`bidmp.primitives.coupling.PhaseStopping`): with a measurement the system's
+    time runs ``1 + coupling ‖y_measured - y‖²`` times slower, so a robot held back makes the
+    command pause where it is, and the motion resumes once it catches up.
+
+    Attributes
+    ----------
+    phase : float
+        The canonical state ``ϑ``.
+    time : float
+        The motion's own time in seconds (slower than the wall clock while paused).
+    """
+
+    def __init__(self, dmp, goal, start, duration, coupling, start_velocity, forcing_increment) -> None:
+        dmp._check_fitted()
+        params = dmp._params()
+        self._dmp = dmp
+        n_dims = dmp.n_dims_
+        self.goal = dmp.goal_.copy() if goal is None else as_point(goal, n_dims, "goal")
+        self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
+        motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
+        self._scale = check_real(motion / dmp.duration_, "duration / duration_ (the temporal scaling)",
+                                 minimum=TAU_RANGE[0], maximum=TAU_RANGE[1])  # tau of the normalised system
+        self._params = params._replace(tau=self._scale)
+        self._couplings, self._temporal = as_couplings(coupling)
+        self._forcing_increment = forcing_increment
+        self.y = self.start.copy()
+        velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
+        # What every step reads, taken once: a control loop should not revalidate the model.
+        self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
+        self._goal_system = dmp.goal_system(self._params)
+        self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
+        self._last_input = None  # (phase, gate, goal, start, u): the end of one step starts the next
+        self.phase = 1.0
+        self._gate = 1.0
+        self._gate = self._goal_system.follow(1.0, 1.0, 0.0, self._scale, params.exact)
+        self.time = 0.0
+
+    @property
+    def coupling(self) -> float:
+        """The phase-stopping gain (0 without phase stopping)."""
+        return sum(getattr(term, "gain", 0.0) for term in self._temporal)
+
+    def _input(self, phase: float, gate: float) -> np.ndarray:
+        """The system's input ``u = αβ g + K f(phase) - K gate (g - y0)`` (D,)."""
+        last = self._last_input
+        if (last is not None and last[0] == phase and last[1] == gate and np.array_equal(last[2], self.goal)
+                and np.array_equal(last[3], self.start)):
+            return last[4]
+        params = self._params
+        basis = basis_row(phase, self._centres, self._widths)
+        forcing = basis @ self._weights
+        if self._forcing_increment is not None:
+            forcing = forcing + self._forcing_increment(np.array([phase]), basis)
+        value = params.alpha * params.beta * self.goal + params.K * (forcing[0] - gate * (self.goal - self.start))
+        self._last_input = (phase, gate, self.goal.copy(), self.start.copy(), value)
+        return value
+
+    def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The command for now, then advance ``dt`` seconds (less while the robot lags).
+
+        Returns
+        -------
+        (y, yd, ydd) : arrays (D,)
+            Position (units), velocity (units/s) and acceleration (units/s²) to command.
+        """
+        dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
+        params = self._params
+        time_unit = self._dmp.time_unit_
+        slowdown = 1.0
+        for term in self._temporal:
+            slowdown *= term.slowdown(self.y, y_measured)
+        step = dt / time_unit / slowdown  # the normalised time this control step advances
+        alpha, beta, tau = params.alpha, params.beta, params.tau
+        input_now = self._input(self.phase, self._gate)  # not cached: goal and start are public
+        position = self.y.copy()
+        # The command's velocity and acceleration, as trajectory() reports them: the system's own.
+        velocity = self._z / (tau * time_unit) / slowdown
+        if self._couplings:
+            # An acceleration a (units/s²) enters the input as a (tau T slowdown)², held over the step.
+            pushed = sum(np.asarray(term(self.time, position, velocity, self.phase), dtype=np.float64)
+                         for term in self._couplings)
+            push = pushed * (tau * time_unit * slowdown) ** 2
+            if not np.all(np.isfinite(push)):
+                raise ValueError("a coupling term returned a non-finite acceleration")
+            input_now = input_now + push
+        acceleration = (input_now - alpha * beta * self.y - alpha * self._z) / (tau * time_unit * slowdown) ** 2
+        decay_phase = float(np.exp(-params.alpha_phase * step / tau)) if params.exact else 1.0 - params.alpha_phase * (step / tau)
+        phase = self.phase * decay_phase
+        gate = self._goal_system.follow(self._gate, phase, step, tau, params.exact)
+        input_next = self._input(phase, gate) if params.exact else input_now
+        if self._couplings and params.exact:
+            input_next = input_next + push
+        self.y, self._z = self._integrator.step(self.y, self._z, input_now, input_next, step)
+        self.phase, self._gate = phase, gate
+        self.time += dt / slowdown
+        return position, velocity, acceleration

@@ -1,0 +1,134 @@
+"""Timed rollouts of a DMP: positions, velocities and accelerations in seconds at any rate
+(:meth:`bidmp.DMP.trajectory`), within velocity, acceleration and jerk limits, and through the
+step integrator when coupling terms are given."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._checks import as_point, check_int, check_real, get_limits
+from .._units import check_reach
+from .integrate import exact_state
+from .protocols import TAU_RANGE, Params
+from .stepper import DMPStepper
+from .timing import Trajectory, scale_factor
+
+__all__ = ["timed_trajectory", "coupled_trajectory", "limited_trajectory", "time_grid", "exact_rates"]
+
+
+def time_grid(dmp, duration, dt, params: Params) -> tuple[float, float, int, float]:
+    """(motion duration s, sample period s, number of samples, normalised step) of a timed
+    rollout; the motion's duration defaults to ``tau · duration_``, the period to the
+    demonstration's."""
+    motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
+    period = dmp.duration_ / (dmp.n_steps_ - 1)
+    dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)  # 1 MHz at most
+    if dt > motion:
+        raise ValueError(f"dt = {dt:g} s is longer than the motion ({motion:g} s)")
+    scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched
+    check_real(scale, "duration / duration_ (the temporal scaling)", minimum=TAU_RANGE[0], maximum=TAU_RANGE[1])
+    if params.protocol == "paper" and duration is None and dt == period:
+        n_samples = max(int(round(params.tau * dmp.n_steps_)), 1)  # the rollout's own samples
+    else:
+        samples = params.settle * motion / dt * (1 + 1e-12)
+        check_real(samples, "the trajectory's samples (duration / dt)", maximum=get_limits().max_steps)
+        n_samples = int(np.floor(samples)) + 1  # never past settle x motion
+    check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
+    step = dmp.dt_ if dt == period else dt / dmp.time_unit_
+    return motion, dt, n_samples, step
+
+
+def timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment):
+    """The fast path of :meth:`bidmp.DMP.trajectory` (no limits, no coupling terms)."""
+    params = dmp._params()
+    motion, dt, n_samples, step = time_grid(dmp, duration, dt, params)
+    params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
+    velocity = None if start_velocity is None else as_point(start_velocity, dmp.n_dims_, "start_velocity") * dmp.time_unit_
+    # Two extra samples give the last velocity and acceleration as forward differences (Euler),
+    # one the last exact state.
+    free, goal_response, forcing, gate = dmp._prepare(start, velocity, n_samples + 2, forcing_increment,
+                                                       params=params, step=step)
+    goal = dmp.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+    if dmp.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
+        check_reach(float(min(np.linalg.norm(goal - dmp.goal_), np.linalg.norm(goal - dmp.start_))), dmp.units_,
+                    "the goal")
+    positions = free + np.outer(goal_response, goal)
+    if params.exact:
+        start = dmp.start_ if start is None else as_point(start, free.shape[1], "start")
+        velocities, accelerations = exact_rates(params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_)
+    else:
+        velocities = np.diff(positions, axis=0) / dt
+        accelerations = np.diff(velocities, axis=0) / dt
+    return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
+                      accelerations[:n_samples], dmp.units_)
+
+
+def exact_rates(params: Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float) -> tuple:
+    """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
+    n out): the system's own state and acceleration, from the positions and the input."""
+    inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
+    inputs -= np.multiply.outer(gate, params.K * (goal - start))
+    inputs += params.alpha * params.beta * goal
+    z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau)
+    # The first state is given, not solved for: a rest start is exactly at rest.
+    z[0] = 0.0 if velocity is None else params.tau * velocity
+    acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
+    return z / (params.tau * time_unit), acceleration / time_unit**2
+
+
+def limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
+    """The trajectory within ``limits``: at the nominal duration if that meets them (limits
+    are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
+    shortest duration that does: scale by the exact factor of
+    :func:`bidmp.primitives.timing.scale_factor`, then bisect for what the discretisation changes."""
+    if not isinstance(limits, dict):
+        raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
+                        f"got {type(limits).__name__}")
+    unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm", "fastest"}
+    if unknown:
+        raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, "
+                         f"max_jerk, norm, fastest")
+    limits = dict(limits)
+    fastest = limits.pop("fastest", False)
+    if not isinstance(fastest, (bool, np.bool_)):
+        raise TypeError(f"limits['fastest'] must be True or False, got {type(fastest).__name__}")
+
+    def attempt(duration):
+        trajectory = dmp.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
+                                     forcing_increment=forcing_increment)
+        return trajectory, scale_factor(trajectory, **limits)
+
+    # The exact factor first (speed ~ 1/k, acceleration ~ 1/k²), then a bisection in log
+    # duration for what re-integrating at another step changes: the result meets every
+    # limit and touches the binding one within 0.1 %.
+    duration = dmp._params().tau * dmp.duration_
+    trajectory, factor = attempt(duration)
+    if factor <= 1.0 and not fastest:
+        return trajectory  # within the limits as demonstrated: a cap does not hurry it
+    low = high = best = None  # durations known to break / to meet the limits
+    for _ in range(60):
+        if 1.0 - 1e-3 <= factor <= 1.0:
+            return trajectory
+        if factor > 1.0:
+            low = duration
+        else:
+            high, best = duration, trajectory
+        if low is not None and high is not None:
+            duration = float(np.sqrt(low * high))
+        else:
+            duration *= factor * (1.0 + 1e-4) if factor > 1.0 else factor
+        trajectory, factor = attempt(duration)
+    return trajectory if factor <= 1.0 or best is None else best
+
+
+def coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling) -> Trajectory:
+    """:meth:`bidmp.DMP.trajectory` through the step integrator, with coupling terms: the same
+    samples as :func:`timed_trajectory` (to rounding) when the terms add nothing."""
+    params = dmp._params()
+    motion, dt, n_samples, _ = time_grid(dmp, duration, dt, params)
+    stepper = DMPStepper(dmp, goal, start, motion, coupling, start_velocity, forcing_increment)
+    states = [stepper.step(dt) for _ in range(n_samples)]
+    y, yd, ydd = (np.array([state[k] for state in states]) for k in range(3))
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(ydd))):
+        raise ValueError("trajectory: the coupled integration is not finite; a coupling term is out of range")
+    return Trajectory(np.arange(n_samples) * dt, y, yd, ydd, dmp.units_)

@@ -1,0 +1,82 @@
+"""The methods registry: every way bidmp can learn a task, one small class in one file each.
+
+Evaluation (:func:`bidmp.evaluate`), the LASA benchmark (``bidmp benchmark lasa``) and the
+simulator (``bidmp sim``) look methods up here by name, so a new method is one file and one
+:func:`register` call::
+
+    from bidmp.tasks.methods import Method, register
+
+    class StraightLine(Method):
+        name = "line"
+        def fit(self, task):
+            return task.demonstration[0], 0.0
+        def rollout(self, start, goal):
+            return start + np.linspace(0, 1, 100)[:, None] * (goal - start)
+
+    register(StraightLine())
+
+Layer 2 (tasks): a method may import the math; the registry imports the built-in methods lazily.
+"""
+
+from __future__ import annotations
+
+from .base import Method, Task
+
+__all__ = ["Method", "Task", "register", "unregister", "get", "names"]
+
+_REGISTRY: dict[str, Method] = {}
+_BUILTINS_LOADED = False
+
+
+def _load_builtins() -> None:
+    """Register the built-in methods (once, on first use: importing them needs NumPy)."""
+    global _BUILTINS_LOADED
+    if _BUILTINS_LOADED:
+        return
+    _BUILTINS_LOADED = True
+    # Each module registers its methods; the order is the order names() lists them in.
+    from . import dmp  # noqa: F401
+    from . import dmp_converged  # noqa: F401
+    from . import bidmp  # noqa: F401
+    from . import gmm  # noqa: F401
+    from . import tpgmm  # noqa: F401
+    from . import mp_dmp  # noqa: F401
+
+
+def register(method: Method, *, replace: bool = False) -> Method:
+    """Add ``method`` under ``method.name``; a name taken by another method is refused unless
+    ``replace``."""
+    _load_builtins()
+    if not isinstance(method, Method):
+        raise TypeError(f"method must be a bidmp.tasks.methods.Method, got {type(method).__name__}")
+    name = method.name
+    if not isinstance(name, str) or not name or not name.replace("-", "").replace("_", "").isalnum():
+        raise ValueError(f"method.name must be a non-empty name of letters, digits, '-' and '_', got {name!r:.40}")
+    if name in _REGISTRY and _REGISTRY[name] is not method and not replace:
+        raise ValueError(f"a method named {name!r} is registered already (pass replace=True to replace it)")
+    _REGISTRY[name] = method
+    return method
+
+
+def unregister(name: str) -> None:
+    """Remove the method ``name`` (a test's own, say)."""
+    _load_builtins()
+    _REGISTRY.pop(name, None)
+
+
+def get(name: str) -> Method:
+    """The method registered as ``name``; a ``ValueError`` lists the known ones otherwise."""
+    _load_builtins()
+    if not isinstance(name, str) or name not in _REGISTRY:
+        shown = name if isinstance(name, str) else type(name).__name__
+        raise ValueError(f"unknown method {shown[:40]!r}; known: {', '.join(_REGISTRY)}")
+    return _REGISTRY[name]
+
+
+def names(*, poses: bool | None = None, lasa: bool | None = None, closed_loop: bool | None = None) -> list[str]:
+    """Registered method names, in registration order, optionally those that learn poses, run by
+    default in the LASA benchmark, or have a closed-loop stepper."""
+    _load_builtins()
+    wanted = {"poses": poses, "lasa": lasa, "closed_loop": closed_loop}
+    return [name for name, method in _REGISTRY.items()
+            if all(value is None or getattr(method, key) == value for key, value in wanted.items())]

@@ -1,0 +1,122 @@
+"""What a method is: the :class:`Method` interface and the :class:`Task` it is run on.
+
+A task is one learning problem — a demonstration, the goals to reach, a seed, the DMP and Bi-DMP
+parameters, and (for a scenario) how its Bi-DMP skills are grown. A method fits once per task and
+then rolls out to each goal; what several methods share (the fitted DMP, the Bi-DMP) is built
+once per task (:meth:`Task.shared_model`), so evaluating all methods costs what each shared step
+costs once.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Method", "Task"]
+
+
+@dataclass
+class Task:
+    """One learning problem.
+
+    Attributes
+    ----------
+    demonstration : array (T, D)
+        Positions (any unit), or poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) when ``poses``.
+    goals : array (G, D)
+        The goals (targets) to roll out to.
+    seed : int
+        The seed of every random choice (extensions, EM).
+    dmp, bidmp : dict
+        Parameters of the DMP and of the Bi-DMP (the scenario's; empty: the defaults).
+    poses : bool
+        Whether the demonstration holds poses.
+    build_skills : callable, optional
+        ``build_skills(dmp) -> model``: the Bi-DMP (or pose Bi-DMP) of this task, with its
+        extended demonstrations learned (a scenario's extension stages). None: a Bi-DMP extends
+        the demonstration to each goal it is asked for (the LASA benchmark).
+    shared : dict
+        Models shared between methods, with the seconds each took to build.
+    """
+
+    demonstration: np.ndarray
+    goals: np.ndarray
+    seed: int = 0
+    dmp: dict = field(default_factory=dict)
+    bidmp: dict = field(default_factory=dict)
+    poses: bool = False
+    build_skills: Callable | None = None
+    shared: dict = field(default_factory=dict)
+
+    def shared_model(self, key, build: Callable) -> tuple[object, float]:
+        """``(model, seconds)``: ``build()`` the first time ``key`` is asked for, the same model after."""
+        if key not in self.shared:
+            start = time.perf_counter()
+            model = build()
+            self.shared[key] = (model, time.perf_counter() - start)
+        return self.shared[key]
+
+    def fitted_dmp(self, **overrides) -> tuple[object, float]:
+        """The task's DMP (a :class:`bidmp.CartesianDMP` for poses) fitted on the demonstration,
+        with ``overrides`` of its parameters; shared by every method that asks for the same."""
+        params = {**self.dmp, **overrides}
+
+        def build():
+            if self.poses:
+                from ...primitives.cartesian import CartesianDMP
+
+                return CartesianDMP(**params).fit(self.demonstration)
+            from ...primitives.dmp import DMP
+
+            return DMP(**params).fit(self.demonstration)
+
+        return self.shared_model(("dmp", tuple(sorted(params.items()))), build)
+
+
+class Method:
+    """A way to learn from one demonstration and reach new goals; subclass it and register one
+    instance (:func:`bidmp.tasks.methods.register`).
+
+    Class attributes say where it can run: ``poses`` (it learns pose demonstrations),
+    ``closed_loop`` (it has a :meth:`stepper` for the simulator's closed loop), ``settles`` (its
+    rollouts run past the demonstrated duration to come to rest: the LASA benchmark compares the
+    first T samples and takes the end point from the last), ``requires`` (an optional package it
+    needs; without it the method is skipped with a note) and ``lasa`` (run by default in the LASA
+    benchmark).
+    """
+
+    name: str = ""
+    description: str = ""
+    poses: bool = False
+    closed_loop: bool = False
+    settles: bool = False
+    requires: str | None = None
+    lasa: bool = True
+
+    def fit(self, task: Task) -> tuple[object, float]:
+        """``(model, seconds)``: the model learned for ``task`` and the seconds it took (shared
+        models included)."""
+        raise NotImplementedError
+
+    def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        """The motion (n, D) to ``goal`` (D,), on the demonstration's sample grid."""
+        raise NotImplementedError
+
+    def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
+        """The motions to every goal (G, D); override when a batch is cheaper than a loop."""
+        return [self.rollout(model, goal) for goal in goals]
+
+    def stepper(self, model, goal: np.ndarray, duration: float, coupling):
+        """A control-loop stepper to ``goal`` (methods with ``closed_loop`` only)."""
+        raise NotImplementedError(f"method {self.name!r} has no stepper for closed-loop control")
+
+    def available(self) -> bool:
+        """Whether what it ``requires`` is installed."""
+        if self.requires is None:
+            return True
+        import importlib.util
+
+        return importlib.util.find_spec(self.requires) is not None

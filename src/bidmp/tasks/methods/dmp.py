@@ -1,0 +1,40 @@
+"""The plain DMP: fitted once on the demonstration, rolled out to each goal (``dmp``: the task's
+protocol; ``dmp-paper`` and ``dmp-robot``: the two protocols, as the LASA benchmark compares them)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import register
+from .base import Method, Task
+
+
+class DMPMethod(Method):
+    """A :class:`bidmp.DMP` (or :class:`bidmp.CartesianDMP` on poses) with the task's parameters,
+    ``protocol`` overriding the task's when given."""
+
+    poses = True
+    closed_loop = True
+    settles = True
+
+    def __init__(self, name: str, protocol: str | None = None, lasa: bool = True) -> None:
+        self.name, self.protocol, self.lasa = name, protocol, lasa
+
+    def fit(self, task: Task) -> tuple[object, float]:
+        return task.fitted_dmp() if self.protocol is None else task.fitted_dmp(protocol=self.protocol)
+
+    def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        return model.rollout(goal)
+
+    def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
+        if model.__class__.__name__ == "DMP":
+            return list(model.rollout_many(goals))  # one integration for every goal
+        return [model.rollout(goal) for goal in goals]
+
+    def stepper(self, model, goal: np.ndarray, duration: float, coupling):
+        return model.stepper(goal, duration=duration, coupling=coupling)
+
+
+register(DMPMethod("dmp", lasa=False))
+register(DMPMethod("dmp-paper", protocol="paper"))
+register(DMPMethod("dmp-robot", protocol="robot"))

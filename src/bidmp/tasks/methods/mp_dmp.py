@@ -1,0 +1,34 @@
+"""``mp-dmp``: movement_primitives' DMP (a peer library, in the ``test``/``bench`` extras), with
+its defaults and 50 weights per dimension, over the demonstration's own time."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import register
+from .base import Method, Task
+
+
+class PeerDMP(Method):
+    name = "mp-dmp"
+    requires = "movement_primitives"
+
+    def fit(self, task: Task) -> tuple[object, float]:
+        def build():
+            from movement_primitives.dmp import DMP
+
+            y = task.demonstration
+            t = np.linspace(0.0, 1.0, len(y))
+            peer = DMP(n_dims=y.shape[1], execution_time=1.0, dt=t[1], n_weights_per_dim=50)
+            peer.imitate(t, y)
+            return peer, y[0]
+
+        return task.shared_model("mp-dmp", build)
+
+    def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        peer, start = model
+        peer.configure(start_y=start, goal_y=goal)
+        return peer.open_loop()[1]
+
+
+register(PeerDMP())

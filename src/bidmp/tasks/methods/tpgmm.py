@@ -1,0 +1,25 @@
+"""``tpgmm``: the task-parameterised GMM (start and goal frames), a baseline that does take a goal."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import register
+from .base import Method, Task
+
+
+class TPGMMMethod(Method):
+    name = "tpgmm"
+
+    def fit(self, task: Task) -> tuple[object, float]:
+        from ...baselines import TPGMM
+
+        return task.shared_model("tpgmm", lambda: (TPGMM(seed=task.seed % (2**31)).fit(task.demonstration),
+                                                   task.demonstration[0]))
+
+    def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        tpgmm, start = model
+        return tpgmm.generate(start, goal)[0]
+
+
+register(TPGMMMethod())
