@@ -47,6 +47,8 @@ __all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkRes
 
 logger = logging.getLogger(__name__)
 
+# The built-in methods the benchmark runs by default (registry.names(lasa=True) lists them, and any
+# method registered with lasa = True after them).
 LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
 CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
@@ -63,15 +65,16 @@ def _cell_seed(shape: str, demo: int) -> int:
 
 
 def _methods_available(methods) -> list[str]:
+    """The methods whose optional package is installed (the others are skipped with a note)."""
+    from ..tasks import methods as registry
+
     out = []
-    for method in methods:
-        if method == "mp-dmp":
-            try:
-                import movement_primitives  # noqa: F401
-            except ImportError:
-                logger.info("movement_primitives is not installed: mp-dmp skipped")
-                continue
-        out.append(method)
+    for name in methods:
+        method = registry.get(name)
+        if not method.available():
+            logger.info("%s is not installed: %s skipped", method.requires, name)
+            continue
+        out.append(name)
     return out
 
 
@@ -102,17 +105,18 @@ def _timed(function):
 def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_once: str | None = None) -> dict:
     """All methods on one (shape, demonstration): ``{"key", "rows": [...], "rollouts": {...}}``.
 
+    ``methods`` are names in the methods registry (:mod:`bidmp.tasks.methods`) or method objects
+    (what a Dask worker is sent, so that a method registered in this process runs there too).
+
     ``rollouts`` keeps the reproductions (for the per-shape figure). ``_kill_once`` is for
     tests: if that file exists, it is removed and this worker process kills itself.
     """
     if _kill_once is not None and os.path.exists(_kill_once):
         os.remove(_kill_once)
         os.kill(os.getpid(), 9)
-    from ..baselines import TPGMM, GMMRegressor
     from ..demonstrations.datasets import lasa as lasa_data
-    from ..primitives.dmp import DMP
-    from ..extension.extend import extend_demonstration
-    from ..incremental.bidmp import BiDMP
+    from ..tasks import methods as registry
+    from ..tasks.methods import Method, Task
     from ..tasks.metrics import path_extent
 
     y = lasa_data(shape)[demo][::every]
@@ -135,47 +139,19 @@ def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_
         if case == "reproduction":
             rollouts[method] = np.asarray(rollout[:: max(1, len(rollout) // 200)]).round(4).tolist()
 
-    for method in methods:
-        if method in ("dmp-paper", "dmp-robot", "bidmp"):
-            protocol = "robot" if method == "dmp-robot" else "paper"
-            dmp, fit_s = _timed(lambda: DMP(protocol=protocol).fit(y))
-            for case, goal in cases:
-                # The first T samples are the motion's time (the robot protocol then rests at
-                # the goal for 10 % longer): what is time-aligned with the demonstration.
-                if method == "bidmp" and case != "reproduction":
-                    def learn_and_roll(goal=goal):
-                        extension = extend_demonstration(y, goal, seed=seed)
-                        return BiDMP(dmp).learn(extension.complete).rollout(goal)
-                    rollout, seconds = _timed(learn_and_roll)
-                else:
-                    rollout, seconds = _timed(lambda goal=goal: dmp.rollout(goal))
-                record(method, case, goal, rollout[: len(y)], fit_s, seconds, end=rollout[-1])
-        elif method == "gmm":
-            model, fit_s = _timed(lambda: GMMRegressor(seed=seed % (2**31)).fit(y))
-            mean, seconds = _timed(lambda: model.generate()[0])
-            for case, goal in cases:  # GMM/GMR has no notion of a new goal
-                record(method, case, goal, mean, fit_s, seconds)
-        elif method == "tpgmm":
-            model, fit_s = _timed(lambda: TPGMM(seed=seed % (2**31)).fit(y))
-            for case, goal in cases:
-                rollout, seconds = _timed(lambda goal=goal: model.generate(y[0], goal)[0])
-                record(method, case, goal, rollout, fit_s, seconds)
-        elif method == "mp-dmp":
-            from movement_primitives.dmp import DMP as PeerDMP
-
-            t = np.linspace(0.0, 1.0, len(y))
-
-            def fit_peer():
-                peer = PeerDMP(n_dims=2, execution_time=1.0, dt=t[1], n_weights_per_dim=50)
-                peer.imitate(t, y)
-                return peer
-            peer, fit_s = _timed(fit_peer)
-            for case, goal in cases:
-                def roll(goal=goal):
-                    peer.configure(start_y=y[0], goal_y=goal)
-                    return peer.open_loop()[1]
-                rollout, seconds = _timed(roll)
-                record(method, case, goal, rollout, fit_s, seconds)
+    # The task of the cell: the paper's DMP (the LASA literature's), a Bi-DMP grown to each goal.
+    task = Task(y, np.array([goal for _, goal in cases]), seed=seed, dmp={"protocol": "paper"})
+    for name in methods:
+        method = name if isinstance(name, Method) else registry.get(name)
+        model, fit_s = method.fit(task)  # seconds to learn, shared models (the DMP) included
+        for case, goal in cases:
+            rollout, seconds = _timed(lambda goal=goal: method.rollout(model, goal))
+            if method.settles:
+                # The first T samples are the motion's time (the robot protocol then rests at the
+                # goal for 10 % longer): what is time-aligned with the demonstration.
+                record(method.name, case, goal, rollout[: len(y)], fit_s, seconds, end=rollout[-1])
+            else:
+                record(method.name, case, goal, rollout, fit_s, seconds)
     return {"key": cell_key(shape, demo), "rows": rows, "rollouts": rollouts}
 
 
@@ -212,10 +188,11 @@ def _validate(shapes, methods, demos: str, every: int) -> tuple[list, list, list
     for shape in shapes:
         if shape not in names:
             raise ValueError(f"unknown LASA shape {shape!r}; see 'bidmp lasa list'")
-    methods = list(LASA_METHODS if methods is None else methods)
+    from ..tasks import methods as registry
+
+    methods = list(registry.names(lasa=True) if methods is None else methods)
     for method in methods:
-        if method not in LASA_METHODS:
-            raise ValueError(f"unknown method {method!r}; known: {', '.join(LASA_METHODS)}")
+        registry.get(method)  # an unknown name is refused, listing the known ones
     check_choice(demos, "demos", ("all", "first3"))
     every = check_int(every, "every", minimum=1, maximum=100)
     indices = list(range(7)) if demos == "all" else [0, 1, 2]
@@ -274,7 +251,8 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     shapes : list of str, optional
         Default all 30.
     methods : list of str, optional
-        From :data:`LASA_METHODS` (default all; ``mp-dmp`` needs movement_primitives).
+        Names in the methods registry (:mod:`bidmp.tasks.methods`); default those marked for
+        LASA, :data:`LASA_METHODS` (``mp-dmp`` needs movement_primitives).
     demos : {"all", "first3"}
     every : int
         Use every k-th sample (1 or 10 in the literature).
@@ -328,7 +306,10 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
             from distributed import as_completed
 
             result.workers = len(client.scheduler_info().get("workers", {})) or n_workers
-            futures = [client.submit(run_cell, shape, demo, methods, every, _kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
+            from ..tasks import methods as registry
+
+            objects = [registry.get(name) for name in methods]
+            futures = [client.submit(run_cell, shape, demo, objects, every, _kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
                                      pure=False, retries=2)
                        for shape, demo in todo]
             for future in as_completed(futures):

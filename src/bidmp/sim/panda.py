@@ -957,8 +957,12 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     for label in labels:
         if label not in scenario.targets:
             raise ValueError(f"unknown target {label!r}; the scenario's targets: {', '.join(scenario.labels[:20])}")
-    if closed_loop and set(methods) - {"dmp", "bidmp"}:
-        raise ValueError("closed_loop runs the DMP and Bi-DMP steppers: methods must be dmp and/or bidmp")
+    from ..tasks import methods as registry
+
+    open_only = [name for name in methods if not registry.get(name).closed_loop]
+    if closed_loop and open_only:
+        raise ValueError(f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
+                         f"{', '.join(registry.names(closed_loop=True))})")
     coupling = COUPLING * _unit(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
     if report is None:
         report = evaluate(scenario, methods, geometry=False)
@@ -970,10 +974,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
                  int(frames.get((method, label), 0)),
                  None if report.methods[method].orientations is None else report.methods[method].orientations[label])
             for method in methods for label in labels]
-    models = None
-    if closed_loop:
-        models = {"bidmp": report.model,
-                  "dmp": report.model.dmp_ if report.model is not None else _plain_dmp(scenario)}
+    models = {name: report.fitted[name] for name in methods} if closed_loop else None
     setup = {"scenario": {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
                           "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold,
                           "axes": {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
@@ -1016,16 +1017,11 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     return out
 
 
-def _plain_dmp(scenario):
-    from ..primitives.dmp import DMP
-
-    return DMP(**scenario.dmp).fit(scenario.demonstration)
-
-
 def _stepper(models, method, goal, duration, coupling):
-    if method == "bidmp":
-        return models["bidmp"].stepper(goal, skill="nearest", duration=duration, coupling=coupling)
-    return models["dmp"].stepper(goal, duration=duration, coupling=coupling)
+    """The registered method's stepper to ``goal`` on its fitted model."""
+    from ..tasks import methods as registry
+
+    return registry.get(method).stepper(models[method], goal, duration, coupling)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -17,14 +17,12 @@ import numpy as np
 
 from ._tables import markdown_table, text_table
 from .._trajectory import resample_time
-from ..primitives.dmp import DMP
 from ..extension.extend import extend_demonstration
 from ..incremental.bidmp import BiDMP, forgetting_runs
 from .metrics import approach_error, endpoint_error, path_difference
+from .methods.dmp_converged import CONVERGED_GAIN
 
 __all__ = ["CONVERGED_GAIN", "MethodResult", "Report", "evaluate", "write_report"]
-
-CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
 
 
 @dataclass
@@ -163,6 +161,7 @@ class Report:
     extension_targets: list = field(default_factory=list)
     failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
     model: object = None  # the Bi-DMP
+    fitted: dict = field(default_factory=dict)  # method name -> its fitted model (the simulator's closed loop)
     forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
 
     def to_dict(self) -> dict:
@@ -306,6 +305,59 @@ def _bidmp_model(scenario, dmp, failed):
     return model, extensions, targets, forgetting
 
 
+def _pose_bidmp_model(scenario, cartesian, failed, report):
+    """The pose scenario's Bi-DMP: extensions on poses, then further demonstrations."""
+    from ..extension.extend import extend_pose_demonstration
+    from ..incremental.cartesian import CartesianBiDMP
+
+    model = CartesianBiDMP(cartesian, **scenario.bidmp)
+    previous = None
+    options = {k: v for k, v in scenario.extension.items() if k != "approach"}
+    for stage in scenario.extensions:
+        target = _resolve_target(stage["target"], scenario, failed)
+        if target is None:
+            continue
+        source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous
+        stage_scene = scenario.scene if stage.get("in_scene", True) else None
+        extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene, **options)
+        previous = extension.poses
+        model.learn(previous)
+        report.extensions.append(extension)
+        report.extension_targets.append(target[:3])
+    for demonstration in scenario.demonstrations.values():
+        model.learn(demonstration)
+    return model
+
+
+def _skills_builder(scenario, failed, report):
+    """``build_skills(dmp)`` of the scenario's task: its Bi-DMP, recorded in the report."""
+
+    def build(dmp):
+        if scenario.is_pose:
+            report.model = _pose_bidmp_model(scenario, dmp, failed, report)
+        else:
+            report.model, report.extensions, report.extension_targets, report.forgetting = \
+                _bidmp_model(scenario, dmp, failed)
+        return report.model
+
+    return build
+
+
+def _method_names(scenario, methods) -> list[str]:
+    """The methods to run, each checked against the registry (and for poses, that it learns them)."""
+    from . import methods as registry
+
+    names = list(scenario.methods if methods is None else methods)
+    if not names:
+        raise ValueError("methods is empty: name at least one of " + ", ".join(registry.names()))
+    for name in names:
+        method = registry.get(name)
+        if scenario.is_pose and not method.poses:
+            raise ValueError(f"method {name!r} does not learn poses; a pose scenario runs "
+                             f"{', '.join(registry.names(poses=True))}")
+    return names
+
+
 def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Report:
     """Run ``methods`` (default: the scenario's) on every target of ``scenario``.
 
@@ -314,7 +366,8 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     scenario : Scenario or str
         A scenario, a scenario file, or a built-in name.
     methods : list of str, optional
-        From dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm.
+        Names from the methods registry (:mod:`bidmp.tasks.methods`): dmp, dmp-converged, bidmp,
+        bidmp-latest, gmm, tpgmm, mp-dmp, or any registered one.
     progress : callable, optional
         Called with each method name before it runs (the CLI hooks a progress bar here).
     geometry : bool, default True
@@ -325,23 +378,51 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     Returns
     -------
     Report
-        ``report.to_dict()`` is the JSON of SPEC §10.
+        ``report.to_dict()`` is the JSON of SPEC §10; ``report.fitted`` holds each method's model.
     """
+    from . import methods as registry
     from . import scenarios as scenario_module
-    from ..baselines import TPGMM, GMMRegressor
 
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
-    if scenario.is_pose:
-        return _evaluate_poses(scenario, methods, progress, geometry)
-    methods = list(scenario.methods if methods is None else methods)
-    if not methods:
-        raise ValueError("methods is empty: name at least one of " + ", ".join(scenario_module.METHODS))
-    for method in methods:
-        if method not in scenario_module.METHODS:
-            raise ValueError(f"unknown method {method!r}; known: {', '.join(scenario_module.METHODS)}")
+    names = _method_names(scenario, methods)
     labels = scenario.labels
-    goals = scenario.target_array
+    goals = np.stack([scenario.targets[label] for label in labels])
+    task = registry.Task(scenario.demonstration, goals, seed=scenario.seed, dmp=scenario.dmp, bidmp=scenario.bidmp,
+                         poses=scenario.is_pose)
+    report = Report(scenario=scenario, methods={})
+    report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
+    task.build_skills = _skills_builder(scenario, failed, report)
+    result = (_pose_results if scenario.is_pose else _position_results)(scenario, labels, geometry)
+    for name in names:
+        if progress is not None:
+            progress(name)
+        method = registry.get(name)
+        model, fit_seconds = method.fit(task)
+        with _Timer() as timer:
+            rollouts = method.rollouts(model, goals)
+        report.methods[name] = result(name, rollouts, fit_seconds + timer.seconds)
+        report.fitted[name] = model
+    if scenario.demonstrations and not report.forgetting and not scenario.is_pose:
+        dmp, _ = task.fitted_dmp()
+        report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
+                                            **scenario.bidmp)
+    return report
+
+
+def _failed_targets(scenario, task, labels, goals) -> list[str]:
+    """The targets the plain DMP misses by more than the success threshold (positions)."""
+    dmp, _ = task.fitted_dmp()
+    if scenario.is_pose:
+        ends = np.array([dmp.rollout(goal)[-1, :3] for goal in goals])
+    else:
+        ends = dmp.rollout_many(goals)[:, -1]
+    errors = np.linalg.norm(ends - goals[:, :3], axis=1)
+    return [label for label, error in zip(labels, errors) if error > scenario.success_threshold]
+
+
+def _position_results(scenario, labels, geometry: bool):
+    """``result(name, trajectories, seconds) -> MethodResult`` for a position scenario."""
     demo = scenario.demonstration
     n_steps = demo.shape[0]
     references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
@@ -362,69 +443,16 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
         return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
                             next(iter(trajectories.values())).shape[0], clearances)
 
-    report = Report(scenario=scenario, methods={})
-    with _Timer() as dmp_time:
-        dmp = DMP(**scenario.dmp).fit(demo)
-        plain = dmp.rollout_many(goals)
-    plain_errors = np.linalg.norm(plain[:, -1] - goals, axis=1)
-    failed = [label for label, error in zip(labels, plain_errors) if error > scenario.success_threshold]
-    report.failed_targets = failed
-    model = None
-    model_seconds = 0.0
-
-    for method in methods:
-        if progress is not None:
-            progress(method)
-        if method == "dmp":
-            report.methods[method] = result(method, plain, dmp_time.seconds)
-        elif method == "dmp-converged":
-            with _Timer() as timer:
-                factor = next((k for k in range(2, 101) if dmp.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100)
-                trajectories = dmp.rollout_many(goals, n_steps=factor * n_steps)
-            report.methods[method] = result(method, trajectories, dmp_time.seconds + timer.seconds)
-        elif method in ("bidmp", "bidmp-latest"):
-            if model is None:
-                with _Timer() as timer:
-                    model, report.extensions, report.extension_targets, report.forgetting = _bidmp_model(scenario, dmp, failed)
-                model_seconds = dmp_time.seconds + timer.seconds
-                report.model = model
-            skill = "nearest" if method == "bidmp" else "latest"
-            with _Timer() as timer:
-                trajectories = [model.rollout(goal, skill=skill) for goal in goals]
-            report.methods[method] = result(method, trajectories, model_seconds + timer.seconds)
-        elif method == "gmm":
-            with _Timer() as timer:
-                mean, _ = GMMRegressor(seed=scenario.seed).fit(demo).generate()
-                trajectories = [mean] * len(labels)  # GMM has no notion of a new target
-            report.methods[method] = result(method, trajectories, timer.seconds)
-        elif method == "tpgmm":
-            with _Timer() as timer:
-                tpgmm = TPGMM(seed=scenario.seed).fit(demo)
-                trajectories = [tpgmm.generate(demo[0], goal)[0] for goal in goals]
-            report.methods[method] = result(method, trajectories, timer.seconds)
-    if scenario.demonstrations and not report.forgetting:
-        report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
-                                            **scenario.bidmp)
-    return report
+    return result
 
 
-def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
-    """:func:`evaluate` for a pose scenario: CartesianDMP and its Bi-DMP, with the extension on
-    poses; metrics on positions, the engagement along each target's axis, and the tool's axis
-    alignment (task success needs it too)."""
-    from ..primitives.cartesian import CartesianDMP
-    from ..incremental.cartesian import CartesianBiDMP
-    from ..extension.extend import extend_pose_demonstration
+def _pose_results(scenario, labels, geometry: bool):
+    """``result(name, rollouts, seconds) -> MethodResult`` for a pose scenario: metrics on
+    positions, the engagement along each target's axis, and the tool's axis alignment (task success
+    needs it too)."""
     from .metrics import axis_deviation
-    from .scenarios import POSE_METHODS
 
-    methods = list(scenario.methods if methods is None else methods)
-    for method in methods:
-        if method not in POSE_METHODS:
-            raise ValueError(f"method {method!r} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
-    labels = scenario.labels
-    demo = scenario.demonstration
-    n_steps = demo.shape[0]
+    n_steps = scenario.demonstration.shape[0]
     scene = scenario.scene if geometry else None
     references = {label: resample_time(scenario.reference(label)[:, :3], n_steps) for label in labels}
     excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
@@ -448,46 +476,7 @@ def _evaluate_poses(scenario, methods, progress, geometry: bool) -> Report:
         return MethodResult(name, positions, seconds, errors, approach, differences, scenario.success_threshold,
                             n_steps, clearances, orientations, deviations, scenario.alignment_threshold)
 
-    report = Report(scenario=scenario, methods={})
-    with _Timer() as dmp_time:
-        cartesian = CartesianDMP(**scenario.dmp).fit(demo)
-        plain = [cartesian.rollout(scenario.targets[label]) for label in labels]
-    failed = [label for label, rollout in zip(labels, plain)
-              if np.linalg.norm(rollout[-1, :3] - scenario.targets[label][:3]) > scenario.success_threshold]
-    report.failed_targets = failed
-    model = None
-    for method in methods:
-        if progress is not None:
-            progress(method)
-        if method == "dmp":
-            report.methods[method] = result(method, plain, dmp_time.seconds)
-            continue
-        if model is None:
-            with _Timer() as timer:
-                model = CartesianBiDMP(cartesian, **scenario.bidmp)
-                previous = None
-                options = {k: v for k, v in scenario.extension.items() if k != "approach"}
-                for stage in scenario.extensions:
-                    target = _resolve_target(stage["target"], scenario, failed)
-                    if target is None:
-                        continue
-                    source = demo if stage["from"] == "demonstration" or previous is None else previous
-                    stage_scene = scenario.scene if stage.get("in_scene", True) else None
-                    extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene,
-                                                          **options)
-                    previous = extension.poses
-                    model.learn(previous)
-                    report.extensions.append(extension)
-                    report.extension_targets.append(target[:3])
-                for demonstration in scenario.demonstrations.values():
-                    model.learn(demonstration)
-            model_seconds = dmp_time.seconds + timer.seconds
-            report.model = model
-        skill = "nearest" if method == "bidmp" else "latest"
-        with _Timer() as timer:
-            rollouts = [model.rollout(scenario.targets[label], skill=skill) for label in labels]
-        report.methods[method] = result(method, rollouts, model_seconds + timer.seconds)
-    return report
+    return result
 
 
 def write_report(report: Report, out: str | os.PathLike) -> list[Path]:

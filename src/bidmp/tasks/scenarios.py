@@ -68,8 +68,8 @@ from ..io.files import load_json, read_trajectory
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
+# The methods a scenario runs when it names none (any registered method may be named: bidmp.tasks.methods).
 METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
-POSE_METHODS = ("dmp", "bidmp", "bidmp-latest")  # what a pose scenario (D = 7) can run
 POSE_DIMS = 7  # x, y, z, qx, qy, qz, qw
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
@@ -413,11 +413,14 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     methods = data.get("methods", list(METHODS))
     if not isinstance(methods, list) or not methods or not all(isinstance(m, str) for m in methods):
         _fail(source, "methods", "expected a non-empty list of method names")
+    from . import methods as registry
+
     for method in methods:
-        if method not in METHODS:
-            _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(METHODS)})")
-        if n_dims == POSE_DIMS and method not in POSE_METHODS:
-            _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs {', '.join(POSE_METHODS)}")
+        if method not in registry.names():
+            _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(registry.names())})")
+        if n_dims == POSE_DIMS and not registry.get(method).poses:
+            _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs "
+                  f"{', '.join(registry.names(poses=True))}")
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")

@@ -26,6 +26,8 @@ __all__ = ["Method", "Task", "register", "unregister", "get", "names"]
 
 _REGISTRY: dict[str, Method] = {}
 _BUILTINS_LOADED = False
+# The built-in methods, in the order names() lists them (whichever module is imported first).
+_BUILTIN_ORDER = ("dmp", "dmp-paper", "dmp-robot", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm", "mp-dmp")
 
 
 def _load_builtins() -> None:
@@ -45,7 +47,7 @@ def _load_builtins() -> None:
 
 def register(method: Method, *, replace: bool = False) -> Method:
     """Add ``method`` under ``method.name``; a name taken by another method is refused unless
-    ``replace``."""
+    ``replace``. Returns ``method``."""
     _load_builtins()
     if not isinstance(method, Method):
         raise TypeError(f"method must be a bidmp.tasks.methods.Method, got {type(method).__name__}")
@@ -78,5 +80,6 @@ def names(*, poses: bool | None = None, lasa: bool | None = None, closed_loop: b
     default in the LASA benchmark, or have a closed-loop stepper."""
     _load_builtins()
     wanted = {"poses": poses, "lasa": lasa, "closed_loop": closed_loop}
-    return [name for name, method in _REGISTRY.items()
-            if all(value is None or getattr(method, key) == value for key, value in wanted.items())]
+    order = sorted(_REGISTRY, key=lambda name: _BUILTIN_ORDER.index(name) if name in _BUILTIN_ORDER else len(_BUILTIN_ORDER))
+    return [name for name in order
+            if all(value is None or getattr(_REGISTRY[name], key) == value for key, value in wanted.items())]
