@@ -82,7 +82,8 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
     """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
     from tqdm import tqdm
 
-    from ..sim.panda import simulate, write_sim_report
+    from ..sim.report import write_sim_report
+    from ..sim.run import simulate
 
     methods = list(methods)
     labels = scenario.labels if targets is None else targets
@@ -109,7 +110,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
     from ..tasks.scenarios import load
-    from ..sim.panda import Hold, _pybullet
+    from ..sim.backend import Hold
+    from ..sim.pybullet.world import pybullet_module as _pybullet
 
     _pybullet()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
@@ -175,7 +177,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
     if args.sim:
-        from ..sim.panda import _pybullet
+        from ..sim.pybullet.world import pybullet_module as _pybullet
 
         _pybullet()
     report = _run_scenario(scenario, out, methods)

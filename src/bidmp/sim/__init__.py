@@ -1,8 +1,15 @@
-"""Simulation: the simulator backend protocol and its PyBullet Franka Panda implementation, the
-simulated task runs and their reports.
+"""Simulation: a scenario's motions executed on a simulated robot, measured.
 
-Layer 3 (the application): imports the math, ``demonstrations``, ``io`` and ``tasks``; never
-``cli``. PyBullet is an extra (``bidmp[sim]``), imported when a cell is built.
+* ``backend`` — the simulator backend protocol (``load_robot``, ``ik``, ``fk``, ``execute``,
+  ``contacts``, ``render``) and the types it exchanges; a new simulator or robot is a subpackage
+  beside ``pybullet`` that implements it;
+* ``pybullet`` — the first backend: the Franka Panda in PyBullet (world, robot, IK, planning,
+  execution, rendering, one module each);
+* ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
+* ``report`` — the results, apart from any backend, and their files.
+
+Layer 3 (the application): imports the math, ``io`` and ``tasks``; never ``cli``. PyBullet is an
+extra (``bidmp[sim]``), imported when a world is built.
 """
 
 from __future__ import annotations
@@ -11,20 +18,22 @@ from .._lazy import exports
 
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
-    "PANDA": "panda",
-    "JointLimits": "panda",
-    "Hold": "panda",
-    "PandaCell": "panda",
-    "MotionPlan": "panda",
-    "Execution": "panda",
-    "SimTarget": "panda",
-    "SimMethod": "panda",
-    "SimReport": "panda",
-    "SimError": "panda",
-    "simulate": "panda",
-    "robot_placement": "panda",
-    "write_sim_report": "panda",
+    "simulate": "run",
+    "SimulatorBackend": "backend",
+    "SimError": "backend",
+    "JointLimits": "backend",
+    "Hold": "backend",
+    "MotionPlan": "backend",
+    "Execution": "backend",
+    "PandaCell": "pybullet.cell",
+    "PANDA": "pybullet.robot",
+    "robot_placement": "pybullet.robot",
+    "SimTarget": "report",
+    "SimMethod": "report",
+    "SimReport": "report",
+    "write_sim_report": "report",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.sim of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("panda",))
+# what the flat module bidmp.sim of bidmp <= 0.4 held (constants, helpers), for code written against it
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(),
+                               fallback=("backend", "run", "report", "pybullet.robot", "pybullet.world"))

@@ -1,0 +1,138 @@
+"""The simulator backend protocol: what the simulated task runs need of a simulator and its robot,
+and the backend-independent types they exchange (plans, executions, disturbances).
+
+A backend is a class with a ``load_robot(scene, units, base, yaw)`` constructor and the methods
+of :class:`SimulatorBackend`; ``bidmp.sim.simulate(..., backend=...)`` runs the task on it. The
+PyBullet Franka Panda (:class:`bidmp.sim.pybullet.PandaCell`) is the first; another simulator or
+robot is one more subpackage beside it.
+
+Lengths inside a backend are metres, angles radians, times seconds; the scene is given in its own
+unit (``units``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+__all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "MotionPlan", "Execution", "SIM_STEP",
+           "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
+
+SIM_STEP = 1e-3  # s: 1 kHz physics and position control
+CONTROL_STEP = 1e-2  # s: the closed-loop stepper and its inverse kinematics run at 100 Hz
+LIMIT_MARGIN = 0.9  # motions are timed to this fraction of the joint velocity and acceleration limits
+COUPLING = 5e5  # 1/m²: phase stopping's default gain in closed loop (0.5 /mm²)
+RECORD_EVERY = 2  # physics steps per recorded sample (500 Hz); contacts are checked every step
+SETTLE = 0.3  # s held at the end before the end point is measured
+
+
+class SimError(ValueError):
+    """A motion cannot be executed (unreachable, outside the joint limits); names the target."""
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Joint limits of a 7-axis arm: position (rad), velocity (rad/s), acceleration (rad/s²)."""
+
+    lower: tuple
+    upper: tuple
+    velocity: tuple
+    acceleration: tuple
+
+
+@dataclass(frozen=True)
+class Hold:
+    """A scripted disturbance: joint ``joint`` (0-6) held where it is from ``start`` for
+    ``duration`` seconds of the motion."""
+
+    joint: int
+    start: float
+    duration: float = 0.5
+
+
+@dataclass
+class MotionPlan:
+    """A Cartesian path turned into a timed joint path (arrays in SI units: s, rad)."""
+
+    label: str
+    points: np.ndarray  # (n, 3) m, the IK samples (the path subdivided)
+    fractions: np.ndarray  # (n,) normalised time of each sample in [0, 1]
+    joints: np.ndarray  # (n, 7) rad
+    duration: float  # s
+    spline: CubicSpline  # q(u), u in [0, 1]
+    peak_velocity: float  # fraction of the limit, the largest over joints
+    peak_acceleration: float
+    orientations: np.ndarray | None = None  # (n, 4) the tool frame at the IK samples (pose skills)
+
+    def command(self, t) -> tuple[np.ndarray, np.ndarray]:
+        """Joint positions and velocities commanded at time(s) ``t`` (s): (7,) or (n, 7)."""
+        u = np.clip(np.asarray(t, dtype=float) / self.duration, 0.0, 1.0)
+        moving = (u > 0.0) & (u < 1.0)  # at rest before the start and after the end
+        return self.spline(u), self.spline(u, 1) / self.duration * moving[..., None]
+
+
+@dataclass
+class Execution:
+    """What the simulated robot did: times (s), measured TCP (m), joints (rad, rad/s)."""
+
+    times: np.ndarray
+    tcp: np.ndarray
+    joints: np.ndarray
+    joint_velocities: np.ndarray
+    commanded_tcp: np.ndarray  # the command's TCP at the same times (FK of the commanded joints)
+    contacts: dict  # part label -> deepest penetration (m, > 0)
+    frames: list = field(default_factory=list)  # rendered RGB images, when asked for
+    command_times: np.ndarray | None = None  # closed loop: the control steps (s) ...
+    command_joints: np.ndarray | None = None  # ... the joints commanded there (rad) ...
+    motion_clock: np.ndarray | None = None  # ... and the stepper's own time (s; stands still while paused)
+    tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
+
+    @property
+    def paused(self) -> float:
+        """Seconds of the run during which the motion's own time ran at under a fifth of the
+        clock's pace (closed loop; 0 otherwise)."""
+        if self.motion_clock is None or len(self.motion_clock) < 2:
+            return 0.0
+        running = self.motion_clock[1:] < self.motion_clock[-1]  # not the settling at the end
+        slow = np.diff(self.motion_clock) < 0.2 * np.diff(self.command_times)
+        return float(np.sum(slow & running) * CONTROL_STEP)
+
+
+class SimulatorBackend(Protocol):
+    """A simulated robot in a scene's world (the methods ``bidmp.sim`` calls)."""
+
+    unit: float  # metres per scene unit
+
+    @classmethod
+    def load_robot(cls, scene, units: str, base, yaw: float) -> "SimulatorBackend":
+        """Build the world of ``scene`` (parts, tool) with the robot at ``base`` (scene units),
+        turned ``yaw`` degrees about z."""
+
+    def ik(self, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
+        """Joint positions that put the tool-centre point at ``point_m`` (m), from ``seed``; and the
+        position error left (m)."""
+
+    def fk(self, q) -> np.ndarray:
+        """The tool-centre point (m) at joint positions ``q``."""
+
+    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
+        """A Cartesian path (n, 3, scene units) turned into a timed joint path within the limits."""
+
+    def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
+        """Run ``plan`` open loop, the parts in ``exclude`` ignored for contacts."""
+
+    def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
+                            frames: int = 0) -> Execution:
+        """Run a DMP stepper on the measured tool-centre point."""
+
+    def contacts(self) -> dict:
+        """Part label -> penetration depth (m) of the robot's contacts now."""
+
+    def render(self, width: int = 320, height: int = 240, target=None) -> np.ndarray:
+        """An RGB image (height, width, 3) of the world."""
+
+    def close(self) -> None:
+        """Release the simulator."""

@@ -1,0 +1,207 @@
+"""Execution: 1 kHz position control of a planned joint path (open loop) or of a DMP stepper's
+commands on the measured tool-centre point (closed loop, 100 Hz), recording the measured motion
+and every contact with a part."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, Hold, MotionPlan, SimError
+from .robot import _EFFORT, _GAINS, _REST, IK_TOLERANCE, PANDA
+
+__all__ = ["execute", "execute_closed_loop", "Recorder", "ignore", "contacts_into", "drive"]
+
+
+# -- execution -------------------------------------------------------------------------
+def ignore(cell, exclude, enable: bool) -> None:
+    """Switch contacts between the robot and the parts in ``exclude`` off (the target enters
+    the tool) or back on."""
+    p = cell.p
+    links = list(range(-1, p.getNumJoints(cell.robot, physicsClientId=cell.client)))
+    for body, owner in cell._owners.items():
+        if owner in exclude:
+            for link in links:
+                p.setCollisionFilterPair(cell.robot, body, link, -1, int(enable), physicsClientId=cell.client)
+
+
+def contacts_into(cell, found: dict) -> None:
+    """Add the robot's contacts now to ``found`` (part label -> deepest penetration, m)."""
+    for contact in cell.p.getContactPoints(bodyA=cell.robot, physicsClientId=cell.client):
+        depth = -contact[8]
+        if depth > 0.0 and contact[2] in cell._bodies:
+            label = cell._bodies[contact[2]]
+            found[label] = max(found.get(label, 0.0), depth)
+
+
+def drive(cell, q, qd) -> None:
+    """Hand joint targets (rad) and velocities (rad/s) to the position control."""
+    cell.p.setJointMotorControlArray(cell.robot, cell.arm, cell.p.POSITION_CONTROL, targetPositions=q,
+                                     targetVelocities=qd, forces=_EFFORT, positionGains=_GAINS,
+                                     velocityGains=_GAINS, physicsClientId=cell.client)
+
+
+def execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
+    """Run ``plan`` under position control at 1 kHz, the parts in ``exclude`` ignored; a
+    ``hold`` keeps one joint still for a while (its command runs on: open loop)."""
+    p = cell.p
+    n_steps = int(math.ceil((plan.duration + SETTLE) / SIM_STEP))
+    positions, velocities = plan.command(np.arange(n_steps) * SIM_STEP)
+    cell._set_joints(positions[0])
+    position_list, velocity_list = positions.tolist(), velocities.tolist()
+    record = Recorder(cell, n_steps, frames)
+    ignore(cell, exclude, False)
+    held = None
+    # The 1 kHz loop is most of a simulation's cost: PyBullet's calls bound once, the
+    # recorder visited only on the steps it records.
+    robot, client, arm, mode, step_simulation = cell.robot, cell.client, cell.arm, p.POSITION_CONTROL, p.stepSimulation
+    motors, contact_points, contacts = p.setJointMotorControlArray, p.getContactPoints, record.contacts
+    bodies = cell._bodies
+    visit = np.zeros(n_steps, dtype=bool)
+    visit[::RECORD_EVERY] = True
+    visit[-1] = True
+    visit[list(record.frame_steps)] = True
+    try:
+        for step in range(n_steps):
+            t = step * SIM_STEP
+            q, qd = position_list[step], velocity_list[step]
+            if hold is not None and hold.start <= t < hold.start + hold.duration:
+                if held is None:
+                    held = p.getJointState(robot, hold.joint, physicsClientId=client)[0]
+                q, qd = list(q), list(qd)
+                q[hold.joint], qd[hold.joint] = held, 0.0
+            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=_EFFORT, positionGains=_GAINS,
+                   velocityGains=_GAINS, physicsClientId=client)
+            step_simulation(physicsClientId=client)
+            for contact in contact_points(bodyA=robot, physicsClientId=client):
+                if contact[8] < 0.0 and contact[2] in bodies:
+                    label = bodies[contact[2]]
+                    contacts[label] = max(contacts.get(label, 0.0), -contact[8])
+            if visit[step]:
+                record.sample(step, t + SIM_STEP, positions[step])
+    finally:
+        ignore(cell, exclude, True)
+    return record.finish()
+
+
+def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
+                        frames: int = 0, max_factor: float = 4.0) -> Execution:
+    """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
+
+    Each control step asks the stepper for the command given where the TCP is, solves IK
+    and hands the joints to the 1 kHz position control, which moves linearly from the last
+    control step's joints to these over the next 10 ms. With phase stopping the motion's
+    own time stands still while the robot is held. The run ends when the stepper's time has
+    reached ``duration`` (at most ``max_factor`` times that in wall time) plus the settling.
+    """
+    p = cell.p
+    q, error = cell.solve_ik(np.asarray(stepper.y) * cell.unit, _REST)
+    if error > IK_TOLERANCE:
+        raise SimError(f"the start {np.round(stepper.y, 2).tolist()} is unreachable")
+    cell._set_joints(q)
+    every = int(round(CONTROL_STEP / SIM_STEP))
+    longest = max_factor * duration + (0.0 if hold is None else hold.duration)
+    n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
+    record = Recorder(cell, n_steps, frames)
+    ignore(cell, exclude, False)
+    command, previous, held, settle_from = q, q, None, None
+    times, commands, clock = [], [], []
+    # A rate limiter on the joint command, as the Panda's own interface has: the stepper's
+    # command changes pace abruptly when phase stopping engages or lets go, and the joints
+    # must not follow that jump faster than their limits allow.
+    speed, max_speed = np.zeros(7), LIMIT_MARGIN * np.asarray(PANDA.velocity)
+    max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
+
+    def limited(wanted, command, speed):
+        """The next command towards ``wanted`` and its joint speed, within the limits."""
+        speed = np.clip(np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change),
+                        -max_speed, max_speed)
+        return command + speed * CONTROL_STEP, speed
+
+    step = 0
+    try:
+        for step in range(n_steps):
+            t = step * SIM_STEP
+            if step % every == 0:
+                previous = command
+                if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
+                    break
+                if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
+                    measured = cell.tcp_position() / cell.unit
+                    y, _, _ = stepper.step(CONTROL_STEP, measured)
+                    wanted, _ = cell.solve_ik(np.asarray(y) * cell.unit, command)
+                command, speed = limited(wanted, command, speed)
+                times.append(t)
+                commands.append(command)
+                clock.append(stepper.time)
+                if settle_from is None and stepper.time >= duration:
+                    settle_from = step
+            share = (step % every + 1) / every
+            between = previous + share * (command - previous)  # linear over the 10 ms
+            q = between.tolist()
+            qd = ((command - previous) / CONTROL_STEP).tolist()
+            if hold is not None and hold.start <= t < hold.start + hold.duration:
+                if held is None:
+                    held = p.getJointState(cell.robot, hold.joint, physicsClientId=cell.client)[0]
+                q[hold.joint], qd[hold.joint] = held, 0.0
+            drive(cell, q, qd)
+            p.stepSimulation(physicsClientId=cell.client)
+            record.sample(step, t + SIM_STEP, between, contacts=True, every_step=True)
+    finally:
+        ignore(cell, exclude, True)
+    run = record.finish()
+    run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(commands), np.array(clock)
+    return run
+
+
+class Recorder:
+    """Measured samples of one execution (every step) and optional frames."""
+
+    def __init__(self, cell, n_steps: int, frames: int):
+        self.cell = cell
+        self.n_steps = n_steps
+        n_records = (n_steps - 1) // RECORD_EVERY + 1
+        self.times = np.empty(n_records)
+        self.tcp = np.empty((n_records, 3))
+        self.tcp_orientation = np.empty((n_records, 4))
+        self.joints = np.empty((n_records, 7))
+        self.velocities = np.empty((n_records, 7))
+        self.commanded = []
+        self.contacts = {}
+        self.frame_steps = set(np.linspace(0, n_steps - 1, frames).astype(int).tolist()) if frames else set()
+        self.frames = []
+        self.filled = 0
+
+    def sample(self, step: int, t: float, commanded_joints, contacts: bool = False, every_step: bool = False) -> None:
+        """Record step ``step`` (the loop calls it on recorded steps only, or ``every_step``)."""
+        cell = self.cell
+        p = cell.p
+        if contacts:
+            contacts_into(cell, self.contacts)
+        if step in self.frame_steps:
+            self.frames.append(cell.render())
+        if every_step and step % RECORD_EVERY and step != self.n_steps - 1:
+            return
+        row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
+        self.filled = row + 1
+        self.times[row] = t
+        state = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client)
+        self.tcp[row], self.tcp_orientation[row] = state[4], state[5]
+        states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
+        self.joints[row] = [s[0] for s in states]
+        self.velocities[row] = [s[1] for s in states]
+        if row % 10 == 0 or step == self.n_steps - 1:  # the command's TCP, 50 Hz (forward kinematics)
+            self.commanded.append((row, np.asarray(commanded_joints, dtype=float).copy()))
+
+    def finish(self) -> Execution:
+        """The execution (cut to the rows recorded when the run ended early)."""
+        cell = self.cell
+        n_rows = self.filled
+        rows = [r for r, _ in self.commanded if r < n_rows]
+        commanded = np.array([cell.forward(q) for r, q in self.commanded if r < n_rows])
+        full = np.column_stack([np.interp(np.arange(n_rows), rows, commanded[:, k]) for k in range(3)])
+        run = Execution(self.times[:n_rows], self.tcp[:n_rows], self.joints[:n_rows], self.velocities[:n_rows], full,
+                        self.contacts, self.frames)
+        run.tcp_orientation = self.tcp_orientation[:n_rows]
+        return run

@@ -1,0 +1,97 @@
+"""The PyBullet world: pybullet imported quietly, the Panda's URDF with the scenario's tool, and the
+scene's parts as static bodies."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..._checks import require_extra
+
+__all__ = ["pybullet_module", "panda_urdf", "add_solid", "colour", "SOLVER_ITERATIONS"]
+
+SOLVER_ITERATIONS = 20
+
+
+def pybullet_module():
+    """Import pybullet without its banner (it writes one line from C to the process's stderr on
+    import; a library must not)."""
+    import sys
+
+    module = sys.modules.get("pybullet")
+    if module is not None:
+        return module
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), 2)
+            try:
+                return require_extra("pybullet", "sim", "the simulator (bidmp sim)")
+            finally:
+                os.dup2(saved[0], 1)
+                os.dup2(saved[1], 2)
+    finally:
+        for fd in saved:
+            os.close(fd)
+
+
+def panda_urdf(tool_radius: float, tool_length: float) -> str:
+    """The Panda of pybullet_data with its hand replaced by a cylindrical tool (metres): link
+    ``tool`` on the flange, link ``tcp`` at the tool's mouth."""
+    import pybullet_data
+
+    folder = Path(pybullet_data.getDataPath()) / "franka_panda"
+    text = (folder / "panda.urdf").read_text()
+    cut = text.index('<joint name="panda_hand_joint"')
+    inertia = 'ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"'
+    tool = (
+        f'  <joint name="tool_joint" type="fixed"><parent link="panda_link8"/><child link="tool"/>'
+        f'<origin rpy="0 0 0" xyz="0 0 {tool_length / 2}"/></joint>\n'
+        f'  <link name="tool"><inertial><origin xyz="0 0 0"/><mass value="0.3"/><inertia {inertia}/></inertial>'
+        f'<visual><geometry><cylinder radius="{tool_radius}" length="{tool_length}"/></geometry>'
+        f'<material name="socket"><color rgba="0.25 0.25 0.28 1"/></material></visual>'
+        f'<collision><geometry><cylinder radius="{tool_radius}" length="{tool_length}"/></geometry></collision></link>\n'
+        f'  <joint name="tcp_joint" type="fixed"><parent link="tool"/><child link="tcp"/>'
+        f'<origin rpy="0 0 0" xyz="0 0 {tool_length / 2}"/></joint>\n'
+        f'  <link name="tcp"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+        f'</inertial></link>\n</robot>\n'
+    )
+    return (text[:cut] + tool).replace("package://meshes/", f"{folder / 'meshes'}/")
+
+
+# -- world -----------------------------------------------------------------------------
+def add_solid(p, client: int, unit: float, solid) -> int:
+    """A static body for one solid of the scene (box, cylinder, or a nut's convex hull), in metres."""
+    if solid.kind == "box":
+        half = [0.5 * v * unit for v in solid.params]
+        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=colour(solid), physicsClientId=client)
+    elif solid.kind == "cylinder":
+        radius, height = solid.params[0] * unit, solid.params[1] * unit
+        shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=client)
+        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=colour(solid),
+                                     physicsClientId=client)
+    else:  # the hex nut: its convex hull
+        vertices = (np.asarray(solid.params[0]) * unit).tolist()
+        shape = p.createCollisionShape(p.GEOM_MESH, vertices=vertices, physicsClientId=client)
+        extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
+        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
+                                     rgbaColor=colour(solid), physicsClientId=client)
+    from scipy.spatial.transform import Rotation
+
+    orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
+    return p.createMultiBody(0.0, shape, visual, (np.asarray(solid.centre) * unit).tolist(), orientation,
+                             physicsClientId=client)
+
+
+def colour(solid) -> list:
+    if solid.label.endswith("/stud"):
+        return [0.35, 0.35, 0.38, 1.0]
+    if solid.kind == "convex":
+        return [0.75, 0.75, 0.7, 1.0]
+    return [0.55, 0.62, 0.72, 1.0] if solid.params[2] < 20 else [0.35, 0.5, 0.8, 1.0]

@@ -1,0 +1,248 @@
+"""Results of simulated runs, apart from any backend: per target (:class:`SimTarget`), per method
+(:class:`SimMethod`) and per run (:class:`SimReport`), measured from an execution, written as JSON,
+a Markdown table and pictures."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..tasks._tables import markdown_table, text_table
+from ..tasks.metrics import approach_error, axis_deviation
+from .backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
+from .pybullet.robot import PANDA
+
+__all__ = ["SimTarget", "SimMethod", "SimReport", "measure", "write_sim_report"]
+
+
+# ---------------------------------------------------------------------------------------------
+# Results
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class SimTarget:
+    """One executed motion (lengths in the scenario's unit, times in s)."""
+
+    label: str
+    commanded_error: float  # end of the commanded path vs the target
+    measured_error: float  # measured TCP after settling vs the target
+    approach_error: float | None
+    engaged: bool | None
+    contacts: dict  # part label -> penetration depth (scenario unit)
+    peak_velocity: float  # commanded, fractions of the joint limits (largest joint)
+    peak_acceleration: float
+    measured_peak_velocity: float  # what the simulated joints did
+    measured_peak_acceleration: float  # (over 10 ms windows)
+    motion_time: float
+    tracking_error: float  # largest distance between the commanded and the measured TCP
+    within_limits: bool  # the commanded joint motion within the velocity and acceleration limits
+    paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
+    axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
+    aligned: bool | None = None
+
+    def task_success(self, threshold: float) -> bool:
+        return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
+                    and self.within_limits and self.aligned is not False)
+
+    def to_dict(self, threshold: float) -> dict:
+        return {
+            "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
+            "approach_error": None if self.approach_error is None else round(self.approach_error, 4),
+            "engaged": self.engaged, "contacts": sorted(self.contacts),
+            "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
+            "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
+            "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
+            "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4), "paused_s": round(self.paused, 3),
+            "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
+            "within_limits": self.within_limits, "task_success": self.task_success(threshold),
+            "axis_deviation_deg": None if self.axis_deviation is None else round(self.axis_deviation, 4),
+            "aligned": self.aligned,
+        }
+
+
+@dataclass
+class SimMethod:
+    name: str
+    targets: dict  # label -> SimTarget
+    threshold: float
+
+    @property
+    def task_successes(self) -> int:
+        return sum(t.task_success(self.threshold) for t in self.targets.values())
+
+    @property
+    def end_successes(self) -> int:
+        return sum(t.measured_error <= self.threshold for t in self.targets.values())
+
+    @property
+    def engaged(self) -> int | None:
+        values = [t.engaged for t in self.targets.values()]
+        return None if any(v is None for v in values) else sum(values)
+
+    @property
+    def contacts(self) -> int:
+        """Motions with at least one contact."""
+        return sum(bool(t.contacts) for t in self.targets.values())
+
+    @property
+    def within_limits(self) -> int:
+        return sum(t.within_limits for t in self.targets.values())
+
+    @property
+    def aligned(self) -> int | None:
+        values = [t.aligned for t in self.targets.values()]
+        return None if any(v is None for v in values) else sum(values)
+
+    def to_dict(self) -> dict:
+        return {"task_successes": self.task_successes, "end_successes": self.end_successes, "engaged": self.engaged,
+                "aligned": self.aligned,
+                "contacts": self.contacts, "within_limits": self.within_limits, "n_targets": len(self.targets),
+                "targets": {label: t.to_dict(self.threshold) for label, t in self.targets.items()}}
+
+
+@dataclass
+class SimReport:
+    scenario: object
+    methods: dict  # name -> SimMethod
+    base: np.ndarray
+    yaw: float
+    closed_loop: bool
+    simulated_s: float = 0.0
+    wall_s: float = 0.0
+    pictures: list = field(default_factory=list)
+    workers: int = 1
+    limits: object = None  # the robot's JointLimits (default the Panda's)
+
+    def to_dict(self) -> dict:
+        return {"scenario": self.scenario.name, "units": self.scenario.units, "closed_loop": self.closed_loop,
+                "robot": {"base": np.round(self.base, 3).tolist(), "yaw_deg": self.yaw},
+                "success_threshold": self.scenario.success_threshold,
+                "limits": {"velocity_rad_s": list((self.limits or PANDA).velocity),
+                           "acceleration_rad_s2": list((self.limits or PANDA).acceleration),
+                           "timed_to": LIMIT_MARGIN},
+                "methods": {name: method.to_dict() for name, method in self.methods.items()}}
+
+    def rows(self) -> tuple[list[str], list[list[str]]]:
+        poses = any(method.aligned is not None for method in self.methods.values())
+        header = ["method", "end point", "engaged"] + (["aligned"] if poses else []) + \
+            ["contacts", "within limits", "task success", "motion time s"]
+        rows = []
+        for name, method in self.methods.items():
+            n = len(method.targets)
+            times = [t.motion_time for t in method.targets.values()]
+            row = [name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}"]
+            if poses:
+                row.append("-" if method.aligned is None else f"{method.aligned}/{n}")
+            rows.append(row + [f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{method.task_successes}/{n}",
+                               f"{min(times):.1f}-{max(times):.1f}"])
+        return header, rows
+
+    def summary(self) -> str:
+        scenario = self.scenario
+        aligned = (f", tool axis within {scenario.alignment_threshold:g} deg of the nut's" if scenario.is_pose else "")
+        lines = [f"{scenario.name} on a simulated Franka Panda (PyBullet, 1 kHz position control), robot base "
+                 f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
+                 f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
+                 f"no contact with another part, joints within the Panda's velocity and acceleration limits", "",
+                 text_table(*self.rows())]
+        if self.wall_s > 0:
+            lines.append(f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
+                         f"({self.simulated_s / self.wall_s:.1f}x real time, {self.workers} worker process"
+                         f"{'es' if self.workers > 1 else ''})")
+        return "\n".join(lines)
+
+    def markdown(self) -> str:
+        return markdown_table(*self.rows())
+
+
+def measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, run: Execution, unit: float,
+            closed_loop: bool, limits=PANDA) -> SimTarget:
+    """The per-target results of one execution (``scenario``: its targets, units, threshold;
+    ``limits``: the robot's joint limits)."""
+    tcp = run.tcp / unit
+    measured_error = float(np.linalg.norm(tcp[-1] - target))
+    commanded_error = float(np.linalg.norm(plan.points[-1] / unit - target))
+    approach = deviation = None
+    axis = scenario.get("axes", {}).get(label)
+    if scenario["approach_height"] is not None:
+        approach = approach_error(tcp, target, scenario["approach_height"], axis)
+        if scenario.get("alignment_threshold") is not None:
+            deviation = axis_deviation(tcp, run.tcp_orientation, target, scenario["approach_height"], axis)
+    velocity = float(np.max(np.abs(run.joint_velocities) / np.asarray(limits.velocity)))
+    if closed_loop:  # no plan timed it: the commands the stepper produced, 100 Hz
+        command_velocity = np.diff(run.command_joints, axis=0) / CONTROL_STEP
+        command_acceleration = np.diff(command_velocity, axis=0) / CONTROL_STEP
+        peak_velocity = float(np.max(np.abs(command_velocity) / np.asarray(limits.velocity)))
+        peak_acceleration = float(np.max(np.abs(command_acceleration) / np.asarray(limits.acceleration)))
+        motion_time = float(run.times[-1]) - SETTLE
+    else:
+        peak_velocity, peak_acceleration, motion_time = plan.peak_velocity, plan.peak_acceleration, plan.duration
+    return SimTarget(
+        label=label, commanded_error=commanded_error, measured_error=measured_error, approach_error=approach,
+        engaged=None if approach is None else bool(approach <= scenario["success_threshold"]),
+        contacts={k: v / unit for k, v in run.contacts.items()}, peak_velocity=peak_velocity,
+        peak_acceleration=peak_acceleration, measured_peak_velocity=velocity,
+        measured_peak_acceleration=measured_acceleration(run, limits), motion_time=motion_time,
+        tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
+        within_limits=bool(peak_velocity <= 1.0 + 1e-9 and peak_acceleration <= 1.0 + 1e-9), paused=run.paused,
+        axis_deviation=deviation,
+        aligned=None if deviation is None else bool(deviation <= scenario["alignment_threshold"]))
+
+
+def measured_acceleration(run: Execution, limits=PANDA) -> float:
+    """Peak joint acceleration (fraction of the limits) of a measured run, over 10 ms windows."""
+    window = int(round(0.01 / (SIM_STEP * RECORD_EVERY)))
+    velocity = run.joint_velocities[::window]
+    acceleration = np.diff(velocity, axis=0) / (window * SIM_STEP * RECORD_EVERY)
+    return float(np.max(np.abs(acceleration) / np.asarray(limits.acceleration))) if len(acceleration) else 0.0
+
+
+# ---------------------------------------------------------------------------------------------
+# Writing
+# ---------------------------------------------------------------------------------------------
+def write_sim_report(report: SimReport, out) -> list[Path]:
+    """``sim_results.json``, ``sim.md`` (the table), a keyframe strip per method and, when both dmp and bidmp have
+    frames of the same target, an animated GIF of the two side by side."""
+    from ..io.files import atomic_write
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [out / "sim_results.json", out / "sim.md"]
+    with atomic_write(written[0], "w") as handle:
+        json.dump(report.to_dict(), handle, indent=2)
+    with atomic_write(written[1], "w") as handle:
+        handle.write(report.markdown() + "\n")
+    by_method = {}
+    for method, label, frames in report.pictures:
+        by_method.setdefault(method, (label, frames))
+    for method, (_, frames) in by_method.items():
+        written.append(_write_strip(out / f"sim_keyframes_{method}.png", frames[:: max(1, len(frames) // 6)][:6]))
+    if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
+        written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1]))
+    return written
+
+
+def _write_strip(path: Path, frames) -> Path:
+    from PIL import Image
+
+    from ..io.files import atomic_write
+
+    strip = np.concatenate(frames, axis=1)
+    with atomic_write(path, "wb") as handle:
+        Image.fromarray(strip).save(handle, format="PNG")
+    return path
+
+
+def _write_gif(path: Path, left, right) -> Path:
+    from PIL import Image
+
+    from ..io.files import atomic_write
+
+    n = min(len(left), len(right))
+    images = [Image.fromarray(np.concatenate([left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]], axis=1))
+              for i in range(n)]
+    with atomic_write(path, "wb") as handle:
+        images[0].save(handle, format="GIF", save_all=True, append_images=images[1:], duration=120, loop=0)
+    return path

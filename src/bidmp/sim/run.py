@@ -1,0 +1,182 @@
+"""Simulated task runs: every method's motion to every target executed on a simulator backend, in
+worker processes (each with its own world), measured into a :class:`bidmp.sim.report.SimReport`."""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import check_int, check_real
+from .backend import COUPLING, Hold
+from .pybullet.cell import PandaCell
+from .pybullet.robot import robot_placement, unit_of
+from .pybullet.world import pybullet_module
+from .report import SimMethod, SimReport, measure
+
+__all__ = ["simulate"]
+
+
+@dataclass
+class _Job:
+    """One motion to execute (what a worker process needs, picklable)."""
+
+    method: str
+    label: str
+    rollout: np.ndarray  # (n, 3) scenario units
+    exclude: list
+    frames: int
+    orientations: np.ndarray | None = None  # (n, 4) a pose skill's tool frames
+
+
+def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
+    """Execute ``jobs`` in one PyBullet world; returns (method, label, SimTarget, frames, seconds)."""
+    from ..scene.geometry import Scene
+
+    scenario = setup["scenario"]
+    scene = Scene.from_dict(setup["scene"], scenario["targets"])
+    results = []
+    with setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"]) as cell:
+        for job in jobs:
+            if progress is not None:
+                progress(job.method, job.label)
+            plan = cell.plan(job.rollout, job.label, orientations=job.orientations)
+            if setup["closed_loop"] and job.orientations is not None:
+                raise ValueError("closed_loop runs position skills; this scenario's are poses")
+            target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
+            if setup["closed_loop"]:
+                stepper = _stepper(setup["models"], job.method, target, plan.duration, setup["coupling"])
+                run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
+            else:
+                run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
+            measured = measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
+            results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
+    return results
+
+
+def _run_chunk(setup: dict, jobs: list) -> list:
+    return _run_jobs(setup, jobs)
+
+
+def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, targets=None, hold: Hold | None = None,
+             coupling: float | None = None, progress=None, frames: dict | None = None, report=None,
+             workers: int | None = None, backend=None) -> SimReport:
+    """Execute ``methods`` on every target of ``scenario`` on the simulated Panda.
+
+    Parameters
+    ----------
+    scenario : Scenario or str
+        Needs a ``"scene"``; ``"robot": {"base": [x, y, z], "yaw": deg}`` places the arm
+        (default :func:`robot_placement`).
+    methods : sequence of str
+        Evaluation methods (dmp, bidmp, ...): their rollouts are what is executed.
+    closed_loop : bool
+        Run the DMP/Bi-DMP stepper on the measured TCP with phase stopping, for dmp and bidmp.
+    coupling : float, optional
+        Phase stopping's ``alpha_e`` in 1/unit² (default :data:`COUPLING` per m², 0.5 /mm²: a
+        0.3 mm lag slows the motion by 5 %, a 3 mm one 5.5 times).
+    targets : list of str, optional
+        A subset of the targets (default all).
+    hold : Hold, optional
+        A scripted disturbance in every motion.
+    progress : callable, optional
+        Called with ``(method, label)`` as each motion starts (in-process) or finishes (workers).
+    frames : dict, optional
+        ``{(method, label): n}``: render n frames of those motions (PyBullet's TinyRenderer).
+    report : bidmp.evaluation.Report, optional
+        A finished evaluation of the same scenario to take the rollouts from.
+    workers : int, optional
+        Worker processes, each with its own PyBullet world (default: one per core, at most 2;
+        1 runs in this process). Results do not depend on it.
+    backend : class, optional
+        A simulator backend (:class:`bidmp.sim.backend.SimulatorBackend`); default the PyBullet
+        Panda, :class:`bidmp.sim.pybullet.PandaCell`.
+
+    Returns
+    -------
+    SimReport
+    """
+    from ..tasks import scenarios as scenario_module
+    from ..tasks.evaluation import evaluate
+
+    if not isinstance(scenario, scenario_module.Scenario):
+        scenario = scenario_module.load(scenario)
+    if scenario.scene is None:
+        raise ValueError(f"scenario {scenario.name!r} has no \"scene\": the simulator needs the parts and the tool")
+    if backend is None:
+        pybullet_module()  # fail early, with the install command, when the extra is missing
+        backend = PandaCell
+    methods = list(dict.fromkeys(methods))
+    if not methods:
+        raise ValueError("methods is empty: name at least one of dmp, bidmp, ...")
+    labels = scenario.labels if targets is None else list(targets)
+    for label in labels:
+        if label not in scenario.targets:
+            raise ValueError(f"unknown target {label!r}; the scenario's targets: {', '.join(scenario.labels[:20])}")
+    from ..tasks import methods as registry
+
+    open_only = [name for name in methods if not registry.get(name).closed_loop]
+    if closed_loop and open_only:
+        raise ValueError(f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
+                         f"{', '.join(registry.names(closed_loop=True))})")
+    coupling = COUPLING * unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
+    if report is None:
+        report = evaluate(scenario, methods, geometry=False)
+    base, yaw = robot_placement(scenario)
+    scene = scenario.scene
+    frames = frames or {}
+    jobs = [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
+                 scene.target_parts(label, scenario.targets[label]),
+                 int(frames.get((method, label), 0)),
+                 None if report.methods[method].orientations is None else report.methods[method].orientations[label])
+            for method in methods for label in labels]
+    models = {name: report.fitted[name] for name in methods} if closed_loop else None
+    setup = {"scenario": {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
+                          "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold,
+                          "axes": {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
+                                   for label in labels},
+                          "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None},
+             "scene": scene.to_dict(), "base": base.tolist(), "yaw": yaw, "closed_loop": closed_loop, "hold": hold,
+             "coupling": coupling, "models": models, "backend": backend}
+    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+    n_workers = max(1, min(n_workers, len(jobs)))
+    start = time.perf_counter()
+    if n_workers == 1:
+        outcomes = _run_jobs(setup, jobs, progress)
+    else:
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        # Interleaved chunks balance long and short motions. "fork" (where there is one) starts
+        # the workers in milliseconds and works from any __main__; "spawn" elsewhere.
+        chunks = [jobs[k::n_workers] for k in range(n_workers)]
+        outcomes = []
+        method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+        with ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(method)) as pool:
+            futures = [pool.submit(_run_chunk, setup, chunk) for chunk in chunks]
+            for future in as_completed(futures):
+                for outcome in future.result():
+                    if progress is not None:
+                        progress(outcome[0], outcome[1])
+                    outcomes.append(outcome)
+    by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds in outcomes}
+    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=getattr(backend, "limits", None))
+    for method in methods:
+        out.methods[method] = SimMethod(method, {label: by_key[(method, label)][0] for label in labels},
+                                        scenario.success_threshold)
+        for label in labels:
+            if by_key[(method, label)][1]:
+                out.pictures.append((method, label, by_key[(method, label)][1]))
+    out.simulated_s = sum(value[2] for value in by_key.values())
+    out.wall_s = time.perf_counter() - start
+    out.workers = n_workers
+    return out
+
+
+def _stepper(models, method, goal, duration, coupling):
+    """The registered method's stepper to ``goal`` on its fitted model."""
+    from ..tasks import methods as registry
+
+    return registry.get(method).stepper(models[method], goal, duration, coupling)
