@@ -28,7 +28,7 @@ OLD_PATHS: dict[str, tuple[str, ...]] = {
     "bidmp.similarity": ("bidmp.extension.similarity",),
     "bidmp.roadmap": ("bidmp.extension.roadmap",),
     "bidmp.bls": ("bidmp.incremental.bls",),
-    "bidmp.geometry": ("bidmp.scene.geometry",),
+    "bidmp.geometry": ("bidmp.scene.parts", "bidmp.scene.clearance", "bidmp.scene.checker", "bidmp.scene.distances"),
     "bidmp.scenarios": ("bidmp.tasks.scenarios",),
     "bidmp.evaluation": ("bidmp.tasks.evaluation",),
     "bidmp.metrics": ("bidmp.tasks.metrics",),

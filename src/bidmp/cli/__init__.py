@@ -47,7 +47,7 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
         for name in lasa_names():
             print(name)
         return EXIT_OK
-    from ..io.files import save_trajectory
+    from ..io.trajectories import save_trajectory
 
     demos = lasa(args.name)
     if not 0 <= args.demo < demos.shape[0]:
@@ -188,7 +188,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 
 def _lasa_demo(shape: str, out) -> int:
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
     from ..plotting.figures import plot_generalisation
     from ..experiments.reproduce import lasa_generalisation
 

@@ -87,7 +87,8 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     it has another), checked against ``model``'s units; timed input prepared unless ``--raw``.
     """
     from .._units import check_units, conversion
-    from ..io.files import declared_units, read_poses, read_trajectory
+    from ..io.trajectories import declared_units, read_trajectory
+    from ..io.poses import read_poses
 
     requested = check_units(args.units or "", "--units")
     values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)

@@ -18,7 +18,7 @@ def _skills_model(args: argparse.Namespace, command: str):
     from ..incremental.cartesian import CartesianBiDMP
     from ..primitives.dmp import DMP
     from ..incremental.bidmp import BiDMP
-    from ..io.files import load_model
+    from ..io.models import load_model
 
     if not args.output.lower().endswith(".npz"):
         hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
@@ -59,7 +59,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     from .._trajectory import resample_time
     from ..primitives.dmp import DMP
-    from ..io.files import save_model
+    from ..io.models import save_model
     from ..tasks.metrics import path_extent
 
     if is_pose_file(args.demo):
@@ -92,7 +92,7 @@ def _fit_poses(args: argparse.Namespace) -> int:
     import numpy as np
 
     from ..primitives.cartesian import CartesianDMP, angle_between
-    from ..io.files import save_model
+    from ..io.models import save_model
 
     poses, times, units, how = read_input(args.demo, args, poses=True)
     model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
@@ -153,7 +153,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     from ..incremental.cartesian import CartesianBiDMP
     from ..primitives.dmp import DMP
     from ..incremental.bidmp import BiDMP
-    from ..io.files import load_model, save_poses, save_trajectory
+    from ..io.models import load_model
+    from ..io.poses import save_poses
+    from ..io.trajectories import save_trajectory
 
     model = load_model(args.model)
     if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
@@ -252,7 +254,9 @@ def cmd_extend(args: argparse.Namespace) -> int:
     from .._trajectory import resample_time
     from ..incremental.cartesian import CartesianBiDMP
     from ..extension.extend import extend_demonstration, extend_pose_demonstration
-    from ..io.files import save_model, save_poses, save_trajectory
+    from ..io.models import save_model
+    from ..io.poses import save_poses
+    from ..io.trajectories import save_trajectory
     from ..tasks.metrics import path_extent, rmse
 
     model = _skills_model(args, "extend")
@@ -308,7 +312,7 @@ def cmd_learn(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time, rmse
-    from ..io.files import save_model
+    from ..io.models import save_model
 
     model = _skills_model(args, "learn")
     y, _, how = _demo_for(model, args)

@@ -184,6 +184,6 @@ def recording(name: str) -> tuple[np.ndarray, np.ndarray]:
     -------
     (y, t) : array (T, 3) in mm, array (T,) in seconds
     """
-    from ..io.files import read_trajectory
+    from ..io.trajectories import read_trajectory
 
     return read_trajectory(recording_path(name))

@@ -205,7 +205,7 @@ def _cell_path(out: Path, key: str) -> Path:
 
 def _load_cell(path: Path, protocol: dict) -> dict | None:
     """A finished cell file, if it holds this protocol's results (else it is recomputed)."""
-    from ..io.files import load_json
+    from ..io.strict_json import load_json
 
     try:
         data = load_json(path.read_bytes(), str(path))
@@ -219,7 +219,7 @@ def _load_cell(path: Path, protocol: dict) -> dict | None:
 
 
 def _write_cell(out: Path, protocol: dict, result: dict) -> None:
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     path = _cell_path(out, result["key"])
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -271,7 +271,7 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     progress : callable, optional
         Called with the cell key as each cell finishes.
     """
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     shapes, methods, indices = _validate(shapes, methods, demos, every)
     check_choice(output_format, "output_format", ("parquet", "csv"))
@@ -341,7 +341,7 @@ _COLUMNS = ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METR
 
 
 def _write_table(rows: list, path: Path, output_format: str) -> None:
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     columns = {name: [row[name] for row in rows] for name in _COLUMNS}
     if output_format == "csv":
@@ -393,7 +393,7 @@ def summary_markdown(rows: list, protocol: dict) -> str:
 def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
     """A per-shape grid (demonstration 0's reproductions) and metric box plots."""
     from ..demonstrations.datasets import lasa as lasa_data
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
     from ..plotting.figures import _matplotlib
 
     mpl = _matplotlib()

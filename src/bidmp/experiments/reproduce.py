@@ -25,7 +25,7 @@ from ..primitives.dmp import DMP
 from ..tasks.evaluation import Report, evaluate, write_report
 from ..extension.extend import ExtendedDemonstration, extend_demonstration
 from ..incremental.bidmp import BiDMP, ForgettingResult, forgetting_runs
-from ..io.files import atomic_write
+from ..io.atomic import atomic_write
 from ..extension.roadmap import RoadmapResult, classic_prm, gaussian_prm
 
 MAX_SEEDS = 200  # seeds of one G-PRM vs PRM comparison (each runs both roadmaps, ~30 ms a seed)

@@ -1,8 +1,14 @@
-"""Files: trajectory and pose CSV/NPY files, model files (``.npz`` + JSON metadata, never pickles),
-strict JSON, and atomic writes (temporary file, then rename).
+"""Files: trajectory and pose files (CSV/NPY), model files (``.npz`` + JSON metadata, never
+pickles), strict JSON, and atomic writes (temporary file, then rename).
 
-Layer 2 (data): imports the math only to build the objects it reads; never ``tasks``, ``sim`` or
-``cli``.
+* ``trajectories``, ``poses`` — read and write recordings and generated motions;
+* ``models`` — :func:`save_model` / :func:`load_model` for every model class, every format since 1;
+* ``strict_json`` — JSON with size and depth caps, no NaN;
+* ``atomic`` — :func:`atomic_write`.
+
+**Reads** never trust a file: sizes are checked from the headers before anything is allocated
+(:class:`bidmp.Limits`). Layer 2 (data): imports the math only to build the objects it reads;
+never ``tasks``, ``sim`` or ``cli``.
 """
 
 from __future__ import annotations
@@ -11,18 +17,20 @@ from .._lazy import exports
 
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
-    "ModelFileError": "files",
-    "FORMAT_VERSION": "files",
-    "save_model": "files",
-    "load_model": "files",
-    "load_trajectory": "files",
-    "read_trajectory": "files",
-    "read_poses": "files",
-    "save_poses": "files",
-    "save_trajectory": "files",
-    "atomic_write": "files",
-    "load_json": "files",
+    "ModelFileError": "models",
+    "FORMAT_VERSION": "models",
+    "save_model": "models",
+    "load_model": "models",
+    "load_trajectory": "trajectories",
+    "read_trajectory": "trajectories",
+    "save_trajectory": "trajectories",
+    "declared_units": "trajectories",
+    "read_poses": "poses",
+    "save_poses": "poses",
+    "atomic_write": "atomic",
+    "load_json": "strict_json",
 }
 __all__ = list(_EXPORTS)
 # what the flat module bidmp.io of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("files",))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(),
+                               fallback=("models", "trajectories", "poses", "atomic", "strict_json", "_csv", "_npy"))

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import as_points, as_trajectory
-from ..io.files import atomic_write
+from ..io.atomic import atomic_write
 
 __all__ = ["plot_trajectories", "plot_generalisation", "plot_segmentation", "plot_extension", "plot_prm_comparison", "plot_incremental", "plot_targets_top_view",
            "plot_error_vs_distance", "plot_scenario_3d"]

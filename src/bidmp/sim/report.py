@@ -205,7 +205,7 @@ def measured_acceleration(run: Execution, limits=PANDA) -> float:
 def write_sim_report(report: SimReport, out) -> list[Path]:
     """``sim_results.json``, ``sim.md`` (the table), a keyframe strip per method and, when both dmp and bidmp have
     frames of the same target, an animated GIF of the two side by side."""
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -227,7 +227,7 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
 def _write_strip(path: Path, frames) -> Path:
     from PIL import Image
 
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     strip = np.concatenate(frames, axis=1)
     with atomic_write(path, "wb") as handle:
@@ -238,7 +238,7 @@ def _write_strip(path: Path, frames) -> Path:
 def _write_gif(path: Path, left, right) -> Path:
     from PIL import Image
 
-    from ..io.files import atomic_write
+    from ..io.atomic import atomic_write
 
     n = min(len(left), len(right))
     images = [Image.fromarray(np.concatenate([left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]], axis=1))

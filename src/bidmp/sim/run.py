@@ -33,7 +33,7 @@ class _Job:
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
     """Execute ``jobs`` in one PyBullet world; returns (method, label, SimTarget, frames, seconds)."""
-    from ..scene.geometry import Scene
+    from ..scene.clearance import Scene
 
     scenario = setup["scenario"]
     scene = Scene.from_dict(setup["scene"], scenario["targets"])

@@ -63,8 +63,10 @@ import numpy as np
 
 from .._checks import check_limit, get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
-from ..scene.geometry import Scene, SceneError
-from ..io.files import load_json, read_trajectory
+from ..scene.clearance import Scene
+from ..scene.parts import SceneError
+from ..io.strict_json import load_json
+from ..io.trajectories import read_trajectory
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
@@ -231,7 +233,7 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
 def _prepared_file(path, units: str) -> np.ndarray:
     """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
     trimmed, filtered, uniform time); a declared unit must be the scenario's."""
-    from ..io.files import declared_units
+    from ..io.trajectories import declared_units
     from ..demonstrations.prepare import prepare
 
     declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""

@@ -1,0 +1,246 @@
+"""Model files: an ``.npz`` archive (a zip of ``.npy`` members, stored or deflated) holding the
+model's arrays under their attribute names plus ``__bidmp__``, a uint8 array with UTF-8 JSON::
+
+    {"format": "bidmp-model", "format_version": 4, "class": "DMP",
+     "bidmp_version": "0.5.0", "state": {...class-specific, e.g. constructor params...}}
+
+It is read member by member with ``allow_pickle=False``, so loading a file can never execute
+code, and a member the model does not ask for is never read; every array is checked for dtype,
+shape and finiteness by the model class. Files of every earlier format load."""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import zipfile
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+
+from .._checks import check_limit, get_limits, short_token
+from ._npy import _EMPTY_ZIP_MAGIC, _NPY_MAGIC, _ZIP_MAGIC, _read_npy, _read_npy_header
+from .atomic import _destination, atomic_write
+from .strict_json import load_json
+
+__all__ = ['ModelFileError', 'FORMAT_VERSION', 'save_model', 'load_model']
+
+logger = logging.getLogger(__name__)
+
+
+FORMAT_VERSION = 4
+# Format 4 (bidmp 0.4): a DMP stores its integrator ("exact" for the robot protocol); files without
+# one load with explicit Euler, so a format-3 robot model rolls out as it did. Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
+# Bi-DMP increments are gated by the phase and the DMP's regression is stored as "regression".
+# Format-1 and -2 DMP and BLS files still load (as protocol "paper", 1 s, no units); format-1
+# Bi-DMP files do not, because their blocks were trained on the ungated increment.
+_MIN_VERSION = {"BiDMP": 2}
+_FORMAT_NAME = "bidmp-model"
+_META_KEY = "__bidmp__"
+_META_MAX_BYTES = 16 << 20
+_MAX_MEMBERS = 100_000
+# Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
+# reading a DMP does not import the whole pipeline.
+_MODEL_CLASSES = {
+    "DMP": ("bidmp.primitives.dmp", "DMP"),
+    "BLS": ("bidmp.incremental.bls", "BLS"),
+    "BiDMP": ("bidmp.incremental.bidmp", "BiDMP"),
+    "CartesianDMP": ("bidmp.primitives.cartesian", "CartesianDMP"),
+    "CartesianBiDMP": ("bidmp.incremental.cartesian", "CartesianBiDMP"),
+}
+
+
+class ModelFileError(ValueError):
+    """A model file is missing, corrupt, truncated, foreign, or from a newer bidmp."""
+
+
+def _model_class(name: str):
+    import importlib
+
+    module_name, attribute = _MODEL_CLASSES[name]
+    return getattr(importlib.import_module(module_name), attribute)
+
+
+def _model_path(path: str | os.PathLike) -> Path:
+    """The model file to write: ``path`` with ``.npz`` added when missing. The given path is
+    checked first, so ``-o somefolder`` or ``-o /dev/null`` are refused, not turned into
+    ``somefolder.npz``."""
+    path = Path(path)
+    _destination(path)
+    if path.suffix != ".npz":
+        path = path.with_name(path.name + ".npz")
+    return path
+
+
+def save_model(model, path: str | os.PathLike) -> Path:
+    """Save a fitted model to ``path`` (``.npz``; the suffix is added if missing).
+
+    Returns
+    -------
+    path : Path
+        The path written.
+    """
+    from .. import __version__
+
+    class_name = type(model).__name__
+    if class_name not in _MODEL_CLASSES or not hasattr(model, "_get_state"):
+        raise TypeError(f"model must be one of {', '.join(sorted(_MODEL_CLASSES))}, got {class_name}")
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = _model_path(path)
+    state, arrays = model._get_state()
+    if _META_KEY in arrays:
+        raise ValueError(f"array name {_META_KEY!r} is reserved")
+    meta = {
+        "format": _FORMAT_NAME,
+        "format_version": FORMAT_VERSION,
+        "class": class_name,
+        "bidmp_version": __version__,
+        "state": state,
+    }
+    payload = {name: np.asarray(value) for name, value in arrays.items()}
+    payload[_META_KEY] = np.frombuffer(json.dumps(meta, allow_nan=False).encode("utf-8"), dtype=np.uint8)
+    with atomic_write(path, "wb") as handle:
+        np.savez(handle, **payload)
+    logger.debug("saved %s to %s", class_name, path)
+    return path
+
+
+class _Members(Mapping):
+    """The arrays of an open model archive, read lazily: a member is decompressed and parsed
+    only when a model class asks for it, after its ``.npy`` header passed the size limits."""
+
+    def __init__(self, archive: zipfile.ZipFile, source: str) -> None:
+        self._archive = archive
+        self._source = source
+        self._infos = {info.filename[:-4]: info for info in archive.infolist() if info.filename.endswith(".npy")}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        info = self._infos.get(name)
+        if info is None:
+            raise KeyError(f"missing member {name}")
+        try:
+            return _read_npy(lambda: self._archive.open(info), f"member {name}")
+        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+            message = str(exc) if str(exc).startswith("member ") else f"member {name} is unreadable ({type(exc).__name__}: {exc})"
+            raise ValueError(message) from None
+
+    def __iter__(self):
+        return (name for name in self._infos if name != _META_KEY)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
+def _check_archive(archive: zipfile.ZipFile, path: Path) -> None:
+    """Refuse archives numpy wrote no part of: encrypted or unusually compressed members,
+    declared sizes over the limits, absurd member counts."""
+    infos = archive.infolist()
+    if len(infos) > _MAX_MEMBERS:
+        raise ModelFileError(f"{path} is not a bidmp model file ({len(infos):,} archive members)")
+    budget = get_limits().max_array_bytes + (64 << 10)
+    for info in infos:
+        if info.flag_bits & 0x1:
+            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} is encrypted)")
+        if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} uses an unsupported "
+                                 f"compression, method {info.compress_type})")
+        if info.file_size > budget:
+            raise ModelFileError(f"{path}: member {info.filename} declares {info.file_size / 2**30:.3g} GiB, over the limit "
+                                 f"max_array_bytes = {get_limits().max_array_bytes:,}; raise it with "
+                                 f"bidmp.set_limits(max_array_bytes=...)")
+        if not info.filename.endswith(".npy"):
+            raise ModelFileError(f"{path} is not a bidmp model file (member {short_token(info.filename, 40)} is not an .npy array)")
+        # Every member's header (a few hundred bytes) is checked, so that a pickled or oversized
+        # member is refused even if the model would never ask for it; the data are not read.
+        try:
+            with archive.open(info) as stream:
+                _read_npy_header(stream, f"member {short_token(info.filename[:-4], 40)}")
+        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+            raise ModelFileError(f"{path} is not a bidmp model file ({exc})") from None
+
+
+def _read_meta(members: _Members, path: Path) -> dict:
+    if _META_KEY not in members._infos:
+        raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
+
+    def check(shape, dtype):
+        if dtype != np.uint8 or len(shape) != 1 or shape[0] > _META_MAX_BYTES:
+            raise ValueError(f"{path} is not a bidmp model file (its metadata member is not UTF-8 JSON bytes)")
+
+    try:
+        raw = _read_npy(lambda: members._archive.open(members._infos[_META_KEY]), "the metadata member", check)
+        meta = load_json(raw.tobytes(), f"{path} metadata")
+    except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+        raise ModelFileError(f"{path} is not a readable bidmp model file ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != _FORMAT_NAME:
+        raise ModelFileError(f"{path} is not a bidmp model file (unknown metadata format)")
+    return meta
+
+
+def load_model(path: str | os.PathLike):
+    """Load a model written by :func:`save_model`.
+
+    Only the members the model needs are read, each after its header passed the size limits, and
+    the model class validates every array (dtype, shape, finite) before it is used.
+
+    Raises
+    ------
+    ModelFileError
+        If the file is missing, not an ``.npz`` archive, truncated or corrupt, has no bidmp
+        metadata (a foreign file), was written by a newer format version, or its contents are
+        inconsistent (the message names the member).
+    """
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = Path(path)
+    if not path.is_file():
+        raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
+    try:
+        with open(path, "rb") as handle:
+            magic = handle.read(4)
+    except OSError as exc:
+        raise ModelFileError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if magic == _NPY_MAGIC[:4]:
+        raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
+    if magic not in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+        raise ModelFileError(f"{path} is not a bidmp model file (not an .npz archive)")
+    try:
+        archive = zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
+        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from None
+    with archive:
+        _check_archive(archive, path)
+        members = _Members(archive, str(path))
+        meta = _read_meta(members, path)
+        version = meta.get("format_version")
+        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+            raise ModelFileError(f"{path} has an invalid format_version {short_token(version)}")
+        if version > FORMAT_VERSION:
+            raise ModelFileError(
+                f"{path} was written in model format {version} by bidmp {short_token(meta.get('bidmp_version', '?'), 20)}; "
+                f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
+            )
+        class_name = meta.get("class")
+        if not isinstance(class_name, str) or class_name not in _MODEL_CLASSES:
+            raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
+        if version < _MIN_VERSION.get(class_name, 1):
+            raise ModelFileError(
+                f"{path} holds a {class_name} in model format {version} (bidmp {short_token(meta.get('bidmp_version', '?'), 20)}), "
+                f"whose learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
+            )
+        state = meta.get("state")
+        if not isinstance(state, dict):
+            raise ModelFileError(f"{path} is corrupt: its metadata has no state object")
+        try:
+            return _model_class(class_name)._from_state(state, members)
+        except MemoryError:
+            raise ModelFileError(f"{path}: a member is too large to load") from None
+        except KeyError as exc:
+            detail = exc.args[0] if exc.args and str(exc.args[0]).startswith("missing member") else f"missing key {exc}"
+            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({detail})") from None
+        except (TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError,
+                zipfile.BadZipFile, EOFError, OSError) as exc:
+            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from None

@@ -1,0 +1,88 @@
+"""The roadmap's collision checker: tool placements and straight tool moves against the scene
+(:func:`bidmp.extension.roadmap.gaussian_prm` calls it)."""
+
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+
+from typing import TYPE_CHECKING
+
+from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _Distances, _cylinder_box_bounds
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .clearance import Scene
+
+__all__ = ['SceneChecker']
+
+logger = logging.getLogger(__name__)
+
+class SceneChecker:
+    """Collision callback for :func:`bidmp.roadmap.gaussian_prm`: ``checker(points)`` says which
+    tool placements are free, :meth:`segments_free` which straight tool moves are."""
+
+    def __init__(self, scene: Scene, chosen: np.ndarray):
+        self.scene = scene
+        self.chosen = chosen
+
+    def __call__(self, points) -> np.ndarray:
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        free = np.ones(points.shape[0], dtype=bool)
+        if self.chosen.size == 0:
+            return free
+        scene = self.scene
+        engine = scene._engine()
+        lower, upper = scene._lower[self.chosen], scene._upper[self.chosen]
+        radius, length = scene.tool.radius, scene.tool.length
+        whole = _cylinder_box_bounds(points, radius, length, lower.min(axis=0)[None], upper.max(axis=0)[None])[:, 0]
+        near = np.flatnonzero(whole <= 0.0)
+        for start in range(0, near.size, _CHUNK):
+            rows = near[start : start + _CHUNK]
+            bounds = _cylinder_box_bounds(points[rows], radius, length, lower, upper)
+            for row, col in zip(*np.nonzero(bounds <= 0.0)):
+                index = rows[row]
+                if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < 0.0:
+                    free[index] = False
+        return free
+
+    def segments_free(self, a, b) -> np.ndarray:
+        """Whether the tool moving straight from ``a[i]`` to ``b[i]`` touches no part, (M,) bool.
+
+        Conservative advancement: the distance to a part changes by at most the distance moved,
+        so the tool may advance by its current clearance without missing a contact."""
+        a = np.asarray(a, dtype=float).reshape(-1, 3)
+        b = np.asarray(b, dtype=float).reshape(-1, 3)
+        free = np.ones(a.shape[0], dtype=bool)
+        if self.chosen.size == 0 or a.shape[0] == 0:
+            return free
+        scene = self.scene
+        radius, length = scene.tool.radius, scene.tool.length
+        lo = np.minimum(a, b) - [radius, radius, 0.0]
+        hi = np.maximum(a, b) + [radius, radius, length]
+        lower, upper = scene._lower[self.chosen], scene._upper[self.chosen]
+        # The swept tool's box against the box around all parts first, then part by part.
+        near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))
+        touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)
+        candidates = [(near[i], j) for i, j in zip(*np.nonzero(touching))]
+        engine = scene._engine()
+        for row, col in candidates:
+            if free[row] and not self._move_free(engine, a[row], b[row], int(self.chosen[col])):
+                free[row] = False
+        return free
+
+    @staticmethod
+    def _move_free(engine: _Distances, a: np.ndarray, b: np.ndarray, index: int) -> bool:
+        length = float(np.linalg.norm(b - a))
+        travelled = 0.0
+        resolution = 1e-9 * max(length, 1.0)
+        for _ in range(_MAX_ADVANCE_STEPS):
+            distance = engine.tool_to(a + (travelled / length) * (b - a) if length > 0 else a, index)
+            if distance < 0.0:
+                return False
+            if travelled >= length:
+                return True
+            travelled = min(travelled + max(distance, resolution), length)  # touching is allowed
+        return False  # grazing for too long: treated as a contact (conservative)

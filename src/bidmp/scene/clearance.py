@@ -1,0 +1,317 @@
+"""The scene and the tool's clearance along a motion.
+
+A :class:`Scene` holds labelled parts (boxes, cylinders, hex nuts with studs, plates, battery
+cells) and a :class:`~bidmp.scene.parts.Tool`: a cylinder of ``radius`` hanging upward from the
+trajectory point (the centre of a socket's mouth) over ``length``. For a trajectory,
+:meth:`Scene.clearance` gives the smallest signed distance between the swept tool and every part
+except those excluded (the target, which enters the socket), with the label of the part it was
+to; negative is a collision (the value is then the penetration depth). :meth:`Scene.checker` is
+the collision callback of the roadmap (:class:`~bidmp.scene.checker.SceneChecker`).
+"""
+
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import as_trajectory, check_real, numerically_guarded, short_token
+from .._trajectory import continuous_quaternions
+
+from .checker import SceneChecker
+from .distances import _CHUNK, _Distances, _box_distance, _cylinder_box_bounds, _densify
+from .parts import Part, Tool, _cylinder_extent, _fail, _number, _parse_parts
+
+__all__ = ['Scene', 'Clearance']
+
+logger = logging.getLogger(__name__)
+
+_SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts"}
+
+
+_OVERLAP_TOLERANCE = 1e-6  # parts may touch (a nut on its plate), not interpenetrate beyond this
+
+
+_DEFAULT_STEP = 0.2  # trajectory checked at most this far apart (scene units)
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """Smallest signed distance between the swept tool and the scene's parts along a motion.
+
+    Attributes
+    ----------
+    distance : float
+        In the scene's unit; negative = the tool penetrates a part by that much; ``inf`` when no
+        part is checked.
+    part : str or None
+        Label of the part (solid) it is to, e.g. ``"4"``, ``"4/stud"``, ``"plate"``.
+    point : array (3,) or None
+        Trajectory point (tool-centre point) where it occurs.
+    """
+
+    distance: float
+    part: str | None
+    point: np.ndarray | None
+
+    @property
+    def collision_free(self) -> bool:
+        return not self.distance < 0.0
+
+    @property
+    def collision_part(self) -> str | None:
+        """The part hit, or None when the motion is collision-free."""
+        return None if self.collision_free else self.part
+
+
+class Scene:
+    """Parts and a tool; clearance of motions (see the module docstring for the data format).
+
+    Parameters
+    ----------
+    parts : sequence of Part
+        Usually built by :meth:`from_dict`.
+    tool : Tool
+    targets : list of str or None
+        Target labels the geometry applies to (None: every target of the scenario).
+    targets_on_parts : bool
+        Whether each of those targets must lie on the part with its label.
+    """
+
+    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True):
+        self.parts = tuple(parts)
+        self.tool = tool
+        self.targets = None if targets is None else list(targets)
+        self.targets_on_parts = bool(targets_on_parts)
+        self.solids = tuple(solid for part in self.parts for solid in part.solids)
+        self._lower = np.array([s.lower for s in self.solids]).reshape(-1, 3)
+        self._upper = np.array([s.upper for s in self.solids]).reshape(-1, 3)
+        self._owner = np.array([s.part for s in self.solids], dtype=object)
+        self._distances = None
+
+    # -- construction ------------------------------------------------------------------------
+    @classmethod
+    def from_dict(cls, data, targets: dict | None = None) -> Scene:
+        """Build and validate a scene from its JSON data; ``targets`` ({label: point}) resolves
+        ``at_targets`` and is checked against ``targets_on_parts``. Raises :class:`SceneError`
+        (a ``ValueError``) naming the key for malformed data, overlapping parts, a target not on
+        its part or a tool of zero size."""
+        if not isinstance(data, dict):
+            _fail("scene", "expected an object with tool and parts")
+        unknown = sorted(set(data) - _SCENE_KEYS)
+        if unknown:
+            _fail(f"scene.{short_token(unknown[0], 20)[1:-1]}", f"unknown key (known: {', '.join(sorted(_SCENE_KEYS))})")
+        tool_data = data.get("tool")
+        if not isinstance(tool_data, dict) or set(tool_data) != {"radius", "length"}:
+            _fail("scene.tool", 'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)')
+        tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}") for k in ("radius", "length")))
+        parts = _parse_parts(data.get("parts"), targets)
+        chosen = data.get("targets", "all")
+        if chosen == "all":
+            chosen = None
+        elif not isinstance(chosen, list) or not all(isinstance(t, str) for t in chosen):
+            _fail("scene.targets", 'expected "all" or a list of target labels')
+        elif targets is not None:
+            for name in chosen:
+                if name not in targets:
+                    _fail("scene.targets", f"{short_token(name, 20)} is not a target label")
+        on_parts = data.get("targets_on_parts", True)
+        if not isinstance(on_parts, bool):
+            _fail("scene.targets_on_parts", "expected true or false")
+        scene = cls(parts, tool, chosen, on_parts)
+        scene.check_overlaps()
+        if targets is not None and on_parts:
+            scene.check_targets(targets)
+        return scene
+
+    def to_dict(self) -> dict:
+        out = {"tool": self.tool.to_dict(), "parts": [dict(part.spec) for part in self.parts],
+               "targets_on_parts": self.targets_on_parts}
+        if self.targets is not None:
+            out["targets"] = list(self.targets)
+        return out
+
+    @property
+    def labels(self) -> list[str]:
+        return [part.label for part in self.parts]
+
+    def part(self, label: str) -> Part:
+        for part in self.parts:
+            if part.label == label:
+                return part
+        raise KeyError(f"no part labelled {label!r}")
+
+    def applies_to(self, label: str) -> bool:
+        """Whether target ``label`` is checked against this scene."""
+        return self.targets is None or label in self.targets
+
+    def bounds(self, part: str) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned bounding box (lower, upper) of a part's solids."""
+        mask = self._owner == part
+        return self._lower[mask].min(axis=0), self._upper[mask].max(axis=0)
+
+    def target_parts(self, label: str, point) -> list[str]:
+        """The parts that enter the tool at target ``label`` (excepted from its clearance): the
+        part labelled like it, else whatever the tool takes into its mouth at ``point``."""
+        return [label] if label in self.labels else self.parts_at(point)
+
+    def parts_at(self, point) -> list[str]:
+        """Labels of the parts the tool would take into its mouth at ``point``: those whose
+        bounding box is within the tool radius of the point."""
+        point = np.asarray(point, dtype=float)[:3]
+        gap = np.maximum(np.maximum(self._lower - point, point - self._upper), 0.0)
+        near = np.linalg.norm(gap, axis=1) <= self.tool.radius
+        return list(dict.fromkeys(self._owner[near]))
+
+    # -- validation ---------------------------------------------------------------------------
+    def check_overlaps(self) -> None:
+        """Raise when solids of two different parts interpenetrate (touching is allowed)."""
+        gap = np.maximum(np.maximum(self._lower[:, None] - self._upper[None], self._lower[None] - self._upper[:, None]), 0.0)
+        close = np.argwhere(np.triu(np.all(gap == 0.0, axis=2), 1))
+        for first, second in close:
+            if self._owner[first] == self._owner[second]:
+                continue
+            depth = self._engine().between(int(first), int(second))
+            if depth < -_OVERLAP_TOLERANCE:
+                _fail("scene.parts", f"parts {self.solids[first].label!r} and {self.solids[second].label!r} overlap "
+                                     f"by {-depth:.3g}; parts may touch but not interpenetrate")
+
+    def check_targets(self, targets: dict) -> None:
+        """Raise when a target the scene applies to has no part with its label, or does not lie
+        on it (more than the tool radius from the part's bounding box)."""
+        for label, point in targets.items():
+            point = np.asarray(point, dtype=float)[:3]  # a pose target: its position
+            if not self.applies_to(label):
+                continue
+            if label not in self.labels:
+                _fail("scene", f"target {short_token(label, 20)} has no part labelled like it (targets_on_parts is "
+                               f"true; set it false, or list the targets the scene applies to in scene.targets)")
+            lower, upper = self.bounds(label)
+            gap = np.linalg.norm(np.maximum(np.maximum(lower - point, np.asarray(point) - upper), 0.0))
+            if gap > self.tool.radius:
+                _fail("scene", f"target {short_token(label, 20)} at {np.round(point, 3).tolist()} is not on part "
+                               f"{short_token(label, 20)} (its box spans {np.round(lower, 3).tolist()} to "
+                               f"{np.round(upper, 3).tolist()}, {gap:.3g} away)")
+
+    # -- distances ----------------------------------------------------------------------------
+    def _engine(self) -> _Distances:
+        if self._distances is None:
+            self._distances = _Distances(self.solids, self.tool)
+        return self._distances
+
+    def _selected(self, exclude) -> np.ndarray:
+        exclude = set([exclude] if isinstance(exclude, str) else (exclude or ()))
+        unknown = exclude - set(self._owner.tolist())
+        if unknown:
+            raise ValueError(f"exclude names {sorted(unknown)[0]!r}, which is not a part of the scene")
+        return np.flatnonzero([owner not in exclude for owner in self._owner])
+
+    def _minimum(self, samples: np.ndarray, chosen: np.ndarray, bounds_of, exact, best: float = math.inf,
+                 part: str | None = None, point=None) -> Clearance:
+        """Branch and bound over (sample, part) pairs: ``bounds_of(rows)`` bounds the distances of
+        ``samples[rows]`` to the chosen parts from below, (m, k); ``exact(row, solid)`` is coal's
+        distance. Pairs are evaluated in ascending bound until no bound can beat the best."""
+        for start in range(0, samples.shape[0], _CHUNK):
+            block = np.arange(start, min(start + _CHUNK, samples.shape[0]))
+            bounds = bounds_of(block)
+            if best == math.inf:  # seed the bound with the most promising pair
+                row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])
+                best, part, point = exact(block[row], int(chosen[col])), self.solids[chosen[col]].label, samples[block[row]]
+            # The bounds are >= 0, so a pair whose bound is 0 may penetrate to any depth: while the
+            # best is a collision, every overlapping pair is evaluated to find the deepest one.
+            rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
+            for at in np.argsort(bounds[rows, cols], kind="stable"):
+                row, col = rows[at], cols[at]
+                if bounds[row, col] > 0.0 and bounds[row, col] >= best:
+                    break  # every remaining pair is bounded below by at least the best so far
+                distance = exact(block[row], int(chosen[col]))
+                if distance < best:
+                    best, part, point = distance, self.solids[chosen[col]].label, samples[block[row]]
+        return Clearance(float(best), part, None if point is None else np.array(point))
+
+    def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
+        """:meth:`clearance` for a tool whose orientation changes along the motion."""
+        from scipy.spatial.transform import Rotation
+
+        q = np.asarray(quaternions, dtype=float)
+        if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
+            raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
+        q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
+        dense, segment, fraction = _densify(points, step, weights=True)
+        if points.shape[0] > 1:  # nlerp between samples at most ``step`` apart
+            dense_q = q[segment] + fraction[:, None] * (q[segment + 1] - q[segment])
+            dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)
+        else:
+            dense_q = q
+        rotations = Rotation.from_quat(dense_q).as_matrix()
+        axes = rotations[:, :, 2]
+        centres = dense - axes * self.tool.length / 2.0
+        extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)
+        lower, upper = self._lower[chosen], self._upper[chosen]
+        engine = self._engine()
+        return self._minimum(
+            dense, chosen,
+            lambda rows: _box_distance((centres[rows] - extent[rows])[:, None], (centres[rows] + extent[rows])[:, None],
+                                       lower[None], upper[None]),
+            lambda row, solid: engine.tool_to(dense[row], solid, rotations[row]))
+
+    @numerically_guarded
+    def clearance(self, trajectory, exclude=(), step: float = _DEFAULT_STEP, orientations=None) -> Clearance:
+        """Smallest signed distance between the tool and the parts along ``trajectory``.
+
+        Parameters
+        ----------
+        trajectory : array (n, 3)
+            Tool-centre points; the tool moves in straight lines between them.
+        exclude : str or iterable of str
+            Part labels not checked (the target: it enters the socket).
+        step : float, default 0.2
+            The tool is placed at least every ``step`` along the path (scene unit).
+        orientations : array (n, 4), optional
+            The tool frame at each point (quaternions x, y, z, w; the frame's z axis is the
+            approach direction, the tool's body extends against it). Default: pointing down.
+
+        Returns
+        -------
+        Clearance
+            The exact minimum over those placements (coal, 1e-8), with the part and point.
+        """
+        points = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+        if points.shape[1] != 3:
+            raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
+        step = check_real(step, "step", positive=True)
+        chosen = self._selected(exclude)
+        if chosen.size == 0:
+            return Clearance(math.inf, None, None)
+        if orientations is not None:
+            return self._clearance_oriented(points, orientations, chosen, step)
+        lower, upper = self._lower[chosen], self._upper[chosen]
+        engine = self._engine()
+        radius, length = self.tool.radius, self.tool.length
+        # Culling: the box around every checked part bounds each sample's distance from below,
+        # and the exact distance of the most promising pair bounds the minimum from above. Only
+        # the segments whose swept tool box could come closer than that are densified and
+        # bounded part by part; most of a motion is far from everything.
+        whole_lower, whole_upper = lower.min(axis=0), upper.max(axis=0)
+        at_samples = _cylinder_box_bounds(points, radius, length, whole_lower[None], whole_upper[None])[:, 0]
+        row = int(np.argmin(at_samples))
+        first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]
+        col = int(np.argmin(first))
+        best = engine.tool_to(points[row], int(chosen[col]))
+        best_part, best_point = self.solids[chosen[col]].label, points[row]
+        if points.shape[0] > 1:
+            swept_lower = np.minimum(points[:-1], points[1:]) - [radius, radius, 0.0]
+            swept_upper = np.maximum(points[:-1], points[1:]) + [radius, radius, length]
+            near = _box_distance(swept_lower, swept_upper, whole_lower, whole_upper)
+            dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))
+        else:
+            dense = points
+        return self._minimum(dense, chosen, lambda rows: _cylinder_box_bounds(dense[rows], radius, length, lower, upper),
+                             lambda row, solid: engine.tool_to(dense[row], solid), best, best_part, best_point)
+
+    def checker(self, exclude=()) -> SceneChecker:
+        """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
+        return SceneChecker(self, self._selected(exclude))
