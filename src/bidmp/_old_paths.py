@@ -32,7 +32,8 @@ OLD_PATHS: dict[str, tuple[str, ...]] = {
     "bidmp.scenarios": ("bidmp.tasks.scenarios",),
     "bidmp.evaluation": ("bidmp.tasks.evaluation",),
     "bidmp.metrics": ("bidmp.tasks.metrics",),
-    "bidmp.reproduce": ("bidmp.experiments.reproduce",),
+    "bidmp.reproduce": ("bidmp.experiments.reproduce", "bidmp.experiments.table4", "bidmp.experiments.table5",
+                        "bidmp.experiments.incremental", "bidmp.experiments.generalisation"),
     "bidmp.benchmark": ("bidmp.experiments.lasa",),
 }
 

@@ -300,28 +300,8 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
                 progress(cell["key"])
         result.workers = 1
     elif todo:
-        n_workers = workers or (os.cpu_count() or 1)
-        client, cluster = _client(scheduler, n_workers)
-        try:
-            from distributed import as_completed
-
-            result.workers = len(client.scheduler_info().get("workers", {})) or n_workers
-            from ..tasks import methods as registry
-
-            objects = [registry.get(name) for name in methods]
-            futures = [client.submit(run_cell, shape, demo, objects, every, _kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
-                                     pure=False, retries=2)
-                       for shape, demo in todo]
-            for future in as_completed(futures):
-                cell = future.result()
-                _write_cell(out, protocol, cell)
-                done[cell["key"]] = cell
-                if progress is not None:
-                    progress(cell["key"])
-        finally:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        result.workers = _run_on_dask(todo, methods, every, workers, scheduler, _kill_once, out, protocol, done,
+                                      progress)
     result.wall_s = time.perf_counter() - start
     # The table: every row of every cell in a fixed order (shape, demo, method, case).
     order = {cell_key(*c): i for i, c in enumerate(cells)}
@@ -335,6 +315,34 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
         handle.write(summary_markdown(rows, protocol) + "\n")
     result.written = [table, out / "lasa.md"] + _figures(out, rows, done, shapes)
     return result
+
+
+def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress) -> int:
+    """The cells ``todo`` on a Dask cluster (embedded, or at ``scheduler``), each written as it
+    finishes and added to ``done``; returns the number of workers."""
+    n_workers = workers or (os.cpu_count() or 1)
+    client, cluster = _client(scheduler, n_workers)
+    try:
+        from distributed import as_completed
+
+        n_running = len(client.scheduler_info().get("workers", {})) or n_workers
+        from ..tasks import methods as registry
+
+        objects = [registry.get(name) for name in methods]
+        futures = [client.submit(run_cell, shape, demo, objects, every, kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
+                                 pure=False, retries=2)
+                   for shape, demo in todo]
+        for future in as_completed(futures):
+            cell = future.result()
+            _write_cell(out, protocol, cell)
+            done[cell["key"]] = cell
+            if progress is not None:
+                progress(cell["key"])
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return n_running
 
 
 _COLUMNS = ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES, "demos", "every")

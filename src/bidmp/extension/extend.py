@@ -303,6 +303,12 @@ def extend_demonstration(
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
         return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
+    return _extend_like_the_paper(y, target, points, seed, roadmap_options)
+
+
+def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> ExtendedDemonstration:
+    """``approach="paper"``: the nearest piece imitated by G-PRM down to the new target, timed like
+    the piece, appended to the demonstration up to the piece's start."""
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
     piece = choose_piece(y, points, target)

@@ -57,10 +57,10 @@ from .._trajectory import resample_time
 from .._units import check_units
 from .canonical import check_phase_span, phase_grid
 from .forcing import basis_functions, learn_weights
-from .goals import DelayedGoal, PhaseGate, ProgressGate
+from .goals import DelayedGoal, PhaseGate, ProgressGate, learned_progress_gate
 from .grid import cached_grid, rollout_grid, store_grid
 from .integrate import check_integration, unit_responses
-from .protocols import PROTOCOLS, FittedParams, Params, resolve_params, with_rest
+from .protocols import PROTOCOLS, FittedParams, Params, resolve_params, resolved_param, with_rest
 from .rest import rest_started
 from .rollouts import iter_rollouts_to, rollouts_to
 from .state import dmp_from_state, dmp_state
@@ -199,30 +199,11 @@ class DMP(FittedParams, BaseEstimator):
         """Validate the hyperparameters as they are now; raise naming the first bad one."""
         return resolve_params(self)
 
-    @property
-    def alpha_value(self) -> float:
-        """The spring gain in use (the protocol's when ``alpha`` is None)."""
-        return self._params().alpha
-
-    @property
-    def n_kernels_value(self) -> int:
-        """The number of kernels in use (the protocol's when ``n_kernels`` is None)."""
-        return self._params().n_kernels
-
-    @property
-    def beta_value(self) -> float:
-        """The spring gain ratio in use (``alpha / 4`` when ``beta`` is None)."""
-        return self._params().beta
-
-    @property
-    def K_value(self) -> float:
-        """The forcing-term gain in use."""
-        return self._params().K
-
-    @property
-    def alpha_phase_value(self) -> float:
-        """The phase decay in use (the protocol's when ``alpha_phase`` is None)."""
-        return self._params().alpha_phase
+    alpha_value = resolved_param("alpha", "The spring gain in use (the protocol's when ``alpha`` is None).")
+    n_kernels_value = resolved_param("n_kernels", "The number of kernels in use (the protocol's when ``n_kernels`` is None).")
+    beta_value = resolved_param("beta", "The spring gain ratio in use (``alpha / 4`` when ``beta`` is None).")
+    K_value = resolved_param("K", "The forcing-term gain in use.")
+    alpha_phase_value = resolved_param("alpha_phase", "The phase decay in use (the protocol's when ``alpha_phase`` is None).")
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
@@ -368,17 +349,7 @@ class DMP(FittedParams, BaseEstimator):
         params = self._params() if params is None else params
         if params.goal_rate is not None:
             return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(params.goal_rate)
-        gate = self.__dict__.get("goal_gate_")
-        if gate is None or gate.shape[0] != self.n_train_:
-            raise ValueError("this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
-                             "set goal_rate to a number or fit it again")
-        key = (self.n_train_, self.dt_, params.alpha_phase, params.exact)
-        cached = self.__dict__.get("_goal_system")
-        if cached is None or cached[0] != key or cached[1].gate is not gate:
-            training_phase = phase_grid(self.n_train_, self.dt_, 1.0, params.alpha_phase, exact=params.exact)
-            cached = (key, ProgressGate(training_phase, gate))
-            self._goal_system = cached
-        return cached[1]
+        return learned_progress_gate(self, params)
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,

@@ -49,7 +49,7 @@ from .._trajectory import arclength
 from .canonical import phase_grid
 
 __all__ = ["GOAL_BLEND", "smoothstep", "smoothstep_derivatives", "goal_share", "goal_gate", "euler_progress_gate",
-           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate"]
+           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate", "learned_progress_gate"]
 
 GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
 
@@ -199,3 +199,19 @@ class ProgressGate:
 
     def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         return float(np.interp(phase, *self._lookup))
+
+
+def learned_progress_gate(model, params) -> ProgressGate:
+    """The :class:`ProgressGate` a fitted DMP learned (its ``goal_gate_`` on its training grid),
+    cached on the model: a control loop asks for it once per stepper."""
+    gate = model.__dict__.get("goal_gate_")
+    if gate is None or gate.shape[0] != model.n_train_:
+        raise ValueError("this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
+                         "set goal_rate to a number or fit it again")
+    key = (model.n_train_, model.dt_, params.alpha_phase, params.exact)
+    cached = model.__dict__.get("_goal_system")
+    if cached is None or cached[0] != key or cached[1].gate is not gate:
+        training_phase = phase_grid(model.n_train_, model.dt_, 1.0, params.alpha_phase, exact=params.exact)
+        cached = (key, ProgressGate(training_phase, gate))
+        model._goal_system = cached
+    return cached[1]

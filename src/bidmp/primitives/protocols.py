@@ -16,7 +16,7 @@ import numpy as np
 
 from .._checks import NotFittedError, check_choice, check_fitted, check_int, check_real
 
-__all__ = ["Params", "FittedParams", "resolve_params", "with_rest", "PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
+__all__ = ["Params", "FittedParams", "resolve_params", "resolved_param", "with_rest", "PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
            "ROBOT_SETTLE", "GAIN_RANGE", "TAU_RANGE"]
 
 K_CHOICES = ("paper", "pastor")
@@ -175,3 +175,9 @@ class FittedParams:
                 f"this DMP's {', '.join(stale)} changed after fit: the weights were learned with the old value, "
                 f"so the model must be fitted again (only tau may change after fit)"
             )
+
+
+def resolved_param(name: str, doc: str) -> property:
+    """A read-only property: the resolved value of parameter ``name`` (the protocol's default when
+    it is None)."""
+    return property(lambda self: getattr(self._params(), name), doc=doc)

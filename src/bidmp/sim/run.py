@@ -108,19 +108,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     if backend is None:
         pybullet_module()  # fail early, with the install command, when the extra is missing
         backend = PandaCell
-    methods = list(dict.fromkeys(methods))
-    if not methods:
-        raise ValueError("methods is empty: name at least one of dmp, bidmp, ...")
-    labels = scenario.labels if targets is None else list(targets)
-    for label in labels:
-        if label not in scenario.targets:
-            raise ValueError(f"unknown target {label!r}; the scenario's targets: {', '.join(scenario.labels[:20])}")
-    from ..tasks import methods as registry
-
-    open_only = [name for name in methods if not registry.get(name).closed_loop]
-    if closed_loop and open_only:
-        raise ValueError(f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
-                         f"{', '.join(registry.names(closed_loop=True))})")
+    methods, labels = _checked(scenario, methods, targets, closed_loop)
     coupling = COUPLING * unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
     if report is None:
         report = evaluate(scenario, methods, geometry=False)
@@ -143,24 +131,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     n_workers = max(1, min(n_workers, len(jobs)))
     start = time.perf_counter()
-    if n_workers == 1:
-        outcomes = _run_jobs(setup, jobs, progress)
-    else:
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor, as_completed
-
-        # Interleaved chunks balance long and short motions. "fork" (where there is one) starts
-        # the workers in milliseconds and works from any __main__; "spawn" elsewhere.
-        chunks = [jobs[k::n_workers] for k in range(n_workers)]
-        outcomes = []
-        method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
-        with ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(method)) as pool:
-            futures = [pool.submit(_run_chunk, setup, chunk) for chunk in chunks]
-            for future in as_completed(futures):
-                for outcome in future.result():
-                    if progress is not None:
-                        progress(outcome[0], outcome[1])
-                    outcomes.append(outcome)
+    outcomes = _execute_jobs(setup, jobs, n_workers, progress)
     by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds in outcomes}
     out = SimReport(scenario, {}, base, yaw, closed_loop, limits=getattr(backend, "limits", None))
     for method in methods:
@@ -173,6 +144,46 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
     return out
+
+
+def _checked(scenario, methods, targets, closed_loop: bool) -> tuple[list, list]:
+    """The methods (registered; with a stepper for the closed loop) and target labels to run."""
+    methods = list(dict.fromkeys(methods))
+    if not methods:
+        raise ValueError("methods is empty: name at least one of dmp, bidmp, ...")
+    labels = scenario.labels if targets is None else list(targets)
+    for label in labels:
+        if label not in scenario.targets:
+            raise ValueError(f"unknown target {label!r}; the scenario's targets: {', '.join(scenario.labels[:20])}")
+    from ..tasks import methods as registry
+
+    open_only = [name for name in methods if not registry.get(name).closed_loop]
+    if closed_loop and open_only:
+        raise ValueError(f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
+                         f"{', '.join(registry.names(closed_loop=True))})")
+    return methods, labels
+
+
+def _execute_jobs(setup: dict, jobs: list, n_workers: int, progress) -> list:
+    """Every job's outcome, in this process or spread over ``n_workers`` worker processes."""
+    if n_workers == 1:
+        return _run_jobs(setup, jobs, progress)
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    # Interleaved chunks balance long and short motions. "fork" (where there is one) starts
+    # the workers in milliseconds and works from any __main__; "spawn" elsewhere.
+    chunks = [jobs[k::n_workers] for k in range(n_workers)]
+    outcomes = []
+    method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+    with ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(method)) as pool:
+        futures = [pool.submit(_run_chunk, setup, chunk) for chunk in chunks]
+        for future in as_completed(futures):
+            for outcome in future.result():
+                if progress is not None:
+                    progress(outcome[0], outcome[1])
+                outcomes.append(outcome)
+    return outcomes
 
 
 def _stepper(models, method, goal, duration, coupling):

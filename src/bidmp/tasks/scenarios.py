@@ -330,6 +330,45 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     ``"file"`` demonstrations are read relative to ``base_dir`` and must lie inside it (after
     resolving ``..`` and symlinks) unless ``allow_outside_files`` is true.
     """
+    units = _check_top_level(data, source)
+    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
+    n_dims = demonstration.shape[1]
+    if n_dims == POSE_DIMS:
+        demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
+    targets, demonstrated = _targets(data, source, n_dims)
+    threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
+    alignment = _number(data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True)
+    approach = data.get("approach_height", 28.5)
+    approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
+
+    from ..extension.extend import check_extension_options
+    from ..incremental.bidmp import BiDMP
+    from ..primitives.dmp import DMP
+
+    dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
+    bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
+    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: check_extension_options(**params))
+    extensions = _extensions(data, source, targets, n_dims)
+    demonstrations = _further_demonstrations(data, source, base_dir, allow_outside_files, units, n_dims)
+    methods = _methods(data, source, n_dims)
+    seed = data.get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
+        _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
+    scene = _scene(data, source, targets, n_dims)
+    robot = _robot(data, source)
+    _check_runs(source, demonstration, targets, dmp)
+    return Scenario(
+        name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
+        success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
+        extensions=extensions,
+        demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
+        units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
+        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment,
+    )
+
+
+def _check_top_level(data, source: str) -> str:
+    """The top-level object, its keys, name, description and units; returns the units."""
     if not isinstance(data, dict):
         raise ScenarioError(f"scenario {source}: expected a JSON object at the top level")
     unknown = sorted(set(data) - _KEYS)
@@ -349,10 +388,16 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     if units not in UNITS:
         _fail(source, "units", f"expected one of {', '.join(UNITS)}, got {_shown(units)}")
 
-    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
-    n_dims = demonstration.shape[1]
-    if n_dims == POSE_DIMS:
-        demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
+    from .._units import UNITS
+
+    units = data.get("units", "mm")
+    if units not in UNITS:
+        _fail(source, "units", f"expected one of {', '.join(UNITS)}, got {_shown(units)}")
+    return units
+
+
+def _targets(data, source: str, n_dims: int) -> tuple[dict, str]:
+    """The targets (label -> point or pose) and the demonstrated one's label."""
     if not isinstance(data["targets"], dict) or not data["targets"]:
         _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
     if len(data["targets"]) > get_limits().max_targets:
@@ -366,20 +411,11 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         _fail(source, "demonstrated", f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
                                       f"{', …' if len(targets) > 10 else ''})")
 
-    threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
-    alignment = _number(data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True)
-    approach = data.get("approach_height", 28.5)
-    approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
+    return targets, demonstrated
 
-    from ..primitives.dmp import DMP
-    from ..incremental.bidmp import BiDMP
 
-    dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
-    bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
-    from ..extension.extend import check_extension_options
-
-    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: check_extension_options(**params))
-
+def _extensions(data, source: str, targets: dict, n_dims: int) -> list[dict]:
+    """The extension stages: ``extensions`` as given, or one to ``extension_target``."""
     if "extensions" in data:
         if not isinstance(data["extensions"], list) or not data["extensions"]:
             _fail(source, "extensions", "expected a non-empty list of {target, from}")
@@ -397,10 +433,15 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
             extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims),
                                "from": origin, "in_scene": in_scene})
         check_limit(len(extensions), "max_targets", "the number of extensions")
+        return extensions
     else:
         target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
-        extensions = [{"target": target, "from": "demonstration", "in_scene": True}]
+        return [{"target": target, "from": "demonstration", "in_scene": True}]
 
+
+
+def _further_demonstrations(data, source: str, base_dir, allow_outside_files: bool, units: str, n_dims: int) -> dict:
+    """The operators' further demonstrations (label -> trajectory)."""
     extra = data.get("demonstrations", {})
     if not isinstance(extra, dict):
         _fail(source, "demonstrations", "expected an object {label: demonstration}")
@@ -412,6 +453,11 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
             _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
         demonstrations[str(label)] = trajectory
 
+    return demonstrations
+
+
+def _methods(data, source: str, n_dims: int) -> list[str]:
+    """The methods the scenario runs, each known to the registry (and learning poses for poses)."""
     methods = data.get("methods", list(METHODS))
     if not isinstance(methods, list) or not methods or not all(isinstance(m, str) for m in methods):
         _fail(source, "methods", "expected a non-empty list of method names")
@@ -423,21 +469,25 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         if n_dims == POSE_DIMS and not registry.get(method).poses:
             _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs "
                   f"{', '.join(registry.names(poses=True))}")
-    seed = data.get("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
-        _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
+    return methods
 
-    scene = None
-    if "scene" in data:
-        if n_dims not in (3, POSE_DIMS):
-            _fail(source, "scene", f"needs 3-D positions or poses (D = 7), these have D = {n_dims}")
-        try:
-            scene = Scene.from_dict(data["scene"], targets)
-        except SceneError as exc:
-            raise ScenarioError(f"scenario {source}: {exc}") from None
-        except ImportError as exc:
-            raise type(exc)(f"scenario {source}: {exc}") from None
 
+def _scene(data, source: str, targets: dict, n_dims: int):
+    """The scene (parts and tool), or None."""
+    if "scene" not in data:
+        return None
+    if n_dims not in (3, POSE_DIMS):
+        _fail(source, "scene", f"needs 3-D positions or poses (D = 7), these have D = {n_dims}")
+    try:
+        return Scene.from_dict(data["scene"], targets)
+    except SceneError as exc:
+        raise ScenarioError(f"scenario {source}: {exc}") from None
+    except ImportError as exc:
+        raise type(exc)(f"scenario {source}: {exc}") from None
+
+
+def _robot(data, source: str) -> dict:
+    """Where ``bidmp sim`` puts the arm (``base``, ``yaw``), validated."""
     robot = data.get("robot", {})
     if not isinstance(robot, dict) or set(robot) - {"base", "yaw"}:
         _fail(source, "robot", 'expected {"base": [x, y, z], "yaw": degrees} (where bidmp sim puts the arm)')
@@ -447,15 +497,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     if "yaw" in robot:
         robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
 
-    _check_runs(source, demonstration, targets, dmp)
-    return Scenario(
-        name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
-        success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
-        extensions=extensions,
-        demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
-        units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
-        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment,
-    )
+    return robot
 
 
 def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_params: dict) -> None:

@@ -1,0 +1,58 @@
+"""What every command of the ``bidmp`` command line shares: exit codes, the one-line error parser,
+argument types and flags. Imports nothing heavy (``bidmp --help`` must not load NumPy)."""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_BROKEN_PIPE", "MAX_MESSAGE", "MAX_SEEDS", "Parser",
+           "parse_K", "allow_outside_files", "one_line", "split_names"]
+
+EXIT_OK = 0
+EXIT_INTERNAL = 1
+EXIT_BAD_INPUT = 2
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a tool killed by a closed pipe reports
+MAX_MESSAGE = 600  # characters of one error line
+MAX_SEEDS = 200  # = bidmp.reproduce.MAX_SEEDS (not imported: --help must not load NumPy)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but usage errors are one line (plus a pointer to --help), exit code 2."""
+
+    def error(self, message: str):  # noqa: D401 - argparse API
+        self.exit(EXIT_BAD_INPUT, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
+
+
+def parse_K(text: str):
+    if text in ("paper", "pastor"):
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be 'paper', 'pastor' or a number, got {text!r}") from None
+
+
+# ---------------------------------------------------------------------------------------------
+# Parser
+# ---------------------------------------------------------------------------------------------
+def allow_outside_files(parser, shown: bool = True) -> None:
+    """The --allow-outside-files flag of every command that reads a scenario file."""
+    parser.add_argument("--allow-outside-files", action="store_true",
+                        help="let the scenario read demonstration files outside its own folder" if shown else argparse.SUPPRESS)
+
+
+def one_line(text: str) -> str:
+    """One printable line: whitespace runs collapsed, control characters (a file name or argument
+    may carry terminal escapes) shown as '?', at most MAX_MESSAGE characters."""
+    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))
+    return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 1] + "…"
+
+
+def split_names(text: str | None, option: str) -> list[str] | None:
+    """A comma-separated list of names (None stays None); an empty list is refused, naming the option."""
+    if text is None:
+        return None
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    if not names:
+        raise ValueError(f"{option} names no method: {text!r}")
+    return names

@@ -1,0 +1,198 @@
+"""``bidmp demo``, ``bidmp sim`` and ``bidmp scenario``: a scenario's task with every method, in
+evaluation and on the simulated robot, and the scenario files themselves."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .common import EXIT_OK, Parser, allow_outside_files
+
+__all__ = ["add_commands"]
+
+
+def _run_scenario(scenario, out, methods=None):
+    """Evaluate a scenario with a progress bar, print its report, write results and figures."""
+    from tqdm import tqdm
+
+    from ..tasks.evaluation import evaluate, write_report
+
+    names = list(scenario.methods if methods is None else methods)
+    with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
+        def progress(method):  # called as each method starts
+            bar.set_postfix_str(method)
+            bar.update(1)
+
+        report = evaluate(scenario, names, progress=progress)
+    print()
+    print(report.summary())
+    written = write_report(report, out)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
+    return report
+
+
+def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=None, pictures=True, targets=None,
+             report=None):
+    """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
+    from tqdm import tqdm
+
+    from ..sim.report import write_sim_report
+    from ..sim.run import simulate
+
+    methods = list(methods)
+    labels = scenario.labels if targets is None else targets
+    frames = {}
+    if pictures:
+        origin = scenario.targets[scenario.demonstrated]
+        far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
+        frames = {(method, far): 30 for method in methods}
+    with tqdm(total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None) as bar:
+        def progress(method, label):
+            bar.set_postfix_str(f"{method} {label}")
+            bar.update(1)
+
+        result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
+                          frames=frames, progress=progress, report=report)
+    print()
+    print(result.summary())
+    written = write_sim_report(result, out)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
+    return result
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    out = Path(args.out)
+    if args.lasa:
+        from .experiments import lasa_demo
+
+        return lasa_demo(args.lasa, out)
+    from ..tasks.scenarios import load
+
+    scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
+    if args.approach is not None:
+        from ..tasks.scenarios import from_dict
+
+        spec = scenario.to_dict()
+        spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
+        scenario = from_dict(spec, source=args.scenario, base_dir=scenario.base_dir,
+                             allow_outside_files=args.allow_outside_files)
+    methods = None
+    if args.methods is not None:
+        methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        if not methods:
+            raise ValueError(f"--methods names no method: {args.methods!r}")
+    if args.sim:
+        from ..sim.pybullet.world import pybullet_module as _pybullet
+
+        _pybullet()
+    report = _run_scenario(scenario, out, methods)
+    if args.sim:
+        sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
+        _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None)
+    return EXIT_OK
+
+
+def _cmd_sim(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from ..tasks.scenarios import load
+    from ..sim.backend import Hold
+    from ..sim.pybullet.world import pybullet_module as _pybullet
+
+    _pybullet()  # without the extra: the install command, before any work
+    scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    if not methods:
+        raise ValueError(f"--methods names no method: {args.methods!r}")
+    hold = None
+    if args.hold is not None:
+        joint, start, duration = args.hold
+        if joint != int(joint) or not 1 <= joint <= 7:
+            raise ValueError(f"--hold: the joint must be 1-7, got {joint:g}")
+        if not (start >= 0 and duration > 0):
+            raise ValueError("--hold: START must be >= 0 s and DURATION > 0 s")
+        hold = Hold(int(joint) - 1, start, duration)
+    targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
+             pictures=not args.no_pictures, targets=targets)
+    return EXIT_OK
+
+
+def _cmd_scenario(args: argparse.Namespace) -> int:
+    from ..tasks.scenarios import builtin_names, builtin_text, load
+
+    if args.scenario_command == "list":
+        for name in builtin_names():
+            scenario = load(name)
+            print(f"{name:16s} {len(scenario.targets):3d} targets  {scenario.description[:90]}")
+        return EXIT_OK
+    if args.scenario_command == "show":
+        sys.stdout.write(builtin_text(args.name))
+        return EXIT_OK
+    scenario = load(args.file, allow_outside_files=args.allow_outside_files)  # what demo validates
+    print(f"{args.file}: valid scenario '{scenario.name}' with {len(scenario.targets)} targets, "
+          f"demonstration of {scenario.demonstration.shape[0]} samples in {scenario.demonstration.shape[1]}-D")
+    return EXIT_OK
+
+
+def _demo_parser(commands) -> None:
+    """``bidmp demo``."""
+    demo = commands.add_parser("demo", help="run a scenario with every method (default: nut unscrewing)",
+                               description="Run a scenario (default: the built-in EV-battery nut-unscrewing task) with every "
+                                           "method, print the paper's Table 4 and per-target errors, write results.json and figures.")
+    demo.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario file or built-in name (see 'bidmp scenario list')")
+    demo.add_argument("--methods", default=None, help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm")
+    demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    demo.add_argument("--approach", choices=("keep", "paper"), default=None,
+                      help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
+    demo.add_argument("--sim", action="store_true",
+                      help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
+    demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
+    allow_outside_files(demo)
+    demo.set_defaults(handler=_cmd_demo)
+
+
+def _sim_parser(commands) -> None:
+    """``bidmp sim``."""
+    sim = commands.add_parser("sim", help="execute a scenario on a simulated Franka Panda (PyBullet)",
+                              description="Execute every method's motion to every target of a scenario on a simulated "
+                                          "Franka Panda (PyBullet, headless): inverse kinematics, timing to the Panda's joint "
+                                          "limits, 1 kHz position control, contacts with the parts. Prints the Table 4 analogue "
+                                          "in simulation and writes sim_results.json, keyframe strips and a GIF. Needs the "
+                                          "sim extra: pip install 'bidmp[sim]'.")
+    sim.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario with a \"scene\" (default nut-unscrewing)")
+    sim.add_argument("--methods", default="dmp,bidmp", help="comma-separated methods to execute (default dmp,bidmp)")
+    sim.add_argument("--targets", default=None, help="comma-separated subset of the targets (default all)")
+    sim.add_argument("--closed-loop", action="store_true",
+                     help="run the DMP/Bi-DMP stepper on the measured tool position with phase stopping (dmp, bidmp)")
+    sim.add_argument("--hold", type=float, nargs=3, metavar=("JOINT", "START", "DURATION"),
+                     help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds")
+    sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
+    sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
+    sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
+    allow_outside_files(sim)
+    sim.set_defaults(handler=_cmd_sim)
+
+
+def _scenario_parser(commands) -> None:
+    """``bidmp scenario list|show|check``."""
+    scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
+                                   description="List the built-in scenarios, print one as JSON to copy and edit "
+                                               "('bidmp scenario show nut-unscrewing > my.json'), or validate a scenario file.")
+    scenario_commands = scenario.add_subparsers(dest="scenario_command", metavar="{list,show,check}", required=True, parser_class=Parser)
+    scenario_commands.add_parser("list", help="list the built-in scenarios")
+    show = scenario_commands.add_parser("show", help="print a built-in scenario as JSON")
+    show.add_argument("name", metavar="NAME")
+    check = scenario_commands.add_parser("check", help="validate a scenario file")
+    check.add_argument("file", metavar="FILE")
+    allow_outside_files(check)
+    scenario.set_defaults(handler=_cmd_scenario)
+
+
+def add_commands(commands) -> None:
+    """The demo, sim and scenario commands of ``bidmp``'s parser."""
+    _demo_parser(commands)
+    _sim_parser(commands)
+    _scenario_parser(commands)

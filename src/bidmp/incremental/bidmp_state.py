@@ -1,0 +1,64 @@
+"""A Bi-DMP's state for model files (``bidmp.io`` stores it): its DMP, skills and BLS blocks, every
+member checked on the way back in (formats 2 and later)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+
+from .._checks import (
+    _check_magnitude,
+    check_loaded,
+    check_real,
+)
+from .._state import Prefixed as _Prefixed
+from .bls import BLS
+from ..primitives.dmp import DMP
+
+
+# -- persistence -----------------------------------------------------------------------------
+def bidmp_state(model) -> tuple[dict, dict]:
+    model._ensure_started()
+    dmp_meta, dmp_arrays = model.dmp_._get_state()
+    arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
+    arrays["skill_goals_"] = model.skill_goals_
+    arrays["skill_starts_"] = model.skill_starts_
+    blocks_meta = []
+    for index, block in enumerate(model.blocks_):
+        meta, block_arrays = block._get_state()
+        blocks_meta.append(meta)
+        arrays.update({f"block{index}/{k}": v for k, v in block_arrays.items()})
+    params = {k: v for k, v in model.get_params(deep=False).items() if k != "dmp"}
+    params["increments"] = list(model.increments)
+    return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": model.phase_min_,
+            "gate_phase_": model.gate_phase_}, arrays
+
+
+def bidmp_from_state(cls, meta: dict, arrays: Mapping):
+    """A Bi-DMP of class ``cls`` from a model file's state (its DMP and BLS blocks read from their
+    prefixes), every member checked."""
+    for key, kind in (("dmp", dict), ("params", dict), ("blocks", list)):
+        if not isinstance(meta.get(key), kind):
+            raise ValueError(f"the Bi-DMP state has no {key} {kind.__name__}")
+    dmp = DMP._from_state(meta["dmp"], _Prefixed(arrays, "dmp/"))
+    params = dict(meta["params"])
+    if not isinstance(params.get("increments"), list):
+        raise ValueError("params.increments must be a list of integers")
+    params["increments"] = tuple(params["increments"])
+    model = cls(dmp, **params)
+    model._check_params()
+    model._start(dmp)
+    model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
+    model.gate_phase_ = check_real(meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0)
+    model.blocks_ = [BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
+                     for index, block_meta in enumerate(meta["blocks"])]
+    for index, block in enumerate(model.blocks_):
+        if block.n_features_ != dmp.weights_.shape[0] or block.output_weights_.shape[1] != dmp.n_dims_:
+            raise ValueError(f"block {index} maps {block.n_features_} inputs to {block.output_weights_.shape[1]} outputs; "
+                             f"the DMP has {dmp.weights_.shape[0]} kernels and D = {dmp.n_dims_}")
+    expected = (len(model.blocks_) + 1, dmp.n_dims_)
+    model.skill_goals_ = check_loaded(arrays["skill_goals_"], "skill_goals_", expected)
+    model.skill_starts_ = check_loaded(arrays["skill_starts_"], "skill_starts_", expected)
+    for name in ("skill_goals_", "skill_starts_"):
+        _check_magnitude(getattr(model, name), f"member {name}")
+    return model
