@@ -356,11 +356,11 @@ def test_fuzz_baselines(y, params, target, n_steps, task_parameterised):
     if task_parameterised:
         model = outcome("TPGMM.fit", TPGMM(**params).fit, y)
         if model is not None:
-            outcome("TPGMM.generate", model.generate, np.zeros(model.n_dims_), target, n_steps=n_steps)
+            outcome("TPGMM.rollout", model.rollout, target, start=np.zeros(model.n_dims_), n_steps=n_steps)
     else:
         model = outcome("GMMRegressor.fit", GMMRegressor(**params).fit, y)
         if model is not None:
-            outcome("GMMRegressor.generate", model.generate, n_steps)
+            outcome("GMMRegressor.rollout", model.rollout, n_steps=n_steps)
 
 
 @given(maybe(st.sampled_from(["Sshape", "WShape", "Angle", "heee"]), st.one_of(st.text(max_size=12), anything)),
@@ -643,11 +643,11 @@ def test_fuzz_cartesian(poses, params, goal, start, duration):
     model = outcome("CartesianDMP.fit", bidmp.CartesianDMP(**params).fit, poses)
     if model is None:
         model = bidmp.CartesianDMP().fit(good_poses())
-    outcome("CartesianDMP.rollout", model.rollout, goal, start)
-    motion = outcome("CartesianDMP.trajectory", model.trajectory, goal, start, duration)
+    outcome("CartesianDMP.rollout", model.rollout, goal, start=start)
+    motion = outcome("CartesianDMP.trajectory", model.trajectory, goal, start=start, duration=duration)
     if motion is not None:
         assert np.all(np.abs(np.linalg.norm(motion.q, axis=1) - 1.0) < 1e-9)
-    stepper = outcome("CartesianDMP.stepper", model.stepper, goal, start)
+    stepper = outcome("CartesianDMP.stepper", model.stepper, goal, start=start)
     if stepper is not None:
         outcome("PoseStepper.step", stepper.step, 0.01)
 
@@ -662,8 +662,8 @@ def test_fuzz_cartesian_bidmp(poses, params, goal, skill):
     if model is None:
         return
     outcome("CartesianBiDMP.learn", model.learn, poses)
-    outcome("CartesianBiDMP.rollout", model.rollout, goal, skill)
-    outcome("CartesianBiDMP.trajectory", model.trajectory, goal, skill)
+    outcome("CartesianBiDMP.rollout", model.rollout, goal, skill=skill)
+    outcome("CartesianBiDMP.trajectory", model.trajectory, goal, skill=skill)
 
 
 @given(st.sampled_from(["t,x,y,z,qx,qy,qz,qw", "x,y,z,qw,qx,qy,qz", "timestamp,x,y,z,qx,qy,qz,qw,grip",

@@ -13,6 +13,7 @@ from sklearn.base import BaseEstimator
 import logging
 import warnings
 
+from .._api import deprecated_alias
 from .._checks import as_trajectory, check_fitted, check_int, check_limit, check_real, numerically_guarded
 from .._noise import perturb
 
@@ -173,9 +174,20 @@ class GMMRegressor(_AugmentedMixture):
         return self
 
     @numerically_guarded
-    def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Mean trajectory (n, D) and covariances (n, D, D) by GMR on t ∈ [0, 1]."""
+    def rollout(self, goal=None, *, n_steps: int | None = None, return_covariance: bool = False):
+        """The mean motion (n, D) by GMR, on the demonstration's sample grid in normalised time
+        (t ∈ [0, 1]); ``return_covariance``: also the covariances (n, D, D). A GMM on time has no
+        notion of a goal: ``goal`` must be None (:class:`TPGMM` takes one)."""
         check_fitted(self, "weights_")
+        if goal is not None:
+            raise ValueError("goal: GMMRegressor reproduces its demonstration and takes no goal (TPGMM does)")
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
         _check_gmr_size(n_steps, self.means_.shape)
-        return gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
+        mean, covariances = gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
+        return (mean, covariances) if return_covariance else mean
+
+    @deprecated_alias("rollout", "; generate() is rollout(return_covariance=True)")
+    def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Mean trajectory (n, D) and covariances (n, D, D) by GMR on t ∈ [0, 1] (deprecated:
+        :meth:`rollout`)."""
+        return self.rollout(n_steps=n_steps, return_covariance=True)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._api import deprecated_alias, goal_first
 from .._checks import as_point, check_fitted, check_int, numerically_guarded
 from .gmm import _AugmentedMixture, _check_gmr_size, augment, fit_mixture, gmr
 
@@ -45,6 +46,8 @@ class TPGMM(_AugmentedMixture):
     ----------
     weights_, means_, covariances_ : the mixture on ``[t, x⁽start⁾, x⁽target⁾]``.
     n_steps_, n_dims_ : int
+    start_, goal_ : array (D,)
+        The demonstration's start and goal (what :meth:`rollout` goes between by default).
     """
 
     def __init__(self, n_components: int = 16, reg_covar: float = 1e-4, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
@@ -65,6 +68,8 @@ class TPGMM(_AugmentedMixture):
         data = np.concatenate([np.hstack([t, demo - demo[0], demo - demo[-1]]) for demo in demos])
         self.weights_, self.means_, self.covariances_ = fit_mixture(data, self.n_components, self.reg_covar, self.seed)
         self.n_steps_, self.n_dims_ = n_steps, n_dims
+        demonstration = np.asarray(y, dtype=np.float64)
+        self.start_, self.goal_ = demonstration[0].copy(), demonstration[-1].copy()
         return self
 
     def _frame_gaussian(self, frame: int, A: np.ndarray, b: np.ndarray):
@@ -80,13 +85,17 @@ class TPGMM(_AugmentedMixture):
         sigma_global = transform @ sigma @ transform.T + self.reg_covar * np.eye(d + 1)
         return mu_global, sigma_global
 
+    @goal_first("start", "n_steps")
     @numerically_guarded
-    def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
-        """Mean trajectory (n, D) and covariances for new start and target frames."""
+    def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_rotation=None, target_rotation=None,
+                return_covariance: bool = False):
+        """The mean motion (n, D) from ``start`` to ``goal`` (the target frame's origin), on the
+        demonstration's sample grid in normalised time (t ∈ [0, 1]); default the demonstration's
+        own start and goal. ``return_covariance``: also the covariances (n, D, D)."""
         check_fitted(self, "weights_")
         d = self.n_dims_
-        start = as_point(start, d, "start")
-        target = as_point(target, d, "target")
+        start = self.start_ if start is None else as_point(start, d, "start")
+        target = self.goal_ if goal is None else as_point(goal, d, "goal")
         rotations = [np.eye(d) if r is None else _rotation(r, d, name)
                      for r, name in ((start_rotation, "start_rotation"), (target_rotation, "target_rotation"))]
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
@@ -100,4 +109,12 @@ class TPGMM(_AugmentedMixture):
             weighted_mean = weighted_mean + np.einsum("kij,kj->ki", precision, mu)
         covariance = np.linalg.inv(precision_sum)  # product of Gaussians
         mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
-        return gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
+        mean, covariances = gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
+        return (mean, covariances) if return_covariance else mean
+
+    @deprecated_alias("rollout", "; generate(start, target) is rollout(target, start=start, return_covariance=True)")
+    def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
+        """Mean trajectory (n, D) and covariances for new start and target frames (deprecated:
+        :meth:`rollout`)."""
+        return self.rollout(target, start=start, n_steps=n_steps, start_rotation=start_rotation,
+                            target_rotation=target_rotation, return_covariance=True)

@@ -57,7 +57,7 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
 
 def lasa_demo(shape: str, out) -> int:
     from ..io.atomic import atomic_write
-    from ..plotting.figures import plot_generalisation
+    from ..plotting.trajectories import plot_generalisation
     from ..experiments.reproduce import lasa_generalisation
 
     out.mkdir(parents=True, exist_ok=True)

@@ -183,7 +183,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
           f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
     print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
-        from ..plotting.figures import plot_trajectories
+        from ..plotting.trajectories import plot_trajectories
 
         reference = dmp.rollout()
         figure = plot_trajectories(args.plot, reference, [trajectory.y], ["rollout"], goals=trajectory.y[-1:],
@@ -213,7 +213,7 @@ def cmd_segment(args: argparse.Namespace) -> int:
         ]
         print(text_table(["index", "curvature", "arc length %", f"position ({units or 'units'})"], rows))
     if args.plot:
-        from ..plotting.figures import plot_segmentation
+        from ..plotting.extension import plot_segmentation
         from ..extension.segmentation import MAX_ANALYSIS_POINTS
 
         kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
@@ -302,7 +302,7 @@ def cmd_extend(args: argparse.Namespace) -> int:
                                                  dmp.units_), args.save_demo)
         print(f"wrote the extended demonstration ({stamps[-1]:.4g} s) to {written}")
     if args.plot:
-        from ..plotting.figures import plot_extension
+        from ..plotting.extension import plot_extension
 
         print(f"wrote {plot_extension(args.plot, extension, units=dmp.units_)}")
     return EXIT_OK

@@ -402,7 +402,7 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
     """A per-shape grid (demonstration 0's reproductions) and metric box plots."""
     from ..demonstrations.datasets import lasa as lasa_data
     from ..io.atomic import atomic_write
-    from ..plotting.figures import _matplotlib
+    from ..plotting._base import _matplotlib
 
     mpl = _matplotlib()
     written = []

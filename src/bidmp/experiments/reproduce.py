@@ -58,7 +58,7 @@ def _write_text(path: Path, text: str) -> None:
 def write_results(result, name: str, out: str | os.PathLike) -> list[Path]:
     """Write a reproduction result into folder ``out``: ``NAME.json``, ``NAME.md`` and its
     figures (per-scenario folders with ``results.json`` and figures for Table 4)."""
-    from ..plotting import figures as plotting
+    from .. import plotting
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
+from .._api import goal_first
 from .._checks import (
     NotFittedError,
     as_point,
@@ -328,8 +329,9 @@ class BiDMP(BaseEstimator):
             raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {skill!r}")
         return self._check_skill_index(skill)
 
+    @goal_first("skill", "start", "n_steps")
     @numerically_guarded
-    def rollout(self, goal=None, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
+    def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Generate a trajectory with one skill of the library.
 
         Parameters
@@ -368,16 +370,18 @@ class BiDMP(BaseEstimator):
         increment = None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
         return index, goal, start, increment
 
+    @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
-    def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
-                   *, limits: dict | None = None, coupling=None):
+    def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
+                   limits: dict | None = None, coupling=None):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
         with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms as there."""
         _, goal, start, increment = self._skill_query(goal, skill, start)
         return self.dmp_.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
                                     forcing_increment=increment, coupling=coupling)
 
-    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *, coupling=0.0):
+    @goal_first("skill", "start", "duration")
+    def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0):
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
         _, goal, start, increment = self._skill_query(goal, skill, start)
         return self.dmp_.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)

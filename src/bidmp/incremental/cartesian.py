@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
+from .._api import goal_first
 from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
 from ..primitives.cartesian import CartesianDMP, _parts_from_state, _parts_state, _pose_parts, _pose_params, _read_poses_state
 from .bidmp import BiDMP
@@ -150,16 +151,18 @@ class CartesianBiDMP(BaseEstimator):
         start_e = nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
         return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
 
-    def rollout(self, goal=None, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
+    @goal_first("skill", "start", "n_steps")
+    def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) with one skill (chosen on the position goal)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         position = self.position_.rollout(goal_p, skill=index, start=start_p, n_steps=n_steps)
         error = self.orientation_.rollout(np.zeros(3), skill=index, start=start_e, n_steps=n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
+    @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
-    def trajectory(self, goal=None, skill="nearest", start=None, duration: float | None = None,
-                   dt: float | None = None, *, limits: dict | None = None, coupling=None) -> PoseTrajectory:
+    def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
+                   dt: float | None = None, limits: dict | None = None, coupling=None) -> PoseTrajectory:
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment = self.position_._skill_query(goal_p, index, start_p)
@@ -168,7 +171,8 @@ class CartesianBiDMP(BaseEstimator):
                                 duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
                                 coupling)
 
-    def stepper(self, goal=None, skill="nearest", start=None, duration: float | None = None, *,
+    @goal_first("skill", "start", "duration")
+    def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
                 coupling=0.0) -> PoseStepper:
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),

@@ -1,6 +1,9 @@
-"""Figures (matplotlib ``Figure`` objects written to files; the global backend is never switched).
+"""Figures per domain (matplotlib ``Figure`` objects written to PNG files; the global backend is never
+switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``; ``_base`` holds what they
+share.
 
-Layer 3 (the application): imports the math and ``bidmp.io``; never ``cli``.
+Layer 2 (data out, beside ``io``): imports the math and ``bidmp.io``; never ``tasks``, ``sim`` or
+``cli`` (a report is passed in and read by its attributes).
 """
 
 from __future__ import annotations
@@ -9,16 +12,17 @@ from .._lazy import exports
 
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
-    "plot_trajectories": "figures",
-    "plot_generalisation": "figures",
-    "plot_segmentation": "figures",
-    "plot_extension": "figures",
-    "plot_prm_comparison": "figures",
-    "plot_incremental": "figures",
-    "plot_targets_top_view": "figures",
-    "plot_error_vs_distance": "figures",
-    "plot_scenario_3d": "figures",
+    "plot_trajectories": "trajectories",
+    "plot_generalisation": "trajectories",
+    "plot_recordings": "trajectories",
+    "plot_segmentation": "extension",
+    "plot_extension": "extension",
+    "plot_prm_comparison": "extension",
+    "plot_incremental": "incremental",
+    "plot_targets_top_view": "tasks",
+    "plot_error_vs_distance": "tasks",
+    "plot_scenario_3d": "tasks",
 }
 __all__ = list(_EXPORTS)
 # what the flat module bidmp.plotting of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("figures",))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("_base", "extension", "tasks"))

@@ -30,6 +30,7 @@ import numpy as np
 from sklearn.base import BaseEstimator
 
 from .._state import Prefixed
+from .._api import goal_first
 from .._checks import as_point, as_trajectory, check_fitted, check_loaded, numerically_guarded
 from .so3 import (
     angle_between,
@@ -174,8 +175,9 @@ class CartesianDMP(BaseEstimator):
         start_q = as_quaternions(start[3:], "start's quaternion")[0]
         return goal[:3], goal_q, start[:3], nearest_turn(start_q, goal_q, self.start_log_)
 
+    @goal_first("start", "duration", "dt")
     @numerically_guarded
-    def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
+    def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, position_increment=None, orientation_increment=None,
                    coupling=None) -> PoseTrajectory:
         """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
@@ -197,18 +199,21 @@ class CartesianDMP(BaseEstimator):
         return pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
                                 limits, position_increment, orientation_increment, self.units_, coupling)
 
-    def rollout(self, goal=None, start=None, n_steps: int | None = None) -> np.ndarray:
-        """Poses (n, 7) on the DMP's sample grid (as :meth:`bidmp.DMP.rollout`)."""
+    @goal_first("start", "n_steps")
+    def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:
+        """Poses (n, 7) on the DMP's sample grid, in normalised time (as :meth:`bidmp.DMP.rollout`;
+        :meth:`trajectory` is in seconds)."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
-        position = self.position_.rollout(goal_p, start_p, n_steps)
-        error = self.orientation_.rollout(np.zeros(3), start_e, n_steps)
+        position = self.position_.rollout(goal_p, start=start_p, n_steps=n_steps)
+        error = self.orientation_.rollout(np.zeros(3), start=start_e, n_steps=n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
-    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling=0.0) -> PoseStepper:
+    @goal_first("start", "duration")
+    def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0) -> PoseStepper:
         """A step-by-step integrator for a control loop; phase stopping on the position error."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
-        return PoseStepper(self.position_.stepper(goal_p, start_p, duration, coupling=coupling),
-                           self.orientation_.stepper(np.zeros(3), start_e, duration), goal_q)
+        return PoseStepper(self.position_.stepper(goal_p, start=start_p, duration=duration, coupling=coupling),
+                           self.orientation_.stepper(np.zeros(3), start=start_e, duration=duration), goal_q)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:

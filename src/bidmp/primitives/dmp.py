@@ -46,6 +46,7 @@ import logging
 import numpy as np
 from sklearn.base import BaseEstimator
 
+from .._api import goal_first
 from .._checks import (
     as_point,
     as_trajectory,
@@ -66,7 +67,7 @@ from .rollouts import iter_rollouts_to, rollouts_to
 from .state import dmp_from_state, dmp_state
 from .stepper import DMPStepper
 from .timed import coupled_trajectory, limited_trajectory, timed_trajectory
-from .timing import drop_duplicate_stamps, uniform_time
+from .timing import on_uniform_time
 
 __all__ = ["DMP", "PROTOCOLS"]
 
@@ -237,12 +238,7 @@ class DMP(FittedParams, BaseEstimator):
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
-        if t is None:
-            duration = (y.shape[0] - 1) / y.shape[0]
-        else:
-            y, stamps = drop_duplicate_stamps(y, t)
-            y, grid = uniform_time(y, stamps)
-            duration = float(grid[-1])
+        y, duration = on_uniform_time(y, t)
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
         if params.rest_start:
@@ -399,8 +395,9 @@ class DMP(FittedParams, BaseEstimator):
             raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
         return free, goal_response, forcing, gate
 
+    @goal_first("start", "n_steps", "start_velocity")
     @numerically_guarded
-    def rollout(self, goal=None, start=None, n_steps: int | None = None, start_velocity=None, *,
+    def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_velocity=None,
                 forcing_increment=None) -> np.ndarray:
         """Generate a trajectory on the normalised grid, one sample every ``dt_`` (``duration_ /
         (T - 1)`` seconds at ``tau = 1``), with the protocol's integrator (robot: exact; paper:
@@ -431,8 +428,9 @@ class DMP(FittedParams, BaseEstimator):
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         return free + np.outer(goal_response, goal)
 
+    @goal_first("start", "n_steps", "start_velocity")
     @numerically_guarded
-    def rollout_many(self, goals, start=None, n_steps: int | None = None, start_velocity=None, *,
+    def rollout_many(self, goals, *, start=None, n_steps: int | None = None, start_velocity=None,
                      forcing_increment=None, out: np.ndarray | None = None) -> np.ndarray:
         """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
 
@@ -456,8 +454,9 @@ class DMP(FittedParams, BaseEstimator):
         free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         return rollouts_to(goals, free, goal_response, out)
 
-    def iter_rollouts(self, goals, chunk_size: int = 1024, start=None, n_steps: int | None = None,
-                      start_velocity=None, *, forcing_increment=None):
+    @goal_first("chunk_size", "start", "n_steps", "start_velocity")
+    def iter_rollouts(self, goals, *, chunk_size: int = 1024, start=None, n_steps: int | None = None,
+                      start_velocity=None, forcing_increment=None):
         """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
 
         Yields
@@ -491,8 +490,9 @@ class DMP(FittedParams, BaseEstimator):
         return float(abs(1.0 - goal_response[-1]))
 
     # -- real time -------------------------------------------------------------------------------
+    @goal_first("start", "duration", "dt")
     @numerically_guarded
-    def trajectory(self, goal=None, start=None, duration: float | None = None, dt: float | None = None, *,
+    def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None):
         """A timed rollout: positions, velocities and accelerations in seconds.
 
@@ -538,7 +538,8 @@ class DMP(FittedParams, BaseEstimator):
             return coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
         return timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
 
-    def stepper(self, goal=None, start=None, duration: float | None = None, *, coupling=0.0,
+    @goal_first("start", "duration")
+    def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0,
                 start_velocity=None, forcing_increment=None) -> DMPStepper:
         """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).
 

@@ -79,11 +79,11 @@ def pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, 
                      position_increment, orientation_increment, units, coupling=None) -> PoseTrajectory:
     """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
     ``coupling`` terms act on the position part, and both parts then run the step integrator."""
-    position = position_model.trajectory(goal_p, start_p, duration, dt, limits=limits, forcing_increment=position_increment,
+    position = position_model.trajectory(goal_p, start=start_p, duration=duration, dt=dt, limits=limits, forcing_increment=position_increment,
                                          coupling=coupling)
     if limits:  # the orientation follows the motion time the position's limits chose
         duration = position.t[-1] / position_model._params().settle
-    error = orientation_model.trajectory(np.zeros(3), start_e, duration, dt, forcing_increment=orientation_increment,
+    error = orientation_model.trajectory(np.zeros(3), start=start_e, duration=duration, dt=dt, forcing_increment=orientation_increment,
                                          coupling=None if coupling is None else [])
     n = min(len(position.t), len(error.t))
     orientation = orientation_from_log(error.y[:n], goal_q)

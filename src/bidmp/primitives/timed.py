@@ -94,7 +94,7 @@ def limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_inc
         raise TypeError(f"limits['fastest'] must be True or False, got {type(fastest).__name__}")
 
     def attempt(duration):
-        trajectory = dmp.trajectory(goal, start, duration, dt, start_velocity=start_velocity,
+        trajectory = dmp.trajectory(goal, start=start, duration=duration, dt=dt, start_velocity=start_velocity,
                                      forcing_increment=forcing_increment)
         return trajectory, scale_factor(trajectory, **limits)
 

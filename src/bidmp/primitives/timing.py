@@ -15,7 +15,7 @@ import numpy as np
 
 from .._checks import check_choice, numerically_guarded
 
-__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "scale_factor",
+__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
 
 logger = logging.getLogger(__name__)
@@ -235,3 +235,14 @@ def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None,
     factor = scale_factor(trajectory, max_velocity, max_acceleration, max_jerk, norm)
     return Trajectory(trajectory.t * factor, trajectory.y.copy(), trajectory.yd / factor, trajectory.ydd / factor**2,
                       trajectory.units)
+
+
+def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
+    """A demonstration (T, D) on uniform time and its duration (s): resampled over the span of its
+    stamps ``t`` (repeated stamps dropped), or, without stamps, the paper's convention of T samples
+    in one unit of time (duration ``(T - 1) / T``)."""
+    if t is None:
+        return y, (y.shape[0] - 1) / y.shape[0]
+    y, stamps = drop_duplicate_stamps(y, t)
+    y, grid = uniform_time(y, stamps)
+    return y, float(grid[-1])

@@ -483,7 +483,7 @@ def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
     """Write ``results.json`` and the three figures of a report into folder ``out`` (created if
     needed); return the paths written."""
     from ..io.atomic import atomic_write
-    from ..plotting.figures import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+    from ..plotting.tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -18,11 +18,11 @@ class GMMMethod(Method):
         return task.shared_model("gmm", lambda: GMMRegressor(seed=task.seed % (2**31)).fit(task.demonstration))
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
-        mean, _ = model.generate()
+        mean = model.rollout()
         return [mean] * len(goals)
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
-        return model.generate()[0]
+        return model.rollout()
 
 
 register(GMMMethod())

@@ -19,7 +19,7 @@ class TPGMMMethod(Method):
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
         tpgmm, start = model
-        return tpgmm.generate(start, goal)[0]
+        return tpgmm.rollout(goal, start=start)
 
 
 register(TPGMMMethod())

@@ -1,0 +1,81 @@
+"""What every figure shares: matplotlib without ``pyplot``, 2-D or 3-D axes, atomic PNG writes.
+
+Figures are built as :class:`matplotlib.figure.Figure` objects, never through ``pyplot``: nothing
+is shown, no global figure registry fills up, and the process-wide backend is left alone, so a
+notebook user keeps theirs."""
+
+from __future__ import annotations
+
+import io as _io
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_write
+
+
+class _Matplotlib:
+    """The parts of matplotlib the figures use, without ``pyplot`` (which would pick a backend)."""
+
+    def __init__(self):
+        from types import SimpleNamespace
+
+        import mpl_toolkits.mplot3d  # noqa: F401 - registers the "3d" projection
+        from matplotlib import colormaps
+        from matplotlib.figure import Figure
+        from matplotlib.patches import Circle, Rectangle
+
+        self._figure_class = Figure
+        self.Circle = Circle
+        self.Rectangle = Rectangle
+        self.cm = SimpleNamespace(viridis=colormaps["viridis"], tab10=colormaps["tab10"])
+
+    def figure(self, figsize, dpi):
+        return self._figure_class(figsize=figsize, dpi=dpi)
+
+    def subplots(self, *grid, figsize, dpi, **kwargs):
+        fig = self._figure_class(figsize=figsize, dpi=dpi)
+        return fig, fig.subplots(*grid, **kwargs)
+
+
+def _matplotlib() -> _Matplotlib:
+    return _Matplotlib()
+
+
+def _figure(projection_3d: bool):
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(7.0, 6.0), dpi=110)
+    ax = fig.add_subplot(projection="3d" if projection_3d else None)
+    return mpl, fig, ax
+
+
+def _save(fig, path: str | os.PathLike) -> Path:
+    buffer = _io.BytesIO()
+    fig.savefig(buffer, format="png", bbox_inches="tight")
+    path = Path(path)
+    with atomic_write(path, "wb") as handle:
+        handle.write(buffer.getvalue())
+    return path
+
+
+def _axes_for(fig, n_dims: int, *grid):
+    return fig.add_subplot(*grid, projection="3d" if n_dims == 3 else None)
+
+
+def _draw(ax, points: np.ndarray, *args, **kwargs):
+    points = np.asarray(points, dtype=float).reshape(-1, points.shape[-1])
+    return ax.plot(*(points[:, i] for i in range(points.shape[1])), *args, **kwargs)
+
+
+def _finish(ax, n_dims: int, units: str, title: str = "") -> None:
+    suffix = f" [{units}]" if units else ""
+    ax.set_xlabel("x" + suffix)
+    ax.set_ylabel("y" + suffix)
+    if n_dims == 3:
+        ax.set_zlabel("z" + suffix)
+    else:
+        ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    if title:
+        ax.set_title(title, fontsize=10)

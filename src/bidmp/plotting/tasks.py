@@ -1,0 +1,129 @@
+"""Figures of a scenario's evaluation: targets from above, error against distance, the scene in 3-D."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ._base import _axes_for, _draw, _finish, _matplotlib, _save
+
+__all__ = ['plot_targets_top_view', 'plot_error_vs_distance', 'plot_scenario_3d']
+
+
+_METHOD_COLOURS = {"dmp": "tab:blue", "dmp-converged": "tab:cyan", "bidmp": "tab:red", "bidmp-latest": "tab:orange",
+                   "gmm": "tab:purple", "tpgmm": "tab:brown"}
+
+
+def plot_targets_top_view(path, report) -> Path:
+    """Top view of the targets, one panel per method: green = success, red = failure (paper
+    Fig. 16c analogue), with the end point of each rollout."""
+    mpl = _matplotlib()
+    scenario = report.scenario
+    names = list(report.methods)
+    n_cols = min(3, len(names))
+    n_rows = int(np.ceil(len(names) / n_cols))
+    fig, axes = mpl.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
+    targets = scenario.target_array
+    checked = any(result.clearances is not None for result in report.methods.values())
+    scene = scenario.scene if checked else None
+    for ax, name in zip(axes.ravel(), names):
+        result = report.methods[name]
+        if scene is not None:  # the parts' footprints, under everything else
+            for solid in scene.solids:
+                ax.add_patch(mpl.Rectangle(solid.lower[:2], *(solid.upper[:2] - solid.lower[:2]), fill=False,
+                                           edgecolor="0.75", linewidth=0.6, zorder=0))
+        for label, target in scenario.targets.items():
+            ok = result.task_success_at(label) if scene is not None else result.errors[label] <= scenario.success_threshold
+            ax.add_patch(mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
+            ax.text(target[0], target[1], label, ha="center", va="center", fontsize=8)
+            end = result.rollouts[label][-1]
+            ax.plot(end[0], end[1], "k.", markersize=3)
+            clearance = result.clearance_at(label)
+            if clearance is not None and not clearance.collision_free:
+                ax.plot(clearance.point[0], clearance.point[1], "x", color="darkred", markersize=7, markeredgewidth=2)
+        if scene is not None:
+            title = (f"{name}: task success {result.task_successes}/{len(targets)}, "
+                     f"{result.collision_free}/{len(result.checked)} collision-free (x = hit)")
+        else:
+            title = f"{name}: {result.successes}/{len(targets)} within {scenario.success_threshold:g} {scenario.units}"
+        ax.set_title(title, fontsize=9)
+        pad = 20.0
+        ax.set_xlim(targets[:, 0].min() - pad, targets[:, 0].max() + pad)
+        ax.set_ylim(targets[:, 1].min() - pad, targets[:, 1].max() + pad)
+        ax.set_aspect("equal")
+        ax.grid(True, alpha=0.3)
+    for ax in axes.ravel()[len(names):]:
+        ax.axis("off")
+    fig.suptitle(f"{scenario.name}: {'task ' if scene is not None else ''}success per target (green) and failure (red)")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def plot_error_vs_distance(path, report) -> Path:
+    """End-point error (and approach error) against the distance from the demonstrated target."""
+    mpl = _matplotlib()
+    scenario = report.scenario
+    origin = scenario.targets[scenario.demonstrated]
+    distance = {label: float(np.linalg.norm(target - origin)) for label, target in scenario.targets.items()}
+    order = sorted(distance, key=distance.get)
+    has_approach = any(r.approach_errors is not None for r in report.methods.values())
+    fig, axes = mpl.subplots(1, 2 if has_approach else 1, figsize=(12 if has_approach else 6.5, 4.8), dpi=100, squeeze=False)
+    panels = [("errors", "end-point error")] + ([("approach_errors", "approach error")] if has_approach else [])
+    for ax, (attribute, title) in zip(axes[0], panels):
+        for name, result in report.methods.items():
+            values = getattr(result, attribute)
+            if values is None:
+                continue
+            ax.plot([distance[label] for label in order], [values[label] for label in order], "o-",
+                    color=_METHOD_COLOURS.get(name), label=name, markersize=4)
+        ax.axhline(scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold")
+        ax.set_yscale("symlog", linthresh=1.0)
+        ax.set_ylim(bottom=0.0)
+        ax.set_xlabel(f"distance from the demonstrated target [{scenario.units}]")
+        ax.set_ylabel(f"{title} [{scenario.units}]")
+        ax.grid(True, alpha=0.3)
+        ax.set_title(title, fontsize=10)
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(f"{scenario.name}: error against distance (symlog scale)")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def plot_scenario_3d(path, report) -> Path:
+    """3-D view: demonstration, segmentation points, extended demonstration(s), Bi-DMP rollouts
+    and the plain DMP's rollouts to the targets it misses (paper Fig. 17 / 19 analogue)."""
+    mpl = _matplotlib()
+    scenario = report.scenario
+    demo = scenario.demonstration
+    n_dims = demo.shape[1]
+    fig = mpl.figure(figsize=(8.0, 6.8), dpi=100)
+    ax = _axes_for(fig, n_dims, 1, 1, 1)
+    _draw(ax, demo, color="0.4", linewidth=3, label="demonstration")
+    for index, extension in enumerate(report.extensions):
+        if len(extension.segmentation_points):
+            _draw(ax, extension.demonstration[extension.segmentation_points], "^", color="k", markersize=6,
+                  linestyle="none", label="segmentation points" if index == 0 else None)
+        _draw(ax, extension.complete, color="goldenrod", linewidth=2.5, alpha=0.8, label="extended demonstration" if index == 0 else None)
+    for label, trajectory in scenario.demonstrations.items():
+        _draw(ax, trajectory, color="goldenrod", linewidth=2.0, alpha=0.6)
+    if "bidmp" in report.methods:
+        for index, trajectory in enumerate(report.methods["bidmp"].rollouts.values()):
+            _draw(ax, trajectory, color="tab:red", linewidth=0.8, alpha=0.7, label="Bi-DMP rollouts" if index == 0 else None)
+    if "dmp" in report.methods:
+        for index, label in enumerate(report.failed_targets):
+            _draw(ax, report.methods["dmp"].rollouts[label], "--", color="tab:blue", linewidth=0.8,
+                  label="plain DMP, missed targets" if index == 0 else None)
+    _draw(ax, scenario.target_array, "o", color="tab:green", markersize=4, linestyle="none", label="targets")
+    hits = [clearance.point for result in report.methods.values() if result.clearances is not None
+            for clearance in result.clearances.values() if clearance is not None and not clearance.collision_free]
+    if scenario.scene is not None and n_dims == 3:
+        for solid in scenario.scene.solids:  # each part as the vertical edges of its box
+            for x, y in ((solid.lower[0], solid.lower[1]), (solid.upper[0], solid.lower[1]),
+                         (solid.upper[0], solid.upper[1]), (solid.lower[0], solid.upper[1])):
+                ax.plot([x, x], [y, y], [solid.lower[2], solid.upper[2]], color="0.7", linewidth=0.5)
+    if hits:
+        _draw(ax, np.array(hits), "X", color="darkred", markersize=7, linestyle="none", label="collisions")
+    _finish(ax, n_dims, scenario.units, f"{scenario.name}")
+    ax.legend(fontsize=7, loc="upper left")
+    return _save(fig, path)

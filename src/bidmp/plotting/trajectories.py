@@ -1,0 +1,150 @@
+"""Figures of motions: demonstrations and rollouts, the generalisation example, recordings."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .._checks import as_points, as_trajectory
+from ._base import _figure, _matplotlib, _save
+
+__all__ = ['plot_trajectories', 'plot_generalisation', 'plot_recordings']
+
+
+def plot_trajectories(
+    path: str | os.PathLike,
+    demonstration: np.ndarray,
+    trajectories: Sequence[np.ndarray] = (),
+    labels: Sequence[str] | None = None,
+    goals: np.ndarray | None = None,
+    title: str = "",
+    units: str = "",
+) -> Path:
+    """Plot a demonstration (thick grey), generated trajectories and their goals (stars).
+
+    Parameters
+    ----------
+    path : path of the PNG to write.
+    demonstration : array, shape (T, D), D = 2 or 3 (D = 1 is plotted against the sample index).
+    trajectories : sequence of arrays (n, D).
+    labels : one legend entry per trajectory (optional).
+    goals : array, shape (G, D), optional; drawn as stars.
+    """
+    demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
+    n_dims = demonstration.shape[1]
+    if n_dims not in (1, 2, 3):
+        raise ValueError(f"can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
+    trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True) for i, t in enumerate(trajectories)]
+    for index, trajectory in enumerate(trajectories):
+        if trajectory.shape[1] != n_dims:
+            raise ValueError(f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}")
+    if goals is not None:
+        goals = as_points(goals, n_dims, "goals")
+    mpl, fig, ax = _figure(n_dims == 3)
+
+    def coords(points: np.ndarray):
+        points = np.asarray(points, dtype=float)
+        if n_dims == 1:
+            return np.arange(len(points)), points[:, 0]
+        return tuple(points[:, i] for i in range(n_dims))
+
+    ax.plot(*coords(demonstration), color="0.55", linewidth=4, alpha=0.6, label="demonstration")
+    ax.scatter(*[[c[0]] for c in coords(demonstration)], color="k", marker="o", zorder=5, label="start")
+    colours = mpl.cm.viridis(np.linspace(0.0, 0.9, max(len(trajectories), 1)))
+    for index, trajectory in enumerate(trajectories):
+        label = labels[index] if labels is not None and index < len(labels) else None
+        ax.plot(*coords(trajectory), color=colours[index], linewidth=1.5, label=label)
+    if goals is not None and n_dims > 1:
+        ax.scatter(*[goals[:, i] for i in range(n_dims)], marker="*", s=140, color="crimson", zorder=6, label="goals")
+    suffix = f" [{units}]" if units else ""
+    names = ("x", "y", "z")
+    if n_dims == 1:
+        ax.set_xlabel("sample")
+        ax.set_ylabel("x" + suffix)
+    else:
+        ax.set_xlabel(names[0] + suffix)
+        ax.set_ylabel(names[1] + suffix)
+        if n_dims == 3:
+            ax.set_zlabel(names[2] + suffix)
+        else:
+            ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
+    return _save(fig, path)
+
+
+def plot_generalisation(path: str | os.PathLike, result) -> Path:
+    """Two panels for a :class:`bidmp.evaluation.GeneralisationResult` (2-D): the rollouts to moved
+    goals with the paper's fixed horizon (left) and run to convergence (right)."""
+    mpl = _matplotlib()
+    fig, axes = mpl.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
+    panels = (
+        (result.fixed_horizon, f"T = {result.demonstration.shape[0]} steps (paper): end-point gain c = {result.endpoint_gain:.3f}"),
+        (result.converged, f"{result.converged.shape[1]} steps (run to convergence): c = {result.endpoint_gain_converged:.1e}"),
+    )
+    colours = mpl.cm.viridis(np.linspace(0.0, 0.85, len(result.goals)))
+    for ax, (rollouts, title) in zip(axes, panels):
+        demo = result.demonstration
+        ax.plot(demo[:, 0], demo[:, 1], color="0.55", linewidth=4, alpha=0.6, label="demonstration")
+        ax.plot(result.reproduction[:, 0], result.reproduction[:, 1], "k--", linewidth=1, label="reproduction")
+        for colour, rollout, goal in zip(colours, rollouts, result.goals):
+            ax.plot(rollout[:, 0], rollout[:, 1], color=colour, linewidth=1.3)
+            ax.plot(*goal, marker="*", markersize=12, color=colour, markeredgecolor="crimson")
+            ax.plot(*rollout[-1], marker="x", markersize=7, color="crimson")
+        ax.plot(*demo[0], "ko", label="start")
+        ax.plot([], [], "*", color="0.3", markeredgecolor="crimson", label="moved goal")
+        ax.plot([], [], "x", color="crimson", label="end point")
+        ax.set_title(title, fontsize=10)
+        ax.set_xlabel("x [mm]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(True, alpha=0.3)
+    axes[0].set_ylabel("y [mm]")
+    axes[0].legend(loc="best", fontsize=8)
+    fig.suptitle(f"LASA {result.shape}: one demonstration, DMP rollouts to moved goals")
+    return _save(fig, path)
+
+
+def plot_recordings(path, recordings, goal_shift=None) -> Path:
+    """Kinesthetic recordings raw and prepared, the DMP's rollout to a moved goal, and the speed
+    profiles in real time (top view, side view, speed).
+
+    Parameters
+    ----------
+    recordings : list of (name, y, t, prepared, info, moved)
+        ``y``, ``t``: the recording; ``prepared``, ``info``: :func:`bidmp.prepare`'s result;
+        ``moved``: a :class:`bidmp.Trajectory` (the rollout to the moved goal), or None.
+    """
+    mpl = _matplotlib()
+    fig, (top, side, speed) = mpl.subplots(1, 3, figsize=(12.0, 4.6), dpi=110)
+    colours = mpl.cm.tab10(np.arange(10))
+    for index, (name, y, t, prepared, info, moved) in enumerate(recordings):
+        colour = colours[index % 10]
+        top.plot(y[:, 0], y[:, 1], color=colour, alpha=0.35, linewidth=3, label=f"{name} (raw)")
+        side.plot(y[:, 0], y[:, 2], color=colour, alpha=0.35, linewidth=3)
+        raw_speed = np.linalg.norm(np.gradient(y, t, axis=0), axis=1)
+        speed.plot(t - t[0], raw_speed, color=colour, alpha=0.25, linewidth=0.6)
+        speed.plot(prepared.t + info.start_s, np.linalg.norm(prepared.yd, axis=1), color=colour, linewidth=2,
+                   label=f"{name}: prepared, kept {info.start_s:.2f}-{info.end_s:.2f} s")
+        if moved is not None:
+            top.plot(moved.y[:, 0], moved.y[:, 1], color=colour, linewidth=1.2, label="DMP to the moved goal")
+            side.plot(moved.y[:, 0], moved.y[:, 2], color=colour, linewidth=1.2)
+            speed.plot(moved.t + info.start_s, np.linalg.norm(moved.yd, axis=1), color=colour, linestyle="--", linewidth=1)
+            top.plot(moved.y[-1, 0], moved.y[-1, 1], marker="*", markersize=12, color="crimson")
+            side.plot(moved.y[-1, 0], moved.y[-1, 2], marker="*", markersize=12, color="crimson")
+    units = recordings[0][3].units if recordings else ""
+    suffix = f" [{units}]" if units else ""
+    top.set(xlabel="x" + suffix, ylabel="y" + suffix, title="top view")
+    side.set(xlabel="x" + suffix, ylabel="z" + suffix, title="side view")
+    speed.set(xlabel="time in the recording [s]", ylabel=f"speed [{units or 'units'}/s]",
+              title="speed: raw (thin), prepared, rollout (dashed)")
+    speed.set_ylim(0.0, 1.3 * max(float(np.max(np.linalg.norm(r[3].yd, axis=1))) for r in recordings))
+    top.legend(fontsize=7, loc="lower right")
+    speed.legend(fontsize=7, loc="upper right")
+    for axes in (top, side, speed):
+        axes.grid(True, alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, path)
