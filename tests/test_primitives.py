@@ -161,3 +161,37 @@ def test_the_goal_systems_each_protocol_composes():
     # A delayed goal at the phase's own rate is Eq. 10's phase gate.
     phase = paper.phase()
     np.testing.assert_allclose(DelayedGoal(1.0).on_grid(phase, paper.dt_, 1.0, False), phase, rtol=1e-12)
+
+
+def test_rollouts_to_many_goals_as_one_matrix_product_are_the_same_numbers():
+    """From GEMM_GOALS goals on, rollout_many is one matrix product: every entry is g B + free with
+    exact zeros elsewhere, so it must equal the per-goal rollout to the last bit."""
+    from bidmp.primitives.integrate import GEMM_GOALS
+
+    rng = np.random.default_rng(5)
+    dmp = bidmp.DMP().fit(random_demo(rng, n_steps=200))
+    goals = dmp.goal_ + rng.normal(scale=50.0, size=(GEMM_GOALS + 7, 3))
+    many = dmp.rollout_many(goals)
+    looped = np.stack([dmp.rollout(goal) for goal in goals])
+    np.testing.assert_array_equal(many, looped)
+    out = np.full_like(many, np.nan)
+    assert dmp.rollout_many(goals, out=out) is out
+    np.testing.assert_array_equal(out, looped)
+
+
+def test_a_skill_increment_is_computed_once_per_grid(monkeypatch):
+    y, t = recording("operator1_nut3")
+    prepared, _ = bidmp.prepare(y, t, units="mm")
+    dmp = bidmp.DMP().fit(prepared.y, prepared.t, units="mm")
+    target = dmp.goal_ + np.array([120.0, -60.0, 0.0])
+    model = bidmp.BiDMP(dmp, increments=(10,))
+    model.learn(bidmp.extend_demonstration(prepared.y, target, seed=0).complete)
+    goals = target + np.random.default_rng(0).normal(scale=5.0, size=(6, 3))
+    calls = []
+    original = type(model.blocks_[0]).predict
+    monkeypatch.setattr(type(model.blocks_[0]), "predict", lambda self, X: calls.append(len(X)) or original(self, X))
+    rollouts = [model.rollout(goal, skill=1) for goal in goals]
+    assert len(calls) == 1  # six goals, one increment
+    model.__dict__.pop("_increments")  # without the cache: the same motions
+    np.testing.assert_array_equal(np.stack(rollouts), np.stack([model.rollout(goal, skill=1) for goal in goals]))
+    assert len(calls) == 2

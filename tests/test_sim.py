@@ -143,3 +143,18 @@ def test_pictures_are_written(tmp_path, nut, nut_report):
 
     with Image.open(tmp_path / "sim_12_dmp_vs_bidmp.gif") as gif:
         assert gif.n_frames == 4 and gif.size == (2 * 320 + 6, 240)
+
+
+def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):
+    """Issue 20: the last PyBullet world is kept for the next call; a job in it must measure as
+    in a world built for it (to the last digit of the report)."""
+    from bidmp.sim import run
+
+    first = sim.simulate(nut, ["dmp"], targets=["4"], report=nut_report, workers=1).to_dict()
+    assert run._WORLD.get("cell") is not None
+    kept = run._WORLD["cell"]
+    again = sim.simulate(nut, ["dmp"], targets=["4"], report=nut_report, workers=1).to_dict()
+    assert run._WORLD["cell"] is kept
+    run._close_world()
+    fresh = sim.simulate(nut, ["dmp"], targets=["4"], report=nut_report, workers=1).to_dict()
+    assert first == again == fresh

@@ -26,17 +26,22 @@ def thread_limits() -> dict[str, int]:
     return limits
 
 
+def one_thread():
+    """Context manager: every loaded BLAS and OpenMP pool limited to one thread inside it."""
+    global _controller
+    if _controller is None:
+        from threadpoolctl import ThreadpoolController
+
+        _controller = ThreadpoolController()  # inspects the loaded libraries once (~7 ms)
+    return _controller.limit(limits=1)
+
+
 def single_threaded(function):
     """Decorator: run ``function`` with every loaded BLAS and OpenMP pool limited to one thread."""
 
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        global _controller
-        if _controller is None:
-            from threadpoolctl import ThreadpoolController
-
-            _controller = ThreadpoolController()  # inspects the loaded libraries once (~7 ms)
-        with _controller.limit(limits=1):
+        with one_thread():
             return function(*args, **kwargs)
 
     return wrapper

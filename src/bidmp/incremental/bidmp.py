@@ -220,6 +220,13 @@ class BiDMP(BaseEstimator):
         total = np.zeros((phase.shape[0], self.dmp_.n_dims_))
         if skill == 0:
             return total
+        # A skill's increment on a grid does not depend on the goal: rollouts to many goals on the
+        # same grid (the same phase and basis objects, from the DMP's grid cache) compute it once.
+        key = tuple(id(block.output_weights_) for block in self.blocks_[:skill])
+        cache = self.__dict__.setdefault("_increments", {})
+        hit = cache.get(skill)
+        if hit is not None and hit[0] is phase and hit[1] is basis and hit[2] == key:
+            return hit[3]
         clipped = np.clip(phase, self.phase_min_, 1.0)
         outside = clipped != phase
         if np.any(outside):  # never extrapolate in phase: hold the BLS input at the trained range
@@ -229,6 +236,9 @@ class BiDMP(BaseEstimator):
         for block in self.blocks_[:skill]:
             total += block.predict(inputs)
         total *= self._gate(phase)[:, None]
+        if phase.shape[0] > 1:  # a control loop's single phases are not worth keeping
+            total.setflags(write=False)
+            cache[skill] = (phase, basis, key, total)
         return total
 
     def _bls_input(self, phase: np.ndarray, basis: np.ndarray) -> np.ndarray:

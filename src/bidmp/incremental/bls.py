@@ -58,9 +58,11 @@ from .._checks import (
     check_real,
     numerically_guarded,
 )
-from .._threads import single_threaded
+from .._threads import one_thread, single_threaded
 
 from .bls_state import bls_from_state, bls_state
+
+_THREADED_ROWS = 64  # predict() runs single-threaded from this many rows on
 
 __all__ = ["BLS", "sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update"]
 
@@ -523,7 +525,11 @@ class BLS(BaseEstimator):
         """Outputs for inputs X: ``hidden(X) @ output_weights_``, shape (N, n_outputs)."""
         check_fitted(self, "output_weights_")
         check_bytes(np.shape(X)[0] * self.n_hidden_ if np.ndim(X) == 2 else 0, "the hidden matrix of X (N x hidden nodes)")
-        out = self.hidden(X) @ self.output_weights_
+        if np.shape(X)[0] >= _THREADED_ROWS:
+            with one_thread():  # as fit: small products, and idle pools would contend (bidmp._threads)
+                out = self.hidden(X) @ self.output_weights_
+        else:  # a control loop's one row: limiting the pools would cost more than the product
+            out = self.hidden(X) @ self.output_weights_
         return out[:, 0] if self._y_was_1d else out
 
     def _get_state(self) -> tuple[dict, dict]:

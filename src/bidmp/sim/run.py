@@ -3,6 +3,7 @@ worker processes (each with its own world), measured into a :class:`bidmp.sim.re
 
 from __future__ import annotations
 
+import atexit
 import os
 import time
 from dataclasses import dataclass
@@ -32,31 +33,64 @@ class _Job:
 
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
-    """Execute ``jobs`` in one PyBullet world; returns (method, label, SimTarget, frames, seconds)."""
-    from ..scene.clearance import Scene
-
+    """Execute ``jobs`` in one world; returns (method, label, SimTarget, frames, seconds)."""
     scenario = setup["scenario"]
-    scene = Scene.from_dict(setup["scene"], scenario["targets"])
     results = []
-    with setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"]) as cell:
-        for job in jobs:
-            if progress is not None:
-                progress(job.method, job.label)
-            plan = cell.plan(job.rollout, job.label, orientations=job.orientations)
-            if setup["closed_loop"] and job.orientations is not None:
-                raise ValueError("closed_loop runs position skills; this scenario's are poses")
-            target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
-            if setup["closed_loop"]:
-                stepper = _stepper(setup["models"], job.method, target, plan.duration, setup["coupling"])
-                run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
-            else:
-                run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
-            measured = measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
-            results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
+    cell = _world(setup)
+    for job in jobs:
+        if progress is not None:
+            progress(job.method, job.label)
+        plan = cell.plan(job.rollout, job.label, orientations=job.orientations)
+        if setup["closed_loop"] and job.orientations is not None:
+            raise ValueError("closed_loop runs position skills; this scenario's are poses")
+        target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
+        if setup["closed_loop"]:
+            stepper = _stepper(setup["models"], job.method, target, plan.duration, setup["coupling"])
+            run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
+        else:
+            run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
+        measured = measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
+        results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
     return results
 
 
+# The last world this process built, kept for the next call with the same scene, robot placement
+# and backend: building one (two URDF loads, the parts' bodies) is a quarter of a one-target run.
+# Every execution resets the joints it starts from, so a kept world runs a job as a new one would
+# (the jobs of one call already share a world: results do not depend on the number of workers).
+_WORLD: dict = {}
+
+
+def _world(setup: dict):
+    """The world of ``setup``: the kept one if it matches, else a new one (the old one closed)."""
+    import json
+
+    from ..scene.clearance import Scene
+
+    scenario = setup["scenario"]
+    key = (setup["backend"], json.dumps(setup["scene"], sort_keys=True), json.dumps(scenario["targets"], sort_keys=True),
+           scenario["units"], tuple(setup["base"]), setup["yaw"])
+    if _WORLD.get("key") != key:
+        _close_world()
+        scene = Scene.from_dict(setup["scene"], scenario["targets"])
+        _WORLD["cell"] = setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"])
+        _WORLD["key"] = key
+    return _WORLD["cell"]
+
+
+def _close_world() -> None:
+    cell = _WORLD.pop("cell", None)
+    _WORLD.pop("key", None)
+    if cell is not None:
+        cell.close()
+
+
+atexit.register(_close_world)
+
+
 def _run_chunk(setup: dict, jobs: list) -> list:
+    """A worker process's jobs (a forked worker builds its own world, never the parent's copy)."""
+    _WORLD.clear()
     return _run_jobs(setup, jobs)
 
 
