@@ -7,6 +7,7 @@ imported until a name is used, so ``import bidmp.cli`` and ``bidmp --help`` neve
 from __future__ import annotations
 
 import importlib
+import importlib.util
 from collections.abc import Callable
 
 
@@ -30,6 +31,10 @@ def exports(package: str, table: dict[str, str], namespace: dict, fallback: tupl
 
     def __getattr__(name: str):
         if name not in table:
+            if importlib.util.find_spec(f"{package}.{name}") is not None:  # a submodule: bidmp.io.models
+                value = importlib.import_module(f"{package}.{name}")
+                namespace[name] = value
+                return value
             for module in fallback:
                 source = importlib.import_module(f"{package}.{module}")
                 if hasattr(source, name):
