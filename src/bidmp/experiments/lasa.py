@@ -8,9 +8,9 @@ beyond it. The direction comes from the cell's seed. Metrics per (cell, method, 
 * ``rmse``: time-aligned RMSE against the reference (the demonstration, or for a shifted goal the
   demonstration with the goal offset blended in linearly over time, so that it starts where the
   demonstration starts and ends at the new goal);
-* ``dtw`` and ``dtw_per_sample``: DTW distance (:func:`bidmp.similarity.dtw_distance`), raw and
+* ``dtw`` and ``dtw_per_sample``: DTW distance (:func:`bidmp.extension.similarity.dtw_distance`), raw and
   divided by the reference's length;
-* ``swept_area``: CLF-DM's swept error area (:func:`bidmp.metrics.swept_area`);
+* ``swept_area``: CLF-DM's swept error area (:func:`bidmp.tasks.metrics.swept_area`);
 * ``frechet``: discrete Fréchet distance;
 * ``endpoint_error``: to the (shifted) goal;
 * ``fit_s`` and ``rollout_s``: wall times, which are not reproducible.

@@ -11,7 +11,7 @@ grows only the transfer from seg to the start of that translated approach::
 
 With a ``scene`` (:class:`bidmp.Scene`) the roadmap's samples and edges are checked against the
 parts for the tool, the parts at the new target excepted (it enters the tool), and a transfer
-or approach that would touch a part is an error (:class:`bidmp.roadmap.NoFreeRouteError`).
+or approach that would touch a part is an error (:class:`bidmp.extension.roadmap.NoFreeRouteError`).
 
 ``"paper"``: the paper's protocol: the whole nearest piece is imitated down to the new target,
 
@@ -261,7 +261,7 @@ def extend_demonstration(
     eps_frac, method
         Segmentation options, see :func:`bidmp.segment`.
     n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare, select, denom, is_free
-        G-PRM options, see :func:`bidmp.roadmap.gaussian_prm` (same defaults).
+        G-PRM options, see :func:`bidmp.extension.roadmap.gaussian_prm` (same defaults).
     approach : {"keep", "paper"}, default "keep"
         ``"keep"``: keep the demonstration's final approach (:func:`final_approach`), translated
         to the new target, and grow only the transfer to its start. ``"paper"``: the paper's
@@ -277,7 +277,7 @@ def extend_demonstration(
 
     Raises
     ------
-    bidmp.roadmap.NoFreeRouteError
+    bidmp.extension.roadmap.NoFreeRouteError
         With a scene or ``is_free``: no collision-free route exists on the roadmap, or the kept
         approach, translated, would touch a part.
     """

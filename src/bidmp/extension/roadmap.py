@@ -197,7 +197,7 @@ def shortest_path(
 
 
 def _edges_free(a: np.ndarray, b: np.ndarray, is_free: CollisionCallback) -> np.ndarray:
-    # A callback that can check straight moves continuously (bidmp.geometry.SceneChecker) does;
+    # A callback that can check straight moves continuously (bidmp.scene.SceneChecker) does;
     # a plain point callback is asked at _EDGE_CHECKS points along each edge.
     segments_free = getattr(is_free, "segments_free", None)
     if segments_free is not None:

@@ -56,7 +56,7 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
 
 
 def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:
-    """Write poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) or a :class:`bidmp.cartesian.PoseTrajectory`
+    """Write poses ``(T, 7)`` (x, y, z, qx, qy, qz, qw) or a :class:`bidmp.primitives.cartesian.PoseTrajectory`
     to a CSV with the header ``[t,]x,y,z,qx,qy,qz,qw`` (a trajectory adds ``vx..vz, wx..wz,
     ax..az, dwx..dwz``: units/s, rad/s, units/s², rad/s², as :meth:`PoseTrajectory.columns`),
     atomically; with a known unit (``units`` or the trajectory's) a first line ``# units: mm``."""

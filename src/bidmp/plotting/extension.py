@@ -61,7 +61,7 @@ def _draw_extension(ax, extension, prm_path: np.ndarray | None = None, show_samp
 
 
 def plot_extension(path, extension, units: str = "", title: str = "Extended demonstration (1D-SEG + G-PRM)") -> Path:
-    """An :class:`bidmp.extension.ExtendedDemonstration`: demonstration, segmentation points,
+    """An :class:`bidmp.extension.extend.ExtendedDemonstration`: demonstration, segmentation points,
     sampling points, Tra_imi, Tra_gen and the complete extended demonstration."""
     mpl = _matplotlib()
     n_dims = extension.demonstration.shape[1]

@@ -78,7 +78,7 @@ def plot_trajectories(
 
 
 def plot_generalisation(path: str | os.PathLike, result) -> Path:
-    """Two panels for a :class:`bidmp.evaluation.GeneralisationResult` (2-D): the rollouts to moved
+    """Two panels for a :class:`bidmp.tasks.evaluation.GeneralisationResult` (2-D): the rollouts to moved
     goals with the paper's fixed horizon (left) and run to convergence (right)."""
     mpl = _matplotlib()
     fig, axes = mpl.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)

@@ -5,7 +5,7 @@ mapped to the rotation vector of its error to the goal,
 
     e(t) = Log(q(t) ⊗ g⁻¹) ∈ R³            (radians; e(T) = 0)
 
-taken *continuous along the demonstration* (:func:`bidmp._so3.continuous_log`), so a turn of
+taken *continuous along the demonstration* (:func:`bidmp.primitives.so3.continuous_log`), so a turn of
 several revolutions keeps its whole angle, and a position DMP with goal 0 is fitted on ``e``. A
 rollout to a new goal orientation ``g'`` from a start ``q₀`` runs that DMP from ``Log(q₀ ⊗ g'⁻¹)``
 (the equivalent nearest the demonstrated start's, so it turns the same way, as many times) to 0
@@ -53,7 +53,7 @@ logger = logging.getLogger(__name__)
 
 def orientation_error(q, goal) -> np.ndarray:
     """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3), radians, continuous along ``q`` (several
-    turns keep their whole angle; see :func:`bidmp._so3.continuous_log`)."""
+    turns keep their whole angle; see :func:`bidmp.primitives.so3.continuous_log`)."""
     return continuous_log(q, goal)
 
 

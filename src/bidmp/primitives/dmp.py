@@ -92,7 +92,7 @@ class DMP(FittedParams, BaseEstimator):
     **Protocols.** ``protocol="robot"`` (default) resolves the unset parameters to a DMP a robot
     can run: ``K = alpha beta`` and a goal share that follows the demonstration's own progress
     along its path with smooth ends (a delayed goal, Kulvicius 2012, timed by the demonstration;
-    :mod:`bidmp._goals`): the first ~50 ms and the initial acceleration do not depend on the goal
+    :mod:`bidmp.primitives.goals`): the first ~50 ms and the initial acceleration do not depend on the goal
     or the start, and a moved goal changes the motion by ``R(t) (g' - g)`` with no overshoot
     beyond the stated bound; the exact integrator (the same motion at any control rate); the
     demonstration learned from rest (a start velocity blended out, so the rollout starts at rest
@@ -139,7 +139,7 @@ class DMP(FittedParams, BaseEstimator):
         ``alpha_phase``, which is exactly Eq. 10's ``-K phase (g - y0)`` term.
     integrator : {"exact", "euler"} or None, default None
         ``"exact"``: the transformation system integrated exactly with the input linear between
-        samples (:mod:`bidmp._integrate`): stable at any step, the same motion at any control
+        samples (:mod:`bidmp.primitives.integrate`): stable at any step, the same motion at any control
         rate. ``"euler"``: explicit Euler, Eq. 14 (its motion depends on the step). ``None``:
         robot exact, paper Euler. A robot-protocol model with ``"euler"`` is bidmp's robot
         protocol of model format 3 (such files load with it).
@@ -349,7 +349,7 @@ class DMP(FittedParams, BaseEstimator):
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
-        for the robot protocol, started and ended at rest (:func:`bidmp._goals.rest_started`) and
+        for the robot protocol, started and ended at rest (:func:`bidmp.primitives.rest.rest_started`) and
         followed by rest at its last point up to :attr:`n_train_`."""
         self._check_fitted()
         params = self._params()

@@ -29,7 +29,7 @@ demonstration's own progress along its path:
   slope when the motion comes to rest;
 * ``G`` is the *continuous* inverse of the spring for ``R``:
   ``G = (αβ (1 - R) - R'' - α R') / K`` (normalised time, ``tau = 1``). Integrated exactly
-  (:mod:`bidmp._integrate`), the response is ``R`` at any control rate.
+  (:mod:`bidmp.primitives.integrate`), the response is ``R`` at any control rate.
 
 **The bound on a moved goal** (stated in the README): ``y_{g'}(t) = y_g(t) + R(t) (g' - g)``
 exactly, and ``|R(t) - σ(t)| ≤ max(σ(w), 1 - σ(T - w))``: the progress made in the first and in

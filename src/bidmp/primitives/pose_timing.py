@@ -96,7 +96,7 @@ class PoseStepper:
     """Steps a :class:`CartesianDMP`'s two parts together; the position part's phase stopping
     paces the orientation part too, so the two stay on the same motion time.
 
-    ``step(dt, y_measured=None)`` returns what :meth:`bidmp.dmp.DMPStepper.step` returns, for a
+    ``step(dt, y_measured=None)`` returns what :meth:`bidmp.primitives.stepper.DMPStepper.step` returns, for a
     pose: ``(pose (7,), velocity (6,), acceleration (6,))`` with the velocity ``[vx, vy, vz, wx,
     wy, wz]`` (units/s, rad/s, world frame) and the acceleration likewise (units/s², rad/s²).
     """

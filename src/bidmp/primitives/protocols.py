@@ -64,7 +64,7 @@ PROTOCOLS = ("robot", "paper")
 INTEGRATOR_CHOICES = ("exact", "euler")
 # robot: K = alpha beta (Pastor 2009: the initial acceleration does not depend on the goal or the
 # start), a goal share that follows the demonstration's progress with smooth ends
-# (bidmp._goals), the exact integrator (the same motion at any control rate), the demonstration
+# (bidmp.primitives.goals), the exact integrator (the same motion at any control rate), the demonstration
 # learned from rest (its start velocity blended out), a phase that decays to e^-4 over the
 # demonstration, 100 kernels fitted by ridge regression, a stiffer spring (alpha = 50), and a
 # horizon of 1.1x the demonstrated duration. The weights are learned on the demonstration

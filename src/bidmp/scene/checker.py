@@ -21,7 +21,7 @@ __all__ = ['SceneChecker']
 logger = logging.getLogger(__name__)
 
 class SceneChecker:
-    """Collision callback for :func:`bidmp.roadmap.gaussian_prm`: ``checker(points)`` says which
+    """Collision callback for :func:`bidmp.extension.roadmap.gaussian_prm`: ``checker(points)`` says which
     tool placements are free, :meth:`segments_free` which straight tool moves are."""
 
     def __init__(self, scene: Scene, chosen: np.ndarray):

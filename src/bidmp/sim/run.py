@@ -119,7 +119,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
         Called with ``(method, label)`` as each motion starts (in-process) or finishes (workers).
     frames : dict, optional
         ``{(method, label): n}``: render n frames of those motions (PyBullet's TinyRenderer).
-    report : bidmp.evaluation.Report, optional
+    report : bidmp.tasks.evaluation.Report, optional
         A finished evaluation of the same scenario to take the rollouts from.
     workers : int, optional
         Worker processes, each with its own PyBullet world (default: one per core, at most 2;

@@ -2,7 +2,7 @@
 
 ``evaluate(scenario, methods)`` returns a :class:`Report`; ``report.to_dict()`` is the JSON the
 CLI writes, ``report.summary()`` the tables it prints, and :func:`write_report` writes the
-results and figures. The paper's experiments built on it live in :mod:`bidmp.reproduce`.
+results and figures. The paper's experiments built on it live in :mod:`bidmp.experiments.reproduce`.
 """
 
 from __future__ import annotations
