@@ -7,6 +7,8 @@ imported inside the command handlers so that ``bidmp --help`` starts fast.
 One module per command group, each adding its commands to the parser: ``skills`` (fit, rollout,
 segment, extend, learn), ``tasks`` (demo, sim, scenario), ``experiments`` (reproduce, lasa,
 benchmark); ``common`` holds what they share, ``inputs`` how demonstrations are read.
+
+Layer 4 (the shell): may import any layer, inside the handlers; nothing imports it.
 """
 
 from __future__ import annotations
