@@ -136,8 +136,13 @@ class FittedParams:
 
     @classmethod
     def _raw_param_names(cls) -> tuple[str, ...]:
-        """The constructor's parameters but tau, as given (compared first: cheap)."""
-        return tuple(name for name in cls._get_param_names() if name != "tau")
+        """The constructor's parameters but tau, as given (compared first: cheap); read from the
+        signature once per class (every rollout checks them)."""
+        names = cls.__dict__.get("_raw_names")
+        if names is None:
+            names = tuple(name for name in cls._get_param_names() if name != "tau")
+            setattr(cls, "_raw_names", names)
+        return names
 
     def _learned_params(self) -> Params:
         """The resolved parameters the weights depend on (all but tau, which only scales time)."""
