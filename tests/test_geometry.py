@@ -307,3 +307,34 @@ def test_final_approach_is_the_straight_tail_of_the_last_piece():
     assert final_approach(line, np.array([], dtype=int)) == 0  # all straight: all of it
     wiggle = np.column_stack([np.linspace(0, 10, 40), np.sin(np.linspace(0, 12 * np.pi, 40)), np.zeros(40)])
     assert final_approach(wiggle, np.array([], dtype=int)) >= 37  # no straight approach to speak of
+
+
+# --- issue 21.5: collision queries never abort -----------------------------------------------------
+def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
+    """A vertical tool beside a vertical post (parallel flat sides): coal's GJK at the tight
+    tolerance ends on a degenerate simplex for some placements and its EPA reports -DBL_MAX for
+    shapes 7.4 mm apart. The engine must give the closed-form gap (axis distance - radii) there and
+    at random placements around the post, and never raise."""
+    from bidmp.scene.distances import _Distances
+
+    coal = pytest.importorskip("coal")
+    scene = Scene.from_dict({"tool": {"radius": 12.5, "length": 100}, "targets_on_parts": False,
+                             "parts": [{"type": "cylinder", "label": "post", "at": [0, 0, 0], "radius": 15, "height": 120}]})
+    engine = _Distances(scene.solids, scene.tool)
+    known_bad = np.array([-28.08238384203306, 20.653673896376088, 51.0573405982136])
+    shape, pose = engine.shapes[0]
+    raw = coal.distance(engine.tool, coal.Transform3s(np.eye(3), known_bad + [0.0, 0.0, 50.0]), shape, pose,
+                        engine.request, coal.DistanceResult())
+    gap = float(np.hypot(*known_bad[:2]) - 27.5)
+    assert raw < -1e100 or abs(raw - gap) <= 1e-6  # the reproduction (if this coal still fails there)
+    assert engine.tool_to(known_bad, 0) == pytest.approx(gap, abs=1e-6)
+    assert engine.tool_to(known_bad, 0) == pytest.approx(gap, abs=1e-6)  # and again on the same engine
+    # Random placements beside the post, the tool's span overlapping the post's: the gap is the
+    # distance between the axes less both radii (an independent closed form).
+    rng = np.random.default_rng(21)
+    angles = rng.uniform(0.0, 2.0 * np.pi, 400)
+    radii = rng.uniform(27.6, 60.0, 400)
+    heights = rng.uniform(-80.0, 100.0, 400)
+    points = np.column_stack([radii * np.cos(angles), radii * np.sin(angles), heights])
+    measured = np.array([engine.tool_to(point, 0) for point in points])
+    np.testing.assert_allclose(measured, radii - 27.5, atol=1e-6)

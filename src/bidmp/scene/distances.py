@@ -90,19 +90,42 @@ class _Distances:
         else:  # the body extends from the mouth against the approach direction
             centre = np.asarray(point, dtype=float) - rotation[:, 2] * self.tool_offset[2]
             tool_pose = self.coal.Transform3s(np.asarray(rotation, dtype=float), centre)
-        return self._checked(float(self.coal.distance(self.tool, tool_pose, shape, pose, self.request, self.result)))
+        return self._distance(self.tool, tool_pose, shape, pose)
 
-    def _checked(self, distance: float) -> float:
-        # EPA that does not converge reports -DBL_MAX; a contact is certain then, its depth is not.
-        if not math.isfinite(distance) or distance < -1e100:
-            raise ValueError("coal could not compute a penetration depth (EPA did not converge)")
-        return distance
+    def _distance(self, a, pose_a, b, pose_b) -> float:
+        """coal's signed distance, never an abort. GJK at the tight tolerance can end on a degenerate
+        simplex when flat faces are parallel (a vertical tool beside a vertical post): coal then runs
+        EPA on shapes that do not touch and reports -DBL_MAX. The same query with Nesterov-accelerated
+        GJK, then at a looser tolerance, converges (to 1e-9 of the closed form in
+        tests/test_geometry.py); if neither does, the query is answered conservatively (0: touching,
+        so nothing is ever reported clearer than it is) and logged."""
+        self.result.clear()
+        distance = float(self.coal.distance(a, pose_a, b, pose_b, self.request, self.result))
+        if math.isfinite(distance) and distance > -1e100:
+            return distance
+        for request in self._retries():
+            distance = float(self.coal.distance(a, pose_a, b, pose_b, request, self.coal.DistanceResult()))
+            if math.isfinite(distance) and distance > -1e100:
+                return distance
+        logger.warning("coal could not compute a distance (GJK/EPA did not converge); the pair is taken as touching")
+        return 0.0
+
+    def _retries(self) -> list:
+        """The fallback requests of :meth:`_distance`, built once."""
+        if getattr(self, "_fallbacks", None) is None:
+            coal = self.coal
+            accelerated = coal.DistanceRequest()
+            accelerated.gjk_tolerance, accelerated.gjk_max_iterations = _GJK_TOLERANCE, 1000
+            accelerated.epa_tolerance, accelerated.gjk_variant = _EPA_TOLERANCE, coal.GJKVariant.NesterovAcceleration
+            looser = coal.DistanceRequest()
+            looser.gjk_tolerance, looser.gjk_max_iterations, looser.epa_tolerance = 1e-10, 1000, _EPA_TOLERANCE
+            self._fallbacks = [accelerated, looser]
+        return self._fallbacks
 
     def between(self, first: int, second: int) -> float:
         a, pose_a = self.shapes[first]
         b, pose_b = self.shapes[second]
-        self.result.clear()
-        return self._checked(float(self.coal.distance(a, pose_a, b, pose_b, self.request, self.result)))
+        return self._distance(a, pose_a, b, pose_b)
 
 
 def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False):
