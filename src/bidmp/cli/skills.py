@@ -51,7 +51,8 @@ def _demo_for(model, args: argparse.Namespace):
 # -- fit ------------------------------------------------------------------------------------------
 def _dmp_params(args: argparse.Namespace) -> dict:
     return dict(n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K, alpha_phase=args.alpha_phase,
-                tau=args.tau, regression=args.regression, protocol=args.protocol)
+                tau=args.tau, regression=args.regression, protocol=args.protocol,
+                keep_approach=getattr(args, "keep_approach", False))
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
@@ -351,6 +352,9 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
     fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling: rollouts take tau times the demonstration's duration (default 1)")
     fit.add_argument("--regression", "--fit", dest="regression", choices=("lwr", "ridge"), default=None,
                      help="weight regression (default: robot ridge, paper lwr)")
+    fit.add_argument("--keep-approach", action="store_true",
+                     help="robot protocol: a moved goal's offset is complete before the final approach (the straight "
+                          "tail into the goal), which then is a translated copy of the demonstrated one")
     fit.set_defaults(handler=cmd_fit)
 
     rollout = commands.add_parser(

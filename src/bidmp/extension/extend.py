@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
+from ..primitives.approach import STRAIGHTNESS, straight_tail_start
 from .._checks import as_point, as_trajectory, check_choice, check_int, check_real, numerically_guarded
 from .._trajectory import arclength, interp_columns, path_extent, resample_time
 from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
@@ -42,8 +43,7 @@ __all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonst
            "check_extension_options", "APPROACHES"]
 
 APPROACHES = ("keep", "paper")
-_STRAIGHTNESS = 0.02  # an approach deviates from its chord by at most this fraction of the chord
-_MAX_TAIL_CANDIDATES = 256  # start indices tried when only the tail of the last piece is straight
+_STRAIGHTNESS = STRAIGHTNESS  # an approach deviates from its chord by at most this fraction of the chord
 
 logger = logging.getLogger(__name__)
 
@@ -166,17 +166,6 @@ def _time_transfer(path: np.ndarray, start_speed: float, end_speed: float, n_ste
     return positions
 
 
-def _straight(points: np.ndarray, tolerance: float) -> bool:
-    chord = points[-1] - points[0]
-    length = float(np.linalg.norm(chord))
-    if length == 0.0:
-        return False
-    offsets = points - points[0]
-    along = offsets @ (chord / length)
-    deviation = np.linalg.norm(offsets - along[:, None] * (chord / length), axis=1)
-    return bool(deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length))
-
-
 def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) -> int:
     """Index where the demonstration's final approach starts: the straight last piece into its
     target.
@@ -203,14 +192,8 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     points = np.asarray(points, dtype=int).reshape(-1)
     last = y.shape[0] - 1
     start = int(points[points < last].max()) if np.any(points < last) else 0
-    if _straight(y[start:], straightness):
-        return start
-    # Only a tail is straight: the earliest start (on a grid of at most 256) from which it is.
-    candidates = np.unique(np.linspace(start, last - 1, min(_MAX_TAIL_CANDIDATES, last - start)).astype(int))
-    for candidate in candidates:
-        if _straight(y[candidate:], straightness):
-            return int(candidate)
-    return last
+    # The last piece if it is straight, else its longest straight tail (primitives.approach).
+    return straight_tail_start(y, start, straightness)
 
 
 def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, approach: str = "keep",

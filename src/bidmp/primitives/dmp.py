@@ -58,7 +58,7 @@ from .._trajectory import resample_time
 from .._units import check_units
 from .canonical import check_phase_span, phase_grid
 from .forcing import basis_functions, learn_weights
-from .goals import DelayedGoal, PhaseGate, ProgressGate, learned_progress_gate
+from .goals import DelayedGoal, PhaseGate, ProgressGate, learn_goal_gate, learned_progress_gate
 from .grid import cached_grid, rollout_grid, store_grid
 from .integrate import check_integration, unit_responses
 from .protocols import PROTOCOLS, FittedParams, Params, resolve_params, resolved_param, with_rest
@@ -143,6 +143,12 @@ class DMP(FittedParams, BaseEstimator):
         rate. ``"euler"``: explicit Euler, Eq. 14 (its motion depends on the step). ``None``:
         robot exact, paper Euler. A robot-protocol model with ``"euler"`` is bidmp's robot
         protocol of model format 3 (such files load with it).
+    keep_approach : bool, default False
+        Robot protocol: complete a moved goal's offset before the final approach (the
+        demonstration's straight tail into its goal, :mod:`bidmp.primitives.approach`), so the
+        approach to a moved goal is a translated copy of the demonstrated one
+        (:class:`bidmp.primitives.goals.ApproachGate`). A demonstration without a straight tail
+        keeps the progress gate.
 
     Attributes
     ----------
@@ -180,6 +186,7 @@ class DMP(FittedParams, BaseEstimator):
         protocol: str = "robot",
         goal_rate: float | None = None,
         integrator: str | None = None,
+        keep_approach: bool = False,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
@@ -194,6 +201,7 @@ class DMP(FittedParams, BaseEstimator):
         self.protocol = protocol
         self.goal_rate = goal_rate
         self.integrator = integrator
+        self.keep_approach = keep_approach
 
     # -- parameters ----------------------------------------------------------------------------
     def _params(self) -> Params:
@@ -250,9 +258,7 @@ class DMP(FittedParams, BaseEstimator):
         check_integration(dt, params._replace(tau=1.0))
         check_integration(dt, params)
         check_phase_span(train.shape[0] * dt, params.alpha_phase)
-        gate = (ProgressGate.learn(train, n_steps, dt, alpha=params.alpha, beta=params.beta, K=params.K,
-                                   exact=params.exact, progress=progress) if params.goal_rate is None
-                else DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact))
+        gate = learn_goal_gate(train, n_steps, dt, params, progress, y)
         weights, centres, widths, phase, phi = learn_weights(train, dt, gate, params)
         self.weights_ = weights
         self.start_ = y[0].copy()

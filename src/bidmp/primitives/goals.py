@@ -8,7 +8,10 @@ the forcing target subtracts):
   smooth scaling (movement_primitives' ``smooth_scaling=True``);
 * :class:`DelayedGoal` — ``G`` decays at its own rate (Kulvicius 2012's delayed goal);
 * :class:`ProgressGate` — the robot protocol's: the goal's share follows the demonstration's own
-  progress along its path (below), learned at ``fit``.
+  progress along its path (below), learned at ``fit``;
+* :class:`ApproachGate` — the progress gate with the goal's share complete before the final
+  approach (the demonstration's straight tail into its goal): the approach to a moved goal is a
+  translated copy of the demonstrated one (``DMP(keep_approach=True)``).
 
 A new goal system is one more class with these three methods, chosen in
 ``bidmp.primitives.dmp.goal_system``.
@@ -49,8 +52,10 @@ from .._trajectory import arclength
 from .canonical import phase_grid
 
 __all__ = ["GOAL_BLEND", "smoothstep", "smoothstep_derivatives", "goal_share", "goal_gate", "euler_progress_gate",
-           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate", "learned_progress_gate"]
+           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate", "learned_progress_gate",
+           "learn_goal_gate"]
 
+MIN_APPROACH_SHARE = 0.05  # of the path's length: a shorter straight tail is no approach
 GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
 
 
@@ -215,3 +220,47 @@ def learned_progress_gate(model, params) -> ProgressGate:
         cached = (key, ProgressGate(training_phase, gate))
         model._goal_system = cached
     return cached[1]
+
+
+class ApproachGate(ProgressGate):
+    """The progress gate, with the goal's share reaching 1 where the final approach begins.
+
+    ``R`` is the demonstration's arc-length progress normalised to the approach's start, ``σ / σ_a``,
+    with the same smooth ends as :func:`goal_share`; so ``R = 1`` over the whole approach, and a goal
+    moved by Δ moves every approach sample by exactly Δ: a translated copy, no tilt. ``R`` stays
+    monotone: no backwards motion, and the overshoot bound of :func:`goal_share` holds with the
+    approach's start in the place of the motion's end.
+    """
+
+    @staticmethod
+    def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
+              progress: np.ndarray | None = None, approach_start: int | None = None) -> np.ndarray:
+        """The gate on the training grid; ``approach_start`` the sample where the approach begins."""
+        n_train = train.shape[0]
+        progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+        if progress.shape != (n_train,):
+            raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+        reach = float(progress[approach_start])
+        share = goal_share(np.clip(progress / reach, 0.0, 1.0), approach_start + 1, dt)
+        return goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
+
+
+def learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progress=None,
+                    demonstration: np.ndarray | None = None) -> np.ndarray:
+    """The goal gate a DMP with resolved ``params`` learns on its training grid: a delayed goal's,
+    the progress gate, or (``keep_approach``) the approach gate, the approach found as the straight
+    tail of ``demonstration`` (T, D) into its goal (a demonstration without one gets the progress
+    gate)."""
+    if params.goal_rate is not None:
+        return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
+    gains = {"alpha": params.alpha, "beta": params.beta, "K": params.K, "exact": params.exact, "progress": progress}
+    if params.keep_approach and demonstration is not None:
+        from .approach import straight_tail_start
+
+        start = straight_tail_start(demonstration)
+        progress_at = arclength_progress(demonstration)[start] if start >= 2 else 0.0
+        # An approach is a straight tail of a real share of the path: any curve's last few samples
+        # are straight to 2 % of their short chord.
+        if progress_at > 0.0 and 1.0 - progress_at >= MIN_APPROACH_SHARE:
+            return ApproachGate.learn(train, n_motion, dt, approach_start=start, **gains)
+    return ProgressGate.learn(train, n_motion, dt, **gains)

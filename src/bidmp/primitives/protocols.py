@@ -47,6 +47,7 @@ class Params(NamedTuple):
     goal_rate: float | None  # None: the goal follows the demonstration's progress (robot default)
     integrator: str  # "exact" (first-order hold, any rate) or "euler" (the paper's Eq. 14)
     settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
+    keep_approach: bool = False  # the goal's offset complete before the final approach (ApproachGate)
 
     @property
     def exact(self) -> bool:
@@ -99,6 +100,8 @@ def resolve_params(estimator) -> Params:
         goal_rate = None if robot else alpha_phase
     else:
         goal_rate = check_real(estimator.goal_rate, "goal_rate", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+    integrator = ("exact" if robot else "euler") if estimator.integrator is None else \
+        check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
     return Params(
         n_kernels=(ROBOT_KERNELS if robot else 50) if estimator.n_kernels is None else
         check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
@@ -114,9 +117,9 @@ def resolve_params(estimator) -> Params:
         widths=check_choice(estimator.widths, "widths", WIDTH_CHOICES),
         protocol=protocol,
         goal_rate=goal_rate,
-        integrator=("exact" if robot else "euler") if estimator.integrator is None else
-        check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES),
+        integrator=integrator,
         settle=ROBOT_SETTLE if robot else 1.0,
+        keep_approach=_keep_approach(estimator, goal_rate, integrator),
     )
 
 
@@ -186,3 +189,14 @@ def resolved_param(name: str, doc: str) -> property:
     """A read-only property: the resolved value of parameter ``name`` (the protocol's default when
     it is None)."""
     return property(lambda self: getattr(self._params(), name), doc=doc)
+
+
+def _keep_approach(estimator, goal_rate, integrator: str) -> bool:
+    """``keep_approach``, validated: a choice of the progress gate on the exact integrator."""
+    keep = getattr(estimator, "keep_approach", False)
+    if not isinstance(keep, (bool, np.bool_)):
+        raise TypeError(f"keep_approach must be True or False, got {type(keep).__name__}")
+    if keep and (goal_rate is not None or integrator != "exact"):
+        raise ValueError("keep_approach shapes the robot protocol's progress gate: it needs goal_rate=None and the "
+                         "exact integrator")
+    return bool(keep)

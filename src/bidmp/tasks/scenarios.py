@@ -78,7 +78,7 @@ _KEYS = {
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
     "seed", "scene", "robot", "alignment_threshold",
 }
-_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol",
+_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol", "keep_approach",
              "goal_rate"}
 _BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
 _EXTENSION_KEYS = {

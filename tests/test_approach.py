@@ -1,0 +1,122 @@
+"""The approach-keeping goal system (issue 21.3): under a moved goal the spatial offset is complete
+before the final approach begins, so the approach is a translated copy of the demonstrated one.
+
+Checked on random demonstrations (random transfers, a straight approach along a random axis, other
+rates and units) against properties that must hold, not against the code: the lateral deviation
+over the last approach height, and, from the rollout's linearity in the goal, the goal share
+R(t) = (y_{g+Δ} - y_g) / Δ itself (monotone, in [0, 1], exactly 1 over the approach). The progress
+gate fails the same checks (so they can fail).
+"""
+
+import numpy as np
+import pytest
+from sklearn.base import clone
+
+import bidmp
+from bidmp.datasets import minimum_jerk
+from bidmp.primitives.approach import straight_tail_start
+
+
+def smooth(s):
+    return 10 * s**3 - 15 * s**4 + 6 * s**5
+
+
+def pick_demo(rng, approach_length=60.0, rate=250.0, scale=1.0):
+    """A random transfer ending above the target, then a straight approach of ``approach_length``
+    along a random axis within 30 degrees of vertical (mm, or metres with ``scale=1e-3``)."""
+    axis = np.array([*rng.normal(scale=0.3, size=2), 1.0])
+    axis /= np.linalg.norm(axis)
+    above = approach_length * axis
+    via = np.vstack([rng.uniform(-150, 150, 3) + [0.0, 0.0, 250.0], rng.uniform(-60, 60, 3) + [0.0, 0.0, 150.0], above])
+    transfer = minimum_jerk(via, n_steps=int(rng.integers(200, 400)))
+    n_approach = int(rng.integers(80, 160))
+    approach = above * (1.0 - smooth(np.linspace(0.0, 1.0, n_approach)))[:, None]
+    y = np.vstack([transfer, approach[1:]]) * scale
+    return y, np.arange(len(y)) / rate, axis, len(transfer) - 1
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_moved_goal_keeps_the_final_approach_within_half_a_millimetre(seed):
+    rng = np.random.default_rng(seed)
+    y, t, axis, approach_start = pick_demo(rng, rate=float(rng.choice([100.0, 250.0, 500.0])))
+    keep = bidmp.DMP(keep_approach=True).fit(y, t, units="mm")
+    plain = bidmp.DMP().fit(y, t, units="mm")
+    direction = rng.normal(size=3)
+    direction[2] = 0.0
+    shift = 200.0 * direction / np.linalg.norm(direction)  # a goal 200 mm away, sideways
+    goal = keep.goal_ + shift
+    for model, bound in ((keep, 0.5), (plain, None)):
+        motion = model.trajectory(goal, dt=0.002)
+        offsets = motion.y - goal
+        height = offsets @ axis  # along the target's axis
+        band = height <= 28.5
+        lateral = np.linalg.norm(offsets[band] - np.outer(height[band], axis), axis=1)
+        if bound is None:
+            assert lateral.max() > 5.0  # the progress gate tilts the approach: the check can fail
+        else:
+            assert lateral.max() <= bound
+            assert np.linalg.norm(motion.y[-1] - goal) <= 0.05
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_goal_share_is_monotone_and_complete_at_the_approach(seed):
+    rng = np.random.default_rng(10 + seed)
+    y, t, _, approach_start = pick_demo(rng, scale=1e-3)  # metres
+    model = bidmp.DMP(keep_approach=True).fit(y, t, units="m")
+    delta = np.array([0.1, -0.05, 0.02])
+    base = model.trajectory(model.goal_, dt=0.004)
+    moved = model.trajectory(model.goal_ + delta, dt=0.004)
+    share = ((moved.y - base.y) @ delta) / (delta @ delta)  # R(t): the rollout is affine in the goal
+    # The gate is built from R by finite differences: its response is R to 1e-4 (the progress gate's
+    # stated bound, README "Robot protocol"), so "monotone" and "in [0, 1]" hold to that.
+    assert share.min() >= -2e-4 and share.max() <= 1.0 + 2e-4
+    assert np.all(np.diff(share) >= -2e-4)  # never backwards
+    start = straight_tail_start(y)
+    assert abs(start - approach_start) <= 0.05 * len(y)  # the detector finds the demonstrated approach
+    approach_time = t[start] - t[0]
+    np.testing.assert_allclose(share[base.t >= approach_time], 1.0, atol=2e-4)
+
+
+def test_without_a_straight_approach_the_progress_gate_is_kept():
+    s = np.linspace(0.0, 1.0, 300)
+    curved = np.column_stack([100 * np.cos(6 * s), 100 * np.sin(6 * s), 50 * s])  # an arc to the end
+    # Its last few samples are straight to 2 % of their short chord, but far shorter than an approach.
+    assert len(curved) - straight_tail_start(curved) < 0.05 * len(curved)
+    keep = bidmp.DMP(keep_approach=True).fit(curved)
+    plain = bidmp.DMP().fit(curved)
+    np.testing.assert_array_equal(keep.goal_gate_, plain.goal_gate_)
+
+
+def test_keep_approach_is_a_parameter_like_any_other(tmp_path):
+    rng = np.random.default_rng(3)
+    y, t, _, _ = pick_demo(rng)
+    model = bidmp.DMP(keep_approach=True).fit(y, t, units="mm")
+    assert clone(model).get_params()["keep_approach"] is True
+    path = bidmp.save(model, tmp_path / "m.npz")
+    loaded = bidmp.load(path)
+    goal = model.goal_ + [100.0, 50.0, 0.0]
+    np.testing.assert_array_equal(loaded.trajectory(goal).y, model.trajectory(goal).y)
+    with pytest.raises(ValueError, match="keep_approach"):
+        bidmp.DMP(keep_approach=True, goal_rate=4.0).fit(y)
+    with pytest.raises(TypeError, match="keep_approach must be True or False"):
+        bidmp.DMP(keep_approach="yes").fit(y)
+    model.keep_approach = False  # a learned parameter changed after fit: refit needed
+    with pytest.raises(bidmp.NotFittedError, match="keep_approach"):
+        model.trajectory()
+    pose = bidmp.CartesianDMP(keep_approach=True)
+    assert clone(pose).get_params()["keep_approach"] is True
+
+
+@pytest.mark.parametrize("name", ["operator1_nut3", "operator2_nut5"])
+def test_the_bundled_recordings_keep_their_descent_under_a_200_mm_shift(name):
+    from bidmp.demonstrations.datasets import recording
+
+    prepared, _ = bidmp.prepare(*recording(name), units="mm")
+    lateral = {}
+    for keep in (False, True):
+        model = bidmp.DMP(keep_approach=keep).fit(prepared.y, prepared.t, units="mm")
+        goal = model.goal_ + [200.0, 0.0, 0.0]
+        offsets = model.trajectory(goal, dt=0.002).y - goal
+        band = offsets[:, 2] <= 28.5  # the last approach height above the nut (vertical axis)
+        lateral[keep] = np.linalg.norm(offsets[band, :2], axis=1).max()
+    assert lateral[True] <= 0.5 < 5.0 < lateral[False]
