@@ -18,6 +18,12 @@ from .pybullet.robot import PANDA
 __all__ = ["SimTarget", "SimMethod", "SimReport", "measure", "write_sim_report"]
 
 
+def _rounded(value: float | None) -> float | None:
+    """A length or angle for the JSON report: 4 decimals; None when absent or infinite (no final
+    approach: strict JSON has no Infinity)."""
+    return None if value is None or not np.isfinite(value) else round(float(value), 4)
+
+
 # ---------------------------------------------------------------------------------------------
 # Results
 # ---------------------------------------------------------------------------------------------
@@ -49,7 +55,7 @@ class SimTarget:
     def to_dict(self, threshold: float) -> dict:
         return {
             "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
-            "approach_error": None if self.approach_error is None else round(self.approach_error, 4),
+            "approach_error": _rounded(self.approach_error),
             "engaged": self.engaged, "contacts": sorted(self.contacts),
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
             "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
@@ -57,7 +63,7 @@ class SimTarget:
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4), "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
-            "axis_deviation_deg": None if self.axis_deviation is None else round(self.axis_deviation, 4),
+            "axis_deviation_deg": _rounded(self.axis_deviation),
             "aligned": self.aligned,
         }
 

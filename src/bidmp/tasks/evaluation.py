@@ -111,7 +111,7 @@ class MethodResult:
             "successes": self.successes,
             "n_targets": n_targets,
             "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
-            "approach_errors": None if self.approach_errors is None else {label: round(float(e), 4) for label, e in self.approach_errors.items()},
+            "approach_errors": None if self.approach_errors is None else {label: _rounded(e) for label, e in self.approach_errors.items()},
             "max_error": round(float(max(self.errors.values())), 4),
             "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
             "runtime_s": round(self.runtime_s, 5),
@@ -135,13 +135,13 @@ class MethodResult:
             clearance = self.clearance_at(label)
             targets[label] = {
                 "error": round(float(error), 4),
-                "approach_error": None if self.approach_errors is None else round(float(self.approach_errors[label]), 4),
+                "approach_error": None if self.approach_errors is None else _rounded(self.approach_errors[label]),
                 "engaged": self.engaged_at(label),
                 "clearance": None if clearance is None else _rounded(clearance.distance),
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
-                "axis_deviation": None if self.axis_deviations is None else round(float(self.axis_deviations[label]), 4),
+                "axis_deviation": None if self.axis_deviations is None else _rounded(self.axis_deviations[label]),
             }
         out["targets"] = targets
         return out

@@ -6,6 +6,8 @@ for users.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .._checks import as_point, as_trajectory, check_real
@@ -20,9 +22,40 @@ def endpoint_error(trajectory, target) -> float:
     return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
 
 
+LIFT_TOLERANCE = 0.05  # of the band's height: a rise smaller than this within the final approach is noise
+
+
+def final_approach_mask(heights: np.ndarray, height: float) -> np.ndarray | None:
+    """The samples of the final approach: from the last sample at or above ``height`` (the motion's
+    final entry into the band, from above) to the end, inside the band, with no rise within it by
+    more than :data:`LIFT_TOLERANCE` of ``height``. None when there is none: the motion ends above
+    the band, never comes from above it, or lifts inside it (a pass through the band, a lift out of
+    it, or a wobble is no engagement).
+
+    Parameters
+    ----------
+    heights : array (n,)
+        Height of each sample above the target, along the target's axis.
+    height : float
+        The band's height (the socket's 28.5 mm, in the trajectory's unit).
+    """
+    above = np.flatnonzero(heights >= height)
+    if above.size == 0 or above[-1] == heights.shape[0] - 1:
+        return None
+    start = above[-1] + 1
+    inside = heights[start:]
+    if np.max(inside - np.minimum.accumulate(inside)) > LIFT_TOLERANCE * height:
+        return None
+    mask = np.zeros(heights.shape[0], dtype=bool)
+    mask[start:] = True
+    return mask
+
+
 def approach_error(trajectory, target, height: float, axis=None) -> float:
-    """Largest horizontal distance from the target's vertical axis while the trajectory is less
-    than ``height`` above the target (SPEC §9). 0 if it never comes that low.
+    """Largest distance from the target's axis over the final approach (SPEC §9, issue 21.6): the
+    motion's final descent along the axis from ``height`` above the target into it
+    (:func:`final_approach_mask`). ``inf`` when the motion has no such descent: a pass through the
+    band, a lift, or a motion that never comes down from above does not engage.
 
     Parameters
     ----------
@@ -42,10 +75,10 @@ def approach_error(trajectory, target, height: float, axis=None) -> float:
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
     offsets = trajectory - target
     along = offsets @ axis
-    low = along < height
-    if not np.any(low):
-        return 0.0
-    return float(np.max(np.linalg.norm(offsets[low] - np.outer(along[low], axis), axis=1)))
+    final = final_approach_mask(along, height)
+    if final is None:
+        return math.inf
+    return float(np.max(np.linalg.norm(offsets[final] - np.outer(along[final], axis), axis=1)))
 
 
 def _unit_axis(axis) -> np.ndarray:
@@ -57,9 +90,9 @@ def _unit_axis(axis) -> np.ndarray:
 
 
 def axis_deviation(trajectory, orientations, target, height: float, axis=None) -> float:
-    """Largest angle (degrees) between the tool's axis and the target's axis while the tool is
-    less than ``height`` above the target (along ``axis``, default +z); 0 if it never comes
-    that low. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
+    """Largest angle (degrees) between the tool's axis and the target's axis over the final
+    approach (:func:`final_approach_mask`, ``height`` along ``axis``, default +z); ``inf`` when the
+    motion has none. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
     pointing into the target, so a perfect approach has it opposite ``axis``."""
     from scipy.spatial.transform import Rotation
 
@@ -70,9 +103,9 @@ def axis_deviation(trajectory, orientations, target, height: float, axis=None) -
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
-    low = (trajectory - target) @ axis < height
-    if not np.any(low):
-        return 0.0
+    low = final_approach_mask((trajectory - target) @ axis, height)
+    if low is None:
+        return math.inf
     tool_axes = Rotation.from_quat(q[low]).apply([0.0, 0.0, 1.0])
     cosines = np.clip(tool_axes @ -axis, -1.0, 1.0)
     return float(np.degrees(np.max(np.arccos(cosines))))
