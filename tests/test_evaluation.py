@@ -136,3 +136,21 @@ def test_approach_error_definition():
 def test_unknown_method_is_rejected():
     with pytest.raises(ValueError, match="unknown method 'magic'"):
         bidmp.evaluate("nut-unscrewing", ["magic"])
+
+
+def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
+    """Issue 21.8: a wall across the plate leaves the far nuts no collision-free route; the
+    evaluation still reports every method, the far targets fail, and the report says why."""
+    import json
+
+    base = scenarios.load("nut-unscrewing")
+    spec = base.to_dict()
+    spec["scene"]["parts"].append({"type": "box", "label": "wall", "at": [105, 25, 0.5], "size": [10, 400, 300]})
+    walled = scenarios.from_dict(spec, base_dir=base.base_dir)
+    report = evaluate(walled, ["dmp", "bidmp"])
+    assert set(report.methods) == {"dmp", "bidmp"}
+    assert len(report.route_failures) == 1 and "no collision-free route" in report.route_failures[0]["reason"]
+    far = [label for label in walled.labels if walled.targets[label][0] > 105]
+    assert far and not any(report.methods["bidmp"].task_success_at(label) for label in far)
+    data = json.loads(json.dumps(report.to_dict(), allow_nan=False))  # strict JSON: no Infinity, no NaN
+    assert data["route_failures"][0]["target"][0] == pytest.approx(150.0)

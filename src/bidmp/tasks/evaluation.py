@@ -8,6 +8,7 @@ results and figures. The paper's experiments built on it live in :mod:`bidmp.exp
 from __future__ import annotations
 
 import json
+import logging
 import os
 import time
 from dataclasses import dataclass, field
@@ -18,9 +19,12 @@ import numpy as np
 from ._tables import markdown_table, text_table
 from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
+from ..extension.roadmap import NoFreeRouteError
 from ..incremental.bidmp import BiDMP, forgetting_runs
 from .metrics import approach_error, endpoint_error, path_difference
 from .methods.dmp_converged import CONVERGED_GAIN
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["CONVERGED_GAIN", "MethodResult", "Report", "evaluate", "write_report"]
 
@@ -162,6 +166,7 @@ class Report:
     failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
     model: object = None  # the Bi-DMP
     fitted: dict = field(default_factory=dict)  # method name -> its fitted model (the simulator's closed loop)
+    route_failures: list = field(default_factory=list)  # extension stages with no free route: {target, reason}
     forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
 
     def to_dict(self) -> dict:
@@ -178,6 +183,8 @@ class Report:
             out["failed_targets"] = list(self.failed_targets)
         if self.forgetting:
             out["forgetting"] = {skill: result.to_dict() for skill, result in self.forgetting.items()}
+        if self.route_failures:
+            out["route_failures"] = list(self.route_failures)
         return out
 
     # -- tables ------------------------------------------------------------------------------
@@ -232,13 +239,15 @@ class Report:
         lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
                  f"success = end-point error <= {scenario.success_threshold:g} {units}"]
         if any(result.clearances is not None for result in self.methods.values()):
-            engaged = (f"engaged (within {scenario.success_threshold:g} {units} of the target's axis over the last "
-                       f"{scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
+            engaged = (f"engaged (a final descent along the target's axis, within {scenario.success_threshold:g} {units} of "
+                       f"it over the last {scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
             lines.append(f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "
                          f"{units}, clearance to every part but the target)")
         if self.extension_targets:
             lines.append(f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
                          + ", ".join(np.array2string(np.asarray(t), precision=1) for t in self.extension_targets))
+        for failure in self.route_failures:
+            lines.append(f"no extension to {failure['target']}: {failure['reason']}")
         lines += ["", f"Table 4 analogue (errors in {units}; run time in s, measured in this run)", text_table(*self.method_rows())]
         lines += ["", f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)", text_table(*self.target_rows())]
         if self.forgetting:
@@ -278,8 +287,16 @@ def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
     return np.asarray(target, dtype=float)
 
 
-def _bidmp_model(scenario, dmp, failed):
-    """Build the scenario's Bi-DMP: chained extensions, then further demonstrations."""
+def _route_failure(target, exc) -> dict:
+    """What the report says of an extension stage the roadmap found no free route for."""
+    logger.warning("no collision-free route to %s: %s", np.round(np.asarray(target)[:3], 3).tolist(), exc)
+    return {"target": np.round(np.asarray(target, dtype=float), 4).tolist(), "reason": str(exc)}
+
+
+def _bidmp_model(scenario, dmp, failed, route_failures: list):
+    """Build the scenario's Bi-DMP: chained extensions, then further demonstrations. A stage the
+    roadmap finds no free route for is skipped and recorded in ``route_failures`` (the targets it
+    was for then fail on their own; the rest of the evaluation goes on)."""
     model = BiDMP(dmp, **scenario.bidmp)
     extensions, targets = [], []
     previous = None
@@ -291,7 +308,11 @@ def _bidmp_model(scenario, dmp, failed):
             continue  # nothing failed: no extension needed
         source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
         scene = scenario.scene if keep and stage.get("in_scene", True) else None
-        previous = extend_demonstration(source, target, seed=scenario.seed, scene=scene, **scenario.extension)
+        try:
+            previous = extend_demonstration(source, target, seed=scenario.seed, scene=scene, **scenario.extension)
+        except NoFreeRouteError as exc:  # that target's failure, not the whole evaluation's
+            route_failures.append(_route_failure(target, exc))
+            continue
         model.learn(previous.complete)
         extensions.append(previous)
         targets.append(target)
@@ -319,7 +340,11 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
             continue
         source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous
         stage_scene = scenario.scene if stage.get("in_scene", True) else None
-        extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene, **options)
+        try:
+            extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene, **options)
+        except NoFreeRouteError as exc:
+            report.route_failures.append(_route_failure(target, exc))
+            continue
         previous = extension.poses
         model.learn(previous)
         report.extensions.append(extension)
@@ -337,7 +362,7 @@ def _skills_builder(scenario, failed, report):
             report.model = _pose_bidmp_model(scenario, dmp, failed, report)
         else:
             report.model, report.extensions, report.extension_targets, report.forgetting = \
-                _bidmp_model(scenario, dmp, failed)
+                _bidmp_model(scenario, dmp, failed, report.route_failures)
         return report.model
 
     return build
