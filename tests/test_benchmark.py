@@ -157,3 +157,27 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
         for new, old in zip(fresh, committed):
             for name in benchmark.METRICS:
                 assert new[name] == pytest.approx(old[name], rel=1e-6, abs=1e-9), (shape, demo, new["method"], name)
+
+
+def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(serial, tmp_path, caplog):
+    """Issue 22.3: --resume trusted cell files; an edited value was merged as is and a missing key
+    ended in an internal error. Each is now recomputed, with a warning naming the cell."""
+    import json
+    import logging
+
+    benchmark.lasa(tmp_path, synchronous=True, **SMALL)
+    cells = tmp_path / "cells"
+    edited = json.loads((cells / "Sshape__0.json").read_text())
+    edited["rows"][0]["rmse"] = 0.0  # a better number than the method earned
+    (cells / "Sshape__0.json").write_text(json.dumps(edited))
+    broken = json.loads((cells / "Sshape__1.json").read_text())
+    del broken["rows"][0]["frechet"]
+    (cells / "Sshape__1.json").write_text(json.dumps(broken))
+    (cells / "WShape__0.json").write_text((cells / "WShape__1.json").read_text())  # another cell's file
+    with caplog.at_level(logging.WARNING, logger="bidmp.experiments.lasa"):
+        again = benchmark.lasa(tmp_path, synchronous=True, resume=True, **SMALL)
+    assert sorted(again.computed) == ["Sshape__0", "Sshape__1", "WShape__0"]
+    assert table(again.rows) == table(serial.rows)
+    said = caplog.text
+    assert "Sshape__0 was changed after it was written" in said and "WShape__0 holds cell 'WShape__1'" in said
+    assert "Sshape__1" in said

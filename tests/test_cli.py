@@ -409,3 +409,39 @@ def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys
     assert durations["fastest"] < 0.5 * durations["plain"] and durations["slow"] > 2 * durations["plain"]
     code, _, err = run(["rollout", str(tmp_path / "m.npz"), "-o", str(tmp_path / "x.csv"), "--fastest"], capsys)
     assert code == 2 and "--fastest needs --max-speed or --max-acc" in err
+
+
+def test_fifos_are_refused_not_waited_on(tmp_path, capsys):
+    """Issue 22.3: `mkfifo f.csv; bidmp fit f.csv` blocked for ever (the unit sniffing opened it)."""
+    import os
+    import threading
+
+    os.mkfifo(tmp_path / "f.csv")
+    os.mkfifo(tmp_path / "m.npz")
+    os.mkfifo(tmp_path / "s.json")
+    codes = []
+    for argv in (["fit", tmp_path / "f.csv", "-o", tmp_path / "out.npz"], ["segment", tmp_path / "f.csv"],
+                 ["rollout", tmp_path / "m.npz", "-o", tmp_path / "r.csv"], ["scenario", "check", tmp_path / "s.json"]):
+        worker = threading.Thread(target=lambda argv=argv: codes.append(main([str(a) for a in argv])), daemon=True)
+        worker.start()
+        worker.join(10.0)
+        assert not worker.is_alive(), f"{argv[0]} blocked on a FIFO"
+    assert codes == [2, 2, 2, 2]
+    err = capsys.readouterr().err
+    assert err.count("not a regular file") == 4
+
+
+def test_printed_names_cannot_drive_the_terminal(tmp_path, capsys):
+    """Issue 22.3: a scenario's name and labels are printed; escape sequences in them are shown as '?'."""
+    from bidmp import scenarios
+
+    spec = json.loads(scenarios.builtin_text("pick-and-place"))
+    spec["name"] = "evil\x1b[31mRED\x1b[0m"
+    spec["targets"] = {"t\x1b[2J" + label: point for label, point in spec["targets"].items()}
+    spec["demonstrated"] = "t\x1b[2J" + spec["demonstrated"]
+    path = tmp_path / "evil.json"
+    path.write_text(json.dumps(spec))
+    assert main(["scenario", "check", str(path)]) == 0
+    assert main(["demo", "--scenario", str(path), "--methods", "dmp", "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "evil?[31mRED" in out

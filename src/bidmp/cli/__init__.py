@@ -13,6 +13,7 @@ Layer 4 (the shell): may import any layer, inside the handlers; nothing imports 
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import sys
 from collections.abc import Sequence
@@ -73,6 +74,33 @@ def _quiet_stdout() -> None:
         pass
 
 
+class _Printable:
+    """stdout with control characters (a scenario name, a label or a file name may carry terminal
+    escapes) shown as '?', like the error lines; newlines and tabs pass."""
+
+    _TABLE = {code: "?" for code in (*range(0, 9), *range(11, 32), 127, *range(128, 160))}
+
+    def __init__(self, stream) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        return self._stream.write(text.translate(self._TABLE))
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+@contextlib.contextmanager
+def _printable_stdout():
+    """Every line a command prints, sanitised (restored afterwards, also on errors)."""
+    original = sys.stdout
+    sys.stdout = _Printable(original)
+    try:
+        yield
+    finally:
+        sys.stdout = original
+
+
 def _bad_input_message(exc: BaseException) -> str:
     """What a failure from bad input says on its one line."""
     if isinstance(exc, MemoryError):
@@ -119,7 +147,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             # success. Other warnings go to the log (one line each, printed on success).
             warnings.simplefilter("error", RuntimeWarning)
             logging.captureWarnings(True)
-            code = args.handler(args)
+            with _printable_stdout():
+                code = args.handler(args)
         sys.stdout.flush()
     except BrokenPipeError:
         _quiet_stdout()

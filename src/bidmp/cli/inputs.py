@@ -4,6 +4,7 @@ the model's), preparation of timed input."""
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 _MODEL_EXTENT_RATIO = 20.0  # a demonstration this many times larger or smaller than the model's is in another unit
 
@@ -29,8 +30,8 @@ def demo_options(parser: argparse.ArgumentParser) -> None:
 # -- input ------------------------------------------------------------------------------------------
 def is_pose_file(path) -> bool:
     """Whether ``path`` is a CSV whose header names a pose (``...,qx,qy,qz,qw``)."""
-    if not str(path).lower().endswith((".csv", ".txt")):
-        return False
+    if not str(path).lower().endswith((".csv", ".txt")) or not Path(path).is_file():
+        return False  # (a FIFO or a device is refused by the reader, never opened here: it would block)
     try:
         with open(path, encoding="utf-8-sig") as handle:
             for _ in range(16):

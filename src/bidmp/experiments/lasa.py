@@ -53,7 +53,7 @@ LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
 CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
 TIMES = ("fit_s", "rollout_s")
-FORMAT = 2  # of the cell files (2: the robot protocol of issue 19); a different protocol or format is recomputed
+FORMAT = 3  # of the cell files (2: the robot protocol of issue 19; 3: a content digest); another is recomputed
 
 
 def cell_key(shape: str, demo: int) -> str:
@@ -203,19 +203,58 @@ def _cell_path(out: Path, key: str) -> Path:
     return out / "cells" / f"{key}.json"
 
 
-def _load_cell(path: Path, protocol: dict) -> dict | None:
-    """A finished cell file, if it holds this protocol's results (else it is recomputed)."""
+def _digest(result: dict) -> str:
+    """A cell's content hash: what it computed, in canonical JSON (floats round-trip exactly)."""
+    import hashlib
+
+    content = json.dumps({"rows": result["rows"], "rollouts": result.get("rollouts", {})}, sort_keys=True)
+    return hashlib.sha256(content.encode()).hexdigest()
+
+
+_ROW_KEYS = frozenset(("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES))
+
+
+def _cell_problem(data, shape: str, demo: int, protocol: dict) -> str | None:
+    """Why a cell file cannot be resumed from (None: it can)."""
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        return f"not a cell file of format {FORMAT}"
+    if data.get("protocol") != protocol:
+        return "computed with another protocol"
+    if data.get("key") != cell_key(shape, demo):
+        return f"holds cell {str(data.get('key'))[:40]!r}"
+    rows = data.get("rows")
+    if not isinstance(rows, list) or not rows or not isinstance(data.get("rollouts", {}), dict):
+        return "has no rows"
+    if data.get("digest") != _digest(data):
+        return "was changed after it was written (its digest does not match)"
+    expected = {(method, case) for method in protocol["methods"] for case, _ in CASES}
+    seen = []
+    for row in rows:
+        if not isinstance(row, dict) or set(row) != _ROW_KEYS or (row["shape"], row["demo"]) != (shape, demo):
+            return "has a malformed row"
+        seen.append((row["method"], row["case"]))
+    if sorted(seen, key=str) != sorted(expected, key=str):
+        return "does not hold one row per method and case"
+    return None
+
+
+def _load_cell(path: Path, protocol: dict, shape: str, demo: int) -> dict | None:
+    """A finished cell file, if it holds this protocol's results for (shape, demo) unchanged; else
+    None (it is recomputed), and a cell file that exists but is unusable is said so."""
     from ..io.strict_json import load_json
 
+    if not path.exists():
+        return None
     try:
         data = load_json(path.read_bytes(), str(path))
-    except (OSError, ValueError):
-        return None
-    if not isinstance(data, dict) or data.get("format") != FORMAT or data.get("protocol") != protocol:
-        return None
-    if not isinstance(data.get("rows"), list) or not data["rows"]:
-        return None
-    return data
+    except (OSError, ValueError) as exc:
+        problem = f"is not readable JSON ({str(exc)[:80]})"
+    else:
+        problem = _cell_problem(data, shape, demo, protocol)
+    if problem is None:
+        return data
+    logger.warning("LASA cell %s %s: recomputed", cell_key(shape, demo), problem)
+    return None
 
 
 def _write_cell(out: Path, protocol: dict, result: dict) -> None:
@@ -224,7 +263,7 @@ def _write_cell(out: Path, protocol: dict, result: dict) -> None:
     path = _cell_path(out, result["key"])
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_write(path, "w") as handle:
-        json.dump({"format": FORMAT, "protocol": protocol, **result}, handle)
+        json.dump({"format": FORMAT, "protocol": protocol, **result, "digest": _digest(result)}, handle)
 
 
 def _client(scheduler: str | None, workers: int):
@@ -283,7 +322,7 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     done, todo = {}, []
     for shape, demo in cells:
         key = cell_key(shape, demo)
-        cached = _load_cell(_cell_path(out, key), protocol) if resume else None
+        cached = _load_cell(_cell_path(out, key), protocol, shape, demo) if resume else None
         if cached is not None:
             done[key] = cached
         else:

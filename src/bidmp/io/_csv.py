@@ -98,6 +98,8 @@ def declared_units(path) -> str:
     """The unit a CSV declares in a leading comment line ``# units: mm`` ("" if none)."""
     from .._units import check_units
 
+    if not Path(path).is_file():  # a FIFO or a device: the reader refuses it; opening it would block
+        return ""
     try:
         with open(path, encoding="utf-8-sig") as handle:
             for _ in range(16):

@@ -196,6 +196,8 @@ def load_model(path: str | os.PathLike):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = Path(path)
     if not path.is_file():
+        if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
+            raise ModelFileError(f"model file {path} is not a regular file (a pipe, device or socket)")
         raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
     try:

@@ -564,6 +564,8 @@ def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) 
     if not text_name.endswith(".json") and text_name in builtin_names():
         return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")
     path = Path(path_or_name)
+    if path.exists() and not path.is_file():  # a folder, a FIFO, a device: opening it could block
+        raise ScenarioError(f"scenario {path}: not a regular file (a folder, pipe, device or socket)")
     if not path.is_file():
         raise ScenarioError(f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})")
     try:
