@@ -187,6 +187,11 @@ class NotFittedError(ValueError, AttributeError):
 def _as_float_array(value, name: str) -> np.ndarray:
     if isinstance(value, (str, bytes)):
         raise TypeError(f"{name} must be an array of numbers, got a string")
+    if value is None:
+        raise TypeError(f"{name} must be an array of numbers, got None")
+    if isinstance(value, np.ndarray) and value.dtype.kind == "c" or isinstance(value, complex):
+        # NumPy would drop the imaginary part with a ComplexWarning and go on with the real one.
+        raise TypeError(f"{name} must be real numbers, got complex values")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:

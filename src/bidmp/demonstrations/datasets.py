@@ -45,13 +45,15 @@ def lasa_names() -> list[str]:
 def _read_lasa(name: str) -> np.ndarray:
     from scipy.io import loadmat
 
+    from .._checks import short_token
+
     names = lasa_names()
     if name not in names:
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
         if not close:
             close = [n for n in names if n.lower() == str(name).lower()]
         hint = f"; did you mean {', '.join(close)}?" if close else "; see bidmp.demonstrations.datasets.lasa_names()"
-        raise ValueError(f"unknown LASA shape {name!r}{hint}")
+        raise ValueError(f"unknown LASA shape {short_token(name, 10)}{hint}")
     data = loadmat(os.path.join(_lasa_dir(), name + ".mat"), squeeze_me=True, struct_as_record=False)
     demos = np.stack([np.asarray(demo.pos, dtype=np.float64).T for demo in np.atleast_1d(data["demos"])])
     demos.setflags(write=False)

@@ -53,7 +53,7 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
     Derivatives come from a Savitzky–Golay fit (order 3) over ``smooth × T`` samples; κ is then
     smoothed over ``smooth_curvature × T`` samples.
     """
-    y = np.asarray(y, dtype=np.float64)
+    y = as_trajectory(y, "y", min_points=3, allow_static=True)
     n_points = y.shape[0]
     if y.shape[1] == 2:
         y = np.column_stack([y, np.zeros(n_points)])

@@ -27,6 +27,7 @@ from sklearn.base import BaseEstimator, clone
 
 from .._api import goal_first
 from .._checks import (
+    _as_float_array,
     NotFittedError,
     as_point,
     as_trajectory,
@@ -287,7 +288,7 @@ class BiDMP(BaseEstimator):
         """
         self._ensure_started()
         dmp = self.dmp_
-        increment = np.asarray(forcing_increment, dtype=np.float64)
+        increment = _as_float_array(forcing_increment, "forcing_increment")
         if increment.shape != (dmp.n_train_, dmp.n_dims_):
             raise ValueError(f"forcing_increment must have shape {(dmp.n_train_, dmp.n_dims_)}, got {increment.shape}")
         if not np.all(np.isfinite(increment)):

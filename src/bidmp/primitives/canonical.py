@@ -2,12 +2,14 @@
 
 ``tau dϑ/dt = -alpha_phase ϑ``, ``ϑ(0) = 1``: solved exactly, ``ϑ = exp(-alpha_phase t / tau)``
 (the robot protocol), or discretised by explicit Euler, ``ϑ[l] = (1 - alpha_phase dt / tau)^l``
-(the paper's). Pure functions on normalised time; layer 1, imports nothing of bidmp.
+(the paper's). Pure functions on normalised time; layer 1, imports only the checks.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from .._checks import check_int
 
 __all__ = ["phase_grid", "phase_decay", "check_phase_span", "MIN_TRAINING_PHASE_LOG"]
 
@@ -30,6 +32,7 @@ def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1
     """Phase at every step (shape ``(n_steps,)``): ``(1 - alpha_phase dt / tau) ** l``, the
     Euler-discretised canonical system (Eq. 13), or with ``exact`` its solution
     ``exp(-alpha_phase l dt / tau)``, which does not depend on the step."""
+    n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
     if exact:
         return np.exp(-alpha_phase * dt / tau * np.arange(n_steps))
     return phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)

@@ -57,7 +57,7 @@ from .._checks import (
 from .._trajectory import resample_time
 from .._units import check_units
 from .canonical import check_phase_span, phase_grid
-from .forcing import basis_functions, learn_weights
+from .forcing import as_phase, basis_functions, check_forcing_increment, learn_weights
 from .goals import DelayedGoal, PhaseGate, ProgressGate, learn_goal_gate, learned_progress_gate
 from .grid import cached_grid, rollout_grid, store_grid
 from .integrate import check_integration, unit_responses
@@ -367,7 +367,7 @@ class DMP(FittedParams, BaseEstimator):
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
         self._check_fitted()
-        return basis_functions(np.asarray(phase, dtype=np.float64).reshape(-1), self.centres_, self.widths_)
+        return basis_functions(as_phase(phase), self.centres_, self.widths_)
 
     def forcing_term(self, phase) -> np.ndarray:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
@@ -381,6 +381,7 @@ class DMP(FittedParams, BaseEstimator):
         return params
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
+        check_forcing_increment(forcing_increment)
         params = self._rollout_params(step) if params is None else params
         step = self.dt_ if step is None else step
         n_dims = self.weights_.shape[1]

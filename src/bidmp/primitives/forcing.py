@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import as_points, check_int
 from .canonical import phase_decay, phase_grid
 
 __all__ = ["kernel_centres", "kernel_widths", "basis_functions", "basis_row", "forcing_target", "regress",
-           "learn_weights", "LOG_PSI_FLOOR"]
+           "learn_weights", "as_phase", "check_forcing_increment", "LOG_PSI_FLOOR"]
 
 LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
 
@@ -26,6 +27,8 @@ def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, al
     belongs to a kernel that never fires, and its LWR weight blows up. ``exact`` as in
     :func:`phase_grid`.
     """
+    n_kernels = check_int(n_kernels, "n_kernels", minimum=1, limit="max_kernels")
+    n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
     steps = np.linspace(0.0, n_steps - 1, n_kernels)
     if exact:
         return np.exp(-alpha_phase * dt / tau * steps)
@@ -192,3 +195,19 @@ def learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tup
     phi = basis_functions(phase, centres, widths)
     weights = regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
     return np.ascontiguousarray(weights), centres, widths, phase, phi
+
+
+def as_phase(phase, name: str = "phase") -> np.ndarray:
+    """Phases (L,) validated: finite and in [0, 1] (a DMP's phase decays from 1 towards 0)."""
+    phase = as_points(np.reshape(phase, (-1, 1)) if np.ndim(phase) <= 1 else phase, 1, name)[:, 0]
+    if phase.size and (phase.min() < 0.0 or phase.max() > 1.0):
+        raise ValueError(f"{name} must lie in [0, 1] (a DMP's phase decays from 1 towards 0), got values in "
+                         f"[{phase.min():.3g}, {phase.max():.3g}]")
+    return phase
+
+
+def check_forcing_increment(forcing_increment) -> None:
+    """Refuse a forcing increment that is not a callable ``f(phase (n,), basis (n, N)) -> (n, D)``."""
+    if forcing_increment is not None and not callable(forcing_increment):
+        raise TypeError(f"forcing_increment must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
+                        f"{type(forcing_increment).__name__}")

@@ -14,7 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import NotFittedError, check_choice, check_fitted, check_int, check_real
+from .._checks import NotFittedError, check_choice, check_fitted, check_int, check_real, short_token
 
 __all__ = ["Params", "FittedParams", "resolve_params", "resolved_param", "with_rest", "PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
            "ROBOT_SETTLE", "GAIN_RANGE", "TAU_RANGE"]
@@ -136,6 +136,14 @@ class FittedParams:
     a parameter changed after ``fit`` makes it unfitted (:class:`bidmp.NotFittedError` names it)."""
 
     _fitted_attribute = "weights_"
+
+    def set_params(self, **params):
+        """scikit-learn's ``set_params``; an unknown name is refused in one short line."""
+        known = self._get_param_names()
+        for name in params:
+            if name not in known:
+                raise ValueError(f"set_params: unknown parameter {short_token(name, 10)}; known: {', '.join(known)}")
+        return super().set_params(**params)
 
     @classmethod
     def _raw_param_names(cls) -> tuple[str, ...]:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import check_choice, numerically_guarded
+from .._checks import _as_float_array, check_choice, numerically_guarded
 
 __all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
@@ -70,10 +70,17 @@ class Trajectory(TimedMotion):
     units: str = ""
 
     def __post_init__(self) -> None:
-        n = self.t.shape[0]
+        # Frozen: the validated arrays are put in place with object.__setattr__.
+        t = _as_float_array(self.t, "Trajectory.t")
+        if t.ndim != 1 or t.shape[0] < 1:
+            raise ValueError(f"Trajectory.t must be a 1-D array of times (s), got shape {t.shape}")
+        object.__setattr__(self, "t", t)
+        n = t.shape[0]
         for name in ("y", "yd", "ydd"):
-            if getattr(self, name).shape[0] != n or getattr(self, name).ndim != 2:
-                raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {getattr(self, name).shape}")
+            array = _as_float_array(getattr(self, name), f"Trajectory.{name}")
+            if array.ndim != 2 or array.shape[0] != n:
+                raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {array.shape}")
+            object.__setattr__(self, name, array)
 
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the

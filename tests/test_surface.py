@@ -1,0 +1,71 @@
+"""The public surface refuses bad input at its boundary (issue 22.2, first defect classes): a
+TypeError/ValueError naming the argument, in one short line, before any work or allocation; never
+an internal error, a silent NaN, a leaked warning or NumPy's own text. Each case failed before."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+import bidmp
+from bidmp.demonstrations.datasets import lasa
+from bidmp.extension.segmentation import curvature
+from bidmp.primitives.canonical import phase_grid
+from bidmp.primitives.forcing import kernel_centres
+
+DEMO = np.linspace([0.0, 0.0], [1.0, 2.0], 50) + np.sin(np.linspace(0, 3, 50))[:, None]
+
+
+@pytest.fixture(autouse=True)
+def no_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        yield
+
+
+def refused(error, match, function, *args, **kwargs):
+    with pytest.raises(error, match=match) as info:
+        function(*args, **kwargs)
+    message = str(info.value)
+    assert "\n" not in message and len(message) <= 300, message
+    return message
+
+
+@pytest.fixture(scope="module")
+def dmp():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return bidmp.DMP().fit(DEMO)
+
+
+def test_a_trajectory_without_times_is_a_type_error():
+    rows = np.zeros((3, 2))
+    refused(TypeError, r"Trajectory\.t must be an array of numbers, got None", bidmp.Trajectory, None, rows, rows, rows)
+    refused(ValueError, r"Trajectory\.yd must have shape \(3, D\)", bidmp.Trajectory, np.arange(3.0), rows, rows[:2], rows)
+
+
+def test_a_phase_outside_the_dmps_range_is_refused_not_overflowed(dmp):
+    refused(ValueError, r"phase must lie in \[0, 1\]", dmp.basis, [-1.0])
+    refused(ValueError, r"phase contains NaN", dmp.forcing_term, [0.5, np.nan])
+    assert np.all(np.isfinite(dmp.forcing_term([0.0, 0.3, 1.0])))
+
+
+def test_messages_name_the_argument_and_quote_at_most_ten_characters(dmp):
+    message = refused(ValueError, r"set_params: unknown parameter 'bogus'", dmp.set_params, bogus=1)
+    assert "alpha_phase" in message
+    refused(ValueError, r"unknown parameter 'xxxxxxxxxx…'", dmp.set_params, **{"x" * 5000: 1})
+    refused(TypeError, r"forcing_increment must be callable", dmp.rollout, forcing_increment=np.zeros((3, 2)))
+    refused(ValueError, r"unknown LASA shape 'xxxxxxxxxx…'", lasa, "x" * 10000)
+
+
+def test_sizes_are_bounded_before_anything_is_allocated():
+    refused(ValueError, r"n_steps = 2,147,483,648 exceeds the limit max_steps", phase_grid, 2**31, 1e-9, exact=True)
+    refused(ValueError, r"n_kernels = 2,147,483,648 exceeds the limit max_kernels", kernel_centres, 2**31, 100, 0.01)
+
+
+def test_complex_input_is_refused_not_truncated(dmp):
+    refused(TypeError, r"y must be real numbers", curvature, DEMO + 1j)
+    refused(TypeError, r"y must be real numbers", bidmp.DMP().fit, DEMO.astype(complex))
+    model = bidmp.BiDMP(dmp)
+    refused(TypeError, r"forcing_increment must be real numbers", model.learn_increment,
+            np.zeros((dmp.n_train_, 2)) + 1j, [1.0, 2.0])
