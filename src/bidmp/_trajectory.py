@@ -69,10 +69,10 @@ def rmse(a, b) -> float:
 @numerically_guarded
 def path_extent(y) -> float:
     """Diagonal of the axis-aligned bounding box of a trajectory (same unit as ``y``)."""
-    y = np.asarray(y, dtype=np.float64)
-    if y.ndim != 2 or y.shape[0] == 0 or not np.all(np.isfinite(y)):
-        raise ValueError(f"path_extent needs a finite, non-empty (T, D) trajectory, got shape {y.shape}")
-    return float(np.linalg.norm(np.ptp(np.asarray(y, dtype=np.float64), axis=0)))
+    from ._checks import as_trajectory
+
+    y = as_trajectory(y, "y", min_points=1, allow_static=True)  # sizes bounded before any work
+    return float(np.linalg.norm(np.ptp(y, axis=0)))
 
 
 def continuous_quaternions(q: np.ndarray) -> np.ndarray:

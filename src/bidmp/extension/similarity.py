@@ -20,6 +20,8 @@ import numpy as np
 
 from .._checks import as_trajectory, check_choice, check_limit, numerically_guarded
 
+REFERENCE_MAX_CELLS = 1e7  # cells of frechet_distance_reference (a few seconds)
+
 __all__ = ["frechet_distance", "frechet_distance_reference", "frechet_similarity", "polyline_length", "dtw_distance"]
 
 logger = logging.getLogger(__name__)
@@ -143,9 +145,14 @@ def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
     Cells on one anti-diagonal ``i + j = s`` depend only on the two previous anti-diagonals, so
     each is one vectorised step.
     """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
+    a = as_trajectory(a, "a", min_points=1, allow_static=True)
+    b = as_trajectory(b, "b", min_points=1, allow_static=True)
     n, m = a.shape[0], b.shape[0]
+    if b.shape[1] != a.shape[1]:
+        raise ValueError(f"a and b must have the same number of columns, got {a.shape[1]} and {b.shape[1]}")
+    if float(n) * m > REFERENCE_MAX_CELLS:  # a Python loop over anti-diagonals: a reference, not a tool
+        raise ValueError(f"frechet_distance_reference: {n:,} x {m:,} cells exceed the reference's "
+                         f"{REFERENCE_MAX_CELLS:,.0f}; use frechet_distance")
     # previous[i] holds ca[i, s-1-i], before_previous[i] holds ca[i, s-2-i]; inf outside the grid.
     before_previous = np.full(n, np.inf)
     previous = np.full(n, np.inf)

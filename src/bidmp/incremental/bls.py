@@ -50,6 +50,7 @@ from .._checks import (
     _as_bounded_array,
     _check_finite,
     _check_magnitude,
+    as_trajectory,
     check_bytes,
     check_choice,
     check_fitted,
@@ -62,6 +63,7 @@ from .._threads import one_thread, single_threaded
 
 from .bls_state import bls_from_state, bls_state
 
+MAX_ADMM_ITERATIONS = 10_000  # sparse_autoencoder's iterations at most (the BLS uses 50)
 _THREADED_ROWS = 64  # predict() runs single-threaded from this many rows on
 
 __all__ = ["BLS", "sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update"]
@@ -115,6 +117,14 @@ def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_it
     -------
     beta : array (q, m), the sparse iterate ``z``.
     """
+    F = as_trajectory(F, "F", min_points=1, allow_static=True)
+    target = as_trajectory(target, "target", min_points=1, allow_static=True)
+    if target.shape[0] != F.shape[0]:
+        raise ValueError(f"target must have {F.shape[0]} rows (one per row of F), got {target.shape[0]}")
+    check_limit(F.shape[1], "max_hidden_nodes", "the columns of F")
+    l1 = check_real(l1, "l1", nonnegative=True, maximum=1e12)
+    n_iter = check_int(n_iter, "n_iter", minimum=1, maximum=MAX_ADMM_ITERATIONS)
+    rho = check_real(rho, "rho", positive=True, minimum=1e-12, maximum=1e12)
     q = F.shape[1]
     factor = cho_factor(F.T @ F + rho * np.eye(q))
     rhs = F.T @ target
