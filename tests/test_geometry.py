@@ -338,3 +338,47 @@ def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
     points = np.column_stack([radii * np.cos(angles), radii * np.sin(angles), heights])
     measured = np.array([engine.tool_to(point, 0) for point in points])
     np.testing.assert_allclose(measured, radii - 27.5, atol=1e-6)
+
+
+# --- issue 21.4 (opt-in): a clearance margin ---------------------------------------------------------
+def _post_scene(margin):
+    base = scenarios.load("nut-unscrewing")
+    data = base.to_dict()["scene"]
+    data["parts"] = [*data["parts"], {"type": "cylinder", "label": "post", "at": [22.5, -27.6, -2], "radius": 8,
+                                      "height": 200}]
+    if margin:
+        data["margin"] = margin
+    return base, Scene.from_dict(data, base.targets)
+
+
+def _post_clearance(path):
+    """Closed form: the tool (radius 12.5, above the path) beside the vertical post (radius 8) whose
+    height spans the tool's here: horizontal distance between the axes less both radii."""
+    fine = np.vstack([path[i] + np.linspace(0.0, 1.0, 25)[:, None] * (path[i + 1] - path[i]) for i in range(len(path) - 1)])
+    return float(np.min(np.hypot(fine[:, 0] - 22.5, fine[:, 1] + 27.6)) - 20.5)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_an_extension_keeps_the_scenes_margin_from_every_part(seed):
+    """A post 3 mm beside the straight transfer: without a margin the extension grazes it (1.8-2 mm),
+    with a 5 mm margin the planned transfer and the sampled extension keep 5 mm, by the closed form."""
+    base, bare = _post_scene(0.0)
+    _, kept = _post_scene(5.0)
+    target = [150.0, 25.0, 0.0]
+    close = extend_demonstration(base.demonstration, target, seed=seed, scene=bare)
+    far = extend_demonstration(base.demonstration, target, seed=seed, scene=kept)
+    assert _post_clearance(close.complete) < 5.0  # the check can fail
+    assert _post_clearance(far.tra_gen) >= 5.0 - 1e-9 and _post_clearance(far.complete) >= 5.0 - 1e-6
+    assert kept.clearance(far.complete, exclude=kept.parts_at(target)).clear
+
+
+def test_a_margin_is_validated_and_counts_in_task_success():
+    _, kept = _post_scene(5.0)
+    assert kept.to_dict()["margin"] == 5.0
+    near = np.array([[22.5 + 20.5 + 2.0, -27.6, 150.0], [22.5 + 20.5 + 2.0, -27.6, 120.0]])  # 2 mm from the post
+    clearance = kept.clearance(near)
+    assert clearance.collision_free and not clearance.clear and clearance.part == "post"
+    with pytest.raises(SceneError, match="scene.margin"):
+        _post_scene(-1.0)
+    with pytest.raises(SceneError, match="scene.margin"):
+        _post_scene(50.0)  # beyond the tool's radius

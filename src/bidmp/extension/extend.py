@@ -276,8 +276,9 @@ def extend_demonstration(
         if y.shape[1] != 3:
             raise ValueError(f"scene needs a 3-D demonstration, got D = {y.shape[1]}")
         exclude = scene.parts_at(target)
-        if is_free is None:
-            is_free = scene.checker(exclude=exclude)
+    scene_checker = None  # the checker built here from the scene (a caller's own is_free is kept as given)
+    if scene is not None and is_free is None:
+        is_free = scene_checker = scene.checker(exclude=exclude)
     roadmap_options = {
         "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
         "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
@@ -285,8 +286,34 @@ def extend_demonstration(
     }
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
+        if scene_checker is not None and scene.margin > 0.0:
+            return _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, exclude)
         return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
     return _extend_like_the_paper(y, target, points, seed, roadmap_options)
+
+
+_MARGIN_ATTEMPTS = 3  # plannings with a wider margin before an extension that keeps it is given up
+
+
+def _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, exclude) -> ExtendedDemonstration:
+    """``approach="keep"`` in a scene with a clearance margin: the extension as timed and sampled
+    (not only the roadmap's polyline) must keep the margin from every part but the target's. When
+    it does not, it is planned again with the margin widened by the shortfall; after
+    :data:`_MARGIN_ATTEMPTS` plannings the call fails naming the part."""
+    from ..scene.checker import SceneChecker
+
+    planning = scene.margin
+    for _ in range(_MARGIN_ATTEMPTS):
+        options = {**roadmap_options, "is_free": SceneChecker(scene, scene._selected(exclude), planning)}
+        extension = _extend_keeping_approach(y, target, points, seed, options, scene, exclude)
+        clearance = scene.clearance(extension.complete, exclude=exclude)
+        if clearance.clear:
+            return extension
+        planning += scene.margin - clearance.distance + 0.1 * scene.margin
+        logger.info("the extension passes %.3g from %s, inside the margin %g: planned again with %.3g",
+                    clearance.distance, clearance.part, scene.margin, planning)
+    raise NoFreeRouteError(f"no extension to {np.round(target, 3).tolist()} keeps the margin {scene.margin:g}: it comes "
+                           f"within {clearance.distance:.3g} of part {clearance.part!r} after {_MARGIN_ATTEMPTS} plannings")
 
 
 def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> ExtendedDemonstration:
@@ -363,7 +390,7 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
         result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
         history = result.history
         tra_gen = _smooth_path(result.path)
-        if scene is not None and not scene.clearance(tra_gen, exclude=exclude).collision_free:
+        if scene is not None and not scene.clearance(tra_gen, exclude=exclude).clear:
             logger.debug("the smoothed transfer cuts a part: the roadmap's polyline is used as it is")
             tra_gen = result.path
     if scene is not None:

@@ -24,9 +24,10 @@ class SceneChecker:
     """Collision callback for :func:`bidmp.extension.roadmap.gaussian_prm`: ``checker(points)`` says which
     tool placements are free, :meth:`segments_free` which straight tool moves are."""
 
-    def __init__(self, scene: Scene, chosen: np.ndarray):
+    def __init__(self, scene: Scene, chosen: np.ndarray, margin: float = 0.0):
         self.scene = scene
         self.chosen = chosen
+        self.margin = float(margin)  # a placement or move closer than this to a part is not free
 
     def __call__(self, points) -> np.ndarray:
         points = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -37,14 +38,15 @@ class SceneChecker:
         engine = scene._engine()
         lower, upper = scene._lower[self.chosen], scene._upper[self.chosen]
         radius, length = scene.tool.radius, scene.tool.length
+        margin = self.margin
         whole = _cylinder_box_bounds(points, radius, length, lower.min(axis=0)[None], upper.max(axis=0)[None])[:, 0]
-        near = np.flatnonzero(whole <= 0.0)
+        near = np.flatnonzero(whole <= margin)
         for start in range(0, near.size, _CHUNK):
             rows = near[start : start + _CHUNK]
             bounds = _cylinder_box_bounds(points[rows], radius, length, lower, upper)
-            for row, col in zip(*np.nonzero(bounds <= 0.0)):
+            for row, col in zip(*np.nonzero(bounds <= margin)):
                 index = rows[row]
-                if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < 0.0:
+                if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < margin:
                     free[index] = False
         return free
 
@@ -60,8 +62,9 @@ class SceneChecker:
             return free
         scene = self.scene
         radius, length = scene.tool.radius, scene.tool.length
-        lo = np.minimum(a, b) - [radius, radius, 0.0]
-        hi = np.maximum(a, b) + [radius, radius, length]
+        grow = self.margin  # the swept tool's box, grown by the margin
+        lo = np.minimum(a, b) - [radius + grow, radius + grow, grow]
+        hi = np.maximum(a, b) + [radius + grow, radius + grow, length + grow]
         lower, upper = scene._lower[self.chosen], scene._upper[self.chosen]
         # The swept tool's box against the box around all parts first, then part by part.
         near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))
@@ -69,20 +72,21 @@ class SceneChecker:
         candidates = [(near[i], j) for i, j in zip(*np.nonzero(touching))]
         engine = scene._engine()
         for row, col in candidates:
-            if free[row] and not self._move_free(engine, a[row], b[row], int(self.chosen[col])):
+            if free[row] and not self._move_free(engine, a[row], b[row], int(self.chosen[col]), self.margin):
                 free[row] = False
         return free
 
     @staticmethod
-    def _move_free(engine: _Distances, a: np.ndarray, b: np.ndarray, index: int) -> bool:
+    def _move_free(engine: _Distances, a: np.ndarray, b: np.ndarray, index: int, margin: float = 0.0) -> bool:
         length = float(np.linalg.norm(b - a))
         travelled = 0.0
         resolution = 1e-9 * max(length, 1.0)
         for _ in range(_MAX_ADVANCE_STEPS):
             distance = engine.tool_to(a + (travelled / length) * (b - a) if length > 0 else a, index)
-            if distance < 0.0:
+            if distance < margin:
                 return False
             if travelled >= length:
                 return True
-            travelled = min(travelled + max(distance, resolution), length)  # touching is allowed
+            # The distance changes by at most the distance moved: advance by what is left above the margin.
+            travelled = min(travelled + max(distance - margin, resolution), length)  # touching the margin is allowed
         return False  # grazing for too long: treated as a contact (conservative)

@@ -29,7 +29,7 @@ __all__ = ['Scene', 'Clearance']
 
 logger = logging.getLogger(__name__)
 
-_SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts"}
+_SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts", "margin"}
 
 
 _OVERLAP_TOLERANCE = 1e-6  # parts may touch (a nut on its plate), not interpenetrate beyond this
@@ -56,10 +56,16 @@ class Clearance:
     distance: float
     part: str | None
     point: np.ndarray | None
+    margin: float = 0.0  # the scene's clearance margin (scene units)
 
     @property
     def collision_free(self) -> bool:
         return not self.distance < 0.0
+
+    @property
+    def clear(self) -> bool:
+        """Collision-free and, when the scene has a margin, no closer to a part than it."""
+        return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin
 
     @property
     def collision_part(self) -> str | None:
@@ -81,8 +87,9 @@ class Scene:
         Whether each of those targets must lie on the part with its label.
     """
 
-    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True):
+    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True, margin: float = 0.0):
         self.parts = tuple(parts)
+        self.margin = float(margin)  # clearance every planned and checked motion keeps (scene units)
         self.tool = tool
         self.targets = None if targets is None else list(targets)
         self.targets_on_parts = bool(targets_on_parts)
@@ -121,7 +128,10 @@ class Scene:
         on_parts = data.get("targets_on_parts", True)
         if not isinstance(on_parts, bool):
             _fail("scene.targets_on_parts", "expected true or false")
-        scene = cls(parts, tool, chosen, on_parts)
+        margin = _number(data.get("margin", 0.0), "scene.margin", positive=False)
+        if not 0.0 <= margin <= tool.radius:
+            _fail("scene.margin", f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}")
+        scene = cls(parts, tool, chosen, on_parts, margin)
         scene.check_overlaps()
         if targets is not None and on_parts:
             scene.check_targets(targets)
@@ -132,6 +142,8 @@ class Scene:
                "targets_on_parts": self.targets_on_parts}
         if self.targets is not None:
             out["targets"] = list(self.targets)
+        if self.margin > 0.0:
+            out["margin"] = self.margin
         return out
 
     @property
@@ -230,7 +242,7 @@ class Scene:
                 distance = exact(block[row], int(chosen[col]))
                 if distance < best:
                     best, part, point = distance, self.solids[chosen[col]].label, samples[block[row]]
-        return Clearance(float(best), part, None if point is None else np.array(point))
+        return Clearance(float(best), part, None if point is None else np.array(point), self.margin)
 
     def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
         """:meth:`clearance` for a tool whose orientation changes along the motion."""
@@ -285,7 +297,7 @@ class Scene:
         step = check_real(step, "step", positive=True)
         chosen = self._selected(exclude)
         if chosen.size == 0:
-            return Clearance(math.inf, None, None)
+            return Clearance(math.inf, None, None, self.margin)
         if orientations is not None:
             return self._clearance_oriented(points, orientations, chosen, step)
         lower, upper = self._lower[chosen], self._upper[chosen]
@@ -314,4 +326,4 @@ class Scene:
 
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
-        return SceneChecker(self, self._selected(exclude))
+        return SceneChecker(self, self._selected(exclude), self.margin)

@@ -6,6 +6,7 @@ unit, angles in degrees::
     {"tool": {"radius": 12.5, "length": 100},
      "targets": "all" | [labels],       # targets the geometry applies to (default all)
      "targets_on_parts": true,          # each of them must lie on the part with its label
+     "margin": 0,                       # clearance kept from every part but the target's
      "parts": [
         {"type": "plate", "label": "plate", "at": [x, y, z_top], "size": [sx, sy, thickness]},
         {"type": "nut", "label": "3", "at": [x, y, z_base], "across_flats": 13, "height": 6.5,

@@ -65,7 +65,7 @@ class MethodResult:
         the scene applies)."""
         clearance = self.clearance_at(label)
         return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
-                    and (clearance is None or clearance.collision_free) and self.aligned_at(label) is not False)
+                    and (clearance is None or clearance.clear) and self.aligned_at(label) is not False)
 
     def aligned_at(self, label: str) -> bool | None:
         """Pose scenarios: the tool's axis within the alignment threshold of the target's over
@@ -93,7 +93,7 @@ class MethodResult:
 
     @property
     def collision_free(self) -> int | None:
-        return None if self.clearances is None else sum(self.clearances[label].collision_free for label in self.checked)
+        return None if self.clearances is None else sum(self.clearances[label].clear for label in self.checked)
 
     @property
     def worst_clearance(self):
