@@ -92,3 +92,18 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
     # Within the bounds they answer as before (the Lasso check of ADMM is in tests/test_bls.py).
     assert np.isfinite(sparse_autoencoder(F, target, 1e-3, 50)).all()
     assert frechet_distance_reference(long[:50], long[:40]) == 0.0
+
+
+def test_the_rotation_helpers_name_their_arguments():
+    """Issue 22.2: the SO(3) helpers passed their input to SciPy, whose messages name no argument,
+    and left_jacobian turned NaN into NaN."""
+    from bidmp.primitives.so3 import angle_between, continuous_log, left_jacobian, orientation_from_log
+
+    unit = np.array([[0.0, 0.0, 0.0, 1.0]])
+    refused(ValueError, r"q must have shape \(n, 4\)", angle_between, np.ones((2, 3)), unit)
+    refused(ValueError, r"goal contains a zero quaternion", continuous_log, unit, np.zeros(4))
+    refused(ValueError, r"r contains NaN", left_jacobian, np.full((2, 3), np.nan))
+    refused(ValueError, r"error must have shape \(n, 3\)", orientation_from_log, np.ones((2, 4)), unit)
+    refused(TypeError, r"q must be real numbers", angle_between, unit.astype(complex), unit)
+    turn = np.array([[0.0, 0.0, np.sin(0.5), np.cos(0.5)]])  # 1 rad about z
+    assert angle_between(turn, unit)[0] == pytest.approx(1.0, abs=1e-12)

@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .._checks import _as_float_array
 from .._trajectory import continuous_quaternions
 
 __all__ = ["as_quaternions", "principal_log", "continuous_log", "nearest_turn", "angle_between", "left_jacobian",
@@ -57,9 +58,33 @@ def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
     return continuous_quaternions(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
 
 
+def _quaternion_rows(q, name: str) -> np.ndarray:
+    """Quaternions (n, 4) or one (4,) checked at the boundary: real, finite, not zero. Their values
+    are left as given (SciPy normalises them), so a checked call computes what an unchecked one did."""
+    array = np.atleast_2d(_as_float_array(q, name))
+    if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:
+        raise ValueError(f"{name} must have shape (n, 4) or (4,) (qx, qy, qz, qw), got {np.shape(q)}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} contains NaN or inf")
+    if np.any(np.linalg.norm(array, axis=1) == 0.0):
+        raise ValueError(f"{name} contains a zero quaternion (no rotation has one)")
+    return array
+
+
+def _vector_rows(r, name: str) -> np.ndarray:
+    """Rotation vectors (n, 3) or one (3,) (rad) checked at the boundary: real and finite."""
+    array = np.atleast_2d(_as_float_array(r, name))
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (n, 3) or (3,) (rotation vectors, rad), got {np.shape(r)}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return array
+
+
 def principal_log(q, goal) -> np.ndarray:
     """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3) with angles in [0, π] (SciPy's ``as_rotvec``)."""
-    return (Rotation.from_quat(q) * Rotation.from_quat(goal).inv()).as_rotvec()
+    q, goal = _quaternion_rows(q, "q"), _quaternion_rows(goal, "goal")
+    return (Rotation.from_quat(q) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal).inv()).as_rotvec()
 
 
 def _angles_and_axes(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -100,7 +125,8 @@ def nearest_turn(q, goal, reference: np.ndarray) -> np.ndarray:
     """``Log(q ⊗ goal⁻¹)`` for one quaternion ``q`` (4,), as the equivalent rotation vector nearest
     ``reference`` (3,): a start pose away from the demonstrated one turns to the goal the same way
     (and as many times) as the demonstration did."""
-    angles, axes = _angles_and_axes(principal_log(np.asarray(q)[None], goal))
+    reference = _vector_rows(reference, "reference")[0]
+    angles, axes = _angles_and_axes(principal_log(_quaternion_rows(q, "q")[:1], goal))
     axis = axes[0]
     if angles[0] <= _AXIS_FLOOR:
         norm = float(np.linalg.norm(reference))
@@ -126,7 +152,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
 def left_jacobian(r: np.ndarray) -> np.ndarray:
     """Left Jacobian of SO(3), (n, 3, 3): ``ω = J_l(r) ṙ`` for ``R = Exp(r) G`` (world-frame ω).
     Valid for rotation vectors of any length (several turns)."""
-    r = np.atleast_2d(r)
+    r = _vector_rows(r, "r")
     theta = np.linalg.norm(r, axis=1)
     small = theta < 1e-6
     safe = np.where(small, 1.0, theta)
@@ -138,5 +164,6 @@ def left_jacobian(r: np.ndarray) -> np.ndarray:
 
 def orientation_from_log(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
     """Unit quaternions ``Exp(e) ⊗ goal`` (n, 4), signs continuous."""
-    q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat()
+    error, goal = _vector_rows(error, "error"), _quaternion_rows(goal, "goal")
+    q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal)).as_quat()
     return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
