@@ -132,6 +132,16 @@ def arclength_progress(y: np.ndarray) -> np.ndarray:
     return arc / arc[-1] if arc[-1] > 0.0 else np.zeros_like(arc)
 
 
+def _training_progress(train: np.ndarray, progress) -> np.ndarray:
+    """The progress σ (n_train,) a gate is learned from: the trajectory's own arc-length progress,
+    or the one given (a part that does not move follows another's)."""
+    n_train = train.shape[0]
+    progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+    if progress.shape != (n_train,):
+        raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+    return progress
+
+
 # -- goal systems ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class DelayedGoal:
@@ -185,10 +195,7 @@ class ProgressGate:
         (exact: the smooth goal share's continuous inverse; Euler: :func:`euler_progress_gate`).
         ``progress`` replaces the demonstration's own arc-length progress (a part that does not
         move follows another's)."""
-        n_train = train.shape[0]
-        progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
-        if progress.shape != (n_train,):
-            raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+        progress = _training_progress(train, progress)
         if not exact:
             return euler_progress_gate(progress, dt, alpha=alpha, beta=beta, K=K)
         return goal_gate(goal_share(progress, n_motion, dt), dt, alpha=alpha, beta=beta, K=K)
@@ -236,10 +243,7 @@ class ApproachGate(ProgressGate):
     def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
               progress: np.ndarray | None = None, approach_start: int | None = None) -> np.ndarray:
         """The gate on the training grid; ``approach_start`` the sample where the approach begins."""
-        n_train = train.shape[0]
-        progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
-        if progress.shape != (n_train,):
-            raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
+        progress = _training_progress(train, progress)
         reach = float(progress[approach_start])
         share = goal_share(np.clip(progress / reach, 0.0, 1.0), approach_start + 1, dt)
         return goal_gate(share, dt, alpha=alpha, beta=beta, K=K)

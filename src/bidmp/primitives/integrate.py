@@ -301,10 +301,6 @@ class StepIntegrator:
         self.alpha, self.beta, self.tau, self.exact = alpha, beta, tau, exact
         self._checked_step = None
 
-    def acceleration(self, y: np.ndarray, z: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """``d²y/ds²`` (normalised time) of the state ``(y, z)`` under the input ``u``."""
-        return (u - self.alpha * self.beta * y - self.alpha * z) / self.tau**2
-
     def step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
              step: float) -> tuple[np.ndarray, np.ndarray]:
         """The state ``step`` (normalised time) later; ``u_next`` (the input at the step's end) is

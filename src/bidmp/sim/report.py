@@ -11,17 +11,11 @@ from pathlib import Path
 import numpy as np
 
 from ..tasks._tables import markdown_table, text_table
-from ..tasks.metrics import approach_error, axis_deviation
+from ..tasks.metrics import approach_error, axis_deviation, json_length
 from .backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
 from .pybullet.robot import PANDA
 
 __all__ = ["SimTarget", "SimMethod", "SimReport", "measure", "write_sim_report"]
-
-
-def _rounded(value: float | None) -> float | None:
-    """A length or angle for the JSON report: 4 decimals; None when absent or infinite (no final
-    approach: strict JSON has no Infinity)."""
-    return None if value is None or not np.isfinite(value) else round(float(value), 4)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -55,7 +49,7 @@ class SimTarget:
     def to_dict(self, threshold: float) -> dict:
         return {
             "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
-            "approach_error": _rounded(self.approach_error),
+            "approach_error": json_length(self.approach_error),
             "engaged": self.engaged, "contacts": sorted(self.contacts),
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
             "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
@@ -63,7 +57,7 @@ class SimTarget:
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4), "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
-            "axis_deviation_deg": _rounded(self.axis_deviation),
+            "axis_deviation_deg": json_length(self.axis_deviation),
             "aligned": self.aligned,
         }
 

@@ -21,7 +21,7 @@ from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
 from ..extension.roadmap import NoFreeRouteError
 from ..incremental.bidmp import BiDMP, forgetting_runs
-from .metrics import approach_error, endpoint_error, path_difference
+from .metrics import approach_error, endpoint_error, json_length, path_difference
 from .methods.dmp_converged import CONVERGED_GAIN
 
 logger = logging.getLogger(__name__)
@@ -115,7 +115,7 @@ class MethodResult:
             "successes": self.successes,
             "n_targets": n_targets,
             "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
-            "approach_errors": None if self.approach_errors is None else {label: _rounded(e) for label, e in self.approach_errors.items()},
+            "approach_errors": None if self.approach_errors is None else {label: json_length(e) for label, e in self.approach_errors.items()},
             "max_error": round(float(max(self.errors.values())), 4),
             "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
             "runtime_s": round(self.runtime_s, 5),
@@ -130,7 +130,7 @@ class MethodResult:
             "engaged": self.engaged,
             "collision_free": self.collision_free,
             "n_checked": None if self.clearances is None else len(self.checked),
-            "min_clearance": None if worst is None else _rounded(worst.distance),
+            "min_clearance": None if worst is None else json_length(worst.distance),
             "min_clearance_part": None if worst is None else worst.part,
             "aligned": self.aligned,
         })
@@ -139,20 +139,16 @@ class MethodResult:
             clearance = self.clearance_at(label)
             targets[label] = {
                 "error": round(float(error), 4),
-                "approach_error": None if self.approach_errors is None else _rounded(self.approach_errors[label]),
+                "approach_error": None if self.approach_errors is None else json_length(self.approach_errors[label]),
                 "engaged": self.engaged_at(label),
-                "clearance": None if clearance is None else _rounded(clearance.distance),
+                "clearance": None if clearance is None else json_length(clearance.distance),
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
-                "axis_deviation": None if self.axis_deviations is None else _rounded(self.axis_deviations[label]),
+                "axis_deviation": None if self.axis_deviations is None else json_length(self.axis_deviations[label]),
             }
         out["targets"] = targets
         return out
-
-
-def _rounded(distance: float) -> float | None:
-    return None if not np.isfinite(distance) else round(float(distance), 4)
 
 
 @dataclass

@@ -89,7 +89,6 @@ class Method:
     """
 
     name: str = ""
-    description: str = ""
     poses: bool = False
     closed_loop: bool = False
     settles: bool = False

@@ -27,7 +27,7 @@ class DMPMethod(Method):
         return model.rollout(goal)
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
-        if model.__class__.__name__ == "DMP":
+        if hasattr(model, "rollout_many"):
             return list(model.rollout_many(goals))  # one integration for every goal
         return [model.rollout(goal) for goal in goals]
 
