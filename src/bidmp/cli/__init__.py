@@ -101,6 +101,20 @@ def _printable_stdout():
         sys.stdout = original
 
 
+def _log_handlers(root: logging.Logger, debug: bool) -> tuple[_BufferedLog, logging.Handler | None]:
+    """The library's log while a command runs: buffered (printed on success), or with ``--debug``
+    streamed at debug level."""
+    buffered = _BufferedLog()
+    if not debug:
+        root.addHandler(buffered)
+        return buffered, None
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    root.addHandler(handler)
+    root.setLevel(logging.DEBUG)
+    return buffered, handler
+
+
 def _bad_input_message(exc: BaseException) -> str:
     """What a failure from bad input says on its one line."""
     if isinstance(exc, MemoryError):
@@ -131,16 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     from .._checks import MissingExtraError
 
-    buffered = _BufferedLog()
     root = logging.getLogger()
-    debug_handler = None
-    if args.debug:
-        debug_handler = logging.StreamHandler(sys.stderr)
-        debug_handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
-        root.addHandler(debug_handler)
-        root.setLevel(logging.DEBUG)
-    else:
-        root.addHandler(buffered)
+    buffered, debug_handler = _log_handlers(root, args.debug)
     try:
         with warnings.catch_warnings():
             # A numerical warning means a non-finite result is on its way: never report it as a

@@ -73,6 +73,27 @@ class Clearance:
         return None if self.collision_free else self.part
 
 
+
+def _scene_options(data: dict, tool: Tool, targets: dict | None) -> tuple:
+    """A scene's ``targets`` (None: all), ``targets_on_parts`` and ``margin``, validated."""
+    chosen = data.get("targets", "all")
+    if chosen == "all":
+        chosen = None
+    elif not isinstance(chosen, list) or not all(isinstance(t, str) for t in chosen):
+        _fail("scene.targets", 'expected "all" or a list of target labels')
+    elif targets is not None:
+        for name in chosen:
+            if name not in targets:
+                _fail("scene.targets", f"{short_token(name, 20)} is not a target label")
+    on_parts = data.get("targets_on_parts", True)
+    if not isinstance(on_parts, bool):
+        _fail("scene.targets_on_parts", "expected true or false")
+    margin = _number(data.get("margin", 0.0), "scene.margin", positive=False)
+    if not 0.0 <= margin <= tool.radius:
+        _fail("scene.margin", f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}")
+    return chosen, on_parts, margin
+
+
 class Scene:
     """Parts and a tool; clearance of motions (see the module docstring for the data format).
 
@@ -116,24 +137,9 @@ class Scene:
             _fail("scene.tool", 'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)')
         tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}") for k in ("radius", "length")))
         parts = _parse_parts(data.get("parts"), targets)
-        chosen = data.get("targets", "all")
-        if chosen == "all":
-            chosen = None
-        elif not isinstance(chosen, list) or not all(isinstance(t, str) for t in chosen):
-            _fail("scene.targets", 'expected "all" or a list of target labels')
-        elif targets is not None:
-            for name in chosen:
-                if name not in targets:
-                    _fail("scene.targets", f"{short_token(name, 20)} is not a target label")
-        on_parts = data.get("targets_on_parts", True)
-        if not isinstance(on_parts, bool):
-            _fail("scene.targets_on_parts", "expected true or false")
-        margin = _number(data.get("margin", 0.0), "scene.margin", positive=False)
-        if not 0.0 <= margin <= tool.radius:
-            _fail("scene.margin", f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}")
-        scene = cls(parts, tool, chosen, on_parts, margin)
+        scene = cls(parts, tool, *_scene_options(data, tool, targets))
         scene.check_overlaps()
-        if targets is not None and on_parts:
+        if targets is not None and scene.targets_on_parts:
             scene.check_targets(targets)
         return scene
 
