@@ -14,6 +14,21 @@ from ._base import _figure, _matplotlib, _save
 __all__ = ['plot_trajectories', 'plot_generalisation', 'plot_recordings']
 
 
+def _label_axes(ax, n_dims: int, units: str) -> None:
+    """Axis names with the unit; 1-D against the sample index, 2-D at equal scale."""
+    suffix = f" [{units}]" if units else ""
+    if n_dims == 1:
+        ax.set_xlabel("sample")
+        ax.set_ylabel("x" + suffix)
+        return
+    ax.set_xlabel("x" + suffix)
+    ax.set_ylabel("y" + suffix)
+    if n_dims == 3:
+        ax.set_zlabel("z" + suffix)
+    else:
+        ax.set_aspect("equal", adjustable="datalim")
+
+
 def plot_trajectories(
     path: str | os.PathLike,
     demonstration: np.ndarray,
@@ -59,18 +74,7 @@ def plot_trajectories(
         ax.plot(*coords(trajectory), color=colours[index], linewidth=1.5, label=label)
     if goals is not None and n_dims > 1:
         ax.scatter(*[goals[:, i] for i in range(n_dims)], marker="*", s=140, color="crimson", zorder=6, label="goals")
-    suffix = f" [{units}]" if units else ""
-    names = ("x", "y", "z")
-    if n_dims == 1:
-        ax.set_xlabel("sample")
-        ax.set_ylabel("x" + suffix)
-    else:
-        ax.set_xlabel(names[0] + suffix)
-        ax.set_ylabel(names[1] + suffix)
-        if n_dims == 3:
-            ax.set_zlabel(names[2] + suffix)
-        else:
-            ax.set_aspect("equal", adjustable="datalim")
+    _label_axes(ax, n_dims, units)
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
