@@ -22,16 +22,18 @@ def goal_first(*old_positional: str):
         @functools.wraps(function)
         def wrapper(self, *args, **kwargs):
             if len(args) > 1:
+                # The class the user holds, not the mixin that defines the method.
+                where = f"{type(self).__name__}.{function.__name__}"
                 extra = args[1:]
                 if len(extra) > len(old_positional):
-                    raise TypeError(f"{function.__qualname__}() takes the goal by position and the rest by keyword; "
+                    raise TypeError(f"{where}() takes the goal by position and the rest by keyword; "
                                     f"got {len(args)} positional arguments")
                 names = old_positional[: len(extra)]
                 for name, value in zip(names, extra):
                     if name in kwargs:
-                        raise TypeError(f"{function.__qualname__}() got multiple values for argument {name!r}")
+                        raise TypeError(f"{where}() got multiple values for argument {name!r}")
                     kwargs[name] = value
-                warnings.warn(f"{function.__qualname__}(): pass {', '.join(names)} by keyword "
+                warnings.warn(f"{where}(): pass {', '.join(names)} by keyword "
                               f"({', '.join(f'{n}=...' for n in names)}); by position is deprecated",
                               DeprecationWarning, stacklevel=2)
                 args = args[:1]

@@ -310,8 +310,6 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     progress : callable, optional
         Called with the cell key as each cell finishes.
     """
-    from ..io.atomic import atomic_write
-
     shapes, methods, indices = _validate(shapes, methods, demos, every)
     check_choice(output_format, "output_format", ("parquet", "csv"))
     out = Path(out)
@@ -319,25 +317,12 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
         raise ValueError(f"out {out} exists and is not a folder")
     protocol = {"demos": demos, "every": every, "methods": methods, "cases": [list(c) for c in CASES]}
     cells = [(shape, demo) for shape in shapes for demo in indices]
-    done, todo = {}, []
-    for shape, demo in cells:
-        key = cell_key(shape, demo)
-        cached = _load_cell(_cell_path(out, key), protocol, shape, demo) if resume else None
-        if cached is not None:
-            done[key] = cached
-        else:
-            todo.append((shape, demo))
+    done, todo = _resumed(out, protocol, cells) if resume else ({}, list(cells))
     result = BenchmarkResult([], protocol, computed=[cell_key(*c) for c in todo], resumed=sorted(done))
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     if todo and (synchronous or workers == 1 and scheduler is None and not dask):
-        for shape, demo in todo:
-            cell = run_cell(shape, demo, methods, every)
-            _write_cell(out, protocol, cell)
-            done[cell["key"]] = cell
-            if progress is not None:
-                progress(cell["key"])
-        result.workers = 1
+        result.workers = _run_here(todo, methods, every, out, protocol, done, progress)
     elif todo:
         result.workers = _run_on_dask(todo, methods, every, workers, scheduler, _kill_once, out, protocol, done,
                                       progress)
@@ -348,12 +333,44 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     for row in rows:
         row.update({"demos": demos, "every": every})
     result.rows = rows
+    table = _write_tables(out, rows, protocol, output_format)
+    result.written = [table, out / "lasa.md"] + _figures(out, rows, done, shapes)
+    return result
+
+
+def _resumed(out: Path, protocol: dict, cells) -> tuple[dict, list]:
+    """The cells already computed for this protocol (``{key: cell}``, read back and checked) and
+    those still to compute."""
+    done, todo = {}, []
+    for shape, demo in cells:
+        cached = _load_cell(_cell_path(out, cell_key(shape, demo)), protocol, shape, demo)
+        if cached is not None:
+            done[cell_key(shape, demo)] = cached
+        else:
+            todo.append((shape, demo))
+    return done, todo
+
+
+def _run_here(todo, methods, every, out, protocol, done, progress) -> int:
+    """Run the cells in this process, one after another, each written as it finishes; 1 worker."""
+    for shape, demo in todo:
+        cell = run_cell(shape, demo, methods, every)
+        _write_cell(out, protocol, cell)
+        done[cell["key"]] = cell
+        if progress is not None:
+            progress(cell["key"])
+    return 1
+
+
+def _write_tables(out: Path, rows: list, protocol: dict, output_format: str) -> Path:
+    """Write the table (Parquet or CSV) and its Markdown summary; return the table's path."""
+    from ..io.atomic import atomic_write
+
     table = out / ("lasa.parquet" if output_format == "parquet" else "lasa.csv")
     _write_table(rows, table, output_format)
     with atomic_write(out / "lasa.md", "w") as handle:
         handle.write(summary_markdown(rows, protocol) + "\n")
-    result.written = [table, out / "lasa.md"] + _figures(out, rows, done, shapes)
-    return result
+    return table
 
 
 def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress) -> int:

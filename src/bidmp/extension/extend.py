@@ -211,25 +211,10 @@ def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence
 
 @numerically_guarded
 def extend_demonstration(
-    y,
-    new_target,
-    *,
-    seed: int | np.random.Generator | None = 0,
-    eps_frac: float = 0.1,
-    method: str = "persistence",
-    n_samples: int = 300,
-    sigma_rel: float = 0.03,
-    n_neighbours: int = 8,
-    n_compare: int = 100,
-    n_iter: int = 10,
-    rho: float = 0.9,
-    schedule: str = "geometric",
-    scaling: str = "axis",
-    compare: str = "template",
-    select: str = "best",
-    denom: str = "sqrt2",
-    is_free: CollisionCallback | None = None,
-    approach: str = "keep",
+    y, new_target, *, seed: int | np.random.Generator | None = 0, eps_frac: float = 0.1, method: str = "persistence",
+    n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100, n_iter: int = 10,
+    rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis", compare: str = "template",
+    select: str = "best", denom: str = "sqrt2", is_free: CollisionCallback | None = None, approach: str = "keep",
     scene=None,
 ) -> ExtendedDemonstration:
     """Grow an extended demonstration from ``y`` to ``new_target`` (1D-SEG + G-PRM).
@@ -266,30 +251,34 @@ def extend_demonstration(
     """
     y = as_trajectory(y, "y", min_points=10)
     target = as_point(new_target, y.shape[1], "new_target")
-    check_extension_options(
-        eps_frac=eps_frac, method=method, seed=seed, n_samples=n_samples, sigma_rel=sigma_rel, n_neighbours=n_neighbours,
-        n_compare=n_compare, n_iter=n_iter, rho=rho, schedule=schedule, scaling=scaling, compare=compare, select=select,
-        denom=denom, approach=approach,
-    )
-    exclude = ()
-    if scene is not None:
-        if y.shape[1] != 3:
-            raise ValueError(f"scene needs a 3-D demonstration, got D = {y.shape[1]}")
-        exclude = scene.parts_at(target)
-    scene_checker = None  # the checker built here from the scene (a caller's own is_free is kept as given)
-    if scene is not None and is_free is None:
-        is_free = scene_checker = scene.checker(exclude=exclude)
     roadmap_options = {
         "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
         "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
-        "select": select, "denom": denom, "is_free": is_free,
+        "select": select, "denom": denom,
     }
+    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, **roadmap_options)
+    exclude, roadmap_options["is_free"], scene_checker = _scene_checker(scene, y, target, is_free)
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
         if scene_checker is not None and scene.margin > 0.0:
             return _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, exclude)
         return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
     return _extend_like_the_paper(y, target, points, seed, roadmap_options)
+
+
+def _scene_checker(scene, y: np.ndarray, target: np.ndarray, is_free):
+    """``(parts at the target, the roadmap's checker, the checker built here or None)``: with a
+    scene and no ``is_free`` of the caller's, a checker of the scene's parts but those at the
+    target (a caller's own ``is_free`` is kept as given)."""
+    if scene is None:
+        return (), is_free, None
+    if y.shape[1] != 3:
+        raise ValueError(f"scene needs a 3-D demonstration, got D = {y.shape[1]}")
+    exclude = scene.parts_at(target)
+    if is_free is not None:
+        return exclude, is_free, None
+    checker = scene.checker(exclude=exclude)
+    return exclude, checker, checker
 
 
 _MARGIN_ATTEMPTS = 3  # plannings with a wider margin before an extension that keeps it is given up

@@ -378,25 +378,31 @@ def gaussian_prm(
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
     check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule)
-    rng = check_seed(seed)
-    seg = piece[0]
-    sigma = sigma_rel * np.linalg.norm(target - seg)
-    t = np.linspace(0.0, 1.0, n_samples)
-    line = seg + t[:, None] * (target - seg)  # Eq. 1-2: samples spread along the chord seg -> n_tar
-    lam = np.linspace(0.0, 1.0, n_compare)
-    bias = np.zeros((n_compare, piece.shape[1]))
-    order = np.arange(n_samples)
+    sampler = _ChordSampler(piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed))
+    return _iterate(comparison, n_iter, sampler.draw, sampler.learn, n_neighbours, is_free, select)
 
-    def draw(iteration):
-        bias_at_samples = interp_columns(t, lam, bias)  # Eq. 9
-        return line + rng.normal(scale=sigma, size=line.shape) + bias_at_samples, order
 
-    def learn(iteration, similarity, direction):  # Eq. 8
-        nonlocal bias
-        rate = rho**iteration if schedule == "geometric" else rho / iteration
-        bias = bias + (1.0 - similarity) * rate * direction
+class _ChordSampler:
+    """G-PRM's sampler: ``n_samples`` points spread along the chord seg → n_tar (Eq. 1–2) with
+    Gaussian noise of ``sigma_rel · ‖n_tar − seg‖`` per axis, shifted by a bias learned over the
+    comparison's ``n_compare`` arc-length stations (Eq. 8–9)."""
 
-    return _iterate(comparison, n_iter, draw, learn, n_neighbours, is_free, select)
+    def __init__(self, seg, target, n_samples, n_compare, sigma_rel, rho, schedule, rng):
+        self.sigma = sigma_rel * np.linalg.norm(target - seg)
+        self.t = np.linspace(0.0, 1.0, n_samples)
+        self.line = seg + self.t[:, None] * (target - seg)
+        self.lam = np.linspace(0.0, 1.0, n_compare)
+        self.bias = np.zeros((n_compare, seg.shape[0]))
+        self.order = np.arange(n_samples)
+        self.rho, self.schedule, self.rng = rho, schedule, rng
+
+    def draw(self, iteration):
+        bias_at_samples = interp_columns(self.t, self.lam, self.bias)  # Eq. 9
+        return self.line + self.rng.normal(scale=self.sigma, size=self.line.shape) + bias_at_samples, self.order
+
+    def learn(self, iteration, similarity, direction):  # Eq. 8
+        rate = self.rho**iteration if self.schedule == "geometric" else self.rho / iteration
+        self.bias = self.bias + (1.0 - similarity) * rate * direction
 
 
 @numerically_guarded

@@ -192,47 +192,13 @@ def load_model(path: str | os.PathLike):
         metadata (a foreign file), was written by a newer format version, or its contents are
         inconsistent (the message names the member).
     """
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
-    if not path.is_file():
-        if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
-            raise ModelFileError(f"model file {path} is not a regular file (a pipe, device or socket)")
-        raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
-    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
-    try:
-        with open(path, "rb") as handle:
-            magic = handle.read(4)
-    except OSError as exc:
-        raise ModelFileError(f"cannot read {path}: {exc.strerror or exc}") from None
-    if magic == _NPY_MAGIC[:4]:
-        raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
-    if magic not in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
-        raise ModelFileError(f"{path} is not a bidmp model file (not an .npz archive)")
-    try:
-        archive = zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
-        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from None
+    path = _readable_model(path)
+    archive = _open_archive(path)
     with archive:
         _check_archive(archive, path)
         members = _Members(archive, str(path))
         meta = _read_meta(members, path)
-        version = meta.get("format_version")
-        if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-            raise ModelFileError(f"{path} has an invalid format_version {short_token(version)}")
-        if version > FORMAT_VERSION:
-            raise ModelFileError(
-                f"{path} was written in model format {version} by bidmp {short_token(meta.get('bidmp_version', '?'), 20)}; "
-                f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
-            )
-        class_name = meta.get("class")
-        if not isinstance(class_name, str) or class_name not in _MODEL_CLASSES:
-            raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
-        if version < _MIN_VERSION.get(class_name, 1):
-            raise ModelFileError(
-                f"{path} holds a {class_name} in model format {version} (bidmp {short_token(meta.get('bidmp_version', '?'), 20)}), "
-                f"whose learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
-            )
+        class_name = _model_class_name(meta, path)
         state = meta.get("state")
         if not isinstance(state, dict):
             raise ModelFileError(f"{path} is corrupt: its metadata has no state object")
@@ -246,3 +212,55 @@ def load_model(path: str | os.PathLike):
         except (TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError,
                 zipfile.BadZipFile, EOFError, OSError) as exc:
             raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from None
+
+
+def _readable_model(path) -> Path:
+    """``path`` as a Path to a regular file within the size limit (a pipe or device is refused
+    without opening it: that could block)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name, got {type(path).__name__}")
+    path = Path(path)
+    if not path.is_file():
+        if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
+            raise ModelFileError(f"model file {path} is not a regular file (a pipe, device or socket)")
+        raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
+    return path
+
+
+def _open_archive(path: Path) -> zipfile.ZipFile:
+    """The model file as a zip archive, after its magic bytes said it is one."""
+    try:
+        with open(path, "rb") as handle:
+            magic = handle.read(4)
+    except OSError as exc:
+        raise ModelFileError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if magic == _NPY_MAGIC[:4]:
+        raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
+    if magic not in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+        raise ModelFileError(f"{path} is not a bidmp model file (not an .npz archive)")
+    try:
+        return zipfile.ZipFile(path)
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
+        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from None
+
+
+def _model_class_name(meta: dict, path: Path) -> str:
+    """The model class the metadata names, once its format version is one this bidmp reads."""
+    version = meta.get("format_version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise ModelFileError(f"{path} has an invalid format_version {short_token(version)}")
+    if version > FORMAT_VERSION:
+        raise ModelFileError(
+            f"{path} was written in model format {version} by bidmp {short_token(meta.get('bidmp_version', '?'), 20)}; "
+            f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
+        )
+    class_name = meta.get("class")
+    if not isinstance(class_name, str) or class_name not in _MODEL_CLASSES:
+        raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
+    if version < _MIN_VERSION.get(class_name, 1):
+        raise ModelFileError(
+            f"{path} holds a {class_name} in model format {version} (bidmp {short_token(meta.get('bidmp_version', '?'), 20)}), "
+            f"whose learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
+        )
+    return class_name

@@ -46,27 +46,18 @@ import logging
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._api import goal_first
-from .._checks import (
-    as_point,
-    as_trajectory,
-    check_bytes,
-    check_int,
-    numerically_guarded,
-)
-from .._trajectory import resample_time
+from .._checks import as_trajectory, check_bytes, numerically_guarded
 from .._units import check_units
-from .canonical import check_phase_span, phase_grid
-from .forcing import as_phase, basis_functions, check_forcing_increment, learn_weights
-from .goals import DelayedGoal, PhaseGate, ProgressGate, learn_goal_gate, learned_progress_gate
-from .grid import cached_grid, rollout_grid, store_grid
-from .integrate import check_integration, unit_responses
+from ._dmp_grids import GridQueries
+from ._dmp_motions import Motions
+from .canonical import check_phase_span
+from .forcing import learn_weights
+from .goals import learn_goal_gate
+from .grid import store_grid
+from .integrate import check_integration
 from .protocols import PROTOCOLS, FittedParams, Params, resolve_params, resolved_param, with_rest
 from .rest import rest_started
-from .rollouts import iter_rollouts_to, rollouts_to
 from .state import dmp_from_state, dmp_state
-from .stepper import DMPStepper
-from .timed import coupled_trajectory, limited_trajectory, timed_trajectory
 from .timing import on_uniform_time
 
 __all__ = ["DMP", "PROTOCOLS"]
@@ -74,7 +65,7 @@ __all__ = ["DMP", "PROTOCOLS"]
 logger = logging.getLogger(__name__)
 
 
-class DMP(FittedParams, BaseEstimator):
+class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
     """Discrete DMP learned from one demonstration (SPEC §1), in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
@@ -293,269 +284,6 @@ class DMP(FittedParams, BaseEstimator):
         """Seconds per unit of normalised time: ``duration_ · T / (T - 1)`` (1 without timestamps)."""
         self._check_fitted()
         return self.duration_ * self.n_steps_ / (self.n_steps_ - 1)
-
-    # -- evaluation ----------------------------------------------------------------------------
-    def default_n_steps(self) -> int:
-        """The default rollout length on the normalised grid: ``round(settle · tau · T)`` samples
-        (paper: T for ``tau = 1``; robot: 1.1 T, time for any goal to be reached)."""
-        self._check_fitted()
-        return self._n_steps(None, self._params())
-
-    def _n_steps(self, n_steps, params: Params) -> int:
-        if n_steps is None:
-            n_steps = max(int(round(params.settle * params.tau * self.n_steps_)), 1)
-            check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
-        else:
-            n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
-        check_bytes(n_steps * self.centres_.shape[0], "the rollout basis (n_steps x n_kernels)")
-        return n_steps
-
-    def phase(self, n_steps: int | None = None) -> np.ndarray:
-        """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
-        self._check_fitted()
-        params = self._params()
-        return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase, exact=params.exact)
-
-    def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Phase (n,) and basis rows (n, N) on the rollout grid (default length
-        :meth:`default_n_steps`), cached."""
-        self._check_fitted()
-        params = self._params()
-        phase, basis, *_ = rollout_grid(self, params, self._n_steps(n_steps, params))
-        return phase, basis
-
-    @property
-    def n_train_(self) -> int:
-        """Samples of the training grid: T (paper), or T followed by rest up to 1.1 T (robot)."""
-        self._check_fitted()
-        return max(int(round(self._params().settle * self.n_steps_)), self.n_steps_)
-
-    def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
-        """Phase and basis rows (N columns) of the grid the weights were learned on
-        (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
-        self._check_fitted()
-        phase, basis, *_ = rollout_grid(self, self._params()._replace(tau=1.0), self.n_train_)
-        return phase, basis
-
-    def training_gate(self) -> np.ndarray:
-        """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
-        fraction (robot); the forcing target of :func:`forcing_target` uses it."""
-        self._check_fitted()
-        params = self._params()
-        return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
-
-    def goal_system(self, params: Params | None = None) -> PhaseGate | DelayedGoal | ProgressGate:
-        """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``params`` (default its
-        own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
-        asks for it once per stepper)."""
-        params = self._params() if params is None else params
-        if params.goal_rate is not None:
-            return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(params.goal_rate)
-        return learned_progress_gate(self, params)
-
-    def training_trajectory(self, y) -> np.ndarray:
-        """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
-        for the robot protocol, started and ended at rest (:func:`bidmp.primitives.rest.rest_started`) and
-        followed by rest at its last point up to :attr:`n_train_`."""
-        self._check_fitted()
-        params = self._params()
-        y = resample_time(np.asarray(y, dtype=np.float64), self.n_steps_)
-        if params.rest_start:
-            y = rest_started(y, self.dt_, self.time_unit_)
-        return with_rest(y, params)
-
-    def basis(self, phase) -> np.ndarray:
-        """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
-        self._check_fitted()
-        return basis_functions(as_phase(phase), self.centres_, self.widths_)
-
-    def forcing_term(self, phase) -> np.ndarray:
-        """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
-        return self.basis(phase) @ self.weights_
-
-    def _rollout_params(self, step: float | None = None, params: Params | None = None) -> Params:
-        """The validated parameters, with the rollout's integration checked for stability."""
-        self._check_fitted()
-        params = self._params() if params is None else params  # validated once per rollout
-        check_integration(self.dt_ if step is None else step, params)
-        return params
-
-    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
-        check_forcing_increment(forcing_increment)
-        params = self._rollout_params(step) if params is None else params
-        step = self.dt_ if step is None else step
-        n_dims = self.weights_.shape[1]
-        n_steps = self._n_steps(n_steps, params)
-        start = self.start_ if start is None else as_point(start, n_dims, "start")
-        velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response), gate = rollout_grid(self, params, n_steps, step)
-        forcing = basis @ self.weights_
-        if forcing_increment is not None:
-            forcing = forcing + forcing_increment(phase, basis)
-        free = unit_responses(params, phase, forcing, step).T
-        free += np.outer(start_response, start)
-        if start_velocity is not None:
-            free += np.outer(velocity_response, velocity)
-        # lfilter runs in C, outside NumPy's floating-point checks: check its output once. With
-        # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
-        if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
-            raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
-        return free, goal_response, forcing, gate
-
-    @goal_first("start", "n_steps", "start_velocity")
-    @numerically_guarded
-    def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_velocity=None,
-                forcing_increment=None) -> np.ndarray:
-        """Generate a trajectory on the normalised grid, one sample every ``dt_`` (``duration_ /
-        (T - 1)`` seconds at ``tau = 1``), with the protocol's integrator (robot: exact; paper:
-        explicit Euler, Eq. 14).
-
-        Parameters
-        ----------
-        goal : array-like, shape (D,), optional
-            Goal position; default the demonstration's last point.
-        start : array-like, shape (D,), optional
-            Start position; default the demonstration's first point.
-        n_steps : int, optional
-            Number of samples, including the start; default :meth:`default_n_steps`
-            (paper: ``round(tau · T)``, the fixed horizon, the phase ends at ≈ e⁻¹; robot:
-            ``round(1.1 · tau · T)``, converged). Use more steps to let a paper DMP converge.
-            For samples in seconds use :meth:`trajectory`.
-        start_velocity : array-like, shape (D,), optional
-            Initial velocity in units per unit of normalised time (:meth:`trajectory` takes units/s); default at rest.
-        forcing_increment : callable, optional
-            ``forcing_increment(phase (n,), basis (n, N)) -> (n, D)`` added to the learned forcing
-            term on the rollout grid (how :class:`bidmp.BiDMP` adds its learned increments).
-
-        Returns
-        -------
-        y : array, shape (n_steps, D)
-        """
-        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
-        return free + np.outer(goal_response, goal)
-
-    @goal_first("start", "n_steps", "start_velocity")
-    @numerically_guarded
-    def rollout_many(self, goals, *, start=None, n_steps: int | None = None, start_velocity=None,
-                     forcing_increment=None, out: np.ndarray | None = None) -> np.ndarray:
-        """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
-
-        Parameters
-        ----------
-        goals : array-like, shape (G, D)
-        start, n_steps, start_velocity, forcing_increment
-            As in :meth:`rollout`, shared by every goal.
-        out : array, shape (G, n_steps, D), optional
-            Where to write the rollouts (float64, writable), e.g. a ``numpy.memmap`` from
-            ``numpy.lib.format.open_memmap`` for more rollouts than fit in memory; it is filled a
-            chunk of goals at a time. Without ``out`` the result is one array, refused over
-            ``max_array_bytes`` (see :func:`bidmp.set_limits`); :meth:`iter_rollouts` yields chunks
-            instead.
-
-        Returns
-        -------
-        y : array, shape (G, n_steps, D)
-            ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
-        """
-        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        return rollouts_to(goals, free, goal_response, out)
-
-    @goal_first("chunk_size", "start", "n_steps", "start_velocity")
-    def iter_rollouts(self, goals, *, chunk_size: int = 1024, start=None, n_steps: int | None = None,
-                      start_velocity=None, forcing_increment=None):
-        """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
-
-        Yields
-        ------
-        (first, y) : int and array (g, n_steps, D)
-            ``y[i]`` is the rollout to ``goals[first + i]``; ``g <= chunk_size``.
-        """
-        chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
-        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
-            free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        yield from iter_rollouts_to(goals, free, goal_response, chunk_size)
-
-    @numerically_guarded
-    def endpoint_gain(self, n_steps: int | None = None) -> float:
-        """End-point gain ``c``: the final error for a shifted goal is ``c · ‖g' - g‖``.
-
-        ``c = |1 - B[n_steps - 1]|`` where ``B`` is the goal's share of the affine rollout; it
-        depends only on ``(alpha, K, alpha_phase, tau, T, n_steps)``, not on the weights. With the
-        paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
-        convergence and it tends to 0.
-        """
-        params = self._rollout_params()
-        n_steps = self._n_steps(n_steps, params)
-        cached = cached_grid(self, params, n_steps, self.dt_)
-        if cached is not None:
-            goal_response = cached[5][0]
-        else:  # B needs no basis matrix, and other horizons should not evict the cached grid
-            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase, exact=params.exact)
-            gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
-            goal_response = unit_responses(params, phase, None, self.dt_, gate)[0]
-        return float(abs(1.0 - goal_response[-1]))
-
-    # -- real time -------------------------------------------------------------------------------
-    @goal_first("start", "duration", "dt")
-    @numerically_guarded
-    def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None):
-        """A timed rollout: positions, velocities and accelerations in seconds.
-
-        Parameters
-        ----------
-        goal, start : array (D,), optional
-            Default: the demonstration's goal and start (in ``units_``).
-        duration : float, optional
-            Duration of the motion in seconds (temporal scaling: the shape is kept and time
-            stretched, like ``execution_time`` in movement_primitives); default ``tau ·
-            duration_``. With ``protocol="robot"`` the trajectory runs 1.1x this long, so that it
-            reaches its goal and comes to rest.
-        dt : float, optional
-            Sample period in seconds; default the demonstration's (``duration_ / (T - 1)``).
-        limits : dict, optional
-            ``{"max_velocity": ..., "max_acceleration": ..., "max_jerk": ..., "norm": "norm" |
-            "axis", "fastest": False}`` (units/s, /s², /s³). Caps: a motion that breaks one is
-            slowed (uniformly) to the shortest duration that meets them all; one within them runs
-            as demonstrated, unless ``"fastest": True`` asks for the shortest duration within the
-            limits, faster than demonstrated. ``duration`` is then ignored.
-        start_velocity : array (D,), optional
-            Initial velocity in units/s (default at rest).
-        forcing_increment : callable, optional
-            As in :meth:`rollout` (how :class:`bidmp.BiDMP` adds its increments).
-        coupling : list of coupling terms, optional
-            ``coupling(t, y, yd, phase) -> acceleration`` (units/s², see
-            :mod:`bidmp.primitives.coupling`): the motion is integrated step by step with their
-            accelerations added. Without them (default) the fast path runs; an empty list runs the
-            step integrator, which gives the same samples to rounding.
-
-        Returns
-        -------
-        bidmp.Trajectory
-            ``t`` from 0 (s), ``y`` (units), ``yd`` (units/s), ``ydd`` (units/s²), each (n, D).
-            Exact integrator (robot): ``yd`` and ``ydd`` are the system's own state and
-            acceleration at each sample (the same continuous motion at any ``dt``). Euler (paper):
-            ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
-        """
-        self._check_fitted()
-        if limits is not None:
-            return limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
-        if coupling is not None:
-            return coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
-        return timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
-
-    @goal_first("start", "duration")
-    def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0,
-                start_velocity=None, forcing_increment=None) -> DMPStepper:
-        """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).
-
-        ``coupling`` is a list of coupling terms (:mod:`bidmp.primitives.coupling`), or a number:
-        ``alpha_e`` of phase stopping (Ijspeert et al. 2013) in 1/units², the system's time running
-        ``1 + alpha_e ‖y_measured - y‖²`` times slower while the robot lags, so a held robot makes the
-        motion pause rather than run away. 0 turns it off.
-        """
-        return DMPStepper(self, goal, start, duration, coupling, start_velocity, forcing_increment)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:

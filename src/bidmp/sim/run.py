@@ -132,8 +132,32 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     -------
     SimReport
     """
-    from ..tasks import scenarios as scenario_module
     from ..tasks.evaluation import evaluate
+
+    scenario, backend = _scenario_and_backend(scenario, backend)
+    methods, labels = _checked(scenario, methods, targets, closed_loop)
+    coupling = COUPLING * unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
+    if report is None:
+        report = evaluate(scenario, methods, geometry=False)
+    base, yaw = robot_placement(scenario)
+    jobs = _jobs(scenario, report, methods, labels, frames or {})
+    models = {name: report.fitted[name] for name in methods} if closed_loop else None
+    setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
+                   backend=backend)
+    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+    n_workers = max(1, min(n_workers, len(jobs)))
+    start = time.perf_counter()
+    outcomes = _execute_jobs(setup, jobs, n_workers, progress)
+    out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, getattr(backend, "limits", None))
+    out.wall_s = time.perf_counter() - start
+    out.workers = n_workers
+    return out
+
+
+def _scenario_and_backend(scenario, backend):
+    """The scenario (loaded if named), which must have a scene, and the backend (default the
+    PyBullet Panda, whose extra must then be installed)."""
+    from ..tasks import scenarios as scenario_module
 
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
@@ -142,41 +166,38 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     if backend is None:
         pybullet_module()  # fail early, with the install command, when the extra is missing
         backend = PandaCell
-    methods, labels = _checked(scenario, methods, targets, closed_loop)
-    coupling = COUPLING * unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
-    if report is None:
-        report = evaluate(scenario, methods, geometry=False)
-    base, yaw = robot_placement(scenario)
-    scene = scenario.scene
-    frames = frames or {}
-    jobs = [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
-                 scene.target_parts(label, scenario.targets[label]),
+    return scenario, backend
+
+
+def _jobs(scenario, report, methods, labels, frames: dict) -> list:
+    """One job per method and target: the rollout to execute, the parts it may touch, frames to render."""
+    return [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
+                 scenario.scene.target_parts(label, scenario.targets[label]),
                  int(frames.get((method, label), 0)),
                  None if report.methods[method].orientations is None else report.methods[method].orientations[label])
             for method in methods for label in labels]
-    models = {name: report.fitted[name] for name in methods} if closed_loop else None
-    setup = {"scenario": {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
-                          "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold,
-                          "axes": {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
-                                   for label in labels},
-                          "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None},
-             "scene": scene.to_dict(), "base": base.tolist(), "yaw": yaw, "closed_loop": closed_loop, "hold": hold,
-             "coupling": coupling, "models": models, "backend": backend}
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
-    n_workers = max(1, min(n_workers, len(jobs)))
-    start = time.perf_counter()
-    outcomes = _execute_jobs(setup, jobs, n_workers, progress)
+
+
+def _setup(scenario, labels, base, yaw, **run) -> dict:
+    """What every worker needs to build its world and judge a motion (plain data, picklable);
+    ``run``: closed_loop, hold, coupling, models, backend."""
+    axes = {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist() for label in labels}
+    task = {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
+            "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold, "axes": axes,
+            "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None}
+    return {"scenario": task, "scene": scenario.scene.to_dict(), "base": base.tolist(), "yaw": yaw, **run}
+
+
+def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, limits) -> SimReport:
+    """The workers' outcomes ``(method, label, measured, images, seconds)`` as a report, in the
+    order of the methods and targets (whatever order the workers finished in)."""
     by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds in outcomes}
-    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=getattr(backend, "limits", None))
+    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=limits)
     for method in methods:
         out.methods[method] = SimMethod(method, {label: by_key[(method, label)][0] for label in labels},
                                         scenario.success_threshold)
-        for label in labels:
-            if by_key[(method, label)][1]:
-                out.pictures.append((method, label, by_key[(method, label)][1]))
+        out.pictures += [(method, label, by_key[(method, label)][1]) for label in labels if by_key[(method, label)][1]]
     out.simulated_s = sum(value[2] for value in by_key.values())
-    out.wall_s = time.perf_counter() - start
-    out.workers = n_workers
     return out
 
 

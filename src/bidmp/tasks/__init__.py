@@ -12,10 +12,10 @@ from .._lazy import exports
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
     "CONVERGED_GAIN": "evaluation",
-    "MethodResult": "evaluation",
-    "Report": "evaluation",
+    "MethodResult": "report",
+    "Report": "report",
     "evaluate": "evaluation",
-    "write_report": "evaluation",
+    "write_report": "report",
     "Scenario": "scenarios",
     "ScenarioError": "scenarios",
     "METHODS": "scenarios",

@@ -56,7 +56,7 @@ import json
 import os
 from dataclasses import dataclass, field
 from importlib import resources
-from numbers import Integral, Real
+from numbers import Integral
 from pathlib import Path
 
 import numpy as np
@@ -66,7 +66,15 @@ from ..demonstrations.datasets import minimum_jerk
 from ..scene.clearance import Scene
 from ..scene.parts import SceneError
 from ..io.strict_json import load_json
-from ..io.trajectories import read_trajectory
+from ._scenario_fields import (
+    ScenarioError,
+    _demonstration,
+    _fail,
+    _number,
+    _point,
+    _pose_points,
+    _shown,
+)
 
 __all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
 
@@ -85,11 +93,6 @@ _EXTENSION_KEYS = {
     "approach", "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
     "scaling", "compare", "select", "denom",
 }
-_MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
-
-
-class ScenarioError(ValueError):
-    """A scenario file is malformed; the message names the key."""
 
 
 @dataclass
@@ -159,136 +162,6 @@ class Scenario:
             via = np.asarray(generator["via"], dtype=float) + offset
             return minimum_jerk(via, generator.get("n_steps", 200), generator.get("noise", 0.0), generator.get("seed", 0))
         return self.demonstration + offset
-
-
-# ---------------------------------------------------------------------------------------------
-# Validation
-# ---------------------------------------------------------------------------------------------
-_MIN_DEMONSTRATION = 10  # samples: what segmentation (and so the extension) needs
-
-
-def _fail(source: str, key: str, message: str):
-    raise ScenarioError(f"scenario {source}: {key}: {message}")
-
-
-def _shown(value) -> str:
-    """A rejected JSON value, quoted short (never a whole file's worth)."""
-    try:
-        text = json.dumps(value)
-    except (TypeError, ValueError):
-        text = type(value).__name__
-    return text if len(text) <= 24 else short_token(text, 20)
-
-
-def _number(value, source, key, positive=False):
-    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value):
-        _fail(source, key, f"expected a number, got {_shown(value)}")
-    if positive and value <= 0:
-        _fail(source, key, f"must be > 0, got {value}")
-    if abs(value) > get_limits().max_abs_value:
-        _fail(source, key, f"{value:.3g} is beyond the limit max_abs_value = {get_limits().max_abs_value:g}")
-    return float(value)
-
-
-def _point(value, source, key, n_dims=None):
-    if not isinstance(value, list) or not value or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value):
-        _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {_shown(value)}")
-    if len(value) > get_limits().max_dims:
-        _fail(source, key, f"has {len(value)} coordinates, more than the limit max_dims = {get_limits().max_dims}")
-    point = np.asarray(value, dtype=float)
-    if not np.all(np.isfinite(point)):
-        _fail(source, key, "contains a non-finite number")
-    if np.max(np.abs(point)) > get_limits().max_abs_value:
-        _fail(source, key, f"has a coordinate beyond the limit max_abs_value = {get_limits().max_abs_value:g} "
-                           f"(raise it with bidmp.set_limits(max_abs_value=...))")
-    if n_dims is not None and point.shape[0] != n_dims:
-        _fail(source, key, f"has {point.shape[0]} coordinates, expected {n_dims}")
-    return point
-
-
-def _points(value, source, key, n_dims=None, minimum=2):
-    if not isinstance(value, list) or len(value) < minimum:
-        _fail(source, key, f"expected a list of at least {minimum} points")
-    if len(value) > get_limits().max_samples:
-        _fail(source, key, f"{len(value):,} points exceed the limit max_samples = {get_limits().max_samples:,}")
-    points = [_point(p, source, f"{key}[{i}]", n_dims) for i, p in enumerate(value)]
-    if len({p.shape[0] for p in points}) != 1:
-        _fail(source, key, "points have different numbers of coordinates")
-    return np.stack(points)
-
-
-def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outside: bool) -> Path:
-    """Resolve a file named in a scenario; unless allowed, it must lie inside the scenario's
-    folder once ``..`` and symlinks are resolved."""
-    if allow_outside:
-        return path
-    base = Path(os.path.realpath(base_dir))
-    resolved = Path(os.path.realpath(path))
-    if os.path.isabs(body) or os.path.commonpath([base, resolved]) != str(base):
-        _fail(source, key, f"{short_token(body, 40)} lies outside the scenario's folder {base}; files are read from "
-                           f"there only (allow_outside_files=True, or 'bidmp ... --allow-outside-files', lifts this)")
-    return resolved
-
-
-def _prepared_file(path, units: str) -> np.ndarray:
-    """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
-    trimmed, filtered, uniform time); a declared unit must be the scenario's."""
-    from ..io.trajectories import declared_units
-    from ..demonstrations.prepare import prepare
-
-    declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
-    if declared and units and declared != units:
-        raise ValueError(f"{path} is in {declared} (declared in the file) but the scenario is in {units}")
-    y, t = read_trajectory(path)
-    return y if t is None else prepare(y, t)[0].y
-
-
-def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):
-    if not isinstance(value, dict) or len(value) != 1:
-        _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
-    (kind, body), = value.items()
-    if kind == "minimum_jerk":
-        if not isinstance(body, dict):
-            _fail(source, f"{key}.minimum_jerk", "expected an object")
-        unknown = sorted(set(body) - _MINIMUM_JERK_KEYS)
-        if unknown:
-            _fail(source, f"{key}.minimum_jerk.{unknown[0]}", f"unknown key (known: {', '.join(sorted(_MINIMUM_JERK_KEYS))})")
-        if "via" not in body:
-            _fail(source, f"{key}.minimum_jerk.via", "missing")
-        via = _points(body["via"], source, f"{key}.minimum_jerk.via")
-        n_steps = body.get("n_steps", 200)
-        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < _MIN_DEMONSTRATION:
-            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= {_MIN_DEMONSTRATION}, got {_shown(n_steps)}")
-        if n_steps > get_limits().max_samples:
-            _fail(source, f"{key}.minimum_jerk.n_steps", f"{n_steps:,} exceeds the limit max_samples = {get_limits().max_samples:,}")
-        noise = _number(body.get("noise", 0.0), source, f"{key}.minimum_jerk.noise")
-        if noise < 0:
-            _fail(source, f"{key}.minimum_jerk.noise", "must be >= 0")
-        seed = body.get("seed", 0)
-        if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**63:
-            _fail(source, f"{key}.minimum_jerk.seed", f"expected an integer in [0, 2**63), got {_shown(seed)}")
-        try:
-            return minimum_jerk(via, int(n_steps), noise, int(seed))
-        except (TypeError, ValueError) as exc:
-            _fail(source, f"{key}.minimum_jerk", str(exc))
-    if kind == "points":
-        points = _points(body, source, f"{key}.points", minimum=_MIN_DEMONSTRATION)
-        if not np.any(points != points[0]):
-            _fail(source, f"{key}.points", "all points are identical: there is no motion to learn")
-        return points
-    if kind == "file":
-        if not isinstance(body, str) or not body or "\x00" in body:
-            _fail(source, f"{key}.file", "expected a file name")
-        path = _inside(Path(body) if os.path.isabs(body) else Path(base_dir) / body, base_dir, source, f"{key}.file",
-                       body, allow_outside)
-        try:
-            trajectory = _prepared_file(path, units)
-        except (TypeError, ValueError, OSError) as exc:
-            _fail(source, f"{key}.file", str(exc))
-        if trajectory.shape[0] < _MIN_DEMONSTRATION:
-            _fail(source, f"{key}.file", f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}")
-        return trajectory
-    _fail(source, key, f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)")
 
 
 def _extension_target(value, source, key, targets, n_dims):
@@ -516,21 +389,6 @@ def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_param
             DMP(**dmp_params).fit(demonstration).rollout_many(np.stack(list(targets.values())))
     except (TypeError, ValueError) as exc:
         _fail(source, "dmp", f"the DMP cannot run on this demonstration: {exc}")
-
-
-def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> np.ndarray:
-    """Pose rows (x, y, z, qx, qy, qz, qw): quaternions must be unit (a generator's are
-    normalised: it interpolates them component by component)."""
-    quaternions = points[:, 3:]
-    norms = np.linalg.norm(quaternions, axis=1)
-    if np.any(norms < 1e-9):
-        _fail(source, key, "a quaternion is zero, which is no rotation")
-    if generated:
-        points = points.copy()
-        points[:, 3:] = quaternions / norms[:, None]
-    elif np.any(np.abs(norms - 1.0) > 1e-6):
-        _fail(source, key, f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})")
-    return points
 
 
 # ---------------------------------------------------------------------------------------------

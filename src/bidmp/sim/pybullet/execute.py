@@ -107,18 +107,7 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
     ignore(cell, exclude, False)
     command, previous, held, settle_from = q, q, None, None
     times, commands, clock = [], [], []
-    # A rate limiter on the joint command, as the Panda's own interface has: the stepper's
-    # command changes pace abruptly when phase stopping engages or lets go, and the joints
-    # must not follow that jump faster than their limits allow.
-    speed, max_speed = np.zeros(7), LIMIT_MARGIN * np.asarray(PANDA.velocity)
-    max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
-
-    def limited(wanted, command, speed):
-        """The next command towards ``wanted`` and its joint speed, within the limits."""
-        speed = np.clip(np.clip((wanted - command) / CONTROL_STEP, speed - max_change, speed + max_change),
-                        -max_speed, max_speed)
-        return command + speed * CONTROL_STEP, speed
-
+    limited = _RateLimiter()
     step = 0
     try:
         for step in range(n_steps):
@@ -131,7 +120,7 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
                     measured = cell.tcp_position() / cell.unit
                     y, _, _ = stepper.step(CONTROL_STEP, measured)
                     wanted, _ = cell.solve_ik(np.asarray(y) * cell.unit, command)
-                command, speed = limited(wanted, command, speed)
+                command = limited(wanted, command)
                 times.append(t)
                 commands.append(command)
                 clock.append(stepper.time)
@@ -141,10 +130,7 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
             between = previous + share * (command - previous)  # linear over the 10 ms
             q = between.tolist()
             qd = ((command - previous) / CONTROL_STEP).tolist()
-            if hold is not None and hold.start <= t < hold.start + hold.duration:
-                if held is None:
-                    held = p.getJointState(cell.robot, hold.joint, physicsClientId=cell.client)[0]
-                q[hold.joint], qd[hold.joint] = held, 0.0
+            held = _apply_hold(cell, hold, t, q, qd, held)
             drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
             record.sample(step, t + SIM_STEP, between, contacts=True, every_step=True)
@@ -153,6 +139,34 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
     run = record.finish()
     run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(commands), np.array(clock)
     return run
+
+
+class _RateLimiter:
+    """A rate limiter on the joint command, as the Panda's own interface has: the stepper's
+    command changes pace abruptly when phase stopping engages or lets go, and the joints must not
+    follow that jump faster than their limits allow."""
+
+    def __init__(self):
+        self.speed = np.zeros(7)
+        self.max_speed = LIMIT_MARGIN * np.asarray(PANDA.velocity)
+        self.max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
+
+    def __call__(self, wanted: np.ndarray, command: np.ndarray) -> np.ndarray:
+        """The next command towards ``wanted``, within the limits."""
+        wanted_speed = (wanted - command) / CONTROL_STEP
+        self.speed = np.clip(np.clip(wanted_speed, self.speed - self.max_change, self.speed + self.max_change),
+                             -self.max_speed, self.max_speed)
+        return command + self.speed * CONTROL_STEP
+
+
+def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None) -> float | None:
+    """During the hold, pin its joint in ``q``/``qd`` (in place) where it was when the hold began;
+    return that angle (None before the hold)."""
+    if hold is not None and hold.start <= t < hold.start + hold.duration:
+        if held is None:
+            held = cell.p.getJointState(cell.robot, hold.joint, physicsClientId=cell.client)[0]
+        q[hold.joint], qd[hold.joint] = held, 0.0
+    return held
 
 
 class Recorder:
