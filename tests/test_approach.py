@@ -40,7 +40,9 @@ def test_a_moved_goal_keeps_the_final_approach_within_half_a_millimetre(seed):
     rng = np.random.default_rng(seed)
     y, t, axis, approach_start = pick_demo(rng, rate=float(rng.choice([100.0, 250.0, 500.0])))
     keep = bidmp.DMP(keep_approach=True).fit(y, t, units="mm")
-    plain = bidmp.DMP().fit(y, t, units="mm")
+    plain = bidmp.DMP(keep_approach=False).fit(y, t, units="mm")  # the progress gate
+    default = bidmp.DMP().fit(y, t, units="mm")  # keep_approach is the robot protocol's default
+    np.testing.assert_array_equal(default.goal_gate_, keep.goal_gate_)
     direction = rng.normal(size=3)
     direction[2] = 0.0
     shift = 200.0 * direction / np.linalg.norm(direction)  # a goal 200 mm away, sideways
@@ -98,7 +100,7 @@ def test_keep_approach_is_a_parameter_like_any_other(tmp_path):
     np.testing.assert_array_equal(loaded.trajectory(goal).y, model.trajectory(goal).y)
     with pytest.raises(ValueError, match="keep_approach"):
         bidmp.DMP(keep_approach=True, goal_rate=4.0).fit(y)
-    with pytest.raises(TypeError, match="keep_approach must be True or False"):
+    with pytest.raises(TypeError, match="keep_approach must be True, False or None"):
         bidmp.DMP(keep_approach="yes").fit(y)
     model.keep_approach = False  # a learned parameter changed after fit: refit needed
     with pytest.raises(bidmp.NotFittedError, match="keep_approach"):

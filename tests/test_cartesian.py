@@ -204,10 +204,11 @@ def test_the_kept_approach_keeps_its_pose_relative_to_the_target():
     orientations = extension.orientations
     np.testing.assert_array_equal(extension.poses, np.hstack([extension.complete, orientations]))
     start = extension.approach_index
-    kept = extension.complete[start:]
+    n = len(flat) - start  # the kept approach: the last n samples (the transfer may take longer, issue 21.1)
+    kept = extension.complete[-n:]
     expected = target[:3] + tilt.apply(flat[start:, :3] - flat[-1, :3])
     np.testing.assert_allclose(kept, expected, rtol=0, atol=1e-9)
-    assert np.max(angle_between(orientations[start:], (tilt * Rotation.from_quat(flat[start:, 3:])).as_quat())) <= 1e-9
+    assert np.max(angle_between(orientations[-n:], (tilt * Rotation.from_quat(flat[start:, 3:])).as_quat())) <= 1e-9
     assert np.max(np.abs(np.linalg.norm(orientations, axis=1) - 1.0)) <= 1e-12
 
 

@@ -147,7 +147,8 @@ def test_the_kept_approach_is_the_demonstrated_one_translated(nut):
     assert start == final_approach(demo, extension.segmentation_points)
     n = demo.shape[0] - start
     np.testing.assert_allclose(extension.complete[-n:], demo[start:] + (target - demo[-1]), rtol=0, atol=1e-9)
-    assert extension.complete.shape == demo.shape and np.array_equal(extension.complete[0], demo[0])
+    # At least T samples: the transfer takes as long as it needs (issue 21.1).
+    assert extension.complete.shape[0] >= demo.shape[0] and np.array_equal(extension.complete[0], demo[0])
     # The kept approach is the straight vertical descent from 40 mm onto the nut.
     np.testing.assert_allclose(demo[start], [0.0, 0.0, 40.0], atol=0.5)
     assert nut.scene.clearance(extension.complete, exclude=nut.scene.parts_at(target)).collision_free

@@ -259,7 +259,7 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
     rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))
     with pytest.raises(ModelFileError, match="did not vanish with the phase"):
         bidmp.load(path)
-    assert FORMAT_VERSION == 4
+    assert FORMAT_VERSION == 5
 
 
 def test_a_format_3_robot_model_rolls_out_as_it_did():

@@ -52,7 +52,7 @@ def _demo_for(model, args: argparse.Namespace):
 def _dmp_params(args: argparse.Namespace) -> dict:
     return dict(n_kernels=args.n_kernels, alpha=args.alpha, beta=args.beta, K=args.K, alpha_phase=args.alpha_phase,
                 tau=args.tau, regression=args.regression, protocol=args.protocol,
-                keep_approach=getattr(args, "keep_approach", False))
+                keep_approach=getattr(args, "keep_approach", None))
 
 
 def cmd_fit(args: argparse.Namespace) -> int:
@@ -281,18 +281,20 @@ def cmd_extend(args: argparse.Namespace) -> int:
     if len(history):
         print(f"G-PRM similarity per iteration: {' '.join(f'{v:.3f}' for v in history)} (best {extension.similarity:.3f})")
     before = np.linalg.norm(model.rollout(target)[-1, :3] - target[:3])
-    model.learn(learned)
-    rollout = model.rollout(target)
     dmp = model_dmp(model)
-    error = rmse(rollout[: dmp.n_steps_, :3], resample_time(extension.complete, dmp.n_steps_))
+    model.learn(learned, duration=extension.duration_for(dmp))
+    rollout = model.rollout(target)
+    # The skill runs as long as the extension lasts: compare over that part of the rollout.
+    n_motion = max(int(round(dmp.n_steps_ * extension.duration_for(dmp) / dmp.duration_)), 2)
+    error = rmse(resample_time(rollout[:n_motion, :3], len(extension.complete)), extension.complete)
     unit = dmp.units_ or "units"
     print(f"learned skill {model.n_skills - 1}: rollout to the target reproduces the extended demonstration with "
           f"RMSE {error:.4g} {unit} ({100 * error / path_extent(extension.complete):.3g} % of its extent)")
     print(f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1, :3] - target[:3]):.4g} {unit} after")
     print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
     if args.save_demo:
-        complete = resample_time(learned, dmp.n_steps_)
-        stamps = np.arange(dmp.n_steps_) * dmp.duration_ / (dmp.n_steps_ - 1)
+        complete = learned  # sampled at the demonstration's period, as long as it lasts
+        stamps = np.arange(len(complete)) * dmp.duration_ / (dmp.n_steps_ - 1)
         if poses:
             written = save_poses(complete, args.save_demo, times=stamps, units=dmp.units_)
         else:
@@ -352,9 +354,10 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
     fit.add_argument("--tau", type=float, default=1.0, help="temporal scaling: rollouts take tau times the demonstration's duration (default 1)")
     fit.add_argument("--regression", "--fit", dest="regression", choices=("lwr", "ridge"), default=None,
                      help="weight regression (default: robot ridge, paper lwr)")
-    fit.add_argument("--keep-approach", action="store_true",
-                     help="robot protocol: a moved goal's offset is complete before the final approach (the straight "
-                          "tail into the goal), which then is a translated copy of the demonstrated one")
+    fit.add_argument("--keep-approach", action=argparse.BooleanOptionalAction, default=None,
+                     help="robot protocol (default on): a moved goal's offset is complete before the final approach "
+                          "(the straight tail into the goal), which then is a translated copy of the demonstrated one; "
+                          "--no-keep-approach spreads it over the whole motion (the progress gate)")
     fit.set_defaults(handler=cmd_fit)
 
     rollout = commands.add_parser(

@@ -17,7 +17,7 @@ _EXPORTS = {
     "extend_demonstration": "extend",
     "extend_pose_demonstration": "extend",
     "final_approach": "extend",
-    "time_path": "extend",
+    "time_path": "timing",
     "check_extension_options": "extend",
     "APPROACHES": "extend",
     "curvature": "segmentation",

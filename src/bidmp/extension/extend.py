@@ -1,7 +1,7 @@
 """Extended demonstrations: segment → pick the piece → G-PRM → complete demonstration (SPEC §2–5).
 
-``extend_demonstration(y, new_target)`` returns the complete extended demonstration, T samples
-uniform in time like the demonstration. Two ways (``approach``):
+``extend_demonstration(y, new_target)`` returns the complete extended demonstration, uniform in
+time at the demonstration's sample period. Two ways (``approach``):
 
 ``"keep"`` (default): the demonstration's final approach, the straight last piece into its target
 (:func:`final_approach`), is kept sample for sample and translated to the new target; G-PRM
@@ -19,9 +19,12 @@ or approach that would touch a part is an error (:class:`bidmp.extension.roadmap
 
 resampled to the demonstration's T samples.
 
-Tra_gen is the G-PRM path, smoothed (it is a polyline) with its ends pinned. It is timed with a
-cubic arc-length profile from the demonstration's speed at seg to its speed where the path goes
-on (rest at the new target in ``"paper"``), so position and speed are continuous at the joints.
+Tra_gen is the G-PRM path, smoothed (it is a polyline) with its ends pinned, and timed by
+:mod:`bidmp.extension.timing`. ``"keep"``: as long as it needs for its peak speed, acceleration
+and jerk to stay within the demonstration's (a longer transfer takes longer; the extended
+demonstration then has more samples than T, and :attr:`ExtendedDemonstration.time_scale` says
+how much longer it lasts). ``"paper"``: the imitated piece's mean speed, to rest at the new
+target, the whole resampled to T samples (the paper's protocol: the demonstration's duration).
 """
 
 from __future__ import annotations
@@ -34,10 +37,12 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ..primitives.approach import STRAIGHTNESS, straight_tail_start
-from .._checks import as_point, as_trajectory, check_choice, check_int, check_real, numerically_guarded
-from .._trajectory import arclength, interp_columns, path_extent, resample_time
+from .._checks import as_point, as_trajectory, check_choice, check_real, numerically_guarded
+from .._trajectory import arclength, path_extent, resample_time
 from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
+from .refine import refine_transfer
+from .timing import time_path, timed_transfer
 
 __all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
            "check_extension_options", "APPROACHES"]
@@ -53,25 +58,33 @@ class ExtendedDemonstration:
 
     Attributes
     ----------
-    complete : array (T, D)
+    complete : array (T', D)
         The extended demonstration y_dn: starts at the demonstration's start, ends exactly at the
-        new target, T samples uniform in time.
+        new target, uniform in time at the demonstration's sample period (``"paper"``: T' = T;
+        ``"keep"``: T' ≥ T when the transfer needs longer, see :attr:`time_scale`).
     tra_imi : array (n, D)
         The demonstrated piece that was imitated (seg → tar), original samples.
     tra_gen : array (k, D)
-        The generated path (seg → new target), smoothed, k = ``n_compare`` points.
+        The generated path (seg → new target; ``"keep"``: → the kept approach's start), as timed:
+        ``"paper"``, G-PRM's smoothed (k = ``n_compare``); ``"keep"``, as :attr:`refinement` says.
     seg_index : int
         Index of seg in the demonstration.
     similarity_history : array (n_iter,)
         G-PRM similarity per iteration (empty when G-PRM was skipped).
     approach : {"keep", "paper"}
-        How it was grown; with ``"keep"``, ``complete[-n:] == demonstration[-n:] + (new_target −
-        demonstration[-1])`` for ``n = T − approach_index``.
+        How it was grown.
     approach_index : int or None
         First sample of the kept approach in the demonstration (``"keep"`` only).
+    refinement : str or None
+        ``"keep"``: how the transfer was made from G-PRM's path (:func:`bidmp.extension.refine.refine_transfer`):
+        ``"template"`` (free, so the imitated piece's own shape), ``"smoothed"``, ``"shortcut"``, or
+        ``"straight"`` (G-PRM not needed).
     orientations : array (T, 4) or None
         For :func:`extend_pose_demonstration`: the orientation (x, y, z, w) at each sample of
         ``complete``; :attr:`poses` is then the extended pose demonstration.
+
+    With ``"keep"``, ``complete[-n:] == demonstration[-n:] + (new_target − demonstration[-1])``
+    for ``n = T − approach_index``.
     """
 
     complete: np.ndarray
@@ -88,6 +101,7 @@ class ExtendedDemonstration:
     samples: np.ndarray | None = None
     approach: str = "paper"
     approach_index: int | None = None  # "keep": where the kept approach starts in the demonstration
+    refinement: str | None = None  # "keep": how the transfer was made from G-PRM's path
     orientations: np.ndarray | None = None  # pose extensions: (T, 4) quaternions along complete
 
     @property
@@ -96,6 +110,20 @@ class ExtendedDemonstration:
         if self.orientations is None:
             raise AttributeError("this extension has no orientations: it was grown from positions (see complete)")
         return np.hstack([self.complete, self.orientations])
+
+    @property
+    def time_scale(self) -> float:
+        """How long ``complete`` lasts over the demonstration (both at the demonstration's sample
+        period): ``(T' − 1) / (T − 1)``. Pass ``duration=time_scale · dmp.duration_`` to
+        :meth:`bidmp.BiDMP.learn` so that the skill is not rushed into the demonstration's time."""
+        return (self.complete.shape[0] - 1) / (self.demonstration.shape[0] - 1)
+
+    def duration_for(self, dmp) -> float:
+        """How long ``complete`` lasts in seconds for ``dmp``, the DMP fitted on the demonstration
+        it was grown from (or on the first of a chain of extensions): ``complete`` is sampled at
+        that demonstration's period ``dmp.duration_ / (T − 1)``. What :meth:`bidmp.BiDMP.learn`
+        takes as ``duration``."""
+        return dmp.duration_ * ((self.complete.shape[0] - 1) / (dmp.n_steps_ - 1))
 
     @property
     def prefix(self) -> np.ndarray:
@@ -113,57 +141,6 @@ def _smooth_path(path: np.ndarray) -> np.ndarray:
     lam = np.linspace(0.0, 1.0, n_points)[:, None]
     smooth += (1.0 - lam) * (path[0] - smooth[0]) + lam * (path[-1] - smooth[-1])
     return smooth
-
-
-def _arc_profile(length: float, start_speed: float, end_speed: float, duration: float, n_steps: int) -> np.ndarray:
-    """Cubic Hermite arc length at ``u = k / n_steps``, k = 1..n_steps, from 0 to ``length`` with
-    speeds ``start_speed`` and ``end_speed`` at the ends. Speeds that would make the profile run
-    back (outside the Fritsch–Carlson disc α² + β² <= 9) are scaled down together."""
-    alpha, beta = start_speed * duration / length, end_speed * duration / length
-    radius = float(np.hypot(alpha, beta))
-    if radius > 3.0:
-        logger.debug("transfer end speeds scaled by %.3f to keep the arc-length profile monotone", 3.0 / radius)
-        alpha, beta = 3.0 * alpha / radius, 3.0 * beta / radius
-    u = np.arange(1, n_steps + 1) / n_steps
-    return length * (3 * u**2 - 2 * u**3 + alpha * (u - 2 * u**2 + u**3) + beta * (u**3 - u**2))
-
-
-def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float) -> tuple[np.ndarray, float]:
-    """Time a geometric path: a cubic arc-length profile from ``start_speed`` to rest.
-
-    ``s(u) = L (3u² − 2u³) + a (u − 2u² + u³)`` on ``u ∈ [0, 1]`` with ``a = start_speed · D``;
-    ``D = L / mean_speed``, shortened if needed so that ``a ≤ 3L`` (then ``s`` never runs back).
-
-    Returns
-    -------
-    (positions, duration) : positions sampled every ``dt`` from u = 0 (excluded) to u = 1
-    (included), shape (n, D), and the duration D.
-    """
-    s = arclength(path)
-    length = s[-1]
-    if length <= 0.0:
-        return path[-1:].copy(), dt
-    duration = length / max(mean_speed, 1e-300)
-    if start_speed > 0.0:
-        duration = min(duration, 3.0 * length / start_speed)
-    n_steps = max(int(round(duration / dt)), 1)
-    check_int(n_steps, "the generated transfer's samples (its length at the demonstrated piece's speed)",
-              limit="max_steps")
-    arc = _arc_profile(length, start_speed, 0.0, duration, n_steps)
-    positions = interp_columns(arc, s, path)
-    positions[-1] = path[-1]
-    return positions, n_steps * dt
-
-
-def _time_transfer(path: np.ndarray, start_speed: float, end_speed: float, n_steps: int, dt: float) -> np.ndarray:
-    """``n_steps`` samples along ``path`` (excluding its start, ending exactly at its end) over a
-    fixed duration ``n_steps · dt``, leaving at ``start_speed`` and arriving at ``end_speed``."""
-    s = arclength(path)
-    if s[-1] <= 0.0:
-        return np.repeat(path[-1:], n_steps, axis=0)
-    positions = interp_columns(_arc_profile(s[-1], start_speed, end_speed, n_steps * dt, n_steps), s, path)
-    positions[-1] = path[-1]
-    return positions
 
 
 def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) -> int:
@@ -374,27 +351,24 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
-        tra_gen, history, result = np.vstack([seg, hover]), np.empty(0), None
+        tra_gen, history, result, refinement = np.vstack([seg, hover]), np.empty(0), None, "straight"
     else:
         result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
         history = result.history
-        tra_gen = _smooth_path(result.path)
-        if scene is not None and not scene.clearance(tra_gen, exclude=exclude).clear:
-            logger.debug("the smoothed transfer cuts a part: the roadmap's polyline is used as it is")
-            tra_gen = result.path
+        tra_gen, refinement = refine_transfer(result.path, result.template, roadmap_options.get("is_free"))
+        logger.debug("transfer: %s", refinement)
     if scene is not None:
         hit = scene.clearance(np.vstack([hover, approach_tail]), exclude=exclude)
         if not hit.collision_free:
             raise NoFreeRouteError(f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
                                    f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
                                    f"keeps it; choose another target, or approach='paper'")
-    start_speed = float(np.linalg.norm(y[piece.start] - y[piece.start - 1]) / dt) if piece.start > 0 else 0.0
-    end_speed = float(np.linalg.norm(y[start + 1] - y[start]) / dt) if start + 1 < n_steps else 0.0
-    transfer = _time_transfer(tra_gen, start_speed, end_speed, start - piece.start, dt)
+    transfer = timed_transfer(tra_gen, y, piece.start, start, approach_tail, dt)
     complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
     logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
                  "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
-    return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start)
+    return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start,
+                      refinement=refinement)
 
 
 def _roadmap_defaults() -> dict:
@@ -444,7 +418,8 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
                                          approach_rotation=turn.as_matrix())
     start, seg = extension.approach_index, extension.seg_index
     kept = (turn * Rotation.from_quat(quaternions[start:])).as_quat()
-    transfer = extension.complete[seg : start + 1]
+    hover = len(extension.complete) - (len(positions) - start)  # where the kept approach begins in complete
+    transfer = extension.complete[seg : hover + 1]
     arc = arclength(transfer)
     fraction = arc / arc[-1] if arc[-1] > 0 else np.linspace(0.0, 1.0, len(transfer))
     ends = Rotation.from_quat(np.vstack([quaternions[seg], kept[0]]))

@@ -4,6 +4,8 @@ trajectories and stepper (a mixin: these read the learned blocks and learn nothi
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from .._api import goal_first
@@ -89,14 +91,31 @@ class SkillLibrary:
         return self._check_skill_index(skill)
 
     def _skill_query(self, goal, skill, start):
-        """(skill index, goal, start, forcing increment) of a query, as :meth:`rollout` resolves it."""
+        """(skill index, goal, start, forcing increment, DMP timed for the skill) of a query, as
+        :meth:`rollout` resolves it."""
         self._ensure_started()
         query = self.skill_goals_[-1] if goal is None else as_point(goal, self.dmp_.n_dims_, "goal")
         index = self.select_skill(query, skill)
         goal = self.skill_goals_[index] if goal is None else query
         start = self.skill_starts_[index] if start is None else start
         increment = None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
-        return index, goal, start, increment
+        return index, goal, start, increment, self._skill_dmp(index)
+
+    def _skill_dmp(self, index: int):
+        """The DMP that runs skill ``index``: ``dmp_`` itself, or for a skill learned from a
+        demonstration of another duration a copy whose ``tau`` is ``dmp_.tau`` times the skill's
+        time scale (the same weights and kernels, the whole skill slower or faster; the increments
+        are learned on the phase, so they follow). Kept until ``dmp_.tau`` changes."""
+        scale = float(self.skill_time_scales_[index])
+        if scale == 1.0:
+            return self.dmp_
+        views = self.__dict__.setdefault("_timed_dmps", {})
+        key = (index, scale, self.dmp_.tau)
+        if key not in views:
+            view = copy.copy(self.dmp_)  # its caches are keyed by tau: sharing them is safe
+            view.tau = self.dmp_.tau * scale
+            views[key] = view
+        return views[key]
 
     @goal_first("skill", "start", "n_steps")
     @numerically_guarded
@@ -117,9 +136,9 @@ class SkillLibrary:
         -------
         y : array (n_steps, D). Skill 0 is exactly ``dmp_.rollout`` (bit for bit).
         """
-        _, goal, start, increment = self._skill_query(goal, skill, start)
+        _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
         # Skill 0 passes no increment: exactly the plain DMP's rollout.
-        return self.dmp_.rollout(goal=goal, start=start, n_steps=n_steps, forcing_increment=increment)
+        return dmp.rollout(goal=goal, start=start, n_steps=n_steps, forcing_increment=increment)
 
     @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
@@ -127,12 +146,12 @@ class SkillLibrary:
                    limits: dict | None = None, coupling=None):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
         with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms as there."""
-        _, goal, start, increment = self._skill_query(goal, skill, start)
-        return self.dmp_.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
+        _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
+        return dmp.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
                                     forcing_increment=increment, coupling=coupling)
 
     @goal_first("skill", "start", "duration")
     def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0):
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
-        _, goal, start, increment = self._skill_query(goal, skill, start)
-        return self.dmp_.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)
+        _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
+        return dmp.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)

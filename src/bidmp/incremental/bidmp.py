@@ -57,6 +57,21 @@ def _derivative_rule(derivatives: str, params) -> str:
     return params.derivatives if derivatives == "dmp" else derivatives
 
 
+_TIME_SCALES = (1e-3, 1e3)  # a skill lasts between a thousandth and a thousand times the demonstration
+
+
+def _time_scale(duration, dmp: DMP) -> float:
+    """A skill's time scale: ``duration`` (s) over the demonstration's, 1 when not given."""
+    if duration is None:
+        return 1.0
+    duration = check_real(duration, "duration", positive=True)
+    scale = duration / dmp.duration_
+    if not _TIME_SCALES[0] <= scale <= _TIME_SCALES[1]:
+        raise ValueError(f"duration {duration:.4g} s is {scale:.3g} times the demonstration's {dmp.duration_:.4g} s; "
+                         f"a skill may last {_TIME_SCALES[0]:g} to {_TIME_SCALES[1]:g} times it")
+    return float(scale)
+
+
 class BiDMP(SkillLibrary, BaseEstimator):
     """A DMP with incrementally learned forcing-term blocks and a skill library (SPEC §7).
 
@@ -105,6 +120,9 @@ class BiDMP(SkillLibrary, BaseEstimator):
         One per learned demonstration.
     skill_goals_, skill_starts_ : array (n_skills, D)
         Training goal and start of every skill (row 0: the plain DMP's).
+    skill_time_scales_ : array (n_skills,)
+        Each skill's duration over the demonstration's (row 0: 1): skill p runs with
+        ``tau = dmp_.tau · skill_time_scales_[p]``.
     gate_phase_ : float
         The increments are ``min(ϑ / gate_phase_, 1) · BLS(...)``: 1 for the paper protocol (the
         increment is ``ϑ · BLS``), the phase at the end of the demonstrated motion for the robot
@@ -167,6 +185,7 @@ class BiDMP(SkillLibrary, BaseEstimator):
         self.blocks_ = []
         self.skill_goals_ = dmp.goal_[None].copy()
         self.skill_starts_ = dmp.start_[None].copy()
+        self.skill_time_scales_ = np.ones(1)
         self.phase_min_ = float(phase.min())
         # 1 for the paper protocol (bit for bit the ϑ-gated increment), else the phase at the last
         # sample of the demonstrated motion.
@@ -203,7 +222,7 @@ class BiDMP(SkillLibrary, BaseEstimator):
         return self.dmp_.n_dims_
 
     @numerically_guarded
-    def learn(self, y_dn) -> "BiDMP":
+    def learn(self, y_dn, *, duration: float | None = None) -> "BiDMP":
         """Learn an extended demonstration as a new skill (Eq. 15, 27, 28). Returns self.
 
         Parameters
@@ -211,9 +230,15 @@ class BiDMP(SkillLibrary, BaseEstimator):
         y_dn : array (T', D)
             Uniform in time, same D as the DMP; resampled to the DMP's T samples. Its last point
             is the skill's goal, its first the skill's start.
+        duration : float, optional
+            How long ``y_dn`` lasts, in seconds (the DMP's time base: ``duration_``). The skill
+            then runs that long (its time scale ``duration / dmp_.duration_``, see
+            ``skill_time_scales_``): a longer extension is not rushed into the demonstration's
+            time. Default: the demonstration's own duration (the paper's protocol).
         """
         self._ensure_started()
         increments, derivatives = self._check_params()
+        time_scale = _time_scale(duration, self.dmp_)
         dmp = self.dmp_
         params = dmp._params()
         y = as_trajectory(y_dn, "y_dn")
@@ -226,7 +251,7 @@ class BiDMP(SkillLibrary, BaseEstimator):
             derivatives=_derivative_rule(derivatives, params), gate=dmp.training_gate(),
         )
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
-        return self._learn_block(target - current, y[-1], y[0], increments)
+        return self._learn_block(target - current, y[-1], y[0], increments, time_scale)
 
     def learn_increment(self, forcing_increment, goal, start=None) -> "BiDMP":
         """Lower level of :meth:`learn`: fit one BLS block to a given forcing increment FI.
@@ -250,7 +275,8 @@ class BiDMP(SkillLibrary, BaseEstimator):
         increments, _ = self._check_params()
         return self._learn_block(increment, goal, start, increments)
 
-    def _learn_block(self, increment: np.ndarray, goal: np.ndarray, start: np.ndarray, increments: tuple[int, ...]) -> "BiDMP":
+    def _learn_block(self, increment: np.ndarray, goal: np.ndarray, start: np.ndarray, increments: tuple[int, ...],
+                     time_scale: float = 1.0) -> "BiDMP":
         """Fit one BLS block to a validated FI (T, D), grow it by ``increments`` nodes and add
         the skill (goal, start)."""
         dmp = self.dmp_
@@ -265,6 +291,7 @@ class BiDMP(SkillLibrary, BaseEstimator):
         self.blocks_.append(block)
         self.skill_goals_ = np.vstack([self.skill_goals_, goal])
         self.skill_starts_ = np.vstack([self.skill_starts_, start])
+        self.skill_time_scales_ = np.append(self.skill_time_scales_, time_scale)
         logger.debug("learned skill %d (goal %s)", len(self.blocks_), goal)
         return self
 

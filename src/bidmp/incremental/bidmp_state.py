@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import numpy as np
 
 from .._checks import (
     _check_magnitude,
@@ -23,6 +24,7 @@ def bidmp_state(model) -> tuple[dict, dict]:
     arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
     arrays["skill_goals_"] = model.skill_goals_
     arrays["skill_starts_"] = model.skill_starts_
+    arrays["skill_time_scales_"] = model.skill_time_scales_
     blocks_meta = []
     for index, block in enumerate(model.blocks_):
         meta, block_arrays = block._get_state()
@@ -61,4 +63,10 @@ def bidmp_from_state(cls, meta: dict, arrays: Mapping):
     model.skill_starts_ = check_loaded(arrays["skill_starts_"], "skill_starts_", expected)
     for name in ("skill_goals_", "skill_starts_"):
         _check_magnitude(getattr(model, name), f"member {name}")
+    if "skill_time_scales_" in arrays:
+        model.skill_time_scales_ = check_loaded(arrays["skill_time_scales_"], "skill_time_scales_", (expected[0],), positive=True)
+        if model.skill_time_scales_[0] != 1.0 or np.any(model.skill_time_scales_ > 1e3) or np.any(model.skill_time_scales_ < 1e-3):
+            raise ValueError("member skill_time_scales_ must be 1 for skill 0 and within [0.001, 1000]")
+    else:  # formats 2-4: every skill took the demonstration's time
+        model.skill_time_scales_ = np.ones(expected[0])
     return model

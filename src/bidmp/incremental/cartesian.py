@@ -121,12 +121,13 @@ class CartesianBiDMP(BaseEstimator):
         return self.position_.n_skills
 
     @numerically_guarded
-    def learn(self, poses) -> "CartesianBiDMP":
-        """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts). Returns self."""
+    def learn(self, poses, *, duration: float | None = None) -> "CartesianBiDMP":
+        """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts), lasting ``duration``
+        seconds (default the demonstration's; see :meth:`bidmp.BiDMP.learn`). Returns self."""
         self._ensure_started()
         positions, quaternions, log = _pose_parts(poses)
-        self.position_.learn(positions)
-        self.orientation_.learn(log)
+        self.position_.learn(positions, duration=duration)
+        self.orientation_.learn(log, duration=duration)
         self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
         self.skill_start_orientations_ = np.vstack([self.skill_start_orientations_, quaternions[0]])
         self.skill_start_logs_ = np.vstack([self.skill_start_logs_, log[0]])
@@ -165,9 +166,9 @@ class CartesianBiDMP(BaseEstimator):
                    dt: float | None = None, limits: dict | None = None, coupling=None) -> PoseTrajectory:
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
-        _, goal_p, start_p, position_increment = self.position_._skill_query(goal_p, index, start_p)
-        _, _, start_e, orientation_increment = self.orientation_._skill_query(np.zeros(3), index, start_e)
-        return pose_trajectory(self.position_.dmp_, self.orientation_.dmp_, goal_p, start_p, goal_q, start_e,
+        _, goal_p, start_p, position_increment, position = self.position_._skill_query(goal_p, index, start_p)
+        _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(np.zeros(3), index, start_e)
+        return pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e,
                                 duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
                                 coupling)
 

@@ -29,7 +29,9 @@ __all__ = ['ModelFileError', 'FORMAT_VERSION', 'save_model', 'load_model']
 logger = logging.getLogger(__name__)
 
 
-FORMAT_VERSION = 4
+FORMAT_VERSION = 5
+# Format 5 (bidmp 0.5): a Bi-DMP stores each skill's time scale (skill_time_scales_: an extension
+# lasts as long as it needs); files without it load with 1 for every skill, as they were learned.
 # Format 4 (bidmp 0.4): a DMP stores its integrator ("exact" for the robot protocol); files without
 # one load with explicit Euler, so a format-3 robot model rolls out as it did. Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
 # Bi-DMP increments are gated by the phase and the DMP's regression is stored as "regression".

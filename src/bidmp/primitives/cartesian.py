@@ -114,7 +114,7 @@ class CartesianDMP(BaseEstimator):
 
     def __init__(self, n_kernels=None, alpha=None, beta=None, K=None, alpha_phase=None, tau: float = 1.0,
                  regression=None, derivatives: str = "gradient", ridge: float = 1e-8, widths: str = "spacing",
-                 protocol: str = "robot", goal_rate=None, integrator=None, keep_approach: bool = False) -> None:
+                 protocol: str = "robot", goal_rate=None, integrator=None, keep_approach: bool | None = None) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
         self.beta = beta

@@ -134,12 +134,14 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
         rate. ``"euler"``: explicit Euler, Eq. 14 (its motion depends on the step). ``None``:
         robot exact, paper Euler. A robot-protocol model with ``"euler"`` is bidmp's robot
         protocol of model format 3 (such files load with it).
-    keep_approach : bool, default False
+    keep_approach : bool or None, default None
         Robot protocol: complete a moved goal's offset before the final approach (the
         demonstration's straight tail into its goal, :mod:`bidmp.primitives.approach`), so the
         approach to a moved goal is a translated copy of the demonstrated one
-        (:class:`bidmp.primitives.goals.ApproachGate`). A demonstration without a straight tail
-        keeps the progress gate.
+        (:class:`bidmp.primitives.goals.ApproachGate`; the progress gate spreads the offset over
+        the whole motion and tilts the approach). A demonstration without a straight tail keeps
+        the progress gate. ``None``: on for the robot protocol (its progress gate), off otherwise;
+        ``False`` asks for the progress gate.
 
     Attributes
     ----------
@@ -177,7 +179,7 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
         protocol: str = "robot",
         goal_rate: float | None = None,
         integrator: str | None = None,
-        keep_approach: bool = False,
+        keep_approach: bool | None = None,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha

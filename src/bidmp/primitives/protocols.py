@@ -200,10 +200,13 @@ def resolved_param(name: str, doc: str) -> property:
 
 
 def _keep_approach(estimator, goal_rate, integrator: str) -> bool:
-    """``keep_approach``, validated: a choice of the progress gate on the exact integrator."""
-    keep = getattr(estimator, "keep_approach", False)
+    """``keep_approach``, validated: a choice of the progress gate on the exact integrator. None
+    (the default) is True where that is the goal system (the robot protocol), else False."""
+    keep = getattr(estimator, "keep_approach", None)
+    if keep is None:
+        return goal_rate is None and integrator == "exact"
     if not isinstance(keep, (bool, np.bool_)):
-        raise TypeError(f"keep_approach must be True or False, got {type(keep).__name__}")
+        raise TypeError(f"keep_approach must be True, False or None, got {type(keep).__name__}")
     if keep and (goal_rate is not None or integrator != "exact"):
         raise ValueError("keep_approach shapes the robot protocol's progress gate: it needs goal_rate=None and the "
                          "exact integrator")

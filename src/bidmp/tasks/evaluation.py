@@ -78,7 +78,7 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
         except NoFreeRouteError as exc:  # that target's failure, not the whole evaluation's
             route_failures.append(_route_failure(target, exc))
             continue
-        model.learn(previous.complete)
+        model.learn(previous.complete, duration=previous.duration_for(dmp))  # a longer extension takes longer
         extensions.append(previous)
         targets.append(target)
     forgetting = {}
@@ -111,7 +111,7 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
             report.route_failures.append(_route_failure(target, exc))
             continue
         previous = extension.poses
-        model.learn(previous)
+        model.learn(previous, duration=extension.duration_for(cartesian.position_))
         report.extensions.append(extension)
         report.extension_targets.append(target[:3])
     for demonstration in scenario.demonstrations.values():

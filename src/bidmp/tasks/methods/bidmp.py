@@ -51,7 +51,8 @@ class _PerGoal:
         if np.array_equal(goal, demonstration[-1]):
             return self.dmp.rollout(goal)
         extension = extend_demonstration(demonstration, goal, seed=self.task.seed)
-        return BiDMP(self.dmp, **self.task.bidmp).learn(extension.complete).rollout(goal)
+        model = BiDMP(self.dmp, **self.task.bidmp).learn(extension.complete, duration=extension.duration_for(self.dmp))
+        return model.rollout(goal)
 
 
 register(BiDMPMethod("bidmp", "nearest"))

@@ -1,0 +1,174 @@
+"""Issue 21.1–21.2: an extension is timed like the demonstration it extends (its peaks within the
+demonstration's, a longer transfer taking longer) and is as smooth as what it imitates (the
+template where it is free; around a part, near the shortest free route) — checked on random
+demonstrations, rates and units, on the bundled recordings as the robot would run them, and
+against a closed form for a route around a post."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import bidmp
+from bidmp.datasets import minimum_jerk
+from bidmp.extension import extend_demonstration
+from bidmp.geometry import Scene
+
+RECORDINGS = Path(__file__).resolve().parents[2] / "shared" / "data" / "recordings"
+
+
+def peaks(points: np.ndarray, dt: float) -> np.ndarray:
+    """Peak speed, acceleration and jerk by central differences (np.gradient): an estimator other
+    than the finite differences the timing search uses."""
+    out, derivative = [], np.asarray(points, dtype=float)
+    for _ in range(3):
+        derivative = np.gradient(derivative, dt, axis=0)
+        out.append(np.max(np.linalg.norm(derivative, axis=1)))
+    return np.array(out)
+
+
+def lateral(path: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """Largest distance of ``path`` from the line through a and b."""
+    direction = (b - a) / np.linalg.norm(b - a)
+    offsets = path - a
+    return float(np.max(np.linalg.norm(offsets - np.outer(offsets @ direction, direction), axis=1)))
+
+
+def arc(path: np.ndarray) -> float:
+    return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+
+
+def random_demonstration(rng: np.random.Generator) -> tuple[np.ndarray, float]:
+    """A transfer and a straight descent, in mm or m, at 150-600 samples: (demo, unit in mm)."""
+    unit = float(rng.choice([1.0, 1e-3]))
+    start = rng.uniform(-100, 100, 3) + [0, 0, 80]
+    corner = start + np.append(rng.uniform(-150, 150, 2), rng.uniform(-20, 20))
+    goal = corner - [0, 0, rng.uniform(30, 80)]
+    demo = minimum_jerk(np.array([start, corner, goal]) * unit, int(rng.integers(150, 600)))
+    return demo, unit
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_extended_demonstration_keeps_within_the_demonstrations_peaks(seed):
+    """Random demonstrations (rates, units, layouts) and far targets: the whole extended
+    demonstration's peak speed, acceleration and jerk are at most 1.1x the demonstration's,
+    measured by another estimator than the search's; it ends at the target and keeps the
+    approach sample for sample."""
+    rng = np.random.default_rng(seed)
+    demo, unit = random_demonstration(rng)
+    extent = np.ptp(demo, axis=0).max()
+    target = demo[-1] + np.append(rng.uniform(-1.5, 1.5, 2) * extent, 0.0)
+    extension = extend_demonstration(demo, target, seed=seed)
+    dt = 1.0 / len(demo)
+    ratio = peaks(extension.complete, dt) / peaks(demo, dt)
+    assert np.all(ratio <= 1.1), (seed, ratio)
+    np.testing.assert_allclose(extension.complete[-1], target, atol=1e-9 * unit)
+    n = len(demo) - extension.approach_index
+    np.testing.assert_allclose(extension.complete[-n:], demo[-n:] + (target - demo[-1]), atol=1e-9 * unit)
+    assert extension.time_scale >= 1.0 - 1e-12
+
+
+def test_a_longer_transfer_takes_longer():
+    demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
+    scales = [extend_demonstration(demo, [100.0 + distance, 0.0, 0.0], seed=0).time_scale
+              for distance in (50.0, 150.0, 300.0, 600.0)]
+    assert all(later > earlier for earlier, later in zip(scales, scales[1:])), scales
+    assert scales[-1] > 1.5
+
+
+@pytest.mark.parametrize("name", ["operator1_nut3", "operator2_nut5"])
+def test_the_bidmp_motion_to_a_far_goal_is_not_rushed(name):
+    """A recording (250 Hz, mm, prepared), a goal 200 mm sideways: the Bi-DMP motion as the robot
+    would run it (``trajectory``, in seconds) peaks at most 1.1x the plain DMP's motion to the
+    demonstrated goal, in speed, acceleration and jerk; it ends at the goal, at rest."""
+    y, t = bidmp.io.read_trajectory(RECORDINGS / f"{name}.csv")
+    demo = bidmp.prepare(y, t)[0]
+    dmp = bidmp.DMP().fit(demo.y, demo.t)
+    goal = dmp.goal_ + [200.0, 0.0, 0.0]
+    extension = extend_demonstration(demo.y, goal, seed=0)
+    model = bidmp.BiDMP(dmp).learn(extension.complete, duration=extension.duration_for(dmp))
+    motion = model.trajectory(goal)
+    reference = dmp.trajectory()
+    ratio = peaks(motion.y, motion.t[1]) / peaks(reference.y, reference.t[1])
+    assert np.all(ratio <= 1.1), ratio
+    assert np.linalg.norm(motion.y[-1] - goal) < 0.1 and np.linalg.norm(motion.yd[-1]) < 1.0
+    assert motion.t[-1] > reference.t[-1]  # it takes longer than the demonstration, as it should
+
+
+def test_a_skill_runs_as_long_as_its_demonstration_lasts():
+    """``learn(y, duration=d)``: the skill's trajectory covers y in d seconds (compared in time with
+    y itself); without ``duration`` it takes the demonstration's time, as before."""
+    demo = minimum_jerk([[0, 0, 0], [50, 20, 10], [100, 0, 0]], 200)
+    dmp = bidmp.DMP().fit(demo, np.linspace(0.0, 2.0, 200))
+    longer = minimum_jerk([[0, 0, 0], [80, 60, 10], [160, 40, 0]], 350)
+    model = bidmp.BiDMP(dmp).learn(longer, duration=3.5)
+    assert model.skill_time_scales_.tolist() == [1.0, 1.75]
+    motion = model.trajectory(longer[-1], skill=1, dt=0.01)
+    within = motion.t <= 3.5 + 1e-9
+    expected = np.array([np.interp(motion.t[within], np.linspace(0.0, 3.5, 350), longer[:, k]) for k in range(3)]).T
+    assert np.sqrt(np.mean(np.sum((motion.y[within] - expected) ** 2, axis=1))) < 0.01 * 160
+    assert motion.t[-1] == pytest.approx(1.1 * 3.5, abs=0.011)  # the robot protocol's rest after it
+    plain = bidmp.BiDMP(dmp).learn(longer)
+    assert plain.skill_time_scales_.tolist() == [1.0, 1.0]
+    assert plain.trajectory(longer[-1], skill=1).t[-1] == pytest.approx(1.1 * 2.0, abs=0.011)
+    with pytest.raises(ValueError, match="duration"):
+        bidmp.BiDMP(dmp).learn(longer, duration=-1.0)
+
+
+def test_skill_durations_survive_a_model_file_and_old_files_load_with_one(tmp_path):
+    demo = minimum_jerk([[0, 0, 0], [50, 20, 10], [100, 0, 0]], 200)
+    dmp = bidmp.DMP().fit(demo)
+    model = bidmp.BiDMP(dmp).learn(demo + [0, 30, 0], duration=1.5 * dmp.duration_)
+    path = bidmp.save(model, tmp_path / "m.npz")
+    loaded = bidmp.load(path)
+    np.testing.assert_array_equal(loaded.skill_time_scales_, model.skill_time_scales_)
+    np.testing.assert_array_equal(loaded.rollout(demo[-1] + [0, 30, 0]), model.rollout(demo[-1] + [0, 30, 0]))
+    with np.load(path, allow_pickle=False) as archive:  # a format-4 file: no time scales
+        arrays = {name: archive[name] for name in archive.files if name != "skill_time_scales_"}
+    np.savez(path, **arrays)
+    assert bidmp.load(path).skill_time_scales_.tolist() == [1.0, 1.0]
+
+
+# ---------------------------------------------------------------------------------------------
+# 21.2: as smooth as what it imitates
+# ---------------------------------------------------------------------------------------------
+TOOL = {"radius": 12.5, "length": 100.0}
+
+
+def test_a_free_transfer_is_the_template_itself():
+    """No part in the way: the transfer is the imitated piece mapped onto seg -> hover, within 1 %
+    of its length of the straight line and no longer than 1.02 times it (G-PRM's own path strays)."""
+    demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
+    for target in ([400.0, 120.0, 0.0], [100.0, -300.0, 0.0], [-150.0, 200.0, 0.0]):
+        extension = extend_demonstration(demo, target, seed=1)
+        transfer = extension.tra_gen
+        length = np.linalg.norm(transfer[-1] - transfer[0])
+        assert extension.refinement == "template"
+        assert lateral(transfer, transfer[0], transfer[-1]) <= 0.01 * length
+        assert arc(transfer) <= 1.02 * length
+
+
+@pytest.mark.parametrize("margin", [0.0, 3.0])
+def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin):
+    """A tall post on the straight transfer: the transfer keeps the tool radius plus the margin
+    from the post's axis (checked densely by hand, not by coal) and is no longer than 1.05 times
+    the shortest free route (tangent, arc, tangent around the inflated post: closed form)."""
+    demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
+    target = np.array([100.0, 300.0, 0.0])
+    blind = extend_demonstration(demo, target, seed=0)
+    seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
+    centre = (seg + hover) / 2
+    post_radius = 10.0
+    post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -200.0], "radius": post_radius,
+            "height": 600.0}
+    scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
+    extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+    transfer = extension.tra_gen
+    assert extension.refinement in ("smoothed", "shortcut")
+    dense = np.concatenate([a + np.linspace(0, 1, 50)[:, None] * (b - a) for a, b in zip(transfer[:-1], transfer[1:])])
+    keep = post_radius + TOOL["radius"] + margin
+    assert np.min(np.linalg.norm(dense[:, :2] - centre[:2], axis=1)) >= keep - 1e-6
+    half = np.linalg.norm(hover[:2] - seg[:2]) / 2
+    shortest = 2 * np.sqrt(half**2 - keep**2) + keep * (np.pi - 2 * np.arccos(keep / half))
+    shortest = np.hypot(shortest, hover[2] - seg[2])
+    assert arc(transfer) <= 1.05 * shortest, (arc(transfer), shortest)
