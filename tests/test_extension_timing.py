@@ -4,17 +4,14 @@ template where it is free; around a part, near the shortest free route) — chec
 demonstrations, rates and units, on the bundled recordings as the robot would run them, and
 against a closed form for a route around a post."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import bidmp
 from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations.datasets import recording
 from bidmp.extension import extend_demonstration
 from bidmp.geometry import Scene
-
-RECORDINGS = Path(__file__).resolve().parents[2] / "shared" / "data" / "recordings"
 
 
 def peaks(points: np.ndarray, dt: float) -> np.ndarray:
@@ -81,8 +78,7 @@ def test_the_bidmp_motion_to_a_far_goal_is_not_rushed(name):
     """A recording (250 Hz, mm, prepared), a goal 200 mm sideways: the Bi-DMP motion as the robot
     would run it (``trajectory``, in seconds) peaks at most 1.1x the plain DMP's motion to the
     demonstrated goal, in speed, acceleration and jerk; it ends at the goal, at rest."""
-    y, t = bidmp.io.read_trajectory(RECORDINGS / f"{name}.csv")
-    demo = bidmp.prepare(y, t)[0]
+    demo = bidmp.prepare(*recording(name))[0]  # the bundled copy of the shared recording
     dmp = bidmp.DMP().fit(demo.y, demo.t)
     goal = dmp.goal_ + [200.0, 0.0, 0.0]
     extension = extend_demonstration(demo.y, goal, seed=0)

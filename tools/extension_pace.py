@@ -12,13 +12,9 @@ Runs on older trees too (``PYTHONPATH=<old tree>/src``): without ``duration_for`
 the demonstration's time, as it did there.
 """
 
-from pathlib import Path
-
 import numpy as np
 
 import bidmp
-
-RECORDINGS = Path(__file__).resolve().parents[2] / "shared" / "data" / "recordings"
 
 
 def peaks(y: np.ndarray, dt: float) -> np.ndarray:
@@ -39,12 +35,11 @@ def lateral(extension) -> float:
 
 
 def main() -> None:
-    from bidmp.io import read_trajectory
+    from bidmp.demonstrations.datasets import recording
 
     print("recording        shift [mm]        speed  accel  jerk   duration [s]  transfer off its chord [mm]")
     for name in ("operator1_nut3", "operator2_nut5"):
-        y, t = read_trajectory(RECORDINGS / f"{name}.csv")
-        demo = bidmp.prepare(y, t)[0]
+        demo = bidmp.prepare(*recording(name))[0]
         dmp = bidmp.DMP().fit(demo.y, demo.t)
         reference = dmp.trajectory()
         base = peaks(reference.y, reference.t[1])

@@ -16,14 +16,13 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 __all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "MotionPlan", "Execution", "SIM_STEP",
            "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
 
 SIM_STEP = 1e-3  # s: 1 kHz physics and position control
 CONTROL_STEP = 1e-2  # s: the closed-loop stepper and its inverse kinematics run at 100 Hz
-LIMIT_MARGIN = 0.9  # motions are timed to this fraction of the joint velocity and acceleration limits
+LIMIT_MARGIN = 0.9  # motions are timed to this fraction of the joint velocity, acceleration and jerk limits
 COUPLING = 5e5  # 1/m²: phase stopping's default gain in closed loop (0.5 /mm²)
 RECORD_EVERY = 2  # physics steps per recorded sample (500 Hz); contacts are checked every step
 SETTLE = 0.3  # s held at the end before the end point is measured
@@ -35,12 +34,14 @@ class SimError(ValueError):
 
 @dataclass(frozen=True)
 class JointLimits:
-    """Joint limits of a 7-axis arm: position (rad), velocity (rad/s), acceleration (rad/s²)."""
+    """Joint limits of a 7-axis arm: position (rad), velocity (rad/s), acceleration (rad/s²) and
+    jerk (rad/s³; None: not checked)."""
 
     lower: tuple
     upper: tuple
     velocity: tuple
     acceleration: tuple
+    jerk: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -62,10 +63,11 @@ class MotionPlan:
     fractions: np.ndarray  # (n,) normalised time of each sample in [0, 1]
     joints: np.ndarray  # (n, 7) rad
     duration: float  # s
-    spline: CubicSpline  # q(u), u in [0, 1]
+    spline: object  # q(u), u in [0, 1]: a scipy spline, q(u, order) its derivatives
     peak_velocity: float  # fraction of the limit, the largest over joints
     peak_acceleration: float
     orientations: np.ndarray | None = None  # (n, 4) the tool frame at the IK samples (pose skills)
+    peak_jerk: float = 0.0  # fraction of the jerk limit (0 when the limits state none)
 
     def command(self, t) -> tuple[np.ndarray, np.ndarray]:
         """Joint positions and velocities commanded at time(s) ``t`` (s): (7,) or (n, 7)."""
@@ -89,6 +91,7 @@ class Execution:
     command_joints: np.ndarray | None = None  # ... the joints commanded there (rad) ...
     motion_clock: np.ndarray | None = None  # ... and the stepper's own time (s; stands still while paused)
     tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
+    commands: np.ndarray | None = None  # (n, 7) rad: the joint positions commanded every SIM_STEP
 
     @property
     def paused(self) -> float:

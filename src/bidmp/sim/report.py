@@ -12,7 +12,8 @@ import numpy as np
 
 from ..tasks._tables import markdown_table, text_table
 from ..tasks.metrics import approach_error, axis_deviation, json_length
-from .backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
+from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
+from .limits import CommandPeaks, command_peaks, measured_peaks
 from .pybullet.robot import PANDA
 
 __all__ = ["SimTarget", "SimMethod", "SimReport", "measure", "write_sim_report"]
@@ -31,13 +32,15 @@ class SimTarget:
     approach_error: float | None
     engaged: bool | None
     contacts: dict  # part label -> penetration depth (scenario unit)
-    peak_velocity: float  # commanded, fractions of the joint limits (largest joint)
+    peak_velocity: float  # the 1 kHz commands, fractions of the joint limits (largest joint)
     peak_acceleration: float
     measured_peak_velocity: float  # what the simulated joints did
     measured_peak_acceleration: float  # (over 10 ms windows)
     motion_time: float
     tracking_error: float  # largest distance between the commanded and the measured TCP
-    within_limits: bool  # the commanded joint motion within the velocity and acceleration limits
+    within_limits: bool  # every 1 kHz command within the velocity, acceleration and jerk limits, from rest to rest
+    peak_jerk: float = 0.0
+    measured_peak_jerk: float = 0.0
     paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
     axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
     aligned: bool | None = None
@@ -54,7 +57,9 @@ class SimTarget:
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
             "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
             "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
-            "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4), "paused_s": round(self.paused, 3),
+            "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4),
+            "peak_joint_jerk": round(self.peak_jerk, 4), "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
+            "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
             "axis_deviation_deg": json_length(self.axis_deviation),
@@ -127,7 +132,7 @@ class SimReport:
     def rows(self) -> tuple[list[str], list[list[str]]]:
         poses = any(method.aligned is not None for method in self.methods.values())
         header = ["method", "end point", "engaged"] + (["aligned"] if poses else []) + \
-            ["contacts", "within limits", "task success", "motion time s"]
+            ["contacts", "within limits", "peak jerk: commands / joints", "task success", "motion time s"]
         rows = []
         for name, method in self.methods.items():
             n = len(method.targets)
@@ -135,8 +140,9 @@ class SimReport:
             row = [name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}"]
             if poses:
                 row.append("-" if method.aligned is None else f"{method.aligned}/{n}")
-            rows.append(row + [f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{method.task_successes}/{n}",
-                               f"{min(times):.1f}-{max(times):.1f}"])
+            jerk = (max(t.peak_jerk for t in method.targets.values()), max(t.measured_peak_jerk for t in method.targets.values()))
+            rows.append(row + [f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{jerk[0]:.2f} / {jerk[1]:.2f}",
+                               f"{method.task_successes}/{n}", f"{min(times):.1f}-{max(times):.1f}"])
         return header, rows
 
     def summary(self) -> str:
@@ -145,7 +151,9 @@ class SimReport:
         lines = [f"{scenario.name} on a simulated Franka Panda (PyBullet, 1 kHz position control), robot base "
                  f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
                  f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
-                 f"no contact with another part, joints within the Panda's velocity and acceleration limits", "",
+                 f"no contact with another part, every 1 kHz joint command within the Panda's velocity, acceleration "
+                 f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "
+                 f"differences)", "",
                  text_table(*self.rows())]
         if self.wall_s > 0:
             lines.append(f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
@@ -170,33 +178,24 @@ def measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, ru
         approach = approach_error(tcp, target, scenario["approach_height"], axis)
         if scenario.get("alignment_threshold") is not None:
             deviation = axis_deviation(tcp, run.tcp_orientation, target, scenario["approach_height"], axis)
-    velocity = float(np.max(np.abs(run.joint_velocities) / np.asarray(limits.velocity)))
-    if closed_loop:  # no plan timed it: the commands the stepper produced, 100 Hz
-        command_velocity = np.diff(run.command_joints, axis=0) / CONTROL_STEP
-        command_acceleration = np.diff(command_velocity, axis=0) / CONTROL_STEP
-        peak_velocity = float(np.max(np.abs(command_velocity) / np.asarray(limits.velocity)))
-        peak_acceleration = float(np.max(np.abs(command_acceleration) / np.asarray(limits.acceleration)))
-        motion_time = float(run.times[-1]) - SETTLE
-    else:
-        peak_velocity, peak_acceleration, motion_time = plan.peak_velocity, plan.peak_acceleration, plan.duration
+    # What counts: the commands the position control was sent every 1 ms, from rest to rest
+    # (bidmp.sim.limits); the measured joints are reported beside them.
+    if run.commands is not None:
+        sent = command_peaks(run.commands, limits)
+    else:  # a backend that does not report its commands: the plan's own peaks
+        sent = CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
+    measured = measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits)
+    motion_time = float(run.times[-1]) - SETTLE if closed_loop else plan.duration
     return SimTarget(
         label=label, commanded_error=commanded_error, measured_error=measured_error, approach_error=approach,
         engaged=None if approach is None else bool(approach <= scenario["success_threshold"]),
-        contacts={k: v / unit for k, v in run.contacts.items()}, peak_velocity=peak_velocity,
-        peak_acceleration=peak_acceleration, measured_peak_velocity=velocity,
-        measured_peak_acceleration=measured_acceleration(run, limits), motion_time=motion_time,
+        contacts={k: v / unit for k, v in run.contacts.items()}, peak_velocity=sent.velocity,
+        peak_acceleration=sent.acceleration, peak_jerk=sent.jerk, measured_peak_velocity=measured.velocity,
+        measured_peak_acceleration=measured.acceleration, measured_peak_jerk=measured.jerk, motion_time=motion_time,
         tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
-        within_limits=bool(peak_velocity <= 1.0 + 1e-9 and peak_acceleration <= 1.0 + 1e-9), paused=run.paused,
+        within_limits=sent.within, paused=run.paused,
         axis_deviation=deviation,
         aligned=None if deviation is None else bool(deviation <= scenario["alignment_threshold"]))
-
-
-def measured_acceleration(run: Execution, limits=PANDA) -> float:
-    """Peak joint acceleration (fraction of the limits) of a measured run, over 10 ms windows."""
-    window = int(round(0.01 / (SIM_STEP * RECORD_EVERY)))
-    velocity = run.joint_velocities[::window]
-    acceleration = np.diff(velocity, axis=0) / (window * SIM_STEP * RECORD_EVERY)
-    return float(np.max(np.abs(acceleration) / np.asarray(limits.acceleration))) if len(acceleration) else 0.0
 
 
 # ---------------------------------------------------------------------------------------------

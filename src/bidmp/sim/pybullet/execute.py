@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from ..backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, Hold, MotionPlan, SimError
+from ..limits import RateLimiter
 from .robot import _EFFORT, _GAINS, _REST, IK_TOLERANCE, PANDA
 
 __all__ = ["execute", "execute_closed_loop", "Recorder", "ignore", "contacts_into", "drive"]
@@ -82,16 +83,20 @@ def execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames
                 record.sample(step, t + SIM_STEP, positions[step])
     finally:
         ignore(cell, exclude, True)
-    return record.finish()
+    run = record.finish()
+    run.commands = positions  # what the position control was sent, every 1 ms (a hold is the world's doing)
+    return run
 
 
 def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
                         frames: int = 0, max_factor: float = 4.0) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
 
-    Each control step asks the stepper for the command given where the TCP is, solves IK
-    and hands the joints to the 1 kHz position control, which moves linearly from the last
-    control step's joints to these over the next 10 ms. With phase stopping the motion's
+    Each control step asks the stepper for the command given where the TCP is and solves IK;
+    every 1 ms the position control gets the joints linearly between the last two control steps'
+    targets, passed through a jerk-limited rate limiter (:class:`bidmp.sim.limits.RateLimiter`),
+    so every command is within the velocity, acceleration and jerk limits and starts and stops at
+    rest. With phase stopping the motion's
     own time stands still while the robot is held. The run ends when the stepper's time has
     reached ``duration`` (at most ``max_factor`` times that in wall time) plus the settling.
     """
@@ -105,58 +110,41 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
     n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
     record = Recorder(cell, n_steps, frames)
     ignore(cell, exclude, False)
-    command, previous, held, settle_from = q, q, None, None
-    times, commands, clock = [], [], []
-    limited = _RateLimiter()
+    target, previous, held, settle_from = q, q, None, None
+    times, targets, clock, sent = [], [], [], []
+    limited = RateLimiter(q, PANDA, LIMIT_MARGIN)
     step = 0
     try:
         for step in range(n_steps):
             t = step * SIM_STEP
             if step % every == 0:
-                previous = command
+                previous = target
                 if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
                     break
                 if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
                     measured = cell.tcp_position() / cell.unit
                     y, _, _ = stepper.step(CONTROL_STEP, measured)
-                    wanted, _ = cell.solve_ik(np.asarray(y) * cell.unit, command)
-                command = limited(wanted, command)
+                    target, _ = cell.solve_ik(np.asarray(y) * cell.unit, target)
                 times.append(t)
-                commands.append(command)
+                targets.append(target)
                 clock.append(stepper.time)
                 if settle_from is None and stepper.time >= duration:
                     settle_from = step
             share = (step % every + 1) / every
-            between = previous + share * (command - previous)  # linear over the 10 ms
-            q = between.tolist()
-            qd = ((command - previous) / CONTROL_STEP).tolist()
+            # Linear between the 100 Hz targets, then the 1 kHz limiter: jerk-limited commands.
+            command = limited(previous + share * (target - previous), (target - previous) / CONTROL_STEP)
+            sent.append(command)
+            q, qd = command.tolist(), limited.velocity.tolist()
             held = _apply_hold(cell, hold, t, q, qd, held)
             drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
-            record.sample(step, t + SIM_STEP, between, contacts=True, every_step=True)
+            record.sample(step, t + SIM_STEP, command, contacts=True, every_step=True)
     finally:
         ignore(cell, exclude, True)
     run = record.finish()
-    run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(commands), np.array(clock)
+    run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(targets), np.array(clock)
+    run.commands = np.array(sent)
     return run
-
-
-class _RateLimiter:
-    """A rate limiter on the joint command, as the Panda's own interface has: the stepper's
-    command changes pace abruptly when phase stopping engages or lets go, and the joints must not
-    follow that jump faster than their limits allow."""
-
-    def __init__(self):
-        self.speed = np.zeros(7)
-        self.max_speed = LIMIT_MARGIN * np.asarray(PANDA.velocity)
-        self.max_change = LIMIT_MARGIN * np.asarray(PANDA.acceleration) * CONTROL_STEP
-
-    def __call__(self, wanted: np.ndarray, command: np.ndarray) -> np.ndarray:
-        """The next command towards ``wanted``, within the limits."""
-        wanted_speed = (wanted - command) / CONTROL_STEP
-        self.speed = np.clip(np.clip(wanted_speed, self.speed - self.max_change, self.speed + self.max_change),
-                             -self.max_speed, self.max_speed)
-        return command + self.speed * CONTROL_STEP
 
 
 def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None) -> float | None:

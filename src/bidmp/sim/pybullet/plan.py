@@ -1,10 +1,11 @@
-"""Planning: a Cartesian path subdivided into IK samples, solved joint by joint, splined and timed to
-the Panda's limits (:data:`bidmp.sim.backend.LIMIT_MARGIN` of them)."""
+"""Planning: a Cartesian path subdivided into IK samples, solved joint by joint, splined (quintic,
+at rest at both ends) and timed to the Panda's velocity, acceleration and jerk limits
+(:data:`bidmp.sim.backend.LIMIT_MARGIN` of them)."""
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicSpline
+from scipy.interpolate import make_interp_spline
 
 from ..._checks import as_trajectory
 from ..._trajectory import interp_columns
@@ -54,16 +55,20 @@ def plan(cell, path, label: str = "", fractions=None, seed=None, orientations=No
             raise SimError(f"target {label!r}: joint {joint + 1} would leave its limits "
                            f"[{PANDA.lower[joint]}, {PANDA.upper[joint]}] rad ({q[joint]:.3f})")
         joints[index] = q
-    spline = CubicSpline(u, joints, bc_type="clamped")
-    grid = np.linspace(0.0, 1.0, max(2001, 10 * len(u)))
+    # A quintic spline at rest at both ends, acceleration included: the arm's interface asks for
+    # zero velocity and acceleration where a motion starts and stops (a clamped cubic ends with
+    # an acceleration, up to 0.45 of the limit), and its jerk is then bounded too.
+    rest = [(1, np.zeros(7)), (2, np.zeros(7))]
+    spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
+    grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
     unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))
-    vmax = LIMIT_MARGIN * np.asarray(PANDA.velocity)
-    amax = LIMIT_MARGIN * np.asarray(PANDA.acceleration)
-    timed = time_scale(unit_time, max_velocity=vmax, max_acceleration=amax, norm="axis")
-    duration = float(timed.t[-1])
-    return MotionPlan(label, points, u, joints, duration, spline,
-                      float(np.max(np.abs(timed.yd) / np.asarray(PANDA.velocity))),
-                      float(np.max(np.abs(timed.ydd) / np.asarray(PANDA.acceleration))), turns)
+    limits = {"max_velocity": LIMIT_MARGIN * np.asarray(PANDA.velocity),
+              "max_acceleration": LIMIT_MARGIN * np.asarray(PANDA.acceleration),
+              "max_jerk": LIMIT_MARGIN * np.asarray(PANDA.jerk)}
+    duration = float(time_scale(unit_time, norm="axis", **limits).t[-1])
+    peaks = [float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
+             for order, limit in ((1, PANDA.velocity), (2, PANDA.acceleration), (3, PANDA.jerk))]
+    return MotionPlan(label, points, u, joints, duration, spline, peaks[0], peaks[1], turns, peak_jerk=peaks[2])
 
 
 def subdivide(points: np.ndarray, fractions: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,135 @@
+"""Joint limits where the robot moves (issue 21.7): the commands as the arm's controller receives
+them, every 1 ms, checked against the velocity, acceleration and jerk limits; the measured joints
+reported beside them; and the 1 kHz rate limiter the closed loop sends its commands through.
+
+What the Panda's interface (libfranka) checks, and so what counts here:
+
+* every 1 kHz command's velocity, acceleration and jerk, by first, second and third differences
+  of the commanded joint positions, within the limits;
+* a motion starts and stops at rest: zero velocity *and acceleration*. The commands are checked
+  with the start position held for three samples before them and the end position for three
+  after (a jump in velocity or acceleration there shows in the differences), and the
+  acceleration of the first and the last command must be at most :data:`AT_REST` of the limit.
+
+The measured joints (the simulator's state) are reported with the estimator stated: differences
+over 10 ms windows of the recorded joint velocities, the way a robot's own filtered state would
+show them; they are reported, not counted (a contact or a held joint moves them, not the command).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .backend import SIM_STEP, JointLimits
+
+__all__ = ["CommandPeaks", "command_peaks", "measured_peaks", "RateLimiter", "PADDING", "AT_REST"]
+
+PADDING = 3  # samples of rest before and after the commands when they are checked
+# A motion starts and stops at rest: the acceleration of its first and last command at most this
+# fraction of the limit (a minimum-jerk start reaches 0.3 % of it in its first millisecond; a clamped
+# cubic starts at its full 6A/T², up to 45 % of the limit on the simulated nut task).
+AT_REST = 0.05
+_WINDOW = 0.01  # s: the measured joints' estimator (differences over 10 ms windows)
+
+
+@dataclass(frozen=True)
+class CommandPeaks:
+    """Peaks of a 1 kHz command, each the largest over the joints as a fraction of its limit
+    (jerk: 0 when the limits state none)."""
+
+    velocity: float
+    acceleration: float
+    jerk: float
+    ends: float = 0.0  # the acceleration at the first and the last command (from and to rest)
+
+    @property
+    def within(self) -> bool:
+        return (self.velocity <= 1.0 + 1e-9 and self.acceleration <= 1.0 + 1e-9 and self.jerk <= 1.0 + 1e-9
+                and self.ends <= AT_REST)
+
+
+def _peaks(positions: np.ndarray, dt: float, limits: JointLimits) -> CommandPeaks:
+    velocity = np.diff(positions, axis=0) / dt
+    acceleration = np.diff(velocity, axis=0) / dt
+    jerk = np.diff(acceleration, axis=0) / dt
+
+    def worst(values: np.ndarray, limit) -> float:
+        if limit is None or values.shape[0] == 0:
+            return 0.0
+        return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
+
+    return CommandPeaks(worst(velocity, limits.velocity), worst(acceleration, limits.acceleration),
+                        worst(jerk, limits.jerk))
+
+
+def command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> CommandPeaks:
+    """The peaks of joint position commands (n, 7) sent every ``dt`` seconds, from rest to rest
+    (the first and last held :data:`PADDING` samples before and after, see the module docstring)."""
+    commands = np.asarray(commands, dtype=float)
+    padded = np.vstack([np.repeat(commands[:1], PADDING, axis=0), commands, np.repeat(commands[-1:], PADDING, axis=0)])
+    peaks = _peaks(padded, dt, limits)
+    if commands.shape[0] < 2:
+        return peaks
+    # From rest: the first command's acceleration is its first step over dt², likewise the last.
+    ends = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
+    ratio = float(np.max(ends / np.asarray(limits.acceleration, dtype=float)))
+    return CommandPeaks(peaks.velocity, peaks.acceleration, peaks.jerk, ratio)
+
+
+def measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> CommandPeaks:
+    """Peaks of the measured joints from their recorded velocities (n, 7), one every
+    ``record_step`` seconds: velocity as recorded, acceleration and jerk by differences over
+    10 ms windows."""
+    window = max(int(round(_WINDOW / record_step)), 1)
+    sampled = np.asarray(velocities, dtype=float)[::window]
+    step = window * record_step
+    acceleration = np.diff(sampled, axis=0) / step
+    jerk = np.diff(acceleration, axis=0) / step
+
+    def worst(values: np.ndarray, limit) -> float:
+        if limit is None or values.shape[0] == 0:
+            return 0.0
+        return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
+
+    return CommandPeaks(worst(np.asarray(velocities), limits.velocity), worst(acceleration, limits.acceleration),
+                        worst(jerk, limits.jerk))
+
+
+class RateLimiter:
+    """A 1 kHz jerk-limited command generator that follows a moving target: cascaded
+    proportional loops (position → velocity → acceleration → jerk, each three times faster than
+    the one outside it) with the target's velocity fed forward and each level clipped to
+    ``margin`` times its limit. So every command it returns is within the jerk and acceleration
+    limits by construction and within the velocity limit up to the inner loop's overshoot, which
+    :func:`command_peaks` measures; it starts at rest at ``start`` and comes to rest at a target
+    that stands still. (Clipping the differences of the target alone, as a plain rate limiter
+    does, is not stable: on a held joint its error grows into a limit cycle.)"""
+
+    # Loop gains (1/s): the acceleration loop 6.7 ms, the velocity loop 20 ms, position 67 ms.
+    _GAINS = (15.0, 50.0, 150.0)
+
+    def __init__(self, start: np.ndarray, limits: JointLimits, margin: float, dt: float = SIM_STEP) -> None:
+        self.position = np.asarray(start, dtype=float).copy()
+        self.velocity = np.zeros_like(self.position)
+        self.acceleration = np.zeros_like(self.position)
+        self.dt = dt
+        self.max_velocity = margin * np.asarray(limits.velocity, dtype=float)
+        self.max_acceleration = margin * np.asarray(limits.acceleration, dtype=float)
+        jerk = limits.jerk if limits.jerk is not None else np.full(self.position.shape, np.inf)
+        self.max_jerk = margin * np.asarray(jerk, dtype=float)
+
+    def __call__(self, target: np.ndarray, target_velocity: np.ndarray | None = None) -> np.ndarray:
+        """The next command (7,) rad towards ``target``, moving at ``target_velocity`` (rad/s)."""
+        position_gain, velocity_gain, acceleration_gain = self._GAINS
+        feed = 0.0 if target_velocity is None else np.asarray(target_velocity, dtype=float)
+        wanted_velocity = np.clip(feed + position_gain * (np.asarray(target, dtype=float) - self.position),
+                                  -self.max_velocity, self.max_velocity)
+        wanted_acceleration = np.clip(velocity_gain * (wanted_velocity - self.velocity),
+                                      -self.max_acceleration, self.max_acceleration)
+        jerk = np.clip(acceleration_gain * (wanted_acceleration - self.acceleration), -self.max_jerk, self.max_jerk)
+        self.acceleration = self.acceleration + jerk * self.dt
+        self.velocity = self.velocity + self.acceleration * self.dt
+        self.position = self.position + self.velocity * self.dt
+        return self.position.copy()
