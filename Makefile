@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean readme fuzz sim lasa
+.PHONY: demo test bench install clean readme fuzz sim lasa random-cells
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -30,6 +30,10 @@ fuzz: $(STAMP)
 sim: $(STAMP)
 	$(VENV)/bin/bidmp sim --out bidmp-sim
 	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim/closed-loop-hold
+
+# Issue 21.9's property on 300 random cells (the tests draw 30).
+random-cells: $(STAMP)
+	BIDMP_RANDOM_CELLS=300 $(VENV)/bin/python -m pytest -q tests/test_random_cells.py
 
 # The full LASA benchmark (30 shapes x 7 demonstrations, every method) on the embedded Dask
 # cluster, into bidmp-lasa/ (resumable: rerun to finish an interrupted sweep).

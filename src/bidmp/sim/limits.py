@@ -50,18 +50,20 @@ class CommandPeaks:
                 and self.ends <= AT_REST)
 
 
+def _worst(values: np.ndarray, limit) -> float:
+    """The largest ``|values| / limit`` over samples and joints (0 without a limit or samples)."""
+    if limit is None or values.shape[0] == 0:
+        return 0.0
+    return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
+
+
 def _peaks(positions: np.ndarray, dt: float, limits: JointLimits) -> CommandPeaks:
     velocity = np.diff(positions, axis=0) / dt
     acceleration = np.diff(velocity, axis=0) / dt
     jerk = np.diff(acceleration, axis=0) / dt
 
-    def worst(values: np.ndarray, limit) -> float:
-        if limit is None or values.shape[0] == 0:
-            return 0.0
-        return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
-
-    return CommandPeaks(worst(velocity, limits.velocity), worst(acceleration, limits.acceleration),
-                        worst(jerk, limits.jerk))
+    return CommandPeaks(_worst(velocity, limits.velocity), _worst(acceleration, limits.acceleration),
+                        _worst(jerk, limits.jerk))
 
 
 def command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> CommandPeaks:
@@ -88,13 +90,8 @@ def measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimi
     acceleration = np.diff(sampled, axis=0) / step
     jerk = np.diff(acceleration, axis=0) / step
 
-    def worst(values: np.ndarray, limit) -> float:
-        if limit is None or values.shape[0] == 0:
-            return 0.0
-        return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
-
-    return CommandPeaks(worst(np.asarray(velocities), limits.velocity), worst(acceleration, limits.acceleration),
-                        worst(jerk, limits.jerk))
+    return CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
+                        _worst(jerk, limits.jerk))
 
 
 class RateLimiter:
