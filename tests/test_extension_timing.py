@@ -168,3 +168,22 @@ def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin):
     shortest = 2 * np.sqrt(half**2 - keep**2) + keep * (np.pi - 2 * np.arccos(keep / half))
     shortest = np.hypot(shortest, hover[2] - seg[2])
     assert arc(transfer) <= 1.05 * shortest, (arc(transfer), shortest)
+
+
+@pytest.mark.parametrize("height", [100.0, 130.0])
+def test_a_route_over_a_cable_duct_across_the_plate(height):
+    """Issue 21.8: a duct across the whole plate between the demonstration and the target. G-PRM's
+    samples around the straight line never clear it ("no collision-free route"), although a route
+    over it exists; the extension now finds it, and it keeps the tool (radius, length) the margin
+    above the duct by a check by hand."""
+    demo = minimum_jerk([[-80, -120, 200], [0, 0, 40], [0, 0, 0]], 200)
+    target = np.array([150.0, 25.0, 0.0])
+    duct = {"type": "box", "label": "duct", "at": [75.0, 0.0, 0.0], "size": [20.0, 2000.0, height]}
+    scene = Scene.from_dict({"tool": TOOL, "parts": [duct], "margin": 3.0})
+    extension = extend_demonstration(demo, target, seed=0, scene=scene)
+    path = extension.complete
+    dense = np.concatenate([a + np.linspace(0, 1, 20)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])])
+    over = np.abs(dense[:, 0] - 75.0) <= 10.0 + TOOL["radius"]  # the tool above the duct's footprint
+    assert np.any(over) and np.min(dense[over, 2]) >= height + 3.0 - 1e-6
+    np.testing.assert_allclose(path[-1], target, atol=1e-9)
+    assert extension.refinement in ("lifted", "template", "smoothed", "shortcut")

@@ -65,6 +65,27 @@ def test_a_motion_through_a_stud_is_a_contact_with_that_stud(cell):
     assert "4/stud" in run.contacts and run.contacts["4/stud"] > 0
 
 
+def test_the_commanded_penetration_is_reported_beside_the_contact(cell, nut):
+    """Issue 21.8: the physics pushes the arm aside, so its contact depth is small; the command's
+    own depth into stud 4 comes from the geometry. Closed form for a vertical tool (radius 12.5,
+    from its tip up) and the stud (radius 4, top 14.5 mm): the smaller of the vertical overlap
+    (top − tip height) and the horizontal one (16.5 − the axes' distance)."""
+    from types import SimpleNamespace
+
+    from bidmp.sim.run import _commanded_penetration
+
+    sweep = np.column_stack([np.linspace(0, 30, 60), np.zeros(60), np.full(60, 8.0)])
+    run = cell.execute(cell.plan(sweep, "sweep"), exclude=["3"])
+    depth = _commanded_penetration(cell, run, SimpleNamespace(exclude=["3"], orientations=None))
+    stud = np.asarray(nut.targets["4"])[:2]
+    commanded = run.commanded_tcp / cell.unit
+    horizontal = 12.5 + 4.0 - np.linalg.norm(commanded[:, :2] - stud, axis=1)
+    vertical = 14.5 - commanded[:, 2]
+    expected = np.max(np.where((horizontal > 0) & (vertical > 0), np.minimum(horizontal, vertical), 0.0))
+    assert expected > 5.0 and depth == pytest.approx(expected, abs=0.05)
+    assert depth > 100 * run.contacts["4/stud"] / cell.unit  # the contact the physics reports is far smaller
+
+
 def test_an_unreachable_target_is_a_clear_error_naming_it(nut, capsys, tmp_path):
     spec = nut.to_dict()
     spec["targets"]["far"] = [1500.0, 0.0, 0.0]

@@ -41,7 +41,7 @@ from .._checks import as_point, as_trajectory, check_choice, check_real, numeric
 from .._trajectory import arclength, path_extent, resample_time
 from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
-from .refine import refine_transfer
+from .refine import _smoothest_free, lifted_route, refine_transfer
 from .timing import time_path, timed_transfer
 
 __all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
@@ -353,9 +353,8 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
         tra_gen, history, result, refinement = np.vstack([seg, hover]), np.empty(0), None, "straight"
     else:
-        result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
-        history = result.history
-        tra_gen, refinement = refine_transfer(result.path, result.template, roadmap_options.get("is_free"))
+        result, tra_gen, refinement = _route(tra_imi, hover, seed, roadmap_options)
+        history = np.empty(0) if result is None else result.history
         logger.debug("transfer: %s", refinement)
     if scene is not None:
         hit = scene.clearance(np.vstack([hover, approach_tail]), exclude=exclude)
@@ -369,6 +368,38 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
                  "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
     return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start,
                       refinement=refinement)
+
+
+_WIDER = (3.0, 9.0)  # G-PRM's sampling spread, widened in turn when it finds no free route
+
+
+def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
+    """``(G-PRM's result or None, the transfer, how it was made)`` from seg to ``hover``: G-PRM,
+    then G-PRM sampling 3 and 9 times wider, then a route lifted over what is in the way
+    (:func:`bidmp.extension.refine.lifted_route`); the first free one is refined. None free: G-PRM's
+    own NoFreeRouteError."""
+    is_free = roadmap_options.get("is_free")
+    try:
+        result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
+    except NoFreeRouteError as exc:
+        first = exc
+        for factor in _WIDER:
+            wider = {**roadmap_options, "sigma_rel": roadmap_options["sigma_rel"] * factor}
+            try:
+                result = gaussian_prm(tra_imi, hover, seed=seed, **wider)
+                logger.info("G-PRM found a free route with its sampling %g times wider", factor)
+                break
+            except NoFreeRouteError:
+                continue
+        else:
+            route = lifted_route(tra_imi[0], hover, is_free)
+            if route is None:
+                raise first from None
+            logger.info("no free route around: over, at %.4g", route[1, 2])
+            smooth, how = _smoothest_free(route, is_free, "lifted")
+            return None, smooth if how == "lifted" else route, "lifted"
+    tra_gen, refinement = refine_transfer(result.path, result.template, is_free)
+    return result, tra_gen, refinement
 
 
 def _roadmap_defaults() -> dict:

@@ -26,7 +26,7 @@ from scipy.signal import savgol_filter
 from .._trajectory import arclength, interp_columns
 from .roadmap import CollisionCallback, _edges_free
 
-__all__ = ["refine_transfer", "path_is_free", "shortcut"]
+__all__ = ["refine_transfer", "path_is_free", "shortcut", "lifted_route"]
 
 logger = logging.getLogger(__name__)
 
@@ -96,3 +96,23 @@ def _smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None, nam
         if path_is_free(candidate, is_free):
             return candidate, name
     return polyline, "unsmoothed" if name == "smoothed" else name
+
+
+_LIFTS = (0.1, 0.2, 0.4, 0.8, 1.6, 3.2)  # heights tried over the higher end, in chord lengths
+
+
+def lifted_route(seg: np.ndarray, end: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
+    """Over what is in the way: up from seg, across at one height, down to ``end`` — the lowest of
+    :data:`_LIFTS` above the higher of the two ends whose three straight moves are free (3-D
+    paths only; None when none is). What a person does over a cable duct across the table, and
+    what G-PRM's samples around the straight line never reach."""
+    if seg.shape[0] != 3:
+        return None
+    chord = float(np.linalg.norm(end - seg))
+    top = max(seg[2], end[2])
+    for lift in _LIFTS:
+        height = top + lift * max(chord, 1e-300)
+        route = np.array([seg, [seg[0], seg[1], height], [end[0], end[1], height], end])
+        if path_is_free(route, is_free):
+            return route
+    return None

@@ -41,13 +41,14 @@ class SimTarget:
     within_limits: bool  # every 1 kHz command within the velocity, acceleration and jerk limits, from rest to rest
     peak_jerk: float = 0.0
     measured_peak_jerk: float = 0.0
+    commanded_penetration: float | None = None  # the command's depth into a part, from the scene geometry
     paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
     axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
     aligned: bool | None = None
 
     def task_success(self, threshold: float) -> bool:
         return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
-                    and self.within_limits and self.aligned is not False)
+                    and not self.commanded_penetration and self.within_limits and self.aligned is not False)
 
     def to_dict(self, threshold: float) -> dict:
         return {
@@ -59,6 +60,7 @@ class SimTarget:
             "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4),
             "peak_joint_jerk": round(self.peak_jerk, 4), "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
+            "commanded_penetration": json_length(self.commanded_penetration),
             "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),

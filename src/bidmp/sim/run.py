@@ -50,6 +50,7 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
         else:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
         measured = measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
+        measured.commanded_penetration = _commanded_penetration(cell, run, job)
         results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
     return results
 
@@ -167,6 +168,17 @@ def _scenario_and_backend(scenario, backend):
         pybullet_module()  # fail early, with the install command, when the extra is missing
         backend = PandaCell
     return scenario, backend
+
+
+def _commanded_penetration(cell, run, job) -> float | None:
+    """How deep the *commanded* tool goes into a part other than the target's, from the scene's
+    geometry (scene units; 0: clear) — beside the simulator's contact depth, which the physics
+    keeps small by pushing the arm aside. None for pose skills (the tool's tilt is not replayed)."""
+    scene = getattr(cell, "scene", None)
+    if scene is None or job.orientations is not None:
+        return None
+    clearance = scene.clearance(run.commanded_tcp / cell.unit, exclude=job.exclude)
+    return max(0.0, -float(clearance.distance))
 
 
 def _jobs(scenario, report, methods, labels, frames: dict) -> list:
