@@ -383,3 +383,57 @@ def test_a_margin_is_validated_and_counts_in_task_success():
         _post_scene(-1.0)
     with pytest.raises(SceneError, match="scene.margin"):
         _post_scene(50.0)  # beyond the tool's radius
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 21.4: a default margin, and stand-offs stated per part
+# ---------------------------------------------------------------------------------------------
+def test_a_scenario_keeps_3_mm_by_default_in_its_units():
+    spec = scenarios.load("pick-and-place").to_dict()
+    assert "margin" not in spec["scene"]
+    assert scenarios.from_dict(spec).scene.margin == 3.0
+    metres = json.loads(json.dumps(spec))
+    metres["units"] = "m"
+    scale = 1e-3
+    metres["targets"] = {k: (np.asarray(v) * scale).tolist() for k, v in spec["targets"].items()}
+    metres["demonstrations"] = {}
+    metres["demonstration"] = {"points": (minimum_jerk_points() * scale).tolist()}
+    metres["success_threshold"] = 1.75 * scale
+    metres["scene"]["tool"] = {"radius": 0.01, "length": 0.1}
+    metres["scene"]["parts"] = [{"type": "box", "label": "pad", "at": [0.3, 0.06, -0.04], "size": [0.03, 0.03, 0.04]}]
+    metres["scene"]["targets"] = ["op1"]
+    metres["scene"]["targets_on_parts"] = False
+    metres["robot"] = {"base": [0.17, -0.33, 0.03], "yaw": 90}
+    assert scenarios.from_dict(metres).scene.margin == pytest.approx(0.003)
+    box = [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [1, 1, 1]}]
+    assert Scene.from_dict({"tool": {"radius": 2.0, "length": 50}, "parts": box}, units="mm").margin == 2.0  # <= the radius
+    assert Scene.from_dict({"tool": TOOL, "parts": box}).margin == 0.0  # no units: no default
+
+
+def minimum_jerk_points():
+    from bidmp.datasets import minimum_jerk
+
+    return minimum_jerk([[0, 0, 0], [150, 20, 190], [300, 60, 30]], 200)
+
+
+def test_a_part_at_its_stand_off_does_not_hide_another_inside_the_margin():
+    """Margin 3, the plate's stand-off 1 (closed forms: a vertical tool of radius 12.5 over the
+    plate's top at height h is h away; beside a post of radius 4, the axes d apart, d − 16.5)."""
+    plate = {"type": "plate", "label": "plate", "at": [0, 0, 0], "size": [400, 400, 5]}
+    post = {"type": "cylinder", "label": "post", "at": [0, 0, 0], "radius": 4, "height": 60}
+    scene = scene_of(plate, post, margin=3.0, standoff={"plate": 1.0})
+
+    def passing(height, gap):  # along x at ``height`` over the plate, ``gap`` beside the post
+        return np.column_stack([np.linspace(-100, 100, 401), np.full(401, 16.5 + gap), np.full(401, height)])
+
+    hidden = scene.clearance(passing(1.5, 2.5))  # plate 1.5 (>= 1), post 2.5 (< 3)
+    assert not hidden.clear and hidden.part == "post" and hidden.distance == pytest.approx(2.5, abs=1e-6)
+    fine = scene.clearance(passing(1.5, 5.0))
+    assert fine.clear and fine.part == "plate" and fine.margin == 1.0 and fine.distance == pytest.approx(1.5, abs=1e-6)
+    low = scene.clearance(passing(0.5, 5.0))
+    assert not low.clear and low.part == "plate"
+    assert not scene_of(plate, post, margin=3.0).clearance(passing(1.5, 5.0)).clear  # without the stand-off
+    with pytest.raises(SceneError, match="standoff.ring: is not the label of a part"):
+        scene_of(plate, margin=3.0, standoff={"ring": 1.0})
+    with pytest.raises(SceneError, match=r"standoff.plate: expected a clearance in \[0, the margin 3\]"):
+        scene_of(plate, margin=3.0, standoff={"plate": 4.0})

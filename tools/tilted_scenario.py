@@ -50,6 +50,8 @@ def main() -> None:
         "robot": {"base": [50, 500, 0], "yaw": -90},
         "scene": {
             "tool": flat["scene"]["tool"],
+            "margin": flat["scene"]["margin"],
+            "standoff": flat["scene"]["standoff"],  # the socket's mouth over the plate at a nut
             "parts": [
                 {"type": "plate", "label": "plate", "at": [round(v, 6) for v in tilt.apply([90.0, 25.0, -2.0])],
                  "size": [280, 130, 5], "rotation": [TILT, 0, 0]},

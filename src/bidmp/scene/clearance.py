@@ -29,7 +29,9 @@ __all__ = ['Scene', 'Clearance']
 
 logger = logging.getLogger(__name__)
 
-_SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts", "margin"}
+_SCENE_KEYS = {"tool", "parts", "targets", "targets_on_parts", "margin", "standoff"}
+DEFAULT_MARGIN_MM = 3.0  # a scenario's clearance margin when it states none (in its units), at most the tool's radius
+_MM = {"mm": 1.0, "cm": 0.1, "m": 1e-3}
 
 
 _OVERLAP_TOLERANCE = 1e-6  # parts may touch (a nut on its plate), not interpenetrate beyond this
@@ -77,8 +79,9 @@ class Clearance:
 
 
 
-def _scene_options(data: dict, tool: Tool, targets: dict | None) -> tuple:
-    """A scene's ``targets`` (None: all), ``targets_on_parts`` and ``margin``, validated."""
+def _scene_options(data: dict, tool: Tool, targets: dict | None, units: str | None, part_labels) -> tuple:
+    """A scene's ``targets`` (None: all), ``targets_on_parts``, ``margin`` (default 3 mm in
+    ``units`` when they are known, else 0) and ``standoff``, validated."""
     chosen = data.get("targets", "all")
     if chosen == "all":
         chosen = None
@@ -91,10 +94,21 @@ def _scene_options(data: dict, tool: Tool, targets: dict | None) -> tuple:
     on_parts = data.get("targets_on_parts", True)
     if not isinstance(on_parts, bool):
         _fail("scene.targets_on_parts", "expected true or false")
-    margin = _number(data.get("margin", 0.0), "scene.margin", positive=False)
+    default = 0.0 if units is None else min(DEFAULT_MARGIN_MM * _MM.get(units, 1.0), tool.radius)
+    margin = _number(data.get("margin", default), "scene.margin", positive=False)
     if not 0.0 <= margin <= tool.radius:
         _fail("scene.margin", f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}")
-    return chosen, on_parts, margin
+    standoff = data.get("standoff", {})
+    if not isinstance(standoff, dict):
+        _fail("scene.standoff", 'expected {"part label": the closest the tool may come to it, ...}')
+    standoff = {str(label): _number(value, f"scene.standoff.{short_token(label, 20)[1:-1]}", positive=False)
+                for label, value in standoff.items()}
+    for label, value in standoff.items():
+        if label not in part_labels:
+            _fail(f"scene.standoff.{short_token(label, 20)[1:-1]}", "is not the label of a part")
+        if not 0.0 <= value <= margin:
+            _fail(f"scene.standoff.{short_token(label, 20)[1:-1]}", f"expected a clearance in [0, the margin {margin:g}], got {value:g}")
+    return chosen, on_parts, margin, standoff
 
 
 class Scene:
@@ -111,9 +125,11 @@ class Scene:
         Whether each of those targets must lie on the part with its label.
     """
 
-    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True, margin: float = 0.0):
+    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True, margin: float = 0.0,
+                 standoff: dict | None = None):
         self.parts = tuple(parts)
         self.margin = float(margin)  # clearance every planned and checked motion keeps (scene units)
+        self.standoff = {str(k): float(v) for k, v in (standoff or {}).items()}  # parts it may come closer to, by design
         self.tool = tool
         self.targets = None if targets is None else list(targets)
         self.targets_on_parts = bool(targets_on_parts)
@@ -125,7 +141,7 @@ class Scene:
 
     # -- construction ------------------------------------------------------------------------
     @classmethod
-    def from_dict(cls, data, targets: dict | None = None) -> Scene:
+    def from_dict(cls, data, targets: dict | None = None, units: str | None = None) -> Scene:
         """Build and validate a scene from its JSON data; ``targets`` ({label: point}) resolves
         ``at_targets`` and is checked against ``targets_on_parts``. Raises :class:`SceneError`
         (a ``ValueError``) naming the key for malformed data, overlapping parts, a target not on
@@ -140,7 +156,7 @@ class Scene:
             _fail("scene.tool", 'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)')
         tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}") for k in ("radius", "length")))
         parts = _parse_parts(data.get("parts"), targets)
-        scene = cls(parts, tool, *_scene_options(data, tool, targets))
+        scene = cls(parts, tool, *_scene_options(data, tool, targets, units, {part.label for part in parts}))
         scene.check_overlaps()
         if targets is not None and scene.targets_on_parts:
             scene.check_targets(targets)
@@ -148,11 +164,11 @@ class Scene:
 
     def to_dict(self) -> dict:
         out = {"tool": self.tool.to_dict(), "parts": [dict(part.spec) for part in self.parts],
-               "targets_on_parts": self.targets_on_parts}
+               "targets_on_parts": self.targets_on_parts, "margin": self.margin}
         if self.targets is not None:
             out["targets"] = list(self.targets)
-        if self.margin > 0.0:
-            out["margin"] = self.margin
+        if self.standoff:
+            out["standoff"] = dict(self.standoff)
         return out
 
     @property
@@ -310,6 +326,12 @@ class Scene:
         chosen = self._selected(exclude)
         if chosen.size == 0:
             return Clearance(math.inf, None, None, self.margin)
+        if not any(self._owner[index] in self.standoff for index in chosen):
+            return self._clearance(points, chosen, step, orientations)
+        return _nearest_to_its_clearance(self, points, chosen, step, orientations)
+
+    def _clearance(self, points: np.ndarray, chosen: np.ndarray, step: float, orientations) -> Clearance:
+        """:meth:`clearance` over the solids ``chosen`` (validated points and step)."""
         if orientations is not None:
             return self._clearance_oriented(points, orientations, chosen, step)
         lower, upper = self._lower[chosen], self._upper[chosen]
@@ -339,3 +361,18 @@ class Scene:
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
         return SceneChecker(self, self._selected(exclude), self.margin)
+
+
+def _nearest_to_its_clearance(scene: Scene, points: np.ndarray, chosen: np.ndarray, step: float, orientations) -> Clearance:
+    """:meth:`Scene.clearance` with stand-offs: the parts that have one are checked against it, the
+    rest against the margin, and the result is the group that comes nearest its own clearance (a
+    plate at its stand-off must not hide a nut inside the margin)."""
+    owner, standoff = scene._owner, scene.standoff
+    groups = [[i for i in chosen if owner[i] not in standoff]] + [[i for i in chosen if owner[i] == label] for label in standoff]
+    results = []
+    for group in groups:
+        if group:
+            found = scene._clearance(points, np.array(group), step, orientations)
+            allowed = scene.margin if group is groups[0] else standoff[owner[group[0]]]
+            results.append(Clearance(found.distance, found.part, found.point, allowed))
+    return min(results, key=lambda c: c.distance - c.margin)

@@ -352,7 +352,8 @@ def _scene(data, source: str, targets: dict, n_dims: int):
     if n_dims not in (3, POSE_DIMS):
         _fail(source, "scene", f"needs 3-D positions or poses (D = 7), these have D = {n_dims}")
     try:
-        return Scene.from_dict(data["scene"], targets)
+        # A scenario's units are known: its margin defaults to 3 mm in them (bidmp.scene.clearance).
+        return Scene.from_dict(data["scene"], targets, units=data.get("units", "mm"))
     except SceneError as exc:
         raise ScenarioError(f"scenario {source}: {exc}") from None
     except ImportError as exc:
