@@ -155,3 +155,32 @@ def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
     assert far and not any(report.methods["bidmp"].task_success_at(label) for label in far)
     data = json.loads(json.dumps(report.to_dict(), allow_nan=False))  # strict JSON: no Infinity, no NaN
     assert data["route_failures"][0]["target"][0] == pytest.approx(150.0)
+
+
+def test_a_learned_skill_inside_the_margin_is_planned_again_wider(caplog, monkeypatch):
+    """Issue 21.4 (structure: the repair loop's control flow, with the first check of the learned
+    rollout forced inside the margin; on 150 random cells no learned rollout came inside its
+    extension's margin). The extension is planned again with the margin widened by the shortfall,
+    and the evaluation goes on to the same successes."""
+    import inspect
+    import logging
+
+    from bidmp.scene.clearance import Clearance
+
+    nut = scenarios.load("nut-unscrewing")
+    real = type(nut.scene).clearance
+    calls = []
+
+    def first_too_close(scene, trajectory, exclude=(), **options):
+        found = real(scene, trajectory, exclude, **options)
+        if inspect.stack()[1].function == "_learned_clear":  # the check of the learned rollout
+            calls.append(found)
+            if len(calls) == 1:
+                return Clearance(scene.margin - 0.5, "12", None, scene.margin)
+        return found
+
+    monkeypatch.setattr(type(nut.scene), "clearance", first_too_close)
+    with caplog.at_level(logging.INFO, logger="bidmp.tasks.evaluation"):
+        report = evaluate(nut, ["bidmp"])
+    assert "planned again with a margin of 3.5" in caplog.text and len(calls) == 2
+    assert report.methods["bidmp"].task_successes == 14

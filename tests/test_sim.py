@@ -145,6 +145,12 @@ def test_the_committed_nut_task_table_is_what_bidmp_sim_measures(tmp_path, capsy
     assert results["bidmp"]["task_successes"] == 14 and results["bidmp"]["contacts"] == 0
     assert results["bidmp"]["within_limits"] == 14 and results["dmp"]["task_successes"] == 8
     assert "x real time" in capsys.readouterr().out
+    # Issue 21.7: every 1 kHz command within the jerk limit too (the plan's 90 %), the joints' measured beside.
+    for method in ("dmp", "bidmp"):
+        for target in results[method]["targets"].values():
+            # (1 kHz differences of the 90 % plan: within 1 % of it)
+            assert 0.0 < target["peak_joint_jerk"] <= 0.91 and target["peak_joint_acceleration"] <= 0.91
+            assert target["measured_peak_joint_jerk"] > 0.0 and target["commanded_penetration"] == 0.0
 
 
 def test_without_pybullet_bidmp_sim_says_how_to_install_it(monkeypatch, capsys):

@@ -7,6 +7,7 @@ results and figures. The paper's experiments built on it live in :mod:`bidmp.exp
 
 from __future__ import annotations
 
+import copy
 import logging
 import time
 
@@ -74,11 +75,10 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
         source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
         scene = scenario.scene if keep and stage.get("in_scene", True) else None
         try:
-            previous = extend_demonstration(source, target, seed=scenario.seed, scene=scene, **scenario.extension)
+            model, previous = _learned_clear(model, dmp, source, target, scenario, scene)
         except NoFreeRouteError as exc:  # that target's failure, not the whole evaluation's
             route_failures.append(_route_failure(target, exc))
             continue
-        model.learn(previous.complete, duration=previous.duration_for(dmp))  # a longer extension takes longer
         extensions.append(previous)
         targets.append(target)
     forgetting = {}
@@ -89,6 +89,32 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
             for demonstration in scenario.demonstrations.values():
                 model.learn(demonstration)
     return model, extensions, targets, forgetting
+
+
+_REPAIRS = 3  # plannings with a wider margin when the learned skill's own rollout comes too close
+
+
+def _learned_clear(model, dmp, source, target, scenario, scene):
+    """``(the Bi-DMP with the stage's skill, its extension)``. With a scene that keeps a margin, the
+    *learned* rollout to the stage's target is checked too — the skill does not follow its
+    extension exactly — and where it comes closer than the margin, the extension is planned again
+    with the margin widened by the shortfall and learned afresh, up to :data:`_REPAIRS` times; then
+    the skill is kept and its motions are reported inside the margin (not clear), naming the part."""
+    planning = scene
+    for attempt in range(_REPAIRS + 1):
+        extension = extend_demonstration(source, target, seed=scenario.seed, scene=planning, **scenario.extension)
+        trial = copy.deepcopy(model)
+        trial.learn(extension.complete, duration=extension.duration_for(dmp))  # a longer extension takes longer
+        if scene is None or scene.margin <= 0.0 or attempt == _REPAIRS:
+            return trial, extension
+        clearance = scene.clearance(trial.rollout(target), exclude=scene.parts_at(target))
+        if clearance.clear:
+            return trial, extension
+        planning = copy.copy(planning)
+        planning.margin = min(planning.margin + (clearance.margin - clearance.distance), scene.tool.radius)
+        logger.info("the skill learned for %s passes %.3g from %s, inside %g: planned again with a margin of %.3g",
+                    np.round(target, 3).tolist(), clearance.distance, clearance.part, clearance.margin, planning.margin)
+    return trial, extension
 
 
 def _pose_bidmp_model(scenario, cartesian, failed, report):
