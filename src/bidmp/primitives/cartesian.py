@@ -41,7 +41,8 @@ from .so3 import (
     orientation_from_log,
 )
 from .pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
-from .._trajectory import continuous_quaternions
+from .._trajectory import continuous_quaternions as _continuous
+from .so3 import _quaternion_rows
 from .dmp import DMP
 from .goals import arclength_progress
 
@@ -93,6 +94,12 @@ def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: 
 
 _PART_PARAMS = tuple(DMP._get_param_names())  # a pose model's parameters are its parts' own
 
+
+
+def continuous_quaternions(q) -> np.ndarray:
+    """Quaternions ``(n, 4)`` (x, y, z, w) with signs flipped so that neighbours lie in the same
+    hemisphere (``q`` and ``-q`` are one rotation); checked first: real, finite, not zero."""
+    return _continuous(_quaternion_rows(q, "q"))
 
 class CartesianDMP(BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).

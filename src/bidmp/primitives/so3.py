@@ -17,7 +17,7 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import _as_float_array
+from .._checks import _as_float_array, _check_magnitude
 from .._trajectory import continuous_quaternions
 
 __all__ = ["as_quaternions", "principal_log", "continuous_log", "nearest_turn", "angle_between", "left_jacobian",
@@ -33,10 +33,7 @@ def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
     normalised with a warning; signs made continuous."""
     if isinstance(q, (str, bytes)):
         raise TypeError(f"{name} must be an array of numbers, got a string")
-    try:
-        array = np.asarray(q, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of numbers (n, 4)") from None
+    array = _as_float_array(q, name)  # None, complex and objects refused, naming the argument
     if array.ndim == 1:
         array = array[None]
     if array.ndim != 2 or array.shape[1] != 4:
@@ -78,6 +75,7 @@ def _vector_rows(r, name: str) -> np.ndarray:
         raise ValueError(f"{name} must have shape (n, 3) or (3,) (rotation vectors, rad), got {np.shape(r)}")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
+    _check_magnitude(array, name)  # rotations of 1e300 rad overflow the Jacobian's products
     return array
 
 

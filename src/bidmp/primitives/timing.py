@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import _as_float_array, check_choice, numerically_guarded
+from .._checks import _as_float_array, check_choice, numerically_guarded, short_token
 
 __all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
@@ -93,10 +93,19 @@ class Trajectory(TimedMotion):
 def _as_stamps(t, name: str) -> np.ndarray:
     if isinstance(t, (str, bytes)):
         raise TypeError(f"{name} must be an array of times in seconds, got a string")
-    try:
-        return np.asarray(t, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be an array of times in seconds") from None
+    return _as_float_array(t, name)  # None, complex and objects refused, naming the argument
+
+
+def _as_samples(y, name: str = "y") -> np.ndarray:
+    """Samples (T, D) checked at a public boundary: real, two-dimensional, finite."""
+    array = _as_float_array(y, name)
+    if array.ndim == 1:
+        array = array[:, None]
+    if array.ndim != 2 or array.shape[0] == 0:
+        raise ValueError(f"{name} must have shape (T, D) with T >= 1, got {np.shape(y)}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} contains NaN or inf")
+    return array
 
 
 def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
@@ -124,6 +133,8 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
         raise ValueError(f"{name} must increase strictly: {kind} at sample {row}: {_stamp(stamps[row])} s after "
                          f"{_stamp(stamps[row - 1])} s ({1e3 * float(steps[row - 1]):+.4g} ms; "
                          f"{float(stamps[row] - stamps[0]):.6g} s into the recording)")
+    if n_samples < 2:  # (every stamp but the first dropped as a repeat, or one sample): no rate
+        raise ValueError(f"{name} must hold at least two distinct times, got {n_samples}")
     rate = (n_samples - 1) / (stamps[-1] - stamps[0])
     if rate < MIN_RATE_HZ:
         raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
@@ -145,9 +156,9 @@ def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray
 
     Stamps going back are still refused (:func:`check_timestamps`).
     """
-    y = np.asarray(y, dtype=np.float64)
+    y = _as_samples(y)
     stamps = _as_stamps(t, name)
-    if stamps.ndim == 1 and y.ndim >= 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1:
+    if stamps.ndim == 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1 and np.all(np.isfinite(stamps)):
         repeated = np.concatenate([[False], np.diff(stamps) == 0])
         if np.any(repeated):
             first = int(np.argmax(repeated))
@@ -160,6 +171,8 @@ def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray
 def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``y`` sampled at stamps ``t`` resampled to as many uniform samples over the same span;
     returns (y_uniform (n, D), t_uniform (n,) starting at 0)."""
+    y = _as_samples(y)
+    t = check_timestamps(t, y.shape[0])
     t = t - t[0]
     grid = np.linspace(0.0, t[-1], t.shape[0])
     steps = np.diff(t)
@@ -180,12 +193,13 @@ def _peaks(values: np.ndarray, norm: str) -> np.ndarray:
 def _limit_array(limit, n_dims: int, norm: str, name: str) -> np.ndarray | None:
     if limit is None:
         return None
-    array = np.asarray(limit, dtype=np.float64).reshape(-1)
+    array = _as_float_array(limit, name).reshape(-1)
     expected = 1 if norm == "norm" else n_dims
     if array.shape[0] == 1 and expected > 1:
         array = np.repeat(array, expected)
     if array.shape[0] != expected or not np.all(np.isfinite(array)) or np.any(array <= 0):
-        raise ValueError(f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, got {limit!r}")
+        raise ValueError(f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, "
+                         f"got {short_token(np.array2string(array, threshold=4))}")
     return array
 
 
@@ -197,6 +211,8 @@ def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=Non
     Velocity scales as 1/k, acceleration as 1/k², jerk as 1/k³.
     """
     check_choice(norm, "norm", ("norm", "axis"))
+    if not isinstance(trajectory, Trajectory):
+        raise TypeError(f"trajectory must be a bidmp.Trajectory (t, y, yd, ydd), got {type(trajectory).__name__}")
     n_dims = trajectory.n_dims
     factors = []
     for limit, values, power, name in (
@@ -248,6 +264,7 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     """A demonstration (T, D) on uniform time and its duration (s): resampled over the span of its
     stamps ``t`` (repeated stamps dropped), or, without stamps, the paper's convention of T samples
     in one unit of time (duration ``(T - 1) / T``)."""
+    y = _as_samples(y)
     if t is None:
         return y, (y.shape[0] - 1) / y.shape[0]
     y, stamps = drop_duplicate_stamps(y, t)
