@@ -154,3 +154,34 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
             if isinstance(values, np.ndarray) and values.dtype.kind == "f" and not np.all(np.isfinite(values)):
                 failures.append((index, case, "silent NaN/inf"))
     assert not failures, failures
+
+
+def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
+    """Issue 22.2, the same check on ``template``, ``shortest_path``, ``polyline_length`` and
+    ``rmse`` (18 cases failed before: internal errors, silent NaN, leaked warnings). An approach
+    error of inf is the documented answer for a motion with no final descent, not a silent one."""
+    import itertools
+    import warnings
+
+    from bidmp.extension import roadmap, similarity
+    from bidmp.tasks import metrics
+
+    y = np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 20)
+    nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
+             np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
+    calls = [lambda v: roadmap.template(v, y[-1] + 5), lambda v: roadmap.template(y, v), roadmap.shortest_path,
+             similarity.polyline_length, lambda v: metrics.rmse(v, y), lambda v: metrics.rmse(y, v)]
+    failures = []
+    for (index, call), (case, value) in itertools.product(enumerate(calls), enumerate(nasty)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                result = call(value)
+                if result is not None and not np.all(np.isfinite(np.asarray(result, dtype=float))):
+                    failures.append((index, case, "silent NaN/inf"))
+            except (ValueError, TypeError) as exc:
+                if len(str(exc)) > 300:
+                    failures.append((index, case, "message of", len(str(exc))))
+            except Exception as exc:
+                failures.append((index, case, type(exc).__name__))
+    assert not failures, failures

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import numerically_guarded
+from ._checks import _as_float_array, numerically_guarded
 
 __all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent",
            "continuous_quaternions"]
@@ -55,8 +55,7 @@ def resample_time(y, n_samples: int) -> np.ndarray:
 @numerically_guarded
 def rmse(a, b) -> float:
     """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
+    a, b = _as_float_array(a, "a"), _as_float_array(b, "b")  # None, complex and objects refused by name
     if a.shape != b.shape:
         raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
     if a.size == 0:

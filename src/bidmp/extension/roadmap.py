@@ -105,6 +105,9 @@ def template(piece: np.ndarray, new_target: np.ndarray, scaling: str = "axis") -
     -------
     array (k, D), starting exactly at seg and ending exactly at ``new_target``.
     """
+    piece = as_trajectory(piece, "piece", min_points=2, allow_static=True)
+    new_target = as_point(new_target, piece.shape[1], "new_target")
+    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
     seg, tar = piece[0], piece[-1]
     chord, new_chord = tar - seg, new_target - seg
     chord_length = np.linalg.norm(chord)
@@ -170,6 +173,8 @@ def shortest_path(
     Returns the node indices of the path, or None when the target is unreachable even with
     ``n_neighbours`` doubled up to 32.
     """
+    nodes = as_trajectory(nodes, "nodes", min_points=2, allow_static=True)
+    n_neighbours = check_int(n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS)
     n_nodes = nodes.shape[0]
     tree = cKDTree(nodes)
     k = n_neighbours

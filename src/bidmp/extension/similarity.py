@@ -202,7 +202,7 @@ def frechet_distance(a, b) -> float:
 
 def polyline_length(y: np.ndarray) -> float:
     """Sum of the segment lengths of a polyline (T, D)."""
-    y = np.asarray(y, dtype=np.float64)
+    y = as_trajectory(y, "y", min_points=1, allow_static=True)
     return float(np.sum(np.linalg.norm(np.diff(y, axis=0), axis=1)))
 
 
