@@ -114,9 +114,6 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
     a silent NaN, a ComplexWarning or a RuntimeWarning): on 18 entry points x 16 nasty inputs,
     every call returns finite numbers or raises ValueError/TypeError with a message of at most
     300 characters, and no warning escapes."""
-    import itertools
-    import warnings
-
     from bidmp.primitives import cartesian, timing
 
     y = np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 20)
@@ -136,23 +133,7 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
         lambda v: cartesian.orientation_error(v, q), lambda v: cartesian.orientation_error(q, v), cartesian.left_jacobian,
         lambda v: cartesian.angle_between(v, q),
     ]
-    failures = []
-    for (index, call), (case, value) in itertools.product(enumerate(calls), enumerate(nasty)):
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            try:
-                result = call(value)
-            except (ValueError, TypeError) as exc:
-                if len(str(exc)) > 300:
-                    failures.append((index, case, "message of", len(str(exc))))
-                continue
-            except Exception as exc:  # an internal error, or a warning turned into one
-                failures.append((index, case, type(exc).__name__))
-                continue
-        for part in result if isinstance(result, tuple) else (result,):
-            values = getattr(part, "y", part)
-            if isinstance(values, np.ndarray) and values.dtype.kind == "f" and not np.all(np.isfinite(values)):
-                failures.append((index, case, "silent NaN/inf"))
+    failures = nasty_failures(calls, nasty)
     assert not failures, failures
 
 
@@ -160,9 +141,6 @@ def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
     """Issue 22.2, the same check on ``template``, ``shortest_path``, ``polyline_length`` and
     ``rmse`` (18 cases failed before: internal errors, silent NaN, leaked warnings). An approach
     error of inf is the documented answer for a motion with no final descent, not a silent one."""
-    import itertools
-    import warnings
-
     from bidmp.extension import roadmap, similarity
     from bidmp.tasks import metrics
 
@@ -171,17 +149,30 @@ def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
              np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
     calls = [lambda v: roadmap.template(v, y[-1] + 5), lambda v: roadmap.template(y, v), roadmap.shortest_path,
              similarity.polyline_length, lambda v: metrics.rmse(v, y), lambda v: metrics.rmse(y, v)]
+    failures = nasty_failures(calls, nasty)
+    assert not failures, failures
+
+
+def nasty_failures(calls, nasty) -> list:
+    """Every (call, input) pair that does not either return finite numbers or raise
+    ValueError/TypeError with at most 300 characters, with no warning escaping: (call index,
+    input index, what happened)."""
+    import itertools
+    import warnings
+
     failures = []
     for (index, call), (case, value) in itertools.product(enumerate(calls), enumerate(nasty)):
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             try:
                 result = call(value)
-                if result is not None and not np.all(np.isfinite(np.asarray(result, dtype=float))):
-                    failures.append((index, case, "silent NaN/inf"))
+                for part in result if isinstance(result, tuple) else (result,):
+                    values = np.asarray(getattr(part, "y", part), dtype=float) if part is not None else None
+                    if values is not None and values.size and not np.all(np.isfinite(values)):
+                        failures.append((index, case, "silent NaN/inf"))
             except (ValueError, TypeError) as exc:
                 if len(str(exc)) > 300:
                     failures.append((index, case, "message of", len(str(exc))))
-            except Exception as exc:
+            except Exception as exc:  # an internal error, or a warning turned into one
                 failures.append((index, case, type(exc).__name__))
-    assert not failures, failures
+    return failures
