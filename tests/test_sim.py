@@ -185,3 +185,23 @@ def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):
     run._close_world()
     fresh = sim.simulate(nut, ["dmp"], targets=["4"], report=nut_report, workers=1).to_dict()
     assert first == again == fresh
+
+
+def test_a_near_miss_of_a_nut_is_no_contact(cell, nut):
+    """Issue 21.8: Bullet grew each nut's hull by its 1 mm collision margin, so a 0.88 mm near miss
+    was a "contact". A 10 mm box beside a nut's flat at 0.5, 0.88 and 2 mm: PyBullet's distance is
+    the gap to 0.05 mm (the nut's flat is across_flats / 2 = 6.5 mm from its axis)."""
+    p, client = cell.p, cell.client
+    label = "4"
+    body = next(b for b, name in cell._bodies.items() if name == label)
+    centre = np.asarray(nut.targets[label]) * cell.unit
+    flat_y = 6.5e-3  # a hexagon with a corner on +x has its flats at +-y
+    box = p.createCollisionShape(p.GEOM_BOX, halfExtents=[0.002, 0.005, 0.002], physicsClientId=client)
+    for gap in (0.5e-3, 0.88e-3, 2e-3):
+        probe = p.createMultiBody(0, box, -1, (centre + [0.0, flat_y + gap + 0.005, -0.002 + 3.25e-3 / 2]).tolist(),
+                                  physicsClientId=client)
+        try:
+            distance = min(point[8] for point in p.getClosestPoints(body, probe, 0.01, physicsClientId=client))
+        finally:
+            p.removeBody(probe, physicsClientId=client)
+        assert distance == pytest.approx(gap, abs=5e-5), gap

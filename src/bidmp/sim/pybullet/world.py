@@ -64,6 +64,24 @@ def panda_urdf(tool_radius: float, tool_length: float) -> str:
     return (text[:cut] + tool).replace("package://meshes/", f"{folder / 'meshes'}/")
 
 
+# Bullet grows a convex hull by its collision margin (PyBullet's default for a mesh: 1 mm), so a
+# 0.88 mm near miss of a nut was a "contact". Boxes and cylinders keep their margin inside.
+HULL_MARGIN = 1e-3  # m
+
+
+def _inset_prism(vertices: np.ndarray, margin: float) -> np.ndarray:
+    """The vertices (local frame, centred, axis z) of a prism moved in by ``margin`` on every face,
+    so that the hull grown by Bullet's margin has the solid's own faces again (its edges rounded)."""
+    from scipy.spatial import ConvexHull
+
+    planes = ConvexHull(vertices).equations  # n·x + d = 0, n outward
+    sides = planes[np.abs(planes[:, 2]) < 1e-9]
+    inradius = float(np.min(-sides[:, 3]))
+    half_height = float(np.max(vertices[:, 2]))
+    scale = np.array([(inradius - margin) / inradius, (inradius - margin) / inradius, (half_height - margin) / half_height])
+    return vertices * scale
+
+
 # -- world -----------------------------------------------------------------------------
 def add_solid(p, client: int, unit: float, solid) -> int:
     """A static body for one solid of the scene (box, cylinder, or a nut's convex hull), in metres."""
@@ -77,7 +95,7 @@ def add_solid(p, client: int, unit: float, solid) -> int:
         visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=colour(solid),
                                      physicsClientId=client)
     else:  # the hex nut: its convex hull
-        vertices = (np.asarray(solid.params[0]) * unit).tolist()
+        vertices = (_inset_prism(np.asarray(solid.params[0]) * unit, HULL_MARGIN)).tolist()
         shape = p.createCollisionShape(p.GEOM_MESH, vertices=vertices, physicsClientId=client)
         extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
         visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
