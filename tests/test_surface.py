@@ -176,3 +176,19 @@ def nasty_failures(calls, nasty) -> list:
             except Exception as exc:  # an internal error, or a warning turned into one
                 failures.append((index, case, type(exc).__name__))
     return failures
+
+
+def test_the_scene_helpers_refuse_bad_input_by_name():
+    """Issue 22.2, the scene: ``parts_at``, the roadmap checker and its straight moves, and
+    oriented clearance (11 cases failed before: IndexError, ComplexWarning, an overflow)."""
+    from bidmp.geometry import Scene
+
+    scene = Scene.from_dict({"tool": {"radius": 10, "length": 100},
+                             "parts": [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [10, 10, 10]}]})
+    y = np.linspace([0.0, 0.0, 30.0], [50.0, 0.0, 30.0], 20)
+    nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
+             np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
+    calls = [scene.parts_at, scene.checker(), lambda v: scene.checker().segments_free(v, y),
+             lambda v: scene.clearance(y, orientations=v).distance]
+    failures = nasty_failures(calls, nasty)
+    assert not failures, failures

@@ -8,6 +8,8 @@ import logging
 
 import numpy as np
 
+from .._checks import _as_float_array
+
 
 from typing import TYPE_CHECKING
 
@@ -30,7 +32,7 @@ class SceneChecker:
         self.margin = float(margin)  # a placement or move closer than this to a part is not free
 
     def __call__(self, points) -> np.ndarray:
-        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        points = _as_float_array(points, "points").reshape(-1, 3)  # complex and objects refused by name
         free = np.ones(points.shape[0], dtype=bool)
         if self.chosen.size == 0:
             return free
@@ -55,8 +57,8 @@ class SceneChecker:
 
         Conservative advancement: the distance to a part changes by at most the distance moved,
         so the tool may advance by its current clearance without missing a contact."""
-        a = np.asarray(a, dtype=float).reshape(-1, 3)
-        b = np.asarray(b, dtype=float).reshape(-1, 3)
+        a = _as_float_array(a, "a").reshape(-1, 3)
+        b = _as_float_array(b, "b").reshape(-1, 3)
         free = np.ones(a.shape[0], dtype=bool)
         if self.chosen.size == 0 or a.shape[0] == 0:
             return free

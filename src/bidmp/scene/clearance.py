@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_trajectory, check_real, numerically_guarded, short_token
+from .._checks import _as_float_array, _check_magnitude, as_trajectory, check_real, numerically_guarded, short_token
 from .._trajectory import continuous_quaternions
 
 from .checker import SceneChecker
@@ -198,7 +198,7 @@ class Scene:
     def parts_at(self, point) -> list[str]:
         """Labels of the parts the tool would take into its mouth at ``point``: those whose
         bounding box is within the tool radius of the point."""
-        point = np.asarray(point, dtype=float)[:3]
+        point = _position(point)
         gap = np.maximum(np.maximum(self._lower - point, point - self._upper), 0.0)
         near = np.linalg.norm(gap, axis=1) <= self.tool.radius
         return list(dict.fromkeys(self._owner[near]))
@@ -273,7 +273,7 @@ class Scene:
         """:meth:`clearance` for a tool whose orientation changes along the motion."""
         from scipy.spatial.transform import Rotation
 
-        q = np.asarray(quaternions, dtype=float)
+        q = _as_float_array(quaternions, "orientations")
         if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
             raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
         q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
@@ -376,3 +376,12 @@ def _nearest_to_its_clearance(scene: Scene, points: np.ndarray, chosen: np.ndarr
             allowed = scene.margin if group is groups[0] else standoff[owner[group[0]]]
             results.append(Clearance(found.distance, found.part, found.point, allowed))
     return min(results, key=lambda c: c.distance - c.margin)
+
+
+def _position(point) -> np.ndarray:
+    """The (x, y, z) of a point or a pose (7,), checked: real, finite, within the value limit."""
+    array = _as_float_array(point, "point").reshape(-1)
+    if array.shape[0] not in (3, 7) or not np.all(np.isfinite(array[:3])):
+        raise ValueError(f"point must be a finite (x, y, z) or pose, got shape {np.shape(point)}")
+    _check_magnitude(array[:3], "point")
+    return array[:3]
