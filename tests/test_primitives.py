@@ -55,13 +55,19 @@ def test_the_step_integrator_equals_the_fast_path_for_a_dmp(protocol, seed):
         assert_same_motion(dmp.trajectory(**query), dmp.trajectory(**query, coupling=[]))
 
 
-def test_the_step_integrator_equals_the_fast_path_for_a_bidmp():
+def recording_bidmp():
+    """(DMP, Bi-DMP with one skill, its target): operator 1's recording, a goal 134 mm away."""
     y, t = recording("operator1_nut3")
     prepared, _ = bidmp.prepare(y, t, units="mm")
     dmp = bidmp.DMP().fit(prepared.y, prepared.t, units="mm")
     target = dmp.goal_ + np.array([120.0, -60.0, 0.0])
     model = bidmp.BiDMP(dmp, increments=(10,))
     model.learn(bidmp.extend_demonstration(prepared.y, target, seed=0).complete)
+    return dmp, model, target
+
+
+def test_the_step_integrator_equals_the_fast_path_for_a_bidmp():
+    dmp, model, target = recording_bidmp()
     for goal in (target, target + [10.0, 5.0, 0.0], dmp.goal_):
         assert_same_motion(model.trajectory(goal), model.trajectory(goal, coupling=[]))
 
@@ -180,12 +186,7 @@ def test_rollouts_to_many_goals_as_one_matrix_product_are_the_same_numbers():
 
 
 def test_a_skill_increment_is_computed_once_per_grid(monkeypatch):
-    y, t = recording("operator1_nut3")
-    prepared, _ = bidmp.prepare(y, t, units="mm")
-    dmp = bidmp.DMP().fit(prepared.y, prepared.t, units="mm")
-    target = dmp.goal_ + np.array([120.0, -60.0, 0.0])
-    model = bidmp.BiDMP(dmp, increments=(10,))
-    model.learn(bidmp.extend_demonstration(prepared.y, target, seed=0).complete)
+    dmp, model, target = recording_bidmp()
     goals = target + np.random.default_rng(0).normal(scale=5.0, size=(6, 3))
     calls = []
     original = type(model.blocks_[0]).predict

@@ -341,14 +341,9 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
 def _resumed(out: Path, protocol: dict, cells) -> tuple[dict, list]:
     """The cells already computed for this protocol (``{key: cell}``, read back and checked) and
     those still to compute."""
-    done, todo = {}, []
-    for shape, demo in cells:
-        cached = _load_cell(_cell_path(out, cell_key(shape, demo)), protocol, shape, demo)
-        if cached is not None:
-            done[cell_key(shape, demo)] = cached
-        else:
-            todo.append((shape, demo))
-    return done, todo
+    loaded = {cell_key(*c): _load_cell(_cell_path(out, cell_key(*c)), protocol, *c) for c in cells}
+    return {key: cell for key, cell in loaded.items() if cell is not None}, \
+        [c for c in cells if loaded[cell_key(*c)] is None]
 
 
 def _run_here(todo, methods, every, out, protocol, done, progress) -> int:

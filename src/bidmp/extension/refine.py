@@ -26,7 +26,7 @@ from scipy.signal import savgol_filter
 from .._trajectory import arclength, interp_columns
 from .roadmap import CollisionCallback, _edges_free
 
-__all__ = ["refine_transfer", "path_is_free", "shortcut", "lifted_route"]
+__all__ = ["refine_transfer", "path_is_free", "shortcut", "smoothest_free", "lifted_route"]
 
 logger = logging.getLogger(__name__)
 
@@ -77,25 +77,23 @@ def refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCa
     if ends_match and path_is_free(template, is_free):
         # Smoothed too: the template is the piece scaled, and scaling a 10 mm piece of a recording
         # onto 200 mm scales its sensor noise 20-fold into kinks the timing would see as jerk.
-        return _smoothest_free(template, is_free, "template")
+        smooth = smoothest_free(template, is_free)
+        return (template if smooth is None else smooth), "template"
     polyline = shortcut(path, is_free)
-    if arclength(polyline)[-1] <= 0.0:
-        return polyline, "shortcut"
-    smooth, how = _smoothest_free(polyline, is_free, "smoothed")
-    if how == "smoothed":
-        return smooth, how
+    smooth = smoothest_free(polyline, is_free) if arclength(polyline)[-1] > 0.0 else None
+    if smooth is not None:
+        return smooth, "smoothed"
     logger.debug("no smoothing of the shortcut transfer stays free: its polyline is used")
     return polyline, "shortcut"
 
 
-def _smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None, name: str) -> tuple[np.ndarray, str]:
-    """The polyline smoothed with the widest window whose result is free, named ``name``; the
-    polyline itself, named ``"unsmoothed"``, when none is."""
+def smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
+    """The polyline smoothed with the widest window whose result is free; None when none is."""
     for window in _WINDOWS:
         candidate = _smoothed(polyline, window)
         if path_is_free(candidate, is_free):
-            return candidate, name
-    return polyline, "unsmoothed" if name == "smoothed" else name
+            return candidate
+    return None
 
 
 _LIFTS = (0.1, 0.2, 0.4, 0.8, 1.6, 3.2)  # heights tried over the higher end, in chord lengths

@@ -68,14 +68,23 @@ def _draw(ax, points: np.ndarray, *args, **kwargs):
     return ax.plot(*(points[:, i] for i in range(points.shape[1])), *args, **kwargs)
 
 
-def _finish(ax, n_dims: int, units: str, title: str = "") -> None:
+def _label_axes(ax, n_dims: int, units: str) -> None:
+    """Axis names with the unit; 1-D against the sample index, 2-D at equal scale."""
     suffix = f" [{units}]" if units else ""
+    if n_dims == 1:
+        ax.set_xlabel("sample")
+        ax.set_ylabel("x" + suffix)
+        return
     ax.set_xlabel("x" + suffix)
     ax.set_ylabel("y" + suffix)
     if n_dims == 3:
         ax.set_zlabel("z" + suffix)
     else:
         ax.set_aspect("equal", adjustable="datalim")
+
+
+def _finish(ax, n_dims: int, units: str, title: str = "") -> None:
+    _label_axes(ax, n_dims, units)
     ax.grid(True, alpha=0.3)
     if title:
         ax.set_title(title, fontsize=10)

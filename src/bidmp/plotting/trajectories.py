@@ -9,24 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import as_points, as_trajectory
-from ._base import _figure, _matplotlib, _save
+from ._base import _figure, _label_axes, _matplotlib, _save
 
 __all__ = ['plot_trajectories', 'plot_generalisation', 'plot_recordings']
-
-
-def _label_axes(ax, n_dims: int, units: str) -> None:
-    """Axis names with the unit; 1-D against the sample index, 2-D at equal scale."""
-    suffix = f" [{units}]" if units else ""
-    if n_dims == 1:
-        ax.set_xlabel("sample")
-        ax.set_ylabel("x" + suffix)
-        return
-    ax.set_xlabel("x" + suffix)
-    ax.set_ylabel("y" + suffix)
-    if n_dims == 3:
-        ax.set_zlabel("z" + suffix)
-    else:
-        ax.set_aspect("equal", adjustable="datalim")
 
 
 def plot_trajectories(

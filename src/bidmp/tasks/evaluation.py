@@ -101,11 +101,13 @@ def _learned_clear(model, dmp, source, target, scenario, scene):
     with the margin widened by the shortfall and learned afresh, up to :data:`_REPAIRS` times; then
     the skill is kept and its motions are reported inside the margin (not clear), naming the part."""
     planning = scene
+    checked = scene is not None and scene.margin > 0.0
     for attempt in range(_REPAIRS + 1):
         extension = extend_demonstration(source, target, seed=scenario.seed, scene=planning, **scenario.extension)
-        trial = copy.deepcopy(model)
+        # A skill that may be planned again is learned on a copy: the Bi-DMP cannot forget a block.
+        trial = copy.deepcopy(model) if checked and attempt < _REPAIRS else model
         trial.learn(extension.complete, duration=extension.duration_for(dmp))  # a longer extension takes longer
-        if scene is None or scene.margin <= 0.0 or attempt == _REPAIRS:
+        if not checked or attempt == _REPAIRS:
             return trial, extension
         clearance = scene.clearance(trial.rollout(target), exclude=scene.parts_at(target))
         if clearance.clear:
