@@ -17,6 +17,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from .._checks import _as_float_array, _check_magnitude, as_trajectory, check_real, numerically_guarded, short_token
 from .._trajectory import continuous_quaternions
@@ -271,13 +272,12 @@ class Scene:
 
     def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
         """:meth:`clearance` for a tool whose orientation changes along the motion."""
-        from scipy.spatial.transform import Rotation
-
         q = _as_float_array(quaternions, "orientations")
         if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
             raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
         q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
-        dense, segment, fraction = _densify(points, step, weights=True)
+        sweep = _sweep(points, q, math.hypot(self.tool.length, self.tool.radius))
+        dense, segment, fraction = _densify(points, step, weights=True, lengths=sweep)
         if points.shape[0] > 1:  # nlerp between samples at most ``step`` apart
             dense_q = q[segment] + fraction[:, None] * (q[segment + 1] - q[segment])
             dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)
@@ -312,7 +312,8 @@ class Scene:
             1-Lipschitz in the tool's position).
         orientations : array (n, 4), optional
             The tool frame at each point (quaternions x, y, z, w; the frame's z axis is the
-            approach direction, the tool's body extends against it). Default: pointing down.
+            approach direction, the tool's body extends against it). Default: pointing down. A
+            turning tool is placed so that none of its points moves more than ``step`` between two.
 
         Returns
         -------
@@ -361,6 +362,14 @@ class Scene:
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
         return SceneChecker(self, self._selected(exclude), self.margin)
+
+
+def _sweep(points: np.ndarray, quaternions: np.ndarray, reach: float) -> np.ndarray:
+    """How far any point of a tool within ``reach`` of its tip moves along each segment: at most
+    |Δp| + reach · Δθ. A turning tool moves its far end more than its tip, so its placements are
+    spaced by this, not by |Δp| alone."""
+    turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), 0.0, 1.0))
+    return np.linalg.norm(np.diff(points, axis=0), axis=1) + reach * turn
 
 
 def _nearest_to_its_clearance(scene: Scene, points: np.ndarray, chosen: np.ndarray, step: float, orientations) -> Clearance:

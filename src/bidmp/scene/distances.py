@@ -128,18 +128,22 @@ class _Distances:
         return self._distance(a, pose_a, b, pose_b)
 
 
-def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False):
+def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False,
+             lengths: np.ndarray | None = None):
     """Points along the polyline through ``points`` no more than ``step`` apart: of every segment
     (``segments`` None), or of the segments whose indices are given (each with both its ends).
     ``weights``: also return each point's segment index and fraction along it (to interpolate
-    anything else given at ``points`` the same way)."""
+    anything else given at ``points`` the same way). ``lengths`` (one per segment of ``points``):
+    how far each segment moves what is placed along it, when that is more than its chord (a tool
+    that turns as it goes), in place of the chord."""
     if points.shape[0] == 1 or (segments is not None and segments.size == 0):
         dense = points.copy() if points.shape[0] == 1 else points[:0]
         return (dense, np.zeros(len(dense), dtype=np.int64), np.zeros(len(dense))) if weights else dense
     if segments is None:
         segments = np.arange(points.shape[0] - 1)
     starts, ends = points[segments], points[segments + 1]
-    pieces = np.maximum(np.ceil(np.linalg.norm(ends - starts, axis=1) / step).astype(np.int64), 1) + 1
+    moved = np.linalg.norm(ends - starts, axis=1) if lengths is None else lengths[segments]
+    pieces = np.maximum(np.ceil(moved / step).astype(np.int64), 1) + 1
     total = int(pieces.sum())
     if total > get_limits().max_samples * 4:
         raise ValueError(f"the trajectory needs {total:,} checks at steps of {step:g}; use a larger step")
