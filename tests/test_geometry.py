@@ -6,6 +6,7 @@ import sys
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import bidmp
 from bidmp import scenarios
@@ -160,8 +161,10 @@ def test_gprm_routes_the_transfer_around_a_part_in_its_way(nut):
     demo = nut.demonstration
     target = np.array([150.0, 25.0, 0.0])
     blind = extend_demonstration(demo, target, seed=0)
-    # A block on the blind transfer's way, half-way along it, with room around it.
-    middle = blind.complete[(blind.seg_index + blind.approach_index) // 2]
+    # A block on the blind transfer's way, half-way along it, with room around it (the transfer
+    # ends where the kept approach, the demonstration's last samples from approach_index, begins).
+    hover = len(blind.complete) - (len(demo) - blind.approach_index)
+    middle = blind.complete[(blind.seg_index + hover) // 2]
     block = {"type": "cylinder", "label": "block", "at": (middle - [0, 0, 10]).tolist(), "radius": 3, "height": 20}
     scene = scene_of(block)
     assert not scene.clearance(blind.complete).collision_free
@@ -342,34 +345,40 @@ def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
 
 
 # --- issue 21.4 (opt-in): a clearance margin ---------------------------------------------------------
-def _post_scene(margin):
+def _post_scene(margin, at=(22.5, -27.6)):
     base = scenarios.load("nut-unscrewing")
     data = base.to_dict()["scene"]
-    data["parts"] = [*data["parts"], {"type": "cylinder", "label": "post", "at": [22.5, -27.6, -2], "radius": 8,
+    data["parts"] = [*data["parts"], {"type": "cylinder", "label": "post", "at": [at[0], at[1], -2], "radius": 8,
                                       "height": 200}]
     if margin:
         data["margin"] = margin
     return base, Scene.from_dict(data, base.targets)
 
 
-def _post_clearance(path):
+def _post_clearance(path, at=(22.5, -27.6)):
     """Closed form: the tool (radius 12.5, above the path) beside the vertical post (radius 8) whose
     height spans the tool's here: horizontal distance between the axes less both radii."""
     fine = np.vstack([path[i] + np.linspace(0.0, 1.0, 25)[:, None] * (path[i + 1] - path[i]) for i in range(len(path) - 1)])
-    return float(np.min(np.hypot(fine[:, 0] - 22.5, fine[:, 1] + 27.6)) - 20.5)
+    return float(np.min(np.hypot(fine[:, 0] - at[0], fine[:, 1] - at[1])) - 20.5)
 
 
 @pytest.mark.parametrize("seed", [1, 2])
 def test_an_extension_keeps_the_scenes_margin_from_every_part(seed):
-    """A post 3 mm beside the straight transfer: without a margin the extension grazes it (1.8-2 mm),
-    with a 5 mm margin the planned transfer and the sampled extension keep 5 mm, by the closed form."""
-    base, bare = _post_scene(0.0)
-    _, kept = _post_scene(5.0)
+    """A post 2 mm beside the straight transfer (placed from the blind extension's own transfer):
+    without a margin the extension grazes it, with a 5 mm margin the planned transfer and the
+    sampled extension keep 5 mm, by the closed form."""
+    base = scenarios.load("nut-unscrewing")
     target = [150.0, 25.0, 0.0]
+    blind = extend_demonstration(base.demonstration, target, seed=seed)
+    chord = blind.tra_gen[-1, :2] - blind.tra_gen[0, :2]
+    across = np.array([chord[1], -chord[0]]) / np.linalg.norm(chord)
+    at = tuple((blind.tra_gen[0, :2] + chord / 2 + (20.5 + 2.0) * across).tolist())
+    _, bare = _post_scene(0.0, at)
+    _, kept = _post_scene(5.0, at)
     close = extend_demonstration(base.demonstration, target, seed=seed, scene=bare)
     far = extend_demonstration(base.demonstration, target, seed=seed, scene=kept)
-    assert _post_clearance(close.complete) < 5.0  # the check can fail
-    assert _post_clearance(far.tra_gen) >= 5.0 - 1e-9 and _post_clearance(far.complete) >= 5.0 - 1e-6
+    assert _post_clearance(close.complete, at) < 5.0  # the check can fail
+    assert _post_clearance(far.tra_gen, at) >= 5.0 - 1e-9 and _post_clearance(far.complete, at) >= 5.0 - 1e-6
     assert kept.clearance(far.complete, exclude=kept.parts_at(target)).clear
 
 
@@ -437,3 +446,19 @@ def test_a_part_at_its_stand_off_does_not_hide_another_inside_the_margin():
         scene_of(plate, margin=3.0, standoff={"ring": 1.0})
     with pytest.raises(SceneError, match=r"standoff.plate: expected a clearance in \[0, the margin 3\]"):
         scene_of(plate, margin=3.0, standoff={"plate": 4.0})
+
+
+def test_a_tool_turning_in_place_is_checked_along_its_sweep():
+    """The tool's tip stays put while it turns 90 degrees about x (its body from up to along +y,
+    two samples): the body sweeps a quarter disc of radius 100 through a block at 45 degrees, 70
+    from the tip, which neither end pose comes near. Placements spaced by the tip's travel alone
+    (zero here) saw only the two end poses and reported it clear; spaced by the sweep, the block
+    is hit."""
+    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 100.0},
+                             "parts": [{"type": "box", "label": "block", "at": [0.0, 49.5, 44.5], "size": [10.0, 10.0, 10.0]}]})
+    poses = (Rotation.from_euler("x", [[0.0], [-90.0]], degrees=True) * Rotation.from_euler("x", 180.0, degrees=True)).as_quat()
+    tip = np.zeros((2, 3))
+    for pose in poses:
+        assert scene.clearance(tip[:1], orientations=pose[None]).distance > 30.0
+    swept = scene.clearance(tip, orientations=poses)
+    assert not swept.collision_free and swept.part == "block"
