@@ -144,30 +144,95 @@ def test_a_free_transfer_is_the_template_itself():
         assert arc(transfer) <= 1.02 * length
 
 
+def log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
+    """LDJ (Hogan & Sternad 2009): -ln(T^5 / v_peak^2 * integral |jerk|^2 dt), central differences."""
+    velocity = np.gradient(points, dt, axis=0)
+    jerk = np.gradient(np.gradient(velocity, dt, axis=0), dt, axis=0)
+    duration, peak = dt * (len(points) - 1), np.max(np.linalg.norm(velocity, axis=1))
+    return float(-np.log(duration**5 / peak**2 * np.trapezoid(np.sum(jerk**2, axis=1), dx=dt)))
+
+
+def transfer(extension, n_demo: int) -> np.ndarray:
+    """The timed transfer inside ``complete``: seg to where the kept approach begins."""
+    return extension.complete[extension.seg_index : len(extension.complete) - (n_demo - extension.approach_index) + 1]
+
+
+def shortest_around(a: np.ndarray, b: np.ndarray, centre: np.ndarray, keep: float) -> float:
+    """Closed form: the shortest route from a to b that keeps ``keep`` from a vertical line through
+    ``centre`` (tangent, arc, tangent in the plane; the height change along it)."""
+    a2, b2, c2 = a[:2], b[:2], centre[:2]
+    chord = b2 - a2
+    nearest = a2 + np.clip(np.dot(c2 - a2, chord) / np.dot(chord, chord), 0.0, 1.0) * chord
+    if np.linalg.norm(nearest - c2) >= keep:
+        flat = float(np.linalg.norm(chord))
+    else:
+        ca, cb = a2 - c2, b2 - c2
+        na, nb = np.linalg.norm(ca), np.linalg.norm(cb)
+        angle = np.arccos(np.clip(np.dot(ca, cb) / (na * nb), -1.0, 1.0))
+        flat = np.sqrt(na**2 - keep**2) + np.sqrt(nb**2 - keep**2) + keep * (angle - np.arccos(keep / na) - np.arccos(keep / nb))
+    return float(np.hypot(flat, b[2] - a[2]))
+
+
+def dense(path: np.ndarray, n: int = 50) -> np.ndarray:
+    return np.concatenate([a + np.linspace(0, 1, n)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])])
+
+
 @pytest.mark.parametrize("margin", [0.0, 3.0])
-def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin):
+@pytest.mark.parametrize("post_radius", [5.0, 10.0, 20.0])
+def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin, post_radius):
     """A tall post on the straight transfer: the transfer keeps the tool radius plus the margin
-    from the post's axis (checked densely by hand, not by coal) and is no longer than 1.05 times
-    the shortest free route (tangent, arc, tangent around the inflated post: closed form)."""
+    from the post's axis (checked densely by hand, not by coal), is no longer than 1.05 times the
+    shortest free route (closed form), keeps the demonstration's peaks, and its log dimensionless
+    jerk is within 0.3 of the free transfer's (the template's, timed the same way). Before the
+    quintic route spline and the spline timing: -17.3 to -18.8 against the template's -10.4."""
     demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
     target = np.array([100.0, 300.0, 0.0])
     blind = extend_demonstration(demo, target, seed=0)
     seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
     centre = (seg + hover) / 2
-    post_radius = 10.0
     post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -200.0], "radius": post_radius,
             "height": 600.0}
     scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
     extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
-    transfer = extension.tra_gen
+    path = extension.tra_gen
     assert extension.refinement in ("smoothed", "shortcut")
-    dense = np.concatenate([a + np.linspace(0, 1, 50)[:, None] * (b - a) for a, b in zip(transfer[:-1], transfer[1:])])
     keep = post_radius + TOOL["radius"] + margin
-    assert np.min(np.linalg.norm(dense[:, :2] - centre[:2], axis=1)) >= keep - 1e-6
-    half = np.linalg.norm(hover[:2] - seg[:2]) / 2
-    shortest = 2 * np.sqrt(half**2 - keep**2) + keep * (np.pi - 2 * np.arccos(keep / half))
-    shortest = np.hypot(shortest, hover[2] - seg[2])
-    assert arc(transfer) <= 1.05 * shortest, (arc(transfer), shortest)
+    assert np.min(np.linalg.norm(dense(path)[:, :2] - centre[:2], axis=1)) >= keep - 1e-6
+    assert arc(path) <= 1.05 * shortest_around(seg, hover, centre, keep), arc(path)
+    assert np.all(peaks(extension.complete, 1 / 300) <= 1.1 * peaks(demo, 1 / 300))
+    smoothness = log_dimensionless_jerk(transfer(extension, 300), 1 / 300)
+    assert smoothness >= log_dimensionless_jerk(transfer(blind, 300), 1 / 300) - 0.3
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_a_transfer_around_a_random_post(seed):
+    """Random demonstrations (mm or m, 150-600 samples), far targets and a post anywhere near the
+    transfer's middle, of a size up to a quarter of the transfer: the route keeps the tool off the
+    post by the margin (by hand), is no longer than 1.05 times the shortest free route (closed
+    form) and the extended demonstration keeps within 1.1 times the demonstration's peaks. (Its
+    smoothness is measured, not bounded: a route that must bow sideways by a tenth of its length
+    or more is rougher than a straight one; the closing note of issue 21 gives the numbers.)"""
+    rng = np.random.default_rng(seed)
+    demo, unit = random_demonstration(rng)
+    extent = np.ptp(demo, axis=0).max()
+    heading = rng.uniform(0.0, 2.0 * np.pi)
+    target = demo[-1] + np.append(np.array([np.cos(heading), np.sin(heading)]) * rng.uniform(1.5, 3.0) * extent, 0.0)
+    blind = extend_demonstration(demo, target, seed=seed)
+    seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
+    tool = {"radius": rng.uniform(6, 14) * unit, "length": 100 * unit}
+    post_radius, margin = rng.uniform(3, 12) * unit, rng.uniform(0, 3) * unit
+    keep = post_radius + tool["radius"] + margin
+    centre = seg + rng.uniform(0.35, 0.65) * (hover - seg)
+    centre[:2] += rng.uniform(-0.5, 0.5, 2) * post_radius
+    assert keep <= 0.25 * np.linalg.norm(hover - seg)
+    post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -300 * unit], "radius": post_radius,
+            "height": 800 * unit}
+    extension = extend_demonstration(demo, target, seed=seed,
+                                     scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}))
+    assert np.min(np.linalg.norm(dense(extension.complete, 10)[:, :2] - centre[:2], axis=1)) >= keep - 1e-6 * unit
+    assert arc(extension.tra_gen) <= 1.05 * shortest_around(seg, hover, centre, keep)
+    dt = 1.0 / len(demo)
+    assert np.all(peaks(extension.complete, dt) <= 1.1 * peaks(demo, dt)), peaks(extension.complete, dt) / peaks(demo, dt)
 
 
 @pytest.mark.parametrize("height", [100.0, 130.0])

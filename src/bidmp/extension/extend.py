@@ -41,7 +41,7 @@ from .._checks import as_point, as_trajectory, check_choice, check_real, numeric
 from .._trajectory import arclength, path_extent, resample_time
 from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
-from .refine import lifted_route, refine_transfer, smoothest_free
+from .refine import lifted_route, refine_transfer, smoothest_free_route
 from .timing import time_path, timed_transfer
 
 __all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
@@ -396,7 +396,7 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
             if route is None:
                 raise first from None
             logger.info("no free route around: over, at %.4g", route[1, 2])
-            smooth = smoothest_free(route, is_free)
+            smooth = smoothest_free_route(route, is_free)
             return None, route if smooth is None else smooth, "lifted"
     tra_gen, refinement = refine_transfer(result.path, result.template, is_free)
     return result, tra_gen, refinement

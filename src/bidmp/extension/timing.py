@@ -106,7 +106,8 @@ class _Joins:
     and where the kept approach takes over, and their components along the transfer's own
     direction there (0 where it turns away by 90° or more), which its arc-length profile keeps."""
 
-    def __init__(self, y: np.ndarray, seg_index: int, approach_index: int, dt: float, path: np.ndarray) -> None:
+    def __init__(self, y: np.ndarray, seg_index: int, approach_index: int, dt: float, path: np.ndarray,
+                 point_at) -> None:
         # Local cubic fits (Savitzky–Golay derivatives): a recording's noise would swamp plain
         # second differences at one sample.
         window = min(_DERIVATIVE_WINDOW, len(y) - 1 + len(y) % 2)
@@ -121,6 +122,15 @@ class _Joins:
         self.velocities = (velocity[seg_index], velocity[approach_index] if ends else zero)
         self.accelerations = (acceleration[seg_index], acceleration[approach_index] if ends else zero)
         self.directions = (_unit(path[1] - path[0]), _unit(path[-1] - path[-2]))
+        # The path's own bend at its ends: moving along it at speed v adds v² p''(s) to the
+        # acceleration, which the blends must take out too (else the acceleration steps at the
+        # join, a jerk spike of one sample whatever the duration).
+        self.bends = (np.zeros(y.shape[1]), np.zeros(y.shape[1]))
+        if hasattr(point_at, "derivative"):
+            tangent, bend = point_at.derivative(1), point_at.derivative(2)
+            ends = (0.0, float(point_at.t[-1]))
+            self.directions = tuple(_unit(tangent(end)) for end in ends)
+            self.bends = tuple(bend(end) / max(float(np.dot(tangent(end), tangent(end))), 1e-300) for end in ends)
         speeds = [max(float(v @ d), 0.0) for v, d in zip(self.velocities, self.directions)]
         # The profile along the path: leave and arrive with the speed along it (accelerations are
         # left to the blends: kept over the whole transfer, they would make a long one run back).
@@ -132,7 +142,9 @@ class _Joins:
         out = []
         for end in (0, 1):
             d = self.directions[end]
-            out += [self.velocities[end] - along[2 * end] * d, self.accelerations[end] - along[2 * end + 1] * d]
+            speed = along[2 * end]
+            out += [self.velocities[end] - speed * d,
+                    self.accelerations[end] - along[2 * end + 1] * d - speed**2 * self.bends[end]]
         return tuple(out)
 
 
@@ -179,6 +191,27 @@ def _corner_blends(times: np.ndarray, duration: float, mismatches: tuple, limit:
     return offsets
 
 
+_SMOOTH_TURN = np.radians(5.0)  # a path turning less at every vertex is taken as samples of a smooth curve
+
+
+def _path_function(path: np.ndarray, s: np.ndarray):
+    """Points at arc lengths along ``path``: a cubic spline by arc length through its vertices when
+    it samples a smooth curve (every vertex turns less than 5°), else the polyline itself (its
+    corners are the route's, checked as such). A polyline through a smooth curve's samples turns
+    at every vertex in one time step: at the robot's rate that is an acceleration and jerk spike
+    per vertex, which the timing would answer by slowing the whole transfer down."""
+    from scipy.interpolate import make_interp_spline
+
+    pieces = np.diff(path, axis=0)
+    lengths = np.linalg.norm(pieces, axis=1)
+    if path.shape[0] < 4 or np.any(lengths <= 0.0):
+        return lambda arc: interp_columns(arc, s, path)
+    cosines = np.sum(pieces[1:] * pieces[:-1], axis=1) / (lengths[1:] * lengths[:-1])
+    if np.any(cosines < np.cos(_SMOOTH_TURN)):
+        return lambda arc: interp_columns(arc, s, path)
+    return make_interp_spline(s, path, k=3)
+
+
 def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_index: int, approach: np.ndarray,
                    dt: float) -> np.ndarray:
     """Samples along ``path`` (excluding its start, ending exactly at its end) from the
@@ -197,7 +230,8 @@ def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_ind
     n_own = max(approach_index - seg_index, 1)
     if s[-1] <= 0.0 or path.shape[0] < 2:
         return np.repeat(path[-1:], n_own, axis=0)
-    joins = _Joins(y, seg_index, approach_index, dt, path)
+    point_at = _path_function(path, s)
+    joins = _Joins(y, seg_index, approach_index, dt, path, point_at)
     limit = motion_peaks(y, dt)
     before, after = y[max(seg_index - 3, 0) : seg_index + 1], approach[:3]
     best, best_excess, n_steps = None, np.inf, n_own
@@ -209,7 +243,7 @@ def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_ind
             arc = _quintic_profile(s[-1], along, duration, n_steps)
             if np.all(np.diff(arc, prepend=0.0) >= -1e-12 * s[-1]):
                 break
-        positions = interp_columns(arc, s, path)
+        positions = point_at(arc)
         positions += _corner_blends(np.arange(1, n_steps + 1) * dt, duration, joins.mismatches(along), limit)
         positions[-1] = path[-1]
         # Within the demonstration's peaks along the transfer; at the joins, where a

@@ -1,0 +1,134 @@
+"""How smooth and how long an extension's transfer is where a part forces a detour (issue 21.2).
+
+    .venv/bin/python tools/extension_smoothness.py [--random N]
+
+Printed, for a demonstration that comes to rest at a corner and a target 300 mm sideways:
+
+* a tall post on the straight transfer (radius 5/10/20 mm, margin 0/3 mm): the transfer's log
+  dimensionless jerk (LDJ, Hogan & Sternad 2009: -ln(T^5 / v_peak^2 * integral |jerk|^2)) beside
+  the free transfer's (the template, timed the same way), its length over the shortest free route
+  (closed form: tangent, arc, tangent), the whole extended demonstration's peaks over the
+  demonstration's;
+* a cable duct across the plate (60/100/130 mm tall): the same, the shortest route not in closed
+  form;
+* N random demonstrations (mm or m, 150-600 samples) with a post near the transfer's middle: the
+  LDJ difference against the post's size relative to the transfer (the tool radius plus the post
+  radius plus the margin, over the chord), and the length ratio.
+
+All derivatives by central differences (``numpy.gradient``) on the extension's own samples.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+from extension_pace import peaks  # the same estimator as the pace script (central differences)
+
+from bidmp.datasets import minimum_jerk
+from bidmp.extension import extend_demonstration
+from bidmp.geometry import Scene
+
+TOOL = {"radius": 12.5, "length": 100.0}
+
+
+def ldj(points: np.ndarray, dt: float) -> float:
+    velocity = np.gradient(points, dt, axis=0)
+    jerk = np.gradient(np.gradient(velocity, dt, axis=0), dt, axis=0)
+    duration, peak = dt * (len(points) - 1), np.max(np.linalg.norm(velocity, axis=1))
+    return float(-np.log(duration**5 / peak**2 * np.trapezoid(np.sum(jerk**2, axis=1), dx=dt)))
+
+
+def transfer(extension, n_demo: int) -> np.ndarray:
+    return extension.complete[extension.seg_index : len(extension.complete) - (n_demo - extension.approach_index) + 1]
+
+
+def length(path: np.ndarray) -> float:
+    return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+
+
+def shortest_around(a, b, centre, keep) -> float:
+    a2, b2, c2 = a[:2], b[:2], centre[:2]
+    chord = b2 - a2
+    nearest = a2 + np.clip(np.dot(c2 - a2, chord) / np.dot(chord, chord), 0.0, 1.0) * chord
+    if np.linalg.norm(nearest - c2) >= keep:
+        return float(np.hypot(np.linalg.norm(chord), b[2] - a[2]))
+    ca, cb = a2 - c2, b2 - c2
+    na, nb = np.linalg.norm(ca), np.linalg.norm(cb)
+    angle = np.arccos(np.clip(np.dot(ca, cb) / (na * nb), -1.0, 1.0))
+    flat = np.sqrt(na**2 - keep**2) + np.sqrt(nb**2 - keep**2) + keep * (angle - np.arccos(keep / na) - np.arccos(keep / nb))
+    return float(np.hypot(flat, b[2] - a[2]))
+
+
+def row(label, extension, blind, demo, dt, shortest=None) -> str:
+    n = len(demo)
+    ratio = peaks(extension.complete, dt) / peaks(demo, dt)
+    shortest_text = "   -  " if shortest is None else f"{length(extension.tra_gen) / shortest:6.3f}"
+    return (f"{label:28s} {extension.refinement:9s} {ldj(transfer(extension, n), dt):7.2f} {ldj(transfer(blind, n), dt):7.2f}"
+            f"   {shortest_text}   {ratio[0]:.2f} {ratio[1]:.2f} {ratio[2]:.2f}")
+
+
+def fixed_cases() -> None:
+    print("case                         transfer  LDJ    template  length/shortest  peaks (speed acc jerk)")
+    demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
+    target = np.array([100.0, 300.0, 0.0])
+    blind = extend_demonstration(demo, target, seed=0)
+    seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
+    centre = (seg + hover) / 2
+    for margin in (0.0, 3.0):
+        for radius in (5.0, 10.0, 20.0):
+            post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -200.0], "radius": radius, "height": 600.0}
+            scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
+            extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+            keep = radius + TOOL["radius"] + margin
+            print(row(f"post r={radius:g} margin={margin:g}", extension, blind, demo, 1 / 300,
+                      shortest_around(seg, hover, centre, keep)))
+    demo = minimum_jerk([[-80, -120, 200], [0, 0, 40], [0, 0, 0]], 200)
+    target = np.array([150.0, 25.0, 0.0])
+    blind = extend_demonstration(demo, target, seed=0)
+    for height in (60.0, 100.0, 130.0):
+        duct = {"type": "box", "label": "duct", "at": [75.0, 0.0, 0.0], "size": [20.0, 2000.0, height]}
+        extension = extend_demonstration(demo, target, seed=0, scene=Scene.from_dict({"tool": TOOL, "parts": [duct], "margin": 3.0}))
+        print(row(f"duct {height:g} mm", extension, blind, demo, 1 / 200))
+
+
+def random_cases(count: int) -> None:
+    print("\nrandom posts: seed  unit  post size / chord  LDJ worse by  length/shortest  peaks max")
+    for seed in range(count):
+        rng = np.random.default_rng(seed)
+        unit = float(rng.choice([1.0, 1e-3]))
+        start = rng.uniform(-100, 100, 3) + [0, 0, 80]
+        corner = start + np.append(rng.uniform(-150, 150, 2), rng.uniform(-20, 20))
+        n = int(rng.integers(150, 600))
+        demo = minimum_jerk(np.array([start, corner, corner - [0, 0, rng.uniform(30, 80)]]) * unit, n)
+        heading = rng.uniform(0.0, 2.0 * np.pi)
+        target = demo[-1] + np.append(np.array([np.cos(heading), np.sin(heading)]) * rng.uniform(1.5, 3.0) * np.ptp(demo, axis=0).max(), 0.0)
+        blind = extend_demonstration(demo, target, seed=seed)
+        seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
+        tool = {"radius": rng.uniform(6, 14) * unit, "length": 100 * unit}
+        radius, margin = rng.uniform(3, 20) * unit, rng.uniform(0, 3) * unit
+        centre = seg + rng.uniform(0.3, 0.7) * (hover - seg)
+        centre[:2] += rng.uniform(-0.5, 0.5, 2) * radius
+        keep = radius + tool["radius"] + margin
+        if min(np.linalg.norm(seg[:2] - centre[:2]), np.linalg.norm(hover[:2] - centre[:2])) <= keep:
+            print(f"  {seed:4d}  skipped: the post is within reach of the transfer's start or end")
+            continue
+        post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -300 * unit], "radius": radius, "height": 800 * unit}
+        extension = extend_demonstration(demo, target, seed=seed, scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}))
+        worse = ldj(transfer(blind, n), 1 / n) - ldj(transfer(extension, n), 1 / n)
+        ratio = length(extension.tra_gen) / shortest_around(seg, hover, centre, keep)
+        top = (peaks(extension.complete, 1 / n) / peaks(demo, 1 / n)).max()
+        print(f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}"
+              f"  {ratio:15.3f}  {top:9.2f}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--random", type=int, default=24, help="random post cases (default 24)")
+    args = parser.parse_args()
+    fixed_cases()
+    random_cases(args.random)
+
+
+if __name__ == "__main__":
+    main()
