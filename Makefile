@@ -19,7 +19,7 @@ demo: $(STAMP)
 	$(VENV)/bin/bidmp demo
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2
 
 # The long hypothesis campaign (tests/test_fuzz.py x20: over 10 000 generated inputs); writes
 # the outcome counts to fuzz-report.json.
@@ -33,7 +33,7 @@ sim: $(STAMP)
 
 # Issue 21.9's property on 300 random cells (the tests draw 30).
 random-cells: $(STAMP)
-	BIDMP_RANDOM_CELLS=300 $(VENV)/bin/python -m pytest -q tests/test_random_cells.py
+	BIDMP_RANDOM_CELLS=300 $(VENV)/bin/python -m pytest -q tests/test_random_cells.py tests/test_random_tilted_cells.py
 
 # The full LASA benchmark (30 shapes x 7 demonstrations, every method) on the embedded Dask
 # cluster, into bidmp-lasa/ (resumable: rerun to finish an interrupted sweep).
