@@ -71,7 +71,7 @@ def get(name: str) -> Method:
     _load_builtins()
     if not isinstance(name, str) or name not in _REGISTRY:
         shown = name if isinstance(name, str) else type(name).__name__
-        raise ValueError(f"unknown method {shown[:40]!r}; known: {', '.join(_REGISTRY)}")
+        raise ValueError(f"unknown method {shown[:40]!r}; known: {', '.join(names())}")
     return _REGISTRY[name]
 
 
