@@ -10,11 +10,11 @@ gate fails the same checks (so they can fail).
 
 import numpy as np
 import pytest
+from bidmp.datasets import minimum_jerk
 from sklearn.base import clone
 
 import bidmp
-from bidmp.datasets import minimum_jerk
-from bidmp.primitives.approach import straight_tail_start
+from bidmp.primitives.approach import _straight_tail_start
 
 
 def smooth(s):
@@ -73,7 +73,7 @@ def test_the_goal_share_is_monotone_and_complete_at_the_approach(seed):
     # stated bound, README "Robot protocol"), so "monotone" and "in [0, 1]" hold to that.
     assert share.min() >= -2e-4 and share.max() <= 1.0 + 2e-4
     assert np.all(np.diff(share) >= -2e-4)  # never backwards
-    start = straight_tail_start(y)
+    start = _straight_tail_start(y)
     assert abs(start - approach_start) <= 0.05 * len(y)  # the detector finds the demonstrated approach
     approach_time = t[start] - t[0]
     np.testing.assert_allclose(share[base.t >= approach_time], 1.0, atol=2e-4)
@@ -83,7 +83,7 @@ def test_without_a_straight_approach_the_progress_gate_is_kept():
     s = np.linspace(0.0, 1.0, 300)
     curved = np.column_stack([100 * np.cos(6 * s), 100 * np.sin(6 * s), 50 * s])  # an arc to the end
     # Its last few samples are straight to 2 % of their short chord, but far shorter than an approach.
-    assert len(curved) - straight_tail_start(curved) < 0.05 * len(curved)
+    assert len(curved) - _straight_tail_start(curved) < 0.05 * len(curved)
     keep = bidmp.DMP(keep_approach=True).fit(curved)
     plain = bidmp.DMP().fit(curved)
     np.testing.assert_array_equal(keep.goal_gate_, plain.goal_gate_)

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
+from bidmp.bls import PINV_RCOND, block_pinv_update, sparse_autoencoder
 
 import bidmp
 from bidmp import BLS
-from bidmp.bls import PINV_RCOND, block_pinv_update, sparse_autoencoder
 
 
 def random_problem(seed=0, n_rows=300, n_inputs=5):

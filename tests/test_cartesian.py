@@ -6,13 +6,20 @@ import warnings
 
 import numpy as np
 import pytest
+from bidmp.cartesian import (
+    CartesianBiDMP,
+    CartesianDMP,
+    angle_between,
+    pose_forgetting,
+    prepare_poses,
+)
+from bidmp.datasets import kinesthetic_recording, minimum_jerk
 from scipy.spatial.transform import Rotation
 
 import bidmp
-from bidmp.cartesian import CartesianBiDMP, CartesianDMP, angle_between, left_jacobian, pose_forgetting, prepare_poses
-from bidmp.datasets import kinesthetic_recording, minimum_jerk
 from bidmp.extension import extend_pose_demonstration
 from bidmp.io import read_poses, save_poses
+from bidmp.primitives.so3 import _left_jacobian as left_jacobian
 
 DOWN = Rotation.from_euler("x", 180, degrees=True)
 

@@ -2,12 +2,11 @@
 
 import numpy as np
 import pytest
-
-import bidmp
-
-from bidmp import extend_demonstration
 from bidmp.datasets import lasa, minimum_jerk
 from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+
+import bidmp
+from bidmp import extend_demonstration
 
 
 @pytest.fixture(scope="module")

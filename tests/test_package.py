@@ -10,6 +10,7 @@ import pytest
 import bidmp
 
 SRC = pathlib.Path(bidmp.__file__).parent
+ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def test_public_names_resolve():
@@ -172,3 +173,72 @@ def test_the_size_check_sees_long_functions_classes_and_modules_docstrings_inclu
     found = oversized(f"class C:\n{methods}", "probe")
     assert found == ["probe:1 class C: 252 lines"]
     assert oversized("x = 1\n" * 501, "probe") == ["probe: 501 lines"]
+
+
+# --- issue 22.1: the public surface is each package's __all__; everything else has an underscore --
+API_PACKAGES = ("bidmp.primitives", "bidmp.demonstrations", "bidmp.extension", "bidmp.incremental", "bidmp.baselines",
+                "bidmp.scene", "bidmp.io", "bidmp.tasks", "bidmp.tasks.methods", "bidmp.sim", "bidmp.sim.pybullet",
+                "bidmp.experiments", "bidmp.plotting", "bidmp.cli")
+
+
+def _owner(module_name: str) -> str:
+    """The package whose __all__ must list a public name of ``module_name``: the deepest of
+    API_PACKAGES that contains it."""
+    return max((p for p in API_PACKAGES if module_name == p or module_name.startswith(p + ".")), key=len)
+
+
+def _unlisted(module, listed: set) -> list[str]:
+    """Functions and classes defined in ``module`` whose names have no underscore and are not in
+    ``listed`` (its package's public names)."""
+    import inspect
+
+    return [f"{module.__name__}.{name}" for name, value in vars(module).items()
+            if not name.startswith("_") and (inspect.isfunction(value) or inspect.isclass(value))
+            and getattr(value, "__module__", None) == module.__name__ and name not in listed]
+
+
+def _public_modules():
+    import importlib
+    import pkgutil
+
+    for info in pkgutil.walk_packages(bidmp.__path__, "bidmp."):
+        if any(part.startswith("_") for part in info.name.split(".")[1:]) or info.name.startswith("bidmp.cli"):
+            continue
+        yield importlib.import_module(info.name)
+
+
+def test_every_public_name_is_listed_and_nothing_else_is_reachable_without_an_underscore():
+    import importlib
+
+    stray = []
+    for module in _public_modules():
+        if module.__name__.count(".") == 1 and module.__name__ not in API_PACKAGES:
+            continue  # an old flat path (bidmp.dmp, …): a view onto the new modules
+        owner = importlib.import_module(_owner(module.__name__))
+        stray += _unlisted(module, set(owner.__all__))
+    assert not stray, stray
+    for package in API_PACKAGES:
+        module = importlib.import_module(package)
+        for name in module.__all__:
+            value = getattr(module, name)  # every listed name resolves ...
+            if callable(value) and not isinstance(value, type(bidmp)):
+                assert (value.__doc__ or "").strip(), f"{package}.{name} has no docstring"  # ... and says what it is
+        hidden = [name for name in dir(module) if not name.startswith("_") and name not in module.__all__
+                  and name != "annotations" and not isinstance(getattr(module, name), type(bidmp))]
+        assert not hidden, (package, hidden)
+
+
+def test_the_surface_check_sees_an_unlisted_name():
+    import types
+
+    probe = types.ModuleType("bidmp.primitives.probe")
+    exec("def helper():\n    pass\n\ndef _private():\n    pass\n", probe.__dict__)  # noqa: S102
+    assert _unlisted(probe, set()) == ["bidmp.primitives.probe.helper"]
+    assert _unlisted(probe, {"helper"}) == []
+    assert _owner("bidmp.sim.pybullet.cell") == "bidmp.sim.pybullet"
+
+
+def test_the_api_reference_is_current():
+    result = subprocess.run([sys.executable, str(ROOT / "tools" / "api_reference.py"), "--check"], capture_output=True,
+                            text=True, check=False)
+    assert result.returncode == 0, result.stderr

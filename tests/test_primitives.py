@@ -12,11 +12,11 @@ Which checks show correctness and which guard structure:
 
 import numpy as np
 import pytest
+from bidmp.datasets import minimum_jerk, recording
 from scipy.spatial.transform import Rotation
 
 import bidmp
-from bidmp.datasets import minimum_jerk, recording
-from bidmp.primitives.coupling import ConstantAcceleration, PhaseStopping, as_couplings
+from bidmp.primitives.coupling import ConstantAcceleration, PhaseStopping, _as_couplings
 from bidmp.primitives.goals import DelayedGoal, PhaseGate, ProgressGate
 
 RELATIVE = 1e-9  # of each quantity's own peak over the motion
@@ -143,11 +143,11 @@ def test_phase_stopping_is_a_coupling_term_and_a_number_still_means_its_gain():
 
 def test_coupling_input_is_checked():
     with pytest.raises(TypeError, match="coupling"):
-        as_couplings("push")
+        _as_couplings("push")
     with pytest.raises(TypeError, match="callable"):
-        as_couplings([1.0])
+        _as_couplings([1.0])
     with pytest.raises(ValueError, match="coupling"):
-        as_couplings(-1.0)
+        _as_couplings(-1.0)
     dmp = bidmp.DMP().fit(minimum_jerk(np.array([[0.0], [1.0]]), n_steps=50))
     with pytest.raises(ValueError, match="non-finite"):
         dmp.trajectory(coupling=[lambda t, y, yd, phase: np.full_like(y, np.inf)])

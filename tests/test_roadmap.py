@@ -2,12 +2,13 @@
 
 import numpy as np
 import pytest
-
 from bidmp.datasets import minimum_jerk
 from bidmp.reproduce import compare_prm, table5_cases
-from bidmp.roadmap import NoFreeRouteError, classic_prm, gaussian_prm, shortest_path, template
-from bidmp._trajectory import resample_arclength
+from bidmp.roadmap import NoFreeRouteError, classic_prm, gaussian_prm, template
 from bidmp.similarity import frechet_similarity
+
+from bidmp._trajectory import resample_arclength
+from bidmp.extension.roadmap import _shortest_path as shortest_path
 
 
 @pytest.fixture

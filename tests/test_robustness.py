@@ -21,7 +21,13 @@ from conftest import curved_demo
 
 import bidmp
 from bidmp.cli import main
-from bidmp.io import ModelFileError, load_model, load_trajectory, save_model, save_trajectory
+from bidmp.io import (
+    ModelFileError,
+    load_model,
+    load_trajectory,
+    save_model,
+    save_trajectory,
+)
 
 PYTHON = sys.executable
 from bidmp.datasets import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)
@@ -438,7 +444,9 @@ def test_unstable_euler_settings_are_refused(tmp_path):
 
 
 def test_the_euler_stability_bound_is_the_closed_form_one():
-    from bidmp.dmp import euler_spectral_radius
+    from bidmp.primitives.integrate import (
+        _euler_spectral_radius as euler_spectral_radius,
+    )
 
     # Critically damped (beta = alpha/4): a double root 1 - h alpha / 2, stable iff h alpha < 4.
     for h_alpha in (0.1, 1.0, 2.0, 3.0, 3.99, 4.01, 5.0):

@@ -76,9 +76,10 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
     a 5e8-row extent: refused up front, in one line."""
     import time
 
+    from bidmp.metrics import path_extent
+
     from bidmp.extension.similarity import frechet_distance_reference
     from bidmp.incremental.bls import sparse_autoencoder
-    from bidmp.metrics import path_extent
 
     rng = np.random.default_rng(0)
     F, target = rng.normal(size=(30, 5)), rng.normal(size=(30, 2))
@@ -96,13 +97,18 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
 
 def test_the_rotation_helpers_name_their_arguments():
     """Issue 22.2: the SO(3) helpers passed their input to SciPy, whose messages name no argument,
-    and left_jacobian turned NaN into NaN."""
-    from bidmp.primitives.so3 import angle_between, continuous_log, left_jacobian, orientation_from_log
+    and _left_jacobian turned NaN into NaN."""
+    from bidmp.primitives.so3 import (
+        _left_jacobian,
+        angle_between,
+        continuous_log,
+        orientation_from_log,
+    )
 
     unit = np.array([[0.0, 0.0, 0.0, 1.0]])
     refused(ValueError, r"q must have shape \(n, 4\)", angle_between, np.ones((2, 3)), unit)
     refused(ValueError, r"goal contains a zero quaternion", continuous_log, unit, np.zeros(4))
-    refused(ValueError, r"r contains NaN", left_jacobian, np.full((2, 3), np.nan))
+    refused(ValueError, r"r contains NaN", _left_jacobian, np.full((2, 3), np.nan))
     refused(ValueError, r"error must have shape \(n, 3\)", orientation_from_log, np.ones((2, 4)), unit)
     refused(TypeError, r"q must be real numbers", angle_between, unit.astype(complex), unit)
     turn = np.array([[0.0, 0.0, np.sin(0.5), np.cos(0.5)]])  # 1 rad about z
@@ -111,7 +117,7 @@ def test_the_rotation_helpers_name_their_arguments():
 
 def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
     """Issue 22.2, the timing and pose helpers (each case below failed before: an internal error,
-    a silent NaN, a ComplexWarning or a RuntimeWarning): on 18 entry points x 16 nasty inputs,
+    a silent NaN, a ComplexWarning or a RuntimeWarning): on 17 entry points x 16 nasty inputs,
     every call returns finite numbers or raises ValueError/TypeError with a message of at most
     300 characters, and no warning escapes."""
     from bidmp.primitives import cartesian, timing
@@ -124,13 +130,13 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
              np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), -t, np.zeros(20), 5.0, ["a", "b"], True,
              y * 1e-300]
     calls = [
-        lambda v: timing.check_timestamps(v, 20), lambda v: timing.drop_duplicate_stamps(v, t),
-        lambda v: timing.drop_duplicate_stamps(y, v), lambda v: timing.uniform_time(v, t), lambda v: timing.uniform_time(y, v),
+        lambda v: timing.check_timestamps(v, 20), lambda v: timing._drop_duplicate_stamps(v, t),
+        lambda v: timing._drop_duplicate_stamps(y, v), lambda v: timing.uniform_time(v, t), lambda v: timing.uniform_time(y, v),
         lambda v: timing.on_uniform_time(v, t), lambda v: timing.on_uniform_time(y, v),
         lambda v: timing.scale_factor(v, max_velocity=1.0), lambda v: timing.scale_factor(trajectory, max_velocity=v),
         lambda v: timing.time_scale(v, max_velocity=1.0), lambda v: timing.time_scale(trajectory, max_velocity=v),
         cartesian.as_quaternions, cartesian.as_poses, cartesian.continuous_quaternions,
-        lambda v: cartesian.orientation_error(v, q), lambda v: cartesian.orientation_error(q, v), cartesian.left_jacobian,
+        lambda v: cartesian.orientation_error(v, q), lambda v: cartesian.orientation_error(q, v),
         lambda v: cartesian.angle_between(v, q),
     ]
     failures = nasty_failures(calls, nasty)
@@ -147,7 +153,7 @@ def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
     y = np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 20)
     nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
              np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
-    calls = [lambda v: roadmap.template(v, y[-1] + 5), lambda v: roadmap.template(y, v), roadmap.shortest_path,
+    calls = [lambda v: roadmap.template(v, y[-1] + 5), lambda v: roadmap.template(y, v), roadmap._shortest_path,
              similarity.polyline_length, lambda v: metrics.rmse(v, y), lambda v: metrics.rmse(y, v)]
     failures = nasty_failures(calls, nasty)
     assert not failures, failures

@@ -84,7 +84,13 @@ def __getattr__(name: str):
 
 
 if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from ._checks import Limits, MissingExtraError, NotFittedError, get_limits, set_limits  # noqa: F401
+    from ._checks import (  # noqa: F401
+        Limits,
+        MissingExtraError,
+        NotFittedError,
+        get_limits,
+        set_limits,
+    )
     from .demonstrations.prepare import prepare  # noqa: F401
     from .extension.extend import extend_demonstration  # noqa: F401
     from .extension.segmentation import Segmentation, segment  # noqa: F401

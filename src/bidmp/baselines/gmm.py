@@ -7,17 +7,24 @@ which is the point of the comparison in the paper's Table 4.
 
 from __future__ import annotations
 
-import numpy as np
-from sklearn.base import BaseEstimator
-
 import logging
 import warnings
 
+import numpy as np
+from sklearn.base import BaseEstimator
+
 from .._api import deprecated_alias
-from .._checks import as_trajectory, check_fitted, check_int, check_limit, check_real, numerically_guarded
+from .._checks import (
+    as_trajectory,
+    check_fitted,
+    check_int,
+    check_limit,
+    check_real,
+    numerically_guarded,
+)
 from .._noise import perturb
 
-__all__ = ["gmr", "augment", "fit_mixture", "GMMRegressor"]
+__all__ = ["gmr", "augment", "GMMRegressor"]
 
 logger = logging.getLogger(__name__)
 _EM_ITERATIONS = 100  # scikit-learn's max_iter default, used for the work bound
@@ -81,7 +88,7 @@ def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0)
     return np.stack([y] + [perturb(y, noise, rng) for _ in range(n_copies)])
 
 
-def fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int):
+def _fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: int):
     """EM for a full-covariance Gaussian mixture (scikit-learn): (weights, means, covariances).
 
     Runs with one BLAS/OpenMP thread, as the BLS does: EM on a few thousand 4–7-D points gains
@@ -169,7 +176,7 @@ class GMMRegressor(_AugmentedMixture):
         n_steps = demos.shape[1]
         t = np.linspace(0.0, 1.0, n_steps)
         data = np.concatenate([np.column_stack([t, demo]) for demo in demos])
-        self.weights_, self.means_, self.covariances_ = fit_mixture(data, self.n_components, self.reg_covar, self.seed)
+        self.weights_, self.means_, self.covariances_ = _fit_mixture(data, self.n_components, self.reg_covar, self.seed)
         self.n_steps_ = n_steps
         return self
 

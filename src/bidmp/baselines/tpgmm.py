@@ -15,7 +15,7 @@ import numpy as np
 
 from .._api import deprecated_alias, goal_first
 from .._checks import as_point, check_fitted, check_int, numerically_guarded
-from .gmm import _AugmentedMixture, _check_gmr_size, augment, fit_mixture, gmr
+from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, augment, gmr
 
 __all__ = ["TPGMM"]
 
@@ -66,7 +66,7 @@ class TPGMM(_AugmentedMixture):
         t = np.linspace(0.0, 1.0, n_steps)[:, None]
         # Identity orientations: local coordinates are translations (A_j⁻¹ = I).
         data = np.concatenate([np.hstack([t, demo - demo[0], demo - demo[-1]]) for demo in demos])
-        self.weights_, self.means_, self.covariances_ = fit_mixture(data, self.n_components, self.reg_covar, self.seed)
+        self.weights_, self.means_, self.covariances_ = _fit_mixture(data, self.n_components, self.reg_covar, self.seed)
         self.n_steps_, self.n_dims_ = n_steps, n_dims
         demonstration = np.asarray(y, dtype=np.float64)
         self.start_, self.goal_ = demonstration[0].copy(), demonstration[-1].copy()

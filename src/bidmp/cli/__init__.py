@@ -16,29 +16,31 @@ from __future__ import annotations
 import contextlib
 import logging
 import sys
-from collections.abc import Sequence
+from collections.abc import Sequence as _Sequence
 
 from .. import __version__
-from .common import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_OK, MAX_MESSAGE, MAX_SEEDS, Parser, one_line
+from .common import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_OK
+from .common import MAX_MESSAGE as _MAX_MESSAGE
+from .common import MAX_SEEDS as _MAX_SEEDS  # noqa: F401  (the name bidmp <= 0.4 had)
+from .common import Parser as _Parser
+from .common import one_line as _one_line
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_BROKEN_PIPE"]
 
-_MAX_SEEDS = MAX_SEEDS  # (the name bidmp <= 0.4 had)
 
-
-def build_parser() -> Parser:
+def build_parser() -> _Parser:
     """The ``bidmp`` parser: global options, then each command group's commands."""
     from . import experiments, skills, tasks
     from .common import allow_outside_files, parse_K
 
-    parser = Parser(
+    parser = _Parser(
         prog="bidmp",
         description="Learn robot movements from one demonstration: DMP, extended demonstrations, Bi-DMP.",
         epilog="Trajectory files are .csv (optional header x,y[,z] or t,x,y[,z]) or .npy of shape (T, D).",
     )
     parser.add_argument("--version", action="version", version=f"bidmp {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logging")
-    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     skills.add_commands(commands, parse_K, allow_outside_files)
     experiments.add_commands(commands)
     tasks.add_commands(commands)
@@ -59,7 +61,7 @@ class _BufferedLog(logging.Handler):
 
     def flush_to(self, stream) -> None:
         for record in self.records:
-            stream.write(" ".join(self.format(record).split())[:MAX_MESSAGE] + "\n")
+            stream.write(" ".join(self.format(record).split())[:_MAX_MESSAGE] + "\n")
         self.records.clear()
 
 
@@ -128,7 +130,7 @@ def _bad_input_message(exc: BaseException) -> str:
     return str(exc) or type(exc).__name__
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: _Sequence[str] | None = None) -> int:
     """Run the command line; return the exit code.
 
     Every failure is one line on stderr: exit 2 for bad input of any kind (including sizes over
@@ -166,12 +168,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             MissingExtraError) as exc:
         if args.debug:
             raise
-        print(f"bidmp {args.command}: error: {one_line(_bad_input_message(exc))}", file=sys.stderr)
+        print(f"bidmp {args.command}: error: {_one_line(_bad_input_message(exc))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except Exception as exc:  # noqa: BLE001 - the CLI promises no tracebacks
         if args.debug:
             raise
-        print(one_line(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)"),
+        print(_one_line(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)"),
               file=sys.stderr)
         return EXIT_INTERNAL
     finally:

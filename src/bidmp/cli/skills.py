@@ -14,11 +14,11 @@ EXIT_OK = 0
 def _skills_model(args: argparse.Namespace, command: str):
     """The model ``extend`` and ``learn`` grow, as a Bi-DMP (a DMP becomes its skill 0): a
     :class:`bidmp.BiDMP` or, for pose models, a :class:`bidmp.CartesianBiDMP`."""
-    from ..primitives.cartesian import CartesianDMP
-    from ..incremental.cartesian import CartesianBiDMP
-    from ..primitives.dmp import DMP
     from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
     from ..io.models import load_model
+    from ..primitives.cartesian import CartesianDMP
+    from ..primitives.dmp import DMP
 
     if not args.output.lower().endswith(".npz"):
         hint = "; use --save-demo to write the extended demonstration" if command == "extend" else ""
@@ -59,8 +59,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time
-    from ..primitives.dmp import DMP
     from ..io.models import save_model
+    from ..primitives.dmp import DMP
     from ..tasks.metrics import path_extent
 
     if is_pose_file(args.demo):
@@ -92,8 +92,8 @@ def _fit_poses(args: argparse.Namespace) -> int:
     """``bidmp fit`` on a pose recording: a CartesianDMP (prepared like positions unless --raw)."""
     import numpy as np
 
-    from ..primitives.cartesian import CartesianDMP, angle_between
     from ..io.models import save_model
+    from ..primitives.cartesian import CartesianDMP, angle_between
 
     poses, times, units, how = read_input(args.demo, args, poses=True)
     model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
@@ -137,8 +137,8 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
 
 
 def _skill_choice(args: argparse.Namespace, model):
-    from ..incremental.cartesian import CartesianBiDMP
     from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
 
     if not isinstance(model, (BiDMP, CartesianBiDMP)):
         if args.skill is not None:
@@ -150,13 +150,13 @@ def _skill_choice(args: argparse.Namespace, model):
 def cmd_rollout(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from ..primitives.cartesian import CartesianDMP, angle_between
-    from ..incremental.cartesian import CartesianBiDMP
-    from ..primitives.dmp import DMP
     from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
     from ..io.models import load_model
     from ..io.poses import save_poses
     from ..io.trajectories import save_trajectory
+    from ..primitives.cartesian import CartesianDMP, angle_between
+    from ..primitives.dmp import DMP
 
     model = load_model(args.model)
     if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
@@ -197,9 +197,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
 def cmd_segment(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from ..tasks._tables import text_table
     from .._trajectory import arclength, resample_arclength
     from ..extension.segmentation import curvature, segment
+    from ..tasks._tables import text_table
 
     y, _, units, how = read_input(args.demo, args, poses=is_pose_file(args.demo))
     y = y[:, :3] if is_pose_file(args.demo) else y
@@ -214,8 +214,8 @@ def cmd_segment(args: argparse.Namespace) -> int:
         ]
         print(text_table(["index", "curvature", "arc length %", f"position ({units or 'units'})"], rows))
     if args.plot:
-        from ..plotting.extension import plot_segmentation
         from ..extension.segmentation import MAX_ANALYSIS_POINTS
+        from ..plotting.extension import plot_segmentation
 
         kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
         print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
@@ -253,8 +253,8 @@ def cmd_extend(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .._trajectory import resample_time
-    from ..incremental.cartesian import CartesianBiDMP
     from ..extension.extend import extend_demonstration, extend_pose_demonstration
+    from ..incremental.cartesian import CartesianBiDMP
     from ..io.models import save_model
     from ..io.poses import save_poses
     from ..io.trajectories import save_trajectory

@@ -84,7 +84,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
     if args.sim:
-        from ..sim.pybullet.world import pybullet_module as _pybullet
+        from ..sim.pybullet.world import _pybullet_module as _pybullet
 
         _pybullet()
     report = _run_scenario(scenario, out, methods)
@@ -97,9 +97,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..tasks.scenarios import load
     from ..sim.backend import Hold
-    from ..sim.pybullet.world import pybullet_module as _pybullet
+    from ..sim.pybullet.world import _pybullet_module as _pybullet
+    from ..tasks.scenarios import load
 
     _pybullet()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)

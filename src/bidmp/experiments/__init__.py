@@ -42,6 +42,7 @@ _EXPORTS = {
     "BenchmarkResult": "lasa",
     "summary_rows": "lasa",
     "cell_key": "lasa",
+    "summary_markdown": "lasa",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -8,10 +8,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import check_int, check_real
-from ..tasks._tables import text_table
 from .._trajectory import path_extent, rmse
 from ..demonstrations.datasets import lasa
 from ..primitives.dmp import DMP
+from ..tasks._tables import text_table
 
 __all__ = ['GeneralisationResult', 'lasa_generalisation']
 

@@ -9,12 +9,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_points, check_int
-from ..tasks._tables import markdown_table, text_table
 from .._trajectory import path_extent, resample_time, rmse
 from ..demonstrations.datasets import lasa
-from ..primitives.dmp import DMP
 from ..extension.extend import extend_demonstration
 from ..incremental.bidmp import BiDMP, ForgettingResult, forgetting_runs
+from ..primitives.dmp import DMP
+from ..tasks._tables import markdown_table, text_table
 
 __all__ = ['LASA_TARGET_OFFSETS', 'FIGURE_SHAPES', 'IncrementalResult', 'lasa_incremental', 'Figures', 'run_figures']
 

@@ -43,7 +43,7 @@ import numpy as np
 
 from .._checks import check_choice, check_int, require_extra
 
-__all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key"]
+__all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key", "summary_markdown"]
 
 logger = logging.getLogger(__name__)
 
@@ -57,6 +57,7 @@ FORMAT = 3  # of the cell files (2: the robot protocol of issue 19; 3: a content
 
 
 def cell_key(shape: str, demo: int) -> str:
+    """The name of one benchmark cell (a LASA shape and a demonstration index), as in its file."""
     return f"{shape}__{demo}"
 
 
@@ -86,8 +87,8 @@ def _reference(demo: np.ndarray, offset: np.ndarray) -> np.ndarray:
 
 def _metrics(rollout: np.ndarray, reference: np.ndarray, goal: np.ndarray) -> dict:
     from .._trajectory import resample_time, rmse
-    from ..tasks.metrics import swept_area
     from ..extension.similarity import dtw_distance, frechet_distance
+    from ..tasks.metrics import swept_area
 
     aligned = resample_time(rollout, reference.shape[0])
     dtw = dtw_distance(aligned, reference)
@@ -438,6 +439,7 @@ def summary_rows(rows: list, metric: str) -> tuple[list[str], list[list[str]]]:
 
 
 def summary_markdown(rows: list, protocol: dict) -> str:
+    """The benchmark's Markdown summary (medians and ranges per method and case) from its rows."""
     from ..tasks._tables import markdown_table
 
     n_cells = len({(row["shape"], row["demo"]) for row in rows})

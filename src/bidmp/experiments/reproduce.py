@@ -14,23 +14,39 @@ import json
 import os
 from pathlib import Path
 
-
-from ..tasks.evaluation import write_report
 from ..io.atomic import atomic_write
+from ..tasks.evaluation import write_report
 
 # The paper's results, importable from one place (bidmp.reproduce of bidmp <= 0.4).
 from .generalisation import (  # noqa: F401
-    GeneralisationResult, lasa_generalisation,
+    GeneralisationResult,
+    lasa_generalisation,
 )
 from .incremental import (  # noqa: F401
-    LASA_TARGET_OFFSETS, FIGURE_SHAPES, IncrementalResult, lasa_incremental, Figures, run_figures,
+    FIGURE_SHAPES,
+    LASA_TARGET_OFFSETS,
+    Figures,
+    IncrementalResult,
+    lasa_incremental,
+    run_figures,
 )
 from .table4 import (  # noqa: F401
-    TABLE4_SCENARIOS, TASK_SCENARIOS, PAPER_TABLE4, PAPER_NUT_ERRORS, Table4, run_table4,
+    PAPER_NUT_ERRORS,
+    PAPER_TABLE4,
+    TABLE4_SCENARIOS,
+    TASK_SCENARIOS,
+    Table4,
+    run_table4,
 )
 from .table5 import (  # noqa: F401
-    MAX_SEEDS, BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET, table5_cases, PRMComparison, compare_prm,
-    Table5, run_table5,
+    BATTERY_APPROACH_VIA,
+    BATTERY_EXTENSION_TARGET,
+    MAX_SEEDS,
+    PRMComparison,
+    Table5,
+    compare_prm,
+    run_table5,
+    table5_cases,
 )
 
 __all__ = [

@@ -8,11 +8,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import check_int
-from ..tasks._tables import markdown_table, text_table
 from .._trajectory import path_extent
 from ..demonstrations.datasets import lasa, minimum_jerk
 from ..extension.extend import ExtendedDemonstration, extend_demonstration
 from ..extension.roadmap import RoadmapResult, classic_prm, gaussian_prm
+from ..tasks._tables import markdown_table, text_table
 
 __all__ = ['MAX_SEEDS', 'BATTERY_APPROACH_VIA', 'BATTERY_EXTENSION_TARGET', 'table5_cases', 'PRMComparison', 'compare_prm', 'Table5', 'run_table5']
 

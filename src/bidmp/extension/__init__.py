@@ -17,8 +17,6 @@ _EXPORTS = {
     "extend_demonstration": "extend",
     "extend_pose_demonstration": "extend",
     "final_approach": "extend",
-    "time_path": "timing",
-    "check_extension_options": "extend",
     "APPROACHES": "extend",
     "curvature": "segmentation",
     "segment": "segmentation",
@@ -35,8 +33,6 @@ _EXPORTS = {
     "template": "roadmap",
     "gaussian_prm": "roadmap",
     "classic_prm": "roadmap",
-    "shortest_path": "roadmap",
-    "check_options": "roadmap",
 }
 __all__ = list(_EXPORTS)
 # what the flat module bidmp.extension of bidmp <= 0.4 held, for code written against it

@@ -36,16 +36,21 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..primitives.approach import STRAIGHTNESS, straight_tail_start
-from .._checks import as_point, as_trajectory, check_choice, check_real, numerically_guarded
+from .._checks import (
+    as_point,
+    as_trajectory,
+    check_choice,
+    check_real,
+    numerically_guarded,
+)
 from .._trajectory import arclength, path_extent, resample_time
-from .roadmap import CollisionCallback, NoFreeRouteError, check_options, gaussian_prm
+from ..primitives.approach import STRAIGHTNESS, _straight_tail_start
+from .refine import _lifted_route, _refine_transfer, _smoothest_free_route
+from .roadmap import CollisionCallback, NoFreeRouteError, _check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
-from .refine import lifted_route, refine_transfer, smoothest_free_route
-from .timing import time_path, timed_transfer
+from .timing import _time_path, _timed_transfer
 
-__all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "time_path",
-           "check_extension_options", "APPROACHES"]
+__all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "APPROACHES"]
 
 APPROACHES = ("keep", "paper")
 _STRAIGHTNESS = STRAIGHTNESS  # an approach deviates from its chord by at most this fraction of the chord
@@ -170,10 +175,10 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     last = y.shape[0] - 1
     start = int(points[points < last].max()) if np.any(points < last) else 0
     # The last piece if it is straight, else its longest straight tail (primitives.approach).
-    return straight_tail_start(y, start, straightness)
+    return _straight_tail_start(y, start, straightness)
 
 
-def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, approach: str = "keep",
+def _check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, approach: str = "keep",
                             **roadmap_options) -> None:
     """Validate the options of :func:`extend_demonstration` without running it (what ``bidmp
     scenario check`` runs on a scenario's ``"extension"`` key); raise naming the first bad one."""
@@ -183,7 +188,7 @@ def check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence
     check_choice(method, "method", ("persistence", "paper"))
     check_choice(approach, "approach", APPROACHES)
     roadmap_options.pop("is_free", None)
-    check_options(seed=seed, **roadmap_options)
+    _check_options(seed=seed, **roadmap_options)
 
 
 @numerically_guarded
@@ -233,7 +238,7 @@ def extend_demonstration(
         "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
         "select": select, "denom": denom,
     }
-    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, **roadmap_options)
+    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, **roadmap_options)
     exclude, roadmap_options["is_free"], scene_checker = _scene_checker(scene, y, target, is_free)
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
@@ -308,7 +313,7 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
     mean_speed = arclength(tra_imi)[-1] / imi_duration
     if mean_speed <= 0.0:
         mean_speed = arclength(y)[-1]  # the piece does not move: use the demonstration's mean speed
-    timed, _ = time_path(tra_gen, start_speed, mean_speed, dt)
+    timed, _ = _time_path(tra_gen, start_speed, mean_speed, dt)
     complete = resample_time(np.vstack([prefix, timed]), n_steps)
     complete[-1] = target
     logger.debug("extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
@@ -362,7 +367,7 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
             raise NoFreeRouteError(f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
                                    f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
                                    f"keeps it; choose another target, or approach='paper'")
-    transfer = timed_transfer(tra_gen, y, piece.start, start, approach_tail, dt)
+    transfer = _timed_transfer(tra_gen, y, piece.start, start, approach_tail, dt)
     complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
     logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
                  "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
@@ -392,13 +397,13 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
             except NoFreeRouteError:
                 continue
         else:
-            route = lifted_route(tra_imi[0], hover, is_free)
+            route = _lifted_route(tra_imi[0], hover, is_free)
             if route is None:
                 raise first from None
             logger.info("no free route around: over, at %.4g", route[1, 2])
-            smooth = smoothest_free_route(route, is_free)
+            smooth = _smoothest_free_route(route, is_free)
             return None, route if smooth is None else smooth, "lifted"
-    tra_gen, refinement = refine_transfer(result.path, result.template, is_free)
+    tra_gen, refinement = _refine_transfer(result.path, result.template, is_free)
     return result, tra_gen, refinement
 
 
@@ -438,7 +443,7 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
     target = as_point(new_target, 7, "new_target")
     target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
     turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
-    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
+    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
     exclude = ()
     if scene is not None:
         exclude = scene.parts_at(target[:3])

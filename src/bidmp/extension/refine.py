@@ -8,9 +8,9 @@ and a polyline sampled at the robot's rate has an acceleration spike at every ve
 * **the template, where it is free.** It is what G-PRM's score measures similarity to (its own
   similarity is 1, every roadmap path's is lower), so where no part is in the way it is the best
   answer G-PRM's objective can give, with the piece's own smoothness;
-* **otherwise the roadmap path, shortcut and smoothed.** Greedy shortcutting (from each kept
+* **otherwise the roadmap path, _shortcut and smoothed.** Greedy shortcutting (from each kept
   vertex, the farthest later vertex a free straight move reaches) removes the sampling's detours;
-  the shortcut polyline is then replaced by the smoothest free least-squares quintic spline
+  the _shortcut polyline is then replaced by the smoothest free least-squares quintic spline
   (fewest knots first, its bow away from the chord widened by up to 1.5 where a fit cuts a
   corner into a part). A quintic spline has continuous curvature and curvature rate, so the
   transfer can be timed through its bends without jerk spikes; a Savitzky–Golay smoothing of the
@@ -31,29 +31,29 @@ from scipy.signal import savgol_filter
 from .._trajectory import arclength, interp_columns
 from .roadmap import CollisionCallback, _edges_free
 
-__all__ = ["refine_transfer", "path_is_free", "shortcut", "smoothest_free", "smoothest_free_route", "lifted_route"]
+__all__ = []
 
 logger = logging.getLogger(__name__)
 
-_RESAMPLED = 200  # points of the shortcut polyline before smoothing
-_TAUT = 60  # points along the shortcut polyline shortcut once more
+_RESAMPLED = 200  # points of the _shortcut polyline before smoothing
+_TAUT = 60  # points along the _shortcut polyline _shortcut once more
 _WINDOWS = (81, 41, 21, 11)  # Savitzky–Golay windows tried on the template, widest first (points of _RESAMPLED)
 _KNOTS = (0, 1, 2, 3, 4, 6, 8, 12, 16, 24, 32)  # interior knots of the route's quintic spline, fewest (smoothest) first
 # Shares of the spline's offset from the template (or chord) tried, widest first: 1.5 where a fit
 # cuts a corner into a part, down to 0.1 where G-PRM's wide samples went further round than needed.
 _SHARES = (1.5, 1.25, 1.1, 1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1)
 _BISECTIONS = 4  # then between the last free share and the first blocked one
-_LONGER = 1.02  # a spline at most this much longer than the shortcut route is taken; else more knots
+_LONGER = 1.02  # a spline at most this much longer than the _shortcut route is taken; else more knots
 
 
-def path_is_free(path: np.ndarray, is_free: CollisionCallback | None) -> bool:
+def _path_is_free(path: np.ndarray, is_free: CollisionCallback | None) -> bool:
     """Whether every straight piece of the polyline ``path`` (n, D) is free (True without a callback)."""
     if is_free is None:
         return True
     return bool(np.all(_edges_free(path[:-1], path[1:], is_free)))
 
 
-def shortcut(path: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray:
+def _shortcut(path: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray:
     """Greedy shortcutting: from each kept vertex, straight to the farthest later vertex a free
     straight move reaches (the next vertex always does: the path's own pieces are free)."""
     kept, index, last = [0], 0, path.shape[0] - 1
@@ -96,13 +96,13 @@ def _spline_fit(polyline: np.ndarray, n_knots: int) -> np.ndarray:
     return fit
 
 
-def smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | None,
+def _smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | None,
                          base: np.ndarray | None = None) -> np.ndarray | None:
     """The smoothest free quintic spline through a route's polyline, pulled as close to ``base``
     (the template, else the chord; same ends) as the parts allow (see the module docstring);
     None when no candidate is free."""
     if polyline.shape[0] < 3 or arclength(polyline)[-1] <= 0.0:
-        return polyline if path_is_free(polyline, is_free) else None
+        return polyline if _path_is_free(polyline, is_free) else None
     u = np.linspace(0.0, 1.0, _RESAMPLED)[:, None]
     route_length, best, best_length = arclength(polyline)[-1], None, np.inf
     for n_knots in _KNOTS:
@@ -116,7 +116,7 @@ def smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | None
         # offset's free set is an interval above some share for a single part in the way).
         free_share, blocked_share = None, 0.0
         for share in _SHARES:
-            if not path_is_free(reference + share * (fit - reference), is_free):
+            if not _path_is_free(reference + share * (fit - reference), is_free):
                 blocked_share = share
                 break
             free_share = share
@@ -124,7 +124,7 @@ def smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | None
             continue
         for _ in range(_BISECTIONS if blocked_share > 0.0 else 0):  # closer to the part, as far as it stays free
             middle = (free_share + blocked_share) / 2.0
-            if path_is_free(reference + middle * (fit - reference), is_free):
+            if _path_is_free(reference + middle * (fit - reference), is_free):
                 free_share = middle
             else:
                 blocked_share = middle
@@ -137,33 +137,33 @@ def smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | None
     return best
 
 
-def refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCallback | None) -> tuple[np.ndarray, str]:
+def _refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCallback | None) -> tuple[np.ndarray, str]:
     """The transfer to use in place of G-PRM's ``path`` (n, D), from seg to the new target, and how
-    it was made: ``"template"``, ``"smoothed"`` (the shortcut path, smoothed) or ``"shortcut"``
-    (the shortcut polyline, where no smoothing stays free). See the module docstring."""
+    it was made: ``"template"``, ``"smoothed"`` (the _shortcut path, smoothed) or ``"_shortcut"``
+    (the _shortcut polyline, where no smoothing stays free). See the module docstring."""
     ends_match = np.allclose(template[[0, -1]], path[[0, -1]], rtol=0.0,
                              atol=1e-9 * max(float(np.ptp(path, axis=0).max()), 1.0))
-    if ends_match and path_is_free(template, is_free):
+    if ends_match and _path_is_free(template, is_free):
         # Smoothed too: the template is the piece scaled, and scaling a 10 mm piece of a recording
         # onto 200 mm scales its sensor noise 20-fold into kinks the timing would see as jerk.
-        smooth = smoothest_free(template, is_free)
+        smooth = _smoothest_free(template, is_free)
         return (template if smooth is None else smooth), "template"
-    polyline = shortcut(path, is_free)
+    polyline = _shortcut(path, is_free)
     if polyline.shape[0] > 2:  # again through points along its pieces: corners cut where the vertices alone cannot
         s = arclength(polyline)
-        polyline = shortcut(interp_columns(np.linspace(0.0, s[-1], _TAUT), s, polyline), is_free)
-    smooth = smoothest_free_route(polyline, is_free, template if ends_match else None) if arclength(polyline)[-1] > 0.0 else None
+        polyline = _shortcut(interp_columns(np.linspace(0.0, s[-1], _TAUT), s, polyline), is_free)
+    smooth = _smoothest_free_route(polyline, is_free, template if ends_match else None) if arclength(polyline)[-1] > 0.0 else None
     if smooth is not None:
         return smooth, "smoothed"
-    logger.debug("no smoothing of the shortcut transfer stays free: its polyline is used")
-    return polyline, "shortcut"
+    logger.debug("no smoothing of the _shortcut transfer stays free: its polyline is used")
+    return polyline, "_shortcut"
 
 
-def smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
+def _smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
     """The polyline smoothed with the widest window whose result is free; None when none is."""
     for window in _WINDOWS:
         candidate = _smoothed(polyline, window)
-        if path_is_free(candidate, is_free):
+        if _path_is_free(candidate, is_free):
             return candidate
     return None
 
@@ -171,7 +171,7 @@ def smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> n
 _LIFTS = (0.1, 0.2, 0.4, 0.8, 1.6, 3.2)  # heights tried over the higher end, in chord lengths
 
 
-def lifted_route(seg: np.ndarray, end: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
+def _lifted_route(seg: np.ndarray, end: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:
     """Over what is in the way: up from seg, across at one height, down to ``end`` — the lowest of
     :data:`_LIFTS` above the higher of the two ends whose three straight moves are free (3-D
     paths only; None when none is). What a person does over a cable duct across the table, and
@@ -183,6 +183,6 @@ def lifted_route(seg: np.ndarray, end: np.ndarray, is_free: CollisionCallback | 
     for lift in _LIFTS:
         height = top + lift * max(chord, 1e-300)
         route = np.array([seg, [seg[0], seg[1], height], [end[0], end[1], height], end])
-        if path_is_free(route, is_free):
+        if _path_is_free(route, is_free):
             return route
     return None

@@ -39,7 +39,7 @@ from .._checks import (
 from .._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
-__all__ = ["NoFreeRouteError", "RoadmapResult", "template", "gaussian_prm", "classic_prm", "shortest_path", "check_options"]
+__all__ = ["NoFreeRouteError", "RoadmapResult", "template", "gaussian_prm", "classic_prm"]
 
 logger = logging.getLogger(__name__)
 
@@ -165,7 +165,7 @@ def _paper_scaled(path: np.ndarray, seg: np.ndarray, tar: np.ndarray, new_target
     return seg + np.where(bad, 1.0, factors) * (path - seg)
 
 
-def shortest_path(
+def _shortest_path(
     nodes: np.ndarray, n_neighbours: int = 8, is_free: CollisionCallback | None = None
 ) -> np.ndarray | None:
     """Dijkstra path from ``nodes[0]`` to ``nodes[-1]`` on a symmetric kNN roadmap.
@@ -224,7 +224,7 @@ def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, 
                                    f"obstacle according to is_free")
         keep = free.copy()
         nodes, order = nodes[keep], order[keep[1:-1]]
-    indices = shortest_path(nodes, n_neighbours, is_free)
+    indices = _shortest_path(nodes, n_neighbours, is_free)
     if indices is None:
         if is_free is not None:
             raise NoFreeRouteError(f"no collision-free route from seg {np.round(seg, 3).tolist()} to "
@@ -268,7 +268,7 @@ def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scal
     """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target")
-    check_options(n_samples=n_samples, n_neighbours=n_neighbours, n_compare=n_compare, n_iter=n_iter,
+    _check_options(n_samples=n_samples, n_neighbours=n_neighbours, n_compare=n_compare, n_iter=n_iter,
                   scaling=scaling, compare=compare, select=select, denom=denom)
     if np.linalg.norm(target - piece[0]) == 0.0:
         raise ValueError("new_target coincides with the start of the piece (seg): nothing to generate")
@@ -276,7 +276,7 @@ def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scal
     return piece, target, comparison
 
 
-def check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100,
+def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100,
                   n_iter: int = 10, rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis",
                   compare: str = "template", select: str = "best", denom: str = "sqrt2", padding: float = 0.3,
                   seed=0) -> None:
@@ -382,7 +382,7 @@ def gaussian_prm(
     """
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule)
+    _check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule)
     sampler = _ChordSampler(piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed))
     return _iterate(comparison, n_iter, sampler.draw, sampler.learn, n_neighbours, is_free, select)
 
@@ -432,7 +432,7 @@ def classic_prm(
     Scored exactly like :func:`gaussian_prm`."""
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    check_options(padding=padding)
+    _check_options(padding=padding)
     rng = check_seed(seed)
     seg = piece[0]
     margin = padding * np.linalg.norm(target - seg)

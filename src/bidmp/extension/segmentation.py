@@ -20,7 +20,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
-from .._checks import as_point, as_trajectory, check_choice, check_limit, check_real, numerically_guarded
+from .._checks import (
+    as_point,
+    as_trajectory,
+    check_choice,
+    check_limit,
+    check_real,
+    numerically_guarded,
+)
 from .._trajectory import arclength, resample_arclength
 
 __all__ = [

@@ -1,9 +1,9 @@
 """Timing a generated path like the demonstration it extends (SPEC §5): arc-length profiles
 that join the demonstration with continuous position, speed and (``"keep"``) acceleration.
 
-* :func:`time_path` (the paper's protocol, ``approach="paper"``): a cubic profile from the
+* :func:`_time_path` (the paper's protocol, ``approach="paper"``): a cubic profile from the
   demonstration's speed at seg to rest, at the imitated piece's mean speed.
-* :func:`timed_transfer` (``approach="keep"``): a quintic profile along the path that leaves
+* :func:`_timed_transfer` (``approach="keep"``): a quintic profile along the path that leaves
   and arrives with the demonstration's speed along it, plus short quintic blends at the two
   joins that add what a profile along the path cannot keep (the velocity across it at a corner,
   the acceleration), so that velocity and acceleration are continuous where the transfer meets
@@ -23,7 +23,7 @@ from scipy.signal import savgol_filter
 from .._checks import check_int
 from .._trajectory import arclength, interp_columns
 
-__all__ = ["time_path", "timed_transfer", "motion_peaks"]
+__all__ = []
 
 logger = logging.getLogger(__name__)
 
@@ -35,7 +35,7 @@ _NEGLIGIBLE = 1.02  # with no duration within the peaks, a longer one is taken o
 _JOIN_SLACK = 1.1  # peaks over the joins (with the demonstration's samples around them) may reach this times its own
 
 
-def motion_peaks(points: np.ndarray, dt: float) -> np.ndarray:
+def _motion_peaks(points: np.ndarray, dt: float) -> np.ndarray:
     """Peak speed, acceleration and jerk of samples ``points`` (n, D) ``dt`` apart, by first,
     second and third finite differences (units/time, /time², /time³); 0 where too short."""
     peaks = np.zeros(3)
@@ -60,7 +60,7 @@ def _arc_profile(length: float, start_speed: float, end_speed: float, duration: 
     return length * (3 * u**2 - 2 * u**3 + alpha * (u - 2 * u**2 + u**3) + beta * (u**3 - u**2))
 
 
-def time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float) -> tuple[np.ndarray, float]:
+def _time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float) -> tuple[np.ndarray, float]:
     """Time a geometric path: a cubic arc-length profile from ``start_speed`` to rest.
 
     ``s(u) = L (3u² − 2u³) + a (u − 2u² + u³)`` on ``u ∈ [0, 1]`` with ``a = start_speed · D``;
@@ -212,7 +212,7 @@ def _path_function(path: np.ndarray, s: np.ndarray):
     return make_interp_spline(s, path, k=3)
 
 
-def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_index: int, approach: np.ndarray,
+def _timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_index: int, approach: np.ndarray,
                    dt: float) -> np.ndarray:
     """Samples along ``path`` (excluding its start, ending exactly at its end) from the
     demonstration ``y`` at ``seg_index`` to the kept ``approach`` (its samples after ``path``'s
@@ -232,7 +232,7 @@ def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_ind
         return np.repeat(path[-1:], n_own, axis=0)
     point_at = _path_function(path, s)
     joins = _Joins(y, seg_index, approach_index, dt, path, point_at)
-    limit = motion_peaks(y, dt)
+    limit = _motion_peaks(y, dt)
     before, after = y[max(seg_index - 3, 0) : seg_index + 1], approach[:3]
     best, best_excess, n_steps = None, np.inf, n_own
     while n_steps <= _LONGEST * n_own:
@@ -248,8 +248,8 @@ def timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_ind
         positions[-1] = path[-1]
         # Within the demonstration's peaks along the transfer; at the joins, where a
         # recording's noise meets a smooth profile in the third differences, within 1.1x.
-        inside = motion_peaks(np.vstack([path[:1], positions]), dt) / np.maximum(limit, 1e-300)
-        joined = motion_peaks(np.vstack([before, positions, after]), dt) / np.maximum(_JOIN_SLACK * limit, 1e-300)
+        inside = _motion_peaks(np.vstack([path[:1], positions]), dt) / np.maximum(limit, 1e-300)
+        joined = _motion_peaks(np.vstack([before, positions, after]), dt) / np.maximum(_JOIN_SLACK * limit, 1e-300)
         excess = float(max(inside.max(), joined.max()))
         if excess <= 1.0 + 1e-9:
             return positions

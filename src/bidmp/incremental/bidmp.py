@@ -26,8 +26,8 @@ import numpy as np
 from sklearn.base import BaseEstimator, clone
 
 from .._checks import (
-    _as_float_array,
     NotFittedError,
+    _as_float_array,
     as_point,
     as_trajectory,
     check_choice,
@@ -37,12 +37,11 @@ from .._checks import (
     numerically_guarded,
 )
 from .._trajectory import resample_time, rmse
-from .bls import BLS
 from ..primitives.dmp import DMP
 from ..primitives.forcing import forcing_target
-
 from ._skills import SkillLibrary
-from .bidmp_state import bidmp_from_state, bidmp_state
+from .bidmp_state import _bidmp_from_state, _bidmp_state
+from .bls import BLS
 
 __all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
 
@@ -296,11 +295,11 @@ class BiDMP(SkillLibrary, BaseEstimator):
         return self
 
     def _get_state(self) -> tuple[dict, dict]:
-        return bidmp_state(self)
+        return _bidmp_state(self)
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "BiDMP":
-        return bidmp_from_state(cls, meta, arrays)
+        return _bidmp_from_state(cls, meta, arrays)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -13,12 +13,12 @@ from .._checks import (
     check_real,
 )
 from .._state import Prefixed as _Prefixed
-from .bls import BLS
 from ..primitives.dmp import DMP
+from .bls import BLS
 
 
 # -- persistence -----------------------------------------------------------------------------
-def bidmp_state(model) -> tuple[dict, dict]:
+def _bidmp_state(model) -> tuple[dict, dict]:
     model._ensure_started()
     dmp_meta, dmp_arrays = model.dmp_._get_state()
     arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
@@ -36,7 +36,7 @@ def bidmp_state(model) -> tuple[dict, dict]:
             "gate_phase_": model.gate_phase_}, arrays
 
 
-def bidmp_from_state(cls, meta: dict, arrays: Mapping):
+def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
     """A Bi-DMP of class ``cls`` from a model file's state (its DMP and BLS blocks read from their
     prefixes), every member checked."""
     for key, kind in (("dmp", dict), ("params", dict), ("blocks", list)):

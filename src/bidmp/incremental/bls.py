@@ -43,17 +43,16 @@ from .._checks import (
     numerically_guarded,
 )
 from .._threads import one_thread, single_threaded
-
-from .bls_state import bls_from_state, bls_state
+from .bls_state import _bls_from_state, _bls_state
 from .linalg import (
     MAX_ADMM_ITERATIONS,
     PINV_GAP,
     PINV_RCOND,
+    _check_gap,
+    _grow_pinv,
+    _grow_ridge,
+    _solve_output,
     block_pinv_update,
-    check_gap,
-    grow_pinv,
-    grow_ridge,
-    solve_output,
     sparse_autoencoder,
     svd_update,
     truncated_svd,
@@ -304,7 +303,7 @@ class BLS(BaseEstimator):
         Z = _mapped_features(X, mapping_weights, mapping_min, mapping_range)
         weights, scale, H = _enhancement_block(Z, params.seed, 0, params.n_enhance, params.shrink)
         A = np.hstack([Z, H])
-        solution = solve_output(A, Y, params.update, params.reg)
+        solution = _solve_output(A, Y, params.update, params.reg)
         # Nothing above touched the model: commit the new state in one go.
         self.n_features_ = X.shape[1]
         self._y_was_1d = y_was_1d
@@ -346,7 +345,7 @@ class BLS(BaseEstimator):
         svd = self.__dict__.get("_svd")
         if svd is None or svd[2].shape[0] != self._n_hidden:
             U, values, V, dropped = truncated_svd(self.train_hidden_)
-            check_gap(values, dropped)
+            _check_gap(values, dropped)
             svd = self._svd = (U, values, V)
         return svd
 
@@ -374,9 +373,9 @@ class BLS(BaseEstimator):
         block = len(self.enhancement_weights_)
         weights, scale, E = _enhancement_block(Z, params.seed, block, n, params.shrink)
         if params.update == "exact_ridge":
-            solution = grow_ridge(self.gram_factor_, A, E, Y, self.output_weights_, self._projected_targets, params.reg)
+            solution = _grow_ridge(self.gram_factor_, A, E, Y, self.output_weights_, self._projected_targets, params.reg)
         else:
-            solution, self._svd = grow_pinv(self._hidden_svd(), E, Y)
+            solution, self._svd = _grow_pinv(self._hidden_svd(), E, Y)
         self.enhancement_weights_.append(weights)
         self.enhancement_scales_.append(scale)
         self._append_train_hidden(E)
@@ -396,10 +395,10 @@ class BLS(BaseEstimator):
         return out[:, 0] if self._y_was_1d else out
 
     def _get_state(self) -> tuple[dict, dict]:
-        return bls_state(self)
+        return _bls_state(self)
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "BLS":
-        return bls_from_state(cls, meta, arrays)
+        return _bls_from_state(cls, meta, arrays)
 
 

@@ -3,7 +3,6 @@ checked on the way back in."""
 
 from __future__ import annotations
 
-
 import numpy as np
 from scipy.linalg import solve_triangular
 
@@ -16,7 +15,7 @@ from .._checks import (
 
 
 # -- persistence -----------------------------------------------------------------------------
-def bls_state(model) -> tuple[dict, dict]:
+def _bls_state(model) -> tuple[dict, dict]:
     check_fitted(model, "output_weights_")
     arrays = {
         "mapping_weights_": model.mapping_weights_,
@@ -35,7 +34,7 @@ def bls_state(model) -> tuple[dict, dict]:
     return meta, arrays
 
 
-def bls_from_state(cls, meta: dict, arrays: dict):
+def _bls_from_state(cls, meta: dict, arrays: dict):
     if not isinstance(meta.get("params"), dict):
         raise ValueError("the BLS state has no params object")
     model = cls(**meta["params"])

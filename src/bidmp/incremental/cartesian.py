@@ -11,10 +11,23 @@ from sklearn.base import BaseEstimator, clone
 
 from .._api import goal_first
 from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
-from ..primitives.cartesian import CartesianDMP, _parts_from_state, _parts_state, _pose_parts, _pose_params, _read_poses_state
+from ..primitives.cartesian import (
+    CartesianDMP,
+    _parts_from_state,
+    _parts_state,
+    _pose_params,
+    _pose_parts,
+    _read_poses_state,
+)
+from ..primitives.pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
+from ..primitives.so3 import (
+    _nearest_turn,
+    angle_between,
+    as_quaternions,
+    orientation_from_log,
+    principal_log,
+)
 from .bidmp import BiDMP
-from ..primitives.so3 import principal_log, angle_between, as_quaternions, nearest_turn, orientation_from_log
-from ..primitives.pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
 
 __all__ = ["CartesianBiDMP", "pose_forgetting"]
 
@@ -149,7 +162,7 @@ class CartesianBiDMP(BaseEstimator):
         goal_q = self.skill_goal_orientations_[index] if goal is None else as_quaternions(goal[3:], "goal's quaternion")[0]
         start = None if start is None else as_point(start, 7, "start")
         start_q = self.skill_start_orientations_[index] if start is None else as_quaternions(start[3:], "start's quaternion")[0]
-        start_e = nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
+        start_e = _nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
         return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
 
     @goal_first("skill", "start", "n_steps")
@@ -168,7 +181,7 @@ class CartesianBiDMP(BaseEstimator):
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment, position = self.position_._skill_query(goal_p, index, start_p)
         _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(np.zeros(3), index, start_e)
-        return pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e,
+        return _pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e,
                                 duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
                                 coupling)
 

@@ -30,8 +30,7 @@ from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
 from .._checks import as_trajectory, check_int, check_limit, check_real
 
-__all__ = ["sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "solve_output", "grow_ridge",
-           "grow_pinv", "PINV_RCOND", "PINV_GAP", "MAX_ADMM_ITERATIONS"]
+__all__ = ["sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "PINV_RCOND", "PINV_GAP", "MAX_ADMM_ITERATIONS"]
 
 MAX_ADMM_ITERATIONS = 10_000  # sparse_autoencoder's iterations at most (the BLS uses 50)
 _RANK_TOLERANCE = 1e-10  # block_pinv_update: singular values of C below this times ‖E‖₂ count as zero
@@ -85,7 +84,7 @@ def truncated_svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np
     return np.ascontiguousarray(u[:, keep]), s[keep], np.ascontiguousarray(vt[keep].T), s[~keep]
 
 
-def check_gap(kept: np.ndarray, dropped: np.ndarray) -> None:
+def _check_gap(kept: np.ndarray, dropped: np.ndarray) -> None:
     """Refuse a pseudo-inverse whose rank cut does not fall in a spectral gap (see the module
     docstring): its weights then depend on rounding, and no update can reproduce them."""
     if kept.size == 0 or dropped.size == 0 or dropped[0] * PINV_GAP <= kept[-1]:
@@ -154,7 +153,7 @@ def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple
     return D, Bt, "general"
 
 
-def solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tuple:
+def _solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tuple:
     """Output weights for hidden matrix A and targets Y: (W, A⁺ or None, R or None, z or None)."""
     if update == "exact_ridge":
         # Upper Cholesky factor R of the ridge Gram matrix: AᵀA + λI = RᵀR, kept in Fortran
@@ -171,15 +170,15 @@ def solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tuple
     return pinv @ Y, pinv, None, None
 
 
-def grow_ridge(R: np.ndarray, A: np.ndarray, E: np.ndarray, Y: np.ndarray, W: np.ndarray, projected: np.ndarray,
+def _grow_ridge(R: np.ndarray, A: np.ndarray, E: np.ndarray, Y: np.ndarray, W: np.ndarray, projected: np.ndarray,
                reg: float) -> tuple:
     """The ridge solution for ``[A | E]`` from that for A (c columns, m new), in the layout of
-    :func:`solve_output`: ``(W', None, R', z')``.
+    :func:`_solve_output`: ``(W', None, R', z')``.
 
     Block Cholesky: ``R' = [[R, R12], [0, R22]]`` with ``R12 = R⁻ᵀAᵀE`` and
     ``R22 = chol(EᵀE + λI − R12ᵀR12)``; block forward and back substitution reuse
     ``z = R⁻ᵀAᵀY`` (``projected``) and the old weights W: O(N·c·m + c²·(m + D)), no
-    refactorisation. Equal to :func:`solve_output` on ``[A | E]`` from scratch.
+    refactorisation. Equal to :func:`_solve_output` on ``[A | E]`` from scratch.
     """
     # Inputs are the model's own finite arrays: skip SciPy's O(c²) finiteness scans.
     c, m = R.shape[0], E.shape[1]
@@ -197,11 +196,11 @@ def grow_ridge(R: np.ndarray, A: np.ndarray, E: np.ndarray, Y: np.ndarray, W: np
     return np.ascontiguousarray(np.vstack([W_old, W_new])), None, grown, np.vstack([projected, z_new])
 
 
-def grow_pinv(svd: tuple[np.ndarray, np.ndarray, np.ndarray], E: np.ndarray, Y: np.ndarray) -> tuple[tuple, tuple]:
+def _grow_pinv(svd: tuple[np.ndarray, np.ndarray, np.ndarray], E: np.ndarray, Y: np.ndarray) -> tuple[tuple, tuple]:
     """The pseudo-inverse solution for ``[A | E]`` from the truncated SVD ``(U, s, V)`` of A:
-    (the solution in the layout of :func:`solve_output`, the grown SVD). Refused where the
-    grown pseudo-inverse is ill-posed (:func:`check_gap`)."""
+    (the solution in the layout of :func:`_solve_output`, the grown SVD). Refused where the
+    grown pseudo-inverse is ill-posed (:func:`_check_gap`)."""
     U, values, V, dropped = svd_update(*svd, E)
-    check_gap(values, dropped)
+    _check_gap(values, dropped)
     pinv = np.ascontiguousarray((V / values) @ U.T)
     return (pinv @ Y, pinv, None, None), (U, values, V)

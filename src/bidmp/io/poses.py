@@ -27,8 +27,8 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them. Samples whose
     timestamp repeats the one before are dropped, with a warning.
     """
+    from ..primitives.timing import _drop_duplicate_stamps
     from ._columns import select_poses
-    from ..primitives.timing import drop_duplicate_stamps
 
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
@@ -52,7 +52,7 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     poses = as_trajectory(values[:, list(selection.values)], name=str(path), allow_static=True)
     if selection.time is None:
         return poses, None
-    return drop_duplicate_stamps(poses, values[:, selection.time], f"{path}: the time column")
+    return _drop_duplicate_stamps(poses, values[:, selection.time], f"{path}: the time column")
 
 
 def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:

@@ -10,7 +10,13 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import as_trajectory, short_token
-from ._csv import _check_file, _check_npy_trajectory, _read_csv, _timed_fields, declared_units
+from ._csv import (
+    _check_file,
+    _check_npy_trajectory,
+    _read_csv,
+    _timed_fields,
+    declared_units,
+)
 from ._npy import _EMPTY_ZIP_MAGIC, _ZIP_MAGIC, _read_npy
 from .atomic import _destination, atomic_write
 
@@ -56,7 +62,7 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
     -------
     (y, t) : array (T, D) and array (T,) or None
     """
-    from ..primitives.timing import drop_duplicate_stamps
+    from ..primitives.timing import _drop_duplicate_stamps
 
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
@@ -88,7 +94,7 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
         raise ValueError(f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays")
     positions = as_trajectory(positions, name=str(path))
     if times is not None:
-        positions, times = drop_duplicate_stamps(positions, times, f"{path}: the time column")
+        positions, times = _drop_duplicate_stamps(positions, times, f"{path}: the time column")
     return positions, times
 
 

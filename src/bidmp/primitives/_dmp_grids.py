@@ -9,12 +9,12 @@ import numpy as np
 from .._checks import check_bytes, check_int, numerically_guarded
 from .._trajectory import resample_time
 from .canonical import phase_grid
-from .forcing import as_phase, basis_functions
-from .goals import DelayedGoal, PhaseGate, ProgressGate, learned_progress_gate
-from .grid import cached_grid, rollout_grid
-from .integrate import unit_responses
-from .protocols import Params, with_rest
-from .rest import rest_started
+from .forcing import _as_phase, basis_functions
+from .goals import DelayedGoal, PhaseGate, ProgressGate, _learned_progress_gate
+from .grid import _cached_grid, _rollout_grid
+from .integrate import _unit_responses
+from .protocols import _Params, _with_rest
+from .rest import _rest_started
 
 __all__ = ["GridQueries"]
 
@@ -29,7 +29,7 @@ class GridQueries:
         self._check_fitted()
         return self._n_steps(None, self._params())
 
-    def _n_steps(self, n_steps, params: Params) -> int:
+    def _n_steps(self, n_steps, params: _Params) -> int:
         if n_steps is None:
             n_steps = max(int(round(params.settle * params.tau * self.n_steps_)), 1)
             check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
@@ -49,7 +49,7 @@ class GridQueries:
         :meth:`default_n_steps`), cached."""
         self._check_fitted()
         params = self._params()
-        phase, basis, *_ = rollout_grid(self, params, self._n_steps(n_steps, params))
+        phase, basis, *_ = _rollout_grid(self, params, self._n_steps(n_steps, params))
         return phase, basis
 
     @property
@@ -62,7 +62,7 @@ class GridQueries:
         """Phase and basis rows (N columns) of the grid the weights were learned on
         (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
         self._check_fitted()
-        phase, basis, *_ = rollout_grid(self, self._params()._replace(tau=1.0), self.n_train_)
+        phase, basis, *_ = _rollout_grid(self, self._params()._replace(tau=1.0), self.n_train_)
         return phase, basis
 
     def training_gate(self) -> np.ndarray:
@@ -72,14 +72,14 @@ class GridQueries:
         params = self._params()
         return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
 
-    def goal_system(self, params: Params | None = None) -> PhaseGate | DelayedGoal | ProgressGate:
+    def goal_system(self, params: _Params | None = None) -> PhaseGate | DelayedGoal | ProgressGate:
         """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``params`` (default its
         own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
         asks for it once per stepper)."""
         params = self._params() if params is None else params
         if params.goal_rate is not None:
             return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(params.goal_rate)
-        return learned_progress_gate(self, params)
+        return _learned_progress_gate(self, params)
 
     def training_trajectory(self, y) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
@@ -89,13 +89,13 @@ class GridQueries:
         params = self._params()
         y = resample_time(np.asarray(y, dtype=np.float64), self.n_steps_)
         if params.rest_start:
-            y = rest_started(y, self.dt_, self.time_unit_)
-        return with_rest(y, params)
+            y = _rest_started(y, self.dt_, self.time_unit_)
+        return _with_rest(y, params)
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
         self._check_fitted()
-        return basis_functions(as_phase(phase), self.centres_, self.widths_)
+        return basis_functions(_as_phase(phase), self.centres_, self.widths_)
 
     def forcing_term(self, phase) -> np.ndarray:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
@@ -112,11 +112,11 @@ class GridQueries:
         """
         params = self._rollout_params()
         n_steps = self._n_steps(n_steps, params)
-        cached = cached_grid(self, params, n_steps, self.dt_)
+        cached = _cached_grid(self, params, n_steps, self.dt_)
         if cached is not None:
             goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
             phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase, exact=params.exact)
             gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
-            goal_response = unit_responses(params, phase, None, self.dt_, gate)[0]
+            goal_response = _unit_responses(params, phase, None, self.dt_, gate)[0]
         return float(abs(1.0 - goal_response[-1]))

@@ -8,13 +8,13 @@ import numpy as np
 
 from .._api import goal_first
 from .._checks import as_point, check_int, numerically_guarded
-from .forcing import check_forcing_increment
-from .grid import rollout_grid
-from .integrate import check_integration, unit_responses
-from .protocols import Params
-from .rollouts import iter_rollouts_to, rollouts_to
+from .forcing import _check_forcing_increment
+from .grid import _rollout_grid
+from .integrate import _check_integration, _unit_responses
+from .protocols import _Params
+from .rollouts import _iter_rollouts_to, _rollouts_to
 from .stepper import DMPStepper
-from .timed import coupled_trajectory, limited_trajectory, timed_trajectory
+from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
 
 __all__ = ["Motions"]
 
@@ -23,26 +23,26 @@ class Motions:
     """Rollouts, trajectories and the stepper of a fitted DMP (mixed into
     :class:`~bidmp.primitives.dmp.DMP`)."""
 
-    def _rollout_params(self, step: float | None = None, params: Params | None = None) -> Params:
+    def _rollout_params(self, step: float | None = None, params: _Params | None = None) -> _Params:
         """The validated parameters, with the rollout's integration checked for stability."""
         self._check_fitted()
         params = self._params() if params is None else params  # validated once per rollout
-        check_integration(self.dt_ if step is None else step, params)
+        _check_integration(self.dt_ if step is None else step, params)
         return params
 
     def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
-        check_forcing_increment(forcing_increment)
+        _check_forcing_increment(forcing_increment)
         params = self._rollout_params(step) if params is None else params
         step = self.dt_ if step is None else step
         n_dims = self.weights_.shape[1]
         n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response), gate = rollout_grid(self, params, n_steps, step)
+        phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(self, params, n_steps, step)
         forcing = basis @ self.weights_
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
-        free = unit_responses(params, phase, forcing, step).T
+        free = _unit_responses(params, phase, forcing, step).T
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
@@ -109,7 +109,7 @@ class Motions:
             ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
         """
         free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        return rollouts_to(goals, free, goal_response, out)
+        return _rollouts_to(goals, free, goal_response, out)
 
     @goal_first("chunk_size", "start", "n_steps", "start_velocity")
     def iter_rollouts(self, goals, *, chunk_size: int = 1024, start=None, n_steps: int | None = None,
@@ -124,7 +124,7 @@ class Motions:
         chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
         with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
             free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        yield from iter_rollouts_to(goals, free, goal_response, chunk_size)
+        yield from _iter_rollouts_to(goals, free, goal_response, chunk_size)
 
     # -- real time -------------------------------------------------------------------------------
     @goal_first("start", "duration", "dt")
@@ -170,10 +170,10 @@ class Motions:
         """
         self._check_fitted()
         if limits is not None:
-            return limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
+            return _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
         if coupling is not None:
-            return coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
-        return timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
+            return _coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
+        return _timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
 
     @goal_first("start", "duration")
     def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0,

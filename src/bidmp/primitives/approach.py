@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["STRAIGHTNESS", "is_straight", "straight_tail_start"]
+__all__ = ["STRAIGHTNESS"]
 
 STRAIGHTNESS = 0.02  # an approach deviates from its chord by at most this fraction of the chord
 MAX_TAIL_CANDIDATES = 256  # start indices tried for the earliest straight tail
 
 
-def is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
+def _is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
     """Whether ``points`` (n, D) stay within ``tolerance`` × their chord of the chord and never move
     back along it (by more than that)."""
     chord = points[-1] - points[0]
@@ -29,15 +29,15 @@ def is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
     return bool(deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length))
 
 
-def straight_tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNESS) -> int:
+def _straight_tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNESS) -> int:
     """The earliest index from ``start`` on (on a grid of at most 256 candidates) from which the
     rest of ``y`` (T, D) is straight; ``T - 1`` when no tail of 2 samples or more is (the motion has
     no approach)."""
     last = y.shape[0] - 1
-    if is_straight(y[start:], straightness):
+    if _is_straight(y[start:], straightness):
         return int(start)
     candidates = np.unique(np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1))).astype(int))
     for candidate in candidates:
-        if is_straight(y[candidate:], straightness):
+        if _is_straight(y[candidate:], straightness):
             return int(candidate)
     return last

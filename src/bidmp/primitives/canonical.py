@@ -11,13 +11,13 @@ import numpy as np
 
 from .._checks import check_int
 
-__all__ = ["phase_grid", "phase_decay", "check_phase_span", "MIN_TRAINING_PHASE_LOG"]
+__all__ = ["phase_grid"]
 
 # Kernels need distinct, representable phases over the training grid: e^-27.6 = 1e-12.
-MIN_TRAINING_PHASE_LOG = -27.6
+_MIN_TRAINING_PHASE_LOG = -27.6
 
 
-def phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
+def _phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
     """Per-step factor of the Euler-discretised canonical system (Eq. 13); refused unless in (0, 1)."""
     decay = 1.0 - alpha_phase * dt / tau
     if not 0.0 < decay < 1.0:
@@ -35,12 +35,12 @@ def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1
     n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
     if exact:
         return np.exp(-alpha_phase * dt / tau * np.arange(n_steps))
-    return phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
+    return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
 
 
-def check_phase_span(span: float, alpha_phase: float) -> None:
+def _check_phase_span(span: float, alpha_phase: float) -> None:
     """Refuse an ``alpha_phase`` that decays the phase below 1e-12 over the training grid (of
     ``span`` normalised time): its kernels' widths and weights would leave float64's range."""
-    if -alpha_phase * span < MIN_TRAINING_PHASE_LOG:
+    if -alpha_phase * span < _MIN_TRAINING_PHASE_LOG:
         raise ValueError(f"alpha_phase = {alpha_phase:g} decays the phase to e^{-alpha_phase * span:.4g} over "
-                         f"the demonstration; the kernels need at least e^{MIN_TRAINING_PHASE_LOG:g}: lower alpha_phase")
+                         f"the demonstration; the kernels need at least e^{_MIN_TRAINING_PHASE_LOG:g}: lower alpha_phase")

@@ -26,28 +26,34 @@ arrays ``x, y, z, qx, qy, qz, qw``. Angular velocities are in the world frame, i
 from __future__ import annotations
 
 import logging
+
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._state import Prefixed
 from .._api import goal_first
-from .._checks import as_point, as_trajectory, check_fitted, check_loaded, numerically_guarded
+from .._checks import (
+    as_point,
+    as_trajectory,
+    check_fitted,
+    check_loaded,
+    numerically_guarded,
+)
+from .._state import Prefixed
+from .._trajectory import continuous_quaternions as _continuous
+from .dmp import DMP
+from .goals import _arclength_progress
+from .pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
 from .so3 import (
+    _nearest_turn,
+    _quaternion_rows,
     angle_between,
     as_quaternions,
     continuous_log,
-    left_jacobian,
-    nearest_turn,
     orientation_from_log,
 )
-from .pose_timing import PoseStepper, PoseTrajectory, pose_trajectory
-from .._trajectory import continuous_quaternions as _continuous
-from .so3 import _quaternion_rows
-from .dmp import DMP
-from .goals import arclength_progress
 
 __all__ = ["CartesianDMP", "PoseStepper", "PoseTrajectory",
-           "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "left_jacobian", "angle_between"]
+           "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "angle_between"]
 
 logger = logging.getLogger(__name__)
 
@@ -84,11 +90,11 @@ def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: 
     orientation_still = np.ptp(log, axis=0).max() <= 1e-12
     if position_still:
         orientation._fit(log, t, name=f"{name}' orientation", unit_label="rad")
-        position._fit(positions, t, units, progress=arclength_progress(orientation.training_trajectory(log)),
+        position._fit(positions, t, units, progress=_arclength_progress(orientation.training_trajectory(log)),
                       name=f"{name}' positions")
         return
     position._fit(positions, t, units, name=f"{name}' positions")
-    progress = arclength_progress(position.training_trajectory(positions)) if orientation_still else None
+    progress = _arclength_progress(position.training_trajectory(positions)) if orientation_still else None
     orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
@@ -181,7 +187,7 @@ class CartesianDMP(BaseEstimator):
         start = self.start_ if start is None else as_point(start, 7, "start")
         goal_q = as_quaternions(goal[3:], "goal's quaternion")[0]
         start_q = as_quaternions(start[3:], "start's quaternion")[0]
-        return goal[:3], goal_q, start[:3], nearest_turn(start_q, goal_q, self.start_log_)
+        return goal[:3], goal_q, start[:3], _nearest_turn(start_q, goal_q, self.start_log_)
 
     @goal_first("start", "duration", "dt")
     @numerically_guarded
@@ -204,7 +210,7 @@ class CartesianDMP(BaseEstimator):
             both parts then run the step integrator.
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
-        return pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
+        return _pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
                                 limits, position_increment, orientation_increment, self.units_, coupling)
 
     @goal_first("start", "n_steps")

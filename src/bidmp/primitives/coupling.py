@@ -22,7 +22,7 @@ import numpy as np
 
 from .._checks import as_point, check_real
 
-__all__ = ["CouplingTerm", "PhaseStopping", "ConstantAcceleration", "as_couplings"]
+__all__ = ["CouplingTerm", "PhaseStopping", "ConstantAcceleration"]
 
 
 class CouplingTerm:
@@ -74,7 +74,7 @@ class ConstantAcceleration(CouplingTerm):
         return np.broadcast_to(self.acceleration, y.shape)
 
 
-def as_couplings(coupling) -> tuple[list, list]:
+def _as_couplings(coupling) -> tuple[list, list]:
     """Split ``coupling`` into (spatial terms, temporal terms).
 
     ``coupling`` is a number (the phase-stopping gain of bidmp ≤ 0.4's ``stepper(coupling=...)``),

@@ -50,14 +50,21 @@ from .._checks import as_trajectory, check_bytes, numerically_guarded
 from .._units import check_units
 from ._dmp_grids import GridQueries
 from ._dmp_motions import Motions
-from .canonical import check_phase_span
-from .forcing import learn_weights
-from .goals import learn_goal_gate
-from .grid import store_grid
-from .integrate import check_integration
-from .protocols import PROTOCOLS, FittedParams, Params, resolve_params, resolved_param, with_rest
-from .rest import rest_started
-from .state import dmp_from_state, dmp_state
+from .canonical import _check_phase_span
+from .forcing import _learn_weights
+from .goals import _learn_goal_gate
+from .grid import _store_grid
+from .integrate import _check_integration
+from .protocols import (
+    PROTOCOLS,
+    _FittedParams,
+    _Params,
+    _resolve_params,
+    _resolved_param,
+    _with_rest,
+)
+from .rest import _rest_started
+from .state import _dmp_from_state, _dmp_state
 from .timing import on_uniform_time
 
 __all__ = ["DMP", "PROTOCOLS"]
@@ -65,7 +72,7 @@ __all__ = ["DMP", "PROTOCOLS"]
 logger = logging.getLogger(__name__)
 
 
-class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
+class DMP(GridQueries, Motions, _FittedParams, BaseEstimator):
     """Discrete DMP learned from one demonstration (SPEC §1), in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
@@ -197,15 +204,15 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
         self.keep_approach = keep_approach
 
     # -- parameters ----------------------------------------------------------------------------
-    def _params(self) -> Params:
+    def _params(self) -> _Params:
         """Validate the hyperparameters as they are now; raise naming the first bad one."""
-        return resolve_params(self)
+        return _resolve_params(self)
 
-    alpha_value = resolved_param("alpha", "The spring gain in use (the protocol's when ``alpha`` is None).")
-    n_kernels_value = resolved_param("n_kernels", "The number of kernels in use (the protocol's when ``n_kernels`` is None).")
-    beta_value = resolved_param("beta", "The spring gain ratio in use (``alpha / 4`` when ``beta`` is None).")
-    K_value = resolved_param("K", "The forcing-term gain in use.")
-    alpha_phase_value = resolved_param("alpha_phase", "The phase decay in use (the protocol's when ``alpha_phase`` is None).")
+    alpha_value = _resolved_param("alpha", "The spring gain in use (the protocol's when ``alpha`` is None).")
+    n_kernels_value = _resolved_param("n_kernels", "The number of kernels in use (the protocol's when ``n_kernels`` is None).")
+    beta_value = _resolved_param("beta", "The spring gain ratio in use (``alpha / 4`` when ``beta`` is None).")
+    K_value = _resolved_param("K", "The forcing-term gain in use.")
+    alpha_phase_value = _resolved_param("alpha_phase", "The phase decay in use (the protocol's when ``alpha_phase`` is None).")
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
@@ -243,16 +250,16 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
         if params.rest_start:
-            y_rest = rest_started(y, dt, duration * n_steps / (n_steps - 1), what="the demonstration" if name == "y"
+            y_rest = _rest_started(y, dt, duration * n_steps / (n_steps - 1), what="the demonstration" if name == "y"
                                          else name, unit=unit_label or units or "units")
-        train = with_rest(y_rest if params.rest_start else y, params)
+        train = _with_rest(y_rest if params.rest_start else y, params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
-        check_integration(dt, params._replace(tau=1.0))
-        check_integration(dt, params)
-        check_phase_span(train.shape[0] * dt, params.alpha_phase)
-        gate = learn_goal_gate(train, n_steps, dt, params, progress, y)
-        weights, centres, widths, phase, phi = learn_weights(train, dt, gate, params)
+        _check_integration(dt, params._replace(tau=1.0))
+        _check_integration(dt, params)
+        _check_phase_span(train.shape[0] * dt, params.alpha_phase)
+        gate = _learn_goal_gate(train, n_steps, dt, params, progress, y)
+        weights, centres, widths, phase, phi = _learn_weights(train, dt, gate, params)
         self.weights_ = weights
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
@@ -265,7 +272,7 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
         self.widths_ = widths
         self._remember_params()
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
-        store_grid(self, params._replace(tau=1.0), phase, phi, dt)
+        _store_grid(self, params._replace(tau=1.0), phase, phi, dt)
         logger.debug("fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration)
         return self
 
@@ -289,11 +296,11 @@ class DMP(GridQueries, Motions, FittedParams, BaseEstimator):
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        return dmp_state(self)
+        return _dmp_state(self)
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> "DMP":
-        return dmp_from_state(cls, meta, arrays)
+        return _dmp_from_state(cls, meta, arrays)
 
-# The constructor's parameters but tau, as given (compared first: cheap), see FittedParams._stale_params.
+# The constructor's parameters but tau, as given (compared first: cheap), see _FittedParams._stale_params.
 _RAW_PARAMS = DMP._raw_param_names()

@@ -11,12 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_points, check_int
-from .canonical import phase_decay, phase_grid
+from .canonical import _phase_decay, phase_grid
 
-__all__ = ["kernel_centres", "kernel_widths", "basis_functions", "basis_row", "forcing_target", "regress",
-           "learn_weights", "as_phase", "check_forcing_increment", "LOG_PSI_FLOOR"]
+__all__ = ["kernel_centres", "kernel_widths", "basis_functions", "forcing_target", "regress"]
 
-LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
+_LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
 
 
 def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *,
@@ -32,7 +31,7 @@ def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, al
     steps = np.linspace(0.0, n_steps - 1, n_kernels)
     if exact:
         return np.exp(-alpha_phase * dt / tau * steps)
-    return np.exp(np.log(phase_decay(dt, tau, alpha_phase)) * steps)
+    return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
 
 
 def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing") -> np.ndarray:
@@ -87,18 +86,18 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
     log_psi = features @ coefficients
     # Terms below e^-40 of the row maximum cannot change a float64 sum; clipping them keeps exp
     # out of the (slow) subnormal range.
-    np.maximum(log_psi, LOG_PSI_FLOOR, out=log_psi)
+    np.maximum(log_psi, _LOG_PSI_FLOOR, out=log_psi)
     psi = np.exp(log_psi, out=log_psi)
     psi *= (phase / (psi @ np.ones(n_kernels)))[:, None]
     return psi
 
 
-def basis_row(phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+def _basis_row(phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
     """``phi(phase)`` (1, N) for one phase: :func:`basis_functions` without its batching (a
     control loop asks for one row per step)."""
     log_psi = -widths * (phase - centres) ** 2
     log_psi -= log_psi.max()
-    psi = np.exp(np.maximum(log_psi, LOG_PSI_FLOOR))
+    psi = np.exp(np.maximum(log_psi, _LOG_PSI_FLOOR))
     return (psi * (phase / psi.sum()))[None]
 
 
@@ -175,7 +174,7 @@ def regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regressio
     return weights
 
 
-def learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tuple[np.ndarray, ...]:
+def _learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tuple[np.ndarray, ...]:
     """The forcing term of a demonstration as learned, ``train`` (n, D) on the normalised grid
     ``dt`` with the goal gate ``gate`` (n,), for a DMP's resolved ``params``.
 
@@ -197,7 +196,7 @@ def learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tup
     return np.ascontiguousarray(weights), centres, widths, phase, phi
 
 
-def as_phase(phase, name: str = "phase") -> np.ndarray:
+def _as_phase(phase, name: str = "phase") -> np.ndarray:
     """Phases (L,) validated: finite and in [0, 1] (a DMP's phase decays from 1 towards 0)."""
     phase = as_points(np.reshape(phase, (-1, 1)) if np.ndim(phase) <= 1 else phase, 1, name)[:, 0]
     if phase.size and (phase.min() < 0.0 or phase.max() > 1.0):
@@ -206,7 +205,7 @@ def as_phase(phase, name: str = "phase") -> np.ndarray:
     return phase
 
 
-def check_forcing_increment(forcing_increment) -> None:
+def _check_forcing_increment(forcing_increment) -> None:
     """Refuse a forcing increment that is not a callable ``f(phase (n,), basis (n, N)) -> (n, D)``."""
     if forcing_increment is not None and not callable(forcing_increment):
         raise TypeError(f"forcing_increment must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "

@@ -25,8 +25,8 @@ demonstration's own progress along its path:
 
 * ``σ`` — the arc-length progress (0 → 1) of the demonstration as learned;
 * ``R = σ · S(t / w)`` over the first ``w`` of the motion and ``1 - (1 - σ) S((T - t) / w)``
-  over its last ``w``, ``R = σ`` in between, 1 after. ``S`` is the 7th-order smoothstep (zero
-  first to third derivative at both ends), ``w = GOAL_BLEND`` (15 %) of the demonstration's
+  over its last ``w``, ``R = σ`` in between, 1 after. ``S`` is the 7th-order _smoothstep (zero
+  first to third derivative at both ends), ``w = _GOAL_BLEND`` (15 %) of the demonstration's
   duration. So ``R, R', R'', R'''`` all start at 0: the first ~50 ms of a motion do not depend on
   its goal (no acceleration or jerk step when the goal moves), and ``R`` reaches 1 with zero
   slope when the motion comes to rest;
@@ -51,30 +51,28 @@ import numpy as np
 from .._trajectory import arclength
 from .canonical import phase_grid
 
-__all__ = ["GOAL_BLEND", "smoothstep", "smoothstep_derivatives", "goal_share", "goal_gate", "euler_progress_gate",
-           "arclength_progress", "PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate", "learned_progress_gate",
-           "learn_goal_gate"]
+__all__ = ["PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate"]
 
 MIN_APPROACH_SHARE = 0.05  # of the path's length: a shorter straight tail is no approach
-GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
+_GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
 
 
-def smoothstep(u: np.ndarray) -> np.ndarray:
-    """The 7th-order smoothstep ``35u⁴ - 84u⁵ + 70u⁶ - 20u⁷`` on [0, 1] (clipped outside): 0 → 1 with
+def _smoothstep(u: np.ndarray) -> np.ndarray:
+    """The 7th-order _smoothstep ``35u⁴ - 84u⁵ + 70u⁶ - 20u⁷`` on [0, 1] (clipped outside): 0 → 1 with
     zero first, second and third derivatives at both ends."""
     u = np.clip(u, 0.0, 1.0)
     return u**4 * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)))
 
 
-def smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """First and second derivative of :func:`smoothstep` (0 outside [0, 1])."""
+def _smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and second derivative of :func:`_smoothstep` (0 outside [0, 1])."""
     inside = (u > 0.0) & (u < 1.0)
     first = np.where(inside, 140.0 * u**3 * (1.0 - u) ** 3, 0.0)
     second = np.where(inside, 420.0 * u**2 * (1.0 - u) ** 2 * (1.0 - 2.0 * u), 0.0)
     return first, second
 
 
-def goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = GOAL_BLEND) -> np.ndarray:
+def _goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = _GOAL_BLEND) -> np.ndarray:
     """The goal share ``R`` on the training grid (module docstring).
 
     Parameters
@@ -89,26 +87,26 @@ def goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = GO
     s = np.arange(progress.shape[0]) * dt
     end = (n_motion - 1) * dt
     width = max(blend * end, dt)
-    share = progress * smoothstep(s / width)
+    share = progress * _smoothstep(s / width)
     closing = s > end - width
-    share[closing] = 1.0 - (1.0 - progress[closing]) * smoothstep((end - s[closing]) / width)
+    share[closing] = 1.0 - (1.0 - progress[closing]) * _smoothstep((end - s[closing]) / width)
     share[s >= end] = 1.0
     return share
 
 
-def goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
+def _goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
     """The gate ``G = (αβ (1 - R) - R'' - α R') / K`` whose continuous response is ``R``."""
     rate = np.gradient(share, dt)
     curvature = np.gradient(rate, dt)
     gate = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
-    # R, R' and R'' vanish at the start (the smoothstep is flat there): one-sided differences
+    # R, R' and R'' vanish at the start (the _smoothstep is flat there): one-sided differences
     # would leave a trace of the next samples, and the initial acceleration must not depend on
     # the goal.
     gate[0] = alpha * beta / K
     return gate
 
 
-def euler_progress_gate(progress: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
+def _euler_progress_gate(progress: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
     """The progress gate of model format 3's robot protocol (``integrator="euler"``): the exact
     inverse of the Euler-discretised spring for the target response ``σ`` delayed by two samples.
 
@@ -126,7 +124,7 @@ def euler_progress_gate(progress: np.ndarray, dt: float, *, alpha: float, beta: 
     return gate
 
 
-def arclength_progress(y: np.ndarray) -> np.ndarray:
+def _arclength_progress(y: np.ndarray) -> np.ndarray:
     """Arc-length progress ``σ`` (0 → 1) of a trajectory (n, D); a static one has none (zeros)."""
     arc = arclength(y)
     return arc / arc[-1] if arc[-1] > 0.0 else np.zeros_like(arc)
@@ -136,7 +134,7 @@ def _training_progress(train: np.ndarray, progress) -> np.ndarray:
     """The progress σ (n_train,) a gate is learned from: the trajectory's own arc-length progress,
     or the one given (a part that does not move follows another's)."""
     n_train = train.shape[0]
-    progress = arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+    progress = _arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
     if progress.shape != (n_train,):
         raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
     return progress
@@ -192,13 +190,13 @@ class ProgressGate:
     def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
               progress: np.ndarray | None = None) -> np.ndarray:
         """The gate on the training grid for a demonstration as learned, ``train`` (n_train, D)
-        (exact: the smooth goal share's continuous inverse; Euler: :func:`euler_progress_gate`).
+        (exact: the smooth goal share's continuous inverse; Euler: :func:`_euler_progress_gate`).
         ``progress`` replaces the demonstration's own arc-length progress (a part that does not
         move follows another's)."""
         progress = _training_progress(train, progress)
         if not exact:
-            return euler_progress_gate(progress, dt, alpha=alpha, beta=beta, K=K)
-        return goal_gate(goal_share(progress, n_motion, dt), dt, alpha=alpha, beta=beta, K=K)
+            return _euler_progress_gate(progress, dt, alpha=alpha, beta=beta, K=K)
+        return _goal_gate(_goal_share(progress, n_motion, dt), dt, alpha=alpha, beta=beta, K=K)
 
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         return np.interp(phase, *self._lookup)
@@ -213,7 +211,7 @@ class ProgressGate:
         return float(np.interp(phase, *self._lookup))
 
 
-def learned_progress_gate(model, params) -> ProgressGate:
+def _learned_progress_gate(model, params) -> ProgressGate:
     """The :class:`ProgressGate` a fitted DMP learned (its ``goal_gate_`` on its training grid),
     cached on the model: a control loop asks for it once per stepper."""
     gate = model.__dict__.get("goal_gate_")
@@ -233,9 +231,9 @@ class ApproachGate(ProgressGate):
     """The progress gate, with the goal's share reaching 1 where the final approach begins.
 
     ``R`` is the demonstration's arc-length progress normalised to the approach's start, ``σ / σ_a``,
-    with the same smooth ends as :func:`goal_share`; so ``R = 1`` over the whole approach, and a goal
+    with the same smooth ends as :func:`_goal_share`; so ``R = 1`` over the whole approach, and a goal
     moved by Δ moves every approach sample by exactly Δ: a translated copy, no tilt. ``R`` stays
-    monotone: no backwards motion, and the overshoot bound of :func:`goal_share` holds with the
+    monotone: no backwards motion, and the overshoot bound of :func:`_goal_share` holds with the
     approach's start in the place of the motion's end.
     """
 
@@ -245,11 +243,11 @@ class ApproachGate(ProgressGate):
         """The gate on the training grid; ``approach_start`` the sample where the approach begins."""
         progress = _training_progress(train, progress)
         reach = float(progress[approach_start])
-        share = goal_share(np.clip(progress / reach, 0.0, 1.0), approach_start + 1, dt)
-        return goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
+        share = _goal_share(np.clip(progress / reach, 0.0, 1.0), approach_start + 1, dt)
+        return _goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
 
 
-def learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progress=None,
+def _learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progress=None,
                     demonstration: np.ndarray | None = None) -> np.ndarray:
     """The goal gate a DMP with resolved ``params`` learns on its training grid: a delayed goal's,
     the progress gate, or (``keep_approach``) the approach gate, the approach found as the straight
@@ -259,10 +257,10 @@ def learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progres
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
     gains = {"alpha": params.alpha, "beta": params.beta, "K": params.K, "exact": params.exact, "progress": progress}
     if params.keep_approach and demonstration is not None:
-        from .approach import straight_tail_start
+        from .approach import _straight_tail_start
 
-        start = straight_tail_start(demonstration)
-        progress_at = arclength_progress(demonstration)[start] if start >= 2 else 0.0
+        start = _straight_tail_start(demonstration)
+        progress_at = _arclength_progress(demonstration)[start] if start >= 2 else 0.0
         # An approach is a straight tail of a real share of the path: any curve's last few samples
         # are straight to 2 % of their short chord.
         if progress_at > 0.0 and 1.0 - progress_at >= MIN_APPROACH_SHARE:

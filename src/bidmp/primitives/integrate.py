@@ -14,7 +14,7 @@ an input ``u``. In normalised time ``s`` with ``z = tau dy/ds``::
 
 Both run as a second-order recursion in ``y`` through :func:`scipy.signal.lfilter` (C), for many
 input signals at once: this is what makes rollouts to many goals cost one integration (the *fast
-path*: :func:`unit_responses`, :func:`affine_rollouts`).
+path*: :func:`_unit_responses`, :func:`_affine_rollouts`).
 
 State feedback (a coupling term that depends on where the system is) cannot go through a filter:
 :class:`StepIntegrator` takes the same exact (or Euler) steps one at a time and adds coupling
@@ -30,16 +30,15 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.signal import lfilter
 
-from .canonical import phase_decay
+from .canonical import _phase_decay
 
 GEMM_GOALS = 64  # rollouts to this many goals and more: one matrix product
 
-__all__ = ["euler_spectral_radius", "check_euler_stable", "check_integration", "euler_responses", "foh_step",
-           "exact_responses", "exact_state", "unit_responses", "affine_rollouts", "StepIntegrator"]
+__all__ = ["StepIntegrator"]
 
 
 # -- explicit Euler --------------------------------------------------------------------------------
-def euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
+def _euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
     """Spectral radius of one explicit-Euler step of the spring-damper (step ``h = dt/tau``).
 
     The homogeneous update ``[y, z] ← [[1, h], [−h α β, 1 − h α]] [y, z]`` has characteristic
@@ -53,15 +52,15 @@ def euler_spectral_radius(step: float, alpha: float, beta: float) -> float:
 
 
 def _max_stable_step(alpha: float, beta: float, step: float) -> float:
-    """The largest ``h`` below ``step`` for which :func:`euler_spectral_radius` stays < 1 (bisection)."""
+    """The largest ``h`` below ``step`` for which :func:`_euler_spectral_radius` stays < 1 (bisection)."""
     low, high = 0.0, step
     for _ in range(60):
         middle = 0.5 * (low + high)
-        low, high = (middle, high) if euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
+        low, high = (middle, high) if _euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
     return low
 
 
-def check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None:
+def _check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None:
     """Refuse an explicit-Euler step ``dt/tau`` for which the transformation system diverges.
 
     Raises
@@ -70,7 +69,7 @@ def check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> None
         Naming the bound on ``dt/tau`` (s) for these gains.
     """
     step = dt / tau
-    radius = euler_spectral_radius(step, alpha, beta)
+    radius = _euler_spectral_radius(step, alpha, beta)
     if not radius < 1.0:
         bound = _max_stable_step(alpha, beta, step)
         raise ValueError(
@@ -94,7 +93,7 @@ def _second_order(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray,
     return out
 
 
-def euler_responses(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, *, h: float, alpha: float,
+def _euler_responses(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, *, h: float, alpha: float,
                     beta: float) -> np.ndarray:
     """Integrate the Euler-discretised spring-damper for several input signals at once.
 
@@ -121,7 +120,7 @@ def euler_responses(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarra
 
 # -- exact (first-order hold) ---------------------------------------------------------------------
 @lru_cache(maxsize=64)
-def foh_step(step: float, alpha: float, beta: float, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _foh_step(step: float, alpha: float, beta: float, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The exact step of the spring-damper with the input linear over the step.
 
     Returns ``(Φ (2, 2), Γ₀ (2,), Γ₁ (2,))`` with ``x[l+1] = Φ x[l] + Γ₀ u[l] + Γ₁ u[l+1]`` for the
@@ -147,7 +146,7 @@ def foh_step(step: float, alpha: float, beta: float, tau: float) -> tuple[np.nda
     return transition, now, after
 
 
-def exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray, *, step: float, alpha: float,
+def _exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray, *, step: float, alpha: float,
                     beta: float, tau: float) -> np.ndarray:
     """Exact (first-order hold) integration for several input signals at once.
 
@@ -162,7 +161,7 @@ def exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray
     -------
     y : array, shape (S, n)
     """
-    transition, now, after = foh_step(step, alpha, beta, tau)
+    transition, now, after = _foh_step(step, alpha, beta, tau)
     n = inputs.shape[1]
     y_second = transition[0, 0] * y_first + transition[0, 1] * z_first
     if n > 1:
@@ -181,7 +180,7 @@ def exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray
     return _second_order(drives, y_first, y_second, [1.0, 0.0, 0.0], a1, a2)
 
 
-def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float, beta: float,
+def _exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float, beta: float,
                 tau: float) -> tuple[np.ndarray, np.ndarray]:
     """``z`` and ``d²y/ds²`` at the samples of an exact rollout, from consecutive positions.
 
@@ -197,7 +196,7 @@ def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float,
         row of ``Φ`` gives ``y[l+1] = Φ₁₁ y[l] + Φ₁₂ z[l] + Γ₀₁ u[l] + Γ₁₁ u[l+1]``, solved for
         ``z[l]``; the acceleration is the system's own, ``(u - αβ y - α z) / tau²``.
     """
-    transition, now, after = foh_step(step, alpha, beta, tau)
+    transition, now, after = _foh_step(step, alpha, beta, tau)
     z = y[1:] - transition[0, 0] * y[:-1]
     z -= now[0] * inputs[:-1]
     z -= after[0] * inputs[1:]
@@ -209,19 +208,19 @@ def exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float,
 
 
 # -- the fast path: unit responses and affine rollouts ---------------------------------------------
-def check_integration(step: float, params) -> None:
+def _check_integration(step: float, params) -> None:
     """Refuse a normalised step for which the Euler spring diverges or the Euler phase (or an
     exponentially delayed goal) does not decay; ``params`` a DMP's resolved parameters. The exact
     integrator is stable at any step."""
     if params.integrator != "euler":
         return
-    check_euler_stable(step, params.tau, params.alpha, params.beta)
-    phase_decay(step, params.tau, params.alpha_phase)
+    _check_euler_stable(step, params.tau, params.alpha, params.beta)
+    _phase_decay(step, params.tau, params.alpha_phase)
     if params.goal_rate is not None:
-        phase_decay(step, params.tau, params.goal_rate)
+        _phase_decay(step, params.tau, params.goal_rate)
 
 
-def unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step: float,
+def _unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step: float,
                    gate: np.ndarray | None = None) -> np.ndarray:
     """Responses that compose every rollout on the grid ``phase`` (n samples ``step`` apart).
 
@@ -248,12 +247,12 @@ def unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step: 
         # the exact integrator's z = tau dy/ds.
         second = np.array([0.0, 0.0, params.tau]) if exact else np.array([0.0, 1.0, step])
     if exact:
-        return exact_responses(drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau)
-    responses = euler_responses(drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta)
+        return _exact_responses(drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau)
+    responses = _euler_responses(drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta)
     return responses[:, :n_steps]
 
 
-def affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray,
+def _affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray,
                     out: np.ndarray | None = None) -> np.ndarray:
     """``y[i] = free + B goals[i]`` for every goal at once, (G, n, D), written into ``out`` if given.
 
@@ -284,7 +283,7 @@ class StepIntegrator:
     """The transformation system ``tau dz/ds = u - αβ y - α z``, ``tau dy/ds = z``, one step at a time.
 
     The same steps as the fast path: exact with the input linear over the step
-    (:func:`foh_step`), or explicit Euler. What the fast path cannot take is an input that depends
+    (:func:`_foh_step`), or explicit Euler. What the fast path cannot take is an input that depends
     on the state: here the caller adds it to ``u`` before each step (coupling terms, see
     :mod:`bidmp.primitives.coupling`).
 
@@ -307,12 +306,12 @@ class StepIntegrator:
         read by the exact step only."""
         alpha, beta, tau = self.alpha, self.beta, self.tau
         if self.exact:
-            transition, now, after = foh_step(step, alpha, beta, tau)
+            transition, now, after = _foh_step(step, alpha, beta, tau)
             state = transition @ np.stack([y, z]) + np.outer(now, u_now) + np.outer(after, u_next)
             return state[0], state[1]
         h = step / tau
         if h != self._checked_step:
-            check_euler_stable(step, tau, alpha, beta)
+            _check_euler_stable(step, tau, alpha, beta)
             self._checked_step = h
         z_next = z + h * (u_now - alpha * beta * y - alpha * z)
         return y + h * z, z_next

@@ -8,10 +8,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .so3 import left_jacobian, orientation_from_log
+from .so3 import _left_jacobian, orientation_from_log
 from .timing import TimedMotion
 
-__all__ = ["PoseTrajectory", "PoseStepper", "pose_trajectory"]
+__all__ = ["PoseTrajectory", "PoseStepper"]
 
 
 @dataclass(frozen=True)
@@ -68,14 +68,14 @@ _JACOBIAN_STEP = 1e-7  # s: the left Jacobian's change along ė, by a forward di
 def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """World-frame angular velocity ``ω = J_l(e) ė`` and acceleration ``ω̇ = J_l(e) ë + (d/dt J_l) ė``
     (n, 3) from the orientation log and its derivatives."""
-    jacobian = left_jacobian(e)
+    jacobian = _left_jacobian(e)
     omega = np.einsum("nij,nj->ni", jacobian, ed)
-    change = (left_jacobian(e + ed * _JACOBIAN_STEP) - jacobian) / _JACOBIAN_STEP
+    change = (_left_jacobian(e + ed * _JACOBIAN_STEP) - jacobian) / _JACOBIAN_STEP
     omega_dot = np.einsum("nij,nj->ni", jacobian, edd) + np.einsum("nij,nj->ni", change, ed)
     return omega, omega_dot
 
 
-def pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
+def _pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
                      position_increment, orientation_increment, units, coupling=None) -> PoseTrajectory:
     """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
     ``coupling`` terms act on the position part, and both parts then run the step integrator."""

@@ -14,10 +14,17 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._checks import NotFittedError, check_choice, check_fitted, check_int, check_real, short_token
+from .._checks import (
+    NotFittedError,
+    check_choice,
+    check_fitted,
+    check_int,
+    check_real,
+    short_token,
+)
 
-__all__ = ["Params", "FittedParams", "resolve_params", "resolved_param", "with_rest", "PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
-           "ROBOT_SETTLE", "GAIN_RANGE", "TAU_RANGE"]
+__all__ = ["PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
+           "ROBOT_SETTLE"]
 
 K_CHOICES = ("paper", "pastor")
 REGRESSION_CHOICES = ("lwr", "ridge")
@@ -25,11 +32,11 @@ DERIVATIVE_CHOICES = ("gradient", "forward")
 WIDTH_CHOICES = ("spacing", "pydmps")
 # Gains (alpha, beta, alpha_phase in 1/s; K) and tau (s) outside these ranges have no physical use
 # and take float64 out of its range in the forcing target (division by K) or the integration.
-GAIN_RANGE = (1e-6, 1e6)
-TAU_RANGE = (1e-6, 1e6)
+_GAIN_RANGE = (1e-6, 1e6)
+_TAU_RANGE = (1e-6, 1e6)
 
 
-class Params(NamedTuple):
+class _Params(NamedTuple):
     """The validated hyperparameters of a :class:`DMP` (``beta``, ``K``, ``alpha_phase`` and
     ``goal_rate`` resolved to numbers for the protocol)."""
 
@@ -78,38 +85,38 @@ ROBOT_ALPHA_PHASE = 4.0
 ROBOT_SETTLE = 1.1
 
 
-def resolve_params(estimator) -> Params:
+def _resolve_params(estimator) -> _Params:
     """The validated parameters of a :class:`bidmp.DMP` (or anything with its constructor's
     parameters) as they are now, the protocol's defaults filled in; raise naming the first bad one."""
     protocol = check_choice(estimator.protocol, "protocol", PROTOCOLS)
     robot = protocol == "robot"
     alpha = (ROBOT_ALPHA if robot else 25.0) if estimator.alpha is None else \
-        check_real(estimator.alpha, "alpha", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
-    beta = alpha / 4.0 if estimator.beta is None else check_real(estimator.beta, "beta", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+        check_real(estimator.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+    beta = alpha / 4.0 if estimator.beta is None else check_real(estimator.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
     K_choice = ("pastor" if robot else "paper") if estimator.K is None else estimator.K
     if isinstance(K_choice, str):
         check_choice(K_choice, "K", K_CHOICES)
         K = alpha if K_choice == "paper" else alpha * beta
     else:
-        K = check_real(K_choice, "K", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1] ** 2)
+        K = check_real(K_choice, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2)
     if estimator.alpha_phase is None:
         alpha_phase = ROBOT_ALPHA_PHASE if robot else 1.0
     else:
-        alpha_phase = check_real(estimator.alpha_phase, "alpha_phase", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+        alpha_phase = check_real(estimator.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
     if estimator.goal_rate is None:
         goal_rate = None if robot else alpha_phase
     else:
-        goal_rate = check_real(estimator.goal_rate, "goal_rate", positive=True, minimum=GAIN_RANGE[0], maximum=GAIN_RANGE[1])
+        goal_rate = check_real(estimator.goal_rate, "goal_rate", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
     integrator = ("exact" if robot else "euler") if estimator.integrator is None else \
         check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
-    return Params(
+    return _Params(
         n_kernels=(ROBOT_KERNELS if robot else 50) if estimator.n_kernels is None else
         check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
         alpha=alpha,
         beta=beta,
         K=K,
         alpha_phase=alpha_phase,
-        tau=check_real(estimator.tau, "tau", positive=True, minimum=TAU_RANGE[0], maximum=TAU_RANGE[1]),
+        tau=check_real(estimator.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]),
         regression=("ridge" if robot else "lwr") if estimator.regression is None else
         check_choice(estimator.regression, "regression", REGRESSION_CHOICES),
         derivatives=check_choice(estimator.derivatives, "derivatives", DERIVATIVE_CHOICES),
@@ -123,7 +130,7 @@ def resolve_params(estimator) -> Params:
     )
 
 
-def with_rest(y: np.ndarray, params: Params) -> np.ndarray:
+def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:
     """``y`` followed by rest at its last point for the protocol's settle time (robot: 0.1 T)."""
     n_rest = int(round(params.settle * y.shape[0])) - y.shape[0]
     if n_rest <= 0:
@@ -131,7 +138,7 @@ def with_rest(y: np.ndarray, params: Params) -> np.ndarray:
     return np.vstack([y, np.repeat(y[-1:], n_rest, axis=0)])
 
 
-class FittedParams:
+class _FittedParams:
     """Mixin of an estimator whose learned state depends on its parameters (all but ``tau``):
     a parameter changed after ``fit`` makes it unfitted (:class:`bidmp.NotFittedError` names it)."""
 
@@ -155,7 +162,7 @@ class FittedParams:
             setattr(cls, "_raw_names", names)
         return names
 
-    def _learned_params(self) -> Params:
+    def _learned_params(self) -> _Params:
         """The resolved parameters the weights depend on (all but tau, which only scales time)."""
         return self._params()._replace(tau=1.0)
 
@@ -193,7 +200,7 @@ class FittedParams:
             )
 
 
-def resolved_param(name: str, doc: str) -> property:
+def _resolved_param(name: str, doc: str) -> property:
     """A read-only property: the resolved value of parameter ``name`` (the protocol's default when
     it is None)."""
     return property(lambda self: getattr(self._params(), name), doc=doc)

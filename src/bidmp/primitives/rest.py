@@ -15,26 +15,26 @@ import logging
 
 import numpy as np
 
-from .goals import smoothstep, smoothstep_derivatives
+from .goals import _smoothstep, _smoothstep_derivatives
 
-__all__ = ["rest_started", "REST_BLEND_SHARE", "REST_BLEND_MAX"]
+__all__ = []
 
 logger = logging.getLogger(__name__)
 
-REST_BLEND_SHARE = 0.1  # the rest blend adds at most this share of the demonstration's acceleration
-REST_BLEND_MAX = 0.25  # the rest blend never spans more than this share of the demonstration
-_REST_CANDIDATES = np.geomspace(0.01, REST_BLEND_MAX, 32)
+_REST_BLEND_SHARE = 0.1  # the rest blend adds at most this share of the demonstration's acceleration
+_REST_BLEND_MAX = 0.25  # the rest blend never spans more than this share of the demonstration
+_REST_CANDIDATES = np.geomspace(0.01, _REST_BLEND_MAX, 32)
 
 
 # The rest blend's acceleration is -v₀ q''(t/w) / w with q(u) = u (1 - S(u)), q'' = -2S' - u S'':
 # its shape on [0, 1] does not depend on the window, so it is tabulated once.
 _BLEND_U = np.linspace(0.0, 1.0, 65)
-_BLEND_SHAPE = np.abs(2.0 * smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * smoothstep_derivatives(_BLEND_U)[1])
+_BLEND_SHAPE = np.abs(2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1])
 
 
 def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float) -> float:
     """The shortest window (normalised time) over which blending ``speed_vector`` out adds at most
-    ``REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
+    ``_REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
     speed = float(np.linalg.norm(speed_vector))
     if speed <= 1e-12 * max(peak, 1e-300):
         return 0.0
@@ -42,11 +42,11 @@ def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float,
     # All candidate windows at once: (candidates, 65) added accelerations against the running peak.
     added = speed * _BLEND_SHAPE[None, :] / _REST_CANDIDATES[:, None]
     index = np.minimum((_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1)
-    within = np.all(added <= REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
-    return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(REST_BLEND_MAX)
+    within = np.all(added <= _REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
+    return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(_REST_BLEND_MAX)
 
 
-def rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
+def _rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
                  unit: str = "units") -> np.ndarray:
     """``y`` (T, D) with its start and end velocity blended out (module docstring).
 
@@ -71,7 +71,7 @@ def rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the d
         if width == 0.0:
             continue
         elapsed = (s[-1] - s) if end else s
-        blend = elapsed * (1.0 - smoothstep(elapsed / width))
+        blend = elapsed * (1.0 - _smoothstep(elapsed / width))
         out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
         speed = float(np.linalg.norm(speed_vector))
         level = logging.WARNING if speed > 0.05 * peak else logging.DEBUG

@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_points, check_bytes, get_limits
-from .integrate import affine_rollouts
+from .integrate import _affine_rollouts
 
-__all__ = ["rollouts_to", "iter_rollouts_to", "chunks"]
+__all__ = []
 
 
-def rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+def _rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
     """The rollouts ``free + B goals[i]`` (G, n, D) of a model's free response ``free`` (n, D) and
     goal response ``goal_response`` (n,), into ``out`` if given (else refused over the limit
     ``max_array_bytes``)."""
@@ -30,16 +30,16 @@ def rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndar
                 f"shape={shape}), iterate with iter_rollouts(goals, chunk_size={chunk:,}), or raise the limit "
                 f"with bidmp.set_limits(max_array_bytes=...)"
             )
-        return affine_rollouts(goal_response, goals, free)
+        return _affine_rollouts(goal_response, goals, free)
     if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
         described = f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
         raise ValueError(f"out must be a writable float64 array of shape {shape}, got {described}")
-    for first, chunk in chunks(goals, free):
-        affine_rollouts(goal_response, chunk, free, out[first : first + chunk.shape[0]])
+    for first, chunk in _chunks(goals, free):
+        _affine_rollouts(goal_response, chunk, free, out[first : first + chunk.shape[0]])
     return out
 
 
-def chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
+def _chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
     """``(first, goals[first : first + chunk_size])``; by default about 64 MiB of rollouts a chunk."""
     if chunk_size is None:
         chunk_size = max((64 << 20) // (8 * free.size), 1)  # about 64 MiB per chunk
@@ -47,9 +47,9 @@ def chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
         yield first, goals[first : first + chunk_size]
 
 
-def iter_rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, chunk_size: int):
-    """:func:`rollouts_to`, ``chunk_size`` goals at a time: yields ``(first, y (g, n, D))``."""
+def _iter_rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, chunk_size: int):
+    """:func:`_rollouts_to`, ``chunk_size`` goals at a time: yields ``(first, y (g, n, D))``."""
     goals = as_points(goals, free.shape[1], "goals")
     check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
-    for first, chunk in chunks(goals, free, chunk_size):
-        yield first, affine_rollouts(goal_response, chunk, free)
+    for first, chunk in _chunks(goals, free, chunk_size):
+        yield first, _affine_rollouts(goal_response, chunk, free)

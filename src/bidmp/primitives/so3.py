@@ -20,7 +20,7 @@ from scipy.spatial.transform import Rotation
 from .._checks import _as_float_array, _check_magnitude
 from .._trajectory import continuous_quaternions
 
-__all__ = ["as_quaternions", "principal_log", "continuous_log", "nearest_turn", "angle_between", "left_jacobian",
+__all__ = ["as_quaternions", "principal_log", "continuous_log", "angle_between",
            "orientation_from_log"]
 
 _NORM_TOLERANCE = 1e-6  # a quaternion further than this from unit length is normalised, with a warning
@@ -119,7 +119,7 @@ def continuous_log(q, goal) -> np.ndarray:
     return np.asarray(signed)[:, None] * np.asarray(out_axes)
 
 
-def nearest_turn(q, goal, reference: np.ndarray) -> np.ndarray:
+def _nearest_turn(q, goal, reference: np.ndarray) -> np.ndarray:
     """``Log(q ⊗ goal⁻¹)`` for one quaternion ``q`` (4,), as the equivalent rotation vector nearest
     ``reference`` (3,): a start pose away from the demonstrated one turns to the goal the same way
     (and as many times) as the demonstration did."""
@@ -147,7 +147,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
     return out
 
 
-def left_jacobian(r: np.ndarray) -> np.ndarray:
+def _left_jacobian(r: np.ndarray) -> np.ndarray:
     """Left Jacobian of SO(3), (n, 3, 3): ``ω = J_l(r) ṙ`` for ``R = Exp(r) G`` (world-frame ω).
     Valid for rotation vectors of any length (several turns)."""
     r = _vector_rows(r, "r")

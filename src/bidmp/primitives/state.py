@@ -7,12 +7,12 @@ import numpy as np
 
 from .._checks import check_int, check_loaded, check_real, get_limits
 from .._units import check_units
-from .integrate import check_euler_stable
+from .integrate import _check_euler_stable
 
-__all__ = ["dmp_state", "dmp_from_state"]
+__all__ = []
 
 
-def dmp_state(model) -> tuple[dict, dict]:
+def _dmp_state(model) -> tuple[dict, dict]:
     """A fitted DMP's state for a model file: (JSON-able meta, arrays)."""
     model._check_fitted()
     arrays = {
@@ -28,7 +28,7 @@ def dmp_state(model) -> tuple[dict, dict]:
             "units_": model.units_}, arrays
 
 
-def dmp_from_state(cls, meta: dict, arrays) -> object:
+def _dmp_from_state(cls, meta: dict, arrays) -> object:
     """A DMP of class ``cls`` from a model file's state, every member checked (a corrupt or forged
     file raises ``ValueError`` naming the member)."""
     params = dict(meta["params"])
@@ -68,6 +68,6 @@ def dmp_from_state(cls, meta: dict, arrays) -> object:
             raise ValueError("member goal_gate_ has values beyond 1e6, which no fit produces")
         model.goal_gate_ = gate
     if params.integrator == "euler":
-        check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
+        _check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
     model._remember_params()
     return model

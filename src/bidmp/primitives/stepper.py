@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import as_point, check_real
-from .coupling import as_couplings
-from .forcing import basis_row
+from .coupling import _as_couplings
+from .forcing import _basis_row
 from .integrate import StepIntegrator
-from .protocols import TAU_RANGE
+from .protocols import _TAU_RANGE
 
 __all__ = ["DMPStepper"]
 
@@ -43,9 +43,9 @@ class DMPStepper:
         self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
         motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
         self._scale = check_real(motion / dmp.duration_, "duration / duration_ (the temporal scaling)",
-                                 minimum=TAU_RANGE[0], maximum=TAU_RANGE[1])  # tau of the normalised system
+                                 minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])  # tau of the normalised system
         self._params = params._replace(tau=self._scale)
-        self._couplings, self._temporal = as_couplings(coupling)
+        self._couplings, self._temporal = _as_couplings(coupling)
         self._forcing_increment = forcing_increment
         self.y = self.start.copy()
         velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
@@ -72,7 +72,7 @@ class DMPStepper:
                 and np.array_equal(last[3], self.start)):
             return last[4]
         params = self._params
-        basis = basis_row(phase, self._centres, self._widths)
+        basis = _basis_row(phase, self._centres, self._widths)
         forcing = basis @ self._weights
         if self._forcing_increment is not None:
             forcing = forcing + self._forcing_increment(np.array([phase]), basis)

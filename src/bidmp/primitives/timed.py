@@ -8,15 +8,15 @@ import numpy as np
 
 from .._checks import as_point, check_int, check_real, get_limits
 from .._units import check_reach
-from .integrate import exact_state
-from .protocols import TAU_RANGE, Params
+from .integrate import _exact_state
+from .protocols import _TAU_RANGE, _Params
 from .stepper import DMPStepper
 from .timing import Trajectory, scale_factor
 
-__all__ = ["timed_trajectory", "coupled_trajectory", "limited_trajectory", "time_grid", "exact_rates"]
+__all__ = []
 
 
-def time_grid(dmp, duration, dt, params: Params) -> tuple[float, float, int, float]:
+def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, float]:
     """(motion duration s, sample period s, number of samples, normalised step) of a timed
     rollout; the motion's duration defaults to ``tau · duration_``, the period to the
     demonstration's."""
@@ -26,7 +26,7 @@ def time_grid(dmp, duration, dt, params: Params) -> tuple[float, float, int, flo
     if dt > motion:
         raise ValueError(f"dt = {dt:g} s is longer than the motion ({motion:g} s)")
     scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched
-    check_real(scale, "duration / duration_ (the temporal scaling)", minimum=TAU_RANGE[0], maximum=TAU_RANGE[1])
+    check_real(scale, "duration / duration_ (the temporal scaling)", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
     if params.protocol == "paper" and duration is None and dt == period:
         n_samples = max(int(round(params.tau * dmp.n_steps_)), 1)  # the rollout's own samples
     else:
@@ -38,10 +38,10 @@ def time_grid(dmp, duration, dt, params: Params) -> tuple[float, float, int, flo
     return motion, dt, n_samples, step
 
 
-def timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment):
+def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment):
     """The fast path of :meth:`bidmp.DMP.trajectory` (no limits, no coupling terms)."""
     params = dmp._params()
-    motion, dt, n_samples, step = time_grid(dmp, duration, dt, params)
+    motion, dt, n_samples, step = _time_grid(dmp, duration, dt, params)
     params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
     velocity = None if start_velocity is None else as_point(start_velocity, dmp.n_dims_, "start_velocity") * dmp.time_unit_
     # Two extra samples give the last velocity and acceleration as forward differences (Euler),
@@ -55,7 +55,7 @@ def timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_inc
     positions = free + np.outer(goal_response, goal)
     if params.exact:
         start = dmp.start_ if start is None else as_point(start, free.shape[1], "start")
-        velocities, accelerations = exact_rates(params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_)
+        velocities, accelerations = _exact_rates(params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_)
     else:
         velocities = np.diff(positions, axis=0) / dt
         accelerations = np.diff(velocities, axis=0) / dt
@@ -63,20 +63,20 @@ def timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_inc
                       accelerations[:n_samples], dmp.units_)
 
 
-def exact_rates(params: Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float) -> tuple:
+def _exact_rates(params: _Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float) -> tuple:
     """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
     n out): the system's own state and acceleration, from the positions and the input."""
     inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
     inputs -= np.multiply.outer(gate, params.K * (goal - start))
     inputs += params.alpha * params.beta * goal
-    z, acceleration = exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau)
+    z, acceleration = _exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau)
     # The first state is given, not solved for: a rest start is exactly at rest.
     z[0] = 0.0 if velocity is None else params.tau * velocity
     acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
     return z / (params.tau * time_unit), acceleration / time_unit**2
 
 
-def limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
+def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
     """The trajectory within ``limits``: at the nominal duration if that meets them (limits
     are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
     shortest duration that does: scale by the exact factor of
@@ -121,11 +121,11 @@ def limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_inc
     return trajectory if factor <= 1.0 or best is None else best
 
 
-def coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling) -> Trajectory:
+def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling) -> Trajectory:
     """:meth:`bidmp.DMP.trajectory` through the step integrator, with coupling terms: the same
-    samples as :func:`timed_trajectory` (to rounding) when the terms add nothing."""
+    samples as :func:`_timed_trajectory` (to rounding) when the terms add nothing."""
     params = dmp._params()
-    motion, dt, n_samples, _ = time_grid(dmp, duration, dt, params)
+    motion, dt, n_samples, _ = _time_grid(dmp, duration, dt, params)
     stepper = DMPStepper(dmp, goal, start, motion, coupling, start_velocity, forcing_increment)
     states = [stepper.step(dt) for _ in range(n_samples)]
     y, yd, ydd = (np.array([state[k] for state in states]) for k in range(3))

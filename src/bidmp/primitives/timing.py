@@ -15,7 +15,7 @@ import numpy as np
 
 from .._checks import _as_float_array, check_choice, numerically_guarded, short_token
 
-__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "drop_duplicate_stamps", "uniform_time", "on_uniform_time", "scale_factor",
+__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
 
 logger = logging.getLogger(__name__)
@@ -150,7 +150,7 @@ def _stamp(value: float) -> str:
     return np.format_float_positional(float(value), unique=True, trim="-")
 
 
-def drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
+def _drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
     """``y`` (T, D) and stamps ``t`` (T,) without the samples whose stamp repeats the previous
     one, as loggers write them (the first of each run is kept); a warning says how many.
 
@@ -267,6 +267,6 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     y = _as_samples(y)
     if t is None:
         return y, (y.shape[0] - 1) / y.shape[0]
-    y, stamps = drop_duplicate_stamps(y, t)
+    y, stamps = _drop_duplicate_stamps(y, t)
     y, grid = uniform_time(y, stamps)
     return y, float(grid[-1])

@@ -5,15 +5,12 @@
 from __future__ import annotations
 
 import logging
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._checks import _as_float_array
-
-
-from typing import TYPE_CHECKING
-
-from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _Distances, _cylinder_box_bounds
+from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _cylinder_box_bounds, _Distances
 
 if TYPE_CHECKING:  # pragma: no cover
     from .clearance import Scene

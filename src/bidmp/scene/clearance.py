@@ -19,11 +19,17 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import _as_float_array, _check_magnitude, as_trajectory, check_real, numerically_guarded, short_token
+from .._checks import (
+    _as_float_array,
+    _check_magnitude,
+    as_trajectory,
+    check_real,
+    numerically_guarded,
+    short_token,
+)
 from .._trajectory import continuous_quaternions
-
 from .checker import SceneChecker
-from .distances import _CHUNK, _Distances, _box_distance, _cylinder_box_bounds, _densify
+from .distances import _CHUNK, _box_distance, _cylinder_box_bounds, _densify, _Distances
 from .parts import Part, Tool, _cylinder_extent, _fail, _number, _parse_parts
 
 __all__ = ['Scene', 'Clearance']

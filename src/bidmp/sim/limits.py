@@ -24,7 +24,7 @@ import numpy as np
 
 from .backend import SIM_STEP, JointLimits
 
-__all__ = ["CommandPeaks", "command_peaks", "measured_peaks", "RateLimiter", "PADDING", "AT_REST"]
+__all__ = ["PADDING", "AT_REST"]
 
 PADDING = 3  # samples of rest before and after the commands when they are checked
 # A motion starts and stops at rest: the acceleration of its first and last command at most this
@@ -35,7 +35,7 @@ _WINDOW = 0.01  # s: the measured joints' estimator (differences over 10 ms wind
 
 
 @dataclass(frozen=True)
-class CommandPeaks:
+class _CommandPeaks:
     """Peaks of a 1 kHz command, each the largest over the joints as a fraction of its limit
     (jerk: 0 when the limits state none)."""
 
@@ -57,16 +57,16 @@ def _worst(values: np.ndarray, limit) -> float:
     return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
 
 
-def _peaks(positions: np.ndarray, dt: float, limits: JointLimits) -> CommandPeaks:
+def _peaks(positions: np.ndarray, dt: float, limits: JointLimits) -> _CommandPeaks:
     velocity = np.diff(positions, axis=0) / dt
     acceleration = np.diff(velocity, axis=0) / dt
     jerk = np.diff(acceleration, axis=0) / dt
 
-    return CommandPeaks(_worst(velocity, limits.velocity), _worst(acceleration, limits.acceleration),
+    return _CommandPeaks(_worst(velocity, limits.velocity), _worst(acceleration, limits.acceleration),
                         _worst(jerk, limits.jerk))
 
 
-def command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> CommandPeaks:
+def _command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> _CommandPeaks:
     """The peaks of joint position commands (n, 7) sent every ``dt`` seconds, from rest to rest
     (the first and last held :data:`PADDING` samples before and after, see the module docstring)."""
     commands = np.asarray(commands, dtype=float)
@@ -77,10 +77,10 @@ def command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STE
     # From rest: the first command's acceleration is its first step over dt², likewise the last.
     ends = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
     ratio = float(np.max(ends / np.asarray(limits.acceleration, dtype=float)))
-    return CommandPeaks(peaks.velocity, peaks.acceleration, peaks.jerk, ratio)
+    return _CommandPeaks(peaks.velocity, peaks.acceleration, peaks.jerk, ratio)
 
 
-def measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> CommandPeaks:
+def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> _CommandPeaks:
     """Peaks of the measured joints from their recorded velocities (n, 7), one every
     ``record_step`` seconds: velocity as recorded, acceleration and jerk by differences over
     10 ms windows."""
@@ -90,17 +90,17 @@ def measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimi
     acceleration = np.diff(sampled, axis=0) / step
     jerk = np.diff(acceleration, axis=0) / step
 
-    return CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
+    return _CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
                         _worst(jerk, limits.jerk))
 
 
-class RateLimiter:
+class _RateLimiter:
     """A 1 kHz jerk-limited command generator that follows a moving target: cascaded
     proportional loops (position → velocity → acceleration → jerk, each three times faster than
     the one outside it) with the target's velocity fed forward and each level clipped to
     ``margin`` times its limit. So every command it returns is within the jerk and acceleration
     limits by construction and within the velocity limit up to the inner loop's overshoot, which
-    :func:`command_peaks` measures; it starts at rest at ``start`` and comes to rest at a target
+    :func:`_command_peaks` measures; it starts at rest at ``start`` and comes to rest at a target
     that stands still. (Clipping the differences of the target alone, as a plain rate limiter
     does, is not stable: on a held joint its error grows into a limit cycle.)"""
 

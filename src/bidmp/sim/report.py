@@ -11,12 +11,12 @@ from pathlib import Path
 import numpy as np
 
 from ..tasks._tables import markdown_table, text_table
-from ..tasks.metrics import approach_error, axis_deviation, json_length
+from ..tasks.metrics import _json_length, approach_error, axis_deviation
 from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
-from .limits import CommandPeaks, command_peaks, measured_peaks
+from .limits import _command_peaks, _CommandPeaks, _measured_peaks
 from .pybullet.robot import PANDA
 
-__all__ = ["SimTarget", "SimMethod", "SimReport", "measure", "write_sim_report"]
+__all__ = ["SimTarget", "SimMethod", "SimReport", "write_sim_report"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -53,18 +53,18 @@ class SimTarget:
     def to_dict(self, threshold: float) -> dict:
         return {
             "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
-            "approach_error": json_length(self.approach_error),
+            "approach_error": _json_length(self.approach_error),
             "engaged": self.engaged, "contacts": sorted(self.contacts),
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
             "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
             "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4),
             "peak_joint_jerk": round(self.peak_jerk, 4), "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
-            "commanded_penetration": json_length(self.commanded_penetration),
+            "commanded_penetration": _json_length(self.commanded_penetration),
             "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
-            "axis_deviation_deg": json_length(self.axis_deviation),
+            "axis_deviation_deg": _json_length(self.axis_deviation),
             "aligned": self.aligned,
         }
 
@@ -167,7 +167,7 @@ class SimReport:
         return markdown_table(*self.rows())
 
 
-def measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, run: Execution, unit: float,
+def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, run: Execution, unit: float,
             closed_loop: bool, limits=PANDA) -> SimTarget:
     """The per-target results of one execution (``scenario``: its targets, units, threshold;
     ``limits``: the robot's joint limits)."""
@@ -183,10 +183,10 @@ def measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, ru
     # What counts: the commands the position control was sent every 1 ms, from rest to rest
     # (bidmp.sim.limits); the measured joints are reported beside them.
     if run.commands is not None:
-        sent = command_peaks(run.commands, limits)
+        sent = _command_peaks(run.commands, limits)
     else:  # a backend that does not report its commands: the plan's own peaks
-        sent = CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
-    measured = measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits)
+        sent = _CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
+    measured = _measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits)
     motion_time = float(run.times[-1]) - SETTLE if closed_loop else plan.duration
     return SimTarget(
         label=label, commanded_error=commanded_error, measured_error=measured_error, approach_error=approach,

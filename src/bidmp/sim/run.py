@@ -13,9 +13,9 @@ import numpy as np
 from .._checks import check_int, check_real
 from .backend import COUPLING, Hold
 from .pybullet.cell import PandaCell
-from .pybullet.robot import robot_placement, unit_of
-from .pybullet.world import pybullet_module
-from .report import SimMethod, SimReport, measure
+from .pybullet.robot import _unit_of, robot_placement
+from .pybullet.world import _pybullet_module
+from .report import SimMethod, SimReport, _measure
 
 __all__ = ["simulate"]
 
@@ -49,7 +49,7 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
             run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
         else:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
-        measured = measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
+        measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
         measured.commanded_penetration = _commanded_penetration(cell, run, job)
         results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
     return results
@@ -137,7 +137,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
 
     scenario, backend = _scenario_and_backend(scenario, backend)
     methods, labels = _checked(scenario, methods, targets, closed_loop)
-    coupling = COUPLING * unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
+    coupling = COUPLING * _unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
     if report is None:
         report = evaluate(scenario, methods, geometry=False)
     base, yaw = robot_placement(scenario)
@@ -165,7 +165,7 @@ def _scenario_and_backend(scenario, backend):
     if scenario.scene is None:
         raise ValueError(f"scenario {scenario.name!r} has no \"scene\": the simulator needs the parts and the tool")
     if backend is None:
-        pybullet_module()  # fail early, with the install command, when the extra is missing
+        _pybullet_module()  # fail early, with the install command, when the extra is missing
         backend = PandaCell
     return scenario, backend
 

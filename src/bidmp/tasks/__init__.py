@@ -30,6 +30,7 @@ _EXPORTS = {
     "axis_deviation": "metrics",
     "path_difference": "metrics",
     "swept_area": "metrics",
+    "final_approach_mask": "metrics",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -13,7 +13,7 @@ import numpy as np
 from .._checks import as_point, as_trajectory, check_real
 from .._trajectory import path_extent, rmse
 
-__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area"]
+__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area", "final_approach_mask"]
 
 
 def endpoint_error(trajectory, target) -> float:
@@ -81,7 +81,7 @@ def approach_error(trajectory, target, height: float, axis=None) -> float:
     return float(np.max(np.linalg.norm(offsets[final] - np.outer(along[final], axis), axis=1)))
 
 
-def json_length(value) -> float | None:
+def _json_length(value) -> float | None:
     """A length or angle for a JSON report: 4 decimals; None when absent or not finite (strict JSON
     has no Infinity: an approach error of a motion without a final approach)."""
     return None if value is None or not np.isfinite(value) else round(float(value), 4)

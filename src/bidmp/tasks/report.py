@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ._tables import markdown_table, text_table
-from .metrics import json_length
+from .metrics import _json_length
 
 __all__ = ["MethodResult", "Report", "write_report"]
 
@@ -103,7 +103,7 @@ class MethodResult:
             "successes": self.successes,
             "n_targets": n_targets,
             "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
-            "approach_errors": None if self.approach_errors is None else {label: json_length(e) for label, e in self.approach_errors.items()},
+            "approach_errors": None if self.approach_errors is None else {label: _json_length(e) for label, e in self.approach_errors.items()},
             "max_error": round(float(max(self.errors.values())), 4),
             "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
             "runtime_s": round(self.runtime_s, 5),
@@ -118,7 +118,7 @@ class MethodResult:
             "engaged": self.engaged,
             "collision_free": self.collision_free,
             "n_checked": None if self.clearances is None else len(self.checked),
-            "min_clearance": None if worst is None else json_length(worst.distance),
+            "min_clearance": None if worst is None else _json_length(worst.distance),
             "min_clearance_part": None if worst is None else worst.part,
             "aligned": self.aligned,
         })
@@ -127,13 +127,13 @@ class MethodResult:
             clearance = self.clearance_at(label)
             targets[label] = {
                 "error": round(float(error), 4),
-                "approach_error": None if self.approach_errors is None else json_length(self.approach_errors[label]),
+                "approach_error": None if self.approach_errors is None else _json_length(self.approach_errors[label]),
                 "engaged": self.engaged_at(label),
-                "clearance": None if clearance is None else json_length(clearance.distance),
+                "clearance": None if clearance is None else _json_length(clearance.distance),
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
-                "axis_deviation": None if self.axis_deviations is None else json_length(self.axis_deviations[label]),
+                "axis_deviation": None if self.axis_deviations is None else _json_length(self.axis_deviations[label]),
             }
         out["targets"] = targets
         return out
@@ -248,7 +248,11 @@ def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
     """Write ``results.json`` and the three figures of a report into folder ``out`` (created if
     needed); return the paths written."""
     from ..io.atomic import atomic_write
-    from ..plotting.tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+    from ..plotting.tasks import (
+        plot_error_vs_distance,
+        plot_scenario_3d,
+        plot_targets_top_view,
+    )
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

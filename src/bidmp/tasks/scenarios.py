@@ -63,9 +63,9 @@ import numpy as np
 
 from .._checks import check_limit, get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
+from ..io.strict_json import load_json
 from ..scene.clearance import Scene
 from ..scene.parts import SceneError
-from ..io.strict_json import load_json
 from ._scenario_fields import (
     ScenarioError,
     _demonstration,
@@ -214,13 +214,13 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     approach = data.get("approach_height", 28.5)
     approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
 
-    from ..extension.extend import check_extension_options
+    from ..extension.extend import _check_extension_options
     from ..incremental.bidmp import BiDMP
     from ..primitives.dmp import DMP
 
     dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
     bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
-    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: check_extension_options(**params))
+    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: _check_extension_options(**params))
     extensions = _extensions(data, source, targets, n_dims)
     demonstrations = _further_demonstrations(data, source, base_dir, allow_outside_files, units, n_dims)
     methods = _methods(data, source, n_dims)

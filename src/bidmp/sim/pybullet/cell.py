@@ -13,8 +13,8 @@ from . import execute as _execute
 from . import ik as _ik
 from . import plan as _plan
 from . import render as _render
-from .robot import _REST, PANDA, unit_of
-from .world import SOLVER_ITERATIONS, add_solid, panda_urdf, pybullet_module
+from .robot import _REST, PANDA, _unit_of
+from .world import SOLVER_ITERATIONS, _add_solid, _panda_urdf, _pybullet_module
 
 __all__ = ["PandaCell"]
 
@@ -36,9 +36,9 @@ class PandaCell:
     """
 
     def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0):
-        self.p = p = pybullet_module()
+        self.p = p = _pybullet_module()
         self.scene = scene
-        self.unit = unit_of(units)
+        self.unit = _unit_of(units)
         self.client = p.connect(p.DIRECT)
         try:
             p.setTimeStep(SIM_STEP, physicsClientId=self.client)
@@ -48,7 +48,7 @@ class PandaCell:
             self._bodies = {}  # body id -> solid label
             self._owners = {}  # body id -> part label
             for solid in scene.solids:
-                body = add_solid(p, self.client, self.unit, solid)
+                body = _add_solid(p, self.client, self.unit, solid)
                 self._bodies[body] = solid.label
                 self._owners[body] = solid.part
             # A second world holds a copy of the arm alone for inverse and forward kinematics, so
@@ -56,7 +56,7 @@ class PandaCell:
             self.ik_client = p.connect(p.DIRECT)
             with tempfile.TemporaryDirectory() as folder:
                 path = Path(folder) / "panda_tool.urdf"
-                path.write_text(panda_urdf(scene.tool.radius * self.unit, scene.tool.length * self.unit))
+                path.write_text(_panda_urdf(scene.tool.radius * self.unit, scene.tool.length * self.unit))
                 base_m = np.asarray(base, dtype=float) * self.unit
                 orientation = p.getQuaternionFromEuler([0, 0, math.radians(yaw)])
                 self.robot = p.loadURDF(str(path), base_m.tolist(), orientation, useFixedBase=True,
@@ -120,34 +120,34 @@ class PandaCell:
         """Joint positions that put the TCP at ``point_m`` (m) with the tool's frame at
         ``orientation`` (quaternion x, y, z, w; default pointing down), started from ``seed``;
         and the position error left (m). See :func:`bidmp.sim.pybullet.ik.solve_ik`."""
-        return _ik.solve_ik(self, point_m, seed, orientation)
+        return _ik._solve_ik(self, point_m, seed, orientation)
 
     ik = solve_ik  # the backend protocol's name
 
     def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
         """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
         within the limits (:func:`bidmp.sim.pybullet.plan.plan`)."""
-        return _plan.plan(self, path, label, fractions, seed, orientations)
+        return _plan._plan(self, path, label, fractions, seed, orientations)
 
     def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
         """Run ``plan`` under position control at 1 kHz (:func:`bidmp.sim.pybullet.execute.execute`)."""
-        return _execute.execute(self, plan, exclude, hold, frames)
+        return _execute._execute(self, plan, exclude, hold, frames)
 
     def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
                             frames: int = 0, max_factor: float = 4.0) -> Execution:
         """Run a DMP/Bi-DMP ``stepper`` on the measured TCP at 100 Hz
         (:func:`bidmp.sim.pybullet.execute.execute_closed_loop`)."""
-        return _execute.execute_closed_loop(self, stepper, duration, exclude, hold, frames, max_factor)
+        return _execute._execute_closed_loop(self, stepper, duration, exclude, hold, frames, max_factor)
 
     def contacts(self) -> dict:
         """Part label -> penetration depth (m) of the robot's contacts now."""
         found = {}
-        _execute.contacts_into(self, found)
+        _execute._contacts_into(self, found)
         return found
 
     def render(self, width: int = 320, height: int = 240, target=None) -> np.ndarray:
         """An RGB image (height, width, 3) of the cell (:func:`bidmp.sim.pybullet.render.render`)."""
-        return _render.render(self, width, height, target)
+        return _render._render(self, width, height, target)
 
     def scene_centre(self) -> np.ndarray:
-        return _render.scene_centre(self)
+        return _render._scene_centre(self)

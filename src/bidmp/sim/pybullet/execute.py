@@ -8,15 +8,25 @@ import math
 
 import numpy as np
 
-from ..backend import CONTROL_STEP, LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, Hold, MotionPlan, SimError
-from ..limits import RateLimiter
+from ..backend import (
+    CONTROL_STEP,
+    LIMIT_MARGIN,
+    RECORD_EVERY,
+    SETTLE,
+    SIM_STEP,
+    Execution,
+    Hold,
+    MotionPlan,
+    SimError,
+)
+from ..limits import _RateLimiter
 from .robot import _EFFORT, _GAINS, _REST, IK_TOLERANCE, PANDA
 
-__all__ = ["execute", "execute_closed_loop", "Recorder", "ignore", "contacts_into", "drive"]
+__all__ = []
 
 
 # -- execution -------------------------------------------------------------------------
-def ignore(cell, exclude, enable: bool) -> None:
+def _ignore(cell, exclude, enable: bool) -> None:
     """Switch contacts between the robot and the parts in ``exclude`` off (the target enters
     the tool) or back on."""
     p = cell.p
@@ -27,7 +37,7 @@ def ignore(cell, exclude, enable: bool) -> None:
                 p.setCollisionFilterPair(cell.robot, body, link, -1, int(enable), physicsClientId=cell.client)
 
 
-def contacts_into(cell, found: dict) -> None:
+def _contacts_into(cell, found: dict) -> None:
     """Add the robot's contacts now to ``found`` (part label -> deepest penetration, m)."""
     for contact in cell.p.getContactPoints(bodyA=cell.robot, physicsClientId=cell.client):
         depth = -contact[8]
@@ -36,14 +46,14 @@ def contacts_into(cell, found: dict) -> None:
             found[label] = max(found.get(label, 0.0), depth)
 
 
-def drive(cell, q, qd) -> None:
+def _drive(cell, q, qd) -> None:
     """Hand joint targets (rad) and velocities (rad/s) to the position control."""
     cell.p.setJointMotorControlArray(cell.robot, cell.arm, cell.p.POSITION_CONTROL, targetPositions=q,
                                      targetVelocities=qd, forces=_EFFORT, positionGains=_GAINS,
                                      velocityGains=_GAINS, physicsClientId=cell.client)
 
 
-def execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
+def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
     """Run ``plan`` under position control at 1 kHz, the parts in ``exclude`` ignored; a
     ``hold`` keeps one joint still for a while (its command runs on: open loop)."""
     p = cell.p
@@ -51,8 +61,8 @@ def execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames
     positions, velocities = plan.command(np.arange(n_steps) * SIM_STEP)
     cell._set_joints(positions[0])
     position_list, velocity_list = positions.tolist(), velocities.tolist()
-    record = Recorder(cell, n_steps, frames)
-    ignore(cell, exclude, False)
+    record = _Recorder(cell, n_steps, frames)
+    _ignore(cell, exclude, False)
     held = None
     # The 1 kHz loop is most of a simulation's cost: PyBullet's calls bound once, the
     # recorder visited only on the steps it records.
@@ -82,13 +92,13 @@ def execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames
             if visit[step]:
                 record.sample(step, t + SIM_STEP, positions[step])
     finally:
-        ignore(cell, exclude, True)
+        _ignore(cell, exclude, True)
     run = record.finish()
     run.commands = positions  # what the position control was sent, every 1 ms (a hold is the world's doing)
     return run
 
 
-def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
+def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
                         frames: int = 0, max_factor: float = 4.0) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
 
@@ -108,11 +118,11 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
     every = int(round(CONTROL_STEP / SIM_STEP))
     longest = max_factor * duration + (0.0 if hold is None else hold.duration)
     n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
-    record = Recorder(cell, n_steps, frames)
-    ignore(cell, exclude, False)
+    record = _Recorder(cell, n_steps, frames)
+    _ignore(cell, exclude, False)
     target, previous, held, settle_from = q, q, None, None
     times, targets, clock, sent = [], [], [], []
-    limited = RateLimiter(q, PANDA, LIMIT_MARGIN)
+    limited = _RateLimiter(q, PANDA, LIMIT_MARGIN)
     step = 0
     try:
         for step in range(n_steps):
@@ -136,11 +146,11 @@ def execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold |
             sent.append(command)
             q, qd = command.tolist(), limited.velocity.tolist()
             held = _apply_hold(cell, hold, t, q, qd, held)
-            drive(cell, q, qd)
+            _drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
             record.sample(step, t + SIM_STEP, command, contacts=True, every_step=True)
     finally:
-        ignore(cell, exclude, True)
+        _ignore(cell, exclude, True)
     run = record.finish()
     run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(targets), np.array(clock)
     run.commands = np.array(sent)
@@ -157,7 +167,7 @@ def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: floa
     return held
 
 
-class Recorder:
+class _Recorder:
     """Measured samples of one execution (every step) and optional frames."""
 
     def __init__(self, cell, n_steps: int, frames: int):
@@ -180,7 +190,7 @@ class Recorder:
         cell = self.cell
         p = cell.p
         if contacts:
-            contacts_into(cell, self.contacts)
+            _contacts_into(cell, self.contacts)
         if step in self.frame_steps:
             self.frames.append(cell.render())
         if every_step and step % RECORD_EVERY and step != self.n_steps - 1:

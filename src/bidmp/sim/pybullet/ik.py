@@ -8,19 +8,19 @@ import math
 import numpy as np
 
 from ..._checks import as_point
-from .robot import _DOWN, _REST, IK_ACCURACY, PANDA, joint_seed, reachable
+from .robot import _DOWN, _REST, IK_ACCURACY, PANDA, _joint_seed, _reachable
 
-__all__ = ["solve_ik"]
+__all__ = []
 
 
 # -- planning --------------------------------------------------------------------------
-def solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
+def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
     """Joint positions that put the TCP at ``point_m`` (m) with the tool's frame at
     ``orientation`` (quaternion x, y, z, w; default pointing down), started from ``seed``;
     and the position error left (m)."""
     p = cell.p
-    point_m = reachable(as_point(point_m, 3, "point_m"), cell.base * cell.unit, "point_m")
-    q = joint_seed(seed)
+    point_m = _reachable(as_point(point_m, 3, "point_m"), cell.base * cell.unit, "point_m")
+    q = _joint_seed(seed)
     if orientation is not None:
         from ...primitives.so3 import as_quaternions
 

@@ -11,12 +11,20 @@ from ..._checks import as_trajectory
 from ..._trajectory import interp_columns
 from ...primitives.timing import Trajectory, time_scale
 from ..backend import LIMIT_MARGIN, MotionPlan, SimError
-from .robot import _REST, IK_TOLERANCE, MAX_SAMPLE_SPACING, PANDA, joint_seed, reachable, unit_name
+from .robot import (
+    _REST,
+    IK_TOLERANCE,
+    MAX_SAMPLE_SPACING,
+    PANDA,
+    _joint_seed,
+    _reachable,
+    _unit_name,
+)
 
-__all__ = ["plan", "subdivide"]
+__all__ = []
 
 
-def plan(cell, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
+def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
     """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
     within :data:`LIMIT_MARGIN` of the joint limits. ``fractions``: normalised time of each
     sample (default: uniform, as a DMP rollout is). ``orientations`` (n, 4): the tool frame
@@ -25,12 +33,12 @@ def plan(cell, path, label: str = "", fractions=None, seed=None, orientations=No
     if path.shape[1] != 3:
         raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
     for point in (path.min(axis=0), path.max(axis=0)):  # before subdividing it into 5 mm steps
-        reachable(point * cell.unit, cell.base * cell.unit, "path")
+        _reachable(point * cell.unit, cell.base * cell.unit, "path")
     given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else np.asarray(fractions, dtype=float)
     if given.shape != (path.shape[0],) or not np.all(np.isfinite(given)) or np.any(np.diff(given) < 0) \
             or given[0] < 0 or given[-1] > 1:
         raise ValueError(f"fractions must be {path.shape[0]} non-decreasing times in [0, 1]")
-    points, u = subdivide(path * cell.unit, given, MAX_SAMPLE_SPACING)
+    points, u = _subdivide(path * cell.unit, given, MAX_SAMPLE_SPACING)
     turns = None
     if orientations is not None:
         from scipy.spatial.transform import Rotation, Slerp
@@ -40,14 +48,14 @@ def plan(cell, path, label: str = "", fractions=None, seed=None, orientations=No
             raise ValueError(f"orientations must have shape ({path.shape[0]}, 4), got {q.shape}")
         keep = np.concatenate([[True], np.diff(given) > 1e-12])
         turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
-    q = np.array(_REST, dtype=float) if seed is None else joint_seed(seed)
+    q = np.array(_REST, dtype=float) if seed is None else _joint_seed(seed)
     joints = np.empty((points.shape[0], 7))
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
             raise SimError(f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
                            f"unreachable for the Panda at base {np.round(cell.base, 1).tolist()} "
-                           f"(inverse kinematics leaves {error / cell.unit:.3g} {unit_name(cell.unit)}); move the "
+                           f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
                            f"robot (scenario key \"robot\": {{\"base\": ...}})")
         below, above = q < np.array(PANDA.lower) - 1e-9, q > np.array(PANDA.upper) + 1e-9
         if below.any() or above.any():
@@ -71,7 +79,7 @@ def plan(cell, path, label: str = "", fractions=None, seed=None, orientations=No
     return MotionPlan(label, points, u, joints, duration, spline, peaks[0], peaks[1], turns, peak_jerk=peaks[2])
 
 
-def subdivide(points: np.ndarray, fractions: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+def _subdivide(points: np.ndarray, fractions: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
     """The IK samples of a path: evenly spaced in time (``fractions``), as few as keep consecutive
     samples at most ``spacing`` apart where the path moves fastest, linearly interpolated between
     the given samples (at rest: the ends only).

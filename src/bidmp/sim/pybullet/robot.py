@@ -8,7 +8,7 @@ import numpy as np
 from ..._checks import as_point
 from ..backend import JointLimits, SimError
 
-__all__ = ["PANDA", "robot_placement", "unit_of", "unit_name", "reachable", "joint_seed"]
+__all__ = ["PANDA", "robot_placement"]
 
 MAX_SAMPLE_SPACING = 5e-3  # m: the Cartesian path is subdivided so that IK points are at most this far apart
 IK_TOLERANCE = 5e-5  # m: a sample whose IK leaves more than this (0.05 mm) is unreachable
@@ -30,13 +30,13 @@ _EFFORT = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]  # N m
 _GAINS = [1.0] * 7  # PyBullet's position and velocity gains: the stiffest its motors allow
 
 
-def unit_of(units: str) -> float:
+def _unit_of(units: str) -> float:
     if units not in _UNITS:
         raise ValueError(f"the simulator needs lengths in m, cm or mm; the scenario's units are {units!r}")
     return _UNITS[units]
 
 
-def unit_name(unit: float) -> str:
+def _unit_name(unit: float) -> str:
     return {1.0: "m", 1e-2: "cm", 1e-3: "mm"}[unit]
 
 
@@ -48,7 +48,7 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
     if "base" in robot:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
     points = np.vstack([scenario.target_array, scenario.demonstration])
-    unit = unit_of(scenario.units)
+    unit = _unit_of(scenario.units)
     base = np.array([0.5 * (points[:, 0].min() + points[:, 0].max()), points[:, 1].min() - 0.33 / unit,
                      scenario.target_array[:, 2].min()])
     return base, float(robot.get("yaw", 90.0))
@@ -57,7 +57,7 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
 _REACH_M = 2.0  # m from the base: far beyond the Panda's 0.855 m, so a path past it is a mistake
 
 
-def reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray:
+def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray:
     """Refuse a point (m) further than any Panda reaches from its base (a unit mistake, or a
     path that IK would chase for ever)."""
     distance = float(np.linalg.norm(point_m - base_m))
@@ -67,7 +67,7 @@ def reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray:
     return point_m
 
 
-def joint_seed(seed) -> np.ndarray:
+def _joint_seed(seed) -> np.ndarray:
     """Seven finite joint angles (rad) within the Panda's limits, to start IK from."""
     q = as_point(seed, 7, "seed")
     outside = (q < np.array(PANDA.lower) - 1e-6) | (q > np.array(PANDA.upper) + 1e-6)

@@ -10,12 +10,12 @@ import numpy as np
 
 from ..._checks import require_extra
 
-__all__ = ["pybullet_module", "panda_urdf", "add_solid", "colour", "SOLVER_ITERATIONS"]
+__all__ = ["SOLVER_ITERATIONS"]
 
 SOLVER_ITERATIONS = 20
 
 
-def pybullet_module():
+def _pybullet_module():
     """Import pybullet without its banner (it writes one line from C to the process's stderr on
     import; a library must not)."""
     import sys
@@ -40,7 +40,7 @@ def pybullet_module():
             os.close(fd)
 
 
-def panda_urdf(tool_radius: float, tool_length: float) -> str:
+def _panda_urdf(tool_radius: float, tool_length: float) -> str:
     """The Panda of pybullet_data with its hand replaced by a cylindrical tool (metres): link
     ``tool`` on the flange, link ``tcp`` at the tool's mouth."""
     import pybullet_data
@@ -83,23 +83,23 @@ def _inset_prism(vertices: np.ndarray, margin: float) -> np.ndarray:
 
 
 # -- world -----------------------------------------------------------------------------
-def add_solid(p, client: int, unit: float, solid) -> int:
+def _add_solid(p, client: int, unit: float, solid) -> int:
     """A static body for one solid of the scene (box, cylinder, or a nut's convex hull), in metres."""
     if solid.kind == "box":
         half = [0.5 * v * unit for v in solid.params]
         shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=colour(solid), physicsClientId=client)
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_colour(solid), physicsClientId=client)
     elif solid.kind == "cylinder":
         radius, height = solid.params[0] * unit, solid.params[1] * unit
         shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=colour(solid),
+        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=_colour(solid),
                                      physicsClientId=client)
     else:  # the hex nut: its convex hull
         vertices = (_inset_prism(np.asarray(solid.params[0]) * unit, HULL_MARGIN)).tolist()
         shape = p.createCollisionShape(p.GEOM_MESH, vertices=vertices, physicsClientId=client)
         extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
         visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
-                                     rgbaColor=colour(solid), physicsClientId=client)
+                                     rgbaColor=_colour(solid), physicsClientId=client)
     from scipy.spatial.transform import Rotation
 
     orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
@@ -107,7 +107,7 @@ def add_solid(p, client: int, unit: float, solid) -> int:
                              physicsClientId=client)
 
 
-def colour(solid) -> list:
+def _colour(solid) -> list:
     if solid.label.endswith("/stud"):
         return [0.35, 0.35, 0.38, 1.0]
     if solid.kind == "convex":

@@ -9,7 +9,7 @@ from . import register
 from .base import Method, Task
 
 
-class BiDMPMethod(Method):
+class _BiDMPMethod(Method):
     """A task with ``build_skills`` (a scenario) builds its Bi-DMP once from its extension stages;
     one without (the LASA benchmark) extends the demonstration to each goal it is asked for, except
     the demonstrated goal itself, which the plain DMP reaches."""
@@ -55,5 +55,5 @@ class _PerGoal:
         return model.rollout(goal)
 
 
-register(BiDMPMethod("bidmp", "nearest"))
-register(BiDMPMethod("bidmp-latest", "latest", lasa=False))
+register(_BiDMPMethod("bidmp", "nearest"))
+register(_BiDMPMethod("bidmp-latest", "latest", lasa=False))

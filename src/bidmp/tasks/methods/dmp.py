@@ -9,7 +9,7 @@ from . import register
 from .base import Method, Task
 
 
-class DMPMethod(Method):
+class _DMPMethod(Method):
     """A :class:`bidmp.DMP` (or :class:`bidmp.CartesianDMP` on poses) with the task's parameters,
     ``protocol`` overriding the task's when given."""
 
@@ -35,6 +35,6 @@ class DMPMethod(Method):
         return model.stepper(goal, duration=duration, coupling=coupling)
 
 
-register(DMPMethod("dmp", lasa=False))
-register(DMPMethod("dmp-paper", protocol="paper"))
-register(DMPMethod("dmp-robot", protocol="robot"))
+register(_DMPMethod("dmp", lasa=False))
+register(_DMPMethod("dmp-paper", protocol="paper"))
+register(_DMPMethod("dmp-robot", protocol="robot"))

@@ -12,7 +12,7 @@ from .base import Method, Task
 CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
 
 
-class DMPConverged(Method):
+class _DMPConverged(Method):
     name = "dmp-converged"
     lasa = False
 
@@ -28,4 +28,4 @@ class DMPConverged(Method):
         return self.rollouts(model, goal[None])[0]
 
 
-register(DMPConverged())
+register(_DMPConverged())

@@ -9,7 +9,7 @@ from . import register
 from .base import Method, Task
 
 
-class GMMMethod(Method):
+class _GMMMethod(Method):
     name = "gmm"
 
     def fit(self, task: Task) -> tuple[object, float]:
@@ -25,4 +25,4 @@ class GMMMethod(Method):
         return model.rollout()
 
 
-register(GMMMethod())
+register(_GMMMethod())

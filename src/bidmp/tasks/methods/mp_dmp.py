@@ -9,7 +9,7 @@ from . import register
 from .base import Method, Task
 
 
-class PeerDMP(Method):
+class _PeerDMP(Method):
     name = "mp-dmp"
     requires = "movement_primitives"
 
@@ -31,4 +31,4 @@ class PeerDMP(Method):
         return peer.open_loop()[1]
 
 
-register(PeerDMP())
+register(_PeerDMP())

@@ -8,7 +8,7 @@ from . import register
 from .base import Method, Task
 
 
-class TPGMMMethod(Method):
+class _TPGMMMethod(Method):
     name = "tpgmm"
 
     def fit(self, task: Task) -> tuple[object, float]:
@@ -22,4 +22,4 @@ class TPGMMMethod(Method):
         return tpgmm.rollout(goal, start=start)
 
 
-register(TPGMMMethod())
+register(_TPGMMMethod())
