@@ -2,9 +2,10 @@
 
 import numpy as np
 import pytest
-
-from bidmp.baselines import TPGMM, GMMRegressor, augment, gmr
 from bidmp.datasets import minimum_jerk
+
+from bidmp.baselines import TPGMM, GMMRegressor, augment
+from bidmp.baselines.gmm import _gmr
 
 
 @pytest.fixture(scope="module")
@@ -18,7 +19,7 @@ def test_gmr_with_one_component_is_the_conditional_gaussian():
     sigma = L @ L.T + 4 * np.eye(4)
     mu = rng.normal(size=4)
     t = np.array([-1.0, 0.3, 2.0])
-    mean, cov = gmr(np.ones(1), mu[None], sigma[None], t)
+    mean, cov = _gmr(np.ones(1), mu[None], sigma[None], t)
     gain = sigma[1:, :1] / sigma[0, 0]
     np.testing.assert_allclose(mean, mu[1:] + (t[:, None] - mu[0]) * gain[:, 0], atol=1e-12)
     np.testing.assert_allclose(cov, np.broadcast_to(sigma[1:, 1:] - gain @ sigma[:1, 1:], (3, 3, 3)), atol=1e-12)
@@ -27,7 +28,7 @@ def test_gmr_with_one_component_is_the_conditional_gaussian():
 def test_gmr_follows_the_responsible_component():
     means = np.array([[0.0, 10.0], [1.0, -10.0]])
     covs = np.array([np.eye(2) * 0.01, np.eye(2) * 0.01])
-    mean, _ = gmr(np.array([0.5, 0.5]), means, covs, np.array([0.0, 1.0]))
+    mean, _ = _gmr(np.array([0.5, 0.5]), means, covs, np.array([0.0, 1.0]))
     np.testing.assert_allclose(mean[:, 0], [10.0, -10.0], atol=1e-6)
 
 

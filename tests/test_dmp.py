@@ -6,7 +6,8 @@ from conftest import curved_demo, minimum_jerk
 
 from bidmp import DMP, NotFittedError
 from bidmp.datasets import lasa
-from bidmp.dmp import basis_functions, forcing_target, kernel_centres, kernel_widths, phase_grid
+from bidmp.dmp import basis_functions, kernel_centres, kernel_widths, phase_grid
+from bidmp.primitives.forcing import _forcing_target as forcing_target
 
 
 def euler_reference(dmp, goal, start, n_steps, start_velocity=None):

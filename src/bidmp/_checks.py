@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import functools
+import math
 from collections.abc import Iterable
 from numbers import Integral, Real
 
@@ -101,6 +102,17 @@ class Limits:
     max_json_bytes: int = 64 << 20
     max_json_depth: int = 64
 
+    def __post_init__(self) -> None:
+        for field in dataclasses.fields(self):
+            value, default = getattr(self, field.name), field.default
+            whole = isinstance(default, int)
+            kind = Integral if whole else Real
+            if isinstance(value, bool) or not isinstance(value, kind):
+                wanted = "an integer" if whole else "a number"
+                raise TypeError(f"Limits.{field.name} must be {wanted}, got {type(value).__name__}")
+            if not (value > 0 and (whole or math.isfinite(value))):
+                raise ValueError(f"Limits.{field.name} must be finite and > 0, got {value}")
+
 
 _LIMITS = Limits()
 _LIMIT_NAMES = tuple(f.name for f in dataclasses.fields(Limits))
@@ -130,7 +142,7 @@ def set_limits(**changes) -> _Restore:
     previous = get_limits()
     for name, value in changes.items():
         if name not in _LIMIT_NAMES:
-            raise TypeError(f"set_limits: unknown limit {name!r}; known: {', '.join(_LIMIT_NAMES)}")
+            raise TypeError(f"set_limits: unknown limit {short_token(name)}; known: {', '.join(_LIMIT_NAMES)}")
         current = getattr(_LIMITS, name)
         if isinstance(current, int) and not isinstance(current, bool):
             value = check_int(value, name, minimum=1)
@@ -194,8 +206,10 @@ def _as_float_array(value, name: str) -> np.ndarray:
         raise TypeError(f"{name} must be real numbers, got complex values")
     try:
         array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(f"{name} must be an array of numbers ({exc})") from None
+    except (TypeError, ValueError, OverflowError):
+        # NumPy's own text ("setting an array element with a sequence", …) names no argument.
+        shape = "ragged rows" if isinstance(value, (list, tuple)) else f"{type(value).__name__} {short_token(value)}"
+        raise TypeError(f"{name} must be an array of numbers, got {shape}") from None
     return array
 
 
@@ -307,7 +321,7 @@ def check_int(value, name: str, minimum: int | None = None, limit: str | None = 
     """Return ``value`` as an ``int`` after checking it is an integer >= ``minimum``, at most
     ``maximum`` and within the :class:`Limits` field ``limit``."""
     if isinstance(value, bool) or not isinstance(value, Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {short_token(value, 40)}")
+        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {short_token(value)}")
     if minimum is not None and value < minimum:
         raise ValueError(f"{name} must be >= {minimum}, got {value}")
     if maximum is not None and value > maximum:
@@ -321,7 +335,7 @@ def check_real(value, name: str, *, positive: bool = False, nonnegative: bool = 
                minimum: float | None = None, maximum: float | None = None) -> float:
     """Return ``value`` as a finite ``float`` (optionally > 0, >= 0, or within [minimum, maximum])."""
     if isinstance(value, bool) or not isinstance(value, Real):
-        raise TypeError(f"{name} must be a number, got {type(value).__name__} {short_token(value, 40)}")
+        raise TypeError(f"{name} must be a number, got {type(value).__name__} {short_token(value)}")
     try:
         value = float(value)
     except OverflowError:
@@ -357,8 +371,62 @@ def check_choice(value, name: str, choices: Iterable[str]) -> str:
     """Check that ``value`` is one of ``choices`` (strings)."""
     choices = tuple(choices)
     if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}; got {value!r}")
+        shown = short_token(value) if isinstance(value, str) else type(value).__name__
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, choices))}; got {shown}")
     return value
+
+
+def as_indices(values, name: str, last: int) -> np.ndarray:
+    """A 1-D array of sample indices in ``[0, last]``: integers (whole-valued floats accepted)."""
+    array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
+    _check_finite(array, name)
+    if np.any(array != np.round(array)):
+        raise ValueError(f"{name} must be whole sample indices")
+    if np.any((array < 0) | (array > last)):
+        raise ValueError(f"{name} must lie in [0, {last}]")
+    return array.astype(np.int64)
+
+
+def check_bool(value, name: str) -> bool:
+    """Return ``value`` if it is a bool (NumPy's included); an array's truth value is ambiguous."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, got {type(value).__name__}")
+    return bool(value)
+
+
+def check_callable(value, name: str, what: str = "a function"):
+    """Return ``value`` if it can be called."""
+    if not callable(value):
+        raise TypeError(f"{name} must be {what}, got {type(value).__name__}")
+    return value
+
+
+_MAX_PATH, _MAX_NAME = 4096, 255  # bytes: Linux's PATH_MAX and NAME_MAX
+
+
+def check_path(value, name: str = "path"):
+    """A file name as a ``pathlib.Path``: a str or PathLike, not empty, no NUL byte, within the
+    operating system's lengths (beyond them ``os.stat`` raises, and ``Path.exists`` with it)."""
+    import os
+    from pathlib import Path
+
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{name} must be a file name, got {type(value).__name__}")
+    text = os.fsdecode(os.fspath(value))
+    if not text:
+        raise ValueError(f"{name} is empty")
+    if "\x00" in text:
+        raise ValueError(f"{name} contains a NUL character")
+    encoded = os.fsencode(text)
+    if len(encoded) > _MAX_PATH or any(len(part) > _MAX_NAME for part in encoded.split(b"/")):
+        raise ValueError(f"{name} is too long for a file name ({len(encoded):,} bytes, a part over {_MAX_NAME})")
+    return Path(text)
+
+
+def shown_path(path, width: int = 60) -> str:
+    """A path for a message: its last ``width`` characters (the file name is what tells)."""
+    text = "".join(c if c.isprintable() else "?" for c in str(path))
+    return text if len(text) <= width else "…" + text[-(width - 1):]
 
 
 def check_loaded(value, name: str, shape: tuple, *, positive: bool = False) -> np.ndarray:

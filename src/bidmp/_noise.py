@@ -13,9 +13,12 @@ def perturb(y, noise: float, seed: int | np.random.Generator | None = 0) -> np.n
     Low-pass filtered Gaussian noise (as from a hand-guided robot), tapered to zero at both ends so
     the start and the end stay exact.
     """
-    y = np.array(y, dtype=np.float64)
+    from ._checks import as_trajectory, check_real, check_seed, get_limits
+
+    y = as_trajectory(y, "y", min_points=1, allow_static=True).copy()
+    noise = check_real(noise, "noise", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
     n_steps = y.shape[0]
-    rng = np.random.default_rng(seed)
+    rng = check_seed(seed)
     wobble = _low_pass(rng.normal(size=y.shape), sigma=max(n_steps / 50.0, 1.0))
     wobble *= noise / max(float(wobble.std()), 1e-300)
     t = np.linspace(0.0, 1.0, n_steps)

@@ -5,7 +5,7 @@ Layer 1 (the math): imports only the package root's private helpers (``_checks``
 ``_threads``). The methods registry (:mod:`bidmp.tasks.methods`) runs them as methods.
 """
 
-from .gmm import GMMRegressor, augment, gmr
+from .gmm import GMMRegressor, augment
 from .tpgmm import TPGMM
 
-__all__ = ["GMMRegressor", "TPGMM", "augment", "gmr"]
+__all__ = ["GMMRegressor", "TPGMM", "augment"]

@@ -13,9 +13,10 @@ import warnings
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._api import deprecated_alias
+from .._api import CheckedParams, deprecated_alias
 from .._checks import (
     as_trajectory,
+    check_bool,
     check_fitted,
     check_int,
     check_limit,
@@ -24,13 +25,13 @@ from .._checks import (
 )
 from .._noise import perturb
 
-__all__ = ["gmr", "augment", "GMMRegressor"]
+__all__ = ["augment", "GMMRegressor"]
 
 logger = logging.getLogger(__name__)
 _EM_ITERATIONS = 100  # scikit-learn's max_iter default, used for the work bound
 
 
-def gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1):
+def _gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1):
     """Gaussian mixture regression of the outputs given the first ``n_in`` input dimensions.
 
     Parameters
@@ -125,7 +126,7 @@ def _max_abs() -> float:
     return get_limits().max_abs_value
 
 
-class _AugmentedMixture(BaseEstimator):
+class _AugmentedMixture(CheckedParams, BaseEstimator):
     """Parameters shared by the baselines: mixture size, regularisation, augmentation, seed.
 
     scikit-learn conventions: the constructor stores, ``fit`` validates (:meth:`_check_params`).
@@ -190,8 +191,8 @@ class GMMRegressor(_AugmentedMixture):
             raise ValueError("goal: GMMRegressor reproduces its demonstration and takes no goal (TPGMM does)")
         n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
         _check_gmr_size(n_steps, self.means_.shape)
-        mean, covariances = gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
-        return (mean, covariances) if return_covariance else mean
+        mean, covariances = _gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
+        return (mean, covariances) if check_bool(return_covariance, "return_covariance") else mean
 
     @deprecated_alias("rollout", "; generate() is rollout(return_covariance=True)")
     def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:

@@ -15,7 +15,7 @@ import numpy as np
 
 from .._api import deprecated_alias, goal_first
 from .._checks import as_point, check_fitted, check_int, numerically_guarded
-from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, augment, gmr
+from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, _gmr, augment
 
 __all__ = ["TPGMM"]
 
@@ -109,7 +109,7 @@ class TPGMM(_AugmentedMixture):
             weighted_mean = weighted_mean + np.einsum("kij,kj->ki", precision, mu)
         covariance = np.linalg.inv(precision_sum)  # product of Gaussians
         mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
-        mean, covariances = gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
+        mean, covariances = _gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
         return (mean, covariances) if return_covariance else mean
 
     @deprecated_alias("rollout", "; generate(start, target) is rollout(target, start=start, return_covariance=True)")

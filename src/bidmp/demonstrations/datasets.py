@@ -144,8 +144,9 @@ def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate
     check_real((duration + 2 * idle) * rate_hz, "the recording's samples (duration + 2 idle) * rate_hz",
                maximum=get_limits().max_samples)
     jitter = check_real(jitter, "jitter", nonnegative=True, maximum=0.45)
-    noise = check_real(noise, "noise", nonnegative=True)
+    noise = check_real(noise, "noise", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
     wobble = check_real(wobble, "wobble", nonnegative=True)
+    epoch = check_real(epoch, "epoch", nonnegative=True, maximum=1e12)
     rng = check_seed(seed)
     total = duration + 2 * idle
     n_samples = int(round(total * rate_hz)) + 1

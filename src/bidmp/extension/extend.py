@@ -37,6 +37,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from .._checks import (
+    as_indices,
     as_point,
     as_trajectory,
     check_choice,
@@ -171,8 +172,8 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     y = as_trajectory(y, "y")
     straightness = check_real(straightness, "straightness", positive=True, maximum=1.0)
     points = getattr(segmentation_points, "points", segmentation_points)
-    points = np.asarray(points, dtype=int).reshape(-1)
     last = y.shape[0] - 1
+    points = as_indices(points, "segmentation_points", last)
     start = int(points[points < last].max()) if np.any(points < last) else 0
     # The last piece if it is straight, else its longest straight tail (primitives.approach).
     return _straight_tail_start(y, start, straightness)
@@ -187,7 +188,6 @@ def _check_extension_options(*, eps_frac: float = 0.1, method: str = "persistenc
         raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
     check_choice(method, "method", ("persistence", "paper"))
     check_choice(approach, "approach", APPROACHES)
-    roadmap_options.pop("is_free", None)
     _check_options(seed=seed, **roadmap_options)
 
 
@@ -238,7 +238,8 @@ def extend_demonstration(
         "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
         "select": select, "denom": denom,
     }
-    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, **roadmap_options)
+    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, is_free=is_free,
+                             **roadmap_options)
     exclude, roadmap_options["is_free"], scene_checker = _scene_checker(scene, y, target, is_free)
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
@@ -254,6 +255,8 @@ def _scene_checker(scene, y: np.ndarray, target: np.ndarray, is_free):
     target (a caller's own ``is_free`` is kept as given)."""
     if scene is None:
         return (), is_free, None
+    if not (hasattr(scene, "parts_at") and hasattr(scene, "checker")):
+        raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
     if y.shape[1] != 3:
         raise ValueError(f"scene needs a 3-D demonstration, got D = {y.shape[1]}")
     exclude = scene.parts_at(target)
@@ -446,6 +449,7 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
     _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
     exclude = ()
     if scene is not None:
+        _scene_checker(scene, positions, target[:3], None)  # validates the scene
         exclude = scene.parts_at(target[:3])
         roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
     options = {**_roadmap_defaults(), **roadmap_options}

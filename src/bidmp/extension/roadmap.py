@@ -29,6 +29,7 @@ from scipy.spatial import cKDTree
 from .._checks import (
     as_point,
     as_trajectory,
+    check_callable,
     check_choice,
     check_int,
     check_limit,
@@ -279,7 +280,7 @@ def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scal
 def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100,
                   n_iter: int = 10, rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis",
                   compare: str = "template", select: str = "best", denom: str = "sqrt2", padding: float = 0.3,
-                  seed=0) -> None:
+                  seed=0, is_free=None) -> None:
     """Validate roadmap options (those of :func:`gaussian_prm` and :func:`classic_prm`) without
     running anything; raise naming the first bad one. Sizes are bounded so that one run stays
     within seconds: ``n_samples · n_iter <= max_roadmap_nodes`` and ``n_compare² · n_iter <=
@@ -299,6 +300,8 @@ def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbour
     check_choice(select, "select", ("best", "last"))
     check_choice(denom, "denom", ("sqrt2", "2"))
     check_seed(seed)
+    if is_free is not None:
+        check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
 
 
 def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select) -> RoadmapResult:
@@ -382,7 +385,7 @@ def gaussian_prm(
     """
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    _check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule)
+    _check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule, is_free=is_free)
     sampler = _ChordSampler(piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed))
     return _iterate(comparison, n_iter, sampler.draw, sampler.learn, n_neighbours, is_free, select)
 
@@ -432,7 +435,7 @@ def classic_prm(
     Scored exactly like :func:`gaussian_prm`."""
     piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
                                        scaling, compare, select, denom)
-    _check_options(padding=padding)
+    _check_options(padding=padding, is_free=is_free)
     rng = check_seed(seed)
     seg = piece[0]
     margin = padding * np.linalg.norm(target - seg)

@@ -21,6 +21,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from .._checks import (
+    as_indices,
     as_point,
     as_trajectory,
     check_choice,
@@ -66,6 +67,8 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
         y = np.column_stack([y, np.zeros(n_points)])
     elif y.shape[1] != 3:
         raise ValueError(f"curvature needs a 2-D or 3-D curve, got D = {y.shape[1]}")
+    smooth = check_real(smooth, "smooth", positive=True, maximum=1.0)
+    smooth_curvature = check_real(smooth_curvature, "smooth_curvature", positive=True, maximum=1.0)
     window = _odd_window(smooth, n_points, 7)
     check_limit(float(n_points) * window, "max_work",
                 "curvature's smoothing work (samples x window); resample to fewer points first")
@@ -282,10 +285,8 @@ def choose_piece(y, segmentation_points, new_target) -> Piece:
     target = as_point(new_target, y.shape[1], "new_target")
     if isinstance(segmentation_points, Segmentation):
         segmentation_points = segmentation_points.points
-    points = np.asarray(segmentation_points, dtype=int).reshape(-1)
     last = y.shape[0] - 1
-    if np.any((points < 0) | (points > last)):
-        raise ValueError(f"segmentation_points must lie in [0, {last}]")
+    points = as_indices(segmentation_points, "segmentation_points", last)
     breakpoints = np.unique(np.concatenate([[0], points, [last]]))
     ends = y[breakpoints[1:]]
     distances = np.linalg.norm(ends - target, axis=1)

@@ -22,8 +22,8 @@ class SkillLibrary:
     def forcing_term(self, phase, skill: int | None = None) -> np.ndarray:
         """``f_in`` of a skill (default: all blocks) at the given phases, shape (L, D)."""
         self._ensure_started()
+        basis = self.dmp_.basis(phase)  # validates the phases
         phase = np.asarray(phase, dtype=np.float64).reshape(-1)
-        basis = self.dmp_.basis(phase)
         return basis @ self.dmp_.weights_ + self._increment(phase, basis, self._check_skill_index(skill))
 
     def _gate(self, phase: np.ndarray) -> np.ndarray:
@@ -71,7 +71,7 @@ class SkillLibrary:
         if skill is None:
             return len(self.blocks_)
         if isinstance(skill, (bool, np.bool_)) or not isinstance(skill, (int, np.integer)):
-            raise ValueError(f"skill must be 'nearest', 'latest' or an integer 0-{len(self.blocks_)}, got {skill!r}")
+            raise ValueError(f"skill must be 'nearest', 'latest' or an integer 0-{len(self.blocks_)}, got {_shown(skill)}")
         if not 0 <= skill <= len(self.blocks_):
             raise ValueError(f"skill must be between 0 and {len(self.blocks_)} (this Bi-DMP has {self.n_skills} skills), got {skill}")
         return int(skill)
@@ -87,7 +87,7 @@ class SkillLibrary:
                 goal = as_point(goal, self.dmp_.n_dims_, "goal")
                 distances = np.linalg.norm(self.skill_goals_ - goal, axis=1)
                 return int(len(distances) - 1 - np.argmin(distances[::-1]))
-            raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {skill!r}")
+            raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {_shown(skill)}")
         return self._check_skill_index(skill)
 
     def _skill_query(self, goal, skill, start):
@@ -155,3 +155,10 @@ class SkillLibrary:
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
         return dmp.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)
+
+
+def _shown(skill) -> str:
+    """A rejected skill for a message: a short quote of a string, else its type."""
+    from .._checks import short_token
+
+    return short_token(skill) if isinstance(skill, str) else type(skill).__name__

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
+from .._api import CheckedParams
 from .._checks import (
     NotFittedError,
     _as_float_array,
@@ -38,7 +39,7 @@ from .._checks import (
 )
 from .._trajectory import resample_time, rmse
 from ..primitives.dmp import DMP
-from ..primitives.forcing import forcing_target
+from ..primitives.forcing import _forcing_target
 from ._skills import SkillLibrary
 from .bidmp_state import _bidmp_from_state, _bidmp_state
 from .bls import BLS
@@ -71,7 +72,7 @@ def _time_scale(duration, dmp: DMP) -> float:
     return float(scale)
 
 
-class BiDMP(SkillLibrary, BaseEstimator):
+class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
     """A DMP with incrementally learned forcing-term blocks and a skill library (SPEC §7).
 
     A scikit-learn style estimator: ``BiDMP(dmp)`` only stores its parameters (``get_params``
@@ -245,7 +246,7 @@ class BiDMP(SkillLibrary, BaseEstimator):
             raise ValueError(f"y_dn has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
         y = dmp.training_trajectory(y)  # T samples (and, robot protocol, rest at the goal after them)
         phase, basis = dmp.training_grid()
-        target = forcing_target(
+        target = _forcing_target(
             y, phase, dt=dmp.dt_, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
             derivatives=_derivative_rule(derivatives, params), gate=dmp.training_gate(),
         )
@@ -330,6 +331,13 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
     ``dmp`` may also be a :class:`BiDMP` with no learned skill yet: the demonstrations are then
     learned into it (so the caller keeps the model; ``bidmp_params`` must be empty).
     """
+    if not isinstance(dmp, (DMP, BiDMP)):
+        raise TypeError(f"dmp must be a fitted bidmp.DMP (or an empty BiDMP), got {type(dmp).__name__}")
+    if not isinstance(demonstrations, (list, tuple)):
+        raise TypeError(f"demonstrations must be a list of arrays (T', D), got {type(demonstrations).__name__}")
+    for skill in skills:
+        if not (isinstance(skill, str) and skill in ("nearest", "latest")) and (isinstance(skill, bool) or not isinstance(skill, int)):
+            raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {type(skill).__name__}")
     if isinstance(dmp, BiDMP):
         if bidmp_params:
             raise TypeError("bidmp_params cannot be combined with a BiDMP model (set them on the model)")

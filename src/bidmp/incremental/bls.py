@@ -30,6 +30,7 @@ from typing import NamedTuple
 import numpy as np
 from sklearn.base import BaseEstimator
 
+from .._api import CheckedParams
 from .._checks import (
     _as_bounded_array,
     _check_finite,
@@ -52,6 +53,7 @@ from .linalg import (
     _grow_pinv,
     _grow_ridge,
     _solve_output,
+    _truncated_svd,
     block_pinv_update,
     sparse_autoencoder,
     svd_update,
@@ -150,7 +152,7 @@ def _check_targets(Y, n_rows: int) -> tuple[np.ndarray, bool]:
     return Y, was_1d
 
 
-class BLS(BaseEstimator):
+class BLS(CheckedParams, BaseEstimator):
     """Broad Learning System regressor with incremental enhancement nodes (SPEC §6).
 
     A scikit-learn style estimator: the constructor only stores its parameters; ``fit``
@@ -344,7 +346,7 @@ class BLS(BaseEstimator):
         at its cut; computed once (after ``fit`` or loading) and then updated block by block."""
         svd = self.__dict__.get("_svd")
         if svd is None or svd[2].shape[0] != self._n_hidden:
-            U, values, V, dropped = truncated_svd(self.train_hidden_)
+            U, values, V, dropped = _truncated_svd(self.train_hidden_)
             _check_gap(values, dropped)
             svd = self._svd = (U, values, V)
         return svd

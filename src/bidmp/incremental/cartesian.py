@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
-from .._api import goal_first
+from .._api import CheckedParams, goal_first
 from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
 from ..primitives.cartesian import (
     CartesianDMP,
@@ -36,6 +36,10 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
     """Learn pose ``demonstrations`` in turn and measure forgetting: for each skill, the largest
     position error (units) and orientation error (rad) between its rollout after all were learned
     and right after it was learned, (n_skills, 2)."""
+    if not isinstance(cartesian, CartesianDMP):
+        raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(cartesian).__name__}")
+    if not isinstance(demonstrations, (list, tuple)):
+        raise TypeError(f"demonstrations must be a list of pose arrays (T', 7), got {type(demonstrations).__name__}")
     model = CartesianBiDMP(cartesian, **bidmp_params)
     queries = [cartesian.goal_]
     when_learned = [model.rollout(cartesian.goal_, skill=skill)]
@@ -55,7 +59,7 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
 _BIDMP_PARAMS = ("n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives")
 
 
-class CartesianBiDMP(BaseEstimator):
+class CartesianBiDMP(CheckedParams, BaseEstimator):
     """Bi-DMP on poses: the increment is learned on both forcing terms, position and orientation.
 
     A scikit-learn style estimator like :class:`bidmp.BiDMP`: ``CartesianBiDMP(cartesian)``

@@ -28,7 +28,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
-from .._checks import as_trajectory, check_int, check_limit, check_real
+from .._checks import (
+    _as_bounded_array,
+    as_trajectory,
+    check_int,
+    check_limit,
+    check_real,
+)
 
 __all__ = ["sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "PINV_RCOND", "PINV_GAP", "MAX_ADMM_ITERATIONS"]
 
@@ -76,9 +82,21 @@ def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_it
     return z
 
 
+def _matrix(value, name: str, rows: int | None = None) -> np.ndarray:
+    """A finite 2-D array (with ``rows`` rows when given): the public algebra's arguments."""
+    matrix = as_trajectory(value, name, min_points=1, allow_static=True)
+    if rows is not None and matrix.shape[0] != rows:
+        raise ValueError(f"{name} must have {rows} rows, got {matrix.shape[0]}")
+    return matrix
+
+
 def truncated_svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Thin SVD of A cut as ``numpy.linalg.pinv(A, rcond=PINV_RCOND)`` cuts it:
     ``(U (N, r), s (r,), V (c, r), dropped singular values)``."""
+    return _truncated_svd(_matrix(A, "A"))
+
+
+def _truncated_svd(A: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     u, s, vt = np.linalg.svd(A, full_matrices=False)
     keep = s > PINV_RCOND * (s[0] if s.size else 0.0)
     return np.ascontiguousarray(u[:, keep]), s[keep], np.ascontiguousarray(vt[keep].T), s[~keep]
@@ -102,6 +120,15 @@ def svd_update(U: np.ndarray, s: np.ndarray, V: np.ndarray, E: np.ndarray):
     """The truncated thin SVD of ``[A | E]`` from that of ``A = U diag(s) Vᵀ`` (r kept values):
     the SVD of ``K = [U diag(s) | E]`` (N × (r + m)), whose right factor maps back through
     ``blockdiag(V, I)``. Returns ``(U', s', V', dropped)`` like :func:`truncated_svd`."""
+    U = _matrix(U, "U")
+    s = _matrix(_as_bounded_array(s, "s", max_ndim=1).reshape(1, -1), "s", rows=1)[0]
+    V, E = _matrix(V, "V"), _matrix(E, "E", rows=U.shape[0])
+    if s.shape[0] != U.shape[1] or V.shape[1] != U.shape[1]:
+        raise ValueError(f"s and V must have one entry / column per column of U ({U.shape[1]})")
+    return _svd_update(U, s, V, E)
+
+
+def _svd_update(U: np.ndarray, s: np.ndarray, V: np.ndarray, E: np.ndarray):
     K = np.hstack([U * s, E])
     u, values, vt = np.linalg.svd(K, full_matrices=False)
     keep = values > PINV_RCOND * values[0]
@@ -134,6 +161,10 @@ def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple
     (D, Bt, case) with ``[A | E]⁺ = [A⁺ − D Bt ; Bt]`` and case ``"zero"`` (C = 0),
     ``"full-rank"`` or ``"general"``.
     """
+    A = _matrix(A, "A")
+    A_pinv, E = _matrix(A_pinv, "A_pinv", rows=A.shape[1]), _matrix(E, "E", rows=A.shape[0])
+    if A_pinv.shape[1] != A.shape[0]:
+        raise ValueError(f"A_pinv must be the pseudo-inverse of A: shape ({A.shape[1]}, {A.shape[0]}), got {A_pinv.shape}")
     D = A_pinv @ E
     C = E - A @ D
     tolerance = _RANK_TOLERANCE * max(np.linalg.norm(E, 2), np.finfo(float).tiny)
@@ -165,7 +196,7 @@ def _solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tupl
                              f"too small for this hidden layer); use a larger reg") from None
         projected = solve_triangular(R, A.T @ Y, trans="T")
         return np.ascontiguousarray(solve_triangular(R, projected)), None, R, projected
-    U, values, V, _ = truncated_svd(A)
+    U, values, V, _ = _truncated_svd(A)
     pinv = np.ascontiguousarray((V / values) @ U.T)  # numpy.linalg.pinv(A, rcond=PINV_RCOND)
     return pinv @ Y, pinv, None, None
 
@@ -200,7 +231,7 @@ def _grow_pinv(svd: tuple[np.ndarray, np.ndarray, np.ndarray], E: np.ndarray, Y:
     """The pseudo-inverse solution for ``[A | E]`` from the truncated SVD ``(U, s, V)`` of A:
     (the solution in the layout of :func:`_solve_output`, the grown SVD). Refused where the
     grown pseudo-inverse is ill-posed (:func:`_check_gap`)."""
-    U, values, V, dropped = svd_update(*svd, E)
+    U, values, V, dropped = _svd_update(*svd, E)
     _check_gap(values, dropped)
     pinv = np.ascontiguousarray((V / values) @ U.T)
     return (pinv @ Y, pinv, None, None), (U, values, V)

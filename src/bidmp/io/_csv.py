@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_limit, get_limits, short_token
+from .._checks import check_limit, check_path, get_limits, short_token
 from ._columns import TIME_NAMES, parse_columns
 
 __all__ = ['declared_units']
@@ -98,7 +98,7 @@ def declared_units(path) -> str:
     """The unit a CSV declares in a leading comment line ``# units: mm`` ("" if none)."""
     from .._units import check_units
 
-    if not Path(path).is_file():  # a FIFO or a device: the reader refuses it; opening it would block
+    if not check_path(path).is_file():  # a FIFO or a device: the reader refuses it; opening it would block
         return ""
     try:
         with open(path, encoding="utf-8-sig") as handle:

@@ -17,7 +17,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-
+from .._checks import check_path
 
 __all__ = ['atomic_write']
 
@@ -70,7 +70,7 @@ def _clear_stale_temporaries(directory: Path, name: str) -> None:
 def _destination(path: str | os.PathLike) -> Path:
     """The file a write to ``path`` replaces: the path itself, or a symlink's target (written
     through). Folders, devices, pipes and sockets are refused."""
-    path = Path(path)
+    path = check_path(path)
     if str(path) in ("", "."):
         raise ValueError("the output path is empty")
     target = Path(os.path.realpath(path)) if path.is_symlink() else path

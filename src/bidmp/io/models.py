@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_limit, get_limits, short_token
+from .._checks import check_limit, check_path, get_limits, short_token
 from ._npy import _EMPTY_ZIP_MAGIC, _NPY_MAGIC, _ZIP_MAGIC, _read_npy, _read_npy_header
 from .atomic import _destination, atomic_write
 from .strict_json import load_json
@@ -68,7 +68,7 @@ def _model_path(path: str | os.PathLike) -> Path:
     """The model file to write: ``path`` with ``.npz`` added when missing. The given path is
     checked first, so ``-o somefolder`` or ``-o /dev/null`` are refused, not turned into
     ``somefolder.npz``."""
-    path = Path(path)
+    path = check_path(path)
     _destination(path)
     if path.suffix != ".npz":
         path = path.with_name(path.name + ".npz")
@@ -219,9 +219,7 @@ def load_model(path: str | os.PathLike):
 def _readable_model(path) -> Path:
     """``path`` as a Path to a regular file within the size limit (a pipe or device is refused
     without opening it: that could block)."""
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
+    path = check_path(path)
     if not path.is_file():
         if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
             raise ModelFileError(f"model file {path} is not a regular file (a pipe, device or socket)")

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_trajectory, short_token
+from .._checks import _as_bounded_array, as_trajectory, check_path, short_token
+from .._units import check_units
 from ._columns import parse_columns
 from ._csv import _check_file, _csv_fast, _csv_rows, _note_ignored
 from .trajectories import _write_columns
@@ -30,9 +31,7 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     from ..primitives.timing import _drop_duplicate_stamps
     from ._columns import select_poses
 
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
+    path = check_path(path)
     _check_file(path, "pose file")
     if path.suffix.lower() not in (".csv", ".txt"):
         raise ValueError(f"{path}: pose recordings are read from .csv files with a header")
@@ -62,9 +61,7 @@ def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None 
     atomically; with a known unit (``units`` or the trajectory's) a first line ``# units: mm``."""
     from ..primitives.cartesian import PoseTrajectory
 
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
+    path = check_path(path)
     names = ["x", "y", "z", "qx", "qy", "qz", "qw"]
     if isinstance(poses, PoseTrajectory):
         names, data = poses.columns()
@@ -74,7 +71,7 @@ def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None 
         if data.shape[1] != 7:
             raise ValueError(f"poses must have 7 columns (x, y, z, qx, qy, qz, qw), got {data.shape[1]}")
         if times is not None:
-            times = np.asarray(times, dtype=np.float64).reshape(-1)
+            times = _as_bounded_array(times, "times", max_ndim=1).reshape(-1)
             if times.shape[0] != data.shape[0] or not np.all(np.isfinite(times)):
                 raise ValueError(f"times must be {data.shape[0]} finite numbers")
             data, names = np.column_stack([times, data]), ["t", *names]
@@ -82,4 +79,4 @@ def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None 
         raise ValueError("the poses contain NaN or inf")
     if path.suffix.lower() != ".csv":
         raise ValueError(f"{path}: poses are written as .csv")
-    return _write_columns(data, names, data, path, units or "")
+    return _write_columns(data, names, data, path, check_units(units, "units"))

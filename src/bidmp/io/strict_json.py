@@ -41,8 +41,13 @@ def load_json(data: bytes | str, source: str):
     ValueError
         Naming ``source`` and what was wrong (too large, too deep, not UTF-8, not JSON).
     """
+    if not isinstance(source, str):
+        raise TypeError(f"source must be a string naming where the JSON came from, got {type(source).__name__}")
+    source = short_token(source, 60)[1:-1]
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogatepass")
+    if not isinstance(data, (bytes, bytearray)):
+        raise TypeError(f"{source}: data must be JSON text (str or bytes), got {type(data).__name__}")
     limits = get_limits()
     if len(data) > limits.max_json_bytes:
         raise ValueError(f"{source}: JSON of {len(data):,} bytes exceeds the limit max_json_bytes = "

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_trajectory, short_token
+from .._checks import _as_bounded_array, as_trajectory, check_path, short_token
+from .._units import check_units
 from ._csv import (
     _check_file,
     _check_npy_trajectory,
@@ -64,9 +65,7 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
     """
     from ..primitives.timing import _drop_duplicate_stamps
 
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
+    path = check_path(path)
     _check_file(path, "demonstration file")
     suffix = path.suffix.lower()
     if suffix == ".npy":
@@ -119,9 +118,7 @@ def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None
 
     if isinstance(y, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
         raise TypeError("save_trajectory takes (y, path): the trajectory first, then the file (as save_model)")
-    if not isinstance(path, (str, os.PathLike)):
-        raise TypeError(f"path must be a file name, got {type(path).__name__}")
-    path = Path(path)
+    path = check_path(path)
     if isinstance(y, Trajectory):
         if times is not None:
             raise TypeError("times is given by the Trajectory itself")
@@ -140,11 +137,11 @@ def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
         return path
-    units = units or ""
+    units = check_units(units, "units")
     names = ["x", "y", "z"][: y.shape[1]] if y.shape[1] <= 3 else [f"x{i}" for i in range(y.shape[1])]
     data = y
     if times is not None:
-        times = np.asarray(times, dtype=np.float64).reshape(-1)
+        times = _as_bounded_array(times, "times", max_ndim=1).reshape(-1)
         if times.shape[0] != y.shape[0]:
             raise ValueError(f"times has {times.shape[0]} entries for {y.shape[0]} samples")
         if not np.all(np.isfinite(times)):

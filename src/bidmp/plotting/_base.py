@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import check_path
 from ..io.atomic import atomic_write
 
 
@@ -53,7 +54,7 @@ def _figure(projection_3d: bool):
 def _save(fig, path: str | os.PathLike) -> Path:
     buffer = _io.BytesIO()
     fig.savefig(buffer, format="png", bbox_inches="tight")
-    path = Path(path)
+    path = check_path(path)
     with atomic_write(path, "wb") as handle:
         handle.write(buffer.getvalue())
     return path
@@ -68,8 +69,26 @@ def _draw(ax, points: np.ndarray, *args, **kwargs):
     return ax.plot(*(points[:, i] for i in range(points.shape[1])), *args, **kwargs)
 
 
+def _text(value, name: str, longest: int) -> str:
+    """A label for a figure: a string of at most ``longest`` characters (matplotlib lays out any
+    length, and runs out of memory on a file read by mistake)."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a string, got {type(value).__name__}")
+    if len(value) > longest:
+        raise ValueError(f"{name} is {len(value):,} characters long; at most {longest}")
+    return value
+
+
+def _sequence(value, name: str) -> list:
+    """A list or tuple of items (a single array or None is not a sequence of them)."""
+    if not isinstance(value, (list, tuple)):
+        raise TypeError(f"{name} must be a list or tuple, got {type(value).__name__}")
+    return list(value)
+
+
 def _label_axes(ax, n_dims: int, units: str) -> None:
     """Axis names with the unit; 1-D against the sample index, 2-D at equal scale."""
+    units = _text(units, "units", 20)
     suffix = f" [{units}]" if units else ""
     if n_dims == 1:
         ax.set_xlabel("sample")
@@ -86,5 +105,5 @@ def _label_axes(ax, n_dims: int, units: str) -> None:
 def _finish(ax, n_dims: int, units: str, title: str = "") -> None:
     _label_axes(ax, n_dims, units)
     ax.grid(True, alpha=0.3)
-    if title:
+    if _text(title, "title", 300):
         ax.set_title(title, fontsize=10)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import _as_bounded_array, as_indices, as_trajectory
 from ._base import _axes_for, _draw, _finish, _matplotlib, _save
 
 __all__ = ['plot_segmentation', 'plot_extension', 'plot_prm_comparison']
@@ -15,6 +16,15 @@ def plot_segmentation(path, y: np.ndarray, points: np.ndarray, kinds: np.ndarray
                       curvature: np.ndarray | None = None, units: str = "", title: str = "1D-SEG") -> Path:
     """The demonstration with its segmentation points (maxima ▲, minima ▼) and, if given, the
     curvature along the normalised arc length with the same points."""
+    y = as_trajectory(y, "y", min_points=2, allow_static=True)
+    points = as_indices(points, "points", y.shape[0] - 1)
+    if kinds is not None:
+        kinds = as_indices(np.abs(_as_bounded_array(kinds, "kinds", 1)), "kinds", 1) * np.sign(kinds)
+        if kinds.shape != points.shape or np.any(kinds == 0):
+            raise ValueError(f"kinds must be +1 or -1 for each of the {points.shape[0]} points")
+    if curvature is not None:
+        curvature = as_trajectory(np.reshape(_as_bounded_array(curvature, "curvature", 1), (-1, 1)), "curvature",
+                                  min_points=2, allow_static=True)[:, 0]
     mpl = _matplotlib()
     y = np.asarray(y, dtype=float)
     n_dims = y.shape[1]

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import as_points, as_trajectory
-from ._base import _figure, _label_axes, _matplotlib, _save
+from ._base import _figure, _label_axes, _matplotlib, _save, _sequence
 
 __all__ = ['plot_trajectories', 'plot_generalisation', 'plot_recordings']
 
@@ -37,7 +37,8 @@ def plot_trajectories(
     n_dims = demonstration.shape[1]
     if n_dims not in (1, 2, 3):
         raise ValueError(f"can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
-    trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True) for i, t in enumerate(trajectories)]
+    trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True)
+                    for i, t in enumerate(_sequence(trajectories, "trajectories"))]
     for index, trajectory in enumerate(trajectories):
         if trajectory.shape[1] != n_dims:
             raise ValueError(f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}")
@@ -110,7 +111,7 @@ def plot_recordings(path, recordings, goal_shift=None) -> Path:
     mpl = _matplotlib()
     fig, (top, side, speed) = mpl.subplots(1, 3, figsize=(12.0, 4.6), dpi=110)
     colours = mpl.cm.tab10(np.arange(10))
-    for index, (name, y, t, prepared, info, moved) in enumerate(recordings):
+    for index, (name, y, t, prepared, info, moved) in enumerate(_sequence(recordings, "recordings")):
         colour = colours[index % 10]
         top.plot(y[:, 0], y[:, 1], color=colour, alpha=0.35, linewidth=3, label=f"{name} (raw)")
         side.plot(y[:, 0], y[:, 2], color=colour, alpha=0.35, linewidth=3)

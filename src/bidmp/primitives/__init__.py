@@ -29,8 +29,6 @@ _EXPORTS = {
     "kernel_centres": "forcing",
     "kernel_widths": "forcing",
     "basis_functions": "forcing",
-    "forcing_target": "forcing",
-    "regress": "forcing",
     "PhaseGate": "goals",
     "DelayedGoal": "goals",
     "ProgressGate": "goals",

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_bytes, check_int, numerically_guarded
+from .._checks import as_trajectory, check_bytes, check_int, numerically_guarded
 from .._trajectory import resample_time
 from .canonical import phase_grid
 from .forcing import _as_phase, basis_functions
@@ -67,7 +67,7 @@ class GridQueries:
 
     def training_gate(self) -> np.ndarray:
         """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
-        fraction (robot); the forcing target of :func:`forcing_target` uses it."""
+        fraction (robot); the forcing target of :func:`_forcing_target` uses it."""
         self._check_fitted()
         params = self._params()
         return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
@@ -76,6 +76,8 @@ class GridQueries:
         """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``params`` (default its
         own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
         asks for it once per stepper)."""
+        if params is not None and not isinstance(params, _Params):
+            raise TypeError(f"goal_system: params must be a DMP's resolved parameters (or None), got {type(params).__name__}")
         params = self._params() if params is None else params
         if params.goal_rate is not None:
             return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(params.goal_rate)
@@ -87,7 +89,7 @@ class GridQueries:
         followed by rest at its last point up to :attr:`n_train_`."""
         self._check_fitted()
         params = self._params()
-        y = resample_time(np.asarray(y, dtype=np.float64), self.n_steps_)
+        y = resample_time(as_trajectory(y, "y", min_points=2, allow_static=True), self.n_steps_)
         if params.rest_start:
             y = _rest_started(y, self.dt_, self.time_unit_)
         return _with_rest(y, params)

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_int
+from .._checks import check_bool, check_int, check_real
 
 __all__ = ["phase_grid"]
 
@@ -33,9 +33,21 @@ def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1
     Euler-discretised canonical system (Eq. 13), or with ``exact`` its solution
     ``exp(-alpha_phase l dt / tau)``, which does not depend on the step."""
     n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+    dt, tau, alpha_phase, exact = _checked_phase_args(dt, tau, alpha_phase, exact)
     if exact:
         return np.exp(-alpha_phase * dt / tau * np.arange(n_steps))
     return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
+
+
+def _checked_phase_args(dt, tau, alpha_phase, exact) -> tuple[float, float, float, bool]:
+    """The canonical system's arguments as the public functions take them: positive finite
+    ``dt``, ``tau`` and ``alpha_phase``, a bool ``exact``; an Euler step must not overshoot."""
+    dt, tau = check_real(dt, "dt", positive=True), check_real(tau, "tau", positive=True)
+    alpha_phase, exact = check_real(alpha_phase, "alpha_phase", positive=True), check_bool(exact, "exact")
+    if not exact and alpha_phase * dt / tau >= 1.0:
+        raise ValueError(f"alpha_phase * dt / tau = {alpha_phase * dt / tau:.3g} must be < 1 (the Euler phase would not "
+                         f"decay); lower dt or use exact=True")
+    return dt, tau, alpha_phase, exact
 
 
 def _check_phase_span(span: float, alpha_phase: float) -> None:

@@ -30,11 +30,12 @@ import logging
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._api import goal_first
+from .._api import CheckedParams, goal_first
 from .._checks import (
     as_point,
     as_trajectory,
     check_fitted,
+    check_int,
     check_loaded,
     numerically_guarded,
 )
@@ -66,7 +67,7 @@ def orientation_error(q, goal) -> np.ndarray:
 
 def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Split ``(T, 7)`` poses into positions ``(T, 3)`` and validated quaternions ``(T, 4)``."""
-    array = as_trajectory(poses, name, min_points=min_points, allow_static=True)
+    array = as_trajectory(poses, name, min_points=check_int(min_points, "min_points", minimum=1), allow_static=True)
     if array.shape[1] != 7:
         raise ValueError(f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}")
     return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
@@ -107,7 +108,7 @@ def continuous_quaternions(q) -> np.ndarray:
     hemisphere (``q`` and ``-q`` are one rotation); checked first: real, finite, not zero."""
     return _continuous(_quaternion_rows(q, "q"))
 
-class CartesianDMP(BaseEstimator):
+class CartesianDMP(CheckedParams, BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
     Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``

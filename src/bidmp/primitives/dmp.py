@@ -46,6 +46,7 @@ import logging
 import numpy as np
 from sklearn.base import BaseEstimator
 
+from .._api import CheckedParams
 from .._checks import as_trajectory, check_bytes, numerically_guarded
 from .._units import check_units
 from ._dmp_grids import GridQueries
@@ -72,7 +73,7 @@ __all__ = ["DMP", "PROTOCOLS"]
 logger = logging.getLogger(__name__)
 
 
-class DMP(GridQueries, Motions, _FittedParams, BaseEstimator):
+class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
     """Discrete DMP learned from one demonstration (SPEC §1), in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates

@@ -10,10 +10,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_points, check_int
-from .canonical import _phase_decay, phase_grid
+from .._checks import (
+    _as_bounded_array,
+    _check_finite,
+    _check_magnitude,
+    as_points,
+    check_choice,
+    check_int,
+    check_real,
+)
+from .canonical import _checked_phase_args, _phase_decay, phase_grid
 
-__all__ = ["kernel_centres", "kernel_widths", "basis_functions", "forcing_target", "regress"]
+__all__ = ["kernel_centres", "kernel_widths", "basis_functions"]
 
 _LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
 
@@ -28,10 +36,23 @@ def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, al
     """
     n_kernels = check_int(n_kernels, "n_kernels", minimum=1, limit="max_kernels")
     n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+    dt, tau, alpha_phase, exact = _checked_phase_args(dt, tau, alpha_phase, exact)
     steps = np.linspace(0.0, n_steps - 1, n_kernels)
     if exact:
         return np.exp(-alpha_phase * dt / tau * steps)
     return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
+
+
+def _as_phases(values, name: str, *, positive: bool = False) -> np.ndarray:
+    """A 1-D, non-empty array of finite numbers (``positive``: each > 0)."""
+    array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
+    if array.size == 0:
+        raise ValueError(f"{name} is empty")
+    _check_finite(array, name)
+    _check_magnitude(array, name)
+    if positive and np.any(array <= 0.0):
+        raise ValueError(f"{name} must be > 0")
+    return array
 
 
 def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing") -> np.ndarray:
@@ -42,7 +63,12 @@ def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "
     ``"pydmps"``: ``h_i = N^1.5 / (c_i alpha_phase)`` (SPEC §1 as printed, the pydmps convention);
     neighbours overlap at ≈ 0.9 and LWR smooths the forcing term noticeably (2–5 % on LASA).
     """
+    centres = _as_phases(centres, "centres", positive=True)
+    alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True)
+    check_choice(method, "method", ("spacing", "pydmps"))
     n_kernels = len(centres)
+    if n_kernels > 1 and np.any(np.diff(np.sort(centres)) == 0.0):
+        raise ValueError("centres must be distinct (two kernels at one phase have no spacing to size them by)")
     if method == "pydmps":
         return n_kernels**1.5 / (centres * alpha_phase)
     if n_kernels == 1:
@@ -67,7 +93,11 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
         computed after subtracting the row maximum, so it never underflows to 0/0 however far
         the phase is from the centres.
     """
-    phase = np.asarray(phase, dtype=np.float64).reshape(-1)
+    phase = _as_phases(phase, "phase")
+    centres = _as_phases(centres, "centres", positive=True)
+    widths = _as_phases(widths, "widths", positive=True)
+    if widths.shape != centres.shape:
+        raise ValueError(f"widths must have one entry per centre ({centres.shape[0]}), got {widths.shape[0]}")
     n_kernels = centres.shape[0]
     # Reference exponent per row: the larger of the two kernels bracketing the phase. It is one
     # of the row's entries, so shifting by it cannot overflow and the largest term survives; it
@@ -116,7 +146,7 @@ def _derivatives(y: np.ndarray, dt: float, method: str) -> tuple[np.ndarray, np.
     return velocity, acceleration
 
 
-def forcing_target(
+def _forcing_target(
     y: np.ndarray,
     phase: np.ndarray,
     *,
@@ -156,7 +186,7 @@ def forcing_target(
     return (tau**2 * acceleration - spring) / K + gate[:, None] * (goal - start)
 
 
-def regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regression: str, ridge: float) -> np.ndarray:
+def _regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regression: str, ridge: float) -> np.ndarray:
     """Forcing-term weights (N, D) from basis rows ``phi`` (L, N) at ``phase`` (L,) and the forcing
     target (L, D): LWR per kernel (``regression="lwr"``) or ridge least squares (``"ridge"``, the
     regulariser ``ridge`` relative to the mean diagonal of ``ΦᵀΦ``)."""
@@ -189,16 +219,17 @@ def _learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tu
     phase = phase_grid(n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
     centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
     widths = kernel_widths(centres, params.alpha_phase, params.widths)
-    target = forcing_target(train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
+    target = _forcing_target(train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
                             derivatives=params.derivatives, gate=gate)
     phi = basis_functions(phase, centres, widths)
-    weights = regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
+    weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
     return np.ascontiguousarray(weights), centres, widths, phase, phi
 
 
 def _as_phase(phase, name: str = "phase") -> np.ndarray:
     """Phases (L,) validated: finite and in [0, 1] (a DMP's phase decays from 1 towards 0)."""
-    phase = as_points(np.reshape(phase, (-1, 1)) if np.ndim(phase) <= 1 else phase, 1, name)[:, 0]
+    phase = _as_bounded_array(phase, name, max_ndim=2)
+    phase = as_points(phase.reshape(-1, 1) if phase.ndim <= 1 else phase, 1, name)[:, 0]
     if phase.size and (phase.min() < 0.0 or phase.max() > 1.0):
         raise ValueError(f"{name} must lie in [0, 1] (a DMP's phase decays from 1 towards 0), got values in "
                          f"[{phase.min():.3g}, {phase.max():.3g}]")

@@ -48,6 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._checks import _as_bounded_array, as_points, check_real
 from .._trajectory import arclength
 from .canonical import phase_grid
 
@@ -147,6 +148,9 @@ class DelayedGoal:
 
     rate: float
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "rate", check_real(self.rate, f"{type(self).__name__}.rate", positive=True))
+
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         """The gate at a rollout grid's samples (``step`` apart in normalised time)."""
         return phase_grid(phase.shape[0], step, tau, self.rate, exact=exact)
@@ -182,6 +186,14 @@ class ProgressGate:
     _lookup: tuple = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        kind = type(self).__name__
+        phase = as_points(_as_bounded_array(self.training_phase, f"{kind}.training_phase", 1).reshape(-1, 1), 1,
+                          f"{kind}.training_phase")[:, 0]
+        gate = as_points(_as_bounded_array(self.gate, f"{kind}.gate", 1).reshape(-1, 1), 1, f"{kind}.gate")[:, 0]
+        if gate.shape != phase.shape or phase.size < 2 or np.any(np.diff(phase) >= 0.0):
+            raise ValueError(f"{kind}: training_phase must decrease strictly, with one gate value per phase")
+        object.__setattr__(self, "training_phase", phase)
+        object.__setattr__(self, "gate", gate)
         # np.interp wants increasing abscissae: the reversed grid, built once (a control loop
         # asks for one phase per step).
         object.__setattr__(self, "_lookup", (self.training_phase[::-1], self.gate[::-1]))

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .so3 import _left_jacobian, orientation_from_log
-from .timing import TimedMotion
+from .timing import TimedMotion, _validate_motion
 
 __all__ = ["PoseTrajectory", "PoseStepper"]
 
@@ -40,10 +40,7 @@ class PoseTrajectory(TimedMotion):
     units: str = ""
 
     def __post_init__(self) -> None:
-        n = self.t.shape[0]
-        for name, width in (("y", 3), ("yd", 3), ("ydd", 3), ("q", 4), ("omega", 3), ("omega_dot", 3)):
-            if getattr(self, name).shape != (n, width):
-                raise ValueError(f"PoseTrajectory.{name} must have shape ({n}, {width}), got {getattr(self, name).shape}")
+        _validate_motion(self, "PoseTrajectory", (("y", 3), ("yd", 3), ("ydd", 3), ("q", 4), ("omega", 3), ("omega_dot", 3)))
 
     @property
     def poses(self) -> np.ndarray:

@@ -13,7 +13,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import _as_float_array, check_choice, numerically_guarded, short_token
+from .._checks import (
+    _as_float_array,
+    _check_finite,
+    check_choice,
+    check_int,
+    numerically_guarded,
+    short_token,
+)
 
 __all__ = ["Trajectory", "TimedMotion", "check_timestamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
@@ -70,17 +77,7 @@ class Trajectory(TimedMotion):
     units: str = ""
 
     def __post_init__(self) -> None:
-        # Frozen: the validated arrays are put in place with object.__setattr__.
-        t = _as_float_array(self.t, "Trajectory.t")
-        if t.ndim != 1 or t.shape[0] < 1:
-            raise ValueError(f"Trajectory.t must be a 1-D array of times (s), got shape {t.shape}")
-        object.__setattr__(self, "t", t)
-        n = t.shape[0]
-        for name in ("y", "yd", "ydd"):
-            array = _as_float_array(getattr(self, name), f"Trajectory.{name}")
-            if array.ndim != 2 or array.shape[0] != n:
-                raise ValueError(f"Trajectory.{name} must have shape ({n}, D), got {array.shape}")
-            object.__setattr__(self, name, array)
+        _validate_motion(self, "Trajectory", (("y", None), ("yd", None), ("ydd", None)))
 
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the
@@ -88,6 +85,27 @@ class Trajectory(TimedMotion):
         names = ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)]
         header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
         return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
+
+
+def _validate_motion(motion, kind: str, fields) -> None:
+    """A timed motion's fields checked and put in place (the dataclass is frozen: with
+    ``object.__setattr__``): ``t`` 1-D, each of ``fields`` (name, width or None) (n, width), all
+    finite; ``units`` a known unit."""
+    from .._units import check_units
+
+    t = _as_float_array(motion.t, f"{kind}.t")
+    if t.ndim != 1 or t.shape[0] < 1:
+        raise ValueError(f"{kind}.t must be a 1-D array of times (s), got shape {t.shape}")
+    _check_finite(t, f"{kind}.t")
+    object.__setattr__(motion, "t", t)
+    n = t.shape[0]
+    for name, width in fields:
+        array = _as_float_array(getattr(motion, name), f"{kind}.{name}")
+        if array.ndim != 2 or array.shape[0] != n or (width is not None and array.shape[1] != width):
+            raise ValueError(f"{kind}.{name} must have shape ({n}, {width or 'D'}), got {array.shape}")
+        _check_finite(array, f"{kind}.{name}")
+        object.__setattr__(motion, name, array)
+    object.__setattr__(motion, "units", check_units(motion.units, f"{kind}.units"))
 
 
 def _as_stamps(t, name: str) -> np.ndarray:
@@ -119,6 +137,7 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
         If they are not finite, not strictly increasing (duplicates are named), or imply a mean
         sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
     """
+    n_samples = check_int(n_samples, "n_samples", minimum=1)
     stamps = _as_stamps(t, name)
     if stamps.ndim != 1 or stamps.shape[0] != n_samples:
         raise ValueError(f"{name} must have shape ({n_samples},) (one time per sample), got {stamps.shape}")

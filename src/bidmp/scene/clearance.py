@@ -23,6 +23,7 @@ from .._checks import (
     _as_float_array,
     _check_magnitude,
     as_trajectory,
+    check_bool,
     check_real,
     numerically_guarded,
     short_token,
@@ -134,12 +135,10 @@ class Scene:
 
     def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True, margin: float = 0.0,
                  standoff: dict | None = None):
-        self.parts = tuple(parts)
-        self.margin = float(margin)  # clearance every planned and checked motion keeps (scene units)
-        self.standoff = {str(k): float(v) for k, v in (standoff or {}).items()}  # parts it may come closer to, by design
-        self.tool = tool
-        self.targets = None if targets is None else list(targets)
-        self.targets_on_parts = bool(targets_on_parts)
+        # margin: what every planned and checked motion keeps (scene units); standoff: the parts it
+        # may come closer to, by design.
+        self.parts, self.tool, self.targets, self.targets_on_parts, self.margin, self.standoff = _init_args(
+            parts, tool, targets, targets_on_parts, margin, standoff)
         self.solids = tuple(solid for part in self.parts for solid in part.solids)
         self._lower = np.array([s.lower for s in self.solids]).reshape(-1, 3)
         self._upper = np.array([s.upper for s in self.solids]).reshape(-1, 3)
@@ -183,10 +182,8 @@ class Scene:
         return [part.label for part in self.parts]
 
     def part(self, label: str) -> Part:
-        for part in self.parts:
-            if part.label == label:
-                return part
-        raise KeyError(f"no part labelled {label!r}")
+        """The part labelled ``label`` (a ``ValueError`` naming the labels when there is none)."""
+        return _labelled(self.parts, label)
 
     def applies_to(self, label: str) -> bool:
         """Whether target ``label`` is checked against this scene."""
@@ -194,13 +191,13 @@ class Scene:
 
     def bounds(self, part: str) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned bounding box (lower, upper) of a part's solids."""
-        mask = self._owner == part
+        mask = self._owner == _labelled(self.parts, part).label
         return self._lower[mask].min(axis=0), self._upper[mask].max(axis=0)
 
     def target_parts(self, label: str, point) -> list[str]:
         """The parts that enter the tool at target ``label`` (excepted from its clearance): the
         part labelled like it, else whatever the tool takes into its mouth at ``point``."""
-        return [label] if label in self.labels else self.parts_at(point)
+        return [label] if _label(label, "label") in self.labels else self.parts_at(point)
 
     def parts_at(self, point) -> list[str]:
         """Labels of the parts the tool would take into its mouth at ``point``: those whose
@@ -226,8 +223,10 @@ class Scene:
     def check_targets(self, targets: dict) -> None:
         """Raise when a target the scene applies to has no part with its label, or does not lie
         on it (more than the tool radius from the part's bounding box)."""
+        if not isinstance(targets, dict):
+            raise TypeError(f"targets must be a dict of label -> point, got {type(targets).__name__}")
         for label, point in targets.items():
-            point = np.asarray(point, dtype=float)[:3]  # a pose target: its position
+            point = _position(np.asarray(_as_float_array(point, "a target"))[:3])  # a pose target: its position
             if not self.applies_to(label):
                 continue
             if label not in self.labels:
@@ -247,10 +246,10 @@ class Scene:
         return self._distances
 
     def _selected(self, exclude) -> np.ndarray:
-        exclude = set([exclude] if isinstance(exclude, str) else (exclude or ()))
+        exclude = {_label(name, "exclude") for name in ([exclude] if isinstance(exclude, str) else _names(exclude))}
         unknown = exclude - set(self._owner.tolist())
         if unknown:
-            raise ValueError(f"exclude names {sorted(unknown)[0]!r}, which is not a part of the scene")
+            raise ValueError(f"exclude names {short_token(sorted(unknown)[0])}, which is not a part of the scene")
         return np.flatnonzero([owner not in exclude for owner in self._owner])
 
     def _minimum(self, samples: np.ndarray, chosen: np.ndarray, bounds_of, exact, best: float = math.inf,
@@ -368,6 +367,43 @@ class Scene:
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
         return SceneChecker(self, self._selected(exclude), self.margin)
+
+
+def _init_args(parts, tool, targets, targets_on_parts, margin, standoff) -> tuple:
+    """:class:`Scene`'s arguments validated (as :meth:`Scene.from_dict` builds them)."""
+    if not isinstance(parts, (list, tuple)) or not all(isinstance(part, Part) for part in parts):
+        raise TypeError("parts must be a list of bidmp.scene.Part (Scene.from_dict builds them)")
+    if not isinstance(tool, Tool):
+        raise TypeError(f"tool must be a bidmp.Tool, got {type(tool).__name__}")
+    if targets is not None:
+        targets = [_label(label, "targets") for label in _names(targets)]
+    margin = check_real(margin, "margin", nonnegative=True, maximum=tool.radius)
+    if standoff is not None and not isinstance(standoff, dict):
+        raise TypeError(f"standoff must be a dict of part label -> clearance, got {type(standoff).__name__}")
+    standoff = {_label(k, "standoff"): check_real(v, "standoff", nonnegative=True) for k, v in (standoff or {}).items()}
+    return tuple(parts), tool, targets, check_bool(targets_on_parts, "targets_on_parts"), margin, standoff
+
+
+def _label(value, name: str) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a part label (a string), got {type(value).__name__}")
+    return value
+
+
+def _names(value) -> list:
+    """``exclude`` as a list of labels: None, or an iterable of strings (not an array)."""
+    if value is None:
+        return []
+    if isinstance(value, np.ndarray) or not hasattr(value, "__iter__"):
+        raise TypeError(f"exclude must be a part label or a list of them, got {type(value).__name__}")
+    return list(value)
+
+
+def _labelled(parts, label) -> Part:
+    for part in parts:
+        if part.label == _label(label, "label"):
+            return part
+    raise ValueError(f"no part labelled {short_token(label)}; parts: {', '.join(p.label for p in parts)[:200]}")
 
 
 def _sweep(points: np.ndarray, quaternions: np.ndarray, reach: float) -> np.ndarray:

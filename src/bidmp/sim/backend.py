@@ -17,6 +17,8 @@ from typing import Protocol
 
 import numpy as np
 
+from .._checks import _as_bounded_array, as_points, check_int, check_real
+
 __all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "MotionPlan", "Execution", "SIM_STEP",
            "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
 
@@ -43,6 +45,18 @@ class JointLimits:
     acceleration: tuple
     jerk: tuple | None = None
 
+    def __post_init__(self) -> None:
+        for name in ("lower", "upper", "velocity", "acceleration", "jerk"):
+            value = getattr(self, name)
+            if value is None and name == "jerk":
+                continue
+            values = as_points(_as_bounded_array(value, f"JointLimits.{name}", 1).reshape(-1), 7, f"JointLimits.{name}")[0]
+            if name not in ("lower", "upper") and np.any(values <= 0.0):
+                raise ValueError(f"JointLimits.{name} must be > 0 for every joint")
+            object.__setattr__(self, name, tuple(float(v) for v in values))
+        if any(low >= high for low, high in zip(self.lower, self.upper)):
+            raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
+
 
 @dataclass(frozen=True)
 class Hold:
@@ -52,6 +66,11 @@ class Hold:
     joint: int
     start: float
     duration: float = 0.5
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=6))
+        object.__setattr__(self, "start", check_real(self.start, "Hold.start", nonnegative=True))
+        object.__setattr__(self, "duration", check_real(self.duration, "Hold.duration", positive=True))
 
 
 @dataclass

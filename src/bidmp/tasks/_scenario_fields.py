@@ -30,7 +30,11 @@ _MIN_DEMONSTRATION = 10  # samples: what segmentation (and so the extension) nee
 
 
 def _fail(source: str, key: str, message: str):
-    raise ScenarioError(f"scenario {source}: {key}: {message}")
+    # The key is the file's (a user's key may be any length) and the message may list choices:
+    # each is shown short, so that the one line stays within 300 characters.
+    key = key if len(key) <= 60 else key[:59] + "…"
+    text = f"scenario {source}: {key}: {message}"
+    raise ScenarioError(text if len(text) <= 300 else text[:299] + "…")
 
 
 def _shown(value) -> str:
@@ -95,8 +99,8 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
 def _prepared_file(path, units: str) -> np.ndarray:
     """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
     trimmed, filtered, uniform time); a declared unit must be the scenario's."""
-    from ..io.trajectories import declared_units
     from ..demonstrations.prepare import prepare
+    from ..io.trajectories import declared_units
 
     declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
     if declared and units and declared != units:

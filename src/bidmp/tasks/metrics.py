@@ -10,7 +10,13 @@ import math
 
 import numpy as np
 
-from .._checks import as_point, as_trajectory, check_real
+from .._checks import (
+    _as_bounded_array,
+    _check_finite,
+    as_point,
+    as_trajectory,
+    check_real,
+)
 from .._trajectory import path_extent, rmse
 
 __all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area", "final_approach_mask"]
@@ -39,6 +45,9 @@ def final_approach_mask(heights: np.ndarray, height: float) -> np.ndarray | None
     height : float
         The band's height (the socket's 28.5 mm, in the trajectory's unit).
     """
+    heights = _as_bounded_array(heights, "heights", max_ndim=1).reshape(-1)
+    _check_finite(heights, "heights")
+    height = check_real(height, "height", positive=True)
     above = np.flatnonzero(heights >= height)
     if above.size == 0 or above[-1] == heights.shape[0] - 1:
         return None
@@ -103,9 +112,12 @@ def axis_deviation(trajectory, orientations, target, height: float, axis=None) -
     from scipy.spatial.transform import Rotation
 
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
-    q = np.asarray(orientations, dtype=float)
+    q = _as_bounded_array(orientations, "orientations", max_ndim=2)
     if q.shape != (trajectory.shape[0], 4):
         raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), got {q.shape}")
+    _check_finite(q, "orientations")
+    if np.any(np.linalg.norm(q, axis=1) < 1e-12):
+        raise ValueError("orientations contains a zero quaternion, which is no rotation")
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)

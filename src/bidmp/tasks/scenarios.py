@@ -61,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_limit, get_limits, short_token
+from .._checks import check_limit, check_path, get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
 from ..io.strict_json import load_json
 from ..scene.clearance import Scene
@@ -203,6 +203,9 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     ``"file"`` demonstrations are read relative to ``base_dir`` and must lie inside it (after
     resolving ``..`` and symlinks) unless ``allow_outside_files`` is true.
     """
+    if not isinstance(source, str):
+        raise TypeError(f"source must be a string naming the scenario's origin, got {type(source).__name__}")
+    source = short_token(source, 40)[1:-1]
     units = _check_top_level(data, source)
     demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
     n_dims = demonstration.shape[1]
@@ -406,8 +409,9 @@ def builtin_names() -> list[str]:
 
 def builtin_text(name: str) -> str:
     """The JSON text of a built-in scenario (for ``bidmp scenario show NAME > my.json``)."""
-    if name not in builtin_names():
-        raise ScenarioError(f"unknown built-in scenario {name!r}; built-ins: {', '.join(builtin_names())}")
+    if not isinstance(name, str) or name not in builtin_names():
+        shown = short_token(name) if isinstance(name, str) else type(name).__name__
+        raise ScenarioError(f"unknown built-in scenario {shown}; built-ins: {', '.join(builtin_names())}")
     return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
 
 
@@ -419,6 +423,7 @@ def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) 
     """
     if not isinstance(path_or_name, (str, os.PathLike)):
         raise TypeError(f"path_or_name must be a file name or a built-in name, got {type(path_or_name).__name__}")
+    check_path(path_or_name, "path_or_name")
     text_name = str(path_or_name)
     if not text_name.endswith(".json") and text_name in builtin_names():
         return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")

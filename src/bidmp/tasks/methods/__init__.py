@@ -37,12 +37,14 @@ def _load_builtins() -> None:
         return
     _BUILTINS_LOADED = True
     # Each module registers its methods; the order is the order names() lists them in.
-    from . import dmp  # noqa: F401
-    from . import dmp_converged  # noqa: F401
-    from . import bidmp  # noqa: F401
-    from . import gmm  # noqa: F401
-    from . import tpgmm  # noqa: F401
-    from . import mp_dmp  # noqa: F401
+    from . import (
+        bidmp,  # noqa: F401
+        dmp,  # noqa: F401
+        dmp_converged,  # noqa: F401
+        gmm,  # noqa: F401
+        mp_dmp,  # noqa: F401
+        tpgmm,  # noqa: F401
+    )
 
 
 def register(method: Method, *, replace: bool = False) -> Method:
@@ -80,6 +82,9 @@ def names(*, poses: bool | None = None, lasa: bool | None = None, closed_loop: b
     default in the LASA benchmark, or have a closed-loop stepper."""
     _load_builtins()
     wanted = {"poses": poses, "lasa": lasa, "closed_loop": closed_loop}
+    for key, value in wanted.items():
+        if value is not None and not isinstance(value, bool):
+            raise TypeError(f"names: {key} must be True, False or None, got {type(value).__name__}")
     order = sorted(_REGISTRY, key=lambda name: _BUILTIN_ORDER.index(name) if name in _BUILTIN_ORDER else len(_BUILTIN_ORDER))
     return [name for name in order
             if all(value is None or getattr(_REGISTRY[name], key) == value for key, value in wanted.items())]
