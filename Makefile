@@ -24,7 +24,7 @@ test: $(STAMP)
 # The long hypothesis campaign (tests/test_fuzz.py x20: over 10 000 generated inputs); writes
 # the outcome counts to fuzz-report.json.
 fuzz: $(STAMP)
-	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py -p no:cacheprovider
+	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py tests/test_fuzz_surface.py -p no:cacheprovider
 
 # The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/).
 sim: $(STAMP)

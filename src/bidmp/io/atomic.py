@@ -17,7 +17,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from .._checks import check_path
+from .._checks import check_path, shown_path
 
 __all__ = ['atomic_write']
 
@@ -107,6 +107,11 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator:
             handle.flush()
             os.fsync(handle.fileno())
         os.replace(tmp_name, target)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp_name)
+        # A full disk says "No space left on device" without the file: name it (the old one stays).
+        raise OSError(exc.errno, f"cannot write {shown_path(target)} ({exc.strerror or exc}); nothing was replaced") from None
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)
