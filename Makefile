@@ -21,8 +21,8 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2
 
-# The long hypothesis campaign (tests/test_fuzz.py x20: over 10 000 generated inputs); writes
-# the outcome counts to fuzz-report.json.
+# The long campaign: the hypothesis suite of tests/test_fuzz.py x20 and the public-surface sweep of
+# tests/test_fuzz_surface.py in full; writes the outcome counts per entry point to fuzz-report.json.
 fuzz: $(STAMP)
 	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py tests/test_fuzz_surface.py -p no:cacheprovider
 

@@ -272,7 +272,12 @@ def test_the_public_surface_refuses_nasty_input_by_name(tmp_path):
     if FULL:
         path = "fuzz-report.json"
         report = json.load(open(path, encoding="utf-8")) if os.path.exists(path) else {}
-        report["surface"] = {"calls": len(chosen), "uncovered": uncovered, "outcomes": dict(sorted(outcomes.items()))}
+        classes = dict.fromkeys(("result", "refused", "internal error", "silent NaN/inf", "raw text", "long message",
+                                 "leaked warning", "hang"), 0)
+        for key, count in outcomes.items():
+            classes[key.rsplit(": ", 1)[1]] += count
+        report["surface"] = {"calls": len(chosen), "uncovered": uncovered, "classes": classes,
+                             "outcomes": dict(sorted(outcomes.items()))}
         with open(path, "w", encoding="utf-8") as handle:
             json.dump(report, handle, indent=2)
     assert not defects, f"{len(defects)} defects of {len(chosen)} calls: {defects[:40]}"
