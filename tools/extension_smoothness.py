@@ -13,7 +13,9 @@ Printed, for a demonstration that comes to rest at a corner and a target 300 mm 
   form;
 * N random demonstrations (mm or m, 150-600 samples) with a post near the transfer's middle: the
   LDJ difference against the post's size relative to the transfer (the tool radius plus the post
-  radius plus the margin, over the chord), and the length ratio.
+  radius plus the margin, over the chord), and the length ratio;
+* the floor: an ideal half-sine bow of a given height over a straight transfer, both on the same
+  quintic time law (what a route that must pass a post at that distance cannot beat).
 
 All derivatives by central differences (``numpy.gradient``) on the extension's own samples.
 """
@@ -122,12 +124,25 @@ def random_cases(count: int) -> None:
               f"  {ratio:15.3f}  {top:9.2f}")
 
 
+def ideal_bows() -> None:
+    """The floor of the jerk measure's excess: a straight transfer and the same transfer bowed by
+    one half-sine of height h (a fraction of its length), both on the quintic rest-to-rest time
+    law. A post that needs the route h away from the chord cannot cost less than this."""
+    t = np.linspace(0.0, 1.0, 20001)
+    s = 10 * t**3 - 15 * t**4 + 6 * t**5
+    straight = ldj(np.column_stack([s, 0 * s]), t[1])
+    print("\nideal half-sine bow, height / length:  " + "  ".join(f"{h:5.2f}" for h in (0.05, 0.08, 0.1, 0.15, 0.2, 0.3)))
+    worse = [straight - ldj(np.column_stack([s, h * np.sin(np.pi * s)]), t[1]) for h in (0.05, 0.08, 0.1, 0.15, 0.2, 0.3)]
+    print("  jerk measure worse than straight by:  " + "  ".join(f"{w:5.2f}" for w in worse))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--random", type=int, default=24, help="random post cases (default 24)")
     args = parser.parse_args()
     fixed_cases()
     random_cases(args.random)
+    ideal_bows()
 
 
 if __name__ == "__main__":
