@@ -376,6 +376,22 @@ def check_choice(value, name: str, choices: Iterable[str]) -> str:
     return value
 
 
+def as_vector(values, name: str, *, length: int | None = None, min_length: int = 1,
+              positive: bool = False) -> np.ndarray:
+    """A 1-D array of finite numbers within ``max_abs_value``: ``length`` of them if given, else
+    at least ``min_length`` (``positive``: each > 0). A scalar is a vector of one."""
+    array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
+    if length is not None and array.shape[0] != length:
+        raise ValueError(f"{name} must have {length} entries, got {array.shape[0]}")
+    if array.shape[0] < min_length:
+        raise ValueError(f"{name} is empty" if array.shape[0] == 0 else f"{name} needs at least {min_length} entries")
+    _check_finite(array, name)
+    _check_magnitude(array, name)
+    if positive and np.any(array <= 0.0):
+        raise ValueError(f"{name} must be > 0")
+    return array
+
+
 def as_indices(values, name: str, last: int) -> np.ndarray:
     """A 1-D array of sample indices in ``[0, last]``: integers (whole-valued floats accepted)."""
     array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)

@@ -8,9 +8,9 @@ and a polyline sampled at the robot's rate has an acceleration spike at every ve
 * **the template, where it is free.** It is what G-PRM's score measures similarity to (its own
   similarity is 1, every roadmap path's is lower), so where no part is in the way it is the best
   answer G-PRM's objective can give, with the piece's own smoothness;
-* **otherwise the roadmap path, _shortcut and smoothed.** Greedy shortcutting (from each kept
+* **otherwise the roadmap path, shortcut and smoothed.** Greedy shortcutting (from each kept
   vertex, the farthest later vertex a free straight move reaches) removes the sampling's detours;
-  the _shortcut polyline is then replaced by the smoothest free least-squares quintic spline
+  the shortcut polyline is then replaced by the smoothest free least-squares quintic spline
   (fewest knots first, its bow away from the chord widened by up to 1.5 where a fit cuts a
   corner into a part). A quintic spline has continuous curvature and curvature rate, so the
   transfer can be timed through its bends without jerk spikes; a Savitzky–Golay smoothing of the
@@ -37,15 +37,15 @@ __all__ = []
 
 logger = logging.getLogger(__name__)
 
-_RESAMPLED = 200  # points of the _shortcut polyline before smoothing
-_TAUT = 60  # points along the _shortcut polyline _shortcut once more
+_RESAMPLED = 200  # points of the shortcut polyline before smoothing
+_TAUT = 60  # points along the shortcut polyline, shortcut once more
 _WINDOWS = (81, 41, 21, 11)  # Savitzky–Golay windows tried on the template, widest first (points of _RESAMPLED)
 _KNOTS = (0, 1, 2, 3, 4, 6, 8, 12, 16, 24, 32)  # interior knots of the route's quintic spline, fewest (smoothest) first
 # Shares of the spline's offset from the template (or chord) tried, widest first: 1.5 where a fit
 # cuts a corner into a part, down to 0.1 where G-PRM's wide samples went further round than needed.
 _SHARES = (1.5, 1.25, 1.1, 1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1)
 _BISECTIONS = 4  # then between the last free share and the first blocked one
-_LONGER = 1.02  # a spline at most this much longer than the _shortcut route is taken; else more knots
+_LONGER = 1.02  # a spline at most this much longer than the shortcut route is taken; else more knots
 
 
 def _path_is_free(path: np.ndarray, is_free: CollisionCallback | None) -> bool:
@@ -105,32 +105,28 @@ def _smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | Non
     None when no candidate is free."""
     if polyline.shape[0] < 3 or arclength(polyline)[-1] <= 0.0:
         return polyline if _path_is_free(polyline, is_free) else None
-    u = np.linspace(0.0, 1.0, _RESAMPLED)[:, None]
+    u = np.linspace(0.0, 1.0, _RESAMPLED)
+    if base is None:  # the chord (every fit keeps the polyline's ends)
+        reference = polyline[0] + u[:, None] * (polyline[-1] - polyline[0])
+    else:
+        s = arclength(base)
+        reference = interp_columns(u * s[-1], s, base)
     route_length, best, best_length = arclength(polyline)[-1], None, np.inf
     for n_knots in _KNOTS:
-        fit = _spline_fit(polyline, n_knots)
-        if base is None:
-            reference = fit[0] + u * (fit[-1] - fit[0])
-        else:
-            s = arclength(base)
-            reference = interp_columns(u[:, 0] * s[-1], s, base)
+        offset = _spline_fit(polyline, n_knots) - reference
         # From the widest offset down: the last free one before the first that is not (the
         # offset's free set is an interval above some share for a single part in the way).
         free_share, blocked_share = None, 0.0
         for share in _SHARES:
-            if not _path_is_free(reference + share * (fit - reference), is_free):
+            if not _path_is_free(reference + share * offset, is_free):
                 blocked_share = share
                 break
             free_share = share
         if free_share is None:
             continue
-        for _ in range(_BISECTIONS if blocked_share > 0.0 else 0):  # closer to the part, as far as it stays free
-            middle = (free_share + blocked_share) / 2.0
-            if _path_is_free(reference + middle * (fit - reference), is_free):
-                free_share = middle
-            else:
-                blocked_share = middle
-        candidate = reference + free_share * (fit - reference)
+        if blocked_share > 0.0:  # closer to the part, as far as it stays free
+            free_share = _least_free_share(reference, offset, blocked_share, free_share, is_free, _BISECTIONS)
+        candidate = reference + free_share * offset
         length = arclength(candidate)[-1]
         if length <= _LONGER * route_length:
             return _smoother(candidate, _bump_route(polyline, reference, is_free, route_length))
@@ -157,11 +153,21 @@ def _bump_route(polyline: np.ndarray, reference: np.ndarray, is_free: CollisionC
         blocked = share
     if free is None:
         return None
-    for _ in range(6):
-        middle = (blocked + free) / 2.0
-        blocked, free = (blocked, middle) if _path_is_free(reference + middle * bow, is_free) else (middle, free)
-    candidate = reference + free * bow
+    candidate = reference + _least_free_share(reference, bow, blocked, free, is_free, 6) * bow
     return candidate if arclength(candidate)[-1] <= 1.03 * route_length else None
+
+
+def _least_free_share(reference: np.ndarray, offset: np.ndarray, blocked: float, free: float,
+                      is_free: CollisionCallback | None, steps: int) -> float:
+    """Bisection between a share of ``offset`` whose route is blocked and one whose route is free:
+    the free share closest to the blocked one after ``steps`` halvings."""
+    for _ in range(steps):
+        middle = (blocked + free) / 2.0
+        if _path_is_free(reference + middle * offset, is_free):
+            free = middle
+        else:
+            blocked = middle
+    return free
 
 
 def _smoother(route: np.ndarray, other: np.ndarray | None) -> np.ndarray:
@@ -183,8 +189,8 @@ def _smoother(route: np.ndarray, other: np.ndarray | None) -> np.ndarray:
 
 def _refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCallback | None) -> tuple[np.ndarray, str]:
     """The transfer to use in place of G-PRM's ``path`` (n, D), from seg to the new target, and how
-    it was made: ``"template"``, ``"smoothed"`` (the _shortcut path, smoothed) or ``"_shortcut"``
-    (the _shortcut polyline, where no smoothing stays free). See the module docstring."""
+    it was made: ``"template"``, ``"smoothed"`` (the shortcut path, smoothed) or ``"shortcut"``
+    (the shortcut polyline, where no smoothing stays free). See the module docstring."""
     ends_match = np.allclose(template[[0, -1]], path[[0, -1]], rtol=0.0,
                              atol=1e-9 * max(float(np.ptp(path, axis=0).max()), 1.0))
     if ends_match and _path_is_free(template, is_free):
@@ -199,8 +205,8 @@ def _refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionC
     smooth = _smoothest_free_route(polyline, is_free, template if ends_match else None) if arclength(polyline)[-1] > 0.0 else None
     if smooth is not None:
         return smooth, "smoothed"
-    logger.debug("no smoothing of the _shortcut transfer stays free: its polyline is used")
-    return polyline, "_shortcut"
+    logger.debug("no smoothing of the shortcut transfer stays free: its polyline is used")
+    return polyline, "shortcut"
 
 
 def _smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:

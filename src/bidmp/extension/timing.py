@@ -204,12 +204,11 @@ def _path_function(path: np.ndarray, s: np.ndarray):
 
     pieces = np.diff(path, axis=0)
     lengths = np.linalg.norm(pieces, axis=1)
-    if path.shape[0] < 4 or np.any(lengths <= 0.0):
-        return lambda arc: interp_columns(arc, s, path)
-    cosines = np.sum(pieces[1:] * pieces[:-1], axis=1) / (lengths[1:] * lengths[:-1])
-    if np.any(cosines < np.cos(_SMOOTH_TURN)):
-        return lambda arc: interp_columns(arc, s, path)
-    return make_interp_spline(s, path, k=3)
+    smooth = path.shape[0] >= 4 and np.all(lengths > 0.0)
+    if smooth:
+        cosines = np.sum(pieces[1:] * pieces[:-1], axis=1) / (lengths[1:] * lengths[:-1])
+        smooth = bool(np.all(cosines >= np.cos(_SMOOTH_TURN)))
+    return make_interp_spline(s, path, k=3) if smooth else (lambda arc: interp_columns(arc, s, path))
 
 
 def _timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_index: int, approach: np.ndarray,

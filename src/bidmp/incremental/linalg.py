@@ -28,13 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
-from .._checks import (
-    _as_bounded_array,
-    as_trajectory,
-    check_int,
-    check_limit,
-    check_real,
-)
+from .._checks import as_trajectory, as_vector, check_int, check_limit, check_real
 
 __all__ = ["sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "PINV_RCOND", "PINV_GAP", "MAX_ADMM_ITERATIONS"]
 
@@ -121,7 +115,7 @@ def svd_update(U: np.ndarray, s: np.ndarray, V: np.ndarray, E: np.ndarray):
     the SVD of ``K = [U diag(s) | E]`` (N × (r + m)), whose right factor maps back through
     ``blockdiag(V, I)``. Returns ``(U', s', V', dropped)`` like :func:`truncated_svd`."""
     U = _matrix(U, "U")
-    s = _matrix(_as_bounded_array(s, "s", max_ndim=1).reshape(1, -1), "s", rows=1)[0]
+    s = as_vector(s, "s")
     V, E = _matrix(V, "V"), _matrix(E, "E", rows=U.shape[0])
     if s.shape[0] != U.shape[1] or V.shape[1] != U.shape[1]:
         raise ValueError(f"s and V must have one entry / column per column of U ({U.shape[1]})")

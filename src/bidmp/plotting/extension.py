@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_indices, as_trajectory
+from .._checks import as_indices, as_trajectory, as_vector
 from ._base import _axes_for, _draw, _finish, _matplotlib, _save
 
 __all__ = ['plot_segmentation', 'plot_extension', 'plot_prm_comparison']
@@ -19,12 +19,11 @@ def plot_segmentation(path, y: np.ndarray, points: np.ndarray, kinds: np.ndarray
     y = as_trajectory(y, "y", min_points=2, allow_static=True)
     points = as_indices(points, "points", y.shape[0] - 1)
     if kinds is not None:
-        kinds = as_indices(np.abs(_as_bounded_array(kinds, "kinds", 1)), "kinds", 1) * np.sign(kinds)
-        if kinds.shape != points.shape or np.any(kinds == 0):
+        kinds = as_vector(kinds, "kinds", length=points.shape[0])
+        if np.any(np.abs(kinds) != 1.0):
             raise ValueError(f"kinds must be +1 or -1 for each of the {points.shape[0]} points")
     if curvature is not None:
-        curvature = as_trajectory(np.reshape(_as_bounded_array(curvature, "curvature", 1), (-1, 1)), "curvature",
-                                  min_points=2, allow_static=True)[:, 0]
+        curvature = as_vector(curvature, "curvature", min_length=2)
     mpl = _matplotlib()
     y = np.asarray(y, dtype=float)
     n_dims = y.shape[1]

@@ -9,7 +9,7 @@ import numpy as np
 from .._checks import as_trajectory, check_bytes, check_int, numerically_guarded
 from .._trajectory import resample_time
 from .canonical import phase_grid
-from .forcing import _as_phase, basis_functions
+from .forcing import _as_phase, _basis_rows
 from .goals import DelayedGoal, PhaseGate, ProgressGate, _learned_progress_gate
 from .grid import _cached_grid, _rollout_grid
 from .integrate import _unit_responses
@@ -97,7 +97,7 @@ class GridQueries:
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
         self._check_fitted()
-        return basis_functions(_as_phase(phase), self.centres_, self.widths_)
+        return _basis_rows(_as_phase(phase), self.centres_, self.widths_)
 
     def forcing_term(self, phase) -> np.ndarray:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_point, as_points, check_real
+from .._checks import as_point, as_vector, check_real
 
 __all__ = ["CouplingTerm", "PhaseStopping", "ConstantAcceleration"]
 
@@ -66,8 +66,7 @@ class ConstantAcceleration(CouplingTerm):
     ``a tau² / (αβ) (1 - (1 + ω t) e^{-ω t})`` (real time, ``ω = α / (2 tau)``)."""
 
     def __init__(self, acceleration) -> None:
-        vector = _as_bounded_array(acceleration, "acceleration", 1).reshape(-1)
-        self.acceleration = as_points(vector, vector.shape[0], "acceleration")[0].copy()
+        self.acceleration = as_vector(acceleration, "acceleration").copy()
 
     def __call__(self, t: float, y: np.ndarray, yd: np.ndarray, phase: float) -> np.ndarray:
         return np.broadcast_to(self.acceleration, y.shape)

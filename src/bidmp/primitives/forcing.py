@@ -12,9 +12,8 @@ import numpy as np
 
 from .._checks import (
     _as_bounded_array,
-    _check_finite,
-    _check_magnitude,
     as_points,
+    as_vector,
     check_choice,
     check_int,
     check_real,
@@ -43,18 +42,6 @@ def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, al
     return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
 
 
-def _as_phases(values, name: str, *, positive: bool = False) -> np.ndarray:
-    """A 1-D, non-empty array of finite numbers (``positive``: each > 0)."""
-    array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
-    if array.size == 0:
-        raise ValueError(f"{name} is empty")
-    _check_finite(array, name)
-    _check_magnitude(array, name)
-    if positive and np.any(array <= 0.0):
-        raise ValueError(f"{name} must be > 0")
-    return array
-
-
 def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing") -> np.ndarray:
     """Kernel widths ``h_i`` of ``ψ_i = exp(-h_i (phase - c_i)²)``.
 
@@ -63,7 +50,7 @@ def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "
     ``"pydmps"``: ``h_i = N^1.5 / (c_i alpha_phase)`` (SPEC §1 as printed, the pydmps convention);
     neighbours overlap at ≈ 0.9 and LWR smooths the forcing term noticeably (2–5 % on LASA).
     """
-    centres = _as_phases(centres, "centres", positive=True)
+    centres = as_vector(centres, "centres", positive=True)
     alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True)
     check_choice(method, "method", ("spacing", "pydmps"))
     n_kernels = len(centres)
@@ -93,11 +80,17 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
         computed after subtracting the row maximum, so it never underflows to 0/0 however far
         the phase is from the centres.
     """
-    phase = _as_phases(phase, "phase")
-    centres = _as_phases(centres, "centres", positive=True)
-    widths = _as_phases(widths, "widths", positive=True)
+    phase = as_vector(phase, "phase")
+    centres = as_vector(centres, "centres", positive=True)
+    widths = as_vector(widths, "widths", positive=True)
     if widths.shape != centres.shape:
         raise ValueError(f"widths must have one entry per centre ({centres.shape[0]}), got {widths.shape[0]}")
+    return _basis_rows(phase, centres, widths)
+
+
+def _basis_rows(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+    """:func:`basis_functions` for a DMP's own (valid) centres and widths and validated phases."""
+    phase = np.asarray(phase, dtype=np.float64).reshape(-1)
     n_kernels = centres.shape[0]
     # Reference exponent per row: the larger of the two kernels bracketing the phase. It is one
     # of the row's entries, so shifting by it cannot overflow and the largest term survives; it
@@ -221,7 +214,7 @@ def _learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tu
     widths = kernel_widths(centres, params.alpha_phase, params.widths)
     target = _forcing_target(train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
                             derivatives=params.derivatives, gate=gate)
-    phi = basis_functions(phase, centres, widths)
+    phi = _basis_rows(phase, centres, widths)
     weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
     return np.ascontiguousarray(weights), centres, widths, phase, phi
 

@@ -25,7 +25,7 @@ demonstration's own progress along its path:
 
 * ``σ`` — the arc-length progress (0 → 1) of the demonstration as learned;
 * ``R = σ · S(t / w)`` over the first ``w`` of the motion and ``1 - (1 - σ) S((T - t) / w)``
-  over its last ``w``, ``R = σ`` in between, 1 after. ``S`` is the 7th-order _smoothstep (zero
+  over its last ``w``, ``R = σ`` in between, 1 after. ``S`` is the 7th-order smoothstep (zero
   first to third derivative at both ends), ``w = _GOAL_BLEND`` (15 %) of the demonstration's
   duration. So ``R, R', R'', R'''`` all start at 0: the first ~50 ms of a motion do not depend on
   its goal (no acceleration or jerk step when the goal moves), and ``R`` reaches 1 with zero
@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_points, check_real
+from .._checks import as_vector, check_real
 from .._trajectory import arclength
 from .canonical import phase_grid
 
@@ -59,7 +59,7 @@ _GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal'
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
-    """The 7th-order _smoothstep ``35u⁴ - 84u⁵ + 70u⁶ - 20u⁷`` on [0, 1] (clipped outside): 0 → 1 with
+    """The 7th-order smoothstep ``35u⁴ - 84u⁵ + 70u⁶ - 20u⁷`` on [0, 1] (clipped outside): 0 → 1 with
     zero first, second and third derivatives at both ends."""
     u = np.clip(u, 0.0, 1.0)
     return u**4 * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)))
@@ -100,7 +100,7 @@ def _goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: fl
     rate = np.gradient(share, dt)
     curvature = np.gradient(rate, dt)
     gate = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
-    # R, R' and R'' vanish at the start (the _smoothstep is flat there): one-sided differences
+    # R, R' and R'' vanish at the start (the smoothstep is flat there): one-sided differences
     # would leave a trace of the next samples, and the initial acceleration must not depend on
     # the goal.
     gate[0] = alpha * beta / K
@@ -187,9 +187,7 @@ class ProgressGate:
 
     def __post_init__(self) -> None:
         kind = type(self).__name__
-        phase = as_points(_as_bounded_array(self.training_phase, f"{kind}.training_phase", 1).reshape(-1, 1), 1,
-                          f"{kind}.training_phase")[:, 0]
-        gate = as_points(_as_bounded_array(self.gate, f"{kind}.gate", 1).reshape(-1, 1), 1, f"{kind}.gate")[:, 0]
+        phase, gate = as_vector(self.training_phase, f"{kind}.training_phase"), as_vector(self.gate, f"{kind}.gate")
         if gate.shape != phase.shape or phase.size < 2 or np.any(np.diff(phase) >= 0.0):
             raise ValueError(f"{kind}: training_phase must decrease strictly, with one gate value per phase")
         object.__setattr__(self, "training_phase", phase)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .canonical import phase_grid
-from .forcing import basis_functions
+from .forcing import _basis_rows
 from .integrate import _unit_responses
 
 __all__ = []
@@ -51,5 +51,5 @@ def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tup
     cached = _cached_grid(model, params, n_steps, step)
     if cached is None:
         phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
-        cached = _store_grid(model, params, phase, basis_functions(phase, model.centres_, model.widths_), step)
+        cached = _store_grid(model, params, phase, _basis_rows(phase, model.centres_, model.widths_), step)
     return cached[3:]

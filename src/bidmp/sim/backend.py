@@ -17,7 +17,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_points, check_int, check_real
+from .._checks import as_vector, check_int, check_real
 
 __all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "MotionPlan", "Execution", "SIM_STEP",
            "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
@@ -50,9 +50,7 @@ class JointLimits:
             value = getattr(self, name)
             if value is None and name == "jerk":
                 continue
-            values = as_points(_as_bounded_array(value, f"JointLimits.{name}", 1).reshape(-1), 7, f"JointLimits.{name}")[0]
-            if name not in ("lower", "upper") and np.any(values <= 0.0):
-                raise ValueError(f"JointLimits.{name} must be > 0 for every joint")
+            values = as_vector(value, f"JointLimits.{name}", length=7, positive=name not in ("lower", "upper"))
             object.__setattr__(self, name, tuple(float(v) for v in values))
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
