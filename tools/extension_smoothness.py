@@ -14,8 +14,10 @@ Printed, for a demonstration that comes to rest at a corner and a target 300 mm 
 * N random demonstrations (mm or m, 150-600 samples) with a post near the transfer's middle: the
   LDJ difference against the post's size relative to the transfer (the tool radius plus the post
   radius plus the margin, over the chord), and the length ratio;
-* the floor: an ideal half-sine bow of a given height over a straight transfer, both on the same
-  quintic time law (what a route that must pass a post at that distance cannot beat).
+* the floor: the least-jerk transfer (Flash & Hogan 1985) that passes a given distance from the
+  chord, against the straight quintic; for each random post the floor at the offset that post
+  forces (its reach less its distance from the chord, at its place along the chord). Beside it, a
+  half-sine bow of that height on the quintic time law.
 
 All derivatives by central differences (``numpy.gradient``) on the extension's own samples.
 """
@@ -95,7 +97,7 @@ def fixed_cases() -> None:
 
 
 def random_cases(count: int) -> None:
-    print("\nrandom posts: seed  unit  post size / chord  LDJ worse by  length/shortest  peaks max")
+    print("\nrandom posts: seed  unit  post size / chord  LDJ worse by  floor  length/shortest  peaks max")
     for seed in range(count):
         rng = np.random.default_rng(seed)
         unit = float(rng.choice([1.0, 1e-3]))
@@ -118,22 +120,54 @@ def random_cases(count: int) -> None:
         post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -300 * unit], "radius": radius, "height": 800 * unit}
         extension = extend_demonstration(demo, target, seed=seed, scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}))
         worse = ldj(transfer(blind, n), 1 / n) - ldj(transfer(extension, n), 1 / n)
+        chord = hover[:2] - seg[:2]
+        along = float(np.dot(centre[:2] - seg[:2], chord) / np.dot(chord, chord))
+        beside = abs(float(chord[0] * (centre[1] - seg[1]) - chord[1] * (centre[0] - seg[0]))) / np.linalg.norm(chord)
+        floor = jerk_floor(max(keep - beside, 0.0) / np.linalg.norm(hover - seg), along)
         ratio = length(extension.tra_gen) / shortest_around(seg, hover, centre, keep)
         top = (peaks(extension.complete, 1 / n) / peaks(demo, 1 / n)).max()
-        print(f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}"
+        print(f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}  {floor:5.2f}"
               f"  {ratio:15.3f}  {top:9.2f}")
 
 
+def _least_jerk_offset(height: float, when: float, n: int = 801) -> np.ndarray:
+    """Samples (n, 2) of the least-jerk rest-to-rest transfer of unit length that is ``height`` away
+    from its chord at the fraction ``when`` of its duration (Flash & Hogan 1985: each axis is the
+    minimum of the integral of its squared third derivative under its own constraints, so the
+    along-chord axis is the quintic and the across axis a via-point problem, solved here as a
+    least-squares problem on third differences)."""
+    third = np.zeros((n - 3, n))
+    rows = np.arange(n - 3)
+    for k, weight in enumerate((-1.0, 3.0, -3.0, 1.0)):
+        third[rows, rows + k] = weight
+    fixed = {0: 0.0, 1: 0.0, 2: 0.0, n - 3: 0.0, n - 2: 0.0, n - 1: 0.0, int(round(when * (n - 1))): height}
+    across = np.zeros(n)
+    across[list(fixed)] = list(fixed.values())
+    free = np.setdiff1d(np.arange(n), list(fixed))
+    across[free] = np.linalg.lstsq(third[:, free], -third @ across, rcond=None)[0]
+    t = np.linspace(0.0, 1.0, n)
+    return np.column_stack([10 * t**3 - 15 * t**4 + 6 * t**5, across])
+
+
+def jerk_floor(height: float, when: float = 0.5) -> float:
+    """How much worse the jerk measure of the least-jerk transfer that passes ``height`` (a fraction
+    of the transfer's length) from the chord is than the straight quintic's."""
+    straight = _least_jerk_offset(0.0, when)
+    return ldj(straight, 1 / (len(straight) - 1)) - ldj(_least_jerk_offset(height, when), 1 / (len(straight) - 1))
+
+
 def ideal_bows() -> None:
-    """The floor of the jerk measure's excess: a straight transfer and the same transfer bowed by
-    one half-sine of height h (a fraction of its length), both on the quintic rest-to-rest time
-    law. A post that needs the route h away from the chord cannot cost less than this."""
+    """The floor of the jerk measure's excess: the least-jerk transfer through a point h (a fraction
+    of its length) from the chord at mid-transfer, and one half-sine bow of height h on the quintic
+    rest-to-rest time law (the shape the refinement's second candidate takes)."""
+    heights = (0.05, 0.08, 0.1, 0.15, 0.2, 0.3)
     t = np.linspace(0.0, 1.0, 20001)
     s = 10 * t**3 - 15 * t**4 + 6 * t**5
     straight = ldj(np.column_stack([s, 0 * s]), t[1])
-    print("\nideal half-sine bow, height / length:  " + "  ".join(f"{h:5.2f}" for h in (0.05, 0.08, 0.1, 0.15, 0.2, 0.3)))
-    worse = [straight - ldj(np.column_stack([s, h * np.sin(np.pi * s)]), t[1]) for h in (0.05, 0.08, 0.1, 0.15, 0.2, 0.3)]
-    print("  jerk measure worse than straight by:  " + "  ".join(f"{w:5.2f}" for w in worse))
+    print("\nfloor, offset from the chord / length:   " + "  ".join(f"{h:5.2f}" for h in heights))
+    print("  least-jerk transfer worse by:          " + "  ".join(f"{jerk_floor(h):5.2f}" for h in heights))
+    bows = [straight - ldj(np.column_stack([s, h * np.sin(np.pi * s)]), t[1]) for h in heights]
+    print("  half-sine bow, quintic law, worse by:  " + "  ".join(f"{w:5.2f}" for w in bows))
 
 
 def main() -> None:
