@@ -93,39 +93,74 @@ class _Distances:
         return self._distance(self.tool, tool_pose, shape, pose)
 
     def _distance(self, a, pose_a, b, pose_b) -> float:
-        """coal's signed distance, never an abort. GJK at the tight tolerance can end on a degenerate
-        simplex when flat faces are parallel (a vertical tool beside a vertical post): coal then runs
-        EPA on shapes that do not touch and reports -DBL_MAX. The same query with Nesterov-accelerated
-        GJK, then at a looser tolerance, converges (to 1e-9 of the closed form in
-        tests/test_geometry.py); if neither does, the query is answered conservatively (0: touching,
-        so nothing is ever reported clearer than it is) and logged."""
-        self.result.clear()
-        distance = float(self.coal.distance(a, pose_a, b, pose_b, self.request, self.result))
-        if math.isfinite(distance) and distance > -1e100:
-            return distance
-        for request in self._retries():
-            distance = float(self.coal.distance(a, pose_a, b, pose_b, request, self.coal.DistanceResult()))
-            if math.isfinite(distance) and distance > -1e100:
+        """coal's signed distance, never an abort and never a wrong separation. GJK at the tight
+        tolerance can end on a degenerate simplex when flat faces are parallel (a vertical tool
+        beside a vertical post): coal then runs EPA on shapes that do not touch and reports
+        -DBL_MAX, or (two vertical cylinders) returns the distance between "nearest points" that
+        lie off the shapes: 1.96 for 16.90, 3.93 for 12.50 (tests/test_geometry.py), and
+        Nesterov-accelerated GJK repeats the second. So an answer is kept only when it is finite
+        and, for a separation, both nearest points lie on their shapes that far apart; otherwise the query is
+        repeated with Nesterov-accelerated GJK, then at looser tolerances (1e-10, 1e-9, coal's
+        default 1e-6 relative), each within 1e-8 of the closed form where it passes. If none
+        passes, the pair is answered conservatively (0: touching, so nothing is ever reported
+        clearer than it is) and logged."""
+        for request in self._requests():  # into self.result: a caller reads the nearest points there
+            self.result.clear()
+            distance = float(self.coal.distance(a, pose_a, b, pose_b, request, self.result))
+            if math.isfinite(distance) and distance > -1e100 and (distance <= 0.0 or self._witnessed(a, pose_a, b, pose_b, distance)):
                 return distance
         logger.warning("coal could not compute a distance (GJK/EPA did not converge); the pair is taken as touching")
         return 0.0
 
-    def _retries(self) -> list:
-        """The fallback requests of :meth:`_distance`, built once."""
+    def _witnessed(self, a, pose_a, b, pose_b, distance: float) -> bool:
+        """Whether a separation ``distance`` is borne out by the nearest points in ``self.result``:
+        each on its shape, and that far apart."""
+        first, second = self.result.getNearestPoint1(), self.result.getNearestPoint2()
+        apart = float(np.linalg.norm(first - second))
+        return (abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first)
+                and _on_shape(b, pose_b, second))
+
+    def _requests(self) -> list:
+        """The requests :meth:`_distance` tries in turn, built once."""
         if getattr(self, "_fallbacks", None) is None:
             coal = self.coal
             accelerated = coal.DistanceRequest()
             accelerated.gjk_tolerance, accelerated.gjk_max_iterations = _GJK_TOLERANCE, 1000
             accelerated.epa_tolerance, accelerated.gjk_variant = _EPA_TOLERANCE, coal.GJKVariant.NesterovAcceleration
-            looser = coal.DistanceRequest()
-            looser.gjk_tolerance, looser.gjk_max_iterations, looser.epa_tolerance = 1e-10, 1000, _EPA_TOLERANCE
-            self._fallbacks = [accelerated, looser]
+            looser = []
+            for tolerance in (1e-10, 1e-9, None):
+                request = coal.DistanceRequest()
+                if tolerance is not None:
+                    request.gjk_tolerance, request.gjk_max_iterations = tolerance, 1000
+                request.epa_tolerance = _EPA_TOLERANCE
+                looser.append(request)
+            self._fallbacks = [self.request, accelerated, *looser]
         return self._fallbacks
 
     def between(self, first: int, second: int) -> float:
         a, pose_a = self.shapes[first]
         b, pose_b = self.shapes[second]
         return self._distance(a, pose_a, b, pose_b)
+
+
+_ON_SHAPE = 1e-6  # relative to the shape's size: a nearest point this far outside it is not on it
+
+
+def _on_shape(shape, pose, point) -> bool:
+    """Whether ``point`` (world frame) lies in ``shape`` at ``pose`` (to :data:`_ON_SHAPE`): boxes and
+    cylinders checked, other shapes taken as given."""
+    local = (np.asarray(point, dtype=float) - pose.getTranslation()) @ pose.getRotation()  # R^T (p - t)
+    x, y, z = local.tolist()
+    half = getattr(shape, "halfSide", None)
+    if half is not None:
+        hx, hy, hz = half.tolist()
+        slack = _ON_SHAPE * max(hx, hy, hz)
+        return abs(x) <= hx + slack and abs(y) <= hy + slack and abs(z) <= hz + slack
+    length = getattr(shape, "halfLength", None)
+    if length is not None:
+        slack = _ON_SHAPE * max(shape.radius, length)
+        return math.hypot(x, y) <= shape.radius + slack and abs(z) <= length + slack
+    return True
 
 
 def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False,
