@@ -4,7 +4,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.bidmp-installed
 
-.PHONY: demo test bench install clean readme fuzz sim lasa random-cells
+.PHONY: demo test bench install clean readme fuzz sim lasa random-cells avoidance
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -35,6 +35,13 @@ sim: $(STAMP)
 random-cells: $(STAMP)
 	BIDMP_RANDOM_CELLS=300 $(VENV)/bin/python -m pytest -q tests/test_random_cells.py tests/test_random_tilted_cells.py
 
+# Issue 23's avoidance on 200 random fields at 1 kHz (the tests run 50 at 250 Hz), then the
+# benchmark against movement_primitives on 50 fields: docs/results/avoidance.md, docs/avoidance.png.
+avoidance: $(STAMP)
+	BIDMP_AVOIDANCE_FIELDS=200 BIDMP_AVOIDANCE_RATE=1000 $(PY) -m pytest -q -n 2 tests/test_avoidance.py
+	$(PY) benchmarks/bench_avoidance.py --fields 50 --out docs/results
+	$(PY) tools/readme.py
+
 # The full LASA benchmark (30 shapes x 7 demonstrations, every method) on the embedded Dask
 # cluster, into bidmp-lasa/ (resumable: rerun to finish an interrupted sweep).
 lasa: $(STAMP)
@@ -51,6 +58,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_sim.py
 	$(PY) benchmarks/bench_cartesian.py
 	$(PY) benchmarks/bench_lasa.py
+	$(PY) benchmarks/bench_avoidance.py --fields 10
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).

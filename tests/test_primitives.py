@@ -83,9 +83,12 @@ def test_the_step_integrator_equals_the_fast_path_for_a_cartesian_dmp():
     goal[3:] = (Rotation.from_euler("z", 40, degrees=True) * Rotation.from_quat(goal[3:])).as_quat()
     fast, stepped = model.trajectory(goal), model.trajectory(goal, coupling=[])
     assert_same_motion(fast, stepped)
-    for name in ("q", "omega", "omega_dot"):
+    for name, share in (("q", RELATIVE), ("omega", RELATIVE), ("omega_dot", 10 * RELATIVE)):
+        # omega_dot differentiates the left Jacobian by a forward difference of step 1e-7: the
+        # inputs' rounding (1e-16) comes out ~1e7 larger, at 1e-9 of the peak (the two paths sum
+        # the same terms in another order).
         a, b = getattr(fast, name), getattr(stepped, name)
-        assert np.max(np.abs(a - b)) <= RELATIVE * max(np.max(np.abs(a)), 1.0), name
+        assert np.max(np.abs(a - b)) <= share * max(np.max(np.abs(a)), 1.0), name
 
 
 @pytest.mark.parametrize("tau", [1.0, 2.5])

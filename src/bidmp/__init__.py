@@ -46,6 +46,7 @@ _LAZY = {
     "CartesianBiDMP": "incremental.cartesian",
     "Tool": "scene",
     "Clearance": "scene",
+    "SceneAvoidance": "primitives.avoidance",
     "MissingExtraError": "_checks",
     "BLS": "incremental.bls",
     "BiDMP": "incremental.bidmp",

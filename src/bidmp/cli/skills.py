@@ -170,6 +170,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
         index = model.select_skill(goals[-1] if args.goal is None and isinstance(model, BiDMP) else args.goal, skill)
         print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})")
+    options.update(_rollout_extras(args, dmp, poses))
     trajectory = model.trajectory(**options)
     path = (save_poses if poses else save_trajectory)(trajectory, args.output)
     unit = dmp.units_ or "units"
@@ -182,6 +183,10 @@ def cmd_rollout(args: argparse.Namespace) -> int:
           + (f", {np.degrees(angle_between(trajectory.q[-1:], goal[None, 3:]))[0]:.3g} deg" if poses and goal.size == 7 else ""))
     print(f"  peak speed {trajectory.peak_speed():.4g} {unit}/s, peak acceleration {trajectory.peak_acceleration():.4g} "
           f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
+    for term in options.get("coupling") or ():
+        clearance = term.clearance_
+        print(f"  steered round the scene's parts: clearance {clearance.distance:.4g} {unit} to {clearance.part} "
+              f"(margin {clearance.margin:g}; the target's parts {', '.join(term.excluded_) or 'none'} left out)")
     print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
         from ..plotting.trajectories import plot_trajectories
@@ -191,6 +196,37 @@ def cmd_rollout(args: argparse.Namespace) -> int:
                                    title="rollout", units=dmp.units_)
         print(f"wrote {figure}")
     return EXIT_OK
+
+
+def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
+    """trajectory() keywords from --via and --scene/--avoid (on by default with a scene)."""
+    import numpy as np
+
+    extras = {}
+    if args.via:
+        width = 7 if poses else dmp.n_dims_
+        for index, values in enumerate(args.via):
+            if len(values) != 1 + width:
+                raise ValueError(f"--via #{index + 1} needs T and {width} coordinates, got {len(values)} numbers")
+        extras["via"] = [(values[0], values[1:]) for values in args.via]
+    avoid = args.scene is not None if args.avoid is None else args.avoid
+    if avoid:
+        if args.scene is None:
+            raise ValueError("--avoid needs --scene (the scenario whose parts to steer round)")
+        if poses or dmp.n_dims_ != 3:
+            raise ValueError("--avoid steers 3-D position models (the tool points down); this model is "
+                             + ("a pose model" if poses else f"{dmp.n_dims_}-D"))
+        from ..primitives.avoidance import SceneAvoidance
+
+        scene, label = _extension_scene(args, dmp.units_), args.target_label
+        if label is None and args.goal is not None:  # the goal is a target of the scenario: its label
+            from ..tasks.scenarios import load
+
+            targets = load(args.scene, allow_outside_files=args.allow_outside_files).targets
+            label = next((name for name, point in targets.items()
+                          if np.allclose(np.asarray(point, dtype=float)[:3], args.goal[:3], atol=1e-9)), None)
+        extras["coupling"] = [SceneAvoidance(scene, target=label)]
+    return extras
 
 
 # -- segment, extend, learn -----------------------------------------------------------------------
@@ -366,6 +402,15 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
                     "units), velocities (units/s) and accelerations (units/s^2), as CSV columns t,x,y,z,vx,vy,vz,ax,ay,az "
                     "or a .npy structured array with those fields. The motion lasts the demonstration's duration "
                     "(times tau, or --duration) plus 10 %% to come to rest (robot protocol).")
+    _add_rollout_arguments(rollout)
+    allow_outside_files(rollout, shown=False)
+    rollout.set_defaults(handler=cmd_rollout)
+
+    _add_extension_commands(commands, allow_outside_files)
+
+
+def _add_rollout_arguments(rollout) -> None:
+    """The arguments of ``bidmp rollout``."""
     rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
     rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates in the model's units (default: the demonstrated goal)")
     rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
@@ -380,9 +425,14 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
     rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy; poses: .csv)")
     rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
-    rollout.set_defaults(handler=cmd_rollout)
-
-    _add_extension_commands(commands, allow_outside_files)
+    rollout.add_argument("--via", type=float, nargs="+", action="append", metavar="T X",
+                         help="via-point: pass X Y Z (a pose: X Y Z QX QY QZ QW) at T seconds exactly (repeatable)")
+    rollout.add_argument("--scene", metavar="FILE|NAME", help="the scenario whose parts the motion is steered round")
+    rollout.add_argument("--avoid", action=argparse.BooleanOptionalAction, default=None,
+                         help="steer round the scene's parts (SceneAvoidance; default: on with --scene); a motion that "
+                              "still comes closer than the margin is an error")
+    rollout.add_argument("--target-label", default=None, metavar="LABEL",
+                         help="the scene's target the goal is (its parts are not avoided; default: what the tool takes in at the goal)")
 
 
 def _add_extension_commands(commands, allow_outside_files) -> None:

@@ -32,7 +32,7 @@ def _run_scenario(scenario, out, methods=None):
 
 
 def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=None, pictures=True, targets=None,
-             report=None):
+             report=None, avoid=False, goal_update=None):
     """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
     from tqdm import tqdm
 
@@ -52,7 +52,7 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
             bar.update(1)
 
         result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
-                          frames=frames, progress=progress, report=report)
+                          frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update)
     print()
     print(result.summary())
     written = write_sim_report(result, out)
@@ -97,7 +97,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..sim.backend import Hold
+    from ..sim.backend import GoalUpdate, Hold
     from ..sim.pybullet.world import _pybullet_module as _pybullet
     from ..tasks.scenarios import load
 
@@ -115,8 +115,11 @@ def _cmd_sim(args: argparse.Namespace) -> int:
             raise ValueError("--hold: START must be >= 0 s and DURATION > 0 s")
         hold = Hold(int(joint) - 1, start, duration)
     targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    update = None if args.goal_update is None else GoalUpdate(args.goal_update[0], tuple(args.goal_update[1:]))
+    if (args.avoid or update is not None) and not args.closed_loop:
+        raise ValueError("--avoid and --goal-update act on the closed loop: add --closed-loop")
     _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
-             pictures=not args.no_pictures, targets=targets)
+             pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update)
     return EXIT_OK
 
 
@@ -169,6 +172,11 @@ def _sim_parser(commands) -> None:
                      help="run the DMP/Bi-DMP stepper on the measured tool position with phase stopping (dmp, bidmp)")
     sim.add_argument("--hold", type=float, nargs=3, metavar=("JOINT", "START", "DURATION"),
                      help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds")
+    sim.add_argument("--avoid", action="store_true",
+                     help="closed loop: also steer round every part but the target's (SceneAvoidance)")
+    sim.add_argument("--goal-update", type=float, nargs=4, metavar=("T", "DX", "DY", "DZ"),
+                     help="closed loop: at T s of each motion the target turns out DX DY DZ (scenario units) away; the part "
+                          "and the goal move there (a scripted perception update)")
     sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
     sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
     sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")

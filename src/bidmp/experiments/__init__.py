@@ -11,6 +11,8 @@ from .._lazy import exports
 
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
+    "AvoidanceCase": "avoidance",
+    "random_case": "avoidance",
     "GeneralisationResult": "reproduce",
     "lasa_generalisation": "reproduce",
     "LASA_TARGET_OFFSETS": "reproduce",

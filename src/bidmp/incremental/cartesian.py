@@ -16,6 +16,7 @@ from ..primitives.cartesian import (
     _parts_from_state,
     _parts_state,
     _pose_params,
+    _pose_vias,
     _pose_parts,
     _read_poses_state,
 )
@@ -180,14 +181,15 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
     @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
-                   dt: float | None = None, limits: dict | None = None, coupling=None) -> PoseTrajectory:
-        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`)."""
+                   dt: float | None = None, limits: dict | None = None, coupling=None, via=None) -> PoseTrajectory:
+        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses as there)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment, position = self.position_._skill_query(goal_p, index, start_p)
         _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(np.zeros(3), index, start_e)
+        vias = None if via is None else _pose_vias(orientation, via, goal_q, start_e, duration, dt, orientation_increment)
         return _pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e,
                                 duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
-                                coupling)
+                                coupling, vias)
 
     @goal_first("skill", "start", "duration")
     def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,

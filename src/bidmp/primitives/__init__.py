@@ -8,7 +8,8 @@ Where things live (the field's split, as in movement_primitives and dmpbbo):
   gate): small objects a DMP composes;
 * ``integrate`` — the fast LTI path (filters and outer products) and the step integrator;
 * ``coupling`` — coupling terms ``coupling(t, y, yd, phase) -> acceleration`` for the step
-  integrator (phase stopping is one);
+  integrator (phase stopping is one); ``avoidance`` — steering round a scene's parts;
+* ``via`` — exact via-points (least-norm weight change); ``goal_shift`` — goals moved mid-motion;
 * ``dmp`` — :class:`DMP`, the estimator that composes them; ``stepper`` — its control-loop stepper;
 * ``cartesian``, ``so3``, ``pose_timing`` — pose DMPs on unit quaternions;
 * ``timing`` — timed trajectories and time scaling to limits.
@@ -36,6 +37,8 @@ _EXPORTS = {
     "CouplingTerm": "coupling",
     "PhaseStopping": "coupling",
     "ConstantAcceleration": "coupling",
+    "SceneAvoidance": "avoidance",
+    "AvoidanceError": "avoidance",
     "DMPStepper": "stepper",
     "Trajectory": "timing",
     "TimedMotion": "timing",

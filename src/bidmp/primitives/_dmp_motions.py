@@ -15,6 +15,7 @@ from .protocols import _Params
 from .rollouts import _iter_rollouts_to, _rollouts_to
 from .stepper import DMPStepper
 from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
+from .via import _via_trajectory
 
 __all__ = ["Motions"]
 
@@ -39,7 +40,10 @@ class Motions:
         start = self.start_ if start is None else as_point(start, n_dims, "start")
         velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
         phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(self, params, n_steps, step)
-        forcing = basis @ self.weights_
+        change = getattr(forcing_increment, "weight_change", None)  # via-points: a change of the weights
+        forcing = basis @ (self.weights_ if change is None else self.weights_ + change)
+        if change is not None:
+            forcing_increment = forcing_increment.wrapped
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
         free = _unit_responses(params, phase, forcing, step).T
@@ -130,7 +134,7 @@ class Motions:
     @goal_first("start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None):
+                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None, via=None):
         """A timed rollout: positions, velocities and accelerations in seconds.
 
         Parameters
@@ -159,6 +163,13 @@ class Motions:
             :mod:`bidmp.primitives.coupling`): the motion is integrated step by step with their
             accelerations added. Without them (default) the fast path runs; an empty list runs the
             step integrator, which gives the same samples to rounding.
+        via : list of (t, point), optional
+            Via-points: the motion passes ``point`` (D,) (units) at ``t`` seconds exactly (on the
+            samples, linearly between them), by the least-norm change of the forcing weights
+            (:mod:`bidmp.primitives.via`). Points past the horizon, more than the kernels, or
+            ones the kernels cannot carry raise ``ValueError``; with ``limits`` the motion is not
+            re-timed (the points would move in time) but checked, and one that breaks a limit
+            raises. With spatial coupling terms the uncoupled motion passes the points exactly.
 
         Returns
         -------
@@ -169,6 +180,8 @@ class Motions:
             ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
         """
         self._check_fitted()
+        if via is not None:
+            return _via_trajectory(self, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via)
         if limits is not None:
             return _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
         if coupling is not None:

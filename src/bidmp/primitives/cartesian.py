@@ -194,7 +194,7 @@ class CartesianDMP(CheckedParams, BaseEstimator):
     @numerically_guarded
     def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, position_increment=None, orientation_increment=None,
-                   coupling=None) -> PoseTrajectory:
+                   coupling=None, via=None) -> PoseTrajectory:
         """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
 
         Parameters
@@ -209,10 +209,15 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         coupling : list of coupling terms, optional
             Added to the position part's acceleration (units/s², see :meth:`bidmp.DMP.trajectory`);
             both parts then run the step integrator.
+        via : list of (t, pose), optional
+            Via poses (7,) passed exactly at ``t`` seconds: the position part through the
+            positions, the orientation part through ``Log(q ⊗ goal⁻¹)`` on the turn nearest its
+            own motion at that time (both least-norm, as :meth:`bidmp.DMP.trajectory`).
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
+        vias = None if via is None else _pose_vias(self.orientation_, via, goal_q, start_e, duration, dt, orientation_increment)
         return _pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
-                                limits, position_increment, orientation_increment, self.units_, coupling)
+                                limits, position_increment, orientation_increment, self.units_, coupling, vias)
 
     @goal_first("start", "n_steps")
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:
@@ -247,6 +252,27 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         _read_poses_state(model, arrays)
         model.units_ = model.position_.units_
         return model
+
+
+def _pose_vias(orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment) -> tuple[list, list]:
+    """(position via-points, orientation-error via-points) of via poses ``[(t, pose (7,)), ...]``;
+    ``orientation`` the orientation part (a DMP) and its skill's increment."""
+    if isinstance(via, (str, bytes)) or not hasattr(via, "__len__"):
+        raise TypeError(f"via must be a list of (t_seconds, pose) pairs, got {type(via).__name__}")
+    pairs = []
+    for index, pair in enumerate(via):
+        if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+            raise TypeError(f"via[{index}] must be a (t_seconds, pose) pair")
+        pairs.append((pair[0], as_point(pair[1], 7, f"via[{index}] pose")))
+    # The orientation part's own motion gives each via pose's turn (a multi-turn motion stays one).
+    plain = orientation.trajectory(np.zeros(3), start=start_e, duration=duration, dt=dt,
+                                          forcing_increment=orientation_increment)
+    errors = []
+    for index, (t, pose) in enumerate(pairs):
+        q = as_quaternions(pose[3:], f"via[{index}] quaternion")[0]
+        reference = np.array([np.interp(float(t), plain.t, column) for column in plain.y.T])
+        errors.append((t, _nearest_turn(q, goal_q, reference)))
+    return [(t, pose[:3]) for t, pose in pairs], errors
 
 
 def _pose_params(params: dict) -> dict:

@@ -299,6 +299,7 @@ class StepIntegrator:
     def __init__(self, alpha: float, beta: float, tau: float, exact: bool) -> None:
         self.alpha, self.beta, self.tau, self.exact = alpha, beta, tau, exact
         self._checked_step = None
+        self._floats = None  # (step, the exact step's coefficients as floats) of the last step
 
     def step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
              step: float) -> tuple[np.ndarray, np.ndarray]:
@@ -306,9 +307,14 @@ class StepIntegrator:
         read by the exact step only."""
         alpha, beta, tau = self.alpha, self.beta, self.tau
         if self.exact:
-            transition, now, after = _foh_step(step, alpha, beta, tau)
-            state = transition @ np.stack([y, z]) + np.outer(now, u_now) + np.outer(after, u_next)
-            return state[0], state[1]
+            # Row by row with Python floats: a control loop's step is a few (D,) arrays, where
+            # NumPy's per-call cost is the time.
+            if self._floats is None or self._floats[0] != step:
+                transition, now, after = _foh_step(step, alpha, beta, tau)
+                self._floats = (step, *transition.ravel().tolist(), *now.tolist(), *after.tolist())
+            _, t00, t01, t10, t11, n0, n1, a0, a1 = self._floats
+            return (t00 * y + t01 * z + n0 * u_now + a0 * u_next,
+                    t10 * y + t11 * z + n1 * u_now + a1 * u_next)
         h = step / tau
         if h != self._checked_step:
             _check_euler_stable(step, tau, alpha, beta)

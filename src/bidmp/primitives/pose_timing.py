@@ -7,8 +7,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from .so3 import _left_jacobian, orientation_from_log
+from .._checks import as_point
+from .goals import _smoothstep, _smoothstep_derivatives
+from .so3 import _left_jacobian, as_quaternions, orientation_from_log, principal_log
 from .timing import TimedMotion, _validate_motion
 
 __all__ = ["PoseTrajectory", "PoseStepper"]
@@ -73,15 +76,17 @@ def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.n
 
 
 def _pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
-                     position_increment, orientation_increment, units, coupling=None) -> PoseTrajectory:
+                     position_increment, orientation_increment, units, coupling=None, vias=None) -> PoseTrajectory:
     """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
-    ``coupling`` terms act on the position part, and both parts then run the step integrator."""
+    ``coupling`` terms act on the position part, and both parts then run the step integrator;
+    ``vias`` = (position via-points, orientation-error via-points)."""
+    position_via, error_via = (None, None) if vias is None else vias
     position = position_model.trajectory(goal_p, start=start_p, duration=duration, dt=dt, limits=limits, forcing_increment=position_increment,
-                                         coupling=coupling)
-    if limits:  # the orientation follows the motion time the position's limits chose
+                                         coupling=coupling, via=position_via)
+    if limits and vias is None:  # the orientation follows the motion time the position's limits chose
         duration = position.t[-1] / position_model._params().settle
     error = orientation_model.trajectory(np.zeros(3), start=start_e, duration=duration, dt=dt, forcing_increment=orientation_increment,
-                                         coupling=None if coupling is None else [])
+                                         coupling=None if coupling is None else [], via=error_via)
     n = min(len(position.t), len(error.t))
     orientation = orientation_from_log(error.y[:n], goal_q)
     omega, omega_dot = _angular_rates(error.y[:n], error.yd[:n], error.ydd[:n])
@@ -102,6 +107,34 @@ class PoseStepper:
         self.position = position
         self.orientation = orientation
         self.goal_orientation = goal_orientation
+        self._turns: list[tuple[np.ndarray, float, float]] = []  # (rotation vector δ, start s, blend s)
+
+    def set_goal_pose(self, pose, *, limits: dict | None = None, blend: float | None = None) -> float:
+        """Move the goal to ``pose`` (7,) mid-motion: the position as
+        :meth:`bidmp.primitives.stepper.DMPStepper.set_goal`, the orientation by turning the goal
+        frame ``Exp(s(t) δ) ⊗ goal`` over the same blend (``δ`` the principal rotation from the
+        current goal orientation to the new one, ``s`` the same smoothstep), so the tool arrives
+        at rest in the new pose. ``limits`` as there (on the position). Returns the blend (s)."""
+        pose = as_point(pose, 7, "pose")
+        new_q = as_quaternions(pose[3:], "pose's quaternion")[0]
+        blend = self.position.set_goal(pose[:3], limits=limits, blend=blend)
+        current = self._goal_now(np.inf)[0]
+        delta = principal_log(new_q[None], current)[0]
+        self._turns.append((delta, self.position.time, float(blend)))
+        return blend
+
+    def _goal_now(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The goal frame (4,) at motion time ``t`` and its angular velocity and acceleration
+        (world frame, rad/s, rad/s²)."""
+        goal, omega, omega_dot = self.goal_orientation, np.zeros(3), np.zeros(3)
+        for delta, start, blend in self._turns:
+            u = np.array(1.0 if blend <= 0.0 else min(max((t - start) / blend, -1.0), 2.0))
+            first, second = _smoothstep_derivatives(u)
+            goal = orientation_from_log((float(_smoothstep(u)) * delta)[None], goal)[0]
+            if blend > 0.0:  # δ's axis is fixed in the world: the turn's rates lie along it
+                omega_dot = omega_dot + float(second) / blend**2 * delta + np.cross(omega, float(first) / blend * delta)
+                omega = omega + float(first) / blend * delta
+        return goal, omega, omega_dot
 
     @property
     def time(self) -> float:
@@ -109,7 +142,7 @@ class PoseStepper:
 
     @property
     def y(self) -> np.ndarray:
-        return np.concatenate([self.position.y, orientation_from_log(self.orientation.y[None], self.goal_orientation)[0]])
+        return np.concatenate([self.position.y, orientation_from_log(self.orientation.y[None], self._goal_now(self.position.time)[0])[0]])
 
     def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Command pose, velocity and acceleration now; advance ``dt`` s (less while the measured
@@ -119,6 +152,14 @@ class PoseStepper:
         advanced = self.position.time - before
         e, ed, edd = self.orientation.step(max(advanced, 1e-6))
         pace = advanced / dt if dt > 0 else 1.0
-        q = orientation_from_log(e[None], self.goal_orientation)[0]
         omega, omega_dot = _angular_rates(e[None], ed[None], edd[None])
-        return np.concatenate([y, q]), np.concatenate([yd, omega[0] * pace]), np.concatenate([ydd, omega_dot[0] * pace**2])
+        omega, omega_dot = omega[0], omega_dot[0]
+        if not self._turns:
+            q = orientation_from_log(e[None], self.goal_orientation)[0]
+        else:  # q = Exp(e) ⊗ G(t): ω = ω_e + R(e) ω_G, ω̇ = ω̇_e + R(e) ω̇_G + ω_e × R(e) ω_G
+            goal, turn, turn_rate = self._goal_now(before)
+            q = orientation_from_log(e[None], goal)[0]
+            rotation = Rotation.from_rotvec(e).as_matrix()
+            omega_dot = omega_dot + rotation @ turn_rate + np.cross(omega, rotation @ turn)
+            omega = omega + rotation @ turn
+        return np.concatenate([y, q]), np.concatenate([yd, omega * pace]), np.concatenate([ydd, omega_dot * pace**2])

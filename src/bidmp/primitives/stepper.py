@@ -3,11 +3,15 @@ with coupling terms (:mod:`bidmp.primitives.coupling`)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .._checks import as_point, check_real
 from .coupling import _as_couplings
 from .forcing import _basis_row
+from .goal_shift import _GoalShifts, _goal_complete_time, logger, _shortest_blend
+from .grid import _rollout_grid
 from .integrate import StepIntegrator
 from .protocols import _TAU_RANGE
 
@@ -53,12 +57,66 @@ class DMPStepper:
         # What every step reads, taken once: a control loop should not revalidate the model.
         self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
         self._goal_system = dmp.goal_system(self._params)
+        self._time_unit = dmp.time_unit_
         self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
         self._last_input = None  # (phase, gate, goal, start, u): the end of one step starts the next
         self.phase = 1.0
         self._gate = 1.0
         self._gate = self._goal_system.follow(1.0, 1.0, 0.0, self._scale, params.exact)
         self.time = 0.0
+        self._shifts = _GoalShifts(n_dims)
+        for term in self._couplings:  # terms that need the motion (a scene's avoidance: its goal, its scale)
+            if hasattr(term, "bind"):
+                term.bind(self)
+
+    @property
+    def target(self) -> np.ndarray:
+        """The goal the motion ends at (D,): :attr:`goal` plus every :meth:`set_goal` offset."""
+        return self.goal + self._shifts.total
+
+    def set_goal(self, goal, *, limits: dict | None = None, blend: float | None = None) -> float:
+        """Move the goal to ``goal`` (D,) (units) from now on, smoothly (see
+        :mod:`bidmp.primitives.goal_shift`): the command is offset by the change along a
+        7th-order smoothstep that ends where the DMP's own goal offset is complete (the final
+        approach's start with ``keep_approach``), so the approach is a translated copy and the
+        motion comes to rest at ``goal``.
+
+        Parameters
+        ----------
+        goal : array (D,)
+            The new goal (units).
+        limits : dict, optional
+            ``max_velocity`` / ``max_acceleration`` / ``max_jerk`` (units/s, /s², /s³): the blend
+            is at least long enough that the offset alone uses a quarter of each.
+        blend : float, optional
+            The blend's duration (s), in place of the one above.
+
+        Returns
+        -------
+        float
+            The blend's duration (s). A blend that ends after the final approach began tilts the
+            approach: logged as a warning.
+        """
+        delta = as_point(goal, self.goal.shape[0], "goal") - self.target
+        if blend is None:
+            complete = self._goal_complete()
+            blend = max(complete - self.time, _shortest_blend(delta, limits))
+            if self.time + blend > complete + 1e-9 and np.any(delta != 0.0):
+                logger.warning("set_goal at %.3f s: the goal's offset ends %.3f s after the final approach began; "
+                               "the approach is not a translated copy", self.time, self.time + blend - complete)
+        else:
+            blend = check_real(blend, "blend", nonnegative=True, maximum=1e6)
+        self._shifts.add(delta, self.time, blend)
+        return float(blend)
+
+    def _goal_complete(self) -> float:
+        """The motion time (s) from which the DMP's own goal offset is complete."""
+        if getattr(self, "_complete", None) is None:
+            dmp, params = self._dmp, self._dmp._rollout_params(self._dmp.dt_, self._params)
+            n_steps = int(np.ceil(params.settle * self._scale * (dmp.n_steps_ - 1))) + 2
+            goal_response = _rollout_grid(dmp, params, n_steps, dmp.dt_)[2][0]
+            self._complete = _goal_complete_time(goal_response, dmp.dt_ * dmp.time_unit_)
+        return self._complete
 
     @property
     def coupling(self) -> float:
@@ -68,8 +126,8 @@ class DMPStepper:
     def _input(self, phase: float, gate: float) -> np.ndarray:
         """The system's input ``u = αβ g + K f(phase) - K gate (g - y0)`` (D,)."""
         last = self._last_input
-        if (last is not None and last[0] == phase and last[1] == gate and np.array_equal(last[2], self.goal)
-                and np.array_equal(last[3], self.start)):
+        if (last is not None and last[0] == phase and last[1] == gate and (last[2] == self.goal).all()
+                and (last[3] == self.start).all()):
             return last[4]
         params = self._params
         basis = _basis_row(phase, self._centres, self._widths)
@@ -88,28 +146,37 @@ class DMPStepper:
         (y, yd, ydd) : arrays (D,)
             Position (units), velocity (units/s) and acceleration (units/s²) to command.
         """
-        dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
+        if not (type(dt) is float and 1e-6 <= dt <= 1e3):  # the usual case checked in one comparison
+            dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
         params = self._params
-        time_unit = self._dmp.time_unit_
+        time_unit = self._time_unit
         slowdown = 1.0
+        offset = self._shifts.at(self.time) if self._shifts else None
+        commanded = self.y if offset is None else self.y + offset[0]
         for term in self._temporal:
-            slowdown *= term.slowdown(self.y, y_measured)
+            slowdown *= term.slowdown(commanded, y_measured)
         step = dt / time_unit / slowdown  # the normalised time this control step advances
         alpha, beta, tau = params.alpha, params.beta, params.tau
         input_now = self._input(self.phase, self._gate)  # not cached: goal and start are public
-        position = self.y.copy()
-        # The command's velocity and acceleration, as trajectory() reports them: the system's own.
+        position = commanded.copy()
+        # The command's velocity and acceleration, as trajectory() reports them: the system's own
+        # (plus a moved goal's offset, whose time runs with the system's).
         velocity = self._z / (tau * time_unit) / slowdown
+        if offset is not None:
+            velocity = velocity + offset[1] / slowdown
         if self._couplings:
             # An acceleration a (units/s²) enters the input as a (tau T slowdown)², held over the step.
-            pushed = sum(np.asarray(term(self.time, position, velocity, self.phase), dtype=np.float64)
-                         for term in self._couplings)
+            terms = self._couplings
+            pushed = (np.asarray(terms[0](self.time, position, velocity, self.phase), dtype=np.float64) if len(terms) == 1
+                      else sum(np.asarray(term(self.time, position, velocity, self.phase), dtype=np.float64) for term in terms))
             push = pushed * (tau * time_unit * slowdown) ** 2
             if not np.all(np.isfinite(push)):
                 raise ValueError("a coupling term returned a non-finite acceleration")
             input_now = input_now + push
         acceleration = (input_now - alpha * beta * self.y - alpha * self._z) / (tau * time_unit * slowdown) ** 2
-        decay_phase = float(np.exp(-params.alpha_phase * step / tau)) if params.exact else 1.0 - params.alpha_phase * (step / tau)
+        if offset is not None:
+            acceleration = acceleration + offset[2] / slowdown**2
+        decay_phase = math.exp(-params.alpha_phase * step / tau) if params.exact else 1.0 - params.alpha_phase * (step / tau)
         phase = self.phase * decay_phase
         gate = self._goal_system.follow(self._gate, phase, step, tau, params.exact)
         input_next = self._input(phase, gate) if params.exact else input_now

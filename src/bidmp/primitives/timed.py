@@ -8,6 +8,7 @@ import numpy as np
 
 from .._checks import as_point, check_int, check_real, get_limits
 from .._units import check_reach
+from .avoidance import SceneAvoidance, _check_avoidance
 from .integrate import _exact_state
 from .protocols import _TAU_RANGE, _Params
 from .stepper import DMPStepper
@@ -95,7 +96,7 @@ def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_in
 
     def attempt(duration):
         trajectory = dmp.trajectory(goal, start=start, duration=duration, dt=dt, start_velocity=start_velocity,
-                                     forcing_increment=forcing_increment)
+                                     forcing_increment=forcing_increment, coupling=coupling)
         return trajectory, scale_factor(trajectory, **limits)
 
     # The exact factor first (speed ~ 1/k, acceleration ~ 1/k²), then a bisection in log
@@ -123,12 +124,31 @@ def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_in
 
 def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling) -> Trajectory:
     """:meth:`bidmp.DMP.trajectory` through the step integrator, with coupling terms: the same
-    samples as :func:`_timed_trajectory` (to rounding) when the terms add nothing."""
+    samples as :func:`_timed_trajectory` (to rounding) when the terms add nothing. With a
+    :class:`bidmp.primitives.avoidance.SceneAvoidance` term the motion runs on past the horizon
+    until it comes to rest (at most as long again: steering round a part takes time), and its
+    clearance is then checked exactly."""
     params = dmp._params()
     motion, dt, n_samples, _ = _time_grid(dmp, duration, dt, params)
     stepper = DMPStepper(dmp, goal, start, motion, coupling, start_velocity, forcing_increment)
     states = [stepper.step(dt) for _ in range(n_samples)]
+    avoiding = [term for term in stepper._couplings if isinstance(term, SceneAvoidance)]
+    if avoiding:
+        reach = float(np.linalg.norm(stepper.target - stepper.start))
+        for _ in range(n_samples):
+            position, velocity = states[-1][0], states[-1][1]
+            if np.linalg.norm(velocity) * motion <= _REST_SHARE * reach and np.linalg.norm(position - stepper.target) <= _REST_SHARE * reach:
+                break
+            states.append(stepper.step(dt))
     y, yd, ydd = (np.array([state[k] for state in states]) for k in range(3))
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(ydd))):
         raise ValueError("trajectory: the coupled integration is not finite; a coupling term is out of range")
-    return Trajectory(np.arange(n_samples) * dt, y, yd, ydd, dmp.units_)
+    trajectory = Trajectory(np.arange(len(states)) * dt, y, yd, ydd, dmp.units_)
+    if avoiding:
+        _check_avoidance(avoiding, trajectory, stepper.target, float(np.linalg.norm(stepper.target - stepper.start)))
+    return trajectory
+
+
+# A coupled motion is at rest when its speed is below this share of its mean speed (start-goal
+# distance over the duration) and it is at its goal within this share of that distance.
+_REST_SHARE = 1e-4

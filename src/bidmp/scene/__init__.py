@@ -15,6 +15,8 @@ _EXPORTS = {
     "Scene": "clearance",
     "Clearance": "clearance",
     "SceneChecker": "checker",
+    "Proximity": "proximity",
+    "random_field": "fields",
     "Tool": "parts",
     "Part": "parts",
     "Solid": "parts",

@@ -23,6 +23,7 @@ _EXPORTS = {
     "SimError": "backend",
     "JointLimits": "backend",
     "Hold": "backend",
+    "GoalUpdate": "backend",
     "MotionPlan": "backend",
     "Execution": "backend",
     "PandaCell": "pybullet.cell",

@@ -19,7 +19,7 @@ import numpy as np
 
 from .._checks import as_vector, check_int, check_real
 
-__all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "MotionPlan", "Execution", "SIM_STEP",
+__all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "GoalUpdate", "MotionPlan", "Execution", "SIM_STEP",
            "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
 
 SIM_STEP = 1e-3  # s: 1 kHz physics and position control
@@ -69,6 +69,23 @@ class Hold:
         object.__setattr__(self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=6))
         object.__setattr__(self, "start", check_real(self.start, "Hold.start", nonnegative=True))
         object.__setattr__(self, "duration", check_real(self.duration, "Hold.duration", positive=True))
+
+
+@dataclass(frozen=True)
+class GoalUpdate:
+    """A scripted perception update (closed loop): at ``time`` seconds of the motion the target
+    part turns out to be ``offset`` (3,) (scene units) away from where it was seen; the part moves
+    there in the world and the stepper's goal with it (:meth:`DMPStepper.set_goal`)."""
+
+    time: float
+    offset: tuple
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "time", check_real(self.time, "GoalUpdate.time", nonnegative=True))
+        offset = np.asarray(self.offset, dtype=float)
+        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+            raise ValueError(f"GoalUpdate.offset must be 3 finite numbers (scene units), got {self.offset!r}")
+        object.__setattr__(self, "offset", tuple(offset.tolist()))
 
 
 @dataclass
@@ -145,8 +162,9 @@ class SimulatorBackend(Protocol):
         """Run ``plan`` open loop, the parts in ``exclude`` ignored for contacts."""
 
     def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                            frames: int = 0) -> Execution:
-        """Run a DMP stepper on the measured tool-centre point."""
+                            frames: int = 0, max_factor: float = 4.0, goal_update: GoalUpdate | None = None) -> Execution:
+        """Run a DMP stepper on the measured tool-centre point (the parts in ``exclude`` moved by
+        ``goal_update`` at its time, and the stepper's goal with them)."""
 
     def contacts(self) -> dict:
         """Part label -> penetration depth (m) of the robot's contacts now."""

@@ -10,8 +10,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import check_int, check_real
-from .backend import COUPLING, Hold
+from .._checks import check_bool, check_int, check_real
+from ..primitives.avoidance import SceneAvoidance
+from ..primitives.coupling import PhaseStopping
+from ..scene.clearance import Scene
+from .backend import COUPLING, GoalUpdate, Hold
 from .pybullet.cell import PandaCell
 from .pybullet.robot import _unit_of, robot_placement
 from .pybullet.world import _pybullet_module
@@ -45,8 +48,14 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
             raise ValueError("closed_loop runs position skills; this scenario's are poses")
         target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
         if setup["closed_loop"]:
-            stepper = _stepper(setup["models"], job.method, target, plan.duration, setup["coupling"])
-            run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames)
+            coupling = setup["coupling"]
+            if setup.get("avoid"):  # steered round every part but the target's, with phase stopping
+                coupling = [PhaseStopping(coupling), SceneAvoidance(Scene.from_dict(setup["scene"]), target=job.label)]
+            stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
+            update = setup.get("goal_update")
+            run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update)
+            if update is not None:  # judged at where the part turned out to be
+                target = target + np.asarray(update.offset)
         else:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
         measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
@@ -97,14 +106,13 @@ def _run_chunk(setup: dict, jobs: list) -> list:
 
 def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, targets=None, hold: Hold | None = None,
              coupling: float | None = None, progress=None, frames: dict | None = None, report=None,
-             workers: int | None = None, backend=None) -> SimReport:
+             workers: int | None = None, backend=None, avoid: bool = False, goal_update: GoalUpdate | None = None) -> SimReport:
     """Execute ``methods`` on every target of ``scenario`` on the simulated Panda.
 
     Parameters
     ----------
     scenario : Scenario or str
-        Needs a ``"scene"``; ``"robot": {"base": [x, y, z], "yaw": deg}`` places the arm
-        (default :func:`robot_placement`).
+        Needs a ``"scene"``; ``"robot": {"base": [x, y, z], "yaw": deg}`` places the arm.
     methods : sequence of str
         Evaluation methods (dmp, bidmp, ...): their rollouts are what is executed.
     closed_loop : bool
@@ -128,6 +136,9 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     backend : class, optional
         A simulator backend (:class:`bidmp.sim.backend.SimulatorBackend`); default the PyBullet
         Panda, :class:`bidmp.sim.pybullet.PandaCell`.
+    avoid, goal_update : bool, GoalUpdate, optional
+        Closed loop: steer round the other parts (SceneAvoidance); a perception update in every
+        motion (the target and the goal move; judged at the moved target).
 
     Returns
     -------
@@ -144,7 +155,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     jobs = _jobs(scenario, report, methods, labels, frames or {})
     models = {name: report.fitted[name] for name in methods} if closed_loop else None
     setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
-                   backend=backend)
+                   backend=backend, **_loop_options(closed_loop, avoid, goal_update))
     n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
     n_workers = max(1, min(n_workers, len(jobs)))
     start = time.perf_counter()
@@ -153,6 +164,15 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
     return out
+
+
+def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:
+    """``avoid`` and ``goal_update`` of :func:`simulate`, validated (closed loop only)."""
+    if (avoid or goal_update is not None) and not closed_loop:
+        raise ValueError("avoid and goal_update act on the closed loop's stepper: give closed_loop=True")
+    if goal_update is not None and not isinstance(goal_update, GoalUpdate):
+        raise TypeError(f"goal_update must be a bidmp.sim.GoalUpdate, got {type(goal_update).__name__}")
+    return {"avoid": check_bool(avoid, "avoid"), "goal_update": goal_update}
 
 
 def _scenario_and_backend(scenario, backend):

@@ -134,10 +134,10 @@ class PandaCell:
         return _execute._execute(self, plan, exclude, hold, frames)
 
     def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                            frames: int = 0, max_factor: float = 4.0) -> Execution:
-        """Run a DMP/Bi-DMP ``stepper`` on the measured TCP at 100 Hz
-        (:func:`bidmp.sim.pybullet.execute.execute_closed_loop`)."""
-        return _execute._execute_closed_loop(self, stepper, duration, exclude, hold, frames, max_factor)
+                            frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:
+        """Run a DMP/Bi-DMP ``stepper`` on the measured TCP at 100 Hz, with an optional perception
+        update (:func:`bidmp.sim.pybullet.execute.execute_closed_loop`)."""
+        return _execute._execute_closed_loop(self, stepper, duration, exclude, hold, frames, max_factor, goal_update)
 
     def contacts(self) -> dict:
         """Part label -> penetration depth (m) of the robot's contacts now."""

@@ -99,16 +99,16 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
 
 
 def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                        frames: int = 0, max_factor: float = 4.0) -> Execution:
+                        frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
 
     Each control step asks the stepper for the command given where the TCP is and solves IK;
     every 1 ms the position control gets the joints linearly between the last two control steps'
     targets, passed through a jerk-limited rate limiter (:class:`bidmp.sim.limits.RateLimiter`),
     so every command is within the velocity, acceleration and jerk limits and starts and stops at
-    rest. With phase stopping the motion's
-    own time stands still while the robot is held. The run ends when the stepper's time has
-    reached ``duration`` (at most ``max_factor`` times that in wall time) plus the settling.
+    rest. With phase stopping the motion's own time stands still while the robot is held. The run
+    ends when the stepper's time has reached ``duration`` (at most ``max_factor`` times that in
+    wall time) plus the settling. ``goal_update``: see :func:`_perceive`.
     """
     p = cell.p
     q, error = cell.solve_ik(np.asarray(stepper.y) * cell.unit, _REST)
@@ -120,7 +120,7 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
     n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
     record = _Recorder(cell, n_steps, frames)
     _ignore(cell, exclude, False)
-    target, previous, held, settle_from = q, q, None, None
+    target, previous, held, settle_from, moved = q, q, None, None, False
     times, targets, clock, sent = [], [], [], []
     limited = _RateLimiter(q, PANDA, LIMIT_MARGIN)
     step = 0
@@ -132,6 +132,7 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
                 if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
                     break
                 if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
+                    moved = moved or _perceive(cell, stepper, goal_update, exclude)
                     measured = cell.tcp_position() / cell.unit
                     y, _, _ = stepper.step(CONTROL_STEP, measured)
                     target, _ = cell.solve_ik(np.asarray(y) * cell.unit, target)
@@ -151,10 +152,34 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
             record.sample(step, t + SIM_STEP, command, contacts=True, every_step=True)
     finally:
         _ignore(cell, exclude, True)
+        if moved:  # the world is kept for the next job: the parts back where they were
+            _move_parts(cell, exclude, -np.asarray(goal_update.offset) * cell.unit)
     run = record.finish()
     run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(targets), np.array(clock)
     run.commands = np.array(sent)
     return run
+
+
+def _perceive(cell, stepper, goal_update, labels) -> bool:
+    """Apply ``goal_update`` (:class:`bidmp.sim.backend.GoalUpdate`) once the motion's time has
+    reached its time: the parts ``labels`` (the target's) and the stepper's goal move by its offset
+    (the run moves the parts back when it ends). Whether it was applied now."""
+    if goal_update is None or stepper.time < goal_update.time:
+        return False
+    stepper.set_goal(stepper.target + np.asarray(goal_update.offset))
+    return _move_parts(cell, labels, np.asarray(goal_update.offset) * cell.unit)
+
+
+def _move_parts(cell, labels, offset_m: np.ndarray) -> bool:
+    """Move every body of the parts ``labels`` by ``offset_m`` (3,) metres (a perception update:
+    the part was there all along)."""
+    p = cell.p
+    for body, owner in cell._owners.items():
+        if owner in labels:
+            position, orientation = p.getBasePositionAndOrientation(body, physicsClientId=cell.client)
+            p.resetBasePositionAndOrientation(body, (np.asarray(position) + offset_m).tolist(), orientation,
+                                              physicsClientId=cell.client)
+    return True
 
 
 def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None) -> float | None:

@@ -1,0 +1,89 @@
+"""What is near the tool, and which way is away from it: the query a coupling term asks at every
+control step (:class:`bidmp.primitives.avoidance.SceneAvoidance`).
+
+One query per step: the vertical tool at a point against every chosen solid's bounding box (the
+exact cylinder-to-box distance of :func:`bidmp.scene.distances._cylinder_box_bounds`: a lower bound), then coal's signed distance and
+nearest points for the solids whose bound is inside the radius asked about. The direction away
+from a solid is the unit vector from its nearest point to the tool's (coal's normal, reversed,
+when they overlap).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .clearance import Scene
+
+__all__ = ["Proximity"]
+
+
+class Proximity:
+    """Signed distances and escape directions from the tool at a point to the parts near it.
+
+    Parameters
+    ----------
+    scene : Scene
+    exclude : iterable of str
+        Part labels left out (the target and what it stands on).
+    """
+
+    def __init__(self, scene: Scene, exclude=()) -> None:
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a bidmp.geometry.Scene, got {type(scene).__name__}")
+        self.scene = scene
+        self._chosen = scene._selected(exclude)
+        self._lower, self._upper = scene._lower[self._chosen], scene._upper[self._chosen]
+        self._engine = scene._engine() if self._chosen.size else None
+        # What each solid may come to: the margin, or a part's designed stand-off (a plate under the nut).
+        # The box around them all: a tool far from it needs no per-solid bound (most of a motion).
+        self._whole = (self._lower.min(axis=0).tolist(), self._upper.max(axis=0).tolist()) if self._chosen.size else None
+        self.margins = np.array([min(scene.margin, scene.standoff.get(scene._owner[index], scene.margin))
+                                 for index in self._chosen])
+
+    def near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Solids whose signed distance from the tool at ``point`` (3,) is below ``within``
+        (scene units): their distances (k,), unit directions from each toward the tool (k, 3), the
+        clearance each is owed (k,): the scene's margin or the part's stand-off, and their indices
+        among the chosen solids (k,). ``skip``: a mask over the chosen solids, those not asked about."""
+        if self._engine is None:
+            return _NONE
+        tool = self.scene.tool
+        x, y, z = point.tolist()
+        (x0, y0, z0), (x1, y1, z1) = self._whole
+        lateral = math.hypot(max(x0 - x, x - x1, 0.0), max(y0 - y, y - y1, 0.0)) - tool.radius
+        vertical = max(z0 - (z + tool.length), z - z1, 0.0)
+        if max(lateral, 0.0) ** 2 + vertical**2 >= within * within:
+            return _NONE
+        # The cylinder-to-box bound of _cylinder_box_bounds for one point, without its batching.
+        gap = np.maximum(np.maximum(self._lower - point, point - self._upper), 0.0)
+        lateral = np.maximum(np.sqrt(gap[:, 0] ** 2 + gap[:, 1] ** 2) - tool.radius, 0.0)
+        vertical = np.maximum(np.maximum(self._lower[:, 2] - (point[2] + tool.length), point[2] - self._upper[:, 2]), 0.0)
+        candidates = np.flatnonzero(lateral**2 + vertical**2 < within * within)
+        if skip is not None and candidates.size:  # a mask over the chosen solids
+            candidates = candidates[~skip[candidates]]
+        distances, directions, owed, found = [], [], [], []
+        engine = self._engine
+        for index in candidates:
+            distance = engine.tool_to(point, int(self._chosen[index]))
+            if distance >= within:
+                continue
+            result = engine.result
+            away = result.getNearestPoint1() - result.getNearestPoint2()
+            if distance <= 0.0:
+                away = -np.asarray(result.normal, dtype=float)
+            size = math.sqrt(away @ away)
+            if not (size > 1e-12 and math.isfinite(size)):  # no direction from coal: away from the solid's centre
+                away = point - self.scene.solids[self._chosen[index]].centre
+                size = max(math.sqrt(away @ away), 1e-300)
+            distances.append(distance)
+            directions.append(away / size)
+            owed.append(self.margins[index])
+            found.append(index)
+        if not distances:
+            return _NONE
+        return np.array(distances), np.array(directions), np.array(owed), np.array(found)
+
+
+_NONE = (np.empty(0), np.empty((0, 3)), np.empty(0), np.empty(0, dtype=int))
