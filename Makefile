@@ -10,7 +10,7 @@ STAMP  := $(VENV)/.bidmp-installed
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,benchmark,test,bench]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,benchmark,test,bench]"
 	touch $(STAMP)
 
 install: $(STAMP)

@@ -27,6 +27,31 @@ def demo_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--cutoff", type=float, default=6.0, metavar="HZ", help="low-pass cutoff for timed input in Hz (default 6)")
 
 
+def bag_options(parser: argparse.ArgumentParser) -> None:
+    """What ``bidmp fit`` reads from a ROS bag (bidmp.io.bags; the ros extra)."""
+    source = parser.add_mutually_exclusive_group()
+    source.add_argument("--topic", default=None, metavar="TOPIC",
+                        help="bag: the PoseStamped, TransformStamped or JointState topic to read (default: the only one)")
+    source.add_argument("--tf", nargs=2, default=None, metavar=("PARENT", "CHILD"),
+                        help="bag: the transform from frame PARENT to frame CHILD on /tf and /tf_static")
+    parser.add_argument("--joints", nargs="*", default=None, metavar="NAME",
+                        help="bag: joint states, these joints in this order (none named: every joint)")
+
+
+def bag_recording(args: argparse.Namespace):
+    """The bag ``args.demo`` read as its options say, once per command (or None: not a bag)."""
+    from ..io.bags import is_bag, read_bag
+
+    if not is_bag(args.demo):
+        return None
+    if getattr(args, "_bag", None) is None:
+        joints = getattr(args, "joints", None)
+        args._bag = read_bag(args.demo, topic=getattr(args, "topic", None),
+                             tf=None if getattr(args, "tf", None) is None else tuple(args.tf),
+                             joints=None if joints is None else (joints or True))
+    return args._bag
+
+
 # -- input ------------------------------------------------------------------------------------------
 def is_pose_file(path) -> bool:
     """Whether ``path`` is a CSV whose header names a pose (``...,qx,qy,qz,qw``)."""
@@ -92,8 +117,14 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     from ..io.poses import read_poses
 
     requested = check_units(args.units or "", "--units")
-    values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)
-    declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
+    bag = bag_recording(args) if path == getattr(args, "demo", None) else None
+    if bag is not None:  # header stamps; metres (poses) or radians (joints: no length unit)
+        if (bag.kind == "pose") != poses:
+            raise ValueError(f"{path}: {bag.source} holds {'poses' if bag.kind == 'pose' else 'joint states'}")
+        values, times, declared = bag.values, bag.t, ("m" if bag.kind == "pose" else "")
+    else:
+        values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)
+        declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
     notes = []
     if declared and requested and declared != requested:
         values = values.copy()
@@ -118,3 +149,18 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
         how = (f"prepared: kept {info.start_s:.2f}-{info.end_s:.2f} s, low-pass {info.cutoff_hz:g} Hz at "
                f"{info.rate_hz:.1f} Hz, peak speed {info.peak_speed:.4g} {units or 'units'}/s")
     return values, times, units, "; ".join([how, *notes])
+
+
+def scene_option(args: argparse.Namespace, units: str):
+    """The scene of ``--scene`` (extend, rollout), in the model's units (refused in another)."""
+    if args.scene is None:
+        return None
+    from ..tasks.scenarios import load
+
+    scenario = load(args.scene, allow_outside_files=args.allow_outside_files)
+    if scenario.scene is None:
+        raise ValueError(f"--scene: scenario {args.scene} has no \"scene\" key")
+    if units and scenario.units and scenario.units != units:
+        raise ValueError(f"--scene: the scene of {args.scene} is in {scenario.units} but the model is in {units}; "
+                         f"use a scene in {units}")
+    return scenario.scene

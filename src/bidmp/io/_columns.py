@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from .._checks import short_token
 
-__all__ = ["TIME_NAMES", "parse_columns", "Selection", "select_positions", "select_poses"]
+__all__ = ["TIME_NAMES", "parse_columns", "Selection", "select_positions", "select_poses", "select_joints"]
 
 TIME_NAMES = ("t", "time", "timestamp")
 _POSITION_ROLES = ("x", "y", "z")
@@ -97,3 +97,15 @@ def select_poses(header: tuple[str, ...], mapping: dict | None, path) -> Selecti
     """The time, position and quaternion columns of a pose header (``values`` in the order
     x, y, z, qx, qy, qz, qw); ``values`` is empty when the header names no pose."""
     return _resolve(header, _POSE_ROLES, mapping, path, required=7)
+
+
+def select_joints(header: tuple[str, ...]) -> Selection:
+    """A joint-space recording ``t, <joint names>``: the time column and every other column, in
+    the header's order; ``values`` is empty unless the header has a time column and names no
+    position or quaternion (a joint-space model has one dimension per joint)."""
+    times = [name for name in TIME_NAMES if name in header]
+    reserved = {*_POSE_ROLES, *TIME_NAMES}
+    if not times or any(name in reserved for name in header if name not in times) or len(header) < 2:
+        return Selection(None, (), ())
+    time = header.index(times[0])
+    return Selection(time, tuple(index for index, name in enumerate(header) if index != time and name not in TIME_NAMES), ())

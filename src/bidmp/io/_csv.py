@@ -64,7 +64,7 @@ def _note_ignored(path: Path, ignored: tuple[str, ...]) -> None:
 def _read_csv(path: Path, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a CSV trajectory; return (positions (T, D), times (T,) or None). ``columns``: a
     column mapping (:func:`bidmp._columns.parse_columns`)."""
-    from ._columns import select_poses, select_positions
+    from ._columns import select_joints, select_poses, select_positions
 
     mapping = parse_columns(columns)
     parsed = _csv_fast(path)
@@ -85,10 +85,13 @@ def _read_csv(path: Path, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
         raise ValueError(f"{path}: a pose recording: read it with bidmp.io.read_poses / bidmp.CartesianDMP (its header "
                          f"names qx, qy, qz, qw)")
     selection = select_positions(header, mapping, path)
+    if not selection.values and mapping is None:  # t, <joint names>: a joint-space recording
+        selection = select_joints(header)
     if not selection.values:
         shown = ",".join(short_token(c, 12)[1:-1] for c in header[:8]) + (",…" if len(header) > 8 else "")
         raise ValueError(f"{path}: header {shown} names no positions; expected x,y[,z] with an optional t/time/timestamp "
-                         f"column, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)")
+                         f"column, t,<joint names> for joint space, or name them with a column mapping (--columns "
+                         f"t=stamp,x=ee_x,y=ee_y,z=ee_z)")
     _note_ignored(path, selection.ignored)
     times = None if selection.time is None else values[:, selection.time]
     return values[:, list(selection.values)], times

@@ -1,0 +1,183 @@
+"""``bidmp rollout``: a saved model rolled out to a goal, with limits, via-points, a scene to steer
+round and a ROS bag out."""
+
+from __future__ import annotations
+
+import argparse
+
+from .inputs import model_dmp, scene_option
+
+EXIT_OK = 0
+
+
+def _timing_options(args: argparse.Namespace, dmp) -> dict:
+    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc/--fastest."""
+    options = {"duration": args.duration}
+    if args.rate is not None and args.n_steps is not None:
+        raise ValueError("give --rate or --n-steps, not both")
+    if args.rate is not None:
+        if not 0 < args.rate <= 100_000:
+            raise ValueError(f"--rate must be in (0, 100000] Hz, got {args.rate:g}")
+        options["dt"] = 1.0 / args.rate
+    elif args.n_steps is not None:
+        from .._checks import check_int
+
+        check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
+        motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
+        options["dt"] = dmp._params().settle * motion / (args.n_steps - 1)  # the same motion, sampled more finely
+    if args.max_speed is not None or args.max_acc is not None:
+        options["limits"] = {"max_velocity": args.max_speed, "max_acceleration": args.max_acc, "fastest": args.fastest}
+        if args.duration is not None:
+            raise ValueError("give --duration or --max-speed/--max-acc, not both (the limits choose the duration)")
+        options.pop("duration")
+    elif args.fastest:
+        raise ValueError("--fastest needs --max-speed or --max-acc (the limits it may run up to)")
+    return options
+
+
+def _skill_choice(args: argparse.Namespace, model):
+    from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
+
+    if not isinstance(model, (BiDMP, CartesianBiDMP)):
+        if args.skill is not None:
+            raise ValueError(f"--skill needs a Bi-DMP model; {args.model} holds a {type(model).__name__}")
+        return None
+    return "nearest" if args.skill is None else (int(args.skill) if args.skill.lstrip("-").isdigit() else args.skill)
+
+
+def cmd_rollout(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..io.models import load_model
+    from ..io.poses import save_poses
+    from ..io.trajectories import save_trajectory
+    from ..primitives.cartesian import CartesianDMP, angle_between
+    from ..primitives.dmp import DMP
+
+    model = load_model(args.model)
+    if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
+        raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
+    dmp = model_dmp(model)
+    poses = isinstance(model, (CartesianDMP, CartesianBiDMP))
+    skill = _skill_choice(args, model)
+    options = {"goal": args.goal, "start": args.start, **_timing_options(args, dmp)}
+    if skill is not None:
+        options["skill"] = skill
+        goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
+        index = model.select_skill(goals[-1] if args.goal is None and isinstance(model, BiDMP) else args.goal, skill)
+        print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})")
+    options.update(_rollout_extras(args, dmp, poses))
+    trajectory = model.trajectory(**options)
+    path = (save_poses if poses else save_trajectory)(trajectory, args.output)
+    unit = dmp.units_ or "units"
+    rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
+    goal = trajectory.y[-1] if args.goal is None else np.asarray(args.goal, dtype=float)
+    print(f"rolled out {len(trajectory)} samples over {trajectory.duration:.4g} s ({rate:.4g} Hz) to goal "
+          f"{np.array2string(goal, precision=4)}")
+    print(f"  end point {np.array2string(trajectory.y[-1], precision=4)}, distance to goal "
+          f"{np.linalg.norm(trajectory.y[-1] - goal[:3 if poses else None]):.4g} {unit}"
+          + (f", {np.degrees(angle_between(trajectory.q[-1:], goal[None, 3:]))[0]:.3g} deg" if poses and goal.size == 7 else ""))
+    print(f"  peak speed {trajectory.peak_speed():.4g} {unit}/s, peak acceleration {trajectory.peak_acceleration():.4g} "
+          f"{unit}/s^2, initial acceleration {np.linalg.norm(trajectory.ydd[0]):.4g} {unit}/s^2")
+    for term in options.get("coupling") or ():
+        clearance = term.clearance_
+        print(f"  steered round the scene's parts: clearance {clearance.distance:.4g} {unit} to {clearance.part} "
+              f"(margin {clearance.margin:g}; the target's parts {', '.join(term.excluded_) or 'none'} left out)")
+    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
+    if args.bag:
+        print(f"wrote {_rollout_bag(args, trajectory, dmp, poses)}")
+    if args.plot:
+        from ..plotting.trajectories import plot_trajectories
+
+        reference = dmp.rollout()
+        figure = plot_trajectories(args.plot, reference, [trajectory.y], ["rollout"], goals=trajectory.y[-1:],
+                                   title="rollout", units=dmp.units_)
+        print(f"wrote {figure}")
+    return EXIT_OK
+
+
+def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
+    """``--bag OUT``: the motion as a PoseStamped stream in metres (position and pose models) or a
+    JointTrajectory (joint-space models: more than 3 dimensions), ROS 2 MCAP or ``--ros1``."""
+    import numpy as np
+
+    from .._units import conversion
+    from ..io.bags import write_bag
+
+    ros = 1 if args.ros1 else 2
+    if poses or dmp.n_dims_ == 3:
+        if not dmp.units_:
+            raise ValueError("--bag: ROS poses are in metres and this model's length unit is not known; fit it with --units")
+        scale = conversion(dmp.units_, "m")
+        values = trajectory.y * scale if not poses else np.hstack([trajectory.y * scale, trajectory.q])
+        path = write_bag(args.bag, trajectory.t, values, kind="pose", frame_id=args.frame, ros=ros)
+        return f"{path} (geometry_msgs/PoseStamped on /bidmp/pose, {len(trajectory)} messages, metres)"
+    path = write_bag(args.bag, trajectory.t, trajectory.y, kind="joints", velocities=trajectory.yd,
+                     accelerations=trajectory.ydd, frame_id=args.frame, ros=ros)
+    return f"{path} (trajectory_msgs/JointTrajectory on /bidmp/joint_trajectory, {len(trajectory)} points)"
+
+
+def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
+    """trajectory() keywords from --via and --scene/--avoid (on by default with a scene)."""
+    import numpy as np
+
+    extras = {}
+    if args.via:
+        width = 7 if poses else dmp.n_dims_
+        for index, values in enumerate(args.via):
+            if len(values) != 1 + width:
+                raise ValueError(f"--via #{index + 1} needs T and {width} coordinates, got {len(values)} numbers")
+        extras["via"] = [(values[0], values[1:]) for values in args.via]
+    avoid = args.scene is not None if args.avoid is None else args.avoid
+    if avoid:
+        if args.scene is None:
+            raise ValueError("--avoid needs --scene (the scenario whose parts to steer round)")
+        if poses or dmp.n_dims_ != 3:
+            raise ValueError("--avoid steers 3-D position models (the tool points down); this model is "
+                             + ("a pose model" if poses else f"{dmp.n_dims_}-D"))
+        from ..primitives.avoidance import SceneAvoidance
+
+        scene, label = scene_option(args, dmp.units_), args.target_label
+        if label is None and args.goal is not None:  # the goal is a target of the scenario: its label
+            from ..tasks.scenarios import load
+
+            targets = load(args.scene, allow_outside_files=args.allow_outside_files).targets
+            label = next((name for name, point in targets.items()
+                          if np.allclose(np.asarray(point, dtype=float)[:3], args.goal[:3], atol=1e-9)), None)
+        extras["coupling"] = [SceneAvoidance(scene, target=label)]
+    return extras
+
+
+
+def _add_rollout_arguments(rollout) -> None:
+    """The arguments of ``bidmp rollout``."""
+    rollout.add_argument("model", metavar="MODEL", help="model file (.npz) written by 'bidmp fit' or 'bidmp extend'")
+    rollout.add_argument("--goal", type=float, nargs="+", metavar="X", help="goal coordinates in the model's units (default: the demonstrated goal)")
+    rollout.add_argument("--start", type=float, nargs="+", metavar="X", help="start coordinates (default: the demonstrated start)")
+    rollout.add_argument("--duration", type=float, default=None, metavar="S", help="duration of the motion in seconds (temporal scaling; default: the demonstration's)")
+    rollout.add_argument("--rate", type=float, default=None, metavar="HZ", help="sample rate in Hz (default: the demonstration's)")
+    rollout.add_argument("--n-steps", type=int, default=None, help="instead of --rate: this many samples over the same motion")
+    rollout.add_argument("--max-speed", type=float, default=None, metavar="V", help="cap: slow the motion (uniformly) if its speed exceeds V units/s")
+    rollout.add_argument("--max-acc", type=float, default=None, metavar="A", help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2")
+    rollout.add_argument("--fastest", action="store_true",
+                         help="with --max-speed/--max-acc: the shortest motion within them, even faster than demonstrated "
+                              "(without it they are caps that only ever slow a motion)")
+    rollout.add_argument("-o", "--output", required=True, metavar="OUT", help="trajectory file to write (.csv or .npy; poses: .csv)")
+    rollout.add_argument("--skill", default=None, help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)")
+    rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
+    rollout.add_argument("--via", type=float, nargs="+", action="append", metavar="T X",
+                         help="via-point: pass X Y Z (a pose: X Y Z QX QY QZ QW) at T seconds exactly (repeatable)")
+    rollout.add_argument("--scene", metavar="FILE|NAME", help="the scenario whose parts the motion is steered round")
+    rollout.add_argument("--avoid", action=argparse.BooleanOptionalAction, default=None,
+                         help="steer round the scene's parts (SceneAvoidance; default: on with --scene); a motion that "
+                              "still comes closer than the margin is an error")
+    rollout.add_argument("--bag", default=None, metavar="OUT",
+                         help="also write the motion to a ROS bag: PoseStamped in metres (a JointTrajectory for a "
+                              "joint-space model), a ROS 2 MCAP folder (--ros1: a .bag file)")
+    rollout.add_argument("--ros1", action="store_true", help="with --bag: write a ROS 1 .bag file")
+    rollout.add_argument("--frame", default="base", metavar="FRAME", help="with --bag: the header's frame_id (default base)")
+    rollout.add_argument("--target-label", default=None, metavar="LABEL",
+                         help="the scene's target the goal is (its parts are not avoided; default: what the tool takes in at the goal)")

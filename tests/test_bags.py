@@ -1,0 +1,212 @@
+"""Issue 24.1: ROS bags without ROS. The bags are written here with rosbags' own writers and
+typestores (not with bidmp's), each holding what a robot's recorder would: other topics beside the
+one read, other frames on /tf, more joints than asked for, header stamps that differ from the
+receive times. Each fits to the same model as the equivalent CSV written from the same numbers
+(≤ 1e-9), and what bidmp writes reads back through rosbags with the right types, stamps and values."""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+from rosbags.highlevel import AnyReader
+from rosbags.typesys import Stores, get_typestore
+
+from bidmp.cli import main
+from bidmp.datasets import minimum_jerk
+from bidmp.io import load_model
+
+START_NS = 1_700_000_000_123_456_789  # a header stamp far from zero, in nanoseconds
+N = 240
+RECEIVED_LATE_NS = 3_000_000  # the recorder wrote each message 3 ms after its stamp
+
+
+def _header(types, ns, frame, ros):
+    stamp = types["builtin_interfaces/msg/Time"](sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
+    return types["std_msgs/msg/Header"](**({"seq": 0} if ros == 1 else {}), stamp=stamp, frame_id=frame)
+
+
+def _stamps(rng):
+    steps = rng.integers(3_500_000, 4_500_000, N - 1)  # jittered ~250 Hz
+    return START_NS + np.concatenate([[0], np.cumsum(steps)])
+
+
+def _write(path: Path, ros: int, topics: list, store=None):
+    """``topics``: [(topic, msgtype, [(stamp ns, message), ...])] into a ROS 1 file or ROS 2 MCAP folder."""
+    store = store or get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
+    if ros == 1:
+        from rosbags.rosbag1 import Writer
+
+        writer, serialize = Writer(path), store.serialize_ros1
+    else:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        writer, serialize = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP), store.serialize_cdr
+    with writer:
+        for topic, msgtype, messages in topics:
+            connection = writer.add_connection(topic, msgtype, typestore=store)
+            for ns, message in messages:
+                writer.write(connection, int(ns) + RECEIVED_LATE_NS, serialize(message, msgtype))
+    return store
+
+
+def _csv(path: Path, stamps, columns, values, units="m"):
+    t = (np.asarray(stamps) - stamps[0]).astype(np.int64) * 1e-9
+    with open(path, "w") as handle:
+        if units:
+            handle.write(f"# units: {units}\n")
+        handle.write(",".join(["t", *columns]) + "\n")
+        for time, row in zip(t, values):
+            handle.write(",".join(repr(float(v)) for v in [time, *row]) + "\n")
+
+
+def _poses(rng):
+    positions = minimum_jerk(np.array([[0.0, 0.0, 0.3], [0.12, 0.05, 0.3], [0.12, 0.05, 0.2]]), N)
+    angles = np.linspace(0.0, 0.6, N)
+    quaternions = np.column_stack([np.sin(angles / 2) * 0.6, np.zeros(N), np.sin(angles / 2) * 0.8, np.cos(angles / 2)])
+    return np.hstack([positions + rng.normal(0, 1e-5, positions.shape), quaternions])
+
+
+def _pose_messages(store, stamps, poses, ros, frame="base"):
+    types = store.types
+    out = []
+    for ns, row in zip(stamps, poses):
+        pose = types["geometry_msgs/msg/Pose"](position=types["geometry_msgs/msg/Point"](*row[:3]),
+                                               orientation=types["geometry_msgs/msg/Quaternion"](*row[3:]))
+        out.append((ns, types["geometry_msgs/msg/PoseStamped"](header=_header(types, int(ns), frame, ros), pose=pose)))
+    return out
+
+
+def _table(path: Path) -> np.ndarray:
+    """A CSV's numbers (comment lines and the header left out)."""
+    lines = [line for line in path.read_text().splitlines() if line and not line.startswith("#")][1:]
+    return np.array([[float(v) for v in line.split(",")] for line in lines])
+
+
+def _fit(tmp_path, source, *options):
+    model = tmp_path / f"{Path(source).name}.npz"
+    assert main(["fit", str(source), "-o", str(model), *options]) == 0
+    return load_model(model)
+
+
+def test_a_ros2_mcap_pose_bag_fits_the_model_of_the_same_csv(tmp_path):
+    rng = np.random.default_rng(1)
+    stamps, poses = _stamps(rng), _poses(rng)
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    other = [(ns, store.types["std_msgs/msg/String"](data="noise")) for ns in stamps[::10]]
+    _write(tmp_path / "poses", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", _pose_messages(store, stamps, poses, 2)),
+                                   ("/log", "std_msgs/msg/String", other)])
+    _csv(tmp_path / "poses.csv", stamps, ["x", "y", "z", "qx", "qy", "qz", "qw"], poses)
+    from_bag = _fit(tmp_path, tmp_path / "poses", "--topic", "/ee_pose")
+    from_csv = _fit(tmp_path, tmp_path / "poses.csv")
+    assert from_bag.units_ == "m" == from_csv.units_
+    for part in ("position_", "orientation_"):
+        np.testing.assert_allclose(getattr(from_bag, part).weights_, getattr(from_csv, part).weights_, atol=1e-9, rtol=0)
+
+
+def test_a_ros1_tf_bag_reads_the_chosen_edge_of_the_tree(tmp_path):
+    rng = np.random.default_rng(2)
+    stamps, poses = _stamps(rng), _poses(rng)
+    store = get_typestore(Stores.ROS1_NOETIC)
+    from rosbags.typesys import get_types_from_msg
+
+    store.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms", "tf2_msgs/msg/TFMessage"))
+    types = store.types
+    messages = []
+    for ns, row in zip(stamps, poses):
+        transforms = []
+        for parent, child, values in (("world", "base", [1.0, 2.0, 0.0, 0, 0, 0, 1]), ("base", "tool", row)):
+            transform = types["geometry_msgs/msg/Transform"](translation=types["geometry_msgs/msg/Vector3"](*values[:3]),
+                                                             rotation=types["geometry_msgs/msg/Quaternion"](*values[3:]))
+            transforms.append(types["geometry_msgs/msg/TransformStamped"](header=_header(types, int(ns), parent, 1),
+                                                                          child_frame_id=child, transform=transform))
+        messages.append((ns, types["tf2_msgs/msg/TFMessage"](transforms=transforms)))
+    _write(tmp_path / "tf.bag", 1, [("/tf", "tf2_msgs/msg/TFMessage", messages)], store)
+    _csv(tmp_path / "tf.csv", stamps, ["x", "y", "z", "qx", "qy", "qz", "qw"], poses)
+    from_bag = _fit(tmp_path, tmp_path / "tf.bag", "--tf", "base", "tool")
+    from_csv = _fit(tmp_path, tmp_path / "tf.csv")
+    np.testing.assert_allclose(from_bag.position_.weights_, from_csv.position_.weights_, atol=1e-9, rtol=0)
+
+
+def test_a_joint_state_bag_fits_the_joint_space_model_of_the_same_csv(tmp_path):
+    rng = np.random.default_rng(3)
+    stamps = _stamps(rng)
+    s = np.linspace(0.0, 1.0, N)
+    names = [f"panda_joint{k}" for k in range(1, 8)]
+    q = np.array([0, -0.785, 0, -2.356, 0, 1.571, 0.785]) + np.outer(10 * s**3 - 15 * s**4 + 6 * s**5, rng.uniform(-0.5, 0.5, 7))
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    types = store.types
+    order = rng.permutation(7)  # the driver publishes its own order, with the gripper too
+    messages = [(ns, types["sensor_msgs/msg/JointState"](
+        header=_header(types, int(ns), "", 2), name=[names[k] for k in order] + ["panda_finger_joint1"],
+        position=np.append(row[order], 0.04), velocity=np.zeros(0), effort=np.zeros(0))) for ns, row in zip(stamps, q)]
+    _write(tmp_path / "joints", 2, [("/joint_states", "sensor_msgs/msg/JointState", messages)])
+    _csv(tmp_path / "joints.csv", stamps, names, q, units="")
+    from_bag = _fit(tmp_path, tmp_path / "joints", "--joints", *names)
+    from_csv = _fit(tmp_path, tmp_path / "joints.csv")
+    assert from_bag.n_dims_ == 7
+    np.testing.assert_allclose(from_bag.weights_, from_csv.weights_, atol=1e-9, rtol=0)
+    np.testing.assert_allclose(from_bag.goal_, q[-1], atol=1e-3)  # the chosen order, not the driver's
+
+
+def test_rolled_out_motions_read_back_as_ros_messages(tmp_path):
+    demonstration = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
+    np.savetxt(tmp_path / "d.csv", np.column_stack([np.linspace(0, 3, 300), demonstration]), delimiter=",",
+               header="# units: mm\nt,x,y,z", comments="")
+    assert main(["fit", str(tmp_path / "d.csv"), "-o", str(tmp_path / "m.npz"), "--raw"]) == 0
+    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "50", "-o", str(tmp_path / "r.csv"),
+                 "--bag", str(tmp_path / "out"), "--frame", "panda_link0"]) == 0
+    rows = _table(tmp_path / "r.csv")
+    with AnyReader([tmp_path / "out"]) as reader:
+        (connection,) = reader.connections
+        assert connection.msgtype == "geometry_msgs/msg/PoseStamped"
+        read = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in read])
+    positions = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in read])
+    np.testing.assert_allclose(stamps, rows[:, 0], atol=1e-9)
+    np.testing.assert_allclose(positions, rows[:, 1:4] / 1000.0, atol=1e-12)  # mm -> m
+    assert {m.header.frame_id for m in read} == {"panda_link0"}
+    # A joint-space model: one JointTrajectory in a ROS 1 bag.
+    q = np.column_stack([np.linspace(0, 1, 300) ** 2 * k for k in range(1, 8)])
+    np.savetxt(tmp_path / "j.csv", np.column_stack([np.linspace(0, 3, 300), q]), delimiter=",",
+               header="t," + ",".join(f"j{k}" for k in range(1, 8)), comments="")
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "50", "-o", str(tmp_path / "jr.csv"),
+                 "--bag", str(tmp_path / "j.bag"), "--ros1"]) == 0
+    joints = _table(tmp_path / "jr.csv")
+    with AnyReader([tmp_path / "j.bag"]) as reader:
+        (connection,) = reader.connections
+        assert connection.msgtype == "trajectory_msgs/msg/JointTrajectory"
+        (message,) = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    np.testing.assert_allclose([p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in message.points], joints[:, 0], atol=1e-9)
+    np.testing.assert_allclose([p.positions for p in message.points], joints[:, 1:8], atol=1e-12)
+    np.testing.assert_allclose([p.velocities for p in message.points], joints[:, 8:15], atol=1e-12)
+
+
+def test_a_bag_without_the_topic_of_a_foreign_type_or_out_of_order_says_what_it_holds(tmp_path, capsys):
+    rng = np.random.default_rng(4)
+    stamps, poses = _stamps(rng), _poses(rng)
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    shuffled = _pose_messages(store, stamps, poses, 2)
+    shuffled[10], shuffled[11] = (shuffled[10][0], shuffled[11][1]), (shuffled[11][0], shuffled[10][1])  # stamps swapped
+    _write(tmp_path / "b", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", shuffled),
+                               ("/log", "std_msgs/msg/String", [(stamps[0], store.types["std_msgs/msg/String"](data="x"))])])
+    for options, expected in ((["--topic", "/nope"], "no topic '/nope'"), (["--topic", "/log"], "does not read"),
+                              (["--topic", "/ee_pose"], "do not increase")):
+        assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz"), *options]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and expected in err[0] and "/ee_pose (geometry_msgs/msg/PoseStamped, 240 messages)" in err[0]
+
+
+def test_without_the_ros_extra_bag_input_says_how_to_install_it(tmp_path, capsys, monkeypatch):
+    (tmp_path / "b").mkdir()
+    (tmp_path / "b" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz")]) == 2  # a broken bag: one line
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot read" in err[0]
+    for name in [module for module in sys.modules if module == "rosbags" or module.startswith("rosbags.")]:
+        monkeypatch.setitem(sys.modules, name, None)  # as if the extra were not installed
+    monkeypatch.setitem(sys.modules, "rosbags", None)
+    monkeypatch.setitem(sys.modules, "rosbags.highlevel", None)
+    assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "pip install 'bidmp[ros]'" in err[0]
