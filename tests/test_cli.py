@@ -409,7 +409,7 @@ def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys
     assert durations["cap"] == durations["plain"]
     assert durations["fastest"] < 0.5 * durations["plain"] and durations["slow"] > 2 * durations["plain"]
     code, _, err = run(["rollout", str(tmp_path / "m.npz"), "-o", str(tmp_path / "x.csv"), "--fastest"], capsys)
-    assert code == 2 and "--fastest needs --max-speed or --max-acc" in err
+    assert code == 2 and "--fastest needs --max-speed, --max-acc or --joint-limits" in err
 
 
 def test_fifos_are_refused_not_waited_on(tmp_path, capsys):

@@ -11,7 +11,7 @@ EXIT_OK = 0
 
 
 def _timing_options(args: argparse.Namespace, dmp) -> dict:
-    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc/--fastest."""
+    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc/--max-jerk/--joint-limits/--fastest."""
     options = {"duration": args.duration}
     if args.rate is not None and args.n_steps is not None:
         raise ValueError("give --rate or --n-steps, not both")
@@ -25,14 +25,38 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
         check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
         motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
         options["dt"] = dmp._params().settle * motion / (args.n_steps - 1)  # the same motion, sampled more finely
-    if args.max_speed is not None or args.max_acc is not None:
-        options["limits"] = {"max_velocity": args.max_speed, "max_acceleration": args.max_acc, "fastest": args.fastest}
+    limits = _limits(args, dmp)
+    if limits:
+        options["limits"] = {**limits, "fastest": args.fastest}
         if args.duration is not None:
-            raise ValueError("give --duration or --max-speed/--max-acc, not both (the limits choose the duration)")
+            raise ValueError("give --duration or --max-speed/--max-acc/--joint-limits, not both (the limits choose the duration)")
         options.pop("duration")
     elif args.fastest:
-        raise ValueError("--fastest needs --max-speed or --max-acc (the limits it may run up to)")
+        raise ValueError("--fastest needs --max-speed, --max-acc or --joint-limits (the limits it may run up to)")
     return options
+
+
+def _limits(args: argparse.Namespace, dmp) -> dict:
+    """The limits of --max-speed/--max-acc/--max-jerk (one value: on the speed's norm; one per
+    dimension: per axis, a joint-space model's per-joint limits) or --joint-limits panda."""
+    given = {key: value for key, value in (("max_velocity", args.max_speed), ("max_acceleration", args.max_acc),
+                                           ("max_jerk", args.max_jerk)) if value is not None}
+    if args.joint_limits is not None:
+        if given:
+            raise ValueError("give --joint-limits or --max-speed/--max-acc/--max-jerk, not both")
+        from ..sim.pybullet.robot import PANDA
+
+        if dmp.n_dims_ != 7:
+            raise ValueError(f"--joint-limits panda needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
+        return {"max_velocity": PANDA.velocity, "max_acceleration": PANDA.acceleration, "max_jerk": PANDA.jerk, "norm": "axis"}
+    if not given:
+        return {}
+    counts = {len(value) for value in given.values()}
+    if counts - {1, dmp.n_dims_} or len(counts) > 1:
+        raise ValueError(f"--max-speed/--max-acc/--max-jerk take one value (on the norm) or {dmp.n_dims_} (one per "
+                         f"dimension), the same count for each")
+    per_axis = counts == {dmp.n_dims_} and dmp.n_dims_ > 1
+    return {key: (value if per_axis else value[0]) for key, value in given.items()} | {"norm": "axis" if per_axis else "norm"}
 
 
 def _skill_choice(args: argparse.Namespace, model):
@@ -160,8 +184,14 @@ def _add_rollout_arguments(rollout) -> None:
     rollout.add_argument("--duration", type=float, default=None, metavar="S", help="duration of the motion in seconds (temporal scaling; default: the demonstration's)")
     rollout.add_argument("--rate", type=float, default=None, metavar="HZ", help="sample rate in Hz (default: the demonstration's)")
     rollout.add_argument("--n-steps", type=int, default=None, help="instead of --rate: this many samples over the same motion")
-    rollout.add_argument("--max-speed", type=float, default=None, metavar="V", help="cap: slow the motion (uniformly) if its speed exceeds V units/s")
-    rollout.add_argument("--max-acc", type=float, default=None, metavar="A", help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2")
+    rollout.add_argument("--max-speed", type=float, nargs="+", default=None, metavar="V",
+                         help="cap: slow the motion (uniformly) if its speed exceeds V units/s (one V per dimension: per axis/joint)")
+    rollout.add_argument("--max-acc", type=float, nargs="+", default=None, metavar="A",
+                         help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2 (or one per dimension)")
+    rollout.add_argument("--max-jerk", type=float, nargs="+", default=None, metavar="J",
+                         help="cap on the jerk, units/s^3 (or one per dimension)")
+    rollout.add_argument("--joint-limits", choices=("panda",), default=None,
+                         help="a joint-space model: the robot's published per-joint velocity, acceleration and jerk limits")
     rollout.add_argument("--fastest", action="store_true",
                          help="with --max-speed/--max-acc: the shortest motion within them, even faster than demonstrated "
                               "(without it they are caps that only ever slow a motion)")

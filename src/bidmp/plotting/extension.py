@@ -59,11 +59,11 @@ def _draw_extension(ax, extension, prm_path: np.ndarray | None = None, show_samp
         _draw(ax, y[extension.segmentation_points], "^", color="0.2", markersize=6, linestyle="none", label="segmentation points")
     if show_samples and extension.samples is not None:
         _draw(ax, extension.samples, ".", color="c", markersize=2, alpha=0.5, linestyle="none", label="G-PRM samples")
-    _draw(ax, extension.tra_imi, "--", color="royalblue", linewidth=2, label="Tra_imi")
+    _draw(ax, extension.tra_imi, "--", color="royalblue", linewidth=2, label="imitated segment (Tra_imi)")
     if prm_path is not None:
         _draw(ax, prm_path, ":", color="purple", linewidth=1.5, label="classic PRM")
-    _draw(ax, extension.tra_gen, color="crimson", linewidth=2, label="Tra_gen (G-PRM)")
-    _draw(ax, extension.complete, color="goldenrod", linewidth=1, alpha=0.9, label="complete y_dn")
+    _draw(ax, extension.tra_gen, color="crimson", linewidth=2, label="new transfer to the target (Tra_gen, G-PRM)")
+    _draw(ax, extension.complete, color="goldenrod", linewidth=1, alpha=0.9, label="extended demonstration Bi-DMP learns")
     _draw(ax, y[:1], "ko")
     _draw(ax, extension.tra_imi[-1:], "o", color="royalblue", markersize=7)
     _draw(ax, extension.new_target[None], "*", color="green", markersize=14, label="new target")
@@ -71,7 +71,8 @@ def _draw_extension(ax, extension, prm_path: np.ndarray | None = None, show_samp
 
 def plot_extension(path, extension, units: str = "", title: str = "Extended demonstration (1D-SEG + G-PRM)") -> Path:
     """An :class:`bidmp.extension.extend.ExtendedDemonstration`: demonstration, segmentation points,
-    sampling points, Tra_imi, Tra_gen and the complete extended demonstration."""
+    sampling points, the imitated segment (Tra_imi), the new transfer (Tra_gen) and the complete
+    extended demonstration, labelled in words."""
     mpl = _matplotlib()
     n_dims = extension.demonstration.shape[1]
     fig = mpl.figure(figsize=(7.5, 6.5), dpi=110)
@@ -80,7 +81,8 @@ def plot_extension(path, extension, units: str = "", title: str = "Extended demo
     history = extension.similarity_history
     subtitle = f"\nG-PRM similarity {history[0]:.3f} → best {np.max(history):.3f}" if len(history) else ""
     _finish(ax, n_dims, units, title + subtitle)
-    ax.legend(fontsize=7, loc="best")
+    # Below the axes: inside, the legend covered the transfer it explains.
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.06), ncol=2)
     return _save(fig, path)
 
 

@@ -1,0 +1,53 @@
+"""Issue 24.2: joint-space recordings (``t,<joint names>``) fit a joint-space DMP (one dimension per
+joint); ``bidmp rollout --joint-limits panda`` (or one limit per joint) times the motion so every
+joint stays within its own velocity, acceleration and jerk limit, measured on the written samples
+(velocity and acceleration as written, jerk by differences of the written accelerations)."""
+
+import numpy as np
+
+from bidmp.cli import main
+from bidmp.sim.pybullet.robot import PANDA
+
+NAMES = [f"panda_joint{k}" for k in range(1, 8)]
+
+
+def _joint_csv(path, rng, duration=3.0, n=300):
+    s = np.linspace(0.0, 1.0, n)
+    q = np.array([0, -0.785, 0, -2.356, 0, 1.571, 0.785]) + np.outer(10 * s**3 - 15 * s**4 + 6 * s**5, rng.uniform(-1.2, 1.2, 7))
+    np.savetxt(path, np.column_stack([s * duration, q]), delimiter=",", header="t," + ",".join(NAMES), comments="")
+    return q
+
+
+def _rows(path):
+    lines = [line for line in path.read_text().splitlines() if line and not line.startswith("#")][1:]
+    return np.array([[float(v) for v in line.split(",")] for line in lines])
+
+
+def test_a_joint_space_motion_at_full_speed_stays_within_every_joints_limits(tmp_path, capsys):
+    rng = np.random.default_rng(0)
+    for trial in range(3):
+        q = _joint_csv(tmp_path / "j.csv", rng, duration=float(rng.uniform(0.5, 3.0)))
+        assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+        assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "1000", "--joint-limits", "panda", "--fastest",
+                     "-o", str(tmp_path / "r.csv")]) == 0
+        rows = _rows(tmp_path / "r.csv")
+        t, position, velocity, acceleration = rows[:, 0], rows[:, 1:8], rows[:, 8:15], rows[:, 15:22]
+        jerk = np.diff(acceleration, axis=0) / np.diff(t)[:, None]
+        shares = [np.max(np.abs(velocity) / PANDA.velocity), np.max(np.abs(acceleration) / PANDA.acceleration),
+                  np.max(np.abs(jerk) / PANDA.jerk)]
+        assert max(shares) <= 1.0 + 1e-6, (trial, shares)
+        assert max(shares) >= 0.99  # --fastest: one of them binds
+        np.testing.assert_allclose(position[-1], q[-1], atol=1e-3)
+    capsys.readouterr()
+
+
+def test_one_limit_per_joint_is_per_joint_and_a_wrong_count_is_refused(tmp_path, capsys):
+    _joint_csv(tmp_path / "j.csv", np.random.default_rng(1))
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    limits = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]
+    assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "500", "--max-speed", *map(str, limits),
+                 "-o", str(tmp_path / "r.csv")]) == 0
+    velocity = _rows(tmp_path / "r.csv")[:, 8:15]
+    assert np.all(np.max(np.abs(velocity), axis=0) <= np.array(limits) * (1 + 1e-6))
+    assert main(["rollout", str(tmp_path / "j.npz"), "--max-speed", "1", "2", "-o", str(tmp_path / "r.csv")]) == 2
+    assert "one per dimension" in capsys.readouterr().err
