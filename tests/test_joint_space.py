@@ -51,3 +51,16 @@ def test_one_limit_per_joint_is_per_joint_and_a_wrong_count_is_refused(tmp_path,
     assert np.all(np.max(np.abs(velocity), axis=0) <= np.array(limits) * (1 + 1e-6))
     assert main(["rollout", str(tmp_path / "j.npz"), "--max-speed", "1", "2", "-o", str(tmp_path / "r.csv")]) == 2
     assert "one per dimension" in capsys.readouterr().err
+
+
+def test_rollout_plot_shows_a_joint_space_motion_and_its_rates(tmp_path, capsys):
+    """``--plot`` on a 7-joint model (before: refused, a path plot takes 1-3 dimensions): the
+    joints against time beside speed and acceleration; a PNG of real size."""
+    _joint_csv(tmp_path / "j.csv", np.random.default_rng(2))
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "100", "-o", str(tmp_path / "r.csv"),
+                 "--plot", str(tmp_path / "r.png")]) == 0
+    data = (tmp_path / "r.png").read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
+    width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+    assert width > 1.8 * height  # two panels side by side

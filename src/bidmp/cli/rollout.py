@@ -114,12 +114,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     if args.bag:
         print(f"wrote {_rollout_bag(args, trajectory, dmp, poses)}")
     if args.plot:
-        from ..plotting.trajectories import plot_trajectories
+        from ..plotting.trajectories import plot_rollout
 
-        reference = dmp.rollout()
-        figure = plot_trajectories(args.plot, reference, [trajectory.y], ["rollout"], goals=trajectory.y[-1:],
-                                   title="rollout", units=dmp.units_)
-        print(f"wrote {figure}")
+        print(f"wrote {plot_rollout(args.plot, dmp.rollout(), trajectory, title='rollout', units=dmp.units_)}")
     return EXIT_OK
 
 

@@ -79,7 +79,7 @@ class BagRecording:
 
 def is_bag(path) -> bool:
     """Whether ``path`` is a ROS bag: a ``.bag`` file or a folder with ``metadata.yaml``."""
-    path = Path(path)
+    path = Path(check_path(path, "path"))  # a name beyond the system's lengths is refused by name
     if path.is_dir():
         return (path / "metadata.yaml").is_file()
     return path.suffix.lower() == ".bag" and path.is_file()

@@ -13,6 +13,7 @@ from .._lazy import exports
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
     "plot_trajectories": "trajectories",
+    "plot_rollout": "trajectories",
     "plot_generalisation": "trajectories",
     "plot_recordings": "trajectories",
     "plot_segmentation": "extension",

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_points, as_trajectory
-from ._base import _figure, _label_axes, _matplotlib, _save, _sequence
+from .._checks import as_points, as_trajectory, check_path
+from ._base import _figure, _label_axes, _matplotlib, _save, _sequence, _text
 
-__all__ = ['plot_trajectories', 'plot_generalisation', 'plot_recordings']
+__all__ = ['plot_trajectories', 'plot_rollout', 'plot_generalisation', 'plot_recordings']
 
 
 def plot_trajectories(
@@ -64,6 +64,56 @@ def plot_trajectories(
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
+    return _save(fig, path)
+
+
+def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory, title: str = "rollout",
+                 units: str = "") -> Path:
+    """A timed rollout: its path beside the demonstration's (left; 2-D or 3-D, more dimensions
+    per coordinate against time) and its speed and acceleration over time (right; the norms, in
+    units/s and units/s², the limits a robot checks first).
+
+    Parameters
+    ----------
+    path : path of the PNG to write.
+    demonstration : (T, D) the model's own reproduction or demonstration.
+    trajectory : bidmp.Trajectory (or PoseTrajectory: its positions).
+    """
+    from ..primitives.timing import TimedMotion
+
+    if not isinstance(trajectory, TimedMotion):
+        raise TypeError(f"trajectory must be a bidmp.Trajectory or PoseTrajectory, got {type(trajectory).__name__}")
+    check_path(path)
+    title, units = _text(title, "title", 200), _text(units, "units", 20)
+    demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
+    n_dims = trajectory.y.shape[1]
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(12.0, 5.0), dpi=110)
+    spatial = n_dims in (2, 3)
+    ax = fig.add_subplot(1, 2, 1, projection="3d" if n_dims == 3 else None)
+    if spatial:
+        ax.plot(*demonstration[:, :n_dims].T, color="0.55", linewidth=4, alpha=0.6, label="reproduction")
+        ax.plot(*trajectory.y.T, color="C0", linewidth=1.5, label="rollout")
+        ax.plot(*[[c] for c in trajectory.y[-1]], marker="*", markersize=12, color="crimson", linestyle="none", label="end")
+        _label_axes(ax, n_dims, units)
+    else:  # a joint-space (or 1-D) motion: each coordinate against time
+        for index in range(n_dims):
+            ax.plot(trajectory.t, trajectory.y[:, index], label=f"x{index}")
+        ax.set_xlabel("t [s]")
+        ax.set_ylabel("position" + (f" [{units}]" if units else ""))
+    ax.set_title(title)
+    ax.legend(loc="best", fontsize=8)
+    rates = fig.add_subplot(1, 2, 2)
+    suffix = units or "units"
+    rates.plot(trajectory.t, np.linalg.norm(trajectory.yd, axis=1), color="C0", label=f"speed [{suffix}/s]")
+    rates.set_xlabel("t [s]")
+    rates.set_ylabel(f"speed [{suffix}/s]", color="C0")
+    twin = rates.twinx()
+    twin.plot(trajectory.t, np.linalg.norm(trajectory.ydd, axis=1), color="C3", label=f"acceleration [{suffix}/s²]")
+    twin.set_ylabel(f"acceleration [{suffix}/s²]", color="C3")
+    rates.set_title(f"peak speed {trajectory.peak_speed():.3g} {suffix}/s, peak acceleration "
+                    f"{trajectory.peak_acceleration():.3g} {suffix}/s²", fontsize=10)
+    rates.grid(True, alpha=0.3)
     return _save(fig, path)
 
 
