@@ -13,7 +13,7 @@ from bidmp import DMP, BiDMP
 from bidmp.datasets import minimum_jerk
 from bidmp.primitives.grid import _rollout_grid
 from bidmp.primitives.timed import _time_grid
-from bidmp.primitives.via import _impulse_rows
+from bidmp.primitives.via import _impulse_rows, _interpolation
 
 
 def random_dmp(seed: int, protocol: str = "robot"):
@@ -38,7 +38,7 @@ def test_the_response_matrix_equals_perturbed_rollouts(protocol):
     times = np.sort(rng.uniform(0.05, 0.95, 3)) * motion
     rollout_params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
     phase, basis, *_ = _rollout_grid(dmp, rollout_params, n_samples + 2, step)
-    fast = _impulse_rows(rollout_params, phase, step, times, dt) @ basis
+    fast = _impulse_rows(rollout_params, phase, step, _interpolation(times, dt, len(phase))) @ basis
     base = dmp.trajectory(dt=dt)
     measured = np.empty_like(fast)
     for kernel in range(dmp.weights_.shape[0]):

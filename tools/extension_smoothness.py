@@ -25,9 +25,17 @@ All derivatives by central differences (``numpy.gradient``) on the extension's o
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 import numpy as np
 from extension_pace import peaks  # the same estimator as the pace script (central differences)
+
+# The measures and closed forms of the tests themselves (tests/test_extension_timing.py): what this
+# script prints is what they assert on.
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
+from test_extension_timing import shortest_around, transfer  # noqa: E402
 
 from bidmp.datasets import minimum_jerk
 from bidmp.extension import extend_demonstration
@@ -36,32 +44,8 @@ from bidmp.geometry import Scene
 TOOL = {"radius": 12.5, "length": 100.0}
 
 
-def ldj(points: np.ndarray, dt: float) -> float:
-    velocity = np.gradient(points, dt, axis=0)
-    jerk = np.gradient(np.gradient(velocity, dt, axis=0), dt, axis=0)
-    duration, peak = dt * (len(points) - 1), np.max(np.linalg.norm(velocity, axis=1))
-    return float(-np.log(duration**5 / peak**2 * np.trapezoid(np.sum(jerk**2, axis=1), dx=dt)))
-
-
-def transfer(extension, n_demo: int) -> np.ndarray:
-    return extension.complete[extension.seg_index : len(extension.complete) - (n_demo - extension.approach_index) + 1]
-
-
 def length(path: np.ndarray) -> float:
     return float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
-
-
-def shortest_around(a, b, centre, keep) -> float:
-    a2, b2, c2 = a[:2], b[:2], centre[:2]
-    chord = b2 - a2
-    nearest = a2 + np.clip(np.dot(c2 - a2, chord) / np.dot(chord, chord), 0.0, 1.0) * chord
-    if np.linalg.norm(nearest - c2) >= keep:
-        return float(np.hypot(np.linalg.norm(chord), b[2] - a[2]))
-    ca, cb = a2 - c2, b2 - c2
-    na, nb = np.linalg.norm(ca), np.linalg.norm(cb)
-    angle = np.arccos(np.clip(np.dot(ca, cb) / (na * nb), -1.0, 1.0))
-    flat = np.sqrt(na**2 - keep**2) + np.sqrt(nb**2 - keep**2) + keep * (angle - np.arccos(keep / na) - np.arccos(keep / nb))
-    return float(np.hypot(flat, b[2] - a[2]))
 
 
 def row(label, extension, blind, demo, dt, shortest=None) -> str:
@@ -152,8 +136,10 @@ def _least_jerk_offset(height: float, when: float, n: int = 801) -> np.ndarray:
 def jerk_floor(height: float, when: float = 0.5) -> float:
     """How much worse the jerk measure of the least-jerk transfer that passes ``height`` (a fraction
     of the transfer's length) from the chord is than the straight quintic's."""
-    straight = _least_jerk_offset(0.0, when)
-    return ldj(straight, 1 / (len(straight) - 1)) - ldj(_least_jerk_offset(height, when), 1 / (len(straight) - 1))
+    bowed = _least_jerk_offset(height, when)
+    straight = bowed.copy()
+    straight[:, 1] = 0.0  # the same quintic along the chord, nothing across
+    return ldj(straight, 1 / (len(bowed) - 1)) - ldj(bowed, 1 / (len(bowed) - 1))
 
 
 def ideal_bows() -> None:

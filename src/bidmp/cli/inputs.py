@@ -153,6 +153,12 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
 
 def scene_option(args: argparse.Namespace, units: str):
     """The scene of ``--scene`` (extend, rollout), in the model's units (refused in another)."""
+    scenario = scenario_option(args, units)
+    return None if scenario is None else scenario.scene
+
+
+def scenario_option(args: argparse.Namespace, units: str):
+    """The scenario of ``--scene``, which must have a scene in the model's units (None without one)."""
     if args.scene is None:
         return None
     from ..tasks.scenarios import load
@@ -163,4 +169,4 @@ def scene_option(args: argparse.Namespace, units: str):
     if units and scenario.units and scenario.units != units:
         raise ValueError(f"--scene: the scene of {args.scene} is in {scenario.units} but the model is in {units}; "
                          f"use a scene in {units}")
-    return scenario.scene
+    return scenario

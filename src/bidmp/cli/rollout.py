@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from .inputs import model_dmp, scene_option
+from .inputs import model_dmp, scenario_option
 
 EXIT_OK = 0
 
@@ -161,14 +161,11 @@ def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
                              + ("a pose model" if poses else f"{dmp.n_dims_}-D"))
         from ..primitives.avoidance import SceneAvoidance
 
-        scene, label = scene_option(args, dmp.units_), args.target_label
+        scenario, label = scenario_option(args, dmp.units_), args.target_label
         if label is None and args.goal is not None:  # the goal is a target of the scenario: its label
-            from ..tasks.scenarios import load
-
-            targets = load(args.scene, allow_outside_files=args.allow_outside_files).targets
-            label = next((name for name, point in targets.items()
+            label = next((name for name, point in scenario.targets.items()
                           if np.allclose(np.asarray(point, dtype=float)[:3], args.goal[:3], atol=1e-9)), None)
-        extras["coupling"] = [SceneAvoidance(scene, target=label)]
+        extras["coupling"] = [SceneAvoidance(scenario.scene, target=label)]
     return extras
 
 

@@ -307,23 +307,20 @@ def _write_atomically(target: Path, ros: int, topic: str, msgtype: str, messages
     store, stamped = messages
     directory = target.parent if str(target.parent) else Path(".")
     scratch = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=directory))
+    built = scratch / target.name
     try:
         if ros == 2:
             from rosbags.rosbag2 import StoragePlugin, Writer
 
-            built = scratch / target.name
-            with Writer(built, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
-                connection = writer.add_connection(topic, msgtype, typestore=store)
-                for stamp, message in stamped:
-                    writer.write(connection, stamp, store.serialize_cdr(message, msgtype))
+            writer, serialize = Writer(built, version=9, storage_plugin=StoragePlugin.MCAP), store.serialize_cdr
         else:
             from rosbags.rosbag1 import Writer
 
-            built = scratch / target.name
-            with Writer(built) as writer:
-                connection = writer.add_connection(topic, msgtype, typestore=store)
-                for stamp, message in stamped:
-                    writer.write(connection, stamp, store.serialize_ros1(message, msgtype))
+            writer, serialize = Writer(built), store.serialize_ros1
+        with writer:
+            connection = writer.add_connection(topic, msgtype, typestore=store)
+            for stamp, message in stamped:
+                writer.write(connection, stamp, serialize(message, msgtype))
         if target.is_dir():
             shutil.rmtree(target)
         os.replace(built, target)

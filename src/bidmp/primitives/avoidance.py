@@ -74,8 +74,8 @@ class SceneAvoidance(CouplingTerm):
         radii.
     strength : float, optional
         The barrier's scale (units/s²); default what the DMP's spring pulls back a motion pushed
-        the influence distance off its course with (``αβ ρ / (τT)²``), set when a stepper binds
-        the term: the barrier holds the spring off at half the influence distance.
+        the influence distance off its course with (``αβ ρ / (τT)²``), resolved into ``strength_``
+        when a stepper binds the term: the barrier holds the spring off at half the influence distance.
     steer : float
         Share of the braking turned along the surface (0: Park-style braking only).
     max_acceleration : float, optional
@@ -97,8 +97,7 @@ class SceneAvoidance(CouplingTerm):
     def __init__(self, scene, margin: float | None = None, influence: float | None = None, strength: float | None = None,
                  steer: float = 1.0, max_acceleration: float | None = None, exclude=(), target: str | None = None,
                  approach: float | None = None, on_miss: str = "raise") -> None:
-        from ..scene.clearance import Scene  # the scene's query; imported here to keep the math's layers apart
-        from ..scene.proximity import Proximity
+        from ..scene.clearance import Scene  # imported here: the primitives do not need the scene otherwise
 
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.geometry.Scene, got {type(scene).__name__}")
@@ -114,34 +113,34 @@ class SceneAvoidance(CouplingTerm):
         self.target = target
         excluded = [exclude] if isinstance(exclude, str) else list(exclude)
         self.exclude = tuple(excluded)
-        self._proximity_class = Proximity
         self._proximity = None
         self._goal = None
-        self._bound_strength = None
 
     def bind(self, stepper) -> None:
         """Called by the stepper that runs the term: the goal (for head-on steering), the default
         strength, the target's parts left out, and the final approach's length."""
+        from ..scene.proximity import Proximity
         from .approach import _straight_tail_start
 
         self._goal = stepper.target
-        plain = stepper._dmp.rollout(stepper.goal, start=stepper.start)
-        tail = _straight_tail_start(plain)
-        self.approach_ = float(np.linalg.norm(plain[-1] - plain[tail])) if self.approach is None else self.approach
-        if self.strength is None:
-            params, scale = stepper._params, stepper._params.tau * stepper._dmp.time_unit_
-            self._bound_strength = params.alpha * params.beta * self.influence / scale**2
+        if self.approach is None:  # the motion's own straight tail, the skill's increment included
+            plain = stepper._dmp.rollout(stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment)
+            self.approach_ = float(np.linalg.norm(plain[-1] - plain[_straight_tail_start(plain)]))
+        else:
+            self.approach_ = self.approach
+        params, scale = stepper._params, stepper._params.tau * stepper._dmp.time_unit_
+        self.strength_ = params.alpha * params.beta * self.influence / scale**2 if self.strength is None else self.strength
         excluded = set(self.exclude)
         if self.target is not None:
             excluded.update(self.scene.target_parts(self.target, self._goal))
         else:
             excluded.update(self.scene.parts_at(self._goal))
-        self._proximity = self._proximity_class(self.scene, sorted(excluded))
+        self._proximity = Proximity(self.scene, sorted(excluded))
         self.excluded_ = tuple(sorted(excluded))
         # The parts the term would push against with the tool at the goal itself (a neighbouring
         # nut beside the socket): only these fade out along the final approach.
         beside = self._proximity.near(np.asarray(self._goal, dtype=float), self.margin + self.influence)[3]
-        self._at_goal = np.zeros(self._proximity.margins.shape[0], dtype=bool)
+        self._at_goal = np.zeros(self._proximity.standoffs.shape[0], dtype=bool)
         self._at_goal[beside] = True
         self._fades = bool(beside.size)
 
@@ -154,19 +153,17 @@ class SceneAvoidance(CouplingTerm):
         if distances.size == 0:
             return np.zeros(3)
         rho = self.influence
-        owed = np.minimum(owed, self.margin)
+        owed = np.minimum(owed, self.margin)  # the margin, or a part's stand-off
         gap = np.maximum(distances - owed, _NEAREST * rho)
         weight = np.clip(1.0 - (distances - owed) / rho, 0.0, 1.0)
         if fade < 1.0:  # the parts beside the goal fade out along the final approach
             weight = np.where(self._at_goal[solids], weight * fade, weight)
         approach = np.maximum(-(away @ yd), 0.0)
         braking = weight * approach**2 / (2.0 * gap)
-        strength = self.strength if self.strength is not None else (self._bound_strength or 0.0)
-        barrier = strength * weight * np.minimum(rho / gap - 1.0, _BARRIER_CAP)
-        push = (braking + barrier) @ away
+        total = braking + self.strength_ * weight * np.minimum(rho / gap - 1.0, _BARRIER_CAP)  # + the barrier
+        push = total @ away
         if self.steer > 0.0:
-            turned = braking + barrier
-            push = push + self.steer * sum(b * self._tangent(n, yd, y) for b, n in zip(turned, away) if b > 0.0)
+            push = push + self.steer * sum(b * self._tangent(n, yd, y) for b, n in zip(total, away) if b > 0.0)
         if self.max_acceleration is not None:
             size = float(np.linalg.norm(push))
             if size > self.max_acceleration:
@@ -209,12 +206,10 @@ class SceneAvoidance(CouplingTerm):
 
 
 def _check_avoidance(terms, trajectory, target: np.ndarray, reach: float) -> None:
-    """After a coupled rollout: raise (or log) when a :class:`SceneAvoidance` term's motion comes
+    """After a coupled rollout: raise (or log) when a :class:`SceneAvoidance` term's (``terms``) motion comes
     closer than its margin, or when it ends short of ``target`` (by more than
     :data:`_STALLED` of ``reach``, the start-goal distance): steered into a dead end."""
     for term in terms:
-        if not isinstance(term, SceneAvoidance):
-            continue
         clearance = term.check(trajectory.y)
         term.clearance_ = clearance
         short = float(np.linalg.norm(trajectory.y[-1] - target))

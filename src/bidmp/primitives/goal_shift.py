@@ -14,15 +14,11 @@ at rest, and a final approach that starts after the blend is a translated copy o
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 
 from .goals import _smoothstep, _smoothstep_derivatives
 
 __all__ = []
-
-logger = logging.getLogger(__name__)
 
 # Peaks of the 7th-order smoothstep's derivatives on [0, 1]: s' 35/16, s'' 7.513, s''' 52.5
 # (numerically, tests/test_goal_shift.py checks them): an offset Δ over T peaks at |Δ| s^(k) / T^k.
@@ -45,7 +41,8 @@ def _shortest_blend(delta: np.ndarray, limits: dict | None) -> float:
 
 
 class _GoalShifts:
-    """The sum of the smooth offsets of every goal update so far."""
+    """The smooth offsets of every goal update so far: summed for positions (:meth:`at`), composed
+    for orientations (``PoseStepper``, from :meth:`profiles`)."""
 
     def __init__(self, n_dims: int) -> None:
         self._shifts: list[tuple[np.ndarray, float, float]] = []  # (delta, start s, duration s)
@@ -58,18 +55,22 @@ class _GoalShifts:
     def __bool__(self) -> bool:
         return bool(self._shifts)
 
+    def profiles(self, t: float):
+        """Per update, in the order given: ``(delta, s, ṡ, s̈)`` at motion time ``t`` (s) — the
+        share of ``delta`` applied and its rates (1/s, 1/s²)."""
+        for delta, start, duration in self._shifts:
+            if duration <= 0.0:
+                yield delta, 1.0, 0.0, 0.0
+                continue
+            u = np.array(min(max((t - start) / duration, -1.0), 2.0))  # any t, inf too: the smoothstep is flat outside [0, 1]
+            first, second = _smoothstep_derivatives(u)
+            yield delta, float(_smoothstep(u)), float(first) / duration, float(second) / duration**2
+
     def at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Offset (D,), its velocity and acceleration at motion time ``t`` (s)."""
         offset, velocity, acceleration = (np.zeros_like(self.total) for _ in range(3))
-        for delta, start, duration in self._shifts:
-            if duration <= 0.0:
-                offset = offset + delta
-                continue
-            u = np.array((t - start) / duration)
-            first, second = _smoothstep_derivatives(u)
-            offset = offset + delta * float(_smoothstep(u))
-            velocity = velocity + delta * float(first) / duration
-            acceleration = acceleration + delta * float(second) / duration**2
+        for delta, share, rate, rate_rate in self.profiles(t):
+            offset, velocity, acceleration = offset + share * delta, velocity + rate * delta, acceleration + rate_rate * delta
         return offset, velocity, acceleration
 
 

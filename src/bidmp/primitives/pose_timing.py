@@ -10,7 +10,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from .._checks import as_point
-from .goals import _smoothstep, _smoothstep_derivatives
+from .goal_shift import _GoalShifts
 from .so3 import _left_jacobian, as_quaternions, orientation_from_log, principal_log
 from .timing import TimedMotion, _validate_motion
 
@@ -107,7 +107,7 @@ class PoseStepper:
         self.position = position
         self.orientation = orientation
         self.goal_orientation = goal_orientation
-        self._turns: list[tuple[np.ndarray, float, float]] = []  # (rotation vector δ, start s, blend s)
+        self._turns = _GoalShifts(3)  # rotation vectors δ of the goal frame, blended in turn
 
     def set_goal_pose(self, pose, *, limits: dict | None = None, blend: float | None = None) -> float:
         """Move the goal to ``pose`` (7,) mid-motion: the position as
@@ -120,20 +120,21 @@ class PoseStepper:
         blend = self.position.set_goal(pose[:3], limits=limits, blend=blend)
         current = self._goal_now(np.inf)[0]
         delta = principal_log(new_q[None], current)[0]
-        self._turns.append((delta, self.position.time, float(blend)))
+        self._turns.add(delta, self.position.time, float(blend))
         return blend
 
     def _goal_now(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The goal frame (4,) at motion time ``t`` and its angular velocity and acceleration
         (world frame, rad/s, rad/s²)."""
         goal, omega, omega_dot = self.goal_orientation, np.zeros(3), np.zeros(3)
-        for delta, start, blend in self._turns:
-            u = np.array(1.0 if blend <= 0.0 else min(max((t - start) / blend, -1.0), 2.0))
-            first, second = _smoothstep_derivatives(u)
-            goal = orientation_from_log((float(_smoothstep(u)) * delta)[None], goal)[0]
-            if blend > 0.0:  # δ's axis is fixed in the world: the turn's rates lie along it
-                omega_dot = omega_dot + float(second) / blend**2 * delta + np.cross(omega, float(first) / blend * delta)
-                omega = omega + float(first) / blend * delta
+        for delta, share, rate, rate_rate in self._turns.profiles(t):
+            # goal ← A ⊗ goal with A = Exp(s δ), whose axis is fixed in the world: ω_A = ṡ δ, and
+            # ω = ω_A + R_A ω, ω̇ = ω̇_A + R_A ω̇ + ω_A × R_A ω.
+            turn = Rotation.from_rotvec(share * delta)
+            goal = orientation_from_log((share * delta)[None], goal)[0]
+            carried = turn.apply(omega)
+            omega_dot = rate_rate * delta + turn.apply(omega_dot) + np.cross(rate * delta, carried)
+            omega = rate * delta + carried
         return goal, omega, omega_dot
 
     @property

@@ -3,6 +3,7 @@ with coupling terms (:mod:`bidmp.primitives.coupling`)."""
 
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
@@ -10,12 +11,14 @@ import numpy as np
 from .._checks import as_point, check_real
 from .coupling import _as_couplings
 from .forcing import _basis_row
-from .goal_shift import _GoalShifts, _goal_complete_time, logger, _shortest_blend
+from .goal_shift import _GoalShifts, _goal_complete_time, _shortest_blend
 from .grid import _rollout_grid
 from .integrate import StepIntegrator
 from .protocols import _TAU_RANGE
 
 __all__ = ["DMPStepper"]
+
+logger = logging.getLogger(__name__)
 
 
 class DMPStepper:
@@ -65,6 +68,7 @@ class DMPStepper:
         self._gate = self._goal_system.follow(1.0, 1.0, 0.0, self._scale, params.exact)
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
+        self._complete = None  # the motion time its own goal offset completes (set_goal asks for it)
         for term in self._couplings:  # terms that need the motion (a scene's avoidance: its goal, its scale)
             if hasattr(term, "bind"):
                 term.bind(self)
@@ -111,7 +115,7 @@ class DMPStepper:
 
     def _goal_complete(self) -> float:
         """The motion time (s) from which the DMP's own goal offset is complete."""
-        if getattr(self, "_complete", None) is None:
+        if self._complete is None:
             dmp, params = self._dmp, self._dmp._rollout_params(self._dmp.dt_, self._params)
             n_steps = int(np.ceil(params.settle * self._scale * (dmp.n_steps_ - 1))) + 2
             goal_response = _rollout_grid(dmp, params, n_steps, dmp.dt_)[2][0]

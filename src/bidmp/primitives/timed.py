@@ -133,8 +133,8 @@ def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_
     stepper = DMPStepper(dmp, goal, start, motion, coupling, start_velocity, forcing_increment)
     states = [stepper.step(dt) for _ in range(n_samples)]
     avoiding = [term for term in stepper._couplings if isinstance(term, SceneAvoidance)]
+    reach = float(np.linalg.norm(stepper.target - stepper.start))
     if avoiding:
-        reach = float(np.linalg.norm(stepper.target - stepper.start))
         for _ in range(n_samples):
             position, velocity = states[-1][0], states[-1][1]
             if np.linalg.norm(velocity) * motion <= _REST_SHARE * reach and np.linalg.norm(position - stepper.target) <= _REST_SHARE * reach:
@@ -145,7 +145,7 @@ def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_
         raise ValueError("trajectory: the coupled integration is not finite; a coupling term is out of range")
     trajectory = Trajectory(np.arange(len(states)) * dt, y, yd, ydd, dmp.units_)
     if avoiding:
-        _check_avoidance(avoiding, trajectory, stepper.target, float(np.linalg.norm(stepper.target - stepper.start)))
+        _check_avoidance(avoiding, trajectory, stepper.target, reach)
     return trajectory
 
 

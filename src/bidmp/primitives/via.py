@@ -37,6 +37,7 @@ _CONDITION = 1e-9
 # as a violent swing (two via-points 50 mm apart 0.1 ms apart on a 3 s motion ask for 60 000x; a
 # via-point 30 mm off the path 11x).
 _MAX_SWING = 100.0
+_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
 
 
 def _parse_via(via, n_dims: int, horizon: float) -> tuple[np.ndarray, np.ndarray]:
@@ -73,15 +74,16 @@ def _interpolation(times: np.ndarray, dt: float, n: int) -> list[tuple[int, floa
     return pairs
 
 
-def _impulse_rows(params, phase: np.ndarray, step: float, times: np.ndarray, dt: float) -> np.ndarray:
-    """(m, n) weights of each sample's forcing ``f`` (K included) on the position at each via time
-    (linear interpolation between the two samples around it): ``y(t_k) = y⁰(t_k) + rows_k @ f``."""
+def _impulse_rows(params, phase: np.ndarray, step: float, between: list[tuple[int, float]]) -> np.ndarray:
+    """(m, n) weights of each sample's forcing ``f`` (K included) on the position at each via time,
+    linearly between the two samples around it (``between``: :func:`_interpolation`):
+    ``y(t_k) = y⁰(t_k) + rows_k @ f``."""
     n = phase.shape[0]
     impulses = np.zeros((n, 2))
     impulses[0, 0] = impulses[1, 1] = 1.0
     first, later = _unit_responses(params, phase, impulses, step)  # (n,) each: y's response
-    rows = np.zeros((times.size, n))
-    for row, (low, share) in zip(rows, _interpolation(times, dt, n)):
+    rows = np.zeros((len(between), n))
+    for row, (low, share) in zip(rows, between):
         for sample, weight in ((low, 1.0 - share), (low + 1, share)):
             if weight == 0.0:
                 continue
@@ -104,7 +106,8 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     phase, basis, (goal_response, start_response, _), _ = _rollout_grid(dmp, params, n_samples, step)
     # Only the samples up to the last via-point's matter (a response never reaches back in time).
     used = min(int(np.ceil(times.max() / dt)) + 2, phase.shape[0])
-    rows = _impulse_rows(params, phase[:used], step, times, dt)
+    between = _interpolation(times, dt, used)
+    rows = _impulse_rows(params, phase[:used], step, between)
     response = rows @ basis[:used]  # (m, N): per unit weight (K inside)
     singular = np.linalg.svd(response, compute_uv=False)
     if singular[-1] <= _CONDITION * max(singular[0], 1e-300):
@@ -115,7 +118,7 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     baseline = response @ dmp.weights_  # rows @ (basis @ W), without the (n, D) forcing
     if forcing_increment is not None:
         baseline += rows @ forcing_increment(phase, basis)[:used]
-    for k, (low, share) in enumerate(_interpolation(times, dt, phase.shape[0])):
+    for k, (low, share) in enumerate(between):
         at = (1.0 - share) * np.array([goal_response[low], start_response[low]]) + share * np.array(
             [goal_response[low + 1], start_response[low + 1]])
         baseline[k] += at[0] * goal + at[1] * start
@@ -161,8 +164,6 @@ def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forc
                              f"move them apart or closer to the path")
     return result
 
-
-_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
 
 
 def _peak(values: np.ndarray) -> float:

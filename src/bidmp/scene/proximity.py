@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from .clearance import Scene
+from .distances import _cylinder_box_bounds
 
 __all__ = ["Proximity"]
 
@@ -36,31 +37,29 @@ class Proximity:
         self._chosen = scene._selected(exclude)
         self._lower, self._upper = scene._lower[self._chosen], scene._upper[self._chosen]
         self._engine = scene._engine() if self._chosen.size else None
-        # What each solid may come to: the margin, or a part's designed stand-off (a plate under the nut).
         # The box around them all: a tool far from it needs no per-solid bound (most of a motion).
         self._whole = (self._lower.min(axis=0).tolist(), self._upper.max(axis=0).tolist()) if self._chosen.size else None
-        self.margins = np.array([min(scene.margin, scene.standoff.get(scene._owner[index], scene.margin))
-                                 for index in self._chosen])
+        # A part's designed stand-off (a plate under the nut), inf for the parts without one.
+        self.standoffs = np.array([scene.standoff.get(scene._owner[index], np.inf) for index in self._chosen])
 
     def near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Solids whose signed distance from the tool at ``point`` (3,) is below ``within``
-        (scene units): their distances (k,), unit directions from each toward the tool (k, 3), the
-        clearance each is owed (k,): the scene's margin or the part's stand-off, and their indices
-        among the chosen solids (k,). ``skip``: a mask over the chosen solids, those not asked about."""
+        (scene units): their distances (k,), unit directions from each toward the tool (k, 3), their
+        parts' stand-offs (k,; inf: none) and their indices among the chosen solids (k,). ``skip``:
+        a mask over the chosen solids, those not asked about."""
         if self._engine is None:
             return _NONE
         tool = self.scene.tool
+        # _cylinder_box_bounds for the one box round every part, in floats: every control step asks
+        # this, and NumPy's per-call cost would be most of it.
         x, y, z = point.tolist()
         (x0, y0, z0), (x1, y1, z1) = self._whole
         lateral = math.hypot(max(x0 - x, x - x1, 0.0), max(y0 - y, y - y1, 0.0)) - tool.radius
         vertical = max(z0 - (z + tool.length), z - z1, 0.0)
-        if max(lateral, 0.0) ** 2 + vertical**2 >= within * within:
+        if math.hypot(max(lateral, 0.0), vertical) >= within:
             return _NONE
-        # The cylinder-to-box bound of _cylinder_box_bounds for one point, without its batching.
-        gap = np.maximum(np.maximum(self._lower - point, point - self._upper), 0.0)
-        lateral = np.maximum(np.sqrt(gap[:, 0] ** 2 + gap[:, 1] ** 2) - tool.radius, 0.0)
-        vertical = np.maximum(np.maximum(self._lower[:, 2] - (point[2] + tool.length), point[2] - self._upper[:, 2]), 0.0)
-        candidates = np.flatnonzero(lateral**2 + vertical**2 < within * within)
+        bounds = _cylinder_box_bounds(point[None], tool.radius, tool.length, self._lower, self._upper)[0]
+        candidates = np.flatnonzero(bounds < within)
         if skip is not None and candidates.size:  # a mask over the chosen solids
             candidates = candidates[~skip[candidates]]
         distances, directions, owed, found = [], [], [], []
@@ -79,7 +78,7 @@ class Proximity:
                 size = max(math.sqrt(away @ away), 1e-300)
             distances.append(distance)
             directions.append(away / size)
-            owed.append(self.margins[index])
+            owed.append(self.standoffs[index])
             found.append(index)
         if not distances:
             return _NONE

@@ -13,7 +13,6 @@ import numpy as np
 from .._checks import check_bool, check_int, check_real
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
-from ..scene.clearance import Scene
 from .backend import COUPLING, GoalUpdate, Hold
 from .pybullet.cell import PandaCell
 from .pybullet.robot import _unit_of, robot_placement
@@ -50,7 +49,7 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
         if setup["closed_loop"]:
             coupling = setup["coupling"]
             if setup.get("avoid"):  # steered round every part but the target's, with phase stopping
-                coupling = [PhaseStopping(coupling), SceneAvoidance(Scene.from_dict(setup["scene"]), target=job.label)]
+                coupling = [PhaseStopping(coupling), SceneAvoidance(cell.scene, target=job.label)]
             stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
             update = setup.get("goal_update")
             run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update)
