@@ -84,6 +84,46 @@ def test_serial_and_two_workers_give_identical_tables(serial, tmp_path):
     assert {"demos", "every"} <= set(stored[0]) and stored[0]["every"] == 10
 
 
+def _worker_environment(_):
+    import os
+
+    return {name: os.environ.get(name) for name in ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS")}
+
+
+@needs_dask
+def test_workers_keep_glibc_adaptive_malloc_and_this_process_its_environment():
+    """Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in their workers, which turns off glibc's
+    adaptive mmap threshold (the cells' fits ran 1.6-2x slower there, issue 24.6); bidmp's cluster
+    starts them without it, and leaves no variable of theirs in this process."""
+    import os
+
+    from bidmp.experiments.lasa import _client
+
+    before = dict(os.environ)
+    client, cluster = _client(None, 1)
+    try:
+        seen = client.submit(_worker_environment, 0, pure=False).result()
+    finally:
+        client.close()
+        cluster.close()
+    assert seen["MALLOC_TRIM_THRESHOLD_"] is None
+    assert seen["OMP_NUM_THREADS"] == "1"  # Dask's single-threaded BLAS in workers is kept
+    assert dict(os.environ) == before
+
+
+def test_a_cell_gives_the_same_floats_whatever_the_thread_pools():
+    """run_cell limits BLAS and OpenMP to one thread itself, as Dask's workers do: the serial path
+    and the workers then agree to the last bit (2 threads sum in another order: without the limit
+    the robot protocol's metrics on this cell differ in the last digits)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=2):
+        two = benchmark.run_cell("Angle", 0, ["dmp-robot"], 10)
+    with threadpool_limits(limits=1):
+        one = benchmark.run_cell("Angle", 0, ["dmp-robot"], 10)
+    assert table(two["rows"]) == table(one["rows"])
+
+
 @needs_dask
 @needs_parquet
 def test_a_worker_killed_mid_run_still_gives_the_complete_table(serial, tmp_path):

@@ -133,7 +133,9 @@ def _benchmark_parser(commands) -> None:
     bench.add_argument("--methods", default=None, help="comma-separated methods (default dmp-paper,dmp-robot,bidmp,gmm,tpgmm,mp-dmp)")
     bench.add_argument("--demos", choices=("all", "first3"), default="all", help="all 7 demonstrations or the first 3")
     bench.add_argument("--every", type=int, default=1, metavar="K", help="use every K-th sample (papers use 1 or 10)")
-    bench.add_argument("--workers", type=int, default=None, help="worker processes of the embedded cluster (default: one per core)")
+    bench.add_argument("--workers", type=int, default=None,
+                       help="worker processes of the embedded Dask cluster (default: one per core); 1 runs the cells "
+                            "serially in this process, without Dask")
     bench.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run on an existing Dask scheduler (tcp://host:8786)")
     bench.add_argument("--resume", action="store_true", help="skip the cells a previous run into --out finished")
     bench.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="results table format (default parquet)")

@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import check_choice, check_int, require_extra
+from ._lasa_dask import _client, _run_on_dask  # noqa: F401  (_client: the benchmark script's cluster)
 
 __all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key", "summary_markdown"]
 
@@ -115,6 +116,17 @@ def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_
     if _kill_once is not None and os.path.exists(_kill_once):
         os.remove(_kill_once)
         os.kill(os.getpid(), 9)
+    import sklearn.mixture  # noqa: F401  (its OpenMP pool loaded, so that the limit below holds it)
+    from threadpoolctl import threadpool_limits
+
+    # One BLAS/OpenMP thread, as in a Dask worker (whose nanny sets OMP_NUM_THREADS=1 and the
+    # like): the serial path and the workers then give the same floats (2 threads summed in
+    # another order, 1 ulp off), and small matrices gain nothing from threads anyway.
+    with threadpool_limits(limits=1):
+        return _run_cell(shape, demo, methods, every)
+
+
+def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
     from ..demonstrations.datasets import lasa as lasa_data
     from ..tasks import methods as registry
     from ..tasks.methods import Method, Task
@@ -267,20 +279,6 @@ def _write_cell(out: Path, protocol: dict, result: dict) -> None:
         json.dump({"format": FORMAT, "protocol": protocol, **result, "digest": _digest(result)}, handle)
 
 
-def _client(scheduler: str | None, workers: int):
-    require_extra("distributed", "benchmark", "the LASA benchmark on Dask")
-    from distributed import Client, LocalCluster
-
-    if scheduler is not None:
-        try:
-            return Client(scheduler, timeout="3s"), None
-        except (OSError, TimeoutError) as exc:
-            raise ValueError(f"cannot reach the Dask scheduler at {scheduler} within 3 s ({type(exc).__name__})") from None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
-    return Client(cluster), cluster
-
-
 def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, workers: int | None = None,
          scheduler: str | None = None, resume: bool = False, output_format: str = "parquet", progress=None,
          synchronous: bool = False, dask: bool = False, _kill_once: str | None = None) -> BenchmarkResult:
@@ -367,34 +365,6 @@ def _write_tables(out: Path, rows: list, protocol: dict, output_format: str) -> 
     with atomic_write(out / "lasa.md", "w") as handle:
         handle.write(summary_markdown(rows, protocol) + "\n")
     return table
-
-
-def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress) -> int:
-    """The cells ``todo`` on a Dask cluster (embedded, or at ``scheduler``), each written as it
-    finishes and added to ``done``; returns the number of workers."""
-    n_workers = workers or (os.cpu_count() or 1)
-    client, cluster = _client(scheduler, n_workers)
-    try:
-        from distributed import as_completed
-
-        n_running = len(client.scheduler_info().get("workers", {})) or n_workers
-        from ..tasks import methods as registry
-
-        objects = [registry.get(name) for name in methods]
-        futures = [client.submit(run_cell, shape, demo, objects, every, kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
-                                 pure=False, retries=2)
-                   for shape, demo in todo]
-        for future in as_completed(futures):
-            cell = future.result()
-            _write_cell(out, protocol, cell)
-            done[cell["key"]] = cell
-            if progress is not None:
-                progress(cell["key"])
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-    return n_running
 
 
 _COLUMNS = ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES, "demos", "every")
