@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
@@ -210,3 +211,41 @@ def test_without_the_ros_extra_bag_input_says_how_to_install_it(tmp_path, capsys
     assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "pip install 'bidmp[ros]'" in err[0]
+
+
+def test_a_position_motion_leaves_as_the_robots_joint_trajectory_after_ik(tmp_path):
+    """bidmp rollout --robot panda --bag: the JointTrajectory's points, put through an independent
+    forward kinematics (a bare Panda in its own PyBullet world, the tool's length added along the
+    flange's z), land on the rolled-out Cartesian samples."""
+    pytest.importorskip("pybullet")
+    import pybullet as p
+    import pybullet_data
+    from scipy.spatial.transform import Rotation
+
+    demonstration = minimum_jerk([[400, -100, 350], [500, 50, 300], [550, 100, 200]], 200)
+    np.savetxt(tmp_path / "d.csv", np.column_stack([np.linspace(0, 2, 200), demonstration]), delimiter=",",
+               header="# units: mm\nt,x,y,z", comments="")
+    assert main(["fit", str(tmp_path / "d.csv"), "-o", str(tmp_path / "m.npz"), "--raw"]) == 0
+    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "25", "-o", str(tmp_path / "r.csv"), "--robot", "panda",
+                 "--tool-length", "0.1", "--base", "0", "0", "50", "--bag", str(tmp_path / "out")]) == 0
+    rows = _table(tmp_path / "r.csv")
+    with AnyReader([tmp_path / "out"]) as reader:
+        (connection,) = reader.connections
+        assert connection.msgtype == "trajectory_msgs/msg/JointTrajectory"
+        (message,) = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    assert list(message.joint_names) == [f"panda_joint{k}" for k in range(1, 8)]
+    times = np.array([q.time_from_start.sec + 1e-9 * q.time_from_start.nanosec for q in message.points])
+    np.testing.assert_allclose(times, rows[:, 0], atol=1e-9)
+    client = p.connect(p.DIRECT)
+    try:
+        body = p.loadURDF(f"{pybullet_data.getDataPath()}/franka_panda/panda.urdf", useFixedBase=True, physicsClientId=client)
+        tips = []
+        for point in message.points:
+            for joint, value in enumerate(point.positions):
+                p.resetJointState(body, joint, value, physicsClientId=client)
+            position, orientation = p.getLinkState(body, 8, computeForwardKinematics=1, physicsClientId=client)[4:6]
+            tips.append(np.array(position) + Rotation.from_quat(orientation).apply([0, 0, 0.1]))
+    finally:
+        p.disconnect(client)
+    expected = (rows[:, 1:4] - [0, 0, 50]) / 1000.0  # the model's mm, relative to the base, in m
+    assert np.max(np.linalg.norm(np.array(tips) - expected, axis=1)) <= 1e-4

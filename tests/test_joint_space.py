@@ -64,3 +64,52 @@ def test_rollout_plot_shows_a_joint_space_motion_and_its_rates(tmp_path, capsys)
     assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
     width, height = int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
     assert width > 1.8 * height  # two panels side by side
+
+
+def test_a_joint_recording_is_in_radians_and_refuses_a_length_unit(tmp_path, capsys):
+    _joint_csv(tmp_path / "j.csv", np.random.default_rng(2))
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    assert "units rad" in capsys.readouterr().out
+    from bidmp.io.models import load_model
+
+    assert load_model(tmp_path / "j.npz").units_ == "rad"
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "k.npz"), "--raw", "--units", "mm"]) == 2
+    assert "joint angles are not lengths" in capsys.readouterr().err
+
+
+def _fk(q, robot):
+    """Forward kinematics of the bare arm (no tool), on an independent PyBullet world."""
+    import pybullet as p
+    import pybullet_data
+
+    client = p.connect(p.DIRECT)
+    try:
+        urdf = {"panda": "franka_panda/panda.urdf", "iiwa": "kuka_iiwa/model.urdf"}[robot]
+        body = p.loadURDF(f"{pybullet_data.getDataPath()}/{urdf}", useFixedBase=True, physicsClientId=client)
+        movable = [j for j in range(p.getNumJoints(body, physicsClientId=client))
+                   if p.getJointInfo(body, j, physicsClientId=client)[2] != p.JOINT_FIXED][:7]
+        for joint, value in zip(movable, q):
+            p.resetJointState(body, joint, float(value), physicsClientId=client)
+        flange = movable[-1] + (1 if robot == "panda" else 0)  # the Panda's flange link8 follows joint 7
+        return np.array(p.getLinkState(body, flange, computeForwardKinematics=1, physicsClientId=client)[4])
+    finally:
+        p.disconnect(client)
+
+
+def test_rollout_to_a_cartesian_goal_through_the_robots_inverse_kinematics(tmp_path, capsys):
+    import pytest
+
+    pytest.importorskip("pybullet")
+    _joint_csv(tmp_path / "j.csv", np.random.default_rng(3))
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    rng = np.random.default_rng(4)
+    for robot in ("panda", "iiwa"):
+        goal = np.array([rng.uniform(0.45, 0.6), rng.uniform(-0.2, 0.2), rng.uniform(0.2, 0.45)])
+        assert main(["rollout", str(tmp_path / "j.npz"), "--robot", robot, "--cartesian-goal", *map(str, goal),
+                     "--joint-limits", robot, "-o", str(tmp_path / "r.csv")]) == 0
+        end = _rows(tmp_path / "r.csv")[-1, 1:8]
+        # The independent FK of the motion's last joints puts the flange on the goal.
+        assert np.linalg.norm(_fk(end, robot) - goal) <= 1e-3, robot
+    capsys.readouterr()
+    assert main(["rollout", str(tmp_path / "j.npz"), "--cartesian-goal", "3", "0", "0", "-o", str(tmp_path / "r.csv")]) == 2
+    assert "reach" in capsys.readouterr().err

@@ -113,7 +113,7 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     it has another), checked against ``model``'s units; timed input prepared unless ``--raw``.
     """
     from .._units import check_units, conversion
-    from ..io.trajectories import declared_units, read_trajectory
+    from ..io.trajectories import declared_units, is_joint_recording, read_trajectory
     from ..io.poses import read_poses
 
     requested = check_units(args.units or "", "--units")
@@ -121,10 +121,12 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     if bag is not None:  # header stamps; metres (poses) or radians (joints: no length unit)
         if (bag.kind == "pose") != poses:
             raise ValueError(f"{path}: {bag.source} holds {'poses' if bag.kind == 'pose' else 'joint states'}")
-        values, times, declared = bag.values, bag.t, ("m" if bag.kind == "pose" else "")
+        values, times, declared = bag.values, bag.t, ("m" if bag.kind == "pose" else "rad")
     else:
         values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)
         declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
+        if not declared and not poses and is_joint_recording(path):  # t,<joint names>: angles in radians
+            declared = "rad"
     notes = []
     if declared and requested and declared != requested:
         values = values.copy()

@@ -44,11 +44,12 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
     if args.joint_limits is not None:
         if given:
             raise ValueError("give --joint-limits or --max-speed/--max-acc/--max-jerk, not both")
-        from ..sim.pybullet.robot import PANDA
+        from ..sim.pybullet.robot import ROBOT_MODELS
 
         if dmp.n_dims_ != 7:
-            raise ValueError(f"--joint-limits panda needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
-        return {"max_velocity": PANDA.velocity, "max_acceleration": PANDA.acceleration, "max_jerk": PANDA.jerk, "norm": "axis"}
+            raise ValueError(f"--joint-limits {args.joint_limits} needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
+        arm = ROBOT_MODELS[args.joint_limits].limits
+        return {"max_velocity": arm.velocity, "max_acceleration": arm.acceleration, "max_jerk": arm.jerk, "norm": "axis"}
     if not given:
         return {}
     counts = {len(value) for value in given.values()}
@@ -81,13 +82,17 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     from ..primitives.cartesian import CartesianDMP, angle_between
     from ..primitives.dmp import DMP
 
+    args.robot_given = args.robot is not None
+    args.robot = args.robot or args.joint_limits or "panda"
+    if not args.tool_length >= 0:
+        raise ValueError(f"--tool-length must be >= 0 metres, got {args.tool_length:g}")
     model = load_model(args.model)
     if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     dmp = model_dmp(model)
     poses = isinstance(model, (CartesianDMP, CartesianBiDMP))
     skill = _skill_choice(args, model)
-    options = {"goal": args.goal, "start": args.start, **_timing_options(args, dmp)}
+    options = {"goal": _joint_goal(args, dmp, poses), "start": args.start, **_timing_options(args, dmp)}
     if skill is not None:
         options["skill"] = skill
         goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
@@ -98,7 +103,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     path = (save_poses if poses else save_trajectory)(trajectory, args.output)
     unit = dmp.units_ or "units"
     rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
-    goal = trajectory.y[-1] if args.goal is None else np.asarray(args.goal, dtype=float)
+    goal = trajectory.y[-1] if options["goal"] is None else np.asarray(options["goal"], dtype=float)
     print(f"rolled out {len(trajectory)} samples over {trajectory.duration:.4g} s ({rate:.4g} Hz) to goal "
           f"{np.array2string(goal, precision=4)}")
     print(f"  end point {np.array2string(trajectory.y[-1], precision=4)}, distance to goal "
@@ -120,15 +125,59 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
+    """The goal of --goal, or of --cartesian-goal: a joint-space model's joints that put the
+    robot's tool there (its IK, from the demonstrated goal's joints: the nearest solution)."""
+    if args.cartesian_goal is None:
+        return args.goal
+    if args.goal is not None:
+        raise ValueError("give --goal (joints) or --cartesian-goal (the tool's position), not both")
+    if poses or dmp.n_dims_ != 7:
+        raise ValueError("--cartesian-goal is for a 7-joint model (t,<joint names> or JointState input); "
+                         f"this model has {7 if poses else dmp.n_dims_} dimensions: give --goal")
+    import numpy as np
+
+    from ..sim.kinematics import inverse_kinematics
+
+    q = inverse_kinematics(np.asarray(args.cartesian_goal, dtype=float), args.robot, units="m",
+                           tool_length=args.tool_length, seed=dmp.goal_)
+    print(f"--cartesian-goal {args.cartesian_goal} m: the {args.robot}'s joints {np.array2string(q, precision=4)} rad "
+          f"(inverse kinematics from the demonstrated goal's)")
+    return q
+
+
+def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
+    """A position model's motion as the robot's JointTrajectory: inverse kinematics at every
+    sample (tool pointing down; the model's frame is the robot's base frame shifted by --base)."""
+    import numpy as np
+
+    from .._units import conversion
+    from ..io.bags import write_bag
+    from ..sim.kinematics import inverse_kinematics, joint_names
+
+    if not dmp.units_ or dmp.units_ == "rad":
+        raise ValueError("--robot with --bag: inverse kinematics needs the model's length unit; fit it with --units")
+    scale = conversion(dmp.units_, "m")
+    base = np.zeros(3) if args.base is None else np.asarray(args.base, dtype=float)
+    joints = inverse_kinematics((trajectory.y - base) * scale, args.robot, units="m", tool_length=args.tool_length)
+    velocities = np.gradient(joints, trajectory.t, axis=0)
+    path = write_bag(args.bag, trajectory.t, joints, kind="joints", names=joint_names(args.robot), velocities=velocities,
+                     accelerations=np.gradient(velocities, trajectory.t, axis=0), frame_id=args.frame, ros=ros)
+    return f"{path} (trajectory_msgs/JointTrajectory of the {args.robot} after inverse kinematics, {len(trajectory)} points)"
+
+
 def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
-    """``--bag OUT``: the motion as a PoseStamped stream in metres (position and pose models) or a
-    JointTrajectory (joint-space models: more than 3 dimensions), ROS 2 MCAP or ``--ros1``."""
+    """``--bag OUT``: the motion as a PoseStamped stream in metres (position and pose models), as
+    the robot's JointTrajectory after IK (position models with --robot) or a JointTrajectory
+    (joint-space models: more than 3 dimensions), ROS 2 MCAP or ``--ros1``."""
     import numpy as np
 
     from .._units import conversion
     from ..io.bags import write_bag
 
     ros = 1 if args.ros1 else 2
+    if args.robot_given and not poses and dmp.n_dims_ == 3:
+        return _ik_bag(args, trajectory, dmp, ros)
     if poses or dmp.n_dims_ == 3:
         if not dmp.units_:
             raise ValueError("--bag: ROS poses are in metres and this model's length unit is not known; fit it with --units")
@@ -184,8 +233,18 @@ def _add_rollout_arguments(rollout) -> None:
                          help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2 (or one per dimension)")
     rollout.add_argument("--max-jerk", type=float, nargs="+", default=None, metavar="J",
                          help="cap on the jerk, units/s^3 (or one per dimension)")
-    rollout.add_argument("--joint-limits", choices=("panda",), default=None,
-                         help="a joint-space model: the robot's published per-joint velocity, acceleration and jerk limits")
+    rollout.add_argument("--joint-limits", choices=("panda", "iiwa"), default=None,
+                         help="a joint-space model: the robot's per-joint velocity, acceleration and jerk limits (the "
+                              "Panda's published ones; the iiwa's published speeds, assumed acceleration and jerk)")
+    rollout.add_argument("--robot", choices=("panda", "iiwa"), default=None,
+                         help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; needs bidmp[sim])")
+    rollout.add_argument("--cartesian-goal", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
+                         help="a 7-joint model: roll out to the joints that put the robot's tool at X Y Z metres in its base "
+                              "frame, tool pointing down (IK from the demonstrated goal's joints)")
+    rollout.add_argument("--tool-length", type=float, default=0.0, metavar="M",
+                         help="with --robot: from the flange to the tool's mouth, metres (default 0)")
+    rollout.add_argument("--base", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
+                         help="with --robot and --bag: where the robot's base is, in the model's units (default the origin)")
     rollout.add_argument("--fastest", action="store_true",
                          help="with --max-speed/--max-acc: the shortest motion within them, even faster than demonstrated "
                               "(without it they are caps that only ever slow a motion)")

@@ -117,6 +117,36 @@ def declared_units(path) -> str:
     return ""
 
 
+def is_joint_recording(path) -> bool:
+    """Whether a CSV's header is a joint-space recording ``t, <joint names>`` (no position or
+    quaternion named): its values are joint angles, in radians unless it declares otherwise."""
+    from ._columns import select_joints, select_positions
+
+    path = check_path(path)
+    if not path.is_file():
+        return False
+    try:
+        with open(path, encoding="utf-8-sig") as handle:
+            for _ in range(16):
+                line = handle.readline(1 << 16).strip()
+                if line and not line.startswith("#"):
+                    break
+    except (OSError, UnicodeDecodeError):
+        return False
+    header = tuple(name.strip() for name in line.split(_csv_delimiter(line)))
+    if not line or not any(name and not _is_number(name) for name in header):
+        return False
+    return not select_positions(header, None, path).values and bool(select_joints(header).values)
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _csv_delimiter(sample: str) -> str:
     return ";" if sample.count(";") > sample.count(",") else ","
 

@@ -17,11 +17,12 @@ from ._csv import (
     _read_csv,
     _timed_fields,
     declared_units,
+    is_joint_recording,
 )
 from ._npy import _EMPTY_ZIP_MAGIC, _ZIP_MAGIC, _read_npy
 from .atomic import _destination, atomic_write
 
-__all__ = ['load_trajectory', 'read_trajectory', 'save_trajectory', 'declared_units']
+__all__ = ['load_trajectory', 'read_trajectory', 'save_trajectory', 'declared_units', 'is_joint_recording']
 
 def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     """Read a demonstration from ``.csv`` or ``.npy`` as positions on a uniform time grid.

@@ -3,9 +3,10 @@
 * ``backend`` — the simulator backend protocol (``load_robot``, ``ik``, ``fk``, ``execute``,
   ``contacts``, ``render``) and the types it exchanges; a new simulator or robot is a subpackage
   beside ``pybullet`` that implements it;
-* ``pybullet`` — the first backend: the Franka Panda in PyBullet (world, robot, IK, planning,
-  execution, rendering, one module each);
+* ``pybullet`` — the first backend: a 7-joint arm in PyBullet, the Franka Panda by default, the
+  KUKA iiwa or your URDF (world, robot, IK, planning, execution, rendering, one module each);
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
+* ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
 * ``report`` — the results, apart from any backend, and their files.
 
 Layer 3 (the application): imports the math, ``io`` and ``tasks``; never ``cli``. PyBullet is an
@@ -19,6 +20,8 @@ from .._lazy import exports
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
     "simulate": "run",
+    "inverse_kinematics": "kinematics",
+    "joint_names": "kinematics",
     "SimulatorBackend": "backend",
     "SimError": "backend",
     "JointLimits": "backend",
@@ -27,7 +30,12 @@ _EXPORTS = {
     "MotionPlan": "backend",
     "Execution": "backend",
     "PandaCell": "pybullet.cell",
+    "RobotCell": "pybullet.cell",
     "PANDA": "pybullet.robot",
+    "IIWA": "pybullet.robot",
+    "RobotModel": "pybullet.robot",
+    "ROBOT_MODELS": "pybullet.robot",
+    "robot_model": "pybullet.robot",
     "robot_placement": "pybullet.robot",
     "SimTarget": "report",
     "SimMethod": "report",

@@ -3,7 +3,7 @@ and the backend-independent types they exchange (plans, executions, disturbances
 
 A backend is a class with a ``load_robot(scene, units, base, yaw)`` constructor and the methods
 of :class:`SimulatorBackend`; ``bidmp.sim.simulate(..., backend=...)`` runs the task on it. The
-PyBullet Franka Panda (:class:`bidmp.sim.pybullet.PandaCell`) is the first; another simulator or
+PyBullet arm (:class:`bidmp.sim.pybullet.RobotCell`: the Panda, the iiwa or a URDF) is the first; another simulator or
 robot is one more subpackage beside it.
 
 Lengths inside a backend are metres, angles radians, times seconds; the scene is given in its own

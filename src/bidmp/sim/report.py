@@ -121,10 +121,21 @@ class SimReport:
     pictures: list = field(default_factory=list)
     workers: int = 1
     limits: object = None  # the robot's JointLimits (default the Panda's)
+    robot: str = "panda"  # the arm's model name
+    motions: dict = field(default_factory=dict)  # (method, label) -> {"times", "links"}: the viewer's arm
+
+    @property
+    def _short_name(self) -> str:
+        return "Panda" if self.robot == "panda" else self.robot
+
+    @property
+    def robot_name(self) -> str:
+        return {"panda": "Franka Panda", "iiwa": "KUKA LBR iiwa 7 R800"}.get(self.robot, self.robot)
 
     def to_dict(self) -> dict:
         return {"scenario": self.scenario.name, "units": self.scenario.units, "closed_loop": self.closed_loop,
-                "robot": {"base": np.round(self.base, 3).tolist(), "yaw_deg": self.yaw},
+                "robot": {**({} if self.robot == "panda" else {"model": self.robot}),
+                          "base": np.round(self.base, 3).tolist(), "yaw_deg": self.yaw},
                 "success_threshold": self.scenario.success_threshold,
                 "limits": {"velocity_rad_s": list((self.limits or PANDA).velocity),
                            "acceleration_rad_s2": list((self.limits or PANDA).acceleration),
@@ -150,10 +161,10 @@ class SimReport:
     def summary(self) -> str:
         scenario = self.scenario
         aligned = (f", tool axis within {scenario.alignment_threshold:g} deg of the nut's" if scenario.is_pose else "")
-        lines = [f"{scenario.name} on a simulated Franka Panda (PyBullet, 1 kHz position control), robot base "
+        lines = [f"{scenario.name} on a simulated {self.robot_name} (PyBullet, 1 kHz position control), robot base "
                  f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
                  f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
-                 f"no contact with another part, every 1 kHz joint command within the Panda's velocity, acceleration "
+                 f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "
                  f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "
                  f"differences)", "",
                  text_table(*self.rows())]

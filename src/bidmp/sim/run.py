@@ -14,8 +14,8 @@ from .._checks import check_bool, check_int, check_real
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold
-from .pybullet.cell import PandaCell
-from .pybullet.robot import _unit_of, robot_placement
+from .pybullet.cell import RobotCell
+from .pybullet.robot import PANDA_MODEL, _unit_of, robot_model, robot_placement
 from .pybullet.world import _pybullet_module
 from .report import SimMethod, SimReport, _measure
 
@@ -32,6 +32,7 @@ class _Job:
     exclude: list
     frames: int
     orientations: np.ndarray | None = None  # (n, 4) a pose skill's tool frames
+    view: bool = False  # record the arm's joint origins along the motion (the 3-D viewer's)
 
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
@@ -59,7 +60,8 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
         measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
         measured.commanded_penetration = _commanded_penetration(cell, run, job)
-        results.append((job.method, job.label, measured, run.frames, float(run.times[-1])))
+        motion = _arm_motion(cell, run) if job.view else None
+        results.append((job.method, job.label, measured, run.frames, float(run.times[-1]), motion))
     return results
 
 
@@ -78,11 +80,13 @@ def _world(setup: dict):
 
     scenario = setup["scenario"]
     key = (setup["backend"], json.dumps(setup["scene"], sort_keys=True), json.dumps(scenario["targets"], sort_keys=True),
-           scenario["units"], tuple(setup["base"]), setup["yaw"])
+           scenario["units"], tuple(setup["base"]), setup["yaw"], setup.get("robot", PANDA_MODEL))
     if _WORLD.get("key") != key:
         _close_world()
         scene = Scene.from_dict(setup["scene"], scenario["targets"])
-        _WORLD["cell"] = setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"])
+        robot = setup.get("robot", PANDA_MODEL)
+        arm = {} if robot is PANDA_MODEL else {"robot": robot}  # another backend need not know of arms
+        _WORLD["cell"] = setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"], **arm)
         _WORLD["key"] = key
     return _WORLD["cell"]
 
@@ -105,24 +109,24 @@ def _run_chunk(setup: dict, jobs: list) -> list:
 
 def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, targets=None, hold: Hold | None = None,
              coupling: float | None = None, progress=None, frames: dict | None = None, report=None,
-             workers: int | None = None, backend=None, avoid: bool = False, goal_update: GoalUpdate | None = None) -> SimReport:
-    """Execute ``methods`` on every target of ``scenario`` on the simulated Panda.
+             workers: int | None = None, backend=None, avoid: bool = False, goal_update: GoalUpdate | None = None,
+             views=()) -> SimReport:
+    """Execute ``methods`` on every target of ``scenario`` on the simulated arm (the Panda, or
+    the one the scenario's ``"robot"`` names).
 
     Parameters
     ----------
     scenario : Scenario or str
-        Needs a ``"scene"``; ``"robot": {"base": [x, y, z], "yaw": deg}`` places the arm.
+        Needs a ``"scene"``; ``"robot": {"base": [x, y, z], "yaw": deg}`` places the arm, and
+        ``"model": "iiwa"`` or ``"urdf"``/``"flange"``/``"limits"`` choose it.
     methods : sequence of str
         Evaluation methods (dmp, bidmp, ...): their rollouts are what is executed.
     closed_loop : bool
         Run the DMP/Bi-DMP stepper on the measured TCP with phase stopping, for dmp and bidmp.
     coupling : float, optional
-        Phase stopping's ``alpha_e`` in 1/unit² (default :data:`COUPLING` per m², 0.5 /mm²: a
-        0.3 mm lag slows the motion by 5 %, a 3 mm one 5.5 times).
-    targets : list of str, optional
-        A subset of the targets (default all).
-    hold : Hold, optional
-        A scripted disturbance in every motion.
+        Phase stopping's ``alpha_e`` in 1/unit² (default :data:`COUPLING` per m², 0.5 /mm²).
+    targets, hold : list of str, Hold, optional
+        A subset of the targets (default all); a scripted disturbance in every motion.
     progress : callable, optional
         Called with ``(method, label)`` as each motion starts (in-process) or finishes (workers).
     frames : dict, optional
@@ -134,14 +138,13 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
         1 runs in this process). Results do not depend on it.
     backend : class, optional
         A simulator backend (:class:`bidmp.sim.backend.SimulatorBackend`); default the PyBullet
-        Panda, :class:`bidmp.sim.pybullet.PandaCell`.
+        arm, :class:`bidmp.sim.pybullet.RobotCell`.
     avoid, goal_update : bool, GoalUpdate, optional
         Closed loop: steer round the other parts (SceneAvoidance); a perception update in every
         motion (the target and the goal move; judged at the moved target).
-
-    Returns
-    -------
-    SimReport
+    views : collection of (method, label), optional
+        Record the arm's joint origins along these motions every 40 ms (``SimReport.motions``,
+        scene units) for the 3-D viewer (:func:`bidmp.plotting.viewer.add_robot_motions`).
     """
     from ..tasks.evaluation import evaluate
 
@@ -151,15 +154,16 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     if report is None:
         report = evaluate(scenario, methods, geometry=False)
     base, yaw = robot_placement(scenario)
-    jobs = _jobs(scenario, report, methods, labels, frames or {})
+    arm = robot_model(scenario.robot, scenario.base_dir)
+    jobs = _jobs(scenario, report, methods, labels, frames or {}, _views(views))
     models = {name: report.fitted[name] for name in methods} if closed_loop else None
     setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
-                   backend=backend, **_loop_options(closed_loop, avoid, goal_update))
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
-    n_workers = max(1, min(n_workers, len(jobs)))
+                   backend=backend, robot=arm, **_loop_options(closed_loop, avoid, goal_update))
+    _check_reach(setup, scenario, labels)
+    n_workers = _n_workers(workers, len(jobs))
     start = time.perf_counter()
     outcomes = _execute_jobs(setup, jobs, n_workers, progress)
-    out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, getattr(backend, "limits", None))
+    out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
     return out
@@ -185,8 +189,46 @@ def _scenario_and_backend(scenario, backend):
         raise ValueError(f"scenario {scenario.name!r} has no \"scene\": the simulator needs the parts and the tool")
     if backend is None:
         _pybullet_module()  # fail early, with the install command, when the extra is missing
-        backend = PandaCell
+        backend = RobotCell
     return scenario, backend
+
+
+def _check_reach(setup: dict, scenario, labels) -> None:
+    """Every target, tool pointing down, within the arm's reach from its base; else one
+    :class:`SimError` that names all the targets out of reach."""
+    from .backend import SimError
+    from .pybullet.robot import IK_TOLERANCE
+
+    if setup["backend"] is not RobotCell:
+        return
+    cell = _world(setup)
+    missed = []
+    start = np.asarray(scenario.demonstration, dtype=float)[0, :3]
+    start_name = "the demonstration's start"
+    points = {start_name: start, **{label: scenario.targets[label] for label in labels}}
+    for label, point in points.items():
+        try:
+            _, error = cell.solve_ik(np.asarray(point, dtype=float)[:3] * cell.unit, cell.model.rest)
+        except SimError:
+            error = np.inf
+        if error > 10 * IK_TOLERANCE:
+            missed.append(label)
+    if missed:
+        named = [label if label == start_name else repr(label) for label in missed]
+        what = f"target {named[0]} is" if len(named) == 1 and missed[0] != start_name else \
+            f"{'targets ' if missed[0] != start_name else ''}{', '.join(named)} {'are' if len(named) > 1 else 'is'}"
+        raise SimError(f"{what} unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
+                       f"{scenario.units} (tool pointing down); move its base (scenario key \"robot\": {{\"base\": ...}})")
+
+
+VIEW_STEP = 0.04  # s between the arm's poses the viewer animates (25 per second)
+
+
+def _arm_motion(cell, run) -> dict:
+    """The arm's joint origins (scene units) every :data:`VIEW_STEP` of the recorded motion."""
+    every = max(1, int(round(VIEW_STEP / float(np.median(np.diff(run.times))))))
+    picked = np.unique(np.r_[np.arange(0, len(run.times), every), len(run.times) - 1])
+    return {"times": run.times[picked], "links": np.array([cell.joint_origins(q) for q in run.joints[picked]]) / cell.unit}
 
 
 def _commanded_penetration(cell, run, job) -> float | None:
@@ -200,12 +242,14 @@ def _commanded_penetration(cell, run, job) -> float | None:
     return max(0.0, -float(clearance.distance))
 
 
-def _jobs(scenario, report, methods, labels, frames: dict) -> list:
-    """One job per method and target: the rollout to execute, the parts it may touch, frames to render."""
+def _jobs(scenario, report, methods, labels, frames: dict, views=()) -> list:
+    """One job per method and target: the rollout to execute, the parts it may touch, frames to
+    render, whether the viewer records the arm's motion."""
     return [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
                  scenario.scene.target_parts(label, scenario.targets[label]),
                  int(frames.get((method, label), 0)),
-                 None if report.methods[method].orientations is None else report.methods[method].orientations[label])
+                 None if report.methods[method].orientations is None else report.methods[method].orientations[label],
+                 view=(method, label) in views)
             for method in methods for label in labels]
 
 
@@ -219,11 +263,32 @@ def _setup(scenario, labels, base, yaw, **run) -> dict:
     return {"scenario": task, "scene": scenario.scene.to_dict(), "base": base.tolist(), "yaw": yaw, **run}
 
 
-def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, limits) -> SimReport:
-    """The workers' outcomes ``(method, label, measured, images, seconds)`` as a report, in the
-    order of the methods and targets (whatever order the workers finished in)."""
-    by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds in outcomes}
-    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=limits)
+def _n_workers(workers, n_jobs: int) -> int:
+    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+    return max(1, min(n_workers, n_jobs))
+
+
+def _views(views) -> set:
+    """``views`` of :func:`simulate`: (method, label) pairs."""
+    if isinstance(views, (str, bytes)) or not hasattr(views, "__iter__"):
+        raise TypeError(f"views must be a collection of (method, label) pairs, got {type(views).__name__}")
+    pairs = set()
+    for pair in views:
+        if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, str) for v in pair)):
+            raise TypeError(f"views must hold (method, label) pairs of strings, got {pair!r:.60}")
+        pairs.add(pair)
+    return pairs
+
+
+def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, backend, arm) -> SimReport:
+    """The workers' outcomes ``(method, label, measured, images, seconds, motion)`` as a report,
+    in the order of the methods and targets (whatever order the workers finished in)."""
+    ours = backend is RobotCell
+    limits = arm.limits if ours else getattr(backend, "limits", None)
+    by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds, _ in outcomes}
+    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=limits,
+                    robot=arm.name if ours else getattr(backend, "__name__", "robot"))
+    out.motions = {(method, label): motion for method, label, _, _, _, motion in outcomes if motion is not None}
     for method in methods:
         out.methods[method] = SimMethod(method, {label: by_key[(method, label)][0] for label in labels},
                                         scenario.success_threshold)

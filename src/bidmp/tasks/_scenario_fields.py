@@ -170,3 +170,58 @@ def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> 
     elif np.any(np.abs(norms - 1.0) > 1e-6):
         _fail(source, key, f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})")
     return points
+
+
+_ROBOT_MODELS = ("panda", "iiwa")
+_LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "jerk")
+
+
+def _joint_values(value, source: str, key: str, positive: bool = False) -> list:
+    """Seven numbers, one per joint (rad, rad/s, ... or N m)."""
+    if not isinstance(value, list) or len(value) != 7:
+        _fail(source, key, f"expected 7 numbers, one per joint, got {_shown(value)}")
+    return [_number(v, source, f"{key}[{i}]", positive=positive) for i, v in enumerate(value)]
+
+
+def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict:
+    """The ``"robot"`` key, validated: where ``bidmp sim`` puts the arm (``base``, ``yaw``) and
+    which arm: ``"model"`` (panda, the default, or iiwa) or its own ``"urdf"`` (a file in the
+    scenario's folder, or a model shipped by pybullet_data) with ``"flange"`` (the link the tool
+    is mounted on) and ``"limits"`` (7 values each: lower, upper in rad; velocity, acceleration,
+    jerk in rad/s, rad/s², rad/s³; jerk optional), ``"rest"`` and ``"effort"`` optional."""
+    robot = data.get("robot", {})
+    allowed = {"base", "yaw", "model", "urdf", "flange", "limits", "rest", "effort"}
+    if not isinstance(robot, dict) or set(robot) - allowed:
+        unknown = sorted(set(robot) - allowed) if isinstance(robot, dict) else []
+        _fail(source, "robot", f"expected keys among {sorted(allowed)}" + (f"; unknown {unknown}" if unknown else ""))
+    robot = dict(robot)
+    if "base" in robot:
+        robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
+    if "yaw" in robot:
+        robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
+    if "model" in robot and robot["model"] not in _ROBOT_MODELS:
+        _fail(source, "robot.model", f"expected one of {list(_ROBOT_MODELS)}, got {_shown(robot['model'])}")
+    if "urdf" not in robot:
+        if set(robot) & {"flange", "limits", "rest", "effort"}:
+            _fail(source, "robot", '"flange", "limits", "rest" and "effort" describe your own "urdf"; name it')
+        return robot
+    if "model" in robot:
+        _fail(source, "robot", 'give "model" (a built-in arm) or "urdf" (your own), not both')
+    if not isinstance(robot["urdf"], str) or not robot["urdf"].endswith(".urdf"):
+        _fail(source, "robot.urdf", f"expected the path of a .urdf file, got {_shown(robot['urdf'])}")
+    local = Path(base_dir) / robot["urdf"]
+    if local.exists() or os.path.isabs(robot["urdf"]):  # else: a model shipped by pybullet_data
+        robot["urdf"] = str(_inside(local, base_dir, source, "robot.urdf", robot["urdf"], allow_outside))
+    if not isinstance(robot.get("flange"), str) or not robot["flange"]:
+        _fail(source, "robot.flange", "expected the name of the URDF link the tool is mounted on")
+    limits = robot.get("limits")
+    if not isinstance(limits, dict) or set(limits) - set(_LIMIT_KEYS) or not set(_LIMIT_KEYS[:4]) <= set(limits):
+        _fail(source, "robot.limits", f"expected {{{', '.join(_LIMIT_KEYS)}}} (jerk optional), 7 values each")
+    robot["limits"] = {name: _joint_values(values, source, f"robot.limits.{name}", positive=name not in ("lower", "upper"))
+                       for name, values in limits.items()}
+    if any(low >= high for low, high in zip(robot["limits"]["lower"], robot["limits"]["upper"])):
+        _fail(source, "robot.limits", "lower must be below upper for every joint")
+    for name in ("rest", "effort"):
+        if name in robot:
+            robot[name] = _joint_values(robot[name], source, f"robot.{name}", positive=name == "effort")
+    return robot

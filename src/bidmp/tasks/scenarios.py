@@ -73,6 +73,7 @@ from ._scenario_fields import (
     _number,
     _point,
     _pose_points,
+    _robot,
     _shown,
 )
 
@@ -231,7 +232,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
     scene = _scene(data, source, targets, n_dims)
-    robot = _robot(data, source)
+    robot = _robot(data, source, base_dir, allow_outside_files)
     _check_runs(source, demonstration, targets, dmp)
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
@@ -361,20 +362,6 @@ def _scene(data, source: str, targets: dict, n_dims: int):
         raise ScenarioError(f"scenario {source}: {exc}") from None
     except ImportError as exc:
         raise type(exc)(f"scenario {source}: {exc}") from None
-
-
-def _robot(data, source: str) -> dict:
-    """Where ``bidmp sim`` puts the arm (``base``, ``yaw``), validated."""
-    robot = data.get("robot", {})
-    if not isinstance(robot, dict) or set(robot) - {"base", "yaw"}:
-        _fail(source, "robot", 'expected {"base": [x, y, z], "yaw": degrees} (where bidmp sim puts the arm)')
-    robot = dict(robot)
-    if "base" in robot:
-        robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
-    if "yaw" in robot:
-        robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
-
-    return robot
 
 
 def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_params: dict) -> None:

@@ -13,15 +13,15 @@ from . import execute as _execute
 from . import ik as _ik
 from . import plan as _plan
 from . import render as _render
-from .robot import _REST, PANDA, _unit_of
-from .world import SOLVER_ITERATIONS, _add_solid, _panda_urdf, _pybullet_module
+from .robot import PANDA_MODEL, RobotModel, _unit_of
+from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
 
-__all__ = ["PandaCell"]
+__all__ = ["PandaCell", "RobotCell"]
 
 
-class PandaCell:
-    """A headless PyBullet world with a scene's parts and a Panda carrying the scene's tool: the
-    PyBullet implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
+class RobotCell:
+    """A headless PyBullet world with a scene's parts and an arm (the Panda unless ``robot``
+    names another) carrying the scene's tool: the PyBullet implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
     state; planning, execution and pictures are the functions of this subpackage's modules.
 
     Parameters
@@ -33,9 +33,16 @@ class PandaCell:
         Robot base position in the scene's unit.
     yaw : float
         Robot base rotation about z in degrees (90: the robot faces +y).
+    robot : RobotModel, optional
+        The arm (:data:`bidmp.sim.pybullet.robot.ROBOT_MODELS`, or a scenario's own URDF).
     """
 
-    def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0):
+    def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
+                 robot: RobotModel = PANDA_MODEL):
+        if not isinstance(robot, RobotModel):
+            raise TypeError(f"robot must be a bidmp.sim.pybullet.robot.RobotModel, got {type(robot).__name__}")
+        self.model = robot
+        self.limits = robot.limits
         self.p = p = _pybullet_module()
         self.scene = scene
         self.unit = _unit_of(units)
@@ -55,8 +62,8 @@ class PandaCell:
             # that planning never resets the simulated robot's state.
             self.ik_client = p.connect(p.DIRECT)
             with tempfile.TemporaryDirectory() as folder:
-                path = Path(folder) / "panda_tool.urdf"
-                path.write_text(_panda_urdf(scene.tool.radius * self.unit, scene.tool.length * self.unit))
+                path = Path(folder) / "robot_tool.urdf"
+                path.write_text(_tool_urdf(robot, scene.tool.radius * self.unit, scene.tool.length * self.unit))
                 base_m = np.asarray(base, dtype=float) * self.unit
                 orientation = p.getQuaternionFromEuler([0, 0, math.radians(yaw)])
                 self.robot = p.loadURDF(str(path), base_m.tolist(), orientation, useFixedBase=True,
@@ -66,20 +73,26 @@ class PandaCell:
             names = [p.getJointInfo(self.robot, j, physicsClientId=self.client)[12].decode()
                      for j in range(p.getNumJoints(self.robot, physicsClientId=self.client))]
             self.tcp = names.index("tcp")
-            self.arm = list(range(7))
+            movable = [j for j in range(len(names)) if p.getJointInfo(self.robot, j, physicsClientId=self.client)[2]
+                       != p.JOINT_FIXED]
+            if len(movable) != 7:
+                raise ValueError(f"robot {robot.name!r}: the simulator drives 7-joint arms; its URDF up to the flange "
+                                 f"has {len(movable)} movable joints")
+            self.arm = movable
             self.base = np.asarray(base, dtype=float)
             self.yaw = float(yaw)
-            self._set_joints(_REST)
+            self._set_joints(robot.rest)
         except BaseException:
             self.close()
             raise
 
-    limits = PANDA  # the robot's joint limits (the backend protocol's)
+    limits = PANDA_MODEL.limits  # the robot's joint limits (the backend protocol's; set per instance)
 
     @classmethod
-    def load_robot(cls, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0) -> "PandaCell":
-        """The backend protocol's constructor (the same as ``PandaCell(...)``)."""
-        return cls(scene, units, base, yaw)
+    def load_robot(cls, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
+                   robot: RobotModel = PANDA_MODEL) -> "RobotCell":
+        """The backend protocol's constructor (the same as ``RobotCell(...)``)."""
+        return cls(scene, units, base, yaw, robot)
 
     def close(self) -> None:
         for name in ("client", "ik_client"):
@@ -97,8 +110,8 @@ class PandaCell:
 
     def _set_joints(self, q, velocities=None, kinematic: bool = False) -> None:
         robot, client = (self.ik_robot, self.ik_client) if kinematic else (self.robot, self.client)
-        for joint in range(7):
-            self.p.resetJointState(robot, joint, float(q[joint]), 0.0 if velocities is None else float(velocities[joint]),
+        for index, joint in enumerate(self.arm):
+            self.p.resetJointState(robot, joint, float(q[index]), 0.0 if velocities is None else float(velocities[index]),
                                    physicsClientId=client)
 
     def tcp_position(self) -> np.ndarray:
@@ -111,6 +124,15 @@ class PandaCell:
         self._set_joints(q, kinematic=True)
         return np.array(self.p.getLinkState(self.ik_robot, self.tcp, computeForwardKinematics=1,
                                             physicsClientId=self.ik_client)[4])
+
+    def joint_origins(self, q) -> np.ndarray:
+        """The arm's joint origins from its base to the tool's mouth (m), (9, 3), at joints ``q``
+        (on the planning copy): what the 3-D viewer draws."""
+        self._set_joints(q, kinematic=True)
+        states = self.p.getLinkStates(self.ik_robot, [*self.arm, self.tcp], computeForwardKinematics=1,
+                                      physicsClientId=self.ik_client)
+        # The base's URDF frame, where it was placed (PyBullet's base position is its centre of mass).
+        return np.array([self.base * self.unit] + [state[4] for state in states])
 
     def fk(self, q) -> np.ndarray:
         """The backend protocol's forward kinematics: :meth:`forward`."""
@@ -151,3 +173,6 @@ class PandaCell:
 
     def scene_centre(self) -> np.ndarray:
         return _render._scene_centre(self)
+
+
+PandaCell = RobotCell  # the name of bidmp <= 0.9, when the Panda was the only arm

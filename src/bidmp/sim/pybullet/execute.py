@@ -20,7 +20,7 @@ from ..backend import (
     SimError,
 )
 from ..limits import _RateLimiter
-from .robot import _EFFORT, _GAINS, _REST, IK_TOLERANCE, PANDA
+from .robot import _GAINS, IK_TOLERANCE
 
 __all__ = []
 
@@ -49,7 +49,7 @@ def _contacts_into(cell, found: dict) -> None:
 def _drive(cell, q, qd) -> None:
     """Hand joint targets (rad) and velocities (rad/s) to the position control."""
     cell.p.setJointMotorControlArray(cell.robot, cell.arm, cell.p.POSITION_CONTROL, targetPositions=q,
-                                     targetVelocities=qd, forces=_EFFORT, positionGains=_GAINS,
+                                     targetVelocities=qd, forces=list(cell.model.effort), positionGains=_GAINS,
                                      velocityGains=_GAINS, physicsClientId=cell.client)
 
 
@@ -68,7 +68,7 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
     # recorder visited only on the steps it records.
     robot, client, arm, mode, step_simulation = cell.robot, cell.client, cell.arm, p.POSITION_CONTROL, p.stepSimulation
     motors, contact_points, contacts = p.setJointMotorControlArray, p.getContactPoints, record.contacts
-    bodies = cell._bodies
+    bodies, effort = cell._bodies, list(cell.model.effort)
     visit = np.zeros(n_steps, dtype=bool)
     visit[::RECORD_EVERY] = True
     visit[-1] = True
@@ -79,10 +79,10 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
             q, qd = position_list[step], velocity_list[step]
             if hold is not None and hold.start <= t < hold.start + hold.duration:
                 if held is None:
-                    held = p.getJointState(robot, hold.joint, physicsClientId=client)[0]
+                    held = p.getJointState(robot, arm[hold.joint], physicsClientId=client)[0]
                 q, qd = list(q), list(qd)
                 q[hold.joint], qd[hold.joint] = held, 0.0
-            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=_EFFORT, positionGains=_GAINS,
+            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=effort, positionGains=_GAINS,
                    velocityGains=_GAINS, physicsClientId=client)
             step_simulation(physicsClientId=client)
             for contact in contact_points(bodyA=robot, physicsClientId=client):
@@ -111,7 +111,7 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
     wall time) plus the settling. ``goal_update``: see :func:`_perceive`.
     """
     p = cell.p
-    q, error = cell.solve_ik(np.asarray(stepper.y) * cell.unit, _REST)
+    q, error = cell.solve_ik(np.asarray(stepper.y) * cell.unit, cell.model.rest)
     if error > IK_TOLERANCE:
         raise SimError(f"the start {np.round(stepper.y, 2).tolist()} is unreachable")
     cell._set_joints(q)
@@ -122,7 +122,7 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
     _ignore(cell, exclude, False)
     target, previous, held, settle_from, moved = q, q, None, None, False
     times, targets, clock, sent = [], [], [], []
-    limited = _RateLimiter(q, PANDA, LIMIT_MARGIN)
+    limited = _RateLimiter(q, cell.limits, LIMIT_MARGIN)
     step = 0
     try:
         for step in range(n_steps):
@@ -187,7 +187,7 @@ def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: floa
     return that angle (None before the hold)."""
     if hold is not None and hold.start <= t < hold.start + hold.duration:
         if held is None:
-            held = cell.p.getJointState(cell.robot, hold.joint, physicsClientId=cell.client)[0]
+            held = cell.p.getJointState(cell.robot, cell.arm[hold.joint], physicsClientId=cell.client)[0]
         q[hold.joint], qd[hold.joint] = held, 0.0
     return held
 

@@ -1,4 +1,4 @@
-"""Inverse kinematics of the Panda on the planning copy of the arm: short bursts of PyBullet's
+"""Inverse kinematics of the arm on the planning copy of the arm: short bursts of PyBullet's
 damped least squares from the previous solution, checked by forward kinematics."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..._checks import as_point
-from .robot import _DOWN, _REST, IK_ACCURACY, PANDA, _joint_seed, _reachable
+from .robot import _DOWN, IK_ACCURACY, _joint_seed, _reachable
 
 __all__ = []
 
@@ -20,7 +20,7 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
     and the position error left (m)."""
     p = cell.p
     point_m = _reachable(as_point(point_m, 3, "point_m"), cell.base * cell.unit, "point_m")
-    q = _joint_seed(seed)
+    q = _joint_seed(seed, cell.limits)
     if orientation is not None:
         from ...primitives.so3 import as_quaternions
 
@@ -34,7 +34,7 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
         from scipy.spatial.transform import Rotation
 
         axis = Rotation.from_quat(target_orientation).apply([0.0, 0.0, 1.0])
-    limits = PANDA
+    limits = cell.limits
     ranges = [u - l for l, u in zip(limits.lower, limits.upper)]
     error = math.inf
     # Short bursts from the previous solution, checked by forward kinematics: a few dozen
@@ -53,7 +53,7 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
         if axis is not None:
             # Joint 7 turns the flange about the tool's axis, which moves neither the tool's
             # mouth nor its axis: park it mid-range instead of letting it drift to a limit.
-            q[6] = _REST[6]
+            q[6] = cell.model.rest[6]
         error = float(np.linalg.norm(cell.forward(q) - point_m))
         if error <= IK_ACCURACY:
             break

@@ -1,5 +1,5 @@
 """Planning: a Cartesian path subdivided into IK samples, solved joint by joint, splined (quintic,
-at rest at both ends) and timed to the Panda's velocity, acceleration and jerk limits
+at rest at both ends) and timed to the arm's velocity, acceleration and jerk limits
 (:data:`bidmp.sim.backend.LIMIT_MARGIN` of them)."""
 
 from __future__ import annotations
@@ -11,15 +11,7 @@ from ..._checks import as_trajectory
 from ..._trajectory import interp_columns
 from ...primitives.timing import Trajectory, time_scale
 from ..backend import LIMIT_MARGIN, MotionPlan, SimError
-from .robot import (
-    _REST,
-    IK_TOLERANCE,
-    MAX_SAMPLE_SPACING,
-    PANDA,
-    _joint_seed,
-    _reachable,
-    _unit_name,
-)
+from .robot import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
 
 __all__ = []
 
@@ -48,20 +40,21 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
             raise ValueError(f"orientations must have shape ({path.shape[0]}, 4), got {q.shape}")
         keep = np.concatenate([[True], np.diff(given) > 1e-12])
         turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
-    q = np.array(_REST, dtype=float) if seed is None else _joint_seed(seed)
+    limits = cell.limits
+    q = np.array(cell.model.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
     joints = np.empty((points.shape[0], 7))
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
             raise SimError(f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
-                           f"unreachable for the Panda at base {np.round(cell.base, 1).tolist()} "
+                           f"unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
                            f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
                            f"robot (scenario key \"robot\": {{\"base\": ...}})")
-        below, above = q < np.array(PANDA.lower) - 1e-9, q > np.array(PANDA.upper) + 1e-9
+        below, above = q < np.array(limits.lower) - 1e-9, q > np.array(limits.upper) + 1e-9
         if below.any() or above.any():
             joint = int(np.flatnonzero(below | above)[0])
             raise SimError(f"target {label!r}: joint {joint + 1} would leave its limits "
-                           f"[{PANDA.lower[joint]}, {PANDA.upper[joint]}] rad ({q[joint]:.3f})")
+                           f"[{limits.lower[joint]}, {limits.upper[joint]}] rad ({q[joint]:.3f})")
         joints[index] = q
     # A quintic spline at rest at both ends, acceleration included: the arm's interface asks for
     # zero velocity and acceleration where a motion starts and stops (a clamped cubic ends with
@@ -70,12 +63,12 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
     grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
     unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))
-    limits = {"max_velocity": LIMIT_MARGIN * np.asarray(PANDA.velocity),
-              "max_acceleration": LIMIT_MARGIN * np.asarray(PANDA.acceleration),
-              "max_jerk": LIMIT_MARGIN * np.asarray(PANDA.jerk)}
-    duration = float(time_scale(unit_time, norm="axis", **limits).t[-1])
-    peaks = [float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
-             for order, limit in ((1, PANDA.velocity), (2, PANDA.acceleration), (3, PANDA.jerk))]
+    caps = {"max_velocity": LIMIT_MARGIN * np.asarray(limits.velocity),
+            "max_acceleration": LIMIT_MARGIN * np.asarray(limits.acceleration),
+            "max_jerk": None if limits.jerk is None else LIMIT_MARGIN * np.asarray(limits.jerk)}
+    duration = float(time_scale(unit_time, norm="axis", **caps).t[-1])
+    peaks = [0.0 if limit is None else float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
+             for order, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk))]
     return MotionPlan(label, points, u, joints, duration, spline, peaks[0], peaks[1], turns, peak_jerk=peaks[2])
 
 

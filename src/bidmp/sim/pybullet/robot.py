@@ -1,14 +1,18 @@
-"""The Franka Panda as the PyBullet backend models it: joint limits, motor efforts and gains, the
-rest pose, where it stands in a scenario, and the checks on points and joint seeds."""
+"""The robots the PyBullet backend models: a :class:`RobotModel` (URDF, tool flange, joint limits,
+motor efforts, rest pose) for the Franka Panda (the default) and the KUKA LBR iiwa 7 R800 of
+``pybullet_data``, or one a scenario names by its own URDF; where a robot stands in a scenario; the
+checks on points and joint seeds."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from dataclasses import dataclass
+
 from ..._checks import as_point
 from ..backend import JointLimits, SimError
 
-__all__ = ["PANDA", "robot_placement"]
+__all__ = ["PANDA", "IIWA", "RobotModel", "ROBOT_MODELS", "robot_model", "robot_placement"]
 
 MAX_SAMPLE_SPACING = 5e-3  # m: the Cartesian path is subdivided so that IK points are at most this far apart
 IK_TOLERANCE = 5e-5  # m: a sample whose IK leaves more than this (0.05 mm) is unreachable
@@ -29,6 +33,86 @@ PANDA = JointLimits(
 _EFFORT = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]  # N m
 _GAINS = [1.0] * 7  # PyBullet's position and velocity gains: the stiffest its motors allow
 
+# KUKA LBR iiwa 7 R800: axis ranges and speeds from KUKA's datasheet (±170/120/170/120/170/120/175°;
+# 98, 98, 100, 130, 140, 180, 180 °/s). KUKA publishes no joint acceleration or jerk limits; these
+# are assumed, 5x and 500x the speed limit per second (the Panda's own ratios are 3.4-7.7x and
+# 1700-3800x), and named as assumptions wherever they are reported.
+_DEG = np.pi / 180.0
+_IIWA_SPEED = tuple(round(v * _DEG, 4) for v in (98.0, 98.0, 100.0, 130.0, 140.0, 180.0, 180.0))
+IIWA = JointLimits(
+    lower=tuple(round(-v * _DEG, 4) for v in (170.0, 120.0, 170.0, 120.0, 170.0, 120.0, 175.0)),
+    upper=tuple(round(v * _DEG, 4) for v in (170.0, 120.0, 170.0, 120.0, 170.0, 120.0, 175.0)),
+    velocity=_IIWA_SPEED,
+    acceleration=tuple(round(5.0 * v, 3) for v in _IIWA_SPEED),
+    jerk=tuple(round(500.0 * v, 1) for v in _IIWA_SPEED),
+)
+
+
+@dataclass(frozen=True)
+class RobotModel:
+    """A 7-joint arm for the PyBullet backend.
+
+    Parameters
+    ----------
+    name : str
+    urdf : str
+        The URDF: a path, or one relative to ``pybullet_data``'s folder.
+    flange : str
+        The link the tool is mounted on (the scenario's tool hangs from it along its z axis).
+    limits : JointLimits
+        Position (rad), velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits.
+    rest : tuple of 7 float
+        The joints (rad) the arm starts from and IK is seeded with: the tool pointing down.
+    effort : tuple of 7 float
+        Motor torques (N m) of PyBullet's position control.
+    cut_at : str, optional
+        A joint of the URDF from which on its text is dropped (the Panda's own hand).
+    standoff : float
+        Where the robot stands by default: this far (m) short of the work's nearest point.
+    """
+
+    name: str
+    urdf: str
+    flange: str
+    limits: JointLimits
+    rest: tuple
+    effort: tuple
+    cut_at: str | None = None
+    standoff: float = 0.33
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "urdf": self.urdf, "flange": self.flange}
+
+
+PANDA_MODEL = RobotModel("panda", "franka_panda/panda.urdf", "panda_link8", PANDA, _REST, tuple(_EFFORT),
+                         cut_at="panda_hand_joint")
+# The iiwa stands further back than the Panda: its shoulder is 0.34 m up (the Panda's 0.33 m) and
+# it does not reach points close in front of its base with the tool pointing down (the nut task's
+# start, 0.33 m away: 47 mm short; from 0.43 m every point of the task within 5 µm).
+IIWA_MODEL = RobotModel("iiwa", "kuka_iiwa/model.urdf", "lbr_iiwa_link_7", IIWA,
+                        (0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0), (176.0, 176.0, 110.0, 110.0, 110.0, 40.0, 40.0),
+                        standoff=0.43)
+ROBOT_MODELS = {"panda": PANDA_MODEL, "iiwa": IIWA_MODEL}
+
+
+def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
+    """The arm a scenario's ``"robot"`` key names: ``"model": "panda"`` (default) or ``"iiwa"``, or
+    its own ``"urdf"`` (inside the scenario's folder ``base_dir``, or shipped by ``pybullet_data``)
+    with ``"flange"`` and ``"limits"`` ({"lower", "upper", "velocity", "acceleration", "jerk"},
+    7 values each, rad) and optionally ``"rest"`` (7 joints, rad) and ``"effort"`` (7, N m)."""
+    from pathlib import Path
+
+    spec = spec or {}
+    if "urdf" not in spec:
+        return ROBOT_MODELS[spec.get("model", "panda")]
+    path = Path(spec["urdf"])
+    if base_dir is not None and not path.is_absolute() and (Path(base_dir) / path).exists():
+        path = Path(base_dir) / path
+    limits = JointLimits(**spec["limits"])
+    middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
+    return RobotModel(spec.get("name", path.stem), str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
+                      tuple(spec.get("effort", (100.0,) * 7)))
+
 
 def _unit_of(units: str) -> float:
     if units not in _UNITS:
@@ -42,8 +126,8 @@ def _unit_name(unit: float) -> str:
 
 def robot_placement(scenario) -> tuple[np.ndarray, float]:
     """The robot's base (scenario units) and yaw (degrees): the scenario's ``"robot"`` key, or in
-    front of the work: 330 mm short of the nearest point in y, centred in x, at the lowest
-    target's height, facing +y."""
+    front of the work: the arm's standoff (the Panda 330 mm, the iiwa 430 mm) short of the nearest
+    point in y, centred in x, at the lowest target's height, facing +y."""
     if not all(hasattr(scenario, name) for name in ("robot", "target_array", "demonstration", "units")):
         raise TypeError(f"scenario must be a bidmp scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
     robot = scenario.robot or {}
@@ -51,30 +135,31 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
     points = np.vstack([scenario.target_array, scenario.demonstration])
     unit = _unit_of(scenario.units)
-    base = np.array([0.5 * (points[:, 0].min() + points[:, 0].max()), points[:, 1].min() - 0.33 / unit,
+    standoff = robot_model(robot, getattr(scenario, "base_dir", None)).standoff if "urdf" not in robot else 0.33
+    base = np.array([0.5 * (points[:, 0].min() + points[:, 0].max()), points[:, 1].min() - standoff / unit,
                      scenario.target_array[:, 2].min()])
     return base, float(robot.get("yaw", 90.0))
 
 
-_REACH_M = 2.0  # m from the base: far beyond the Panda's 0.855 m, so a path past it is a mistake
+_REACH_M = 2.0  # m from the base: far beyond a cobot's ~0.8-0.9 m, so a path past it is a mistake
 
 
 def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray:
-    """Refuse a point (m) further than any Panda reaches from its base (a unit mistake, or a
+    """Refuse a point (m) further than any cobot reaches from its base (a unit mistake, or a
     path that IK would chase for ever)."""
     distance = float(np.linalg.norm(point_m - base_m))
     if not distance <= _REACH_M:
-        raise SimError(f"{name}: a point {distance:.3g} m from the robot's base, beyond the Panda's reach "
-                       f"(0.855 m); check the units and the base")
+        raise SimError(f"{name}: a point {distance:.3g} m from the robot's base, beyond the arm's reach "
+                       f"(the Panda's is 0.855 m); check the units and the base")
     return point_m
 
 
-def _joint_seed(seed) -> np.ndarray:
-    """Seven finite joint angles (rad) within the Panda's limits, to start IK from."""
+def _joint_seed(seed, limits: JointLimits = PANDA) -> np.ndarray:
+    """Seven finite joint angles (rad) within the robot's limits, to start IK from."""
     q = as_point(seed, 7, "seed")
-    outside = (q < np.array(PANDA.lower) - 1e-6) | (q > np.array(PANDA.upper) + 1e-6)
+    outside = (q < np.array(limits.lower) - 1e-6) | (q > np.array(limits.upper) + 1e-6)
     if outside.any():
         joint = int(np.argmax(outside))
         raise ValueError(f"seed: joint {joint + 1} at {q[joint]:.4g} rad is outside its limits "
-                         f"[{PANDA.lower[joint]}, {PANDA.upper[joint]}]")
+                         f"[{limits.lower[joint]}, {limits.upper[joint]}]")
     return q

@@ -23,8 +23,9 @@ def _pybullet_module():
     module = sys.modules.get("pybullet")
     if module is not None:
         return module
-    sys.stdout.flush()
-    sys.stderr.flush()
+    for stream in (sys.stdout, sys.stderr):
+        if stream is not None:  # None: a caller redirected it away (contextlib.redirect_stdout(None))
+            stream.flush()
     saved = [os.dup(1), os.dup(2)]
     try:
         with open(os.devnull, "w") as null:
@@ -40,17 +41,32 @@ def _pybullet_module():
             os.close(fd)
 
 
-def _panda_urdf(tool_radius: float, tool_length: float) -> str:
-    """The Panda of pybullet_data with its hand replaced by a cylindrical tool (metres): link
-    ``tool`` on the flange, link ``tcp`` at the tool's mouth."""
+def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
+    """The URDF of ``model`` (a :class:`~bidmp.sim.pybullet.robot.RobotModel`) carrying a
+    cylindrical tool (metres) on its flange: link ``tool`` on the flange, link ``tcp`` at the
+    tool's mouth. The Panda's own hand is cut away (``model.cut_at``). Mesh paths are made
+    absolute, since the text is loaded from another folder."""
+    import re
+
     import pybullet_data
 
-    folder = Path(pybullet_data.getDataPath()) / "franka_panda"
-    text = (folder / "panda.urdf").read_text()
-    cut = text.index('<joint name="panda_hand_joint"')
+    path = Path(model.urdf)
+    if not path.is_absolute():
+        path = Path(pybullet_data.getDataPath()) / path
+    if not path.is_file():
+        raise ValueError(f"robot URDF {model.urdf!r}: no such file (a path in the scenario's folder, or a model "
+                         f"shipped by pybullet_data such as kuka_iiwa/model.urdf)")
+    text = path.read_text()
+    folder = path.parent
+    if model.cut_at is not None:
+        text = text[: text.index(f'<joint name="{model.cut_at}"')]
+    else:
+        text = text[: text.rindex("</robot>")]
+    if f'<link name="{model.flange}"' not in text:
+        raise ValueError(f"robot URDF {model.urdf!r} has no link {model.flange!r} (the flange)")
     inertia = 'ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"'
     tool = (
-        f'  <joint name="tool_joint" type="fixed"><parent link="panda_link8"/><child link="tool"/>'
+        f'  <joint name="tool_joint" type="fixed"><parent link="{model.flange}"/><child link="tool"/>'
         f'<origin rpy="0 0 0" xyz="0 0 {tool_length / 2}"/></joint>\n'
         f'  <link name="tool"><inertial><origin xyz="0 0 0"/><mass value="0.3"/><inertia {inertia}/></inertial>'
         f'<visual><geometry><cylinder radius="{tool_radius}" length="{tool_length}"/></geometry>'
@@ -61,7 +77,14 @@ def _panda_urdf(tool_radius: float, tool_length: float) -> str:
         f'  <link name="tcp"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
         f'</inertial></link>\n</robot>\n'
     )
-    return (text[:cut] + tool).replace("package://meshes/", f"{folder / 'meshes'}/")
+
+    def absolute(match):
+        name = match.group(1)
+        if name.startswith("package://"):
+            name = name[len("package://"):]
+        return f'filename="{name if Path(name).is_absolute() else folder / name}"'
+
+    return re.sub(r'filename="([^"]+)"', absolute, text + tool)
 
 
 # Bullet grows a convex hull by its collision margin (PyBullet's default for a mesh: 1 mm), so a

@@ -1,0 +1,100 @@
+"""An arm's inverse kinematics without a task: joint goals for a joint-space DMP, and a Cartesian
+motion turned into joint positions sample by sample (what a ``JointTrajectory`` carries).
+
+Points are in the robot's base frame (the base at the origin, yaw 0: x forward), in ``units``;
+the tool points down (z of the flange towards -z) unless orientations are given. Uses the
+PyBullet backend's arm models (``"panda"``, ``"iiwa"`` or a :class:`RobotModel`).
+"""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from .._checks import _as_float_array, as_points, check_choice, check_real
+from .backend import SimError
+
+__all__ = ["inverse_kinematics", "joint_names"]
+
+
+def _arm(robot, units: str, tool_length: float):
+    from ..scene.parts import Tool
+    from .pybullet.cell import RobotCell
+    from .pybullet.robot import ROBOT_MODELS, RobotModel
+
+    if isinstance(robot, str):
+        if robot not in ROBOT_MODELS:
+            raise ValueError(f"robot must be one of {', '.join(ROBOT_MODELS)} (or a RobotModel), got {robot[:20]!r}")
+        robot = ROBOT_MODELS[robot]
+    if not isinstance(robot, RobotModel):
+        raise TypeError(f"robot must be a name or a RobotModel, got {type(robot).__name__}")
+    length = check_real(tool_length, "tool_length", nonnegative=True)
+    # No parts: the cell needs only the tool (its mouth is the point IK places).
+    scene = SimpleNamespace(solids=(), tool=Tool(radius=0.01 if units == "m" else 10.0, length=max(length, 1e-6)))
+    return RobotCell(scene, units, (0.0, 0.0, 0.0), 0.0, robot)
+
+
+def _seed(seed) -> np.ndarray:
+    from .._checks import as_point
+
+    return as_point(seed, 7, "seed")
+
+
+def joint_names(robot="panda") -> list[str]:
+    """The names of the arm's 7 driven joints, base to flange, as in its URDF."""
+    with _arm(robot, "m", 0.0) as cell:
+        return [cell.p.getJointInfo(cell.robot, j, physicsClientId=cell.client)[1].decode() for j in cell.arm]
+
+
+def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: float = 0.0, seed=None,
+                       orientations=None) -> np.ndarray:
+    """Joint positions (n, 7) rad that put the tool's mouth on each of ``points`` (n, 3), each
+    solved from the previous one (the first from ``seed``, default the arm's rest pose).
+
+    Parameters
+    ----------
+    points : array (n, 3) or (3,)
+        In the robot's base frame, in ``units`` ("m", "cm" or "mm").
+    robot : {"panda", "iiwa"} or RobotModel
+    tool_length : float
+        From the flange to the tool's mouth, in ``units`` (0: the flange itself).
+    seed : array (7,), optional
+    orientations : array (n, 4), optional
+        The tool frame's quaternions (x, y, z, w); default pointing down.
+
+    Raises
+    ------
+    SimError
+        A point the arm does not reach (within 0.05 mm) or that needs a joint beyond its limits,
+        named by its index.
+    """
+    from .pybullet.robot import IK_TOLERANCE
+
+    units = check_choice(units, "units", ("m", "cm", "mm"))
+    array = _as_float_array(points, "points")
+    single = array.ndim == 1
+    path = as_points(array[None] if single else array, 3, "points")
+    if orientations is not None:
+        from ..primitives.so3 import as_quaternions
+
+        orientations = as_quaternions(orientations, "orientations")
+        if len(orientations) != len(path):
+            raise ValueError(f"orientations must be one quaternion per point ({len(path)}), got {len(orientations)}")
+    with _arm(robot, units, tool_length) as cell:
+        lower, upper = np.array(cell.limits.lower), np.array(cell.limits.upper)
+        # A seed is only where the search starts: one outside this arm's limits (another arm's
+        # recording) starts from the nearest joints within them.
+        q = np.array(cell.model.rest, dtype=float) if seed is None else np.clip(_seed(seed), lower, upper)
+        joints = np.empty((len(path), 7))
+        for index, point in enumerate(path):
+            turn = None if orientations is None else orientations[index]
+            start = q
+            q, error = cell.solve_ik(point * cell.unit, start, turn)
+            if error > IK_TOLERANCE and index == 0 and seed is not None:  # a seed far off: the rest pose
+                q, error = cell.solve_ik(point * cell.unit, np.array(cell.model.rest, dtype=float), turn)
+            if error > IK_TOLERANCE or np.any(q < lower - 1e-9) or np.any(q > upper + 1e-9):
+                raise SimError(f"point {index} {np.round(point, 4).tolist()} {units} is out of the {cell.model.name}'s "
+                               f"reach from its base (inverse kinematics leaves {error / cell.unit:.3g} {units})")
+            joints[index] = q
+    return joints[0] if single else joints
