@@ -11,7 +11,7 @@ from .common import EXIT_OK, Parser, allow_outside_files
 __all__ = ["add_commands"]
 
 
-def _run_scenario(scenario, out, methods=None):
+def _run_scenario(scenario, out, methods=None, view=False):
     """Evaluate a scenario with a progress bar, print its report, write results and figures."""
     from tqdm import tqdm
 
@@ -27,13 +27,18 @@ def _run_scenario(scenario, out, methods=None):
     print()
     print(report.summary())
     written = write_report(report, out)
+    if view:
+        from .view import write_view_files
+
+        written += write_view_files(out, report=report)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     return report
 
 
 def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=None, pictures=True, targets=None,
-             report=None, avoid=False, goal_update=None):
-    """Execute a scenario on the simulated Panda with a progress bar; print and write the results."""
+             report=None, avoid=False, goal_update=None, view=False):
+    """Execute a scenario on the simulated arm with a progress bar; print and write the results
+    (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it)."""
     from tqdm import tqdm
 
     from ..sim.report import write_sim_report
@@ -41,21 +46,28 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
 
     methods = list(methods)
     labels = scenario.labels if targets is None else targets
-    frames = {}
-    if pictures:
-        origin = scenario.targets[scenario.demonstrated]
-        far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
-        frames = {(method, far): 30 for method in methods}
+    origin = scenario.targets[scenario.demonstrated]
+    far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
+    frames = {(method, far): 30 for method in methods} if pictures else {}
+    if view and report is None:
+        from ..tasks.evaluation import evaluate
+
+        report = evaluate(scenario, methods, geometry=False)
     with tqdm(total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None) as bar:
         def progress(method, label):
             bar.set_postfix_str(f"{method} {label}")
             bar.update(1)
 
         result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
-                          frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update)
+                          frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update,
+                          views={(method, far) for method in methods} if view else ())
     print()
     print(result.summary())
     written = write_sim_report(result, out)
+    if view:
+        from .view import write_view_files
+
+        written += write_view_files(out, report=report, sim_result=result)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     return result
 
@@ -87,10 +99,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         from ..sim.pybullet.world import _pybullet_module as _pybullet
 
         _pybullet()
-    report = _run_scenario(scenario, out, methods)
+    report = _run_scenario(scenario, out, methods, view=args.view)
     if args.sim:
         sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
-        _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None)
+        _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None,
+                 view=args.view)
     return EXIT_OK
 
 
@@ -119,7 +132,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     if (args.avoid or update is not None) and not args.closed_loop:
         raise ValueError("--avoid and --goal-update act on the closed loop: add --closed-loop")
     _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
-             pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update)
+             pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update, view=args.view)
     return EXIT_OK
 
 
@@ -152,6 +165,9 @@ def _demo_parser(commands) -> None:
                       help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
     demo.add_argument("--sim", action="store_true",
                       help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
+    demo.add_argument("--view", action="store_true",
+                      help="also write view.html: the 3-D viewer (one offline file; with --sim the robot's motion on a "
+                           "time slider; needs bidmp[view])")
     demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
     allow_outside_files(demo)
     demo.set_defaults(handler=_cmd_demo)
@@ -159,9 +175,10 @@ def _demo_parser(commands) -> None:
 
 def _sim_parser(commands) -> None:
     """``bidmp sim``."""
-    sim = commands.add_parser("sim", help="execute a scenario on a simulated Franka Panda (PyBullet)",
+    sim = commands.add_parser("sim", help="execute a scenario on a simulated arm (PyBullet; Panda, iiwa or your URDF)",
                               description="Execute every method's motion to every target of a scenario on a simulated "
-                                          "Franka Panda (PyBullet, headless): inverse kinematics, timing to the Panda's joint "
+                                          "arm (PyBullet, headless; the Franka Panda unless the scenario's \"robot\" names the "
+                                          "iiwa or a URDF): inverse kinematics, timing to the arm's joint "
                                           "limits, 1 kHz position control, contacts with the parts. Prints the Table 4 analogue "
                                           "in simulation and writes sim_results.json, keyframe strips and a GIF. Needs the "
                                           "sim extra: pip install 'bidmp[sim]'.")
@@ -179,6 +196,9 @@ def _sim_parser(commands) -> None:
                           "and the goal move there (a scripted perception update)")
     sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
     sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
+    sim.add_argument("--view", action="store_true",
+                     help="also write view.html: the 3-D viewer with the robot's motion to the furthest target on a time "
+                          "slider (needs bidmp[view])")
     sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
     allow_outside_files(sim)
     sim.set_defaults(handler=_cmd_sim)

@@ -1,6 +1,6 @@
 """Figures per domain (matplotlib ``Figure`` objects written to PNG files; the global backend is never
 switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``; ``_base`` holds what they
-share.
+share. ``viewer`` writes the 3-D viewer (one offline HTML file, plotly: the ``view`` extra).
 
 Layer 2 (data out, beside ``io``): imports the math and ``bidmp.io``; never ``tasks``, ``sim`` or
 ``cli`` (a report is passed in and read by its attributes).
@@ -23,6 +23,14 @@ _EXPORTS = {
     "plot_targets_top_view": "tasks",
     "plot_error_vs_distance": "tasks",
     "plot_scenario_3d": "tasks",
+    "ViewLayers": "viewer",
+    "layers_from_report": "viewer",
+    "add_robot_motions": "viewer",
+    "solid_mesh": "viewer",
+    "view_figure": "viewer",
+    "write_view": "viewer",
+    "save_layers": "viewer",
+    "load_layers": "viewer",
 }
 __all__ = list(_EXPORTS)
 # what the flat module bidmp.plotting of bidmp <= 0.4 held, for code written against it

@@ -1,0 +1,252 @@
+"""The 3-D viewer: a scenario's result as one self-contained HTML file a browser opens offline and
+turns — demonstration, segmentation points, extended demonstrations, each method's rollouts, the
+scene's parts and, for simulation runs, the robot's motion with a time slider.
+
+Why plotly: it writes one HTML file with plotly.js inside (no network, no CDN, no server), the
+layers toggle from the legend, and animation frames with a slider carry the robot's motion.
+``viser`` needs a live Python server for its viewer; ``rerun-sdk`` is a 170 MB wheel whose
+recordings need its own viewer. (Measured for issue 24: plotly 6.3.1 is a 9.8 MB wheel plus
+narwhals; viser 1.1.1 a 3.6 MB wheel plus websockets, trimesh, msgspec, rich, imageio and more.)
+
+The layers are kept beside the HTML as ``view_layers.npz`` (arrays, ``allow_pickle=False``) with
+JSON metadata inside it, so that ``bidmp view RESULTS_DIR`` rebuilds the file without rerunning.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._checks import check_path, require_extra
+from ..io.atomic import atomic_write
+
+__all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_mesh", "view_figure", "write_view",
+           "save_layers", "load_layers", "VIEW_FORMAT"]
+
+VIEW_FORMAT = 1  # of view_layers.npz
+_COLOURS = {"dmp": "#1f77b4", "dmp-converged": "#17becf", "bidmp": "#d62728", "bidmp-latest": "#ff7f0e",
+            "gmm": "#9467bd", "tpgmm": "#8c564b"}
+
+
+@dataclass
+class ViewLayers:
+    """What the viewer shows (positions (n, 3) in ``units``; times in s).
+
+    ``rollouts`` maps method -> target label -> (T, 3); ``solids`` are the scene's convex parts as
+    ``{"label", "kind", "centre", "rotation", "params"}``; ``robot`` maps a motion's name
+    ("bidmp -> 11") to ``{"times": (F,), "links": (F, L, 3)}``: the arm's joint origins from
+    base to tool tip, sampled along the simulated motion.
+    """
+
+    title: str
+    units: str
+    demonstration: np.ndarray
+    targets: dict = field(default_factory=dict)
+    segmentation: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    extended: list = field(default_factory=list)
+    rollouts: dict = field(default_factory=dict)
+    solids: list = field(default_factory=list)
+    robot: dict = field(default_factory=dict)
+
+
+def _xyz(points) -> np.ndarray:
+    """Positions (n, 3) of a path (poses: their first three columns; 2-D: z = 0)."""
+    points = np.asarray(points, dtype=float)
+    if points.ndim != 2 or points.shape[1] < 2:
+        raise ValueError(f"expected a path (n, 2+), got shape {points.shape}")
+    if points.shape[1] == 2:
+        return np.column_stack([points, np.zeros(len(points))])
+    return points[:, :3]
+
+
+def layers_from_report(report) -> ViewLayers:
+    """The layers of a finished evaluation (:func:`bidmp.evaluate`)."""
+    scenario = report.scenario
+    points = [_xyz(e.demonstration)[e.segmentation_points] for e in report.extensions if len(e.segmentation_points)]
+    solids = []
+    if scenario.scene is not None:
+        solids = [{"label": s.label, "kind": s.kind, "centre": np.asarray(s.centre, float).tolist(),
+                   "rotation": np.asarray(s.rotation, float).tolist(),
+                   "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in s.params]}
+                  for s in scenario.scene.solids]
+    return ViewLayers(
+        title=scenario.name, units=scenario.units, demonstration=_xyz(scenario.demonstration),
+        targets={label: _xyz(np.atleast_2d(target))[0] for label, target in scenario.targets.items()},
+        segmentation=np.vstack(points) if points else np.zeros((0, 3)),
+        extended=[_xyz(e.complete) for e in report.extensions] + [_xyz(t) for t in scenario.demonstrations.values()],
+        rollouts={name: {label: _xyz(r) for label, r in result.rollouts.items()} for name, result in report.methods.items()},
+        solids=solids)
+
+
+def add_robot_motions(layers: ViewLayers, sim_report) -> ViewLayers:
+    """Add the arm's motions a simulation recorded (``SimReport.motions``), in scene units."""
+    for (method, label), motion in getattr(sim_report, "motions", {}).items():
+        layers.robot[f"{method} -> {label}"] = {"times": np.asarray(motion["times"], float),
+                                               "links": np.asarray(motion["links"], float)}
+    return layers
+
+
+def solid_mesh(kind: str, centre, rotation, params, sides: int = 24) -> tuple[np.ndarray, np.ndarray]:
+    """A triangle mesh of a scene solid: vertices (n, 3) and faces (m, 3) (vertex indices).
+
+    Boxes: 8 corners; cylinders: ``sides`` around each cap; convex: the hull of its vertices
+    (scipy's Qhull)."""
+    from scipy.spatial import ConvexHull
+
+    centre, rotation = np.asarray(centre, float), np.asarray(rotation, float)
+    if kind == "box":
+        half = np.asarray(params, float) / 2.0
+        local = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
+    elif kind == "cylinder":
+        radius, height = float(params[0]), float(params[1])
+        angles = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
+        ring = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
+        local = np.vstack([np.column_stack([ring, np.full(sides, z)]) for z in (-height / 2, height / 2)])
+    elif kind == "convex":
+        local = np.asarray(params[0], float)
+    else:
+        raise ValueError(f"solid kind must be box, cylinder or convex, got {kind!r}")
+    vertices = local @ rotation.T + centre
+    return vertices, ConvexHull(vertices).simplices  # every solid here is convex
+
+
+def _path(go, points, name, colour, group, show, **line):
+    return go.Scatter3d(x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="lines", name=name, legendgroup=group,
+                        showlegend=show, line={"color": colour, **line}, hoverinfo="name")
+
+
+def _static_traces(go, layers: ViewLayers) -> list:
+    """Every layer but the robot: paths, points and the parts' meshes, one legend entry each."""
+    traces = [_path(go, layers.demonstration, "demonstration", "black", "demonstration", True, width=7)]
+    if len(layers.segmentation):
+        s = layers.segmentation
+        traces.append(go.Scatter3d(x=s[:, 0], y=s[:, 1], z=s[:, 2], mode="markers", name="segmentation points",
+                                   marker={"symbol": "diamond", "size": 5, "color": "black"}))
+    for index, path in enumerate(layers.extended):
+        traces.append(_path(go, path, "extended demonstrations", "goldenrod", "extended", index == 0, width=5))
+    for method, paths in layers.rollouts.items():
+        for index, (label, path) in enumerate(paths.items()):
+            trace = _path(go, path, f"{method} rollouts", _COLOURS.get(method, "#2ca02c"), method, index == 0, width=2)
+            trace.update(visible=True if method in ("bidmp", "dmp") else "legendonly", hovertext=f"{method} -> {label}")
+            traces.append(trace)
+    if layers.targets:
+        t = np.array(list(layers.targets.values()))
+        traces.append(go.Scatter3d(x=t[:, 0], y=t[:, 1], z=t[:, 2], mode="markers+text", name="targets",
+                                   text=list(layers.targets), marker={"size": 3, "color": "green"}))
+    for index, solid in enumerate(layers.solids):
+        vertices, faces = solid_mesh(solid["kind"], solid["centre"], solid["rotation"], solid["params"])
+        traces.append(go.Mesh3d(x=vertices[:, 0], y=vertices[:, 1], z=vertices[:, 2], i=faces[:, 0], j=faces[:, 1],
+                                k=faces[:, 2], color="lightsteelblue", opacity=0.35, name="scene parts",
+                                legendgroup="scene", showlegend=index == 0, hovertext=solid["label"], hoverinfo="text"))
+    return traces
+
+
+def _robot_frames(go, layers: ViewLayers, first: int) -> tuple[list, list, list]:
+    """The arm as a thick line through its joints: its first pose as a trace (index ``first``),
+    one animation frame per recorded sample of every motion, and the slider's steps."""
+    frames, steps, trace = [], [], []
+    for name, motion in layers.robot.items():
+        for time, links in zip(motion["times"], motion["links"]):
+            key = f"{name} @ {time:.2f} s"
+            data = _path(go, links, "robot (joint to joint)", "#9a9a9a", "robot", True, width=14)
+            data.update(mode="lines+markers", marker={"size": 5, "color": "darkorange"})
+            if not trace:
+                trace.append(data)
+            frames.append(go.Frame(name=key, data=[data], traces=[first]))
+            steps.append({"label": key, "method": "animate",
+                          "args": [[key], {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
+                                           "transition": {"duration": 0}}]})
+    return trace, frames, steps
+
+
+def view_figure(layers: ViewLayers):
+    """A plotly figure of ``layers``: every layer a legend entry (click to hide), the robot's
+    motions on a time slider with play and pause."""
+    if not isinstance(layers, ViewLayers):
+        raise TypeError(f"layers must be a bidmp ViewLayers, got {type(layers).__name__}")
+    require_extra("plotly", "view", "the 3-D viewer")
+    import plotly.graph_objects as go
+
+    traces = _static_traces(go, layers)
+    robot, frames, steps = _robot_frames(go, layers, len(traces))
+    unit = f" [{layers.units}]" if layers.units else ""
+    figure = go.Figure(data=traces + robot, frames=frames)
+    figure.update_layout(
+        title=f"{layers.title}: drag to turn, scroll to zoom, click a legend entry to hide it",
+        scene={"xaxis_title": "x" + unit, "yaxis_title": "y" + unit, "zaxis_title": "z" + unit, "aspectmode": "data"},
+        legend={"itemsizing": "constant"}, margin={"l": 0, "r": 0, "t": 40, "b": 0}, height=800)
+    if frames:
+        figure.update_layout(
+            # Tick labels hidden (one per 40 ms would overlap); the current one is shown above.
+            sliders=[{"steps": steps, "currentvalue": {"prefix": "robot: ", "font": {"color": "#333333"}},
+                      "font": {"color": "rgba(0,0,0,0)"}, "x": 0.12, "len": 0.86, "pad": {"t": 10}}],
+            updatemenus=[{"type": "buttons", "showactive": False, "direction": "right", "x": 0.0, "y": 0.0,
+                          "xanchor": "left", "yanchor": "top", "pad": {"t": 20}, "buttons": [
+                {"label": "play", "method": "animate",
+                 "args": [None, {"frame": {"duration": 40, "redraw": True}, "fromcurrent": True}]},
+                {"label": "pause", "method": "animate",
+                 "args": [[None], {"mode": "immediate", "frame": {"duration": 0, "redraw": False}}]}]}])
+    return figure
+
+
+def write_view(path, layers: ViewLayers) -> Path:
+    """Write the viewer as one HTML file (plotly.js inside: opens offline); returns its path."""
+    path = check_path(path)
+    html = view_figure(layers).to_html(include_plotlyjs=True, full_html=True, auto_play=False)
+    with atomic_write(path, "w") as handle:
+        handle.write(html)
+    return path
+
+
+def save_layers(path, layers: ViewLayers) -> Path:
+    """Store ``layers`` as ``.npz`` (arrays only) with their JSON metadata and a format version."""
+    path = check_path(path)
+    arrays = {"demonstration": layers.demonstration, "segmentation": layers.segmentation}
+    arrays.update({f"extended_{i}": p for i, p in enumerate(layers.extended)})
+    rollouts = {}
+    for m, (method, paths) in enumerate(layers.rollouts.items()):
+        for r, (label, trajectory) in enumerate(paths.items()):
+            arrays[f"rollout_{m}_{r}"] = trajectory
+            rollouts.setdefault(method, []).append([label, f"rollout_{m}_{r}"])
+    robot = {}
+    for k, (name, motion) in enumerate(layers.robot.items()):
+        arrays[f"robot_times_{k}"], arrays[f"robot_links_{k}"] = motion["times"], motion["links"]
+        robot[name] = k
+    meta = {"format": VIEW_FORMAT, "kind": "bidmp-view", "title": layers.title, "units": layers.units,
+            "targets": {label: np.asarray(t, float).tolist() for label, t in layers.targets.items()},
+            "n_extended": len(layers.extended), "rollouts": rollouts, "solids": layers.solids, "robot": robot}
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    import io
+
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **{k: np.asarray(v) for k, v in arrays.items()})
+    with atomic_write(path, "wb") as handle:
+        handle.write(buffer.getvalue())
+    return path
+
+
+def load_layers(path) -> ViewLayers:
+    """Read layers written by :func:`save_layers`; a foreign or broken file is named as such."""
+    import zipfile
+
+    path = check_path(path)
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(bytes(data["meta"]).decode())
+            if not isinstance(meta, dict) or meta.get("kind") != "bidmp-view":
+                raise ValueError("it is not a bidmp view file")
+            if meta.get("format") != VIEW_FORMAT:
+                raise ValueError(f"its format {meta.get('format')!r} is not {VIEW_FORMAT}")
+            return ViewLayers(
+                title=meta["title"], units=meta["units"], demonstration=data["demonstration"],
+                targets={label: np.asarray(t) for label, t in meta["targets"].items()},
+                segmentation=data["segmentation"], extended=[data[f"extended_{i}"] for i in range(meta["n_extended"])],
+                rollouts={method: {label: data[key] for label, key in pairs} for method, pairs in meta["rollouts"].items()},
+                solids=meta["solids"],
+                robot={name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
+                       for name, k in meta["robot"].items()})
+    except (OSError, KeyError, ValueError, TypeError, zipfile.BadZipFile, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read a bidmp view ({str(exc)[:120]})") from None

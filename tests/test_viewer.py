@@ -1,0 +1,126 @@
+"""The 3-D viewer (issue 24.4): meshes of the scene's solids against closed forms, every layer in
+the file, the robot's motion from its base to the target, round trips, bad files, the CLI."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("plotly")
+
+from bidmp import scenarios  # noqa: E402
+from bidmp.cli import main  # noqa: E402
+from bidmp.evaluation import evaluate  # noqa: E402
+from bidmp.plotting import viewer  # noqa: E402
+
+
+def hull_volume(vertices, faces):
+    """Volume enclosed by a closed triangle mesh (divergence theorem, about its centroid)."""
+    centre = vertices.mean(axis=0)
+    a, b, c = (vertices[faces[:, k]] - centre for k in range(3))
+    return float(np.abs(np.einsum("ij,ij->i", a, np.cross(b, c))).sum() / 6.0)
+
+
+def rotation(seed):
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.random(random_state=seed).as_matrix()
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_solid_meshes_enclose_the_solids_volume(seed):
+    rng = np.random.default_rng(seed)
+    turn, centre = rotation(seed), rng.uniform(-100, 100, 3)
+    size = rng.uniform(1, 50, 3)
+    vertices, faces = viewer.solid_mesh("box", centre, turn, size)
+    assert hull_volume(vertices, faces) == pytest.approx(np.prod(size), rel=1e-9)
+    radius, height, sides = rng.uniform(1, 20), rng.uniform(1, 40), 24
+    vertices, faces = viewer.solid_mesh("cylinder", centre, turn, (radius, height), sides=sides)
+    polygon = 0.5 * sides * radius**2 * math.sin(2 * math.pi / sides)  # the inscribed 24-gon's area
+    assert hull_volume(vertices, faces) == pytest.approx(polygon * height, rel=1e-9)
+    # The cylinder's axis is the rotation's z: every vertex at its radius from that axis.
+    offset = vertices - centre
+    along = offset @ turn[:, 2]
+    np.testing.assert_allclose(np.linalg.norm(offset - np.outer(along, turn[:, 2]), axis=1), radius)
+    np.testing.assert_allclose(np.abs(along), height / 2)
+
+
+def test_an_unknown_solid_kind_is_named():
+    with pytest.raises(ValueError, match="solid kind must be box, cylinder or convex, got 'sphere'"):
+        viewer.solid_mesh("sphere", [0, 0, 0], np.eye(3), (1.0,))
+
+
+@pytest.fixture(scope="module")
+def nut_layers():
+    pytest.importorskip("pybullet")
+    from bidmp import sim
+
+    nut = scenarios.load("nut-unscrewing")
+    report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
+    result = sim.simulate(nut, ["bidmp"], targets=["11"], report=report, workers=1, views=[("bidmp", "11")])
+    return nut, viewer.add_robot_motions(viewer.layers_from_report(report), result)
+
+
+def test_the_viewer_holds_every_layer(nut_layers, tmp_path):
+    nut, layers = nut_layers
+    assert len(layers.segmentation) >= 1 and len(layers.extended) >= 1
+    assert set(layers.rollouts) == {"dmp", "bidmp"} and set(layers.rollouts["bidmp"]) == set(nut.targets)
+    assert len(layers.solids) == len(nut.scene.solids)
+    figure = viewer.view_figure(layers)
+    names = {trace.name for trace in figure.data}
+    assert names == {"demonstration", "segmentation points", "extended demonstrations", "dmp rollouts",
+                     "bidmp rollouts", "targets", "scene parts", "robot (joint to joint)"}
+    assert len(figure.frames) == len(layers.robot["bidmp -> 11"]["times"])
+    assert len(figure.layout.sliders[0].steps) == len(figure.frames)
+    page = viewer.write_view(tmp_path / "view.html", layers)
+    text = page.read_text()
+    assert "plotly.js v" in text and '<script src="http' not in text  # plotly.js inside: opens offline
+    for name in names:
+        assert json.dumps(name) in text
+
+
+def test_the_robot_moves_from_its_base_to_the_target(nut_layers):
+    """Independent anchors: the first joint origin is the scenario's robot base, and the tool's
+    mouth (the last point) ends on the target within the task's threshold."""
+    nut, layers = nut_layers
+    motion = layers.robot["bidmp -> 11"]
+    links, times = motion["links"], motion["times"]
+    base = np.asarray(nut.robot["base"], dtype=float)
+    np.testing.assert_allclose(links[:, 0], np.broadcast_to(base, links[:, 0].shape), atol=1e-6)
+    assert np.linalg.norm(links[-1, -1] - nut.targets["11"]) <= nut.success_threshold
+    assert np.all(np.diff(times) > 0) and times[-1] > 1.0
+    # Joints move continuously: no link jumps more than 40 ms at 2 m/s would carry it.
+    assert np.max(np.linalg.norm(np.diff(links, axis=0), axis=2)) <= 2000.0 * 0.04 + 1e-9
+
+
+def test_layers_round_trip_and_bad_files_are_named(nut_layers, tmp_path):
+    _, layers = nut_layers
+    path = viewer.save_layers(tmp_path / "view_layers.npz", layers)
+    back = viewer.load_layers(path)
+    np.testing.assert_array_equal(back.demonstration, layers.demonstration)
+    np.testing.assert_array_equal(back.robot["bidmp -> 11"]["links"], layers.robot["bidmp -> 11"]["links"])
+    assert back.solids == layers.solids and back.rollouts.keys() == layers.rollouts.keys()
+    for method in layers.rollouts:
+        for label, path_ in layers.rollouts[method].items():
+            np.testing.assert_array_equal(back.rollouts[method][label], path_)
+    broken = tmp_path / "broken.npz"
+    broken.write_bytes(path.read_bytes()[:300])
+    with pytest.raises(ValueError, match="broken.npz: cannot read a bidmp view"):
+        viewer.load_layers(broken)
+    foreign = tmp_path / "foreign.npz"
+    np.savez(foreign, meta=np.frombuffer(json.dumps({"kind": "other"}).encode(), dtype=np.uint8))
+    with pytest.raises(ValueError, match="not a bidmp view file"):
+        viewer.load_layers(foreign)
+
+
+def test_bidmp_demo_view_and_bidmp_view(tmp_path, capsys):
+    assert main(["demo", "--methods", "dmp,bidmp", "--view", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "view.html").stat().st_size > 3_000_000  # plotly.js is inside
+    (tmp_path / "view.html").unlink()
+    assert main(["view", str(tmp_path)]) == 0
+    assert (tmp_path / "view.html").is_file()
+    capsys.readouterr()
+    assert main(["view", str(tmp_path / "nothing")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds no view_layers.npz" in err and "\n" not in err
