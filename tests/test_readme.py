@@ -68,3 +68,27 @@ def test_the_readme_cites_only_files_in_the_repository():
         assert outside not in README, outside
     for name in re.findall(r"\b((?:docs|tools|benchmarks|tests|src)/[\w./-]*\w)", README):
         assert (ROOT / name).exists(), name
+
+
+def test_the_own_robot_commands_run_as_written(tmp_path, monkeypatch, capsys):
+    """Issue 24.7: the section "Your own robot and data" — its Python block, then every command of
+    its marked block in order, in one folder (each may use what the ones before it wrote)."""
+    import shlex
+    import shutil
+
+    pytest.importorskip("pybullet")
+    pytest.importorskip("rosbags")
+    pytest.importorskip("plotly")
+    from bidmp.cli import main
+
+    section = README.split("## Your own robot and data", 1)[1].split("\n## ", 1)[0]
+    python = re.search(r"```python\n(.*?)```", section, re.DOTALL).group(1)
+    commands = re.search(r"<!-- own-robot-commands -->\n```sh\n(.*?)```", section, re.DOTALL).group(1)
+    shutil.copy(ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv", tmp_path / "recording.csv")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(python, "README", "exec"), {})
+    lines = [line for line in commands.splitlines() if line.startswith("bidmp ")]
+    assert len(lines) >= 8
+    for line in lines:
+        assert main(shlex.split(line)[1:]) == 0, (line, capsys.readouterr().err[-500:])
+    assert (tmp_path / "viewed" / "view.html").is_file() and (tmp_path / "joints.bag").is_file()

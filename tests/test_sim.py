@@ -187,7 +187,16 @@ def test_pictures_are_written(tmp_path, nut, nut_report):
     from PIL import Image
 
     with Image.open(tmp_path / "sim_12_dmp_vs_bidmp.gif") as gif:
-        assert gif.n_frames == 4 and gif.size == (2 * 320 + 6, 240)
+        # Each side: the whole arm (240 px) over a close-up on tool and target (240 px), under a
+        # 26 px title band naming the methods and the target.
+        assert gif.n_frames == 4 and gif.size == (2 * 320 + 6, 26 + 2 * 240)
+        frame = np.asarray(gif.convert("RGB"))
+    title, wide, close = frame[:26], frame[26:266, :320], frame[266:, :320]
+    assert (title.min(axis=2) < 100).sum() > 50  # text written in the band
+    assert (wide.min(axis=2) < 100).sum() > 20  # the time label; the scenes differ
+    assert np.abs(wide.astype(int) - close.astype(int)).mean() > 10
+    with Image.open(tmp_path / "sim_keyframes_bidmp.png") as strip:
+        assert strip.size == (4 * 320 + 3 * 4, 26 + 2 * 240)
 
 
 def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):

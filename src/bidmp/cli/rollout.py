@@ -148,7 +148,7 @@ def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
 
 def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
     """A position model's motion as the robot's JointTrajectory: inverse kinematics at every
-    sample (tool pointing down; the model's frame is the robot's base frame shifted by --base)."""
+    sample (tool pointing down; the robot at --base, turned by --yaw, in the model's frame)."""
     import numpy as np
 
     from .._units import conversion
@@ -159,7 +159,8 @@ def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
         raise ValueError("--robot with --bag: inverse kinematics needs the model's length unit; fit it with --units")
     scale = conversion(dmp.units_, "m")
     base = np.zeros(3) if args.base is None else np.asarray(args.base, dtype=float)
-    joints = inverse_kinematics((trajectory.y - base) * scale, args.robot, units="m", tool_length=args.tool_length)
+    joints = inverse_kinematics(trajectory.y * scale, args.robot, units="m", tool_length=args.tool_length,
+                                base=base * scale, yaw=args.yaw)
     velocities = np.gradient(joints, trajectory.t, axis=0)
     path = write_bag(args.bag, trajectory.t, joints, kind="joints", names=joint_names(args.robot), velocities=velocities,
                      accelerations=np.gradient(velocities, trajectory.t, axis=0), frame_id=args.frame, ros=ros)
@@ -245,6 +246,8 @@ def _add_rollout_arguments(rollout) -> None:
                          help="with --robot: from the flange to the tool's mouth, metres (default 0)")
     rollout.add_argument("--base", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
                          help="with --robot and --bag: where the robot's base is, in the model's units (default the origin)")
+    rollout.add_argument("--yaw", type=float, default=0.0, metavar="DEG",
+                         help="with --robot and --bag: the base's turn about z, degrees (90: facing +y; default 0)")
     rollout.add_argument("--fastest", action="store_true",
                          help="with --max-speed/--max-acc: the shortest motion within them, even faster than demonstrated "
                               "(without it they are caps that only ever slow a motion)")

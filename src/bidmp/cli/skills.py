@@ -137,7 +137,10 @@ def cmd_segment(args: argparse.Namespace) -> int:
         from ..plotting.extension import plot_segmentation
 
         kappa = curvature(resample_arclength(y, min(y.shape[0], MAX_ANALYSIS_POINTS)))
-        print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, title=f'1D-SEG of {args.demo}')}")
+        from pathlib import Path
+
+        title = f"1D-SEG of {Path(args.demo).name}"
+        print(f"wrote {plot_segmentation(args.plot, y, points, kinds, curvature=kappa, units=units, title=title)}")
     return EXIT_OK
 
 

@@ -436,7 +436,7 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
     for ax, shape in zip(axes.ravel(), shapes):
         key = next((k for k in cells if k.startswith(f"{shape}__")), None)
         demo = int(key.split("__")[1]) if key else 0
-        ax.plot(*lasa_data(shape)[demo].T, color="0.6", linewidth=2.5)
+        ax.plot(*lasa_data(shape)[demo].T, color="0.6", linewidth=2.5, label="demonstration")
         if key is not None:
             for index, (method, rollout) in enumerate(cells[key].get("rollouts", {}).items()):
                 ax.plot(*np.asarray(rollout).T, color=colours(index % 10), linewidth=0.9, label=method)
@@ -446,19 +446,29 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
     for ax in axes.ravel()[len(shapes):]:
         ax.axis("off")
     handles, labels = axes.ravel()[0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    fig.tight_layout()
+    if handles:  # below the grid, as many columns as fit its width; the saved area grows to hold it
+        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=min(len(labels), max(2, n_cols)),
+                   fontsize=8, frameon=False)
     written.append(out / "lasa_shapes.png")
     with atomic_write(written[-1], "wb") as handle:
-        fig.savefig(handle, format="png")
+        fig.savefig(handle, format="png", bbox_inches="tight")
+    from matplotlib.ticker import FuncFormatter
+
+    plain = FuncFormatter(lambda value, _: f"{value:g}")
+    # Within two decades, the 2s and 5s between the powers of ten are labelled too.
+    two_five = FuncFormatter(lambda value, _: f"{value:g}" if round(value / 10 ** np.floor(np.log10(value))) in (2, 5) else "")
     methods = list(dict.fromkeys(row["method"] for row in rows))
     fig, axes = mpl.subplots(1, 3, figsize=(15, 4.2), dpi=90, squeeze=False)
     for ax, metric in zip(axes[0], ("rmse", "dtw_per_sample", "endpoint_error")):
         data = [[row[metric] for row in rows if row["method"] == method and row["case"] == "far"] for method in methods]
         ax.boxplot(data, tick_labels=methods, showfliers=False)
         ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(plain)  # 10, 0.01 rather than 10^1, 10^-2
+        low, high = ax.get_ylim()
+        ax.yaxis.set_minor_formatter(two_five if high / low < 300 else FuncFormatter(lambda value, _: ""))
         ax.set_title(f"{metric}, far goals", fontsize=10)
+        ax.set_ylabel(f"{metric} [mm{' per sample' if metric == 'dtw_per_sample' else ''}] (log)")  # LASA: tablet mm
         ax.tick_params(axis="x", labelrotation=30, labelsize=8)
     fig.tight_layout()
     written.append(out / "lasa_metrics.png")

@@ -98,6 +98,10 @@ def _label_axes(ax, n_dims: int, units: str) -> None:
     ax.set_ylabel("y" + suffix)
     if n_dims == 3:
         ax.set_zlabel("z" + suffix)
+        from matplotlib.ticker import MaxNLocator
+
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # 3-D tick labels crowd into each other beyond ~6
+            axis.set_major_locator(MaxNLocator(6))
     else:
         ax.set_aspect("equal", adjustable="datalim")
 

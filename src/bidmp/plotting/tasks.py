@@ -52,6 +52,8 @@ def plot_targets_top_view(path, report) -> Path:
         ax.set_xlim(targets[:, 0].min() - pad, targets[:, 0].max() + pad)
         ax.set_ylim(targets[:, 1].min() - pad, targets[:, 1].max() + pad)
         ax.set_aspect("equal")
+        ax.set_xlabel(f"x [{scenario.units}]")
+        ax.set_ylabel(f"y [{scenario.units}]")
         ax.grid(True, alpha=0.3)
     for ax in axes.ravel()[len(names):]:
         ax.axis("off")
@@ -78,8 +80,7 @@ def plot_error_vs_distance(path, report) -> Path:
             ax.plot([distance[label] for label in order], [values[label] for label in order], "o-",
                     color=_METHOD_COLOURS.get(name), label=name, markersize=4)
         ax.axhline(scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold")
-        ax.set_yscale("symlog", linthresh=1.0)
-        ax.set_ylim(bottom=0.0)
+        _readable_symlog(ax)
         ax.set_xlabel(f"distance from the demonstrated target [{scenario.units}]")
         ax.set_ylabel(f"{title} [{scenario.units}]")
         ax.grid(True, alpha=0.3)
@@ -90,31 +91,47 @@ def plot_error_vs_distance(path, report) -> Path:
     return _save(fig, path)
 
 
+def _readable_symlog(ax) -> None:
+    """A symlog error axis with plain-number ticks (0, 0.5, 1, 2, 5, 10, ...): the default puts
+    powers of ten only, and none between 0 and 1, where the successes lie."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+    ax.set_yscale("symlog", linthresh=1.0, linscale=1.5)
+    ax.set_ylim(bottom=0.0)
+    top = ax.get_ylim()[1]
+    ticks = [t for t in (0, 0.25, 0.5, 0.75, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000) if t <= top * 1.05]
+    ax.yaxis.set_major_locator(FixedLocator(ticks))
+    ax.yaxis.set_minor_locator(NullLocator())
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+
+
 def plot_scenario_3d(path, report) -> Path:
     """3-D view: demonstration, segmentation points, extended demonstration(s), Bi-DMP rollouts
     and the plain DMP's rollouts to the targets it misses (paper Fig. 17 / 19 analogue)."""
     mpl = _matplotlib()
     scenario = report.scenario
-    demo = scenario.demonstration
+    # A pose scenario's paths are (T, 7): the positions are its first three columns (drawn as
+    # they were, x, y against z, qx, ... made a 2-D plot with every entry in the legend four times).
+    demo = scenario.demonstration[:, :3]
     n_dims = demo.shape[1]
     fig = mpl.figure(figsize=(8.0, 6.8), dpi=100)
     ax = _axes_for(fig, n_dims, 1, 1, 1)
     _draw(ax, demo, color="0.4", linewidth=3, label="demonstration")
     for index, extension in enumerate(report.extensions):
         if len(extension.segmentation_points):
-            _draw(ax, extension.demonstration[extension.segmentation_points], "^", color="k", markersize=6,
+            _draw(ax, extension.demonstration[extension.segmentation_points][:, :3], "^", color="k", markersize=6,
                   linestyle="none", label="segmentation points" if index == 0 else None)
-        _draw(ax, extension.complete, color="goldenrod", linewidth=2.5, alpha=0.8, label="extended demonstration" if index == 0 else None)
+        _draw(ax, extension.complete[:, :3], color="goldenrod", linewidth=2.5, alpha=0.8, label="extended demonstration" if index == 0 else None)
     for label, trajectory in scenario.demonstrations.items():
-        _draw(ax, trajectory, color="goldenrod", linewidth=2.0, alpha=0.6)
+        _draw(ax, trajectory[:, :3], color="goldenrod", linewidth=2.0, alpha=0.6)
     if "bidmp" in report.methods:
         for index, trajectory in enumerate(report.methods["bidmp"].rollouts.values()):
-            _draw(ax, trajectory, color="tab:red", linewidth=0.8, alpha=0.7, label="Bi-DMP rollouts" if index == 0 else None)
+            _draw(ax, trajectory[:, :3], color="tab:red", linewidth=0.8, alpha=0.7, label="Bi-DMP rollouts" if index == 0 else None)
     if "dmp" in report.methods:
         for index, label in enumerate(report.failed_targets):
-            _draw(ax, report.methods["dmp"].rollouts[label], "--", color="tab:blue", linewidth=0.8,
+            _draw(ax, report.methods["dmp"].rollouts[label][:, :3], "--", color="tab:blue", linewidth=0.8,
                   label="plain DMP, missed targets" if index == 0 else None)
-    _draw(ax, scenario.target_array, "o", color="tab:green", markersize=4, linestyle="none", label="targets")
+    _draw(ax, scenario.target_array[:, :3], "o", color="tab:green", markersize=4, linestyle="none", label="targets")
     hits = [clearance.point for result in report.methods.values() if result.clearances is not None
             for clearance in result.clearances.values() if clearance is not None and not clearance.collision_free]
     if scenario.scene is not None and n_dims == 3:

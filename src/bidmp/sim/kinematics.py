@@ -1,8 +1,8 @@
 """An arm's inverse kinematics without a task: joint goals for a joint-space DMP, and a Cartesian
 motion turned into joint positions sample by sample (what a ``JointTrajectory`` carries).
 
-Points are in the robot's base frame (the base at the origin, yaw 0: x forward), in ``units``;
-the tool points down (z of the flange towards -z) unless orientations are given. Uses the
+Points are in the world's frame, in ``units``, the robot's base at ``base`` turned by ``yaw``
+about z (defaults: the origin and 0, so that x is forward from the base); the tool points down (z of the flange towards -z) unless orientations are given. Uses the
 PyBullet backend's arm models (``"panda"``, ``"iiwa"`` or a :class:`RobotModel`).
 """
 
@@ -18,7 +18,7 @@ from .backend import SimError
 __all__ = ["inverse_kinematics", "joint_names"]
 
 
-def _arm(robot, units: str, tool_length: float):
+def _arm(robot, units: str, tool_length: float, base=(0.0, 0.0, 0.0), yaw: float = 0.0):
     from ..scene.parts import Tool
     from .pybullet.cell import RobotCell
     from .pybullet.robot import ROBOT_MODELS, RobotModel
@@ -32,7 +32,7 @@ def _arm(robot, units: str, tool_length: float):
     length = check_real(tool_length, "tool_length", nonnegative=True)
     # No parts: the cell needs only the tool (its mouth is the point IK places).
     scene = SimpleNamespace(solids=(), tool=Tool(radius=0.01 if units == "m" else 10.0, length=max(length, 1e-6)))
-    return RobotCell(scene, units, (0.0, 0.0, 0.0), 0.0, robot)
+    return RobotCell(scene, units, base, yaw, robot)
 
 
 def _seed(seed) -> np.ndarray:
@@ -48,20 +48,22 @@ def joint_names(robot="panda") -> list[str]:
 
 
 def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: float = 0.0, seed=None,
-                       orientations=None) -> np.ndarray:
+                       orientations=None, base=(0.0, 0.0, 0.0), yaw: float = 0.0) -> np.ndarray:
     """Joint positions (n, 7) rad that put the tool's mouth on each of ``points`` (n, 3), each
     solved from the previous one (the first from ``seed``, default the arm's rest pose).
 
     Parameters
     ----------
     points : array (n, 3) or (3,)
-        In the robot's base frame, in ``units`` ("m", "cm" or "mm").
+        In ``units`` ("m", "cm" or "mm").
     robot : {"panda", "iiwa"} or RobotModel
     tool_length : float
         From the flange to the tool's mouth, in ``units`` (0: the flange itself).
     seed : array (7,), optional
     orientations : array (n, 4), optional
         The tool frame's quaternions (x, y, z, w); default pointing down.
+    base, yaw : array (3,), float
+        Where the robot stands (``units``) and its turn about z (degrees; 90: facing +y).
 
     Raises
     ------
@@ -81,7 +83,11 @@ def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: 
         orientations = as_quaternions(orientations, "orientations")
         if len(orientations) != len(path):
             raise ValueError(f"orientations must be one quaternion per point ({len(path)}), got {len(orientations)}")
-    with _arm(robot, units, tool_length) as cell:
+    from .._checks import as_point
+
+    base = as_point(base, 3, "base")
+    yaw = check_real(yaw, "yaw")
+    with _arm(robot, units, tool_length, base, yaw) as cell:
         lower, upper = np.array(cell.limits.lower), np.array(cell.limits.upper)
         # A seed is only where the search starts: one outside this arm's limits (another arm's
         # recording) starts from the nearest joints within them.

@@ -229,31 +229,47 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
     by_method = {}
     for method, label, frames in report.pictures:
         by_method.setdefault(method, (label, frames))
-    for method, (_, frames) in by_method.items():
-        written.append(_write_strip(out / f"sim_keyframes_{method}.png", frames[:: max(1, len(frames) // 6)][:6]))
+    for method, (label, frames) in by_method.items():
+        strip = _write_strip(out / f"sim_keyframes_{method}.png", frames[:: max(1, len(frames) // 6)][:6],
+                             f"{method}: motion to target {label} on the simulated {report.robot_name}")
+        written.append(strip)
     if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
-        written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1]))
+        written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1],
+                                  f"target {by_method['dmp'][0]}"))
     return written
 
 
-def _write_strip(path: Path, frames) -> Path:
+def _titled(image: np.ndarray, title: str) -> np.ndarray:
+    """``image`` under a white band with ``title`` (the method and target) written in it."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    band = Image.new("RGB", (image.shape[1], 26), (255, 255, 255))
+    ImageDraw.Draw(band).text((8, 4), title, fill=(20, 20, 20), font=ImageFont.load_default(size=16))
+    return np.concatenate([np.asarray(band), image], axis=0)
+
+
+def _write_strip(path: Path, frames, title: str = "") -> Path:
     from PIL import Image
 
     from ..io.atomic import atomic_write
 
-    strip = np.concatenate(frames, axis=1)
+    gap = np.full((frames[0].shape[0], 4, 3), 255, np.uint8)
+    strip = np.concatenate([part for frame in frames for part in (frame, gap)][:-1], axis=1)
+    strip = _titled(strip, title) if title else strip
     with atomic_write(path, "wb") as handle:
         Image.fromarray(strip).save(handle, format="PNG")
     return path
 
 
-def _write_gif(path: Path, left, right) -> Path:
+def _write_gif(path: Path, left, right, target: str = "") -> Path:
     from PIL import Image
 
     from ..io.atomic import atomic_write
 
     n = min(len(left), len(right))
-    images = [Image.fromarray(np.concatenate([left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]], axis=1))
+    title = f"left: plain DMP    right: Bi-DMP    ({target})" if target else "left: plain DMP    right: Bi-DMP"
+    images = [Image.fromarray(_titled(np.concatenate([left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]],
+                                                     axis=1), title))
               for i in range(n)]
     with atomic_write(path, "wb") as handle:
         images[0].save(handle, format="GIF", save_all=True, append_images=images[1:], duration=120, loop=0)

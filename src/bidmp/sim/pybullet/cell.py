@@ -171,6 +171,11 @@ class RobotCell:
         """An RGB image (height, width, 3) of the cell (:func:`bidmp.sim.pybullet.render.render`)."""
         return _render._render(self, width, height, target)
 
+    def keyframe(self, t: float, focus, width: int = 320, height: int = 240) -> np.ndarray:
+        """A labelled keyframe (2 height, width, 3): the whole arm above, a close-up on the tool
+        and ``focus`` (scene units) below, the time ``t`` (s) written in."""
+        return _render._keyframe(self, t, focus, width, height)
+
     def scene_centre(self) -> np.ndarray:
         return _render._scene_centre(self)
 

@@ -61,7 +61,7 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
     positions, velocities = plan.command(np.arange(n_steps) * SIM_STEP)
     cell._set_joints(positions[0])
     position_list, velocity_list = positions.tolist(), velocities.tolist()
-    record = _Recorder(cell, n_steps, frames)
+    record = _Recorder(cell, n_steps, frames, focus=plan.points[-1] / cell.unit)
     _ignore(cell, exclude, False)
     held = None
     # The 1 kHz loop is most of a simulation's cost: PyBullet's calls bound once, the
@@ -118,7 +118,7 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
     every = int(round(CONTROL_STEP / SIM_STEP))
     longest = max_factor * duration + (0.0 if hold is None else hold.duration)
     n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
-    record = _Recorder(cell, n_steps, frames)
+    record = _Recorder(cell, n_steps, frames, focus=np.asarray(stepper.target, dtype=float))
     _ignore(cell, exclude, False)
     target, previous, held, settle_from, moved = q, q, None, None, False
     times, targets, clock, sent = [], [], [], []
@@ -195,8 +195,9 @@ def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: floa
 class _Recorder:
     """Measured samples of one execution (every step) and optional frames."""
 
-    def __init__(self, cell, n_steps: int, frames: int):
+    def __init__(self, cell, n_steps: int, frames: int, focus=None):
         self.cell = cell
+        self.focus = focus  # the target (scene units) the keyframes' close-up looks at
         self.n_steps = n_steps
         n_records = (n_steps - 1) // RECORD_EVERY + 1
         self.times = np.empty(n_records)
@@ -217,7 +218,7 @@ class _Recorder:
         if contacts:
             _contacts_into(cell, self.contacts)
         if step in self.frame_steps:
-            self.frames.append(cell.render())
+            self.frames.append(cell.render() if self.focus is None else cell.keyframe(t, self.focus))
         if every_step and step % RECORD_EVERY and step != self.n_steps - 1:
             return
         row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
