@@ -113,3 +113,28 @@ def test_rollout_to_a_cartesian_goal_through_the_robots_inverse_kinematics(tmp_p
     capsys.readouterr()
     assert main(["rollout", str(tmp_path / "j.npz"), "--cartesian-goal", "3", "0", "0", "-o", str(tmp_path / "r.csv")]) == 2
     assert "reach" in capsys.readouterr().err
+
+
+def test_joint_limits_from_a_scenarios_own_robot(tmp_path, capsys):
+    """--joint-limits SCENARIO: the limits of the robot the scenario names (here its own URDF's,
+    slower than any built-in arm), each joint within its own, one of them binding."""
+    import json
+
+    from bidmp import scenarios
+
+    spec = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    velocity = [0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6]
+    spec["robot"] = {"urdf": "kuka_iiwa/model.urdf", "flange": "lbr_iiwa_link_7",
+                     "limits": {"lower": [-2.9] * 7, "upper": [2.9] * 7, "velocity": velocity,
+                                "acceleration": [2.0] * 7, "jerk": [50.0] * 7}}
+    (tmp_path / "cell.json").write_text(json.dumps(spec))
+    _joint_csv(tmp_path / "j.csv", np.random.default_rng(5))
+    assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
+    assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "1000", "--joint-limits", str(tmp_path / "cell.json"),
+                 "--fastest", "-o", str(tmp_path / "r.csv")]) == 0
+    rows = _rows(tmp_path / "r.csv")
+    t, velocities, accelerations = rows[:, 0], rows[:, 8:15], rows[:, 15:22]
+    jerk = np.diff(accelerations, axis=0) / np.diff(t)[:, None]
+    shares = [np.max(np.abs(velocities) / velocity), np.max(np.abs(accelerations) / 2.0), np.max(np.abs(jerk) / 50.0)]
+    assert max(shares) <= 1.0 + 1e-6 and max(shares) >= 0.99, shares
+    capsys.readouterr()

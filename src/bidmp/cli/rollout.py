@@ -44,11 +44,9 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
     if args.joint_limits is not None:
         if given:
             raise ValueError("give --joint-limits or --max-speed/--max-acc/--max-jerk, not both")
-        from ..sim.pybullet.robot import ROBOT_MODELS
-
         if dmp.n_dims_ != 7:
-            raise ValueError(f"--joint-limits {args.joint_limits} needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
-        arm = ROBOT_MODELS[args.joint_limits].limits
+            raise ValueError(f"--joint-limits needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
+        arm = _arm_limits(args)
         return {"max_velocity": arm.velocity, "max_acceleration": arm.acceleration, "max_jerk": arm.jerk, "norm": "axis"}
     if not given:
         return {}
@@ -58,6 +56,19 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
                          f"dimension), the same count for each")
     per_axis = counts == {dmp.n_dims_} and dmp.n_dims_ > 1
     return {key: (value if per_axis else value[0]) for key, value in given.items()} | {"norm": "axis" if per_axis else "norm"}
+
+
+def _arm_limits(args: argparse.Namespace):
+    """The JointLimits of --joint-limits: a built-in arm (panda, iiwa), or the robot a scenario
+    names (its "robot" key: a model or its own URDF's limits)."""
+    from ..sim.pybullet.robot import ROBOT_MODELS, robot_model
+
+    if args.joint_limits in ROBOT_MODELS:
+        return ROBOT_MODELS[args.joint_limits].limits
+    from ..tasks.scenarios import load
+
+    scenario = load(args.joint_limits, allow_outside_files=getattr(args, "allow_outside_files", False))
+    return robot_model(scenario.robot, scenario.base_dir).limits
 
 
 def _skill_choice(args: argparse.Namespace, model):
@@ -83,7 +94,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
 
     args.robot_given = args.robot is not None
-    args.robot = args.robot or args.joint_limits or "panda"
+    args.robot = args.robot or (args.joint_limits if args.joint_limits in ("panda", "iiwa") else "panda")
     if not args.tool_length >= 0:
         raise ValueError(f"--tool-length must be >= 0 metres, got {args.tool_length:g}")
     model = load_model(args.model)
@@ -234,9 +245,10 @@ def _add_rollout_arguments(rollout) -> None:
                          help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2 (or one per dimension)")
     rollout.add_argument("--max-jerk", type=float, nargs="+", default=None, metavar="J",
                          help="cap on the jerk, units/s^3 (or one per dimension)")
-    rollout.add_argument("--joint-limits", choices=("panda", "iiwa"), default=None,
+    rollout.add_argument("--joint-limits", default=None, metavar="panda|iiwa|SCENARIO",
                          help="a joint-space model: the robot's per-joint velocity, acceleration and jerk limits (the "
-                              "Panda's published ones; the iiwa's published speeds, assumed acceleration and jerk)")
+                              "Panda's published ones; the iiwa's published speeds, assumed acceleration and jerk; or "
+                              "those of the robot a scenario file names)")
     rollout.add_argument("--robot", choices=("panda", "iiwa"), default=None,
                          help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; needs bidmp[sim])")
     rollout.add_argument("--cartesian-goal", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
