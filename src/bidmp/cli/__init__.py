@@ -5,7 +5,7 @@ stderr and exit code 2, never a traceback (``--debug`` shows it). NumPy and the 
 imported inside the command handlers so that ``bidmp --help`` starts fast.
 
 One module per command group, each adding its commands to the parser: ``skills`` (fit, rollout,
-segment, extend, learn), ``tasks`` (demo, sim, scenario), ``view`` (view), ``experiments`` (reproduce, lasa,
+segment, extend, learn), ``tasks`` (demo, sim, scenario), ``view`` (view), ``job`` (job), ``experiments`` (reproduce, lasa,
 benchmark); ``common`` holds what they share, ``inputs`` how demonstrations are read.
 
 Layer 4 (the shell): may import any layer, inside the handlers; nothing imports it.
@@ -30,7 +30,7 @@ __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT",
 
 def build_parser() -> _Parser:
     """The ``bidmp`` parser: global options, then each command group's commands."""
-    from . import experiments, skills, tasks, view
+    from . import experiments, job, skills, tasks, view
     from .common import allow_outside_files, parse_K
 
     parser = _Parser(
@@ -45,6 +45,7 @@ def build_parser() -> _Parser:
     experiments.add_commands(commands)
     tasks.add_commands(commands)
     view.add_commands(commands)
+    job.add_commands(commands)
     return parser
 
 

@@ -95,15 +95,21 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
-    if args.sim:
+    if args.sim or args.job:
         from ..sim.pybullet.world import _pybullet_module as _pybullet
 
         _pybullet()
+    if args.job and scenario.job is None:
+        raise ValueError(f"--job: scenario {scenario.name!r} has no \"job\" (the steps to run at each target)")
     report = _run_scenario(scenario, out, methods, view=args.view)
     if args.sim:
         sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
         _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None,
                  view=args.view)
+    if args.job:
+        from .job import run_job_command
+
+        run_job_command(scenario, out / "job", view=args.view)
     return EXIT_OK
 
 
@@ -165,6 +171,8 @@ def _demo_parser(commands) -> None:
                       help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
     demo.add_argument("--sim", action="store_true",
                       help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
+    demo.add_argument("--job", action="store_true",
+                      help="then run the scenario's whole task sequence on the simulated arm (see 'bidmp job'; needs bidmp[sim])")
     demo.add_argument("--view", action="store_true",
                       help="also write view.html: the 3-D viewer (one offline file; with --sim the robot's motion on a "
                            "time slider; needs bidmp[view])")

@@ -6,6 +6,7 @@
 * ``pybullet`` — the first backend: a 7-joint arm in PyBullet, the Franka Panda by default, the
   KUKA iiwa or your URDF (world, robot, IK, planning, execution, rendering, one module each);
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
+* ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
 * ``report`` — the results, apart from any backend, and their files.
 
@@ -20,6 +21,11 @@ from .._lazy import exports
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
     "simulate": "run",
+    "run_job": "job",
+    "JobReport": "job_report",
+    "JobTarget": "job_report",
+    "JobPhase": "job_report",
+    "write_job_report": "job_report",
     "inverse_kinematics": "kinematics",
     "joint_names": "kinematics",
     "SimulatorBackend": "backend",

@@ -31,6 +31,9 @@ _EXPORTS = {
     "path_difference": "metrics",
     "swept_area": "metrics",
     "final_approach_mask": "metrics",
+    "JobSpec": "jobs",
+    "parse_job": "jobs",
+    "tour": "jobs",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

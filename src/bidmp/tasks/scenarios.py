@@ -85,7 +85,7 @@ POSE_DIMS = 7  # x, y, z, qx, qy, qz, qw
 _KEYS = {
     "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
     "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-    "seed", "scene", "robot", "alignment_threshold",
+    "seed", "scene", "robot", "alignment_threshold", "job",
 }
 _DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol", "keep_approach",
              "goal_rate"}
@@ -119,6 +119,7 @@ class Scenario:
     scene: Scene | None = None
     alignment_threshold: float = 2.0  # degrees: a pose scenario's tool axis vs the target's over the approach
     robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
+    job: object = None  # bidmp.tasks.jobs.JobSpec: the task sequence bidmp job runs
     base_dir: str = "."  # where "file" demonstrations were read from
 
     @property
@@ -233,6 +234,11 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
     scene = _scene(data, source, targets, n_dims)
     robot = _robot(data, source, base_dir, allow_outside_files)
+    from .jobs import parse_job
+
+    job = parse_job(data, source)
+    if job is not None and scene is None:
+        _fail(source, "job", 'a job runs in the simulator: the scenario needs a "scene"')
     _check_runs(source, demonstration, targets, dmp)
     return Scenario(
         name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
@@ -240,7 +246,7 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         extensions=extensions,
         demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
         units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
-        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment,
+        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment, job=job,
     )
 
 

@@ -151,9 +151,11 @@ class RobotCell:
         within the limits (:func:`bidmp.sim.pybullet.plan.plan`)."""
         return _plan._plan(self, path, label, fractions, seed, orientations)
 
-    def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
-        """Run ``plan`` under position control at 1 kHz (:func:`bidmp.sim.pybullet.execute.execute`)."""
-        return _execute._execute(self, plan, exclude, hold, frames)
+    def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0,
+                on_record=None) -> Execution:
+        """Run ``plan`` under position control at 1 kHz (:func:`bidmp.sim.pybullet.execute.execute`);
+        ``on_record(t)`` after every recorded step."""
+        return _execute._execute(self, plan, exclude, hold, frames, on_record)
 
     def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
                             frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:

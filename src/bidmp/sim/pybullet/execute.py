@@ -53,9 +53,10 @@ def _drive(cell, q, qd) -> None:
                                      velocityGains=_GAINS, physicsClientId=cell.client)
 
 
-def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
+def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0, on_record=None) -> Execution:
     """Run ``plan`` under position control at 1 kHz, the parts in ``exclude`` ignored; a
-    ``hold`` keeps one joint still for a while (its command runs on: open loop)."""
+    ``hold`` keeps one joint still for a while (its command runs on: open loop). ``on_record``
+    is called with the time (s) after every recorded step (a part that follows the tool)."""
     p = cell.p
     n_steps = int(math.ceil((plan.duration + SETTLE) / SIM_STEP))
     positions, velocities = plan.command(np.arange(n_steps) * SIM_STEP)
@@ -91,6 +92,8 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
                     contacts[label] = max(contacts.get(label, 0.0), -contact[8])
             if visit[step]:
                 record.sample(step, t + SIM_STEP, positions[step])
+                if on_record is not None:
+                    on_record(t + SIM_STEP)
     finally:
         _ignore(cell, exclude, True)
     run = record.finish()

@@ -106,8 +106,9 @@ def _inset_prism(vertices: np.ndarray, margin: float) -> np.ndarray:
 
 
 # -- world -----------------------------------------------------------------------------
-def _add_solid(p, client: int, unit: float, solid) -> int:
-    """A static body for one solid of the scene (box, cylinder, or a nut's convex hull), in metres."""
+def _add_solid(p, client: int, unit: float, solid, mass: float = 0.0) -> int:
+    """A body for one solid of the scene (box, cylinder, or a nut's convex hull), in metres: static,
+    or dynamic with ``mass`` (kg)."""
     if solid.kind == "box":
         half = [0.5 * v * unit for v in solid.params]
         shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
@@ -126,7 +127,7 @@ def _add_solid(p, client: int, unit: float, solid) -> int:
     from scipy.spatial.transform import Rotation
 
     orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
-    return p.createMultiBody(0.0, shape, visual, (np.asarray(solid.centre) * unit).tolist(), orientation,
+    return p.createMultiBody(float(mass), shape, visual, (np.asarray(solid.centre) * unit).tolist(), orientation,
                              physicsClientId=client)
 
 

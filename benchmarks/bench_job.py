@@ -1,0 +1,50 @@
+"""The whole job's speed against real time (issue 25), and bidmp sim's with 1 and 2 worker
+processes, in one run, the sides interleaved.
+
+    .venv/bin/python benchmarks/bench_job.py [--repeats N]
+
+Prints, for the built-in 14-nut job (target >= 5x real time on 2 cores) and the 12-cell job,
+simulated seconds over wall seconds (the skills' evaluation before the job not counted: it is
+the same for any run length), and for ``bidmp.sim.simulate`` on every nut with dmp and bidmp
+without pictures (target >= 10x) the real-time factor with 1 and with 2 workers and their ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from bidmp import scenarios
+from bidmp.evaluation import evaluate
+from bidmp.sim import simulate
+from bidmp.sim.job import _robot_protocol, run_job
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    nut, cells = scenarios.load("nut-unscrewing"), scenarios.load("cell-removal")
+    job_reports = {"nut": evaluate(_robot_protocol(nut), ["bidmp"], geometry=False),
+                   "cells": evaluate(_robot_protocol(cells), ["bidmp"], geometry=False)}
+    sim_report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
+    factors = {"nut job": [], "cell job": [], "sim 1 worker": [], "sim 2 workers": []}
+    for _ in range(args.repeats):  # each round runs every side once: load drift falls on all alike
+        for name, scenario, key in (("nut job", nut, "nut"), ("cell job", cells, "cells")):
+            report = run_job(scenario, report=job_reports[key])
+            factors[name].append(report.simulated_s / report.wall_s)
+        for workers in (1, 2):
+            start = time.perf_counter()
+            result = simulate(nut, ["dmp", "bidmp"], report=sim_report, workers=workers)
+            factors[f"sim {workers} worker{'s' if workers > 1 else ''}"].append(result.simulated_s / (time.perf_counter() - start))
+    for name, values in factors.items():
+        print(f"  {name:14s} {statistics.median(values):5.1f}x real time (median of {len(values)}: "
+              f"{', '.join(f'{v:.1f}' for v in values)})")
+    ratio = statistics.median(factors["sim 2 workers"]) / statistics.median(factors["sim 1 worker"])
+    print(f"  bidmp sim: 2 workers / 1 worker = {ratio:.2f}x (target >= 1.6x, or the workers go)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

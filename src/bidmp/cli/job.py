@@ -1,0 +1,60 @@
+"""``bidmp job`` (and ``bidmp demo --job``): a scenario's whole task sequence on the simulated arm."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .common import EXIT_OK, allow_outside_files
+
+
+def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True, view: bool = False) -> int:
+    """Run the job with a progress bar, print its report, write its files (and the viewer)."""
+    from tqdm import tqdm
+
+    from ..sim.job import run_job
+    from ..sim.job_report import write_job_report
+
+    labels = list(scenario.targets) if targets is None else targets
+    with tqdm(total=len(labels), desc=f"{scenario.name} (job)", unit="part", disable=None) as bar:
+        def progress(label):
+            bar.set_postfix_str(label)
+            bar.update(1)
+
+        report = run_job(scenario, targets=targets, progress=progress, pictures=pictures, view=view)
+    print()
+    print(report.summary())
+    written = write_job_report(report, out)
+    if view:
+        from .view import write_view_files
+
+        written += write_view_files(out, report=report.evaluation, sim_result=report)
+    print(f"\nwrote {', '.join(str(path) for path in written)}")
+    return EXIT_OK
+
+
+def _cmd_job(args: argparse.Namespace) -> int:
+    from ..sim.pybullet.world import _pybullet_module
+    from ..tasks.scenarios import load
+
+    _pybullet_module()  # without the extra: the install command, before any work
+    scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
+    targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    return run_job_command(scenario, Path(args.out), targets=targets, pictures=not args.no_pictures, view=args.view)
+
+
+def add_commands(commands) -> None:
+    """``bidmp job``."""
+    job = commands.add_parser("job", help="the whole task sequence on the simulated arm (unscrew every nut, ...)",
+                              description="Run a scenario's \"job\" on the simulated arm: at every target, in the job's "
+                                          "order, the learned approach, engaging, unscrewing (a spindle coupled to the "
+                                          "arm's retraction), retracting with the nut and dropping it into the bin. "
+                                          "Prints per target and phase: success, contacts, joint peaks as fractions of the "
+                                          "limits, times; writes job_results.json, job.md and job_cycle.png. Needs bidmp[sim].")
+    job.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="a scenario with a \"job\" (default nut-unscrewing)")
+    job.add_argument("--targets", default=None, help="comma-separated subset of the targets (default all, in the job's order)")
+    job.add_argument("--no-pictures", action="store_true", help="skip the keyframes of the first cycle")
+    job.add_argument("--view", action="store_true", help="also write view.html: the 3-D viewer, the first cycle on a time slider")
+    job.add_argument("--out", default="bidmp-job", help="output folder (default ./bidmp-job)")
+    allow_outside_files(job)
+    job.set_defaults(handler=_cmd_job)

@@ -1,0 +1,184 @@
+"""What a simulated job did: per target and per phase, and in all (lengths in the scenario's unit,
+times in simulated seconds, peaks as fractions of the arm's joint limits)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..tasks._tables import markdown_table, text_table
+from .backend import RECORD_EVERY, SETTLE, SIM_STEP
+from .limits import _command_peaks, _measured_peaks
+
+__all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report"]
+
+FORMAT = 1  # of job_results.json
+
+
+@dataclass
+class JobPhase:
+    """One step at one target: done or not (and why), how long, what it touched, how hard."""
+
+    name: str
+    ok: bool
+    seconds: float  # simulated time, the settling after a motion included
+    note: str = ""
+    contacts: dict = field(default_factory=dict)  # part label -> deepest penetration (scene unit), non-targets
+    peaks: tuple = (0.0, 0.0, 0.0)  # commanded joint velocity, acceleration, jerk / their limits (largest joint)
+    measured_peaks: tuple = (0.0, 0.0, 0.0)  # what the simulated joints did (10 ms differences)
+    within_limits: bool = True  # every 1 kHz command within the limits, from rest to rest
+
+    def to_dict(self) -> dict:
+        return {"phase": self.name, "ok": self.ok, "seconds": round(self.seconds, 3), "note": self.note,
+                "contacts": {k: round(v, 3) for k, v in self.contacts.items()},
+                "peak_velocity": round(self.peaks[0], 3), "peak_acceleration": round(self.peaks[1], 3),
+                "peak_jerk": round(self.peaks[2], 3), "measured_peak_velocity": round(self.measured_peaks[0], 3),
+                "measured_peak_acceleration": round(self.measured_peaks[1], 3),
+                "measured_peak_jerk": round(self.measured_peaks[2], 3), "within_limits": self.within_limits}
+
+
+def _phase(name: str, run, plan, cell) -> JobPhase:
+    """A motion's phase from its execution: the commands' and the joints' peaks, the contacts."""
+    sent = _command_peaks(run.commands, cell.limits)
+    measured = _measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, cell.limits)
+    contacts = {label: depth / cell.unit for label, depth in run.contacts.items()}
+    return JobPhase(name, not contacts, plan.duration + SETTLE, "", contacts,
+                    (sent.velocity, sent.acceleration, sent.jerk), (measured.velocity, measured.acceleration, measured.jerk),
+                    sent.within)
+
+
+@dataclass
+class JobTarget:
+    label: str
+    phases: list = field(default_factory=list)
+    removed: bool = False  # the part ended where it belongs (in the bin, in its slot)
+    reason: str = ""  # the first step that failed, and why
+    final_position: np.ndarray | None = None  # where the part came to rest (scene units)
+    thread: np.ndarray | None = None  # (n, 3) while unscrewing: rise (scene units), angle turned (rad), time (s)
+
+    @property
+    def seconds(self) -> float:
+        return float(sum(phase.seconds for phase in self.phases))
+
+    @property
+    def contacts(self) -> dict:
+        found = {}
+        for phase in self.phases:
+            for label, depth in phase.contacts.items():
+                found[label] = max(found.get(label, 0.0), depth)
+        return found
+
+    @property
+    def within_limits(self) -> bool:
+        return all(phase.within_limits for phase in self.phases)
+
+    def to_dict(self) -> dict:
+        return {"target": self.label, "removed": self.removed, "reason": self.reason, "seconds": round(self.seconds, 3),
+                "final_position": None if self.final_position is None else np.round(self.final_position, 2).tolist(),
+                "phases": [phase.to_dict() for phase in self.phases]}
+
+
+@dataclass
+class JobReport:
+    scenario: object
+    kind: str
+    robot: str
+    targets: list
+    wall_s: float = 0.0
+    pictures: list = field(default_factory=list)  # (target, phase, s into its cycle, image) of the first cycle
+    motions: dict = field(default_factory=dict)  # ("job", first target) -> {"times", "links"}: the viewer's arm
+    evaluation: object = None  # the evaluation whose learned skills ran (bidmp.evaluate's report)
+
+    @property
+    def removed(self) -> int:
+        return sum(target.removed for target in self.targets)
+
+    @property
+    def simulated_s(self) -> float:
+        return float(sum(target.seconds for target in self.targets))
+
+    def phase_names(self) -> list:
+        return list(dict.fromkeys(phase.name for target in self.targets for phase in target.phases))
+
+    def rows(self) -> tuple[list, list]:
+        names = self.phase_names()
+        header = ["target", "removed"] + [f"{name} s" for name in names] + ["cycle s", "contacts", "peak v / a / j", "failed step"]
+        rows = []
+        for target in self.targets:
+            times = {phase.name: phase for phase in target.phases}
+            peaks = np.max([phase.peaks for phase in target.phases], axis=0) if target.phases else np.zeros(3)
+            rows.append([target.label, "yes" if target.removed else "no"]
+                        + [("-" if name not in times else f"{times[name].seconds:.2f}" + ("" if times[name].ok else " ✗"))
+                           for name in names]
+                        + [f"{target.seconds:.2f}", str(len(target.contacts)), "/".join(f"{v:.2f}" for v in peaks),
+                           target.reason or "-"])
+        return header, rows
+
+    def totals(self) -> dict:
+        cycles = [target.seconds for target in self.targets if target.removed]
+        return {"targets": len(self.targets), "removed": self.removed,
+                "contacts": sum(len(target.contacts) for target in self.targets),
+                "within_limits": sum(target.within_limits for target in self.targets),
+                "cycle_s_mean": round(float(np.mean(cycles)), 3) if cycles else None,
+                "cycle_s_max": round(float(np.max(cycles)), 3) if cycles else None,
+                "total_s": round(self.simulated_s, 3)}  # simulated seconds; the wall time is not reproducible
+
+    def summary(self) -> str:
+        totals = self.totals()
+        lines = [f"{self.scenario.name}: the whole {self.kind} job on the simulated {self.robot}, "
+                 f"{totals['removed']}/{totals['targets']} parts removed, {totals['contacts']} contacts with other parts, "
+                 f"{totals['within_limits']}/{totals['targets']} within the joint limits", "",
+                 text_table(*self.rows())]
+        if totals["cycle_s_mean"] is not None:
+            lines.append(f"\ncycle per part {totals['cycle_s_mean']:.2f} s (longest {totals['cycle_s_max']:.2f} s), "
+                         f"{totals['total_s']:.1f} s in all")
+        if self.wall_s > 0:
+            lines.append(f"simulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
+                         f"({self.simulated_s / self.wall_s:.1f}x real time)")
+        return "\n".join(lines)
+
+    def markdown(self) -> str:
+        return markdown_table(*self.rows())
+
+    def to_dict(self) -> dict:
+        return {"format": FORMAT, "scenario": self.scenario.name, "job": self.kind, "robot": self.robot,
+                "units": self.scenario.units, "totals": self.totals(),
+                "targets": [target.to_dict() for target in self.targets]}
+
+
+def write_job_report(report: JobReport, out) -> list[Path]:
+    """``job_results.json`` and ``job.md`` (the table) into folder ``out``."""
+    from ..io.atomic import atomic_write
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [out / "job_results.json", out / "job.md"]
+    with atomic_write(written[0], "w") as handle:
+        json.dump(report.to_dict(), handle, indent=2)
+    with atomic_write(written[1], "w") as handle:
+        handle.write(report.markdown() + "\n")
+    if report.pictures:
+        written.append(_cycle_strip(out / "job_cycle.png", report))
+    return written
+
+
+def _cycle_strip(path: Path, report: JobReport) -> Path:
+    """The first cycle's keyframes side by side, each titled with its phase, target and time."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    from ..io.atomic import atomic_write
+
+    font = ImageFont.load_default(size=15)
+    tiles = []
+    for label, phase, seconds, image in report.pictures:
+        band = Image.new("RGB", (image.shape[1], 24), (255, 255, 255))
+        ImageDraw.Draw(band).text((6, 3), f"{phase} done, target {label}, {seconds:.2f} s", fill=(20, 20, 20), font=font)
+        tiles.append(np.concatenate([np.asarray(band), image], axis=0))
+        tiles.append(np.full((tiles[-1].shape[0], 4, 3), 255, np.uint8))
+    strip = np.concatenate(tiles[:-1], axis=1)
+    with atomic_write(path, "wb") as handle:
+        Image.fromarray(strip).save(handle, format="PNG")
+    return path

@@ -1,0 +1,128 @@
+"""Parts the job takes away, in the PyBullet world: a nut on its stud's thread, a part held by
+the tool, a part let go that falls under gravity; and the job's own parts (bin, rack).
+
+**The thread** is kinematic: while the socket is engaged the nut turns about its axis and rises
+by the pitch per turn, ``rise = pitch * turns``; once its bottom clears the stud's top it is off
+the thread and stays in the socket. **Held** parts move with the tool (a suction or socket hold:
+rigid, no slip). **Released** parts become dynamic bodies with their mass and fall under gravity,
+colliding with everything else. (A full contact model of a thread — helical surfaces, friction —
+would cost far more than it shows: what the job needs is where the nut is.)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .world import _add_solid
+
+__all__ = []
+
+
+class _MovablePart:
+    """One part of the scene (a nut or a cell) that the job moves: ``seated`` → (``threading``) →
+    ``held`` → ``released``. Poses in scene units."""
+
+    def __init__(self, cell, label: str, mass: float):
+        self.cell, self.label, self.mass = cell, label, float(mass)
+        solids = [s for s in cell.scene.solids if s.label == label]
+        if not solids:
+            raise ValueError(f"target {label!r} has no part of its own in the scene to take away")
+        self.solid = solids[0]
+        self.body = next(body for body, name in cell._bodies.items() if name == label)
+        self.centre0 = np.asarray(self.solid.centre, dtype=float)
+        self.rotation0 = Rotation.from_matrix(self.solid.rotation)
+        self.axis = self.solid.rotation[:, 2]
+        self.height = float(np.dot(self.solid.upper - self.solid.lower, np.abs(self.axis)))  # along its axis
+        self.state, self.offset, self.rise = "seated", None, 0.0
+        self.trace: list[tuple[float, float, float]] = []  # (rise, angle turned, time) while threading
+
+    def set_pose(self, centre, rotation: Rotation) -> None:
+        p, unit = self.cell.p, self.cell.unit
+        p.resetBasePositionAndOrientation(self.body, (np.asarray(centre) * unit).tolist(), rotation.as_quat().tolist(),
+                                          physicsClientId=self.cell.client)
+
+    def pose(self) -> tuple[np.ndarray, Rotation]:
+        position, orientation = self.cell.p.getBasePositionAndOrientation(self.body, physicsClientId=self.cell.client)
+        return np.asarray(position) / self.cell.unit, Rotation.from_quat(orientation)
+
+    def thread(self, rise: float, pitch: float, t: float) -> None:
+        """On the thread: risen ``rise`` along its axis, turned ``rise / pitch`` turns
+        (counter-clockwise seen from above: a right-hand thread loosening). The spindle only
+        loosens: a lag of the arm (the measured tool dips back a few micrometres) holds the nut
+        where it is rather than screwing it back."""
+        self.state, self.rise = "threading", max(self.rise, float(rise))
+        angle = 2.0 * math.pi * self.rise / pitch
+        self.set_pose(self.centre0 + self.axis * self.rise, Rotation.from_rotvec(self.axis * angle) * self.rotation0)
+        self.trace.append((self.rise, angle, t))
+
+    def hold(self, tcp) -> None:
+        """Held by the tool from now on, where it is relative to the tool's mouth ``tcp``."""
+        centre, _ = self.pose()
+        self.state, self.offset = "held", centre - np.asarray(tcp, dtype=float)
+
+    def follow(self, tcp) -> None:
+        _, rotation = self.pose()
+        self.set_pose(np.asarray(tcp, dtype=float) + self.offset, rotation)
+
+    def release(self) -> None:
+        """Let go: a dynamic body with the part's mass in its place, falling under gravity."""
+        p, cell = self.cell.p, self.cell
+        centre, rotation = self.pose()
+        cell._bodies.pop(self.body, None)
+        cell._owners.pop(self.body, None)
+        p.removeBody(self.body, physicsClientId=cell.client)
+        self.body = _add_solid(p, cell.client, cell.unit, self.solid, mass=self.mass)
+        self.set_pose(centre, rotation)
+        # It leaves the socket: no contact with the arm (it starts inside the tool's solid, which
+        # would throw both apart), with everything else as any body.
+        for link in range(-1, p.getNumJoints(cell.robot, physicsClientId=cell.client)):
+            p.setCollisionFilterPair(cell.robot, self.body, link, -1, 0, physicsClientId=cell.client)
+        self.state = "released"
+
+
+def _rest(part: _MovablePart) -> None:
+    """A released part that has come to rest: a static body where it lies (13 nuts tumbling in a
+    bin on every later step made the 14-nut job run at half the speed)."""
+    p, cell = part.cell.p, part.cell
+    centre, rotation = part.pose()
+    p.removeBody(part.body, physicsClientId=cell.client)
+    part.body = _add_solid(p, cell.client, cell.unit, part.solid)
+    part.set_pose(centre, rotation)
+    part.state = "at rest"
+
+
+def _open_box(label: str, floor_centre, inner) -> list:
+    """An open box (a bin) as five thin boxes: floor and walls, 2 % of its size thick (scene units)."""
+    from ...scene.parts import _box_solid
+
+    floor_centre, inner = np.asarray(floor_centre, float), np.asarray(inner, float)
+    wall = max(0.02 * float(inner[:2].min()), 1e-3 * float(inner.max()))
+    eye = np.eye(3)
+    half = inner / 2.0
+    pieces = [(floor_centre - [0, 0, wall / 2], [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
+    for sign in (-1.0, 1.0):
+        pieces.append((floor_centre + [sign * (half[0] + wall / 2), 0, half[2]], [wall, inner[1] + 2 * wall, inner[2]]))
+        pieces.append((floor_centre + [0, sign * (half[1] + wall / 2), half[2]], [inner[0], wall, inner[2]]))
+    return [_box_solid(label, label, np.asarray(centre, float), size, eye) for centre, size in pieces]
+
+
+def _add_job_solids(cell, solids) -> None:
+    """Static bodies for the job's own parts (bin walls, ...), their contacts reported by label."""
+    for solid in solids:
+        body = _add_solid(cell.p, cell.client, cell.unit, solid)
+        cell._bodies[body] = solid.label
+        cell._owners[body] = solid.part
+
+
+def _settle(cell, seconds: float) -> None:
+    """Let the world run ``seconds`` with the arm holding where it is (a released part falls)."""
+    p = cell.p
+    states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
+    held = [s[0] for s in states]
+    p.setJointMotorControlArray(cell.robot, cell.arm, p.POSITION_CONTROL, targetPositions=held,
+                                targetVelocities=[0.0] * 7, forces=list(cell.model.effort), physicsClientId=cell.client)
+    for _ in range(int(round(seconds / 1e-3))):
+        p.stepSimulation(physicsClientId=cell.client)

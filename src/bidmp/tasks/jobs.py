@@ -1,0 +1,152 @@
+"""Task sequences: a scenario's ``"job"`` key, the steps run at every target, and their order.
+
+A job names what the robot does at each target after the learned approach brings the tool there:
+
+* ``"unscrew"`` (the nut task): approach → engage (the socket over the nut, its axis within
+  ``engage_tolerance``) → unscrew (a powered spindle turns the socket while the arm retracts by the
+  thread's pitch per turn) → retract with the nut → drop it into the ``bin``;
+* ``"lift"`` (cell removal): approach → grasp (a vacuum gripper, made when the tool is within
+  ``engage_tolerance`` of the part's top centre) → lift straight out past the neighbours → place
+  in the next ``rack`` slot;
+* ``"pick-place"``: approach → grasp → place in the next ``rack`` slot (no straight lift).
+
+``"order"``: ``"listed"`` (the targets' order in the file) or ``"shortest"``: a short tour from
+the demonstrated target by a small heuristic — nearest neighbour, then 2-opt exchanges until
+none shortens it (not an optimal TSP solution; the distances come from SciPy's ``cdist``).
+
+Lengths in the scenario's unit; the bin and the rack are open boxes / slot grids added to the
+scene's parts in the simulated world only (the evaluation's geometry is unchanged).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from numbers import Real
+
+import numpy as np
+
+from ._scenario_fields import _fail, _point, _shown
+
+__all__ = ["JobSpec", "JOB_KINDS", "parse_job", "tour"]
+
+JOB_KINDS = {"unscrew": ("approach", "engage", "unscrew", "retract", "drop"),
+             "lift": ("approach", "grasp", "lift", "place"),
+             "pick-place": ("approach", "grasp", "place")}
+MAX_TOUR = 200
+_KEYS = {"steps", "order", "bin", "rack", "pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance"}
+
+
+@dataclass(frozen=True)
+class JobSpec:
+    """A validated ``"job"`` (lengths in the scenario's unit, times in s, masses in kg).
+
+    ``bin``: (centre of its floor's top (3,), inner size (3,)); ``rack``: (first slot (3,), step
+    between slots (3,), slots per row, step between rows (3,)); ``pitch``: thread pitch per turn;
+    ``spindle_speed``: the socket's top speed, turns/s; ``lift``: how far above a part's
+    neighbours it is lifted; ``clearance``: the height over the work the transfers keep.
+    """
+
+    kind: str
+    steps: tuple
+    order: str = "listed"
+    bin: tuple | None = None
+    rack: tuple | None = None
+    pitch: float = 1.25
+    spindle_speed: float = 10.0
+    engage_tolerance: float = 1.0
+    part_mass: float = 0.005
+    lift: float = 20.0
+    clearance: float = 40.0
+
+
+def _positive(value, source: str, key: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value) or value <= 0:
+        _fail(source, key, f"expected a positive number, got {_shown(value)}")
+    return float(value)
+
+
+def _box(value, source: str, key: str) -> tuple:
+    if not isinstance(value, dict) or set(value) != {"at", "size"}:
+        _fail(source, key, 'expected {"at": [x, y, z] (its floor\'s centre), "size": [sx, sy, sz] (inside)}')
+    size = _point(value["size"], source, f"{key}.size", 3)
+    if np.any(size <= 0):
+        _fail(source, f"{key}.size", "every side must be > 0")
+    return _point(value["at"], source, f"{key}.at", 3), size
+
+
+def _rack(value, source: str, key: str) -> tuple:
+    known = {"at", "step", "per_row", "row_step"}
+    if not isinstance(value, dict) or set(value) - known or not {"at", "step"} <= set(value):
+        _fail(source, key, 'expected {"at": first slot [x, y, z], "step": [dx, dy, dz], "per_row": n, "row_step": [...]}')
+    per_row = value.get("per_row", 1000)
+    if isinstance(per_row, bool) or not isinstance(per_row, int) or per_row < 1:
+        _fail(source, f"{key}.per_row", f"expected a positive integer, got {_shown(per_row)}")
+    return (_point(value["at"], source, f"{key}.at", 3), _point(value["step"], source, f"{key}.step", 3), per_row,
+            _point(value.get("row_step", [0, 0, 0]), source, f"{key}.row_step", 3))
+
+
+def parse_job(data, source: str) -> JobSpec | None:
+    """The scenario's ``"job"`` validated key by key (None when it has none)."""
+    if not isinstance(data, dict):
+        raise TypeError(f"data must be a scenario's dict, got {type(data).__name__}")
+    source = source if isinstance(source, str) else "<data>"
+    job = data.get("job")
+    if job is None:
+        return None
+    if not isinstance(job, dict) or set(job) - _KEYS:
+        unknown = sorted(set(job) - _KEYS) if isinstance(job, dict) else []
+        _fail(source, "job", f"expected keys among {sorted(_KEYS)}" + (f"; unknown {unknown}" if unknown else ""))
+    steps = job.get("steps")
+    kinds = {names: kind for kind, names in JOB_KINDS.items()}
+    if not isinstance(steps, list) or tuple(steps) not in kinds:
+        choices = "; ".join(" → ".join(names) for names in JOB_KINDS.values())
+        _fail(source, "job.steps", f"expected one of the sequences {choices}, got {_shown(steps)}")
+    kind = kinds[tuple(steps)]
+    order = job.get("order", "listed")
+    if order not in ("listed", "shortest"):
+        _fail(source, "job.order", f'expected "listed" or "shortest", got {_shown(order)}')
+    if kind == "unscrew" and "bin" not in job:
+        _fail(source, "job.bin", "unscrewing drops each nut into a bin: give its floor's centre and inner size")
+    if kind != "unscrew" and "rack" not in job:
+        _fail(source, "job.rack", "a part is placed in a rack slot: give the first slot and the step between slots")
+    numbers = {name: _positive(job[name], source, f"job.{name}") for name in
+               ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance") if name in job}
+    return JobSpec(kind=kind, steps=tuple(steps), order=order,
+                   bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
+                   rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None, **numbers)
+
+
+def tour(points: np.ndarray, start: np.ndarray) -> list[int]:
+    """A short open tour through ``points`` (n, 3) from ``start`` (3,): the visiting order, by
+    nearest neighbour then 2-opt (a heuristic: short, not proven shortest)."""
+    from scipy.spatial.distance import cdist
+
+    from .._checks import as_point, as_points
+
+    points = as_points(points, 3, "points")
+    start = as_point(start, 3, "start")
+    n = len(points)
+    if n > MAX_TOUR:  # 2-opt here is O(n^4): a job's targets, not a point cloud
+        raise ValueError(f"points: {n:,} targets; a tour orders at most {MAX_TOUR}")
+    if n < 2:
+        return list(range(n))
+    distance = cdist(points, points)
+    first = cdist(np.asarray(start, float)[None], points)[0]
+    order, left = [int(np.argmin(first))], set(range(n)) - {int(np.argmin(first))}
+    while left:
+        here = order[-1]
+        order.append(min(left, key=lambda j: (distance[here, j], j)))
+        left.remove(order[-1])
+
+    def length(path):
+        return first[path[0]] + sum(distance[a, b] for a, b in zip(path, path[1:]))
+
+    improved = True
+    while improved:  # 2-opt: reverse a stretch while that shortens the tour
+        improved = False
+        for i in range(n - 1):
+            for j in range(i + 1, n):
+                candidate = order[:i] + order[i:j + 1][::-1] + order[j + 1:]
+                if length(candidate) < length(order) - 1e-9:
+                    order, improved = candidate, True
+    return order
