@@ -48,8 +48,10 @@ class _World:
         return self.cell.tcp_position() / self.cell.unit
 
 
-def _move(world: _World, path, fractions, exclude, name: str, on_record=None, least_duration: float = 0.0):
-    """Plan ``path`` (n, 3) from the arm's joints now, execute it, measure the phase."""
+def _move(world: _World, path, fractions, exclude, name: str, on_record=None, least_duration: float = 0.0,
+          carried=None):
+    """Plan ``path`` (n, 3) from the arm's joints now, execute it, measure the phase; with a
+    ``carried`` part, its own contacts with other parts count as the arm's."""
     cell = world.cell
     plan = cell.plan(np.asarray(path, dtype=float), name, fractions=fractions, seed=world.q)
     if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
@@ -58,6 +60,12 @@ def _move(world: _World, path, fractions, exclude, name: str, on_record=None, le
         plan.peak_velocity *= scale
         plan.peak_acceleration *= scale**2
         plan.peak_jerk *= scale**3
+    touched = {}
+    if carried is not None:
+        def on_record(t, inner=on_record):
+            carried.contacts(touched, ignore=exclude)
+            if inner is not None:
+                inner(t)
     run = cell.execute(plan, exclude, on_record=on_record)
     world.q = run.joints[-1]
     if world.motion is not None:
@@ -66,6 +74,9 @@ def _move(world: _World, path, fractions, exclude, name: str, on_record=None, le
         arm = _arm_motion(cell, run)
         world.motion.append((world.clock + arm["times"], arm["links"]))
     phase = _phase(name, run, plan, cell)
+    for label, depth in touched.items():
+        phase.contacts[label] = max(phase.contacts.get(label, 0.0), depth)
+    phase.ok = not phase.contacts
     world.clock += phase.seconds
     return phase
 
@@ -138,9 +149,7 @@ def _engaged(world: _World, part: _MovablePart, target) -> tuple[bool, str]:
 def _straight(world: _World, direction, length: float, exclude, name: str, part=None, **options) -> JobPhase:
     start = world.tcp
     end = start + np.asarray(direction, dtype=float) * length
-    follow = None if part is None else (lambda t: part.follow(world.tcp))
-    return _move(world, np.vstack([start, end]), None, exclude, name, on_record=options.pop("on_record", follow),
-                 **options)
+    return _move(world, np.vstack([start, end]), None, exclude, name, carried=part, **options)
 
 
 def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
@@ -170,7 +179,7 @@ def _drop_point(world: _World) -> np.ndarray:
 def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
     path, fractions, note = _clear_path(world, _drop_point(world), 0, exclude=exclude)
-    phase = _move(world, path, fractions, exclude, "drop", on_record=lambda t: part.follow(world.tcp))
+    phase = _move(world, path, fractions, exclude, "drop", carried=part)
     part.release()
     world.held = None
     _settle(world.cell, RELEASE_S)
@@ -218,7 +227,7 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     bottom = part.pose()[0] - part.axis * part.height / 2.0
     goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, 0.5]  # let go half a unit above
     path, fractions, note = _clear_path(world, goal, 0, exclude, carried=part.height)
-    phase = _move(world, path, fractions, exclude, "place", on_record=lambda t: part.follow(world.tcp))
+    phase = _move(world, path, fractions, exclude, "place", carried=part)
     part.release()
     world.held = None
     _settle(world.cell, RELEASE_S)

@@ -3,8 +3,8 @@ the tool, a part let go that falls under gravity; and the job's own parts (bin, 
 
 **The thread** is kinematic: while the socket is engaged the nut turns about its axis and rises
 by the pitch per turn, ``rise = pitch * turns``; once its bottom clears the stud's top it is off
-the thread and stays in the socket. **Held** parts move with the tool (a suction or socket hold:
-rigid, no slip). **Released** parts become dynamic bodies with their mass and fall under gravity,
+the thread and stays in the socket. **Held** parts are bodies with their mass fixed to the tool
+by a constraint (a socket's or a suction gripper's hold), carried by the arm under physics. **Released** parts become dynamic bodies with their mass and fall under gravity,
 colliding with everything else. (A full contact model of a thread — helical surfaces, friction —
 would cost far more than it shows: what the job needs is where the nut is.)
 """
@@ -36,7 +36,7 @@ class _MovablePart:
         self.rotation0 = Rotation.from_matrix(self.solid.rotation)
         self.axis = self.solid.rotation[:, 2]
         self.height = float(np.dot(self.solid.upper - self.solid.lower, np.abs(self.axis)))  # along its axis
-        self.state, self.offset, self.rise = "seated", None, 0.0
+        self.state, self.offset, self.rise, self.constraint = "seated", None, 0.0, None
         self.trace: list[tuple[float, float, float]] = []  # (rise, angle turned, time) while threading
 
     def set_pose(self, centre, rotation: Rotation) -> None:
@@ -58,29 +58,58 @@ class _MovablePart:
         self.set_pose(self.centre0 + self.axis * self.rise, Rotation.from_rotvec(self.axis * angle) * self.rotation0)
         self.trace.append((self.rise, angle, t))
 
-    def hold(self, tcp) -> None:
-        """Held by the tool from now on, where it is relative to the tool's mouth ``tcp``."""
-        centre, _ = self.pose()
-        self.state, self.offset = "held", centre - np.asarray(tcp, dtype=float)
+    def hold(self, tcp=None) -> None:
+        """Held by the tool from now on: a body with the part's mass, fixed to the tool's mouth
+        where it is by a constraint (the gripper's or the socket's hold), carried by the arm
+        under physics; its contacts with other parts are its own (:meth:`contacts`)."""
+        p, cell = self.cell.p, self.cell
+        self._make_dynamic()
+        tcp_position, tcp_orientation = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1,
+                                                       physicsClientId=cell.client)[4:6]
+        position, orientation = p.getBasePositionAndOrientation(self.body, physicsClientId=cell.client)
+        inverse = p.invertTransform(tcp_position, tcp_orientation)
+        local_position, local_orientation = p.multiplyTransforms(*inverse, position, orientation)
+        self.constraint = p.createConstraint(cell.robot, cell.tcp, self.body, -1, p.JOINT_FIXED, [0, 0, 0],
+                                             local_position, [0, 0, 0], local_orientation, [0, 0, 0, 1],
+                                             physicsClientId=cell.client)
+        p.changeConstraint(self.constraint, maxForce=500.0, physicsClientId=cell.client)
+        self.state = "held"
 
-    def follow(self, tcp) -> None:
-        _, rotation = self.pose()
-        self.set_pose(np.asarray(tcp, dtype=float) + self.offset, rotation)
+    def follow(self, tcp=None) -> None:
+        """Kept for a part moved by hand; a held part is carried by its constraint."""
+
+    def contacts(self, found: dict, ignore=()) -> None:
+        """Add the part's contacts with the scene's parts (not those in ``ignore``) to ``found``."""
+        cell = self.cell
+        for contact in cell.p.getContactPoints(bodyA=self.body, physicsClientId=cell.client):
+            label = cell._bodies.get(contact[2])
+            if label is not None and contact[8] < 0.0 and cell._owners.get(contact[2]) not in ignore:
+                found[label] = max(found.get(label, 0.0), -contact[8] / cell.unit)
 
     def release(self) -> None:
-        """Let go: a dynamic body with the part's mass in its place, falling under gravity."""
+        """Let go: the constraint removed, the part falls under gravity."""
         p, cell = self.cell.p, self.cell
+        if getattr(self, "constraint", None) is not None:
+            p.removeConstraint(self.constraint, physicsClientId=cell.client)
+            self.constraint = None
+        self._make_dynamic()
+        self.state = "released"
+
+    def _make_dynamic(self) -> None:
+        """The part as a body with its mass in its place (no longer one of the scene's static
+        bodies); no contact with the arm: it sits inside the tool's solid (a socket, a gripper),
+        which would throw both apart."""
+        p, cell = self.cell.p, self.cell
+        if self.state in ("held", "released"):
+            return
         centre, rotation = self.pose()
         cell._bodies.pop(self.body, None)
         cell._owners.pop(self.body, None)
         p.removeBody(self.body, physicsClientId=cell.client)
         self.body = _add_solid(p, cell.client, cell.unit, self.solid, mass=self.mass)
         self.set_pose(centre, rotation)
-        # It leaves the socket: no contact with the arm (it starts inside the tool's solid, which
-        # would throw both apart), with everything else as any body.
         for link in range(-1, p.getNumJoints(cell.robot, physicsClientId=cell.client)):
             p.setCollisionFilterPair(cell.robot, self.body, link, -1, 0, physicsClientId=cell.client)
-        self.state = "released"
 
 
 def _rest(part: _MovablePart) -> None:
