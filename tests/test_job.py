@@ -165,3 +165,27 @@ def test_the_built_in_jobs_in_one_run_as_committed(name, committed, parts):
     assert totals["removed"] == parts == totals["targets"] and totals["contacts"] == 0
     assert totals["within_limits"] == parts and totals["cycle_s_max"] <= 10.0
     assert (RESULTS / committed).read_text() == report.markdown() + "\n"
+
+
+def test_pick_and_place_steps_place_a_free_part_and_name_a_boxed_in_one():
+    """The pick-place sequence (no straight lift) on the cell module: a corner cell is carried
+    off and set in its slot; a cell boxed in by its neighbours would drag against one, and the
+    job says which instead of running it."""
+    spec = json.loads(scenarios.builtin_text("cell-removal"))
+    spec["job"]["steps"] = ["approach", "grasp", "place"]
+    report = run_job(scenarios.from_dict(spec), targets=["B1", "B12"])
+    corner, boxed = report.targets
+    assert corner.removed and [p.name for p in corner.phases] == ["approach", "grasp", "place"]
+    assert not boxed.removed and "would touch B" in boxed.reason and "\n" not in boxed.reason
+    assert report.kind == "pick-place" and not any(t.contacts for t in report.targets)
+
+
+def test_bidmp_demo_job_runs_the_evaluation_then_the_job(tmp_path, capsys):
+    spec = json.loads(json.dumps(NUT))
+    spec["targets"] = {label: spec["targets"][label] for label in ("3", "4", "11")}
+    spec["methods"] = ["dmp", "bidmp"]
+    (tmp_path / "two.json").write_text(json.dumps(spec))
+    assert main(["demo", "--scenario", str(tmp_path / "two.json"), "--job", "--out", str(tmp_path / "out")]) == 0
+    assert "3/3 parts removed" in capsys.readouterr().out
+    assert json.loads((tmp_path / "out" / "job" / "job_results.json").read_text())["totals"]["removed"] == 3
+    assert main(["demo", "--scenario", "pick-and-place", "--job", "--out", str(tmp_path / "p")]) == 2
