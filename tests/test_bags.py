@@ -249,3 +249,23 @@ def test_a_position_motion_leaves_as_the_robots_joint_trajectory_after_ik(tmp_pa
         p.disconnect(client)
     expected = (rows[:, 1:4] - [0, 0, 50]) / 1000.0  # the model's mm, relative to the base, in m
     assert np.max(np.linalg.norm(np.array(tips) - expected, axis=1)) <= 1e-4
+
+
+def test_the_scenarios_robot_where_it_stands_gives_the_same_joint_trajectory(tmp_path):
+    """--robot SCENARIO: the scenario's arm at its base and yaw with its tool; the same as
+    naming them by hand (the nut task's Panda at (50, -450, 0) mm facing +y, a 100 mm socket)."""
+    pytest.importorskip("pybullet")
+    recording = Path(__file__).resolve().parent.parent / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv"
+    assert main(["fit", str(recording), "--units", "mm", "-o", str(tmp_path / "m.npz")]) == 0
+    common = ["rollout", str(tmp_path / "m.npz"), "--goal", "150", "0", "0", "--rate", "50"]
+    assert main(common + ["-o", str(tmp_path / "a.csv"), "--robot", "nut-unscrewing", "--bag", str(tmp_path / "a")]) == 0
+    assert main(common + ["-o", str(tmp_path / "b.csv"), "--robot", "panda", "--base", "50", "-450", "0", "--yaw", "90",
+                          "--tool-length", "0.1", "--bag", str(tmp_path / "b")]) == 0
+    points = []
+    for name in ("a", "b"):
+        with AnyReader([tmp_path / name]) as reader:
+            (connection,) = reader.connections
+            (message,) = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+        points.append(np.array([point.positions for point in message.points]))
+    assert points[0].shape[1] == 7
+    np.testing.assert_allclose(points[0], points[1], atol=1e-12)

@@ -150,11 +150,31 @@ def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
 
     from ..sim.kinematics import inverse_kinematics
 
-    q = inverse_kinematics(np.asarray(args.cartesian_goal, dtype=float), args.robot, units="m",
-                           tool_length=args.tool_length, seed=dmp.goal_)
+    q = inverse_kinematics(np.asarray(args.cartesian_goal, dtype=float), units="m", seed=dmp.goal_, **_arm(args, 1.0))
     print(f"--cartesian-goal {args.cartesian_goal} m: the {args.robot}'s joints {np.array2string(q, precision=4)} rad "
           f"(inverse kinematics from the demonstrated goal's)")
     return q
+
+
+def _arm(args: argparse.Namespace, metres_per_unit: float) -> dict:
+    """The arm of --robot for inverse kinematics, in metres: a built-in (at --base, turned by
+    --yaw, --tool-length on its flange), or a scenario's robot where the scenario puts it, with
+    the scenario's tool (its model, URDF and limits)."""
+    import numpy as np
+
+    from ..sim.pybullet.robot import ROBOT_MODELS, robot_model, robot_placement
+
+    if args.robot in ROBOT_MODELS:
+        base = np.zeros(3) if args.base is None else np.asarray(args.base, dtype=float) * metres_per_unit
+        return {"robot": args.robot, "base": base, "yaw": args.yaw, "tool_length": args.tool_length}
+    from .._units import conversion
+    from ..tasks.scenarios import load
+
+    scenario = load(args.robot, allow_outside_files=getattr(args, "allow_outside_files", False))
+    scale = conversion(scenario.units, "m")
+    base, yaw = robot_placement(scenario)
+    tool = args.tool_length if scenario.scene is None else scenario.scene.tool.length * scale
+    return {"robot": robot_model(scenario.robot, scenario.base_dir), "base": base * scale, "yaw": yaw, "tool_length": tool}
 
 
 def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
@@ -169,13 +189,13 @@ def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
     if not dmp.units_ or dmp.units_ == "rad":
         raise ValueError("--robot with --bag: inverse kinematics needs the model's length unit; fit it with --units")
     scale = conversion(dmp.units_, "m")
-    base = np.zeros(3) if args.base is None else np.asarray(args.base, dtype=float)
-    joints = inverse_kinematics(trajectory.y * scale, args.robot, units="m", tool_length=args.tool_length,
-                                base=base * scale, yaw=args.yaw)
+    arm = _arm(args, scale)
+    joints = inverse_kinematics(trajectory.y * scale, units="m", **arm)
     velocities = np.gradient(joints, trajectory.t, axis=0)
-    path = write_bag(args.bag, trajectory.t, joints, kind="joints", names=joint_names(args.robot), velocities=velocities,
+    path = write_bag(args.bag, trajectory.t, joints, kind="joints", names=joint_names(arm["robot"]), velocities=velocities,
                      accelerations=np.gradient(velocities, trajectory.t, axis=0), frame_id=args.frame, ros=ros)
-    return f"{path} (trajectory_msgs/JointTrajectory of the {args.robot} after inverse kinematics, {len(trajectory)} points)"
+    name = arm["robot"] if isinstance(arm["robot"], str) else arm["robot"].name
+    return f"{path} (trajectory_msgs/JointTrajectory of the {name} after inverse kinematics, {len(trajectory)} points)"
 
 
 def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
@@ -249,8 +269,9 @@ def _add_rollout_arguments(rollout) -> None:
                          help="a joint-space model: the robot's per-joint velocity, acceleration and jerk limits (the "
                               "Panda's published ones; the iiwa's published speeds, assumed acceleration and jerk; or "
                               "those of the robot a scenario file names)")
-    rollout.add_argument("--robot", choices=("panda", "iiwa"), default=None,
-                         help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; needs bidmp[sim])")
+    rollout.add_argument("--robot", default=None, metavar="panda|iiwa|SCENARIO",
+                         help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; a scenario: "
+                              "its robot where it stands, with its tool; needs bidmp[sim])")
     rollout.add_argument("--cartesian-goal", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
                          help="a 7-joint model: roll out to the joints that put the robot's tool at X Y Z metres in its base "
                               "frame, tool pointing down (IK from the demonstrated goal's joints)")
