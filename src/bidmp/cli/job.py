@@ -28,7 +28,9 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
     if view:
         from .view import write_view_files
 
-        written += write_view_files(out, report=report.evaluation, sim_result=report)
+        own = {solid.label for solid in scenario.scene.solids}
+        extra = [solid for solid in report.scene.solids if solid.label not in own]  # the bin, the rack
+        written += write_view_files(out, report=report.evaluation, sim_result=report, extra_solids=extra)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     return EXIT_OK
 

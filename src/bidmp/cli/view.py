@@ -11,16 +11,18 @@ LAYERS = "view_layers.npz"
 PAGE = "view.html"
 
 
-def write_view_files(out: Path, report=None, sim_result=None) -> list[Path]:
+def write_view_files(out: Path, report=None, sim_result=None, extra_solids=()) -> list[Path]:
     """Store the layers of an evaluation (and a simulation's arm motions, added to the layers
-    already in ``out``) and write the HTML viewer; returns the files written."""
-    from ..plotting.viewer import add_robot_motions, layers_from_report, load_layers, save_layers, write_view
+    already in ``out``; ``extra_solids``: a job's own parts) and write the HTML viewer; returns
+    the files written."""
+    from ..plotting.viewer import add_robot_motions, layers_from_report, load_layers, save_layers, solid_layer, write_view
 
     out = Path(out)
     if report is not None:
         layers = layers_from_report(report)
     else:
         layers = load_layers(out / LAYERS)
+    layers.solids += [solid_layer(solid) for solid in extra_solids]
     if sim_result is not None:
         add_robot_motions(layers, sim_result)
     return [save_layers(out / LAYERS, layers), write_view(out / PAGE, layers)]

@@ -26,6 +26,7 @@ _EXPORTS = {
     "ViewLayers": "viewer",
     "layers_from_report": "viewer",
     "add_robot_motions": "viewer",
+    "solid_layer": "viewer",
     "solid_mesh": "viewer",
     "view_figure": "viewer",
     "write_view": "viewer",

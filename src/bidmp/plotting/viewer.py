@@ -23,7 +23,7 @@ import numpy as np
 from .._checks import check_path, require_extra
 from ..io.atomic import atomic_write
 
-__all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_mesh", "view_figure", "write_view",
+__all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_layer", "solid_mesh", "view_figure", "write_view",
            "save_layers", "load_layers", "VIEW_FORMAT"]
 
 VIEW_FORMAT = 1  # of view_layers.npz
@@ -66,12 +66,7 @@ def layers_from_report(report) -> ViewLayers:
     """The layers of a finished evaluation (:func:`bidmp.evaluate`)."""
     scenario = report.scenario
     points = [_xyz(e.demonstration)[e.segmentation_points] for e in report.extensions if len(e.segmentation_points)]
-    solids = []
-    if scenario.scene is not None:
-        solids = [{"label": s.label, "kind": s.kind, "centre": np.asarray(s.centre, float).tolist(),
-                   "rotation": np.asarray(s.rotation, float).tolist(),
-                   "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in s.params]}
-                  for s in scenario.scene.solids]
+    solids = [] if scenario.scene is None else [solid_layer(s) for s in scenario.scene.solids]
     return ViewLayers(
         title=scenario.name, units=scenario.units, demonstration=_xyz(scenario.demonstration),
         targets={label: _xyz(np.atleast_2d(target))[0] for label, target in scenario.targets.items()},
@@ -79,6 +74,13 @@ def layers_from_report(report) -> ViewLayers:
         extended=[_xyz(e.complete) for e in report.extensions] + [_xyz(t) for t in scenario.demonstrations.values()],
         rollouts={name: {label: _xyz(r) for label, r in result.rollouts.items()} for name, result in report.methods.items()},
         solids=solids)
+
+
+def solid_layer(solid) -> dict:
+    """A scene solid (:class:`bidmp.scene.parts.Solid`) as the viewer draws it."""
+    return {"label": solid.label, "kind": solid.kind, "centre": np.asarray(solid.centre, float).tolist(),
+            "rotation": np.asarray(solid.rotation, float).tolist(),
+            "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in solid.params]}
 
 
 def add_robot_motions(layers: ViewLayers, sim_report) -> ViewLayers:

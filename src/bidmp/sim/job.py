@@ -382,5 +382,5 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
                 world.motion = None
     out = JobReport(scenario, scenario.job.kind, arm.name, done, wall_s=time.perf_counter() - start, pictures=world.pictures or [],
                     motions=motions)
-    out.evaluation = report
+    out.evaluation, out.scene = report, scene
     return out

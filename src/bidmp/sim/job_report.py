@@ -91,6 +91,7 @@ class JobReport:
     pictures: list = field(default_factory=list)  # (target, phase, s into its cycle, image) of the first cycle
     motions: dict = field(default_factory=dict)  # ("job", first target) -> {"times", "links"}: the viewer's arm
     evaluation: object = None  # the evaluation whose learned skills ran (bidmp.evaluate's report)
+    scene: object = None  # the scene the job ran in: the scenario's parts and the job's own (bin, rack)
 
     @property
     def removed(self) -> int:
