@@ -136,3 +136,12 @@ def test_bidmp_sim_runs_the_iiwa_scenario(tmp_path, capsys):
     written = json.loads((tmp_path / "sim_results.json").read_text())
     assert written["robot"]["model"] == "iiwa"
     assert written["limits"]["velocity_rad_s"] == list(sim.IIWA.velocity)
+
+
+def test_the_iiwa_runs_the_nut_job(iiwa):
+    """Issue 25 on another arm: the same job, its plans timed to the iiwa's own limits."""
+    from bidmp.sim.job import run_job
+
+    report = run_job(iiwa, targets=["3", "12"])
+    assert report.robot == "iiwa" and report.removed == 2
+    assert all(not target.contacts and target.within_limits for target in report.targets)
