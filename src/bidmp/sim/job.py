@@ -165,7 +165,7 @@ def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
                       least_duration=rise / spec.pitch / spec.spindle_speed)
     if part.rise < rise - 0.05:
         raise _StepFailed(f"the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud")
-    part.hold(world.tcp)
+    part.hold()
     world.held = part
     phase.note = f"{rise / spec.pitch:.1f} turns, {rise:.2f} {world.scenario.units} up the thread"
     return phase
@@ -251,7 +251,7 @@ def _lift_cycle(world: _World, label: str, target, record: JobTarget) -> None:
     record.phases.append(JobPhase("grasp", engaged, 0.0, note))
     if not engaged:
         raise _StepFailed(f"grasp: {note}")
-    part.hold(world.tcp)
+    part.hold()
     world.held = part
     if "lift" in world.spec.steps:
         _add(world, record, _straight(world, part.axis, part.height + world.spec.lift, exclude, "lift", part), target)

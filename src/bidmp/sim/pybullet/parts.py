@@ -36,7 +36,7 @@ class _MovablePart:
         self.rotation0 = Rotation.from_matrix(self.solid.rotation)
         self.axis = self.solid.rotation[:, 2]
         self.height = float(np.dot(self.solid.upper - self.solid.lower, np.abs(self.axis)))  # along its axis
-        self.state, self.offset, self.rise, self.constraint = "seated", None, 0.0, None
+        self.state, self.rise, self.constraint = "seated", 0.0, None
         self.trace: list[tuple[float, float, float]] = []  # (rise, angle turned, time) while threading
 
     def set_pose(self, centre, rotation: Rotation) -> None:
@@ -58,7 +58,7 @@ class _MovablePart:
         self.set_pose(self.centre0 + self.axis * self.rise, Rotation.from_rotvec(self.axis * angle) * self.rotation0)
         self.trace.append((self.rise, angle, t))
 
-    def hold(self, tcp=None) -> None:
+    def hold(self) -> None:
         """Held by the tool from now on: a body with the part's mass, fixed to the tool's mouth
         where it is by a constraint (the gripper's or the socket's hold), carried by the arm
         under physics; its contacts with other parts are its own (:meth:`contacts`)."""
@@ -74,9 +74,6 @@ class _MovablePart:
                                              physicsClientId=cell.client)
         p.changeConstraint(self.constraint, maxForce=500.0, physicsClientId=cell.client)
         self.state = "held"
-
-    def follow(self, tcp=None) -> None:
-        """Kept for a part moved by hand; a held part is carried by its constraint."""
 
     def contacts(self, found: dict, ignore=()) -> None:
         """Add the part's contacts with the scene's parts (not those in ``ignore``) to ``found``."""
