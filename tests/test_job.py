@@ -99,7 +99,9 @@ def test_a_layout_nobody_tuned_every_nut_off_or_one_line_why():
     ({"steps": ["approach", "engage", "unscrew", "retract", "drop"], "bin": {"at": [0, 0, 0], "size": [1, 1, 1]},
       "order": "random"}, 'job.order: expected "listed" or "shortest"'),
     ({"steps": ["approach", "grasp", "lift", "place"]}, "job.rack"),
-    ({"colour": 1}, r"unknown \['colour'\]"),
+    ({"colour": 1}, r"unknown \[.colour.\]"),
+    ({"steps": ["approach", "grasp", "place"], "rack": {"at": [0, 0, 0], "step": [1, 0, 0]}, "transfer": "bent"},
+     "job.transfer: expected"),
 ])
 def test_the_job_key_is_validated_by_name(job, message):
     spec = json.loads(json.dumps(NUT))
@@ -133,7 +135,7 @@ def test_bidmp_job_writes_its_report_and_a_cycle_strip(tmp_path, capsys):
 
     with Image.open(tmp_path / "job_cycle.png") as strip:
         assert strip.size[0] == 4 * 320 + 3 * 4  # approach, unscrew, retract, drop
-    assert main(["job", "--scenario", "pick-and-place", "--out", str(tmp_path / "x")]) == 2
+    assert main(["job", "--scenario", "nut-unscrewing-tilted", "--out", str(tmp_path / "x")]) == 2
     assert "has no \"job\"" in capsys.readouterr().err
 
 
@@ -188,4 +190,14 @@ def test_bidmp_demo_job_runs_the_evaluation_then_the_job(tmp_path, capsys):
     assert main(["demo", "--scenario", str(tmp_path / "two.json"), "--job", "--out", str(tmp_path / "out")]) == 0
     assert "3/3 parts removed" in capsys.readouterr().out
     assert json.loads((tmp_path / "out" / "job" / "job_results.json").read_text())["totals"]["removed"] == 3
-    assert main(["demo", "--scenario", "pick-and-place", "--job", "--out", str(tmp_path / "p")]) == 2
+    assert main(["demo", "--scenario", "nut-unscrewing-tilted", "--job", "--out", str(tmp_path / "p")]) == 2
+
+
+def test_the_pick_and_place_job_moves_every_box_by_the_skills_turned_and_scaled_shape():
+    place = scenarios.load("pick-and-place")
+    assert place.job.transfer == "similarity"
+    report = run_job(place)
+    assert report.removed == 3 and not any(t.contacts for t in report.targets)
+    first, step, _, _ = place.job.rack
+    for index, target in enumerate(report.targets):
+        assert np.linalg.norm(target.final_position[:2] - (first + index * step)[:2]) <= 5.0

@@ -120,6 +120,27 @@ def _clear_path(world: _World, goal, skill, exclude, carried: float = 0.0) -> tu
     return lifted, fractions, f"lifted over the work (it would have touched {clearance.part})"
 
 
+def _transfer(world: _World, goal, exclude, carried: float = 0.0) -> tuple[np.ndarray, np.ndarray, str]:
+    """A move to the bin or the rack from the learned skill: the DMP's start and goal
+    generalisation (lifted over the work if it would touch), or with ``transfer: "similarity"``
+    the plain DMP's own reproduction turned (the smallest rotation taking its start-to-goal onto
+    this one), scaled and moved to run from the tool's place to ``goal``."""
+    if world.spec.transfer == "dmp":
+        return _clear_path(world, goal, 0, exclude, carried)
+    from scipy.spatial.transform import Rotation
+
+    reproduction = world.model.trajectory(skill=0)
+    shape, start, goal = reproduction.y, world.tcp, np.asarray(goal, dtype=float)
+    demonstrated, wanted = shape[-1] - shape[0], goal - start
+    turn, _ = Rotation.align_vectors([wanted], [demonstrated])
+    path = start + np.linalg.norm(wanted) / np.linalg.norm(demonstrated) * turn.apply(shape - shape[0])
+    clearance = _clearance(world, path, exclude, carried)
+    if clearance.distance < 0.0:
+        raise _StepFailed(f"the learned shape, turned and scaled, would touch {clearance.part} "
+                          f"({-clearance.distance:.2f} {world.scenario.units} deep)")
+    return path, reproduction.t / reproduction.t[-1], "the skill's shape turned and scaled"
+
+
 class _StepFailed(Exception):
     """A step that cannot be done; the message says which and why."""
 
@@ -178,7 +199,7 @@ def _drop_point(world: _World) -> np.ndarray:
 
 def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
-    path, fractions, note = _clear_path(world, _drop_point(world), 0, exclude=exclude)
+    path, fractions, note = _transfer(world, _drop_point(world), exclude)
     phase = _move(world, path, fractions, exclude, "drop", carried=part)
     part.release()
     world.held = None
@@ -210,9 +231,7 @@ def _nut_cycle(world: _World, label: str, target, record: JobTarget) -> None:
     _add(world, record, _drop(world, part, exclude), _drop_point(world))
     record.removed = record.phases[-1].ok
     record.final_position = part.pose()[0]
-    failed = next((phase for phase in record.phases if not phase.ok), None)
-    if failed is not None:
-        record.reason = f"{failed.name}: {failed.note or 'touched ' + ', '.join(sorted(failed.contacts))}"
+    record.reason = _why(record)
 
 
 def _slot(world: _World, index: int) -> np.ndarray:
@@ -226,7 +245,7 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     approach coming straight down), set it down, let go."""
     bottom = part.pose()[0] - part.axis * part.height / 2.0
     goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, 0.5]  # let go half a unit above
-    path, fractions, note = _clear_path(world, goal, 0, exclude, carried=part.height)
+    path, fractions, note = _transfer(world, goal, exclude, carried=part.height)
     phase = _move(world, path, fractions, exclude, "place", carried=part)
     part.release()
     world.held = None
@@ -261,8 +280,18 @@ def _lift_cycle(world: _World, label: str, target, record: JobTarget) -> None:
     world.placed += record.removed
     world.gone.append(label)  # out of the module, wherever it ended
     record.final_position = part.pose()[0]
-    if not record.removed:
-        record.reason = f"place: {record.phases[-1].note}"
+    record.reason = _why(record)
+
+
+def _why(record: JobTarget) -> str:
+    """The first phase that failed and why: what it touched (and how deep), or its note."""
+    failed = next((phase for phase in record.phases if not phase.ok), None)
+    if failed is None:
+        return ""
+    if failed.contacts:
+        touched = ", ".join(f"{label} ({depth:.2f} deep)" for label, depth in sorted(failed.contacts.items()))
+        return f"{failed.name}: touched {touched}"
+    return f"{failed.name}: {failed.note}"
 
 
 def _add(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:

@@ -33,7 +33,8 @@ JOB_KINDS = {"unscrew": ("approach", "engage", "unscrew", "retract", "drop"),
              "lift": ("approach", "grasp", "lift", "place"),
              "pick-place": ("approach", "grasp", "place")}
 MAX_TOUR = 200
-_KEYS = {"steps", "order", "bin", "rack", "pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance"}
+_KEYS = {"steps", "order", "bin", "rack", "pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance",
+         "transfer"}
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,11 @@ class JobSpec:
     ``bin``: (centre of its floor's top (3,), inner size (3,)); ``rack``: (first slot (3,), step
     between slots (3,), slots per row, step between rows (3,)); ``pitch``: thread pitch per turn;
     ``spindle_speed``: the socket's top speed, turns/s; ``lift``: how far above a part's
-    neighbours it is lifted; ``clearance``: the height over the work the transfers keep.
+    neighbours it is lifted; ``clearance``: the height over the work the transfers keep;
+    ``transfer``: how a move to the bin or the rack is made from the learned skill — ``"dmp"``,
+    the DMP's start and goal generalisation, or ``"similarity"``, its reproduction turned,
+    scaled and moved so that it runs from the start to the goal (for a skill whose shape is a
+    long arc that the DMP would carry, whole, into a short move).
     """
 
     kind: str
@@ -57,6 +62,7 @@ class JobSpec:
     part_mass: float = 0.005
     lift: float = 20.0
     clearance: float = 40.0
+    transfer: str = "dmp"
 
 
 def _positive(value, source: str, key: str) -> float:
@@ -109,9 +115,12 @@ def parse_job(data, source: str) -> JobSpec | None:
         _fail(source, "job.bin", "unscrewing drops each nut into a bin: give its floor's centre and inner size")
     if kind != "unscrew" and "rack" not in job:
         _fail(source, "job.rack", "a part is placed in a rack slot: give the first slot and the step between slots")
+    transfer = job.get("transfer", "dmp")
+    if transfer not in ("dmp", "similarity"):
+        _fail(source, "job.transfer", f'expected "dmp" or "similarity", got {_shown(transfer)}')
     numbers = {name: _positive(job[name], source, f"job.{name}") for name in
                ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance") if name in job}
-    return JobSpec(kind=kind, steps=tuple(steps), order=order,
+    return JobSpec(kind=kind, steps=tuple(steps), order=order, transfer=transfer,
                    bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
                    rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None, **numbers)
 
