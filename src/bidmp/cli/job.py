@@ -12,16 +12,16 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
     """Run the job with a progress bar, print its report, write its files (and the viewer)."""
     from tqdm import tqdm
 
-    from ..sim.job import run_job
+    from ..sim.job import job_targets, run_job
     from ..sim.job_report import write_job_report
 
-    labels = list(scenario.targets) if targets is None else targets
+    labels = job_targets(scenario, targets)
     with tqdm(total=len(labels), desc=f"{scenario.name} (job)", unit="part", disable=None) as bar:
         def progress(label):
             bar.set_postfix_str(label)
             bar.update(1)
 
-        report = run_job(scenario, targets=targets, progress=progress, pictures=pictures, view=view)
+        report = run_job(scenario, targets=labels, progress=progress, pictures=pictures, view=view)
     print()
     print(report.summary())
     written = write_job_report(report, out)

@@ -121,7 +121,9 @@ def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_
 
     # One BLAS/OpenMP thread, as in a Dask worker (whose nanny sets OMP_NUM_THREADS=1 and the
     # like): the serial path and the workers then give the same floats (2 threads summed in
-    # another order, 1 ulp off), and small matrices gain nothing from threads anyway.
+    # another order, 1 ulp off), and small matrices gain nothing from threads anyway. Not
+    # bidmp._threads.one_thread: its controller holds the pools loaded when it was first made,
+    # and the first cell loads scikit-learn's OpenMP after that.
     with threadpool_limits(limits=1):
         return _run_cell(shape, demo, methods, every)
 

@@ -221,12 +221,8 @@ def save_layers(path, layers: ViewLayers) -> Path:
             "targets": {label: np.asarray(t, float).tolist() for label, t in layers.targets.items()},
             "n_extended": len(layers.extended), "rollouts": rollouts, "solids": layers.solids, "robot": robot}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
-    import io
-
-    buffer = io.BytesIO()
-    np.savez_compressed(buffer, **{k: np.asarray(v) for k, v in arrays.items()})
     with atomic_write(path, "wb") as handle:
-        handle.write(buffer.getvalue())
+        np.savez_compressed(handle, **{k: np.asarray(v) for k, v in arrays.items()})
     return path
 
 

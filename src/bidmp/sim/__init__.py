@@ -22,6 +22,7 @@ from .._lazy import exports
 _EXPORTS = {
     "simulate": "run",
     "run_job": "job",
+    "job_targets": "job",
     "JobReport": "job_report",
     "JobTarget": "job_report",
     "JobPhase": "job_report",

@@ -21,9 +21,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .job_report import JobPhase, JobReport, JobTarget, _phase
-from .pybullet.parts import _add_job_solids, _MovablePart, _open_box, _rest, _settle
+from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle
 
-__all__ = ["run_job"]
+__all__ = ["run_job", "job_targets"]
 
 RELEASE_S = 0.6  # s the world runs after a part is let go, for it to come to rest
 
@@ -73,10 +73,7 @@ def _move(world: _World, path, fractions, exclude, name: str, on_record=None, le
 
         arm = _arm_motion(cell, run)
         world.motion.append((world.clock + arm["times"], arm["links"]))
-    phase = _phase(name, run, plan, cell)
-    for label, depth in touched.items():
-        phase.contacts[label] = max(phase.contacts.get(label, 0.0), depth)
-    phase.ok = not phase.contacts
+    phase = _phase(name, run, plan, cell, touched)
     world.clock += phase.seconds
     return phase
 
@@ -177,7 +174,7 @@ def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Turn the nut off its stud: the spindle turns the socket one turn per pitch the arm rises."""
     spec = world.spec
     stud = [s for s in world.scenario.scene.solids if s.label == f"{part.label}/stud"]
-    bottom = float(np.dot(part.centre0, part.axis)) - 0.5 * float(np.ptp(part.solid.params[0][:, 2]))
+    bottom = float(np.dot(part.centre0, part.axis)) - 0.5 * part.height
     top = float(np.max([np.dot(s.upper, part.axis) for s in stud])) if stud else bottom
     rise = top - bottom + 0.5  # off the thread, half a unit clear of the stud's end
     start = float(np.dot(world.tcp, part.axis))
@@ -201,13 +198,9 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
     path, fractions, note = _transfer(world, _drop_point(world), exclude)
     phase = _move(world, path, fractions, exclude, "drop", carried=part)
-    part.release()
-    world.held = None
-    _settle(world.cell, RELEASE_S)
+    centre = _release(world)
     phase.seconds += RELEASE_S
     floor, inner = world.spec.bin
-    centre, _ = part.pose()
-    _rest(part)
     inside = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0) and floor[2] <= centre[2] <= floor[2] + inner[2])
     phase.note = note or ""
     if not inside:
@@ -216,28 +209,33 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     return phase
 
 
-def _nut_cycle(world: _World, label: str, target, record: JobTarget) -> None:
-    """approach → engage → unscrew → retract → drop for one nut, each phase into ``record``."""
+def _reach(world: _World, label: str, target, record: JobTarget, step: str) -> tuple[_MovablePart, list]:
+    """The approach to ``target`` and the check that the tool took the part in (``step``:
+    engage, grasp); the part and the parts its moves may touch."""
     part = _MovablePart(world.cell, label, world.spec.part_mass)
-    exclude = world.scenario.scene.target_parts(label, target)
+    exclude = world.scenario.scene.target_parts(label, target) + world.gone
     _add(world, record, _approach(world, label, target), target)
     engaged, note = _engaged(world, part, target)
-    record.phases.append(JobPhase("engage", engaged, 0.0, note))
+    record.phases.append(JobPhase(step, engaged, 0.0, note))
     if not engaged:
-        raise _StepFailed(f"engage: {note}")
-    _add(world, record, _unscrew(world, part, exclude), target)
-    _add(world, record, _straight(world, part.axis, world.spec.clearance, exclude, "retract", part), target)
-    record.thread = np.array(part.trace)
-    _add(world, record, _drop(world, part, exclude), _drop_point(world))
+        raise _StepFailed(f"{step}: {note}")
+    return part, exclude
+
+
+def _finish(record: JobTarget, part: _MovablePart) -> None:
     record.removed = record.phases[-1].ok
     record.final_position = part.pose()[0]
     record.reason = _why(record)
 
 
-def _slot(world: _World, index: int) -> np.ndarray:
-    """Where the ``index``-th placed part's bottom centre goes in the rack."""
-    first, step, per_row, row_step = world.spec.rack
-    return first + (index % per_row) * step + (index // per_row) * row_step
+def _nut_cycle(world: _World, label: str, target, record: JobTarget) -> None:
+    """approach → engage → unscrew → retract → drop for one nut, each phase into ``record``."""
+    part, exclude = _reach(world, label, target, record, "engage")
+    _add(world, record, _unscrew(world, part, exclude), target)
+    _add(world, record, _straight(world, part.axis, world.spec.clearance, exclude, "retract", part), target)
+    record.thread = np.array(part.trace)
+    _add(world, record, _drop(world, part, exclude), _drop_point(world))
+    _finish(record, part)
 
 
 def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
@@ -247,12 +245,8 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, 0.5]  # let go half a unit above
     path, fractions, note = _transfer(world, goal, exclude, carried=part.height)
     phase = _move(world, path, fractions, exclude, "place", carried=part)
-    part.release()
-    world.held = None
-    _settle(world.cell, RELEASE_S)
+    centre = _release(world)
     phase.seconds += RELEASE_S
-    centre, _ = part.pose()
-    _rest(part)
     off = float(np.linalg.norm(centre[:2] - np.asarray(slot)[:2]))
     phase.note = note
     if off > world.spec.engage_tolerance * 5 or abs(centre[2] - part.height / 2.0 - slot[2]) > 1.0:
@@ -263,24 +257,16 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
 
 def _lift_cycle(world: _World, label: str, target, record: JobTarget) -> None:
     """approach → grasp → lift straight out → place in the next rack slot, for one part."""
-    part = _MovablePart(world.cell, label, world.spec.part_mass)
-    exclude = world.scenario.scene.target_parts(label, target) + world.gone
-    _add(world, record, _approach(world, label, target), target)
-    engaged, note = _engaged(world, part, target)
-    record.phases.append(JobPhase("grasp", engaged, 0.0, note))
-    if not engaged:
-        raise _StepFailed(f"grasp: {note}")
+    part, exclude = _reach(world, label, target, record, "grasp")
     part.hold()
     world.held = part
     if "lift" in world.spec.steps:
         _add(world, record, _straight(world, part.axis, part.height + world.spec.lift, exclude, "lift", part), target)
-    slot = _slot(world, world.placed)
+    slot = world.spec.slot(world.placed)
     _add(world, record, _place(world, part, slot, exclude), slot)
-    record.removed = record.phases[-1].ok
+    _finish(record, part)
     world.placed += record.removed
     world.gone.append(label)  # out of the module, wherever it ended
-    record.final_position = part.pose()[0]
-    record.reason = _why(record)
 
 
 def _why(record: JobTarget) -> str:
@@ -302,14 +288,22 @@ def _add(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:
         world.pictures.append((record.label, phase.name, record.seconds, image))
 
 
+def _release(world: _World) -> np.ndarray:
+    """Let go of the part in the tool, let it fall and come to rest; where it lies (scene units)."""
+    part, world.held = world.held, None
+    part.release()
+    _settle(world.cell, RELEASE_S)
+    centre, _ = part.pose()
+    _rest(part)
+    return centre
+
+
 def _let_go(world: _World) -> None:
     """After a failed step: a part still in the tool is let go where it is (reported with its
     target), so that the next target starts with an empty tool."""
-    part, world.held = world.held, None
-    if part is not None and part.state == "held":
-        part.release()
-        _settle(world.cell, RELEASE_S)
-        _rest(part)
+    if world.held is not None and world.held.state == "held":
+        _release(world)
+    world.held = None
 
 
 def _job_parts(scenario, labels) -> list:
@@ -317,10 +311,9 @@ def _job_parts(scenario, labels) -> list:
     rack's slots (its top at their height, a part's size round them)."""
     spec = scenario.job
     if spec.kind == "unscrew":
-        return [{"type": "box", "label": f"bin{'' if k == 0 else f'-wall-{k}'}", "at": (s.centre - [0, 0, s.params[2] / 2]).tolist(),
-                 "size": list(s.params)} for k, s in enumerate(_open_box("bin", *spec.bin))]
-    first, step, per_row, row_step = spec.rack
-    corners = np.array([first + (k % per_row) * step + (k // per_row) * row_step for k in range(len(labels))])
+        return _bin_parts(*spec.bin)
+    first = spec.rack[0]
+    corners = np.array([spec.slot(k) for k in range(len(labels))])
     parts = [s for s in scenario.scene.solids if s.label in labels]
     room = np.max([s.upper - s.lower for s in parts], axis=0) if parts else np.zeros(3)
     lower, upper = corners.min(axis=0) - room, corners.max(axis=0) + room
@@ -329,12 +322,26 @@ def _job_parts(scenario, labels) -> list:
              "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), 5.0]}]
 
 
-def _job_scene(scenario, labels):
-    """The scene with the job's own parts: what the motions are checked against and the world holds."""
+def _bin_parts(floor, inner) -> list:
+    """An open box (the bin) as five thin box parts, floor and walls 2 % of its width thick; ``at``
+    is each part's bottom centre, as the scene's parts have it (scene units)."""
+    floor, inner = np.asarray(floor, float), np.asarray(inner, float)
+    wall = max(0.02 * float(inner[:2].min()), 1e-3 * float(inner.max()))
+    half = inner / 2.0
+    pieces = [(floor - [0, 0, wall], [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
+    for sign in (-1.0, 1.0):
+        pieces.append((floor + [sign * (half[0] + wall / 2), 0, 0], [wall, inner[1] + 2 * wall, inner[2]]))
+        pieces.append((floor + [0, sign * (half[1] + wall / 2), 0], [inner[0], wall, inner[2]]))
+    return [{"type": "box", "label": "bin" if k == 0 else f"bin-wall-{k}", "at": np.asarray(at, float).tolist(),
+             "size": [float(v) for v in size]} for k, (at, size) in enumerate(pieces)]
+
+
+def _job_scene(scenario, parts):
+    """The scene with the job's own ``parts``: what the motions are checked against and the world holds."""
     from ..scene.clearance import Scene
 
     data = scenario.scene.to_dict()
-    data["parts"] = data["parts"] + _job_parts(scenario, labels)
+    data["parts"] = data["parts"] + parts
     return Scene.from_dict(data, {k: v.tolist() for k, v in scenario.targets.items()})
 
 
@@ -360,6 +367,20 @@ def _order(scenario, labels) -> list:
     return [labels[i] for i in tour(points, scenario.targets[scenario.demonstrated][:3])]
 
 
+def job_targets(scenario, targets=None) -> list:
+    """The targets a job visits: ``targets`` (checked against the scenario's), or every target
+    with a part of its own to take away (not a cell task's nut)."""
+    from ..tasks.scenarios import Scenario
+    from .run import _checked
+
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
+    if scenario.job is None:
+        raise ValueError(f"scenario {scenario.name!r} has no \"job\": the steps to run at each target")
+    _, labels = _checked(scenario, ["bidmp"], targets, False)
+    return labels if targets is not None else [label for label in labels if label in scenario.scene.labels]
+
+
 def run_job(scenario, *, targets=None, report=None, progress=None, pictures: bool = False, view: bool = False) -> JobReport:
     """Run the scenario's ``"job"`` on the simulated arm at every target (or ``targets``);
     ``pictures``: keyframes of the first cycle's phases (``JobReport.pictures``); ``view``: the
@@ -369,27 +390,23 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     with other parts and their depth, peak joint velocity, acceleration and jerk as fractions of
     the limits (commanded and measured), simulated seconds; the parts removed and the cycle times.
     """
+    from .._checks import check_bool
     from ..tasks.evaluation import evaluate
-    from .run import _checked, _scenario_and_backend
     from .pybullet.cell import RobotCell
     from .pybullet.robot import robot_model, robot_placement
-
-    from .._checks import check_bool
+    from .run import _scenario_and_backend
 
     pictures, view = check_bool(pictures, "pictures"), check_bool(view, "view")
     scenario, _ = _scenario_and_backend(scenario, None)
-    if scenario.job is None:
-        raise ValueError(f"scenario {scenario.name!r} has no \"job\": the steps to run at each target")
-    _, labels = _checked(scenario, ["bidmp"], targets, False)
-    if targets is None:  # the targets with a part of their own to take away (not a cell task's nut)
-        labels = [label for label in labels if label in scenario.scene.labels]
+    labels = job_targets(scenario, targets)
     report = evaluate(_robot_protocol(scenario), ["bidmp"], geometry=False) if report is None else report
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
     start = time.perf_counter()
-    scene = _job_scene(scenario, labels)
+    parts = _job_parts(scenario, labels)
+    scene = _job_scene(scenario, parts)
     with RobotCell(scenario.scene, scenario.units, base, yaw, arm) as cell:
-        added = {part["label"] for part in _job_parts(scenario, labels)}
+        added = {part["label"] for part in parts}
         _add_job_solids(cell, [solid for solid in scene.solids if solid.part in added])
         world = _World(cell, scenario, scenario.job, report.fitted["bidmp"], np.array(arm.rest, dtype=float),
                        [] if pictures else None, [] if view else None, scene=scene)

@@ -3,7 +3,6 @@ times in simulated seconds, peaks as fractions of the arm's joint limits)."""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import numpy as np
 from ..tasks._tables import markdown_table, text_table
 from .backend import RECORD_EVERY, SETTLE, SIM_STEP
 from .limits import _command_peaks, _measured_peaks
+from .report import _titled, _write_results, _write_strip
 
 __all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report"]
 
@@ -40,11 +40,14 @@ class JobPhase:
                 "measured_peak_jerk": round(self.measured_peaks[2], 3), "within_limits": self.within_limits}
 
 
-def _phase(name: str, run, plan, cell) -> JobPhase:
-    """A motion's phase from its execution: the commands' and the joints' peaks, the contacts."""
+def _phase(name: str, run, plan, cell, carried_contacts=None) -> JobPhase:
+    """A motion's phase from its execution: the commands' and the joints' peaks, the contacts
+    (the arm's, and ``carried_contacts`` of a part it held, both in scene units)."""
     sent = _command_peaks(run.commands, cell.limits)
     measured = _measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, cell.limits)
     contacts = {label: depth / cell.unit for label, depth in run.contacts.items()}
+    for label, depth in (carried_contacts or {}).items():
+        contacts[label] = max(contacts.get(label, 0.0), depth)
     return JobPhase(name, not contacts, plan.duration + SETTLE, "", contacts,
                     (sent.velocity, sent.acceleration, sent.jerk), (measured.velocity, measured.acceleration, measured.jerk),
                     sent.within)
@@ -151,35 +154,11 @@ class JobReport:
 
 
 def write_job_report(report: JobReport, out) -> list[Path]:
-    """``job_results.json`` and ``job.md`` (the table) into folder ``out``."""
-    from ..io.atomic import atomic_write
+    """``job_results.json``, ``job.md`` (the table) and ``job_cycle.png`` into folder ``out``."""
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [out / "job_results.json", out / "job.md"]
-    with atomic_write(written[0], "w") as handle:
-        json.dump(report.to_dict(), handle, indent=2)
-    with atomic_write(written[1], "w") as handle:
-        handle.write(report.markdown() + "\n")
-    if report.pictures:
-        written.append(_cycle_strip(out / "job_cycle.png", report))
+    written = _write_results(out, "job_results.json", "job.md", report.to_dict(), report.markdown())
+    if report.pictures:  # the first cycle's keyframes side by side, each titled with its phase, target, time
+        tiles = [_titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
+                 for label, phase, seconds, image in report.pictures]
+        written.append(_write_strip(Path(out) / "job_cycle.png", tiles))
     return written
-
-
-def _cycle_strip(path: Path, report: JobReport) -> Path:
-    """The first cycle's keyframes side by side, each titled with its phase, target and time."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    from ..io.atomic import atomic_write
-
-    font = ImageFont.load_default(size=15)
-    tiles = []
-    for label, phase, seconds, image in report.pictures:
-        band = Image.new("RGB", (image.shape[1], 24), (255, 255, 255))
-        ImageDraw.Draw(band).text((6, 3), f"{phase} done, target {label}, {seconds:.2f} s", fill=(20, 20, 20), font=font)
-        tiles.append(np.concatenate([np.asarray(band), image], axis=0))
-        tiles.append(np.full((tiles[-1].shape[0], 4, 3), 255, np.uint8))
-    strip = np.concatenate(tiles[:-1], axis=1)
-    with atomic_write(path, "wb") as handle:
-        Image.fromarray(strip).save(handle, format="PNG")
-    return path

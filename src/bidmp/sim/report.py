@@ -217,15 +217,7 @@ def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, r
 def write_sim_report(report: SimReport, out) -> list[Path]:
     """``sim_results.json``, ``sim.md`` (the table), a keyframe strip per method and, when both dmp and bidmp have
     frames of the same target, an animated GIF of the two side by side."""
-    from ..io.atomic import atomic_write
-
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    written = [out / "sim_results.json", out / "sim.md"]
-    with atomic_write(written[0], "w") as handle:
-        json.dump(report.to_dict(), handle, indent=2)
-    with atomic_write(written[1], "w") as handle:
-        handle.write(report.markdown() + "\n")
+    written = _write_results(out, "sim_results.json", "sim.md", report.to_dict(), report.markdown())
     by_method = {}
     for method, label, frames in report.pictures:
         by_method.setdefault(method, (label, frames))
@@ -236,6 +228,20 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
     if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
         written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1],
                                   f"target {by_method['dmp'][0]}"))
+    return written
+
+
+def _write_results(out, json_name: str, table_name: str, data: dict, table: str) -> list[Path]:
+    """A run's results as JSON and its Markdown table, into folder ``out`` (made if missing)."""
+    from ..io.atomic import atomic_write
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    written = [out / json_name, out / table_name]
+    with atomic_write(written[0], "w") as handle:
+        json.dump(data, handle, indent=2)
+    with atomic_write(written[1], "w") as handle:
+        handle.write(table + "\n")
     return written
 
 

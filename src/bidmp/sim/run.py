@@ -214,9 +214,10 @@ def _check_reach(setup: dict, scenario, labels) -> None:
         if error > 10 * IK_TOLERANCE:
             missed.append(label)
     if missed:
-        named = [label if label == start_name else repr(label) for label in missed]
-        what = f"target {named[0]} is" if len(named) == 1 and missed[0] != start_name else \
-            f"{'targets ' if missed[0] != start_name else ''}{', '.join(named)} {'are' if len(named) > 1 else 'is'}"
+        what = ", ".join(label if label == start_name else repr(label) for label in missed)
+        if missed[0] != start_name:
+            what = ("target " if len(missed) == 1 else "targets ") + what
+        what += " is" if len(missed) == 1 else " are"
         raise SimError(f"{what} unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
                        f"{scenario.units} (tool pointing down); move its base (scenario key \"robot\": {{\"base\": ...}})")
 

@@ -64,6 +64,11 @@ class JobSpec:
     clearance: float = 40.0
     transfer: str = "dmp"
 
+    def slot(self, index: int) -> np.ndarray:
+        """Where the ``index``-th part placed in the rack has its bottom centre (scene units)."""
+        first, step, per_row, row_step = self.rack
+        return first + (index % per_row) * step + (index // per_row) * row_step
+
 
 def _positive(value, source: str, key: str) -> float:
     if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value) or value <= 0:

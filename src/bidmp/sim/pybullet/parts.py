@@ -16,6 +16,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ..backend import SIM_STEP
 from .world import _add_solid
 
 __all__ = []
@@ -35,7 +36,7 @@ class _MovablePart:
         self.centre0 = np.asarray(self.solid.centre, dtype=float)
         self.rotation0 = Rotation.from_matrix(self.solid.rotation)
         self.axis = self.solid.rotation[:, 2]
-        self.height = float(np.dot(self.solid.upper - self.solid.lower, np.abs(self.axis)))  # along its axis
+        self.height = _height(self.solid)
         self.state, self.rise, self.constraint = "seated", 0.0, None
         self.trace: list[tuple[float, float, float]] = []  # (rise, angle turned, time) while threading
 
@@ -86,7 +87,7 @@ class _MovablePart:
     def release(self) -> None:
         """Let go: the constraint removed, the part falls under gravity."""
         p, cell = self.cell.p, self.cell
-        if getattr(self, "constraint", None) is not None:
+        if self.constraint is not None:
             p.removeConstraint(self.constraint, physicsClientId=cell.client)
             self.constraint = None
         self._make_dynamic()
@@ -99,40 +100,36 @@ class _MovablePart:
         p, cell = self.cell.p, self.cell
         if self.state in ("held", "released"):
             return
-        centre, rotation = self.pose()
         cell._bodies.pop(self.body, None)
         cell._owners.pop(self.body, None)
-        p.removeBody(self.body, physicsClientId=cell.client)
-        self.body = _add_solid(p, cell.client, cell.unit, self.solid, mass=self.mass)
-        self.set_pose(centre, rotation)
+        self._replace_body(self.mass)
         for link in range(-1, p.getNumJoints(cell.robot, physicsClientId=cell.client)):
             p.setCollisionFilterPair(cell.robot, self.body, link, -1, 0, physicsClientId=cell.client)
+
+
+    def _replace_body(self, mass: float) -> None:
+        """The part's body made anew where it is: dynamic with ``mass`` (kg), or static (0)."""
+        p, cell = self.cell.p, self.cell
+        centre, rotation = self.pose()
+        p.removeBody(self.body, physicsClientId=cell.client)
+        self.body = _add_solid(p, cell.client, cell.unit, self.solid, mass=mass)
+        self.set_pose(centre, rotation)
+
+
+def _height(solid) -> float:
+    """A solid's height along its own z axis (scene units)."""
+    if solid.kind == "box":
+        return float(solid.params[2])
+    if solid.kind == "cylinder":
+        return float(solid.params[1])
+    return float(np.ptp(np.asarray(solid.params[0])[:, 2]))
 
 
 def _rest(part: _MovablePart) -> None:
     """A released part that has come to rest: a static body where it lies (13 nuts tumbling in a
     bin on every later step made the 14-nut job run at half the speed)."""
-    p, cell = part.cell.p, part.cell
-    centre, rotation = part.pose()
-    p.removeBody(part.body, physicsClientId=cell.client)
-    part.body = _add_solid(p, cell.client, cell.unit, part.solid)
-    part.set_pose(centre, rotation)
+    part._replace_body(0.0)
     part.state = "at rest"
-
-
-def _open_box(label: str, floor_centre, inner) -> list:
-    """An open box (a bin) as five thin boxes: floor and walls, 2 % of its size thick (scene units)."""
-    from ...scene.parts import _box_solid
-
-    floor_centre, inner = np.asarray(floor_centre, float), np.asarray(inner, float)
-    wall = max(0.02 * float(inner[:2].min()), 1e-3 * float(inner.max()))
-    eye = np.eye(3)
-    half = inner / 2.0
-    pieces = [(floor_centre - [0, 0, wall / 2], [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
-    for sign in (-1.0, 1.0):
-        pieces.append((floor_centre + [sign * (half[0] + wall / 2), 0, half[2]], [wall, inner[1] + 2 * wall, inner[2]]))
-        pieces.append((floor_centre + [0, sign * (half[1] + wall / 2), half[2]], [inner[0], wall, inner[2]]))
-    return [_box_solid(label, label, np.asarray(centre, float), size, eye) for centre, size in pieces]
 
 
 def _add_job_solids(cell, solids) -> None:
@@ -150,5 +147,5 @@ def _settle(cell, seconds: float) -> None:
     held = [s[0] for s in states]
     p.setJointMotorControlArray(cell.robot, cell.arm, p.POSITION_CONTROL, targetPositions=held,
                                 targetVelocities=[0.0] * 7, forces=list(cell.model.effort), physicsClientId=cell.client)
-    for _ in range(int(round(seconds / 1e-3))):
+    for _ in range(int(round(seconds / SIM_STEP))):
         p.stepSimulation(physicsClientId=cell.client)

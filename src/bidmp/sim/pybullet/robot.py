@@ -110,7 +110,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
         path = Path(base_dir) / path
     limits = JointLimits(**spec["limits"])
     middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
-    return RobotModel(spec.get("name", path.stem), str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
+    return RobotModel(path.stem, str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
                       tuple(spec.get("effort", (100.0,) * 7)))
 
 
@@ -135,7 +135,7 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
     points = np.vstack([scenario.target_array, scenario.demonstration])
     unit = _unit_of(scenario.units)
-    standoff = robot_model(robot, getattr(scenario, "base_dir", None)).standoff if "urdf" not in robot else 0.33
+    standoff = robot_model(robot, getattr(scenario, "base_dir", None)).standoff
     base = np.array([0.5 * (points[:, 0].min() + points[:, 0].max()), points[:, 1].min() - standoff / unit,
                      scenario.target_array[:, 2].min()])
     return base, float(robot.get("yaw", 90.0))
