@@ -18,7 +18,7 @@ import time
 from bidmp import scenarios
 from bidmp.evaluation import evaluate
 from bidmp.sim import simulate
-from bidmp.sim.job import _robot_protocol, run_job
+from bidmp.sim.job import run_job
 
 
 def main() -> int:
@@ -26,8 +26,8 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
     nut, cells = scenarios.load("nut-unscrewing"), scenarios.load("cell-removal")
-    job_reports = {"nut": evaluate(_robot_protocol(nut), ["bidmp"], geometry=False),
-                   "cells": evaluate(_robot_protocol(cells), ["bidmp"], geometry=False)}
+    job_reports = {"nut": evaluate(nut.with_robot_protocol(), ["bidmp"], geometry=False),
+                   "cells": evaluate(cells.with_robot_protocol(), ["bidmp"], geometry=False)}
     sim_report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
     factors = {"nut job": [], "cell job": [], "sim 1 worker": [], "sim 2 workers": []}
     for _ in range(args.repeats):  # each round runs every side once: load drift falls on all alike

@@ -74,6 +74,19 @@ class DMPStepper:
                 term.bind(self)
 
     @property
+    def position(self) -> np.ndarray:
+        """The position the next :meth:`step` commands (D,): the state plus any moved goal's offset."""
+        offset = self._shifts.at(self.time) if self._shifts else None
+        return self.y.copy() if offset is None else self.y + offset[0]
+
+    @property
+    def horizon(self) -> float:
+        """The motion's own time (s) at which it is complete: its duration times the protocol's
+        horizon (the robot protocol's 1.1, within which it comes to rest; the paper's 1, its fixed
+        horizon)."""
+        return float(self._params.settle * self._scale * self._dmp.duration_)
+
+    @property
     def target(self) -> np.ndarray:
         """The goal the motion ends at (D,): :attr:`goal` plus every :meth:`set_goal` offset."""
         return self.goal + self._shifts.total

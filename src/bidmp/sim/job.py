@@ -345,19 +345,6 @@ def _job_scene(scenario, parts):
     return Scene.from_dict(data, {k: v.tolist() for k, v in scenario.targets.items()})
 
 
-def _robot_protocol(scenario):
-    """The scenario with its DMP on the robot protocol: the paper's (fixed horizon, the forcing
-    scaled by goal minus start per axis) sends a motion from anywhere but the demonstrated start
-    off at 6 m/s and 4.5 mm short; the robot's reaches every goal from every start of the job."""
-    from ..tasks.scenarios import from_dict
-
-    spec = scenario.to_dict()
-    if spec.get("dmp", {}).get("protocol", "robot") == "robot":
-        return scenario
-    spec["dmp"] = {"protocol": "robot", **{k: v for k, v in spec["dmp"].items() if k in ("n_kernels", "regression")}}
-    return from_dict(spec, source=scenario.name, base_dir=scenario.base_dir, allow_outside_files=True)
-
-
 def _order(scenario, labels) -> list:
     from ..tasks.jobs import tour
 
@@ -399,7 +386,7 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     pictures, view = check_bool(pictures, "pictures"), check_bool(view, "view")
     scenario, _ = _scenario_and_backend(scenario, None)
     labels = job_targets(scenario, targets)
-    report = evaluate(_robot_protocol(scenario), ["bidmp"], geometry=False) if report is None else report
+    report = evaluate(scenario.with_robot_protocol(), ["bidmp"], geometry=False) if report is None else report
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
     start = time.perf_counter()

@@ -1,4 +1,4 @@
-"""Joint limits where the robot moves (issue 21.7): the commands as the arm's controller receives
+"""Joint limits where the robot moves: the commands as the arm's controller receives
 them, every 1 ms, checked against the velocity, acceleration and jerk limits; the measured joints
 reported beside them; and the 1 kHz rate limiter the closed loop sends its commands through.
 
@@ -18,36 +18,14 @@ show them; they are reported, not counted (a contact or a held joint moves them,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from ..tasks.contract import AT_REST, PADDING, CommandPeaks, command_peaks
 from .backend import SIM_STEP, JointLimits
 
 __all__ = ["PADDING", "AT_REST"]
 
-PADDING = 3  # samples of rest before and after the commands when they are checked
-# A motion starts and stops at rest: the acceleration of its first and last command at most this
-# fraction of the limit (a minimum-jerk start reaches 0.3 % of it in its first millisecond; a clamped
-# cubic starts at its full 6A/T², up to 45 % of the limit on the simulated nut task).
-AT_REST = 0.05
 _WINDOW = 0.01  # s: the measured joints' estimator (differences over 10 ms windows)
-
-
-@dataclass(frozen=True)
-class _CommandPeaks:
-    """Peaks of a 1 kHz command, each the largest over the joints as a fraction of its limit
-    (jerk: 0 when the limits state none)."""
-
-    velocity: float
-    acceleration: float
-    jerk: float
-    ends: float = 0.0  # the acceleration at the first and the last command (from and to rest)
-
-    @property
-    def within(self) -> bool:
-        return (self.velocity <= 1.0 + 1e-9 and self.acceleration <= 1.0 + 1e-9 and self.jerk <= 1.0 + 1e-9
-                and self.ends <= AT_REST)
 
 
 def _worst(values: np.ndarray, limit) -> float:
@@ -57,30 +35,13 @@ def _worst(values: np.ndarray, limit) -> float:
     return float(np.max(np.abs(values) / np.asarray(limit, dtype=float)))
 
 
-def _peaks(positions: np.ndarray, dt: float, limits: JointLimits) -> _CommandPeaks:
-    velocity = np.diff(positions, axis=0) / dt
-    acceleration = np.diff(velocity, axis=0) / dt
-    jerk = np.diff(acceleration, axis=0) / dt
-
-    return _CommandPeaks(_worst(velocity, limits.velocity), _worst(acceleration, limits.acceleration),
-                        _worst(jerk, limits.jerk))
+def _command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> CommandPeaks:
+    """The peaks of joint position commands (n, J) sent every ``dt`` seconds, from rest to rest: the
+    contract's check (:func:`bidmp.tasks.contract.command_peaks`)."""
+    return command_peaks(commands, limits, dt)
 
 
-def _command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_STEP) -> _CommandPeaks:
-    """The peaks of joint position commands (n, 7) sent every ``dt`` seconds, from rest to rest
-    (the first and last held :data:`PADDING` samples before and after, see the module docstring)."""
-    commands = np.asarray(commands, dtype=float)
-    padded = np.vstack([np.repeat(commands[:1], PADDING, axis=0), commands, np.repeat(commands[-1:], PADDING, axis=0)])
-    peaks = _peaks(padded, dt, limits)
-    if commands.shape[0] < 2:
-        return peaks
-    # From rest: the first command's acceleration is its first step over dt², likewise the last.
-    ends = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
-    ratio = float(np.max(ends / np.asarray(limits.acceleration, dtype=float)))
-    return _CommandPeaks(peaks.velocity, peaks.acceleration, peaks.jerk, ratio)
-
-
-def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> _CommandPeaks:
+def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> CommandPeaks:
     """Peaks of the measured joints from their recorded velocities (n, 7), one every
     ``record_step`` seconds: velocity as recorded, acceleration and jerk by differences over
     10 ms windows."""
@@ -90,7 +51,7 @@ def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLim
     acceleration = np.diff(sampled, axis=0) / step
     jerk = np.diff(acceleration, axis=0) / step
 
-    return _CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
+    return CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
                         _worst(jerk, limits.jerk))
 
 
@@ -117,13 +78,18 @@ class _RateLimiter:
         jerk = limits.jerk if limits.jerk is not None else np.full(self.position.shape, np.inf)
         self.max_jerk = margin * np.asarray(jerk, dtype=float)
 
-    def __call__(self, target: np.ndarray, target_velocity: np.ndarray | None = None) -> np.ndarray:
-        """The next command (7,) rad towards ``target``, moving at ``target_velocity`` (rad/s)."""
+    def __call__(self, target: np.ndarray, target_velocity: np.ndarray | None = None,
+                 target_acceleration: np.ndarray | None = None) -> np.ndarray:
+        """The next command (J,) rad towards ``target``, moving at ``target_velocity`` (rad/s) with
+        ``target_acceleration`` (rad/s²), both fed forward: a smooth target within the limits is
+        followed without overshoot (the velocity fed forward alone, the lagging velocity loop
+        overshoots where the target brakes)."""
         position_gain, velocity_gain, acceleration_gain = self._GAINS
         feed = 0.0 if target_velocity is None else np.asarray(target_velocity, dtype=float)
+        feed_acceleration = 0.0 if target_acceleration is None else np.asarray(target_acceleration, dtype=float)
         wanted_velocity = np.clip(feed + position_gain * (np.asarray(target, dtype=float) - self.position),
                                   -self.max_velocity, self.max_velocity)
-        wanted_acceleration = np.clip(velocity_gain * (wanted_velocity - self.velocity),
+        wanted_acceleration = np.clip(feed_acceleration + velocity_gain * (wanted_velocity - self.velocity),
                                       -self.max_acceleration, self.max_acceleration)
         jerk = np.clip(acceleration_gain * (wanted_acceleration - self.acceleration), -self.max_jerk, self.max_jerk)
         self.acceleration = self.acceleration + jerk * self.dt

@@ -11,9 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from ..tasks._tables import markdown_table, text_table
-from ..tasks.metrics import _json_length, approach_error, axis_deviation
+from ..tasks.contract import CommandPeaks
+from ..tasks.metrics import _json_length
 from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
-from .limits import _command_peaks, _CommandPeaks, _measured_peaks
+from .limits import _measured_peaks
 from .pybullet.robot import PANDA
 
 __all__ = ["SimTarget", "SimMethod", "SimReport", "write_sim_report"]
@@ -45,10 +46,21 @@ class SimTarget:
     paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
     axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
     aligned: bool | None = None
+    verdict: object = None  # bidmp.tasks.contract.Verdict on the executed motion and the commands
+    repair: str = ""  # how the motion was repaired (empty: the method's own motion ran)
 
     def task_success(self, threshold: float) -> bool:
+        """The motion contract on what the arm did (:mod:`bidmp.tasks.contract`): the measured end,
+        the measured final descent, the executed tool's clearance by the margin and no contact, the
+        1 kHz commands within the limits."""
+        if self.verdict is not None:
+            return self.verdict.ok
         return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
                     and not self.commanded_penetration and self.within_limits and self.aligned is not False)
+
+    @property
+    def reason(self) -> str:
+        return "" if self.verdict is None else self.verdict.reason()
 
     def to_dict(self, threshold: float) -> dict:
         return {
@@ -66,6 +78,10 @@ class SimTarget:
             "within_limits": self.within_limits, "task_success": self.task_success(threshold),
             "axis_deviation_deg": _json_length(self.axis_deviation),
             "aligned": self.aligned,
+            "clearance": None if self.verdict is None or self.verdict.clearance is None
+            else _json_length(self.verdict.clearance.distance),
+            "clearance_part": None if self.verdict is None or self.verdict.clearance is None else self.verdict.clearance.part,
+            "reason": self.reason, "repair": self.repair,
         }
 
 
@@ -179,36 +195,38 @@ class SimReport:
 
 
 def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, run: Execution, unit: float,
-            closed_loop: bool, limits=PANDA) -> SimTarget:
+             closed_loop: bool, limits=PANDA, contract=None, exclude=()) -> SimTarget:
     """The per-target results of one execution (``scenario``: its targets, units, threshold;
-    ``limits``: the robot's joint limits)."""
+    ``limits``: the robot's joint limits), judged by ``contract`` (a
+    :class:`bidmp.tasks.contract.Contract` with the scene; default: built from ``scenario`` without
+    one) on the executed motion: the measured tool path, the commands, the contacts."""
+    from ..tasks.contract import Contract
+
+    if contract is None:
+        contract = Contract(scenario["success_threshold"], scenario["approach_height"], None, scenario["units"],
+                            scenario.get("alignment_threshold"), limits)
     tcp = run.tcp / unit
-    measured_error = float(np.linalg.norm(tcp[-1] - target))
-    commanded_error = float(np.linalg.norm(plan.points[-1] / unit - target))
-    approach = deviation = None
     axis = scenario.get("axes", {}).get(label)
-    if scenario["approach_height"] is not None:
-        approach = approach_error(tcp, target, scenario["approach_height"], axis)
-        if scenario.get("alignment_threshold") is not None:
-            deviation = axis_deviation(tcp, run.tcp_orientation, target, scenario["approach_height"], axis)
-    # What counts: the commands the position control was sent every 1 ms, from rest to rest
-    # (bidmp.sim.limits); the measured joints are reported beside them.
-    if run.commands is not None:
-        sent = _command_peaks(run.commands, limits)
-    else:  # a backend that does not report its commands: the plan's own peaks
-        sent = _CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
+    pose = scenario.get("alignment_threshold") is not None
+    # What counts: the commands the position control was sent every 1 ms, from rest to rest; the
+    # measured joints are reported beside them. A backend that does not report its commands: the
+    # plan's own peaks.
+    contacts = {k: v / unit for k, v in run.contacts.items()}
+    verdict = contract.judge(tcp, target, label=label, axis=axis, exclude=exclude,
+                             orientations=run.tcp_orientation if pose else None, commands=run.commands,
+                             contacts=contacts)
+    sent = verdict.limits or CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
     measured = _measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits)
     motion_time = float(run.times[-1]) - SETTLE if closed_loop else plan.duration
     return SimTarget(
-        label=label, commanded_error=commanded_error, measured_error=measured_error, approach_error=approach,
-        engaged=None if approach is None else bool(approach <= scenario["success_threshold"]),
-        contacts={k: v / unit for k, v in run.contacts.items()}, peak_velocity=sent.velocity,
+        label=label, commanded_error=float(np.linalg.norm(plan.points[-1] / unit - target)),
+        measured_error=verdict.end_error, approach_error=verdict.approach_error, engaged=verdict.engaged,
+        contacts=contacts, peak_velocity=sent.velocity,
         peak_acceleration=sent.acceleration, peak_jerk=sent.jerk, measured_peak_velocity=measured.velocity,
         measured_peak_acceleration=measured.acceleration, measured_peak_jerk=measured.jerk, motion_time=motion_time,
         tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
-        within_limits=sent.within, paused=run.paused,
-        axis_deviation=deviation,
-        aligned=None if deviation is None else bool(deviation <= scenario["alignment_threshold"]))
+        within_limits=sent.within, paused=run.paused, axis_deviation=verdict.axis_deviation, aligned=verdict.aligned,
+        verdict=verdict)
 
 
 # ---------------------------------------------------------------------------------------------

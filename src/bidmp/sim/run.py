@@ -4,6 +4,7 @@ worker processes (each with its own world), measured into a :class:`bidmp.sim.re
 from __future__ import annotations
 
 import atexit
+import logging
 import os
 import time
 from dataclasses import dataclass
@@ -15,11 +16,15 @@ from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold
 from .pybullet.cell import RobotCell
-from .pybullet.robot import PANDA_MODEL, _unit_of, robot_model, robot_placement
+from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
 from .pybullet.world import _pybullet_module
 from .report import SimMethod, SimReport, _measure
 
 __all__ = ["simulate"]
+
+logger = logging.getLogger(__name__)
+
+CLOSED_LOOP_SPACING = 1e-3  # m: the IK samples a closed-loop motion is timed on
 
 
 @dataclass
@@ -40,10 +45,15 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
     scenario = setup["scenario"]
     results = []
     cell = _world(setup)
+    contract = _contract(scenario, cell)
     for job in jobs:
         if progress is not None:
             progress(job.method, job.label)
-        plan = cell.plan(job.rollout, job.label, orientations=job.orientations)
+        # The closed loop runs the learned motion itself, not a spline through IK samples 5 mm apart,
+        # which smooths its final stop: it is timed on samples 1 mm apart (else a fast descent stops
+        # harder than the joints' acceleration limits, and the limiter overshoots the nut).
+        spacing = CLOSED_LOOP_SPACING if setup["closed_loop"] else MAX_SAMPLE_SPACING
+        plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
         if setup["closed_loop"] and job.orientations is not None:
             raise ValueError("closed_loop runs position skills; this scenario's are poses")
         target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
@@ -58,11 +68,21 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
                 target = target + np.asarray(update.offset)
         else:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
-        measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits)
+        measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits,
+                            contract, job.exclude)
         measured.commanded_penetration = _commanded_penetration(cell, run, job)
         motion = _arm_motion(cell, run) if job.view else None
         results.append((job.method, job.label, measured, run.frames, float(run.times[-1]), motion))
     return results
+
+
+def _contract(scenario: dict, cell):
+    """The motion contract in a worker: the scenario's threshold, approach height and alignment,
+    the world's scene (margin and stand-offs) and the arm's joint limits."""
+    from ..tasks.contract import Contract
+
+    return Contract(scenario["success_threshold"], scenario["approach_height"], getattr(cell, "scene", None),
+                    scenario["units"], scenario.get("alignment_threshold"), cell.limits)
 
 
 # The last world this process built, kept for the next call with the same scene, robot placement
@@ -122,7 +142,9 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     methods : sequence of str
         Evaluation methods (dmp, bidmp, ...): their rollouts are what is executed.
     closed_loop : bool
-        Run the DMP/Bi-DMP stepper on the measured TCP with phase stopping, for dmp and bidmp.
+        Run the DMP/Bi-DMP stepper on the measured TCP with phase stopping, for dmp and bidmp, with
+        the skills on the robot protocol (a paper-protocol scenario's are learned again on it: its
+        fixed horizon stops a motion that is still moving).
     coupling : float, optional
         Phase stopping's ``alpha_e`` in 1/unit² (default :data:`COUPLING` per m², 0.5 /mm²).
     targets, hold : list of str, Hold, optional
@@ -151,6 +173,14 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     scenario, backend = _scenario_and_backend(scenario, backend)
     methods, labels = _checked(scenario, methods, targets, closed_loop)
     coupling = COUPLING * _unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
+    if closed_loop and scenario.protocol != "robot":
+        # The closed loop steps the skills as a robot runs them: the paper's protocol stops at its
+        # fixed horizon while still moving, and an arm stopped there overshoots the target.
+        logger.info("closed loop: the skills of %s on the robot protocol (the scenario's is %r)", scenario.name,
+                    scenario.protocol)
+        scenario = scenario.with_robot_protocol()
+        if report is not None and report.scenario.protocol != "robot":
+            report = None
     if report is None:
         report = evaluate(scenario, methods, geometry=False)
     base, yaw = robot_placement(scenario)

@@ -17,7 +17,7 @@ from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
 from ..extension.roadmap import NoFreeRouteError
 from ..incremental.bidmp import BiDMP, forgetting_runs
-from .metrics import approach_error, endpoint_error, path_difference
+from .metrics import path_difference
 from .methods.dmp_converged import CONVERGED_GAIN
 from .report import MethodResult, Report, write_report
 
@@ -211,7 +211,7 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     report = Report(scenario=scenario, methods={})
     report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
     task.build_skills = _skills_builder(scenario, failed, report)
-    result = (_pose_results if scenario.is_pose else _position_results)(scenario, labels, geometry)
+    result = _results_builder(scenario, labels, geometry)
     for name in names:
         if progress is not None:
             progress(name)
@@ -239,61 +239,38 @@ def _failed_targets(scenario, task, labels, goals) -> list[str]:
     return [label for label, error in zip(labels, errors) if error > scenario.success_threshold]
 
 
-def _position_results(scenario, labels, geometry: bool):
-    """``result(name, trajectories, seconds) -> MethodResult`` for a position scenario."""
-    demo = scenario.demonstration
-    n_steps = demo.shape[0]
-    references = {label: resample_time(scenario.reference(label), n_steps) for label in labels}
-    scene = scenario.scene if geometry else None
-    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
-
-    def result(name, trajectories, seconds):
-        trajectories = dict(zip(labels, trajectories))
-        errors = {label: endpoint_error(trajectories[label], scenario.targets[label]) for label in labels}
-        approach = None
-        if scenario.approach_height is not None and demo.shape[1] == 3:
-            approach = {label: approach_error(trajectories[label], scenario.targets[label], scenario.approach_height) for label in labels}
-        differences = {label: path_difference(trajectories[label], references[label]) for label in labels}
-        clearances = None
-        if scene is not None:
-            clearances = {label: scene.clearance(trajectories[label], exclude=excluded[label]) if scene.applies_to(label)
-                          else None for label in labels}
-        return MethodResult(name, trajectories, seconds, errors, approach, differences, scenario.success_threshold,
-                            next(iter(trajectories.values())).shape[0], clearances)
-
-    return result
-
-
-def _pose_results(scenario, labels, geometry: bool):
-    """``result(name, rollouts, seconds) -> MethodResult`` for a pose scenario: metrics on
-    positions, the engagement along each target's axis, and the tool's axis alignment (task success
-    needs it too)."""
-    from .metrics import axis_deviation
+def _results_builder(scenario, labels, geometry: bool):
+    """``result(name, rollouts, seconds) -> MethodResult``: every motion judged by the scenario's
+    :class:`~bidmp.tasks.contract.Contract` (end, engagement along the target's axis, clearance from
+    every part but the target's own, alignment for poses), plus the paper's "difference" against the
+    reference motion to the same target."""
+    from .contract import Contract
 
     n_steps = scenario.demonstration.shape[0]
-    scene = scenario.scene if geometry else None
-    references = {label: resample_time(scenario.reference(label)[:, :3], n_steps) for label in labels}
+    contract = Contract.of(scenario, geometry=geometry and scenario.scene is not None)
+    scene = contract.scene
+    poses = scenario.is_pose
+    references = {label: resample_time(scenario.reference(label)[:, :3] if poses else scenario.reference(label), n_steps)
+                  for label in labels}
     excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
 
     def result(name, rollouts, seconds):
-        positions = {label: rollout[:, :3] for label, rollout in zip(labels, rollouts)}
-        orientations = {label: rollout[:, 3:] for label, rollout in zip(labels, rollouts)}
-        targets = {label: scenario.targets[label][:3] for label in labels}
-        errors = {label: endpoint_error(positions[label], targets[label]) for label in labels}
-        approach = deviations = None
-        if scenario.approach_height is not None:
-            approach = {label: approach_error(positions[label], targets[label], scenario.approach_height,
-                                              scenario.target_axis(label)) for label in labels}
-            deviations = {label: axis_deviation(positions[label], orientations[label], targets[label],
-                                                scenario.approach_height, scenario.target_axis(label)) for label in labels}
+        rollouts = dict(zip(labels, rollouts))
+        positions = {label: rollout[:, :3] if poses else rollout for label, rollout in rollouts.items()}
+        orientations = {label: rollout[:, 3:] for label, rollout in rollouts.items()} if poses else None
+        verdicts = {label: contract.judge(positions[label], scenario.targets[label], label=label,
+                                          axis=scenario.target_axis(label), exclude=excluded.get(label, ()),
+                                          orientations=None if orientations is None else orientations[label],
+                                          applies=scene is not None and scene.applies_to(label))
+                    for label in labels}
+        errors = {label: verdict.end_error for label, verdict in verdicts.items()}
+        approach = None if contract.approach_height is None else \
+            {label: verdict.approach_error for label, verdict in verdicts.items()}
+        deviations = None if contract.alignment_threshold is None else \
+            {label: verdict.axis_deviation for label, verdict in verdicts.items()}
+        clearances = None if scene is None else {label: verdict.clearance for label, verdict in verdicts.items()}
         differences = {label: path_difference(positions[label], references[label]) for label in labels}
-        clearances = None
-        if scene is not None:
-            clearances = {label: scene.clearance(positions[label], exclude=excluded[label], orientations=orientations[label])
-                          if scene.applies_to(label) else None for label in labels}
         return MethodResult(name, positions, seconds, errors, approach, differences, scenario.success_threshold,
-                            n_steps, clearances, orientations, deviations, scenario.alignment_threshold)
+                            n_steps, clearances, orientations, deviations, scenario.alignment_threshold, verdicts)
 
     return result
-
-

@@ -28,15 +28,21 @@ def endpoint_error(trajectory, target) -> float:
     return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
 
 
-LIFT_TOLERANCE = 0.05  # of the band's height: a rise smaller than this within the final approach is noise
+# Of the band's height: inside the final approach a motion may rise by at most this much (0.1 mm of the
+# socket's 28.5 mm). The robot protocol's DMP learned from the nut demonstration's abrupt stop dips
+# 0.054 mm below its goal and settles back; executed on the simulated arm, 0.06-0.08 mm. A motion that
+# dips 0.19 mm below its target and comes back up (the paper's DMP run on to convergence) is no
+# monotone descent, and no engagement.
+LIFT_TOLERANCE = 0.0035
 
 
 def final_approach_mask(heights: np.ndarray, height: float) -> np.ndarray | None:
     """The samples of the final approach: from the last sample at or above ``height`` (the motion's
-    final entry into the band, from above) to the end, inside the band, with no rise within it by
-    more than :data:`LIFT_TOLERANCE` of ``height``. None when there is none: the motion ends above
-    the band, never comes from above it, or lifts inside it (a pass through the band, a lift out of
-    it, or a wobble is no engagement).
+    final entry into the band, from above) to the end, inside the band, a monotone descent: no rise
+    within it by more than :data:`LIFT_TOLERANCE` of ``height`` above the lowest point reached so far.
+    None when there is none: the motion ends above the band, never comes from above it, or rises
+    inside it (a pass through the band, a lift out of it, a wobble, or a dip below the target and
+    back up is no engagement).
 
     Parameters
     ----------

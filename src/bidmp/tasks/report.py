@@ -33,6 +33,7 @@ class MethodResult:
     orientations: dict | None = None  # pose scenarios: label -> (n, 4) quaternions of the rollout
     axis_deviations: dict | None = None  # pose scenarios: label -> degrees between tool and target axes
     alignment_threshold: float = 2.0
+    verdicts: dict | None = None  # label -> bidmp.tasks.contract.Verdict: the contract's judgement of each motion
 
     @property
     def successes(self) -> int:
@@ -49,11 +50,18 @@ class MethodResult:
         return None if self.clearances is None else self.clearances.get(label)
 
     def task_success_at(self, label: str) -> bool:
-        """End point within the threshold, engaged (where measured) and collision-free (where
-        the scene applies)."""
+        """The motion contract (:mod:`bidmp.tasks.contract`): end point within the threshold,
+        engaged (where measured), clear of every part but the target's by the margin (where the
+        scene applies), aligned (poses)."""
+        if self.verdicts is not None:
+            return self.verdicts[label].ok
         clearance = self.clearance_at(label)
         return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
                     and (clearance is None or clearance.clear) and self.aligned_at(label) is not False)
+
+    def reason_at(self, label: str) -> str:
+        """Why the motion to ``label`` breaks the contract, in one sentence (empty when it does not)."""
+        return "" if self.verdicts is None else self.verdicts[label].reason()
 
     def aligned_at(self, label: str) -> bool | None:
         """Pose scenarios: the tool's axis within the alignment threshold of the target's over
@@ -134,6 +142,7 @@ class MethodResult:
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
                 "axis_deviation": None if self.axis_deviations is None else _json_length(self.axis_deviations[label]),
+                "reason": self.reason_at(label),
             }
         out["targets"] = targets
         return out

@@ -148,6 +148,22 @@ class Scenario:
         """The scenario as JSON-ready data (round-trips through :func:`from_dict`)."""
         return copy.deepcopy(self.spec)
 
+    @property
+    def protocol(self) -> str:
+        """The DMP protocol of the scenario's skills ("robot", the default, or "paper")."""
+        return self.dmp.get("protocol", "robot")
+
+    def with_robot_protocol(self) -> Scenario:
+        """The scenario with its DMP on the robot protocol (its kernels and regression kept), or itself
+        when it is on it. What a robot runs: the paper's protocol stops at a fixed horizon while still
+        moving (an arm that stops there overshoots), and sends a motion from any start but the
+        demonstrated one off at 6 m/s."""
+        if self.protocol == "robot":
+            return self
+        spec = self.to_dict()
+        spec["dmp"] = {"protocol": "robot", **{k: v for k, v in spec["dmp"].items() if k in ("n_kernels", "regression")}}
+        return from_dict(spec, source=self.name, base_dir=self.base_dir, allow_outside_files=True)
+
     def reference(self, label: str) -> np.ndarray:
         """A reference demonstration to target ``label`` "produced by the same generator"
         (SPEC §9): its own demonstration if one is given, else the demonstration generator with

@@ -13,7 +13,7 @@ from . import execute as _execute
 from . import ik as _ik
 from . import plan as _plan
 from . import render as _render
-from .robot import PANDA_MODEL, RobotModel, _unit_of
+from .robot import MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
 
 __all__ = ["PandaCell", "RobotCell"]
@@ -146,10 +146,12 @@ class RobotCell:
 
     ik = solve_ik  # the backend protocol's name
 
-    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
-        """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
-        within the limits (:func:`bidmp.sim.pybullet.plan.plan`)."""
-        return _plan._plan(self, path, label, fractions, seed, orientations)
+    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None,
+             spacing: float = MAX_SAMPLE_SPACING) -> MotionPlan:
+        """Inverse kinematics along ``path`` (n, 3, scene units), IK samples at most ``spacing`` (m)
+        apart where it moves fastest, and the fastest uniform timing within the limits
+        (:func:`bidmp.sim.pybullet.plan.plan`)."""
+        return _plan._plan(self, path, label, fractions, seed, orientations, spacing)
 
     def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0,
                 on_record=None) -> Execution:

@@ -105,11 +105,14 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
                         frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
 
-    Each control step asks the stepper for the command given where the TCP is and solves IK;
-    every 1 ms the position control gets the joints linearly between the last two control steps'
-    targets, passed through a jerk-limited rate limiter (:class:`bidmp.sim.limits.RateLimiter`),
-    so every command is within the velocity, acceleration and jerk limits and starts and stops at
-    rest. With phase stopping the motion's own time stands still while the robot is held. The run
+    Each control step asks the stepper for the command given where the TCP is, solves IK for its
+    position and maps its velocity to the joints through the arm's Jacobian (the tool's orientation
+    held); every 1 ms the position control gets the joints on the cubic (Hermite) segment between the
+    last two control steps' joints and joint velocities, passed through a jerk-limited rate limiter
+    (:class:`bidmp.sim.limits.RateLimiter`) with the segment's velocity and acceleration fed forward,
+    so every command is within the velocity, acceleration and jerk limits, starts and stops at rest,
+    and follows a monotone approach without overshoot (straight segments between the 100 Hz targets
+    step the velocity every 10 ms, and the limiter then overshot a fast final descent by 1 mm). With phase stopping the motion's own time stands still while the robot is held. The run
     ends when the stepper's time has reached ``duration`` (at most ``max_factor`` times that in
     wall time) plus the settling. ``goal_update``: see :func:`_perceive`.
     """
@@ -119,11 +122,13 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
         raise SimError(f"the start {np.round(stepper.y, 2).tolist()} is unreachable")
     cell._set_joints(q)
     every = int(round(CONTROL_STEP / SIM_STEP))
-    longest = max_factor * duration + (0.0 if hold is None else hold.duration)
+    complete = float(getattr(stepper, "horizon", duration))
+    longest = max_factor * max(duration, complete) + (0.0 if hold is None else hold.duration)
     n_steps = int(math.ceil((longest + SETTLE) / SIM_STEP))
     record = _Recorder(cell, n_steps, frames, focus=np.asarray(stepper.target, dtype=float))
     _ignore(cell, exclude, False)
     target, previous, held, settle_from, moved = q, q, None, None, False
+    target_rate = previous_rate = np.zeros_like(q)
     times, targets, clock, sent = [], [], [], []
     limited = _RateLimiter(q, cell.limits, LIMIT_MARGIN)
     step = 0
@@ -131,22 +136,25 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
         for step in range(n_steps):
             t = step * SIM_STEP
             if step % every == 0:
-                previous = target
+                previous, previous_rate = target, target_rate
                 if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
                     break
                 if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
                     moved = moved or _perceive(cell, stepper, goal_update, exclude)
-                    measured = cell.tcp_position() / cell.unit
-                    y, _, _ = stepper.step(CONTROL_STEP, measured)
-                    target, _ = cell.solve_ik(np.asarray(y) * cell.unit, target)
+                    y, yd, _ = stepper.step(CONTROL_STEP, _tracked(cell, stepper, sent))
+                    point = np.asarray(y) * cell.unit
+                    target, _ = cell.solve_ik(point, target)
+                    target_rate = _joint_velocity(cell, target, point, np.asarray(yd) * cell.unit)
+                else:
+                    target_rate = np.zeros_like(target)
                 times.append(t)
                 targets.append(target)
                 clock.append(stepper.time)
-                if settle_from is None and stepper.time >= duration:
+                if settle_from is None and stepper.time >= complete:
                     settle_from = step
             share = (step % every + 1) / every
-            # Linear between the 100 Hz targets, then the 1 kHz limiter: jerk-limited commands.
-            command = limited(previous + share * (target - previous), (target - previous) / CONTROL_STEP)
+            # The cubic between the 100 Hz targets, then the 1 kHz limiter: jerk-limited commands.
+            command = limited(*_hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP))
             sent.append(command)
             q, qd = command.tolist(), limited.velocity.tolist()
             held = _apply_hold(cell, hold, t, q, qd, held)
@@ -161,6 +169,43 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
     run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(targets), np.array(clock)
     run.commands = np.array(sent)
     return run
+
+
+def _tracked(cell, stepper, sent: list) -> np.ndarray:
+    """What the stepper's phase stopping compares its command with: that command moved by the arm's
+    tracking error — the measured tool against the tool of the joints it was sent last (scene
+    units). The measured tool alone lags the stepper's newest command by the pipeline's own delay
+    (a control step of interpolation and the limiter's lag, 1 mm at 130 mm/s), and phase stopping
+    slowed and warped every fast motion for it; an arm held back still lags its commands."""
+    measured = cell.tcp_position() / cell.unit
+    if not sent:
+        return measured
+    return stepper.position + measured - cell.forward(sent[-1]) / cell.unit
+
+
+def _hermite(q0, v0, q1, v1, share: float, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, velocity and acceleration at ``share`` (0-1) of the cubic from ``(q0, v0)`` to
+    ``(q1, v1)`` over ``duration`` seconds (velocities per second)."""
+    s, h = share, duration
+    position = (2 * s**3 - 3 * s**2 + 1) * q0 + (s**3 - 2 * s**2 + s) * h * v0 + (3 * s**2 - 2 * s**3) * q1 \
+        + (s**3 - s**2) * h * v1
+    velocity = ((6 * s**2 - 6 * s) * (q0 - q1) / h + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1)
+    acceleration = ((12 * s - 6) * (q0 - q1) / h + (6 * s - 4) * v0 + (6 * s - 2) * v1) / h
+    return position, velocity, acceleration
+
+
+_AHEAD = 2e-3  # s: the joint velocity is the IK's own, by a step of the command's velocity this far ahead
+
+
+def _joint_velocity(cell, q: np.ndarray, point_m: np.ndarray, velocity_m: np.ndarray) -> np.ndarray:
+    """The joint velocities (rad/s) with which the IK's own solutions follow the tool's mouth moving
+    at ``velocity_m`` (m/s) from ``point_m`` (m), where it is at joints ``q``: the IK solved
+    :data:`_AHEAD` further along, from ``q`` (a redundant arm's least-norm Jacobian velocity takes
+    another null-space path than its IK does, and the segments between the IK's targets then bend)."""
+    if not np.any(velocity_m):
+        return np.zeros_like(q)
+    ahead, _ = cell.solve_ik(point_m + velocity_m * _AHEAD, q)
+    return (ahead - q) / _AHEAD
 
 
 def _perceive(cell, stepper, goal_update, labels) -> bool:

@@ -16,7 +16,8 @@ from .robot import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _u
 __all__ = []
 
 
-def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
+def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=None,
+          spacing: float = MAX_SAMPLE_SPACING) -> MotionPlan:
     """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
     within :data:`LIMIT_MARGIN` of the joint limits. ``fractions``: normalised time of each
     sample (default: uniform, as a DMP rollout is). ``orientations`` (n, 4): the tool frame
@@ -30,7 +31,7 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     if given.shape != (path.shape[0],) or not np.all(np.isfinite(given)) or np.any(np.diff(given) < 0) \
             or given[0] < 0 or given[-1] > 1:
         raise ValueError(f"fractions must be {path.shape[0]} non-decreasing times in [0, 1]")
-    points, u = _subdivide(path * cell.unit, given, MAX_SAMPLE_SPACING)
+    points, u = _subdivide(path * cell.unit, given, spacing)
     turns = None
     if orientations is not None:
         from scipy.spatial.transform import Rotation, Slerp

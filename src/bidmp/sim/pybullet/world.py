@@ -112,18 +112,18 @@ def _add_solid(p, client: int, unit: float, solid, mass: float = 0.0) -> int:
     if solid.kind == "box":
         half = [0.5 * v * unit for v in solid.params]
         shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_colour(solid), physicsClientId=client)
+        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_colour(solid, unit), physicsClientId=client)
     elif solid.kind == "cylinder":
         radius, height = solid.params[0] * unit, solid.params[1] * unit
         shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=_colour(solid),
+        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=_colour(solid, unit),
                                      physicsClientId=client)
     else:  # the hex nut: its convex hull
         vertices = (_inset_prism(np.asarray(solid.params[0]) * unit, HULL_MARGIN)).tolist()
         shape = p.createCollisionShape(p.GEOM_MESH, vertices=vertices, physicsClientId=client)
         extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
         visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
-                                     rgbaColor=_colour(solid), physicsClientId=client)
+                                     rgbaColor=_colour(solid, unit), physicsClientId=client)
     from scipy.spatial.transform import Rotation
 
     orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
@@ -131,9 +131,13 @@ def _add_solid(p, client: int, unit: float, solid, mass: float = 0.0) -> int:
                              physicsClientId=client)
 
 
-def _colour(solid) -> list:
+def _colour(solid, unit: float) -> list:
+    """A part's colour in the pictures: studs dark, nuts light, posts and other cylinders steel,
+    boxes by their height in metres (thin plates pale, tall parts such as cells blue)."""
     if solid.label.endswith("/stud"):
         return [0.35, 0.35, 0.38, 1.0]
     if solid.kind == "convex":
         return [0.75, 0.75, 0.7, 1.0]
-    return [0.55, 0.62, 0.72, 1.0] if solid.params[2] < 20 else [0.35, 0.5, 0.8, 1.0]
+    if solid.kind == "cylinder":
+        return [0.5, 0.52, 0.56, 1.0]
+    return [0.55, 0.62, 0.72, 1.0] if solid.params[2] * unit < 0.02 else [0.35, 0.5, 0.8, 1.0]
