@@ -28,7 +28,7 @@ def main() -> int:
         result = sim.simulate(scenario, ["dmp", "bidmp"], report=report, workers=workers)
         print(f"  {workers} worker process{'es' if workers > 1 else '  '}: simulated {result.simulated_s:6.1f} s in "
               f"{result.wall_s:5.1f} s wall = {result.simulated_s / result.wall_s:5.1f}x real time (target >= 10)")
-    with sim.PandaCell(scenario.scene, scenario.units, *sim.robot_placement(scenario)) as cell:
+    with sim.RobotCell(scenario.scene, scenario.units, *sim.robot_placement(scenario)) as cell:
         n = 5000
         start = time.perf_counter()
         for _ in range(n):

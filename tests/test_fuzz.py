@@ -690,10 +690,10 @@ def test_fuzz_pose_files(files, header, poses, columns):
 def panda():
     pytest.importorskip("pybullet")
     from bidmp import scenarios
-    from bidmp.sim import PandaCell, robot_placement
+    from bidmp.sim import RobotCell, robot_placement
 
     scenario = scenarios.load("nut-unscrewing")
-    cell = PandaCell(scenario.scene, scenario.units, *robot_placement(scenario))
+    cell = RobotCell(scenario.scene, scenario.units, *robot_placement(scenario))
     yield cell
     cell.close()
 
@@ -702,8 +702,8 @@ def panda():
        st.one_of(trajectories(max_points=20, dims=(3,)), st.just(np.array([[0.0, 0.0, 40.0], [10.0, 0.0, 20.0]]))))
 @examples(15)
 def test_fuzz_sim(panda, target, seed, path):
-    outcome("PandaCell.solve_ik", panda.solve_ik, target, seed)
-    outcome("PandaCell.plan", panda.plan, path, seed=seed)
+    outcome("RobotCell.solve_ik", panda.solve_ik, target, seed)
+    outcome("RobotCell.plan", panda.plan, path, seed=seed)
 
 
 @given(maybe(st.lists(st.sampled_from(["Sshape", "Angle", "Nope", ""]), max_size=2), anything),

@@ -37,7 +37,7 @@ PACKAGES = ("bidmp", "bidmp.primitives", "bidmp.demonstrations", "bidmp.extensio
 # and by the hypothesis campaign with valid scenarios, not with one argument swapped.
 SKIPPED = {"evaluate", "simulate", "run_job", "write_job_report", "JobReport", "JobTarget", "JobPhase", "run_figures", "run_table4", "run_table5", "lasa_generalisation", "lasa_incremental",
            "compare_prm", "forgetting_runs", "run_cell", "write_report", "write_sim_report", "write_results", "register",
-           "unregister", "summary_rows", "summary_markdown", "PandaCell", "Report", "MethodResult", "SimReport",
+           "unregister", "summary_rows", "summary_markdown", "Report", "MethodResult", "SimReport",
            "SimTarget", "SimMethod", "Table4", "Table5", "Figures", "BenchmarkResult", "GeneralisationResult",
            "IncrementalResult", "PRMComparison", "Task", "Method", "SimulatorBackend", "MotionPlan", "Execution",
            # Records the library returns (users receive them, never build them) and objects made by

@@ -136,43 +136,28 @@ def test_library_code_never_prints():
         assert not calls, f"{path.name} calls print()"
 
 
-# Sizes that keep rooms livable (ARCHITECTURE.md): every line counts, docstrings and comments
-# included, from a definition's first line to its last (decorators aside).
-MAX_LINES = {"module": 500, "class": 250, "function": 60}
+# Rooms are cut by cohesion (one idea per module, class and function), not by a line count: a module
+# past this many lines usually holds more than one idea. Functions and classes are left to review
+# (splitting one only to pass a count moves walls without making a room).
+MAX_MODULE_LINES = 800
 
 
 def oversized(text: str, name: str) -> list[str]:
-    """The module, classes and functions of ``text`` over :data:`MAX_LINES`."""
-    tree = ast.parse(text)
-    found = []
+    """``name`` when the module ``text`` is over :data:`MAX_MODULE_LINES` (every line counts)."""
     lines = len(text.splitlines())
-    if lines > MAX_LINES["module"]:
-        found.append(f"{name}: {lines} lines")
-    for node in ast.walk(tree):
-        kind = "class" if isinstance(node, ast.ClassDef) else \
-            "function" if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) else None
-        if kind:
-            size = node.end_lineno - node.lineno + 1
-            if size > MAX_LINES[kind]:
-                found.append(f"{name}:{node.lineno} {kind} {node.name}: {size} lines")
-    return found
+    return [f"{name}: {lines} lines"] if lines > MAX_MODULE_LINES else []
 
 
-def test_no_module_class_or_function_is_too_big():
+def test_no_module_is_past_the_size_where_it_holds_two_ideas():
+    """Structure guard."""
     found = [item for path in sorted(SRC.rglob("*.py")) for item in oversized(path.read_text(), str(path.relative_to(SRC)))]
-    assert not found, "over the size limits:\n" + "\n".join(found)
+    assert not found, "modules past the size where they hold more than one idea:\n" + "\n".join(found)
 
 
-def test_the_size_check_sees_long_functions_classes_and_modules_docstrings_included():
-    body = "".join(f"    x{i} = {i}\n" for i in range(59))
-    assert oversized(f"def f():\n{body}", "probe") == []  # 60 lines: at the limit
-    assert oversized(f"def f():\n{body}    x = 0\n", "probe") == ["probe:1 function f: 61 lines"]
-    documented = 'def f():\n    """' + "doc\n" * 10 + '    """\n' + body  # 1 + 11 + 59 lines
-    assert oversized(documented, "probe") == ["probe:1 function f: 71 lines"]
-    methods = "".join(f"    def m{i}(self):\n        return {i}\n\n" for i in range(84))  # 3 lines each
-    found = oversized(f"class C:\n{methods}", "probe")
-    assert found == ["probe:1 class C: 252 lines"]
-    assert oversized("x = 1\n" * 501, "probe") == ["probe: 501 lines"]
+def test_the_size_check_sees_a_long_module():
+    """Structure guard: the probe that the check above can fail."""
+    assert oversized("x = 1\n" * 800, "probe") == []
+    assert oversized("x = 1\n" * 801, "probe") == ["probe: 801 lines"]
 
 
 # --- issue 22.1: the public surface is each package's __all__; everything else has an underscore --

@@ -30,7 +30,7 @@ def nut_report(nut):
 @pytest.fixture(scope="module")
 def cell(nut):
     base, yaw = sim.robot_placement(nut)
-    with sim.PandaCell(nut.scene, nut.units, base, yaw) as panda:
+    with sim.RobotCell(nut.scene, nut.units, base, yaw) as panda:
         yield panda
 
 

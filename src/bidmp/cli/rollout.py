@@ -44,9 +44,10 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
     if args.joint_limits is not None:
         if given:
             raise ValueError("give --joint-limits or --max-speed/--max-acc/--max-jerk, not both")
-        if dmp.n_dims_ != 7:
-            raise ValueError(f"--joint-limits needs a 7-joint model; this one has {dmp.n_dims_} dimensions")
         arm = _arm_limits(args)
+        if dmp.n_dims_ != arm.n_joints:
+            raise ValueError(f"--joint-limits {args.joint_limits}: that arm has {arm.n_joints} joints; this model has "
+                             f"{dmp.n_dims_} dimensions")
         return {"max_velocity": arm.velocity, "max_acceleration": arm.acceleration, "max_jerk": arm.jerk, "norm": "axis"}
     if not given:
         return {}
@@ -59,7 +60,7 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
 
 
 def _arm_limits(args: argparse.Namespace):
-    """The JointLimits of --joint-limits: a built-in arm (panda, iiwa), or the robot a scenario
+    """The JointLimits of --joint-limits: a built-in arm (panda, iiwa, xarm6, ur5), or the robot a scenario
     names (its "robot" key: a model or its own URDF's limits)."""
     from ..sim.pybullet.robot import ROBOT_MODELS, robot_model
 
@@ -94,7 +95,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
 
     args.robot_given = args.robot is not None
-    args.robot = args.robot or (args.joint_limits if args.joint_limits in ("panda", "iiwa") else "panda")
+    from ..sim.pybullet.robot import ROBOT_MODELS
+
+    args.robot = args.robot or (args.joint_limits if args.joint_limits in ROBOT_MODELS else "panda")
     if not args.tool_length >= 0:
         raise ValueError(f"--tool-length must be >= 0 metres, got {args.tool_length:g}")
     model = load_model(args.model)
@@ -143,14 +146,19 @@ def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
         return args.goal
     if args.goal is not None:
         raise ValueError("give --goal (joints) or --cartesian-goal (the tool's position), not both")
-    if poses or dmp.n_dims_ != 7:
-        raise ValueError("--cartesian-goal is for a 7-joint model (t,<joint names> or JointState input); "
-                         f"this model has {7 if poses else dmp.n_dims_} dimensions: give --goal")
     import numpy as np
 
     from ..sim.kinematics import inverse_kinematics
+    from ..sim.pybullet.robot import ROBOT_MODELS
 
-    q = inverse_kinematics(np.asarray(args.cartesian_goal, dtype=float), units="m", seed=dmp.goal_, **_arm(args, 1.0))
+    arm = _arm(args, 1.0)
+    robot = arm["robot"]
+    n_joints = (ROBOT_MODELS[robot] if isinstance(robot, str) else robot).n_joints
+    if poses or dmp.n_dims_ != n_joints:
+        name = robot if isinstance(robot, str) else robot.name
+        raise ValueError(f"--cartesian-goal is for a joint-space model of the {name}'s {n_joints} joints (t,<joint names> "
+                         f"or JointState input); this model has {7 if poses else dmp.n_dims_} dimensions: give --goal")
+    q = inverse_kinematics(np.asarray(args.cartesian_goal, dtype=float), units="m", seed=dmp.goal_, **arm)
     print(f"--cartesian-goal {args.cartesian_goal} m: the {args.robot}'s joints {np.array2string(q, precision=4)} rad "
           f"(inverse kinematics from the demonstrated goal's)")
     return q
@@ -265,15 +273,15 @@ def _add_rollout_arguments(rollout) -> None:
                          help="cap: slow the motion (uniformly) if its acceleration exceeds A units/s^2 (or one per dimension)")
     rollout.add_argument("--max-jerk", type=float, nargs="+", default=None, metavar="J",
                          help="cap on the jerk, units/s^3 (or one per dimension)")
-    rollout.add_argument("--joint-limits", default=None, metavar="panda|iiwa|SCENARIO",
+    rollout.add_argument("--joint-limits", default=None, metavar="panda|iiwa|xarm6|ur5|SCENARIO",
                          help="a joint-space model: the robot's per-joint velocity, acceleration and jerk limits (the "
-                              "Panda's published ones; the iiwa's published speeds, assumed acceleration and jerk; or "
-                              "those of the robot a scenario file names)")
-    rollout.add_argument("--robot", default=None, metavar="panda|iiwa|SCENARIO",
+                              "Panda's published ones; the iiwa's, the xArm6's and the UR5's published speeds with "
+                              "assumed acceleration and jerk; or those of the robot a scenario file names)")
+    rollout.add_argument("--robot", default=None, metavar="panda|iiwa|xarm6|ur5|SCENARIO",
                          help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; a scenario: "
                               "its robot where it stands, with its tool; needs bidmp[sim])")
     rollout.add_argument("--cartesian-goal", type=float, nargs=3, default=None, metavar=("X", "Y", "Z"),
-                         help="a 7-joint model: roll out to the joints that put the robot's tool at X Y Z metres in its base "
+                         help="a joint-space model of the --robot's joints: roll out to the joints that put its tool at X Y Z metres in its base "
                               "frame, tool pointing down (IK from the demonstrated goal's joints)")
     rollout.add_argument("--tool-length", type=float, default=0.0, metavar="M",
                          help="with --robot: from the flange to the tool's mouth, metres (default 0)")

@@ -3,8 +3,8 @@
 * ``backend`` — the simulator backend protocol (``load_robot``, ``ik``, ``fk``, ``execute``,
   ``contacts``, ``render``) and the types it exchanges; a new simulator or robot is a subpackage
   beside ``pybullet`` that implements it;
-* ``pybullet`` — the first backend: a 7-joint arm in PyBullet, the Franka Panda by default, the
-  KUKA iiwa or your URDF (world, robot, IK, planning, execution, rendering, one module each);
+* ``pybullet`` — the first backend: a serial arm of six or more joints in PyBullet, the Franka
+  Panda by default, the KUKA iiwa, the xArm6, a UR5-class arm or your URDF (world, robot, IK, planning, execution, rendering, one module each);
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
 * ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
@@ -36,10 +36,11 @@ _EXPORTS = {
     "GoalUpdate": "backend",
     "MotionPlan": "backend",
     "Execution": "backend",
-    "PandaCell": "pybullet.cell",
     "RobotCell": "pybullet.cell",
     "PANDA": "pybullet.robot",
     "IIWA": "pybullet.robot",
+    "XARM6": "pybullet.robot",
+    "UR5": "pybullet.robot",
     "RobotModel": "pybullet.robot",
     "ROBOT_MODELS": "pybullet.robot",
     "robot_model": "pybullet.robot",

@@ -36,8 +36,8 @@ class SimError(ValueError):
 
 @dataclass(frozen=True)
 class JointLimits:
-    """Joint limits of a 7-axis arm: position (rad), velocity (rad/s), acceleration (rad/s²) and
-    jerk (rad/s³; None: not checked)."""
+    """Joint limits of an arm, one value per joint, base to flange: position (rad), velocity
+    (rad/s), acceleration (rad/s²) and jerk (rad/s³; None: not checked)."""
 
     lower: tuple
     upper: tuple
@@ -46,27 +46,33 @@ class JointLimits:
     jerk: tuple | None = None
 
     def __post_init__(self) -> None:
+        count = None
         for name in ("lower", "upper", "velocity", "acceleration", "jerk"):
             value = getattr(self, name)
             if value is None and name == "jerk":
                 continue
-            values = as_vector(value, f"JointLimits.{name}", length=7, positive=name not in ("lower", "upper"))
+            values = as_vector(value, f"JointLimits.{name}", length=count, positive=name not in ("lower", "upper"))
+            count = len(values)
             object.__setattr__(self, name, tuple(float(v) for v in values))
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
 
+    @property
+    def n_joints(self) -> int:
+        return len(self.lower)
+
 
 @dataclass(frozen=True)
 class Hold:
-    """A scripted disturbance: joint ``joint`` (0-6) held where it is from ``start`` for
-    ``duration`` seconds of the motion."""
+    """A scripted disturbance: joint ``joint`` (0-based, base first) held where it is from
+    ``start`` for ``duration`` seconds of the motion."""
 
     joint: int
     start: float
     duration: float = 0.5
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=6))
+        object.__setattr__(self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=63))
         object.__setattr__(self, "start", check_real(self.start, "Hold.start", nonnegative=True))
         object.__setattr__(self, "duration", check_real(self.duration, "Hold.duration", positive=True))
 
@@ -95,7 +101,7 @@ class MotionPlan:
     label: str
     points: np.ndarray  # (n, 3) m, the IK samples (the path subdivided)
     fractions: np.ndarray  # (n,) normalised time of each sample in [0, 1]
-    joints: np.ndarray  # (n, 7) rad
+    joints: np.ndarray  # (n, J) rad, J the arm's joints
     duration: float  # s
     spline: object  # q(u), u in [0, 1]: a scipy spline, q(u, order) its derivatives
     peak_velocity: float  # fraction of the limit, the largest over joints
@@ -104,7 +110,7 @@ class MotionPlan:
     peak_jerk: float = 0.0  # fraction of the jerk limit (0 when the limits state none)
 
     def command(self, t) -> tuple[np.ndarray, np.ndarray]:
-        """Joint positions and velocities commanded at time(s) ``t`` (s): (7,) or (n, 7)."""
+        """Joint positions and velocities commanded at time(s) ``t`` (s): (J,) or (n, J)."""
         u = np.clip(np.asarray(t, dtype=float) / self.duration, 0.0, 1.0)
         moving = (u > 0.0) & (u < 1.0)  # at rest before the start and after the end
         return self.spline(u), self.spline(u, 1) / self.duration * moving[..., None]
@@ -125,7 +131,7 @@ class Execution:
     command_joints: np.ndarray | None = None  # ... the joints commanded there (rad) ...
     motion_clock: np.ndarray | None = None  # ... and the stepper's own time (s; stands still while paused)
     tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
-    commands: np.ndarray | None = None  # (n, 7) rad: the joint positions commanded every SIM_STEP
+    commands: np.ndarray | None = None  # (n, J) rad: the joint positions commanded every SIM_STEP
 
     @property
     def paused(self) -> float:

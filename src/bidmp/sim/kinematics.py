@@ -35,31 +35,32 @@ def _arm(robot, units: str, tool_length: float, base=(0.0, 0.0, 0.0), yaw: float
     return RobotCell(scene, units, base, yaw, robot)
 
 
-def _seed(seed) -> np.ndarray:
+def _seed(seed, n_joints: int) -> np.ndarray:
     from .._checks import as_point
 
-    return as_point(seed, 7, "seed")
+    return as_point(seed, n_joints, "seed")
 
 
 def joint_names(robot="panda") -> list[str]:
-    """The names of the arm's 7 driven joints, base to flange, as in its URDF."""
+    """The names of the arm's driven joints, base to flange, as in its URDF."""
     with _arm(robot, "m", 0.0) as cell:
         return [cell.p.getJointInfo(cell.robot, j, physicsClientId=cell.client)[1].decode() for j in cell.arm]
 
 
 def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: float = 0.0, seed=None,
                        orientations=None, base=(0.0, 0.0, 0.0), yaw: float = 0.0) -> np.ndarray:
-    """Joint positions (n, 7) rad that put the tool's mouth on each of ``points`` (n, 3), each
-    solved from the previous one (the first from ``seed``, default the arm's rest pose).
+    """Joint positions (n, J) rad (J the arm's joints) that put the tool's mouth on each of
+    ``points`` (n, 3), each solved from the previous one (the first from ``seed``, default the
+    arm's rest pose).
 
     Parameters
     ----------
     points : array (n, 3) or (3,)
         In ``units`` ("m", "cm" or "mm").
-    robot : {"panda", "iiwa"} or RobotModel
+    robot : {"panda", "iiwa", "xarm6", "ur5"} or RobotModel
     tool_length : float
         From the flange to the tool's mouth, in ``units`` (0: the flange itself).
-    seed : array (7,), optional
+    seed : array (J,), optional
     orientations : array (n, 4), optional
         The tool frame's quaternions (x, y, z, w); default pointing down.
     base, yaw : array (3,), float
@@ -91,8 +92,8 @@ def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: 
         lower, upper = np.array(cell.limits.lower), np.array(cell.limits.upper)
         # A seed is only where the search starts: one outside this arm's limits (another arm's
         # recording) starts from the nearest joints within them.
-        q = np.array(cell.model.rest, dtype=float) if seed is None else np.clip(_seed(seed), lower, upper)
-        joints = np.empty((len(path), 7))
+        q = np.array(cell.model.rest, dtype=float) if seed is None else np.clip(_seed(seed, cell.n_joints), lower, upper)
+        joints = np.empty((len(path), cell.n_joints))
         for index, point in enumerate(path):
             turn = None if orientations is None else orientations[index]
             start = q

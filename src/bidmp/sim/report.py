@@ -146,7 +146,9 @@ class SimReport:
 
     @property
     def robot_name(self) -> str:
-        return {"panda": "Franka Panda", "iiwa": "KUKA LBR iiwa 7 R800"}.get(self.robot, self.robot)
+        from .pybullet.robot import ROBOT_NAMES
+
+        return ROBOT_NAMES.get(self.robot, self.robot)
 
     def to_dict(self) -> dict:
         return {"scenario": self.scenario.name, "units": self.scenario.units, "closed_loop": self.closed_loop,

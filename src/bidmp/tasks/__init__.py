@@ -1,5 +1,6 @@
 """Tasks: scenario files (``scenarios``), the methods registry (``methods``), evaluation of every
-method on every target (``evaluation``) and the metrics it reports (``metrics``).
+method on every target (``evaluation``), the metrics it reports (``metrics``) and the motion
+contract every motion is judged by (``contract``).
 
 Layer 2 (data and tasks): imports the math and ``bidmp.io``; never ``sim``, ``experiments``,
 ``plotting`` at import time (figures are drawn on request) or ``cli``.
@@ -31,6 +32,11 @@ _EXPORTS = {
     "path_difference": "metrics",
     "swept_area": "metrics",
     "final_approach_mask": "metrics",
+    "Contract": "contract",
+    "Verdict": "contract",
+    "CommandPeaks": "contract",
+    "command_peaks": "contract",
+    "mm": "contract",
     "JobSpec": "jobs",
     "parse_job": "jobs",
     "tour": "jobs",

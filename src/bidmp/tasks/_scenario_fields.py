@@ -172,23 +172,26 @@ def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> 
     return points
 
 
-_ROBOT_MODELS = ("panda", "iiwa")
+_ROBOT_MODELS = ("panda", "iiwa", "xarm6", "ur5")
+MIN_JOINTS = 6  # the arms the simulator drives: serial, six joints or more
 _LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "jerk")
 
 
-def _joint_values(value, source: str, key: str, positive: bool = False) -> list:
-    """Seven numbers, one per joint (rad, rad/s, ... or N m)."""
-    if not isinstance(value, list) or len(value) != 7:
-        _fail(source, key, f"expected 7 numbers, one per joint, got {_shown(value)}")
+def _joint_values(value, source: str, key: str, positive: bool = False, count: int | None = None) -> list:
+    """One number per joint (rad, rad/s, ... or N m): ``count`` of them, else six or more."""
+    if not isinstance(value, list) or (len(value) != count if count is not None else len(value) < MIN_JOINTS):
+        wanted = f"{count}" if count is not None else f"{MIN_JOINTS} or more"
+        _fail(source, key, f"expected {wanted} numbers, one per joint of the arm, got {_shown(value)}")
     return [_number(v, source, f"{key}[{i}]", positive=positive) for i, v in enumerate(value)]
 
 
 def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict:
     """The ``"robot"`` key, validated: where ``bidmp sim`` puts the arm (``base``, ``yaw``) and
-    which arm: ``"model"`` (panda, the default, or iiwa) or its own ``"urdf"`` (a file in the
-    scenario's folder, or a model shipped by pybullet_data) with ``"flange"`` (the link the tool
-    is mounted on) and ``"limits"`` (7 values each: lower, upper in rad; velocity, acceleration,
-    jerk in rad/s, rad/s², rad/s³; jerk optional), ``"rest"`` and ``"effort"`` optional."""
+    which arm: ``"model"`` (panda, the default, iiwa, xarm6 or ur5) or its own ``"urdf"`` (a file in
+    the scenario's folder, or a model shipped by pybullet_data) with ``"flange"`` (the link the tool
+    is mounted on) and ``"limits"`` (one value per joint, six joints or more: lower, upper in rad;
+    velocity, acceleration, jerk in rad/s, rad/s², rad/s³; jerk optional), ``"rest"`` and
+    ``"effort"`` optional (one per joint)."""
     robot = data.get("robot", {})
     allowed = {"base", "yaw", "model", "urdf", "flange", "limits", "rest", "effort"}
     if not isinstance(robot, dict) or set(robot) - allowed:
@@ -216,12 +219,15 @@ def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict
         _fail(source, "robot.flange", "expected the name of the URDF link the tool is mounted on")
     limits = robot.get("limits")
     if not isinstance(limits, dict) or set(limits) - set(_LIMIT_KEYS) or not set(_LIMIT_KEYS[:4]) <= set(limits):
-        _fail(source, "robot.limits", f"expected {{{', '.join(_LIMIT_KEYS)}}} (jerk optional), 7 values each")
-    robot["limits"] = {name: _joint_values(values, source, f"robot.limits.{name}", positive=name not in ("lower", "upper"))
+        _fail(source, "robot.limits", f"expected {{{', '.join(_LIMIT_KEYS)}}} (jerk optional), one value per joint each")
+    count = len(limits["lower"]) if isinstance(limits["lower"], list) else None
+    robot["limits"] = {name: _joint_values(values, source, f"robot.limits.{name}", positive=name not in ("lower", "upper"),
+                                           count=count if name != "lower" else None)
                        for name, values in limits.items()}
+    count = len(robot["limits"]["lower"])
     if any(low >= high for low, high in zip(robot["limits"]["lower"], robot["limits"]["upper"])):
         _fail(source, "robot.limits", "lower must be below upper for every joint")
     for name in ("rest", "effort"):
         if name in robot:
-            robot[name] = _joint_values(robot[name], source, f"robot.{name}", positive=name == "effort")
+            robot[name] = _joint_values(robot[name], source, f"robot.{name}", positive=name == "effort", count=count)
     return robot

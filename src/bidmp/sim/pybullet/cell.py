@@ -13,15 +13,15 @@ from . import execute as _execute
 from . import ik as _ik
 from . import plan as _plan
 from . import render as _render
-from .robot import MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
+from .robot import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
 
-__all__ = ["PandaCell", "RobotCell"]
+__all__ = ["RobotCell"]
 
 
 class RobotCell:
-    """A headless PyBullet world with a scene's parts and an arm (the Panda unless ``robot``
-    names another) carrying the scene's tool: the PyBullet implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
+    """A headless PyBullet world with a scene's parts and a serial arm of six or more joints (the
+    Panda unless ``robot`` names another) carrying the scene's tool: the PyBullet implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
     state; planning, execution and pictures are the functions of this subpackage's modules.
 
     Parameters
@@ -75,10 +75,16 @@ class RobotCell:
             self.tcp = names.index("tcp")
             movable = [j for j in range(len(names)) if p.getJointInfo(self.robot, j, physicsClientId=self.client)[2]
                        != p.JOINT_FIXED]
-            if len(movable) != 7:
-                raise ValueError(f"robot {robot.name!r}: the simulator drives 7-joint arms; its URDF up to the flange "
-                                 f"has {len(movable)} movable joints")
+            if len(movable) < 6 or len(movable) != robot.n_joints:
+                what = "serial arms of six or more joints" if len(movable) < 6 else f"its {robot.n_joints} limits"
+                raise ValueError(f"robot {robot.name!r} has {len(movable)} movable joints up to its flange "
+                                 f"{robot.flange!r}; the simulator drives {what}")
             self.arm = movable
+            self.gains = [GAIN] * len(movable)
+            # A tool symmetric about its axis leaves the turn about that axis free; it is the last
+            # joint's when that joint turns about the tool's axis (the Panda, the iiwa, the xArm6, the
+            # UR5): pose skills then park it and solve the others for the position and the axis.
+            self.wrist_turns_tool = self._last_joint_turns_tool()
             self.base = np.asarray(base, dtype=float)
             self.yaw = float(yaw)
             self._set_joints(robot.rest)
@@ -87,6 +93,23 @@ class RobotCell:
             raise
 
     limits = PANDA_MODEL.limits  # the robot's joint limits (the backend protocol's; set per instance)
+
+    @property
+    def n_joints(self) -> int:
+        return len(self.arm)
+
+    def _last_joint_turns_tool(self) -> bool:
+        """Whether the last joint turns about the tool's axis through its mouth (at the rest pose)."""
+        p, robot, client = self.p, self.ik_robot, self.ik_client
+        self._set_joints(self.model.rest, kinematic=True)
+        last = p.getJointInfo(robot, self.arm[-1], physicsClientId=client)
+        frame = p.getLinkState(robot, self.arm[-1], computeForwardKinematics=1, physicsClientId=client)
+        tcp = p.getLinkState(robot, self.tcp, computeForwardKinematics=1, physicsClientId=client)
+        axis = np.array(p.getMatrixFromQuaternion(frame[5])).reshape(3, 3) @ np.asarray(last[13])
+        tool = np.array(p.getMatrixFromQuaternion(tcp[5])).reshape(3, 3)[:, 2]
+        offset = np.asarray(tcp[4]) - np.asarray(frame[4])
+        across = offset - (offset @ tool) * tool
+        return bool(abs(abs(axis @ tool) - 1.0) < 1e-6 and np.linalg.norm(across) < 1e-6)
 
     @classmethod
     def load_robot(cls, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
@@ -184,4 +207,3 @@ class RobotCell:
         return _render._scene_centre(self)
 
 
-PandaCell = RobotCell  # the name of bidmp <= 0.9, when the Panda was the only arm

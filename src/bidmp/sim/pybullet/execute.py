@@ -20,7 +20,7 @@ from ..backend import (
     SimError,
 )
 from ..limits import _RateLimiter
-from .robot import _GAINS, IK_TOLERANCE
+from .robot import GAIN, IK_TOLERANCE
 
 __all__ = []
 
@@ -49,8 +49,8 @@ def _contacts_into(cell, found: dict) -> None:
 def _drive(cell, q, qd) -> None:
     """Hand joint targets (rad) and velocities (rad/s) to the position control."""
     cell.p.setJointMotorControlArray(cell.robot, cell.arm, cell.p.POSITION_CONTROL, targetPositions=q,
-                                     targetVelocities=qd, forces=list(cell.model.effort), positionGains=_GAINS,
-                                     velocityGains=_GAINS, physicsClientId=cell.client)
+                                     targetVelocities=qd, forces=list(cell.model.effort), positionGains=cell.gains,
+                                     velocityGains=cell.gains, physicsClientId=cell.client)
 
 
 def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0, on_record=None) -> Execution:
@@ -69,7 +69,7 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
     # recorder visited only on the steps it records.
     robot, client, arm, mode, step_simulation = cell.robot, cell.client, cell.arm, p.POSITION_CONTROL, p.stepSimulation
     motors, contact_points, contacts = p.setJointMotorControlArray, p.getContactPoints, record.contacts
-    bodies, effort = cell._bodies, list(cell.model.effort)
+    bodies, effort, gains = cell._bodies, list(cell.model.effort), cell.gains
     visit = np.zeros(n_steps, dtype=bool)
     visit[::RECORD_EVERY] = True
     visit[-1] = True
@@ -83,8 +83,8 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
                     held = p.getJointState(robot, arm[hold.joint], physicsClientId=client)[0]
                 q, qd = list(q), list(qd)
                 q[hold.joint], qd[hold.joint] = held, 0.0
-            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=effort, positionGains=_GAINS,
-                   velocityGains=_GAINS, physicsClientId=client)
+            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=effort, positionGains=gains,
+                   velocityGains=gains, physicsClientId=client)
             step_simulation(physicsClientId=client)
             for contact in contact_points(bodyA=robot, physicsClientId=client):
                 if contact[8] < 0.0 and contact[2] in bodies:
@@ -251,8 +251,8 @@ class _Recorder:
         self.times = np.empty(n_records)
         self.tcp = np.empty((n_records, 3))
         self.tcp_orientation = np.empty((n_records, 4))
-        self.joints = np.empty((n_records, 7))
-        self.velocities = np.empty((n_records, 7))
+        self.joints = np.empty((n_records, len(cell.arm)))
+        self.velocities = np.empty((n_records, len(cell.arm)))
         self.commanded = []
         self.contacts = {}
         self.frame_steps = set(np.linspace(0, n_steps - 1, frames).astype(int).tolist()) if frames else set()

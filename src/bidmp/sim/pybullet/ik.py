@@ -49,11 +49,11 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
         q = np.array(p.calculateInverseKinematics(
             cell.ik_robot, cell.tcp, point_m.tolist(), target_orientation, lowerLimits=list(limits.lower),
             upperLimits=list(limits.upper), jointRanges=ranges, restPoses=q.tolist(), maxNumIterations=40,
-            residualThreshold=1e-9, physicsClientId=cell.ik_client)[:7])
-        if axis is not None:
-            # Joint 7 turns the flange about the tool's axis, which moves neither the tool's
-            # mouth nor its axis: park it mid-range instead of letting it drift to a limit.
-            q[6] = cell.model.rest[6]
+            residualThreshold=1e-9, physicsClientId=cell.ik_client)[: len(cell.arm)])
+        if axis is not None and cell.wrist_turns_tool:
+            # The last joint turns the flange about the tool's axis, which moves neither the tool's
+            # mouth nor its axis: park it where it rests instead of letting it drift to a limit.
+            q[-1] = cell.model.rest[-1]
         error = float(np.linalg.norm(cell.forward(q) - point_m))
         if error <= IK_ACCURACY:
             break

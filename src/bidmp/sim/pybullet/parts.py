@@ -146,6 +146,6 @@ def _settle(cell, seconds: float) -> None:
     states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
     held = [s[0] for s in states]
     p.setJointMotorControlArray(cell.robot, cell.arm, p.POSITION_CONTROL, targetPositions=held,
-                                targetVelocities=[0.0] * 7, forces=list(cell.model.effort), physicsClientId=cell.client)
+                                targetVelocities=[0.0] * len(cell.arm), forces=list(cell.model.effort), physicsClientId=cell.client)
     for _ in range(int(round(seconds / SIM_STEP))):
         p.stepSimulation(physicsClientId=cell.client)

@@ -43,7 +43,7 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
         turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
     limits = cell.limits
     q = np.array(cell.model.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
-    joints = np.empty((points.shape[0], 7))
+    joints = np.empty((points.shape[0], len(cell.arm)))
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
@@ -60,7 +60,7 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     # A quintic spline at rest at both ends, acceleration included: the arm's interface asks for
     # zero velocity and acceleration where a motion starts and stops (a clamped cubic ends with
     # an acceleration, up to 0.45 of the limit), and its jerk is then bounded too.
-    rest = [(1, np.zeros(7)), (2, np.zeros(7))]
+    rest = [(1, np.zeros(len(cell.arm))), (2, np.zeros(len(cell.arm)))]
     spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
     grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
     unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))

@@ -1,18 +1,22 @@
 """The robots the PyBullet backend models: a :class:`RobotModel` (URDF, tool flange, joint limits,
-motor efforts, rest pose) for the Franka Panda (the default) and the KUKA LBR iiwa 7 R800 of
-``pybullet_data``, or one a scenario names by its own URDF; where a robot stands in a scenario; the
-checks on points and joint seeds."""
+motor efforts, rest pose) for any serial arm of six or more joints — built in: the Franka Panda (the
+default) and the KUKA LBR iiwa 7 R800 of ``pybullet_data`` (7 joints), UFACTORY's xArm6 of
+``pybullet_data`` and a UR5-class arm written from Universal Robots' published DH parameters (6
+joints) — or one a scenario names by its own URDF; where a robot stands in a scenario; the checks on
+points and joint seeds."""
 
 from __future__ import annotations
 
-import numpy as np
-
+import math
 from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
 
 from ..._checks import as_point
 from ..backend import JointLimits, SimError
 
-__all__ = ["PANDA", "IIWA", "RobotModel", "ROBOT_MODELS", "robot_model", "robot_placement"]
+__all__ = ["PANDA", "IIWA", "XARM6", "UR5", "RobotModel", "ROBOT_MODELS", "ROBOT_NAMES", "robot_model", "robot_placement"]
 
 MAX_SAMPLE_SPACING = 5e-3  # m: the Cartesian path is subdivided so that IK points are at most this far apart
 IK_TOLERANCE = 5e-5  # m: a sample whose IK leaves more than this (0.05 mm) is unreachable
@@ -31,7 +35,7 @@ PANDA = JointLimits(
 )
 
 _EFFORT = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]  # N m
-_GAINS = [1.0] * 7  # PyBullet's position and velocity gains: the stiffest its motors allow
+GAIN = 1.0  # PyBullet's position and velocity gains, every joint: the stiffest its motors allow
 
 # KUKA LBR iiwa 7 R800: axis ranges and speeds from KUKA's datasheet (±170/120/170/120/170/120/175°;
 # 98, 98, 100, 130, 140, 180, 180 °/s). KUKA publishes no joint acceleration or jerk limits; these
@@ -48,9 +52,28 @@ IIWA = JointLimits(
 )
 
 
+# UFACTORY xArm6: joint ranges from UFACTORY's SDK (its JOINT_LIMITS for the xArm6), 180 deg/s every
+# joint (the xArm's datasheet). UFACTORY publishes no joint acceleration or jerk limits: assumed as
+# for the iiwa, 5x and 500x the speed per second, and named as assumptions wherever reported.
+_XARM_SPEED = (math.pi,) * 6
+XARM6 = JointLimits(
+    lower=(-2 * math.pi, -2.059488, -3.92699, -2 * math.pi, -1.692969, -2 * math.pi),
+    upper=(2 * math.pi, 2.094395, 0.191986, 2 * math.pi, math.pi, 2 * math.pi),
+    velocity=_XARM_SPEED,
+    acceleration=tuple(round(5.0 * v, 4) for v in _XARM_SPEED),
+    jerk=tuple(round(500.0 * v, 1) for v in _XARM_SPEED),
+)
+# A UR5-class arm: +-360 deg and 180 deg/s every joint (Universal Robots' UR5 datasheet); acceleration
+# and jerk are not published: assumed like the xArm6's.
+UR5 = JointLimits(lower=(-2 * math.pi,) * 6, upper=(2 * math.pi,) * 6, velocity=_XARM_SPEED,
+                  acceleration=XARM6.acceleration, jerk=XARM6.jerk)
+# The arms whose acceleration and jerk limits are assumptions (reports say so).
+ASSUMED_LIMITS = {"iiwa", "xarm6", "ur5"}
+
+
 @dataclass(frozen=True)
 class RobotModel:
-    """A 7-joint arm for the PyBullet backend.
+    """A serial arm of six or more joints for the PyBullet backend.
 
     Parameters
     ----------
@@ -60,10 +83,11 @@ class RobotModel:
     flange : str
         The link the tool is mounted on (the scenario's tool hangs from it along its z axis).
     limits : JointLimits
-        Position (rad), velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits.
-    rest : tuple of 7 float
+        Position (rad), velocity (rad/s), acceleration (rad/s²) and jerk (rad/s³) limits, one value
+        per joint from the base to the flange.
+    rest : tuple of float
         The joints (rad) the arm starts from and IK is seeded with: the tool pointing down.
-    effort : tuple of 7 float
+    effort : tuple of float
         Motor torques (N m) of PyBullet's position control.
     cut_at : str, optional
         A joint of the URDF from which on its text is dropped (the Panda's own hand).
@@ -80,6 +104,17 @@ class RobotModel:
     cut_at: str | None = None
     standoff: float = 0.33
 
+    def __post_init__(self) -> None:
+        n = self.limits.n_joints
+        for name in ("rest", "effort"):
+            if len(getattr(self, name)) != n:
+                raise ValueError(f"robot {self.name!r}: {name} gives {len(getattr(self, name))} values; its limits "
+                                 f"name {n} joints")
+
+    @property
+    def n_joints(self) -> int:
+        return self.limits.n_joints
+
     def to_dict(self) -> dict:
         return {"name": self.name, "urdf": self.urdf, "flange": self.flange}
 
@@ -92,14 +127,24 @@ PANDA_MODEL = RobotModel("panda", "franka_panda/panda.urdf", "panda_link8", PAND
 IIWA_MODEL = RobotModel("iiwa", "kuka_iiwa/model.urdf", "lbr_iiwa_link_7", IIWA,
                         (0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0), (176.0, 176.0, 110.0, 110.0, 110.0, 40.0, 40.0),
                         standoff=0.43)
-ROBOT_MODELS = {"panda": PANDA_MODEL, "iiwa": IIWA_MODEL}
+# The xArm6's reach (0.7 m) and its shoulder 0.27 m up put it closer to the work than the Panda; the
+# UR5's forearm offsets keep its wrist 0.11 m beside the tool, so it stands a little further back.
+XARM6_MODEL = RobotModel("xarm6", "xarm/xarm6_robot.urdf", "link6", XARM6,
+                         (0.0, -0.3, -1.2, 0.0, 1.5, 0.0), (50.0, 50.0, 32.0, 32.0, 32.0, 20.0), standoff=0.3)
+UR5_MODEL = RobotModel("ur5", str(Path(__file__).resolve().parents[2] / "data" / "robots" / "ur5_dh.urdf"), "flange", UR5,
+                       (math.pi, -math.pi / 2, math.pi / 2, -math.pi / 2, -math.pi / 2, 0.0),
+                       (150.0, 150.0, 150.0, 28.0, 28.0, 28.0), standoff=0.38)
+ROBOT_MODELS = {"panda": PANDA_MODEL, "iiwa": IIWA_MODEL, "xarm6": XARM6_MODEL, "ur5": UR5_MODEL}
+ROBOT_NAMES = {"panda": "Franka Panda", "iiwa": "KUKA LBR iiwa 7 R800", "xarm6": "UFACTORY xArm6",
+               "ur5": "UR5-class arm (DH model)"}
 
 
 def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
-    """The arm a scenario's ``"robot"`` key names: ``"model": "panda"`` (default) or ``"iiwa"``, or
-    its own ``"urdf"`` (inside the scenario's folder ``base_dir``, or shipped by ``pybullet_data``)
-    with ``"flange"`` and ``"limits"`` ({"lower", "upper", "velocity", "acceleration", "jerk"},
-    7 values each, rad) and optionally ``"rest"`` (7 joints, rad) and ``"effort"`` (7, N m)."""
+    """The arm a scenario's ``"robot"`` key names: ``"model"`` (one of :data:`ROBOT_MODELS`, default
+    ``"panda"``), or its own ``"urdf"`` (inside the scenario's folder ``base_dir``, or shipped by
+    ``pybullet_data``) with ``"flange"`` and ``"limits"`` ({"lower", "upper", "velocity",
+    "acceleration", "jerk"}, one value per joint, rad) and optionally ``"rest"`` (one per joint, rad)
+    and ``"effort"`` (one per joint, N m)."""
     from pathlib import Path
 
     spec = spec or {}
@@ -111,7 +156,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     limits = JointLimits(**spec["limits"])
     middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
     return RobotModel(path.stem, str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
-                      tuple(spec.get("effort", (100.0,) * 7)))
+                      tuple(spec.get("effort", (100.0,) * limits.n_joints)))
 
 
 def _unit_of(units: str) -> float:
@@ -155,8 +200,8 @@ def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray
 
 
 def _joint_seed(seed, limits: JointLimits = PANDA) -> np.ndarray:
-    """Seven finite joint angles (rad) within the robot's limits, to start IK from."""
-    q = as_point(seed, 7, "seed")
+    """Finite joint angles (rad), one per joint of the robot, within its limits, to start IK from."""
+    q = as_point(seed, limits.n_joints, "seed")
     outside = (q < np.array(limits.lower) - 1e-6) | (q > np.array(limits.upper) + 1e-6)
     if outside.any():
         joint = int(np.argmax(outside))
