@@ -99,7 +99,7 @@ def test_a_urdf_named_in_the_scenario(tmp_path):
 
 
 @pytest.mark.parametrize("robot, message", [
-    ({"model": "ur5"}, r"robot.model: expected one of \['panda', 'iiwa'\]"),
+    ({"model": "kr6"}, r"robot.model: expected one of \['panda', 'iiwa', 'xarm6', 'ur5'\]"),
     ({"model": "iiwa", "urdf": "a.urdf"}, "not both"),
     ({"flange": "x"}, "describe your own"),
     ({"urdf": "a.urdf"}, "robot.flange"),

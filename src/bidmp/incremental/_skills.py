@@ -143,13 +143,13 @@ class SkillLibrary:
     @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, coupling=None, via=None):
+                   limits: dict | None = None, coupling=None, via=None, via_until: float | None = None):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
         with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms and ``via``
         points as there (the skill's increment kept, the least-norm change added to it)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
         return dmp.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
-                              forcing_increment=increment, coupling=coupling, via=via)
+                              forcing_increment=increment, coupling=coupling, via=via, via_until=via_until)
 
     @goal_first("skill", "start", "duration")
     def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0):

@@ -134,7 +134,8 @@ class Motions:
     @goal_first("start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None, via=None):
+                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None, via=None,
+                   via_until: float | None = None):
         """A timed rollout: positions, velocities and accelerations in seconds.
 
         Parameters
@@ -170,6 +171,10 @@ class Motions:
             ones the kernels cannot carry raise ``ValueError``; with ``limits`` the motion is not
             re-timed (the points would move in time) but checked, and one that breaks a limit
             raises. With spatial coupling terms the uncoupled motion passes the points exactly.
+        via_until : float, optional
+            With ``via``: only the kernels that act (99 % of their activation) before this time (s)
+            change, so after it the motion returns to its own course (a lift over a part that keeps
+            the final approach and where the motion comes to rest); default every kernel.
 
         Returns
         -------
@@ -181,7 +186,8 @@ class Motions:
         """
         self._check_fitted()
         if via is not None:
-            return _via_trajectory(self, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via)
+            return _via_trajectory(self, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
+                                   via_until)
         if limits is not None:
             return _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
         if coupling is not None:

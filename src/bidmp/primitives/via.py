@@ -37,6 +37,7 @@ _CONDITION = 1e-9
 # as a violent swing (two via-points 50 mm apart 0.1 ms apart on a 3 s motion ask for 60 000x; a
 # via-point 30 mm off the path 11x).
 _MAX_SWING = 100.0
+_UNTIL_SHARE = 0.99  # of a kernel's activation on the rollout grid: before ``via_until``, it may change
 _MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
 
 
@@ -94,12 +95,14 @@ def _impulse_rows(params, phase: np.ndarray, step: float, between: list[tuple[in
 
 
 def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, params, step: float, n_samples: int,
-                   dt: float, forcing_increment: Callable | None) -> Callable:
+                   dt: float, forcing_increment: Callable | None, until: float | None = None) -> Callable:
     """The forcing increment ``(phase, basis) -> (n, D)`` that moves the rollout from ``ends`` =
     (goal, start) through ``points`` (m, D) at ``times`` with the least-norm weight change. The
     rollout's own positions at the via times come from the same responses (its forcing through the
     impulse rows, goal and start through their unit responses): no rollout is run for them.
-    Raises ``ValueError`` when the kernels cannot carry the via-points."""
+    ``until`` (s): only the kernels with :data:`_UNTIL_SHARE` of their activation before it change
+    (after it the motion returns to its own course). Raises ``ValueError`` when the kernels cannot
+    carry the via-points."""
     n_kernels = dmp.weights_.shape[0]
     if times.size > n_kernels:
         raise ValueError(f"via has {times.size} points; this DMP's {n_kernels} kernels can carry at most {n_kernels}")
@@ -109,6 +112,13 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     between = _interpolation(times, dt, used)
     rows = _impulse_rows(params, phase[:used], step, between)
     response = rows @ basis[:used]  # (m, N): per unit weight (K inside)
+    if until is not None:
+        cut = min(max(int(np.floor(until / dt)) + 1, 1), basis.shape[0])
+        activation = np.abs(basis)
+        early = activation[:cut].sum(axis=0) >= _UNTIL_SHARE * activation.sum(axis=0)
+        if not np.any(early):
+            raise ValueError(f"via_until {until:g} s: no kernel of this DMP acts before it; give a later time")
+        response = response * early  # the kernels acting after ``until`` keep their weights
     singular = np.linalg.svd(response, compute_uv=False)
     if singular[-1] <= _CONDITION * max(singular[0], 1e-300):
         at = ", ".join(f"{t:g}" for t in times)
@@ -134,7 +144,8 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     return increment
 
 
-def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via):
+def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
+                    until: float | None = None):
     """:meth:`bidmp.DMP.trajectory` through ``via``: the least-norm weight change, then the rollout
     with it (and ``limits`` checked, not met by re-timing: a re-timed motion would reach the
     via-points at other times)."""
@@ -146,7 +157,12 @@ def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forc
     ends = (dmp.goal_ if goal is None else as_point(goal, dmp.n_dims_, "goal"),
             dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start"))
     rollout_params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
-    increment = _via_increment(dmp, times, points, ends, rollout_params, step, n_samples + 2, dt_used, forcing_increment)
+    if until is not None:
+        until = check_real(until, "via_until", positive=True)
+        if np.any(times > until):
+            raise ValueError(f"via_until {until:g} s is before a via-point ({times.max():g} s): the change must act there")
+    increment = _via_increment(dmp, times, points, ends, rollout_params, step, n_samples + 2, dt_used, forcing_increment,
+                               until)
     result = dmp.trajectory(goal, start=start, duration=motion, dt=dt_used, forcing_increment=increment, coupling=coupling)
     if limits:
         limits = {key: value for key, value in limits.items() if key != "fastest"}

@@ -177,6 +177,15 @@ class Scene:
             out["standoff"] = dict(self.standoff)
         return out
 
+    def with_tool(self, tool: Tool) -> Scene:
+        """The same parts, margin and stand-offs with another ``tool`` (a part carried under the
+        tool's mouth: its height and the radius round its footprint); the margin is kept up to the
+        new tool's radius."""
+        if not isinstance(tool, Tool):
+            raise TypeError(f"tool must be a bidmp.Tool, got {type(tool).__name__}")
+        return Scene(self.parts, tool, self.targets, self.targets_on_parts, min(self.margin, tool.radius),
+                     {k: min(v, tool.radius) for k, v in self.standoff.items()})
+
     @property
     def labels(self) -> list[str]:
         return [part.label for part in self.parts]
@@ -198,6 +207,18 @@ class Scene:
         """The parts that enter the tool at target ``label`` (excepted from its clearance): the
         part labelled like it, else whatever the tool takes into its mouth at ``point``."""
         return [label] if _label(label, "label") in self.labels else self.parts_at(point)
+
+    def near(self, trajectory, part: str, distance: float) -> np.ndarray:
+        """Which points of ``trajectory`` (n, 3) put the tool (pointing down) within ``distance`` of
+        part ``part``'s bounding boxes: a superset of the points within ``distance`` of the part
+        itself (the box is no smaller than what it bounds). (n,) bool."""
+        points = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+        if points.shape[1] != 3:
+            raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
+        distance = check_real(distance, "distance", nonnegative=True)
+        mask = self._owner == _labelled(self.parts, part).label
+        bounds = _cylinder_box_bounds(points, self.tool.radius, self.tool.length, self._lower[mask], self._upper[mask])
+        return np.min(bounds, axis=1) <= distance
 
     def parts_at(self, point) -> list[str]:
         """Labels of the parts the tool would take into its mouth at ``point``: those whose
@@ -363,6 +384,33 @@ class Scene:
             dense = points
         return self._minimum(dense, chosen, lambda rows: _cylinder_box_bounds(dense[rows], radius, length, lower, upper),
                              lambda row, solid: engine.tool_to(dense[row], solid), best, best_part, best_point)
+
+    @numerically_guarded
+    def body_clearance(self, solid, trajectory, offset, exclude=(), step: float | None = None) -> Clearance:
+        """Smallest signed distance between a body carried along ``trajectory`` and the parts: a
+        solid (one of a part the tool holds, :class:`~bidmp.scene.parts.Solid`), its centre
+        ``offset`` (3,) from the trajectory point and its orientation as it is, at least every
+        ``step`` (default as :meth:`clearance`); the parts in ``exclude`` (the carried part's own,
+        those it is lifted off) not checked."""
+        points = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
+        if points.shape[1] != 3:
+            raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
+        offset = np.asarray(_as_float_array(offset, "offset"), dtype=float).reshape(-1)
+        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+            raise ValueError("offset must be 3 finite numbers (scene units)")
+        step = _STEP_SHARE * self.tool.length if step is None else check_real(step, "step", positive=True)
+        chosen = self._selected(exclude)
+        if chosen.size == 0:
+            return Clearance(math.inf, None, None, self.margin)
+        engine = self._engine()
+        shape = engine.shape_of(solid)
+        half = (np.asarray(solid.upper) - np.asarray(solid.lower)) / 2.0  # the body's box round its centre
+        centres = _densify(points, step) + offset
+        lower, upper = self._lower[chosen], self._upper[chosen]
+        return self._minimum(
+            centres - offset, chosen,
+            lambda rows: _box_distance((centres[rows] - half)[:, None], (centres[rows] + half)[:, None], lower[None], upper[None]),
+            lambda row, index: engine.body_to(shape, solid.rotation, centres[row], index))
 
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""

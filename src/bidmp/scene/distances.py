@@ -137,6 +137,27 @@ class _Distances:
             self._fallbacks = [self.request, accelerated, *looser]
         return self._fallbacks
 
+    def shape_of(self, solid):
+        """A coal shape for ``solid`` (a part's solid that moves: one the tool carries) and its
+        centre and rotation."""
+        coal = self.coal
+        if solid.kind == "box":
+            shape = coal.Box(*solid.params)
+        elif solid.kind == "cylinder":
+            shape = coal.Cylinder(*solid.params)
+        else:
+            vertices = coal.StdVec_Vec3s()
+            for vertex in solid.params[0]:
+                vertices.append(np.asarray(vertex, dtype=float))
+            shape = coal.Convex.convexHull(vertices, False, "")
+        return shape
+
+    def body_to(self, shape, rotation: np.ndarray, centre: np.ndarray, index: int) -> float:
+        """Signed distance from a moving body (``shape`` at ``centre``, turned by ``rotation``) to solid ``index``."""
+        other, pose = self.shapes[index]
+        return self._distance(shape, self.coal.Transform3s(np.asarray(rotation, dtype=float), np.asarray(centre, dtype=float)),
+                              other, pose)
+
     def between(self, first: int, second: int) -> float:
         a, pose_a = self.shapes[first]
         b, pose_b = self.shapes[second]

@@ -95,6 +95,20 @@ class Solid:
     lower: np.ndarray  # axis-aligned bounding box
     upper: np.ndarray
 
+    def moved(self, centre, rotation) -> Solid:
+        """The same solid with its centre at ``centre`` (3,) and turned to ``rotation`` (3, 3): a
+        part the tool carries, where it is now."""
+        centre, rotation = np.asarray(centre, dtype=float), np.asarray(rotation, dtype=float)
+        if self.kind == "box":
+            half = np.asarray(self.params, dtype=float) / 2.0
+            extent = np.abs(rotation) @ half
+        elif self.kind == "cylinder":
+            extent = _cylinder_extent(rotation[:, 2], self.params[0], self.params[1] / 2.0)
+        else:
+            vertices = np.asarray(self.params[0], dtype=float) @ rotation.T
+            extent = np.max(np.abs(vertices), axis=0)
+        return Solid(self.label, self.part, self.kind, centre, rotation, self.params, centre - extent, centre + extent)
+
 
 @dataclass(frozen=True)
 class Part:

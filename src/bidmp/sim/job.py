@@ -1,16 +1,21 @@
 """The whole job on the simulated arm: at every target, in the job's order, the learned approach,
 then the job's steps (engage, unscrew, retract, drop; or grasp, lift, place), each a motion
-planned through the arm's IK, timed within its limits and executed at 1 kHz, measured.
+planned through the arm's IK, timed within its limits, executed at 1 kHz and judged by the motion
+contract (:mod:`bidmp.tasks.contract`) on what the arm did.
 
 Every motion between places comes from the learned skills: the approach is the Bi-DMP's (skill
-"nearest") from wherever the tool is, the transfers to the bin or the rack the plain DMP's start
-and goal generalisation; each is clearance-checked on the scene before it runs, and one that would
-touch a part is lifted by a via-point over the work (the DMP's exact via-points) — nothing is
-written per target. Straight moves along a part's axis (unscrewing, retracting, lifting out) are
-lines. The unscrewing is a powered spindle on the tool coupled to the retraction: it turns the
-socket by one turn per pitch the arm rises (measured, every 2 ms), which a wrist cannot (its
-last joint turns less than one turn each way) and which keeps the nut on its thread whatever the
-arm's timing.
+"nearest") from wherever the tool is, repaired like any motion that would break the contract
+(:mod:`bidmp.tasks.repair`: lifted over a part by via-points, steered round it, or a skill learned
+for this target); the transfers to the bin or the rack are the plain DMP's start and goal
+generalisation, lifted over the work by a via-point where the tool or the part it carries would
+come within the margin of a part. Straight moves along a part's axis (unscrewing, retracting,
+lifting out) are lines. The unscrewing is a powered spindle on the tool coupled to the retraction:
+it turns the socket by one turn per pitch the arm rises (measured, every 2 ms), which a wrist
+cannot (its last joint turns less than one turn each way) and which keeps the nut on its thread
+whatever the arm's timing. A tilted part (a pose scenario) is approached by the pose skill along
+its own axis and unscrewed and lifted along it.
+
+A target whose step fails is a row of the report with its reason; the job goes on with the next.
 """
 
 from __future__ import annotations
@@ -19,13 +24,16 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
+from ..tasks.contract import Contract, mm
 from .job_report import JobPhase, JobReport, JobTarget, _phase
 from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle
 
 __all__ = ["run_job", "job_targets"]
 
 RELEASE_S = 0.6  # s the world runs after a part is let go, for it to come to rest
+_DOWN = Rotation.from_quat([1.0, 0.0, 0.0, 0.0])  # the tool pointing down (its z axis along -z)
 
 
 @dataclass
@@ -33,27 +41,55 @@ class _World:
     cell: object
     scenario: object
     spec: object
-    model: object  # the fitted Bi-DMP
+    model: object  # the fitted Bi-DMP (a pose Bi-DMP for a tilted scenario)
     q: np.ndarray  # the arm's joints now (rad)
+    contract: Contract  # the job's scene (the scenario's parts, the bin, the rack), the arm's limits
+    repairer: object  # bidmp.tasks.repair.Repairer of the approaches
+    transfers: object  # ... and of the transfers to the bin or the rack (lift, steer; a carried part kept clear too)
     pictures: list | None = None  # keyframes at the end of each phase of the first cycle, when asked for
     motion: list | None = None  # (times, joint origins) of the first cycle's motions, for the viewer
     clock: float = 0.0  # simulated seconds since the job began
     placed: int = 0  # parts in the rack so far
+    dropped: int = 0  # parts let go over the bin so far
     held: object = None  # the part in the tool, if any (let go where it is when a step fails)
     gone: list = field(default_factory=list)  # whole parts taken away (cells): no longer in the way
-    scene: object = None  # the scenario's scene with the job's own parts (bin, rack): motions are checked on it
+    failures: list = field(default_factory=list)  # (target, phase, image) where a motion broke the contract
+
+    @property
+    def scene(self):
+        return self.contract.scene
 
     @property
     def tcp(self) -> np.ndarray:
         return self.cell.tcp_position() / self.cell.unit
 
+    @property
+    def pose(self) -> bool:
+        return self.scenario.is_pose
 
-def _move(world: _World, path, fractions, exclude, name: str, on_record=None, least_duration: float = 0.0,
-          carried=None):
-    """Plan ``path`` (n, 3) from the arm's joints now, execute it, measure the phase; with a
-    ``carried`` part, its own contacts with other parts count as the arm's."""
+    def orientation(self) -> Rotation:
+        """The tool frame now (measured)."""
+        p, cell = self.cell.p, self.cell
+        return Rotation.from_quat(p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1,
+                                                 physicsClientId=cell.client)[5])
+
+
+class _StepFailed(Exception):
+    """A step that cannot be done; the message says which and why."""
+
+
+# ---------------------------------------------------------------------------------------------
+# Motions
+# ---------------------------------------------------------------------------------------------
+def _move(world: _World, path, fractions, exclude, name: str, *, orientations=None, on_record=None,
+          least_duration: float = 0.0, carried=None, target=None, axis=None, support=()) -> JobPhase:
+    """Plan ``path`` (n, 3) from the arm's joints now, execute it and judge what the arm did by the
+    contract: its end within the threshold of ``target`` (default the path's end), the final descent
+    along ``axis`` when it is the approach, clearance by the margin of the executed tool and of a
+    ``carried`` part (its own contacts count as the arm's; not from the parts it stands on,
+    ``support``, while it is lifted off them), the 1 kHz commands within the limits."""
     cell = world.cell
-    plan = cell.plan(np.asarray(path, dtype=float), name, fractions=fractions, seed=world.q)
+    plan = cell.plan(np.asarray(path, dtype=float), name, fractions=fractions, seed=world.q, orientations=orientations)
     if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
         scale = plan.duration / least_duration
         plan.duration = least_duration
@@ -74,100 +110,182 @@ def _move(world: _World, path, fractions, exclude, name: str, on_record=None, le
         arm = _arm_motion(cell, run)
         world.motion.append((world.clock + arm["times"], arm["links"]))
     phase = _phase(name, run, plan, cell, touched)
+    executed = run.tcp / cell.unit
+    tool_frames = run.tcp_orientation if world.pose else None
+    clearance = _clearance(world, executed, exclude, carried, tool_frames, support)
+    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
+    phase.verdict = contract.judge(executed, executed[-1] if target is None else np.asarray(target)[:3], label=name,
+                                   axis=axis, exclude=exclude, orientations=tool_frames, commands=run.commands,
+                                   contacts=phase.contacts, clearance=clearance)
+    phase.ok = phase.verdict.ok
     world.clock += phase.seconds
     return phase
 
 
-def _skill_path(world: _World, goal, skill, via=None) -> tuple[np.ndarray, np.ndarray]:
-    """The learned skill's motion from the tool's place now to ``goal`` (positions, fractions)."""
-    options = {"goal": np.asarray(goal, dtype=float), "start": world.tcp, "skill": skill}
+def _transfer_contract(contract: Contract) -> Contract:
+    """The contract of a move that is not an approach: no final descent to judge."""
+    return Contract(contract.threshold, None, contract.scene, contract.units, None, contract.limits)
+
+
+def _clearance(world: _World, path, exclude, carried, orientations=None, support=()):
+    """The tool's clearance along ``path``, and of a ``carried`` part (a :class:`_MovablePart`, or
+    ``(solid, offset from the mouth)``) but from the parts it is lifted off (``support``): the nearer
+    of the two to its margin."""
+    from ..tasks.repair import carried_clearance
+
+    if isinstance(carried, _MovablePart):  # where it is now, with the tool where it is now
+        carried = _body(world, carried)
+    return carried_clearance(world.scene, path, exclude, carried, support, orientations)
+
+
+def _body(world: _World, part: _MovablePart) -> tuple:
+    """A carried part as the clearance checks see it: its solid where it is now and its centre's
+    offset from the tool's mouth now."""
+    centre, rotation = part.pose()
+    return part.solid.moved(centre, rotation.as_matrix()), centre - world.tcp
+
+
+def _skill_path(world: _World, goal, skill, via=None, start_pose=None):
+    """The learned skill's motion from the tool's place now to ``goal``: (positions, fractions,
+    orientations or None)."""
+    options = {"skill": skill}
     if via is not None:
         options["via"] = via
-    trajectory = world.model.trajectory(**options)
-    return trajectory.y, trajectory.t / trajectory.t[-1]
+    if world.pose:
+        start = np.concatenate([world.tcp, world.orientation().as_quat()]) if start_pose is None else start_pose
+        trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options)
+        return trajectory.y, trajectory.t / trajectory.t[-1], trajectory.q
+    trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=world.tcp, **options)
+    return trajectory.y, trajectory.t / trajectory.t[-1], None
 
 
-def _clearance(world: _World, path, exclude, carried: float):
-    """The tool's clearance along ``path``; with a part of height ``carried`` under its mouth, the
-    smaller of the tool's and that of the part's bottom (the path lowered by its height)."""
+def _clear_transfer(world: _World, goal, exclude, carried=None):
+    """The plain DMP's motion to ``goal`` (a transfer), repaired where the tool, or the part it
+    carries (``carried``: its solid and offset from the mouth), would come within the margin of a
+    part: lifted over it by
+    via-points, or steered round it; ``(positions, fractions, orientations, note)``."""
+    if not world.pose:
+        repaired = world.transfers.repair(world.model, np.asarray(goal, dtype=float), "the transfer", start=world.tcp,
+                                          exclude=exclude, skill=0, carried=carried)
+        if not repaired.ok:
+            raise _StepFailed(repaired.reason())
+        note = f"repaired: {repaired.how}" if repaired.how else ""
+        return repaired.motion, np.linspace(0.0, 1.0, repaired.motion.shape[0]), None, note
     scene = world.scene
-    clearance = scene.clearance(path, exclude=exclude)
-    if carried > 0.0:
-        below = scene.clearance(np.asarray(path) - [0.0, 0.0, carried], exclude=exclude)
-        clearance = min(clearance, below, key=lambda c: c.distance)
-    return clearance
-
-
-def _clear_path(world: _World, goal, skill, exclude, carried: float = 0.0) -> tuple[np.ndarray, np.ndarray, str]:
-    """The skill's motion to ``goal``, lifted by a via-point over the work if it (or the part it
-    carries, ``carried`` high) would touch a part; and a note of what was done."""
-    scene = world.scene
-    path, fractions = _skill_path(world, goal, skill)
+    start_pose = None
+    if world.pose:  # a transfer ends with the tool upright: over the bin or a slot
+        start_pose = np.concatenate([world.tcp, world.orientation().as_quat()])
+        goal = np.concatenate([goal[:3], _DOWN.as_quat()])
+    path, fractions, turns = _skill_path(world, goal, 0, start_pose=start_pose)
     clearance = _clearance(world, path, exclude, carried)
-    if clearance.distance >= 0.0:
-        return path, fractions, ""
-    top = max(float(np.max([s.upper[2] for s in scene.solids])) + carried, float(world.tcp[2]), float(goal[2]))
-    over = 0.5 * (world.tcp + np.asarray(goal, dtype=float))
+    if clearance.clear:
+        return path, fractions, turns, ""
+    from ..tasks.repair import _depth
+
+    height = _depth(carried)
+    top = max(float(np.max([s.upper[2] for s in scene.solids])) + height, float(world.tcp[2]), float(goal[2]))
+    over = 0.5 * (world.tcp + np.asarray(goal, dtype=float)[:3])
     over[2] = top + world.spec.clearance
-    lifted, fractions = _skill_path(world, goal, skill, via=[(0.5, over)])
+    via = [(0.5 * _skill_duration(world, goal, start_pose), np.concatenate([over, _DOWN.as_quat()]) if world.pose else over)]
+    lifted, fractions, turns = _skill_path(world, goal, 0, via=via, start_pose=start_pose)
     again = _clearance(world, lifted, exclude, carried)
-    if again.distance < 0.0:
-        raise _StepFailed(f"the learned motion would touch {clearance.part} ({-clearance.distance:.2f} "
-                          f"{world.scenario.units} deep), and lifted over the work still {again.part}")
-    return lifted, fractions, f"lifted over the work (it would have touched {clearance.part})"
+    if not again.clear:
+        unit = world.scenario.units
+        raise _StepFailed(f"the learned move would {_closeness(clearance, unit)} {clearance.part}, and lifted "
+                          f"{world.spec.clearance:g} {unit} over the work still {_closeness(again, unit)} {again.part}")
+    return lifted, fractions, turns, f"lifted over the work (it would have come within the margin of {clearance.part})"
 
 
-def _transfer(world: _World, goal, exclude, carried: float = 0.0) -> tuple[np.ndarray, np.ndarray, str]:
+def _skill_duration(world: _World, goal, start_pose) -> float:
+    """How long the plain skill's motion to ``goal`` lasts (s)."""
+    options = {"skill": 0}
+    start = start_pose if world.pose else world.tcp
+    return float(world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options).t[-1])
+
+
+def _closeness(clearance, unit: str) -> str:
+    """How a clearance breaks the margin, in words ("cut 2.1 mm into", "pass 1.2 mm from")."""
+    if clearance.distance < 0.0:
+        return f"cut {-clearance.distance:.2f} {unit} into"
+    return f"pass {clearance.distance:.2f} {unit} from"
+
+
+def _transfer(world: _World, goal, exclude, carried=None):
     """A move to the bin or the rack from the learned skill: the DMP's start and goal
-    generalisation (lifted over the work if it would touch), or with ``transfer: "similarity"``
-    the plain DMP's own reproduction turned (the smallest rotation taking its start-to-goal onto
-    this one), scaled and moved to run from the tool's place to ``goal``."""
-    if world.spec.transfer == "dmp":
-        return _clear_path(world, goal, 0, exclude, carried)
-    from scipy.spatial.transform import Rotation
-
+    generalisation (lifted over the work if it would come too close), or with ``transfer:
+    "similarity"`` the plain DMP's own reproduction turned (the smallest rotation taking its
+    start-to-goal onto this one), scaled and moved to run from the tool's place to ``goal``."""
+    if world.spec.transfer == "dmp" or world.pose:
+        return _clear_transfer(world, goal, exclude, carried)
     reproduction = world.model.trajectory(skill=0)
     shape, start, goal = reproduction.y, world.tcp, np.asarray(goal, dtype=float)
     demonstrated, wanted = shape[-1] - shape[0], goal - start
     turn, _ = Rotation.align_vectors([wanted], [demonstrated])
     path = start + np.linalg.norm(wanted) / np.linalg.norm(demonstrated) * turn.apply(shape - shape[0])
     clearance = _clearance(world, path, exclude, carried)
-    if clearance.distance < 0.0:
-        raise _StepFailed(f"the learned shape, turned and scaled, would touch {clearance.part} "
-                          f"({-clearance.distance:.2f} {world.scenario.units} deep)")
-    return path, reproduction.t / reproduction.t[-1], "the skill's shape turned and scaled"
+    if not clearance.clear:
+        raise _StepFailed(f"the learned shape, turned and scaled, would {_closeness(clearance, world.scenario.units)} "
+                          f"{clearance.part}")
+    return path, reproduction.t / reproduction.t[-1], None, "the skill's shape turned and scaled"
 
 
-class _StepFailed(Exception):
-    """A step that cannot be done; the message says which and why."""
-
-
-def _approach(world: _World, label: str, target) -> JobPhase:
-    exclude = world.scenario.scene.target_parts(label, target) + world.gone
-    path, fractions, note = _clear_path(world, target, "nearest", exclude)
-    phase = _move(world, path, fractions, exclude, "approach")
+# ---------------------------------------------------------------------------------------------
+# Steps
+# ---------------------------------------------------------------------------------------------
+def _approach(world: _World, label: str, target, axis) -> JobPhase:
+    """The learned approach from the tool's place now, repaired if it would break the contract."""
+    exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone
+    if world.pose:
+        start = np.concatenate([world.tcp, world.orientation().as_quat()])
+        trajectory = world.model.trajectory(np.asarray(target, dtype=float), start=start, skill="nearest")
+        path, turns, note = trajectory.y, trajectory.q, ""
+        fractions = trajectory.t / trajectory.t[-1]
+    else:
+        repaired = world.repairer.repair(world.model, target, label, start=world.tcp, axis=axis, exclude=exclude)
+        if not repaired.ok:
+            raise _StepFailed(f"approach: {repaired.reason()}")
+        path, turns = repaired.motion, None
+        fractions = np.linspace(0.0, 1.0, path.shape[0])
+        note = f"repaired: {repaired.how}" if repaired.how else ""
+    phase = _move(world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis)
     phase.note = note
     return phase
 
 
 def _engaged(world: _World, part: _MovablePart, target) -> tuple[bool, str]:
     """Whether the tool's mouth is on the part's own axis (where the part is, not where the
-    target says) within the tolerance, at the target's height."""
+    target says) within the tolerance, at the target's height along the axis."""
     tcp = world.tcp
     offset = tcp - part.centre0
     across = float(np.linalg.norm(offset - np.dot(offset, part.axis) * part.axis))
-    along = abs(float(np.dot(tcp - np.asarray(target, dtype=float), part.axis)))
-    tolerance = world.spec.engage_tolerance
+    along = abs(float(np.dot(tcp - np.asarray(target, dtype=float)[:3], part.axis)))
+    tolerance, unit = world.spec.engage_tolerance, world.scenario.units
     if across > tolerance or along > world.scenario.success_threshold:
-        return False, (f"the tool is {across:.2f} {world.scenario.units} off the part's axis and {along:.2f} off its "
-                       f"height (engages within {tolerance:g} and {world.scenario.success_threshold:g})")
-    return True, f"{across:.3f} {world.scenario.units} off the axis"
+        return False, (f"the tool is {across:.2f} {unit} off the part's axis and {along:.2f} {unit} off its height "
+                       f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})")
+    return True, f"{across:.3f} {unit} off the axis"
+
+
+def _supports(world: _World, part: _MovablePart) -> list:
+    """The parts ``part`` stands on: those whose top is where its bottom is, under its centre."""
+    bottom = part.centre0 - part.axis * part.height / 2.0
+    found = []
+    for other in world.scene.labels:
+        if other == part.label:
+            continue
+        lower, upper = world.scene.bounds(other)
+        under = np.all(lower[:2] <= bottom[:2]) and np.all(bottom[:2] <= upper[:2])
+        if under and abs(float(upper[2] - bottom[2])) <= world.spec.play:
+            found.append(other)
+    return found
 
 
 def _straight(world: _World, direction, length: float, exclude, name: str, part=None, **options) -> JobPhase:
+    """A straight move ``length`` along ``direction``, the tool's frame kept as it is."""
     start = world.tcp
     end = start + np.asarray(direction, dtype=float) * length
-    return _move(world, np.vstack([start, end]), None, exclude, name, carried=part, **options)
+    turns = np.repeat(world.orientation().as_quat()[None], 2, axis=0) if world.pose else None
+    return _move(world, np.vstack([start, end]), None, exclude, name, orientations=turns, carried=part, **options)
 
 
 def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
@@ -175,30 +293,51 @@ def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
     spec = world.spec
     stud = [s for s in world.scenario.scene.solids if s.label == f"{part.label}/stud"]
     bottom = float(np.dot(part.centre0, part.axis)) - 0.5 * part.height
-    top = float(np.max([np.dot(s.upper, part.axis) for s in stud])) if stud else bottom
-    rise = top - bottom + 0.5  # off the thread, half a unit clear of the stud's end
+    top = float(np.max([np.max(_corners(s) @ part.axis) for s in stud])) if stud else bottom
+    rise = top - bottom + spec.play  # off the thread, a little clear of the stud's end
     start = float(np.dot(world.tcp, part.axis))
     phase = _straight(world, part.axis, rise, exclude, "unscrew",
                       on_record=lambda t: part.thread(float(np.dot(world.tcp, part.axis)) - start, spec.pitch, t),
                       least_duration=rise / spec.pitch / spec.spindle_speed)
-    if part.rise < rise - 0.05:
-        raise _StepFailed(f"the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud")
+    if part.rise < rise - 0.1 * spec.play:
+        raise _StepFailed(f"unscrew: the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud")
     part.hold()
     world.held = part
     phase.note = f"{rise / spec.pitch:.1f} turns, {rise:.2f} {world.scenario.units} up the thread"
     return phase
 
 
+def _corners(solid) -> np.ndarray:
+    """The eight corners of a solid's box in its own frame, in the scene (a stud's top, a tilted one's too)."""
+    if solid.kind == "cylinder":
+        half = np.array([solid.params[0], solid.params[0], solid.params[1] / 2.0])
+    elif solid.kind == "box":
+        half = np.asarray(solid.params, dtype=float) / 2.0
+    else:
+        half = np.ptp(np.asarray(solid.params[0]), axis=0) / 2.0
+    signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    return (signs * half) @ np.asarray(solid.rotation).T + np.asarray(solid.centre)
+
+
 def _drop_point(world: _World) -> np.ndarray:
+    """Where the next part is let go: over the bin, on a grid over its floor (parts dropped all at
+    its centre stack into a tower once at rest, and the tower rises out of the bin)."""
     floor, inner = world.spec.bin
-    return floor + [0.0, 0.0, inner[2] + world.spec.clearance]
+    span = max(float(world.scene.tool.radius) * 2.0, 1e-9)
+    counts = np.maximum(np.floor(inner[:2] / span).astype(int), 1)
+    index = world.dropped % int(np.prod(counts))
+    cell = np.array([index % counts[0], index // counts[0]])
+    offset = (cell + 0.5) / counts * inner[:2] - inner[:2] / 2.0
+    return floor + np.array([offset[0], offset[1], inner[2] + world.spec.clearance])
 
 
 def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
-    path, fractions, note = _transfer(world, _drop_point(world), exclude)
-    phase = _move(world, path, fractions, exclude, "drop", carried=part)
+    point = _drop_point(world)
+    path, fractions, turns, note = _transfer(world, point, exclude, carried=_body(world, part))
+    phase = _move(world, path, fractions, exclude, "drop", orientations=turns, carried=part, target=point)
     centre = _release(world)
+    world.dropped += 1
     phase.seconds += RELEASE_S
     floor, inner = world.spec.bin
     inside = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0) and floor[2] <= centre[2] <= floor[2] + inner[2])
@@ -209,12 +348,15 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     return phase
 
 
-def _reach(world: _World, label: str, target, record: JobTarget, step: str) -> tuple[_MovablePart, list]:
+def _reach(world: _World, label: str, target, axis, record: JobTarget, step: str) -> tuple[_MovablePart, list]:
     """The approach to ``target`` and the check that the tool took the part in (``step``:
     engage, grasp); the part and the parts its moves may touch."""
     part = _MovablePart(world.cell, label, world.spec.part_mass)
-    exclude = world.scenario.scene.target_parts(label, target) + world.gone
-    _add(world, record, _approach(world, label, target), target)
+    exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone
+    approach = _approach(world, label, target, axis)
+    _add(world, record, approach, target[:3])
+    if not approach.ok:
+        raise _StepFailed(f"approach: {approach.verdict.reason()}")
     engaged, note = _engaged(world, part, target)
     record.phases.append(JobPhase(step, engaged, 0.0, note))
     if not engaged:
@@ -223,16 +365,17 @@ def _reach(world: _World, label: str, target, record: JobTarget, step: str) -> t
 
 
 def _finish(record: JobTarget, part: _MovablePart) -> None:
-    record.removed = record.phases[-1].ok
+    """The part is removed when every step kept the contract and it ended where it belongs."""
+    record.removed = all(phase.ok for phase in record.phases)
     record.final_position = part.pose()[0]
     record.reason = _why(record)
 
 
-def _nut_cycle(world: _World, label: str, target, record: JobTarget) -> None:
+def _nut_cycle(world: _World, label: str, target, axis, record: JobTarget) -> None:
     """approach → engage → unscrew → retract → drop for one nut, each phase into ``record``."""
-    part, exclude = _reach(world, label, target, record, "engage")
-    _add(world, record, _unscrew(world, part, exclude), target)
-    _add(world, record, _straight(world, part.axis, world.spec.clearance, exclude, "retract", part), target)
+    part, exclude = _reach(world, label, target, axis, record, "engage")
+    _checked(world, record, _unscrew(world, part, exclude), target[:3])
+    _checked(world, record, _straight(world, part.axis, world.spec.clearance, exclude, "retract", part), target[:3])
     record.thread = np.array(part.trace)
     _add(world, record, _drop(world, part, exclude), _drop_point(world))
     _finish(record, part)
@@ -242,26 +385,28 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     """Carry the part to its rack slot (the plain DMP's start and goal generalisation, its kept
     approach coming straight down), set it down, let go."""
     bottom = part.pose()[0] - part.axis * part.height / 2.0
-    goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, 0.5]  # let go half a unit above
-    path, fractions, note = _transfer(world, goal, exclude, carried=part.height)
-    phase = _move(world, path, fractions, exclude, "place", carried=part)
+    goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, world.spec.play]
+    path, fractions, turns, note = _transfer(world, goal, exclude + ["rack"], carried=_body(world, part))
+    phase = _move(world, path, fractions, exclude + ["rack"], "place", orientations=turns, carried=part, target=goal)
     centre = _release(world)
     phase.seconds += RELEASE_S
     off = float(np.linalg.norm(centre[:2] - np.asarray(slot)[:2]))
     phase.note = note
-    if off > world.spec.engage_tolerance * 5 or abs(centre[2] - part.height / 2.0 - slot[2]) > 1.0:
+    if off > world.spec.engage_tolerance * 5 or abs(centre[2] - part.height / 2.0 - slot[2]) > world.spec.slot_tolerance:
         phase.ok = False
-        phase.note = f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at {np.round(centre, 1).tolist()}"
+        phase.note = (f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at "
+                      f"{np.round(centre, 1).tolist()}")
     return phase
 
 
-def _lift_cycle(world: _World, label: str, target, record: JobTarget) -> None:
+def _lift_cycle(world: _World, label: str, target, axis, record: JobTarget) -> None:
     """approach → grasp → lift straight out → place in the next rack slot, for one part."""
-    part, exclude = _reach(world, label, target, record, "grasp")
+    part, exclude = _reach(world, label, target, axis, record, "grasp")
     part.hold()
     world.held = part
     if "lift" in world.spec.steps:
-        _add(world, record, _straight(world, part.axis, part.height + world.spec.lift, exclude, "lift", part), target)
+        _checked(world, record, _straight(world, part.axis, part.height + world.spec.lift, exclude, "lift", part,
+                                          support=_supports(world, part)), target[:3])
     slot = world.spec.slot(world.placed)
     _add(world, record, _place(world, part, slot, exclude), slot)
     _finish(record, part)
@@ -270,22 +415,36 @@ def _lift_cycle(world: _World, label: str, target, record: JobTarget) -> None:
 
 
 def _why(record: JobTarget) -> str:
-    """The first phase that failed and why: what it touched (and how deep), or its note."""
+    """The first phase that failed and why, in one sentence: the contract's reason, or its note."""
     failed = next((phase for phase in record.phases if not phase.ok), None)
     if failed is None:
         return ""
-    if failed.contacts:
-        touched = ", ".join(f"{label} ({depth:.2f} deep)" for label, depth in sorted(failed.contacts.items()))
-        return f"{failed.name}: touched {touched}"
+    verdict = getattr(failed, "verdict", None)
+    if verdict is not None and not verdict.ok:
+        return f"{failed.name}: {verdict.reason()}"
     return f"{failed.name}: {failed.note}"
 
 
+def _checked(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:
+    """Record ``phase``; a motion that broke the contract ends the target's cycle."""
+    _add(world, record, phase, focus)
+    if not phase.ok:
+        raise _StepFailed(_why(record))
+
+
 def _add(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:
-    """Record ``phase``; on the first cycle with pictures, a keyframe of where it ended."""
+    """Record ``phase``; on the first cycle with pictures, a keyframe of where it ended; a keyframe
+    of every phase that broke the contract, looking at the part it came too close to."""
     record.phases.append(phase)
-    if world.pictures is not None and (not world.pictures or world.pictures[0][0] == record.label):
+    first = world.pictures is not None and (not world.pictures or world.pictures[0][0] == record.label)
+    if first:
         image = world.cell.keyframe(record.seconds, focus)
         world.pictures.append((record.label, phase.name, record.seconds, image))
+    verdict = getattr(phase, "verdict", None)
+    if world.pictures is not None and verdict is not None and not verdict.ok:
+        clearance = verdict.clearance
+        near = focus if clearance is None or clearance.point is None else clearance.point
+        world.failures.append((record.label, phase.name, world.cell.keyframe(record.seconds, near), verdict.reason()))
 
 
 def _release(world: _World) -> np.ndarray:
@@ -306,6 +465,9 @@ def _let_go(world: _World) -> None:
     world.held = None
 
 
+# ---------------------------------------------------------------------------------------------
+# The job's world
+# ---------------------------------------------------------------------------------------------
 def _job_parts(scenario, labels) -> list:
     """The job's own parts as scene parts: the bin (floor and four walls), or a shelf under the
     rack's slots (its top at their height, a part's size round them)."""
@@ -318,8 +480,9 @@ def _job_parts(scenario, labels) -> list:
     room = np.max([s.upper - s.lower for s in parts], axis=0) if parts else np.zeros(3)
     lower, upper = corners.min(axis=0) - room, corners.max(axis=0) + room
     centre = 0.5 * (lower + upper)
-    return [{"type": "box", "label": "rack", "at": [float(centre[0]), float(centre[1]), float(first[2]) - 5.0],
-             "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), 5.0]}]
+    thickness = mm(5.0, spec.units)
+    return [{"type": "box", "label": "rack", "at": [float(centre[0]), float(centre[1]), float(first[2]) - thickness],
+             "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), thickness]}]
 
 
 def _bin_parts(floor, inner) -> list:
@@ -358,24 +521,45 @@ def job_targets(scenario, targets=None) -> list:
     """The targets a job visits: ``targets`` (checked against the scenario's), or every target
     with a part of its own to take away (not a cell task's nut)."""
     from ..tasks.scenarios import Scenario
-    from .run import _checked
+    from .run import _checked as _checked_names
 
     if not isinstance(scenario, Scenario):
         raise TypeError(f"scenario must be a bidmp Scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
     if scenario.job is None:
         raise ValueError(f"scenario {scenario.name!r} has no \"job\": the steps to run at each target")
-    _, labels = _checked(scenario, ["bidmp"], targets, False)
+    _, labels = _checked_names(scenario, ["bidmp"], targets, False)
     return labels if targets is not None else [label for label in labels if label in scenario.scene.labels]
+
+
+def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -> _World:
+    """The job's state: the learned skills, the contract on the job's scene and the arm's limits,
+    the repairs of the approaches (planned with room for the arm's tracking)."""
+    from ..tasks.repair import Repairer
+    from .run import TRACKING_ALLOWANCE_MM
+
+    contract = Contract(scenario.success_threshold, scenario.approach_height, scene, scenario.units,
+                        scenario.alignment_threshold if scenario.is_pose else None, cell.limits)
+    repairer = transfers = None
+    allowance = mm(TRACKING_ALLOWANCE_MM, scenario.units)
+    if not scenario.is_pose:
+        repairer = Repairer(contract, scenario.demonstration, extension=scenario.extension, seed=scenario.seed,
+                            allowance=allowance, bidmp=scenario.bidmp)
+        transfers = Repairer(_transfer_contract(contract), scenario.demonstration, order=("lift", "avoid"),
+                             allowance=allowance)
+    return _World(cell, scenario, scenario.job, report.fitted["bidmp"], np.array(arm.rest, dtype=float), contract,
+                  repairer, transfers, [] if pictures else None, [] if view else None)
 
 
 def run_job(scenario, *, targets=None, report=None, progress=None, pictures: bool = False, view: bool = False) -> JobReport:
     """Run the scenario's ``"job"`` on the simulated arm at every target (or ``targets``);
-    ``pictures``: keyframes of the first cycle's phases (``JobReport.pictures``); ``view``: the
-    arm's motion over the first cycle (``JobReport.motions``, for the 3-D viewer).
+    ``pictures``: keyframes of the first cycle's phases and of every phase that broke the
+    contract (``JobReport.pictures``, ``JobReport.failures``); ``view``: the arm's motion over the
+    first cycle (``JobReport.motions``, for the 3-D viewer).
 
-    Returns a :class:`~bidmp.sim.job_report.JobReport`: per target and phase, success, contacts
-    with other parts and their depth, peak joint velocity, acceleration and jerk as fractions of
-    the limits (commanded and measured), simulated seconds; the parts removed and the cycle times.
+    Returns a :class:`~bidmp.sim.job_report.JobReport`: per target and phase, the contract's
+    verdict, contacts with other parts and their depth, peak joint velocity, acceleration and jerk
+    as fractions of the limits (commanded and measured), simulated seconds; the parts removed, the
+    reason each other one was not, and the cycle times. A target that fails is a row; the job goes on.
     """
     from .._checks import check_bool
     from ..tasks.evaluation import evaluate
@@ -386,7 +570,8 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     pictures, view = check_bool(pictures, "pictures"), check_bool(view, "view")
     scenario, _ = _scenario_and_backend(scenario, None)
     labels = job_targets(scenario, targets)
-    report = evaluate(scenario.with_robot_protocol(), ["bidmp"], geometry=False) if report is None else report
+    if report is None:
+        report = evaluate(scenario.with_robot_protocol(), ["bidmp"], geometry=False)
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
     start = time.perf_counter()
@@ -395,8 +580,7 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     with RobotCell(scenario.scene, scenario.units, base, yaw, arm) as cell:
         added = {part["label"] for part in parts}
         _add_job_solids(cell, [solid for solid in scene.solids if solid.part in added])
-        world = _World(cell, scenario, scenario.job, report.fitted["bidmp"], np.array(arm.rest, dtype=float),
-                       [] if pictures else None, [] if view else None, scene=scene)
+        world = _job_world(scenario, report, cell, scene, arm, pictures, view)
         done, motions = [], {}
         for label in _order(scenario, labels):
             if progress is not None:
@@ -404,7 +588,7 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
             record = JobTarget(label)
             try:
                 cycle = _nut_cycle if scenario.job.kind == "unscrew" else _lift_cycle
-                cycle(world, label, scenario.targets[label][:3], record)
+                cycle(world, label, scenario.targets[label], scenario.target_axis(label), record)
             except (_StepFailed, ValueError) as exc:  # a SimError (unreachable) is a ValueError
                 record.reason = str(exc)
                 _let_go(world)
@@ -413,7 +597,8 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
                 motions = {("job", label): {"times": np.concatenate([t for t, _ in world.motion]),
                                             "links": np.concatenate([links for _, links in world.motion])}}
                 world.motion = None
-    out = JobReport(scenario, scenario.job.kind, arm.name, done, wall_s=time.perf_counter() - start, pictures=world.pictures or [],
-                    motions=motions)
+    out = JobReport(scenario, scenario.job.kind, arm.name, done, wall_s=time.perf_counter() - start,
+                    pictures=world.pictures or [], motions=motions)
+    out.failures = world.failures
     out.evaluation, out.scene = report, scene
     return out

@@ -15,7 +15,7 @@ from .report import _titled, _write_results, _write_strip
 
 __all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report"]
 
-FORMAT = 1  # of job_results.json
+FORMAT = 2  # of job_results.json (2: each motion's contract verdict)
 
 
 @dataclass
@@ -30,9 +30,11 @@ class JobPhase:
     peaks: tuple = (0.0, 0.0, 0.0)  # commanded joint velocity, acceleration, jerk / their limits (largest joint)
     measured_peaks: tuple = (0.0, 0.0, 0.0)  # what the simulated joints did (10 ms differences)
     within_limits: bool = True  # every 1 kHz command within the limits, from rest to rest
+    verdict: object = None  # the motion contract on what the arm did (bidmp.tasks.contract.Verdict); None: no motion
 
     def to_dict(self) -> dict:
         return {"phase": self.name, "ok": self.ok, "seconds": round(self.seconds, 3), "note": self.note,
+                "verdict": None if self.verdict is None else self.verdict.to_dict(),
                 "contacts": {k: round(v, 3) for k, v in self.contacts.items()},
                 "peak_velocity": round(self.peaks[0], 3), "peak_acceleration": round(self.peaks[1], 3),
                 "peak_jerk": round(self.peaks[2], 3), "measured_peak_velocity": round(self.measured_peaks[0], 3),
@@ -95,6 +97,7 @@ class JobReport:
     motions: dict = field(default_factory=dict)  # ("job", first target) -> {"times", "links"}: the viewer's arm
     evaluation: object = None  # the evaluation whose learned skills ran (bidmp.evaluate's report)
     scene: object = None  # the scene the job ran in: the scenario's parts and the job's own (bin, rack)
+    failures: list = field(default_factory=list)  # (target, phase, image, reason) where a motion broke the contract
 
     @property
     def removed(self) -> int:
@@ -142,6 +145,10 @@ class JobReport:
         if self.wall_s > 0:
             lines.append(f"simulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
                          f"({self.simulated_s / self.wall_s:.1f}x real time)")
+        failed = [target for target in self.targets if not target.removed]
+        if failed:
+            lines.append(f"\n{len(failed)} of {len(self.targets)} not removed:")
+            lines += [f"  {target.label}: {target.reason or 'not where it belongs'}" for target in failed]
         return "\n".join(lines)
 
     def markdown(self) -> str:
@@ -161,4 +168,7 @@ def write_job_report(report: JobReport, out) -> list[Path]:
         tiles = [_titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
                  for label, phase, seconds, image in report.pictures]
         written.append(_write_strip(Path(out) / "job_cycle.png", tiles))
+    if report.failures:  # where each failing motion ended, looking at the part it came too close to
+        tiles = [_titled(image, f"target {label}: {phase} failed") for label, phase, image, _ in report.failures[:6]]
+        written.append(_write_strip(Path(out) / "job_failures.png", tiles))
     return written

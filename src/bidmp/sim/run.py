@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import check_bool, check_int, check_real
+from ..tasks.contract import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold
@@ -25,6 +26,9 @@ __all__ = ["simulate"]
 logger = logging.getLogger(__name__)
 
 CLOSED_LOOP_SPACING = 1e-3  # m: the IK samples a closed-loop motion is timed on
+# mm the repairs add to the margin they plan for: the simulated arm's tool strays up to 0.3 mm from
+# its command (open loop, the nut task), so a motion planned at the margin could run inside it.
+TRACKING_ALLOWANCE_MM = 0.5
 
 
 @dataclass
@@ -38,6 +42,7 @@ class _Job:
     frames: int
     orientations: np.ndarray | None = None  # (n, 4) a pose skill's tool frames
     view: bool = False  # record the arm's joint origins along the motion (the 3-D viewer's)
+    repair: str = ""  # how the evaluation repaired the motion (empty: the method's own)
 
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
@@ -70,6 +75,7 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
             run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
         measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits,
                             contract, job.exclude)
+        measured.repair = job.repair
         measured.commanded_penetration = _commanded_penetration(cell, run, job)
         motion = _arm_motion(cell, run) if job.view else None
         results.append((job.method, job.label, measured, run.frames, float(run.times[-1]), motion))
@@ -181,8 +187,8 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
         scenario = scenario.with_robot_protocol()
         if report is not None and report.scenario.protocol != "robot":
             report = None
-    if report is None:
-        report = evaluate(scenario, methods, geometry=False)
+    if report is None:  # the motions to run, repaired where they break the contract, planned with room for tracking
+        report = evaluate(scenario, methods, allowance=mm(TRACKING_ALLOWANCE_MM, scenario.units))
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
     jobs = _jobs(scenario, report, methods, labels, frames or {}, _views(views))
@@ -280,7 +286,7 @@ def _jobs(scenario, report, methods, labels, frames: dict, views=()) -> list:
                  scenario.scene.target_parts(label, scenario.targets[label]),
                  int(frames.get((method, label), 0)),
                  None if report.methods[method].orientations is None else report.methods[method].orientations[label],
-                 view=(method, label) in views)
+                 view=(method, label) in views, repair=report.methods[method].repaired_at(label))
             for method in methods for label in labels]
 
 

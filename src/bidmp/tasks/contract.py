@@ -8,7 +8,7 @@ A motion meets the contract when
 * **engaged** (where the scenario has an approach height): its final approach is a monotone descent
   along the target's axis — the motion enters the band of that height above the target from above
   and, inside it, never rises (nor dips below where it has been and comes back up) by more than
-  :data:`ENGAGE_RISE_SHARE` of the band, and stays within the threshold of the axis;
+  :data:`ENGAGE_RISE_MM`, and stays within the threshold of the axis;
 * **clear**: the whole tool, swept between the samples, keeps the scene's margin from every part but
   the target's own (stand-offs declared in the scene, such as the plate under the nuts, are kept
   instead of the margin), and the simulator reports no contact of the arm with such a part;
@@ -29,14 +29,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._units import UNITS
-from .metrics import LIFT_TOLERANCE, approach_error, axis_deviation, endpoint_error
+from .metrics import approach_error, axis_deviation, endpoint_error
 
-__all__ = ["Contract", "Verdict", "CommandPeaks", "command_peaks", "mm", "ENGAGE_RISE_SHARE", "AT_REST", "PADDING"]
+__all__ = ["Contract", "Verdict", "CommandPeaks", "command_peaks", "mm", "ENGAGE_RISE_MM", "AT_REST", "PADDING"]
 
-# Inside the final approach the motion may rise by at most this share of the band's height (0.057 mm of
-# the socket's 28.5 mm): an executed approach on the simulated arm rises by at most 0.2 µm, while a motion
-# that dips 0.19 mm below its target and comes back up is no monotone descent.
-ENGAGE_RISE_SHARE = 0.002
+# The most a final approach may rise inside its band, in mm: 1.5 times the repeatability the Panda, the
+# xArm6 and the UR5 are specified to (+-0.1 mm), below which a rise cannot be told from the arm's own
+# scatter. A learned skill's approach settles 0.04-0.11 mm below its target and back (the DMP's fit of
+# a demonstration's abrupt stop), executed on the simulated arm 0.06-0.08 mm; the paper's DMP run on to
+# convergence dips 0.19 mm below each nut and comes back up: no monotone descent.
+ENGAGE_RISE_MM = 0.15
 PADDING = 3  # samples of rest before and after the commands when they are checked
 # A motion starts and stops at rest: the acceleration of its first and last command at most this
 # fraction of the limit (a minimum-jerk start reaches 0.3 % of it in its first millisecond; a clamped
@@ -192,7 +194,8 @@ class Verdict:
         if self.clearance is not None and not self.clearance.clear:
             c = self.clearance
             if c.distance < 0.0:
-                words.append(f"cuts {-c.distance:.2f} {unit} into {c.part}")
+                words.append(f"cuts {-c.distance:.2f} {unit} into {c.part}" if -c.distance >= 0.005
+                             else f"touches {c.part}")
             else:
                 words.append(f"passes {c.distance:.2f} {unit} from {c.part}, inside the {c.margin:g} {unit} it must keep")
         if self.contacts:
@@ -284,10 +287,11 @@ class Contract:
         end = endpoint_error(position, goal)
         approach = engaged = deviation = aligned = None
         if self.approach_height is not None and position.shape[1] == 3:
-            approach = approach_error(position, goal, self.approach_height, axis)
+            approach = approach_error(position, goal, self.approach_height, axis, rise=mm(ENGAGE_RISE_MM, self.units))
             engaged = bool(approach <= self.threshold)
             if self.alignment_threshold is not None and orientations is not None:
-                deviation = axis_deviation(position, orientations, goal, self.approach_height, axis)
+                deviation = axis_deviation(position, orientations, goal, self.approach_height, axis,
+                                           rise=mm(ENGAGE_RISE_MM, self.units))
                 aligned = bool(deviation <= self.alignment_threshold)
         if clearance is None and self.scene is not None and applies and position.shape[1] == 3:
             clearance = self.scene.clearance(position, exclude=list(exclude), orientations=orientations)

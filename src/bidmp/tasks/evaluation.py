@@ -176,8 +176,11 @@ def _method_names(scenario, methods) -> list[str]:
     return names
 
 
-def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Report:
-    """Run ``methods`` (default: the scenario's) on every target of ``scenario``.
+def evaluate(scenario, methods=None, progress=None, geometry: bool = True, repair: bool | None = None,
+             allowance: float = 0.0) -> Report:
+    """Run ``methods`` (default: the scenario's) on every target of ``scenario``, each motion judged
+    by the motion contract (:mod:`bidmp.tasks.contract`); the pipeline's method's motions that
+    break it repaired (:mod:`bidmp.tasks.repair`).
 
     Parameters
     ----------
@@ -187,11 +190,23 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
         Names from the methods registry (:mod:`bidmp.tasks.methods`): dmp, dmp-converged, bidmp,
         bidmp-latest, gmm, tpgmm, mp-dmp, or any registered one.
     progress : callable, optional
-        Called with each method name before it runs (the CLI hooks a progress bar here).
+        Called with each method name before it runs, and with ``"<method>: repair <target>"``
+        before each repair (the CLI hooks a progress bar here).
     geometry : bool, default True
         Check every rollout against the scenario's scene (clearance, collisions, task success).
         False skips the checks (the extensions are still grown around the parts); the report
         then has no geometry columns.
+    repair : bool, optional
+        Repair the motions of the methods that repair theirs (``bidmp``) that break the contract:
+        a lift over a part by via-points, the scene avoidance coupling, an extended demonstration
+        to the target learned as a skill, one planned with a wider margin; a target no repair
+        brings within the contract fails with its reason (``report.methods[m].reason_at``). False:
+        every method as it is (the paper's protocol, ``bidmp reproduce``). Default: repair, except a
+        scenario whose extension takes the paper's approach (``"approach": "paper"``: its skills
+        are the paper's, the final approach not kept). Needs a scene.
+    allowance : float, default 0
+        Scene units the repairs add to the margin they plan for (what running the motion on an
+        arm may take off it: the simulator passes its tracking allowance).
 
     Returns
     -------
@@ -212,6 +227,9 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
     report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
     task.build_skills = _skills_builder(scenario, failed, report)
     result = _results_builder(scenario, labels, geometry)
+    if repair is None:
+        repair = scenario.extension.get("approach", "keep") == "keep"
+    repairer = _repairer(scenario, allowance) if repair and geometry and scenario.scene is not None else None
     for name in names:
         if progress is not None:
             progress(name)
@@ -219,13 +237,49 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True) -> Re
         model, fit_seconds = method.fit(task)
         with _Timer() as timer:
             rollouts = method.rollouts(model, goals)
-        report.methods[name] = result(name, rollouts, fit_seconds + timer.seconds)
+            outcome = result(name, rollouts, 0.0)
+            if repairer is not None and method.repairs and not scenario.is_pose:
+                outcome = _repaired(outcome, repairer, model, scenario, labels, result, progress)
+        outcome.runtime_s = fit_seconds + timer.seconds
+        report.methods[name] = outcome
         report.fitted[name] = model
     if scenario.demonstrations and not report.forgetting and not scenario.is_pose:
         dmp, _ = task.fitted_dmp()
         report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
                                             **scenario.bidmp)
     return report
+
+
+def _repairer(scenario, allowance: float):
+    """The scenario's repairs: its contract, demonstration, extension options and seed."""
+    from .contract import Contract
+    from .repair import Repairer
+
+    return Repairer(Contract.of(scenario), scenario.demonstration, extension=scenario.extension, seed=scenario.seed,
+                    allowance=allowance, bidmp=scenario.bidmp)
+
+
+def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, progress) -> MethodResult:
+    """``outcome`` with every motion that broke the contract repaired where a repair keeps it
+    (``outcome.repairs``: label -> :class:`~bidmp.tasks.repair.Repaired` of each one tried)."""
+    failed = [label for label in labels if not outcome.verdicts[label].ok]
+    if not failed:
+        return outcome
+    scene = scenario.scene
+    rollouts = dict(outcome.rollouts)
+    repairs = {}
+    for label in failed:
+        if progress is not None:
+            progress(f"{outcome.name}: repair {label}")
+        fixed = repairer.repair(model, scenario.targets[label], label, axis=scenario.target_axis(label),
+                                exclude=scene.target_parts(label, scenario.targets[label]), motion=rollouts[label],
+                                verdict=outcome.verdicts[label])
+        repairs[label] = fixed
+        if fixed.how:
+            rollouts[label] = fixed.motion
+    repaired = result(outcome.name, [rollouts[label] for label in labels], outcome.runtime_s)
+    repaired.repairs = repairs
+    return repaired
 
 
 def _failed_targets(scenario, task, labels, goals) -> list[str]:

@@ -14,8 +14,10 @@ A job names what the robot does at each target after the learned approach brings
 the demonstrated target by a small heuristic — nearest neighbour, then 2-opt exchanges until
 none shortens it (not an optimal TSP solution; the distances come from SciPy's ``cdist``).
 
-Lengths in the scenario's unit; the bin and the rack are open boxes / slot grids added to the
-scene's parts in the simulated world only (the evaluation's geometry is unchanged).
+Lengths in the scenario's unit; every default is defined in millimetres and converted to it (a job
+in metres or centimetres runs as the same job in mm). The bin and the rack are open boxes / slot
+grids added to the scene's parts in the simulated world only (the evaluation's geometry is
+unchanged).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from numbers import Real
 import numpy as np
 
 from ._scenario_fields import _fail, _point, _shown
+from .contract import mm
 
 __all__ = ["JobSpec", "JOB_KINDS", "parse_job", "tour"]
 
@@ -37,9 +40,16 @@ _KEYS = {"steps", "order", "bin", "rack", "pitch", "spindle_speed", "engage_tole
          "transfer"}
 
 
+# The defaults, in mm (converted to the scenario's unit).
+DEFAULTS_MM = {"pitch": 1.25, "engage_tolerance": 1.0, "lift": 20.0, "clearance": 40.0}
+PLAY_MM = 0.5  # a part is let go this far above where it rests; a nut leaves its stud this far clear of it
+SLOT_TOLERANCE_MM = 1.0  # a placed part's bottom within this of its slot's height
+
+
 @dataclass(frozen=True)
 class JobSpec:
-    """A validated ``"job"`` (lengths in the scenario's unit, times in s, masses in kg).
+    """A validated ``"job"`` (lengths in ``units``, times in s, masses in kg; a length left out is
+    its default in mm, :data:`DEFAULTS_MM`, converted to ``units``).
 
     ``bin``: (centre of its floor's top (3,), inner size (3,)); ``rack``: (first slot (3,), step
     between slots (3,), slots per row, step between rows (3,)); ``pitch``: thread pitch per turn;
@@ -56,13 +66,29 @@ class JobSpec:
     order: str = "listed"
     bin: tuple | None = None
     rack: tuple | None = None
-    pitch: float = 1.25
+    pitch: float | None = None
     spindle_speed: float = 10.0
-    engage_tolerance: float = 1.0
+    engage_tolerance: float | None = None
     part_mass: float = 0.005
-    lift: float = 20.0
-    clearance: float = 40.0
+    lift: float | None = None
+    clearance: float | None = None
     transfer: str = "dmp"
+    units: str = "mm"
+
+    def __post_init__(self) -> None:
+        for name, value in DEFAULTS_MM.items():
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, mm(value, self.units))
+
+    @property
+    def play(self) -> float:
+        """How far above where it rests a part is let go, and a nut clears its stud (scene units)."""
+        return mm(PLAY_MM, self.units)
+
+    @property
+    def slot_tolerance(self) -> float:
+        """How far a placed part's bottom may be from its slot's height (scene units)."""
+        return mm(SLOT_TOLERANCE_MM, self.units)
 
     def slot(self, index: int) -> np.ndarray:
         """Where the ``index``-th part placed in the rack has its bottom centre (scene units)."""
@@ -125,9 +151,10 @@ def parse_job(data, source: str) -> JobSpec | None:
         _fail(source, "job.transfer", f'expected "dmp" or "similarity", got {_shown(transfer)}')
     numbers = {name: _positive(job[name], source, f"job.{name}") for name in
                ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance") if name in job}
+    units = data.get("units", "mm") if isinstance(data.get("units", "mm"), str) else "mm"
     return JobSpec(kind=kind, steps=tuple(steps), order=order, transfer=transfer,
                    bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
-                   rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None, **numbers)
+                   rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None, units=units, **numbers)
 
 
 def tour(points: np.ndarray, start: np.ndarray) -> list[int]:

@@ -28,18 +28,16 @@ def endpoint_error(trajectory, target) -> float:
     return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
 
 
-# Of the band's height: inside the final approach a motion may rise by at most this much (0.1 mm of the
-# socket's 28.5 mm). The robot protocol's DMP learned from the nut demonstration's abrupt stop dips
-# 0.054 mm below its goal and settles back; executed on the simulated arm, 0.06-0.08 mm. A motion that
-# dips 0.19 mm below its target and comes back up (the paper's DMP run on to convergence) is no
-# monotone descent, and no engagement.
-LIFT_TOLERANCE = 0.0035
+# Of the band's height: the most a final approach may rise when no tolerance is given (0.15 mm of the
+# socket's 28.5 mm band: the motion contract's own tolerance, bidmp.tasks.contract, is 0.15 mm in any unit).
+LIFT_TOLERANCE = 0.15 / 28.5
 
 
-def final_approach_mask(heights: np.ndarray, height: float) -> np.ndarray | None:
+def final_approach_mask(heights: np.ndarray, height: float, rise: float | None = None) -> np.ndarray | None:
     """The samples of the final approach: from the last sample at or above ``height`` (the motion's
     final entry into the band, from above) to the end, inside the band, a monotone descent: no rise
-    within it by more than :data:`LIFT_TOLERANCE` of ``height`` above the lowest point reached so far.
+    within it by more than ``rise`` (default :data:`LIFT_TOLERANCE` of ``height``) above the lowest
+    point reached so far.
     None when there is none: the motion ends above the band, never comes from above it, or rises
     inside it (a pass through the band, a lift out of it, a wobble, or a dip below the target and
     back up is no engagement).
@@ -50,23 +48,26 @@ def final_approach_mask(heights: np.ndarray, height: float) -> np.ndarray | None
         Height of each sample above the target, along the target's axis.
     height : float
         The band's height (the socket's 28.5 mm, in the trajectory's unit).
+    rise : float, optional
+        The largest rise allowed inside the band (the trajectory's unit).
     """
     heights = _as_bounded_array(heights, "heights", max_ndim=1).reshape(-1)
     _check_finite(heights, "heights")
     height = check_real(height, "height", positive=True)
+    rise = LIFT_TOLERANCE * height if rise is None else check_real(rise, "rise", nonnegative=True)
     above = np.flatnonzero(heights >= height)
     if above.size == 0 or above[-1] == heights.shape[0] - 1:
         return None
     start = above[-1] + 1
     inside = heights[start:]
-    if np.max(inside - np.minimum.accumulate(inside)) > LIFT_TOLERANCE * height:
+    if np.max(inside - np.minimum.accumulate(inside)) > rise:
         return None
     mask = np.zeros(heights.shape[0], dtype=bool)
     mask[start:] = True
     return mask
 
 
-def approach_error(trajectory, target, height: float, axis=None) -> float:
+def approach_error(trajectory, target, height: float, axis=None, rise: float | None = None) -> float:
     """Largest distance from the target's axis over the final approach (SPEC §9, issue 21.6): the
     motion's final descent along the axis from ``height`` above the target into it
     (:func:`final_approach_mask`). ``inf`` when the motion has no such descent: a pass through the
@@ -81,6 +82,8 @@ def approach_error(trajectory, target, height: float, axis=None) -> float:
     axis : array (3,), optional
         The target's axis, pointing out of it (a tilted nut's); default +z. Height is measured
         along it and the distance across it.
+    rise : float, optional
+        The largest rise allowed inside the band (:func:`final_approach_mask`).
     """
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     if trajectory.shape[1] != 3:
@@ -90,7 +93,7 @@ def approach_error(trajectory, target, height: float, axis=None) -> float:
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
     offsets = trajectory - target
     along = offsets @ axis
-    final = final_approach_mask(along, height)
+    final = final_approach_mask(along, height, rise)
     if final is None:
         return math.inf
     return float(np.max(np.linalg.norm(offsets[final] - np.outer(along[final], axis), axis=1)))
@@ -110,7 +113,7 @@ def _unit_axis(axis) -> np.ndarray:
     return axis / norm
 
 
-def axis_deviation(trajectory, orientations, target, height: float, axis=None) -> float:
+def axis_deviation(trajectory, orientations, target, height: float, axis=None, rise: float | None = None) -> float:
     """Largest angle (degrees) between the tool's axis and the target's axis over the final
     approach (:func:`final_approach_mask`, ``height`` along ``axis``, default +z); ``inf`` when the
     motion has none. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
@@ -127,7 +130,7 @@ def axis_deviation(trajectory, orientations, target, height: float, axis=None) -
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
-    low = final_approach_mask((trajectory - target) @ axis, height)
+    low = final_approach_mask((trajectory - target) @ axis, height, rise)
     if low is None:
         return math.inf
     tool_axes = Rotation.from_quat(q[low]).apply([0.0, 0.0, 1.0])

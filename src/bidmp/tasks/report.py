@@ -34,6 +34,7 @@ class MethodResult:
     axis_deviations: dict | None = None  # pose scenarios: label -> degrees between tool and target axes
     alignment_threshold: float = 2.0
     verdicts: dict | None = None  # label -> bidmp.tasks.contract.Verdict: the contract's judgement of each motion
+    repairs: dict = field(default_factory=dict)  # label -> bidmp.tasks.repair.Repaired, where a repair was tried
 
     @property
     def successes(self) -> int:
@@ -61,7 +62,19 @@ class MethodResult:
 
     def reason_at(self, label: str) -> str:
         """Why the motion to ``label`` breaks the contract, in one sentence (empty when it does not)."""
+        if label in self.repairs:
+            return self.repairs[label].reason()
         return "" if self.verdicts is None else self.verdicts[label].reason()
+
+    def repaired_at(self, label: str) -> str:
+        """Which repair brought the motion to ``label`` within the contract (empty: none did, or none was needed)."""
+        repair = self.repairs.get(label)
+        return "" if repair is None else repair.how
+
+    @property
+    def repaired(self) -> int:
+        """Motions a repair brought within the contract."""
+        return sum(bool(repair.how) for repair in self.repairs.values())
 
     def aligned_at(self, label: str) -> bool | None:
         """Pose scenarios: the tool's axis within the alignment threshold of the target's over
@@ -143,6 +156,7 @@ class MethodResult:
                 "task_success": self.task_success_at(label),
                 "axis_deviation": None if self.axis_deviations is None else _json_length(self.axis_deviations[label]),
                 "reason": self.reason_at(label),
+                "repair": None if label not in self.repairs else self.repairs[label].to_dict(),
             }
         out["targets"] = targets
         return out

@@ -85,10 +85,13 @@ class Method:
     rollouts run past the demonstrated duration to come to rest: the LASA benchmark compares the
     first T samples and takes the end point from the last), ``requires`` (an optional package it
     needs; without it the method is skipped with a note) and ``lasa`` (run by default in the LASA
-    benchmark).
+    benchmark), ``repairs`` (the pipeline's own method: :func:`bidmp.evaluate` repairs its motions
+    that break the contract, from its skills; the other methods are reported as they are, for
+    comparison).
     """
 
     name: str = ""
+    repairs: bool = False  # the pipeline's method: a motion that breaks the contract is repaired (bidmp.tasks.repair)
     poses: bool = False
     closed_loop: bool = False
     settles: bool = False

@@ -18,8 +18,8 @@ class _BiDMPMethod(Method):
     closed_loop = True
     settles = True
 
-    def __init__(self, name: str, skill: str, lasa: bool = True) -> None:
-        self.name, self.skill, self.lasa = name, skill, lasa
+    def __init__(self, name: str, skill: str, lasa: bool = True, repairs: bool = False) -> None:
+        self.name, self.skill, self.lasa, self.repairs = name, skill, lasa, repairs
 
     def fit(self, task: Task) -> tuple[object, float]:
         dmp, seconds = task.fitted_dmp()
@@ -55,5 +55,5 @@ class _PerGoal:
         return model.rollout(goal)
 
 
-register(_BiDMPMethod("bidmp", "nearest"))
+register(_BiDMPMethod("bidmp", "nearest", repairs=True))
 register(_BiDMPMethod("bidmp-latest", "latest", lasa=False))

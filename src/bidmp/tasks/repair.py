@@ -1,0 +1,369 @@
+"""Repairs: a motion to a target that breaks the motion contract (:mod:`bidmp.tasks.contract`) made
+into one that keeps it, from the same learned skills — or the target failed with the reason.
+
+Whatever failed — the end, the engagement or the clearance — the repairs are tried in this order
+(:data:`REPAIRS`), each judged by the contract, the first motion that keeps it taken:
+
+* ``"lift"``: exact via-points (:mod:`bidmp.primitives.via`) raise the motion over the part it
+  comes too close to, before its final approach, one point at a time where it comes closest (a
+  few milliseconds each: the skill's shape is kept everywhere else);
+* ``"avoid"``: the :class:`~bidmp.primitives.avoidance.SceneAvoidance` coupling steers it round
+  the parts as it runs (one coupled rollout);
+* ``"extend"``: an extended demonstration grown to this target through the scene (1D-SEG and a
+  scene-aware G-PRM, the final approach kept) and learned by the Bi-DMP as a new skill, on a copy
+  of the model (the learned skills are not changed by a repair);
+* ``"margin"``: the extension planned again with the margin widened by what the last attempt
+  lacked (the learned skill does not follow its extension exactly).
+
+The order is the cost: a lift is about a hundredth of an extension, and on the random cells of
+``tools/repair_order.py`` it repairs most motions that only a part in the way spoils. A motion
+that misses its end or its engagement cannot be lifted or steered into its target: it goes
+straight to the extension.
+
+Before any of them, the final approach itself is checked: when the tool coming straight down the
+target's axis onto it already comes too close to a part (a post beside the nut, a duct over it),
+no motion can keep the contract and the target is refused at once, naming the part.
+
+Motions are planned for a margin widened by ``allowance`` (what the arm's tracking may take off
+it when the motion runs) and judged by the contract as it is.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .contract import Contract, Verdict
+
+__all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance"]
+
+logger = logging.getLogger(__name__)
+
+REPAIRS = ("lift", "avoid", "extend", "margin")
+_MAX_ROUNDS = 4  # rounds of lifting (each lifts the stretch past the part the motion comes nearest)
+_STRETCH = 5  # via-points spread along each stretch lifted
+_WIDENINGS = 2  # plannings with a wider margin
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One repair tried: which, whether its motion kept the contract, how long it took (s), and why not."""
+
+    how: str
+    ok: bool
+    seconds: float
+    note: str = ""
+
+    def to_dict(self) -> dict:
+        return {"how": self.how, "ok": self.ok, "seconds": round(self.seconds, 4), "note": self.note}
+
+
+@dataclass
+class Repaired:
+    """What a repair made of a motion: the motion that keeps the contract (or, when none does, the
+    method's own), its verdict, which repair made it (``how``; empty: none), every attempt, and for
+    ``extend``/``margin`` the Bi-DMP with the new skill (``model``, ``skill``)."""
+
+    motion: np.ndarray
+    verdict: Verdict
+    how: str = ""
+    attempts: list = field(default_factory=list)
+    model: object = None
+    skill: object = None
+    refused: str = ""  # why no repair was tried (the final approach itself is blocked)
+
+    @property
+    def ok(self) -> bool:
+        return self.verdict.ok
+
+    def reason(self) -> str:
+        """Why the target fails, in one sentence (empty when it does not)."""
+        if self.ok:
+            return ""
+        if self.refused:
+            return self.refused
+        tried = ", ".join(attempt.how for attempt in self.attempts)
+        return self.verdict.reason() + (f"; repairs tried: {tried}" if tried else "")
+
+    def to_dict(self) -> dict:
+        return {"how": self.how, "refused": self.refused, "attempts": [a.to_dict() for a in self.attempts]}
+
+
+def _is_bidmp(model) -> bool:
+    return hasattr(model, "learn") and hasattr(model, "skill_goals_")
+
+
+def _trajectory(model, goal, start, skill, **options):
+    """The model's timed motion to ``goal`` from ``start`` (a Bi-DMP's ``skill``)."""
+    if _is_bidmp(model):
+        options["skill"] = skill
+    return model.trajectory(goal, start=start, **options)
+
+
+class Repairer:
+    """The repairs of one task (module docstring).
+
+    Parameters
+    ----------
+    contract : Contract
+        What a motion must keep; its scene is where the parts are.
+    demonstration : array (T, 3)
+        The demonstration an extension grows from.
+    extension : dict
+        Options of :func:`bidmp.extend_demonstration` (the scenario's ``"extension"``).
+    seed : int
+        The extension's seed.
+    order : sequence of str
+        The repairs to try, in order (a subset of :data:`REPAIRS`).
+    allowance : float
+        Scene units added to the margin the repairs plan for (what execution may take off it).
+    bidmp : dict
+        Parameters of a Bi-DMP built when the model is a plain DMP (``extend`` needs one).
+    """
+
+    def __init__(self, contract: Contract, demonstration, *, extension: dict | None = None, seed: int = 0,
+                 order=REPAIRS, allowance: float = 0.0, bidmp: dict | None = None) -> None:
+        unknown = [how for how in order if how not in REPAIRS]
+        if unknown:
+            raise ValueError(f"order names {unknown[0]!r}, which is no repair (known: {', '.join(REPAIRS)})")
+        if contract.scene is None:
+            raise ValueError("repairs need the contract's scene: the parts a motion is kept away from")
+        self.contract, self.demonstration = contract, np.asarray(demonstration, dtype=float)
+        self.extension = {k: v for k, v in (extension or {}).items() if k != "approach"}
+        self.seed, self.order, self.bidmp = seed, tuple(order), dict(bidmp or {})
+        scene = contract.scene
+        self.allowance = float(allowance)
+        self.planning = self._widened(self.allowance)
+
+    def _widened(self, extra: float) -> Contract:
+        """The contract with the scene's margin widened by ``extra`` (at most the tool's radius)."""
+        scene = copy.copy(self.contract.scene)
+        scene.margin = min(scene.margin + max(extra, 0.0), scene.tool.radius)
+        return Contract(self.contract.threshold, self.contract.approach_height, scene, self.contract.units,
+                        self.contract.alignment_threshold, self.contract.limits)
+
+    # -- the judgement -----------------------------------------------------------------------------
+    def _judge(self, contract: Contract, motion, goal, label, axis, exclude, carried=None) -> Verdict:
+        clearance = None
+        if contract.scene is not None and carried:
+            clearance = self._clearance(contract.scene, np.asarray(motion)[:, :3], exclude, carried)
+        return contract.judge(motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance)
+
+    def blocked(self, goal, axis, exclude) -> str:
+        """Why no motion can keep the contract at ``goal`` (empty when one may): the tool coming
+        straight down the target's axis over the approach height already comes too close to a part."""
+        contract = self.contract
+        height = contract.approach_height or 0.0
+        axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)
+        corridor = np.vstack([goal[:3] + axis * height, goal[:3]])
+        orientations = None
+        if axis[2] < 1.0 - 1e-12:  # a tilted target: the tool along its axis
+            from scipy.spatial.transform import Rotation
+
+            turn, _ = Rotation.align_vectors([-axis], [[0.0, 0.0, -1.0]])
+            orientations = np.repeat((turn * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()[None], 2, axis=0)
+        clearance = contract.scene.clearance(corridor, exclude=list(exclude), orientations=orientations)
+        if clearance.clear:
+            return ""
+        unit = contract.units or "units"
+        depth = (f"cuts {-clearance.distance:.2f} {unit} into" if clearance.distance < 0
+                 else f"passes {clearance.distance:.2f} {unit} from")
+        return (f"no motion can engage it: the tool coming straight down onto it {depth} {clearance.part} "
+                f"(the margin is {clearance.margin:g} {unit})")
+
+    # -- repairing -----------------------------------------------------------------------------------
+    def repair(self, model, goal, label: str, *, start=None, axis=None, exclude=(), motion=None, verdict=None,
+               skill="nearest", carried=None) -> Repaired:
+        """The motion of ``model`` (a DMP or Bi-DMP) to ``goal`` kept within the contract, or why not.
+
+        ``motion`` and ``verdict``: the method's own motion and its verdict when the caller has
+        them (else computed). The repairs are tried only when that verdict fails. ``carried``: a
+        part the tool carries (a transfer), ``(solid, offset from the mouth)``, kept clear too.
+        """
+        goal = np.asarray(goal, dtype=float)
+        exclude = list(exclude)
+        if motion is None:
+            motion = _trajectory(model, goal, start, skill).y
+        if verdict is None:
+            verdict = self._judge(self.contract, motion, goal, label, axis, exclude, carried)
+        out = Repaired(np.asarray(motion), verdict)
+        if verdict.ok:
+            return out
+        refused = self.blocked(goal, axis, exclude) if self.contract.approach_height is not None else ""
+        if refused:
+            out.refused = f"the motion to {label} cannot be repaired: {refused}"
+            logger.info("%s", out.refused)
+            return out
+        only_clearance = set(verdict.failed) <= {"clearance"}
+        shortfall = 0.0
+        for how in self.order:
+            if how in ("lift", "avoid") and not only_clearance:
+                continue  # a lift or a steer does not bring a motion that misses its target onto it
+            if how in ("extend", "margin") and not _is_bidmp(model) and not self.bidmp_possible(model):
+                continue
+            started = time.perf_counter()
+            try:
+                found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried)
+            except ValueError as exc:  # a via-point refused, an avoidance miss, no free route ...
+                out.attempts.append(Attempt(how, False, time.perf_counter() - started, _first_line(exc)))
+                continue
+            candidate, trial, trial_skill, planned = found
+            final = self._judge(self.contract, candidate, goal, label, axis, exclude, carried)
+            ok = final.ok and planned.ok
+            out.attempts.append(Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason()))
+            if ok:
+                out.motion, out.verdict, out.how, out.model, out.skill = candidate, final, how, trial, trial_skill
+                logger.info("the motion to %s kept the contract after %s", label, how)
+                return out
+            if planned.clearance is not None:
+                shortfall = max(shortfall, planned.clearance.margin - planned.clearance.distance)
+        return out
+
+    @staticmethod
+    def bidmp_possible(model) -> bool:
+        """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP)."""
+        return hasattr(model, "weights_") and hasattr(model, "n_steps_")
+
+    def _try(self, how, model, goal, label, start, axis, exclude, skill, shortfall, carried=None):
+        """``(motion, model, skill, verdict on the planning contract)`` of one repair."""
+        if how == "lift":
+            motion = self._lift(model, goal, label, start, axis, exclude, skill, carried)
+            return motion, None, None, self._judge(self.planning, motion, goal, label, axis, exclude, carried)
+        if how == "avoid":
+            from ..primitives.avoidance import SceneAvoidance
+
+            scene = self.planning.scene
+            term = SceneAvoidance(scene, margin=scene.margin, target=label if label in scene.labels else None)
+            motion = _trajectory(model, goal, start, skill, coupling=[term]).y
+            return motion, None, None, self._judge(self.planning, motion, goal, label, axis, exclude, carried)
+        widen = self.allowance + (shortfall if how == "margin" else 0.0)
+        attempts = _WIDENINGS if how == "margin" else 1
+        for _ in range(attempts):
+            planning = self._widened(widen)
+            trial, index = self._learned(model, goal, planning, start, skill)
+            motion = _trajectory(trial, goal, start, index).y
+            verdict = self._judge(planning, motion, goal, label, axis, exclude)
+            if verdict.ok or verdict.clearance is None or how != "margin":
+                return motion, trial, index, verdict
+            widen += max(verdict.clearance.margin - verdict.clearance.distance, 0.0)
+        return motion, trial, index, verdict
+
+    def _learned(self, model, goal, planning: Contract, start=None, skill="nearest"):
+        """A copy of the Bi-DMP (one is built on a plain DMP) with a skill learned from an extended
+        demonstration grown to ``goal`` through the planning scene, and that skill's index. It grows
+        from the demonstration, or for a motion from another ``start`` from the skill's own motion
+        from there (a skill learned from the demonstration, run from elsewhere, is another motion)."""
+        from ..extension.extend import extend_demonstration
+        from ..incremental.bidmp import BiDMP
+
+        dmp = model.dmp_ if _is_bidmp(model) else model  # the DMP fitted on the demonstration
+        trial = copy.deepcopy(model) if _is_bidmp(model) else BiDMP(copy.deepcopy(model), **self.bidmp)
+        source, duration = self.demonstration, None
+        if start is not None:
+            own = _trajectory(model, goal, start, skill)
+            source, duration = own.y[:, :3], float(own.t[-1])
+        extension = extend_demonstration(source, goal[:3], seed=self.seed, scene=planning.scene, **self.extension)
+        scale = 1.0 if duration is None else duration / dmp.duration_ * (dmp.n_steps_ - 1) / (source.shape[0] - 1)
+        trial.learn(extension.complete, duration=extension.duration_for(dmp) * scale)
+        return trial, trial.n_skills - 1
+
+    def _lift(self, model, goal, label, start, axis, exclude, skill, carried=None):
+        """The motion raised over the parts it comes too close to by exact via-points: each round,
+        the stretch of the motion that passes the nearest part (by its bounding box) before the
+        final approach is lifted to over the part's top, by up to :data:`_STRETCH` points spread
+        along it; a ``ValueError`` when it cannot be."""
+        scene = self.planning.scene
+        trajectory = _trajectory(model, goal, start, skill)
+        final = _final_approach_time(trajectory, goal, self.contract.approach_height, axis)
+        # The weight change acts only through the kernels active before the final approach, so the
+        # motion returns to its own approach and comes to rest where it did; the points lie after the
+        # motion's first tenth (the kernels cannot move its start) and before the last fifth of the
+        # time to the approach (the motion needs it to settle back).
+        earliest = 0.1 * float(trajectory.t[-1])
+        until = min(final, _motion_duration(model, goal, skill))
+        latest = until - 0.2 * (until - earliest)
+        via: dict = {}
+        band = scene.margin + scene.tool.radius  # the tool's mouth this close to a part's box is near it
+        for _ in range(_MAX_ROUNDS):
+            clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
+            if clearance.clear:
+                return trajectory.y
+            owner = _owner(scene, clearance.part)
+            path = trajectory.y[:, :3]
+            height = _depth(carried)
+            near = scene.near(path, owner, band) | scene.near(path - [0.0, 0.0, height], owner, band)
+            before = (trajectory.t <= latest) & (trajectory.t >= earliest)
+            if not np.any(near & before):
+                raise ValueError(f"it comes too close to {clearance.part} within its final approach: no lift helps")
+            top = float(scene.bounds(owner)[1][2]) + scene.margin + 0.5 * scene.tool.radius + height
+            stretch = np.flatnonzero(near & before)
+            for index in np.unique(np.linspace(stretch[0], stretch[-1], min(_STRETCH, stretch.size)).round().astype(int)):
+                point = trajectory.y[index].copy()
+                point[2] = max(point[2], top)
+                via[round(float(trajectory.t[index]), 12)] = point
+            trajectory = _trajectory(model, goal, start, skill, via=sorted(via.items()), via_until=until)
+        if self._clearance(scene, trajectory.y[:, :3], exclude, carried).clear:
+            return trajectory.y
+        raise ValueError(f"{_MAX_ROUNDS} rounds of via-points did not lift it clear of the parts")
+
+    @staticmethod
+    def _clearance(scene, path, exclude, carried=None):
+        """The tool's clearance along ``path``, and of a part it carries (:func:`carried_clearance`)."""
+        return carried_clearance(scene, path, exclude, carried)
+
+
+def carried_clearance(scene, path, exclude, carried=None, support=(), orientations=None):
+    """The clearance along ``path`` (n, 3) of the tool and of a part it carries: ``carried`` is
+    ``(solid, offset)``, the part's solid where it is and its centre's offset (3,) from the tool's
+    mouth (:meth:`bidmp.Scene.body_clearance`). ``support``: parts left out of the part's check
+    (those it is lifted off). The nearer of the two to its margin."""
+    clearance = scene.clearance(path, exclude=list(exclude), orientations=orientations)
+    if not carried:
+        return clearance
+    solid, offset = carried
+    body = scene.body_clearance(solid, np.asarray(path)[:, :3], offset, exclude=list(exclude) + list(support))
+    body = type(body)(body.distance, body.part, body.point, scene.margin)
+    return min(clearance, body, key=lambda c: c.distance - c.margin)
+
+
+def _depth(carried) -> float:
+    """How far a carried part reaches below the tool's mouth (scene units; 0 without one)."""
+    if not carried:
+        return 0.0
+    solid, offset = carried
+    return max(float(np.asarray(solid.centre)[2] - np.asarray(solid.lower)[2] - np.asarray(offset)[2]), 0.0)
+
+
+def _motion_duration(model, goal, skill) -> float:
+    """How long the skill's motion lasts (s) before it rests at its goal: via-points lie within it."""
+    if _is_bidmp(model):
+        index = model.select_skill(np.asarray(goal, dtype=float), skill)
+        return float(model.dmp_.tau * model.dmp_.duration_ * model.skill_time_scales_[index])
+    return float(model.tau * model.duration_)
+
+
+def _owner(scene, solid_label: str) -> str:
+    """The part a solid belongs to ("4/stud" belongs to "4")."""
+    for solid in scene.solids:
+        if solid.label == solid_label:
+            return solid.part
+    return solid_label
+
+
+def _final_approach_time(trajectory, goal, height, axis) -> float:
+    """The time (s) the motion enters the final approach band for the last time (its whole length
+    when it has no band)."""
+    if height is None:
+        return float(trajectory.t[-1])
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)
+    along = (trajectory.y[:, :3] - np.asarray(goal)[:3]) @ axis
+    above = np.flatnonzero(along >= height)
+    return float(trajectory.t[above[-1]]) if above.size else 0.0
+
+
+def _first_line(exc: Exception) -> str:
+    return str(exc).splitlines()[0][:300] if str(exc) else type(exc).__name__
