@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_BROKEN_PIPE", "MAX_MESSAGE", "MAX_SEEDS", "Parser",
+__all__ = ["EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_TARGETS_FAILED", "judged_methods", "EXIT_BROKEN_PIPE", "MAX_MESSAGE", "MAX_SEEDS", "Parser",
            "parse_K", "allow_outside_files", "one_line", "split_names"]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
 EXIT_BAD_INPUT = 2
+# A run that went through but not every target succeeded (bidmp demo, sim, job): the summary says how
+# many and why. Judged on the pipeline's method (bidmp) when it ran, else on every method run.
+EXIT_TARGETS_FAILED = 3
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a tool killed by a closed pipe reports
 MAX_MESSAGE = 600  # characters of one error line
 MAX_SEEDS = 200  # = bidmp.reproduce.MAX_SEEDS (not imported: --help must not load NumPy)
@@ -56,3 +59,12 @@ def split_names(text: str | None, option: str) -> list[str] | None:
     if not names:
         raise ValueError(f"{option} names no method: {text!r}")
     return names
+
+
+def judged_methods(methods) -> list:
+    """The methods a run's exit status is judged on: the pipeline's (those that repair their motions:
+    bidmp) when any ran, else every one (a baseline asked for alone is judged on its own)."""
+    from ..tasks.methods import get
+
+    methods = list(methods)
+    return [name for name in methods if get(name).repairs] or methods

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import EXIT_OK, allow_outside_files
+from .common import EXIT_OK, EXIT_TARGETS_FAILED, allow_outside_files
 
 
 def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True, view: bool = False) -> int:
@@ -32,7 +32,7 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
         extra = [solid for solid in report.scene.solids if solid.label not in own]  # the bin, the rack
         written += write_view_files(out, report=report.evaluation, sim_result=report, extra_solids=extra)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
-    return EXIT_OK
+    return EXIT_OK if report.removed == len(report.targets) else EXIT_TARGETS_FAILED
 
 
 def _cmd_job(args: argparse.Namespace) -> int:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_OK, Parser, allow_outside_files
+from .common import EXIT_OK, EXIT_TARGETS_FAILED, Parser, allow_outside_files, judged_methods
 
 __all__ = ["add_commands"]
 
@@ -102,15 +102,17 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     if args.job and scenario.job is None:
         raise ValueError(f"--job: scenario {scenario.name!r} has no \"job\" (the steps to run at each target)")
     report = _run_scenario(scenario, out, methods, view=args.view)
+    failed = report.failed(judged_methods(report.methods))
     if args.sim:
         sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
-        _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None,
-                 view=args.view)
+        result = _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None,
+                          view=args.view)
+        failed += result.failed(judged_methods(sim_methods))
     if args.job:
         from .job import run_job_command
 
-        run_job_command(scenario, out / "job", view=args.view)
-    return EXIT_OK
+        failed += run_job_command(scenario, out / "job", view=args.view) != EXIT_OK
+    return EXIT_TARGETS_FAILED if failed else EXIT_OK
 
 
 def _cmd_sim(args: argparse.Namespace) -> int:
@@ -137,9 +139,9 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     update = None if args.goal_update is None else GoalUpdate(args.goal_update[0], tuple(args.goal_update[1:]))
     if (args.avoid or update is not None) and not args.closed_loop:
         raise ValueError("--avoid and --goal-update act on the closed loop: add --closed-loop")
-    _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
-             pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update, view=args.view)
-    return EXIT_OK
+    result = _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
+                      pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update, view=args.view)
+    return EXIT_TARGETS_FAILED if result.failed(judged_methods(methods)) else EXIT_OK
 
 
 def _cmd_scenario(args: argparse.Namespace) -> int:

@@ -48,11 +48,27 @@ class SimTarget:
     aligned: bool | None = None
     verdict: object = None  # bidmp.tasks.contract.Verdict on the executed motion and the commands
     repair: str = ""  # how the motion was repaired (empty: the method's own motion ran)
+    error: str = ""  # why the motion did not run (unreachable, outside the joint limits); empty: it ran
+
+    @classmethod
+    def not_run(cls, label: str, error: str) -> SimTarget:
+        """A motion that could not run (its target out of reach, a joint past its limits): a row
+        with its reason, no measurements."""
+        nan = float("nan")
+        return cls(label=label, commanded_error=nan, measured_error=nan, approach_error=None, engaged=False, contacts={},
+                   peak_velocity=0.0, peak_acceleration=0.0, measured_peak_velocity=0.0, measured_peak_acceleration=0.0,
+                   motion_time=0.0, tracking_error=0.0, within_limits=False, error=error)
+
+    @property
+    def ran(self) -> bool:
+        return not self.error
 
     def task_success(self, threshold: float) -> bool:
         """The motion contract on what the arm did (:mod:`bidmp.tasks.contract`): the measured end,
         the measured final descent, the executed tool's clearance by the margin and no contact, the
         1 kHz commands within the limits."""
+        if self.error:
+            return False
         if self.verdict is not None:
             return self.verdict.ok
         return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
@@ -60,10 +76,14 @@ class SimTarget:
 
     @property
     def reason(self) -> str:
+        if self.error:
+            return self.error
         return "" if self.verdict is None else self.verdict.reason()
 
     def to_dict(self, threshold: float) -> dict:
-        return {
+        if self.error:
+            return {"ran": False, "task_success": False, "reason": self.error}
+        return {"ran": True,
             "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
             "approach_error": _json_length(self.approach_error),
             "engaged": self.engaged, "contacts": sorted(self.contacts),
@@ -167,7 +187,7 @@ class SimReport:
         rows = []
         for name, method in self.methods.items():
             n = len(method.targets)
-            times = [t.motion_time for t in method.targets.values()]
+            times = [t.motion_time for t in method.targets.values() if t.ran] or [0.0]
             row = [name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}"]
             if poses:
                 row.append("-" if method.aligned is None else f"{method.aligned}/{n}")
@@ -190,7 +210,17 @@ class SimReport:
             lines.append(f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
                          f"({self.simulated_s / self.wall_s:.1f}x real time, {self.workers} worker process"
                          f"{'es' if self.workers > 1 else ''})")
+        for name, method in self.methods.items():
+            failed = [t for t in method.targets.values() if not t.task_success(method.threshold)]
+            if failed:
+                lines.append(f"\n{name}: {len(failed)} of {len(method.targets)} targets failed")
+                lines += [f"  {t.label}: {t.reason or 'breaks the contract'}" for t in failed]
         return "\n".join(lines)
+
+    def failed(self, methods=None) -> int:
+        """Targets that failed, over ``methods`` (default every method run)."""
+        names = self.methods if methods is None else [m for m in methods if m in self.methods]
+        return sum(not t.task_success(self.methods[m].threshold) for m in names for t in self.methods[m].targets.values())
 
     def markdown(self) -> str:
         return markdown_table(*self.rows())

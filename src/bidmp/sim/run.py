@@ -15,11 +15,11 @@ from .._checks import check_bool, check_int, check_real
 from ..tasks.contract import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
-from .backend import COUPLING, GoalUpdate, Hold
+from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
 from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
 from .pybullet.world import _pybullet_module
-from .report import SimMethod, SimReport, _measure
+from .report import SimMethod, SimReport, SimTarget, _measure
 
 __all__ = ["simulate"]
 
@@ -54,32 +54,41 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
     for job in jobs:
         if progress is not None:
             progress(job.method, job.label)
-        # The closed loop runs the learned motion itself, not a spline through IK samples 5 mm apart,
-        # which smooths its final stop: it is timed on samples 1 mm apart (else a fast descent stops
-        # harder than the joints' acceleration limits, and the limiter overshoots the nut).
-        spacing = CLOSED_LOOP_SPACING if setup["closed_loop"] else MAX_SAMPLE_SPACING
-        plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
-        if setup["closed_loop"] and job.orientations is not None:
-            raise ValueError("closed_loop runs position skills; this scenario's are poses")
-        target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
-        if setup["closed_loop"]:
-            coupling = setup["coupling"]
-            if setup.get("avoid"):  # steered round every part but the target's, with phase stopping
-                coupling = [PhaseStopping(coupling), SceneAvoidance(cell.scene, target=job.label)]
-            stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
-            update = setup.get("goal_update")
-            run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update)
-            if update is not None:  # judged at where the part turned out to be
-                target = target + np.asarray(update.offset)
-        else:
-            run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
-        measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits,
-                            contract, job.exclude)
-        measured.repair = job.repair
-        measured.commanded_penetration = _commanded_penetration(cell, run, job)
-        motion = _arm_motion(cell, run) if job.view else None
-        results.append((job.method, job.label, measured, run.frames, float(run.times[-1]), motion))
+        try:
+            results.append(_run_one(setup, cell, contract, job))
+        except SimError as exc:  # a motion that cannot run (unreachable, past a joint limit): its row
+            results.append((job.method, job.label, SimTarget.not_run(job.label, str(exc)), [], 0.0, None))
     return results
+
+
+def _run_one(setup: dict, cell, contract, job):
+    """One motion planned, executed and measured: (method, label, SimTarget, frames, seconds, motion)."""
+    scenario = setup["scenario"]
+    # The closed loop runs the learned motion itself, not a spline through IK samples 5 mm apart,
+    # which smooths its final stop: it is timed on samples 1 mm apart (else a fast descent stops
+    # harder than the joints' acceleration limits, and the limiter overshoots the nut).
+    spacing = CLOSED_LOOP_SPACING if setup["closed_loop"] else MAX_SAMPLE_SPACING
+    plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
+    if setup["closed_loop"] and job.orientations is not None:
+        raise ValueError("closed_loop runs position skills; this scenario's are poses")
+    target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
+    if setup["closed_loop"]:
+        coupling = setup["coupling"]
+        if setup.get("avoid"):  # steered round every part but the target's, with phase stopping
+            coupling = [PhaseStopping(coupling), SceneAvoidance(cell.scene, target=job.label)]
+        stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
+        update = setup.get("goal_update")
+        run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update)
+        if update is not None:  # judged at where the part turned out to be
+            target = target + np.asarray(update.offset)
+    else:
+        run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
+    measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits,
+                        contract, job.exclude)
+    measured.repair = job.repair
+    measured.commanded_penetration = _commanded_penetration(cell, run, job)
+    motion = _arm_motion(cell, run) if job.view else None
+    return job.method, job.label, measured, run.frames, float(run.times[-1]), motion
 
 
 def _contract(scenario: dict, cell):
@@ -195,10 +204,14 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     models = {name: report.fitted[name] for name in methods} if closed_loop else None
     setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
                    backend=backend, robot=arm, **_loop_options(closed_loop, avoid, goal_update))
-    _check_reach(setup, scenario, labels)
-    n_workers = _n_workers(workers, len(jobs))
+    unreachable = _unreachable(setup, scenario, labels)
+    skipped = [job for job in jobs if job.label in unreachable]
+    jobs = [job for job in jobs if job.label not in unreachable]
+    n_workers = _n_workers(workers, max(len(jobs), 1))
     start = time.perf_counter()
-    outcomes = _execute_jobs(setup, jobs, n_workers, progress)
+    outcomes = _execute_jobs(setup, jobs, n_workers, progress) if jobs else []
+    outcomes += [(job.method, job.label, SimTarget.not_run(job.label, unreachable[job.label]), [], 0.0, None)
+                 for job in skipped]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
@@ -229,33 +242,28 @@ def _scenario_and_backend(scenario, backend):
     return scenario, backend
 
 
-def _check_reach(setup: dict, scenario, labels) -> None:
-    """Every target, tool pointing down, within the arm's reach from its base; else one
-    :class:`SimError` that names all the targets out of reach."""
+def _unreachable(setup: dict, scenario, labels) -> dict:
+    """The targets out of the arm's reach from its base, tool pointing down, each with its reason
+    (every target, when the demonstration's start is out of reach: every motion starts there)."""
     from .backend import SimError
     from .pybullet.robot import IK_TOLERANCE
 
     if setup["backend"] is not RobotCell:
-        return
+        return {}
     cell = _world(setup)
-    missed = []
-    start = np.asarray(scenario.demonstration, dtype=float)[0, :3]
-    start_name = "the demonstration's start"
-    points = {start_name: start, **{label: scenario.targets[label] for label in labels}}
-    for label, point in points.items():
+    where = (f"for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
+             f"down); move its base (scenario key \"robot\": {{\"base\": ...}})")
+
+    def reached(point) -> bool:
         try:
             _, error = cell.solve_ik(np.asarray(point, dtype=float)[:3] * cell.unit, cell.model.rest)
         except SimError:
-            error = np.inf
-        if error > 10 * IK_TOLERANCE:
-            missed.append(label)
-    if missed:
-        what = ", ".join(label if label == start_name else repr(label) for label in missed)
-        if missed[0] != start_name:
-            what = ("target " if len(missed) == 1 else "targets ") + what
-        what += " is" if len(missed) == 1 else " are"
-        raise SimError(f"{what} unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
-                       f"{scenario.units} (tool pointing down); move its base (scenario key \"robot\": {{\"base\": ...}})")
+            return False
+        return error <= 10 * IK_TOLERANCE
+
+    if not reached(np.asarray(scenario.demonstration, dtype=float)[0, :3]):
+        return {label: f"the demonstration's start is unreachable {where}" for label in labels}
+    return {label: f"target {label} is unreachable {where}" for label in labels if not reached(scenario.targets[label])}
 
 
 VIEW_STEP = 0.04  # s between the arm's poses the viewer animates (25 per second)

@@ -194,6 +194,11 @@ class Report:
             out["route_failures"] = list(self.route_failures)
         return out
 
+    def failed(self, methods=None) -> int:
+        """Targets whose motion breaks the contract, over ``methods`` (default every method run)."""
+        names = self.methods if methods is None else [m for m in methods if m in self.methods]
+        return sum(not self.methods[m].task_success_at(label) for m in names for label in self.methods[m].errors)
+
     # -- tables ------------------------------------------------------------------------------
     def method_rows(self, runtimes: bool = True) -> tuple[list[str], list[list[str]]]:
         """The Table 4 analogue: header and one row per method. With a scene: engaged,
@@ -257,6 +262,16 @@ class Report:
             lines.append(f"no extension to {failure['target']}: {failure['reason']}")
         lines += ["", f"Table 4 analogue (errors in {units}; run time in s, measured in this run)", text_table(*self.method_rows())]
         lines += ["", f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)", text_table(*self.target_rows())]
+        for name, result in self.methods.items():
+            if not result.repairs:
+                continue
+            hows = [result.repaired_at(label) for label in result.repairs if result.repaired_at(label)]
+            counts = ", ".join(f"{how} {hows.count(how)}" for how in dict.fromkeys(hows))
+            failed = [label for label in result.errors if not result.task_success_at(label)]
+            lines += ["", f"{name}: {len(hows)} of {len(result.errors)} motions repaired to keep the contract"
+                          + (f" ({counts})" if counts else "")
+                          + (f"; {len(failed)} still fail:" if failed else "")]
+            lines += [f"  {label}: {result.reason_at(label)}" for label in failed]
         if self.forgetting:
             lines += ["", f"forgetting (error after learning every demonstration minus error when learned, {units}):"]
             lines += [f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting) for skill, result in self.forgetting.items()]
