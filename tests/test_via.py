@@ -60,7 +60,11 @@ def test_via_points_are_passed_exactly_with_the_least_norm_change(seed):
     times += rng.uniform(0, 0.3) * (plain.t[1] - plain.t[0])  # between samples too
     points = np.array([sample_at(plain, t) for t in times]) + rng.uniform(-10, 10, (times.size, 3)) * unit
     via = list(zip(times, points))
-    result = dmp.trajectory(dt=dt, via=via)
+    try:
+        result = dmp.trajectory(dt=dt, via=via)
+    except ValueError as refused:  # a late via-point whose kernels would still act at the end: said, not done
+        assert protocol == "robot" and "put the via-points earlier" in str(refused)
+        return
     for t, point in via:
         assert np.max(np.abs(sample_at(result, t) - point)) <= 1e-6 * max(unit, 1e-3)
     # The least-norm change: pinv of the measured response (perturbed rollouts, one per kernel).
@@ -68,9 +72,13 @@ def test_via_points_are_passed_exactly_with_the_least_norm_change(seed):
     increment = dmp.trajectory(dt=dt, forcing_increment=lambda _, rows: rows @ change)
     np.testing.assert_allclose(result.y, increment.y, atol=1e-7 * max(unit, 1e-3))
     # The whole motion, not only the via samples: the robot protocol still comes to rest at its
-    # goal (the paper's rollout stops after T samples, before it settles, so its end moves too).
+    # goal, or the call was refused above (the paper's rollout stops after T samples, before it
+    # settles, so its end moves too).
     if protocol == "robot":
-        assert np.linalg.norm(result.y[-1] - dmp.goal_) <= 1e-3 * np.linalg.norm(dmp.goal_ - dmp.start_)
+        corners = np.vstack([dmp.goal_, dmp.start_, points])
+        reach = np.max(np.linalg.norm(corners[:, None] - corners[None], axis=2))
+        assert np.linalg.norm(result.y[-1] - dmp.goal_) <= 1.1e-4 * reach + np.linalg.norm(plain.y[-1] - dmp.goal_)
+        assert np.linalg.norm(result.yd[-1]) <= 1.1e-2 * reach / result.t[-1] + np.linalg.norm(plain.yd[-1])
 
 
 def _measured_least_norm_change(dmp, dt, plain, times, points):
@@ -96,7 +104,7 @@ def test_via_points_the_kernels_cannot_carry_are_refused():
     cases = [
         ([(3.5, [0, 0, 0])], "duration"),
         ([(0.0, [1, 1, 1])], "cannot carry"),
-        ([(1.0, [0, 0, 0]), (1.0001, [50, 0, 0])], "cannot carry|peak acceleration"),
+        ([(1.0, [0, 0, 0]), (1.0001, [50, 0, 0])], "cannot carry|peak acceleration|still act at the motion.s end"),
         ([(0.1 * k + 0.1, [50, 0, 60]) for k in range(11)], "at most 10"),
         ([(1.0, [1, 2, 3]), (1.0, [1, 2, 3])], "same time"),
         ([(1.0, [1, 2])], "via\\[0\\] point"),

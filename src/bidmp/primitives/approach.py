@@ -1,4 +1,5 @@
-"""The final approach of a demonstration: its straight tail into the goal.
+"""The final approach of a demonstration, its straight tail into the goal; and its departure, the
+straight head it starts with (a lift off a part).
 
 A robot's last motion into a nut or a socket is a straight move along the target's axis; a DMP that
 keeps it (``DMP(keep_approach=True)``, :class:`bidmp.primitives.goals.ApproachGate`) completes a
@@ -27,6 +28,12 @@ def _is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
     along = offsets @ (chord / length)
     deviation = np.linalg.norm(offsets - along[:, None] * (chord / length), axis=1)
     return bool(deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length))
+
+
+def _straight_head_end(y: np.ndarray, straightness: float = STRAIGHTNESS) -> int:
+    """The latest index up to which ``y`` (T, D) is straight from its start (on the same grid of
+    candidates as :func:`_straight_tail_start`); 0 when no head of 2 samples or more is."""
+    return y.shape[0] - 1 - _straight_tail_start(y[::-1], 0, straightness)
 
 
 def _straight_tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNESS) -> int:

@@ -48,7 +48,7 @@ from sklearn.base import BaseEstimator
 
 from .._api import CheckedParams
 from .._checks import as_trajectory, check_bytes, numerically_guarded
-from .._units import check_units
+from .._units import ANGLE_UNITS, check_units
 from ._dmp_grids import GridQueries
 from ._dmp_motions import Motions
 from .canonical import _check_phase_span
@@ -144,12 +144,14 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         protocol of model format 3 (such files load with it).
     keep_approach : bool or None, default None
         Robot protocol: complete a moved goal's offset before the final approach (the
-        demonstration's straight tail into its goal, :mod:`bidmp.primitives.approach`), so the
-        approach to a moved goal is a translated copy of the demonstrated one
-        (:class:`bidmp.primitives.goals.ApproachGate`; the progress gate spreads the offset over
-        the whole motion and tilts the approach). A demonstration without a straight tail keeps
-        the progress gate. ``None``: on for the robot protocol (its progress gate), off otherwise;
-        ``False`` asks for the progress gate.
+        demonstration's straight tail into its goal, :mod:`bidmp.primitives.approach`), and start
+        it after the departure (a straight head it starts with: a lift, 5-40 % of the path), so the
+        approach and the departure under a moved goal or start are translated copies of the
+        demonstrated ones (:class:`bidmp.primitives.goals.ApproachGate`; the progress gate spreads
+        the offset over the whole motion and tilts both). A demonstration without a straight tail
+        keeps the progress gate. ``None``: on for the robot protocol (its progress gate) on
+        positions, off for joint angles (``units="rad"``: a straight tail in joint space is no
+        approach) and for the paper protocol; ``False`` asks for the progress gate.
 
     Attributes
     ----------
@@ -259,6 +261,11 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         _check_integration(dt, params._replace(tau=1.0))
         _check_integration(dt, params)
         _check_phase_span(train.shape[0] * dt, params.alpha_phase)
+        if units in ANGLE_UNITS and self.keep_approach is None:
+            # A straight tail in joint space is no approach along a part's axis (that one is straight
+            # in the tool's space): keeping it compressed a moved goal's whole offset into the
+            # transfer, a 17 rad/s² spike on a wrist that the demonstration moved at 1.7.
+            params = params._replace(keep_approach=False)
         gate = _learn_goal_gate(train, n_steps, dt, params, progress, y)
         weights, centres, widths, phase, phi = _learn_weights(train, dt, gate, params)
         self.weights_ = weights

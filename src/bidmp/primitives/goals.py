@@ -73,8 +73,9 @@ def _smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return first, second
 
 
-def _goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = _GOAL_BLEND) -> np.ndarray:
-    """The goal share ``R`` on the training grid (module docstring).
+def _goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = _GOAL_BLEND, begin: float = 0.0) -> np.ndarray:
+    """The goal share ``R`` on the training grid (module docstring), 0 before ``begin`` (normalised
+    time: the end of a kept departure) and rising from there.
 
     Parameters
     ----------
@@ -87,8 +88,8 @@ def _goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = _
     """
     s = np.arange(progress.shape[0]) * dt
     end = (n_motion - 1) * dt
-    width = max(blend * end, dt)
-    share = progress * _smoothstep(s / width)
+    width = max(blend * (end - begin), dt)
+    share = progress * _smoothstep((s - begin) / width)
     closing = s > end - width
     share[closing] = 1.0 - (1.0 - progress[closing]) * _smoothstep((end - s[closing]) / width)
     share[s >= end] = 1.0
@@ -238,31 +239,57 @@ def _learned_progress_gate(model, params) -> ProgressGate:
 
 
 class ApproachGate(ProgressGate):
-    """The progress gate, with the goal's share reaching 1 where the final approach begins.
+    """The progress gate, with the goal's share reaching 1 where the final approach begins, and
+    held at 0 until a kept departure ends.
 
-    ``R`` is the demonstration's arc-length progress normalised to the approach's start, ``σ / σ_a``,
-    with the same smooth ends as :func:`_goal_share`; so ``R = 1`` over the whole approach, and a goal
-    moved by Δ moves every approach sample by exactly Δ: a translated copy, no tilt. ``R`` stays
-    monotone: no backwards motion, and the overshoot bound of :func:`_goal_share` holds with the
-    approach's start in the place of the motion's end.
+    ``R`` is the demonstration's arc-length progress normalised to the stretch between the
+    departure's end and the approach's start, ``(σ - σ_d) / (σ_a - σ_d)`` (``σ_d = 0`` without a
+    departure), with the same smooth ends as :func:`_goal_share`; so ``R = 1`` over the whole
+    approach, and a goal moved by Δ moves every approach sample by exactly Δ: a translated copy, no
+    tilt. ``R = 0`` over the departure, so a moved goal does not move it, and a moved start (which
+    moves the motion by ``(1 - R)`` times the shift) moves it whole: a translated copy too. ``R``
+    stays monotone and its first three derivatives are 0 where it leaves 0 (the smoothstep begins at
+    the departure's end). The overshoot bound of :func:`_goal_share` holds with the approach's start
+    in the place of the motion's end.
     """
 
     @staticmethod
     def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
-              progress: np.ndarray | None = None, approach_start: int | None = None) -> np.ndarray:
-        """The gate on the training grid; ``approach_start`` the sample where the approach begins."""
+              progress: np.ndarray | None = None, approach_start: int | None = None,
+              departure_end: int = 0) -> np.ndarray:
+        """The gate on the training grid; ``approach_start`` the sample where the approach begins,
+        ``departure_end`` the one where a kept departure ends (0: none)."""
         progress = _training_progress(train, progress)
-        reach = float(progress[approach_start])
-        share = _goal_share(np.clip(progress / reach, 0.0, 1.0), approach_start + 1, dt)
+        reach, leave = float(progress[approach_start]), float(progress[departure_end])
+        normalised = np.clip((progress - leave) / (reach - leave), 0.0, 1.0)
+        share = _goal_share(normalised, approach_start + 1, dt, begin=departure_end * dt)
         return _goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
+
+
+MAX_DEPARTURE_SHARE = 0.4  # of the path's length: a longer straight head is the transfer itself
+MIN_TRANSFER_SHARE = 0.3  # of the path's length left between a kept departure and the kept approach
+
+
+def _departure_end(demonstration: np.ndarray, approach_start: int) -> int:
+    """Where the demonstration's departure ends: its straight head, when that is 5-40 % of the path
+    and leaves at least 30 % of it before the approach (a head that is most of the way, like a
+    min-jerk leg from the start to the approach, is the transfer); 0 when it has none."""
+    from .approach import _straight_head_end
+
+    end = _straight_head_end(demonstration)
+    progress = _arclength_progress(demonstration)
+    head, before = float(progress[end]), float(progress[approach_start])
+    if end < 2 or head < MIN_APPROACH_SHARE or head > MAX_DEPARTURE_SHARE or before - head < MIN_TRANSFER_SHARE:
+        return 0
+    return int(end)
 
 
 def _learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progress=None,
                     demonstration: np.ndarray | None = None) -> np.ndarray:
     """The goal gate a DMP with resolved ``params`` learns on its training grid: a delayed goal's,
     the progress gate, or (``keep_approach``) the approach gate, the approach found as the straight
-    tail of ``demonstration`` (T, D) into its goal (a demonstration without one gets the progress
-    gate)."""
+    tail of ``demonstration`` (T, D) into its goal and a departure as its straight head
+    (:func:`_departure_end`; a demonstration without an approach gets the progress gate)."""
     if params.goal_rate is not None:
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
     gains = {"alpha": params.alpha, "beta": params.beta, "K": params.K, "exact": params.exact, "progress": progress}
@@ -274,5 +301,6 @@ def _learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progre
         # An approach is a straight tail of a real share of the path: any curve's last few samples
         # are straight to 2 % of their short chord.
         if progress_at > 0.0 and 1.0 - progress_at >= MIN_APPROACH_SHARE:
-            return ApproachGate.learn(train, n_motion, dt, approach_start=start, **gains)
+            return ApproachGate.learn(train, n_motion, dt, approach_start=start,
+                                      departure_end=_departure_end(demonstration, start), **gains)
     return ProgressGate.learn(train, n_motion, dt, **gains)

@@ -69,6 +69,7 @@ class DMPStepper:
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
         self._complete = None  # the motion time its own goal offset completes (set_goal asks for it)
+        self._peaks = None  # the motion's own peaks (set_goal without limits asks for them)
         for term in self._couplings:  # terms that need the motion (a scene's avoidance: its goal, its scale)
             if hasattr(term, "bind"):
                 term.bind(self)
@@ -104,7 +105,9 @@ class DMPStepper:
             The new goal (units).
         limits : dict, optional
             ``max_velocity`` / ``max_acceleration`` / ``max_jerk`` (units/s, /s², /s³): the blend
-            is at least long enough that the offset alone uses a quarter of each.
+            is at least long enough that the offset alone uses a quarter of each. Default the
+            motion's own peaks (its learned motion at this duration): a goal moved after the DMP's
+            own goal share is complete still arrives smoothly, never in one step.
         blend : float, optional
             The blend's duration (s), in place of the one above.
 
@@ -117,7 +120,7 @@ class DMPStepper:
         delta = as_point(goal, self.goal.shape[0], "goal") - self.target
         if blend is None:
             complete = self._goal_complete()
-            blend = max(complete - self.time, _shortest_blend(delta, limits))
+            blend = max(complete - self.time, _shortest_blend(delta, limits if limits else self._own_peaks()))
             if self.time + blend > complete + 1e-9 and np.any(delta != 0.0):
                 logger.warning("set_goal at %.3f s: the goal's offset ends %.3f s after the final approach began; "
                                "the approach is not a translated copy", self.time, self.time + blend - complete)
@@ -125,6 +128,20 @@ class DMPStepper:
             blend = check_real(blend, "blend", nonnegative=True, maximum=1e6)
         self._shifts.add(delta, self.time, blend)
         return float(blend)
+
+    def _own_peaks(self) -> dict:
+        """The peak speed, acceleration and jerk (norms, units/s, /s², /s³) of the motion this
+        stepper runs, without coupling: what a moved goal's blend keeps a quarter of, when no limits
+        are given. Computed once."""
+        if getattr(self, "_peaks", None) is None:
+            dmp = self._dmp
+            motion = dmp.trajectory(self.goal, start=self.start, duration=self._scale * dmp.duration_,
+                                    forcing_increment=self._forcing_increment)
+            jerk = np.gradient(motion.ydd, motion.t, axis=0)
+            tiny = 1e-12 * max(float(np.ptp(motion.y)), 1e-300)
+            self._peaks = {key: max(float(np.max(np.linalg.norm(values, axis=1))), tiny) for key, values in
+                           (("max_velocity", motion.yd), ("max_acceleration", motion.ydd), ("max_jerk", jerk))}
+        return self._peaks
 
     def _goal_complete(self) -> float:
         """The motion time (s) from which the DMP's own goal offset is complete."""

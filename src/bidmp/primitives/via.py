@@ -133,6 +133,8 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
             [goal_response[low + 1], start_response[low + 1]])
         baseline[k] += at[0] * goal + at[1] * start
     change = np.linalg.lstsq(response, points - baseline, rcond=None)[0]  # least-norm (N, D)
+    if params.settle > 1.0:  # a protocol that comes to rest at its goal (the paper's stops before it does)
+        _check_end(params, phase, basis, step, dt, change, ends, points, times)
 
     def increment(phase_in: np.ndarray, basis_in: np.ndarray) -> np.ndarray:
         added = basis_in @ change
@@ -142,6 +144,31 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     # product (Motions._prepare) and calls ``wrapped`` for the rest.
     increment.weight_change, increment.wrapped = change, forcing_increment
     return increment
+
+
+# A via-point change may move the motion's end by at most this share of its reach, and leave it moving
+# at most this share of its reach per second of its duration: the goal reached at rest, as without it.
+_END_SHARE = 1e-4
+_END_SPEED_SHARE = 1e-2
+
+
+def _check_end(params, phase: np.ndarray, basis: np.ndarray, step: float, dt: float, change: np.ndarray,
+               ends: tuple, points: np.ndarray, times: np.ndarray) -> None:
+    """Refuse a weight change that moves the motion's last sample off where it ends without it, or
+    leaves it moving there: via-points late in a motion are carried by kernels that still act at its
+    end. From the same impulse responses as the via-points (no rollout)."""
+    last = phase.shape[0] - 1
+    rows = _impulse_rows(params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)])  # samples last, last - 1
+    moved = rows @ (basis @ change)  # (2, D)
+    corners = np.vstack([ends[0], ends[1], points])
+    reach = max(float(np.max(np.linalg.norm(corners[:, None] - corners[None], axis=2))), 1e-300)
+    horizon = last * dt
+    off = float(np.linalg.norm(moved[0]))
+    speed = float(np.linalg.norm(moved[0] - moved[1])) / dt
+    if off > _END_SHARE * reach or speed > _END_SPEED_SHARE * reach / horizon:
+        raise ValueError(f"via: the kernels that carry a via-point at {times.max():g} s still act at the motion's end: "
+                         f"it would end {off:.3g} units off its goal and still moving ({speed:.3g} units/s) after "
+                         f"{horizon:.3g} s; put the via-points earlier")
 
 
 def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
