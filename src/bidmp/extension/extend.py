@@ -46,7 +46,7 @@ from .._checks import (
 )
 from .._trajectory import arclength, path_extent, resample_time
 from ..primitives.approach import STRAIGHTNESS, _straight_tail_start
-from .refine import _lifted_route, _refine_transfer, _smoothest_free_route
+from .refine import _lifted_route, _path_is_free, _refine_transfer, _smoothest_free_route
 from .roadmap import CollisionCallback, NoFreeRouteError, _check_options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
 from .timing import _time_path, _timed_transfer
@@ -324,6 +324,18 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
     return _extension(complete, y, target, points, piece, tra_gen, history, result)
 
 
+def _log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
+    """The log dimensionless jerk (Hogan & Sternad 2009), ``-ln(T⁵ / v_peak² ∫ |jerk|²)``, of
+    samples ``dt`` apart (central differences): larger is smoother, independent of size and duration."""
+    velocity = np.gradient(points, dt, axis=0)
+    jerk = np.gradient(np.gradient(velocity, dt, axis=0), dt, axis=0)
+    peak = float(np.max(np.linalg.norm(velocity, axis=1)))
+    squared = float(np.trapezoid(np.sum(jerk**2, axis=1), dx=dt))
+    if peak <= 0.0 or squared <= 0.0:
+        return np.inf
+    return float(-np.log((dt * (len(points) - 1)) ** 5 / peak**2 * squared))
+
+
 def _extension(complete, y, target, points, piece, tra_gen, history, result, **approach) -> ExtendedDemonstration:
     """The :class:`ExtendedDemonstration` both ways build (``result``: G-PRM's, or None when it
     was skipped)."""
@@ -359,18 +371,24 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
-        tra_gen, history, result, refinement = np.vstack([seg, hover]), np.empty(0), None, "straight"
+        candidates, history, result, refinement = [np.vstack([seg, hover])], np.empty(0), None, "straight"
     else:
-        result, tra_gen, refinement = _route(tra_imi, hover, seed, roadmap_options)
+        result, candidates, refinement = _route(tra_imi, hover, seed, roadmap_options)
         history = np.empty(0) if result is None else result.history
-        logger.debug("transfer: %s", refinement)
+        logger.debug("transfer: %s (%d candidates)", refinement, len(candidates))
     if scene is not None:
         hit = scene.clearance(np.vstack([hover, approach_tail]), exclude=exclude)
         if not hit.collision_free:
             raise NoFreeRouteError(f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
                                    f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
                                    f"keeps it; choose another target, or approach='paper'")
-    transfer = _timed_transfer(tra_gen, y, piece.start, start, approach_tail, dt)
+    # Each candidate route timed like the demonstration; of those still free as timed (a corner's
+    # blend moves the samples off the route), the smoothest timed transfer kept.
+    seg_sample = y[piece.start : piece.start + 1]
+    timed = [(_timed_transfer(route, y, piece.start, start, approach_tail, dt), route) for route in candidates]
+    is_free = roadmap_options.get("is_free")
+    free = [pair for pair in timed if _path_is_free(np.vstack([seg_sample, pair[0]]), is_free)] or timed
+    transfer, tra_gen = max(free, key=lambda pair: _log_dimensionless_jerk(np.vstack([seg_sample, pair[0]]), dt))
     complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
     logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
                  "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
@@ -405,9 +423,9 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
                 raise first from None
             logger.info("no free route around: over, at %.4g", route[1, 2])
             smooth = _smoothest_free_route(route, is_free)
-            return None, route if smooth is None else smooth, "lifted"
-    tra_gen, refinement = _refine_transfer(result.path, result.template, is_free)
-    return result, tra_gen, refinement
+            return None, [route] if not smooth else smooth, "lifted"
+    candidates, refinement = _refine_transfer(result.path, result.template, is_free)
+    return result, candidates, refinement
 
 
 def _roadmap_defaults() -> dict:

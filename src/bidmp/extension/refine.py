@@ -17,10 +17,14 @@ and a polyline sampled at the robot's rate has an acceleration spike at every ve
   polyline (tried before, still used for the template's sensor noise) had to keep narrow windows
   next to a post, and the tight bends it kept made the transfer around a post take three times
   as long as the free one (log dimensionless jerk -17 against the template's -10.4 in
-  ``tests/test_extension_timing.py``'s post; -10.1 to -10.7 now). Beside it, the route's offset
-  reduced to one half-sine bow (its curvature spread over the whole transfer), scaled to the least
-  that is free; the less rough of the two is kept. Every candidate is checked by the same
-  collision callback the roadmap used (with a scene: continuously, with the margin).
+  ``tests/test_extension_timing.py``'s post; -10.1 to -10.7 now). Beside it two bows from the
+  template (or the chord), each scaled to the least that is free: the route's offset reduced to one
+  half-sine bow (its curvature spread over the whole transfer), and the least-jerk bow through the
+  point where the route is furthest from the template (two quintics meeting there, flat at the
+  top: the shape of the least rough route through a clearance point). Each candidate is timed like
+  the demonstration and the one whose timed transfer is smoothest (largest log dimensionless jerk)
+  is kept (:func:`bidmp.extension.extend`). Every candidate is checked by the same collision
+  callback the roadmap used (with a scene: continuously, with the margin).
 """
 
 from __future__ import annotations
@@ -46,6 +50,7 @@ _KNOTS = (0, 1, 2, 3, 4, 6, 8, 12, 16, 24, 32)  # interior knots of the route's 
 _SHARES = (1.5, 1.25, 1.1, 1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1)
 _BISECTIONS = 4  # then between the last free share and the first blocked one
 _LONGER = 1.02  # a spline at most this much longer than the shortcut route is taken; else more knots
+_SLACK = 1.05  # a bow is widened this much beyond the least free share, where that is free
 
 
 def _path_is_free(path: np.ndarray, is_free: CollisionCallback | None) -> bool:
@@ -129,10 +134,62 @@ def _smoothest_free_route(polyline: np.ndarray, is_free: CollisionCallback | Non
         candidate = reference + free_share * offset
         length = arclength(candidate)[-1]
         if length <= _LONGER * route_length:
-            return _smoother(candidate, _bump_route(polyline, reference, is_free, route_length))
+            bows = [_bump_route(polyline, reference, is_free, route_length),
+                    _least_jerk_bow(polyline, reference, is_free, route_length)]
+            return [candidate] + [bow for bow in bows if bow is not None]
         if best is None or length < best_length:  # a bow much longer than the route: more knots, if one is free
             best, best_length = candidate, length
-    return best
+    return None if best is None else [best]
+
+
+def _least_jerk_bow(polyline: np.ndarray, reference: np.ndarray, is_free: CollisionCallback | None,
+                    route_length: float) -> np.ndarray | None:
+    """The least-jerk bow from ``reference`` through the point where the route is furthest from it:
+    two quintics in the reference's arc-length share meeting there, at the route's offset with no
+    slope across, at rest in value, slope and curvature at both ends; scaled to the least that is
+    free (bisection). None when no scale up to 3 is free or it is over 1.03 times the route's length."""
+    s = arclength(polyline)
+    u = np.linspace(0.0, 1.0, reference.shape[0])
+    offset = interp_columns(u * s[-1], s, polyline) - reference
+    size = np.linalg.norm(offset, axis=1)
+    top = int(np.argmax(size))
+    if size[top] <= 0.0 or not 0 < top < len(u) - 1:
+        return None
+    bow = np.outer(_quintic_bump(u, u[top]), offset[top])
+    blocked, free = 0.0, None
+    for share in (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0):
+        if _path_is_free(reference + share * bow, is_free):
+            free = share
+            break
+        blocked = share
+    if free is None:
+        return None
+    candidate = _slack(reference, bow, _least_free_share(reference, bow, blocked, free, is_free, 6), is_free)
+    return candidate if arclength(candidate)[-1] <= 1.03 * route_length else None
+
+
+def _quintic_bump(u: np.ndarray, apex: float) -> np.ndarray:
+    """The least-jerk profile on [0, 1] that is 1 with zero slope at ``apex`` and 0 with zero slope and
+    curvature at both ends: a quintic on each side, their curvature at the apex the least-jerk one."""
+    def piece(duration: float, curvature: float) -> np.ndarray:
+        T = duration
+        matrix = np.array([[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 2, 0, 0, 0],
+                           [1, T, T**2, T**3, T**4, T**5], [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
+                           [0, 0, 2, 6 * T, 12 * T**2, 20 * T**3]])
+        return np.linalg.solve(matrix, [0.0, 0.0, 0.0, 1.0, 0.0, curvature])
+
+    def jerk(coefficients: np.ndarray, duration: float) -> float:
+        third = np.polynomial.Polynomial([6 * coefficients[3], 24 * coefficients[4], 60 * coefficients[5]])
+        integral = (third**2).integ()
+        return float(integral(duration) - integral(0.0))
+
+    def total(curvature: float) -> float:
+        return jerk(piece(apex, curvature), apex) + jerk(piece(1.0 - apex, curvature), 1.0 - apex)
+
+    low, mid, high = total(-1.0), total(0.0), total(1.0)
+    curvature = -(high - low) / (2.0 * (high - 2.0 * mid + low))
+    left, right = np.polynomial.Polynomial(piece(apex, curvature)), np.polynomial.Polynomial(piece(1.0 - apex, curvature))
+    return np.where(u <= apex, left(np.minimum(u, apex)), right(np.maximum(1.0 - u, 0.0)))
 
 
 def _bump_route(polyline: np.ndarray, reference: np.ndarray, is_free: CollisionCallback | None,
@@ -153,8 +210,15 @@ def _bump_route(polyline: np.ndarray, reference: np.ndarray, is_free: CollisionC
         blocked = share
     if free is None:
         return None
-    candidate = reference + _least_free_share(reference, bow, blocked, free, is_free, 6) * bow
+    candidate = _slack(reference, bow, _least_free_share(reference, bow, blocked, free, is_free, 6), is_free)
     return candidate if arclength(candidate)[-1] <= 1.03 * route_length else None
+
+
+def _slack(reference: np.ndarray, bow: np.ndarray, share: float, is_free: CollisionCallback | None) -> np.ndarray:
+    """The bow at ``share`` widened by :data:`_SLACK` where that is free too: a bow at the least free
+    share has no room left, and the timing's blends at the transfer's ends move its samples a hair."""
+    wider = reference + _SLACK * share * bow
+    return wider if _path_is_free(wider, is_free) else reference + share * bow
 
 
 def _least_free_share(reference: np.ndarray, offset: np.ndarray, blocked: float, free: float,
@@ -170,43 +234,27 @@ def _least_free_share(reference: np.ndarray, offset: np.ndarray, blocked: float,
     return free
 
 
-def _smoother(route: np.ndarray, other: np.ndarray | None) -> np.ndarray:
-    """Of two free routes, the one with the smaller roughness ``L³ ∫ |p‴(s)|² ds`` (arc length s,
-    scale-free): a geometric stand-in for the timed transfer's jerk, which the timing then keeps
-    within the demonstration's peaks. Measured on 38 random posts (tools/extension_smoothness.py):
-    the jerk measure within 0.3 of the template's on 28 (24 with the spline alone)."""
-    if other is None:
-        return route
-
-    def roughness(path: np.ndarray) -> float:
-        s = arclength(path)
-        dense = interp_columns(np.linspace(0.0, s[-1], 400), s, path)
-        step = s[-1] / 399
-        return float(np.sum((np.diff(dense, 3, axis=0) / step**3) ** 2) * step * s[-1] ** 3)
-
-    return other if roughness(other) < roughness(route) else route
-
-
-def _refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCallback | None) -> tuple[np.ndarray, str]:
-    """The transfer to use in place of G-PRM's ``path`` (n, D), from seg to the new target, and how
-    it was made: ``"template"``, ``"smoothed"`` (the shortcut path, smoothed) or ``"shortcut"``
-    (the shortcut polyline, where no smoothing stays free). See the module docstring."""
+def _refine_transfer(path: np.ndarray, template: np.ndarray, is_free: CollisionCallback | None) -> tuple[list, str]:
+    """The transfers that may replace G-PRM's ``path`` (n, D), from seg to the new target (one or
+    more free candidates; the caller keeps the one whose timed transfer is smoothest), and how they
+    were made: ``"template"``, ``"smoothed"`` (the shortcut path, smoothed, and the bows) or
+    ``"shortcut"`` (the shortcut polyline, where no smoothing stays free). See the module docstring."""
     ends_match = np.allclose(template[[0, -1]], path[[0, -1]], rtol=0.0,
                              atol=1e-9 * max(float(np.ptp(path, axis=0).max()), 1.0))
     if ends_match and _path_is_free(template, is_free):
         # Smoothed too: the template is the piece scaled, and scaling a 10 mm piece of a recording
         # onto 200 mm scales its sensor noise 20-fold into kinks the timing would see as jerk.
         smooth = _smoothest_free(template, is_free)
-        return (template if smooth is None else smooth), "template"
+        return [template if smooth is None else smooth], "template"
     polyline = _shortcut(path, is_free)
     if polyline.shape[0] > 2:  # again through points along its pieces: corners cut where the vertices alone cannot
         s = arclength(polyline)
         polyline = _shortcut(interp_columns(np.linspace(0.0, s[-1], _TAUT), s, polyline), is_free)
     smooth = _smoothest_free_route(polyline, is_free, template if ends_match else None) if arclength(polyline)[-1] > 0.0 else None
-    if smooth is not None:
+    if smooth:
         return smooth, "smoothed"
     logger.debug("no smoothing of the shortcut transfer stays free: its polyline is used")
-    return polyline, "shortcut"
+    return [polyline], "shortcut"
 
 
 def _smoothest_free(polyline: np.ndarray, is_free: CollisionCallback | None) -> np.ndarray | None:

@@ -27,7 +27,7 @@ __all__ = []
 
 logger = logging.getLogger(__name__)
 
-_GROWTH = 1.05  # candidate durations grow by this factor ...
+_GROWTH = 1.01  # candidate durations grow by this factor ...
 _LONGEST = 40.0  # ... up to this multiple of the imitated piece's own duration
 _DERIVATIVE_WINDOW = 11  # samples of the local fits for the demonstration's velocity and acceleration at the joins
 _SPEED_SHARES = (1.0, 0.75, 0.5, 0.25, 0.0)  # of the end speeds along the path, tried in turn

@@ -145,7 +145,8 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
     keep_approach : bool or None, default None
         Robot protocol: complete a moved goal's offset before the final approach (the
         demonstration's straight tail into its goal, :mod:`bidmp.primitives.approach`), and start
-        it after the departure (a straight head it starts with: a lift, 5-40 % of the path), so the
+        it after the departure (a straight lift it starts with: within 45 degrees of +z, 5-40 % of
+        the path), so the
         approach and the departure under a moved goal or start are translated copies of the
         demonstrated ones (:class:`bidmp.primitives.goals.ApproachGate`; the progress gate spreads
         the offset over the whole motion and tilts both). A demonstration without a straight tail

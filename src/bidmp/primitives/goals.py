@@ -270,16 +270,25 @@ MAX_DEPARTURE_SHARE = 0.4  # of the path's length: a longer straight head is the
 MIN_TRANSFER_SHARE = 0.3  # of the path's length left between a kept departure and the kept approach
 
 
+MAX_LIFT_ANGLE = np.radians(45.0)  # a departure rises: its direction within this of straight up (+z)
+
+
 def _departure_end(demonstration: np.ndarray, approach_start: int) -> int:
-    """Where the demonstration's departure ends: its straight head, when that is 5-40 % of the path
-    and leaves at least 30 % of it before the approach (a head that is most of the way, like a
-    min-jerk leg from the start to the approach, is the transfer); 0 when it has none."""
+    """Where the demonstration's departure ends: its straight head, when that is a lift (3-D, within
+    45 degrees of straight up: off a part, not a handwriting stroke), 5-40 % of the path, and leaves
+    at least 30 % of it before the approach (a head that is most of the way, like a min-jerk leg
+    from the start to the approach, is the transfer); 0 when it has none."""
     from .approach import _straight_head_end
 
+    if demonstration.shape[1] != 3:
+        return 0
     end = _straight_head_end(demonstration)
     progress = _arclength_progress(demonstration)
     head, before = float(progress[end]), float(progress[approach_start])
     if end < 2 or head < MIN_APPROACH_SHARE or head > MAX_DEPARTURE_SHARE or before - head < MIN_TRANSFER_SHARE:
+        return 0
+    rise = demonstration[end] - demonstration[0]
+    if np.arccos(np.clip(rise[2] / max(float(np.linalg.norm(rise)), 1e-300), -1.0, 1.0)) > MAX_LIFT_ANGLE:
         return 0
     return int(end)
 
