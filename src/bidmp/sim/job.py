@@ -54,6 +54,7 @@ class _World:
     held: object = None  # the part in the tool, if any (let go where it is when a step fails)
     gone: list = field(default_factory=list)  # whole parts taken away (cells): no longer in the way
     failures: list = field(default_factory=list)  # (target, phase, image) where a motion broke the contract
+    record: bool = False  # keep each phase's measured path and commands
 
     @property
     def scene(self):
@@ -118,6 +119,8 @@ def _move(world: _World, path, fractions, exclude, name: str, *, orientations=No
                                    axis=axis, exclude=exclude, orientations=tool_frames, commands=run.commands,
                                    contacts=phase.contacts, clearance=clearance)
     phase.ok = phase.verdict.ok
+    if world.record:
+        phase.path, phase.commands = executed, np.asarray(run.commands)
     world.clock += phase.seconds
     return phase
 
@@ -550,11 +553,13 @@ def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -
                   repairer, transfers, [] if pictures else None, [] if view else None)
 
 
-def run_job(scenario, *, targets=None, report=None, progress=None, pictures: bool = False, view: bool = False) -> JobReport:
+def run_job(scenario, *, targets=None, report=None, progress=None, pictures: bool = False, view: bool = False,
+            record: bool = False) -> JobReport:
     """Run the scenario's ``"job"`` on the simulated arm at every target (or ``targets``);
     ``pictures``: keyframes of the first cycle's phases and of every phase that broke the
     contract (``JobReport.pictures``, ``JobReport.failures``); ``view``: the arm's motion over the
-    first cycle (``JobReport.motions``, for the 3-D viewer).
+    first cycle (``JobReport.motions``, for the 3-D viewer); ``record``: keep each motion's measured
+    tool path and 1 kHz joint commands on its phase (``JobPhase.path``, ``JobPhase.commands``).
 
     Returns a :class:`~bidmp.sim.job_report.JobReport`: per target and phase, the contract's
     verdict, contacts with other parts and their depth, peak joint velocity, acceleration and jerk
@@ -567,7 +572,7 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     from .pybullet.robot import robot_model, robot_placement
     from .run import _scenario_and_backend
 
-    pictures, view = check_bool(pictures, "pictures"), check_bool(view, "view")
+    pictures, view, record = check_bool(pictures, "pictures"), check_bool(view, "view"), check_bool(record, "record")
     scenario, _ = _scenario_and_backend(scenario, None)
     labels = job_targets(scenario, targets)
     if report is None:
@@ -581,6 +586,7 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
         added = {part["label"] for part in parts}
         _add_job_solids(cell, [solid for solid in scene.solids if solid.part in added])
         world = _job_world(scenario, report, cell, scene, arm, pictures, view)
+        world.record = record
         done, motions = [], {}
         for label in _order(scenario, labels):
             if progress is not None:

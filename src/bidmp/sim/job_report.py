@@ -31,6 +31,8 @@ class JobPhase:
     measured_peaks: tuple = (0.0, 0.0, 0.0)  # what the simulated joints did (10 ms differences)
     within_limits: bool = True  # every 1 kHz command within the limits, from rest to rest
     verdict: object = None  # the motion contract on what the arm did (bidmp.tasks.contract.Verdict); None: no motion
+    path: np.ndarray | None = None  # run_job(record=True): the measured tool path (n, 3), scene units
+    commands: np.ndarray | None = None  # ... and the joint commands (m, J) rad sent every 1 ms
 
     def to_dict(self) -> dict:
         return {"phase": self.name, "ok": self.ok, "seconds": round(self.seconds, 3), "note": self.note,

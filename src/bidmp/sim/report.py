@@ -49,6 +49,8 @@ class SimTarget:
     verdict: object = None  # bidmp.tasks.contract.Verdict on the executed motion and the commands
     repair: str = ""  # how the motion was repaired (empty: the method's own motion ran)
     error: str = ""  # why the motion did not run (unreachable, outside the joint limits); empty: it ran
+    path: np.ndarray | None = None  # simulate(record=True): the measured tool path (n, 3), scene units, 500 Hz
+    commands: np.ndarray | None = None  # ... and the joint commands (m, J) rad the arm was sent every 1 ms
 
     @classmethod
     def not_run(cls, label: str, error: str) -> SimTarget:

@@ -43,6 +43,7 @@ class _Job:
     orientations: np.ndarray | None = None  # (n, 4) a pose skill's tool frames
     view: bool = False  # record the arm's joint origins along the motion (the 3-D viewer's)
     repair: str = ""  # how the evaluation repaired the motion (empty: the method's own)
+    record: bool = False  # keep the measured path and the 1 kHz commands on the result
 
 
 def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
@@ -87,6 +88,8 @@ def _run_one(setup: dict, cell, contract, job):
                         contract, job.exclude)
     measured.repair = job.repair
     measured.commanded_penetration = _commanded_penetration(cell, run, job)
+    if job.record:
+        measured.path, measured.commands = run.tcp / cell.unit, np.asarray(run.commands)
     motion = _arm_motion(cell, run) if job.view else None
     return job.method, job.label, measured, run.frames, float(run.times[-1]), motion
 
@@ -145,7 +148,7 @@ def _run_chunk(setup: dict, jobs: list) -> list:
 def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, targets=None, hold: Hold | None = None,
              coupling: float | None = None, progress=None, frames: dict | None = None, report=None,
              workers: int | None = None, backend=None, avoid: bool = False, goal_update: GoalUpdate | None = None,
-             views=()) -> SimReport:
+             views=(), record: bool = False) -> SimReport:
     """Execute ``methods`` on every target of ``scenario`` on the simulated arm (the Panda, or
     the one the scenario's ``"robot"`` names).
 
@@ -182,6 +185,10 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
     views : collection of (method, label), optional
         Record the arm's joint origins along these motions every 40 ms (``SimReport.motions``,
         scene units) for the 3-D viewer (:func:`bidmp.plotting.viewer.add_robot_motions`).
+    record : bool
+        Keep on every :class:`~bidmp.sim.report.SimTarget` what the arm did: its measured tool path
+        (``path``, scene units) and the joint commands it was sent every 1 ms (``commands``, rad),
+        for a check of one's own.
     """
     from ..tasks.evaluation import evaluate
 
@@ -200,7 +207,7 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
         report = evaluate(scenario, methods, allowance=mm(TRACKING_ALLOWANCE_MM, scenario.units))
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
-    jobs = _jobs(scenario, report, methods, labels, frames or {}, _views(views))
+    jobs = _jobs(scenario, report, methods, labels, frames or {}, _views(views), check_bool(record, "record"))
     models = {name: report.fitted[name] for name in methods} if closed_loop else None
     setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
                    backend=backend, robot=arm, **_loop_options(closed_loop, avoid, goal_update))
@@ -287,14 +294,14 @@ def _commanded_penetration(cell, run, job) -> float | None:
     return max(0.0, -float(clearance.distance))
 
 
-def _jobs(scenario, report, methods, labels, frames: dict, views=()) -> list:
+def _jobs(scenario, report, methods, labels, frames: dict, views=(), record: bool = False) -> list:
     """One job per method and target: the rollout to execute, the parts it may touch, frames to
     render, whether the viewer records the arm's motion."""
     return [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
                  scenario.scene.target_parts(label, scenario.targets[label]),
                  int(frames.get((method, label), 0)),
                  None if report.methods[method].orientations is None else report.methods[method].orientations[label],
-                 view=(method, label) in views, repair=report.methods[method].repaired_at(label))
+                 view=(method, label) in views, repair=report.methods[method].repaired_at(label), record=record)
             for method in methods for label in labels]
 
 
