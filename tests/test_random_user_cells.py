@@ -206,12 +206,21 @@ def clearance(path: np.ndarray, spec: dict, exclude: set, extra=()) -> dict:
             continue
         if kind == "oriented":
             centre, rotation, half = data
+            # Only where the tool's box comes within a radius of the bracket's box (else it is further
+            # than the margin from it); there, points on the tool's surface.
+            reach = np.abs(rotation) @ half
+            gap = np.maximum(np.maximum(centre - reach - (points + [radius, radius, length]),
+                                        (points - [radius, radius, 0.0]) - (centre + reach)), 0.0)
+            near = points[np.linalg.norm(gap, axis=1) <= radius]
+            if near.shape[0] == 0:
+                found[owner] = min(found.get(owner, np.inf), float(np.linalg.norm(gap, axis=1).min()))
+                continue
             angles = np.linspace(0, 2 * np.pi, 48, endpoint=False)
             rim = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
             heights = np.linspace(0.0, length, 24)
             surface = np.array([[x, y, h] for x, y in rim for h in heights] + [[0, 0, h] for h in heights])
             best = np.inf
-            for chunk in np.array_split(points, max(1, len(points) // 500)):
+            for chunk in np.array_split(near, max(1, len(near) // 500)):
                 local = ((chunk[:, None, :] + surface[None]) - centre) @ rotation  # into the bracket's frame
                 gap = np.abs(local) - half
                 outside = np.linalg.norm(np.maximum(gap, 0.0), axis=2)
@@ -361,9 +370,8 @@ def test_the_checks_can_fail():
     neighbour = np.asarray(list(spec["targets"].values())[1])
     with pytest.raises(AssertionError, match="clearance"):
         check_clear(np.vstack([down, neighbour]), spec, {"r0c0"}, ("probe",))
-    bump = down.copy()
-    bump[-5:, 2] += np.array([0.0, 0.2, 0.4, 0.2, 0.0]) * f + 0.001 * f
-    bump[-1] = target
+    bump = np.vstack([down[:-1], target - [0.0, 0.0, 0.2 * f], target])  # 0.2 mm below, then back up
+    check_end_and_descent(np.vstack([down[:-1], target - [0.0, 0.0, 0.1 * f], target]), target, spec, ("probe",))
     with pytest.raises(AssertionError, match="rise"):
         check_end_and_descent(bump, target, spec, ("probe",))
     from bidmp.sim import PANDA

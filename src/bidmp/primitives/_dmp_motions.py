@@ -174,7 +174,9 @@ class Motions:
         via_until : float, optional
             With ``via``: only the kernels that act (99 % of their activation) before this time (s)
             change, so after it the motion returns to its own course (a lift over a part that keeps
-            the final approach and where the motion comes to rest); default every kernel.
+            the final approach and where the motion comes to rest); default every kernel. With it,
+            the motion's end is the caller's to judge (without it, via-points that would leave the
+            motion off its goal or moving at its end are refused).
 
         Returns
         -------

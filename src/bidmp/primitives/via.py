@@ -133,7 +133,10 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
             [goal_response[low + 1], start_response[low + 1]])
         baseline[k] += at[0] * goal + at[1] * start
     change = np.linalg.lstsq(response, points - baseline, rcond=None)[0]  # least-norm (N, D)
-    if params.settle > 1.0:  # a protocol that comes to rest at its goal (the paper's stops before it does)
+    # A protocol that comes to rest at its goal (the paper's stops before it does), its change free to
+    # act anywhere: a change kept before ``until`` is the caller's to judge (a repair judges the
+    # motion it makes by the motion contract).
+    if params.settle > 1.0 and until is None:
         _check_end(params, phase, basis, step, dt, change, ends, points, times)
 
     def increment(phase_in: np.ndarray, basis_in: np.ndarray) -> np.ndarray:

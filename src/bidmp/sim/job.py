@@ -325,7 +325,7 @@ def _corners(solid) -> np.ndarray:
 def _drop_point(world: _World) -> np.ndarray:
     """Where the next part is let go: over the bin, on a grid over its floor (parts dropped all at
     its centre stack into a tower once at rest, and the tower rises out of the bin)."""
-    floor, inner = world.spec.bin
+    floor, inner = world.spec.bin_floor, np.asarray(world.spec.bin[1], dtype=float)
     span = max(float(world.scene.tool.radius) * 2.0, 1e-9)
     counts = np.maximum(np.floor(inner[:2] / span).astype(int), 1)
     index = world.dropped % int(np.prod(counts))
@@ -342,7 +342,7 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     centre = _release(world)
     world.dropped += 1
     phase.seconds += RELEASE_S
-    floor, inner = world.spec.bin
+    floor, inner = world.spec.bin_floor, np.asarray(world.spec.bin[1], dtype=float)
     inside = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0) and floor[2] <= centre[2] <= floor[2] + inner[2])
     phase.note = note or ""
     if not inside:
@@ -476,7 +476,7 @@ def _job_parts(scenario, labels) -> list:
     rack's slots (its top at their height, a part's size round them)."""
     spec = scenario.job
     if spec.kind == "unscrew":
-        return _bin_parts(*spec.bin)
+        return _bin_parts(spec.bin[0], spec.bin[1], spec.bin_wall)
     first = spec.rack[0]
     corners = np.array([spec.slot(k) for k in range(len(labels))])
     parts = [s for s in scenario.scene.solids if s.label in labels]
@@ -488,16 +488,16 @@ def _job_parts(scenario, labels) -> list:
              "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), thickness]}]
 
 
-def _bin_parts(floor, inner) -> list:
-    """An open box (the bin) as five thin box parts, floor and walls 2 % of its width thick; ``at``
-    is each part's bottom centre, as the scene's parts have it (scene units)."""
-    floor, inner = np.asarray(floor, float), np.asarray(inner, float)
-    wall = max(0.02 * float(inner[:2].min()), 1e-3 * float(inner.max()))
+def _bin_parts(bottom, inner, wall: float) -> list:
+    """An open box (the bin) standing at ``bottom`` (its bottom's centre) as five thin box parts: a
+    floor slab ``wall`` thick under its whole footprint, four walls ``wall`` thick and ``inner[2]``
+    high on it; ``at`` is each part's bottom centre, as the scene's parts have it (scene units)."""
+    bottom, inner = np.asarray(bottom, float), np.asarray(inner, float)
     half = inner / 2.0
-    pieces = [(floor - [0, 0, wall], [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
-    for sign in (-1.0, 1.0):
-        pieces.append((floor + [sign * (half[0] + wall / 2), 0, 0], [wall, inner[1] + 2 * wall, inner[2]]))
-        pieces.append((floor + [0, sign * (half[1] + wall / 2), 0], [inner[0], wall, inner[2]]))
+    pieces = [(bottom, [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
+    for sign in (-1.0, 1.0):  # on the floor slab, round the inner floor
+        pieces.append((bottom + [sign * (half[0] + wall / 2), 0, wall], [wall, inner[1] + 2 * wall, inner[2]]))
+        pieces.append((bottom + [0, sign * (half[1] + wall / 2), wall], [inner[0], wall, inner[2]]))
     return [{"type": "box", "label": "bin" if k == 0 else f"bin-wall-{k}", "at": np.asarray(at, float).tolist(),
              "size": [float(v) for v in size]} for k, (at, size) in enumerate(pieces)]
 

@@ -280,11 +280,11 @@ class Repairer:
         trajectory = _trajectory(model, goal, start, skill)
         final = _final_approach_time(trajectory, goal, self.contract.approach_height, axis)
         # The weight change acts only through the kernels active before the final approach, so the
-        # motion returns to its own approach and comes to rest where it did; the points lie after the
-        # motion's first tenth (the kernels cannot move its start) and before the last fifth of the
-        # time to the approach (the motion needs it to settle back).
+        # motion returns to its own course there (the contract judges how it ends); the points lie
+        # after the motion's first tenth (the kernels cannot move its start) and before the last fifth
+        # of the time they may act in.
         earliest = 0.1 * float(trajectory.t[-1])
-        until = min(final, _motion_duration(model, goal, skill))
+        until = max(min(final, _motion_duration(model, goal, skill)), 2.0 * earliest)
         latest = until - 0.2 * (until - earliest)
         via: dict = {}
         band = scene.margin + scene.tool.radius  # the tool's mouth this close to a part's box is near it
