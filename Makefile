@@ -71,6 +71,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_lasa.py
 	$(PY) benchmarks/bench_avoidance.py --fields 10
 	$(PY) benchmarks/bench_job.py
+	$(PY) benchmarks/bench_repair.py
 
 # The 3-D viewer of a simulation run rendered in headless Chromium (Debian's package chromium:
 # apt install chromium), offline, and its screenshot checked not to be blank (tools/view_check.py).
@@ -89,10 +90,17 @@ readme: $(STAMP)
 	$(VENV)/bin/bidmp sim --out .readme-out/sim > /dev/null
 	$(VENV)/bin/bidmp job --out .readme-out/job > /dev/null
 	$(VENV)/bin/bidmp job --scenario cell-removal --no-pictures --out .readme-out/cells > /dev/null
+	$(VENV)/bin/bidmp job --scenario nut-unscrewing-xarm6 --no-pictures --out .readme-out/xarm6 > /dev/null
+	$(VENV)/bin/bidmp job --scenario nut-unscrewing-ur5 --no-pictures --out .readme-out/ur5 > /dev/null
+	$(PY) tools/user_cells.py --out .readme-out/user_cells.md > /dev/null
+	$(PY) tools/repair_order.py --out .readme-out/repair_order.md > /dev/null
 	cp .readme-out/table4.md .readme-out/tasks.md .readme-out/table5.md .readme-out/figures.md .readme-out/sim/sim.md docs/results/
 	cp .readme-out/job/job.md .readme-out/job/job_results.json docs/results/
 	cp .readme-out/cells/job.md docs/results/job_cells.md
 	cp .readme-out/cells/job_results.json docs/results/job_cells_results.json
+	cp .readme-out/xarm6/job.md docs/results/job_xarm6.md
+	cp .readme-out/ur5/job.md docs/results/job_ur5.md
+	cp .readme-out/user_cells.md .readme-out/repair_order.md docs/results/
 	cp .readme-out/sim/sim_keyframes_bidmp.png docs/sim_keyframes_bidmp.png
 	cp .readme-out/job/job_cycle.png docs/job_cycle.png
 	rm -rf .readme-out

@@ -91,6 +91,31 @@ def test_a_late_update_is_blended_over_the_limits_and_said_to_tilt_the_approach(
         stepper.set_goal(dmp.goal_, blend=-1.0)
 
 
+def test_a_goal_moved_after_the_goal_share_is_complete_without_limits_is_blended_not_jumped():
+    """A goal moved 5 mm at 95 % of the motion, no limits given (the command jumped 5 mm in one 1 ms
+    step before): the offset is blended within a quarter of the motion's own peaks (measured here on
+    the commands: speed, acceleration), never in zero time, and the new goal is reached at rest."""
+    demonstration = minimum_jerk([[0, 0, 100], [200, 0, 100], [200, 0, 0]], 400)
+    dmp = DMP().fit(demonstration, np.linspace(0, 4, 400))
+    own = dmp.trajectory(dt=0.001)
+    own_speed, own_acceleration = (np.linalg.norm(own.yd, axis=1).max(), np.linalg.norm(own.ydd, axis=1).max())
+    stepper = dmp.stepper()
+    commands = []
+    for step in range(12000):
+        if step == int(0.95 * 4000):
+            blend = stepper.set_goal(dmp.goal_ + [5.0, 0.0, 0.0])
+        commands.append(stepper.step(0.001))
+    assert blend > 0.0
+    y = np.array([c[0] for c in commands])
+    offset = y[int(0.95 * 4000):] - np.array([c[0] for c in commands])[int(0.95 * 4000)]
+    speed = np.linalg.norm(np.diff(y, axis=0), axis=1) / 0.001
+    assert speed.max() <= own_speed * (1 + 1e-6) + 0.25 * own_speed  # the motion's own plus a quarter
+    assert np.linalg.norm(np.diff(y[-3:], axis=0)) <= 1e-9 and np.linalg.norm(y[-1] - (dmp.goal_ + [5, 0, 0])) <= 1e-3
+    acceleration = np.linalg.norm(np.diff(y, n=2, axis=0), axis=1) / 0.001**2
+    assert acceleration[int(0.95 * 4000):].max() <= 1.3 * own_acceleration
+    assert offset.shape[0] > 0
+
+
 def test_the_blends_peak_derivatives_are_the_constants_used():
     u = np.linspace(0.0, 1.0, 400001)
     first, second = _smoothstep_derivatives(u)

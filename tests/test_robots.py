@@ -146,3 +146,102 @@ def test_the_iiwa_runs_the_nut_job(iiwa):
     report = run_job(iiwa, targets=["3", "12"])
     assert report.robot == "iiwa" and report.removed == 2
     assert all(not target.contacts and target.within_limits for target in report.targets)
+
+
+# --- arms of six joints ---------------------------------------------------------------------
+def dh_forward(q) -> np.ndarray:
+    """Independent oracle: the UR5's flange pose (4, 4) from Universal Robots' published classic DH
+    table, the product Rz(theta) Tz(d) Tx(a) Rx(alpha) written out here (not read from the URDF)."""
+    table = ((0.089159, 0.0, np.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
+             (0.10915, 0.0, np.pi / 2), (0.09465, 0.0, -np.pi / 2), (0.0823, 0.0, 0.0))
+    pose = np.eye(4)
+    for (d, a, alpha), theta in zip(table, q):
+        ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+        pose = pose @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
+    return pose
+
+
+def test_the_ur5_urdf_is_its_published_dh_kinematics():
+    """Independent oracle: PyBullet's forward kinematics of the written URDF against the DH product
+    for 50 random joint vectors, the flange's position to 1 µm and its frame to 1e-6; and the file is
+    the one the tool writes (structure guard)."""
+    import sys
+    from pathlib import Path
+
+    p = sim.pybullet.world._pybullet_module()
+    urdf = sim.UR5_MODEL.urdf if hasattr(sim, "UR5_MODEL") else sim.ROBOT_MODELS["ur5"].urdf
+    tools = Path(__file__).resolve().parents[1] / "tools"
+    sys.path.insert(0, str(tools))
+    try:
+        import ur5_urdf
+    finally:
+        sys.path.remove(str(tools))
+    assert Path(urdf).read_text() == ur5_urdf.urdf()
+    client = p.connect(p.DIRECT)
+    try:
+        robot = p.loadURDF(urdf, useFixedBase=True, physicsClientId=client)
+        names = [p.getJointInfo(robot, j, physicsClientId=client)[12].decode() for j in range(p.getNumJoints(robot, physicsClientId=client))]
+        flange = names.index("flange")
+        rng = np.random.default_rng(0)
+        for _ in range(50):
+            q = rng.uniform(-np.pi, np.pi, 6)
+            for joint in range(6):
+                p.resetJointState(robot, joint, q[joint], physicsClientId=client)
+            state = p.getLinkState(robot, flange, computeForwardKinematics=1, physicsClientId=client)
+            expected = dh_forward(q)
+            np.testing.assert_allclose(state[4], expected[:3, 3], atol=1e-6)
+            np.testing.assert_allclose(np.array(p.getMatrixFromQuaternion(state[5])).reshape(3, 3), expected[:3, :3], atol=1e-6)
+    finally:
+        p.disconnect(client)
+
+
+def test_six_axis_inverse_kinematics_puts_the_tool_where_asked_by_an_independent_forward_model():
+    """Independent oracle: the UR5's IK (the tool pointing down, full pose) along a path, each
+    solution's flange checked by the DH product: the tool's mouth on the point to 0.05 mm, pointing
+    straight down, every joint within its limits."""
+    points = np.array([[0.45, 0.1, 0.25], [0.5, -0.05, 0.12], [0.38, 0.2, 0.3]])
+    joints = sim.inverse_kinematics(points, "ur5", units="m", tool_length=0.1)
+    assert joints.shape == (3, 6)
+    for q, point in zip(joints, points):
+        flange = dh_forward(q)
+        mouth = flange[:3, 3] + flange[:3, 2] * 0.1  # the tool along the flange's z
+        assert np.linalg.norm(mouth - point) <= 5e-5
+        assert flange[2, 2] <= -1 + 1e-6  # pointing down
+        assert np.all(np.abs(q) <= 2 * np.pi)
+
+
+@pytest.mark.parametrize("arm", ["xarm6", "ur5"])
+def test_a_six_axis_arm_takes_a_far_nut_off_within_its_limits(arm):
+    """The built-in nut task on the 6-axis arms (the whole 14-nut job: make readme's job_xarm6.md and
+    job_ur5.md): the furthest nut, every phase within the contract and the arm's published limits."""
+    scenario = scenarios.load(f"nut-unscrewing-{arm}")
+    report = sim.run_job(scenario, targets=["12"])
+    record = report.targets[0]
+    assert report.robot == arm and record.removed and record.within_limits and not record.contacts, record.reason
+    assert len(sim.joint_names(arm)) == 6
+
+
+def test_a_six_joint_urdf_with_seven_limits_names_the_arm_and_its_joints(tmp_path):
+    limits = {"lower": [-6.0] * 7, "upper": [6.0] * 7, "velocity": [3.0] * 7, "acceleration": [15.0] * 7}
+    spec = nut_spec(urdf="xarm/xarm6_robot.urdf", flange="link6", limits=limits, base=[50, -400, 0])
+    with pytest.raises(ValueError, match=r"robot 'xarm6_robot' has 6 movable joints up to its flange 'link6'; the "
+                                         r"simulator drives its 7 limits"):
+        sim.simulate(scenarios.from_dict(spec), ["bidmp"], targets=["3"], workers=1)
+    spec["robot"]["limits"]["velocity"] = [3.0] * 6
+    with pytest.raises(ScenarioError, match=r"robot.limits.velocity.*expected 7 numbers, one per joint"):
+        scenarios.from_dict(spec)
+
+
+def test_joint_limits_and_the_robot_for_a_six_joint_model(tmp_path, capsys):
+    """A 6-joint recording (the UR5's joints along a path): --joint-limits ur5 times it to the UR5's
+    limits; a 7-joint arm's limits are refused naming both counts; the JointTrajectory after IK
+    carries the UR5's six joints."""
+    points = np.column_stack([np.linspace(0.4, 0.5, 60), np.linspace(0.0, 0.1, 60), np.full(60, 0.2)])
+    q = sim.inverse_kinematics(points, "ur5", units="m")
+    names = sim.joint_names("ur5")
+    table = np.column_stack([np.linspace(0.0, 2.0, 60), q])
+    (tmp_path / "q.csv").write_text("t," + ",".join(names) + "\n" + "\n".join(",".join(f"{v:.9g}" for v in row) for row in table))
+    assert main(["fit", str(tmp_path / "q.csv"), "-o", str(tmp_path / "q.npz")]) == 0
+    assert main(["rollout", str(tmp_path / "q.npz"), "--joint-limits", "ur5", "-o", str(tmp_path / "r.csv")]) == 0
+    assert main(["rollout", str(tmp_path / "q.npz"), "--joint-limits", "panda", "-o", str(tmp_path / "r.csv")]) == 2
+    assert "that arm has 7 joints; this model has 6 dimensions" in capsys.readouterr().err

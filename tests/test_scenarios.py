@@ -16,7 +16,8 @@ def nut_spec():
 
 
 def test_builtins_load_and_have_the_spec_geometry():
-    assert scenarios.builtin_names() == ["cell-removal", "nut-unscrewing", "nut-unscrewing-iiwa", "nut-unscrewing-tilted", "pick-and-place"]
+    assert scenarios.builtin_names() == ["cell-removal", "nut-unscrewing", "nut-unscrewing-iiwa", "nut-unscrewing-tilted",
+                                        "nut-unscrewing-ur5", "nut-unscrewing-xarm6", "pick-and-place"]
     nut = scenarios.load("nut-unscrewing")
     assert len(nut.targets) == 14 and nut.demonstrated == "3"
     np.testing.assert_array_equal(nut.targets["3"], [0, 0, 0])

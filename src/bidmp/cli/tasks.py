@@ -19,9 +19,10 @@ def _run_scenario(scenario, out, methods=None, view=False):
 
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
-        def progress(method):  # called as each method starts
-            bar.set_postfix_str(method)
-            bar.update(1)
+        def progress(step):  # each method as it starts, each repair as it is tried ("bidmp: repair 12")
+            bar.set_postfix_str(step)
+            if step in names:
+                bar.update(1)
 
         report = evaluate(scenario, names, progress=progress)
     print()

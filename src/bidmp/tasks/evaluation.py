@@ -277,7 +277,9 @@ def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, 
         repairs[label] = fixed
         if fixed.how:
             rollouts[label] = fixed.motion
-    repaired = result(outcome.name, [rollouts[label] for label in labels], outcome.runtime_s)
+    verdicts = dict(outcome.verdicts)  # the repaired motions' verdicts are the repairs' own
+    verdicts.update({label: fixed.verdict for label, fixed in repairs.items() if fixed.how})
+    repaired = result(outcome.name, [rollouts[label] for label in labels], outcome.runtime_s, verdicts)
     repaired.repairs = repairs
     return repaired
 
@@ -308,14 +310,17 @@ def _results_builder(scenario, labels, geometry: bool):
                   for label in labels}
     excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
 
-    def result(name, rollouts, seconds):
+    def result(name, rollouts, seconds, known=None):
+        """``known``: verdicts already reached (label -> Verdict), not judged again."""
         rollouts = dict(zip(labels, rollouts))
         positions = {label: rollout[:, :3] if poses else rollout for label, rollout in rollouts.items()}
         orientations = {label: rollout[:, 3:] for label, rollout in rollouts.items()} if poses else None
-        verdicts = {label: contract.judge(positions[label], scenario.targets[label], label=label,
-                                          axis=scenario.target_axis(label), exclude=excluded.get(label, ()),
-                                          orientations=None if orientations is None else orientations[label],
-                                          applies=scene is not None and scene.applies_to(label))
+        known = known or {}
+        verdicts = {label: known[label] if label in known else
+                    contract.judge(positions[label], scenario.targets[label], label=label,
+                                   axis=scenario.target_axis(label), exclude=excluded.get(label, ()),
+                                   orientations=None if orientations is None else orientations[label],
+                                   applies=scene is not None and scene.applies_to(label))
                     for label in labels}
         errors = {label: verdict.end_error for label, verdict in verdicts.items()}
         approach = None if contract.approach_height is None else \

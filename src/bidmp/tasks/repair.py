@@ -207,7 +207,8 @@ class Repairer:
                 continue
             started = time.perf_counter()
             try:
-                found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried)
+                found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried,
+                                  verdict.clearance if motion is out.motion and how == "lift" else None)
             except ValueError as exc:  # a via-point refused, an avoidance miss, no free route ...
                 out.attempts.append(Attempt(how, False, time.perf_counter() - started, _first_line(exc)))
                 continue
@@ -228,11 +229,13 @@ class Repairer:
         """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP)."""
         return hasattr(model, "weights_") and hasattr(model, "n_steps_")
 
-    def _try(self, how, model, goal, label, start, axis, exclude, skill, shortfall, carried=None):
-        """``(motion, model, skill, verdict on the planning contract)`` of one repair."""
+    def _try(self, how, model, goal, label, start, axis, exclude, skill, shortfall, carried=None, known=None):
+        """``(motion, model, skill, verdict on the planning contract)`` of one repair (``known``: the
+        method's own motion's clearance, where it has one: the lift's first round)."""
         if how == "lift":
-            motion = self._lift(model, goal, label, start, axis, exclude, skill, carried)
-            return motion, None, None, self._judge(self.planning, motion, goal, label, axis, exclude, carried)
+            motion, clearance = self._lift(model, goal, label, start, axis, exclude, skill, carried, known)
+            return motion, None, None, self.planning.judge(motion, goal, label=label, axis=axis, exclude=exclude,
+                                                           clearance=clearance)
         if how == "avoid":
             from ..primitives.avoidance import SceneAvoidance
 
@@ -271,7 +274,7 @@ class Repairer:
         trial.learn(extension.complete, duration=extension.duration_for(dmp) * scale)
         return trial, trial.n_skills - 1
 
-    def _lift(self, model, goal, label, start, axis, exclude, skill, carried=None):
+    def _lift(self, model, goal, label, start, axis, exclude, skill, carried=None, known=None):
         """The motion raised over the parts it comes too close to by exact via-points: each round,
         the stretch of the motion that passes the nearest part (by its bounding box) before the
         final approach is lifted to over the part's top, by up to :data:`_STRETCH` points spread
@@ -288,10 +291,13 @@ class Repairer:
         latest = until - 0.2 * (until - earliest)
         via: dict = {}
         band = scene.margin + scene.tool.radius  # the tool's mouth this close to a part's box is near it
-        for _ in range(_MAX_ROUNDS):
-            clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
+        for round_ in range(_MAX_ROUNDS):
+            if round_ == 0 and known is not None and not carried:  # the same motion: its distances are known
+                clearance = type(known)(known.distance, known.part, known.point, scene.margin)
+            else:
+                clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
             if clearance.clear:
-                return trajectory.y
+                return trajectory.y, clearance
             owner = _owner(scene, clearance.part)
             path = trajectory.y[:, :3]
             height = _depth(carried)
@@ -306,8 +312,9 @@ class Repairer:
                 point[2] = max(point[2], top)
                 via[round(float(trajectory.t[index]), 12)] = point
             trajectory = _trajectory(model, goal, start, skill, via=sorted(via.items()), via_until=until)
-        if self._clearance(scene, trajectory.y[:, :3], exclude, carried).clear:
-            return trajectory.y
+        clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
+        if clearance.clear:
+            return trajectory.y, clearance
         raise ValueError(f"{_MAX_ROUNDS} rounds of via-points did not lift it clear of the parts")
 
     @staticmethod
