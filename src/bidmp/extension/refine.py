@@ -155,17 +155,7 @@ def _least_jerk_bow(polyline: np.ndarray, reference: np.ndarray, is_free: Collis
     top = int(np.argmax(size))
     if size[top] <= 0.0 or not 0 < top < len(u) - 1:
         return None
-    bow = np.outer(_quintic_bump(u, u[top]), offset[top])
-    blocked, free = 0.0, None
-    for share in (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0):
-        if _path_is_free(reference + share * bow, is_free):
-            free = share
-            break
-        blocked = share
-    if free is None:
-        return None
-    candidate = _slack(reference, bow, _least_free_share(reference, bow, blocked, free, is_free, 6), is_free)
-    return candidate if arclength(candidate)[-1] <= 1.03 * route_length else None
+    return _least_free_bow(reference, np.outer(_quintic_bump(u, u[top]), offset[top]), is_free, route_length)
 
 
 def _quintic_bump(u: np.ndarray, apex: float) -> np.ndarray:
@@ -202,6 +192,13 @@ def _bump_route(polyline: np.ndarray, reference: np.ndarray, is_free: CollisionC
     u = np.linspace(0.0, 1.0, reference.shape[0])
     offset = interp_columns(u * s[-1], s, polyline) - reference
     bow = np.outer(np.sin(np.pi * u), offset.T @ np.sin(np.pi * u) / np.sum(np.sin(np.pi * u) ** 2))
+    return _least_free_bow(reference, bow, is_free, route_length)
+
+
+def _least_free_bow(reference: np.ndarray, bow: np.ndarray, is_free: CollisionCallback | None,
+                    route_length: float) -> np.ndarray | None:
+    """``reference + share * bow`` for the least free ``share`` up to 3 (a coarse search, then
+    bisection, then the slack), or None when none is free or it is over 1.03 times the route's length."""
     blocked, free = 0.0, None
     for share in (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0):
         if _path_is_free(reference + share * bow, is_free):

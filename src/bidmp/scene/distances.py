@@ -66,18 +66,9 @@ class _Distances:
         self.result = coal.DistanceResult()
         self.tool = coal.Cylinder(tool.radius, tool.length)
         self.tool_offset = np.array([0.0, 0.0, tool.length / 2.0])
-        self.shapes = []
-        for solid in solids:
-            if solid.kind == "box":
-                shape = coal.Box(*solid.params)
-            elif solid.kind == "cylinder":
-                shape = coal.Cylinder(*solid.params)
-            else:
-                vertices = coal.StdVec_Vec3s()
-                for vertex in solid.params[0]:
-                    vertices.append(np.asarray(vertex, dtype=float))
-                shape = coal.Convex.convexHull(vertices, False, "")
-            self.shapes.append((shape, coal.Transform3s(np.asarray(solid.rotation, dtype=float), np.asarray(solid.centre, dtype=float))))
+        self.shapes = [(self.shape_of(solid), coal.Transform3s(np.asarray(solid.rotation, dtype=float),
+                                                               np.asarray(solid.centre, dtype=float)))
+                       for solid in solids]
         self.identity = np.eye(3)
 
     def tool_to(self, point: np.ndarray, index: int, rotation: np.ndarray | None = None) -> float:
@@ -138,8 +129,7 @@ class _Distances:
         return self._fallbacks
 
     def shape_of(self, solid):
-        """A coal shape for ``solid`` (a part's solid that moves: one the tool carries) and its
-        centre and rotation."""
+        """The coal shape of ``solid`` in its own frame (box, cylinder or convex hull of its vertices)."""
         coal = self.coal
         if solid.kind == "box":
             shape = coal.Box(*solid.params)

@@ -1,4 +1,4 @@
-"""Scenario evaluation: every method on every target of a scenario (SPEC §9, report JSON of §10).
+"""Scenario evaluation: every method on every target of a scenario, judged by the motion contract.
 
 ``evaluate(scenario, methods)`` returns a :class:`Report`; ``report.to_dict()`` is the JSON the
 CLI writes, ``report.summary()`` the tables it prints, and :func:`write_report` writes the
@@ -211,7 +211,7 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True, repai
     Returns
     -------
     Report
-        ``report.to_dict()`` is the JSON of SPEC §10; ``report.fitted`` holds each method's model.
+        ``report.to_dict()`` is its JSON (``results.json``); ``report.fitted`` holds each method's model.
     """
     from . import methods as registry
     from . import scenarios as scenario_module

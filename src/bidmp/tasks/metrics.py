@@ -1,4 +1,4 @@
-"""Metrics of generated trajectories (SPEC §9), in the trajectories' own length unit.
+"""Metrics of generated trajectories (end error, approach error, axis deviation), in the trajectories' own length unit.
 
 RMSE and extent live in the private helper module ``bidmp._trajectory`` and are re-exported here
 for users.
@@ -68,7 +68,7 @@ def final_approach_mask(heights: np.ndarray, height: float, rise: float | None =
 
 
 def approach_error(trajectory, target, height: float, axis=None, rise: float | None = None) -> float:
-    """Largest distance from the target's axis over the final approach (SPEC §9, issue 21.6): the
+    """Largest distance from the target's axis over the final approach: the
     motion's final descent along the axis from ``height`` above the target into it
     (:func:`final_approach_mask`). ``inf`` when the motion has no such descent: a pass through the
     band, a lift, or a motion that never comes down from above does not engage.

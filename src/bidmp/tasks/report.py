@@ -1,5 +1,5 @@
 """What :func:`bidmp.tasks.evaluation.evaluate` returns: one :class:`MethodResult` per method and
-the :class:`Report` over them (the report JSON of SPEC §10, its tables and summary), and
+the :class:`Report` over them (the report JSON, its tables and summary), and
 :func:`write_report`, which writes the JSON and the figures."""
 
 from __future__ import annotations
@@ -177,7 +177,7 @@ class Report:
     forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
 
     def to_dict(self) -> dict:
-        """The report JSON of SPEC §10 (plus the extension and forgetting details)."""
+        """The report JSON: per method its counts and per target its verdict (plus the extension and forgetting details)."""
         out = {
             "scenario": self.scenario.name,
             "units": self.scenario.units,

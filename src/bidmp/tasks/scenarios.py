@@ -1,4 +1,4 @@
-"""Scenario files: a task as JSON (SPEC §9–10), validated strictly, with built-in scenarios.
+"""Scenario files: a task as JSON, validated strictly, with built-in scenarios.
 
 A scenario names the targets (labelled points), the demonstration and which target it shows, the
 success threshold, the DMP parameters and how Bi-DMP extends the skill. Unknown keys, wrong types,
@@ -166,7 +166,7 @@ class Scenario:
 
     def reference(self, label: str) -> np.ndarray:
         """A reference demonstration to target ``label`` "produced by the same generator"
-        (SPEC §9): its own demonstration if one is given, else the demonstration generator with
+        (the paper's protocol): its own demonstration if one is given, else the demonstration generator with
         its via points moved by the target offset, else the demonstration translated."""
         if label in self.demonstrations:
             return self.demonstrations[label]
