@@ -41,7 +41,7 @@ def test_augment_keeps_ends_and_adds_copies(approach):
 
 
 def test_gmm_reproduces_its_demonstration_but_cannot_move(approach):
-    mean, cov = GMMRegressor().fit(approach).generate()
+    mean, cov = GMMRegressor().fit(approach).rollout(return_covariance=True)
     assert mean.shape == (200, 3) and cov.shape == (200, 3, 3)
     assert np.linalg.norm(mean[-1] - approach[-1]) < 1.75
     assert np.sqrt(np.mean(np.sum((mean - approach) ** 2, axis=1))) < 3.0
@@ -50,12 +50,12 @@ def test_gmm_reproduces_its_demonstration_but_cannot_move(approach):
 def test_tpgmm_is_translation_equivariant_and_halfway_with_one_demonstration(approach):
     model = TPGMM().fit(approach)
     start, target = approach[0], approach[-1]
-    base, _ = model.generate(start, target)
+    base, _ = model.rollout(target, start=start, return_covariance=True)
     assert np.linalg.norm(base[-1] - target) < 1.75
     shift = np.array([25.0, -40.0, 10.0])
-    moved, _ = model.generate(start + shift, target + shift)
+    moved, _ = model.rollout(target + shift, start=start + shift, return_covariance=True)
     np.testing.assert_allclose(moved, base + shift, atol=1e-8)
     # One demonstration: both frames are equally sure, so the product lands halfway.
     new_target = target + np.array([100.0, 0.0, 0.0])
-    end = model.generate(start, new_target)[0][-1]
+    end = model.rollout(new_target, start=start)[-1]
     assert 0.35 < np.linalg.norm(end - new_target) / 100.0 < 0.65

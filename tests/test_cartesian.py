@@ -303,7 +303,7 @@ def test_a_multi_turn_skill_keeps_its_turns_for_a_new_start_and_goal():
     goal[3:] = (Rotation.from_rotvec(np.radians(20) * axis) * Rotation.from_quat(poses[-1, 3:])).as_quat()
     start = poses[0].copy()
     start[3:] = (Rotation.from_rotvec(np.radians(-15) * axis) * Rotation.from_quat(poses[0, 3:])).as_quat()
-    moved = model.trajectory(goal, start)
+    moved = model.trajectory(goal, start=start)
     assert np.degrees(angle_between(moved.q[-1:], goal[None, 3:]))[0] <= 0.1
     assert turned_angle(moved.q) == pytest.approx(720 + 20 + 15, abs=1.0)  # the same two turns, plus the offsets
 

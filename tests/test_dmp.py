@@ -52,7 +52,7 @@ def test_rollout_equals_plain_euler_loop(params, demo3d):
     rng = np.random.default_rng(3)
     goal, start, velocity = rng.normal(size=(3, 3))
     for n_steps in (1, 2, 3, 50, dmp.n_steps_, 3 * dmp.n_steps_):
-        fast = dmp.rollout(goal, start, n_steps=n_steps, start_velocity=velocity)
+        fast = dmp.rollout(goal, start=start, n_steps=n_steps, start_velocity=velocity)
         slow = euler_reference(dmp, goal, start, n_steps, velocity)
         assert fast.shape == (n_steps, 3)
         np.testing.assert_allclose(fast, slow, rtol=0, atol=1e-9 * (1 + np.abs(slow).max()))
@@ -104,8 +104,8 @@ def test_rollout_is_affine_in_goal_and_start(demo2d):
     rng = np.random.default_rng(0)
     g1, g2, s1, s2 = rng.normal(size=(4, 2))
     lam = 0.3
-    mixed = dmp.rollout(lam * g1 + (1 - lam) * g2, lam * s1 + (1 - lam) * s2)
-    np.testing.assert_allclose(mixed, lam * dmp.rollout(g1, s1) + (1 - lam) * dmp.rollout(g2, s2), atol=1e-12)
+    mixed = dmp.rollout(lam * g1 + (1 - lam) * g2, start=lam * s1 + (1 - lam) * s2)
+    np.testing.assert_allclose(mixed, lam * dmp.rollout(g1, start=s1) + (1 - lam) * dmp.rollout(g2, start=s2), atol=1e-12)
 
 
 @pytest.mark.parametrize("n_steps", [None, 37, 2000])
@@ -115,7 +115,7 @@ def test_rollout_many_equals_looped_rollout(demo3d, n_steps):
     goals = rng.normal(scale=2.0, size=(25, 3))
     start = rng.normal(size=3)
     many = dmp.rollout_many(goals, start=start, n_steps=n_steps)
-    looped = np.stack([dmp.rollout(g, start, n_steps=n_steps) for g in goals])
+    looped = np.stack([dmp.rollout(g, start=start, n_steps=n_steps) for g in goals])
     assert many.shape == looped.shape
     np.testing.assert_allclose(many, looped, rtol=0, atol=1e-9)
 

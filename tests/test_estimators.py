@@ -33,8 +33,8 @@ def output(model):
     if isinstance(model, (DMP, BiDMP)):
         return model.rollout()
     if isinstance(model, TPGMM):
-        return model.generate(np.zeros(3), np.ones(3))[0]
-    return model.generate()[0]
+        return model.rollout(np.ones(3), start=np.zeros(3))
+    return model.rollout()
 
 
 @pytest.mark.parametrize("cls, params", ESTIMATORS, ids=lambda v: getattr(v, "__name__", ""))

@@ -345,6 +345,7 @@ def test_a_writer_killed_mid_write_leaves_nothing_the_next_write_keeps(tmp_path)
     assert len(temporaries) == 1  # recognisably named
     process.send_signal(signal.SIGKILL)
     process.wait()
+    process.stdout.close()
     assert load_trajectory(target).shape == (50, 2)  # the old file is intact
     # A live writer's temporary (this process's pid) must survive the clean-up.
     live = tmp_path / f".out.npy.{os.getpid()}.abcdef.bidmp-tmp"

@@ -96,7 +96,7 @@ def test_the_initial_acceleration_does_not_depend_on_the_goal_or_the_start(fitte
     reference = dmp.trajectory().ydd[0]
     scale = max(np.linalg.norm(reference), 1.0)
     for goal, start in ((dmp.goal_ + SHIFT, None), (dmp.goal_ - 2 * SHIFT, None), (None, dmp.start_ + [30.0, -20.0, 10.0])):
-        moved = dmp.trajectory(goal, start)
+        moved = dmp.trajectory(goal, start=start)
         assert np.linalg.norm(moved.ydd[0] - reference) <= 1e-9 * scale
 
 

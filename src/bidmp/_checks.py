@@ -22,6 +22,7 @@ from numbers import Integral, Real
 import numpy as np
 
 __all__ = [
+    "printable",
     "NotFittedError",
     "MissingExtraError",
     "require_extra",
@@ -170,10 +171,16 @@ def check_bytes(n_elements, what: str, itemsize: int = 8) -> None:
         raise ValueError(f"{what} would take {n_bytes / 2**30:.3g} GiB, over {_limit_hint('max_array_bytes')}")
 
 
+def printable(text) -> str:
+    """``text`` with every character that is not printable (a terminal escape, a control code) shown
+    as '?': what a name read from a file may be shown as, in a message, a terminal or a figure."""
+    return "".join(c if c.isprintable() else "?" for c in str(text))
+
+
 def short_token(value, width: int = 10) -> str:
     """A rejected value quoted for an error message: at most ``width`` characters, printable only
     (a file read by mistake must not be echoed into a terminal or a log)."""
-    text = "".join(c if c.isprintable() else "?" for c in str(value)[: width + 1])
+    text = printable(str(value)[: width + 1])
     return repr(text[:width] + "…") if len(text) > width else repr(text)
 
 
@@ -441,7 +448,7 @@ def check_path(value, name: str = "path"):
 
 def shown_path(path, width: int = 60) -> str:
     """A path for a message: its last ``width`` characters (the file name is what tells)."""
-    text = "".join(c if c.isprintable() else "?" for c in str(path))
+    text = printable(path)
     return text if len(text) <= width else "…" + text[-(width - 1):]
 
 

@@ -47,7 +47,7 @@ def allow_outside_files(parser, shown: bool = True) -> None:
 def one_line(text: str) -> str:
     """One printable line: whitespace runs collapsed, control characters (a file name or argument
     may carry terminal escapes) shown as '?', at most MAX_MESSAGE characters."""
-    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))
+    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))  # no NumPy import here
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 1] + "…"
 
 

@@ -14,13 +14,12 @@ import json
 import logging
 import os
 import zipfile
-from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_limit, check_path, get_limits, short_token
-from ._npy import _EMPTY_ZIP_MAGIC, _NPY_MAGIC, _ZIP_MAGIC, _read_npy, _read_npy_header
+from .._checks import check_path, short_token
+from ._npy import NpzMembers, read_npz
 from .atomic import _destination, atomic_write
 from .strict_json import load_json
 
@@ -41,7 +40,6 @@ _MIN_VERSION = {"BiDMP": 2}
 _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
 _META_MAX_BYTES = 16 << 20
-_MAX_MEMBERS = 100_000
 # Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
 # reading a DMP does not import the whole pipeline.
 _MODEL_CLASSES = {
@@ -109,62 +107,8 @@ def save_model(model, path: str | os.PathLike) -> Path:
     return path
 
 
-class _Members(Mapping):
-    """The arrays of an open model archive, read lazily: a member is decompressed and parsed
-    only when a model class asks for it, after its ``.npy`` header passed the size limits."""
-
-    def __init__(self, archive: zipfile.ZipFile, source: str) -> None:
-        self._archive = archive
-        self._source = source
-        self._infos = {info.filename[:-4]: info for info in archive.infolist() if info.filename.endswith(".npy")}
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        info = self._infos.get(name)
-        if info is None:
-            raise KeyError(f"missing member {name}")
-        try:
-            return _read_npy(lambda: self._archive.open(info), f"member {name}")
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
-            message = str(exc) if str(exc).startswith("member ") else f"member {name} is unreadable ({type(exc).__name__}: {exc})"
-            raise ValueError(message) from None
-
-    def __iter__(self):
-        return (name for name in self._infos if name != _META_KEY)
-
-    def __len__(self) -> int:
-        return sum(1 for _ in self)
-
-
-def _check_archive(archive: zipfile.ZipFile, path: Path) -> None:
-    """Refuse archives numpy wrote no part of: encrypted or unusually compressed members,
-    declared sizes over the limits, absurd member counts."""
-    infos = archive.infolist()
-    if len(infos) > _MAX_MEMBERS:
-        raise ModelFileError(f"{path} is not a bidmp model file ({len(infos):,} archive members)")
-    budget = get_limits().max_array_bytes + (64 << 10)
-    for info in infos:
-        if info.flag_bits & 0x1:
-            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} is encrypted)")
-        if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
-            raise ModelFileError(f"{path} is not a bidmp model file (member {info.filename} uses an unsupported "
-                                 f"compression, method {info.compress_type})")
-        if info.file_size > budget:
-            raise ModelFileError(f"{path}: member {info.filename} declares {info.file_size / 2**30:.3g} GiB, over the limit "
-                                 f"max_array_bytes = {get_limits().max_array_bytes:,}; raise it with "
-                                 f"bidmp.set_limits(max_array_bytes=...)")
-        if not info.filename.endswith(".npy"):
-            raise ModelFileError(f"{path} is not a bidmp model file (member {short_token(info.filename, 40)} is not an .npy array)")
-        # Every member's header (a few hundred bytes) is checked, so that a pickled or oversized
-        # member is refused even if the model would never ask for it; the data are not read.
-        try:
-            with archive.open(info) as stream:
-                _read_npy_header(stream, f"member {short_token(info.filename[:-4], 40)}")
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
-            raise ModelFileError(f"{path} is not a bidmp model file ({exc})") from None
-
-
-def _read_meta(members: _Members, path: Path) -> dict:
-    if _META_KEY not in members._infos:
+def _read_meta(members: NpzMembers, path: Path) -> dict:
+    if _META_KEY not in members.names:
         raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
 
     def check(shape, dtype):
@@ -172,9 +116,9 @@ def _read_meta(members: _Members, path: Path) -> dict:
             raise ValueError(f"{path} is not a bidmp model file (its metadata member is not UTF-8 JSON bytes)")
 
     try:
-        raw = _read_npy(lambda: members._archive.open(members._infos[_META_KEY]), "the metadata member", check)
+        raw = members.read(_META_KEY, check)
         meta = load_json(raw.tobytes(), f"{path} metadata")
-    except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+    except ValueError as exc:
         raise ModelFileError(f"{path} is not a readable bidmp model file ({exc})") from None
     if not isinstance(meta, dict) or meta.get("format") != _FORMAT_NAME:
         raise ModelFileError(f"{path} is not a bidmp model file (unknown metadata format)")
@@ -194,11 +138,8 @@ def load_model(path: str | os.PathLike):
         metadata (a foreign file), was written by a newer format version, or its contents are
         inconsistent (the message names the member).
     """
-    path = _readable_model(path)
-    archive = _open_archive(path)
-    with archive:
-        _check_archive(archive, path)
-        members = _Members(archive, str(path))
+    path = check_path(path)
+    with read_npz(path, "bidmp model file", ModelFileError) as members:
         meta = _read_meta(members, path)
         class_name = _model_class_name(meta, path)
         state = meta.get("state")
@@ -214,35 +155,6 @@ def load_model(path: str | os.PathLike):
         except (TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError,
                 zipfile.BadZipFile, EOFError, OSError) as exc:
             raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from None
-
-
-def _readable_model(path) -> Path:
-    """``path`` as a Path to a regular file within the size limit (a pipe or device is refused
-    without opening it: that could block)."""
-    path = check_path(path)
-    if not path.is_file():
-        if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
-            raise ModelFileError(f"model file {path} is not a regular file (a pipe, device or socket)")
-        raise ModelFileError(f"model file {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
-    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
-    return path
-
-
-def _open_archive(path: Path) -> zipfile.ZipFile:
-    """The model file as a zip archive, after its magic bytes said it is one."""
-    try:
-        with open(path, "rb") as handle:
-            magic = handle.read(4)
-    except OSError as exc:
-        raise ModelFileError(f"cannot read {path}: {exc.strerror or exc}") from None
-    if magic == _NPY_MAGIC[:4]:
-        raise ModelFileError(f"{path} is not a bidmp model file (a plain .npy array, not an .npz archive)")
-    if magic not in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
-        raise ModelFileError(f"{path} is not a bidmp model file (not an .npz archive)")
-    try:
-        return zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
-        raise ModelFileError(f"{path} is not a readable bidmp model file ({type(exc).__name__}: {exc})") from None
 
 
 def _model_class_name(meta: dict, path: Path) -> str:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_path
+from .._checks import check_path, printable
 from ..io.atomic import atomic_write
 
 
@@ -76,7 +76,7 @@ def _text(value, name: str, longest: int) -> str:
         raise TypeError(f"{name} must be a string, got {type(value).__name__}")
     if len(value) > longest:
         raise ValueError(f"{name} is {len(value):,} characters long; at most {longest}")
-    return value
+    return printable(value)  # a control code has no glyph in any font
 
 
 def _sequence(value, name: str) -> list:
@@ -109,5 +109,6 @@ def _label_axes(ax, n_dims: int, units: str) -> None:
 def _finish(ax, n_dims: int, units: str, title: str = "") -> None:
     _label_axes(ax, n_dims, units)
     ax.grid(True, alpha=0.3)
-    if _text(title, "title", 300):
+    title = _text(title, "title", 300)
+    if title:
         ax.set_title(title, fontsize=10)

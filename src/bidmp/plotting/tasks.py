@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import printable
 from ._base import _axes_for, _draw, _finish, _matplotlib, _save
 
 __all__ = ['plot_targets_top_view', 'plot_error_vs_distance', 'plot_scenario_3d']
@@ -36,7 +37,7 @@ def plot_targets_top_view(path, report) -> Path:
         for label, target in scenario.targets.items():
             ok = result.task_success_at(label) if scene is not None else result.errors[label] <= scenario.success_threshold
             ax.add_patch(mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
-            ax.text(target[0], target[1], label, ha="center", va="center", fontsize=8)
+            ax.text(target[0], target[1], printable(label), ha="center", va="center", fontsize=8)
             end = result.rollouts[label][-1]
             ax.plot(end[0], end[1], "k.", markersize=3)
             clearance = result.clearance_at(label)
@@ -57,7 +58,7 @@ def plot_targets_top_view(path, report) -> Path:
         ax.grid(True, alpha=0.3)
     for ax in axes.ravel()[len(names):]:
         ax.axis("off")
-    fig.suptitle(f"{scenario.name}: {'task ' if scene is not None else ''}success per target (green) and failure (red)")
+    fig.suptitle(f"{printable(scenario.name)}: {'task ' if scene is not None else ''}success per target (green) and failure (red)")
     fig.tight_layout()
     return _save(fig, path)
 
@@ -86,7 +87,7 @@ def plot_error_vs_distance(path, report) -> Path:
         ax.grid(True, alpha=0.3)
         ax.set_title(title, fontsize=10)
     axes[0][0].legend(fontsize=8)
-    fig.suptitle(f"{scenario.name}: error against distance (symlog scale)")
+    fig.suptitle(f"{printable(scenario.name)}: error against distance (symlog scale)")
     fig.tight_layout()
     return _save(fig, path)
 

@@ -20,8 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_path, require_extra
+from .._checks import check_path, printable, require_extra, short_token
 from ..io.atomic import atomic_write
+from ..io.strict_json import load_json
 
 __all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_layer", "solid_mesh", "view_figure", "write_view",
            "save_layers", "load_layers", "VIEW_FORMAT"]
@@ -203,6 +204,9 @@ def write_view(path, layers: ViewLayers) -> Path:
     return path
 
 
+_META_MAX_BYTES = 16 << 20
+
+
 def save_layers(path, layers: ViewLayers) -> Path:
     """Store ``layers`` as ``.npz`` (arrays only) with their JSON metadata and a format version."""
     path = check_path(path)
@@ -226,18 +230,23 @@ def save_layers(path, layers: ViewLayers) -> Path:
     return path
 
 
+def _json_bytes(shape, dtype) -> None:
+    if dtype != np.uint8 or len(shape) != 1 or shape[0] > _META_MAX_BYTES:
+        raise ValueError("its metadata member is not UTF-8 JSON bytes")
+
+
 def load_layers(path) -> ViewLayers:
     """Read layers written by :func:`save_layers`; a foreign or broken file is named as such."""
-    import zipfile
+    from ..io._npy import read_npz
 
     path = check_path(path)
     try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(bytes(data["meta"]).decode())
+        with read_npz(path, "bidmp view file") as data:
+            meta = load_json(data.read("meta", _json_bytes).tobytes(), f"{path} metadata")
             if not isinstance(meta, dict) or meta.get("kind") != "bidmp-view":
                 raise ValueError("it is not a bidmp view file")
             if meta.get("format") != VIEW_FORMAT:
-                raise ValueError(f"its format {meta.get('format')!r} is not {VIEW_FORMAT}")
+                raise ValueError(f"its format {short_token(meta.get('format'))} is not {VIEW_FORMAT}")
             return ViewLayers(
                 title=meta["title"], units=meta["units"], demonstration=data["demonstration"],
                 targets={label: np.asarray(t) for label, t in meta["targets"].items()},
@@ -246,5 +255,5 @@ def load_layers(path) -> ViewLayers:
                 solids=meta["solids"],
                 robot={name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
                        for name, k in meta["robot"].items()})
-    except (OSError, KeyError, ValueError, TypeError, zipfile.BadZipFile, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read a bidmp view ({str(exc)[:120]})") from None
+    except (KeyError, ValueError, TypeError, AttributeError) as exc:
+        raise ValueError(f"{path}: cannot read a bidmp view ({printable(str(exc))[:120]})") from None

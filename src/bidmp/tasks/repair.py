@@ -135,7 +135,6 @@ class Repairer:
         self.contract, self.demonstration = contract, np.asarray(demonstration, dtype=float)
         self.extension = {k: v for k, v in (extension or {}).items() if k != "approach"}
         self.seed, self.order, self.bidmp = seed, tuple(order), dict(bidmp or {})
-        scene = contract.scene
         self.allowance = float(allowance)
         self.planning = self._widened(self.allowance)
 
