@@ -191,7 +191,7 @@ def test_a_bag_without_the_topic_of_a_foreign_type_or_out_of_order_says_what_it_
     shuffled[10], shuffled[11] = (shuffled[10][0], shuffled[11][1]), (shuffled[11][0], shuffled[10][1])  # stamps swapped
     _write(tmp_path / "b", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", shuffled),
                                ("/log", "std_msgs/msg/String", [(stamps[0], store.types["std_msgs/msg/String"](data="x"))])])
-    for options, expected in ((["--topic", "/nope"], "no topic '/nope'"), (["--topic", "/log"], "does not read"),
+    for options, expected in ((["--topic", "/nope"], "topic '/nope' is not in the bag"), (["--topic", "/log"], "does not read"),
                               (["--topic", "/ee_pose"], "do not increase")):
         assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz"), *options]) == 2
         err = capsys.readouterr().err.strip().splitlines()

@@ -47,7 +47,7 @@ def test_solid_meshes_enclose_the_solids_volume(seed):
 
 
 def test_an_unknown_solid_kind_is_named():
-    with pytest.raises(ValueError, match="solid kind must be box, cylinder or convex, got 'sphere'"):
+    with pytest.raises(ValueError, match="kind must be one of 'box', 'cylinder', 'convex'; got 'sphere'"):
         viewer.solid_mesh("sphere", [0, 0, 0], np.eye(3), (1.0,))
 
 

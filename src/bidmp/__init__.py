@@ -1,6 +1,6 @@
 """bidmp — one-shot Learning from Demonstration with DMPs, extended demonstrations and Bi-DMP.
 
-The public names of SPEC §10 are imported lazily (PEP 562), so ``import bidmp`` and
+The public names are imported lazily (PEP 562), so ``import bidmp`` and
 ``bidmp --help`` do not pay for NumPy/SciPy until a name is used.
 
 The subpackages, in layers (each imports only from the layers above it; ``tests/test_package.py``
@@ -21,12 +21,17 @@ The flat module paths of bidmp ≤ 0.4 (``bidmp.dmp``, ``bidmp.geometry``, …) 
 
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING
 
 from . import _old_paths
 from ._lazy import exports
 
 __version__ = "0.5.0"
+
+# A library logs; the application decides what is shown (without a handler of its own, Python's
+# last resort would print every warning of bidmp to stderr).
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 _old_paths.install()
 

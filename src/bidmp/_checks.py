@@ -23,6 +23,9 @@ import numpy as np
 
 __all__ = [
     "printable",
+    "as_rotation",
+    "as_labels",
+    "check_options",
     "NotFittedError",
     "MissingExtraError",
     "require_extra",
@@ -157,11 +160,19 @@ def _limit_hint(limit: str) -> str:
     return f"the limit {limit} = {getattr(_LIMITS, limit):,}; raise it with bidmp.set_limits({limit}=...)"
 
 
+def _count(value) -> str:
+    """A number for a message: thousands separated, or its order of magnitude when it has more than
+    15 digits (an integer of hundreds of digits is not a message)."""
+    if isinstance(value, (int, np.integer)):
+        digits = len(str(abs(int(value))))
+        return f"{int(value):,}" if digits <= 15 else f"{'-' if value < 0 else ''}about 10^{digits - 1}"
+    return f"{float(value):.3g}"
+
+
 def check_limit(value, limit: str, what: str) -> None:
     """Raise ``ValueError`` if ``value`` exceeds the limit named ``limit`` (a :class:`Limits` field)."""
     if value > getattr(_LIMITS, limit):
-        shown = f"{value:,}" if isinstance(value, (int, np.integer)) else f"{value:.3g}"
-        raise ValueError(f"{what} = {shown} exceeds {_limit_hint(limit)}")
+        raise ValueError(f"{what} = {_count(value)} exceeds {_limit_hint(limit)}")
 
 
 def check_bytes(n_elements, what: str, itemsize: int = 8) -> None:
@@ -180,7 +191,14 @@ def printable(text) -> str:
 def short_token(value, width: int = 10) -> str:
     """A rejected value quoted for an error message: at most ``width`` characters, printable only
     (a file read by mistake must not be echoed into a terminal or a log)."""
-    text = printable(str(value)[: width + 1])
+    if isinstance(value, (list, tuple, dict, set)) and len(value) > 4 or isinstance(value, np.ndarray) and value.size > 8:
+        text = f"{type(value).__name__} of {len(value) if not isinstance(value, np.ndarray) else value.shape}"
+    else:
+        try:  # a container nested thousands deep, or an integer of thousands of digits, has no short text
+            text = str(value)
+        except (RecursionError, ValueError, TypeError):
+            text = f"{type(value).__name__} that cannot be shown"
+    text = printable(text[: width + 1])
     return repr(text[:width] + "…") if len(text) > width else repr(text)
 
 
@@ -298,13 +316,15 @@ def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = 
     return np.ascontiguousarray(array)
 
 
-def as_point(p, n_dims: int, name: str = "point") -> np.ndarray:
-    """Validate one point of dimension ``n_dims`` and return it as a float64 array (n_dims,)."""
+def as_point(p, n_dims: int, name: str = "point", like: str = "") -> np.ndarray:
+    """Validate one point of dimension ``n_dims`` and return it as a float64 array (n_dims,)
+    (``like``: the argument whose dimension it must match, for the message; default the model)."""
     array = _as_bounded_array(p, name, 2)
     if array.ndim == 0:
         array = array.reshape(1)
     if array.ndim != 1 or array.shape[0] != n_dims:
-        raise ValueError(f"{name} must have {n_dims} coordinate(s) to match the model, got shape {array.shape}")
+        match = f"as {like} has" if like else "to match the model"
+        raise ValueError(f"{name} must have {n_dims} coordinate(s) {match}, got shape {array.shape}")
     _check_finite(array, name)
     _check_magnitude(array, name)
     return array
@@ -330,9 +350,9 @@ def check_int(value, name: str, minimum: int | None = None, limit: str | None = 
     if isinstance(value, bool) or not isinstance(value, Integral):
         raise TypeError(f"{name} must be an integer, got {type(value).__name__} {short_token(value)}")
     if minimum is not None and value < minimum:
-        raise ValueError(f"{name} must be >= {minimum}, got {value}")
+        raise ValueError(f"{name} must be >= {minimum}, got {_count(value)}")
     if maximum is not None and value > maximum:
-        raise ValueError(f"{name} must be <= {maximum:,}, got {value:,}")
+        raise ValueError(f"{name} must be <= {maximum:,}, got {_count(value)}")
     if limit is not None:
         check_limit(int(value), limit, name)
     return int(value)
@@ -347,7 +367,7 @@ def check_real(value, name: str, *, positive: bool = False, nonnegative: bool = 
         value = float(value)
     except OverflowError:
         raise ValueError(f"{name} is too large for a float") from None
-    if not np.isfinite(value):
+    if not math.isfinite(value):
         raise ValueError(f"{name} must be finite, got {value}")
     if positive and value <= 0:
         raise ValueError(f"{name} must be > 0, got {value}")
@@ -399,14 +419,14 @@ def as_vector(values, name: str, *, length: int | None = None, min_length: int =
     return array
 
 
-def as_indices(values, name: str, last: int) -> np.ndarray:
+def as_indices(values, name: str, last: int, of: str = "the trajectory") -> np.ndarray:
     """A 1-D array of sample indices in ``[0, last]``: integers (whole-valued floats accepted)."""
     array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
     _check_finite(array, name)
     if np.any(array != np.round(array)):
         raise ValueError(f"{name} must be whole sample indices")
     if np.any((array < 0) | (array > last)):
-        raise ValueError(f"{name} must lie in [0, {last}]")
+        raise ValueError(f"{name} must lie in [0, {last}] (sample indices of {of})")
     return array.astype(np.int64)
 
 
@@ -415,6 +435,49 @@ def check_bool(value, name: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{name} must be True or False, got {type(value).__name__}")
     return bool(value)
+
+
+def as_rotation(value, name: str = "rotation") -> np.ndarray:
+    """A rotation matrix (3, 3): orthonormal within 1e-6, determinant +1."""
+    array = _as_bounded_array(value, name, 2)
+    if array.shape != (3, 3):
+        raise ValueError(f"{name} must be a 3 x 3 rotation matrix, got shape {array.shape}")
+    _check_finite(array, name)
+    if not np.allclose(array @ array.T, np.eye(3), atol=1e-6) or np.linalg.det(array) <= 0.0:
+        raise ValueError(f"{name} must be a rotation matrix (orthonormal, determinant +1)")
+    return np.ascontiguousarray(array)
+
+
+def as_labels(values, name: str) -> list[str]:
+    """Part or target labels: a list, tuple or set of strings (None: none)."""
+    if values is None:
+        return []
+    if isinstance(values, str) or not isinstance(values, (list, tuple, set, frozenset)):
+        raise TypeError(f"{name} must be a list of labels (strings), got {type(values).__name__} {short_token(values)}")
+    if len(values) > _LIMITS.max_targets * 10:
+        raise ValueError(f"{name} names {len(values):,} labels; at most {_LIMITS.max_targets * 10:,}")
+    if not all(isinstance(value, str) and len(value) <= 256 for value in values):
+        raise TypeError(f"{name} must hold labels (strings of at most 256 characters), got {short_token(list(values), 30)}")
+    return list(values)
+
+
+def check_text(value, name: str, max_length: int = 80) -> str:
+    """A name or phrase that a message will show: a string of printable characters, at most
+    ``max_length`` long (a caller's wording must not make the message unreadable)."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a string, got {type(value).__name__}")
+    if len(value) > max_length or not value.isprintable():
+        raise ValueError(f"{name} must be at most {max_length} printable characters, got {short_token(value, 30)}")
+    return value
+
+
+def check_options(value, name: str) -> dict:
+    """An options mapping: a dict with string keys (None: no options)."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict) or not all(isinstance(key, str) for key in value):
+        raise TypeError(f"{name} must be a dict of options (string keys), got {type(value).__name__} {short_token(value)}")
+    return dict(value)
 
 
 def check_callable(value, name: str, what: str = "a function"):

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import _as_float_array, numerically_guarded
+from ._checks import numerically_guarded
 
 __all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent",
            "continuous_quaternions"]
@@ -55,13 +55,12 @@ def resample_time(y, n_samples: int) -> np.ndarray:
 @numerically_guarded
 def rmse(a, b) -> float:
     """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
-    a, b = _as_float_array(a, "a"), _as_float_array(b, "b")  # None, complex and objects refused by name
+    from ._checks import as_trajectory
+
+    a = as_trajectory(a, "a", min_points=1, allow_static=True)  # sizes, types and finiteness checked by name
+    b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape != b.shape:
-        raise ValueError(f"trajectories must have the same shape, got {a.shape} and {b.shape}")
-    if a.size == 0:
-        raise ValueError("rmse of empty trajectories")
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-        raise ValueError("rmse: the trajectories contain NaN or inf")
+        raise ValueError(f"a has shape {a.shape} but b has {b.shape}: rmse compares trajectories of equal shape")
     return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._api import deprecated_alias, goal_first
-from .._checks import as_point, check_fitted, check_int, numerically_guarded
+from .._checks import _as_bounded_array, as_point, check_bool, check_fitted, check_int, numerically_guarded
 from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, _gmr, augment
 
 __all__ = ["TPGMM"]
@@ -22,7 +22,7 @@ __all__ = ["TPGMM"]
 
 def _rotation(value, n_dims: int, name: str) -> np.ndarray:
     """A frame orientation: an orthonormal (D, D) matrix."""
-    matrix = np.asarray(value, dtype=np.float64)
+    matrix = _as_bounded_array(value, name, 2)
     if matrix.shape != (n_dims, n_dims) or not np.all(np.isfinite(matrix)):
         raise ValueError(f"{name} must be a finite ({n_dims}, {n_dims}) rotation matrix, got shape {matrix.shape}")
     if not np.allclose(matrix @ matrix.T, np.eye(n_dims), atol=1e-6):
@@ -110,7 +110,7 @@ class TPGMM(_AugmentedMixture):
         covariance = np.linalg.inv(precision_sum)  # product of Gaussians
         mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
         mean, covariances = _gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
-        return (mean, covariances) if return_covariance else mean
+        return (mean, covariances) if check_bool(return_covariance, "return_covariance") else mean
 
     @deprecated_alias("rollout", "; generate(start, target) is rollout(target, start=start, return_covariance=True)")
     def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):

@@ -147,6 +147,11 @@ def main(argv: _Sequence[str] | None = None) -> int:
         parser.print_help()
         print("bidmp: error: no command given (see 'bidmp --help')", file=sys.stderr)
         return EXIT_BAD_INPUT
+    empty = [dest for dest, value in vars(args).items()
+             if value == "" or isinstance(value, list) and "" in value]
+    if empty:  # an empty file name or option would silently mean "here" or "none"
+        print(f"bidmp {args.command}: error: argument {empty[0].replace('_', '-')} is empty", file=sys.stderr)
+        return EXIT_BAD_INPUT
     from .._checks import MissingExtraError
 
     root = logging.getLogger()

@@ -43,10 +43,10 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
     from tqdm import tqdm
 
     from ..sim.report import write_sim_report
-    from ..sim.run import simulate
+    from ..sim.run import simulate, target_labels
 
     methods = list(methods)
-    labels = scenario.labels if targets is None else targets
+    labels = target_labels(scenario, targets)
     origin = scenario.targets[scenario.demonstrated]
     far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
     frames = {(method, far): 30 for method in methods} if pictures else {}

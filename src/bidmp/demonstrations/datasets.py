@@ -14,6 +14,7 @@ import os
 
 import numpy as np
 
+from .._checks import short_token
 from .._noise import perturb
 
 __all__ = ["lasa", "lasa_names", "minimum_jerk", "perturb", "recording", "recording_names", "recording_path", "kinesthetic_recording"]
@@ -53,7 +54,7 @@ def _read_lasa(name: str) -> np.ndarray:
         if not close:
             close = [n for n in names if n.lower() == str(name).lower()]
         hint = f"; did you mean {', '.join(close)}?" if close else "; see bidmp.demonstrations.datasets.lasa_names()"
-        raise ValueError(f"unknown LASA shape {short_token(name, 10)}{hint}")
+        raise ValueError(f"name: unknown LASA shape {short_token(name, 10)}{hint}")
     data = loadmat(os.path.join(_lasa_dir(), name + ".mat"), squeeze_me=True, struct_as_record=False)
     demos = np.stack([np.asarray(demo.pos, dtype=np.float64).T for demo in np.atleast_1d(data["demos"])])
     demos.setflags(write=False)
@@ -145,7 +146,7 @@ def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate
                maximum=get_limits().max_samples)
     jitter = check_real(jitter, "jitter", nonnegative=True, maximum=0.45)
     noise = check_real(noise, "noise", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
-    wobble = check_real(wobble, "wobble", nonnegative=True)
+    wobble = check_real(wobble, "wobble", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
     epoch = check_real(epoch, "epoch", nonnegative=True, maximum=1e12)
     rng = check_seed(seed)
     total = duration + 2 * idle
@@ -173,8 +174,10 @@ def recording_path(name: str) -> str:
     from importlib import resources
 
     names = recording_names()
-    if not isinstance(name, str) or name not in names:
-        raise ValueError(f"unknown recording {str(name)[:40]!r}; bundled: {', '.join(names)}")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a bundled recording's name (a string), got {type(name).__name__}")
+    if name not in names:
+        raise ValueError(f"name: unknown recording {short_token(name, 40)}; bundled: {', '.join(names)}")
     return str(resources.files("bidmp").joinpath("data", "recordings", f"{name}.csv"))
 
 

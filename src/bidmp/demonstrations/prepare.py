@@ -89,7 +89,7 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
     uniform, grid = uniform_time(y, t)
     rate = (grid.shape[0] - 1) / grid[-1]
     if cutoff_hz >= 0.5 * rate:
-        raise ValueError(f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate ({0.5 * rate:.4g} Hz)")
+        raise ValueError(f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate of t ({0.5 * rate:.4g} Hz)")
     sos = butter(4, cutoff_hz, fs=rate, output="sos")
     # Pad with the signal's even reflection (a resting end stays at rest) over ~3 filter periods.
     padlen = min(3 * int(np.ceil(rate / cutoff_hz)), uniform.shape[0] - 1)

@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_choice, check_int, require_extra
+from .._checks import check_choice, check_int, require_extra, short_token
 from ._lasa_dask import _client, _run_on_dask  # noqa: F401  (_client: the benchmark script's cluster)
 
 __all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key", "summary_markdown"]
@@ -59,7 +59,9 @@ FORMAT = 3  # of the cell files (2: the robot protocol of issue 19; 3: a content
 
 def cell_key(shape: str, demo: int) -> str:
     """The name of one benchmark cell (a LASA shape and a demonstration index), as in its file."""
-    return f"{shape}__{demo}"
+    if not isinstance(shape, str) or not shape or len(shape) > 100:
+        raise TypeError(f"shape must be a LASA shape's name, got {short_token(shape, 20)}")
+    return f"{shape}__{check_int(demo, 'demo', minimum=0, maximum=10_000)}"
 
 
 def _cell_seed(shape: str, demo: int) -> int:
@@ -392,8 +394,21 @@ def _write_table(rows: list, path: Path, output_format: str) -> None:
         pq.write_table(pa.Table.from_pydict(columns), handle)
 
 
+def _checked_rows(rows) -> list:
+    """The benchmark's rows (dicts with shape, demo, method, case and the metrics), checked."""
+    if not isinstance(rows, (list, tuple)):
+        raise TypeError(f"rows must be a list of the benchmark's rows, got {type(rows).__name__}")
+    needed = {"shape", "demo", "method", "case", *METRICS}
+    for index, row in enumerate(rows):
+        if not isinstance(row, dict) or not needed <= set(row):
+            raise TypeError(f"rows[{index}] must be one of the benchmark's rows (a dict with {', '.join(sorted(needed))})")
+    return list(rows)
+
+
 def summary_rows(rows: list, metric: str) -> tuple[list[str], list[list[str]]]:
     """Median (IQR) of ``metric`` per method (rows) and case (columns)."""
+    rows = _checked_rows(rows)
+    metric = check_choice(metric, "metric", METRICS)
     methods = list(dict.fromkeys(row["method"] for row in rows))
     header = ["method"] + [name for name, _ in CASES]
     table = []
@@ -414,6 +429,10 @@ def summary_markdown(rows: list, protocol: dict) -> str:
     """The benchmark's Markdown summary (medians and ranges per method and case) from its rows."""
     from ..tasks._tables import markdown_table
 
+    rows = _checked_rows(rows)
+    if not isinstance(protocol, dict) or not {"demos", "every"} <= set(protocol):
+        raise TypeError(f"protocol must be the benchmark's protocol (a dict with demos and every), got "
+                        f"{short_token(protocol, 30)}")
     n_cells = len({(row["shape"], row["demo"]) for row in rows})
     parts = [f"LASA benchmark: {n_cells} cells (shape x demonstration), demos {protocol['demos']}, every "
              f"{protocol['every']} sample(s); median (IQR) per method; goal shifted by 0, 10 % and 60 % of the "

@@ -129,6 +129,10 @@ class ExtendedDemonstration:
         it was grown from (or on the first of a chain of extensions): ``complete`` is sampled at
         that demonstration's period ``dmp.duration_ / (T − 1)``. What :meth:`bidmp.BiDMP.learn`
         takes as ``duration``."""
+        from ..primitives.dmp import DMP
+
+        if not isinstance(dmp, DMP) or getattr(dmp, "duration_", None) is None:
+            raise TypeError(f"dmp must be the fitted bidmp.DMP the extension was grown for, got {type(dmp).__name__}")
         return dmp.duration_ * ((self.complete.shape[0] - 1) / (dmp.n_steps_ - 1))
 
     @property
@@ -173,7 +177,7 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     straightness = check_real(straightness, "straightness", positive=True, maximum=1.0)
     points = getattr(segmentation_points, "points", segmentation_points)
     last = y.shape[0] - 1
-    points = as_indices(points, "segmentation_points", last)
+    points = as_indices(points, "segmentation_points", last, "y")
     start = int(points[points < last].max()) if np.any(points < last) else 0
     # The last piece if it is straight, else its longest straight tail (primitives.approach).
     return _straight_tail_start(y, start, straightness)
@@ -232,7 +236,7 @@ def extend_demonstration(
         approach, translated, would touch a part.
     """
     y = as_trajectory(y, "y", min_points=10)
-    target = as_point(new_target, y.shape[1], "new_target")
+    target = as_point(new_target, y.shape[1], "new_target", like="y")
     roadmap_options = {
         "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
         "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,

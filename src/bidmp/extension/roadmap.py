@@ -107,7 +107,7 @@ def template(piece: np.ndarray, new_target: np.ndarray, scaling: str = "axis") -
     array (k, D), starting exactly at seg and ending exactly at ``new_target``.
     """
     piece = as_trajectory(piece, "piece", min_points=2, allow_static=True)
-    new_target = as_point(new_target, piece.shape[1], "new_target")
+    new_target = as_point(new_target, piece.shape[1], "new_target", like="piece")
     check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
     seg, tar = piece[0], piece[-1]
     chord, new_chord = tar - seg, new_target - seg
@@ -268,7 +268,7 @@ class _Comparison:
 def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scaling, compare, select, denom):
     """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
-    target = as_point(new_target, piece.shape[1], "new_target")
+    target = as_point(new_target, piece.shape[1], "new_target", like="tra_imi")
     _check_options(n_samples=n_samples, n_neighbours=n_neighbours, n_compare=n_compare, n_iter=n_iter,
                   scaling=scaling, compare=compare, select=select, denom=denom)
     if np.linalg.norm(target - piece[0]) == 0.0:
@@ -290,7 +290,7 @@ def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbour
     check_int(n_compare, "n_compare", minimum=3)
     check_int(n_iter, "n_iter", minimum=1)
     check_limit(n_samples * n_iter, "max_roadmap_nodes", "the roadmap nodes drawn, n_samples * n_iter")
-    check_limit(n_compare * n_compare * n_iter, "max_frechet_cells", "the similarity work, n_compare² * n_iter")
+    check_limit(n_compare * n_compare * n_iter, "max_frechet_cells", "the similarity work, n_compare^2 * n_iter")
     check_real(sigma_rel, "sigma_rel", nonnegative=True, maximum=10.0)
     check_real(rho, "rho", positive=True, maximum=2.0)
     check_real(padding, "padding", nonnegative=True, maximum=100.0)

@@ -66,7 +66,7 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
     if y.shape[1] == 2:
         y = np.column_stack([y, np.zeros(n_points)])
     elif y.shape[1] != 3:
-        raise ValueError(f"curvature needs a 2-D or 3-D curve, got D = {y.shape[1]}")
+        raise ValueError(f"y: curvature needs a 2-D or 3-D curve, got D = {y.shape[1]}")
     smooth = check_real(smooth, "smooth", positive=True, maximum=1.0)
     smooth_curvature = check_real(smooth_curvature, "smooth_curvature", positive=True, maximum=1.0)
     window = _odd_window(smooth, n_points, 7)
@@ -282,11 +282,11 @@ def choose_piece(y, segmentation_points, new_target) -> Piece:
     runs from ``b_j`` to ``b_{j+1}``.
     """
     y = as_trajectory(y, "y")
-    target = as_point(new_target, y.shape[1], "new_target")
+    target = as_point(new_target, y.shape[1], "new_target", like="y")
     if isinstance(segmentation_points, Segmentation):
         segmentation_points = segmentation_points.points
     last = y.shape[0] - 1
-    points = as_indices(segmentation_points, "segmentation_points", last)
+    points = as_indices(segmentation_points, "segmentation_points", last, "y")
     breakpoints = np.unique(np.concatenate([[0], points, [last]]))
     ends = y[breakpoints[1:]]
     distances = np.linalg.norm(ends - target, axis=1)

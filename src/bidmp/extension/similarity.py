@@ -222,6 +222,6 @@ def frechet_similarity(a, b, denom: str = "sqrt2") -> float:
     distance = frechet_distance(a, b)
     length_a, length_b = polyline_length(a), polyline_length(b)
     if length_a <= 0.0 or length_b <= 0.0:
-        raise ValueError("frechet_similarity needs curves of non-zero length")
+        raise ValueError(f"a and b must be curves of non-zero length (the normaliser), got lengths {length_a:g} and {length_b:g}")
     scale = np.sqrt(length_a * length_b) / (np.sqrt(2.0) if denom == "sqrt2" else 2.0)
     return float(max(1.0 - distance / scale, 0.0))

@@ -73,7 +73,8 @@ class SkillLibrary:
         if isinstance(skill, (bool, np.bool_)) or not isinstance(skill, (int, np.integer)):
             raise ValueError(f"skill must be 'nearest', 'latest' or an integer 0-{len(self.blocks_)}, got {_shown(skill)}")
         if not 0 <= skill <= len(self.blocks_):
-            raise ValueError(f"skill must be between 0 and {len(self.blocks_)} (this Bi-DMP has {self.n_skills} skills), got {skill}")
+            raise ValueError(f"skill must be between 0 and {len(self.blocks_)} (this Bi-DMP has {self.n_skills} skills), "
+                             f"got {_shown(skill)}")
         return int(skill)
 
     def select_skill(self, goal, skill="nearest") -> int:

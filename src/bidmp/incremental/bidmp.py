@@ -36,6 +36,7 @@ from .._checks import (
     check_limit,
     check_real,
     numerically_guarded,
+    short_token,
 )
 from .._trajectory import resample_time, rmse
 from ..primitives.dmp import DMP
@@ -165,7 +166,7 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         check_real(self.shrink, "shrink", positive=True, maximum=1e6)
         check_real(self.reg, "reg", nonnegative=True, maximum=1e6)
         check_int(self.seed, "seed", minimum=0, maximum=2**62)
-        if isinstance(self.increments, (str, bytes)) or not hasattr(self.increments, "__iter__"):
+        if not isinstance(self.increments, (tuple, list)):
             raise TypeError(f"increments must be a sequence of integers, got {type(self.increments).__name__}")
         increments = tuple(self.increments)
         check_limit(len(increments), "max_hidden_nodes", "the number of increments")
@@ -236,14 +237,19 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
             ``skill_time_scales_``): a longer extension is not rushed into the demonstration's
             time. Default: the demonstration's own duration (the paper's protocol).
         """
+        return self._learn(y_dn, duration)
+
+    def _learn(self, y_dn, duration: float | None, name: str = "y_dn", still: bool = False) -> "BiDMP":
+        """:meth:`learn`; ``still``: ``y_dn`` may stand still (one part of a pose skill that moves
+        in its other part)."""
         self._ensure_started()
         increments, derivatives = self._check_params()
         time_scale = _time_scale(duration, self.dmp_)
         dmp = self.dmp_
         params = dmp._params()
-        y = as_trajectory(y_dn, "y_dn")
+        y = as_trajectory(y_dn, name, allow_static=still)
         if y.shape[1] != dmp.n_dims_:
-            raise ValueError(f"y_dn has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
+            raise ValueError(f"{name} has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
         y = dmp.training_trajectory(y)  # T samples (and, robot protocol, rest at the goal after them)
         phase, basis = dmp.training_grid()
         target = _forcing_target(
@@ -335,6 +341,10 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
         raise TypeError(f"dmp must be a fitted bidmp.DMP (or an empty BiDMP), got {type(dmp).__name__}")
     if not isinstance(demonstrations, (list, tuple)):
         raise TypeError(f"demonstrations must be a list of arrays (T', D), got {type(demonstrations).__name__}")
+    check_limit(len(demonstrations), "max_targets", "demonstrations: the number of skills to learn")
+    demonstrations = [as_trajectory(y, f"demonstrations[{index}]") for index, y in enumerate(demonstrations)]
+    if not isinstance(skills, (list, tuple)) or not skills:
+        raise TypeError(f"skills must be a list of skill rules ('nearest', 'latest' or indices), got {short_token(skills, 30)}")
     for skill in skills:
         if not (isinstance(skill, str) and skill in ("nearest", "latest")) and (isinstance(skill, bool) or not isinstance(skill, int)):
             raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {type(skill).__name__}")
@@ -362,8 +372,8 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
 
     measure(0)
     for index, demonstration in enumerate(demonstrations, start=1):
-        model.learn(demonstration)
-        references.append(resample_time(as_trajectory(demonstration, "demonstration"), dmp.n_steps_))
+        model._learn(demonstration, None, f"demonstrations[{index - 1}]")
+        references.append(resample_time(demonstration, dmp.n_steps_))
         measure(index)
     return {
         skill: ForgettingResult(skill=str(skill), errors=matrix, forgetting=matrix[:, -1] - np.diag(matrix))

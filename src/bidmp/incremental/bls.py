@@ -388,7 +388,8 @@ class BLS(CheckedParams, BaseEstimator):
     def predict(self, X) -> np.ndarray:
         """Outputs for inputs X: ``hidden(X) @ output_weights_``, shape (N, n_outputs)."""
         check_fitted(self, "output_weights_")
-        check_bytes(np.shape(X)[0] * self.n_hidden_ if np.ndim(X) == 2 else 0, "the hidden matrix of X (N x hidden nodes)")
+        X = _check_inputs(X, self.n_features_)
+        check_bytes(X.shape[0] * self.n_hidden_, "the hidden matrix of X (N x hidden nodes)")
         if np.shape(X)[0] >= _THREADED_ROWS:
             with one_thread():  # as fit: small products, and idle pools would contend (bidmp._threads)
                 out = self.hidden(X) @ self.output_weights_

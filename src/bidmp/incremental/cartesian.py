@@ -10,9 +10,10 @@ import numpy as np
 from sklearn.base import BaseEstimator, clone
 
 from .._api import CheckedParams, goal_first
-from .._checks import as_point, check_fitted, check_loaded, numerically_guarded
+from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
 from ..primitives.cartesian import (
     CartesianDMP,
+    as_poses,
     _parts_from_state,
     _parts_state,
     _pose_params,
@@ -41,6 +42,9 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
         raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(cartesian).__name__}")
     if not isinstance(demonstrations, (list, tuple)):
         raise TypeError(f"demonstrations must be a list of pose arrays (T', 7), got {type(demonstrations).__name__}")
+    check_limit(len(demonstrations), "max_targets", "demonstrations: the number of skills to learn")
+    for index, poses in enumerate(demonstrations):
+        as_poses(poses, f"demonstrations[{index}]")
     model = CartesianBiDMP(cartesian, **bidmp_params)
     queries = [cartesian.goal_]
     when_learned = [model.rollout(cartesian.goal_, skill=skill)]
@@ -144,8 +148,9 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         seconds (default the demonstration's; see :meth:`bidmp.BiDMP.learn`). Returns self."""
         self._ensure_started()
         positions, quaternions, log = _pose_parts(poses)
-        self.position_.learn(positions, duration=duration)
-        self.orientation_.learn(log, duration=duration)
+        # A pose skill may keep its position or its orientation still (not both: _pose_parts).
+        self.position_._learn(positions, duration, "poses' positions", still=True)
+        self.orientation_._learn(log, duration, "poses' orientation", still=True)
         self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
         self.skill_start_orientations_ = np.vstack([self.skill_start_orientations_, quaternions[0]])
         self.skill_start_logs_ = np.vstack([self.skill_start_logs_, log[0]])
@@ -154,7 +159,7 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
     def select_skill(self, goal=None, skill="nearest") -> int:
         """The skill a query uses (chosen on the position goal, as :meth:`bidmp.BiDMP.select_skill`)."""
         self._ensure_started()
-        if goal is None and skill == "nearest":
+        if goal is None and isinstance(skill, str) and skill == "nearest":
             return self.n_skills - 1
         goal = None if goal is None else as_point(goal, 7, "goal")[:3]
         return self.position_.select_skill(goal, skill)

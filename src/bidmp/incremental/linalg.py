@@ -76,11 +76,11 @@ def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_it
     return z
 
 
-def _matrix(value, name: str, rows: int | None = None) -> np.ndarray:
-    """A finite 2-D array (with ``rows`` rows when given): the public algebra's arguments."""
+def _matrix(value, name: str, rows: int | None = None, like: str = "") -> np.ndarray:
+    """A finite 2-D array (with ``rows`` rows when given, as ``like`` says): the public algebra's arguments."""
     matrix = as_trajectory(value, name, min_points=1, allow_static=True)
     if rows is not None and matrix.shape[0] != rows:
-        raise ValueError(f"{name} must have {rows} rows, got {matrix.shape[0]}")
+        raise ValueError(f"{name} must have {rows} rows ({like}), got {matrix.shape[0]}")
     return matrix
 
 
@@ -116,7 +116,7 @@ def svd_update(U: np.ndarray, s: np.ndarray, V: np.ndarray, E: np.ndarray):
     ``blockdiag(V, I)``. Returns ``(U', s', V', dropped)`` like :func:`truncated_svd`."""
     U = _matrix(U, "U")
     s = as_vector(s, "s")
-    V, E = _matrix(V, "V"), _matrix(E, "E", rows=U.shape[0])
+    V, E = _matrix(V, "V"), _matrix(E, "E", rows=U.shape[0], like="as U has")
     if s.shape[0] != U.shape[1] or V.shape[1] != U.shape[1]:
         raise ValueError(f"s and V must have one entry / column per column of U ({U.shape[1]})")
     return _svd_update(U, s, V, E)
@@ -156,7 +156,8 @@ def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple
     ``"full-rank"`` or ``"general"``.
     """
     A = _matrix(A, "A")
-    A_pinv, E = _matrix(A_pinv, "A_pinv", rows=A.shape[1]), _matrix(E, "E", rows=A.shape[0])
+    A_pinv = _matrix(A_pinv, "A_pinv", rows=A.shape[1], like="A's columns")
+    E = _matrix(E, "E", rows=A.shape[0], like="as A has")
     if A_pinv.shape[1] != A.shape[0]:
         raise ValueError(f"A_pinv must be the pseudo-inverse of A: shape ({A.shape[1]}, {A.shape[0]}), got {A_pinv.shape}")
     D = A_pinv @ E

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_choice, check_path, require_extra, shown_path
+from .._checks import as_trajectory, as_vector, check_choice, check_path, check_real, require_extra, short_token, shown_path
 
 __all__ = ["BagRecording", "read_bag", "write_bag", "is_bag"]
 
@@ -103,7 +103,7 @@ def _stamp(header) -> int:
 def _open(path):
     """An AnyReader on the bag at ``path``."""
     highlevel = require_extra("rosbags.highlevel", "ros", "ROS bags")
-    path = Path(check_path(path, "bag"))
+    path = Path(check_path(path))
     if not path.exists():
         raise ValueError(f"bag {shown_path(path)} does not exist")
     if not is_bag(path):
@@ -111,6 +111,8 @@ def _open(path):
     reader = highlevel.AnyReader([path])
     try:
         reader.open()
+    except RecursionError:  # rosbags parses message definitions recursively
+        raise ValueError(f"cannot read bag {shown_path(path)}: its message definitions nest types too deeply") from None
     except Exception as exc:  # rosbags' own errors (AnyReaderError, a broken metadata.yaml, ...): one line
         raise ValueError(f"cannot read bag {shown_path(path)}: {type(exc).__name__}: {exc}") from None
     return reader
@@ -135,6 +137,7 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
     -------
     BagRecording
     """
+    _check_selection(topic, tf, joints)
     reader = _open(path)
     try:
         wanted = _wanted_connections(reader, topic, tf, joints)
@@ -162,32 +165,46 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
     return BagRecording(t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9)
 
 
+def _check_selection(topic, tf, joints) -> None:
+    """Refuse a topic, frame pair or joint list that could name nothing, before the bag is opened."""
+    if topic is not None and (not isinstance(topic, str) or not topic.strip() or len(topic) > 256):
+        raise ValueError(f"topic must be a topic name such as '/bidmp/pose', got {short_token(topic, 30)}")
+    if tf is not None and (not isinstance(tf, (tuple, list)) or len(tf) != 2
+                           or not all(isinstance(frame, str) and frame and len(frame) <= 256 for frame in tf)):
+        raise ValueError(f"tf must be (parent frame, child frame), two names, got {short_token(tf, 30)}")
+    if joints is not None and joints is not True and (
+            not isinstance(joints, (list, tuple)) or not joints
+            or not all(isinstance(name, str) and name and len(name) <= 256 for name in joints)):
+        raise ValueError(f"joints must be a list of joint names or True (every joint), got {short_token(joints, 30)}")
+    if tf is not None and joints is not None:
+        raise ValueError("tf and joints: give one (a transform or joint states), not both")
+
+
 def _wanted_connections(reader, topic, tf, joints) -> list:
     """The connections to read, refused in one line that lists the bag's contents."""
     if tf is not None:
-        if len(tf) != 2 or not all(isinstance(frame, str) and frame for frame in tf):
-            raise ValueError("tf must be (parent frame, child frame), two names")
         topics = {topic} if topic is not None else {"/tf", "/tf_static"}
         found = [c for c in reader.connections if c.topic in topics and c.msgtype == TF_MESSAGE]
         if not found:
-            raise ValueError(f"the bag has no TFMessage topic {' or '.join(sorted(topics))}; it has: {_contents(reader)}")
+            raise ValueError(f"tf: the bag has no TFMessage topic {' or '.join(sorted(topics))}; it has: {_contents(reader)}")
         return found
     if topic is None:
         types = (JOINT_STATE,) if joints is not None else (POSE_STAMPED, TRANSFORM_STAMPED)
         found = [c for c in reader.connections if c.msgtype in types]
         if len({c.topic for c in found}) != 1:
-            raise ValueError(f"name the topic to read (--topic): the bag has {len({c.topic for c in found})} topics of "
+            wanted = "joints" if joints is not None else "topic"
+            raise ValueError(f"{wanted}: name the topic to read: the bag has {len({c.topic for c in found})} topics of "
                              f"type {' or '.join(types)}; it has: {_contents(reader)}")
         return found
     found = [c for c in reader.connections if c.topic == topic]
     if not found:
-        raise ValueError(f"the bag has no topic {topic!r}; it has: {_contents(reader)}")
+        raise ValueError(f"topic {short_token(topic, 40)} is not in the bag; it has: {_contents(reader)}")
     if found[0].msgtype not in (POSE_STAMPED, TRANSFORM_STAMPED, JOINT_STATE):
         raise ValueError(f"topic {topic} carries {found[0].msgtype}, which bidmp does not read (it reads "
-                         f"{', '.join(_READABLE)}; TFMessage with --tf); it has: {_contents(reader)}")
+                         f"{', '.join(_READABLE)}; TFMessage with tf); it has: {_contents(reader)}")
     if (found[0].msgtype == JOINT_STATE) != (joints is not None):
-        raise ValueError(f"topic {topic} carries {found[0].msgtype}: " + ("give the joints to read (--joints)" if joints is None
-                                                                        else "--joints reads a JointState topic"))
+        raise ValueError(f"topic {topic} carries {found[0].msgtype}: " + ("give joints, the joints to read" if joints is None
+                                                                        else "joints are read from a JointState topic"))
     return found
 
 
@@ -251,17 +268,43 @@ def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=Non
     """
     _rosbags()
     kind = check_choice(kind, "kind", ("pose", "joints"))
-    if isinstance(ros, bool) or ros not in (1, 2):
-        raise ValueError(f"ros must be 1 or 2, got {ros!r}")
-    t = np.asarray(t, dtype=float)
-    values = np.asarray(values, dtype=float)
-    if t.ndim != 1 or values.ndim != 2 or values.shape[0] != t.size or t.size == 0 or np.any(np.diff(t) <= 0):
-        raise ValueError("t must be increasing seconds (n,) and values (n, D) with one row per time")
+    if isinstance(ros, bool) or not isinstance(ros, int) or ros not in (1, 2):
+        raise ValueError(f"ros must be 1 or 2, got {short_token(ros)}")
+    t = as_vector(t, "t")
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("t must increase from sample to sample (seconds)")
+    values = as_trajectory(values, "values", min_points=1, allow_static=True)
+    if values.shape[0] != t.size:
+        raise ValueError(f"values has {values.shape[0]} rows but t has {t.size} times: one row per time")
     if kind == "pose" and values.shape[1] not in (3, 7):
-        raise ValueError(f"a pose stream needs 3 (x, y, z) or 7 (with qx, qy, qz, qw) columns, got {values.shape[1]}")
-    target = Path(check_path(path, "bag"))
-    topic = topic or ("/bidmp/pose" if kind == "pose" else "/bidmp/joint_trajectory")
-    names = list(names) if names is not None else [f"joint{index + 1}" for index in range(values.shape[1])]
+        raise ValueError(f"values: a pose stream needs 3 (x, y, z) or 7 (with qx, qy, qz, qw) columns, got {values.shape[1]}")
+    origin = check_real(origin, "origin", nonnegative=True)
+    # Header stamps are whole seconds in a signed 32-bit field (ROS 2; ROS 1 an unsigned one).
+    if origin + t[0] < 0 or origin + t[-1] >= 2**31:
+        raise ValueError(f"t: origin + t must lie within [0, 2**31) s (a header stamp's seconds), "
+                         f"got {origin + t[0]:.6g} to {origin + t[-1]:.6g} s")
+    target = Path(check_path(path))
+    if topic is None:
+        topic = "/bidmp/pose" if kind == "pose" else "/bidmp/joint_trajectory"
+    elif not isinstance(topic, str) or not topic.startswith("/") or len(topic) > 256 or not topic[1:].strip():
+        raise ValueError(f"topic must be a ROS topic name such as '/bidmp/pose', got {short_token(topic, 30)}")
+    if not isinstance(frame_id, str) or len(frame_id) > 256:
+        raise TypeError(f"frame_id must be a frame name (text), got {short_token(frame_id, 30)}")
+    if names is None:
+        names = [f"joint{index + 1}" for index in range(values.shape[1])]
+    elif (not isinstance(names, (list, tuple)) or len(names) != values.shape[1]
+          or not all(isinstance(name, str) and name for name in names)):
+        raise ValueError(f"names must be {values.shape[1]} joint names (text), one per column of values, "
+                         f"got {short_token(names, 30)}")
+    names = list(names)
+    rates = []
+    for rate, label in ((velocities, "velocities"), (accelerations, "accelerations")):
+        if rate is not None:
+            rate = as_trajectory(rate, label, min_points=1, allow_static=True)
+            if rate.shape != values.shape:
+                raise ValueError(f"{label} must have the shape of values {values.shape}, got {rate.shape}")
+        rates.append(rate)
+    velocities, accelerations = rates
     messages = _messages(ros, kind, t, values, names, velocities, accelerations, frame_id, origin)
     return _write_atomically(target, ros, topic, POSE_STAMPED if kind == "pose" else JOINT_TRAJECTORY, messages)
 
@@ -306,6 +349,14 @@ def _write_atomically(target: Path, ros: int, topic: str, msgtype: str, messages
     """Write into a temporary path beside ``target``, then rename it into place."""
     store, stamped = messages
     directory = target.parent if str(target.parent) else Path(".")
+    if not directory.is_dir():
+        raise ValueError(f"path: cannot write {shown_path(target)}: folder {shown_path(directory)} does not exist")
+    if target.is_dir() and not is_bag(target):  # only a bag folder is replaced, never another folder
+        raise ValueError(f"path: {shown_path(target)} is a folder that is not a ROS bag; give a new name")
+    if target.exists() and not target.is_dir() and not target.is_file():
+        raise ValueError(f"path: {shown_path(target)} is not a regular file (a device, pipe or socket)")
+    if ros == 2 and target.is_file():  # a ROS 2 bag is a folder: it does not replace a file
+        raise ValueError(f"path: {shown_path(target)} is a file; a ROS 2 bag is a folder (give a new name, or ros=1)")
     scratch = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=directory))
     built = scratch / target.name
     try:

@@ -17,7 +17,7 @@ def plot_segmentation(path, y: np.ndarray, points: np.ndarray, kinds: np.ndarray
     """The demonstration with its segmentation points (maxima ▲, minima ▼) and, if given, the
     curvature along the normalised arc length with the same points."""
     y = as_trajectory(y, "y", min_points=2, allow_static=True)
-    points = as_indices(points, "points", y.shape[0] - 1)
+    points = as_indices(points, "points", y.shape[0] - 1, "y")
     if kinds is not None:
         kinds = as_vector(kinds, "kinds", length=points.shape[0])
         if np.any(np.abs(kinds) != 1.0):

@@ -8,7 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_points, as_trajectory, check_path
+from .._checks import as_points, as_trajectory, check_limit, check_path, short_token
+from ..primitives.timing import check_timestamps
 from ._base import _figure, _label_axes, _matplotlib, _save, _sequence, _text
 
 __all__ = ['plot_trajectories', 'plot_rollout', 'plot_generalisation', 'plot_recordings']
@@ -36,14 +37,20 @@ def plot_trajectories(
     demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
     n_dims = demonstration.shape[1]
     if n_dims not in (1, 2, 3):
-        raise ValueError(f"can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
+        raise ValueError(f"demonstration: can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
     trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True)
                     for i, t in enumerate(_sequence(trajectories, "trajectories"))]
     for index, trajectory in enumerate(trajectories):
         if trajectory.shape[1] != n_dims:
             raise ValueError(f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}")
+    check_limit(len(trajectories), "max_targets", "trajectories: the number drawn")
     if goals is not None:
         goals = as_points(goals, n_dims, "goals")
+        check_limit(goals.shape[0], "max_targets", "goals: the number drawn")
+    if labels is not None:
+        labels = [_text(label, f"labels[{index}]", 200) for index, label in enumerate(_sequence(labels, "labels"))]
+    title, units = _text(title, "title", 300), _text(units, "units", 16)
+    path = check_path(path)
     mpl, fig, ax = _figure(n_dims == 3)
 
     def coords(points: np.ndarray):
@@ -148,7 +155,26 @@ def plot_generalisation(path: str | os.PathLike, result) -> Path:
     return _save(fig, path)
 
 
-def plot_recordings(path, recordings, goal_shift=None) -> Path:
+def _recording(entry, index: int) -> tuple:
+    """One entry of :func:`plot_recordings`' ``recordings``, checked."""
+    from ..demonstrations import PrepareInfo
+    from ..primitives.timing import Trajectory
+
+    where = f"recordings[{index}]"
+    if not isinstance(entry, (tuple, list)) or len(entry) != 6:
+        raise TypeError(f"{where} must be (name, y, t, prepared, info, moved), got {short_token(entry, 30)}")
+    name, y, t, prepared, info, moved = entry
+    name = _text(name, f"{where}'s name", 100)
+    y = as_trajectory(y, f"{where}'s y", min_points=2)
+    t = check_timestamps(t, y.shape[0], f"{where}'s t")
+    if not isinstance(prepared, Trajectory) or not isinstance(info, PrepareInfo):
+        raise TypeError(f"{where}: prepared and info must be what bidmp.prepare returns")
+    if moved is not None and not isinstance(moved, Trajectory):
+        raise TypeError(f"{where}: moved must be a bidmp.Trajectory or None, got {type(moved).__name__}")
+    return name, y, t, prepared, info, moved
+
+
+def plot_recordings(path, recordings) -> Path:
     """Kinesthetic recordings raw and prepared, the DMP's rollout to a moved goal, and the speed
     profiles in real time (top view, side view, speed).
 
@@ -158,10 +184,14 @@ def plot_recordings(path, recordings, goal_shift=None) -> Path:
         ``y``, ``t``: the recording; ``prepared``, ``info``: :func:`bidmp.prepare`'s result;
         ``moved``: a :class:`bidmp.Trajectory` (the rollout to the moved goal), or None.
     """
+    recordings = [_recording(entry, index) for index, entry in enumerate(_sequence(recordings, "recordings"))]
+    if not recordings:
+        raise ValueError("recordings is empty: nothing to draw")
+    path = check_path(path)
     mpl = _matplotlib()
     fig, (top, side, speed) = mpl.subplots(1, 3, figsize=(12.0, 4.6), dpi=110)
     colours = mpl.cm.tab10(np.arange(10))
-    for index, (name, y, t, prepared, info, moved) in enumerate(_sequence(recordings, "recordings")):
+    for index, (name, y, t, prepared, info, moved) in enumerate(recordings):
         colour = colours[index % 10]
         top.plot(y[:, 0], y[:, 1], color=colour, alpha=0.35, linewidth=3, label=f"{name} (raw)")
         side.plot(y[:, 0], y[:, 2], color=colour, alpha=0.35, linewidth=3)

@@ -20,7 +20,18 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_path, printable, require_extra, short_token
+from .._checks import (
+    as_point,
+    as_rotation,
+    as_trajectory,
+    as_vector,
+    check_choice,
+    check_int,
+    check_path,
+    printable,
+    require_extra,
+    short_token,
+)
 from ..io.atomic import atomic_write
 from ..io.strict_json import load_json
 
@@ -79,6 +90,10 @@ def layers_from_report(report) -> ViewLayers:
 
 def solid_layer(solid) -> dict:
     """A scene solid (:class:`bidmp.scene.parts.Solid`) as the viewer draws it."""
+    from ..scene import Solid
+
+    if not isinstance(solid, Solid):
+        raise TypeError(f"solid must be a bidmp.scene.Solid, got {type(solid).__name__}")
     return {"label": solid.label, "kind": solid.kind, "centre": np.asarray(solid.centre, float).tolist(),
             "rotation": np.asarray(solid.rotation, float).tolist(),
             "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in solid.params]}
@@ -99,19 +114,23 @@ def solid_mesh(kind: str, centre, rotation, params, sides: int = 24) -> tuple[np
     (scipy's Qhull)."""
     from scipy.spatial import ConvexHull
 
-    centre, rotation = np.asarray(centre, float), np.asarray(rotation, float)
+    kind = check_choice(kind, "kind", ("box", "cylinder", "convex"))
+    centre, rotation = as_point(centre, 3, "centre"), as_rotation(rotation, "rotation")
+    sides = check_int(sides, "sides", minimum=3, maximum=1024)
+    if not isinstance(params, (tuple, list, np.ndarray)) or getattr(params, "ndim", 1) == 0 or len(params) == 0:
+        raise TypeError(f"params must be the solid's parameters (a tuple), got {type(params).__name__}")
     if kind == "box":
-        half = np.asarray(params, float) / 2.0
+        half = as_vector(params, "params", length=3, positive=True) / 2.0
         local = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
     elif kind == "cylinder":
-        radius, height = float(params[0]), float(params[1])
+        radius, height = as_vector(params, "params", length=2, positive=True)
         angles = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
         ring = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
         local = np.vstack([np.column_stack([ring, np.full(sides, z)]) for z in (-height / 2, height / 2)])
-    elif kind == "convex":
-        local = np.asarray(params[0], float)
     else:
-        raise ValueError(f"solid kind must be box, cylinder or convex, got {kind!r}")
+        local = as_trajectory(params[0], "params[0]", min_points=4)
+        if local.shape[1] != 3 or np.linalg.matrix_rank(local - local.mean(axis=0)) < 3:
+            raise ValueError("params[0] must be the convex solid's vertices (n, 3), spanning a volume")
     vertices = local @ rotation.T + centre
     return vertices, ConvexHull(vertices).simplices  # every solid here is convex
 
@@ -210,6 +229,7 @@ _META_MAX_BYTES = 16 << 20
 def save_layers(path, layers: ViewLayers) -> Path:
     """Store ``layers`` as ``.npz`` (arrays only) with their JSON metadata and a format version."""
     path = check_path(path)
+    _check_layers(layers)
     arrays = {"demonstration": layers.demonstration, "segmentation": layers.segmentation}
     arrays.update({f"extended_{i}": p for i, p in enumerate(layers.extended)})
     rollouts = {}
@@ -228,6 +248,11 @@ def save_layers(path, layers: ViewLayers) -> Path:
     with atomic_write(path, "wb") as handle:
         np.savez_compressed(handle, **{k: np.asarray(v) for k, v in arrays.items()})
     return path
+
+
+def _check_layers(layers) -> None:
+    if not isinstance(layers, ViewLayers):
+        raise TypeError(f"layers must be bidmp.plotting.ViewLayers, got {type(layers).__name__}")
 
 
 def _json_bytes(shape, dtype) -> None:

@@ -187,6 +187,7 @@ class Motions:
             ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
         """
         self._check_fitted()
+        _check_forcing_increment(forcing_increment)  # every path below takes it
         if via is not None:
             return _via_trajectory(self, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
                                    via_until)

@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from .._checks import check_choice, check_real
+from .._checks import as_labels, check_choice, check_real
 from .coupling import CouplingTerm
 
 __all__ = ["SceneAvoidance", "AvoidanceError"]
@@ -110,9 +110,10 @@ class SceneAvoidance(CouplingTerm):
         self.max_acceleration = None if max_acceleration is None else check_real(max_acceleration, "max_acceleration", positive=True)
         self.approach = None if approach is None else check_real(approach, "approach", nonnegative=True)
         self.on_miss = check_choice(on_miss, "on_miss", ("raise", "warn"))
+        if target is not None and not isinstance(target, str):
+            raise TypeError(f"target must be the target's label (a string) or None, got {type(target).__name__}")
         self.target = target
-        excluded = [exclude] if isinstance(exclude, str) else list(exclude)
-        self.exclude = tuple(excluded)
+        self.exclude = tuple([exclude] if isinstance(exclude, str) else as_labels(exclude, "exclude"))
         self._proximity = None
         self._goal = None
 
@@ -121,7 +122,10 @@ class SceneAvoidance(CouplingTerm):
         strength, the target's parts left out, and the final approach's length."""
         from ..scene.proximity import Proximity
         from .approach import _straight_tail_start
+        from .stepper import DMPStepper
 
+        if not isinstance(stepper, DMPStepper):
+            raise TypeError(f"stepper must be the DMPStepper that runs the term, got {type(stepper).__name__}")
         self._goal = stepper.target
         if self.approach is None:  # the motion's own straight tail, the skill's increment included
             plain = stepper._dmp.rollout(stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment)
@@ -139,7 +143,7 @@ class SceneAvoidance(CouplingTerm):
         self.excluded_ = tuple(sorted(excluded))
         # The parts the term would push against with the tool at the goal itself (a neighbouring
         # nut beside the socket): only these fade out along the final approach.
-        beside = self._proximity.near(np.asarray(self._goal, dtype=float), self.margin + self.influence)[3]
+        beside = self._proximity._near(np.asarray(self._goal, dtype=float), self.margin + self.influence)[3]
         self._at_goal = np.zeros(self._proximity.standoffs.shape[0], dtype=bool)
         self._at_goal[beside] = True
         self._fades = bool(beside.size)
@@ -148,7 +152,7 @@ class SceneAvoidance(CouplingTerm):
         if self._proximity is None:
             raise ValueError("SceneAvoidance is run by a DMP's trajectory or stepper (which binds it to the motion)")
         fade = self._fade(y) if self._fades else 1.0
-        distances, away, owed, solids = self._proximity.near(y, self.margin + self.influence,
+        distances, away, owed, solids = self._proximity._near(y, self.margin + self.influence,
                                                              self._at_goal if fade == 0.0 else None)
         if distances.size == 0:
             return np.zeros(3)

@@ -42,6 +42,7 @@ from .._checks import (
 from .._state import Prefixed
 from .._trajectory import continuous_quaternions as _continuous
 from .dmp import DMP
+from .forcing import _check_forcing_increment
 from .goals import _arclength_progress
 from .pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
 from .so3 import (
@@ -67,7 +68,10 @@ def orientation_error(q, goal) -> np.ndarray:
 
 def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Split ``(T, 7)`` poses into positions ``(T, 3)`` and validated quaternions ``(T, 4)``."""
-    array = as_trajectory(poses, name, min_points=check_int(min_points, "min_points", minimum=1), allow_static=True)
+    if not isinstance(name, str) or not name or len(name) > 100:
+        raise TypeError(f"name must be the argument's name (a short string), got {type(name).__name__}")
+    min_points = check_int(min_points, "min_points", minimum=1, limit="max_samples")
+    array = as_trajectory(poses, name, min_points=min_points, allow_static=True)
     if array.shape[1] != 7:
         raise ValueError(f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}")
     return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
@@ -215,6 +219,8 @@ class CartesianDMP(CheckedParams, BaseEstimator):
             own motion at that time (both least-norm, as :meth:`bidmp.DMP.trajectory`).
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
+        _check_forcing_increment(position_increment, "position_increment")
+        _check_forcing_increment(orientation_increment, "orientation_increment")
         vias = None if via is None else _pose_vias(self.orientation_, via, goal_q, start_e, duration, dt, orientation_increment)
         return _pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
                                 limits, position_increment, orientation_increment, self.units_, coupling, vias)
@@ -257,7 +263,7 @@ class CartesianDMP(CheckedParams, BaseEstimator):
 def _pose_vias(orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment) -> tuple[list, list]:
     """(position via-points, orientation-error via-points) of via poses ``[(t, pose (7,)), ...]``;
     ``orientation`` the orientation part (a DMP) and its skill's increment."""
-    if isinstance(via, (str, bytes)) or not hasattr(via, "__len__"):
+    if not isinstance(via, (list, tuple)):
         raise TypeError(f"via must be a list of (t_seconds, pose) pairs, got {type(via).__name__}")
     pairs = []
     for index, pair in enumerate(via):

@@ -16,6 +16,8 @@ coupling terms and belong here, one small class each.
 
 from __future__ import annotations
 
+import math
+
 from collections.abc import Sequence
 
 import numpy as np
@@ -47,17 +49,22 @@ class PhaseStopping(CouplingTerm):
     """
 
     def __init__(self, gain: float) -> None:
-        self.gain = check_real(gain, "coupling", nonnegative=True, maximum=1e6)
+        self.gain = check_real(gain, "gain", nonnegative=True, maximum=1e6)
 
     def __call__(self, t: float, y: np.ndarray, yd: np.ndarray, phase: float) -> np.ndarray:
         return np.zeros_like(y)
 
     def slowdown(self, y: np.ndarray, y_measured) -> float:
         """How many times slower the system's time runs for a measurement ``y_measured`` (D,)."""
+        if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):  # a stepper's own state passes as is
+            y = as_vector(y, "y")
         if y_measured is None or self.gain == 0.0:
             return 1.0
-        error = as_point(y_measured, y.shape[0], "y_measured") - y
-        return 1.0 + self.gain * float(error @ error)
+        error = as_point(y_measured, y.shape[0], "y_measured", like="y") - y
+        slowdown = 1.0 + self.gain * float(error @ error)
+        if not math.isfinite(slowdown):
+            raise ValueError("y must be finite numbers (the command), and so must y_measured")
+        return slowdown
 
 
 class ConstantAcceleration(CouplingTerm):
@@ -81,7 +88,7 @@ def _as_couplings(coupling) -> tuple[list, list]:
     if coupling is None:
         return [], []
     if isinstance(coupling, (int, float, np.integer, np.floating)) and not isinstance(coupling, bool):
-        return [], [PhaseStopping(coupling)]
+        return [], [PhaseStopping(check_real(coupling, "coupling", nonnegative=True, maximum=1e6))]
     terms = [coupling] if callable(coupling) else coupling
     if not isinstance(terms, Sequence) or isinstance(terms, (str, bytes)):
         raise TypeError(f"coupling must be a number (the phase-stopping gain), a coupling term or a list of them, "

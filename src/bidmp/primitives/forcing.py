@@ -84,7 +84,7 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
     centres = as_vector(centres, "centres", positive=True)
     widths = as_vector(widths, "widths", positive=True)
     if widths.shape != centres.shape:
-        raise ValueError(f"widths must have one entry per centre ({centres.shape[0]}), got {widths.shape[0]}")
+        raise ValueError(f"widths must have one entry per entry of centres ({centres.shape[0]}), got {widths.shape[0]}")
     return _basis_rows(phase, centres, widths)
 
 
@@ -229,8 +229,8 @@ def _as_phase(phase, name: str = "phase") -> np.ndarray:
     return phase
 
 
-def _check_forcing_increment(forcing_increment) -> None:
+def _check_forcing_increment(forcing_increment, name: str = "forcing_increment") -> None:
     """Refuse a forcing increment that is not a callable ``f(phase (n,), basis (n, N)) -> (n, D)``."""
     if forcing_increment is not None and not callable(forcing_increment):
-        raise TypeError(f"forcing_increment must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
+        raise TypeError(f"{name} must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
                         f"{type(forcing_increment).__name__}")

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._checks import as_vector, short_token
 from .goals import _smoothstep, _smoothstep_derivatives
 
 __all__ = []
@@ -32,10 +33,13 @@ def _shortest_blend(delta: np.ndarray, limits: dict | None) -> float:
     scalars, on the norm); 0 without limits."""
     size = float(np.linalg.norm(delta))
     shortest = 0.0
+    if limits is not None and (not isinstance(limits, dict) or set(limits) - {"max_velocity", "max_acceleration", "max_jerk"}):
+        raise ValueError(f"limits must be a dict of max_velocity, max_acceleration and max_jerk (units/s, /s², /s³), "
+                         f"got {short_token(limits, 40)}")
     for power, key in enumerate(("max_velocity", "max_acceleration", "max_jerk"), start=1):
         limit = None if not limits else limits.get(key)
         if limit is not None and size > 0.0:
-            limit = float(np.min(limit))
+            limit = float(np.min(as_vector(limit, f"limits[{key!r}]", positive=True)))
             shortest = max(shortest, (size * _PEAKS[power - 1] / (_LIMIT_SHARE * limit)) ** (1.0 / power))
     return shortest
 

@@ -44,11 +44,12 @@ overshoot itself is far smaller (``σ (1 - S)`` peaks near ``w/2``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_vector, check_real
+from .._checks import as_vector, check_bool, check_int, check_real
 from .._trajectory import arclength
 from .canonical import phase_grid
 
@@ -142,6 +143,30 @@ def _training_progress(train: np.ndarray, progress) -> np.ndarray:
     return progress
 
 
+# -- the goal systems' arguments, checked (a user may drive a goal system of their own) ------------
+_MAX_STEP = 1e3  # normalised time of one step: a motion lasts 1
+
+
+def _step_args(gate, phase, step, tau, exact) -> tuple[float, float, float, float, bool]:
+    return (check_real(gate, "gate"), check_real(phase, "phase", minimum=0.0, maximum=1.0),
+            check_real(step, "step", nonnegative=True, maximum=_MAX_STEP), check_real(tau, "tau", positive=True),
+            check_bool(exact, "exact"))
+
+
+def _grid_args(phase, step, tau, exact) -> tuple[np.ndarray, float, float, bool]:
+    phase = as_vector(phase, "phase")
+    if np.any((phase < 0.0) | (phase > 1.0)):
+        raise ValueError("phase must lie in [0, 1]")
+    # one sample has no spacing: a step of 0 is then as good as any
+    step = check_real(step, "step", positive=phase.shape[0] > 1, nonnegative=True, maximum=_MAX_STEP)
+    return phase, step, check_real(tau, "tau", positive=True), check_bool(exact, "exact")
+
+
+def _training_args(n_train, dt, exact) -> tuple[int, float, bool]:
+    return (check_int(n_train, "n_train", minimum=1, limit="max_steps"), check_real(dt, "dt", positive=True, maximum=1.0),
+            check_bool(exact, "exact"))
+
+
 # -- goal systems ----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class DelayedGoal:
@@ -154,15 +179,21 @@ class DelayedGoal:
 
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         """The gate at a rollout grid's samples (``step`` apart in normalised time)."""
+        phase, step, tau, exact = _grid_args(phase, step, tau, exact)
         return phase_grid(phase.shape[0], step, tau, self.rate, exact=exact)
 
     def training_gate(self, n_train: int, dt: float, exact: bool) -> np.ndarray:
         """The gate on the training grid (``tau = 1``)."""
+        n_train, dt, exact = _training_args(n_train, dt, exact)
         return phase_grid(n_train, dt, 1.0, self.rate, exact=exact)
 
     def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         """The gate one control step of ``step`` (normalised time) after ``gate``."""
-        return gate * (float(np.exp(-self.rate * step / tau)) if exact else 1.0 - self.rate * (step / tau))
+        return self._follow(*_step_args(gate, phase, step, tau, exact))
+
+    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        """:meth:`follow` on checked arguments (a stepper's control loop asks it every step)."""
+        return gate * (math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau))
 
 
 @dataclass(frozen=True)
@@ -171,9 +202,12 @@ class PhaseGate(DelayedGoal):
     ``K = αβ``). It is the phase itself, so it costs nothing."""
 
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
-        return phase
+        return _grid_args(phase, step, tau, exact)[0]
 
     def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        return self._follow(*_step_args(gate, phase, step, tau, exact))
+
+    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         return phase
 
 
@@ -210,15 +244,19 @@ class ProgressGate:
         return _goal_gate(_goal_share(progress, n_motion, dt), dt, alpha=alpha, beta=beta, K=K)
 
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
-        return np.interp(phase, *self._lookup)
+        return np.interp(_grid_args(phase, step, tau, exact)[0], *self._lookup)
 
     def training_gate(self, n_train: int, dt: float, exact: bool) -> np.ndarray:
         """The learned gate itself (the training grid is the one it was learned on)."""
+        n_train, dt, exact = _training_args(n_train, dt, exact)
         if n_train != self.gate.shape[0]:
-            raise ValueError(f"the progress gate was learned on {self.gate.shape[0]} samples, not {n_train}")
+            raise ValueError(f"n_train: the progress gate was learned on {self.gate.shape[0]} samples, not {n_train}")
         return self.gate
 
     def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        return self._follow(*_step_args(gate, phase, step, tau, exact))
+
+    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         return float(np.interp(phase, *self._lookup))
 
 

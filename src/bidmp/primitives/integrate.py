@@ -30,6 +30,7 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.signal import lfilter
 
+from .._checks import as_vector, check_bool, check_real
 from .canonical import _phase_decay
 
 GEMM_GOALS = 64  # rollouts to this many goals and more: one matrix product
@@ -297,14 +298,27 @@ class StepIntegrator:
     """
 
     def __init__(self, alpha: float, beta: float, tau: float, exact: bool) -> None:
-        self.alpha, self.beta, self.tau, self.exact = alpha, beta, tau, exact
+        self.alpha = check_real(alpha, "alpha", positive=True)
+        self.beta = check_real(beta, "beta", positive=True)
+        self.tau = check_real(tau, "tau", positive=True)
+        self.exact = check_bool(exact, "exact")
         self._checked_step = None
         self._floats = None  # (step, the exact step's coefficients as floats) of the last step
 
     def step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
              step: float) -> tuple[np.ndarray, np.ndarray]:
         """The state ``step`` (normalised time) later; ``u_next`` (the input at the step's end) is
-        read by the exact step only."""
+        read by the exact step only. ``y``, ``z``, ``u_now`` and ``u_next`` are (D,) arrays."""
+        y, z, u_now, u_next = (as_vector(value, name) for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"),
+                                                                        (u_next, "u_next")))
+        if not y.shape == z.shape == u_now.shape == u_next.shape:
+            raise ValueError(f"y, z, u_now and u_next must have one value per dimension each, got "
+                             f"{y.shape[0]}, {z.shape[0]}, {u_now.shape[0]} and {u_next.shape[0]}")
+        return self._step(y, z, u_now, u_next, check_real(step, "step", positive=True, maximum=1e3))
+
+    def _step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
+              step: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`step` on arguments a stepper has checked (its control loop calls it every step)."""
         alpha, beta, tau = self.alpha, self.beta, self.tau
         if self.exact:
             # Row by row with Python floats: a control loop's step is a few (D,) arrays, where

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import as_point
+from .._checks import as_point, as_vector
 from .goal_shift import _GoalShifts
 from .so3 import _left_jacobian, as_quaternions, orientation_from_log, principal_log
 from .timing import TimedMotion, _validate_motion
@@ -149,7 +149,11 @@ class PoseStepper:
         """Command pose, velocity and acceleration now; advance ``dt`` s (less while the measured
         position lags)."""
         before = self.position.time
-        y, yd, ydd = self.position.step(dt, None if y_measured is None else np.asarray(y_measured, dtype=float)[:3])
+        if y_measured is not None:
+            y_measured = as_vector(y_measured, "y_measured")
+            if y_measured.shape[0] not in (3, 7):
+                raise ValueError(f"y_measured must be a position (3,) or a pose (7,), got {y_measured.shape[0]} values")
+        y, yd, ydd = self.position.step(dt, None if y_measured is None else y_measured[:3])
         advanced = self.position.time - before
         e, ed, edd = self.orientation.step(max(advanced, 1e-6))
         pace = advanced / dt if dt > 0 else 1.0

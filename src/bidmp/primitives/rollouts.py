@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_points, check_bytes, get_limits
+from .._checks import as_points, check_bytes, check_limit, get_limits
 from .integrate import _affine_rollouts
 
 __all__ = []
@@ -16,7 +16,7 @@ def _rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.nda
     """The rollouts ``free + B goals[i]`` (G, n, D) of a model's free response ``free`` (n, D) and
     goal response ``goal_response`` (n,), into ``out`` if given (else refused over the limit
     ``max_array_bytes``)."""
-    goals = as_points(goals, free.shape[1], "goals")
+    goals = _goals(goals, free)
     shape = (goals.shape[0], *free.shape)
     if out is None:
         n_bytes = 8 * goals.shape[0] * free.size
@@ -24,11 +24,10 @@ def _rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.nda
         if n_bytes > budget:
             chunk = max(budget // (8 * free.size), 1)
             raise ValueError(
-                f"rollout_many: {goals.shape[0]:,} goals x {free.shape[0]:,} steps x {free.shape[1]} dims would take "
-                f"{n_bytes / 2**30:.3g} GiB in one array, over the limit max_array_bytes = {budget / 2**30:.3g} GiB; "
-                f"write into a file with out=numpy.lib.format.open_memmap(path, mode='w+', dtype='float64', "
-                f"shape={shape}), iterate with iter_rollouts(goals, chunk_size={chunk:,}), or raise the limit "
-                f"with bidmp.set_limits(max_array_bytes=...)"
+                f"goals: {goals.shape[0]:,} goals x {free.shape[0]:,} steps x {free.shape[1]} dims would take "
+                f"{n_bytes / 2**30:.3g} GiB, over max_array_bytes = {budget / 2**30:.3g} GiB; give out= (a "
+                f"numpy.lib.format.open_memmap of shape {shape}), use iter_rollouts(goals, chunk_size={chunk:,}) "
+                f"or raise the limit"
             )
         return _affine_rollouts(goal_response, goals, free)
     if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
@@ -47,9 +46,18 @@ def _chunks(goals: np.ndarray, free: np.ndarray, chunk_size: int | None = None):
         yield first, goals[first : first + chunk_size]
 
 
+def _goals(goals, free: np.ndarray) -> np.ndarray:
+    """Goals (G, D) of a batch: at most ``max_samples`` of them, and no more rollout samples in all
+    than ``max_work`` (each goal is a whole motion: the total work is bounded, not only one array)."""
+    goals = as_points(goals, free.shape[1], "goals")
+    check_limit(goals.shape[0], "max_samples", "goals: the number of goals")
+    check_limit(goals.shape[0] * free.size, "max_work", "goals: the rollouts' samples in all (goals x n_steps x D)")
+    return goals
+
+
 def _iter_rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, chunk_size: int):
     """:func:`_rollouts_to`, ``chunk_size`` goals at a time: yields ``(first, y (g, n, D))``."""
-    goals = as_points(goals, free.shape[1], "goals")
+    goals = _goals(goals, free)
     check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
     for first, chunk in _chunks(goals, free, chunk_size):
         yield first, _affine_rollouts(goal_response, chunk, free)

@@ -17,7 +17,7 @@ import warnings
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import _as_float_array, _check_magnitude
+from .._checks import _as_bounded_array, _check_magnitude, check_limit
 from .._trajectory import continuous_quaternions
 
 __all__ = ["as_quaternions", "principal_log", "continuous_log", "angle_between",
@@ -28,18 +28,21 @@ _AXIS_FLOOR = 1e-6  # below this angle (rad) a rotation's axis is noise: the nei
 _TWO_PI = 2.0 * math.pi
 
 
-def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
+def as_quaternions(q, name: str = "q") -> np.ndarray:
     """Validate quaternions ``(n, 4)`` (x, y, z, w): finite, not zero; non-unit ones are
-    normalised with a warning; signs made continuous."""
+    normalised with a warning; signs made continuous. ``name``: the argument's name in messages."""
+    if not isinstance(name, str) or not name or len(name) > 100:
+        raise TypeError(f"name must be the argument's name (a short string), got {type(name).__name__}")
     if isinstance(q, (str, bytes)):
         raise TypeError(f"{name} must be an array of numbers, got a string")
-    array = _as_float_array(q, name)  # None, complex and objects refused, naming the argument
+    array = _as_bounded_array(q, name, 2)  # None, complex, objects and oversized arrays refused, naming the argument
     if array.ndim == 1:
         array = array[None]
-    if array.ndim != 2 or array.shape[1] != 4:
+    if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:
         raise ValueError(f"{name} must have shape (n, 4) (qx, qy, qz, qw), got {np.shape(q)}")
+    check_limit(array.shape[0], "max_samples", f"{name}: the number of quaternions")
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} contain NaN or inf")
+        raise ValueError(f"{name} contains NaN or inf")
     # Scaled by the largest component first, so that 1e200 and 1e-200 quaternions normalise too.
     largest = np.max(np.abs(array), axis=1, keepdims=True)
     if np.any(largest < 1e-300):
@@ -58,9 +61,10 @@ def as_quaternions(q, name: str = "quaternions") -> np.ndarray:
 def _quaternion_rows(q, name: str) -> np.ndarray:
     """Quaternions (n, 4) or one (4,) checked at the boundary: real, finite, not zero. Their values
     are left as given (SciPy normalises them), so a checked call computes what an unchecked one did."""
-    array = np.atleast_2d(_as_float_array(q, name))
+    array = np.atleast_2d(_as_bounded_array(q, name, 2))
     if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:
         raise ValueError(f"{name} must have shape (n, 4) or (4,) (qx, qy, qz, qw), got {np.shape(q)}")
+    check_limit(array.shape[0], "max_samples", f"{name}: the number of quaternions")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
     if np.any(np.linalg.norm(array, axis=1) == 0.0):
@@ -70,9 +74,10 @@ def _quaternion_rows(q, name: str) -> np.ndarray:
 
 def _vector_rows(r, name: str) -> np.ndarray:
     """Rotation vectors (n, 3) or one (3,) (rad) checked at the boundary: real and finite."""
-    array = np.atleast_2d(_as_float_array(r, name))
-    if array.ndim != 2 or array.shape[1] != 3:
+    array = np.atleast_2d(_as_bounded_array(r, name, 2))
+    if array.ndim != 2 or array.shape[1] != 3 or array.shape[0] == 0:
         raise ValueError(f"{name} must have shape (n, 3) or (3,) (rotation vectors, rad), got {np.shape(r)}")
+    check_limit(array.shape[0], "max_samples", f"{name}: the number of rotation vectors")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
     _check_magnitude(array, name)  # rotations of 1e300 rad overflow the Jacobian's products
@@ -81,7 +86,13 @@ def _vector_rows(r, name: str) -> np.ndarray:
 
 def principal_log(q, goal) -> np.ndarray:
     """Rotation vectors ``Log(q ⊗ goal⁻¹)`` (n, 3) with angles in [0, π] (SciPy's ``as_rotvec``)."""
-    q, goal = _quaternion_rows(q, "q"), _quaternion_rows(goal, "goal")
+    return _principal_log(q, goal, "q", "goal")
+
+
+def _principal_log(q, goal, q_name: str, goal_name: str) -> np.ndarray:
+    q, goal = _quaternion_rows(q, q_name), _quaternion_rows(goal, goal_name)
+    if goal.shape[0] not in (1, q.shape[0]):
+        raise ValueError(f"{goal_name} has {goal.shape[0]} quaternions; give one, or one per row of {q_name} ({q.shape[0]})")
     return (Rotation.from_quat(q) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal).inv()).as_rotvec()
 
 
@@ -137,7 +148,7 @@ def _nearest_turn(q, goal, reference: np.ndarray) -> np.ndarray:
 
 def angle_between(q, p) -> np.ndarray:
     """The angle (rad, in [0, π]) of the rotation between orientations ``q`` and ``p`` (n,)."""
-    return np.linalg.norm(principal_log(q, p), axis=-1)
+    return np.linalg.norm(_principal_log(q, p, "q", "p"), axis=-1)
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -163,5 +174,7 @@ def _left_jacobian(r: np.ndarray) -> np.ndarray:
 def orientation_from_log(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
     """Unit quaternions ``Exp(e) ⊗ goal`` (n, 4), signs continuous."""
     error, goal = _vector_rows(error, "error"), _quaternion_rows(goal, "goal")
+    if goal.shape[0] not in (1, error.shape[0]):
+        raise ValueError(f"goal has {goal.shape[0]} quaternions; give one, or one per row of error ({error.shape[0]})")
     q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal)).as_quat()
     return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))

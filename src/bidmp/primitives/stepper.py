@@ -21,6 +21,9 @@ __all__ = ["DMPStepper"]
 logger = logging.getLogger(__name__)
 
 
+_SHORTEST_BLEND = 1e-6  # s
+
+
 class DMPStepper:
     """Integrates a DMP (or a Bi-DMP skill) one control step at a time.
 
@@ -42,6 +45,10 @@ class DMPStepper:
     """
 
     def __init__(self, dmp, goal, start, duration, coupling, start_velocity, forcing_increment) -> None:
+        from .dmp import DMP
+
+        if not isinstance(dmp, DMP):
+            raise TypeError(f"dmp must be a fitted bidmp.DMP (DMP.stepper() builds its stepper), got {type(dmp).__name__}")
         dmp._check_fitted()
         params = dmp._params()
         self._dmp = dmp
@@ -65,7 +72,7 @@ class DMPStepper:
         self._last_input = None  # (phase, gate, goal, start, u): the end of one step starts the next
         self.phase = 1.0
         self._gate = 1.0
-        self._gate = self._goal_system.follow(1.0, 1.0, 0.0, self._scale, params.exact)
+        self._gate = self._goal_system._follow(1.0, 1.0, 0.0, self._scale, params.exact)
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
         self._complete = None  # the motion time its own goal offset completes (set_goal asks for it)
@@ -120,12 +127,14 @@ class DMPStepper:
         delta = as_point(goal, self.goal.shape[0], "goal") - self.target
         if blend is None:
             complete = self._goal_complete()
-            blend = max(complete - self.time, _shortest_blend(delta, limits if limits else self._own_peaks()))
+            blend = max(complete - self.time, _shortest_blend(delta, limits if limits is not None else self._own_peaks()))
             if self.time + blend > complete + 1e-9 and np.any(delta != 0.0):
                 logger.warning("set_goal at %.3f s: the goal's offset ends %.3f s after the final approach began; "
                                "the approach is not a translated copy", self.time, self.time + blend - complete)
         else:
             blend = check_real(blend, "blend", nonnegative=True, maximum=1e6)
+            if 0.0 < blend < _SHORTEST_BLEND:  # below it a blend's acceleration is not a number
+                raise ValueError(f"blend must be 0 (a jump) or at least {_SHORTEST_BLEND:g} s, got {blend:g}")
         self._shifts.add(delta, self.time, blend)
         return float(blend)
 
@@ -212,11 +221,11 @@ class DMPStepper:
             acceleration = acceleration + offset[2] / slowdown**2
         decay_phase = math.exp(-params.alpha_phase * step / tau) if params.exact else 1.0 - params.alpha_phase * (step / tau)
         phase = self.phase * decay_phase
-        gate = self._goal_system.follow(self._gate, phase, step, tau, params.exact)
+        gate = self._goal_system._follow(self._gate, phase, step, tau, params.exact)
         input_next = self._input(phase, gate) if params.exact else input_now
         if self._couplings and params.exact:
             input_next = input_next + push
-        self.y, self._z = self._integrator.step(self.y, self._z, input_now, input_next, step)
+        self.y, self._z = self._integrator._step(self.y, self._z, input_now, input_next, step)
         self.phase, self._gate = phase, gate
         self.time += dt / slowdown
         return position, velocity, acceleration

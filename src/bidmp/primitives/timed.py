@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_point, check_int, check_real, get_limits
+from .._checks import as_point, check_int, check_real, get_limits, short_token
 from .._units import check_reach
 from .avoidance import SceneAvoidance, _check_avoidance
 from .integrate import _exact_state
@@ -25,7 +25,7 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
     period = dmp.duration_ / (dmp.n_steps_ - 1)
     dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)  # 1 MHz at most
     if dt > motion:
-        raise ValueError(f"dt = {dt:g} s is longer than the motion ({motion:g} s)")
+        raise ValueError(f"dt = {dt:g} s is longer than the motion's duration ({motion:g} s)")
     scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched
     check_real(scale, "duration / duration_ (the temporal scaling)", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
     if params.protocol == "paper" and duration is None and dt == period:
@@ -77,22 +77,28 @@ def _exact_rates(params: _Params, positions, forcing, gate, goal, start, velocit
     return z / (params.tau * time_unit), acceleration / time_unit**2
 
 
-def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
-    """The trajectory within ``limits``: at the nominal duration if that meets them (limits
-    are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
-    shortest duration that does: scale by the exact factor of
-    :func:`bidmp.primitives.timing.scale_factor`, then bisect for what the discretisation changes."""
+def _checked_limits(limits) -> tuple[dict, bool]:
+    """A trajectory's ``limits`` dict as :func:`scale_factor`'s keywords, and its ``fastest`` flag."""
     if not isinstance(limits, dict):
         raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
                         f"got {type(limits).__name__}")
     unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm", "fastest"}
     if unknown:
-        raise ValueError(f"limits has unknown key(s) {sorted(unknown)}; known: max_velocity, max_acceleration, "
-                         f"max_jerk, norm, fastest")
+        raise ValueError(f"limits has unknown key(s) {short_token(sorted(map(str, unknown)), 40)}; known: max_velocity, "
+                         f"max_acceleration, max_jerk, norm, fastest")
     limits = dict(limits)
     fastest = limits.pop("fastest", False)
     if not isinstance(fastest, (bool, np.bool_)):
         raise TypeError(f"limits['fastest'] must be True or False, got {type(fastest).__name__}")
+    return limits, bool(fastest)
+
+
+def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
+    """The trajectory within ``limits``: at the nominal duration if that meets them (limits
+    are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
+    shortest duration that does: scale by the exact factor of
+    :func:`bidmp.primitives.timing.scale_factor`, then bisect for what the discretisation changes."""
+    limits, fastest = _checked_limits(limits)
 
     def attempt(duration):
         trajectory = dmp.trajectory(goal, start=start, duration=duration, dt=dt, start_velocity=start_velocity,

@@ -14,16 +14,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import (
+    _as_bounded_array,
     _as_float_array,
     _check_finite,
     check_choice,
+    check_text,
     check_int,
+    check_limit,
     numerically_guarded,
     short_token,
 )
 
 __all__ = ["Trajectory", "TimedMotion", "check_timestamps", "uniform_time", "on_uniform_time", "scale_factor",
            "time_scale"]
+
+_FACTORS = (1e-9, 1e9)  # the time stretch a limit may ask for (beyond it no motion of this world)
 
 logger = logging.getLogger(__name__)
 
@@ -102,7 +107,8 @@ def _validate_motion(motion, kind: str, fields) -> None:
     for name, width in fields:
         array = _as_float_array(getattr(motion, name), f"{kind}.{name}")
         if array.ndim != 2 or array.shape[0] != n or (width is not None and array.shape[1] != width):
-            raise ValueError(f"{kind}.{name} must have shape ({n}, {width or 'D'}), got {array.shape}")
+            raise ValueError(f"{kind}.{name} must have shape ({n}, {width or 'D'}): one row per time of {kind}.t, "
+                             f"got {array.shape}")
         _check_finite(array, f"{kind}.{name}")
         object.__setattr__(motion, name, array)
     object.__setattr__(motion, "units", check_units(motion.units, f"{kind}.units"))
@@ -116,17 +122,18 @@ def _as_stamps(t, name: str) -> np.ndarray:
 
 def _as_samples(y, name: str = "y") -> np.ndarray:
     """Samples (T, D) checked at a public boundary: real, two-dimensional, finite."""
-    array = _as_float_array(y, name)
+    array = _as_bounded_array(y, name, 2)
     if array.ndim == 1:
         array = array[:, None]
     if array.ndim != 2 or array.shape[0] == 0:
         raise ValueError(f"{name} must have shape (T, D) with T >= 1, got {np.shape(y)}")
+    check_limit(array.shape[0], "max_samples", f"{name}: the number of samples T")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
     return array
 
 
-def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
+def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> np.ndarray:
     """Validate timestamps (s) for ``n_samples`` samples and return them as float64 (n,).
 
     Any monotone stamps are accepted: jittered, starting anywhere (epoch seconds included).
@@ -137,10 +144,14 @@ def check_timestamps(t, n_samples: int, name: str = "t") -> np.ndarray:
         If they are not finite, not strictly increasing (duplicates are named), or imply a mean
         sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
     """
-    n_samples = check_int(n_samples, "n_samples", minimum=1)
+    name, samples = check_text(name, "name", 4096), check_text(samples, "samples")
+    if len(name) > 100:  # a name built from a file's path: its ends tell it apart
+        name = f"{name[:40]}…{name[-59:]}"
+    n_samples = check_int(n_samples, "n_samples", minimum=1, limit="max_samples")
     stamps = _as_stamps(t, name)
     if stamps.ndim != 1 or stamps.shape[0] != n_samples:
-        raise ValueError(f"{name} must have shape ({n_samples},) (one time per sample), got {stamps.shape}")
+        of = samples or "n_samples"
+        raise ValueError(f"{name} must have one time per sample ({of}: {n_samples}), got shape {stamps.shape}")
     if not np.all(np.isfinite(stamps)):
         raise ValueError(f"{name} contains NaN or inf")
     if np.max(np.abs(stamps)) > 1e12:
@@ -184,14 +195,14 @@ def _drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarra
             logger.warning("%s: dropped %d sample(s) whose timestamp repeats the one before (the first at sample %d, "
                            "%s s)", name, int(repeated.sum()), first, _stamp(stamps[first]))
             y, stamps = y[~repeated], stamps[~repeated]
-    return y, check_timestamps(stamps, y.shape[0] if y.ndim else 0, name)
+    return y, check_timestamps(stamps, y.shape[0] if y.ndim else 0, name, "the rows of y")
 
 
 def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``y`` sampled at stamps ``t`` resampled to as many uniform samples over the same span;
     returns (y_uniform (n, D), t_uniform (n,) starting at 0)."""
     y = _as_samples(y)
-    t = check_timestamps(t, y.shape[0])
+    t = check_timestamps(t, y.shape[0], "t", "the rows of y")
     t = t - t[0]
     grid = np.linspace(0.0, t[-1], t.shape[0])
     steps = np.diff(t)
@@ -245,12 +256,16 @@ def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=Non
         if values is None:
             values = np.gradient(trajectory.ydd, trajectory.t, axis=0)
         peaks = _peaks(values, norm)
-        factors.append(float(np.max((peaks / limits) ** (1.0 / power))))
+        with np.errstate(over="ignore", divide="ignore", under="ignore"):  # judged below, by name
+            factors.append((float(np.max((peaks / limits) ** (1.0 / power))), name))
     if not factors:
         raise ValueError("time_scale needs at least one of max_velocity, max_acceleration, max_jerk")
-    factor = max(factors)
+    factor, binding = max(factors)
     if factor <= 0.0:
         raise ValueError("the trajectory does not move: there is no time scaling that touches a limit")
+    if not _FACTORS[0] <= factor <= _FACTORS[1]:
+        raise ValueError(f"{binding}: the limits would stretch the motion's time by {factor:.3g}, beyond "
+                         f"[{_FACTORS[0]:g}, {_FACTORS[1]:g}]; give limits in the trajectory's units per second")
     return factor
 
 

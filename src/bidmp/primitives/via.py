@@ -24,7 +24,7 @@ import numpy as np
 from .._checks import as_point, check_real
 from .grid import _rollout_grid
 from .integrate import _unit_responses
-from .timed import _time_grid
+from .timed import _checked_limits, _time_grid
 from .timing import scale_factor
 
 __all__ = []
@@ -44,7 +44,7 @@ _MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)  # peak acceleration of a rest-to-rest 
 def _parse_via(via, n_dims: int, horizon: float) -> tuple[np.ndarray, np.ndarray]:
     """(times (m,) s, points (m, D)) of ``via`` = ``[(t, point), ...]``, validated; ``horizon``
     (s) is the motion's duration (after it the motion settles at its goal)."""
-    if isinstance(via, (str, bytes)) or not hasattr(via, "__len__"):
+    if not isinstance(via, (list, tuple)):
         raise TypeError(f"via must be a list of (t_seconds, point) pairs, got {type(via).__name__}")
     times, points = [], []
     for index, pair in enumerate(via):
@@ -181,6 +181,8 @@ def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forc
     via-points at other times)."""
     if start_velocity is not None:
         raise ValueError("via-points are solved for a motion from rest: start_velocity cannot be given with via")
+    if limits is not None:
+        limits = _checked_limits(limits)[0]  # checked before the solve; "fastest" does not apply (not re-timed)
     params = dmp._params()
     motion, dt_used, n_samples, step = _time_grid(dmp, duration, dt, params)
     times, points = _parse_via(via, dmp.n_dims_, min(motion, (n_samples - 1) * dt_used))
@@ -195,7 +197,6 @@ def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forc
                                until)
     result = dmp.trajectory(goal, start=start, duration=motion, dt=dt_used, forcing_increment=increment, coupling=coupling)
     if limits:
-        limits = {key: value for key, value in limits.items() if key != "fastest"}
         factor = scale_factor(result, **limits)
         if factor > 1.0 + 1e-9:
             raise ValueError(f"via: the motion through the via-points needs {factor:.3g}x its duration to stay within "

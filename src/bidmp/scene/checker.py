@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._checks import _as_float_array
+from .._checks import as_indices, as_points, check_limit, check_real
 from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _cylinder_box_bounds, _Distances
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -24,12 +24,18 @@ class SceneChecker:
     tool placements are free, :meth:`segments_free` which straight tool moves are."""
 
     def __init__(self, scene: Scene, chosen: np.ndarray, margin: float = 0.0):
+        from .clearance import Scene
+
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
         self.scene = scene
-        self.chosen = chosen
-        self.margin = float(margin)  # a placement or move closer than this to a part is not free
+        self.chosen = as_indices(chosen, "chosen", len(scene.solids) - 1) if len(scene.solids) else np.zeros(0, np.int64)
+        # a placement or move closer than this to a part is not free
+        self.margin = check_real(margin, "margin", nonnegative=True)
 
     def __call__(self, points) -> np.ndarray:
-        points = _as_float_array(points, "points").reshape(-1, 3)  # complex and objects refused by name
+        points = as_points(points, 3, "points")
+        check_limit(points.shape[0], "max_samples", "points: the number of tool placements")
         free = np.ones(points.shape[0], dtype=bool)
         if self.chosen.size == 0:
             return free
@@ -54,8 +60,10 @@ class SceneChecker:
 
         Conservative advancement: the distance to a part changes by at most the distance moved,
         so the tool may advance by its current clearance without missing a contact."""
-        a = _as_float_array(a, "a").reshape(-1, 3)
-        b = _as_float_array(b, "b").reshape(-1, 3)
+        a, b = as_points(a, 3, "a"), as_points(b, 3, "b")
+        if a.shape != b.shape:
+            raise ValueError(f"a has {a.shape[0]} start points but b has {b.shape[0]} end points: one move each")
+        check_limit(a.shape[0], "max_samples", "a: the number of moves")
         free = np.ones(a.shape[0], dtype=bool)
         if self.chosen.size == 0 or a.shape[0] == 0:
             return free

@@ -22,16 +22,19 @@ from scipy.spatial.transform import Rotation
 from .._checks import (
     _as_float_array,
     _check_magnitude,
+    as_point,
     as_trajectory,
+    as_vector,
     check_bool,
     check_real,
     numerically_guarded,
     short_token,
 )
 from .._trajectory import continuous_quaternions
+from .._units import check_units
 from .checker import SceneChecker
 from .distances import _CHUNK, _box_distance, _cylinder_box_bounds, _densify, _Distances
-from .parts import Part, Tool, _cylinder_extent, _fail, _number, _parse_parts
+from .parts import Part, Solid, Tool, _cylinder_extent, _fail, _number, _parse_parts
 
 __all__ = ['Scene', 'Clearance']
 
@@ -153,7 +156,10 @@ class Scene:
         (a ``ValueError``) naming the key for malformed data, overlapping parts, a target not on
         its part or a tool of zero size."""
         if not isinstance(data, dict):
-            _fail("scene", "expected an object with tool and parts")
+            _fail("scene", f"data must be an object with tool and parts, got {type(data).__name__}")
+        units = None if units is None else check_units(units)
+        if targets is not None and (not isinstance(targets, dict) or not all(isinstance(k, str) for k in targets)):
+            raise TypeError(f"targets must be a dict of target label -> point, got {type(targets).__name__}")
         unknown = sorted(set(data) - _SCENE_KEYS)
         if unknown:
             _fail(f"scene.{short_token(unknown[0], 20)[1:-1]}", f"unknown key (known: {', '.join(sorted(_SCENE_KEYS))})")
@@ -247,7 +253,12 @@ class Scene:
         if not isinstance(targets, dict):
             raise TypeError(f"targets must be a dict of label -> point, got {type(targets).__name__}")
         for label, point in targets.items():
-            point = _position(np.asarray(_as_float_array(point, "a target"))[:3])  # a pose target: its position
+            if not isinstance(label, str):
+                raise TypeError(f"targets: a target's label must be a string, got {type(label).__name__}")
+            point = as_vector(point, f"targets[{short_token(label, 20)}]")
+            if point.shape[0] < 3:
+                raise ValueError(f"targets[{short_token(label, 20)}] must be a point (3,) or a pose (7,), got {point.shape[0]} values")
+            point = _position(point[:3])  # a pose target: its position
             if not self.applies_to(label):
                 continue
             if label not in self.labels:
@@ -267,7 +278,7 @@ class Scene:
         return self._distances
 
     def _selected(self, exclude) -> np.ndarray:
-        exclude = {_label(name, "exclude") for name in ([exclude] if isinstance(exclude, str) else _names(exclude))}
+        exclude = {_label(name, "exclude") for name in ([exclude] if isinstance(exclude, str) else _names(exclude, "exclude"))}
         unknown = exclude - set(self._owner.tolist())
         if unknown:
             raise ValueError(f"exclude names {short_token(sorted(unknown)[0])}, which is not a part of the scene")
@@ -349,7 +360,7 @@ class Scene:
         points = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
         if points.shape[1] != 3:
             raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
-        step = _STEP_SHARE * self.tool.length if step is None else check_real(step, "step", positive=True)
+        step = _STEP_SHARE * self.tool.length if step is None else _checked_step(step, self.tool)
         chosen = self._selected(exclude)
         if chosen.size == 0:
             return Clearance(math.inf, None, None, self.margin)
@@ -395,10 +406,10 @@ class Scene:
         points = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
         if points.shape[1] != 3:
             raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
-        offset = np.asarray(_as_float_array(offset, "offset"), dtype=float).reshape(-1)
-        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
-            raise ValueError("offset must be 3 finite numbers (scene units)")
-        step = _STEP_SHARE * self.tool.length if step is None else check_real(step, "step", positive=True)
+        if not isinstance(solid, Solid):
+            raise TypeError(f"solid must be a bidmp.scene.Solid (one of a part's solids), got {type(solid).__name__}")
+        offset = as_point(offset, 3, "offset")
+        step = _STEP_SHARE * self.tool.length if step is None else _checked_step(step, self.tool)
         chosen = self._selected(exclude)
         if chosen.size == 0:
             return Clearance(math.inf, None, None, self.margin)
@@ -424,7 +435,7 @@ def _init_args(parts, tool, targets, targets_on_parts, margin, standoff) -> tupl
     if not isinstance(tool, Tool):
         raise TypeError(f"tool must be a bidmp.Tool, got {type(tool).__name__}")
     if targets is not None:
-        targets = [_label(label, "targets") for label in _names(targets)]
+        targets = [_label(label, "targets") for label in _names(targets, "targets")]
     margin = check_real(margin, "margin", nonnegative=True, maximum=tool.radius)
     if standoff is not None and not isinstance(standoff, dict):
         raise TypeError(f"standoff must be a dict of part label -> clearance, got {type(standoff).__name__}")
@@ -438,12 +449,12 @@ def _label(value, name: str) -> str:
     return value
 
 
-def _names(value) -> list:
-    """``exclude`` as a list of labels: None, or an iterable of strings (not an array)."""
+def _names(value, name: str) -> list:
+    """Labels: None, or a list, tuple or set of strings (not an array)."""
     if value is None:
         return []
-    if isinstance(value, np.ndarray) or not hasattr(value, "__iter__"):
-        raise TypeError(f"exclude must be a part label or a list of them, got {type(value).__name__}")
+    if not isinstance(value, (list, tuple, set, frozenset)):
+        raise TypeError(f"{name} must be a part label or a list of them, got {type(value).__name__}")
     return list(value)
 
 
@@ -451,7 +462,13 @@ def _labelled(parts, label) -> Part:
     for part in parts:
         if part.label == _label(label, "label"):
             return part
-    raise ValueError(f"no part labelled {short_token(label)}; parts: {', '.join(p.label for p in parts)[:200]}")
+    raise ValueError(f"label: no part labelled {short_token(label)}; parts: {', '.join(p.label for p in parts)[:200]}")
+
+
+def _checked_step(step, tool: Tool) -> float:
+    """A placement step (scene units): positive, at least a millionth of the tool's length (finer
+    steps only multiply the placements, and their count overflows)."""
+    return check_real(step, "step", minimum=1e-6 * tool.length)
 
 
 def _sweep(points: np.ndarray, quaternions: np.ndarray, reach: float) -> np.ndarray:

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_int, check_real
+from .._checks import as_point, check_int, check_real, short_token
 from .clearance import Scene
 
 __all__ = ["random_field"]
@@ -45,11 +45,17 @@ def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: floa
     """
     if not isinstance(rng, np.random.Generator):
         raise TypeError(f"rng must be a numpy.random.Generator, got {type(rng).__name__}")
-    start, goal = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
-    if start.shape != (3,) or goal.shape != (3,):
-        raise ValueError("start and goal must be 3-D points")
+    start, goal = as_point(start, 3, "start"), as_point(goal, 3, "goal")
     margin = check_real(margin, "margin", nonnegative=True)
+    if not isinstance(n_parts, (tuple, list)) or len(n_parts) != 2:
+        raise TypeError(f"n_parts must be (fewest, most), two integers, got {short_token(n_parts, 30)}")
     low, high = (check_int(n, "n_parts", minimum=1, maximum=16) for n in n_parts)
+    if low > high:
+        raise ValueError(f"n_parts: the fewest ({low}) is more than the most ({high})")
+    attempts = check_int(attempts, "attempts", minimum=1, maximum=100_000)
+    if not isinstance(tool, dict) or set(tool) != {"radius", "length"}:
+        raise TypeError(f"tool must be {{'radius': r, 'length': l}} (scene units), got {short_token(tool, 30)}")
+    tool = {key: check_real(value, f"tool's {key}", positive=True) for key, value in tool.items()}
     chord = goal - start
     reach = float(np.linalg.norm(chord[:2]))
     if reach <= 0.0:
@@ -78,5 +84,8 @@ def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: floa
             yaw = float(rng.uniform(0.0, 180.0))
             sides = [2.0 * size, 2.0 * size * float(rng.uniform(0.4, 1.0)), float(top - bottom)]
             parts.append({"type": "box", "label": f"o{index}", "at": at, "size": sides, "yaw": yaw})
+    if not parts:  # the margin or the tool leaves no room between the start and the goal
+        raise ValueError(f"margin and tool: no part fits between start and goal {reach:.3g} apart with a margin of "
+                         f"{margin:g} and a tool of radius {tool['radius']:g}")
     return Scene.from_dict({"tool": {"radius": float(tool["radius"]), "length": float(tool["length"])}, "parts": parts,
                             "margin": margin})

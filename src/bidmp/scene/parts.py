@@ -32,7 +32,7 @@ from numbers import Real
 
 import numpy as np
 
-from .._checks import get_limits, short_token
+from .._checks import as_point, as_rotation, get_limits, short_token
 
 __all__ = ['PART_TYPES', 'SceneError', 'Tool', 'Solid', 'Part']
 
@@ -73,7 +73,7 @@ class Tool:
     def __post_init__(self):
         for name in ("radius", "length"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value) or value <= 0:
+            if isinstance(value, bool) or not isinstance(value, Real) or not _finite(value) or value <= 0:
                 raise SceneError(f"tool.{name} must be a positive number, got {short_token(value, 20)}")
             if value > get_limits().max_abs_value:
                 raise SceneError(f"tool.{name} = {value:g} exceeds the limit max_abs_value")
@@ -98,7 +98,7 @@ class Solid:
     def moved(self, centre, rotation) -> Solid:
         """The same solid with its centre at ``centre`` (3,) and turned to ``rotation`` (3, 3): a
         part the tool carries, where it is now."""
-        centre, rotation = np.asarray(centre, dtype=float), np.asarray(rotation, dtype=float)
+        centre, rotation = as_point(centre, 3, "centre"), as_rotation(rotation, "rotation")
         if self.kind == "box":
             half = np.asarray(self.params, dtype=float) / 2.0
             extent = np.abs(rotation) @ half
@@ -160,8 +160,16 @@ def _fail(key: str, message: str):
     raise SceneError(f"{key}: {message}")
 
 
+def _finite(value) -> bool:
+    """Whether a real number is finite as a float (an integer of 400 digits is not)."""
+    try:
+        return math.isfinite(float(value))
+    except OverflowError:
+        return False
+
+
 def _number(value, key, *, positive=True) -> float:
-    if isinstance(value, bool) or not isinstance(value, Real) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, Real) or not _finite(value):
         _fail(key, f"expected a number, got {short_token(value, 20)}")
     if positive and value <= 0:
         _fail(key, f"must be > 0, got {value:g}")

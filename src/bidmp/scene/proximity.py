@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .._checks import as_point, check_real
 from .clearance import Scene
 from .distances import _cylinder_box_bounds
 
@@ -32,7 +33,7 @@ class Proximity:
 
     def __init__(self, scene: Scene, exclude=()) -> None:
         if not isinstance(scene, Scene):
-            raise TypeError(f"scene must be a bidmp.geometry.Scene, got {type(scene).__name__}")
+            raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
         self.scene = scene
         self._chosen = scene._selected(exclude)
         self._lower, self._upper = scene._lower[self._chosen], scene._upper[self._chosen]
@@ -47,6 +48,15 @@ class Proximity:
         (scene units): their distances (k,), unit directions from each toward the tool (k, 3), their
         parts' stand-offs (k,; inf: none) and their indices among the chosen solids (k,). ``skip``:
         a mask over the chosen solids, those not asked about."""
+        point = as_point(point, 3, "point")
+        within = check_real(within, "within", positive=True)
+        if skip is not None:
+            if not isinstance(skip, np.ndarray) or skip.dtype != bool or skip.shape != self._chosen.shape:
+                raise ValueError(f"skip must be a boolean mask over the {self._chosen.size} chosen solids")
+        return self._near(point, within, skip)
+
+    def _near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None):
+        """:meth:`near` on checked arguments (the avoidance term asks it every control step)."""
         if self._engine is None:
             return _NONE
         tool = self.scene.tool

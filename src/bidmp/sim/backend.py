@@ -17,7 +17,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .._checks import as_vector, check_int, check_real
+from .._checks import as_point, as_vector, check_int, check_real
 
 __all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "GoalUpdate", "MotionPlan", "Execution", "SIM_STEP",
            "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
@@ -46,14 +46,17 @@ class JointLimits:
     jerk: tuple | None = None
 
     def __post_init__(self) -> None:
-        count = None
+        counts = {}
         for name in ("lower", "upper", "velocity", "acceleration", "jerk"):
             value = getattr(self, name)
             if value is None and name == "jerk":
                 continue
-            values = as_vector(value, f"JointLimits.{name}", length=count, positive=name not in ("lower", "upper"))
-            count = len(values)
+            values = as_vector(value, f"JointLimits.{name}", positive=name not in ("lower", "upper"))
+            counts[name] = len(values)
             object.__setattr__(self, name, tuple(float(v) for v in values))
+        if len(set(counts.values())) > 1:
+            raise ValueError("JointLimits: one value per joint in each of " + ", ".join(f"{name} ({count})" for name, count
+                                                                                       in counts.items()))
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
 
@@ -88,10 +91,7 @@ class GoalUpdate:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "time", check_real(self.time, "GoalUpdate.time", nonnegative=True))
-        offset = np.asarray(self.offset, dtype=float)
-        if offset.shape != (3,) or not np.all(np.isfinite(offset)):
-            raise ValueError(f"GoalUpdate.offset must be 3 finite numbers (scene units), got {self.offset!r}")
-        object.__setattr__(self, "offset", tuple(offset.tolist()))
+        object.__setattr__(self, "offset", tuple(as_point(self.offset, 3, "GoalUpdate.offset").tolist()))
 
 
 @dataclass

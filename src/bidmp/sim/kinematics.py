@@ -8,18 +8,17 @@ PyBullet backend's arm models (``"panda"``, ``"iiwa"`` or a :class:`RobotModel`)
 
 from __future__ import annotations
 
-from types import SimpleNamespace
 
 import numpy as np
 
-from .._checks import _as_float_array, as_points, check_choice, check_real
+from .._checks import _as_bounded_array, as_points, check_choice, check_limit, check_real
 from .backend import SimError
 
 __all__ = ["inverse_kinematics", "joint_names"]
 
 
 def _arm(robot, units: str, tool_length: float, base=(0.0, 0.0, 0.0), yaw: float = 0.0):
-    from ..scene.parts import Tool
+    from ..scene import Scene, Tool
     from .pybullet.cell import RobotCell
     from .pybullet.robot import ROBOT_MODELS, RobotModel
 
@@ -29,9 +28,10 @@ def _arm(robot, units: str, tool_length: float, base=(0.0, 0.0, 0.0), yaw: float
         robot = ROBOT_MODELS[robot]
     if not isinstance(robot, RobotModel):
         raise TypeError(f"robot must be a name or a RobotModel, got {type(robot).__name__}")
-    length = check_real(tool_length, "tool_length", nonnegative=True)
+    # A tool up to 10 m long (no arm carries a longer one), in the points' units.
+    length = check_real(tool_length, "tool_length", nonnegative=True, maximum={"m": 10.0, "cm": 1e3, "mm": 1e4}[units])
     # No parts: the cell needs only the tool (its mouth is the point IK places).
-    scene = SimpleNamespace(solids=(), tool=Tool(radius=0.01 if units == "m" else 10.0, length=max(length, 1e-6)))
+    scene = Scene([], Tool(radius=0.01 if units == "m" else 10.0, length=max(length, 1e-6)))
     return RobotCell(scene, units, base, yaw, robot)
 
 
@@ -75,9 +75,10 @@ def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: 
     from .pybullet.robot import IK_TOLERANCE
 
     units = check_choice(units, "units", ("m", "cm", "mm"))
-    array = _as_float_array(points, "points")
+    array = _as_bounded_array(points, "points", 2)
     single = array.ndim == 1
     path = as_points(array[None] if single else array, 3, "points")
+    check_limit(path.shape[0], "max_samples", "points: the number of points (each an inverse kinematics solve)")
     if orientations is not None:
         from ..primitives.so3 import as_quaternions
 
@@ -101,7 +102,7 @@ def inverse_kinematics(points, robot="panda", *, units: str = "m", tool_length: 
             if error > IK_TOLERANCE and index == 0 and seed is not None:  # a seed far off: the rest pose
                 q, error = cell.solve_ik(point * cell.unit, np.array(cell.model.rest, dtype=float), turn)
             if error > IK_TOLERANCE or np.any(q < lower - 1e-9) or np.any(q > upper + 1e-9):
-                raise SimError(f"point {index} {np.round(point, 4).tolist()} {units} is out of the {cell.model.name}'s "
+                raise SimError(f"points[{index}] {np.round(point, 4).tolist()} {units} is out of the {cell.model.name}'s "
                                f"reach from its base (inverse kinematics leaves {error / cell.unit:.3g} {units})")
             joints[index] = q
     return joints[0] if single else joints

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import check_bool, check_int, check_real
+from .._checks import as_labels, check_bool, check_int, check_real, short_token
 from ..tasks.contract import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
@@ -349,15 +349,22 @@ def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: boo
     return out
 
 
+def target_labels(scenario, targets) -> list[str]:
+    """The labels of ``targets`` (None: every target of the scenario), each one the scenario has."""
+    labels = scenario.labels if targets is None else as_labels(targets, "targets")
+    for label in labels:
+        if label not in scenario.targets:
+            raise ValueError(f"targets: unknown target {short_token(label, 20)}; the scenario's targets: "
+                             f"{', '.join(scenario.labels[:20])}")
+    return list(labels)
+
+
 def _checked(scenario, methods, targets, closed_loop: bool) -> tuple[list, list]:
     """The methods (registered; with a stepper for the closed loop) and target labels to run."""
     methods = list(dict.fromkeys(methods))
     if not methods:
         raise ValueError("methods is empty: name at least one of dmp, bidmp, ...")
-    labels = scenario.labels if targets is None else list(targets)
-    for label in labels:
-        if label not in scenario.targets:
-            raise ValueError(f"unknown target {label!r}; the scenario's targets: {', '.join(scenario.labels[:20])}")
+    labels = target_labels(scenario, targets)
     from ..tasks import methods as registry
 
     open_only = [name for name in methods if not registry.get(name).closed_loop]

@@ -28,7 +28,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._units import UNITS
+from .._checks import as_labels, as_point, as_trajectory, as_vector, check_bool, check_real, short_token
+from .._units import UNITS, check_units
+from ..primitives.so3 import as_quaternions
 from .metrics import approach_error, axis_deviation, endpoint_error
 
 __all__ = ["Contract", "Verdict", "CommandPeaks", "command_peaks", "mm", "ENGAGE_RISE_MM", "AT_REST", "PADDING"]
@@ -48,8 +50,9 @@ _SLACK = 1e-9  # a peak equal to its limit to rounding is within it
 
 
 def mm(value_mm: float, units: str) -> float:
-    """``value_mm`` millimetres in ``units`` ("m", "cm", "mm"; unknown units are taken as mm)."""
-    return float(value_mm) * 1e-3 / UNITS.get(units, 1e-3)
+    """``value_mm`` millimetres in ``units`` ("m", "cm", "mm"; "" and joint units are taken as mm)."""
+    value_mm = check_real(value_mm, "value_mm")
+    return value_mm * 1e-3 / UNITS.get(check_units(units), 1e-3)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -100,19 +103,29 @@ def command_peaks(commands, limits, dt: float = 1e-3) -> CommandPeaks:
     the differences). ``limits`` has ``velocity``, ``acceleration`` and ``jerk`` per joint
     (``jerk`` may be None: not checked).
     """
-    commands = np.asarray(commands, dtype=float)
-    if commands.ndim != 2 or commands.shape[0] == 0:
-        raise ValueError(f"commands must be (n, joints) with n >= 1, got shape {commands.shape}")
+    commands = as_trajectory(commands, "commands", min_points=1, allow_static=True)
+    dt = check_real(dt, "dt", minimum=1e-6, maximum=1.0)  # a controller's period: 1 µs to 1 s
+    rates = []
+    for key in ("velocity", "acceleration", "jerk"):
+        value = getattr(limits, key, None)
+        if value is None and key == "jerk":
+            rates.append(None)
+            continue
+        if value is None:
+            raise TypeError(f"limits must have velocity, acceleration and jerk per joint, got {type(limits).__name__}")
+        rate = as_vector(value, f"limits.{key}", positive=True)
+        if rate.shape[0] != commands.shape[1]:
+            raise ValueError(f"limits.{key} has {rate.shape[0]} values but commands has {commands.shape[1]} joints (columns)")
+        rates.append(rate)
     padded = np.vstack([np.repeat(commands[:1], PADDING, axis=0), commands, np.repeat(commands[-1:], PADDING, axis=0)])
     velocity = np.diff(padded, axis=0) / dt
     acceleration = np.diff(velocity, axis=0) / dt
     jerk = np.diff(acceleration, axis=0) / dt
-    per_joint = np.vstack([_fractions(velocity, limits.velocity), _fractions(acceleration, limits.acceleration),
-                           _fractions(jerk, limits.jerk)])
+    per_joint = np.vstack([_fractions(velocity, rates[0]), _fractions(acceleration, rates[1]), _fractions(jerk, rates[2])])
     ends = 0.0
     if commands.shape[0] >= 2:  # from rest: the first command's acceleration is its first step over dt²
         steps = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
-        ends = float(np.max(steps / np.asarray(limits.acceleration, dtype=float)))
+        ends = float(np.max(steps / rates[1]))
     joint = int(np.argmax(np.max(per_joint, axis=0)))
     return CommandPeaks(float(per_joint[0].max()), float(per_joint[1].max()), float(per_joint[2].max()), ends, joint)
 
@@ -245,9 +258,31 @@ class Contract:
     alignment_threshold: float | None = None
     limits: object = None
 
+    def __post_init__(self) -> None:
+        from ..scene import Scene
+
+        object.__setattr__(self, "threshold", check_real(self.threshold, "threshold", positive=True))
+        if self.approach_height is not None:
+            object.__setattr__(self, "approach_height", check_real(self.approach_height, "approach_height", positive=True))
+        if self.scene is not None and not isinstance(self.scene, Scene):
+            raise TypeError(f"scene must be a bidmp.Scene or None, got {type(self.scene).__name__}")
+        if not isinstance(self.units, str) or len(self.units) > 16:
+            raise TypeError(f"units must be a unit name such as 'mm', got {short_token(self.units)}")
+        if self.alignment_threshold is not None:
+            object.__setattr__(self, "alignment_threshold",
+                               check_real(self.alignment_threshold, "alignment_threshold", positive=True, maximum=180.0))
+        if self.limits is not None and not all(hasattr(self.limits, key) for key in ("velocity", "acceleration", "jerk")):
+            raise TypeError(f"limits must be joint limits (velocity, acceleration, jerk per joint), got "
+                            f"{type(self.limits).__name__}")
+
     @classmethod
     def of(cls, scenario, limits=None, geometry: bool = True) -> Contract:
         """The contract of a :class:`bidmp.tasks.scenarios.Scenario` (``geometry`` False: without its scene)."""
+        from .scenarios import Scenario
+
+        if not isinstance(scenario, Scenario):
+            raise TypeError(f"scenario must be a bidmp.tasks.Scenario, got {type(scenario).__name__}")
+        geometry = check_bool(geometry, "geometry")
         return cls(scenario.success_threshold, scenario.approach_height if scenario.demonstration.shape[1] >= 3 else None,
                    scenario.scene if geometry else None, scenario.units,
                    scenario.alignment_threshold if scenario.is_pose else None, limits)
@@ -280,10 +315,32 @@ class Contract:
         applies : bool
             Whether the scene applies to this target (its ``targets`` list); else no clearance.
         """
-        path = np.asarray(path, dtype=float)
-        target = np.asarray(target, dtype=float)
+        path = as_trajectory(path, "path", min_points=1, allow_static=True)
+        target = as_vector(target, "target")
         position = path[:, :3] if path.shape[1] >= 3 else path
+        if target.shape[0] < position.shape[1]:
+            raise ValueError(f"target has {target.shape[0]} coordinates; path's positions have {position.shape[1]}")
         goal = target[: position.shape[1]]
+        if not isinstance(label, str):
+            raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
+        if axis is not None:
+            axis = as_point(axis, 3, "axis")
+            if not np.linalg.norm(axis) > 0.0:
+                raise ValueError("axis must be a direction (not zero)")
+        exclude = as_labels(exclude, "exclude")
+        if orientations is not None:
+            orientations = as_quaternions(orientations, "orientations")
+            if orientations.shape[0] != path.shape[0]:
+                raise ValueError(f"orientations has {orientations.shape[0]} rows but path has {path.shape[0]}")
+        dt = check_real(dt, "dt", positive=True)
+        if contacts is not None and (not isinstance(contacts, dict) or not all(
+                isinstance(key, str) and isinstance(value, (int, float)) and math.isfinite(value) for key, value in contacts.items())):
+            raise TypeError(f"contacts must be a dict of part label -> depth, got {short_token(contacts, 30)}")
+        if clearance is not None and not all(hasattr(clearance, key) for key in ("distance", "part", "clear")):
+            raise TypeError(f"clearance must be a bidmp.Clearance or None, got {type(clearance).__name__}")
+        applies = check_bool(applies, "applies")
+        if commands is not None:
+            commands = as_trajectory(commands, "commands", min_points=1, allow_static=True)
         end = endpoint_error(position, goal)
         approach = engaged = deviation = aligned = None
         if self.approach_height is not None and position.shape[1] == 3:
@@ -294,7 +351,7 @@ class Contract:
                                            rise=mm(ENGAGE_RISE_MM, self.units))
                 aligned = bool(deviation <= self.alignment_threshold)
         if clearance is None and self.scene is not None and applies and position.shape[1] == 3:
-            clearance = self.scene.clearance(position, exclude=list(exclude), orientations=orientations)
+            clearance = self.scene.clearance(position, exclude=exclude, orientations=orientations)
         peaks = None
         if commands is not None and self.limits is not None:
             peaks = command_peaks(commands, self.limits, dt)

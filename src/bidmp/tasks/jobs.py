@@ -27,6 +27,8 @@ from numbers import Real
 
 import numpy as np
 
+from .._checks import as_point, as_vector, check_choice, check_int, check_real, short_token
+from .._units import UNITS, check_units
 from ._scenario_fields import _fail, _point, _shown
 from .contract import mm
 
@@ -77,9 +79,34 @@ class JobSpec:
     units: str = "mm"
 
     def __post_init__(self) -> None:
+        kind = check_choice(self.kind, "kind", JOB_KINDS)
+        if not isinstance(self.steps, (tuple, list)) or tuple(self.steps) != JOB_KINDS[kind]:
+            raise ValueError(f"steps must be {' -> '.join(JOB_KINDS[kind])} for a {kind} job, got {short_token(self.steps, 40)}")
+        object.__setattr__(self, "steps", tuple(self.steps))
+        check_choice(self.order, "order", ("listed", "shortest"))
+        check_choice(self.transfer, "transfer", ("dmp", "similarity"))
+        units = check_units(self.units)
+        if units not in UNITS:
+            raise ValueError(f"units must be a length unit ({', '.join(UNITS)}), got {short_token(units)}")
         for name, value in DEFAULTS_MM.items():
-            if getattr(self, name) is None:
-                object.__setattr__(self, name, mm(value, self.units))
+            object.__setattr__(self, name, mm(value, units) if getattr(self, name) is None
+                               else check_real(getattr(self, name), name, positive=True))
+        for name in ("spindle_speed", "part_mass"):
+            object.__setattr__(self, name, check_real(getattr(self, name), name, positive=True))
+        if self.bin is not None:
+            if not isinstance(self.bin, (tuple, list)) or len(self.bin) != 2:
+                raise TypeError(f"bin must be (its bottom's centre (3,), inner size (3,)), got {short_token(self.bin, 30)}")
+            object.__setattr__(self, "bin", (as_point(self.bin[0], 3, "bin[0]"), as_vector(self.bin[1], "bin[1]", length=3,
+                                                                                          positive=True)))
+        if self.rack is not None:
+            if not isinstance(self.rack, (tuple, list)) or len(self.rack) != 4:
+                raise TypeError(f"rack must be (first slot (3,), step (3,), slots per row, row step (3,)), got "
+                                f"{short_token(self.rack, 30)}")
+            first, step, per_row, row_step = self.rack
+            object.__setattr__(self, "rack", (as_point(first, 3, "rack[0]"), as_point(step, 3, "rack[1]"),
+                                              check_int(per_row, "rack[2]", minimum=1), as_point(row_step, 3, "rack[3]")))
+        if kind == "unscrew" and self.bin is None:
+            raise ValueError("bin: an unscrew job drops each nut into a bin; give where it stands and its size")
 
     @property
     def play(self) -> float:
@@ -105,6 +132,9 @@ class JobSpec:
 
     def slot(self, index: int) -> np.ndarray:
         """Where the ``index``-th part placed in the rack has its bottom centre (scene units)."""
+        if self.rack is None:
+            raise ValueError(f"index: this {self.kind} job has no rack to place parts in")
+        index = check_int(index, "index", minimum=0, maximum=10**6)
         first, step, per_row, row_step = self.rack
         return first + (index % per_row) * step + (index // per_row) * row_step
 

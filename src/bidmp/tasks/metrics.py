@@ -25,7 +25,7 @@ __all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_devi
 def endpoint_error(trajectory, target) -> float:
     """Distance between the last point of ``trajectory`` (n, D) and ``target`` (D,)."""
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
-    return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target")))
+    return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target", like="trajectory")))
 
 
 # Of the band's height: the most a final approach may rise when no tolerance is given (0.15 mm of the
@@ -123,7 +123,7 @@ def axis_deviation(trajectory, orientations, target, height: float, axis=None, r
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     q = _as_bounded_array(orientations, "orientations", max_ndim=2)
     if q.shape != (trajectory.shape[0], 4):
-        raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), got {q.shape}")
+        raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), one per row of trajectory, got {q.shape}")
     _check_finite(q, "orientations")
     if np.any(np.linalg.norm(q, axis=1) < 1e-12):
         raise ValueError("orientations contains a zero quaternion, which is no rotation")
@@ -160,8 +160,8 @@ def swept_area(trajectory, reference) -> float:
     trajectory = as_trajectory(trajectory, "trajectory", min_points=2, allow_static=True)
     reference = as_trajectory(reference, "reference", min_points=2, allow_static=True)
     if trajectory.shape != reference.shape or trajectory.shape[1] != 2:
-        raise ValueError(f"swept_area needs two 2-D trajectories of the same length, got {trajectory.shape} and "
-                         f"{reference.shape}")
+        raise ValueError(f"trajectory and reference must be 2-D curves (T, 2) of the same length, got "
+                         f"{trajectory.shape} and {reference.shape}")
     corners = np.stack([reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1)  # (T-1, 4, 2)
     x, y = corners[..., 0], corners[..., 1]
     twice = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)

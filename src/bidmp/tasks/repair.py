@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._checks import as_labels, as_point, as_trajectory, as_vector, check_options, check_real, check_seed, short_token
 from .contract import Contract, Verdict
 
 __all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance"]
@@ -47,6 +48,22 @@ REPAIRS = ("lift", "avoid", "extend", "margin")
 _MAX_ROUNDS = 4  # rounds of lifting (each lifts the stretch past the part the motion comes nearest)
 _STRETCH = 5  # via-points spread along each stretch lifted
 _WIDENINGS = 2  # plannings with a wider margin
+
+
+def _target_args(goal, axis, exclude) -> tuple[np.ndarray, np.ndarray, list]:
+    """A goal (position, or a pose's first three values), its axis (default +z, unit) and the parts excluded."""
+    goal = as_vector(goal, "goal")
+    if goal.shape[0] < 3:
+        raise ValueError(f"goal must have at least 3 coordinates (x, y, z), got {goal.shape[0]}")
+    if axis is None:
+        axis = np.array([0.0, 0.0, 1.0])
+    else:
+        axis = as_point(axis, 3, "axis")
+        norm = float(np.linalg.norm(axis))
+        if not norm > 0.0:
+            raise ValueError("axis must be a direction (not zero)")
+        axis = axis / norm
+    return goal, axis, as_labels(exclude, "exclude")
 
 
 @dataclass(frozen=True)
@@ -127,15 +144,20 @@ class Repairer:
 
     def __init__(self, contract: Contract, demonstration, *, extension: dict | None = None, seed: int = 0,
                  order=REPAIRS, allowance: float = 0.0, bidmp: dict | None = None) -> None:
+        if not isinstance(contract, Contract):
+            raise TypeError(f"contract must be a bidmp.tasks.Contract, got {type(contract).__name__}")
+        order = as_labels(order, "order")
         unknown = [how for how in order if how not in REPAIRS]
         if unknown:
-            raise ValueError(f"order names {unknown[0]!r}, which is no repair (known: {', '.join(REPAIRS)})")
+            raise ValueError(f"order names {short_token(unknown[0], 20)}, which is no repair (known: {', '.join(REPAIRS)})")
         if contract.scene is None:
-            raise ValueError("repairs need the contract's scene: the parts a motion is kept away from")
-        self.contract, self.demonstration = contract, np.asarray(demonstration, dtype=float)
-        self.extension = {k: v for k, v in (extension or {}).items() if k != "approach"}
-        self.seed, self.order, self.bidmp = seed, tuple(order), dict(bidmp or {})
-        self.allowance = float(allowance)
+            raise ValueError("contract: repairs need the contract's scene, the parts a motion is kept away from")
+        self.contract = contract
+        self.demonstration = as_trajectory(demonstration, "demonstration")
+        self.extension = {k: v for k, v in check_options(extension, "extension").items() if k != "approach"}
+        check_seed(seed, "seed")
+        self.seed, self.order, self.bidmp = seed, tuple(order), check_options(bidmp, "bidmp")
+        self.allowance = check_real(allowance, "allowance", nonnegative=True)
         self.planning = self._widened(self.allowance)
 
     def _widened(self, extra: float) -> Contract:
@@ -157,7 +179,7 @@ class Repairer:
         straight down the target's axis over the approach height already comes too close to a part."""
         contract = self.contract
         height = contract.approach_height or 0.0
-        axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)
+        goal, axis, exclude = _target_args(goal, axis, exclude)
         corridor = np.vstack([goal[:3] + axis * height, goal[:3]])
         orientations = None
         if axis[2] < 1.0 - 1e-12:  # a tilted target: the tool along its axis
@@ -183,8 +205,11 @@ class Repairer:
         them (else computed). The repairs are tried only when that verdict fails. ``carried``: a
         part the tool carries (a transfer), ``(solid, offset from the mouth)``, kept clear too.
         """
-        goal = np.asarray(goal, dtype=float)
-        exclude = list(exclude)
+        goal, axis, exclude = _target_args(goal, axis, exclude)
+        if not isinstance(label, str):
+            raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
+        if not hasattr(model, "trajectory"):
+            raise TypeError(f"model must be a fitted DMP or Bi-DMP, got {type(model).__name__}")
         if motion is None:
             motion = _trajectory(model, goal, start, skill).y
         if verdict is None:
@@ -327,11 +352,23 @@ def carried_clearance(scene, path, exclude, carried=None, support=(), orientatio
     ``(solid, offset)``, the part's solid where it is and its centre's offset (3,) from the tool's
     mouth (:meth:`bidmp.Scene.body_clearance`). ``support``: parts left out of the part's check
     (those it is lifted off). The nearer of the two to its margin."""
-    clearance = scene.clearance(path, exclude=list(exclude), orientations=orientations)
-    if not carried:
+    from ..scene import Scene
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
+    exclude, support = as_labels(exclude, "exclude"), as_labels(support, "support")
+    path = as_trajectory(path, "path", min_points=1, allow_static=True)
+    if path.shape[1] != 3:
+        raise ValueError(f"path must have 3 columns (x, y, z), got {path.shape[1]}")
+    clearance = scene.clearance(path, exclude=exclude, orientations=orientations)
+    if carried is None:
         return clearance
+    from ..scene import Solid
+
+    if not isinstance(carried, (tuple, list)) or len(carried) != 2 or not isinstance(carried[0], Solid):
+        raise TypeError(f"carried must be (a scene Solid, its offset (3,)) or None, got {short_token(carried, 30)}")
     solid, offset = carried
-    body = scene.body_clearance(solid, np.asarray(path)[:, :3], offset, exclude=list(exclude) + list(support))
+    body = scene.body_clearance(solid, path[:, :3], offset, exclude=exclude + support)
     body = type(body)(body.distance, body.part, body.point, scene.margin)
     return min(clearance, body, key=lambda c: c.distance - c.margin)
 

@@ -61,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import check_limit, check_path, get_limits, short_token
+from .._checks import check_bool, check_limit, check_path, get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
 from ..io.strict_json import load_json
 from ..scene.clearance import Scene
@@ -131,9 +131,16 @@ class Scenario:
         """Whether targets and demonstration are poses (x, y, z, qx, qy, qz, qw)."""
         return self.demonstration.shape[1] == POSE_DIMS
 
+    def _check_label(self, label) -> None:
+        if not isinstance(label, str):
+            raise TypeError(f"label must be a target's label (a string), got {type(label).__name__}")
+        if label not in self.targets:
+            raise ValueError(f"label {short_token(label, 20)} is not a target of scenario {short_token(self.name, 30)}")
+
     def target_axis(self, label: str) -> np.ndarray | None:
         """A pose target's axis, pointing out of it (the tool comes in along minus it); None for
         position targets (the evaluation then uses +z)."""
+        self._check_label(label)
         if not self.is_pose:
             return None
         from scipy.spatial.transform import Rotation
@@ -168,6 +175,7 @@ class Scenario:
         """A reference demonstration to target ``label`` "produced by the same generator"
         (the paper's protocol): its own demonstration if one is given, else the demonstration generator with
         its via points moved by the target offset, else the demonstration translated."""
+        self._check_label(label)
         if label in self.demonstrations:
             return self.demonstrations[label]
         offset = self.targets[label] - self.targets[self.demonstrated]
@@ -224,6 +232,8 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
     if not isinstance(source, str):
         raise TypeError(f"source must be a string naming the scenario's origin, got {type(source).__name__}")
     source = short_token(source, 40)[1:-1]
+    base_dir = str(check_path(base_dir, "base_dir"))
+    allow_outside_files = check_bool(allow_outside_files, "allow_outside_files")
     units = _check_top_level(data, source)
     demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
     n_dims = demonstration.shape[1]
@@ -418,9 +428,10 @@ def builtin_names() -> list[str]:
 
 def builtin_text(name: str) -> str:
     """The JSON text of a built-in scenario (for ``bidmp scenario show NAME > my.json``)."""
-    if not isinstance(name, str) or name not in builtin_names():
-        shown = short_token(name) if isinstance(name, str) else type(name).__name__
-        raise ScenarioError(f"unknown built-in scenario {shown}; built-ins: {', '.join(builtin_names())}")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a built-in scenario's name (a string), got {type(name).__name__}")
+    if name not in builtin_names():
+        raise ScenarioError(f"name: unknown built-in scenario {short_token(name)}; built-ins: {', '.join(builtin_names())}")
     return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
 
 

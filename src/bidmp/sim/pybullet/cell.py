@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..._checks import as_point, check_real
+
 from ..backend import SIM_STEP, Execution, Hold, MotionPlan
 from . import execute as _execute
 from . import ik as _ik
@@ -39,13 +41,18 @@ class RobotCell:
 
     def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
                  robot: RobotModel = PANDA_MODEL):
+        from ...scene import Scene
+
         if not isinstance(robot, RobotModel):
             raise TypeError(f"robot must be a bidmp.sim.pybullet.robot.RobotModel, got {type(robot).__name__}")
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
+        base, yaw = as_point(base, 3, "base"), check_real(yaw, "yaw")
         self.model = robot
         self.limits = robot.limits
-        self.p = p = _pybullet_module()
         self.scene = scene
         self.unit = _unit_of(units)
+        self.p = p = _pybullet_module()
         self.client = p.connect(p.DIRECT)
         try:
             p.setTimeStep(SIM_STEP, physicsClientId=self.client)
@@ -131,6 +138,10 @@ class RobotCell:
         self.close()
         return False
 
+    def _joints(self, q) -> np.ndarray:
+        """Joint positions (J,) rad, checked: one per joint of the arm, finite."""
+        return as_point(q, len(self.arm), "q")
+
     def _set_joints(self, q, velocities=None, kinematic: bool = False) -> None:
         robot, client = (self.ik_robot, self.ik_client) if kinematic else (self.robot, self.client)
         for index, joint in enumerate(self.arm):
@@ -144,14 +155,14 @@ class RobotCell:
 
     def forward(self, q) -> np.ndarray:
         """TCP position (m) for joint positions ``q`` (forward kinematics on the planning copy)."""
-        self._set_joints(q, kinematic=True)
+        self._set_joints(self._joints(q), kinematic=True)
         return np.array(self.p.getLinkState(self.ik_robot, self.tcp, computeForwardKinematics=1,
                                             physicsClientId=self.ik_client)[4])
 
     def joint_origins(self, q) -> np.ndarray:
         """The arm's joint origins from its base to the tool's mouth (m), (9, 3), at joints ``q``
         (on the planning copy): what the 3-D viewer draws."""
-        self._set_joints(q, kinematic=True)
+        self._set_joints(self._joints(q), kinematic=True)
         states = self.p.getLinkStates(self.ik_robot, [*self.arm, self.tcp], computeForwardKinematics=1,
                                       physicsClientId=self.ik_client)
         # The base's URDF frame, where it was placed (PyBullet's base position is its centre of mass).

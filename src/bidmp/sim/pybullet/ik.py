@@ -24,7 +24,10 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
     if orientation is not None:
         from ...primitives.so3 import as_quaternions
 
-        orientation = as_quaternions(orientation, "orientation")[0]
+        orientation = as_quaternions(orientation, "orientation")
+        if orientation.shape[0] != 1:
+            raise ValueError(f"orientation must be one quaternion (4,), got {orientation.shape[0]}")
+        orientation = orientation[0]
     target_orientation = _DOWN if orientation is None else [float(v) for v in orientation]
     axis = None
     if orientation is not None:

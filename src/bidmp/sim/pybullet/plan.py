@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from ..._checks import as_trajectory
+from ..._checks import as_trajectory, as_vector, check_real
+from ...primitives.so3 import as_quaternions
 from ..._trajectory import interp_columns
 from ...primitives.timing import Trajectory, time_scale
 from ..backend import LIMIT_MARGIN, MotionPlan, SimError
@@ -25,18 +26,20 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     path = as_trajectory(path, "path", min_points=2, allow_static=True)
     if path.shape[1] != 3:
         raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
+    if not isinstance(label, str) or len(label) > 256:
+        raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
+    spacing = check_real(spacing, "spacing", positive=True, maximum=1.0)
     for point in (path.min(axis=0), path.max(axis=0)):  # before subdividing it into 5 mm steps
         _reachable(point * cell.unit, cell.base * cell.unit, "path")
-    given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else np.asarray(fractions, dtype=float)
-    if given.shape != (path.shape[0],) or not np.all(np.isfinite(given)) or np.any(np.diff(given) < 0) \
-            or given[0] < 0 or given[-1] > 1:
+    given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else as_vector(fractions, "fractions")
+    if given.shape != (path.shape[0],) or np.any(np.diff(given) < 0) or given[0] < 0 or given[-1] > 1:
         raise ValueError(f"fractions must be {path.shape[0]} non-decreasing times in [0, 1]")
     points, u = _subdivide(path * cell.unit, given, spacing)
     turns = None
     if orientations is not None:
         from scipy.spatial.transform import Rotation, Slerp
 
-        q = np.asarray(orientations, dtype=float)
+        q = as_quaternions(orientations, "orientations")
         if q.shape != (path.shape[0], 4):
             raise ValueError(f"orientations must have shape ({path.shape[0]}, 4), got {q.shape}")
         keep = np.concatenate([[True], np.diff(given) > 1e-12])

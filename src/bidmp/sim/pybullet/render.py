@@ -4,17 +4,27 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._checks import as_point, check_int, check_real
+
 __all__ = []
+
+_MAX_PIXELS = 4096  # per side: TinyRenderer allocates width x height buffers (a negative size aborts it)
+
+
+def _image_size(width, height) -> tuple[int, int]:
+    return (check_int(width, "width", minimum=8, maximum=_MAX_PIXELS),
+            check_int(height, "height", minimum=8, maximum=_MAX_PIXELS))
 
 
 # -- pictures --------------------------------------------------------------------------
 def _render(cell, width: int = 320, height: int = 240, target=None) -> np.ndarray:
     """An RGB image (height, width, 3) of the cell by PyBullet's TinyRenderer (headless)."""
     p = cell.p
+    width, height = _image_size(width, height)
     if target is None:  # between the robot and its work, a little above: the whole arm in view
         look = 0.5 * (cell.base + _scene_centre(cell)) * cell.unit + [0.0, 0.0, 0.2]
     else:
-        look = np.asarray(target, dtype=float) * cell.unit
+        look = as_point(target, 3, "target") * cell.unit
     view = p.computeViewMatrixFromYawPitchRoll(look.tolist(), 1.2, cell.yaw - 50.0, -25.0, 0.0, 2,
                                                physicsClientId=cell.client)
     projection = p.computeProjectionMatrixFOV(45.0, width / height, 0.02, 5.0, physicsClientId=cell.client)
@@ -36,7 +46,9 @@ def _camera(cell, look_m, distance: float, yaw: float, pitch: float, width: int,
 def _keyframe(cell, t: float, focus, width: int = 320, height: int = 240) -> np.ndarray:
     """A labelled keyframe (2 height, width, 3): above, the whole arm and its work from the side;
     below, a close-up on the tool and the target ``focus`` (scene units); the time written in."""
-    focus_m = np.asarray(focus, dtype=float) * cell.unit
+    width, height = _image_size(width, height)
+    t = check_real(t, "t")
+    focus_m = as_point(focus, 3, "focus") * cell.unit
     base_m = cell.base * cell.unit
     # The whole arm: between its base and the target, at mid-height of a ~0.9 m arm, from 1.45 m.
     look = 0.5 * (base_m + focus_m) + [0.0, 0.0, 0.3]

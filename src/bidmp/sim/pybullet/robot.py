@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._checks import as_point
+from ..._checks import as_point, as_vector, check_limit, check_path, check_real, short_token, shown_path
 from ..backend import JointLimits, SimError
 
 __all__ = ["PANDA", "IIWA", "XARM6", "UR5", "RobotModel", "ROBOT_MODELS", "ROBOT_NAMES", "robot_model", "robot_placement"]
@@ -105,11 +105,18 @@ class RobotModel:
     standoff: float = 0.33
 
     def __post_init__(self) -> None:
+        for name in ("name", "urdf", "flange"):
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value or len(value) > 4096:
+                raise TypeError(f"{name} must be a non-empty string, got {short_token(value, 30)}")
+        if not isinstance(self.limits, JointLimits):
+            raise TypeError(f"limits must be bidmp.sim.JointLimits, got {type(self.limits).__name__}")
         n = self.limits.n_joints
-        for name in ("rest", "effort"):
-            if len(getattr(self, name)) != n:
-                raise ValueError(f"robot {self.name!r}: {name} gives {len(getattr(self, name))} values; its limits "
-                                 f"name {n} joints")
+        for name, positive in (("rest", False), ("effort", True)):
+            object.__setattr__(self, name, tuple(as_vector(getattr(self, name), name, length=n, positive=positive).tolist()))
+        if self.cut_at is not None and (not isinstance(self.cut_at, str) or not self.cut_at):
+            raise TypeError(f"cut_at must be a joint name or None, got {short_token(self.cut_at, 30)}")
+        object.__setattr__(self, "standoff", check_real(self.standoff, "standoff", positive=True, maximum=2.0))
 
     @property
     def n_joints(self) -> int:
@@ -144,15 +151,27 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     ``"panda"``), or its own ``"urdf"`` (inside the scenario's folder ``base_dir``, or shipped by
     ``pybullet_data``) with ``"flange"`` and ``"limits"`` ({"lower", "upper", "velocity",
     "acceleration", "jerk"}, one value per joint, rad) and optionally ``"rest"`` (one per joint, rad)
-    and ``"effort"`` (one per joint, N m)."""
-    from pathlib import Path
+    and ``"effort"`` (one per joint, N m). The key is checked as a scenario file's is; the URDF must
+    be a regular ``.urdf`` file within the file size limit."""
+    import pybullet_data
 
-    spec = spec or {}
+    from ...tasks._scenario_fields import _robot
+
+    if spec is not None and not isinstance(spec, dict):
+        raise TypeError(f"spec must be a scenario's \"robot\" object (a dict) or None, got {type(spec).__name__}")
+    folder = "." if base_dir is None else check_path(base_dir, "base_dir")
+    # Scenarios resolve their URDF when they load: here it may be absolute (the folder rule was applied then).
+    spec = _robot({"robot": spec or {}}, "robot", folder, allow_outside=True)
     if "urdf" not in spec:
         return ROBOT_MODELS[spec.get("model", "panda")]
     path = Path(spec["urdf"])
-    if base_dir is not None and not path.is_absolute() and (Path(base_dir) / path).exists():
-        path = Path(base_dir) / path
+    if not path.is_absolute():
+        local = Path(folder) / path
+        path = local if local.exists() else Path(pybullet_data.getDataPath()) / path
+    if not path.is_file():
+        raise ValueError(f"robot.urdf {shown_path(spec['urdf'])}: no such regular file (a path in the scenario's "
+                         f"folder, or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)")
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {shown_path(path)} in bytes")
     limits = JointLimits(**spec["limits"])
     middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
     return RobotModel(path.stem, str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
@@ -160,8 +179,8 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
 
 
 def _unit_of(units: str) -> float:
-    if units not in _UNITS:
-        raise ValueError(f"the simulator needs lengths in m, cm or mm; the scenario's units are {units!r}")
+    if not isinstance(units, str) or units not in _UNITS:
+        raise ValueError(f"units: the simulator needs lengths in m, cm or mm, got {short_token(units)}")
     return _UNITS[units]
 
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._checks import require_extra
+from ..._checks import check_limit, require_extra, short_token, shown_path
 
 __all__ = ["SOLVER_ITERATIONS"]
 
@@ -41,6 +41,23 @@ def _pybullet_module():
             os.close(fd)
 
 
+_MESHES = (".stl", ".obj", ".dae")
+
+
+def _mesh(folder: Path, name: str, urdf: Path) -> Path:
+    """A URDF's mesh file, made absolute: a regular .stl, .obj or .dae file inside the URDF's folder
+    (a URDF is data: it may not make the simulator read files elsewhere)."""
+    import os
+
+    resolved = Path(os.path.realpath(folder / name))
+    inside = os.path.commonpath([os.path.realpath(folder), resolved]) == os.path.realpath(folder)
+    if not inside or resolved.suffix.lower() not in _MESHES or not resolved.is_file():
+        raise ValueError(f"robot URDF {shown_path(urdf)}: mesh {short_token(name, 40)} must be a .stl, .obj or .dae "
+                         f"file inside the URDF's folder")
+    check_limit(resolved.stat().st_size, "max_file_bytes", f"the size of mesh {shown_path(resolved)} in bytes")
+    return resolved
+
+
 def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
     """The URDF of ``model`` (a :class:`~bidmp.sim.pybullet.robot.RobotModel`) carrying a
     cylindrical tool (metres) on its flange: link ``tool`` on the flange, link ``tcp`` at the
@@ -54,14 +71,19 @@ def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
     if not path.is_absolute():
         path = Path(pybullet_data.getDataPath()) / path
     if not path.is_file():
-        raise ValueError(f"robot URDF {model.urdf!r}: no such file (a path in the scenario's folder, or a model "
-                         f"shipped by pybullet_data such as kuka_iiwa/model.urdf)")
-    text = path.read_text()
+        raise ValueError(f"robot URDF {shown_path(model.urdf)}: no such regular file (a path in the scenario's folder, "
+                         f"or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)")
+    check_limit(path.stat().st_size, "max_file_bytes", f"the size of {shown_path(path)} in bytes")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"robot URDF {shown_path(path)} cannot be read as text ({type(exc).__name__})") from None
     folder = path.parent
-    if model.cut_at is not None:
-        text = text[: text.index(f'<joint name="{model.cut_at}"')]
-    else:
-        text = text[: text.rindex("</robot>")]
+    cut = text.find(f'<joint name="{model.cut_at}"') if model.cut_at is not None else text.rfind("</robot>")
+    if "<robot" not in text or cut < 0:
+        raise ValueError(f"robot URDF {shown_path(path)} is not a URDF with the joint the hand is cut at"
+                         if model.cut_at is not None and "<robot" in text else f"{shown_path(path)} is not a URDF robot")
+    text = text[:cut]
     if f'<link name="{model.flange}"' not in text:
         raise ValueError(f"robot URDF {model.urdf!r} has no link {model.flange!r} (the flange)")
     inertia = 'ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"'
@@ -79,12 +101,12 @@ def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
     )
 
     def absolute(match):
-        name = match.group(1)
+        name = match.group(2)
         if name.startswith("package://"):
             name = name[len("package://"):]
-        return f'filename="{name if Path(name).is_absolute() else folder / name}"'
+        return f'{match.group(1)}{_mesh(folder, name, path)}"'
 
-    return re.sub(r'filename="([^"]+)"', absolute, text + tool)
+    return re.sub(r'(<mesh\b[^>]*?\sfilename=")([^"]+)"', absolute, text + tool)
 
 
 # Bullet grows a convex hull by its collision margin (PyBullet's default for a mesh: 1 mm), so a

@@ -10,8 +10,8 @@ simulator (``bidmp sim``) look methods up here by name, so a new method is one f
         name = "line"
         def fit(self, task):
             return task.demonstration[0], 0.0
-        def rollout(self, start, goal):
-            return start + np.linspace(0, 1, 100)[:, None] * (goal - start)
+        def rollout(self, model, goal):  # model: what fit returned (here the start)
+            return model + np.linspace(0, 1, 100)[:, None] * (goal - model)
 
     register(StraightLine())
 
@@ -20,9 +20,10 @@ Layer 2 (tasks): a method may import the math; the registry imports the built-in
 
 from __future__ import annotations
 
-from .base import Method, Task
+from ..._checks import short_token as _short_token
+from .base import Method, Task, checked_goals
 
-__all__ = ["Method", "Task", "register", "unregister", "get", "names"]
+__all__ = ["Method", "Task", "checked_goals", "register", "unregister", "get", "names"]
 
 _REGISTRY: dict[str, Method] = {}
 _BUILTINS_LOADED = False
@@ -71,9 +72,10 @@ def unregister(name: str) -> None:
 def get(name: str) -> Method:
     """The method registered as ``name``; a ``ValueError`` lists the known ones otherwise."""
     _load_builtins()
-    if not isinstance(name, str) or name not in _REGISTRY:
-        shown = name if isinstance(name, str) else type(name).__name__
-        raise ValueError(f"unknown method {shown[:40]!r}; known: {', '.join(names())}")
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a method's name (a string), got {type(name).__name__}")
+    if name not in _REGISTRY:
+        raise ValueError(f"name: unknown method {_short_token(name, 40)}; known: {', '.join(names())}")
     return _REGISTRY[name]
 
 

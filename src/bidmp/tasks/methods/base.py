@@ -15,7 +15,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Method", "Task"]
+from ..._checks import as_trajectory, check_bool, check_callable, check_limit, check_options, check_seed, check_text
+from ..._checks import short_token as _short_token
+
+__all__ = ["Method", "Task", "checked_goals"]
+
+
+def checked_goals(goals) -> np.ndarray:
+    """Goals (G, D) for a batch of rollouts: finite numbers, at most ``max_targets`` of them (each
+    goal is a whole motion: millions of them are no batch)."""
+    goals = as_trajectory(goals, "goals", min_points=1, allow_static=True)
+    check_limit(goals.shape[0], "max_targets", "goals: the number of goals")
+    return goals
 
 
 @dataclass
@@ -50,6 +61,20 @@ class Task:
     poses: bool = False
     build_skills: Callable | None = None
     shared: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.poses = check_bool(self.poses, "poses")
+        self.demonstration = as_trajectory(self.demonstration, "demonstration", allow_static=self.poses)
+        self.goals = checked_goals(self.goals)
+        if self.goals.shape[1] != self.demonstration.shape[1]:
+            raise ValueError(f"goals have D = {self.goals.shape[1]} but the demonstration has D = "
+                             f"{self.demonstration.shape[1]}")
+        check_seed(self.seed, "seed")
+        self.dmp, self.bidmp = check_options(self.dmp, "dmp"), check_options(self.bidmp, "bidmp")
+        if self.build_skills is not None:
+            check_callable(self.build_skills, "build_skills", "a function build_skills(dmp) -> model")
+        if not isinstance(self.shared, dict):
+            raise TypeError(f"shared must be a dict, got {type(self.shared).__name__}")
 
     def shared_model(self, key, build: Callable) -> tuple[object, float]:
         """``(model, seconds)``: ``build()`` the first time ``key`` is asked for, the same model after."""
@@ -109,7 +134,16 @@ class Method:
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
         """The motions to every goal (G, D); override when a batch is cheaper than a loop."""
-        return [self.rollout(model, goal) for goal in goals]
+        return [self.rollout(model, goal) for goal in checked_goals(goals)]
+
+    def check_model(self, model, kinds: tuple, what: str) -> None:
+        """Refuse a ``model`` that is not what :meth:`fit` returns (``kinds``, described as ``what``)."""
+        kinds = kinds if isinstance(kinds, tuple) else (kinds,)
+        if not kinds or not all(isinstance(kind, type) for kind in kinds):
+            raise TypeError(f"kinds must be a class or a tuple of classes, got {_short_token(kinds, 30)}")
+        check_text(what, "what")
+        if not isinstance(model, kinds):
+            raise TypeError(f"model must be {what}, what method {self.name!r}'s fit returns, got {type(model).__name__}")
 
     def stepper(self, model, goal: np.ndarray, duration: float, coupling):
         """A control-loop stepper to ``goal`` (methods with ``closed_loop`` only)."""

@@ -6,6 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import register
+from ..._checks import as_point
+from ...incremental.bidmp import BiDMP
+from ...incremental.cartesian import CartesianBiDMP
 from .base import Method, Task
 
 
@@ -29,11 +32,13 @@ class _BiDMPMethod(Method):
         return model, seconds + built
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        self.check_model(model, _MODELS, "a Bi-DMP (or a per-goal one)")
         if isinstance(model, _PerGoal):
-            return model.rollout(goal)
+            return model.rollout(as_point(goal, model.dmp.n_dims_, "goal"))
         return model.rollout(goal, skill=self.skill)
 
     def stepper(self, model, goal: np.ndarray, duration: float, coupling):
+        self.check_model(model, _MODELS[:2], "a Bi-DMP")
         return model.stepper(goal, skill=self.skill, duration=duration, coupling=coupling)
 
 
@@ -55,5 +60,6 @@ class _PerGoal:
         return model.rollout(goal)
 
 
+_MODELS = (BiDMP, CartesianBiDMP, _PerGoal)
 register(_BiDMPMethod("bidmp", "nearest", repairs=True))
 register(_BiDMPMethod("bidmp-latest", "latest", lasa=False))

@@ -6,7 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import register
-from .base import Method, Task
+from ...primitives.cartesian import CartesianDMP
+from ...primitives.dmp import DMP
+from .base import Method, Task, checked_goals
+
+_DMPS = (DMP, CartesianDMP)
 
 
 class _DMPMethod(Method):
@@ -24,14 +28,18 @@ class _DMPMethod(Method):
         return task.fitted_dmp() if self.protocol is None else task.fitted_dmp(protocol=self.protocol)
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        self.check_model(model, _DMPS, "a fitted DMP or CartesianDMP")
         return model.rollout(goal)
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
+        self.check_model(model, _DMPS, "a fitted DMP or CartesianDMP")
+        goals = checked_goals(goals)
         if hasattr(model, "rollout_many"):
             return list(model.rollout_many(goals))  # one integration for every goal
         return [model.rollout(goal) for goal in goals]
 
     def stepper(self, model, goal: np.ndarray, duration: float, coupling):
+        self.check_model(model, _DMPS, "a fitted DMP or CartesianDMP")
         return model.stepper(goal, duration=duration, coupling=coupling)
 
 

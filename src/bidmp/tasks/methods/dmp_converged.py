@@ -7,7 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from . import register
-from .base import Method, Task
+from ..._checks import as_vector
+from ...primitives.dmp import DMP
+from .base import Method, Task, checked_goals
 
 CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
 
@@ -20,12 +22,14 @@ class _DMPConverged(Method):
         return task.fitted_dmp()
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
+        self.check_model(model, DMP, "a fitted DMP")
+        goals = checked_goals(goals)
         n_steps = model.n_steps_
         factor = next((k for k in range(2, 101) if model.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100)
         return list(model.rollout_many(goals, n_steps=factor * n_steps))
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
-        return self.rollouts(model, goal[None])[0]
+        return self.rollouts(model, as_vector(goal, "goal")[None])[0]
 
 
 register(_DMPConverged())

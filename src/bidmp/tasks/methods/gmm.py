@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import register
-from .base import Method, Task
+from ..._checks import as_vector
+from .base import Method, Task, checked_goals
 
 
 class _GMMMethod(Method):
@@ -18,10 +19,14 @@ class _GMMMethod(Method):
         return task.shared_model("gmm", lambda: GMMRegressor(seed=task.seed % (2**31)).fit(task.demonstration))
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
-        mean = model.rollout()
-        return [mean] * len(goals)
+        goals = checked_goals(goals)
+        return [self.rollout(model, goals[0])] * len(goals)
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        from ...baselines import GMMRegressor
+
+        self.check_model(model, GMMRegressor, "a fitted GMMRegressor")
+        as_vector(goal, "goal")  # a goal is asked for, and ignored: GMR on time reproduces its demonstration
         return model.rollout()
 
 

@@ -18,6 +18,11 @@ class _TPGMMMethod(Method):
                                                    task.demonstration[0]))
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
+        from ...baselines import TPGMM
+
+        if not (isinstance(model, tuple) and len(model) == 2 and isinstance(model[0], TPGMM)):
+            raise TypeError(f"model must be (a fitted TPGMM, start), what method 'tpgmm''s fit returns, got "
+                            f"{type(model).__name__}")
         tpgmm, start = model
         return tpgmm.rollout(goal, start=start)
 
