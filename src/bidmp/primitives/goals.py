@@ -180,7 +180,8 @@ class DelayedGoal:
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         """The gate at a rollout grid's samples (``step`` apart in normalised time)."""
         phase, step, tau, exact = _grid_args(phase, step, tau, exact)
-        return phase_grid(phase.shape[0], step, tau, self.rate, exact=exact)
+        # one sample (the only case a step of 0 passes): the grid's first value is 1 whatever the step
+        return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)
 
     def training_gate(self, n_train: int, dt: float, exact: bool) -> np.ndarray:
         """The gate on the training grid (``tau = 1``)."""

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..tasks.contract import Contract, mm
-from .job_report import JobPhase, JobReport, JobTarget, _phase
+from .job_report import JobPhase, JobReport, JobTarget, _phase, in_bin, in_slot
 from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle
 
 __all__ = ["run_job", "job_targets"]
@@ -342,10 +342,8 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     centre = _release(world)
     world.dropped += 1
     phase.seconds += RELEASE_S
-    floor, inner = world.spec.bin_floor, np.asarray(world.spec.bin[1], dtype=float)
-    inside = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0) and floor[2] <= centre[2] <= floor[2] + inner[2])
     phase.note = note or ""
-    if not inside:
+    if not in_bin(centre, world.spec.bin_floor, world.spec.bin[1]):
         phase.ok = False
         phase.note = f"released outside the bin: the nut lies at {np.round(centre, 1).tolist()} {world.scenario.units}"
     return phase
@@ -395,7 +393,7 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     phase.seconds += RELEASE_S
     off = float(np.linalg.norm(centre[:2] - np.asarray(slot)[:2]))
     phase.note = note
-    if off > world.spec.engage_tolerance * 5 or abs(centre[2] - part.height / 2.0 - slot[2]) > world.spec.slot_tolerance:
+    if not in_slot(centre, slot, part.height, world.spec.engage_tolerance * 5, world.spec.slot_tolerance):
         phase.ok = False
         phase.note = (f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at "
                       f"{np.round(centre, 1).tolist()}")

@@ -57,6 +57,25 @@ def _phase(name: str, run, plan, cell, carried_contacts=None) -> JobPhase:
                     sent.within)
 
 
+def in_bin(centre, floor, inner) -> bool:
+    """Whether a part that came to rest with its centre at ``centre`` (3,) lies in the bin whose
+    floor's centre is ``floor`` (3,) and whose inside measures ``inner`` (3,): over its floor
+    (within half the inner width and half the inner depth of the floor's centre) and between the
+    floor and the rim. Scene units."""
+    centre, floor, inner = (np.asarray(value, dtype=float) for value in (centre, floor, inner))
+    over_floor = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0))
+    return over_floor and bool(floor[2] <= centre[2] <= floor[2] + inner[2])
+
+
+def in_slot(centre, slot, height: float, off_tolerance: float, height_tolerance: float) -> bool:
+    """Whether a part of ``height`` that came to rest with its centre at ``centre`` (3,) stands in
+    its rack slot (the slot's floor centre ``slot``, 3): its axis within ``off_tolerance`` of the
+    slot's centre sideways, its bottom within ``height_tolerance`` of the slot's floor."""
+    centre, slot = np.asarray(centre, dtype=float), np.asarray(slot, dtype=float)
+    off = float(np.linalg.norm(centre[:2] - slot[:2]))
+    return off <= off_tolerance and abs(centre[2] - height / 2.0 - slot[2]) <= height_tolerance
+
+
 @dataclass
 class JobTarget:
     label: str

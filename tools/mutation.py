@@ -1,0 +1,477 @@
+"""Mutation testing of the checks that guard the robot and judge success (``make mutation``).
+
+For each judging function named in :data:`TARGETS`, every small realistic bug is planted one at a
+time — a comparison made strict or loose, ``==`` turned ``!=``, ``+`` for ``-``, ``*`` for ``/``, a
+constant changed, an ``abs`` or a sign dropped, ``and`` for ``or``, ``min`` for ``max``, ``all`` for
+``any`` — and the tests that cover the function run against it. A mutant the tests fail on is
+*killed*; one they pass is a *survivor*, and each survivor is either killed by a new test or shown
+to be an equivalent mutant in :data:`EQUIVALENT` (with the reason). The result is
+``docs/mutation.md``: the score per area and every survivor.
+
+Why a small tool of our own: mutmut 3 copies the project and runs the whole suite once per file
+to map tests, then mutates whole files (argument checks and messages included); cosmic-ray needs
+a session database and a configuration per module. Here the mutants are confined to the judging
+logic (input checks are swept by ``tests/surface_sweep.py``; messages and logging are not
+judged), and each mutant costs one ``fork`` of a process that has already imported bidmp, its
+dependencies and pytest: the mutated function's code object is swapped into the live function, so
+every reference to it (``from x import f`` included) runs the mutant.
+
+What is not mutated: docstrings, ``raise`` statements and the ``if`` tests whose body only raises
+(input validation), f-strings and ``logger`` calls.
+
+Usage::
+
+    python tools/mutation.py                    # every area, 2 workers, writes docs/mutation.md
+    python tools/mutation.py --area similarity  # one area (printed, docs untouched)
+    python tools/mutation.py --list             # the mutants, not run
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import contextlib
+import copy
+import importlib
+import importlib.util
+import io
+import os
+import signal
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+TESTS = ROOT / "tests"
+
+
+@dataclass(frozen=True)
+class Target:
+    """An area: the judging functions of one module and the tests that cover them."""
+
+    area: str
+    module: str
+    functions: tuple[str, ...]
+    tests: tuple[str, ...]
+    pure_python: bool = False  # run numba kernels as plain Python (their mutants are in the Python source)
+
+
+TARGETS = (
+    Target("scene clearance", "bidmp.scene.clearance",
+           ("Clearance.collision_free", "Clearance.clear", "Clearance.collision_part", "Scene._minimum",
+            "Scene._clearance", "Scene._clearance_oriented", "_sweep", "_nearest_to_its_clearance"),
+           ("tests/test_oracles.py", "tests/test_geometry.py")),
+    Target("scene distances (culling bounds)", "bidmp.scene.distances",
+           ("_cylinder_box_bounds", "_densify", "_box_distance", "_Distances.tool_to", "_Distances._witnessed"),
+           ("tests/test_oracles.py", "tests/test_geometry.py")),
+    Target("scene checker", "bidmp.scene.checker",
+           ("SceneChecker.__call__", "SceneChecker.segments_free", "SceneChecker._move_free"),
+           ("tests/test_oracles.py", "tests/test_geometry.py", "tests/test_roadmap.py")),
+    Target("limit checks and measurement", "bidmp.tasks.contract",
+           ("_fractions", "command_peaks", "CommandPeaks.within", "Verdict.reached", "Verdict.clear",
+            "Verdict.within_limits", "Verdict.ok", "Verdict.failed"),
+           ("tests/test_oracles.py", "tests/test_contract.py", "tests/test_sim_limits.py")),
+    Target("engagement", "bidmp.tasks.metrics",
+           ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),
+           ("tests/test_oracles.py", "tests/test_engagement.py", "tests/test_contract.py")),
+    Target("job success criteria", "bidmp.sim.job_report",
+           ("in_bin", "in_slot", "JobTarget.contacts", "JobTarget.within_limits", "JobReport.removed"),
+           ("tests/test_oracles.py",)),
+    Target("job: a cycle's verdict", "bidmp.sim.job",
+           ("_finish", "_why"),
+           ("tests/test_oracles.py",)),
+    Target("similarity (Fréchet, normaliser)", "bidmp.extension.similarity",
+           ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
+           ("tests/test_oracles.py", "tests/test_similarity.py"), pure_python=True),
+    Target("similarity template", "bidmp.extension.roadmap",
+           ("template",),
+           ("tests/test_oracles.py", "tests/test_roadmap.py")),
+    Target("segmentation", "bidmp.extension.segmentation",
+           ("curvature", "_alternating_extrema", "_prune_persistence", "_prune_persistence_plain", "_prune_paper",
+            "choose_piece"),
+           ("tests/test_segmentation.py",)),
+    Target("BLS", "bidmp.incremental.bls",
+           ("_with_bias", "_affine", "_mapped_features", "_enhancement_block", "BLS.hidden", "BLS.fit"),
+           ("tests/test_bls.py",)),
+    Target("Bi-DMP skill selection", "bidmp.incremental._skills",
+           ("SkillLibrary.select_skill",),
+           ("tests/test_oracles.py", "tests/test_incremental.py")),
+    Target("goal systems", "bidmp.primitives.goals",
+           ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
+           ("tests/test_oracles.py", "tests/test_dmp.py", "tests/test_approach.py")),
+    Target("phase stopping", "bidmp.primitives.coupling",
+           ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
+           ("tests/test_oracles.py", "tests/test_primitives.py")),
+)
+
+# Survivors shown equivalent: (module, function, the mutated line's text, mutation) -> why no test
+# can tell the mutant from the original.
+_FAST_PATH = ("a fast path's guard: both branches give the same value (the slow one validates a "
+              "float64 vector and returns it unchanged)")
+EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    ("bidmp.primitives.coupling", "PhaseStopping.slowdown",
+     "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):", mutation): _FAST_PATH
+    for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")
+}
+
+
+# -- the mutants ------------------------------------------------------------------------------------
+_COMPARE = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq,
+            ast.NotEq: ast.Eq, ast.Is: ast.IsNot, ast.IsNot: ast.Is, ast.In: ast.NotIn, ast.NotIn: ast.In}
+_BINARY = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult, ast.Pow: ast.Mult,
+           ast.FloorDiv: ast.Mult, ast.Mod: ast.FloorDiv}
+_SWAPPED_NAMES = {"min": "max", "max": "min", "minimum": "maximum", "maximum": "minimum", "argmin": "argmax",
+                  "argmax": "argmin", "all": "any", "any": "all", "amin": "amax", "amax": "amin",
+                  "nanmin": "nanmax", "nanmax": "nanmin"}
+_SYMBOL = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!=", ast.Is: "is",
+           ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in", ast.Add: "+", ast.Sub: "-", ast.Mult: "*",
+           ast.Div: "/", ast.Pow: "**", ast.FloorDiv: "//", ast.Mod: "%", ast.And: "and", ast.Or: "or"}
+
+
+def _only_raises(body) -> bool:
+    return all(isinstance(statement, ast.Raise) for statement in body)
+
+
+def _skipped(node) -> bool:
+    """Input validation, messages and logging: not the judging logic."""
+    if isinstance(node, (ast.Raise, ast.JoinedStr, ast.Assert)):
+        return True
+    if isinstance(node, ast.If) and _only_raises(node.body) and not node.orelse:
+        return True
+    if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
+        return True  # a docstring
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name):
+        return node.func.value.id in ("logger", "logging", "warnings")
+    return False
+
+
+def _walk(node):
+    """The nodes of a function in a fixed order, without the skipped subtrees."""
+    yield node
+    for child in ast.iter_child_nodes(node):
+        if not _skipped(child):
+            yield from _walk(child)
+
+
+def _call_name(node: ast.Call) -> str | None:
+    if isinstance(node.func, ast.Name):
+        return node.func.id
+    if isinstance(node.func, ast.Attribute):
+        return node.func.attr
+    return None
+
+
+def _variants(node) -> list[tuple[str, callable]]:
+    """The mutations of one node: (description, apply(node) -> replacement node)."""
+    out = []
+    if isinstance(node, ast.Compare):
+        for index, op in enumerate(node.ops):
+            if type(op) in _COMPARE:
+                new = _COMPARE[type(op)]
+
+                def apply(n, index=index, new=new):
+                    n.ops[index] = new()
+                    return n
+                out.append((f"{_SYMBOL[type(op)]} -> {_SYMBOL[new]}", apply))
+    elif isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+        new = _BINARY[type(node.op)]
+
+        def apply(n, new=new):
+            n.op = new()
+            return n
+        out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", apply))
+    elif isinstance(node, ast.AugAssign) and type(node.op) in _BINARY:
+        new = _BINARY[type(node.op)]
+
+        def apply(n, new=new):
+            n.op = new()
+            return n
+        out.append((f"{_SYMBOL[type(node.op)]}= -> {_SYMBOL[new]}=", apply))
+    elif isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.Not)):
+        out.append(("drop " + ("-" if isinstance(node.op, ast.USub) else "not"), lambda n: n.operand))
+    elif isinstance(node, ast.BoolOp):
+        new = ast.Or if isinstance(node.op, ast.And) else ast.And
+
+        def apply(n, new=new):
+            n.op = new()
+            return n
+        out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", apply))
+    elif isinstance(node, ast.Constant) and isinstance(node.value, bool):
+        out.append((f"{node.value} -> {not node.value}", lambda n: ast.Constant(not n.value)))
+    elif isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+        value = node.value
+        changed = value + 1 if isinstance(value, int) else (value * 2.0 if value != 0.0 else 1.0)
+        out.append((f"{value!r} -> {changed!r}", lambda n, changed=changed: ast.Constant(changed)))
+    elif isinstance(node, ast.Call):
+        name = _call_name(node)
+        if name in ("abs", "fabs") and len(node.args) == 1:
+            out.append((f"drop {name}()", lambda n: n.args[0]))
+        elif name == "abs" or (name in ("absolute",) and node.args):
+            out.append((f"drop {name}()", lambda n: n.args[0]))
+        elif name in _SWAPPED_NAMES:
+            new = _SWAPPED_NAMES[name]
+
+            def apply(n, new=new):
+                if isinstance(n.func, ast.Name):
+                    n.func = ast.Name(new, ast.Load())
+                else:
+                    n.func.attr = new
+                return n
+            out.append((f"{name} -> {new}", apply))
+    return out
+
+
+@dataclass
+class Mutant:
+    target: Target
+    function: str
+    index: int  # the node's position in _walk(function)
+    variant: int
+    line: int
+    description: str
+    text: str = ""  # the mutated line, stripped
+    outcome: str = ""
+    seconds: float = 0.0
+
+    @property
+    def key(self) -> tuple[str, str, str, str]:
+        return (self.target.module, self.function, self.text, self.description)
+
+
+def _source_tree(module: str) -> tuple[Path, ast.Module]:
+    spec = importlib.util.find_spec(module)
+    path = Path(spec.origin)
+    return path, ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+
+def _function_node(tree: ast.Module, qualname: str):
+    scope = tree
+    for part in qualname.split("."):
+        found = next((node for node in ast.iter_child_nodes(scope)
+                      if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node.name == part), None)
+        if found is None:
+            raise SystemExit(f"mutation: {qualname} not found")
+        scope = found
+    return scope
+
+
+def mutants(target: Target) -> list[Mutant]:
+    path, tree = _source_tree(target.module)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    out = []
+    for function in target.functions:
+        node = _function_node(tree, function)
+        body = node.body[1:] if ast.get_docstring(node) else node.body
+        nodes = [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
+        for index, inner in enumerate(nodes):
+            for variant, (description, _) in enumerate(_variants(inner)):
+                out.append(Mutant(target, function, index, variant, inner.lineno, description,
+                                  lines[inner.lineno - 1].strip()))
+    return out
+
+
+def _mutated_code(mutant: Mutant):
+    """The mutated function's code object, compiled from the module with the one node changed."""
+    path, tree = _source_tree(mutant.target.module)
+    node = _function_node(tree, mutant.function)
+    body = node.body[1:] if ast.get_docstring(node) else node.body
+    nodes = [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
+    chosen = nodes[mutant.index]
+    _, apply = _variants(chosen)[mutant.variant]
+    replacement = apply(copy.copy(chosen) if isinstance(chosen, ast.Call) else chosen)
+    if replacement is not chosen:
+        for parent in ast.walk(node):
+            for name, value in ast.iter_fields(parent):
+                if value is chosen:
+                    setattr(parent, name, replacement)
+                elif isinstance(value, list):
+                    for position, item in enumerate(value):
+                        if item is chosen:
+                            value[position] = replacement
+    ast.fix_missing_locations(tree)
+    code = compile(tree, str(path), "exec")
+    wanted = mutant.function.split(".")[-1]
+    stack = [code]
+    while stack:
+        current = stack.pop()
+        if current.co_qualname == mutant.function or (current.co_name == wanted and current.co_qualname.endswith(mutant.function)):
+            return current
+        stack.extend(const for const in current.co_consts if hasattr(const, "co_code"))
+    raise SystemExit(f"mutation: no code object for {mutant.function}")
+
+
+def _live_function(module, qualname: str):
+    """The function object whose code runs for ``qualname`` (through properties and decorators)."""
+    owner, *rest = qualname.split(".")
+    value = getattr(module, owner)
+    for part in rest:
+        value = vars(value)[part] if isinstance(value, type) else getattr(value, part)
+    if isinstance(value, property):
+        value = value.fget
+    if isinstance(value, (staticmethod, classmethod)):
+        value = value.__func__
+    while getattr(value, "__code__", None) is None or value.__code__.co_qualname != qualname:
+        value = value.__wrapped__
+    return value
+
+
+def _run_child(mutant: Mutant | None, tests: tuple[str, ...]) -> int:
+    """In a forked child: plant the mutant, run the tests quietly, return pytest's exit code."""
+    import pytest
+
+    module = importlib.import_module(mutant.target.module if mutant else "bidmp")
+    if mutant is not None:
+        function = _live_function(module, mutant.function)
+        function.__code__ = _mutated_code(mutant)
+    if mutant is not None and mutant.target.pure_python or mutant is None and tests[-1] == "pure":
+        from bidmp.extension import similarity
+
+        similarity._kernel_state.update({"Fréchet": similarity._frechet_rows, "DTW": similarity._dtw_rows})
+    tests = tuple(test for test in tests if test != "pure")
+    sink = io.StringIO()
+    with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
+        return pytest.main([*tests, "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "--no-header"])
+
+
+def _fork(mutant: Mutant | None, tests: tuple[str, ...]) -> int:
+    pid = os.fork()
+    if pid == 0:  # the child
+        code = 3
+        try:
+            os.setpgid(0, 0)
+            code = int(_run_child(mutant, tests))
+        except BaseException:  # noqa: BLE001 - a mutant may break anything; the exit code says it
+            code = 4
+        finally:
+            os._exit(code)
+    return pid
+
+
+def run(selected: list[Mutant], workers: int, timeout_of: dict) -> None:
+    """Run the mutants ``workers`` at a time; set each one's outcome."""
+    pending, running = list(selected), {}
+    done = 0
+    while pending or running:
+        while pending and len(running) < workers:
+            mutant = pending.pop(0)
+            running[_fork(mutant, mutant.target.tests)] = (mutant, time.monotonic())
+        time.sleep(0.02)
+        for pid, (mutant, began) in list(running.items()):
+            finished, status = os.waitpid(pid, os.WNOHANG)
+            elapsed = time.monotonic() - began
+            if finished == 0 and elapsed < timeout_of[mutant.target.area]:
+                continue
+            if finished == 0:
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                mutant.outcome = "killed (timeout)"
+            else:
+                code = os.waitstatus_to_exitcode(status)
+                mutant.outcome = "survived" if code == 0 else ("killed" if code == 1 else f"killed (exit {code})")
+            mutant.seconds = elapsed
+            del running[pid]
+            done += 1
+            if mutant.outcome == "survived":
+                print(f"  survived: {mutant.target.module}:{mutant.line} {mutant.function}: {mutant.description}",
+                      flush=True)
+    return None
+
+
+def baseline(target: Target) -> float:
+    """The covering tests' time on the unmutated code; they must pass."""
+    began = time.monotonic()
+    pid = _fork(None, target.tests + (("pure",) if target.pure_python else ()))
+    _, status = os.waitpid(pid, 0)
+    code = os.waitstatus_to_exitcode(status)
+    if code != 0:
+        raise SystemExit(f"mutation: the tests of {target.area} fail on the unmutated code (exit {code}): "
+                         f"{' '.join(target.tests)}")
+    return time.monotonic() - began
+
+
+def report(selected: list[Mutant], seconds: float) -> str:
+    lines = ["# Mutation testing of the checks that guard the robot", "",
+             "Written by `make mutation` (`python tools/mutation.py`); do not edit. Each mutant is one small "
+             "bug planted in one judging function (a comparison made strict or loose, an operator or a constant "
+             "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
+             "tests that cover the area run against it. Input validation (`raise` and the `if` tests that only "
+             "raise), messages and logging are not mutated: the surface sweep (`make fuzz`) covers them.", "",
+             "| area | module | functions | mutants | killed | equivalent | survived | score |",
+             "|---|---|---|---:|---:|---:|---:|---:|"]
+    survivors = []
+    for target in TARGETS:
+        own = [m for m in selected if m.target is target]
+        if not own:
+            continue
+        killed = sum(m.outcome.startswith("killed") for m in own)
+        equivalent = [m for m in own if m.outcome == "survived" and m.key in EQUIVALENT]
+        survived = [m for m in own if m.outcome == "survived" and m.key not in EQUIVALENT]
+        survivors += survived + equivalent
+        score = (killed + len(equivalent)) / len(own)
+        lines.append(f"| {target.area} | `{target.module}` | {len(target.functions)} | {len(own)} | {killed} | "
+                     f"{len(equivalent)} | {len(survived)} | {100 * score:.1f} % |")
+    total = len(selected)
+    killed = sum(m.outcome.startswith("killed") for m in selected)
+    lines += ["", f"{total} mutants, {killed} killed by the tests, in {seconds / 60:.1f} min on 2 workers.", ""]
+    lines += ["## Survivors", ""]
+    if not survivors:
+        lines.append("None.")
+    for mutant in survivors:
+        why = EQUIVALENT.get(mutant.key)
+        verdict = f"equivalent: {why}" if why else "**not killed**"
+        lines.append(f"- `{mutant.target.module}:{mutant.line}` `{mutant.function}`: `{mutant.description}` — {verdict}")
+    lines += ["", "## Functions mutated", ""]
+    for target in TARGETS:
+        lines.append(f"- {target.area}: " + ", ".join(f"`{name}`" for name in target.functions)
+                     + " — tests: " + ", ".join(f"`{Path(test).name}`" for test in target.tests))
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--area", action="append", help="only this area (repeatable; a prefix is enough)")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--list", action="store_true", help="list the mutants without running them")
+    parser.add_argument("--out", default=str(ROOT / "docs" / "mutation.md"))
+    args = parser.parse_args(argv)
+    os.chdir(ROOT)
+    os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
+    sys.path.insert(0, str(TESTS))
+    targets = [t for t in TARGETS if not args.area or any(t.area.startswith(a) for a in args.area)]
+    selected = [m for target in targets for m in mutants(target)]
+    if args.list:
+        for m in selected:
+            print(f"{m.target.area}: {m.target.module}:{m.line} {m.function}: {m.description}")
+        print(f"{len(selected)} mutants")
+        return 0
+    import bidmp  # noqa: F401 - imported once here; every child is a fork of this process
+    import pytest  # noqa: F401
+
+    for target in targets:
+        importlib.import_module(target.module)
+    began = time.monotonic()
+    timeout_of = {}
+    for target in targets:
+        seconds = baseline(target)
+        timeout_of[target.area] = 3.0 * seconds + 20.0
+        own = [m for m in selected if m.target is target]
+        print(f"{target.area}: {len(own)} mutants, tests {seconds:.1f} s", flush=True)
+        run(own, args.workers, timeout_of)
+        killed = sum(m.outcome.startswith("killed") for m in own)
+        print(f"{target.area}: {killed}/{len(own)} killed", flush=True)
+    text = report(selected, time.monotonic() - began)
+    if args.area:
+        print(text)
+    else:
+        out = Path(args.out)
+        partial = out.with_name(out.name + ".partial")
+        partial.write_text(text, encoding="utf-8")
+        partial.replace(out)
+        print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
