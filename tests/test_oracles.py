@@ -63,13 +63,14 @@ def test_a_path_over_a_box_at_the_margin_is_judged_by_its_closed_form_clearance(
 def test_the_nearest_point_of_a_v_shaped_pass_over_a_box_is_its_lowest_sample():
     """Independent oracle: a path dipping to 7 mm over a box's top at one sample (x = 10) and
     rising either side is nearest there, 7 mm; with the tool's orientation given (pointing down,
-    the default) the answer is the same, also when the path starts at its nearest point."""
+    the default) the answer is the same, also when the path starts at its nearest point and
+    when the quaternions are not normalised."""
     scene = Scene.from_dict({"tool": {"radius": 4.0, "length": 80.0},
                              "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [60.0, 60.0, 20.0]}]})
     x = np.linspace(-50.0, 50.0, 41)
     path = np.column_stack([x, np.zeros(41), 27.0 + 0.5 * np.abs(x - 10.0)])
     down = np.tile([1.0, 0.0, 0.0, 0.0], (41, 1))  # half a turn about x: the tool's z axis points down
-    for points, turns in ((path, None), (path, down), (path[24:], down[24:])):
+    for points, turns in ((path, None), (path, down), (path[24:], down[24:]), (path, 2.5 * down)):
         found = scene.clearance(points, orientations=turns)
         assert found.distance == pytest.approx(7.0, abs=1e-6)
         np.testing.assert_allclose(found.point, [10.0, 0.0, 27.0], atol=1e-9)
@@ -133,6 +134,12 @@ def test_a_command_jump_at_either_end_is_an_acceleration_from_rest():
     assert not peaks.within
     backwards = command_peaks(-commands, limits, 1e-3)
     assert backwards.ends == pytest.approx(peaks.ends) and not backwards.within
+    assert peaks.jerk == 0.0  # no jerk limit: not judged
+    two = command_peaks(commands[:2], limits, 1e-3)  # one step: from rest and back to rest at once
+    assert two.ends == pytest.approx(peaks.ends) and not two.within
+    for held in (np.full((1, 1), 0.3), np.full((6, 1), 0.3)):  # an arm held still: nothing moves
+        still = command_peaks(held, limits, 1e-3)
+        assert (still.velocity, still.acceleration, still.jerk, still.ends) == (0.0, 0.0, 0.0, 0.0) and still.within
 
 
 # -- engagement: the final approach ---------------------------------------------------------------
@@ -153,7 +160,7 @@ def test_the_final_approach_is_the_descent_below_its_height_and_its_error_is_the
     assert approach_error(along_x, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]) == pytest.approx(offset[below].max(), rel=1e-12)
 
 
-@pytest.mark.parametrize("rise, engaged", [(0.0, True), (0.2, True), (0.3, False), (2.0, False)])
+@pytest.mark.parametrize("rise, engaged", [(0.0, True), (0.2, True), (0.25, True), (0.3, False), (2.0, False)])
 def test_a_rise_inside_the_band_beyond_the_tolerance_is_no_engagement(rise, engaged):
     """Independent oracle: a descent into a 20 mm band that rises by ``rise`` on the way down
     (a wobble) engages iff the rise is at most the tolerance (0.25 here)."""
@@ -333,3 +340,509 @@ def test_the_default_spring_is_critically_damped():
         t = index * step
         expected = goal * (1.0 - (1.0 + lam * t) * np.exp(-lam * t))
         assert np.allclose(y, expected, atol=1e-9), (t, y, expected)
+
+
+# -- clearance on random cells against a closed form ----------------------------------------------
+def _tool_to_boxes(tips, radius, length, lower, upper):
+    """Signed distance (n, k) from a vertical cylindrical tool (tip at ``tips`` (n, 3), radius r,
+    rising ``length``) to axis-aligned boxes (k, 3): both are products of a horizontal and a
+    vertical set, so the distance is the hypotenuse of the horizontal and vertical gaps, and a
+    penetration is the smaller of the two ways out (sideways, or along z)."""
+    xy, lo, hi = tips[:, None, :2], lower[None, :, :2], upper[None, :, :2]
+    outside = np.maximum(np.maximum(lo - xy, xy - hi), 0.0)
+    horizontal_gap = np.linalg.norm(outside, axis=2) - radius
+    inside_depth = np.min(np.minimum(xy - lo, hi - xy), axis=2)  # to the rectangle's edge, when inside
+    horizontal_depth = np.where(np.all(outside == 0.0, axis=2), inside_depth + radius, radius - np.linalg.norm(outside, axis=2))
+    bottom, top = tips[:, None, 2], tips[:, None, 2] + length
+    vertical_gap = np.maximum(np.maximum(lower[None, :, 2] - top, bottom - upper[None, :, 2]), 0.0)
+    vertical_depth = np.minimum(top - lower[None, :, 2], upper[None, :, 2] - bottom)
+    separated = (horizontal_gap > 0.0) | (vertical_gap > 0.0)
+    distance = np.hypot(np.maximum(horizontal_gap, 0.0), vertical_gap)
+    return np.where(separated, distance, -np.minimum(horizontal_depth, vertical_depth))
+
+
+def _random_cell(rng):
+    boxes = []
+    cells = [(x, y) for x in (-100.0, 0.0, 100.0) for y in (-100.0, 0.0, 100.0)]  # 100 apart: no overlap
+    for cell in rng.permutation(len(cells))[: int(rng.integers(1, 5))]:
+        size = rng.uniform([10, 10, 10], [90, 90, 60])
+        at = np.array([*cells[cell], 0.0]) + [*rng.uniform(-5.0, 5.0, 2), rng.uniform(0.0, 40.0)]
+        boxes.append({"type": "box", "label": f"b{len(boxes)}", "at": at.tolist(), "size": size.tolist()})
+    radius, length = rng.uniform(2.0, 12.0), rng.uniform(30.0, 150.0)
+    scene = Scene.from_dict({"tool": {"radius": radius, "length": length}, "parts": boxes})
+    lower = np.array([[b["at"][0] - b["size"][0] / 2, b["at"][1] - b["size"][1] / 2, b["at"][2]] for b in boxes])
+    upper = lower + np.array([b["size"] for b in boxes])
+    return scene, radius, length, lower, upper
+
+
+def _random_path(rng):
+    kind = rng.integers(3)
+    points = rng.uniform([-160, -160, -60], [160, 160, 140], (int(rng.integers(2, 6)), 3))
+    if kind == 1:  # out and back
+        points = np.vstack([points[:2], points[:1]])
+    elif kind == 2:  # a level pass under or through the parts
+        points[:, 2] = rng.uniform(-80.0, 60.0)
+    return points
+
+
+def _dense(points, spacing):
+    pieces = [np.linspace(a, b, max(int(np.ceil(np.linalg.norm(b - a) / spacing)), 1) + 1)
+              for a, b in zip(points[:-1], points[1:])]
+    return np.vstack(pieces)
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_clearance_on_random_cells_is_the_closed_form_minimum_within_the_placement_step(seed):
+    """Independent oracle: for random boxes, tools and multi-point paths (zig-zags, out and back,
+    level passes through the parts), the clearance is the minimum of the closed-form signed
+    distance over the path sampled 20 times finer than the library's placements, within the
+    documented step / 2; its part is the nearest box there, its point on the path."""
+    rng = np.random.default_rng(seed)
+    scene, radius, length, lower, upper = _random_cell(rng)
+    step = 0.002 * length
+    for _ in range(6):
+        path = _random_path(rng)
+        found = scene.clearance(path)
+        fine = _dense(path, step / 20.0)
+        distances = _tool_to_boxes(fine, radius, length, lower, upper)
+        truth = float(distances.min())
+        tolerance = 1e-4  # coal's penetration depths (EPA) agree with the closed form to ~3e-5
+        assert truth - step / 40.0 - tolerance <= found.distance <= truth + step / 2.0 + tolerance, (found.distance, truth)
+        own = _tool_to_boxes(found.point[None], radius, length, lower, upper)[0]
+        assert own.min() == pytest.approx(found.distance, abs=tolerance)
+        assert found.part == f"b{int(np.argmin(own))}" or np.sort(own)[1] - own.min() < tolerance
+        on_path = np.min(np.linalg.norm(_dense(path, step / 4.0) - found.point, axis=1))
+        assert on_path <= step
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_checker_and_straight_moves_on_random_cells_agree_with_the_closed_form(seed):
+    """Independent oracle: a placement is free iff its closed-form clearance is at least the
+    margin; a straight move iff it is along the whole move (sampled finely here). Cases within
+    a hair of the margin are left out (either answer is right there)."""
+    rng = np.random.default_rng(100 + seed)
+    scene, radius, length, lower, upper = _random_cell(rng)
+    margin = float(rng.uniform(0.0, 6.0))
+    checker = bidmp.scene.SceneChecker(scene, np.arange(len(scene.solids)), margin)
+    points = rng.uniform([-160, -160, -60], [160, 160, 140], (300, 3))
+    truth = _tool_to_boxes(points, radius, length, lower, upper).min(axis=1)
+    sure = np.abs(truth - margin) > 1e-4
+    assert checker(points)[sure].tolist() == (truth >= margin)[sure].tolist()
+    a = rng.uniform([-160, -160, -60], [160, 160, 140], (40, 3))
+    b = a + rng.uniform(-120.0, 120.0, (40, 3))
+    along = np.array([_tool_to_boxes(_dense(np.vstack([p, q]), 0.05), radius, length, lower, upper).min()
+                      for p, q in zip(a, b)])
+    sure = np.abs(along - margin) > 0.1
+    assert checker.segments_free(a, b)[sure].tolist() == (along >= margin)[sure].tolist()
+    assert sure.sum() >= 30
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_culling_bounds_are_the_exact_distances_to_boxes(seed):
+    """Independent oracle: the culling's lower bound of a tool placement against a box is the
+    closed-form distance (0 when they overlap); two boxes' distance is the norm of their per-axis
+    gaps, computed here axis by axis."""
+    from bidmp.scene.distances import _box_distance, _cylinder_box_bounds
+
+    rng = np.random.default_rng(seed)
+    lower = rng.uniform(-100.0, 100.0, (5, 3))
+    upper = lower + rng.uniform(1.0, 60.0, (5, 3))
+    points = rng.uniform(-200.0, 200.0, (400, 3))
+    radius, length = rng.uniform(1.0, 15.0), rng.uniform(10.0, 120.0)
+    expected = np.maximum(_tool_to_boxes(points, radius, length, lower, upper), 0.0)
+    np.testing.assert_allclose(_cylinder_box_bounds(points, radius, length, lower, upper), expected, atol=1e-9)
+    other_lower = rng.uniform(-150.0, 150.0, (400, 3))
+    other_upper = other_lower + rng.uniform(0.0, 50.0, (400, 3))
+    for k in range(5):
+        gaps = [max(lower[k, axis] - other_upper[i, axis], other_lower[i, axis] - upper[k, axis], 0.0)
+                for i in range(400) for axis in range(3)]
+        by_hand = np.sqrt(np.sum(np.reshape(gaps, (400, 3)) ** 2, axis=1))
+        np.testing.assert_allclose(_box_distance(other_lower, other_upper, lower[k], upper[k]), by_hand, atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_placements_along_a_path_are_at_most_a_step_apart_and_no_more_than_needed(seed):
+    """Property: the placements of every (or every chosen) segment run from its start to its end,
+    no two more than ``step`` apart, ceil(length / step) + 1 of them (none wasted); their segment
+    index and fraction give them back."""
+    from bidmp.scene.distances import _densify
+
+    rng = np.random.default_rng(seed)
+    points = np.cumsum(rng.uniform(-30.0, 30.0, (7, 3)), axis=0)
+    step = float(rng.uniform(0.5, 4.0))
+    chosen = np.sort(rng.choice(6, 3, replace=False))
+    for segments in (None, chosen):
+        dense, which, fraction = _densify(points, step, segments, weights=True)
+        indices = np.arange(6) if segments is None else segments
+        np.testing.assert_allclose(dense, points[which] + fraction[:, None] * (points[which + 1] - points[which]),
+                                   atol=1e-9)
+        for index in indices:
+            own = dense[which == index]
+            length = np.linalg.norm(points[index + 1] - points[index])
+            assert own.shape[0] == int(np.ceil(length / step)) + 1
+            np.testing.assert_allclose(own[[0, -1]], points[[index, index + 1]], atol=1e-9)
+            assert np.all(np.linalg.norm(np.diff(own, axis=0), axis=1) <= step + 1e-9)
+        assert set(which.tolist()) == set(indices.tolist())
+    single = _densify(points[:1], step)
+    assert single.tolist() == points[:1].tolist()
+    assert _densify(points, step, np.array([], dtype=int)).shape == (0, 3)
+
+
+@pytest.mark.parametrize("field", ["velocity", "acceleration", "jerk"])
+def test_a_peak_at_its_limit_is_within_it_and_a_hair_over_is_not(field):
+    """Independent oracle: a peak equal to its limit (to rounding, 1e-9) is within it; 3e-9 over,
+    or half over, is not; a motion that starts or ends at 5 % of the acceleration limit is at rest."""
+    from bidmp.tasks.contract import AT_REST, CommandPeaks
+
+    def peaks(value, ends=0.0):
+        return CommandPeaks(**{"velocity": 0.2, "acceleration": 0.2, "jerk": 0.2, field: value}, ends=ends)
+
+    assert peaks(1.0).within and peaks(1.0 + 1e-9).within
+    assert not peaks(1.0 + 3e-9).within and not peaks(1.5).within
+    assert peaks(0.5, ends=AT_REST).within and not peaks(0.5, ends=AT_REST * 1.001).within
+    assert AT_REST == 0.05
+
+
+def test_the_worst_joint_is_the_one_with_the_largest_peak_of_any_kind():
+    """Independent oracle: two joints making the same move, joint 2 with a tight speed limit
+    (0.9 of it used) and loose others, joint 1 at half of every limit: joint 2 is the worst."""
+    s = np.linspace(0.0, 1.0, 2001)
+    q = 0.8 * (10 * s**3 - 15 * s**4 + 6 * s**5)
+    speed, acceleration, jerk = 15 * 0.8 / 16, 10 * 0.8 / (math.sqrt(3) * 4), 60 * 0.8 / 8
+    limits = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2 * speed, speed / 0.9),
+                                   acceleration=(2 * acceleration, 100 * acceleration), jerk=(2 * jerk, 100 * jerk))
+    peaks = command_peaks(np.column_stack([q, q]), limits, 1e-3)
+    assert peaks.joint == 1 and peaks.velocity == pytest.approx(0.9, rel=2e-3)
+
+
+def test_a_verdict_is_ok_only_when_every_check_that_applies_holds():
+    """Independent oracle: the end within the threshold (equal is success), and each of
+    engagement, clearance, alignment and limits True or not applying (None); contacts of the arm
+    with another part are no clearance."""
+    from bidmp.scene import Clearance
+    from bidmp.tasks.contract import CommandPeaks, Verdict
+
+    base = Verdict("3", end_error=1.0, threshold=1.0, units="mm")
+    assert base.reached and base.ok and base.failed == [] and base.clear is None and base.within_limits is None
+    assert not Verdict("3", 1.0 + 1e-12, 1.0, "mm").reached
+    for change, name in (({"engaged": False}, "engagement"), ({"aligned": False, "axis_deviation": 7.0}, "alignment"),
+                         ({"contacts": {"plate": 0.2}}, "clearance"),
+                         ({"clearance": Clearance(1.0, "plate", np.zeros(3), 3.0)}, "clearance"),
+                         ({"limits": CommandPeaks(1.2, 0.1, 0.1)}, "limits")):
+        verdict = Verdict("3", 0.5, 1.0, "mm", **change)
+        assert not verdict.ok and verdict.failed == [name] and verdict.reason().startswith("the motion to 3 ")
+    for change in ({"engaged": True}, {"aligned": True}, {"clearance": Clearance(3.0, "plate", np.zeros(3), 3.0)},
+                   {"limits": CommandPeaks(1.0, 0.1, 0.1)}):
+        assert Verdict("3", 0.5, 1.0, "mm", **change).ok
+
+
+def test_the_tools_tilt_over_the_final_approach_is_the_largest_angle_below_the_band():
+    """Independent oracle: a tool pointing down tilted by θ about x has its axis at angle |θ| from
+    the target's −z; above the band a 30° tilt does not count, below it the largest |θ| is 6°. Along
+    a target's +x axis, the same tilts turned with it give the same angles."""
+    from bidmp.tasks.metrics import axis_deviation
+
+    z = np.linspace(40.0, 0.0, 81)
+    tilt = np.full(81, 30.0)  # above the band
+    tilt[z < 25.0] = 6.0 * np.sin(np.pi * z[z < 25.0] / 25.0) ** 2 * np.where(z[z < 25.0] > 12.5, 1.0, -1.0)
+    half = np.radians(tilt + 180.0) / 2.0  # the tilt after half a turn about x (pointing down)
+    q = np.column_stack([np.sin(half), np.zeros(81), np.zeros(81), np.cos(half)])
+    path = np.column_stack([np.zeros(81), np.zeros(81), z])
+    expected = np.max(np.abs(tilt[z < 25.0]))
+    assert axis_deviation(path, q, np.zeros(3), 25.0) == pytest.approx(expected, abs=1e-9)
+    # The same along +x: turn the world by 90° about y (z -> x); the tool's frame turns with it.
+    turn = np.array([0.0, np.sin(np.pi / 4), 0.0, np.cos(np.pi / 4)])
+    turned_q = np.array([_quaternion_product(turn, row) for row in q])
+    turned_path = np.column_stack([z, np.zeros(81), np.zeros(81)])
+    assert axis_deviation(turned_path, turned_q, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]) == pytest.approx(expected, abs=1e-9)
+    assert math.isinf(axis_deviation(path[:30], q[:30], np.zeros(3), 25.0))  # ends above the band
+
+
+def _quaternion_product(a, b):
+    """Hamilton product of quaternions (x, y, z, w), written out."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
+                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
+
+
+def _frechet_by_table(a, b):
+    """The discrete Fréchet distance by its defining recursion over the full table (Eiter and
+    Mannila 1994), written here."""
+    n, m = len(a), len(b)
+    table = np.full((n, m), np.inf)
+    for i in range(n):
+        for j in range(m):
+            d = float(np.linalg.norm(a[i] - b[j]))
+            if i == 0 and j == 0:
+                table[i, j] = d
+            elif i == 0:
+                table[i, j] = max(table[i, j - 1], d)
+            elif j == 0:
+                table[i, j] = max(table[i - 1, j], d)
+            else:
+                table[i, j] = max(min(table[i - 1, j], table[i, j - 1], table[i - 1, j - 1]), d)
+    return table[-1, -1]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_both_frechet_implementations_are_the_defining_recursion(seed):
+    """Independent oracle: the kernel and the anti-diagonal reference equal the full-table
+    recursion on random curves of unequal lengths (1 to 40 points, 1 to 3 dimensions), including
+    ones whose last points decide and ones that wander."""
+    from bidmp.extension.similarity import frechet_distance_reference
+
+    rng = np.random.default_rng(seed)
+    for _ in range(8):
+        n_dims = int(rng.integers(1, 4))
+        a = np.cumsum(rng.normal(size=(int(rng.integers(1, 41)), n_dims)), axis=0)
+        b = np.cumsum(rng.normal(size=(int(rng.integers(1, 41)), n_dims)), axis=0)
+        truth = _frechet_by_table(a, b)
+        assert frechet_distance(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
+        assert frechet_distance_reference(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
+        assert frechet_distance(b, a) == pytest.approx(truth, rel=1e-12, abs=1e-12)
+
+
+def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_moves_along():
+    """Independent oracle: per axis, seg + (n_tar − seg)/(tar − seg) · (piece − seg); an axis whose
+    chord is under 1e-3 of the chord's length (or whose factor is over 10) instead gets the piece
+    plus λ (n_tar − tar), λ the normalised arc length computed here; a closed piece (it ends where it
+    starts) is ramped on every axis, with either scaling."""
+    s = np.linspace(0.0, 1.0, 50)
+    piece = np.column_stack([100 * s, 20 * np.sin(np.pi * s), 5.0 + 0 * s])  # z: the piece does not move
+    new_target = np.array([160.0, -30.0, 12.0])
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])
+    lam = arc / arc[-1]
+    out = template(piece, new_target, scaling="axis")
+    np.testing.assert_allclose(out[:, 0], 1.6 * piece[:, 0], atol=1e-9)
+    np.testing.assert_allclose(out[:, 1], piece[:, 1] + lam * (-30.0 - piece[-1, 1]), atol=1e-9)  # y: chord ~0
+    np.testing.assert_allclose(out[:, 2], 5.0 + lam * 7.0, atol=1e-9)
+    steep = piece.copy()
+    steep[:, 1] = 20 * np.sin(np.pi * s) + 2.0 * s  # y chord 2: factor (-30 - 0)/2 = -15, over 10: ramped
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(steep, axis=0), axis=1))])
+    out = template(steep, new_target, scaling="axis")
+    np.testing.assert_allclose(out[:, 1], steep[:, 1] + arc / arc[-1] * (-30.0 - 2.0), atol=1e-9)
+    loop = np.column_stack([30 * np.sin(2 * np.pi * s), 30 * (1 - np.cos(2 * np.pi * s)), 0 * s])
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(loop, axis=0), axis=1))])
+    for scaling in ("axis", "similarity"):
+        np.testing.assert_allclose(template(loop, [10.0, 5.0, 2.0], scaling=scaling),
+                                   loop + (arc / arc[-1])[:, None] * np.array([10.0, 5.0, 2.0]), atol=1e-9)
+    still = np.tile([3.0, 4.0, 5.0], (5, 1))  # no length at all: λ by sample
+    np.testing.assert_allclose(template(still, [7.0, 4.0, 5.0]), still + np.linspace(0, 1, 5)[:, None] * [4.0, 0, 0],
+                               atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0, 0.5])
+def test_a_similarity_template_along_or_against_its_chord_keeps_the_shape(direction):
+    """Property: a similarity template is the piece turned and scaled — all pairwise distances
+    times the chord ratio — also when the new chord points the same way (no turn) or the opposite
+    way (half a turn, a special case of the rotation), and it ends on the new target."""
+    from scipy.spatial.distance import pdist
+
+    s = np.linspace(0.0, 1.0, 40)[:, None]
+    piece = s * np.array([80.0, 30.0, -10.0]) + np.sin(np.pi * s) * np.array([0.0, 15.0, 25.0])
+    new_target = piece[0] + direction * 1.7 * (piece[-1] - piece[0])
+    out = template(piece, new_target, scaling="similarity")
+    np.testing.assert_allclose(pdist(out), 1.7 * abs(direction) * pdist(piece), rtol=1e-9)
+    np.testing.assert_allclose(out[-1], new_target, atol=1e-9)
+    if direction > 0:
+        np.testing.assert_allclose(out, piece[0] + 1.7 * direction * (piece - piece[0]), atol=1e-9)
+
+
+# -- segmentation ---------------------------------------------------------------------------------
+def _documented_curvature(y, smooth=0.05, smooth_curvature=0.03):
+    """The documented procedure, written out from the docstring: Savitzky–Golay first and second
+    derivatives (order 3) over an odd window of round(smooth T) samples (at least 7, at most T),
+    κ = ‖r′ × r″‖ / ‖r′‖³, then κ smoothed (order 2) over round(smooth_curvature T) (at least 5),
+    clipped at 0."""
+    from scipy.signal import savgol_filter
+
+    def odd(fraction, n, least):
+        window = max(int(round(fraction * n)), least)
+        window = window if window % 2 else window + 1
+        return min(window, n if n % 2 else n - 1)
+
+    n = y.shape[0]
+    first = savgol_filter(y, odd(smooth, n, 7), 3, deriv=1, axis=0)
+    second = savgol_filter(y, odd(smooth, n, 7), 3, deriv=2, axis=0)
+    kappa = np.linalg.norm(np.cross(first, second), axis=1) / np.linalg.norm(first, axis=1) ** 3
+    window = odd(smooth_curvature, n, 5)
+    return np.maximum(savgol_filter(kappa, window, 2) if window > 3 else kappa, 0.0)
+
+
+@pytest.mark.parametrize("n_points, smooth, smooth_curvature", [(400, 0.05, 0.03), (120, 0.1, 0.08), (57, 0.02, 0.01),
+                                                                 (2000, 0.05, 0.03)])
+def test_curvature_is_the_documented_smoothing_of_the_closed_form(n_points, smooth, smooth_curvature):
+    """Independent oracle: on a helix (κ = r / (r² + c²)) the curvature is the closed form inside
+    the curve, and everywhere it is the documented procedure written out in the test."""
+    from bidmp.extension.segmentation import curvature
+
+    radius, pitch = 40.0, 15.0
+    t = np.linspace(0.0, 3 * np.pi, n_points)
+    helix = np.column_stack([radius * np.cos(t), radius * np.sin(t), pitch * t])  # even in arc length
+    kappa = curvature(helix, smooth, smooth_curvature)
+    np.testing.assert_allclose(kappa, _documented_curvature(helix, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+    inside = slice(n_points // 10, -n_points // 10)
+    # a cubic fit over a window of 5-10 % of the helix (0.5-0.9 rad of turn) reads 0.4-1.8 % low
+    np.testing.assert_allclose(kappa[inside], radius / (radius**2 + pitch**2), rtol=3e-2)
+    rng = np.random.default_rng(n_points)
+    wiggly = np.cumsum(rng.normal(size=(n_points, 3)), axis=0)
+    np.testing.assert_allclose(curvature(wiggly, smooth, smooth_curvature),
+                               _documented_curvature(wiggly, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+    flat = curvature(wiggly[:, :2], smooth, smooth_curvature)  # a 2-D curve is the z = 0 curve
+    padded = np.column_stack([wiggly[:, :2], np.zeros(n_points)])
+    np.testing.assert_allclose(flat, _documented_curvature(padded, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+
+
+def test_curvature_where_the_curve_stops_is_zero_and_a_tiny_curve_has_none():
+    """Independent oracle: samples where the curve does not advance have κ = 0 (not inf); a
+    curve shorter than the smallest window has no curvature to estimate."""
+    from bidmp.extension.segmentation import curvature
+
+    still = np.tile([1.0, 2.0, 3.0], (30, 1))
+    assert curvature(still).tolist() == [0.0] * 30
+    assert curvature(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])).tolist() == [0.0, 0.0, 0.0]
+
+
+def _extrema_by_runs(kappa, low, high):
+    """Interior local extrema of kappa[low:high], a plateau counted once at its middle sample:
+    runs of equal values, a run higher than both neighbours a maximum, lower a minimum."""
+    segment = list(kappa[low:high])
+    runs = []
+    for index, value in enumerate(segment):
+        if runs and runs[-1][0] == value:
+            runs[-1][2] = index
+        else:
+            runs.append([value, index, index])
+    indices, types = [], []
+    for previous, (value, first, last), following in zip(runs, runs[1:], runs[2:]):
+        kind = 1 if previous[0] < value > following[0] else -1 if previous[0] > value < following[0] else 0
+        if kind:
+            indices.append(low + (first + last) // 2)
+            types.append(kind)
+    return indices, types
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_curvature_extrema_are_the_runs_higher_or_lower_than_both_neighbours(seed):
+    """Independent oracle: extrema found by comparing runs of equal values with their
+    neighbours, written here, on random sequences full of plateaus, in random windows."""
+    from bidmp.extension.segmentation import _alternating_extrema
+
+    rng = np.random.default_rng(seed)
+    for _ in range(50):
+        kappa = rng.integers(0, 4, int(rng.integers(3, 40))).astype(float)
+        low = int(rng.integers(0, 3))
+        high = int(rng.integers(low, kappa.size + 1))
+        indices, types = _alternating_extrema(kappa, low, high)
+        expected = _extrema_by_runs(kappa, low, high) if high - low >= 3 else ([], [])
+        assert (indices.tolist(), types.tolist()) == expected, (kappa, low, high)
+        assert all(a != b for a, b in zip(types, types[1:]))  # they alternate
+
+
+def _prune_by_hand(values, epsilon):
+    """The persistence rule written out: cancel the adjacent pair with the smallest difference
+    (the leftmost of equals) while it is below epsilon."""
+    kept = list(range(len(values)))
+    while len(kept) >= 2:
+        gaps = [abs(values[b] - values[a]) for a, b in zip(kept, kept[1:])]
+        smallest = min(gaps)
+        if smallest >= epsilon:
+            break
+        pair = gaps.index(smallest)
+        del kept[pair : pair + 2]
+    return kept
+
+
+def _paper_by_hand(types, values, epsilon):
+    """The paper's rule written out: walk the sequence; a maximum followed by a minimum closer
+    than epsilon in curvature is dropped, the pair is skipped either way; anything else steps one."""
+    keep, position = [True] * len(types), 0
+    while position + 1 < len(types):
+        if types[position] == 1 and types[position + 1] == -1:
+            if abs(values[position] - values[position + 1]) < epsilon:
+                keep[position] = keep[position + 1] = False
+            position += 2
+        else:
+            position += 1
+    return [i for i in range(len(types)) if keep[i]]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_both_pruning_rules_are_their_written_out_loops(seed):
+    """Independent oracle: the heap-based persistence pruning and the paper's rule against loops
+    written here, on random alternating sequences with ties (integer curvatures), epsilon on a
+    tie too."""
+    from bidmp.extension.segmentation import _prune_paper, _prune_persistence
+
+    rng = np.random.default_rng(seed)
+    for _ in range(60):
+        count = int(rng.integers(0, 14))
+        types = np.where(np.arange(count) % 2 == int(rng.integers(2)), 1, -1)
+        values = rng.integers(0, 6, count).astype(float)
+        kappa = np.zeros(count + 5)
+        indices = np.sort(rng.choice(count + 5, count, replace=False))
+        kappa[indices] = values
+        epsilon = float(rng.integers(0, 4))
+        kept, kinds = _prune_persistence(indices, types, kappa, epsilon)
+        expected = _prune_by_hand(values, epsilon)
+        assert kept.tolist() == indices[expected].tolist() and kinds.tolist() == types[expected].tolist()
+        kept, kinds = _prune_paper(indices, types, kappa, epsilon)
+        expected = _paper_by_hand(types, values, epsilon)
+        assert kept.tolist() == indices[expected].tolist() and kinds.tolist() == types[expected].tolist()
+
+
+# -- the Broad Learning System --------------------------------------------------------------------
+@pytest.mark.parametrize("reg", [1e-6, 0.0])
+def test_a_bls_is_its_documented_forward_pass_and_output_solve(reg):
+    """Independent oracle: with the fitted weights, the hidden layer is [Z | H] written out:
+    Z_i = ([X, 0.1] W_Z,i − min) / range (each node spanning exactly [0, 1] on the training
+    inputs), H = tanh(s [Z, 0.1] W_H) with s = shrink / max|[Z, 0.1] W_H| and W_H orthonormal; the
+    output weights are the ridge solution (AᵀA + λI)⁻¹AᵀY, or numpy.linalg.pinv(A) Y at λ = 0;
+    predictions are A W. Inputs of 4 columns with 3 nodes per window (no shape coincides)."""
+    rng = np.random.default_rng(7)
+    X, Y = rng.normal(size=(70, 4)), rng.normal(size=(70, 2))
+    model = bidmp.BLS(n_windows=2, n_mapped=3, n_enhance=9, shrink=0.7, reg=reg, seed=5).fit(X, Y)
+    with_bias = np.hstack([X, np.full((70, 1), 0.1)])
+    Z = np.hstack([with_bias @ model.mapping_weights_[i] for i in range(2)])
+    Z = (Z - model.mapping_min_) / model.mapping_range_
+    np.testing.assert_allclose(Z.min(axis=0), 0.0, atol=1e-12)
+    np.testing.assert_allclose(Z.max(axis=0), 1.0, atol=1e-12)
+    weights = model.enhancement_weights_[0]
+    assert weights.shape == (7, 9)
+    pre = np.hstack([Z, np.full((70, 1), 0.1)]) @ weights
+    assert model.enhancement_scales_[0] == pytest.approx(0.7 / np.abs(pre).max(), rel=1e-12)
+    A = np.hstack([Z, np.tanh(model.enhancement_scales_[0] * pre)])
+    np.testing.assert_allclose(model.hidden(X), A, atol=1e-12)
+    np.testing.assert_allclose(weights @ weights.T, np.eye(7), atol=1e-12)  # wide: orthonormal rows
+    if reg > 0:
+        expected = np.linalg.solve(A.T @ A + reg * np.eye(A.shape[1]), A.T @ Y)
+    else:
+        expected = np.linalg.pinv(A) @ Y
+    np.testing.assert_allclose(model.output_weights_, expected, rtol=1e-6, atol=1e-8)
+    np.testing.assert_allclose(model.predict(X), A @ model.output_weights_, atol=1e-10)
+    fresh = rng.normal(size=(5, 4))
+    fresh_with_bias = np.hstack([fresh, np.full((5, 1), 0.1)])
+    Z_fresh = (np.hstack([fresh_with_bias @ model.mapping_weights_[i] for i in range(2)]) - model.mapping_min_) / model.mapping_range_
+    H_fresh = np.tanh(model.enhancement_scales_[0] * np.hstack([Z_fresh, np.full((5, 1), 0.1)]) @ weights)
+    np.testing.assert_allclose(model.predict(fresh), np.hstack([Z_fresh, H_fresh]) @ model.output_weights_, atol=1e-10)
+
+
+def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seeded_projections():
+    """Independent oracle of the fit (Chen & Liu 2018, as documented): window i projects [X, 0.1]
+    by a matrix uniform in [−1, 1] drawn from default_rng([seed, 0, i]), min–max normalises it to
+    F_i, and W_Z,i is the sparse autoencoder's answer for F_i → [X, 0.1] (its lasso is checked in
+    test_bls); an added enhancement block is a new draw, not the first block again."""
+    from bidmp.incremental.linalg import sparse_autoencoder
+
+    rng = np.random.default_rng(3)
+    X, Y = rng.normal(size=(50, 2)), rng.normal(size=(50, 1))
+    model = bidmp.BLS(n_windows=3, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-3, admm_iterations=30, seed=11).fit(X, Y)
+    with_bias = np.hstack([X, np.full((50, 1), 0.1)])
+    for window in range(3):
+        projection = with_bias @ np.random.default_rng([11, 0, window]).uniform(-1.0, 1.0, size=(3, 4))
+        F = (projection - projection.min(axis=0)) / np.ptp(projection, axis=0)
+        expected = sparse_autoencoder(F, with_bias, 1e-3, 30).T
+        np.testing.assert_allclose(model.mapping_weights_[window], expected, rtol=1e-10, atol=1e-12)
+    model.add_enhancement_nodes(6)
+    assert not np.allclose(model.enhancement_weights_[1], model.enhancement_weights_[0])

@@ -6,7 +6,8 @@ constant changed, an ``abs`` or a sign dropped, ``and`` for ``or``, ``min`` for 
 ``any`` — and the tests that cover the function run against it. A mutant the tests fail on is
 *killed*; one they pass is a *survivor*, and each survivor is either killed by a new test or shown
 to be an equivalent mutant in :data:`EQUIVALENT` (with the reason). The result is
-``docs/mutation.md``: the score per area and every survivor.
+``docs/mutation.md``: the score per area and every survivor (the outcomes kept in
+``docs/mutation.json``).
 
 Why a small tool of our own: mutmut 3 copies the project and runs the whole suite once per file
 to map tests, then mutates whole files (argument checks and messages included); cosmic-ray needs
@@ -16,14 +17,16 @@ judged), and each mutant costs one ``fork`` of a process that has already import
 dependencies and pytest: the mutated function's code object is swapped into the live function, so
 every reference to it (``from x import f`` included) runs the mutant.
 
-What is not mutated: docstrings, ``raise`` statements and the ``if`` tests whose body only raises
-(input validation), f-strings and ``logger`` calls.
+What is not mutated: docstrings, ``raise`` statements, the ``if`` tests whose body only raises and
+the calls of validation helpers (``check_*``, ``as_*``: input validation), f-strings and
+``logger`` calls.
 
 Usage::
 
     python tools/mutation.py                    # every area, 2 workers, writes docs/mutation.md
     python tools/mutation.py --area similarity  # one area (printed, docs untouched)
     python tools/mutation.py --list             # the mutants, not run
+    python tools/mutation.py --report           # docs/mutation.md again from docs/mutation.json
 """
 
 from __future__ import annotations
@@ -35,11 +38,12 @@ import copy
 import importlib
 import importlib.util
 import io
+import json
 import os
 import signal
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -85,12 +89,12 @@ TARGETS = (
            ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
            ("tests/test_oracles.py", "tests/test_similarity.py"), pure_python=True),
     Target("similarity template", "bidmp.extension.roadmap",
-           ("template",),
+           ("template", "_minimal_rotation"),
            ("tests/test_oracles.py", "tests/test_roadmap.py")),
     Target("segmentation", "bidmp.extension.segmentation",
-           ("curvature", "_alternating_extrema", "_prune_persistence", "_prune_persistence_plain", "_prune_paper",
+           ("curvature", "_alternating_extrema", "_prune_persistence", "_prune_paper", "segment",
             "choose_piece"),
-           ("tests/test_segmentation.py",)),
+           ("tests/test_oracles.py", "tests/test_segmentation.py")),
     Target("BLS", "bidmp.incremental.bls",
            ("_with_bias", "_affine", "_mapped_features", "_enhancement_block", "BLS.hidden", "BLS.fit"),
            ("tests/test_bls.py",)),
@@ -141,8 +145,12 @@ def _skipped(node) -> bool:
         return True
     if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
         return True  # a docstring
-    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name):
-        return node.func.value.id in ("logger", "logging", "warnings")
+    if isinstance(node, ast.Call):
+        name = _call_name(node) or ""
+        if name.startswith(("check_", "as_", "_check", "_as_")):  # a validation helper's arguments
+            return True
+        if isinstance(node.func, ast.Attribute) and isinstance(node.func.value, ast.Name):
+            return node.func.value.id in ("logger", "logging", "warnings")
     return False
 
 
@@ -396,8 +404,9 @@ def report(selected: list[Mutant], seconds: float) -> str:
              "Written by `make mutation` (`python tools/mutation.py`); do not edit. Each mutant is one small "
              "bug planted in one judging function (a comparison made strict or loose, an operator or a constant "
              "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
-             "tests that cover the area run against it. Input validation (`raise` and the `if` tests that only "
-             "raise), messages and logging are not mutated: the surface sweep (`make fuzz`) covers them.", "",
+             "tests that cover the area run against it. Input validation (`raise`, the `if` tests that only "
+             "raise, the calls of `check_*`/`as_*` helpers), messages and logging are not mutated: the surface "
+             "sweep (`make fuzz`) covers them.", "",
              "| area | module | functions | mutants | killed | equivalent | survived | score |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
     survivors = []
@@ -435,7 +444,13 @@ def main(argv=None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--list", action="store_true", help="list the mutants without running them")
     parser.add_argument("--out", default=str(ROOT / "docs" / "mutation.md"))
+    parser.add_argument("--report", action="store_true",
+                        help="only rewrite the report from the kept outcomes (after marking equivalents)")
     args = parser.parse_args(argv)
+    if args.report:
+        report_again(Path(args.out))
+        print(f"wrote {args.out}")
+        return 0
     os.chdir(ROOT)
     os.environ.setdefault("OPENBLAS_CORETYPE", "Haswell")
     sys.path.insert(0, str(TESTS))
@@ -461,16 +476,33 @@ def main(argv=None) -> int:
         run(own, args.workers, timeout_of)
         killed = sum(m.outcome.startswith("killed") for m in own)
         print(f"{target.area}: {killed}/{len(own)} killed", flush=True)
-    text = report(selected, time.monotonic() - began)
+    seconds = time.monotonic() - began
     if args.area:
-        print(text)
-    else:
-        out = Path(args.out)
-        partial = out.with_name(out.name + ".partial")
-        partial.write_text(text, encoding="utf-8")
-        partial.replace(out)
-        print(f"wrote {out}")
+        print(report(selected, seconds))
+        return 0
+    outcomes = {"seconds": round(seconds, 1), "mutants": [
+        {"area": m.target.area, "module": m.target.module, "function": m.function, "line": m.line,
+         "text": m.text, "mutation": m.description, "outcome": m.outcome} for m in selected]}
+    _write(Path(args.out).with_suffix(".json"), json.dumps(outcomes, indent=1) + "\n")
+    _write(Path(args.out), report(selected, seconds))
+    print(f"wrote {args.out}")
     return 0
+
+
+def _write(path: Path, text: str) -> None:
+    partial = path.with_name(path.name + ".partial")
+    partial.write_text(text, encoding="utf-8")
+    partial.replace(path)
+
+
+def report_again(out: Path) -> None:
+    """docs/mutation.md from the outcomes a run kept (docs/mutation.json) and today's
+    :data:`EQUIVALENT`: a survivor shown equivalent after the run needs no new run."""
+    kept = json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
+    by_area = {target.area: target for target in TARGETS}
+    selected = [Mutant(by_area[m["area"]], m["function"], 0, 0, m["line"], m["mutation"], m["text"], m["outcome"])
+                for m in kept["mutants"] if m["area"] in by_area]
+    _write(out, report(selected, kept["seconds"]))
 
 
 if __name__ == "__main__":

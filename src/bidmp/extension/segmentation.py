@@ -72,7 +72,8 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
     window = _odd_window(smooth, n_points, 7)
     check_limit(float(n_points) * window, "max_work",
                 "curvature's smoothing work (samples x window); resample to fewer points first")
-    if window <= 3:
+    # A curve that does not move (to rounding) has no curvature: its derivatives are rounding noise.
+    if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):
         return np.zeros(n_points)
     first = savgol_filter(y, window, 3, deriv=1, axis=0)
     second = savgol_filter(y, window, 3, deriv=2, axis=0)

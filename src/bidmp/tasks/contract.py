@@ -88,8 +88,9 @@ class CommandPeaks:
 
 
 def _fractions(values: np.ndarray, limit) -> np.ndarray:
-    """``max over samples of |values| / limit`` per joint (zeros without a limit or samples)."""
-    if limit is None or values.shape[0] == 0:
+    """``max over samples of |values| / limit`` per joint (zeros without a limit); ``values`` are
+    the padded commands' differences, never empty."""
+    if limit is None:
         return np.zeros(values.shape[1])
     return np.max(np.abs(values), axis=0) / np.asarray(limit, dtype=float)
 
