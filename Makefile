@@ -35,6 +35,13 @@ test: $(STAMP)
 fuzz: $(STAMP)
 	BIDMP_FUZZ=full $(PY) -m pytest -q tests/test_fuzz.py tests/test_fuzz_surface.py -p no:cacheprovider
 
+# Mutation testing of the checks that guard the robot and judge success (tools/mutation.py): every
+# small bug planted one at a time in the judging functions, the covering tests run against each;
+# writes docs/mutation.md (score per area, every survivor killed or shown equivalent) and its
+# outcomes docs/mutation.json. About 40 min on 2 cores.
+mutation: $(STAMP)
+	$(PY) tools/mutation.py --workers 2
+
 # The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/).
 sim: $(STAMP)
 	$(VENV)/bin/bidmp sim --out bidmp-sim

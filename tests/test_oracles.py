@@ -43,9 +43,29 @@ def test_a_two_point_path_under_a_beam_is_as_deep_as_the_shaft_reaches(tool_leng
     found = scene.clearance(path)
     assert found.part == "beam"
     assert found.distance == pytest.approx(truth, abs=1e-6)
+    down = np.tile([1.0, 0.0, 0.0, 0.0], (2, 1))  # the same, the tool's attitude given (pointing down)
+    assert scene.clearance(path, orientations=down).distance == pytest.approx(truth, abs=1e-5)
+    # Turned about its own axis (the same cylinder), by an angle whose unit quaternion's square sums
+    # to 1 + 2e-16: the attitude does not change along the path, whatever the rounding says.
+    spun = np.tile([0.99759293, 0.0693423, 0.0, 0.0], (2, 1))
+    assert scene.clearance(path, orientations=spun).distance == pytest.approx(truth, abs=1e-5)
     at_samples = 60.0 - half_width - radius  # both samples: the shaft's side to the beam's side
     assert scene.clearance(path[1:]).distance == pytest.approx(at_samples, abs=1e-6)
     assert not found.clear and not found.collision_free
+
+
+def test_a_later_segment_under_a_beam_is_checked_by_its_own_sweep():
+    """Independent oracle: a path comes from far away (its first segment passes the beam 28 mm
+    clear), then crosses under it with the shaft 15.5 mm inside; both ends of the crossing are
+    75 mm clear. The clearance is the crossing's −15.5 (the shorter way out: down)."""
+    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 120.0},
+                             "parts": [{"type": "box", "label": "beam", "at": [0.0, 0.0, 100.0], "size": [40.0, 100.0, 30.0]}]})
+    tip = 100.0 + 15.5 - 120.0
+    for sign in (1.0, -1.0):  # from either side
+        path = sign * np.array([[500.0, 500.0, 0.0], [-100.0, 0.0, 0.0], [100.0, 0.0, 0.0]]) + [0.0, 0.0, tip]
+        found = scene.clearance(path)
+        assert found.distance == pytest.approx(-15.5, abs=1e-6) and found.part == "beam"
+        assert abs(found.point[1]) < 1e-9 and abs(found.point[0]) <= 20.0 + 5.0 - 15.5
 
 
 def test_a_path_over_a_box_at_the_margin_is_judged_by_its_closed_form_clearance():
@@ -84,11 +104,18 @@ def test_segments_free_judges_each_straight_move_by_its_own_closed_form():
     scene = Scene.from_dict({"tool": {"radius": radius, "length": 50.0},
                              "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [2 * half, 2 * half, 40.0]}]})
     checker = scene.checker()
-    offsets = np.array([13.0, 14.5, 15.0, 30.0, -14.0, -30.0])
-    starts = np.column_stack([offsets, np.full(6, -100.0), np.full(6, 5.0)])
-    ends = np.column_stack([offsets, np.full(6, 100.0), np.full(6, 5.0)])
+    offsets = np.array([13.0, 14.5, 15.0, 30.0, -13.0, -14.5, -30.0])
+    starts = np.column_stack([offsets, np.full(7, -100.0), np.full(7, 5.0)])
+    ends = np.column_stack([offsets, np.full(7, 100.0), np.full(7, 5.0)])
     expected = np.abs(offsets) - half - radius > 0.0
     assert checker.segments_free(starts, ends).tolist() == expected.tolist()
+    # Under the box (its bottom at 0): the shaft (50 long) reaches into it from a tip 20 below.
+    under = checker.segments_free(np.array([[-100.0, 0.0, -20.0], [-100.0, 0.0, -60.0]]),
+                                  np.array([[100.0, 0.0, -20.0], [100.0, 0.0, -60.0]]))
+    assert under.tolist() == [False, True]
+    # Starting 0.5 inside the box's side and moving straight away: the first placement decides.
+    away = checker.segments_free(np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[100.0, 0.0, 5.0]]))
+    assert away.tolist() == [False]
 
 
 @pytest.mark.parametrize("distance, margin, collision_free, clear", [
@@ -135,6 +162,8 @@ def test_a_command_jump_at_either_end_is_an_acceleration_from_rest():
     backwards = command_peaks(-commands, limits, 1e-3)
     assert backwards.ends == pytest.approx(peaks.ends) and not backwards.within
     assert peaks.jerk == 0.0  # no jerk limit: not judged
+    stopping = command_peaks(commands[::-1], limits, 1e-3)  # the same jump at the end: to rest at once
+    assert stopping.ends == pytest.approx(peaks.ends) and not stopping.within
     two = command_peaks(commands[:2], limits, 1e-3)  # one step: from rest and back to rest at once
     assert two.ends == pytest.approx(peaks.ends) and not two.within
     for held in (np.full((1, 1), 0.3), np.full((6, 1), 0.3)):  # an arm held still: nothing moves
@@ -343,9 +372,10 @@ def test_the_default_spring_is_critically_damped():
 
 
 # -- clearance on random cells against a closed form ----------------------------------------------
-def _tool_to_boxes(tips, radius, length, lower, upper):
+def _tool_to_boxes(tips, radius, length, lower, upper, discs=None):
     """Signed distance (n, k) from a vertical cylindrical tool (tip at ``tips`` (n, 3), radius r,
-    rising ``length``) to axis-aligned boxes (k, 3): both are products of a horizontal and a
+    rising ``length``) to axis-aligned boxes (k, 3), or with ``discs`` (k, 3: x, y, radius) to
+    vertical cylinders spanning the boxes' heights: both are products of a horizontal and a
     vertical set, so the distance is the hypotenuse of the horizontal and vertical gaps, and a
     penetration is the smaller of the two ways out (sideways, or along z)."""
     xy, lo, hi = tips[:, None, :2], lower[None, :, :2], upper[None, :, :2]
@@ -353,6 +383,11 @@ def _tool_to_boxes(tips, radius, length, lower, upper):
     horizontal_gap = np.linalg.norm(outside, axis=2) - radius
     inside_depth = np.min(np.minimum(xy - lo, hi - xy), axis=2)  # to the rectangle's edge, when inside
     horizontal_depth = np.where(np.all(outside == 0.0, axis=2), inside_depth + radius, radius - np.linalg.norm(outside, axis=2))
+    if discs is not None:  # cylinders: the distance between two discs' centres less both radii
+        round_ = ~np.isnan(discs[:, 2])
+        apart = np.linalg.norm(xy - discs[None, :, :2], axis=2) - radius - discs[None, :, 2]
+        horizontal_gap = np.where(round_[None], apart, horizontal_gap)
+        horizontal_depth = np.where(round_[None], -apart, horizontal_depth)
     bottom, top = tips[:, None, 2], tips[:, None, 2] + length
     vertical_gap = np.maximum(np.maximum(lower[None, :, 2] - top, bottom - upper[None, :, 2]), 0.0)
     vertical_depth = np.minimum(top - lower[None, :, 2], upper[None, :, 2] - bottom)
@@ -361,18 +396,29 @@ def _tool_to_boxes(tips, radius, length, lower, upper):
     return np.where(separated, distance, -np.minimum(horizontal_depth, vertical_depth))
 
 
-def _random_cell(rng):
-    boxes = []
+def _random_cell(rng, cylinders=False):
+    """1-4 boxes (or, with ``cylinders``, some vertical cylinders) 100 apart on a grid, and a
+    tool: (scene, radius, length, lower, upper, discs)."""
+    parts, discs = [], []
     cells = [(x, y) for x in (-100.0, 0.0, 100.0) for y in (-100.0, 0.0, 100.0)]  # 100 apart: no overlap
     for cell in rng.permutation(len(cells))[: int(rng.integers(1, 5))]:
         size = rng.uniform([10, 10, 10], [90, 90, 60])
         at = np.array([*cells[cell], 0.0]) + [*rng.uniform(-5.0, 5.0, 2), rng.uniform(0.0, 40.0)]
-        boxes.append({"type": "box", "label": f"b{len(boxes)}", "at": at.tolist(), "size": size.tolist()})
+        label = f"b{len(parts)}"
+        if cylinders and rng.random() < 0.5:
+            size[:2] = 2 * rng.uniform(5.0, 45.0)
+            parts.append({"type": "cylinder", "label": label, "at": at.tolist(), "radius": size[0] / 2, "height": size[2]})
+            discs.append([at[0], at[1], size[0] / 2])
+        else:
+            parts.append({"type": "box", "label": label, "at": at.tolist(), "size": size.tolist()})
+            discs.append([at[0], at[1], np.nan])
+        parts[-1]["_lower"] = (at - [size[0] / 2, size[1] / 2, 0.0]).tolist()
+        parts[-1]["_upper"] = (at + [size[0] / 2, size[1] / 2, size[2]]).tolist()
+    lower = np.array([part.pop("_lower") for part in parts])
+    upper = np.array([part.pop("_upper") for part in parts])
     radius, length = rng.uniform(2.0, 12.0), rng.uniform(30.0, 150.0)
-    scene = Scene.from_dict({"tool": {"radius": radius, "length": length}, "parts": boxes})
-    lower = np.array([[b["at"][0] - b["size"][0] / 2, b["at"][1] - b["size"][1] / 2, b["at"][2]] for b in boxes])
-    upper = lower + np.array([b["size"] for b in boxes])
-    return scene, radius, length, lower, upper
+    scene = Scene.from_dict({"tool": {"radius": radius, "length": length}, "parts": parts})
+    return scene, radius, length, lower, upper, np.array(discs)
 
 
 def _random_path(rng):
@@ -398,17 +444,19 @@ def test_clearance_on_random_cells_is_the_closed_form_minimum_within_the_placeme
     distance over the path sampled 20 times finer than the library's placements, within the
     documented step / 2; its part is the nearest box there, its point on the path."""
     rng = np.random.default_rng(seed)
-    scene, radius, length, lower, upper = _random_cell(rng)
+    scene, radius, length, lower, upper, discs = _random_cell(rng, cylinders=seed % 2 == 1)
     step = 0.002 * length
     for _ in range(6):
         path = _random_path(rng)
         found = scene.clearance(path)
         fine = _dense(path, step / 20.0)
-        distances = _tool_to_boxes(fine, radius, length, lower, upper)
+        distances = _tool_to_boxes(fine, radius, length, lower, upper, discs)
         truth = float(distances.min())
-        tolerance = 1e-4  # coal's penetration depths (EPA) agree with the closed form to ~3e-5
+        # coal's penetration depths (EPA) agree with the closed form to ~3e-5 for boxes, 4e-4 of the
+        # depth for cylinders; separations to 1e-8
+        tolerance = 1e-4 + (1e-3 * abs(truth) if truth < 0 else 0.0)
         assert truth - step / 40.0 - tolerance <= found.distance <= truth + step / 2.0 + tolerance, (found.distance, truth)
-        own = _tool_to_boxes(found.point[None], radius, length, lower, upper)[0]
+        own = _tool_to_boxes(found.point[None], radius, length, lower, upper, discs)[0]
         assert own.min() == pytest.approx(found.distance, abs=tolerance)
         assert found.part == f"b{int(np.argmin(own))}" or np.sort(own)[1] - own.min() < tolerance
         on_path = np.min(np.linalg.norm(_dense(path, step / 4.0) - found.point, axis=1))
@@ -421,20 +469,24 @@ def test_the_checker_and_straight_moves_on_random_cells_agree_with_the_closed_fo
     margin; a straight move iff it is along the whole move (sampled finely here). Cases within
     a hair of the margin are left out (either answer is right there)."""
     rng = np.random.default_rng(100 + seed)
-    scene, radius, length, lower, upper = _random_cell(rng)
-    margin = float(rng.uniform(0.0, 6.0))
+    scene, radius, length, lower, upper, discs = _random_cell(rng, cylinders=True)
+    margin = 0.0 if seed % 3 == 0 else float(rng.uniform(0.0, 6.0))
     checker = bidmp.scene.SceneChecker(scene, np.arange(len(scene.solids)), margin)
     points = rng.uniform([-160, -160, -60], [160, 160, 140], (300, 3))
-    truth = _tool_to_boxes(points, radius, length, lower, upper).min(axis=1)
+    truth = _tool_to_boxes(points, radius, length, lower, upper, discs).min(axis=1)
     sure = np.abs(truth - margin) > 1e-4
     assert checker(points)[sure].tolist() == (truth >= margin)[sure].tolist()
     a = rng.uniform([-160, -160, -60], [160, 160, 140], (40, 3))
     b = a + rng.uniform(-120.0, 120.0, (40, 3))
-    along = np.array([_tool_to_boxes(_dense(np.vstack([p, q]), 0.05), radius, length, lower, upper).min()
+    along = np.array([_tool_to_boxes(_dense(np.vstack([p, q]), 0.05), radius, length, lower, upper, discs).min()
                       for p, q in zip(a, b)])
     sure = np.abs(along - margin) > 0.1
     assert checker.segments_free(a, b)[sure].tolist() == (along >= margin)[sure].tolist()
     assert sure.sum() >= 30
+    blocked = int(np.argmin(along))  # one move alone, and none
+    assert checker.segments_free(a[blocked : blocked + 1], b[blocked : blocked + 1]).tolist() == [bool(along[blocked] >= margin)]
+    nothing = bidmp.scene.SceneChecker(scene, np.array([], dtype=int), margin)
+    assert nothing.segments_free(a, b).all() and nothing(points).all()
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -479,10 +531,12 @@ def test_placements_along_a_path_are_at_most_a_step_apart_and_no_more_than_neede
         for index in indices:
             own = dense[which == index]
             length = np.linalg.norm(points[index + 1] - points[index])
-            assert own.shape[0] == int(np.ceil(length / step)) + 1
+            assert own.shape[0] == max(int(np.ceil(length / step)), 1) + 1
             np.testing.assert_allclose(own[[0, -1]], points[[index, index + 1]], atol=1e-9)
             assert np.all(np.linalg.norm(np.diff(own, axis=0), axis=1) <= step + 1e-9)
         assert set(which.tolist()) == set(indices.tolist())
+    pause = _densify(np.vstack([points[:2], points[1:2], points[2:3]]), step, weights=True)
+    assert np.sum(pause[1] == 1) == 2  # a segment that does not move: its two ends only
     single = _densify(points[:1], step)
     assert single.tolist() == points[:1].tolist()
     assert _densify(points, step, np.array([], dtype=int)).shape == (0, 3)
@@ -601,6 +655,8 @@ def test_both_frechet_implementations_are_the_defining_recursion(seed):
         assert frechet_distance(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         assert frechet_distance_reference(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         assert frechet_distance(b, a) == pytest.approx(truth, rel=1e-12, abs=1e-12)
+        for same in (a, b):  # a curve against itself: the diagonal path, distance 0
+            assert frechet_distance(same, same) == 0.0 and frechet_distance_reference(same, same) == 0.0
 
 
 def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_moves_along():
@@ -627,6 +683,13 @@ def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_
     for scaling in ("axis", "similarity"):
         np.testing.assert_allclose(template(loop, [10.0, 5.0, 2.0], scaling=scaling),
                                    loop + (arc / arc[-1])[:, None] * np.array([10.0, 5.0, 2.0]), atol=1e-9)
+    # In metres (shorter than 1 in all), pausing at its start: λ is still the arc length's share.
+    short = np.vstack([piece[:1], piece]) / 1000.0
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(short, axis=0), axis=1))])
+    out = template(short, new_target / 1000.0, scaling="axis")
+    np.testing.assert_allclose(out[:, 2], short[:, 2] + arc / arc[-1] * 0.007, atol=1e-12)
+    waits = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [10.0, 0.0, 0.0]])  # one step, at the end
+    np.testing.assert_allclose(template(waits, [20.0, 5.0, 0.0])[:, 1], [0.0, 0.0, 0.0, 5.0], atol=1e-12)
     still = np.tile([3.0, 4.0, 5.0], (5, 1))  # no length at all: λ by sample
     np.testing.assert_allclose(template(still, [7.0, 4.0, 5.0]), still + np.linspace(0, 1, 5)[:, None] * [4.0, 0, 0],
                                atol=1e-12)
@@ -701,6 +764,19 @@ def test_curvature_where_the_curve_stops_is_zero_and_a_tiny_curve_has_none():
 
     still = np.tile([1.0, 2.0, 3.0], (30, 1))
     assert curvature(still).tolist() == [0.0] * 30
+    rng = np.random.default_rng(1)  # held still far from the origin, jittering by rounding (1e-14)
+    for centre in ([0.0, -1000.0, -5.0], [0.0, 1000.0, 5.0]):
+        jittered = np.array(centre) * (1.0 + 1e-14 * rng.standard_normal((30, 3)))
+        assert curvature(jittered).tolist() == [0.0] * 30
+    # A path that stops for 120 samples between two arcs: inside the pause (a smoothing window from
+    # its ends) the curve does not advance and has no curvature.
+    t = np.linspace(0.0, np.pi / 2, 100)
+    arc = np.column_stack([50 * np.cos(t), 50 * np.sin(t), np.zeros(100)])
+    paused = np.vstack([arc, np.tile(arc[-1], (120, 1)), arc[-1] + (arc - arc[0])[::-1] * [-1, 1, 1]])
+    kappa = curvature(paused)
+    window = 17  # 5 % of 320 samples, odd
+    assert np.all(kappa[100 + window : 220 - window] == 0.0)
+    assert np.all(kappa[20:80] > 0.01)
     assert curvature(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])).tolist() == [0.0, 0.0, 0.0]
 
 
@@ -729,6 +805,8 @@ def test_curvature_extrema_are_the_runs_higher_or_lower_than_both_neighbours(see
     neighbours, written here, on random sequences full of plateaus, in random windows."""
     from bidmp.extension.segmentation import _alternating_extrema
 
+    flat = _alternating_extrema(np.full(10, 2.0), 0, 10)
+    assert flat[0].tolist() == [] and flat[1].tolist() == []
     rng = np.random.default_rng(seed)
     for _ in range(50):
         kappa = rng.integers(0, 4, int(rng.integers(3, 40))).astype(float)
@@ -846,3 +924,231 @@ def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seede
         np.testing.assert_allclose(model.mapping_weights_[window], expected, rtol=1e-10, atol=1e-12)
     model.add_enhancement_nodes(6)
     assert not np.allclose(model.enhancement_weights_[1], model.enhancement_weights_[0])
+
+
+def test_a_tool_turning_past_a_block_is_checked_at_its_nearest_mid_turn_attitude():
+    """Property: a turn given by its two end attitudes (quaternions unnormalised too) is judged as
+    the same turn given by 2001 attitudes written out here: within the documented step / 2. The
+    block sits beyond the tool's end at mid-turn (45°), 4.7 mm away; at both ends it is 68 mm away,
+    so a check that places the turning tool too sparsely sees 68."""
+    length, radius = 100.0, 6.0
+    centre = np.array([0.0, -np.sin(np.pi / 4), np.cos(np.pi / 4)]) * length * 1.12
+    scene = Scene.from_dict({"tool": {"radius": radius, "length": length},
+                             "parts": [{"type": "box", "label": "block", "at": (centre - [0, 0, 5]).tolist(), "size": [10, 10, 10]}]})
+
+    def attitude(angle):  # pointing down (half a turn about x), then turned by angle about x
+        half = (angle + np.pi) / 2.0
+        return np.array([np.sin(half), 0.0, 0.0, np.cos(half)])
+
+    angles = np.linspace(0.0, np.pi / 2, 2001)
+    dense = scene.clearance(np.zeros((2001, 3)), orientations=np.array([attitude(a) for a in angles])).distance
+    step = 0.002 * length
+    ends = np.array([attitude(0.0), attitude(np.pi / 2)])
+    moving = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0]])  # rising 3 mm as it turns: nearer still
+    for points, turns in ((np.zeros((2, 3)), ends), (np.zeros((2, 3)), 2.5 * ends)):
+        found = scene.clearance(points, orientations=turns)
+        assert dense - step / 2.0 - 1e-6 <= found.distance <= dense + 1e-6
+        assert found.distance < 5.0
+    rising = scene.clearance(moving, orientations=ends).distance
+    assert rising < dense - 1.0
+    # Turning there and back, the way back at the block: the way out turns 300 mm away from it.
+    there_and_back = np.array([attitude(0.0), attitude(np.pi / 2), attitude(0.0)])
+    tips = np.array([[-300.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    found = scene.clearance(tips, orientations=there_and_back)
+    assert dense - step / 2.0 - 1e-6 <= found.distance <= dense + 1e-6
+
+
+def test_a_separation_is_kept_only_when_the_nearest_points_are_that_far_apart():
+    """Structure guard of the check on coal's answers: a separation whose nearest points lie on
+    the shapes as far apart as it says is kept; the same points offered for a larger or a smaller
+    separation are not (coal's known failure: a distance between points off the shapes)."""
+    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 50.0},
+                             "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [20.0, 20.0, 20.0]}]})
+    engine = scene._engine()
+    distance = engine.tool_to(np.array([0.0, 0.0, 32.0]), 0)  # 12 above the box's top
+    assert distance == pytest.approx(12.0, abs=1e-8)
+    tool_pose = engine.coal.Transform3s(np.eye(3), np.array([0.0, 0.0, 32.0]) + engine.tool_offset)
+    shape, pose = engine.shapes[0]
+    assert engine._witnessed(engine.tool, tool_pose, shape, pose, distance)
+    for claimed in (15.0, 9.0):
+        assert not engine._witnessed(engine.tool, tool_pose, shape, pose, claimed)
+    # The tolerance is 1e-6 of the distance (of 1 below 1): 12 ± 1e-5 is borne out, 12 ± 1.5e-5 not.
+    for claimed, kept in ((distance + 1e-5, True), (distance - 1e-5, True), (distance + 1.5e-5, False)):
+        assert engine._witnessed(engine.tool, tool_pose, shape, pose, claimed) is kept
+    near = engine.tool_to(np.array([0.0, 0.0, 21.5]), 0)  # 1.5 above: the tolerance is 1.5e-6
+    near_pose = engine.coal.Transform3s(np.eye(3), np.array([0.0, 0.0, 21.5]) + engine.tool_offset)
+    assert engine._witnessed(engine.tool, near_pose, shape, pose, near + 1.2e-6)
+    assert not engine._witnessed(engine.tool, near_pose, shape, pose, near + 1.8e-6)
+
+
+# -- goal systems ---------------------------------------------------------------------------------
+def test_the_smoothstep_is_its_polynomial_with_flat_ends():
+    """Independent oracle: S(u) = 35u⁴ − 84u⁵ + 70u⁶ − 20u⁷ on [0, 1] (0 before, 1 after), its
+    derivatives those of the polynomial, zero at both ends."""
+    from bidmp.primitives.goals import _smoothstep, _smoothstep_derivatives
+
+    u = np.linspace(-0.2, 1.2, 141)
+    inside = np.clip(u, 0.0, 1.0)
+    np.testing.assert_allclose(_smoothstep(u), 35 * inside**4 - 84 * inside**5 + 70 * inside**6 - 20 * inside**7,
+                               atol=1e-14)
+    first, second = _smoothstep_derivatives(u)
+    within = (u > 0) & (u < 1)
+    np.testing.assert_allclose(first[within], (140 * u**3 - 420 * u**4 + 420 * u**5 - 140 * u**6)[within], atol=1e-12)
+    np.testing.assert_allclose(second[within], (420 * u**2 - 1680 * u**3 + 2100 * u**4 - 840 * u**5)[within], atol=1e-11)
+    assert np.all(first[~within] == 0.0) and np.all(second[~within] == 0.0)
+    assert _smoothstep(np.array([0.5]))[0] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("begin", [0.0, 0.3])
+def test_the_goal_share_follows_the_progress_with_smooth_ends(begin):
+    """Independent oracle: R = σ S((t − b)/w) over the first w after b, 1 − (1 − σ) S((T − t)/w)
+    over the last w, σ between, 1 from T on (w = 15 % of T − b), written out here."""
+    from bidmp.primitives.goals import _goal_share
+
+    n_motion, dt, n_total = 120, 0.01, 150
+    progress = np.clip(np.linspace(-0.1, 1.1, n_total), 0.0, 1.0) ** 1.5
+    share = _goal_share(progress, n_motion, dt, begin=begin)
+    t = np.arange(n_total) * dt
+    end = (n_motion - 1) * dt
+    width = 0.15 * (end - begin)
+
+    def smooth(u):
+        u = np.clip(u, 0.0, 1.0)
+        return 35 * u**4 - 84 * u**5 + 70 * u**6 - 20 * u**7
+
+    expected = progress * smooth((t - begin) / width)
+    closing = t > end - width
+    expected[closing] = 1.0 - (1.0 - progress[closing]) * smooth((end - t[closing]) / width)
+    expected[t >= end] = 1.0
+    np.testing.assert_allclose(share, expected, atol=1e-12)
+    assert np.all(share[t <= begin] == 0.0)
+
+
+def test_the_goal_gate_is_the_springs_inverse_for_the_share():
+    """Independent oracle: for a share R with known derivatives, G = (αβ (1 − R) − R'' − α R') / K
+    from the analytic R', R'' (the library differentiates numerically: within 2e-3 of the
+    drive's scale), and exactly αβ / K at the start."""
+    from bidmp.primitives.goals import _goal_gate
+
+    alpha, beta, K, dt = 25.0, 6.25, 25.0 * 6.25, 1e-3
+    t = np.arange(0.0, 1.0 + dt / 2, dt)
+    share = 0.5 - 0.5 * np.cos(np.pi * t)
+    rate, curvature = 0.5 * np.pi * np.sin(np.pi * t), 0.5 * np.pi**2 * np.cos(np.pi * t)
+    gate = _goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
+    expected = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
+    assert gate[0] == alpha * beta / K
+    np.testing.assert_allclose(gate[2:-2], expected[2:-2], atol=2e-3 * alpha * beta / K)  # central differences
+
+
+@pytest.mark.parametrize("exact", [True, False])
+def test_a_delayed_goal_decays_at_its_own_rate(exact):
+    """Independent oracle: G_l = exp(−r l h / τ) (exact) or (1 − r h / τ)^l (Euler) on a grid of
+    step h; one control step multiplies by the same factor; the phase gate is the phase."""
+    from bidmp.primitives.goals import DelayedGoal, PhaseGate
+
+    rate, step, tau = 3.0, 0.01, 1.7
+    goal = DelayedGoal(rate)
+    factor = math.exp(-rate * step / tau) if exact else 1.0 - rate * step / tau
+    grid = goal.on_grid(np.linspace(1.0, 0.2, 40), step, tau, exact)
+    np.testing.assert_allclose(grid, factor ** np.arange(40), rtol=1e-12)
+    assert goal.follow(0.6, 0.5, step, tau, exact) == pytest.approx(0.6 * factor, rel=1e-12)
+    phase = np.linspace(1.0, 0.2, 40)
+    assert PhaseGate(rate).on_grid(phase, step, tau, exact).tolist() == phase.tolist()
+    assert PhaseGate(rate).follow(0.6, 0.37, step, tau, exact) == 0.37
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_the_measured_joints_peaks_are_a_quintics_closed_forms(sign):
+    """Independent oracle: a joint moving a minimum-jerk A over T, its velocity recorded every
+    2 ms: peak speed 15A/(8T) as recorded, acceleration 10A/(√3 T²) and jerk 60A/T³ estimated by
+    differences over 10 ms windows, as fractions of the limits, either direction;
+    a joint with no jerk limit is not judged on jerk."""
+    from bidmp.sim.limits import _measured_peaks
+
+    amplitude, duration, step = 0.9, 2.0, 0.002
+    t = np.arange(0.0, duration + step / 2, step) / duration
+    velocity = sign * amplitude / duration * (30 * t**2 - 60 * t**3 + 30 * t**4)
+    recorded = np.column_stack([velocity, 0.5 * velocity])
+    limits = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2.0, 2.0),
+                                   acceleration=(4.0, 4.0), jerk=(50.0, 50.0))
+    peaks = _measured_peaks(recorded, step, limits)
+    assert peaks.velocity == pytest.approx(15 * amplitude / (8 * duration) / 2.0, rel=1e-6)
+    assert peaks.acceleration == pytest.approx(10 * amplitude / (math.sqrt(3) * duration**2) / 4.0, rel=1e-2)
+    # the first jerk estimate is centred 10 ms in, where it is 60A/T³ (1 − 6u + 6u²), u = 0.005
+    u = 0.01 / duration
+    assert peaks.jerk == pytest.approx(60 * amplitude / duration**3 * (1 - 6 * u + 6 * u**2) / 50.0, rel=2e-3)
+    loose = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2.0, 2.0),
+                                  acceleration=(4.0, 4.0), jerk=None)
+    assert _measured_peaks(recorded, step, loose).jerk == 0.0
+
+
+def test_the_end_error_is_the_last_samples_distance():
+    """Independent oracle: the end error is the distance of the last sample alone (the one before
+    it is farther)."""
+    from bidmp.tasks.metrics import endpoint_error
+
+    path = np.array([[0.0, 0.0, 0.0], [3.0, 4.0, 12.0], [1.0, 2.0, 2.0]])
+    assert endpoint_error(path, [1.0, 0.0, 0.0]) == pytest.approx(math.sqrt(8.0))
+
+
+def test_the_tools_tilt_is_measured_about_every_axis_and_survives_rounding():
+    """Independent oracle: a tool pointing down and tilted by θ about y, over a final approach
+    offset sideways in x and y, is |θ| off the default +z axis; a tool spun about its own axis
+    (whose unit axis rounds to 1 + 2e-16 in its cosine) is 0° off, and one pointing straight up,
+    spun, is 180° off — not NaN."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.tasks.metrics import axis_deviation
+
+    z = np.linspace(40.0, 0.0, 41)
+    path = np.column_stack([np.full(41, 7.0), np.full(41, -3.0), z])
+    tilt = np.where(z < 25.0, 4.0 * np.sin(np.pi * z / 25.0), 20.0)
+    q = (Rotation.from_euler("y", tilt[:, None], degrees=True) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()
+    assert axis_deviation(path, q, [7.0, -3.0, 0.0], 25.0) == pytest.approx(np.max(np.abs(tilt[z < 25.0])), abs=1e-9)
+    spins = np.linspace(0.0, 2 * np.pi, 4001)
+    down = [(Rotation.from_euler("z", a) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat() for a in spins]
+    rounding_up = next(q for q in down if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] > 1.0)
+    assert axis_deviation(path, np.tile(rounding_up, (41, 1)), [7.0, -3.0, 0.0], 25.0) == 0.0
+    up = [Rotation.from_euler("z", a).as_quat() for a in spins]
+    rounding_down = next(q for q in up if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] < -1.0)
+    assert axis_deviation(path, np.tile(rounding_down, (41, 1)), [7.0, -3.0, 0.0], 25.0) == 180.0
+
+
+def test_the_axis_template_scales_negative_chords_and_ramps_by_the_documented_thresholds():
+    """Independent oracle: an axis moving backwards is scaled like any other; an axis whose chord
+    is under 1e-3 of the chord's length is ramped even when its factor would be small; a factor of
+    exactly 10 is still scaled, 10.5 is ramped."""
+    s = np.linspace(0.0, 1.0, 30)
+    bump = np.sin(np.pi * s)
+    piece = np.column_stack([-100 * s, 0.05 * s + 3 * bump, 2 * s + bump])  # y: chord 0.05 (< 0.1)
+    for new_z, scaled in ((20.0, True), (21.0, False)):
+        out = template(piece, [-160.0, 0.4, new_z], scaling="axis")
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])
+        lam = arc / arc[-1]
+        np.testing.assert_allclose(out[:, 0], 1.6 * piece[:, 0], atol=1e-9)
+        np.testing.assert_allclose(out[:, 1], piece[:, 1] + lam * (0.4 - piece[-1, 1]), atol=1e-9)
+        z = new_z / 2.0 * piece[:, 2] if scaled else piece[:, 2] + lam * (new_z - piece[-1, 2])
+        np.testing.assert_allclose(out[1:-1, 2], z[1:-1], atol=1e-9)
+
+
+def test_a_half_turn_template_turns_in_the_plane_of_the_least_aligned_axis():
+    """Independent oracle: when the new chord points against the old one, the template is the
+    piece turned half a turn in the plane of the chord and the coordinate axis least aligned with
+    it (|component| smallest), scaled: the direction normal to that plane keeps its sign. In 1-D
+    it is the mirror image; a new chord of length exactly 1 turns like any other."""
+    s = np.linspace(0.0, 1.0, 25)[:, None]
+    chord = np.array([-0.8, 0.6, 0.0]) * 50.0  # least aligned: z
+    normal = np.cross(chord / 50.0, [0.0, 0.0, 1.0])
+    piece = s * chord + np.sin(np.pi * s) * (10.0 * normal + np.array([0.0, 0.0, 7.0]))
+    out = template(piece, -0.5 * chord, scaling="similarity")
+    np.testing.assert_allclose((out - piece[0]) @ normal, 0.5 * (piece - piece[0]) @ normal, atol=1e-9)
+    np.testing.assert_allclose((out - piece[0]) @ chord, -0.5 * (piece - piece[0]) @ chord, atol=1e-9)
+    np.testing.assert_allclose(out[:, 2], -0.5 * piece[:, 2], atol=1e-9)  # in the plane: turned over
+    line = np.linspace(0.0, 10.0, 11)[:, None] + 0.5 * np.sin(np.linspace(0, np.pi, 11))[:, None]
+    np.testing.assert_allclose(template(line, [-5.0], scaling="similarity"), -0.5 * line, atol=1e-12)
+    unit = template(piece, piece[0] + [0.0, 1.0, 0.0], scaling="similarity")  # a new chord exactly 1 long
+    from scipy.spatial.distance import pdist
+
+    np.testing.assert_allclose(pdist(unit), pdist(piece) / 50.0, rtol=1e-9)
+    np.testing.assert_allclose(unit[-2] - unit[0], (piece[-2] - piece[0]) @ _rodrigues(chord, [0.0, 1.0, 0.0]).T / 50.0,
+                               atol=1e-9)

@@ -24,7 +24,7 @@ the calls of validation helpers (``check_*``, ``as_*``: input validation), f-str
 Usage::
 
     python tools/mutation.py                    # every area, 2 workers, writes docs/mutation.md
-    python tools/mutation.py --area similarity  # one area (printed, docs untouched)
+    python tools/mutation.py --area similarity  # one area again (the others' outcomes kept)
     python tools/mutation.py --list             # the mutants, not run
     python tools/mutation.py --report           # docs/mutation.md again from docs/mutation.json
 """
@@ -76,6 +76,9 @@ TARGETS = (
            ("_fractions", "command_peaks", "CommandPeaks.within", "Verdict.reached", "Verdict.clear",
             "Verdict.within_limits", "Verdict.ok", "Verdict.failed"),
            ("tests/test_oracles.py", "tests/test_contract.py", "tests/test_sim_limits.py")),
+    Target("simulator: measured peaks and the 1 kHz command generator", "bidmp.sim.limits",
+           ("_worst", "_measured_peaks", "_RateLimiter.__call__"),
+           ("tests/test_oracles.py", "tests/test_sim_limits.py")),
     Target("engagement", "bidmp.tasks.metrics",
            ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),
            ("tests/test_oracles.py", "tests/test_engagement.py", "tests/test_contract.py")),
@@ -113,10 +116,109 @@ TARGETS = (
 # can tell the mutant from the original.
 _FAST_PATH = ("a fast path's guard: both branches give the same value (the slow one validates a "
               "float64 vector and returns it unchanged)")
+_BOUND = ("cost only: branch and bound returns the least exact distance over every pair whose lower bound "
+          "is below the best found so far; this changes which further pairs are evaluated, or the seed it "
+          "starts from, not that minimum (a tie keeps the same distance)")
+_CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
-    ("bidmp.primitives.coupling", "PhaseStopping.slowdown",
-     "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):", mutation): _FAST_PATH
-    for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")
+    **{("bidmp.primitives.coupling", "PhaseStopping.slowdown",
+        "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):", mutation): _FAST_PATH
+       for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")},
+    (_CLEARANCE, "Clearance.clear", "return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin",
+     "<= -> <"): "at a margin of exactly 0 both branches are `not distance < 0`",
+    **{(_CLEARANCE, "Scene._minimum", text, mutation): _BOUND for text, mutation in (
+        ("row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])", "argmin -> argmax"),
+        ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "< -> <="),
+        ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "0.0 -> 1.0"),
+        ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", "0.0 -> 1.0"),
+        ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", ">= -> >"),
+        ("if distance < best:", "< -> <="))},
+    **{(_CLEARANCE, "Scene._clearance", text, mutation): _BOUND for text, mutation in (
+        ("row = int(np.argmin(at_samples))", "argmin -> argmax"),
+        ("col = int(np.argmin(first))", "argmin -> argmax"),
+        ("swept_lower = np.minimum(points[:-1], points[1:]) - [radius, radius, 0.0]", "0.0 -> 1.0"))},
+    **{(_CLEARANCE, "Scene._clearance", "dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))",
+        mutation): "cost only: more segments are placed densely; the minimum over them is the same"
+       for mutation in ("< -> <=", "0.0 -> 1.0")},
+    (_CLEARANCE, "_sweep", "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
+     "0.0, 1.0))", "2.0 -> 4.0"): "cost only: twice the turn, twice the placements a turning tool needs",
+    (_CLEARANCE, "_sweep", "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
+     "0.0, 1.0))", "drop abs()"): "the quaternions are made continuous first (q · q' >= 0): abs changes nothing",
+    ("bidmp.scene.distances", "_Distances._witnessed",
+     "return (abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first)", "<= -> <"):
+        "differs only when coal's points are apart by exactly the tolerance more or less than its distance",
+    ("bidmp.scene.checker", "SceneChecker.__call__",
+     "if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < margin:", "< -> <="):
+        "differs only for a placement exactly at the margin, to the last bit",
+    ("bidmp.scene.checker", "SceneChecker.segments_free",
+     "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))", "all -> any"):
+        "cost only: more moves are candidates; each is then checked exactly",
+    **{("bidmp.scene.checker", "SceneChecker.segments_free", text, "<= -> <"):
+       "differs only where the move's box exactly touches a part's box: the tool is then at least touching "
+       "distance away, which is free either way" for text in (
+           "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
+           "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)")},
+    **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-9 * max(length, 1.0)", mutation):
+       "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
+       "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
+       for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min")},
+    ("bidmp.tasks.metrics", "final_approach_mask",
+     'heights = _as_bounded_array(heights, "heights", max_ndim=1).reshape(-1)', "1 -> 2"):
+        "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
+    ("bidmp.extension.similarity", "frechet_distance_reference", "i = np.arange(max(0, s - m + 1), min(n, s + 1))",
+     "1 -> 2"): "one more cell per anti-diagonal, just off the table (j = -1): it derives only from other such "
+                "cells, which are infinite from the start, so it is infinite and never wins a minimum",
+    ("bidmp.extension.roadmap", "template",
+     "lam = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])", "0.0 -> 1.0"):
+        "changes the first sample's λ alone, and the first sample is set to seg afterwards",
+    ("bidmp.extension.roadmap", "template", "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):", "<= -> <"):
+        "the threshold is at least 1e-12: the two differ only for a chord exactly that long",
+    ("bidmp.extension.roadmap", "template",
+     "degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)",
+     "< -> <="): "differs only for an axis whose chord is exactly 1e-3 of the chord's length",
+    ("bidmp.extension.roadmap", "template", "scaled = seg + np.where(degenerate, 0.0, factors) * (piece - seg)",
+     "0.0 -> 1.0"): "the degenerate axes' scaled values are replaced by their ramps on the next line",
+    **{("bidmp.extension.roadmap", "_minimal_rotation", "cos = float(np.clip(u @ v, -1.0, 1.0))", mutation):
+       "|u · v| rounds past 1 only for parallel chords, where sin is below 1e-12 and the branch on the sign "
+       "of cos (not its value) decides" for mutation in ("1.0 -> 2.0",)},
+    **{("bidmp.extension.roadmap", "_minimal_rotation", "if sin < 1e-12:", mutation):
+       "chords parallel to within 1e-12 rad: the general formula gives the same rotation to 1e-12"
+       for mutation in ("< -> <=", "1e-12 -> 2e-12")},
+    ("bidmp.extension.roadmap", "_minimal_rotation", "if cos > 0:", "> -> >="):
+        "reached only when sin < 1e-12, where cos is ±1, never 0",
+    **{("bidmp.extension.segmentation", "curvature",
+        "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):", mutation): why
+       for mutation, why in (("3 -> 4", "the window is odd: at most 3 and at most 4 are the same windows"),
+                             ("<= -> <", "differs only for a curve resting at the origin, whose speed floor gives "
+                                         "zero curvature too"))},
+    ("bidmp.extension.segmentation", "curvature",
+     "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):", "1e-12 -> 2e-12"):
+        "the rounding scale of a still curve doubled: a still curve's spread is exactly 0 or rounding-level",
+    **{("bidmp.extension.segmentation", "curvature",
+        "floor = 1e-12 * max(float(np.max(speed)), np.finfo(float).tiny)", mutation):
+       "the speed floor's scale: speeds where the curve does not advance are rounding-level (1e-16 of the "
+       "peak), far below either floor, and moving samples far above" for mutation in ("* -> /", "1e-12 -> 2e-12")},
+    ("bidmp.extension.segmentation", "curvature", "kappa[speed <= floor] = 0.0", "<= -> <"):
+        "differs only for a speed exactly at the floor",
+    **{("bidmp.extension.segmentation", "curvature", "if window > 3:", mutation):
+       "the second window is at least 5 whenever this line is reached (a curve of fewer than 5 samples "
+       "returned above)" for mutation in ("> -> >=", "3 -> 4")},
+    ("bidmp.extension.segmentation", "_alternating_extrema", "if nonzero.size == 0:", "0 -> 1"):
+        "a single non-zero slope fills the whole segment with one sign: no change, no extremum, the same empty answer",
+    ("bidmp.extension.segmentation", "_alternating_extrema", "kind = 1 if filled[index - 1] > 0 else -1", "> -> >="):
+        "filled slopes are ±1, never 0",
+    **{("bidmp.extension.segmentation", "_alternating_extrema", "while start > 0 and slope[start - 1] == 0:", mutation):
+       "the walk back over a plateau never reaches the first slope: a plateau from the segment's start takes "
+       "its filled sign from the slope after it, so no change ends it" for mutation in ("> -> >=", "0 -> 1")},
+    ("bidmp.extension.segmentation", "_prune_persistence", "left = np.arange(-1, count - 1)", "- -> +"):
+        "two more entries past the last extremum, never read: the links are read at extrema 0 .. count - 1",
+    ("bidmp.extension.segmentation", "_prune_persistence", "right = np.arange(1, count + 1)  # right[-1] == count: no neighbour",
+     "1 -> 2"): "(as arange(1, count + 2)) one more entry past the last extremum, never read",
+    (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]",
+     "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
+    **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
+       "a one-point path: the placements to add are none either way, and the seed (the exact distance at "
+       "that point) is the answer" for mutation in ("> -> >=", "0 -> 1")},
 }
 
 
@@ -466,25 +568,26 @@ def main(argv=None) -> int:
 
     for target in targets:
         importlib.import_module(target.module)
-    began = time.monotonic()
-    timeout_of = {}
+    timeout_of, area_seconds = {}, {}
     for target in targets:
+        began = time.monotonic()
         seconds = baseline(target)
         timeout_of[target.area] = 3.0 * seconds + 20.0
         own = [m for m in selected if m.target is target]
         print(f"{target.area}: {len(own)} mutants, tests {seconds:.1f} s", flush=True)
         run(own, args.workers, timeout_of)
         killed = sum(m.outcome.startswith("killed") for m in own)
+        area_seconds[target.area] = round(time.monotonic() - began, 1)
         print(f"{target.area}: {killed}/{len(own)} killed", flush=True)
-    seconds = time.monotonic() - began
-    if args.area:
-        print(report(selected, seconds))
-        return 0
-    outcomes = {"seconds": round(seconds, 1), "mutants": [
-        {"area": m.target.area, "module": m.target.module, "function": m.function, "line": m.line,
-         "text": m.text, "mutation": m.description, "outcome": m.outcome} for m in selected]}
-    _write(Path(args.out).with_suffix(".json"), json.dumps(outcomes, indent=1) + "\n")
-    _write(Path(args.out), report(selected, seconds))
+    rows = [{"area": m.target.area, "module": m.target.module, "function": m.function, "line": m.line,
+             "text": m.text, "mutation": m.description, "outcome": m.outcome} for m in selected]
+    kept = Path(args.out).with_suffix(".json")
+    if args.area and kept.exists():  # the areas run again replace theirs; the others are kept
+        previous = json.loads(kept.read_text(encoding="utf-8"))
+        rows = [row for row in previous["mutants"] if row["area"] not in area_seconds] + rows
+        area_seconds = {**previous["area_seconds"], **area_seconds}
+    _write(kept, json.dumps({"area_seconds": area_seconds, "mutants": rows}, indent=1) + "\n")
+    report_again(Path(args.out))
     print(f"wrote {args.out}")
     return 0
 
@@ -502,7 +605,7 @@ def report_again(out: Path) -> None:
     by_area = {target.area: target for target in TARGETS}
     selected = [Mutant(by_area[m["area"]], m["function"], 0, 0, m["line"], m["mutation"], m["text"], m["outcome"])
                 for m in kept["mutants"] if m["area"] in by_area]
-    _write(out, report(selected, kept["seconds"]))
+    _write(out, report(selected, sum(kept["area_seconds"].values())))
 
 
 if __name__ == "__main__":

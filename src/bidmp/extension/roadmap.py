@@ -147,11 +147,13 @@ def _minimal_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     if sin < 1e-12:
         if cos > 0:
             return np.eye(n_dims)
+        if n_dims == 1:  # on a line, the opposite direction is the mirror image
+            return -np.eye(1)
         # Opposite directions: turn by π in the plane of u and the axis least aligned with it.
         axis = np.eye(n_dims)[int(np.argmin(np.abs(u)))]
         w = axis - (axis @ u) * u
         w /= np.linalg.norm(w)
-        return np.eye(n_dims) - 2.0 * np.outer(u, u) - 2.0 * np.outer(w, w) if n_dims > 1 else -np.eye(1)
+        return np.eye(n_dims) - 2.0 * np.outer(u, u) - 2.0 * np.outer(w, w)
     w /= sin
     # R = I + sinθ (w uᵀ − u wᵀ) + (cosθ − 1)(u uᵀ + w wᵀ)
     return np.eye(n_dims) + sin * (np.outer(w, u) - np.outer(u, w)) + (cos - 1.0) * (np.outer(u, u) + np.outer(w, w))

@@ -89,7 +89,7 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
 
 
 def _alternating_extrema(kappa: np.ndarray, low: int, high: int) -> tuple[np.ndarray, np.ndarray]:
-    """Local maxima (+1) and minima (-1) of ``kappa[low:high]``, merged so that types alternate.
+    """Local maxima (+1) and minima (-1) of ``kappa[low:high]``; they alternate.
 
     Returns (indices, types). A plateau counts once, at its middle (a straight stretch has
     κ ≈ 0 over its whole length: its minimum is its centre, not where it happens to start).
@@ -110,12 +110,8 @@ def _alternating_extrema(kappa: np.ndarray, low: int, high: int) -> tuple[np.nda
         start = index
         while start > 0 and slope[start - 1] == 0:
             start -= 1
-        position = low + (start + index) // 2
-        if types and types[-1] == kind:  # same type twice in a row: keep the more extreme
-            if kind * kappa[position] > kind * kappa[indices[-1]]:
-                indices[-1] = position
-            continue
-        indices.append(position)
+        # Each change flips the sign of the filled slope, so maxima and minima alternate by themselves.
+        indices.append(low + (start + index) // 2)
         types.append(kind)
     return np.asarray(indices, int), np.asarray(types, int)
 

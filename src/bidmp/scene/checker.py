@@ -65,7 +65,7 @@ class SceneChecker:
             raise ValueError(f"a has {a.shape[0]} start points but b has {b.shape[0]} end points: one move each")
         check_limit(a.shape[0], "max_samples", "a: the number of moves")
         free = np.ones(a.shape[0], dtype=bool)
-        if self.chosen.size == 0 or a.shape[0] == 0:
+        if self.chosen.size == 0:  # (as_points refuses no moves at all)
             return free
         scene = self.scene
         radius, length = scene.tool.radius, scene.tool.length
