@@ -1152,3 +1152,70 @@ def test_a_half_turn_template_turns_in_the_plane_of_the_least_aligned_axis():
     np.testing.assert_allclose(pdist(unit), pdist(piece) / 50.0, rtol=1e-9)
     np.testing.assert_allclose(unit[-2] - unit[0], (piece[-2] - piece[0]) @ _rodrigues(chord, [0.0, 1.0, 0.0]).T / 50.0,
                                atol=1e-9)
+
+
+def _segment_by_hand(y, eps_frac, method):
+    """1D-SEG as the module documents it, the wiring written out here (its parts — curvature,
+    extrema, pruning — are checked against their own oracles above): resample to min(T, 4096)
+    points equally spaced in arc length, curvature, extrema on the interior 5 % … 95 %, prune with
+    ε = eps_frac (max − min) of the interior's curvature, map each kept point to the original sample
+    nearest in arc length (the earlier one on a tie), one point per sample."""
+    from bidmp.extension.segmentation import _alternating_extrema, _prune_paper, _prune_persistence, curvature
+
+    steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(steps)])
+    n = min(len(y), 4096)
+    moving = np.concatenate([[True], steps > 0])
+    targets = np.linspace(0.0, s[-1], n)
+    resampled = np.column_stack([np.interp(targets, s[moving], column) for column in y[moving].T])
+    resampled[0], resampled[-1] = y[0], y[-1]
+    kappa = curvature(resampled)
+    low, high = int(np.ceil(0.05 * (n - 1))), int(np.floor(0.95 * (n - 1))) + 1
+    interior = kappa[low:high]
+    if np.max(interior) * s[-1] < 1e-6:
+        return [], []
+    indices, types = _alternating_extrema(kappa, low, high)
+    epsilon = eps_frac * (np.max(interior) - np.min(interior))
+    kept, kinds = (_prune_persistence if method == "persistence" else _prune_paper)(indices, types, kappa, epsilon)
+    points, point_kinds = [], []
+    for index, kind in zip(kept, kinds):
+        position = index / (n - 1) * s[-1]
+        distance = np.abs(s - position)
+        nearest = int(np.flatnonzero(distance == distance.min())[0])
+        if nearest not in points:
+            points.append(nearest)
+            point_kinds.append(int(kind))
+    order = np.argsort(points)
+    return [points[i] for i in order], [point_kinds[i] for i in order]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_segmentation_is_its_documented_procedure_on_random_recordings(seed):
+    """Independent oracle of the wiring: random smooth 2-D and 3-D curves with corners, sampled
+    unevenly (a hand slowing down and pausing), 200 to 5000 samples (past the 4096 analysed), both
+    pruning rules and three thresholds, against :func:`_segment_by_hand`."""
+    from bidmp.extension.segmentation import segment
+
+    rng = np.random.default_rng(seed)
+    n = [200, 900, 5000, 350, 1200, 4500][seed]
+    u = np.cumsum(rng.uniform(0.2, 1.8, n))  # uneven speed along the path
+    u = (u - u[0]) / (u[-1] - u[0])
+    u[n // 3 : n // 3 + 10] = u[n // 3]  # a pause
+    corners = rng.uniform(-100, 100, (int(rng.integers(3, 7)), 3 if seed % 2 else 2))
+    knots = np.linspace(0.0, 1.0, len(corners))
+    y = np.column_stack([np.interp(u, knots, c) for c in corners.T]) + 0.5 * np.sin(7 * u)[:, None]
+    for method in ("persistence", "paper"):
+        for eps_frac in (0.05, 0.1, 0.3):
+            found = segment(y, eps_frac, method)
+            points, kinds = _segment_by_hand(y, eps_frac, method)
+            assert (found.points.tolist(), found.kinds.tolist()) == (points, kinds), (method, eps_frac)
+    # An ellipse and a spiral: curved everywhere, so the threshold's min κ is far from 0.
+    t = np.linspace(0.0, 3 * np.pi, 700 + 300 * seed)
+    for curve in (np.column_stack([100 * np.cos(t), 40 * np.sin(t)]),
+                  np.column_stack([(60 + 8 * t) * np.cos(t), (60 + 8 * t) * np.sin(t), 3 * t])):
+        for method in ("persistence", "paper"):
+            for eps_frac in (0.02, 0.2, 0.95):
+                found = segment(curve, eps_frac, method)
+                assert (found.points.tolist(), found.kinds.tolist()) == _segment_by_hand(curve, eps_frac, method)
+    line = np.outer(np.linspace(0.0, 1.0, 300), [40.0, -20.0, 5.0])  # a straight line: no points
+    assert len(segment(line)) == 0 and _segment_by_hand(line, 0.1, "persistence") == ([], [])

@@ -100,7 +100,7 @@ TARGETS = (
            ("tests/test_oracles.py", "tests/test_segmentation.py")),
     Target("BLS", "bidmp.incremental.bls",
            ("_with_bias", "_affine", "_mapped_features", "_enhancement_block", "BLS.hidden", "BLS.fit"),
-           ("tests/test_bls.py",)),
+           ("tests/test_oracles.py", "tests/test_bls.py")),
     Target("Bi-DMP skill selection", "bidmp.incremental._skills",
            ("SkillLibrary.select_skill",),
            ("tests/test_oracles.py", "tests/test_incremental.py")),
@@ -214,6 +214,13 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "two more entries past the last extremum, never read: the links are read at extrema 0 .. count - 1",
     ("bidmp.extension.segmentation", "_prune_persistence", "right = np.arange(1, count + 1)  # right[-1] == count: no neighbour",
      "1 -> 2"): "(as arange(1, count + 2)) one more entry past the last extremum, never read",
+    ("bidmp.incremental.bls", "_mapped_features",
+     "weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))  # (d+1, u·q)",
+     "1 -> 2"): "(as reshape(..., -2)) NumPy takes any negative size in reshape as 'the rest'",
+    ("bidmp.incremental.bls", "_enhancement_block",
+     "weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))", "1 -> 2"):
+        "(as _rng(seed, 2, block)) another seeded stream no other matrix draws from: an equally valid draw, "
+        "as reproducible from the seed",
     (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]",
      "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
     **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
