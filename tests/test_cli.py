@@ -446,3 +446,23 @@ def test_printed_names_cannot_drive_the_terminal(tmp_path, capsys):
     assert main(["demo", "--scenario", str(path), "--methods", "dmp", "--out", str(tmp_path / "o")]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "evil?[31mRED" in out
+
+
+def test_every_help_text_renders_as_written(capsys):
+    """Structure guard: no command's --help shows argparse's escapes ('%%') or an unfilled
+    '%(...)s' (descriptions and epilogs are not %-formatted, argument help is)."""
+    import argparse
+
+    from bidmp.cli import build_parser
+
+    parser = build_parser()
+    commands = next(action for action in parser._actions if isinstance(action, argparse._SubParsersAction))
+    shown = [parser.format_help()]
+    for name, sub in commands.choices.items():
+        shown.append(sub.format_help())
+        for action in sub._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                shown += [inner.format_help() for inner in action.choices.values()]
+    assert len(shown) > 10
+    for text in shown:
+        assert "%%" not in text and "%(" not in text, text[:200]

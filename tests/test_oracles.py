@@ -113,6 +113,14 @@ def test_segments_free_judges_each_straight_move_by_its_own_closed_form():
     under = checker.segments_free(np.array([[-100.0, 0.0, -20.0], [-100.0, 0.0, -60.0]]),
                                   np.array([[100.0, 0.0, -20.0], [100.0, 0.0, -60.0]]))
     assert under.tolist() == [False, True]
+    # With a 3 mm margin: a move passing 2 mm beside the box (either side) or 2 mm under it is not free.
+    kept = bidmp.scene.SceneChecker(scene, np.arange(len(scene.solids)), 3.0)
+    side = half + radius + 2.0
+    starts = np.array([[side, -100.0, 5.0], [-side, -100.0, 5.0], [-100.0, -side, 5.0], [-100.0, side, 5.0],
+                       [-100.0, 0.0, -52.0], [side + 1.5, -100.0, 5.0]])
+    along_y, along_x = [0.0, 200.0, 0.0], [200.0, 0.0, 0.0]
+    ends = starts + [along_y, along_y, along_x, along_x, along_x, along_y]
+    assert kept.segments_free(starts, ends).tolist() == [False, False, False, False, False, True]
     # Starting 0.5 inside the box's side and moving straight away: the first placement decides.
     away = checker.segments_free(np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[100.0, 0.0, 5.0]]))
     assert away.tolist() == [False]
@@ -585,6 +593,7 @@ def test_a_verdict_is_ok_only_when_every_check_that_applies_holds():
                          ({"limits": CommandPeaks(1.2, 0.1, 0.1)}, "limits")):
         verdict = Verdict("3", 0.5, 1.0, "mm", **change)
         assert not verdict.ok and verdict.failed == [name] and verdict.reason().startswith("the motion to 3 ")
+    assert Verdict("3", 0.5, 1.0, "mm", aligned=False).reason() == "the motion to 3 tilts the tool off the target's axis"
     for change in ({"engaged": True}, {"aligned": True}, {"clearance": Clearance(3.0, "plate", np.zeros(3), 3.0)},
                    {"limits": CommandPeaks(1.0, 0.1, 0.1)}):
         assert Verdict("3", 0.5, 1.0, "mm", **change).ok
@@ -955,6 +964,10 @@ def test_a_tool_turning_past_a_block_is_checked_at_its_nearest_mid_turn_attitude
     there_and_back = np.array([attitude(0.0), attitude(np.pi / 2), attitude(0.0)])
     tips = np.array([[-300.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
     found = scene.clearance(tips, orientations=there_and_back)
+    assert dense - step / 2.0 - 1e-6 <= found.distance <= dense + 1e-6
+    # Three attitudes, each segment turning its own way (−30° → 0° → 90°): the second passes 45°.
+    three = np.array([attitude(-np.pi / 6), attitude(0.0), attitude(np.pi / 2)])
+    found = scene.clearance(np.zeros((3, 3)), orientations=three)
     assert dense - step / 2.0 - 1e-6 <= found.distance <= dense + 1e-6
 
 

@@ -124,3 +124,18 @@ def test_bidmp_demo_view_and_bidmp_view(tmp_path, capsys):
     assert main(["view", str(tmp_path / "nothing")]) == 2
     err = capsys.readouterr().err.strip()
     assert "holds no view_layers.npz" in err and "\n" not in err
+
+
+def test_every_3d_figure_has_one_scale_on_its_three_axes():
+    """Structure guard: a 300 mm move along x with micrometre noise along z is drawn in a cube
+    (equal spans, equal box sides), not with z stretched to fill the figure."""
+    from bidmp.plotting._base import _figure, _label_axes
+
+    rng = np.random.default_rng(0)
+    path = np.column_stack([np.linspace(0.0, 300.0, 50), np.linspace(0.0, 40.0, 50), 5.0 + 1e-3 * rng.normal(size=50)])
+    _, _, ax = _figure(True)  # a Figure without pyplot: nothing to close
+    ax.plot(*path.T)
+    _label_axes(ax, 3, "mm")
+    spans = [np.ptp(limits) for limits in (ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d())]
+    assert spans[0] >= 300.0 and np.allclose(spans, spans[0])
+    np.testing.assert_allclose(ax.get_box_aspect() / ax.get_box_aspect()[0], 1.0)

@@ -153,11 +153,12 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("bidmp.scene.checker", "SceneChecker.segments_free",
      "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))", "all -> any"):
         "cost only: more moves are candidates; each is then checked exactly",
-    **{("bidmp.scene.checker", "SceneChecker.segments_free", text, "<= -> <"):
+    **{("bidmp.scene.checker", "SceneChecker.segments_free", text, mutation):
        "differs only where the move's box exactly touches a part's box: the tool is then at least touching "
        "distance away, which is free either way" for text in (
            "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
-           "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)")},
+           "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)")
+       for mutation in ("<= -> <", ">= -> >")},
     **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-9 * max(length, 1.0)", mutation):
        "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
        "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
@@ -221,6 +222,11 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
      "weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))", "1 -> 2"):
         "(as _rng(seed, 2, block)) another seeded stream no other matrix draws from: an equally valid draw, "
         "as reproducible from the seed",
+    (_CLEARANCE, "Scene._clearance_oriented", "dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)", "/= -> *="):
+        "the quaternions go to Rotation.from_quat alone, which normalises them itself",
+    (_CLEARANCE, "Scene._clearance_oriented",
+     "extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)", "/ -> *"):
+        "cost only: boxes four times too tall bound the distances from below all the same",
     (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]",
      "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
     **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
@@ -515,7 +521,9 @@ def report(selected: list[Mutant], seconds: float) -> str:
              "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
              "tests that cover the area run against it. Input validation (`raise`, the `if` tests that only "
              "raise, the calls of `check_*`/`as_*` helpers), messages and logging are not mutated: the surface "
-             "sweep (`make fuzz`) covers them.", "",
+             "sweep (`make fuzz`) covers them. The score is the share killed of the mutants that can be killed: "
+             "an equivalent mutant (listed below with its reason) returns what the original returns — at "
+             "another cost, or differing only on an exact floating-point tie that rounding decides.", "",
              "| area | module | functions | mutants | killed | equivalent | survived | score |",
              "|---|---|---|---:|---:|---:|---:|---:|"]
     survivors = []
@@ -527,7 +535,8 @@ def report(selected: list[Mutant], seconds: float) -> str:
         equivalent = [m for m in own if m.outcome == "survived" and m.key in EQUIVALENT]
         survived = [m for m in own if m.outcome == "survived" and m.key not in EQUIVALENT]
         survivors += survived + equivalent
-        score = (killed + len(equivalent)) / len(own)
+        # The standard score: killed among the mutants that can be killed (equivalent ones cannot).
+        score = killed / max(len(own) - len(equivalent), 1)
         lines.append(f"| {target.area} | `{target.module}` | {len(target.functions)} | {len(own)} | {killed} | "
                      f"{len(equivalent)} | {len(survived)} | {100 * score:.1f} % |")
     total = len(selected)

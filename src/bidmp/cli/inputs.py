@@ -9,7 +9,7 @@ from pathlib import Path
 _MODEL_EXTENT_RATIO = 20.0  # a demonstration this many times larger or smaller than the model's is in another unit
 
 TIMED_INPUT = ("A timed DEMO (a CSV t column in seconds, or a timed .npy) is prepared unless --raw: the idle start "
-               "and end are trimmed (speed below 5 %% of the peak), the noise is removed by a zero-phase low-pass "
+               "and end are trimmed (speed below 5 % of the peak), the noise is removed by a zero-phase low-pass "
                "filter (--cutoff, default 6 Hz) and the samples are resampled to uniform time. A CSV may declare its "
                "unit in a first line '# units: mm'; --units converts it.")
 

@@ -273,7 +273,7 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
         description="Roll a saved model out to a goal and write the timed trajectory: t (s), positions (the model's "
                     "units), velocities (units/s) and accelerations (units/s^2), as CSV columns t,x,y,z,vx,vy,vz,ax,ay,az "
                     "or a .npy structured array with those fields. The motion lasts the demonstration's duration "
-                    "(times tau, or --duration) plus 10 %% to come to rest (robot protocol).")
+                    "(times tau, or --duration) plus 10 % to come to rest (robot protocol).")
     _add_rollout_arguments(rollout)
     allow_outside_files(rollout, shown=False)
     rollout.set_defaults(handler=cmd_rollout)

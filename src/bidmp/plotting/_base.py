@@ -102,8 +102,22 @@ def _label_axes(ax, n_dims: int, units: str) -> None:
 
         for axis in (ax.xaxis, ax.yaxis, ax.zaxis):  # 3-D tick labels crowd into each other beyond ~6
             axis.set_major_locator(MaxNLocator(6))
+        _equal_3d(ax)
     else:
         ax.set_aspect("equal", adjustable="datalim")
+
+
+def _equal_3d(ax) -> None:
+    """One scale on all three axes (as 2-D plots have): a cube around what is drawn. Matplotlib
+    stretches each 3-D axis to its own data, so micrometre noise along one axis is drawn as large
+    as a 300 mm move along another."""
+    limits = np.array([ax.get_xlim3d(), ax.get_ylim3d(), ax.get_zlim3d()])
+    centre = limits.mean(axis=1)
+    half = max(float(np.max(limits[:, 1] - limits[:, 0])) / 2.0, 1e-12)
+    ax.set_xlim3d(centre[0] - half, centre[0] + half)
+    ax.set_ylim3d(centre[1] - half, centre[1] + half)
+    ax.set_zlim3d(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1.0, 1.0, 1.0))
 
 
 def _finish(ax, n_dims: int, units: str, title: str = "") -> None:

@@ -21,12 +21,15 @@ from .._lazy import exports
 # public name -> the module that holds it (imported on first use)
 _EXPORTS = {
     "simulate": "run",
+    "target_labels": "run",
     "run_job": "job",
     "job_targets": "job",
     "JobReport": "job_report",
     "JobTarget": "job_report",
     "JobPhase": "job_report",
     "write_job_report": "job_report",
+    "in_bin": "job_report",
+    "in_slot": "job_report",
     "inverse_kinematics": "kinematics",
     "joint_names": "kinematics",
     "SimulatorBackend": "backend",

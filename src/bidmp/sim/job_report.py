@@ -8,12 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import as_point, as_vector, check_real
 from ..tasks._tables import markdown_table, text_table
 from .backend import RECORD_EVERY, SETTLE, SIM_STEP
 from .limits import _command_peaks, _measured_peaks
 from .report import _titled, _write_results, _write_strip
 
-__all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report"]
+__all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report", "in_bin", "in_slot"]
 
 FORMAT = 2  # of job_results.json (2: each motion's contract verdict)
 
@@ -62,7 +63,8 @@ def in_bin(centre, floor, inner) -> bool:
     floor's centre is ``floor`` (3,) and whose inside measures ``inner`` (3,): over its floor
     (within half the inner width and half the inner depth of the floor's centre) and between the
     floor and the rim. Scene units."""
-    centre, floor, inner = (np.asarray(value, dtype=float) for value in (centre, floor, inner))
+    centre, floor = as_point(centre, 3, "centre"), as_point(floor, 3, "floor")
+    inner = as_vector(inner, "inner", length=3, positive=True)
     over_floor = bool(np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0))
     return over_floor and bool(floor[2] <= centre[2] <= floor[2] + inner[2])
 
@@ -71,7 +73,10 @@ def in_slot(centre, slot, height: float, off_tolerance: float, height_tolerance:
     """Whether a part of ``height`` that came to rest with its centre at ``centre`` (3,) stands in
     its rack slot (the slot's floor centre ``slot``, 3): its axis within ``off_tolerance`` of the
     slot's centre sideways, its bottom within ``height_tolerance`` of the slot's floor."""
-    centre, slot = np.asarray(centre, dtype=float), np.asarray(slot, dtype=float)
+    centre, slot = as_point(centre, 3, "centre"), as_point(slot, 3, "slot")
+    height = check_real(height, "height", positive=True)
+    off_tolerance = check_real(off_tolerance, "off_tolerance", nonnegative=True)
+    height_tolerance = check_real(height_tolerance, "height_tolerance", nonnegative=True)
     off = float(np.linalg.norm(centre[:2] - slot[:2]))
     return off <= off_tolerance and abs(centre[2] - height / 2.0 - slot[2]) <= height_tolerance
 

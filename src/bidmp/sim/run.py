@@ -21,7 +21,7 @@ from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_mod
 from .pybullet.world import _pybullet_module
 from .report import SimMethod, SimReport, SimTarget, _measure
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "target_labels"]
 
 logger = logging.getLogger(__name__)
 
@@ -351,6 +351,10 @@ def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: boo
 
 def target_labels(scenario, targets) -> list[str]:
     """The labels of ``targets`` (None: every target of the scenario), each one the scenario has."""
+    from ..tasks.scenarios import Scenario
+
+    if not isinstance(scenario, Scenario):
+        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
     labels = scenario.labels if targets is None else as_labels(targets, "targets")
     for label in labels:
         if label not in scenario.targets:

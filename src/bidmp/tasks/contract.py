@@ -196,7 +196,8 @@ class Verdict:
             elif name == "clearance":
                 parts.append(self._clearance_words(unit))
             elif name == "alignment":
-                parts.append(f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis")
+                parts.append("tilts the tool off the target's axis" if self.axis_deviation is None
+                             else f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis")
             else:
                 parts.append(self.limits.reason())
         if not parts:
