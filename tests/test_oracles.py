@@ -121,6 +121,22 @@ def test_segments_free_judges_each_straight_move_by_its_own_closed_form():
     along_y, along_x = [0.0, 200.0, 0.0], [200.0, 0.0, 0.0]
     ends = starts + [along_y, along_y, along_x, along_x, along_x, along_y]
     assert kept.segments_free(starts, ends).tolist() == [False, False, False, False, False, True]
+    # A move of no length is its one placement; a move shorter than 1 ending inside the box is not
+    # free; a move that grazes the margin (1e-7 outside it) all along is taken as touching.
+    inside, outside = np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[half + radius + 1.0, 0.0, 5.0]])
+    assert checker.segments_free(inside, inside).tolist() == [False]
+    assert checker.segments_free(outside, outside).tolist() == [True]
+    near = np.array([[half + radius + 0.3, 0.0, 5.0]])
+    assert checker.segments_free(near, near - [0.8, 0.0, 0.0]).tolist() == [False]  # ends 0.5 inside
+    post = Scene.from_dict({"tool": {"radius": radius, "length": 50.0},
+                            "parts": [{"type": "cylinder", "label": "post", "at": [0.0, 0.0, -200.0], "radius": 20.0,
+                                       "height": 400.0}]})
+    corner = (20.0 + radius + 3.0) / np.sqrt(2.0)  # 3 from the post, diagonally (inside its bounding box)
+    top, bottom = np.array([[corner, corner, 100.0]]), np.array([[corner, corner, -100.0]])
+    clearance = post.clearance(top).distance
+    grazing = bidmp.scene.SceneChecker(post, np.arange(len(post.solids)), clearance - 1e-7)
+    assert grazing.segments_free(top, bottom).tolist() == [False]  # 200 along the margin: taken as touching
+    assert bidmp.scene.SceneChecker(post, np.arange(len(post.solids)), clearance - 1.0).segments_free(top, bottom).tolist() == [True]
     # Starting 0.5 inside the box's side and moving straight away: the first placement decides.
     away = checker.segments_free(np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[100.0, 0.0, 5.0]]))
     assert away.tolist() == [False]
@@ -697,6 +713,13 @@ def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(short, axis=0), axis=1))])
     out = template(short, new_target / 1000.0, scaling="axis")
     np.testing.assert_allclose(out[:, 2], short[:, 2] + arc / arc[-1] * 0.007, atol=1e-12)
+    for offset in ([1e4, 1e4, 0.0], [-1e4, -1e4, 0.0]):  # closed to rounding (1e-10) far from the origin
+        far_loop = loop + offset
+        far_loop[-1] += 1e-10
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(far_loop, axis=0), axis=1))])
+        np.testing.assert_allclose(template(far_loop, far_loop[0] + [10.0, 5.0, 2.0], scaling="similarity"),
+                                   far_loop + (arc / arc[-1])[:, None] * (far_loop[0] + [10.0, 5.0, 2.0] - far_loop[-1]),
+                                   atol=1e-7)
     waits = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [10.0, 0.0, 0.0]])  # one step, at the end
     np.testing.assert_allclose(template(waits, [20.0, 5.0, 0.0])[:, 1], [0.0, 0.0, 0.0, 5.0], atol=1e-12)
     still = np.tile([3.0, 4.0, 5.0], (5, 1))  # no length at all: λ by sample
@@ -933,6 +956,22 @@ def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seede
         np.testing.assert_allclose(model.mapping_weights_[window], expected, rtol=1e-10, atol=1e-12)
     model.add_enhancement_nodes(6)
     assert not np.allclose(model.enhancement_weights_[1], model.enhancement_weights_[0])
+    # Small inputs (projections spanning less than 1) are normalised all the same.
+    small = X * 0.01
+    model = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-6, admm_iterations=30, seed=11).fit(small, Y)
+    small_with_bias = np.hstack([small, np.full((50, 1), 0.1)])
+    projection = small_with_bias @ np.random.default_rng([11, 0, 0]).uniform(-1.0, 1.0, size=(3, 4))
+    assert np.ptp(projection, axis=0).max() < 1.0
+    F = (projection - projection.min(axis=0)) / np.ptp(projection, axis=0)
+    np.testing.assert_allclose(model.mapping_weights_[0], sparse_autoencoder(F, small_with_bias, 1e-6, 30).T,
+                               rtol=1e-10, atol=1e-12)
+    # A sparsity weight so large that every mapped node is 0: constant nodes stay 0, not 0/0.
+    flat = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e6, seed=11).fit(X, Y)
+    assert np.all(flat.mapping_weights_[0] == 0.0) and np.all(flat.mapping_range_ == 1.0)
+    assert np.all(flat.hidden(X)[:, :4] == 0.0) and np.all(np.isfinite(flat.predict(X)))
+    # Inputs that never change: every projection is constant, and the fit stays finite.
+    same = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, seed=11).fit(np.ones((50, 2)), Y)
+    assert np.all(np.isfinite(same.predict(np.ones((3, 2)))))
 
 
 def test_a_tool_turning_past_a_block_is_checked_at_its_nearest_mid_turn_attitude():
@@ -1093,6 +1132,11 @@ def test_the_measured_joints_peaks_are_a_quintics_closed_forms(sign):
     loose = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2.0, 2.0),
                                   acceleration=(4.0, 4.0), jerk=None)
     assert _measured_peaks(recorded, step, loose).jerk == 0.0
+    # A short recording: one sample has no acceleration; two windows' worth one (its difference).
+    one = _measured_peaks(recorded[:1], step, limits)
+    assert (one.acceleration, one.jerk) == (0.0, 0.0)
+    two = _measured_peaks(np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.2, 0.0]]), step, limits)
+    assert two.acceleration == pytest.approx(0.2 / 0.01 / 4.0) and two.jerk == 0.0 and two.velocity == pytest.approx(0.1)
 
 
 def test_the_end_error_is_the_last_samples_distance():
@@ -1225,6 +1269,7 @@ def test_segmentation_is_its_documented_procedure_on_random_recordings(seed):
     # An ellipse and a spiral: curved everywhere, so the threshold's min κ is far from 0.
     t = np.linspace(0.0, 3 * np.pi, 700 + 300 * seed)
     for curve in (np.column_stack([100 * np.cos(t), 40 * np.sin(t)]),
+                  np.column_stack([1e4 * np.cos(t), 4e3 * np.sin(t)]),  # 100 m long: κ·L decides, not κ
                   np.column_stack([(60 + 8 * t) * np.cos(t), (60 + 8 * t) * np.sin(t), 3 * t])):
         for method in ("persistence", "paper"):
             for eps_frac in (0.02, 0.2, 0.95):
@@ -1232,3 +1277,60 @@ def test_segmentation_is_its_documented_procedure_on_random_recordings(seed):
                 assert (found.points.tolist(), found.kinds.tolist()) == _segment_by_hand(curve, eps_frac, method)
     line = np.outer(np.linspace(0.0, 1.0, 300), [40.0, -20.0, 5.0])  # a straight line: no points
     assert len(segment(line)) == 0 and _segment_by_hand(line, 0.1, "persistence") == ([], [])
+
+
+def test_the_command_generator_feeds_the_targets_rates_forward_and_settles_on_a_held_target():
+    """Property of the cascaded loops with feed-forward: a target moving at a constant 0.1 rad/s
+    (its velocity given) is tracked with no lag once the start has settled (each command is the
+    position at the end of its 1 ms step) (a position loop of
+    gain 15/s alone would lag 0.1/15 = 6.7 mrad); one accelerating at 0.2 rad/s² (velocity and
+    acceleration given) likewise; a held target given alone is reached at rest."""
+    from bidmp.sim.limits import _RateLimiter
+
+    limits = bidmp.sim.JointLimits(lower=(-3.0,), upper=(3.0,), velocity=(1.0,), acceleration=(5.0,), jerk=(100.0,))
+    ramp, accelerating, held = (_RateLimiter(np.zeros(1), limits, 0.9) for _ in range(3))
+    for k in range(4000):
+        t = k * 1e-3
+        ramp_command = ramp([0.1 * t], [0.1])
+        accelerating_command = accelerating([0.1 * t * t], [0.2 * t], [0.2])
+        held_command = held([0.3])
+    end = t + 1e-3  # each command is where the joint is at the end of its 1 ms step
+    assert abs(ramp_command[0] - 0.1 * end) < 1e-6
+    # (fed its acceleration the lag is a discretisation residue, 7e-6; without it the velocity loop
+    # would lag 0.2/50 rad/s and the position 0.2/(50 · 15) = 2.7e-4 rad)
+    assert abs(accelerating_command[0] - 0.1 * end * end) < 2e-5
+    assert abs(held_command[0] - 0.3) < 1e-6 and abs(held.velocity[0]) < 1e-5
+
+
+def test_the_measured_acceleration_is_the_velocitys_difference_over_10_ms():
+    """Independent oracle: velocities recorded every 10 ms (one window) or every 2 ms (five
+    samples a window): the acceleration peak is the largest difference of the velocities 10 ms
+    apart over 10 ms, computed here."""
+    from bidmp.sim.limits import _measured_peaks
+
+    limits = bidmp.sim.JointLimits(lower=(-3.0,), upper=(3.0,), velocity=(2.0,), acceleration=(1.0,), jerk=(1e6,))
+    for step in (0.01, 0.002):
+        t = np.arange(0.0, 1.0, step)
+        velocity = np.sin(3.0 * t) ** 3
+        every = int(round(0.01 / step))
+        expected = np.max(np.abs(np.diff(velocity[::every]))) / 0.01
+        assert _measured_peaks(velocity[:, None], step, limits).acceleration == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("n, bumps, expected", [(101, (6, 94), ([6, 50, 94], [1, -1, 1])), (101, (95,), ([], [])),
+                                                 (101, (4,), ([], [])), (102, (6,), ([], [])), (102, (7,), ([7], [1]))])
+def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(monkeypatch, n, bumps, expected):
+    """Structure guard of the window, with a curvature designed here (the curve is a straight line
+    of 101 evenly spaced samples, so sample i is resampled point i): on the interior, samples
+    ceil(0.05 · 100) = 5 … floor(0.95 · 100) = 95, a maximum needs a neighbour on each side inside
+    it — so bumps at 6 and 94 are found (with the minimum between them at its plateau's middle),
+    one at the edge (95) or outside (4) is not. With 102 samples the interior starts at
+    ceil(0.05 · 101) = 6."""
+    from bidmp.extension import segmentation
+
+    kappa = np.zeros(n)
+    kappa[list(bumps)] = 1.0
+    monkeypatch.setattr(segmentation, "curvature", lambda y: kappa.copy())
+    line = np.outer(np.linspace(0.0, 1.0, n), [100.0, 20.0, 0.0])
+    found = segmentation.segment(line)
+    assert (found.points.tolist(), found.kinds.tolist()) == expected

@@ -122,7 +122,8 @@ _BOUND = ("cost only: branch and bound returns the least exact distance over eve
 _CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     **{("bidmp.primitives.coupling", "PhaseStopping.slowdown",
-        "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):", mutation): _FAST_PATH
+        "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):  # a stepper's own state passes as is",
+        mutation): _FAST_PATH
        for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")},
     (_CLEARANCE, "Clearance.clear", "return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin",
      "<= -> <"): "at a margin of exactly 0 both branches are `not distance < 0`",
@@ -162,7 +163,9 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-9 * max(length, 1.0)", mutation):
        "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
        "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
-       for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min")},
+       for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min", "1.0 -> 2.0")},
+    ("bidmp.scene.checker", "SceneChecker._move_free", "if distance < margin:", "< -> <="):
+        "differs only for a placement exactly at the margin, to the last bit",
     ("bidmp.tasks.metrics", "final_approach_mask",
      'heights = _as_bounded_array(heights, "heights", max_ndim=1).reshape(-1)', "1 -> 2"):
         "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
@@ -174,6 +177,9 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "changes the first sample's λ alone, and the first sample is set to seg afterwards",
     ("bidmp.extension.roadmap", "template", "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):", "<= -> <"):
         "the threshold is at least 1e-12: the two differ only for a chord exactly that long",
+    **{("bidmp.extension.roadmap", "template", "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):", mutation):
+       "a rounding-level threshold doubled (a closed piece's chord is 0 or rounding; an open one's is not "
+       "within a factor 2 of 1e-12 of its size)" for mutation in ("1e-12 -> 2e-12", "1.0 -> 2.0")},
     ("bidmp.extension.roadmap", "template",
      "degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)",
      "< -> <="): "differs only for an axis whose chord is exactly 1e-3 of the chord's length",
@@ -227,6 +233,26 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (_CLEARANCE, "Scene._clearance_oriented",
      "extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)", "/ -> *"):
         "cost only: boxes four times too tall bound the distances from below all the same",
+    ("bidmp.extension.segmentation", "_prune_paper",
+     "if types[position] == 1 and types[position + 1] == -1:  # a (Ma_i, Mi_i) pair", "and -> or"):
+        "the extrema alternate, so a maximum is always followed by a minimum: either half implies the other",
+    ("bidmp.incremental.bls", "BLS.fit", "F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)", "1.0 -> 2.0"):
+        "the divisor of a constant projection, whose numerator F - F_low is 0 either way",
+    ("bidmp.primitives.goals", "_goal_share", "closing = s > end - width", "> -> >="):
+        "at s = end - width both formulas give σ (the share is continuous there)",
+    ("bidmp.primitives.goals", "_goal_share", "share[s >= end] = 1.0", ">= -> >"):
+        "at s = end the closing formula gives 1 - (1 - σ) S(0) = 1",
+    ("bidmp.primitives.goals", "DelayedGoal.on_grid", "return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)",
+     "1.0 -> 2.0"): "a step of 0 passes only for one sample, whose gate is 1 whatever the step",
+    ("bidmp.extension.segmentation", "segment",
+     "if np.max(interior) * total < 1e-6:  # (at least 10 samples: the interior has 8 or more)", "< -> <="):
+        "differs only for a curve whose κ·L is exactly 1e-6",
+    ("bidmp.extension.segmentation", "segment", "original = np.clip(np.searchsorted(s, positions), 1, n_samples - 1)",
+     "- -> +"): "the upper bound is never reached: a kept point lies within the path, so searchsorted gives at "
+                "most n_samples - 1",
+    ("bidmp.extension.segmentation", "segment",
+     "nearer_left = (positions - s[original - 1]) < (s[original] - positions)", "< -> <="):
+        "differs only for a point exactly halfway in arc length between two samples",
     (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]",
      "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
     **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
