@@ -1334,3 +1334,25 @@ def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(monkeypa
     line = np.outer(np.linspace(0.0, 1.0, n), [100.0, 20.0, 0.0])
     found = segmentation.segment(line)
     assert (found.points.tolist(), found.kinds.tolist()) == expected
+
+
+@pytest.mark.parametrize("x, bump, height, expected", [
+    (np.r_[0.0, np.arange(30.0, 101.0)], 6, 1.0, ([0], [1])),  # at 8.5 % of the path: sample 0 (0 %), not 1 (30 %)
+    (np.r_[np.arange(0.0, 71.0), 100.0], 65, 1.0, ([71], [1])),  # at 91.5 %: the last sample (100 %), not 70 %
+    (np.linspace(0.0, 100.0, 101), 50, 1.5e-8, ([50], [1])),  # κ·L = 1.5e-6: a bend, however slight
+    (np.linspace(0.0, 100.0, 101), 50, 0.5e-8, ([], [])),  # κ·L = 5e-7: straight
+])
+def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_flat_path_straight(monkeypatch, x, bump,
+                                                                                                height, expected):
+    """Structure guard of the mapping and the straight-path threshold, with a curvature designed
+    here on a straight line sampled unevenly (a first or last step of 30 % of the path): a point
+    found at a resampled position goes to the original sample nearest in arc length, whichever end
+    of the path it is near; a path whose curvature times length stays below 1e-6 is straight."""
+    from bidmp.extension import segmentation
+
+    kappa = np.zeros(len(x))
+    kappa[bump] = height
+    monkeypatch.setattr(segmentation, "curvature", lambda y: kappa.copy())
+    line = np.column_stack([x, 0.2 * x, np.zeros(len(x))]) / np.sqrt(1.04)  # arc length = x
+    found = segmentation.segment(line)
+    assert (found.points.tolist(), found.kinds.tolist()) == expected
