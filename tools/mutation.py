@@ -311,6 +311,14 @@ def _call_name(node: ast.Call) -> str | None:
     return None
 
 
+def _set_op(new):
+    """A mutation that gives a binary, augmented or boolean operation the operator ``new``."""
+    def apply(n):
+        n.op = new()
+        return n
+    return apply
+
+
 def _variants(node) -> list[tuple[str, callable]]:
     """The mutations of one node: (description, apply(node) -> replacement node)."""
     out = []
@@ -323,29 +331,14 @@ def _variants(node) -> list[tuple[str, callable]]:
                     n.ops[index] = new()
                     return n
                 out.append((f"{_SYMBOL[type(op)]} -> {_SYMBOL[new]}", apply))
-    elif isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        new = _BINARY[type(node.op)]
-
-        def apply(n, new=new):
-            n.op = new()
-            return n
-        out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", apply))
-    elif isinstance(node, ast.AugAssign) and type(node.op) in _BINARY:
-        new = _BINARY[type(node.op)]
-
-        def apply(n, new=new):
-            n.op = new()
-            return n
-        out.append((f"{_SYMBOL[type(node.op)]}= -> {_SYMBOL[new]}=", apply))
+    elif isinstance(node, (ast.BinOp, ast.AugAssign)) and type(node.op) in _BINARY:
+        new, equals = _BINARY[type(node.op)], "=" if isinstance(node, ast.AugAssign) else ""
+        out.append((f"{_SYMBOL[type(node.op)]}{equals} -> {_SYMBOL[new]}{equals}", _set_op(new)))
     elif isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.Not)):
         out.append(("drop " + ("-" if isinstance(node.op, ast.USub) else "not"), lambda n: n.operand))
     elif isinstance(node, ast.BoolOp):
         new = ast.Or if isinstance(node.op, ast.And) else ast.And
-
-        def apply(n, new=new):
-            n.op = new()
-            return n
-        out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", apply))
+        out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", _set_op(new)))
     elif isinstance(node, ast.Constant) and isinstance(node.value, bool):
         out.append((f"{node.value} -> {not node.value}", lambda n: ast.Constant(not n.value)))
     elif isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
@@ -354,9 +347,7 @@ def _variants(node) -> list[tuple[str, callable]]:
         out.append((f"{value!r} -> {changed!r}", lambda n, changed=changed: ast.Constant(changed)))
     elif isinstance(node, ast.Call):
         name = _call_name(node)
-        if name in ("abs", "fabs") and len(node.args) == 1:
-            out.append((f"drop {name}()", lambda n: n.args[0]))
-        elif name == "abs" or (name in ("absolute",) and node.args):
+        if name in ("abs", "fabs", "absolute") and len(node.args) == 1:
             out.append((f"drop {name}()", lambda n: n.args[0]))
         elif name in _SWAPPED_NAMES:
             new = _SWAPPED_NAMES[name]
