@@ -396,15 +396,20 @@ def _function_node(tree: ast.Module, qualname: str):
     return scope
 
 
+def _points(function: ast.FunctionDef) -> list:
+    """The nodes of ``function``'s body that may be mutated, in a fixed order (a mutant is an index
+    into this list, so the parent that lists it and the child that plants it agree)."""
+    body = function.body[1:] if ast.get_docstring(function) else function.body
+    return [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
+
+
 def mutants(target: Target) -> list[Mutant]:
     path, tree = _source_tree(target.module)
     lines = path.read_text(encoding="utf-8").splitlines()
     out = []
     for function in target.functions:
         node = _function_node(tree, function)
-        body = node.body[1:] if ast.get_docstring(node) else node.body
-        nodes = [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
-        for index, inner in enumerate(nodes):
+        for index, inner in enumerate(_points(node)):
             for variant, (description, _) in enumerate(_variants(inner)):
                 out.append(Mutant(target, function, index, variant, inner.lineno, description,
                                   lines[inner.lineno - 1].strip()))
@@ -415,9 +420,7 @@ def _mutated_code(mutant: Mutant):
     """The mutated function's code object, compiled from the module with the one node changed."""
     path, tree = _source_tree(mutant.target.module)
     node = _function_node(tree, mutant.function)
-    body = node.body[1:] if ast.get_docstring(node) else node.body
-    nodes = [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
-    chosen = nodes[mutant.index]
+    chosen = _points(node)[mutant.index]
     _, apply = _variants(chosen)[mutant.variant]
     replacement = apply(copy.copy(chosen) if isinstance(chosen, ast.Call) else chosen)
     if replacement is not chosen:
@@ -456,31 +459,30 @@ def _live_function(module, qualname: str):
     return value
 
 
-def _run_child(mutant: Mutant | None, tests: tuple[str, ...]) -> int:
-    """In a forked child: plant the mutant, run the tests quietly, return pytest's exit code."""
+def _run_child(target: Target, mutant: Mutant | None) -> int:
+    """In a forked child: plant the mutant (None: the original), run the target's tests quietly,
+    return pytest's exit code."""
     import pytest
 
-    module = importlib.import_module(mutant.target.module if mutant else "bidmp")
     if mutant is not None:
-        function = _live_function(module, mutant.function)
+        function = _live_function(importlib.import_module(target.module), mutant.function)
         function.__code__ = _mutated_code(mutant)
-    if mutant is not None and mutant.target.pure_python or mutant is None and tests[-1] == "pure":
+    if target.pure_python:
         from bidmp.extension import similarity
 
         similarity._kernel_state.update({"Fréchet": similarity._frechet_rows, "DTW": similarity._dtw_rows})
-    tests = tuple(test for test in tests if test != "pure")
     sink = io.StringIO()
     with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
-        return pytest.main([*tests, "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "--no-header"])
+        return pytest.main([*target.tests, "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "--no-header"])
 
 
-def _fork(mutant: Mutant | None, tests: tuple[str, ...]) -> int:
+def _fork(target: Target, mutant: Mutant | None) -> int:
     pid = os.fork()
     if pid == 0:  # the child
         code = 3
         try:
             os.setpgid(0, 0)
-            code = int(_run_child(mutant, tests))
+            code = int(_run_child(target, mutant))
         except BaseException:  # noqa: BLE001 - a mutant may break anything; the exit code says it
             code = 4
         finally:
@@ -495,7 +497,7 @@ def run(selected: list[Mutant], workers: int, timeout_of: dict) -> None:
     while pending or running:
         while pending and len(running) < workers:
             mutant = pending.pop(0)
-            running[_fork(mutant, mutant.target.tests)] = (mutant, time.monotonic())
+            running[_fork(mutant.target, mutant)] = (mutant, time.monotonic())
         time.sleep(0.02)
         for pid, (mutant, began) in list(running.items()):
             finished, status = os.waitpid(pid, os.WNOHANG)
@@ -522,7 +524,7 @@ def run(selected: list[Mutant], workers: int, timeout_of: dict) -> None:
 def baseline(target: Target) -> float:
     """The covering tests' time on the unmutated code; they must pass."""
     began = time.monotonic()
-    pid = _fork(None, target.tests + (("pure",) if target.pure_python else ()))
+    pid = _fork(target, None)
     _, status = os.waitpid(pid, 0)
     code = os.waitstatus_to_exitcode(status)
     if code != 0:
