@@ -61,7 +61,7 @@ SKIPPED = {
     "Report", "MethodResult", "SimReport", "SimTarget", "SimMethod", "JobReport", "JobTarget", "JobPhase", "Table4",
     "Table5", "Figures", "BenchmarkResult", "GeneralisationResult", "IncrementalResult", "PRMComparison", "Segmentation",
     "Clearance", "PrepareInfo", "ExtendedDemonstration", "Piece", "RoadmapResult", "ForgettingResult", "Part", "Solid",
-    "Scenario", "Verdict", "CommandPeaks", "Repaired", "Attempt", "MotionPlan", "Execution", "BagRecording", "AvoidanceCase",
+    "Scenario", "Verdict", "CommandPeaks", "Repaired", "Attempt", "MotionPlan", "Execution", "Recording", "AvoidanceCase",
     "ViewLayers", "Limits", "Method", "SimulatorBackend", "CouplingTerm", "TimedMotion",
     "plot_generalisation", "plot_extension", "plot_prm_comparison", "plot_incremental", "plot_targets_top_view",
     "plot_error_vs_distance", "plot_scenario_3d", "layers_from_report", "add_robot_motions",

@@ -32,7 +32,8 @@ def _package_overrides(tmp: Path) -> dict:
 
     bag = write_bag(tmp / "poses_bag", TIMES, DEMO / 1000.0, kind="pose")
     readers = {f"bidmp.io.{name}": {"path": csv} for name in ("load_trajectory", "read_trajectory", "declared_units",
-                                                                "is_joint_recording")}
+                                                                "is_joint_recording", "read_recording",
+                                                                "recording_kind")}
     rng = np.random.default_rng(3)
     A, E = rng.normal(size=(30, 5)), rng.normal(size=(30, 2))
     U, sv, V, _ = truncated_svd(A)
@@ -54,7 +55,7 @@ def _package_overrides(tmp: Path) -> dict:
             "bidmp.sim.in_slot": {"centre": [1.0, 0.0, 20.0], "slot": [0.0, 0.0, 0.0], "height": 40.0,
                                   "off_tolerance": 2.0, "height_tolerance": 1.0},
             "bidmp.sim.inverse_kinematics": {"points": np.array([[0.45, -0.1, 0.3], [0.5, 0.0, 0.3]])},
-            "bidmp.sim.joint_names": {"robot": "panda"},
+            "bidmp.sim.joint_names": {"robot": "panda"}, "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
             "bidmp.sim.RobotCell": {"scene": scenario.scene},
             "bidmp.io.load_model": {"path": model}, "bidmp.plotting.plot_segmentation": {"points": segment(DEMO).points},
             "bidmp.plotting.load_layers": {"path": layers}, "bidmp.plotting.save_layers": {"path": tmp / "l2.npz",

@@ -149,50 +149,109 @@ def test_a_joint_state_bag_fits_the_joint_space_model_of_the_same_csv(tmp_path):
     np.testing.assert_allclose(from_bag.goal_, q[-1], atol=1e-3)  # the chosen order, not the driver's
 
 
+def _read_all(path):
+    with AnyReader([path]) as reader:
+        (connection,) = reader.connections
+        return connection, [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+
+
 def test_rolled_out_motions_read_back_as_ros_messages(tmp_path):
+    """Issue 35.4: stamps from the given start (not 1970), the user's topic and frame, no made-up
+    orientation (a position model writes PointStamped, or PoseStamped holding the orientation
+    it is given), joint names from the recording in the JointTrajectory and the FollowJointTrajectory
+    goal (read back through rosbags from the definitions the bag carries)."""
     demonstration = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
     np.savetxt(tmp_path / "d.csv", np.column_stack([np.linspace(0, 3, 300), demonstration]), delimiter=",",
                header="# units: mm\nt,x,y,z", comments="")
     assert main(["fit", str(tmp_path / "d.csv"), "-o", str(tmp_path / "m.npz"), "--raw"]) == 0
-    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "50", "-o", str(tmp_path / "r.csv"),
-                 "--bag", str(tmp_path / "out"), "--frame", "panda_link0"]) == 0
+    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "50", "-o", str(tmp_path / "r.csv"), "--bag",
+                 str(tmp_path / "out"), "--frame", "panda_link0", "--stamp", "2026-12-03T14:00:00.25Z",
+                 "--bag-topic", "/cell/tool_point"]) == 0
     rows = _table(tmp_path / "r.csv")
-    with AnyReader([tmp_path / "out"]) as reader:
-        (connection,) = reader.connections
-        assert connection.msgtype == "geometry_msgs/msg/PoseStamped"
-        read = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    connection, read = _read_all(tmp_path / "out")
+    assert connection.msgtype == "geometry_msgs/msg/PointStamped" and connection.topic == "/cell/tool_point"
     stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in read])
-    positions = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in read])
-    np.testing.assert_allclose(stamps, rows[:, 0], atol=1e-9)
+    start = 1_796_306_400.25  # 2026-12-03T14:00:00.25Z, by hand: 20 790 days after 1970-01-01, then 14 h
+    assert 20_790 * 86_400 + 14 * 3_600 + 0.25 == start
+    np.testing.assert_allclose(stamps - start, rows[:, 0], atol=1e-6)
+    positions = np.array([[m.point.x, m.point.y, m.point.z] for m in read])
     np.testing.assert_allclose(positions, rows[:, 1:4] / 1000.0, atol=1e-12)  # mm -> m
     assert {m.header.frame_id for m in read} == {"panda_link0"}
-    # A joint-space model: one JointTrajectory in a ROS 1 bag.
-    q = np.column_stack([np.linspace(0, 1, 300) ** 2 * k for k in range(1, 8)])
+    # The same motion holding a given orientation: PoseStamped, that quaternion in every message.
+    held = [1.0, 0.0, 0.0, 0.0]  # tool pointing down
+    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "50", "-o", str(tmp_path / "r2.csv"), "--bag",
+                 str(tmp_path / "held"), "--stamp", "1796306400.25", "--orientation", *map(str, held)]) == 0
+    connection, read = _read_all(tmp_path / "held")
+    assert connection.msgtype == "geometry_msgs/msg/PoseStamped" and connection.topic == "/bidmp/pose"
+    assert {(m.pose.orientation.x, m.pose.orientation.y, m.pose.orientation.z, m.pose.orientation.w) for m in read} == {tuple(held)}
+    assert read[0].header.stamp.sec == 1_796_306_400 and abs(read[0].header.stamp.nanosec - 250_000_000) <= 1
+    # A joint-space model: one JointTrajectory in a ROS 1 bag, with the recording's joint names.
+    names = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint"]
+    q = np.column_stack([np.linspace(0, 1, 300) ** 2 * k * 0.2 for k in range(1, 7)])
     np.savetxt(tmp_path / "j.csv", np.column_stack([np.linspace(0, 3, 300), q]), delimiter=",",
-               header="t," + ",".join(f"j{k}" for k in range(1, 8)), comments="")
+               header="t," + ",".join(names), comments="")
     assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "j.npz"), "--raw"]) == 0
     assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "50", "-o", str(tmp_path / "jr.csv"),
                  "--bag", str(tmp_path / "j.bag"), "--ros1"]) == 0
+    header = (tmp_path / "jr.csv").read_text().splitlines()[1].split(",")
+    assert header == ["t", *names, *(f"v{n}" for n in names), *(f"a{n}" for n in names)]
     joints = _table(tmp_path / "jr.csv")
-    with AnyReader([tmp_path / "j.bag"]) as reader:
-        (connection,) = reader.connections
-        assert connection.msgtype == "trajectory_msgs/msg/JointTrajectory"
-        (message,) = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    connection, (message,) = _read_all(tmp_path / "j.bag")
+    assert connection.msgtype == "trajectory_msgs/msg/JointTrajectory" and list(message.joint_names) == names
     np.testing.assert_allclose([p.time_from_start.sec + 1e-9 * p.time_from_start.nanosec for p in message.points], joints[:, 0], atol=1e-9)
-    np.testing.assert_allclose([p.positions for p in message.points], joints[:, 1:8], atol=1e-12)
-    np.testing.assert_allclose([p.velocities for p in message.points], joints[:, 8:15], atol=1e-12)
+    np.testing.assert_allclose([p.positions for p in message.points], joints[:, 1:7], atol=1e-12)
+    np.testing.assert_allclose([p.velocities for p in message.points], joints[:, 7:13], atol=1e-12)
+    # The goal a ROS 2 controller takes, in ROS 2 and ROS 1 bags.
+    for ros, out in ((2, tmp_path / "goal"), (1, tmp_path / "goal.bag")):
+        assert main(["rollout", str(tmp_path / "j.npz"), "--rate", "50", "-o", str(tmp_path / "jr.csv"), "--bag", str(out),
+                     "--follow", *(["--ros1"] if ros == 1 else [])]) == 0
+        connection, (goal,) = _read_all(out)
+        assert connection.msgtype == ("control_msgs/action/FollowJointTrajectory_Goal" if ros == 2
+                                      else "control_msgs/msg/FollowJointTrajectoryGoal")
+        assert list(goal.trajectory.joint_names) == names and len(goal.path_tolerance) == 0
+        np.testing.assert_allclose([p.positions for p in goal.trajectory.points], joints[:, 1:7], atol=1e-12)
 
 
-def test_a_bag_without_the_topic_of_a_foreign_type_or_out_of_order_says_what_it_holds(tmp_path, capsys):
+def test_a_bag_with_receive_jitter_fits_the_model_of_its_csv_and_real_jumps_back_are_refused(tmp_path, capsys):
+    """Issue 35.4: messages received 0-4 ms after their stamps, and 0-9 ms (then out of receive
+    order: transport jitter), are put in the order of their stamps: the same model as the CSV of
+    the same samples; two messages with one stamp, or a
+    stamp 0.5 s back (a clock reset), are refused in one line that lists the bag."""
     rng = np.random.default_rng(4)
     stamps, poses = _stamps(rng), _poses(rng)
     store = get_typestore(Stores.ROS2_HUMBLE)
-    shuffled = _pose_messages(store, stamps, poses, 2)
-    shuffled[10], shuffled[11] = (shuffled[10][0], shuffled[11][1]), (shuffled[11][0], shuffled[10][1])  # stamps swapped
-    _write(tmp_path / "b", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", shuffled),
+    messages = _pose_messages(store, stamps, poses, 2)
+    _csv(tmp_path / "j.csv", stamps, ["x", "y", "z", "qx", "qy", "qz", "qw"], poses)
+    from_csv = _fit(tmp_path, tmp_path / "j.csv")
+    for delay_ms in (4, 9):
+        received = stamps + rng.integers(0, delay_ms * 1_000_000 + 1, N)
+        order = np.argsort(received, kind="stable")
+        assert (delay_ms == 9) == bool(np.any(order != np.arange(N)))  # 9 ms: really out of order
+        _write(tmp_path / f"j{delay_ms}", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped",
+                                               [(received[i] - RECEIVED_LATE_NS, messages[i][1]) for i in order])])
+        from_bag = _fit(tmp_path, tmp_path / f"j{delay_ms}")
+        for part in ("position_", "orientation_"):
+            np.testing.assert_allclose(getattr(from_bag, part).weights_, getattr(from_csv, part).weights_, atol=1e-9, rtol=0)
+    repeated = list(messages)
+    repeated[11] = (stamps[11], _pose_messages(store, [stamps[10]], poses[11:12], 2)[0][1])  # stamped as message 10
+    back = list(messages)
+    back[100] = (stamps[100], _pose_messages(store, [stamps[100] - 500_000_000], poses[100:101], 2)[0][1])
+    capsys.readouterr()
+    for name, bag, expected in (("r", repeated, "repeat: two messages stamped"), ("b", back, "jump back in time")):
+        _write(tmp_path / name, 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", bag),
+                                    ("/log", "std_msgs/msg/String", [(stamps[0], store.types["std_msgs/msg/String"](data="x"))])])
+        assert main(["fit", str(tmp_path / name), "-o", str(tmp_path / "m.npz"), "--topic", "/ee_pose"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and expected in err[0] and "/ee_pose (geometry_msgs/msg/PoseStamped, 240 messages)" in err[0]
+
+
+def test_a_bag_without_the_topic_or_of_a_foreign_type_says_what_it_holds(tmp_path, capsys):
+    rng = np.random.default_rng(4)
+    stamps, poses = _stamps(rng), _poses(rng)
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    _write(tmp_path / "b", 2, [("/ee_pose", "geometry_msgs/msg/PoseStamped", _pose_messages(store, stamps, poses, 2)),
                                ("/log", "std_msgs/msg/String", [(stamps[0], store.types["std_msgs/msg/String"](data="x"))])])
-    for options, expected in ((["--topic", "/nope"], "topic '/nope' is not in the bag"), (["--topic", "/log"], "does not read"),
-                              (["--topic", "/ee_pose"], "do not increase")):
+    for options, expected in ((["--topic", "/nope"], "topic '/nope' is not in the bag"), (["--topic", "/log"], "does not read")):
         assert main(["fit", str(tmp_path / "b"), "-o", str(tmp_path / "m.npz"), *options]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and expected in err[0] and "/ee_pose (geometry_msgs/msg/PoseStamped, 240 messages)" in err[0]

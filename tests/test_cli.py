@@ -27,7 +27,7 @@ def demo_csv(tmp_path):
 
 def test_fit_then_rollout_round_trip(tmp_path, demo_csv, capsys):
     model = tmp_path / "model.npz"
-    code, out, err = run(["fit", str(demo_csv), "-o", str(model), "--alpha", "100", "--protocol", "paper"], capsys)
+    code, out, err = run(["fit", str(demo_csv), "-o", str(model), "--alpha", "100", "--protocol", "paper", "--no-time"], capsys)
     assert code == 0 and err == ""
     assert "T = 200" in out and "end-point gain" in out and model.is_file()
     dmp = bidmp.load(model)
@@ -127,8 +127,8 @@ def test_reproduce_table4_runs_the_three_case_studies(tmp_path, capsys):
         (["fit", "{tmp}/missing.csv", "-o", "{tmp}/m.npz"], "does not exist"),
         (["fit", "{tmp}/bad.csv", "-o", "{tmp}/m.npz"], "line 3, column 2: 'oops' is not a number"),
         (["fit", "{tmp}/nan.csv", "-o", "{tmp}/m.npz"], "contains NaN"),
-        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/m.npz", "--n-kernels", "0"], "n_kernels must be >= 1"),
-        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/no/such/dir/m.npz"], "does not exist"),
+        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/m.npz", "--n-kernels", "0", "--no-time"], "n_kernels must be >= 1"),
+        (["fit", "{tmp}/demo.csv", "-o", "{tmp}/no/such/dir/m.npz", "--no-time"], "does not exist"),
         (["rollout", "{tmp}/corrupt.npz", "-o", "{tmp}/o.csv"], "not a readable bidmp model file"),
         (["rollout", "{tmp}/model.npz", "--goal", "1", "2", "-o", "{tmp}/o.csv"], "goal must have 3 coordinate"),
         (["rollout", "{tmp}/model.npz", "-o", "{tmp}/o.txt"], "unsupported file type .txt"),
@@ -189,7 +189,7 @@ def battery_files(tmp_path, capsys):
 
     demo = save_trajectory(minimum_jerk(BATTERY_APPROACH_VIA, 200), tmp_path / "approach.csv")
     model = tmp_path / "approach.npz"
-    assert main(["fit", str(demo), "-o", str(model), "--alpha", "100"]) == 0
+    assert main(["fit", str(demo), "-o", str(model), "--alpha", "100", "--no-time"]) == 0
     capsys.readouterr()
     return demo, model
 
@@ -290,7 +290,7 @@ def test_extension_commands_reject_bad_input(tmp_path, battery_files, argv, matc
 
 def test_fit_tau_makes_rollouts_slower_in_real_time(tmp_path, demo_csv, capsys):
     for tau in ("1", "2"):
-        assert main(["fit", str(demo_csv), "-o", str(tmp_path / f"m{tau}.npz"), "--tau", tau]) == 0
+        assert main(["fit", str(demo_csv), "-o", str(tmp_path / f"m{tau}.npz"), "--tau", tau, "--no-time"]) == 0
         assert main(["rollout", str(tmp_path / f"m{tau}.npz"), "-o", str(tmp_path / f"r{tau}.csv")]) == 0
     capsys.readouterr()
     one = np.loadtxt(tmp_path / "r1.csv", delimiter=",", skiprows=1)[:, :4]
@@ -370,7 +370,8 @@ def test_units_are_a_known_set_checked_against_the_model_and_converted_on_reques
     assert code == 0 and "converted from m (declared in the file) to mm" in out
     assert bidmp.load(tmp_path / "y.npz").skill_goals_[1] == pytest.approx(y[-1], abs=1.0)  # learned in mm
     code, out, err = run(["rollout", str(tmp_path / "m.npz"), "--goal", "150", "20", "0", "-o", str(tmp_path / "g.csv")], capsys)
-    assert code == 0 and "beyond any robot's reach" in err and "is it in cm or mm?" in err
+    assert code == 2 and "beyond any robot's reach" in err and "is it in cm or mm?" in err  # refused, not warned
+    assert not (tmp_path / "g.csv").exists()
     code, _, err = run(["extend", str(tmp_path / "m.npz"), str(in_metres), "--target", "0.1", "0.1", "0",
                         "--scene", "nut-unscrewing", "-o", str(tmp_path / "z.npz")], capsys)
     assert code == 2 and "the scene of nut-unscrewing is in mm but the model is in m" in err
@@ -391,8 +392,10 @@ def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
     assert "dropped 1 sample(s) whose timestamp repeats" in err
     expected = bidmp.prepare(y, bidmp.datasets.recording("operator2_nut5")[1])[0].y[-1]  # the file without a dropped sample
     np.testing.assert_allclose(bidmp.load(tmp_path / "m.npz").goal_, expected, atol=0.1)
+    # Without the mapping, stamp is the time and the other columns read as a joint recording,
+    # whose speed (3.4 "rad/s" of millimetres) no arm's joints reach: refused, naming --columns.
     code, _, err = run(["fit", str(path), "-o", str(tmp_path / "m.npz")], capsys)
-    assert code == 2 and "names no positions" in err and "--columns" in err
+    assert code == 2 and "read as joints (ee_z, grip, ee_x, ee_y)" in err and "--columns" in err
 
 
 def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys):

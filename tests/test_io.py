@@ -67,7 +67,7 @@ def test_trajectory_round_trip_is_exact(tmp_path, suffix):
         ("nan.csv", "x,y\n0,0\nnan,1\n2,2\n", "NaN"),
         ("short.csv", "x,y\n0,0\n1,1\n", "at least 3 points"),
         ("same.csv", "x,y\n1,1\n1,1\n1,1\n", "identical"),
-        ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b names no positions.*--columns"),
+        ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b names no motion.*--columns"),
         ("onecol.csv", "1\n2\n3\n", "expected 2-4 columns"),
         ("time.csv", "t,x,y\n0,0,0\n1,1,1\n0.5,2,2\n", "must increase strictly: timestamp going back at sample 2"),
         ("demo.json", "{}", "unsupported file type .json"),

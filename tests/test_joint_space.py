@@ -74,7 +74,7 @@ def test_a_joint_recording_is_in_radians_and_refuses_a_length_unit(tmp_path, cap
 
     assert load_model(tmp_path / "j.npz").units_ == "rad"
     assert main(["fit", str(tmp_path / "j.csv"), "-o", str(tmp_path / "k.npz"), "--raw", "--units", "mm"]) == 2
-    assert "joint angles are not lengths" in capsys.readouterr().err
+    assert "its columns read as joints" in capsys.readouterr().err  # and how to say they are positions
 
 
 def _fk(q, robot):

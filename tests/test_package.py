@@ -32,7 +32,7 @@ def test_import_and_cli_help_do_not_import_numpy():
 # here, not in 3: figures are data out, like files, and evaluation reports draw them; it imports
 # only the math and io); 3: the application; 4: the shell.
 LAYERS = {
-    "_checks": 0, "_threads": 0, "_noise": 0, "_trajectory": 0, "_units": 0, "_lazy": 0, "_state": 0, "_old_paths": 0, "_api": 0,
+    "_checks": 0, "_progress": 0, "_threads": 0, "_noise": 0, "_trajectory": 0, "_units": 0, "_lazy": 0, "_state": 0, "_old_paths": 0, "_api": 0,
     "primitives": 1, "extension": 1, "incremental": 1, "baselines": 1, "scene": 1,
     "demonstrations": 2, "io": 2, "tasks": 2, "plotting": 2,
     "sim": 3, "experiments": 3,

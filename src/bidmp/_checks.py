@@ -22,6 +22,7 @@ from numbers import Integral, Real
 import numpy as np
 
 __all__ = [
+    "check_names",
     "printable",
     "as_rotation",
     "as_labels",
@@ -392,6 +393,23 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
         raise TypeError(f"{name} must be an integer or a numpy.random.Generator (None would make results irreproducible)")
     seed = check_int(seed, name, minimum=0, maximum=2**128 - 1)
     return np.random.default_rng(seed)
+
+
+def check_names(names, count: int, name: str = "names") -> list[str]:
+    """``count`` distinct, non-empty names of at most 256 printable characters (the names of a
+    model's dimensions: a joint recording's joint names); ``[]`` for None."""
+    if names is None:
+        return []
+    if isinstance(names, str) or not isinstance(names, (list, tuple)):
+        raise TypeError(f"{name} must be a list of {count} names (text), got {type(names).__name__}")
+    if len(names) != count:
+        raise ValueError(f"{name} must name the {count} dimension(s), one each; got {len(names)} name(s)")
+    for entry in names:
+        if not isinstance(entry, str) or not entry.strip() or len(entry) > 256 or not entry.isprintable():
+            raise ValueError(f"{name}: each name must be printable text of 1-256 characters, got {short_token(entry, 30)}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"{name}: two dimensions have the same name")
+    return [str(entry) for entry in names]
 
 
 def check_choice(value, name: str, choices: Iterable[str]) -> str:

@@ -3,9 +3,9 @@
 A model keeps the unit its demonstration was in (``units_``). bidmp knows the lengths ``m``, ``cm``
 and ``mm``, and ``rad`` for joint angles (a joint-space model's), "" when not given; anything else
 is refused, so that a typo never becomes a unit. Numbers are
-converted only where the user asks (a file declaring one unit read into another), and a goal or
-a scene implausibly far for a robot in the model's unit is reported (a millimetre goal given to a
-metre model is 1000 times too far).
+converted only where the user asks (a file declaring one unit read into another), and a goal
+implausibly far for a robot in the model's unit, or a motion implausibly fast or slow, is refused
+(a millimetre goal given to a metre model is 1000 times too far).
 """
 
 from __future__ import annotations
@@ -14,13 +14,17 @@ import logging
 
 import numpy as np
 
-__all__ = ["UNITS", "ANGLE_UNITS", "check_units", "conversion", "check_reach", "REACH_M"]
+__all__ = ["UNITS", "ANGLE_UNITS", "check_units", "conversion", "check_reach", "check_speed", "REACH_M", "PLAUSIBLE_SPEED"]
 
 logger = logging.getLogger(__name__)
 
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}  # metres per unit
 ANGLE_UNITS = ("rad",)  # joint angles: not converted into or out of a length
 REACH_M = 5.0  # no robot arm reaches further than this (m): a larger distance is a unit mistake
+# The peak speed of a motion a robot is taught or runs, per unit: (slowest, fastest). A hand-guided
+# demonstration peaks at centimetres to a metre per second; no arm moves its tool at 10 m/s or a
+# joint at 10 rad/s, and one that never passes 1 mm/s (or 0.001 rad/s) is a number in another unit.
+PLAUSIBLE_SPEED = {"m": (1e-3, 10.0), "rad": (1e-3, 10.0)}
 
 
 def check_units(units, name: str = "units") -> str:
@@ -51,16 +55,56 @@ def conversion(source: str, target: str) -> float:
     return UNITS[source] / UNITS[target]
 
 
-def check_reach(distance: float, units: str, what: str) -> bool:
-    """Log a warning (and return False) if ``distance`` (in ``units``) is beyond any robot's
-    reach, as a number in the wrong unit is; True otherwise. Unknown units are not judged."""
+def check_reach(distance: float, units: str, what: str) -> None:
+    """Refuse ``distance`` (in ``units``) beyond any robot's reach, as a number in another unit
+    is (a goal in mm given to a metre model is 1000 times too far). Unknown units are not judged.
+
+    Raises
+    ------
+    ValueError
+        Naming ``what``, the distance and the units in which it would be within reach.
+    """
     units = check_units(units)
     if not units or units in ANGLE_UNITS or not np.isfinite(distance):
-        return True
-    metres = distance * UNITS[units]
-    if metres <= REACH_M:
-        return True
+        return
+    if distance * UNITS[units] <= REACH_M:
+        return
     within = [unit for unit in UNITS if unit != units and distance * UNITS[unit] <= REACH_M]
-    hint = f": is it in {' or '.join(within)}?" if within else ""
-    logger.warning("%s is %.4g %s away, beyond any robot's reach (%g m)%s", what, distance, units, REACH_M, hint)
-    return False
+    hint = f"; is it in {' or '.join(within)}? Give it in {units}, the model's unit" if within else ""
+    raise ValueError(f"{what} is {distance:.4g} {units} away, beyond any robot's reach ({REACH_M:g} m){hint}")
+
+
+def check_speed(peak_speed: float, units: str, what: str, *, fast_only: bool = False) -> None:
+    """Refuse a peak speed (``units``/s) no robot moves at, as numbers in another unit give:
+    metre data declared as mm peaks at a fraction of a mm/s, millimetre data declared as m at
+    hundreds of m/s. Unknown units are not judged (:data:`PLAUSIBLE_SPEED`). ``fast_only``: judge
+    only the upper bound (a generated motion to a goal near its start may be as slow as it likes).
+
+    Raises
+    ------
+    ValueError
+        Naming ``what``, the speed and the unit that would make it plausible.
+    """
+    units = check_units(units)
+    if not units or not np.isfinite(peak_speed):
+        return
+    if units in ANGLE_UNITS:
+        slowest, fastest = PLAUSIBLE_SPEED["rad"]
+        slowest = 0.0 if fast_only else slowest
+        if slowest <= peak_speed <= fastest:
+            return
+        hint = (f"; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians"
+                if peak_speed > fastest and np.radians(peak_speed) <= fastest else "")
+        raise ValueError(f"{what} peaks at {peak_speed:.4g} rad/s, {'faster' if peak_speed > fastest else 'slower'} than "
+                         f"any robot's joint moves ({slowest:g} to {fastest:g} rad/s){hint}")
+    slowest, fastest = PLAUSIBLE_SPEED["m"]
+    slowest = 0.0 if fast_only else slowest
+    if slowest <= peak_speed * UNITS[units] <= fastest:
+        return
+    plausible = [unit for unit in UNITS if slowest <= peak_speed * UNITS[unit] <= fastest]
+    plausible.sort(key=lambda unit: abs(np.log(peak_speed * UNITS[unit] / 0.25)))  # nearest a hand-guided motion's
+    hint = (f"; in {plausible[0]} it would be {peak_speed * UNITS[plausible[0]]:.3g} m/s: is it in {plausible[0]}? "
+            f"(--units {plausible[0]}, or declare '# units: {plausible[0]}' in the file)" if plausible else "")
+    raise ValueError(f"{what} peaks at {peak_speed:.4g} {units}/s = {peak_speed * UNITS[units]:.4g} m/s, "
+                     f"{'faster' if peak_speed * UNITS[units] > fastest else 'slower'} than any robot moves its tool "
+                     f"({slowest * 1e3:g} mm/s to {fastest:g} m/s){hint}")

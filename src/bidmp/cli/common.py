@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 __all__ = ["EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_TARGETS_FAILED", "judged_methods", "EXIT_BROKEN_PIPE", "MAX_MESSAGE", "MAX_SEEDS", "Parser",
-           "parse_K", "allow_outside_files", "one_line", "split_names"]
+           "parse_K", "allow_outside_files", "one_line", "split_names", "progress_bars"]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -68,3 +68,40 @@ def judged_methods(methods) -> list:
 
     methods = list(methods)
     return [name for name in methods if get(name).repairs] or methods
+
+
+def progress_bars():
+    """A context in which the library's reported progress (:mod:`bidmp._progress`) shows as tqdm
+    bars on stderr, one per stage, when stderr is a terminal (tqdm's ``disable=None``)."""
+    from .._progress import reporting
+
+    class _Bars:
+        def __init__(self) -> None:
+            self.bars: dict = {}
+
+        def __call__(self, stage: str, done: int, total: int) -> None:
+            from tqdm import tqdm
+
+            bar = self.bars.get(stage)
+            if bar is None or bar.total != total or done < bar.n:  # a new round of the stage (another planning)
+                if bar is not None:
+                    bar.close()
+                bar = self.bars[stage] = tqdm(total=total, desc=stage, unit="step", disable=None, leave=False)
+            bar.update(done - bar.n)
+
+        def close(self) -> None:
+            for bar in self.bars.values():
+                bar.close()
+
+    import contextlib
+
+    @contextlib.contextmanager
+    def shown():
+        bars = _Bars()
+        try:
+            with reporting(bars):
+                yield
+        finally:
+            bars.close()
+
+    return shown()

@@ -4,14 +4,18 @@ the model's), preparation of timed input."""
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 _MODEL_EXTENT_RATIO = 20.0  # a demonstration this many times larger or smaller than the model's is in another unit
 
-TIMED_INPUT = ("A timed DEMO (a CSV t column in seconds, or a timed .npy) is prepared unless --raw: the idle start "
-               "and end are trimmed (speed below 5 % of the peak), the noise is removed by a zero-phase low-pass "
-               "filter (--cutoff, default 6 Hz) and the samples are resampled to uniform time. A CSV may declare its "
-               "unit in a first line '# units: mm'; --units converts it.")
+TIMED_INPUT = ("A DEMO's columns are read by their names, as robot loggers write them (t,x,y,z; UR RTDE timestamp "
+               "and actual_TCP_pose_0..5 or actual_q_0..5; ROS header.stamp and pose.position.x ...; t,<joint "
+               "names>); --columns decides where they do not. A timed DEMO (a time column in seconds, or a timed "
+               ".npy) is prepared unless --raw: the idle start and end are trimmed (speed below 5 % of the peak), "
+               "the noise is removed by a zero-phase low-pass filter (--cutoff, default 6 Hz) and the samples are "
+               "resampled to uniform time. A DEMO without a time column needs --no-time (its samples are then "
+               "taken as uniform over 1 s, the paper's convention). A CSV may declare its unit in a first line "
+               "'# units: mm'; --units converts it; a motion no robot makes in its unit (over 10 m/s, under 1 mm/s) "
+               "is refused, naming the unit that fits it.")
 
 
 def demo_options(parser: argparse.ArgumentParser) -> None:
@@ -19,8 +23,12 @@ def demo_options(parser: argparse.ArgumentParser) -> None:
                         help="length unit (m, cm, mm): of the demonstration, or the one to convert a file that declares "
                              "another to")
     parser.add_argument("--columns", default=None, metavar="MAP",
-                        help="which CSV columns are time and positions, e.g. t=timestamp,x=ee_x,y=ee_y,z=ee_z "
-                             "(and qx,qy,qz,qw for poses); other columns are ignored")
+                        help="which CSV columns are time and the motion: single columns (t=timestamp,x=ee_x,y=ee_y,"
+                             "z=ee_z; qx,qy,qz,qw or rx,ry,rz for poses) or a group by prefix (pose=actual_TCP_pose, "
+                             "position=actual_TCP_pose, joints=actual_q); other columns are ignored")
+    parser.add_argument("--no-time", action="store_true",
+                        help="take the DEMO's samples as uniform over 1 s, the paper's convention (needed for a file without "
+                             "a time column; a time column is then not used)")
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--prepare", action="store_true", help="prepare timed input: trim idle ends, filter, uniform time (the default)")
     mode.add_argument("--raw", action="store_true", help="use a timed demonstration as recorded (no trimming or filtering)")
@@ -53,20 +61,15 @@ def bag_recording(args: argparse.Namespace):
 
 
 # -- input ------------------------------------------------------------------------------------------
-def is_pose_file(path) -> bool:
-    """Whether ``path`` is a CSV whose header names a pose (``...,qx,qy,qz,qw``)."""
-    if not str(path).lower().endswith((".csv", ".txt")) or not Path(path).is_file():
-        return False  # (a FIFO or a device is refused by the reader, never opened here: it would block)
-    try:
-        with open(path, encoding="utf-8-sig") as handle:
-            for _ in range(16):
-                header = handle.readline(4096)
-                if not header.lstrip().startswith("#"):
-                    break
-    except OSError:
-        return False
-    names = {name.strip().lower() for name in header.replace(";", ",").split(",")}
-    return {"qx", "qy", "qz", "qw"} <= names
+def demo_kind(args: argparse.Namespace) -> str:
+    """What ``args.demo`` holds: "positions", "pose" or "joints" (a bag by its messages, a CSV by
+    its header and --columns; "" when only reading it can tell)."""
+    from ..io.recordings import recording_kind
+
+    bag = bag_recording(args)
+    if bag is not None:
+        return bag.kind
+    return recording_kind(args.demo, columns=getattr(args, "columns", None))
 
 
 def model_dmp(model):
@@ -106,27 +109,33 @@ def _match_units(path, positions, units: str, model, what: str) -> str:
     return model_units
 
 
-def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, model=None, what: str = ""):
+def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, model=None, what: str = "",
+               timed: bool = False):
     """A demonstration file as the library wants it: ``(values, t or None, units, how)``.
 
     Positions (T, D) or poses (T, 7), in ``--units`` (converted from the file's declared unit if
     it has another), checked against ``model``'s units; timed input prepared unless ``--raw``.
+    ``timed`` (``bidmp fit``: the model keeps the duration): a file without a time column is
+    refused unless ``--no-time``. A motion implausibly fast or slow for a robot in its unit is
+    refused.
     """
     from .._units import check_units, conversion
-    from ..io.trajectories import declared_units, is_joint_recording, read_trajectory
-    from ..io.poses import read_poses
+    from ..io.recordings import read_recording
 
     requested = check_units(args.units or "", "--units")
     bag = bag_recording(args) if path == getattr(args, "demo", None) else None
-    if bag is not None:  # header stamps; metres (poses) or radians (joints: no length unit)
-        if (bag.kind == "pose") != poses:
-            raise ValueError(f"{path}: {bag.source} holds {'poses' if bag.kind == 'pose' else 'joint states'}")
-        values, times, declared = bag.values, bag.t, ("m" if bag.kind == "pose" else "rad")
-    else:
-        values, times = (read_poses if poses else read_trajectory)(path, columns=args.columns)
-        declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
-        if not declared and not poses and is_joint_recording(path):  # t,<joint names>: angles in radians
-            declared = "rad"
+    recording = bag if bag is not None else read_recording(path, columns=args.columns)
+    if (recording.kind == "pose") != poses:
+        raise ValueError(f"{path}: {recording.source} holds {'poses' if recording.kind == 'pose' else recording.kind}"
+                         + ("; pick its positions with --columns (e.g. position=<prefix> or x=..,y=..,z=..)"
+                            if recording.kind == "pose" else ""))
+    values, times, declared = recording.values, recording.t, recording.units
+    if recording.kind == "joints" and requested and requested != declared and declared == "rad":
+        raise ValueError(f"{path}: its columns read as joints ({', '.join(recording.names[:8])}: t,<joint names>), in "
+                         f"radians, but --units says {requested}; if they are positions, name them with --columns "
+                         f"(e.g. t=stamp,x=..,y=..,z=..)")
+    if timed:
+        times = _time_option(path, times, args, recording)
     notes = []
     if declared and requested and declared != requested:
         values = values.copy()
@@ -135,22 +144,70 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     units = requested or declared
     if model is not None:
         units = _match_units(path, values[:, :3] if poses else values, units, model, what)
+    peak = None
     if times is None or args.raw:
         how = "as recorded" if times is None else f"as recorded ({times[-1] - times[0]:.3f} s)"
+        peak = None if times is None else _peak_speed(values[:, :3] if poses else values, times)
     elif poses:
         from ..demonstrations.prepare import prepare_poses
 
         values, times, info = prepare_poses(values, times, cutoff_hz=args.cutoff, units=units)
+        peak = _peak_speed(values[:, :3], times)
         how = (f"prepared: {info.rate_hz:.4g} Hz, low-pass {info.cutoff_hz:g} Hz, motion {info.start_s:.3g}-"
                f"{info.end_s:.3g} s of the recording")
     else:
         from ..demonstrations.prepare import prepare
 
         prepared, info = prepare(values, times, cutoff_hz=args.cutoff, units=units)
-        values, times = prepared.y, prepared.t
+        values, times, peak = prepared.y, prepared.t, info.peak_speed
         how = (f"prepared: kept {info.start_s:.2f}-{info.end_s:.2f} s, low-pass {info.cutoff_hz:g} Hz at "
                f"{info.rate_hz:.1f} Hz, peak speed {info.peak_speed:.4g} {units or 'units'}/s")
+    if peak is not None:
+        _check_speed(peak, units, path, recording)
+    if recording.source and not recording.source.startswith(("columns", "an .npy", "x,y", "t,<joint")):
+        notes.append(f"read {recording.source}")
+    if recording.kind == "joints" and recording.names:
+        args.joint_names = list(recording.names)
     return values, times, units, "; ".join([how, *notes])
+
+
+def _time_option(path, times, args: argparse.Namespace, recording):
+    """The stamps, or None with ``--no-time`` (the samples then uniform over 1 s, whatever the
+    file's stamps); a file without stamps needs ``--no-time``."""
+    no_time = getattr(args, "no_time", False)
+    if times is None and not no_time:
+        others = f"; its other columns: {', '.join(recording.ignored[:6])}" if recording.ignored else ""
+        raise ValueError(f"{path} has no time column ({recording.source}{others}), so its duration is unknown: name the time column with "
+                         f"--columns t=NAME, or pass --no-time to take its samples as uniform over 1 s (the paper's "
+                         f"convention)")
+    return None if no_time else times
+
+
+def _peak_speed(values, times) -> float:
+    """A raw recording's peak speed: the 99th percentile on uniform time (the noise of one sample
+    or a jittered stamp is no robot's speed)."""
+    import numpy as np
+
+    from ..primitives.timing import uniform_time
+
+    if len(times) < 3:
+        return float("nan")
+    uniform, grid = uniform_time(values, times)
+    return float(np.percentile(np.linalg.norm(np.gradient(uniform, grid, axis=0), axis=1), 99))
+
+
+def _check_speed(peak: float, units: str, path, recording) -> None:
+    """Refuse a motion no robot makes in ``units``; for columns read as joints, say how to name
+    them if they are not."""
+    from .._units import check_speed
+
+    try:
+        check_speed(peak, units, f"{path}: the demonstration")
+    except ValueError as exc:
+        if recording.kind != "joints" or not recording.names:
+            raise
+        raise ValueError(f"{exc}; its columns were read as joints ({', '.join(recording.names[:6])}): if they are "
+                         f"positions, name them with --columns (t=..,x=..,y=..,z=..)") from None
 
 
 def scene_option(args: argparse.Namespace, units: str):

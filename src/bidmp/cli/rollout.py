@@ -113,7 +113,12 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         index = model.select_skill(goals[-1] if args.goal is None and isinstance(model, BiDMP) else args.goal, skill)
         print(f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})")
     options.update(_rollout_extras(args, dmp, poses))
+    if not args.bag and (args.follow or args.orientation is not None or args.bag_topic is not None or args.stamp != "now"):
+        raise ValueError("--follow, --orientation, --bag-topic and --stamp shape the bag: give --bag OUT")
     trajectory = model.trajectory(**options)
+    from .._units import check_speed
+
+    check_speed(trajectory.peak_speed(), dmp.units_, "the rolled-out motion", fast_only=True)  # never write what no robot runs
     path = (save_poses if poses else save_trajectory)(trajectory, args.output)
     unit = dmp.units_ or "units"
     rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
@@ -185,7 +190,21 @@ def _arm(args: argparse.Namespace, metres_per_unit: float) -> dict:
     return {"robot": robot_model(scenario.robot, scenario.base_dir), "base": base * scale, "yaw": yaw, "tool_length": tool}
 
 
-def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
+def _bag_options(args: argparse.Namespace) -> dict:
+    """write_bag keywords of --bag-topic, --frame, --stamp, --ros1."""
+    from ..io.bags import start_stamp
+
+    return {"topic": args.bag_topic, "frame_id": args.frame, "origin": start_stamp(args.stamp), "ros": 1 if args.ros1 else 2}
+
+
+def _stamped(options: dict) -> str:
+    import datetime
+
+    moment = datetime.datetime.fromtimestamp(options["origin"], datetime.timezone.utc)
+    return f"stamped from {moment.isoformat(timespec='milliseconds').replace('+00:00', 'Z')}, frame {options['frame_id']}"
+
+
+def _ik_bag(args: argparse.Namespace, trajectory, dmp) -> str:
     """A position model's motion as the robot's JointTrajectory: inverse kinematics at every
     sample (tool pointing down; the robot at --base, turned by --yaw, in the model's frame)."""
     import numpy as np
@@ -200,34 +219,59 @@ def _ik_bag(args: argparse.Namespace, trajectory, dmp, ros: int) -> str:
     arm = _arm(args, scale)
     joints = inverse_kinematics(trajectory.y * scale, units="m", **arm)
     velocities = np.gradient(joints, trajectory.t, axis=0)
-    path = write_bag(args.bag, trajectory.t, joints, kind="joints", names=joint_names(arm["robot"]), velocities=velocities,
-                     accelerations=np.gradient(velocities, trajectory.t, axis=0), frame_id=args.frame, ros=ros)
+    options = _bag_options(args)
+    kind = "follow" if args.follow else "joints"
+    path = write_bag(args.bag, trajectory.t, joints, kind=kind, names=joint_names(arm["robot"]), velocities=velocities,
+                     accelerations=np.gradient(velocities, trajectory.t, axis=0), **options)
     name = arm["robot"] if isinstance(arm["robot"], str) else arm["robot"].name
-    return f"{path} (trajectory_msgs/JointTrajectory of the {name} after inverse kinematics, {len(trajectory)} points)"
+    return f"{path} ({_joint_message(kind, options)} of the {name} after inverse kinematics, {len(trajectory)} points, {_stamped(options)})"
+
+
+def _joint_message(kind: str, options: dict) -> str:
+    from ..io.bags import FOLLOW_JOINT_TRAJECTORY, JOINT_TRAJECTORY
+
+    msgtype = FOLLOW_JOINT_TRAJECTORY[options["ros"]] if kind == "follow" else JOINT_TRAJECTORY
+    topic = options["topic"] or ("/bidmp/follow_joint_trajectory/goal" if kind == "follow" else "/bidmp/joint_trajectory")
+    return f"{msgtype.replace('/msg/', '/')} on {topic}"
 
 
 def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
-    """``--bag OUT``: the motion as a PoseStamped stream in metres (position and pose models), as
-    the robot's JointTrajectory after IK (position models with --robot) or a JointTrajectory
-    (joint-space models: more than 3 dimensions), ROS 2 MCAP or ``--ros1``."""
+    """``--bag OUT``: the motion as a PoseStamped stream in metres (pose models; position models
+    with --orientation, the orientation held), a PointStamped stream (position models without it:
+    no orientation is made up), the robot's JointTrajectory after IK (position models with
+    --robot), or a JointTrajectory (joint-space models, their joint names); --follow: a
+    FollowJointTrajectory goal instead of the JointTrajectory. ROS 2 MCAP or ``--ros1``."""
     import numpy as np
 
     from .._units import conversion
     from ..io.bags import write_bag
 
-    ros = 1 if args.ros1 else 2
     if args.robot_given and not poses and dmp.n_dims_ == 3:
-        return _ik_bag(args, trajectory, dmp, ros)
+        return _ik_bag(args, trajectory, dmp)
+    options = _bag_options(args)
     if poses or dmp.n_dims_ == 3:
+        if args.follow:
+            raise ValueError("--follow writes joint motions: a joint-space model, or --robot for a position model's joints")
         if not dmp.units_:
             raise ValueError("--bag: ROS poses are in metres and this model's length unit is not known; fit it with --units")
+        if poses and args.orientation is not None:
+            raise ValueError("--orientation is the held orientation of a position model; a pose model has its own")
         scale = conversion(dmp.units_, "m")
         values = trajectory.y * scale if not poses else np.hstack([trajectory.y * scale, trajectory.q])
-        path = write_bag(args.bag, trajectory.t, values, kind="pose", frame_id=args.frame, ros=ros)
-        return f"{path} (geometry_msgs/PoseStamped on /bidmp/pose, {len(trajectory)} messages, metres)"
-    path = write_bag(args.bag, trajectory.t, trajectory.y, kind="joints", velocities=trajectory.yd,
-                     accelerations=trajectory.ydd, frame_id=args.frame, ros=ros)
-    return f"{path} (trajectory_msgs/JointTrajectory on /bidmp/joint_trajectory, {len(trajectory)} points)"
+        path = write_bag(args.bag, trajectory.t, values, kind="pose", orientation=args.orientation, **options)
+        if poses:
+            what = "geometry_msgs/PoseStamped"
+        elif args.orientation is not None:
+            what = f"geometry_msgs/PoseStamped, orientation {args.orientation} held"
+        else:
+            what = "geometry_msgs/PointStamped: a position model has no orientation (--orientation QX QY QZ QW to hold one)"
+        topic = options["topic"] or ("/bidmp/pose" if poses or args.orientation is not None else "/bidmp/point")
+        return f"{path} ({what} on {topic}, {len(trajectory)} messages, metres, {_stamped(options)})"
+    kind = "follow" if args.follow else "joints"
+    path = write_bag(args.bag, trajectory.t, trajectory.y, kind=kind, velocities=trajectory.yd, names=list(trajectory.names) or None,
+                     accelerations=trajectory.ydd, **options)
+    named = f"joints {', '.join(trajectory.names)}" if trajectory.names else "joints unnamed: joint1 ..."
+    return f"{path} ({_joint_message(kind, options)}, {len(trajectory)} points, {named}, {_stamped(options)})"
 
 
 def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
@@ -302,9 +346,22 @@ def _add_rollout_arguments(rollout) -> None:
                          help="steer round the scene's parts (SceneAvoidance; default: on with --scene); a motion that "
                               "still comes closer than the margin is an error")
     rollout.add_argument("--bag", default=None, metavar="OUT",
-                         help="also write the motion to a ROS bag: PoseStamped in metres (a JointTrajectory for a "
-                              "joint-space model), a ROS 2 MCAP folder (--ros1: a .bag file)")
+                         help="also write the motion to a ROS bag: PoseStamped in metres (a position model: "
+                              "PointStamped, or PoseStamped with --orientation; a joint-space model: a JointTrajectory "
+                              "with its joint names), a ROS 2 MCAP folder (--ros1: a .bag file)")
     rollout.add_argument("--ros1", action="store_true", help="with --bag: write a ROS 1 .bag file")
     rollout.add_argument("--frame", default="base", metavar="FRAME", help="with --bag: the header's frame_id (default base)")
+    rollout.add_argument("--bag-topic", default=None, metavar="TOPIC",
+                         help="with --bag: the topic (default /bidmp/pose, /bidmp/point, /bidmp/joint_trajectory or "
+                              "/bidmp/follow_joint_trajectory/goal)")
+    rollout.add_argument("--stamp", default="now", metavar="now|SECONDS|ISO",
+                         help="with --bag: the first header stamp: now (default), seconds since the epoch, or an ISO "
+                              "8601 time such as 2026-12-03T14:00:00Z")
+    rollout.add_argument("--orientation", type=float, nargs=4, default=None, metavar=("QX", "QY", "QZ", "QW"),
+                         help="with --bag, a position model: the tool's orientation, held throughout (PoseStamped); "
+                              "without it a PointStamped stream (no orientation is made up)")
+    rollout.add_argument("--follow", action="store_true",
+                         help="with --bag, joint motions: a control_msgs/FollowJointTrajectory goal (what a ROS 2 "
+                              "joint trajectory controller takes) instead of a trajectory_msgs/JointTrajectory")
     rollout.add_argument("--target-label", default=None, metavar="LABEL",
                          help="the scene's target the goal is (its parts are not avoided; default: what the tool takes in at the goal)")

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import argparse
 
-from .inputs import TIMED_INPUT, bag_options, bag_recording, demo_options, is_pose_file, model_dmp, read_input, scene_option
+from .common import progress_bars
+from .inputs import TIMED_INPUT, bag_options, demo_kind, demo_options, model_dmp, read_input, scene_option
 from .rollout import _add_rollout_arguments, cmd_rollout
 
 EXIT_OK = 0
@@ -39,9 +40,10 @@ def _demo_for(model, args: argparse.Namespace):
     from ..incremental.cartesian import CartesianBiDMP
 
     poses = isinstance(model, CartesianBiDMP)
-    if poses and not is_pose_file(args.demo):
+    kind = demo_kind(args)
+    if poses and kind != "pose":
         raise ValueError(f"{args.model} holds a pose model; {args.demo} is not a pose file (a CSV header with qx,qy,qz,qw)")
-    if not poses and is_pose_file(args.demo):
+    if not poses and kind == "pose":
         raise ValueError(f"{args.demo} holds poses; {args.model} holds a position model: fit a pose model on it first")
     y, _, units, how = read_input(args.demo, args, poses=poses, model=model, what=args.model)
     if not poses and y.shape[1] != model.n_dims_:
@@ -64,11 +66,10 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
     from ..tasks.metrics import path_extent
 
-    bag = bag_recording(args)
-    if is_pose_file(args.demo) or (bag is not None and bag.kind == "pose"):
+    if demo_kind(args) == "pose":
         return _fit_poses(args)
-    demonstration, times, units, how = read_input(args.demo, args)
-    dmp = DMP(**_dmp_params(args)).fit(demonstration, times, units=units)
+    demonstration, times, units, how = read_input(args.demo, args, timed=True)
+    dmp = DMP(**_dmp_params(args)).fit(demonstration, times, units=units, names=getattr(args, "joint_names", None))
     path = save_model(dmp, args.output)
     reproduction = dmp.trajectory()
     reference = resample_time(demonstration, dmp.n_steps_)
@@ -79,7 +80,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     unit = dmp.units_ or "units"
     print(f"fitted a DMP ({dmp.protocol} protocol) on {args.demo}, {how}")
     print(f"  T = {dmp.n_steps_} samples over {dmp.duration_:.4g} s ({dmp.sample_rate_:.4g} Hz), D = {dmp.n_dims_}, "
-          f"units {dmp.units_ or '(not given)'}")
+          f"units {dmp.units_ or '(not given)'}" + (f", joints {', '.join(dmp.names_)}" if dmp.names_ else ""))
     print(f"  start {np.array2string(dmp.start_, precision=4)}  goal {np.array2string(dmp.goal_, precision=4)}")
     print(f"  reproduction RMSE {error:.4g} {unit} ({100 * error / extent:.3g} % of the extent {extent:.4g})")
     print(f"  rollouts last {reproduction.duration:.4g} s (tau = {dmp.tau:g}; peak speed {reproduction.peak_speed():.4g} {unit}/s, "
@@ -97,7 +98,7 @@ def _fit_poses(args: argparse.Namespace) -> int:
     from ..io.models import save_model
     from ..primitives.cartesian import CartesianDMP, angle_between
 
-    poses, times, units, how = read_input(args.demo, args, poses=True)
+    poses, times, units, how = read_input(args.demo, args, poses=True, timed=True)
     model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
     path = save_model(model, args.output)
     reproduction = model.rollout()[: len(poses)]
@@ -120,8 +121,9 @@ def cmd_segment(args: argparse.Namespace) -> int:
     from ..extension.segmentation import curvature, segment
     from ..tasks._tables import text_table
 
-    y, _, units, how = read_input(args.demo, args, poses=is_pose_file(args.demo))
-    y = y[:, :3] if is_pose_file(args.demo) else y
+    poses = demo_kind(args) == "pose"
+    y, _, units, how = read_input(args.demo, args, poses=poses)
+    y = y[:, :3] if poses else y
     result = segment(y, eps_frac=args.eps_frac, method=args.method)
     points, kinds = result.points, result.kinds
     s = arclength(y)
@@ -174,10 +176,12 @@ def cmd_extend(args: argparse.Namespace) -> int:
     if poses:
         if args.approach != "keep":
             raise ValueError("--approach paper is for positions; a pose extension keeps the approach")
-        extension = extend_pose_demonstration(y, _pose_target(args.target, y), seed=args.seed, scene=scene)
+        with progress_bars():
+            extension = extend_pose_demonstration(y, _pose_target(args.target, y), seed=args.seed, scene=scene)
         learned = extension.poses
     else:
-        extension = extend_demonstration(y, args.target, seed=args.seed, approach=args.approach, scene=scene)
+        with progress_bars():
+            extension = extend_demonstration(y, args.target, seed=args.seed, approach=args.approach, scene=scene)
         learned = extension.complete
     target = learned[-1]
     history = extension.similarity_history

@@ -37,6 +37,7 @@ from .._checks import (
     check_seed,
     numerically_guarded,
 )
+from .._progress import report
 from .._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
@@ -324,6 +325,7 @@ def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is
         history.append(similarity)
         paths.append(path)
         all_samples.append(samples)
+        report("G-PRM iterations", iteration, n_iter)
     history = np.asarray(history)
     chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
     return RoadmapResult(

@@ -30,10 +30,13 @@ _EXPORTS = {
     "save_poses": "poses",
     "atomic_write": "atomic",
     "load_json": "strict_json",
-    "BagRecording": "bags",
+    "Recording": "recordings",
+    "read_recording": "recordings",
+    "recording_kind": "recordings",
     "read_bag": "bags",
     "write_bag": "bags",
     "is_bag": "bags",
+    "start_stamp": "bags",
 }
 __all__ = list(_EXPORTS)
 # what the flat module bidmp.io of bidmp <= 0.4 held, for code written against it

@@ -1,42 +1,114 @@
-"""Which CSV columns are time, positions and quaternions: headers as loggers write them.
+"""Which CSV columns are time, positions, orientations and joints: headers as robot loggers write them.
 
-A header names its columns. Time is ``t``, ``time`` or ``timestamp`` (seconds); positions are
-``x, y[, z]``; quaternions ``qx, qy, qz, qw`` (in any order: the names say which is which). Other
-columns (a force, a gripper state, a joint) are ignored, and the reader says which. A *column
-mapping* names the file's own columns for the roles, ``{"t": "stamp", "x": "ee_x", …}``, or as
-the command line writes it, ``t=stamp,x=ee_x,y=ee_y,z=ee_z``.
+Recognised by name (case does not matter; ``/``, ``[ ]`` and ``.`` separate a field's parts alike):
+
+* **time** — ``t``, ``time``, ``timestamp``, ``stamp``, ``__time`` (PlotJuggler), ``%time``
+  (``rostopic echo -p``: nanoseconds), and header stamps: ``header.stamp`` (``field.header.stamp``:
+  nanoseconds) or ``header.stamp.sec`` with ``header.stamp.nanosec`` (``nsec``). A header stamp
+  is preferred over a receive time, as bags are read; two candidates of one kind are refused;
+* **positions** — ``x, y[, z]``; ROS exports ``<prefix>position.x/y/z`` or
+  ``<prefix>translation.x/y/z``;
+* **orientations** — ``qx, qy, qz, qw`` (any order) or a rotation vector ``rx, ry, rz`` (rad,
+  beside ``x, y, z``); ROS ``<prefix>orientation.x/y/z/w`` or ``rotation.x/y/z/w``; UR RTDE
+  ``actual_TCP_pose_0..5`` (and ``target_TCP_pose_…``): x, y, z in metres and a rotation vector;
+* **joints** — UR RTDE ``actual_q_0..`` / ``target_q_0..`` (rad), or a file ``t, <joint names>``
+  whose other columns are all joints.
+
+A file whose columns hold more than one motion (an RTDE log of the measured and the commanded
+pose and joints) is refused with the candidates listed and the ``columns`` that picks each; it
+is never guessed. A *column mapping* decides: roles ``t``, ``x``, ``y``, ``z``, ``qx``…``qw``,
+``rx``, ``ry``, ``rz`` name single columns, and ``pose=``, ``position=``, ``joints=`` a group by
+its prefix (``pose=actual_TCP_pose``, ``joints=actual_q``); as the command line writes it,
+``t=stamp,x=ee_x,y=ee_y,z=ee_z``. A mapping with only ``t`` fixes the time and leaves the rest
+to the names.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+
+import numpy as np
 
 from .._checks import short_token
 
-__all__ = ["TIME_NAMES", "parse_columns", "Selection", "select_positions", "select_poses", "select_joints"]
+__all__ = ["TIME_NAMES", "Layout", "parse_columns", "resolve", "times_in_seconds"]
 
-TIME_NAMES = ("t", "time", "timestamp")
+TIME_NAMES = ("t", "time", "timestamp", "stamp", "__time", "%time")
 _POSITION_ROLES = ("x", "y", "z")
 _QUATERNION_ROLES = ("qx", "qy", "qz", "qw")
-_POSE_ROLES = ("x", "y", "z", *_QUATERNION_ROLES)
+_ROTVEC_ROLES = ("rx", "ry", "rz")
+_SINGLE_ROLES = ("t", *_POSITION_ROLES, *_QUATERNION_ROLES, *_ROTVEC_ROLES)
+_GROUP_ROLES = ("pose", "position", "joints")
 _MAX_MAPPING = 16
+_RTDE_POSE = re.compile(r"^(.*tcp_pose)_([0-9]+)$")
+_RTDE_JOINTS = re.compile(r"^((?:actual|target)_q)_([0-9]+)$")
+_INDEXED = re.compile(r"^(.*?)[._]?([0-9]+)$")
+_TRANSLATIONS = (("position.", "orientation."), ("translation.", "rotation."))
 
 
 @dataclass(frozen=True)
-class Selection:
-    """Column indices of a header's roles: ``time`` (or None), ``values`` in role order
-    (``x, y[, z]`` or ``x, y, z, qx, qy, qz, qw``) and the names of the ignored columns."""
+class Layout:
+    """What a header's columns hold.
 
-    time: int | None
+    Attributes
+    ----------
+    kind : {"positions", "pose", "joints"}
+    time : tuple of int
+        The time column (one index), a header stamp's ``sec`` and ``nanosec`` columns (two), or
+        none.
+    time_divisor : float
+        Units of the time column per second (1e9 for nanosecond stamps; a division, so that a
+        stamp a float holds exactly in seconds comes out exact).
+    values : tuple of int
+        Positions ``x, y[, z]``; a pose's ``x, y, z`` and its rotation (``qx, qy, qz, qw`` or
+        ``rx, ry, rz``); or the joints, in order.
+    rotation : {"quaternion", "rotvec", None}
+    names : tuple of str
+        The file's own names of the value columns (a joint recording's joint names).
+    units : str
+        The unit the logger's convention fixes (metres for ROS and RTDE poses, radians for
+        joints), "" when the names say none.
+    label : str
+        What was read, for messages (``UR RTDE actual_TCP_pose_0..5``).
+    ignored : tuple of str
+        The other columns.
+    """
+
+    kind: str
+    time: tuple[int, ...]
+    time_divisor: float
     values: tuple[int, ...]
+    rotation: str | None
+    names: tuple[str, ...]
+    units: str
+    label: str
     ignored: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class _Candidate:
+    kind: str
+    values: tuple[int, ...]
+    rotation: str | None
+    units: str
+    label: str
+    pick: str  # the mapping that selects it
+
+
+def _key(name: str) -> str:
+    """A header name as compared: lower case, one separator (``.``), no ``field.`` prefix."""
+    key = re.sub(r"[/\[\]]", ".", name.strip().lower())
+    key = re.sub(r"\.+", ".", key).strip(".")
+    return key[len("field."):] if key.startswith("field.") else key
 
 
 def parse_columns(spec) -> dict[str, str] | None:
     """A column mapping from ``"t=stamp,x=ee_x,…"`` or a dict (roles to the file's names).
 
-    Roles: ``t``, ``x``, ``y``, ``z``, ``qx``, ``qy``, ``qz``, ``qw``. Names are matched without
-    regard to case.
+    Roles: ``t``, ``x``, ``y``, ``z``, ``qx``, ``qy``, ``qz``, ``qw``, ``rx``, ``ry``, ``rz``
+    (single columns) and ``pose``, ``position``, ``joints`` (a group by its prefix). Names are
+    matched without regard to case.
     """
     if spec is None:
         return None
@@ -48,64 +120,259 @@ def parse_columns(spec) -> dict[str, str] | None:
     if not isinstance(spec, dict):
         raise TypeError(f"columns must be a dict or a role=name,... string, got {type(spec).__name__}")
     if len(spec) > _MAX_MAPPING:
-        raise ValueError(f"columns names {len(spec)} roles; there are at most {len(_POSE_ROLES) + 1}")
+        raise ValueError(f"columns names {len(spec)} roles; there are at most {len(_SINGLE_ROLES)}")
     mapping = {}
     for role, name in spec.items():
-        if role not in ("t", *_POSE_ROLES):
-            raise ValueError(f"columns: unknown role {short_token(role)}; roles are t, x, y, z, qx, qy, qz, qw")
+        if role not in (*_SINGLE_ROLES, *_GROUP_ROLES):
+            raise ValueError(f"columns: unknown role {short_token(role)}; roles are {', '.join(_SINGLE_ROLES)} "
+                             f"and the groups {', '.join(_GROUP_ROLES)}")
         if not isinstance(name, str) or not name:
             raise ValueError(f"columns: role {role} needs a column name")
-        mapping[role] = name.lower()
+        mapping[role] = _key(name)
     if len(set(mapping.values())) != len(mapping):
         raise ValueError("columns: two roles name the same column")
+    groups = [role for role in _GROUP_ROLES if role in mapping]
+    singles = [role for role in mapping if role in _SINGLE_ROLES and role != "t"]
+    if len(groups) > 1 or (groups and singles):
+        raise ValueError(f"columns: give one group ({', '.join(_GROUP_ROLES)}) or single columns, not "
+                         f"{' and '.join(groups + singles[:1])}")
+    if "qx" in mapping or any(role in mapping for role in _QUATERNION_ROLES):
+        if not all(role in mapping for role in _QUATERNION_ROLES):
+            raise ValueError("columns: a quaternion needs all of qx, qy, qz, qw")
+    if any(role in mapping for role in _ROTVEC_ROLES) and not all(role in mapping for role in _ROTVEC_ROLES):
+        raise ValueError("columns: a rotation vector needs all of rx, ry, rz")
+    if "qw" in mapping and "rx" in mapping:
+        raise ValueError("columns: give a quaternion (qx..qw) or a rotation vector (rx, ry, rz), not both")
     return mapping
 
 
-def _index(header: tuple[str, ...], name: str, role: str, path) -> int:
-    if name not in header:
-        shown = ",".join(short_token(c, 12)[1:-1] for c in header[:10]) + (",…" if len(header) > 10 else "")
-        raise ValueError(f"{path}: no column {short_token(name, 20)} for {role} (the header has {shown})")
-    return header.index(name)
+def _shown(header, limit: int = 8) -> str:
+    return ",".join(short_token(c, 16)[1:-1] for c in header[:limit]) + (",…" if len(header) > limit else "")
 
 
-def _resolve(header: tuple[str, ...], roles: tuple[str, ...], mapping: dict | None, path, required: int) -> Selection:
-    if mapping is not None:
-        unknown = set(mapping) - {"t", *roles}
-        if unknown:
-            raise ValueError(f"columns: role {sorted(unknown)[0]} does not belong in this file (roles: t, {', '.join(roles)})")
-        time = _index(header, mapping["t"], "t", path) if "t" in mapping else None
-        present = [role for role in roles if role in mapping]
-        values = tuple(_index(header, mapping[role], role, path) for role in present)
+# -- time -----------------------------------------------------------------------------------------
+def _time_candidates(header: tuple[str, ...], keys: list[str]) -> tuple[list, list]:
+    """(header stamps, other time columns): each a list of (indices, scale, name)."""
+    stamps, others = [], []
+    for index, key in enumerate(keys):
+        nanoseconds = header[index].strip().lower().startswith("field.") or key == "%time"
+        if key == "header.stamp" or key.endswith(".header.stamp"):
+            stamps.append(((index,), 1e9 if nanoseconds else 1.0, header[index]))
+        elif key.endswith("header.stamp.sec") or key == "stamp.sec":
+            stem = key[: -len("sec")]
+            fraction = next((keys.index(stem + part) for part in ("nanosec", "nsec") if stem + part in keys), None)
+            if fraction is not None:
+                stamps.append(((index, fraction), 1.0, f"{header[index]} + {header[fraction]}"))
+        elif key in TIME_NAMES:
+            others.append(((index,), 1e9 if nanoseconds else 1.0, header[index]))
+    return stamps, others
+
+
+def _time_from_names(header, keys, path) -> tuple[tuple[int, ...], float]:
+    stamps, others = _time_candidates(header, keys)
+    for found, what in ((stamps, "header stamps"), (others, "time columns")):
+        if len(found) > 1:
+            names = ", ".join(name for _, _, name in found)
+            raise ValueError(f"{path}: {len(found)} {what} ({names}); name the one to use, e.g. --columns / columns= "
+                             f"t={short_token(found[0][2], 30)[1:-1]}")
+        if found:
+            return found[0][0], found[0][1]
+    return (), 1.0
+
+
+def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | None:
+    """The time column of ``values`` (rows of the file) in seconds, or None without one.
+
+    Stamps as loggers write them: seconds, the two fields of a ROS header, or nanoseconds by
+    name (``%time``, ``field.header.stamp``); epoch stamps in milliseconds, microseconds or
+    nanoseconds are recognised by their size (no epoch in seconds lies beyond the year 5000)."""
+    if not layout.time:
+        return None
+    if len(layout.time) == 2:  # sec + nanosec: the seconds counted from the first, so no digit is lost
+        seconds, fraction = values[:, layout.time[0]], values[:, layout.time[1]]
+        return (seconds - seconds[0]) + fraction / 1e9 + seconds[0]
+    stamps = values[:, layout.time[0]] / layout.time_divisor
+    first = float(np.min(np.abs(stamps))) if stamps.size else 0.0
+    if layout.time_divisor == 1.0 and first > 1e11:
+        for divisor, unit in ((1e9, "nanoseconds"), (1e6, "microseconds"), (1e3, "milliseconds")):
+            if first / divisor > 1e8:  # an epoch stamp after 1973
+                import logging
+
+                logging.getLogger(__name__).info("%s: the time column holds epoch stamps in %s", path, unit)
+                return stamps / divisor
+    return stamps
+
+
+# -- motions --------------------------------------------------------------------------------------
+def _ros_candidates(header, keys) -> list[_Candidate]:
+    found = []
+    for index, key in enumerate(keys):
+        for translation, rotation in _TRANSLATIONS:
+            if not key.endswith(translation + "x"):
+                continue
+            prefix = key[: -len(translation + "x")]
+            where = [keys.index(prefix + translation + axis) if prefix + translation + axis in keys else None
+                     for axis in "xyz"]
+            if None in where:
+                continue
+            turn = [keys.index(prefix + rotation + axis) if prefix + rotation + axis in keys else None for axis in "xyzw"]
+            group = prefix.rstrip(".") or translation.rstrip(".")
+            if None in turn:
+                found.append(_Candidate("positions", tuple(where), None, "m", f"{prefix}{translation}x/y/z",
+                                        f"position={group}"))
+            else:
+                found.append(_Candidate("pose", (*where, *turn), "quaternion", "m",
+                                        f"{prefix}{translation}x/y/z + {prefix}{rotation}x/y/z/w", f"pose={group}"))
+    return found
+
+
+def _indexed_groups(header, keys, pattern) -> dict[str, list[tuple[int, int]]]:
+    groups: dict[str, list[tuple[int, int]]] = {}
+    for index, key in enumerate(keys):
+        match = pattern.match(key)
+        if match:
+            groups.setdefault(match.group(1), []).append((int(match.group(2)), index))
+    return groups
+
+
+def _rtde_candidates(header, keys) -> list[_Candidate]:
+    found = []
+    for prefix, members in _indexed_groups(header, keys, _RTDE_POSE).items():
+        by_number = dict(members)
+        if all(n in by_number for n in range(6)):
+            name = header[by_number[0]][:-2]
+            found.append(_Candidate("pose", tuple(by_number[n] for n in range(6)), "rotvec", "m",
+                                    f"UR RTDE {name}_0..5", f"pose={name}"))
+    for prefix, members in _indexed_groups(header, keys, _RTDE_JOINTS).items():
+        members.sort()
+        if [n for n, _ in members] == list(range(len(members))):
+            name = header[members[0][1]][:-2]
+            found.append(_Candidate("joints", tuple(index for _, index in members), None, "rad",
+                                    f"UR RTDE {name}_0..{len(members) - 1}", f"joints={name}"))
+    return found
+
+
+def _plain_candidate(keys) -> list[_Candidate]:
+    if not ("x" in keys and "y" in keys):
+        return []
+    where = tuple(keys.index(axis) for axis in _POSITION_ROLES if axis in keys)
+    if all(role in keys for role in _QUATERNION_ROLES) and len(where) == 3:
+        return [_Candidate("pose", (*where, *(keys.index(r) for r in _QUATERNION_ROLES)), "quaternion", "", "x,y,z,qx,qy,qz,qw",
+                           "x=x,y=y,z=z,qx=qx,qy=qy,qz=qz,qw=qw")]
+    if all(role in keys for role in _ROTVEC_ROLES) and len(where) == 3:
+        return [_Candidate("pose", (*where, *(keys.index(r) for r in _ROTVEC_ROLES)), "rotvec", "", "x,y,z,rx,ry,rz",
+                           "x=x,y=y,z=z,rx=rx,ry=ry,rz=rz")]
+    return [_Candidate("positions", where, None, "", ",".join(_POSITION_ROLES[: len(where)]),
+                       ",".join(f"{axis}={axis}" for axis in _POSITION_ROLES[: len(where)]))]
+
+
+def _own_timed_joints(keys) -> tuple[int, ...] | None:
+    """A timed joint trajectory bidmp wrote, ``t, <names>, v<names>, a<names>``: the names' columns."""
+    if len(keys) < 4 or (len(keys) - 1) % 3 or keys[0] not in TIME_NAMES:
+        return None
+    n = (len(keys) - 1) // 3
+    names = keys[1 : 1 + n]
+    if keys[1 + n :] != [f"v{name}" for name in names] + [f"a{name}" for name in names]:
+        return None
+    return tuple(range(1, 1 + n))
+
+
+def _joints_candidate(header, keys, time: tuple[int, ...]) -> list[_Candidate]:
+    """``t, <joint names>``: every column but the time is a joint (none may be a reserved name)."""
+    if not time:
+        return []
+    own = _own_timed_joints(keys)
+    if own is not None:
+        return [_Candidate("joints", own, None, "rad", "t,<joint names>", "joints=<names>")]
+    reserved = {*_POSITION_ROLES, *_QUATERNION_ROLES, *TIME_NAMES}
+    rest = [index for index in range(len(keys)) if index not in time]
+    if not rest or any(keys[index] in reserved for index in rest):
+        return []
+    return [_Candidate("joints", tuple(rest), None, "rad", "t,<joint names>", "joints=<names>")]
+
+
+_OWN_RATES = re.compile(r"^(v|a|w|dw)(x|y|z|x[0-9]+)$")  # what save_trajectory / save_poses add beside positions
+
+
+def _layout(header, keys, time, scale, chosen: _Candidate) -> Layout:
+    used = set(chosen.values) | set(time)
+    ignored = tuple(name for index, (name, key) in enumerate(zip(header, keys))
+                    if index not in used and not _OWN_RATES.match(key)
+                    and not (chosen.kind == "joints" and key[:1] in "va" and key[1:] in {keys[i] for i in chosen.values}))
+    return Layout(chosen.kind, time, scale, chosen.values, chosen.rotation,
+                  tuple(header[index] for index in chosen.values), chosen.units, chosen.label, ignored)
+
+
+def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
+    """The layout of a CSV header, by the names or by a column mapping (module docstring).
+
+    Raises
+    ------
+    ValueError
+        A header that names no motion, or more than one (the candidates listed), or a mapping that
+        names a column the header does not have.
+    """
+    header = tuple(header)
+    keys = [_key(name) for name in header]
+    if mapping is not None and "t" in mapping:
+        time, scale = (_index(header, keys, mapping["t"], "t", path),), 1.0
+        if header[time[0]].strip().lower().startswith("field.") or mapping["t"] == "%time":
+            scale = 1e9
     else:
-        times = [name for name in TIME_NAMES if name in header]
-        time = header.index(times[0]) if times else None
-        present = [role for role in roles if role in header]
-        values = tuple(header.index(role) for role in present)
-    if tuple(present) != roles[: len(present)] or len(present) < required:
-        return Selection(time, (), ())
-    used = set(values) | ({time} if time is not None else set())
-    return Selection(time, values, tuple(name for index, name in enumerate(header) if index not in used))
+        time, scale = _time_from_names(header, keys, path)
+    if mapping is not None and set(mapping) - {"t"}:
+        return _layout(header, keys, time, scale, _mapped(header, keys, mapping, path))
+    candidates = _plain_candidate(keys) + _ros_candidates(header, keys) + _rtde_candidates(header, keys)
+    if not candidates:
+        candidates = _joints_candidate(header, keys, time)
+    if len(candidates) > 1:
+        listed = "; ".join(f"{c.label} ({'joints' if c.kind == 'joints' else c.kind}: columns {c.pick})" for c in candidates)
+        raise ValueError(f"{path}: the columns hold {len(candidates)} motions, so which to learn is yours to say: {listed}. "
+                         f"Pick one with --columns / columns=, e.g. --columns {candidates[0].pick}")
+    if not candidates:
+        raise ValueError(f"{path}: header {_shown(header)} names no motion; expected x,y[,z] (with qx,qy,qz,qw or "
+                         f"rx,ry,rz for poses) and a time column t/time/timestamp/stamp, a robot logger's columns (UR "
+                         f"RTDE actual_TCP_pose_0..5 or actual_q_0..5, ROS pose.position.x ...), t,<joint names> for "
+                         f"joint space, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)")
+    return _layout(header, keys, time, scale, candidates[0])
 
 
-def select_positions(header: tuple[str, ...], mapping: dict | None, path) -> Selection:
-    """The time and position columns (``x, y`` or ``x, y, z``) of a header; ``values`` is empty
-    when the header names no positions."""
-    return _resolve(header, _POSITION_ROLES, mapping, path, required=2)
+def _index(header, keys, name: str, role: str, path) -> int:
+    if name not in keys:
+        raise ValueError(f"{path}: no column {short_token(name, 30)} for {role} (the header has {_shown(header, 10)})")
+    return keys.index(name)
 
 
-def select_poses(header: tuple[str, ...], mapping: dict | None, path) -> Selection:
-    """The time, position and quaternion columns of a pose header (``values`` in the order
-    x, y, z, qx, qy, qz, qw); ``values`` is empty when the header names no pose."""
-    return _resolve(header, _POSE_ROLES, mapping, path, required=7)
-
-
-def select_joints(header: tuple[str, ...]) -> Selection:
-    """A joint-space recording ``t, <joint names>``: the time column and every other column, in
-    the header's order; ``values`` is empty unless the header has a time column and names no
-    position or quaternion (a joint-space model has one dimension per joint)."""
-    times = [name for name in TIME_NAMES if name in header]
-    reserved = {*_POSE_ROLES, *TIME_NAMES}
-    if not times or any(name in reserved for name in header if name not in times) or len(header) < 2:
-        return Selection(None, (), ())
-    time = header.index(times[0])
-    return Selection(time, tuple(index for index, name in enumerate(header) if index != time and name not in TIME_NAMES), ())
+def _mapped(header, keys, mapping: dict, path) -> _Candidate:
+    """The motion a mapping names: single columns or a group by prefix."""
+    if "pose" in mapping or "position" in mapping:
+        wanted = mapping.get("pose", mapping.get("position"))
+        for candidate in _ros_candidates(header, keys) + _rtde_candidates(header, keys):
+            if candidate.kind != "joints" and _key(candidate.pick.split("=", 1)[1]) == wanted.rstrip("."):
+                if "position" in mapping:
+                    return _Candidate("positions", candidate.values[:3], None, candidate.units,
+                                      candidate.label.split(" + ")[0].replace("_0..5", "_0..2"), f"position={wanted}")
+                if candidate.kind == "pose":
+                    return candidate
+        role = "pose" if "pose" in mapping else "position"
+        raise ValueError(f"{path}: no {role} group {short_token(wanted, 30)} (x, y, z{' and a rotation' if role == 'pose' else ''} "
+                         f"under that prefix) in the header {_shown(header, 10)}")
+    if "joints" in mapping:
+        wanted = mapping["joints"]
+        members = sorted((int(m.group(2)), index) for index, key in enumerate(keys)
+                         if (m := _INDEXED.match(key)) and m.group(1).rstrip("._") == wanted)
+        if not members:
+            raise ValueError(f"{path}: no joint columns {short_token(wanted, 30)}_0, _1, ... in the header {_shown(header, 10)}")
+        return _Candidate("joints", tuple(index for _, index in members), None, "rad",
+                          f"{wanted}_0..{len(members) - 1}", f"joints={wanted}")
+    where = tuple(_index(header, keys, mapping[role], role, path) for role in _POSITION_ROLES if role in mapping)
+    present = [role for role in _POSITION_ROLES if role in mapping]
+    if present != list(_POSITION_ROLES[: len(present)]) or len(present) < 2:
+        raise ValueError("columns: positions need x and y (and z), e.g. x=ee_x,y=ee_y,z=ee_z")
+    for roles, rotation in ((_QUATERNION_ROLES, "quaternion"), (_ROTVEC_ROLES, "rotvec")):
+        if roles[0] in mapping:
+            if len(where) != 3:
+                raise ValueError("columns: a pose needs x, y and z")
+            turn = tuple(_index(header, keys, mapping[role], role, path) for role in roles)
+            return _Candidate("pose", (*where, *turn), rotation, "", "mapped pose", "")
+    return _Candidate("positions", where, None, "", "mapped positions", "")

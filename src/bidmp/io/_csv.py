@@ -14,14 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import check_limit, check_path, get_limits, short_token
-from ._columns import TIME_NAMES, parse_columns
 
 __all__ = ['declared_units']
 
 logger = logging.getLogger(__name__)
 
 
-_TIME_NAMES = TIME_NAMES
 
 _SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
@@ -44,57 +42,10 @@ def _check_file(path: Path, what: str) -> None:
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
 
 
-def _timed_columns(columns: tuple[str, ...]) -> int | None:
-    """For a header ``t,x,y[,z],vx,…,ax,…`` (what :func:`save_trajectory` writes for a
-    :class:`bidmp.Trajectory`): the number of position columns; None for other headers."""
-    if not columns or columns[0] not in _TIME_NAMES:
-        return None
-    for names in _POSITION_HEADERS:
-        if columns[1:] == (*names, *(f"v{n}" for n in names), *(f"a{n}" for n in names)):
-            return len(names)
-    return None
-
-
 def _note_ignored(path: Path, ignored: tuple[str, ...]) -> None:
     if ignored:
         shown = ", ".join(short_token(name, 16)[1:-1] for name in ignored[:8]) + (", …" if len(ignored) > 8 else "")
         logger.warning("%s: ignored %d column(s) that are not time or positions: %s", path, len(ignored), shown)
-
-
-def _read_csv(path: Path, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
-    """Read a CSV trajectory; return (positions (T, D), times (T,) or None). ``columns``: a
-    column mapping (:func:`bidmp._columns.parse_columns`)."""
-    from ._columns import select_joints, select_poses, select_positions
-
-    mapping = parse_columns(columns)
-    parsed = _csv_fast(path)
-    header, values = parsed if parsed is not None else _csv_rows(path)
-    n_columns = values.shape[1]
-    if header is None:
-        if mapping is not None:
-            raise ValueError(f"{path} has no header, so --columns / columns= cannot name its columns")
-        if n_columns in (2, 3):  # header-less: positions only (add a header "t,x,y" to mark a time column)
-            return values, None
-        if n_columns == 4:
-            return values[:, 1:], values[:, 0]
-        raise ValueError(f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z) without a header, found {n_columns}")
-    n_positions = _timed_columns(header)
-    if n_positions is not None and mapping is None:  # a timed trajectory written by bidmp
-        return values[:, 1 : 1 + n_positions], values[:, 0]
-    if mapping is None and select_poses(header, None, path).values:
-        raise ValueError(f"{path}: a pose recording: read it with bidmp.io.read_poses / bidmp.CartesianDMP (its header "
-                         f"names qx, qy, qz, qw)")
-    selection = select_positions(header, mapping, path)
-    if not selection.values and mapping is None:  # t, <joint names>: a joint-space recording
-        selection = select_joints(header)
-    if not selection.values:
-        shown = ",".join(short_token(c, 12)[1:-1] for c in header[:8]) + (",…" if len(header) > 8 else "")
-        raise ValueError(f"{path}: header {shown} names no positions; expected x,y[,z] with an optional t/time/timestamp "
-                         f"column, t,<joint names> for joint space, or name them with a column mapping (--columns "
-                         f"t=stamp,x=ee_x,y=ee_y,z=ee_z)")
-    _note_ignored(path, selection.ignored)
-    times = None if selection.time is None else values[:, selection.time]
-    return values[:, list(selection.values)], times
 
 
 def declared_units(path) -> str:
@@ -118,25 +69,12 @@ def declared_units(path) -> str:
 
 
 def is_joint_recording(path) -> bool:
-    """Whether a CSV's header is a joint-space recording ``t, <joint names>`` (no position or
-    quaternion named): its values are joint angles, in radians unless it declares otherwise."""
-    from ._columns import select_joints, select_positions
+    """Whether a CSV's header is a joint-space recording (``t, <joint names>``, or a logger's
+    joint columns such as UR RTDE ``actual_q_0..5``): its values are joint angles, in radians
+    unless it declares otherwise."""
+    from .recordings import recording_kind
 
-    path = check_path(path)
-    if not path.is_file():
-        return False
-    try:
-        with open(path, encoding="utf-8-sig") as handle:
-            for _ in range(16):
-                line = handle.readline(1 << 16).strip()
-                if line and not line.startswith("#"):
-                    break
-    except (OSError, UnicodeDecodeError):
-        return False
-    header = tuple(name.strip() for name in line.split(_csv_delimiter(line)))
-    if not line or not any(name and not _is_number(name) for name in header):
-        return False
-    return not select_positions(header, None, path).values and bool(select_joints(header).values)
+    return recording_kind(path) == "joints"
 
 
 def _is_number(text: str) -> bool:
@@ -148,7 +86,19 @@ def _is_number(text: str) -> bool:
 
 
 def _csv_delimiter(sample: str) -> str:
-    return ";" if sample.count(";") > sample.count(",") else ","
+    """``,`` or ``;`` (the more frequent in the sample), else a tab, else spaces (UR's RTDE
+    recorder writes space-separated files)."""
+    lines = [line for line in sample.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+    body = "\n".join(lines) if lines else sample
+    if body.count(";") > body.count(","):
+        return ";"
+    if "," in body:
+        return ","
+    return "\t" if "\t" in body else " "
+
+
+def _split(line: str, delimiter: str) -> list[str]:
+    return line.split() if delimiter == " " else line.split(delimiter)
 
 
 def _row_limit_error(path: Path) -> ValueError:
@@ -156,7 +106,7 @@ def _row_limit_error(path: Path) -> ValueError:
     return ValueError(f"{path}: more than {limit:,} rows, the limit max_samples; raise it with bidmp.set_limits(max_samples=...)")
 
 
-def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray] | None:
+def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | None:
     """The common case, parsed by NumPy's C reader (a 1e6-row recording in about a second):
     an optional header line, then plain numbers. Returns None for anything else (quotes, ragged or
     bad rows, odd text), which :func:`_csv_rows` then reads row by row to name the problem."""
@@ -173,15 +123,15 @@ def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray] | None:
                 stripped = line.strip()
                 if stripped and not stripped.startswith("#"):
                     break
-            cells = [cell.strip() for cell in stripped.split(delimiter)]
+            cells = [cell.strip() for cell in _split(stripped, delimiter)]
             if any(_parse_float(cell) is None for cell in cells):
-                columns = tuple(cell.lower() for cell in cells)
+                columns = tuple(cells)
             else:
                 first = line
             lines = itertools.chain([first], handle) if first is not None else handle
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "empty input": the slow path words it
-                values = np.loadtxt(lines, delimiter=delimiter, comments="#", ndmin=2, dtype=np.float64,
+                values = np.loadtxt(lines, delimiter=None if delimiter == " " else delimiter, comments="#", ndmin=2, dtype=np.float64,
                                     max_rows=limits.max_samples + 1, encoding=None)
     except (ValueError, TypeError, OSError, UnicodeDecodeError, OverflowError, MemoryError):
         return None
@@ -191,12 +141,12 @@ def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray] | None:
         return None
     if values.shape[0] > limits.max_samples:
         raise _row_limit_error(path)
-    return columns, values
+    return columns, values, ()
 
 
-def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray]:
-    """Row-by-row CSV reading with the csv module: quotes, comments, and an error that names the
-    first bad line (quoting at most a short token of it)."""
+def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int, ...]]:
+    """Row-by-row CSV reading with the csv module: quotes, comments, text columns (their indices
+    third), and an error that names the first bad line (quoting at most a short token of it)."""
     limits = get_limits()
     max_rows = limits.max_samples + 1  # + a header
     max_columns = limits.max_dims + 1  # + a time column
@@ -210,7 +160,7 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray]:
         with open(path, newline="", encoding="utf-8-sig") as handle:
             delimiter = _csv_delimiter(handle.read(4096))
             handle.seek(0)
-            reader = csv.reader(handle, delimiter=delimiter)
+            reader = csv.reader(handle, delimiter=delimiter, skipinitialspace=delimiter == " ")
             try:
                 for row in reader:
                     if not any(row) or row[0].lstrip().startswith("#"):
@@ -231,29 +181,35 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray]:
     columns: tuple[str, ...] | None = None
     _, first_row = rows[0]
     if any(_parse_float(cell) is None for cell in first_row):
-        columns = tuple(cell.lower() for cell in first_row)
+        columns = tuple(first_row)
         rows = rows[1:]
         if not rows:
             raise ValueError(f"{path} has a header but no data rows")
     n_columns = len(columns) if columns else len(rows[0][1])
-    return columns, _csv_values(rows, n_columns, path)
+    return (columns, *_csv_values(rows, n_columns, path, named=columns is not None))
 
 
-def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path) -> np.ndarray:
+def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path,
+                named: bool = False) -> tuple[np.ndarray, tuple[int, ...]]:
     """The numbers of the data rows (T, n_columns): NumPy's parser first (fast), and on failure a
-    row-by-row pass that names the first bad line (quoting at most a short token of it)."""
+    row-by-row pass that names the first bad line (quoting at most a short token of it). With a
+    header (``named``), a column of text in every row (a ROS export's ``frame_id``) is NaN and
+    listed second: the reader refuses it only if it is one the layout uses."""
     cells = [row for _, row in rows]
     with contextlib.suppress(ValueError, TypeError, OverflowError):
         values = np.array(cells, dtype=np.float64)
         if values.ndim == 2 and values.shape[1] == n_columns:
-            return values
+            return values, ()
     for number, row in rows:
         if len(row) != n_columns:
             raise ValueError(f"{path} line {number}: expected {n_columns} columns, found {len(row)}")
+    text = [column for column in range(n_columns) if named and all(_parse_float(row[column]) is None for row in cells)]
+    for number, row in rows:
         for column, cell in enumerate(row, 1):
-            if _parse_float(cell) is None:
+            if column - 1 not in text and _parse_float(cell) is None:
                 raise ValueError(f"{path} line {number}, column {column}: {short_token(cell)} is not a number")
-    raise ValueError(f"{path}: the data rows could not be read as numbers")  # pragma: no cover
+    values = np.array([[float("nan") if index in text else float(cell) for index, cell in enumerate(row)] for row in cells])
+    return values, tuple(text)
 
 
 def _check_npy_trajectory(path: Path):

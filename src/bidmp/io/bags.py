@@ -4,19 +4,28 @@
 Reading (:func:`read_bag`): a demonstration from
 
 * ``geometry_msgs/PoseStamped`` or ``geometry_msgs/TransformStamped`` on a topic → poses
-  ``x, y, z, qx, qy, qz, qw`` (m);
+  ``x, y, z, qx, qy, qz, qw`` (m); ``geometry_msgs/PointStamped`` → positions ``x, y, z`` (m);
 * ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) → the transform from a parent frame to a child
   frame chosen by name (the direct edge of the tree, as published) → poses (m);
 * ``sensor_msgs/JointState`` → the positions of the joints chosen by name, or all (rad).
 
 Times are the messages' header stamps (not when the recorder received them), seconds from the
-first. A ROS 1 ``.bag`` file or a ROS 2 bag folder (SQLite or MCAP, with its ``metadata.yaml``). A bag without the topic, with a message type bidmp does not read, or with stamps
-that do not increase gives a one-line error that lists what the bag contains.
+first; the messages are put in the order of their stamps, as transport jitter leaves them a few
+milliseconds out of receive order. Two messages with one stamp, or a stamp more than
+:data:`MAX_STAMP_DISORDER` s before one already received (a clock reset, a replayed log), are
+refused. A ROS 1 ``.bag`` file or a ROS 2 bag folder (SQLite or MCAP, with its
+``metadata.yaml``). A bag without the topic, with a message type bidmp does not read, or with
+such stamps gives a one-line error that lists what the bag contains.
 
 Writing (:func:`write_bag`): a motion as a ``geometry_msgs/PoseStamped`` stream (one message per
-sample, stamped ``origin + t``) or as one ``trajectory_msgs/JointTrajectory`` (positions,
-velocities, accelerations, ``time_from_start``), ROS 2 MCAP by default, ROS 1 on request; written
-beside the target and renamed into place (a bag folder or file appears whole or not at all).
+sample, stamped ``origin + t``; positions alone with an orientation held throughout, or a
+``geometry_msgs/PointStamped`` stream: no orientation is ever made up), as one
+``trajectory_msgs/JointTrajectory`` (positions, velocities, accelerations,
+``time_from_start``), or as one ``control_msgs/FollowJointTrajectory`` goal, the action a ROS 2
+joint trajectory controller takes (its type registered from the message definition); ROS 2 MCAP by
+default, ROS 1 on request; stamped from a given start (``"now"`` or seconds since the epoch);
+written beside the target and renamed into place (a bag folder or file appears whole or not at
+all).
 """
 
 from __future__ import annotations
@@ -24,57 +33,56 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from .recordings import Recording
 from .._checks import as_trajectory, as_vector, check_choice, check_path, check_real, require_extra, short_token, shown_path
 
-__all__ = ["BagRecording", "read_bag", "write_bag", "is_bag"]
+__all__ = ["read_bag", "write_bag", "is_bag", "start_stamp"]
 
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 TRANSFORM_STAMPED = "geometry_msgs/msg/TransformStamped"
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
-_READABLE = (POSE_STAMPED, TRANSFORM_STAMPED, TF_MESSAGE, JOINT_STATE)
+POINT_STAMPED = "geometry_msgs/msg/PointStamped"
+FOLLOW_JOINT_TRAJECTORY = {2: "control_msgs/action/FollowJointTrajectory_Goal", 1: "control_msgs/msg/FollowJointTrajectoryGoal"}
+MAX_STAMP_DISORDER = 0.1  # s: transport jitter reorders messages by milliseconds; more is a jump back in time
+# The goal of control_msgs' FollowJointTrajectory action (ROS 2 Humble's control_msgs 4, ROS 1's
+# Noetic control_msgs 1.5), with the two tolerance messages it uses: rosbags' typestores do not
+# ship control_msgs, so the types are registered from these definitions.
+_FOLLOW_DEFINITIONS = {
+    2: {
+        "control_msgs/msg/JointTolerance": "string name\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n",
+        "control_msgs/msg/JointComponentTolerance": (
+            "uint16 X_AXIS=1\nuint16 Y_AXIS=2\nuint16 Z_AXIS=3\nuint16 TRANSLATION=4\nuint16 ROTATION=5\n"
+            "string joint_name\nuint16 component\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n"),
+        "control_msgs/action/FollowJointTrajectory_Goal": (
+            "trajectory_msgs/JointTrajectory trajectory\n"
+            "trajectory_msgs/MultiDOFJointTrajectory multi_dof_trajectory\n"
+            "control_msgs/JointTolerance[] path_tolerance\n"
+            "control_msgs/JointComponentTolerance[] component_path_tolerance\n"
+            "control_msgs/JointTolerance[] goal_tolerance\n"
+            "control_msgs/JointComponentTolerance[] component_goal_tolerance\n"
+            "builtin_interfaces/Duration goal_time_tolerance\n"),
+    },
+    1: {
+        "control_msgs/msg/JointTolerance": "string name\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n",
+        "control_msgs/msg/FollowJointTrajectoryGoal": (
+            "trajectory_msgs/JointTrajectory trajectory\n"
+            "control_msgs/JointTolerance[] path_tolerance\n"
+            "control_msgs/JointTolerance[] goal_tolerance\n"
+            "duration goal_time_tolerance\n"),
+    },
+}
+_READABLE = (POSE_STAMPED, TRANSFORM_STAMPED, "geometry_msgs/msg/PointStamped", TF_MESSAGE, JOINT_STATE)
 POSE_COLUMNS = ["x", "y", "z", "qx", "qy", "qz", "qw"]
 
 
 def _rosbags():
     return require_extra("rosbags", "ros", "ROS bags")
-
-
-@dataclass(frozen=True)
-class BagRecording:
-    """A demonstration read from a bag.
-
-    Attributes
-    ----------
-    t : (n,)
-        Header stamps in seconds from the first.
-    values : (n, D)
-        Poses ``x, y, z, qx, qy, qz, qw`` (m) or joint positions (rad).
-    names : list of str
-        The columns of ``values`` (the joint names for joint states).
-    kind : {"pose", "joints"}
-    units : str
-        ``"m"`` for poses, ``"rad"`` for joints.
-    source : str
-        What was read (``topic /ee_pose``, ``tf base -> tool``, ...).
-    stamp : float
-        The first header stamp (s since the epoch): ``t`` is counted from it, in integer
-        nanoseconds (exact).
-    """
-
-    t: np.ndarray
-    values: np.ndarray
-    names: list
-    kind: str
-    units: str
-    source: str
-    stamp: float
 
 
 def is_bag(path) -> bool:
@@ -118,7 +126,7 @@ def _open(path):
     return reader
 
 
-def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = None, joints=None) -> BagRecording:
+def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = None, joints=None) -> Recording:
     """A demonstration from a bag (module docstring).
 
     Parameters
@@ -126,8 +134,8 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
     path : str or Path
         A ROS 1 ``.bag`` file or a ROS 2 bag folder.
     topic : str, optional
-        A ``PoseStamped``, ``TransformStamped`` or ``JointState`` topic (default: the bag's only
-        one of these types; with ``tf``, ``/tf`` and ``/tf_static``).
+        A ``PoseStamped``, ``TransformStamped``, ``PointStamped`` or ``JointState`` topic (default:
+        the bag's only one of these types; with ``tf``, ``/tf`` and ``/tf_static``).
     tf : (parent, child), optional
         Read the transform from frame ``parent`` to frame ``child`` from ``TFMessage`` topics.
     joints : list of str or True, optional
@@ -135,13 +143,13 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
 
     Returns
     -------
-    BagRecording
+    Recording
     """
     _check_selection(topic, tf, joints)
     reader = _open(path)
     try:
         wanted = _wanted_connections(reader, topic, tf, joints)
-        kind = "joints" if wanted[0].msgtype == JOINT_STATE else "pose"
+        kind = {JOINT_STATE: "joints", POINT_STAMPED: "positions"}.get(wanted[0].msgtype, "pose")
         stamps, rows, names = [], [], None
         for connection, _, raw in reader.messages(connections=wanted):
             message = reader.deserialize(raw, connection.msgtype)
@@ -152,17 +160,39 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
         source = (f"tf {tf[0]} -> {tf[1]}" if tf is not None else f"topic {wanted[0].topic}")
         if not rows:
             raise ValueError(f"bag {shown_path(path)}: no {source} message in it; it has: {_contents(reader)}")
-        steps = [later - earlier for earlier, later in zip(stamps, stamps[1:])]
-        if any(step <= 0 for step in steps):
-            first = next(index for index, step in enumerate(steps) if step <= 0)
-            raise ValueError(f"bag {shown_path(path)}: the header stamps of {source} do not increase (message {first + 1} "
-                             f"at {stamps[first] * 1e-9:.9f} s, the next at {stamps[first + 1] * 1e-9:.9f} s); "
-                             f"it has: {_contents(reader)}")
+        order = _stamp_order(stamps, f"bag {shown_path(path)}: the header stamps of {source}", _contents(reader))
     finally:
         reader.close()
-    values = np.array(rows, dtype=float)
+    stamps = [stamps[index] for index in order]
+    values = np.array(rows, dtype=float)[order]
     t = np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9  # exact to the nanosecond
-    return BagRecording(t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9)
+    return Recording(t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9)
+
+
+def _stamp_order(stamps: list, what: str, contents: str) -> np.ndarray:
+    """The messages' order by their header stamps (stable), refusing a stamp repeated or one more
+    than :data:`MAX_STAMP_DISORDER` before the latest already received."""
+    received = np.asarray(stamps, dtype=np.int64)
+    latest = np.maximum.accumulate(received)
+    behind = latest - received
+    if np.any(behind > MAX_STAMP_DISORDER * 1e9):
+        index = int(np.argmax(behind > MAX_STAMP_DISORDER * 1e9))
+        raise ValueError(f"{what} jump back in time (message {index + 1} at {received[index] * 1e-9:.9f} s, "
+                         f"{behind[index] * 1e-9:.6g} s before one received earlier; more than the "
+                         f"{MAX_STAMP_DISORDER:g} s transport jitter reorders); it has: {contents}")
+    order = np.argsort(received, kind="stable")
+    ordered = received[order]
+    if np.any(np.diff(ordered) == 0):
+        index = int(np.argmax(np.diff(ordered) == 0))
+        raise ValueError(f"{what} repeat: two messages stamped {ordered[index] * 1e-9:.9f} s (messages "
+                         f"{order[index] + 1} and {order[index + 1] + 1}); it has: {contents}")
+    if np.any(order != np.arange(order.size)):
+        import logging
+
+        logging.getLogger(__name__).info("%s: %d message(s) out of receive order, put in the order of their stamps "
+                                         "(at most %.3g ms apart)", what, int(np.sum(order != np.arange(order.size))),
+                                         float(behind.max()) * 1e-6)
+    return order
 
 
 def _check_selection(topic, tf, joints) -> None:
@@ -189,7 +219,7 @@ def _wanted_connections(reader, topic, tf, joints) -> list:
             raise ValueError(f"tf: the bag has no TFMessage topic {' or '.join(sorted(topics))}; it has: {_contents(reader)}")
         return found
     if topic is None:
-        types = (JOINT_STATE,) if joints is not None else (POSE_STAMPED, TRANSFORM_STAMPED)
+        types = (JOINT_STATE,) if joints is not None else (POSE_STAMPED, TRANSFORM_STAMPED, POINT_STAMPED)
         found = [c for c in reader.connections if c.msgtype in types]
         if len({c.topic for c in found}) != 1:
             wanted = "joints" if joints is not None else "topic"
@@ -199,7 +229,7 @@ def _wanted_connections(reader, topic, tf, joints) -> list:
     found = [c for c in reader.connections if c.topic == topic]
     if not found:
         raise ValueError(f"topic {short_token(topic, 40)} is not in the bag; it has: {_contents(reader)}")
-    if found[0].msgtype not in (POSE_STAMPED, TRANSFORM_STAMPED, JOINT_STATE):
+    if found[0].msgtype not in (POSE_STAMPED, TRANSFORM_STAMPED, POINT_STAMPED, JOINT_STATE):
         raise ValueError(f"topic {topic} carries {found[0].msgtype}, which bidmp does not read (it reads "
                          f"{', '.join(_READABLE)}; TFMessage with tf); it has: {_contents(reader)}")
     if (found[0].msgtype == JOINT_STATE) != (joints is not None):
@@ -213,6 +243,9 @@ def _rows(message, msgtype: str, tf, joints, names):
     if msgtype == POSE_STAMPED:
         p, q = message.pose.position, message.pose.orientation
         yield _stamp(message.header), [p.x, p.y, p.z, q.x, q.y, q.z, q.w], POSE_COLUMNS
+    elif msgtype == POINT_STAMPED:
+        p = message.point
+        yield _stamp(message.header), [p.x, p.y, p.z], POSE_COLUMNS[:3]
     elif msgtype == TRANSFORM_STAMPED:
         yield _stamp(message.header), _transform_row(message), POSE_COLUMNS
     elif msgtype == TF_MESSAGE:
@@ -236,7 +269,8 @@ def _transform_row(stamped) -> list:
 
 # -- writing --------------------------------------------------------------------------------------
 def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=None, velocities=None,
-              accelerations=None, frame_id: str = "base", origin: float = 0.0, ros: int = 2) -> Path:
+              accelerations=None, frame_id: str = "base", origin: float | str = "now", ros: int = 2,
+              orientation=None) -> Path:
     """Write a motion to a bag (module docstring).
 
     Parameters
@@ -245,29 +279,34 @@ def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=Non
         A folder (ROS 2) or a ``.bag`` file (ROS 1).
     t : (n,)
         Seconds from the start.
-    values : (n, 3) or (n, 7) for ``kind="pose"`` (m; no orientation: identity), (n, J) for
-        ``kind="joints"`` (rad).
-    kind : {"pose", "joints"}
-        A ``PoseStamped`` stream or one ``JointTrajectory``.
+    values : (n, 3) or (n, 7) for ``kind="pose"`` (m), (n, J) for ``kind="joints"`` or
+        ``"follow"`` (rad).
+    kind : {"pose", "joints", "follow"}
+        A ``PoseStamped`` stream (a ``PointStamped`` stream for positions without
+        ``orientation``), one ``JointTrajectory``, or one ``FollowJointTrajectory`` goal.
     topic : str, optional
-        Default ``/bidmp/pose`` or ``/bidmp/joint_trajectory``.
+        Default ``/bidmp/pose`` (``/bidmp/point``), ``/bidmp/joint_trajectory`` or
+        ``/bidmp/follow_joint_trajectory/goal``.
     names : list of str, optional
         Joint names (default ``joint1`` ...).
     velocities, accelerations : (n, J), optional
         For the joint trajectory's points (rad/s, rad/s²).
     frame_id : str
         The header's frame.
-    origin : float
-        The first stamp, seconds since the epoch.
+    origin : float or "now"
+        The first stamp, seconds since the epoch; ``"now"`` (the default): the time of writing.
     ros : {1, 2}
         ROS 2 MCAP (default) or ROS 1.
+    orientation : (4,), optional
+        ``qx, qy, qz, qw``: the orientation a position stream (3 columns) holds throughout, written
+        as a PoseStamped stream.
 
     Returns
     -------
     Path
     """
     _rosbags()
-    kind = check_choice(kind, "kind", ("pose", "joints"))
+    kind = check_choice(kind, "kind", ("pose", "joints", "follow"))
     if isinstance(ros, bool) or not isinstance(ros, int) or ros not in (1, 2):
         raise ValueError(f"ros must be 1 or 2, got {short_token(ros)}")
     t = as_vector(t, "t")
@@ -278,14 +317,23 @@ def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=Non
         raise ValueError(f"values has {values.shape[0]} rows but t has {t.size} times: one row per time")
     if kind == "pose" and values.shape[1] not in (3, 7):
         raise ValueError(f"values: a pose stream needs 3 (x, y, z) or 7 (with qx, qy, qz, qw) columns, got {values.shape[1]}")
-    origin = check_real(origin, "origin", nonnegative=True)
+    if orientation is not None:
+        if kind != "pose" or values.shape[1] != 3:
+            raise ValueError("orientation is the held orientation of a position stream (kind='pose', 3 columns)")
+        orientation = as_vector(orientation, "orientation", length=4)
+        if not abs(np.linalg.norm(orientation) - 1.0) <= 1e-6:
+            raise ValueError(f"orientation must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(orientation):.6g}")
+    origin = start_stamp(origin)
     # Header stamps are whole seconds in a signed 32-bit field (ROS 2; ROS 1 an unsigned one).
     if origin + t[0] < 0 or origin + t[-1] >= 2**31:
         raise ValueError(f"t: origin + t must lie within [0, 2**31) s (a header stamp's seconds), "
                          f"got {origin + t[0]:.6g} to {origin + t[-1]:.6g} s")
     target = Path(check_path(path))
+    msgtype = {"pose": POSE_STAMPED if values.shape[1] == 7 or orientation is not None else POINT_STAMPED,
+               "joints": JOINT_TRAJECTORY, "follow": FOLLOW_JOINT_TRAJECTORY[ros]}[kind]
     if topic is None:
-        topic = "/bidmp/pose" if kind == "pose" else "/bidmp/joint_trajectory"
+        topic = {POSE_STAMPED: "/bidmp/pose", POINT_STAMPED: "/bidmp/point", JOINT_TRAJECTORY: "/bidmp/joint_trajectory"
+                 }.get(msgtype, "/bidmp/follow_joint_trajectory/goal")
     elif not isinstance(topic, str) or not topic.startswith("/") or len(topic) > 256 or not topic[1:].strip():
         raise ValueError(f"topic must be a ROS topic name such as '/bidmp/pose', got {short_token(topic, 30)}")
     if not isinstance(frame_id, str) or len(frame_id) > 256:
@@ -305,44 +353,95 @@ def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=Non
                 raise ValueError(f"{label} must have the shape of values {values.shape}, got {rate.shape}")
         rates.append(rate)
     velocities, accelerations = rates
-    messages = _messages(ros, kind, t, values, names, velocities, accelerations, frame_id, origin)
-    return _write_atomically(target, ros, topic, POSE_STAMPED if kind == "pose" else JOINT_TRAJECTORY, messages)
+    if orientation is not None:
+        values = np.hstack([values, np.tile(orientation, (values.shape[0], 1))])
+    messages = _messages(ros, msgtype, t, values, names, velocities, accelerations, frame_id, origin)
+    return _write_atomically(target, ros, topic, msgtype, messages)
 
 
-def _messages(ros: int, kind: str, t, values, names, velocities, accelerations, frame_id: str, origin: float):
-    """(typestore, [(stamp ns, message), ...])."""
-    from rosbags.typesys import Stores, get_typestore
+def start_stamp(origin) -> float:
+    """The first stamp of a bag, seconds since the epoch: ``"now"``, a number, or an ISO 8601
+    time (``2026-12-03T14:00:00Z``; without a zone: UTC)."""
+    import datetime
+
+    if isinstance(origin, str):
+        if origin.strip().lower() == "now":
+            import time
+
+            return time.time()
+        try:
+            moment = datetime.datetime.fromisoformat(origin.strip().replace("Z", "+00:00"))
+        except ValueError:
+            try:
+                return start_stamp(float(origin))
+            except ValueError:
+                raise ValueError(f"origin must be 'now', seconds since the epoch or an ISO 8601 time "
+                                 f"(2026-12-03T14:00:00Z), got {short_token(origin, 30)}") from None
+        if moment.tzinfo is None:
+            moment = moment.replace(tzinfo=datetime.timezone.utc)
+        return start_stamp(moment.timestamp())
+    return check_real(origin, "origin", nonnegative=True)
+
+
+def _store(ros: int, msgtype: str):
+    """The typestore for ``ros``, with control_msgs' goal registered when it is wanted."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros == 2 else Stores.ROS1_NOETIC)
+    if msgtype == FOLLOW_JOINT_TRAJECTORY[ros]:
+        types = {}
+        for name, definition in _FOLLOW_DEFINITIONS[ros].items():
+            types.update(get_types_from_msg(definition, name))
+        store.register(types)
+    return store
+
+
+def _messages(ros: int, msgtype: str, t, values, names, velocities, accelerations, frame_id: str, origin: float):
+    """(typestore, [(stamp ns, message), ...])."""
+    store = _store(ros, msgtype)
     types = store.types
 
-    start = int(round(origin * 1e9))  # stamps in integer nanoseconds: origin + t, each rounded once
+    # Stamps in integer nanoseconds, origin + t, each rounded once (the whole seconds apart: a float
+    # of 1.8e18 ns would keep only 256 ns).
+    start = int(origin) * 1_000_000_000 + int(round((origin - int(origin)) * 1e9))
 
     def header(nanoseconds: int):
         sec, nanosec = divmod(nanoseconds, 1_000_000_000)
         fields = {"stamp": types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), "frame_id": frame_id}
         return types["std_msgs/msg/Header"](**({"seq": 0} if ros == 1 else {}), **fields)
 
-    if kind == "pose":
-        quaternions = values[:, 3:] if values.shape[1] == 7 else np.tile([0.0, 0.0, 0.0, 1.0], (len(t), 1))
+    def duration(seconds: float):
+        sec, nanosec = divmod(int(round(seconds * 1e9)), 1_000_000_000)
+        return types["builtin_interfaces/msg/Duration"](sec=sec, nanosec=nanosec)
+
+    if msgtype in (POSE_STAMPED, POINT_STAMPED):
         out = []
-        for time, point, q in zip(t, values[:, :3], quaternions):
-            pose = types["geometry_msgs/msg/Pose"](position=types["geometry_msgs/msg/Point"](*map(float, point)),
-                                                   orientation=types["geometry_msgs/msg/Quaternion"](*map(float, q)))
+        for time, row in zip(t, values):
+            point = types["geometry_msgs/msg/Point"](*map(float, row[:3]))
             stamp = start + int(round(time * 1e9))
+            if msgtype == POINT_STAMPED:
+                out.append((stamp, types[POINT_STAMPED](header=header(stamp), point=point)))
+                continue
+            pose = types["geometry_msgs/msg/Pose"](position=point, orientation=types["geometry_msgs/msg/Quaternion"](*map(float, row[3:])))
             out.append((stamp, types[POSE_STAMPED](header=header(stamp), pose=pose)))
         return store, out
     zeros = np.zeros_like(values)
     rates = (zeros if velocities is None else np.asarray(velocities, dtype=float),
              zeros if accelerations is None else np.asarray(accelerations, dtype=float))
-    points = []
-    for time, position, velocity, acceleration in zip(t, values, *rates):
-        sec, nanosec = divmod(int(round(time * 1e9)), 1_000_000_000)
-        points.append(types["trajectory_msgs/msg/JointTrajectoryPoint"](
-            positions=position.copy(), velocities=velocity.copy(), accelerations=acceleration.copy(), effort=np.zeros(0),
-            time_from_start=types["builtin_interfaces/msg/Duration"](sec=sec, nanosec=nanosec)))
-    message = types[JOINT_TRAJECTORY](header=header(start), joint_names=names, points=points)
-    return store, [(start, message)]
+    points = [types["trajectory_msgs/msg/JointTrajectoryPoint"](
+        positions=position.copy(), velocities=velocity.copy(), accelerations=acceleration.copy(), effort=np.zeros(0),
+        time_from_start=duration(time)) for time, position, velocity, acceleration in zip(t, values, *rates)]
+    trajectory = types[JOINT_TRAJECTORY](header=header(start), joint_names=names, points=points)
+    if msgtype == JOINT_TRAJECTORY:
+        return store, [(start, trajectory)]
+    goal = {"trajectory": trajectory, "path_tolerance": [], "goal_tolerance": []}
+    if ros == 2:
+        goal |= {"multi_dof_trajectory": types["trajectory_msgs/msg/MultiDOFJointTrajectory"](
+            header=header(start), joint_names=[], points=[]), "component_path_tolerance": [],
+            "component_goal_tolerance": [], "goal_time_tolerance": duration(0.0)}
+    else:
+        goal["goal_time_tolerance"] = types["builtin_interfaces/msg/Duration"](sec=0, nanosec=0)
+    return store, [(start, types[msgtype](**goal))]
 
 
 def _write_atomically(target: Path, ros: int, topic: str, msgtype: str, messages) -> Path:

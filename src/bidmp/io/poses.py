@@ -8,10 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_trajectory, check_path, short_token
+from .._checks import _as_bounded_array, as_trajectory, check_path
 from .._units import check_units
-from ._columns import parse_columns
-from ._csv import _check_file, _csv_fast, _csv_rows, _note_ignored
 from .trajectories import _write_columns
 
 __all__ = ['read_poses', 'save_poses']
@@ -20,38 +18,26 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     """Read a pose recording (CSV with a header): poses ``(T, 7)`` as ``x, y, z, qx, qy, qz,
     qw`` (scalar last) and timestamps (s) or None.
 
-    The header must name the columns ``x, y, z, qx, qy, qz, qw`` in any order, and optionally a
-    time column ``t`` (``time``, ``timestamp``); other columns are ignored with a warning (a
-    timed pose trajectory written by :func:`save_poses` reads too). ``columns`` maps other names
-    (as :func:`read_trajectory`). The quaternion's order is taken from the names, never guessed
+    The header must name the columns ``x, y, z, qx, qy, qz, qw`` in any order (or a rotation
+    vector ``rx, ry, rz`` in radians, or a logger's own names: UR RTDE ``actual_TCP_pose_0..5``,
+    ROS ``pose.position.x`` … ``pose.orientation.w``), and optionally a time column; other
+    columns are ignored with a warning (a timed pose trajectory written by :func:`save_poses`
+    reads too). ``columns`` decides (as :func:`read_trajectory`, e.g. ``pose=target_TCP_pose``). The quaternion's order is taken from the names, never guessed
     from the numbers; ``qw`` first or last both read. Quaternions are checked by
     :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them. Samples whose
     timestamp repeats the one before are dropped, with a warning.
     """
-    from ..primitives.timing import _drop_duplicate_stamps
-    from ._columns import select_poses
+    from .recordings import read_recording
 
     path = check_path(path)
-    _check_file(path, "pose file")
     if path.suffix.lower() not in (".csv", ".txt"):
         raise ValueError(f"{path}: pose recordings are read from .csv files with a header")
-    mapping = parse_columns(columns)
-    parsed = _csv_fast(path)
-    header, values = parsed if parsed is not None else _csv_rows(path)
-    accepted = "t,x,y,z,qw,qx,qy,qz or t,x,y,z,qx,qy,qz,qw (t optional)"
-    if header is None:
-        raise ValueError(f"{path}: a pose file needs a header naming the columns ({accepted})")
-    selection = select_poses(header, mapping, path)
-    if not selection.values:
-        shown = ",".join(short_token(c, 12)[1:-1] for c in header[:8]) + (",…" if len(header) > 8 else "")
-        raise ValueError(f"{path}: header {shown} does not name a pose; accepted headers: {accepted}")
-    written = {"vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az", "dwx", "dwy", "dwz"}  # save_poses' own columns
-    if not set(selection.ignored) <= written:
-        _note_ignored(path, selection.ignored)
-    poses = as_trajectory(values[:, list(selection.values)], name=str(path), allow_static=True)
-    if selection.time is None:
-        return poses, None
-    return _drop_duplicate_stamps(poses, values[:, selection.time], f"{path}: the time column")
+    recording = read_recording(path, columns=columns)
+    if recording.kind != "pose":
+        accepted = "x,y,z with qx,qy,qz,qw or rx,ry,rz, a UR RTDE actual_TCP_pose_0..5, a ROS pose.position/orientation"
+        raise ValueError(f"{path}: its columns ({recording.source}) hold {recording.kind}, not poses; a pose file's header "
+                         f"names {accepted} (t optional)")
+    return recording.values, recording.t
 
 
 def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:

@@ -11,14 +11,7 @@ import numpy as np
 
 from .._checks import _as_bounded_array, as_trajectory, check_path, short_token
 from .._units import check_units
-from ._csv import (
-    _check_file,
-    _check_npy_trajectory,
-    _read_csv,
-    _timed_fields,
-    declared_units,
-    is_joint_recording,
-)
+from ._csv import _check_npy_trajectory, _timed_fields, declared_units, is_joint_recording
 from ._npy import _EMPTY_ZIP_MAGIC, _ZIP_MAGIC, _read_npy
 from .atomic import _destination, atomic_write
 
@@ -48,12 +41,14 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
     """Read a demonstration from ``.csv`` or ``.npy``: positions and, if the file has them,
     timestamps in seconds (as recorded: any monotone stamps, epoch-like or jittered).
 
-    CSV: one sample per row, comma (or semicolon) separated, ``#`` comments allowed, UTF-8 with
-    or without a byte-order mark. An optional header names the columns: ``x,y[,z]`` with an
-    optional time column ``t`` (or ``time``, ``timestamp``), other columns ignored with a
-    warning that names them; ``columns`` maps other names, e.g. ``"t=stamp,x=ee_x,y=ee_y,z=ee_z"``
-    (see :mod:`bidmp._columns`). A timed trajectory written by bidmp (``t,x,y[,z],vx,…,ax,…``)
-    reads its positions and times. Without a header 2 or 3 columns are positions and 4 columns
+    CSV: one sample per row, comma, semicolon, tab or space separated, ``#`` comments allowed,
+    UTF-8 with or without a byte-order mark. An optional header names the columns: ``x,y[,z]``
+    with a time column ``t`` (``time``, ``timestamp``, ``stamp``, a ROS ``header.stamp``), a
+    robot logger's own names (UR RTDE, ROS exports, ``t,<joint names>``: see
+    :func:`bidmp.io.read_recording`), other columns ignored with a warning that names them;
+    ``columns`` decides, e.g. ``"t=stamp,x=ee_x,y=ee_y,z=ee_z"`` or
+    ``"t=timestamp,position=actual_TCP_pose"``. A timed trajectory written by bidmp
+    (``t,x,y[,z],vx,…,ax,…``) reads its positions and times. Without a header 2 or 3 columns are positions and 4 columns
     are ``t,x,y,z``. Samples whose timestamp repeats the one before are dropped, with a warning.
     NPY: a float array of shape (T, D) (positions), or a structured array of shape (T,) with
     fields ``t, x, y[, z]`` (and optionally ``vx … az``), as :func:`save_trajectory` writes a
@@ -64,37 +59,34 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
     -------
     (y, t) : array (T, D) and array (T,) or None
     """
-    from ..primitives.timing import _drop_duplicate_stamps
+    from .recordings import read_recording
 
-    path = check_path(path)
-    _check_file(path, "demonstration file")
-    suffix = path.suffix.lower()
-    if suffix == ".npy":
-        with open(path, "rb") as handle:
-            magic = handle.read(4)
-        if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
-            raise ValueError(f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)")
-        try:
-            positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
-        except (EOFError, OSError) as exc:
-            raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
-        except ValueError as exc:
-            message = str(exc)
-            raise ValueError(message if str(path) in message else f"{path} is not a readable .npy array ({message})") from None
-        times = None
-        if positions.dtype.names is not None:
-            fields = _timed_fields(positions.dtype)
-            times = np.asarray(positions["t"], dtype=np.float64)
-            positions = np.column_stack([np.asarray(positions[name], dtype=np.float64) for name in fields])
-    elif suffix in (".csv", ".txt"):
-        positions, times = _read_csv(path, columns)
-    else:
-        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
-    if columns is not None and suffix == ".npy":
-        raise ValueError(f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays")
-    positions = as_trajectory(positions, name=str(path))
-    if times is not None:
-        positions, times = _drop_duplicate_stamps(positions, times, f"{path}: the time column")
+    recording = read_recording(path, columns=columns)
+    if recording.kind == "pose":
+        raise ValueError(f"{check_path(path)}: a pose recording ({recording.source}): read it with bidmp.io.read_poses / "
+                         f"bidmp.CartesianDMP, or pick its positions with --columns / columns= (x=..,y=..,z=.. or "
+                         f"position=<prefix>)")
+    return recording.values, recording.t
+
+
+def _read_npy_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
+    """An ``.npy`` demonstration: a float array (T, D), or a structured timed trajectory."""
+    with open(path, "rb") as handle:
+        magic = handle.read(4)
+    if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+        raise ValueError(f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)")
+    try:
+        positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
+    except (EOFError, OSError) as exc:
+        raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
+    except ValueError as exc:
+        message = str(exc)
+        raise ValueError(message if str(path) in message else f"{path} is not a readable .npy array ({message})") from None
+    times = None
+    if positions.dtype.names is not None:
+        fields = _timed_fields(positions.dtype)
+        times = np.asarray(positions["t"], dtype=np.float64)
+        positions = np.column_stack([np.asarray(positions[name], dtype=np.float64) for name in fields])
     return positions, times
 
 

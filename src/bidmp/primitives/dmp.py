@@ -47,7 +47,7 @@ import numpy as np
 from sklearn.base import BaseEstimator
 
 from .._api import CheckedParams
-from .._checks import as_trajectory, check_bytes, numerically_guarded
+from .._checks import as_trajectory, check_bytes, check_names, numerically_guarded
 from .._units import ANGLE_UNITS, check_units
 from ._dmp_grids import GridQueries
 from ._dmp_motions import Motions
@@ -167,7 +167,10 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         The demonstration's duration in seconds (``(T - 1) / T`` without timestamps: the paper's
         convention of one second per T samples).
     units_ : str
-        Length unit of the demonstration ("" if not given).
+        Unit of the demonstration ("" if not given).
+    names_ : list of str
+        The names of the D dimensions given to :meth:`fit` (a joint recording's joint names),
+        empty when none were.
     goal_gate_ : array (n_train_,) or None
         The goal gate on the training grid when the goal follows the demonstration's progress
         (``1 - arc length so far / total``), else None.
@@ -220,7 +223,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
-    def fit(self, y, t=None, units: str | None = None) -> "DMP":
+    def fit(self, y, t=None, units: str | None = None, names=None) -> "DMP":
         """Learn the forcing-term weights from one demonstration.
 
         Parameters
@@ -232,8 +235,12 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
             samples are resampled to uniform time over the same span, whose length becomes
             ``duration_``. Without them the samples are taken as uniform over 1 s (the paper's
             protocol).
-        units : {"m", "cm", "mm"}, optional
-            The length unit of ``y``, kept in model files (anything else is refused).
+        units : {"m", "cm", "mm", "rad"}, optional
+            The unit of ``y`` (a length, or radians for joint angles), kept in model files
+            (anything else is refused).
+        names : list of str, optional
+            The names of the D dimensions (a joint recording's joint names), kept in model files
+            and written in every trajectory file's header and joint trajectory.
 
         Returns
         -------
@@ -241,15 +248,16 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
 
         A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
-        return self._fit(y, t, units)
+        return self._fit(y, t, units, names=names)
 
     def _fit(self, y, t=None, units: str | None = None, *, progress: np.ndarray | None = None,
-             name: str = "y", unit_label: str | None = None) -> "DMP":
+             name: str = "y", unit_label: str | None = None, names=None) -> "DMP":
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
         move on its own: then ``y`` may be static)."""
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
+        names = check_names(names, y.shape[1])
         y, duration = on_uniform_time(y, t)
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
@@ -276,6 +284,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         self.dt_ = dt
         self.duration_ = duration
         self.units_ = units
+        self.names_ = names
         self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_int, check_loaded, check_real, get_limits
+from .._checks import check_int, check_loaded, check_names, check_real, get_limits
 from .._units import check_units
 from .integrate import _check_euler_stable
 
@@ -24,8 +24,10 @@ def _dmp_state(model) -> tuple[dict, dict]:
     }
     if model.__dict__.get("goal_gate_") is not None:
         arrays["goal_gate_"] = model.goal_gate_
-    return {"params": model.get_params(), "n_steps_": model.n_steps_, "duration_": model.duration_,
-            "units_": model.units_}, arrays
+    meta = {"params": model.get_params(), "n_steps_": model.n_steps_, "duration_": model.duration_, "units_": model.units_}
+    if model.__dict__.get("names_"):
+        meta["names_"] = list(model.names_)
+    return meta, arrays
 
 
 def _dmp_from_state(cls, meta: dict, arrays) -> object:
@@ -61,6 +63,7 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
     if (n_steps - 1) / model.duration_ > 1e5 or (n_steps - 1) / model.duration_ < 1e-3:
         raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
     model.units_ = check_units(meta.get("units_", ""))
+    model.names_ = check_names(meta.get("names_"), n_dims, "names_")  # absent before bidmp 0.6: unnamed
     model.goal_gate_ = None
     if params.goal_rate is None:
         gate = check_loaded(arrays["goal_gate_"], "goal_gate_", (model.n_train_,))

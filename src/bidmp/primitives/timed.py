@@ -61,7 +61,7 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
         velocities = np.diff(positions, axis=0) / dt
         accelerations = np.diff(velocities, axis=0) / dt
     return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
-                      accelerations[:n_samples], dmp.units_)
+                      accelerations[:n_samples], dmp.units_, tuple(dmp.__dict__.get("names_", ())))
 
 
 def _exact_rates(params: _Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float) -> tuple:
@@ -149,7 +149,7 @@ def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_
     y, yd, ydd = (np.array([state[k] for state in states]) for k in range(3))
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(ydd))):
         raise ValueError("trajectory: the coupled integration is not finite; a coupling term is out of range")
-    trajectory = Trajectory(np.arange(len(states)) * dt, y, yd, ydd, dmp.units_)
+    trajectory = Trajectory(np.arange(len(states)) * dt, y, yd, ydd, dmp.units_, tuple(dmp.__dict__.get("names_", ())))
     if avoiding:
         _check_avoidance(avoiding, trajectory, stepper.target, reach)
     return trajectory

@@ -72,7 +72,9 @@ class Trajectory(TimedMotion):
     y, yd, ydd : array (n, D)
         Position (units), velocity (units/s), acceleration (units/s²).
     units : str
-        Length unit of ``y`` ("" if unknown).
+        Unit of ``y`` ("" if unknown).
+    names : tuple of str
+        The names of the D dimensions (a joint-space model's joint names), () when unnamed.
     """
 
     t: np.ndarray
@@ -80,14 +82,22 @@ class Trajectory(TimedMotion):
     yd: np.ndarray
     ydd: np.ndarray
     units: str = ""
+    names: tuple = ()
 
     def __post_init__(self) -> None:
+        from .._checks import check_names
+
         _validate_motion(self, "Trajectory", (("y", None), ("yd", None), ("ydd", None)))
+        names = self.names if isinstance(self.names, (list, tuple)) and len(self.names) == 0 else (
+            check_names(self.names, self.y.shape[1], "Trajectory.names"))
+        object.__setattr__(self, "names", tuple(names))
 
     def columns(self) -> tuple[list[str], np.ndarray]:
-        """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D) and the
+        """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D; the
+        trajectory's ``names`` when it has them, ``t, <names>, v<names>, a<names>``) and the
         matching (n, 1 + 3D) array: the layout of timed CSV and ``.npy`` files."""
-        names = ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)]
+        names = list(self.names) if self.names else (
+            ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)])
         header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
         return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
 
@@ -291,7 +301,7 @@ def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None,
         raise TypeError(f"trajectory must be a bidmp.Trajectory, got {type(trajectory).__name__}")
     factor = scale_factor(trajectory, max_velocity, max_acceleration, max_jerk, norm)
     return Trajectory(trajectory.t * factor, trajectory.y.copy(), trajectory.yd / factor, trajectory.ydd / factor**2,
-                      trajectory.units)
+                      trajectory.units, trajectory.names)
 
 
 def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
