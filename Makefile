@@ -80,6 +80,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_avoidance.py --fields 10
 	$(PY) benchmarks/bench_job.py
 	$(PY) benchmarks/bench_repair.py
+	$(PY) benchmarks/bench_startup.py
 
 # The 3-D viewer of a simulation run rendered in headless Chromium (Debian's package chromium:
 # apt install chromium), offline, and its screenshot checked not to be blank (tools/view_check.py).

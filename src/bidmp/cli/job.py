@@ -13,6 +13,7 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
     from tqdm import tqdm
 
     from ..sim.job import job_targets, run_job
+    from .common import progress_bars
     from ..sim.job_report import write_job_report
 
     labels = job_targets(scenario, targets)
@@ -21,7 +22,8 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
             bar.set_postfix_str(label)
             bar.update(1)
 
-        report = run_job(scenario, targets=labels, progress=progress, pictures=pictures, view=view)
+        with progress_bars():  # the learning and repairs of each cycle (G-PRM, repairs)
+            report = run_job(scenario, targets=labels, progress=progress, pictures=pictures, view=view)
     print()
     print(report.summary())
     written = write_job_report(report, out)

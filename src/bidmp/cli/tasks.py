@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_OK, EXIT_TARGETS_FAILED, Parser, allow_outside_files, judged_methods
+from .common import EXIT_OK, EXIT_TARGETS_FAILED, Parser, allow_outside_files, judged_methods, progress_bars
 
 __all__ = ["add_commands"]
 
@@ -24,7 +24,8 @@ def _run_scenario(scenario, out, methods=None, view=False):
             if step in names:
                 bar.update(1)
 
-        report = evaluate(scenario, names, progress=progress)
+        with progress_bars():
+            report = evaluate(scenario, names, progress=progress)
     print()
     print(report.summary())
     written = write_report(report, out)
@@ -59,9 +60,10 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
             bar.set_postfix_str(f"{method} {label}")
             bar.update(1)
 
-        result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
-                          frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update,
-                          views={(method, far) for method in methods} if view else ())
+        with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
+            result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
+                              frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update,
+                              views={(method, far) for method in methods} if view else ())
     print()
     print(result.summary())
     written = write_sim_report(result, out)

@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+from .._progress import report
 from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
 from ..extension.roadmap import NoFreeRouteError
@@ -268,7 +269,8 @@ def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, 
     scene = scenario.scene
     rollouts = dict(outcome.rollouts)
     repairs = {}
-    for label in failed:
+    for done, label in enumerate(failed):
+        report("repairs", done, len(failed))
         if progress is not None:
             progress(f"{outcome.name}: repair {label}")
         fixed = repairer.repair(model, scenario.targets[label], label, axis=scenario.target_axis(label),
@@ -277,6 +279,7 @@ def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, 
         repairs[label] = fixed
         if fixed.how:
             rollouts[label] = fixed.motion
+    report("repairs", len(failed), len(failed))
     verdicts = dict(outcome.verdicts)  # the repaired motions' verdicts are the repairs' own
     verdicts.update({label: fixed.verdict for label, fixed in repairs.items() if fixed.how})
     repaired = result(outcome.name, [rollouts[label] for label in labels], outcome.runtime_s, verdicts)
