@@ -107,17 +107,21 @@ def _readable_symlog(ax) -> None:
 
 
 def plot_scenario_3d(path, report) -> Path:
-    """3-D view: demonstration, segmentation points, extended demonstration(s), Bi-DMP rollouts
-    and the plain DMP's rollouts to the targets it misses (paper Fig. 17 / 19 analogue)."""
+    """3-D view (paper Fig. 17 / 19 analogue): the demonstration, its segmentation points and
+    extended demonstration(s), every rollout the evaluation judged, one colour per method (a
+    motion that breaks the contract dashed, where it comes closest to a part or into it marked
+    ×), the targets, and the scene's parts as solids."""
     mpl = _matplotlib()
     scenario = report.scenario
     # A pose scenario's paths are (T, 7): the positions are its first three columns (drawn as
     # they were, x, y against z, qx, ... made a 2-D plot with every entry in the legend four times).
     demo = scenario.demonstration[:, :3]
     n_dims = demo.shape[1]
-    fig = mpl.figure(figsize=(8.0, 6.8), dpi=100)
+    fig = mpl.figure(figsize=(9.0, 7.4), dpi=100)
     ax = _axes_for(fig, n_dims, 1, 1, 1)
-    _draw(ax, demo, color="0.4", linewidth=3, label="demonstration")
+    if scenario.scene is not None and n_dims == 3:
+        _draw_solids(ax, scenario.scene.solids)
+    _draw(ax, demo, color="0.2", linewidth=3, label="demonstration")
     for index, extension in enumerate(report.extensions):
         if len(extension.segmentation_points):
             _draw(ax, extension.demonstration[extension.segmentation_points][:, :3], "^", color="k", markersize=6,
@@ -125,23 +129,41 @@ def plot_scenario_3d(path, report) -> Path:
         _draw(ax, extension.complete[:, :3], color="goldenrod", linewidth=2.5, alpha=0.8, label="extended demonstration" if index == 0 else None)
     for label, trajectory in scenario.demonstrations.items():
         _draw(ax, trajectory[:, :3], color="goldenrod", linewidth=2.0, alpha=0.6)
-    if "bidmp" in report.methods:
-        for index, trajectory in enumerate(report.methods["bidmp"].rollouts.values()):
-            _draw(ax, trajectory[:, :3], color="tab:red", linewidth=0.8, alpha=0.7, label="Bi-DMP rollouts" if index == 0 else None)
-    if "dmp" in report.methods:
-        for index, label in enumerate(report.failed_targets):
-            _draw(ax, report.methods["dmp"].rollouts[label][:, :3], "--", color="tab:blue", linewidth=0.8,
-                  label="plain DMP, missed targets" if index == 0 else None)
+    for name, result in report.methods.items():
+        colour = _METHOD_COLOURS.get(name, "tab:green")
+        failed = [label for label in result.rollouts if not result.task_success_at(label)]
+        ax.plot([], [], color=colour, linewidth=1.2,
+                label=f"{name}: {len(result.rollouts) - len(failed)} of {len(result.rollouts)} within the contract")
+        for label, trajectory in result.rollouts.items():
+            bad = label in failed
+            _draw(ax, trajectory[:, :3], "--" if bad else "-", color=colour, linewidth=1.0 if bad else 0.8,
+                  alpha=0.9 if bad else 0.6)
+            clearance = result.clearance_at(label)
+            if bad and clearance is not None and clearance.point is not None and not clearance.clear:
+                _draw(ax, np.asarray(clearance.point, dtype=float)[None, :3], "X", color=colour, markersize=8,
+                      markeredgecolor="black", markeredgewidth=0.5, linestyle="none")
+    if any(not result.task_success_at(label) for result in report.methods.values() for label in result.rollouts):
+        ax.plot([], [], "--", color="0.3", label="breaks the contract (dashed; × closest to a part)")
     _draw(ax, scenario.target_array[:, :3], "o", color="tab:green", markersize=4, linestyle="none", label="targets")
-    hits = [clearance.point for result in report.methods.values() if result.clearances is not None
-            for clearance in result.clearances.values() if clearance is not None and not clearance.collision_free]
-    if scenario.scene is not None and n_dims == 3:
-        for solid in scenario.scene.solids:  # each part as the vertical edges of its box
-            for x, y in ((solid.lower[0], solid.lower[1]), (solid.upper[0], solid.lower[1]),
-                         (solid.upper[0], solid.upper[1]), (solid.lower[0], solid.upper[1])):
-                ax.plot([x, x], [y, y], [solid.lower[2], solid.upper[2]], color="0.7", linewidth=0.5)
-    if hits:
-        _draw(ax, np.array(hits), "X", color="darkred", markersize=7, linestyle="none", label="collisions")
     _finish(ax, n_dims, scenario.units, f"{scenario.name}")
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)
+
+
+def _draw_solids(ax, solids) -> None:
+    """The scene's parts as shaded solids (their triangle meshes, light and translucent, so the
+    motions past them stay visible)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    from .viewer import solid_layer, solid_mesh
+
+    for index, solid in enumerate(solids):
+        layer = solid_layer(solid)
+        vertices, faces = solid_mesh(layer["kind"], layer["centre"], layer["rotation"], layer["params"], sides=16)
+        mesh = Poly3DCollection(vertices[faces], facecolor="lightsteelblue", edgecolor="none", alpha=0.35)
+        ax.add_collection3d(mesh)
+        if index == 0:
+            ax.plot([], [], "s", color="lightsteelblue", label="scene parts")
+    if solids:  # add_collection3d does not widen the axes: take the parts' extent in
+        corners = np.vstack([np.asarray(s.lower, float)[None] for s in solids] + [np.asarray(s.upper, float)[None] for s in solids])
+        ax.auto_scale_xyz(corners[:, 0], corners[:, 1], corners[:, 2], had_data=True)

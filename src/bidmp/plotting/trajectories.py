@@ -78,13 +78,16 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
                  units: str = "") -> Path:
     """A timed rollout: its path beside the demonstration's (left; 2-D or 3-D, more dimensions
     per coordinate against time) and its speed and acceleration over time (right; the norms, in
-    units/s and units/s², the limits a robot checks first).
+    units/s and units/s², the limits a robot checks first). A pose rollout
+    (:class:`~bidmp.primitives.cartesian.PoseTrajectory`) also shows its orientation: the tool's
+    frame (x red, y green, z blue) at twelve poses along the path, and a third panel with the turn
+    about the tool's own z axis and the tilt of that axis from the start's, in degrees, over time.
 
     Parameters
     ----------
     path : path of the PNG to write.
     demonstration : (T, D) the model's own reproduction or demonstration.
-    trajectory : bidmp.Trajectory (or PoseTrajectory: its positions).
+    trajectory : bidmp.Trajectory or PoseTrajectory.
     """
     from ..primitives.timing import TimedMotion
 
@@ -94,23 +97,28 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
     title, units = _text(title, "title", 200), _text(units, "units", 20)
     demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
     n_dims = trajectory.y.shape[1]
+    quaternions = getattr(trajectory, "q", None)
+    panels = 2 if quaternions is None else 3
     mpl = _matplotlib()
-    fig = mpl.figure(figsize=(12.0, 5.0), dpi=110)
+    fig = mpl.figure(figsize=(6.0 * panels, 5.0), dpi=110)
     spatial = n_dims in (2, 3)
-    ax = fig.add_subplot(1, 2, 1, projection="3d" if n_dims == 3 else None)
+    ax = fig.add_subplot(1, panels, 1, projection="3d" if n_dims == 3 else None)
     if spatial:
         ax.plot(*demonstration[:, :n_dims].T, color="0.55", linewidth=4, alpha=0.6, label="reproduction")
         ax.plot(*trajectory.y.T, color="C0", linewidth=1.5, label="rollout")
         ax.plot(*[[c] for c in trajectory.y[-1]], marker="*", markersize=12, color="crimson", linestyle="none", label="end")
+        if quaternions is not None:
+            _draw_frames(ax, trajectory.y, quaternions)
         _label_axes(ax, n_dims, units)
     else:  # a joint-space (or 1-D) motion: each coordinate against time
+        names = list(getattr(trajectory, "names", ())) or [f"x{index}" for index in range(n_dims)]
         for index in range(n_dims):
-            ax.plot(trajectory.t, trajectory.y[:, index], label=f"x{index}")
+            ax.plot(trajectory.t, trajectory.y[:, index], label=names[index])
         ax.set_xlabel("t [s]")
         ax.set_ylabel("position" + (f" [{units}]" if units else ""))
     ax.set_title(title)
     ax.legend(loc="best", fontsize=8)
-    rates = fig.add_subplot(1, 2, 2)
+    rates = fig.add_subplot(1, panels, 2)
     suffix = units or "units"
     rates.plot(trajectory.t, np.linalg.norm(trajectory.yd, axis=1), color="C0", label=f"speed [{suffix}/s]")
     rates.set_xlabel("t [s]")
@@ -121,7 +129,60 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
     rates.set_title(f"peak speed {trajectory.peak_speed():.3g} {suffix}/s, peak acceleration "
                     f"{trajectory.peak_acceleration():.3g} {suffix}/s²", fontsize=10)
     rates.grid(True, alpha=0.3)
+    if quaternions is not None:
+        turn, tilt = _tool_angles(quaternions)
+        angles = fig.add_subplot(1, panels, 3)
+        angles.plot(trajectory.t, turn, color="C2", label="turn about the tool's z axis")
+        angles.plot(trajectory.t, tilt, color="C4", label="tilt of the tool's z axis")
+        angles.set_xlabel("t [s]")
+        angles.set_ylabel("angle from the start's orientation [deg]")
+        angles.set_title(f"orientation: turned {turn[-1]:.4g} deg, tilted {tilt[-1]:.3g} deg at the end", fontsize=10)
+        angles.legend(loc="best", fontsize=8)
+        angles.grid(True, alpha=0.3)
+        fig.subplots_adjust(left=0.04, right=0.97, wspace=0.42)  # room for the middle panel's second axis
     return _save(fig, path)
+
+
+def _tool_angles(quaternions) -> tuple[np.ndarray, np.ndarray]:
+    """The turn about the tool's own z axis and the tilt of that axis, from the first orientation
+    (degrees; the turn unwrapped, so 540 degrees of unscrewing read as 540).
+
+    The relative rotation ``q0⁻¹ q`` is split into a twist about z and a swing of the z axis:
+    twist ``2·atan2(qz, qw)``, swing the angle between the two z axes.
+
+    Parameters
+    ----------
+    quaternions : (n, 4) unit quaternions ``qx, qy, qz, qw``.
+
+    Returns
+    -------
+    turn, tilt : arrays (n,), degrees.
+    """
+    from scipy.spatial.transform import Rotation
+
+    q = as_trajectory(quaternions, "quaternions", min_points=1, allow_static=True)
+    if q.shape[1] != 4:
+        raise ValueError(f"quaternions must have 4 columns (qx, qy, qz, qw), got {q.shape[1]}")
+    relative = (Rotation.from_quat(q[:1]).inv() * Rotation.from_quat(q)).as_quat()
+    turn = np.unwrap(2.0 * np.arctan2(relative[:, 2], relative[:, 3]))
+    axis = Rotation.from_quat(relative).apply([0.0, 0.0, 1.0])
+    tilt = np.arccos(np.clip(axis[:, 2], -1.0, 1.0))
+    return np.degrees(turn), np.degrees(tilt)
+
+
+def _draw_frames(ax, positions: np.ndarray, quaternions: np.ndarray, count: int = 12) -> None:
+    """The tool's frame at ``count`` poses along the path: x red, y green, z blue, each a tenth
+    of the path's extent (3-D only)."""
+    from scipy.spatial.transform import Rotation
+
+    if positions.shape[1] != 3:
+        return
+    extent = float(np.max(np.ptp(positions, axis=0))) or 1.0
+    chosen = np.unique(np.linspace(0, len(positions) - 1, min(count, len(positions))).round().astype(int))
+    axes = Rotation.from_quat(quaternions[chosen]).as_matrix() * (0.1 * extent)
+    for column, colour in enumerate(("tab:red", "tab:green", "tab:blue")):
+        ax.quiver(*positions[chosen].T, *axes[:, :, column].T, color=colour, linewidth=1.0, arrow_length_ratio=0.15,
+                  label=f"tool {'xyz'[column]} axis")
 
 
 def plot_generalisation(path: str | os.PathLike, result) -> Path:

@@ -39,8 +39,9 @@ __all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_layer
            "save_layers", "load_layers", "VIEW_FORMAT"]
 
 VIEW_FORMAT = 1  # of view_layers.npz
-_COLOURS = {"dmp": "#1f77b4", "dmp-converged": "#17becf", "bidmp": "#d62728", "bidmp-latest": "#ff7f0e",
+_COLOURS = {"dmp": "#1f77b4", "dmp-converged": "#17becf", "bidmp": "#d62728", "bidmp-latest": "#bcbd22",
             "gmm": "#9467bd", "tpgmm": "#8c564b"}
+WARNING = "#ffc000"  # amber: a motion that breaks the contract, and the part it came too close to (not the robot joints' dark orange)
 
 
 @dataclass
@@ -50,7 +51,9 @@ class ViewLayers:
     ``rollouts`` maps method -> target label -> (T, 3); ``solids`` are the scene's convex parts as
     ``{"label", "kind", "centre", "rotation", "params"}``; ``robot`` maps a motion's name
     ("bidmp -> 11") to ``{"times": (F,), "links": (F, L, 3)}``: the arm's joint origins from
-    base to tool tip, sampled along the simulated motion.
+    base to tool tip, sampled along the simulated motion. ``failures`` maps method -> target
+    label -> ``{"reason": str, "part": str or None, "point": [x, y, z] or None}`` for the rollouts
+    that break the motion contract (the part it came too close to, and where).
     """
 
     title: str
@@ -62,6 +65,7 @@ class ViewLayers:
     rollouts: dict = field(default_factory=dict)
     solids: list = field(default_factory=list)
     robot: dict = field(default_factory=dict)
+    failures: dict = field(default_factory=dict)
 
 
 def _xyz(points) -> np.ndarray:
@@ -85,7 +89,21 @@ def layers_from_report(report) -> ViewLayers:
         segmentation=np.vstack(points) if points else np.zeros((0, 3)),
         extended=[_xyz(e.complete) for e in report.extensions] + [_xyz(t) for t in scenario.demonstrations.values()],
         rollouts={name: {label: _xyz(r) for label, r in result.rollouts.items()} for name, result in report.methods.items()},
-        solids=solids)
+        solids=solids, failures={name: _failures(result) for name, result in report.methods.items() if _failures(result)})
+
+
+def _failures(result) -> dict:
+    """The rollouts of one method that break the contract: why, and the part they came too close to."""
+    failed = {}
+    for label in result.rollouts:
+        if result.task_success_at(label):
+            continue
+        clearance = result.clearance_at(label)
+        close = clearance is not None and not clearance.clear and clearance.point is not None
+        failed[label] = {"reason": result.reason_at(label) or "breaks the motion contract",
+                         "part": clearance.part if close else None,
+                         "point": _xyz(np.atleast_2d(clearance.point))[0].tolist() if close else None}
+    return failed
 
 
 def solid_layer(solid) -> dict:
@@ -149,20 +167,46 @@ def _static_traces(go, layers: ViewLayers) -> list:
                                    marker={"symbol": "diamond", "size": 5, "color": "black"}))
     for index, path in enumerate(layers.extended):
         traces.append(_path(go, path, "extended demonstrations", "goldenrod", "extended", index == 0, width=5))
+    close_parts = {}
     for method, paths in layers.rollouts.items():
-        for index, (label, path) in enumerate(paths.items()):
-            trace = _path(go, path, f"{method} rollouts", _COLOURS.get(method, "#2ca02c"), method, index == 0, width=2)
-            trace.update(visible=True if method in ("bidmp", "dmp") else "legendonly", hovertext=f"{method} -> {label}")
+        failures = layers.failures.get(method, {})
+        shown = [label for label in paths if label not in failures]
+        for label, path in paths.items():
+            visible = True if method in ("bidmp", "dmp") else "legendonly"
+            if label in failures:
+                failure = failures[label]
+                trace = _path(go, path, f"{method}: breaks the contract", WARNING, f"{method} failing",
+                              label == next(iter(failures)), width=5, dash="dash")
+                trace.update(visible=visible, hovertext=f"{method} -> {label}: {failure['reason']}")
+                traces.append(trace)
+                if failure.get("point") is not None:
+                    point = np.asarray(failure["point"], dtype=float)
+                    traces.append(go.Scatter3d(
+                        x=[point[0]], y=[point[1]], z=[point[2]], mode="markers+text", legendgroup=f"{method} failing",
+                        showlegend=False, visible=visible, text=[f"{label}: too close to {failure['part']}"],
+                        marker={"symbol": "x", "size": 6, "color": WARNING}, hovertext=failure["reason"], hoverinfo="text"))
+                    close_parts.setdefault(failure["part"], []).append(f"{method} -> {label}")
+                continue
+            trace = _path(go, path, f"{method} rollouts", _COLOURS.get(method, "#2ca02c"), method, label == shown[0], width=2)
+            trace.update(visible=visible, hovertext=f"{method} -> {label}")
             traces.append(trace)
     if layers.targets:
         t = np.array(list(layers.targets.values()))
         traces.append(go.Scatter3d(x=t[:, 0], y=t[:, 1], z=t[:, 2], mode="markers+text", name="targets",
                                    text=list(layers.targets), marker={"size": 3, "color": "green"}))
+    first_close = True
     for index, solid in enumerate(layers.solids):
         vertices, faces = solid_mesh(solid["kind"], solid["centre"], solid["rotation"], solid["params"])
-        traces.append(go.Mesh3d(x=vertices[:, 0], y=vertices[:, 1], z=vertices[:, 2], i=faces[:, 0], j=faces[:, 1],
-                                k=faces[:, 2], color="lightsteelblue", opacity=0.35, name="scene parts",
-                                legendgroup="scene", showlegend=index == 0, hovertext=solid["label"], hoverinfo="text"))
+        mesh = {"x": vertices[:, 0], "y": vertices[:, 1], "z": vertices[:, 2], "i": faces[:, 0], "j": faces[:, 1],
+                "k": faces[:, 2], "hoverinfo": "text"}
+        if solid["label"] in close_parts:  # a part a failing motion came too close to: in the warning colour
+            traces.append(go.Mesh3d(**mesh, color=WARNING, opacity=0.7, name="parts motions came too close to",
+                                    legendgroup="too close", showlegend=first_close,
+                                    hovertext=f"{solid['label']}: too close for {', '.join(close_parts[solid['label']])}"))
+            first_close = False
+            continue
+        traces.append(go.Mesh3d(**mesh, color="lightsteelblue", opacity=0.35, name="scene parts",
+                                legendgroup="scene", showlegend=index == 0, hovertext=solid["label"]))
     return traces
 
 
@@ -243,7 +287,8 @@ def save_layers(path, layers: ViewLayers) -> Path:
         robot[name] = k
     meta = {"format": VIEW_FORMAT, "kind": "bidmp-view", "title": layers.title, "units": layers.units,
             "targets": {label: np.asarray(t, float).tolist() for label, t in layers.targets.items()},
-            "n_extended": len(layers.extended), "rollouts": rollouts, "solids": layers.solids, "robot": robot}
+            "n_extended": len(layers.extended), "rollouts": rollouts, "solids": layers.solids, "robot": robot,
+            "failures": layers.failures}
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     with atomic_write(path, "wb") as handle:
         np.savez_compressed(handle, **{k: np.asarray(v) for k, v in arrays.items()})
@@ -258,6 +303,21 @@ def _check_layers(layers) -> None:
 def _json_bytes(shape, dtype) -> None:
     if dtype != np.uint8 or len(shape) != 1 or shape[0] > _META_MAX_BYTES:
         raise ValueError("its metadata member is not UTF-8 JSON bytes")
+
+
+def _checked_failures(failures) -> dict:
+    """A view file's failures, each entry of the shape :class:`ViewLayers` documents."""
+    if not isinstance(failures, dict) or not all(isinstance(entries, dict) for entries in failures.values()):
+        raise ValueError("its failures are not a mapping of method -> label -> failure")
+    for entries in failures.values():
+        for failure in entries.values():
+            if not isinstance(failure, dict) or not isinstance(failure.get("reason"), str):
+                raise ValueError("a failure has no reason")
+            point = failure.get("point")
+            if point is not None and (not isinstance(point, list) or len(point) != 3
+                                      or not all(isinstance(v, (int, float)) for v in point)):
+                raise ValueError("a failure's point is not three numbers")
+    return failures
 
 
 def load_layers(path) -> ViewLayers:
@@ -279,6 +339,7 @@ def load_layers(path) -> ViewLayers:
                 rollouts={method: {label: data[key] for label, key in pairs} for method, pairs in meta["rollouts"].items()},
                 solids=meta["solids"],
                 robot={name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
-                       for name, k in meta["robot"].items()})
+                       for name, k in meta["robot"].items()},
+                failures=_checked_failures(meta.get("failures", {})))  # absent in files of bidmp 0.5
     except (KeyError, ValueError, TypeError, AttributeError) as exc:
         raise ValueError(f"{path}: cannot read a bidmp view ({printable(str(exc))[:120]})") from None
