@@ -174,3 +174,51 @@ def test_joint_names_stay_on_the_model_and_in_every_file(tmp_path, capsys):
         bidmp.DMP().fit(q, names=names[:5])
     with pytest.raises(ValueError, match="two dimensions have the same name"):
         bidmp.DMP().fit(q, names=[names[0]] * 6)
+
+
+def test_a_position_model_keeps_the_orientation_its_demonstration_held(tmp_path, capsys):
+    """Issue 35.4: positions picked from an RTDE pose (the tool pointing down, 0.06 deg of sensor
+    noise) keep that orientation; the bag a rollout writes carries it in every PoseStamped (the
+    closed form of the axis-angle, here by hand). A demonstration that turns the tool is told it
+    loses the turn, and its rollout is a PointStamped stream: no orientation is made up."""
+    pytest.importorskip("rosbags")
+    from rosbags.highlevel import AnyReader
+
+    t, y, rotvec, _ = _motion()
+    angle = np.pi * 0.999
+    noisy = np.array([angle, 0.0, 0.0]) + np.random.default_rng(5).normal(0.0, 1e-3, (N, 3))
+    held = _write(tmp_path / "held.csv", ["timestamp", *(f"actual_TCP_pose_{i}" for i in range(6))], [t, y, noisy], sep=" ")
+    model = _fit(tmp_path, "held", held, "--columns", "t=timestamp,position=actual_TCP_pose")
+    assert "orientation held within" in capsys.readouterr().out
+    expected = np.array([np.sin(angle / 2), 0.0, 0.0, np.cos(angle / 2)])  # qx, qy, qz, qw of a turn about x
+    assert min(np.linalg.norm(model.held_orientation_ - expected), np.linalg.norm(model.held_orientation_ + expected)) < 2e-3
+    assert main(["rollout", str(tmp_path / "held.npz"), "-o", str(tmp_path / "r.csv"), "--rate", "50", "--bag",
+                 str(tmp_path / "held_bag")]) == 0
+    with AnyReader([tmp_path / "held_bag"]) as reader:
+        (connection,) = reader.connections
+        read = [reader.deserialize(raw, connection.msgtype) for _, _, raw in reader.messages()]
+    assert connection.msgtype == "geometry_msgs/msg/PoseStamped"
+    quaternions = np.array([[m.pose.orientation.x, m.pose.orientation.y, m.pose.orientation.z, m.pose.orientation.w]
+                            for m in read])
+    np.testing.assert_allclose(quaternions, np.broadcast_to(model.held_orientation_, quaternions.shape), atol=0)
+    # The turning tool of _motion(): the turn is dropped, and said to be.
+    turning = _write(tmp_path / "turning.csv", ["timestamp", *(f"actual_TCP_pose_{i}" for i in range(6))],
+                     [t, y, rotvec], sep=" ")
+    capsys.readouterr()
+    plain = _fit(tmp_path, "turning", turning, "--columns", "t=timestamp,position=actual_TCP_pose")
+    assert "which a position model drops" in capsys.readouterr().out and plain.held_orientation_ is None
+    assert main(["rollout", str(tmp_path / "turning.npz"), "-o", str(tmp_path / "r2.csv"), "--rate", "50", "--bag",
+                 str(tmp_path / "point_bag")]) == 0
+    assert "PointStamped: the model knows no orientation and none is made up" in capsys.readouterr().out
+
+
+def test_joints_chosen_by_name_in_the_order_given(tmp_path):
+    names = ["panda_joint1", "panda_joint2", "panda_finger_joint1", "panda_joint3"]
+    s = np.linspace(0.0, 1.0, 200)
+    values = np.column_stack([s * 0.5, -s * 0.3, 0.04 + 0 * s, s * 0.2])
+    path = _write(tmp_path / "js.csv", ["stamp", *names], [np.linspace(0.0, 2.0, 200), values])
+    picked = bidmp.io.read_recording(path, columns="joints=panda_joint3|panda_joint1")
+    assert picked.names == ["panda_joint3", "panda_joint1"] and picked.ignored == ("panda_joint2", "panda_finger_joint1")
+    np.testing.assert_array_equal(picked.values, values[:, [3, 0]])
+    with pytest.raises(ValueError, match="no column 'panda_joint9' for joints"):
+        bidmp.io.read_recording(path, columns="joints=panda_joint9|panda_joint1")

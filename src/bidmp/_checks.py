@@ -22,6 +22,7 @@ from numbers import Integral, Real
 import numpy as np
 
 __all__ = [
+    "as_unit_quaternion",
     "check_names",
     "printable",
     "as_rotation",
@@ -393,6 +394,14 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
         raise TypeError(f"{name} must be an integer or a numpy.random.Generator (None would make results irreproducible)")
     seed = check_int(seed, name, minimum=0, maximum=2**128 - 1)
     return np.random.default_rng(seed)
+
+
+def as_unit_quaternion(value, name: str) -> np.ndarray:
+    """A unit quaternion ``qx, qy, qz, qw`` (4,), its norm within 1e-6 of 1."""
+    quaternion = as_vector(value, name, length=4)
+    if not abs(float(np.linalg.norm(quaternion)) - 1.0) <= 1e-6:
+        raise ValueError(f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(quaternion):.6g}")
+    return quaternion
 
 
 def check_names(names, count: int, name: str = "names") -> list[str]:

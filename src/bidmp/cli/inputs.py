@@ -168,7 +168,32 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
         notes.append(f"read {recording.source}")
     if recording.kind == "joints" and recording.names:
         args.joint_names = list(recording.names)
+    if getattr(recording, "orientation", None) is not None:
+        held, spread = held_orientation(recording.orientation)
+        if spread <= HELD_DEGREES:
+            args.held_orientation = held
+            notes.append(f"the tool's orientation held within {spread:.2g} deg: kept with the model")
+        else:
+            notes.append(f"the tool turns by up to {spread:.3g} deg, which a position model drops (a pose model keeps "
+                         f"it: --columns pose=...)")
     return values, times, units, "; ".join([how, *notes])
+
+
+HELD_DEGREES = 1.0  # an orientation that stays within this of its mean is one the demonstration held
+
+
+def held_orientation(quaternions):
+    """The mean of unit quaternions (n, 4) (signs aligned to the first) and the largest angle (deg)
+    between it and any of them."""
+    import numpy as np
+
+    from ..primitives.cartesian import angle_between
+
+    q = np.asarray(quaternions, dtype=float)
+    q = q * np.where(q @ q[0] < 0.0, -1.0, 1.0)[:, None]
+    mean = q.mean(axis=0)
+    mean /= np.linalg.norm(mean)
+    return mean, float(np.degrees(np.max(angle_between(q, mean[None]))))
 
 
 def _time_option(path, times, args: argparse.Namespace, recording):

@@ -256,16 +256,19 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
             raise ValueError("--bag: ROS poses are in metres and this model's length unit is not known; fit it with --units")
         if poses and args.orientation is not None:
             raise ValueError("--orientation is the held orientation of a position model; a pose model has its own")
+        held = None if poses else args.orientation if args.orientation is not None else dmp.__dict__.get("held_orientation_")
         scale = conversion(dmp.units_, "m")
         values = trajectory.y * scale if not poses else np.hstack([trajectory.y * scale, trajectory.q])
-        path = write_bag(args.bag, trajectory.t, values, kind="pose", orientation=args.orientation, **options)
+        path = write_bag(args.bag, trajectory.t, values, kind="pose", orientation=held, **options)
         if poses:
             what = "geometry_msgs/PoseStamped"
-        elif args.orientation is not None:
-            what = f"geometry_msgs/PoseStamped, orientation {args.orientation} held"
+        elif held is not None:
+            source = "given" if args.orientation is not None else "the demonstration's"
+            what = f"geometry_msgs/PoseStamped, {source} orientation {np.array2string(np.asarray(held), precision=4)} held"
         else:
-            what = "geometry_msgs/PointStamped: a position model has no orientation (--orientation QX QY QZ QW to hold one)"
-        topic = options["topic"] or ("/bidmp/pose" if poses or args.orientation is not None else "/bidmp/point")
+            what = ("geometry_msgs/PointStamped: the model knows no orientation and none is made up (--orientation QX QY "
+                    "QZ QW holds one)")
+        topic = options["topic"] or ("/bidmp/pose" if held is not None or poses else "/bidmp/point")
         return f"{path} ({what} on {topic}, {len(trajectory)} messages, metres, {_stamped(options)})"
     kind = "follow" if args.follow else "joints"
     path = write_bag(args.bag, trajectory.t, trajectory.y, kind=kind, velocities=trajectory.yd, names=list(trajectory.names) or None,

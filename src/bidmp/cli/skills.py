@@ -69,7 +69,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if demo_kind(args) == "pose":
         return _fit_poses(args)
     demonstration, times, units, how = read_input(args.demo, args, timed=True)
-    dmp = DMP(**_dmp_params(args)).fit(demonstration, times, units=units, names=getattr(args, "joint_names", None))
+    dmp = DMP(**_dmp_params(args)).fit(demonstration, times, units=units, names=getattr(args, "joint_names", None),
+                                       held_orientation=getattr(args, "held_orientation", None))
     path = save_model(dmp, args.output)
     reproduction = dmp.trajectory()
     reference = resample_time(demonstration, dmp.n_steps_)

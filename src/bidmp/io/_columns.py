@@ -18,7 +18,8 @@ A file whose columns hold more than one motion (an RTDE log of the measured and 
 pose and joints) is refused with the candidates listed and the ``columns`` that picks each; it
 is never guessed. A *column mapping* decides: roles ``t``, ``x``, ``y``, ``z``, ``qx``…``qw``,
 ``rx``, ``ry``, ``rz`` name single columns, and ``pose=``, ``position=``, ``joints=`` a group by
-its prefix (``pose=actual_TCP_pose``, ``joints=actual_q``); as the command line writes it,
+its prefix (``pose=actual_TCP_pose``, ``joints=actual_q``) or joints by name
+(``joints=shoulder_pan_joint|elbow_joint``, in that order); as the command line writes it,
 ``t=stamp,x=ee_x,y=ee_y,z=ee_z``. A mapping with only ``t`` fixes the time and leaves the rest
 to the names.
 """
@@ -64,6 +65,10 @@ class Layout:
         Positions ``x, y[, z]``; a pose's ``x, y, z`` and its rotation (``qx, qy, qz, qw`` or
         ``rx, ry, rz``); or the joints, in order.
     rotation : {"quaternion", "rotvec", None}
+        How a pose's rotation columns (or the ``orientation`` columns) give it.
+    orientation : tuple of int
+        Positions picked from a pose group (``position=actual_TCP_pose``): the group's rotation
+        columns, read beside them (a position model keeps the orientation the demonstration held).
     names : tuple of str
         The file's own names of the value columns (a joint recording's joint names).
     units : str
@@ -80,6 +85,7 @@ class Layout:
     time_divisor: float
     values: tuple[int, ...]
     rotation: str | None
+    orientation: tuple[int, ...]
     names: tuple[str, ...]
     units: str
     label: str
@@ -94,6 +100,7 @@ class _Candidate:
     units: str
     label: str
     pick: str  # the mapping that selects it
+    orientation: tuple[int, ...] = ()
 
 
 def _key(name: str) -> str:
@@ -295,11 +302,11 @@ _OWN_RATES = re.compile(r"^(v|a|w|dw)(x|y|z|x[0-9]+)$")  # what save_trajectory 
 
 
 def _layout(header, keys, time, scale, chosen: _Candidate) -> Layout:
-    used = set(chosen.values) | set(time)
+    used = set(chosen.values) | set(time) | set(chosen.orientation)
     ignored = tuple(name for index, (name, key) in enumerate(zip(header, keys))
                     if index not in used and not _OWN_RATES.match(key)
                     and not (chosen.kind == "joints" and key[:1] in "va" and key[1:] in {keys[i] for i in chosen.values}))
-    return Layout(chosen.kind, time, scale, chosen.values, chosen.rotation,
+    return Layout(chosen.kind, time, scale, chosen.values, chosen.rotation, chosen.orientation,
                   tuple(header[index] for index in chosen.values), chosen.units, chosen.label, ignored)
 
 
@@ -350,8 +357,9 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
         for candidate in _ros_candidates(header, keys) + _rtde_candidates(header, keys):
             if candidate.kind != "joints" and _key(candidate.pick.split("=", 1)[1]) == wanted.rstrip("."):
                 if "position" in mapping:
-                    return _Candidate("positions", candidate.values[:3], None, candidate.units,
-                                      candidate.label.split(" + ")[0].replace("_0..5", "_0..2"), f"position={wanted}")
+                    return _Candidate("positions", candidate.values[:3], candidate.rotation, candidate.units,
+                                      candidate.label.split(" + ")[0].replace("_0..5", "_0..2"), f"position={wanted}",
+                                      candidate.values[3:])
                 if candidate.kind == "pose":
                     return candidate
         role = "pose" if "pose" in mapping else "position"
@@ -359,6 +367,12 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
                          f"under that prefix) in the header {_shown(header, 10)}")
     if "joints" in mapping:
         wanted = mapping["joints"]
+        if "|" in wanted:  # the joints by name, in this order
+            names = [name for name in wanted.split("|") if name]
+            where = tuple(_index(header, keys, name, "joints", path) for name in names)
+            if len(set(where)) != len(where):
+                raise ValueError("columns: joints names a column twice")
+            return _Candidate("joints", where, None, "rad", "|".join(header[i] for i in where), f"joints={wanted}")
         members = sorted((int(m.group(2)), index) for index, key in enumerate(keys)
                          if (m := _INDEXED.match(key)) and m.group(1).rstrip("._") == wanted)
         if not members:

@@ -42,6 +42,9 @@ class Recording:
         The first stamp (s since the epoch for a logger's stamps; 0 without a time column).
     ignored : tuple of str
         The file's columns that were not read (a CSV's).
+    orientation : (n, 4) or None
+        Positions picked from a pose group (``columns="position=actual_TCP_pose"``): the tool's
+        orientation beside them, ``qx, qy, qz, qw``.
     """
 
     t: np.ndarray | None
@@ -52,6 +55,7 @@ class Recording:
     source: str
     stamp: float
     ignored: tuple = ()
+    orientation: np.ndarray | None = None
 
 
 def _header_line(path) -> str:
@@ -134,19 +138,26 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
             _note_ignored(path, layout.ignored)
             times = times_in_seconds(values, layout, path)
             positions = _values(values, layout)
+            if layout.orientation:  # read beside the positions, filtered with them
+                orientation = _quaternions(values[:, list(layout.orientation)], layout.rotation)
+                positions = np.hstack([positions, orientation])
     else:
         raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
     kind = "positions" if layout is None else layout.kind
     positions = as_trajectory(positions, name=str(path), allow_static=kind == "pose")
     if times is not None:
         positions, times = _drop_duplicate_stamps(positions, times, f"{path}: the time column")
+    orientation = None
+    if layout is not None and layout.orientation:
+        positions, orientation = positions[:, :3], positions[:, 3:]
+        positions = as_trajectory(positions, name=str(path))
     declared = declared_units(path) if suffix in (".csv", ".txt") else ""
     if layout is None:
         names, units, source = [], declared, f"{'an .npy array' if suffix == '.npy' else 'columns without a header'}"
     else:
         names, units, source = list(layout.names), declared or layout.units, layout.label
     return Recording(times, positions, names, kind, units, source, float(times[0]) if times is not None else 0.0,
-                     () if layout is None else layout.ignored)
+                     () if layout is None else layout.ignored, orientation)
 
 
 def _headerless(values: np.ndarray, path) -> np.ndarray:
@@ -156,12 +167,18 @@ def _headerless(values: np.ndarray, path) -> np.ndarray:
 
 
 def _values(values: np.ndarray, layout: Layout) -> np.ndarray:
-    """The value columns of ``values`` in the layout's order; a rotation vector as a quaternion."""
+    """The value columns of ``values`` in the layout's order; a pose's rotation as a quaternion."""
     data = values[:, list(layout.values)]
-    if layout.rotation != "rotvec":
+    if layout.kind != "pose":
         return data
+    return np.hstack([data[:, :3], _quaternions(data[:, 3:], layout.rotation)])
+
+
+def _quaternions(rotation: np.ndarray, kind: str) -> np.ndarray:
+    """Rotation columns as quaternions ``qx, qy, qz, qw``: as they are, or from a rotation vector
+    (UR's axis-angle, radians)."""
+    if kind != "rotvec" or not np.all(np.isfinite(rotation)):
+        return rotation  # (a bad value: as_trajectory names it)
     from scipy.spatial.transform import Rotation
 
-    if not np.all(np.isfinite(data)):
-        return data  # as_trajectory names the bad value
-    return np.hstack([data[:, :3], Rotation.from_rotvec(data[:, 3:]).as_quat()])
+    return Rotation.from_rotvec(rotation).as_quat()

@@ -47,7 +47,7 @@ import numpy as np
 from sklearn.base import BaseEstimator
 
 from .._api import CheckedParams
-from .._checks import as_trajectory, check_bytes, check_names, numerically_guarded
+from .._checks import as_trajectory, as_unit_quaternion, check_bytes, check_names, numerically_guarded
 from .._units import ANGLE_UNITS, check_units
 from ._dmp_grids import GridQueries
 from ._dmp_motions import Motions
@@ -171,6 +171,8 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
     names_ : list of str
         The names of the D dimensions given to :meth:`fit` (a joint recording's joint names),
         empty when none were.
+    held_orientation_ : array (4,) or None
+        The tool orientation the demonstration held (``qx, qy, qz, qw``), when given to :meth:`fit`.
     goal_gate_ : array (n_train_,) or None
         The goal gate on the training grid when the goal follows the demonstration's progress
         (``1 - arc length so far / total``), else None.
@@ -223,7 +225,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
-    def fit(self, y, t=None, units: str | None = None, names=None) -> "DMP":
+    def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> "DMP":
         """Learn the forcing-term weights from one demonstration.
 
         Parameters
@@ -248,16 +250,17 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
 
         A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
-        return self._fit(y, t, units, names=names)
+        return self._fit(y, t, units, names=names, held_orientation=held_orientation)
 
     def _fit(self, y, t=None, units: str | None = None, *, progress: np.ndarray | None = None,
-             name: str = "y", unit_label: str | None = None, names=None) -> "DMP":
+             name: str = "y", unit_label: str | None = None, names=None, held_orientation=None) -> "DMP":
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
         move on its own: then ``y`` may be static)."""
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
         names = check_names(names, y.shape[1])
+        held = None if held_orientation is None else as_unit_quaternion(held_orientation, "held_orientation")
         y, duration = on_uniform_time(y, t)
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
@@ -285,6 +288,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         self.duration_ = duration
         self.units_ = units
         self.names_ = names
+        self.held_orientation_ = held
         self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import check_int, check_loaded, check_names, check_real, get_limits
+from .._checks import as_unit_quaternion, check_int, check_loaded, check_names, check_real, get_limits
 from .._units import check_units
 from .integrate import _check_euler_stable
 
@@ -24,6 +24,8 @@ def _dmp_state(model) -> tuple[dict, dict]:
     }
     if model.__dict__.get("goal_gate_") is not None:
         arrays["goal_gate_"] = model.goal_gate_
+    if model.__dict__.get("held_orientation_") is not None:
+        arrays["held_orientation_"] = model.held_orientation_
     meta = {"params": model.get_params(), "n_steps_": model.n_steps_, "duration_": model.duration_, "units_": model.units_}
     if model.__dict__.get("names_"):
         meta["names_"] = list(model.names_)
@@ -64,6 +66,9 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
         raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
     model.units_ = check_units(meta.get("units_", ""))
     model.names_ = check_names(meta.get("names_"), n_dims, "names_")  # absent before bidmp 0.6: unnamed
+    model.held_orientation_ = (as_unit_quaternion(check_loaded(arrays["held_orientation_"], "held_orientation_", (4,)),
+                                                  "member held_orientation_")
+                               if "held_orientation_" in arrays else None)
     model.goal_gate_ = None
     if params.goal_rate is None:
         gate = check_loaded(arrays["goal_gate_"], "goal_gate_", (model.n_train_,))
