@@ -226,3 +226,27 @@ def test_the_pose_plot_shows_the_orientation_turn_and_tilt():
     measured_turn, measured_tilt = _tool_angles(rotations.as_quat())
     np.testing.assert_allclose(measured_turn, np.degrees(turn), atol=1e-9)
     np.testing.assert_allclose(measured_tilt, np.degrees(tilt), atol=1e-6)
+
+
+def test_a_two_line_title_renders_as_two_lines_and_control_codes_do_not(tmp_path):
+    """Found looking at the extension figure: its second title line ('G-PRM similarity ...') was
+    drawn after a '?' in place of the line break."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from bidmp.datasets import minimum_jerk
+    from bidmp.extension import extend_demonstration
+    from bidmp.plotting import extension as figures
+
+    demo = minimum_jerk(np.array([[0.0, 0.0, 60.0], [80.0, 0.0, 60.0], [80.0, 0.0, 0.0]]), 200)
+    extended = extend_demonstration(demo, [160.0, 40.0, 0.0])
+    captured = {}
+    original = figures._save
+    figures._save = lambda fig, path: captured.setdefault("fig", fig) and original(fig, path)
+    try:
+        figures.plot_extension(tmp_path / "e.png", extended, units="mm", title="run \x1b[31m7")
+    finally:
+        figures._save = original
+    title = captured["fig"].axes[0].get_title()
+    first, second = title.split("\n")
+    assert first == "run ?[31m7" and second.startswith("G-PRM similarity ")

@@ -76,7 +76,9 @@ def _text(value, name: str, longest: int) -> str:
         raise TypeError(f"{name} must be a string, got {type(value).__name__}")
     if len(value) > longest:
         raise ValueError(f"{name} is {len(value):,} characters long; at most {longest}")
-    return printable(value)  # a control code has no glyph in any font
+    # A control code has no glyph in any font (a file name may carry terminal escapes); a line
+    # break is the one that lays out, as the figures' own two-line titles use it.
+    return "\n".join(printable(line) for line in value.split("\n"))
 
 
 def _sequence(value, name: str) -> list:
