@@ -388,7 +388,7 @@ def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
     code, out, err = run(["fit", str(path), "-o", str(tmp_path / "m.npz"), "--units", "mm",
                           "--columns", "t=stamp,x=ee_x,y=ee_y,z=ee_z"], capsys)
     assert code == 0, err
-    assert "ignored 1 column(s) that are not time or positions: grip" in err
+    assert "ignored 1 column(s) that are not time or the motion read: grip" in err
     assert "dropped 1 sample(s) whose timestamp repeats" in err
     expected = bidmp.prepare(y, bidmp.datasets.recording("operator2_nut5")[1])[0].y[-1]  # the file without a dropped sample
     np.testing.assert_allclose(bidmp.load(tmp_path / "m.npz").goal_, expected, atol=0.1)

@@ -116,7 +116,7 @@ def test_logger_headers_extra_columns_and_a_column_mapping(tmp_path, caplog):
         positions, stamps = bidmp.io.read_trajectory(plain)
     np.testing.assert_array_equal(positions, y)
     np.testing.assert_array_equal(stamps, t)
-    assert "ignored 2 column(s) that are not time or positions: force, gripper" in caplog.text
+    assert "ignored 2 column(s) that are not time or the motion read: force, gripper" in caplog.text
     named = logger_file(tmp_path, "stamp,ee_z,force,ee_x,ee_y", np.column_stack([t, y[:, 2], force, y[:, 0], y[:, 1]]), "b.csv")
     positions, stamps = bidmp.io.read_trajectory(named, columns="t=stamp,x=ee_x,y=ee_y,z=ee_z")
     np.testing.assert_array_equal(positions, y)

@@ -1356,3 +1356,112 @@ def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_fla
     line = np.column_stack([x, 0.2 * x, np.zeros(len(x))]) / np.sqrt(1.04)  # arc length = x
     found = segmentation.segment(line)
     assert (found.points.tolist(), found.kinds.tolist()) == expected
+
+
+# -- units and speeds a robot can run; bags' stamp order (issue 35) --------------------------------
+@pytest.mark.parametrize("units, per_metre", [("m", 1.0), ("cm", 100.0), ("mm", 1000.0)])
+def test_a_peak_speed_is_judged_at_1_mm_per_s_and_10_m_per_s_in_every_unit(units, per_metre):
+    """Boundaries written out: 1 mm/s and 10 m/s are plausible, a hair beyond either is not, in
+    the numbers of each unit; fast_only judges only the upper bound."""
+    from bidmp._units import check_speed
+
+    for metres_per_s in (1e-3, 0.25, 10.0):
+        check_speed(metres_per_s * per_metre, units, "x")
+    for metres_per_s, word in ((1e-3 * (1 - 1e-9), "slower"), (10.0 * (1 + 1e-9), "faster")):
+        with pytest.raises(ValueError, match=word):
+            check_speed(metres_per_s * per_metre, units, "x")
+    check_speed(1e-6 * per_metre, units, "x", fast_only=True)
+    with pytest.raises(ValueError, match="faster"):
+        check_speed(10.0 * (1 + 1e-9) * per_metre, units, "x", fast_only=True)
+    check_speed(float("nan"), units, "x")  # not a speed: nothing to judge
+    check_speed(1e9, "", "x")  # no unit: not judged
+
+
+@pytest.mark.parametrize("speed, units, hint", [
+    (0.3, "mm", "is it in m?"),      # metre numbers declared as mm: 0.3 mm/s, 0.3 m/s in m
+    (300.0, "m", "is it in mm?"),    # mm numbers declared as m: 300 m/s, 0.3 m/s in mm
+    (30.0, "m", "is it in cm?"),     # 30 m/s: 0.3 m/s in cm (0.03 in mm is further from a hand's 0.25 m/s)
+    (0.03, "cm", "is it in m?"),     # 0.3 mm/s in cm: 0.03 m/s in m
+    (120.0, "m", "is it in mm?"),    # 1.2 m/s in cm, 0.12 m/s in mm: mm is nearer a hand's 0.25 m/s (log scale)
+    (1e-3, "mm", "is it in m?"),     # 1 mm/s in m: plausible at its very boundary, and no other unit is
+    (1e4, "m", "is it in mm?"),      # 10 m/s in mm: at the other boundary (100 m/s in cm is not)
+])
+def test_an_implausible_speed_names_the_unit_that_fits_it(speed, units, hint):
+    from bidmp._units import check_speed
+
+    with pytest.raises(ValueError, match=hint.replace("?", r"\?")):
+        check_speed(speed, units, "the demonstration")
+
+
+def test_a_joint_speed_is_judged_in_radians_and_degrees_are_named():
+    from bidmp._units import check_speed
+
+    for speed in (1e-3, 3.0, 10.0):
+        check_speed(speed, "rad", "q")
+    with pytest.raises(ValueError, match=r"in degrees it would be 0\.524 rad/s"):
+        check_speed(30.0, "rad", "q")  # 30 deg/s read as rad/s
+    with pytest.raises(ValueError, match=r"in degrees it would be 10 rad/s"):
+        check_speed(float(np.degrees(10.0)), "rad", "q")  # at the boundary in degrees (radians() gives 10.0 exactly)
+    with pytest.raises(ValueError, match="faster") as refused:
+        check_speed(1000.0, "rad", "q")  # 17 rad/s even in degrees: no hint
+    assert "degrees" not in str(refused.value)
+    with pytest.raises(ValueError, match="slower"):
+        check_speed(1e-3 * (1 - 1e-9), "rad", "q")
+    check_speed(1e-6, "rad", "q", fast_only=True)
+
+
+@pytest.mark.parametrize("units, per_metre", [("m", 1.0), ("cm", 100.0), ("mm", 1000.0)])
+def test_a_goal_is_within_reach_up_to_5_m_in_every_unit(units, per_metre):
+    from bidmp._units import check_reach
+
+    check_reach(5.0 * per_metre, units, "the goal")
+    with pytest.raises(ValueError, match="beyond any robot's reach"):
+        check_reach(5.0 * (1 + 1e-9) * per_metre, units, "the goal")
+    check_reach(1e9, "rad", "the goal")  # joint angles are no distance
+    check_reach(1e9, "", "the goal")
+
+
+def test_a_metre_goal_named_in_mm_is_told_so():
+    from bidmp._units import check_reach
+
+    with pytest.raises(ValueError, match="is it in cm or mm"):
+        check_reach(150.0, "m", "the goal")  # 150 m: 1.5 m in cm, 0.15 m in mm
+    with pytest.raises(ValueError, match="is it in cm or mm"):
+        check_reach(500.0, "m", "the goal")  # 500 m: 5 m in cm, at the boundary of reach
+    with pytest.raises(ValueError, match=r"is it in mm\?"):
+        check_reach(4000.0, "m", "the goal")  # 40 m in cm: only mm is within reach
+
+
+def test_bag_stamps_are_ordered_and_only_repeats_and_real_jumps_back_refused():
+    """Boundaries written out: 0.1 s behind the latest stamp received is transport jitter, a
+    nanosecond more is a jump back; equal stamps are refused wherever they sit."""
+    from bidmp.io.bags import MAX_STAMP_DISORDER, _stamp_order
+
+    limit = int(MAX_STAMP_DISORDER * 1e9)
+    np.testing.assert_array_equal(_stamp_order([0, 10, 20, 30], "s", "c"), [0, 1, 2, 3])
+    np.testing.assert_array_equal(_stamp_order([0, 20, 10, 30], "s", "c"), [0, 2, 1, 3])
+    np.testing.assert_array_equal(_stamp_order([5, limit + 5, 5 + 1, limit + 10], "s", "c"), [0, 2, 1, 3])
+    np.testing.assert_array_equal(_stamp_order([1, limit + 2, 2, limit + 3], "s", "c"), [0, 2, 1, 3])  # limit behind
+    with pytest.raises(ValueError, match=r"jump back in time \(message 3 at "):
+        _stamp_order([5, limit + 6, 5, limit + 10], "s", "c")  # 5 is limit + 1 ns behind
+    with pytest.raises(ValueError, match="jump back"):
+        _stamp_order([0, 10 * limit, 20, 10 * limit + 5], "s", "c")
+    with pytest.raises(ValueError, match=r"jump back in time \(message 4 at "):  # message 3 is only at the limit
+        _stamp_order([1, limit + 2, 2, 0], "s", "c")
+    for stamps, messages in (([0, 10, 10, 20], "2 and 3"), ([0, 20, 10, 20], "2 and 4"), ([7, 3, 7], "1 and 3")):
+        with pytest.raises(ValueError, match=f"repeat: two messages stamped .* \\(messages {messages}\\)"):
+            _stamp_order(stamps, "s", "c")
+
+
+def test_bag_messages_put_in_order_are_counted_in_the_log(caplog):
+    import logging
+
+    from bidmp.io.bags import _stamp_order
+
+    with caplog.at_level(logging.INFO, logger="bidmp.io.bags"):
+        _stamp_order([0, 4_000_000, 13_000_000, 9_000_000, 20_000_000], "bag b", "c")
+    assert "bag b: 2 message(s) out of receive order, put in the order of their stamps (at most 4 ms apart)" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.INFO, logger="bidmp.io.bags"):
+        _stamp_order([0, 4_000_000, 9_000_000], "bag b", "c")
+    assert "out of receive order" not in caplog.text

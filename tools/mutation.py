@@ -107,6 +107,12 @@ TARGETS = (
     Target("goal systems", "bidmp.primitives.goals",
            ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
            ("tests/test_oracles.py", "tests/test_dmp.py", "tests/test_approach.py")),
+    Target("units and speeds a robot can run", "bidmp._units",
+           ("check_reach", "check_speed"),
+           ("tests/test_oracles.py",)),
+    Target("bags: header stamp order", "bidmp.io.bags",
+           ("_stamp_order",),
+           ("tests/test_oracles.py",)),
     Target("phase stopping", "bidmp.primitives.coupling",
            ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
            ("tests/test_oracles.py", "tests/test_primitives.py")),
@@ -121,6 +127,9 @@ _BOUND = ("cost only: branch and bound returns the least exact distance over eve
           "starts from, not that minimum (a tie keeps the same distance)")
 _CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    ("bidmp._units", "check_speed",
+     "if peak_speed > fastest and np.radians(peak_speed) <= fastest else \"\")", "> -> >="):
+        "a peak of exactly the fastest joint speed returned as plausible two lines above: this hint is never built for it",
     **{("bidmp.primitives.coupling", "PhaseStopping.slowdown",
         "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):  # a stepper's own state passes as is",
         mutation): _FAST_PATH

@@ -143,9 +143,8 @@ def parse_columns(spec) -> dict[str, str] | None:
     if len(groups) > 1 or (groups and singles):
         raise ValueError(f"columns: give one group ({', '.join(_GROUP_ROLES)}) or single columns, not "
                          f"{' and '.join(groups + singles[:1])}")
-    if "qx" in mapping or any(role in mapping for role in _QUATERNION_ROLES):
-        if not all(role in mapping for role in _QUATERNION_ROLES):
-            raise ValueError("columns: a quaternion needs all of qx, qy, qz, qw")
+    if any(role in mapping for role in _QUATERNION_ROLES) and not all(role in mapping for role in _QUATERNION_ROLES):
+        raise ValueError("columns: a quaternion needs all of qx, qy, qz, qw")
     if any(role in mapping for role in _ROTVEC_ROLES) and not all(role in mapping for role in _ROTVEC_ROLES):
         raise ValueError("columns: a rotation vector needs all of rx, ry, rz")
     if "qw" in mapping and "rx" in mapping:

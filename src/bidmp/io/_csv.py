@@ -19,8 +19,6 @@ __all__ = ['declared_units']
 
 logger = logging.getLogger(__name__)
 
-
-
 _SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
@@ -44,8 +42,8 @@ def _check_file(path: Path, what: str) -> None:
 
 def _note_ignored(path: Path, ignored: tuple[str, ...]) -> None:
     if ignored:
-        shown = ", ".join(short_token(name, 16)[1:-1] for name in ignored[:8]) + (", …" if len(ignored) > 8 else "")
-        logger.warning("%s: ignored %d column(s) that are not time or positions: %s", path, len(ignored), shown)
+        shown = ", ".join(short_token(name, 28)[1:-1] for name in ignored[:8]) + (", …" if len(ignored) > 8 else "")
+        logger.warning("%s: ignored %d column(s) that are not time or the motion read: %s", path, len(ignored), shown)
 
 
 def declared_units(path) -> str:
