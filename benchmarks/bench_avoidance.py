@@ -28,7 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bidmp import DMP, scenarios
+from bidmp import DMP
+from bidmp.tasks import scenarios
 from bidmp.experiments import random_case
 from bidmp.primitives import AvoidanceError, SceneAvoidance
 

@@ -19,8 +19,8 @@ import numpy as np
 from _timing import median_time
 from scipy.spatial.transform import Rotation
 
-from bidmp.cartesian import CartesianDMP, angle_between
-from bidmp.datasets import minimum_jerk
+from bidmp.primitives import CartesianDMP, angle_between
+from bidmp.demonstrations import minimum_jerk
 
 
 def demonstration(n_steps: int = 1000):

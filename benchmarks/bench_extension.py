@@ -22,10 +22,10 @@ import numpy as np
 from _timing import median_time
 
 from bidmp import extend_demonstration, frechet_distance
-from bidmp.datasets import minimum_jerk
-from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
-from bidmp.roadmap import classic_prm, gaussian_prm
-from bidmp.similarity import frechet_distance_reference
+from bidmp.demonstrations import minimum_jerk
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.extension import classic_prm, gaussian_prm
+from bidmp.extension import frechet_distance_reference
 
 
 def jit_compile_seconds() -> float:

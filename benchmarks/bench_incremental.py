@@ -18,9 +18,10 @@ import numpy as np
 from _timing import median_time
 
 from bidmp import BLS, DMP, BiDMP, extend_demonstration
-from bidmp.bls import PINV_RCOND, block_pinv_update
-from bidmp.datasets import minimum_jerk
-from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.incremental.linalg import PINV_RCOND
+from bidmp.incremental import block_pinv_update
+from bidmp.demonstrations import minimum_jerk
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 
 def bidmp_like_problem(n_rows: int = 1000):

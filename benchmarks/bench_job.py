@@ -15,8 +15,8 @@ import argparse
 import statistics
 import time
 
-from bidmp import scenarios
-from bidmp.evaluation import evaluate
+from bidmp.tasks import scenarios
+from bidmp.tasks import evaluate
 from bidmp.sim import simulate
 from bidmp.sim.job import run_job
 

@@ -20,7 +20,7 @@ import shutil
 import time
 from pathlib import Path
 
-from bidmp import benchmark
+from bidmp.experiments import benchmark
 from bidmp.demonstrations.datasets import lasa_names
 
 
@@ -40,7 +40,7 @@ def _strip(rows):
 
 def _rounds(out: Path, shapes, rounds: int, every: int) -> tuple[float, float, bool]:
     """Serial and 2-worker wall times summed over the rounds, and whether every table agreed."""
-    from bidmp.experiments.lasa import _client
+    from bidmp.experiments.benchmark import _client
 
     groups = [shapes[i::rounds] for i in range(rounds)]
     start = time.perf_counter()

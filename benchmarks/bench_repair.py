@@ -20,8 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bidmp import scenarios
-from bidmp.evaluation import evaluate
+from bidmp.tasks import scenarios
+from bidmp.tasks import evaluate
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
 
@@ -60,7 +60,7 @@ def cells(rounds: int, smoke: bool) -> list[str]:
 def each_repair(rounds: int, smoke: bool) -> list[str]:
     """A skill (the robot protocol) whose motion to a far goal passes a post: each repair alone."""
     from bidmp import DMP, Scene
-    from bidmp.datasets import minimum_jerk
+    from bidmp.demonstrations import minimum_jerk
     from bidmp.tasks.contract import Contract
     from bidmp.tasks.repair import Repairer
 

@@ -22,9 +22,9 @@ import numpy as np
 from _timing import median_time
 from threadpoolctl import threadpool_limits
 
-from bidmp import scenarios
+from bidmp.tasks import scenarios
 from bidmp.baselines import augment
-from bidmp.evaluation import evaluate
+from bidmp.tasks import evaluate
 
 
 def main() -> int:

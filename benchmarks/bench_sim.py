@@ -16,8 +16,9 @@ import sys
 import tempfile
 import time
 
-from bidmp import scenarios, sim
-from bidmp.evaluation import evaluate
+from bidmp import sim
+from bidmp.tasks import scenarios
+from bidmp.tasks import evaluate
 
 
 def main() -> int:

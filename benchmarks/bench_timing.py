@@ -25,7 +25,7 @@ from _timing import median_time
 import bidmp
 from bidmp.io import read_trajectory
 
-RECORDING = bidmp.datasets.recording_path("operator1_nut3")
+RECORDING = bidmp.demonstrations.recording_path("operator1_nut3")
 SHIFT = np.array([150.0, 25.0, 0.0]) * 150.0 / np.hypot(150.0, 25.0)
 
 

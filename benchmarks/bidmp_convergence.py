@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from bidmp import DMP, BiDMP, extend_demonstration
-from bidmp.datasets import minimum_jerk
-from bidmp.metrics import rmse
-from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.demonstrations import minimum_jerk
+from bidmp.tasks import rmse
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 
 def main() -> int:

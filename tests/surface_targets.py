@@ -39,7 +39,7 @@ def _package_overrides(tmp: Path) -> dict:
     U, sv, V, _ = truncated_svd(A)
     dmp = bidmp.DMP(n_kernels=10).fit(DEMO)
     joint = {"lower": -np.ones(7), "upper": np.ones(7), "velocity": np.ones(7), "acceleration": np.ones(7)}
-    scenario = bidmp.scenarios.load("nut-unscrewing")
+    scenario = bidmp.tasks.load("nut-unscrewing")
     joints = np.zeros((60, 7))
     return {**readers, "bidmp.io.read_poses": {"path": poses}, "bidmp.load": {"path": model},
             "bidmp.Scene": {"tool": Tool(5.0, 50.0)}, "bidmp.save": {"model": dmp, "path": tmp / "saved.npz"},
@@ -162,7 +162,7 @@ def _instances(tmp: Path):
     scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 50.0}, "margin": 1.0,
                              "parts": [{"type": "cylinder", "label": "post", "at": [200.0, 0.0, 0.0], "radius": 5.0, "height": 50.0},
                                        {"type": "box", "label": "beam", "at": [50.0, 0.0, 120.0], "size": [10.0, 80.0, 10.0]}]})
-    scenario = bidmp.scenarios.load("nut-unscrewing")
+    scenario = bidmp.tasks.load("nut-unscrewing")
     contract = Contract.of(scenario)
     X = rng.normal(size=(40, 3))
     bls = BLS().fit(X, rng.normal(size=(40, 2)))

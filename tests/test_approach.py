@@ -10,7 +10,7 @@ gate fails the same checks (so they can fail).
 
 import numpy as np
 import pytest
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from sklearn.base import clone
 
 import bidmp

@@ -17,9 +17,10 @@ import os
 import numpy as np
 import pytest
 
-from bidmp import DMP, scenarios
-from bidmp.datasets import minimum_jerk
-from bidmp.geometry import Scene
+from bidmp import DMP
+from bidmp.tasks import scenarios
+from bidmp.demonstrations import minimum_jerk
+from bidmp.scene import Scene
 from bidmp.primitives import AvoidanceError, SceneAvoidance
 from bidmp.experiments import random_case
 

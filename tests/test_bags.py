@@ -13,7 +13,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.typesys import Stores, get_typestore
 
 from bidmp.cli import main
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from bidmp.io import load_model
 
 START_NS = 1_700_000_000_123_456_789  # a header stamp far from zero, in nanoseconds

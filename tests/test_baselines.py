@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 
 from bidmp.baselines import TPGMM, GMMRegressor, augment
 from bidmp.baselines.gmm import _gmr

@@ -10,10 +10,10 @@ import time
 import numpy as np
 import pytest
 
-from bidmp import benchmark
+from bidmp.experiments import benchmark
 from bidmp.cli import main
-from bidmp.metrics import swept_area
-from bidmp.similarity import dtw_distance
+from bidmp.tasks import swept_area
+from bidmp.extension import dtw_distance
 
 # Only what runs on Dask or writes Parquet needs the benchmark extra; the metrics do not.
 needs_dask = pytest.mark.skipif(__import__("importlib").util.find_spec("distributed") is None,
@@ -97,7 +97,7 @@ def test_workers_keep_glibc_adaptive_malloc_and_this_process_its_environment():
     starts them without it, and leaves no variable of theirs in this process."""
     import os
 
-    from bidmp.experiments.lasa import _client
+    from bidmp.experiments.benchmark import _client
 
     before = dict(os.environ)
     client, cluster = _client(None, 1)
@@ -214,7 +214,7 @@ def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(seri
     del broken["rows"][0]["frechet"]
     (cells / "Sshape__1.json").write_text(json.dumps(broken))
     (cells / "WShape__0.json").write_text((cells / "WShape__1.json").read_text())  # another cell's file
-    with caplog.at_level(logging.WARNING, logger="bidmp.experiments.lasa"):
+    with caplog.at_level(logging.WARNING, logger="bidmp.experiments.benchmark"):
         again = benchmark.lasa(tmp_path, synchronous=True, resume=True, **SMALL)
     assert sorted(again.computed) == ["Sshape__0", "Sshape__1", "WShape__0"]
     assert table(again.rows) == table(serial.rows)

@@ -2,7 +2,8 @@
 
 import numpy as np
 import pytest
-from bidmp.bls import PINV_RCOND, block_pinv_update, sparse_autoencoder
+from bidmp.incremental.linalg import PINV_RCOND
+from bidmp.incremental import block_pinv_update, sparse_autoencoder
 
 import bidmp
 from bidmp import BLS
@@ -90,14 +91,14 @@ def bidmp_hidden_problem(model):
 
 @pytest.fixture(scope="module")
 def nut_bidmp():
-    from bidmp.evaluation import evaluate
+    from bidmp.tasks import evaluate
 
-    return evaluate(bidmp.scenarios.load("nut-unscrewing"), ["bidmp"]).model
+    return evaluate(bidmp.tasks.load("nut-unscrewing"), ["bidmp"]).model
 
 
 def test_pinv_update_on_a_recordings_bidmp_matrices_equals_numpy_pinv():
     """Issue 19.9 on the project's own matrices: a Bi-DMP learned from a bundled recording."""
-    y, t = bidmp.datasets.recording("operator1_nut3")
+    y, t = bidmp.demonstrations.recording("operator1_nut3")
     prepared, _ = bidmp.prepare(y, t)
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
     model = bidmp.BiDMP(dmp).learn(bidmp.extend_demonstration(prepared.y, dmp.goal_ + [150.0, 25.0, 0.0], seed=0).complete)

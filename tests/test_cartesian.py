@@ -6,14 +6,10 @@ import warnings
 
 import numpy as np
 import pytest
-from bidmp.cartesian import (
-    CartesianBiDMP,
-    CartesianDMP,
-    angle_between,
-    pose_forgetting,
-    prepare_poses,
-)
-from bidmp.datasets import kinesthetic_recording, minimum_jerk
+from bidmp.incremental.cartesian import CartesianBiDMP, pose_forgetting
+from bidmp.primitives import CartesianDMP, angle_between
+from bidmp.demonstrations.prepare import prepare_poses
+from bidmp.demonstrations import kinesthetic_recording, minimum_jerk
 from scipy.spatial.transform import Rotation
 
 import bidmp
@@ -273,7 +269,7 @@ def screw_turn(degrees, n_steps=400, pitch=1.25):
 
 def turned_angle(quaternions):
     """The whole angle (deg) turned from the first to the last orientation, several turns included."""
-    from bidmp.cartesian import orientation_error
+    from bidmp.primitives import orientation_error
 
     return np.degrees(np.linalg.norm(orientation_error(quaternions, quaternions[-1])[0]))
 
@@ -409,7 +405,7 @@ def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
 
 def test_pose_parameters_after_fit_follow_the_position_rules(demo):
     """Only tau may change after fit (it slows both parts); a learned parameter unfits the model."""
-    from bidmp.cartesian import _PART_PARAMS
+    from bidmp.primitives.cartesian import _PART_PARAMS
 
     assert set(_PART_PARAMS) == set(CartesianDMP().get_params())
     t = np.linspace(0.0, 2.0, len(demo))

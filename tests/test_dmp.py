@@ -5,8 +5,8 @@ import pytest
 from conftest import curved_demo, minimum_jerk
 
 from bidmp import DMP, NotFittedError
-from bidmp.datasets import lasa
-from bidmp.dmp import basis_functions, kernel_centres, kernel_widths, phase_grid
+from bidmp.demonstrations import lasa
+from bidmp.primitives import basis_functions, kernel_centres, kernel_widths, phase_grid
 from bidmp.primitives.forcing import _forcing_target as forcing_target
 
 
@@ -361,7 +361,7 @@ def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how
 
 
 def test_every_parameter_but_tau_is_checked_after_fit():
-    from bidmp.dmp import _RAW_PARAMS
+    from bidmp.primitives.dmp import _RAW_PARAMS
 
     assert set(_RAW_PARAMS) | {"tau"} == set(DMP().get_params())  # a new parameter must be checked too
 

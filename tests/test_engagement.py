@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from bidmp.metrics import approach_error, axis_deviation
+from bidmp.tasks import approach_error, axis_deviation
 
 TARGET = np.array([100.0, 50.0, 0.0])
 BAND = 28.5

@@ -7,9 +7,10 @@ import pytest
 from scipy.stats import spearmanr
 
 import bidmp
-from bidmp import DMP, scenarios
-from bidmp.evaluation import evaluate
-from bidmp.metrics import approach_error
+from bidmp import DMP
+from bidmp.tasks import scenarios
+from bidmp.tasks import evaluate
+from bidmp.tasks import approach_error
 
 NUT_COLUMNS_FAILED = ["9", "10", "11", "12", "13", "14"]
 

@@ -2,8 +2,8 @@
 
 import numpy as np
 import pytest
-from bidmp.datasets import lasa, minimum_jerk
-from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.demonstrations import lasa, minimum_jerk
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 import bidmp
 from bidmp import extend_demonstration
@@ -97,7 +97,7 @@ def test_extension_is_fast_enough_to_stay_out_of_the_way(battery):
 def test_options_are_listed_in_the_signature():
     import inspect
 
-    from bidmp.roadmap import gaussian_prm
+    from bidmp.extension import gaussian_prm
 
     signature = inspect.signature(extend_demonstration).parameters
     for name, parameter in inspect.signature(gaussian_prm).parameters.items():

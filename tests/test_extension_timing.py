@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 import bidmp
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from bidmp.demonstrations.datasets import recording
 from bidmp.extension import extend_demonstration
-from bidmp.geometry import Scene
+from bidmp.scene import Scene
 
 
 def peaks(points: np.ndarray, dt: float) -> np.ndarray:

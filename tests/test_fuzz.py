@@ -216,7 +216,7 @@ def test_fuzz_dmp(y, params, goal, start, n_steps):
 @examples(60)
 def test_fuzz_segment(y, eps_frac, method):
     outcome("segment", bidmp.segment, y, eps_frac=eps_frac, method=method)
-    outcome("curvature", bidmp.segmentation.curvature, y)
+    outcome("curvature", bidmp.extension.curvature, y)
 
 
 timestamps = st.one_of(st.none(), st.sampled_from(["uniform", "jitter", "epoch", "ms", "duplicate", "reverse", "nan", "short"]))
@@ -255,7 +255,7 @@ def test_fuzz_timed_dmp(y, stamps, params, goal, start, duration, dt, limits):
 def test_fuzz_prepare_and_recordings(y, stamps, cutoff, fraction, seed):
     n = len(y) if hasattr(y, "__len__") else 0
     outcome("prepare", bidmp.prepare, y, _stamps(stamps, n), cutoff_hz=cutoff, idle_fraction=fraction)
-    recording = outcome("kinesthetic_recording", bidmp.datasets.kinesthetic_recording, [[0, 0, 0], [50, 20, 10]],
+    recording = outcome("kinesthetic_recording", bidmp.demonstrations.kinesthetic_recording, [[0, 0, 0], [50, 20, 10]],
                         seed=seed, duration=cutoff, idle=fraction)
     if recording is not None:
         outcome("prepare(recording)", bidmp.prepare, *recording)
@@ -290,7 +290,7 @@ def test_fuzz_extend_demonstration(y, target, seed, options):
        st.sampled_from(["gaussian", "classic"]), extension_options)
 @examples(30)
 def test_fuzz_roadmaps(piece, target, seed, which, options):
-    from bidmp.roadmap import classic_prm, gaussian_prm
+    from bidmp.extension import classic_prm, gaussian_prm
 
     options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
     if which == "classic":
@@ -373,14 +373,14 @@ def test_fuzz_baselines(y, params, target, n_steps, task_parameterised):
        maybe(st.integers(3, 3000), nasty_ints), maybe(st.floats(0.0, 3.0)), maybe(st.integers(0, 2**32), anything))
 @examples(40)
 def test_fuzz_datasets(name, via, n_steps, noise, seed):
-    outcome("lasa", bidmp.datasets.lasa, name)
-    outcome("minimum_jerk", bidmp.datasets.minimum_jerk, via, n_steps, noise, seed)
+    outcome("lasa", bidmp.demonstrations.lasa, name)
+    outcome("minimum_jerk", bidmp.demonstrations.minimum_jerk, via, n_steps, noise, seed)
 
 
 @given(trajectories(max_points=100), trajectories(max_points=100), points, maybe(st.floats(0.1, 50.0)))
 @examples(40)
 def test_fuzz_metrics(a, b, target, height):
-    from bidmp import metrics
+    from bidmp.tasks import metrics
 
     outcome("metrics.endpoint_error", metrics.endpoint_error, a, target)
     # inf is documented (issue 21.6): the motion has no final approach into the target; any other
@@ -395,7 +395,7 @@ def test_fuzz_metrics(a, b, target, height):
        maybe(st.integers(1, 4), nasty_ints), maybe(st.floats(0.0, 1.0)), maybe(st.integers(1, 3), nasty_ints))
 @examples(10)
 def test_fuzz_reproduce_entry_points(name, demo_index, n_goals, shift, factor):
-    from bidmp import reproduce
+    from bidmp import experiments as reproduce
 
     outcome("reproduce.lasa_generalisation", reproduce.lasa_generalisation, name, demo_index=demo_index,
             n_goals=n_goals, shift=shift, convergence_factor=factor)
@@ -426,9 +426,9 @@ def files(tmp_path_factory):
     bimodel = bidmp.save(bi, folder / "bidmp.npz")
     (folder / "dir").mkdir()
     (folder / "out").mkdir()
-    recording = bidmp.io.save_trajectory(bidmp.datasets.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[0],
+    recording = bidmp.io.save_trajectory(bidmp.demonstrations.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[0],
                                          folder / "recording.csv",
-                                         times=bidmp.datasets.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[1])
+                                         times=bidmp.demonstrations.kinesthetic_recording([[0, 0, 50], [40, 30, 0]], seed=5)[1])
     return {"folder": folder, "demo": demo, "model": model, "demo2": two_d, "bidmp": bimodel, "recording": recording}
 
 
@@ -563,7 +563,7 @@ inner_keys = {"dmp": ["alpha", "tau", "n_kernels", "alpha_phase", "K", "beta", "
                           scenario_values), min_size=1, max_size=3))
 @examples(60)
 def test_fuzz_scenarios(files, changes):
-    from bidmp import scenarios
+    from bidmp.tasks import scenarios
 
     data = json.loads(scenarios.builtin_text("nut-unscrewing"))
     for key, inner, value in changes:
@@ -586,8 +586,8 @@ scene_part_keys = st.sampled_from(["type", "label", "at", "at_targets", "offset"
        trajectories(max_points=60, dims=(3,)))
 @examples(60)
 def test_fuzz_scene(changes, trajectory):
-    from bidmp import scenarios
-    from bidmp.geometry import Scene
+    from bidmp.tasks import scenarios
+    from bidmp.scene import Scene
 
     data = json.loads(scenarios.builtin_text("nut-unscrewing"))
     scene, targets = data["scene"], data["targets"]
@@ -689,7 +689,7 @@ def test_fuzz_pose_files(files, header, poses, columns):
 @pytest.fixture(scope="module")
 def panda():
     pytest.importorskip("pybullet")
-    from bidmp import scenarios
+    from bidmp.tasks import scenarios
     from bidmp.sim import RobotCell, robot_placement
 
     scenario = scenarios.load("nut-unscrewing")
@@ -711,7 +711,7 @@ def test_fuzz_sim(panda, target, seed, path):
        maybe(st.sampled_from(["first3", "all"]), anything), maybe(st.sampled_from([200, 500]), nasty_ints))
 @examples(12)
 def test_fuzz_benchmark(files, shapes, methods, demos, every):
-    from bidmp import benchmark
+    from bidmp.experiments import benchmark
 
     if every in (200, 500) and demos in ("first3", "all") and isinstance(shapes, list) and isinstance(methods, list):
         demos = "first3"  # a valid sweep stays small: 1-2 shapes x 3 demonstrations of a few samples
@@ -743,7 +743,7 @@ def cli_templates(files):
     folder = files["folder"]
     scenario = folder / "scenario.json"
     if not scenario.exists():
-        data = json.loads(bidmp.scenarios.builtin_text("pick-and-place"))
+        data = json.loads(bidmp.tasks.builtin_text("pick-and-place"))
         data["methods"] = ["dmp", "bidmp"]
         scenario.write_text(json.dumps(data))
     out = folder / "out"

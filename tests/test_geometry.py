@@ -9,12 +9,12 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import bidmp
-from bidmp import scenarios
+from bidmp.tasks import scenarios
 from bidmp.cli import main
-from bidmp.evaluation import evaluate
+from bidmp.tasks import evaluate
 from bidmp.extension import extend_demonstration, final_approach
-from bidmp.geometry import Scene, SceneError, Tool
-from bidmp.roadmap import NoFreeRouteError
+from bidmp.scene import Scene, SceneError, Tool
+from bidmp.extension import NoFreeRouteError
 
 TOOL = {"radius": 12.5, "length": 100.0}
 NUT = {"across_flats": 13, "height": 6.5, "stud": {"radius": 4, "above": 10}}
@@ -140,7 +140,7 @@ def test_clearance_along_a_trajectory_is_the_minimum_over_a_brute_force_check():
         path = np.cumsum(rng.normal(0.0, 6.0, size=(30, 3)), axis=0) + [60.0, 20.0, 25.0]
         got = scene.clearance(path, exclude="3", step=0.5)
         # The plain way: every part at every sample of the same densified path.
-        from bidmp.geometry import _densify
+        from bidmp.scene.clearance import _densify
 
         dense = _densify(path, 0.5)
         chosen = [i for i, solid in enumerate(scene.solids) if solid.part != "3"]
@@ -463,7 +463,7 @@ def test_a_scenario_keeps_3_mm_by_default_in_its_units():
 
 
 def minimum_jerk_points():
-    from bidmp.datasets import minimum_jerk
+    from bidmp.demonstrations import minimum_jerk
 
     return minimum_jerk([[0, 0, 0], [150, 20, 190], [300, 60, 30]], 200)
 

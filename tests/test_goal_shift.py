@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from bidmp import DMP
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from bidmp.primitives.goal_shift import _PEAKS
 from bidmp.primitives.goals import _smoothstep_derivatives
 

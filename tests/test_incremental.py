@@ -5,8 +5,8 @@ import pytest
 
 import bidmp
 from bidmp import BiDMP, DMP, extend_demonstration, forgetting
-from bidmp.datasets import lasa, minimum_jerk
-from bidmp.reproduce import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.demonstrations import lasa, minimum_jerk
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 from bidmp._trajectory import resample_time
 
 

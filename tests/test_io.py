@@ -87,7 +87,7 @@ def logger_file(tmp_path, header, rows, name="log.csv"):
 
 def test_a_repeated_timestamp_is_dropped_with_a_warning(tmp_path, caplog):
     """On today's main one repeated stamp refused the whole recording."""
-    y, t = bidmp.datasets.recording("operator1_nut3")
+    y, t = bidmp.demonstrations.recording("operator1_nut3")
     t = t.copy()
     t[100] = t[99]  # the logger wrote one stamp twice
     path = logger_file(tmp_path, "t,x,y,z", np.column_stack([t, y]))
@@ -105,11 +105,11 @@ def test_a_stamp_going_back_is_refused_with_values_that_can_be_told_apart():
     t = 1733086800.0 + np.arange(10) * 0.004
     t[5] = t[4] - 0.001
     with pytest.raises(ValueError, match=r"going back at sample 5: 1733086800\.015 s after 1733086800\.016 s \(-0\.9999 ms"):
-        bidmp.timing.check_timestamps(t, 10)
+        bidmp.primitives.check_timestamps(t, 10)
 
 
 def test_logger_headers_extra_columns_and_a_column_mapping(tmp_path, caplog):
-    y, t = bidmp.datasets.recording("operator2_nut5")
+    y, t = bidmp.demonstrations.recording("operator2_nut5")
     force = np.sin(np.arange(len(t)))
     plain = logger_file(tmp_path, "timestamp,x,y,z,force,gripper", np.column_stack([t, y, force, force > 0]), "a.csv")
     with caplog.at_level("WARNING"):
@@ -250,7 +250,7 @@ def test_format_1_dmp_files_still_load(tmp_path, fitted):
 
 
 def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
-    from bidmp.datasets import minimum_jerk
+    from bidmp.demonstrations import minimum_jerk
 
     demo = minimum_jerk([[0, 0, 1], [1, 1, 0], [2, 0, 0]], 60)
     model = bidmp.BiDMP(DMP(protocol="paper").fit(demo)).learn(demo + np.linspace(0, 1, 60)[:, None])

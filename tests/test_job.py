@@ -10,9 +10,9 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from bidmp import scenarios  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.scenarios import ScenarioError  # noqa: E402
+from bidmp.tasks import ScenarioError# noqa: E402
 from bidmp.sim import job as job_module  # noqa: E402
 from bidmp.sim.job import run_job  # noqa: E402
 from bidmp.tasks.jobs import tour  # noqa: E402

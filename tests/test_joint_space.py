@@ -120,7 +120,7 @@ def test_joint_limits_from_a_scenarios_own_robot(tmp_path, capsys):
     slower than any built-in arm), each joint within its own, one of them binding."""
     import json
 
-    from bidmp import scenarios
+    from bidmp.tasks import scenarios
 
     spec = json.loads(scenarios.builtin_text("nut-unscrewing"))
     velocity = [0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6]

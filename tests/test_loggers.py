@@ -21,7 +21,7 @@ N = 700
 
 def _motion():
     """A recorded nut approach in metres with a turning tool, on jittered ~200 Hz stamps (epoch s)."""
-    y, _ = bidmp.datasets.recording("operator1_nut3")
+    y, _ = bidmp.demonstrations.recording("operator1_nut3")
     y = y[:: max(1, len(y) // N)][:N] / 1000.0
     ticks = np.concatenate([[0], np.cumsum(np.random.default_rng(7).integers(2, 4, N - 1))])  # 2-3 ticks of 1/512 s
     t = 1_732_000_000 + ticks / 512.0

@@ -10,8 +10,9 @@ test; the name checks are structural.
 import numpy as np
 import pytest
 
-from bidmp import benchmark, scenarios
-from bidmp.evaluation import evaluate
+from bidmp.experiments import benchmark
+from bidmp.tasks import scenarios
+from bidmp.tasks import evaluate
 from bidmp.tasks import methods as registry
 from bidmp.tasks.methods import Method, Task
 

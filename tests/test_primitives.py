@@ -12,7 +12,7 @@ Which checks show correctness and which guard structure:
 
 import numpy as np
 import pytest
-from bidmp.datasets import minimum_jerk, recording
+from bidmp.demonstrations import minimum_jerk, recording
 from scipy.spatial.transform import Rotation
 
 import bidmp

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from bidmp.reproduce import BATTERY_APPROACH_VIA  # noqa: F401  (the package imports: a broken install fails here)
+from bidmp.experiments import BATTERY_APPROACH_VIA# noqa: F401  (the package imports: a broken install fails here)
 
 ROOT = Path(__file__).resolve().parent.parent
 RECORDING = ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv"

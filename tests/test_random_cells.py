@@ -13,9 +13,9 @@ import os
 import numpy as np
 import pytest
 
-from bidmp import scenarios
-from bidmp.datasets import minimum_jerk
-from bidmp.evaluation import evaluate
+from bidmp.tasks import scenarios
+from bidmp.demonstrations import minimum_jerk
+from bidmp.tasks import evaluate
 
 N_CELLS = int(os.environ.get("BIDMP_RANDOM_CELLS", "30"))  # `make random-cells` draws 300
 
@@ -199,7 +199,7 @@ def test_no_motion_on_a_random_cell_is_a_silent_violation(chunk):
 def test_a_straight_move_through_a_post_is_a_collision_in_any_unit(unit):
     """The default step was 0.2 scene units: 200 mm in a scene in metres, where a two-point move
     straight through a post was checked at its ends only and reported clear."""
-    from bidmp.geometry import Scene
+    from bidmp.scene import Scene
 
     scene = Scene.from_dict({"tool": {"radius": 10 * unit, "length": 100 * unit},
                              "parts": [{"type": "cylinder", "label": "post", "at": [0.0, 0.0, 0.0], "radius": 5 * unit,

@@ -27,9 +27,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 from test_random_cells import random_cell, solids
 
-from bidmp import scenarios
-from bidmp.datasets import minimum_jerk
-from bidmp.evaluation import evaluate
+from bidmp.tasks import scenarios
+from bidmp.demonstrations import minimum_jerk
+from bidmp.tasks import evaluate
 
 N_CELLS = int(os.environ.get("BIDMP_RANDOM_CELLS", "30")) // 5  # `make random-cells`: 60 tilted cells
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0

@@ -23,9 +23,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bidmp import scenarios
-from bidmp.datasets import minimum_jerk
-from bidmp.evaluation import evaluate
+from bidmp.tasks import scenarios
+from bidmp.demonstrations import minimum_jerk
+from bidmp.tasks import evaluate
 
 pytest.importorskip("pybullet")
 

@@ -36,7 +36,7 @@ def dmp(demo):
 
 @pytest.fixture(scope="module")
 def scene():
-    return bidmp.scenarios.load("nut-unscrewing").scene
+    return bidmp.tasks.load("nut-unscrewing").scene
 
 
 def refused(call, *names, kinds=(ValueError, TypeError), seconds=5.0):
@@ -80,7 +80,7 @@ def test_an_empty_layers_file_is_named_and_bidmp_view_exits_2(tmp_path, capsys):
 
 
 def test_a_scenario_nested_five_thousand_deep_is_refused():
-    data = json.loads(bidmp.scenarios.builtin_text("nut-unscrewing"))
+    data = json.loads(bidmp.tasks.builtin_text("nut-unscrewing"))
     deep: list = []
     for _ in range(5_000):
         deep = [deep]
@@ -132,7 +132,7 @@ def test_robot_models_of_the_wrong_shape_or_from_places_a_scenario_may_not_read(
 
 
 def test_a_rack_slot_at_nan_and_nan_integrator_settings_are_refused():
-    job = bidmp.scenarios.load("cell-removal").job
+    job = bidmp.tasks.load("cell-removal").job
     refused(lambda: job.slot(float("nan")), "index")
     refused(lambda: bidmp.primitives.StepIntegrator(25.0, float("nan"), 1.0, True), "beta")
 
@@ -210,7 +210,7 @@ def test_a_urdf_whose_meshes_point_at_system_files_exits_2(tmp_path, capsys):
     shipped = Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf"
     text = re.sub(r'filename="[^"]+"', 'filename="/etc/passwd"', shipped.read_text())
     (tmp_path / "arm.urdf").write_text(text)
-    spec = json.loads(bidmp.scenarios.builtin_text("nut-unscrewing-iiwa"))
+    spec = json.loads(bidmp.tasks.builtin_text("nut-unscrewing-iiwa"))
     spec["robot"] = {"urdf": "arm.urdf", "flange": "lbr_iiwa_link_7",
                      "limits": {"lower": [-2.9] * 7, "upper": [2.9] * 7, "velocity": [1.0] * 7, "acceleration": [5.0] * 7}}
     (tmp_path / "cell.json").write_text(json.dumps(spec))

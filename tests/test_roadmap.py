@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-from bidmp.datasets import minimum_jerk
-from bidmp.reproduce import compare_prm, table5_cases
-from bidmp.roadmap import NoFreeRouteError, classic_prm, gaussian_prm, template
-from bidmp.similarity import frechet_similarity
+from bidmp.demonstrations import minimum_jerk
+from bidmp.experiments import compare_prm, table5_cases
+from bidmp.extension import NoFreeRouteError, classic_prm, gaussian_prm, template
+from bidmp.extension import frechet_similarity
 
 from bidmp._trajectory import resample_arclength
 from bidmp.extension.roadmap import _shortest_path as shortest_path

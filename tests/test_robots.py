@@ -8,10 +8,11 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from bidmp import scenarios, sim  # noqa: E402
+from bidmp import sim  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.evaluation import evaluate  # noqa: E402
-from bidmp.scenarios import ScenarioError  # noqa: E402
+from bidmp.tasks import evaluate# noqa: E402
+from bidmp.tasks import ScenarioError# noqa: E402
 
 
 def nut_spec(**robot):
@@ -59,7 +60,7 @@ def test_plans_are_timed_to_the_arm_own_limits(iiwa):
             plan = cell.plan(rollout, "11")
             grid = np.linspace(0.0, 1.0, 4001)
             speeds = np.abs(plan.spline(grid, 1)) / plan.duration
-            assert np.all(speeds.max(axis=0) <= np.asarray(model.limits.velocity) * sim.LIMIT_MARGIN * 1.001)
+            assert np.all(speeds.max(axis=0) <= np.asarray(model.limits.velocity) * sim.backend.LIMIT_MARGIN * 1.001)
             durations.append(plan.duration)
     assert 2 ** (1 / 3) - 1e-3 <= durations[1] / durations[0] <= 2.0 + 1e-3
 

@@ -30,7 +30,7 @@ from bidmp.io import (
 )
 
 PYTHON = sys.executable
-from bidmp.datasets import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)
+from bidmp.demonstrations import recording_path# noqa: E402  (the bundled copies of shared/data/recordings)
 
 
 def cli(argv, seconds=10.0):
@@ -185,7 +185,7 @@ def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
 
 
 def test_persistence_pruning_matches_the_literal_quadratic_rule():
-    from bidmp.segmentation import _prune_persistence, _prune_persistence_plain
+    from bidmp.extension.segmentation import _prune_persistence, _prune_persistence_plain
 
     rng = np.random.default_rng(3)
     for trial in range(200):
@@ -554,7 +554,7 @@ def test_numba_without_a_writable_cache_compiles_in_memory():
         import numba.core.caching as caching
         caching.CacheImpl._locator_classes = []  # no cache folder anywhere, as for a read-only install
         import numpy as np
-        from bidmp.similarity import frechet_distance
+        from bidmp.extension import frechet_distance
         print(frechet_distance(np.zeros((3, 2)), np.ones((4, 2))))
     """)
     result = subprocess.run([PYTHON, "-c", script], capture_output=True, text=True, timeout=120)
@@ -595,5 +595,5 @@ def test_long_noisy_minimum_jerk_is_fast_and_equals_the_direct_filter():
     noise = np.random.default_rng(1).normal(size=(30_000, 3))
     np.testing.assert_allclose(_low_pass(noise, 600.0), gaussian_filter1d(noise, 600.0, axis=0), atol=1e-12)
     started = time.perf_counter()
-    y = bidmp.datasets.minimum_jerk([[0, 0, 0], [100, 50, 20]], 1_000_000, noise=1.0)
+    y = bidmp.demonstrations.minimum_jerk([[0, 0, 0], [100, 50, 20]], 1_000_000, noise=1.0)
     assert time.perf_counter() - started < 5.0 and np.all(np.isfinite(y))

@@ -5,10 +5,10 @@ import json
 import numpy as np
 import pytest
 
-from bidmp import scenarios
+from bidmp.tasks import scenarios
 from bidmp.cli import main
 from bidmp.io import save_trajectory
-from bidmp.scenarios import ScenarioError
+from bidmp.tasks import ScenarioError
 
 
 def nut_spec():
@@ -117,7 +117,7 @@ def test_not_json_and_unknown_builtin(tmp_path):
 
 
 def test_scenario_sets_bidmp_and_extension_parameters():
-    from bidmp.evaluation import evaluate
+    from bidmp.tasks import evaluate
 
     data = mutate(lambda d: d.update(bidmp={"reg": 1e-2, "increments": [5]}, extension={"n_iter": 3, "n_samples": 120}))
     scenario = scenarios.from_dict(data)

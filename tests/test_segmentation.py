@@ -6,7 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from bidmp import segment
 from bidmp._trajectory import arclength, resample_arclength
-from bidmp.segmentation import choose_piece, curvature
+from bidmp.extension import choose_piece, curvature
 
 POLYLINES = {
     "L": [[0, 0], [0, 1], [1, 1]],

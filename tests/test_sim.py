@@ -10,9 +10,10 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from bidmp import scenarios, sim  # noqa: E402
+from bidmp import sim  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.evaluation import evaluate  # noqa: E402
+from bidmp.tasks import evaluate# noqa: E402
 
 RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
 
@@ -56,7 +57,7 @@ def test_forward_kinematics_of_the_executed_joints_follows_the_commanded_path(ce
     np.testing.assert_allclose(executed, run.tcp[::25] / cell.unit, atol=1e-6)
     assert np.linalg.norm(run.tcp[-1] / cell.unit - rollout[-1]) <= 0.1
     assert not run.contacts
-    assert plan.peak_velocity <= 1.0 and plan.peak_acceleration == pytest.approx(sim.LIMIT_MARGIN, rel=1e-6)
+    assert plan.peak_velocity <= 1.0 and plan.peak_acceleration == pytest.approx(sim.backend.LIMIT_MARGIN, rel=1e-6)
 
 
 def test_a_motion_through_a_stud_is_a_contact_with_that_stud(cell):

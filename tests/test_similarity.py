@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from bidmp import frechet_distance, frechet_similarity
-from bidmp.similarity import frechet_distance_reference, polyline_length
+from bidmp.extension import frechet_distance_reference, polyline_length
 
 
 

@@ -76,10 +76,10 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
     a 5e8-row extent: refused up front, in one line."""
     import time
 
-    from bidmp.metrics import path_extent
+    from bidmp.tasks import path_extent
 
     from bidmp.extension.similarity import frechet_distance_reference
-    from bidmp.incremental.bls import sparse_autoencoder
+    from bidmp.incremental.linalg import sparse_autoencoder
 
     rng = np.random.default_rng(0)
     F, target = rng.normal(size=(30, 5)), rng.normal(size=(30, 2))
@@ -187,7 +187,7 @@ def nasty_failures(calls, nasty) -> list:
 def test_the_scene_helpers_refuse_bad_input_by_name():
     """Issue 22.2, the scene: ``parts_at``, the roadmap checker and its straight moves, and
     oriented clearance (11 cases failed before: IndexError, ComplexWarning, an overflow)."""
-    from bidmp.geometry import Scene
+    from bidmp.scene import Scene
 
     scene = Scene.from_dict({"tool": {"radius": 10, "length": 100},
                              "parts": [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [10, 10, 10]}]})

@@ -6,19 +6,19 @@ import numpy as np
 import pytest
 
 import bidmp
-from bidmp.datasets import kinesthetic_recording, minimum_jerk
-from bidmp.timing import Trajectory, check_timestamps, scale_factor
+from bidmp.demonstrations import kinesthetic_recording, minimum_jerk
+from bidmp.primitives import Trajectory, check_timestamps, scale_factor
 
 NUT_VIA = [[-80.0, -120.0, 200.0], [0.0, 0.0, 40.0], [0.0, 0.0, 0.0]]
 SHIFT = np.array([150.0, 25.0, 0.0]) * 150.0 / np.hypot(150.0, 25.0)  # a nut 150 mm away
 
 
 def recording(name):
-    return bidmp.datasets.recording(name.removesuffix(".csv"))
+    return bidmp.demonstrations.recording(name.removesuffix(".csv"))
 
 
 def recording_file(name):
-    return bidmp.datasets.recording_path(name.removesuffix(".csv"))
+    return bidmp.demonstrations.recording_path(name.removesuffix(".csv"))
 
 
 def recordings():
@@ -255,7 +255,7 @@ def test_no_overshoot_when_the_goal_is_nearer_than_the_demonstrated_one():
     demo = minimum_jerk([[0.0, 0.0, 0.0], [100.0, 0.0, 0.0]], 500)
     t = np.arange(500) / 250.0
     dmp = bidmp.DMP().fit(demo, t)
-    phase_gated = bidmp.DMP(goal_rate=bidmp.dmp.ROBOT_ALPHA_PHASE).fit(demo, t)  # Pastor's: goal gated by the phase
+    phase_gated = bidmp.DMP(goal_rate=bidmp.primitives.ROBOT_ALPHA_PHASE).fit(demo, t)  # Pastor's: goal gated by the phase
     for fraction in (0.1, 0.2, 0.5, 0.8, 1.0, 1.5):
         goal = np.array([100.0 * fraction, 0.0, 0.0])
         x = dmp.trajectory(goal).y[:, 0]

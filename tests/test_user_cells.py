@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 from test_random_user_cells import UNITS, check_clear, check_commands, check_end_and_descent, one_sentence
 
-from bidmp import scenarios
+from bidmp.tasks import scenarios
 from bidmp.cli import main
-from bidmp.evaluation import evaluate
+from bidmp.tasks import evaluate
 
 pytest.importorskip("pybullet")
 from bidmp import sim  # noqa: E402

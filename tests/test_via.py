@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from bidmp import DMP, BiDMP
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from bidmp.primitives.grid import _rollout_grid
 from bidmp.primitives.timed import _time_grid
 from bidmp.primitives.via import _impulse_rows, _interpolation

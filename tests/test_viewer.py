@@ -10,9 +10,9 @@ import pytest
 
 pytest.importorskip("plotly")
 
-from bidmp import scenarios  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.evaluation import evaluate  # noqa: E402
+from bidmp.tasks import evaluate# noqa: E402
 from bidmp.plotting import viewer  # noqa: E402
 
 
@@ -234,7 +234,7 @@ def test_a_two_line_title_renders_as_two_lines_and_control_codes_do_not(tmp_path
     import matplotlib
 
     matplotlib.use("Agg")
-    from bidmp.datasets import minimum_jerk
+    from bidmp.demonstrations import minimum_jerk
     from bidmp.extension import extend_demonstration
     from bidmp.plotting import extension as figures
 

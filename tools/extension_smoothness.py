@@ -40,10 +40,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
 from test_extension_timing import ldj_floor, shortest_around, transfer  # noqa: E402
 
-from bidmp.datasets import minimum_jerk
+from bidmp.demonstrations import minimum_jerk
 from bidmp.extension import extend_demonstration
 from bidmp.extension.roadmap import NoFreeRouteError
-from bidmp.geometry import Scene
+from bidmp.scene import Scene
 
 TOOL = {"radius": 12.5, "length": 100.0}
 

@@ -16,8 +16,8 @@ SHIFT = np.array([150.0, 25.0, 0.0]) * 150.0 / np.hypot(150.0, 25.0)
 
 def main() -> Path:
     recordings = []
-    for name in bidmp.datasets.recording_names():
-        y, t = bidmp.datasets.recording(name)
+    for name in bidmp.demonstrations.recording_names():
+        y, t = bidmp.demonstrations.recording(name)
         prepared, info = bidmp.prepare(y, t, units="mm")
         dmp = bidmp.DMP().fit(prepared.y, prepared.t, units="mm")
         recordings.append((name, y, t, prepared, info, dmp.trajectory(dmp.goal_ + SHIFT)))

@@ -25,8 +25,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from test_random_user_cells import user_cell  # noqa: E402  (the random cells as the tests draw them)
 
-from bidmp import scenarios  # noqa: E402
-from bidmp.evaluation import evaluate  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
+from bidmp.tasks import evaluate# noqa: E402
 from bidmp.tasks.contract import Contract  # noqa: E402
 from bidmp.tasks.repair import REPAIRS, Repairer  # noqa: E402
 

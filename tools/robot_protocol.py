@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import bidmp
-from bidmp.datasets import kinesthetic_recording, minimum_jerk
+from bidmp.demonstrations import kinesthetic_recording, minimum_jerk
 
 ROOT = Path(__file__).resolve().parent.parent
 NUT_VIA = [[-80.0, -120.0, 200.0], [0.0, 0.0, 40.0], [0.0, 0.0, 0.0]]
@@ -128,7 +128,7 @@ def _peer_near(prepared, goal, direction, distance):
 def recording_rows():
     rows = []
     for name in ("operator1_nut3", "operator2_nut5"):
-        prepared, _ = bidmp.prepare(*bidmp.datasets.recording(name))
+        prepared, _ = bidmp.prepare(*bidmp.demonstrations.recording(name))
         cells = [name]
         for params in VERSIONS.values():
             dmp = bidmp.DMP(**params).fit(prepared.y, prepared.t)
@@ -145,7 +145,7 @@ def table(header, rows):
 
 
 def markdown() -> str:
-    starts = [start_row(name, *(lambda p: (p.y, p.t))(bidmp.prepare(*bidmp.datasets.recording(name))[0]))
+    starts = [start_row(name, *(lambda p: (p.y, p.t))(bidmp.prepare(*bidmp.demonstrations.recording(name))[0]))
               for name in ("operator1_nut3", "operator2_nut5")]
     for speed in (0.0, 1.9, 5.0):
         for via, n in ((NUT_VIA, 2000), ([[0, 0, 0], [100, 50, 20]], 1000), ([[0, 0, 0], [0, 0, -60]], 600)):

@@ -18,8 +18,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from test_user_cells import spec  # noqa: E402  (the cells and their unit conversion, as the tests use them)
 
-from bidmp import scenarios, sim  # noqa: E402
-from bidmp.evaluation import evaluate  # noqa: E402
+from bidmp import sim  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
+from bidmp.tasks import evaluate# noqa: E402
 
 CELLS = (("two_posts.json", "mm"), ("duct_module.json", "mm"), ("duct_module.json", "cm"), ("duct_module.json", "m"))
 

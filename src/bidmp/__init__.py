@@ -14,9 +14,6 @@ checks it):
 3. the application — ``sim`` (simulator backends), ``experiments`` (the paper's tables, LASA),
    ``plotting``;
 4. the shell — ``cli``.
-
-The flat module paths of bidmp ≤ 0.4 (``bidmp.dmp``, ``bidmp.geometry``, …) still import
-(:mod:`bidmp._old_paths`).
 """
 
 from __future__ import annotations
@@ -24,16 +21,13 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING
 
-from . import _old_paths
 from ._lazy import exports
 
-__version__ = "0.5.0"
+from ._version import __version__
 
 # A library logs; the application decides what is shown (without a handler of its own, Python's
 # last resort would print every warning of bidmp to stderr).
 logging.getLogger(__name__).addHandler(logging.NullHandler())
-
-_old_paths.install()
 
 # public name -> "module[:attribute]" relative to bidmp
 _LAZY = {
@@ -65,19 +59,17 @@ _LAZY = {
     "get_limits": "_checks",
     "set_limits": "_checks",
 }
-# subpackages of the layout, and the flat modules of bidmp <= 0.4 (bidmp._old_paths)
+# the subpackages of the layout
 _SUBPACKAGES = ("primitives", "demonstrations", "extension", "incremental", "baselines", "scene", "tasks", "sim",
                 "experiments", "io", "plotting")
-_OLD_MODULES = ("dmp", "timing", "segmentation", "similarity", "roadmap", "bls", "geometry", "cartesian", "datasets",
-                "scenarios", "metrics", "evaluation", "reproduce", "benchmark")
 
-__all__ = ["__version__", *_LAZY, *_SUBPACKAGES, *_OLD_MODULES]
+__all__ = ["__version__", *_LAZY, *_SUBPACKAGES]
 
 _getattr, __dir__ = exports(__name__, _LAZY, globals())
 
 
 def __getattr__(name: str):
-    if name in _SUBPACKAGES or name in _OLD_MODULES:
+    if name in _SUBPACKAGES:
         import importlib
 
         value = importlib.import_module(f"{__name__}.{name}")

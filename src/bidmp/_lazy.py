@@ -11,7 +11,7 @@ import importlib.util
 from collections.abc import Callable
 
 
-def exports(package: str, table: dict[str, str], namespace: dict, fallback: tuple[str, ...] = ()) -> tuple[Callable, Callable]:
+def exports(package: str, table: dict[str, str], namespace: dict) -> tuple[Callable, Callable]:
     """``__getattr__`` and ``__dir__`` for ``package`` whose public names live in its modules.
 
     Parameters
@@ -23,10 +23,6 @@ def exports(package: str, table: dict[str, str], namespace: dict, fallback: tupl
         the attribute's name differs from the public one.
     namespace : dict
         The package's ``globals()``: a resolved name is cached there, so it is looked up once.
-    fallback : tuple of str
-        Modules (relative to ``package``) searched for any other name: a subpackage that took the
-        place of a flat module of bidmp ≤ 0.4 (``bidmp.io``, ``bidmp.sim``, …) still answers for
-        everything that module held.
     """
 
     def __getattr__(name: str):
@@ -35,10 +31,6 @@ def exports(package: str, table: dict[str, str], namespace: dict, fallback: tupl
                 value = importlib.import_module(f"{package}.{name}")
                 namespace[name] = value
                 return value
-            for module in fallback:
-                source = importlib.import_module(f"{package}.{module}")
-                if hasattr(source, name):
-                    return getattr(source, name)
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         module, _, attribute = table[name].partition(":")
         value = getattr(importlib.import_module(f"{package}.{module}"), attribute or name)

@@ -13,7 +13,7 @@ import warnings
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams, deprecated_alias
+from .._api import CheckedParams
 from .._checks import (
     as_trajectory,
     check_bool,
@@ -193,9 +193,3 @@ class GMMRegressor(_AugmentedMixture):
         _check_gmr_size(n_steps, self.means_.shape)
         mean, covariances = _gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
         return (mean, covariances) if check_bool(return_covariance, "return_covariance") else mean
-
-    @deprecated_alias("rollout", "; generate() is rollout(return_covariance=True)")
-    def generate(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Mean trajectory (n, D) and covariances (n, D, D) by GMR on t ∈ [0, 1] (deprecated:
-        :meth:`rollout`)."""
-        return self.rollout(n_steps=n_steps, return_covariance=True)

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._api import deprecated_alias, goal_first
 from .._checks import _as_bounded_array, as_point, check_bool, check_fitted, check_int, numerically_guarded
 from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, _gmr, augment
 
@@ -85,7 +84,6 @@ class TPGMM(_AugmentedMixture):
         sigma_global = transform @ sigma @ transform.T + self.reg_covar * np.eye(d + 1)
         return mu_global, sigma_global
 
-    @goal_first("start", "n_steps")
     @numerically_guarded
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_rotation=None, target_rotation=None,
                 return_covariance: bool = False):
@@ -111,10 +109,3 @@ class TPGMM(_AugmentedMixture):
         mean = np.einsum("kij,kj->ki", covariance, weighted_mean)
         mean, covariances = _gmr(self.weights_, mean, covariance, np.linspace(0.0, 1.0, n_steps))
         return (mean, covariances) if check_bool(return_covariance, "return_covariance") else mean
-
-    @deprecated_alias("rollout", "; generate(start, target) is rollout(target, start=start, return_covariance=True)")
-    def generate(self, start, target, n_steps: int | None = None, start_rotation=None, target_rotation=None):
-        """Mean trajectory (n, D) and covariances for new start and target frames (deprecated:
-        :meth:`rollout`)."""
-        return self.rollout(target, start=start, n_steps=n_steps, start_rotation=start_rotation,
-                            target_rotation=target_rotation, return_covariance=True)

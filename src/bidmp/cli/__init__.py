@@ -21,7 +21,6 @@ from collections.abc import Sequence as _Sequence
 from .. import __version__
 from .common import EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_OK
 from .common import MAX_MESSAGE as _MAX_MESSAGE
-from .common import MAX_SEEDS as _MAX_SEEDS  # noqa: F401  (the name bidmp <= 0.4 had)
 from .common import Parser as _Parser
 from .common import one_line as _one_line
 

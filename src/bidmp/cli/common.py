@@ -16,7 +16,7 @@ EXIT_BAD_INPUT = 2
 EXIT_TARGETS_FAILED = 3
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a tool killed by a closed pipe reports
 MAX_MESSAGE = 600  # characters of one error line
-MAX_SEEDS = 200  # = bidmp.reproduce.MAX_SEEDS (not imported: --help must not load NumPy)
+MAX_SEEDS = 200  # = bidmp.experiments.MAX_SEEDS (not imported: --help must not load NumPy)
 
 
 class Parser(argparse.ArgumentParser):

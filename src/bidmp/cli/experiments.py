@@ -75,7 +75,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from ..experiments.lasa import _validate, lasa
+    from ..experiments.benchmark import _validate, lasa
 
     shapes = None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
     methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]

@@ -45,7 +45,7 @@ def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, proto
 
         n_running = len(client.scheduler_info().get("workers", {})) or n_workers
         from ..tasks import methods as registry
-        from .lasa import _write_cell, cell_key, run_cell
+        from .benchmark import _write_cell, cell_key, run_cell
 
         objects = [registry.get(name) for name in methods]
         futures = [client.submit(run_cell, shape, demo, objects, every, kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",

@@ -17,7 +17,7 @@ from pathlib import Path
 from ..io.atomic import atomic_write
 from ..tasks.evaluation import write_report
 
-# The paper's results, importable from one place (bidmp.reproduce of bidmp <= 0.4).
+# The paper's results, importable from one place (bidmp.experiments lists them from here).
 from .generalisation import (  # noqa: F401
     GeneralisationResult,
     lasa_generalisation,

@@ -35,5 +35,4 @@ _EXPORTS = {
     "classic_prm": "roadmap",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.extension of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("extend",))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -24,5 +24,4 @@ _EXPORTS = {
     "pose_forgetting": "cartesian",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.incremental of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("bidmp",))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -8,7 +8,6 @@ import copy
 
 import numpy as np
 
-from .._api import goal_first
 from .._checks import as_point, numerically_guarded
 
 __all__ = ["SkillLibrary"]
@@ -118,7 +117,6 @@ class SkillLibrary:
             views[key] = view
         return views[key]
 
-    @goal_first("skill", "start", "n_steps")
     @numerically_guarded
     def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Generate a trajectory with one skill of the library.
@@ -141,7 +139,6 @@ class SkillLibrary:
         # Skill 0 passes no increment: exactly the plain DMP's rollout.
         return dmp.rollout(goal=goal, start=start, n_steps=n_steps, forcing_increment=increment)
 
-    @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, coupling=None, via=None, via_until: float | None = None):
@@ -152,7 +149,6 @@ class SkillLibrary:
         return dmp.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
                               forcing_increment=increment, coupling=coupling, via=via, via_until=via_until)
 
-    @goal_first("skill", "start", "duration")
     def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0):
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)

@@ -47,23 +47,17 @@ from .._threads import one_thread, single_threaded
 from .bls_state import _bls_from_state, _bls_state
 from .linalg import (
     MAX_ADMM_ITERATIONS,
-    PINV_GAP,
-    PINV_RCOND,
     _check_gap,
     _grow_pinv,
     _grow_ridge,
     _solve_output,
     _truncated_svd,
-    block_pinv_update,
     sparse_autoencoder,
-    svd_update,
-    truncated_svd,
 )
 
 _THREADED_ROWS = 64  # predict() runs single-threaded from this many rows on
 
-# The algebra is re-exported here, where bidmp <= 0.5 defined it.
-__all__ = ["BLS", "sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "PINV_RCOND", "PINV_GAP"]
+__all__ = ["BLS"]
 
 logger = logging.getLogger(__name__)
 

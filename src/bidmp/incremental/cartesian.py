@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from sklearn.base import BaseEstimator, clone
 
-from .._api import CheckedParams, goal_first
+from .._api import CheckedParams
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
 from ..primitives.cartesian import (
     CartesianDMP,
@@ -175,7 +175,6 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         start_e = _nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
         return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
 
-    @goal_first("skill", "start", "n_steps")
     def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) with one skill (chosen on the position goal)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
@@ -183,7 +182,6 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         error = self.orientation_.rollout(np.zeros(3), skill=index, start=start_e, n_steps=n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
-    @goal_first("skill", "start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
                    dt: float | None = None, limits: dict | None = None, coupling=None, via=None) -> PoseTrajectory:
@@ -196,7 +194,6 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
                                 duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
                                 coupling, vias)
 
-    @goal_first("skill", "start", "duration")
     def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
                 coupling=0.0) -> PoseStepper:
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)

@@ -39,6 +39,4 @@ _EXPORTS = {
     "start_stamp": "bags",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.io of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(),
-                               fallback=("models", "trajectories", "poses", "atomic", "strict_json", "_csv", "_npy"))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

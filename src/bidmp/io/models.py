@@ -2,7 +2,7 @@
 model's arrays under their attribute names plus ``__bidmp__``, a uint8 array with UTF-8 JSON::
 
     {"format": "bidmp-model", "format_version": 4, "class": "DMP",
-     "bidmp_version": "0.5.0", "state": {...class-specific, e.g. constructor params...}}
+     "bidmp_version": "0.6.0", "state": {...class-specific, e.g. constructor params...}}
 
 It is read member by member with ``allow_pickle=False``, so loading a file can never execute
 code, and a member the model does not ask for is never read; every array is checked for dtype,

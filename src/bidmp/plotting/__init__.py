@@ -34,5 +34,4 @@ _EXPORTS = {
     "load_layers": "viewer",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.plotting of bidmp <= 0.4 held, for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(), fallback=("_base", "extension", "tasks"))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._api import goal_first
 from .._checks import as_point, check_int, numerically_guarded
 from .forcing import _check_forcing_increment
 from .grid import _rollout_grid
@@ -56,7 +55,6 @@ class Motions:
             raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
         return free, goal_response, forcing, gate
 
-    @goal_first("start", "n_steps", "start_velocity")
     @numerically_guarded
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_velocity=None,
                 forcing_increment=None) -> np.ndarray:
@@ -89,7 +87,6 @@ class Motions:
         goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
         return free + np.outer(goal_response, goal)
 
-    @goal_first("start", "n_steps", "start_velocity")
     @numerically_guarded
     def rollout_many(self, goals, *, start=None, n_steps: int | None = None, start_velocity=None,
                      forcing_increment=None, out: np.ndarray | None = None) -> np.ndarray:
@@ -115,7 +112,6 @@ class Motions:
         free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         return _rollouts_to(goals, free, goal_response, out)
 
-    @goal_first("chunk_size", "start", "n_steps", "start_velocity")
     def iter_rollouts(self, goals, *, chunk_size: int = 1024, start=None, n_steps: int | None = None,
                       start_velocity=None, forcing_increment=None):
         """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
@@ -131,7 +127,6 @@ class Motions:
         yield from _iter_rollouts_to(goals, free, goal_response, chunk_size)
 
     # -- real time -------------------------------------------------------------------------------
-    @goal_first("start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None, via=None,
@@ -197,7 +192,6 @@ class Motions:
             return _coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
         return _timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
 
-    @goal_first("start", "duration")
     def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0,
                 start_velocity=None, forcing_increment=None) -> DMPStepper:
         """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).

@@ -27,7 +27,7 @@ margin, and within the final approach's length of the goal the parts beside the 
 the approach is never pushed off its target (its clearance is still checked).
 
 After a coupled rollout :meth:`check` measures the motion's clearance exactly
-(:meth:`bidmp.geometry.Scene.clearance`); :meth:`bidmp.DMP.trajectory` raises
+(:meth:`bidmp.scene.Scene.clearance`); :meth:`bidmp.DMP.trajectory` raises
 :class:`AvoidanceError` (with the motion and its clearance) when it comes closer than the margin
 or ends short of its goal (held in a dead end), or logs it with ``on_miss="warn"``. A motion is
 never returned as clear when it is not.
@@ -53,7 +53,7 @@ _BARRIER_CAP = 1e3  # the barrier's factor ρ/p - 1 at most this (without a limi
 
 class AvoidanceError(ValueError):
     """A coupled motion that comes closer to a part than the margin, or that the parts hold short
-    of its goal. ``trajectory`` is the motion, ``clearance`` its :class:`bidmp.geometry.Clearance`."""
+    of its goal. ``trajectory`` is the motion, ``clearance`` its :class:`bidmp.scene.Clearance`."""
 
     def __init__(self, message: str, trajectory=None, clearance=None) -> None:
         super().__init__(message)
@@ -65,7 +65,7 @@ class SceneAvoidance(CouplingTerm):
 
     Parameters
     ----------
-    scene : bidmp.geometry.Scene
+    scene : bidmp.scene.Scene
         Parts and tool; positions in the scene's unit (the DMP's must be the same).
     margin : float, optional
         Clearance to keep (scene units); default the scene's margin.
@@ -100,7 +100,7 @@ class SceneAvoidance(CouplingTerm):
         from ..scene.clearance import Scene  # imported here: the primitives do not need the scene otherwise
 
         if not isinstance(scene, Scene):
-            raise TypeError(f"scene must be a bidmp.geometry.Scene, got {type(scene).__name__}")
+            raise TypeError(f"scene must be a bidmp.scene.Scene, got {type(scene).__name__}")
         self.scene = scene
         self.margin = float(scene.margin) if margin is None else check_real(margin, "margin", nonnegative=True)
         radius = float(scene.tool.radius)
@@ -199,7 +199,7 @@ class SceneAvoidance(CouplingTerm):
 
     def check(self, trajectory):
         """The exact clearance of a motion ``trajectory`` (n, 3) with the parts this term avoids
-        (:class:`bidmp.geometry.Clearance`, with this term's margin)."""
+        (:class:`bidmp.scene.Clearance`, with this term's margin)."""
         from ..scene.clearance import Clearance
 
         found = self.scene.clearance(trajectory, exclude=getattr(self, "excluded_", self.exclude))

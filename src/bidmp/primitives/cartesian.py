@@ -30,7 +30,7 @@ import logging
 import numpy as np
 from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams, goal_first
+from .._api import CheckedParams
 from .._checks import (
     as_point,
     as_trajectory,
@@ -194,7 +194,6 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         start_q = as_quaternions(start[3:], "start's quaternion")[0]
         return goal[:3], goal_q, start[:3], _nearest_turn(start_q, goal_q, self.start_log_)
 
-    @goal_first("start", "duration", "dt")
     @numerically_guarded
     def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
                    limits: dict | None = None, position_increment=None, orientation_increment=None,
@@ -225,7 +224,6 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         return _pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
                                 limits, position_increment, orientation_increment, self.units_, coupling, vias)
 
-    @goal_first("start", "n_steps")
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) on the DMP's sample grid, in normalised time (as :meth:`bidmp.DMP.rollout`;
         :meth:`trajectory` is in seconds)."""
@@ -234,7 +232,6 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         error = self.orientation_.rollout(np.zeros(3), start=start_e, n_steps=n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
-    @goal_first("start", "duration")
     def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0) -> PoseStepper:
         """A step-by-step integrator for a control loop; phase stopping on the position error."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)

@@ -82,7 +82,7 @@ class ConstantAcceleration(CouplingTerm):
 def _as_couplings(coupling) -> tuple[list, list]:
     """Split ``coupling`` into (spatial terms, temporal terms).
 
-    ``coupling`` is a number (the phase-stopping gain of bidmp ≤ 0.4's ``stepper(coupling=...)``),
+    ``coupling`` is a number (the gain of a :class:`PhaseStopping` term: ``stepper(coupling=20.0)``),
     one coupling term, or a sequence of them; ``None`` is none.
     """
     if coupling is None:

@@ -1,6 +1,6 @@
 """Timed pose motion: :class:`PoseTrajectory` (the pose counterpart of :class:`bidmp.Trajectory`),
 the timed rollout of a pose skill's two parts, and :class:`PoseStepper` for a control loop.
-Public through :mod:`bidmp.cartesian`."""
+Public through :mod:`bidmp.primitives`."""
 
 from __future__ import annotations
 

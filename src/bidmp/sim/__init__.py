@@ -54,6 +54,4 @@ _EXPORTS = {
     "write_sim_report": "report",
 }
 __all__ = list(_EXPORTS)
-# what the flat module bidmp.sim of bidmp <= 0.4 held (constants, helpers), for code written against it
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals(),
-                               fallback=("backend", "run", "report", "pybullet.robot", "pybullet.world"))
+__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -148,7 +148,7 @@ class SimulatorBackend(Protocol):
     """A simulated robot in a scene's world (the methods ``bidmp.sim`` calls)."""
 
     unit: float  # metres per scene unit
-    scene: object  # the bidmp.geometry.Scene it was built from (the closed loop steers round it)
+    scene: object  # the bidmp.scene.Scene it was built from (the closed loop steers round it)
 
     @classmethod
     def load_robot(cls, scene, units: str, base, yaw: float) -> "SimulatorBackend":

@@ -525,7 +525,7 @@ def job_targets(scenario, targets=None) -> list:
     from .run import _checked as _checked_names
 
     if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
+        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}")
     if scenario.job is None:
         raise ValueError(f"scenario {scenario.name!r} has no \"job\": the steps to run at each target")
     _, labels = _checked_names(scenario, ["bidmp"], targets, False)

@@ -354,7 +354,7 @@ def target_labels(scenario, targets) -> list[str]:
     from ..tasks.scenarios import Scenario
 
     if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
+        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}")
     labels = scenario.labels if targets is None else as_labels(targets, "targets")
     for label in labels:
         if label not in scenario.targets:

@@ -37,7 +37,7 @@ Keys (units: millimetres for the battery scenarios)::
     methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
     seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
     robot                {"base": [x, y, z], "yaw": degrees}: where bidmp sim puts the Panda
-    scene                geometry of the work cell: tool and parts (see bidmp.geometry); with it
+    scene                geometry of the work cell: tool and parts (see bidmp.scene); with it
                          the evaluation reports clearance, collisions and task success, and the
                          extensions (approach "keep") are grown around the parts. A stage of
                          "extensions" with "in_scene": false is grown without it (a skill of an

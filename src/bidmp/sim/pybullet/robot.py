@@ -193,7 +193,7 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
     front of the work: the arm's standoff (the Panda 330 mm, the iiwa 430 mm) short of the nearest
     point in y, centred in x, at the lowest target's height, facing +y."""
     if not all(hasattr(scenario, name) for name in ("robot", "target_array", "demonstration", "units")):
-        raise TypeError(f"scenario must be a bidmp scenario (bidmp.scenarios.load), got {type(scenario).__name__}")
+        raise TypeError(f"scenario must be a bidmp scenario (bidmp.tasks.load), got {type(scenario).__name__}")
     robot = scenario.robot or {}
     if "base" in robot:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
