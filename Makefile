@@ -54,7 +54,7 @@ sim: $(STAMP)
 random-cells: $(STAMP)
 	BIDMP_RANDOM_CELLS=300 $(PY) -m pytest -q -n 2 tests/test_random_user_cells.py tests/test_random_cells.py tests/test_random_tilted_cells.py
 
-# Issue 23's avoidance on 200 random fields at 1 kHz (the tests run 50 at 250 Hz), then the
+# The avoidance on 200 random fields at 1 kHz (the tests run 50 at 250 Hz), then the
 # benchmark against movement_primitives on 50 fields: docs/results/avoidance.md, docs/avoidance.png.
 avoidance: $(STAMP)
 	BIDMP_AVOIDANCE_FIELDS=200 BIDMP_AVOIDANCE_RATE=1000 $(PY) -m pytest -q -n 2 tests/test_avoidance.py

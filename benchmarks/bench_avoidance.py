@@ -1,4 +1,4 @@
-"""Obstacle avoidance against movement_primitives on the same random fields (issue 23.4).
+"""Obstacle avoidance against movement_primitives on the same random fields.
 
     .venv/bin/python benchmarks/bench_avoidance.py [--fields N] [--out DIR]
     make avoidance        # 50 fields, writes docs/results/avoidance.md and docs/avoidance.png

@@ -1,4 +1,4 @@
-"""The whole job's speed against real time (issue 25), and bidmp sim's with 1 and 2 worker
+"""The whole job's speed against real time, and bidmp sim's with 1 and 2 worker
 processes, in one run, the sides interleaved.
 
     .venv/bin/python benchmarks/bench_job.py [--repeats N]

@@ -1,4 +1,4 @@
-"""Bi-DMP on the nut task: convergence past the horizon and the block ridge (issue 8).
+"""Bi-DMP on the nut task: convergence past the horizon and the block ridge.
 
     .venv/bin/python benchmarks/bidmp_convergence.py
 

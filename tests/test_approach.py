@@ -1,4 +1,4 @@
-"""The approach-keeping goal system (issue 21.3): under a moved goal the spatial offset is complete
+"""The approach-keeping goal system: under a moved goal the spatial offset is complete
 before the final approach begins, so the approach is a translated copy of the demonstrated one.
 
 Checked on random demonstrations (random transfers, a straight approach along a random axis, other

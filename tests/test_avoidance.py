@@ -1,4 +1,4 @@
-"""Issue 23.1: SceneAvoidance steers a DMP round parts it never saw, on fields nobody tuned it for.
+"""SceneAvoidance steers a DMP round parts it never saw, on fields nobody tuned it for.
 
 The property on random fields (bidmp.scene.random_field: 1-4 tall posts and boxes across the
 line from start to goal, a free path guaranteed by construction; random demonstrations in mm or

@@ -1,4 +1,4 @@
-"""Issue 24.1: ROS bags without ROS. The bags are written here with rosbags' own writers and
+"""ROS bags without ROS. The bags are written here with rosbags' own writers and
 typestores (not with bidmp's), each holding what a robot's recorder would: other topics beside the
 one read, other frames on /tf, more joints than asked for, header stamps that differ from the
 receive times. Each fits to the same model as the equivalent CSV written from the same numbers
@@ -156,7 +156,7 @@ def _read_all(path):
 
 
 def test_rolled_out_motions_read_back_as_ros_messages(tmp_path):
-    """Issue 35.4: stamps from the given start (not 1970), the user's topic and frame, no made-up
+    """stamps from the given start (not 1970), the user's topic and frame, no made-up
     orientation (a position model writes PointStamped, or PoseStamped holding the orientation
     it is given), joint names from the recording in the JointTrajectory and the FollowJointTrajectory
     goal (read back through rosbags from the definitions the bag carries)."""
@@ -213,7 +213,7 @@ def test_rolled_out_motions_read_back_as_ros_messages(tmp_path):
 
 
 def test_a_bag_with_receive_jitter_fits_the_model_of_its_csv_and_real_jumps_back_are_refused(tmp_path, capsys):
-    """Issue 35.4: messages received 0-4 ms after their stamps, and 0-9 ms (then out of receive
+    """messages received 0-4 ms after their stamps, and 0-9 ms (then out of receive
     order: transport jitter), are put in the order of their stamps: the same model as the CSV of
     the same samples; two messages with one stamp, or a
     stamp 0.5 s back (a clock reset), are refused in one line that lists the bag."""

@@ -1,4 +1,4 @@
-"""GMM/GMR and TP-GMM baselines (SPEC §8), against closed forms and properties."""
+"""GMM/GMR and TP-GMM baselines, against closed forms and properties."""
 
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""The LASA benchmark (issue 14): metrics against independent references, Dask runs that agree
+"""The LASA benchmark: metrics against independent references, Dask runs that agree
 with the serial one, survive a killed worker and resume, and bad input that fails fast."""
 
 import functools
@@ -93,7 +93,7 @@ def _worker_environment(_):
 @needs_dask
 def test_workers_keep_glibc_adaptive_malloc_and_this_process_its_environment():
     """Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in their workers, which turns off glibc's
-    adaptive mmap threshold (the cells' fits ran 1.6-2x slower there, issue 24.6); bidmp's cluster
+    adaptive mmap threshold (the cells' fits ran 1.6-2x slower there); bidmp's cluster
     starts them without it, and leaves no variable of theirs in this process."""
     import os
 
@@ -180,7 +180,7 @@ def test_csv_output_and_the_summary(serial, tmp_path):
 
 
 def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
-    """Issue 19.14: docs/results/lasa.md (the README's LASA tables, from `make lasa`) is the
+    """docs/results/lasa.md (the README's LASA tables, from `make lasa`) is the
     summary of the committed per-cell table docs/results/lasa.parquet, and a fresh run of two of
     its cells gives the same rows (every metric; the times aside)."""
     pq = pytest.importorskip("pyarrow.parquet")
@@ -200,7 +200,7 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
 
 
 def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(serial, tmp_path, caplog):
-    """Issue 22.3: --resume trusted cell files; an edited value was merged as is and a missing key
+    """--resume trusted cell files; an edited value was merged as is and a missing key
     ended in an internal error. Each is now recomputed, with a warning naming the cell."""
     import json
     import logging

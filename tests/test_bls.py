@@ -1,4 +1,4 @@
-"""Broad Learning System (SPEC §6): incremental updates against from-scratch pinv / ridge."""
+"""Broad Learning System: incremental updates against from-scratch pinv / ridge."""
 
 import numpy as np
 import pytest
@@ -97,7 +97,7 @@ def nut_bidmp():
 
 
 def test_pinv_update_on_a_recordings_bidmp_matrices_equals_numpy_pinv():
-    """Issue 19.9 on the project's own matrices: a Bi-DMP learned from a bundled recording."""
+    """9 on the project's own matrices: a Bi-DMP learned from a bundled recording."""
     y, t = bidmp.demonstrations.recording("operator1_nut3")
     prepared, _ = bidmp.prepare(y, t)
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
@@ -111,7 +111,7 @@ def test_pinv_update_on_a_recordings_bidmp_matrices_equals_numpy_pinv():
 
 
 def test_pinv_update_on_the_nut_tasks_bidmp_matrices_is_refused_with_the_reason(nut_bidmp):
-    """Issue 19.9: on today's main add_enhancement_nodes(20) raised the training residual from
+    """before the fix, add_enhancement_nodes(20) raised the training residual from
     322 to 27 570 (a from-scratch pinv: 307) and BiDMP(reg=0) rolled out 108 mm off. The
     pseudo-inverse of these matrices is ill-posed (shown here with NumPy alone): the update is
     refused, saying why; reg > 0 is exact on the same matrices."""

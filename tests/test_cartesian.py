@@ -1,4 +1,4 @@
-"""Pose skills (issue 13): CartesianDMP against movement_primitives and closed forms, pose files,
+"""Pose skills: CartesianDMP against movement_primitives and closed forms, pose files,
 pose Bi-DMP, the pose extension and the tilted pack."""
 
 import json
@@ -207,7 +207,7 @@ def test_the_kept_approach_keeps_its_pose_relative_to_the_target():
     orientations = extension.orientations
     np.testing.assert_array_equal(extension.poses, np.hstack([extension.complete, orientations]))
     start = extension.approach_index
-    n = len(flat) - start  # the kept approach: the last n samples (the transfer may take longer, issue 21.1)
+    n = len(flat) - start  # the kept approach: the last n samples (the transfer may take longer)
     kept = extension.complete[-n:]
     expected = target[:3] + tilt.apply(flat[start:, :3] - flat[-1, :3])
     np.testing.assert_allclose(kept, expected, rtol=0, atol=1e-9)
@@ -256,7 +256,7 @@ def test_cli_fits_and_rolls_out_a_pose_recording(tmp_path, capsys):
     assert main(["rollout", str(tmp_path / "m.npz"), "--goal", "1", "2", "-o", str(tmp_path / "x.csv")]) == 2
 
 
-# --- issue 19: turns past 180 degrees, still parts, one pose API --------------------------------
+# --- turns past 180 degrees, still parts, one pose API --------------------------------
 def screw_turn(degrees, n_steps=400, pitch=1.25):
     """A nutrunner's demonstration: the socket turns ``degrees`` about its own (vertical) axis,
     minimum jerk, and rises by the M8 thread's pitch per turn (mm)."""
@@ -277,7 +277,7 @@ def turned_angle(quaternions):
 @pytest.mark.parametrize("degrees", [190, 270, 360, 720])
 @pytest.mark.parametrize("protocol", ["robot", "paper"])
 def test_turns_past_180_degrees_are_reproduced(degrees, protocol):
-    """Issue 19.5: on today's main SciPy's principal rotation vector wrapped at 180 degrees, and
+    """before the fix, SciPy's principal rotation vector wrapped at 180 degrees, and
     190 / 270 / 360 degree turns reproduced 155 / 178 / 171 degrees off."""
     poses, t = screw_turn(degrees)
     model = CartesianDMP(protocol=protocol).fit(poses, t, units="mm")
@@ -322,7 +322,7 @@ def test_movement_primitives_agrees_on_a_270_degree_turn():
 
 
 def test_a_constant_orientation_and_a_rotation_in_place_fit_and_reproduce():
-    """Issue 19.6: on today's main both were refused with "y is degenerate: all 200 points are
+    """before the fix, both were refused with "y is degenerate: all 200 points are
     identical", about the part that does not move."""
     positions = minimum_jerk([[0, 0, 100], [80, 20, 40], [150, 25, 0]], 300)
     t = np.linspace(0.0, 3.0, 300)
@@ -354,7 +354,7 @@ def test_a_constant_orientation_and_a_rotation_in_place_fit_and_reproduce():
 
 
 def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
-    """Issue 19.7: PoseTrajectory mirrors Trajectory, the steppers return the same triple, goal_
+    """PoseTrajectory mirrors Trajectory, the steppers return the same triple, goal_
     is named alike, CartesianBiDMP is an estimator with trajectory(), the pose extension returns
     one object and the pose CSV carries accelerations."""
     import dataclasses

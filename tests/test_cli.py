@@ -215,7 +215,7 @@ def test_extend_learns_a_bidmp_and_rollout_uses_its_skills(tmp_path, battery_fil
     extension = bidmp.extend_demonstration(load_trajectory(demo), [150, 25, 0], seed=3)
     records = np.load(demo_out)
     np.testing.assert_array_equal(np.column_stack([records["x"], records["y"], records["z"]]), extension.complete)
-    dmp = bidmp.load(model)  # the extension lasts longer than the demonstration (issue 21.1): written as it lasts
+    dmp = bidmp.load(model)  # the extension lasts longer than the demonstration: written as it lasts
     assert records["t"][-1] == pytest.approx(extension.duration_for(dmp)) and extension.duration_for(dmp) > dmp.duration_
     learned = bidmp.load(bidmp_file)
     assert isinstance(learned, bidmp.BiDMP) and learned.n_skills == 2
@@ -306,7 +306,7 @@ def test_the_cli_seed_bound_is_the_library_one():
     assert cli.common.MAX_SEEDS == reproduce.MAX_SEEDS
 
 
-# --- issue 19: the pose commands, units, loggers' files, limits as caps ---------------------------
+# --- the pose commands, units, loggers' files, limits as caps ---------------------------
 @pytest.fixture
 def pose_recording(tmp_path):
     from scipy.spatial.transform import Rotation
@@ -323,7 +323,7 @@ def pose_recording(tmp_path):
 
 
 def test_the_pose_commands_extend_learn_and_roll_out_a_pose_bidmp(tmp_path, pose_recording, capsys):
-    """Issue 19.8: on today's main extend and learn on a pose model ended with 'internal error:
+    """before the fix, extend and learn on a pose model ended with 'internal error:
     AttributeError: Namespace object has no attribute skill', and rollout --plot wrote nothing."""
     model, grown, more = tmp_path / "pose.npz", tmp_path / "grown.npz", tmp_path / "more.npz"
     assert run(["fit", str(pose_recording), "-o", str(model), "--units", "mm"], capsys)[0] == 0
@@ -350,7 +350,7 @@ def test_the_pose_commands_extend_learn_and_roll_out_a_pose_bidmp(tmp_path, pose
 
 
 def test_units_are_a_known_set_checked_against_the_model_and_converted_on_request(tmp_path, capsys):
-    """Issue 19.10: on today's main --units took any text, a mm recording learned into a metre
+    """before the fix, --units took any text, a mm recording learned into a metre
     model silently, and a mm goal on a metre model wrote a 458 m/s trajectory without a word."""
     y, t = bidmp.demonstrations.recording("operator1_nut3")
     in_metres = save_trajectory(y / 1000.0, tmp_path / "m.csv", times=t, units="m")
@@ -379,7 +379,7 @@ def test_units_are_a_known_set_checked_against_the_model_and_converted_on_reques
 
 
 def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
-    """Issue 19.11: other column names, extra columns and a repeated stamp, as loggers write them."""
+    """other column names, extra columns and a repeated stamp, as loggers write them."""
     y, t = bidmp.demonstrations.recording("operator2_nut5")
     t = t.copy()
     t[300] = t[299]
@@ -400,7 +400,7 @@ def test_a_loggers_file_reads_with_a_column_mapping(tmp_path, capsys):
 
 
 def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys):
-    """Issue 19.12: on today's main --max-speed above the demonstrated speed shortened the motion."""
+    """before the fix, --max-speed above the demonstrated speed shortened the motion."""
     y, t = bidmp.demonstrations.recording("operator1_nut3")
     recording = save_trajectory(y, tmp_path / "r.csv", times=t)
     assert run(["fit", str(recording), "-o", str(tmp_path / "m.npz"), "--units", "mm"], capsys)[0] == 0
@@ -417,7 +417,7 @@ def test_max_speed_is_a_cap_and_fastest_asks_for_more(tmp_path, demo_csv, capsys
 
 
 def test_fifos_are_refused_not_waited_on(tmp_path, capsys):
-    """Issue 22.3: `mkfifo f.csv; bidmp fit f.csv` blocked for ever (the unit sniffing opened it)."""
+    """`mkfifo f.csv; bidmp fit f.csv` blocked for ever (the unit sniffing opened it)."""
     import os
     import threading
 
@@ -437,7 +437,7 @@ def test_fifos_are_refused_not_waited_on(tmp_path, capsys):
 
 
 def test_printed_names_cannot_drive_the_terminal(tmp_path, capsys):
-    """Issue 22.3: a scenario's name and labels are printed; escape sequences in them are shown as '?'."""
+    """a scenario's name and labels are printed; escape sequences in them are shown as '?'."""
     from bidmp.tasks import scenarios
 
     spec = json.loads(scenarios.builtin_text("pick-and-place"))

@@ -1,4 +1,4 @@
-"""DMP (SPEC §1): checked against a plain Euler loop, closed-form properties and movement_primitives."""
+"""DMP: checked against a plain Euler loop, closed-form properties and movement_primitives."""
 
 import numpy as np
 import pytest
@@ -146,7 +146,7 @@ def test_endpoint_gain_matches_scalar_recursion_and_rollout(alpha, K):
 
 
 def test_endpoint_gain_spec_values_and_convergence():
-    # SPEC §1: T = 200, alpha_phase = 1, K = alpha: c = 0.0695 at alpha = 25, 0.0153 at alpha = 100.
+    # The paper's settings: T = 200, alpha_phase = 1, K = alpha: c = 0.0695 at alpha = 25, 0.0153 at alpha = 100.
     demo = minimum_jerk([0.0], [1.0], 200)
     assert DMP(protocol="paper", alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(0.0695, abs=5e-4)
     assert DMP(protocol="paper", alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(0.0153, abs=2e-4)
@@ -342,7 +342,7 @@ def test_tau_may_change_after_fit_and_equals_a_fresh_model_with_it(how, demo3d):
 )
 @pytest.mark.parametrize("how", ["attribute", "set_params"])
 def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how, demo3d):
-    """Issue 19.4: on today's main, set_params(alpha=...) kept the weights learned for the old
+    """before the fix, set_params(alpha=...) kept the weights learned for the old
     gains (LASA Sshape: 0.50 % -> 44.6 % RMSE). Now the model says it must be fitted again."""
     from sklearn.utils.validation import check_is_fitted
 
@@ -367,7 +367,7 @@ def test_every_parameter_but_tau_is_checked_after_fit():
 
 
 def test_changing_alpha_after_fit_on_lasa_would_have_ruined_the_reproduction():
-    """The measurement behind issue 19.4: the old weights under new gains reproduce Sshape badly,
+    """The measurement behind the refit on set_params: the old weights under new gains reproduce Sshape badly,
     a refit reproduces it well; so reusing them silently was wrong."""
     demo = lasa("Sshape")[0]
     dmp = DMP(protocol="paper").fit(demo)

@@ -1,4 +1,4 @@
-"""Engagement along the final approach (issue 21.6): only the motion's final descent along the
+"""Engagement along the final approach: only the motion's final descent along the
 target's axis into the target counts; a pass through the band, a lift out of it or a motion that
 never comes down does not engage. The trajectories are built by hand, with the answer known."""
 

@@ -1,4 +1,4 @@
-"""Scenario evaluation (SPEC §9): the paper's structure on the battery tasks, honestly measured."""
+"""Scenario evaluation: the paper's structure on the battery tasks, honestly measured."""
 
 import json
 
@@ -39,7 +39,7 @@ def test_bidmp_succeeds_everywhere_with_the_two_level_pattern(nut):
     # horizon term c·(g − g_n), whose direction differs per nut).
     target = np.asarray(nut.extension_targets[0])
     own = np.linalg.norm(nut.model.rollout(target)[-1] - target)
-    assert own < 0.25  # 0.18 mm since the skill lasts as long as its extension (issue 21.1; 0.04 before)
+    assert own < 0.25  # 0.18 mm since the skill lasts as long as its extension (0.04 before)
     assert np.ptp(middle) <= 2 * own + 0.02 and np.ptp(outer) <= 2 * own + 0.02
     assert max(middle) + 0.05 < min(outer) < 0.8
     # The two levels are the horizon artefact around the new skill's goal: c · ‖g − g_n‖.
@@ -136,7 +136,7 @@ def test_cell_removal_second_extension_fixes_b6():
     before_spec["extensions"] = before_spec["extensions"][:1]
     before = evaluate(scenarios.from_dict(before_spec), ["bidmp"]).methods["bidmp"].errors
     after = evaluate("cell-removal", ["bidmp"]).methods["bidmp"].errors
-    assert after["B6"] < 0.6 * before["B6"]  # 0.51 since issue 21.1 timed the extensions (0.10 before)
+    assert after["B6"] < 0.6 * before["B6"]  # 0.51 since the extensions are timed (0.10 before)
     assert after["N3"] == pytest.approx(before["N3"])  # the nut skill is not forgotten
 
 
@@ -152,7 +152,7 @@ def test_unknown_method_is_rejected():
 
 
 def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
-    """Issue 21.8: a wall across the plate, up to the ceiling, leaves the far nuts no
+    """a wall across the plate, up to the ceiling, leaves the far nuts no
     collision-free route (over a 300 mm one the extension now lifts); the evaluation still reports
     every method, the far targets fail, and the report says why."""
     import json
@@ -171,7 +171,7 @@ def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
 
 
 def test_a_learned_skill_inside_the_margin_is_planned_again_wider(caplog, monkeypatch):
-    """Issue 21.4 (structure: the repair loop's control flow, with the first check of the learned
+    """4 (structure: the repair loop's control flow, with the first check of the learned
     rollout forced inside the margin; on 150 random cells no learned rollout came inside its
     extension's margin). The extension is planned again with the margin widened by the shortfall,
     and the evaluation goes on to the same successes."""

@@ -1,4 +1,4 @@
-"""Issue 21.1–21.2: an extension is timed like the demonstration it extends (its peaks within the
+"""an extension is timed like the demonstration it extends (its peaks within the
 demonstration's, a longer transfer taking longer) and is as smooth as what it imitates (the
 template where it is free; around a part, near the shortest free route) — checked on random
 demonstrations, rates and units, on the bundled recordings as the robot would run them, and
@@ -307,7 +307,7 @@ def test_a_transfer_around_a_random_post(seed):
 
 @pytest.mark.parametrize("height", [100.0, 130.0])
 def test_a_route_over_a_cable_duct_across_the_plate(height):
-    """Issue 21.8: a duct across the whole plate between the demonstration and the target. G-PRM's
+    """a duct across the whole plate between the demonstration and the target. G-PRM's
     samples around the straight line never clear it ("no collision-free route"), although a route
     over it exists; the extension now finds it, and it keeps the tool (radius, length) the margin
     above the duct by a check by hand."""

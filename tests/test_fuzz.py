@@ -1,4 +1,4 @@
-"""Fuzzing every public entry point and every CLI command (issues 9 and 19): DMP, pose DMP and
+"""Fuzzing every public entry point and every CLI command: DMP, pose DMP and
 Bi-DMP, BLS, extension and roadmaps, baselines, datasets, metrics, plotting, scenarios, scene
 geometry, the simulator's IK and planning, the LASA benchmark, every file reader.
 
@@ -383,7 +383,7 @@ def test_fuzz_metrics(a, b, target, height):
     from bidmp.tasks import metrics
 
     outcome("metrics.endpoint_error", metrics.endpoint_error, a, target)
-    # inf is documented (issue 21.6): the motion has no final approach into the target; any other
+    # inf is documented: the motion has no final approach into the target; any other
     # result must be finite.
     outcome("metrics.approach_error", lambda *args: _inf_as_none(metrics.approach_error(*args)), a, target, height)
     outcome("metrics.path_difference", metrics.path_difference, a, b)

@@ -69,7 +69,7 @@ def test_clearance_to_a_cylinder_matches_the_closed_form_for_parallel_axes():
 def test_gjk_answers_off_the_shapes_are_not_taken_for_distances(monkeypatch):
     """Two vertical cylinders with parallel axes: coal's GJK at the tight tolerance (and its
     Nesterov variant) sometimes returned the distance between "nearest points" that lie off the
-    shapes — found by the avoidance coupling term (issue 23) mid-rollout: 1.96 for 16.90, 3.93 for
+    shapes — found by the avoidance coupling term mid-rollout: 1.96 for 16.90, 3.93 for
     12.50, near the two placements below. It depends on the solver's state from the queries before,
     so it is not replayed here in isolation; the guard is tested by making coal's first answer
     a distance its nearest points do not bear out, and every answer is checked against
@@ -191,7 +191,7 @@ def test_the_kept_approach_is_the_demonstrated_one_translated(nut):
     assert start == final_approach(demo, extension.segmentation_points)
     n = demo.shape[0] - start
     np.testing.assert_allclose(extension.complete[-n:], demo[start:] + (target - demo[-1]), rtol=0, atol=1e-9)
-    # At least T samples: the transfer takes as long as it needs (issue 21.1).
+    # At least T samples: the transfer takes as long as it needs.
     assert extension.complete.shape[0] >= demo.shape[0] and np.array_equal(extension.complete[0], demo[0])
     # The kept approach is the straight vertical descent from 40 mm onto the nut.
     np.testing.assert_allclose(demo[start], [0.0, 0.0, 40.0], atol=0.5)
@@ -356,7 +356,7 @@ def test_final_approach_is_the_straight_tail_of_the_last_piece():
     assert final_approach(wiggle, np.array([], dtype=int)) >= 37  # no straight approach to speak of
 
 
-# --- issue 21.5: collision queries never abort -----------------------------------------------------
+# --- collision queries never abort -----------------------------------------------------
 def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
     """A vertical tool beside a vertical post (parallel flat sides): coal's GJK at the tight
     tolerance ends on a degenerate simplex for some placements and its EPA reports -DBL_MAX for
@@ -387,7 +387,7 @@ def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
     np.testing.assert_allclose(measured, radii - 27.5, atol=1e-6)
 
 
-# --- issue 21.4 (opt-in): a clearance margin ---------------------------------------------------------
+# --- 4 (opt-in): a clearance margin ---------------------------------------------------------
 def _post_scene(margin, at=(22.5, -27.6)):
     base = scenarios.load("nut-unscrewing")
     data = base.to_dict()["scene"]
@@ -438,7 +438,7 @@ def test_a_margin_is_validated_and_counts_in_task_success():
 
 
 # ---------------------------------------------------------------------------------------------
-# Issue 21.4: a default margin, and stand-offs stated per part
+# a default margin, and stand-offs stated per part
 # ---------------------------------------------------------------------------------------------
 def test_a_scenario_keeps_3_mm_by_default_in_its_units():
     spec = scenarios.load("pick-and-place").to_dict()

@@ -1,4 +1,4 @@
-"""Issue 23.3: goals moved during execution (``stepper.set_goal``).
+"""goals moved during execution (``stepper.set_goal``).
 
 Checked on the measured motion (the stepper's commands at 1 kHz), on random demonstrations that
 end in a straight approach (mm and m, random durations and approach lengths), random shifts in

@@ -1,4 +1,4 @@
-"""Bi-DMP (SPEC §7): incremental forcing term, skill library, forgetting, persistence."""
+"""Bi-DMP: incremental forcing term, skill library, forgetting, persistence."""
 
 import numpy as np
 import pytest
@@ -38,7 +38,7 @@ def test_lasa_extension_reproduced(name):
     demo = lasa(name)[0]
     dmp = DMP(protocol="paper").fit(demo)
     extension = extend_demonstration(demo, demo[-1] + [12.0, -9.0], seed=1)
-    # The transfer takes as long as it needs (issue 21.1): the skill lasts as long as the extension.
+    # The transfer takes as long as it needs: the skill lasts as long as the extension.
     model = BiDMP(dmp).learn(extension.complete, duration=extension.duration_for(dmp))
     rollout = model.rollout(extension.complete[-1])
     assert abs(len(rollout) - len(extension.complete)) <= 1

@@ -78,7 +78,7 @@ def test_bad_trajectory_files(tmp_path, name, text, match):
         load_trajectory(write(tmp_path / name, text))
 
 
-# --- recordings as loggers write them (issue 19.11) -------------------------------------------
+# --- recordings as loggers write them -------------------------------------------
 def logger_file(tmp_path, header, rows, name="log.csv"):
     path = tmp_path / name
     path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n")
@@ -86,7 +86,7 @@ def logger_file(tmp_path, header, rows, name="log.csv"):
 
 
 def test_a_repeated_timestamp_is_dropped_with_a_warning(tmp_path, caplog):
-    """On today's main one repeated stamp refused the whole recording."""
+    """before the fix, one repeated stamp refused the whole recording."""
     y, t = bidmp.demonstrations.recording("operator1_nut3")
     t = t.copy()
     t[100] = t[99]  # the logger wrote one stamp twice
@@ -101,7 +101,7 @@ def test_a_repeated_timestamp_is_dropped_with_a_warning(tmp_path, caplog):
 
 
 def test_a_stamp_going_back_is_refused_with_values_that_can_be_told_apart():
-    """On today's main the message printed 1.7330868e+09 twice."""
+    """before the fix, the message printed 1.7330868e+09 twice."""
     t = 1733086800.0 + np.arange(10) * 0.004
     t[5] = t[4] - 0.001
     with pytest.raises(ValueError, match=r"going back at sample 5: 1733086800\.015 s after 1733086800\.016 s \(-0\.9999 ms"):
@@ -264,7 +264,7 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
 
 def test_a_format_3_robot_model_rolls_out_as_it_did():
     """tests/data/format3_robot_dmp.npz and its rollouts (to its goal and to a goal 150 mm away)
-    were written by bidmp 0.3 (the main before issue 19). Format 3 knew only explicit Euler, so
+    were written by bidmp 0.3 (before the robot protocol). Format 3 knew only explicit Euler, so
     the file loads with integrator="euler" and its rollouts are unchanged."""
     data = Path(__file__).parent / "data"
     model = bidmp.load(data / "format3_robot_dmp.npz")

@@ -1,4 +1,4 @@
-"""The whole job in simulation (issue 25): nuts unscrewed off their studs by the thread's pitch,
+"""The whole job in simulation: nuts unscrewed off their studs by the thread's pitch,
 carried to the bin and dropped; a socket off the axis does not engage; a part let go outside the
 bin is reported; a layout nobody tuned; the job key's validation; the tour heuristic."""
 

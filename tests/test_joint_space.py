@@ -1,4 +1,4 @@
-"""Issue 24.2: joint-space recordings (``t,<joint names>``) fit a joint-space DMP (one dimension per
+"""joint-space recordings (``t,<joint names>``) fit a joint-space DMP (one dimension per
 joint); ``bidmp rollout --joint-limits panda`` (or one limit per joint) times the motion so every
 joint stays within its own velocity, acceleration and jerk limit, measured on the written samples
 (velocity and acceleration as written, jerk by differences of the written accelerations)."""

@@ -1,4 +1,4 @@
-"""Issue 35.1-3: a robot engineer's own files, as their loggers write them. The same motion logged
+"""a robot engineer's own files, as their loggers write them. The same motion logged
 by UR's RTDE recorder (space-separated, ``timestamp`` + ``actual_TCP_pose_0..5`` with an axis-angle
 rotation), exported from ROS (``header.stamp`` split in sec/nanosec, ``pose.position.x``, a text
 ``frame_id``; ``rostopic echo -p`` with nanosecond stamps) and written as a plain ``t,x,y,z(,q)``
@@ -177,7 +177,7 @@ def test_joint_names_stay_on_the_model_and_in_every_file(tmp_path, capsys):
 
 
 def test_a_position_model_keeps_the_orientation_its_demonstration_held(tmp_path, capsys):
-    """Issue 35.4: positions picked from an RTDE pose (the tool pointing down, 0.06 deg of sensor
+    """positions picked from an RTDE pose (the tool pointing down, 0.06 deg of sensor
     noise) keep that orientation; the bag a rollout writes carries it in every PoseStamped (the
     closed form of the axis-angle, here by hand). A demonstration that turns the tool is told it
     loses the turn, and its rollout is a PointStamped stream: no orientation is made up."""

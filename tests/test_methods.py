@@ -1,4 +1,4 @@
-"""The methods registry (issue 20): a method registered here, in a test, runs in evaluation, the
+"""The methods registry: a method registered here, in a test, runs in evaluation, the
 LASA benchmark and the simulator without a line of theirs changed; the built-ins are registered
 under the names every report uses; the registry refuses what it cannot hold.
 

@@ -1358,7 +1358,7 @@ def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_fla
     assert (found.points.tolist(), found.kinds.tolist()) == expected
 
 
-# -- units and speeds a robot can run; bags' stamp order (issue 35) --------------------------------
+# -- units and speeds a robot can run; bags' stamp order --------------------------------
 @pytest.mark.parametrize("units, per_metre", [("m", 1.0), ("cm", 100.0), ("mm", 1000.0)])
 def test_a_peak_speed_is_judged_at_1_mm_per_s_and_10_m_per_s_in_every_unit(units, per_metre):
     """Boundaries written out: 1 mm/s and 10 m/s are plausible, a hair beyond either is not, in

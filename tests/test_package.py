@@ -160,7 +160,7 @@ def test_the_size_check_sees_a_long_module():
     assert oversized("x = 1\n" * 801, "probe") == ["probe: 801 lines"]
 
 
-# --- issue 22.1: the public surface is each package's __all__; everything else has an underscore --
+# --- the public surface is each package's __all__; everything else has an underscore --
 API_PACKAGES = ("bidmp.primitives", "bidmp.demonstrations", "bidmp.extension", "bidmp.incremental", "bidmp.baselines",
                 "bidmp.scene", "bidmp.io", "bidmp.tasks", "bidmp.tasks.methods", "bidmp.sim", "bidmp.sim.pybullet",
                 "bidmp.experiments", "bidmp.plotting", "bidmp.cli")

@@ -1,4 +1,4 @@
-"""The primitives core (issue 20): the step integrator against the fast path, coupling terms
+"""The primitives core: the step integrator against the fast path, coupling terms
 against closed forms, goal systems as objects.
 
 Which checks show correctness and which guard structure:

@@ -1,4 +1,4 @@
-"""Issue 35.5: every command that can run for minutes shows its progress on stderr when stderr is a
+"""every command that can run for minutes shows its progress on stderr when stderr is a
 terminal (tqdm bars: the extension's G-PRM iterations, the evaluation with each repair it tries,
 the simulated motions, the job's parts, the LASA cells), and nothing when it is not (a log or a
 pipe stays clean). Each command runs in a child process whose stderr is a pseudo-terminal of 120

@@ -1,4 +1,4 @@
-"""Issue 21.9: cells nobody tuned bidmp for. Each is drawn at random — grid pitch, two pad
+"""cells nobody tuned bidmp for. Each is drawn at random — grid pitch, two pad
 heights, posts, bus bars and cable ducts (up to 130 mm tall) between the demonstrated target and
 the far ones, tool size, clearance margin, millimetres or metres, the demonstration's rate and
 its final descent — and evaluated with the plain DMP and Bi-DMP. The property: every motion the

@@ -1,4 +1,4 @@
-"""Issue 21.9, tilted plates: a random cell of ``test_random_cells`` tipped 10-35 degrees about a
+"""tilted plates: a random cell of ``test_random_cells`` tipped 10-35 degrees about a
 random horizontal axis, every part with it, the targets poses whose tool axis points into the
 pad along the plate's normal, and a pose demonstration that turns the tool from vertical onto
 that axis and comes down along it. Evaluated with the pose DMP and Bi-DMP.

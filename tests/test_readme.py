@@ -64,7 +64,7 @@ def test_the_robot_protocol_table_is_what_its_tool_measures(tmp_path):
 
 
 def test_the_readme_cites_only_files_in_the_repository():
-    """Issue 19.14: the README cited SPEC.md and ARCHITECTURE.md, which live outside it. Every
+    """The README once cited SPEC.md and ARCHITECTURE.md, which live outside it. Every
     repository path it names (docs/, tools/, benchmarks/, tests/, src/) exists."""
     for outside in ("SPEC.md", "ARCHITECTURE.md", "../shared"):
         assert outside not in README, outside
@@ -73,7 +73,7 @@ def test_the_readme_cites_only_files_in_the_repository():
 
 
 def test_the_own_robot_commands_run_as_written(tmp_path, monkeypatch, capsys):
-    """Issue 24.7: the section "Your own robot and data" — its Python block, then every command of
+    """the section "Your own robot and data" — its Python block, then every command of
     its marked block in order, in one folder (each may use what the ones before it wrote)."""
     import shlex
     import shutil

@@ -1,4 +1,4 @@
-"""G-PRM and classic PRM (SPEC §5)."""
+"""G-PRM and classic PRM."""
 
 import numpy as np
 import pytest
@@ -66,7 +66,7 @@ def test_bias_update_follows_eq8_when_the_noise_vanishes(arc_piece, schedule, rh
     np.testing.assert_allclose(gap[1:], predicted, rtol=0.02)
     assert np.all(np.diff(result.history) > 0)
     # Eq. 8 shrinks its own steps ((1 - s) eta): with the defaults a quarter circle plateaus near
-    # 0.92, short of SPEC's hoped-for 0.95, after 10 iterations (noted in the README).
+    # 0.92, short of the 0.95 hoped for, after 10 iterations (noted in the README).
     if (schedule, rho) == ("geometric", 0.9):
         assert 0.85 < result.history[-1] < 0.95
 

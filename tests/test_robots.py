@@ -1,4 +1,4 @@
-"""Your own robot in the simulator (issue 24.3): the KUKA iiwa of pybullet_data on the nut task,
+"""Your own robot in the simulator: the KUKA iiwa of pybullet_data on the nut task,
 a URDF named in a scenario, its validation, and the one-line message for targets out of reach."""
 
 import json
@@ -141,7 +141,7 @@ def test_bidmp_sim_runs_the_iiwa_scenario(tmp_path, capsys):
 
 
 def test_the_iiwa_runs_the_nut_job(iiwa):
-    """Issue 25 on another arm: the same job, its plans timed to the iiwa's own limits."""
+    """On another arm: the same job, its plans timed to the iiwa's own limits."""
     from bidmp.sim.job import run_job
 
     report = run_job(iiwa, targets=["3", "12"])

@@ -1,4 +1,4 @@
-"""Issue 9: no input crashes bidmp. One test (or a few) per defect class 1-10 of the fuzzing
+"""no input crashes bidmp. One test (or a few) per defect class 1-10 of the fuzzing
 campaign; each failed before the fix. The generated campaign itself is tests/test_fuzz.py."""
 
 import contextlib

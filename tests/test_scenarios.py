@@ -1,4 +1,4 @@
-"""Scenario files (SPEC §9–10): built-ins, round trips and every kind of malformed file."""
+"""Scenario files: built-ins, round trips and every kind of malformed file."""
 
 import json
 
@@ -21,7 +21,7 @@ def test_builtins_load_and_have_the_spec_geometry():
     nut = scenarios.load("nut-unscrewing")
     assert len(nut.targets) == 14 and nut.demonstrated == "3"
     np.testing.assert_array_equal(nut.targets["3"], [0, 0, 0])
-    # SPEC §9 numbering: row y = 0: 3, 4, 5, 6, 9, 10, 11; row y = 50: 2, 1, 7, 8, 14, 13, 12.
+    # The paper's numbering: row y = 0: 3, 4, 5, 6, 9, 10, 11; row y = 50: 2, 1, 7, 8, 14, 13, 12.
     row0 = [label for label, p in sorted(nut.targets.items(), key=lambda kv: kv[1][0]) if p[1] == 0]
     row50 = [label for label, p in sorted(nut.targets.items(), key=lambda kv: kv[1][0]) if p[1] == 50]
     assert row0 == ["3", "4", "5", "6", "9", "10", "11"] and row50 == ["2", "1", "7", "8", "14", "13", "12"]

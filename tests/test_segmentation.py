@@ -1,4 +1,4 @@
-"""1D-SEG (SPEC §2) and the choice of the piece to imitate (SPEC §3)."""
+"""1D-SEG and the choice of the piece to imitate."""
 
 import numpy as np
 import pytest

@@ -67,7 +67,7 @@ def test_a_motion_through_a_stud_is_a_contact_with_that_stud(cell):
 
 
 def test_the_commanded_penetration_is_reported_beside_the_contact(cell, nut):
-    """Issue 21.8: the physics pushes the arm aside, so its contact depth is small; the command's
+    """the physics pushes the arm aside, so its contact depth is small; the command's
     own depth into stud 4 comes from the geometry. Closed form for a vertical tool (radius 12.5,
     from its tip up) and the stud (radius 4, top 14.5 mm): the smaller of the vertical overlap
     (top − tip height) and the horizontal one (16.5 − the axes' distance)."""
@@ -121,7 +121,7 @@ def test_closed_loop_pauses_for_a_held_joint_and_still_engages(nut, nut_report):
 
 
 def test_a_perception_update_mid_motion_moves_the_nut_and_the_closed_loop_still_engages_it(nut, nut_report):
-    """Issue 23.3 in the simulator: at 1.5 s the nut turns out 5 mm further in x; the part moves in
+    """at 1.5 s the nut turns out 5 mm further in x; the part moves in
     the world, the stepper's goal with it (steered round the other parts too), and the socket
     comes down on the moved nut: engaged and within 1.75 mm of it (so 3.25 mm or more from where it
     was seen), no contact, within limits. The same run without the update engages the nut where it
@@ -167,7 +167,7 @@ def test_the_committed_nut_task_table_is_what_bidmp_sim_measures(tmp_path, capsy
     assert results["bidmp"]["task_successes"] == 14 and results["bidmp"]["contacts"] == 0
     assert results["bidmp"]["within_limits"] == 14 and results["dmp"]["task_successes"] == 8
     assert "x real time" in capsys.readouterr().out
-    # Issue 21.7: every 1 kHz command within the jerk limit too (the plan's 90 %), the joints' measured beside.
+    # every 1 kHz command within the jerk limit too (the plan's 90 %), the joints' measured beside.
     for method in ("dmp", "bidmp"):
         for target in results[method]["targets"].values():
             # (1 kHz differences of the 90 % plan: within 1 % of it)
@@ -204,7 +204,7 @@ def test_pictures_are_written(tmp_path, nut, nut_report):
 
 
 def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):
-    """Issue 20: the last PyBullet world is kept for the next call; a job in it must measure as
+    """the last PyBullet world is kept for the next call; a job in it must measure as
     in a world built for it (to the last digit of the report)."""
     from bidmp.sim import run
 
@@ -219,7 +219,7 @@ def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):
 
 
 def test_a_near_miss_of_a_nut_is_no_contact(cell, nut):
-    """Issue 21.8: Bullet grew each nut's hull by its 1 mm collision margin, so a 0.88 mm near miss
+    """Bullet grew each nut's hull by its 1 mm collision margin, so a 0.88 mm near miss
     was a "contact". A 10 mm box beside a nut's flat at 0.5, 0.88 and 2 mm: PyBullet's distance is
     the gap to 0.05 mm (the nut's flat is across_flats / 2 = 6.5 mm from its axis)."""
     p, client = cell.p, cell.client

@@ -1,4 +1,4 @@
-"""Issue 21.7: limits where the robot moves — the 1 kHz commands checked against velocity,
+"""limits where the robot moves — the 1 kHz commands checked against velocity,
 acceleration and jerk limits from rest to rest (closed forms) and the closed loop's jerk-limited
 command generator on random targets (the simulated nut task's commands: tests/test_sim.py)."""
 

@@ -1,4 +1,4 @@
-"""Discrete Fréchet distance and Fre_sim (SPEC §4), against similaritymeasures and properties."""
+"""Discrete Fréchet distance and Fre_sim, against similaritymeasures and properties."""
 
 import numpy as np
 import pytest

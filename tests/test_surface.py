@@ -1,4 +1,4 @@
-"""The public surface refuses bad input at its boundary (issue 22.2, first defect classes): a
+"""The public surface refuses bad input at its boundary: a
 TypeError/ValueError naming the argument, in one short line, before any work or allocation; never
 an internal error, a silent NaN, a leaked warning or NumPy's own text. Each case failed before."""
 
@@ -96,7 +96,7 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
 
 
 def test_the_rotation_helpers_name_their_arguments():
-    """Issue 22.2: the SO(3) helpers passed their input to SciPy, whose messages name no argument,
+    """the SO(3) helpers passed their input to SciPy, whose messages name no argument,
     and _left_jacobian turned NaN into NaN."""
     from bidmp.primitives.so3 import (
         _left_jacobian,
@@ -116,7 +116,7 @@ def test_the_rotation_helpers_name_their_arguments():
 
 
 def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
-    """Issue 22.2, the timing and pose helpers (each case below failed before: an internal error,
+    """the timing and pose helpers (each case below failed before: an internal error,
     a silent NaN, a ComplexWarning or a RuntimeWarning): on 17 entry points x 16 nasty inputs,
     every call returns finite numbers or raises ValueError/TypeError with a message of at most
     300 characters, and no warning escapes."""
@@ -144,7 +144,7 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
 
 
 def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
-    """Issue 22.2, the same check on ``template``, ``shortest_path``, ``polyline_length`` and
+    """the same check on ``template``, ``shortest_path``, ``polyline_length`` and
     ``rmse`` (18 cases failed before: internal errors, silent NaN, leaked warnings). An approach
     error of inf is the documented answer for a motion with no final descent, not a silent one."""
     from bidmp.extension import roadmap, similarity
@@ -185,7 +185,7 @@ def nasty_failures(calls, nasty) -> list:
 
 
 def test_the_scene_helpers_refuse_bad_input_by_name():
-    """Issue 22.2, the scene: ``parts_at``, the roadmap checker and its straight moves, and
+    """the scene: ``parts_at``, the roadmap checker and its straight moves, and
     oriented clearance (11 cases failed before: IndexError, ComplexWarning, an overflow)."""
     from bidmp.scene import Scene
 

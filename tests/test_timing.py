@@ -1,4 +1,4 @@
-"""Issue 10: robot-ready motion. Real time, goals reached by default, smooth starts, limits by
+"""robot-ready motion. Real time, goals reached by default, smooth starts, limits by
 time scaling, a control-loop stepper with phase stopping, and real recordings prepared."""
 
 
@@ -129,7 +129,7 @@ def start_cases():
 
 @pytest.mark.parametrize("case", start_cases(), ids=lambda case: case[0])
 def test_the_first_50_ms_move_as_the_demonstration_does(case):
-    """Issue 19.1. On today's main a min-jerk demonstration starting at 1.9 mm/s gave |ydd|
+    """before the fix, a min-jerk demonstration starting at 1.9 mm/s gave |ydd|
     33.9 -> 443 -> 10.4 mm/s² (a one-sample velocity step of the delayed goal): 34x the
     demonstration here. The acceptance: over the first 50 ms the peak acceleration and jerk are
     within 1.2x the demonstration's own, at 250 Hz and 1 kHz, for its goal and goals 150 mm away."""
@@ -153,7 +153,7 @@ def hundred_hertz_demonstration():
 
 
 def test_the_motion_is_the_same_at_any_controller_rate():
-    """Issue 19.2. On today's main a 100 Hz demonstration reproduced at 1 kHz moved by 1.00 mm
+    """before the fix, a 100 Hz demonstration reproduced at 1 kHz moved by 1.00 mm
     RMS (2.26 mm at most) against its own-rate reproduction. The acceptance: within 0.05 % of the
     extent at 1 kHz and 10 kHz, for the demonstrated and a moved goal."""
     prepared = hundred_hertz_demonstration()
@@ -196,7 +196,7 @@ def test_the_exact_integrator_is_the_continuous_system():
 
 
 def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
-    """Issue 19.3, the bound the README states: a goal moved by Δ changes the whole motion by
+    """the bound the README states: a goal moved by Δ changes the whole motion by
     R(t) Δ, R rising monotonically from 0 to 1, and |R - σ| stays within the demonstration's own
     progress σ over the first and last 15 % of its duration (σ: arc length so far / total, of the
     demonstration as learned). Checked on random demonstrations, each against its own σ."""
@@ -206,7 +206,7 @@ def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
         y, t = kinesthetic_recording(via, seed=100 + case, duration=float(rng.uniform(2.0, 6.0)),
                                      rate_hz=float(rng.choice([100.0, 250.0, 500.0])))
         prepared, _ = bidmp.prepare(y, t)
-        # The progress gate's bound (keep_approach, the default since issue 21.3, completes R at
+        # The progress gate's bound (keep_approach, the default, completes R at
         # the approach: tests/test_approach.py).
         dmp = bidmp.DMP(keep_approach=False).fit(prepared.y, prepared.t)
         home = dmp.trajectory()
@@ -226,7 +226,7 @@ def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
 
 
 def test_a_near_goal_on_a_straight_recording_barely_overshoots():
-    """Issue 19.3. On today's main a goal 1 % along a straight 113 mm recording was overshot by
+    """before the fix, a goal 1 % along a straight 113 mm recording was overshot by
     0.295 mm (26 % of the 1.1 mm move; "two samples of demonstrated travel"). Now it is a few
     hundredths of a millimetre: the goal's share starts flat while the recording accelerates."""
     y, t = kinesthetic_recording([[0, 0, 0], [100, 50, 20]], seed=13, duration=3.0)
@@ -299,7 +299,7 @@ def test_time_scale_meets_every_limit_and_touches_one(fitted, limits):
 
 
 def test_limits_are_caps_that_never_hurry_a_motion(fitted):
-    """Issue 19.12: on today's main --max-speed above the demonstrated speed shortened a 4.5 s
+    """before the fix, --max-speed above the demonstrated speed shortened a 4.5 s
     motion to 3.78 s. A cap that the motion already keeps leaves it as demonstrated."""
     *_, dmp = fitted
     nominal = dmp.trajectory()

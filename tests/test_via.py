@@ -1,4 +1,4 @@
-"""Issue 23.2: exact via-points by the least-norm weight change.
+"""exact via-points by the least-norm weight change.
 
 References independent of the code under test: the response of the via samples to each weight is
 measured by N perturbed rollouts (finite differences of a linear map, exact to rounding), and the

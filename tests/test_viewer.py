@@ -1,4 +1,4 @@
-"""The 3-D viewer (issue 24.4): meshes of the scene's solids against closed forms, every layer in
+"""The 3-D viewer: meshes of the scene's solids against closed forms, every layer in
 the file, the robot's motion from its base to the target, round trips, bad files, the CLI."""
 
 import json
@@ -152,7 +152,7 @@ def posts_report():
 
 
 def test_a_failing_motion_is_drawn_in_amber_with_the_part_it_came_too_close_to(posts_report, tmp_path):
-    """Issue 35.6. Independent anchor: the point each failure names lies within the tool's radius
+    """Independent anchor: the point each failure names lies within the tool's radius
     plus the margin of the post it names (a vertical cylinder of the spec, measured here)."""
     data, report = posts_report
     layers = viewer.layers_from_report(report)
@@ -180,7 +180,7 @@ def test_a_failing_motion_is_drawn_in_amber_with_the_part_it_came_too_close_to(p
 
 
 def test_the_scenario_figure_draws_every_judged_rollout_and_the_parts_as_solids(posts_report, tmp_path):
-    """Issue 35.6: each collision mark belongs to a drawn rollout (before, the marks of GMM's
+    """each collision mark belongs to a drawn rollout (before, the marks of GMM's
     rollouts floated where no drawn path went) and every part is a shaded solid."""
     import matplotlib
 
@@ -213,7 +213,7 @@ def test_the_scenario_figure_draws_every_judged_rollout_and_the_parts_as_solids(
 
 
 def test_the_pose_plot_shows_the_orientation_turn_and_tilt():
-    """Issue 35.6, against closed forms: a tool turning 540 degrees about its own axis while that
+    """against closed forms: a tool turning 540 degrees about its own axis while that
     axis tilts by 20 degrees about x reads 540 (unwrapped) and 20."""
     from scipy.spatial.transform import Rotation
 

@@ -1,4 +1,4 @@
-"""Write docs/api.md: bidmp's public surface, subpackage by subpackage (issue 22.1).
+"""Write docs/api.md: bidmp's public surface, subpackage by subpackage.
 
     .venv/bin/python tools/api_reference.py           # rewrites docs/api.md
     .venv/bin/python tools/api_reference.py --check   # exit 1 if docs/api.md is not current

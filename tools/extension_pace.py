@@ -1,4 +1,4 @@
-"""How fast the Bi-DMP motion to a far goal runs against the demonstration (issue 21.1).
+"""How fast the Bi-DMP motion to a far goal runs against the demonstration.
 
 For each bundled recording (prepared, robot-protocol DMP) and a goal moved 200 mm sideways (x,
 then y) and 300/150 mm: the extension (``approach="keep"``), the Bi-DMP skill learned from it

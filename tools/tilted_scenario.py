@@ -1,4 +1,4 @@
-"""Write the built-in scenario nut-unscrewing-tilted (issue 13): the nut task's 2 x 7 grid on a
+"""Write the built-in scenario nut-unscrewing-tilted: the nut task's 2 x 7 grid on a
 plate tilted 30 degrees about x, with a pose demonstration to nut 3.
 
     .venv/bin/python tools/tilted_scenario.py      # rewrites src/bidmp/data/scenarios/nut-unscrewing-tilted.json
@@ -30,7 +30,7 @@ def main() -> None:
     via = [[-80.0, -120.0, 200.0, *vertical], [*hover, *into_nut], [0.0, 0.0, 0.0, *into_nut]]
     scenario = {
         "name": "nut-unscrewing-tilted",
-        "description": (f"The nut task on a battery pack tilted {TILT:g} degrees about x (issue 13): the same 2 x 7 grid of M8 "
+        "description": (f"The nut task on a battery pack tilted {TILT:g} degrees about x: the same 2 x 7 grid of M8 "
                         "nuts on studs, one pose demonstration to nut 3 that turns the socket from vertical onto the nut's "
                         "axis and comes down along it. Success also needs the tool axis within 2 degrees of the nut's "
                         "axis over the last approach height. Written by tools/tilted_scenario.py."),

@@ -1,5 +1,5 @@
 """Render a bidmp 3-D viewer file in headless Chromium and check the picture is not blank
-(``make view-check``; issue 24.4).
+(``make view-check``).
 
     python tools/view_check.py VIEW_HTML [--screenshot PNG]
 

@@ -1,4 +1,4 @@
-"""Time-driven GMM/GMR (SPEC §8): a Gaussian mixture on ``[t, y]`` fitted by EM (scikit-learn's
+"""Time-driven GMM/GMR: a Gaussian mixture on ``[t, y]`` fitted by EM (scikit-learn's
 ``GaussianMixture``), and Gaussian mixture regression of ``y`` given ``t``.
 
 It reproduces the demonstrations it was given and has no notion of a new target: it cannot adapt,
@@ -77,7 +77,7 @@ def _check_gmr_size(n_steps: int, means_shape: tuple) -> None:
 
 
 def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0) -> np.ndarray:
-    """The single-demonstration augmentation of SPEC §8: ``y`` plus smooth noisy copies.
+    """The single-demonstration augmentation: ``y`` plus smooth noisy copies.
 
     Returns (n_copies + 1, T, D); the copies keep the start and the end exact.
     """
@@ -152,7 +152,7 @@ class GMMRegressor(_AugmentedMixture):
         With fewer, GMR's per-component linear regression averages the decelerating end of a
         movement: 8 components end 6 mm short on the battery approach, 16 end within 0.8 mm.
     reg_covar : float, default 1e-6
-        Added to the covariance diagonals (SPEC §8: ≥ 1e-6).
+        Added to the covariance diagonals (at least 1e-6).
     n_copies, noise : augmentation of a single demonstration (see :func:`augment`).
     seed : int
 

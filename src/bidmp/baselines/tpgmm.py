@@ -1,5 +1,5 @@
 """Task-parameterised GMM (Calinon 2016, "A tutorial on task-parameterized movement learning and
-retrieval"), SPEC §8. No maintained Python 3 library under a permissive licence exists, so it is
+retrieval"). No maintained Python 3 library under a permissive licence exists, so it is
 written here.
 
 Two frames ``(A_j, b_j)``: the start and the target. Each (augmented) demonstration is expressed

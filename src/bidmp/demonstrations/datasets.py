@@ -81,7 +81,7 @@ def lasa(name: str) -> np.ndarray:
 
 
 def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.random.Generator | None = 0) -> np.ndarray:
-    """A minimum-jerk movement through via points, coming to rest at each (SPEC §9, §10).
+    """A minimum-jerk movement through via points, coming to rest at each.
 
     Each leg is the rest-to-rest minimum-jerk profile ``10s³ − 15s⁴ + 6s⁵``; legs last in
     proportion to their length, and the whole movement has exactly ``n_steps`` samples.

@@ -1,4 +1,4 @@
-"""Random avoidance cases: a demonstration and a field of parts across it (issue 23), the same for
+"""Random avoidance cases: a demonstration and a field of parts across it, the same for
 the tests (tests/test_avoidance.py), the benchmark against movement_primitives
 (benchmarks/bench_avoidance.py) and anyone who wants to try a coupling term on cells nobody tuned.
 

@@ -1,4 +1,4 @@
-"""The LASA handwriting benchmark with the LfD literature's metrics, swept on Dask (issue 14).
+"""The LASA handwriting benchmark with the LfD literature's metrics, swept on Dask.
 
 ``lasa(out, ...)`` evaluates every method on every (shape, demonstration) cell of the LASA set:
 the reproduction of the demonstration, and generalisation to two shifted goals. ``near`` moves
@@ -54,7 +54,7 @@ LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
 CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
 TIMES = ("fit_s", "rollout_s")
-FORMAT = 3  # of the cell files (2: the robot protocol of issue 19; 3: a content digest); another is recomputed
+FORMAT = 3  # of the cell files (2: the robot protocol; 3: a content digest); another is recomputed
 
 
 def cell_key(shape: str, demo: int) -> str:

@@ -23,7 +23,7 @@ MAX_SEEDS = 200  # seeds of one G-PRM vs PRM comparison (each runs both roadmaps
 # ---------------------------------------------------------------------------------------------
 # Paper Table 5: G-PRM vs classic PRM
 # ---------------------------------------------------------------------------------------------
-BATTERY_APPROACH_VIA = ((-80.0, -120.0, 200.0), (0.0, 0.0, 40.0), (0.0, 0.0, 0.0))  # SPEC §9, mm
+BATTERY_APPROACH_VIA = ((-80.0, -120.0, 200.0), (0.0, 0.0, 40.0), (0.0, 0.0, 0.0))  # mm, the paper's battery approach
 
 
 BATTERY_EXTENSION_TARGET = (150.0, 25.0, 0.0)  # centre of the nuts the plain DMP misses
@@ -33,7 +33,7 @@ def table5_cases() -> dict[str, tuple[np.ndarray, np.ndarray, str]]:
     """The cases of ``bidmp reproduce table5``: name -> (demonstration, new target, unit).
 
     Four LASA shapes (demonstration 0; new target = end + (0.3, −0.2) × extent) and the battery
-    approach path of SPEC §9 (T = 200) extended to (150, 25, 0) mm.
+    battery approach path (T = 200) extended to (150, 25, 0) mm.
     """
     cases = {}
     for name in ("Sshape", "WShape", "NShape", "Angle"):

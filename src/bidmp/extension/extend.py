@@ -1,4 +1,4 @@
-"""Extended demonstrations: segment → pick the piece → G-PRM → complete demonstration (SPEC §2–5).
+"""Extended demonstrations: segment → pick the piece → G-PRM → complete demonstration.
 
 ``extend_demonstration(y, new_target)`` returns the complete extended demonstration, uniform in
 time at the demonstration's sample period. Two ways (``approach``):

@@ -1,4 +1,4 @@
-"""The transfer G-PRM found, made as smooth as what it imitates (``approach="keep"``, issue 21.2).
+"""The transfer G-PRM found, made as smooth as what it imitates (``approach="keep"``).
 
 G-PRM scores its roadmap paths by their Fréchet similarity to the *template*, the imitated piece
 mapped onto seg → the new target. Its answer is a shortest path through Gaussian samples: on the

@@ -1,5 +1,5 @@
 """G-PRM: a Gaussian probabilistic roadmap that grows a path to a new target in the shape of a
-demonstrated piece (SPEC §5, paper §3.2, Eq. 1–9), and the classic uniform PRM baseline.
+demonstrated piece (paper §3.2, Eq. 1–9), and the classic uniform PRM baseline.
 
 One iteration of G-PRM:
 
@@ -235,7 +235,7 @@ def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, 
                                    f"{np.round(new_target, 3).tolist()}: the roadmap's {nodes.shape[0] - 2} free samples "
                                    f"do not connect them even with {_MAX_NEIGHBOURS} neighbours (the parts block the "
                                    f"way, or sigma_rel / n_samples are too small to go around them)")
-        # Unreachable even with 32 neighbours: chain the samples in their sampling order (SPEC §5).
+        # Unreachable even with 32 neighbours: chain the samples in their sampling order.
         logger.warning("new target unreachable on the roadmap even with %d neighbours: chaining the samples in order",
                        _MAX_NEIGHBOURS)
         inner = nodes[1:-1][np.argsort(order, kind="stable")]
@@ -245,7 +245,7 @@ def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, 
 
 @dataclass
 class _Comparison:
-    """How a generated path is scored and which way the bias pushes (SPEC §5 steps 4–6)."""
+    """How a generated path is scored and which way the bias pushes."""
 
     piece: np.ndarray  # Tra_imi resampled
     new_target: np.ndarray

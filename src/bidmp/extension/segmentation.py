@@ -1,4 +1,4 @@
-"""1D-SEG: cut a demonstration at its curvature extrema (SPEC §2–3, paper §3.1).
+"""1D-SEG: cut a demonstration at its curvature extrema (paper §3.1).
 
 1. Resample by arc length (curvature must not depend on speed).
 2. Smooth with Savitzky–Golay (window ≈ 5 % of T, odd, ≥ 7, order 3) and differentiate.
@@ -206,7 +206,7 @@ class Segmentation:
 
 @numerically_guarded
 def segment(y, eps_frac: float = 0.1, method: str = "persistence") -> Segmentation:
-    """Segmentation points of a demonstration (1D-SEG, SPEC §2).
+    """Segmentation points of a demonstration (1D-SEG).
 
     Parameters
     ----------
@@ -259,7 +259,7 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence") -> Segmentati
 
 @dataclass(frozen=True)
 class Piece:
-    """The piece of a demonstration to imitate towards a new target (SPEC §3).
+    """The piece of a demonstration to imitate towards a new target.
 
     ``start`` (= seg) and ``end`` are sample indices into the demonstration, inclusive.
     """

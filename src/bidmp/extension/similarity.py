@@ -1,4 +1,4 @@
-"""Discrete Fréchet distance and the paper's Fréchet similarity (SPEC §4, paper Eq. 3–5).
+"""Discrete Fréchet distance and the paper's Fréchet similarity (paper Eq. 3–5).
 
 The coupling recursion (Eiter & Mannila 1994)::
 

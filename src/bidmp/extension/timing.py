@@ -1,4 +1,4 @@
-"""Timing a generated path like the demonstration it extends (SPEC §5): arc-length profiles
+"""Timing a generated path like the demonstration it extends: arc-length profiles
 that join the demonstration with continuous position, speed and (``"keep"``) acceleration.
 
 * :func:`_time_path` (the paper's protocol, ``approach="paper"``): a cubic profile from the

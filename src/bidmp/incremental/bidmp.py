@@ -1,4 +1,4 @@
-"""Bi-DMP: a DMP whose forcing term grows by Broad Learning System increments (SPEC §7, paper
+"""Bi-DMP: a DMP whose forcing term grows by Broad Learning System increments (paper
 Eq. 15, 27, 28), with a skill library so that earlier skills are not forgotten.
 
 Learning an extended demonstration y_dn (resampled to the DMP's T samples and phase grid):
@@ -74,7 +74,7 @@ def _time_scale(duration, dmp: DMP) -> float:
 
 
 class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
-    """A DMP with incrementally learned forcing-term blocks and a skill library (SPEC §7).
+    """A DMP with incrementally learned forcing-term blocks and a skill library.
 
     A scikit-learn style estimator: ``BiDMP(dmp)`` only stores its parameters (``get_params``
     includes the DMP's as ``dmp__alpha`` …). The model starts from a fitted ``dmp`` at the first
@@ -310,7 +310,7 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
 
 
 # ---------------------------------------------------------------------------------------------
-# Forgetting (SPEC §7)
+# Forgetting
 # ---------------------------------------------------------------------------------------------
 @dataclass
 class ForgettingResult:

@@ -1,4 +1,4 @@
-"""Broad Learning System with incremental enhancement nodes (SPEC §6, paper Eq. 16–26).
+"""Broad Learning System with incremental enhancement nodes (paper Eq. 16–26).
 
 Hidden layer for inputs X (N × d), with ``X̃ = [X, 0.1]``:
 
@@ -147,7 +147,7 @@ def _check_targets(Y, n_rows: int) -> tuple[np.ndarray, bool]:
 
 
 class BLS(CheckedParams, BaseEstimator):
-    """Broad Learning System regressor with incremental enhancement nodes (SPEC §6).
+    """Broad Learning System regressor with incremental enhancement nodes.
 
     A scikit-learn style estimator: the constructor only stores its parameters; ``fit``
     validates them and learns; a failed ``fit`` leaves the model as it was.

@@ -5,7 +5,7 @@ scene's parts and, for simulation runs, the robot's motion with a time slider.
 Why plotly: it writes one HTML file with plotly.js inside (no network, no CDN, no server), the
 layers toggle from the legend, and animation frames with a slider carry the robot's motion.
 ``viser`` needs a live Python server for its viewer; ``rerun-sdk`` is a 170 MB wheel whose
-recordings need its own viewer. (Measured for issue 24: plotly 6.3.1 is a 9.8 MB wheel plus
+recordings need its own viewer. (Measured: plotly 6.3.1 is a 9.8 MB wheel plus
 narwhals; viser 1.1.1 a 3.6 MB wheel plus websockets, trimesh, msgspec, rich, imageio and more.)
 
 The layers are kept beside the HTML as ``view_layers.npz`` (arrays, ``allow_pickle=False``) with

@@ -1,4 +1,4 @@
-"""Pose skills: position + unit quaternion DMPs, and their Bi-DMP (issues 13 and 19).
+"""Pose skills: position + unit quaternion DMPs, and their Bi-DMP.
 
 Orientation is learned in the tangent space at the goal. A demonstrated orientation ``q(t)`` is
 mapped to the rotation vector of its error to the goal,

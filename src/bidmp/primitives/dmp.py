@@ -1,4 +1,4 @@
-"""Discrete Dynamic Movement Primitive (SPEC §1, paper Eq. 10–14): the estimator, a thin
+"""Discrete Dynamic Movement Primitive (paper Eq. 10–14): the estimator, a thin
 composition of the canonical system (:mod:`~bidmp.primitives.canonical`), the forcing term
 (:mod:`~bidmp.primitives.forcing`), a goal system (:mod:`~bidmp.primitives.goals`) and the
 integrators (:mod:`~bidmp.primitives.integrate`; coupling terms: :mod:`~bidmp.primitives.coupling`).
@@ -14,7 +14,7 @@ on the normalised grid ``dt = 1/T`` (the demonstration's T samples span one unit
 
 * ``integrator="euler"`` (the paper's protocol): explicit Euler for exactly ``T`` steps,
   ``z[l+1] = z[l] + dt/tau · (alpha (beta (g - y[l]) - z[l]) + u[l])``, ``y[l+1] = y[l] + dt/tau · z[l]``
-  — for ``tau = 1`` SPEC Eq. 14 to the letter, with the phase ``(1 - alpha_phase dt)^l``;
+  — for ``tau = 1`` paper Eq. 14 to the letter, with the phase ``(1 - alpha_phase dt)^l``;
 * ``integrator="exact"`` (the robot protocol): the continuous system integrated exactly with the
   input linear between samples and the phase ``exp(-alpha_phase t)``, so the same weights give
   the same motion at any control rate.
@@ -74,7 +74,7 @@ logger = logging.getLogger(__name__)
 
 
 class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
-    """Discrete DMP learned from one demonstration (SPEC §1), in real time.
+    """Discrete DMP learned from one demonstration, in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
     them and learns, ``get_params``/``set_params``/``sklearn.base.clone`` work, and learned state

@@ -1,5 +1,5 @@
 """The forcing term: Gaussian kernels on the phase, their weights, and the forcing target that
-makes the transformation system reproduce a demonstration (SPEC §1)::
+makes the transformation system reproduce a demonstration::
 
     f(phase) = phase · Σ_i w_i ψ_i(phase) / Σ_i ψ_i(phase),  ψ_i = exp(-h_i (phase - c_i)²)
 
@@ -47,7 +47,7 @@ def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "
 
     ``"spacing"`` (default): ``h_i = 1 / (c_{i+1} - c_i)²``, so neighbouring kernels overlap at
     ``e⁻¹``; LWR then reproduces LASA shapes to < 1 % of their extent.
-    ``"pydmps"``: ``h_i = N^1.5 / (c_i alpha_phase)`` (SPEC §1 as printed, the pydmps convention);
+    ``"pydmps"``: ``h_i = N^1.5 / (c_i alpha_phase)`` (as the paper prints it, the pydmps convention);
     neighbours overlap at ≈ 0.9 and LWR smooths the forcing term noticeably (2–5 % on LASA).
     """
     centres = as_vector(centres, "centres", positive=True)
@@ -151,7 +151,7 @@ def _forcing_target(
     derivatives: str = "gradient",
     gate: np.ndarray | None = None,
 ) -> np.ndarray:
-    """The forcing term that makes Eq. 10 reproduce ``y`` (SPEC §1, "forcing target").
+    """The forcing term that makes Eq. 10 reproduce ``y``.
 
     ``f*[l] = (tau² ÿ[l] - alpha (beta (g - y[l]) - tau ẏ[l])) / K + gate[l] (g - y0)`` with
     ``g = y[-1]``, ``y0 = y[0]`` and the goal gate ``gate`` (default: the phase, Eq. 10; the

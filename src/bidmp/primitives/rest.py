@@ -1,4 +1,4 @@
-"""Learning a demonstration from rest (issue 19): its start and end velocity blended out.
+"""Learning a demonstration from rest: its start and end velocity blended out.
 
 A robot starts at rest; a prepared recording starts at the sensor's noise floor
 (1.6 mm/s for the bundled ones) and a user's demonstration may start at speed. The learned
