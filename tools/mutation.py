@@ -128,10 +128,10 @@ _BOUND = ("cost only: branch and bound returns the least exact distance over eve
 _CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("bidmp._units", "check_speed",
-     "if peak_speed > fastest and np.radians(peak_speed) <= fastest else \"\")", "> -> >="):
+     "hint = f'; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians' if peak_speed > fastest and np.radians(peak_speed) <= fastest else ''", "> -> >="):
         "a peak of exactly the fastest joint speed returned as plausible two lines above: this hint is never built for it",
     **{("bidmp.primitives.coupling", "PhaseStopping.slowdown",
-        "if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):  # a stepper's own state passes as is",
+        "if not (type(y) is np.ndarray and y.dtype == np.float64 and (y.ndim == 1)):",
         mutation): _FAST_PATH
        for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")},
     (_CLEARANCE, "Clearance.clear", "return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin",
@@ -155,7 +155,7 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (_CLEARANCE, "_sweep", "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
      "0.0, 1.0))", "drop abs()"): "the quaternions are made continuous first (q · q' >= 0): abs changes nothing",
     ("bidmp.scene.distances", "_Distances._witnessed",
-     "return (abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first)", "<= -> <"):
+     "return abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first) and _on_shape(b, pose_b, second)", "<= -> <"):
         "differs only when coal's points are apart by exactly the tolerance more or less than its distance",
     ("bidmp.scene.checker", "SceneChecker.__call__",
      "if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < margin:", "< -> <="):
@@ -169,14 +169,14 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
            "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
            "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)")
        for mutation in ("<= -> <", ">= -> >")},
-    **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-9 * max(length, 1.0)", mutation):
+    **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-09 * max(length, 1.0)", mutation):
        "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
        "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
        for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min", "1.0 -> 2.0")},
     ("bidmp.scene.checker", "SceneChecker._move_free", "if distance < margin:", "< -> <="):
         "differs only for a placement exactly at the margin, to the last bit",
     ("bidmp.tasks.metrics", "final_approach_mask",
-     'heights = _as_bounded_array(heights, "heights", max_ndim=1).reshape(-1)', "1 -> 2"):
+     "heights = _as_bounded_array(heights, 'heights', max_ndim=1).reshape(-1)", "1 -> 2"):
         "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
     ("bidmp.extension.similarity", "frechet_distance_reference", "i = np.arange(max(0, s - m + 1), min(n, s + 1))",
      "1 -> 2"): "one more cell per anti-diagonal, just off the table (j = -1): it derives only from other such "
@@ -228,10 +228,10 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
        "its filled sign from the slope after it, so no change ends it" for mutation in ("> -> >=", "0 -> 1")},
     ("bidmp.extension.segmentation", "_prune_persistence", "left = np.arange(-1, count - 1)", "- -> +"):
         "two more entries past the last extremum, never read: the links are read at extrema 0 .. count - 1",
-    ("bidmp.extension.segmentation", "_prune_persistence", "right = np.arange(1, count + 1)  # right[-1] == count: no neighbour",
+    ("bidmp.extension.segmentation", "_prune_persistence", "right = np.arange(1, count + 1)",
      "1 -> 2"): "(as arange(1, count + 2)) one more entry past the last extremum, never read",
     ("bidmp.incremental.bls", "_mapped_features",
-     "weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))  # (d+1, u·q)",
+     "weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))",
      "1 -> 2"): "(as reshape(..., -2)) NumPy takes any negative size in reshape as 'the rest'",
     ("bidmp.incremental.bls", "_enhancement_block",
      "weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))", "1 -> 2"):
@@ -243,7 +243,7 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
      "extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)", "/ -> *"):
         "cost only: boxes four times too tall bound the distances from below all the same",
     ("bidmp.extension.segmentation", "_prune_paper",
-     "if types[position] == 1 and types[position + 1] == -1:  # a (Ma_i, Mi_i) pair", "and -> or"):
+     "if types[position] == 1 and types[position + 1] == -1:", "and -> or"):
         "the extrema alternate, so a maximum is always followed by a minimum: either half implies the other",
     ("bidmp.incremental.bls", "BLS.fit", "F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)", "1.0 -> 2.0"):
         "the divisor of a constant projection, whose numerator F - F_low is 0 either way",
@@ -254,15 +254,15 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ("bidmp.primitives.goals", "DelayedGoal.on_grid", "return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)",
      "1.0 -> 2.0"): "a step of 0 passes only for one sample, whose gate is 1 whatever the step",
     ("bidmp.extension.segmentation", "segment",
-     "if np.max(interior) * total < 1e-6:  # (at least 10 samples: the interior has 8 or more)", "< -> <="):
+     "if np.max(interior) * total < 1e-06:", "< -> <="):
         "differs only for a curve whose κ·L is exactly 1e-6",
     ("bidmp.extension.segmentation", "segment", "original = np.clip(np.searchsorted(s, positions), 1, n_samples - 1)",
      "- -> +"): "the upper bound is never reached: a kept point lies within the path, so searchsorted gives at "
                 "most n_samples - 1",
     ("bidmp.extension.segmentation", "segment",
-     "nearer_left = (positions - s[original - 1]) < (s[original] - positions)", "< -> <="):
+     "nearer_left = positions - s[original - 1] < s[original] - positions", "< -> <="):
         "differs only for a point exactly halfway in arc length between two samples",
-    (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]",
+    (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row:row + 1], radius, length, lower, upper)[0]",
      "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
     **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
        "a one-point path: the placements to add are none either way, and the seed (the exact distance at "
@@ -379,7 +379,7 @@ class Mutant:
     variant: int
     line: int
     description: str
-    text: str = ""  # the mutated line, stripped
+    text: str = ""  # the mutated statement (statement_text)
     outcome: str = ""
     seconds: float = 0.0
 
@@ -412,16 +412,34 @@ def _points(function: ast.FunctionDef) -> list:
     return [inner for statement in body if not _skipped(statement) for inner in _walk(statement)]
 
 
+def statement_text(function: ast.FunctionDef, inner: ast.AST) -> str:
+    """The statement of ``function`` that holds ``inner``, as ``ast.unparse`` writes it (a compound
+    statement by its header): the same however the source is formatted, so the survivors shown
+    equivalent keep their keys when a formatter reflows a line."""
+    holder = None
+    for statement in ast.walk(function):
+        if isinstance(statement, ast.stmt) and statement is not function and any(n is inner for n in ast.walk(statement)):
+            holder = statement  # ast.walk is breadth first: the last one found is the innermost
+    if holder is None:
+        return ast.unparse(inner)
+    headers = {ast.If: lambda s: f"if {ast.unparse(s.test)}:", ast.While: lambda s: f"while {ast.unparse(s.test)}:",
+               ast.For: lambda s: f"for {ast.unparse(s.target)} in {ast.unparse(s.iter)}:",
+               ast.With: lambda s: f"with {', '.join(ast.unparse(item) for item in s.items)}:"}
+    for kind, header in headers.items():
+        if isinstance(holder, kind):
+            return header(holder)
+    return ast.unparse(holder)
+
+
 def mutants(target: Target) -> list[Mutant]:
     path, tree = _source_tree(target.module)
-    lines = path.read_text(encoding="utf-8").splitlines()
     out = []
     for function in target.functions:
         node = _function_node(tree, function)
         for index, inner in enumerate(_points(node)):
             for variant, (description, _) in enumerate(_variants(inner)):
                 out.append(Mutant(target, function, index, variant, inner.lineno, description,
-                                  lines[inner.lineno - 1].strip()))
+                                  statement_text(node, inner)))
     return out
 
 
