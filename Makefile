@@ -12,13 +12,13 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test bench install clean readme fuzz mutation sim lasa random-cells avoidance view-check
+.PHONY: demo test lint bench install clean readme fuzz mutation sim lasa random-cells avoidance view-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -28,6 +28,12 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2
+
+# ruff's linter (pycodestyle, pyflakes, import order, bugbear, pyupgrade, complexity, argument
+# counts; settings in pyproject.toml) and its formatter, checked, over everything Python here.
+lint: $(STAMP)
+	$(VENV)/bin/ruff check src tests tools benchmarks
+	$(VENV)/bin/ruff format --check src tests tools benchmarks
 
 # The long campaign: the hypothesis suite of tests/test_fuzz.py x20 and the public-surface sweep of
 # tests/test_fuzz_surface.py in full (every single change and 12 000 pairs); commits the outcome

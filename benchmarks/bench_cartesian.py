@@ -19,15 +19,17 @@ import numpy as np
 from _timing import median_time
 from scipy.spatial.transform import Rotation
 
-from bidmp.primitives import CartesianDMP, angle_between
 from bidmp.demonstrations import minimum_jerk
+from bidmp.primitives import CartesianDMP, angle_between
 
 
 def demonstration(n_steps: int = 1000):
     positions = minimum_jerk([[0.0, 0.0, 0.0], [0.1, 0.05, 0.08], [0.2, 0.0, 0.0]], n_steps=n_steps)
     s = np.linspace(0.0, 1.0, n_steps)
     s = 10 * s**3 - 15 * s**4 + 6 * s**5
-    rotations = Rotation.from_rotvec(np.outer(s, [0.3, -0.8, 1.2])) * Rotation.from_euler("x", 180, degrees=True)
+    rotations = Rotation.from_rotvec(np.outer(s, [0.3, -0.8, 1.2])) * Rotation.from_euler(
+        "x", 180, degrees=True
+    )
     return np.linspace(0.0, 2.0, n_steps), np.hstack([positions, rotations.as_quat()])
 
 
@@ -55,10 +57,16 @@ def main() -> int:
     mine, theirs = ours(), peer()
     n = min(len(poses), len(mine.t))
     ours_error = np.degrees(angle_between(mine.q[:n], poses[:n, 3:]).max())
-    peer_error = np.degrees(angle_between(theirs[: len(poses), [4, 5, 6, 3]], poses[: len(theirs), 3:]).max())
+    peer_error = np.degrees(
+        angle_between(theirs[: len(poses), [4, 5, 6, 3]], poses[: len(theirs), 3:]).max()
+    )
     print(f"pose DMP, T = {len(poses)}, 50 weights per dimension (median of {args.repeats} runs)")
-    print(f"  bidmp CartesianDMP fit + trajectory:            {ours_s * 1e3:7.2f} ms   (max orientation error {ours_error:.3f} deg)")
-    print(f"  movement_primitives imitate + open_loop (cython): {peer_s * 1e3:7.2f} ms   (max orientation error {peer_error:.3f} deg)")
+    print(
+        f"  bidmp CartesianDMP fit + trajectory:            {ours_s * 1e3:7.2f} ms   (max orientation error {ours_error:.3f} deg)"
+    )
+    print(
+        f"  movement_primitives imitate + open_loop (cython): {peer_s * 1e3:7.2f} ms   (max orientation error {peer_error:.3f} deg)"
+    )
     print(f"  ratio: {peer_s / ours_s:.1f}x   (target >= 10x)")
     return 0
 

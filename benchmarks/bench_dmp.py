@@ -18,7 +18,6 @@ import sys
 import warnings
 
 import numpy as np
-
 from _timing import median_time
 
 from bidmp import DMP
@@ -40,15 +39,20 @@ def bench_fit_rollout(n_dims: int, repeats: int) -> dict:
     y = demonstration(n_dims)
     times = np.arange(N_STEPS) / N_STEPS
     results = {}
-    results["bidmp fit+rollout"] = median_time(lambda: DMP(protocol="paper", n_kernels=N_KERNELS).fit(y).rollout(), repeats)
+    results["bidmp fit+rollout"] = median_time(
+        lambda: DMP(protocol="paper", n_kernels=N_KERNELS).fit(y).rollout(), repeats
+    )
 
     try:
         from movement_primitives.dmp import DMP as MPDMP
     except ImportError:  # pragma: no cover - optional peer
         print("movement_primitives not installed: skipped", file=sys.stderr)
     else:
+
         def mp_fit():
-            dmp = MPDMP(n_dims=n_dims, execution_time=times[-1], dt=1 / N_STEPS, n_weights_per_dim=N_KERNELS)
+            dmp = MPDMP(
+                n_dims=n_dims, execution_time=times[-1], dt=1 / N_STEPS, n_weights_per_dim=N_KERNELS
+            )
             dmp.imitate(times, y)
             dmp.configure(start_y=y[0], goal_y=y[-1])
             return dmp
@@ -60,13 +64,16 @@ def bench_fit_rollout(n_dims: int, repeats: int) -> dict:
             if elapsed < best_rollout:
                 best_name, best_rollout = step, elapsed
         results[f"movement_primitives rollout ({best_name})"] = best_rollout
-        results["movement_primitives fit+rollout"] = median_time(lambda: mp_fit().open_loop(step_function=best_name), repeats)
+        results["movement_primitives fit+rollout"] = median_time(
+            lambda: mp_fit().open_loop(step_function=best_name), repeats
+        )
 
     try:
         from pydmps.dmp_discrete import DMPs_discrete
     except ImportError:  # pragma: no cover - optional peer
         print("pydmps not installed: skipped", file=sys.stderr)
     else:
+
         def pydmps_fit_rollout():
             dmp = DMPs_discrete(n_dmps=n_dims, n_bfs=N_KERNELS, dt=1 / N_STEPS)
             dmp.imitate_path(y_des=y.T)
@@ -92,24 +99,36 @@ def bench_many_goals(n_goals: int, repeats: int) -> dict:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=61, help="timed repetitions per measurement (median)")
-    parser.add_argument("--goals", type=int, default=10_000, help="number of goals for rollout_many")
+    parser.add_argument(
+        "--repeats", type=int, default=61, help="timed repetitions per measurement (median)"
+    )
+    parser.add_argument(
+        "--goals", type=int, default=10_000, help="number of goals for rollout_many"
+    )
     args = parser.parse_args()
 
-    print(f"fit + rollout, T = {N_STEPS}, {N_KERNELS} kernels per dimension (median of {args.repeats})")
+    print(
+        f"fit + rollout, T = {N_STEPS}, {N_KERNELS} kernels per dimension (median of {args.repeats})"
+    )
     for n_dims in (2, 3):
         results = bench_fit_rollout(n_dims, args.repeats)
         ours = results["bidmp fit+rollout"]
         print(f"\n  D = {n_dims}")
         for name, seconds in results.items():
-            ratio = "" if name.startswith("bidmp") else f"   bidmp fit+rollout is {seconds / ours:7.1f}x faster"
+            ratio = (
+                ""
+                if name.startswith("bidmp")
+                else f"   bidmp fit+rollout is {seconds / ours:7.1f}x faster"
+            )
             print(f"    {name:48s} {seconds * 1e3:9.3f} ms{ratio}")
 
     results = bench_many_goals(args.goals, max(3, args.repeats // 4))
     print(f"\nrollouts to {args.goals} goals, T = {N_STEPS}, D = 3")
     print(f"    {'rollout_many':48s} {results['rollout_many']:9.3f} s   (target <= 0.5 s)")
-    print(f"    {'loop of rollout':48s} {results['loop of rollout']:9.3f} s   "
-          f"rollout_many is {results['loop of rollout'] / results['rollout_many']:.1f}x faster")
+    print(
+        f"    {'loop of rollout':48s} {results['loop of rollout']:9.3f} s   "
+        f"rollout_many is {results['loop of rollout'] / results['rollout_many']:.1f}x faster"
+    )
     print(f"    max |rollout_many - rollout| on a sample: {results['max difference']:.2e}")
     return 0
 

@@ -18,14 +18,12 @@ import sys
 import tempfile
 
 import numpy as np
-
 from _timing import median_time
 
 from bidmp import extend_demonstration, frechet_distance
 from bidmp.demonstrations import minimum_jerk
 from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
-from bidmp.extension import classic_prm, gaussian_prm
-from bidmp.extension import frechet_distance_reference
+from bidmp.extension import classic_prm, frechet_distance_reference, gaussian_prm
 
 
 def jit_compile_seconds() -> float:
@@ -36,8 +34,16 @@ def jit_compile_seconds() -> float:
     )
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-        cold = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout)
-        warm = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout)
+        cold = float(
+            subprocess.run(
+                [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+            ).stdout
+        )
+        warm = float(
+            subprocess.run(
+                [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+            ).stdout
+        )
     return cold, warm
 
 
@@ -76,8 +82,10 @@ def main() -> int:
     args = parser.parse_args()
 
     cold, warm = jit_compile_seconds()
-    print(f"numba Fréchet kernel: first call in a fresh environment {cold:.2f} s (compile), "
-          f"from the on-disk cache {warm:.2f} s (import + load)")
+    print(
+        f"numba Fréchet kernel: first call in a fresh environment {cold:.2f} s (compile), "
+        f"from the on-disk cache {warm:.2f} s (import + load)"
+    )
     for size in (200, 1000):
         bench_frechet(size, args.repeats)
 
@@ -85,7 +93,9 @@ def main() -> int:
     target = np.array(BATTERY_EXTENSION_TARGET)
     result = extend_demonstration(demo, target, seed=0)
     piece = result.tra_imi
-    print(f"\n  battery approach path: 200 samples, 3-D, extension to {BATTERY_EXTENSION_TARGET} (median of {args.repeats})")
+    print(
+        f"\n  battery approach path: 200 samples, 3-D, extension to {BATTERY_EXTENSION_TARGET} (median of {args.repeats})"
+    )
     rows = {
         "G-PRM, 10 iterations, 300 samples": lambda: gaussian_prm(piece, target, seed=1),
         "classic PRM, 10 iterations, 300 samples": lambda: classic_prm(piece, target, seed=1),

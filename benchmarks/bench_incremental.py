@@ -18,10 +18,10 @@ import numpy as np
 from _timing import median_time
 
 from bidmp import BLS, DMP, BiDMP, extend_demonstration
-from bidmp.incremental.linalg import PINV_RCOND
-from bidmp.incremental import block_pinv_update
 from bidmp.demonstrations import minimum_jerk
 from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.incremental import block_pinv_update
+from bidmp.incremental.linalg import PINV_RCOND
 
 
 def bidmp_like_problem(n_rows: int = 1000):
@@ -59,10 +59,16 @@ def bench_bls(n_nodes: int, repeats: int, n_enhance: int = 300) -> None:
     t_incremental = median_time(incremental, repeats)  # each call on its own prepared copy
     t_refit = median_time(refit, max(3, repeats // 3))
     t_solve = median_time(solve_only, repeats)
-    print(f"\n  BLS, N = {X.shape[0]}, {A.shape[1] - n_nodes} hidden nodes + {n_nodes} added (exact_ridge, reg = {reg:g})")
+    print(
+        f"\n  BLS, N = {X.shape[0]}, {A.shape[1] - n_nodes} hidden nodes + {n_nodes} added (exact_ridge, reg = {reg:g})"
+    )
     print(f"    {'add_enhancement_nodes':44s} {t_incremental * 1e3:9.3f} ms")
-    print(f"    {'refit BLS from scratch with the same nodes':44s} {t_refit * 1e3:9.3f} ms   incremental is {t_refit / t_incremental:6.1f}x faster")
-    print(f"    {'ridge solve of the output weights alone':44s} {t_solve * 1e3:9.3f} ms   incremental is {t_solve / t_incremental:6.1f}x faster")
+    print(
+        f"    {'refit BLS from scratch with the same nodes':44s} {t_refit * 1e3:9.3f} ms   incremental is {t_refit / t_incremental:6.1f}x faster"
+    )
+    print(
+        f"    {'ridge solve of the output weights alone':44s} {t_solve * 1e3:9.3f} ms   incremental is {t_solve / t_incremental:6.1f}x faster"
+    )
     print(f"    max |W_incremental - W_scratch| / max |W| = {difference:.1e}")
 
 
@@ -75,11 +81,17 @@ def bench_block_pinv(n_nodes: int, repeats: int) -> None:
     updated = np.vstack([A_pinv - D @ Bt, Bt])
     scratch = np.linalg.pinv(np.hstack([A, E]), rcond=PINV_RCOND)
     t_update = median_time(lambda: block_pinv_update(A, A_pinv, E), repeats)
-    t_scratch = median_time(lambda: np.linalg.pinv(np.hstack([A, E]), rcond=PINV_RCOND), max(3, repeats // 3))
+    t_scratch = median_time(
+        lambda: np.linalg.pinv(np.hstack([A, E]), rcond=PINV_RCOND), max(3, repeats // 3)
+    )
     print(f"\n  Eq. 23-26 block pseudo-inverse, A 2000 x 400, E 2000 x {n_nodes} (case {case})")
     print(f"    {'block_pinv_update':44s} {t_update * 1e3:9.3f} ms")
-    print(f"    {'numpy.linalg.pinv([A | E]) from scratch':44s} {t_scratch * 1e3:9.3f} ms   update is {t_scratch / t_update:6.1f}x faster")
-    print(f"    max |difference| / max |pinv| = {np.abs(updated - scratch).max() / np.abs(scratch).max():.1e}")
+    print(
+        f"    {'numpy.linalg.pinv([A | E]) from scratch':44s} {t_scratch * 1e3:9.3f} ms   update is {t_scratch / t_update:6.1f}x faster"
+    )
+    print(
+        f"    max |difference| / max |pinv| = {np.abs(updated - scratch).max() / np.abs(scratch).max():.1e}"
+    )
 
 
 def bench_bidmp(repeats: int) -> None:

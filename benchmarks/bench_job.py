@@ -15,10 +15,9 @@ import argparse
 import statistics
 import time
 
-from bidmp.tasks import scenarios
-from bidmp.tasks import evaluate
 from bidmp.sim import simulate
 from bidmp.sim.job import run_job
+from bidmp.tasks import evaluate, scenarios
 
 
 def main() -> int:
@@ -26,8 +25,10 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()
     nut, cells = scenarios.load("nut-unscrewing"), scenarios.load("cell-removal")
-    job_reports = {"nut": evaluate(nut.with_robot_protocol(), ["bidmp"], geometry=False),
-                   "cells": evaluate(cells.with_robot_protocol(), ["bidmp"], geometry=False)}
+    job_reports = {
+        "nut": evaluate(nut.with_robot_protocol(), ["bidmp"], geometry=False),
+        "cells": evaluate(cells.with_robot_protocol(), ["bidmp"], geometry=False),
+    }
     sim_report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
     factors = {"nut job": [], "cell job": [], "sim 1 worker": [], "sim 2 workers": []}
     for _ in range(args.repeats):  # each round runs every side once: load drift falls on all alike
@@ -37,10 +38,14 @@ def main() -> int:
         for workers in (1, 2):
             start = time.perf_counter()
             result = simulate(nut, ["dmp", "bidmp"], report=sim_report, workers=workers)
-            factors[f"sim {workers} worker{'s' if workers > 1 else ''}"].append(result.simulated_s / (time.perf_counter() - start))
+            factors[f"sim {workers} worker{'s' if workers > 1 else ''}"].append(
+                result.simulated_s / (time.perf_counter() - start)
+            )
     for name, values in factors.items():
-        print(f"  {name:14s} {statistics.median(values):5.1f}x real time (median of {len(values)}: "
-              f"{', '.join(f'{v:.1f}' for v in values)})")
+        print(
+            f"  {name:14s} {statistics.median(values):5.1f}x real time (median of {len(values)}: "
+            f"{', '.join(f'{v:.1f}' for v in values)})"
+        )
     ratio = statistics.median(factors["sim 2 workers"]) / statistics.median(factors["sim 1 worker"])
     print(f"  bidmp sim: 2 workers / 1 worker = {ratio:.2f}x (target >= 1.6x, or the workers go)")
     return 0

@@ -20,8 +20,8 @@ import shutil
 import time
 from pathlib import Path
 
-from bidmp.experiments import benchmark
 from bidmp.demonstrations.datasets import lasa_names
+from bidmp.experiments import benchmark
 
 
 def _nothing(index: int) -> int:
@@ -50,15 +50,24 @@ def _rounds(out: Path, shapes, rounds: int, every: int) -> tuple[float, float, b
     try:
         for index, group in enumerate(groups):
             order = (1, 2) if index % 2 == 0 else (2, 1)
-            runs = {workers: _one_side(out / f"round{index}" / f"workers{workers}", group, every,
-                                       None if workers == 1 else cluster.scheduler_address)
-                    for workers in order}
+            runs = {
+                workers: _one_side(
+                    out / f"round{index}" / f"workers{workers}",
+                    group,
+                    every,
+                    None if workers == 1 else cluster.scheduler_address,
+                )
+                for workers in order
+            }
             for workers, run in runs.items():
                 totals[workers] += run.wall_s
             identical &= _strip(runs[1].rows) == _strip(runs[2].rows)
-            print(f"  round {index + 1}/{rounds} ({len(group)} shapes, {'serial' if order[0] == 1 else '2 workers'} first): "
-                  f"serial {runs[1].wall_s:6.1f} s, 2 workers {runs[2].wall_s:6.1f} s, ratio "
-                  f"{runs[1].wall_s / runs[2].wall_s:.2f}x", flush=True)
+            print(
+                f"  round {index + 1}/{rounds} ({len(group)} shapes, {'serial' if order[0] == 1 else '2 workers'} first): "
+                f"serial {runs[1].wall_s:6.1f} s, 2 workers {runs[2].wall_s:6.1f} s, ratio "
+                f"{runs[1].wall_s / runs[2].wall_s:.2f}x",
+                flush=True,
+            )
     finally:
         start = time.perf_counter()
         client.close()
@@ -70,8 +79,12 @@ def _rounds(out: Path, shapes, rounds: int, every: int) -> tuple[float, float, b
 def _dask_overhead() -> float:
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         client.gather(client.map(_nothing, range(100)))  # warm
         n = 2000
         start = time.perf_counter()
@@ -83,20 +96,29 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--every", type=int, default=1)
     parser.add_argument("--rounds", type=int, default=6)
-    parser.add_argument("--shapes", type=int, default=30, help="how many of the 30 shapes (default all)")
+    parser.add_argument(
+        "--shapes", type=int, default=30, help="how many of the 30 shapes (default all)"
+    )
     parser.add_argument("--out", default="bidmp-lasa-bench")
     args = parser.parse_args()
     out = Path(args.out)
     shutil.rmtree(out, ignore_errors=True)
     shapes = list(lasa_names())[: args.shapes]
-    print(f"LASA, {len(shapes)} shapes x 7 demonstrations, every {args.every} sample(s), all methods; "
-          f"serial path and 2 Dask workers interleaved in {args.rounds} round(s)", flush=True)
+    print(
+        f"LASA, {len(shapes)} shapes x 7 demonstrations, every {args.every} sample(s), all methods; "
+        f"serial path and 2 Dask workers interleaved in {args.rounds} round(s)",
+        flush=True,
+    )
     serial, parallel, identical = _rounds(out, shapes, args.rounds, args.every)
     print(f"  serial:    {serial:7.1f} s")
-    print(f"  2 workers: {parallel:7.1f} s (cluster start and stop included)   speed-up {serial / parallel:.2f}x (target >= 1.6x); tables identical: {identical}")
+    print(
+        f"  2 workers: {parallel:7.1f} s (cluster start and stop included)   speed-up {serial / parallel:.2f}x (target >= 1.6x); tables identical: {identical}"
+    )
     rate = _dask_overhead()
-    print(f"  Dask overhead: {rate:.0f} empty tasks/s on 2 workers ({1e3 / rate:.2f} ms per task; a LASA cell "
-          f"takes {serial / (7 * len(shapes)):.2f} s serially)")
+    print(
+        f"  Dask overhead: {rate:.0f} empty tasks/s on 2 workers ({1e3 / rate:.2f} ms per task; a LASA cell "
+        f"takes {serial / (7 * len(shapes)):.2f} s serially)"
+    )
     return 0
 
 

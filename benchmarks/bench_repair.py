@@ -20,8 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bidmp.tasks import scenarios
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
 
@@ -46,14 +45,21 @@ def cells(rounds: int, smoke: bool) -> list[str]:
     for name in ("two_posts.json",) if smoke else ("two_posts.json", "duct_module.json"):
         scenario = scenarios.from_dict(json.loads((DATA / name).read_text()))
         repaired = evaluate(scenario, ["bidmp"]).methods["bidmp"]
-        hows = [repaired.repaired_at(label) for label in repaired.repairs if repaired.repaired_at(label)]
+        hows = [
+            repaired.repaired_at(label) for label in repaired.repairs if repaired.repaired_at(label)
+        ]
         assert hows and repaired.task_successes == len(scenario.labels), name
-        plain, repair = interleaved(lambda: evaluate(scenario, ["bidmp"], repair=False),
-                                    lambda: evaluate(scenario, ["bidmp"]), rounds)
+        plain, repair = interleaved(
+            lambda: evaluate(scenario, ["bidmp"], repair=False),
+            lambda: evaluate(scenario, ["bidmp"]),
+            rounds,
+        )
         per_target = plain / len(scenario.labels)
         cost = per_target + (repair - plain) / len(hows)
-        lines.append(f"{name:18s} {len(hows):2d}/{len(scenario.labels):<3d} {'+'.join(sorted(set(hows))):7s} "
-                     f"{1e3 * per_target:9.1f} {1e3 * cost:9.1f} {cost / per_target:6.2f}x")
+        lines.append(
+            f"{name:18s} {len(hows):2d}/{len(scenario.labels):<3d} {'+'.join(sorted(set(hows))):7s} "
+            f"{1e3 * per_target:9.1f} {1e3 * cost:9.1f} {cost / per_target:6.2f}x"
+        )
     return lines
 
 
@@ -66,9 +72,23 @@ def each_repair(rounds: int, smoke: bool) -> list[str]:
 
     demo = minimum_jerk([[-100, -120, 150], [0, 0, 35], [0, 0, 0]], 300)
     t = np.linspace(0, 3, 300)
-    scene = Scene.from_dict({"tool": {"radius": 10.0, "length": 100.0}, "margin": 3.0, "standoff": {"plate": 1.0},
-                             "parts": [{"type": "plate", "label": "plate", "at": [0, 0, -2], "size": [400, 400, 5]},
-                                       {"type": "cylinder", "label": "post", "at": [60, -33, -2], "radius": 5.0, "height": 80.0}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 10.0, "length": 100.0},
+            "margin": 3.0,
+            "standoff": {"plate": 1.0},
+            "parts": [
+                {"type": "plate", "label": "plate", "at": [0, 0, -2], "size": [400, 400, 5]},
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [60, -33, -2],
+                    "radius": 5.0,
+                    "height": 80.0,
+                },
+            ],
+        }
+    )
     contract = Contract(1.75, 25.0, scene, "mm")
     goal = np.array([120.0, 0.0, 0.0])
 
@@ -77,14 +97,18 @@ def each_repair(rounds: int, smoke: bool) -> list[str]:
         return contract.judge(dmp.trajectory(goal).y, goal)
 
     lines = []
-    for how in (("lift",) if smoke else ("lift", "avoid", "extend")):
+    for how in ("lift",) if smoke else ("lift", "avoid", "extend"):
+
         def repaired(how=how):
             dmp = DMP().fit(demo, t, units="mm")
             return Repairer(contract, demo, order=(how,)).repair(dmp, goal, "far")
+
         outcome = repaired()
         base, cost = interleaved(plain, repaired, rounds)
-        lines.append(f"{'post across a skill':18s} {'1/1':6s} {how:7s} {1e3 * base:9.1f} {1e3 * cost:9.1f} {cost / base:6.2f}x"
-                     f"{'' if outcome.ok else '  (not repaired: ' + outcome.reason()[:60] + ')'}")
+        lines.append(
+            f"{'post across a skill':18s} {'1/1':6s} {how:7s} {1e3 * base:9.1f} {1e3 * cost:9.1f} {cost / base:6.2f}x"
+            f"{'' if outcome.ok else '  (not repaired: ' + outcome.reason()[:60] + ')'}"
+        )
     return lines
 
 

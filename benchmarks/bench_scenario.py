@@ -22,9 +22,8 @@ import numpy as np
 from _timing import median_time
 from threadpoolctl import threadpool_limits
 
-from bidmp.tasks import scenarios
 from bidmp.baselines import augment
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
 
 def main() -> int:
@@ -40,13 +39,19 @@ def main() -> int:
     report = evaluate(scenario)
     print(f"nut-unscrewing, 14 targets (median of {args.repeats} runs, warm)")
     print(f"  {'dmp + bidmp, no geometry':32s} {without * 1e3:8.1f} ms   (target <= 100 ms)")
-    print(f"  {'dmp + bidmp, geometry checks':32s} {whole * 1e3:8.1f} ms   (target <= 150 ms; "
-          f"{whole / without:.2f}x the run without)")
+    print(
+        f"  {'dmp + bidmp, geometry checks':32s} {whole * 1e3:8.1f} ms   (target <= 150 ms; "
+        f"{whole / without:.2f}x the run without)"
+    )
     for name, result in report.methods.items():
-        print(f"  {name:32s} {result.runtime_s * 1e3:8.1f} ms   {result.successes}/14 within 1.75 mm, "
-              f"task success {result.task_successes}/14")
+        print(
+            f"  {name:32s} {result.runtime_s * 1e3:8.1f} ms   {result.successes}/14 within 1.75 mm, "
+            f"task success {result.task_successes}/14"
+        )
     gmm, bidmp = report.methods["gmm"].runtime_s, report.methods["bidmp"].runtime_s
-    print(f"  GMM / Bi-DMP run time ratio: {gmm / bidmp:.1f}  (paper Table 4: GMM-based methods are slower)")
+    print(
+        f"  GMM / Bi-DMP run time ratio: {gmm / bidmp:.1f}  (paper Table 4: GMM-based methods are slower)"
+    )
 
     from sklearn.mixture import GaussianMixture
 
@@ -61,8 +66,10 @@ def main() -> int:
     default = median_time(em, repeats)
     with threadpool_limits(limits=1):
         single = median_time(em, repeats)
-    print(f"  GaussianMixture EM (16 components, {data.shape[0]} points): default threads {default * 1e3:.0f} ms, "
-          f"one thread {single * 1e3:.0f} ms, ratio {default / single:.1f}")
+    print(
+        f"  GaussianMixture EM (16 components, {data.shape[0]} points): default threads {default * 1e3:.0f} ms, "
+        f"one thread {single * 1e3:.0f} ms, ratio {default / single:.1f}"
+    )
     return 0
 
 

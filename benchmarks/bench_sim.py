@@ -17,8 +17,7 @@ import tempfile
 import time
 
 from bidmp import sim
-from bidmp.tasks import scenarios
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
 
 def main() -> int:
@@ -27,28 +26,40 @@ def main() -> int:
     print("nut-unscrewing on the simulated Panda, dmp + bidmp, 28 motions")
     for workers in (1, 2):
         result = sim.simulate(scenario, ["dmp", "bidmp"], report=report, workers=workers)
-        print(f"  {workers} worker process{'es' if workers > 1 else '  '}: simulated {result.simulated_s:6.1f} s in "
-              f"{result.wall_s:5.1f} s wall = {result.simulated_s / result.wall_s:5.1f}x real time (target >= 10)")
+        print(
+            f"  {workers} worker process{'es' if workers > 1 else '  '}: simulated {result.simulated_s:6.1f} s in "
+            f"{result.wall_s:5.1f} s wall = {result.simulated_s / result.wall_s:5.1f}x real time (target >= 10)"
+        )
     with sim.RobotCell(scenario.scene, scenario.units, *sim.robot_placement(scenario)) as cell:
         n = 5000
         start = time.perf_counter()
         for _ in range(n):
             cell.p.stepSimulation(physicsClientId=cell.client)
-        print(f"  PyBullet stepSimulation alone: {(time.perf_counter() - start) / n * 1e6:.0f} us per 1 ms step")
+        print(
+            f"  PyBullet stepSimulation alone: {(time.perf_counter() - start) / n * 1e6:.0f} us per 1 ms step"
+        )
         points = seconds = 0.0
         for label in scenario.labels:
             start = time.perf_counter()
             plan = cell.plan(report.methods["bidmp"].rollouts[label], label)
             seconds += time.perf_counter() - start
             points += len(plan.points)
-        print(f"  inverse kinematics and timing: {seconds / points * 1e3:.2f} ms per IK point "
-              f"({points / len(scenario.labels):.0f} points per motion)")
+        print(
+            f"  inverse kinematics and timing: {seconds / points * 1e3:.2f} ms per IK point "
+            f"({points / len(scenario.labels):.0f} points per motion)"
+        )
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "bidmp", "sim", "--methods", "dmp,bidmp", "--out", out], check=True,
-                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        print(f"  bidmp sim --methods dmp,bidmp (whole command, pictures included): {time.perf_counter() - start:.1f} s "
-              f"(target <= 60 s on 2 cores)")
+        subprocess.run(
+            [sys.executable, "-m", "bidmp", "sim", "--methods", "dmp,bidmp", "--out", out],
+            check=True,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        print(
+            f"  bidmp sim --methods dmp,bidmp (whole command, pictures included): {time.perf_counter() - start:.1f} s "
+            f"(target <= 60 s on 2 cores)"
+        )
     return 0
 
 

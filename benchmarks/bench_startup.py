@@ -21,7 +21,14 @@ import tempfile
 import time
 from pathlib import Path
 
-RECORDING = Path(__file__).resolve().parent.parent / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv"
+RECORDING = (
+    Path(__file__).resolve().parent.parent
+    / "src"
+    / "bidmp"
+    / "data"
+    / "recordings"
+    / "operator1_nut3.csv"
+)
 
 
 def _commands(scratch: Path) -> dict[str, list[str]]:
@@ -31,14 +38,28 @@ def _commands(scratch: Path) -> dict[str, list[str]]:
         "bidmp --help": [python, "-m", "bidmp", "--help"],
         "import bidmp": [python, "-c", "import bidmp"],
         "import bidmp; bidmp.DMP": [python, "-c", "import bidmp; bidmp.DMP"],
-        "bidmp fit (a 7 s recording)": [python, "-m", "bidmp", "fit", str(RECORDING), "--units", "mm", "-o",
-                                        str(scratch / "m.npz")],
+        "bidmp fit (a 7 s recording)": [
+            python,
+            "-m",
+            "bidmp",
+            "fit",
+            str(RECORDING),
+            "--units",
+            "mm",
+            "-o",
+            str(scratch / "m.npz"),
+        ],
     }
 
 
 def _import_cost(statement: str, module: str) -> tuple[float, float]:
     """(cumulative import time of the statement's imports, the share of ``module`` in it) in s."""
-    run = subprocess.run([sys.executable, "-X", "importtime", "-c", statement], capture_output=True, text=True, check=True)
+    run = subprocess.run(
+        [sys.executable, "-X", "importtime", "-c", statement],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
     total = own = 0.0
     for line in run.stderr.splitlines():
         if not line.startswith("import time:") or "|" not in line:
@@ -46,7 +67,9 @@ def _import_cost(statement: str, module: str) -> tuple[float, float]:
         _, cumulative, name = line.split("|")
         if not cumulative.strip().isdigit():
             continue
-        if name.startswith(" ") and not name.startswith("  "):  # a top-level import of the statement
+        if name.startswith(" ") and not name.startswith(
+            "  "
+        ):  # a top-level import of the statement
             total += int(cumulative) * 1e-6
         if name.strip() == module and (own == 0.0):
             own = int(cumulative) * 1e-6
@@ -62,7 +85,9 @@ def main() -> int:
     env = dict(os.environ, PYTHONWARNINGS="ignore")
     with tempfile.TemporaryDirectory() as folder:
         commands = _commands(Path(folder))
-        for argv in commands.values():  # warm-up: the disk cache, numba's cached kernels, __pycache__
+        for (
+            argv
+        ) in commands.values():  # warm-up: the disk cache, numba's cached kernels, __pycache__
             subprocess.run(argv, capture_output=True, env=env, check=True)
         times: dict[str, list[float]] = {name: [] for name in commands}
         for _ in range(rounds):
@@ -77,8 +102,10 @@ def main() -> int:
         median = statistics.median(samples)
         print(f"{name:32s} {median:8.3f} {median / baseline:18.1f}")
     total, sklearn = _import_cost("import bidmp; bidmp.DMP", "sklearn.base")
-    print(f"import bidmp; bidmp.DMP: {total:.3f} s of imports (python -X importtime), of which sklearn.base "
-          f"{sklearn:.3f} s ({100 * sklearn / max(total, 1e-9):.0f} %)")
+    print(
+        f"import bidmp; bidmp.DMP: {total:.3f} s of imports (python -X importtime), of which sklearn.base "
+        f"{sklearn:.3f} s ({100 * sklearn / max(total, 1e-9):.0f} %)"
+    )
     return 0
 
 

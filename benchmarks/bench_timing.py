@@ -19,7 +19,6 @@ import sys
 import warnings
 
 import numpy as np
-
 from _timing import median_time
 
 import bidmp
@@ -37,19 +36,25 @@ def main(argv=None) -> int:
     prepared, _ = bidmp.prepare(y, t)
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
     goal = dmp.goal_ + SHIFT
-    print(f"recording {os.path.basename(RECORDING)}: {y.shape[0]} samples over {t[-1] - t[0]:.2f} s; "
-          f"prepared: {prepared.y.shape[0]} samples over {prepared.duration:.2f} s")
+    print(
+        f"recording {os.path.basename(RECORDING)}: {y.shape[0]} samples over {t[-1] - t[0]:.2f} s; "
+        f"prepared: {prepared.y.shape[0]} samples over {prepared.duration:.2f} s"
+    )
 
     prepare_fit = median_time(lambda: bidmp.DMP().fit(*_prepared(y, t)), args.repeats)
     print(f"  prepare + fit                       {1e3 * prepare_fit:8.3f} ms   (target <= 20 ms)")
     rollout = median_time(lambda: dmp.rollout(goal), args.repeats * 5)
     trajectory = median_time(lambda: dmp.trajectory(goal), args.repeats * 5)
     print(f"  rollout()                           {1e3 * rollout:8.3f} ms")
-    print(f"  trajectory() with derivatives       {1e3 * trajectory:8.3f} ms   ratio {trajectory / rollout:.2f} (target <= 1.5)")
+    print(
+        f"  trajectory() with derivatives       {1e3 * trajectory:8.3f} ms   ratio {trajectory / rollout:.2f} (target <= 1.5)"
+    )
     ours = dmp.trajectory(goal)
-    print(f"  bidmp: end-point error {np.linalg.norm(ours.y[-1] - goal):.4f} mm after {ours.duration:.2f} s, "
-          f"initial acceleration change from the demonstrated goal "
-          f"{np.linalg.norm(ours.ydd[0] - dmp.trajectory().ydd[0]):.2e} mm/s^2")
+    print(
+        f"  bidmp: end-point error {np.linalg.norm(ours.y[-1] - goal):.4f} mm after {ours.duration:.2f} s, "
+        f"initial acceleration change from the demonstrated goal "
+        f"{np.linalg.norm(ours.ydd[0] - dmp.trajectory().ydd[0]):.2e} mm/s^2"
+    )
 
     try:
         from movement_primitives.dmp import DMP as MPDMP
@@ -59,7 +64,12 @@ def main(argv=None) -> int:
     times = prepared.t
 
     def theirs(step_function):
-        mp = MPDMP(n_dims=3, execution_time=times[-1], dt=times[1] - times[0], n_weights_per_dim=bidmp.DMP().n_kernels_value)
+        mp = MPDMP(
+            n_dims=3,
+            execution_time=times[-1],
+            dt=times[1] - times[0],
+            n_weights_per_dim=bidmp.DMP().n_kernels_value,
+        )
         mp.imitate(times, prepared.y)
         mp.configure(start_y=prepared.y[0], goal_y=goal)
         return mp.open_loop(step_function=step_function)
@@ -75,11 +85,17 @@ def main(argv=None) -> int:
             if best is None or seconds < best[1]:
                 best = (step_function, seconds)
     _, positions = theirs(best[0])
-    ours_fit_traj = median_time(lambda: bidmp.DMP().fit(prepared.y, prepared.t).trajectory(goal), args.repeats)
+    ours_fit_traj = median_time(
+        lambda: bidmp.DMP().fit(prepared.y, prepared.t).trajectory(goal), args.repeats
+    )
     print(f"  bidmp fit + trajectory              {1e3 * ours_fit_traj:8.3f} ms")
-    print(f"  movement_primitives fit + open loop {1e3 * best[1]:8.3f} ms   ({best[0]}; bidmp is "
-          f"{best[1] / ours_fit_traj:.1f}x faster)")
-    print(f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm after {times[-1]:.2f} s")
+    print(
+        f"  movement_primitives fit + open loop {1e3 * best[1]:8.3f} ms   ({best[0]}; bidmp is "
+        f"{best[1] / ours_fit_traj:.1f}x faster)"
+    )
+    print(
+        f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm after {times[-1]:.2f} s"
+    )
     return 0
 
 

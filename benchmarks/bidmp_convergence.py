@@ -13,8 +13,8 @@ import numpy as np
 
 from bidmp import DMP, BiDMP, extend_demonstration
 from bidmp.demonstrations import minimum_jerk
-from bidmp.tasks import rmse
 from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.tasks import rmse
 
 
 def main() -> int:
@@ -26,15 +26,19 @@ def main() -> int:
     print("nut task, goal (150, 25, 0) mm: miss after k x T steps (default Bi-DMP)")
     for factor in (1, 2, 10, 20):
         n = factor * dmp.n_steps_
-        print(f"  {factor:3d} x T   Bi-DMP {np.linalg.norm(model.rollout(goal, n_steps=n)[-1] - goal):10.3g} mm"
-              f"   plain DMP {np.linalg.norm(dmp.rollout(goal, n_steps=n)[-1] - goal):10.3g} mm")
+        print(
+            f"  {factor:3d} x T   Bi-DMP {np.linalg.norm(model.rollout(goal, n_steps=n)[-1] - goal):10.3g} mm"
+            f"   plain DMP {np.linalg.norm(dmp.rollout(goal, n_steps=n)[-1] - goal):10.3g} mm"
+        )
     print("block ridge: largest output weight, reproduction RMSE, own end-point error")
     for reg in (1e-8, 1e-6, 1e-4, 1e-2):
         model = BiDMP(dmp, reg=reg).learn(extension.complete)
         rollout = model.rollout(goal)
         weight = max(np.abs(block.output_weights_).max() for block in model.blocks_)
-        print(f"  reg {reg:7.0e}   max |W| {weight:9.3g}   RMSE {rmse(rollout, extension.complete):.3f} mm"
-              f"   end {np.linalg.norm(rollout[-1] - goal):.3f} mm")
+        print(
+            f"  reg {reg:7.0e}   max |W| {weight:9.3g}   RMSE {rmse(rollout, extension.complete):.3f} mm"
+            f"   end {np.linalg.norm(rollout[-1] - goal):.3f} mm"
+        )
     return 0
 
 

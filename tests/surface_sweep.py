@@ -44,54 +44,185 @@ import numpy as np
 import bidmp
 
 MAX_SECONDS = 10.0
-CLASSES = ("result", "refused", "unnamed refusal", "raw text", "long message", "internal error", "silent NaN/inf",
-           "leaked warning", "hang")
+CLASSES = (
+    "result",
+    "refused",
+    "unnamed refusal",
+    "raw text",
+    "long message",
+    "internal error",
+    "silent NaN/inf",
+    "leaked warning",
+    "hang",
+)
 DEFECTS = CLASSES[2:]
-PACKAGES = ("bidmp", "bidmp.primitives", "bidmp.demonstrations", "bidmp.extension", "bidmp.incremental", "bidmp.baselines",
-            "bidmp.scene", "bidmp.io", "bidmp.tasks", "bidmp.tasks.methods", "bidmp.sim", "bidmp.sim.pybullet",
-            "bidmp.experiments", "bidmp.plotting")
+PACKAGES = (
+    "bidmp",
+    "bidmp.primitives",
+    "bidmp.demonstrations",
+    "bidmp.extension",
+    "bidmp.incremental",
+    "bidmp.baselines",
+    "bidmp.scene",
+    "bidmp.io",
+    "bidmp.tasks",
+    "bidmp.tasks.methods",
+    "bidmp.sim",
+    "bidmp.sim.pybullet",
+    "bidmp.experiments",
+    "bidmp.plotting",
+)
 # Whole experiments and runs (their own tests run them with valid scenarios; one swapped argument
 # would only repeat the scenario checks the scenario sweep makes), the registry's mutators, and
 # records the library fills in and hands out (users read them; their methods are swept on real
 # instances below).
 SKIPPED = {
-    "evaluate", "simulate", "run_job", "run_figures", "run_table4", "run_table5", "lasa_generalisation",
-    "lasa_incremental", "compare_prm", "forgetting_runs", "run_cell", "register", "unregister",
+    "evaluate",
+    "simulate",
+    "run_job",
+    "run_figures",
+    "run_table4",
+    "run_table5",
+    "lasa_generalisation",
+    "lasa_incremental",
+    "compare_prm",
+    "forgetting_runs",
+    "run_cell",
+    "register",
+    "unregister",
     "bidmp.experiments.lasa",  # the whole LASA benchmark (its own tests run a small one)
-    "write_report", "write_sim_report", "write_job_report", "write_results",
-    "Report", "MethodResult", "SimReport", "SimTarget", "SimMethod", "JobReport", "JobTarget", "JobPhase", "Table4",
-    "Table5", "Figures", "BenchmarkResult", "GeneralisationResult", "IncrementalResult", "PRMComparison", "Segmentation",
-    "Clearance", "PrepareInfo", "ExtendedDemonstration", "Piece", "RoadmapResult", "ForgettingResult", "Part", "Solid",
-    "Scenario", "Verdict", "CommandPeaks", "Repaired", "Attempt", "MotionPlan", "Execution", "Recording", "AvoidanceCase",
-    "ViewLayers", "Limits", "Method", "SimulatorBackend", "CouplingTerm", "TimedMotion",
-    "plot_generalisation", "plot_extension", "plot_prm_comparison", "plot_incremental", "plot_targets_top_view",
-    "plot_error_vs_distance", "plot_scenario_3d", "layers_from_report", "add_robot_motions",
+    "write_report",
+    "write_sim_report",
+    "write_job_report",
+    "write_results",
+    "Report",
+    "MethodResult",
+    "SimReport",
+    "SimTarget",
+    "SimMethod",
+    "JobReport",
+    "JobTarget",
+    "JobPhase",
+    "Table4",
+    "Table5",
+    "Figures",
+    "BenchmarkResult",
+    "GeneralisationResult",
+    "IncrementalResult",
+    "PRMComparison",
+    "Segmentation",
+    "Clearance",
+    "PrepareInfo",
+    "ExtendedDemonstration",
+    "Piece",
+    "RoadmapResult",
+    "ForgettingResult",
+    "Part",
+    "Solid",
+    "Scenario",
+    "Verdict",
+    "CommandPeaks",
+    "Repaired",
+    "Attempt",
+    "MotionPlan",
+    "Execution",
+    "Recording",
+    "AvoidanceCase",
+    "ViewLayers",
+    "Limits",
+    "Method",
+    "SimulatorBackend",
+    "CouplingTerm",
+    "TimedMotion",
+    "plot_generalisation",
+    "plot_extension",
+    "plot_prm_comparison",
+    "plot_incremental",
+    "plot_targets_top_view",
+    "plot_error_vs_distance",
+    "plot_scenario_3d",
+    "layers_from_report",
+    "add_robot_motions",
     # scikit-learn's metadata routing and parameters, inherited and tested by scikit-learn:
-    "set_fit_request", "get_metadata_routing", "get_params", "set_params",
+    "set_fit_request",
+    "get_metadata_routing",
+    "get_params",
+    "set_params",
     # dataclass/namedtuple plumbing:
-    "count", "index"}
+    "count",
+    "index",
+}
 # Methods swept on instances whose valid call needs a live world or a long run: the robot cell's
 # execution (its own tests run it; a stepper or plan per call would take seconds).
-SKIPPED_METHODS = {"RobotCell.execute", "RobotCell.execute_closed_loop", "RobotCell.load_robot", "RobotCell.close",
-                   "Repairer.repair", "Method.fit", "Task.shared_model", "Task.fitted_dmp"}
+SKIPPED_METHODS = {
+    "RobotCell.execute",
+    "RobotCell.execute_closed_loop",
+    "RobotCell.load_robot",
+    "RobotCell.close",
+    "Repairer.repair",
+    "Method.fit",
+    "Task.shared_model",
+    "Task.fitted_dmp",
+}
 DOCUMENTED_INF = {"bidmp.tasks.approach_error", "bidmp.tasks.axis_deviation"}
 # Documented non-finite values inside results: (record, field) — no final approach: inf; no part:
 # an infinite clearance; a part without a stand-off: inf; a skill not yet learned: NaN.
-DOCUMENTED_FIELDS = {("ForgettingResult", "errors"), ("ExtendedDemonstration", "similarity"), ("Verdict", "approach_error"),
-                     ("Verdict", "axis_deviation"), ("Clearance", "distance")}
+DOCUMENTED_FIELDS = {
+    ("ForgettingResult", "errors"),
+    ("ExtendedDemonstration", "similarity"),
+    ("Verdict", "approach_error"),
+    ("Verdict", "axis_deviation"),
+    ("Clearance", "distance"),
+}
 DOCUMENTED_ANY = {"Proximity.near"}  # its stand-offs are inf for parts without one
 
 # NumPy's, SciPy's, pybullet's and Python's own wording: a refusal in these words did not check its input.
-RAW_TEXT = ("could not convert", "unsupported operand", "not subscriptable", "has no len", "truth value of an array",
-            "could not be broadcast", "object too deep", "is not callable", "invalid literal", "SeedSequence",
-            "expected non-negative integer", "did not converge", "not supported between instances", "argument must be",
-            "index out of", "too many indices", "cannot convert", "object is not", "object has no attribute",
-            "setting an array element", "inhomogeneous", "only integer scalar", "ambiguous", "must be real number, not",
-            "got an unexpected keyword", "missing 1 required", "positional argument", "QH6", "qhull", "Qhull",
-            "b3Printf", "pybullet.error", "required argument is not", "maximum recursion", "cannot reshape",
-            "operands could not", "zero-size array", "Cannot cast", "ufunc", "dtype('")
+RAW_TEXT = (
+    "could not convert",
+    "unsupported operand",
+    "not subscriptable",
+    "has no len",
+    "truth value of an array",
+    "could not be broadcast",
+    "object too deep",
+    "is not callable",
+    "invalid literal",
+    "SeedSequence",
+    "expected non-negative integer",
+    "did not converge",
+    "not supported between instances",
+    "argument must be",
+    "index out of",
+    "too many indices",
+    "cannot convert",
+    "object is not",
+    "object has no attribute",
+    "setting an array element",
+    "inhomogeneous",
+    "only integer scalar",
+    "ambiguous",
+    "must be real number, not",
+    "got an unexpected keyword",
+    "missing 1 required",
+    "positional argument",
+    "QH6",
+    "qhull",
+    "Qhull",
+    "b3Printf",
+    "pybullet.error",
+    "required argument is not",
+    "maximum recursion",
+    "cannot reshape",
+    "operands could not",
+    "zero-size array",
+    "Cannot cast",
+    "ufunc",
+    "dtype('",
+)
 
-DEMO = np.column_stack([np.linspace(0, 100, 60), 30 * np.sin(np.linspace(0, 3, 60)), np.linspace(80, 0, 60)])
+DEMO = np.column_stack(
+    [np.linspace(0, 100, 60), 30 * np.sin(np.linspace(0, 3, 60)), np.linspace(80, 0, 60)]
+)
 TIMES = np.linspace(0.0, 1.2, 60)
 QUATS = np.tile([0.0, 0.0, 0.0, 1.0], (60, 1))
 POSES = np.hstack([DEMO, QUATS])
@@ -117,16 +248,38 @@ def _nested_dict(depth: int):
 
 def generic_nasty(tmp: Path) -> list:
     """(label, value) pairs any argument may get."""
-    return [("None", None), ("True", True), ("long text", "x" * 10_000), ("object", object()), ("complex", DEMO + 1j),
-            ("NaN array", np.full((60, 3), np.nan)), ("inf", np.inf), ("-inf", -np.inf), ("NaN", float("nan")),
-            ("-1", -1), ("0", 0), ("2**40", 2**40), ("10**400", 10**400), ("1e308", 1e308), ("empty", np.empty((0, 3))),
-            ("3-D array", np.zeros((2, 60, 3))), ("ragged", [[1.0, 2.0], [3.0]]), ("0-d array", np.array(5.0)),
-            ("1j", 1j), ("negative array", -DEMO * 1e300), ("a directory", tmp), ("empty text", ""),
-            ("list nested 5000 deep", _nested_list(5000)), ("dict nested 5000 deep", _nested_dict(5000)),
-            ("float labels", np.arange(7.0))]
+    return [
+        ("None", None),
+        ("True", True),
+        ("long text", "x" * 10_000),
+        ("object", object()),
+        ("complex", DEMO + 1j),
+        ("NaN array", np.full((60, 3), np.nan)),
+        ("inf", np.inf),
+        ("-inf", -np.inf),
+        ("NaN", float("nan")),
+        ("-1", -1),
+        ("0", 0),
+        ("2**40", 2**40),
+        ("10**400", 10**400),
+        ("1e308", 1e308),
+        ("empty", np.empty((0, 3))),
+        ("3-D array", np.zeros((2, 60, 3))),
+        ("ragged", [[1.0, 2.0], [3.0]]),
+        ("0-d array", np.array(5.0)),
+        ("1j", 1j),
+        ("negative array", -DEMO * 1e300),
+        ("a directory", tmp),
+        ("empty text", ""),
+        ("list nested 5000 deep", _nested_list(5000)),
+        ("dict nested 5000 deep", _nested_dict(5000)),
+        ("float labels", np.arange(7.0)),
+    ]
 
 
-WRITER = re.compile(r"(save|write|atomic|plot_|keyframe)", re.IGNORECASE)  # labels of callables that write files
+WRITER = re.compile(
+    r"(save|write|atomic|plot_|keyframe)", re.IGNORECASE
+)  # labels of callables that write files
 
 
 def derived_nasty(valid, tmp: Path, writer: bool = True) -> list:
@@ -153,15 +306,26 @@ def derived_nasty(valid, tmp: Path, writer: bool = True) -> list:
         fifo = tmp / "a-fifo"
         if not fifo.exists():
             os.mkfifo(fifo)
-        if writer:  # never a system file: the sweep may run as root, and writing is what a writer does
+        if (
+            writer
+        ):  # never a system file: the sweep may run as root, and writing is what a writer does
             system = tmp / "system" / "passwd"
             system.parent.mkdir(exist_ok=True)
             system.write_text("root:x:0:0:root:/root:/bin/bash\n")
-            out += [("a system-like file", system), ("a FIFO", fifo), ("file:// URL", f"file://{tmp}/url.out"),
-                    ("missing folder", tmp / "missing" / "x.out")]
+            out += [
+                ("a system-like file", system),
+                ("a FIFO", fifo),
+                ("file:// URL", f"file://{tmp}/url.out"),
+                ("missing folder", tmp / "missing" / "x.out"),
+            ]
         else:
-            out += [("/etc/passwd", "/etc/passwd"), ("/dev/zero", "/dev/zero"), ("a FIFO", fifo),
-                    ("file:// URL", "file:///etc/passwd"), ("missing file", tmp / "missing" / "x.csv")]
+            out += [
+                ("/etc/passwd", "/etc/passwd"),
+                ("/dev/zero", "/dev/zero"),
+                ("a FIFO", fifo),
+                ("file:// URL", "file:///etc/passwd"),
+                ("missing file", tmp / "missing" / "x.csv"),
+            ]
     if isinstance(valid, dict):
         out += [("unknown key", {**valid, "bogus-key": 1.0}), ("list of the dict", [valid])]
     if isinstance(valid, (int, float)) and not isinstance(valid, bool):
@@ -177,27 +341,111 @@ def valid_arguments(tmp: Path) -> dict:
     centres = kernel_centres(10, 100, 0.01)
     rng = np.random.default_rng(0)
     return {
-        "y": DEMO, "demo": DEMO, "demonstration": DEMO, "trajectory": DEMO, "reference": DEMO, "a": DEMO, "b": DEMO[::-1],
-        "tra_imi": DEMO[20:45], "piece": DEMO[20:45], "points": DEMO, "positions": DEMO, "curve": DEMO, "path": tmp / "file.csv",
-        "via": DEMO[[0, 30, 59]], "t": TIMES, "stamps": TIMES, "goal": DEMO[-1] + 10, "target": DEMO[-1],
-        "new_target": DEMO[-1] + [150.0, 0.0, 0.0], "start": DEMO[0], "point": DEMO[5], "dt": 0.01, "n_steps": 50,
-        "n_kernels": 10, "seed": 0, "alpha": 25.0, "beta": 6.25, "K": 625.0, "tau": 1.0, "alpha_phase": 1.0, "height": 20.0,
-        "q": QUATS, "p": QUATS, "quaternions": QUATS, "poses": POSES, "phase": np.linspace(1.0, 0.05, 60), "centres": centres,
-        "widths": kernel_widths(centres), "span": 0.99, "name": "Sshape", "path_or_name": "nut-unscrewing", "noise": 0.1,
-        "segmentation_points": segment(DEMO).points, "orientations": QUATS, "n_samples": 60, "data": {"a": 1},
-        "source": "fuzz", "r": np.zeros((5, 3)), "error": np.zeros((5, 3)), "nodes": DEMO[::6],
-        "F": rng.normal(size=(40, 6)), "A": rng.normal(size=(30, 5)), "X": rng.normal(size=(30, 4)), "Y": rng.normal(size=(30, 2)),
-        "shape": "Sshape", "metric": "rmse", "rows": [], "recordings": [DEMO, DEMO * 1.1], "parts": [], "radius": 10.0,
-        "length": 100.0, "label": "post", "yd": np.gradient(DEMO, TIMES, axis=0), "ydd": np.zeros_like(DEMO),
-        "omega": np.zeros((60, 3)), "omega_dot": np.zeros((60, 3)), "rate": 1.0, "training_phase": np.linspace(1.0, 0.05, 60),
-        "gate": np.linspace(0.0, 1.0, 60), "exact": True, "gain": 0.5, "acceleration": np.ones(3), "joint": 2,
-        "heights": np.linspace(50.0, 0.0, 60), "goals": DEMO[-1] + np.array([[0.0, 0.0, 0.0], [10.0, 5.0, 0.0]]),
-        "part": "post", "targets": {"post": [200.0, 0.0, 50.0]}, "demonstrations": [DEMO, DEMO + [0.0, 30.0, 0.0]],
-        "weights": np.array([0.5, 0.5]), "means": np.array([[0.0, 0.0], [1.0, 1.0]]), "value_mm": 2.0, "units": "mm",
-        "covariances": np.array([np.eye(2), np.eye(2)]), "index": 1, "step": 0.01, "n_train": 60, "n_motion": 60,
-        "within": 20.0, "distance": 20.0, "exclude": (), "width": 64, "height_px": 48, "kind": "box", "centre": np.zeros(3),
-        "rotation": np.eye(3), "params": (10.0, 10.0, 10.0), "u_now": np.zeros(3), "u_next": np.zeros(3), "z": np.zeros(3),
-        "y_measured": DEMO[0], "n": 5, "threshold": 1.75, "offset": np.zeros(3), "duration": 1.0, "blend": 0.2,
+        "y": DEMO,
+        "demo": DEMO,
+        "demonstration": DEMO,
+        "trajectory": DEMO,
+        "reference": DEMO,
+        "a": DEMO,
+        "b": DEMO[::-1],
+        "tra_imi": DEMO[20:45],
+        "piece": DEMO[20:45],
+        "points": DEMO,
+        "positions": DEMO,
+        "curve": DEMO,
+        "path": tmp / "file.csv",
+        "via": DEMO[[0, 30, 59]],
+        "t": TIMES,
+        "stamps": TIMES,
+        "goal": DEMO[-1] + 10,
+        "target": DEMO[-1],
+        "new_target": DEMO[-1] + [150.0, 0.0, 0.0],
+        "start": DEMO[0],
+        "point": DEMO[5],
+        "dt": 0.01,
+        "n_steps": 50,
+        "n_kernels": 10,
+        "seed": 0,
+        "alpha": 25.0,
+        "beta": 6.25,
+        "K": 625.0,
+        "tau": 1.0,
+        "alpha_phase": 1.0,
+        "height": 20.0,
+        "q": QUATS,
+        "p": QUATS,
+        "quaternions": QUATS,
+        "poses": POSES,
+        "phase": np.linspace(1.0, 0.05, 60),
+        "centres": centres,
+        "widths": kernel_widths(centres),
+        "span": 0.99,
+        "name": "Sshape",
+        "path_or_name": "nut-unscrewing",
+        "noise": 0.1,
+        "segmentation_points": segment(DEMO).points,
+        "orientations": QUATS,
+        "n_samples": 60,
+        "data": {"a": 1},
+        "source": "fuzz",
+        "r": np.zeros((5, 3)),
+        "error": np.zeros((5, 3)),
+        "nodes": DEMO[::6],
+        "F": rng.normal(size=(40, 6)),
+        "A": rng.normal(size=(30, 5)),
+        "X": rng.normal(size=(30, 4)),
+        "Y": rng.normal(size=(30, 2)),
+        "shape": "Sshape",
+        "metric": "rmse",
+        "rows": [],
+        "recordings": [DEMO, DEMO * 1.1],
+        "parts": [],
+        "radius": 10.0,
+        "length": 100.0,
+        "label": "post",
+        "yd": np.gradient(DEMO, TIMES, axis=0),
+        "ydd": np.zeros_like(DEMO),
+        "omega": np.zeros((60, 3)),
+        "omega_dot": np.zeros((60, 3)),
+        "rate": 1.0,
+        "training_phase": np.linspace(1.0, 0.05, 60),
+        "gate": np.linspace(0.0, 1.0, 60),
+        "exact": True,
+        "gain": 0.5,
+        "acceleration": np.ones(3),
+        "joint": 2,
+        "heights": np.linspace(50.0, 0.0, 60),
+        "goals": DEMO[-1] + np.array([[0.0, 0.0, 0.0], [10.0, 5.0, 0.0]]),
+        "part": "post",
+        "targets": {"post": [200.0, 0.0, 50.0]},
+        "demonstrations": [DEMO, DEMO + [0.0, 30.0, 0.0]],
+        "weights": np.array([0.5, 0.5]),
+        "means": np.array([[0.0, 0.0], [1.0, 1.0]]),
+        "value_mm": 2.0,
+        "units": "mm",
+        "covariances": np.array([np.eye(2), np.eye(2)]),
+        "index": 1,
+        "step": 0.01,
+        "n_train": 60,
+        "n_motion": 60,
+        "within": 20.0,
+        "distance": 20.0,
+        "exclude": (),
+        "width": 64,
+        "height_px": 48,
+        "kind": "box",
+        "centre": np.zeros(3),
+        "rotation": np.eye(3),
+        "params": (10.0, 10.0, 10.0),
+        "u_now": np.zeros(3),
+        "u_next": np.zeros(3),
+        "z": np.zeros(3),
+        "y_measured": DEMO[0],
+        "n": 5,
+        "threshold": 1.75,
+        "offset": np.zeros(3),
+        "duration": 1.0,
+        "blend": 0.2,
     }
 
 
@@ -214,7 +462,11 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int):
             signature = inspect.signature(function)
         except (TypeError, ValueError):
             continue
-        parameters = [p for p in signature.parameters.values() if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+        parameters = [
+            p
+            for p in signature.parameters.values()
+            if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+        ]
         valid = {**common, **special}
         required = [p.name for p in parameters if p.default is inspect.Parameter.empty]
         if any(name not in valid for name in required):
@@ -227,7 +479,9 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int):
         options = {name: generic + derived_nasty(valid.get(name), tmp, writer) for name in names}
         for name in names:
             for nasty_label, value in options[name]:
-                singles.append((label, (name,), (nasty_label,), function, base, {name: value}, names))
+                singles.append(
+                    (label, (name,), (nasty_label,), function, base, {name: value}, names)
+                )
         for first, second in itertools.combinations(names, 2):
             pair_pool.append((label, function, base, names, first, second, options))
     yield from (_call(*single) for single in singles)
@@ -236,7 +490,15 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int):
             label, function, base, names, first, second, options = pair_pool[int(index)]
             a = options[first][int(rng.integers(len(options[first])))]
             b = options[second][int(rng.integers(len(options[second])))]
-            yield _call(label, (first, second), (a[0], b[0]), function, base, {first: a[1], second: b[1]}, names)
+            yield _call(
+                label,
+                (first, second),
+                (a[0], b[0]),
+                function,
+                base,
+                {first: a[1], second: b[1]},
+                names,
+            )
 
 
 def _call(label, swapped, nasty_labels, function, base, changes, names):
@@ -246,9 +508,13 @@ def _call(label, swapped, nasty_labels, function, base, changes, names):
 
 # Arguments whose refusals name them by the document they hold: a scene's keys under "scene", a
 # scenario's under "scenario", a robot's under "robot" (as in a scenario file, where these arrive from).
-ALIASES = {"Scene.from_dict": {"data": "scene"}, "bidmp.tasks.from_dict": {"data": "scenario"},
-           "bidmp.io.load_json": {"data": "fuzz"},  # a JSON document is named by its source
-           "bidmp.tasks.parse_job": {"data": "job"}, "bidmp.sim.robot_model": {"spec": "robot"}}
+ALIASES = {
+    "Scene.from_dict": {"data": "scene"},
+    "bidmp.tasks.from_dict": {"data": "scenario"},
+    "bidmp.io.load_json": {"data": "fuzz"},  # a JSON document is named by its source
+    "bidmp.tasks.parse_job": {"data": "job"},
+    "bidmp.sim.robot_model": {"spec": "robot"},
+}
 
 
 def names_argument(message: str, changes: dict, label: str = "") -> bool:
@@ -267,8 +533,11 @@ def names_argument(message: str, changes: dict, label: str = "") -> bool:
         if len(name) > 2:
             if re.search(rf"(?<![\w]){escaped}(?![\w])", message):
                 return True
-        elif re.search(rf"(?:^|[\s(`'\".]){escaped}(?:\s+(?:must|has|is|are|contains|needs|holds|of|with|should|and|"
-                       rf"gives|takes|would|was|were|can|cannot|does|lies|rows?|columns?|values?|\(|[/*+<>=-])|[:=\[,)'\"`.]|$)", message):
+        elif re.search(
+            rf"(?:^|[\s(`'\".]){escaped}(?:\s+(?:must|has|is|are|contains|needs|holds|of|with|should|and|"
+            rf"gives|takes|would|was|were|can|cannot|does|lies|rows?|columns?|values?|\(|[/*+<>=-])|[:=\[,)'\"`.]|$)",
+            message,
+        ):
             return True
     return False
 
@@ -294,8 +563,10 @@ def classify(call, changes: dict, allow_inf: bool = False, label: str = "") -> s
     """One call under the contract: its outcome class (:data:`CLASSES`)."""
     previous = None
     if threading.current_thread() is threading.main_thread():
+
         def alarm(*_):
             raise _Hang
+
         previous = signal.signal(signal.SIGALRM, alarm)
         signal.setitimer(signal.ITIMER_REAL, MAX_SECONDS)
     try:
@@ -325,7 +596,10 @@ def classify(call, changes: dict, allow_inf: bool = False, label: str = "") -> s
         if caught:
             return "leaked warning"
         try:
-            if not (allow_inf and isinstance(result, float) and result == np.inf) and label not in DOCUMENTED_ANY:
+            if (
+                not (allow_inf and isinstance(result, float) and result == np.inf)
+                and label not in DOCUMENTED_ANY
+            ):
                 check_finite(result)
         except AssertionError:
             return "silent NaN/inf"
@@ -338,7 +612,10 @@ def classify(call, changes: dict, allow_inf: bool = False, label: str = "") -> s
 
 def _system_files() -> dict:
     """Size and modification time of the system files a reader is offered (a writer never is)."""
-    return {path: (os.stat(path).st_size, os.stat(path).st_mtime_ns) for path in ("/etc/passwd", "/dev/zero")}
+    return {
+        path: (os.stat(path).st_size, os.stat(path).st_mtime_ns)
+        for path in ("/etc/passwd", "/dev/zero")
+    }
 
 
 def run(chosen) -> tuple[Counter, list]:
@@ -347,13 +624,17 @@ def run(chosen) -> tuple[Counter, list]:
     try:
         return _run(chosen)
     finally:
-        assert _system_files() == before, "the sweep changed a system file: a writer was offered one"
+        assert _system_files() == before, (
+            "the sweep changed a system file: a writer was offered one"
+        )
 
 
 def _run(chosen) -> tuple[Counter, list]:
     outcomes, defects = Counter(), []
     with bidmp.set_limits(max_array_bytes=256 << 20):
-        trail = os.environ.get("BIDMP_FUZZ_TRAIL")  # a file naming each call before it runs (a crash's culprit)
+        trail = os.environ.get(
+            "BIDMP_FUZZ_TRAIL"
+        )  # a file naming each call before it runs (a crash's culprit)
         for label, swapped, nasty_labels, thunk, _, changes in chosen:
             if trail:
                 with open(trail, "a", encoding="utf-8") as handle:
@@ -373,8 +654,13 @@ def packages_entry_points():
         module = importlib.import_module(package)
         for name in module.__all__:
             value = getattr(module, name)
-            if name in SKIPPED or f"{package}.{name}" in SKIPPED or inspect.ismodule(value) or not callable(value) \
-                    or id(value) in seen:
+            if (
+                name in SKIPPED
+                or f"{package}.{name}" in SKIPPED
+                or inspect.ismodule(value)
+                or not callable(value)
+                or id(value) in seen
+            ):
                 continue
             if inspect.isclass(value) and issubclass(value, BaseException):
                 continue

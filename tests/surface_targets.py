@@ -8,9 +8,9 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+from surface_sweep import DEMO, POSES, QUATS, SKIPPED, SKIPPED_METHODS, TIMES, packages_entry_points
 
 import bidmp
-from surface_sweep import DEMO, POSES, QUATS, SKIPPED, SKIPPED_METHODS, TIMES, packages_entry_points
 
 
 def _package_overrides(tmp: Path) -> dict:
@@ -31,92 +31,195 @@ def _package_overrides(tmp: Path) -> dict:
     from bidmp.io import write_bag
 
     bag = write_bag(tmp / "poses_bag", TIMES, DEMO / 1000.0, kind="pose")
-    readers = {f"bidmp.io.{name}": {"path": csv} for name in ("load_trajectory", "read_trajectory", "declared_units",
-                                                                "is_joint_recording", "read_recording",
-                                                                "recording_kind")}
+    readers = {
+        f"bidmp.io.{name}": {"path": csv}
+        for name in (
+            "load_trajectory",
+            "read_trajectory",
+            "declared_units",
+            "is_joint_recording",
+            "read_recording",
+            "recording_kind",
+        )
+    }
     rng = np.random.default_rng(3)
     A, E = rng.normal(size=(30, 5)), rng.normal(size=(30, 2))
     U, sv, V, _ = truncated_svd(A)
     dmp = bidmp.DMP(n_kernels=10).fit(DEMO)
-    joint = {"lower": -np.ones(7), "upper": np.ones(7), "velocity": np.ones(7), "acceleration": np.ones(7)}
+    joint = {
+        "lower": -np.ones(7),
+        "upper": np.ones(7),
+        "velocity": np.ones(7),
+        "acceleration": np.ones(7),
+    }
     scenario = bidmp.tasks.load("nut-unscrewing")
     joints = np.zeros((60, 7))
-    return {**readers, "bidmp.io.read_poses": {"path": poses}, "bidmp.load": {"path": model},
-            "bidmp.Scene": {"tool": Tool(5.0, 50.0)}, "bidmp.save": {"model": dmp, "path": tmp / "saved.npz"},
-            "bidmp.forgetting": {"dmp": dmp},
-            "bidmp.incremental.block_pinv_update": {"A": A, "A_pinv": np.linalg.pinv(A), "E": E},
-            "bidmp.incremental.svd_update": {"U": U, "s": sv, "V": V, "E": E},
-            "bidmp.incremental.pose_forgetting": {"cartesian": bidmp.CartesianDMP(n_kernels=10).fit(POSES),
-                                                   "demonstrations": [POSES, POSES + [0.0, 30.0, 0.0, 0.0, 0.0, 0.0, 0.0]]},
-            "bidmp.sim.JointLimits": joint, "bidmp.sim.robot_placement": {"scenario": scenario},
-            "bidmp.sim.robot_model": {"spec": {"model": "xarm6"}}, "bidmp.sim.job_targets": {"scenario": scenario},
-            "bidmp.sim.target_labels": {"scenario": scenario, "targets": ["1", "3"]},
-            "bidmp.sim.in_bin": {"centre": [1.0, 2.0, 5.0], "floor": [0.0, 0.0, 0.0], "inner": [60.0, 60.0, 40.0]},
-            "bidmp.sim.in_slot": {"centre": [1.0, 0.0, 20.0], "slot": [0.0, 0.0, 0.0], "height": 40.0,
-                                  "off_tolerance": 2.0, "height_tolerance": 1.0},
-            "bidmp.sim.inverse_kinematics": {"points": np.array([[0.45, -0.1, 0.3], [0.5, 0.0, 0.3]])},
-            "bidmp.sim.joint_names": {"robot": "panda"}, "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
-            "bidmp.sim.RobotCell": {"scene": scenario.scene},
-            "bidmp.io.load_model": {"path": model}, "bidmp.plotting.plot_segmentation": {"points": segment(DEMO).points},
-            "bidmp.plotting.load_layers": {"path": layers}, "bidmp.plotting.save_layers": {"path": tmp / "l2.npz",
-                                                                                          "layers": ViewLayers("x", "mm", DEMO)},
-            "bidmp.plotting.write_view": {"path": tmp / "v.html", "layers": ViewLayers("x", "mm", DEMO)},
-            "bidmp.plotting.view_figure": {"layers": ViewLayers("x", "mm", DEMO)},
-            "bidmp.plotting.solid_layer": {"solid": scenario.scene.solids[0]},
-            "bidmp.plotting.solid_mesh": {"kind": "box", "centre": np.zeros(3), "rotation": np.eye(3), "params": (5.0, 5.0, 5.0)},
-            "bidmp.plotting.plot_trajectories": {"path": tmp / "p.png"}, "bidmp.plotting.plot_rollout":
-                {"path": tmp / "r.png", "trajectory": dmp.trajectory()},
-            "bidmp.plotting.plot_recordings": {"path": tmp / "rec.png", "recordings": [
-                ("demo", DEMO, TIMES, *bidmp.prepare(DEMO, TIMES), None)]},
-            "bidmp.io.save_poses": {"poses": POSES, "path": tmp / "p.csv"}, "bidmp.io.save_trajectory": {"path": tmp / "t.csv"},
-            "bidmp.io.write_bag": {"path": tmp / "b.bag", "t": TIMES, "values": joints, "kind": "joints",
-                                   "names": [f"j{i}" for i in range(7)]},
-            "bidmp.io.read_bag": {"path": bag}, "bidmp.io.is_bag": {"path": bag},
-            "bidmp.io.atomic_write": {"path": tmp / "a.bin"},
-            "bidmp.io.load_json": {"data": '{"a": 1}'},
-            "bidmp.primitives.as_poses": {"poses": POSES},
-            **{f"bidmp.primitives.{name}": {"goal": QUATS[-1]} for name in ("principal_log", "continuous_log",
-                                                                           "orientation_error", "orientation_from_log")},
-            "bidmp.primitives.DMPStepper": {"dmp": dmp, "goal": DEMO[-1], "start": DEMO[0], "duration": 1.0, "coupling": 0.0,
-                                            "start_velocity": None, "forcing_increment": None},
-            "bidmp.primitives.PoseStepper": {"position": dmp.stepper(), "orientation": np.array([0.0, 0.0, 0.0, 1.0]),
-                                             "goal_orientation": np.array([0.0, 0.0, 0.0, 1.0])},
-            "bidmp.primitives.ProgressGate": {"training_phase": np.linspace(1.0, 0.05, 60), "gate": np.linspace(0.0, 1.0, 60)},
-            "bidmp.primitives.ApproachGate": {"training_phase": np.linspace(1.0, 0.05, 60), "gate": np.linspace(0.0, 1.0, 60)},
-            "bidmp.primitives.StepIntegrator": {"alpha": 25.0, "beta": 6.25, "tau": 1.0, "exact": True},
-            "bidmp.primitives.time_scale": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
-            "bidmp.time_scale": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
-            "bidmp.primitives.scale_factor": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
-            "bidmp.primitives.on_uniform_time": {"y": DEMO, "t": TIMES},
-            "bidmp.extension.extend_pose_demonstration": {"poses": POSES, "new_target": POSES[-1] + [150.0, 0, 0, 0, 0, 0, 0]},
-            "bidmp.incremental.sparse_autoencoder": {"F": rng.normal(size=(40, 6)), "target": rng.normal(size=(40, 3))},
-            "bidmp.tasks.carried_clearance": {"scene": scenario.scene, "path": DEMO, "exclude": ()},
-            "bidmp.tasks.Contract": {"threshold": 1.75},
-            "bidmp.tasks.command_peaks": {"commands": np.zeros((50, 7)), "limits": _panda_limits()},
-            "bidmp.tasks.parse_job": {"data": scenario.spec.get("job"), "source": "fuzz"},
-            "bidmp.tasks.tour": {"points": DEMO[::6], "start": DEMO[0]},
-            "bidmp.tasks.JobSpec": {"kind": "unscrew", "steps": ("approach", "engage", "unscrew", "retract", "drop"),
-                                    "bin": (np.zeros(3), np.array([70.0, 70.0, 40.0]))},
-            "bidmp.tasks.from_dict": {"data": scenario.spec},
-            "bidmp.tasks.Repairer": {"contract": bidmp.tasks.Contract.of(scenario), "demonstration": scenario.demonstration},
-            "bidmp.tasks.methods.get": {"name": "dmp"}, "bidmp.tasks.methods.Task": {"demonstration": DEMO, "goals": DEMO[-2:]},
-            "bidmp.tasks.final_approach_mask": {"heights": np.linspace(50.0, 0.0, 60), "height": 20.0},
-            "bidmp.experiments.random_case": {"seed": 3}, "bidmp.experiments.cell_key": {"shape": "Sshape", "demo": 0},
-            "bidmp.experiments.summary_rows": {"rows": [], "metric": "rmse"},
-            "bidmp.experiments.summary_markdown": {"rows": [], "protocol": {}},
-            "bidmp.scene.SceneChecker": {"scene": scenario.scene, "chosen": np.arange(3)},
-            "bidmp.scene.Proximity": {"scene": scenario.scene},
-            "bidmp.scene.random_field": {"rng": np.random.default_rng(0), "start": DEMO[0], "goal": DEMO[-1],
-                                         "tool": {"radius": 5.0, "length": 50.0}, "margin": 1.0},
-            "bidmp.SceneAvoidance": {"scene": scenario.scene}, "bidmp.Tool": {"radius": 5.0, "length": 50.0},
-            "bidmp.demonstrations.kinesthetic_recording": {"via": DEMO[[0, 30, 59]]},
-            "bidmp.demonstrations.recording": {"name": "operator1_nut3"},
-            "bidmp.demonstrations.recording_path": {"name": "operator1_nut3"},
-            "bidmp.demonstrations.prepare_poses": {"poses": POSES, "t": TIMES},
-            "bidmp.prepare": {"y": DEMO, "t": TIMES},
-            "bidmp.sim.Hold": {"joint": 2, "start": 0.5}, "bidmp.sim.GoalUpdate": {"time": 0.5, "offset": (0.0, 0.0, 1.0)},
-            "bidmp.sim.RobotModel": {"name": "x", "urdf": "franka_panda/panda.urdf", "flange": "panda_link8",
-                                     "limits": _panda_limits(), "rest": (0.0,) * 7, "effort": (87.0,) * 7}}
+    return {
+        **readers,
+        "bidmp.io.read_poses": {"path": poses},
+        "bidmp.load": {"path": model},
+        "bidmp.Scene": {"tool": Tool(5.0, 50.0)},
+        "bidmp.save": {"model": dmp, "path": tmp / "saved.npz"},
+        "bidmp.forgetting": {"dmp": dmp},
+        "bidmp.incremental.block_pinv_update": {"A": A, "A_pinv": np.linalg.pinv(A), "E": E},
+        "bidmp.incremental.svd_update": {"U": U, "s": sv, "V": V, "E": E},
+        "bidmp.incremental.pose_forgetting": {
+            "cartesian": bidmp.CartesianDMP(n_kernels=10).fit(POSES),
+            "demonstrations": [POSES, POSES + [0.0, 30.0, 0.0, 0.0, 0.0, 0.0, 0.0]],
+        },
+        "bidmp.sim.JointLimits": joint,
+        "bidmp.sim.robot_placement": {"scenario": scenario},
+        "bidmp.sim.robot_model": {"spec": {"model": "xarm6"}},
+        "bidmp.sim.job_targets": {"scenario": scenario},
+        "bidmp.sim.target_labels": {"scenario": scenario, "targets": ["1", "3"]},
+        "bidmp.sim.in_bin": {
+            "centre": [1.0, 2.0, 5.0],
+            "floor": [0.0, 0.0, 0.0],
+            "inner": [60.0, 60.0, 40.0],
+        },
+        "bidmp.sim.in_slot": {
+            "centre": [1.0, 0.0, 20.0],
+            "slot": [0.0, 0.0, 0.0],
+            "height": 40.0,
+            "off_tolerance": 2.0,
+            "height_tolerance": 1.0,
+        },
+        "bidmp.sim.inverse_kinematics": {"points": np.array([[0.45, -0.1, 0.3], [0.5, 0.0, 0.3]])},
+        "bidmp.sim.joint_names": {"robot": "panda"},
+        "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
+        "bidmp.sim.RobotCell": {"scene": scenario.scene},
+        "bidmp.io.load_model": {"path": model},
+        "bidmp.plotting.plot_segmentation": {"points": segment(DEMO).points},
+        "bidmp.plotting.load_layers": {"path": layers},
+        "bidmp.plotting.save_layers": {
+            "path": tmp / "l2.npz",
+            "layers": ViewLayers("x", "mm", DEMO),
+        },
+        "bidmp.plotting.write_view": {
+            "path": tmp / "v.html",
+            "layers": ViewLayers("x", "mm", DEMO),
+        },
+        "bidmp.plotting.view_figure": {"layers": ViewLayers("x", "mm", DEMO)},
+        "bidmp.plotting.solid_layer": {"solid": scenario.scene.solids[0]},
+        "bidmp.plotting.solid_mesh": {
+            "kind": "box",
+            "centre": np.zeros(3),
+            "rotation": np.eye(3),
+            "params": (5.0, 5.0, 5.0),
+        },
+        "bidmp.plotting.plot_trajectories": {"path": tmp / "p.png"},
+        "bidmp.plotting.plot_rollout": {"path": tmp / "r.png", "trajectory": dmp.trajectory()},
+        "bidmp.plotting.plot_recordings": {
+            "path": tmp / "rec.png",
+            "recordings": [("demo", DEMO, TIMES, *bidmp.prepare(DEMO, TIMES), None)],
+        },
+        "bidmp.io.save_poses": {"poses": POSES, "path": tmp / "p.csv"},
+        "bidmp.io.save_trajectory": {"path": tmp / "t.csv"},
+        "bidmp.io.write_bag": {
+            "path": tmp / "b.bag",
+            "t": TIMES,
+            "values": joints,
+            "kind": "joints",
+            "names": [f"j{i}" for i in range(7)],
+        },
+        "bidmp.io.read_bag": {"path": bag},
+        "bidmp.io.is_bag": {"path": bag},
+        "bidmp.io.atomic_write": {"path": tmp / "a.bin"},
+        "bidmp.io.load_json": {"data": '{"a": 1}'},
+        "bidmp.primitives.as_poses": {"poses": POSES},
+        **{
+            f"bidmp.primitives.{name}": {"goal": QUATS[-1]}
+            for name in (
+                "principal_log",
+                "continuous_log",
+                "orientation_error",
+                "orientation_from_log",
+            )
+        },
+        "bidmp.primitives.DMPStepper": {
+            "dmp": dmp,
+            "goal": DEMO[-1],
+            "start": DEMO[0],
+            "duration": 1.0,
+            "coupling": 0.0,
+            "start_velocity": None,
+            "forcing_increment": None,
+        },
+        "bidmp.primitives.PoseStepper": {
+            "position": dmp.stepper(),
+            "orientation": np.array([0.0, 0.0, 0.0, 1.0]),
+            "goal_orientation": np.array([0.0, 0.0, 0.0, 1.0]),
+        },
+        "bidmp.primitives.ProgressGate": {
+            "training_phase": np.linspace(1.0, 0.05, 60),
+            "gate": np.linspace(0.0, 1.0, 60),
+        },
+        "bidmp.primitives.ApproachGate": {
+            "training_phase": np.linspace(1.0, 0.05, 60),
+            "gate": np.linspace(0.0, 1.0, 60),
+        },
+        "bidmp.primitives.StepIntegrator": {"alpha": 25.0, "beta": 6.25, "tau": 1.0, "exact": True},
+        "bidmp.primitives.time_scale": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
+        "bidmp.time_scale": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
+        "bidmp.primitives.scale_factor": {"trajectory": dmp.trajectory(), "max_velocity": 100.0},
+        "bidmp.primitives.on_uniform_time": {"y": DEMO, "t": TIMES},
+        "bidmp.extension.extend_pose_demonstration": {
+            "poses": POSES,
+            "new_target": POSES[-1] + [150.0, 0, 0, 0, 0, 0, 0],
+        },
+        "bidmp.incremental.sparse_autoencoder": {
+            "F": rng.normal(size=(40, 6)),
+            "target": rng.normal(size=(40, 3)),
+        },
+        "bidmp.tasks.carried_clearance": {"scene": scenario.scene, "path": DEMO, "exclude": ()},
+        "bidmp.tasks.Contract": {"threshold": 1.75},
+        "bidmp.tasks.command_peaks": {"commands": np.zeros((50, 7)), "limits": _panda_limits()},
+        "bidmp.tasks.parse_job": {"data": scenario.spec.get("job"), "source": "fuzz"},
+        "bidmp.tasks.tour": {"points": DEMO[::6], "start": DEMO[0]},
+        "bidmp.tasks.JobSpec": {
+            "kind": "unscrew",
+            "steps": ("approach", "engage", "unscrew", "retract", "drop"),
+            "bin": (np.zeros(3), np.array([70.0, 70.0, 40.0])),
+        },
+        "bidmp.tasks.from_dict": {"data": scenario.spec},
+        "bidmp.tasks.Repairer": {
+            "contract": bidmp.tasks.Contract.of(scenario),
+            "demonstration": scenario.demonstration,
+        },
+        "bidmp.tasks.methods.get": {"name": "dmp"},
+        "bidmp.tasks.methods.Task": {"demonstration": DEMO, "goals": DEMO[-2:]},
+        "bidmp.tasks.final_approach_mask": {"heights": np.linspace(50.0, 0.0, 60), "height": 20.0},
+        "bidmp.experiments.random_case": {"seed": 3},
+        "bidmp.experiments.cell_key": {"shape": "Sshape", "demo": 0},
+        "bidmp.experiments.summary_rows": {"rows": [], "metric": "rmse"},
+        "bidmp.experiments.summary_markdown": {"rows": [], "protocol": {}},
+        "bidmp.scene.SceneChecker": {"scene": scenario.scene, "chosen": np.arange(3)},
+        "bidmp.scene.Proximity": {"scene": scenario.scene},
+        "bidmp.scene.random_field": {
+            "rng": np.random.default_rng(0),
+            "start": DEMO[0],
+            "goal": DEMO[-1],
+            "tool": {"radius": 5.0, "length": 50.0},
+            "margin": 1.0,
+        },
+        "bidmp.SceneAvoidance": {"scene": scenario.scene},
+        "bidmp.Tool": {"radius": 5.0, "length": 50.0},
+        "bidmp.demonstrations.kinesthetic_recording": {"via": DEMO[[0, 30, 59]]},
+        "bidmp.demonstrations.recording": {"name": "operator1_nut3"},
+        "bidmp.demonstrations.recording_path": {"name": "operator1_nut3"},
+        "bidmp.demonstrations.prepare_poses": {"poses": POSES, "t": TIMES},
+        "bidmp.prepare": {"y": DEMO, "t": TIMES},
+        "bidmp.sim.Hold": {"joint": 2, "start": 0.5},
+        "bidmp.sim.GoalUpdate": {"time": 0.5, "offset": (0.0, 0.0, 1.0)},
+        "bidmp.sim.RobotModel": {
+            "name": "x",
+            "urdf": "franka_panda/panda.urdf",
+            "flange": "panda_link8",
+            "limits": _panda_limits(),
+            "rest": (0.0,) * 7,
+            "effort": (87.0,) * 7,
+        },
+    }
 
 
 def _panda_limits():
@@ -128,6 +231,7 @@ def _panda_limits():
 def _fitting(cls, fit_args: tuple):
     """A function of ``cls``'s parameters that builds the estimator and fits it to ``fit_args``:
     where scikit-learn's conventions validate parameters."""
+
     def fit(**params):
         return cls(**params).fit(*fit_args)
 
@@ -136,21 +240,32 @@ def _fitting(cls, fit_args: tuple):
 
 
 def _estimators():
-    from bidmp.baselines import GMMRegressor, TPGMM
+    from bidmp.baselines import TPGMM, GMMRegressor
     from bidmp.incremental import BLS
 
     rng = np.random.default_rng(1)
-    return [("DMP", bidmp.DMP, (DEMO, TIMES)), ("CartesianDMP", bidmp.CartesianDMP, (POSES, TIMES)),
-            ("BiDMP", bidmp.BiDMP, (DEMO,)), ("CartesianBiDMP", bidmp.CartesianBiDMP, (POSES, TIMES)),
-            ("BLS", BLS, (rng.normal(size=(40, 3)), rng.normal(size=(40, 2)))),
-            ("GMMRegressor", GMMRegressor, (DEMO,)), ("TPGMM", TPGMM, (DEMO,))]
+    return [
+        ("DMP", bidmp.DMP, (DEMO, TIMES)),
+        ("CartesianDMP", bidmp.CartesianDMP, (POSES, TIMES)),
+        ("BiDMP", bidmp.BiDMP, (DEMO,)),
+        ("CartesianBiDMP", bidmp.CartesianBiDMP, (POSES, TIMES)),
+        ("BLS", BLS, (rng.normal(size=(40, 3)), rng.normal(size=(40, 2)))),
+        ("GMMRegressor", GMMRegressor, (DEMO,)),
+        ("TPGMM", TPGMM, (DEMO,)),
+    ]
 
 
 def _instances(tmp: Path):
     """(owner, instance, valid arguments of its methods) for the objects the library hands out."""
-    from bidmp.baselines import GMMRegressor, TPGMM
+    from bidmp.baselines import TPGMM, GMMRegressor
     from bidmp.incremental import BLS
-    from bidmp.primitives import ConstantAcceleration, DelayedGoal, PhaseGate, PhaseStopping, StepIntegrator
+    from bidmp.primitives import (
+        ConstantAcceleration,
+        DelayedGoal,
+        PhaseGate,
+        PhaseStopping,
+        StepIntegrator,
+    )
     from bidmp.scene import Proximity, Scene
     from bidmp.tasks import Contract, Repairer, methods
 
@@ -158,10 +273,30 @@ def _instances(tmp: Path):
     dmp = bidmp.DMP(n_kernels=20).fit(DEMO, TIMES, units="mm")
     pose = bidmp.CartesianDMP(n_kernels=20).fit(POSES, TIMES)
     model = bidmp.BiDMP(bidmp.DMP(n_kernels=20).fit(DEMO)).learn(DEMO + [0.0, 40.0, 0.0])
-    pose_model = bidmp.CartesianBiDMP().fit(POSES, TIMES).learn(POSES + [0.0, 40.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 50.0}, "margin": 1.0,
-                             "parts": [{"type": "cylinder", "label": "post", "at": [200.0, 0.0, 0.0], "radius": 5.0, "height": 50.0},
-                                       {"type": "box", "label": "beam", "at": [50.0, 0.0, 120.0], "size": [10.0, 80.0, 10.0]}]})
+    pose_model = (
+        bidmp.CartesianBiDMP().fit(POSES, TIMES).learn(POSES + [0.0, 40.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    )
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 5.0, "length": 50.0},
+            "margin": 1.0,
+            "parts": [
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [200.0, 0.0, 0.0],
+                    "radius": 5.0,
+                    "height": 50.0,
+                },
+                {
+                    "type": "box",
+                    "label": "beam",
+                    "at": [50.0, 0.0, 120.0],
+                    "size": [10.0, 80.0, 10.0],
+                },
+            ],
+        }
+    )
     scenario = bidmp.tasks.load("nut-unscrewing")
     contract = Contract.of(scenario)
     X = rng.normal(size=(40, 3))
@@ -169,51 +304,137 @@ def _instances(tmp: Path):
     task = methods.Task(demonstration=DEMO, goals=DEMO[-2:])
     dmp_method = methods.get("dmp")
     method_model, _ = dmp_method.fit(task)
-    goal_args = {"gate": 0.5, "phase": 0.5, "step": 0.01, "tau": 1.0, "exact": True, "n_train": 60, "dt": 0.01}
-    yield "DMP", dmp, {"phase": np.linspace(1.0, 0.05, 60), "goals": DEMO[-1] + np.zeros((3, 3)), "y": DEMO}
+    goal_args = {
+        "gate": 0.5,
+        "phase": 0.5,
+        "step": 0.01,
+        "tau": 1.0,
+        "exact": True,
+        "n_train": 60,
+        "dt": 0.01,
+    }
+    yield (
+        "DMP",
+        dmp,
+        {"phase": np.linspace(1.0, 0.05, 60), "goals": DEMO[-1] + np.zeros((3, 3)), "y": DEMO},
+    )
     yield "CartesianDMP", pose, {"goal": POSES[-1], "start": POSES[0]}
-    yield "BiDMP", model, {"goal": DEMO[-1] + [0.0, 40.0, 0.0], "y_dn": DEMO + [0.0, 20.0, 0.0],
-                           "forcing_increment": np.zeros((model.dmp.n_train_, 3)), "phase": np.linspace(1.0, 0.05, 60)}
-    yield "CartesianBiDMP", pose_model, {"goal": POSES[-1], "start": POSES[0], "poses": POSES + [0.0, 20.0, 0.0, 0, 0, 0, 0]}
+    yield (
+        "BiDMP",
+        model,
+        {
+            "goal": DEMO[-1] + [0.0, 40.0, 0.0],
+            "y_dn": DEMO + [0.0, 20.0, 0.0],
+            "forcing_increment": np.zeros((model.dmp.n_train_, 3)),
+            "phase": np.linspace(1.0, 0.05, 60),
+        },
+    )
+    yield (
+        "CartesianBiDMP",
+        pose_model,
+        {"goal": POSES[-1], "start": POSES[0], "poses": POSES + [0.0, 20.0, 0.0, 0, 0, 0, 0]},
+    )
     yield "BLS", bls, {"X": X, "n": 5}
     yield "GMMRegressor", GMMRegressor(n_components=3).fit(DEMO), {"goal": None}
     yield "TPGMM", TPGMM(n_components=3).fit(DEMO), {"goal": DEMO[-1] + 5.0}
-    yield "Scene", scene, {"part": "post", "label": "post", "tool": bidmp.Tool(4.0, 40.0), "targets": {"post": [200.0, 0.0, 50.0]},
-                           "solid": scene.solids[0], "data": scene.to_dict(), "trajectory": DEMO, "offset": np.zeros(3)}
+    yield (
+        "Scene",
+        scene,
+        {
+            "part": "post",
+            "label": "post",
+            "tool": bidmp.Tool(4.0, 40.0),
+            "targets": {"post": [200.0, 0.0, 50.0]},
+            "solid": scene.solids[0],
+            "data": scene.to_dict(),
+            "trajectory": DEMO,
+            "offset": np.zeros(3),
+        },
+    )
     yield "SceneChecker", scene.checker(), {"a": DEMO[:-1], "b": DEMO[1:]}
     yield "Proximity", Proximity(scene), {"point": DEMO[5], "within": 20.0}
     yield "Solid", scene.solids[0], {"centre": np.zeros(3), "rotation": np.eye(3)}
-    yield "SceneAvoidance", bidmp.SceneAvoidance(scene), {"stepper": dmp.stepper(), "trajectory": dmp.trajectory()}
+    yield (
+        "SceneAvoidance",
+        bidmp.SceneAvoidance(scene),
+        {"stepper": dmp.stepper(), "trajectory": dmp.trajectory()},
+    )
     yield "DMPStepper", dmp.stepper(), {"dt": 0.01, "goal": DEMO[-1] + 5.0}
     yield "PoseStepper", pose.stepper(), {"dt": 0.01, "pose": POSES[-1]}
     yield "Trajectory", dmp.trajectory(), {}
     yield "PoseTrajectory", pose.trajectory(), {}
     yield "PhaseGate", PhaseGate(2.0), goal_args
     yield "DelayedGoal", DelayedGoal(2.0), goal_args
-    yield "ProgressGate", dmp.goal_system(), {**goal_args, "on_grid:phase": np.linspace(1.0, 0.05, 60), "n_train": dmp.n_train_}
-    yield "StepIntegrator", StepIntegrator(25.0, 6.25, 1.0, True), {"y": np.zeros(3), "z": np.zeros(3)}
+    yield (
+        "ProgressGate",
+        dmp.goal_system(),
+        {**goal_args, "on_grid:phase": np.linspace(1.0, 0.05, 60), "n_train": dmp.n_train_},
+    )
+    yield (
+        "StepIntegrator",
+        StepIntegrator(25.0, 6.25, 1.0, True),
+        {"y": np.zeros(3), "z": np.zeros(3)},
+    )
     yield "PhaseStopping", PhaseStopping(0.5), {"y": DEMO[0], "y_measured": DEMO[0] + 1.0}
     yield "ConstantAcceleration", ConstantAcceleration(np.ones(3)), {}
-    yield "Contract", contract, {"path": scenario.demonstration, "target": scenario.targets["3"], "label": "3",
-                                 "scenario": scenario}
-    yield "Repairer", Repairer(contract, scenario.demonstration), {"goal": scenario.targets["3"], "axis": None,
-                                                                    "exclude": ["3"], "model": dmp}
+    yield (
+        "Contract",
+        contract,
+        {
+            "path": scenario.demonstration,
+            "target": scenario.targets["3"],
+            "label": "3",
+            "scenario": scenario,
+        },
+    )
+    yield (
+        "Repairer",
+        Repairer(contract, scenario.demonstration),
+        {"goal": scenario.targets["3"], "axis": None, "exclude": ["3"], "model": dmp},
+    )
     yield "JobSpec", scenario.job, {"index": 1}
     yield "Scenario", scenario, {"label": "3"}
-    yield "Method", dmp_method, {"model": method_model, "goal": DEMO[-1] + 5.0, "goals": DEMO[-1] + np.zeros((3, 3)),
-                                 "duration": 1.0, "coupling": 0.0, "kinds": (bidmp.DMP,), "what": "a fitted DMP"}
+    yield (
+        "Method",
+        dmp_method,
+        {
+            "model": method_model,
+            "goal": DEMO[-1] + 5.0,
+            "goals": DEMO[-1] + np.zeros((3, 3)),
+            "duration": 1.0,
+            "coupling": 0.0,
+            "kinds": (bidmp.DMP,),
+            "what": "a fitted DMP",
+        },
+    )
     yield "Task", task, {}
     from bidmp.extension import extend_demonstration
 
-    yield "ExtendedDemonstration", extend_demonstration(DEMO, DEMO[-1] + [150.0, 0.0, 0.0], seed=0), {"dmp": dmp}
+    yield (
+        "ExtendedDemonstration",
+        extend_demonstration(DEMO, DEMO[-1] + [150.0, 0.0, 0.0], seed=0),
+        {"dmp": dmp},
+    )
     try:
         from bidmp.sim import RobotCell
     except ImportError:
         return
     cell = RobotCell(scenario.scene)
     q = np.array(cell.model.rest, dtype=float)
-    yield "RobotCell", cell, {"q": q, "point_m": np.array([0.1, -0.1, 0.2]), "seed": q, "path": scenario.demonstration[::20],
-                              "t": 0.5, "focus": np.zeros(3), "width": 64, "height": 48}
+    yield (
+        "RobotCell",
+        cell,
+        {
+            "q": q,
+            "point_m": np.array([0.1, -0.1, 0.2]),
+            "seed": q,
+            "path": scenario.demonstration[::20],
+            "t": 0.5,
+            "focus": np.zeros(3),
+            "width": 64,
+            "height": 48,
+        },
+    )
 
 
 def targets(tmp: Path):
@@ -226,10 +447,22 @@ def targets(tmp: Path):
     for owner, instance, special in _instances(tmp):
         for name, member in inspect.getmembers(type(instance)):
             label = f"{owner}.{name}"
-            if (name.startswith("_") or not callable(member) or isinstance(member, type) or name in SKIPPED
-                    or label in SKIPPED_METHODS or name in ("fit", "learn", "set_params")):
+            if (
+                name.startswith("_")
+                or not callable(member)
+                or isinstance(member, type)
+                or name in SKIPPED
+                or label in SKIPPED_METHODS
+                or name in ("fit", "learn", "set_params")
+            ):
                 continue
             # "method:argument" keys give one method's argument a value of its own
             own = {key: value for key, value in special.items() if ":" not in key}
-            own.update({key.split(":", 1)[1]: value for key, value in special.items() if key.startswith(f"{name}:")})
+            own.update(
+                {
+                    key.split(":", 1)[1]: value
+                    for key, value in special.items()
+                    if key.startswith(f"{name}:")
+                }
+            )
             yield label, getattr(instance, name), own

@@ -10,10 +10,10 @@ gate fails the same checks (so they can fail).
 
 import numpy as np
 import pytest
-from bidmp.demonstrations import minimum_jerk
 from sklearn.base import clone
 
 import bidmp
+from bidmp.demonstrations import minimum_jerk
 from bidmp.primitives.approach import _straight_tail_start
 
 
@@ -27,7 +27,13 @@ def pick_demo(rng, approach_length=60.0, rate=250.0, scale=1.0):
     axis = np.array([*rng.normal(scale=0.3, size=2), 1.0])
     axis /= np.linalg.norm(axis)
     above = approach_length * axis
-    via = np.vstack([rng.uniform(-150, 150, 3) + [0.0, 0.0, 250.0], rng.uniform(-60, 60, 3) + [0.0, 0.0, 150.0], above])
+    via = np.vstack(
+        [
+            rng.uniform(-150, 150, 3) + [0.0, 0.0, 250.0],
+            rng.uniform(-60, 60, 3) + [0.0, 0.0, 150.0],
+            above,
+        ]
+    )
     transfer = minimum_jerk(via, n_steps=int(rng.integers(200, 400)))
     n_approach = int(rng.integers(80, 160))
     approach = above * (1.0 - smooth(np.linspace(0.0, 1.0, n_approach)))[:, None]
@@ -68,20 +74,26 @@ def test_the_goal_share_is_monotone_and_complete_at_the_approach(seed):
     delta = np.array([0.1, -0.05, 0.02])
     base = model.trajectory(model.goal_, dt=0.004)
     moved = model.trajectory(model.goal_ + delta, dt=0.004)
-    share = ((moved.y - base.y) @ delta) / (delta @ delta)  # R(t): the rollout is affine in the goal
+    share = ((moved.y - base.y) @ delta) / (
+        delta @ delta
+    )  # R(t): the rollout is affine in the goal
     # The gate is built from R by finite differences: its response is R to 1e-4 (the progress gate's
     # stated bound, README "Robot protocol"), so "monotone" and "in [0, 1]" hold to that.
     assert share.min() >= -2e-4 and share.max() <= 1.0 + 2e-4
     assert np.all(np.diff(share) >= -2e-4)  # never backwards
     start = _straight_tail_start(y)
-    assert abs(start - approach_start) <= 0.05 * len(y)  # the detector finds the demonstrated approach
+    assert abs(start - approach_start) <= 0.05 * len(
+        y
+    )  # the detector finds the demonstrated approach
     approach_time = t[start] - t[0]
     np.testing.assert_allclose(share[base.t >= approach_time], 1.0, atol=2e-4)
 
 
 def test_without_a_straight_approach_the_progress_gate_is_kept():
     s = np.linspace(0.0, 1.0, 300)
-    curved = np.column_stack([100 * np.cos(6 * s), 100 * np.sin(6 * s), 50 * s])  # an arc to the end
+    curved = np.column_stack(
+        [100 * np.cos(6 * s), 100 * np.sin(6 * s), 50 * s]
+    )  # an arc to the end
     # Its last few samples are straight to 2 % of their short chord, but far shorter than an approach.
     assert len(curved) - _straight_tail_start(curved) < 0.05 * len(curved)
     keep = bidmp.DMP(keep_approach=True).fit(curved)
@@ -136,7 +148,10 @@ def test_a_lift_is_a_translated_copy_under_a_moved_goal_or_start(shift):
     progress gate without the departure kept moves it 22 mm, the control that this can fail)."""
     y = lift_and_place()
     t = np.linspace(0.0, 4.0, len(y))
-    kept, plain = bidmp.DMP().fit(y, t, units="mm"), bidmp.DMP(keep_approach=False).fit(y, t, units="mm")
+    kept, plain = (
+        bidmp.DMP().fit(y, t, units="mm"),
+        bidmp.DMP(keep_approach=False).fit(y, t, units="mm"),
+    )
     for model, bound in ((kept, 0.5), (plain, None)):
         goal = model.trajectory(model.goal_ + shift)
         start = model.trajectory(start=model.start_ + shift)
@@ -171,13 +186,19 @@ def test_a_joint_space_model_keeps_the_demonstrations_peak_acceleration_under_a_
     pytest.importorskip("pybullet")
     from bidmp.sim import inverse_kinematics
 
-    y = minimum_jerk([[0, 0, 0], [120, 20, 150], [300, 60, 30]], 240, noise=0.5) / 1000 + [0.3, -0.15, 0.05]
+    y = minimum_jerk([[0, 0, 0], [120, 20, 150], [300, 60, 30]], 240, noise=0.5) / 1000 + [
+        0.3,
+        -0.15,
+        0.05,
+    ]
     t = np.linspace(0, 4, len(y))
     q = inverse_kinematics(y, "panda", units="m")
     peak = np.abs(np.diff(q, n=2, axis=0)).max() / (t[1] - t[0]) ** 2
     goal = inverse_kinematics(y[-1] + [0, 0.25, 0], "panda", units="m", seed=q[-1])
     for keep, bound in ((None, 1.25), (True, None)):
-        motion = bidmp.DMP(keep_approach=keep).fit(q, t, units="rad").trajectory(goal, dt=t[1] - t[0])
+        motion = (
+            bidmp.DMP(keep_approach=keep).fit(q, t, units="rad").trajectory(goal, dt=t[1] - t[0])
+        )
         ratio = np.abs(np.diff(motion.y, n=2, axis=0)).max() / (t[1] - t[0]) ** 2 / peak
         if bound is None:
             assert ratio > 2.0

@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-from bidmp.demonstrations import minimum_jerk
 
 from bidmp.baselines import TPGMM, GMMRegressor, augment
 from bidmp.baselines.gmm import _gmr
+from bidmp.demonstrations import minimum_jerk
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +22,9 @@ def test_gmr_with_one_component_is_the_conditional_gaussian():
     mean, cov = _gmr(np.ones(1), mu[None], sigma[None], t)
     gain = sigma[1:, :1] / sigma[0, 0]
     np.testing.assert_allclose(mean, mu[1:] + (t[:, None] - mu[0]) * gain[:, 0], atol=1e-12)
-    np.testing.assert_allclose(cov, np.broadcast_to(sigma[1:, 1:] - gain @ sigma[:1, 1:], (3, 3, 3)), atol=1e-12)
+    np.testing.assert_allclose(
+        cov, np.broadcast_to(sigma[1:, 1:] - gain @ sigma[:1, 1:], (3, 3, 3)), atol=1e-12
+    )
 
 
 def test_gmr_follows_the_responsible_component():
@@ -36,7 +38,9 @@ def test_augment_keeps_ends_and_adds_copies(approach):
     copies = augment(approach, n_copies=4, noise=1.5, seed=3)
     assert copies.shape == (5, 200, 3)
     np.testing.assert_array_equal(copies[0], approach)
-    np.testing.assert_allclose(copies[:, [0, -1]], np.broadcast_to(approach[[0, -1]], (5, 2, 3)), atol=1e-12)
+    np.testing.assert_allclose(
+        copies[:, [0, -1]], np.broadcast_to(approach[[0, -1]], (5, 2, 3)), atol=1e-12
+    )
     assert 0.5 < np.std(copies[1:] - approach) < 3.0
 
 

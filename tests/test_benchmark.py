@@ -10,18 +10,27 @@ import time
 import numpy as np
 import pytest
 
-from bidmp.experiments import benchmark
 from bidmp.cli import main
-from bidmp.tasks import swept_area
+from bidmp.experiments import benchmark
 from bidmp.extension import dtw_distance
+from bidmp.tasks import swept_area
 
 # Only what runs on Dask or writes Parquet needs the benchmark extra; the metrics do not.
-needs_dask = pytest.mark.skipif(__import__("importlib").util.find_spec("distributed") is None,
-                                reason="the benchmark extra (dask[distributed]) is not installed")
-needs_parquet = pytest.mark.skipif(__import__("importlib").util.find_spec("pyarrow") is None,
-                                   reason="the benchmark extra (pyarrow) is not installed")
+needs_dask = pytest.mark.skipif(
+    __import__("importlib").util.find_spec("distributed") is None,
+    reason="the benchmark extra (dask[distributed]) is not installed",
+)
+needs_parquet = pytest.mark.skipif(
+    __import__("importlib").util.find_spec("pyarrow") is None,
+    reason="the benchmark extra (pyarrow) is not installed",
+)
 
-SMALL = {"shapes": ["Sshape", "WShape"], "demos": "first3", "every": 10, "methods": ["dmp-paper", "bidmp"]}
+SMALL = {
+    "shapes": ["Sshape", "WShape"],
+    "demos": "first3",
+    "every": 10,
+    "methods": ["dmp-paper", "bidmp"],
+}
 TIMING = set(benchmark.TIMES)
 
 
@@ -29,7 +38,7 @@ def plain_dtw(a, b):
     """The textbook recursion, memoised: D(i, j) = d(i, j) + min(D(i-1, j), D(i, j-1), D(i-1, j-1))."""
     sys.setrecursionlimit(10_000)
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache
     def cost(i, j):
         here = float(np.linalg.norm(a[i] - b[j]))
         if i == 0 and j == 0:
@@ -56,7 +65,9 @@ def test_swept_area_against_hand_computed_polygons():
     reference = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
     assert swept_area(reference + [0.0, 1.0], reference) == pytest.approx(2.0)  # two unit squares
     # One step: reference (0,0)->(2,0), trajectory (0,1)->(2,3): a trapezoid of heights 1 and 3.
-    assert swept_area(np.array([[0.0, 1.0], [2.0, 3.0]]), np.array([[0.0, 0.0], [2.0, 0.0]])) == pytest.approx(4.0)
+    assert swept_area(
+        np.array([[0.0, 1.0], [2.0, 3.0]]), np.array([[0.0, 0.0], [2.0, 0.0]])
+    ) == pytest.approx(4.0)
     assert swept_area(reference, reference) == 0.0
 
 
@@ -151,14 +162,33 @@ def test_an_interrupted_run_resumes_with_only_the_missing_cells(serial, tmp_path
     assert len(other.computed) == 6
 
 
-@pytest.mark.parametrize("argv, match", [
-    (["--shapes", "Sshape,Nope"], "unknown LASA shape 'Nope'"),
-    (["--methods", "dmp-paper,magic"], "unknown method 'magic'"),
-    pytest.param(["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler at tcp://127.0.0.1:9", marks=needs_dask),
-])
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["--shapes", "Sshape,Nope"], "unknown LASA shape 'Nope'"),
+        (["--methods", "dmp-paper,magic"], "unknown method 'magic'"),
+        pytest.param(
+            ["--scheduler", "tcp://127.0.0.1:9"],
+            "cannot reach the Dask scheduler at tcp://127.0.0.1:9",
+            marks=needs_dask,
+        ),
+    ],
+)
 def test_bad_input_is_one_line_within_ten_seconds_and_leaves_nothing(argv, match, tmp_path, capsys):
     start = time.perf_counter()
-    code = main(["benchmark", "lasa", "--shapes", "Sshape", "--every", "10", "--out", str(tmp_path / "o"), *argv])
+    code = main(
+        [
+            "benchmark",
+            "lasa",
+            "--shapes",
+            "Sshape",
+            "--every",
+            "10",
+            "--out",
+            str(tmp_path / "o"),
+            *argv,
+        ]
+    )
     elapsed = time.perf_counter() - start
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and elapsed < 10.0
@@ -173,10 +203,14 @@ def test_csv_output_and_the_summary(serial, tmp_path):
     summary = (tmp_path / "lasa.md").read_text()
     assert "median (IQR)" in summary and "| bidmp |" in summary
     header, rows = benchmark.summary_rows(result.rows, "endpoint_error")
-    values = [r["endpoint_error"] for r in result.rows if r["method"] == "bidmp" and r["case"] == "far"]
+    values = [
+        r["endpoint_error"] for r in result.rows if r["method"] == "bidmp" and r["case"] == "far"
+    ]
     assert rows[[r[0] for r in rows].index("bidmp")][3].startswith(f"{np.median(values):.3g}")
     cell = json.loads((tmp_path / "cells" / "Sshape__0.json").read_text())
-    assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == benchmark._cell_seed("Sshape", 0)
+    assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == benchmark._cell_seed(
+        "Sshape", 0
+    )
 
 
 def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
@@ -188,7 +222,9 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
     root = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
     rows = pq.read_table(root / "lasa.parquet").to_pylist()
     protocol = {"demos": rows[0]["demos"], "every": rows[0]["every"]}
-    assert benchmark.summary_markdown(rows, protocol).strip() == (root / "lasa.md").read_text().strip()
+    assert (
+        benchmark.summary_markdown(rows, protocol).strip() == (root / "lasa.md").read_text().strip()
+    )
     methods = list(dict.fromkeys(row["method"] for row in rows))
     for shape, demo in (("Sshape", 0), ("WShape", 4)):
         fresh = benchmark.run_cell(shape, demo, methods, protocol["every"])["rows"]
@@ -196,10 +232,17 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
         assert len(fresh) == len(committed)
         for new, old in zip(fresh, committed):
             for name in benchmark.METRICS:
-                assert new[name] == pytest.approx(old[name], rel=1e-6, abs=1e-9), (shape, demo, new["method"], name)
+                assert new[name] == pytest.approx(old[name], rel=1e-6, abs=1e-9), (
+                    shape,
+                    demo,
+                    new["method"],
+                    name,
+                )
 
 
-def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(serial, tmp_path, caplog):
+def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(
+    serial, tmp_path, caplog
+):
     """--resume trusted cell files; an edited value was merged as is and a missing key
     ended in an internal error. Each is now recomputed, with a warning naming the cell."""
     import json
@@ -213,11 +256,16 @@ def test_resume_recomputes_an_edited_a_foreign_or_a_broken_cell_and_says_so(seri
     broken = json.loads((cells / "Sshape__1.json").read_text())
     del broken["rows"][0]["frechet"]
     (cells / "Sshape__1.json").write_text(json.dumps(broken))
-    (cells / "WShape__0.json").write_text((cells / "WShape__1.json").read_text())  # another cell's file
+    (cells / "WShape__0.json").write_text(
+        (cells / "WShape__1.json").read_text()
+    )  # another cell's file
     with caplog.at_level(logging.WARNING, logger="bidmp.experiments.benchmark"):
         again = benchmark.lasa(tmp_path, synchronous=True, resume=True, **SMALL)
     assert sorted(again.computed) == ["Sshape__0", "Sshape__1", "WShape__0"]
     assert table(again.rows) == table(serial.rows)
     said = caplog.text
-    assert "Sshape__0 was changed after it was written" in said and "WShape__0 holds cell 'WShape__1'" in said
+    assert (
+        "Sshape__0 was changed after it was written" in said
+        and "WShape__0 holds cell 'WShape__1'" in said
+    )
     assert "Sshape__1" in said

@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
-from bidmp.incremental.linalg import PINV_RCOND
-from bidmp.incremental import block_pinv_update, sparse_autoencoder
 
 import bidmp
 from bidmp import BLS
+from bidmp.incremental import block_pinv_update, sparse_autoencoder
+from bidmp.incremental.linalg import PINV_RCOND
 
 
 def random_problem(seed=0, n_rows=300, n_inputs=5):
@@ -25,7 +25,9 @@ def rank_deficient(rng, n_rows, n_cols, rank):
 
 
 @pytest.mark.parametrize("base", ["full", "deficient"])
-@pytest.mark.parametrize("kind, expected_case", [("random", "full-rank"), ("span", "zero"), ("mixed", "general")])
+@pytest.mark.parametrize(
+    "kind, expected_case", [("random", "full-rank"), ("span", "zero"), ("mixed", "general")]
+)
 def test_block_update_equals_pinv_from_scratch(base, kind, expected_case):
     rng = np.random.default_rng(7)
     A = full_rank(rng, 120, 25) if base == "full" else rank_deficient(rng, 120, 25, 15)
@@ -42,7 +44,9 @@ def test_block_update_equals_pinv_from_scratch(base, kind, expected_case):
     reference = np.linalg.pinv(np.hstack([A, E]), rcond=PINV_RCOND)
     np.testing.assert_allclose(updated, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
     Y = rng.normal(size=(120, 3))
-    np.testing.assert_allclose(updated @ Y, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max())
+    np.testing.assert_allclose(
+        updated @ Y, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max()
+    )
 
 
 def test_zero_case_uses_plus_sign_not_the_circulating_minus():
@@ -68,7 +72,9 @@ def test_exact_ridge_update_equals_ridge_from_scratch():
         model.add_enhancement_nodes(n_nodes)
         A = model.hidden(X)
         reference = np.linalg.solve(A.T @ A + reg * np.eye(A.shape[1]), A.T @ Y)
-        np.testing.assert_allclose(model.output_weights_, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+        np.testing.assert_allclose(
+            model.output_weights_, reference, rtol=0, atol=1e-8 * np.abs(reference).max()
+        )
 
 
 def test_pinv_update_equals_numpy_pinv_from_scratch_on_random_problems():
@@ -79,8 +85,12 @@ def test_pinv_update_equals_numpy_pinv_from_scratch_on_random_problems():
         model.add_enhancement_nodes(n_nodes)
         A = model.hidden(X)
         reference = np.linalg.pinv(A, rcond=PINV_RCOND)
-        np.testing.assert_allclose(model.output_weights_, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max())
-        np.testing.assert_allclose(model.hidden_pinv_, reference, rtol=0, atol=1e-8 * np.abs(reference).max())
+        np.testing.assert_allclose(
+            model.output_weights_, reference @ Y, rtol=0, atol=1e-8 * np.abs(reference @ Y).max()
+        )
+        np.testing.assert_allclose(
+            model.hidden_pinv_, reference, rtol=0, atol=1e-8 * np.abs(reference).max()
+        )
 
 
 def bidmp_hidden_problem(model):
@@ -101,7 +111,9 @@ def test_pinv_update_on_a_recordings_bidmp_matrices_equals_numpy_pinv():
     y, t = bidmp.demonstrations.recording("operator1_nut3")
     prepared, _ = bidmp.prepare(y, t)
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
-    model = bidmp.BiDMP(dmp).learn(bidmp.extend_demonstration(prepared.y, dmp.goal_ + [150.0, 25.0, 0.0], seed=0).complete)
+    model = bidmp.BiDMP(dmp).learn(
+        bidmp.extend_demonstration(prepared.y, dmp.goal_ + [150.0, 25.0, 0.0], seed=0).complete
+    )
     X, Y = bidmp_hidden_problem(model)
     bls = BLS(reg=0.0, seed=model.blocks_[0].seed).fit(X, Y)
     for _ in range(2):
@@ -117,10 +129,19 @@ def test_pinv_update_on_the_nut_tasks_bidmp_matrices_is_refused_with_the_reason(
     refused, saying why; reg > 0 is exact on the same matrices."""
     X, Y = bidmp_hidden_problem(nut_bidmp)
     bls = BLS(reg=0.0, seed=1).fit(X, Y)
-    A = np.hstack([bls.train_hidden_, np.tanh(np.random.default_rng(0).normal(size=(X.shape[0], 20)))])
+    A = np.hstack(
+        [bls.train_hidden_, np.tanh(np.random.default_rng(0).normal(size=(X.shape[0], 20)))]
+    )
     weights = np.linalg.pinv(A, rcond=PINV_RCOND) @ Y
-    nudged = np.linalg.pinv(A * (1.0 + 1e-15 * np.random.default_rng(1).normal(size=A.shape)), rcond=PINV_RCOND) @ Y
-    assert np.linalg.norm(nudged - weights) > 1e-8 * np.linalg.norm(weights)  # rounding moves NumPy's own answer
+    nudged = (
+        np.linalg.pinv(
+            A * (1.0 + 1e-15 * np.random.default_rng(1).normal(size=A.shape)), rcond=PINV_RCOND
+        )
+        @ Y
+    )
+    assert np.linalg.norm(nudged - weights) > 1e-8 * np.linalg.norm(
+        weights
+    )  # rounding moves NumPy's own answer
     with pytest.raises(ValueError, match="ill-posed.*decay through the rank cut.*use reg > 0"):
         bls.add_enhancement_nodes(20)
     assert bls.n_hidden_ == 200  # refused before anything changed
@@ -132,7 +153,9 @@ def test_pinv_update_on_the_nut_tasks_bidmp_matrices_is_refused_with_the_reason(
     assert np.linalg.norm(ridge.output_weights_ - reference) <= 1e-6 * np.linalg.norm(reference)
 
 
-@pytest.mark.parametrize("params", [{}, {"reg": 0.0}, {"reg": 1e-3}, {"n_windows": 3, "n_mapped": 7}])
+@pytest.mark.parametrize(
+    "params", [{}, {"reg": 0.0}, {"reg": 1e-3}, {"n_windows": 3, "n_mapped": 7}]
+)
 def test_training_residual_never_rises_as_nodes_are_added(params):
     X, Y = random_problem(4)
     model = BLS(n_enhance=30, seed=5, **params).fit(X, Y)
@@ -140,7 +163,9 @@ def test_training_residual_never_rises_as_nodes_are_added(params):
     for _ in range(4):
         model.add_enhancement_nodes(15)
         residuals.append(np.sqrt(np.mean((model.predict(X) - Y) ** 2)))
-    assert all(later <= earlier * (1 + 1e-9) for earlier, later in zip(residuals, residuals[1:])), residuals
+    assert all(later <= earlier * (1 + 1e-9) for earlier, later in zip(residuals, residuals[1:])), (
+        residuals
+    )
     assert residuals[-1] < residuals[0]
 
 
@@ -179,7 +204,11 @@ def test_save_load_reproduces_predictions_and_continues_learning(tmp_path):
         loaded = bidmp.load(path)
         np.testing.assert_array_equal(loaded.predict(X), model.predict(X))
         # Learning continues after loading (equal up to BLAS rounding, which depends on memory layout).
-        np.testing.assert_allclose(loaded.add_enhancement_nodes(7).predict(X), model.add_enhancement_nodes(7).predict(X), atol=1e-9)
+        np.testing.assert_allclose(
+            loaded.add_enhancement_nodes(7).predict(X),
+            model.add_enhancement_nodes(7).predict(X),
+            atol=1e-9,
+        )
 
 
 @pytest.mark.parametrize(
@@ -191,7 +220,11 @@ def test_save_load_reproduces_predictions_and_continues_learning(tmp_path):
         (lambda m, X, Y: m.predict(X[:, :3]), ValueError, "X must have 5 columns"),
         (lambda m, X, Y: m.predict(np.full_like(X, np.nan)), ValueError, "NaN"),
         (lambda m, X, Y: BLS().fit(X, Y[:10]), ValueError, "Y must have shape"),
-        (lambda m, X, Y: BLS(update="pinv", reg=1e-3).fit(X, Y), ValueError, "exact only with reg=0"),
+        (
+            lambda m, X, Y: BLS(update="pinv", reg=1e-3).fit(X, Y),
+            ValueError,
+            "exact only with reg=0",
+        ),
         (lambda m, X, Y: BLS(n_windows=0).fit(X, Y), ValueError, "n_windows must be >= 1"),
         (lambda m, X, Y: BLS().predict(X), bidmp.NotFittedError, "not fitted"),
     ],

@@ -4,23 +4,40 @@ against a motion made here to break it, the reasons in words, the units."""
 import numpy as np
 import pytest
 
-from bidmp.tasks import scenarios
 from bidmp.demonstrations import minimum_jerk
+from bidmp.tasks import scenarios
 from bidmp.tasks.contract import ENGAGE_RISE_MM, Contract, command_peaks, mm
 from bidmp.tasks.repair import REPAIRS, Repairer
 
-SCENE = {"tool": {"radius": 10.0, "length": 100.0}, "margin": 3.0, "standoff": {"plate": 1.0},
-         "parts": [{"type": "plate", "label": "plate", "at": [0, 0, -2], "size": [400, 400, 5]},
-                   {"type": "cylinder", "label": "post", "at": [60, 0, -2], "radius": 5.0, "height": 80.0}]}
+SCENE = {
+    "tool": {"radius": 10.0, "length": 100.0},
+    "margin": 3.0,
+    "standoff": {"plate": 1.0},
+    "parts": [
+        {"type": "plate", "label": "plate", "at": [0, 0, -2], "size": [400, 400, 5]},
+        {"type": "cylinder", "label": "post", "at": [60, 0, -2], "radius": 5.0, "height": 80.0},
+    ],
+}
 
 
 def contract(units: str = "mm", post=(60.0, 0.0)) -> Contract:
     from bidmp import Scene
 
     f = {"mm": 1.0, "cm": 0.1, "m": 1e-3}[units]
-    scene = {"tool": {k: v * f for k, v in SCENE["tool"].items()}, "margin": 3.0 * f, "standoff": {"plate": 1.0 * f},
-             "parts": [{**SCENE["parts"][0], "at": [0, 0, -2 * f], "size": [400 * f, 400 * f, 5 * f]},
-                       {**SCENE["parts"][1], "at": [post[0] * f, post[1] * f, -2 * f], "radius": 5 * f, "height": 80 * f}]}
+    scene = {
+        "tool": {k: v * f for k, v in SCENE["tool"].items()},
+        "margin": 3.0 * f,
+        "standoff": {"plate": 1.0 * f},
+        "parts": [
+            {**SCENE["parts"][0], "at": [0, 0, -2 * f], "size": [400 * f, 400 * f, 5 * f]},
+            {
+                **SCENE["parts"][1],
+                "at": [post[0] * f, post[1] * f, -2 * f],
+                "radius": 5 * f,
+                "height": 80 * f,
+            },
+        ],
+    }
     return Contract(1.75 * f, 25.0 * f, Scene.from_dict(scene, units=units), units)
 
 
@@ -35,18 +52,29 @@ def test_a_straight_descent_meets_it_and_each_rule_fails_on_its_own_breach():
     assert c.judge(descent(target), target, label="t", exclude=["nothing"] if False else ()).ok
     short = descent(target)[:-60]  # stops 5.3 mm above the target
     assert c.judge(short, target, label="t").failed == ["end"]
-    tilted = descent(target) + np.outer(np.linspace(1.0, 0.0, 200), [3.0, 0.0, 0.0])  # comes in 3 mm off the axis
+    tilted = descent(target) + np.outer(
+        np.linspace(1.0, 0.0, 200), [3.0, 0.0, 0.0]
+    )  # comes in 3 mm off the axis
     tilted[-1] = target
     assert c.judge(tilted, target, label="t").failed == ["engagement"]
-    dip = np.vstack([descent(target)[:-1], target - [0.0, 0.0, 0.2], target])  # 0.2 mm below, back up
+    dip = np.vstack(
+        [descent(target)[:-1], target - [0.0, 0.0, 0.2], target]
+    )  # 0.2 mm below, back up
     verdict = c.judge(dip, target, label="t")
     assert verdict.failed == ["engagement"] and "monotone" in verdict.reason()
-    assert c.judge(np.vstack([descent(target)[:-1], target - [0, 0, 0.1], target]), target, label="t").ok  # under 0.15
-    beside = np.array([40.0, 0.0, 0.0])  # the socket 40 mm from the post's axis: 40 - 5 - 10 = 25 clear
+    assert c.judge(
+        np.vstack([descent(target)[:-1], target - [0, 0, 0.1], target]), target, label="t"
+    ).ok  # under 0.15
+    beside = np.array(
+        [40.0, 0.0, 0.0]
+    )  # the socket 40 mm from the post's axis: 40 - 5 - 10 = 25 clear
     assert c.judge(descent(beside), beside, label="t").ok
     close = np.array([60.0 - 5 - 10 - 2.0, 0.0, 0.0])  # 2 mm from the post: inside the 3 mm margin
     verdict = c.judge(descent(close), close, label="t")
-    assert verdict.failed == ["clearance"] and "passes 2.00 mm from post, inside the 3 mm it must keep" in verdict.reason()
+    assert (
+        verdict.failed == ["clearance"]
+        and "passes 2.00 mm from post, inside the 3 mm it must keep" in verdict.reason()
+    )
 
 
 def test_the_verdicts_are_the_same_in_mm_cm_and_m():
@@ -54,7 +82,9 @@ def test_the_verdicts_are_the_same_in_mm_cm_and_m():
     for units, f in (("mm", 1.0), ("cm", 0.1), ("m", 1e-3)):
         c, target = contract(units), np.zeros(3)
         dip = np.vstack([descent(target * f, 60 * f)[:-1], (target - [0, 0, 0.2]) * f, target * f])
-        small = np.vstack([descent(target * f, 60 * f)[:-1], (target - [0, 0, 0.1]) * f, target * f])
+        small = np.vstack(
+            [descent(target * f, 60 * f)[:-1], (target - [0, 0, 0.1]) * f, target * f]
+        )
         close = np.array([43.0, 0.0, 0.0]) * f
         assert c.judge(dip, target * f).failed == ["engagement"]
         assert c.judge(small, target * f).ok
@@ -71,7 +101,9 @@ def test_commands_are_judged_in_both_directions_and_from_rest():
     t = np.arange(0.0, 1.0 + 1e-9, 1e-3)
     s = 10 * t**3 - 15 * t**4 + 6 * t**5
     for sign in (1.0, -1.0):
-        q = np.column_stack([sign * 0.5 * s, np.zeros_like(s)])  # peak speed 0.5 * 1.875 = 0.94 rad/s
+        q = np.column_stack(
+            [sign * 0.5 * s, np.zeros_like(s)]
+        )  # peak speed 0.5 * 1.875 = 0.94 rad/s
         peaks = command_peaks(q, limits)
         assert peaks.within and peaks.velocity == pytest.approx(0.9375, rel=1e-3)
         fast = np.column_stack([sign * 0.6 * s, np.zeros_like(s)])  # 1.125 rad/s
@@ -99,7 +131,9 @@ def test_each_repair_alone_keeps_the_contract_past_a_post(how):
 
     demo = minimum_jerk([[-100, -120, 150], [0, 0, 35], [0, 0, 0]], 300)
     dmp = DMP().fit(demo, np.linspace(0, 3, 300), units="mm")
-    post = np.array([60.0, -33.0])  # on the skill's way to the goal, the tool's mouth 66 mm up there
+    post = np.array(
+        [60.0, -33.0]
+    )  # on the skill's way to the goal, the tool's mouth 66 mm up there
     c = contract(post=post)
     goal = np.array([120.0, 0.0, 0.0])
     repairer = Repairer(c, demo, order=(how,))
@@ -110,7 +144,9 @@ def test_each_repair_alone_keeps_the_contract_past_a_post(how):
         return
     assert repaired.ok and repaired.how == how, repaired.reason()
     path = repaired.motion
-    dense = np.vstack([a + np.linspace(0, 1, 30)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])])
+    dense = np.vstack(
+        [a + np.linspace(0, 1, 30)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])]
+    )
     tall = dense[:, 2] < 78.0 + 3.0  # the tool's mouth below the post's top plus the margin
     assert np.all(np.linalg.norm(dense[tall, :2] - post, axis=1) >= 5.0 + 10.0 + 3.0 - 1e-6)
     assert np.linalg.norm(path[-1] - goal) <= 1.75

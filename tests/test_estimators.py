@@ -14,7 +14,15 @@ from bidmp.baselines import TPGMM, GMMRegressor
 ESTIMATORS = [
     (DMP, {"alpha": 40.0, "K": "pastor", "regression": "ridge", "tau": 1.5}),
     (BLS, {"n_windows": 3, "n_enhance": 17, "reg": 1e-3, "seed": 5}),
-    (BiDMP, {"dmp": DMP(protocol="paper", alpha=60.0, n_kernels=20), "n_enhance": 30, "increments": (4, 6), "reg": 1e-3}),
+    (
+        BiDMP,
+        {
+            "dmp": DMP(protocol="paper", alpha=60.0, n_kernels=20),
+            "n_enhance": 30,
+            "increments": (4, 6),
+            "reg": 1e-3,
+        },
+    ),
     (GMMRegressor, {"n_components": 5, "noise": 0.5, "seed": 3}),
     (TPGMM, {"n_components": 4, "reg_covar": 1e-3, "n_copies": 2}),
 ]
@@ -71,8 +79,13 @@ def test_fitted_state_is_absent_before_fit_and_clone_refits_identically(cls, par
 
 @pytest.mark.parametrize("cls, params", ESTIMATORS, ids=lambda v: getattr(v, "__name__", ""))
 def test_validation_happens_in_fit_with_the_name_of_the_parameter(cls, params):
-    bad = {DMP: ("n_kernels", 0), BLS: ("n_windows", 0), BiDMP: ("n_enhance", 0),
-           GMMRegressor: ("n_components", 0), TPGMM: ("reg_covar", -1.0)}[cls]
+    bad = {
+        DMP: ("n_kernels", 0),
+        BLS: ("n_windows", 0),
+        BiDMP: ("n_enhance", 0),
+        GMMRegressor: ("n_components", 0),
+        TPGMM: ("reg_covar", -1.0),
+    }[cls]
     model = cls(**{**params, bad[0]: bad[1]})  # constructing never raises
     with pytest.raises(ValueError, match=bad[0]):
         fit(model)
@@ -80,7 +93,11 @@ def test_validation_happens_in_fit_with_the_name_of_the_parameter(cls, params):
 
 def test_bidmp_params_include_the_dmps():
     params = BiDMP(DMP(protocol="paper", alpha=60.0, K="paper")).get_params(deep=True)
-    assert params["dmp__alpha"] == 60.0 and params["dmp__K"] == "paper" and params["dmp__protocol"] == "paper"
+    assert (
+        params["dmp__alpha"] == 60.0
+        and params["dmp__K"] == "paper"
+        and params["dmp__protocol"] == "paper"
+    )
     model = BiDMP(DMP(protocol="paper")).set_params(dmp__alpha=80.0)
     assert model.dmp.alpha_value == 80.0
 

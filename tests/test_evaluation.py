@@ -8,9 +8,7 @@ from scipy.stats import spearmanr
 
 import bidmp
 from bidmp import DMP
-from bidmp.tasks import scenarios
-from bidmp.tasks import evaluate
-from bidmp.tasks import approach_error
+from bidmp.tasks import approach_error, evaluate, scenarios
 
 NUT_COLUMNS_FAILED = ["9", "10", "11", "12", "13", "14"]
 
@@ -72,7 +70,9 @@ def test_run_to_convergence_reaches_every_nut_but_dips_below_it_and_its_descent_
         band = height < 28.5
         tilt.append(np.max(np.linalg.norm(rollout[band, :2] - target[:2], axis=1)))
         distance.append(np.linalg.norm(target - origin))
-    assert spearmanr(distance, tilt).statistic > 0.95  # the descent tilts more as the goal moves away
+    assert (
+        spearmanr(distance, tilt).statistic > 0.95
+    )  # the descent tilts more as the goal moves away
     assert max(tilt) > 1.75 and converged.engaged == 0
 
 
@@ -87,8 +87,16 @@ def test_report_json_follows_the_spec_schema(nut):
     assert data["scenario"] == "nut-unscrewing"
     assert set(data["methods"]) == {"dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm"}
     for result in data["methods"].values():
-        assert {"success_rate", "successes", "n_targets", "errors", "approach_errors", "max_error",
-                "difference_range", "runtime_s"} <= set(result)
+        assert {
+            "success_rate",
+            "successes",
+            "n_targets",
+            "errors",
+            "approach_errors",
+            "max_error",
+            "difference_range",
+            "runtime_s",
+        } <= set(result)
         assert result["n_targets"] == 14 and set(result["errors"]) == set(nut.scenario.targets)
         assert result["success_rate"] == pytest.approx(result["successes"] / 14, abs=1e-4)
         assert isinstance(result["max_error"], float) and result["runtime_s"] > 0
@@ -100,7 +108,10 @@ def test_report_json_follows_the_spec_schema(nut):
 def test_another_layout_from_a_file_agrees_with_the_endpoint_gain(tmp_path):
     data = json.loads(scenarios.builtin_text("nut-unscrewing"))
     rng = np.random.default_rng(5)
-    data["targets"] = {f"n{i}": [float(x), float(y), 0.0] for i, (x, y) in enumerate(rng.uniform(-100, 250, (9, 2)))}
+    data["targets"] = {
+        f"n{i}": [float(x), float(y), 0.0]
+        for i, (x, y) in enumerate(rng.uniform(-100, 250, (9, 2)))
+    }
     data["targets"]["demo"] = [0.0, 0.0, 0.0]
     data["demonstrated"] = "demo"
     data["methods"] = ["dmp"]
@@ -111,7 +122,9 @@ def test_another_layout_from_a_file_agrees_with_the_endpoint_gain(tmp_path):
     e0 = dmp.rollout()[-1] - report.scenario.targets["demo"]
     for label, target in report.scenario.targets.items():
         shift = target - report.scenario.targets["demo"]
-        assert report.methods["dmp"].errors[label] == pytest.approx(np.linalg.norm(e0 - gain * shift), abs=1e-9)
+        assert report.methods["dmp"].errors[label] == pytest.approx(
+            np.linalg.norm(e0 - gain * shift), abs=1e-9
+        )
 
 
 def test_pick_and_place_learns_every_operator_faithfully():
@@ -121,14 +134,21 @@ def test_pick_and_place_learns_every_operator_faithfully():
     assert np.all(report.forgetting["latest"].forgetting[:-1] > 1.0)
     scenario = report.scenario
     for label, demonstration in scenario.demonstrations.items():
-        learned = report.model.rollout(demonstration[-1], start=demonstration[0])[: len(demonstration)]
+        learned = report.model.rollout(demonstration[-1], start=demonstration[0])[
+            : len(demonstration)
+        ]
         scratch = DMP(**scenario.dmp).fit(demonstration).rollout()[: len(demonstration)]
-        errors = [np.sqrt(np.mean(np.sum((r - demonstration) ** 2, axis=1))) for r in (learned, scratch)]
+        errors = [
+            np.sqrt(np.mean(np.sum((r - demonstration) ** 2, axis=1))) for r in (learned, scratch)
+        ]
         assert errors[0] <= 1.05 * errors[1], (label, errors)
     assert report.methods["bidmp"].successes == 3
     # Every operator's own trajectory is reproduced (difference to its demonstration, mm summed).
     for label in ("op2", "op3"):
-        assert report.methods["bidmp"].differences[label] < 0.05 * report.methods["dmp"].differences[label] + 5.0
+        assert (
+            report.methods["bidmp"].differences[label]
+            < 0.05 * report.methods["dmp"].differences[label] + 5.0
+        )
 
 
 def test_cell_removal_second_extension_fixes_b6():
@@ -159,14 +179,21 @@ def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
 
     base = scenarios.load("nut-unscrewing")
     spec = base.to_dict()
-    spec["scene"]["parts"].append({"type": "box", "label": "wall", "at": [105, 25, 0.5], "size": [10, 400, 4000]})
+    spec["scene"]["parts"].append(
+        {"type": "box", "label": "wall", "at": [105, 25, 0.5], "size": [10, 400, 4000]}
+    )
     walled = scenarios.from_dict(spec, base_dir=base.base_dir)
     report = evaluate(walled, ["dmp", "bidmp"])
     assert set(report.methods) == {"dmp", "bidmp"}
-    assert len(report.route_failures) == 1 and "no collision-free route" in report.route_failures[0]["reason"]
+    assert (
+        len(report.route_failures) == 1
+        and "no collision-free route" in report.route_failures[0]["reason"]
+    )
     far = [label for label in walled.labels if walled.targets[label][0] > 105]
     assert far and not any(report.methods["bidmp"].task_success_at(label) for label in far)
-    data = json.loads(json.dumps(report.to_dict(), allow_nan=False))  # strict JSON: no Infinity, no NaN
+    data = json.loads(
+        json.dumps(report.to_dict(), allow_nan=False)
+    )  # strict JSON: no Infinity, no NaN
     assert data["route_failures"][0]["target"][0] == pytest.approx(150.0)
 
 

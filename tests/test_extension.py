@@ -2,11 +2,11 @@
 
 import numpy as np
 import pytest
-from bidmp.demonstrations import lasa, minimum_jerk
-from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 import bidmp
 from bidmp import extend_demonstration
+from bidmp.demonstrations import lasa, minimum_jerk
+from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,9 @@ def test_complete_demonstration_shape_ends_and_parts(battery):
     assert result.complete.shape == battery.shape
     assert np.array_equal(result.complete[0], battery[0])
     assert np.array_equal(result.complete[-1], BATTERY_EXTENSION_TARGET)
-    np.testing.assert_array_equal(result.tra_imi, battery[result.piece.start : result.piece.end + 1])
+    np.testing.assert_array_equal(
+        result.tra_imi, battery[result.piece.start : result.piece.end + 1]
+    )
     assert result.seg_index == result.piece.start
     assert np.array_equal(result.tra_gen[0], battery[result.seg_index])
     assert np.array_equal(result.tra_gen[-1], BATTERY_EXTENSION_TARGET)
@@ -57,16 +59,22 @@ def test_same_seed_same_extension_and_options_pass_through(battery):
     first = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4)
     again = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4)
     assert np.array_equal(first.complete, again.complete)
-    fewer = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4, n_iter=3, n_samples=100, eps_frac=0.2)
+    fewer = extend_demonstration(
+        battery, BATTERY_EXTENSION_TARGET, seed=4, n_iter=3, n_samples=100, eps_frac=0.2
+    )
     assert fewer.similarity_history.shape == (3,)
     with pytest.raises(TypeError, match="unexpected keyword argument 'n_iterations'"):
         extend_demonstration(battery, BATTERY_EXTENSION_TARGET, n_iterations=3)
 
 
 def test_target_at_seg_skips_gprm(battery):
-    result = extend_demonstration(battery, battery[-1], seed=0, approach="paper")  # the demonstrated end: nearest piece end
+    result = extend_demonstration(
+        battery, battery[-1], seed=0, approach="paper"
+    )  # the demonstrated end: nearest piece end
     assert np.array_equal(result.complete[-1], battery[-1])
-    seg_target = extend_demonstration(battery, battery[0], seed=0, approach="paper")  # coincides with seg of piece 0
+    seg_target = extend_demonstration(
+        battery, battery[0], seed=0, approach="paper"
+    )  # coincides with seg of piece 0
     assert seg_target.similarity_history.size == 0
     assert np.array_equal(seg_target.complete[-1], battery[0])
 
@@ -103,5 +111,8 @@ def test_options_are_listed_in_the_signature():
     for name, parameter in inspect.signature(gaussian_prm).parameters.items():
         if parameter.kind is inspect.Parameter.KEYWORD_ONLY:
             assert signature[name].default == parameter.default, name  # same defaults as G-PRM
-    assert signature["eps_frac"].default == inspect.signature(bidmp.segment).parameters["eps_frac"].default
+    assert (
+        signature["eps_frac"].default
+        == inspect.signature(bidmp.segment).parameters["eps_frac"].default
+    )
     assert not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in signature.values())

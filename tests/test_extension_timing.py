@@ -61,14 +61,18 @@ def test_the_extended_demonstration_keeps_within_the_demonstrations_peaks(seed):
     assert np.all(ratio <= 1.1), (seed, ratio)
     np.testing.assert_allclose(extension.complete[-1], target, atol=1e-9 * unit)
     n = len(demo) - extension.approach_index
-    np.testing.assert_allclose(extension.complete[-n:], demo[-n:] + (target - demo[-1]), atol=1e-9 * unit)
+    np.testing.assert_allclose(
+        extension.complete[-n:], demo[-n:] + (target - demo[-1]), atol=1e-9 * unit
+    )
     assert extension.time_scale >= 1.0 - 1e-12
 
 
 def test_a_longer_transfer_takes_longer():
     demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
-    scales = [extend_demonstration(demo, [100.0 + distance, 0.0, 0.0], seed=0).time_scale
-              for distance in (50.0, 150.0, 300.0, 600.0)]
+    scales = [
+        extend_demonstration(demo, [100.0 + distance, 0.0, 0.0], seed=0).time_scale
+        for distance in (50.0, 150.0, 300.0, 600.0)
+    ]
     assert all(later > earlier for earlier, later in zip(scales, scales[1:])), scales
     assert scales[-1] > 1.5
 
@@ -101,7 +105,9 @@ def test_a_skill_runs_as_long_as_its_demonstration_lasts():
     assert model.skill_time_scales_.tolist() == [1.0, 1.75]
     motion = model.trajectory(longer[-1], skill=1, dt=0.01)
     within = motion.t <= 3.5 + 1e-9
-    expected = np.array([np.interp(motion.t[within], np.linspace(0.0, 3.5, 350), longer[:, k]) for k in range(3)]).T
+    expected = np.array(
+        [np.interp(motion.t[within], np.linspace(0.0, 3.5, 350), longer[:, k]) for k in range(3)]
+    ).T
     assert np.sqrt(np.mean(np.sum((motion.y[within] - expected) ** 2, axis=1))) < 0.01 * 160
     assert motion.t[-1] == pytest.approx(1.1 * 3.5, abs=0.011)  # the robot protocol's rest after it
     plain = bidmp.BiDMP(dmp).learn(longer)
@@ -118,7 +124,9 @@ def test_skill_durations_survive_a_model_file_and_old_files_load_with_one(tmp_pa
     path = bidmp.save(model, tmp_path / "m.npz")
     loaded = bidmp.load(path)
     np.testing.assert_array_equal(loaded.skill_time_scales_, model.skill_time_scales_)
-    np.testing.assert_array_equal(loaded.rollout(demo[-1] + [0, 30, 0]), model.rollout(demo[-1] + [0, 30, 0]))
+    np.testing.assert_array_equal(
+        loaded.rollout(demo[-1] + [0, 30, 0]), model.rollout(demo[-1] + [0, 30, 0])
+    )
     with np.load(path, allow_pickle=False) as archive:  # a format-4 file: no time scales
         arrays = {name: archive[name] for name in archive.files if name != "skill_time_scales_"}
     np.savez(path, **arrays)
@@ -154,21 +162,32 @@ def log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
 
 def transfer(extension, n_demo: int) -> np.ndarray:
     """The timed transfer inside ``complete``: seg to where the kept approach begins."""
-    return extension.complete[extension.seg_index : len(extension.complete) - (n_demo - extension.approach_index) + 1]
+    return extension.complete[
+        extension.seg_index : len(extension.complete) - (n_demo - extension.approach_index) + 1
+    ]
 
 
 def _quintic(start, end, duration: float) -> np.ndarray:
     """Coefficients c0..c5 of the quintic from the state ``start`` = (x, v, a) at 0 to ``end`` at ``duration``."""
     T = duration
-    matrix = np.array([[1, 0, 0, 0, 0, 0], [0, 1, 0, 0, 0, 0], [0, 0, 2, 0, 0, 0],
-                       [1, T, T**2, T**3, T**4, T**5], [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
-                       [0, 0, 2, 6 * T, 12 * T**2, 20 * T**3]])
+    matrix = np.array(
+        [
+            [1, 0, 0, 0, 0, 0],
+            [0, 1, 0, 0, 0, 0],
+            [0, 0, 2, 0, 0, 0],
+            [1, T, T**2, T**3, T**4, T**5],
+            [0, 1, 2 * T, 3 * T**2, 4 * T**3, 5 * T**4],
+            [0, 0, 2, 6 * T, 12 * T**2, 20 * T**3],
+        ]
+    )
     return np.linalg.solve(matrix, [*start, *end])
 
 
 def _squared_jerk(coefficients: np.ndarray, duration: float) -> float:
     """The integral of the squared third derivative of a quintic over [0, duration] (exact)."""
-    jerk = np.polynomial.Polynomial([6 * coefficients[3], 24 * coefficients[4], 60 * coefficients[5]])
+    jerk = np.polynomial.Polynomial(
+        [6 * coefficients[3], 24 * coefficients[4], 60 * coefficients[5]]
+    )
     integral = (jerk**2).integ()
     return float(integral(duration) - integral(0.0))
 
@@ -177,10 +196,12 @@ def _through(end: float, when: float, position: float, velocity: float):
     """One axis of the least-jerk rest-to-rest motion 0 -> ``end`` over unit time that is at
     ``position`` with ``velocity`` at time ``when``: two quintics meeting there, their shared
     acceleration the minimum of the (quadratic) jerk integral. ((c1, c2), jerk integral)."""
+
     def total(acceleration):
         first = _quintic((0.0, 0.0, 0.0), (position, velocity, acceleration), when)
         second = _quintic((position, velocity, acceleration), (end, 0.0, 0.0), 1.0 - when)
         return _squared_jerk(first, when) + _squared_jerk(second, 1.0 - when), (first, second)
+
     low, mid, high = (total(a)[0] for a in (-1.0, 0.0, 1.0))
     best = -(high - low) / (2.0 * (high - 2.0 * mid + low))
     jerk, pieces = total(best)
@@ -200,7 +221,9 @@ def _route_ldj(when: float, velocity, point) -> float:
     return float(-np.log((jx + jy) / peak**2))
 
 
-STRAIGHT_LDJ = float(-np.log(720.0 / 1.875**2))  # the rest-to-rest quintic over unit time: jerk integral 720, peak 15/8
+STRAIGHT_LDJ = float(
+    -np.log(720.0 / 1.875**2)
+)  # the rest-to-rest quintic over unit time: jerk integral 720, peak 15/8
 
 
 def ldj_floor(height: float, along: float = 0.5) -> float:
@@ -215,7 +238,12 @@ def ldj_floor(height: float, along: float = 0.5) -> float:
         when, vx, vy = parameters
         return 1e9 if not 0.02 < when < 0.98 else -_route_ldj(when, (vx, vy), (along, height))
 
-    found = minimize(cost, [along, 1.875, 0.0], method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 1e-7, "maxiter": 2000})
+    found = minimize(
+        cost,
+        [along, 1.875, 0.0],
+        method="Nelder-Mead",
+        options={"xatol": 1e-5, "fatol": 1e-7, "maxiter": 2000},
+    )
     return max(STRAIGHT_LDJ + float(found.fun), 0.0)
 
 
@@ -231,12 +259,18 @@ def shortest_around(a: np.ndarray, b: np.ndarray, centre: np.ndarray, keep: floa
         ca, cb = a2 - c2, b2 - c2
         na, nb = np.linalg.norm(ca), np.linalg.norm(cb)
         angle = np.arccos(np.clip(np.dot(ca, cb) / (na * nb), -1.0, 1.0))
-        flat = np.sqrt(na**2 - keep**2) + np.sqrt(nb**2 - keep**2) + keep * (angle - np.arccos(keep / na) - np.arccos(keep / nb))
+        flat = (
+            np.sqrt(na**2 - keep**2)
+            + np.sqrt(nb**2 - keep**2)
+            + keep * (angle - np.arccos(keep / na) - np.arccos(keep / nb))
+        )
     return float(np.hypot(flat, b[2] - a[2]))
 
 
 def dense(path: np.ndarray, n: int = 50) -> np.ndarray:
-    return np.concatenate([a + np.linspace(0, 1, n)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])])
+    return np.concatenate(
+        [a + np.linspace(0, 1, n)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])]
+    )
 
 
 @pytest.mark.parametrize("margin", [0.0, 3.0])
@@ -252,8 +286,13 @@ def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin, post_r
     blind = extend_demonstration(demo, target, seed=0)
     seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
     centre = (seg + hover) / 2
-    post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -200.0], "radius": post_radius,
-            "height": 600.0}
+    post = {
+        "type": "cylinder",
+        "label": "post",
+        "at": [centre[0], centre[1], -200.0],
+        "radius": post_radius,
+        "height": 600.0,
+    }
     scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
     extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
     path = extension.tra_gen
@@ -279,7 +318,9 @@ def test_a_transfer_around_a_random_post(seed):
     demo, unit = random_demonstration(rng)
     extent = np.ptp(demo, axis=0).max()
     heading = rng.uniform(0.0, 2.0 * np.pi)
-    target = demo[-1] + np.append(np.array([np.cos(heading), np.sin(heading)]) * rng.uniform(1.5, 3.0) * extent, 0.0)
+    target = demo[-1] + np.append(
+        np.array([np.cos(heading), np.sin(heading)]) * rng.uniform(1.5, 3.0) * extent, 0.0
+    )
     blind = extend_demonstration(demo, target, seed=seed)
     seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
     tool = {"radius": rng.uniform(6, 14) * unit, "length": 100 * unit}
@@ -288,20 +329,38 @@ def test_a_transfer_around_a_random_post(seed):
     centre = seg + rng.uniform(0.35, 0.65) * (hover - seg)
     centre[:2] += rng.uniform(-0.5, 0.5, 2) * post_radius
     assert keep <= 0.25 * np.linalg.norm(hover - seg)
-    post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -300 * unit], "radius": post_radius,
-            "height": 800 * unit}
-    extension = extend_demonstration(demo, target, seed=seed,
-                                     scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}))
-    assert np.min(np.linalg.norm(dense(extension.complete, 10)[:, :2] - centre[:2], axis=1)) >= keep - 1e-6 * unit
+    post = {
+        "type": "cylinder",
+        "label": "post",
+        "at": [centre[0], centre[1], -300 * unit],
+        "radius": post_radius,
+        "height": 800 * unit,
+    }
+    extension = extend_demonstration(
+        demo,
+        target,
+        seed=seed,
+        scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}),
+    )
+    assert (
+        np.min(np.linalg.norm(dense(extension.complete, 10)[:, :2] - centre[:2], axis=1))
+        >= keep - 1e-6 * unit
+    )
     assert arc(extension.tra_gen) <= 1.05 * shortest_around(seg, hover, centre, keep)
     dt = 1.0 / len(demo)
-    assert np.all(peaks(extension.complete, dt) <= 1.1 * peaks(demo, dt)), peaks(extension.complete, dt) / peaks(demo, dt)
+    assert np.all(peaks(extension.complete, dt) <= 1.1 * peaks(demo, dt)), peaks(
+        extension.complete, dt
+    ) / peaks(demo, dt)
     chord = hover[:2] - seg[:2]
     along = float(np.dot(centre[:2] - seg[:2], chord) / np.dot(chord, chord))
-    beside = abs(float(chord[0] * (centre[1] - seg[1]) - chord[1] * (centre[0] - seg[0]))) / np.linalg.norm(chord)
+    beside = abs(
+        float(chord[0] * (centre[1] - seg[1]) - chord[1] * (centre[0] - seg[0]))
+    ) / np.linalg.norm(chord)
     floor = ldj_floor(max(keep - beside, 0.0) / np.linalg.norm(chord), along)
     n = len(demo)
-    deficit = log_dimensionless_jerk(transfer(blind, n), dt) - log_dimensionless_jerk(transfer(extension, n), dt)
+    deficit = log_dimensionless_jerk(transfer(blind, n), dt) - log_dimensionless_jerk(
+        transfer(extension, n), dt
+    )
     assert deficit <= floor + 0.3, (deficit, floor)
 
 
@@ -317,8 +376,12 @@ def test_a_route_over_a_cable_duct_across_the_plate(height):
     scene = Scene.from_dict({"tool": TOOL, "parts": [duct], "margin": 3.0})
     extension = extend_demonstration(demo, target, seed=0, scene=scene)
     path = extension.complete
-    dense = np.concatenate([a + np.linspace(0, 1, 20)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])])
-    over = np.abs(dense[:, 0] - 75.0) <= 10.0 + TOOL["radius"]  # the tool above the duct's footprint
+    dense = np.concatenate(
+        [a + np.linspace(0, 1, 20)[:, None] * (b - a) for a, b in zip(path[:-1], path[1:])]
+    )
+    over = (
+        np.abs(dense[:, 0] - 75.0) <= 10.0 + TOOL["radius"]
+    )  # the tool above the duct's footprint
     assert np.any(over) and np.min(dense[over, 2]) >= height + 3.0 - 1e-6
     np.testing.assert_allclose(path[-1], target, atol=1e-9)
     assert extension.refinement in ("lifted", "template", "smoothed", "shortcut")

@@ -65,7 +65,9 @@ def test_a_disk_that_fills_up_mid_write_keeps_the_old_file(tmp_path):
     path = tmp_path / "demo.csv"
     save_trajectory(np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 50), path)
     before = path.read_bytes()
-    result = subprocess.run([sys.executable, "-c", FULL_DISK, str(path)], capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [sys.executable, "-c", FULL_DISK, str(path)], capture_output=True, text=True, timeout=120
+    )
     assert result.returncode == 3, (result.stdout, result.stderr)
     assert path.read_bytes() == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["demo.csv"]
@@ -75,8 +77,12 @@ def test_a_full_disk_reaches_the_cli_as_one_line(tmp_path):
     """The same through the CLI: ``bidmp rollout ... -o`` under the size limit exits non-zero with
     an error line naming the file (after the fit's notes), and leaves no temporary file."""
     model = tmp_path / "m.npz"
-    bidmp.save(bidmp.DMP(n_kernels=10).fit(np.linspace([0.0, 0.0], [1.0, 2.0], 50) + np.sin(np.linspace(0, 3, 50))[:, None]),
-               model)
+    bidmp.save(
+        bidmp.DMP(n_kernels=10).fit(
+            np.linspace([0.0, 0.0], [1.0, 2.0], 50) + np.sin(np.linspace(0, 3, 50))[:, None]
+        ),
+        model,
+    )
     script = textwrap.dedent("""
         import resource, signal, sys
         signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
@@ -85,8 +91,12 @@ def test_a_full_disk_reaches_the_cli_as_one_line(tmp_path):
         sys.exit(main(sys.argv[1:]))
     """)
     out = tmp_path / "r.csv"
-    result = subprocess.run([sys.executable, "-c", script, "rollout", str(model), "--n-steps", "20000", "-o", str(out)],
-                            capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [sys.executable, "-c", script, "rollout", str(model), "--n-steps", "20000", "-o", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode != 0
     error = result.stderr.strip().splitlines()[-1]
     assert "r.csv" in error and "Traceback" not in result.stderr, result.stderr

@@ -34,7 +34,11 @@ def test_the_public_surface_refuses_nasty_input_by_name(tmp_path):
     everything = list(surface_sweep.sweep_calls(tmp_path, rng, PAIRS_FULL if FULL else 2_000))
     uncovered = sorted({label for label, _, kind, thunk, _, *_ in everything if thunk is None})
     runnable = [call for call in everything if call[3] is not None]
-    chosen = runnable if FULL else [runnable[i] for i in rng.choice(len(runnable), SAMPLE, replace=False)]
+    chosen = (
+        runnable
+        if FULL
+        else [runnable[i] for i in rng.choice(len(runnable), SAMPLE, replace=False)]
+    )
     with contextlib.chdir(tmp_path):  # a relative path a call may create lands in the test's folder
         outcomes, defects = surface_sweep.run(chosen)
     if FULL:
@@ -42,25 +46,36 @@ def test_the_public_surface_refuses_nasty_input_by_name(tmp_path):
         for key, count in outcomes.items():
             classes[key.rsplit(": ", 1)[1]] += count
         pairs = sum(1 for call in chosen if len(call[1]) == 2)
-        report = {"calls": len(chosen), "pairs": pairs, "entry_points": len({call[0] for call in chosen}),
-                  "uncovered": uncovered, "classes": classes, "defects": defects,
-                  "outcomes": dict(sorted(outcomes.items()))}
+        report = {
+            "calls": len(chosen),
+            "pairs": pairs,
+            "entry_points": len({call[0] for call in chosen}),
+            "uncovered": uncovered,
+            "classes": classes,
+            "defects": defects,
+            "outcomes": dict(sorted(outcomes.items())),
+        }
         path = ROOT / "docs" / "results" / "fuzz.json"
         partial = path.with_name(path.name + ".partial")
         partial.write_text(json.dumps(report, indent=1) + "\n", encoding="utf-8")
         partial.replace(path)
-    assert not uncovered, f"entry points without valid arguments (add them to surface_targets.py): {uncovered}"
+    assert not uncovered, (
+        f"entry points without valid arguments (add them to surface_targets.py): {uncovered}"
+    )
     assert not defects, f"{len(defects)} defects of {len(chosen)} calls: {defects[:40]}"
 
 
-@pytest.mark.parametrize("message, changes, named", [
-    ("y must have shape (T, D), got 1 dimension", {"y": None}, True),
-    ("got a string", {"a": "x"}, False),  # "a" the article is not the argument a
-    ("a has 3 rows, b has 4", {"a": None}, True),
-    ("goal must have 3 coordinates", {"start": None}, False),
-    ("model file /tmp/x/m.npz does not exist", {"path": "/tmp/x/m.npz"}, True),
-    ("n_steps must be >= 2", {"n_steps": -1, "dt": 0}, True),
-])
+@pytest.mark.parametrize(
+    "message, changes, named",
+    [
+        ("y must have shape (T, D), got 1 dimension", {"y": None}, True),
+        ("got a string", {"a": "x"}, False),  # "a" the article is not the argument a
+        ("a has 3 rows, b has 4", {"a": None}, True),
+        ("goal must have 3 coordinates", {"start": None}, False),
+        ("model file /tmp/x/m.npz does not exist", {"path": "/tmp/x/m.npz"}, True),
+        ("n_steps must be >= 2", {"n_steps": -1, "dt": 0}, True),
+    ],
+)
 def test_names_argument_tells_a_named_refusal(message, changes, named):
     """Structure guard of the sweep's own judge: what counts as naming the argument."""
     assert surface_sweep.names_argument(message, changes) is named

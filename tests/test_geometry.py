@@ -9,12 +9,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import bidmp
-from bidmp.tasks import scenarios
 from bidmp.cli import main
-from bidmp.tasks import evaluate
-from bidmp.extension import extend_demonstration, final_approach
+from bidmp.extension import NoFreeRouteError, extend_demonstration, final_approach
 from bidmp.scene import Scene, SceneError, Tool
-from bidmp.extension import NoFreeRouteError
+from bidmp.tasks import evaluate, scenarios
 
 TOOL = {"radius": 12.5, "length": 100.0}
 NUT = {"across_flats": 13, "height": 6.5, "stud": {"radius": 4, "above": 10}}
@@ -43,7 +41,9 @@ def cylinder_closed_form(point, tool_radius, tool_length, base, radius, height):
 
 def box_closed_form(point, tool_radius, tool_length, lower, upper):
     """Distance (> 0 cases) from a vertical cylinder to an axis-aligned box."""
-    to_rectangle = np.linalg.norm(np.maximum(np.maximum(lower[:2] - point[:2], point[:2] - upper[:2]), 0.0))
+    to_rectangle = np.linalg.norm(
+        np.maximum(np.maximum(lower[:2] - point[:2], point[:2] - upper[:2]), 0.0)
+    )
     vertical_gap = max(lower[2] - (point[2] + tool_length), point[2] - upper[2], 0.0)
     return float(np.hypot(max(to_rectangle - tool_radius, 0.0), vertical_gap))
 
@@ -51,7 +51,9 @@ def box_closed_form(point, tool_radius, tool_length, lower, upper):
 def test_clearance_to_a_cylinder_matches_the_closed_form_for_parallel_axes():
     rng = np.random.default_rng(0)
     base = np.array([10.0, -5.0, 0.0])
-    scene = scene_of({"type": "cylinder", "label": "post", "at": base.tolist(), "radius": 4.0, "height": 16.5})
+    scene = scene_of(
+        {"type": "cylinder", "label": "post", "at": base.tolist(), "radius": 4.0, "height": 16.5}
+    )
     checked = 0
     for point in rng.uniform([-60, -60, -140], [60, 60, 60], size=(400, 3)):
         expected = cylinder_closed_form(point, 12.5, 100.0, base, 4.0, 16.5)
@@ -74,34 +76,80 @@ def test_gjk_answers_off_the_shapes_are_not_taken_for_distances(monkeypatch):
     so it is not replayed here in isolation; the guard is tested by making coal's first answer
     a distance its nearest points do not bear out, and every answer is checked against
     the closed form on those placements, sweeps past them and 1000 random placements each."""
-    cases = [((169.80415092295226, -22.281346540941826), 18.06691042669175, 280.9494237754709, (194.93626516, 17.98545751, 59.99999999), 12.5),
-             ((-192.68901374467922, -18.703061415319553), 27.063229384665757, 436.3844539761248, (-149.88034053, -42.22793144, 126.1722646), 9.279404857491983)]
+    cases = [
+        (
+            (169.80415092295226, -22.281346540941826),
+            18.06691042669175,
+            280.9494237754709,
+            (194.93626516, 17.98545751, 59.99999999),
+            12.5,
+        ),
+        (
+            (-192.68901374467922, -18.703061415319553),
+            27.063229384665757,
+            436.3844539761248,
+            (-149.88034053, -42.22793144, 126.1722646),
+            9.279404857491983,
+        ),
+    ]
     rng = np.random.default_rng(23)
     checked = 0
     for (x, y), radius, height, point, tool_radius in cases:
         base = np.array([x, y, -100.0])
-        scene = Scene.from_dict({"tool": {"radius": tool_radius, "length": 100.0},
-                                 "parts": [{"type": "cylinder", "label": "post", "at": base.tolist(), "radius": radius, "height": height}]})
+        scene = Scene.from_dict(
+            {
+                "tool": {"radius": tool_radius, "length": 100.0},
+                "parts": [
+                    {
+                        "type": "cylinder",
+                        "label": "post",
+                        "at": base.tolist(),
+                        "radius": radius,
+                        "height": height,
+                    }
+                ],
+            }
+        )
         # GJK keeps a guess from one query to the next: placements in a row, as a motion queries them.
-        sweep = np.linspace(np.asarray(point) - [60, -40, 0], np.asarray(point) + [60, -40, 0], 1000)
-        scattered = base + np.column_stack([rng.uniform(-80, 80, (1000, 2)), rng.uniform(0, 200, 1000)])
+        sweep = np.linspace(
+            np.asarray(point) - [60, -40, 0], np.asarray(point) + [60, -40, 0], 1000
+        )
+        scattered = base + np.column_stack(
+            [rng.uniform(-80, 80, (1000, 2)), rng.uniform(0, 200, 1000)]
+        )
         for sample in np.vstack([sweep, point, scattered]):
             expected = cylinder_closed_form(sample, tool_radius, 100.0, base, radius, height)
             if expected > 0:
-                assert scene.clearance(sample[None]).distance == pytest.approx(expected, abs=1e-6), sample.tolist()
+                assert scene.clearance(sample[None]).distance == pytest.approx(
+                    expected, abs=1e-6
+                ), sample.tolist()
                 checked += 1
     assert checked > 1000
     # The guard: coal's first answer is a separation its nearest points do not bear out; the engine
     # asks again and returns the closed form.
-    scene = Scene.from_dict({"tool": {"radius": 12.5, "length": 100.0},
-                             "parts": [{"type": "cylinder", "label": "post", "at": [0, 0, -100], "radius": 18, "height": 300}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 12.5, "length": 100.0},
+            "parts": [
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [0, 0, -100],
+                    "radius": 18,
+                    "height": 300,
+                }
+            ],
+        }
+    )
     engine = scene._engine()
     real, calls = engine.coal.distance, []
 
     def first_answer_wrong(a, pose_a, b, pose_b, request, result):
         distance = real(a, pose_a, b, pose_b, request, result)
         calls.append(distance)
-        return 2.0 if len(calls) == 1 else distance  # the first: a separation its points do not bear out
+        return (
+            2.0 if len(calls) == 1 else distance
+        )  # the first: a separation its points do not bear out
 
     monkeypatch.setattr(engine.coal, "distance", first_answer_wrong)
     point = np.array([50.0, 10.0, 20.0])
@@ -124,7 +172,9 @@ def test_clearance_to_a_box_matches_the_closed_form():
 def test_hex_nut_clearance_at_its_corners_and_flats():
     scene = scene_of({"type": "nut", "label": "4", "at": [30, 0, -2], **NUT})
     corner = 13 / np.sqrt(3)  # yaw 0: a corner on +x and -x, flats facing +y and -y
-    assert scene.clearance([[0.0, 0.0, 0.0]]).distance == pytest.approx(30 - corner - 12.5, abs=1e-6)
+    assert scene.clearance([[0.0, 0.0, 0.0]]).distance == pytest.approx(
+        30 - corner - 12.5, abs=1e-6
+    )
     assert scene.clearance([[30.0, 50.0, 0.0]]).distance == pytest.approx(50 - 6.5 - 12.5, abs=1e-6)
     # Above the nut, the stud (4 mm radius up to 14.5 mm) is what the tool meets.
     over = scene.clearance([[30.0, 18.0, 10.0]])  # 5.5 mm above the nut, beside the stud
@@ -153,8 +203,12 @@ def test_clearance_along_a_trajectory_is_the_minimum_over_a_brute_force_check():
 
 def test_a_trajectory_through_a_stud_is_reported_with_the_studs_label():
     targets = {"3": [0, 0, 0], "4": [30, 0, 0]}
-    scene = scene_of({"type": "nut", "at_targets": "all", "offset": [0, 0, -2], **NUT}, targets=targets)
-    sweep = np.column_stack([np.linspace(0, 30, 50), np.zeros(50), np.full(50, 8.0)])  # above the nut, into the stud
+    scene = scene_of(
+        {"type": "nut", "at_targets": "all", "offset": [0, 0, -2], **NUT}, targets=targets
+    )
+    sweep = np.column_stack(
+        [np.linspace(0, 30, 50), np.zeros(50), np.full(50, 8.0)]
+    )  # above the nut, into the stud
     hit = scene.clearance(sweep, exclude="3")
     assert not hit.collision_free and hit.collision_part == "4/stud"
     assert hit.distance == pytest.approx(-(14.5 - 8.0), abs=1e-4)  # pushed up out of the stud
@@ -190,12 +244,18 @@ def test_the_kept_approach_is_the_demonstrated_one_translated(nut):
     start = extension.approach_index
     assert start == final_approach(demo, extension.segmentation_points)
     n = demo.shape[0] - start
-    np.testing.assert_allclose(extension.complete[-n:], demo[start:] + (target - demo[-1]), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        extension.complete[-n:], demo[start:] + (target - demo[-1]), rtol=0, atol=1e-9
+    )
     # At least T samples: the transfer takes as long as it needs.
-    assert extension.complete.shape[0] >= demo.shape[0] and np.array_equal(extension.complete[0], demo[0])
+    assert extension.complete.shape[0] >= demo.shape[0] and np.array_equal(
+        extension.complete[0], demo[0]
+    )
     # The kept approach is the straight vertical descent from 40 mm onto the nut.
     np.testing.assert_allclose(demo[start], [0.0, 0.0, 40.0], atol=0.5)
-    assert nut.scene.clearance(extension.complete, exclude=nut.scene.parts_at(target)).collision_free
+    assert nut.scene.clearance(
+        extension.complete, exclude=nut.scene.parts_at(target)
+    ).collision_free
     paper = extend_demonstration(demo, target, seed=0, approach="paper")
     assert paper.approach == "paper" and paper.approach_index is None
 
@@ -208,7 +268,13 @@ def test_gprm_routes_the_transfer_around_a_part_in_its_way(nut):
     # ends where the kept approach, the demonstration's last samples from approach_index, begins).
     hover = len(blind.complete) - (len(demo) - blind.approach_index)
     middle = blind.complete[(blind.seg_index + hover) // 2]
-    block = {"type": "cylinder", "label": "block", "at": (middle - [0, 0, 10]).tolist(), "radius": 3, "height": 20}
+    block = {
+        "type": "cylinder",
+        "label": "block",
+        "at": (middle - [0, 0, 10]).tolist(),
+        "radius": 3,
+        "height": 20,
+    }
     scene = scene_of(block)
     assert not scene.clearance(blind.complete).collision_free
     routed = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
@@ -222,7 +288,12 @@ def test_a_wall_that_blocks_every_route_is_a_clear_error(nut):
 
 
 def test_a_part_in_the_translated_approach_is_a_clear_error(nut):
-    shelf = {"type": "box", "label": "shelf", "at": [170, 25, 20], "size": [24, 40, 5]}  # overhangs the descent
+    shelf = {
+        "type": "box",
+        "label": "shelf",
+        "at": [170, 25, 20],
+        "size": [24, 40, 5],
+    }  # overhangs the descent
     with pytest.raises(NoFreeRouteError, match="approach.*hits part 'shelf'"):
         extend_demonstration(nut.demonstration, [150.0, 25.0, 0.0], seed=0, scene=scene_of(shelf))
 
@@ -237,11 +308,21 @@ def nut_report(nut):
 
 def test_nut_task_bidmp_defaults_succeed_on_every_nut(nut_report):
     bidmp_result = nut_report.methods["bidmp"]
-    assert bidmp_result.task_successes == 14 and bidmp_result.collision_free == 14 and bidmp_result.engaged == 14
+    assert (
+        bidmp_result.task_successes == 14
+        and bidmp_result.collision_free == 14
+        and bidmp_result.engaged == 14
+    )
     assert bidmp_result.worst_clearance.distance >= 0.0
     assert nut_report.methods["dmp"].task_successes == 8
     data = nut_report.to_dict()["methods"]["bidmp"]
-    for key in ("task_successes", "collision_free", "engaged", "min_clearance", "min_clearance_part"):
+    for key in (
+        "task_successes",
+        "collision_free",
+        "engaged",
+        "min_clearance",
+        "min_clearance_part",
+    ):
         assert key in data
     assert set(data["targets"]["12"]) >= {"clearance", "engaged", "collision_part"}
     assert data["targets"]["12"]["collision_part"] is None
@@ -254,8 +335,12 @@ def test_nut_task_with_the_paper_approach_keeps_todays_numbers(nut):
     result = report.methods["bidmp"]
     assert result.successes == 14 and result.engaged == 6  # ends on every nut, engages 6
     data = result.to_dict()
-    hits = {label: t["collision_part"] for label, t in data["targets"].items() if t["collision_part"]}
-    assert hits and all(part.endswith("/stud") for part in hits.values())  # through the neighbours' studs
+    hits = {
+        label: t["collision_part"] for label, t in data["targets"].items() if t["collision_part"]
+    }
+    assert hits and all(
+        part.endswith("/stud") for part in hits.values()
+    )  # through the neighbours' studs
     assert data["min_clearance"] < 0
 
 
@@ -270,9 +355,16 @@ def test_cell_removal_reaches_every_cell_without_touching_a_neighbour():
 
 def test_a_layout_read_from_a_file_behaves_the_same(tmp_path, nut):
     spec = nut.to_dict()
-    spec["targets"] = {f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)}
+    spec["targets"] = {
+        f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)
+    }
     spec["demonstrated"] = "r0c0"
-    spec["scene"]["parts"][0] = {"type": "plate", "label": "plate", "at": [70, 45, -2], "size": [240, 160, 5]}
+    spec["scene"]["parts"][0] = {
+        "type": "plate",
+        "label": "plate",
+        "at": [70, 45, -2],
+        "size": [240, 160, 5],
+    }
     spec["scene"]["parts"][1]["stud"]["above"] = 14
     spec["methods"] = ["dmp", "bidmp"]
     path = tmp_path / "grid.json"
@@ -289,25 +381,95 @@ def test_a_layout_read_from_a_file_behaves_the_same(tmp_path, nut):
 @pytest.mark.parametrize(
     "data, targets, match",
     [
-        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [10, 10, 10]},
-                                  {"type": "box", "label": "b", "at": [5, 0, 0], "size": [10, 10, 10]}]}, None, "overlap by 5"),
-        ({"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]}, {"3": [0, 0, 0], "9": [90, 0, 0]},
-         "target '9' has no part"),
-        ({"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]}, {"3": [60, 0, 0]},
-         "target '3' .* is not on part '3'"),
-        ({"tool": {"radius": 0, "length": 100}, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]}]},
-         None, "tool.radius: must be > 0"),
-        ({"tool": TOOL, "parts": [{"type": "sphere", "label": "a", "at": [0, 0, 0]}]}, None,
-         "unknown part type 'sphere' .known: box, cell, cylinder, nut, plate"),
-        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1], "colour": "red"}]}, None,
-         "unknown key for a box"),
-        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0]}]}, None, "size: expected a list of 3"),
-        ({"tool": TOOL, "parts": [{"type": "nut", "label": "a", "at": [0, 0, 0], "across_flats": 13, "height": 6.5,
-                                   "stud": {"radius": 7, "above": 10}}]}, None, "does not fit inside the nut"),
-        ({"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]},
-                                  {"type": "box", "label": "a", "at": [9, 0, 0], "size": [1, 1, 1]}]}, None, "two parts are labelled 'a'"),
+        (
+            {
+                "tool": TOOL,
+                "parts": [
+                    {"type": "box", "label": "a", "at": [0, 0, 0], "size": [10, 10, 10]},
+                    {"type": "box", "label": "b", "at": [5, 0, 0], "size": [10, 10, 10]},
+                ],
+            },
+            None,
+            "overlap by 5",
+        ),
+        (
+            {"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]},
+            {"3": [0, 0, 0], "9": [90, 0, 0]},
+            "target '9' has no part",
+        ),
+        (
+            {"tool": TOOL, "parts": [{"type": "nut", "label": "3", "at": [0, 0, -2], **NUT}]},
+            {"3": [60, 0, 0]},
+            "target '3' .* is not on part '3'",
+        ),
+        (
+            {
+                "tool": {"radius": 0, "length": 100},
+                "parts": [{"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]}],
+            },
+            None,
+            "tool.radius: must be > 0",
+        ),
+        (
+            {"tool": TOOL, "parts": [{"type": "sphere", "label": "a", "at": [0, 0, 0]}]},
+            None,
+            "unknown part type 'sphere' .known: box, cell, cylinder, nut, plate",
+        ),
+        (
+            {
+                "tool": TOOL,
+                "parts": [
+                    {
+                        "type": "box",
+                        "label": "a",
+                        "at": [0, 0, 0],
+                        "size": [1, 1, 1],
+                        "colour": "red",
+                    }
+                ],
+            },
+            None,
+            "unknown key for a box",
+        ),
+        (
+            {"tool": TOOL, "parts": [{"type": "box", "label": "a", "at": [0, 0, 0]}]},
+            None,
+            "size: expected a list of 3",
+        ),
+        (
+            {
+                "tool": TOOL,
+                "parts": [
+                    {
+                        "type": "nut",
+                        "label": "a",
+                        "at": [0, 0, 0],
+                        "across_flats": 13,
+                        "height": 6.5,
+                        "stud": {"radius": 7, "above": 10},
+                    }
+                ],
+            },
+            None,
+            "does not fit inside the nut",
+        ),
+        (
+            {
+                "tool": TOOL,
+                "parts": [
+                    {"type": "box", "label": "a", "at": [0, 0, 0], "size": [1, 1, 1]},
+                    {"type": "box", "label": "a", "at": [9, 0, 0], "size": [1, 1, 1]},
+                ],
+            },
+            None,
+            "two parts are labelled 'a'",
+        ),
         ({"tool": TOOL, "parts": []}, None, "non-empty list of parts"),
-        ({"tool": TOOL, "parts": [{"type": "box", "at_targets": ["x"], "size": [1, 1, 1]}]}, {"3": [0, 0, 0]}, "'x' is not a target"),
+        (
+            {"tool": TOOL, "parts": [{"type": "box", "at_targets": ["x"], "size": [1, 1, 1]}]},
+            {"3": [0, 0, 0]},
+            "'x' is not a target",
+        ),
     ],
 )
 def test_bad_scene_data_is_a_clear_error(data, targets, match):
@@ -322,7 +484,9 @@ def test_a_tool_of_zero_size_is_refused_directly():
 
 def test_bad_scene_in_a_scenario_file_is_one_line_from_the_cli(tmp_path, capsys, nut):
     spec = nut.to_dict()
-    spec["scene"]["parts"].append({"type": "box", "label": "intruder", "at": [0, 0, -2], "size": [5, 5, 5]})
+    spec["scene"]["parts"].append(
+        {"type": "box", "label": "intruder", "at": [0, 0, -2], "size": [5, 5, 5]}
+    )
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(spec))
     assert main(["scenario", "check", str(path)]) == 2
@@ -341,7 +505,9 @@ def test_without_coal_the_geometry_says_how_to_install_it(monkeypatch, capsys):
 
 def test_final_approach_is_the_straight_tail_of_the_last_piece():
     angles = np.linspace(0.0, np.pi / 2, 50)
-    arc = np.column_stack([40 * np.cos(angles), 40 * np.sin(angles), np.zeros(50)])  # ends at (0, 40, 0) heading -x
+    arc = np.column_stack(
+        [40 * np.cos(angles), 40 * np.sin(angles), np.zeros(50)]
+    )  # ends at (0, 40, 0) heading -x
     line = np.column_stack([np.linspace(0, -60, 31)[1:], np.full(30, 40.0), np.zeros(30)])
     y = np.vstack([arc, line])
     start = final_approach(y, np.array([], dtype=int))
@@ -350,9 +516,13 @@ def test_final_approach_is_the_straight_tail_of_the_last_piece():
     offsets = y[start:] - y[start]
     deviation = np.linalg.norm(offsets - np.outer(offsets @ chord, chord), axis=1)
     assert deviation.max() <= 0.02 * np.linalg.norm(y[-1] - y[start])
-    assert final_approach(y, np.array([], dtype=int), straightness=0.001) >= 47  # stricter: closer to the join
+    assert (
+        final_approach(y, np.array([], dtype=int), straightness=0.001) >= 47
+    )  # stricter: closer to the join
     assert final_approach(line, np.array([], dtype=int)) == 0  # all straight: all of it
-    wiggle = np.column_stack([np.linspace(0, 10, 40), np.sin(np.linspace(0, 12 * np.pi, 40)), np.zeros(40)])
+    wiggle = np.column_stack(
+        [np.linspace(0, 10, 40), np.sin(np.linspace(0, 12 * np.pi, 40)), np.zeros(40)]
+    )
     assert final_approach(wiggle, np.array([], dtype=int)) >= 37  # no straight approach to speak of
 
 
@@ -365,17 +535,34 @@ def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
     from bidmp.scene.distances import _Distances
 
     coal = pytest.importorskip("coal")
-    scene = Scene.from_dict({"tool": {"radius": 12.5, "length": 100}, "targets_on_parts": False,
-                             "parts": [{"type": "cylinder", "label": "post", "at": [0, 0, 0], "radius": 15, "height": 120}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 12.5, "length": 100},
+            "targets_on_parts": False,
+            "parts": [
+                {"type": "cylinder", "label": "post", "at": [0, 0, 0], "radius": 15, "height": 120}
+            ],
+        }
+    )
     engine = _Distances(scene.solids, scene.tool)
     known_bad = np.array([-28.08238384203306, 20.653673896376088, 51.0573405982136])
     shape, pose = engine.shapes[0]
-    raw = coal.distance(engine.tool, coal.Transform3s(np.eye(3), known_bad + [0.0, 0.0, 50.0]), shape, pose,
-                        engine.request, coal.DistanceResult())
+    raw = coal.distance(
+        engine.tool,
+        coal.Transform3s(np.eye(3), known_bad + [0.0, 0.0, 50.0]),
+        shape,
+        pose,
+        engine.request,
+        coal.DistanceResult(),
+    )
     gap = float(np.hypot(*known_bad[:2]) - 27.5)
-    assert raw < -1e100 or abs(raw - gap) <= 1e-6  # the reproduction (if this coal still fails there)
+    assert (
+        raw < -1e100 or abs(raw - gap) <= 1e-6
+    )  # the reproduction (if this coal still fails there)
     assert engine.tool_to(known_bad, 0) == pytest.approx(gap, abs=1e-6)
-    assert engine.tool_to(known_bad, 0) == pytest.approx(gap, abs=1e-6)  # and again on the same engine
+    assert engine.tool_to(known_bad, 0) == pytest.approx(
+        gap, abs=1e-6
+    )  # and again on the same engine
     # Random placements beside the post, the tool's span overlapping the post's: the gap is the
     # distance between the axes less both radii (an independent closed form).
     rng = np.random.default_rng(21)
@@ -391,8 +578,10 @@ def test_gjk_degenerate_queries_get_the_closed_form_distance_not_an_abort():
 def _post_scene(margin, at=(22.5, -27.6)):
     base = scenarios.load("nut-unscrewing")
     data = base.to_dict()["scene"]
-    data["parts"] = [*data["parts"], {"type": "cylinder", "label": "post", "at": [at[0], at[1], -2], "radius": 8,
-                                      "height": 200}]
+    data["parts"] = [
+        *data["parts"],
+        {"type": "cylinder", "label": "post", "at": [at[0], at[1], -2], "radius": 8, "height": 200},
+    ]
     if margin:
         data["margin"] = margin
     return base, Scene.from_dict(data, base.targets)
@@ -401,7 +590,12 @@ def _post_scene(margin, at=(22.5, -27.6)):
 def _post_clearance(path, at=(22.5, -27.6)):
     """Closed form: the tool (radius 12.5, above the path) beside the vertical post (radius 8) whose
     height spans the tool's here: horizontal distance between the axes less both radii."""
-    fine = np.vstack([path[i] + np.linspace(0.0, 1.0, 25)[:, None] * (path[i + 1] - path[i]) for i in range(len(path) - 1)])
+    fine = np.vstack(
+        [
+            path[i] + np.linspace(0.0, 1.0, 25)[:, None] * (path[i + 1] - path[i])
+            for i in range(len(path) - 1)
+        ]
+    )
     return float(np.min(np.hypot(fine[:, 0] - at[0], fine[:, 1] - at[1])) - 20.5)
 
 
@@ -421,14 +615,19 @@ def test_an_extension_keeps_the_scenes_margin_from_every_part(seed):
     close = extend_demonstration(base.demonstration, target, seed=seed, scene=bare)
     far = extend_demonstration(base.demonstration, target, seed=seed, scene=kept)
     assert _post_clearance(close.complete, at) < 5.0  # the check can fail
-    assert _post_clearance(far.tra_gen, at) >= 5.0 - 1e-9 and _post_clearance(far.complete, at) >= 5.0 - 1e-6
+    assert (
+        _post_clearance(far.tra_gen, at) >= 5.0 - 1e-9
+        and _post_clearance(far.complete, at) >= 5.0 - 1e-6
+    )
     assert kept.clearance(far.complete, exclude=kept.parts_at(target)).clear
 
 
 def test_a_margin_is_validated_and_counts_in_task_success():
     _, kept = _post_scene(5.0)
     assert kept.to_dict()["margin"] == 5.0
-    near = np.array([[22.5 + 20.5 + 2.0, -27.6, 150.0], [22.5 + 20.5 + 2.0, -27.6, 120.0]])  # 2 mm from the post
+    near = np.array(
+        [[22.5 + 20.5 + 2.0, -27.6, 150.0], [22.5 + 20.5 + 2.0, -27.6, 120.0]]
+    )  # 2 mm from the post
     clearance = kept.clearance(near)
     assert clearance.collision_free and not clearance.clear and clearance.part == "post"
     with pytest.raises(SceneError, match="scene.margin"):
@@ -452,13 +651,18 @@ def test_a_scenario_keeps_3_mm_by_default_in_its_units():
     metres["demonstration"] = {"points": (minimum_jerk_points() * scale).tolist()}
     metres["success_threshold"] = 1.75 * scale
     metres["scene"]["tool"] = {"radius": 0.01, "length": 0.1}
-    metres["scene"]["parts"] = [{"type": "box", "label": "pad", "at": [0.3, 0.06, -0.04], "size": [0.03, 0.03, 0.04]}]
+    metres["scene"]["parts"] = [
+        {"type": "box", "label": "pad", "at": [0.3, 0.06, -0.04], "size": [0.03, 0.03, 0.04]}
+    ]
     metres["scene"]["targets"] = ["op1"]
     metres["scene"]["targets_on_parts"] = False
     metres["robot"] = {"base": [0.17, -0.33, 0.03], "yaw": 90}
     assert scenarios.from_dict(metres).scene.margin == pytest.approx(0.003)
     box = [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [1, 1, 1]}]
-    assert Scene.from_dict({"tool": {"radius": 2.0, "length": 50}, "parts": box}, units="mm").margin == 2.0  # <= the radius
+    assert (
+        Scene.from_dict({"tool": {"radius": 2.0, "length": 50}, "parts": box}, units="mm").margin
+        == 2.0
+    )  # <= the radius
     assert Scene.from_dict({"tool": TOOL, "parts": box}).margin == 0.0  # no units: no default
 
 
@@ -476,18 +680,33 @@ def test_a_part_at_its_stand_off_does_not_hide_another_inside_the_margin():
     scene = scene_of(plate, post, margin=3.0, standoff={"plate": 1.0})
 
     def passing(height, gap):  # along x at ``height`` over the plate, ``gap`` beside the post
-        return np.column_stack([np.linspace(-100, 100, 401), np.full(401, 16.5 + gap), np.full(401, height)])
+        return np.column_stack(
+            [np.linspace(-100, 100, 401), np.full(401, 16.5 + gap), np.full(401, height)]
+        )
 
     hidden = scene.clearance(passing(1.5, 2.5))  # plate 1.5 (>= 1), post 2.5 (< 3)
-    assert not hidden.clear and hidden.part == "post" and hidden.distance == pytest.approx(2.5, abs=1e-6)
+    assert (
+        not hidden.clear
+        and hidden.part == "post"
+        and hidden.distance == pytest.approx(2.5, abs=1e-6)
+    )
     fine = scene.clearance(passing(1.5, 5.0))
-    assert fine.clear and fine.part == "plate" and fine.margin == 1.0 and fine.distance == pytest.approx(1.5, abs=1e-6)
+    assert (
+        fine.clear
+        and fine.part == "plate"
+        and fine.margin == 1.0
+        and fine.distance == pytest.approx(1.5, abs=1e-6)
+    )
     low = scene.clearance(passing(0.5, 5.0))
     assert not low.clear and low.part == "plate"
-    assert not scene_of(plate, post, margin=3.0).clearance(passing(1.5, 5.0)).clear  # without the stand-off
+    assert (
+        not scene_of(plate, post, margin=3.0).clearance(passing(1.5, 5.0)).clear
+    )  # without the stand-off
     with pytest.raises(SceneError, match="standoff.ring: is not the label of a part"):
         scene_of(plate, margin=3.0, standoff={"ring": 1.0})
-    with pytest.raises(SceneError, match=r"standoff.plate: expected a clearance in \[0, the margin 3\]"):
+    with pytest.raises(
+        SceneError, match=r"standoff.plate: expected a clearance in \[0, the margin 3\]"
+    ):
         scene_of(plate, margin=3.0, standoff={"plate": 4.0})
 
 
@@ -497,9 +716,23 @@ def test_a_tool_turning_in_place_is_checked_along_its_sweep():
     from the tip, which neither end pose comes near. Placements spaced by the tip's travel alone
     (zero here) saw only the two end poses and reported it clear; spaced by the sweep, the block
     is hit."""
-    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 100.0},
-                             "parts": [{"type": "box", "label": "block", "at": [0.0, 49.5, 44.5], "size": [10.0, 10.0, 10.0]}]})
-    poses = (Rotation.from_euler("x", [[0.0], [-90.0]], degrees=True) * Rotation.from_euler("x", 180.0, degrees=True)).as_quat()
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 5.0, "length": 100.0},
+            "parts": [
+                {
+                    "type": "box",
+                    "label": "block",
+                    "at": [0.0, 49.5, 44.5],
+                    "size": [10.0, 10.0, 10.0],
+                }
+            ],
+        }
+    )
+    poses = (
+        Rotation.from_euler("x", [[0.0], [-90.0]], degrees=True)
+        * Rotation.from_euler("x", 180.0, degrees=True)
+    ).as_quat()
     tip = np.zeros((2, 3))
     for pose in poses:
         assert scene.clearance(tip[:1], orientations=pose[None]).distance > 30.0

@@ -33,8 +33,12 @@ def test_a_goal_moved_half_way_is_reached_at_rest_within_the_limits_with_the_app
     unit = float(rng.choice([1.0, 1e-3]))
     goal = rng.uniform(-150, 150, 3)
     descent = rng.uniform(30, 80)
-    start = goal + np.append(rng.uniform(-200, 200, 2), descent + rng.uniform(60, 200))  # above the approach
-    demonstration = minimum_jerk(np.array([start, goal + [0, 0, descent], goal]) * unit, int(rng.integers(200, 500)))
+    start = goal + np.append(
+        rng.uniform(-200, 200, 2), descent + rng.uniform(60, 200)
+    )  # above the approach
+    demonstration = minimum_jerk(
+        np.array([start, goal + [0, 0, descent], goal]) * unit, int(rng.integers(200, 500))
+    )
     duration = float(rng.uniform(2, 5))
     dmp = DMP(keep_approach=True).fit(demonstration, np.linspace(0, duration, len(demonstration)))
     dt = 0.001
@@ -44,15 +48,25 @@ def test_a_goal_moved_half_way_is_reached_at_rest_within_the_limits_with_the_app
     shift *= 5.0 * unit / np.linalg.norm(shift)  # 5 mm, any direction
     new_goal = dmp.goal_ + shift
     half = int(round(0.5 * duration / dt))
-    y, yd, ydd = run(dmp.stepper(), len(plain.t), dt, (half, lambda s: s.set_goal(new_goal, limits=limits)))
+    y, yd, ydd = run(
+        dmp.stepper(), len(plain.t), dt, (half, lambda s: s.set_goal(new_goal, limits=limits))
+    )
     assert np.linalg.norm(y[-1] - new_goal) <= 1e-3 * unit + np.linalg.norm(plain.y[-1] - dmp.goal_)
-    assert np.linalg.norm(yd[-1]) <= np.linalg.norm(plain.yd[-1]) + 1e-6 * unit  # at rest as the plain motion is
+    assert (
+        np.linalg.norm(yd[-1]) <= np.linalg.norm(plain.yd[-1]) + 1e-6 * unit
+    )  # at rest as the plain motion is
     assert np.max(np.linalg.norm(ydd, axis=1)) <= limits["max_acceleration"]
     # No step in the command: consecutive accelerations differ by what a smooth motion allows.
-    assert np.max(np.linalg.norm(np.diff(ydd, axis=0), axis=1)) <= 2.0 * np.max(np.linalg.norm(np.diff(plain.ydd, axis=0), axis=1)) + 1e-9
+    assert (
+        np.max(np.linalg.norm(np.diff(ydd, axis=0), axis=1))
+        <= 2.0 * np.max(np.linalg.norm(np.diff(plain.ydd, axis=0), axis=1)) + 1e-9
+    )
     # The last approach height (the lower half of the demonstrated descent, as the nut task's last
     # 28.5 mm of its 40): the moved motion is the plain one plus the shift.
-    low = np.arange(len(plain.t)) > np.flatnonzero(plain.y[:, 2] > dmp.goal_[2] + 0.5 * descent * unit)[-1]
+    low = (
+        np.arange(len(plain.t))
+        > np.flatnonzero(plain.y[:, 2] > dmp.goal_[2] + 0.5 * descent * unit)[-1]
+    )
     lateral = (y[low] - plain.y[low] - shift)[:, :2]
     assert np.max(np.linalg.norm(lateral, axis=1)) <= 0.5 * unit  # 0.5 mm
 
@@ -81,10 +95,14 @@ def test_a_late_update_is_blended_over_the_limits_and_said_to_tilt_the_approach(
     for _ in range(3900):
         stepper.step(0.001)
     with caplog.at_level(logging.WARNING):
-        blend = stepper.set_goal(dmp.goal_ + [5.0, 0, 0], limits={"max_acceleration": 100.0, "max_jerk": 1000.0})
+        blend = stepper.set_goal(
+            dmp.goal_ + [5.0, 0, 0], limits={"max_acceleration": 100.0, "max_jerk": 1000.0}
+        )
     assert any("approach" in record.getMessage() for record in caplog.records)
     # A quarter of each limit on its own: 5 mm needs sqrt(5 · 7.51 / 25) s and cbrt(5 · 52.5 / 250) s.
-    assert blend == pytest.approx(max(np.sqrt(5 * 7.5132 / 25.0), np.cbrt(5 * 52.5 / 250.0)), rel=1e-4)
+    assert blend == pytest.approx(
+        max(np.sqrt(5 * 7.5132 / 25.0), np.cbrt(5 * 52.5 / 250.0)), rel=1e-4
+    )
     with pytest.raises(ValueError, match="goal"):
         stepper.set_goal([1.0, 2.0])
     with pytest.raises(ValueError, match="blend"):
@@ -98,7 +116,10 @@ def test_a_goal_moved_after_the_goal_share_is_complete_without_limits_is_blended
     demonstration = minimum_jerk([[0, 0, 100], [200, 0, 100], [200, 0, 0]], 400)
     dmp = DMP().fit(demonstration, np.linspace(0, 4, 400))
     own = dmp.trajectory(dt=0.001)
-    own_speed, own_acceleration = (np.linalg.norm(own.yd, axis=1).max(), np.linalg.norm(own.ydd, axis=1).max())
+    own_speed, own_acceleration = (
+        np.linalg.norm(own.yd, axis=1).max(),
+        np.linalg.norm(own.ydd, axis=1).max(),
+    )
     stepper = dmp.stepper()
     commands = []
     for step in range(12000):
@@ -107,12 +128,17 @@ def test_a_goal_moved_after_the_goal_share_is_complete_without_limits_is_blended
         commands.append(stepper.step(0.001))
     assert blend > 0.0
     y = np.array([c[0] for c in commands])
-    offset = y[int(0.95 * 4000):] - np.array([c[0] for c in commands])[int(0.95 * 4000)]
+    offset = y[int(0.95 * 4000) :] - np.array([c[0] for c in commands])[int(0.95 * 4000)]
     speed = np.linalg.norm(np.diff(y, axis=0), axis=1) / 0.001
-    assert speed.max() <= own_speed * (1 + 1e-6) + 0.25 * own_speed  # the motion's own plus a quarter
-    assert np.linalg.norm(np.diff(y[-3:], axis=0)) <= 1e-9 and np.linalg.norm(y[-1] - (dmp.goal_ + [5, 0, 0])) <= 1e-3
+    assert (
+        speed.max() <= own_speed * (1 + 1e-6) + 0.25 * own_speed
+    )  # the motion's own plus a quarter
+    assert (
+        np.linalg.norm(np.diff(y[-3:], axis=0)) <= 1e-9
+        and np.linalg.norm(y[-1] - (dmp.goal_ + [5, 0, 0])) <= 1e-3
+    )
     acceleration = np.linalg.norm(np.diff(y, n=2, axis=0), axis=1) / 0.001**2
-    assert acceleration[int(0.95 * 4000):].max() <= 1.3 * own_acceleration
+    assert acceleration[int(0.95 * 4000) :].max() <= 1.3 * own_acceleration
     assert offset.shape[0] > 0
 
 
@@ -120,7 +146,9 @@ def test_the_blends_peak_derivatives_are_the_constants_used():
     u = np.linspace(0.0, 1.0, 400001)
     first, second = _smoothstep_derivatives(u)
     third = np.gradient(second, u)
-    np.testing.assert_allclose([first.max(), np.abs(second).max(), np.abs(third).max()], _PEAKS, rtol=1e-4)
+    np.testing.assert_allclose(
+        [first.max(), np.abs(second).max(), np.abs(third).max()], _PEAKS, rtol=1e-4
+    )
 
 
 def test_a_pose_goal_moved_mid_motion_is_reached_and_the_reported_rates_are_the_motions():
@@ -133,12 +161,18 @@ def test_a_pose_goal_moved_mid_motion_is_reached_and_the_reported_rates_are_the_
 
     s = np.linspace(0.0, 1.0, 300)
     turn = Rotation.from_rotvec(np.outer(10 * s**3 - 15 * s**4 + 6 * s**5, [0.2, -0.4, 2.5]))
-    poses = np.hstack([minimum_jerk(np.array([[0.0, 0, 150], [120, 30, 60], [120, 30, 0]]), 300),
-                       (turn * Rotation.from_euler("x", 180, degrees=True)).as_quat()])
+    poses = np.hstack(
+        [
+            minimum_jerk(np.array([[0.0, 0, 150], [120, 30, 60], [120, 30, 0]]), 300),
+            (turn * Rotation.from_euler("x", 180, degrees=True)).as_quat(),
+        ]
+    )
     model = CartesianDMP().fit(poses, np.linspace(0.0, 3.0, 300), units="mm")
     new_pose = poses[-1].copy()
     new_pose[:3] += [4.0, -3.0, 0.0]
-    new_pose[3:] = (Rotation.from_rotvec([0.0, 0.0, 0.2]) * Rotation.from_quat(poses[-1, 3:])).as_quat()
+    new_pose[3:] = (
+        Rotation.from_rotvec([0.0, 0.0, 0.2]) * Rotation.from_quat(poses[-1, 3:])
+    ).as_quat()
     stepper, dt, commands = model.stepper(), 0.001, []
     for index in range(3300):
         if index == 1500:
@@ -152,4 +186,6 @@ def test_a_pose_goal_moved_mid_motion_is_reached_and_the_reported_rates_are_the_
     # ω from the quaternions themselves: R(t+dt) R(t-dt)^-1 as a rotation vector over 2 dt.
     rotations = Rotation.from_quat(pose[:, 3:])
     measured = (rotations[2:] * rotations[:-2].inv()).as_rotvec() / (2 * dt)
-    np.testing.assert_allclose(velocity[1:-1, 3:], measured, atol=2e-3 * max(np.abs(measured).max(), 1.0))
+    np.testing.assert_allclose(
+        velocity[1:-1, 3:], measured, atol=2e-3 * max(np.abs(measured).max(), 1.0)
+    )

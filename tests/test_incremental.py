@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 import bidmp
-from bidmp import BiDMP, DMP, extend_demonstration, forgetting
+from bidmp import DMP, BiDMP, extend_demonstration, forgetting
+from bidmp._trajectory import resample_time
 from bidmp.demonstrations import lasa, minimum_jerk
 from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
-from bidmp._trajectory import resample_time
 
 
 def relative_rmse(a, b):
@@ -27,10 +27,17 @@ def test_learned_demonstration_is_reproduced_at_its_goal(battery):
     model = BiDMP(dmp).learn(extension.complete, duration=extension.duration_for(dmp))
     assert model.n_skills == 2
     rollout = model.rollout(BATTERY_EXTENSION_TARGET)
-    assert abs(len(rollout) - len(extension.complete)) <= 1  # the skill lasts as long as its demonstration
+    assert (
+        abs(len(rollout) - len(extension.complete)) <= 1
+    )  # the skill lasts as long as its demonstration
     assert relative_rmse(rollout, resample_time(extension.complete, len(rollout))) < 0.01
     # ... which the plain DMP cannot do.
-    assert relative_rmse(dmp.rollout(BATTERY_EXTENSION_TARGET), resample_time(extension.complete, dmp.n_steps_)) > 0.05
+    assert (
+        relative_rmse(
+            dmp.rollout(BATTERY_EXTENSION_TARGET), resample_time(extension.complete, dmp.n_steps_)
+        )
+        > 0.05
+    )
 
 
 @pytest.mark.parametrize("name", ["Sshape", "WShape"])
@@ -58,8 +65,12 @@ def test_zero_forcing_increment_leaves_the_dmp_unchanged(battery):
     demo, dmp, _ = battery
     model = BiDMP(dmp).learn_increment(np.zeros((dmp.n_steps_, 3)), goal=[150.0, 25.0, 0.0])
     for goal in ([150.0, 25.0, 0.0], [30.0, 50.0, 0.0]):
-        np.testing.assert_allclose(model.rollout(goal, skill=1), dmp.rollout(goal), rtol=0, atol=1e-12)
-    np.testing.assert_allclose(model.forcing_term(dmp.phase()), dmp.forcing_term(dmp.phase()), atol=1e-12)
+        np.testing.assert_allclose(
+            model.rollout(goal, skill=1), dmp.rollout(goal), rtol=0, atol=1e-12
+        )
+    np.testing.assert_allclose(
+        model.forcing_term(dmp.phase()), dmp.forcing_term(dmp.phase()), atol=1e-12
+    )
 
 
 def three_operator_demonstrations(n_steps=200):
@@ -132,22 +143,44 @@ def test_save_load_reproduces_rollouts_bit_for_bit(tmp_path, battery):
     assert isinstance(loaded, BiDMP) and loaded.n_skills == 2 and loaded.increments == (10, 15)
     for goal in (BATTERY_EXTENSION_TARGET, demo[-1], [90.0, 50.0, 0.0]):
         for skill in ("nearest", "latest", 0, 1):
-            np.testing.assert_array_equal(loaded.rollout(goal, skill=skill), model.rollout(goal, skill=skill))
+            np.testing.assert_array_equal(
+                loaded.rollout(goal, skill=skill), model.rollout(goal, skill=skill)
+            )
 
 
 @pytest.mark.parametrize(
     "call, error, match",
     [
-        (lambda m: m.learn(np.zeros((50, 2)) + np.arange(50)[:, None]), ValueError, "y_dn has D = 2"),
+        (
+            lambda m: m.learn(np.zeros((50, 2)) + np.arange(50)[:, None]),
+            ValueError,
+            "y_dn has D = 2",
+        ),
         (lambda m: m.learn(np.full((50, 3), np.nan)), ValueError, "NaN"),
         (lambda m: m.learn(np.ones((2, 3))), ValueError, "at least 3 points"),
-        (lambda m: m.rollout([1.0, 2.0, 3.0], skill="favourite"), ValueError, "skill must be 'nearest', 'latest'"),
-        (lambda m: m.rollout([1.0, 2.0, 3.0], skill=5), ValueError, "skill must be between 0 and 1"),
+        (
+            lambda m: m.rollout([1.0, 2.0, 3.0], skill="favourite"),
+            ValueError,
+            "skill must be 'nearest', 'latest'",
+        ),
+        (
+            lambda m: m.rollout([1.0, 2.0, 3.0], skill=5),
+            ValueError,
+            "skill must be between 0 and 1",
+        ),
         (lambda m: m.rollout([1.0, 2.0]), ValueError, "goal must have 3"),
-        (lambda m: BiDMP(DMP(protocol="paper")).learn(np.ones((5, 3))), bidmp.NotFittedError, "not fitted"),
+        (
+            lambda m: BiDMP(DMP(protocol="paper")).learn(np.ones((5, 3))),
+            bidmp.NotFittedError,
+            "not fitted",
+        ),
         (lambda m: BiDMP(DMP(protocol="paper")).rollout(), bidmp.NotFittedError, "not fitted"),
         (lambda m: BiDMP("dmp").fit(np.eye(3)), TypeError, "dmp must be a bidmp.DMP"),
-        (lambda m: BiDMP(m.dmp_, increments=(0,)).learn(np.eye(3)), ValueError, "increments must be >= 1"),
+        (
+            lambda m: BiDMP(m.dmp_, increments=(0,)).learn(np.eye(3)),
+            ValueError,
+            "increments must be >= 1",
+        ),
     ],
 )
 def test_bad_input(battery, call, error, match):

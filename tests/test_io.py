@@ -2,7 +2,6 @@
 
 import json
 import zipfile
-
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +28,10 @@ def write(path, text):
     "text, expected",
     [
         ("x,y\n0,0\n1,2\n2,3\n", [[0, 0], [1, 2], [2, 3]]),
-        ("0,0,0\n1,2,3\n2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),  # header-less 3 columns: x,y,z
+        (
+            "0,0,0\n1,2,3\n2,3,5\n",
+            [[0, 0, 0], [1, 2, 3], [2, 3, 5]],
+        ),  # header-less 3 columns: x,y,z
         ("t,x,y\n0,0,0\n0.5,1,2\n1,2,3\n", [[0, 0], [1, 2], [2, 3]]),
         ("time,x,y,z\n0,0,0,0\n1,1,2,3\n2,2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),
         ("0,0,0,0\n1,1,2,3\n2,2,3,5\n", [[0, 0, 0], [1, 2, 3], [2, 3, 5]]),  # 4 columns: t,x,y,z
@@ -69,7 +71,11 @@ def test_trajectory_round_trip_is_exact(tmp_path, suffix):
         ("same.csv", "x,y\n1,1\n1,1\n1,1\n", "identical"),
         ("header.csv", "a,b\n0,0\n1,1\n2,2\n", "header a,b names no motion.*--columns"),
         ("onecol.csv", "1\n2\n3\n", "expected 2-4 columns"),
-        ("time.csv", "t,x,y\n0,0,0\n1,1,1\n0.5,2,2\n", "must increase strictly: timestamp going back at sample 2"),
+        (
+            "time.csv",
+            "t,x,y\n0,0,0\n1,1,1\n0.5,2,2\n",
+            "must increase strictly: timestamp going back at sample 2",
+        ),
         ("demo.json", "{}", "unsupported file type .json"),
     ],
 )
@@ -81,7 +87,9 @@ def test_bad_trajectory_files(tmp_path, name, text, match):
 # --- recordings as loggers write them -------------------------------------------
 def logger_file(tmp_path, header, rows, name="log.csv"):
     path = tmp_path / name
-    path.write_text(header + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n")
+    path.write_text(
+        header + "\n" + "\n".join(",".join(repr(float(v)) for v in row) for row in rows) + "\n"
+    )
     return path
 
 
@@ -95,7 +103,10 @@ def test_a_repeated_timestamp_is_dropped_with_a_warning(tmp_path, caplog):
         positions, stamps = bidmp.io.read_trajectory(path)
     assert len(positions) == len(y) - 1 and np.all(np.diff(stamps) > 0)
     np.testing.assert_array_equal(positions[:100], y[:100])
-    assert "dropped 1 sample(s) whose timestamp repeats the one before (the first at sample 100" in caplog.text
+    assert (
+        "dropped 1 sample(s) whose timestamp repeats the one before (the first at sample 100"
+        in caplog.text
+    )
     prepared, _ = bidmp.prepare(y, t)  # prepare() and fit() take such stamps too
     assert bidmp.DMP().fit(y, t).n_steps_ == len(y) - 1 and prepared.t[0] == 0.0
 
@@ -104,24 +115,39 @@ def test_a_stamp_going_back_is_refused_with_values_that_can_be_told_apart():
     """before the fix, the message printed 1.7330868e+09 twice."""
     t = 1733086800.0 + np.arange(10) * 0.004
     t[5] = t[4] - 0.001
-    with pytest.raises(ValueError, match=r"going back at sample 5: 1733086800\.015 s after 1733086800\.016 s \(-0\.9999 ms"):
+    with pytest.raises(
+        ValueError,
+        match=r"going back at sample 5: 1733086800\.015 s after 1733086800\.016 s \(-0\.9999 ms",
+    ):
         bidmp.primitives.check_timestamps(t, 10)
 
 
 def test_logger_headers_extra_columns_and_a_column_mapping(tmp_path, caplog):
     y, t = bidmp.demonstrations.recording("operator2_nut5")
     force = np.sin(np.arange(len(t)))
-    plain = logger_file(tmp_path, "timestamp,x,y,z,force,gripper", np.column_stack([t, y, force, force > 0]), "a.csv")
+    plain = logger_file(
+        tmp_path,
+        "timestamp,x,y,z,force,gripper",
+        np.column_stack([t, y, force, force > 0]),
+        "a.csv",
+    )
     with caplog.at_level("WARNING"):
         positions, stamps = bidmp.io.read_trajectory(plain)
     np.testing.assert_array_equal(positions, y)
     np.testing.assert_array_equal(stamps, t)
     assert "ignored 2 column(s) that are not time or the motion read: force, gripper" in caplog.text
-    named = logger_file(tmp_path, "stamp,ee_z,force,ee_x,ee_y", np.column_stack([t, y[:, 2], force, y[:, 0], y[:, 1]]), "b.csv")
+    named = logger_file(
+        tmp_path,
+        "stamp,ee_z,force,ee_x,ee_y",
+        np.column_stack([t, y[:, 2], force, y[:, 0], y[:, 1]]),
+        "b.csv",
+    )
     positions, stamps = bidmp.io.read_trajectory(named, columns="t=stamp,x=ee_x,y=ee_y,z=ee_z")
     np.testing.assert_array_equal(positions, y)
     np.testing.assert_array_equal(stamps, t)
-    with pytest.raises(ValueError, match="no column 'ee_q' for z .*the header has stamp,ee_z,force,ee_x,ee_y"):
+    with pytest.raises(
+        ValueError, match="no column 'ee_q' for z .*the header has stamp,ee_z,force,ee_x,ee_y"
+    ):
         bidmp.io.read_trajectory(named, columns="t=stamp,x=ee_x,y=ee_y,z=ee_q")
     with pytest.raises(ValueError, match="unknown role 'w'"):
         bidmp.io.read_trajectory(named, columns="t=stamp,w=ee_x")
@@ -197,15 +223,36 @@ def rewrite_meta(path, change):
     "corrupt, match",
     [
         (lambda p: p.write_bytes(b"\x00garbage" * 50), "not a bidmp model file"),
-        (lambda p: p.write_bytes(p.read_bytes()[: len(p.read_bytes()) // 2]), "not a readable bidmp model file"),
+        (
+            lambda p: p.write_bytes(p.read_bytes()[: len(p.read_bytes()) // 2]),
+            "not a readable bidmp model file",
+        ),
         (lambda p: np.savez(p, weights=np.ones(3)), "without bidmp metadata"),
-        (lambda p: np.save(p.with_suffix(".npy"), np.ones(3)) or p.with_suffix(".npy").rename(p), "plain .npy"),
-        (lambda p: rewrite_meta(p, lambda m, a: m.update(format_version=FORMAT_VERSION + 1)), "newer|upgrade bidmp"),
-        (lambda p: rewrite_meta(p, lambda m, a: m.update(format="something-else")), "unknown metadata format"),
-        (lambda p: rewrite_meta(p, lambda m, a: m.update({"class": "Pickle"})), "unknown model class 'Pickle'"),
+        (
+            lambda p: np.save(p.with_suffix(".npy"), np.ones(3)) or p.with_suffix(".npy").rename(p),
+            "plain .npy",
+        ),
+        (
+            lambda p: rewrite_meta(p, lambda m, a: m.update(format_version=FORMAT_VERSION + 1)),
+            "newer|upgrade bidmp",
+        ),
+        (
+            lambda p: rewrite_meta(p, lambda m, a: m.update(format="something-else")),
+            "unknown metadata format",
+        ),
+        (
+            lambda p: rewrite_meta(p, lambda m, a: m.update({"class": "Pickle"})),
+            "unknown model class 'Pickle'",
+        ),
         (lambda p: rewrite_meta(p, lambda m, a: a.pop("weights_")), "corrupt"),
-        (lambda p: rewrite_meta(p, lambda m, a: a.update(weights_=np.ones((3, 3)))), "corrupt.*weights_"),
-        (lambda p: rewrite_meta(p, lambda m, a: m["state"]["params"].update(alpha=-1)), "corrupt.*alpha"),
+        (
+            lambda p: rewrite_meta(p, lambda m, a: a.update(weights_=np.ones((3, 3)))),
+            "corrupt.*weights_",
+        ),
+        (
+            lambda p: rewrite_meta(p, lambda m, a: m["state"]["params"].update(alpha=-1)),
+            "corrupt.*alpha",
+        ),
     ],
 )
 def test_bad_model_files_give_clear_errors(tmp_path, fitted, corrupt, match):
@@ -253,7 +300,9 @@ def test_format_1_bidmp_files_are_refused(tmp_path, fitted):
     from bidmp.demonstrations import minimum_jerk
 
     demo = minimum_jerk([[0, 0, 1], [1, 1, 0], [2, 0, 0]], 60)
-    model = bidmp.BiDMP(DMP(protocol="paper").fit(demo)).learn(demo + np.linspace(0, 1, 60)[:, None])
+    model = bidmp.BiDMP(DMP(protocol="paper").fit(demo)).learn(
+        demo + np.linspace(0, 1, 60)[:, None]
+    )
     path = bidmp.save(model, tmp_path / "old.npz")
     assert bidmp.load(path).n_skills == 2
     rewrite_meta(path, lambda meta, arrays: meta.update(format_version=1))
@@ -271,7 +320,9 @@ def test_a_format_3_robot_model_rolls_out_as_it_did():
     assert model.protocol == "robot" and model.integrator == "euler"
     expected = np.load(data / "format3_robot_rollout.npy")
     np.testing.assert_allclose(model.rollout(), expected[0], rtol=0, atol=1e-9)
-    np.testing.assert_allclose(model.rollout(model.goal_ + [150, 25, 0]), expected[1], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        model.rollout(model.goal_ + [150, 25, 0]), expected[1], rtol=0, atol=1e-9
+    )
     fresh = bidmp.DMP().fit(model.rollout())  # a model fitted today has the exact integrator
     assert fresh.integrator is None and fresh._params().integrator == "exact"
 
@@ -288,5 +339,7 @@ def test_format_2_dmp_files_load_as_the_paper_protocol(tmp_path, fitted):
 
     rewrite_meta(path, to_format_2)
     old = bidmp.load(path)
-    assert old.protocol == "paper" and old.duration_ == pytest.approx((fitted.n_steps_ - 1) / fitted.n_steps_)
+    assert old.protocol == "paper" and old.duration_ == pytest.approx(
+        (fitted.n_steps_ - 1) / fitted.n_steps_
+    )
     np.testing.assert_array_equal(old.rollout(), fitted.rollout())

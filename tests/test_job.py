@@ -10,19 +10,24 @@ import pytest
 
 pytest.importorskip("pybullet")
 
-from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.tasks import ScenarioError# noqa: E402
 from bidmp.sim import job as job_module  # noqa: E402
 from bidmp.sim.job import run_job  # noqa: E402
+from bidmp.tasks import ScenarioError, scenarios  # noqa: E402
 from bidmp.tasks.jobs import tour  # noqa: E402
 
 NUT = json.loads(scenarios.builtin_text("nut-unscrewing"))
 
 
 def in_bin(point, spec):
-    floor, inner = np.array(spec["job"]["bin"]["at"], float), np.array(spec["job"]["bin"]["size"], float)
-    return bool(np.all(np.abs(point[:2] - floor[:2]) <= inner[:2] / 2) and floor[2] <= point[2] <= floor[2] + inner[2])
+    floor, inner = (
+        np.array(spec["job"]["bin"]["at"], float),
+        np.array(spec["job"]["bin"]["size"], float),
+    )
+    return bool(
+        np.all(np.abs(point[:2] - floor[:2]) <= inner[:2] / 2)
+        and floor[2] <= point[2] <= floor[2] + inner[2]
+    )
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +49,13 @@ def test_the_nut_rises_by_the_pitch_per_turn_leaves_the_stud_and_ends_in_the_bin
         assert nut.lower[2] + rise[-1] > stud.upper[2]
         assert in_bin(target.final_position, NUT), target.final_position
         assert not target.contacts and target.within_limits
-        assert [phase.name for phase in target.phases] == ["approach", "engage", "unscrew", "retract", "drop"]
+        assert [phase.name for phase in target.phases] == [
+            "approach",
+            "engage",
+            "unscrew",
+            "retract",
+            "drop",
+        ]
 
 
 def test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted():
@@ -52,8 +63,16 @@ def test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted():
     # Nut "b" sits 2 mm off the target the skill goes to; nut "a" on its target.
     spec["targets"] = {"3": [0, 0, 0], "a": [60, 0, 0], "b": [120, 0, 0]}
     spec["scene"]["parts"] = [spec["scene"]["parts"][0]] + [
-        {"type": "nut", "label": label, "at": [x + dx, 0, -2], "across_flats": 13, "height": 6.5,
-         "stud": {"radius": 4, "above": 10}} for label, x, dx in (("3", 0, 0), ("a", 60, 0), ("b", 120, 2.0))]
+        {
+            "type": "nut",
+            "label": label,
+            "at": [x + dx, 0, -2],
+            "across_flats": 13,
+            "height": 6.5,
+            "stud": {"radius": 4, "above": 10},
+        }
+        for label, x, dx in (("3", 0, 0), ("a", 60, 0), ("b", 120, 2.0))
+    ]
     report = run_job(scenarios.from_dict(spec), targets=["a", "b"])
     by_label = {target.label: target for target in report.targets}
     assert by_label["a"].removed and not by_label["b"].removed and report.removed == 1
@@ -77,9 +96,17 @@ def test_a_layout_nobody_tuned_every_nut_off_or_one_line_why():
     spec = json.loads(json.dumps(NUT))
     spec["targets"] = {str(k): [40.0 * (k % 3), 40.0 * (k // 3), 0.0] for k in range(6)}
     spec["demonstrated"] = "0"
-    spec["scene"]["parts"] = [{"type": "plate", "label": "plate", "at": [40, 20, -2], "size": [160, 120, 5]},
-                              {"type": "nut", "at_targets": "all", "offset": [0, 0, -2], "across_flats": 13, "height": 6.5,
-                               "stud": {"radius": 4, "above": 20}}]
+    spec["scene"]["parts"] = [
+        {"type": "plate", "label": "plate", "at": [40, 20, -2], "size": [160, 120, 5]},
+        {
+            "type": "nut",
+            "at_targets": "all",
+            "offset": [0, 0, -2],
+            "across_flats": 13,
+            "height": 6.5,
+            "stud": {"radius": 4, "above": 20},
+        },
+    ]
     spec["job"]["bin"] = {"at": [-100, 60, -2], "size": [60, 60, 40]}
     spec.pop("extension_target", None)
     report = run_job(scenarios.from_dict(spec), targets=["1", "4", "5"])
@@ -90,19 +117,49 @@ def test_a_layout_nobody_tuned_every_nut_off_or_one_line_why():
     assert rise > 26.0  # 6.5 + 20: the taller stud took more turns
 
 
-@pytest.mark.parametrize("job, message", [
-    ({"steps": ["approach", "drop"]}, "job.steps: expected one of the sequences"),
-    ({"steps": ["approach", "engage", "unscrew", "retract", "drop"]}, "job.bin: unscrewing drops"),
-    ({"steps": ["approach", "engage", "unscrew", "retract", "drop"], "bin": {"at": [0, 0, 0]}}, "job.bin: expected"),
-    ({"steps": ["approach", "engage", "unscrew", "retract", "drop"], "bin": {"at": [0, 0, 0], "size": [1, 1, 1]},
-      "pitch": -1}, "job.pitch: expected a positive number"),
-    ({"steps": ["approach", "engage", "unscrew", "retract", "drop"], "bin": {"at": [0, 0, 0], "size": [1, 1, 1]},
-      "order": "random"}, 'job.order: expected "listed" or "shortest"'),
-    ({"steps": ["approach", "grasp", "lift", "place"]}, "job.rack"),
-    ({"colour": 1}, r"unknown \[.colour.\]"),
-    ({"steps": ["approach", "grasp", "place"], "rack": {"at": [0, 0, 0], "step": [1, 0, 0]}, "transfer": "bent"},
-     "job.transfer: expected"),
-])
+@pytest.mark.parametrize(
+    "job, message",
+    [
+        ({"steps": ["approach", "drop"]}, "job.steps: expected one of the sequences"),
+        (
+            {"steps": ["approach", "engage", "unscrew", "retract", "drop"]},
+            "job.bin: unscrewing drops",
+        ),
+        (
+            {
+                "steps": ["approach", "engage", "unscrew", "retract", "drop"],
+                "bin": {"at": [0, 0, 0]},
+            },
+            "job.bin: expected",
+        ),
+        (
+            {
+                "steps": ["approach", "engage", "unscrew", "retract", "drop"],
+                "bin": {"at": [0, 0, 0], "size": [1, 1, 1]},
+                "pitch": -1,
+            },
+            "job.pitch: expected a positive number",
+        ),
+        (
+            {
+                "steps": ["approach", "engage", "unscrew", "retract", "drop"],
+                "bin": {"at": [0, 0, 0], "size": [1, 1, 1]},
+                "order": "random",
+            },
+            'job.order: expected "listed" or "shortest"',
+        ),
+        ({"steps": ["approach", "grasp", "lift", "place"]}, "job.rack"),
+        ({"colour": 1}, r"unknown \[.colour.\]"),
+        (
+            {
+                "steps": ["approach", "grasp", "place"],
+                "rack": {"at": [0, 0, 0], "step": [1, 0, 0]},
+                "transfer": "bent",
+            },
+            "job.transfer: expected",
+        ),
+    ],
+)
 def test_the_job_key_is_validated_by_name(job, message):
     spec = json.loads(json.dumps(NUT))
     spec["job"] = job
@@ -121,7 +178,9 @@ def test_the_tour_is_a_permutation_no_longer_than_nearest_neighbour_and_near_the
     points, start = rng.uniform(0, 100, (7, 3)), rng.uniform(0, 100, 3)
     order = tour(points, start)
     assert sorted(order) == list(range(7))
-    best = min(tour_length(points, start, list(p)) for p in itertools.permutations(range(7)))  # brute force
+    best = min(
+        tour_length(points, start, list(p)) for p in itertools.permutations(range(7))
+    )  # brute force
     assert tour_length(points, start, order) <= 1.1 * best
 
 
@@ -136,7 +195,7 @@ def test_bidmp_job_writes_its_report_and_a_cycle_strip(tmp_path, capsys):
     with Image.open(tmp_path / "job_cycle.png") as strip:
         assert strip.size[0] == 4 * 320 + 3 * 4  # approach, unscrew, retract, drop
     assert main(["job", "--scenario", "nut-unscrewing-tilted", "--out", str(tmp_path / "x")]) == 2
-    assert "has no \"job\"" in capsys.readouterr().err
+    assert 'has no "job"' in capsys.readouterr().err
 
 
 def test_cells_are_lifted_straight_out_and_set_down_in_their_rack_slots():
@@ -157,7 +216,10 @@ def test_cells_are_lifted_straight_out_and_set_down_in_their_rack_slots():
 RESULTS = __import__("pathlib").Path(__file__).resolve().parent.parent / "docs" / "results"
 
 
-@pytest.mark.parametrize("name, committed, parts", [("nut-unscrewing", "job.md", 14), ("cell-removal", "job_cells.md", 12)])
+@pytest.mark.parametrize(
+    "name, committed, parts",
+    [("nut-unscrewing", "job.md", 14), ("cell-removal", "job_cells.md", 12)],
+)
 def test_the_built_in_jobs_in_one_run_as_committed(name, committed, parts):
     """Acceptance: every nut unscrewed and in the bin, every cell in the rack, no contact with
     another part, every command within the Panda's limits, the cycle per part within 10 s; the
@@ -190,10 +252,28 @@ def test_bidmp_demo_job_runs_the_evaluation_then_the_job(tmp_path, capsys):
     spec["targets"] = {label: spec["targets"][label] for label in ("3", "4", "11")}
     spec["methods"] = ["dmp", "bidmp"]
     (tmp_path / "two.json").write_text(json.dumps(spec))
-    assert main(["demo", "--scenario", str(tmp_path / "two.json"), "--job", "--out", str(tmp_path / "out")]) == 0
+    assert (
+        main(
+            [
+                "demo",
+                "--scenario",
+                str(tmp_path / "two.json"),
+                "--job",
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 0
+    )
     assert "3/3 parts removed" in capsys.readouterr().out
-    assert json.loads((tmp_path / "out" / "job" / "job_results.json").read_text())["totals"]["removed"] == 3
-    assert main(["demo", "--scenario", "nut-unscrewing-tilted", "--job", "--out", str(tmp_path / "p")]) == 2
+    assert (
+        json.loads((tmp_path / "out" / "job" / "job_results.json").read_text())["totals"]["removed"]
+        == 3
+    )
+    assert (
+        main(["demo", "--scenario", "nut-unscrewing-tilted", "--job", "--out", str(tmp_path / "p")])
+        == 2
+    )
 
 
 def test_the_pick_and_place_job_moves_every_box_by_the_skills_turned_and_scaled_shape():

@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 from bidmp.experiments import benchmark
-from bidmp.tasks import scenarios
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 from bidmp.tasks import methods as registry
 from bidmp.tasks.methods import Method, Task
 
@@ -59,13 +58,23 @@ def test_a_registered_method_runs_in_evaluate(line):
 
 
 def test_a_registered_method_runs_in_the_lasa_benchmark(line, tmp_path):
-    result = benchmark.lasa(tmp_path, shapes=["Sshape"], methods=["test-line", "dmp-paper"], demos="first3", every=10,
-                            synchronous=True)
+    result = benchmark.lasa(
+        tmp_path,
+        shapes=["Sshape"],
+        methods=["test-line", "dmp-paper"],
+        demos="first3",
+        every=10,
+        synchronous=True,
+    )
     rows = [row for row in result.rows if row["method"] == "test-line"]
     assert len(rows) == 3 * len(benchmark.CASES)
     assert all(row["endpoint_error"] <= 1e-9 for row in rows)
     # The line is no LASA shape: it reproduces the demonstration far worse than the DMP does.
-    reproduction = {row["method"]: row["rmse"] for row in result.rows if row["case"] == "reproduction" and row["demo"] == 0}
+    reproduction = {
+        row["method"]: row["rmse"]
+        for row in result.rows
+        if row["case"] == "reproduction" and row["demo"] == 0
+    }
     assert reproduction["test-line"] > 10 * reproduction["dmp-paper"]
     assert "test-line" in (tmp_path / "lasa.md").read_text()
 
@@ -89,12 +98,27 @@ def test_a_registered_method_runs_in_the_simulator(line):
 
 
 def test_the_built_in_methods_keep_their_names():
-    assert registry.names()[:9] == ["dmp", "dmp-paper", "dmp-robot", "dmp-converged", "bidmp", "bidmp-latest", "gmm",
-                                    "tpgmm", "mp-dmp"]
+    assert registry.names()[:9] == [
+        "dmp",
+        "dmp-paper",
+        "dmp-robot",
+        "dmp-converged",
+        "bidmp",
+        "bidmp-latest",
+        "gmm",
+        "tpgmm",
+        "mp-dmp",
+    ]
     assert tuple(registry.names(lasa=True)) == benchmark.LASA_METHODS
     assert set(scenarios.METHODS) <= set(registry.names())
     assert registry.names(poses=True) == ["dmp", "dmp-paper", "dmp-robot", "bidmp", "bidmp-latest"]
-    assert registry.names(closed_loop=True) == ["dmp", "dmp-paper", "dmp-robot", "bidmp", "bidmp-latest"]
+    assert registry.names(closed_loop=True) == [
+        "dmp",
+        "dmp-paper",
+        "dmp-robot",
+        "bidmp",
+        "bidmp-latest",
+    ]
 
 
 def test_the_registry_refuses_what_it_cannot_hold(line):

@@ -25,9 +25,13 @@ from bidmp.tasks.metrics import approach_error, final_approach_mask
 
 
 # -- clearance: the tool's whole shaft between sparse samples -------------------------------------
-@pytest.mark.parametrize("tool_length, beam_bottom, run_up", [(120.0, 100.0, 60.0), (300.0, 270.0, 60.0),
-                                                               (60.0, 50.0, 60.0), (100.0, 90.0, 2000.0)])
-def test_a_two_point_path_under_a_beam_is_as_deep_as_the_shaft_reaches(tool_length, beam_bottom, run_up):
+@pytest.mark.parametrize(
+    "tool_length, beam_bottom, run_up",
+    [(120.0, 100.0, 60.0), (300.0, 270.0, 60.0), (60.0, 50.0, 60.0), (100.0, 90.0, 2000.0)],
+)
+def test_a_two_point_path_under_a_beam_is_as_deep_as_the_shaft_reaches(
+    tool_length, beam_bottom, run_up
+):
     """Independent oracle: a vertical cylindrical tool (radius r, its shaft rising ``length``
     above its tip) crosses under a beam between two samples that are both clear of it. Where the
     shaft is under the beam it is inside it by min(shaft top − beam bottom, beam half-width + r)
@@ -35,15 +39,27 @@ def test_a_two_point_path_under_a_beam_is_as_deep_as_the_shaft_reaches(tool_leng
     are at least 35 mm clear. (A 2 m run-up puts the beam past the first 8192 placements.)"""
     radius, half_width, depth_up = 5.0, 20.0, 15.5
     tip = beam_bottom + depth_up - tool_length
-    scene = Scene.from_dict({"tool": {"radius": radius, "length": tool_length},
-                             "parts": [{"type": "box", "label": "beam", "at": [0.0, 0.0, beam_bottom],
-                                        "size": [2 * half_width, 400.0, 30.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": radius, "length": tool_length},
+            "parts": [
+                {
+                    "type": "box",
+                    "label": "beam",
+                    "at": [0.0, 0.0, beam_bottom],
+                    "size": [2 * half_width, 400.0, 30.0],
+                }
+            ],
+        }
+    )
     path = np.array([[-run_up, 0.0, tip], [60.0, 0.0, tip]])
     truth = -min(depth_up, half_width + radius)
     found = scene.clearance(path)
     assert found.part == "beam"
     assert found.distance == pytest.approx(truth, abs=1e-6)
-    down = np.tile([1.0, 0.0, 0.0, 0.0], (2, 1))  # the same, the tool's attitude given (pointing down)
+    down = np.tile(
+        [1.0, 0.0, 0.0, 0.0], (2, 1)
+    )  # the same, the tool's attitude given (pointing down)
     assert scene.clearance(path, orientations=down).distance == pytest.approx(truth, abs=1e-5)
     # Turned about its own axis (the same cylinder), by an angle whose unit quaternion's square sums
     # to 1 + 2e-16: the attitude does not change along the path, whatever the rounding says.
@@ -58,11 +74,26 @@ def test_a_later_segment_under_a_beam_is_checked_by_its_own_sweep():
     """Independent oracle: a path comes from far away (its first segment passes the beam 28 mm
     clear), then crosses under it with the shaft 15.5 mm inside; both ends of the crossing are
     75 mm clear. The clearance is the crossing's −15.5 (the shorter way out: down)."""
-    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 120.0},
-                             "parts": [{"type": "box", "label": "beam", "at": [0.0, 0.0, 100.0], "size": [40.0, 100.0, 30.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 5.0, "length": 120.0},
+            "parts": [
+                {
+                    "type": "box",
+                    "label": "beam",
+                    "at": [0.0, 0.0, 100.0],
+                    "size": [40.0, 100.0, 30.0],
+                }
+            ],
+        }
+    )
     tip = 100.0 + 15.5 - 120.0
     for sign in (1.0, -1.0):  # from either side
-        path = sign * np.array([[500.0, 500.0, 0.0], [-100.0, 0.0, 0.0], [100.0, 0.0, 0.0]]) + [0.0, 0.0, tip]
+        path = sign * np.array([[500.0, 500.0, 0.0], [-100.0, 0.0, 0.0], [100.0, 0.0, 0.0]]) + [
+            0.0,
+            0.0,
+            tip,
+        ]
         found = scene.clearance(path)
         assert found.distance == pytest.approx(-15.5, abs=1e-6) and found.part == "beam"
         assert abs(found.point[1]) < 1e-9 and abs(found.point[0]) <= 20.0 + 5.0 - 15.5
@@ -71,8 +102,15 @@ def test_a_later_segment_under_a_beam_is_checked_by_its_own_sweep():
 def test_a_path_over_a_box_at_the_margin_is_judged_by_its_closed_form_clearance():
     """Independent oracle: a tool tip passing above a box at height h over its top keeps exactly h;
     at the margin it is clear, 1e-3 below it not (the judge compares with ``>=``)."""
-    scene = Scene.from_dict({"tool": {"radius": 4.0, "length": 80.0}, "margin": 3.0,
-                             "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [50.0, 50.0, 20.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 4.0, "length": 80.0},
+            "margin": 3.0,
+            "parts": [
+                {"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [50.0, 50.0, 20.0]}
+            ],
+        }
+    )
     for height, clear in ((3.001, True), (2.999, False), (10.0, True)):
         path = np.array([[-100.0, 0.0, 20.0 + height], [100.0, 0.0, 20.0 + height]])
         found = scene.clearance(path)
@@ -85,11 +123,19 @@ def test_the_nearest_point_of_a_v_shaped_pass_over_a_box_is_its_lowest_sample():
     rising either side is nearest there, 7 mm; with the tool's orientation given (pointing down,
     the default) the answer is the same, also when the path starts at its nearest point and
     when the quaternions are not normalised."""
-    scene = Scene.from_dict({"tool": {"radius": 4.0, "length": 80.0},
-                             "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [60.0, 60.0, 20.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 4.0, "length": 80.0},
+            "parts": [
+                {"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [60.0, 60.0, 20.0]}
+            ],
+        }
+    )
     x = np.linspace(-50.0, 50.0, 41)
     path = np.column_stack([x, np.zeros(41), 27.0 + 0.5 * np.abs(x - 10.0)])
-    down = np.tile([1.0, 0.0, 0.0, 0.0], (41, 1))  # half a turn about x: the tool's z axis points down
+    down = np.tile(
+        [1.0, 0.0, 0.0, 0.0], (41, 1)
+    )  # half a turn about x: the tool's z axis points down
     for points, turns in ((path, None), (path, down), (path[24:], down[24:]), (path, 2.5 * down)):
         found = scene.clearance(points, orientations=turns)
         assert found.distance == pytest.approx(7.0, abs=1e-6)
@@ -101,8 +147,19 @@ def test_segments_free_judges_each_straight_move_by_its_own_closed_form():
     """Independent oracle: moves beside a box (tool radius r, box half-width w): a move at lateral
     offset d from the box's side axis is free iff d − w − r exceeds the checker's margin."""
     radius, half = 4.0, 10.0
-    scene = Scene.from_dict({"tool": {"radius": radius, "length": 50.0},
-                             "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [2 * half, 2 * half, 40.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": radius, "length": 50.0},
+            "parts": [
+                {
+                    "type": "box",
+                    "label": "box",
+                    "at": [0.0, 0.0, 0.0],
+                    "size": [2 * half, 2 * half, 40.0],
+                }
+            ],
+        }
+    )
     checker = scene.checker()
     offsets = np.array([13.0, 14.5, 15.0, 30.0, -13.0, -14.5, -30.0])
     starts = np.column_stack([offsets, np.full(7, -100.0), np.full(7, 5.0)])
@@ -110,41 +167,83 @@ def test_segments_free_judges_each_straight_move_by_its_own_closed_form():
     expected = np.abs(offsets) - half - radius > 0.0
     assert checker.segments_free(starts, ends).tolist() == expected.tolist()
     # Under the box (its bottom at 0): the shaft (50 long) reaches into it from a tip 20 below.
-    under = checker.segments_free(np.array([[-100.0, 0.0, -20.0], [-100.0, 0.0, -60.0]]),
-                                  np.array([[100.0, 0.0, -20.0], [100.0, 0.0, -60.0]]))
+    under = checker.segments_free(
+        np.array([[-100.0, 0.0, -20.0], [-100.0, 0.0, -60.0]]),
+        np.array([[100.0, 0.0, -20.0], [100.0, 0.0, -60.0]]),
+    )
     assert under.tolist() == [False, True]
     # With a 3 mm margin: a move passing 2 mm beside the box (either side) or 2 mm under it is not free.
     kept = bidmp.scene.SceneChecker(scene, np.arange(len(scene.solids)), 3.0)
     side = half + radius + 2.0
-    starts = np.array([[side, -100.0, 5.0], [-side, -100.0, 5.0], [-100.0, -side, 5.0], [-100.0, side, 5.0],
-                       [-100.0, 0.0, -52.0], [side + 1.5, -100.0, 5.0]])
+    starts = np.array(
+        [
+            [side, -100.0, 5.0],
+            [-side, -100.0, 5.0],
+            [-100.0, -side, 5.0],
+            [-100.0, side, 5.0],
+            [-100.0, 0.0, -52.0],
+            [side + 1.5, -100.0, 5.0],
+        ]
+    )
     along_y, along_x = [0.0, 200.0, 0.0], [200.0, 0.0, 0.0]
     ends = starts + [along_y, along_y, along_x, along_x, along_x, along_y]
     assert kept.segments_free(starts, ends).tolist() == [False, False, False, False, False, True]
     # A move of no length is its one placement; a move shorter than 1 ending inside the box is not
     # free; a move that grazes the margin (1e-7 outside it) all along is taken as touching.
-    inside, outside = np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[half + radius + 1.0, 0.0, 5.0]])
+    inside, outside = (
+        np.array([[half + radius - 0.5, 0.0, 5.0]]),
+        np.array([[half + radius + 1.0, 0.0, 5.0]]),
+    )
     assert checker.segments_free(inside, inside).tolist() == [False]
     assert checker.segments_free(outside, outside).tolist() == [True]
     near = np.array([[half + radius + 0.3, 0.0, 5.0]])
-    assert checker.segments_free(near, near - [0.8, 0.0, 0.0]).tolist() == [False]  # ends 0.5 inside
-    post = Scene.from_dict({"tool": {"radius": radius, "length": 50.0},
-                            "parts": [{"type": "cylinder", "label": "post", "at": [0.0, 0.0, -200.0], "radius": 20.0,
-                                       "height": 400.0}]})
-    corner = (20.0 + radius + 3.0) / np.sqrt(2.0)  # 3 from the post, diagonally (inside its bounding box)
+    assert checker.segments_free(near, near - [0.8, 0.0, 0.0]).tolist() == [
+        False
+    ]  # ends 0.5 inside
+    post = Scene.from_dict(
+        {
+            "tool": {"radius": radius, "length": 50.0},
+            "parts": [
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [0.0, 0.0, -200.0],
+                    "radius": 20.0,
+                    "height": 400.0,
+                }
+            ],
+        }
+    )
+    corner = (20.0 + radius + 3.0) / np.sqrt(
+        2.0
+    )  # 3 from the post, diagonally (inside its bounding box)
     top, bottom = np.array([[corner, corner, 100.0]]), np.array([[corner, corner, -100.0]])
     clearance = post.clearance(top).distance
     grazing = bidmp.scene.SceneChecker(post, np.arange(len(post.solids)), clearance - 1e-7)
-    assert grazing.segments_free(top, bottom).tolist() == [False]  # 200 along the margin: taken as touching
-    assert bidmp.scene.SceneChecker(post, np.arange(len(post.solids)), clearance - 1.0).segments_free(top, bottom).tolist() == [True]
+    assert grazing.segments_free(top, bottom).tolist() == [
+        False
+    ]  # 200 along the margin: taken as touching
+    assert bidmp.scene.SceneChecker(
+        post, np.arange(len(post.solids)), clearance - 1.0
+    ).segments_free(top, bottom).tolist() == [True]
     # Starting 0.5 inside the box's side and moving straight away: the first placement decides.
-    away = checker.segments_free(np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[100.0, 0.0, 5.0]]))
+    away = checker.segments_free(
+        np.array([[half + radius - 0.5, 0.0, 5.0]]), np.array([[100.0, 0.0, 5.0]])
+    )
     assert away.tolist() == [False]
 
 
-@pytest.mark.parametrize("distance, margin, collision_free, clear", [
-    (0.0, 0.0, True, True), (-1e-12, 0.0, False, False), (2.0, 2.0, True, True), (1.999, 2.0, True, False),
-    (-0.5, 2.0, False, False), (math.inf, 2.0, True, True)])
+@pytest.mark.parametrize(
+    "distance, margin, collision_free, clear",
+    [
+        (0.0, 0.0, True, True),
+        (-1e-12, 0.0, False, False),
+        (2.0, 2.0, True, True),
+        (1.999, 2.0, True, False),
+        (-0.5, 2.0, False, False),
+        (math.inf, 2.0, True, True),
+    ],
+)
 def test_a_clearance_is_judged_at_its_boundaries(distance, margin, collision_free, clear):
     """Independent oracle: touching is not a collision; at the margin is clear, under it is not."""
     from bidmp.scene import Clearance
@@ -164,35 +263,56 @@ def test_command_peaks_of_a_quintic_match_its_closed_form_in_either_direction(si
     s = np.linspace(0.0, 1.0, int(round(duration / dt)) + 1)
     q = sign * amplitude * (10 * s**3 - 15 * s**4 + 6 * s**5)
     commands = np.column_stack([q, np.zeros_like(q)])
-    limits = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(1.0, 1.0),
-                                   acceleration=(5.0, 5.0), jerk=(100.0, 100.0))
+    limits = bidmp.sim.JointLimits(
+        lower=(-3.0, -3.0),
+        upper=(3.0, 3.0),
+        velocity=(1.0, 1.0),
+        acceleration=(5.0, 5.0),
+        jerk=(100.0, 100.0),
+    )
     peaks = command_peaks(commands, limits, dt)
     assert peaks.velocity == pytest.approx(15 * amplitude / (8 * duration), rel=2e-3)
-    assert peaks.acceleration == pytest.approx(10 * amplitude / (math.sqrt(3) * duration**2) / 5.0, rel=5e-3)
+    assert peaks.acceleration == pytest.approx(
+        10 * amplitude / (math.sqrt(3) * duration**2) / 5.0, rel=5e-3
+    )
     assert peaks.jerk == pytest.approx(60 * amplitude / duration**3 / 100.0, rel=5e-3)
     assert peaks.joint == 0 and peaks.within
-    slow = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(0.5, 1.0),
-                                 acceleration=(5.0, 5.0), jerk=(100.0, 100.0))
+    slow = bidmp.sim.JointLimits(
+        lower=(-3.0, -3.0),
+        upper=(3.0, 3.0),
+        velocity=(0.5, 1.0),
+        acceleration=(5.0, 5.0),
+        jerk=(100.0, 100.0),
+    )
     assert not command_peaks(commands, slow, dt).within  # 0.75 rad/s against 0.5
 
 
 def test_a_command_jump_at_either_end_is_an_acceleration_from_rest():
     """Independent oracle: a first command 1 mrad from rest is a step of 1e-3/dt² in acceleration."""
     commands = np.array([[0.0], [1e-3], [1e-3], [1e-3]])
-    limits = bidmp.sim.JointLimits(lower=(-1.0,), upper=(1.0,), velocity=(10.0,), acceleration=(2000.0,), jerk=None)
+    limits = bidmp.sim.JointLimits(
+        lower=(-1.0,), upper=(1.0,), velocity=(10.0,), acceleration=(2000.0,), jerk=None
+    )
     peaks = command_peaks(commands, limits, 1e-3)
     assert peaks.ends == pytest.approx(1e-3 / 1e-6 / 2000.0)
     assert not peaks.within
     backwards = command_peaks(-commands, limits, 1e-3)
     assert backwards.ends == pytest.approx(peaks.ends) and not backwards.within
     assert peaks.jerk == 0.0  # no jerk limit: not judged
-    stopping = command_peaks(commands[::-1], limits, 1e-3)  # the same jump at the end: to rest at once
+    stopping = command_peaks(
+        commands[::-1], limits, 1e-3
+    )  # the same jump at the end: to rest at once
     assert stopping.ends == pytest.approx(peaks.ends) and not stopping.within
     two = command_peaks(commands[:2], limits, 1e-3)  # one step: from rest and back to rest at once
     assert two.ends == pytest.approx(peaks.ends) and not two.within
     for held in (np.full((1, 1), 0.3), np.full((6, 1), 0.3)):  # an arm held still: nothing moves
         still = command_peaks(held, limits, 1e-3)
-        assert (still.velocity, still.acceleration, still.jerk, still.ends) == (0.0, 0.0, 0.0, 0.0) and still.within
+        assert (still.velocity, still.acceleration, still.jerk, still.ends) == (
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ) and still.within
 
 
 # -- engagement: the final approach ---------------------------------------------------------------
@@ -209,16 +329,27 @@ def test_the_final_approach_is_the_descent_below_its_height_and_its_error_is_the
     assert mask.tolist() == (heights < 25.0).tolist()  # after the last sample at or above the band
     below = z < 25.0
     assert approach_error(path, target, 25.0) == pytest.approx(offset[below].max(), rel=1e-12)
-    along_x = np.column_stack([z, offset, np.zeros(81)])  # the same descent along a target's +x axis
-    assert approach_error(along_x, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]) == pytest.approx(offset[below].max(), rel=1e-12)
+    along_x = np.column_stack(
+        [z, offset, np.zeros(81)]
+    )  # the same descent along a target's +x axis
+    assert approach_error(along_x, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]) == pytest.approx(
+        offset[below].max(), rel=1e-12
+    )
 
 
-@pytest.mark.parametrize("rise, engaged", [(0.0, True), (0.2, True), (0.25, True), (0.3, False), (2.0, False)])
+@pytest.mark.parametrize(
+    "rise, engaged", [(0.0, True), (0.2, True), (0.25, True), (0.3, False), (2.0, False)]
+)
 def test_a_rise_inside_the_band_beyond_the_tolerance_is_no_engagement(rise, engaged):
     """Independent oracle: a descent into a 20 mm band that rises by ``rise`` on the way down
     (a wobble) engages iff the rise is at most the tolerance (0.25 here)."""
-    heights = np.concatenate([np.linspace(30.0, 10.0, 41), 10.0 + rise * np.sin(np.linspace(0, np.pi, 11)),
-                              np.linspace(10.0, 0.0, 21)])
+    heights = np.concatenate(
+        [
+            np.linspace(30.0, 10.0, 41),
+            10.0 + rise * np.sin(np.linspace(0, np.pi, 11)),
+            np.linspace(10.0, 0.0, 21),
+        ]
+    )
     mask = final_approach_mask(heights, 20.0, rise=0.25)
     assert (mask is not None) is engaged
     path = np.column_stack([np.zeros_like(heights), np.zeros_like(heights), heights])
@@ -229,11 +360,18 @@ def test_a_motion_ending_above_the_band_or_never_above_it_does_not_engage():
     """Independent oracle: no final approach without a descent from above the band to its end."""
     assert final_approach_mask(np.linspace(30.0, 21.0, 10), 20.0) is None  # ends above
     assert final_approach_mask(np.linspace(15.0, 0.0, 10), 20.0) is None  # never above
-    assert final_approach_mask(np.array([30.0, 20.0, 10.0, 0.0]), 20.0).tolist() == [False, False, True, True]
+    assert final_approach_mask(np.array([30.0, 20.0, 10.0, 0.0]), 20.0).tolist() == [
+        False,
+        False,
+        True,
+        True,
+    ]
 
 
 # -- the job: in the bin, in the slot, removed ----------------------------------------------------
-@pytest.mark.parametrize("fraction, inside", [(0.0, True), (0.49, True), (0.5, True), (0.51, False), (0.9, False)])
+@pytest.mark.parametrize(
+    "fraction, inside", [(0.0, True), (0.49, True), (0.5, True), (0.51, False), (0.9, False)]
+)
 def test_a_part_is_in_the_bin_within_half_its_inner_width(fraction, inside):
     """Independent oracle: a bin 120 × 80 inside: a part at rest a fraction f of the inner width
     off its centre (in x, then in y, either side) is in it iff f ≤ 1/2; below the floor or over
@@ -271,11 +409,22 @@ def test_a_target_is_removed_only_when_every_phase_kept_the_contract_and_says_th
         def pose(self):
             return np.array([1.0, 2.0, 3.0]), np.array([0.0, 0.0, 0.0, 1.0])
 
-    record = JobTarget("n1", [JobPhase("approach", True, 1.0, contacts={"plate": 0.2}),
-                              JobPhase("engage", True, 0.0),
-                              JobPhase("drop", False, 2.0, "released outside the bin", contacts={"plate": 0.5, "bin": 0.1},
-                                       within_limits=False),
-                              JobPhase("settle", False, 0.5, "later")])
+    record = JobTarget(
+        "n1",
+        [
+            JobPhase("approach", True, 1.0, contacts={"plate": 0.2}),
+            JobPhase("engage", True, 0.0),
+            JobPhase(
+                "drop",
+                False,
+                2.0,
+                "released outside the bin",
+                contacts={"plate": 0.5, "bin": 0.1},
+                within_limits=False,
+            ),
+            JobPhase("settle", False, 0.5, "later"),
+        ],
+    )
     _finish(record, Part())
     assert not record.removed and record.reason == "drop: released outside the bin"
     assert record.final_position.tolist() == [1.0, 2.0, 3.0]
@@ -283,6 +432,7 @@ def test_a_target_is_removed_only_when_every_phase_kept_the_contract_and_says_th
     good = JobTarget("n2", [JobPhase("approach", True, 1.0), JobPhase("drop", True, 2.0)])
     _finish(good, Part())
     assert good.removed and good.reason == "" and good.within_limits and good.seconds == 3.0
+
     class Verdict:
         def __init__(self, ok):
             self.ok = ok
@@ -405,8 +555,14 @@ def _tool_to_boxes(tips, radius, length, lower, upper, discs=None):
     xy, lo, hi = tips[:, None, :2], lower[None, :, :2], upper[None, :, :2]
     outside = np.maximum(np.maximum(lo - xy, xy - hi), 0.0)
     horizontal_gap = np.linalg.norm(outside, axis=2) - radius
-    inside_depth = np.min(np.minimum(xy - lo, hi - xy), axis=2)  # to the rectangle's edge, when inside
-    horizontal_depth = np.where(np.all(outside == 0.0, axis=2), inside_depth + radius, radius - np.linalg.norm(outside, axis=2))
+    inside_depth = np.min(
+        np.minimum(xy - lo, hi - xy), axis=2
+    )  # to the rectangle's edge, when inside
+    horizontal_depth = np.where(
+        np.all(outside == 0.0, axis=2),
+        inside_depth + radius,
+        radius - np.linalg.norm(outside, axis=2),
+    )
     if discs is not None:  # cylinders: the distance between two discs' centres less both radii
         round_ = ~np.isnan(discs[:, 2])
         apart = np.linalg.norm(xy - discs[None, :, :2], axis=2) - radius - discs[None, :, 2]
@@ -424,14 +580,24 @@ def _random_cell(rng, cylinders=False):
     """1-4 boxes (or, with ``cylinders``, some vertical cylinders) 100 apart on a grid, and a
     tool: (scene, radius, length, lower, upper, discs)."""
     parts, discs = [], []
-    cells = [(x, y) for x in (-100.0, 0.0, 100.0) for y in (-100.0, 0.0, 100.0)]  # 100 apart: no overlap
+    cells = [
+        (x, y) for x in (-100.0, 0.0, 100.0) for y in (-100.0, 0.0, 100.0)
+    ]  # 100 apart: no overlap
     for cell in rng.permutation(len(cells))[: int(rng.integers(1, 5))]:
         size = rng.uniform([10, 10, 10], [90, 90, 60])
         at = np.array([*cells[cell], 0.0]) + [*rng.uniform(-5.0, 5.0, 2), rng.uniform(0.0, 40.0)]
         label = f"b{len(parts)}"
         if cylinders and rng.random() < 0.5:
             size[:2] = 2 * rng.uniform(5.0, 45.0)
-            parts.append({"type": "cylinder", "label": label, "at": at.tolist(), "radius": size[0] / 2, "height": size[2]})
+            parts.append(
+                {
+                    "type": "cylinder",
+                    "label": label,
+                    "at": at.tolist(),
+                    "radius": size[0] / 2,
+                    "height": size[2],
+                }
+            )
             discs.append([at[0], at[1], size[0] / 2])
         else:
             parts.append({"type": "box", "label": label, "at": at.tolist(), "size": size.tolist()})
@@ -456,8 +622,10 @@ def _random_path(rng):
 
 
 def _dense(points, spacing):
-    pieces = [np.linspace(a, b, max(int(np.ceil(np.linalg.norm(b - a) / spacing)), 1) + 1)
-              for a, b in zip(points[:-1], points[1:])]
+    pieces = [
+        np.linspace(a, b, max(int(np.ceil(np.linalg.norm(b - a) / spacing)), 1) + 1)
+        for a, b in zip(points[:-1], points[1:])
+    ]
     return np.vstack(pieces)
 
 
@@ -479,7 +647,9 @@ def test_clearance_on_random_cells_is_the_closed_form_minimum_within_the_placeme
         # coal's penetration depths (EPA) agree with the closed form to ~3e-5 for boxes, 4e-4 of the
         # depth for cylinders; separations to 1e-8
         tolerance = 1e-4 + (1e-3 * abs(truth) if truth < 0 else 0.0)
-        assert truth - step / 40.0 - tolerance <= found.distance <= truth + step / 2.0 + tolerance, (found.distance, truth)
+        assert (
+            truth - step / 40.0 - tolerance <= found.distance <= truth + step / 2.0 + tolerance
+        ), (found.distance, truth)
         own = _tool_to_boxes(found.point[None], radius, length, lower, upper, discs)[0]
         assert own.min() == pytest.approx(found.distance, abs=tolerance)
         assert found.part == f"b{int(np.argmin(own))}" or np.sort(own)[1] - own.min() < tolerance
@@ -502,13 +672,21 @@ def test_the_checker_and_straight_moves_on_random_cells_agree_with_the_closed_fo
     assert checker(points)[sure].tolist() == (truth >= margin)[sure].tolist()
     a = rng.uniform([-160, -160, -60], [160, 160, 140], (40, 3))
     b = a + rng.uniform(-120.0, 120.0, (40, 3))
-    along = np.array([_tool_to_boxes(_dense(np.vstack([p, q]), 0.05), radius, length, lower, upper, discs).min()
-                      for p, q in zip(a, b)])
+    along = np.array(
+        [
+            _tool_to_boxes(
+                _dense(np.vstack([p, q]), 0.05), radius, length, lower, upper, discs
+            ).min()
+            for p, q in zip(a, b)
+        ]
+    )
     sure = np.abs(along - margin) > 0.1
     assert checker.segments_free(a, b)[sure].tolist() == (along >= margin)[sure].tolist()
     assert sure.sum() >= 30
     blocked = int(np.argmin(along))  # one move alone, and none
-    assert checker.segments_free(a[blocked : blocked + 1], b[blocked : blocked + 1]).tolist() == [bool(along[blocked] >= margin)]
+    assert checker.segments_free(a[blocked : blocked + 1], b[blocked : blocked + 1]).tolist() == [
+        bool(along[blocked] >= margin)
+    ]
     nothing = bidmp.scene.SceneChecker(scene, np.array([], dtype=int), margin)
     assert nothing.segments_free(a, b).all() and nothing(points).all()
 
@@ -526,14 +704,21 @@ def test_the_culling_bounds_are_the_exact_distances_to_boxes(seed):
     points = rng.uniform(-200.0, 200.0, (400, 3))
     radius, length = rng.uniform(1.0, 15.0), rng.uniform(10.0, 120.0)
     expected = np.maximum(_tool_to_boxes(points, radius, length, lower, upper), 0.0)
-    np.testing.assert_allclose(_cylinder_box_bounds(points, radius, length, lower, upper), expected, atol=1e-9)
+    np.testing.assert_allclose(
+        _cylinder_box_bounds(points, radius, length, lower, upper), expected, atol=1e-9
+    )
     other_lower = rng.uniform(-150.0, 150.0, (400, 3))
     other_upper = other_lower + rng.uniform(0.0, 50.0, (400, 3))
     for k in range(5):
-        gaps = [max(lower[k, axis] - other_upper[i, axis], other_lower[i, axis] - upper[k, axis], 0.0)
-                for i in range(400) for axis in range(3)]
+        gaps = [
+            max(lower[k, axis] - other_upper[i, axis], other_lower[i, axis] - upper[k, axis], 0.0)
+            for i in range(400)
+            for axis in range(3)
+        ]
         by_hand = np.sqrt(np.sum(np.reshape(gaps, (400, 3)) ** 2, axis=1))
-        np.testing.assert_allclose(_box_distance(other_lower, other_upper, lower[k], upper[k]), by_hand, atol=1e-9)
+        np.testing.assert_allclose(
+            _box_distance(other_lower, other_upper, lower[k], upper[k]), by_hand, atol=1e-9
+        )
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -550,8 +735,11 @@ def test_placements_along_a_path_are_at_most_a_step_apart_and_no_more_than_neede
     for segments in (None, chosen):
         dense, which, fraction = _densify(points, step, segments, weights=True)
         indices = np.arange(6) if segments is None else segments
-        np.testing.assert_allclose(dense, points[which] + fraction[:, None] * (points[which + 1] - points[which]),
-                                   atol=1e-9)
+        np.testing.assert_allclose(
+            dense,
+            points[which] + fraction[:, None] * (points[which + 1] - points[which]),
+            atol=1e-9,
+        )
         for index in indices:
             own = dense[which == index]
             length = np.linalg.norm(points[index + 1] - points[index])
@@ -573,7 +761,9 @@ def test_a_peak_at_its_limit_is_within_it_and_a_hair_over_is_not(field):
     from bidmp.tasks.contract import AT_REST, CommandPeaks
 
     def peaks(value, ends=0.0):
-        return CommandPeaks(**{"velocity": 0.2, "acceleration": 0.2, "jerk": 0.2, field: value}, ends=ends)
+        return CommandPeaks(
+            **{"velocity": 0.2, "acceleration": 0.2, "jerk": 0.2, field: value}, ends=ends
+        )
 
     assert peaks(1.0).within and peaks(1.0 + 1e-9).within
     assert not peaks(1.0 + 3e-9).within and not peaks(1.5).within
@@ -587,8 +777,13 @@ def test_the_worst_joint_is_the_one_with_the_largest_peak_of_any_kind():
     s = np.linspace(0.0, 1.0, 2001)
     q = 0.8 * (10 * s**3 - 15 * s**4 + 6 * s**5)
     speed, acceleration, jerk = 15 * 0.8 / 16, 10 * 0.8 / (math.sqrt(3) * 4), 60 * 0.8 / 8
-    limits = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2 * speed, speed / 0.9),
-                                   acceleration=(2 * acceleration, 100 * acceleration), jerk=(2 * jerk, 100 * jerk))
+    limits = bidmp.sim.JointLimits(
+        lower=(-3.0, -3.0),
+        upper=(3.0, 3.0),
+        velocity=(2 * speed, speed / 0.9),
+        acceleration=(2 * acceleration, 100 * acceleration),
+        jerk=(2 * jerk, 100 * jerk),
+    )
     peaks = command_peaks(np.column_stack([q, q]), limits, 1e-3)
     assert peaks.joint == 1 and peaks.velocity == pytest.approx(0.9, rel=2e-3)
 
@@ -601,17 +796,37 @@ def test_a_verdict_is_ok_only_when_every_check_that_applies_holds():
     from bidmp.tasks.contract import CommandPeaks, Verdict
 
     base = Verdict("3", end_error=1.0, threshold=1.0, units="mm")
-    assert base.reached and base.ok and base.failed == [] and base.clear is None and base.within_limits is None
+    assert (
+        base.reached
+        and base.ok
+        and base.failed == []
+        and base.clear is None
+        and base.within_limits is None
+    )
     assert not Verdict("3", 1.0 + 1e-12, 1.0, "mm").reached
-    for change, name in (({"engaged": False}, "engagement"), ({"aligned": False, "axis_deviation": 7.0}, "alignment"),
-                         ({"contacts": {"plate": 0.2}}, "clearance"),
-                         ({"clearance": Clearance(1.0, "plate", np.zeros(3), 3.0)}, "clearance"),
-                         ({"limits": CommandPeaks(1.2, 0.1, 0.1)}, "limits")):
+    for change, name in (
+        ({"engaged": False}, "engagement"),
+        ({"aligned": False, "axis_deviation": 7.0}, "alignment"),
+        ({"contacts": {"plate": 0.2}}, "clearance"),
+        ({"clearance": Clearance(1.0, "plate", np.zeros(3), 3.0)}, "clearance"),
+        ({"limits": CommandPeaks(1.2, 0.1, 0.1)}, "limits"),
+    ):
         verdict = Verdict("3", 0.5, 1.0, "mm", **change)
-        assert not verdict.ok and verdict.failed == [name] and verdict.reason().startswith("the motion to 3 ")
-    assert Verdict("3", 0.5, 1.0, "mm", aligned=False).reason() == "the motion to 3 tilts the tool off the target's axis"
-    for change in ({"engaged": True}, {"aligned": True}, {"clearance": Clearance(3.0, "plate", np.zeros(3), 3.0)},
-                   {"limits": CommandPeaks(1.0, 0.1, 0.1)}):
+        assert (
+            not verdict.ok
+            and verdict.failed == [name]
+            and verdict.reason().startswith("the motion to 3 ")
+        )
+    assert (
+        Verdict("3", 0.5, 1.0, "mm", aligned=False).reason()
+        == "the motion to 3 tilts the tool off the target's axis"
+    )
+    for change in (
+        {"engaged": True},
+        {"aligned": True},
+        {"clearance": Clearance(3.0, "plate", np.zeros(3), 3.0)},
+        {"limits": CommandPeaks(1.0, 0.1, 0.1)},
+    ):
         assert Verdict("3", 0.5, 1.0, "mm", **change).ok
 
 
@@ -623,7 +838,9 @@ def test_the_tools_tilt_over_the_final_approach_is_the_largest_angle_below_the_b
 
     z = np.linspace(40.0, 0.0, 81)
     tilt = np.full(81, 30.0)  # above the band
-    tilt[z < 25.0] = 6.0 * np.sin(np.pi * z[z < 25.0] / 25.0) ** 2 * np.where(z[z < 25.0] > 12.5, 1.0, -1.0)
+    tilt[z < 25.0] = (
+        6.0 * np.sin(np.pi * z[z < 25.0] / 25.0) ** 2 * np.where(z[z < 25.0] > 12.5, 1.0, -1.0)
+    )
     half = np.radians(tilt + 180.0) / 2.0  # the tilt after half a turn about x (pointing down)
     q = np.column_stack([np.sin(half), np.zeros(81), np.zeros(81), np.cos(half)])
     path = np.column_stack([np.zeros(81), np.zeros(81), z])
@@ -633,7 +850,9 @@ def test_the_tools_tilt_over_the_final_approach_is_the_largest_angle_below_the_b
     turn = np.array([0.0, np.sin(np.pi / 4), 0.0, np.cos(np.pi / 4)])
     turned_q = np.array([_quaternion_product(turn, row) for row in q])
     turned_path = np.column_stack([z, np.zeros(81), np.zeros(81)])
-    assert axis_deviation(turned_path, turned_q, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]) == pytest.approx(expected, abs=1e-9)
+    assert axis_deviation(
+        turned_path, turned_q, np.zeros(3), 25.0, axis=[1.0, 0.0, 0.0]
+    ) == pytest.approx(expected, abs=1e-9)
     assert math.isinf(axis_deviation(path[:30], q[:30], np.zeros(3), 25.0))  # ends above the band
 
 
@@ -641,8 +860,14 @@ def _quaternion_product(a, b):
     """Hamilton product of quaternions (x, y, z, w), written out."""
     ax, ay, az, aw = a
     bx, by, bz, bw = b
-    return np.array([aw * bx + ax * bw + ay * bz - az * by, aw * by - ax * bz + ay * bw + az * bx,
-                     aw * bz + ax * by - ay * bx + az * bw, aw * bw - ax * bx - ay * by - az * bz])
+    return np.array(
+        [
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        ]
+    )
 
 
 def _frechet_by_table(a, b):
@@ -681,7 +906,10 @@ def test_both_frechet_implementations_are_the_defining_recursion(seed):
         assert frechet_distance_reference(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         assert frechet_distance(b, a) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         for same in (a, b):  # a curve against itself: the diagonal path, distance 0
-            assert frechet_distance(same, same) == 0.0 and frechet_distance_reference(same, same) == 0.0
+            assert (
+                frechet_distance(same, same) == 0.0
+                and frechet_distance_reference(same, same) == 0.0
+            )
 
 
 def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_moves_along():
@@ -690,41 +918,62 @@ def test_the_axis_template_scales_each_axis_and_ramps_the_ones_the_piece_barely_
     plus λ (n_tar − tar), λ the normalised arc length computed here; a closed piece (it ends where it
     starts) is ramped on every axis, with either scaling."""
     s = np.linspace(0.0, 1.0, 50)
-    piece = np.column_stack([100 * s, 20 * np.sin(np.pi * s), 5.0 + 0 * s])  # z: the piece does not move
+    piece = np.column_stack(
+        [100 * s, 20 * np.sin(np.pi * s), 5.0 + 0 * s]
+    )  # z: the piece does not move
     new_target = np.array([160.0, -30.0, 12.0])
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])
     lam = arc / arc[-1]
     out = template(piece, new_target, scaling="axis")
     np.testing.assert_allclose(out[:, 0], 1.6 * piece[:, 0], atol=1e-9)
-    np.testing.assert_allclose(out[:, 1], piece[:, 1] + lam * (-30.0 - piece[-1, 1]), atol=1e-9)  # y: chord ~0
+    np.testing.assert_allclose(
+        out[:, 1], piece[:, 1] + lam * (-30.0 - piece[-1, 1]), atol=1e-9
+    )  # y: chord ~0
     np.testing.assert_allclose(out[:, 2], 5.0 + lam * 7.0, atol=1e-9)
     steep = piece.copy()
-    steep[:, 1] = 20 * np.sin(np.pi * s) + 2.0 * s  # y chord 2: factor (-30 - 0)/2 = -15, over 10: ramped
+    steep[:, 1] = (
+        20 * np.sin(np.pi * s) + 2.0 * s
+    )  # y chord 2: factor (-30 - 0)/2 = -15, over 10: ramped
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(steep, axis=0), axis=1))])
     out = template(steep, new_target, scaling="axis")
     np.testing.assert_allclose(out[:, 1], steep[:, 1] + arc / arc[-1] * (-30.0 - 2.0), atol=1e-9)
     loop = np.column_stack([30 * np.sin(2 * np.pi * s), 30 * (1 - np.cos(2 * np.pi * s)), 0 * s])
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(loop, axis=0), axis=1))])
     for scaling in ("axis", "similarity"):
-        np.testing.assert_allclose(template(loop, [10.0, 5.0, 2.0], scaling=scaling),
-                                   loop + (arc / arc[-1])[:, None] * np.array([10.0, 5.0, 2.0]), atol=1e-9)
+        np.testing.assert_allclose(
+            template(loop, [10.0, 5.0, 2.0], scaling=scaling),
+            loop + (arc / arc[-1])[:, None] * np.array([10.0, 5.0, 2.0]),
+            atol=1e-9,
+        )
     # In metres (shorter than 1 in all), pausing at its start: λ is still the arc length's share.
     short = np.vstack([piece[:1], piece]) / 1000.0
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(short, axis=0), axis=1))])
     out = template(short, new_target / 1000.0, scaling="axis")
     np.testing.assert_allclose(out[:, 2], short[:, 2] + arc / arc[-1] * 0.007, atol=1e-12)
-    for offset in ([1e4, 1e4, 0.0], [-1e4, -1e4, 0.0]):  # closed to rounding (1e-10) far from the origin
+    for offset in (
+        [1e4, 1e4, 0.0],
+        [-1e4, -1e4, 0.0],
+    ):  # closed to rounding (1e-10) far from the origin
         far_loop = loop + offset
         far_loop[-1] += 1e-10
         arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(far_loop, axis=0), axis=1))])
-        np.testing.assert_allclose(template(far_loop, far_loop[0] + [10.0, 5.0, 2.0], scaling="similarity"),
-                                   far_loop + (arc / arc[-1])[:, None] * (far_loop[0] + [10.0, 5.0, 2.0] - far_loop[-1]),
-                                   atol=1e-7)
-    waits = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [10.0, 0.0, 0.0]])  # one step, at the end
-    np.testing.assert_allclose(template(waits, [20.0, 5.0, 0.0])[:, 1], [0.0, 0.0, 0.0, 5.0], atol=1e-12)
+        np.testing.assert_allclose(
+            template(far_loop, far_loop[0] + [10.0, 5.0, 2.0], scaling="similarity"),
+            far_loop + (arc / arc[-1])[:, None] * (far_loop[0] + [10.0, 5.0, 2.0] - far_loop[-1]),
+            atol=1e-7,
+        )
+    waits = np.array(
+        [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [10.0, 0.0, 0.0]]
+    )  # one step, at the end
+    np.testing.assert_allclose(
+        template(waits, [20.0, 5.0, 0.0])[:, 1], [0.0, 0.0, 0.0, 5.0], atol=1e-12
+    )
     still = np.tile([3.0, 4.0, 5.0], (5, 1))  # no length at all: λ by sample
-    np.testing.assert_allclose(template(still, [7.0, 4.0, 5.0]), still + np.linspace(0, 1, 5)[:, None] * [4.0, 0, 0],
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        template(still, [7.0, 4.0, 5.0]),
+        still + np.linspace(0, 1, 5)[:, None] * [4.0, 0, 0],
+        atol=1e-12,
+    )
 
 
 @pytest.mark.parametrize("direction", [1.0, -1.0, 0.5])
@@ -765,28 +1014,42 @@ def _documented_curvature(y, smooth=0.05, smooth_curvature=0.03):
     return np.maximum(savgol_filter(kappa, window, 2) if window > 3 else kappa, 0.0)
 
 
-@pytest.mark.parametrize("n_points, smooth, smooth_curvature", [(400, 0.05, 0.03), (120, 0.1, 0.08), (57, 0.02, 0.01),
-                                                                 (2000, 0.05, 0.03)])
-def test_curvature_is_the_documented_smoothing_of_the_closed_form(n_points, smooth, smooth_curvature):
+@pytest.mark.parametrize(
+    "n_points, smooth, smooth_curvature",
+    [(400, 0.05, 0.03), (120, 0.1, 0.08), (57, 0.02, 0.01), (2000, 0.05, 0.03)],
+)
+def test_curvature_is_the_documented_smoothing_of_the_closed_form(
+    n_points, smooth, smooth_curvature
+):
     """Independent oracle: on a helix (κ = r / (r² + c²)) the curvature is the closed form inside
     the curve, and everywhere it is the documented procedure written out in the test."""
     from bidmp.extension.segmentation import curvature
 
     radius, pitch = 40.0, 15.0
     t = np.linspace(0.0, 3 * np.pi, n_points)
-    helix = np.column_stack([radius * np.cos(t), radius * np.sin(t), pitch * t])  # even in arc length
+    helix = np.column_stack(
+        [radius * np.cos(t), radius * np.sin(t), pitch * t]
+    )  # even in arc length
     kappa = curvature(helix, smooth, smooth_curvature)
-    np.testing.assert_allclose(kappa, _documented_curvature(helix, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        kappa, _documented_curvature(helix, smooth, smooth_curvature), rtol=1e-9, atol=1e-12
+    )
     inside = slice(n_points // 10, -n_points // 10)
     # a cubic fit over a window of 5-10 % of the helix (0.5-0.9 rad of turn) reads 0.4-1.8 % low
     np.testing.assert_allclose(kappa[inside], radius / (radius**2 + pitch**2), rtol=3e-2)
     rng = np.random.default_rng(n_points)
     wiggly = np.cumsum(rng.normal(size=(n_points, 3)), axis=0)
-    np.testing.assert_allclose(curvature(wiggly, smooth, smooth_curvature),
-                               _documented_curvature(wiggly, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        curvature(wiggly, smooth, smooth_curvature),
+        _documented_curvature(wiggly, smooth, smooth_curvature),
+        rtol=1e-9,
+        atol=1e-12,
+    )
     flat = curvature(wiggly[:, :2], smooth, smooth_curvature)  # a 2-D curve is the z = 0 curve
     padded = np.column_stack([wiggly[:, :2], np.zeros(n_points)])
-    np.testing.assert_allclose(flat, _documented_curvature(padded, smooth, smooth_curvature), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        flat, _documented_curvature(padded, smooth, smooth_curvature), rtol=1e-9, atol=1e-12
+    )
 
 
 def test_curvature_where_the_curve_stops_is_zero_and_a_tiny_curve_has_none():
@@ -804,7 +1067,9 @@ def test_curvature_where_the_curve_stops_is_zero_and_a_tiny_curve_has_none():
     # its ends) the curve does not advance and has no curvature.
     t = np.linspace(0.0, np.pi / 2, 100)
     arc = np.column_stack([50 * np.cos(t), 50 * np.sin(t), np.zeros(100)])
-    paused = np.vstack([arc, np.tile(arc[-1], (120, 1)), arc[-1] + (arc - arc[0])[::-1] * [-1, 1, 1]])
+    paused = np.vstack(
+        [arc, np.tile(arc[-1], (120, 1)), arc[-1] + (arc - arc[0])[::-1] * [-1, 1, 1]]
+    )
     kappa = curvature(paused)
     window = 17  # 5 % of 320 samples, odd
     assert np.all(kappa[100 + window : 220 - window] == 0.0)
@@ -824,7 +1089,13 @@ def _extrema_by_runs(kappa, low, high):
             runs.append([value, index, index])
     indices, types = [], []
     for previous, (value, first, last), following in zip(runs, runs[1:], runs[2:]):
-        kind = 1 if previous[0] < value > following[0] else -1 if previous[0] > value < following[0] else 0
+        kind = (
+            1
+            if previous[0] < value > following[0]
+            else -1
+            if previous[0] > value < following[0]
+            else 0
+        )
         if kind:
             indices.append(low + (first + last) // 2)
             types.append(kind)
@@ -896,10 +1167,16 @@ def test_both_pruning_rules_are_their_written_out_loops(seed):
         epsilon = float(rng.integers(0, 4))
         kept, kinds = _prune_persistence(indices, types, kappa, epsilon)
         expected = _prune_by_hand(values, epsilon)
-        assert kept.tolist() == indices[expected].tolist() and kinds.tolist() == types[expected].tolist()
+        assert (
+            kept.tolist() == indices[expected].tolist()
+            and kinds.tolist() == types[expected].tolist()
+        )
         kept, kinds = _prune_paper(indices, types, kappa, epsilon)
         expected = _paper_by_hand(types, values, epsilon)
-        assert kept.tolist() == indices[expected].tolist() and kinds.tolist() == types[expected].tolist()
+        assert (
+            kept.tolist() == indices[expected].tolist()
+            and kinds.tolist() == types[expected].tolist()
+        )
 
 
 # -- the Broad Learning System --------------------------------------------------------------------
@@ -933,9 +1210,16 @@ def test_a_bls_is_its_documented_forward_pass_and_output_solve(reg):
     np.testing.assert_allclose(model.predict(X), A @ model.output_weights_, atol=1e-10)
     fresh = rng.normal(size=(5, 4))
     fresh_with_bias = np.hstack([fresh, np.full((5, 1), 0.1)])
-    Z_fresh = (np.hstack([fresh_with_bias @ model.mapping_weights_[i] for i in range(2)]) - model.mapping_min_) / model.mapping_range_
-    H_fresh = np.tanh(model.enhancement_scales_[0] * np.hstack([Z_fresh, np.full((5, 1), 0.1)]) @ weights)
-    np.testing.assert_allclose(model.predict(fresh), np.hstack([Z_fresh, H_fresh]) @ model.output_weights_, atol=1e-10)
+    Z_fresh = (
+        np.hstack([fresh_with_bias @ model.mapping_weights_[i] for i in range(2)])
+        - model.mapping_min_
+    ) / model.mapping_range_
+    H_fresh = np.tanh(
+        model.enhancement_scales_[0] * np.hstack([Z_fresh, np.full((5, 1), 0.1)]) @ weights
+    )
+    np.testing.assert_allclose(
+        model.predict(fresh), np.hstack([Z_fresh, H_fresh]) @ model.output_weights_, atol=1e-10
+    )
 
 
 def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seeded_projections():
@@ -947,10 +1231,14 @@ def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seede
 
     rng = np.random.default_rng(3)
     X, Y = rng.normal(size=(50, 2)), rng.normal(size=(50, 1))
-    model = bidmp.BLS(n_windows=3, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-3, admm_iterations=30, seed=11).fit(X, Y)
+    model = bidmp.BLS(
+        n_windows=3, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-3, admm_iterations=30, seed=11
+    ).fit(X, Y)
     with_bias = np.hstack([X, np.full((50, 1), 0.1)])
     for window in range(3):
-        projection = with_bias @ np.random.default_rng([11, 0, window]).uniform(-1.0, 1.0, size=(3, 4))
+        projection = with_bias @ np.random.default_rng([11, 0, window]).uniform(
+            -1.0, 1.0, size=(3, 4)
+        )
         F = (projection - projection.min(axis=0)) / np.ptp(projection, axis=0)
         expected = sparse_autoencoder(F, with_bias, 1e-3, 30).T
         np.testing.assert_allclose(model.mapping_weights_[window], expected, rtol=1e-10, atol=1e-12)
@@ -958,19 +1246,27 @@ def test_a_bls_learns_its_mapped_features_by_the_sparse_autoencoder_of_its_seede
     assert not np.allclose(model.enhancement_weights_[1], model.enhancement_weights_[0])
     # Small inputs (projections spanning less than 1) are normalised all the same.
     small = X * 0.01
-    model = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-6, admm_iterations=30, seed=11).fit(small, Y)
+    model = bidmp.BLS(
+        n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e-6, admm_iterations=30, seed=11
+    ).fit(small, Y)
     small_with_bias = np.hstack([small, np.full((50, 1), 0.1)])
     projection = small_with_bias @ np.random.default_rng([11, 0, 0]).uniform(-1.0, 1.0, size=(3, 4))
     assert np.ptp(projection, axis=0).max() < 1.0
     F = (projection - projection.min(axis=0)) / np.ptp(projection, axis=0)
-    np.testing.assert_allclose(model.mapping_weights_[0], sparse_autoencoder(F, small_with_bias, 1e-6, 30).T,
-                               rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(
+        model.mapping_weights_[0],
+        sparse_autoencoder(F, small_with_bias, 1e-6, 30).T,
+        rtol=1e-10,
+        atol=1e-12,
+    )
     # A sparsity weight so large that every mapped node is 0: constant nodes stay 0, not 0/0.
     flat = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, l1=1e6, seed=11).fit(X, Y)
     assert np.all(flat.mapping_weights_[0] == 0.0) and np.all(flat.mapping_range_ == 1.0)
     assert np.all(flat.hidden(X)[:, :4] == 0.0) and np.all(np.isfinite(flat.predict(X)))
     # Inputs that never change: every projection is constant, and the fit stays finite.
-    same = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, seed=11).fit(np.ones((50, 2)), Y)
+    same = bidmp.BLS(n_windows=1, n_mapped=4, n_enhance=6, reg=1e-6, seed=11).fit(
+        np.ones((50, 2)), Y
+    )
     assert np.all(np.isfinite(same.predict(np.ones((3, 2)))))
 
 
@@ -981,15 +1277,28 @@ def test_a_tool_turning_past_a_block_is_checked_at_its_nearest_mid_turn_attitude
     so a check that places the turning tool too sparsely sees 68."""
     length, radius = 100.0, 6.0
     centre = np.array([0.0, -np.sin(np.pi / 4), np.cos(np.pi / 4)]) * length * 1.12
-    scene = Scene.from_dict({"tool": {"radius": radius, "length": length},
-                             "parts": [{"type": "box", "label": "block", "at": (centre - [0, 0, 5]).tolist(), "size": [10, 10, 10]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": radius, "length": length},
+            "parts": [
+                {
+                    "type": "box",
+                    "label": "block",
+                    "at": (centre - [0, 0, 5]).tolist(),
+                    "size": [10, 10, 10],
+                }
+            ],
+        }
+    )
 
     def attitude(angle):  # pointing down (half a turn about x), then turned by angle about x
         half = (angle + np.pi) / 2.0
         return np.array([np.sin(half), 0.0, 0.0, np.cos(half)])
 
     angles = np.linspace(0.0, np.pi / 2, 2001)
-    dense = scene.clearance(np.zeros((2001, 3)), orientations=np.array([attitude(a) for a in angles])).distance
+    dense = scene.clearance(
+        np.zeros((2001, 3)), orientations=np.array([attitude(a) for a in angles])
+    ).distance
     step = 0.002 * length
     ends = np.array([attitude(0.0), attitude(np.pi / 2)])
     moving = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0]])  # rising 3 mm as it turns: nearer still
@@ -1014,8 +1323,14 @@ def test_a_separation_is_kept_only_when_the_nearest_points_are_that_far_apart():
     """Structure guard of the check on coal's answers: a separation whose nearest points lie on
     the shapes as far apart as it says is kept; the same points offered for a larger or a smaller
     separation are not (coal's known failure: a distance between points off the shapes)."""
-    scene = Scene.from_dict({"tool": {"radius": 5.0, "length": 50.0},
-                             "parts": [{"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [20.0, 20.0, 20.0]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 5.0, "length": 50.0},
+            "parts": [
+                {"type": "box", "label": "box", "at": [0.0, 0.0, 0.0], "size": [20.0, 20.0, 20.0]}
+            ],
+        }
+    )
     engine = scene._engine()
     distance = engine.tool_to(np.array([0.0, 0.0, 32.0]), 0)  # 12 above the box's top
     assert distance == pytest.approx(12.0, abs=1e-8)
@@ -1025,7 +1340,11 @@ def test_a_separation_is_kept_only_when_the_nearest_points_are_that_far_apart():
     for claimed in (15.0, 9.0):
         assert not engine._witnessed(engine.tool, tool_pose, shape, pose, claimed)
     # The tolerance is 1e-6 of the distance (of 1 below 1): 12 ± 1e-5 is borne out, 12 ± 1.5e-5 not.
-    for claimed, kept in ((distance + 1e-5, True), (distance - 1e-5, True), (distance + 1.5e-5, False)):
+    for claimed, kept in (
+        (distance + 1e-5, True),
+        (distance - 1e-5, True),
+        (distance + 1.5e-5, False),
+    ):
         assert engine._witnessed(engine.tool, tool_pose, shape, pose, claimed) is kept
     near = engine.tool_to(np.array([0.0, 0.0, 21.5]), 0)  # 1.5 above: the tolerance is 1.5e-6
     near_pose = engine.coal.Transform3s(np.eye(3), np.array([0.0, 0.0, 21.5]) + engine.tool_offset)
@@ -1041,12 +1360,19 @@ def test_the_smoothstep_is_its_polynomial_with_flat_ends():
 
     u = np.linspace(-0.2, 1.2, 141)
     inside = np.clip(u, 0.0, 1.0)
-    np.testing.assert_allclose(_smoothstep(u), 35 * inside**4 - 84 * inside**5 + 70 * inside**6 - 20 * inside**7,
-                               atol=1e-14)
+    np.testing.assert_allclose(
+        _smoothstep(u),
+        35 * inside**4 - 84 * inside**5 + 70 * inside**6 - 20 * inside**7,
+        atol=1e-14,
+    )
     first, second = _smoothstep_derivatives(u)
     within = (u > 0) & (u < 1)
-    np.testing.assert_allclose(first[within], (140 * u**3 - 420 * u**4 + 420 * u**5 - 140 * u**6)[within], atol=1e-12)
-    np.testing.assert_allclose(second[within], (420 * u**2 - 1680 * u**3 + 2100 * u**4 - 840 * u**5)[within], atol=1e-11)
+    np.testing.assert_allclose(
+        first[within], (140 * u**3 - 420 * u**4 + 420 * u**5 - 140 * u**6)[within], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        second[within], (420 * u**2 - 1680 * u**3 + 2100 * u**4 - 840 * u**5)[within], atol=1e-11
+    )
     assert np.all(first[~within] == 0.0) and np.all(second[~within] == 0.0)
     assert _smoothstep(np.array([0.5]))[0] == pytest.approx(0.5)
 
@@ -1089,7 +1415,9 @@ def test_the_goal_gate_is_the_springs_inverse_for_the_share():
     gate = _goal_gate(share, dt, alpha=alpha, beta=beta, K=K)
     expected = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
     assert gate[0] == alpha * beta / K
-    np.testing.assert_allclose(gate[2:-2], expected[2:-2], atol=2e-3 * alpha * beta / K)  # central differences
+    np.testing.assert_allclose(
+        gate[2:-2], expected[2:-2], atol=2e-3 * alpha * beta / K
+    )  # central differences
 
 
 @pytest.mark.parametrize("exact", [True, False])
@@ -1121,22 +1449,44 @@ def test_the_measured_joints_peaks_are_a_quintics_closed_forms(sign):
     t = np.arange(0.0, duration + step / 2, step) / duration
     velocity = sign * amplitude / duration * (30 * t**2 - 60 * t**3 + 30 * t**4)
     recorded = np.column_stack([velocity, 0.5 * velocity])
-    limits = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2.0, 2.0),
-                                   acceleration=(4.0, 4.0), jerk=(50.0, 50.0))
+    limits = bidmp.sim.JointLimits(
+        lower=(-3.0, -3.0),
+        upper=(3.0, 3.0),
+        velocity=(2.0, 2.0),
+        acceleration=(4.0, 4.0),
+        jerk=(50.0, 50.0),
+    )
     peaks = _measured_peaks(recorded, step, limits)
     assert peaks.velocity == pytest.approx(15 * amplitude / (8 * duration) / 2.0, rel=1e-6)
-    assert peaks.acceleration == pytest.approx(10 * amplitude / (math.sqrt(3) * duration**2) / 4.0, rel=1e-2)
+    assert peaks.acceleration == pytest.approx(
+        10 * amplitude / (math.sqrt(3) * duration**2) / 4.0, rel=1e-2
+    )
     # the first jerk estimate is centred 10 ms in, where it is 60A/T³ (1 − 6u + 6u²), u = 0.005
     u = 0.01 / duration
-    assert peaks.jerk == pytest.approx(60 * amplitude / duration**3 * (1 - 6 * u + 6 * u**2) / 50.0, rel=2e-3)
-    loose = bidmp.sim.JointLimits(lower=(-3.0, -3.0), upper=(3.0, 3.0), velocity=(2.0, 2.0),
-                                  acceleration=(4.0, 4.0), jerk=None)
+    assert peaks.jerk == pytest.approx(
+        60 * amplitude / duration**3 * (1 - 6 * u + 6 * u**2) / 50.0, rel=2e-3
+    )
+    loose = bidmp.sim.JointLimits(
+        lower=(-3.0, -3.0),
+        upper=(3.0, 3.0),
+        velocity=(2.0, 2.0),
+        acceleration=(4.0, 4.0),
+        jerk=None,
+    )
     assert _measured_peaks(recorded, step, loose).jerk == 0.0
     # A short recording: one sample has no acceleration; two windows' worth one (its difference).
     one = _measured_peaks(recorded[:1], step, limits)
     assert (one.acceleration, one.jerk) == (0.0, 0.0)
-    two = _measured_peaks(np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.2, 0.0]]), step, limits)
-    assert two.acceleration == pytest.approx(0.2 / 0.01 / 4.0) and two.jerk == 0.0 and two.velocity == pytest.approx(0.1)
+    two = _measured_peaks(
+        np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0], [0.2, 0.0]]),
+        step,
+        limits,
+    )
+    assert (
+        two.acceleration == pytest.approx(0.2 / 0.01 / 4.0)
+        and two.jerk == 0.0
+        and two.velocity == pytest.approx(0.1)
+    )
 
 
 def test_the_end_error_is_the_last_samples_distance():
@@ -1160,14 +1510,26 @@ def test_the_tools_tilt_is_measured_about_every_axis_and_survives_rounding():
     z = np.linspace(40.0, 0.0, 41)
     path = np.column_stack([np.full(41, 7.0), np.full(41, -3.0), z])
     tilt = np.where(z < 25.0, 4.0 * np.sin(np.pi * z / 25.0), 20.0)
-    q = (Rotation.from_euler("y", tilt[:, None], degrees=True) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()
-    assert axis_deviation(path, q, [7.0, -3.0, 0.0], 25.0) == pytest.approx(np.max(np.abs(tilt[z < 25.0])), abs=1e-9)
+    q = (
+        Rotation.from_euler("y", tilt[:, None], degrees=True)
+        * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])
+    ).as_quat()
+    assert axis_deviation(path, q, [7.0, -3.0, 0.0], 25.0) == pytest.approx(
+        np.max(np.abs(tilt[z < 25.0])), abs=1e-9
+    )
     spins = np.linspace(0.0, 2 * np.pi, 4001)
-    down = [(Rotation.from_euler("z", a) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat() for a in spins]
-    rounding_up = next(q for q in down if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] > 1.0)
+    down = [
+        (Rotation.from_euler("z", a) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()
+        for a in spins
+    ]
+    rounding_up = next(
+        q for q in down if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] > 1.0
+    )
     assert axis_deviation(path, np.tile(rounding_up, (41, 1)), [7.0, -3.0, 0.0], 25.0) == 0.0
     up = [Rotation.from_euler("z", a).as_quat() for a in spins]
-    rounding_down = next(q for q in up if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] < -1.0)
+    rounding_down = next(
+        q for q in up if Rotation.from_quat(q).apply([0.0, 0.0, 1.0]) @ [0.0, 0.0, -1.0] < -1.0
+    )
     assert axis_deviation(path, np.tile(rounding_down, (41, 1)), [7.0, -3.0, 0.0], 25.0) == 180.0
 
 
@@ -1198,17 +1560,30 @@ def test_a_half_turn_template_turns_in_the_plane_of_the_least_aligned_axis():
     normal = np.cross(chord / 50.0, [0.0, 0.0, 1.0])
     piece = s * chord + np.sin(np.pi * s) * (10.0 * normal + np.array([0.0, 0.0, 7.0]))
     out = template(piece, -0.5 * chord, scaling="similarity")
-    np.testing.assert_allclose((out - piece[0]) @ normal, 0.5 * (piece - piece[0]) @ normal, atol=1e-9)
-    np.testing.assert_allclose((out - piece[0]) @ chord, -0.5 * (piece - piece[0]) @ chord, atol=1e-9)
-    np.testing.assert_allclose(out[:, 2], -0.5 * piece[:, 2], atol=1e-9)  # in the plane: turned over
+    np.testing.assert_allclose(
+        (out - piece[0]) @ normal, 0.5 * (piece - piece[0]) @ normal, atol=1e-9
+    )
+    np.testing.assert_allclose(
+        (out - piece[0]) @ chord, -0.5 * (piece - piece[0]) @ chord, atol=1e-9
+    )
+    np.testing.assert_allclose(
+        out[:, 2], -0.5 * piece[:, 2], atol=1e-9
+    )  # in the plane: turned over
     line = np.linspace(0.0, 10.0, 11)[:, None] + 0.5 * np.sin(np.linspace(0, np.pi, 11))[:, None]
-    np.testing.assert_allclose(template(line, [-5.0], scaling="similarity"), -0.5 * line, atol=1e-12)
-    unit = template(piece, piece[0] + [0.0, 1.0, 0.0], scaling="similarity")  # a new chord exactly 1 long
+    np.testing.assert_allclose(
+        template(line, [-5.0], scaling="similarity"), -0.5 * line, atol=1e-12
+    )
+    unit = template(
+        piece, piece[0] + [0.0, 1.0, 0.0], scaling="similarity"
+    )  # a new chord exactly 1 long
     from scipy.spatial.distance import pdist
 
     np.testing.assert_allclose(pdist(unit), pdist(piece) / 50.0, rtol=1e-9)
-    np.testing.assert_allclose(unit[-2] - unit[0], (piece[-2] - piece[0]) @ _rodrigues(chord, [0.0, 1.0, 0.0]).T / 50.0,
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        unit[-2] - unit[0],
+        (piece[-2] - piece[0]) @ _rodrigues(chord, [0.0, 1.0, 0.0]).T / 50.0,
+        atol=1e-9,
+    )
 
 
 def _segment_by_hand(y, eps_frac, method):
@@ -1217,7 +1592,12 @@ def _segment_by_hand(y, eps_frac, method):
     points equally spaced in arc length, curvature, extrema on the interior 5 % … 95 %, prune with
     ε = eps_frac (max − min) of the interior's curvature, map each kept point to the original sample
     nearest in arc length (the earlier one on a tie), one point per sample."""
-    from bidmp.extension.segmentation import _alternating_extrema, _prune_paper, _prune_persistence, curvature
+    from bidmp.extension.segmentation import (
+        _alternating_extrema,
+        _prune_paper,
+        _prune_persistence,
+        curvature,
+    )
 
     steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
     s = np.concatenate([[0.0], np.cumsum(steps)])
@@ -1233,7 +1613,9 @@ def _segment_by_hand(y, eps_frac, method):
         return [], []
     indices, types = _alternating_extrema(kappa, low, high)
     epsilon = eps_frac * (np.max(interior) - np.min(interior))
-    kept, kinds = (_prune_persistence if method == "persistence" else _prune_paper)(indices, types, kappa, epsilon)
+    kept, kinds = (_prune_persistence if method == "persistence" else _prune_paper)(
+        indices, types, kappa, epsilon
+    )
     points, point_kinds = [], []
     for index, kind in zip(kept, kinds):
         position = index / (n - 1) * s[-1]
@@ -1265,16 +1647,23 @@ def test_segmentation_is_its_documented_procedure_on_random_recordings(seed):
         for eps_frac in (0.05, 0.1, 0.3):
             found = segment(y, eps_frac, method)
             points, kinds = _segment_by_hand(y, eps_frac, method)
-            assert (found.points.tolist(), found.kinds.tolist()) == (points, kinds), (method, eps_frac)
+            assert (found.points.tolist(), found.kinds.tolist()) == (points, kinds), (
+                method,
+                eps_frac,
+            )
     # An ellipse and a spiral: curved everywhere, so the threshold's min κ is far from 0.
     t = np.linspace(0.0, 3 * np.pi, 700 + 300 * seed)
-    for curve in (np.column_stack([100 * np.cos(t), 40 * np.sin(t)]),
-                  np.column_stack([1e4 * np.cos(t), 4e3 * np.sin(t)]),  # 100 m long: κ·L decides, not κ
-                  np.column_stack([(60 + 8 * t) * np.cos(t), (60 + 8 * t) * np.sin(t), 3 * t])):
+    for curve in (
+        np.column_stack([100 * np.cos(t), 40 * np.sin(t)]),
+        np.column_stack([1e4 * np.cos(t), 4e3 * np.sin(t)]),  # 100 m long: κ·L decides, not κ
+        np.column_stack([(60 + 8 * t) * np.cos(t), (60 + 8 * t) * np.sin(t), 3 * t]),
+    ):
         for method in ("persistence", "paper"):
             for eps_frac in (0.02, 0.2, 0.95):
                 found = segment(curve, eps_frac, method)
-                assert (found.points.tolist(), found.kinds.tolist()) == _segment_by_hand(curve, eps_frac, method)
+                assert (found.points.tolist(), found.kinds.tolist()) == _segment_by_hand(
+                    curve, eps_frac, method
+                )
     line = np.outer(np.linspace(0.0, 1.0, 300), [40.0, -20.0, 5.0])  # a straight line: no points
     assert len(segment(line)) == 0 and _segment_by_hand(line, 0.1, "persistence") == ([], [])
 
@@ -1287,7 +1676,9 @@ def test_the_command_generator_feeds_the_targets_rates_forward_and_settles_on_a_
     acceleration given) likewise; a held target given alone is reached at rest."""
     from bidmp.sim.limits import _RateLimiter
 
-    limits = bidmp.sim.JointLimits(lower=(-3.0,), upper=(3.0,), velocity=(1.0,), acceleration=(5.0,), jerk=(100.0,))
+    limits = bidmp.sim.JointLimits(
+        lower=(-3.0,), upper=(3.0,), velocity=(1.0,), acceleration=(5.0,), jerk=(100.0,)
+    )
     ramp, accelerating, held = (_RateLimiter(np.zeros(1), limits, 0.9) for _ in range(3))
     for k in range(4000):
         t = k * 1e-3
@@ -1308,18 +1699,32 @@ def test_the_measured_acceleration_is_the_velocitys_difference_over_10_ms():
     apart over 10 ms, computed here."""
     from bidmp.sim.limits import _measured_peaks
 
-    limits = bidmp.sim.JointLimits(lower=(-3.0,), upper=(3.0,), velocity=(2.0,), acceleration=(1.0,), jerk=(1e6,))
+    limits = bidmp.sim.JointLimits(
+        lower=(-3.0,), upper=(3.0,), velocity=(2.0,), acceleration=(1.0,), jerk=(1e6,)
+    )
     for step in (0.01, 0.002):
         t = np.arange(0.0, 1.0, step)
         velocity = np.sin(3.0 * t) ** 3
         every = int(round(0.01 / step))
         expected = np.max(np.abs(np.diff(velocity[::every]))) / 0.01
-        assert _measured_peaks(velocity[:, None], step, limits).acceleration == pytest.approx(expected, rel=1e-12)
+        assert _measured_peaks(velocity[:, None], step, limits).acceleration == pytest.approx(
+            expected, rel=1e-12
+        )
 
 
-@pytest.mark.parametrize("n, bumps, expected", [(101, (6, 94), ([6, 50, 94], [1, -1, 1])), (101, (95,), ([], [])),
-                                                 (101, (4,), ([], [])), (102, (6,), ([], [])), (102, (7,), ([7], [1]))])
-def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(monkeypatch, n, bumps, expected):
+@pytest.mark.parametrize(
+    "n, bumps, expected",
+    [
+        (101, (6, 94), ([6, 50, 94], [1, -1, 1])),
+        (101, (95,), ([], [])),
+        (101, (4,), ([], [])),
+        (102, (6,), ([], [])),
+        (102, (7,), ([7], [1])),
+    ],
+)
+def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(
+    monkeypatch, n, bumps, expected
+):
     """Structure guard of the window, with a curvature designed here (the curve is a straight line
     of 101 evenly spaced samples, so sample i is resampled point i): on the interior, samples
     ceil(0.05 · 100) = 5 … floor(0.95 · 100) = 95, a maximum needs a neighbour on each side inside
@@ -1336,14 +1741,33 @@ def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(monkeypa
     assert (found.points.tolist(), found.kinds.tolist()) == expected
 
 
-@pytest.mark.parametrize("x, bump, height, expected", [
-    (np.r_[0.0, np.arange(30.0, 101.0)], 6, 1.0, ([0], [1])),  # at 8.5 % of the path: sample 0 (0 %), not 1 (30 %)
-    (np.r_[np.arange(0.0, 71.0), 100.0], 65, 1.0, ([71], [1])),  # at 91.5 %: the last sample (100 %), not 70 %
-    (np.linspace(0.0, 100.0, 101), 50, 1.5e-8, ([50], [1])),  # κ·L = 1.5e-6: a bend, however slight
-    (np.linspace(0.0, 100.0, 101), 50, 0.5e-8, ([], [])),  # κ·L = 5e-7: straight
-])
-def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_flat_path_straight(monkeypatch, x, bump,
-                                                                                                height, expected):
+@pytest.mark.parametrize(
+    "x, bump, height, expected",
+    [
+        (
+            np.r_[0.0, np.arange(30.0, 101.0)],
+            6,
+            1.0,
+            ([0], [1]),
+        ),  # at 8.5 % of the path: sample 0 (0 %), not 1 (30 %)
+        (
+            np.r_[np.arange(0.0, 71.0), 100.0],
+            65,
+            1.0,
+            ([71], [1]),
+        ),  # at 91.5 %: the last sample (100 %), not 70 %
+        (
+            np.linspace(0.0, 100.0, 101),
+            50,
+            1.5e-8,
+            ([50], [1]),
+        ),  # κ·L = 1.5e-6: a bend, however slight
+        (np.linspace(0.0, 100.0, 101), 50, 0.5e-8, ([], [])),  # κ·L = 5e-7: straight
+    ],
+)
+def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_flat_path_straight(
+    monkeypatch, x, bump, height, expected
+):
     """Structure guard of the mapping and the straight-path threshold, with a curvature designed
     here on a straight line sampled unevenly (a first or last step of 30 % of the path): a point
     found at a resampled position goes to the original sample nearest in arc length, whichever end
@@ -1377,15 +1801,30 @@ def test_a_peak_speed_is_judged_at_1_mm_per_s_and_10_m_per_s_in_every_unit(units
     check_speed(1e9, "", "x")  # no unit: not judged
 
 
-@pytest.mark.parametrize("speed, units, hint", [
-    (0.3, "mm", "is it in m?"),      # metre numbers declared as mm: 0.3 mm/s, 0.3 m/s in m
-    (300.0, "m", "is it in mm?"),    # mm numbers declared as m: 300 m/s, 0.3 m/s in mm
-    (30.0, "m", "is it in cm?"),     # 30 m/s: 0.3 m/s in cm (0.03 in mm is further from a hand's 0.25 m/s)
-    (0.03, "cm", "is it in m?"),     # 0.3 mm/s in cm: 0.03 m/s in m
-    (120.0, "m", "is it in mm?"),    # 1.2 m/s in cm, 0.12 m/s in mm: mm is nearer a hand's 0.25 m/s (log scale)
-    (1e-3, "mm", "is it in m?"),     # 1 mm/s in m: plausible at its very boundary, and no other unit is
-    (1e4, "m", "is it in mm?"),      # 10 m/s in mm: at the other boundary (100 m/s in cm is not)
-])
+@pytest.mark.parametrize(
+    "speed, units, hint",
+    [
+        (0.3, "mm", "is it in m?"),  # metre numbers declared as mm: 0.3 mm/s, 0.3 m/s in m
+        (300.0, "m", "is it in mm?"),  # mm numbers declared as m: 300 m/s, 0.3 m/s in mm
+        (
+            30.0,
+            "m",
+            "is it in cm?",
+        ),  # 30 m/s: 0.3 m/s in cm (0.03 in mm is further from a hand's 0.25 m/s)
+        (0.03, "cm", "is it in m?"),  # 0.3 mm/s in cm: 0.03 m/s in m
+        (
+            120.0,
+            "m",
+            "is it in mm?",
+        ),  # 1.2 m/s in cm, 0.12 m/s in mm: mm is nearer a hand's 0.25 m/s (log scale)
+        (
+            1e-3,
+            "mm",
+            "is it in m?",
+        ),  # 1 mm/s in m: plausible at its very boundary, and no other unit is
+        (1e4, "m", "is it in mm?"),  # 10 m/s in mm: at the other boundary (100 m/s in cm is not)
+    ],
+)
 def test_an_implausible_speed_names_the_unit_that_fits_it(speed, units, hint):
     from bidmp._units import check_speed
 
@@ -1401,7 +1840,9 @@ def test_a_joint_speed_is_judged_in_radians_and_degrees_are_named():
     with pytest.raises(ValueError, match=r"in degrees it would be 0\.524 rad/s"):
         check_speed(30.0, "rad", "q")  # 30 deg/s read as rad/s
     with pytest.raises(ValueError, match=r"in degrees it would be 10 rad/s"):
-        check_speed(float(np.degrees(10.0)), "rad", "q")  # at the boundary in degrees (radians() gives 10.0 exactly)
+        check_speed(
+            float(np.degrees(10.0)), "rad", "q"
+        )  # at the boundary in degrees (radians() gives 10.0 exactly)
     with pytest.raises(ValueError, match="faster") as refused:
         check_speed(1000.0, "rad", "q")  # 17 rad/s even in degrees: no hint
     assert "degrees" not in str(refused.value)
@@ -1440,16 +1881,28 @@ def test_bag_stamps_are_ordered_and_only_repeats_and_real_jumps_back_refused():
     limit = int(MAX_STAMP_DISORDER * 1e9)
     np.testing.assert_array_equal(_stamp_order([0, 10, 20, 30], "s", "c"), [0, 1, 2, 3])
     np.testing.assert_array_equal(_stamp_order([0, 20, 10, 30], "s", "c"), [0, 2, 1, 3])
-    np.testing.assert_array_equal(_stamp_order([5, limit + 5, 5 + 1, limit + 10], "s", "c"), [0, 2, 1, 3])
-    np.testing.assert_array_equal(_stamp_order([1, limit + 2, 2, limit + 3], "s", "c"), [0, 2, 1, 3])  # limit behind
+    np.testing.assert_array_equal(
+        _stamp_order([5, limit + 5, 5 + 1, limit + 10], "s", "c"), [0, 2, 1, 3]
+    )
+    np.testing.assert_array_equal(
+        _stamp_order([1, limit + 2, 2, limit + 3], "s", "c"), [0, 2, 1, 3]
+    )  # limit behind
     with pytest.raises(ValueError, match=r"jump back in time \(message 3 at "):
         _stamp_order([5, limit + 6, 5, limit + 10], "s", "c")  # 5 is limit + 1 ns behind
     with pytest.raises(ValueError, match="jump back"):
         _stamp_order([0, 10 * limit, 20, 10 * limit + 5], "s", "c")
-    with pytest.raises(ValueError, match=r"jump back in time \(message 4 at "):  # message 3 is only at the limit
+    with pytest.raises(
+        ValueError, match=r"jump back in time \(message 4 at "
+    ):  # message 3 is only at the limit
         _stamp_order([1, limit + 2, 2, 0], "s", "c")
-    for stamps, messages in (([0, 10, 10, 20], "2 and 3"), ([0, 20, 10, 20], "2 and 4"), ([7, 3, 7], "1 and 3")):
-        with pytest.raises(ValueError, match=f"repeat: two messages stamped .* \\(messages {messages}\\)"):
+    for stamps, messages in (
+        ([0, 10, 10, 20], "2 and 3"),
+        ([0, 20, 10, 20], "2 and 4"),
+        ([7, 3, 7], "1 and 3"),
+    ):
+        with pytest.raises(
+            ValueError, match=f"repeat: two messages stamped .* \\(messages {messages}\\)"
+        ):
             _stamp_order(stamps, "s", "c")
 
 
@@ -1460,7 +1913,10 @@ def test_bag_messages_put_in_order_are_counted_in_the_log(caplog):
 
     with caplog.at_level(logging.INFO, logger="bidmp.io.bags"):
         _stamp_order([0, 4_000_000, 13_000_000, 9_000_000, 20_000_000], "bag b", "c")
-    assert "bag b: 2 message(s) out of receive order, put in the order of their stamps (at most 4 ms apart)" in caplog.text
+    assert (
+        "bag b: 2 message(s) out of receive order, put in the order of their stamps (at most 4 ms apart)"
+        in caplog.text
+    )
     caplog.clear()
     with caplog.at_level(logging.INFO, logger="bidmp.io.bags"):
         _stamp_order([0, 4_000_000, 9_000_000], "bag b", "c")

@@ -23,7 +23,9 @@ def test_public_names_resolve():
 
 def test_import_and_cli_help_do_not_import_numpy():
     code = "import sys, bidmp, bidmp.cli; bidmp.cli.build_parser(); print('numpy' in sys.modules)"
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
     assert result.stdout.strip() == "False"
 
 
@@ -32,21 +34,45 @@ def test_import_and_cli_help_do_not_import_numpy():
 # here, not in 3: figures are data out, like files, and evaluation reports draw them; it imports
 # only the math and io); 3: the application; 4: the shell.
 LAYERS = {
-    "_checks": 0, "_progress": 0, "_threads": 0, "_noise": 0, "_trajectory": 0, "_units": 0, "_lazy": 0, "_state": 0, "_version": 0, "_api": 0,
-    "primitives": 1, "extension": 1, "incremental": 1, "baselines": 1, "scene": 1,
-    "demonstrations": 2, "io": 2, "tasks": 2, "plotting": 2,
-    "sim": 3, "experiments": 3,
-    "cli": 4, "__main__": 4,
+    "_checks": 0,
+    "_progress": 0,
+    "_threads": 0,
+    "_noise": 0,
+    "_trajectory": 0,
+    "_units": 0,
+    "_lazy": 0,
+    "_state": 0,
+    "_version": 0,
+    "_api": 0,
+    "primitives": 1,
+    "extension": 1,
+    "incremental": 1,
+    "baselines": 1,
+    "scene": 1,
+    "demonstrations": 2,
+    "io": 2,
+    "tasks": 2,
+    "plotting": 2,
+    "sim": 3,
+    "experiments": 3,
+    "cli": 4,
+    "__main__": 4,
 }
 
 
 def bidmp_imports(path):
     """Subpackages (or root modules) of bidmp imported by ``path``, relative imports resolved."""
-    package = path.parent.relative_to(SRC).parts  # () for bidmp/, ("primitives",) for bidmp/primitives/
+    package = path.parent.relative_to(
+        SRC
+    ).parts  # () for bidmp/, ("primitives",) for bidmp/primitives/
     tree = ast.parse(path.read_text())
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom) and node.level >= 1:
-            base = list(package[: len(package) - (node.level - 1)]) if node.level - 1 <= len(package) else []
+            base = (
+                list(package[: len(package) - (node.level - 1)])
+                if node.level - 1 <= len(package)
+                else []
+            )
             parts = base + (node.module.split(".") if node.module else [])
             if parts:
                 yield parts[0]
@@ -55,7 +81,9 @@ def bidmp_imports(path):
         elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("bidmp."):
             yield node.module.split(".")[1]
         elif isinstance(node, ast.Import):
-            yield from (alias.name.split(".")[1] for alias in node.names if alias.name.startswith("bidmp."))
+            yield from (
+                alias.name.split(".")[1] for alias in node.names if alias.name.startswith("bidmp.")
+            )
 
 
 def module_of(path):
@@ -71,7 +99,9 @@ def test_modules_respect_the_layers():
         assert module in LAYERS, f"{module} is not placed in a layer of ARCHITECTURE.md"
         for imported in bidmp_imports(path):
             if imported in LAYERS and imported not in ("__init__", module):
-                assert LAYERS[imported] <= LAYERS[module], f"{path.relative_to(SRC)} ({module}, layer {LAYERS[module]}) imports {imported}"
+                assert LAYERS[imported] <= LAYERS[module], (
+                    f"{path.relative_to(SRC)} ({module}, layer {LAYERS[module]}) imports {imported}"
+                )
 
 
 def test_the_math_never_imports_files_scenarios_or_the_cli():
@@ -79,7 +109,15 @@ def test_the_math_never_imports_files_scenarios_or_the_cli():
     math = {name for name, layer in LAYERS.items() if layer <= 1}
     for path in SRC.rglob("*.py"):
         if module_of(path) in math:
-            assert not set(bidmp_imports(path)) & {"io", "tasks", "sim", "cli", "experiments", "demonstrations", "plotting"}, path
+            assert not set(bidmp_imports(path)) & {
+                "io",
+                "tasks",
+                "sim",
+                "cli",
+                "experiments",
+                "demonstrations",
+                "plotting",
+            }, path
 
 
 def test_the_layer_check_sees_a_violation(tmp_path):
@@ -98,7 +136,9 @@ def test_no_import_cycles():
     for path in SRC.rglob("*.py"):
         module = module_of(path)
         if module != "__init__":
-            graph.setdefault(module, set()).update(m for m in bidmp_imports(path) if m in LAYERS and m != module)
+            graph.setdefault(module, set()).update(
+                m for m in bidmp_imports(path) if m in LAYERS and m != module
+            )
     state = {}
 
     def visit(module, trail):
@@ -120,7 +160,9 @@ def test_plotting_never_switches_the_matplotlib_backend(tmp_path):
         f"plot_trajectories({str(tmp_path / 'p.png')!r}, np.random.default_rng(0).normal(size=(20, 3)));"
         "import sys; print(matplotlib.get_backend(), 'matplotlib.pyplot' in sys.modules)"
     )
-    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
     assert result.stdout.split() == ["svg", "False"]
     assert (tmp_path / "p.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -130,7 +172,8 @@ def test_library_code_never_prints():
         if path.stem in ("cli", "__main__") or "cli" in path.relative_to(SRC).parts:
             continue
         calls = [
-            node for node in ast.walk(ast.parse(path.read_text()))
+            node
+            for node in ast.walk(ast.parse(path.read_text()))
             if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "print"
         ]
         assert not calls, f"{path.name} calls print()"
@@ -150,8 +193,14 @@ def oversized(text: str, name: str) -> list[str]:
 
 def test_no_module_is_past_the_size_where_it_holds_two_ideas():
     """Structure guard."""
-    found = [item for path in sorted(SRC.rglob("*.py")) for item in oversized(path.read_text(), str(path.relative_to(SRC)))]
-    assert not found, "modules past the size where they hold more than one idea:\n" + "\n".join(found)
+    found = [
+        item
+        for path in sorted(SRC.rglob("*.py"))
+        for item in oversized(path.read_text(), str(path.relative_to(SRC)))
+    ]
+    assert not found, "modules past the size where they hold more than one idea:\n" + "\n".join(
+        found
+    )
 
 
 def test_the_size_check_sees_a_long_module():
@@ -161,15 +210,30 @@ def test_the_size_check_sees_a_long_module():
 
 
 # --- the public surface is each package's __all__; everything else has an underscore --
-API_PACKAGES = ("bidmp.primitives", "bidmp.demonstrations", "bidmp.extension", "bidmp.incremental", "bidmp.baselines",
-                "bidmp.scene", "bidmp.io", "bidmp.tasks", "bidmp.tasks.methods", "bidmp.sim", "bidmp.sim.pybullet",
-                "bidmp.experiments", "bidmp.plotting", "bidmp.cli")
+API_PACKAGES = (
+    "bidmp.primitives",
+    "bidmp.demonstrations",
+    "bidmp.extension",
+    "bidmp.incremental",
+    "bidmp.baselines",
+    "bidmp.scene",
+    "bidmp.io",
+    "bidmp.tasks",
+    "bidmp.tasks.methods",
+    "bidmp.sim",
+    "bidmp.sim.pybullet",
+    "bidmp.experiments",
+    "bidmp.plotting",
+    "bidmp.cli",
+)
 
 
 def _owner(module_name: str) -> str:
     """The package whose __all__ must list a public name of ``module_name``: the deepest of
     API_PACKAGES that contains it."""
-    return max((p for p in API_PACKAGES if module_name == p or module_name.startswith(p + ".")), key=len)
+    return max(
+        (p for p in API_PACKAGES if module_name == p or module_name.startswith(p + ".")), key=len
+    )
 
 
 def _unlisted(module, listed: set) -> list[str]:
@@ -177,9 +241,14 @@ def _unlisted(module, listed: set) -> list[str]:
     ``listed`` (its package's public names)."""
     import inspect
 
-    return [f"{module.__name__}.{name}" for name, value in vars(module).items()
-            if not name.startswith("_") and (inspect.isfunction(value) or inspect.isclass(value))
-            and getattr(value, "__module__", None) == module.__name__ and name not in listed]
+    return [
+        f"{module.__name__}.{name}"
+        for name, value in vars(module).items()
+        if not name.startswith("_")
+        and (inspect.isfunction(value) or inspect.isclass(value))
+        and getattr(value, "__module__", None) == module.__name__
+        and name not in listed
+    ]
 
 
 def _public_modules():
@@ -187,7 +256,9 @@ def _public_modules():
     import pkgutil
 
     for info in pkgutil.walk_packages(bidmp.__path__, "bidmp."):
-        if any(part.startswith("_") for part in info.name.split(".")[1:]) or info.name.startswith("bidmp.cli"):
+        if any(part.startswith("_") for part in info.name.split(".")[1:]) or info.name.startswith(
+            "bidmp.cli"
+        ):
             continue
         yield importlib.import_module(info.name)
 
@@ -205,9 +276,17 @@ def test_every_public_name_is_listed_and_nothing_else_is_reachable_without_an_un
         for name in module.__all__:
             value = getattr(module, name)  # every listed name resolves ...
             if callable(value) and not isinstance(value, type(bidmp)):
-                assert (value.__doc__ or "").strip(), f"{package}.{name} has no docstring"  # ... and says what it is
-        hidden = [name for name in dir(module) if not name.startswith("_") and name not in module.__all__
-                  and name != "annotations" and not isinstance(getattr(module, name), type(bidmp))]
+                assert (value.__doc__ or "").strip(), (
+                    f"{package}.{name} has no docstring"
+                )  # ... and says what it is
+        hidden = [
+            name
+            for name in dir(module)
+            if not name.startswith("_")
+            and name not in module.__all__
+            and name != "annotations"
+            and not isinstance(getattr(module, name), type(bidmp))
+        ]
         assert not hidden, (package, hidden)
 
 
@@ -222,6 +301,10 @@ def test_the_surface_check_sees_an_unlisted_name():
 
 
 def test_the_api_reference_is_current():
-    result = subprocess.run([sys.executable, str(ROOT / "tools" / "api_reference.py"), "--check"], capture_output=True,
-                            text=True, check=False)
+    result = subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "api_reference.py"), "--check"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     assert result.returncode == 0, result.stderr

@@ -12,10 +12,10 @@ Which checks show correctness and which guard structure:
 
 import numpy as np
 import pytest
-from bidmp.demonstrations import minimum_jerk, recording
 from scipy.spatial.transform import Rotation
 
 import bidmp
+from bidmp.demonstrations import minimum_jerk, recording
 from bidmp.primitives.coupling import ConstantAcceleration, PhaseStopping, _as_couplings
 from bidmp.primitives.goals import DelayedGoal, PhaseGate, ProgressGate
 
@@ -108,7 +108,9 @@ def test_a_constant_push_moves_the_motion_by_the_closed_form(tau):
     expected = np.outer(shape, push * (tau * unit) ** 2 / (params.alpha * params.beta))
     moved = pushed.y - free.y
     assert np.max(np.abs(expected)) > 1.0  # the push moves the motion by millimetres...
-    np.testing.assert_allclose(moved, expected, rtol=0, atol=1e-9 * np.max(np.abs(expected)))  # ...exactly as predicted
+    np.testing.assert_allclose(
+        moved, expected, rtol=0, atol=1e-9 * np.max(np.abs(expected))
+    )  # ...exactly as predicted
     # The reported acceleration includes the push: a at the first sample, where the spring is at rest.
     np.testing.assert_allclose(pushed.ydd[0] - free.ydd[0], push, rtol=1e-9)
 
@@ -129,7 +131,9 @@ def test_a_coupling_term_sees_the_commanded_state():
     np.testing.assert_allclose(np.array([s[1] for s in seen]), motion.y, atol=1e-12)
     np.testing.assert_allclose(np.array([s[2] for s in seen]), motion.yd, atol=1e-12)
     phases = np.array([s[3] for s in seen])
-    np.testing.assert_allclose(phases, np.exp(-dmp._params().alpha_phase * motion.t / dmp.time_unit_), rtol=1e-12)
+    np.testing.assert_allclose(
+        phases, np.exp(-dmp._params().alpha_phase * motion.t / dmp.time_unit_), rtol=1e-12
+    )
 
 
 def test_phase_stopping_is_a_coupling_term_and_a_number_still_means_its_gain():
@@ -169,7 +173,9 @@ def test_the_goal_systems_each_protocol_composes():
         assert gate[0] == pytest.approx(1.0, abs=1e-9) and gate[-1] < 0.5
     # A delayed goal at the phase's own rate is Eq. 10's phase gate.
     phase = paper.phase()
-    np.testing.assert_allclose(DelayedGoal(1.0).on_grid(phase, paper.dt_, 1.0, False), phase, rtol=1e-12)
+    np.testing.assert_allclose(
+        DelayedGoal(1.0).on_grid(phase, paper.dt_, 1.0, False), phase, rtol=1e-12
+    )
 
 
 def test_rollouts_to_many_goals_as_one_matrix_product_are_the_same_numbers():
@@ -193,9 +199,13 @@ def test_a_skill_increment_is_computed_once_per_grid(monkeypatch):
     goals = target + np.random.default_rng(0).normal(scale=5.0, size=(6, 3))
     calls = []
     original = type(model.blocks_[0]).predict
-    monkeypatch.setattr(type(model.blocks_[0]), "predict", lambda self, X: calls.append(len(X)) or original(self, X))
+    monkeypatch.setattr(
+        type(model.blocks_[0]), "predict", lambda self, X: calls.append(len(X)) or original(self, X)
+    )
     rollouts = [model.rollout(goal, skill=1) for goal in goals]
     assert len(calls) == 1  # six goals, one increment
     model.__dict__.pop("_increments")  # without the cache: the same motions
-    np.testing.assert_array_equal(np.stack(rollouts), np.stack([model.rollout(goal, skill=1) for goal in goals]))
+    np.testing.assert_array_equal(
+        np.stack(rollouts), np.stack([model.rollout(goal, skill=1) for goal in goals])
+    )
     assert len(calls) == 2

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from bidmp.experiments import BATTERY_APPROACH_VIA# noqa: F401  (the package imports: a broken install fails here)
+from bidmp.experiments import BATTERY_APPROACH_VIA  # noqa: F401  (the package imports: a broken install fails here)
 
 ROOT = Path(__file__).resolve().parent.parent
 RECORDING = ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv"
@@ -47,20 +47,66 @@ def _bidmp(argv, cwd, terminal: bool) -> tuple[int, str]:
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
     folder = tmp_path_factory.mktemp("progress")
-    code, err = _bidmp(["fit", RECORDING, "--units", "mm", "-o", folder / "nut.npz"], folder, terminal=False)
+    code, err = _bidmp(
+        ["fit", RECORDING, "--units", "mm", "-o", folder / "nut.npz"], folder, terminal=False
+    )
     assert code == 0, err
     return folder
 
 
 COMMANDS = {
-    "extend": (["extend", "nut.npz", RECORDING, "--target", "200", "-100", "0", "--units", "mm", "-o", "ext.npz"],
-               "G-PRM iterations"),
-    "sim": (["sim", "--targets", "3", "--methods", "bidmp", "--no-pictures", "--out", "sim"], "nut-unscrewing (sim)"),
+    "extend": (
+        [
+            "extend",
+            "nut.npz",
+            RECORDING,
+            "--target",
+            "200",
+            "-100",
+            "0",
+            "--units",
+            "mm",
+            "-o",
+            "ext.npz",
+        ],
+        "G-PRM iterations",
+    ),
+    "sim": (
+        ["sim", "--targets", "3", "--methods", "bidmp", "--no-pictures", "--out", "sim"],
+        "nut-unscrewing (sim)",
+    ),
     "job": (["job", "--targets", "3", "--no-pictures", "--out", "job"], "nut-unscrewing (job)"),
-    "lasa": (["benchmark", "lasa", "--shapes", "Sshape", "--demos", "first3", "--every", "10", "--methods", "dmp",
-              "--workers", "1", "--out", "lasa"], "LASA"),
-    "repair": (["demo", "--scenario", ROOT / "tests" / "data" / "two_posts.json", "--methods", "bidmp", "--out", "demo"],
-               "bidmp: repair 8"),
+    "lasa": (
+        [
+            "benchmark",
+            "lasa",
+            "--shapes",
+            "Sshape",
+            "--demos",
+            "first3",
+            "--every",
+            "10",
+            "--methods",
+            "dmp",
+            "--workers",
+            "1",
+            "--out",
+            "lasa",
+        ],
+        "LASA",
+    ),
+    "repair": (
+        [
+            "demo",
+            "--scenario",
+            ROOT / "tests" / "data" / "two_posts.json",
+            "--methods",
+            "bidmp",
+            "--out",
+            "demo",
+        ],
+        "bidmp: repair 8",
+    ),
 }
 
 
@@ -68,8 +114,13 @@ COMMANDS = {
 def test_a_long_command_shows_progress_on_a_terminal_and_not_in_a_pipe(model, name):
     argv, shown = COMMANDS[name]
     code, err = _bidmp(argv, model, terminal=True)
-    assert code in (0, 3), err[-2000:]  # 3: ran, not every target succeeded (the exit status says so)
+    assert code in (0, 3), err[
+        -2000:
+    ]  # 3: ran, not every target succeeded (the exit status says so)
     assert shown in err and "%|" in err, err[-2000:]
-    if name in ("extend", "sim"):  # the library's own reports and a command's bar alike (the others cost seconds each)
+    if name in (
+        "extend",
+        "sim",
+    ):  # the library's own reports and a command's bar alike (the others cost seconds each)
         code, err = _bidmp(argv, model, terminal=False)
         assert code in (0, 3) and "%|" not in err and shown not in err, err[-2000:]

@@ -27,11 +27,12 @@ import pytest
 from scipy.spatial.transform import Rotation
 from test_random_cells import random_cell, solids
 
-from bidmp.tasks import scenarios
 from bidmp.demonstrations import minimum_jerk
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
-N_CELLS = int(os.environ.get("BIDMP_RANDOM_CELLS", "30")) // 5  # `make random-cells`: 60 tilted cells
+N_CELLS = (
+    int(os.environ.get("BIDMP_RANDOM_CELLS", "30")) // 5
+)  # `make random-cells`: 60 tilted cells
 GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
 
@@ -43,14 +44,23 @@ def random_tilted_cell(seed: int) -> tuple[dict, dict, Rotation, np.ndarray]:
     tilt = Rotation.from_rotvec(angle * np.array([np.cos(heading), np.sin(heading), 0.0]))
     pivot = np.asarray(flat["targets"]["r0c0"], dtype=float)
     move = lambda point: (pivot + tilt.apply(np.asarray(point, dtype=float) - pivot)).tolist()  # noqa: E731
-    into = (tilt * Rotation.from_euler("x", 180.0, degrees=True)).as_quat()  # the tool's z into the pad
+    into = (
+        tilt * Rotation.from_euler("x", 180.0, degrees=True)
+    ).as_quat()  # the tool's z into the pad
     vertical = Rotation.from_euler("x", 180.0, degrees=True).as_quat()
-    spec = {key: value for key, value in flat.items() if key not in ("targets", "demonstration", "scene")}
+    spec = {
+        key: value
+        for key, value in flat.items()
+        if key not in ("targets", "demonstration", "scene")
+    }
     spec["name"] = f"random-tilted-{seed}"
     spec["targets"] = {label: [*move(point), *into] for label, point in flat["targets"].items()}
     flat_demo = np.asarray(flat["demonstration"]["points"])
     height = flat["approach_height"]
-    start, hover = move(flat_demo[0]), move(flat_demo[-1] + [0.0, 0.0, 2.0 * height])  # down the normal, 2x the band
+    start, hover = (
+        move(flat_demo[0]),
+        move(flat_demo[-1] + [0.0, 0.0, 2.0 * height]),
+    )  # down the normal, 2x the band
     via = np.array([[*start, *vertical], [*hover, *into], [*pivot, *into]])
     demo = minimum_jerk(via, len(flat_demo))
     demo[:, 3:] /= np.linalg.norm(demo[:, 3:], axis=1, keepdims=True)
@@ -70,7 +80,9 @@ def random_tilted_cell(seed: int) -> tuple[dict, dict, Rotation, np.ndarray]:
 # Geometry in the plate's frame: parts as boxes (lower, upper) and upright cylinders
 # (centre x, y, radius; z from, to), the tool a cylinder from its tip p up its axis to p + L u.
 # ---------------------------------------------------------------------------------------------
-def point_distance(points: np.ndarray, kind: str, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+def point_distance(
+    points: np.ndarray, kind: str, lower: np.ndarray, upper: np.ndarray
+) -> np.ndarray:
     """Signed distance from points (..., 3) to one part (negative inside, by the shallower way out)."""
     if kind == "box":
         gap = np.maximum(lower - points, points - upper)
@@ -78,19 +90,28 @@ def point_distance(points: np.ndarray, kind: str, lower: np.ndarray, upper: np.n
         return np.where(np.all(gap <= 0, axis=-1), np.max(gap, axis=-1), outside)
     radial = np.linalg.norm(points[..., :2] - lower[:2], axis=-1) - upper[0]
     vertical = np.maximum(lower[2] - points[..., 2], points[..., 2] - upper[2])
-    return np.where((radial <= 0) & (vertical <= 0), np.maximum(radial, vertical),
-                    np.hypot(np.maximum(radial, 0.0), np.maximum(vertical, 0.0)))
+    return np.where(
+        (radial <= 0) & (vertical <= 0),
+        np.maximum(radial, vertical),
+        np.hypot(np.maximum(radial, 0.0), np.maximum(vertical, 0.0)),
+    )
 
 
 def part_support(n: np.ndarray, kind: str, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     """max over the part of n·y, for directions n (..., 3)."""
     if kind == "box":
         return np.sum(np.maximum(n * lower, n * upper), axis=-1)
-    return (n[..., 0] * lower[0] + n[..., 1] * lower[1] + upper[0] * np.linalg.norm(n[..., :2], axis=-1)
-            + np.maximum(n[..., 2] * lower[2], n[..., 2] * upper[2]))
+    return (
+        n[..., 0] * lower[0]
+        + n[..., 1] * lower[1]
+        + upper[0] * np.linalg.norm(n[..., :2], axis=-1)
+        + np.maximum(n[..., 2] * lower[2], n[..., 2] * upper[2])
+    )
 
 
-def tool_floor(n: np.ndarray, tips: np.ndarray, axes: np.ndarray, radius: float, length: float) -> np.ndarray:
+def tool_floor(
+    n: np.ndarray, tips: np.ndarray, axes: np.ndarray, radius: float, length: float
+) -> np.ndarray:
     """min over the tool cylinder of n·x, for directions n (..., 3)."""
     along = np.sum(n * axes, axis=-1)
     across = np.linalg.norm(n - along[..., None] * axes, axis=-1)
@@ -116,11 +137,29 @@ def separating_bound(tips, axes, radius, length, kind, lower, upper, s):
     point, the part's face normals, the tool's axis) refined by a seeded local search."""
     rng = np.random.default_rng(0)
     axis_points = tips + s[:, None] * axes
-    nearest = axis_points - (np.clip(axis_points, lower, upper) if kind == "box" else
-                             np.column_stack([lower[:2] + (axis_points[:, :2] - lower[:2]) * np.minimum(
-                                 1.0, upper[0] / np.maximum(np.linalg.norm(axis_points[:, :2] - lower[:2], axis=1), 1e-300))[:, None],
-                                 np.clip(axis_points[:, 2], lower[2], upper[2])]))
-    candidates = [nearest, axes, -axes, *np.eye(3)[:, None, :].repeat(len(tips), 1), *(-np.eye(3))[:, None, :].repeat(len(tips), 1)]
+    nearest = axis_points - (
+        np.clip(axis_points, lower, upper)
+        if kind == "box"
+        else np.column_stack(
+            [
+                lower[:2]
+                + (axis_points[:, :2] - lower[:2])
+                * np.minimum(
+                    1.0,
+                    upper[0]
+                    / np.maximum(np.linalg.norm(axis_points[:, :2] - lower[:2], axis=1), 1e-300),
+                )[:, None],
+                np.clip(axis_points[:, 2], lower[2], upper[2]),
+            ]
+        )
+    )
+    candidates = [
+        nearest,
+        axes,
+        -axes,
+        *np.eye(3)[:, None, :].repeat(len(tips), 1),
+        *(-np.eye(3))[:, None, :].repeat(len(tips), 1),
+    ]
     gap = lambda n: tool_floor(n, tips, axes, radius, length) - part_support(n, kind, lower, upper)  # noqa: E731
     best_n, best = None, np.full(len(tips), -np.inf)
     for n in candidates:
@@ -146,7 +185,10 @@ def surface_bound(tips, axes, radius, length, kind, lower, upper, s):
     first /= np.linalg.norm(first, axis=1, keepdims=True)
     second = np.cross(axes, first)
     angles = np.linspace(0.0, 2.0 * np.pi, 64, endpoint=False)
-    ring = np.cos(angles)[None, :, None] * first[:, None] + np.sin(angles)[None, :, None] * second[:, None]
+    ring = (
+        np.cos(angles)[None, :, None] * first[:, None]
+        + np.sin(angles)[None, :, None] * second[:, None]
+    )
     best = np.full(len(tips), np.inf)
     for height in (s, np.zeros_like(s), np.full_like(s, length)):
         for share in (1.0, 0.5, 0.0):
@@ -163,8 +205,13 @@ def placements(points: np.ndarray, quaternions: np.ndarray, radius: float, lengt
     sweep = np.linalg.norm(np.diff(points, axis=0), axis=1) + np.hypot(length, radius) * turn
     steps = np.maximum(np.ceil(sweep / (0.01 * radius)), 1).astype(int)
     segment = np.repeat(np.arange(len(steps)), steps)
-    share = ((np.arange(segment.size) - np.repeat(np.cumsum(steps) - steps, steps)) / np.repeat(steps, steps))[:, None]
-    tips = np.vstack([points[segment] + share * (points[segment + 1] - points[segment]), points[-1:]])
+    share = (
+        (np.arange(segment.size) - np.repeat(np.cumsum(steps) - steps, steps))
+        / np.repeat(steps, steps)
+    )[:, None]
+    tips = np.vstack(
+        [points[segment] + share * (points[segment + 1] - points[segment]), points[-1:]]
+    )
     dense_axes = np.vstack([axes[segment] + share * (axes[segment + 1] - axes[segment]), axes[-1:]])
     return tips, dense_axes / np.linalg.norm(dense_axes, axis=1, keepdims=True)
 
@@ -174,7 +221,12 @@ def clearance_bounds(points, quaternions, flat, tilt, pivot, exclude, floor):
     flat cell's frame; pairs whose capsule bound already clears ``floor`` are not refined."""
     radius, length = flat["scene"]["tool"]["radius"], flat["scene"]["tool"]["length"]
     back = tilt.inv()
-    tips, axes = placements(pivot + back.apply(points - pivot), (back * Rotation.from_quat(quaternions)).as_quat(), radius, length)
+    tips, axes = placements(
+        pivot + back.apply(points - pivot),
+        (back * Rotation.from_quat(quaternions)).as_quat(),
+        radius,
+        length,
+    )
     lower_bound, upper_bound = np.inf, np.inf
     for label, kind, lower, upper in solids(flat):
         if label in exclude:
@@ -191,14 +243,25 @@ def clearance_bounds(points, quaternions, flat, tilt, pivot, exclude, floor):
         close = bound < floor
         lower_bound = min(lower_bound, float(bound[~close].min(initial=np.inf)))
         if np.any(close):
-            args = (tips[near][close], axes[near][close], radius, length, kind, lower, upper, s[close])
+            args = (
+                tips[near][close],
+                axes[near][close],
+                radius,
+                length,
+                kind,
+                lower,
+                upper,
+                s[close],
+            )
             refined = np.maximum(bound[close], separating_bound(*args))
             lower_bound = min(lower_bound, float(refined.min()))
             upper_bound = min(upper_bound, float(surface_bound(*args).min()))
     return lower_bound, upper_bound
 
 
-def along_the_axis(points, quaternions, flat_target, tilt, pivot, height, threshold, alignment) -> bool:
+def along_the_axis(
+    points, quaternions, flat_target, tilt, pivot, height, threshold, alignment
+) -> bool:
     """In the plate's frame: the final descent from ``height`` above the target stays within the
     threshold of its axis, keeps going down, and holds the tool within ``alignment`` degrees."""
     back = tilt.inv()
@@ -209,9 +272,16 @@ def along_the_axis(points, quaternions, flat_target, tilt, pivot, height, thresh
         return False
     band = slice(outside[-1] + 1, None)
     lateral = np.linalg.norm(local[band, :2] - flat_target[:2], axis=1)
-    tool_down = (back * Rotation.from_quat(quaternions[band])).as_matrix()[:, :, 2] @ [0.0, 0.0, -1.0]
-    return bool(lateral.max() <= threshold and np.all(np.diff(local[band, 2]) <= 1e-2 * threshold)
-                and np.degrees(np.arccos(np.clip(tool_down, -1.0, 1.0))).max() <= alignment * (1 + 1e-9))
+    tool_down = (back * Rotation.from_quat(quaternions[band])).as_matrix()[:, :, 2] @ [
+        0.0,
+        0.0,
+        -1.0,
+    ]
+    return bool(
+        lateral.max() <= threshold
+        and np.all(np.diff(local[band, 2]) <= 1e-2 * threshold)
+        and np.degrees(np.arccos(np.clip(tool_down, -1.0, 1.0))).max() <= alignment * (1 + 1e-9)
+    )
 
 
 @pytest.mark.parametrize("chunk", range(3))
@@ -227,21 +297,35 @@ def test_no_motion_on_a_random_tilted_cell_is_a_silent_violation(chunk):
         report = evaluate(scenario, ["dmp", "bidmp"])
         assert all("target" in f and f["reason"] for f in report.route_failures)
         margin, threshold = spec["scene"]["margin"], spec["success_threshold"]
-        tolerance = 0.001 * spec["scene"]["tool"]["length"]  # the report's half step (Scene.clearance)
+        tolerance = (
+            0.001 * spec["scene"]["tool"]["length"]
+        )  # the report's half step (Scene.clearance)
         for name, result in report.methods.items():
             for label, rollout in result.rollouts.items():
                 rollout, quaternions = np.asarray(rollout), np.asarray(result.orientations[label])
                 clearance = result.clearance_at(label)
                 if clearance is not None and clearance.collision_free:
                     floor = (margin if clearance.clear else 0.0) - tolerance * (1 + 1e-9)
-                    lower, upper = clearance_bounds(rollout, quaternions, flat, tilt, pivot, {label}, floor)
+                    lower, upper = clearance_bounds(
+                        rollout, quaternions, flat, tilt, pivot, {label}, floor
+                    )
                     assert upper >= floor, ("silent violation", seed, name, label, upper, floor)
                     assert lower >= floor, ("undecided", seed, name, label, lower, upper, floor)
                 if result.task_success_at(label):
                     flat_target = np.asarray(flat["targets"][label])
-                    assert np.linalg.norm(rollout[-1] - np.asarray(spec["targets"][label][:3])) <= threshold * (1 + 1e-9)
-                    assert along_the_axis(rollout, quaternions, flat_target, tilt, pivot, spec["approach_height"], threshold,
-                                          scenario.alignment_threshold), (seed, name, label)
+                    assert np.linalg.norm(
+                        rollout[-1] - np.asarray(spec["targets"][label][:3])
+                    ) <= threshold * (1 + 1e-9)
+                    assert along_the_axis(
+                        rollout,
+                        quaternions,
+                        flat_target,
+                        tilt,
+                        pivot,
+                        spec["approach_height"],
+                        threshold,
+                        scenario.alignment_threshold,
+                    ), (seed, name, label)
                 checked += 1
     assert checked > 0
 
@@ -252,13 +336,27 @@ def test_the_tilted_check_can_fail():
     spec, flat, tilt, pivot = random_tilted_cell(0)
     unit = 1.0 if spec["units"] == "mm" else 1e-3
     plate = next(part for part in flat["scene"]["parts"] if part["label"] == "plate")
-    point = np.array(plate["at"]) + [0.0, -0.5 * plate["size"][1] + 5.0 * unit, 5.0 * unit]  # near its edge, off the pads
+    point = np.array(plate["at"]) + [
+        0.0,
+        -0.5 * plate["size"][1] + 5.0 * unit,
+        5.0 * unit,
+    ]  # near its edge, off the pads
     world = pivot + tilt.apply(point - pivot)
     upright = (tilt * Rotation.from_euler("x", 180.0, degrees=True)).as_quat()
-    lower, upper = clearance_bounds(world[None], upright[None], flat, tilt, pivot, set(), 10.0 * unit)
-    assert lower == pytest.approx(5.0 * unit, abs=1e-6 * unit) and upper == pytest.approx(5.0 * unit, abs=1e-6 * unit)
+    lower, upper = clearance_bounds(
+        world[None], upright[None], flat, tilt, pivot, set(), 10.0 * unit
+    )
+    assert lower == pytest.approx(5.0 * unit, abs=1e-6 * unit) and upper == pytest.approx(
+        5.0 * unit, abs=1e-6 * unit
+    )
     radius = flat["scene"]["tool"]["radius"]
-    lean = np.arcsin(7.0 * unit / radius) if radius > 7.0 * unit else np.pi / 3  # rim 7 lower: 2 into the plate
-    tipped = (tilt * Rotation.from_euler("y", lean) * Rotation.from_euler("x", 180.0, degrees=True)).as_quat()
-    lower, upper = clearance_bounds(world[None], tipped[None], flat, tilt, pivot, set(), 10.0 * unit)
+    lean = (
+        np.arcsin(7.0 * unit / radius) if radius > 7.0 * unit else np.pi / 3
+    )  # rim 7 lower: 2 into the plate
+    tipped = (
+        tilt * Rotation.from_euler("y", lean) * Rotation.from_euler("x", 180.0, degrees=True)
+    ).as_quat()
+    lower, upper = clearance_bounds(
+        world[None], tipped[None], flat, tilt, pivot, set(), 10.0 * unit
+    )
     assert upper < 0.0 and lower <= upper + 1e-12 * unit  # both are -2 units here, up to rounding

@@ -23,17 +23,19 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bidmp.tasks import scenarios
 from bidmp.demonstrations import minimum_jerk
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
 pytest.importorskip("pybullet")
 
 N_CELLS = int(os.environ.get("BIDMP_RANDOM_CELLS", "20"))  # `make random-cells`: 300
-EVERY = 1 if N_CELLS >= 100 else 5  # cells whose motions also run on the simulated arm and in the job
+EVERY = (
+    1 if N_CELLS >= 100 else 5
+)  # cells whose motions also run on the simulated arm and in the job
 ARMS = ("panda", "iiwa", "xarm6", "ur5")
 UNITS = {"mm": 1.0, "cm": 0.1, "m": 1e-3}
-RISE_MM = 0.15  # the contract's allowed rise inside the final approach, in mm (stated, not imported)
+# the contract's allowed rise inside the final approach, in mm (stated, not imported)
+RISE_MM = 0.15
 
 
 # ---------------------------------------------------------------------------------------------
@@ -46,7 +48,9 @@ def user_cell(seed: int) -> dict:
     rows, cols, pitch = int(rng.integers(1, 3)), int(rng.integers(2, 5)), float(rng.uniform(40, 60))
     across, nut_height = float(rng.uniform(10, 14)), float(rng.uniform(5, 8))
     stud = {"radius": float(rng.uniform(2.5, across / 2 - 1.5)), "above": float(rng.uniform(6, 12))}
-    sink = float(rng.uniform(1.6, 3.0))  # the target (the socket's mouth) this far above the nut's base
+    sink = float(
+        rng.uniform(1.6, 3.0)
+    )  # the target (the socket's mouth) this far above the nut's base
     targets = {f"r{r}c{c}": [c * pitch, r * pitch, 0.0] for r in range(rows) for c in range(cols)}
     tool = {"radius": float(rng.uniform(9, 13)), "length": float(rng.uniform(90, 130))}
     margin = float(rng.uniform(1.2, 3.0))
@@ -56,30 +60,62 @@ def user_cell(seed: int) -> dict:
     hover = home + [0.0, 0.0, rng.uniform(approach + 10, 60)]
     demo = minimum_jerk(np.array([start, hover, home]), int(rng.integers(150, 400)))
     width, depth = (cols - 1) * pitch, (rows - 1) * pitch
-    parts = [{"type": "plate", "label": "plate", "at": [width / 2, depth / 2, -sink], "size": [width + 160, depth + 140, 5.0]},
-             {"type": "nut", "at_targets": "all", "offset": [0.0, 0.0, -sink], "across_flats": across, "height": nut_height,
-              "stud": stud}]
+    parts = [
+        {
+            "type": "plate",
+            "label": "plate",
+            "at": [width / 2, depth / 2, -sink],
+            "size": [width + 160, depth + 140, 5.0],
+        },
+        {
+            "type": "nut",
+            "at_targets": "all",
+            "offset": [0.0, 0.0, -sink],
+            "across_flats": across,
+            "height": nut_height,
+            "stud": stud,
+        },
+    ]
     # Obstacles between the demonstrated nut and the far ones, a socket and the margin off every nut.
     keep = tool["radius"] + margin + across / np.sqrt(3.0) + 4.0
     taken = []
     for index in range(int(rng.integers(0, 4))):
         kind = str(rng.choice(["post", "boss", "duct", "bracket"]))
         for _ in range(60):
-            spot = np.array([rng.uniform(0.2, 1.0) * max(width, pitch) - 0.1 * pitch, rng.uniform(-0.5, 1.5) * max(depth, pitch / 2), 0.0])
+            spot = np.array(
+                [
+                    rng.uniform(0.2, 1.0) * max(width, pitch) - 0.1 * pitch,
+                    rng.uniform(-0.5, 1.5) * max(depth, pitch / 2),
+                    0.0,
+                ]
+            )
             if kind in ("post", "boss"):
                 radius = float(rng.uniform(3, 8) if kind == "post" else rng.uniform(6, 14))
                 half = np.array([radius, radius])
             else:
-                size = [float(rng.uniform(10, 20)), float(rng.uniform(40, 140)),
-                        float(rng.uniform(40, 130)) if kind == "duct" else 4.0]
+                size = [
+                    float(rng.uniform(10, 20)),
+                    float(rng.uniform(40, 140)),
+                    float(rng.uniform(40, 130)) if kind == "duct" else 4.0,
+                ]
                 if kind == "bracket":
                     size = [float(rng.uniform(25, 45)), float(rng.uniform(25, 45)), 4.0]
                 if rng.uniform() < 0.5:
                     size[0], size[1] = size[1], size[0]
-                half = np.hypot(size[0], size[1]) / 2 * np.ones(2) if kind == "bracket" else np.array(size[:2]) / 2
-            nearest = min(max(np.max(np.abs(spot[:2] - t[:2]) - half), 0.0) for t in map(np.array, targets.values()))
-            apart = all(np.max(np.abs(spot[:2] - other[0]) - half - other[1]) > 2 * tool["radius"] + 2 * margin
-                        for other in taken)
+                half = (
+                    np.hypot(size[0], size[1]) / 2 * np.ones(2)
+                    if kind == "bracket"
+                    else np.array(size[:2]) / 2
+                )
+            nearest = min(
+                max(np.max(np.abs(spot[:2] - t[:2]) - half), 0.0)
+                for t in map(np.array, targets.values())
+            )
+            apart = all(
+                np.max(np.abs(spot[:2] - other[0]) - half - other[1])
+                > 2 * tool["radius"] + 2 * margin
+                for other in taken
+            )
             if nearest > keep and apart:
                 break
         else:
@@ -88,17 +124,40 @@ def user_cell(seed: int) -> dict:
         label = f"{kind}{index}"
         if kind in ("post", "boss"):
             height = float(rng.uniform(50, 130) if kind == "post" else rng.uniform(8, 20))
-            parts.append({"type": "cylinder", "label": label, "at": [*spot[:2], -sink], "radius": radius, "height": height})
+            parts.append(
+                {
+                    "type": "cylinder",
+                    "label": label,
+                    "at": [*spot[:2], -sink],
+                    "radius": radius,
+                    "height": height,
+                }
+            )
         elif kind == "duct":
             parts.append({"type": "box", "label": label, "at": [*spot[:2], -sink], "size": size})
         else:  # a bracket on a stand, tilted 5-20 degrees about x or y
             lift = float(rng.uniform(15, 50))
-            tilt = [float(rng.uniform(5, 20)) if axis == int(rng.integers(0, 2)) else 0.0 for axis in range(2)] + [0.0]
-            parts.append({"type": "box", "label": label, "at": [*spot[:2], -sink + lift], "size": size, "rotation": tilt})
+            tilt = [
+                float(rng.uniform(5, 20)) if axis == int(rng.integers(0, 2)) else 0.0
+                for axis in range(2)
+            ] + [0.0]
+            parts.append(
+                {
+                    "type": "box",
+                    "label": label,
+                    "at": [*spot[:2], -sink + lift],
+                    "size": size,
+                    "rotation": tilt,
+                }
+            )
     side = -1.0 if rng.uniform() < 0.5 else 1.0
     bin_x = width / 2 + side * (width / 2 + rng.uniform(90, 130))
-    job = {"steps": ["approach", "engage", "unscrew", "retract", "drop"], "order": "listed", "pitch": float(rng.uniform(1.0, 1.5)),
-           "bin": {"at": [bin_x, depth / 2, -sink], "size": [70.0, 70.0, 40.0]}}
+    job = {
+        "steps": ["approach", "engage", "unscrew", "retract", "drop"],
+        "order": "listed",
+        "pitch": float(rng.uniform(1.0, 1.5)),
+        "bin": {"at": [bin_x, depth / 2, -sink], "size": [70.0, 70.0, 40.0]},
+    }
     f = UNITS[units]
     scale = lambda values: (np.asarray(values, dtype=float) * f).tolist()  # noqa: E731
     for part in parts:
@@ -113,12 +172,23 @@ def user_cell(seed: int) -> dict:
     job["pitch"] *= f
     job["bin"] = {key: scale(value) for key, value in job["bin"].items()}
     return {
-        "name": f"user-cell-{seed}", "units": units, "targets": {label: scale(point) for label, point in targets.items()},
-        "demonstrated": "r0c0", "demonstration": {"points": scale(demo)}, "success_threshold": 1.75 * f,
-        "approach_height": approach * f, "methods": ["dmp", "bidmp"], "seed": seed,
-        "dmp": {"protocol": str(rng.choice(["robot", "paper"]))}, "robot": {"model": str(rng.choice(ARMS))},
-        "scene": {"tool": {key: value * f for key, value in tool.items()}, "margin": margin * f,
-                  "standoff": {"plate": 1.0 * f}, "parts": parts},
+        "name": f"user-cell-{seed}",
+        "units": units,
+        "targets": {label: scale(point) for label, point in targets.items()},
+        "demonstrated": "r0c0",
+        "demonstration": {"points": scale(demo)},
+        "success_threshold": 1.75 * f,
+        "approach_height": approach * f,
+        "methods": ["dmp", "bidmp"],
+        "seed": seed,
+        "dmp": {"protocol": str(rng.choice(["robot", "paper"]))},
+        "robot": {"model": str(rng.choice(ARMS))},
+        "scene": {
+            "tool": {key: value * f for key, value in tool.items()},
+            "margin": margin * f,
+            "standoff": {"plate": 1.0 * f},
+            "parts": parts,
+        },
         "job": job,
     }
 
@@ -140,12 +210,31 @@ def _solids(spec: dict, scene_extra=()) -> list:
                 corners = base[:2] + circum * np.column_stack([np.cos(angles), np.sin(angles)])
                 out.append((label, label, "hex", (corners, base[2], base[2] + part["height"])))
                 stud = part["stud"]
-                out.append((f"{label}/stud", label, "cylinder",
-                            (base[0], base[1], stud["radius"], base[2], base[2] + part["height"] + stud["above"])))
+                out.append(
+                    (
+                        f"{label}/stud",
+                        label,
+                        "cylinder",
+                        (
+                            base[0],
+                            base[1],
+                            stud["radius"],
+                            base[2],
+                            base[2] + part["height"] + stud["above"],
+                        ),
+                    )
+                )
             continue
         at = np.asarray(part["at"], dtype=float)
         if part["type"] == "cylinder":
-            out.append((part["label"], part["label"], "cylinder", (at[0], at[1], part["radius"], at[2], at[2] + part["height"])))
+            out.append(
+                (
+                    part["label"],
+                    part["label"],
+                    "cylinder",
+                    (at[0], at[1], part["radius"], at[2], at[2] + part["height"]),
+                )
+            )
             continue
         size = np.asarray(part["size"], dtype=float)
         if "rotation" in part:
@@ -171,13 +260,20 @@ def _flat_distance(xy: np.ndarray, kind: str, data) -> np.ndarray:
     if kind == "box":
         lower, upper = data
         gap = np.maximum(lower[:2] - xy, xy - upper[:2])
-        return np.where(np.all(gap <= 0, axis=1), gap.max(axis=1), np.linalg.norm(np.maximum(gap, 0.0), axis=1))
+        return np.where(
+            np.all(gap <= 0, axis=1), gap.max(axis=1), np.linalg.norm(np.maximum(gap, 0.0), axis=1)
+        )
     if kind == "cylinder":
         return np.linalg.norm(xy - np.array(data[:2]), axis=1) - data[2]
     corners = data[0]
-    edges = np.min([_segment_distance(xy, corners[k], corners[(k + 1) % 6]) for k in range(6)], axis=0)
+    edges = np.min(
+        [_segment_distance(xy, corners[k], corners[(k + 1) % 6]) for k in range(6)], axis=0
+    )
     centre = corners.mean(axis=0)
-    inside = np.linalg.norm(xy - centre, axis=1) <= np.sqrt(3.0) / 2 * np.linalg.norm(corners[0] - centre) - 1e-12
+    inside = (
+        np.linalg.norm(xy - centre, axis=1)
+        <= np.sqrt(3.0) / 2 * np.linalg.norm(corners[0] - centre) - 1e-12
+    )
     return np.where(inside, -edges, edges)
 
 
@@ -189,9 +285,13 @@ def _z_range(kind: str, data) -> tuple:
 
 def dense(path: np.ndarray, step: float) -> np.ndarray:
     """The polyline ``path`` (n, 3) with points at most ``step`` apart."""
-    pieces = np.maximum(np.ceil(np.linalg.norm(np.diff(path, axis=0), axis=1) / step), 1).astype(int)
+    pieces = np.maximum(np.ceil(np.linalg.norm(np.diff(path, axis=0), axis=1) / step), 1).astype(
+        int
+    )
     which = np.repeat(np.arange(len(pieces)), pieces)
-    share = (np.arange(which.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)) / np.repeat(pieces, pieces)
+    share = (np.arange(which.size) - np.repeat(np.cumsum(pieces) - pieces, pieces)) / np.repeat(
+        pieces, pieces
+    )
     return np.vstack([path[which] + share[:, None] * (path[which + 1] - path[which]), path[-1:]])
 
 
@@ -201,7 +301,7 @@ def clearance(path: np.ndarray, spec: dict, exclude: set, extra=()) -> dict:
     radius, length = spec["scene"]["tool"]["radius"], spec["scene"]["tool"]["length"]
     points = dense(np.asarray(path, dtype=float), 0.01 * radius)
     found = {}
-    for label, owner, kind, data in _solids(spec, extra):
+    for _label, owner, kind, data in _solids(spec, extra):
         if owner in exclude:
             continue
         if kind == "oriented":
@@ -209,19 +309,30 @@ def clearance(path: np.ndarray, spec: dict, exclude: set, extra=()) -> dict:
             # Only where the tool's box comes within a radius of the bracket's box (else it is further
             # than the margin from it); there, points on the tool's surface.
             reach = np.abs(rotation) @ half
-            gap = np.maximum(np.maximum(centre - reach - (points + [radius, radius, length]),
-                                        (points - [radius, radius, 0.0]) - (centre + reach)), 0.0)
+            gap = np.maximum(
+                np.maximum(
+                    centre - reach - (points + [radius, radius, length]),
+                    (points - [radius, radius, 0.0]) - (centre + reach),
+                ),
+                0.0,
+            )
             near = points[np.linalg.norm(gap, axis=1) <= radius]
             if near.shape[0] == 0:
-                found[owner] = min(found.get(owner, np.inf), float(np.linalg.norm(gap, axis=1).min()))
+                found[owner] = min(
+                    found.get(owner, np.inf), float(np.linalg.norm(gap, axis=1).min())
+                )
                 continue
             angles = np.linspace(0, 2 * np.pi, 48, endpoint=False)
             rim = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
             heights = np.linspace(0.0, length, 24)
-            surface = np.array([[x, y, h] for x, y in rim for h in heights] + [[0, 0, h] for h in heights])
+            surface = np.array(
+                [[x, y, h] for x, y in rim for h in heights] + [[0, 0, h] for h in heights]
+            )
             best = np.inf
             for chunk in np.array_split(near, max(1, len(near) // 500)):
-                local = ((chunk[:, None, :] + surface[None]) - centre) @ rotation  # into the bracket's frame
+                local = (
+                    (chunk[:, None, :] + surface[None]) - centre
+                ) @ rotation  # into the bracket's frame
                 gap = np.abs(local) - half
                 outside = np.linalg.norm(np.maximum(gap, 0.0), axis=2)
                 signed = np.where(np.all(gap <= 0, axis=2), gap.max(axis=2), outside)
@@ -231,8 +342,11 @@ def clearance(path: np.ndarray, spec: dict, exclude: set, extra=()) -> dict:
             flat = _flat_distance(points[:, :2], kind, data) - radius
             low, high = _z_range(kind, data)
             vertical = np.maximum(low - (points[:, 2] + length), points[:, 2] - high)
-            signed = np.where((flat <= 0) & (vertical <= 0), np.maximum(flat, vertical),
-                              np.hypot(np.maximum(flat, 0.0), np.maximum(vertical, 0.0)))
+            signed = np.where(
+                (flat <= 0) & (vertical <= 0),
+                np.maximum(flat, vertical),
+                np.hypot(np.maximum(flat, 0.0), np.maximum(vertical, 0.0)),
+            )
             distance = float(signed.min())
         found[owner] = min(found.get(owner, np.inf), distance)
     return found
@@ -256,10 +370,15 @@ def check_end_and_descent(path, target, spec, context, slack: float = 0.0):
     assert np.linalg.norm(path[-1] - target) <= threshold * (1 + 1e-9), (*context, "end")
     above = np.flatnonzero(path[:, 2] - target[2] >= height)
     assert above.size and above[-1] < len(path) - 1, (*context, "no entry from above")
-    band = path[above[-1] + 1:]
-    assert np.linalg.norm(band[:, :2] - target[:2], axis=1).max() <= threshold * (1 + 1e-9) + slack, (*context, "lateral")
+    band = path[above[-1] + 1 :]
+    assert (
+        np.linalg.norm(band[:, :2] - target[:2], axis=1).max() <= threshold * (1 + 1e-9) + slack
+    ), (*context, "lateral")
     heights = band[:, 2]
-    assert np.max(heights - np.minimum.accumulate(heights)) <= RISE_MM * f * (1 + 1e-9), (*context, "rise")
+    assert np.max(heights - np.minimum.accumulate(heights)) <= RISE_MM * f * (1 + 1e-9), (
+        *context,
+        "rise",
+    )
 
 
 def check_commands(commands, limits, context):
@@ -286,7 +405,9 @@ def one_sentence(reason: str, context) -> None:
 def _evaluated(spec: dict, seed: int):
     try:
         scenario = scenarios.from_dict(spec)
-    except scenarios.ScenarioError as exc:  # parts drawn overlapping, a target off its part: refused, named
+    except (
+        scenarios.ScenarioError
+    ) as exc:  # parts drawn overlapping, a target off its part: refused, named
         assert "overlap" in str(exc) or "not on part" in str(exc), str(exc)
         return None, None
     report = evaluate(scenario, ["dmp", "bidmp"])
@@ -370,8 +491,12 @@ def test_the_checks_can_fail():
     neighbour = np.asarray(list(spec["targets"].values())[1])
     with pytest.raises(AssertionError, match="clearance"):
         check_clear(np.vstack([down, neighbour]), spec, {"r0c0"}, ("probe",))
-    bump = np.vstack([down[:-1], target - [0.0, 0.0, 0.2 * f], target])  # 0.2 mm below, then back up
-    check_end_and_descent(np.vstack([down[:-1], target - [0.0, 0.0, 0.1 * f], target]), target, spec, ("probe",))
+    bump = np.vstack(
+        [down[:-1], target - [0.0, 0.0, 0.2 * f], target]
+    )  # 0.2 mm below, then back up
+    check_end_and_descent(
+        np.vstack([down[:-1], target - [0.0, 0.0, 0.1 * f], target]), target, spec, ("probe",)
+    )
     with pytest.raises(AssertionError, match="rise"):
         check_end_and_descent(bump, target, spec, ("probe",))
     from bidmp.sim import PANDA

@@ -22,11 +22,20 @@ def readme_tool():
 
 def test_readme_tables_equal_the_committed_command_outputs():
     blocks = readme_tool().blocks(README)
-    assert {path for path, _ in blocks} == {"docs/results/table4.md", "docs/results/tasks.md", "docs/results/table5.md",
-                                       "docs/results/figures.md", "docs/results/sim.md",
-                                       "docs/results/lasa.md", "docs/results/robot.md", "docs/results/avoidance.md",
-                                       "docs/results/job.md", "docs/results/job_cells.md",
-                                       "docs/results/repair_order.md", "docs/results/user_cells.md"}
+    assert {path for path, _ in blocks} == {
+        "docs/results/table4.md",
+        "docs/results/tasks.md",
+        "docs/results/table5.md",
+        "docs/results/figures.md",
+        "docs/results/sim.md",
+        "docs/results/lasa.md",
+        "docs/results/robot.md",
+        "docs/results/avoidance.md",
+        "docs/results/job.md",
+        "docs/results/job_cells.md",
+        "docs/results/repair_order.md",
+        "docs/results/user_cells.md",
+    }
     for path, body in blocks:
         committed = (ROOT / path).read_text(encoding="utf-8")
         assert body.strip() == committed.strip(), f"README block {path} is stale: run 'make readme'"
@@ -37,8 +46,13 @@ PYTHON_BLOCKS = re.findall(r"```python\n(.*?)```", README, re.DOTALL)
 
 @pytest.mark.parametrize("index", range(len(PYTHON_BLOCKS)))
 def test_every_python_block_runs_alone(index, tmp_path):
-    result = subprocess.run([sys.executable, "-c", PYTHON_BLOCKS[index]], cwd=tmp_path, capture_output=True, text=True,
-                            timeout=120)
+    result = subprocess.run(
+        [sys.executable, "-c", PYTHON_BLOCKS[index]],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 0, result.stderr[-2000:]
 
 
@@ -58,8 +72,12 @@ def test_the_robot_protocol_table_is_what_its_tool_measures(tmp_path):
     """docs/results/robot.md (the README's robot-protocol numbers) against a fresh run of
     tools/robot_protocol.py (about 6 s)."""
     out = tmp_path / "robot.md"
-    subprocess.run([sys.executable, str(ROOT / "tools" / "robot_protocol.py"), "--out", str(out)], check=True,
-                   capture_output=True, timeout=120)
+    subprocess.run(
+        [sys.executable, str(ROOT / "tools" / "robot_protocol.py"), "--out", str(out)],
+        check=True,
+        capture_output=True,
+        timeout=120,
+    )
     assert out.read_text() == (ROOT / "docs" / "results" / "robot.md").read_text()
 
 
@@ -85,8 +103,13 @@ def test_the_own_robot_commands_run_as_written(tmp_path, monkeypatch, capsys):
 
     section = README.split("## Your own robot and data", 1)[1].split("\n## ", 1)[0]
     python = re.search(r"```python\n(.*?)```", section, re.DOTALL).group(1)
-    commands = re.search(r"<!-- own-robot-commands -->\n```sh\n(.*?)```", section, re.DOTALL).group(1)
-    shutil.copy(ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv", tmp_path / "recording.csv")
+    commands = re.search(r"<!-- own-robot-commands -->\n```sh\n(.*?)```", section, re.DOTALL).group(
+        1
+    )
+    shutil.copy(
+        ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv",
+        tmp_path / "recording.csv",
+    )
     monkeypatch.chdir(tmp_path)
     exec(compile(python, "README", "exec"), {})
     lines = [line for line in commands.splitlines() if line.startswith("bidmp ")]

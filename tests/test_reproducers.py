@@ -45,7 +45,9 @@ def refused(call, *names, kinds=(ValueError, TypeError), seconds=5.0):
     with pytest.raises(kinds) as caught:
         call()
     message = str(caught.value)
-    assert time.perf_counter() - begin < seconds, f"took {time.perf_counter() - begin:.1f} s to refuse"
+    assert time.perf_counter() - begin < seconds, (
+        f"took {time.perf_counter() - begin:.1f} s to refuse"
+    )
     assert "\n" not in message and len(message) <= 300, message
     assert any(name in message for name in names), f"{message!r} names none of {names}"
     return message
@@ -94,10 +96,14 @@ def test_a_bag_with_three_thousand_nested_types_is_refused(tmp_path):
 
     path = tmp_path / "deep.bag"
     n_types = 3_000
-    sections = ["pkg/T0 a"] + [f"{'=' * 80}\nMSG: pkg/T{i}\n" + (f"pkg/T{i + 1} a" if i < n_types - 1 else "int32 x")
-                               for i in range(n_types)]
+    sections = ["pkg/T0 a"] + [
+        f"{'=' * 80}\nMSG: pkg/T{i}\n" + (f"pkg/T{i + 1} a" if i < n_types - 1 else "int32 x")
+        for i in range(n_types)
+    ]
     with Writer(path) as writer:
-        connection = writer.add_connection("/deep", "pkg/msg/Deep", msgdef="\n".join(sections), md5sum="0" * 32)
+        connection = writer.add_connection(
+            "/deep", "pkg/msg/Deep", msgdef="\n".join(sections), md5sum="0" * 32
+        )
         writer.write(connection, 1, b"\x00\x00\x00\x00")
     refused(lambda: bidmp.io.read_bag(path, topic="/deep"), "deep.bag")
 
@@ -117,7 +123,9 @@ def test_bls_predict_of_none_is_refused():
 def test_via_points_with_limits_given_as_a_list_or_with_an_unknown_key_are_refused(dmp):
     via = [(0.5, dmp.goal_ * 0.5)]
     refused(lambda: dmp.trajectory(via=via, limits=[{"velocity": 100.0}]), "limits")
-    refused(lambda: dmp.trajectory(via=via, limits={"velocity": 100.0, "speed": 3.0}), "speed", "limits")
+    refused(
+        lambda: dmp.trajectory(via=via, limits={"velocity": 100.0, "speed": 3.0}), "speed", "limits"
+    )
 
 
 def test_robot_models_of_the_wrong_shape_or_from_places_a_scenario_may_not_read(tmp_path):
@@ -128,7 +136,12 @@ def test_robot_models_of_the_wrong_shape_or_from_places_a_scenario_may_not_read(
     fifo = tmp_path / "arm.urdf"
     os.mkfifo(fifo)
     for urdf in ("/etc/passwd", "/dev/zero", str(fifo), "file:///etc/passwd"):
-        refused(lambda urdf=urdf: bidmp.sim.robot_model({"urdf": urdf, "flange": "x", "limits": limits}), "urdf")
+        refused(
+            lambda urdf=urdf: bidmp.sim.robot_model(
+                {"urdf": urdf, "flange": "x", "limits": limits}
+            ),
+            "urdf",
+        )
 
 
 def test_a_rack_slot_at_nan_and_nan_integrator_settings_are_refused():
@@ -138,8 +151,13 @@ def test_a_rack_slot_at_nan_and_nan_integrator_settings_are_refused():
 
 
 def test_a_task_with_a_nan_seed_or_an_infinite_goal_is_refused(demo):
-    refused(lambda: bidmp.tasks.methods.Task(demonstration=demo, goals=[[0.0, 0.0, -np.inf]]), "goals")
-    refused(lambda: bidmp.tasks.methods.Task(demonstration=demo, goals=demo[-1:], seed=float("nan")), "seed")
+    refused(
+        lambda: bidmp.tasks.methods.Task(demonstration=demo, goals=[[0.0, 0.0, -np.inf]]), "goals"
+    )
+    refused(
+        lambda: bidmp.tasks.methods.Task(demonstration=demo, goals=demo[-1:], seed=float("nan")),
+        "seed",
+    )
 
 
 def test_a_pose_stepper_with_an_infinite_measurement_is_refused():
@@ -154,12 +172,19 @@ def test_a_pose_stepper_with_an_infinite_measurement_is_refused():
 def test_bags_with_numbers_for_joint_names_or_integer_times_are_refused(tmp_path):
     pytest.importorskip("rosbags")
     t, q = np.linspace(0.0, 1.0, 20), np.zeros((20, 7))
-    refused(lambda: bidmp.io.write_bag(tmp_path / "b.bag", t, q, kind="joints", names=np.arange(7.0), ros=1), "names")
+    refused(
+        lambda: bidmp.io.write_bag(
+            tmp_path / "b.bag", t, q, kind="joints", names=np.arange(7.0), ros=1
+        ),
+        "names",
+    )
     from rosbags.highlevel import AnyReader
 
-    written = bidmp.io.write_bag(tmp_path / "c.bag", np.arange(20, dtype=np.int64), q, kind="joints", ros=1)
+    written = bidmp.io.write_bag(
+        tmp_path / "c.bag", np.arange(20, dtype=np.int64), q, kind="joints", ros=1
+    )
     with AnyReader([written]) as reader:  # read by rosbags itself: integer seconds are seconds
-        (connection, _, raw), = reader.messages()
+        ((connection, _, raw),) = reader.messages()
         points = reader.deserialize(raw, connection.msgtype).points
     assert [point.time_from_start.sec for point in points] == list(range(20))
 
@@ -182,20 +207,28 @@ def test_segments_free_with_unequal_ends_is_refused(scene, demo):
 def test_tools_time_scaling_cells_and_meshes_refuse_what_they_cannot_represent(scene, demo):
     refused(lambda: bidmp.Tool(1.0, 10**400), "length")
     one = bidmp.Trajectory(np.zeros(1), demo[:1], np.zeros((1, 3)), np.zeros((1, 3)))
-    refused(lambda: bidmp.primitives.time_scale(one, max_velocity=100.0), "trajectory", "samples", "y")
+    refused(
+        lambda: bidmp.primitives.time_scale(one, max_velocity=100.0), "trajectory", "samples", "y"
+    )
     motion = bidmp.DMP().fit(demo, T, units="mm").trajectory()
     refused(lambda: bidmp.primitives.time_scale(motion, max_velocity=1e-300), "max_velocity")
     refused(lambda: bidmp.sim.RobotCell(scene, base=[[0.0, -450.0, 0.0]]), "base")
-    refused(lambda: bidmp.plotting.solid_mesh("box", [np.inf, 0.0, 0.0], np.eye(3), (1.0, 1.0, 1.0)), "centre")
+    refused(
+        lambda: bidmp.plotting.solid_mesh("box", [np.inf, 0.0, 0.0], np.eye(3), (1.0, 1.0, 1.0)),
+        "centre",
+    )
 
 
 # -- the command line: exit 2, one line ------------------------------------------------------------
-@pytest.mark.parametrize("argv", [
-    ["sim", "--targets", "zz", "--no-pictures", "--workers", "1"],
-    ["fit", "{demo}", "-o", "{out}/m.npz", "--cutoff", "+inf"],
-    ["rollout", "{model}", "-o", "{out}/r.csv", "--bag", ""],
-    ["view", "{out}", "-o", ""],
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sim", "--targets", "zz", "--no-pictures", "--workers", "1"],
+        ["fit", "{demo}", "-o", "{out}/m.npz", "--cutoff", "+inf"],
+        ["rollout", "{model}", "-o", "{out}/r.csv", "--bag", ""],
+        ["view", "{out}", "-o", ""],
+    ],
+)
 def test_the_command_line_refuses_in_one_line_with_exit_2(argv, tmp_path, demo, capsys):
     path = bidmp.io.save_trajectory(demo, tmp_path / "demo.csv", times=T)
     model = bidmp.io.save_model(bidmp.DMP().fit(demo, T, units="mm"), tmp_path / "m.npz")
@@ -211,11 +244,33 @@ def test_a_urdf_whose_meshes_point_at_system_files_exits_2(tmp_path, capsys):
     text = re.sub(r'filename="[^"]+"', 'filename="/etc/passwd"', shipped.read_text())
     (tmp_path / "arm.urdf").write_text(text)
     spec = json.loads(bidmp.tasks.builtin_text("nut-unscrewing-iiwa"))
-    spec["robot"] = {"urdf": "arm.urdf", "flange": "lbr_iiwa_link_7",
-                     "limits": {"lower": [-2.9] * 7, "upper": [2.9] * 7, "velocity": [1.0] * 7, "acceleration": [5.0] * 7}}
+    spec["robot"] = {
+        "urdf": "arm.urdf",
+        "flange": "lbr_iiwa_link_7",
+        "limits": {
+            "lower": [-2.9] * 7,
+            "upper": [2.9] * 7,
+            "velocity": [1.0] * 7,
+            "acceleration": [5.0] * 7,
+        },
+    }
     (tmp_path / "cell.json").write_text(json.dumps(spec))
-    code = main(["sim", "--scenario", str(tmp_path / "cell.json"), "--methods", "dmp", "--targets", "3",
-                 "--no-pictures", "--workers", "1", "--out", str(tmp_path / "out")])
+    code = main(
+        [
+            "sim",
+            "--scenario",
+            str(tmp_path / "cell.json"),
+            "--methods",
+            "dmp",
+            "--targets",
+            "3",
+            "--no-pictures",
+            "--workers",
+            "1",
+            "--out",
+            str(tmp_path / "out"),
+        ]
+    )
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and "internal error" not in err, err
     assert "mesh" in err and "/etc/passwd" in err

@@ -2,12 +2,17 @@
 
 import numpy as np
 import pytest
-from bidmp.demonstrations import minimum_jerk
-from bidmp.experiments import compare_prm, table5_cases
-from bidmp.extension import NoFreeRouteError, classic_prm, gaussian_prm, template
-from bidmp.extension import frechet_similarity
 
 from bidmp._trajectory import resample_arclength
+from bidmp.demonstrations import minimum_jerk
+from bidmp.experiments import compare_prm, table5_cases
+from bidmp.extension import (
+    NoFreeRouteError,
+    classic_prm,
+    frechet_similarity,
+    gaussian_prm,
+    template,
+)
 from bidmp.extension.roadmap import _shortest_path as shortest_path
 
 
@@ -41,7 +46,9 @@ def test_template_ends_at_new_target_and_is_finite_on_degenerate_axes(scaling):
 
 def test_axis_template_is_the_piece_when_the_target_is_tar(arc_piece):
     np.testing.assert_allclose(template(arc_piece, arc_piece[-1], "axis"), arc_piece, atol=1e-12)
-    np.testing.assert_allclose(template(arc_piece, arc_piece[-1], "similarity"), arc_piece, atol=1e-12)
+    np.testing.assert_allclose(
+        template(arc_piece, arc_piece[-1], "similarity"), arc_piece, atol=1e-12
+    )
 
 
 def test_similarity_template_is_a_scaled_rotation(arc_piece):
@@ -55,11 +62,15 @@ def test_similarity_template_is_a_scaled_rotation(arc_piece):
     assert np.all(np.isfinite(antiparallel))
 
 
-@pytest.mark.parametrize("schedule, rho", [("geometric", 0.9), ("harmonic", 0.9), ("geometric", 0.7)])
+@pytest.mark.parametrize(
+    "schedule, rho", [("geometric", 0.9), ("harmonic", 0.9), ("geometric", 0.7)]
+)
 def test_bias_update_follows_eq8_when_the_noise_vanishes(arc_piece, schedule, rho):
     """With sigma -> 0 and n_tar = tar the path is the biased line itself, so the gap 1 - s to
     the template shrinks exactly as Eq. 8 says: gap <- gap (1 - gap eta_it)."""
-    result = gaussian_prm(arc_piece, arc_piece[-1], sigma_rel=1e-9, schedule=schedule, rho=rho, seed=0)
+    result = gaussian_prm(
+        arc_piece, arc_piece[-1], sigma_rel=1e-9, schedule=schedule, rho=rho, seed=0
+    )
     gap = 1.0 - result.history
     eta = rho ** np.arange(1, 10) if schedule == "geometric" else rho / np.arange(1, 10)
     predicted = gap[:-1] * (1.0 - gap[:-1] * eta)
@@ -119,14 +130,24 @@ def test_a_wall_that_blocks_every_route_is_an_error_never_a_path_through_it():
     wall = lambda points: np.abs(points[:, 0] - 1.5) > 0.4  # noqa: E731 - a wall at x = 1.5
     assert shortest_path(nodes, 1, is_free=wall) is None
     with pytest.raises(NoFreeRouteError, match="no collision-free route"):
-        gaussian_prm(np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=20, is_free=wall, seed=0)
+        gaussian_prm(
+            np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=20, is_free=wall, seed=0
+        )
 
 
 def test_unreachable_target_without_a_callback_falls_back_to_the_sample_chain():
     # Far apart samples and one neighbour: the kNN graph is disconnected, nothing is in the way.
-    result = gaussian_prm(np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=2, n_neighbours=1,
-                          sigma_rel=5.0, seed=0)
-    assert np.array_equal(result.path[0], [0.0, 0.0]) and np.array_equal(result.path[-1], [3.0, 0.0])
+    result = gaussian_prm(
+        np.linspace([0.0, 0.0], [1.0, 0.0], 10),
+        [3.0, 0.0],
+        n_samples=2,
+        n_neighbours=1,
+        sigma_rel=5.0,
+        seed=0,
+    )
+    assert np.array_equal(result.path[0], [0.0, 0.0]) and np.array_equal(
+        result.path[-1], [3.0, 0.0]
+    )
 
 
 @pytest.mark.parametrize(
@@ -149,10 +170,21 @@ def test_bad_input(arc_piece, kwargs, error, match):
 
 def test_paper_scaling_and_raw_comparison_run(arc_piece):
     target = np.array([-4.0, 14.0])
-    for options in ({"scaling": "paper"}, {"compare": "raw"}, {"schedule": "harmonic"}, {"select": "last"}):
+    for options in (
+        {"scaling": "paper"},
+        {"compare": "raw"},
+        {"schedule": "harmonic"},
+        {"select": "last"},
+    ):
         result = gaussian_prm(arc_piece, target, seed=1, **options)
         assert 0.0 <= result.similarity <= 1.0 and np.array_equal(result.path[-1], target)
     raw = gaussian_prm(arc_piece, target, seed=1, compare="raw")
     # Against Tra_imi itself the end-point gap caps the score below the template's.
-    assert raw.history.max() < frechet_similarity(template(resample_arclength(arc_piece, 100), target), resample_arclength(arc_piece, 100)) + 0.2
+    assert (
+        raw.history.max()
+        < frechet_similarity(
+            template(resample_arclength(arc_piece, 100), target), resample_arclength(arc_piece, 100)
+        )
+        + 0.2
+    )
     assert gaussian_prm(arc_piece, target, seed=1, select="last").iteration == 9

@@ -9,10 +9,8 @@ import pytest
 pytest.importorskip("pybullet")
 
 from bidmp import sim  # noqa: E402
-from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.tasks import evaluate# noqa: E402
-from bidmp.tasks import ScenarioError# noqa: E402
+from bidmp.tasks import ScenarioError, evaluate, scenarios  # noqa: E402
 
 
 def nut_spec(**robot):
@@ -33,7 +31,7 @@ def test_the_iiwa_runs_the_nut_task_within_its_own_limits(iiwa):
     assert result.robot == "iiwa" and result.limits == sim.IIWA
     method = result.methods["bidmp"]
     assert method.task_successes == 3 and method.contacts == 0 and method.within_limits == 3
-    for label, target in method.targets.items():
+    for _label, target in method.targets.items():
         # The measured motion against the iiwa's limits, not the Panda's (the iiwa's joint speeds
         # are 0.75-1.2 rad/s lower: a plan timed to the Panda would break them).
         assert target.measured_peak_velocity <= 1.0 and target.measured_peak_acceleration <= 1.0
@@ -51,16 +49,27 @@ def test_plans_are_timed_to_the_arm_own_limits(iiwa):
     report = evaluate(iiwa, ["bidmp"], geometry=False)
     rollout = report.methods["bidmp"].rollouts["11"]
     full = sim.ROBOT_MODELS["iiwa"]
-    halved = dataclasses.replace(full, limits=sim.JointLimits(
-        full.limits.lower, full.limits.upper, *(tuple(v / 2 for v in getattr(full.limits, name))
-                                                for name in ("velocity", "acceleration", "jerk"))))
+    halved = dataclasses.replace(
+        full,
+        limits=sim.JointLimits(
+            full.limits.lower,
+            full.limits.upper,
+            *(
+                tuple(v / 2 for v in getattr(full.limits, name))
+                for name in ("velocity", "acceleration", "jerk")
+            ),
+        ),
+    )
     durations = []
     for model in (full, halved):
         with sim.RobotCell(iiwa.scene, iiwa.units, [50.0, -550.0, 0.0], 90.0, model) as cell:
             plan = cell.plan(rollout, "11")
             grid = np.linspace(0.0, 1.0, 4001)
             speeds = np.abs(plan.spline(grid, 1)) / plan.duration
-            assert np.all(speeds.max(axis=0) <= np.asarray(model.limits.velocity) * sim.backend.LIMIT_MARGIN * 1.001)
+            assert np.all(
+                speeds.max(axis=0)
+                <= np.asarray(model.limits.velocity) * sim.backend.LIMIT_MARGIN * 1.001
+            )
             durations.append(plan.duration)
     assert 2 ** (1 / 3) - 1e-3 <= durations[1] / durations[0] <= 2.0 + 1e-3
 
@@ -68,8 +77,12 @@ def test_plans_are_timed_to_the_arm_own_limits(iiwa):
 def test_a_base_too_close_names_what_is_out_of_reach():
     scenario = scenarios.from_dict(nut_spec(model="iiwa", base=[50, -450, 0], yaw=90))
     targets = sim.simulate(scenario, ["dmp"], targets=["3", "4"], workers=1).methods["dmp"].targets
-    for target in targets.values():  # every motion starts there: every target is a row with the reason
-        assert not target.ran and target.reason.startswith("the demonstration's start is unreachable for the iiwa at base")
+    for (
+        target
+    ) in targets.values():  # every motion starts there: every target is a row with the reason
+        assert not target.ran and target.reason.startswith(
+            "the demonstration's start is unreachable for the iiwa at base"
+        )
         assert "\n" not in target.reason
 
 
@@ -83,10 +96,20 @@ def test_the_default_placement_of_the_iiwa_reaches_the_task():
 
 
 def test_a_urdf_named_in_the_scenario(tmp_path):
-    limits = {"lower": [-2.9, -2.0, -2.9, -2.0, -2.9, -2.0, -3.0], "upper": [2.9, 2.0, 2.9, 2.0, 2.9, 2.0, 3.0],
-              "velocity": [1.0] * 7, "acceleration": [5.0] * 7, "jerk": [500.0] * 7}
-    spec = nut_spec(urdf="kuka_iiwa/model.urdf", flange="lbr_iiwa_link_7", limits=limits,
-                    rest=[0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0], base=[50, -550, 0])
+    limits = {
+        "lower": [-2.9, -2.0, -2.9, -2.0, -2.9, -2.0, -3.0],
+        "upper": [2.9, 2.0, 2.9, 2.0, 2.9, 2.0, 3.0],
+        "velocity": [1.0] * 7,
+        "acceleration": [5.0] * 7,
+        "jerk": [500.0] * 7,
+    }
+    spec = nut_spec(
+        urdf="kuka_iiwa/model.urdf",
+        flange="lbr_iiwa_link_7",
+        limits=limits,
+        rest=[0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0],
+        base=[50, -550, 0],
+    )
     scenario = scenarios.from_dict(spec)
     result = sim.simulate(scenario, ["bidmp"], targets=["3"], workers=1)
     assert result.robot == "model" and result.limits.velocity == (1.0,) * 7
@@ -94,27 +117,65 @@ def test_a_urdf_named_in_the_scenario(tmp_path):
     assert result.methods["bidmp"].task_successes == 1 and target.peak_velocity <= 1.0
     # A URDF in the scenario's folder is read from there; outside it, refused.
     (tmp_path / "arm.urdf").write_text("<robot name='x'></robot>")
-    local = scenarios.from_dict(nut_spec(urdf="arm.urdf", flange="tool0", limits=limits), base_dir=tmp_path)
+    local = scenarios.from_dict(
+        nut_spec(urdf="arm.urdf", flange="tool0", limits=limits), base_dir=tmp_path
+    )
     assert local.robot["urdf"] == str((tmp_path / "arm.urdf").resolve())
     with pytest.raises(ValueError, match="no link 'tool0'"):
         sim.simulate(local, ["dmp"], targets=["3"], workers=1)
 
 
-@pytest.mark.parametrize("robot, message", [
-    ({"model": "kr6"}, r"robot.model: expected one of \['panda', 'iiwa', 'xarm6', 'ur5'\]"),
-    ({"model": "iiwa", "urdf": "a.urdf"}, "not both"),
-    ({"flange": "x"}, "describe your own"),
-    ({"urdf": "a.urdf"}, "robot.flange"),
-    ({"urdf": "a.txt", "flange": "x"}, r"robot.urdf: expected the path of a .urdf"),
-    ({"urdf": "a.urdf", "flange": "x", "limits": {"lower": [0] * 7}}, "robot.limits: expected"),
-    ({"urdf": "a.urdf", "flange": "x", "limits": {"lower": [0] * 7, "upper": [1] * 7, "velocity": [1] * 6,
-                                                   "acceleration": [1] * 7}}, r"robot.limits.velocity: expected 7"),
-    ({"urdf": "a.urdf", "flange": "x", "limits": {"lower": [1] * 7, "upper": [0] * 7, "velocity": [1] * 7,
-                                                   "acceleration": [1] * 7}}, "lower must be below upper"),
-    ({"urdf": "a.urdf", "flange": "x", "limits": {"lower": [0] * 7, "upper": [1] * 7, "velocity": [-1] * 7,
-                                                   "acceleration": [1] * 7}}, r"velocity\[0\]: must be > 0"),
-    ({"speed": 3}, r"unknown \['speed'\]"),
-])
+@pytest.mark.parametrize(
+    "robot, message",
+    [
+        ({"model": "kr6"}, r"robot.model: expected one of \['panda', 'iiwa', 'xarm6', 'ur5'\]"),
+        ({"model": "iiwa", "urdf": "a.urdf"}, "not both"),
+        ({"flange": "x"}, "describe your own"),
+        ({"urdf": "a.urdf"}, "robot.flange"),
+        ({"urdf": "a.txt", "flange": "x"}, r"robot.urdf: expected the path of a .urdf"),
+        ({"urdf": "a.urdf", "flange": "x", "limits": {"lower": [0] * 7}}, "robot.limits: expected"),
+        (
+            {
+                "urdf": "a.urdf",
+                "flange": "x",
+                "limits": {
+                    "lower": [0] * 7,
+                    "upper": [1] * 7,
+                    "velocity": [1] * 6,
+                    "acceleration": [1] * 7,
+                },
+            },
+            r"robot.limits.velocity: expected 7",
+        ),
+        (
+            {
+                "urdf": "a.urdf",
+                "flange": "x",
+                "limits": {
+                    "lower": [1] * 7,
+                    "upper": [0] * 7,
+                    "velocity": [1] * 7,
+                    "acceleration": [1] * 7,
+                },
+            },
+            "lower must be below upper",
+        ),
+        (
+            {
+                "urdf": "a.urdf",
+                "flange": "x",
+                "limits": {
+                    "lower": [0] * 7,
+                    "upper": [1] * 7,
+                    "velocity": [-1] * 7,
+                    "acceleration": [1] * 7,
+                },
+            },
+            r"velocity\[0\]: must be > 0",
+        ),
+        ({"speed": 3}, r"unknown \['speed'\]"),
+    ],
+)
 def test_robot_keys_are_validated_by_name(robot, message):
     with pytest.raises(ScenarioError, match=message):
         scenarios.from_dict(nut_spec(**robot))
@@ -131,8 +192,22 @@ def test_a_urdf_outside_the_scenario_folder_is_refused(tmp_path):
 
 
 def test_bidmp_sim_runs_the_iiwa_scenario(tmp_path, capsys):
-    code = main(["sim", "--scenario", "nut-unscrewing-iiwa", "--methods", "bidmp", "--targets", "3",
-                 "--no-pictures", "--workers", "1", "--out", str(tmp_path)])
+    code = main(
+        [
+            "sim",
+            "--scenario",
+            "nut-unscrewing-iiwa",
+            "--methods",
+            "bidmp",
+            "--targets",
+            "3",
+            "--no-pictures",
+            "--workers",
+            "1",
+            "--out",
+            str(tmp_path),
+        ]
+    )
     out = capsys.readouterr().out
     assert code == 0 and "KUKA LBR iiwa 7 R800" in out
     written = json.loads((tmp_path / "sim_results.json").read_text())
@@ -153,12 +228,25 @@ def test_the_iiwa_runs_the_nut_job(iiwa):
 def dh_forward(q) -> np.ndarray:
     """Independent oracle: the UR5's flange pose (4, 4) from Universal Robots' published classic DH
     table, the product Rz(theta) Tz(d) Tx(a) Rx(alpha) written out here (not read from the URDF)."""
-    table = ((0.089159, 0.0, np.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
-             (0.10915, 0.0, np.pi / 2), (0.09465, 0.0, -np.pi / 2), (0.0823, 0.0, 0.0))
+    table = (
+        (0.089159, 0.0, np.pi / 2),
+        (0.0, -0.425, 0.0),
+        (0.0, -0.39225, 0.0),
+        (0.10915, 0.0, np.pi / 2),
+        (0.09465, 0.0, -np.pi / 2),
+        (0.0823, 0.0, 0.0),
+    )
     pose = np.eye(4)
     for (d, a, alpha), theta in zip(table, q):
         ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-        pose = pose @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
+        pose = pose @ np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0, sa, ca, d],
+                [0, 0, 0, 1],
+            ]
+        )
     return pose
 
 
@@ -181,17 +269,26 @@ def test_the_ur5_urdf_is_its_published_dh_kinematics():
     client = p.connect(p.DIRECT)
     try:
         robot = p.loadURDF(urdf, useFixedBase=True, physicsClientId=client)
-        names = [p.getJointInfo(robot, j, physicsClientId=client)[12].decode() for j in range(p.getNumJoints(robot, physicsClientId=client))]
+        names = [
+            p.getJointInfo(robot, j, physicsClientId=client)[12].decode()
+            for j in range(p.getNumJoints(robot, physicsClientId=client))
+        ]
         flange = names.index("flange")
         rng = np.random.default_rng(0)
         for _ in range(50):
             q = rng.uniform(-np.pi, np.pi, 6)
             for joint in range(6):
                 p.resetJointState(robot, joint, q[joint], physicsClientId=client)
-            state = p.getLinkState(robot, flange, computeForwardKinematics=1, physicsClientId=client)
+            state = p.getLinkState(
+                robot, flange, computeForwardKinematics=1, physicsClientId=client
+            )
             expected = dh_forward(q)
             np.testing.assert_allclose(state[4], expected[:3, 3], atol=1e-6)
-            np.testing.assert_allclose(np.array(p.getMatrixFromQuaternion(state[5])).reshape(3, 3), expected[:3, :3], atol=1e-6)
+            np.testing.assert_allclose(
+                np.array(p.getMatrixFromQuaternion(state[5])).reshape(3, 3),
+                expected[:3, :3],
+                atol=1e-6,
+            )
     finally:
         p.disconnect(client)
 
@@ -218,18 +315,30 @@ def test_a_six_axis_arm_takes_a_far_nut_off_within_its_limits(arm):
     scenario = scenarios.load(f"nut-unscrewing-{arm}")
     report = sim.run_job(scenario, targets=["12"])
     record = report.targets[0]
-    assert report.robot == arm and record.removed and record.within_limits and not record.contacts, record.reason
+    assert (
+        report.robot == arm and record.removed and record.within_limits and not record.contacts
+    ), record.reason
     assert len(sim.joint_names(arm)) == 6
 
 
 def test_a_six_joint_urdf_with_seven_limits_names_the_arm_and_its_joints(tmp_path):
-    limits = {"lower": [-6.0] * 7, "upper": [6.0] * 7, "velocity": [3.0] * 7, "acceleration": [15.0] * 7}
+    limits = {
+        "lower": [-6.0] * 7,
+        "upper": [6.0] * 7,
+        "velocity": [3.0] * 7,
+        "acceleration": [15.0] * 7,
+    }
     spec = nut_spec(urdf="xarm/xarm6_robot.urdf", flange="link6", limits=limits, base=[50, -400, 0])
-    with pytest.raises(ValueError, match=r"robot 'xarm6_robot' has 6 movable joints up to its flange 'link6'; the "
-                                         r"simulator drives its 7 limits"):
+    with pytest.raises(
+        ValueError,
+        match=r"robot 'xarm6_robot' has 6 movable joints up to its flange 'link6'; the "
+        r"simulator drives its 7 limits",
+    ):
         sim.simulate(scenarios.from_dict(spec), ["bidmp"], targets=["3"], workers=1)
     spec["robot"]["limits"]["velocity"] = [3.0] * 6
-    with pytest.raises(ScenarioError, match=r"robot.limits.velocity.*expected 7 numbers, one per joint"):
+    with pytest.raises(
+        ScenarioError, match=r"robot.limits.velocity.*expected 7 numbers, one per joint"
+    ):
         scenarios.from_dict(spec)
 
 
@@ -237,12 +346,43 @@ def test_joint_limits_and_the_robot_for_a_six_joint_model(tmp_path, capsys):
     """A 6-joint recording (the UR5's joints along a path): --joint-limits ur5 times it to the UR5's
     limits; a 7-joint arm's limits are refused naming both counts; the JointTrajectory after IK
     carries the UR5's six joints."""
-    points = np.column_stack([np.linspace(0.4, 0.5, 60), np.linspace(0.0, 0.1, 60), np.full(60, 0.2)])
+    points = np.column_stack(
+        [np.linspace(0.4, 0.5, 60), np.linspace(0.0, 0.1, 60), np.full(60, 0.2)]
+    )
     q = sim.inverse_kinematics(points, "ur5", units="m")
     names = sim.joint_names("ur5")
     table = np.column_stack([np.linspace(0.0, 2.0, 60), q])
-    (tmp_path / "q.csv").write_text("t," + ",".join(names) + "\n" + "\n".join(",".join(f"{v:.9g}" for v in row) for row in table))
+    (tmp_path / "q.csv").write_text(
+        "t,"
+        + ",".join(names)
+        + "\n"
+        + "\n".join(",".join(f"{v:.9g}" for v in row) for row in table)
+    )
     assert main(["fit", str(tmp_path / "q.csv"), "-o", str(tmp_path / "q.npz")]) == 0
-    assert main(["rollout", str(tmp_path / "q.npz"), "--joint-limits", "ur5", "-o", str(tmp_path / "r.csv")]) == 0
-    assert main(["rollout", str(tmp_path / "q.npz"), "--joint-limits", "panda", "-o", str(tmp_path / "r.csv")]) == 2
+    assert (
+        main(
+            [
+                "rollout",
+                str(tmp_path / "q.npz"),
+                "--joint-limits",
+                "ur5",
+                "-o",
+                str(tmp_path / "r.csv"),
+            ]
+        )
+        == 0
+    )
+    assert (
+        main(
+            [
+                "rollout",
+                str(tmp_path / "q.npz"),
+                "--joint-limits",
+                "panda",
+                "-o",
+                str(tmp_path / "r.csv"),
+            ]
+        )
+        == 2
+    )
     assert "that arm has 7 joints; this model has 6 dimensions" in capsys.readouterr().err

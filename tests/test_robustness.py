@@ -30,7 +30,7 @@ from bidmp.io import (
 )
 
 PYTHON = sys.executable
-from bidmp.demonstrations import recording_path# noqa: E402  (the bundled copies of shared/data/recordings)
+from bidmp.demonstrations import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)
 
 
 def cli(argv, seconds=10.0):
@@ -79,12 +79,15 @@ def npy_bytes(array):
 def npy_header_only(shape, dtype="<f8"):
     """An .npy header that declares ``shape`` and no data at all."""
     buffer = io.BytesIO()
-    np.lib.format.write_array_header_1_0(buffer, {"descr": dtype, "fortran_order": False, "shape": shape})
+    np.lib.format.write_array_header_1_0(
+        buffer, {"descr": dtype, "fortran_order": False, "shape": shape}
+    )
     return buffer.getvalue()
 
 
 def set_meta_text(path, change):
     """Rewrite the raw JSON text of a model's metadata: ``change(text) -> text``."""
+
     def edit(members):
         text = np.load(io.BytesIO(members["__bidmp__.npy"])).tobytes().decode()
         members["__bidmp__.npy"] = npy_bytes(np.frombuffer(change(text).encode(), np.uint8))
@@ -119,12 +122,19 @@ def test_npz_renamed_npy_and_raw_members(tmp_path, model_file):
 
 
 def test_deeply_nested_json_in_model_metadata_and_scenarios(tmp_path, model_file):
-    set_meta_text(model_file, lambda text: text.replace('"state": {', '"state": {"deep": ' + "[" * 5000 + "]" * 5000 + ", ", 1))
+    set_meta_text(
+        model_file,
+        lambda text: text.replace(
+            '"state": {', '"state": {"deep": ' + "[" * 5000 + "]" * 5000 + ", ", 1
+        ),
+    )
     assert_one_line_error(["rollout", model_file, "-o", tmp_path / "r.csv"], "max_json_depth")
     scenario = tmp_path / "deep.json"
     scenario.write_text('{"name": ' + "[" * 100_000 + "]" * 100_000 + "}")
     assert_one_line_error(["scenario", "check", scenario], "max_json_depth")
-    assert_one_line_error(["demo", "--scenario", scenario, "--out", tmp_path / "o"], "max_json_depth")
+    assert_one_line_error(
+        ["demo", "--scenario", scenario, "--out", tmp_path / "o"], "max_json_depth"
+    )
 
 
 def test_declared_sizes_are_refused_before_allocating(tmp_path, model_file):
@@ -141,13 +151,20 @@ def test_declared_sizes_are_refused_before_allocating(tmp_path, model_file):
 def test_huge_n_steps_and_n_kernels(tmp_path, model_file):
     demo = save_trajectory(curved_demo(200, 3), tmp_path / "demo.csv")
     for n_steps in (10**8, 10**12, 2**63):
-        assert_one_line_error(["rollout", model_file, "-o", tmp_path / "r.csv", "--n-steps", n_steps], "max_steps")
-    assert_one_line_error(["fit", demo, "-o", tmp_path / "m.npz", "--n-kernels", 10**9, "--no-time"], "max_kernels")
+        assert_one_line_error(
+            ["rollout", model_file, "-o", tmp_path / "r.csv", "--n-steps", n_steps], "max_steps"
+        )
+    assert_one_line_error(
+        ["fit", demo, "-o", tmp_path / "m.npz", "--n-kernels", 10**9, "--no-time"], "max_kernels"
+    )
 
 
 def test_unsupported_compression_and_encrypted_members(tmp_path, model_file):
     bz2 = tmp_path / "bz2.npz"
-    with zipfile.ZipFile(model_file) as source, zipfile.ZipFile(bz2, "w", compression=zipfile.ZIP_BZIP2) as target:
+    with (
+        zipfile.ZipFile(model_file) as source,
+        zipfile.ZipFile(bz2, "w", compression=zipfile.ZIP_BZIP2) as target,
+    ):
         for info in source.infolist():
             target.writestr(info.filename, source.read(info))
     assert_one_line_error(["rollout", bz2, "-o", tmp_path / "r.csv"], "unsupported compression")
@@ -166,14 +183,23 @@ def test_unsupported_compression_and_encrypted_members(tmp_path, model_file):
 def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
     rng = np.random.default_rng(0)
     t = np.linspace(0.0, 1.0, 1_000_000)
-    y = np.column_stack([np.cos(3 * t), np.sin(5 * t), t]) * 100 + rng.normal(scale=0.01, size=(t.size, 3))
+    y = np.column_stack([np.cos(3 * t), np.sin(5 * t), t]) * 100 + rng.normal(
+        scale=0.01, size=(t.size, 3)
+    )
     path = tmp_path / "long.npy"
     np.save(path, y)
     code, out, err = cli(["segment", path], seconds=20.0)
     assert code == 0, err
     assert "1000000 samples" in out
     csv_path = tmp_path / "long.csv"
-    np.savetxt(csv_path, np.column_stack([1.7e9 + t * 4000.0, y]), delimiter=",", header="t,x,y,z", comments="", fmt="%.6f")
+    np.savetxt(
+        csv_path,
+        np.column_stack([1.7e9 + t * 4000.0, y]),
+        delimiter=",",
+        header="t,x,y,z",
+        comments="",
+        fmt="%.6f",
+    )
     code, out, err = cli(["segment", csv_path, "--raw"], seconds=20.0)
     assert code == 0 and "1000000 samples" in out, err
     code, out, err = cli(["segment", csv_path], seconds=20.0)  # timed input is prepared, as by fit
@@ -203,7 +229,9 @@ def test_persistence_pruning_matches_the_literal_quadratic_rule():
 def test_segmentation_of_long_demonstrations_matches_short_ones():
     """Analysing 4096 arc-length samples instead of all of them keeps the segmentation points."""
     short = curved_demo(2000, 3, seed=4)
-    long = np.vstack([np.interp(np.linspace(0, 1999, 20_000), np.arange(2000), c) for c in short.T]).T
+    long = np.vstack(
+        [np.interp(np.linspace(0, 1999, 20_000), np.arange(2000), c) for c in short.T]
+    ).T
     s_short = bidmp.segment(short).points / 1999
     s_long = bidmp.segment(long).points / 19_999
     assert len(s_short) == len(s_long)
@@ -255,7 +283,10 @@ def test_limits_can_be_raised_in_the_library_and_are_restored():
 
 
 # --- 3. dependency exceptions become ValueError / TypeError naming the argument ----------------
-@pytest.mark.parametrize("seed, error", [(-1, ValueError), (2**130, ValueError), (1.5, TypeError), ("7", TypeError), (None, TypeError)])
+@pytest.mark.parametrize(
+    "seed, error",
+    [(-1, ValueError), (2**130, ValueError), (1.5, TypeError), ("7", TypeError), (None, TypeError)],
+)
 def test_bad_seeds_are_named(seed, error):
     with pytest.raises(error, match="seed"):
         bidmp.extend_demonstration(curved_demo(100, 3), [1.0, 1.0, 1.0], seed=seed)
@@ -266,12 +297,18 @@ def test_singular_bls_and_oversized_bls_are_value_errors():
     with pytest.raises(ValueError, match="reg"):
         bidmp.BLS(reg=1e-300, update="exact_ridge").fit(X, X[:, 0])
     started = time.perf_counter()
-    for params in ({"n_windows": 10**6}, {"n_enhance": 10**7}, {"n_windows": 50, "n_mapped": 50, "n_enhance": 2000},
-                   {"admm_iterations": 10**9}):
+    for params in (
+        {"n_windows": 10**6},
+        {"n_enhance": 10**7},
+        {"n_windows": 50, "n_mapped": 50, "n_enhance": 2000},
+        {"admm_iterations": 10**9},
+    ):
         with pytest.raises(ValueError, match="max_hidden_nodes|admm_iterations"):
             bidmp.BLS(**params).fit(X, X[:, 0])
     with pytest.raises(ValueError, match="max_work"):
-        bidmp.BLS(n_enhance=2500).fit(np.random.default_rng(0).random((20_000, 3)), np.zeros(20_000))
+        bidmp.BLS(n_enhance=2500).fit(
+            np.random.default_rng(0).random((20_000, 3)), np.zeros(20_000)
+        )
     assert time.perf_counter() - started < 2.0
 
 
@@ -285,7 +322,9 @@ def test_load_never_leaks_attribute_index_or_recursion_errors(tmp_path, model_fi
         lambda meta: meta.pop("state"),
     ]
     for index, change in enumerate(cases):
-        path = save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / f"m{index}.npz")
+        path = save_model(
+            bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / f"m{index}.npz"
+        )
         set_meta(path, change)
         with pytest.raises(ModelFileError):
             load_model(path)
@@ -296,9 +335,11 @@ def test_load_never_leaks_attribute_index_or_recursion_errors(tmp_path, model_fi
 def test_outputs_honour_the_umask(tmp_path, umask, expected):
     old = os.umask(umask)
     try:
-        paths = [save_model(bidmp.DMP(protocol="paper").fit(curved_demo(50, 2)), tmp_path / "m.npz"),
-                 save_trajectory(curved_demo(50, 2), tmp_path / "t.csv"),
-                 save_trajectory(curved_demo(50, 2), tmp_path / "t.npy")]
+        paths = [
+            save_model(bidmp.DMP(protocol="paper").fit(curved_demo(50, 2)), tmp_path / "m.npz"),
+            save_trajectory(curved_demo(50, 2), tmp_path / "t.csv"),
+            save_trajectory(curved_demo(50, 2), tmp_path / "t.npy"),
+        ]
     finally:
         os.umask(old)
     for path in paths:
@@ -315,14 +356,18 @@ def test_overwriting_keeps_the_files_mode(tmp_path):
 
 def test_a_csv_given_as_a_model_is_not_answered_with_pickle_advice(tmp_path):
     path = save_trajectory(curved_demo(50, 3), tmp_path / "demo.csv")
-    err = assert_one_line_error(["rollout", path, "-o", tmp_path / "r.csv"], "not a bidmp model file")
+    err = assert_one_line_error(
+        ["rollout", path, "-o", tmp_path / "r.csv"], "not a bidmp model file"
+    )
     assert "pickle" not in err
 
 
 def test_extend_with_a_demonstration_of_another_length(tmp_path):
     model = save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / "m.npz")
     demo = save_trajectory(curved_demo(333, 3), tmp_path / "d.csv")
-    code, out, err = cli(["extend", model, demo, "--target", 1.5, 1.5, 1.5, "-o", tmp_path / "e.npz"], seconds=30)
+    code, out, err = cli(
+        ["extend", model, demo, "--target", 1.5, 1.5, 1.5, "-o", tmp_path / "e.npz"], seconds=30
+    )
     assert code == 0, err
     assert np.all(np.isfinite(load_model(tmp_path / "e.npz").rollout([1.5, 1.5, 1.5])))
 
@@ -356,8 +401,11 @@ def test_a_writer_killed_mid_write_leaves_nothing_the_next_write_keeps(tmp_path)
 
 
 def test_a_closed_pipe_ends_quietly():
-    process = subprocess.Popen([PYTHON, "-m", "bidmp", "scenario", "show", "nut-unscrewing"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        [PYTHON, "-m", "bidmp", "scenario", "show", "nut-unscrewing"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     process.stdout.close()  # like `| head` exiting before bidmp writes
     _, err = process.communicate(timeout=60)
     assert err == b"", err
@@ -379,8 +427,12 @@ def test_non_finite_dmp_members_are_refused_by_name(tmp_path, model_file, member
 
 
 def test_wrong_shapes_and_dtypes_are_refused_by_name(tmp_path, model_file):
-    for member, value in (("weights_", np.ones((7, 3))), ("goal_", np.ones(2)), ("centres_", np.ones((50, 2))),
-                          ("start_", np.array(["a", "b", "c"]))):
+    for member, value in (
+        ("weights_", np.ones((7, 3))),
+        ("goal_", np.ones(2)),
+        ("centres_", np.ones((50, 2))),
+        ("start_", np.array(["a", "b", "c"])),
+    ):
         path = tmp_path / f"{member}.npz"
         path.write_bytes(model_file.read_bytes())
         rewrite_archive(path, lambda m: m.update({f"{member}.npy": npy_bytes(value)}))
@@ -396,8 +448,16 @@ def bidmp_model_bytes(tmp_path_factory):
     return save_model(model, tmp_path_factory.mktemp("bidmp") / "b.npz").read_bytes()
 
 
-@pytest.mark.parametrize("member", ["block0/enhancement_scales_", "skill_goals_", "block0/output_weights_",
-                                    "block0/mapping_range_", "dmp/weights_"])
+@pytest.mark.parametrize(
+    "member",
+    [
+        "block0/enhancement_scales_",
+        "skill_goals_",
+        "block0/output_weights_",
+        "block0/mapping_range_",
+        "dmp/weights_",
+    ],
+)
 def test_non_finite_bidmp_members_are_refused_by_name(tmp_path, bidmp_model_bytes, member):
     path = tmp_path / "b.npz"
     path.write_bytes(bidmp_model_bytes)
@@ -431,13 +491,28 @@ def test_loading_never_materialises_a_member_it_does_not_need(tmp_path, model_fi
 # --- 6. unstable settings are refused, naming the bound --------------------------------------
 def test_unstable_euler_settings_are_refused(tmp_path):
     demo = save_trajectory(curved_demo(1000, 3), tmp_path / "demo.csv")
-    assert_one_line_error(["fit", demo, "-o", tmp_path / "m.npz", "--alpha", 5000, "--protocol", "paper", "--no-time"], "dt/tau <")
+    assert_one_line_error(
+        [
+            "fit",
+            demo,
+            "-o",
+            tmp_path / "m.npz",
+            "--alpha",
+            5000,
+            "--protocol",
+            "paper",
+            "--no-time",
+        ],
+        "dt/tau <",
+    )
     assert not (tmp_path / "m.npz").exists()
     # The robot protocol integrates exactly: stable at any step, so the same gains run.
     stiff = bidmp.DMP(alpha=5000.0).fit(curved_demo(1000, 3))
     assert np.all(np.isfinite(stiff.rollout())) and np.all(np.isfinite(stiff.trajectory(dt=0.1).y))
     with pytest.raises(ValueError, match="unstable|alpha_phase"):
-        bidmp.DMP(protocol="paper", tau=0.001, alpha_phase=0.001, K="pastor").fit(curved_demo(1000, 3))
+        bidmp.DMP(protocol="paper", tau=0.001, alpha_phase=0.001, K="pastor").fit(
+            curved_demo(1000, 3)
+        )
     dmp = bidmp.DMP(protocol="paper").fit(curved_demo(1000, 3))
     dmp.tau = 0.001  # changed after fit: refused at the rollout
     with pytest.raises(ValueError, match="unstable"):
@@ -456,29 +531,36 @@ def test_the_euler_stability_bound_is_the_closed_form_one():
         assert radius == pytest.approx(abs(1 - h_alpha / 2), abs=1e-6)
     # Rollouts grow exactly where the radius says so.
     demo = curved_demo(100, 2)
-    assert np.all(np.isfinite(bidmp.DMP(protocol="paper", alpha=390.0).fit(demo).rollout(n_steps=5000)))  # h alpha = 3.9
+    assert np.all(
+        np.isfinite(bidmp.DMP(protocol="paper", alpha=390.0).fit(demo).rollout(n_steps=5000))
+    )  # h alpha = 3.9
     with pytest.raises(ValueError, match="unstable"):
         bidmp.DMP(protocol="paper", alpha=410.0).fit(demo)  # h alpha = 4.1
 
 
 BASE_SCENARIO = {
-    "name": "t", "targets": {"a": [0.0, 0.0, 0.0], "b": [10.0, 0.0, 0.0]}, "demonstrated": "a",
+    "name": "t",
+    "targets": {"a": [0.0, 0.0, 0.0], "b": [10.0, 0.0, 0.0]},
+    "demonstrated": "a",
     "demonstration": {"minimum_jerk": {"via": [[0, 0, 40], [0, 0, 0]], "n_steps": 200}},
 }
 
 
-@pytest.mark.parametrize("change, match", [
-    (lambda d: d.update(demonstration={"points": [[0, 0, 0], [1, 1, 1]]}), "at least 10"),
-    (lambda d: d.update(demonstration={"points": [[1, 1, 1]] * 20}), "identical"),
-    (lambda d: d.update(dmp={"alpha_phase": 1000}), "alpha_phase"),
-    (lambda d: d.update(dmp={"tau": 1e-9}), "tau"),
-    (lambda d: d.update(dmp={"n_kernels": 10**9}), "max_kernels"),
-    (lambda d: d["targets"].update(b=[1e12, 0, 0]), "max_abs_value"),
-    (lambda d: d.update(bidmp={"n_enhance": 10**8}), "max_hidden_nodes"),
-    (lambda d: d.update(extension={"n_samples": 10**9}), "max_roadmap_nodes"),
-    (lambda d: d.update(extension={"seed": 3}), "unknown parameter"),
-    (lambda d: d.update(seed=2**40), "seed"),
-])
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        (lambda d: d.update(demonstration={"points": [[0, 0, 0], [1, 1, 1]]}), "at least 10"),
+        (lambda d: d.update(demonstration={"points": [[1, 1, 1]] * 20}), "identical"),
+        (lambda d: d.update(dmp={"alpha_phase": 1000}), "alpha_phase"),
+        (lambda d: d.update(dmp={"tau": 1e-9}), "tau"),
+        (lambda d: d.update(dmp={"n_kernels": 10**9}), "max_kernels"),
+        (lambda d: d["targets"].update(b=[1e12, 0, 0]), "max_abs_value"),
+        (lambda d: d.update(bidmp={"n_enhance": 10**8}), "max_hidden_nodes"),
+        (lambda d: d.update(extension={"n_samples": 10**9}), "max_roadmap_nodes"),
+        (lambda d: d.update(extension={"seed": 3}), "unknown parameter"),
+        (lambda d: d.update(seed=2**40), "seed"),
+    ],
+)
 def test_scenario_check_runs_what_demo_runs(tmp_path, change, match):
     data = json.loads(json.dumps(BASE_SCENARIO))
     change(data)
@@ -498,7 +580,9 @@ def test_rollout_many_refuses_a_huge_block_and_says_how_to_chunk(tmp_path):
     assert time.perf_counter() - started < 2.0
     goals = np.random.default_rng(0).normal(size=(300, 2))
     expected = dmp.rollout_many(goals)
-    out = np.lib.format.open_memmap(tmp_path / "r.npy", mode="w+", dtype="float64", shape=expected.shape)
+    out = np.lib.format.open_memmap(
+        tmp_path / "r.npy", mode="w+", dtype="float64", shape=expected.shape
+    )
     assert dmp.rollout_many(goals, out=out) is out
     np.testing.assert_array_equal(np.load(tmp_path / "r.npy"), expected)
     chunks = list(dmp.iter_rollouts(goals, chunk_size=64))
@@ -523,11 +607,15 @@ def test_scenario_files_stay_inside_the_scenario_folder(tmp_path):
         assert "admin" not in err and "hunter2" not in err
         # Allowed explicitly, the file is read, and its text is never quoted whole (a column of text
         # in every row is named by its header only).
-        err = assert_one_line_error(["scenario", "check", path, "--allow-outside-files"], "holds text, not numbers")
+        err = assert_one_line_error(
+            ["scenario", "check", path, "--allow-outside-files"], "holds text, not numbers"
+        )
         assert "hunter2hunter2" not in err
     inside = folder / "demo.csv"
     save_trajectory(curved_demo(100, 3), inside)
-    (folder / "s.json").write_text(json.dumps(dict(BASE_SCENARIO, demonstration={"file": "demo.csv"})))
+    (folder / "s.json").write_text(
+        json.dumps(dict(BASE_SCENARIO, demonstration={"file": "demo.csv"}))
+    )
     code, out, err = cli(["scenario", "check", folder / "s.json"])
     assert code == 0, err
 
@@ -564,7 +652,11 @@ def test_numba_without_a_writable_cache_compiles_in_memory():
 
 def test_utf8_bom_csv_is_read(tmp_path):
     path = tmp_path / "excel.csv"
-    path.write_bytes(b"\xef\xbb\xbf" + b"t,x,y\n" + b"".join(f"{i / 100},{i},{i * i / 50}\n".encode() for i in range(20)))
+    path.write_bytes(
+        b"\xef\xbb\xbf"
+        + b"t,x,y\n"
+        + b"".join(f"{i / 100},{i},{i * i / 50}\n".encode() for i in range(20))
+    )
     assert load_trajectory(path).shape == (20, 2)
 
 
@@ -593,7 +685,9 @@ def test_long_noisy_minimum_jerk_is_fast_and_equals_the_direct_filter():
     from bidmp._noise import _low_pass
 
     noise = np.random.default_rng(1).normal(size=(30_000, 3))
-    np.testing.assert_allclose(_low_pass(noise, 600.0), gaussian_filter1d(noise, 600.0, axis=0), atol=1e-12)
+    np.testing.assert_allclose(
+        _low_pass(noise, 600.0), gaussian_filter1d(noise, 600.0, axis=0), atol=1e-12
+    )
     started = time.perf_counter()
     y = bidmp.demonstrations.minimum_jerk([[0, 0, 0], [100, 50, 20]], 1_000_000, noise=1.0)
     assert time.perf_counter() - started < 5.0 and np.all(np.isfinite(y))

@@ -5,10 +5,9 @@ import json
 import numpy as np
 import pytest
 
-from bidmp.tasks import scenarios
 from bidmp.cli import main
 from bidmp.io import save_trajectory
-from bidmp.tasks import ScenarioError
+from bidmp.tasks import ScenarioError, scenarios
 
 
 def nut_spec():
@@ -16,15 +15,32 @@ def nut_spec():
 
 
 def test_builtins_load_and_have_the_spec_geometry():
-    assert scenarios.builtin_names() == ["cell-removal", "nut-unscrewing", "nut-unscrewing-iiwa", "nut-unscrewing-tilted",
-                                        "nut-unscrewing-ur5", "nut-unscrewing-xarm6", "pick-and-place"]
+    assert scenarios.builtin_names() == [
+        "cell-removal",
+        "nut-unscrewing",
+        "nut-unscrewing-iiwa",
+        "nut-unscrewing-tilted",
+        "nut-unscrewing-ur5",
+        "nut-unscrewing-xarm6",
+        "pick-and-place",
+    ]
     nut = scenarios.load("nut-unscrewing")
     assert len(nut.targets) == 14 and nut.demonstrated == "3"
     np.testing.assert_array_equal(nut.targets["3"], [0, 0, 0])
     # The paper's numbering: row y = 0: 3, 4, 5, 6, 9, 10, 11; row y = 50: 2, 1, 7, 8, 14, 13, 12.
     row0 = [label for label, p in sorted(nut.targets.items(), key=lambda kv: kv[1][0]) if p[1] == 0]
-    row50 = [label for label, p in sorted(nut.targets.items(), key=lambda kv: kv[1][0]) if p[1] == 50]
-    assert row0 == ["3", "4", "5", "6", "9", "10", "11"] and row50 == ["2", "1", "7", "8", "14", "13", "12"]
+    row50 = [
+        label for label, p in sorted(nut.targets.items(), key=lambda kv: kv[1][0]) if p[1] == 50
+    ]
+    assert row0 == ["3", "4", "5", "6", "9", "10", "11"] and row50 == [
+        "2",
+        "1",
+        "7",
+        "8",
+        "14",
+        "13",
+        "12",
+    ]
     assert nut.demonstration.shape == (200, 3)
     np.testing.assert_allclose(nut.demonstration[[0, -1]], [[-80, -120, 200], [0, 0, 0]])
     for name in ("cell-removal", "pick-and-place"):
@@ -76,16 +92,30 @@ MALFORMED = [
     (lambda d: d["dmp"].update(alpha=-5), "dmp: alpha must be > 0"),
     (lambda d: d.update(methods=["dmp", "magic"]), "methods: unknown method 'magic'"),
     (lambda d: d.update(extension_target="middle"), "extension_target: 'middle' is neither"),
-    (lambda d: d.update(demonstration={"minimum_jerk": {"via": [[0, 0, 0]]}}), "via: expected a list of at least 2 points"),
-    (lambda d: d.update(demonstration={"minimum_jerk": {"via": [[0, 0, 1], [0, 0, 0]], "speed": 3}}), "minimum_jerk.speed: unknown key"),
-    (lambda d: d.update(demonstration={"points": [[0, 0, 0], [1, 1, 1]], "file": "x.csv"}), "demonstration: expected exactly one of"),
+    (
+        lambda d: d.update(demonstration={"minimum_jerk": {"via": [[0, 0, 0]]}}),
+        "via: expected a list of at least 2 points",
+    ),
+    (
+        lambda d: d.update(
+            demonstration={"minimum_jerk": {"via": [[0, 0, 1], [0, 0, 0]], "speed": 3}}
+        ),
+        "minimum_jerk.speed: unknown key",
+    ),
+    (
+        lambda d: d.update(demonstration={"points": [[0, 0, 0], [1, 1, 1]], "file": "x.csv"}),
+        "demonstration: expected exactly one of",
+    ),
     (lambda d: d.update(demonstration={"file": "missing.csv"}), "demonstration.file:"),
     (lambda d: d.update(extensions=[{"target": "3", "from": "previous"}]), "extensions[0].from"),
     (lambda d: d.update(seed=-2), "seed: expected an integer in [0, 2**32)"),
     (lambda d: d["dmp"].update(fit="ridge"), "dmp.fit: renamed to 'regression'"),
     (lambda d: d.update(bidmp={"reg": -1.0}), "bidmp: reg must be >= 0"),
     (lambda d: d.update(bidmp={"n_nodes": 3}), "bidmp.n_nodes: unknown parameter"),
-    (lambda d: d.update(extension={"n_iterations": 3}), "extension.n_iterations: unknown parameter"),
+    (
+        lambda d: d.update(extension={"n_iterations": 3}),
+        "extension.n_iterations: unknown parameter",
+    ),
 ]
 
 
@@ -119,9 +149,16 @@ def test_not_json_and_unknown_builtin(tmp_path):
 def test_scenario_sets_bidmp_and_extension_parameters():
     from bidmp.tasks import evaluate
 
-    data = mutate(lambda d: d.update(bidmp={"reg": 1e-2, "increments": [5]}, extension={"n_iter": 3, "n_samples": 120}))
+    data = mutate(
+        lambda d: d.update(
+            bidmp={"reg": 1e-2, "increments": [5]}, extension={"n_iter": 3, "n_samples": 120}
+        )
+    )
     scenario = scenarios.from_dict(data)
-    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension == {"n_iter": 3, "n_samples": 120}
+    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension == {
+        "n_iter": 3,
+        "n_samples": 120,
+    }
     report = evaluate(scenario, ["bidmp"])
     assert report.model.reg == 1e-2 and report.model.increments == (5,)
     assert report.extensions[0].similarity_history.shape == (3,)

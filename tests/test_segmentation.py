@@ -54,7 +54,9 @@ def test_corners_found_in_2d_and_3d_over_many_seeds():
     # dimensions x 30 seeds the corners are recovered in >= 97 % of the cases (measured 179/180).
     outcomes = [
         corners_recovered(noisy_polyline(vertices, seed=seed, n_dims=n_dims), vertices)
-        for vertices in POLYLINES.values() for n_dims in (2, 3) for seed in range(30)
+        for vertices in POLYLINES.values()
+        for n_dims in (2, 3)
+        for seed in range(30)
     ]
     assert np.mean(outcomes) >= 0.97
 

@@ -11,9 +11,8 @@ import pytest
 pytest.importorskip("pybullet")
 
 from bidmp import sim  # noqa: E402
-from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.tasks import evaluate# noqa: E402
+from bidmp.tasks import evaluate, scenarios  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
 
@@ -39,12 +38,19 @@ def point_to_path(points, path):
     """Distance from each point to the polyline ``path`` (both (n, 3))."""
     a, b = path[:-1], path[1:]
     ab = b - a
-    t = np.clip(np.einsum("pkd,kd->pk", points[:, None] - a[None], ab) / np.maximum((ab * ab).sum(1), 1e-30), 0.0, 1.0)
+    t = np.clip(
+        np.einsum("pkd,kd->pk", points[:, None] - a[None], ab)
+        / np.maximum((ab * ab).sum(1), 1e-30),
+        0.0,
+        1.0,
+    )
     nearest = a[None] + t[..., None] * ab[None]
     return np.min(np.linalg.norm(points[:, None] - nearest, axis=2), axis=1)
 
 
-def test_forward_kinematics_of_the_executed_joints_follows_the_commanded_path(cell, nut, nut_report):
+def test_forward_kinematics_of_the_executed_joints_follows_the_commanded_path(
+    cell, nut, nut_report
+):
     rollout = nut_report.methods["bidmp"].rollouts["12"]
     plan = cell.plan(rollout, "12")
     run = cell.execute(plan, exclude=["12"])
@@ -57,11 +63,15 @@ def test_forward_kinematics_of_the_executed_joints_follows_the_commanded_path(ce
     np.testing.assert_allclose(executed, run.tcp[::25] / cell.unit, atol=1e-6)
     assert np.linalg.norm(run.tcp[-1] / cell.unit - rollout[-1]) <= 0.1
     assert not run.contacts
-    assert plan.peak_velocity <= 1.0 and plan.peak_acceleration == pytest.approx(sim.backend.LIMIT_MARGIN, rel=1e-6)
+    assert plan.peak_velocity <= 1.0 and plan.peak_acceleration == pytest.approx(
+        sim.backend.LIMIT_MARGIN, rel=1e-6
+    )
 
 
 def test_a_motion_through_a_stud_is_a_contact_with_that_stud(cell):
-    sweep = np.column_stack([np.linspace(0, 30, 60), np.zeros(60), np.full(60, 8.0)])  # 8 mm up, into stud 4
+    sweep = np.column_stack(
+        [np.linspace(0, 30, 60), np.zeros(60), np.full(60, 8.0)]
+    )  # 8 mm up, into stud 4
     run = cell.execute(cell.plan(sweep, "sweep"), exclude=["3"])
     assert "4/stud" in run.contacts and run.contacts["4/stud"] > 0
 
@@ -82,9 +92,13 @@ def test_the_commanded_penetration_is_reported_beside_the_contact(cell, nut):
     commanded = run.commanded_tcp / cell.unit
     horizontal = 12.5 + 4.0 - np.linalg.norm(commanded[:, :2] - stud, axis=1)
     vertical = 14.5 - commanded[:, 2]
-    expected = np.max(np.where((horizontal > 0) & (vertical > 0), np.minimum(horizontal, vertical), 0.0))
+    expected = np.max(
+        np.where((horizontal > 0) & (vertical > 0), np.minimum(horizontal, vertical), 0.0)
+    )
     assert expected > 5.0 and depth == pytest.approx(expected, abs=0.05)
-    assert depth > 100 * run.contacts["4/stud"] / cell.unit  # the contact the physics reports is far smaller
+    assert (
+        depth > 100 * run.contacts["4/stud"] / cell.unit
+    )  # the contact the physics reports is far smaller
 
 
 def test_an_unreachable_target_is_a_row_with_its_reason_and_the_run_goes_on(nut, capsys, tmp_path):
@@ -95,20 +109,52 @@ def test_an_unreachable_target_is_a_row_with_its_reason_and_the_run_goes_on(nut,
     spec["methods"] = ["dmp"]
     far = scenarios.from_dict(spec)
     result = sim.simulate(far, ["dmp"], targets=["far", "3"], workers=1).methods["dmp"]
-    assert not result.targets["far"].ran and "target far is unreachable for the panda" in result.targets["far"].reason
+    assert (
+        not result.targets["far"].ran
+        and "target far is unreachable for the panda" in result.targets["far"].reason
+    )
     assert result.targets["3"].ran and result.targets["3"].task_success(1.75)
     path = tmp_path / "far.json"
     path.write_text(json.dumps(spec))
-    assert main(["sim", "--scenario", str(path), "--methods", "dmp", "--targets", "far,3", "--workers", "1",
-                 "--no-pictures", "--out", str(tmp_path / "o")]) == 3
+    assert (
+        main(
+            [
+                "sim",
+                "--scenario",
+                str(path),
+                "--methods",
+                "dmp",
+                "--targets",
+                "far,3",
+                "--workers",
+                "1",
+                "--no-pictures",
+                "--out",
+                str(tmp_path / "o"),
+            ]
+        )
+        == 3
+    )
     out = capsys.readouterr().out
     assert "dmp: 1 of 2 targets failed" in out and "  far: target far is unreachable" in out
 
 
 def test_closed_loop_pauses_for_a_held_joint_and_still_engages(nut, nut_report):
     hold = sim.Hold(joint=1, start=3.5, duration=0.5)  # joint 2 held while the socket comes down
-    runs = {closed: sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, closed_loop=closed,
-                                 hold=hold).methods["bidmp"].targets["12"] for closed in (False, True)}
+    runs = {
+        closed: sim.simulate(
+            nut,
+            ["bidmp"],
+            targets=["12"],
+            report=nut_report,
+            workers=1,
+            closed_loop=closed,
+            hold=hold,
+        )
+        .methods["bidmp"]
+        .targets["12"]
+        for closed in (False, True)
+    }
     open_loop, closed_loop = runs[False], runs[True]
     # Open loop the command runs on: the held arm falls behind, then lunges and misses the axis.
     assert open_loop.tracking_error > 20.0 and (not open_loop.engaged or open_loop.contacts)
@@ -116,39 +162,79 @@ def test_closed_loop_pauses_for_a_held_joint_and_still_engages(nut, nut_report):
     # Closed loop the motion's time stands still while the joint is held, then it engages.
     assert closed_loop.paused >= 0.3
     assert closed_loop.engaged and not closed_loop.contacts and closed_loop.measured_error <= 1.75
-    assert closed_loop.within_limits and closed_loop.task_success(1.75)  # the command's rate limiter
+    assert closed_loop.within_limits and closed_loop.task_success(
+        1.75
+    )  # the command's rate limiter
     assert closed_loop.tracking_error < open_loop.tracking_error / 3
 
 
-def test_a_perception_update_mid_motion_moves_the_nut_and_the_closed_loop_still_engages_it(nut, nut_report):
+def test_a_perception_update_mid_motion_moves_the_nut_and_the_closed_loop_still_engages_it(
+    nut, nut_report
+):
     """at 1.5 s the nut turns out 5 mm further in x; the part moves in
     the world, the stepper's goal with it (steered round the other parts too), and the socket
     comes down on the moved nut: engaged and within 1.75 mm of it (so 3.25 mm or more from where it
     was seen), no contact, within limits. The same run without the update engages the nut where it
     was seen."""
     update = sim.GoalUpdate(1.5, (5.0, 0.0, 0.0))
-    moved = sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, closed_loop=True, avoid=True,
-                         goal_update=update).methods["bidmp"].targets["12"]
+    moved = (
+        sim.simulate(
+            nut,
+            ["bidmp"],
+            targets=["12"],
+            report=nut_report,
+            workers=1,
+            closed_loop=True,
+            avoid=True,
+            goal_update=update,
+        )
+        .methods["bidmp"]
+        .targets["12"]
+    )
     assert moved.engaged and not moved.contacts and moved.measured_error <= 1.75
     assert moved.within_limits and moved.task_success(1.75)
-    still = sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, closed_loop=True,
-                         avoid=True).methods["bidmp"].targets["12"]
+    still = (
+        sim.simulate(
+            nut,
+            ["bidmp"],
+            targets=["12"],
+            report=nut_report,
+            workers=1,
+            closed_loop=True,
+            avoid=True,
+        )
+        .methods["bidmp"]
+        .targets["12"]
+    )
     assert still.engaged and still.measured_error <= 1.75
     with pytest.raises(ValueError, match="closed_loop"):
-        sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, goal_update=update)
+        sim.simulate(
+            nut, ["bidmp"], targets=["12"], report=nut_report, workers=1, goal_update=update
+        )
 
 
 def test_workers_do_not_change_the_results(nut, nut_report):
-    serial = sim.simulate(nut, ["bidmp"], targets=["4", "11"], report=nut_report, workers=1).to_dict()
-    parallel = sim.simulate(nut, ["bidmp"], targets=["4", "11"], report=nut_report, workers=2).to_dict()
+    serial = sim.simulate(
+        nut, ["bidmp"], targets=["4", "11"], report=nut_report, workers=1
+    ).to_dict()
+    parallel = sim.simulate(
+        nut, ["bidmp"], targets=["4", "11"], report=nut_report, workers=2
+    ).to_dict()
     assert serial["methods"] == parallel["methods"]
 
 
 def test_a_layout_from_a_file_with_another_robot_base(tmp_path, nut):
     spec = nut.to_dict()
-    spec["targets"] = {f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)}
+    spec["targets"] = {
+        f"r{row}c{col}": [35.0 * col, 45.0 * row, 0.0] for row in range(3) for col in range(5)
+    }
     spec["demonstrated"] = "r0c0"
-    spec["scene"]["parts"][0] = {"type": "plate", "label": "plate", "at": [70, 45, -2], "size": [240, 160, 5]}
+    spec["scene"]["parts"][0] = {
+        "type": "plate",
+        "label": "plate",
+        "at": [70, 45, -2],
+        "size": [240, 160, 5],
+    }
     spec["robot"] = {"base": [200.0, -380.0, 0.0], "yaw": 100.0}
     spec["methods"] = ["dmp", "bidmp"]
     path = tmp_path / "grid.json"
@@ -171,8 +257,13 @@ def test_the_committed_nut_task_table_is_what_bidmp_sim_measures(tmp_path, capsy
     for method in ("dmp", "bidmp"):
         for target in results[method]["targets"].values():
             # (1 kHz differences of the 90 % plan: within 1 % of it)
-            assert 0.0 < target["peak_joint_jerk"] <= 0.91 and target["peak_joint_acceleration"] <= 0.91
-            assert target["measured_peak_joint_jerk"] > 0.0 and target["commanded_penetration"] == 0.0
+            assert (
+                0.0 < target["peak_joint_jerk"] <= 0.91
+                and target["peak_joint_acceleration"] <= 0.91
+            )
+            assert (
+                target["measured_peak_joint_jerk"] > 0.0 and target["commanded_penetration"] == 0.0
+            )
 
 
 def test_without_pybullet_bidmp_sim_says_how_to_install_it(monkeypatch, capsys):
@@ -183,11 +274,22 @@ def test_without_pybullet_bidmp_sim_says_how_to_install_it(monkeypatch, capsys):
 
 
 def test_pictures_are_written(tmp_path, nut, nut_report):
-    result = sim.simulate(nut, ["dmp", "bidmp"], targets=["12"], report=nut_report, workers=1,
-                          frames={("dmp", "12"): 4, ("bidmp", "12"): 4})
+    result = sim.simulate(
+        nut,
+        ["dmp", "bidmp"],
+        targets=["12"],
+        report=nut_report,
+        workers=1,
+        frames={("dmp", "12"): 4, ("bidmp", "12"): 4},
+    )
     written = {path.name for path in sim.write_sim_report(result, tmp_path)}
-    assert {"sim_results.json", "sim.md", "sim_keyframes_dmp.png", "sim_keyframes_bidmp.png",
-            "sim_12_dmp_vs_bidmp.gif"} <= written
+    assert {
+        "sim_results.json",
+        "sim.md",
+        "sim_keyframes_dmp.png",
+        "sim_keyframes_bidmp.png",
+        "sim_12_dmp_vs_bidmp.gif",
+    } <= written
     from PIL import Image
 
     with Image.open(tmp_path / "sim_12_dmp_vs_bidmp.gif") as gif:
@@ -227,12 +329,21 @@ def test_a_near_miss_of_a_nut_is_no_contact(cell, nut):
     body = next(b for b, name in cell._bodies.items() if name == label)
     centre = np.asarray(nut.targets[label]) * cell.unit
     flat_y = 6.5e-3  # a hexagon with a corner on +x has its flats at +-y
-    box = p.createCollisionShape(p.GEOM_BOX, halfExtents=[0.002, 0.005, 0.002], physicsClientId=client)
+    box = p.createCollisionShape(
+        p.GEOM_BOX, halfExtents=[0.002, 0.005, 0.002], physicsClientId=client
+    )
     for gap in (0.5e-3, 0.88e-3, 2e-3):
-        probe = p.createMultiBody(0, box, -1, (centre + [0.0, flat_y + gap + 0.005, -0.002 + 3.25e-3 / 2]).tolist(),
-                                  physicsClientId=client)
+        probe = p.createMultiBody(
+            0,
+            box,
+            -1,
+            (centre + [0.0, flat_y + gap + 0.005, -0.002 + 3.25e-3 / 2]).tolist(),
+            physicsClientId=client,
+        )
         try:
-            distance = min(point[8] for point in p.getClosestPoints(body, probe, 0.01, physicsClientId=client))
+            distance = min(
+                point[8] for point in p.getClosestPoints(body, probe, 0.01, physicsClientId=client)
+            )
         finally:
             p.removeBody(probe, physicsClientId=client)
         assert distance == pytest.approx(gap, abs=5e-5), gap

@@ -8,8 +8,13 @@ import pytest
 from bidmp.sim.backend import LIMIT_MARGIN, SIM_STEP, JointLimits
 from bidmp.sim.limits import _command_peaks, _RateLimiter
 
-LIMITS = JointLimits(lower=(-3.0,) * 7, upper=(3.0,) * 7, velocity=(2.0,) * 7, acceleration=(10.0,) * 7,
-                     jerk=(5000.0,) * 7)
+LIMITS = JointLimits(
+    lower=(-3.0,) * 7,
+    upper=(3.0,) * 7,
+    velocity=(2.0,) * 7,
+    acceleration=(10.0,) * 7,
+    jerk=(5000.0,) * 7,
+)
 
 
 def quintic(amplitude: float, duration: float) -> np.ndarray:
@@ -37,7 +42,11 @@ def test_a_move_that_starts_or_stops_with_an_acceleration_is_out_of_limits():
     s = np.arange(0.0, duration + SIM_STEP / 2, SIM_STEP) / duration
     cubic = np.outer(amplitude * (3 * s**2 - 2 * s**3), np.ones(7))
     peaks = _command_peaks(cubic, LIMITS)
-    assert peaks.velocity < 1 and peaks.acceleration < 1 and 12 * amplitude / duration**3 < 0.01 * 5000.0
+    assert (
+        peaks.velocity < 1
+        and peaks.acceleration < 1
+        and 12 * amplitude / duration**3 < 0.01 * 5000.0
+    )
     assert peaks.ends == pytest.approx(3 * amplitude / duration**2 / 10.0, rel=1e-2)
     assert peaks.jerk == pytest.approx(3 * amplitude / duration**2 / SIM_STEP / 5000.0, rel=2e-2)
     assert not peaks.within
@@ -52,14 +61,18 @@ def test_the_rate_limiter_keeps_every_command_within_the_limits_and_comes_to_res
     rng = np.random.default_rng(seed)
     n = 300
     t = np.arange(n) * 0.01
-    targets = np.sin(np.outer(t, rng.uniform(0.5, 3.0, 7)) + rng.uniform(0, 6, 7)) * rng.uniform(0.1, 1.0, 7)
+    targets = np.sin(np.outer(t, rng.uniform(0.5, 3.0, 7)) + rng.uniform(0, 6, 7)) * rng.uniform(
+        0.1, 1.0, 7
+    )
     targets[150:] += rng.uniform(-0.3, 0.3, 7)  # a jump
     targets[200:] = targets[200]  # then it stops
     limiter = _RateLimiter(targets[0], LIMITS, LIMIT_MARGIN)
     commands = []
     for previous, target in zip(np.vstack([targets[:1], targets[:-1]]), targets):
         for step in range(1, 11):
-            commands.append(limiter(previous + step / 10 * (target - previous), (target - previous) / 0.01))
+            commands.append(
+                limiter(previous + step / 10 * (target - previous), (target - previous) / 0.01)
+            )
     for _ in range(1000):  # a second of settling on the last target
         commands.append(limiter(targets[-1], np.zeros(7)))
     commands = np.array(commands)

@@ -10,7 +10,6 @@ from bidmp import frechet_distance, frechet_similarity
 from bidmp.extension import frechet_distance_reference, polyline_length
 
 
-
 def test_spec_reference_case():
     p = [[1, 1], [2, 1], [2, 2]]
     q = [[2, 2], [0, 1], [2, 4]]
@@ -67,10 +66,22 @@ def test_similarity_definition_and_options():
 @pytest.mark.parametrize(
     "call, error, match",
     [
-        (lambda: frechet_distance(np.zeros((3, 2)), np.zeros((3, 3))), ValueError, "same dimension"),
+        (
+            lambda: frechet_distance(np.zeros((3, 2)), np.zeros((3, 3))),
+            ValueError,
+            "same dimension",
+        ),
         (lambda: frechet_distance([[0.0, np.nan]], [[0.0, 0.0]]), ValueError, "NaN"),
-        (lambda: frechet_distance(np.zeros((0, 2)), np.zeros((3, 2))), ValueError, "at least 1 point"),
-        (lambda: frechet_similarity([[0.0, 0.0]], [[1.0, 1.0], [2.0, 2.0]]), ValueError, "non-zero length"),
+        (
+            lambda: frechet_distance(np.zeros((0, 2)), np.zeros((3, 2))),
+            ValueError,
+            "at least 1 point",
+        ),
+        (
+            lambda: frechet_similarity([[0.0, 0.0]], [[1.0, 1.0], [2.0, 2.0]]),
+            ValueError,
+            "non-zero length",
+        ),
         (lambda: frechet_similarity(np.eye(2), np.eye(2), denom="3"), ValueError, "denom"),
     ],
 )

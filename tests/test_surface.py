@@ -40,8 +40,24 @@ def dmp():
 
 def test_a_trajectory_without_times_is_a_type_error():
     rows = np.zeros((3, 2))
-    refused(TypeError, r"Trajectory\.t must be an array of numbers, got None", bidmp.Trajectory, None, rows, rows, rows)
-    refused(ValueError, r"Trajectory\.yd must have shape \(3, D\)", bidmp.Trajectory, np.arange(3.0), rows, rows[:2], rows)
+    refused(
+        TypeError,
+        r"Trajectory\.t must be an array of numbers, got None",
+        bidmp.Trajectory,
+        None,
+        rows,
+        rows,
+        rows,
+    )
+    refused(
+        ValueError,
+        r"Trajectory\.yd must have shape \(3, D\)",
+        bidmp.Trajectory,
+        np.arange(3.0),
+        rows,
+        rows[:2],
+        rows,
+    )
 
 
 def test_a_phase_outside_the_dmps_range_is_refused_not_overflowed(dmp):
@@ -54,21 +70,45 @@ def test_messages_name_the_argument_and_quote_at_most_ten_characters(dmp):
     message = refused(ValueError, r"set_params: unknown parameter 'bogus'", dmp.set_params, bogus=1)
     assert "alpha_phase" in message
     refused(ValueError, r"unknown parameter 'xxxxxxxxxx…'", dmp.set_params, **{"x" * 5000: 1})
-    refused(TypeError, r"forcing_increment must be callable", dmp.rollout, forcing_increment=np.zeros((3, 2)))
+    refused(
+        TypeError,
+        r"forcing_increment must be callable",
+        dmp.rollout,
+        forcing_increment=np.zeros((3, 2)),
+    )
     refused(ValueError, r"unknown LASA shape 'xxxxxxxxxx…'", lasa, "x" * 10000)
 
 
 def test_sizes_are_bounded_before_anything_is_allocated():
-    refused(ValueError, r"n_steps = 2,147,483,648 exceeds the limit max_steps", phase_grid, 2**31, 1e-9, exact=True)
-    refused(ValueError, r"n_kernels = 2,147,483,648 exceeds the limit max_kernels", kernel_centres, 2**31, 100, 0.01)
+    refused(
+        ValueError,
+        r"n_steps = 2,147,483,648 exceeds the limit max_steps",
+        phase_grid,
+        2**31,
+        1e-9,
+        exact=True,
+    )
+    refused(
+        ValueError,
+        r"n_kernels = 2,147,483,648 exceeds the limit max_kernels",
+        kernel_centres,
+        2**31,
+        100,
+        0.01,
+    )
 
 
 def test_complex_input_is_refused_not_truncated(dmp):
     refused(TypeError, r"y must be real numbers", curvature, DEMO + 1j)
     refused(TypeError, r"y must be real numbers", bidmp.DMP().fit, DEMO.astype(complex))
     model = bidmp.BiDMP(dmp)
-    refused(TypeError, r"forcing_increment must be real numbers", model.learn_increment,
-            np.zeros((dmp.n_train_, 2)) + 1j, [1.0, 2.0])
+    refused(
+        TypeError,
+        r"forcing_increment must be real numbers",
+        model.learn_increment,
+        np.zeros((dmp.n_train_, 2)) + 1j,
+        [1.0, 2.0],
+    )
 
 
 def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
@@ -76,19 +116,31 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
     a 5e8-row extent: refused up front, in one line."""
     import time
 
-    from bidmp.tasks import path_extent
-
     from bidmp.extension.similarity import frechet_distance_reference
     from bidmp.incremental.linalg import sparse_autoencoder
+    from bidmp.tasks import path_extent
 
     rng = np.random.default_rng(0)
     F, target = rng.normal(size=(30, 5)), rng.normal(size=(30, 2))
     start = time.perf_counter()
-    refused(ValueError, r"n_iter must be <= 10,000, got 10,000,000", sparse_autoencoder, F, target, 1e-3, 10**7)
+    refused(
+        ValueError,
+        r"n_iter must be <= 10,000, got 10,000,000",
+        sparse_autoencoder,
+        F,
+        target,
+        1e-3,
+        10**7,
+    )
     refused(ValueError, r"target must have 30 rows", sparse_autoencoder, F, target[:5])
     long = np.zeros((10_001, 2))
     refused(ValueError, r"use frechet_distance", frechet_distance_reference, long, long)
-    refused(ValueError, r"over the limit max_array_bytes", path_extent, np.broadcast_to(np.zeros(2), (500_000_000, 2)))
+    refused(
+        ValueError,
+        r"over the limit max_array_bytes",
+        path_extent,
+        np.broadcast_to(np.zeros(2), (500_000_000, 2)),
+    )
     assert time.perf_counter() - start < 2.0
     # Within the bounds they answer as before (the Lasso check of ADMM is in tests/test_bls.py).
     assert np.isfinite(sparse_autoencoder(F, target, 1e-3, 50)).all()
@@ -109,7 +161,9 @@ def test_the_rotation_helpers_name_their_arguments():
     refused(ValueError, r"q must have shape \(n, 4\)", angle_between, np.ones((2, 3)), unit)
     refused(ValueError, r"goal contains a zero quaternion", continuous_log, unit, np.zeros(4))
     refused(ValueError, r"r contains NaN", _left_jacobian, np.full((2, 3), np.nan))
-    refused(ValueError, r"error must have shape \(n, 3\)", orientation_from_log, np.ones((2, 4)), unit)
+    refused(
+        ValueError, r"error must have shape \(n, 3\)", orientation_from_log, np.ones((2, 4)), unit
+    )
     refused(TypeError, r"q must be real numbers", angle_between, unit.astype(complex), unit)
     turn = np.array([[0.0, 0.0, np.sin(0.5), np.cos(0.5)]])  # 1 rad about z
     assert angle_between(turn, unit)[0] == pytest.approx(1.0, abs=1e-12)
@@ -126,17 +180,41 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
     t = np.linspace(0.0, 1.0, 20)
     trajectory = timing.Trajectory(t, y, np.gradient(y, t, axis=0), np.zeros_like(y))
     q = np.tile([0.0, 0.0, 0.0, 1.0], (20, 1))
-    nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
-             np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), -t, np.zeros(20), 5.0, ["a", "b"], True,
-             y * 1e-300]
+    nasty = [
+        None,
+        "abc",
+        np.full((20, 3), np.nan),
+        np.full((20, 3), np.inf),
+        np.zeros((0, 3)),
+        np.zeros(20),
+        np.zeros((2, 20, 3)),
+        y + 1j,
+        y * 1e300,
+        np.array([object()] * 3),
+        -t,
+        np.zeros(20),
+        5.0,
+        ["a", "b"],
+        True,
+        y * 1e-300,
+    ]
     calls = [
-        lambda v: timing.check_timestamps(v, 20), lambda v: timing._drop_duplicate_stamps(v, t),
-        lambda v: timing._drop_duplicate_stamps(y, v), lambda v: timing.uniform_time(v, t), lambda v: timing.uniform_time(y, v),
-        lambda v: timing.on_uniform_time(v, t), lambda v: timing.on_uniform_time(y, v),
-        lambda v: timing.scale_factor(v, max_velocity=1.0), lambda v: timing.scale_factor(trajectory, max_velocity=v),
-        lambda v: timing.time_scale(v, max_velocity=1.0), lambda v: timing.time_scale(trajectory, max_velocity=v),
-        cartesian.as_quaternions, cartesian.as_poses, cartesian.continuous_quaternions,
-        lambda v: cartesian.orientation_error(v, q), lambda v: cartesian.orientation_error(q, v),
+        lambda v: timing.check_timestamps(v, 20),
+        lambda v: timing._drop_duplicate_stamps(v, t),
+        lambda v: timing._drop_duplicate_stamps(y, v),
+        lambda v: timing.uniform_time(v, t),
+        lambda v: timing.uniform_time(y, v),
+        lambda v: timing.on_uniform_time(v, t),
+        lambda v: timing.on_uniform_time(y, v),
+        lambda v: timing.scale_factor(v, max_velocity=1.0),
+        lambda v: timing.scale_factor(trajectory, max_velocity=v),
+        lambda v: timing.time_scale(v, max_velocity=1.0),
+        lambda v: timing.time_scale(trajectory, max_velocity=v),
+        cartesian.as_quaternions,
+        cartesian.as_poses,
+        cartesian.continuous_quaternions,
+        lambda v: cartesian.orientation_error(v, q),
+        lambda v: cartesian.orientation_error(q, v),
         lambda v: cartesian.angle_between(v, q),
     ]
     failures = nasty_failures(calls, nasty)
@@ -151,10 +229,29 @@ def test_the_roadmap_similarity_and_metric_helpers_refuse_bad_input_by_name():
     from bidmp.tasks import metrics
 
     y = np.linspace([0.0, 0.0, 0.0], [1.0, 2.0, 3.0], 20)
-    nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
-             np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
-    calls = [lambda v: roadmap.template(v, y[-1] + 5), lambda v: roadmap.template(y, v), roadmap._shortest_path,
-             similarity.polyline_length, lambda v: metrics.rmse(v, y), lambda v: metrics.rmse(y, v)]
+    nasty = [
+        None,
+        "abc",
+        np.full((20, 3), np.nan),
+        np.full((20, 3), np.inf),
+        np.zeros((0, 3)),
+        np.zeros(20),
+        np.zeros((2, 20, 3)),
+        y + 1j,
+        y * 1e300,
+        np.array([object()] * 3),
+        5.0,
+        ["a", "b"],
+        True,
+    ]
+    calls = [
+        lambda v: roadmap.template(v, y[-1] + 5),
+        lambda v: roadmap.template(y, v),
+        roadmap._shortest_path,
+        similarity.polyline_length,
+        lambda v: metrics.rmse(v, y),
+        lambda v: metrics.rmse(y, v),
+    ]
     failures = nasty_failures(calls, nasty)
     assert not failures, failures
 
@@ -173,7 +270,11 @@ def nasty_failures(calls, nasty) -> list:
             try:
                 result = call(value)
                 for part in result if isinstance(result, tuple) else (result,):
-                    values = np.asarray(getattr(part, "y", part), dtype=float) if part is not None else None
+                    values = (
+                        np.asarray(getattr(part, "y", part), dtype=float)
+                        if part is not None
+                        else None
+                    )
                     if values is not None and values.size and not np.all(np.isfinite(values)):
                         failures.append((index, case, "silent NaN/inf"))
             except (ValueError, TypeError) as exc:
@@ -189,12 +290,33 @@ def test_the_scene_helpers_refuse_bad_input_by_name():
     oriented clearance (11 cases failed before: IndexError, ComplexWarning, an overflow)."""
     from bidmp.scene import Scene
 
-    scene = Scene.from_dict({"tool": {"radius": 10, "length": 100},
-                             "parts": [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [10, 10, 10]}]})
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 10, "length": 100},
+            "parts": [{"type": "box", "label": "b", "at": [0, 0, 0], "size": [10, 10, 10]}],
+        }
+    )
     y = np.linspace([0.0, 0.0, 30.0], [50.0, 0.0, 30.0], 20)
-    nasty = [None, "abc", np.full((20, 3), np.nan), np.full((20, 3), np.inf), np.zeros((0, 3)), np.zeros(20),
-             np.zeros((2, 20, 3)), y + 1j, y * 1e300, np.array([object()] * 3), 5.0, ["a", "b"], True]
-    calls = [scene.parts_at, scene.checker(), lambda v: scene.checker().segments_free(v, y),
-             lambda v: scene.clearance(y, orientations=v).distance]
+    nasty = [
+        None,
+        "abc",
+        np.full((20, 3), np.nan),
+        np.full((20, 3), np.inf),
+        np.zeros((0, 3)),
+        np.zeros(20),
+        np.zeros((2, 20, 3)),
+        y + 1j,
+        y * 1e300,
+        np.array([object()] * 3),
+        5.0,
+        ["a", "b"],
+        True,
+    ]
+    calls = [
+        scene.parts_at,
+        scene.checker(),
+        lambda v: scene.checker().segments_free(v, y),
+        lambda v: scene.clearance(y, orientations=v).distance,
+    ]
     failures = nasty_failures(calls, nasty)
     assert not failures, failures

@@ -11,11 +11,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_random_user_cells import UNITS, check_clear, check_commands, check_end_and_descent, one_sentence
+from test_random_user_cells import (
+    UNITS,
+    check_clear,
+    check_commands,
+    check_end_and_descent,
+    one_sentence,
+)
 
-from bidmp.tasks import scenarios
 from bidmp.cli import main
-from bidmp.tasks import evaluate
+from bidmp.tasks import evaluate, scenarios
 
 pytest.importorskip("pybullet")
 from bidmp import sim  # noqa: E402
@@ -33,7 +38,9 @@ def spec(name: str, units: str = "mm") -> dict:
     data["name"] += f"-{units}"
     data["units"] = units
     data["targets"] = {k: [v * f for v in p] for k, p in data["targets"].items()}
-    data["demonstration"]["minimum_jerk"]["via"] = [[v * f for v in p] for p in data["demonstration"]["minimum_jerk"]["via"]]
+    data["demonstration"]["minimum_jerk"]["via"] = [
+        [v * f for v in p] for p in data["demonstration"]["minimum_jerk"]["via"]
+    ]
     data["success_threshold"] *= f
     data["approach_height"] *= f
     if "base" in data.get("robot", {}):
@@ -82,7 +89,12 @@ def test_two_posts_in_the_nut_task_every_nut_within_the_contract_by_a_lift(posts
     report = evaluate(scenario, ["dmp", "bidmp"])
     bidmp = report.methods["bidmp"]
     assert bidmp.task_successes == 14 and report.methods["dmp"].task_successes < 14
-    assert {label: bidmp.repaired_at(label) for label in bidmp.repairs} == {"8": "lift", "12": "lift", "13": "lift", "14": "lift"}
+    assert {label: bidmp.repaired_at(label) for label in bidmp.repairs} == {
+        "8": "lift",
+        "12": "lift",
+        "13": "lift",
+        "14": "lift",
+    }
     check_evaluation(report, data)
     check_evaluation(report, data, "dmp")  # its failures must each say why
 
@@ -114,7 +126,12 @@ def test_a_cable_duct_between_the_demonstration_and_the_far_nuts_in_any_unit(uni
     report = evaluate(scenarios.from_dict(data), ["dmp", "bidmp"])
     bidmp = report.methods["bidmp"]
     assert bidmp.task_successes == 8 and report.methods["dmp"].task_successes == 4
-    assert sorted(label for label in bidmp.repairs if bidmp.repaired_at(label)) == ["A3", "A4", "B3", "B4"]
+    assert sorted(label for label in bidmp.repairs if bidmp.repaired_at(label)) == [
+        "A3",
+        "A4",
+        "B3",
+        "B4",
+    ]
     check_evaluation(report, data)
 
 
@@ -154,9 +171,25 @@ def test_a_nut_no_motion_can_engage_is_refused_at_once_naming_the_part(tmp_path,
     assert bidmp.repairs["B4"].attempts == [] and "no motion can engage it" in bidmp.reason_at("B4")
     assert "tray" in bidmp.reason_at("B4")
     (tmp_path / "cell.json").write_text(json.dumps(data))
-    assert main(["demo", "--scenario", str(tmp_path / "cell.json"), "--methods", "bidmp", "--out", str(tmp_path / "out")]) == 3
+    assert (
+        main(
+            [
+                "demo",
+                "--scenario",
+                str(tmp_path / "cell.json"),
+                "--methods",
+                "bidmp",
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 3
+    )
     out = capsys.readouterr().out
-    assert "1 still fail:" in out and "  B4: the motion to B4 cannot be repaired: no motion can engage it" in out
+    assert (
+        "1 still fail:" in out
+        and "  B4: the motion to B4 cannot be repaired: no motion can engage it" in out
+    )
 
 
 def test_every_part_type_runs_through_the_evaluation_the_simulator_and_the_job():
@@ -164,17 +197,38 @@ def test_every_part_type_runs_through_the_evaluation_the_simulator_and_the_job()
     the bin: nothing raises (a cylinder ended the simulator and the job with an IndexError before)."""
     data = spec("duct_module.json")
     data["scene"]["parts"] += [
-        {"type": "cylinder", "label": "post", "at": [-45.0, 45.0, -2.0], "radius": 5.0, "height": 70.0},
-        {"type": "cylinder", "label": "boss", "at": [-45.0, 0.0, -2.0], "radius": 8.0, "height": 12.0},
+        {
+            "type": "cylinder",
+            "label": "post",
+            "at": [-45.0, 45.0, -2.0],
+            "radius": 5.0,
+            "height": 70.0,
+        },
+        {
+            "type": "cylinder",
+            "label": "boss",
+            "at": [-45.0, 0.0, -2.0],
+            "radius": 8.0,
+            "height": 12.0,
+        },
         {"type": "box", "label": "block", "at": [170.0, 90.0, -2.0], "size": [20.0, 20.0, 30.0]},
         {"type": "cell", "label": "spare", "at": [120.0, 100.0, -2.0], "size": [20.0, 30.0, 30.0]},
-        {"type": "box", "label": "bracket", "at": [20.0, 100.0, 20.0], "size": [40.0, 30.0, 4.0], "rotation": [15.0, 0.0, 0.0]}]
+        {
+            "type": "box",
+            "label": "bracket",
+            "at": [20.0, 100.0, 20.0],
+            "size": [40.0, 30.0, 4.0],
+            "rotation": [15.0, 0.0, 0.0],
+        },
+    ]
     scenario = scenarios.from_dict(data)
     labels = {part.type for part in scenario.scene.parts}
     assert labels == {"plate", "nut", "box", "cylinder", "cell"}
     report = evaluate(scenario, ["bidmp"])
     check_evaluation(report, data)
-    result = sim.simulate(scenario, ["bidmp"], targets=["A4"], workers=1).methods["bidmp"].targets["A4"]
+    result = (
+        sim.simulate(scenario, ["bidmp"], targets=["A4"], workers=1).methods["bidmp"].targets["A4"]
+    )
     assert result.ran and (result.task_success(1.75) or result.reason)
     job = sim.run_job(scenario, targets=["A2"])
     assert job.targets[0].removed or job.targets[0].reason
@@ -184,10 +238,25 @@ def test_a_job_target_that_fails_is_a_row_and_the_command_exits_3(tmp_path, caps
     """The tray over B4: the job refuses its approach with the reason and takes the next nut off."""
     data = blocked_cell()
     (tmp_path / "cell.json").write_text(json.dumps(data))
-    assert main(["job", "--scenario", str(tmp_path / "cell.json"), "--targets", "B4,A2", "--no-pictures",
-                 "--out", str(tmp_path / "job")]) == 3
+    assert (
+        main(
+            [
+                "job",
+                "--scenario",
+                str(tmp_path / "cell.json"),
+                "--targets",
+                "B4,A2",
+                "--no-pictures",
+                "--out",
+                str(tmp_path / "job"),
+            ]
+        )
+        == 3
+    )
     out = capsys.readouterr().out
-    assert "1 of 2 not removed:" in out and "B4: approach: the motion to B4 cannot be repaired" in out
+    assert (
+        "1 of 2 not removed:" in out and "B4: approach: the motion to B4 cannot be repaired" in out
+    )
     rows = json.loads((tmp_path / "job" / "job_results.json").read_text())["targets"]
     assert {row["target"]: row["removed"] for row in rows} == {"B4": False, "A2": True}
 
@@ -206,4 +275,6 @@ def test_the_job_on_a_tilted_pack_takes_a_nut_off_along_its_axis():
     axis = scenario.target_axis("12")
     unscrew = next(phase for phase in record.phases if phase.name == "unscrew").path
     travel = unscrew[-1] - unscrew[0]
-    assert np.degrees(np.arccos(travel @ axis / np.linalg.norm(travel))) < 1.0  # up the nut's own axis
+    assert (
+        np.degrees(np.arccos(travel @ axis / np.linalg.norm(travel))) < 1.0
+    )  # up the nut's own axis

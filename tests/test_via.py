@@ -21,7 +21,9 @@ def random_dmp(seed: int, protocol: str = "robot"):
     unit = float(rng.choice([1.0, 1e-3]))
     points = np.cumsum(rng.uniform(-80, 80, (3, 3)), axis=0) * unit
     n, duration = int(rng.integers(100, 400)), float(rng.uniform(1.5, 4.0))
-    dmp = DMP(protocol=protocol, n_kernels=int(rng.integers(20, 60))).fit(minimum_jerk(points, n), np.linspace(0, duration, n))
+    dmp = DMP(protocol=protocol, n_kernels=int(rng.integers(20, 60))).fit(
+        minimum_jerk(points, n), np.linspace(0, duration, n)
+    )
     return rng, unit, dmp
 
 
@@ -42,8 +44,10 @@ def test_the_response_matrix_equals_perturbed_rollouts(protocol):
     base = dmp.trajectory(dt=dt)
     measured = np.empty_like(fast)
     for kernel in range(dmp.weights_.shape[0]):
+
         def bump(_, rows, kernel=kernel):
             return rows[:, [kernel]] @ np.array([[1.0, 0.0, 0.0]])
+
         moved = dmp.trajectory(dt=dt, forcing_increment=bump)
         measured[:, kernel] = [sample_at(moved, t)[0] - sample_at(base, t)[0] for t in times]
     np.testing.assert_allclose(fast, measured, rtol=1e-7, atol=1e-9 * np.abs(measured).max())
@@ -56,13 +60,21 @@ def test_via_points_are_passed_exactly_with_the_least_norm_change(seed):
     dt = None if protocol == "paper" else float(rng.choice([0.001, 0.004, 0.0073]))
     plain = dmp.trajectory(dt=dt)
     motion = dmp.duration_ * dmp._params().tau
-    times = np.sort(rng.choice(np.linspace(0.1, 0.9, 17), size=int(rng.integers(1, 4)), replace=False)) * motion
+    times = (
+        np.sort(rng.choice(np.linspace(0.1, 0.9, 17), size=int(rng.integers(1, 4)), replace=False))
+        * motion
+    )
     times += rng.uniform(0, 0.3) * (plain.t[1] - plain.t[0])  # between samples too
-    points = np.array([sample_at(plain, t) for t in times]) + rng.uniform(-10, 10, (times.size, 3)) * unit
+    points = (
+        np.array([sample_at(plain, t) for t in times])
+        + rng.uniform(-10, 10, (times.size, 3)) * unit
+    )
     via = list(zip(times, points))
     try:
         result = dmp.trajectory(dt=dt, via=via)
-    except ValueError as refused:  # a late via-point whose kernels would still act at the end: said, not done
+    except (
+        ValueError
+    ) as refused:  # a late via-point whose kernels would still act at the end: said, not done
         assert protocol == "robot" and "put the via-points earlier" in str(refused)
         return
     for t, point in via:
@@ -77,14 +89,21 @@ def test_via_points_are_passed_exactly_with_the_least_norm_change(seed):
     if protocol == "robot":
         corners = np.vstack([dmp.goal_, dmp.start_, points])
         reach = np.max(np.linalg.norm(corners[:, None] - corners[None], axis=2))
-        assert np.linalg.norm(result.y[-1] - dmp.goal_) <= 1.1e-4 * reach + np.linalg.norm(plain.y[-1] - dmp.goal_)
-        assert np.linalg.norm(result.yd[-1]) <= 1.1e-2 * reach / result.t[-1] + np.linalg.norm(plain.yd[-1])
+        assert np.linalg.norm(result.y[-1] - dmp.goal_) <= 1.1e-4 * reach + np.linalg.norm(
+            plain.y[-1] - dmp.goal_
+        )
+        assert np.linalg.norm(result.yd[-1]) <= 1.1e-2 * reach / result.t[-1] + np.linalg.norm(
+            plain.yd[-1]
+        )
 
 
 def _measured_least_norm_change(dmp, dt, plain, times, points):
     response = np.empty((times.size, dmp.weights_.shape[0]))
     for kernel in range(response.shape[1]):
-        moved = dmp.trajectory(dt=dt, forcing_increment=lambda _, rows, kernel=kernel: rows[:, [kernel]] @ np.ones((1, 3)))
+        moved = dmp.trajectory(
+            dt=dt,
+            forcing_increment=lambda _, rows, kernel=kernel: rows[:, [kernel]] @ np.ones((1, 3)),
+        )
         response[:, kernel] = [sample_at(moved, t)[0] - sample_at(plain, t)[0] for t in times]
     residual = points - np.array([sample_at(plain, t) for t in times])
     return np.linalg.pinv(response) @ residual
@@ -93,7 +112,9 @@ def _measured_least_norm_change(dmp, dt, plain, times, points):
 def test_via_points_for_a_bidmp_skill():
     demonstration = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 200)
     dmp = DMP().fit(demonstration, np.linspace(0, 2, 200))
-    model = BiDMP(dmp).learn(minimum_jerk([[0, 0, 60], [150, 40, 60], [200, 50, 0]], 200), duration=2.0)
+    model = BiDMP(dmp).learn(
+        minimum_jerk([[0, 0, 60], [150, 40, 60], [200, 50, 0]], 200), duration=2.0
+    )
     trajectory = model.trajectory([200, 50, 0], via=[(1.0, [120, 30, 70])], dt=0.002)
     assert np.max(np.abs(sample_at(trajectory, 1.0) - [120, 30, 70])) <= 1e-6
 
@@ -104,7 +125,10 @@ def test_via_points_the_kernels_cannot_carry_are_refused():
     cases = [
         ([(3.5, [0, 0, 0])], "duration"),
         ([(0.0, [1, 1, 1])], "cannot carry"),
-        ([(1.0, [0, 0, 0]), (1.0001, [50, 0, 0])], "cannot carry|peak acceleration|still act at the motion.s end"),
+        (
+            [(1.0, [0, 0, 0]), (1.0001, [50, 0, 0])],
+            "cannot carry|peak acceleration|still act at the motion.s end",
+        ),
         ([(0.1 * k + 0.1, [50, 0, 60]) for k in range(11)], "at most 10"),
         ([(1.0, [1, 2, 3]), (1.0, [1, 2, 3])], "same time"),
         ([(1.0, [1, 2])], "via\\[0\\] point"),
@@ -129,8 +153,12 @@ def test_via_poses_for_a_multi_turn_cartesian_dmp():
 
     s = np.linspace(0.0, 1.0, 200)
     turn = Rotation.from_rotvec(np.outer(10 * s**3 - 15 * s**4 + 6 * s**5, [0.3, -0.8, 5.2]))
-    poses = np.hstack([minimum_jerk(np.array([[0.0, 0, 100], [80, 20, 40], [150, 25, 0]]), 200),
-                       (turn * Rotation.from_euler("x", 180, degrees=True)).as_quat()])
+    poses = np.hstack(
+        [
+            minimum_jerk(np.array([[0.0, 0, 100], [80, 20, 40], [150, 25, 0]]), 200),
+            (turn * Rotation.from_euler("x", 180, degrees=True)).as_quat(),
+        ]
+    )
     model = CartesianDMP().fit(poses, np.linspace(0.0, 2.0, 200), units="mm")
     plain = model.trajectory(dt=0.001)
     k = 900
@@ -147,14 +175,48 @@ def test_the_cli_passes_via_points_and_names_a_bad_one(tmp_path, capsys):
     from bidmp.cli import main
 
     demonstration = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
-    np.savetxt(tmp_path / "demo.csv", np.column_stack([np.linspace(0, 3, 300), demonstration]), delimiter=",",
-               header="t,x,y,z", comments="")
+    np.savetxt(
+        tmp_path / "demo.csv",
+        np.column_stack([np.linspace(0, 3, 300), demonstration]),
+        delimiter=",",
+        header="t,x,y,z",
+        comments="",
+    )
     assert main(["fit", str(tmp_path / "demo.csv"), "-o", str(tmp_path / "m.npz")]) == 0
     out = tmp_path / "r.csv"
-    assert main(["rollout", str(tmp_path / "m.npz"), "--rate", "1000", "--via", "1.25", "60", "20", "75",
-                 "--via", "2", "110", "5", "30", "-o", str(out)]) == 0
+    assert (
+        main(
+            [
+                "rollout",
+                str(tmp_path / "m.npz"),
+                "--rate",
+                "1000",
+                "--via",
+                "1.25",
+                "60",
+                "20",
+                "75",
+                "--via",
+                "2",
+                "110",
+                "5",
+                "30",
+                "-o",
+                str(out),
+            ]
+        )
+        == 0
+    )
     rows = np.loadtxt(out, delimiter=",", skiprows=1)
     for t, point in ((1.25, [60, 20, 75]), (2.0, [110, 5, 30])):
-        assert np.max(np.abs(np.array([np.interp(t, rows[:, 0], rows[:, k]) for k in (1, 2, 3)]) - point)) <= 1e-6
-    assert main(["rollout", str(tmp_path / "m.npz"), "--via", "9", "60", "20", "75", "-o", str(out)]) == 2
+        assert (
+            np.max(
+                np.abs(np.array([np.interp(t, rows[:, 0], rows[:, k]) for k in (1, 2, 3)]) - point)
+            )
+            <= 1e-6
+        )
+    assert (
+        main(["rollout", str(tmp_path / "m.npz"), "--via", "9", "60", "20", "75", "-o", str(out)])
+        == 2
+    )
     assert "duration" in capsys.readouterr().err

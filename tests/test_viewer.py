@@ -10,10 +10,9 @@ import pytest
 
 pytest.importorskip("plotly")
 
-from bidmp.tasks import scenarios  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.tasks import evaluate# noqa: E402
 from bidmp.plotting import viewer  # noqa: E402
+from bidmp.tasks import evaluate, scenarios  # noqa: E402
 
 
 def hull_volume(vertices, faces):
@@ -48,7 +47,9 @@ def test_solid_meshes_enclose_the_solids_volume(seed):
 
 
 def test_an_unknown_solid_kind_is_named():
-    with pytest.raises(ValueError, match="kind must be one of 'box', 'cylinder', 'convex'; got 'sphere'"):
+    with pytest.raises(
+        ValueError, match="kind must be one of 'box', 'cylinder', 'convex'; got 'sphere'"
+    ):
         viewer.solid_mesh("sphere", [0, 0, 0], np.eye(3), (1.0,))
 
 
@@ -59,25 +60,39 @@ def nut_layers():
 
     nut = scenarios.load("nut-unscrewing")
     report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
-    result = sim.simulate(nut, ["bidmp"], targets=["11"], report=report, workers=1, views=[("bidmp", "11")])
+    result = sim.simulate(
+        nut, ["bidmp"], targets=["11"], report=report, workers=1, views=[("bidmp", "11")]
+    )
     return nut, viewer.add_robot_motions(viewer.layers_from_report(report), result)
 
 
 def test_the_viewer_holds_every_layer(nut_layers, tmp_path):
     nut, layers = nut_layers
     assert len(layers.segmentation) >= 1 and len(layers.extended) >= 1
-    assert set(layers.rollouts) == {"dmp", "bidmp"} and set(layers.rollouts["bidmp"]) == set(nut.targets)
+    assert set(layers.rollouts) == {"dmp", "bidmp"} and set(layers.rollouts["bidmp"]) == set(
+        nut.targets
+    )
     assert len(layers.solids) == len(nut.scene.solids)
     figure = viewer.view_figure(layers)
     names = {trace.name for trace in figure.data}
-    assert names - {None} == {"demonstration", "segmentation points", "extended demonstrations", "dmp rollouts",
-                              "dmp: breaks the contract", "bidmp rollouts", "targets", "scene parts",
-                              "robot (joint to joint)"}  # the DMP misses the far nuts: drawn as failing
+    assert names - {None} == {
+        "demonstration",
+        "segmentation points",
+        "extended demonstrations",
+        "dmp rollouts",
+        "dmp: breaks the contract",
+        "bidmp rollouts",
+        "targets",
+        "scene parts",
+        "robot (joint to joint)",
+    }  # the DMP misses the far nuts: drawn as failing
     assert len(figure.frames) == len(layers.robot["bidmp -> 11"]["times"])
     assert len(figure.layout.sliders[0].steps) == len(figure.frames)
     page = viewer.write_view(tmp_path / "view.html", layers)
     text = page.read_text()
-    assert "plotly.js v" in text and '<script src="http' not in text  # plotly.js inside: opens offline
+    assert (
+        "plotly.js v" in text and '<script src="http' not in text
+    )  # plotly.js inside: opens offline
     for name in names - {None}:
         assert json.dumps(name) in text
 
@@ -101,7 +116,9 @@ def test_layers_round_trip_and_bad_files_are_named(nut_layers, tmp_path):
     path = viewer.save_layers(tmp_path / "view_layers.npz", layers)
     back = viewer.load_layers(path)
     np.testing.assert_array_equal(back.demonstration, layers.demonstration)
-    np.testing.assert_array_equal(back.robot["bidmp -> 11"]["links"], layers.robot["bidmp -> 11"]["links"])
+    np.testing.assert_array_equal(
+        back.robot["bidmp -> 11"]["links"], layers.robot["bidmp -> 11"]["links"]
+    )
     assert back.solids == layers.solids and back.rollouts.keys() == layers.rollouts.keys()
     for method in layers.rollouts:
         for label, path_ in layers.rollouts[method].items():
@@ -134,7 +151,9 @@ def test_every_3d_figure_has_one_scale_on_its_three_axes():
     from bidmp.plotting._base import _figure, _label_axes
 
     rng = np.random.default_rng(0)
-    path = np.column_stack([np.linspace(0.0, 300.0, 50), np.linspace(0.0, 40.0, 50), 5.0 + 1e-3 * rng.normal(size=50)])
+    path = np.column_stack(
+        [np.linspace(0.0, 300.0, 50), np.linspace(0.0, 40.0, 50), 5.0 + 1e-3 * rng.normal(size=50)]
+    )
     _, _, ax = _figure(True)  # a Figure without pyplot: nothing to close
     ax.plot(*path.T)
     _label_axes(ax, 3, "mm")
@@ -151,35 +170,61 @@ def posts_report():
     return data, evaluate(scenarios.from_dict(data), ["dmp", "bidmp"])
 
 
-def test_a_failing_motion_is_drawn_in_amber_with_the_part_it_came_too_close_to(posts_report, tmp_path):
+def test_a_failing_motion_is_drawn_in_amber_with_the_part_it_came_too_close_to(
+    posts_report, tmp_path
+):
     """Independent anchor: the point each failure names lies within the tool's radius
     plus the margin of the post it names (a vertical cylinder of the spec, measured here)."""
     data, report = posts_report
     layers = viewer.layers_from_report(report)
     dmp = report.methods["dmp"]
-    assert set(layers.failures["dmp"]) == {label for label in dmp.rollouts if not dmp.task_success_at(label)}
+    assert set(layers.failures["dmp"]) == {
+        label for label in dmp.rollouts if not dmp.task_success_at(label)
+    }
     assert "bidmp" not in layers.failures  # every Bi-DMP motion keeps the contract here
-    posts = {part["label"]: part for part in data["scene"]["parts"] if part.get("type") == "cylinder"}
+    posts = {
+        part["label"]: part for part in data["scene"]["parts"] if part.get("type") == "cylinder"
+    }
     reach = data["scene"]["tool"]["radius"] + data["scene"]["margin"]
-    near_posts = {label: failure for label, failure in layers.failures["dmp"].items() if failure["part"] in posts}
+    near_posts = {
+        label: failure
+        for label, failure in layers.failures["dmp"].items()
+        if failure["part"] in posts
+    }
     assert len(near_posts) >= 2
     for label, failure in near_posts.items():
         post = posts[failure["part"]]
-        horizontal = np.hypot(failure["point"][0] - post["at"][0], failure["point"][1] - post["at"][1])
+        horizontal = np.hypot(
+            failure["point"][0] - post["at"][0], failure["point"][1] - post["at"][1]
+        )
         assert horizontal <= post["radius"] + reach + 1e-6, (label, failure)
         assert failure["reason"]
     figure = viewer.view_figure(layers)
-    amber = [trace for trace in figure.data if getattr(trace, "line", None) is not None and trace.line.color == viewer.WARNING]
-    assert len(amber) == len(layers.failures["dmp"]) and all(trace.line.dash == "dash" for trace in amber)
-    meshes = {trace.hovertext.split(":")[0]: trace.color for trace in figure.data if trace.type == "mesh3d"}
+    amber = [
+        trace
+        for trace in figure.data
+        if getattr(trace, "line", None) is not None and trace.line.color == viewer.WARNING
+    ]
+    assert len(amber) == len(layers.failures["dmp"]) and all(
+        trace.line.dash == "dash" for trace in amber
+    )
+    meshes = {
+        trace.hovertext.split(":")[0]: trace.color
+        for trace in figure.data
+        if trace.type == "mesh3d"
+    }
     for failure in near_posts.values():
         assert meshes[failure["part"]] == viewer.WARNING
-    assert meshes["plate"] != viewer.WARNING or any(f["part"] == "plate" for f in layers.failures["dmp"].values())
+    assert meshes["plate"] != viewer.WARNING or any(
+        f["part"] == "plate" for f in layers.failures["dmp"].values()
+    )
     back = viewer.load_layers(viewer.save_layers(tmp_path / "v.npz", layers))
     assert back.failures == json.loads(json.dumps(layers.failures))
 
 
-def test_the_scenario_figure_draws_every_judged_rollout_and_the_parts_as_solids(posts_report, tmp_path):
+def test_the_scenario_figure_draws_every_judged_rollout_and_the_parts_as_solids(
+    posts_report, tmp_path
+):
     """each collision mark belongs to a drawn rollout (before, the marks of GMM's
     rollouts floated where no drawn path went) and every part is a shaded solid."""
     import matplotlib
@@ -204,9 +249,14 @@ def test_the_scenario_figure_draws_every_judged_rollout_and_the_parts_as_solids(
         for rollout in result.rollouts.values():
             assert tuple(np.round(rollout[-1, :3], 6)) in drawn
     marks = [line for line in ax.get_lines() if line.get_marker() == "X"]
-    failing = [(name, label) for name, result in report.methods.items() for label in result.rollouts
-               if not result.task_success_at(label) and result.clearance_at(label) is not None
-               and not result.clearance_at(label).clear]
+    failing = [
+        (name, label)
+        for name, result in report.methods.items()
+        for label in result.rollouts
+        if not result.task_success_at(label)
+        and result.clearance_at(label) is not None
+        and not result.clearance_at(label).clear
+    ]
     assert len(marks) == len(failing) >= 2
     solids = [c for c in ax.collections if isinstance(c, Poly3DCollection)]
     assert len(solids) == len(report.scenario.scene.solids)
@@ -222,7 +272,9 @@ def test_the_pose_plot_shows_the_orientation_turn_and_tilt():
     s = np.linspace(0.0, 1.0, 301)
     turn, tilt = np.radians(540.0) * s, np.radians(20.0) * s
     start = Rotation.from_euler("x", 180, degrees=True)  # the tool pointing down
-    rotations = start * Rotation.from_euler("x", tilt[:, None]) * Rotation.from_euler("z", turn[:, None])
+    rotations = (
+        start * Rotation.from_euler("x", tilt[:, None]) * Rotation.from_euler("z", turn[:, None])
+    )
     measured_turn, measured_tilt = _tool_angles(rotations.as_quat())
     np.testing.assert_allclose(measured_turn, np.degrees(turn), atol=1e-9)
     np.testing.assert_allclose(measured_tilt, np.degrees(tilt), atol=1e-6)

@@ -37,7 +37,9 @@ def lateral(extension) -> float:
 def main() -> None:
     from bidmp.demonstrations.datasets import recording
 
-    print("recording        shift [mm]        speed  accel  jerk   duration [s]  transfer off its chord [mm]")
+    print(
+        "recording        shift [mm]        speed  accel  jerk   duration [s]  transfer off its chord [mm]"
+    )
     for name in ("operator1_nut3", "operator2_nut5"):
         demo = bidmp.prepare(*recording(name))[0]
         dmp = bidmp.DMP().fit(demo.y, demo.t)
@@ -46,11 +48,17 @@ def main() -> None:
         for shift in ([200.0, 0.0, 0.0], [0.0, 200.0, 0.0], [300.0, 150.0, 0.0]):
             goal = dmp.goal_ + shift
             extension = bidmp.extend_demonstration(demo.y, goal, seed=0)
-            options = {"duration": extension.duration_for(dmp)} if hasattr(extension, "duration_for") else {}
+            options = (
+                {"duration": extension.duration_for(dmp)}
+                if hasattr(extension, "duration_for")
+                else {}
+            )
             motion = bidmp.BiDMP(dmp).learn(extension.complete, **options).trajectory(goal)
             ratio = peaks(motion.y, motion.t[1]) / base
-            print(f"{name:16s} {str(shift):18s} {ratio[0]:5.2f}  {ratio[1]:5.2f}  {ratio[2]:5.2f}   "
-                  f"{motion.t[-1]:5.2f} (DMP {reference.t[-1]:.2f})   {lateral(extension):6.2f}")
+            print(
+                f"{name:16s} {str(shift):18s} {ratio[0]:5.2f}  {ratio[1]:5.2f}  {ratio[2]:5.2f}   "
+                f"{motion.t[-1]:5.2f} (DMP {reference.t[-1]:.2f})   {lateral(extension):6.2f}"
+            )
 
 
 if __name__ == "__main__":

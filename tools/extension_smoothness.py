@@ -37,8 +37,8 @@ from extension_pace import peaks  # the same estimator as the pace script (centr
 # The measures and closed forms of the tests themselves (tests/test_extension_timing.py): what this
 # script prints is what they assert on.
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
-from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
 from test_extension_timing import ldj_floor, shortest_around, transfer  # noqa: E402
+from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
 
 from bidmp.demonstrations import minimum_jerk
 from bidmp.extension import extend_demonstration
@@ -56,12 +56,16 @@ def row(label, extension, blind, demo, dt, shortest=None) -> str:
     n = len(demo)
     ratio = peaks(extension.complete, dt) / peaks(demo, dt)
     shortest_text = "   -  " if shortest is None else f"{length(extension.tra_gen) / shortest:6.3f}"
-    return (f"{label:28s} {extension.refinement:9s} {ldj(transfer(extension, n), dt):7.2f} {ldj(transfer(blind, n), dt):7.2f}"
-            f"   {shortest_text}   {ratio[0]:.2f} {ratio[1]:.2f} {ratio[2]:.2f}")
+    return (
+        f"{label:28s} {extension.refinement:9s} {ldj(transfer(extension, n), dt):7.2f} {ldj(transfer(blind, n), dt):7.2f}"
+        f"   {shortest_text}   {ratio[0]:.2f} {ratio[1]:.2f} {ratio[2]:.2f}"
+    )
 
 
 def fixed_cases() -> None:
-    print("case                         transfer  LDJ    template  length/shortest  peaks (speed acc jerk)")
+    print(
+        "case                         transfer  LDJ    template  length/shortest  peaks (speed acc jerk)"
+    )
     demo = minimum_jerk([[0, 0, 60], [100, 0, 60], [100, 0, 0]], 300)
     target = np.array([100.0, 300.0, 0.0])
     blind = extend_demonstration(demo, target, seed=0)
@@ -69,23 +73,49 @@ def fixed_cases() -> None:
     centre = (seg + hover) / 2
     for margin in (0.0, 3.0):
         for radius in (5.0, 10.0, 20.0):
-            post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -200.0], "radius": radius, "height": 600.0}
+            post = {
+                "type": "cylinder",
+                "label": "post",
+                "at": [centre[0], centre[1], -200.0],
+                "radius": radius,
+                "height": 600.0,
+            }
             scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
             extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
             keep = radius + TOOL["radius"] + margin
-            print(row(f"post r={radius:g} margin={margin:g}", extension, blind, demo, 1 / 300,
-                      shortest_around(seg, hover, centre, keep)))
+            print(
+                row(
+                    f"post r={radius:g} margin={margin:g}",
+                    extension,
+                    blind,
+                    demo,
+                    1 / 300,
+                    shortest_around(seg, hover, centre, keep),
+                )
+            )
     demo = minimum_jerk([[-80, -120, 200], [0, 0, 40], [0, 0, 0]], 200)
     target = np.array([150.0, 25.0, 0.0])
     blind = extend_demonstration(demo, target, seed=0)
     for height in (60.0, 100.0, 130.0):
-        duct = {"type": "box", "label": "duct", "at": [75.0, 0.0, 0.0], "size": [20.0, 2000.0, height]}
-        extension = extend_demonstration(demo, target, seed=0, scene=Scene.from_dict({"tool": TOOL, "parts": [duct], "margin": 3.0}))
+        duct = {
+            "type": "box",
+            "label": "duct",
+            "at": [75.0, 0.0, 0.0],
+            "size": [20.0, 2000.0, height],
+        }
+        extension = extend_demonstration(
+            demo,
+            target,
+            seed=0,
+            scene=Scene.from_dict({"tool": TOOL, "parts": [duct], "margin": 3.0}),
+        )
         print(row(f"duct {height:g} mm", extension, blind, demo, 1 / 200))
 
 
 def random_cases(count: int) -> None:
-    print("\nrandom posts: seed  unit  post size / chord  LDJ worse by  floor(h)  excess  length/shortest  peaks max")
+    print(
+        "\nrandom posts: seed  unit  post size / chord  LDJ worse by  floor(h)  excess  length/shortest  peaks max"
+    )
     excesses = []
     for seed in range(count):
         rng = np.random.default_rng(seed)
@@ -93,9 +123,16 @@ def random_cases(count: int) -> None:
         start = rng.uniform(-100, 100, 3) + [0, 0, 80]
         corner = start + np.append(rng.uniform(-150, 150, 2), rng.uniform(-20, 20))
         n = int(rng.integers(150, 600))
-        demo = minimum_jerk(np.array([start, corner, corner - [0, 0, rng.uniform(30, 80)]]) * unit, n)
+        demo = minimum_jerk(
+            np.array([start, corner, corner - [0, 0, rng.uniform(30, 80)]]) * unit, n
+        )
         heading = rng.uniform(0.0, 2.0 * np.pi)
-        target = demo[-1] + np.append(np.array([np.cos(heading), np.sin(heading)]) * rng.uniform(1.5, 3.0) * np.ptp(demo, axis=0).max(), 0.0)
+        target = demo[-1] + np.append(
+            np.array([np.cos(heading), np.sin(heading)])
+            * rng.uniform(1.5, 3.0)
+            * np.ptp(demo, axis=0).max(),
+            0.0,
+        )
         blind = extend_demonstration(demo, target, seed=seed)
         seg, hover = blind.tra_gen[0], blind.tra_gen[-1]
         tool = {"radius": rng.uniform(6, 14) * unit, "length": 100 * unit}
@@ -103,28 +140,47 @@ def random_cases(count: int) -> None:
         centre = seg + rng.uniform(0.3, 0.7) * (hover - seg)
         centre[:2] += rng.uniform(-0.5, 0.5, 2) * radius
         keep = radius + tool["radius"] + margin
-        if min(np.linalg.norm(seg[:2] - centre[:2]), np.linalg.norm(hover[:2] - centre[:2])) <= keep:
+        if (
+            min(np.linalg.norm(seg[:2] - centre[:2]), np.linalg.norm(hover[:2] - centre[:2]))
+            <= keep
+        ):
             print(f"  {seed:4d}  skipped: the post is within reach of the transfer's start or end")
             continue
-        post = {"type": "cylinder", "label": "post", "at": [centre[0], centre[1], -300 * unit], "radius": radius, "height": 800 * unit}
+        post = {
+            "type": "cylinder",
+            "label": "post",
+            "at": [centre[0], centre[1], -300 * unit],
+            "radius": radius,
+            "height": 800 * unit,
+        }
         try:
-            extension = extend_demonstration(demo, target, seed=seed,
-                                             scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}))
+            extension = extend_demonstration(
+                demo,
+                target,
+                seed=seed,
+                scene=Scene.from_dict({"tool": tool, "parts": [post], "margin": margin}),
+            )
         except NoFreeRouteError as exc:
             print(f"  {seed:4d}  no free route: {exc}")
             continue
         worse = ldj(transfer(blind, n), 1 / n) - ldj(transfer(extension, n), 1 / n)
         chord = hover[:2] - seg[:2]
         along = float(np.dot(centre[:2] - seg[:2], chord) / np.dot(chord, chord))
-        beside = abs(float(chord[0] * (centre[1] - seg[1]) - chord[1] * (centre[0] - seg[0]))) / np.linalg.norm(chord)
+        beside = abs(
+            float(chord[0] * (centre[1] - seg[1]) - chord[1] * (centre[0] - seg[0]))
+        ) / np.linalg.norm(chord)
         floor = ldj_floor(max(keep - beside, 0.0) / np.linalg.norm(hover[:2] - seg[:2]), along)
         ratio = length(extension.tra_gen) / shortest_around(seg, hover, centre, keep)
         top = (peaks(extension.complete, 1 / n) / peaks(demo, 1 / n)).max()
         excesses.append(worse - floor)
-        print(f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}  "
-              f"{floor:8.2f}  {worse - floor:6.2f}  {ratio:15.3f}  {top:9.2f}")
+        print(
+            f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}  "
+            f"{floor:8.2f}  {worse - floor:6.2f}  {ratio:15.3f}  {top:9.2f}"
+        )
     if excesses:
-        print(f"  excess over floor(h): at most {max(excesses):.2f}; {sum(e <= 0.3 for e in excesses)} of {len(excesses)} within 0.3")
+        print(
+            f"  excess over floor(h): at most {max(excesses):.2f}; {sum(e <= 0.3 for e in excesses)} of {len(excesses)} within 0.3"
+        )
 
 
 def _least_jerk_offset(height: float, when: float, n: int = 801) -> np.ndarray:
@@ -137,7 +193,15 @@ def _least_jerk_offset(height: float, when: float, n: int = 801) -> np.ndarray:
     rows = np.arange(n - 3)
     for k, weight in enumerate((-1.0, 3.0, -3.0, 1.0)):
         third[rows, rows + k] = weight
-    fixed = {0: 0.0, 1: 0.0, 2: 0.0, n - 3: 0.0, n - 2: 0.0, n - 1: 0.0, int(round(when * (n - 1))): height}
+    fixed = {
+        0: 0.0,
+        1: 0.0,
+        2: 0.0,
+        n - 3: 0.0,
+        n - 2: 0.0,
+        n - 1: 0.0,
+        int(round(when * (n - 1))): height,
+    }
     across = np.zeros(n)
     across[list(fixed)] = list(fixed.values())
     free = np.setdiff1d(np.arange(n), list(fixed))
@@ -164,8 +228,14 @@ def ideal_bows() -> None:
     s = 10 * t**3 - 15 * t**4 + 6 * t**5
     straight = ldj(np.column_stack([s, 0 * s]), t[1])
     print("\nfloor, offset from the chord / length:   " + "  ".join(f"{h:5.2f}" for h in heights))
-    print("  floor(h), the least-LDJ route:         " + "  ".join(f"{ldj_floor(h):5.2f}" for h in heights))
-    print("  least-jerk route, point at mid-time:   " + "  ".join(f"{jerk_floor(h):5.2f}" for h in heights))
+    print(
+        "  floor(h), the least-LDJ route:         "
+        + "  ".join(f"{ldj_floor(h):5.2f}" for h in heights)
+    )
+    print(
+        "  least-jerk route, point at mid-time:   "
+        + "  ".join(f"{jerk_floor(h):5.2f}" for h in heights)
+    )
     bows = [straight - ldj(np.column_stack([s, h * np.sin(np.pi * s)]), t[1]) for h in heights]
     print("  half-sine bow, quintic law, worse by:  " + "  ".join(f"{w:5.2f}" for w in bows))
 

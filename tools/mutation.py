@@ -58,229 +58,579 @@ class Target:
     module: str
     functions: tuple[str, ...]
     tests: tuple[str, ...]
-    pure_python: bool = False  # run numba kernels as plain Python (their mutants are in the Python source)
+    # run numba kernels as plain Python (their mutants are in the Python source)
+    pure_python: bool = False
 
 
 TARGETS = (
-    Target("scene clearance", "bidmp.scene.clearance",
-           ("Clearance.collision_free", "Clearance.clear", "Clearance.collision_part", "Scene._minimum",
-            "Scene._clearance", "Scene._clearance_oriented", "_sweep", "_nearest_to_its_clearance"),
-           ("tests/test_oracles.py", "tests/test_geometry.py")),
-    Target("scene distances (culling bounds)", "bidmp.scene.distances",
-           ("_cylinder_box_bounds", "_densify", "_box_distance", "_Distances.tool_to", "_Distances._witnessed"),
-           ("tests/test_oracles.py", "tests/test_geometry.py")),
-    Target("scene checker", "bidmp.scene.checker",
-           ("SceneChecker.__call__", "SceneChecker.segments_free", "SceneChecker._move_free"),
-           ("tests/test_oracles.py", "tests/test_geometry.py", "tests/test_roadmap.py")),
-    Target("limit checks and measurement", "bidmp.tasks.contract",
-           ("_fractions", "command_peaks", "CommandPeaks.within", "Verdict.reached", "Verdict.clear",
-            "Verdict.within_limits", "Verdict.ok", "Verdict.failed"),
-           ("tests/test_oracles.py", "tests/test_contract.py", "tests/test_sim_limits.py")),
-    Target("simulator: measured peaks and the 1 kHz command generator", "bidmp.sim.limits",
-           ("_worst", "_measured_peaks", "_RateLimiter.__call__"),
-           ("tests/test_oracles.py", "tests/test_sim_limits.py")),
-    Target("engagement", "bidmp.tasks.metrics",
-           ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),
-           ("tests/test_oracles.py", "tests/test_engagement.py", "tests/test_contract.py")),
-    Target("job success criteria", "bidmp.sim.job_report",
-           ("in_bin", "in_slot", "JobTarget.contacts", "JobTarget.within_limits", "JobReport.removed"),
-           ("tests/test_oracles.py",)),
-    Target("job: a cycle's verdict", "bidmp.sim.job",
-           ("_finish", "_why"),
-           ("tests/test_oracles.py",)),
-    Target("similarity (Fréchet, normaliser)", "bidmp.extension.similarity",
-           ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
-           ("tests/test_oracles.py", "tests/test_similarity.py"), pure_python=True),
-    Target("similarity template", "bidmp.extension.roadmap",
-           ("template", "_minimal_rotation"),
-           ("tests/test_oracles.py", "tests/test_roadmap.py")),
-    Target("segmentation", "bidmp.extension.segmentation",
-           ("curvature", "_alternating_extrema", "_prune_persistence", "_prune_paper", "segment",
-            "choose_piece"),
-           ("tests/test_oracles.py", "tests/test_segmentation.py")),
-    Target("BLS", "bidmp.incremental.bls",
-           ("_with_bias", "_affine", "_mapped_features", "_enhancement_block", "BLS.hidden", "BLS.fit"),
-           ("tests/test_oracles.py", "tests/test_bls.py")),
-    Target("Bi-DMP skill selection", "bidmp.incremental._skills",
-           ("SkillLibrary.select_skill",),
-           ("tests/test_oracles.py", "tests/test_incremental.py")),
-    Target("goal systems", "bidmp.primitives.goals",
-           ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
-           ("tests/test_oracles.py", "tests/test_dmp.py", "tests/test_approach.py")),
-    Target("units and speeds a robot can run", "bidmp._units",
-           ("check_reach", "check_speed"),
-           ("tests/test_oracles.py",)),
-    Target("bags: header stamp order", "bidmp.io.bags",
-           ("_stamp_order",),
-           ("tests/test_oracles.py",)),
-    Target("phase stopping", "bidmp.primitives.coupling",
-           ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
-           ("tests/test_oracles.py", "tests/test_primitives.py")),
+    Target(
+        "scene clearance",
+        "bidmp.scene.clearance",
+        (
+            "Clearance.collision_free",
+            "Clearance.clear",
+            "Clearance.collision_part",
+            "Scene._minimum",
+            "Scene._clearance",
+            "Scene._clearance_oriented",
+            "_sweep",
+            "_nearest_to_its_clearance",
+        ),
+        ("tests/test_oracles.py", "tests/test_geometry.py"),
+    ),
+    Target(
+        "scene distances (culling bounds)",
+        "bidmp.scene.distances",
+        (
+            "_cylinder_box_bounds",
+            "_densify",
+            "_box_distance",
+            "_Distances.tool_to",
+            "_Distances._witnessed",
+        ),
+        ("tests/test_oracles.py", "tests/test_geometry.py"),
+    ),
+    Target(
+        "scene checker",
+        "bidmp.scene.checker",
+        ("SceneChecker.__call__", "SceneChecker.segments_free", "SceneChecker._move_free"),
+        ("tests/test_oracles.py", "tests/test_geometry.py", "tests/test_roadmap.py"),
+    ),
+    Target(
+        "limit checks and measurement",
+        "bidmp.tasks.contract",
+        (
+            "_fractions",
+            "command_peaks",
+            "CommandPeaks.within",
+            "Verdict.reached",
+            "Verdict.clear",
+            "Verdict.within_limits",
+            "Verdict.ok",
+            "Verdict.failed",
+        ),
+        ("tests/test_oracles.py", "tests/test_contract.py", "tests/test_sim_limits.py"),
+    ),
+    Target(
+        "simulator: measured peaks and the 1 kHz command generator",
+        "bidmp.sim.limits",
+        ("_worst", "_measured_peaks", "_RateLimiter.__call__"),
+        ("tests/test_oracles.py", "tests/test_sim_limits.py"),
+    ),
+    Target(
+        "engagement",
+        "bidmp.tasks.metrics",
+        ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),
+        ("tests/test_oracles.py", "tests/test_engagement.py", "tests/test_contract.py"),
+    ),
+    Target(
+        "job success criteria",
+        "bidmp.sim.job_report",
+        ("in_bin", "in_slot", "JobTarget.contacts", "JobTarget.within_limits", "JobReport.removed"),
+        ("tests/test_oracles.py",),
+    ),
+    Target(
+        "job: a cycle's verdict", "bidmp.sim.job", ("_finish", "_why"), ("tests/test_oracles.py",)
+    ),
+    Target(
+        "similarity (Fréchet, normaliser)",
+        "bidmp.extension.similarity",
+        ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
+        ("tests/test_oracles.py", "tests/test_similarity.py"),
+        pure_python=True,
+    ),
+    Target(
+        "similarity template",
+        "bidmp.extension.roadmap",
+        ("template", "_minimal_rotation"),
+        ("tests/test_oracles.py", "tests/test_roadmap.py"),
+    ),
+    Target(
+        "segmentation",
+        "bidmp.extension.segmentation",
+        (
+            "curvature",
+            "_alternating_extrema",
+            "_prune_persistence",
+            "_prune_paper",
+            "segment",
+            "choose_piece",
+        ),
+        ("tests/test_oracles.py", "tests/test_segmentation.py"),
+    ),
+    Target(
+        "BLS",
+        "bidmp.incremental.bls",
+        (
+            "_with_bias",
+            "_affine",
+            "_mapped_features",
+            "_enhancement_block",
+            "BLS.hidden",
+            "BLS.fit",
+        ),
+        ("tests/test_oracles.py", "tests/test_bls.py"),
+    ),
+    Target(
+        "Bi-DMP skill selection",
+        "bidmp.incremental._skills",
+        ("SkillLibrary.select_skill",),
+        ("tests/test_oracles.py", "tests/test_incremental.py"),
+    ),
+    Target(
+        "goal systems",
+        "bidmp.primitives.goals",
+        ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
+        ("tests/test_oracles.py", "tests/test_dmp.py", "tests/test_approach.py"),
+    ),
+    Target(
+        "units and speeds a robot can run",
+        "bidmp._units",
+        ("check_reach", "check_speed"),
+        ("tests/test_oracles.py",),
+    ),
+    Target(
+        "bags: header stamp order", "bidmp.io.bags", ("_stamp_order",), ("tests/test_oracles.py",)
+    ),
+    Target(
+        "phase stopping",
+        "bidmp.primitives.coupling",
+        ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
+        ("tests/test_oracles.py", "tests/test_primitives.py"),
+    ),
 )
 
 # Survivors shown equivalent: (module, function, the mutated line's text, mutation) -> why no test
 # can tell the mutant from the original.
-_FAST_PATH = ("a fast path's guard: both branches give the same value (the slow one validates a "
-              "float64 vector and returns it unchanged)")
-_BOUND = ("cost only: branch and bound returns the least exact distance over every pair whose lower bound "
-          "is below the best found so far; this changes which further pairs are evaluated, or the seed it "
-          "starts from, not that minimum (a tie keeps the same distance)")
+_FAST_PATH = (
+    "a fast path's guard: both branches give the same value (the slow one validates a "
+    "float64 vector and returns it unchanged)"
+)
+_BOUND = (
+    "cost only: branch and bound returns the least exact distance over every pair whose lower bound "
+    "is below the best found so far; this changes which further pairs are evaluated, or the seed it "
+    "starts from, not that minimum (a tie keeps the same distance)"
+)
 _CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
-    ("bidmp._units", "check_speed",
-     "hint = f'; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians' if peak_speed > fastest and np.radians(peak_speed) <= fastest else ''", "> -> >="):
-        "a peak of exactly the fastest joint speed returned as plausible two lines above: this hint is never built for it",
-    **{("bidmp.primitives.coupling", "PhaseStopping.slowdown",
-        "if not (type(y) is np.ndarray and y.dtype == np.float64 and (y.ndim == 1)):",
-        mutation): _FAST_PATH
-       for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")},
-    (_CLEARANCE, "Clearance.clear", "return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin",
-     "<= -> <"): "at a margin of exactly 0 both branches are `not distance < 0`",
-    **{(_CLEARANCE, "Scene._minimum", text, mutation): _BOUND for text, mutation in (
-        ("row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])", "argmin -> argmax"),
-        ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "< -> <="),
-        ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "0.0 -> 1.0"),
-        ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", "0.0 -> 1.0"),
-        ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", ">= -> >"),
-        ("if distance < best:", "< -> <="))},
-    **{(_CLEARANCE, "Scene._clearance", text, mutation): _BOUND for text, mutation in (
-        ("row = int(np.argmin(at_samples))", "argmin -> argmax"),
-        ("col = int(np.argmin(first))", "argmin -> argmax"),
-        ("swept_lower = np.minimum(points[:-1], points[1:]) - [radius, radius, 0.0]", "0.0 -> 1.0"))},
-    **{(_CLEARANCE, "Scene._clearance", "dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))",
-        mutation): "cost only: more segments are placed densely; the minimum over them is the same"
-       for mutation in ("< -> <=", "0.0 -> 1.0")},
-    (_CLEARANCE, "_sweep", "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
-     "0.0, 1.0))", "2.0 -> 4.0"): "cost only: twice the turn, twice the placements a turning tool needs",
-    (_CLEARANCE, "_sweep", "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
-     "0.0, 1.0))", "drop abs()"): "the quaternions are made continuous first (q · q' >= 0): abs changes nothing",
-    ("bidmp.scene.distances", "_Distances._witnessed",
-     "return abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first) and _on_shape(b, pose_b, second)", "<= -> <"):
-        "differs only when coal's points are apart by exactly the tolerance more or less than its distance",
-    ("bidmp.scene.checker", "SceneChecker.__call__",
-     "if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < margin:", "< -> <="):
-        "differs only for a placement exactly at the margin, to the last bit",
-    ("bidmp.scene.checker", "SceneChecker.segments_free",
-     "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))", "all -> any"):
-        "cost only: more moves are candidates; each is then checked exactly",
-    **{("bidmp.scene.checker", "SceneChecker.segments_free", text, mutation):
-       "differs only where the move's box exactly touches a part's box: the tool is then at least touching "
-       "distance away, which is free either way" for text in (
-           "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
-           "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)")
-       for mutation in ("<= -> <", ">= -> >")},
-    **{("bidmp.scene.checker", "SceneChecker._move_free", "resolution = 1e-09 * max(length, 1.0)", mutation):
-       "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
-       "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
-       for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min", "1.0 -> 2.0")},
-    ("bidmp.scene.checker", "SceneChecker._move_free", "if distance < margin:", "< -> <="):
-        "differs only for a placement exactly at the margin, to the last bit",
-    ("bidmp.tasks.metrics", "final_approach_mask",
-     "heights = _as_bounded_array(heights, 'heights', max_ndim=1).reshape(-1)", "1 -> 2"):
-        "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
-    ("bidmp.extension.similarity", "frechet_distance_reference", "i = np.arange(max(0, s - m + 1), min(n, s + 1))",
-     "1 -> 2"): "one more cell per anti-diagonal, just off the table (j = -1): it derives only from other such "
-                "cells, which are infinite from the start, so it is infinite and never wins a minimum",
-    ("bidmp.extension.roadmap", "template",
-     "lam = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])", "0.0 -> 1.0"):
-        "changes the first sample's λ alone, and the first sample is set to seg afterwards",
-    ("bidmp.extension.roadmap", "template", "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):", "<= -> <"):
-        "the threshold is at least 1e-12: the two differ only for a chord exactly that long",
-    **{("bidmp.extension.roadmap", "template", "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):", mutation):
-       "a rounding-level threshold doubled (a closed piece's chord is 0 or rounding; an open one's is not "
-       "within a factor 2 of 1e-12 of its size)" for mutation in ("1e-12 -> 2e-12", "1.0 -> 2.0")},
-    ("bidmp.extension.roadmap", "template",
-     "degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)",
-     "< -> <="): "differs only for an axis whose chord is exactly 1e-3 of the chord's length",
-    ("bidmp.extension.roadmap", "template", "scaled = seg + np.where(degenerate, 0.0, factors) * (piece - seg)",
-     "0.0 -> 1.0"): "the degenerate axes' scaled values are replaced by their ramps on the next line",
-    **{("bidmp.extension.roadmap", "_minimal_rotation", "cos = float(np.clip(u @ v, -1.0, 1.0))", mutation):
-       "|u · v| rounds past 1 only for parallel chords, where sin is below 1e-12 and the branch on the sign "
-       "of cos (not its value) decides" for mutation in ("1.0 -> 2.0",)},
-    **{("bidmp.extension.roadmap", "_minimal_rotation", "if sin < 1e-12:", mutation):
-       "chords parallel to within 1e-12 rad: the general formula gives the same rotation to 1e-12"
-       for mutation in ("< -> <=", "1e-12 -> 2e-12")},
-    ("bidmp.extension.roadmap", "_minimal_rotation", "if cos > 0:", "> -> >="):
-        "reached only when sin < 1e-12, where cos is ±1, never 0",
-    **{("bidmp.extension.segmentation", "curvature",
-        "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):", mutation): why
-       for mutation, why in (("3 -> 4", "the window is odd: at most 3 and at most 4 are the same windows"),
-                             ("<= -> <", "differs only for a curve resting at the origin, whose speed floor gives "
-                                         "zero curvature too"))},
-    ("bidmp.extension.segmentation", "curvature",
-     "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):", "1e-12 -> 2e-12"):
-        "the rounding scale of a still curve doubled: a still curve's spread is exactly 0 or rounding-level",
-    **{("bidmp.extension.segmentation", "curvature",
-        "floor = 1e-12 * max(float(np.max(speed)), np.finfo(float).tiny)", mutation):
-       "the speed floor's scale: speeds where the curve does not advance are rounding-level (1e-16 of the "
-       "peak), far below either floor, and moving samples far above" for mutation in ("* -> /", "1e-12 -> 2e-12")},
-    ("bidmp.extension.segmentation", "curvature", "kappa[speed <= floor] = 0.0", "<= -> <"):
-        "differs only for a speed exactly at the floor",
-    **{("bidmp.extension.segmentation", "curvature", "if window > 3:", mutation):
-       "the second window is at least 5 whenever this line is reached (a curve of fewer than 5 samples "
-       "returned above)" for mutation in ("> -> >=", "3 -> 4")},
-    ("bidmp.extension.segmentation", "_alternating_extrema", "if nonzero.size == 0:", "0 -> 1"):
-        "a single non-zero slope fills the whole segment with one sign: no change, no extremum, the same empty answer",
-    ("bidmp.extension.segmentation", "_alternating_extrema", "kind = 1 if filled[index - 1] > 0 else -1", "> -> >="):
-        "filled slopes are ±1, never 0",
-    **{("bidmp.extension.segmentation", "_alternating_extrema", "while start > 0 and slope[start - 1] == 0:", mutation):
-       "the walk back over a plateau never reaches the first slope: a plateau from the segment's start takes "
-       "its filled sign from the slope after it, so no change ends it" for mutation in ("> -> >=", "0 -> 1")},
-    ("bidmp.extension.segmentation", "_prune_persistence", "left = np.arange(-1, count - 1)", "- -> +"):
-        "two more entries past the last extremum, never read: the links are read at extrema 0 .. count - 1",
-    ("bidmp.extension.segmentation", "_prune_persistence", "right = np.arange(1, count + 1)",
-     "1 -> 2"): "(as arange(1, count + 2)) one more entry past the last extremum, never read",
-    ("bidmp.incremental.bls", "_mapped_features",
-     "weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))",
-     "1 -> 2"): "(as reshape(..., -2)) NumPy takes any negative size in reshape as 'the rest'",
-    ("bidmp.incremental.bls", "_enhancement_block",
-     "weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))", "1 -> 2"):
-        "(as _rng(seed, 2, block)) another seeded stream no other matrix draws from: an equally valid draw, "
-        "as reproducible from the seed",
-    (_CLEARANCE, "Scene._clearance_oriented", "dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)", "/= -> *="):
-        "the quaternions go to Rotation.from_quat alone, which normalises them itself",
-    (_CLEARANCE, "Scene._clearance_oriented",
-     "extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)", "/ -> *"):
-        "cost only: boxes four times too tall bound the distances from below all the same",
-    ("bidmp.extension.segmentation", "_prune_paper",
-     "if types[position] == 1 and types[position + 1] == -1:", "and -> or"):
-        "the extrema alternate, so a maximum is always followed by a minimum: either half implies the other",
-    ("bidmp.incremental.bls", "BLS.fit", "F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)", "1.0 -> 2.0"):
-        "the divisor of a constant projection, whose numerator F - F_low is 0 either way",
-    ("bidmp.primitives.goals", "_goal_share", "closing = s > end - width", "> -> >="):
-        "at s = end - width both formulas give σ (the share is continuous there)",
-    ("bidmp.primitives.goals", "_goal_share", "share[s >= end] = 1.0", ">= -> >"):
-        "at s = end the closing formula gives 1 - (1 - σ) S(0) = 1",
-    ("bidmp.primitives.goals", "DelayedGoal.on_grid", "return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)",
-     "1.0 -> 2.0"): "a step of 0 passes only for one sample, whose gate is 1 whatever the step",
-    ("bidmp.extension.segmentation", "segment",
-     "if np.max(interior) * total < 1e-06:", "< -> <="):
-        "differs only for a curve whose κ·L is exactly 1e-6",
-    ("bidmp.extension.segmentation", "segment", "original = np.clip(np.searchsorted(s, positions), 1, n_samples - 1)",
-     "- -> +"): "the upper bound is never reached: a kept point lies within the path, so searchsorted gives at "
-                "most n_samples - 1",
-    ("bidmp.extension.segmentation", "segment",
-     "nearer_left = positions - s[original - 1] < s[original] - positions", "< -> <="):
-        "differs only for a point exactly halfway in arc length between two samples",
-    (_CLEARANCE, "Scene._clearance", "first = _cylinder_box_bounds(points[row:row + 1], radius, length, lower, upper)[0]",
-     "1 -> 2"): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
-    **{(_CLEARANCE, "Scene._clearance", "if points.shape[0] > 1:", mutation):
-       "a one-point path: the placements to add are none either way, and the seed (the exact distance at "
-       "that point) is the answer" for mutation in ("> -> >=", "0 -> 1")},
+    (
+        "bidmp._units",
+        "check_speed",
+        "hint = f'; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians' if peak_speed > fastest and np.radians(peak_speed) <= fastest else ''",
+        "> -> >=",
+    ): "a peak of exactly the fastest joint speed returned as plausible two lines above: this hint is never built for it",
+    **{
+        (
+            "bidmp.primitives.coupling",
+            "PhaseStopping.slowdown",
+            "if not (type(y) is np.ndarray and y.dtype == np.float64 and (y.ndim == 1)):",
+            mutation,
+        ): _FAST_PATH
+        for mutation in ("drop not", "and -> or", "is -> is not", "== -> !=", "1 -> 2")
+    },
+    (
+        _CLEARANCE,
+        "Clearance.clear",
+        "return self.collision_free if self.margin <= 0.0 else not self.distance < self.margin",
+        "<= -> <",
+    ): "at a margin of exactly 0 both branches are `not distance < 0`",
+    **{
+        (_CLEARANCE, "Scene._minimum", text, mutation): _BOUND
+        for text, mutation in (
+            ("row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])", "argmin -> argmax"),
+            ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "< -> <="),
+            ("rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))", "0.0 -> 1.0"),
+            ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", "0.0 -> 1.0"),
+            ("if bounds[row, col] > 0.0 and bounds[row, col] >= best:", ">= -> >"),
+            ("if distance < best:", "< -> <="),
+        )
+    },
+    **{
+        (_CLEARANCE, "Scene._clearance", text, mutation): _BOUND
+        for text, mutation in (
+            ("row = int(np.argmin(at_samples))", "argmin -> argmax"),
+            ("col = int(np.argmin(first))", "argmin -> argmax"),
+            (
+                "swept_lower = np.minimum(points[:-1], points[1:]) - [radius, radius, 0.0]",
+                "0.0 -> 1.0",
+            ),
+        )
+    },
+    **{
+        (
+            _CLEARANCE,
+            "Scene._clearance",
+            "dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))",
+            mutation,
+        ): "cost only: more segments are placed densely; the minimum over them is the same"
+        for mutation in ("< -> <=", "0.0 -> 1.0")
+    },
+    (
+        _CLEARANCE,
+        "_sweep",
+        "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
+        "0.0, 1.0))",
+        "2.0 -> 4.0",
+    ): "cost only: twice the turn, twice the placements a turning tool needs",
+    (
+        _CLEARANCE,
+        "_sweep",
+        "turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), "
+        "0.0, 1.0))",
+        "drop abs()",
+    ): "the quaternions are made continuous first (q · q' >= 0): abs changes nothing",
+    (
+        "bidmp.scene.distances",
+        "_Distances._witnessed",
+        "return abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first) and _on_shape(b, pose_b, second)",
+        "<= -> <",
+    ): "differs only when coal's points are apart by exactly the tolerance more or less than its distance",
+    (
+        "bidmp.scene.checker",
+        "SceneChecker.__call__",
+        "if free[index] and engine.tool_to(points[index], int(self.chosen[col])) < margin:",
+        "< -> <=",
+    ): "differs only for a placement exactly at the margin, to the last bit",
+    (
+        "bidmp.scene.checker",
+        "SceneChecker.segments_free",
+        "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
+        "all -> any",
+    ): "cost only: more moves are candidates; each is then checked exactly",
+    **{
+        (
+            "bidmp.scene.checker",
+            "SceneChecker.segments_free",
+            text,
+            mutation,
+        ): "differs only where the move's box exactly touches a part's box: the tool is then at least touching "
+        "distance away, which is free either way"
+        for text in (
+            "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
+            "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)",
+        )
+        for mutation in ("<= -> <", ">= -> >")
+    },
+    **{
+        (
+            "bidmp.scene.checker",
+            "SceneChecker._move_free",
+            "resolution = 1e-09 * max(length, 1.0)",
+            mutation,
+        ): "the least advance while grazing the margin (1e-9 of the move): it changes how long a graze is followed "
+        "before it is called a contact, not the answer for a move that keeps clear of the margin or crosses it"
+        for mutation in ("* -> /", "1e-09 -> 2e-09", "max -> min", "1.0 -> 2.0")
+    },
+    (
+        "bidmp.scene.checker",
+        "SceneChecker._move_free",
+        "if distance < margin:",
+        "< -> <=",
+    ): "differs only for a placement exactly at the margin, to the last bit",
+    (
+        "bidmp.tasks.metrics",
+        "final_approach_mask",
+        "heights = _as_bounded_array(heights, 'heights', max_ndim=1).reshape(-1)",
+        "1 -> 2",
+    ): "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
+    (
+        "bidmp.extension.similarity",
+        "frechet_distance_reference",
+        "i = np.arange(max(0, s - m + 1), min(n, s + 1))",
+        "1 -> 2",
+    ): "one more cell per anti-diagonal, just off the table (j = -1): it derives only from other such "
+    "cells, which are infinite from the start, so it is infinite and never wins a minimum",
+    (
+        "bidmp.extension.roadmap",
+        "template",
+        "lam = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])",
+        "0.0 -> 1.0",
+    ): "changes the first sample's λ alone, and the first sample is set to seg afterwards",
+    (
+        "bidmp.extension.roadmap",
+        "template",
+        "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):",
+        "<= -> <",
+    ): "the threshold is at least 1e-12: the two differ only for a chord exactly that long",
+    **{
+        (
+            "bidmp.extension.roadmap",
+            "template",
+            "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):",
+            mutation,
+        ): "a rounding-level threshold doubled (a closed piece's chord is 0 or rounding; an open one's is not "
+        "within a factor 2 of 1e-12 of its size)"
+        for mutation in ("1e-12 -> 2e-12", "1.0 -> 2.0")
+    },
+    (
+        "bidmp.extension.roadmap",
+        "template",
+        "degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)",
+        "< -> <=",
+    ): "differs only for an axis whose chord is exactly 1e-3 of the chord's length",
+    (
+        "bidmp.extension.roadmap",
+        "template",
+        "scaled = seg + np.where(degenerate, 0.0, factors) * (piece - seg)",
+        "0.0 -> 1.0",
+    ): "the degenerate axes' scaled values are replaced by their ramps on the next line",
+    **{
+        (
+            "bidmp.extension.roadmap",
+            "_minimal_rotation",
+            "cos = float(np.clip(u @ v, -1.0, 1.0))",
+            mutation,
+        ): "|u · v| rounds past 1 only for parallel chords, where sin is below 1e-12 and the branch on the sign "
+        "of cos (not its value) decides"
+        for mutation in ("1.0 -> 2.0",)
+    },
+    **{
+        (
+            "bidmp.extension.roadmap",
+            "_minimal_rotation",
+            "if sin < 1e-12:",
+            mutation,
+        ): "chords parallel to within 1e-12 rad: the general formula gives the same rotation to 1e-12"
+        for mutation in ("< -> <=", "1e-12 -> 2e-12")
+    },
+    (
+        "bidmp.extension.roadmap",
+        "_minimal_rotation",
+        "if cos > 0:",
+        "> -> >=",
+    ): "reached only when sin < 1e-12, where cos is ±1, never 0",
+    **{
+        (
+            "bidmp.extension.segmentation",
+            "curvature",
+            "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):",
+            mutation,
+        ): why
+        for mutation, why in (
+            ("3 -> 4", "the window is odd: at most 3 and at most 4 are the same windows"),
+            (
+                "<= -> <",
+                "differs only for a curve resting at the origin, whose speed floor gives "
+                "zero curvature too",
+            ),
+        )
+    },
+    (
+        "bidmp.extension.segmentation",
+        "curvature",
+        "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):",
+        "1e-12 -> 2e-12",
+    ): "the rounding scale of a still curve doubled: a still curve's spread is exactly 0 or rounding-level",
+    **{
+        (
+            "bidmp.extension.segmentation",
+            "curvature",
+            "floor = 1e-12 * max(float(np.max(speed)), np.finfo(float).tiny)",
+            mutation,
+        ): "the speed floor's scale: speeds where the curve does not advance are rounding-level (1e-16 of the "
+        "peak), far below either floor, and moving samples far above"
+        for mutation in ("* -> /", "1e-12 -> 2e-12")
+    },
+    (
+        "bidmp.extension.segmentation",
+        "curvature",
+        "kappa[speed <= floor] = 0.0",
+        "<= -> <",
+    ): "differs only for a speed exactly at the floor",
+    **{
+        (
+            "bidmp.extension.segmentation",
+            "curvature",
+            "if window > 3:",
+            mutation,
+        ): "the second window is at least 5 whenever this line is reached (a curve of fewer than 5 samples "
+        "returned above)"
+        for mutation in ("> -> >=", "3 -> 4")
+    },
+    (
+        "bidmp.extension.segmentation",
+        "_alternating_extrema",
+        "if nonzero.size == 0:",
+        "0 -> 1",
+    ): "a single non-zero slope fills the whole segment with one sign: no change, no extremum, the same empty answer",
+    (
+        "bidmp.extension.segmentation",
+        "_alternating_extrema",
+        "kind = 1 if filled[index - 1] > 0 else -1",
+        "> -> >=",
+    ): "filled slopes are ±1, never 0",
+    **{
+        (
+            "bidmp.extension.segmentation",
+            "_alternating_extrema",
+            "while start > 0 and slope[start - 1] == 0:",
+            mutation,
+        ): "the walk back over a plateau never reaches the first slope: a plateau from the segment's start takes "
+        "its filled sign from the slope after it, so no change ends it"
+        for mutation in ("> -> >=", "0 -> 1")
+    },
+    (
+        "bidmp.extension.segmentation",
+        "_prune_persistence",
+        "left = np.arange(-1, count - 1)",
+        "- -> +",
+    ): "two more entries past the last extremum, never read: the links are read at extrema 0 .. count - 1",
+    (
+        "bidmp.extension.segmentation",
+        "_prune_persistence",
+        "right = np.arange(1, count + 1)",
+        "1 -> 2",
+    ): "(as arange(1, count + 2)) one more entry past the last extremum, never read",
+    (
+        "bidmp.incremental.bls",
+        "_mapped_features",
+        "weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))",
+        "1 -> 2",
+    ): "(as reshape(..., -2)) NumPy takes any negative size in reshape as 'the rest'",
+    (
+        "bidmp.incremental.bls",
+        "_enhancement_block",
+        "weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))",
+        "1 -> 2",
+    ): "(as _rng(seed, 2, block)) another seeded stream no other matrix draws from: an equally valid draw, "
+    "as reproducible from the seed",
+    (
+        _CLEARANCE,
+        "Scene._clearance_oriented",
+        "dense_q /= np.linalg.norm(dense_q, axis=1, keepdims=True)",
+        "/= -> *=",
+    ): "the quaternions go to Rotation.from_quat alone, which normalises them itself",
+    (
+        _CLEARANCE,
+        "Scene._clearance_oriented",
+        "extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)",
+        "/ -> *",
+    ): "cost only: boxes four times too tall bound the distances from below all the same",
+    (
+        "bidmp.extension.segmentation",
+        "_prune_paper",
+        "if types[position] == 1 and types[position + 1] == -1:",
+        "and -> or",
+    ): "the extrema alternate, so a maximum is always followed by a minimum: either half implies the other",
+    (
+        "bidmp.incremental.bls",
+        "BLS.fit",
+        "F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)",
+        "1.0 -> 2.0",
+    ): "the divisor of a constant projection, whose numerator F - F_low is 0 either way",
+    (
+        "bidmp.primitives.goals",
+        "_goal_share",
+        "closing = s > end - width",
+        "> -> >=",
+    ): "at s = end - width both formulas give σ (the share is continuous there)",
+    (
+        "bidmp.primitives.goals",
+        "_goal_share",
+        "share[s >= end] = 1.0",
+        ">= -> >",
+    ): "at s = end the closing formula gives 1 - (1 - σ) S(0) = 1",
+    (
+        "bidmp.primitives.goals",
+        "DelayedGoal.on_grid",
+        "return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)",
+        "1.0 -> 2.0",
+    ): "a step of 0 passes only for one sample, whose gate is 1 whatever the step",
+    (
+        "bidmp.extension.segmentation",
+        "segment",
+        "if np.max(interior) * total < 1e-06:",
+        "< -> <=",
+    ): "differs only for a curve whose κ·L is exactly 1e-6",
+    (
+        "bidmp.extension.segmentation",
+        "segment",
+        "original = np.clip(np.searchsorted(s, positions), 1, n_samples - 1)",
+        "- -> +",
+    ): "the upper bound is never reached: a kept point lies within the path, so searchsorted gives at "
+    "most n_samples - 1",
+    (
+        "bidmp.extension.segmentation",
+        "segment",
+        "nearer_left = positions - s[original - 1] < s[original] - positions",
+        "< -> <=",
+    ): "differs only for a point exactly halfway in arc length between two samples",
+    (
+        _CLEARANCE,
+        "Scene._clearance",
+        "first = _cylinder_box_bounds(points[row:row + 1], radius, length, lower, upper)[0]",
+        "1 -> 2",
+    ): "the bounds of rows row and row + 1, of which [0] is read: the same row's",
+    **{
+        (
+            _CLEARANCE,
+            "Scene._clearance",
+            "if points.shape[0] > 1:",
+            mutation,
+        ): "a one-point path: the placements to add are none either way, and the seed (the exact distance at "
+        "that point) is the answer"
+        for mutation in ("> -> >=", "0 -> 1")
+    },
 }
 
 
 # -- the mutants ------------------------------------------------------------------------------------
-_COMPARE = {ast.Lt: ast.LtE, ast.LtE: ast.Lt, ast.Gt: ast.GtE, ast.GtE: ast.Gt, ast.Eq: ast.NotEq,
-            ast.NotEq: ast.Eq, ast.Is: ast.IsNot, ast.IsNot: ast.Is, ast.In: ast.NotIn, ast.NotIn: ast.In}
-_BINARY = {ast.Add: ast.Sub, ast.Sub: ast.Add, ast.Mult: ast.Div, ast.Div: ast.Mult, ast.Pow: ast.Mult,
-           ast.FloorDiv: ast.Mult, ast.Mod: ast.FloorDiv}
-_SWAPPED_NAMES = {"min": "max", "max": "min", "minimum": "maximum", "maximum": "minimum", "argmin": "argmax",
-                  "argmax": "argmin", "all": "any", "any": "all", "amin": "amax", "amax": "amin",
-                  "nanmin": "nanmax", "nanmax": "nanmin"}
-_SYMBOL = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!=", ast.Is: "is",
-           ast.IsNot: "is not", ast.In: "in", ast.NotIn: "not in", ast.Add: "+", ast.Sub: "-", ast.Mult: "*",
-           ast.Div: "/", ast.Pow: "**", ast.FloorDiv: "//", ast.Mod: "%", ast.And: "and", ast.Or: "or"}
+_COMPARE = {
+    ast.Lt: ast.LtE,
+    ast.LtE: ast.Lt,
+    ast.Gt: ast.GtE,
+    ast.GtE: ast.Gt,
+    ast.Eq: ast.NotEq,
+    ast.NotEq: ast.Eq,
+    ast.Is: ast.IsNot,
+    ast.IsNot: ast.Is,
+    ast.In: ast.NotIn,
+    ast.NotIn: ast.In,
+}
+_BINARY = {
+    ast.Add: ast.Sub,
+    ast.Sub: ast.Add,
+    ast.Mult: ast.Div,
+    ast.Div: ast.Mult,
+    ast.Pow: ast.Mult,
+    ast.FloorDiv: ast.Mult,
+    ast.Mod: ast.FloorDiv,
+}
+_SWAPPED_NAMES = {
+    "min": "max",
+    "max": "min",
+    "minimum": "maximum",
+    "maximum": "minimum",
+    "argmin": "argmax",
+    "argmax": "argmin",
+    "all": "any",
+    "any": "all",
+    "amin": "amax",
+    "amax": "amin",
+    "nanmin": "nanmax",
+    "nanmax": "nanmin",
+}
+_SYMBOL = {
+    ast.Lt: "<",
+    ast.LtE: "<=",
+    ast.Gt: ">",
+    ast.GtE: ">=",
+    ast.Eq: "==",
+    ast.NotEq: "!=",
+    ast.Is: "is",
+    ast.IsNot: "is not",
+    ast.In: "in",
+    ast.NotIn: "not in",
+    ast.Add: "+",
+    ast.Sub: "-",
+    ast.Mult: "*",
+    ast.Div: "/",
+    ast.Pow: "**",
+    ast.FloorDiv: "//",
+    ast.Mod: "%",
+    ast.And: "and",
+    ast.Or: "or",
+}
 
 
 def _only_raises(body) -> bool:
@@ -293,7 +643,11 @@ def _skipped(node) -> bool:
         return True
     if isinstance(node, ast.If) and _only_raises(node.body) and not node.orelse:
         return True
-    if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
+    if (
+        isinstance(node, ast.Expr)
+        and isinstance(node.value, ast.Constant)
+        and isinstance(node.value.value, str)
+    ):
         return True  # a docstring
     if isinstance(node, ast.Call):
         name = _call_name(node) or ""
@@ -322,9 +676,11 @@ def _call_name(node: ast.Call) -> str | None:
 
 def _set_op(new):
     """A mutation that gives a binary, augmented or boolean operation the operator ``new``."""
+
     def apply(n):
         n.op = new()
         return n
+
     return apply
 
 
@@ -339,18 +695,25 @@ def _variants(node) -> list[tuple[str, callable]]:
                 def apply(n, index=index, new=new):
                     n.ops[index] = new()
                     return n
+
                 out.append((f"{_SYMBOL[type(op)]} -> {_SYMBOL[new]}", apply))
     elif isinstance(node, (ast.BinOp, ast.AugAssign)) and type(node.op) in _BINARY:
         new, equals = _BINARY[type(node.op)], "=" if isinstance(node, ast.AugAssign) else ""
         out.append((f"{_SYMBOL[type(node.op)]}{equals} -> {_SYMBOL[new]}{equals}", _set_op(new)))
     elif isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.Not)):
-        out.append(("drop " + ("-" if isinstance(node.op, ast.USub) else "not"), lambda n: n.operand))
+        out.append(
+            ("drop " + ("-" if isinstance(node.op, ast.USub) else "not"), lambda n: n.operand)
+        )
     elif isinstance(node, ast.BoolOp):
         new = ast.Or if isinstance(node.op, ast.And) else ast.And
         out.append((f"{_SYMBOL[type(node.op)]} -> {_SYMBOL[new]}", _set_op(new)))
     elif isinstance(node, ast.Constant) and isinstance(node.value, bool):
         out.append((f"{node.value} -> {not node.value}", lambda n: ast.Constant(not n.value)))
-    elif isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+    elif (
+        isinstance(node, ast.Constant)
+        and isinstance(node.value, (int, float))
+        and not isinstance(node.value, bool)
+    ):
         value = node.value
         changed = value + 1 if isinstance(value, int) else (value * 2.0 if value != 0.0 else 1.0)
         out.append((f"{value!r} -> {changed!r}", lambda n, changed=changed: ast.Constant(changed)))
@@ -367,6 +730,7 @@ def _variants(node) -> list[tuple[str, callable]]:
                 else:
                     n.func.attr = new
                 return n
+
             out.append((f"{name} -> {new}", apply))
     return out
 
@@ -397,8 +761,15 @@ def _source_tree(module: str) -> tuple[Path, ast.Module]:
 def _function_node(tree: ast.Module, qualname: str):
     scope = tree
     for part in qualname.split("."):
-        found = next((node for node in ast.iter_child_nodes(scope)
-                      if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node.name == part), None)
+        found = next(
+            (
+                node
+                for node in ast.iter_child_nodes(scope)
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))
+                and node.name == part
+            ),
+            None,
+        )
         if found is None:
             raise SystemExit(f"mutation: {qualname} not found")
         scope = found
@@ -418,13 +789,20 @@ def statement_text(function: ast.FunctionDef, inner: ast.AST) -> str:
     equivalent keep their keys when a formatter reflows a line."""
     holder = None
     for statement in ast.walk(function):
-        if isinstance(statement, ast.stmt) and statement is not function and any(n is inner for n in ast.walk(statement)):
+        if (
+            isinstance(statement, ast.stmt)
+            and statement is not function
+            and any(n is inner for n in ast.walk(statement))
+        ):
             holder = statement  # ast.walk is breadth first: the last one found is the innermost
     if holder is None:
         return ast.unparse(inner)
-    headers = {ast.If: lambda s: f"if {ast.unparse(s.test)}:", ast.While: lambda s: f"while {ast.unparse(s.test)}:",
-               ast.For: lambda s: f"for {ast.unparse(s.target)} in {ast.unparse(s.iter)}:",
-               ast.With: lambda s: f"with {', '.join(ast.unparse(item) for item in s.items)}:"}
+    headers = {
+        ast.If: lambda s: f"if {ast.unparse(s.test)}:",
+        ast.While: lambda s: f"while {ast.unparse(s.test)}:",
+        ast.For: lambda s: f"for {ast.unparse(s.target)} in {ast.unparse(s.iter)}:",
+        ast.With: lambda s: f"with {', '.join(ast.unparse(item) for item in s.items)}:",
+    }
     for kind, header in headers.items():
         if isinstance(holder, kind):
             return header(holder)
@@ -438,8 +816,17 @@ def mutants(target: Target) -> list[Mutant]:
         node = _function_node(tree, function)
         for index, inner in enumerate(_points(node)):
             for variant, (description, _) in enumerate(_variants(inner)):
-                out.append(Mutant(target, function, index, variant, inner.lineno, description,
-                                  statement_text(node, inner)))
+                out.append(
+                    Mutant(
+                        target,
+                        function,
+                        index,
+                        variant,
+                        inner.lineno,
+                        description,
+                        statement_text(node, inner),
+                    )
+                )
     return out
 
 
@@ -465,7 +852,9 @@ def _mutated_code(mutant: Mutant):
     stack = [code]
     while stack:
         current = stack.pop()
-        if current.co_qualname == mutant.function or (current.co_name == wanted and current.co_qualname.endswith(mutant.function)):
+        if current.co_qualname == mutant.function or (
+            current.co_name == wanted and current.co_qualname.endswith(mutant.function)
+        ):
             return current
         stack.extend(const for const in current.co_consts if hasattr(const, "co_code"))
     raise SystemExit(f"mutation: no code object for {mutant.function}")
@@ -497,10 +886,14 @@ def _run_child(target: Target, mutant: Mutant | None) -> int:
     if target.pure_python:
         from bidmp.extension import similarity
 
-        similarity._kernel_state.update({"Fréchet": similarity._frechet_rows, "DTW": similarity._dtw_rows})
+        similarity._kernel_state.update(
+            {"Fréchet": similarity._frechet_rows, "DTW": similarity._dtw_rows}
+        )
     sink = io.StringIO()
     with contextlib.redirect_stdout(sink), contextlib.redirect_stderr(sink):
-        return pytest.main([*target.tests, "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "--no-header"])
+        return pytest.main(
+            [*target.tests, "-x", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "--no-header"]
+        )
 
 
 def _fork(target: Target, mutant: Mutant | None) -> int:
@@ -538,13 +931,19 @@ def run(selected: list[Mutant], workers: int, timeout_of: dict) -> None:
                 mutant.outcome = "killed (timeout)"
             else:
                 code = os.waitstatus_to_exitcode(status)
-                mutant.outcome = "survived" if code == 0 else ("killed" if code == 1 else f"killed (exit {code})")
+                mutant.outcome = (
+                    "survived"
+                    if code == 0
+                    else ("killed" if code == 1 else f"killed (exit {code})")
+                )
             mutant.seconds = elapsed
             del running[pid]
             done += 1
             if mutant.outcome == "survived":
-                print(f"  survived: {mutant.target.module}:{mutant.line} {mutant.function}: {mutant.description}",
-                      flush=True)
+                print(
+                    f"  survived: {mutant.target.module}:{mutant.line} {mutant.function}: {mutant.description}",
+                    flush=True,
+                )
     return None
 
 
@@ -555,23 +954,29 @@ def baseline(target: Target) -> float:
     _, status = os.waitpid(pid, 0)
     code = os.waitstatus_to_exitcode(status)
     if code != 0:
-        raise SystemExit(f"mutation: the tests of {target.area} fail on the unmutated code (exit {code}): "
-                         f"{' '.join(target.tests)}")
+        raise SystemExit(
+            f"mutation: the tests of {target.area} fail on the unmutated code (exit {code}): "
+            f"{' '.join(target.tests)}"
+        )
     return time.monotonic() - began
 
 
 def report(selected: list[Mutant], seconds: float) -> str:
-    lines = ["# Mutation testing of the checks that guard the robot", "",
-             "Written by `make mutation` (`python tools/mutation.py`); do not edit. Each mutant is one small "
-             "bug planted in one judging function (a comparison made strict or loose, an operator or a constant "
-             "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
-             "tests that cover the area run against it. Input validation (`raise`, the `if` tests that only "
-             "raise, the calls of `check_*`/`as_*` helpers), messages and logging are not mutated: the surface "
-             "sweep (`make fuzz`) covers them. The score is the share killed of the mutants that can be killed: "
-             "an equivalent mutant (listed below with its reason) returns what the original returns — at "
-             "another cost, or differing only on an exact floating-point tie that rounding decides.", "",
-             "| area | module | functions | mutants | killed | equivalent | survived | score |",
-             "|---|---|---|---:|---:|---:|---:|---:|"]
+    lines = [
+        "# Mutation testing of the checks that guard the robot",
+        "",
+        "Written by `make mutation` (`python tools/mutation.py`); do not edit. Each mutant is one small "
+        "bug planted in one judging function (a comparison made strict or loose, an operator or a constant "
+        "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
+        "tests that cover the area run against it. Input validation (`raise`, the `if` tests that only "
+        "raise, the calls of `check_*`/`as_*` helpers), messages and logging are not mutated: the surface "
+        "sweep (`make fuzz`) covers them. The score is the share killed of the mutants that can be killed: "
+        "an equivalent mutant (listed below with its reason) returns what the original returns — at "
+        "another cost, or differing only on an exact floating-point tie that rounding decides.",
+        "",
+        "| area | module | functions | mutants | killed | equivalent | survived | score |",
+        "|---|---|---|---:|---:|---:|---:|---:|",
+    ]
     survivors = []
     for target in TARGETS:
         own = [m for m in selected if m.target is target]
@@ -583,33 +988,50 @@ def report(selected: list[Mutant], seconds: float) -> str:
         survivors += survived + equivalent
         # The standard score: killed among the mutants that can be killed (equivalent ones cannot).
         score = killed / max(len(own) - len(equivalent), 1)
-        lines.append(f"| {target.area} | `{target.module}` | {len(target.functions)} | {len(own)} | {killed} | "
-                     f"{len(equivalent)} | {len(survived)} | {100 * score:.1f} % |")
+        lines.append(
+            f"| {target.area} | `{target.module}` | {len(target.functions)} | {len(own)} | {killed} | "
+            f"{len(equivalent)} | {len(survived)} | {100 * score:.1f} % |"
+        )
     total = len(selected)
     killed = sum(m.outcome.startswith("killed") for m in selected)
-    lines += ["", f"{total} mutants, {killed} killed by the tests, in {seconds / 60:.1f} min on 2 workers.", ""]
+    lines += [
+        "",
+        f"{total} mutants, {killed} killed by the tests, in {seconds / 60:.1f} min on 2 workers.",
+        "",
+    ]
     lines += ["## Survivors", ""]
     if not survivors:
         lines.append("None.")
     for mutant in survivors:
         why = EQUIVALENT.get(mutant.key)
         verdict = f"equivalent: {why}" if why else "**not killed**"
-        lines.append(f"- `{mutant.target.module}:{mutant.line}` `{mutant.function}`: `{mutant.description}` — {verdict}")
+        lines.append(
+            f"- `{mutant.target.module}:{mutant.line}` `{mutant.function}`: `{mutant.description}` — {verdict}"
+        )
     lines += ["", "## Functions mutated", ""]
     for target in TARGETS:
-        lines.append(f"- {target.area}: " + ", ".join(f"`{name}`" for name in target.functions)
-                     + " — tests: " + ", ".join(f"`{Path(test).name}`" for test in target.tests))
+        lines.append(
+            f"- {target.area}: "
+            + ", ".join(f"`{name}`" for name in target.functions)
+            + " — tests: "
+            + ", ".join(f"`{Path(test).name}`" for test in target.tests)
+        )
     return "\n".join(lines) + "\n"
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--area", action="append", help="only this area (repeatable; a prefix is enough)")
+    parser.add_argument(
+        "--area", action="append", help="only this area (repeatable; a prefix is enough)"
+    )
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--list", action="store_true", help="list the mutants without running them")
     parser.add_argument("--out", default=str(ROOT / "docs" / "mutation.md"))
-    parser.add_argument("--report", action="store_true",
-                        help="only rewrite the report from the kept outcomes (after marking equivalents)")
+    parser.add_argument(
+        "--report",
+        action="store_true",
+        help="only rewrite the report from the kept outcomes (after marking equivalents)",
+    )
     args = parser.parse_args(argv)
     if args.report:
         report_again(Path(args.out))
@@ -625,8 +1047,9 @@ def main(argv=None) -> int:
             print(f"{m.target.area}: {m.target.module}:{m.line} {m.function}: {m.description}")
         print(f"{len(selected)} mutants")
         return 0
-    import bidmp  # noqa: F401 - imported once here; every child is a fork of this process
     import pytest  # noqa: F401
+
+    import bidmp  # noqa: F401 - imported once here; every child is a fork of this process
 
     for target in targets:
         importlib.import_module(target.module)
@@ -641,8 +1064,18 @@ def main(argv=None) -> int:
         killed = sum(m.outcome.startswith("killed") for m in own)
         area_seconds[target.area] = round(time.monotonic() - began, 1)
         print(f"{target.area}: {killed}/{len(own)} killed", flush=True)
-    rows = [{"area": m.target.area, "module": m.target.module, "function": m.function, "line": m.line,
-             "text": m.text, "mutation": m.description, "outcome": m.outcome} for m in selected]
+    rows = [
+        {
+            "area": m.target.area,
+            "module": m.target.module,
+            "function": m.function,
+            "line": m.line,
+            "text": m.text,
+            "mutation": m.description,
+            "outcome": m.outcome,
+        }
+        for m in selected
+    ]
     kept = Path(args.out).with_suffix(".json")
     if args.area and kept.exists():  # the areas run again replace theirs; the others are kept
         previous = json.loads(kept.read_text(encoding="utf-8"))
@@ -665,8 +1098,20 @@ def report_again(out: Path) -> None:
     :data:`EQUIVALENT`: a survivor shown equivalent after the run needs no new run."""
     kept = json.loads(out.with_suffix(".json").read_text(encoding="utf-8"))
     by_area = {target.area: target for target in TARGETS}
-    selected = [Mutant(by_area[m["area"]], m["function"], 0, 0, m["line"], m["mutation"], m["text"], m["outcome"])
-                for m in kept["mutants"] if m["area"] in by_area]
+    selected = [
+        Mutant(
+            by_area[m["area"]],
+            m["function"],
+            0,
+            0,
+            m["line"],
+            m["mutation"],
+            m["text"],
+            m["outcome"],
+        )
+        for m in kept["mutants"]
+        if m["area"] in by_area
+    ]
     _write(out, report(selected, sum(kept["area_seconds"].values())))
 
 

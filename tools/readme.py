@@ -18,7 +18,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
-BLOCK = re.compile(r"(<!-- generated: (?P<path>\S+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.DOTALL)
+BLOCK = re.compile(
+    r"(<!-- generated: (?P<path>\S+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.DOTALL
+)
 
 
 def blocks(text: str) -> list[tuple[str, str]]:
@@ -28,6 +30,7 @@ def blocks(text: str) -> list[tuple[str, str]]:
 
 def render(text: str) -> str:
     """``text`` with every generated block replaced by its file's current content."""
+
     def replace(match):
         content = (ROOT / match["path"]).read_text(encoding="utf-8")
         return match.group(1) + content.rstrip("\n") + "\n" + match.group(4)

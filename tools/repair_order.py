@@ -25,8 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
 from test_random_user_cells import user_cell  # noqa: E402  (the random cells as the tests draw them)
 
-from bidmp.tasks import scenarios  # noqa: E402
-from bidmp.tasks import evaluate# noqa: E402
+from bidmp.tasks import evaluate, scenarios  # noqa: E402
 from bidmp.tasks.contract import Contract  # noqa: E402
 from bidmp.tasks.repair import REPAIRS, Repairer  # noqa: E402
 
@@ -47,8 +46,14 @@ def broken_motions(spec: dict):
 
 
 def repairer(scenario, order) -> Repairer:
-    return Repairer(Contract.of(scenario), scenario.demonstration, extension=scenario.extension, seed=scenario.seed,
-                    bidmp=scenario.bidmp, order=order)
+    return Repairer(
+        Contract.of(scenario),
+        scenario.demonstration,
+        extension=scenario.extension,
+        seed=scenario.seed,
+        bidmp=scenario.bidmp,
+        order=order,
+    )
 
 
 def main() -> None:
@@ -58,7 +63,10 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="write the Markdown table here too")
     args = parser.parse_args()
     specs = [user_cell(seed) for seed in range(args.first_seed, args.first_seed + args.cells)]
-    specs += [json.loads((ROOT / "tests" / "data" / name).read_text()) for name in ("two_posts.json", "duct_module.json")]
+    specs += [
+        json.loads((ROOT / "tests" / "data" / name).read_text())
+        for name in ("two_posts.json", "duct_module.json")
+    ]
     orders = [(how,) for how in REPAIRS if how != "margin"] + [REPAIRS]
     logging.basicConfig(level=logging.ERROR)  # a repair that finds no route says so at WARNING
     kinds = ("too close", "off target")
@@ -79,25 +87,38 @@ def main() -> None:
                 if kind == kinds[1] and "extend" not in order:
                     continue  # skipped by design: nothing but an extension brings a motion onto its target
                 started = time.perf_counter()
-                fixed = repairer(scenario, order).repair(model, scenario.targets[label], label, axis=axis,
-                                                         exclude=exclude, motion=motion, verdict=verdict)
+                fixed = repairer(scenario, order).repair(
+                    model,
+                    scenario.targets[label],
+                    label,
+                    axis=axis,
+                    exclude=exclude,
+                    motion=motion,
+                    verdict=verdict,
+                )
                 counts[order, kind][1].append(time.perf_counter() - started)
                 counts[order, kind][0] += bool(fixed.how)
-    lines = [f"{len(specs)} cells; broken motions: {seen['too close']} only too close to a part, "
-             f"{seen['off target']} missing the end or the engagement; {blocked} refused at once (final approach "
-             "blocked)", "",
-             "| repairs | motion broken by | kept within the contract | median s per motion | mean s per motion |",
-             "|---|---|---|---|---|"]
+    lines = [
+        f"{len(specs)} cells; broken motions: {seen['too close']} only too close to a part, "
+        f"{seen['off target']} missing the end or the engagement; {blocked} refused at once (final approach "
+        "blocked)",
+        "",
+        "| repairs | motion broken by | kept within the contract | median s per motion | mean s per motion |",
+        "|---|---|---|---|---|",
+    ]
     for (order, kind), (ok, seconds) in counts.items():
         if seconds:
-            lines.append(f"| {' -> '.join(order)} | {kind} | {ok}/{seen[kind]} | {statistics.median(seconds):.3f} | "
-                         f"{statistics.fmean(seconds):.3f} |")
+            lines.append(
+                f"| {' -> '.join(order)} | {kind} | {ok}/{seen[kind]} | {statistics.median(seconds):.3f} | "
+                f"{statistics.fmean(seconds):.3f} |"
+            )
     text = "\n".join(lines) + "\n"
     print(text, end="")
     if args.out is not None:
         partial = args.out.with_name(args.out.name + ".partial")
         partial.write_text(text, encoding="utf-8")
         partial.replace(args.out)  # atomically
+
 
 if __name__ == "__main__":
     main()

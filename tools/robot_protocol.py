@@ -29,13 +29,19 @@ VERSIONS = {"bidmp": {}, "bidmp 0.3": {"integrator": "euler", "regression": "lwr
 def at_speed(via, n_samples, speed, rate=250.0):
     demo = minimum_jerk(via, n_samples)
     t = np.arange(n_samples) / rate
-    first = int(np.argmax(np.linalg.norm(np.gradient(demo, t, axis=0), axis=1) >= speed)) if speed > 0 else 0
+    first = (
+        int(np.argmax(np.linalg.norm(np.gradient(demo, t, axis=0), axis=1) >= speed))
+        if speed > 0
+        else 0
+    )
     return demo[first:], t[first:] - t[first]
 
 
 def start_peaks(t, ydd):
     early = t <= 0.05 + 1e-12
-    return np.linalg.norm(ydd, axis=1)[early].max(), np.linalg.norm(np.gradient(ydd, t, axis=0), axis=1)[early].max()
+    return np.linalg.norm(ydd, axis=1)[early].max(), np.linalg.norm(
+        np.gradient(ydd, t, axis=0), axis=1
+    )[early].max()
 
 
 def start_row(name, y, t):
@@ -49,7 +55,9 @@ def start_row(name, y, t):
         for goal in (None, dmp.goal_ + SHIFT, dmp.goal_ - SHIFT, dmp.goal_ + [0.0, 0.0, 150.0]):
             for dt in (1 / 250, 1e-3):
                 motion = dmp.trajectory(goal, dt=dt)
-                worst = np.maximum(worst, np.array(start_peaks(motion.t, motion.ydd)) / demonstrated)
+                worst = np.maximum(
+                    worst, np.array(start_peaks(motion.t, motion.ydd)) / demonstrated
+                )
         cells += [f"{worst[0]:.3g}", f"{worst[1]:.3g}"]
     return cells
 
@@ -66,7 +74,9 @@ def rate_row():
         worst = 0.0
         for dt in (1e-3, 1e-4):
             fast = dmp.trajectory(dt=dt)
-            resampled = np.column_stack([np.interp(native.t, fast.t, column) for column in fast.y.T])
+            resampled = np.column_stack(
+                [np.interp(native.t, fast.t, column) for column in fast.y.T]
+            )
             worst = max(worst, float(np.max(np.linalg.norm(resampled - native.y, axis=1))))
         cells.append(f"{100 * worst / extent:.3g} % ({worst:.3g} mm)")
     return cells
@@ -99,7 +109,9 @@ def near_goal_rows():
     start, end = prepared.y[0], prepared.y[-1]
     length = float(np.linalg.norm(end - start))
     direction = (end - start) / length
-    models = {name: bidmp.DMP(**params).fit(prepared.y, prepared.t) for name, params in VERSIONS.items()}
+    models = {
+        name: bidmp.DMP(**params).fit(prepared.y, prepared.t) for name, params in VERSIONS.items()
+    }
     models["delayed goal (goal_rate = 4/T)"] = bidmp.DMP(goal_rate=4.0).fit(prepared.y, prepared.t)
     rows = []
     for fraction in (0.01, 0.1):
@@ -107,7 +119,9 @@ def near_goal_rows():
         cells = [f"{fraction * length:.3g} mm"]
         for model in models.values():
             along = (model.trajectory(goal).y - start) @ direction
-            cells.append(f"{max(along.max() - fraction * length, 0.0) + 0.0:.3g} / {max(-along.min(), 0.0) + 0.0:.3g}")
+            cells.append(
+                f"{max(along.max() - fraction * length, 0.0) + 0.0:.3g} / {max(-along.min(), 0.0) + 0.0:.3g}"
+            )
         cells.append(_peer_near(prepared, goal, direction, fraction * length))
         rows.append(cells)
     return rows, length
@@ -118,7 +132,13 @@ def _peer_near(prepared, goal, direction, distance):
         from movement_primitives.dmp import DMP as PeerDMP
     except ImportError:
         return "not installed"
-    peer = PeerDMP(n_dims=3, execution_time=prepared.t[-1], dt=prepared.t[1], n_weights_per_dim=100, smooth_scaling=True)
+    peer = PeerDMP(
+        n_dims=3,
+        execution_time=prepared.t[-1],
+        dt=prepared.t[1],
+        n_weights_per_dim=100,
+        smooth_scaling=True,
+    )
     peer.imitate(prepared.t, prepared.y)
     peer.configure(start_y=prepared.y[0], goal_y=goal)
     along = (peer.open_loop()[1] - prepared.y[0]) @ direction
@@ -132,7 +152,9 @@ def recording_rows():
         cells = [name]
         for params in VERSIONS.values():
             dmp = bidmp.DMP(**params).fit(prepared.y, prepared.t)
-            rms = np.sqrt(np.mean(np.sum((dmp.rollout()[: dmp.n_steps_] - prepared.y) ** 2, axis=1)))
+            rms = np.sqrt(
+                np.mean(np.sum((dmp.rollout()[: dmp.n_steps_] - prepared.y) ** 2, axis=1))
+            )
             moved = dmp.trajectory(dmp.goal_ + SHIFT)
             cells += [f"{rms:.3g}", f"{np.linalg.norm(moved.y[-1] - dmp.goal_ - SHIFT):.2g}"]
         rows.append(cells)
@@ -145,11 +167,23 @@ def table(header, rows):
 
 
 def markdown() -> str:
-    starts = [start_row(name, *(lambda p: (p.y, p.t))(bidmp.prepare(*bidmp.demonstrations.recording(name))[0]))
-              for name in ("operator1_nut3", "operator2_nut5")]
+    starts = [
+        start_row(
+            name, *(lambda p: (p.y, p.t))(bidmp.prepare(*bidmp.demonstrations.recording(name))[0])
+        )
+        for name in ("operator1_nut3", "operator2_nut5")
+    ]
     for speed in (0.0, 1.9, 5.0):
-        for via, n in ((NUT_VIA, 2000), ([[0, 0, 0], [100, 50, 20]], 1000), ([[0, 0, 0], [0, 0, -60]], 600)):
-            starts.append(start_row(f"minimum jerk, {n / 250:g} s, from {speed:g} mm/s", *at_speed(via, n, speed)))
+        for via, n in (
+            (NUT_VIA, 2000),
+            ([[0, 0, 0], [100, 50, 20]], 1000),
+            ([[0, 0, 0], [0, 0, -60]], 600),
+        ):
+            starts.append(
+                start_row(
+                    f"minimum jerk, {n / 250:g} s, from {speed:g} mm/s", *at_speed(via, n, speed)
+                )
+            )
     near, length = near_goal_rows()
     ours, old = rate_row()
     parts = [
@@ -157,7 +191,16 @@ def markdown() -> str:
         "over its first 50 ms to the demonstration's own over the same span, for the demonstrated goal and goals moved "
         "by 150 mm, at 250 Hz and 1 kHz.",
         "",
-        table(["demonstration", "bidmp: acceleration", "bidmp: jerk", "bidmp 0.3: acceleration", "bidmp 0.3: jerk"], starts),
+        table(
+            [
+                "demonstration",
+                "bidmp: acceleration",
+                "bidmp: jerk",
+                "bidmp 0.3: acceleration",
+                "bidmp 0.3: jerk",
+            ],
+            starts,
+        ),
         "",
         f"**Any control rate.** A 100 Hz recording rolled out at 1 kHz and 10 kHz, the largest distance to its own-rate "
         f"rollout: bidmp {ours}; bidmp 0.3 {old}; movement_primitives at 1 kHz {movement_primitives_rate()}.",
@@ -165,12 +208,28 @@ def markdown() -> str:
         f"**Nearer goals** on a straight {length:.3g} mm recording: overshoot past the goal / distance run backwards "
         f"from the start (mm).",
         "",
-        table(["goal", *VERSIONS, "delayed goal (goal_rate = 4/T)", "movement_primitives (smooth scaling)"], near),
+        table(
+            [
+                "goal",
+                *VERSIONS,
+                "delayed goal (goal_rate = 4/T)",
+                "movement_primitives (smooth scaling)",
+            ],
+            near,
+        ),
         "",
         "**The shared recordings**: reproduction RMSE (mm) and the distance to a goal moved by 150 mm at rest (mm).",
         "",
-        table(["recording", "bidmp: RMSE", "bidmp: moved goal", "bidmp 0.3: RMSE", "bidmp 0.3: moved goal"],
-              recording_rows()),
+        table(
+            [
+                "recording",
+                "bidmp: RMSE",
+                "bidmp: moved goal",
+                "bidmp 0.3: RMSE",
+                "bidmp 0.3: moved goal",
+            ],
+            recording_rows(),
+        ),
     ]
     return "\n".join(parts) + "\n"
 
@@ -181,7 +240,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     import logging
 
-    logging.getLogger("bidmp").setLevel(logging.ERROR)  # the demonstrations that start at speed say so
+    logging.getLogger("bidmp").setLevel(
+        logging.ERROR
+    )  # the demonstrations that start at speed say so
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         text = markdown()

@@ -23,22 +23,33 @@ def main() -> None:
     tilt = Rotation.from_euler("x", TILT, degrees=True)
     down = Rotation.from_euler("x", 180.0, degrees=True)  # the tool's z axis pointing down
     into_nut = (tilt * down).as_quat()
-    targets = {label: [round(float(v), 6) for v in (*tilt.apply(point), *into_nut)] for label, point in flat["targets"].items()}
+    targets = {
+        label: [round(float(v), 6) for v in (*tilt.apply(point), *into_nut)]
+        for label, point in flat["targets"].items()
+    }
     axis = tilt.apply([0.0, 0.0, 1.0])
     hover = 40.0 * axis  # the demonstrated descent: 40 mm along nut 3's axis
     vertical = down.as_quat()
     via = [[-80.0, -120.0, 200.0, *vertical], [*hover, *into_nut], [0.0, 0.0, 0.0, *into_nut]]
     scenario = {
         "name": "nut-unscrewing-tilted",
-        "description": (f"The nut task on a battery pack tilted {TILT:g} degrees about x: the same 2 x 7 grid of M8 "
-                        "nuts on studs, one pose demonstration to nut 3 that turns the socket from vertical onto the nut's "
-                        "axis and comes down along it. Success also needs the tool axis within 2 degrees of the nut's "
-                        "axis over the last approach height. Written by tools/tilted_scenario.py."),
+        "description": (
+            f"The nut task on a battery pack tilted {TILT:g} degrees about x: the same 2 x 7 grid of M8 "
+            "nuts on studs, one pose demonstration to nut 3 that turns the socket from vertical onto the nut's "
+            "axis and comes down along it. Success also needs the tool axis within 2 degrees of the nut's "
+            "axis over the last approach height. Written by tools/tilted_scenario.py."
+        ),
         "units": "mm",
         "targets": targets,
         "demonstrated": "3",
-        "demonstration": {"minimum_jerk": {"via": [[round(v, 6) for v in row] for row in via], "n_steps": 200,
-                                           "noise": 0.0, "seed": 0}},
+        "demonstration": {
+            "minimum_jerk": {
+                "via": [[round(v, 6) for v in row] for row in via],
+                "n_steps": 200,
+                "noise": 0.0,
+                "seed": 0,
+            }
+        },
         "success_threshold": 1.75,
         "approach_height": 28.5,
         "alignment_threshold": 2.0,
@@ -53,10 +64,22 @@ def main() -> None:
             "margin": flat["scene"]["margin"],
             "standoff": flat["scene"]["standoff"],  # the socket's mouth over the plate at a nut
             "parts": [
-                {"type": "plate", "label": "plate", "at": [round(v, 6) for v in tilt.apply([90.0, 25.0, -2.0])],
-                 "size": [280, 130, 5], "rotation": [TILT, 0, 0]},
-                {"type": "nut", "at_targets": "all", "offset": [0, 0, -2], "rotation": [TILT, 0, 0], "across_flats": 13,
-                 "height": 6.5, "stud": {"radius": 4, "above": 10}},
+                {
+                    "type": "plate",
+                    "label": "plate",
+                    "at": [round(v, 6) for v in tilt.apply([90.0, 25.0, -2.0])],
+                    "size": [280, 130, 5],
+                    "rotation": [TILT, 0, 0],
+                },
+                {
+                    "type": "nut",
+                    "at_targets": "all",
+                    "offset": [0, 0, -2],
+                    "rotation": [TILT, 0, 0],
+                    "across_flats": 13,
+                    "height": 6.5,
+                    "stud": {"radius": 4, "above": 10},
+                },
             ],
         },
         "methods": ["dmp", "bidmp", "bidmp-latest"],

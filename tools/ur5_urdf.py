@@ -21,8 +21,14 @@ import math
 from pathlib import Path
 
 # (d, a, alpha) per joint, metres and radians: the UR5 (CB3) table.
-DH = ((0.089159, 0.0, math.pi / 2), (0.0, -0.425, 0.0), (0.0, -0.39225, 0.0),
-      (0.10915, 0.0, math.pi / 2), (0.09465, 0.0, -math.pi / 2), (0.0823, 0.0, 0.0))
+DH = (
+    (0.089159, 0.0, math.pi / 2),
+    (0.0, -0.425, 0.0),
+    (0.0, -0.39225, 0.0),
+    (0.10915, 0.0, math.pi / 2),
+    (0.09465, 0.0, -math.pi / 2),
+    (0.0823, 0.0, 0.0),
+)
 MASSES = (3.7, 8.393, 2.275, 1.219, 1.219, 0.1879)  # kg, shoulder ... wrist 3
 RADII = (0.06, 0.054, 0.04, 0.045, 0.045, 0.04)  # m: the tube or housing round each DH segment
 EFFORT = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)  # N m
@@ -36,36 +42,50 @@ def _segment(d: float, a: float, radius: float, mass: float) -> str:
     length = math.hypot(a, d)
     pitch = math.atan2(a, d)  # turns the cylinder's z onto (a, 0, d)
     centre = f"{a / 2:.6f} 0 {d / 2:.6f}"
-    shape = (f'<origin xyz="{centre}" rpy="0 {pitch:.6f} 0"/><geometry><cylinder radius="{radius}" '
-             f'length="{max(length, 0.02):.6f}"/></geometry>')
+    shape = (
+        f'<origin xyz="{centre}" rpy="0 {pitch:.6f} 0"/><geometry><cylinder radius="{radius}" '
+        f'length="{max(length, 0.02):.6f}"/></geometry>'
+    )
     inertia = mass * radius**2 / 2.0
-    return (f"    <inertial><origin xyz=\"{centre}\"/><mass value=\"{mass}\"/><inertia ixx=\"{inertia:.6g}\" ixy=\"0\" "
-            f"ixz=\"0\" iyy=\"{inertia:.6g}\" iyz=\"0\" izz=\"{inertia:.6g}\"/></inertial>\n"
-            f"    <visual>{shape}<material name=\"ur\"><color rgba=\"0.6 0.65 0.7 1\"/></material></visual>\n"
-            f"    <collision>{shape}</collision>\n")
+    return (
+        f'    <inertial><origin xyz="{centre}"/><mass value="{mass}"/><inertia ixx="{inertia:.6g}" ixy="0" '
+        f'ixz="0" iyy="{inertia:.6g}" iyz="0" izz="{inertia:.6g}"/></inertial>\n'
+        f'    <visual>{shape}<material name="ur"><color rgba="0.6 0.65 0.7 1"/></material></visual>\n'
+        f"    <collision>{shape}</collision>\n"
+    )
 
 
 def urdf() -> str:
-    lines = ['<?xml version="1.0"?>',
-             "<!-- Written by tools/ur5_urdf.py from the UR5's published DH parameters and limits. -->",
-             '<robot name="ur5_dh">',
-             '  <link name="base_link">',
-             '    <inertial><mass value="4.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
-             '    <visual><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></visual>',
-             '    <collision><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></collision>',
-             "  </link>"]
+    lines = [
+        '<?xml version="1.0"?>',
+        "<!-- Written by tools/ur5_urdf.py from the UR5's published DH parameters and limits. -->",
+        '<robot name="ur5_dh">',
+        '  <link name="base_link">',
+        '    <inertial><mass value="4.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
+        '    <visual><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></visual>',
+        '    <collision><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></collision>',
+        "  </link>",
+    ]
     parent, origin = "base_link", ("0 0 0", "0 0 0")
-    for index, ((d, a, alpha), mass, radius, effort) in enumerate(zip(DH, MASSES, RADII, EFFORT), start=1):
+    for index, ((d, a, alpha), mass, radius, effort) in enumerate(
+        zip(DH, MASSES, RADII, EFFORT), start=1
+    ):
         name = f"link{index}"
-        lines.append(f'  <joint name="joint{index}" type="revolute"><parent link="{parent}"/><child link="{name}"/>'
-                     f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/><axis xyz="0 0 1"/>'
-                     f'<limit lower="{-RANGE:.6f}" upper="{RANGE:.6f}" velocity="{SPEED:.6f}" effort="{effort}"/></joint>')
+        lines.append(
+            f'  <joint name="joint{index}" type="revolute"><parent link="{parent}"/><child link="{name}"/>'
+            f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/><axis xyz="0 0 1"/>'
+            f'<limit lower="{-RANGE:.6f}" upper="{RANGE:.6f}" velocity="{SPEED:.6f}" effort="{effort}"/></joint>'
+        )
         lines.append(f'  <link name="{name}">\n{_segment(d, a, radius, mass)}  </link>')
         parent, origin = name, (f"{a} 0 {d}", f"{alpha:.10f} 0 0")
-    lines.append(f'  <joint name="flange_joint" type="fixed"><parent link="{parent}"/><child link="flange"/>'
-                 f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/></joint>')
-    lines.append('  <link name="flange"><inertial><mass value="0.01"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" '
-                 'iyz="0" izz="1e-6"/></inertial></link>')
+    lines.append(
+        f'  <joint name="flange_joint" type="fixed"><parent link="{parent}"/><child link="flange"/>'
+        f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/></joint>'
+    )
+    lines.append(
+        '  <link name="flange"><inertial><mass value="0.01"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" '
+        'iyz="0" izz="1e-6"/></inertial></link>'
+    )
     lines.append("</robot>")
     return "\n".join(lines) + "\n"
 

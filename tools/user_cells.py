@@ -19,10 +19,14 @@ sys.path.insert(0, str(ROOT / "tests"))
 from test_user_cells import spec  # noqa: E402  (the cells and their unit conversion, as the tests use them)
 
 from bidmp import sim  # noqa: E402
-from bidmp.tasks import scenarios  # noqa: E402
-from bidmp.tasks import evaluate# noqa: E402
+from bidmp.tasks import evaluate, scenarios  # noqa: E402
 
-CELLS = (("two_posts.json", "mm"), ("duct_module.json", "mm"), ("duct_module.json", "cm"), ("duct_module.json", "m"))
+CELLS = (
+    ("two_posts.json", "mm"),
+    ("duct_module.json", "mm"),
+    ("duct_module.json", "cm"),
+    ("duct_module.json", "m"),
+)
 
 
 def row(name: str, units: str) -> list[str]:
@@ -30,24 +34,50 @@ def row(name: str, units: str) -> list[str]:
     n = len(scenario.labels)
     report = evaluate(scenario, ["dmp", "bidmp"])
     dmp, bidmp = report.methods["dmp"], report.methods["bidmp"]
-    hows = collections.Counter(bidmp.repaired_at(label) for label in bidmp.repairs if bidmp.repaired_at(label))
+    hows = collections.Counter(
+        bidmp.repaired_at(label) for label in bidmp.repairs if bidmp.repaired_at(label)
+    )
     repaired = ", ".join(f"{how} {count}" for how, count in sorted(hows.items())) or "-"
     ran = sim.simulate(scenario, ["bidmp"], workers=2).methods["bidmp"]
     job = sim.run_job(scenario)
-    return [scenario.name, units, f"{dmp.task_successes}/{n}", f"{bidmp.task_successes}/{n}", repaired,
-            f"{ran.task_successes}/{n}", f"{ran.contacts}", f"{ran.within_limits}/{n}", f"{job.removed}/{n}",
-            f"{sum(t.within_limits for t in job.targets)}/{n}"]
+    return [
+        scenario.name,
+        units,
+        f"{dmp.task_successes}/{n}",
+        f"{bidmp.task_successes}/{n}",
+        repaired,
+        f"{ran.task_successes}/{n}",
+        f"{ran.contacts}",
+        f"{ran.within_limits}/{n}",
+        f"{job.removed}/{n}",
+        f"{sum(t.within_limits for t in job.targets)}/{n}",
+    ]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=None, help="write the Markdown table here too")
     args = parser.parse_args()
-    header = ["cell", "units", "evaluate: dmp", "evaluate: bidmp", "repaired (how)", "sim: bidmp", "contacts",
-              "within limits", "job: removed", "job: within limits"]
+    header = [
+        "cell",
+        "units",
+        "evaluate: dmp",
+        "evaluate: bidmp",
+        "repaired (how)",
+        "sim: bidmp",
+        "contacts",
+        "within limits",
+        "job: removed",
+        "job: within limits",
+    ]
     rows = [row(name, units) for name, units in CELLS]
-    table = "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-                      + ["| " + " | ".join(cells) + " |" for cells in rows]) + "\n"
+    table = (
+        "\n".join(
+            ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+            + ["| " + " | ".join(cells) + " |" for cells in rows]
+        )
+        + "\n"
+    )
     print(table)
     if args.out:
         Path(args.out).write_text(table)

@@ -22,7 +22,6 @@ import logging
 from typing import TYPE_CHECKING
 
 from ._lazy import exports
-
 from ._version import __version__
 
 # A library logs; the application decides what is shown (without a handler of its own, Python's
@@ -60,8 +59,19 @@ _LAZY = {
     "set_limits": "_checks",
 }
 # the subpackages of the layout
-_SUBPACKAGES = ("primitives", "demonstrations", "extension", "incremental", "baselines", "scene", "tasks", "sim",
-                "experiments", "io", "plotting")
+_SUBPACKAGES = (
+    "primitives",
+    "demonstrations",
+    "extension",
+    "incremental",
+    "baselines",
+    "scene",
+    "tasks",
+    "sim",
+    "experiments",
+    "io",
+    "plotting",
+)
 
 __all__ = ["__version__", *_LAZY, *_SUBPACKAGES]
 

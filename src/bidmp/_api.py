@@ -23,6 +23,10 @@ class CheckedParams:
 
         known = self._get_param_names()
         for name in params:
-            if name.partition("__")[0] not in known:  # "dmp__alpha": a nested estimator's, checked by it
-                raise ValueError(f"set_params: unknown parameter {short_token(name)}; known: {', '.join(known)}")
+            if (
+                name.partition("__")[0] not in known
+            ):  # "dmp__alpha": a nested estimator's, checked by it
+                raise ValueError(
+                    f"set_params: unknown parameter {short_token(name)}; known: {', '.join(known)}"
+                )
         return super().set_params(**params)

@@ -148,7 +148,9 @@ def set_limits(**changes) -> _Restore:
     previous = get_limits()
     for name, value in changes.items():
         if name not in _LIMIT_NAMES:
-            raise TypeError(f"set_limits: unknown limit {short_token(name)}; known: {', '.join(_LIMIT_NAMES)}")
+            raise TypeError(
+                f"set_limits: unknown limit {short_token(name)}; known: {', '.join(_LIMIT_NAMES)}"
+            )
         current = getattr(_LIMITS, name)
         if isinstance(current, int) and not isinstance(current, bool):
             value = check_int(value, name, minimum=1)
@@ -167,7 +169,11 @@ def _count(value) -> str:
     15 digits (an integer of hundreds of digits is not a message)."""
     if isinstance(value, (int, np.integer)):
         digits = len(str(abs(int(value))))
-        return f"{int(value):,}" if digits <= 15 else f"{'-' if value < 0 else ''}about 10^{digits - 1}"
+        return (
+            f"{int(value):,}"
+            if digits <= 15
+            else f"{'-' if value < 0 else ''}about 10^{digits - 1}"
+        )
     return f"{float(value):.3g}"
 
 
@@ -181,7 +187,9 @@ def check_bytes(n_elements, what: str, itemsize: int = 8) -> None:
     """Refuse an array of ``n_elements`` (of ``itemsize`` bytes) over ``max_array_bytes``."""
     n_bytes = int(n_elements) * int(itemsize)
     if n_bytes > _LIMITS.max_array_bytes:
-        raise ValueError(f"{what} would take {n_bytes / 2**30:.3g} GiB, over {_limit_hint('max_array_bytes')}")
+        raise ValueError(
+            f"{what} would take {n_bytes / 2**30:.3g} GiB, over {_limit_hint('max_array_bytes')}"
+        )
 
 
 def printable(text) -> str:
@@ -193,7 +201,12 @@ def printable(text) -> str:
 def short_token(value, width: int = 10) -> str:
     """A rejected value quoted for an error message: at most ``width`` characters, printable only
     (a file read by mistake must not be echoed into a terminal or a log)."""
-    if isinstance(value, (list, tuple, dict, set)) and len(value) > 4 or isinstance(value, np.ndarray) and value.size > 8:
+    if (
+        isinstance(value, (list, tuple, dict, set))
+        and len(value) > 4
+        or isinstance(value, np.ndarray)
+        and value.size > 8
+    ):
         text = f"{type(value).__name__} of {len(value) if not isinstance(value, np.ndarray) else value.shape}"
     else:
         try:  # a container nested thousands deep, or an integer of thousands of digits, has no short text
@@ -216,7 +229,9 @@ def require_extra(module: str, extra: str, what: str):
     try:
         return importlib.import_module(module)
     except ImportError:
-        raise MissingExtraError(f"{module}, needed for {what}, is not installed: pip install 'bidmp[{extra}]'") from None
+        raise MissingExtraError(
+            f"{module}, needed for {what}, is not installed: pip install 'bidmp[{extra}]'"
+        ) from None
 
 
 class NotFittedError(ValueError, AttributeError):
@@ -235,7 +250,11 @@ def _as_float_array(value, name: str) -> np.ndarray:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
         # NumPy's own text ("setting an array element with a sequence", …) names no argument.
-        shape = "ragged rows" if isinstance(value, (list, tuple)) else f"{type(value).__name__} {short_token(value)}"
+        shape = (
+            "ragged rows"
+            if isinstance(value, (list, tuple))
+            else f"{type(value).__name__} {short_token(value)}"
+        )
         raise TypeError(f"{name} must be an array of numbers, got {shape}") from None
     return array
 
@@ -251,8 +270,10 @@ def _check_finite(array: np.ndarray, name: str) -> None:
 def _check_magnitude(array: np.ndarray, name: str) -> None:
     """Refuse coordinates beyond ``max_abs_value`` (finite, but their squares or spring forces overflow)."""
     if array.size and float(np.max(np.abs(array))) > _LIMITS.max_abs_value:
-        raise ValueError(f"{name} has a coordinate of magnitude {float(np.max(np.abs(array))):.3g}, beyond "
-                         f"{_limit_hint('max_abs_value')} (or rescale the data to another unit)")
+        raise ValueError(
+            f"{name} has a coordinate of magnitude {float(np.max(np.abs(array))):.3g}, beyond "
+            f"{_limit_hint('max_abs_value')} (or rescale the data to another unit)"
+        )
 
 
 def _as_bounded_array(value, name: str, max_ndim: int) -> np.ndarray:
@@ -265,13 +286,17 @@ def _as_bounded_array(value, name: str, max_ndim: int) -> np.ndarray:
             raise TypeError(f"{name} must be real numbers, got complex")
         if value.dtype == np.float64:
             return value
-    elif isinstance(value, complex) or (isinstance(value, (list, tuple)) and any(isinstance(v, complex) for v in value)):
+    elif isinstance(value, complex) or (
+        isinstance(value, (list, tuple)) and any(isinstance(v, complex) for v in value)
+    ):
         raise TypeError(f"{name} must be real numbers, got complex")
     array = _as_float_array(value, name)
     return array
 
 
-def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = False) -> np.ndarray:
+def as_trajectory(
+    y, name: str = "y", min_points: int = 3, allow_static: bool = False
+) -> np.ndarray:
     """Validate a trajectory and return it as a C-contiguous float64 array of shape (T, D).
 
     Raises
@@ -285,7 +310,9 @@ def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = 
     array = _as_bounded_array(y, name, 3)
     if array.ndim != 2:
         hint = " (for a 1-D signal use shape (T, 1))" if array.ndim == 1 else ""
-        raise ValueError(f"{name} must have shape (T, D), got an array with {array.ndim} dimension(s){hint}")
+        raise ValueError(
+            f"{name} must have shape (T, D), got an array with {array.ndim} dimension(s){hint}"
+        )
     n_points, n_dims = array.shape
     if n_dims < 1:
         raise ValueError(f"{name} must have at least one column (D >= 1), got shape {array.shape}")
@@ -312,9 +339,11 @@ def as_trajectory(y, name: str = "y", min_points: int = 3, allow_static: bool = 
         if motion == 0.0:
             raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
         if motion < _LIMITS.min_extent or motion < 1e-12 * scale:
-            raise ValueError(f"{name} barely moves: no coordinate leaves the start by more than {motion:.3g}, below the "
-                             f"smallest supported motion (min_extent = {_LIMITS.min_extent:g}, or 1e-12 of its "
-                             f"coordinates' magnitude {scale:.3g}); rescale the data")
+            raise ValueError(
+                f"{name} barely moves: no coordinate leaves the start by more than {motion:.3g}, below the "
+                f"smallest supported motion (min_extent = {_LIMITS.min_extent:g}, or 1e-12 of its "
+                f"coordinates' magnitude {scale:.3g}); rescale the data"
+            )
     return np.ascontiguousarray(array)
 
 
@@ -326,7 +355,9 @@ def as_point(p, n_dims: int, name: str = "point", like: str = "") -> np.ndarray:
         array = array.reshape(1)
     if array.ndim != 1 or array.shape[0] != n_dims:
         match = f"as {like} has" if like else "to match the model"
-        raise ValueError(f"{name} must have {n_dims} coordinate(s) {match}, got shape {array.shape}")
+        raise ValueError(
+            f"{name} must have {n_dims} coordinate(s) {match}, got shape {array.shape}"
+        )
     _check_finite(array, name)
     _check_magnitude(array, name)
     return array
@@ -338,7 +369,9 @@ def as_points(points, n_dims: int, name: str = "points") -> np.ndarray:
     if array.ndim == 1 and array.shape[0] == n_dims:
         array = array.reshape(1, n_dims)
     if array.ndim != 2 or array.shape[1] != n_dims:
-        raise ValueError(f"{name} must have shape (G, {n_dims}) to match the model, got shape {array.shape}")
+        raise ValueError(
+            f"{name} must have shape (G, {n_dims}) to match the model, got shape {array.shape}"
+        )
     if array.shape[0] == 0:
         raise ValueError(f"{name} is empty")
     _check_finite(array, name)
@@ -346,11 +379,19 @@ def as_points(points, n_dims: int, name: str = "points") -> np.ndarray:
     return np.ascontiguousarray(array)
 
 
-def check_int(value, name: str, minimum: int | None = None, limit: str | None = None, maximum: int | None = None) -> int:
+def check_int(
+    value,
+    name: str,
+    minimum: int | None = None,
+    limit: str | None = None,
+    maximum: int | None = None,
+) -> int:
     """Return ``value`` as an ``int`` after checking it is an integer >= ``minimum``, at most
     ``maximum`` and within the :class:`Limits` field ``limit``."""
     if isinstance(value, bool) or not isinstance(value, Integral):
-        raise TypeError(f"{name} must be an integer, got {type(value).__name__} {short_token(value)}")
+        raise TypeError(
+            f"{name} must be an integer, got {type(value).__name__} {short_token(value)}"
+        )
     if minimum is not None and value < minimum:
         raise ValueError(f"{name} must be >= {minimum}, got {_count(value)}")
     if maximum is not None and value > maximum:
@@ -360,8 +401,15 @@ def check_int(value, name: str, minimum: int | None = None, limit: str | None = 
     return int(value)
 
 
-def check_real(value, name: str, *, positive: bool = False, nonnegative: bool = False,
-               minimum: float | None = None, maximum: float | None = None) -> float:
+def check_real(
+    value,
+    name: str,
+    *,
+    positive: bool = False,
+    nonnegative: bool = False,
+    minimum: float | None = None,
+    maximum: float | None = None,
+) -> float:
     """Return ``value`` as a finite ``float`` (optionally > 0, >= 0, or within [minimum, maximum])."""
     if isinstance(value, bool) or not isinstance(value, Real):
         raise TypeError(f"{name} must be a number, got {type(value).__name__} {short_token(value)}")
@@ -391,7 +439,9 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
     if isinstance(seed, np.random.SeedSequence):
         return np.random.default_rng(seed)
     if seed is None:
-        raise TypeError(f"{name} must be an integer or a numpy.random.Generator (None would make results irreproducible)")
+        raise TypeError(
+            f"{name} must be an integer or a numpy.random.Generator (None would make results irreproducible)"
+        )
     seed = check_int(seed, name, minimum=0, maximum=2**128 - 1)
     return np.random.default_rng(seed)
 
@@ -400,7 +450,9 @@ def as_unit_quaternion(value, name: str) -> np.ndarray:
     """A unit quaternion ``qx, qy, qz, qw`` (4,), its norm within 1e-6 of 1."""
     quaternion = as_vector(value, name, length=4)
     if not abs(float(np.linalg.norm(quaternion)) - 1.0) <= 1e-6:
-        raise ValueError(f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(quaternion):.6g}")
+        raise ValueError(
+            f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(quaternion):.6g}"
+        )
     return quaternion
 
 
@@ -410,12 +462,23 @@ def check_names(names, count: int, name: str = "names") -> list[str]:
     if names is None:
         return []
     if isinstance(names, str) or not isinstance(names, (list, tuple)):
-        raise TypeError(f"{name} must be a list of {count} names (text), got {type(names).__name__}")
+        raise TypeError(
+            f"{name} must be a list of {count} names (text), got {type(names).__name__}"
+        )
     if len(names) != count:
-        raise ValueError(f"{name} must name the {count} dimension(s), one each; got {len(names)} name(s)")
+        raise ValueError(
+            f"{name} must name the {count} dimension(s), one each; got {len(names)} name(s)"
+        )
     for entry in names:
-        if not isinstance(entry, str) or not entry.strip() or len(entry) > 256 or not entry.isprintable():
-            raise ValueError(f"{name}: each name must be printable text of 1-256 characters, got {short_token(entry, 30)}")
+        if (
+            not isinstance(entry, str)
+            or not entry.strip()
+            or len(entry) > 256
+            or not entry.isprintable()
+        ):
+            raise ValueError(
+                f"{name}: each name must be printable text of 1-256 characters, got {short_token(entry, 30)}"
+            )
     if len(set(names)) != len(names):
         raise ValueError(f"{name}: two dimensions have the same name")
     return [str(entry) for entry in names]
@@ -430,15 +493,20 @@ def check_choice(value, name: str, choices: Iterable[str]) -> str:
     return value
 
 
-def as_vector(values, name: str, *, length: int | None = None, min_length: int = 1,
-              positive: bool = False) -> np.ndarray:
+def as_vector(
+    values, name: str, *, length: int | None = None, min_length: int = 1, positive: bool = False
+) -> np.ndarray:
     """A 1-D array of finite numbers within ``max_abs_value``: ``length`` of them if given, else
     at least ``min_length`` (``positive``: each > 0). A scalar is a vector of one."""
     array = _as_bounded_array(values, name, max_ndim=1).reshape(-1)
     if length is not None and array.shape[0] != length:
         raise ValueError(f"{name} must have {length} entries, got {array.shape[0]}")
     if array.shape[0] < min_length:
-        raise ValueError(f"{name} is empty" if array.shape[0] == 0 else f"{name} needs at least {min_length} entries")
+        raise ValueError(
+            f"{name} is empty"
+            if array.shape[0] == 0
+            else f"{name} needs at least {min_length} entries"
+        )
     _check_finite(array, name)
     _check_magnitude(array, name)
     if positive and np.any(array <= 0.0):
@@ -480,11 +548,17 @@ def as_labels(values, name: str) -> list[str]:
     if values is None:
         return []
     if isinstance(values, str) or not isinstance(values, (list, tuple, set, frozenset)):
-        raise TypeError(f"{name} must be a list of labels (strings), got {type(values).__name__} {short_token(values)}")
+        raise TypeError(
+            f"{name} must be a list of labels (strings), got {type(values).__name__} {short_token(values)}"
+        )
     if len(values) > _LIMITS.max_targets * 10:
-        raise ValueError(f"{name} names {len(values):,} labels; at most {_LIMITS.max_targets * 10:,}")
+        raise ValueError(
+            f"{name} names {len(values):,} labels; at most {_LIMITS.max_targets * 10:,}"
+        )
     if not all(isinstance(value, str) and len(value) <= 256 for value in values):
-        raise TypeError(f"{name} must hold labels (strings of at most 256 characters), got {short_token(list(values), 30)}")
+        raise TypeError(
+            f"{name} must hold labels (strings of at most 256 characters), got {short_token(list(values), 30)}"
+        )
     return list(values)
 
 
@@ -494,7 +568,9 @@ def check_text(value, name: str, max_length: int = 80) -> str:
     if not isinstance(value, str):
         raise TypeError(f"{name} must be a string, got {type(value).__name__}")
     if len(value) > max_length or not value.isprintable():
-        raise ValueError(f"{name} must be at most {max_length} printable characters, got {short_token(value, 30)}")
+        raise ValueError(
+            f"{name} must be at most {max_length} printable characters, got {short_token(value, 30)}"
+        )
     return value
 
 
@@ -503,7 +579,9 @@ def check_options(value, name: str) -> dict:
     if value is None:
         return {}
     if not isinstance(value, dict) or not all(isinstance(key, str) for key in value):
-        raise TypeError(f"{name} must be a dict of options (string keys), got {type(value).__name__} {short_token(value)}")
+        raise TypeError(
+            f"{name} must be a dict of options (string keys), got {type(value).__name__} {short_token(value)}"
+        )
     return dict(value)
 
 
@@ -532,14 +610,16 @@ def check_path(value, name: str = "path"):
         raise ValueError(f"{name} contains a NUL character")
     encoded = os.fsencode(text)
     if len(encoded) > _MAX_PATH or any(len(part) > _MAX_NAME for part in encoded.split(b"/")):
-        raise ValueError(f"{name} is too long for a file name ({len(encoded):,} bytes, a part over {_MAX_NAME})")
+        raise ValueError(
+            f"{name} is too long for a file name ({len(encoded):,} bytes, a part over {_MAX_NAME})"
+        )
     return Path(text)
 
 
 def shown_path(path, width: int = 60) -> str:
     """A path for a message: its last ``width`` characters (the file name is what tells)."""
     text = printable(path)
-    return text if len(text) <= width else "…" + text[-(width - 1):]
+    return text if len(text) <= width else "…" + text[-(width - 1) :]
 
 
 def check_loaded(value, name: str, shape: tuple, *, positive: bool = False) -> np.ndarray:
@@ -549,8 +629,15 @@ def check_loaded(value, name: str, shape: tuple, *, positive: bool = False) -> n
     if array.dtype.kind not in "fiub":
         raise ValueError(f"member {name} holds {array.dtype} data, expected float64")
     array = array.astype(np.float64, copy=False)
-    if array.ndim != len(shape) or any(s is not None and a != s for a, s in zip(array.shape, shape)):
-        expected = "(" + ", ".join("any" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+    if array.ndim != len(shape) or any(
+        s is not None and a != s for a, s in zip(array.shape, shape)
+    ):
+        expected = (
+            "("
+            + ", ".join("any" if s is None else str(s) for s in shape)
+            + ("," if len(shape) == 1 else "")
+            + ")"
+        )
         raise ValueError(f"member {name} has shape {array.shape}, expected {expected}")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"member {name} contains NaN or inf")
@@ -571,14 +658,20 @@ def numerically_guarded(function):
             with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
                 return function(*args, **kwargs)
         except FloatingPointError as exc:
-            raise ValueError(f"{function.__qualname__}: the computation overflowed ({exc}): the inputs' scale or the "
-                             f"parameters are out of the range float64 can represent") from None
+            raise ValueError(
+                f"{function.__qualname__}: the computation overflowed ({exc}): the inputs' scale or the "
+                f"parameters are out of the range float64 can represent"
+            ) from None
         except np.linalg.LinAlgError as exc:
-            raise ValueError(f"{function.__qualname__}: a linear system is singular ({exc}); "
-                             f"increase the regularisation or check the inputs") from None
+            raise ValueError(
+                f"{function.__qualname__}: a linear system is singular ({exc}); "
+                f"increase the regularisation or check the inputs"
+            ) from None
         except MemoryError:
-            raise ValueError(f"{function.__qualname__}: out of memory; lower the sizes or "
-                             f"bidmp.set_limits(max_array_bytes=...)") from None
+            raise ValueError(
+                f"{function.__qualname__}: out of memory; lower the sizes or "
+                f"bidmp.set_limits(max_array_bytes=...)"
+            ) from None
 
     return wrapper
 

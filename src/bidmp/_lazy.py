@@ -27,7 +27,9 @@ def exports(package: str, table: dict[str, str], namespace: dict) -> tuple[Calla
 
     def __getattr__(name: str):
         if name not in table:
-            if importlib.util.find_spec(f"{package}.{name}") is not None:  # a submodule: bidmp.io.models
+            if (
+                importlib.util.find_spec(f"{package}.{name}") is not None
+            ):  # a submodule: bidmp.io.models
                 value = importlib.import_module(f"{package}.{name}")
                 namespace[name] = value
                 return value

@@ -19,7 +19,7 @@ class Prefixed(Mapping):
             raise KeyError(f"missing member {self._prefix + name}") from None
 
     def __iter__(self):
-        return (name[len(self._prefix):] for name in self._arrays if name.startswith(self._prefix))
+        return (name[len(self._prefix) :] for name in self._arrays if name.startswith(self._prefix))
 
     def __len__(self) -> int:
         return sum(1 for _ in self)

@@ -10,8 +10,15 @@ import numpy as np
 
 from ._checks import numerically_guarded
 
-__all__ = ["arclength", "interp_columns", "resample_arclength", "resample_time", "rmse", "path_extent",
-           "continuous_quaternions"]
+__all__ = [
+    "arclength",
+    "interp_columns",
+    "resample_arclength",
+    "resample_time",
+    "rmse",
+    "path_extent",
+    "continuous_quaternions",
+]
 
 
 def arclength(y: np.ndarray) -> np.ndarray:
@@ -57,10 +64,14 @@ def rmse(a, b) -> float:
     """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
     from ._checks import as_trajectory
 
-    a = as_trajectory(a, "a", min_points=1, allow_static=True)  # sizes, types and finiteness checked by name
+    a = as_trajectory(
+        a, "a", min_points=1, allow_static=True
+    )  # sizes, types and finiteness checked by name
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape != b.shape:
-        raise ValueError(f"a has shape {a.shape} but b has {b.shape}: rmse compares trajectories of equal shape")
+        raise ValueError(
+            f"a has shape {a.shape} but b has {b.shape}: rmse compares trajectories of equal shape"
+        )
     return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=-1))))
 
 

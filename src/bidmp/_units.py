@@ -14,7 +14,16 @@ import logging
 
 import numpy as np
 
-__all__ = ["UNITS", "ANGLE_UNITS", "check_units", "conversion", "check_reach", "check_speed", "REACH_M", "PLAUSIBLE_SPEED"]
+__all__ = [
+    "UNITS",
+    "ANGLE_UNITS",
+    "check_units",
+    "conversion",
+    "check_reach",
+    "check_speed",
+    "REACH_M",
+    "PLAUSIBLE_SPEED",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -41,7 +50,9 @@ def check_units(units, name: str = "units") -> str:
         raise TypeError(f"{name} must be a string such as 'mm', got {type(units).__name__}")
     if units not in ("", *UNITS, *ANGLE_UNITS):
         shown = repr(units[:10]) + ("…" if len(units) > 10 else "")
-        raise ValueError(f"{name} must be one of {', '.join((*UNITS, *ANGLE_UNITS))} (or empty for unknown), got {shown}")
+        raise ValueError(
+            f"{name} must be one of {', '.join((*UNITS, *ANGLE_UNITS))} (or empty for unknown), got {shown}"
+        )
     return units
 
 
@@ -70,8 +81,12 @@ def check_reach(distance: float, units: str, what: str) -> None:
     if distance * UNITS[units] <= REACH_M:
         return
     within = [unit for unit in UNITS if unit != units and distance * UNITS[unit] <= REACH_M]
-    hint = f"; is it in {' or '.join(within)}? Give it in {units}, the model's unit" if within else ""
-    raise ValueError(f"{what} is {distance:.4g} {units} away, beyond any robot's reach ({REACH_M:g} m){hint}")
+    hint = (
+        f"; is it in {' or '.join(within)}? Give it in {units}, the model's unit" if within else ""
+    )
+    raise ValueError(
+        f"{what} is {distance:.4g} {units} away, beyond any robot's reach ({REACH_M:g} m){hint}"
+    )
 
 
 def check_speed(peak_speed: float, units: str, what: str, *, fast_only: bool = False) -> None:
@@ -93,18 +108,31 @@ def check_speed(peak_speed: float, units: str, what: str, *, fast_only: bool = F
         slowest = 0.0 if fast_only else slowest
         if slowest <= peak_speed <= fastest:
             return
-        hint = (f"; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians"
-                if peak_speed > fastest and np.radians(peak_speed) <= fastest else "")
-        raise ValueError(f"{what} peaks at {peak_speed:.4g} rad/s, {'faster' if peak_speed > fastest else 'slower'} than "
-                         f"any robot's joint moves ({slowest:g} to {fastest:g} rad/s){hint}")
+        hint = (
+            f"; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians"
+            if peak_speed > fastest and np.radians(peak_speed) <= fastest
+            else ""
+        )
+        raise ValueError(
+            f"{what} peaks at {peak_speed:.4g} rad/s, {'faster' if peak_speed > fastest else 'slower'} than "
+            f"any robot's joint moves ({slowest:g} to {fastest:g} rad/s){hint}"
+        )
     slowest, fastest = PLAUSIBLE_SPEED["m"]
     slowest = 0.0 if fast_only else slowest
     if slowest <= peak_speed * UNITS[units] <= fastest:
         return
     plausible = [unit for unit in UNITS if slowest <= peak_speed * UNITS[unit] <= fastest]
-    plausible.sort(key=lambda unit: abs(np.log(peak_speed * UNITS[unit] / 0.25)))  # nearest a hand-guided motion's
-    hint = (f"; in {plausible[0]} it would be {peak_speed * UNITS[plausible[0]]:.3g} m/s: is it in {plausible[0]}? "
-            f"(--units {plausible[0]}, or declare '# units: {plausible[0]}' in the file)" if plausible else "")
-    raise ValueError(f"{what} peaks at {peak_speed:.4g} {units}/s = {peak_speed * UNITS[units]:.4g} m/s, "
-                     f"{'faster' if peak_speed * UNITS[units] > fastest else 'slower'} than any robot moves its tool "
-                     f"({slowest * 1e3:g} mm/s to {fastest:g} m/s){hint}")
+    plausible.sort(
+        key=lambda unit: abs(np.log(peak_speed * UNITS[unit] / 0.25))
+    )  # nearest a hand-guided motion's
+    hint = (
+        f"; in {plausible[0]} it would be {peak_speed * UNITS[plausible[0]]:.3g} m/s: is it in {plausible[0]}? "
+        f"(--units {plausible[0]}, or declare '# units: {plausible[0]}' in the file)"
+        if plausible
+        else ""
+    )
+    raise ValueError(
+        f"{what} peaks at {peak_speed:.4g} {units}/s = {peak_speed * UNITS[units]:.4g} m/s, "
+        f"{'faster' if peak_speed * UNITS[units] > fastest else 'slower'} than any robot moves its tool "
+        f"({slowest * 1e3:g} mm/s to {fastest:g} m/s){hint}"
+    )

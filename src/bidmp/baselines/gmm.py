@@ -31,7 +31,9 @@ logger = logging.getLogger(__name__)
 _EM_ITERATIONS = 100  # scikit-learn's max_iter default, used for the work bound
 
 
-def _gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1):
+def _gmr(
+    weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.ndarray, n_in: int = 1
+):
     """Gaussian mixture regression of the outputs given the first ``n_in`` input dimensions.
 
     Parameters
@@ -65,7 +67,9 @@ def _gmr(weights: np.ndarray, means: np.ndarray, covariances: np.ndarray, t: np.
     mean = np.einsum("lk,lko->lo", h, conditional)
     cond_cov = s_oo - np.einsum("koj,kpj->kop", gain, s_oi)  # Σ_oo − Σ_oi Σ_ii⁻¹ Σ_io
     spread = conditional - mean[:, None, :]
-    covariance = np.einsum("lk,kop->lop", h, cond_cov) + np.einsum("lk,lko,lkp->lop", h, spread, spread)
+    covariance = np.einsum("lk,kop->lop", h, cond_cov) + np.einsum(
+        "lk,lko,lkp->lop", h, spread, spread
+    )
     return mean, covariance
 
 
@@ -73,7 +77,10 @@ def _check_gmr_size(n_steps: int, means_shape: tuple) -> None:
     from .._checks import check_bytes
 
     n_components, n_dims = means_shape
-    check_bytes(n_steps * n_components * n_dims * n_dims, "GMR's intermediate arrays (steps x components x dims²)")
+    check_bytes(
+        n_steps * n_components * n_dims * n_dims,
+        "GMR's intermediate arrays (steps x components x dims²)",
+    )
 
 
 def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0) -> np.ndarray:
@@ -84,7 +91,11 @@ def augment(y: np.ndarray, n_copies: int = 5, noise: float = 1.5, seed: int = 0)
     y = as_trajectory(y, "y")
     check_int(n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
     check_real(noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
-    check_limit(y.size * (n_copies + 1), "max_samples", "the augmented data's values, T * D * (n_copies + 1)")
+    check_limit(
+        y.size * (n_copies + 1),
+        "max_samples",
+        "the augmented data's values, T * D * (n_copies + 1)",
+    )
     rng = np.random.default_rng(check_int(seed, "seed", minimum=0, maximum=2**63 - 1))
     return np.stack([y] + [perturb(y, noise, rng) for _ in range(n_copies)])
 
@@ -103,14 +114,21 @@ def _fit_mixture(data: np.ndarray, n_components: int, reg_covar: float, seed: in
 
     n_samples, n_dims = data.shape
     if n_samples < n_components:
-        raise ValueError(f"n_components = {n_components} needs at least as many samples, got {n_samples}")
-    check_limit(float(n_samples) * n_components * n_dims * n_dims * _EM_ITERATIONS, "max_work",
-                "EM's work (samples x components x dims² x iterations)")
+        raise ValueError(
+            f"n_components = {n_components} needs at least as many samples, got {n_samples}"
+        )
+    check_limit(
+        float(n_samples) * n_components * n_dims * n_dims * _EM_ITERATIONS,
+        "max_work",
+        "EM's work (samples x components x dims² x iterations)",
+    )
     # A fresh limiter (not the BLS's cached one): it must see the OpenMP runtime that
     # scikit-learn's k-means initialisation loads, which may not have been loaded before.
     with threadpool_limits(limits=1), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ConvergenceWarning)
-        mixture = GaussianMixture(n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed).fit(data)
+        mixture = GaussianMixture(
+            n_components, covariance_type="full", reg_covar=reg_covar, random_state=seed
+        ).fit(data)
     for warning in caught:  # library code never prints: report EM's convergence through logging
         logger.warning("GaussianMixture: %s", warning.message)
     return mixture.weights_, mixture.means_, mixture.covariances_
@@ -137,7 +155,9 @@ class _AugmentedMixture(CheckedParams, BaseEstimator):
         check_real(self.reg_covar, "reg_covar", positive=True, maximum=1e6)
         check_int(self.n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
         check_real(self.noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
-        check_int(self.seed, "seed", minimum=0, maximum=2**32 - 1)  # scikit-learn's random_state range
+        check_int(
+            self.seed, "seed", minimum=0, maximum=2**32 - 1
+        )  # scikit-learn's random_state range
 
     def __sklearn_is_fitted__(self) -> bool:
         return "weights_" in self.__dict__
@@ -162,7 +182,14 @@ class GMMRegressor(_AugmentedMixture):
     n_steps_ : int
     """
 
-    def __init__(self, n_components: int = 16, reg_covar: float = 1e-6, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
+    def __init__(
+        self,
+        n_components: int = 16,
+        reg_covar: float = 1e-6,
+        n_copies: int = 5,
+        noise: float = 1.5,
+        seed: int = 0,
+    ):
         self.n_components = n_components
         self.reg_covar = reg_covar
         self.n_copies = n_copies
@@ -170,14 +197,16 @@ class GMMRegressor(_AugmentedMixture):
         self.seed = seed
 
     @numerically_guarded
-    def fit(self, y) -> "GMMRegressor":
+    def fit(self, y) -> GMMRegressor:
         """Fit on one demonstration (T, D), time scaled to [0, 1]."""
         self._check_params()
         demos = augment(y, self.n_copies, self.noise, self.seed)
         n_steps = demos.shape[1]
         t = np.linspace(0.0, 1.0, n_steps)
         data = np.concatenate([np.column_stack([t, demo]) for demo in demos])
-        self.weights_, self.means_, self.covariances_ = _fit_mixture(data, self.n_components, self.reg_covar, self.seed)
+        self.weights_, self.means_, self.covariances_ = _fit_mixture(
+            data, self.n_components, self.reg_covar, self.seed
+        )
         self.n_steps_ = n_steps
         return self
 
@@ -188,8 +217,16 @@ class GMMRegressor(_AugmentedMixture):
         notion of a goal: ``goal`` must be None (:class:`TPGMM` takes one)."""
         check_fitted(self, "weights_")
         if goal is not None:
-            raise ValueError("goal: GMMRegressor reproduces its demonstration and takes no goal (TPGMM does)")
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+            raise ValueError(
+                "goal: GMMRegressor reproduces its demonstration and takes no goal (TPGMM does)"
+            )
+        n_steps = (
+            self.n_steps_
+            if n_steps is None
+            else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+        )
         _check_gmr_size(n_steps, self.means_.shape)
-        mean, covariances = _gmr(self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps))
+        mean, covariances = _gmr(
+            self.weights_, self.means_, self.covariances_, np.linspace(0.0, 1.0, n_steps)
+        )
         return (mean, covariances) if check_bool(return_covariance, "return_covariance") else mean

@@ -13,7 +13,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import _as_bounded_array, as_point, check_bool, check_fitted, check_int, numerically_guarded
+from .._checks import (
+    _as_bounded_array,
+    as_point,
+    check_bool,
+    check_fitted,
+    check_int,
+    numerically_guarded,
+)
 from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, _gmr, augment
 
 __all__ = ["TPGMM"]
@@ -23,7 +30,9 @@ def _rotation(value, n_dims: int, name: str) -> np.ndarray:
     """A frame orientation: an orthonormal (D, D) matrix."""
     matrix = _as_bounded_array(value, name, 2)
     if matrix.shape != (n_dims, n_dims) or not np.all(np.isfinite(matrix)):
-        raise ValueError(f"{name} must be a finite ({n_dims}, {n_dims}) rotation matrix, got shape {matrix.shape}")
+        raise ValueError(
+            f"{name} must be a finite ({n_dims}, {n_dims}) rotation matrix, got shape {matrix.shape}"
+        )
     if not np.allclose(matrix @ matrix.T, np.eye(n_dims), atol=1e-6):
         raise ValueError(f"{name} must be orthonormal (R Rᵀ = I)")
     return matrix
@@ -49,7 +58,14 @@ class TPGMM(_AugmentedMixture):
         The demonstration's start and goal (what :meth:`rollout` goes between by default).
     """
 
-    def __init__(self, n_components: int = 16, reg_covar: float = 1e-4, n_copies: int = 5, noise: float = 1.5, seed: int = 0):
+    def __init__(
+        self,
+        n_components: int = 16,
+        reg_covar: float = 1e-4,
+        n_copies: int = 5,
+        noise: float = 1.5,
+        seed: int = 0,
+    ):
         self.n_components = n_components
         self.reg_covar = reg_covar
         self.n_copies = n_copies
@@ -57,7 +73,7 @@ class TPGMM(_AugmentedMixture):
         self.seed = seed
 
     @numerically_guarded
-    def fit(self, y) -> "TPGMM":
+    def fit(self, y) -> TPGMM:
         """Fit on one demonstration (T, D); frames at each copy's own start and end."""
         self._check_params()
         demos = augment(y, self.n_copies, self.noise, self.seed)
@@ -65,7 +81,9 @@ class TPGMM(_AugmentedMixture):
         t = np.linspace(0.0, 1.0, n_steps)[:, None]
         # Identity orientations: local coordinates are translations (A_j⁻¹ = I).
         data = np.concatenate([np.hstack([t, demo - demo[0], demo - demo[-1]]) for demo in demos])
-        self.weights_, self.means_, self.covariances_ = _fit_mixture(data, self.n_components, self.reg_covar, self.seed)
+        self.weights_, self.means_, self.covariances_ = _fit_mixture(
+            data, self.n_components, self.reg_covar, self.seed
+        )
         self.n_steps_, self.n_dims_ = n_steps, n_dims
         demonstration = np.asarray(y, dtype=np.float64)
         self.start_, self.goal_ = demonstration[0].copy(), demonstration[-1].copy()
@@ -85,8 +103,16 @@ class TPGMM(_AugmentedMixture):
         return mu_global, sigma_global
 
     @numerically_guarded
-    def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_rotation=None, target_rotation=None,
-                return_covariance: bool = False):
+    def rollout(
+        self,
+        goal=None,
+        *,
+        start=None,
+        n_steps: int | None = None,
+        start_rotation=None,
+        target_rotation=None,
+        return_covariance: bool = False,
+    ):
         """The mean motion (n, D) from ``start`` to ``goal`` (the target frame's origin), on the
         demonstration's sample grid in normalised time (t ∈ [0, 1]); default the demonstration's
         own start and goal. ``return_covariance``: also the covariances (n, D, D)."""
@@ -94,9 +120,18 @@ class TPGMM(_AugmentedMixture):
         d = self.n_dims_
         start = self.start_ if start is None else as_point(start, d, "start")
         target = self.goal_ if goal is None else as_point(goal, d, "goal")
-        rotations = [np.eye(d) if r is None else _rotation(r, d, name)
-                     for r, name in ((start_rotation, "start_rotation"), (target_rotation, "target_rotation"))]
-        n_steps = self.n_steps_ if n_steps is None else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+        rotations = [
+            np.eye(d) if r is None else _rotation(r, d, name)
+            for r, name in (
+                (start_rotation, "start_rotation"),
+                (target_rotation, "target_rotation"),
+            )
+        ]
+        n_steps = (
+            self.n_steps_
+            if n_steps is None
+            else check_int(n_steps, "n_steps", minimum=2, limit="max_steps")
+        )
         _check_gmr_size(n_steps, self.means_.shape)
         precision_sum = 0.0
         weighted_mean = 0.0

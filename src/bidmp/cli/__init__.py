@@ -73,7 +73,11 @@ def _quiet_stdout() -> None:
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
-    except (OSError, ValueError, AttributeError):  # a replaced sys.stdout (tests) has no file number
+    except (
+        OSError,
+        ValueError,
+        AttributeError,
+    ):  # a replaced sys.stdout (tests) has no file number
         pass
 
 
@@ -146,10 +150,16 @@ def main(argv: _Sequence[str] | None = None) -> int:
         parser.print_help()
         print("bidmp: error: no command given (see 'bidmp --help')", file=sys.stderr)
         return EXIT_BAD_INPUT
-    empty = [dest for dest, value in vars(args).items()
-             if value == "" or isinstance(value, list) and "" in value]
+    empty = [
+        dest
+        for dest, value in vars(args).items()
+        if value == "" or isinstance(value, list) and "" in value
+    ]
     if empty:  # an empty file name or option would silently mean "here" or "none"
-        print(f"bidmp {args.command}: error: argument {empty[0].replace('_', '-')} is empty", file=sys.stderr)
+        print(
+            f"bidmp {args.command}: error: argument {empty[0].replace('_', '-')} is empty",
+            file=sys.stderr,
+        )
         return EXIT_BAD_INPUT
     from .._checks import MissingExtraError
 
@@ -170,8 +180,16 @@ def main(argv: _Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("bidmp: interrupted", file=sys.stderr)
         return 130
-    except (ValueError, TypeError, OSError, ArithmeticError, RuntimeWarning, RecursionError, MemoryError,
-            MissingExtraError) as exc:
+    except (
+        ValueError,
+        TypeError,
+        OSError,
+        ArithmeticError,
+        RuntimeWarning,
+        RecursionError,
+        MemoryError,
+        MissingExtraError,
+    ) as exc:
         if args.debug:
             raise
         print(f"bidmp {args.command}: error: {_one_line(_bad_input_message(exc))}", file=sys.stderr)
@@ -179,8 +197,12 @@ def main(argv: _Sequence[str] | None = None) -> int:
     except Exception as exc:  # noqa: BLE001 - the CLI promises no tracebacks
         if args.debug:
             raise
-        print(_one_line(f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)"),
-              file=sys.stderr)
+        print(
+            _one_line(
+                f"bidmp {args.command}: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details)"
+            ),
+            file=sys.stderr,
+        )
         return EXIT_INTERNAL
     finally:
         logging.captureWarnings(False)

@@ -5,8 +5,22 @@ from __future__ import annotations
 
 import argparse
 
-__all__ = ["EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT", "EXIT_TARGETS_FAILED", "judged_methods", "EXIT_BROKEN_PIPE", "MAX_MESSAGE", "MAX_SEEDS", "Parser",
-           "parse_K", "allow_outside_files", "one_line", "split_names", "progress_bars"]
+__all__ = [
+    "EXIT_OK",
+    "EXIT_INTERNAL",
+    "EXIT_BAD_INPUT",
+    "EXIT_TARGETS_FAILED",
+    "judged_methods",
+    "EXIT_BROKEN_PIPE",
+    "MAX_MESSAGE",
+    "MAX_SEEDS",
+    "Parser",
+    "parse_K",
+    "allow_outside_files",
+    "one_line",
+    "split_names",
+    "progress_bars",
+]
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -23,7 +37,10 @@ class Parser(argparse.ArgumentParser):
     """argparse, but usage errors are one line (plus a pointer to --help), exit code 2."""
 
     def error(self, message: str):  # noqa: D401 - argparse API
-        self.exit(EXIT_BAD_INPUT, one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n")
+        self.exit(
+            EXIT_BAD_INPUT,
+            one_line(f"{self.prog}: error: {message} (see '{self.prog} --help')") + "\n",
+        )
 
 
 def parse_K(text: str):
@@ -32,7 +49,9 @@ def parse_K(text: str):
     try:
         return float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be 'paper', 'pastor' or a number, got {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"must be 'paper', 'pastor' or a number, got {text!r}"
+        ) from None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -40,14 +59,21 @@ def parse_K(text: str):
 # ---------------------------------------------------------------------------------------------
 def allow_outside_files(parser, shown: bool = True) -> None:
     """The --allow-outside-files flag of every command that reads a scenario file."""
-    parser.add_argument("--allow-outside-files", action="store_true",
-                        help="let the scenario read demonstration files outside its own folder" if shown else argparse.SUPPRESS)
+    parser.add_argument(
+        "--allow-outside-files",
+        action="store_true",
+        help="let the scenario read demonstration files outside its own folder"
+        if shown
+        else argparse.SUPPRESS,
+    )
 
 
 def one_line(text: str) -> str:
     """One printable line: whitespace runs collapsed, control characters (a file name or argument
     may carry terminal escapes) shown as '?', at most MAX_MESSAGE characters."""
-    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))  # no NumPy import here
+    text = "".join(
+        c if c.isprintable() else "?" for c in " ".join(str(text).split())
+    )  # no NumPy import here
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 1] + "…"
 
 
@@ -83,10 +109,14 @@ def progress_bars():
             from tqdm import tqdm
 
             bar = self.bars.get(stage)
-            if bar is None or bar.total != total or done < bar.n:  # a new round of the stage (another planning)
+            if (
+                bar is None or bar.total != total or done < bar.n
+            ):  # a new round of the stage (another planning)
                 if bar is not None:
                     bar.close()
-                bar = self.bars[stage] = tqdm(total=total, desc=stage, unit="step", disable=None, leave=False)
+                bar = self.bars[stage] = tqdm(
+                    total=total, desc=stage, unit="step", disable=None, leave=False
+                )
             bar.update(done - bar.n)
 
         def close(self) -> None:

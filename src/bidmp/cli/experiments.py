@@ -23,12 +23,20 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     if not 1 <= args.seeds <= MAX_SEEDS:
         raise ValueError(f"--seeds must be 1-{MAX_SEEDS}, got {args.seeds}")
     if args.what == "table4":
-        with tqdm(total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None) as bar:
-            result = reproduce.run_table4(progress=lambda name: (bar.set_postfix_str(name), bar.update(1)))
+        with tqdm(
+            total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None
+        ) as bar:
+            result = reproduce.run_table4(
+                progress=lambda name: (bar.set_postfix_str(name), bar.update(1))
+            )
     elif args.what == "figures":
-        result = reproduce.run_figures(progress=partial(tqdm, desc="figures", unit="shape", disable=None))
+        result = reproduce.run_figures(
+            progress=partial(tqdm, desc="figures", unit="shape", disable=None)
+        )
     else:
-        result = reproduce.run_table5(args.seeds, progress=partial(tqdm, desc="table5", unit="case", disable=None))
+        result = reproduce.run_table5(
+            args.seeds, progress=partial(tqdm, desc="table5", unit="case", disable=None)
+        )
     print(result.summary())
     written = reproduce.write_results(result, args.what, out)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
@@ -51,14 +59,16 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
     if not 0 <= args.demo < demos.shape[0]:
         raise ValueError(f"--demo must be 0-{demos.shape[0] - 1}, got {args.demo}")
     path = save_trajectory(demos[args.demo], args.output)
-    print(f"wrote {args.name} demonstration {args.demo} ({demos.shape[1]} x {demos.shape[2]}) to {path}")
+    print(
+        f"wrote {args.name} demonstration {args.demo} ({demos.shape[1]} x {demos.shape[2]}) to {path}"
+    )
     return EXIT_OK
 
 
 def lasa_demo(shape: str, out) -> int:
+    from ..experiments.reproduce import lasa_generalisation
     from ..io.atomic import atomic_write
     from ..plotting.trajectories import plot_generalisation
-    from ..experiments.reproduce import lasa_generalisation
 
     out.mkdir(parents=True, exist_ok=True)
     result = lasa_generalisation(shape)
@@ -77,17 +87,36 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
     from ..experiments.benchmark import _validate, lasa
 
-    shapes = None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
-    methods = None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
-    shapes_checked, _, indices = _validate(shapes, methods, args.demos, args.every)  # before starting a cluster
+    shapes = (
+        None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
+    )
+    methods = (
+        None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
+    )
+    shapes_checked, _, indices = _validate(
+        shapes, methods, args.demos, args.every
+    )  # before starting a cluster
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be 1-256, got {args.workers}")
-    with tqdm(total=len(shapes_checked) * len(indices), desc="LASA", unit="cell", disable=None) as bar:
-        result = lasa(Path(args.out), shapes=shapes, methods=methods, demos=args.demos, every=args.every,
-                      workers=args.workers, scheduler=args.scheduler, resume=args.resume, output_format=args.format,
-                      progress=lambda key: bar.update(1))
-    print(f"LASA benchmark: {len(result.computed)} cells computed, {len(result.resumed)} resumed, "
-          f"{result.workers} worker(s), {result.wall_s:.1f} s")
+    with tqdm(
+        total=len(shapes_checked) * len(indices), desc="LASA", unit="cell", disable=None
+    ) as bar:
+        result = lasa(
+            Path(args.out),
+            shapes=shapes,
+            methods=methods,
+            demos=args.demos,
+            every=args.every,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            resume=args.resume,
+            output_format=args.format,
+            progress=lambda key: bar.update(1),
+        )
+    print(
+        f"LASA benchmark: {len(result.computed)} cells computed, {len(result.resumed)} resumed, "
+        f"{result.workers} worker(s), {result.wall_s:.1f} s"
+    )
     print((Path(args.out) / "lasa.md").read_text())
     print(f"wrote {', '.join(str(path) for path in result.written)}")
     return EXIT_OK
@@ -95,13 +124,16 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
 def _reproduce_parser(commands) -> None:
     """``bidmp reproduce table4|table5|figures``."""
-    reproduce = commands.add_parser("reproduce", help="reproduce a table of the paper",
-                                    description="Reproduce the paper's comparisons. table4: the three case studies (nut "
-                                                "unscrewing, cell removal before/after the second extension, pick-and-place with "
-                                                "three operators). table5: G-PRM vs classic PRM similarity "
-                                                "per iteration over many seeds (LASA shapes and the battery approach path). "
-                                                "figures: Bi-DMP on LASA shapes, three new targets each (Fig. 11), "
-                                                "with reproduction errors and forgetting.")
+    reproduce = commands.add_parser(
+        "reproduce",
+        help="reproduce a table of the paper",
+        description="Reproduce the paper's comparisons. table4: the three case studies (nut "
+        "unscrewing, cell removal before/after the second extension, pick-and-place with "
+        "three operators). table5: G-PRM vs classic PRM similarity "
+        "per iteration over many seeds (LASA shapes and the battery approach path). "
+        "figures: Bi-DMP on LASA shapes, three new targets each (Fig. 11), "
+        "with reproduction errors and forgetting.",
+    )
     reproduce.add_argument("what", choices=("table4", "table5", "figures"), help="which result")
     reproduce.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
     reproduce.add_argument("--seeds", type=int, default=20, help="number of seeds (default 20)")
@@ -110,35 +142,81 @@ def _reproduce_parser(commands) -> None:
 
 def _lasa_parser(commands) -> None:
     """``bidmp lasa list|export``."""
-    lasa = commands.add_parser("lasa", help="the bundled LASA handwriting data", description="List or export the LASA handwriting shapes.")
-    lasa_commands = lasa.add_subparsers(dest="lasa_command", metavar="{list,export}", required=True, parser_class=Parser)
+    lasa = commands.add_parser(
+        "lasa",
+        help="the bundled LASA handwriting data",
+        description="List or export the LASA handwriting shapes.",
+    )
+    lasa_commands = lasa.add_subparsers(
+        dest="lasa_command", metavar="{list,export}", required=True, parser_class=Parser
+    )
     lasa_commands.add_parser("list", help="list the shape names")
     export = lasa_commands.add_parser("export", help="write one demonstration of a shape")
     export.add_argument("name", metavar="NAME", help="shape name, e.g. Sshape")
-    export.add_argument("--demo", type=int, default=0, help="which of the 7 demonstrations (0-6, default 0)")
-    export.add_argument("-o", "--output", required=True, metavar="OUT", help="file to write (.csv or .npy)")
+    export.add_argument(
+        "--demo", type=int, default=0, help="which of the 7 demonstrations (0-6, default 0)"
+    )
+    export.add_argument(
+        "-o", "--output", required=True, metavar="OUT", help="file to write (.csv or .npy)"
+    )
     lasa.set_defaults(handler=_cmd_lasa)
 
 
 def _benchmark_parser(commands) -> None:
     """``bidmp benchmark lasa``."""
-    benchmark = commands.add_parser("benchmark", help="the full LASA benchmark with the standard metrics, on Dask",
-                                    description="Sweep every LASA shape x demonstration with every method (reproduction, "
-                                                "near and far goals): RMSE, DTW, swept area, Fréchet, end-point error, "
-                                                "times. Runs on an embedded Dask LocalCluster (one worker per core) or on "
-                                                "--scheduler ADDRESS. Needs bidmp[benchmark].")
-    bench_commands = benchmark.add_subparsers(dest="benchmark_command", metavar="{lasa}", required=True, parser_class=Parser)
+    benchmark = commands.add_parser(
+        "benchmark",
+        help="the full LASA benchmark with the standard metrics, on Dask",
+        description="Sweep every LASA shape x demonstration with every method (reproduction, "
+        "near and far goals): RMSE, DTW, swept area, Fréchet, end-point error, "
+        "times. Runs on an embedded Dask LocalCluster (one worker per core) or on "
+        "--scheduler ADDRESS. Needs bidmp[benchmark].",
+    )
+    bench_commands = benchmark.add_subparsers(
+        dest="benchmark_command", metavar="{lasa}", required=True, parser_class=Parser
+    )
     bench = bench_commands.add_parser("lasa", help="the LASA handwriting benchmark")
     bench.add_argument("--shapes", default=None, help="comma-separated shapes (default all 30)")
-    bench.add_argument("--methods", default=None, help="comma-separated methods (default dmp-paper,dmp-robot,bidmp,gmm,tpgmm,mp-dmp)")
-    bench.add_argument("--demos", choices=("all", "first3"), default="all", help="all 7 demonstrations or the first 3")
-    bench.add_argument("--every", type=int, default=1, metavar="K", help="use every K-th sample (papers use 1 or 10)")
-    bench.add_argument("--workers", type=int, default=None,
-                       help="worker processes of the embedded Dask cluster (default: one per core); 1 runs the cells "
-                            "serially in this process, without Dask")
-    bench.add_argument("--scheduler", default=None, metavar="ADDRESS", help="run on an existing Dask scheduler (tcp://host:8786)")
-    bench.add_argument("--resume", action="store_true", help="skip the cells a previous run into --out finished")
-    bench.add_argument("--format", choices=("parquet", "csv"), default="parquet", help="results table format (default parquet)")
+    bench.add_argument(
+        "--methods",
+        default=None,
+        help="comma-separated methods (default dmp-paper,dmp-robot,bidmp,gmm,tpgmm,mp-dmp)",
+    )
+    bench.add_argument(
+        "--demos",
+        choices=("all", "first3"),
+        default="all",
+        help="all 7 demonstrations or the first 3",
+    )
+    bench.add_argument(
+        "--every",
+        type=int,
+        default=1,
+        metavar="K",
+        help="use every K-th sample (papers use 1 or 10)",
+    )
+    bench.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes of the embedded Dask cluster (default: one per core); 1 runs the cells "
+        "serially in this process, without Dask",
+    )
+    bench.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run on an existing Dask scheduler (tcp://host:8786)",
+    )
+    bench.add_argument(
+        "--resume", action="store_true", help="skip the cells a previous run into --out finished"
+    )
+    bench.add_argument(
+        "--format",
+        choices=("parquet", "csv"),
+        default="parquet",
+        help="results table format (default parquet)",
+    )
     bench.add_argument("--out", default="bidmp-lasa", help="output folder (default ./bidmp-lasa)")
     benchmark.set_defaults(handler=_cmd_benchmark)
 

@@ -5,45 +5,88 @@ from __future__ import annotations
 
 import argparse
 
-_MODEL_EXTENT_RATIO = 20.0  # a demonstration this many times larger or smaller than the model's is in another unit
+# a demonstration this many times larger or smaller than the model's is in another unit
+_MODEL_EXTENT_RATIO = 20.0
 
-TIMED_INPUT = ("A DEMO's columns are read by their names, as robot loggers write them (t,x,y,z; UR RTDE timestamp "
-               "and actual_TCP_pose_0..5 or actual_q_0..5; ROS header.stamp and pose.position.x ...; t,<joint "
-               "names>); --columns decides where they do not. A timed DEMO (a time column in seconds, or a timed "
-               ".npy) is prepared unless --raw: the idle start and end are trimmed (speed below 5 % of the peak), "
-               "the noise is removed by a zero-phase low-pass filter (--cutoff, default 6 Hz) and the samples are "
-               "resampled to uniform time. A DEMO without a time column needs --no-time (its samples are then "
-               "taken as uniform over 1 s, the paper's convention). A CSV may declare its unit in a first line "
-               "'# units: mm'; --units converts it; a motion no robot makes in its unit (over 10 m/s, under 1 mm/s) "
-               "is refused, naming the unit that fits it.")
+TIMED_INPUT = (
+    "A DEMO's columns are read by their names, as robot loggers write them (t,x,y,z; UR RTDE timestamp "
+    "and actual_TCP_pose_0..5 or actual_q_0..5; ROS header.stamp and pose.position.x ...; t,<joint "
+    "names>); --columns decides where they do not. A timed DEMO (a time column in seconds, or a timed "
+    ".npy) is prepared unless --raw: the idle start and end are trimmed (speed below 5 % of the peak), "
+    "the noise is removed by a zero-phase low-pass filter (--cutoff, default 6 Hz) and the samples are "
+    "resampled to uniform time. A DEMO without a time column needs --no-time (its samples are then "
+    "taken as uniform over 1 s, the paper's convention). A CSV may declare its unit in a first line "
+    "'# units: mm'; --units converts it; a motion no robot makes in its unit (over 10 m/s, under 1 mm/s) "
+    "is refused, naming the unit that fits it."
+)
 
 
 def demo_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--units", default=None, metavar="UNIT", choices=("m", "cm", "mm"),
-                        help="length unit (m, cm, mm): of the demonstration, or the one to convert a file that declares "
-                             "another to")
-    parser.add_argument("--columns", default=None, metavar="MAP",
-                        help="which CSV columns are time and the motion: single columns (t=timestamp,x=ee_x,y=ee_y,"
-                             "z=ee_z; qx,qy,qz,qw or rx,ry,rz for poses) or a group by prefix (pose=actual_TCP_pose, "
-                             "position=actual_TCP_pose, joints=actual_q); other columns are ignored")
-    parser.add_argument("--no-time", action="store_true",
-                        help="take the DEMO's samples as uniform over 1 s, the paper's convention (needed for a file without "
-                             "a time column; a time column is then not used)")
+    parser.add_argument(
+        "--units",
+        default=None,
+        metavar="UNIT",
+        choices=("m", "cm", "mm"),
+        help="length unit (m, cm, mm): of the demonstration, or the one to convert a file that declares "
+        "another to",
+    )
+    parser.add_argument(
+        "--columns",
+        default=None,
+        metavar="MAP",
+        help="which CSV columns are time and the motion: single columns (t=timestamp,x=ee_x,y=ee_y,"
+        "z=ee_z; qx,qy,qz,qw or rx,ry,rz for poses) or a group by prefix (pose=actual_TCP_pose, "
+        "position=actual_TCP_pose, joints=actual_q); other columns are ignored",
+    )
+    parser.add_argument(
+        "--no-time",
+        action="store_true",
+        help="take the DEMO's samples as uniform over 1 s, the paper's convention (needed for a file without "
+        "a time column; a time column is then not used)",
+    )
     mode = parser.add_mutually_exclusive_group()
-    mode.add_argument("--prepare", action="store_true", help="prepare timed input: trim idle ends, filter, uniform time (the default)")
-    mode.add_argument("--raw", action="store_true", help="use a timed demonstration as recorded (no trimming or filtering)")
-    parser.add_argument("--cutoff", type=float, default=6.0, metavar="HZ", help="low-pass cutoff for timed input in Hz (default 6)")
+    mode.add_argument(
+        "--prepare",
+        action="store_true",
+        help="prepare timed input: trim idle ends, filter, uniform time (the default)",
+    )
+    mode.add_argument(
+        "--raw",
+        action="store_true",
+        help="use a timed demonstration as recorded (no trimming or filtering)",
+    )
+    parser.add_argument(
+        "--cutoff",
+        type=float,
+        default=6.0,
+        metavar="HZ",
+        help="low-pass cutoff for timed input in Hz (default 6)",
+    )
 
 
 def bag_options(parser: argparse.ArgumentParser) -> None:
     """What ``bidmp fit`` reads from a ROS bag (bidmp.io.bags; the ros extra)."""
     source = parser.add_mutually_exclusive_group()
-    source.add_argument("--topic", default=None, metavar="TOPIC",
-                        help="bag: the PoseStamped, TransformStamped or JointState topic to read (default: the only one)")
-    source.add_argument("--tf", nargs=2, default=None, metavar=("PARENT", "CHILD"),
-                        help="bag: the transform from frame PARENT to frame CHILD on /tf and /tf_static")
-    parser.add_argument("--joints", nargs="*", default=None, metavar="NAME",
-                        help="bag: joint states, these joints in this order (none named: every joint)")
+    source.add_argument(
+        "--topic",
+        default=None,
+        metavar="TOPIC",
+        help="bag: the PoseStamped, TransformStamped or JointState topic to read (default: the only one)",
+    )
+    source.add_argument(
+        "--tf",
+        nargs=2,
+        default=None,
+        metavar=("PARENT", "CHILD"),
+        help="bag: the transform from frame PARENT to frame CHILD on /tf and /tf_static",
+    )
+    parser.add_argument(
+        "--joints",
+        nargs="*",
+        default=None,
+        metavar="NAME",
+        help="bag: joint states, these joints in this order (none named: every joint)",
+    )
 
 
 def bag_recording(args: argparse.Namespace):
@@ -54,9 +97,12 @@ def bag_recording(args: argparse.Namespace):
         return None
     if getattr(args, "_bag", None) is None:
         joints = getattr(args, "joints", None)
-        args._bag = read_bag(args.demo, topic=getattr(args, "topic", None),
-                             tf=None if getattr(args, "tf", None) is None else tuple(args.tf),
-                             joints=None if joints is None else (joints or True))
+        args._bag = read_bag(
+            args.demo,
+            topic=getattr(args, "topic", None),
+            tf=None if getattr(args, "tf", None) is None else tuple(args.tf),
+            joints=None if joints is None else (joints or True),
+        )
     return args._bag
 
 
@@ -74,9 +120,9 @@ def demo_kind(args: argparse.Namespace) -> str:
 
 def model_dmp(model):
     """The position DMP of any model class (its units and workspace)."""
-    from ..primitives.cartesian import CartesianDMP
-    from ..incremental.cartesian import CartesianBiDMP
     from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.cartesian import CartesianDMP
 
     if isinstance(model, CartesianBiDMP):
         return model_dmp(model.__dict__.get("cartesian_", model.cartesian))
@@ -97,20 +143,31 @@ def _match_units(path, positions, units: str, model, what: str) -> str:
     dmp = model_dmp(model)
     model_units = dmp.units_
     if model_units and units and units != model_units:
-        raise ValueError(f"{path} is in {units} but the model {what} is in {model_units}: pass --units {model_units} to "
-                         f"convert it")
+        raise ValueError(
+            f"{path} is in {units} but the model {what} is in {model_units}: pass --units {model_units} to "
+            f"convert it"
+        )
     if units or not model_units:
         return units or model_units
     extent, reference = path_extent(positions), path_extent(dmp.rollout())
     ratio = extent / max(reference, np.finfo(float).tiny)
     if not 1.0 / _MODEL_EXTENT_RATIO <= ratio <= _MODEL_EXTENT_RATIO:
-        raise ValueError(f"{path} declares no units and its motion ({extent:.4g}) is {ratio:.3g} times the model's "
-                         f"({reference:.4g} {model_units}): it is in another unit; pass --units (m, cm, mm) to say which")
+        raise ValueError(
+            f"{path} declares no units and its motion ({extent:.4g}) is {ratio:.3g} times the model's "
+            f"({reference:.4g} {model_units}): it is in another unit; pass --units (m, cm, mm) to say which"
+        )
     return model_units
 
 
-def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, model=None, what: str = "",
-               timed: bool = False):
+def read_input(
+    path: str,
+    args: argparse.Namespace,
+    *,
+    poses: bool = False,
+    model=None,
+    what: str = "",
+    timed: bool = False,
+):
     """A demonstration file as the library wants it: ``(values, t or None, units, how)``.
 
     Positions (T, D) or poses (T, 7), in ``--units`` (converted from the file's declared unit if
@@ -126,14 +183,21 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
     bag = bag_recording(args) if path == getattr(args, "demo", None) else None
     recording = bag if bag is not None else read_recording(path, columns=args.columns)
     if (recording.kind == "pose") != poses:
-        raise ValueError(f"{path}: {recording.source} holds {'poses' if recording.kind == 'pose' else recording.kind}"
-                         + ("; pick its positions with --columns (e.g. position=<prefix> or x=..,y=..,z=..)"
-                            if recording.kind == "pose" else ""))
+        raise ValueError(
+            f"{path}: {recording.source} holds {'poses' if recording.kind == 'pose' else recording.kind}"
+            + (
+                "; pick its positions with --columns (e.g. position=<prefix> or x=..,y=..,z=..)"
+                if recording.kind == "pose"
+                else ""
+            )
+        )
     values, times, declared = recording.values, recording.t, recording.units
     if recording.kind == "joints" and requested and requested != declared and declared == "rad":
-        raise ValueError(f"{path}: its columns read as joints ({', '.join(recording.names[:8])}: t,<joint names>), in "
-                         f"radians, but --units says {requested}; if they are positions, name them with --columns "
-                         f"(e.g. t=stamp,x=..,y=..,z=..)")
+        raise ValueError(
+            f"{path}: its columns read as joints ({', '.join(recording.names[:8])}: t,<joint names>), in "
+            f"radians, but --units says {requested}; if they are positions, name them with --columns "
+            f"(e.g. t=stamp,x=..,y=..,z=..)"
+        )
     if timed:
         times = _time_option(path, times, args, recording)
     notes = []
@@ -153,18 +217,24 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
 
         values, times, info = prepare_poses(values, times, cutoff_hz=args.cutoff, units=units)
         peak = _peak_speed(values[:, :3], times)
-        how = (f"prepared: {info.rate_hz:.4g} Hz, low-pass {info.cutoff_hz:g} Hz, motion {info.start_s:.3g}-"
-               f"{info.end_s:.3g} s of the recording")
+        how = (
+            f"prepared: {info.rate_hz:.4g} Hz, low-pass {info.cutoff_hz:g} Hz, motion {info.start_s:.3g}-"
+            f"{info.end_s:.3g} s of the recording"
+        )
     else:
         from ..demonstrations.prepare import prepare
 
         prepared, info = prepare(values, times, cutoff_hz=args.cutoff, units=units)
         values, times, peak = prepared.y, prepared.t, info.peak_speed
-        how = (f"prepared: kept {info.start_s:.2f}-{info.end_s:.2f} s, low-pass {info.cutoff_hz:g} Hz at "
-               f"{info.rate_hz:.1f} Hz, peak speed {info.peak_speed:.4g} {units or 'units'}/s")
+        how = (
+            f"prepared: kept {info.start_s:.2f}-{info.end_s:.2f} s, low-pass {info.cutoff_hz:g} Hz at "
+            f"{info.rate_hz:.1f} Hz, peak speed {info.peak_speed:.4g} {units or 'units'}/s"
+        )
     if peak is not None:
         _check_speed(peak, units, path, recording)
-    if recording.source and not recording.source.startswith(("columns", "an .npy", "x,y", "t,<joint")):
+    if recording.source and not recording.source.startswith(
+        ("columns", "an .npy", "x,y", "t,<joint")
+    ):
         notes.append(f"read {recording.source}")
     if recording.kind == "joints" and recording.names:
         args.joint_names = list(recording.names)
@@ -172,14 +242,19 @@ def read_input(path: str, args: argparse.Namespace, *, poses: bool = False, mode
         held, spread = held_orientation(recording.orientation)
         if spread <= HELD_DEGREES:
             args.held_orientation = held
-            notes.append(f"the tool's orientation held within {spread:.2g} deg: kept with the model")
+            notes.append(
+                f"the tool's orientation held within {spread:.2g} deg: kept with the model"
+            )
         else:
-            notes.append(f"the tool turns by up to {spread:.3g} deg, which a position model drops (a pose model keeps "
-                         f"it: --columns pose=...)")
+            notes.append(
+                f"the tool turns by up to {spread:.3g} deg, which a position model drops (a pose model keeps "
+                f"it: --columns pose=...)"
+            )
     return values, times, units, "; ".join([how, *notes])
 
 
-HELD_DEGREES = 1.0  # an orientation that stays within this of its mean is one the demonstration held
+# an orientation that stays within this of its mean is one the demonstration held
+HELD_DEGREES = 1.0
 
 
 def held_orientation(quaternions):
@@ -201,10 +276,14 @@ def _time_option(path, times, args: argparse.Namespace, recording):
     file's stamps); a file without stamps needs ``--no-time``."""
     no_time = getattr(args, "no_time", False)
     if times is None and not no_time:
-        others = f"; its other columns: {', '.join(recording.ignored[:6])}" if recording.ignored else ""
-        raise ValueError(f"{path} has no time column ({recording.source}{others}), so its duration is unknown: name the time column with "
-                         f"--columns t=NAME, or pass --no-time to take its samples as uniform over 1 s (the paper's "
-                         f"convention)")
+        others = (
+            f"; its other columns: {', '.join(recording.ignored[:6])}" if recording.ignored else ""
+        )
+        raise ValueError(
+            f"{path} has no time column ({recording.source}{others}), so its duration is unknown: name the time column with "
+            f"--columns t=NAME, or pass --no-time to take its samples as uniform over 1 s (the paper's "
+            f"convention)"
+        )
     return None if no_time else times
 
 
@@ -231,8 +310,10 @@ def _check_speed(peak: float, units: str, path, recording) -> None:
     except ValueError as exc:
         if recording.kind != "joints" or not recording.names:
             raise
-        raise ValueError(f"{exc}; its columns were read as joints ({', '.join(recording.names[:6])}): if they are "
-                         f"positions, name them with --columns (t=..,x=..,y=..,z=..)") from None
+        raise ValueError(
+            f"{exc}; its columns were read as joints ({', '.join(recording.names[:6])}): if they are "
+            f"positions, name them with --columns (t=..,x=..,y=..,z=..)"
+        ) from None
 
 
 def scene_option(args: argparse.Namespace, units: str):
@@ -249,8 +330,10 @@ def scenario_option(args: argparse.Namespace, units: str):
 
     scenario = load(args.scene, allow_outside_files=args.allow_outside_files)
     if scenario.scene is None:
-        raise ValueError(f"--scene: scenario {args.scene} has no \"scene\" key")
+        raise ValueError(f'--scene: scenario {args.scene} has no "scene" key')
     if units and scenario.units and scenario.units != units:
-        raise ValueError(f"--scene: the scene of {args.scene} is in {scenario.units} but the model is in {units}; "
-                         f"use a scene in {units}")
+        raise ValueError(
+            f"--scene: the scene of {args.scene} is in {scenario.units} but the model is in {units}; "
+            f"use a scene in {units}"
+        )
     return scenario

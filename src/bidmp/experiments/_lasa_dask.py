@@ -19,7 +19,9 @@ def _client(scheduler: str | None, workers: int):
         try:
             return Client(scheduler, timeout="3s"), None
         except (OSError, TimeoutError) as exc:
-            raise ValueError(f"cannot reach the Dask scheduler at {scheduler} within 3 s ({type(exc).__name__})") from None
+            raise ValueError(
+                f"cannot reach the Dask scheduler at {scheduler} within 3 s ({type(exc).__name__})"
+            ) from None
     import dask
 
     # Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in every worker. Setting any of glibc's malloc
@@ -28,14 +30,21 @@ def _client(scheduler: str | None, workers: int):
     # nannies also leave their variables in this process's environment; it is restored after.
     saved = dict(os.environ)
     with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.ERROR)
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
     os.environ.clear()
     os.environ.update(saved)
     return Client(cluster), cluster
 
 
-def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress) -> int:
+def _run_on_dask(
+    todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress
+) -> int:
     """The cells ``todo`` on a Dask cluster (embedded, or at ``scheduler``), each written as it
     finishes and added to ``done``; returns the number of workers."""
     n_workers = workers or (os.cpu_count() or 1)
@@ -48,9 +57,20 @@ def _run_on_dask(todo, methods, every, workers, scheduler, kill_once, out, proto
         from .benchmark import _write_cell, cell_key, run_cell
 
         objects = [registry.get(name) for name in methods]
-        futures = [client.submit(run_cell, shape, demo, objects, every, kill_once, key=f"bidmp-lasa-{cell_key(shape, demo)}",
-                                 pure=False, retries=2)
-                   for shape, demo in todo]
+        futures = [
+            client.submit(
+                run_cell,
+                shape,
+                demo,
+                objects,
+                every,
+                kill_once,
+                key=f"bidmp-lasa-{cell_key(shape, demo)}",
+                pure=False,
+                retries=2,
+            )
+            for shape, demo in todo
+        ]
         for future in as_completed(futures):
             cell = future.result()
             _write_cell(out, protocol, cell)

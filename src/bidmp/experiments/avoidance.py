@@ -37,10 +37,14 @@ def random_case(seed: int) -> AvoidanceCase:
     unit = float(rng.choice([1.0, 1e-3]))
     start = rng.uniform(-100, 100, 3) + [0, 0, 80]
     heading, reach = rng.uniform(0, 2 * np.pi), rng.uniform(200, 400)
-    goal = start + np.array([np.cos(heading) * reach, np.sin(heading) * reach, rng.uniform(-30, 30)])
+    goal = start + np.array(
+        [np.cos(heading) * reach, np.sin(heading) * reach, rng.uniform(-30, 30)]
+    )
     middle = (start + goal) / 2 + np.append(rng.uniform(-20, 20, 2), rng.uniform(0, 40))
     n, duration = int(rng.integers(150, 600)), float(rng.uniform(2, 5))
     demonstration = minimum_jerk(np.array([start, middle, goal]) * unit, n)
     tool = {"radius": rng.uniform(6, 14) * unit, "length": 100 * unit}
-    scene = random_field(rng, demonstration[0], demonstration[-1], tool, margin=rng.uniform(1, 5) * unit)
+    scene = random_field(
+        rng, demonstration[0], demonstration[-1], tool, margin=rng.uniform(1, 5) * unit
+    )
     return AvoidanceCase(demonstration, np.linspace(0, duration, n), scene, unit)

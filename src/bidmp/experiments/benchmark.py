@@ -44,14 +44,28 @@ import numpy as np
 from .._checks import check_choice, check_int, require_extra, short_token
 from ._lasa_dask import _client, _run_on_dask  # noqa: F401  (_client: the benchmark script's cluster)
 
-__all__ = ["LASA_METHODS", "CASES", "METRICS", "run_cell", "lasa", "BenchmarkResult", "summary_rows", "cell_key", "summary_markdown"]
+__all__ = [
+    "LASA_METHODS",
+    "CASES",
+    "METRICS",
+    "run_cell",
+    "lasa",
+    "BenchmarkResult",
+    "summary_rows",
+    "cell_key",
+    "summary_markdown",
+]
 
 logger = logging.getLogger(__name__)
 
 # The built-in methods the benchmark runs by default (registry.names(lasa=True) lists them, and any
 # method registered with lasa = True after them).
 LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
-CASES = (("reproduction", 0.0), ("near", 0.1), ("far", 0.6))  # goal shift as a fraction of the shape's extent
+CASES = (
+    ("reproduction", 0.0),
+    ("near", 0.1),
+    ("far", 0.6),
+)  # goal shift as a fraction of the shape's extent
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")
 TIMES = ("fit_s", "rollout_s")
 FORMAT = 3  # of the cell files (2: the robot protocol; 3: a content digest); another is recomputed
@@ -95,9 +109,14 @@ def _metrics(rollout: np.ndarray, reference: np.ndarray, goal: np.ndarray) -> di
 
     aligned = resample_time(rollout, reference.shape[0])
     dtw = dtw_distance(aligned, reference)
-    return {"rmse": rmse(aligned, reference), "dtw": dtw, "dtw_per_sample": dtw / reference.shape[0],
-            "swept_area": swept_area(aligned, reference), "frechet": frechet_distance(aligned, reference),
-            "endpoint_error": float(np.linalg.norm(rollout[-1] - goal))}
+    return {
+        "rmse": rmse(aligned, reference),
+        "dtw": dtw,
+        "dtw_per_sample": dtw / reference.shape[0],
+        "swept_area": swept_area(aligned, reference),
+        "frechet": frechet_distance(aligned, reference),
+        "endpoint_error": float(np.linalg.norm(rollout[-1] - goal)),
+    }
 
 
 def _timed(function):
@@ -106,7 +125,9 @@ def _timed(function):
     return value, time.perf_counter() - start
 
 
-def run_cell(shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_once: str | None = None) -> dict:
+def run_cell(
+    shape: str, demo: int, methods=LASA_METHODS, every: int = 1, _kill_once: str | None = None
+) -> dict:
     """All methods on one (shape, demonstration): ``{"key", "rows": [...], "rollouts": {...}}``.
 
     ``methods`` are names in the methods registry (:mod:`bidmp.tasks.methods`) or method objects
@@ -150,9 +171,20 @@ def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
         metrics = _metrics(rollout, reference, goal)
         if end is not None:  # where the motion comes to rest, after the time-aligned part
             metrics["endpoint_error"] = float(np.linalg.norm(end - goal))
-        rows.append({"shape": shape, "demo": demo, "method": method, "case": case, "seed": seed,
-                     "goal_x": float(goal[0]), "goal_y": float(goal[1]), **metrics,
-                     "fit_s": fit_s, "rollout_s": rollout_s})
+        rows.append(
+            {
+                "shape": shape,
+                "demo": demo,
+                "method": method,
+                "case": case,
+                "seed": seed,
+                "goal_x": float(goal[0]),
+                "goal_y": float(goal[1]),
+                **metrics,
+                "fit_s": fit_s,
+                "rollout_s": rollout_s,
+            }
+        )
         if case == "reproduction":
             rollouts[method] = np.asarray(rollout[:: max(1, len(rollout) // 200)]).round(4).tolist()
 
@@ -162,7 +194,9 @@ def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
         method = name if isinstance(name, Method) else registry.get(name)
         model, fit_s = method.fit(task)  # seconds to learn, shared models (the DMP) included
         for case, goal in cases:
-            rollout, seconds = _timed(lambda goal=goal: method.rollout(model, goal))
+            rollout, seconds = _timed(
+                lambda goal=goal, method=method, model=model: method.rollout(model, goal)
+            )
             if method.settles:
                 # The first T samples are the motion's time (the robot protocol then rests at the
                 # goal for 10 % longer): what is time-aligned with the demonstration.
@@ -224,11 +258,15 @@ def _digest(result: dict) -> str:
     """A cell's content hash: what it computed, in canonical JSON (floats round-trip exactly)."""
     import hashlib
 
-    content = json.dumps({"rows": result["rows"], "rollouts": result.get("rollouts", {})}, sort_keys=True)
+    content = json.dumps(
+        {"rows": result["rows"], "rollouts": result.get("rollouts", {})}, sort_keys=True
+    )
     return hashlib.sha256(content.encode()).hexdigest()
 
 
-_ROW_KEYS = frozenset(("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES))
+_ROW_KEYS = frozenset(
+    ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES)
+)
 
 
 def _cell_problem(data, shape: str, demo: int, protocol: dict) -> str | None:
@@ -247,7 +285,11 @@ def _cell_problem(data, shape: str, demo: int, protocol: dict) -> str | None:
     expected = {(method, case) for method in protocol["methods"] for case, _ in CASES}
     seen = []
     for row in rows:
-        if not isinstance(row, dict) or set(row) != _ROW_KEYS or (row["shape"], row["demo"]) != (shape, demo):
+        if (
+            not isinstance(row, dict)
+            or set(row) != _ROW_KEYS
+            or (row["shape"], row["demo"]) != (shape, demo)
+        ):
             return "has a malformed row"
         seen.append((row["method"], row["case"]))
     if sorted(seen, key=str) != sorted(expected, key=str):
@@ -280,12 +322,27 @@ def _write_cell(out: Path, protocol: dict, result: dict) -> None:
     path = _cell_path(out, result["key"])
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_write(path, "w") as handle:
-        json.dump({"format": FORMAT, "protocol": protocol, **result, "digest": _digest(result)}, handle)
+        json.dump(
+            {"format": FORMAT, "protocol": protocol, **result, "digest": _digest(result)}, handle
+        )
 
 
-def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, workers: int | None = None,
-         scheduler: str | None = None, resume: bool = False, output_format: str = "parquet", progress=None,
-         synchronous: bool = False, dask: bool = False, _kill_once: str | None = None) -> BenchmarkResult:
+def lasa(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    out,
+    *,
+    shapes=None,
+    methods=None,
+    demos: str = "all",
+    every: int = 1,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    output_format: str = "parquet",
+    progress=None,
+    synchronous: bool = False,
+    dask: bool = False,
+    _kill_once: str | None = None,
+) -> BenchmarkResult:
     """Run the LASA benchmark into folder ``out``.
 
     Parameters
@@ -318,17 +375,25 @@ def lasa(out, *, shapes=None, methods=None, demos: str = "all", every: int = 1, 
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out {out} exists and is not a folder")
-    protocol = {"demos": demos, "every": every, "methods": methods, "cases": [list(c) for c in CASES]}
+    protocol = {
+        "demos": demos,
+        "every": every,
+        "methods": methods,
+        "cases": [list(c) for c in CASES],
+    }
     cells = [(shape, demo) for shape in shapes for demo in indices]
     done, todo = _resumed(out, protocol, cells) if resume else ({}, list(cells))
-    result = BenchmarkResult([], protocol, computed=[cell_key(*c) for c in todo], resumed=sorted(done))
+    result = BenchmarkResult(
+        [], protocol, computed=[cell_key(*c) for c in todo], resumed=sorted(done)
+    )
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
     if todo and (synchronous or workers == 1 and scheduler is None and not dask):
         result.workers = _run_here(todo, methods, every, out, protocol, done, progress)
     elif todo:
-        result.workers = _run_on_dask(todo, methods, every, workers, scheduler, _kill_once, out, protocol, done,
-                                      progress)
+        result.workers = _run_on_dask(
+            todo, methods, every, workers, scheduler, _kill_once, out, protocol, done, progress
+        )
     result.wall_s = time.perf_counter() - start
     # The table: every row of every cell in a fixed order (shape, demo, method, case).
     order = {cell_key(*c): i for i, c in enumerate(cells)}
@@ -345,8 +410,9 @@ def _resumed(out: Path, protocol: dict, cells) -> tuple[dict, list]:
     """The cells already computed for this protocol (``{key: cell}``, read back and checked) and
     those still to compute."""
     loaded = {cell_key(*c): _load_cell(_cell_path(out, cell_key(*c)), protocol, *c) for c in cells}
-    return {key: cell for key, cell in loaded.items() if cell is not None}, \
-        [c for c in cells if loaded[cell_key(*c)] is None]
+    return {key: cell for key, cell in loaded.items() if cell is not None}, [
+        c for c in cells if loaded[cell_key(*c)] is None
+    ]
 
 
 def _run_here(todo, methods, every, out, protocol, done, progress) -> int:
@@ -371,7 +437,19 @@ def _write_tables(out: Path, rows: list, protocol: dict, output_format: str) -> 
     return table
 
 
-_COLUMNS = ("shape", "demo", "method", "case", "seed", "goal_x", "goal_y", *METRICS, *TIMES, "demos", "every")
+_COLUMNS = (
+    "shape",
+    "demo",
+    "method",
+    "case",
+    "seed",
+    "goal_x",
+    "goal_y",
+    *METRICS,
+    *TIMES,
+    "demos",
+    "every",
+)
 
 
 def _write_table(rows: list, path: Path, output_format: str) -> None:
@@ -401,7 +479,9 @@ def _checked_rows(rows) -> list:
     needed = {"shape", "demo", "method", "case", *METRICS}
     for index, row in enumerate(rows):
         if not isinstance(row, dict) or not needed <= set(row):
-            raise TypeError(f"rows[{index}] must be one of the benchmark's rows (a dict with {', '.join(sorted(needed))})")
+            raise TypeError(
+                f"rows[{index}] must be one of the benchmark's rows (a dict with {', '.join(sorted(needed))})"
+            )
     return list(rows)
 
 
@@ -415,7 +495,9 @@ def summary_rows(rows: list, metric: str) -> tuple[list[str], list[list[str]]]:
     for method in methods:
         cells = [method]
         for case, _ in CASES:
-            values = np.array([row[metric] for row in rows if row["method"] == method and row["case"] == case])
+            values = np.array(
+                [row[metric] for row in rows if row["method"] == method and row["case"] == case]
+            )
             if values.size == 0:
                 cells.append("-")
                 continue
@@ -431,12 +513,16 @@ def summary_markdown(rows: list, protocol: dict) -> str:
 
     rows = _checked_rows(rows)
     if not isinstance(protocol, dict) or not {"demos", "every"} <= set(protocol):
-        raise TypeError(f"protocol must be the benchmark's protocol (a dict with demos and every), got "
-                        f"{short_token(protocol, 30)}")
+        raise TypeError(
+            f"protocol must be the benchmark's protocol (a dict with demos and every), got "
+            f"{short_token(protocol, 30)}"
+        )
     n_cells = len({(row["shape"], row["demo"]) for row in rows})
-    parts = [f"LASA benchmark: {n_cells} cells (shape x demonstration), demos {protocol['demos']}, every "
-             f"{protocol['every']} sample(s); median (IQR) per method; goal shifted by 0, 10 % and 60 % of the "
-             f"shape's extent (reproduction, near, far)."]
+    parts = [
+        f"LASA benchmark: {n_cells} cells (shape x demonstration), demos {protocol['demos']}, every "
+        f"{protocol['every']} sample(s); median (IQR) per method; goal shifted by 0, 10 % and 60 % of the "
+        f"shape's extent (reproduction, near, far)."
+    ]
     for metric in ("rmse", "dtw_per_sample", "swept_area", "frechet", "endpoint_error"):
         parts.append(f"**{metric}**\n\n" + markdown_table(*summary_rows(rows, metric)))
     return "\n\n".join(parts)
@@ -452,7 +538,9 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
     written = []
     n_cols = min(6, len(shapes))
     n_rows = int(np.ceil(len(shapes) / n_cols))
-    fig, axes = mpl.subplots(n_rows, n_cols, figsize=(2.6 * n_cols, 2.4 * n_rows), dpi=90, squeeze=False)
+    fig, axes = mpl.subplots(
+        n_rows, n_cols, figsize=(2.6 * n_cols, 2.4 * n_rows), dpi=90, squeeze=False
+    )
     colours = mpl.cm.tab10
     for ax, shape in zip(axes.ravel(), shapes):
         key = next((k for k in cells if k.startswith(f"{shape}__")), None)
@@ -460,17 +548,26 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
         ax.plot(*lasa_data(shape)[demo].T, color="0.6", linewidth=2.5, label="demonstration")
         if key is not None:
             for index, (method, rollout) in enumerate(cells[key].get("rollouts", {}).items()):
-                ax.plot(*np.asarray(rollout).T, color=colours(index % 10), linewidth=0.9, label=method)
+                ax.plot(
+                    *np.asarray(rollout).T, color=colours(index % 10), linewidth=0.9, label=method
+                )
         ax.set_title(shape, fontsize=8)
         ax.set_xticks([])
         ax.set_yticks([])
-    for ax in axes.ravel()[len(shapes):]:
+    for ax in axes.ravel()[len(shapes) :]:
         ax.axis("off")
     handles, labels = axes.ravel()[0].get_legend_handles_labels()
     fig.tight_layout()
     if handles:  # below the grid, as many columns as fit its width; the saved area grows to hold it
-        fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=min(len(labels), max(2, n_cols)),
-                   fontsize=8, frameon=False)
+        fig.legend(
+            handles,
+            labels,
+            loc="upper center",
+            bbox_to_anchor=(0.5, 0.0),
+            ncol=min(len(labels), max(2, n_cols)),
+            fontsize=8,
+            frameon=False,
+        )
     written.append(out / "lasa_shapes.png")
     with atomic_write(written[-1], "wb") as handle:
         fig.savefig(handle, format="png", bbox_inches="tight")
@@ -478,18 +575,29 @@ def _figures(out: Path, rows: list, cells: dict, shapes: list) -> list[Path]:
 
     plain = FuncFormatter(lambda value, _: f"{value:g}")
     # Within two decades, the 2s and 5s between the powers of ten are labelled too.
-    two_five = FuncFormatter(lambda value, _: f"{value:g}" if round(value / 10 ** np.floor(np.log10(value))) in (2, 5) else "")
+    two_five = FuncFormatter(
+        lambda value, _: (
+            f"{value:g}" if round(value / 10 ** np.floor(np.log10(value))) in (2, 5) else ""
+        )
+    )
     methods = list(dict.fromkeys(row["method"] for row in rows))
     fig, axes = mpl.subplots(1, 3, figsize=(15, 4.2), dpi=90, squeeze=False)
     for ax, metric in zip(axes[0], ("rmse", "dtw_per_sample", "endpoint_error")):
-        data = [[row[metric] for row in rows if row["method"] == method and row["case"] == "far"] for method in methods]
+        data = [
+            [row[metric] for row in rows if row["method"] == method and row["case"] == "far"]
+            for method in methods
+        ]
         ax.boxplot(data, tick_labels=methods, showfliers=False)
         ax.set_yscale("log")
         ax.yaxis.set_major_formatter(plain)  # 10, 0.01 rather than 10^1, 10^-2
         low, high = ax.get_ylim()
-        ax.yaxis.set_minor_formatter(two_five if high / low < 300 else FuncFormatter(lambda value, _: ""))
+        ax.yaxis.set_minor_formatter(
+            two_five if high / low < 300 else FuncFormatter(lambda value, _: "")
+        )
         ax.set_title(f"{metric}, far goals", fontsize=10)
-        ax.set_ylabel(f"{metric} [mm{' per sample' if metric == 'dtw_per_sample' else ''}] (log)")  # LASA: tablet mm
+        ax.set_ylabel(
+            f"{metric} [mm{' per sample' if metric == 'dtw_per_sample' else ''}] (log)"
+        )  # LASA: tablet mm
         ax.tick_params(axis="x", labelrotation=30, labelsize=8)
     fig.tight_layout()
     written.append(out / "lasa_metrics.png")

@@ -13,7 +13,7 @@ from ..demonstrations.datasets import lasa
 from ..primitives.dmp import DMP
 from ..tasks._tables import text_table
 
-__all__ = ['GeneralisationResult', 'lasa_generalisation']
+__all__ = ["GeneralisationResult", "lasa_generalisation"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -80,22 +80,41 @@ class GeneralisationResult:
     def summary(self) -> str:
         data = self.to_dict()
         rows = [
-            [str(i + 1), f"{shift:.2f}", f"{fixed:.3f}", f"{self.endpoint_gain * shift:.3f}", f"{conv:.2e}"]
-            for i, (shift, fixed, conv) in enumerate(zip(self.goal_shifts, self.errors_fixed, self.errors_converged))
+            [
+                str(i + 1),
+                f"{shift:.2f}",
+                f"{fixed:.3f}",
+                f"{self.endpoint_gain * shift:.3f}",
+                f"{conv:.2e}",
+            ]
+            for i, (shift, fixed, conv) in enumerate(
+                zip(self.goal_shifts, self.errors_fixed, self.errors_converged)
+            )
         ]
-        return "\n".join([
-            f"one LASA '{self.shape}' demonstration ({data['n_samples']} samples, 2-D), DMP with defaults",
-            f"  reproduction RMSE {data['reproduction_rmse']:.3f} mm = {data['reproduction_rmse_percent']:.2f} % of the extent",
-            f"  end-point gain c = {self.endpoint_gain:.4f} after T steps, {self.endpoint_gain_converged:.2e} after "
-            f"{data['n_steps_converged']} steps",
-            f"  end-point error at the demonstrated goal after T steps: e0 = {self.goal_error:.3f} mm",
-            "",
-            text_table(["goal", "shift [mm]", "error, T steps", "c * shift", f"error, {data['n_steps_converged']} steps"], rows),
-            "",
-            "Stopped after the demonstration's T steps (the paper's protocol), a DMP misses a moved goal by",
-            "c * shift on top of e0 (the error vector is e0 + (B - 1) * shift, exactly); run to convergence it",
-            "reaches every goal.",
-        ])
+        return "\n".join(
+            [
+                f"one LASA '{self.shape}' demonstration ({data['n_samples']} samples, 2-D), DMP with defaults",
+                f"  reproduction RMSE {data['reproduction_rmse']:.3f} mm = {data['reproduction_rmse_percent']:.2f} % of the extent",
+                f"  end-point gain c = {self.endpoint_gain:.4f} after T steps, {self.endpoint_gain_converged:.2e} after "
+                f"{data['n_steps_converged']} steps",
+                f"  end-point error at the demonstrated goal after T steps: e0 = {self.goal_error:.3f} mm",
+                "",
+                text_table(
+                    [
+                        "goal",
+                        "shift [mm]",
+                        "error, T steps",
+                        "c * shift",
+                        f"error, {data['n_steps_converged']} steps",
+                    ],
+                    rows,
+                ),
+                "",
+                "Stopped after the demonstration's T steps (the paper's protocol), a DMP misses a moved goal by",
+                "c * shift on top of e0 (the error vector is e0 + (B - 1) * shift, exactly); run to convergence it",
+                "reaches every goal.",
+            ]
+        )
 
 
 def lasa_generalisation(
@@ -113,9 +132,13 @@ def lasa_generalisation(
     reached twice: with the paper's fixed horizon (T steps; the end-point error is
     ``endpoint_gain · shift``) and run ``convergence_factor`` times longer (error → 0).
     """
-    demo_index = check_int(demo_index, "demo_index", minimum=0, maximum=6)  # LASA has 7 demonstrations per shape
+    demo_index = check_int(
+        demo_index, "demo_index", minimum=0, maximum=6
+    )  # LASA has 7 demonstrations per shape
     n_goals = check_int(n_goals, "n_goals", minimum=1, limit="max_targets")
-    convergence_factor = check_int(convergence_factor, "convergence_factor", minimum=1, maximum=1000)
+    convergence_factor = check_int(
+        convergence_factor, "convergence_factor", minimum=1, maximum=1000
+    )
     shift = check_real(shift, "shift", nonnegative=True, maximum=1e3)
     demonstration = lasa(name)[demo_index]
     dmp = DMP(**{"protocol": "paper", **dmp_params}).fit(demonstration)

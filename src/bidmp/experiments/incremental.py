@@ -16,13 +16,24 @@ from ..incremental.bidmp import BiDMP, ForgettingResult, forgetting_runs
 from ..primitives.dmp import DMP
 from ..tasks._tables import markdown_table, text_table
 
-__all__ = ['LASA_TARGET_OFFSETS', 'FIGURE_SHAPES', 'IncrementalResult', 'lasa_incremental', 'Figures', 'run_figures']
+__all__ = [
+    "LASA_TARGET_OFFSETS",
+    "FIGURE_SHAPES",
+    "IncrementalResult",
+    "lasa_incremental",
+    "Figures",
+    "run_figures",
+]
 
 
 # ---------------------------------------------------------------------------------------------
 # Paper Fig. 11: Bi-DMP on LASA shapes
 # ---------------------------------------------------------------------------------------------
-LASA_TARGET_OFFSETS = ((0.3, -0.2), (-0.25, -0.3), (0.15, 0.35))  # × extent, from the demonstrated end
+LASA_TARGET_OFFSETS = (
+    (0.3, -0.2),
+    (-0.25, -0.3),
+    (0.15, 0.35),
+)  # × extent, from the demonstrated end
 
 
 FIGURE_SHAPES = ("Sshape", "WShape", "NShape")
@@ -43,16 +54,20 @@ class IncrementalResult:
 
     def reproduction_errors(self) -> np.ndarray:
         """RMSE of each Bi-DMP rollout against its extended demonstration (mm)."""
-        return np.array([
-            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
-            for rollout, extension in zip(self.bidmp_rollouts, self.extensions)
-        ])
+        return np.array(
+            [
+                rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
+                for rollout, extension in zip(self.bidmp_rollouts, self.extensions)
+            ]
+        )
 
     def dmp_errors(self) -> np.ndarray:
-        return np.array([
-            rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
-            for rollout, extension in zip(self.dmp_rollouts, self.extensions)
-        ])
+        return np.array(
+            [
+                rmse(rollout, resample_time(extension.complete, rollout.shape[0]))
+                for rollout, extension in zip(self.dmp_rollouts, self.extensions)
+            ]
+        )
 
     def to_dict(self) -> dict:
         return {
@@ -65,7 +80,9 @@ class IncrementalResult:
         }
 
 
-def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET_OFFSETS, **bidmp_params) -> IncrementalResult:
+def lasa_incremental(
+    name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET_OFFSETS, **bidmp_params
+) -> IncrementalResult:
     """Fit a DMP to LASA demonstration 0, extend it to several new targets (1D-SEG + G-PRM) and
     learn the extensions in turn with a Bi-DMP; measure reproduction and forgetting (one
     learning pass: the forgetting measurement learns into the model that is then rolled out)."""
@@ -75,10 +92,14 @@ def lasa_incremental(name: str = "Sshape", *, seed: int = 0, offsets=LASA_TARGET
     seed = check_int(seed, "seed", minimum=0, maximum=2**32)
     dmp = DMP(protocol="paper").fit(demonstration)
     targets = demonstration[-1] + offsets * path_extent(demonstration)
-    extensions = [extend_demonstration(demonstration, target, seed=seed + index, approach="paper")
-                  for index, target in enumerate(targets)]
+    extensions = [
+        extend_demonstration(demonstration, target, seed=seed + index, approach="paper")
+        for index, target in enumerate(targets)
+    ]
     model = BiDMP(dmp, **bidmp_params)
-    runs = forgetting_runs(model, [extension.complete for extension in extensions], ("nearest", "latest"))
+    runs = forgetting_runs(
+        model, [extension.complete for extension in extensions], ("nearest", "latest")
+    )
     return IncrementalResult(
         shape=name,
         demonstration=demonstration,
@@ -98,23 +119,50 @@ class Figures:
     results: list[IncrementalResult]
 
     def rows(self) -> tuple[list[str], list[list[str]]]:
-        header = ["shape", "skill", "Bi-DMP RMSE", "plain DMP RMSE", "forgetting nearest", "forgetting latest"]
+        header = [
+            "shape",
+            "skill",
+            "Bi-DMP RMSE",
+            "plain DMP RMSE",
+            "forgetting nearest",
+            "forgetting latest",
+        ]
         rows = []
         for result in self.results:
-            for index, (bidmp_error, dmp_error) in enumerate(zip(result.reproduction_errors(), result.dmp_errors()), start=1):
-                rows.append([result.shape, str(index), f"{bidmp_error:.3f}", f"{dmp_error:.1f}",
-                             f"{result.forgetting_nearest.forgetting[index]:.3f}", f"{result.forgetting_latest.forgetting[index]:.1f}"])
-            rows.append([result.shape, "0 (demo)", "-", "-", f"{result.forgetting_nearest.forgetting[0]:.3f}",
-                         f"{result.forgetting_latest.forgetting[0]:.1f}"])
+            for index, (bidmp_error, dmp_error) in enumerate(
+                zip(result.reproduction_errors(), result.dmp_errors()), start=1
+            ):
+                rows.append(
+                    [
+                        result.shape,
+                        str(index),
+                        f"{bidmp_error:.3f}",
+                        f"{dmp_error:.1f}",
+                        f"{result.forgetting_nearest.forgetting[index]:.3f}",
+                        f"{result.forgetting_latest.forgetting[index]:.1f}",
+                    ]
+                )
+            rows.append(
+                [
+                    result.shape,
+                    "0 (demo)",
+                    "-",
+                    "-",
+                    f"{result.forgetting_nearest.forgetting[0]:.3f}",
+                    f"{result.forgetting_latest.forgetting[0]:.1f}",
+                ]
+            )
         return header, rows
 
     def to_dict(self) -> dict:
         return {"results": [result.to_dict() for result in self.results]}
 
     def summary(self) -> str:
-        return ("Bi-DMP on LASA shapes: three extended demonstrations learned in turn (errors in mm)\n"
-                + text_table(*self.rows())
-                + "\nforgetting = error of a skill after all learning minus its error when it was learned")
+        return (
+            "Bi-DMP on LASA shapes: three extended demonstrations learned in turn (errors in mm)\n"
+            + text_table(*self.rows())
+            + "\nforgetting = error of a skill after all learning minus its error when it was learned"
+        )
 
     def markdown(self) -> str:
         return markdown_table(*self.rows())

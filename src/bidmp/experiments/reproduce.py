@@ -50,10 +50,28 @@ from .table5 import (  # noqa: F401
 )
 
 __all__ = [
-    "GeneralisationResult", "lasa_generalisation", "LASA_TARGET_OFFSETS", "FIGURE_SHAPES",
-    "IncrementalResult", "lasa_incremental", "Figures", "run_figures", "TABLE4_SCENARIOS", "TASK_SCENARIOS",
-    "PAPER_TABLE4", "PAPER_NUT_ERRORS", "Table4", "run_table4", "MAX_SEEDS", "BATTERY_APPROACH_VIA",
-    "BATTERY_EXTENSION_TARGET", "table5_cases", "PRMComparison", "compare_prm", "Table5", "run_table5",
+    "GeneralisationResult",
+    "lasa_generalisation",
+    "LASA_TARGET_OFFSETS",
+    "FIGURE_SHAPES",
+    "IncrementalResult",
+    "lasa_incremental",
+    "Figures",
+    "run_figures",
+    "TABLE4_SCENARIOS",
+    "TASK_SCENARIOS",
+    "PAPER_TABLE4",
+    "PAPER_NUT_ERRORS",
+    "Table4",
+    "run_table4",
+    "MAX_SEEDS",
+    "BATTERY_APPROACH_VIA",
+    "BATTERY_EXTENSION_TARGET",
+    "table5_cases",
+    "PRMComparison",
+    "compare_prm",
+    "Table5",
+    "run_table5",
     "write_results",
 ]
 

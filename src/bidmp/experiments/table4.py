@@ -6,11 +6,17 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-
 from ..tasks._tables import markdown_table, text_table
 from ..tasks.evaluation import Report, evaluate
 
-__all__ = ['TABLE4_SCENARIOS', 'TASK_SCENARIOS', 'PAPER_TABLE4', 'PAPER_NUT_ERRORS', 'Table4', 'run_table4']
+__all__ = [
+    "TABLE4_SCENARIOS",
+    "TASK_SCENARIOS",
+    "PAPER_TABLE4",
+    "PAPER_NUT_ERRORS",
+    "Table4",
+    "run_table4",
+]
 
 
 TABLE4_SCENARIOS = ("nut-unscrewing", "cell-removal", "pick-and-place")
@@ -28,7 +34,12 @@ PAPER_TABLE4 = {
 
 # The paper's Tables 1 and 2: end-point error per nut [mm] (DMP; Bi-DMP on nuts 9-14).
 PAPER_NUT_ERRORS = {
-    "dmp": dict(zip(map(str, range(1, 15)), (0.40, 0.26, 0, 0.99, 1.02, 1.07, 1.49, 1.43, 1.75, 1.76, 1.79, 2.76, 2.74, 2.73))),
+    "dmp": dict(
+        zip(
+            map(str, range(1, 15)),
+            (0.40, 0.26, 0, 0.99, 1.02, 1.07, 1.49, 1.43, 1.75, 1.76, 1.79, 2.76, 2.74, 2.73),
+        )
+    ),
     "bidmp": dict(zip(map(str, range(9, 15)), (1.48, 1.25, 1.48, 1.48, 1.25, 1.48))),
 }
 
@@ -53,24 +64,45 @@ class Table4:
 
     reports: dict[str, Report]  # the paper's protocol (extension approach "paper")
     cells_before: Report  # cell removal with the nut extension only, Bi-DMP
-    keep: dict = field(default_factory=dict)  # nut and cell tasks with the defaults (approach "keep"), dmp + bidmp
+    keep: dict = field(
+        default_factory=dict
+    )  # nut and cell tasks with the defaults (approach "keep"), dmp + bidmp
 
     def task_rows(self) -> tuple[list[str], list[list[str]]]:
         """Task success with the battery geometry: end point ∧ engaged ∧ collision-free, for the
         defaults (approach "keep") beside the paper-literal extension (approach "paper")."""
-        header = ["task", "method", "end point", "engaged", "collision-free", "worst clearance mm (part)",
-                  "to the other targets' parts", "task success"]
+        header = [
+            "task",
+            "method",
+            "end point",
+            "engaged",
+            "collision-free",
+            "worst clearance mm (part)",
+            "to the other targets' parts",
+            "task success",
+        ]
         rows = []
         for name, report in self.keep.items():
-            variants = [("dmp", report.methods["dmp"]), ('bidmp, approach "keep" (default)', report.methods["bidmp"]),
-                        ('bidmp, approach "paper" (paper-literal)', self.reports[name].methods["bidmp"])]
+            variants = [
+                ("dmp", report.methods["dmp"]),
+                ('bidmp, approach "keep" (default)', report.methods["bidmp"]),
+                ('bidmp, approach "paper" (paper-literal)', self.reports[name].methods["bidmp"]),
+            ]
             for method, result in variants:
                 data = result.to_dict()
                 n = data["n_targets"]
-                rows.append([name, method, f"{data['successes']}/{n}", f"{data['engaged']}/{n}",
-                             f"{data['collision_free']}/{data['n_checked']}",
-                             f"{data['min_clearance']:.2f} ({data['min_clearance_part']})",
-                             _neighbour_clearance(report.scenario, result), f"{data['task_successes']}/{n}"])
+                rows.append(
+                    [
+                        name,
+                        method,
+                        f"{data['successes']}/{n}",
+                        f"{data['engaged']}/{n}",
+                        f"{data['collision_free']}/{data['n_checked']}",
+                        f"{data['min_clearance']:.2f} ({data['min_clearance_part']})",
+                        _neighbour_clearance(report.scenario, result),
+                        f"{data['task_successes']}/{n}",
+                    ]
+                )
         return header, rows
 
     def case_studies(self) -> dict:
@@ -84,7 +116,9 @@ class Table4:
                 "difference_before": before.differences["B6"],
                 "difference_after": after.differences["B6"],
             },
-            "pick_and_place": {skill: result.to_dict() for skill, result in picking.forgetting.items()},
+            "pick_and_place": {
+                skill: result.to_dict() for skill, result in picking.forgetting.items()
+            },
         }
 
     def to_dict(self) -> dict:
@@ -95,26 +129,54 @@ class Table4:
 
     def summary(self) -> str:
         studies = self.case_studies()
-        parts = [f"==================== {name} ====================\n{report.summary()}" for name, report in self.reports.items()]
-        rows = [[label, f"{studies['cell_removal']['before'][label]:.3f}", f"{studies['cell_removal']['after'][label]:.3f}"]
-                for label in studies["cell_removal"]["before"]]
-        parts.append("cell removal, Bi-DMP before (nut skill only) and after the second extended demonstration to B6:\n"
-                     + text_table(["target", "end error before", "end error after"], rows)
-                     + f"\n  difference (path deviation from the reference) at B6: before {studies['cell_removal']['difference_before']:.1f}, "
-                     f"after {studies['cell_removal']['difference_after']:.1f}")
+        parts = [
+            f"==================== {name} ====================\n{report.summary()}"
+            for name, report in self.reports.items()
+        ]
+        rows = [
+            [
+                label,
+                f"{studies['cell_removal']['before'][label]:.3f}",
+                f"{studies['cell_removal']['after'][label]:.3f}",
+            ]
+            for label in studies["cell_removal"]["before"]
+        ]
+        parts.append(
+            "cell removal, Bi-DMP before (nut skill only) and after the second extended demonstration to B6:\n"
+            + text_table(["target", "end error before", "end error after"], rows)
+            + f"\n  difference (path deviation from the reference) at B6: before {studies['cell_removal']['difference_before']:.1f}, "
+            f"after {studies['cell_removal']['difference_after']:.1f}"
+        )
         return "\n\n".join(parts)
 
     def nut_rows(self) -> tuple[list[str], list[list[str]]]:
         """Table 4 for the nut task beside the paper's."""
-        names = {"gmm": "GMM", "tpgmm": "TP-GMM", "dmp": "DMP (fixed horizon)", "bidmp": 'Bi-DMP (`skill="nearest"`)',
-                 "dmp-converged": "DMP run to convergence", "bidmp-latest": 'Bi-DMP `skill="latest"` (paper-literal)'}
-        header = ["method", "success rate (ours / paper)", "max error mm (ours / paper)", "approach ok (ours)"]
+        names = {
+            "gmm": "GMM",
+            "tpgmm": "TP-GMM",
+            "dmp": "DMP (fixed horizon)",
+            "bidmp": 'Bi-DMP (`skill="nearest"`)',
+            "dmp-converged": "DMP run to convergence",
+            "bidmp-latest": 'Bi-DMP `skill="latest"` (paper-literal)',
+        }
+        header = [
+            "method",
+            "success rate (ours / paper)",
+            "max error mm (ours / paper)",
+            "approach ok (ours)",
+        ]
         rows = []
         for method in ("gmm", "tpgmm", "dmp", "bidmp", "dmp-converged", "bidmp-latest"):
             data = self.reports["nut-unscrewing"].methods[method].to_dict()
             paper = PAPER_TABLE4.get(method, ("–", "–", "–"))
-            rows.append([names[method], f"{100 * data['success_rate']:.2f} % / {paper[0]} %".replace("– %", "–"),
-                         f"{data['max_error']:.2f} / {paper[1]}", f"{data['approach_successes']}/{data['n_targets']}"])
+            rows.append(
+                [
+                    names[method],
+                    f"{100 * data['success_rate']:.2f} % / {paper[0]} %".replace("– %", "–"),
+                    f"{data['max_error']:.2f} / {paper[1]}",
+                    f"{data['approach_successes']}/{data['n_targets']}",
+                ]
+            )
         return header, rows
 
     def per_nut_rows(self) -> tuple[list[str], list[list[str]]]:
@@ -125,21 +187,52 @@ class Table4:
         for method, name in (("dmp", "DMP"), ("bidmp", "Bi-DMP")):
             errors = report.methods[method].errors
             paper = PAPER_NUT_ERRORS[method]
-            rows.append([name] + [f"{errors[label]:.2f} ({paper[label]:.2f})" if label in paper else "" for label in labels])
+            rows.append(
+                [name]
+                + [
+                    f"{errors[label]:.2f} ({paper[label]:.2f})" if label in paper else ""
+                    for label in labels
+                ]
+            )
         return ["nut"] + labels, rows
 
     def markdown(self) -> str:
         studies = self.case_studies()
         picking = studies["pick_and_place"]
-        cells = [[label, f"{studies['cell_removal']['before'][label]:.2f}", f"{studies['cell_removal']['after'][label]:.2f}"]
-                 for label in ("N3", "B6")]
-        return "\n\n".join([
-            markdown_table(*self.nut_rows()),
-            markdown_table(*self.per_nut_rows()),
-            markdown_table(["cell removal, Bi-DMP end error (mm)", "nut skill only", "after the second extension to B6"], cells),
-            markdown_table(["pick-and-place forgetting (mm)", "demonstrated operator", "operator 2", "operator 3"],
-                           [[f'`skill="{skill}"`'] + [f"{v:.3f}" for v in result["forgetting"]] for skill, result in picking.items()]),
-        ])
+        cells = [
+            [
+                label,
+                f"{studies['cell_removal']['before'][label]:.2f}",
+                f"{studies['cell_removal']['after'][label]:.2f}",
+            ]
+            for label in ("N3", "B6")
+        ]
+        return "\n\n".join(
+            [
+                markdown_table(*self.nut_rows()),
+                markdown_table(*self.per_nut_rows()),
+                markdown_table(
+                    [
+                        "cell removal, Bi-DMP end error (mm)",
+                        "nut skill only",
+                        "after the second extension to B6",
+                    ],
+                    cells,
+                ),
+                markdown_table(
+                    [
+                        "pick-and-place forgetting (mm)",
+                        "demonstrated operator",
+                        "operator 2",
+                        "operator 3",
+                    ],
+                    [
+                        [f'`skill="{skill}"`'] + [f"{v:.3f}" for v in result["forgetting"]]
+                        for skill, result in picking.items()
+                    ],
+                ),
+            ]
+        )
 
     def task_markdown(self) -> str:
         """The task-success table (``tasks.md``): defaults beside the paper-literal extension."""
@@ -157,11 +250,20 @@ def run_table4(progress: Callable | None = None) -> Table4:
         if progress is not None:
             progress(name)
         spec = scenarios.load(name).to_dict()
-        spec["extension"] = {**spec.get("extension", {}), "approach": "paper"}  # the paper's protocol
-        reports[name] = evaluate(scenarios.from_dict(spec, source=f"built-in {name} (approach paper)"), repair=False)
+        spec["extension"] = {
+            **spec.get("extension", {}),
+            "approach": "paper",
+        }  # the paper's protocol
+        reports[name] = evaluate(
+            scenarios.from_dict(spec, source=f"built-in {name} (approach paper)"), repair=False
+        )
         if name in TASK_SCENARIOS:
-            keep[name] = evaluate(scenarios.load(name), ["dmp", "bidmp"], repair=False)  # approach keep, as learned
+            keep[name] = evaluate(
+                scenarios.load(name), ["dmp", "bidmp"], repair=False
+            )  # approach keep, as learned
     spec = reports["cell-removal"].scenario.to_dict()
     spec["extensions"] = spec["extensions"][:1]
-    before = evaluate(scenarios.from_dict(spec, source="cell-removal (nut skill only)"), ["bidmp"], repair=False)
+    before = evaluate(
+        scenarios.from_dict(spec, source="cell-removal (nut skill only)"), ["bidmp"], repair=False
+    )
     return Table4(reports, before, keep)

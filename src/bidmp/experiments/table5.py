@@ -14,7 +14,16 @@ from ..extension.extend import ExtendedDemonstration, extend_demonstration
 from ..extension.roadmap import RoadmapResult, classic_prm, gaussian_prm
 from ..tasks._tables import markdown_table, text_table
 
-__all__ = ['MAX_SEEDS', 'BATTERY_APPROACH_VIA', 'BATTERY_EXTENSION_TARGET', 'table5_cases', 'PRMComparison', 'compare_prm', 'Table5', 'run_table5']
+__all__ = [
+    "MAX_SEEDS",
+    "BATTERY_APPROACH_VIA",
+    "BATTERY_EXTENSION_TARGET",
+    "table5_cases",
+    "PRMComparison",
+    "compare_prm",
+    "Table5",
+    "run_table5",
+]
 
 
 MAX_SEEDS = 200  # seeds of one G-PRM vs PRM comparison (each runs both roadmaps, ~30 ms a seed)
@@ -23,7 +32,11 @@ MAX_SEEDS = 200  # seeds of one G-PRM vs PRM comparison (each runs both roadmaps
 # ---------------------------------------------------------------------------------------------
 # Paper Table 5: G-PRM vs classic PRM
 # ---------------------------------------------------------------------------------------------
-BATTERY_APPROACH_VIA = ((-80.0, -120.0, 200.0), (0.0, 0.0, 40.0), (0.0, 0.0, 0.0))  # mm, the paper's battery approach
+BATTERY_APPROACH_VIA = (
+    (-80.0, -120.0, 200.0),
+    (0.0, 0.0, 40.0),
+    (0.0, 0.0, 0.0),
+)  # mm, the paper's battery approach
 
 
 BATTERY_EXTENSION_TARGET = (150.0, 25.0, 0.0)  # centre of the nuts the plain DMP misses
@@ -71,7 +84,9 @@ class PRMComparison:
         }
 
 
-def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int = 20, **options) -> PRMComparison:
+def compare_prm(
+    y, new_target, *, name: str = "", units: str = "", n_seeds: int = 20, **options
+) -> PRMComparison:
     """Run G-PRM and classic PRM on the piece that :func:`extend_demonstration` imitates.
 
     Seeds ``0 … n_seeds − 1``; ``options`` go to :func:`extend_demonstration` (segmentation and
@@ -80,18 +95,30 @@ def compare_prm(y, new_target, *, name: str = "", units: str = "", n_seeds: int 
     n_seeds = check_int(n_seeds, "n_seeds", minimum=1, maximum=MAX_SEEDS)
     extension = extend_demonstration(y, new_target, seed=0, approach="paper", **options)
     roadmap_options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
-    prm_options = {k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")}
+    prm_options = {
+        k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")
+    }
     gprm, prm, example_prm = [], [], None
     for seed in range(n_seeds):
         if seed == 0 and len(extension.similarity_history):
             gprm.append(extension.similarity_history)  # the extension already ran G-PRM with seed 0
         else:
-            gprm.append(gaussian_prm(extension.tra_imi, extension.new_target, seed=seed, **roadmap_options).history)
+            gprm.append(
+                gaussian_prm(
+                    extension.tra_imi, extension.new_target, seed=seed, **roadmap_options
+                ).history
+            )
         result = classic_prm(extension.tra_imi, extension.new_target, seed=seed, **prm_options)
         prm.append(result.history)
         example_prm = example_prm or result
-    return PRMComparison(name=name, units=units, gprm=np.array(gprm), prm=np.array(prm),
-                         extension=extension, example_prm=example_prm)
+    return PRMComparison(
+        name=name,
+        units=units,
+        gprm=np.array(gprm),
+        prm=np.array(prm),
+        extension=extension,
+        example_prm=example_prm,
+    )
 
 
 @dataclass
@@ -108,29 +135,52 @@ class Table5:
         for comparison in self.comparisons:
             for label, data in (("G-PRM", comparison.gprm), ("PRM", comparison.prm)):
                 best = data.max(axis=1)
-                rows.append([comparison.name, label]
-                            + [f"{m:.3f}±{sd:.3f}" for m, sd in zip(data.mean(axis=0), data.std(axis=0))]
-                            + [f"{best.mean():.3f}±{best.std():.3f}"])
+                rows.append(
+                    [comparison.name, label]
+                    + [f"{m:.3f}±{sd:.3f}" for m, sd in zip(data.mean(axis=0), data.std(axis=0))]
+                    + [f"{best.mean():.3f}±{best.std():.3f}"]
+                )
         return header, rows
 
     def compact_rows(self) -> tuple[list[str], list[list[str]]]:
         """The README's columns: G-PRM first/last/best-of, classic PRM all iterations/best-of."""
-        header = ["case", "G-PRM it 1", f"G-PRM it {self.comparisons[0].gprm.shape[1]}", "G-PRM best-of",
-                  "classic PRM (all iterations)", "classic PRM best-of"]
+        header = [
+            "case",
+            "G-PRM it 1",
+            f"G-PRM it {self.comparisons[0].gprm.shape[1]}",
+            "G-PRM best-of",
+            "classic PRM (all iterations)",
+            "classic PRM best-of",
+        ]
 
         def cell(values):
             return f"{np.mean(values):.3f} ± {np.std(values):.3f}"
 
-        rows = [[c.name, cell(c.gprm[:, 0]), cell(c.gprm[:, -1]), cell(c.gprm.max(axis=1)), cell(c.prm),
-                 cell(c.prm.max(axis=1))] for c in self.comparisons]
+        rows = [
+            [
+                c.name,
+                cell(c.gprm[:, 0]),
+                cell(c.gprm[:, -1]),
+                cell(c.gprm.max(axis=1)),
+                cell(c.prm),
+                cell(c.prm.max(axis=1)),
+            ]
+            for c in self.comparisons
+        ]
         return header, rows
 
     def to_dict(self) -> dict:
-        return {"table": "5", "n_seeds": self.n_seeds, "cases": [c.to_dict() for c in self.comparisons]}
+        return {
+            "table": "5",
+            "n_seeds": self.n_seeds,
+            "cases": [c.to_dict() for c in self.comparisons],
+        }
 
     def summary(self) -> str:
-        return (f"Table 5 analogue: Fréchet similarity of the generated path, mean ± std over {self.n_seeds} seeds\n"
-                + text_table(*self.rows()))
+        return (
+            f"Table 5 analogue: Fréchet similarity of the generated path, mean ± std over {self.n_seeds} seeds\n"
+            + text_table(*self.rows())
+        )
 
     def markdown(self) -> str:
         return markdown_table(*self.compact_rows())
@@ -142,5 +192,10 @@ def run_table5(n_seeds: int = 20, progress: Callable | None = None) -> Table5:
     n_seeds = check_int(n_seeds, "n_seeds", minimum=1, maximum=MAX_SEEDS)
     cases = table5_cases().items()
     iterator = progress(cases) if progress is not None else cases
-    return Table5([compare_prm(y, target, name=name, units=units, n_seeds=n_seeds) for name, (y, target, units) in iterator],
-                  n_seeds)
+    return Table5(
+        [
+            compare_prm(y, target, name=name, units=units, n_seeds=n_seeds)
+            for name, (y, target, units) in iterator
+        ],
+        n_seeds,
+    )

@@ -51,12 +51,20 @@ from .roadmap import CollisionCallback, NoFreeRouteError, _check_options, gaussi
 from .segmentation import Piece, choose_piece, segment
 from .timing import _time_path, _timed_transfer
 
-__all__ = ["ExtendedDemonstration", "extend_demonstration", "extend_pose_demonstration", "final_approach", "APPROACHES"]
+__all__ = [
+    "ExtendedDemonstration",
+    "extend_demonstration",
+    "extend_pose_demonstration",
+    "final_approach",
+    "APPROACHES",
+]
 
 APPROACHES = ("keep", "paper")
-_STRAIGHTNESS = STRAIGHTNESS  # an approach deviates from its chord by at most this fraction of the chord
+# an approach deviates from its chord by at most this fraction of the chord
+_STRAIGHTNESS = STRAIGHTNESS
 
 logger = logging.getLogger(__name__)
+
 
 @dataclass
 class ExtendedDemonstration:
@@ -114,7 +122,9 @@ class ExtendedDemonstration:
     def poses(self) -> np.ndarray:
         """The extended pose demonstration (T, 7) of :func:`extend_pose_demonstration`."""
         if self.orientations is None:
-            raise AttributeError("this extension has no orientations: it was grown from positions (see complete)")
+            raise AttributeError(
+                "this extension has no orientations: it was grown from positions (see complete)"
+            )
         return np.hstack([self.complete, self.orientations])
 
     @property
@@ -132,7 +142,9 @@ class ExtendedDemonstration:
         from ..primitives.dmp import DMP
 
         if not isinstance(dmp, DMP) or getattr(dmp, "duration_", None) is None:
-            raise TypeError(f"dmp must be the fitted bidmp.DMP the extension was grown for, got {type(dmp).__name__}")
+            raise TypeError(
+                f"dmp must be the fitted bidmp.DMP the extension was grown for, got {type(dmp).__name__}"
+            )
         return dmp.duration_ * ((self.complete.shape[0] - 1) / (dmp.n_steps_ - 1))
 
     @property
@@ -183,8 +195,14 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     return _straight_tail_start(y, start, straightness)
 
 
-def _check_extension_options(*, eps_frac: float = 0.1, method: str = "persistence", seed=0, approach: str = "keep",
-                            **roadmap_options) -> None:
+def _check_extension_options(
+    *,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
+    seed=0,
+    approach: str = "keep",
+    **roadmap_options,
+) -> None:
     """Validate the options of :func:`extend_demonstration` without running it (what ``bidmp
     scenario check`` runs on a scenario's ``"extension"`` key); raise naming the first bad one."""
     eps_frac = check_real(eps_frac, "eps_frac")
@@ -196,11 +214,26 @@ def _check_extension_options(*, eps_frac: float = 0.1, method: str = "persistenc
 
 
 @numerically_guarded
-def extend_demonstration(
-    y, new_target, *, seed: int | np.random.Generator | None = 0, eps_frac: float = 0.1, method: str = "persistence",
-    n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100, n_iter: int = 10,
-    rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis", compare: str = "template",
-    select: str = "best", denom: str = "sqrt2", is_free: CollisionCallback | None = None, approach: str = "keep",
+def extend_demonstration(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    y,
+    new_target,
+    *,
+    seed: int | np.random.Generator | None = 0,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
+    n_samples: int = 300,
+    sigma_rel: float = 0.03,
+    n_neighbours: int = 8,
+    n_compare: int = 100,
+    n_iter: int = 10,
+    rho: float = 0.9,
+    schedule: str = "geometric",
+    scaling: str = "axis",
+    compare: str = "template",
+    select: str = "best",
+    denom: str = "sqrt2",
+    is_free: CollisionCallback | None = None,
+    approach: str = "keep",
     scene=None,
 ) -> ExtendedDemonstration:
     """Grow an extended demonstration from ``y`` to ``new_target`` (1D-SEG + G-PRM).
@@ -238,17 +271,33 @@ def extend_demonstration(
     y = as_trajectory(y, "y", min_points=10)
     target = as_point(new_target, y.shape[1], "new_target", like="y")
     roadmap_options = {
-        "n_samples": n_samples, "sigma_rel": sigma_rel, "n_neighbours": n_neighbours, "n_compare": n_compare,
-        "n_iter": n_iter, "rho": rho, "schedule": schedule, "scaling": scaling, "compare": compare,
-        "select": select, "denom": denom,
+        "n_samples": n_samples,
+        "sigma_rel": sigma_rel,
+        "n_neighbours": n_neighbours,
+        "n_compare": n_compare,
+        "n_iter": n_iter,
+        "rho": rho,
+        "schedule": schedule,
+        "scaling": scaling,
+        "compare": compare,
+        "select": select,
+        "denom": denom,
     }
-    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach, is_free=is_free,
-                             **roadmap_options)
+    _check_extension_options(
+        eps_frac=eps_frac,
+        method=method,
+        seed=seed,
+        approach=approach,
+        is_free=is_free,
+        **roadmap_options,
+    )
     exclude, roadmap_options["is_free"], scene_checker = _scene_checker(scene, y, target, is_free)
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
         if scene_checker is not None and scene.margin > 0.0:
-            return _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, exclude)
+            return _extend_keeping_the_margin(
+                y, target, points, seed, roadmap_options, scene, exclude
+            )
         return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
     return _extend_like_the_paper(y, target, points, seed, roadmap_options)
 
@@ -273,7 +322,9 @@ def _scene_checker(scene, y: np.ndarray, target: np.ndarray, is_free):
 _MARGIN_ATTEMPTS = 3  # plannings with a wider margin before an extension that keeps it is given up
 
 
-def _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, exclude) -> ExtendedDemonstration:
+def _extend_keeping_the_margin(
+    y, target, points, seed, roadmap_options, scene, exclude
+) -> ExtendedDemonstration:
     """``approach="keep"`` in a scene with a clearance margin: the extension as timed and sampled
     (not only the roadmap's polyline) must keep the margin from every part but the target's. When
     it does not, it is planned again with the margin widened by the shortfall; after
@@ -282,16 +333,26 @@ def _extend_keeping_the_margin(y, target, points, seed, roadmap_options, scene, 
 
     planning = scene.margin
     for _ in range(_MARGIN_ATTEMPTS):
-        options = {**roadmap_options, "is_free": SceneChecker(scene, scene._selected(exclude), planning)}
+        options = {
+            **roadmap_options,
+            "is_free": SceneChecker(scene, scene._selected(exclude), planning),
+        }
         extension = _extend_keeping_approach(y, target, points, seed, options, scene, exclude)
         clearance = scene.clearance(extension.complete, exclude=exclude)
         if clearance.clear:
             return extension
         planning += scene.margin - clearance.distance + 0.1 * scene.margin
-        logger.info("the extension passes %.3g from %s, inside the margin %g: planned again with %.3g",
-                    clearance.distance, clearance.part, scene.margin, planning)
-    raise NoFreeRouteError(f"no extension to {np.round(target, 3).tolist()} keeps the margin {scene.margin:g}: it comes "
-                           f"within {clearance.distance:.3g} of part {clearance.part!r} after {_MARGIN_ATTEMPTS} plannings")
+        logger.info(
+            "the extension passes %.3g from %s, inside the margin %g: planned again with %.3g",
+            clearance.distance,
+            clearance.part,
+            scene.margin,
+            planning,
+        )
+    raise NoFreeRouteError(
+        f"no extension to {np.round(target, 3).tolist()} keeps the margin {scene.margin:g}: it comes "
+        f"within {clearance.distance:.3g} of part {clearance.part!r} after {_MARGIN_ATTEMPTS} plannings"
+    )
 
 
 def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> ExtendedDemonstration:
@@ -315,7 +376,9 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
         history = result.history
 
     prefix = y[: piece.start + 1]  # includes seg
-    start_speed = float(np.linalg.norm(y[piece.start] - y[piece.start - 1]) / dt) if piece.start > 0 else 0.0
+    start_speed = (
+        float(np.linalg.norm(y[piece.start] - y[piece.start - 1]) / dt) if piece.start > 0 else 0.0
+    )
     imi_duration = max(piece.end - piece.start, 1) * dt
     mean_speed = arclength(tra_imi)[-1] / imi_duration
     if mean_speed <= 0.0:
@@ -323,8 +386,13 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
     timed, _ = _time_path(tra_gen, start_speed, mean_speed, dt)
     complete = resample_time(np.vstack([prefix, timed]), n_steps)
     complete[-1] = target
-    logger.debug("extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
-                 piece.index, piece.start, piece.end, len(history))
+    logger.debug(
+        "extended demonstration: piece %d (samples %d-%d), %d G-PRM iterations",
+        piece.index,
+        piece.start,
+        piece.end,
+        len(history),
+    )
     return _extension(complete, y, target, points, piece, tra_gen, history, result)
 
 
@@ -340,13 +408,21 @@ def _log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
     return float(-np.log((dt * (len(points) - 1)) ** 5 / peak**2 * squared))
 
 
-def _extension(complete, y, target, points, piece, tra_gen, history, result, **approach) -> ExtendedDemonstration:
+def _extension(
+    complete, y, target, points, piece, tra_gen, history, result, **approach
+) -> ExtendedDemonstration:
     """The :class:`ExtendedDemonstration` both ways build (``result``: G-PRM's, or None when it
     was skipped)."""
     return ExtendedDemonstration(
-        complete=complete, tra_imi=y[piece.start : piece.end + 1].copy(), tra_gen=tra_gen, seg_index=piece.start,
-        similarity_history=np.asarray(history), demonstration=y, new_target=target,
-        segmentation_points=points, piece=piece,
+        complete=complete,
+        tra_imi=y[piece.start : piece.end + 1].copy(),
+        tra_gen=tra_gen,
+        seg_index=piece.start,
+        similarity_history=np.asarray(history),
+        demonstration=y,
+        new_target=target,
+        segmentation_points=points,
+        piece=piece,
         similarity=float("nan") if result is None else result.similarity,
         template=None if result is None else result.template,
         samples=None if result is None else result.samples,
@@ -354,8 +430,9 @@ def _extension(complete, y, target, points, piece, tra_gen, history, result, **a
     )
 
 
-def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude,
-                             approach_rotation=None) -> ExtendedDemonstration:
+def _extend_keeping_approach(
+    y, target, points, seed, roadmap_options, scene, exclude, approach_rotation=None
+) -> ExtendedDemonstration:
     """``approach="keep"``: transfer by G-PRM to the translated approach's start, then the approach
     (rotated about the target by ``approach_rotation`` (D, D) when the target turns too)."""
     n_steps = y.shape[0]
@@ -375,7 +452,12 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
-        candidates, history, result, refinement = [np.vstack([seg, hover])], np.empty(0), None, "straight"
+        candidates, history, result, refinement = (
+            [np.vstack([seg, hover])],
+            np.empty(0),
+            None,
+            "straight",
+        )
     else:
         result, candidates, refinement = _route(tra_imi, hover, seed, roadmap_options)
         history = np.empty(0) if result is None else result.history
@@ -383,21 +465,48 @@ def _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, ex
     if scene is not None:
         hit = scene.clearance(np.vstack([hover, approach_tail]), exclude=exclude)
         if not hit.collision_free:
-            raise NoFreeRouteError(f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
-                                   f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
-                                   f"keeps it; choose another target, or approach='paper'")
+            raise NoFreeRouteError(
+                f"the demonstrated approach, translated to the new target {np.round(target, 3).tolist()}, "
+                f"hits part {hit.part!r} ({-hit.distance:.3g} deep): no collision-free extension "
+                f"keeps it; choose another target, or approach='paper'"
+            )
     # Each candidate route timed like the demonstration; of those still free as timed (a corner's
     # blend moves the samples off the route), the smoothest timed transfer kept.
     seg_sample = y[piece.start : piece.start + 1]
-    timed = [(_timed_transfer(route, y, piece.start, start, approach_tail, dt), route) for route in candidates]
+    timed = [
+        (_timed_transfer(route, y, piece.start, start, approach_tail, dt), route)
+        for route in candidates
+    ]
     is_free = roadmap_options.get("is_free")
-    free = [pair for pair in timed if _path_is_free(np.vstack([seg_sample, pair[0]]), is_free)] or timed
-    transfer, tra_gen = max(free, key=lambda pair: _log_dimensionless_jerk(np.vstack([seg_sample, pair[0]]), dt))
+    free = [
+        pair for pair in timed if _path_is_free(np.vstack([seg_sample, pair[0]]), is_free)
+    ] or timed
+    transfer, tra_gen = max(
+        free, key=lambda pair: _log_dimensionless_jerk(np.vstack([seg_sample, pair[0]]), dt)
+    )
     complete = np.vstack([y[: piece.start + 1], transfer, approach_tail])
-    logger.debug("extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
-                 "%d G-PRM iterations", start, piece.index, piece.start, piece.end, len(history))
-    return _extension(complete, y, target, points, piece, tra_gen, history, result, approach="keep", approach_index=start,
-                      refinement=refinement)
+    logger.debug(
+        "extended demonstration (keep): approach from sample %d kept, transfer from piece %d (samples %d-%d), "
+        "%d G-PRM iterations",
+        start,
+        piece.index,
+        piece.start,
+        piece.end,
+        len(history),
+    )
+    return _extension(
+        complete,
+        y,
+        target,
+        points,
+        piece,
+        tra_gen,
+        history,
+        result,
+        approach="keep",
+        approach_index=start,
+        refinement=refinement,
+    )
 
 
 _WIDER = (3.0, 9.0)  # G-PRM's sampling spread, widened in turn when it finds no free route
@@ -443,8 +552,16 @@ def _roadmap_defaults() -> dict:
 
 
 @numerically_guarded
-def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Generator | None = 0, scene=None,
-                              eps_frac: float = 0.1, method: str = "persistence", **roadmap_options):
+def extend_pose_demonstration(
+    poses,
+    new_target,
+    *,
+    seed: int | np.random.Generator | None = 0,
+    scene=None,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
+    **roadmap_options,
+):
     """Grow an extended pose demonstration (``approach="keep"``) from ``poses`` (T, 7) to the
     pose ``new_target`` (7,) (x, y, z, qx, qy, qz, qw).
 
@@ -468,7 +585,9 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
     target = as_point(new_target, 7, "new_target")
     target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
     turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
-    _check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options)
+    _check_extension_options(
+        eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options
+    )
     exclude = ()
     if scene is not None:
         _scene_checker(scene, positions, target[:3], None)  # validates the scene
@@ -476,11 +595,21 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
         roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
     options = {**_roadmap_defaults(), **roadmap_options}
     points = segment(positions, eps_frac=eps_frac, method=method).points
-    extension = _extend_keeping_approach(positions, target[:3], points, seed, options, None, exclude,
-                                         approach_rotation=turn.as_matrix())
+    extension = _extend_keeping_approach(
+        positions,
+        target[:3],
+        points,
+        seed,
+        options,
+        None,
+        exclude,
+        approach_rotation=turn.as_matrix(),
+    )
     start, seg = extension.approach_index, extension.seg_index
     kept = (turn * Rotation.from_quat(quaternions[start:])).as_quat()
-    hover = len(extension.complete) - (len(positions) - start)  # where the kept approach begins in complete
+    hover = len(extension.complete) - (
+        len(positions) - start
+    )  # where the kept approach begins in complete
     transfer = extension.complete[seg : hover + 1]
     arc = arclength(transfer)
     fraction = arc / arc[-1] if arc[-1] > 0 else np.linspace(0.0, 1.0, len(transfer))
@@ -493,6 +622,8 @@ def extend_pose_demonstration(poses, new_target, *, seed: int | np.random.Genera
     if scene is not None:
         hit = scene.clearance(extension.complete, exclude=exclude, orientations=orientations)
         if not hit.collision_free:
-            raise NoFreeRouteError(f"the extended pose demonstration to {np.round(target[:3], 3).tolist()} hits part "
-                                   f"{hit.part!r} ({-hit.distance:.3g} deep) with the tool as it is turned")
+            raise NoFreeRouteError(
+                f"the extended pose demonstration to {np.round(target[:3], 3).tolist()} hits part "
+                f"{hit.part!r} ({-hit.distance:.3g} deep) with the tool as it is turned"
+            )
     return dataclasses.replace(extension, orientations=orientations)

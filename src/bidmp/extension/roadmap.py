@@ -45,6 +45,7 @@ __all__ = ["NoFreeRouteError", "RoadmapResult", "template", "gaussian_prm", "cla
 
 logger = logging.getLogger(__name__)
 
+
 class NoFreeRouteError(ValueError):
     """The roadmap found no collision-free route (never a path through an obstacle)."""
 
@@ -121,7 +122,9 @@ def template(piece: np.ndarray, new_target: np.ndarray, scaling: str = "axis") -
     elif scaling == "axis":
         with np.errstate(divide="ignore", invalid="ignore"):
             factors = new_chord / chord
-        degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)
+        degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(
+            np.abs(factors) <= _MAX_AXIS_FACTOR
+        )
         scaled = seg + np.where(degenerate, 0.0, factors) * (piece - seg)
         out = np.where(degenerate, ramp, scaled)
     elif scaling == "similarity":
@@ -157,15 +160,23 @@ def _minimal_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.eye(n_dims) - 2.0 * np.outer(u, u) - 2.0 * np.outer(w, w)
     w /= sin
     # R = I + sinθ (w uᵀ − u wᵀ) + (cosθ − 1)(u uᵀ + w wᵀ)
-    return np.eye(n_dims) + sin * (np.outer(w, u) - np.outer(u, w)) + (cos - 1.0) * (np.outer(u, u) + np.outer(w, w))
+    return (
+        np.eye(n_dims)
+        + sin * (np.outer(w, u) - np.outer(u, w))
+        + (cos - 1.0) * (np.outer(u, u) + np.outer(w, w))
+    )
 
 
-def _paper_scaled(path: np.ndarray, seg: np.ndarray, tar: np.ndarray, new_target: np.ndarray) -> np.ndarray:
+def _paper_scaled(
+    path: np.ndarray, seg: np.ndarray, tar: np.ndarray, new_target: np.ndarray
+) -> np.ndarray:
     """Eq. 6–7 as printed: the factors ``(n_tar − seg)/(tar − seg)`` applied to Tra_gen."""
     chord = tar - seg
     with np.errstate(divide="ignore", invalid="ignore"):
         factors = (new_target - seg) / chord
-    bad = (np.abs(chord) < _DEGENERATE_AXIS * max(np.linalg.norm(chord), 1e-300)) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)
+    bad = (np.abs(chord) < _DEGENERATE_AXIS * max(np.linalg.norm(chord), 1e-300)) | ~(
+        np.abs(factors) <= _MAX_AXIS_FACTOR
+    )
     return seg + np.where(bad, 1.0, factors) * (path - seg)
 
 
@@ -217,27 +228,39 @@ def _edges_free(a: np.ndarray, b: np.ndarray, is_free: CollisionCallback) -> np.
     return free.all(axis=1)
 
 
-def _path_through(samples: np.ndarray, seg: np.ndarray, new_target: np.ndarray, order: np.ndarray,
-                  n_neighbours: int, is_free: CollisionCallback | None) -> np.ndarray:
+def _path_through(
+    samples: np.ndarray,
+    seg: np.ndarray,
+    new_target: np.ndarray,
+    order: np.ndarray,
+    n_neighbours: int,
+    is_free: CollisionCallback | None,
+) -> np.ndarray:
     nodes = np.vstack([seg, samples, new_target])
     if is_free is not None:
         free = np.asarray(is_free(nodes), dtype=bool)
         if not (free[0] and free[-1]):
-            raise NoFreeRouteError(f"the {'start (seg)' if not free[0] else 'new target'} "
-                                   f"{np.round(nodes[0] if not free[0] else nodes[-1], 3).tolist()} is inside an "
-                                   f"obstacle according to is_free")
+            raise NoFreeRouteError(
+                f"the {'start (seg)' if not free[0] else 'new target'} "
+                f"{np.round(nodes[0] if not free[0] else nodes[-1], 3).tolist()} is inside an "
+                f"obstacle according to is_free"
+            )
         keep = free.copy()
         nodes, order = nodes[keep], order[keep[1:-1]]
     indices = _shortest_path(nodes, n_neighbours, is_free)
     if indices is None:
         if is_free is not None:
-            raise NoFreeRouteError(f"no collision-free route from seg {np.round(seg, 3).tolist()} to "
-                                   f"{np.round(new_target, 3).tolist()}: the roadmap's {nodes.shape[0] - 2} free samples "
-                                   f"do not connect them even with {_MAX_NEIGHBOURS} neighbours (the parts block the "
-                                   f"way, or sigma_rel / n_samples are too small to go around them)")
+            raise NoFreeRouteError(
+                f"no collision-free route from seg {np.round(seg, 3).tolist()} to "
+                f"{np.round(new_target, 3).tolist()}: the roadmap's {nodes.shape[0] - 2} free samples "
+                f"do not connect them even with {_MAX_NEIGHBOURS} neighbours (the parts block the "
+                f"way, or sigma_rel / n_samples are too small to go around them)"
+            )
         # Unreachable even with 32 neighbours: chain the samples in their sampling order.
-        logger.warning("new target unreachable on the roadmap even with %d neighbours: chaining the samples in order",
-                       _MAX_NEIGHBOURS)
+        logger.warning(
+            "new target unreachable on the roadmap even with %d neighbours: chaining the samples in order",
+            _MAX_NEIGHBOURS,
+        )
         inner = nodes[1:-1][np.argsort(order, kind="stable")]
         return np.vstack([seg, inner, new_target])
     return nodes[indices]
@@ -258,7 +281,9 @@ class _Comparison:
             self.reference = self.piece
         else:
             self.reference = template(self.piece, self.new_target, self.scaling)
-        self.target_shape = self.reference if self.compare == "template" or self.scaling == "paper" else self.piece
+        self.target_shape = (
+            self.reference if self.compare == "template" or self.scaling == "paper" else self.piece
+        )
 
     def score(self, path: np.ndarray) -> tuple[float, np.ndarray]:
         """(similarity, bias direction) for a resampled path."""
@@ -268,22 +293,47 @@ class _Comparison:
         return frechet_similarity(path, self.target_shape, self.denom), self.reference - path
 
 
-def _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scaling, compare, select, denom):
+def _setup(
+    tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scaling, compare, select, denom
+):
     """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target", like="tra_imi")
-    _check_options(n_samples=n_samples, n_neighbours=n_neighbours, n_compare=n_compare, n_iter=n_iter,
-                  scaling=scaling, compare=compare, select=select, denom=denom)
+    _check_options(
+        n_samples=n_samples,
+        n_neighbours=n_neighbours,
+        n_compare=n_compare,
+        n_iter=n_iter,
+        scaling=scaling,
+        compare=compare,
+        select=select,
+        denom=denom,
+    )
     if np.linalg.norm(target - piece[0]) == 0.0:
-        raise ValueError("new_target coincides with the start of the piece (seg): nothing to generate")
+        raise ValueError(
+            "new_target coincides with the start of the piece (seg): nothing to generate"
+        )
     comparison = _Comparison(resample_arclength(piece, n_compare), target, scaling, compare, denom)
     return piece, target, comparison
 
 
-def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbours: int = 8, n_compare: int = 100,
-                  n_iter: int = 10, rho: float = 0.9, schedule: str = "geometric", scaling: str = "axis",
-                  compare: str = "template", select: str = "best", denom: str = "sqrt2", padding: float = 0.3,
-                  seed=0, is_free=None) -> None:
+def _check_options(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    *,
+    n_samples: int = 300,
+    sigma_rel: float = 0.03,
+    n_neighbours: int = 8,
+    n_compare: int = 100,
+    n_iter: int = 10,
+    rho: float = 0.9,
+    schedule: str = "geometric",
+    scaling: str = "axis",
+    compare: str = "template",
+    select: str = "best",
+    denom: str = "sqrt2",
+    padding: float = 0.3,
+    seed=0,
+    is_free=None,
+) -> None:
     """Validate roadmap options (those of :func:`gaussian_prm` and :func:`classic_prm`) without
     running anything; raise naming the first bad one. Sizes are bounded so that one run stays
     within seconds: ``n_samples · n_iter <= max_roadmap_nodes`` and ``n_compare² · n_iter <=
@@ -292,8 +342,14 @@ def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbour
     check_int(n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS_OPTION)
     check_int(n_compare, "n_compare", minimum=3)
     check_int(n_iter, "n_iter", minimum=1)
-    check_limit(n_samples * n_iter, "max_roadmap_nodes", "the roadmap nodes drawn, n_samples * n_iter")
-    check_limit(n_compare * n_compare * n_iter, "max_frechet_cells", "the similarity work, n_compare^2 * n_iter")
+    check_limit(
+        n_samples * n_iter, "max_roadmap_nodes", "the roadmap nodes drawn, n_samples * n_iter"
+    )
+    check_limit(
+        n_compare * n_compare * n_iter,
+        "max_frechet_cells",
+        "the similarity work, n_compare^2 * n_iter",
+    )
     check_real(sigma_rel, "sigma_rel", nonnegative=True, maximum=10.0)
     check_real(rho, "rho", positive=True, maximum=2.0)
     check_real(padding, "padding", nonnegative=True, maximum=100.0)
@@ -307,7 +363,9 @@ def _check_options(*, n_samples: int = 300, sigma_rel: float = 0.03, n_neighbour
         check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
 
 
-def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select) -> RoadmapResult:
+def _iterate(
+    comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select
+) -> RoadmapResult:
     """The loop both roadmaps share: draw samples, shortest path, score, learn (G-PRM only).
 
     ``draw(iteration) -> (samples (n, D), order (n,))``; ``learn(iteration, similarity,
@@ -318,7 +376,9 @@ def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is
     history, paths, all_samples = [], [], []
     for iteration in range(1, n_iter + 1):
         samples, order = draw(iteration)
-        path = resample_arclength(_path_through(samples, seg, target, order, n_neighbours, is_free), n_compare)
+        path = resample_arclength(
+            _path_through(samples, seg, target, order, n_neighbours, is_free), n_compare
+        )
         similarity, direction = comparison.score(path)
         if learn is not None:
             learn(iteration, similarity, direction)
@@ -329,13 +389,17 @@ def _iterate(comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is
     history = np.asarray(history)
     chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
     return RoadmapResult(
-        path=paths[chosen], similarity=float(history[chosen]), history=history, iteration=chosen,
-        template=comparison.reference, samples=all_samples[chosen],
+        path=paths[chosen],
+        similarity=float(history[chosen]),
+        history=history,
+        iteration=chosen,
+        template=comparison.reference,
+        samples=all_samples[chosen],
     )
 
 
 @numerically_guarded
-def gaussian_prm(
+def gaussian_prm(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     tra_imi,
     new_target,
     *,
@@ -387,10 +451,22 @@ def gaussian_prm(
         :class:`NoFreeRouteError` (a ``ValueError``) is raised: never a path through an obstacle.
     seed : int or numpy.random.Generator
     """
-    piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
-                                       scaling, compare, select, denom)
+    piece, target, comparison = _setup(
+        tra_imi,
+        new_target,
+        n_samples,
+        n_neighbours,
+        n_compare,
+        n_iter,
+        scaling,
+        compare,
+        select,
+        denom,
+    )
     _check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule, is_free=is_free)
-    sampler = _ChordSampler(piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed))
+    sampler = _ChordSampler(
+        piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed)
+    )
     return _iterate(comparison, n_iter, sampler.draw, sampler.learn, n_neighbours, is_free, select)
 
 
@@ -410,7 +486,9 @@ class _ChordSampler:
 
     def draw(self, iteration):
         bias_at_samples = interp_columns(self.t, self.lam, self.bias)  # Eq. 9
-        return self.line + self.rng.normal(scale=self.sigma, size=self.line.shape) + bias_at_samples, self.order
+        return self.line + self.rng.normal(
+            scale=self.sigma, size=self.line.shape
+        ) + bias_at_samples, self.order
 
     def learn(self, iteration, similarity, direction):  # Eq. 8
         rate = self.rho**iteration if self.schedule == "geometric" else self.rho / iteration
@@ -418,7 +496,7 @@ class _ChordSampler:
 
 
 @numerically_guarded
-def classic_prm(
+def classic_prm(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     tra_imi,
     new_target,
     *,
@@ -437,8 +515,18 @@ def classic_prm(
     """Classic PRM baseline (paper Table 5): uniform samples in the bounding box of seg and
     ``new_target`` padded by ``padding · ‖n_tar − seg‖``, no bias; each iteration only redraws.
     Scored exactly like :func:`gaussian_prm`."""
-    piece, target, comparison = _setup(tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter,
-                                       scaling, compare, select, denom)
+    piece, target, comparison = _setup(
+        tra_imi,
+        new_target,
+        n_samples,
+        n_neighbours,
+        n_compare,
+        n_iter,
+        scaling,
+        compare,
+        select,
+        denom,
+    )
     _check_options(padding=padding, is_free=is_free)
     rng = check_seed(seed)
     seg = piece[0]
@@ -448,7 +536,9 @@ def classic_prm(
     def draw(iteration):
         samples = rng.uniform(low, high, size=(n_samples, piece.shape[1]))
         # Uniform samples have no order of their own: the fallback chain follows the chord.
-        order = np.argsort(np.argsort((samples - seg) @ (target - seg), kind="stable"), kind="stable")
+        order = np.argsort(
+            np.argsort((samples - seg) @ (target - seg), kind="stable"), kind="stable"
+        )
         return samples, order
 
     return _iterate(comparison, n_iter, draw, None, n_neighbours, is_free, select)

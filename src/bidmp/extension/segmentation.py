@@ -70,8 +70,11 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
     smooth = check_real(smooth, "smooth", positive=True, maximum=1.0)
     smooth_curvature = check_real(smooth_curvature, "smooth_curvature", positive=True, maximum=1.0)
     window = _odd_window(smooth, n_points, 7)
-    check_limit(float(n_points) * window, "max_work",
-                "curvature's smoothing work (samples x window); resample to fewer points first")
+    check_limit(
+        float(n_points) * window,
+        "max_work",
+        "curvature's smoothing work (samples x window); resample to fewer points first",
+    )
     # A curve that does not move (to rounding) has no curvature: its derivatives are rounding noise.
     if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):
         return np.zeros(n_points)
@@ -102,7 +105,9 @@ def _alternating_extrema(kappa: np.ndarray, low: int, high: int) -> tuple[np.nda
     nonzero = np.flatnonzero(slope)
     if nonzero.size == 0:
         return np.empty(0, int), np.empty(0, int)
-    filled = slope[nonzero[np.maximum(np.searchsorted(nonzero, np.arange(slope.size), side="right") - 1, 0)]]
+    filled = slope[
+        nonzero[np.maximum(np.searchsorted(nonzero, np.arange(slope.size), side="right") - 1, 0)]
+    ]
     change = np.flatnonzero(np.diff(filled) != 0) + 1
     indices, types = [], []
     for index in change:
@@ -239,7 +244,10 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence") -> Segmentati
     total = s[-1]
     resampled = resample_arclength(y, n_points)
     kappa = curvature(resampled)
-    low, high = int(np.ceil(_INTERIOR[0] * (n_points - 1))), int(np.floor(_INTERIOR[1] * (n_points - 1))) + 1
+    low, high = (
+        int(np.ceil(_INTERIOR[0] * (n_points - 1))),
+        int(np.floor(_INTERIOR[1] * (n_points - 1))) + 1,
+    )
     interior = kappa[low:high]
     # Dimensionless curvature κ·L below 1e-6 everywhere: a straight line, nothing to cut.
     if np.max(interior) * total < 1e-6:  # (at least 10 samples: the interior has 8 or more)
@@ -289,4 +297,9 @@ def choose_piece(y, segmentation_points, new_target) -> Piece:
     distances = np.linalg.norm(ends - target, axis=1)
     # Ties go to the later piece: search the reversed distances for the first minimum.
     index = len(distances) - 1 - int(np.argmin(distances[::-1]))
-    return Piece(index=index, start=int(breakpoints[index]), end=int(breakpoints[index + 1]), breakpoints=breakpoints)
+    return Piece(
+        index=index,
+        start=int(breakpoints[index]),
+        end=int(breakpoints[index + 1]),
+        breakpoints=breakpoints,
+    )

@@ -22,7 +22,13 @@ from .._checks import as_trajectory, check_choice, check_limit, numerically_guar
 
 REFERENCE_MAX_CELLS = 1e7  # cells of frechet_distance_reference (a few seconds)
 
-__all__ = ["frechet_distance", "frechet_distance_reference", "frechet_similarity", "polyline_length", "dtw_distance"]
+__all__ = [
+    "frechet_distance",
+    "frechet_distance_reference",
+    "frechet_similarity",
+    "polyline_length",
+    "dtw_distance",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -94,7 +100,9 @@ def _compiled(name: str, function):
     if name not in _kernel_state:
         try:
             import numba
-        except ImportError:  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
+        except (
+            ImportError
+        ):  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
             _kernel_state[name] = None
             return None
         probe = (np.zeros((1, 1)), np.zeros((1, 1)))
@@ -102,7 +110,9 @@ def _compiled(name: str, function):
             kernel = numba.njit(cache=True, nogil=True)(function)
             kernel(*probe)
         except Exception as exc:  # noqa: BLE001 - numba's caching errors have no common class
-            logger.info("numba cannot cache the %s kernel here (%s); compiling it in memory", name, exc)
+            logger.info(
+                "numba cannot cache the %s kernel here (%s); compiling it in memory", name, exc
+            )
             kernel = numba.njit(cache=False, nogil=True)(function)
             kernel(*probe)
         _kernel_state[name] = kernel
@@ -131,8 +141,14 @@ def dtw_distance(a, b) -> float:
     a = as_trajectory(a, "a", min_points=1, allow_static=True)
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape[1] != b.shape[1]:
-        raise ValueError(f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}")
-    check_limit(a.shape[0] * b.shape[0], "max_frechet_cells", "the DTW table's size n x m; resample the curves")
+        raise ValueError(
+            f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}"
+        )
+    check_limit(
+        a.shape[0] * b.shape[0],
+        "max_frechet_cells",
+        "the DTW table's size n x m; resample the curves",
+    )
     kernel = _compiled("DTW", _dtw_rows)
     if kernel is None:  # pragma: no cover
         return float(_dtw_rows(a, b))
@@ -149,10 +165,16 @@ def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     n, m = a.shape[0], b.shape[0]
     if b.shape[1] != a.shape[1]:
-        raise ValueError(f"a and b must have the same number of columns, got {a.shape[1]} and {b.shape[1]}")
-    if float(n) * m > REFERENCE_MAX_CELLS:  # a Python loop over anti-diagonals: a reference, not a tool
-        raise ValueError(f"frechet_distance_reference: {n:,} x {m:,} cells exceed the reference's "
-                         f"{REFERENCE_MAX_CELLS:,.0f}; use frechet_distance")
+        raise ValueError(
+            f"a and b must have the same number of columns, got {a.shape[1]} and {b.shape[1]}"
+        )
+    if (
+        float(n) * m > REFERENCE_MAX_CELLS
+    ):  # a Python loop over anti-diagonals: a reference, not a tool
+        raise ValueError(
+            f"frechet_distance_reference: {n:,} x {m:,} cells exceed the reference's "
+            f"{REFERENCE_MAX_CELLS:,.0f}; use frechet_distance"
+        )
     # previous[i] holds ca[i, s-1-i], before_previous[i] holds ca[i, s-2-i]; inf outside the grid.
     before_previous = np.full(n, np.inf)
     previous = np.full(n, np.inf)
@@ -166,7 +188,9 @@ def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
         else:
             up = np.where(i >= 1, previous[np.maximum(i - 1, 0)], np.inf)  # ca[i-1, j]
             left = previous[i]  # ca[i, j-1]
-            diagonal = np.where(i >= 1, before_previous[np.maximum(i - 1, 0)], np.inf)  # ca[i-1, j-1]
+            diagonal = np.where(
+                i >= 1, before_previous[np.maximum(i - 1, 0)], np.inf
+            )  # ca[i-1, j-1]
             current = np.full(n, np.inf)
             current[i] = np.maximum(np.minimum(np.minimum(up, left), diagonal), distance)
         before_previous, previous = previous, current
@@ -191,9 +215,14 @@ def frechet_distance(a, b) -> float:
     a = as_trajectory(a, "a", min_points=1, allow_static=True)
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape[1] != b.shape[1]:
-        raise ValueError(f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}")
-    check_limit(a.shape[0] * b.shape[0], "max_frechet_cells",
-                "the Fréchet table's size n x m; resample the curves to fewer points")
+        raise ValueError(
+            f"a and b must have the same dimension, got D = {a.shape[1]} and D = {b.shape[1]}"
+        )
+    check_limit(
+        a.shape[0] * b.shape[0],
+        "max_frechet_cells",
+        "the Fréchet table's size n x m; resample the curves to fewer points",
+    )
     kernel = _frechet_kernel()
     if kernel is None:  # pragma: no cover
         return frechet_distance_reference(a, b)
@@ -222,6 +251,8 @@ def frechet_similarity(a, b, denom: str = "sqrt2") -> float:
     distance = frechet_distance(a, b)
     length_a, length_b = polyline_length(a), polyline_length(b)
     if length_a <= 0.0 or length_b <= 0.0:
-        raise ValueError(f"a and b must be curves of non-zero length (the normaliser), got lengths {length_a:g} and {length_b:g}")
+        raise ValueError(
+            f"a and b must be curves of non-zero length (the normaliser), got lengths {length_a:g} and {length_b:g}"
+        )
     scale = np.sqrt(length_a * length_b) / (np.sqrt(2.0) if denom == "sqrt2" else 2.0)
     return float(max(1.0 - distance / scale, 0.0))

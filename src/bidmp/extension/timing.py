@@ -29,7 +29,8 @@ logger = logging.getLogger(__name__)
 
 _GROWTH = 1.01  # candidate durations grow by this factor ...
 _LONGEST = 40.0  # ... up to this multiple of the imitated piece's own duration
-_DERIVATIVE_WINDOW = 11  # samples of the local fits for the demonstration's velocity and acceleration at the joins
+# samples of the local fits for the demonstration's velocity and acceleration at the joins
+_DERIVATIVE_WINDOW = 11
 _SPEED_SHARES = (1.0, 0.75, 0.5, 0.25, 0.0)  # of the end speeds along the path, tried in turn
 _NEGLIGIBLE = 1.02  # with no duration within the peaks, a longer one is taken only if 2 % better
 _JOIN_SLACK = 1.1  # peaks over the joins (with the demonstration's samples around them) may reach this times its own
@@ -47,20 +48,27 @@ def _motion_peaks(points: np.ndarray, dt: float) -> np.ndarray:
     return peaks
 
 
-def _arc_profile(length: float, start_speed: float, end_speed: float, duration: float, n_steps: int) -> np.ndarray:
+def _arc_profile(
+    length: float, start_speed: float, end_speed: float, duration: float, n_steps: int
+) -> np.ndarray:
     """Cubic Hermite arc length at ``u = k / n_steps``, k = 1..n_steps, from 0 to ``length`` with
     speeds ``start_speed`` and ``end_speed`` at the ends. Speeds that would make the profile run
     back (outside the Fritsch–Carlson disc α² + β² <= 9) are scaled down together."""
     alpha, beta = start_speed * duration / length, end_speed * duration / length
     radius = float(np.hypot(alpha, beta))
     if radius > 3.0:
-        logger.debug("transfer end speeds scaled by %.3f to keep the arc-length profile monotone", 3.0 / radius)
+        logger.debug(
+            "transfer end speeds scaled by %.3f to keep the arc-length profile monotone",
+            3.0 / radius,
+        )
         alpha, beta = 3.0 * alpha / radius, 3.0 * beta / radius
     u = np.arange(1, n_steps + 1) / n_steps
     return length * (3 * u**2 - 2 * u**3 + alpha * (u - 2 * u**2 + u**3) + beta * (u**3 - u**2))
 
 
-def _time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: float) -> tuple[np.ndarray, float]:
+def _time_path(
+    path: np.ndarray, start_speed: float, mean_speed: float, dt: float
+) -> tuple[np.ndarray, float]:
     """Time a geometric path: a cubic arc-length profile from ``start_speed`` to rest.
 
     ``s(u) = L (3u² − 2u³) + a (u − 2u² + u³)`` on ``u ∈ [0, 1]`` with ``a = start_speed · D``;
@@ -79,26 +87,33 @@ def _time_path(path: np.ndarray, start_speed: float, mean_speed: float, dt: floa
     if start_speed > 0.0:
         duration = min(duration, 3.0 * length / start_speed)
     n_steps = max(int(round(duration / dt)), 1)
-    check_int(n_steps, "the generated transfer's samples (its length at the demonstrated piece's speed)",
-              limit="max_steps")
+    check_int(
+        n_steps,
+        "the generated transfer's samples (its length at the demonstrated piece's speed)",
+        limit="max_steps",
+    )
     arc = _arc_profile(length, start_speed, 0.0, duration, n_steps)
     positions = interp_columns(arc, s, path)
     positions[-1] = path[-1]
     return positions, n_steps * dt
 
 
-def _quintic_profile(length: float, ends: tuple[float, float, float, float], duration: float, n_steps: int) -> np.ndarray:
+def _quintic_profile(
+    length: float, ends: tuple[float, float, float, float], duration: float, n_steps: int
+) -> np.ndarray:
     """Quintic Hermite arc length at ``u = k / n_steps``, k = 1..n_steps: from 0 to ``length``
     over ``duration``, leaving at speed and tangential acceleration ``ends[0:2]``, arriving at
     ``ends[2:4]``."""
     start_speed, start_acceleration, end_speed, end_acceleration = ends
     u = np.arange(1, n_steps + 1) / n_steps
     u2, u3, u4, u5 = u**2, u**3, u**4, u**5
-    return (length * (10 * u3 - 15 * u4 + 6 * u5)
-            + start_speed * duration * (u - 6 * u3 + 8 * u4 - 3 * u5)
-            + end_speed * duration * (-4 * u3 + 7 * u4 - 3 * u5)
-            + start_acceleration * duration**2 * (0.5 * u2 - 1.5 * u3 + 1.5 * u4 - 0.5 * u5)
-            + end_acceleration * duration**2 * (0.5 * u3 - u4 + 0.5 * u5))
+    return (
+        length * (10 * u3 - 15 * u4 + 6 * u5)
+        + start_speed * duration * (u - 6 * u3 + 8 * u4 - 3 * u5)
+        + end_speed * duration * (-4 * u3 + 7 * u4 - 3 * u5)
+        + start_acceleration * duration**2 * (0.5 * u2 - 1.5 * u3 + 1.5 * u4 - 0.5 * u5)
+        + end_acceleration * duration**2 * (0.5 * u3 - u4 + 0.5 * u5)
+    )
 
 
 class _Joins:
@@ -106,8 +121,15 @@ class _Joins:
     and where the kept approach takes over, and their components along the transfer's own
     direction there (0 where it turns away by 90° or more), which its arc-length profile keeps."""
 
-    def __init__(self, y: np.ndarray, seg_index: int, approach_index: int, dt: float, path: np.ndarray,
-                 point_at) -> None:
+    def __init__(
+        self,
+        y: np.ndarray,
+        seg_index: int,
+        approach_index: int,
+        dt: float,
+        path: np.ndarray,
+        point_at,
+    ) -> None:
         # Local cubic fits (Savitzky–Golay derivatives): a recording's noise would swamp plain
         # second differences at one sample.
         window = min(_DERIVATIVE_WINDOW, len(y) - 1 + len(y) % 2)
@@ -120,7 +142,10 @@ class _Joins:
         ends = approach_index < len(y) - 1  # an approach of one sample ends at rest
         zero = np.zeros(y.shape[1])
         self.velocities = (velocity[seg_index], velocity[approach_index] if ends else zero)
-        self.accelerations = (acceleration[seg_index], acceleration[approach_index] if ends else zero)
+        self.accelerations = (
+            acceleration[seg_index],
+            acceleration[approach_index] if ends else zero,
+        )
         self.directions = (_unit(path[1] - path[0]), _unit(path[-1] - path[-2]))
         # The path's own bend at its ends: moving along it at speed v adds v² p''(s) to the
         # acceleration, which the blends must take out too (else the acceleration steps at the
@@ -130,7 +155,9 @@ class _Joins:
             tangent, bend = point_at.derivative(1), point_at.derivative(2)
             ends = (0.0, float(point_at.t[-1]))
             self.directions = tuple(_unit(tangent(end)) for end in ends)
-            self.bends = tuple(bend(end) / max(float(np.dot(tangent(end), tangent(end))), 1e-300) for end in ends)
+            self.bends = tuple(
+                bend(end) / max(float(np.dot(tangent(end), tangent(end))), 1e-300) for end in ends
+            )
         speeds = [max(float(v @ d), 0.0) for v, d in zip(self.velocities, self.directions)]
         # The profile along the path: leave and arrive with the speed along it (accelerations are
         # left to the blends: kept over the whole transfer, they would make a long one run back).
@@ -143,8 +170,10 @@ class _Joins:
         for end in (0, 1):
             d = self.directions[end]
             speed = along[2 * end]
-            out += [self.velocities[end] - speed * d,
-                    self.accelerations[end] - along[2 * end + 1] * d - speed**2 * self.bends[end]]
+            out += [
+                self.velocities[end] - speed * d,
+                self.accelerations[end] - along[2 * end + 1] * d - speed**2 * self.bends[end],
+            ]
         return tuple(out)
 
 
@@ -159,7 +188,9 @@ def _unit(vector: np.ndarray) -> np.ndarray:
 _BLEND_ACCELERATION, _BLEND_JERK, _BLEND_JERK_A = 3.94, 36.0, 9.0
 
 
-def _blend_time(delta_v: np.ndarray, delta_a: np.ndarray, limit: np.ndarray, longest: float) -> float:
+def _blend_time(
+    delta_v: np.ndarray, delta_a: np.ndarray, limit: np.ndarray, longest: float
+) -> float:
     """The shortest blend (at most ``longest``) that adds no more than 80 % of the acceleration and
     jerk limits: how far a corner at a join is rounded."""
     dv, da = float(np.linalg.norm(delta_v)), float(np.linalg.norm(delta_a))
@@ -167,12 +198,18 @@ def _blend_time(delta_v: np.ndarray, delta_a: np.ndarray, limit: np.ndarray, lon
         return 0.0
     acceleration, jerk = 0.8 * max(limit[1], 1e-300), 0.8 * max(limit[2], 1e-300)
     # The two blends' peaks add: 3.94 dv / τ + da <= acceleration and 36 dv / τ² + 9 da / τ <= jerk.
-    by_acceleration = _BLEND_ACCELERATION * dv / (acceleration - da) if acceleration > da else longest
-    by_jerk = (_BLEND_JERK_A * da + np.sqrt((_BLEND_JERK_A * da) ** 2 + 4.0 * jerk * _BLEND_JERK * dv)) / (2.0 * jerk)
+    by_acceleration = (
+        _BLEND_ACCELERATION * dv / (acceleration - da) if acceleration > da else longest
+    )
+    by_jerk = (
+        _BLEND_JERK_A * da + np.sqrt((_BLEND_JERK_A * da) ** 2 + 4.0 * jerk * _BLEND_JERK * dv)
+    ) / (2.0 * jerk)
     return min(max(by_acceleration, by_jerk), longest)
 
 
-def _corner_blends(times: np.ndarray, duration: float, mismatches: tuple, limit: np.ndarray) -> np.ndarray:
+def _corner_blends(
+    times: np.ndarray, duration: float, mismatches: tuple, limit: np.ndarray
+) -> np.ndarray:
     """Offsets (n, D) that vanish with their first two derivatives outside a short window at each
     end and give the transfer the demonstration's velocity and acceleration vectors at the joins
     (quintic Hermite blends): a corner between the transfer and the piece it joins is rounded
@@ -183,15 +220,20 @@ def _corner_blends(times: np.ndarray, duration: float, mismatches: tuple, limit:
     if tau > 0.0:
         u = np.clip(times / tau, 0.0, 1.0)[:, None]
         offsets += dv0 * tau * (u - 6 * u**3 + 8 * u**4 - 3 * u**5) + da0 * tau**2 * (
-            0.5 * u**2 - 1.5 * u**3 + 1.5 * u**4 - 0.5 * u**5)
+            0.5 * u**2 - 1.5 * u**3 + 1.5 * u**4 - 0.5 * u**5
+        )
     tau = _blend_time(dv1, da1, limit, duration / 2)
     if tau > 0.0:
         u = np.clip((times - (duration - tau)) / tau, 0.0, 1.0)[:, None]
-        offsets += dv1 * tau * (-4 * u**3 + 7 * u**4 - 3 * u**5) + da1 * tau**2 * (0.5 * u**3 - u**4 + 0.5 * u**5)
+        offsets += dv1 * tau * (-4 * u**3 + 7 * u**4 - 3 * u**5) + da1 * tau**2 * (
+            0.5 * u**3 - u**4 + 0.5 * u**5
+        )
     return offsets
 
 
-_SMOOTH_TURN = np.radians(5.0)  # a path turning less at every vertex is taken as samples of a smooth curve
+_SMOOTH_TURN = np.radians(
+    5.0
+)  # a path turning less at every vertex is taken as samples of a smooth curve
 
 
 def _path_function(path: np.ndarray, s: np.ndarray):
@@ -208,11 +250,19 @@ def _path_function(path: np.ndarray, s: np.ndarray):
     if smooth:
         cosines = np.sum(pieces[1:] * pieces[:-1], axis=1) / (lengths[1:] * lengths[:-1])
         smooth = bool(np.all(cosines >= np.cos(_SMOOTH_TURN)))
-    return make_interp_spline(s, path, k=3) if smooth else (lambda arc: interp_columns(arc, s, path))
+    return (
+        make_interp_spline(s, path, k=3) if smooth else (lambda arc: interp_columns(arc, s, path))
+    )
 
 
-def _timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_index: int, approach: np.ndarray,
-                   dt: float) -> np.ndarray:
+def _timed_transfer(
+    path: np.ndarray,
+    y: np.ndarray,
+    seg_index: int,
+    approach_index: int,
+    approach: np.ndarray,
+    dt: float,
+) -> np.ndarray:
     """Samples along ``path`` (excluding its start, ending exactly at its end) from the
     demonstration ``y`` at ``seg_index`` to the kept ``approach`` (its samples after ``path``'s
     end; it began at ``approach_index`` in ``y``), timed as the module docstring says.
@@ -243,18 +293,25 @@ def _timed_transfer(path: np.ndarray, y: np.ndarray, seg_index: int, approach_in
             if np.all(np.diff(arc, prepend=0.0) >= -1e-12 * s[-1]):
                 break
         positions = point_at(arc)
-        positions += _corner_blends(np.arange(1, n_steps + 1) * dt, duration, joins.mismatches(along), limit)
+        positions += _corner_blends(
+            np.arange(1, n_steps + 1) * dt, duration, joins.mismatches(along), limit
+        )
         positions[-1] = path[-1]
         # Within the demonstration's peaks along the transfer; at the joins, where a
         # recording's noise meets a smooth profile in the third differences, within 1.1x.
         inside = _motion_peaks(np.vstack([path[:1], positions]), dt) / np.maximum(limit, 1e-300)
-        joined = _motion_peaks(np.vstack([before, positions, after]), dt) / np.maximum(_JOIN_SLACK * limit, 1e-300)
+        joined = _motion_peaks(np.vstack([before, positions, after]), dt) / np.maximum(
+            _JOIN_SLACK * limit, 1e-300
+        )
         excess = float(max(inside.max(), joined.max()))
         if excess <= 1.0 + 1e-9:
             return positions
         if excess < best_excess / _NEGLIGIBLE:  # a longer transfer must earn its time
             best, best_excess = positions, excess
         n_steps = max(n_steps + 1, int(np.ceil(n_steps * _GROWTH)))
-    logger.info("the transfer's peaks exceed the demonstration's by %.0f %% at best (%d samples)",
-                100 * (best_excess - 1), len(best))
+    logger.info(
+        "the transfer's peaks exceed the demonstration's by %.0f %% at best (%d samples)",
+        100 * (best_excess - 1),
+        len(best),
+    )
     return best

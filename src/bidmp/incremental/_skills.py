@@ -23,7 +23,9 @@ class SkillLibrary:
         self._ensure_started()
         basis = self.dmp_.basis(phase)  # validates the phases
         phase = np.asarray(phase, dtype=np.float64).reshape(-1)
-        return basis @ self.dmp_.weights_ + self._increment(phase, basis, self._check_skill_index(skill))
+        return basis @ self.dmp_.weights_ + self._increment(
+            phase, basis, self._check_skill_index(skill)
+        )
 
     def _gate(self, phase: np.ndarray) -> np.ndarray:
         """``min(ϑ / gate_phase_, 1)``: ϑ itself for the paper protocol (gate_phase_ = 1)."""
@@ -70,10 +72,14 @@ class SkillLibrary:
         if skill is None:
             return len(self.blocks_)
         if isinstance(skill, (bool, np.bool_)) or not isinstance(skill, (int, np.integer)):
-            raise ValueError(f"skill must be 'nearest', 'latest' or an integer 0-{len(self.blocks_)}, got {_shown(skill)}")
+            raise ValueError(
+                f"skill must be 'nearest', 'latest' or an integer 0-{len(self.blocks_)}, got {_shown(skill)}"
+            )
         if not 0 <= skill <= len(self.blocks_):
-            raise ValueError(f"skill must be between 0 and {len(self.blocks_)} (this Bi-DMP has {self.n_skills} skills), "
-                             f"got {_shown(skill)}")
+            raise ValueError(
+                f"skill must be between 0 and {len(self.blocks_)} (this Bi-DMP has {self.n_skills} skills), "
+                f"got {_shown(skill)}"
+            )
         return int(skill)
 
     def select_skill(self, goal, skill="nearest") -> int:
@@ -87,7 +93,9 @@ class SkillLibrary:
                 goal = as_point(goal, self.dmp_.n_dims_, "goal")
                 distances = np.linalg.norm(self.skill_goals_ - goal, axis=1)
                 return int(len(distances) - 1 - np.argmin(distances[::-1]))
-            raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {_shown(skill)}")
+            raise ValueError(
+                f"skill must be 'nearest', 'latest' or an integer, got {_shown(skill)}"
+            )
         return self._check_skill_index(skill)
 
     def _skill_query(self, goal, skill, start):
@@ -98,7 +106,9 @@ class SkillLibrary:
         index = self.select_skill(query, skill)
         goal = self.skill_goals_[index] if goal is None else query
         start = self.skill_starts_[index] if start is None else start
-        increment = None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
+        increment = (
+            None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
+        )
         return index, goal, start, increment, self._skill_dmp(index)
 
     def _skill_dmp(self, index: int):
@@ -118,7 +128,9 @@ class SkillLibrary:
         return views[key]
 
     @numerically_guarded
-    def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
+    def rollout(
+        self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None
+    ) -> np.ndarray:
         """Generate a trajectory with one skill of the library.
 
         Parameters
@@ -140,19 +152,47 @@ class SkillLibrary:
         return dmp.rollout(goal=goal, start=start, n_steps=n_steps, forcing_increment=increment)
 
     @numerically_guarded
-    def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, coupling=None, via=None, via_until: float | None = None):
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        skill="nearest",
+        start=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        limits: dict | None = None,
+        coupling=None,
+        via=None,
+        via_until: float | None = None,
+    ):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
         with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms and ``via``
         points as there (the skill's increment kept, the least-norm change added to it)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
-        return dmp.trajectory(goal=goal, start=start, duration=duration, dt=dt, limits=limits,
-                              forcing_increment=increment, coupling=coupling, via=via, via_until=via_until)
+        return dmp.trajectory(
+            goal=goal,
+            start=start,
+            duration=duration,
+            dt=dt,
+            limits=limits,
+            forcing_increment=increment,
+            coupling=coupling,
+            via=via,
+            via_until=via_until,
+        )
 
-    def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0):
+    def stepper(
+        self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0
+    ):
         """A step-by-step integrator of one skill for a control loop (see :meth:`bidmp.DMP.stepper`)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
-        return dmp.stepper(goal=goal, start=start, duration=duration, coupling=coupling, forcing_increment=increment)
+        return dmp.stepper(
+            goal=goal,
+            start=start,
+            duration=duration,
+            coupling=coupling,
+            forcing_increment=increment,
+        )
 
 
 def _shown(skill) -> str:

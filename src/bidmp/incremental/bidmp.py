@@ -58,7 +58,10 @@ def _derivative_rule(derivatives: str, params) -> str:
     return params.derivatives if derivatives == "dmp" else derivatives
 
 
-_TIME_SCALES = (1e-3, 1e3)  # a skill lasts between a thousandth and a thousand times the demonstration
+_TIME_SCALES = (
+    1e-3,
+    1e3,
+)  # a skill lasts between a thousandth and a thousand times the demonstration
 
 
 def _time_scale(duration, dmp: DMP) -> float:
@@ -68,8 +71,10 @@ def _time_scale(duration, dmp: DMP) -> float:
     duration = check_real(duration, "duration", positive=True)
     scale = duration / dmp.duration_
     if not _TIME_SCALES[0] <= scale <= _TIME_SCALES[1]:
-        raise ValueError(f"duration {duration:.4g} s is {scale:.3g} times the demonstration's {dmp.duration_:.4g} s; "
-                         f"a skill may last {_TIME_SCALES[0]:g} to {_TIME_SCALES[1]:g} times it")
+        raise ValueError(
+            f"duration {duration:.4g} s is {scale:.3g} times the demonstration's {dmp.duration_:.4g} s; "
+            f"a skill may last {_TIME_SCALES[0]:g} to {_TIME_SCALES[1]:g} times it"
+        )
     return float(scale)
 
 
@@ -167,17 +172,28 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         check_real(self.reg, "reg", nonnegative=True, maximum=1e6)
         check_int(self.seed, "seed", minimum=0, maximum=2**62)
         if not isinstance(self.increments, (tuple, list)):
-            raise TypeError(f"increments must be a sequence of integers, got {type(self.increments).__name__}")
+            raise TypeError(
+                f"increments must be a sequence of integers, got {type(self.increments).__name__}"
+            )
         increments = tuple(self.increments)
         check_limit(len(increments), "max_hidden_nodes", "the number of increments")
-        increments = tuple(check_int(n, "increments", minimum=1, limit="max_hidden_nodes") for n in increments)
-        check_limit(n_windows * n_mapped + n_enhance + sum(increments), "max_hidden_nodes",
-                    "the hidden nodes of one block, n_windows * n_mapped + n_enhance + sum(increments)")
-        derivatives = check_choice(self.derivatives, "derivatives", ("auto", "forward", "gradient", "dmp"))
+        increments = tuple(
+            check_int(n, "increments", minimum=1, limit="max_hidden_nodes") for n in increments
+        )
+        check_limit(
+            n_windows * n_mapped + n_enhance + sum(increments),
+            "max_hidden_nodes",
+            "the hidden nodes of one block, n_windows * n_mapped + n_enhance + sum(increments)",
+        )
+        derivatives = check_choice(
+            self.derivatives, "derivatives", ("auto", "forward", "gradient", "dmp")
+        )
         return increments, derivatives
 
     def __sklearn_is_fitted__(self) -> bool:
-        return "dmp_" in self.__dict__ or (isinstance(self.dmp, DMP) and self.dmp.__sklearn_is_fitted__())
+        return "dmp_" in self.__dict__ or (
+            isinstance(self.dmp, DMP) and self.dmp.__sklearn_is_fitted__()
+        )
 
     def _start(self, dmp: DMP) -> None:
         """Skill 0 only: the plain DMP."""
@@ -190,7 +206,9 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         self.phase_min_ = float(phase.min())
         # 1 for the paper protocol (bit for bit the ϑ-gated increment), else the phase at the last
         # sample of the demonstrated motion.
-        self.gate_phase_ = 1.0 if dmp._params().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
+        self.gate_phase_ = (
+            1.0 if dmp._params().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
+        )
 
     def _ensure_started(self) -> None:
         if "dmp_" in self.__dict__:
@@ -202,7 +220,7 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         self._check_params()
         self._start(self.dmp)
 
-    def fit(self, y) -> "BiDMP":
+    def fit(self, y) -> BiDMP:
         """Fit a copy of ``dmp`` (default ``DMP()``) on the demonstration ``y`` (T, D) as skill 0,
         forgetting every learned skill. Returns self."""
         self._check_params()
@@ -223,7 +241,7 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         return self.dmp_.n_dims_
 
     @numerically_guarded
-    def learn(self, y_dn, *, duration: float | None = None) -> "BiDMP":
+    def learn(self, y_dn, *, duration: float | None = None) -> BiDMP:
         """Learn an extended demonstration as a new skill (Eq. 15, 27, 28). Returns self.
 
         Parameters
@@ -239,7 +257,9 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         """
         return self._learn(y_dn, duration)
 
-    def _learn(self, y_dn, duration: float | None, name: str = "y_dn", still: bool = False) -> "BiDMP":
+    def _learn(
+        self, y_dn, duration: float | None, name: str = "y_dn", still: bool = False
+    ) -> BiDMP:
         """:meth:`learn`; ``still``: ``y_dn`` may stand still (one part of a pose skill that moves
         in its other part)."""
         self._ensure_started()
@@ -250,16 +270,25 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         y = as_trajectory(y_dn, name, allow_static=still)
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"{name} has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
-        y = dmp.training_trajectory(y)  # T samples (and, robot protocol, rest at the goal after them)
+        y = dmp.training_trajectory(
+            y
+        )  # T samples (and, robot protocol, rest at the goal after them)
         phase, basis = dmp.training_grid()
         target = _forcing_target(
-            y, phase, dt=dmp.dt_, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
-            derivatives=_derivative_rule(derivatives, params), gate=dmp.training_gate(),
+            y,
+            phase,
+            dt=dmp.dt_,
+            tau=1.0,
+            alpha=params.alpha,
+            beta=params.beta,
+            K=params.K,
+            derivatives=_derivative_rule(derivatives, params),
+            gate=dmp.training_gate(),
         )
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
         return self._learn_block(target - current, y[-1], y[0], increments, time_scale)
 
-    def learn_increment(self, forcing_increment, goal, start=None) -> "BiDMP":
+    def learn_increment(self, forcing_increment, goal, start=None) -> BiDMP:
         """Lower level of :meth:`learn`: fit one BLS block to a given forcing increment FI.
 
         Parameters
@@ -273,7 +302,9 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         dmp = self.dmp_
         increment = _as_float_array(forcing_increment, "forcing_increment")
         if increment.shape != (dmp.n_train_, dmp.n_dims_):
-            raise ValueError(f"forcing_increment must have shape {(dmp.n_train_, dmp.n_dims_)}, got {increment.shape}")
+            raise ValueError(
+                f"forcing_increment must have shape {(dmp.n_train_, dmp.n_dims_)}, got {increment.shape}"
+            )
         if not np.all(np.isfinite(increment)):
             raise ValueError("forcing_increment contains NaN or inf")
         goal = as_point(goal, dmp.n_dims_, "goal")
@@ -281,17 +312,29 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         increments, _ = self._check_params()
         return self._learn_block(increment, goal, start, increments)
 
-    def _learn_block(self, increment: np.ndarray, goal: np.ndarray, start: np.ndarray, increments: tuple[int, ...],
-                     time_scale: float = 1.0) -> "BiDMP":
+    def _learn_block(
+        self,
+        increment: np.ndarray,
+        goal: np.ndarray,
+        start: np.ndarray,
+        increments: tuple[int, ...],
+        time_scale: float = 1.0,
+    ) -> BiDMP:
         """Fit one BLS block to a validated FI (T, D), grow it by ``increments`` nodes and add
         the skill (goal, start)."""
         dmp = self.dmp_
         phase, basis = dmp.training_grid()
         inputs = self._bls_input(phase, basis)
         block = BLS(
-            n_windows=self.n_windows, n_mapped=self.n_mapped, n_enhance=self.n_enhance, shrink=self.shrink,
-            reg=self.reg, seed=self.seed + len(self.blocks_) + 1,
-        ).fit(inputs, increment / self._gate(phase)[:, None])  # the increment is gate · BLS: learn FI / gate
+            n_windows=self.n_windows,
+            n_mapped=self.n_mapped,
+            n_enhance=self.n_enhance,
+            shrink=self.shrink,
+            reg=self.reg,
+            seed=self.seed + len(self.blocks_) + 1,
+        ).fit(
+            inputs, increment / self._gate(phase)[:, None]
+        )  # the increment is gate · BLS: learn FI / gate
         for n_nodes in increments:
             block.add_enhancement_nodes(n_nodes)
         self.blocks_.append(block)
@@ -305,7 +348,7 @@ class BiDMP(SkillLibrary, CheckedParams, BaseEstimator):
         return _bidmp_state(self)
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> "BiDMP":
+    def _from_state(cls, meta: dict, arrays) -> BiDMP:
         return _bidmp_from_state(cls, meta, arrays)
 
 
@@ -327,34 +370,55 @@ class ForgettingResult:
     forgetting: np.ndarray  # (P + 1,)
 
     def to_dict(self) -> dict:
-        return {"skill": self.skill, "errors": np.where(np.isnan(self.errors), None, self.errors).tolist(),
-                "forgetting": self.forgetting.tolist()}
+        return {
+            "skill": self.skill,
+            "errors": np.where(np.isnan(self.errors), None, self.errors).tolist(),
+            "forgetting": self.forgetting.tolist(),
+        }
 
 
-def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest"), **bidmp_params) -> dict:
+def forgetting_runs(
+    dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest"), **bidmp_params
+) -> dict:
     """:func:`forgetting` for several skill rules from one learning pass: {skill: ForgettingResult}.
 
     ``dmp`` may also be a :class:`BiDMP` with no learned skill yet: the demonstrations are then
     learned into it (so the caller keeps the model; ``bidmp_params`` must be empty).
     """
     if not isinstance(dmp, (DMP, BiDMP)):
-        raise TypeError(f"dmp must be a fitted bidmp.DMP (or an empty BiDMP), got {type(dmp).__name__}")
+        raise TypeError(
+            f"dmp must be a fitted bidmp.DMP (or an empty BiDMP), got {type(dmp).__name__}"
+        )
     if not isinstance(demonstrations, (list, tuple)):
-        raise TypeError(f"demonstrations must be a list of arrays (T', D), got {type(demonstrations).__name__}")
+        raise TypeError(
+            f"demonstrations must be a list of arrays (T', D), got {type(demonstrations).__name__}"
+        )
     check_limit(len(demonstrations), "max_targets", "demonstrations: the number of skills to learn")
-    demonstrations = [as_trajectory(y, f"demonstrations[{index}]") for index, y in enumerate(demonstrations)]
+    demonstrations = [
+        as_trajectory(y, f"demonstrations[{index}]") for index, y in enumerate(demonstrations)
+    ]
     if not isinstance(skills, (list, tuple)) or not skills:
-        raise TypeError(f"skills must be a list of skill rules ('nearest', 'latest' or indices), got {short_token(skills, 30)}")
+        raise TypeError(
+            f"skills must be a list of skill rules ('nearest', 'latest' or indices), got {short_token(skills, 30)}"
+        )
     for skill in skills:
-        if not (isinstance(skill, str) and skill in ("nearest", "latest")) and (isinstance(skill, bool) or not isinstance(skill, int)):
-            raise ValueError(f"skill must be 'nearest', 'latest' or an integer, got {type(skill).__name__}")
+        if not (isinstance(skill, str) and skill in ("nearest", "latest")) and (
+            isinstance(skill, bool) or not isinstance(skill, int)
+        ):
+            raise ValueError(
+                f"skill must be 'nearest', 'latest' or an integer, got {type(skill).__name__}"
+            )
     if isinstance(dmp, BiDMP):
         if bidmp_params:
-            raise TypeError("bidmp_params cannot be combined with a BiDMP model (set them on the model)")
+            raise TypeError(
+                "bidmp_params cannot be combined with a BiDMP model (set them on the model)"
+            )
         model = dmp
         model._ensure_started()
         if model.blocks_:
-            raise ValueError(f"the BiDMP given already has {len(model.blocks_)} learned skill(s); forgetting starts from none")
+            raise ValueError(
+                f"the BiDMP given already has {len(model.blocks_)} learned skill(s); forgetting starts from none"
+            )
         dmp = model.dmp_
     else:
         model = BiDMP(dmp, **bidmp_params)
@@ -367,7 +431,9 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
     def measure(column: int) -> None:
         for skill in skills:
             for p in range(column + 1):
-                rollout = model.rollout(model.skill_goals_[p], skill=skill, start=model.skill_starts_[p])
+                rollout = model.rollout(
+                    model.skill_goals_[p], skill=skill, start=model.skill_starts_[p]
+                )
                 errors[skill][p, column] = rmse(rollout[: dmp.n_steps_], references[p])
 
     measure(0)
@@ -376,7 +442,9 @@ def forgetting_runs(dmp: DMP | BiDMP, demonstrations, skills=("nearest", "latest
         references.append(resample_time(demonstration, dmp.n_steps_))
         measure(index)
     return {
-        skill: ForgettingResult(skill=str(skill), errors=matrix, forgetting=matrix[:, -1] - np.diag(matrix))
+        skill: ForgettingResult(
+            skill=str(skill), errors=matrix, forgetting=matrix[:, -1] - np.diag(matrix)
+        )
         for skill, matrix in errors.items()
     }
 

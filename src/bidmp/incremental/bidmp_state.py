@@ -32,8 +32,13 @@ def _bidmp_state(model) -> tuple[dict, dict]:
         arrays.update({f"block{index}/{k}": v for k, v in block_arrays.items()})
     params = {k: v for k, v in model.get_params(deep=False).items() if k != "dmp"}
     params["increments"] = list(model.increments)
-    return {"params": params, "dmp": dmp_meta, "blocks": blocks_meta, "phase_min_": model.phase_min_,
-            "gate_phase_": model.gate_phase_}, arrays
+    return {
+        "params": params,
+        "dmp": dmp_meta,
+        "blocks": blocks_meta,
+        "phase_min_": model.phase_min_,
+        "gate_phase_": model.gate_phase_,
+    }, arrays
 
 
 def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
@@ -51,22 +56,39 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
     model._check_params()
     model._start(dmp)
     model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
-    model.gate_phase_ = check_real(meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0)
-    model.blocks_ = [BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
-                     for index, block_meta in enumerate(meta["blocks"])]
+    model.gate_phase_ = check_real(
+        meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0
+    )
+    model.blocks_ = [
+        BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
+        for index, block_meta in enumerate(meta["blocks"])
+    ]
     for index, block in enumerate(model.blocks_):
-        if block.n_features_ != dmp.weights_.shape[0] or block.output_weights_.shape[1] != dmp.n_dims_:
-            raise ValueError(f"block {index} maps {block.n_features_} inputs to {block.output_weights_.shape[1]} outputs; "
-                             f"the DMP has {dmp.weights_.shape[0]} kernels and D = {dmp.n_dims_}")
+        if (
+            block.n_features_ != dmp.weights_.shape[0]
+            or block.output_weights_.shape[1] != dmp.n_dims_
+        ):
+            raise ValueError(
+                f"block {index} maps {block.n_features_} inputs to {block.output_weights_.shape[1]} outputs; "
+                f"the DMP has {dmp.weights_.shape[0]} kernels and D = {dmp.n_dims_}"
+            )
     expected = (len(model.blocks_) + 1, dmp.n_dims_)
     model.skill_goals_ = check_loaded(arrays["skill_goals_"], "skill_goals_", expected)
     model.skill_starts_ = check_loaded(arrays["skill_starts_"], "skill_starts_", expected)
     for name in ("skill_goals_", "skill_starts_"):
         _check_magnitude(getattr(model, name), f"member {name}")
     if "skill_time_scales_" in arrays:
-        model.skill_time_scales_ = check_loaded(arrays["skill_time_scales_"], "skill_time_scales_", (expected[0],), positive=True)
-        if model.skill_time_scales_[0] != 1.0 or np.any(model.skill_time_scales_ > 1e3) or np.any(model.skill_time_scales_ < 1e-3):
-            raise ValueError("member skill_time_scales_ must be 1 for skill 0 and within [0.001, 1000]")
+        model.skill_time_scales_ = check_loaded(
+            arrays["skill_time_scales_"], "skill_time_scales_", (expected[0],), positive=True
+        )
+        if (
+            model.skill_time_scales_[0] != 1.0
+            or np.any(model.skill_time_scales_ > 1e3)
+            or np.any(model.skill_time_scales_ < 1e-3)
+        ):
+            raise ValueError(
+                "member skill_time_scales_ must be 1 for skill 0 and within [0.001, 1000]"
+            )
     else:  # formats 2-4: every skill took the demonstration's time
         model.skill_time_scales_ = np.ones(expected[0])
     return model

@@ -66,8 +66,14 @@ _BIAS = 0.1  # the constant appended to inputs and to Z (paper Eq. 17-18)
 
 def _check_work(n_samples: int, n_hidden: int, n_inputs: int = 0) -> None:
     """Refuse a fit whose dense algebra (N·h² for the output solve) would run for minutes."""
-    check_bytes(n_samples * max(n_hidden, n_inputs + 1), "the BLS hidden matrix (samples x hidden nodes)")
-    check_limit(float(n_samples) * n_hidden * n_hidden, "max_work", "the BLS solve's work (samples x hidden nodes^2)")
+    check_bytes(
+        n_samples * max(n_hidden, n_inputs + 1), "the BLS hidden matrix (samples x hidden nodes)"
+    )
+    check_limit(
+        float(n_samples) * n_hidden * n_hidden,
+        "max_work",
+        "the BLS solve's work (samples x hidden nodes^2)",
+    )
 
 
 def _with_bias(X: np.ndarray) -> np.ndarray:
@@ -104,13 +110,19 @@ def _rng(seed: int, kind: int, index: int) -> np.random.Generator:
     return np.random.default_rng([seed, kind, index])
 
 
-def _mapped_features(X: np.ndarray, mapping_weights: np.ndarray, low: np.ndarray, span: np.ndarray) -> np.ndarray:
+def _mapped_features(
+    X: np.ndarray, mapping_weights: np.ndarray, low: np.ndarray, span: np.ndarray
+) -> np.ndarray:
     """Min–max normalised mapped features Z of inputs X; every window in one matrix product."""
-    weights = np.ascontiguousarray(mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1))  # (d+1, u·q)
+    weights = np.ascontiguousarray(
+        mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1)
+    )  # (d+1, u·q)
     return (_affine(X, weights) - low) / span
 
 
-def _enhancement_block(Z: np.ndarray, seed: int, block: int, n_nodes: int, shrink: float) -> tuple[np.ndarray, float, np.ndarray]:
+def _enhancement_block(
+    Z: np.ndarray, seed: int, block: int, n_nodes: int, shrink: float
+) -> tuple[np.ndarray, float, np.ndarray]:
     """Draw enhancement block number ``block``: (weights (c+1, n), scale s, H = tanh(s·[Z, 0.1]W))."""
     weights = np.ascontiguousarray(_orthonormal(_rng(seed, 1, block), Z.shape[1] + 1, n_nodes))
     pre_activation = _affine(Z, weights)
@@ -132,6 +144,7 @@ def _check_inputs(X, expected: int | None = None) -> np.ndarray:
     _check_finite(X, "X")
     _check_magnitude(X, "X")
     return X
+
 
 def _check_targets(Y, n_rows: int) -> tuple[np.ndarray, bool]:
     """Targets Y (n_rows, n_outputs) or (n_rows,) as float64 2-D, and whether they were 1-D."""
@@ -218,9 +231,13 @@ class BLS(CheckedParams, BaseEstimator):
         reg = check_real(self.reg, "reg", nonnegative=True)
         update = check_choice(self.update, "update", ("auto", "pinv", "exact_ridge"))
         if update == "pinv" and reg > 0:
-            raise ValueError("update='pinv' (Eq. 23-26) is exact only with reg=0; use update='exact_ridge' for reg > 0")
+            raise ValueError(
+                "update='pinv' (Eq. 23-26) is exact only with reg=0; use update='exact_ridge' for reg > 0"
+            )
         if update == "exact_ridge" and reg <= 0:
-            raise ValueError("update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)")
+            raise ValueError(
+                "update='exact_ridge' needs reg > 0 (the hidden matrix is rank-deficient)"
+            )
         if update == "auto":
             update = "pinv" if reg == 0.0 else "exact_ridge"
         params = _BLSParams(
@@ -230,12 +247,17 @@ class BLS(CheckedParams, BaseEstimator):
             shrink=check_real(self.shrink, "shrink", positive=True, maximum=1e6),
             reg=check_real(reg, "reg", maximum=1e6),
             l1=check_real(self.l1, "l1", nonnegative=True, maximum=1e6),
-            admm_iterations=check_int(self.admm_iterations, "admm_iterations", minimum=1, maximum=MAX_ADMM_ITERATIONS),
+            admm_iterations=check_int(
+                self.admm_iterations, "admm_iterations", minimum=1, maximum=MAX_ADMM_ITERATIONS
+            ),
             update=update,
             seed=check_int(self.seed, "seed", minimum=0, maximum=2**63 - 1),
         )
-        check_limit(params.n_windows * params.n_mapped + params.n_enhance, "max_hidden_nodes",
-                    "the hidden nodes n_windows * n_mapped + n_enhance")
+        check_limit(
+            params.n_windows * params.n_mapped + params.n_enhance,
+            "max_hidden_nodes",
+            "the hidden nodes n_windows * n_mapped + n_enhance",
+        )
         return params
 
     def __sklearn_is_fitted__(self) -> bool:
@@ -246,14 +268,18 @@ class BLS(CheckedParams, BaseEstimator):
         return _mapped_features(X, self.mapping_weights_, self.mapping_min_, self.mapping_range_)
 
     def _enhancement(self, Z: np.ndarray, block: int) -> np.ndarray:
-        return np.tanh(self.enhancement_scales_[block] * _affine(Z, self.enhancement_weights_[block]))
+        return np.tanh(
+            self.enhancement_scales_[block] * _affine(Z, self.enhancement_weights_[block])
+        )
 
     def hidden(self, X) -> np.ndarray:
         """The hidden-layer matrix ``[Z | H | E_1 | …]`` for inputs X, shape (N, n_hidden)."""
         check_fitted(self, "output_weights_")
         X = _check_inputs(X, self.n_features_)
         Z = self._mapped(X)
-        return np.hstack([Z] + [self._enhancement(Z, block) for block in range(len(self.enhancement_weights_))])
+        return np.hstack(
+            [Z] + [self._enhancement(Z, block) for block in range(len(self.enhancement_weights_))]
+        )
 
     @property
     def n_hidden_(self) -> int:
@@ -263,7 +289,7 @@ class BLS(CheckedParams, BaseEstimator):
     # -- learning --------------------------------------------------------------------------------
     @numerically_guarded
     @single_threaded
-    def fit(self, X, Y) -> "BLS":
+    def fit(self, X, Y) -> BLS:
         """Fit mapped features, the first enhancement block and the output weights.
 
         Parameters
@@ -285,10 +311,14 @@ class BLS(CheckedParams, BaseEstimator):
         X_bias = _with_bias(X)
         windows, mins, ranges = [], [], []
         for window in range(params.n_windows):
-            F = X_bias @ _rng(params.seed, 0, window).uniform(-1.0, 1.0, size=(X_bias.shape[1], params.n_mapped))
+            F = X_bias @ _rng(params.seed, 0, window).uniform(
+                -1.0, 1.0, size=(X_bias.shape[1], params.n_mapped)
+            )
             F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
             F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
-            W_Z = np.ascontiguousarray(sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T)  # (d+1, q)
+            W_Z = np.ascontiguousarray(
+                sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T
+            )  # (d+1, q)
             Z = X_bias @ W_Z
             low, span = Z.min(axis=0), np.ptp(Z, axis=0)
             windows.append(W_Z)
@@ -303,7 +333,11 @@ class BLS(CheckedParams, BaseEstimator):
         # Nothing above touched the model: commit the new state in one go.
         self.n_features_ = X.shape[1]
         self._y_was_1d = y_was_1d
-        self.mapping_weights_, self.mapping_min_, self.mapping_range_ = mapping_weights, mapping_min, mapping_range
+        self.mapping_weights_, self.mapping_min_, self.mapping_range_ = (
+            mapping_weights,
+            mapping_min,
+            mapping_range,
+        )
         self.enhancement_weights_, self.enhancement_scales_ = [weights], [scale]
         self._set_train_hidden(A)
         self.train_targets_ = Y
@@ -353,7 +387,7 @@ class BLS(CheckedParams, BaseEstimator):
 
     @numerically_guarded
     @single_threaded
-    def add_enhancement_nodes(self, n: int) -> "BLS":
+    def add_enhancement_nodes(self, n: int) -> BLS:
         """Add a block of ``n`` enhancement nodes and update the output weights without
         retraining (Eq. 23–26, or the exact ridge block inverse). Returns self.
 
@@ -369,7 +403,15 @@ class BLS(CheckedParams, BaseEstimator):
         block = len(self.enhancement_weights_)
         weights, scale, E = _enhancement_block(Z, params.seed, block, n, params.shrink)
         if params.update == "exact_ridge":
-            solution = _grow_ridge(self.gram_factor_, A, E, Y, self.output_weights_, self._projected_targets, params.reg)
+            solution = _grow_ridge(
+                self.gram_factor_,
+                A,
+                E,
+                Y,
+                self.output_weights_,
+                self._projected_targets,
+                params.reg,
+            )
         else:
             solution, self._svd = _grow_pinv(self._hidden_svd(), E, Y)
         self.enhancement_weights_.append(weights)
@@ -385,7 +427,9 @@ class BLS(CheckedParams, BaseEstimator):
         X = _check_inputs(X, self.n_features_)
         check_bytes(X.shape[0] * self.n_hidden_, "the hidden matrix of X (N x hidden nodes)")
         if np.shape(X)[0] >= _THREADED_ROWS:
-            with one_thread():  # as fit: small products, and idle pools would contend (bidmp._threads)
+            with (
+                one_thread()
+            ):  # as fit: small products, and idle pools would contend (bidmp._threads)
                 out = self.hidden(X) @ self.output_weights_
         else:  # a control loop's one row: limiting the pools would cost more than the product
             out = self.hidden(X) @ self.output_weights_
@@ -395,7 +439,5 @@ class BLS(CheckedParams, BaseEstimator):
         return _bls_state(self)
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> "BLS":
+    def _from_state(cls, meta: dict, arrays) -> BLS:
         return _bls_from_state(cls, meta, arrays)
-
-

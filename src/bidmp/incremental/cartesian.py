@@ -13,13 +13,13 @@ from .._api import CheckedParams
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
 from ..primitives.cartesian import (
     CartesianDMP,
-    as_poses,
     _parts_from_state,
     _parts_state,
     _pose_params,
-    _pose_vias,
     _pose_parts,
+    _pose_vias,
     _read_poses_state,
+    as_poses,
 )
 from ..primitives.pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
 from ..primitives.so3 import (
@@ -34,14 +34,20 @@ from .bidmp import BiDMP
 __all__ = ["CartesianBiDMP", "pose_forgetting"]
 
 
-def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "nearest", **bidmp_params) -> np.ndarray:
+def pose_forgetting(
+    cartesian: CartesianDMP, demonstrations, skill: str = "nearest", **bidmp_params
+) -> np.ndarray:
     """Learn pose ``demonstrations`` in turn and measure forgetting: for each skill, the largest
     position error (units) and orientation error (rad) between its rollout after all were learned
     and right after it was learned, (n_skills, 2)."""
     if not isinstance(cartesian, CartesianDMP):
-        raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(cartesian).__name__}")
+        raise TypeError(
+            f"cartesian must be a fitted bidmp.CartesianDMP, got {type(cartesian).__name__}"
+        )
     if not isinstance(demonstrations, (list, tuple)):
-        raise TypeError(f"demonstrations must be a list of pose arrays (T', 7), got {type(demonstrations).__name__}")
+        raise TypeError(
+            f"demonstrations must be a list of pose arrays (T', 7), got {type(demonstrations).__name__}"
+        )
     check_limit(len(demonstrations), "max_targets", "demonstrations: the number of skills to learn")
     for index, poses in enumerate(demonstrations):
         as_poses(poses, f"demonstrations[{index}]")
@@ -56,12 +62,23 @@ def pose_forgetting(cartesian: CartesianDMP, demonstrations, skill: str = "neare
     out = np.zeros((len(queries), 2))
     for index, (goal, before) in enumerate(zip(queries, when_learned)):
         after = model.rollout(goal, skill=skill)
-        out[index] = (np.max(np.linalg.norm(after[:, :3] - before[:, :3], axis=1)),
-                      np.max(angle_between(after[:, 3:], before[:, 3:])))
+        out[index] = (
+            np.max(np.linalg.norm(after[:, :3] - before[:, :3], axis=1)),
+            np.max(angle_between(after[:, 3:], before[:, 3:])),
+        )
     return out
 
 
-_BIDMP_PARAMS = ("n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives")
+_BIDMP_PARAMS = (
+    "n_windows",
+    "n_mapped",
+    "n_enhance",
+    "increments",
+    "shrink",
+    "reg",
+    "seed",
+    "derivatives",
+)
 
 
 class CartesianBiDMP(CheckedParams, BaseEstimator):
@@ -91,9 +108,18 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
     skill_start_logs_ : array (n_skills, 3)
     """
 
-    def __init__(self, cartesian: CartesianDMP | None = None, n_windows: int = 10, n_mapped: int = 10,
-                 n_enhance: int = 100, increments: tuple[int, ...] = (20, 20), shrink: float = 0.8, reg: float = 1e-4,
-                 seed: int = 0, derivatives: str = "auto") -> None:
+    def __init__(
+        self,
+        cartesian: CartesianDMP | None = None,
+        n_windows: int = 10,
+        n_mapped: int = 10,
+        n_enhance: int = 100,
+        increments: tuple[int, ...] = (20, 20),
+        shrink: float = 0.8,
+        reg: float = 1e-4,
+        seed: int = 0,
+        derivatives: str = "auto",
+    ) -> None:
         self.cartesian = cartesian
         self.n_windows = n_windows
         self.n_mapped = n_mapped
@@ -122,7 +148,9 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         if "cartesian_" in self.__dict__:
             return
         if self.cartesian is None or not isinstance(self.cartesian, CartesianDMP):
-            raise TypeError(f"cartesian must be a fitted bidmp.CartesianDMP, got {type(self.cartesian).__name__}")
+            raise TypeError(
+                f"cartesian must be a fitted bidmp.CartesianDMP, got {type(self.cartesian).__name__}"
+            )
         check_fitted(self.cartesian, "position_")
         self._start(self.cartesian)
 
@@ -130,10 +158,12 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         return "cartesian_" in self.__dict__
 
     @numerically_guarded
-    def fit(self, poses, t=None, units: str | None = None) -> "CartesianBiDMP":
+    def fit(self, poses, t=None, units: str | None = None) -> CartesianBiDMP:
         """Fit a copy of ``cartesian`` (default ``CartesianDMP()``) on one pose demonstration as
         skill 0, with no learned skills yet. Returns self."""
-        cartesian = clone(self.cartesian) if isinstance(self.cartesian, CartesianDMP) else CartesianDMP()
+        cartesian = (
+            clone(self.cartesian) if isinstance(self.cartesian, CartesianDMP) else CartesianDMP()
+        )
         self._start(cartesian.fit(poses, t, units))
         return self
 
@@ -143,7 +173,7 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         return self.position_.n_skills
 
     @numerically_guarded
-    def learn(self, poses, *, duration: float | None = None) -> "CartesianBiDMP":
+    def learn(self, poses, *, duration: float | None = None) -> CartesianBiDMP:
         """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts), lasting ``duration``
         seconds (default the demonstration's; see :meth:`bidmp.BiDMP.learn`). Returns self."""
         self._ensure_started()
@@ -169,13 +199,29 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         self.cartesian_._parts()
         index = self.select_skill(goal, skill)
         goal = None if goal is None else as_point(goal, 7, "goal")
-        goal_q = self.skill_goal_orientations_[index] if goal is None else as_quaternions(goal[3:], "goal's quaternion")[0]
+        goal_q = (
+            self.skill_goal_orientations_[index]
+            if goal is None
+            else as_quaternions(goal[3:], "goal's quaternion")[0]
+        )
         start = None if start is None else as_point(start, 7, "start")
-        start_q = self.skill_start_orientations_[index] if start is None else as_quaternions(start[3:], "start's quaternion")[0]
+        start_q = (
+            self.skill_start_orientations_[index]
+            if start is None
+            else as_quaternions(start[3:], "start's quaternion")[0]
+        )
         start_e = _nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
-        return index, None if goal is None else goal[:3], None if start is None else start[:3], goal_q, start_e
+        return (
+            index,
+            None if goal is None else goal[:3],
+            None if start is None else start[:3],
+            goal_q,
+            start_e,
+        )
 
-    def rollout(self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None) -> np.ndarray:
+    def rollout(
+        self, goal=None, *, skill="nearest", start=None, n_steps: int | None = None
+    ) -> np.ndarray:
         """Poses (n, 7) with one skill (chosen on the position goal)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         position = self.position_.rollout(goal_p, skill=index, start=start_p, n_steps=n_steps)
@@ -183,38 +229,86 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
     @numerically_guarded
-    def trajectory(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
-                   dt: float | None = None, limits: dict | None = None, coupling=None, via=None) -> PoseTrajectory:
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        skill="nearest",
+        start=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        limits: dict | None = None,
+        coupling=None,
+        via=None,
+    ) -> PoseTrajectory:
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses as there)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
-        _, goal_p, start_p, position_increment, position = self.position_._skill_query(goal_p, index, start_p)
-        _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(np.zeros(3), index, start_e)
-        vias = None if via is None else _pose_vias(orientation, via, goal_q, start_e, duration, dt, orientation_increment)
-        return _pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e,
-                                duration, dt, limits, position_increment, orientation_increment, self.cartesian_.units_,
-                                coupling, vias)
+        _, goal_p, start_p, position_increment, position = self.position_._skill_query(
+            goal_p, index, start_p
+        )
+        _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(
+            np.zeros(3), index, start_e
+        )
+        vias = (
+            None
+            if via is None
+            else _pose_vias(orientation, via, goal_q, start_e, duration, dt, orientation_increment)
+        )
+        return _pose_trajectory(
+            position,
+            orientation,
+            goal_p,
+            start_p,
+            goal_q,
+            start_e,
+            duration,
+            dt,
+            limits,
+            position_increment,
+            orientation_increment,
+            self.cartesian_.units_,
+            coupling,
+            vias,
+        )
 
-    def stepper(self, goal=None, *, skill="nearest", start=None, duration: float | None = None,
-                coupling=0.0) -> PoseStepper:
+    def stepper(
+        self, goal=None, *, skill="nearest", start=None, duration: float | None = None, coupling=0.0
+    ) -> PoseStepper:
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
-        return PoseStepper(self.position_.stepper(goal_p, skill=index, start=start_p, duration=duration, coupling=coupling),
-                           self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration), goal_q)
+        return PoseStepper(
+            self.position_.stepper(
+                goal_p, skill=index, start=start_p, duration=duration, coupling=coupling
+            ),
+            self.orientation_.stepper(np.zeros(3), skill=index, start=start_e, duration=duration),
+            goal_q,
+        )
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
         self._ensure_started()
         cartesian = self.cartesian_
-        return _parts_state(self, {"params": cartesian.get_params()},
-                            {"start_": cartesian.start_, "goal_": cartesian.goal_, "start_log_": cartesian.start_log_,
-                             "skill_goal_orientations_": self.skill_goal_orientations_,
-                             "skill_start_orientations_": self.skill_start_orientations_,
-                             "skill_start_logs_": self.skill_start_logs_})
+        return _parts_state(
+            self,
+            {"params": cartesian.get_params()},
+            {
+                "start_": cartesian.start_,
+                "goal_": cartesian.goal_,
+                "start_log_": cartesian.start_log_,
+                "skill_goal_orientations_": self.skill_goal_orientations_,
+                "skill_start_orientations_": self.skill_start_orientations_,
+                "skill_start_logs_": self.skill_start_logs_,
+            },
+        )
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> "CartesianBiDMP":
+    def _from_state(cls, meta: dict, arrays) -> CartesianBiDMP:
 
         position, orientation = _parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
-        if position.n_skills != orientation.n_skills or position.dmp_.n_dims_ != 3 or orientation.dmp_.n_dims_ != 3:
+        if (
+            position.n_skills != orientation.n_skills
+            or position.dmp_.n_dims_ != 3
+            or orientation.dmp_.n_dims_ != 3
+        ):
             raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
         cartesian = CartesianDMP(**_pose_params(meta["params"]))
         cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
@@ -224,13 +318,22 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation
         shape = (position.n_skills, 4)
         goals = check_loaded(arrays["skill_goal_orientations_"], "skill_goal_orientations_", shape)
-        starts = check_loaded(arrays["skill_start_orientations_"], "skill_start_orientations_", shape)
-        for name, values in (("skill_goal_orientations_", goals), ("skill_start_orientations_", starts)):
+        starts = check_loaded(
+            arrays["skill_start_orientations_"], "skill_start_orientations_", shape
+        )
+        for name, values in (
+            ("skill_goal_orientations_", goals),
+            ("skill_start_orientations_", starts),
+        ):
             if np.any(np.abs(np.linalg.norm(values, axis=1) - 1.0) > 1e-6):
                 raise ValueError(f"member {name} does not hold unit quaternions")
         model.skill_goal_orientations_, model.skill_start_orientations_ = goals, starts
         if "skill_start_logs_" in arrays:
-            model.skill_start_logs_ = check_loaded(arrays["skill_start_logs_"], "skill_start_logs_", (position.n_skills, 3))
+            model.skill_start_logs_ = check_loaded(
+                arrays["skill_start_logs_"], "skill_start_logs_", (position.n_skills, 3)
+            )
         else:  # format 3
-            model.skill_start_logs_ = np.array([principal_log(s[None], g)[0] for s, g in zip(starts, goals)])
+            model.skill_start_logs_ = np.array(
+                [principal_log(s[None], g)[0] for s, g in zip(starts, goals)]
+            )
         return model

@@ -30,10 +30,19 @@ from scipy.linalg import cho_factor, cho_solve, cholesky, solve_triangular
 
 from .._checks import as_trajectory, as_vector, check_int, check_limit, check_real
 
-__all__ = ["sparse_autoencoder", "block_pinv_update", "truncated_svd", "svd_update", "PINV_RCOND", "PINV_GAP", "MAX_ADMM_ITERATIONS"]
+__all__ = [
+    "sparse_autoencoder",
+    "block_pinv_update",
+    "truncated_svd",
+    "svd_update",
+    "PINV_RCOND",
+    "PINV_GAP",
+    "MAX_ADMM_ITERATIONS",
+]
 
 MAX_ADMM_ITERATIONS = 10_000  # sparse_autoencoder's iterations at most (the BLS uses 50)
-_RANK_TOLERANCE = 1e-10  # block_pinv_update: singular values of C below this times ‖E‖₂ count as zero
+# block_pinv_update: singular values of C below this times ‖E‖₂ count as zero
+_RANK_TOLERANCE = 1e-10
 # The truncated pseudo-inverse is well posed when its cut falls in a spectral gap this wide.
 PINV_GAP = 1e4
 # Mapped features are linear in [X, 0.1], so the hidden matrix is rank-deficient by construction
@@ -42,7 +51,9 @@ PINV_GAP = 1e4
 PINV_RCOND = 1e-10
 
 
-def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_iter: int = 50, rho: float = 1.0) -> np.ndarray:
+def sparse_autoencoder(
+    F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_iter: int = 50, rho: float = 1.0
+) -> np.ndarray:
     """Lasso ``argmin_β ½‖F β − target‖² + l1 ‖β‖₁`` by ADMM (Boyd et al. 2011, §6.4).
 
     Parameters
@@ -57,7 +68,9 @@ def sparse_autoencoder(F: np.ndarray, target: np.ndarray, l1: float = 1e-3, n_it
     F = as_trajectory(F, "F", min_points=1, allow_static=True)
     target = as_trajectory(target, "target", min_points=1, allow_static=True)
     if target.shape[0] != F.shape[0]:
-        raise ValueError(f"target must have {F.shape[0]} rows (one per row of F), got {target.shape[0]}")
+        raise ValueError(
+            f"target must have {F.shape[0]} rows (one per row of F), got {target.shape[0]}"
+        )
     check_limit(F.shape[1], "max_hidden_nodes", "the columns of F")
     l1 = check_real(l1, "l1", nonnegative=True, maximum=1e12)
     n_iter = check_int(n_iter, "n_iter", minimum=1, maximum=MAX_ADMM_ITERATIONS)
@@ -141,7 +154,9 @@ def _pinv_absolute(C: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
     return (vt[keep].T / s[keep]) @ u[:, keep].T, rank
 
 
-def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple[np.ndarray, np.ndarray, str]:
+def block_pinv_update(
+    A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, str]:
     """Pseudo-inverse of ``[A | E]`` from that of A (Eq. 23–26, Cline 1964).
 
     Parameters
@@ -159,7 +174,9 @@ def block_pinv_update(A: np.ndarray, A_pinv: np.ndarray, E: np.ndarray) -> tuple
     A_pinv = _matrix(A_pinv, "A_pinv", rows=A.shape[1], like="A's columns")
     E = _matrix(E, "E", rows=A.shape[0], like="as A has")
     if A_pinv.shape[1] != A.shape[0]:
-        raise ValueError(f"A_pinv must be the pseudo-inverse of A: shape ({A.shape[1]}, {A.shape[0]}), got {A_pinv.shape}")
+        raise ValueError(
+            f"A_pinv must be the pseudo-inverse of A: shape ({A.shape[1]}, {A.shape[0]}), got {A_pinv.shape}"
+        )
     D = A_pinv @ E
     C = E - A @ D
     tolerance = _RANK_TOLERANCE * max(np.linalg.norm(E, 2), np.finfo(float).tiny)
@@ -187,8 +204,10 @@ def _solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tupl
         try:
             R = np.asfortranarray(cholesky(A.T @ A + reg * np.eye(A.shape[1]), lower=False))
         except np.linalg.LinAlgError:
-            raise ValueError(f"fit: the ridge Gram matrix is not positive definite in float64 (reg = {reg:g} is "
-                             f"too small for this hidden layer); use a larger reg") from None
+            raise ValueError(
+                f"fit: the ridge Gram matrix is not positive definite in float64 (reg = {reg:g} is "
+                f"too small for this hidden layer); use a larger reg"
+            ) from None
         projected = solve_triangular(R, A.T @ Y, trans="T")
         return np.ascontiguousarray(solve_triangular(R, projected)), None, R, projected
     U, values, V, _ = _truncated_svd(A)
@@ -196,8 +215,15 @@ def _solve_output(A: np.ndarray, Y: np.ndarray, update: str, reg: float) -> tupl
     return pinv @ Y, pinv, None, None
 
 
-def _grow_ridge(R: np.ndarray, A: np.ndarray, E: np.ndarray, Y: np.ndarray, W: np.ndarray, projected: np.ndarray,
-               reg: float) -> tuple:
+def _grow_ridge(
+    R: np.ndarray,
+    A: np.ndarray,
+    E: np.ndarray,
+    Y: np.ndarray,
+    W: np.ndarray,
+    projected: np.ndarray,
+    reg: float,
+) -> tuple:
     """The ridge solution for ``[A | E]`` from that for A (c columns, m new), in the layout of
     :func:`_solve_output`: ``(W', None, R', z')``.
 
@@ -212,17 +238,26 @@ def _grow_ridge(R: np.ndarray, A: np.ndarray, E: np.ndarray, Y: np.ndarray, W: n
     try:
         R22 = cholesky(E.T @ E + reg * np.eye(m) - R12.T @ R12, lower=False, check_finite=False)
     except np.linalg.LinAlgError:
-        raise ValueError(f"add_enhancement_nodes: the ridge Gram matrix lost positive definiteness in "
-                         f"float64 (reg = {reg:g} is too small for these nodes); use a larger reg") from None
+        raise ValueError(
+            f"add_enhancement_nodes: the ridge Gram matrix lost positive definiteness in "
+            f"float64 (reg = {reg:g} is too small for these nodes); use a larger reg"
+        ) from None
     z_new = solve_triangular(R22, E.T @ Y - R12.T @ projected, trans="T", check_finite=False)
     W_new = solve_triangular(R22, z_new, check_finite=False)
     W_old = W - solve_triangular(R, R12 @ W_new, check_finite=False)
     grown = np.zeros((c + m, c + m), order="F")
     grown[:c, :c], grown[:c, c:], grown[c:, c:] = R, R12, R22
-    return np.ascontiguousarray(np.vstack([W_old, W_new])), None, grown, np.vstack([projected, z_new])
+    return (
+        np.ascontiguousarray(np.vstack([W_old, W_new])),
+        None,
+        grown,
+        np.vstack([projected, z_new]),
+    )
 
 
-def _grow_pinv(svd: tuple[np.ndarray, np.ndarray, np.ndarray], E: np.ndarray, Y: np.ndarray) -> tuple[tuple, tuple]:
+def _grow_pinv(
+    svd: tuple[np.ndarray, np.ndarray, np.ndarray], E: np.ndarray, Y: np.ndarray
+) -> tuple[tuple, tuple]:
     """The pseudo-inverse solution for ``[A | E]`` from the truncated SVD ``(U, s, V)`` of A:
     (the solution in the layout of :func:`_solve_output`, the grown SVD). Refused where the
     grown pseudo-inverse is ill-posed (:func:`_check_gap`)."""

@@ -107,7 +107,7 @@ def _key(name: str) -> str:
     """A header name as compared: lower case, one separator (``.``), no ``field.`` prefix."""
     key = re.sub(r"[/\[\]]", ".", name.strip().lower())
     key = re.sub(r"\.+", ".", key).strip(".")
-    return key[len("field."):] if key.startswith("field.") else key
+    return key[len("field.") :] if key.startswith("field.") else key
 
 
 def parse_columns(spec) -> dict[str, str] | None:
@@ -122,17 +122,23 @@ def parse_columns(spec) -> dict[str, str] | None:
     if isinstance(spec, str):
         pairs = [item.split("=", 1) for item in spec.split(",") if item.strip()]
         if not pairs or any(len(pair) != 2 for pair in pairs):
-            raise ValueError(f"columns must read role=name[,role=name...], e.g. t=timestamp,x=ee_x; got {short_token(spec, 40)}")
+            raise ValueError(
+                f"columns must read role=name[,role=name...], e.g. t=timestamp,x=ee_x; got {short_token(spec, 40)}"
+            )
         spec = {role.strip(): name.strip() for role, name in pairs}
     if not isinstance(spec, dict):
-        raise TypeError(f"columns must be a dict or a role=name,... string, got {type(spec).__name__}")
+        raise TypeError(
+            f"columns must be a dict or a role=name,... string, got {type(spec).__name__}"
+        )
     if len(spec) > _MAX_MAPPING:
         raise ValueError(f"columns names {len(spec)} roles; there are at most {len(_SINGLE_ROLES)}")
     mapping = {}
     for role, name in spec.items():
         if role not in (*_SINGLE_ROLES, *_GROUP_ROLES):
-            raise ValueError(f"columns: unknown role {short_token(role)}; roles are {', '.join(_SINGLE_ROLES)} "
-                             f"and the groups {', '.join(_GROUP_ROLES)}")
+            raise ValueError(
+                f"columns: unknown role {short_token(role)}; roles are {', '.join(_SINGLE_ROLES)} "
+                f"and the groups {', '.join(_GROUP_ROLES)}"
+            )
         if not isinstance(name, str) or not name:
             raise ValueError(f"columns: role {role} needs a column name")
         mapping[role] = _key(name)
@@ -141,19 +147,29 @@ def parse_columns(spec) -> dict[str, str] | None:
     groups = [role for role in _GROUP_ROLES if role in mapping]
     singles = [role for role in mapping if role in _SINGLE_ROLES and role != "t"]
     if len(groups) > 1 or (groups and singles):
-        raise ValueError(f"columns: give one group ({', '.join(_GROUP_ROLES)}) or single columns, not "
-                         f"{' and '.join(groups + singles[:1])}")
-    if any(role in mapping for role in _QUATERNION_ROLES) and not all(role in mapping for role in _QUATERNION_ROLES):
+        raise ValueError(
+            f"columns: give one group ({', '.join(_GROUP_ROLES)}) or single columns, not "
+            f"{' and '.join(groups + singles[:1])}"
+        )
+    if any(role in mapping for role in _QUATERNION_ROLES) and not all(
+        role in mapping for role in _QUATERNION_ROLES
+    ):
         raise ValueError("columns: a quaternion needs all of qx, qy, qz, qw")
-    if any(role in mapping for role in _ROTVEC_ROLES) and not all(role in mapping for role in _ROTVEC_ROLES):
+    if any(role in mapping for role in _ROTVEC_ROLES) and not all(
+        role in mapping for role in _ROTVEC_ROLES
+    ):
         raise ValueError("columns: a rotation vector needs all of rx, ry, rz")
     if "qw" in mapping and "rx" in mapping:
-        raise ValueError("columns: give a quaternion (qx..qw) or a rotation vector (rx, ry, rz), not both")
+        raise ValueError(
+            "columns: give a quaternion (qx..qw) or a rotation vector (rx, ry, rz), not both"
+        )
     return mapping
 
 
 def _shown(header, limit: int = 8) -> str:
-    return ",".join(short_token(c, 16)[1:-1] for c in header[:limit]) + (",…" if len(header) > limit else "")
+    return ",".join(short_token(c, 16)[1:-1] for c in header[:limit]) + (
+        ",…" if len(header) > limit else ""
+    )
 
 
 # -- time -----------------------------------------------------------------------------------------
@@ -166,7 +182,10 @@ def _time_candidates(header: tuple[str, ...], keys: list[str]) -> tuple[list, li
             stamps.append(((index,), 1e9 if nanoseconds else 1.0, header[index]))
         elif key.endswith("header.stamp.sec") or key == "stamp.sec":
             stem = key[: -len("sec")]
-            fraction = next((keys.index(stem + part) for part in ("nanosec", "nsec") if stem + part in keys), None)
+            fraction = next(
+                (keys.index(stem + part) for part in ("nanosec", "nsec") if stem + part in keys),
+                None,
+            )
             if fraction is not None:
                 stamps.append(((index, fraction), 1.0, f"{header[index]} + {header[fraction]}"))
         elif key in TIME_NAMES:
@@ -179,8 +198,10 @@ def _time_from_names(header, keys, path) -> tuple[tuple[int, ...], float]:
     for found, what in ((stamps, "header stamps"), (others, "time columns")):
         if len(found) > 1:
             names = ", ".join(name for _, _, name in found)
-            raise ValueError(f"{path}: {len(found)} {what} ({names}); name the one to use, e.g. --columns / columns= "
-                             f"t={short_token(found[0][2], 30)[1:-1]}")
+            raise ValueError(
+                f"{path}: {len(found)} {what} ({names}); name the one to use, e.g. --columns / columns= "
+                f"t={short_token(found[0][2], 30)[1:-1]}"
+            )
         if found:
             return found[0][0], found[0][1]
     return (), 1.0
@@ -194,7 +215,9 @@ def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | N
     nanoseconds are recognised by their size (no epoch in seconds lies beyond the year 5000)."""
     if not layout.time:
         return None
-    if len(layout.time) == 2:  # sec + nanosec: the seconds counted from the first, so no digit is lost
+    if (
+        len(layout.time) == 2
+    ):  # sec + nanosec: the seconds counted from the first, so no digit is lost
         seconds, fraction = values[:, layout.time[0]], values[:, layout.time[1]]
         return (seconds - seconds[0]) + fraction / 1e9 + seconds[0]
     stamps = values[:, layout.time[0]] / layout.time_divisor
@@ -204,7 +227,9 @@ def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | N
             if first / divisor > 1e8:  # an epoch stamp after 1973
                 import logging
 
-                logging.getLogger(__name__).info("%s: the time column holds epoch stamps in %s", path, unit)
+                logging.getLogger(__name__).info(
+                    "%s: the time column holds epoch stamps in %s", path, unit
+                )
                 return stamps / divisor
     return stamps
 
@@ -212,23 +237,46 @@ def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | N
 # -- motions --------------------------------------------------------------------------------------
 def _ros_candidates(header, keys) -> list[_Candidate]:
     found = []
-    for index, key in enumerate(keys):
+    for _index, key in enumerate(keys):
         for translation, rotation in _TRANSLATIONS:
             if not key.endswith(translation + "x"):
                 continue
             prefix = key[: -len(translation + "x")]
-            where = [keys.index(prefix + translation + axis) if prefix + translation + axis in keys else None
-                     for axis in "xyz"]
+            where = [
+                keys.index(prefix + translation + axis)
+                if prefix + translation + axis in keys
+                else None
+                for axis in "xyz"
+            ]
             if None in where:
                 continue
-            turn = [keys.index(prefix + rotation + axis) if prefix + rotation + axis in keys else None for axis in "xyzw"]
+            turn = [
+                keys.index(prefix + rotation + axis) if prefix + rotation + axis in keys else None
+                for axis in "xyzw"
+            ]
             group = prefix.rstrip(".") or translation.rstrip(".")
             if None in turn:
-                found.append(_Candidate("positions", tuple(where), None, "m", f"{prefix}{translation}x/y/z",
-                                        f"position={group}"))
+                found.append(
+                    _Candidate(
+                        "positions",
+                        tuple(where),
+                        None,
+                        "m",
+                        f"{prefix}{translation}x/y/z",
+                        f"position={group}",
+                    )
+                )
             else:
-                found.append(_Candidate("pose", (*where, *turn), "quaternion", "m",
-                                        f"{prefix}{translation}x/y/z + {prefix}{rotation}x/y/z/w", f"pose={group}"))
+                found.append(
+                    _Candidate(
+                        "pose",
+                        (*where, *turn),
+                        "quaternion",
+                        "m",
+                        f"{prefix}{translation}x/y/z + {prefix}{rotation}x/y/z/w",
+                        f"pose={group}",
+                    )
+                )
     return found
 
 
@@ -243,18 +291,34 @@ def _indexed_groups(header, keys, pattern) -> dict[str, list[tuple[int, int]]]:
 
 def _rtde_candidates(header, keys) -> list[_Candidate]:
     found = []
-    for prefix, members in _indexed_groups(header, keys, _RTDE_POSE).items():
+    for _prefix, members in _indexed_groups(header, keys, _RTDE_POSE).items():
         by_number = dict(members)
         if all(n in by_number for n in range(6)):
             name = header[by_number[0]][:-2]
-            found.append(_Candidate("pose", tuple(by_number[n] for n in range(6)), "rotvec", "m",
-                                    f"UR RTDE {name}_0..5", f"pose={name}"))
-    for prefix, members in _indexed_groups(header, keys, _RTDE_JOINTS).items():
+            found.append(
+                _Candidate(
+                    "pose",
+                    tuple(by_number[n] for n in range(6)),
+                    "rotvec",
+                    "m",
+                    f"UR RTDE {name}_0..5",
+                    f"pose={name}",
+                )
+            )
+    for _prefix, members in _indexed_groups(header, keys, _RTDE_JOINTS).items():
         members.sort()
         if [n for n, _ in members] == list(range(len(members))):
             name = header[members[0][1]][:-2]
-            found.append(_Candidate("joints", tuple(index for _, index in members), None, "rad",
-                                    f"UR RTDE {name}_0..{len(members) - 1}", f"joints={name}"))
+            found.append(
+                _Candidate(
+                    "joints",
+                    tuple(index for _, index in members),
+                    None,
+                    "rad",
+                    f"UR RTDE {name}_0..{len(members) - 1}",
+                    f"joints={name}",
+                )
+            )
     return found
 
 
@@ -263,13 +327,37 @@ def _plain_candidate(keys) -> list[_Candidate]:
         return []
     where = tuple(keys.index(axis) for axis in _POSITION_ROLES if axis in keys)
     if all(role in keys for role in _QUATERNION_ROLES) and len(where) == 3:
-        return [_Candidate("pose", (*where, *(keys.index(r) for r in _QUATERNION_ROLES)), "quaternion", "", "x,y,z,qx,qy,qz,qw",
-                           "x=x,y=y,z=z,qx=qx,qy=qy,qz=qz,qw=qw")]
+        return [
+            _Candidate(
+                "pose",
+                (*where, *(keys.index(r) for r in _QUATERNION_ROLES)),
+                "quaternion",
+                "",
+                "x,y,z,qx,qy,qz,qw",
+                "x=x,y=y,z=z,qx=qx,qy=qy,qz=qz,qw=qw",
+            )
+        ]
     if all(role in keys for role in _ROTVEC_ROLES) and len(where) == 3:
-        return [_Candidate("pose", (*where, *(keys.index(r) for r in _ROTVEC_ROLES)), "rotvec", "", "x,y,z,rx,ry,rz",
-                           "x=x,y=y,z=z,rx=rx,ry=ry,rz=rz")]
-    return [_Candidate("positions", where, None, "", ",".join(_POSITION_ROLES[: len(where)]),
-                       ",".join(f"{axis}={axis}" for axis in _POSITION_ROLES[: len(where)]))]
+        return [
+            _Candidate(
+                "pose",
+                (*where, *(keys.index(r) for r in _ROTVEC_ROLES)),
+                "rotvec",
+                "",
+                "x,y,z,rx,ry,rz",
+                "x=x,y=y,z=z,rx=rx,ry=ry,rz=rz",
+            )
+        ]
+    return [
+        _Candidate(
+            "positions",
+            where,
+            None,
+            "",
+            ",".join(_POSITION_ROLES[: len(where)]),
+            ",".join(f"{axis}={axis}" for axis in _POSITION_ROLES[: len(where)]),
+        )
+    ]
 
 
 def _own_timed_joints(keys) -> tuple[int, ...] | None:
@@ -297,16 +385,36 @@ def _joints_candidate(header, keys, time: tuple[int, ...]) -> list[_Candidate]:
     return [_Candidate("joints", tuple(rest), None, "rad", "t,<joint names>", "joints=<names>")]
 
 
-_OWN_RATES = re.compile(r"^(v|a|w|dw)(x|y|z|x[0-9]+)$")  # what save_trajectory / save_poses add beside positions
+_OWN_RATES = re.compile(
+    r"^(v|a|w|dw)(x|y|z|x[0-9]+)$"
+)  # what save_trajectory / save_poses add beside positions
 
 
 def _layout(header, keys, time, scale, chosen: _Candidate) -> Layout:
     used = set(chosen.values) | set(time) | set(chosen.orientation)
-    ignored = tuple(name for index, (name, key) in enumerate(zip(header, keys))
-                    if index not in used and not _OWN_RATES.match(key)
-                    and not (chosen.kind == "joints" and key[:1] in "va" and key[1:] in {keys[i] for i in chosen.values}))
-    return Layout(chosen.kind, time, scale, chosen.values, chosen.rotation, chosen.orientation,
-                  tuple(header[index] for index in chosen.values), chosen.units, chosen.label, ignored)
+    ignored = tuple(
+        name
+        for index, (name, key) in enumerate(zip(header, keys))
+        if index not in used
+        and not _OWN_RATES.match(key)
+        and not (
+            chosen.kind == "joints"
+            and key[:1] in "va"
+            and key[1:] in {keys[i] for i in chosen.values}
+        )
+    )
+    return Layout(
+        chosen.kind,
+        time,
+        scale,
+        chosen.values,
+        chosen.rotation,
+        chosen.orientation,
+        tuple(header[index] for index in chosen.values),
+        chosen.units,
+        chosen.label,
+        ignored,
+    )
 
 
 def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
@@ -328,24 +436,35 @@ def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
         time, scale = _time_from_names(header, keys, path)
     if mapping is not None and set(mapping) - {"t"}:
         return _layout(header, keys, time, scale, _mapped(header, keys, mapping, path))
-    candidates = _plain_candidate(keys) + _ros_candidates(header, keys) + _rtde_candidates(header, keys)
+    candidates = (
+        _plain_candidate(keys) + _ros_candidates(header, keys) + _rtde_candidates(header, keys)
+    )
     if not candidates:
         candidates = _joints_candidate(header, keys, time)
     if len(candidates) > 1:
-        listed = "; ".join(f"{c.label} ({'joints' if c.kind == 'joints' else c.kind}: columns {c.pick})" for c in candidates)
-        raise ValueError(f"{path}: the columns hold {len(candidates)} motions, so which to learn is yours to say: {listed}. "
-                         f"Pick one with --columns / columns=, e.g. --columns {candidates[0].pick}")
+        listed = "; ".join(
+            f"{c.label} ({'joints' if c.kind == 'joints' else c.kind}: columns {c.pick})"
+            for c in candidates
+        )
+        raise ValueError(
+            f"{path}: the columns hold {len(candidates)} motions, so which to learn is yours to say: {listed}. "
+            f"Pick one with --columns / columns=, e.g. --columns {candidates[0].pick}"
+        )
     if not candidates:
-        raise ValueError(f"{path}: header {_shown(header)} names no motion; expected x,y[,z] (with qx,qy,qz,qw or "
-                         f"rx,ry,rz for poses) and a time column t/time/timestamp/stamp, a robot logger's columns (UR "
-                         f"RTDE actual_TCP_pose_0..5 or actual_q_0..5, ROS pose.position.x ...), t,<joint names> for "
-                         f"joint space, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)")
+        raise ValueError(
+            f"{path}: header {_shown(header)} names no motion; expected x,y[,z] (with qx,qy,qz,qw or "
+            f"rx,ry,rz for poses) and a time column t/time/timestamp/stamp, a robot logger's columns (UR "
+            f"RTDE actual_TCP_pose_0..5 or actual_q_0..5, ROS pose.position.x ...), t,<joint names> for "
+            f"joint space, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)"
+        )
     return _layout(header, keys, time, scale, candidates[0])
 
 
 def _index(header, keys, name: str, role: str, path) -> int:
     if name not in keys:
-        raise ValueError(f"{path}: no column {short_token(name, 30)} for {role} (the header has {_shown(header, 10)})")
+        raise ValueError(
+            f"{path}: no column {short_token(name, 30)} for {role} (the header has {_shown(header, 10)})"
+        )
     return keys.index(name)
 
 
@@ -354,16 +473,26 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
     if "pose" in mapping or "position" in mapping:
         wanted = mapping.get("pose", mapping.get("position"))
         for candidate in _ros_candidates(header, keys) + _rtde_candidates(header, keys):
-            if candidate.kind != "joints" and _key(candidate.pick.split("=", 1)[1]) == wanted.rstrip("."):
+            if candidate.kind != "joints" and _key(
+                candidate.pick.split("=", 1)[1]
+            ) == wanted.rstrip("."):
                 if "position" in mapping:
-                    return _Candidate("positions", candidate.values[:3], candidate.rotation, candidate.units,
-                                      candidate.label.split(" + ")[0].replace("_0..5", "_0..2"), f"position={wanted}",
-                                      candidate.values[3:])
+                    return _Candidate(
+                        "positions",
+                        candidate.values[:3],
+                        candidate.rotation,
+                        candidate.units,
+                        candidate.label.split(" + ")[0].replace("_0..5", "_0..2"),
+                        f"position={wanted}",
+                        candidate.values[3:],
+                    )
                 if candidate.kind == "pose":
                     return candidate
         role = "pose" if "pose" in mapping else "position"
-        raise ValueError(f"{path}: no {role} group {short_token(wanted, 30)} (x, y, z{' and a rotation' if role == 'pose' else ''} "
-                         f"under that prefix) in the header {_shown(header, 10)}")
+        raise ValueError(
+            f"{path}: no {role} group {short_token(wanted, 30)} (x, y, z{' and a rotation' if role == 'pose' else ''} "
+            f"under that prefix) in the header {_shown(header, 10)}"
+        )
     if "joints" in mapping:
         wanted = mapping["joints"]
         if "|" in wanted:  # the joints by name, in this order
@@ -371,14 +500,31 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
             where = tuple(_index(header, keys, name, "joints", path) for name in names)
             if len(set(where)) != len(where):
                 raise ValueError("columns: joints names a column twice")
-            return _Candidate("joints", where, None, "rad", "|".join(header[i] for i in where), f"joints={wanted}")
-        members = sorted((int(m.group(2)), index) for index, key in enumerate(keys)
-                         if (m := _INDEXED.match(key)) and m.group(1).rstrip("._") == wanted)
+            return _Candidate(
+                "joints", where, None, "rad", "|".join(header[i] for i in where), f"joints={wanted}"
+            )
+        members = sorted(
+            (int(m.group(2)), index)
+            for index, key in enumerate(keys)
+            if (m := _INDEXED.match(key)) and m.group(1).rstrip("._") == wanted
+        )
         if not members:
-            raise ValueError(f"{path}: no joint columns {short_token(wanted, 30)}_0, _1, ... in the header {_shown(header, 10)}")
-        return _Candidate("joints", tuple(index for _, index in members), None, "rad",
-                          f"{wanted}_0..{len(members) - 1}", f"joints={wanted}")
-    where = tuple(_index(header, keys, mapping[role], role, path) for role in _POSITION_ROLES if role in mapping)
+            raise ValueError(
+                f"{path}: no joint columns {short_token(wanted, 30)}_0, _1, ... in the header {_shown(header, 10)}"
+            )
+        return _Candidate(
+            "joints",
+            tuple(index for _, index in members),
+            None,
+            "rad",
+            f"{wanted}_0..{len(members) - 1}",
+            f"joints={wanted}",
+        )
+    where = tuple(
+        _index(header, keys, mapping[role], role, path)
+        for role in _POSITION_ROLES
+        if role in mapping
+    )
     present = [role for role in _POSITION_ROLES if role in mapping]
     if present != list(_POSITION_ROLES[: len(present)]) or len(present) < 2:
         raise ValueError("columns: positions need x and y (and z), e.g. x=ee_x,y=ee_y,z=ee_z")

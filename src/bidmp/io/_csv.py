@@ -15,11 +15,13 @@ import numpy as np
 
 from .._checks import check_limit, check_path, get_limits, short_token
 
-__all__ = ['declared_units']
+__all__ = ["declared_units"]
 
 logger = logging.getLogger(__name__)
 
-_SLOW_CSV_BYTES = 256 << 20  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
+_SLOW_CSV_BYTES = (
+    256 << 20
+)  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
 _POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
 
@@ -42,15 +44,24 @@ def _check_file(path: Path, what: str) -> None:
 
 def _note_ignored(path: Path, ignored: tuple[str, ...]) -> None:
     if ignored:
-        shown = ", ".join(short_token(name, 28)[1:-1] for name in ignored[:8]) + (", …" if len(ignored) > 8 else "")
-        logger.warning("%s: ignored %d column(s) that are not time or the motion read: %s", path, len(ignored), shown)
+        shown = ", ".join(short_token(name, 28)[1:-1] for name in ignored[:8]) + (
+            ", …" if len(ignored) > 8 else ""
+        )
+        logger.warning(
+            "%s: ignored %d column(s) that are not time or the motion read: %s",
+            path,
+            len(ignored),
+            shown,
+        )
 
 
 def declared_units(path) -> str:
     """The unit a CSV declares in a leading comment line ``# units: mm`` ("" if none)."""
     from .._units import check_units
 
-    if not check_path(path).is_file():  # a FIFO or a device: the reader refuses it; opening it would block
+    if not check_path(
+        path
+    ).is_file():  # a FIFO or a device: the reader refuses it; opening it would block
         return ""
     try:
         with open(path, encoding="utf-8-sig") as handle:
@@ -86,7 +97,9 @@ def _is_number(text: str) -> bool:
 def _csv_delimiter(sample: str) -> str:
     """``,`` or ``;`` (the more frequent in the sample), else a tab, else spaces (UR's RTDE
     recorder writes space-separated files)."""
-    lines = [line for line in sample.splitlines() if line.strip() and not line.lstrip().startswith("#")]
+    lines = [
+        line for line in sample.splitlines() if line.strip() and not line.lstrip().startswith("#")
+    ]
     body = "\n".join(lines) if lines else sample
     if body.count(";") > body.count(","):
         return ";"
@@ -101,7 +114,9 @@ def _split(line: str, delimiter: str) -> list[str]:
 
 def _row_limit_error(path: Path) -> ValueError:
     limit = get_limits().max_samples
-    return ValueError(f"{path}: more than {limit:,} rows, the limit max_samples; raise it with bidmp.set_limits(max_samples=...)")
+    return ValueError(
+        f"{path}: more than {limit:,} rows, the limit max_samples; raise it with bidmp.set_limits(max_samples=...)"
+    )
 
 
 def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | None:
@@ -129,8 +144,15 @@ def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | 
             lines = itertools.chain([first], handle) if first is not None else handle
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "empty input": the slow path words it
-                values = np.loadtxt(lines, delimiter=None if delimiter == " " else delimiter, comments="#", ndmin=2, dtype=np.float64,
-                                    max_rows=limits.max_samples + 1, encoding=None)
+                values = np.loadtxt(
+                    lines,
+                    delimiter=None if delimiter == " " else delimiter,
+                    comments="#",
+                    ndmin=2,
+                    dtype=np.float64,
+                    max_rows=limits.max_samples + 1,
+                    encoding=None,
+                )
     except (ValueError, TypeError, OSError, UnicodeDecodeError, OverflowError, MemoryError):
         return None
     if values.shape[0] == 0 or values.shape[1] > limits.max_dims + 1:
@@ -149,9 +171,11 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
     max_rows = limits.max_samples + 1  # + a header
     max_columns = limits.max_dims + 1  # + a time column
     if path.stat().st_size > _SLOW_CSV_BYTES:  # Python rows take ~6x the file's size in memory
-        raise ValueError(f"{path} is not a plain numeric CSV (one optional header line, then numbers in every row), "
-                         f"and at {path.stat().st_size / 2**20:.0f} MiB it is too large to read row by row to find the "
-                         f"bad line (limit {_SLOW_CSV_BYTES >> 20} MiB)")
+        raise ValueError(
+            f"{path} is not a plain numeric CSV (one optional header line, then numbers in every row), "
+            f"and at {path.stat().st_size / 2**20:.0f} MiB it is too large to read row by row to find the "
+            f"bad line (limit {_SLOW_CSV_BYTES >> 20} MiB)"
+        )
     rows: list[tuple[int, list[str]]] = []
     try:
         # utf-8-sig: Excel writes a byte-order mark at the start of UTF-8 files.
@@ -164,8 +188,10 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
                     if not any(row) or row[0].lstrip().startswith("#"):
                         continue
                     if len(row) > max_columns:
-                        raise ValueError(f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
-                                         f"max_dims = {limits.max_dims} allows (plus a time column)")
+                        raise ValueError(
+                            f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
+                            f"max_dims = {limits.max_dims} allows (plus a time column)"
+                        )
                     rows.append((reader.line_num, [cell.strip() for cell in row]))
                     if len(rows) > max_rows:
                         raise _row_limit_error(path)
@@ -187,8 +213,9 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
     return (columns, *_csv_values(rows, n_columns, path, named=columns is not None))
 
 
-def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path,
-                named: bool = False) -> tuple[np.ndarray, tuple[int, ...]]:
+def _csv_values(
+    rows: list[tuple[int, list[str]]], n_columns: int, path: Path, named: bool = False
+) -> tuple[np.ndarray, tuple[int, ...]]:
     """The numbers of the data rows (T, n_columns): NumPy's parser first (fast), and on failure a
     row-by-row pass that names the first bad line (quoting at most a short token of it). With a
     header (``named``), a column of text in every row (a ROS export's ``frame_id``) is NaN and
@@ -200,13 +227,26 @@ def _csv_values(rows: list[tuple[int, list[str]]], n_columns: int, path: Path,
             return values, ()
     for number, row in rows:
         if len(row) != n_columns:
-            raise ValueError(f"{path} line {number}: expected {n_columns} columns, found {len(row)}")
-    text = [column for column in range(n_columns) if named and all(_parse_float(row[column]) is None for row in cells)]
+            raise ValueError(
+                f"{path} line {number}: expected {n_columns} columns, found {len(row)}"
+            )
+    text = [
+        column
+        for column in range(n_columns)
+        if named and all(_parse_float(row[column]) is None for row in cells)
+    ]
     for number, row in rows:
         for column, cell in enumerate(row, 1):
             if column - 1 not in text and _parse_float(cell) is None:
-                raise ValueError(f"{path} line {number}, column {column}: {short_token(cell)} is not a number")
-    values = np.array([[float("nan") if index in text else float(cell) for index, cell in enumerate(row)] for row in cells])
+                raise ValueError(
+                    f"{path} line {number}, column {column}: {short_token(cell)} is not a number"
+                )
+    values = np.array(
+        [
+            [float("nan") if index in text else float(cell) for index, cell in enumerate(row)]
+            for row in cells
+        ]
+    )
     return values, tuple(text)
 
 
@@ -216,20 +256,28 @@ def _check_npy_trajectory(path: Path):
     def check(shape, dtype):
         if dtype.names is not None:  # a timed trajectory: one record per sample
             if len(shape) != 1 or not _timed_fields(dtype):
-                raise ValueError(f"{path} holds records with fields {', '.join(dtype.names[:8])}; expected t, x, y[, z] "
-                                 f"(and optionally vx, … ax, …) in shape (T,)")
+                raise ValueError(
+                    f"{path} holds records with fields {', '.join(dtype.names[:8])}; expected t, x, y[, z] "
+                    f"(and optionally vx, … ax, …) in shape (T,)"
+                )
             if shape[0] > limits.max_samples:
-                raise ValueError(f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}")
+                raise ValueError(
+                    f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}"
+                )
             return
         if dtype.kind not in "fiu":
             raise ValueError(f"{path} holds {dtype} data, not numbers")
         if len(shape) != 2:
             raise ValueError(f"{path} must hold an array of shape (T, D), got shape {shape}")
         if shape[0] > limits.max_samples:
-            raise ValueError(f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}; "
-                             f"raise it with bidmp.set_limits(max_samples=...)")
+            raise ValueError(
+                f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}; "
+                f"raise it with bidmp.set_limits(max_samples=...)"
+            )
         if shape[1] > limits.max_dims:
-            raise ValueError(f"{path} has {shape[1]:,} columns, over the limit max_dims = {limits.max_dims}")
+            raise ValueError(
+                f"{path} has {shape[1]:,} columns, over the limit max_dims = {limits.max_dims}"
+            )
 
     return check
 
@@ -241,6 +289,8 @@ def _timed_fields(dtype: np.dtype) -> tuple[str, ...] | None:
     if "t" not in names:
         return None
     for positions in reversed(_POSITION_HEADERS):
-        if all(name in names for name in positions) and all(dtype[n].kind in "fiu" and dtype[n].shape == () for n in ("t", *positions)):
+        if all(name in names for name in positions) and all(
+            dtype[n].kind in "fiu" and dtype[n].shape == () for n in ("t", *positions)
+        ):
             return positions
     return None

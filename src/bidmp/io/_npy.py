@@ -12,7 +12,6 @@ import numpy as np
 
 from .._checks import check_bytes, check_limit, get_limits, short_token
 
-
 _ZIP_MAGIC = b"PK\x03\x04"
 _EMPTY_ZIP_MAGIC = b"PK\x05\x06"
 _NPY_MAGIC = b"\x93NUMPY"
@@ -60,7 +59,9 @@ def _read_npy(open_stream, what: str, check=None) -> np.ndarray:
         except (ValueError, EOFError, OSError):
             raise
         except Exception as exc:  # noqa: BLE001 - as above: a corrupt header or body
-            raise ValueError(f"{what} is not a readable .npy array ({type(exc).__name__})") from None
+            raise ValueError(
+                f"{what} is not a readable .npy array ({type(exc).__name__})"
+            ) from None
 
 
 class NpzMembers(Mapping):
@@ -70,7 +71,11 @@ class NpzMembers(Mapping):
     def __init__(self, archive: zipfile.ZipFile, error: type[Exception]) -> None:
         self._archive = archive
         self._error = error
-        self._infos = {info.filename[:-4]: info for info in archive.infolist() if info.filename.endswith(".npy")}
+        self._infos = {
+            info.filename[:-4]: info
+            for info in archive.infolist()
+            if info.filename.endswith(".npy")
+        }
 
     @property
     def names(self) -> set[str]:
@@ -84,8 +89,19 @@ class NpzMembers(Mapping):
             raise KeyError(f"missing member {name}")
         try:
             return _read_npy(lambda: self._archive.open(info), f"member {name}", check)
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
-            message = str(exc) if str(exc).startswith("member ") else f"member {name} is unreadable ({type(exc).__name__}: {exc})"
+        except (
+            ValueError,
+            EOFError,
+            OSError,
+            zipfile.BadZipFile,
+            NotImplementedError,
+            RuntimeError,
+        ) as exc:
+            message = (
+                str(exc)
+                if str(exc).startswith("member ")
+                else f"member {name} is unreadable ({type(exc).__name__}: {exc})"
+            )
             raise ValueError(message) from None
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -107,9 +123,13 @@ def read_npz(path: Path, kind: str, error: type[Exception] = ValueError) -> Iter
     (a pickled or oversized member is refused even if it would never be asked for). The file is
     closed however reading ends; a problem raises ``error`` naming ``path``."""
     if not path.is_file():
-        if path.exists() and not path.is_dir():  # a FIFO, a device or a socket: opening it could block
+        if (
+            path.exists() and not path.is_dir()
+        ):  # a FIFO, a device or a socket: opening it could block
             raise error(f"{kind} {path} is not a regular file (a pipe, device or socket)")
-        raise error(f"{kind} {path} does not exist" + (" (it is a folder)" if path.is_dir() else ""))
+        raise error(
+            f"{kind} {path} does not exist" + (" (it is a folder)" if path.is_dir() else "")
+        )
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {path} in bytes")
     try:
         with open(path, "rb") as handle:
@@ -122,7 +142,14 @@ def read_npz(path: Path, kind: str, error: type[Exception] = ValueError) -> Iter
         raise error(f"{path} is not a {kind} (not an .npz archive)")
     try:
         archive = zipfile.ZipFile(path)
-    except (zipfile.BadZipFile, zipfile.LargeZipFile, OSError, EOFError, ValueError, NotImplementedError) as exc:
+    except (
+        zipfile.BadZipFile,
+        zipfile.LargeZipFile,
+        OSError,
+        EOFError,
+        ValueError,
+        NotImplementedError,
+    ) as exc:
         raise error(f"{path} is not a readable {kind} ({type(exc).__name__}: {exc})") from None
     with archive:
         _check_archive(archive, path, kind, error)
@@ -140,16 +167,29 @@ def _check_archive(archive: zipfile.ZipFile, path: Path, kind: str, error: type[
         if info.flag_bits & 0x1:
             raise error(f"{path} is not a {kind} (member {info.filename} is encrypted)")
         if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
-            raise error(f"{path} is not a {kind} (member {info.filename} uses an unsupported "
-                        f"compression, method {info.compress_type})")
+            raise error(
+                f"{path} is not a {kind} (member {info.filename} uses an unsupported "
+                f"compression, method {info.compress_type})"
+            )
         if info.file_size > budget:
-            raise error(f"{path}: member {info.filename} declares {info.file_size / 2**30:.3g} GiB, over the limit "
-                        f"max_array_bytes = {get_limits().max_array_bytes:,}; raise it with "
-                        f"bidmp.set_limits(max_array_bytes=...)")
+            raise error(
+                f"{path}: member {info.filename} declares {info.file_size / 2**30:.3g} GiB, over the limit "
+                f"max_array_bytes = {get_limits().max_array_bytes:,}; raise it with "
+                f"bidmp.set_limits(max_array_bytes=...)"
+            )
         if not info.filename.endswith(".npy"):
-            raise error(f"{path} is not a {kind} (member {short_token(info.filename, 40)} is not an .npy array)")
+            raise error(
+                f"{path} is not a {kind} (member {short_token(info.filename, 40)} is not an .npy array)"
+            )
         try:  # the header only (a few hundred bytes): the data are not read
             with archive.open(info) as stream:
                 _read_npy_header(stream, f"member {short_token(info.filename[:-4], 40)}")
-        except (ValueError, EOFError, OSError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
+        except (
+            ValueError,
+            EOFError,
+            OSError,
+            zipfile.BadZipFile,
+            NotImplementedError,
+            RuntimeError,
+        ) as exc:
             raise error(f"{path} is not a {kind} ({exc})") from None

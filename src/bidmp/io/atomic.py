@@ -19,7 +19,7 @@ from pathlib import Path
 
 from .._checks import check_path, shown_path
 
-__all__ = ['atomic_write']
+__all__ = ["atomic_write"]
 
 logger = logging.getLogger(__name__)
 
@@ -78,7 +78,9 @@ def _destination(path: str | os.PathLike) -> Path:
         if target.is_dir():
             raise ValueError(f"cannot write {path}: it is a folder; give a file name")
         if not stat.S_ISREG(target.stat().st_mode):
-            raise ValueError(f"cannot write {path}: it is not a regular file (a device, pipe or socket)")
+            raise ValueError(
+                f"cannot write {path}: it is not a regular file (a device, pipe or socket)"
+            )
     directory = target.parent if str(target.parent) else Path(".")
     if not directory.is_dir():
         raise ValueError(f"cannot write {path}: folder {directory} does not exist")
@@ -99,10 +101,14 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator:
         file_mode = stat.S_IMODE(target.stat().st_mode)
     except FileNotFoundError:
         file_mode = 0o666 & ~_umask()
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory)
+    fd, tmp_name = tempfile.mkstemp(
+        prefix=f".{target.name}.{os.getpid()}.", suffix=_TMP_SUFFIX, dir=directory
+    )
     try:
         os.fchmod(fd, file_mode)
-        with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as handle:
+        with os.fdopen(
+            fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})
+        ) as handle:
             yield handle
             handle.flush()
             os.fsync(handle.fileno())
@@ -111,7 +117,10 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)
         # A full disk says "No space left on device" without the file: name it (the old one stays).
-        raise OSError(exc.errno, f"cannot write {shown_path(target)} ({exc.strerror or exc}); nothing was replaced") from None
+        raise OSError(
+            exc.errno,
+            f"cannot write {shown_path(target)} ({exc.strerror or exc}); nothing was replaced",
+        ) from None
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)

@@ -37,8 +37,17 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import (
+    as_trajectory,
+    as_vector,
+    check_choice,
+    check_path,
+    check_real,
+    require_extra,
+    short_token,
+    shown_path,
+)
 from .recordings import Recording
-from .._checks import as_trajectory, as_vector, check_choice, check_path, check_real, require_extra, short_token, shown_path
 
 __all__ = ["read_bag", "write_bag", "is_bag", "start_stamp"]
 
@@ -48,8 +57,12 @@ TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 POINT_STAMPED = "geometry_msgs/msg/PointStamped"
-FOLLOW_JOINT_TRAJECTORY = {2: "control_msgs/action/FollowJointTrajectory_Goal", 1: "control_msgs/msg/FollowJointTrajectoryGoal"}
-MAX_STAMP_DISORDER = 0.1  # s: transport jitter reorders messages by milliseconds; more is a jump back in time
+FOLLOW_JOINT_TRAJECTORY = {
+    2: "control_msgs/action/FollowJointTrajectory_Goal",
+    1: "control_msgs/msg/FollowJointTrajectoryGoal",
+}
+# s: transport jitter reorders messages by milliseconds; more is a jump back in time
+MAX_STAMP_DISORDER = 0.1
 # The goal of control_msgs' FollowJointTrajectory action (ROS 2 Humble's control_msgs 4, ROS 1's
 # Noetic control_msgs 1.5), with the two tolerance messages it uses: rosbags' typestores do not
 # ship control_msgs, so the types are registered from these definitions.
@@ -58,7 +71,8 @@ _FOLLOW_DEFINITIONS = {
         "control_msgs/msg/JointTolerance": "string name\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n",
         "control_msgs/msg/JointComponentTolerance": (
             "uint16 X_AXIS=1\nuint16 Y_AXIS=2\nuint16 Z_AXIS=3\nuint16 TRANSLATION=4\nuint16 ROTATION=5\n"
-            "string joint_name\nuint16 component\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n"),
+            "string joint_name\nuint16 component\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n"
+        ),
         "control_msgs/action/FollowJointTrajectory_Goal": (
             "trajectory_msgs/JointTrajectory trajectory\n"
             "trajectory_msgs/MultiDOFJointTrajectory multi_dof_trajectory\n"
@@ -66,7 +80,8 @@ _FOLLOW_DEFINITIONS = {
             "control_msgs/JointComponentTolerance[] component_path_tolerance\n"
             "control_msgs/JointTolerance[] goal_tolerance\n"
             "control_msgs/JointComponentTolerance[] component_goal_tolerance\n"
-            "builtin_interfaces/Duration goal_time_tolerance\n"),
+            "builtin_interfaces/Duration goal_time_tolerance\n"
+        ),
     },
     1: {
         "control_msgs/msg/JointTolerance": "string name\nfloat64 position\nfloat64 velocity\nfloat64 acceleration\n",
@@ -74,10 +89,17 @@ _FOLLOW_DEFINITIONS = {
             "trajectory_msgs/JointTrajectory trajectory\n"
             "control_msgs/JointTolerance[] path_tolerance\n"
             "control_msgs/JointTolerance[] goal_tolerance\n"
-            "duration goal_time_tolerance\n"),
+            "duration goal_time_tolerance\n"
+        ),
     },
 }
-_READABLE = (POSE_STAMPED, TRANSFORM_STAMPED, "geometry_msgs/msg/PointStamped", TF_MESSAGE, JOINT_STATE)
+_READABLE = (
+    POSE_STAMPED,
+    TRANSFORM_STAMPED,
+    "geometry_msgs/msg/PointStamped",
+    TF_MESSAGE,
+    JOINT_STATE,
+)
 POSE_COLUMNS = ["x", "y", "z", "qx", "qy", "qz", "qw"]
 
 
@@ -99,7 +121,9 @@ def _contents(reader) -> str:
     for connection in reader.connections:
         key = (connection.topic, connection.msgtype)
         counts[key] = counts.get(key, 0) + connection.msgcount
-    listed = ", ".join(f"{topic} ({kind}, {count} messages)" for (topic, kind), count in sorted(counts.items()))
+    listed = ", ".join(
+        f"{topic} ({kind}, {count} messages)" for (topic, kind), count in sorted(counts.items())
+    )
     return listed or "no topics"
 
 
@@ -115,18 +139,28 @@ def _open(path):
     if not path.exists():
         raise ValueError(f"bag {shown_path(path)} does not exist")
     if not is_bag(path):
-        raise ValueError(f"{shown_path(path)} is not a ROS bag (a ROS 1 .bag file or a ROS 2 bag folder with metadata.yaml)")
+        raise ValueError(
+            f"{shown_path(path)} is not a ROS bag (a ROS 1 .bag file or a ROS 2 bag folder with metadata.yaml)"
+        )
     reader = highlevel.AnyReader([path])
     try:
         reader.open()
     except RecursionError:  # rosbags parses message definitions recursively
-        raise ValueError(f"cannot read bag {shown_path(path)}: its message definitions nest types too deeply") from None
-    except Exception as exc:  # rosbags' own errors (AnyReaderError, a broken metadata.yaml, ...): one line
-        raise ValueError(f"cannot read bag {shown_path(path)}: {type(exc).__name__}: {exc}") from None
+        raise ValueError(
+            f"cannot read bag {shown_path(path)}: its message definitions nest types too deeply"
+        ) from None
+    except (
+        Exception
+    ) as exc:  # rosbags' own errors (AnyReaderError, a broken metadata.yaml, ...): one line
+        raise ValueError(
+            f"cannot read bag {shown_path(path)}: {type(exc).__name__}: {exc}"
+        ) from None
     return reader
 
 
-def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = None, joints=None) -> Recording:
+def read_bag(
+    path, *, topic: str | None = None, tf: tuple[str, str] | None = None, joints=None
+) -> Recording:
     """A demonstration from a bag (module docstring).
 
     Parameters
@@ -157,16 +191,24 @@ def read_bag(path, *, topic: str | None = None, tf: tuple[str, str] | None = Non
                 names = found if names is None else names
                 stamps.append(stamp)
                 rows.append(row)
-        source = (f"tf {tf[0]} -> {tf[1]}" if tf is not None else f"topic {wanted[0].topic}")
+        source = f"tf {tf[0]} -> {tf[1]}" if tf is not None else f"topic {wanted[0].topic}"
         if not rows:
-            raise ValueError(f"bag {shown_path(path)}: no {source} message in it; it has: {_contents(reader)}")
-        order = _stamp_order(stamps, f"bag {shown_path(path)}: the header stamps of {source}", _contents(reader))
+            raise ValueError(
+                f"bag {shown_path(path)}: no {source} message in it; it has: {_contents(reader)}"
+            )
+        order = _stamp_order(
+            stamps, f"bag {shown_path(path)}: the header stamps of {source}", _contents(reader)
+        )
     finally:
         reader.close()
     stamps = [stamps[index] for index in order]
     values = np.array(rows, dtype=float)[order]
-    t = np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9  # exact to the nanosecond
-    return Recording(t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9)
+    t = (
+        np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9
+    )  # exact to the nanosecond
+    return Recording(
+        t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9
+    )
 
 
 def _stamp_order(stamps: list, what: str, contents: str) -> np.ndarray:
@@ -177,35 +219,58 @@ def _stamp_order(stamps: list, what: str, contents: str) -> np.ndarray:
     behind = latest - received
     if np.any(behind > MAX_STAMP_DISORDER * 1e9):
         index = int(np.argmax(behind > MAX_STAMP_DISORDER * 1e9))
-        raise ValueError(f"{what} jump back in time (message {index + 1} at {received[index] * 1e-9:.9f} s, "
-                         f"{behind[index] * 1e-9:.6g} s before one received earlier; more than the "
-                         f"{MAX_STAMP_DISORDER:g} s transport jitter reorders); it has: {contents}")
+        raise ValueError(
+            f"{what} jump back in time (message {index + 1} at {received[index] * 1e-9:.9f} s, "
+            f"{behind[index] * 1e-9:.6g} s before one received earlier; more than the "
+            f"{MAX_STAMP_DISORDER:g} s transport jitter reorders); it has: {contents}"
+        )
     order = np.argsort(received, kind="stable")
     ordered = received[order]
     if np.any(np.diff(ordered) == 0):
         index = int(np.argmax(np.diff(ordered) == 0))
-        raise ValueError(f"{what} repeat: two messages stamped {ordered[index] * 1e-9:.9f} s (messages "
-                         f"{order[index] + 1} and {order[index + 1] + 1}); it has: {contents}")
+        raise ValueError(
+            f"{what} repeat: two messages stamped {ordered[index] * 1e-9:.9f} s (messages "
+            f"{order[index] + 1} and {order[index + 1] + 1}); it has: {contents}"
+        )
     if np.any(order != np.arange(order.size)):
         import logging
 
-        logging.getLogger(__name__).info("%s: %d message(s) out of receive order, put in the order of their stamps "
-                                         "(at most %.3g ms apart)", what, int(np.sum(order != np.arange(order.size))),
-                                         float(behind.max()) * 1e-6)
+        logging.getLogger(__name__).info(
+            "%s: %d message(s) out of receive order, put in the order of their stamps "
+            "(at most %.3g ms apart)",
+            what,
+            int(np.sum(order != np.arange(order.size))),
+            float(behind.max()) * 1e-6,
+        )
     return order
 
 
 def _check_selection(topic, tf, joints) -> None:
     """Refuse a topic, frame pair or joint list that could name nothing, before the bag is opened."""
     if topic is not None and (not isinstance(topic, str) or not topic.strip() or len(topic) > 256):
-        raise ValueError(f"topic must be a topic name such as '/bidmp/pose', got {short_token(topic, 30)}")
-    if tf is not None and (not isinstance(tf, (tuple, list)) or len(tf) != 2
-                           or not all(isinstance(frame, str) and frame and len(frame) <= 256 for frame in tf)):
-        raise ValueError(f"tf must be (parent frame, child frame), two names, got {short_token(tf, 30)}")
-    if joints is not None and joints is not True and (
-            not isinstance(joints, (list, tuple)) or not joints
-            or not all(isinstance(name, str) and name and len(name) <= 256 for name in joints)):
-        raise ValueError(f"joints must be a list of joint names or True (every joint), got {short_token(joints, 30)}")
+        raise ValueError(
+            f"topic must be a topic name such as '/bidmp/pose', got {short_token(topic, 30)}"
+        )
+    if tf is not None and (
+        not isinstance(tf, (tuple, list))
+        or len(tf) != 2
+        or not all(isinstance(frame, str) and frame and len(frame) <= 256 for frame in tf)
+    ):
+        raise ValueError(
+            f"tf must be (parent frame, child frame), two names, got {short_token(tf, 30)}"
+        )
+    if (
+        joints is not None
+        and joints is not True
+        and (
+            not isinstance(joints, (list, tuple))
+            or not joints
+            or not all(isinstance(name, str) and name and len(name) <= 256 for name in joints)
+        )
+    ):
+        raise ValueError(
+            f"joints must be a list of joint names or True (every joint), got {short_token(joints, 30)}"
+        )
     if tf is not None and joints is not None:
         raise ValueError("tf and joints: give one (a transform or joint states), not both")
 
@@ -216,25 +281,43 @@ def _wanted_connections(reader, topic, tf, joints) -> list:
         topics = {topic} if topic is not None else {"/tf", "/tf_static"}
         found = [c for c in reader.connections if c.topic in topics and c.msgtype == TF_MESSAGE]
         if not found:
-            raise ValueError(f"tf: the bag has no TFMessage topic {' or '.join(sorted(topics))}; it has: {_contents(reader)}")
+            raise ValueError(
+                f"tf: the bag has no TFMessage topic {' or '.join(sorted(topics))}; it has: {_contents(reader)}"
+            )
         return found
     if topic is None:
-        types = (JOINT_STATE,) if joints is not None else (POSE_STAMPED, TRANSFORM_STAMPED, POINT_STAMPED)
+        types = (
+            (JOINT_STATE,)
+            if joints is not None
+            else (POSE_STAMPED, TRANSFORM_STAMPED, POINT_STAMPED)
+        )
         found = [c for c in reader.connections if c.msgtype in types]
         if len({c.topic for c in found}) != 1:
             wanted = "joints" if joints is not None else "topic"
-            raise ValueError(f"{wanted}: name the topic to read: the bag has {len({c.topic for c in found})} topics of "
-                             f"type {' or '.join(types)}; it has: {_contents(reader)}")
+            raise ValueError(
+                f"{wanted}: name the topic to read: the bag has {len({c.topic for c in found})} topics of "
+                f"type {' or '.join(types)}; it has: {_contents(reader)}"
+            )
         return found
     found = [c for c in reader.connections if c.topic == topic]
     if not found:
-        raise ValueError(f"topic {short_token(topic, 40)} is not in the bag; it has: {_contents(reader)}")
+        raise ValueError(
+            f"topic {short_token(topic, 40)} is not in the bag; it has: {_contents(reader)}"
+        )
     if found[0].msgtype not in (POSE_STAMPED, TRANSFORM_STAMPED, POINT_STAMPED, JOINT_STATE):
-        raise ValueError(f"topic {topic} carries {found[0].msgtype}, which bidmp does not read (it reads "
-                         f"{', '.join(_READABLE)}; TFMessage with tf); it has: {_contents(reader)}")
+        raise ValueError(
+            f"topic {topic} carries {found[0].msgtype}, which bidmp does not read (it reads "
+            f"{', '.join(_READABLE)}; TFMessage with tf); it has: {_contents(reader)}"
+        )
     if (found[0].msgtype == JOINT_STATE) != (joints is not None):
-        raise ValueError(f"topic {topic} carries {found[0].msgtype}: " + ("give joints, the joints to read" if joints is None
-                                                                        else "joints are read from a JointState topic"))
+        raise ValueError(
+            f"topic {topic} carries {found[0].msgtype}: "
+            + (
+                "give joints, the joints to read"
+                if joints is None
+                else "joints are read from a JointState topic"
+            )
+        )
     return found
 
 
@@ -250,14 +333,18 @@ def _rows(message, msgtype: str, tf, joints, names):
         yield _stamp(message.header), _transform_row(message), POSE_COLUMNS
     elif msgtype == TF_MESSAGE:
         for transform in message.transforms:
-            if transform.header.frame_id.lstrip("/") == tf[0].lstrip("/") and transform.child_frame_id.lstrip("/") == tf[1].lstrip("/"):
+            if transform.header.frame_id.lstrip("/") == tf[0].lstrip(
+                "/"
+            ) and transform.child_frame_id.lstrip("/") == tf[1].lstrip("/"):
                 yield _stamp(transform.header), _transform_row(transform), POSE_COLUMNS
     else:
         available = list(message.name)
         chosen = available if joints is True else (names or list(joints))
         missing = [name for name in chosen if name not in available]
         if missing:
-            raise ValueError(f"joint state without joint(s) {', '.join(missing)}; it names {', '.join(available)}")
+            raise ValueError(
+                f"joint state without joint(s) {', '.join(missing)}; it names {', '.join(available)}"
+            )
         positions = np.asarray(message.position, dtype=float)
         yield _stamp(message.header), [positions[available.index(name)] for name in chosen], chosen
 
@@ -268,9 +355,21 @@ def _transform_row(stamped) -> list:
 
 
 # -- writing --------------------------------------------------------------------------------------
-def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=None, velocities=None,
-              accelerations=None, frame_id: str = "base", origin: float | str = "now", ros: int = 2,
-              orientation=None) -> Path:
+def write_bag(  # noqa: C901, PLR0913 - the public call spells its options out, as users pass them; one branch per documented option or part kind, each a line
+    path,
+    t,
+    values,
+    *,
+    kind: str,
+    topic: str | None = None,
+    names=None,
+    velocities=None,
+    accelerations=None,
+    frame_id: str = "base",
+    origin: float | str = "now",
+    ros: int = 2,
+    orientation=None,
+) -> Path:
     """Write a motion to a bag (module docstring).
 
     Parameters
@@ -314,48 +413,80 @@ def write_bag(path, t, values, *, kind: str, topic: str | None = None, names=Non
         raise ValueError("t must increase from sample to sample (seconds)")
     values = as_trajectory(values, "values", min_points=1, allow_static=True)
     if values.shape[0] != t.size:
-        raise ValueError(f"values has {values.shape[0]} rows but t has {t.size} times: one row per time")
+        raise ValueError(
+            f"values has {values.shape[0]} rows but t has {t.size} times: one row per time"
+        )
     if kind == "pose" and values.shape[1] not in (3, 7):
-        raise ValueError(f"values: a pose stream needs 3 (x, y, z) or 7 (with qx, qy, qz, qw) columns, got {values.shape[1]}")
+        raise ValueError(
+            f"values: a pose stream needs 3 (x, y, z) or 7 (with qx, qy, qz, qw) columns, got {values.shape[1]}"
+        )
     if orientation is not None:
         if kind != "pose" or values.shape[1] != 3:
-            raise ValueError("orientation is the held orientation of a position stream (kind='pose', 3 columns)")
+            raise ValueError(
+                "orientation is the held orientation of a position stream (kind='pose', 3 columns)"
+            )
         orientation = as_vector(orientation, "orientation", length=4)
         if not abs(np.linalg.norm(orientation) - 1.0) <= 1e-6:
-            raise ValueError(f"orientation must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(orientation):.6g}")
+            raise ValueError(
+                f"orientation must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(orientation):.6g}"
+            )
     origin = start_stamp(origin)
     # Header stamps are whole seconds in a signed 32-bit field (ROS 2; ROS 1 an unsigned one).
     if origin + t[0] < 0 or origin + t[-1] >= 2**31:
-        raise ValueError(f"t: origin + t must lie within [0, 2**31) s (a header stamp's seconds), "
-                         f"got {origin + t[0]:.6g} to {origin + t[-1]:.6g} s")
+        raise ValueError(
+            f"t: origin + t must lie within [0, 2**31) s (a header stamp's seconds), "
+            f"got {origin + t[0]:.6g} to {origin + t[-1]:.6g} s"
+        )
     target = Path(check_path(path))
-    msgtype = {"pose": POSE_STAMPED if values.shape[1] == 7 or orientation is not None else POINT_STAMPED,
-               "joints": JOINT_TRAJECTORY, "follow": FOLLOW_JOINT_TRAJECTORY[ros]}[kind]
+    msgtype = {
+        "pose": POSE_STAMPED if values.shape[1] == 7 or orientation is not None else POINT_STAMPED,
+        "joints": JOINT_TRAJECTORY,
+        "follow": FOLLOW_JOINT_TRAJECTORY[ros],
+    }[kind]
     if topic is None:
-        topic = {POSE_STAMPED: "/bidmp/pose", POINT_STAMPED: "/bidmp/point", JOINT_TRAJECTORY: "/bidmp/joint_trajectory"
-                 }.get(msgtype, "/bidmp/follow_joint_trajectory/goal")
-    elif not isinstance(topic, str) or not topic.startswith("/") or len(topic) > 256 or not topic[1:].strip():
-        raise ValueError(f"topic must be a ROS topic name such as '/bidmp/pose', got {short_token(topic, 30)}")
+        topic = {
+            POSE_STAMPED: "/bidmp/pose",
+            POINT_STAMPED: "/bidmp/point",
+            JOINT_TRAJECTORY: "/bidmp/joint_trajectory",
+        }.get(msgtype, "/bidmp/follow_joint_trajectory/goal")
+    elif (
+        not isinstance(topic, str)
+        or not topic.startswith("/")
+        or len(topic) > 256
+        or not topic[1:].strip()
+    ):
+        raise ValueError(
+            f"topic must be a ROS topic name such as '/bidmp/pose', got {short_token(topic, 30)}"
+        )
     if not isinstance(frame_id, str) or len(frame_id) > 256:
         raise TypeError(f"frame_id must be a frame name (text), got {short_token(frame_id, 30)}")
     if names is None:
         names = [f"joint{index + 1}" for index in range(values.shape[1])]
-    elif (not isinstance(names, (list, tuple)) or len(names) != values.shape[1]
-          or not all(isinstance(name, str) and name for name in names)):
-        raise ValueError(f"names must be {values.shape[1]} joint names (text), one per column of values, "
-                         f"got {short_token(names, 30)}")
+    elif (
+        not isinstance(names, (list, tuple))
+        or len(names) != values.shape[1]
+        or not all(isinstance(name, str) and name for name in names)
+    ):
+        raise ValueError(
+            f"names must be {values.shape[1]} joint names (text), one per column of values, "
+            f"got {short_token(names, 30)}"
+        )
     names = list(names)
     rates = []
     for rate, label in ((velocities, "velocities"), (accelerations, "accelerations")):
         if rate is not None:
             rate = as_trajectory(rate, label, min_points=1, allow_static=True)
             if rate.shape != values.shape:
-                raise ValueError(f"{label} must have the shape of values {values.shape}, got {rate.shape}")
+                raise ValueError(
+                    f"{label} must have the shape of values {values.shape}, got {rate.shape}"
+                )
         rates.append(rate)
     velocities, accelerations = rates
     if orientation is not None:
         values = np.hstack([values, np.tile(orientation, (values.shape[0], 1))])
-    messages = _messages(ros, msgtype, t, values, names, velocities, accelerations, frame_id, origin)
+    messages = _messages(
+        ros, msgtype, t, values, names, velocities, accelerations, frame_id, origin
+    )
     return _write_atomically(target, ros, topic, msgtype, messages)
 
 
@@ -375,10 +506,12 @@ def start_stamp(origin) -> float:
             try:
                 return start_stamp(float(origin))
             except ValueError:
-                raise ValueError(f"origin must be 'now', seconds since the epoch or an ISO 8601 time "
-                                 f"(2026-12-03T14:00:00Z), got {short_token(origin, 30)}") from None
+                raise ValueError(
+                    f"origin must be 'now', seconds since the epoch or an ISO 8601 time "
+                    f"(2026-12-03T14:00:00Z), got {short_token(origin, 30)}"
+                ) from None
         if moment.tzinfo is None:
-            moment = moment.replace(tzinfo=datetime.timezone.utc)
+            moment = moment.replace(tzinfo=datetime.UTC)
         return start_stamp(moment.timestamp())
     return check_real(origin, "origin", nonnegative=True)
 
@@ -396,7 +529,17 @@ def _store(ros: int, msgtype: str):
     return store
 
 
-def _messages(ros: int, msgtype: str, t, values, names, velocities, accelerations, frame_id: str, origin: float):
+def _messages(
+    ros: int,
+    msgtype: str,
+    t,
+    values,
+    names,
+    velocities,
+    accelerations,
+    frame_id: str,
+    origin: float,
+):
     """(typestore, [(stamp ns, message), ...])."""
     store = _store(ros, msgtype)
     types = store.types
@@ -407,7 +550,10 @@ def _messages(ros: int, msgtype: str, t, values, names, velocities, acceleration
 
     def header(nanoseconds: int):
         sec, nanosec = divmod(nanoseconds, 1_000_000_000)
-        fields = {"stamp": types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), "frame_id": frame_id}
+        fields = {
+            "stamp": types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec),
+            "frame_id": frame_id,
+        }
         return types["std_msgs/msg/Header"](**({"seq": 0} if ros == 1 else {}), **fields)
 
     def duration(seconds: float):
@@ -422,23 +568,40 @@ def _messages(ros: int, msgtype: str, t, values, names, velocities, acceleration
             if msgtype == POINT_STAMPED:
                 out.append((stamp, types[POINT_STAMPED](header=header(stamp), point=point)))
                 continue
-            pose = types["geometry_msgs/msg/Pose"](position=point, orientation=types["geometry_msgs/msg/Quaternion"](*map(float, row[3:])))
+            pose = types["geometry_msgs/msg/Pose"](
+                position=point,
+                orientation=types["geometry_msgs/msg/Quaternion"](*map(float, row[3:])),
+            )
             out.append((stamp, types[POSE_STAMPED](header=header(stamp), pose=pose)))
         return store, out
     zeros = np.zeros_like(values)
-    rates = (zeros if velocities is None else np.asarray(velocities, dtype=float),
-             zeros if accelerations is None else np.asarray(accelerations, dtype=float))
-    points = [types["trajectory_msgs/msg/JointTrajectoryPoint"](
-        positions=position.copy(), velocities=velocity.copy(), accelerations=acceleration.copy(), effort=np.zeros(0),
-        time_from_start=duration(time)) for time, position, velocity, acceleration in zip(t, values, *rates)]
+    rates = (
+        zeros if velocities is None else np.asarray(velocities, dtype=float),
+        zeros if accelerations is None else np.asarray(accelerations, dtype=float),
+    )
+    points = [
+        types["trajectory_msgs/msg/JointTrajectoryPoint"](
+            positions=position.copy(),
+            velocities=velocity.copy(),
+            accelerations=acceleration.copy(),
+            effort=np.zeros(0),
+            time_from_start=duration(time),
+        )
+        for time, position, velocity, acceleration in zip(t, values, *rates)
+    ]
     trajectory = types[JOINT_TRAJECTORY](header=header(start), joint_names=names, points=points)
     if msgtype == JOINT_TRAJECTORY:
         return store, [(start, trajectory)]
     goal = {"trajectory": trajectory, "path_tolerance": [], "goal_tolerance": []}
     if ros == 2:
-        goal |= {"multi_dof_trajectory": types["trajectory_msgs/msg/MultiDOFJointTrajectory"](
-            header=header(start), joint_names=[], points=[]), "component_path_tolerance": [],
-            "component_goal_tolerance": [], "goal_time_tolerance": duration(0.0)}
+        goal |= {
+            "multi_dof_trajectory": types["trajectory_msgs/msg/MultiDOFJointTrajectory"](
+                header=header(start), joint_names=[], points=[]
+            ),
+            "component_path_tolerance": [],
+            "component_goal_tolerance": [],
+            "goal_time_tolerance": duration(0.0),
+        }
     else:
         goal["goal_time_tolerance"] = types["builtin_interfaces/msg/Duration"](sec=0, nanosec=0)
     return store, [(start, types[msgtype](**goal))]
@@ -449,20 +612,33 @@ def _write_atomically(target: Path, ros: int, topic: str, msgtype: str, messages
     store, stamped = messages
     directory = target.parent if str(target.parent) else Path(".")
     if not directory.is_dir():
-        raise ValueError(f"path: cannot write {shown_path(target)}: folder {shown_path(directory)} does not exist")
-    if target.is_dir() and not is_bag(target):  # only a bag folder is replaced, never another folder
-        raise ValueError(f"path: {shown_path(target)} is a folder that is not a ROS bag; give a new name")
+        raise ValueError(
+            f"path: cannot write {shown_path(target)}: folder {shown_path(directory)} does not exist"
+        )
+    if target.is_dir() and not is_bag(
+        target
+    ):  # only a bag folder is replaced, never another folder
+        raise ValueError(
+            f"path: {shown_path(target)} is a folder that is not a ROS bag; give a new name"
+        )
     if target.exists() and not target.is_dir() and not target.is_file():
-        raise ValueError(f"path: {shown_path(target)} is not a regular file (a device, pipe or socket)")
+        raise ValueError(
+            f"path: {shown_path(target)} is not a regular file (a device, pipe or socket)"
+        )
     if ros == 2 and target.is_file():  # a ROS 2 bag is a folder: it does not replace a file
-        raise ValueError(f"path: {shown_path(target)} is a file; a ROS 2 bag is a folder (give a new name, or ros=1)")
+        raise ValueError(
+            f"path: {shown_path(target)} is a file; a ROS 2 bag is a folder (give a new name, or ros=1)"
+        )
     scratch = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=directory))
     built = scratch / target.name
     try:
         if ros == 2:
             from rosbags.rosbag2 import StoragePlugin, Writer
 
-            writer, serialize = Writer(built, version=9, storage_plugin=StoragePlugin.MCAP), store.serialize_cdr
+            writer, serialize = (
+                Writer(built, version=9, storage_plugin=StoragePlugin.MCAP),
+                store.serialize_cdr,
+            )
         else:
             from rosbags.rosbag1 import Writer
 

@@ -23,7 +23,7 @@ from ._npy import NpzMembers, read_npz
 from .atomic import _destination, atomic_write
 from .strict_json import load_json
 
-__all__ = ['ModelFileError', 'FORMAT_VERSION', 'save_model', 'load_model']
+__all__ = ["ModelFileError", "FORMAT_VERSION", "save_model", "load_model"]
 
 logger = logging.getLogger(__name__)
 
@@ -85,7 +85,9 @@ def save_model(model, path: str | os.PathLike) -> Path:
 
     class_name = type(model).__name__
     if class_name not in _MODEL_CLASSES or not hasattr(model, "_get_state"):
-        raise TypeError(f"model must be one of {', '.join(sorted(_MODEL_CLASSES))}, got {class_name}")
+        raise TypeError(
+            f"model must be one of {', '.join(sorted(_MODEL_CLASSES))}, got {class_name}"
+        )
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = _model_path(path)
@@ -100,7 +102,9 @@ def save_model(model, path: str | os.PathLike) -> Path:
         "state": state,
     }
     payload = {name: np.asarray(value) for name, value in arrays.items()}
-    payload[_META_KEY] = np.frombuffer(json.dumps(meta, allow_nan=False).encode("utf-8"), dtype=np.uint8)
+    payload[_META_KEY] = np.frombuffer(
+        json.dumps(meta, allow_nan=False).encode("utf-8"), dtype=np.uint8
+    )
     with atomic_write(path, "wb") as handle:
         np.savez(handle, **payload)
     logger.debug("saved %s to %s", class_name, path)
@@ -109,11 +113,15 @@ def save_model(model, path: str | os.PathLike) -> Path:
 
 def _read_meta(members: NpzMembers, path: Path) -> dict:
     if _META_KEY not in members.names:
-        raise ModelFileError(f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)")
+        raise ModelFileError(
+            f"{path} is not a bidmp model file (an .npz archive without bidmp metadata)"
+        )
 
     def check(shape, dtype):
         if dtype != np.uint8 or len(shape) != 1 or shape[0] > _META_MAX_BYTES:
-            raise ValueError(f"{path} is not a bidmp model file (its metadata member is not UTF-8 JSON bytes)")
+            raise ValueError(
+                f"{path} is not a bidmp model file (its metadata member is not UTF-8 JSON bytes)"
+            )
 
     try:
         raw = members.read(_META_KEY, check)
@@ -150,11 +158,28 @@ def load_model(path: str | os.PathLike):
         except MemoryError:
             raise ModelFileError(f"{path}: a member is too large to load") from None
         except KeyError as exc:
-            detail = exc.args[0] if exc.args and str(exc.args[0]).startswith("missing member") else f"missing key {exc}"
-            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({detail})") from None
-        except (TypeError, ValueError, AttributeError, IndexError, RecursionError, OverflowError,
-                zipfile.BadZipFile, EOFError, OSError) as exc:
-            raise ModelFileError(f"{path} is corrupt: {class_name} state is inconsistent ({exc})") from None
+            detail = (
+                exc.args[0]
+                if exc.args and str(exc.args[0]).startswith("missing member")
+                else f"missing key {exc}"
+            )
+            raise ModelFileError(
+                f"{path} is corrupt: {class_name} state is inconsistent ({detail})"
+            ) from None
+        except (
+            TypeError,
+            ValueError,
+            AttributeError,
+            IndexError,
+            RecursionError,
+            OverflowError,
+            zipfile.BadZipFile,
+            EOFError,
+            OSError,
+        ) as exc:
+            raise ModelFileError(
+                f"{path} is corrupt: {class_name} state is inconsistent ({exc})"
+            ) from None
 
 
 def _model_class_name(meta: dict, path: Path) -> str:

@@ -12,7 +12,8 @@ from .._checks import _as_bounded_array, as_trajectory, check_path
 from .._units import check_units
 from .trajectories import _write_columns
 
-__all__ = ['read_poses', 'save_poses']
+__all__ = ["read_poses", "save_poses"]
+
 
 def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a pose recording (CSV with a header): poses ``(T, 7)`` as ``x, y, z, qx, qy, qz,
@@ -35,8 +36,10 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     recording = read_recording(path, columns=columns)
     if recording.kind != "pose":
         accepted = "x,y,z with qx,qy,qz,qw or rx,ry,rz, a UR RTDE actual_TCP_pose_0..5, a ROS pose.position/orientation"
-        raise ValueError(f"{path}: its columns ({recording.source}) hold {recording.kind}, not poses; a pose file's header "
-                         f"names {accepted} (t optional)")
+        raise ValueError(
+            f"{path}: its columns ({recording.source}) hold {recording.kind}, not poses; a pose file's header "
+            f"names {accepted} (t optional)"
+        )
     return recording.values, recording.t
 
 
@@ -55,7 +58,9 @@ def save_poses(poses, path: str | os.PathLike, times=None, *, units: str | None 
     else:
         data = as_trajectory(poses, "poses", min_points=1, allow_static=True)
         if data.shape[1] != 7:
-            raise ValueError(f"poses must have 7 columns (x, y, z, qx, qy, qz, qw), got {data.shape[1]}")
+            raise ValueError(
+                f"poses must have 7 columns (x, y, z, qx, qy, qz, qw), got {data.shape[1]}"
+            )
         if times is not None:
             times = _as_bounded_array(times, "times", max_ndim=1).reshape(-1)
             if times.shape[0] != data.shape[0] or not np.all(np.isfinite(times)):

@@ -81,7 +81,9 @@ def recording_kind(path: str | os.PathLike, *, columns=None) -> str:
 
     path = check_path(path)
     if path.suffix.lower() not in (".csv", ".txt") or not path.is_file():
-        return ""  # (a FIFO or a device is refused by the reader, never opened here: it would block)
+        return (
+            ""  # (a FIFO or a device is refused by the reader, never opened here: it would block)
+        )
     line = _header_line(path)
     header = tuple(name.strip() for name in _split(line, _csv_delimiter(line)))
     if not line or all(not name or _is_number(name) for name in header):
@@ -115,7 +117,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     suffix = path.suffix.lower()
     if suffix == ".npy":
         if columns is not None:
-            raise ValueError(f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays")
+            raise ValueError(
+                f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays"
+            )
         from .trajectories import _read_npy_trajectory
 
         positions, times = _read_npy_trajectory(path)
@@ -126,7 +130,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         header, values, text = parsed if parsed is not None else _csv_rows(path)
         if header is None:
             if mapping is not None:
-                raise ValueError(f"{path} has no header, so --columns / columns= cannot name its columns")
+                raise ValueError(
+                    f"{path} has no header, so --columns / columns= cannot name its columns"
+                )
             positions, times, layout = _headerless(values, path), None, None
             if values.shape[1] == 4:
                 positions, times = values[:, 1:], values[:, 0]
@@ -134,7 +140,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
             layout = resolve(header, mapping, path)
             used_text = set(text) & {*layout.time, *layout.values}
             if used_text:
-                raise ValueError(f"{path}: column {short_token(header[min(used_text)], 30)} holds text, not numbers")
+                raise ValueError(
+                    f"{path}: column {short_token(header[min(used_text)], 30)} holds text, not numbers"
+                )
             _note_ignored(path, layout.ignored)
             times = times_in_seconds(values, layout, path)
             positions = _values(values, layout)
@@ -142,7 +150,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
                 orientation = _quaternions(values[:, list(layout.orientation)], layout.rotation)
                 positions = np.hstack([positions, orientation])
     else:
-        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+        raise ValueError(
+            f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy"
+        )
     kind = "positions" if layout is None else layout.kind
     positions = as_trajectory(positions, name=str(path), allow_static=kind == "pose")
     if times is not None:
@@ -153,17 +163,36 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         positions = as_trajectory(positions, name=str(path))
     declared = declared_units(path) if suffix in (".csv", ".txt") else ""
     if layout is None:
-        names, units, source = [], declared, f"{'an .npy array' if suffix == '.npy' else 'columns without a header'}"
+        names, units, source = (
+            [],
+            declared,
+            f"{'an .npy array' if suffix == '.npy' else 'columns without a header'}",
+        )
     else:
         names, units, source = list(layout.names), declared or layout.units, layout.label
-    return Recording(times, positions, names, kind, units, source, float(times[0]) if times is not None else 0.0,
-                     () if layout is None else layout.ignored, orientation)
+    return Recording(
+        times,
+        positions,
+        names,
+        kind,
+        units,
+        source,
+        float(times[0]) if times is not None else 0.0,
+        () if layout is None else layout.ignored,
+        orientation,
+    )
 
 
 def _headerless(values: np.ndarray, path) -> np.ndarray:
-    if values.shape[1] in (2, 3, 4):  # x,y[,z] or t,x,y,z (add a header "t,x,y" to mark a time column)
+    if values.shape[1] in (
+        2,
+        3,
+        4,
+    ):  # x,y[,z] or t,x,y,z (add a header "t,x,y" to mark a time column)
         return values
-    raise ValueError(f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z) without a header, found {values.shape[1]}")
+    raise ValueError(
+        f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z) without a header, found {values.shape[1]}"
+    )
 
 
 def _values(values: np.ndarray, layout: Layout) -> np.ndarray:

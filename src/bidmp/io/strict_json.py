@@ -10,7 +10,7 @@ import numpy as np
 
 from .._checks import get_limits, short_token
 
-__all__ = ['load_json']
+__all__ = ["load_json"]
 
 _JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"')
 
@@ -18,7 +18,9 @@ _JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"')
 def _json_depth(data: bytes) -> int:
     """Maximum nesting depth of ``[``/``{`` in a JSON text, strings excluded (no parsing)."""
     codes = np.frombuffer(_JSON_STRING.sub(b'""', data), dtype=np.uint8)
-    steps = (np.isin(codes, (ord("["), ord("{")))).astype(np.int64) - np.isin(codes, (ord("]"), ord("}")))
+    steps = (np.isin(codes, (ord("["), ord("{")))).astype(np.int64) - np.isin(
+        codes, (ord("]"), ord("}"))
+    )
     return int(np.max(np.cumsum(steps), initial=0))
 
 
@@ -42,20 +44,28 @@ def load_json(data: bytes | str, source: str):
         Naming ``source`` and what was wrong (too large, too deep, not UTF-8, not JSON).
     """
     if not isinstance(source, str):
-        raise TypeError(f"source must be a string naming where the JSON came from, got {type(source).__name__}")
+        raise TypeError(
+            f"source must be a string naming where the JSON came from, got {type(source).__name__}"
+        )
     source = short_token(source, 60)[1:-1]
     if isinstance(data, str):
         data = data.encode("utf-8", "surrogatepass")
     if not isinstance(data, (bytes, bytearray)):
-        raise TypeError(f"{source}: data must be JSON text (str or bytes), got {type(data).__name__}")
+        raise TypeError(
+            f"{source}: data must be JSON text (str or bytes), got {type(data).__name__}"
+        )
     limits = get_limits()
     if len(data) > limits.max_json_bytes:
-        raise ValueError(f"{source}: JSON of {len(data):,} bytes exceeds the limit max_json_bytes = "
-                         f"{limits.max_json_bytes:,}; raise it with bidmp.set_limits(max_json_bytes=...)")
+        raise ValueError(
+            f"{source}: JSON of {len(data):,} bytes exceeds the limit max_json_bytes = "
+            f"{limits.max_json_bytes:,}; raise it with bidmp.set_limits(max_json_bytes=...)"
+        )
     depth = _json_depth(data)
     if depth > limits.max_json_depth:
-        raise ValueError(f"{source}: JSON nested {depth} levels deep exceeds the limit max_json_depth = "
-                         f"{limits.max_json_depth}; raise it with bidmp.set_limits(max_json_depth=...)")
+        raise ValueError(
+            f"{source}: JSON nested {depth} levels deep exceeds the limit max_json_depth = "
+            f"{limits.max_json_depth}; raise it with bidmp.set_limits(max_json_depth=...)"
+        )
     try:
         text = data.decode("utf-8-sig")
         return json.loads(text, parse_float=_finite_float, parse_constant=_no_constant)
@@ -64,6 +74,8 @@ def load_json(data: bytes | str, source: str):
     except RecursionError:  # pragma: no cover - the depth cap comes first
         raise ValueError(f"{source}: JSON nested too deeply") from None
     except json.JSONDecodeError as exc:
-        raise ValueError(f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})") from None
+        raise ValueError(
+            f"{source}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})"
+        ) from None
     except ValueError as exc:  # a non-finite number, an integer of too many digits
         raise ValueError(f"{source}: {exc}") from None

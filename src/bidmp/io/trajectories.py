@@ -15,7 +15,14 @@ from ._csv import _check_npy_trajectory, _timed_fields, declared_units, is_joint
 from ._npy import _EMPTY_ZIP_MAGIC, _ZIP_MAGIC, _read_npy
 from .atomic import _destination, atomic_write
 
-__all__ = ['load_trajectory', 'read_trajectory', 'save_trajectory', 'declared_units', 'is_joint_recording']
+__all__ = [
+    "load_trajectory",
+    "read_trajectory",
+    "save_trajectory",
+    "declared_units",
+    "is_joint_recording",
+]
+
 
 def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     """Read a demonstration from ``.csv`` or ``.npy`` as positions on a uniform time grid.
@@ -37,7 +44,9 @@ def load_trajectory(path: str | os.PathLike) -> np.ndarray:
     return y
 
 
-def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np.ndarray | None]:
+def read_trajectory(
+    path: str | os.PathLike, *, columns=None
+) -> tuple[np.ndarray, np.ndarray | None]:
     """Read a demonstration from ``.csv`` or ``.npy``: positions and, if the file has them,
     timestamps in seconds (as recorded: any monotone stamps, epoch-like or jittered).
 
@@ -63,9 +72,11 @@ def read_trajectory(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarra
 
     recording = read_recording(path, columns=columns)
     if recording.kind == "pose":
-        raise ValueError(f"{check_path(path)}: a pose recording ({recording.source}): read it with bidmp.io.read_poses / "
-                         f"bidmp.CartesianDMP, or pick its positions with --columns / columns= (x=..,y=..,z=.. or "
-                         f"position=<prefix>)")
+        raise ValueError(
+            f"{check_path(path)}: a pose recording ({recording.source}): read it with bidmp.io.read_poses / "
+            f"bidmp.CartesianDMP, or pick its positions with --columns / columns= (x=..,y=..,z=.. or "
+            f"position=<prefix>)"
+        )
     return recording.values, recording.t
 
 
@@ -74,19 +85,25 @@ def _read_npy_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     with open(path, "rb") as handle:
         magic = handle.read(4)
     if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
-        raise ValueError(f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)")
+        raise ValueError(
+            f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)"
+        )
     try:
         positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
     except (EOFError, OSError) as exc:
         raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
     except ValueError as exc:
         message = str(exc)
-        raise ValueError(message if str(path) in message else f"{path} is not a readable .npy array ({message})") from None
+        raise ValueError(
+            message if str(path) in message else f"{path} is not a readable .npy array ({message})"
+        ) from None
     times = None
     if positions.dtype.names is not None:
         fields = _timed_fields(positions.dtype)
         times = np.asarray(positions["t"], dtype=np.float64)
-        positions = np.column_stack([np.asarray(positions[name], dtype=np.float64) for name in fields])
+        positions = np.column_stack(
+            [np.asarray(positions[name], dtype=np.float64) for name in fields]
+        )
     return positions, times
 
 
@@ -110,7 +127,9 @@ def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None
     from ..primitives.timing import Trajectory
 
     if isinstance(y, (str, os.PathLike)) and not isinstance(path, (str, os.PathLike)):
-        raise TypeError("save_trajectory takes (y, path): the trajectory first, then the file (as save_model)")
+        raise TypeError(
+            "save_trajectory takes (y, path): the trajectory first, then the file (as save_model)"
+        )
     path = check_path(path)
     if isinstance(y, Trajectory):
         if times is not None:
@@ -119,19 +138,28 @@ def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None
         for name, column in (("t", y.t), ("yd", y.yd), ("ydd", y.ydd)):
             if not np.all(np.isfinite(column)):
                 raise ValueError(f"the trajectory's {name} contains NaN or inf")
-        return _write_columns(as_trajectory(y.y, "y", min_points=1, allow_static=True), names, data, path,
-                              y.units if units is None else units)
+        return _write_columns(
+            as_trajectory(y.y, "y", min_points=1, allow_static=True),
+            names,
+            data,
+            path,
+            y.units if units is None else units,
+        )
     y = as_trajectory(y, "y", min_points=1, allow_static=True)
     _destination(path)
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv"):
-        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+        raise ValueError(
+            f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy"
+        )
     if suffix == ".npy" and times is None:
         with atomic_write(path, "wb") as handle:
             np.save(handle, y, allow_pickle=False)
         return path
     units = check_units(units, "units")
-    names = ["x", "y", "z"][: y.shape[1]] if y.shape[1] <= 3 else [f"x{i}" for i in range(y.shape[1])]
+    names = (
+        ["x", "y", "z"][: y.shape[1]] if y.shape[1] <= 3 else [f"x{i}" for i in range(y.shape[1])]
+    )
     data = y
     if times is not None:
         times = _as_bounded_array(times, "times", max_ndim=1).reshape(-1)
@@ -144,7 +172,9 @@ def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None
     return _write_columns(y, names, data, path, units)
 
 
-def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path, units: str = "") -> Path:
+def _write_columns(
+    y: np.ndarray, names: list[str], data: np.ndarray, path: Path, units: str = ""
+) -> Path:
     """Write named columns as CSV (a ``# units:`` comment when known, a header row) or as a
     structured ``.npy`` (one field each)."""
     from .._units import check_units
@@ -153,7 +183,9 @@ def _write_columns(y: np.ndarray, names: list[str], data: np.ndarray, path: Path
     _destination(path)
     suffix = path.suffix.lower()
     if suffix not in (".npy", ".csv"):
-        raise ValueError(f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy")
+        raise ValueError(
+            f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy"
+        )
     if suffix == ".npy":
         records = np.empty(data.shape[0], dtype=[(name, np.float64) for name in names])
         for index, name in enumerate(names):

@@ -9,11 +9,17 @@ import numpy as np
 from .._checks import printable
 from ._base import _axes_for, _draw, _finish, _matplotlib, _save
 
-__all__ = ['plot_targets_top_view', 'plot_error_vs_distance', 'plot_scenario_3d']
+__all__ = ["plot_targets_top_view", "plot_error_vs_distance", "plot_scenario_3d"]
 
 
-_METHOD_COLOURS = {"dmp": "tab:blue", "dmp-converged": "tab:cyan", "bidmp": "tab:red", "bidmp-latest": "tab:orange",
-                   "gmm": "tab:purple", "tpgmm": "tab:brown"}
+_METHOD_COLOURS = {
+    "dmp": "tab:blue",
+    "dmp-converged": "tab:cyan",
+    "bidmp": "tab:red",
+    "bidmp-latest": "tab:orange",
+    "gmm": "tab:purple",
+    "tpgmm": "tab:brown",
+}
 
 
 def plot_targets_top_view(path, report) -> Path:
@@ -24,7 +30,9 @@ def plot_targets_top_view(path, report) -> Path:
     names = list(report.methods)
     n_cols = min(3, len(names))
     n_rows = int(np.ceil(len(names) / n_cols))
-    fig, axes = mpl.subplots(n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False)
+    fig, axes = mpl.subplots(
+        n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False
+    )
     targets = scenario.target_array
     checked = any(result.clearances is not None for result in report.methods.values())
     scene = scenario.scene if checked else None
@@ -32,20 +40,43 @@ def plot_targets_top_view(path, report) -> Path:
         result = report.methods[name]
         if scene is not None:  # the parts' footprints, under everything else
             for solid in scene.solids:
-                ax.add_patch(mpl.Rectangle(solid.lower[:2], *(solid.upper[:2] - solid.lower[:2]), fill=False,
-                                           edgecolor="0.75", linewidth=0.6, zorder=0))
+                ax.add_patch(
+                    mpl.Rectangle(
+                        solid.lower[:2],
+                        *(solid.upper[:2] - solid.lower[:2]),
+                        fill=False,
+                        edgecolor="0.75",
+                        linewidth=0.6,
+                        zorder=0,
+                    )
+                )
         for label, target in scenario.targets.items():
-            ok = result.task_success_at(label) if scene is not None else result.errors[label] <= scenario.success_threshold
-            ax.add_patch(mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35))
+            ok = (
+                result.task_success_at(label)
+                if scene is not None
+                else result.errors[label] <= scenario.success_threshold
+            )
+            ax.add_patch(
+                mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35)
+            )
             ax.text(target[0], target[1], printable(label), ha="center", va="center", fontsize=8)
             end = result.rollouts[label][-1]
             ax.plot(end[0], end[1], "k.", markersize=3)
             clearance = result.clearance_at(label)
             if clearance is not None and not clearance.collision_free:
-                ax.plot(clearance.point[0], clearance.point[1], "x", color="darkred", markersize=7, markeredgewidth=2)
+                ax.plot(
+                    clearance.point[0],
+                    clearance.point[1],
+                    "x",
+                    color="darkred",
+                    markersize=7,
+                    markeredgewidth=2,
+                )
         if scene is not None:
-            title = (f"{name}: task success {result.task_successes}/{len(targets)}, "
-                     f"{result.collision_free}/{len(result.checked)} collision-free (x = hit)")
+            title = (
+                f"{name}: task success {result.task_successes}/{len(targets)}, "
+                f"{result.collision_free}/{len(result.checked)} collision-free (x = hit)"
+            )
         else:
             title = f"{name}: {result.successes}/{len(targets)} within {scenario.success_threshold:g} {scenario.units}"
         ax.set_title(title, fontsize=9)
@@ -56,9 +87,11 @@ def plot_targets_top_view(path, report) -> Path:
         ax.set_xlabel(f"x [{scenario.units}]")
         ax.set_ylabel(f"y [{scenario.units}]")
         ax.grid(True, alpha=0.3)
-    for ax in axes.ravel()[len(names):]:
+    for ax in axes.ravel()[len(names) :]:
         ax.axis("off")
-    fig.suptitle(f"{printable(scenario.name)}: {'task ' if scene is not None else ''}success per target (green) and failure (red)")
+    fig.suptitle(
+        f"{printable(scenario.name)}: {'task ' if scene is not None else ''}success per target (green) and failure (red)"
+    )
     fig.tight_layout()
     return _save(fig, path)
 
@@ -68,19 +101,37 @@ def plot_error_vs_distance(path, report) -> Path:
     mpl = _matplotlib()
     scenario = report.scenario
     origin = scenario.targets[scenario.demonstrated]
-    distance = {label: float(np.linalg.norm(target - origin)) for label, target in scenario.targets.items()}
+    distance = {
+        label: float(np.linalg.norm(target - origin)) for label, target in scenario.targets.items()
+    }
     order = sorted(distance, key=distance.get)
     has_approach = any(r.approach_errors is not None for r in report.methods.values())
-    fig, axes = mpl.subplots(1, 2 if has_approach else 1, figsize=(12 if has_approach else 6.5, 4.8), dpi=100, squeeze=False)
-    panels = [("errors", "end-point error")] + ([("approach_errors", "approach error")] if has_approach else [])
+    fig, axes = mpl.subplots(
+        1,
+        2 if has_approach else 1,
+        figsize=(12 if has_approach else 6.5, 4.8),
+        dpi=100,
+        squeeze=False,
+    )
+    panels = [("errors", "end-point error")] + (
+        [("approach_errors", "approach error")] if has_approach else []
+    )
     for ax, (attribute, title) in zip(axes[0], panels):
         for name, result in report.methods.items():
             values = getattr(result, attribute)
             if values is None:
                 continue
-            ax.plot([distance[label] for label in order], [values[label] for label in order], "o-",
-                    color=_METHOD_COLOURS.get(name), label=name, markersize=4)
-        ax.axhline(scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold")
+            ax.plot(
+                [distance[label] for label in order],
+                [values[label] for label in order],
+                "o-",
+                color=_METHOD_COLOURS.get(name),
+                label=name,
+                markersize=4,
+            )
+        ax.axhline(
+            scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold"
+        )
         _readable_symlog(ax)
         ax.set_xlabel(f"distance from the demonstrated target [{scenario.units}]")
         ax.set_ylabel(f"{title} [{scenario.units}]")
@@ -100,7 +151,11 @@ def _readable_symlog(ax) -> None:
     ax.set_yscale("symlog", linthresh=1.0, linscale=1.5)
     ax.set_ylim(bottom=0.0)
     top = ax.get_ylim()[1]
-    ticks = [t for t in (0, 0.25, 0.5, 0.75, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000) if t <= top * 1.05]
+    ticks = [
+        t
+        for t in (0, 0.25, 0.5, 0.75, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
+        if t <= top * 1.05
+    ]
     ax.yaxis.set_major_locator(FixedLocator(ticks))
     ax.yaxis.set_minor_locator(NullLocator())
     ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
@@ -124,27 +179,79 @@ def plot_scenario_3d(path, report) -> Path:
     _draw(ax, demo, color="0.2", linewidth=3, label="demonstration")
     for index, extension in enumerate(report.extensions):
         if len(extension.segmentation_points):
-            _draw(ax, extension.demonstration[extension.segmentation_points][:, :3], "^", color="k", markersize=6,
-                  linestyle="none", label="segmentation points" if index == 0 else None)
-        _draw(ax, extension.complete[:, :3], color="goldenrod", linewidth=2.5, alpha=0.8, label="extended demonstration" if index == 0 else None)
-    for label, trajectory in scenario.demonstrations.items():
+            _draw(
+                ax,
+                extension.demonstration[extension.segmentation_points][:, :3],
+                "^",
+                color="k",
+                markersize=6,
+                linestyle="none",
+                label="segmentation points" if index == 0 else None,
+            )
+        _draw(
+            ax,
+            extension.complete[:, :3],
+            color="goldenrod",
+            linewidth=2.5,
+            alpha=0.8,
+            label="extended demonstration" if index == 0 else None,
+        )
+    for trajectory in scenario.demonstrations.values():
         _draw(ax, trajectory[:, :3], color="goldenrod", linewidth=2.0, alpha=0.6)
     for name, result in report.methods.items():
         colour = _METHOD_COLOURS.get(name, "tab:green")
         failed = [label for label in result.rollouts if not result.task_success_at(label)]
-        ax.plot([], [], color=colour, linewidth=1.2,
-                label=f"{name}: {len(result.rollouts) - len(failed)} of {len(result.rollouts)} within the contract")
+        ax.plot(
+            [],
+            [],
+            color=colour,
+            linewidth=1.2,
+            label=f"{name}: {len(result.rollouts) - len(failed)} of {len(result.rollouts)} within the contract",
+        )
         for label, trajectory in result.rollouts.items():
             bad = label in failed
-            _draw(ax, trajectory[:, :3], "--" if bad else "-", color=colour, linewidth=1.0 if bad else 0.8,
-                  alpha=0.9 if bad else 0.6)
+            _draw(
+                ax,
+                trajectory[:, :3],
+                "--" if bad else "-",
+                color=colour,
+                linewidth=1.0 if bad else 0.8,
+                alpha=0.9 if bad else 0.6,
+            )
             clearance = result.clearance_at(label)
-            if bad and clearance is not None and clearance.point is not None and not clearance.clear:
-                _draw(ax, np.asarray(clearance.point, dtype=float)[None, :3], "X", color=colour, markersize=8,
-                      markeredgecolor="black", markeredgewidth=0.5, linestyle="none")
-    if any(not result.task_success_at(label) for result in report.methods.values() for label in result.rollouts):
-        ax.plot([], [], "--", color="0.3", label="breaks the contract (dashed; × closest to a part)")
-    _draw(ax, scenario.target_array[:, :3], "o", color="tab:green", markersize=4, linestyle="none", label="targets")
+            if (
+                bad
+                and clearance is not None
+                and clearance.point is not None
+                and not clearance.clear
+            ):
+                _draw(
+                    ax,
+                    np.asarray(clearance.point, dtype=float)[None, :3],
+                    "X",
+                    color=colour,
+                    markersize=8,
+                    markeredgecolor="black",
+                    markeredgewidth=0.5,
+                    linestyle="none",
+                )
+    if any(
+        not result.task_success_at(label)
+        for result in report.methods.values()
+        for label in result.rollouts
+    ):
+        ax.plot(
+            [], [], "--", color="0.3", label="breaks the contract (dashed; × closest to a part)"
+        )
+    _draw(
+        ax,
+        scenario.target_array[:, :3],
+        "o",
+        color="tab:green",
+        markersize=4,
+        linestyle="none",
+        label="targets",
+    )
     _finish(ax, n_dims, scenario.units, f"{scenario.name}")
     ax.legend(fontsize=7, loc="upper left")
     return _save(fig, path)
@@ -159,11 +266,18 @@ def _draw_solids(ax, solids) -> None:
 
     for index, solid in enumerate(solids):
         layer = solid_layer(solid)
-        vertices, faces = solid_mesh(layer["kind"], layer["centre"], layer["rotation"], layer["params"], sides=16)
-        mesh = Poly3DCollection(vertices[faces], facecolor="lightsteelblue", edgecolor="none", alpha=0.35)
+        vertices, faces = solid_mesh(
+            layer["kind"], layer["centre"], layer["rotation"], layer["params"], sides=16
+        )
+        mesh = Poly3DCollection(
+            vertices[faces], facecolor="lightsteelblue", edgecolor="none", alpha=0.35
+        )
         ax.add_collection3d(mesh)
         if index == 0:
             ax.plot([], [], "s", color="lightsteelblue", label="scene parts")
     if solids:  # add_collection3d does not widen the axes: take the parts' extent in
-        corners = np.vstack([np.asarray(s.lower, float)[None] for s in solids] + [np.asarray(s.upper, float)[None] for s in solids])
+        corners = np.vstack(
+            [np.asarray(s.lower, float)[None] for s in solids]
+            + [np.asarray(s.upper, float)[None] for s in solids]
+        )
         ax.auto_scale_xyz(corners[:, 0], corners[:, 1], corners[:, 2], had_data=True)

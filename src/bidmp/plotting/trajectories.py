@@ -12,7 +12,7 @@ from .._checks import as_points, as_trajectory, check_limit, check_path, short_t
 from ..primitives.timing import check_timestamps
 from ._base import _figure, _label_axes, _matplotlib, _save, _sequence, _text
 
-__all__ = ['plot_trajectories', 'plot_rollout', 'plot_generalisation', 'plot_recordings']
+__all__ = ["plot_trajectories", "plot_rollout", "plot_generalisation", "plot_recordings"]
 
 
 def plot_trajectories(
@@ -37,18 +37,27 @@ def plot_trajectories(
     demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
     n_dims = demonstration.shape[1]
     if n_dims not in (1, 2, 3):
-        raise ValueError(f"demonstration: can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}")
-    trajectories = [as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True)
-                    for i, t in enumerate(_sequence(trajectories, "trajectories"))]
+        raise ValueError(
+            f"demonstration: can only plot 1-, 2- or 3-D trajectories, got D = {n_dims}"
+        )
+    trajectories = [
+        as_trajectory(t, f"trajectories[{i}]", min_points=1, allow_static=True)
+        for i, t in enumerate(_sequence(trajectories, "trajectories"))
+    ]
     for index, trajectory in enumerate(trajectories):
         if trajectory.shape[1] != n_dims:
-            raise ValueError(f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}")
+            raise ValueError(
+                f"trajectories[{index}] has D = {trajectory.shape[1]}, the demonstration D = {n_dims}"
+            )
     check_limit(len(trajectories), "max_targets", "trajectories: the number drawn")
     if goals is not None:
         goals = as_points(goals, n_dims, "goals")
         check_limit(goals.shape[0], "max_targets", "goals: the number drawn")
     if labels is not None:
-        labels = [_text(label, f"labels[{index}]", 200) for index, label in enumerate(_sequence(labels, "labels"))]
+        labels = [
+            _text(label, f"labels[{index}]", 200)
+            for index, label in enumerate(_sequence(labels, "labels"))
+        ]
     title, units = _text(title, "title", 300), _text(units, "units", 16)
     path = check_path(path)
     mpl, fig, ax = _figure(n_dims == 3)
@@ -60,13 +69,22 @@ def plot_trajectories(
         return tuple(points[:, i] for i in range(n_dims))
 
     ax.plot(*coords(demonstration), color="0.55", linewidth=4, alpha=0.6, label="demonstration")
-    ax.scatter(*[[c[0]] for c in coords(demonstration)], color="k", marker="o", zorder=5, label="start")
+    ax.scatter(
+        *[[c[0]] for c in coords(demonstration)], color="k", marker="o", zorder=5, label="start"
+    )
     colours = mpl.cm.viridis(np.linspace(0.0, 0.9, max(len(trajectories), 1)))
     for index, trajectory in enumerate(trajectories):
         label = labels[index] if labels is not None and index < len(labels) else None
         ax.plot(*coords(trajectory), color=colours[index], linewidth=1.5, label=label)
     if goals is not None and n_dims > 1:
-        ax.scatter(*[goals[:, i] for i in range(n_dims)], marker="*", s=140, color="crimson", zorder=6, label="goals")
+        ax.scatter(
+            *[goals[:, i] for i in range(n_dims)],
+            marker="*",
+            s=140,
+            color="crimson",
+            zorder=6,
+            label="goals",
+        )
     _label_axes(ax, n_dims, units)
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
@@ -74,8 +92,13 @@ def plot_trajectories(
     return _save(fig, path)
 
 
-def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory, title: str = "rollout",
-                 units: str = "") -> Path:
+def plot_rollout(
+    path: str | os.PathLike,
+    demonstration: np.ndarray,
+    trajectory,
+    title: str = "rollout",
+    units: str = "",
+) -> Path:
     """A timed rollout: its path beside the demonstration's (left; 2-D or 3-D, more dimensions
     per coordinate against time) and its speed and acceleration over time (right; the norms, in
     units/s and units/s², the limits a robot checks first). A pose rollout
@@ -92,7 +115,9 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
     from ..primitives.timing import TimedMotion
 
     if not isinstance(trajectory, TimedMotion):
-        raise TypeError(f"trajectory must be a bidmp.Trajectory or PoseTrajectory, got {type(trajectory).__name__}")
+        raise TypeError(
+            f"trajectory must be a bidmp.Trajectory or PoseTrajectory, got {type(trajectory).__name__}"
+        )
     check_path(path)
     title, units = _text(title, "title", 200), _text(units, "units", 20)
     demonstration = as_trajectory(demonstration, "demonstration", min_points=1, allow_static=True)
@@ -104,9 +129,18 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
     spatial = n_dims in (2, 3)
     ax = fig.add_subplot(1, panels, 1, projection="3d" if n_dims == 3 else None)
     if spatial:
-        ax.plot(*demonstration[:, :n_dims].T, color="0.55", linewidth=4, alpha=0.6, label="reproduction")
+        ax.plot(
+            *demonstration[:, :n_dims].T, color="0.55", linewidth=4, alpha=0.6, label="reproduction"
+        )
         ax.plot(*trajectory.y.T, color="C0", linewidth=1.5, label="rollout")
-        ax.plot(*[[c] for c in trajectory.y[-1]], marker="*", markersize=12, color="crimson", linestyle="none", label="end")
+        ax.plot(
+            *[[c] for c in trajectory.y[-1]],
+            marker="*",
+            markersize=12,
+            color="crimson",
+            linestyle="none",
+            label="end",
+        )
         if quaternions is not None:
             _draw_frames(ax, trajectory.y, quaternions)
         _label_axes(ax, n_dims, units)
@@ -120,14 +154,24 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
     ax.legend(loc="best", fontsize=8)
     rates = fig.add_subplot(1, panels, 2)
     suffix = units or "units"
-    rates.plot(trajectory.t, np.linalg.norm(trajectory.yd, axis=1), color="C0", label=f"speed [{suffix}/s]")
+    rates.plot(
+        trajectory.t, np.linalg.norm(trajectory.yd, axis=1), color="C0", label=f"speed [{suffix}/s]"
+    )
     rates.set_xlabel("t [s]")
     rates.set_ylabel(f"speed [{suffix}/s]", color="C0")
     twin = rates.twinx()
-    twin.plot(trajectory.t, np.linalg.norm(trajectory.ydd, axis=1), color="C3", label=f"acceleration [{suffix}/s²]")
+    twin.plot(
+        trajectory.t,
+        np.linalg.norm(trajectory.ydd, axis=1),
+        color="C3",
+        label=f"acceleration [{suffix}/s²]",
+    )
     twin.set_ylabel(f"acceleration [{suffix}/s²]", color="C3")
-    rates.set_title(f"peak speed {trajectory.peak_speed():.3g} {suffix}/s, peak acceleration "
-                    f"{trajectory.peak_acceleration():.3g} {suffix}/s²", fontsize=10)
+    rates.set_title(
+        f"peak speed {trajectory.peak_speed():.3g} {suffix}/s, peak acceleration "
+        f"{trajectory.peak_acceleration():.3g} {suffix}/s²",
+        fontsize=10,
+    )
     rates.grid(True, alpha=0.3)
     if quaternions is not None:
         turn, tilt = _tool_angles(quaternions)
@@ -136,10 +180,15 @@ def plot_rollout(path: str | os.PathLike, demonstration: np.ndarray, trajectory,
         angles.plot(trajectory.t, tilt, color="C4", label="tilt of the tool's z axis")
         angles.set_xlabel("t [s]")
         angles.set_ylabel("angle from the start's orientation [deg]")
-        angles.set_title(f"orientation: turned {turn[-1]:.4g} deg, tilted {tilt[-1]:.3g} deg at the end", fontsize=10)
+        angles.set_title(
+            f"orientation: turned {turn[-1]:.4g} deg, tilted {tilt[-1]:.3g} deg at the end",
+            fontsize=10,
+        )
         angles.legend(loc="best", fontsize=8)
         angles.grid(True, alpha=0.3)
-        fig.subplots_adjust(left=0.04, right=0.97, wspace=0.42)  # room for the middle panel's second axis
+        fig.subplots_adjust(
+            left=0.04, right=0.97, wspace=0.42
+        )  # room for the middle panel's second axis
     return _save(fig, path)
 
 
@@ -178,11 +227,19 @@ def _draw_frames(ax, positions: np.ndarray, quaternions: np.ndarray, count: int 
     if positions.shape[1] != 3:
         return
     extent = float(np.max(np.ptp(positions, axis=0))) or 1.0
-    chosen = np.unique(np.linspace(0, len(positions) - 1, min(count, len(positions))).round().astype(int))
+    chosen = np.unique(
+        np.linspace(0, len(positions) - 1, min(count, len(positions))).round().astype(int)
+    )
     axes = Rotation.from_quat(quaternions[chosen]).as_matrix() * (0.1 * extent)
     for column, colour in enumerate(("tab:red", "tab:green", "tab:blue")):
-        ax.quiver(*positions[chosen].T, *axes[:, :, column].T, color=colour, linewidth=1.0, arrow_length_ratio=0.15,
-                  label=f"tool {'xyz'[column]} axis")
+        ax.quiver(
+            *positions[chosen].T,
+            *axes[:, :, column].T,
+            color=colour,
+            linewidth=1.0,
+            arrow_length_ratio=0.15,
+            label=f"tool {'xyz'[column]} axis",
+        )
 
 
 def plot_generalisation(path: str | os.PathLike, result) -> Path:
@@ -191,14 +248,26 @@ def plot_generalisation(path: str | os.PathLike, result) -> Path:
     mpl = _matplotlib()
     fig, axes = mpl.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
     panels = (
-        (result.fixed_horizon, f"T = {result.demonstration.shape[0]} steps (paper): end-point gain c = {result.endpoint_gain:.3f}"),
-        (result.converged, f"{result.converged.shape[1]} steps (run to convergence): c = {result.endpoint_gain_converged:.1e}"),
+        (
+            result.fixed_horizon,
+            f"T = {result.demonstration.shape[0]} steps (paper): end-point gain c = {result.endpoint_gain:.3f}",
+        ),
+        (
+            result.converged,
+            f"{result.converged.shape[1]} steps (run to convergence): c = {result.endpoint_gain_converged:.1e}",
+        ),
     )
     colours = mpl.cm.viridis(np.linspace(0.0, 0.85, len(result.goals)))
     for ax, (rollouts, title) in zip(axes, panels):
         demo = result.demonstration
         ax.plot(demo[:, 0], demo[:, 1], color="0.55", linewidth=4, alpha=0.6, label="demonstration")
-        ax.plot(result.reproduction[:, 0], result.reproduction[:, 1], "k--", linewidth=1, label="reproduction")
+        ax.plot(
+            result.reproduction[:, 0],
+            result.reproduction[:, 1],
+            "k--",
+            linewidth=1,
+            label="reproduction",
+        )
         for colour, rollout, goal in zip(colours, rollouts, result.goals):
             ax.plot(rollout[:, 0], rollout[:, 1], color=colour, linewidth=1.3)
             ax.plot(*goal, marker="*", markersize=12, color=colour, markeredgecolor="crimson")
@@ -223,7 +292,9 @@ def _recording(entry, index: int) -> tuple:
 
     where = f"recordings[{index}]"
     if not isinstance(entry, (tuple, list)) or len(entry) != 6:
-        raise TypeError(f"{where} must be (name, y, t, prepared, info, moved), got {short_token(entry, 30)}")
+        raise TypeError(
+            f"{where} must be (name, y, t, prepared, info, moved), got {short_token(entry, 30)}"
+        )
     name, y, t, prepared, info, moved = entry
     name = _text(name, f"{where}'s name", 100)
     y = as_trajectory(y, f"{where}'s y", min_points=2)
@@ -231,7 +302,9 @@ def _recording(entry, index: int) -> tuple:
     if not isinstance(prepared, Trajectory) or not isinstance(info, PrepareInfo):
         raise TypeError(f"{where}: prepared and info must be what bidmp.prepare returns")
     if moved is not None and not isinstance(moved, Trajectory):
-        raise TypeError(f"{where}: moved must be a bidmp.Trajectory or None, got {type(moved).__name__}")
+        raise TypeError(
+            f"{where}: moved must be a bidmp.Trajectory or None, got {type(moved).__name__}"
+        )
     return name, y, t, prepared, info, moved
 
 
@@ -245,7 +318,9 @@ def plot_recordings(path, recordings) -> Path:
         ``y``, ``t``: the recording; ``prepared``, ``info``: :func:`bidmp.prepare`'s result;
         ``moved``: a :class:`bidmp.Trajectory` (the rollout to the moved goal), or None.
     """
-    recordings = [_recording(entry, index) for index, entry in enumerate(_sequence(recordings, "recordings"))]
+    recordings = [
+        _recording(entry, index) for index, entry in enumerate(_sequence(recordings, "recordings"))
+    ]
     if not recordings:
         raise ValueError("recordings is empty: nothing to draw")
     path = check_path(path)
@@ -258,21 +333,43 @@ def plot_recordings(path, recordings) -> Path:
         side.plot(y[:, 0], y[:, 2], color=colour, alpha=0.35, linewidth=3)
         raw_speed = np.linalg.norm(np.gradient(y, t, axis=0), axis=1)
         speed.plot(t - t[0], raw_speed, color=colour, alpha=0.25, linewidth=0.6)
-        speed.plot(prepared.t + info.start_s, np.linalg.norm(prepared.yd, axis=1), color=colour, linewidth=2,
-                   label=f"{name}: prepared, kept {info.start_s:.2f}-{info.end_s:.2f} s")
+        speed.plot(
+            prepared.t + info.start_s,
+            np.linalg.norm(prepared.yd, axis=1),
+            color=colour,
+            linewidth=2,
+            label=f"{name}: prepared, kept {info.start_s:.2f}-{info.end_s:.2f} s",
+        )
         if moved is not None:
-            top.plot(moved.y[:, 0], moved.y[:, 1], color=colour, linewidth=1.2, label="DMP to the moved goal")
+            top.plot(
+                moved.y[:, 0],
+                moved.y[:, 1],
+                color=colour,
+                linewidth=1.2,
+                label="DMP to the moved goal",
+            )
             side.plot(moved.y[:, 0], moved.y[:, 2], color=colour, linewidth=1.2)
-            speed.plot(moved.t + info.start_s, np.linalg.norm(moved.yd, axis=1), color=colour, linestyle="--", linewidth=1)
+            speed.plot(
+                moved.t + info.start_s,
+                np.linalg.norm(moved.yd, axis=1),
+                color=colour,
+                linestyle="--",
+                linewidth=1,
+            )
             top.plot(moved.y[-1, 0], moved.y[-1, 1], marker="*", markersize=12, color="crimson")
             side.plot(moved.y[-1, 0], moved.y[-1, 2], marker="*", markersize=12, color="crimson")
     units = recordings[0][3].units if recordings else ""
     suffix = f" [{units}]" if units else ""
     top.set(xlabel="x" + suffix, ylabel="y" + suffix, title="top view")
     side.set(xlabel="x" + suffix, ylabel="z" + suffix, title="side view")
-    speed.set(xlabel="time in the recording [s]", ylabel=f"speed [{units or 'units'}/s]",
-              title="speed: raw (thin), prepared, rollout (dashed)")
-    speed.set_ylim(0.0, 1.3 * max(float(np.max(np.linalg.norm(r[3].yd, axis=1))) for r in recordings))
+    speed.set(
+        xlabel="time in the recording [s]",
+        ylabel=f"speed [{units or 'units'}/s]",
+        title="speed: raw (thin), prepared, rollout (dashed)",
+    )
+    speed.set_ylim(
+        0.0, 1.3 * max(float(np.max(np.linalg.norm(r[3].yd, axis=1))) for r in recordings)
+    )
     top.legend(fontsize=7, loc="lower right")
     speed.legend(fontsize=7, loc="upper right")
     for axes in (top, side, speed):

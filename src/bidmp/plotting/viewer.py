@@ -35,12 +35,28 @@ from .._checks import (
 from ..io.atomic import atomic_write
 from ..io.strict_json import load_json
 
-__all__ = ["ViewLayers", "layers_from_report", "add_robot_motions", "solid_layer", "solid_mesh", "view_figure", "write_view",
-           "save_layers", "load_layers", "VIEW_FORMAT"]
+__all__ = [
+    "ViewLayers",
+    "layers_from_report",
+    "add_robot_motions",
+    "solid_layer",
+    "solid_mesh",
+    "view_figure",
+    "write_view",
+    "save_layers",
+    "load_layers",
+    "VIEW_FORMAT",
+]
 
 VIEW_FORMAT = 1  # of view_layers.npz
-_COLOURS = {"dmp": "#1f77b4", "dmp-converged": "#17becf", "bidmp": "#d62728", "bidmp-latest": "#bcbd22",
-            "gmm": "#9467bd", "tpgmm": "#8c564b"}
+_COLOURS = {
+    "dmp": "#1f77b4",
+    "dmp-converged": "#17becf",
+    "bidmp": "#d62728",
+    "bidmp-latest": "#bcbd22",
+    "gmm": "#9467bd",
+    "tpgmm": "#8c564b",
+}
 WARNING = "#ffc000"  # amber: a motion that breaks the contract, and the part it came too close to (not the robot joints' dark orange)
 
 
@@ -81,15 +97,31 @@ def _xyz(points) -> np.ndarray:
 def layers_from_report(report) -> ViewLayers:
     """The layers of a finished evaluation (:func:`bidmp.evaluate`)."""
     scenario = report.scenario
-    points = [_xyz(e.demonstration)[e.segmentation_points] for e in report.extensions if len(e.segmentation_points)]
+    points = [
+        _xyz(e.demonstration)[e.segmentation_points]
+        for e in report.extensions
+        if len(e.segmentation_points)
+    ]
     solids = [] if scenario.scene is None else [solid_layer(s) for s in scenario.scene.solids]
     return ViewLayers(
-        title=scenario.name, units=scenario.units, demonstration=_xyz(scenario.demonstration),
-        targets={label: _xyz(np.atleast_2d(target))[0] for label, target in scenario.targets.items()},
+        title=scenario.name,
+        units=scenario.units,
+        demonstration=_xyz(scenario.demonstration),
+        targets={
+            label: _xyz(np.atleast_2d(target))[0] for label, target in scenario.targets.items()
+        },
         segmentation=np.vstack(points) if points else np.zeros((0, 3)),
-        extended=[_xyz(e.complete) for e in report.extensions] + [_xyz(t) for t in scenario.demonstrations.values()],
-        rollouts={name: {label: _xyz(r) for label, r in result.rollouts.items()} for name, result in report.methods.items()},
-        solids=solids, failures={name: _failures(result) for name, result in report.methods.items() if _failures(result)})
+        extended=[_xyz(e.complete) for e in report.extensions]
+        + [_xyz(t) for t in scenario.demonstrations.values()],
+        rollouts={
+            name: {label: _xyz(r) for label, r in result.rollouts.items()}
+            for name, result in report.methods.items()
+        },
+        solids=solids,
+        failures={
+            name: _failures(result) for name, result in report.methods.items() if _failures(result)
+        },
+    )
 
 
 def _failures(result) -> dict:
@@ -100,9 +132,11 @@ def _failures(result) -> dict:
             continue
         clearance = result.clearance_at(label)
         close = clearance is not None and not clearance.clear and clearance.point is not None
-        failed[label] = {"reason": result.reason_at(label) or "breaks the motion contract",
-                         "part": clearance.part if close else None,
-                         "point": _xyz(np.atleast_2d(clearance.point))[0].tolist() if close else None}
+        failed[label] = {
+            "reason": result.reason_at(label) or "breaks the motion contract",
+            "part": clearance.part if close else None,
+            "point": _xyz(np.atleast_2d(clearance.point))[0].tolist() if close else None,
+        }
     return failed
 
 
@@ -112,20 +146,28 @@ def solid_layer(solid) -> dict:
 
     if not isinstance(solid, Solid):
         raise TypeError(f"solid must be a bidmp.scene.Solid, got {type(solid).__name__}")
-    return {"label": solid.label, "kind": solid.kind, "centre": np.asarray(solid.centre, float).tolist(),
-            "rotation": np.asarray(solid.rotation, float).tolist(),
-            "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in solid.params]}
+    return {
+        "label": solid.label,
+        "kind": solid.kind,
+        "centre": np.asarray(solid.centre, float).tolist(),
+        "rotation": np.asarray(solid.rotation, float).tolist(),
+        "params": [np.asarray(v, float).tolist() if np.ndim(v) else float(v) for v in solid.params],
+    }
 
 
 def add_robot_motions(layers: ViewLayers, sim_report) -> ViewLayers:
     """Add the arm's motions a simulation recorded (``SimReport.motions``), in scene units."""
     for (method, label), motion in getattr(sim_report, "motions", {}).items():
-        layers.robot[f"{method} -> {label}"] = {"times": np.asarray(motion["times"], float),
-                                               "links": np.asarray(motion["links"], float)}
+        layers.robot[f"{method} -> {label}"] = {
+            "times": np.asarray(motion["times"], float),
+            "links": np.asarray(motion["links"], float),
+        }
     return layers
 
 
-def solid_mesh(kind: str, centre, rotation, params, sides: int = 24) -> tuple[np.ndarray, np.ndarray]:
+def solid_mesh(
+    kind: str, centre, rotation, params, sides: int = 24
+) -> tuple[np.ndarray, np.ndarray]:
     """A triangle mesh of a scene solid: vertices (n, 3) and faces (m, 3) (vertex indices).
 
     Boxes: 8 corners; cylinders: ``sides`` around each cap; convex: the hull of its vertices
@@ -135,8 +177,14 @@ def solid_mesh(kind: str, centre, rotation, params, sides: int = 24) -> tuple[np
     kind = check_choice(kind, "kind", ("box", "cylinder", "convex"))
     centre, rotation = as_point(centre, 3, "centre"), as_rotation(rotation, "rotation")
     sides = check_int(sides, "sides", minimum=3, maximum=1024)
-    if not isinstance(params, (tuple, list, np.ndarray)) or getattr(params, "ndim", 1) == 0 or len(params) == 0:
-        raise TypeError(f"params must be the solid's parameters (a tuple), got {type(params).__name__}")
+    if (
+        not isinstance(params, (tuple, list, np.ndarray))
+        or getattr(params, "ndim", 1) == 0
+        or len(params) == 0
+    ):
+        raise TypeError(
+            f"params must be the solid's parameters (a tuple), got {type(params).__name__}"
+        )
     if kind == "box":
         half = as_vector(params, "params", length=3, positive=True) / 2.0
         local = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half
@@ -144,29 +192,54 @@ def solid_mesh(kind: str, centre, rotation, params, sides: int = 24) -> tuple[np
         radius, height = as_vector(params, "params", length=2, positive=True)
         angles = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
         ring = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
-        local = np.vstack([np.column_stack([ring, np.full(sides, z)]) for z in (-height / 2, height / 2)])
+        local = np.vstack(
+            [np.column_stack([ring, np.full(sides, z)]) for z in (-height / 2, height / 2)]
+        )
     else:
         local = as_trajectory(params[0], "params[0]", min_points=4)
         if local.shape[1] != 3 or np.linalg.matrix_rank(local - local.mean(axis=0)) < 3:
-            raise ValueError("params[0] must be the convex solid's vertices (n, 3), spanning a volume")
+            raise ValueError(
+                "params[0] must be the convex solid's vertices (n, 3), spanning a volume"
+            )
     vertices = local @ rotation.T + centre
     return vertices, ConvexHull(vertices).simplices  # every solid here is convex
 
 
 def _path(go, points, name, colour, group, show, **line):
-    return go.Scatter3d(x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="lines", name=name, legendgroup=group,
-                        showlegend=show, line={"color": colour, **line}, hoverinfo="name")
+    return go.Scatter3d(
+        x=points[:, 0],
+        y=points[:, 1],
+        z=points[:, 2],
+        mode="lines",
+        name=name,
+        legendgroup=group,
+        showlegend=show,
+        line={"color": colour, **line},
+        hoverinfo="name",
+    )
 
 
 def _static_traces(go, layers: ViewLayers) -> list:
     """Every layer but the robot: paths, points and the parts' meshes, one legend entry each."""
-    traces = [_path(go, layers.demonstration, "demonstration", "black", "demonstration", True, width=7)]
+    traces = [
+        _path(go, layers.demonstration, "demonstration", "black", "demonstration", True, width=7)
+    ]
     if len(layers.segmentation):
         s = layers.segmentation
-        traces.append(go.Scatter3d(x=s[:, 0], y=s[:, 1], z=s[:, 2], mode="markers", name="segmentation points",
-                                   marker={"symbol": "diamond", "size": 5, "color": "black"}))
+        traces.append(
+            go.Scatter3d(
+                x=s[:, 0],
+                y=s[:, 1],
+                z=s[:, 2],
+                mode="markers",
+                name="segmentation points",
+                marker={"symbol": "diamond", "size": 5, "color": "black"},
+            )
+        )
     for index, path in enumerate(layers.extended):
-        traces.append(_path(go, path, "extended demonstrations", "goldenrod", "extended", index == 0, width=5))
+        traces.append(
+            _path(go, path, "extended demonstrations", "goldenrod", "extended", index == 0, width=5)
+        )
     close_parts = {}
     for method, paths in layers.rollouts.items():
         failures = layers.failures.get(method, {})
@@ -175,38 +248,102 @@ def _static_traces(go, layers: ViewLayers) -> list:
             visible = True if method in ("bidmp", "dmp") else "legendonly"
             if label in failures:
                 failure = failures[label]
-                trace = _path(go, path, f"{method}: breaks the contract", WARNING, f"{method} failing",
-                              label == next(iter(failures)), width=5, dash="dash")
+                trace = _path(
+                    go,
+                    path,
+                    f"{method}: breaks the contract",
+                    WARNING,
+                    f"{method} failing",
+                    label == next(iter(failures)),
+                    width=5,
+                    dash="dash",
+                )
                 trace.update(visible=visible, hovertext=f"{method} -> {label}: {failure['reason']}")
                 traces.append(trace)
                 if failure.get("point") is not None:
                     point = np.asarray(failure["point"], dtype=float)
-                    traces.append(go.Scatter3d(
-                        x=[point[0]], y=[point[1]], z=[point[2]], mode="markers+text", legendgroup=f"{method} failing",
-                        showlegend=False, visible=visible, text=[f"{label}: too close to {failure['part']}"],
-                        marker={"symbol": "x", "size": 6, "color": WARNING}, hovertext=failure["reason"], hoverinfo="text"))
+                    traces.append(
+                        go.Scatter3d(
+                            x=[point[0]],
+                            y=[point[1]],
+                            z=[point[2]],
+                            mode="markers+text",
+                            legendgroup=f"{method} failing",
+                            showlegend=False,
+                            visible=visible,
+                            text=[f"{label}: too close to {failure['part']}"],
+                            marker={"symbol": "x", "size": 6, "color": WARNING},
+                            hovertext=failure["reason"],
+                            hoverinfo="text",
+                        )
+                    )
                     close_parts.setdefault(failure["part"], []).append(f"{method} -> {label}")
                 continue
-            trace = _path(go, path, f"{method} rollouts", _COLOURS.get(method, "#2ca02c"), method, label == shown[0], width=2)
+            trace = _path(
+                go,
+                path,
+                f"{method} rollouts",
+                _COLOURS.get(method, "#2ca02c"),
+                method,
+                label == shown[0],
+                width=2,
+            )
             trace.update(visible=visible, hovertext=f"{method} -> {label}")
             traces.append(trace)
     if layers.targets:
         t = np.array(list(layers.targets.values()))
-        traces.append(go.Scatter3d(x=t[:, 0], y=t[:, 1], z=t[:, 2], mode="markers+text", name="targets",
-                                   text=list(layers.targets), marker={"size": 3, "color": "green"}))
+        traces.append(
+            go.Scatter3d(
+                x=t[:, 0],
+                y=t[:, 1],
+                z=t[:, 2],
+                mode="markers+text",
+                name="targets",
+                text=list(layers.targets),
+                marker={"size": 3, "color": "green"},
+            )
+        )
     first_close = True
     for index, solid in enumerate(layers.solids):
-        vertices, faces = solid_mesh(solid["kind"], solid["centre"], solid["rotation"], solid["params"])
-        mesh = {"x": vertices[:, 0], "y": vertices[:, 1], "z": vertices[:, 2], "i": faces[:, 0], "j": faces[:, 1],
-                "k": faces[:, 2], "hoverinfo": "text"}
-        if solid["label"] in close_parts:  # a part a failing motion came too close to: in the warning colour
-            traces.append(go.Mesh3d(**mesh, color=WARNING, opacity=0.7, name="parts motions came too close to",
-                                    legendgroup="too close", showlegend=first_close,
-                                    hovertext=f"{solid['label']}: too close for {', '.join(close_parts[solid['label']])}"))
+        vertices, faces = solid_mesh(
+            solid["kind"], solid["centre"], solid["rotation"], solid["params"]
+        )
+        mesh = {
+            "x": vertices[:, 0],
+            "y": vertices[:, 1],
+            "z": vertices[:, 2],
+            "i": faces[:, 0],
+            "j": faces[:, 1],
+            "k": faces[:, 2],
+            "hoverinfo": "text",
+        }
+        if (
+            solid["label"] in close_parts
+        ):  # a part a failing motion came too close to: in the warning colour
+            traces.append(
+                go.Mesh3d(
+                    **mesh,
+                    color=WARNING,
+                    opacity=0.7,
+                    name="parts motions came too close to",
+                    legendgroup="too close",
+                    showlegend=first_close,
+                    hovertext=f"{solid['label']}: too close for {', '.join(close_parts[solid['label']])}",
+                )
+            )
             first_close = False
             continue
-        traces.append(go.Mesh3d(**mesh, color="lightsteelblue", opacity=0.35, name="scene parts",
-                                legendgroup="scene", showlegend=index == 0, hovertext=solid["label"]))
+        traces.append(
+            go.Mesh3d(
+                **mesh,
+                color="lightsteelblue",
+                opacity=0.35,
+                name="scene parts",
+                legendgroup="scene",
+                showlegend=index == 0,
+                hovertext=solid["label"],
+            )
+        )
     return traces
 
 
@@ -222,9 +359,20 @@ def _robot_frames(go, layers: ViewLayers, first: int) -> tuple[list, list, list]
             if not trace:
                 trace.append(data)
             frames.append(go.Frame(name=key, data=[data], traces=[first]))
-            steps.append({"label": key, "method": "animate",
-                          "args": [[key], {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
-                                           "transition": {"duration": 0}}]})
+            steps.append(
+                {
+                    "label": key,
+                    "method": "animate",
+                    "args": [
+                        [key],
+                        {
+                            "mode": "immediate",
+                            "frame": {"duration": 0, "redraw": True},
+                            "transition": {"duration": 0},
+                        },
+                    ],
+                }
+            )
     return trace, frames, steps
 
 
@@ -242,19 +390,60 @@ def view_figure(layers: ViewLayers):
     figure = go.Figure(data=traces + robot, frames=frames)
     figure.update_layout(
         title=f"{layers.title}: drag to turn, scroll to zoom, click a legend entry to hide it",
-        scene={"xaxis_title": "x" + unit, "yaxis_title": "y" + unit, "zaxis_title": "z" + unit, "aspectmode": "data"},
-        legend={"itemsizing": "constant"}, margin={"l": 0, "r": 0, "t": 40, "b": 0}, height=800)
+        scene={
+            "xaxis_title": "x" + unit,
+            "yaxis_title": "y" + unit,
+            "zaxis_title": "z" + unit,
+            "aspectmode": "data",
+        },
+        legend={"itemsizing": "constant"},
+        margin={"l": 0, "r": 0, "t": 40, "b": 0},
+        height=800,
+    )
     if frames:
         figure.update_layout(
             # Tick labels hidden (one per 40 ms would overlap); the current one is shown above.
-            sliders=[{"steps": steps, "currentvalue": {"prefix": "robot: ", "font": {"color": "#333333"}},
-                      "font": {"color": "rgba(0,0,0,0)"}, "x": 0.12, "len": 0.86, "pad": {"t": 10}}],
-            updatemenus=[{"type": "buttons", "showactive": False, "direction": "right", "x": 0.0, "y": 0.0,
-                          "xanchor": "left", "yanchor": "top", "pad": {"t": 20}, "buttons": [
-                {"label": "play", "method": "animate",
-                 "args": [None, {"frame": {"duration": 40, "redraw": True}, "fromcurrent": True}]},
-                {"label": "pause", "method": "animate",
-                 "args": [[None], {"mode": "immediate", "frame": {"duration": 0, "redraw": False}}]}]}])
+            sliders=[
+                {
+                    "steps": steps,
+                    "currentvalue": {"prefix": "robot: ", "font": {"color": "#333333"}},
+                    "font": {"color": "rgba(0,0,0,0)"},
+                    "x": 0.12,
+                    "len": 0.86,
+                    "pad": {"t": 10},
+                }
+            ],
+            updatemenus=[
+                {
+                    "type": "buttons",
+                    "showactive": False,
+                    "direction": "right",
+                    "x": 0.0,
+                    "y": 0.0,
+                    "xanchor": "left",
+                    "yanchor": "top",
+                    "pad": {"t": 20},
+                    "buttons": [
+                        {
+                            "label": "play",
+                            "method": "animate",
+                            "args": [
+                                None,
+                                {"frame": {"duration": 40, "redraw": True}, "fromcurrent": True},
+                            ],
+                        },
+                        {
+                            "label": "pause",
+                            "method": "animate",
+                            "args": [
+                                [None],
+                                {"mode": "immediate", "frame": {"duration": 0, "redraw": False}},
+                            ],
+                        },
+                    ],
+                }
+            ],
+        )
     return figure
 
 
@@ -285,10 +474,18 @@ def save_layers(path, layers: ViewLayers) -> Path:
     for k, (name, motion) in enumerate(layers.robot.items()):
         arrays[f"robot_times_{k}"], arrays[f"robot_links_{k}"] = motion["times"], motion["links"]
         robot[name] = k
-    meta = {"format": VIEW_FORMAT, "kind": "bidmp-view", "title": layers.title, "units": layers.units,
-            "targets": {label: np.asarray(t, float).tolist() for label, t in layers.targets.items()},
-            "n_extended": len(layers.extended), "rollouts": rollouts, "solids": layers.solids, "robot": robot,
-            "failures": layers.failures}
+    meta = {
+        "format": VIEW_FORMAT,
+        "kind": "bidmp-view",
+        "title": layers.title,
+        "units": layers.units,
+        "targets": {label: np.asarray(t, float).tolist() for label, t in layers.targets.items()},
+        "n_extended": len(layers.extended),
+        "rollouts": rollouts,
+        "solids": layers.solids,
+        "robot": robot,
+        "failures": layers.failures,
+    }
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     with atomic_write(path, "wb") as handle:
         np.savez_compressed(handle, **{k: np.asarray(v) for k, v in arrays.items()})
@@ -307,15 +504,20 @@ def _json_bytes(shape, dtype) -> None:
 
 def _checked_failures(failures) -> dict:
     """A view file's failures, each entry of the shape :class:`ViewLayers` documents."""
-    if not isinstance(failures, dict) or not all(isinstance(entries, dict) for entries in failures.values()):
+    if not isinstance(failures, dict) or not all(
+        isinstance(entries, dict) for entries in failures.values()
+    ):
         raise ValueError("its failures are not a mapping of method -> label -> failure")
     for entries in failures.values():
         for failure in entries.values():
             if not isinstance(failure, dict) or not isinstance(failure.get("reason"), str):
                 raise ValueError("a failure has no reason")
             point = failure.get("point")
-            if point is not None and (not isinstance(point, list) or len(point) != 3
-                                      or not all(isinstance(v, (int, float)) for v in point)):
+            if point is not None and (
+                not isinstance(point, list)
+                or len(point) != 3
+                or not all(isinstance(v, (int, float)) for v in point)
+            ):
                 raise ValueError("a failure's point is not three numbers")
     return failures
 
@@ -331,15 +533,28 @@ def load_layers(path) -> ViewLayers:
             if not isinstance(meta, dict) or meta.get("kind") != "bidmp-view":
                 raise ValueError("it is not a bidmp view file")
             if meta.get("format") != VIEW_FORMAT:
-                raise ValueError(f"its format {short_token(meta.get('format'))} is not {VIEW_FORMAT}")
+                raise ValueError(
+                    f"its format {short_token(meta.get('format'))} is not {VIEW_FORMAT}"
+                )
             return ViewLayers(
-                title=meta["title"], units=meta["units"], demonstration=data["demonstration"],
+                title=meta["title"],
+                units=meta["units"],
+                demonstration=data["demonstration"],
                 targets={label: np.asarray(t) for label, t in meta["targets"].items()},
-                segmentation=data["segmentation"], extended=[data[f"extended_{i}"] for i in range(meta["n_extended"])],
-                rollouts={method: {label: data[key] for label, key in pairs} for method, pairs in meta["rollouts"].items()},
+                segmentation=data["segmentation"],
+                extended=[data[f"extended_{i}"] for i in range(meta["n_extended"])],
+                rollouts={
+                    method: {label: data[key] for label, key in pairs}
+                    for method, pairs in meta["rollouts"].items()
+                },
                 solids=meta["solids"],
-                robot={name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
-                       for name, k in meta["robot"].items()},
-                failures=_checked_failures(meta.get("failures", {})))  # absent in files of bidmp 0.5
+                robot={
+                    name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
+                    for name, k in meta["robot"].items()
+                },
+                failures=_checked_failures(meta.get("failures", {})),
+            )  # absent in files of bidmp 0.5
     except (KeyError, ValueError, TypeError, AttributeError) as exc:
-        raise ValueError(f"{path}: cannot read a bidmp view ({printable(str(exc))[:120]})") from None
+        raise ValueError(
+            f"{path}: cannot read a bidmp view ({printable(str(exc))[:120]})"
+        ) from None

@@ -42,7 +42,13 @@ class GridQueries:
         """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
         self._check_fitted()
         params = self._params()
-        return phase_grid(self._n_steps(n_steps, params), self.dt_, params.tau, params.alpha_phase, exact=params.exact)
+        return phase_grid(
+            self._n_steps(n_steps, params),
+            self.dt_,
+            params.tau,
+            params.alpha_phase,
+            exact=params.exact,
+        )
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Phase (n,) and basis rows (n, N) on the rollout grid (default length
@@ -77,10 +83,14 @@ class GridQueries:
         own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
         asks for it once per stepper)."""
         if params is not None and not isinstance(params, _Params):
-            raise TypeError(f"goal_system: params must be a DMP's resolved parameters (or None), got {type(params).__name__}")
+            raise TypeError(
+                f"goal_system: params must be a DMP's resolved parameters (or None), got {type(params).__name__}"
+            )
         params = self._params() if params is None else params
         if params.goal_rate is not None:
-            return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(params.goal_rate)
+            return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(
+                params.goal_rate
+            )
         return _learned_progress_gate(self, params)
 
     def training_trajectory(self, y) -> np.ndarray:
@@ -118,7 +128,9 @@ class GridQueries:
         if cached is not None:
             goal_response = cached[5][0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
-            phase = phase_grid(n_steps, self.dt_, params.tau, params.alpha_phase, exact=params.exact)
+            phase = phase_grid(
+                n_steps, self.dt_, params.tau, params.alpha_phase, exact=params.exact
+            )
             gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
             goal_response = _unit_responses(params, phase, None, self.dt_, gate)[0]
         return float(abs(1.0 - goal_response[-1]))

@@ -30,16 +30,24 @@ class Motions:
         _check_integration(self.dt_ if step is None else step, params)
         return params
 
-    def _prepare(self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None):
+    def _prepare(
+        self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None
+    ):
         _check_forcing_increment(forcing_increment)
         params = self._rollout_params(step) if params is None else params
         step = self.dt_ if step is None else step
         n_dims = self.weights_.shape[1]
         n_steps = self._n_steps(n_steps, params)
         start = self.start_ if start is None else as_point(start, n_dims, "start")
-        velocity = None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(self, params, n_steps, step)
-        change = getattr(forcing_increment, "weight_change", None)  # via-points: a change of the weights
+        velocity = (
+            None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        )
+        phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(
+            self, params, n_steps, step
+        )
+        change = getattr(
+            forcing_increment, "weight_change", None
+        )  # via-points: a change of the weights
         forcing = basis @ (self.weights_ if change is None else self.weights_ + change)
         if change is not None:
             forcing_increment = forcing_increment.wrapped
@@ -52,12 +60,21 @@ class Motions:
         # lfilter runs in C, outside NumPy's floating-point checks: check its output once. With
         # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
         if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
-            raise ValueError("rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range")
+            raise ValueError(
+                "rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range"
+            )
         return free, goal_response, forcing, gate
 
     @numerically_guarded
-    def rollout(self, goal=None, *, start=None, n_steps: int | None = None, start_velocity=None,
-                forcing_increment=None) -> np.ndarray:
+    def rollout(
+        self,
+        goal=None,
+        *,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+    ) -> np.ndarray:
         """Generate a trajectory on the normalised grid, one sample every ``dt_`` (``duration_ /
         (T - 1)`` seconds at ``tau = 1``), with the protocol's integrator (robot: exact; paper:
         explicit Euler, Eq. 14).
@@ -88,8 +105,16 @@ class Motions:
         return free + np.outer(goal_response, goal)
 
     @numerically_guarded
-    def rollout_many(self, goals, *, start=None, n_steps: int | None = None, start_velocity=None,
-                     forcing_increment=None, out: np.ndarray | None = None) -> np.ndarray:
+    def rollout_many(
+        self,
+        goals,
+        *,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+        out: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
 
         Parameters
@@ -112,8 +137,16 @@ class Motions:
         free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
         return _rollouts_to(goals, free, goal_response, out)
 
-    def iter_rollouts(self, goals, *, chunk_size: int = 1024, start=None, n_steps: int | None = None,
-                      start_velocity=None, forcing_increment=None):
+    def iter_rollouts(
+        self,
+        goals,
+        *,
+        chunk_size: int = 1024,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+    ):
         """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
 
         Yields
@@ -123,14 +156,27 @@ class Motions:
         """
         chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
         with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
-            free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
+            free, goal_response, *_ = self._prepare(
+                start, start_velocity, n_steps, forcing_increment
+            )
         yield from _iter_rollouts_to(goals, free, goal_response, chunk_size)
 
     # -- real time -------------------------------------------------------------------------------
     @numerically_guarded
-    def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, start_velocity=None, forcing_increment=None, coupling=None, via=None,
-                   via_until: float | None = None):
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        start=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        limits: dict | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+        coupling=None,
+        via=None,
+        via_until: float | None = None,
+    ):
         """A timed rollout: positions, velocities and accelerations in seconds.
 
         Parameters
@@ -184,16 +230,39 @@ class Motions:
         self._check_fitted()
         _check_forcing_increment(forcing_increment)  # every path below takes it
         if via is not None:
-            return _via_trajectory(self, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
-                                   via_until)
+            return _via_trajectory(
+                self,
+                goal,
+                start,
+                duration,
+                dt,
+                limits,
+                start_velocity,
+                forcing_increment,
+                coupling,
+                via,
+                via_until,
+            )
         if limits is not None:
-            return _limited_trajectory(self, goal, start, dt, limits, start_velocity, forcing_increment, coupling)
+            return _limited_trajectory(
+                self, goal, start, dt, limits, start_velocity, forcing_increment, coupling
+            )
         if coupling is not None:
-            return _coupled_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment, coupling)
+            return _coupled_trajectory(
+                self, goal, start, duration, dt, start_velocity, forcing_increment, coupling
+            )
         return _timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
 
-    def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0,
-                start_velocity=None, forcing_increment=None) -> DMPStepper:
+    def stepper(
+        self,
+        goal=None,
+        *,
+        start=None,
+        duration: float | None = None,
+        coupling=0.0,
+        start_velocity=None,
+        forcing_increment=None,
+    ) -> DMPStepper:
         """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).
 
         ``coupling`` is a list of coupling terms (:mod:`bidmp.primitives.coupling`), or a number:

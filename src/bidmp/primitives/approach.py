@@ -27,7 +27,9 @@ def _is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
     offsets = points - points[0]
     along = offsets @ (chord / length)
     deviation = np.linalg.norm(offsets - along[:, None] * (chord / length), axis=1)
-    return bool(deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length))
+    return bool(
+        deviation.max() <= tolerance * length and np.all(np.diff(along) >= -tolerance * length)
+    )
 
 
 def _straight_head_end(y: np.ndarray, straightness: float = STRAIGHTNESS) -> int:
@@ -43,7 +45,9 @@ def _straight_tail_start(y: np.ndarray, start: int = 0, straightness: float = ST
     last = y.shape[0] - 1
     if _is_straight(y[start:], straightness):
         return int(start)
-    candidates = np.unique(np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1))).astype(int))
+    candidates = np.unique(
+        np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1))).astype(int)
+    )
     for candidate in candidates:
         if _is_straight(y[candidate:], straightness):
             return int(candidate)

@@ -94,26 +94,56 @@ class SceneAvoidance(CouplingTerm):
         What a trajectory whose clearance is below the margin does.
     """
 
-    def __init__(self, scene, margin: float | None = None, influence: float | None = None, strength: float | None = None,
-                 steer: float = 1.0, max_acceleration: float | None = None, exclude=(), target: str | None = None,
-                 approach: float | None = None, on_miss: str = "raise") -> None:
-        from ..scene.clearance import Scene  # imported here: the primitives do not need the scene otherwise
+    def __init__(
+        self,
+        scene,
+        margin: float | None = None,
+        influence: float | None = None,
+        strength: float | None = None,
+        steer: float = 1.0,
+        max_acceleration: float | None = None,
+        exclude=(),
+        target: str | None = None,
+        approach: float | None = None,
+        on_miss: str = "raise",
+    ) -> None:
+        from ..scene.clearance import (
+            Scene,
+        )  # imported here: the primitives do not need the scene otherwise
 
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.scene.Scene, got {type(scene).__name__}")
         self.scene = scene
-        self.margin = float(scene.margin) if margin is None else check_real(margin, "margin", nonnegative=True)
+        self.margin = (
+            float(scene.margin)
+            if margin is None
+            else check_real(margin, "margin", nonnegative=True)
+        )
         radius = float(scene.tool.radius)
-        self.influence = 2.0 * radius if influence is None else check_real(influence, "influence", positive=True)
-        self.strength = None if strength is None else check_real(strength, "strength", nonnegative=True)
+        self.influence = (
+            2.0 * radius if influence is None else check_real(influence, "influence", positive=True)
+        )
+        self.strength = (
+            None if strength is None else check_real(strength, "strength", nonnegative=True)
+        )
         self.steer = check_real(steer, "steer", nonnegative=True, maximum=10.0)
-        self.max_acceleration = None if max_acceleration is None else check_real(max_acceleration, "max_acceleration", positive=True)
-        self.approach = None if approach is None else check_real(approach, "approach", nonnegative=True)
+        self.max_acceleration = (
+            None
+            if max_acceleration is None
+            else check_real(max_acceleration, "max_acceleration", positive=True)
+        )
+        self.approach = (
+            None if approach is None else check_real(approach, "approach", nonnegative=True)
+        )
         self.on_miss = check_choice(on_miss, "on_miss", ("raise", "warn"))
         if target is not None and not isinstance(target, str):
-            raise TypeError(f"target must be the target's label (a string) or None, got {type(target).__name__}")
+            raise TypeError(
+                f"target must be the target's label (a string) or None, got {type(target).__name__}"
+            )
         self.target = target
-        self.exclude = tuple([exclude] if isinstance(exclude, str) else as_labels(exclude, "exclude"))
+        self.exclude = tuple(
+            [exclude] if isinstance(exclude, str) else as_labels(exclude, "exclude")
+        )
         self._proximity = None
         self._goal = None
 
@@ -125,15 +155,23 @@ class SceneAvoidance(CouplingTerm):
         from .stepper import DMPStepper
 
         if not isinstance(stepper, DMPStepper):
-            raise TypeError(f"stepper must be the DMPStepper that runs the term, got {type(stepper).__name__}")
+            raise TypeError(
+                f"stepper must be the DMPStepper that runs the term, got {type(stepper).__name__}"
+            )
         self._goal = stepper.target
         if self.approach is None:  # the motion's own straight tail, the skill's increment included
-            plain = stepper._dmp.rollout(stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment)
+            plain = stepper._dmp.rollout(
+                stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment
+            )
             self.approach_ = float(np.linalg.norm(plain[-1] - plain[_straight_tail_start(plain)]))
         else:
             self.approach_ = self.approach
         params, scale = stepper._params, stepper._params.tau * stepper._dmp.time_unit_
-        self.strength_ = params.alpha * params.beta * self.influence / scale**2 if self.strength is None else self.strength
+        self.strength_ = (
+            params.alpha * params.beta * self.influence / scale**2
+            if self.strength is None
+            else self.strength
+        )
         excluded = set(self.exclude)
         if self.target is not None:
             excluded.update(self.scene.target_parts(self.target, self._goal))
@@ -143,17 +181,22 @@ class SceneAvoidance(CouplingTerm):
         self.excluded_ = tuple(sorted(excluded))
         # The parts the term would push against with the tool at the goal itself (a neighbouring
         # nut beside the socket): only these fade out along the final approach.
-        beside = self._proximity._near(np.asarray(self._goal, dtype=float), self.margin + self.influence)[3]
+        beside = self._proximity._near(
+            np.asarray(self._goal, dtype=float), self.margin + self.influence
+        )[3]
         self._at_goal = np.zeros(self._proximity.standoffs.shape[0], dtype=bool)
         self._at_goal[beside] = True
         self._fades = bool(beside.size)
 
     def __call__(self, t: float, y: np.ndarray, yd: np.ndarray, phase: float) -> np.ndarray:
         if self._proximity is None:
-            raise ValueError("SceneAvoidance is run by a DMP's trajectory or stepper (which binds it to the motion)")
+            raise ValueError(
+                "SceneAvoidance is run by a DMP's trajectory or stepper (which binds it to the motion)"
+            )
         fade = self._fade(y) if self._fades else 1.0
-        distances, away, owed, solids = self._proximity._near(y, self.margin + self.influence,
-                                                             self._at_goal if fade == 0.0 else None)
+        distances, away, owed, solids = self._proximity._near(
+            y, self.margin + self.influence, self._at_goal if fade == 0.0 else None
+        )
         if distances.size == 0:
             return np.zeros(3)
         rho = self.influence
@@ -164,10 +207,14 @@ class SceneAvoidance(CouplingTerm):
             weight = np.where(self._at_goal[solids], weight * fade, weight)
         approach = np.maximum(-(away @ yd), 0.0)
         braking = weight * approach**2 / (2.0 * gap)
-        total = braking + self.strength_ * weight * np.minimum(rho / gap - 1.0, _BARRIER_CAP)  # + the barrier
+        total = braking + self.strength_ * weight * np.minimum(
+            rho / gap - 1.0, _BARRIER_CAP
+        )  # + the barrier
         push = total @ away
         if self.steer > 0.0:
-            push = push + self.steer * sum(b * self._tangent(n, yd, y) for b, n in zip(total, away) if b > 0.0)
+            push = push + self.steer * sum(
+                b * self._tangent(n, yd, y) for b, n in zip(total, away) if b > 0.0
+            )
         if self.max_acceleration is not None:
             size = float(np.linalg.norm(push))
             if size > self.max_acceleration:
@@ -184,7 +231,9 @@ class SceneAvoidance(CouplingTerm):
         u = (math.sqrt((x - gx) ** 2 + (y_ - gy) ** 2 + (z - gz) ** 2) / self.approach_ - 1.0) / 0.5
         return 1.0 if u >= 1.0 else 0.0 if u <= 0.0 else u * u * (3.0 - 2.0 * u)
 
-    def _tangent(self, normal: np.ndarray, velocity: np.ndarray, position: np.ndarray) -> np.ndarray:
+    def _tangent(
+        self, normal: np.ndarray, velocity: np.ndarray, position: np.ndarray
+    ) -> np.ndarray:
         """Unit direction along the surface: the velocity's tangent part, else the goal's, else a
         fixed perpendicular."""
         for direction in (velocity, self._goal - position):
@@ -218,11 +267,15 @@ def _check_avoidance(terms, trajectory, target: np.ndarray, reach: float) -> Non
         term.clearance_ = clearance
         short = float(np.linalg.norm(trajectory.y[-1] - target))
         if not clearance.clear:
-            message = (f"the coupled motion comes {clearance.distance:.3g} from part {clearance.part!r} "
-                       f"(margin {clearance.margin:g}) at {np.round(clearance.point, 3).tolist()}")
+            message = (
+                f"the coupled motion comes {clearance.distance:.3g} from part {clearance.part!r} "
+                f"(margin {clearance.margin:g}) at {np.round(clearance.point, 3).tolist()}"
+            )
         elif short > _STALLED * reach:
-            message = (f"the coupled motion ends {short:.3g} from its goal after {trajectory.t[-1]:.3g} s: the parts "
-                       f"hold it in a dead end (give a via-point round them, or plan with extend_demonstration)")
+            message = (
+                f"the coupled motion ends {short:.3g} from its goal after {trajectory.t[-1]:.3g} s: the parts "
+                f"hold it in a dead end (give a via-point round them, or plan with extend_demonstration)"
+            )
         else:
             continue
         if term.on_miss == "raise":
@@ -230,4 +283,5 @@ def _check_avoidance(terms, trajectory, target: np.ndarray, reach: float) -> Non
         logger.warning(message)
 
 
-_STALLED = 1e-3  # of the start-goal distance: a coupled motion that ends further from its goal is reported
+# of the start-goal distance: a coupled motion that ends further from its goal is reported
+_STALLED = 1e-3

@@ -28,7 +28,9 @@ def _phase_decay(dt: float, tau: float, alpha_phase: float) -> float:
     return decay
 
 
-def phase_grid(n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *, exact: bool = False) -> np.ndarray:
+def phase_grid(
+    n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *, exact: bool = False
+) -> np.ndarray:
     """Phase at every step (shape ``(n_steps,)``): ``(1 - alpha_phase dt / tau) ** l``, the
     Euler-discretised canonical system (Eq. 13), or with ``exact`` its solution
     ``exp(-alpha_phase l dt / tau)``, which does not depend on the step."""
@@ -43,10 +45,15 @@ def _checked_phase_args(dt, tau, alpha_phase, exact) -> tuple[float, float, floa
     """The canonical system's arguments as the public functions take them: positive finite
     ``dt``, ``tau`` and ``alpha_phase``, a bool ``exact``; an Euler step must not overshoot."""
     dt, tau = check_real(dt, "dt", positive=True), check_real(tau, "tau", positive=True)
-    alpha_phase, exact = check_real(alpha_phase, "alpha_phase", positive=True), check_bool(exact, "exact")
+    alpha_phase, exact = (
+        check_real(alpha_phase, "alpha_phase", positive=True),
+        check_bool(exact, "exact"),
+    )
     if not exact and alpha_phase * dt / tau >= 1.0:
-        raise ValueError(f"alpha_phase * dt / tau = {alpha_phase * dt / tau:.3g} must be < 1 (the Euler phase would not "
-                         f"decay); lower dt or use exact=True")
+        raise ValueError(
+            f"alpha_phase * dt / tau = {alpha_phase * dt / tau:.3g} must be < 1 (the Euler phase would not "
+            f"decay); lower dt or use exact=True"
+        )
     return dt, tau, alpha_phase, exact
 
 
@@ -54,5 +61,7 @@ def _check_phase_span(span: float, alpha_phase: float) -> None:
     """Refuse an ``alpha_phase`` that decays the phase below 1e-12 over the training grid (of
     ``span`` normalised time): its kernels' widths and weights would leave float64's range."""
     if -alpha_phase * span < _MIN_TRAINING_PHASE_LOG:
-        raise ValueError(f"alpha_phase = {alpha_phase:g} decays the phase to e^{-alpha_phase * span:.4g} over "
-                         f"the demonstration; the kernels need at least e^{_MIN_TRAINING_PHASE_LOG:g}: lower alpha_phase")
+        raise ValueError(
+            f"alpha_phase = {alpha_phase:g} decays the phase to e^{-alpha_phase * span:.4g} over "
+            f"the demonstration; the kernels need at least e^{_MIN_TRAINING_PHASE_LOG:g}: lower alpha_phase"
+        )

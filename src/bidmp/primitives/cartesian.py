@@ -54,8 +54,16 @@ from .so3 import (
     orientation_from_log,
 )
 
-__all__ = ["CartesianDMP", "PoseStepper", "PoseTrajectory",
-           "as_quaternions", "as_poses", "continuous_quaternions", "orientation_error", "angle_between"]
+__all__ = [
+    "CartesianDMP",
+    "PoseStepper",
+    "PoseTrajectory",
+    "as_quaternions",
+    "as_poses",
+    "continuous_quaternions",
+    "orientation_error",
+    "angle_between",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -69,13 +77,16 @@ def orientation_error(q, goal) -> np.ndarray:
 def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """Split ``(T, 7)`` poses into positions ``(T, 3)`` and validated quaternions ``(T, 4)``."""
     if not isinstance(name, str) or not name or len(name) > 100:
-        raise TypeError(f"name must be the argument's name (a short string), got {type(name).__name__}")
+        raise TypeError(
+            f"name must be the argument's name (a short string), got {type(name).__name__}"
+        )
     min_points = check_int(min_points, "min_points", minimum=1, limit="max_samples")
     array = as_trajectory(poses, name, min_points=min_points, allow_static=True)
     if array.shape[1] != 7:
-        raise ValueError(f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}")
+        raise ValueError(
+            f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}"
+        )
     return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
-
 
 
 def _pose_parts(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -84,33 +95,44 @@ def _pose_parts(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     positions, quaternions = as_poses(poses)
     log = continuous_log(quaternions, quaternions[-1])
     if np.ptp(positions, axis=0).max() == 0.0 and np.ptp(log, axis=0).max() <= 1e-12:
-        raise ValueError(f"poses: the demonstration does not move: all {len(positions)} poses are the same "
-                         f"(position {np.round(positions[0], 6).tolist()}, one orientation)")
+        raise ValueError(
+            f"poses: the demonstration does not move: all {len(positions)} poses are the same "
+            f"(position {np.round(positions[0], 6).tolist()}, one orientation)"
+        )
     return positions, quaternions, log
 
 
-def _fit_parts(position: DMP, orientation: DMP, positions, log, t, units, name: str = "poses") -> None:
+def _fit_parts(
+    position: DMP, orientation: DMP, positions, log, t, units, name: str = "poses"
+) -> None:
     """Fit the two parts; a part that does not move follows the other's progress."""
     position_still = np.ptp(positions, axis=0).max() == 0.0
     orientation_still = np.ptp(log, axis=0).max() <= 1e-12
     if position_still:
         orientation._fit(log, t, name=f"{name}' orientation", unit_label="rad")
-        position._fit(positions, t, units, progress=_arclength_progress(orientation.training_trajectory(log)),
-                      name=f"{name}' positions")
+        position._fit(
+            positions,
+            t,
+            units,
+            progress=_arclength_progress(orientation.training_trajectory(log)),
+            name=f"{name}' positions",
+        )
         return
     position._fit(positions, t, units, name=f"{name}' positions")
-    progress = _arclength_progress(position.training_trajectory(positions)) if orientation_still else None
+    progress = (
+        _arclength_progress(position.training_trajectory(positions)) if orientation_still else None
+    )
     orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
 _PART_PARAMS = tuple(DMP._get_param_names())  # a pose model's parameters are its parts' own
 
 
-
 def continuous_quaternions(q) -> np.ndarray:
     """Quaternions ``(n, 4)`` (x, y, z, w) with signs flipped so that neighbours lie in the same
     hemisphere (``q`` and ``-q`` are one rotation); checked first: real, finite, not zero."""
     return _continuous(_quaternion_rows(q, "q"))
+
 
 class CartesianDMP(CheckedParams, BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
@@ -130,9 +152,23 @@ class CartesianDMP(CheckedParams, BaseEstimator):
     units_ : str
     """
 
-    def __init__(self, n_kernels=None, alpha=None, beta=None, K=None, alpha_phase=None, tau: float = 1.0,
-                 regression=None, derivatives: str = "gradient", ridge: float = 1e-8, widths: str = "spacing",
-                 protocol: str = "robot", goal_rate=None, integrator=None, keep_approach: bool | None = None) -> None:
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
+        self,
+        n_kernels=None,
+        alpha=None,
+        beta=None,
+        K=None,
+        alpha_phase=None,
+        tau: float = 1.0,
+        regression=None,
+        derivatives: str = "gradient",
+        ridge: float = 1e-8,
+        widths: str = "spacing",
+        protocol: str = "robot",
+        goal_rate=None,
+        integrator=None,
+        keep_approach: bool | None = None,
+    ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
         self.beta = beta
@@ -152,7 +188,7 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         return DMP(**self.get_params())
 
     @numerically_guarded
-    def fit(self, poses, t=None, units: str | None = None) -> "CartesianDMP":
+    def fit(self, poses, t=None, units: str | None = None) -> CartesianDMP:
         """Learn from one pose demonstration ``(T, 7)`` (x, y, z, qx, qy, qz, qw), with optional
         timestamps ``t`` (s) as :meth:`bidmp.DMP.fit`. Quaternion sign flips are made continuous;
         non-unit quaternions are normalised with a warning; zero ones refused."""
@@ -174,7 +210,9 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         learned parameter makes them refuse, naming it)."""
         check_fitted(self, "position_")
         for part in (self.position_, self.orientation_):
-            for name in _PART_PARAMS:  # attribute access, not get_params(): this runs on every query
+            for (
+                name
+            ) in _PART_PARAMS:  # attribute access, not get_params(): this runs on every query
                 value = getattr(self, name)
                 if getattr(part, name) is not value:
                     setattr(part, name, value)
@@ -195,9 +233,19 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         return goal[:3], goal_q, start[:3], _nearest_turn(start_q, goal_q, self.start_log_)
 
     @numerically_guarded
-    def trajectory(self, goal=None, *, start=None, duration: float | None = None, dt: float | None = None,
-                   limits: dict | None = None, position_increment=None, orientation_increment=None,
-                   coupling=None, via=None) -> PoseTrajectory:
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        start=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        limits: dict | None = None,
+        position_increment=None,
+        orientation_increment=None,
+        coupling=None,
+        via=None,
+    ) -> PoseTrajectory:
         """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
 
         Parameters
@@ -220,9 +268,29 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         _check_forcing_increment(position_increment, "position_increment")
         _check_forcing_increment(orientation_increment, "orientation_increment")
-        vias = None if via is None else _pose_vias(self.orientation_, via, goal_q, start_e, duration, dt, orientation_increment)
-        return _pose_trajectory(self.position_, self.orientation_, goal_p, start_p, goal_q, start_e, duration, dt,
-                                limits, position_increment, orientation_increment, self.units_, coupling, vias)
+        vias = (
+            None
+            if via is None
+            else _pose_vias(
+                self.orientation_, via, goal_q, start_e, duration, dt, orientation_increment
+            )
+        )
+        return _pose_trajectory(
+            self.position_,
+            self.orientation_,
+            goal_p,
+            start_p,
+            goal_q,
+            start_e,
+            duration,
+            dt,
+            limits,
+            position_increment,
+            orientation_increment,
+            self.units_,
+            coupling,
+            vias,
+        )
 
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:
         """Poses (n, 7) on the DMP's sample grid, in normalised time (as :meth:`bidmp.DMP.rollout`;
@@ -232,20 +300,28 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         error = self.orientation_.rollout(np.zeros(3), start=start_e, n_steps=n_steps)
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
-    def stepper(self, goal=None, *, start=None, duration: float | None = None, coupling=0.0) -> PoseStepper:
+    def stepper(
+        self, goal=None, *, start=None, duration: float | None = None, coupling=0.0
+    ) -> PoseStepper:
         """A step-by-step integrator for a control loop; phase stopping on the position error."""
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
-        return PoseStepper(self.position_.stepper(goal_p, start=start_p, duration=duration, coupling=coupling),
-                           self.orientation_.stepper(np.zeros(3), start=start_e, duration=duration), goal_q)
+        return PoseStepper(
+            self.position_.stepper(goal_p, start=start_p, duration=duration, coupling=coupling),
+            self.orientation_.stepper(np.zeros(3), start=start_e, duration=duration),
+            goal_q,
+        )
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
         self._parts()
-        return _parts_state(self, {"params": self.get_params()},
-                            {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_})
+        return _parts_state(
+            self,
+            {"params": self.get_params()},
+            {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_},
+        )
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> "CartesianDMP":
+    def _from_state(cls, meta: dict, arrays) -> CartesianDMP:
         position, orientation = _parts_from_state(DMP, "CartesianDMP", meta, arrays)
         model = cls(**_pose_params(meta["params"]))
         model.position_, model.orientation_ = position, orientation
@@ -257,7 +333,9 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         return model
 
 
-def _pose_vias(orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment) -> tuple[list, list]:
+def _pose_vias(
+    orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment
+) -> tuple[list, list]:
     """(position via-points, orientation-error via-points) of via poses ``[(t, pose (7,)), ...]``;
     ``orientation`` the orientation part (a DMP) and its skill's increment."""
     if not isinstance(via, (list, tuple)):
@@ -268,8 +346,13 @@ def _pose_vias(orientation: DMP, via, goal_q, start_e, duration, dt, orientation
             raise TypeError(f"via[{index}] must be a (t_seconds, pose) pair")
         pairs.append((pair[0], as_point(pair[1], 7, f"via[{index}] pose")))
     # The orientation part's own motion gives each via pose's turn (a multi-turn motion stays one).
-    plain = orientation.trajectory(np.zeros(3), start=start_e, duration=duration, dt=dt,
-                                          forcing_increment=orientation_increment)
+    plain = orientation.trajectory(
+        np.zeros(3),
+        start=start_e,
+        duration=duration,
+        dt=dt,
+        forcing_increment=orientation_increment,
+    )
     errors = []
     for index, (t, pose) in enumerate(pairs):
         q = as_quaternions(pose[3:], f"via[{index}] quaternion")[0]
@@ -302,7 +385,6 @@ def _read_poses_state(model: CartesianDMP, arrays) -> None:
         model.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
 
 
-
 def _parts_state(model, meta: dict, arrays: dict) -> tuple[dict, dict]:
     """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
     ``orientation_`` parts, the parts' members prefixed with their names."""
@@ -318,6 +400,7 @@ def _parts_from_state(part_class, name: str, meta: dict, arrays) -> tuple:
     for key in ("params", "position", "orientation"):
         if not isinstance(meta.get(key), dict):
             raise ValueError(f"the {name} state has no {key} object")
-    return tuple(part_class._from_state(meta[part], Prefixed(arrays, f"{part}/")) for part in ("position", "orientation"))
-
-
+    return tuple(
+        part_class._from_state(meta[part], Prefixed(arrays, f"{part}/"))
+        for part in ("position", "orientation")
+    )

@@ -17,7 +17,6 @@ coupling terms and belong here, one small class each.
 from __future__ import annotations
 
 import math
-
 from collections.abc import Sequence
 
 import numpy as np
@@ -33,7 +32,9 @@ class CouplingTerm:
     Subclasses implement ``__call__(t, y, yd, phase) -> acceleration (D,)`` in units/s².
     """
 
-    def __call__(self, t: float, y: np.ndarray, yd: np.ndarray, phase: float) -> np.ndarray:  # pragma: no cover
+    def __call__(
+        self, t: float, y: np.ndarray, yd: np.ndarray, phase: float
+    ) -> np.ndarray:  # pragma: no cover
         raise NotImplementedError
 
 
@@ -56,7 +57,9 @@ class PhaseStopping(CouplingTerm):
 
     def slowdown(self, y: np.ndarray, y_measured) -> float:
         """How many times slower the system's time runs for a measurement ``y_measured`` (D,)."""
-        if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):  # a stepper's own state passes as is
+        if not (
+            type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1
+        ):  # a stepper's own state passes as is
             y = as_vector(y, "y")
         if y_measured is None or self.gain == 0.0:
             return 1.0
@@ -87,15 +90,21 @@ def _as_couplings(coupling) -> tuple[list, list]:
     """
     if coupling is None:
         return [], []
-    if isinstance(coupling, (int, float, np.integer, np.floating)) and not isinstance(coupling, bool):
+    if isinstance(coupling, (int, float, np.integer, np.floating)) and not isinstance(
+        coupling, bool
+    ):
         return [], [PhaseStopping(check_real(coupling, "coupling", nonnegative=True, maximum=1e6))]
     terms = [coupling] if callable(coupling) else coupling
     if not isinstance(terms, Sequence) or isinstance(terms, (str, bytes)):
-        raise TypeError(f"coupling must be a number (the phase-stopping gain), a coupling term or a list of them, "
-                        f"got {type(coupling).__name__}")
+        raise TypeError(
+            f"coupling must be a number (the phase-stopping gain), a coupling term or a list of them, "
+            f"got {type(coupling).__name__}"
+        )
     spatial, temporal = [], []
     for term in terms:
         if not callable(term):
-            raise TypeError(f"coupling terms must be callable as coupling(t, y, yd, phase), got {type(term).__name__}")
+            raise TypeError(
+                f"coupling terms must be callable as coupling(t, y, yd, phase), got {type(term).__name__}"
+            )
         (temporal if hasattr(term, "slowdown") else spatial).append(term)
     return spatial, temporal

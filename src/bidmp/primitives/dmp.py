@@ -47,7 +47,13 @@ import numpy as np
 from sklearn.base import BaseEstimator
 
 from .._api import CheckedParams
-from .._checks import as_trajectory, as_unit_quaternion, check_bytes, check_names, numerically_guarded
+from .._checks import (
+    as_trajectory,
+    as_unit_quaternion,
+    check_bytes,
+    check_names,
+    numerically_guarded,
+)
 from .._units import ANGLE_UNITS, check_units
 from ._dmp_grids import GridQueries
 from ._dmp_motions import Motions
@@ -180,7 +186,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         Kernel centres (phase) and widths.
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
         self,
         n_kernels: int | None = None,
         alpha: float | None = None,
@@ -217,15 +223,23 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         """Validate the hyperparameters as they are now; raise naming the first bad one."""
         return _resolve_params(self)
 
-    alpha_value = _resolved_param("alpha", "The spring gain in use (the protocol's when ``alpha`` is None).")
-    n_kernels_value = _resolved_param("n_kernels", "The number of kernels in use (the protocol's when ``n_kernels`` is None).")
-    beta_value = _resolved_param("beta", "The spring gain ratio in use (``alpha / 4`` when ``beta`` is None).")
+    alpha_value = _resolved_param(
+        "alpha", "The spring gain in use (the protocol's when ``alpha`` is None)."
+    )
+    n_kernels_value = _resolved_param(
+        "n_kernels", "The number of kernels in use (the protocol's when ``n_kernels`` is None)."
+    )
+    beta_value = _resolved_param(
+        "beta", "The spring gain ratio in use (``alpha / 4`` when ``beta`` is None)."
+    )
     K_value = _resolved_param("K", "The forcing-term gain in use.")
-    alpha_phase_value = _resolved_param("alpha_phase", "The phase decay in use (the protocol's when ``alpha_phase`` is None).")
+    alpha_phase_value = _resolved_param(
+        "alpha_phase", "The phase decay in use (the protocol's when ``alpha_phase`` is None)."
+    )
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
-    def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> "DMP":
+    def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> DMP:
         """Learn the forcing-term weights from one demonstration.
 
         Parameters
@@ -252,21 +266,40 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         """
         return self._fit(y, t, units, names=names, held_orientation=held_orientation)
 
-    def _fit(self, y, t=None, units: str | None = None, *, progress: np.ndarray | None = None,
-             name: str = "y", unit_label: str | None = None, names=None, held_orientation=None) -> "DMP":
+    def _fit(
+        self,
+        y,
+        t=None,
+        units: str | None = None,
+        *,
+        progress: np.ndarray | None = None,
+        name: str = "y",
+        unit_label: str | None = None,
+        names=None,
+        held_orientation=None,
+    ) -> DMP:
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
         move on its own: then ``y`` may be static)."""
         params = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
         names = check_names(names, y.shape[1])
-        held = None if held_orientation is None else as_unit_quaternion(held_orientation, "held_orientation")
+        held = (
+            None
+            if held_orientation is None
+            else as_unit_quaternion(held_orientation, "held_orientation")
+        )
         y, duration = on_uniform_time(y, t)
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
         if params.rest_start:
-            y_rest = _rest_started(y, dt, duration * n_steps / (n_steps - 1), what="the demonstration" if name == "y"
-                                         else name, unit=unit_label or units or "units")
+            y_rest = _rest_started(
+                y,
+                dt,
+                duration * n_steps / (n_steps - 1),
+                what="the demonstration" if name == "y" else name,
+                unit=unit_label or units or "units",
+            )
         train = _with_rest(y_rest if params.rest_start else y, params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
@@ -295,7 +328,9 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         self._remember_params()
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
         _store_grid(self, params._replace(tau=1.0), phase, phi, dt)
-        logger.debug("fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration)
+        logger.debug(
+            "fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration
+        )
         return self
 
     @property
@@ -321,8 +356,9 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         return _dmp_state(self)
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> "DMP":
+    def _from_state(cls, meta: dict, arrays) -> DMP:
         return _dmp_from_state(cls, meta, arrays)
+
 
 # The constructor's parameters but tau, as given (compared first: cheap), see _FittedParams._stale_params.
 _RAW_PARAMS = DMP._raw_param_names()

@@ -25,8 +25,15 @@ __all__ = ["kernel_centres", "kernel_widths", "basis_functions"]
 _LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
 
 
-def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, alpha_phase: float = 1.0, *,
-                   exact: bool = False) -> np.ndarray:
+def kernel_centres(
+    n_kernels: int,
+    n_steps: int,
+    dt: float,
+    tau: float = 1.0,
+    alpha_phase: float = 1.0,
+    *,
+    exact: bool = False,
+) -> np.ndarray:
     """Kernel centres at the phase of ``n_kernels`` equally spaced times over the horizon.
 
     They span exactly the visited phase range ``[phase[n_steps - 1], 1]``: a centre outside it
@@ -42,7 +49,9 @@ def kernel_centres(n_kernels: int, n_steps: int, dt: float, tau: float = 1.0, al
     return np.exp(np.log(_phase_decay(dt, tau, alpha_phase)) * steps)
 
 
-def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing") -> np.ndarray:
+def kernel_widths(
+    centres: np.ndarray, alpha_phase: float = 1.0, method: str = "spacing"
+) -> np.ndarray:
     """Kernel widths ``h_i`` of ``ψ_i = exp(-h_i (phase - c_i)²)``.
 
     ``"spacing"`` (default): ``h_i = 1 / (c_{i+1} - c_i)²``, so neighbouring kernels overlap at
@@ -55,7 +64,9 @@ def kernel_widths(centres: np.ndarray, alpha_phase: float = 1.0, method: str = "
     check_choice(method, "method", ("spacing", "pydmps"))
     n_kernels = len(centres)
     if n_kernels > 1 and np.any(np.diff(np.sort(centres)) == 0.0):
-        raise ValueError("centres must be distinct (two kernels at one phase have no spacing to size them by)")
+        raise ValueError(
+            "centres must be distinct (two kernels at one phase have no spacing to size them by)"
+        )
     if method == "pydmps":
         return n_kernels**1.5 / (centres * alpha_phase)
     if n_kernels == 1:
@@ -84,7 +95,9 @@ def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) 
     centres = as_vector(centres, "centres", positive=True)
     widths = as_vector(widths, "widths", positive=True)
     if widths.shape != centres.shape:
-        raise ValueError(f"widths must have one entry per entry of centres ({centres.shape[0]}), got {widths.shape[0]}")
+        raise ValueError(
+            f"widths must have one entry per entry of centres ({centres.shape[0]}), got {widths.shape[0]}"
+        )
     return _basis_rows(phase, centres, widths)
 
 
@@ -105,7 +118,9 @@ def _basis_rows(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> n
     # writes the whole (L, N) exponent matrix. Cancellation costs ~h·phase²·1e-16 in the exponent
     # (< 1e-11 for any sensible number of kernels).
     features = np.column_stack([phase * phase, phase, np.ones_like(phase), -shift])
-    coefficients = np.stack([-widths, 2.0 * widths * centres, -widths * centres * centres, np.ones_like(centres)])
+    coefficients = np.stack(
+        [-widths, 2.0 * widths * centres, -widths * centres * centres, np.ones_like(centres)]
+    )
     log_psi = features @ coefficients
     # Terms below e^-40 of the row maximum cannot change a float64 sum; clipping them keeps exp
     # out of the (slow) subnormal range.
@@ -179,7 +194,9 @@ def _forcing_target(
     return (tau**2 * acceleration - spring) / K + gate[:, None] * (goal - start)
 
 
-def _regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regression: str, ridge: float) -> np.ndarray:
+def _regress(
+    phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regression: str, ridge: float
+) -> np.ndarray:
     """Forcing-term weights (N, D) from basis rows ``phi`` (L, N) at ``phase`` (L,) and the forcing
     target (L, D): LWR per kernel (``regression="lwr"``) or ridge least squares (``"ridge"``, the
     regulariser ``ridge`` relative to the mean diagonal of ``ΦᵀΦ``)."""
@@ -193,11 +210,15 @@ def _regress(phi: np.ndarray, phase: np.ndarray, target: np.ndarray, *, regressi
         reg = ridge * max(np.trace(gram) / n_kernels, np.finfo(float).tiny)
         weights = np.linalg.solve(gram + reg * np.eye(n_kernels), phi.T @ target)
     if not np.all(np.isfinite(weights)):
-        raise ValueError("fit: the learned weights are not finite; the demonstration's scale or the gains are out of range")
+        raise ValueError(
+            "fit: the learned weights are not finite; the demonstration's scale or the gains are out of range"
+        )
     return weights
 
 
-def _learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tuple[np.ndarray, ...]:
+def _learn_weights(
+    train: np.ndarray, dt: float, gate: np.ndarray, params
+) -> tuple[np.ndarray, ...]:
     """The forcing term of a demonstration as learned, ``train`` (n, D) on the normalised grid
     ``dt`` with the goal gate ``gate`` (n,), for a DMP's resolved ``params``.
 
@@ -210,10 +231,21 @@ def _learn_weights(train: np.ndarray, dt: float, gate: np.ndarray, params) -> tu
     """
     n_train = train.shape[0]
     phase = phase_grid(n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
-    centres = kernel_centres(params.n_kernels, n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
+    centres = kernel_centres(
+        params.n_kernels, n_train, dt, 1.0, params.alpha_phase, exact=params.exact
+    )
     widths = kernel_widths(centres, params.alpha_phase, params.widths)
-    target = _forcing_target(train, phase, dt=dt, tau=1.0, alpha=params.alpha, beta=params.beta, K=params.K,
-                            derivatives=params.derivatives, gate=gate)
+    target = _forcing_target(
+        train,
+        phase,
+        dt=dt,
+        tau=1.0,
+        alpha=params.alpha,
+        beta=params.beta,
+        K=params.K,
+        derivatives=params.derivatives,
+        gate=gate,
+    )
     phi = _basis_rows(phase, centres, widths)
     weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
     return np.ascontiguousarray(weights), centres, widths, phase, phi
@@ -224,13 +256,17 @@ def _as_phase(phase, name: str = "phase") -> np.ndarray:
     phase = _as_bounded_array(phase, name, max_ndim=2)
     phase = as_points(phase.reshape(-1, 1) if phase.ndim <= 1 else phase, 1, name)[:, 0]
     if phase.size and (phase.min() < 0.0 or phase.max() > 1.0):
-        raise ValueError(f"{name} must lie in [0, 1] (a DMP's phase decays from 1 towards 0), got values in "
-                         f"[{phase.min():.3g}, {phase.max():.3g}]")
+        raise ValueError(
+            f"{name} must lie in [0, 1] (a DMP's phase decays from 1 towards 0), got values in "
+            f"[{phase.min():.3g}, {phase.max():.3g}]"
+        )
     return phase
 
 
 def _check_forcing_increment(forcing_increment, name: str = "forcing_increment") -> None:
     """Refuse a forcing increment that is not a callable ``f(phase (n,), basis (n, N)) -> (n, D)``."""
     if forcing_increment is not None and not callable(forcing_increment):
-        raise TypeError(f"{name} must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
-                        f"{type(forcing_increment).__name__}")
+        raise TypeError(
+            f"{name} must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
+            f"{type(forcing_increment).__name__}"
+        )

@@ -33,14 +33,21 @@ def _shortest_blend(delta: np.ndarray, limits: dict | None) -> float:
     scalars, on the norm); 0 without limits."""
     size = float(np.linalg.norm(delta))
     shortest = 0.0
-    if limits is not None and (not isinstance(limits, dict) or set(limits) - {"max_velocity", "max_acceleration", "max_jerk"}):
-        raise ValueError(f"limits must be a dict of max_velocity, max_acceleration and max_jerk (units/s, /s², /s³), "
-                         f"got {short_token(limits, 40)}")
+    if limits is not None and (
+        not isinstance(limits, dict)
+        or set(limits) - {"max_velocity", "max_acceleration", "max_jerk"}
+    ):
+        raise ValueError(
+            f"limits must be a dict of max_velocity, max_acceleration and max_jerk (units/s, /s², /s³), "
+            f"got {short_token(limits, 40)}"
+        )
     for power, key in enumerate(("max_velocity", "max_acceleration", "max_jerk"), start=1):
         limit = None if not limits else limits.get(key)
         if limit is not None and size > 0.0:
             limit = float(np.min(as_vector(limit, f"limits[{key!r}]", positive=True)))
-            shortest = max(shortest, (size * _PEAKS[power - 1] / (_LIMIT_SHARE * limit)) ** (1.0 / power))
+            shortest = max(
+                shortest, (size * _PEAKS[power - 1] / (_LIMIT_SHARE * limit)) ** (1.0 / power)
+            )
     return shortest
 
 
@@ -66,7 +73,9 @@ class _GoalShifts:
             if duration <= 0.0:
                 yield delta, 1.0, 0.0, 0.0
                 continue
-            u = np.array(min(max((t - start) / duration, -1.0), 2.0))  # any t, inf too: the smoothstep is flat outside [0, 1]
+            u = np.array(
+                min(max((t - start) / duration, -1.0), 2.0)
+            )  # any t, inf too: the smoothstep is flat outside [0, 1]
             first, second = _smoothstep_derivatives(u)
             yield delta, float(_smoothstep(u)), float(first) / duration, float(second) / duration**2
 
@@ -74,7 +83,11 @@ class _GoalShifts:
         """Offset (D,), its velocity and acceleration at motion time ``t`` (s)."""
         offset, velocity, acceleration = (np.zeros_like(self.total) for _ in range(3))
         for delta, share, rate, rate_rate in self.profiles(t):
-            offset, velocity, acceleration = offset + share * delta, velocity + rate * delta, acceleration + rate_rate * delta
+            offset, velocity, acceleration = (
+                offset + share * delta,
+                velocity + rate * delta,
+                acceleration + rate_rate * delta,
+            )
         return offset, velocity, acceleration
 
 

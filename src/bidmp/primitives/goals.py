@@ -56,7 +56,8 @@ from .canonical import phase_grid
 __all__ = ["PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate"]
 
 MIN_APPROACH_SHARE = 0.05  # of the path's length: a shorter straight tail is no approach
-_GOAL_BLEND = 0.15  # share of the demonstration's duration over which the goal's share starts and ends
+# share of the demonstration's duration over which the goal's share starts and ends
+_GOAL_BLEND = 0.15
 
 
 def _smoothstep(u: np.ndarray) -> np.ndarray:
@@ -74,7 +75,9 @@ def _smoothstep_derivatives(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return first, second
 
 
-def _goal_share(progress: np.ndarray, n_motion: int, dt: float, blend: float = _GOAL_BLEND, begin: float = 0.0) -> np.ndarray:
+def _goal_share(
+    progress: np.ndarray, n_motion: int, dt: float, blend: float = _GOAL_BLEND, begin: float = 0.0
+) -> np.ndarray:
     """The goal share ``R`` on the training grid (module docstring), 0 before ``begin`` (normalised
     time: the end of a kept departure) and rising from there.
 
@@ -109,7 +112,9 @@ def _goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: fl
     return gate
 
 
-def _euler_progress_gate(progress: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
+def _euler_progress_gate(
+    progress: np.ndarray, dt: float, *, alpha: float, beta: float, K: float
+) -> np.ndarray:
     """The progress gate of model format 3's robot protocol (``integrator="euler"``): the exact
     inverse of the Euler-discretised spring for the target response ``σ`` delayed by two samples.
 
@@ -137,7 +142,9 @@ def _training_progress(train: np.ndarray, progress) -> np.ndarray:
     """The progress σ (n_train,) a gate is learned from: the trajectory's own arc-length progress,
     or the one given (a part that does not move follows another's)."""
     n_train = train.shape[0]
-    progress = _arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+    progress = (
+        _arclength_progress(train) if progress is None else np.asarray(progress, dtype=np.float64)
+    )
     if progress.shape != (n_train,):
         raise ValueError(f"progress must have shape ({n_train},), got {progress.shape}")
     return progress
@@ -148,9 +155,13 @@ _MAX_STEP = 1e3  # normalised time of one step: a motion lasts 1
 
 
 def _step_args(gate, phase, step, tau, exact) -> tuple[float, float, float, float, bool]:
-    return (check_real(gate, "gate"), check_real(phase, "phase", minimum=0.0, maximum=1.0),
-            check_real(step, "step", nonnegative=True, maximum=_MAX_STEP), check_real(tau, "tau", positive=True),
-            check_bool(exact, "exact"))
+    return (
+        check_real(gate, "gate"),
+        check_real(phase, "phase", minimum=0.0, maximum=1.0),
+        check_real(step, "step", nonnegative=True, maximum=_MAX_STEP),
+        check_real(tau, "tau", positive=True),
+        check_bool(exact, "exact"),
+    )
 
 
 def _grid_args(phase, step, tau, exact) -> tuple[np.ndarray, float, float, bool]:
@@ -158,13 +169,18 @@ def _grid_args(phase, step, tau, exact) -> tuple[np.ndarray, float, float, bool]
     if np.any((phase < 0.0) | (phase > 1.0)):
         raise ValueError("phase must lie in [0, 1]")
     # one sample has no spacing: a step of 0 is then as good as any
-    step = check_real(step, "step", positive=phase.shape[0] > 1, nonnegative=True, maximum=_MAX_STEP)
+    step = check_real(
+        step, "step", positive=phase.shape[0] > 1, nonnegative=True, maximum=_MAX_STEP
+    )
     return phase, step, check_real(tau, "tau", positive=True), check_bool(exact, "exact")
 
 
 def _training_args(n_train, dt, exact) -> tuple[int, float, bool]:
-    return (check_int(n_train, "n_train", minimum=1, limit="max_steps"), check_real(dt, "dt", positive=True, maximum=1.0),
-            check_bool(exact, "exact"))
+    return (
+        check_int(n_train, "n_train", minimum=1, limit="max_steps"),
+        check_real(dt, "dt", positive=True, maximum=1.0),
+        check_bool(exact, "exact"),
+    )
 
 
 # -- goal systems ----------------------------------------------------------------------------------
@@ -175,7 +191,9 @@ class DelayedGoal:
     rate: float
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "rate", check_real(self.rate, f"{type(self).__name__}.rate", positive=True))
+        object.__setattr__(
+            self, "rate", check_real(self.rate, f"{type(self).__name__}.rate", positive=True)
+        )
 
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         """The gate at a rollout grid's samples (``step`` apart in normalised time)."""
@@ -194,7 +212,9 @@ class DelayedGoal:
 
     def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         """:meth:`follow` on checked arguments (a stepper's control loop asks it every step)."""
-        return gate * (math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau))
+        return gate * (
+            math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau)
+        )
 
 
 @dataclass(frozen=True)
@@ -223,9 +243,14 @@ class ProgressGate:
 
     def __post_init__(self) -> None:
         kind = type(self).__name__
-        phase, gate = as_vector(self.training_phase, f"{kind}.training_phase"), as_vector(self.gate, f"{kind}.gate")
+        phase, gate = (
+            as_vector(self.training_phase, f"{kind}.training_phase"),
+            as_vector(self.gate, f"{kind}.gate"),
+        )
         if gate.shape != phase.shape or phase.size < 2 or np.any(np.diff(phase) >= 0.0):
-            raise ValueError(f"{kind}: training_phase must decrease strictly, with one gate value per phase")
+            raise ValueError(
+                f"{kind}: training_phase must decrease strictly, with one gate value per phase"
+            )
         object.__setattr__(self, "training_phase", phase)
         object.__setattr__(self, "gate", gate)
         # np.interp wants increasing abscissae: the reversed grid, built once (a control loop
@@ -233,8 +258,17 @@ class ProgressGate:
         object.__setattr__(self, "_lookup", (self.training_phase[::-1], self.gate[::-1]))
 
     @staticmethod
-    def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
-              progress: np.ndarray | None = None) -> np.ndarray:
+    def learn(
+        train: np.ndarray,
+        n_motion: int,
+        dt: float,
+        *,
+        alpha: float,
+        beta: float,
+        K: float,
+        exact: bool,
+        progress: np.ndarray | None = None,
+    ) -> np.ndarray:
         """The gate on the training grid for a demonstration as learned, ``train`` (n_train, D)
         (exact: the smooth goal share's continuous inverse; Euler: :func:`_euler_progress_gate`).
         ``progress`` replaces the demonstration's own arc-length progress (a part that does not
@@ -251,7 +285,9 @@ class ProgressGate:
         """The learned gate itself (the training grid is the one it was learned on)."""
         n_train, dt, exact = _training_args(n_train, dt, exact)
         if n_train != self.gate.shape[0]:
-            raise ValueError(f"n_train: the progress gate was learned on {self.gate.shape[0]} samples, not {n_train}")
+            raise ValueError(
+                f"n_train: the progress gate was learned on {self.gate.shape[0]} samples, not {n_train}"
+            )
         return self.gate
 
     def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
@@ -266,12 +302,16 @@ def _learned_progress_gate(model, params) -> ProgressGate:
     cached on the model: a control loop asks for it once per stepper."""
     gate = model.__dict__.get("goal_gate_")
     if gate is None or gate.shape[0] != model.n_train_:
-        raise ValueError("this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
-                         "set goal_rate to a number or fit it again")
+        raise ValueError(
+            "this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
+            "set goal_rate to a number or fit it again"
+        )
     key = (model.n_train_, model.dt_, params.alpha_phase, params.exact)
     cached = model.__dict__.get("_goal_system")
     if cached is None or cached[0] != key or cached[1].gate is not gate:
-        training_phase = phase_grid(model.n_train_, model.dt_, 1.0, params.alpha_phase, exact=params.exact)
+        training_phase = phase_grid(
+            model.n_train_, model.dt_, 1.0, params.alpha_phase, exact=params.exact
+        )
         cached = (key, ProgressGate(training_phase, gate))
         model._goal_system = cached
     return cached[1]
@@ -293,9 +333,19 @@ class ApproachGate(ProgressGate):
     """
 
     @staticmethod
-    def learn(train: np.ndarray, n_motion: int, dt: float, *, alpha: float, beta: float, K: float, exact: bool,
-              progress: np.ndarray | None = None, approach_start: int | None = None,
-              departure_end: int = 0) -> np.ndarray:
+    def learn(
+        train: np.ndarray,
+        n_motion: int,
+        dt: float,
+        *,
+        alpha: float,
+        beta: float,
+        K: float,
+        exact: bool,
+        progress: np.ndarray | None = None,
+        approach_start: int | None = None,
+        departure_end: int = 0,
+    ) -> np.ndarray:
         """The gate on the training grid; ``approach_start`` the sample where the approach begins,
         ``departure_end`` the one where a kept departure ends (0: none)."""
         progress = _training_progress(train, progress)
@@ -309,7 +359,9 @@ MAX_DEPARTURE_SHARE = 0.4  # of the path's length: a longer straight head is the
 MIN_TRANSFER_SHARE = 0.3  # of the path's length left between a kept departure and the kept approach
 
 
-MAX_LIFT_ANGLE = np.radians(45.0)  # a departure rises: its direction within this of straight up (+z)
+MAX_LIFT_ANGLE = np.radians(
+    45.0
+)  # a departure rises: its direction within this of straight up (+z)
 
 
 def _departure_end(demonstration: np.ndarray, approach_start: int) -> int:
@@ -324,23 +376,43 @@ def _departure_end(demonstration: np.ndarray, approach_start: int) -> int:
     end = _straight_head_end(demonstration)
     progress = _arclength_progress(demonstration)
     head, before = float(progress[end]), float(progress[approach_start])
-    if end < 2 or head < MIN_APPROACH_SHARE or head > MAX_DEPARTURE_SHARE or before - head < MIN_TRANSFER_SHARE:
+    if (
+        end < 2
+        or head < MIN_APPROACH_SHARE
+        or head > MAX_DEPARTURE_SHARE
+        or before - head < MIN_TRANSFER_SHARE
+    ):
         return 0
     rise = demonstration[end] - demonstration[0]
-    if np.arccos(np.clip(rise[2] / max(float(np.linalg.norm(rise)), 1e-300), -1.0, 1.0)) > MAX_LIFT_ANGLE:
+    if (
+        np.arccos(np.clip(rise[2] / max(float(np.linalg.norm(rise)), 1e-300), -1.0, 1.0))
+        > MAX_LIFT_ANGLE
+    ):
         return 0
     return int(end)
 
 
-def _learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progress=None,
-                    demonstration: np.ndarray | None = None) -> np.ndarray:
+def _learn_goal_gate(
+    train: np.ndarray,
+    n_motion: int,
+    dt: float,
+    params,
+    progress=None,
+    demonstration: np.ndarray | None = None,
+) -> np.ndarray:
     """The goal gate a DMP with resolved ``params`` learns on its training grid: a delayed goal's,
     the progress gate, or (``keep_approach``) the approach gate, the approach found as the straight
     tail of ``demonstration`` (T, D) into its goal and a departure as its straight head
     (:func:`_departure_end`; a demonstration without an approach gets the progress gate)."""
     if params.goal_rate is not None:
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
-    gains = {"alpha": params.alpha, "beta": params.beta, "K": params.K, "exact": params.exact, "progress": progress}
+    gains = {
+        "alpha": params.alpha,
+        "beta": params.beta,
+        "K": params.K,
+        "exact": params.exact,
+        "progress": progress,
+    }
     if params.keep_approach and demonstration is not None:
         from .approach import _straight_tail_start
 
@@ -349,6 +421,12 @@ def _learn_goal_gate(train: np.ndarray, n_motion: int, dt: float, params, progre
         # An approach is a straight tail of a real share of the path: any curve's last few samples
         # are straight to 2 % of their short chord.
         if progress_at > 0.0 and 1.0 - progress_at >= MIN_APPROACH_SHARE:
-            return ApproachGate.learn(train, n_motion, dt, approach_start=start,
-                                      departure_end=_departure_end(demonstration, start), **gains)
+            return ApproachGate.learn(
+                train,
+                n_motion,
+                dt,
+                approach_start=start,
+                departure_end=_departure_end(demonstration, start),
+                **gains,
+            )
     return ProgressGate.learn(train, n_motion, dt, **gains)

@@ -19,24 +19,47 @@ __all__ = []
 
 def _grid_key(params, n_steps: int, step: float) -> tuple:
     """Everything a rollout grid depends on besides the learned kernels."""
-    return (n_steps, params.tau, params.alpha, params.beta, params.K, params.alpha_phase, params.goal_rate,
-            params.integrator, step)
+    return (
+        n_steps,
+        params.tau,
+        params.alpha,
+        params.beta,
+        params.K,
+        params.alpha_phase,
+        params.goal_rate,
+        params.integrator,
+        step,
+    )
+
 
 def _store_grid(model, params, phase: np.ndarray, basis: np.ndarray, step: float) -> tuple:
     """Cache the grid (phase, basis rows, unit responses, goal gate) on ``model``; return the entry."""
     gate = model.goal_system(params).on_grid(phase, step, params.tau, params.exact)
-    cached = (_grid_key(params, phase.shape[0], step), model.centres_, model.widths_, phase, basis,
-              _unit_responses(params, phase, None, step, gate), gate)
+    cached = (
+        _grid_key(params, phase.shape[0], step),
+        model.centres_,
+        model.widths_,
+        phase,
+        basis,
+        _unit_responses(params, phase, None, step, gate),
+        gate,
+    )
     model._grid_cache = cached
     return cached
+
 
 def _cached_grid(model, params, n_steps: int, step: float) -> tuple | None:
     """The cached entry for this grid, or None (another grid, or the kernels changed)."""
     cached = model.__dict__.get("_grid_cache")
-    if (cached is None or cached[0] != _grid_key(params, n_steps, step)
-            or cached[1] is not model.centres_ or cached[2] is not model.widths_):
+    if (
+        cached is None
+        or cached[0] != _grid_key(params, n_steps, step)
+        or cached[1] is not model.centres_
+        or cached[2] is not model.widths_
+    ):
         return None
     return cached
+
 
 def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, ...]:
     """Phase (n,), basis rows (n, N), unit responses ``[B, C, V]`` (3, n) and goal gate (n,) on the grid of
@@ -51,5 +74,7 @@ def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tup
     cached = _cached_grid(model, params, n_steps, step)
     if cached is None:
         phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
-        cached = _store_grid(model, params, phase, _basis_rows(phase, model.centres_, model.widths_), step)
+        cached = _store_grid(
+            model, params, phase, _basis_rows(phase, model.centres_, model.widths_), step
+        )
     return cached[3:]

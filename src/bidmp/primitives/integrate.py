@@ -57,7 +57,9 @@ def _max_stable_step(alpha: float, beta: float, step: float) -> float:
     low, high = 0.0, step
     for _ in range(60):
         middle = 0.5 * (low + high)
-        low, high = (middle, high) if _euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
+        low, high = (
+            (middle, high) if _euler_spectral_radius(middle, alpha, beta) < 1.0 else (low, middle)
+        )
     return low
 
 
@@ -80,7 +82,9 @@ def _check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> Non
         )
 
 
-def _second_order(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, numerator, a1: float, a2: float):
+def _second_order(
+    drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, numerator, a1: float, a2: float
+):
     """``y[n+2] = -a1 y[n+1] - a2 y[n] + drive[n]`` for several signals, with ``drive`` filtered
     by ``numerator`` first; (S, n_drives + 2) with ``y[0], y[1]`` given."""
     out = np.empty((drives.shape[0], drives.shape[1] + 2))
@@ -94,8 +98,15 @@ def _second_order(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray,
     return out
 
 
-def _euler_responses(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, *, h: float, alpha: float,
-                    beta: float) -> np.ndarray:
+def _euler_responses(
+    drives: np.ndarray,
+    y_first: np.ndarray,
+    y_second: np.ndarray,
+    *,
+    h: float,
+    alpha: float,
+    beta: float,
+) -> np.ndarray:
     """Integrate the Euler-discretised spring-damper for several input signals at once.
 
     With ``z = (y[n+1] - y[n]) / h`` the two Euler updates become
@@ -121,7 +132,9 @@ def _euler_responses(drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarr
 
 # -- exact (first-order hold) ---------------------------------------------------------------------
 @lru_cache(maxsize=64)
-def _foh_step(step: float, alpha: float, beta: float, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _foh_step(
+    step: float, alpha: float, beta: float, tau: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The exact step of the spring-damper with the input linear over the step.
 
     Returns ``(Φ (2, 2), Γ₀ (2,), Γ₁ (2,))`` with ``x[l+1] = Φ x[l] + Γ₀ u[l] + Γ₁ u[l+1]`` for the
@@ -147,8 +160,16 @@ def _foh_step(step: float, alpha: float, beta: float, tau: float) -> tuple[np.nd
     return transition, now, after
 
 
-def _exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarray, *, step: float, alpha: float,
-                    beta: float, tau: float) -> np.ndarray:
+def _exact_responses(
+    inputs: np.ndarray,
+    y_first: np.ndarray,
+    z_first: np.ndarray,
+    *,
+    step: float,
+    alpha: float,
+    beta: float,
+    tau: float,
+) -> np.ndarray:
     """Exact (first-order hold) integration for several input signals at once.
 
     Parameters
@@ -181,8 +202,9 @@ def _exact_responses(inputs: np.ndarray, y_first: np.ndarray, z_first: np.ndarra
     return _second_order(drives, y_first, y_second, [1.0, 0.0, 0.0], a1, a2)
 
 
-def _exact_state(y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float, beta: float,
-                tau: float) -> tuple[np.ndarray, np.ndarray]:
+def _exact_state(
+    y: np.ndarray, inputs: np.ndarray, *, step: float, alpha: float, beta: float, tau: float
+) -> tuple[np.ndarray, np.ndarray]:
     """``z`` and ``d²y/ds²`` at the samples of an exact rollout, from consecutive positions.
 
     Parameters
@@ -221,8 +243,13 @@ def _check_integration(step: float, params) -> None:
         _phase_decay(step, params.tau, params.goal_rate)
 
 
-def _unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step: float,
-                   gate: np.ndarray | None = None) -> np.ndarray:
+def _unit_responses(
+    params,
+    phase: np.ndarray,
+    forcing: np.ndarray | None,
+    step: float,
+    gate: np.ndarray | None = None,
+) -> np.ndarray:
     """Responses that compose every rollout on the grid ``phase`` (n samples ``step`` apart).
 
     ``y = a + B g + C y0 + V v0``: ``a`` is driven by ``K f`` from rest at 0 (one row per
@@ -248,13 +275,18 @@ def _unit_responses(params, phase: np.ndarray, forcing: np.ndarray | None, step:
         # the exact integrator's z = tau dy/ds.
         second = np.array([0.0, 0.0, params.tau]) if exact else np.array([0.0, 1.0, step])
     if exact:
-        return _exact_responses(drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau)
-    responses = _euler_responses(drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta)
+        return _exact_responses(
+            drives, y_first, second, step=step, alpha=alpha, beta=beta, tau=params.tau
+        )
+    responses = _euler_responses(
+        drives, y_first, second, h=step / params.tau, alpha=alpha, beta=beta
+    )
     return responses[:, :n_steps]
 
 
-def _affine_rollouts(goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray,
-                    out: np.ndarray | None = None) -> np.ndarray:
+def _affine_rollouts(
+    goal_response: np.ndarray, goals: np.ndarray, free: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """``y[i] = free + B goals[i]`` for every goal at once, (G, n, D), written into ``out`` if given.
 
     From :data:`GEMM_GOALS` goals on, one matrix product ``[goals | 1] @ [B e_d ... | free]``
@@ -305,19 +337,25 @@ class StepIntegrator:
         self._checked_step = None
         self._floats = None  # (step, the exact step's coefficients as floats) of the last step
 
-    def step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
-             step: float) -> tuple[np.ndarray, np.ndarray]:
+    def step(
+        self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray, step: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The state ``step`` (normalised time) later; ``u_next`` (the input at the step's end) is
         read by the exact step only. ``y``, ``z``, ``u_now`` and ``u_next`` are (D,) arrays."""
-        y, z, u_now, u_next = (as_vector(value, name) for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"),
-                                                                        (u_next, "u_next")))
+        y, z, u_now, u_next = (
+            as_vector(value, name)
+            for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"), (u_next, "u_next"))
+        )
         if not y.shape == z.shape == u_now.shape == u_next.shape:
-            raise ValueError(f"y, z, u_now and u_next must have one value per dimension each, got "
-                             f"{y.shape[0]}, {z.shape[0]}, {u_now.shape[0]} and {u_next.shape[0]}")
+            raise ValueError(
+                f"y, z, u_now and u_next must have one value per dimension each, got "
+                f"{y.shape[0]}, {z.shape[0]}, {u_now.shape[0]} and {u_next.shape[0]}"
+            )
         return self._step(y, z, u_now, u_next, check_real(step, "step", positive=True, maximum=1e3))
 
-    def _step(self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray,
-              step: float) -> tuple[np.ndarray, np.ndarray]:
+    def _step(
+        self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray, step: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`step` on arguments a stepper has checked (its control loop calls it every step)."""
         alpha, beta, tau = self.alpha, self.beta, self.tau
         if self.exact:
@@ -327,8 +365,10 @@ class StepIntegrator:
                 transition, now, after = _foh_step(step, alpha, beta, tau)
                 self._floats = (step, *transition.ravel().tolist(), *now.tolist(), *after.tolist())
             _, t00, t01, t10, t11, n0, n1, a0, a1 = self._floats
-            return (t00 * y + t01 * z + n0 * u_now + a0 * u_next,
-                    t10 * y + t11 * z + n1 * u_now + a1 * u_next)
+            return (
+                t00 * y + t01 * z + n0 * u_now + a0 * u_next,
+                t10 * y + t11 * z + n1 * u_now + a1 * u_next,
+            )
         h = step / tau
         if h != self._checked_step:
             _check_euler_stable(step, tau, alpha, beta)

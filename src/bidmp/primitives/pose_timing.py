@@ -43,7 +43,11 @@ class PoseTrajectory(TimedMotion):
     units: str = ""
 
     def __post_init__(self) -> None:
-        _validate_motion(self, "PoseTrajectory", (("y", 3), ("yd", 3), ("ydd", 3), ("q", 4), ("omega", 3), ("omega_dot", 3)))
+        _validate_motion(
+            self,
+            "PoseTrajectory",
+            (("y", 3), ("yd", 3), ("ydd", 3), ("q", 4), ("omega", 3), ("omega_dot", 3)),
+        )
 
     @property
     def poses(self) -> np.ndarray:
@@ -53,9 +57,31 @@ class PoseTrajectory(TimedMotion):
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, qx, qy, qz, qw, vx, vy, vz, wx, wy, wz, ax, ay, az, dwx, dwy,
         dwz`` and the matching (n, 20) array: the layout of timed pose CSV files."""
-        header = ["t", "x", "y", "z", "qx", "qy", "qz", "qw", "vx", "vy", "vz", "wx", "wy", "wz", "ax", "ay", "az",
-                  "dwx", "dwy", "dwz"]
-        return header, np.column_stack([self.t, self.y, self.q, self.yd, self.omega, self.ydd, self.omega_dot])
+        header = [
+            "t",
+            "x",
+            "y",
+            "z",
+            "qx",
+            "qy",
+            "qz",
+            "qw",
+            "vx",
+            "vy",
+            "vz",
+            "wx",
+            "wy",
+            "wz",
+            "ax",
+            "ay",
+            "az",
+            "dwx",
+            "dwy",
+            "dwz",
+        ]
+        return header, np.column_stack(
+            [self.t, self.y, self.q, self.yd, self.omega, self.ydd, self.omega_dot]
+        )
 
     def peak_angular_speed(self) -> float:
         """Largest ‖omega‖ (rad/s)."""
@@ -75,23 +101,62 @@ def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.n
     return omega, omega_dot
 
 
-def _pose_trajectory(position_model, orientation_model, goal_p, start_p, goal_q, start_e, duration, dt, limits,
-                     position_increment, orientation_increment, units, coupling=None, vias=None) -> PoseTrajectory:
+def _pose_trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    position_model,
+    orientation_model,
+    goal_p,
+    start_p,
+    goal_q,
+    start_e,
+    duration,
+    dt,
+    limits,
+    position_increment,
+    orientation_increment,
+    units,
+    coupling=None,
+    vias=None,
+) -> PoseTrajectory:
     """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
     ``coupling`` terms act on the position part, and both parts then run the step integrator;
     ``vias`` = (position via-points, orientation-error via-points)."""
     position_via, error_via = (None, None) if vias is None else vias
-    position = position_model.trajectory(goal_p, start=start_p, duration=duration, dt=dt, limits=limits, forcing_increment=position_increment,
-                                         coupling=coupling, via=position_via)
-    if limits and vias is None:  # the orientation follows the motion time the position's limits chose
+    position = position_model.trajectory(
+        goal_p,
+        start=start_p,
+        duration=duration,
+        dt=dt,
+        limits=limits,
+        forcing_increment=position_increment,
+        coupling=coupling,
+        via=position_via,
+    )
+    if (
+        limits and vias is None
+    ):  # the orientation follows the motion time the position's limits chose
         duration = position.t[-1] / position_model._params().settle
-    error = orientation_model.trajectory(np.zeros(3), start=start_e, duration=duration, dt=dt, forcing_increment=orientation_increment,
-                                         coupling=None if coupling is None else [], via=error_via)
+    error = orientation_model.trajectory(
+        np.zeros(3),
+        start=start_e,
+        duration=duration,
+        dt=dt,
+        forcing_increment=orientation_increment,
+        coupling=None if coupling is None else [],
+        via=error_via,
+    )
     n = min(len(position.t), len(error.t))
     orientation = orientation_from_log(error.y[:n], goal_q)
     omega, omega_dot = _angular_rates(error.y[:n], error.yd[:n], error.ydd[:n])
-    return PoseTrajectory(position.t[:n], position.y[:n], position.yd[:n], position.ydd[:n], orientation, omega,
-                          omega_dot, units)
+    return PoseTrajectory(
+        position.t[:n],
+        position.y[:n],
+        position.yd[:n],
+        position.ydd[:n],
+        orientation,
+        omega,
+        omega_dot,
+        units,
+    )
 
 
 class PoseStepper:
@@ -109,7 +174,9 @@ class PoseStepper:
         self.goal_orientation = goal_orientation
         self._turns = _GoalShifts(3)  # rotation vectors δ of the goal frame, blended in turn
 
-    def set_goal_pose(self, pose, *, limits: dict | None = None, blend: float | None = None) -> float:
+    def set_goal_pose(
+        self, pose, *, limits: dict | None = None, blend: float | None = None
+    ) -> float:
         """Move the goal to ``pose`` (7,) mid-motion: the position as
         :meth:`bidmp.primitives.stepper.DMPStepper.set_goal`, the orientation by turning the goal
         frame ``Exp(s(t) δ) ⊗ goal`` over the same blend (``δ`` the principal rotation from the
@@ -143,7 +210,14 @@ class PoseStepper:
 
     @property
     def y(self) -> np.ndarray:
-        return np.concatenate([self.position.y, orientation_from_log(self.orientation.y[None], self._goal_now(self.position.time)[0])[0]])
+        return np.concatenate(
+            [
+                self.position.y,
+                orientation_from_log(
+                    self.orientation.y[None], self._goal_now(self.position.time)[0]
+                )[0],
+            ]
+        )
 
     def step(self, dt: float, y_measured=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Command pose, velocity and acceleration now; advance ``dt`` s (less while the measured
@@ -152,7 +226,9 @@ class PoseStepper:
         if y_measured is not None:
             y_measured = as_vector(y_measured, "y_measured")
             if y_measured.shape[0] not in (3, 7):
-                raise ValueError(f"y_measured must be a position (3,) or a pose (7,), got {y_measured.shape[0]} values")
+                raise ValueError(
+                    f"y_measured must be a position (3,) or a pose (7,), got {y_measured.shape[0]} values"
+                )
         y, yd, ydd = self.position.step(dt, None if y_measured is None else y_measured[:3])
         advanced = self.position.time - before
         e, ed, edd = self.orientation.step(max(advanced, 1e-6))
@@ -167,4 +243,8 @@ class PoseStepper:
             rotation = Rotation.from_rotvec(e).as_matrix()
             omega_dot = omega_dot + rotation @ turn_rate + np.cross(omega, rotation @ turn)
             omega = omega + rotation @ turn
-        return np.concatenate([y, q]), np.concatenate([yd, omega * pace]), np.concatenate([ydd, omega_dot * pace**2])
+        return (
+            np.concatenate([y, q]),
+            np.concatenate([yd, omega * pace]),
+            np.concatenate([ydd, omega_dot * pace**2]),
+        )

@@ -22,8 +22,7 @@ from .._checks import (
     check_real,
 )
 
-__all__ = ["PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE",
-           "ROBOT_SETTLE"]
+__all__ = ["PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE", "ROBOT_SETTLE"]
 
 K_CHOICES = ("paper", "pastor")
 REGRESSION_CHOICES = ("lwr", "ridge")
@@ -53,7 +52,8 @@ class _Params(NamedTuple):
     goal_rate: float | None  # None: the goal follows the demonstration's progress (robot default)
     integrator: str  # "exact" (first-order hold, any rate) or "euler" (the paper's Eq. 14)
     settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
-    keep_approach: bool = False  # the goal's offset complete before the final approach (ApproachGate)
+    # the goal's offset complete before the final approach (ApproachGate)
+    keep_approach: bool = False
 
     @property
     def exact(self) -> bool:
@@ -89,35 +89,67 @@ def _resolve_params(estimator) -> _Params:
     parameters) as they are now, the protocol's defaults filled in; raise naming the first bad one."""
     protocol = check_choice(estimator.protocol, "protocol", PROTOCOLS)
     robot = protocol == "robot"
-    alpha = (ROBOT_ALPHA if robot else 25.0) if estimator.alpha is None else \
-        check_real(estimator.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
-    beta = alpha / 4.0 if estimator.beta is None else check_real(estimator.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+    alpha = (
+        (ROBOT_ALPHA if robot else 25.0)
+        if estimator.alpha is None
+        else check_real(
+            estimator.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]
+        )
+    )
+    beta = (
+        alpha / 4.0
+        if estimator.beta is None
+        else check_real(
+            estimator.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]
+        )
+    )
     K_choice = ("pastor" if robot else "paper") if estimator.K is None else estimator.K
     if isinstance(K_choice, str):
         check_choice(K_choice, "K", K_CHOICES)
         K = alpha if K_choice == "paper" else alpha * beta
     else:
-        K = check_real(K_choice, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2)
+        K = check_real(
+            K_choice, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2
+        )
     if estimator.alpha_phase is None:
         alpha_phase = ROBOT_ALPHA_PHASE if robot else 1.0
     else:
-        alpha_phase = check_real(estimator.alpha_phase, "alpha_phase", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
+        alpha_phase = check_real(
+            estimator.alpha_phase,
+            "alpha_phase",
+            positive=True,
+            minimum=_GAIN_RANGE[0],
+            maximum=_GAIN_RANGE[1],
+        )
     if estimator.goal_rate is None:
         goal_rate = None if robot else alpha_phase
     else:
-        goal_rate = check_real(estimator.goal_rate, "goal_rate", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1])
-    integrator = ("exact" if robot else "euler") if estimator.integrator is None else \
-        check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
+        goal_rate = check_real(
+            estimator.goal_rate,
+            "goal_rate",
+            positive=True,
+            minimum=_GAIN_RANGE[0],
+            maximum=_GAIN_RANGE[1],
+        )
+    integrator = (
+        ("exact" if robot else "euler")
+        if estimator.integrator is None
+        else check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
+    )
     return _Params(
-        n_kernels=(ROBOT_KERNELS if robot else 50) if estimator.n_kernels is None else
-        check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
+        n_kernels=(ROBOT_KERNELS if robot else 50)
+        if estimator.n_kernels is None
+        else check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
         alpha=alpha,
         beta=beta,
         K=K,
         alpha_phase=alpha_phase,
-        tau=check_real(estimator.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]),
-        regression=("ridge" if robot else "lwr") if estimator.regression is None else
-        check_choice(estimator.regression, "regression", REGRESSION_CHOICES),
+        tau=check_real(
+            estimator.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]
+        ),
+        regression=("ridge" if robot else "lwr")
+        if estimator.regression is None
+        else check_choice(estimator.regression, "regression", REGRESSION_CHOICES),
         derivatives=check_choice(estimator.derivatives, "derivatives", DERIVATIVE_CHOICES),
         ridge=check_real(estimator.ridge, "ridge", nonnegative=True, maximum=1e6),
         widths=check_choice(estimator.widths, "widths", WIDTH_CHOICES),
@@ -150,7 +182,7 @@ class _FittedParams:
         names = cls.__dict__.get("_raw_names")
         if names is None:
             names = tuple(name for name in cls._get_param_names() if name != "tau")
-            setattr(cls, "_raw_names", names)
+            cls._raw_names = names
         return names
 
     def _learned_params(self) -> _Params:
@@ -170,13 +202,18 @@ class _FittedParams:
             return []
         raw, resolved = learned
         try:
-            if self._raw_params() == raw:  # the common case, without resolving the protocol's defaults
+            if (
+                self._raw_params() == raw
+            ):  # the common case, without resolving the protocol's defaults
                 return []
         except (TypeError, ValueError):  # an array set by mistake: resolving names it
             pass
         now = self._learned_params()
-        return [f"{name} (fitted with {before!r}, now {after!r})" for name, before, after in zip(now._fields, resolved, now)
-                if before != after]
+        return [
+            f"{name} (fitted with {before!r}, now {after!r})"
+            for name, before, after in zip(now._fields, resolved, now)
+            if before != after
+        ]
 
     def __sklearn_is_fitted__(self) -> bool:
         return self._fitted_attribute in self.__dict__ and not self._stale_params()
@@ -206,6 +243,8 @@ def _keep_approach(estimator, goal_rate, integrator: str) -> bool:
     if not isinstance(keep, (bool, np.bool_)):
         raise TypeError(f"keep_approach must be True, False or None, got {type(keep).__name__}")
     if keep and (goal_rate is not None or integrator != "exact"):
-        raise ValueError("keep_approach shapes the robot protocol's progress gate: it needs goal_rate=None and the "
-                         "exact integrator")
+        raise ValueError(
+            "keep_approach shapes the robot protocol's progress gate: it needs goal_rate=None and the "
+            "exact integrator"
+        )
     return bool(keep)

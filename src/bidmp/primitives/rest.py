@@ -21,7 +21,8 @@ __all__ = []
 
 logger = logging.getLogger(__name__)
 
-_REST_BLEND_SHARE = 0.1  # the rest blend adds at most this share of the demonstration's acceleration
+# the rest blend adds at most this share of the demonstration's acceleration
+_REST_BLEND_SHARE = 0.1
 _REST_BLEND_MAX = 0.25  # the rest blend never spans more than this share of the demonstration
 _REST_CANDIDATES = np.geomspace(0.01, _REST_BLEND_MAX, 32)
 
@@ -29,10 +30,14 @@ _REST_CANDIDATES = np.geomspace(0.01, _REST_BLEND_MAX, 32)
 # The rest blend's acceleration is -v₀ q''(t/w) / w with q(u) = u (1 - S(u)), q'' = -2S' - u S'':
 # its shape on [0, 1] does not depend on the window, so it is tabulated once.
 _BLEND_U = np.linspace(0.0, 1.0, 65)
-_BLEND_SHAPE = np.abs(2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1])
+_BLEND_SHAPE = np.abs(
+    2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1]
+)
 
 
-def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float) -> float:
+def _blend_window(
+    speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float
+) -> float:
     """The shortest window (normalised time) over which blending ``speed_vector`` out adds at most
     ``_REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
     speed = float(np.linalg.norm(speed_vector))
@@ -41,13 +46,20 @@ def _blend_window(speed_vector: np.ndarray, acceleration: np.ndarray, dt: float,
     running = np.maximum.accumulate(np.linalg.norm(acceleration, axis=1))
     # All candidate windows at once: (candidates, 65) added accelerations against the running peak.
     added = speed * _BLEND_SHAPE[None, :] / _REST_CANDIDATES[:, None]
-    index = np.minimum((_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1)
+    index = np.minimum(
+        (_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1
+    )
     within = np.all(added <= _REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
     return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(_REST_BLEND_MAX)
 
 
-def _rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the demonstration",
-                 unit: str = "units") -> np.ndarray:
+def _rest_started(
+    y: np.ndarray,
+    dt: float,
+    duration_s: float,
+    what: str = "the demonstration",
+    unit: str = "units",
+) -> np.ndarray:
     """``y`` (T, D) with its start and end velocity blended out (module docstring).
 
     Parameters
@@ -66,7 +78,10 @@ def _rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the 
     peak = float(np.max(np.linalg.norm(velocity, axis=1)))
     s = np.arange(y.shape[0]) * dt
     out = y.copy()
-    for end, speed_vector, forward in ((False, velocity[0], acceleration), (True, velocity[-1], acceleration[::-1])):
+    for end, speed_vector, forward in (
+        (False, velocity[0], acceleration),
+        (True, velocity[-1], acceleration[::-1]),
+    ):
         width = _blend_window(speed_vector, forward, dt, peak)
         if width == 0.0:
             continue
@@ -75,7 +90,15 @@ def _rest_started(y: np.ndarray, dt: float, duration_s: float, what: str = "the 
         out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
         speed = float(np.linalg.norm(speed_vector))
         level = logging.WARNING if speed > 0.05 * peak else logging.DEBUG
-        logger.log(level, "%s %s at %.3g %s/s (%.1f %% of its peak speed); the DMP %s at rest, blended over %.3g s",
-                   what, "ends" if end else "starts", speed / duration_s, unit, 100 * speed / peak,
-                   "ends" if end else "starts", width * duration_s)
+        logger.log(
+            level,
+            "%s %s at %.3g %s/s (%.1f %% of its peak speed); the DMP %s at rest, blended over %.3g s",
+            what,
+            "ends" if end else "starts",
+            speed / duration_s,
+            unit,
+            100 * speed / peak,
+            "ends" if end else "starts",
+            width * duration_s,
+        )
     return out

@@ -12,7 +12,9 @@ from .integrate import _affine_rollouts
 __all__ = []
 
 
-def _rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+def _rollouts_to(
+    goals, free: np.ndarray, goal_response: np.ndarray, out: np.ndarray | None = None
+) -> np.ndarray:
     """The rollouts ``free + B goals[i]`` (G, n, D) of a model's free response ``free`` (n, D) and
     goal response ``goal_response`` (n,), into ``out`` if given (else refused over the limit
     ``max_array_bytes``)."""
@@ -30,8 +32,15 @@ def _rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, out: np.nda
                 f"or raise the limit"
             )
         return _affine_rollouts(goal_response, goals, free)
-    if not isinstance(out, np.ndarray) or out.shape != shape or out.dtype != np.float64 or not out.flags.writeable:
-        described = f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
+    if (
+        not isinstance(out, np.ndarray)
+        or out.shape != shape
+        or out.dtype != np.float64
+        or not out.flags.writeable
+    ):
+        described = (
+            f"{type(out).__name__} {getattr(out, 'shape', '')} {getattr(out, 'dtype', '')}".strip()
+        )
         raise ValueError(f"out must be a writable float64 array of shape {shape}, got {described}")
     for first, chunk in _chunks(goals, free):
         _affine_rollouts(goal_response, chunk, free, out[first : first + chunk.shape[0]])
@@ -51,13 +60,20 @@ def _goals(goals, free: np.ndarray) -> np.ndarray:
     than ``max_work`` (each goal is a whole motion: the total work is bounded, not only one array)."""
     goals = as_points(goals, free.shape[1], "goals")
     check_limit(goals.shape[0], "max_samples", "goals: the number of goals")
-    check_limit(goals.shape[0] * free.size, "max_work", "goals: the rollouts' samples in all (goals x n_steps x D)")
+    check_limit(
+        goals.shape[0] * free.size,
+        "max_work",
+        "goals: the rollouts' samples in all (goals x n_steps x D)",
+    )
     return goals
 
 
 def _iter_rollouts_to(goals, free: np.ndarray, goal_response: np.ndarray, chunk_size: int):
     """:func:`_rollouts_to`, ``chunk_size`` goals at a time: yields ``(first, y (g, n, D))``."""
     goals = _goals(goals, free)
-    check_bytes(min(chunk_size, goals.shape[0]) * free.size, "one chunk of iter_rollouts (chunk_size x n_steps x D)")
+    check_bytes(
+        min(chunk_size, goals.shape[0]) * free.size,
+        "one chunk of iter_rollouts (chunk_size x n_steps x D)",
+    )
     for first, chunk in _chunks(goals, free, chunk_size):
         yield first, _affine_rollouts(goal_response, chunk, free)

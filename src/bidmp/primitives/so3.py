@@ -20,11 +20,18 @@ from scipy.spatial.transform import Rotation
 from .._checks import _as_bounded_array, _check_magnitude, check_limit
 from .._trajectory import continuous_quaternions
 
-__all__ = ["as_quaternions", "principal_log", "continuous_log", "angle_between",
-           "orientation_from_log"]
+__all__ = [
+    "as_quaternions",
+    "principal_log",
+    "continuous_log",
+    "angle_between",
+    "orientation_from_log",
+]
 
-_NORM_TOLERANCE = 1e-6  # a quaternion further than this from unit length is normalised, with a warning
-_AXIS_FLOOR = 1e-6  # below this angle (rad) a rotation's axis is noise: the neighbour's axis is kept
+# a quaternion further than this from unit length is normalised, with a warning
+_NORM_TOLERANCE = 1e-6
+# below this angle (rad) a rotation's axis is noise: the neighbour's axis is kept
+_AXIS_FLOOR = 1e-6
 _TWO_PI = 2.0 * math.pi
 
 
@@ -32,10 +39,14 @@ def as_quaternions(q, name: str = "q") -> np.ndarray:
     """Validate quaternions ``(n, 4)`` (x, y, z, w): finite, not zero; non-unit ones are
     normalised with a warning; signs made continuous. ``name``: the argument's name in messages."""
     if not isinstance(name, str) or not name or len(name) > 100:
-        raise TypeError(f"name must be the argument's name (a short string), got {type(name).__name__}")
+        raise TypeError(
+            f"name must be the argument's name (a short string), got {type(name).__name__}"
+        )
     if isinstance(q, (str, bytes)):
         raise TypeError(f"{name} must be an array of numbers, got a string")
-    array = _as_bounded_array(q, name, 2)  # None, complex, objects and oversized arrays refused, naming the argument
+    array = _as_bounded_array(
+        q, name, 2
+    )  # None, complex, objects and oversized arrays refused, naming the argument
     if array.ndim == 1:
         array = array[None]
     if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:
@@ -46,15 +57,23 @@ def as_quaternions(q, name: str = "q") -> np.ndarray:
     # Scaled by the largest component first, so that 1e200 and 1e-200 quaternions normalise too.
     largest = np.max(np.abs(array), axis=1, keepdims=True)
     if np.any(largest < 1e-300):
-        raise ValueError(f"{name}: row {int(np.argmax(largest[:, 0] < 1e-300))} is a zero quaternion, which is no rotation")
+        raise ValueError(
+            f"{name}: row {int(np.argmax(largest[:, 0] < 1e-300))} is a zero quaternion, which is no rotation"
+        )
     scaled = array / largest
     norms = np.linalg.norm(scaled, axis=1) * largest[:, 0]
     if np.any(norms < 1e-9):
-        raise ValueError(f"{name}: row {int(np.argmax(norms < 1e-9))} is a zero quaternion, which is no rotation")
+        raise ValueError(
+            f"{name}: row {int(np.argmax(norms < 1e-9))} is a zero quaternion, which is no rotation"
+        )
     off = np.abs(norms - 1.0) > _NORM_TOLERANCE
     if np.any(off):
-        warnings.warn(f"{name}: {int(off.sum())} quaternion(s) were not of unit length (up to "
-                      f"{np.max(np.abs(norms - 1)):.3g} off) and were normalised", UserWarning, stacklevel=3)
+        warnings.warn(
+            f"{name}: {int(off.sum())} quaternion(s) were not of unit length (up to "
+            f"{np.max(np.abs(norms - 1)):.3g} off) and were normalised",
+            UserWarning,
+            stacklevel=3,
+        )
     return continuous_quaternions(scaled / np.linalg.norm(scaled, axis=1, keepdims=True))
 
 
@@ -63,7 +82,9 @@ def _quaternion_rows(q, name: str) -> np.ndarray:
     are left as given (SciPy normalises them), so a checked call computes what an unchecked one did."""
     array = np.atleast_2d(_as_bounded_array(q, name, 2))
     if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:
-        raise ValueError(f"{name} must have shape (n, 4) or (4,) (qx, qy, qz, qw), got {np.shape(q)}")
+        raise ValueError(
+            f"{name} must have shape (n, 4) or (4,) (qx, qy, qz, qw), got {np.shape(q)}"
+        )
     check_limit(array.shape[0], "max_samples", f"{name}: the number of quaternions")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
@@ -76,7 +97,9 @@ def _vector_rows(r, name: str) -> np.ndarray:
     """Rotation vectors (n, 3) or one (3,) (rad) checked at the boundary: real and finite."""
     array = np.atleast_2d(_as_bounded_array(r, name, 2))
     if array.ndim != 2 or array.shape[1] != 3 or array.shape[0] == 0:
-        raise ValueError(f"{name} must have shape (n, 3) or (3,) (rotation vectors, rad), got {np.shape(r)}")
+        raise ValueError(
+            f"{name} must have shape (n, 3) or (3,) (rotation vectors, rad), got {np.shape(r)}"
+        )
     check_limit(array.shape[0], "max_samples", f"{name}: the number of rotation vectors")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
@@ -92,13 +115,19 @@ def principal_log(q, goal) -> np.ndarray:
 def _principal_log(q, goal, q_name: str, goal_name: str) -> np.ndarray:
     q, goal = _quaternion_rows(q, q_name), _quaternion_rows(goal, goal_name)
     if goal.shape[0] not in (1, q.shape[0]):
-        raise ValueError(f"{goal_name} has {goal.shape[0]} quaternions; give one, or one per row of {q_name} ({q.shape[0]})")
-    return (Rotation.from_quat(q) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal).inv()).as_rotvec()
+        raise ValueError(
+            f"{goal_name} has {goal.shape[0]} quaternions; give one, or one per row of {q_name} ({q.shape[0]})"
+        )
+    return (
+        Rotation.from_quat(q) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal).inv()
+    ).as_rotvec()
 
 
 def _angles_and_axes(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     angles = np.linalg.norm(vectors, axis=1)
-    axes = np.divide(vectors, angles[:, None], out=np.zeros_like(vectors), where=angles[:, None] > _AXIS_FLOOR)
+    axes = np.divide(
+        vectors, angles[:, None], out=np.zeros_like(vectors), where=angles[:, None] > _AXIS_FLOOR
+    )
     return angles, axes
 
 
@@ -111,7 +140,10 @@ def continuous_log(q, goal) -> np.ndarray:
     of the sample after it is kept. Sequential by nature; a scalar loop (about 1 µs a sample).
     """
     principal = principal_log(q, goal)
-    if principal.shape[0] < 2 or np.max(np.linalg.norm(np.diff(principal, axis=0), axis=1)) < 0.5 * math.pi:
+    if (
+        principal.shape[0] < 2
+        or np.max(np.linalg.norm(np.diff(principal, axis=0), axis=1)) < 0.5 * math.pi
+    ):
         return principal  # no jump anywhere: the principal values are already continuous
     angles, axes = _angles_and_axes(principal)
     n = angles.shape[0]
@@ -126,7 +158,9 @@ def continuous_log(q, goal) -> np.ndarray:
         axis = out_axes[index]
         alignment = axis[0] * after[0] + axis[1] * after[1] + axis[2] * after[2]
         wanted = signed[index + 1] * alignment  # the neighbour's vector projected on this axis
-        signed[index] = angle_list[index] + _TWO_PI * math.floor((wanted - angle_list[index]) / _TWO_PI + 0.5)
+        signed[index] = angle_list[index] + _TWO_PI * math.floor(
+            (wanted - angle_list[index]) / _TWO_PI + 0.5
+        )
     return np.asarray(signed)[:, None] * np.asarray(out_axes)
 
 
@@ -175,6 +209,10 @@ def orientation_from_log(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
     """Unit quaternions ``Exp(e) ⊗ goal`` (n, 4), signs continuous."""
     error, goal = _vector_rows(error, "error"), _quaternion_rows(goal, "goal")
     if goal.shape[0] not in (1, error.shape[0]):
-        raise ValueError(f"goal has {goal.shape[0]} quaternions; give one, or one per row of error ({error.shape[0]})")
-    q = (Rotation.from_rotvec(error) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal)).as_quat()
+        raise ValueError(
+            f"goal has {goal.shape[0]} quaternions; give one, or one per row of error ({error.shape[0]})"
+        )
+    q = (
+        Rotation.from_rotvec(error) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal)
+    ).as_quat()
     return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))

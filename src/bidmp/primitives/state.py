@@ -5,7 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_unit_quaternion, check_int, check_loaded, check_names, check_real, get_limits
+from .._checks import (
+    as_unit_quaternion,
+    check_int,
+    check_loaded,
+    check_names,
+    check_real,
+    get_limits,
+)
 from .._units import check_units
 from .integrate import _check_euler_stable
 
@@ -26,7 +33,12 @@ def _dmp_state(model) -> tuple[dict, dict]:
         arrays["goal_gate_"] = model.goal_gate_
     if model.__dict__.get("held_orientation_") is not None:
         arrays["held_orientation_"] = model.held_orientation_
-    meta = {"params": model.get_params(), "n_steps_": model.n_steps_, "duration_": model.duration_, "units_": model.units_}
+    meta = {
+        "params": model.get_params(),
+        "n_steps_": model.n_steps_,
+        "duration_": model.duration_,
+        "units_": model.units_,
+    }
     if model.__dict__.get("names_"):
         meta["names_"] = list(model.names_)
     return meta, arrays
@@ -54,21 +66,34 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
     model.centres_ = check_loaded(arrays["centres_"], "centres_", (n_kernels,), positive=True)
     model.widths_ = check_loaded(arrays["widths_"], "widths_", (n_kernels,), positive=True)
     for name in ("weights_", "start_", "goal_"):
-        limit = 1e3 * get_limits().max_abs_value if name == "weights_" else get_limits().max_abs_value
+        limit = (
+            1e3 * get_limits().max_abs_value if name == "weights_" else get_limits().max_abs_value
+        )
         if np.max(np.abs(getattr(model, name))) > limit:
             raise ValueError(f"member {name} has values beyond {limit:.3g}, which no fit produces")
     if np.any(model.centres_ > 1.0):
         raise ValueError("member centres_ must lie in (0, 1] (they are phases)")
     model.n_steps_ = n_steps
     model.dt_ = 1.0 / n_steps
-    model.duration_ = check_real(meta.get("duration_", (n_steps - 1) / n_steps), "duration_", positive=True, maximum=1e7)
+    model.duration_ = check_real(
+        meta.get("duration_", (n_steps - 1) / n_steps), "duration_", positive=True, maximum=1e7
+    )
     if (n_steps - 1) / model.duration_ > 1e5 or (n_steps - 1) / model.duration_ < 1e-3:
-        raise ValueError(f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples")
+        raise ValueError(
+            f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples"
+        )
     model.units_ = check_units(meta.get("units_", ""))
-    model.names_ = check_names(meta.get("names_"), n_dims, "names_")  # absent before bidmp 0.6: unnamed
-    model.held_orientation_ = (as_unit_quaternion(check_loaded(arrays["held_orientation_"], "held_orientation_", (4,)),
-                                                  "member held_orientation_")
-                               if "held_orientation_" in arrays else None)
+    model.names_ = check_names(
+        meta.get("names_"), n_dims, "names_"
+    )  # absent before bidmp 0.6: unnamed
+    model.held_orientation_ = (
+        as_unit_quaternion(
+            check_loaded(arrays["held_orientation_"], "held_orientation_", (4,)),
+            "member held_orientation_",
+        )
+        if "held_orientation_" in arrays
+        else None
+    )
     model.goal_gate_ = None
     if params.goal_rate is None:
         gate = check_loaded(arrays["goal_gate_"], "goal_gate_", (model.n_train_,))

@@ -11,7 +11,7 @@ import numpy as np
 from .._checks import as_point, check_real
 from .coupling import _as_couplings
 from .forcing import _basis_row
-from .goal_shift import _GoalShifts, _goal_complete_time, _shortest_blend
+from .goal_shift import _goal_complete_time, _GoalShifts, _shortest_blend
 from .grid import _rollout_grid
 from .integrate import StepIntegrator
 from .protocols import _TAU_RANGE
@@ -44,40 +44,60 @@ class DMPStepper:
         The motion's own time in seconds (slower than the wall clock while paused).
     """
 
-    def __init__(self, dmp, goal, start, duration, coupling, start_velocity, forcing_increment) -> None:
+    def __init__(
+        self, dmp, goal, start, duration, coupling, start_velocity, forcing_increment
+    ) -> None:
         from .dmp import DMP
 
         if not isinstance(dmp, DMP):
-            raise TypeError(f"dmp must be a fitted bidmp.DMP (DMP.stepper() builds its stepper), got {type(dmp).__name__}")
+            raise TypeError(
+                f"dmp must be a fitted bidmp.DMP (DMP.stepper() builds its stepper), got {type(dmp).__name__}"
+            )
         dmp._check_fitted()
         params = dmp._params()
         self._dmp = dmp
         n_dims = dmp.n_dims_
         self.goal = dmp.goal_.copy() if goal is None else as_point(goal, n_dims, "goal")
         self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
-        motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
-        self._scale = check_real(motion / dmp.duration_, "duration / duration_ (the temporal scaling)",
-                                 minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])  # tau of the normalised system
+        motion = (
+            params.tau * dmp.duration_
+            if duration is None
+            else check_real(duration, "duration", positive=True)
+        )
+        self._scale = check_real(
+            motion / dmp.duration_,
+            "duration / duration_ (the temporal scaling)",
+            minimum=_TAU_RANGE[0],
+            maximum=_TAU_RANGE[1],
+        )  # tau of the normalised system
         self._params = params._replace(tau=self._scale)
         self._couplings, self._temporal = _as_couplings(coupling)
         self._forcing_increment = forcing_increment
         self.y = self.start.copy()
-        velocity = np.zeros(n_dims) if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        velocity = (
+            np.zeros(n_dims)
+            if start_velocity is None
+            else as_point(start_velocity, n_dims, "start_velocity")
+        )
         self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
         # What every step reads, taken once: a control loop should not revalidate the model.
         self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
         self._goal_system = dmp.goal_system(self._params)
         self._time_unit = dmp.time_unit_
         self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
-        self._last_input = None  # (phase, gate, goal, start, u): the end of one step starts the next
+        # (phase, gate, goal, start, u): the end of one step starts the next
+        self._last_input = None
         self.phase = 1.0
         self._gate = 1.0
         self._gate = self._goal_system._follow(1.0, 1.0, 0.0, self._scale, params.exact)
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
-        self._complete = None  # the motion time its own goal offset completes (set_goal asks for it)
+        # the motion time its own goal offset completes (set_goal asks for it)
+        self._complete = None
         self._peaks = None  # the motion's own peaks (set_goal without limits asks for them)
-        for term in self._couplings:  # terms that need the motion (a scene's avoidance: its goal, its scale)
+        for term in (
+            self._couplings
+        ):  # terms that need the motion (a scene's avoidance: its goal, its scale)
             if hasattr(term, "bind"):
                 term.bind(self)
 
@@ -127,14 +147,23 @@ class DMPStepper:
         delta = as_point(goal, self.goal.shape[0], "goal") - self.target
         if blend is None:
             complete = self._goal_complete()
-            blend = max(complete - self.time, _shortest_blend(delta, limits if limits is not None else self._own_peaks()))
+            blend = max(
+                complete - self.time,
+                _shortest_blend(delta, limits if limits is not None else self._own_peaks()),
+            )
             if self.time + blend > complete + 1e-9 and np.any(delta != 0.0):
-                logger.warning("set_goal at %.3f s: the goal's offset ends %.3f s after the final approach began; "
-                               "the approach is not a translated copy", self.time, self.time + blend - complete)
+                logger.warning(
+                    "set_goal at %.3f s: the goal's offset ends %.3f s after the final approach began; "
+                    "the approach is not a translated copy",
+                    self.time,
+                    self.time + blend - complete,
+                )
         else:
             blend = check_real(blend, "blend", nonnegative=True, maximum=1e6)
             if 0.0 < blend < _SHORTEST_BLEND:  # below it a blend's acceleration is not a number
-                raise ValueError(f"blend must be 0 (a jump) or at least {_SHORTEST_BLEND:g} s, got {blend:g}")
+                raise ValueError(
+                    f"blend must be 0 (a jump) or at least {_SHORTEST_BLEND:g} s, got {blend:g}"
+                )
         self._shifts.add(delta, self.time, blend)
         return float(blend)
 
@@ -144,12 +173,22 @@ class DMPStepper:
         are given. Computed once."""
         if getattr(self, "_peaks", None) is None:
             dmp = self._dmp
-            motion = dmp.trajectory(self.goal, start=self.start, duration=self._scale * dmp.duration_,
-                                    forcing_increment=self._forcing_increment)
+            motion = dmp.trajectory(
+                self.goal,
+                start=self.start,
+                duration=self._scale * dmp.duration_,
+                forcing_increment=self._forcing_increment,
+            )
             jerk = np.gradient(motion.ydd, motion.t, axis=0)
             tiny = 1e-12 * max(float(np.ptp(motion.y)), 1e-300)
-            self._peaks = {key: max(float(np.max(np.linalg.norm(values, axis=1))), tiny) for key, values in
-                           (("max_velocity", motion.yd), ("max_acceleration", motion.ydd), ("max_jerk", jerk))}
+            self._peaks = {
+                key: max(float(np.max(np.linalg.norm(values, axis=1))), tiny)
+                for key, values in (
+                    ("max_velocity", motion.yd),
+                    ("max_acceleration", motion.ydd),
+                    ("max_jerk", jerk),
+                )
+            }
         return self._peaks
 
     def _goal_complete(self) -> float:
@@ -169,15 +208,22 @@ class DMPStepper:
     def _input(self, phase: float, gate: float) -> np.ndarray:
         """The system's input ``u = αβ g + K f(phase) - K gate (g - y0)`` (D,)."""
         last = self._last_input
-        if (last is not None and last[0] == phase and last[1] == gate and (last[2] == self.goal).all()
-                and (last[3] == self.start).all()):
+        if (
+            last is not None
+            and last[0] == phase
+            and last[1] == gate
+            and (last[2] == self.goal).all()
+            and (last[3] == self.start).all()
+        ):
             return last[4]
         params = self._params
         basis = _basis_row(phase, self._centres, self._widths)
         forcing = basis @ self._weights
         if self._forcing_increment is not None:
             forcing = forcing + self._forcing_increment(np.array([phase]), basis)
-        value = params.alpha * params.beta * self.goal + params.K * (forcing[0] - gate * (self.goal - self.start))
+        value = params.alpha * params.beta * self.goal + params.K * (
+            forcing[0] - gate * (self.goal - self.start)
+        )
         self._last_input = (phase, gate, self.goal.copy(), self.start.copy(), value)
         return value
 
@@ -189,7 +235,9 @@ class DMPStepper:
         (y, yd, ydd) : arrays (D,)
             Position (units), velocity (units/s) and acceleration (units/s²) to command.
         """
-        if not (type(dt) is float and 1e-6 <= dt <= 1e3):  # the usual case checked in one comparison
+        if not (
+            type(dt) is float and 1e-6 <= dt <= 1e3
+        ):  # the usual case checked in one comparison
             dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
         params = self._params
         time_unit = self._time_unit
@@ -210,16 +258,28 @@ class DMPStepper:
         if self._couplings:
             # An acceleration a (units/s²) enters the input as a (tau T slowdown)², held over the step.
             terms = self._couplings
-            pushed = (np.asarray(terms[0](self.time, position, velocity, self.phase), dtype=np.float64) if len(terms) == 1
-                      else sum(np.asarray(term(self.time, position, velocity, self.phase), dtype=np.float64) for term in terms))
+            pushed = (
+                np.asarray(terms[0](self.time, position, velocity, self.phase), dtype=np.float64)
+                if len(terms) == 1
+                else sum(
+                    np.asarray(term(self.time, position, velocity, self.phase), dtype=np.float64)
+                    for term in terms
+                )
+            )
             push = pushed * (tau * time_unit * slowdown) ** 2
             if not np.all(np.isfinite(push)):
                 raise ValueError("a coupling term returned a non-finite acceleration")
             input_now = input_now + push
-        acceleration = (input_now - alpha * beta * self.y - alpha * self._z) / (tau * time_unit * slowdown) ** 2
+        acceleration = (input_now - alpha * beta * self.y - alpha * self._z) / (
+            tau * time_unit * slowdown
+        ) ** 2
         if offset is not None:
             acceleration = acceleration + offset[2] / slowdown**2
-        decay_phase = math.exp(-params.alpha_phase * step / tau) if params.exact else 1.0 - params.alpha_phase * (step / tau)
+        decay_phase = (
+            math.exp(-params.alpha_phase * step / tau)
+            if params.exact
+            else 1.0 - params.alpha_phase * (step / tau)
+        )
         phase = self.phase * decay_phase
         gate = self._goal_system._follow(self._gate, phase, step, tau, params.exact)
         input_next = self._input(phase, gate) if params.exact else input_now

@@ -21,18 +21,31 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
     """(motion duration s, sample period s, number of samples, normalised step) of a timed
     rollout; the motion's duration defaults to ``tau · duration_``, the period to the
     demonstration's."""
-    motion = params.tau * dmp.duration_ if duration is None else check_real(duration, "duration", positive=True)
+    motion = (
+        params.tau * dmp.duration_
+        if duration is None
+        else check_real(duration, "duration", positive=True)
+    )
     period = dmp.duration_ / (dmp.n_steps_ - 1)
-    dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)  # 1 MHz at most
+    dt = (
+        period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)
+    )  # 1 MHz at most
     if dt > motion:
         raise ValueError(f"dt = {dt:g} s is longer than the motion's duration ({motion:g} s)")
     scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched
-    check_real(scale, "duration / duration_ (the temporal scaling)", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
+    check_real(
+        scale,
+        "duration / duration_ (the temporal scaling)",
+        minimum=_TAU_RANGE[0],
+        maximum=_TAU_RANGE[1],
+    )
     if params.protocol == "paper" and duration is None and dt == period:
         n_samples = max(int(round(params.tau * dmp.n_steps_)), 1)  # the rollout's own samples
     else:
         samples = params.settle * motion / dt * (1 + 1e-12)
-        check_real(samples, "the trajectory's samples (duration / dt)", maximum=get_limits().max_steps)
+        check_real(
+            samples, "the trajectory's samples (duration / dt)", maximum=get_limits().max_steps
+        )
         n_samples = int(np.floor(samples)) + 1  # never past settle x motion
     check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
     step = dmp.dt_ if dt == period else dt / dmp.time_unit_
@@ -44,48 +57,74 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
     params = dmp._params()
     motion, dt, n_samples, step = _time_grid(dmp, duration, dt, params)
     params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
-    velocity = None if start_velocity is None else as_point(start_velocity, dmp.n_dims_, "start_velocity") * dmp.time_unit_
+    velocity = (
+        None
+        if start_velocity is None
+        else as_point(start_velocity, dmp.n_dims_, "start_velocity") * dmp.time_unit_
+    )
     # Two extra samples give the last velocity and acceleration as forward differences (Euler),
     # one the last exact state.
-    free, goal_response, forcing, gate = dmp._prepare(start, velocity, n_samples + 2, forcing_increment,
-                                                       params=params, step=step)
+    free, goal_response, forcing, gate = dmp._prepare(
+        start, velocity, n_samples + 2, forcing_increment, params=params, step=step
+    )
     goal = dmp.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
     if dmp.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
-        check_reach(float(min(np.linalg.norm(goal - dmp.goal_), np.linalg.norm(goal - dmp.start_))), dmp.units_,
-                    "the goal")
+        check_reach(
+            float(min(np.linalg.norm(goal - dmp.goal_), np.linalg.norm(goal - dmp.start_))),
+            dmp.units_,
+            "the goal",
+        )
     positions = free + np.outer(goal_response, goal)
     if params.exact:
         start = dmp.start_ if start is None else as_point(start, free.shape[1], "start")
-        velocities, accelerations = _exact_rates(params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_)
+        velocities, accelerations = _exact_rates(
+            params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_
+        )
     else:
         velocities = np.diff(positions, axis=0) / dt
         accelerations = np.diff(velocities, axis=0) / dt
-    return Trajectory(np.arange(n_samples) * dt, positions[:n_samples], velocities[:n_samples],
-                      accelerations[:n_samples], dmp.units_, tuple(dmp.__dict__.get("names_", ())))
+    return Trajectory(
+        np.arange(n_samples) * dt,
+        positions[:n_samples],
+        velocities[:n_samples],
+        accelerations[:n_samples],
+        dmp.units_,
+        tuple(dmp.__dict__.get("names_", ())),
+    )
 
 
-def _exact_rates(params: _Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float) -> tuple:
+def _exact_rates(
+    params: _Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float
+) -> tuple:
     """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
     n out): the system's own state and acceleration, from the positions and the input."""
     inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
     inputs -= np.multiply.outer(gate, params.K * (goal - start))
     inputs += params.alpha * params.beta * goal
-    z, acceleration = _exact_state(positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau)
+    z, acceleration = _exact_state(
+        positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau
+    )
     # The first state is given, not solved for: a rest start is exactly at rest.
     z[0] = 0.0 if velocity is None else params.tau * velocity
-    acceleration[0] = (inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]) / params.tau**2
+    acceleration[0] = (
+        inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]
+    ) / params.tau**2
     return z / (params.tau * time_unit), acceleration / time_unit**2
 
 
 def _checked_limits(limits) -> tuple[dict, bool]:
     """A trajectory's ``limits`` dict as :func:`scale_factor`'s keywords, and its ``fastest`` flag."""
     if not isinstance(limits, dict):
-        raise TypeError(f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
-                        f"got {type(limits).__name__}")
+        raise TypeError(
+            f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
+            f"got {type(limits).__name__}"
+        )
     unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm", "fastest"}
     if unknown:
-        raise ValueError(f"limits has unknown key(s) {short_token(sorted(map(str, unknown)), 40)}; known: max_velocity, "
-                         f"max_acceleration, max_jerk, norm, fastest")
+        raise ValueError(
+            f"limits has unknown key(s) {short_token(sorted(map(str, unknown)), 40)}; known: max_velocity, "
+            f"max_acceleration, max_jerk, norm, fastest"
+        )
     limits = dict(limits)
     fastest = limits.pop("fastest", False)
     if not isinstance(fastest, (bool, np.bool_)):
@@ -93,7 +132,9 @@ def _checked_limits(limits) -> tuple[dict, bool]:
     return limits, bool(fastest)
 
 
-def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None):
+def _limited_trajectory(
+    dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None
+):
     """The trajectory within ``limits``: at the nominal duration if that meets them (limits
     are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
     shortest duration that does: scale by the exact factor of
@@ -101,8 +142,15 @@ def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_in
     limits, fastest = _checked_limits(limits)
 
     def attempt(duration):
-        trajectory = dmp.trajectory(goal, start=start, duration=duration, dt=dt, start_velocity=start_velocity,
-                                     forcing_increment=forcing_increment, coupling=coupling)
+        trajectory = dmp.trajectory(
+            goal,
+            start=start,
+            duration=duration,
+            dt=dt,
+            start_velocity=start_velocity,
+            forcing_increment=forcing_increment,
+            coupling=coupling,
+        )
         return trajectory, scale_factor(trajectory, **limits)
 
     # The exact factor first (speed ~ 1/k, acceleration ~ 1/k²), then a bisection in log
@@ -128,7 +176,9 @@ def _limited_trajectory(dmp, goal, start, dt, limits, start_velocity, forcing_in
     return trajectory if factor <= 1.0 or best is None else best
 
 
-def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling) -> Trajectory:
+def _coupled_trajectory(
+    dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling
+) -> Trajectory:
     """:meth:`bidmp.DMP.trajectory` through the step integrator, with coupling terms: the same
     samples as :func:`_timed_trajectory` (to rounding) when the terms add nothing. With a
     :class:`bidmp.primitives.avoidance.SceneAvoidance` term the motion runs on past the horizon
@@ -143,13 +193,20 @@ def _coupled_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_
     if avoiding:
         for _ in range(n_samples):
             position, velocity = states[-1][0], states[-1][1]
-            if np.linalg.norm(velocity) * motion <= _REST_SHARE * reach and np.linalg.norm(position - stepper.target) <= _REST_SHARE * reach:
+            if (
+                np.linalg.norm(velocity) * motion <= _REST_SHARE * reach
+                and np.linalg.norm(position - stepper.target) <= _REST_SHARE * reach
+            ):
                 break
             states.append(stepper.step(dt))
     y, yd, ydd = (np.array([state[k] for state in states]) for k in range(3))
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(ydd))):
-        raise ValueError("trajectory: the coupled integration is not finite; a coupling term is out of range")
-    trajectory = Trajectory(np.arange(len(states)) * dt, y, yd, ydd, dmp.units_, tuple(dmp.__dict__.get("names_", ())))
+        raise ValueError(
+            "trajectory: the coupled integration is not finite; a coupling term is out of range"
+        )
+    trajectory = Trajectory(
+        np.arange(len(states)) * dt, y, yd, ydd, dmp.units_, tuple(dmp.__dict__.get("names_", ()))
+    )
     if avoiding:
         _check_avoidance(avoiding, trajectory, stepper.target, reach)
     return trajectory

@@ -18,15 +18,22 @@ from .._checks import (
     _as_float_array,
     _check_finite,
     check_choice,
-    check_text,
     check_int,
     check_limit,
+    check_text,
     numerically_guarded,
     short_token,
 )
 
-__all__ = ["Trajectory", "TimedMotion", "check_timestamps", "uniform_time", "on_uniform_time", "scale_factor",
-           "time_scale"]
+__all__ = [
+    "Trajectory",
+    "TimedMotion",
+    "check_timestamps",
+    "uniform_time",
+    "on_uniform_time",
+    "scale_factor",
+    "time_scale",
+]
 
 _FACTORS = (1e-9, 1e9)  # the time stretch a limit may ask for (beyond it no motion of this world)
 
@@ -88,16 +95,26 @@ class Trajectory(TimedMotion):
         from .._checks import check_names
 
         _validate_motion(self, "Trajectory", (("y", None), ("yd", None), ("ydd", None)))
-        names = self.names if isinstance(self.names, (list, tuple)) and len(self.names) == 0 else (
-            check_names(self.names, self.y.shape[1], "Trajectory.names"))
+        names = (
+            self.names
+            if isinstance(self.names, (list, tuple)) and len(self.names) == 0
+            else (check_names(self.names, self.y.shape[1], "Trajectory.names"))
+        )
         object.__setattr__(self, "names", tuple(names))
 
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D; the
         trajectory's ``names`` when it has them, ``t, <names>, v<names>, a<names>``) and the
         matching (n, 1 + 3D) array: the layout of timed CSV and ``.npy`` files."""
-        names = list(self.names) if self.names else (
-            ["x", "y", "z"][: self.n_dims] if self.n_dims <= 3 else [f"x{i}" for i in range(self.n_dims)])
+        names = (
+            list(self.names)
+            if self.names
+            else (
+                ["x", "y", "z"][: self.n_dims]
+                if self.n_dims <= 3
+                else [f"x{i}" for i in range(self.n_dims)]
+            )
+        )
         header = ["t", *names, *(f"v{name}" for name in names), *(f"a{name}" for name in names)]
         return header, np.column_stack([self.t, self.y, self.yd, self.ydd])
 
@@ -116,9 +133,15 @@ def _validate_motion(motion, kind: str, fields) -> None:
     n = t.shape[0]
     for name, width in fields:
         array = _as_float_array(getattr(motion, name), f"{kind}.{name}")
-        if array.ndim != 2 or array.shape[0] != n or (width is not None and array.shape[1] != width):
-            raise ValueError(f"{kind}.{name} must have shape ({n}, {width or 'D'}): one row per time of {kind}.t, "
-                             f"got {array.shape}")
+        if (
+            array.ndim != 2
+            or array.shape[0] != n
+            or (width is not None and array.shape[1] != width)
+        ):
+            raise ValueError(
+                f"{kind}.{name} must have shape ({n}, {width or 'D'}): one row per time of {kind}.t, "
+                f"got {array.shape}"
+            )
         _check_finite(array, f"{kind}.{name}")
         object.__setattr__(motion, name, array)
     object.__setattr__(motion, "units", check_units(motion.units, f"{kind}.units"))
@@ -161,7 +184,9 @@ def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> n
     stamps = _as_stamps(t, name)
     if stamps.ndim != 1 or stamps.shape[0] != n_samples:
         of = samples or "n_samples"
-        raise ValueError(f"{name} must have one time per sample ({of}: {n_samples}), got shape {stamps.shape}")
+        raise ValueError(
+            f"{name} must have one time per sample ({of}: {n_samples}), got shape {stamps.shape}"
+        )
     if not np.all(np.isfinite(stamps)):
         raise ValueError(f"{name} contains NaN or inf")
     if np.max(np.abs(stamps)) > 1e12:
@@ -170,18 +195,24 @@ def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> n
     if np.any(steps <= 0):
         row = int(np.argmax(steps <= 0)) + 1
         kind = "duplicate timestamp" if steps[row - 1] == 0 else "timestamp going back"
-        raise ValueError(f"{name} must increase strictly: {kind} at sample {row}: {_stamp(stamps[row])} s after "
-                         f"{_stamp(stamps[row - 1])} s ({1e3 * float(steps[row - 1]):+.4g} ms; "
-                         f"{float(stamps[row] - stamps[0]):.6g} s into the recording)")
+        raise ValueError(
+            f"{name} must increase strictly: {kind} at sample {row}: {_stamp(stamps[row])} s after "
+            f"{_stamp(stamps[row - 1])} s ({1e3 * float(steps[row - 1]):+.4g} ms; "
+            f"{float(stamps[row] - stamps[0]):.6g} s into the recording)"
+        )
     if n_samples < 2:  # (every stamp but the first dropped as a repeat, or one sample): no rate
         raise ValueError(f"{name} must hold at least two distinct times, got {n_samples}")
     rate = (n_samples - 1) / (stamps[-1] - stamps[0])
     if rate < MIN_RATE_HZ:
-        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
-                         f"seconds (these look like milliseconds, microseconds or nanoseconds)")
+        raise ValueError(
+            f"{name} implies a sample rate of {rate:.3g} Hz, below {MIN_RATE_HZ:g} Hz: timestamps must be "
+            f"seconds (these look like milliseconds, microseconds or nanoseconds)"
+        )
     if rate > MAX_RATE_HZ:
-        raise ValueError(f"{name} implies a sample rate of {rate:.3g} Hz, above {MAX_RATE_HZ:g} Hz: timestamps must be "
-                         f"seconds (these look like minutes or hours, or the samples are not a recording)")
+        raise ValueError(
+            f"{name} implies a sample rate of {rate:.3g} Hz, above {MAX_RATE_HZ:g} Hz: timestamps must be "
+            f"seconds (these look like minutes or hours, or the samples are not a recording)"
+        )
     return stamps
 
 
@@ -198,12 +229,23 @@ def _drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarra
     """
     y = _as_samples(y)
     stamps = _as_stamps(t, name)
-    if stamps.ndim == 1 and stamps.shape[0] == y.shape[0] and stamps.shape[0] > 1 and np.all(np.isfinite(stamps)):
+    if (
+        stamps.ndim == 1
+        and stamps.shape[0] == y.shape[0]
+        and stamps.shape[0] > 1
+        and np.all(np.isfinite(stamps))
+    ):
         repeated = np.concatenate([[False], np.diff(stamps) == 0])
         if np.any(repeated):
             first = int(np.argmax(repeated))
-            logger.warning("%s: dropped %d sample(s) whose timestamp repeats the one before (the first at sample %d, "
-                           "%s s)", name, int(repeated.sum()), first, _stamp(stamps[first]))
+            logger.warning(
+                "%s: dropped %d sample(s) whose timestamp repeats the one before (the first at sample %d, "
+                "%s s)",
+                name,
+                int(repeated.sum()),
+                first,
+                _stamp(stamps[first]),
+            )
             y, stamps = y[~repeated], stamps[~repeated]
     return y, check_timestamps(stamps, y.shape[0] if y.ndim else 0, name, "the rows of y")
 
@@ -221,8 +263,6 @@ def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.column_stack([np.interp(grid, t, column) for column in y.T]), grid
 
 
-
-
 def _peaks(values: np.ndarray, norm: str) -> np.ndarray:
     """Peak magnitude of (n, D) values: one number ('norm') or one per axis ('axis')."""
     if norm == "norm":
@@ -238,13 +278,20 @@ def _limit_array(limit, n_dims: int, norm: str, name: str) -> np.ndarray | None:
     if array.shape[0] == 1 and expected > 1:
         array = np.repeat(array, expected)
     if array.shape[0] != expected or not np.all(np.isfinite(array)) or np.any(array <= 0):
-        raise ValueError(f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, "
-                         f"got {short_token(np.array2string(array, threshold=4))}")
+        raise ValueError(
+            f"{name} must be a positive number{'' if norm == 'norm' else f' or {n_dims} of them'}, "
+            f"got {short_token(np.array2string(array, threshold=4))}"
+        )
     return array
 
 
-def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
-                 norm: str = "norm") -> float:
+def scale_factor(
+    trajectory: Trajectory,
+    max_velocity=None,
+    max_acceleration=None,
+    max_jerk=None,
+    norm: str = "norm",
+) -> float:
     """The factor ``k`` by which a uniform time scaling ``t → k t`` makes ``trajectory`` meet
     the limits with the binding one met exactly (``k < 1`` speeds up a slow trajectory).
 
@@ -252,7 +299,9 @@ def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=Non
     """
     check_choice(norm, "norm", ("norm", "axis"))
     if not isinstance(trajectory, Trajectory):
-        raise TypeError(f"trajectory must be a bidmp.Trajectory (t, y, yd, ydd), got {type(trajectory).__name__}")
+        raise TypeError(
+            f"trajectory must be a bidmp.Trajectory (t, y, yd, ydd), got {type(trajectory).__name__}"
+        )
     n_dims = trajectory.n_dims
     factors = []
     for limit, values, power, name in (
@@ -269,19 +318,30 @@ def scale_factor(trajectory: Trajectory, max_velocity=None, max_acceleration=Non
         with np.errstate(over="ignore", divide="ignore", under="ignore"):  # judged below, by name
             factors.append((float(np.max((peaks / limits) ** (1.0 / power))), name))
     if not factors:
-        raise ValueError("time_scale needs at least one of max_velocity, max_acceleration, max_jerk")
+        raise ValueError(
+            "time_scale needs at least one of max_velocity, max_acceleration, max_jerk"
+        )
     factor, binding = max(factors)
     if factor <= 0.0:
-        raise ValueError("the trajectory does not move: there is no time scaling that touches a limit")
+        raise ValueError(
+            "the trajectory does not move: there is no time scaling that touches a limit"
+        )
     if not _FACTORS[0] <= factor <= _FACTORS[1]:
-        raise ValueError(f"{binding}: the limits would stretch the motion's time by {factor:.3g}, beyond "
-                         f"[{_FACTORS[0]:g}, {_FACTORS[1]:g}]; give limits in the trajectory's units per second")
+        raise ValueError(
+            f"{binding}: the limits would stretch the motion's time by {factor:.3g}, beyond "
+            f"[{_FACTORS[0]:g}, {_FACTORS[1]:g}]; give limits in the trajectory's units per second"
+        )
     return factor
 
 
 @numerically_guarded
-def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None, max_jerk=None,
-               norm: str = "norm") -> Trajectory:
+def time_scale(
+    trajectory: Trajectory,
+    max_velocity=None,
+    max_acceleration=None,
+    max_jerk=None,
+    norm: str = "norm",
+) -> Trajectory:
     """The shortest uniformly time-scaled copy of ``trajectory`` within the limits.
 
     The path is unchanged; time is stretched (or shrunk) by one factor ``k`` so that the binding
@@ -300,8 +360,14 @@ def time_scale(trajectory: Trajectory, max_velocity=None, max_acceleration=None,
     if not isinstance(trajectory, Trajectory):
         raise TypeError(f"trajectory must be a bidmp.Trajectory, got {type(trajectory).__name__}")
     factor = scale_factor(trajectory, max_velocity, max_acceleration, max_jerk, norm)
-    return Trajectory(trajectory.t * factor, trajectory.y.copy(), trajectory.yd / factor, trajectory.ydd / factor**2,
-                      trajectory.units, trajectory.names)
+    return Trajectory(
+        trajectory.t * factor,
+        trajectory.y.copy(),
+        trajectory.yd / factor,
+        trajectory.ydd / factor**2,
+        trajectory.units,
+        trajectory.names,
+    )
 
 
 def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:

@@ -37,8 +37,11 @@ _CONDITION = 1e-9
 # as a violent swing (two via-points 50 mm apart 0.1 ms apart on a 3 s motion ask for 60 000x; a
 # via-point 30 mm off the path 11x).
 _MAX_SWING = 100.0
-_UNTIL_SHARE = 0.99  # of a kernel's activation on the rollout grid: before ``via_until``, it may change
-_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
+# of a kernel's activation on the rollout grid: before ``via_until``, it may change
+_UNTIL_SHARE = 0.99
+_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(
+    3.0
+)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
 
 
 def _parse_via(via, n_dims: int, horizon: float) -> tuple[np.ndarray, np.ndarray]:
@@ -52,8 +55,10 @@ def _parse_via(via, n_dims: int, horizon: float) -> tuple[np.ndarray, np.ndarray
             raise TypeError(f"via[{index}] must be a (t_seconds, point) pair")
         t = check_real(pair[0], f"via[{index}] time", nonnegative=True)
         if t > horizon * (1 + 1e-12):
-            raise ValueError(f"via[{index}] time {t:g} s is past the motion's duration ({horizon:g} s; after it the "
-                             f"motion settles at its goal)")
+            raise ValueError(
+                f"via[{index}] time {t:g} s is past the motion's duration ({horizon:g} s; after it the "
+                f"motion settles at its goal)"
+            )
         times.append(t)
         points.append(as_point(pair[1], n_dims, f"via[{index}] point"))
     if not times:
@@ -75,7 +80,9 @@ def _interpolation(times: np.ndarray, dt: float, n: int) -> list[tuple[int, floa
     return pairs
 
 
-def _impulse_rows(params, phase: np.ndarray, step: float, between: list[tuple[int, float]]) -> np.ndarray:
+def _impulse_rows(
+    params, phase: np.ndarray, step: float, between: list[tuple[int, float]]
+) -> np.ndarray:
     """(m, n) weights of each sample's forcing ``f`` (K included) on the position at each via time,
     linearly between the two samples around it (``between``: :func:`_interpolation`):
     ``y(t_k) = y⁰(t_k) + rows_k @ f``."""
@@ -94,8 +101,18 @@ def _impulse_rows(params, phase: np.ndarray, step: float, between: list[tuple[in
     return rows
 
 
-def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, params, step: float, n_samples: int,
-                   dt: float, forcing_increment: Callable | None, until: float | None = None) -> Callable:
+def _via_increment(
+    dmp,
+    times: np.ndarray,
+    points: np.ndarray,
+    ends: tuple,
+    params,
+    step: float,
+    n_samples: int,
+    dt: float,
+    forcing_increment: Callable | None,
+    until: float | None = None,
+) -> Callable:
     """The forcing increment ``(phase, basis) -> (n, D)`` that moves the rollout from ``ends`` =
     (goal, start) through ``points`` (m, D) at ``times`` with the least-norm weight change. The
     rollout's own positions at the via times come from the same responses (its forcing through the
@@ -105,8 +122,12 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
     carry the via-points."""
     n_kernels = dmp.weights_.shape[0]
     if times.size > n_kernels:
-        raise ValueError(f"via has {times.size} points; this DMP's {n_kernels} kernels can carry at most {n_kernels}")
-    phase, basis, (goal_response, start_response, _), _ = _rollout_grid(dmp, params, n_samples, step)
+        raise ValueError(
+            f"via has {times.size} points; this DMP's {n_kernels} kernels can carry at most {n_kernels}"
+        )
+    phase, basis, (goal_response, start_response, _), _ = _rollout_grid(
+        dmp, params, n_samples, step
+    )
     # Only the samples up to the last via-point's matter (a response never reaches back in time).
     used = min(int(np.ceil(times.max() / dt)) + 2, phase.shape[0])
     between = _interpolation(times, dt, used)
@@ -117,20 +138,25 @@ def _via_increment(dmp, times: np.ndarray, points: np.ndarray, ends: tuple, para
         activation = np.abs(basis)
         early = activation[:cut].sum(axis=0) >= _UNTIL_SHARE * activation.sum(axis=0)
         if not np.any(early):
-            raise ValueError(f"via_until {until:g} s: no kernel of this DMP acts before it; give a later time")
+            raise ValueError(
+                f"via_until {until:g} s: no kernel of this DMP acts before it; give a later time"
+            )
         response = response * early  # the kernels acting after ``until`` keep their weights
     singular = np.linalg.svd(response, compute_uv=False)
     if singular[-1] <= _CONDITION * max(singular[0], 1e-300):
         at = ", ".join(f"{t:g}" for t in times)
-        raise ValueError(f"via: the kernels cannot carry via-points at t = {at} s (too close together, at the "
-                         f"start, or where the phase has decayed); move them apart or earlier")
+        raise ValueError(
+            f"via: the kernels cannot carry via-points at t = {at} s (too close together, at the "
+            f"start, or where the phase has decayed); move them apart or earlier"
+        )
     goal, start = ends
     baseline = response @ dmp.weights_  # rows @ (basis @ W), without the (n, D) forcing
     if forcing_increment is not None:
         baseline += rows @ forcing_increment(phase, basis)[:used]
     for k, (low, share) in enumerate(between):
         at = (1.0 - share) * np.array([goal_response[low], start_response[low]]) + share * np.array(
-            [goal_response[low + 1], start_response[low + 1]])
+            [goal_response[low + 1], start_response[low + 1]]
+        )
         baseline[k] += at[0] * goal + at[1] * start
     change = np.linalg.lstsq(response, points - baseline, rcond=None)[0]  # least-norm (N, D)
     # A protocol that comes to rest at its goal (the paper's stops before it does), its change free to
@@ -155,13 +181,24 @@ _END_SHARE = 1e-4
 _END_SPEED_SHARE = 1e-2
 
 
-def _check_end(params, phase: np.ndarray, basis: np.ndarray, step: float, dt: float, change: np.ndarray,
-               ends: tuple, points: np.ndarray, times: np.ndarray) -> None:
+def _check_end(
+    params,
+    phase: np.ndarray,
+    basis: np.ndarray,
+    step: float,
+    dt: float,
+    change: np.ndarray,
+    ends: tuple,
+    points: np.ndarray,
+    times: np.ndarray,
+) -> None:
     """Refuse a weight change that moves the motion's last sample off where it ends without it, or
     leaves it moving there: via-points late in a motion are carried by kernels that still act at its
     end. From the same impulse responses as the via-points (no rollout)."""
     last = phase.shape[0] - 1
-    rows = _impulse_rows(params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)])  # samples last, last - 1
+    rows = _impulse_rows(
+        params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)]
+    )  # samples last, last - 1
     moved = rows @ (basis @ change)  # (2, D)
     corners = np.vstack([ends[0], ends[1], points])
     reach = max(float(np.max(np.linalg.norm(corners[:, None] - corners[None], axis=2))), 1e-300)
@@ -169,48 +206,91 @@ def _check_end(params, phase: np.ndarray, basis: np.ndarray, step: float, dt: fl
     off = float(np.linalg.norm(moved[0]))
     speed = float(np.linalg.norm(moved[0] - moved[1])) / dt
     if off > _END_SHARE * reach or speed > _END_SPEED_SHARE * reach / horizon:
-        raise ValueError(f"via: the kernels that carry a via-point at {times.max():g} s still act at the motion's end: "
-                         f"it would end {off:.3g} units off its goal and still moving ({speed:.3g} units/s) after "
-                         f"{horizon:.3g} s; put the via-points earlier")
+        raise ValueError(
+            f"via: the kernels that carry a via-point at {times.max():g} s still act at the motion's end: "
+            f"it would end {off:.3g} units off its goal and still moving ({speed:.3g} units/s) after "
+            f"{horizon:.3g} s; put the via-points earlier"
+        )
 
 
-def _via_trajectory(dmp, goal, start, duration, dt, limits, start_velocity, forcing_increment, coupling, via,
-                    until: float | None = None):
+def _via_trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    dmp,
+    goal,
+    start,
+    duration,
+    dt,
+    limits,
+    start_velocity,
+    forcing_increment,
+    coupling,
+    via,
+    until: float | None = None,
+):
     """:meth:`bidmp.DMP.trajectory` through ``via``: the least-norm weight change, then the rollout
     with it (and ``limits`` checked, not met by re-timing: a re-timed motion would reach the
     via-points at other times)."""
     if start_velocity is not None:
-        raise ValueError("via-points are solved for a motion from rest: start_velocity cannot be given with via")
+        raise ValueError(
+            "via-points are solved for a motion from rest: start_velocity cannot be given with via"
+        )
     if limits is not None:
-        limits = _checked_limits(limits)[0]  # checked before the solve; "fastest" does not apply (not re-timed)
+        limits = _checked_limits(limits)[
+            0
+        ]  # checked before the solve; "fastest" does not apply (not re-timed)
     params = dmp._params()
     motion, dt_used, n_samples, step = _time_grid(dmp, duration, dt, params)
     times, points = _parse_via(via, dmp.n_dims_, min(motion, (n_samples - 1) * dt_used))
-    ends = (dmp.goal_ if goal is None else as_point(goal, dmp.n_dims_, "goal"),
-            dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start"))
+    ends = (
+        dmp.goal_ if goal is None else as_point(goal, dmp.n_dims_, "goal"),
+        dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start"),
+    )
     rollout_params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
     if until is not None:
         until = check_real(until, "via_until", positive=True)
         if np.any(times > until):
-            raise ValueError(f"via_until {until:g} s is before a via-point ({times.max():g} s): the change must act there")
-    increment = _via_increment(dmp, times, points, ends, rollout_params, step, n_samples + 2, dt_used, forcing_increment,
-                               until)
-    result = dmp.trajectory(goal, start=start, duration=motion, dt=dt_used, forcing_increment=increment, coupling=coupling)
+            raise ValueError(
+                f"via_until {until:g} s is before a via-point ({times.max():g} s): the change must act there"
+            )
+    increment = _via_increment(
+        dmp,
+        times,
+        points,
+        ends,
+        rollout_params,
+        step,
+        n_samples + 2,
+        dt_used,
+        forcing_increment,
+        until,
+    )
+    result = dmp.trajectory(
+        goal,
+        start=start,
+        duration=motion,
+        dt=dt_used,
+        forcing_increment=increment,
+        coupling=coupling,
+    )
     if limits:
         factor = scale_factor(result, **limits)
         if factor > 1.0 + 1e-9:
-            raise ValueError(f"via: the motion through the via-points needs {factor:.3g}x its duration to stay within "
-                             f"the limits; move the via-points or give a longer duration")
+            raise ValueError(
+                f"via: the motion through the via-points needs {factor:.3g}x its duration to stay within "
+                f"the limits; move the via-points or give a longer duration"
+            )
     else:
         # Against the peak acceleration of a minimum-jerk motion over the same reach and duration.
-        scale = _MINIMUM_JERK_PEAK * max(float(np.linalg.norm(ends[0] - ends[1])), 1e-300) / motion**2
+        scale = (
+            _MINIMUM_JERK_PEAK * max(float(np.linalg.norm(ends[0] - ends[1])), 1e-300) / motion**2
+        )
         swing = _peak(result.ydd) / scale
         if swing > _MAX_SWING:
-            raise ValueError(f"via: the kernels can carry these via-points only with {swing:.3g}x the peak acceleration "
-                             f"of a minimum-jerk motion over the same reach (at most {_MAX_SWING:g}x without limits); "
-                             f"move them apart or closer to the path")
+            raise ValueError(
+                f"via: the kernels can carry these via-points only with {swing:.3g}x the peak acceleration "
+                f"of a minimum-jerk motion over the same reach (at most {_MAX_SWING:g}x without limits); "
+                f"move them apart or closer to the path"
+            )
     return result
-
 
 
 def _peak(values: np.ndarray) -> float:

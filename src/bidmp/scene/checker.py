@@ -1,7 +1,6 @@
 """The roadmap's collision checker: tool placements and straight tool moves against the scene
 (:func:`bidmp.extension.roadmap.gaussian_prm` calls it)."""
 
-
 from __future__ import annotations
 
 import logging
@@ -15,9 +14,10 @@ from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _cylinder_box_bounds, _Distan
 if TYPE_CHECKING:  # pragma: no cover
     from .clearance import Scene
 
-__all__ = ['SceneChecker']
+__all__ = ["SceneChecker"]
 
 logger = logging.getLogger(__name__)
+
 
 class SceneChecker:
     """Collision callback for :func:`bidmp.extension.roadmap.gaussian_prm`: ``checker(points)`` says which
@@ -29,7 +29,11 @@ class SceneChecker:
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
         self.scene = scene
-        self.chosen = as_indices(chosen, "chosen", len(scene.solids) - 1) if len(scene.solids) else np.zeros(0, np.int64)
+        self.chosen = (
+            as_indices(chosen, "chosen", len(scene.solids) - 1)
+            if len(scene.solids)
+            else np.zeros(0, np.int64)
+        )
         # a placement or move closer than this to a part is not free
         self.margin = check_real(margin, "margin", nonnegative=True)
 
@@ -44,7 +48,9 @@ class SceneChecker:
         lower, upper = scene._lower[self.chosen], scene._upper[self.chosen]
         radius, length = scene.tool.radius, scene.tool.length
         margin = self.margin
-        whole = _cylinder_box_bounds(points, radius, length, lower.min(axis=0)[None], upper.max(axis=0)[None])[:, 0]
+        whole = _cylinder_box_bounds(
+            points, radius, length, lower.min(axis=0)[None], upper.max(axis=0)[None]
+        )[:, 0]
         near = np.flatnonzero(whole <= margin)
         for start in range(0, near.size, _CHUNK):
             rows = near[start : start + _CHUNK]
@@ -62,7 +68,9 @@ class SceneChecker:
         so the tool may advance by its current clearance without missing a contact."""
         a, b = as_points(a, 3, "a"), as_points(b, 3, "b")
         if a.shape != b.shape:
-            raise ValueError(f"a has {a.shape[0]} start points but b has {b.shape[0]} end points: one move each")
+            raise ValueError(
+                f"a has {a.shape[0]} start points but b has {b.shape[0]} end points: one move each"
+            )
         check_limit(a.shape[0], "max_samples", "a: the number of moves")
         free = np.ones(a.shape[0], dtype=bool)
         if self.chosen.size == 0:  # (as_points refuses no moves at all)
@@ -79,21 +87,29 @@ class SceneChecker:
         candidates = [(near[i], j) for i, j in zip(*np.nonzero(touching))]
         engine = scene._engine()
         for row, col in candidates:
-            if free[row] and not self._move_free(engine, a[row], b[row], int(self.chosen[col]), self.margin):
+            if free[row] and not self._move_free(
+                engine, a[row], b[row], int(self.chosen[col]), self.margin
+            ):
                 free[row] = False
         return free
 
     @staticmethod
-    def _move_free(engine: _Distances, a: np.ndarray, b: np.ndarray, index: int, margin: float = 0.0) -> bool:
+    def _move_free(
+        engine: _Distances, a: np.ndarray, b: np.ndarray, index: int, margin: float = 0.0
+    ) -> bool:
         length = float(np.linalg.norm(b - a))
         travelled = 0.0
         resolution = 1e-9 * max(length, 1.0)
         for _ in range(_MAX_ADVANCE_STEPS):
-            distance = engine.tool_to(a + (travelled / length) * (b - a) if length > 0 else a, index)
+            distance = engine.tool_to(
+                a + (travelled / length) * (b - a) if length > 0 else a, index
+            )
             if distance < margin:
                 return False
             if travelled >= length:
                 return True
             # The distance changes by at most the distance moved: advance by what is left above the margin.
-            travelled = min(travelled + max(distance - margin, resolution), length)  # touching the margin is allowed
+            travelled = min(
+                travelled + max(distance - margin, resolution), length
+            )  # touching the margin is allowed
         return False  # grazing for too long: treated as a contact (conservative)

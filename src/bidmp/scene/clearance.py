@@ -9,7 +9,6 @@ to; negative is a collision (the value is then the penetration depth). :meth:`Sc
 the collision callback of the roadmap (:class:`~bidmp.scene.checker.SceneChecker`).
 """
 
-
 from __future__ import annotations
 
 import logging
@@ -36,7 +35,7 @@ from .checker import SceneChecker
 from .distances import _CHUNK, _box_distance, _cylinder_box_bounds, _densify, _Distances
 from .parts import Part, Solid, Tool, _cylinder_extent, _fail, _number, _parse_parts
 
-__all__ = ['Scene', 'Clearance']
+__all__ = ["Scene", "Clearance"]
 
 logger = logging.getLogger(__name__)
 
@@ -89,8 +88,9 @@ class Clearance:
         return None if self.collision_free else self.part
 
 
-
-def _scene_options(data: dict, tool: Tool, targets: dict | None, units: str | None, part_labels) -> tuple:
+def _scene_options(
+    data: dict, tool: Tool, targets: dict | None, units: str | None, part_labels
+) -> tuple:
     """A scene's ``targets`` (None: all), ``targets_on_parts``, ``margin`` (default 3 mm in
     ``units`` when they are known, else 0) and ``standoff``, validated."""
     chosen = data.get("targets", "all")
@@ -108,17 +108,25 @@ def _scene_options(data: dict, tool: Tool, targets: dict | None, units: str | No
     default = 0.0 if units is None else min(DEFAULT_MARGIN_MM * _MM.get(units, 1.0), tool.radius)
     margin = _number(data.get("margin", default), "scene.margin", positive=False)
     if not 0.0 <= margin <= tool.radius:
-        _fail("scene.margin", f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}")
+        _fail(
+            "scene.margin",
+            f"expected a clearance in [0, the tool's radius {tool.radius:g}], got {margin:g}",
+        )
     standoff = data.get("standoff", {})
     if not isinstance(standoff, dict):
         _fail("scene.standoff", 'expected {"part label": the closest the tool may come to it, ...}')
-    standoff = {str(label): _number(value, f"scene.standoff.{short_token(label, 20)[1:-1]}", positive=False)
-                for label, value in standoff.items()}
+    standoff = {
+        str(label): _number(value, f"scene.standoff.{short_token(label, 20)[1:-1]}", positive=False)
+        for label, value in standoff.items()
+    }
     for label, value in standoff.items():
         if label not in part_labels:
             _fail(f"scene.standoff.{short_token(label, 20)[1:-1]}", "is not the label of a part")
         if not 0.0 <= value <= margin:
-            _fail(f"scene.standoff.{short_token(label, 20)[1:-1]}", f"expected a clearance in [0, the margin {margin:g}], got {value:g}")
+            _fail(
+                f"scene.standoff.{short_token(label, 20)[1:-1]}",
+                f"expected a clearance in [0, the margin {margin:g}], got {value:g}",
+            )
     return chosen, on_parts, margin, standoff
 
 
@@ -136,12 +144,20 @@ class Scene:
         Whether each of those targets must lie on the part with its label.
     """
 
-    def __init__(self, parts, tool: Tool, targets=None, targets_on_parts: bool = True, margin: float = 0.0,
-                 standoff: dict | None = None):
+    def __init__(
+        self,
+        parts,
+        tool: Tool,
+        targets=None,
+        targets_on_parts: bool = True,
+        margin: float = 0.0,
+        standoff: dict | None = None,
+    ):
         # margin: what every planned and checked motion keeps (scene units); standoff: the parts it
         # may come closer to, by design.
-        self.parts, self.tool, self.targets, self.targets_on_parts, self.margin, self.standoff = _init_args(
-            parts, tool, targets, targets_on_parts, margin, standoff)
+        self.parts, self.tool, self.targets, self.targets_on_parts, self.margin, self.standoff = (
+            _init_args(parts, tool, targets, targets_on_parts, margin, standoff)
+        )
         self.solids = tuple(solid for part in self.parts for solid in part.solids)
         self._lower = np.array([s.lower for s in self.solids]).reshape(-1, 3)
         self._upper = np.array([s.upper for s in self.solids]).reshape(-1, 3)
@@ -158,25 +174,41 @@ class Scene:
         if not isinstance(data, dict):
             _fail("scene", f"data must be an object with tool and parts, got {type(data).__name__}")
         units = None if units is None else check_units(units)
-        if targets is not None and (not isinstance(targets, dict) or not all(isinstance(k, str) for k in targets)):
-            raise TypeError(f"targets must be a dict of target label -> point, got {type(targets).__name__}")
+        if targets is not None and (
+            not isinstance(targets, dict) or not all(isinstance(k, str) for k in targets)
+        ):
+            raise TypeError(
+                f"targets must be a dict of target label -> point, got {type(targets).__name__}"
+            )
         unknown = sorted(set(data) - _SCENE_KEYS)
         if unknown:
-            _fail(f"scene.{short_token(unknown[0], 20)[1:-1]}", f"unknown key (known: {', '.join(sorted(_SCENE_KEYS))})")
+            _fail(
+                f"scene.{short_token(unknown[0], 20)[1:-1]}",
+                f"unknown key (known: {', '.join(sorted(_SCENE_KEYS))})",
+            )
         tool_data = data.get("tool")
         if not isinstance(tool_data, dict) or set(tool_data) != {"radius", "length"}:
-            _fail("scene.tool", 'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)')
+            _fail(
+                "scene.tool",
+                'expected {"radius": r, "length": l} (a cylinder hanging from the trajectory point)',
+            )
         tool = Tool(*(_number(tool_data[k], f"scene.tool.{k}") for k in ("radius", "length")))
         parts = _parse_parts(data.get("parts"), targets)
-        scene = cls(parts, tool, *_scene_options(data, tool, targets, units, {part.label for part in parts}))
+        scene = cls(
+            parts, tool, *_scene_options(data, tool, targets, units, {part.label for part in parts})
+        )
         scene.check_overlaps()
         if targets is not None and scene.targets_on_parts:
             scene.check_targets(targets)
         return scene
 
     def to_dict(self) -> dict:
-        out = {"tool": self.tool.to_dict(), "parts": [dict(part.spec) for part in self.parts],
-               "targets_on_parts": self.targets_on_parts, "margin": self.margin}
+        out = {
+            "tool": self.tool.to_dict(),
+            "parts": [dict(part.spec) for part in self.parts],
+            "targets_on_parts": self.targets_on_parts,
+            "margin": self.margin,
+        }
         if self.targets is not None:
             out["targets"] = list(self.targets)
         if self.standoff:
@@ -189,8 +221,14 @@ class Scene:
         new tool's radius."""
         if not isinstance(tool, Tool):
             raise TypeError(f"tool must be a bidmp.Tool, got {type(tool).__name__}")
-        return Scene(self.parts, tool, self.targets, self.targets_on_parts, min(self.margin, tool.radius),
-                     {k: min(v, tool.radius) for k, v in self.standoff.items()})
+        return Scene(
+            self.parts,
+            tool,
+            self.targets,
+            self.targets_on_parts,
+            min(self.margin, tool.radius),
+            {k: min(v, tool.radius) for k, v in self.standoff.items()},
+        )
 
     @property
     def labels(self) -> list[str]:
@@ -223,7 +261,9 @@ class Scene:
             raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
         distance = check_real(distance, "distance", nonnegative=True)
         mask = self._owner == _labelled(self.parts, part).label
-        bounds = _cylinder_box_bounds(points, self.tool.radius, self.tool.length, self._lower[mask], self._upper[mask])
+        bounds = _cylinder_box_bounds(
+            points, self.tool.radius, self.tool.length, self._lower[mask], self._upper[mask]
+        )
         return np.min(bounds, axis=1) <= distance
 
     def parts_at(self, point) -> list[str]:
@@ -237,39 +277,61 @@ class Scene:
     # -- validation ---------------------------------------------------------------------------
     def check_overlaps(self) -> None:
         """Raise when solids of two different parts interpenetrate (touching is allowed)."""
-        gap = np.maximum(np.maximum(self._lower[:, None] - self._upper[None], self._lower[None] - self._upper[:, None]), 0.0)
+        gap = np.maximum(
+            np.maximum(
+                self._lower[:, None] - self._upper[None], self._lower[None] - self._upper[:, None]
+            ),
+            0.0,
+        )
         close = np.argwhere(np.triu(np.all(gap == 0.0, axis=2), 1))
         for first, second in close:
             if self._owner[first] == self._owner[second]:
                 continue
             depth = self._engine().between(int(first), int(second))
             if depth < -_OVERLAP_TOLERANCE:
-                _fail("scene.parts", f"parts {self.solids[first].label!r} and {self.solids[second].label!r} overlap "
-                                     f"by {-depth:.3g}; parts may touch but not interpenetrate")
+                _fail(
+                    "scene.parts",
+                    f"parts {self.solids[first].label!r} and {self.solids[second].label!r} overlap "
+                    f"by {-depth:.3g}; parts may touch but not interpenetrate",
+                )
 
     def check_targets(self, targets: dict) -> None:
         """Raise when a target the scene applies to has no part with its label, or does not lie
         on it (more than the tool radius from the part's bounding box)."""
         if not isinstance(targets, dict):
-            raise TypeError(f"targets must be a dict of label -> point, got {type(targets).__name__}")
+            raise TypeError(
+                f"targets must be a dict of label -> point, got {type(targets).__name__}"
+            )
         for label, point in targets.items():
             if not isinstance(label, str):
-                raise TypeError(f"targets: a target's label must be a string, got {type(label).__name__}")
+                raise TypeError(
+                    f"targets: a target's label must be a string, got {type(label).__name__}"
+                )
             point = as_vector(point, f"targets[{short_token(label, 20)}]")
             if point.shape[0] < 3:
-                raise ValueError(f"targets[{short_token(label, 20)}] must be a point (3,) or a pose (7,), got {point.shape[0]} values")
+                raise ValueError(
+                    f"targets[{short_token(label, 20)}] must be a point (3,) or a pose (7,), got {point.shape[0]} values"
+                )
             point = _position(point[:3])  # a pose target: its position
             if not self.applies_to(label):
                 continue
             if label not in self.labels:
-                _fail("scene", f"target {short_token(label, 20)} has no part labelled like it (targets_on_parts is "
-                               f"true; set it false, or list the targets the scene applies to in scene.targets)")
+                _fail(
+                    "scene",
+                    f"target {short_token(label, 20)} has no part labelled like it (targets_on_parts is "
+                    f"true; set it false, or list the targets the scene applies to in scene.targets)",
+                )
             lower, upper = self.bounds(label)
-            gap = np.linalg.norm(np.maximum(np.maximum(lower - point, np.asarray(point) - upper), 0.0))
+            gap = np.linalg.norm(
+                np.maximum(np.maximum(lower - point, np.asarray(point) - upper), 0.0)
+            )
             if gap > self.tool.radius:
-                _fail("scene", f"target {short_token(label, 20)} at {np.round(point, 3).tolist()} is not on part "
-                               f"{short_token(label, 20)} (its box spans {np.round(lower, 3).tolist()} to "
-                               f"{np.round(upper, 3).tolist()}, {gap:.3g} away)")
+                _fail(
+                    "scene",
+                    f"target {short_token(label, 20)} at {np.round(point, 3).tolist()} is not on part "
+                    f"{short_token(label, 20)} (its box spans {np.round(lower, 3).tolist()} to "
+                    f"{np.round(upper, 3).tolist()}, {gap:.3g} away)",
+                )
 
     # -- distances ----------------------------------------------------------------------------
     def _engine(self) -> _Distances:
@@ -278,14 +340,27 @@ class Scene:
         return self._distances
 
     def _selected(self, exclude) -> np.ndarray:
-        exclude = {_label(name, "exclude") for name in ([exclude] if isinstance(exclude, str) else _names(exclude, "exclude"))}
+        exclude = {
+            _label(name, "exclude")
+            for name in ([exclude] if isinstance(exclude, str) else _names(exclude, "exclude"))
+        }
         unknown = exclude - set(self._owner.tolist())
         if unknown:
-            raise ValueError(f"exclude names {short_token(sorted(unknown)[0])}, which is not a part of the scene")
+            raise ValueError(
+                f"exclude names {short_token(sorted(unknown)[0])}, which is not a part of the scene"
+            )
         return np.flatnonzero([owner not in exclude for owner in self._owner])
 
-    def _minimum(self, samples: np.ndarray, chosen: np.ndarray, bounds_of, exact, best: float = math.inf,
-                 part: str | None = None, point=None) -> Clearance:
+    def _minimum(
+        self,
+        samples: np.ndarray,
+        chosen: np.ndarray,
+        bounds_of,
+        exact,
+        best: float = math.inf,
+        part: str | None = None,
+        point=None,
+    ) -> Clearance:
         """Branch and bound over (sample, part) pairs: ``bounds_of(rows)`` bounds the distances of
         ``samples[rows]`` to the chosen parts from below, (m, k); ``exact(row, solid)`` is coal's
         distance. Pairs are evaluated in ascending bound until no bound can beat the best."""
@@ -294,7 +369,11 @@ class Scene:
             bounds = bounds_of(block)
             if best == math.inf:  # seed the bound with the most promising pair
                 row, col = divmod(int(np.argmin(bounds)), bounds.shape[1])
-                best, part, point = exact(block[row], int(chosen[col])), self.solids[chosen[col]].label, samples[block[row]]
+                best, part, point = (
+                    exact(block[row], int(chosen[col])),
+                    self.solids[chosen[col]].label,
+                    samples[block[row]],
+                )
             # The bounds are >= 0, so a pair whose bound is 0 may penetrate to any depth: while the
             # best is a collision, every overlapping pair is evaluated to find the deepest one.
             rows, cols = np.nonzero((bounds < best) | (bounds <= 0.0))
@@ -304,14 +383,26 @@ class Scene:
                     break  # every remaining pair is bounded below by at least the best so far
                 distance = exact(block[row], int(chosen[col]))
                 if distance < best:
-                    best, part, point = distance, self.solids[chosen[col]].label, samples[block[row]]
+                    best, part, point = (
+                        distance,
+                        self.solids[chosen[col]].label,
+                        samples[block[row]],
+                    )
         return Clearance(float(best), part, None if point is None else np.array(point), self.margin)
 
-    def _clearance_oriented(self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float) -> Clearance:
+    def _clearance_oriented(
+        self, points: np.ndarray, quaternions, chosen: np.ndarray, step: float
+    ) -> Clearance:
         """:meth:`clearance` for a tool whose orientation changes along the motion."""
         q = _as_float_array(quaternions, "orientations")
-        if q.shape != (points.shape[0], 4) or not np.all(np.isfinite(q)) or np.any(np.linalg.norm(q, axis=1) < 1e-9):
-            raise ValueError(f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)")
+        if (
+            q.shape != (points.shape[0], 4)
+            or not np.all(np.isfinite(q))
+            or np.any(np.linalg.norm(q, axis=1) < 1e-9)
+        ):
+            raise ValueError(
+                f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)"
+            )
         q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
         sweep = _sweep(points, q, math.hypot(self.tool.length, self.tool.radius))
         dense, segment, fraction = _densify(points, step, weights=True, lengths=sweep)
@@ -327,13 +418,21 @@ class Scene:
         lower, upper = self._lower[chosen], self._upper[chosen]
         engine = self._engine()
         return self._minimum(
-            dense, chosen,
-            lambda rows: _box_distance((centres[rows] - extent[rows])[:, None], (centres[rows] + extent[rows])[:, None],
-                                       lower[None], upper[None]),
-            lambda row, solid: engine.tool_to(dense[row], solid, rotations[row]))
+            dense,
+            chosen,
+            lambda rows: _box_distance(
+                (centres[rows] - extent[rows])[:, None],
+                (centres[rows] + extent[rows])[:, None],
+                lower[None],
+                upper[None],
+            ),
+            lambda row, solid: engine.tool_to(dense[row], solid, rotations[row]),
+        )
 
     @numerically_guarded
-    def clearance(self, trajectory, exclude=(), step: float | None = None, orientations=None) -> Clearance:
+    def clearance(
+        self, trajectory, exclude=(), step: float | None = None, orientations=None
+    ) -> Clearance:
         """Smallest signed distance between the tool and the parts along ``trajectory``.
 
         Parameters
@@ -368,7 +467,9 @@ class Scene:
             return self._clearance(points, chosen, step, orientations)
         return _nearest_to_its_clearance(self, points, chosen, step, orientations)
 
-    def _clearance(self, points: np.ndarray, chosen: np.ndarray, step: float, orientations) -> Clearance:
+    def _clearance(
+        self, points: np.ndarray, chosen: np.ndarray, step: float, orientations
+    ) -> Clearance:
         """:meth:`clearance` over the solids ``chosen`` (validated points and step)."""
         if orientations is not None:
             return self._clearance_oriented(points, orientations, chosen, step)
@@ -380,7 +481,9 @@ class Scene:
         # the segments whose swept tool box could come closer than that are densified and
         # bounded part by part; most of a motion is far from everything.
         whole_lower, whole_upper = lower.min(axis=0), upper.max(axis=0)
-        at_samples = _cylinder_box_bounds(points, radius, length, whole_lower[None], whole_upper[None])[:, 0]
+        at_samples = _cylinder_box_bounds(
+            points, radius, length, whole_lower[None], whole_upper[None]
+        )[:, 0]
         row = int(np.argmin(at_samples))
         first = _cylinder_box_bounds(points[row : row + 1], radius, length, lower, upper)[0]
         col = int(np.argmin(first))
@@ -393,11 +496,20 @@ class Scene:
             dense = _densify(points, step, np.flatnonzero((near < best) | (near <= 0.0)))
         else:
             dense = points
-        return self._minimum(dense, chosen, lambda rows: _cylinder_box_bounds(dense[rows], radius, length, lower, upper),
-                             lambda row, solid: engine.tool_to(dense[row], solid), best, best_part, best_point)
+        return self._minimum(
+            dense,
+            chosen,
+            lambda rows: _cylinder_box_bounds(dense[rows], radius, length, lower, upper),
+            lambda row, solid: engine.tool_to(dense[row], solid),
+            best,
+            best_part,
+            best_point,
+        )
 
     @numerically_guarded
-    def body_clearance(self, solid, trajectory, offset, exclude=(), step: float | None = None) -> Clearance:
+    def body_clearance(
+        self, solid, trajectory, offset, exclude=(), step: float | None = None
+    ) -> Clearance:
         """Smallest signed distance between a body carried along ``trajectory`` and the parts: a
         solid (one of a part the tool holds, :class:`~bidmp.scene.parts.Solid`), its centre
         ``offset`` (3,) from the trajectory point and its orientation as it is, at least every
@@ -407,7 +519,9 @@ class Scene:
         if points.shape[1] != 3:
             raise ValueError(f"trajectory must have 3 columns (x, y, z), got {points.shape[1]}")
         if not isinstance(solid, Solid):
-            raise TypeError(f"solid must be a bidmp.scene.Solid (one of a part's solids), got {type(solid).__name__}")
+            raise TypeError(
+                f"solid must be a bidmp.scene.Solid (one of a part's solids), got {type(solid).__name__}"
+            )
         offset = as_point(offset, 3, "offset")
         step = _STEP_SHARE * self.tool.length if step is None else _checked_step(step, self.tool)
         chosen = self._selected(exclude)
@@ -415,13 +529,22 @@ class Scene:
             return Clearance(math.inf, None, None, self.margin)
         engine = self._engine()
         shape = engine.shape_of(solid)
-        half = (np.asarray(solid.upper) - np.asarray(solid.lower)) / 2.0  # the body's box round its centre
+        half = (
+            np.asarray(solid.upper) - np.asarray(solid.lower)
+        ) / 2.0  # the body's box round its centre
         centres = _densify(points, step) + offset
         lower, upper = self._lower[chosen], self._upper[chosen]
         return self._minimum(
-            centres - offset, chosen,
-            lambda rows: _box_distance((centres[rows] - half)[:, None], (centres[rows] + half)[:, None], lower[None], upper[None]),
-            lambda row, index: engine.body_to(shape, solid.rotation, centres[row], index))
+            centres - offset,
+            chosen,
+            lambda rows: _box_distance(
+                (centres[rows] - half)[:, None],
+                (centres[rows] + half)[:, None],
+                lower[None],
+                upper[None],
+            ),
+            lambda row, index: engine.body_to(shape, solid.rotation, centres[row], index),
+        )
 
     def checker(self, exclude=()) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
@@ -438,9 +561,21 @@ def _init_args(parts, tool, targets, targets_on_parts, margin, standoff) -> tupl
         targets = [_label(label, "targets") for label in _names(targets, "targets")]
     margin = check_real(margin, "margin", nonnegative=True, maximum=tool.radius)
     if standoff is not None and not isinstance(standoff, dict):
-        raise TypeError(f"standoff must be a dict of part label -> clearance, got {type(standoff).__name__}")
-    standoff = {_label(k, "standoff"): check_real(v, "standoff", nonnegative=True) for k, v in (standoff or {}).items()}
-    return tuple(parts), tool, targets, check_bool(targets_on_parts, "targets_on_parts"), margin, standoff
+        raise TypeError(
+            f"standoff must be a dict of part label -> clearance, got {type(standoff).__name__}"
+        )
+    standoff = {
+        _label(k, "standoff"): check_real(v, "standoff", nonnegative=True)
+        for k, v in (standoff or {}).items()
+    }
+    return (
+        tuple(parts),
+        tool,
+        targets,
+        check_bool(targets_on_parts, "targets_on_parts"),
+        margin,
+        standoff,
+    )
 
 
 def _label(value, name: str) -> str:
@@ -454,7 +589,9 @@ def _names(value, name: str) -> list:
     if value is None:
         return []
     if not isinstance(value, (list, tuple, set, frozenset)):
-        raise TypeError(f"{name} must be a part label or a list of them, got {type(value).__name__}")
+        raise TypeError(
+            f"{name} must be a part label or a list of them, got {type(value).__name__}"
+        )
     return list(value)
 
 
@@ -462,7 +599,9 @@ def _labelled(parts, label) -> Part:
     for part in parts:
         if part.label == _label(label, "label"):
             return part
-    raise ValueError(f"label: no part labelled {short_token(label)}; parts: {', '.join(p.label for p in parts)[:200]}")
+    raise ValueError(
+        f"label: no part labelled {short_token(label)}; parts: {', '.join(p.label for p in parts)[:200]}"
+    )
 
 
 def _checked_step(step, tool: Tool) -> float:
@@ -475,16 +614,22 @@ def _sweep(points: np.ndarray, quaternions: np.ndarray, reach: float) -> np.ndar
     """How far any point of a tool within ``reach`` of its tip moves along each segment: at most
     |Δp| + reach · Δθ. A turning tool moves its far end more than its tip, so its placements are
     spaced by this, not by |Δp| alone."""
-    turn = 2.0 * np.arccos(np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), 0.0, 1.0))
+    turn = 2.0 * np.arccos(
+        np.clip(np.abs(np.sum(quaternions[1:] * quaternions[:-1], axis=1)), 0.0, 1.0)
+    )
     return np.linalg.norm(np.diff(points, axis=0), axis=1) + reach * turn
 
 
-def _nearest_to_its_clearance(scene: Scene, points: np.ndarray, chosen: np.ndarray, step: float, orientations) -> Clearance:
+def _nearest_to_its_clearance(
+    scene: Scene, points: np.ndarray, chosen: np.ndarray, step: float, orientations
+) -> Clearance:
     """:meth:`Scene.clearance` with stand-offs: the parts that have one are checked against it, the
     rest against the margin, and the result is the group that comes nearest its own clearance (a
     plate at its stand-off must not hide a nut inside the margin)."""
     owner, standoff = scene._owner, scene.standoff
-    groups = [[i for i in chosen if owner[i] not in standoff]] + [[i for i in chosen if owner[i] == label] for label in standoff]
+    groups = [[i for i in chosen if owner[i] not in standoff]] + [
+        [i for i in chosen if owner[i] == label] for label in standoff
+    ]
     results = []
     for group in groups:
         if group:

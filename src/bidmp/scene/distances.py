@@ -10,7 +10,6 @@ coal only when its bound could beat the best distance found so far, so a traject
 dozen coal calls, not one per sample and part.
 """
 
-
 from __future__ import annotations
 
 import logging
@@ -19,12 +18,12 @@ import math
 import numpy as np
 
 from .._checks import get_limits, require_extra
-
 from .parts import Tool
 
 logger = logging.getLogger(__name__)
 
-_GJK_TOLERANCE = 1e-12  # coal's default (1e-6 relative) leaves clearances ~1e-4 off; see the module docstring
+# coal's default (1e-6 relative) leaves clearances ~1e-4 off; see the module docstring
+_GJK_TOLERANCE = 1e-12
 
 
 _EPA_TOLERANCE = 1e-6  # penetration depths (coal's default): tighter, its EPA stops early on cylinders and over-reports
@@ -43,13 +42,25 @@ def _coal():
 # ---------------------------------------------------------------------------------------------
 # Distances
 # ---------------------------------------------------------------------------------------------
-def _cylinder_box_bounds(points: np.ndarray, radius: float, length: float, lower: np.ndarray,
-                         upper: np.ndarray) -> np.ndarray:
+def _cylinder_box_bounds(
+    points: np.ndarray, radius: float, length: float, lower: np.ndarray, upper: np.ndarray
+) -> np.ndarray:
     """Exact distance from the vertical tool cylinder at each point to each axis-aligned box,
     (m, k): a lower bound of the distance to whatever the box bounds (0 when they overlap)."""
-    gap_xy = np.maximum(np.maximum(lower[None, :, :2] - points[:, None, :2], points[:, None, :2] - upper[None, :, :2]), 0.0)
+    gap_xy = np.maximum(
+        np.maximum(
+            lower[None, :, :2] - points[:, None, :2], points[:, None, :2] - upper[None, :, :2]
+        ),
+        0.0,
+    )
     lateral = np.maximum(np.sqrt(np.einsum("mkj,mkj->mk", gap_xy, gap_xy)) - radius, 0.0)
-    vertical = np.maximum(np.maximum(lower[None, :, 2] - (points[:, None, 2] + length), points[:, None, 2] - upper[None, :, 2]), 0.0)
+    vertical = np.maximum(
+        np.maximum(
+            lower[None, :, 2] - (points[:, None, 2] + length),
+            points[:, None, 2] - upper[None, :, 2],
+        ),
+        0.0,
+    )
     return np.hypot(lateral, vertical)
 
 
@@ -66,9 +77,15 @@ class _Distances:
         self.result = coal.DistanceResult()
         self.tool = coal.Cylinder(tool.radius, tool.length)
         self.tool_offset = np.array([0.0, 0.0, tool.length / 2.0])
-        self.shapes = [(self.shape_of(solid), coal.Transform3s(np.asarray(solid.rotation, dtype=float),
-                                                               np.asarray(solid.centre, dtype=float)))
-                       for solid in solids]
+        self.shapes = [
+            (
+                self.shape_of(solid),
+                coal.Transform3s(
+                    np.asarray(solid.rotation, dtype=float), np.asarray(solid.centre, dtype=float)
+                ),
+            )
+            for solid in solids
+        ]
         self.identity = np.eye(3)
 
     def tool_to(self, point: np.ndarray, index: int, rotation: np.ndarray | None = None) -> float:
@@ -77,7 +94,9 @@ class _Distances:
         shape, pose = self.shapes[index]
         self.result.clear()
         if rotation is None:
-            tool_pose = self.coal.Transform3s(self.identity, np.asarray(point, dtype=float) + self.tool_offset)
+            tool_pose = self.coal.Transform3s(
+                self.identity, np.asarray(point, dtype=float) + self.tool_offset
+            )
         else:  # the body extends from the mouth against the approach direction
             centre = np.asarray(point, dtype=float) - rotation[:, 2] * self.tool_offset[2]
             tool_pose = self.coal.Transform3s(np.asarray(rotation, dtype=float), centre)
@@ -95,12 +114,20 @@ class _Distances:
         default 1e-6 relative), each within 1e-8 of the closed form where it passes. If none
         passes, the pair is answered conservatively (0: touching, so nothing is ever reported
         clearer than it is) and logged."""
-        for request in self._requests():  # into self.result: a caller reads the nearest points there
+        for (
+            request
+        ) in self._requests():  # into self.result: a caller reads the nearest points there
             self.result.clear()
             distance = float(self.coal.distance(a, pose_a, b, pose_b, request, self.result))
-            if math.isfinite(distance) and distance > -1e100 and (distance <= 0.0 or self._witnessed(a, pose_a, b, pose_b, distance)):
+            if (
+                math.isfinite(distance)
+                and distance > -1e100
+                and (distance <= 0.0 or self._witnessed(a, pose_a, b, pose_b, distance))
+            ):
                 return distance
-        logger.warning("coal could not compute a distance (GJK/EPA did not converge); the pair is taken as touching")
+        logger.warning(
+            "coal could not compute a distance (GJK/EPA did not converge); the pair is taken as touching"
+        )
         return 0.0
 
     def _witnessed(self, a, pose_a, b, pose_b, distance: float) -> bool:
@@ -108,8 +135,11 @@ class _Distances:
         each on its shape, and that far apart."""
         first, second = self.result.getNearestPoint1(), self.result.getNearestPoint2()
         apart = float(np.linalg.norm(first - second))
-        return (abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first)
-                and _on_shape(b, pose_b, second))
+        return (
+            abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0)
+            and _on_shape(a, pose_a, first)
+            and _on_shape(b, pose_b, second)
+        )
 
     def _requests(self) -> list:
         """The requests :meth:`_distance` tries in turn, built once."""
@@ -117,7 +147,10 @@ class _Distances:
             coal = self.coal
             accelerated = coal.DistanceRequest()
             accelerated.gjk_tolerance, accelerated.gjk_max_iterations = _GJK_TOLERANCE, 1000
-            accelerated.epa_tolerance, accelerated.gjk_variant = _EPA_TOLERANCE, coal.GJKVariant.NesterovAcceleration
+            accelerated.epa_tolerance, accelerated.gjk_variant = (
+                _EPA_TOLERANCE,
+                coal.GJKVariant.NesterovAcceleration,
+            )
             looser = []
             for tolerance in (1e-10, 1e-9, None):
                 request = coal.DistanceRequest()
@@ -145,8 +178,14 @@ class _Distances:
     def body_to(self, shape, rotation: np.ndarray, centre: np.ndarray, index: int) -> float:
         """Signed distance from a moving body (``shape`` at ``centre``, turned by ``rotation``) to solid ``index``."""
         other, pose = self.shapes[index]
-        return self._distance(shape, self.coal.Transform3s(np.asarray(rotation, dtype=float), np.asarray(centre, dtype=float)),
-                              other, pose)
+        return self._distance(
+            shape,
+            self.coal.Transform3s(
+                np.asarray(rotation, dtype=float), np.asarray(centre, dtype=float)
+            ),
+            other,
+            pose,
+        )
 
     def between(self, first: int, second: int) -> float:
         a, pose_a = self.shapes[first]
@@ -160,7 +199,9 @@ _ON_SHAPE = 1e-6  # relative to the shape's size: a nearest point this far outsi
 def _on_shape(shape, pose, point) -> bool:
     """Whether ``point`` (world frame) lies in ``shape`` at ``pose`` (to :data:`_ON_SHAPE`): boxes and
     cylinders checked, other shapes taken as given."""
-    local = (np.asarray(point, dtype=float) - pose.getTranslation()) @ pose.getRotation()  # R^T (p - t)
+    local = (
+        np.asarray(point, dtype=float) - pose.getTranslation()
+    ) @ pose.getRotation()  # R^T (p - t)
     x, y, z = local.tolist()
     half = getattr(shape, "halfSide", None)
     if half is not None:
@@ -174,8 +215,13 @@ def _on_shape(shape, pose, point) -> bool:
     return True
 
 
-def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None, weights: bool = False,
-             lengths: np.ndarray | None = None):
+def _densify(
+    points: np.ndarray,
+    step: float,
+    segments: np.ndarray | None = None,
+    weights: bool = False,
+    lengths: np.ndarray | None = None,
+):
     """Points along the polyline through ``points`` no more than ``step`` apart: of every segment
     (``segments`` None), or of the segments whose indices are given (each with both its ends).
     ``weights``: also return each point's segment index and fraction along it (to interpolate
@@ -184,7 +230,11 @@ def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None
     that turns as it goes), in place of the chord."""
     if points.shape[0] == 1 or (segments is not None and segments.size == 0):
         dense = points.copy() if points.shape[0] == 1 else points[:0]
-        return (dense, np.zeros(len(dense), dtype=np.int64), np.zeros(len(dense))) if weights else dense
+        return (
+            (dense, np.zeros(len(dense), dtype=np.int64), np.zeros(len(dense)))
+            if weights
+            else dense
+        )
     if segments is None:
         segments = np.arange(points.shape[0] - 1)
     starts, ends = points[segments], points[segments + 1]
@@ -192,7 +242,9 @@ def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None
     pieces = np.maximum(np.ceil(moved / step).astype(np.int64), 1) + 1
     total = int(pieces.sum())
     if total > get_limits().max_samples * 4:
-        raise ValueError(f"the trajectory needs {total:,} checks at steps of {step:g}; use a larger step")
+        raise ValueError(
+            f"the trajectory needs {total:,} checks at steps of {step:g}; use a larger step"
+        )
     which = np.repeat(np.arange(segments.size), pieces)
     first = np.concatenate([[0], np.cumsum(pieces)[:-1]])
     fraction = (np.arange(total) - np.repeat(first, pieces)) / np.repeat(pieces - 1, pieces)
@@ -200,7 +252,9 @@ def _densify(points: np.ndarray, step: float, segments: np.ndarray | None = None
     return (dense, segments[which], fraction) if weights else dense
 
 
-def _box_distance(lower_a: np.ndarray, upper_a: np.ndarray, lower_b: np.ndarray, upper_b: np.ndarray) -> np.ndarray:
+def _box_distance(
+    lower_a: np.ndarray, upper_a: np.ndarray, lower_b: np.ndarray, upper_b: np.ndarray
+) -> np.ndarray:
     """Distance between axis-aligned boxes, broadcast over leading axes."""
     gap = np.maximum(np.maximum(lower_b - upper_a, lower_a - upper_b), 0.0)
     return np.sqrt(np.sum(gap * gap, axis=-1))

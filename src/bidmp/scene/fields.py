@@ -20,8 +20,15 @@ from .clearance import Scene
 __all__ = ["random_field"]
 
 
-def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: float, n_parts: tuple[int, int] = (1, 4),
-                 attempts: int = 200) -> Scene:
+def random_field(
+    rng: np.random.Generator,
+    start,
+    goal,
+    tool: dict,
+    margin: float,
+    n_parts: tuple[int, int] = (1, 4),
+    attempts: int = 200,
+) -> Scene:
     """A random field of posts and boxes across the line from ``start`` to ``goal`` (module docstring).
 
     Parameters
@@ -48,13 +55,17 @@ def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: floa
     start, goal = as_point(start, 3, "start"), as_point(goal, 3, "goal")
     margin = check_real(margin, "margin", nonnegative=True)
     if not isinstance(n_parts, (tuple, list)) or len(n_parts) != 2:
-        raise TypeError(f"n_parts must be (fewest, most), two integers, got {short_token(n_parts, 30)}")
+        raise TypeError(
+            f"n_parts must be (fewest, most), two integers, got {short_token(n_parts, 30)}"
+        )
     low, high = (check_int(n, "n_parts", minimum=1, maximum=16) for n in n_parts)
     if low > high:
         raise ValueError(f"n_parts: the fewest ({low}) is more than the most ({high})")
     attempts = check_int(attempts, "attempts", minimum=1, maximum=100_000)
     if not isinstance(tool, dict) or set(tool) != {"radius", "length"}:
-        raise TypeError(f"tool must be {{'radius': r, 'length': l}} (scene units), got {short_token(tool, 30)}")
+        raise TypeError(
+            f"tool must be {{'radius': r, 'length': l}} (scene units), got {short_token(tool, 30)}"
+        )
     tool = {key: check_real(value, f"tool's {key}", positive=True) for key, value in tool.items()}
     chord = goal - start
     reach = float(np.linalg.norm(chord[:2]))
@@ -64,14 +75,25 @@ def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: floa
     width = 2.0 * (float(tool["radius"]) + margin)  # what the tool needs to pass between two parts
     keep = width + 0.02 * reach  # no part this close to the start or the goal (plus its own size)
     parts, footprints = [], []
-    bottom, top = min(start[2], goal[2]) - 0.5 * reach, max(start[2], goal[2]) + 0.5 * reach + float(tool["length"])
+    bottom, top = (
+        min(start[2], goal[2]) - 0.5 * reach,
+        max(start[2], goal[2]) + 0.5 * reach + float(tool["length"]),
+    )
     for index in range(int(rng.integers(low, high + 1))):
         for _ in range(attempts):
             size = float(rng.uniform(0.03, 0.10)) * reach  # the part's half-width
-            centre = start[:2] + float(rng.uniform(0.25, 0.75)) * reach * along + float(rng.uniform(-1.5, 1.5)) * size * across
-            ends_ok = min(np.linalg.norm(centre - start[:2]), np.linalg.norm(centre - goal[:2])) > keep + size * np.sqrt(2.0)
-            apart = all(np.linalg.norm(centre - other) > size * np.sqrt(2.0) + reach_ * np.sqrt(2.0) + width
-                        for other, reach_ in footprints)
+            centre = (
+                start[:2]
+                + float(rng.uniform(0.25, 0.75)) * reach * along
+                + float(rng.uniform(-1.5, 1.5)) * size * across
+            )
+            ends_ok = min(
+                np.linalg.norm(centre - start[:2]), np.linalg.norm(centre - goal[:2])
+            ) > keep + size * np.sqrt(2.0)
+            apart = all(
+                np.linalg.norm(centre - other) > size * np.sqrt(2.0) + reach_ * np.sqrt(2.0) + width
+                for other, reach_ in footprints
+            )
             if ends_ok and apart:
                 break
         else:
@@ -79,13 +101,28 @@ def random_field(rng: np.random.Generator, start, goal, tool: dict, margin: floa
         footprints.append((centre, size))
         at = [float(centre[0]), float(centre[1]), float(bottom)]
         if rng.random() < 0.5:
-            parts.append({"type": "cylinder", "label": f"o{index}", "at": at, "radius": size, "height": float(top - bottom)})
+            parts.append(
+                {
+                    "type": "cylinder",
+                    "label": f"o{index}",
+                    "at": at,
+                    "radius": size,
+                    "height": float(top - bottom),
+                }
+            )
         else:
             yaw = float(rng.uniform(0.0, 180.0))
             sides = [2.0 * size, 2.0 * size * float(rng.uniform(0.4, 1.0)), float(top - bottom)]
             parts.append({"type": "box", "label": f"o{index}", "at": at, "size": sides, "yaw": yaw})
     if not parts:  # the margin or the tool leaves no room between the start and the goal
-        raise ValueError(f"margin and tool: no part fits between start and goal {reach:.3g} apart with a margin of "
-                         f"{margin:g} and a tool of radius {tool['radius']:g}")
-    return Scene.from_dict({"tool": {"radius": float(tool["radius"]), "length": float(tool["length"])}, "parts": parts,
-                            "margin": margin})
+        raise ValueError(
+            f"margin and tool: no part fits between start and goal {reach:.3g} apart with a margin of "
+            f"{margin:g} and a tool of radius {tool['radius']:g}"
+        )
+    return Scene.from_dict(
+        {
+            "tool": {"radius": float(tool["radius"]), "length": float(tool["length"])},
+            "parts": parts,
+            "margin": margin,
+        }
+    )

@@ -34,7 +34,7 @@ import numpy as np
 
 from .._checks import as_point, as_rotation, get_limits, short_token
 
-__all__ = ['PART_TYPES', 'SceneError', 'Tool', 'Solid', 'Part']
+__all__ = ["PART_TYPES", "SceneError", "Tool", "Solid", "Part"]
 
 logger = logging.getLogger(__name__)
 
@@ -42,9 +42,11 @@ PART_TYPES = ("box", "cell", "cylinder", "nut", "plate")
 
 
 _PART_KEYS = {
-    "box": {"size", "yaw"}, "cell": {"size", "yaw"}, "plate": {"size", "yaw"},
-    "cylinder": {"radius", "height"}, "nut": {"across_flats", "height", "stud", "yaw"},
-
+    "box": {"size", "yaw"},
+    "cell": {"size", "yaw"},
+    "plate": {"size", "yaw"},
+    "cylinder": {"radius", "height"},
+    "nut": {"across_flats", "height", "stud", "yaw"},
 }
 
 
@@ -73,8 +75,15 @@ class Tool:
     def __post_init__(self):
         for name in ("radius", "length"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, Real) or not _finite(value) or value <= 0:
-                raise SceneError(f"tool.{name} must be a positive number, got {short_token(value, 20)}")
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, Real)
+                or not _finite(value)
+                or value <= 0
+            ):
+                raise SceneError(
+                    f"tool.{name} must be a positive number, got {short_token(value, 20)}"
+                )
             if value > get_limits().max_abs_value:
                 raise SceneError(f"tool.{name} = {value:g} exceeds the limit max_abs_value")
 
@@ -107,7 +116,16 @@ class Solid:
         else:
             vertices = np.asarray(self.params[0], dtype=float) @ rotation.T
             extent = np.max(np.abs(vertices), axis=0)
-        return Solid(self.label, self.part, self.kind, centre, rotation, self.params, centre - extent, centre + extent)
+        return Solid(
+            self.label,
+            self.part,
+            self.kind,
+            centre,
+            rotation,
+            self.params,
+            centre - extent,
+            centre + extent,
+        )
 
 
 @dataclass(frozen=True)
@@ -132,7 +150,15 @@ def _bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _box_solid(label, part, centre, size, rotation) -> Solid:
     half = np.asarray(size, dtype=float) / 2.0
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
-    return Solid(label, part, "box", centre, rotation, tuple(float(v) for v in size), *_bounds(corners @ rotation.T + centre))
+    return Solid(
+        label,
+        part,
+        "box",
+        centre,
+        rotation,
+        tuple(float(v) for v in size),
+        *_bounds(corners @ rotation.T + centre),
+    )
 
 
 def _cylinder_extent(axis: np.ndarray, radius: float, half_height: float) -> np.ndarray:
@@ -142,7 +168,16 @@ def _cylinder_extent(axis: np.ndarray, radius: float, half_height: float) -> np.
 
 def _cylinder_solid(label, part, centre, radius, height, rotation) -> Solid:
     extent = _cylinder_extent(rotation[:, 2], radius, height / 2.0)
-    return Solid(label, part, "cylinder", centre, rotation, (float(radius), float(height)), centre - extent, centre + extent)
+    return Solid(
+        label,
+        part,
+        "cylinder",
+        centre,
+        rotation,
+        (float(radius), float(height)),
+        centre - extent,
+        centre + extent,
+    )
 
 
 def _hex_solid(label, part, centre, across_flats, height, rotation) -> Solid:
@@ -150,7 +185,15 @@ def _hex_solid(label, part, centre, across_flats, height, rotation) -> Solid:
     angles = np.deg2rad(np.arange(6) * 60.0)
     ring = np.column_stack([corner * np.cos(angles), corner * np.sin(angles), np.zeros(6)])
     vertices = np.vstack([ring + [0, 0, -height / 2.0], ring + [0, 0, height / 2.0]])
-    return Solid(label, part, "convex", centre, rotation, (vertices,), *_bounds(vertices @ rotation.T + centre))
+    return Solid(
+        label,
+        part,
+        "convex",
+        centre,
+        rotation,
+        (vertices,),
+        *_bounds(vertices @ rotation.T + centre),
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -191,11 +234,15 @@ def _part_rotation(spec: dict, key: str) -> np.ndarray:
     if "rotation" in spec:
         from scipy.spatial.transform import Rotation
 
-        return Rotation.from_euler("xyz", _vector(spec["rotation"], f"{key}.rotation"), degrees=True).as_matrix()
+        return Rotation.from_euler(
+            "xyz", _vector(spec["rotation"], f"{key}.rotation"), degrees=True
+        ).as_matrix()
     return _rotation_z(math.radians(_number(spec.get("yaw", 0.0), f"{key}.yaw", positive=False)))
 
 
-def _part_solids(label: str, kind: str, at: np.ndarray, spec: dict, key: str, rotation: np.ndarray) -> tuple:
+def _part_solids(
+    label: str, kind: str, at: np.ndarray, spec: dict, key: str, rotation: np.ndarray
+) -> tuple:
     up = rotation[:, 2]  # the part's own z axis: "bottom" and "top" are along it
     if kind in ("box", "cell"):
         size = _vector(spec.get("size"), f"{key}.size", positive=True)
@@ -213,18 +260,30 @@ def _part_solids(label: str, kind: str, at: np.ndarray, spec: dict, key: str, ro
     solids = [_hex_solid(label, label, at + up * height / 2.0, across, height, rotation)]
     stud = spec.get("stud")
     if stud is not None:
-        if not isinstance(stud, dict) or set(stud) - {"radius", "above"} or not {"radius", "above"} <= set(stud):
-            _fail(f"{key}.stud", 'expected {"radius": r, "above": h} (the stud sticks out h over the nut)')
+        if (
+            not isinstance(stud, dict)
+            or set(stud) - {"radius", "above"}
+            or not {"radius", "above"} <= set(stud)
+        ):
+            _fail(
+                f"{key}.stud",
+                'expected {"radius": r, "above": h} (the stud sticks out h over the nut)',
+            )
         radius = _number(stud["radius"], f"{key}.stud.radius")
         above = _number(stud["above"], f"{key}.stud.above")
         if radius >= across / 2.0:
-            _fail(f"{key}.stud.radius", f"{radius:g} does not fit inside the nut ({across:g} across flats)")
+            _fail(
+                f"{key}.stud.radius",
+                f"{radius:g} does not fit inside the nut ({across:g} across flats)",
+            )
         total = height + above
-        solids.append(_cylinder_solid(f"{label}/stud", label, at + up * total / 2.0, radius, total, rotation))
+        solids.append(
+            _cylinder_solid(f"{label}/stud", label, at + up * total / 2.0, radius, total, rotation)
+        )
     return tuple(solids)
 
 
-def _parse_parts(items, targets: dict | None) -> list[Part]:
+def _parse_parts(items, targets: dict | None) -> list[Part]:  # noqa: C901 - one branch per documented option or part kind, each a line
     if not isinstance(items, list) or not items:
         _fail("scene.parts", "expected a non-empty list of parts")
     parts: list[Part] = []
@@ -234,27 +293,43 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:
             _fail(key, "expected an object")
         kind = item.get("type")
         if kind not in PART_TYPES:
-            _fail(f"{key}.type", f"unknown part type {short_token(kind, 20)} (known: {', '.join(PART_TYPES)})")
+            _fail(
+                f"{key}.type",
+                f"unknown part type {short_token(kind, 20)} (known: {', '.join(PART_TYPES)})",
+            )
         rotation = _part_rotation(item, key)
         unknown = sorted(set(item) - _COMMON_KEYS - _PART_KEYS[kind])
         if unknown:
-            _fail(f"{key}.{short_token(unknown[0], 20)[1:-1]}",
-                  f"unknown key for a {kind} (known: {', '.join(sorted(_COMMON_KEYS | _PART_KEYS[kind]))})")
+            _fail(
+                f"{key}.{short_token(unknown[0], 20)[1:-1]}",
+                f"unknown key for a {kind} (known: {', '.join(sorted(_COMMON_KEYS | _PART_KEYS[kind]))})",
+            )
         if "at_targets" in item:
             if "at" in item or "label" in item:
-                _fail(key, "give either at_targets (one part per target, labelled like it) or at and label")
+                _fail(
+                    key,
+                    "give either at_targets (one part per target, labelled like it) or at and label",
+                )
             if targets is None:
                 _fail(f"{key}.at_targets", "needs the scenario's targets")
             names = item["at_targets"]
             if names == "all":
                 names = list(targets)
-            if not isinstance(names, list) or not names or not all(isinstance(n, str) for n in names):
+            if (
+                not isinstance(names, list)
+                or not names
+                or not all(isinstance(n, str) for n in names)
+            ):
                 _fail(f"{key}.at_targets", 'expected "all" or a list of target labels')
             for name in names:
                 if name not in targets:
                     _fail(f"{key}.at_targets", f"{short_token(name, 20)} is not a target label")
-            offset = rotation @ _vector(item.get("offset", [0, 0, 0]), f"{key}.offset")  # in the part's frame
-            placements = [(name, np.asarray(targets[name], dtype=float)[:3] + offset) for name in names]
+            offset = rotation @ _vector(
+                item.get("offset", [0, 0, 0]), f"{key}.offset"
+            )  # in the part's frame
+            placements = [
+                (name, np.asarray(targets[name], dtype=float)[:3] + offset) for name in names
+            ]
         else:
             if "offset" in item:
                 _fail(f"{key}.offset", "only with at_targets")
@@ -265,8 +340,14 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:
         spec = {k: v for k, v in item.items() if k not in _COMMON_KEYS}
         for label, at in placements:
             extra = {"rotation": item["rotation"]} if "rotation" in item else {}
-            parts.append(Part(label, kind, {"type": kind, "label": label, "at": at.tolist(), **extra, **spec},
-                              _part_solids(label, kind, at, spec, key, rotation)))
+            parts.append(
+                Part(
+                    label,
+                    kind,
+                    {"type": kind, "label": label, "at": at.tolist(), **extra, **spec},
+                    _part_solids(label, kind, at, spec, key, rotation),
+                )
+            )
     seen = set()
     for part in parts:
         if part.label in seen:

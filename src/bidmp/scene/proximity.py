@@ -39,11 +39,19 @@ class Proximity:
         self._lower, self._upper = scene._lower[self._chosen], scene._upper[self._chosen]
         self._engine = scene._engine() if self._chosen.size else None
         # The box around them all: a tool far from it needs no per-solid bound (most of a motion).
-        self._whole = (self._lower.min(axis=0).tolist(), self._upper.max(axis=0).tolist()) if self._chosen.size else None
+        self._whole = (
+            (self._lower.min(axis=0).tolist(), self._upper.max(axis=0).tolist())
+            if self._chosen.size
+            else None
+        )
         # A part's designed stand-off (a plate under the nut), inf for the parts without one.
-        self.standoffs = np.array([scene.standoff.get(scene._owner[index], np.inf) for index in self._chosen])
+        self.standoffs = np.array(
+            [scene.standoff.get(scene._owner[index], np.inf) for index in self._chosen]
+        )
 
-    def near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def near(
+        self, point: np.ndarray, within: float, skip: np.ndarray | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Solids whose signed distance from the tool at ``point`` (3,) is below ``within``
         (scene units): their distances (k,), unit directions from each toward the tool (k, 3), their
         parts' stand-offs (k,; inf: none) and their indices among the chosen solids (k,). ``skip``:
@@ -51,8 +59,14 @@ class Proximity:
         point = as_point(point, 3, "point")
         within = check_real(within, "within", positive=True)
         if skip is not None:
-            if not isinstance(skip, np.ndarray) or skip.dtype != bool or skip.shape != self._chosen.shape:
-                raise ValueError(f"skip must be a boolean mask over the {self._chosen.size} chosen solids")
+            if (
+                not isinstance(skip, np.ndarray)
+                or skip.dtype != bool
+                or skip.shape != self._chosen.shape
+            ):
+                raise ValueError(
+                    f"skip must be a boolean mask over the {self._chosen.size} chosen solids"
+                )
         return self._near(point, within, skip)
 
     def _near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None):
@@ -68,7 +82,9 @@ class Proximity:
         vertical = max(z0 - (z + tool.length), z - z1, 0.0)
         if math.hypot(max(lateral, 0.0), vertical) >= within:
             return _NONE
-        bounds = _cylinder_box_bounds(point[None], tool.radius, tool.length, self._lower, self._upper)[0]
+        bounds = _cylinder_box_bounds(
+            point[None], tool.radius, tool.length, self._lower, self._upper
+        )[0]
         candidates = np.flatnonzero(bounds < within)
         if skip is not None and candidates.size:  # a mask over the chosen solids
             candidates = candidates[~skip[candidates]]
@@ -83,7 +99,9 @@ class Proximity:
             if distance <= 0.0:
                 away = -np.asarray(result.normal, dtype=float)
             size = math.sqrt(away @ away)
-            if not (size > 1e-12 and math.isfinite(size)):  # no direction from coal: away from the solid's centre
+            if not (
+                size > 1e-12 and math.isfinite(size)
+            ):  # no direction from coal: away from the solid's centre
                 away = point - self.scene.solids[self._chosen[index]].centre
                 size = max(math.sqrt(away @ away), 1e-300)
             distances.append(distance)

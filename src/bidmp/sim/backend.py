@@ -19,12 +19,26 @@ import numpy as np
 
 from .._checks import as_point, as_vector, check_int, check_real
 
-__all__ = ["SimulatorBackend", "SimError", "JointLimits", "Hold", "GoalUpdate", "MotionPlan", "Execution", "SIM_STEP",
-           "CONTROL_STEP", "LIMIT_MARGIN", "COUPLING", "RECORD_EVERY", "SETTLE"]
+__all__ = [
+    "SimulatorBackend",
+    "SimError",
+    "JointLimits",
+    "Hold",
+    "GoalUpdate",
+    "MotionPlan",
+    "Execution",
+    "SIM_STEP",
+    "CONTROL_STEP",
+    "LIMIT_MARGIN",
+    "COUPLING",
+    "RECORD_EVERY",
+    "SETTLE",
+]
 
 SIM_STEP = 1e-3  # s: 1 kHz physics and position control
 CONTROL_STEP = 1e-2  # s: the closed-loop stepper and its inverse kinematics run at 100 Hz
-LIMIT_MARGIN = 0.9  # motions are timed to this fraction of the joint velocity, acceleration and jerk limits
+# motions are timed to this fraction of the joint velocity, acceleration and jerk limits
+LIMIT_MARGIN = 0.9
 COUPLING = 5e5  # 1/m²: phase stopping's default gain in closed loop (0.5 /mm²)
 RECORD_EVERY = 2  # physics steps per recorded sample (500 Hz); contacts are checked every step
 SETTLE = 0.3  # s held at the end before the end point is measured
@@ -51,12 +65,16 @@ class JointLimits:
             value = getattr(self, name)
             if value is None and name == "jerk":
                 continue
-            values = as_vector(value, f"JointLimits.{name}", positive=name not in ("lower", "upper"))
+            values = as_vector(
+                value, f"JointLimits.{name}", positive=name not in ("lower", "upper")
+            )
             counts[name] = len(values)
             object.__setattr__(self, name, tuple(float(v) for v in values))
         if len(set(counts.values())) > 1:
-            raise ValueError("JointLimits: one value per joint in each of " + ", ".join(f"{name} ({count})" for name, count
-                                                                                       in counts.items()))
+            raise ValueError(
+                "JointLimits: one value per joint in each of "
+                + ", ".join(f"{name} ({count})" for name, count in counts.items())
+            )
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
 
@@ -75,9 +93,13 @@ class Hold:
     duration: float = 0.5
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=63))
+        object.__setattr__(
+            self, "joint", check_int(self.joint, "Hold.joint", minimum=0, maximum=63)
+        )
         object.__setattr__(self, "start", check_real(self.start, "Hold.start", nonnegative=True))
-        object.__setattr__(self, "duration", check_real(self.duration, "Hold.duration", positive=True))
+        object.__setattr__(
+            self, "duration", check_real(self.duration, "Hold.duration", positive=True)
+        )
 
 
 @dataclass(frozen=True)
@@ -91,7 +113,9 @@ class GoalUpdate:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "time", check_real(self.time, "GoalUpdate.time", nonnegative=True))
-        object.__setattr__(self, "offset", tuple(as_point(self.offset, 3, "GoalUpdate.offset").tolist()))
+        object.__setattr__(
+            self, "offset", tuple(as_point(self.offset, 3, "GoalUpdate.offset").tolist())
+        )
 
 
 @dataclass
@@ -129,7 +153,8 @@ class Execution:
     frames: list = field(default_factory=list)  # rendered RGB images, when asked for
     command_times: np.ndarray | None = None  # closed loop: the control steps (s) ...
     command_joints: np.ndarray | None = None  # ... the joints commanded there (rad) ...
-    motion_clock: np.ndarray | None = None  # ... and the stepper's own time (s; stands still while paused)
+    # ... and the stepper's own time (s; stands still while paused)
+    motion_clock: np.ndarray | None = None
     tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
     commands: np.ndarray | None = None  # (n, J) rad: the joint positions commanded every SIM_STEP
 
@@ -151,7 +176,7 @@ class SimulatorBackend(Protocol):
     scene: object  # the bidmp.scene.Scene it was built from (the closed loop steers round it)
 
     @classmethod
-    def load_robot(cls, scene, units: str, base, yaw: float) -> "SimulatorBackend":
+    def load_robot(cls, scene, units: str, base, yaw: float) -> SimulatorBackend:
         """Build the world of ``scene`` (parts, tool) with the robot at ``base`` (scene units),
         turned ``yaw`` degrees about z."""
 
@@ -162,14 +187,26 @@ class SimulatorBackend(Protocol):
     def fk(self, q) -> np.ndarray:
         """The tool-centre point (m) at joint positions ``q``."""
 
-    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None) -> MotionPlan:
+    def plan(
+        self, path, label: str = "", fractions=None, seed=None, orientations=None
+    ) -> MotionPlan:
         """A Cartesian path (n, 3, scene units) turned into a timed joint path within the limits."""
 
-    def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0) -> Execution:
+    def execute(
+        self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0
+    ) -> Execution:
         """Run ``plan`` open loop, the parts in ``exclude`` ignored for contacts."""
 
-    def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                            frames: int = 0, max_factor: float = 4.0, goal_update: GoalUpdate | None = None) -> Execution:
+    def execute_closed_loop(
+        self,
+        stepper,
+        duration: float,
+        exclude=(),
+        hold: Hold | None = None,
+        frames: int = 0,
+        max_factor: float = 4.0,
+        goal_update: GoalUpdate | None = None,
+    ) -> Execution:
         """Run a DMP stepper on the measured tool-centre point (the parts in ``exclude`` moved by
         ``goal_update`` at its time, and the stepper's goal with them)."""
 

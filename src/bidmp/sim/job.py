@@ -21,215 +21,17 @@ A target whose step fails is a row of the report with its reason; the job goes o
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..tasks.contract import Contract, mm
-from .job_report import JobPhase, JobReport, JobTarget, _phase, in_bin, in_slot
+from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
+from .job_world import _body, _move, _StepFailed, _transfer, _transfer_contract, _World
 from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle
 
 __all__ = ["run_job", "job_targets"]
 
 RELEASE_S = 0.6  # s the world runs after a part is let go, for it to come to rest
-_DOWN = Rotation.from_quat([1.0, 0.0, 0.0, 0.0])  # the tool pointing down (its z axis along -z)
-
-
-@dataclass
-class _World:
-    cell: object
-    scenario: object
-    spec: object
-    model: object  # the fitted Bi-DMP (a pose Bi-DMP for a tilted scenario)
-    q: np.ndarray  # the arm's joints now (rad)
-    contract: Contract  # the job's scene (the scenario's parts, the bin, the rack), the arm's limits
-    repairer: object  # bidmp.tasks.repair.Repairer of the approaches
-    transfers: object  # ... and of the transfers to the bin or the rack (lift, steer; a carried part kept clear too)
-    pictures: list | None = None  # keyframes at the end of each phase of the first cycle, when asked for
-    motion: list | None = None  # (times, joint origins) of the first cycle's motions, for the viewer
-    clock: float = 0.0  # simulated seconds since the job began
-    placed: int = 0  # parts in the rack so far
-    dropped: int = 0  # parts let go over the bin so far
-    held: object = None  # the part in the tool, if any (let go where it is when a step fails)
-    gone: list = field(default_factory=list)  # whole parts taken away (cells): no longer in the way
-    failures: list = field(default_factory=list)  # (target, phase, image) where a motion broke the contract
-    record: bool = False  # keep each phase's measured path and commands
-
-    @property
-    def scene(self):
-        return self.contract.scene
-
-    @property
-    def tcp(self) -> np.ndarray:
-        return self.cell.tcp_position() / self.cell.unit
-
-    @property
-    def pose(self) -> bool:
-        return self.scenario.is_pose
-
-    def orientation(self) -> Rotation:
-        """The tool frame now (measured)."""
-        p, cell = self.cell.p, self.cell
-        return Rotation.from_quat(p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1,
-                                                 physicsClientId=cell.client)[5])
-
-
-class _StepFailed(Exception):
-    """A step that cannot be done; the message says which and why."""
-
-
-# ---------------------------------------------------------------------------------------------
-# Motions
-# ---------------------------------------------------------------------------------------------
-def _move(world: _World, path, fractions, exclude, name: str, *, orientations=None, on_record=None,
-          least_duration: float = 0.0, carried=None, target=None, axis=None, support=()) -> JobPhase:
-    """Plan ``path`` (n, 3) from the arm's joints now, execute it and judge what the arm did by the
-    contract: its end within the threshold of ``target`` (default the path's end), the final descent
-    along ``axis`` when it is the approach, clearance by the margin of the executed tool and of a
-    ``carried`` part (its own contacts count as the arm's; not from the parts it stands on,
-    ``support``, while it is lifted off them), the 1 kHz commands within the limits."""
-    cell = world.cell
-    plan = cell.plan(np.asarray(path, dtype=float), name, fractions=fractions, seed=world.q, orientations=orientations)
-    if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
-        scale = plan.duration / least_duration
-        plan.duration = least_duration
-        plan.peak_velocity *= scale
-        plan.peak_acceleration *= scale**2
-        plan.peak_jerk *= scale**3
-    touched = {}
-    if carried is not None:
-        def on_record(t, inner=on_record):
-            carried.contacts(touched, ignore=exclude)
-            if inner is not None:
-                inner(t)
-    run = cell.execute(plan, exclude, on_record=on_record)
-    world.q = run.joints[-1]
-    if world.motion is not None:
-        from .run import _arm_motion
-
-        arm = _arm_motion(cell, run)
-        world.motion.append((world.clock + arm["times"], arm["links"]))
-    phase = _phase(name, run, plan, cell, touched)
-    executed = run.tcp / cell.unit
-    tool_frames = run.tcp_orientation if world.pose else None
-    clearance = _clearance(world, executed, exclude, carried, tool_frames, support)
-    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
-    phase.verdict = contract.judge(executed, executed[-1] if target is None else np.asarray(target)[:3], label=name,
-                                   axis=axis, exclude=exclude, orientations=tool_frames, commands=run.commands,
-                                   contacts=phase.contacts, clearance=clearance)
-    phase.ok = phase.verdict.ok
-    if world.record:
-        phase.path, phase.commands = executed, np.asarray(run.commands)
-    world.clock += phase.seconds
-    return phase
-
-
-def _transfer_contract(contract: Contract) -> Contract:
-    """The contract of a move that is not an approach: no final descent to judge."""
-    return Contract(contract.threshold, None, contract.scene, contract.units, None, contract.limits)
-
-
-def _clearance(world: _World, path, exclude, carried, orientations=None, support=()):
-    """The tool's clearance along ``path``, and of a ``carried`` part (a :class:`_MovablePart`, or
-    ``(solid, offset from the mouth)``) but from the parts it is lifted off (``support``): the nearer
-    of the two to its margin."""
-    from ..tasks.repair import carried_clearance
-
-    if isinstance(carried, _MovablePart):  # where it is now, with the tool where it is now
-        carried = _body(world, carried)
-    return carried_clearance(world.scene, path, exclude, carried, support, orientations)
-
-
-def _body(world: _World, part: _MovablePart) -> tuple:
-    """A carried part as the clearance checks see it: its solid where it is now and its centre's
-    offset from the tool's mouth now."""
-    centre, rotation = part.pose()
-    return part.solid.moved(centre, rotation.as_matrix()), centre - world.tcp
-
-
-def _skill_path(world: _World, goal, skill, via=None, start_pose=None):
-    """The learned skill's motion from the tool's place now to ``goal``: (positions, fractions,
-    orientations or None)."""
-    options = {"skill": skill}
-    if via is not None:
-        options["via"] = via
-    if world.pose:
-        start = np.concatenate([world.tcp, world.orientation().as_quat()]) if start_pose is None else start_pose
-        trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options)
-        return trajectory.y, trajectory.t / trajectory.t[-1], trajectory.q
-    trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=world.tcp, **options)
-    return trajectory.y, trajectory.t / trajectory.t[-1], None
-
-
-def _clear_transfer(world: _World, goal, exclude, carried=None):
-    """The plain DMP's motion to ``goal`` (a transfer), repaired where the tool, or the part it
-    carries (``carried``: its solid and offset from the mouth), would come within the margin of a
-    part: lifted over it by
-    via-points, or steered round it; ``(positions, fractions, orientations, note)``."""
-    if not world.pose:
-        repaired = world.transfers.repair(world.model, np.asarray(goal, dtype=float), "the transfer", start=world.tcp,
-                                          exclude=exclude, skill=0, carried=carried)
-        if not repaired.ok:
-            raise _StepFailed(repaired.reason())
-        note = f"repaired: {repaired.how}" if repaired.how else ""
-        return repaired.motion, np.linspace(0.0, 1.0, repaired.motion.shape[0]), None, note
-    scene = world.scene
-    start_pose = None
-    if world.pose:  # a transfer ends with the tool upright: over the bin or a slot
-        start_pose = np.concatenate([world.tcp, world.orientation().as_quat()])
-        goal = np.concatenate([goal[:3], _DOWN.as_quat()])
-    path, fractions, turns = _skill_path(world, goal, 0, start_pose=start_pose)
-    clearance = _clearance(world, path, exclude, carried)
-    if clearance.clear:
-        return path, fractions, turns, ""
-    from ..tasks.repair import _depth
-
-    height = _depth(carried)
-    top = max(float(np.max([s.upper[2] for s in scene.solids])) + height, float(world.tcp[2]), float(goal[2]))
-    over = 0.5 * (world.tcp + np.asarray(goal, dtype=float)[:3])
-    over[2] = top + world.spec.clearance
-    via = [(0.5 * _skill_duration(world, goal, start_pose), np.concatenate([over, _DOWN.as_quat()]) if world.pose else over)]
-    lifted, fractions, turns = _skill_path(world, goal, 0, via=via, start_pose=start_pose)
-    again = _clearance(world, lifted, exclude, carried)
-    if not again.clear:
-        unit = world.scenario.units
-        raise _StepFailed(f"the learned move would {_closeness(clearance, unit)} {clearance.part}, and lifted "
-                          f"{world.spec.clearance:g} {unit} over the work still {_closeness(again, unit)} {again.part}")
-    return lifted, fractions, turns, f"lifted over the work (it would have come within the margin of {clearance.part})"
-
-
-def _skill_duration(world: _World, goal, start_pose) -> float:
-    """How long the plain skill's motion to ``goal`` lasts (s)."""
-    options = {"skill": 0}
-    start = start_pose if world.pose else world.tcp
-    return float(world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options).t[-1])
-
-
-def _closeness(clearance, unit: str) -> str:
-    """How a clearance breaks the margin, in words ("cut 2.1 mm into", "pass 1.2 mm from")."""
-    if clearance.distance < 0.0:
-        return f"cut {-clearance.distance:.2f} {unit} into"
-    return f"pass {clearance.distance:.2f} {unit} from"
-
-
-def _transfer(world: _World, goal, exclude, carried=None):
-    """A move to the bin or the rack from the learned skill: the DMP's start and goal
-    generalisation (lifted over the work if it would come too close), or with ``transfer:
-    "similarity"`` the plain DMP's own reproduction turned (the smallest rotation taking its
-    start-to-goal onto this one), scaled and moved to run from the tool's place to ``goal``."""
-    if world.spec.transfer == "dmp" or world.pose:
-        return _clear_transfer(world, goal, exclude, carried)
-    reproduction = world.model.trajectory(skill=0)
-    shape, start, goal = reproduction.y, world.tcp, np.asarray(goal, dtype=float)
-    demonstrated, wanted = shape[-1] - shape[0], goal - start
-    turn, _ = Rotation.align_vectors([wanted], [demonstrated])
-    path = start + np.linalg.norm(wanted) / np.linalg.norm(demonstrated) * turn.apply(shape - shape[0])
-    clearance = _clearance(world, path, exclude, carried)
-    if not clearance.clear:
-        raise _StepFailed(f"the learned shape, turned and scaled, would {_closeness(clearance, world.scenario.units)} "
-                          f"{clearance.part}")
-    return path, reproduction.t / reproduction.t[-1], None, "the skill's shape turned and scaled"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -240,17 +42,23 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone
     if world.pose:
         start = np.concatenate([world.tcp, world.orientation().as_quat()])
-        trajectory = world.model.trajectory(np.asarray(target, dtype=float), start=start, skill="nearest")
+        trajectory = world.model.trajectory(
+            np.asarray(target, dtype=float), start=start, skill="nearest"
+        )
         path, turns, note = trajectory.y, trajectory.q, ""
         fractions = trajectory.t / trajectory.t[-1]
     else:
-        repaired = world.repairer.repair(world.model, target, label, start=world.tcp, axis=axis, exclude=exclude)
+        repaired = world.repairer.repair(
+            world.model, target, label, start=world.tcp, axis=axis, exclude=exclude
+        )
         if not repaired.ok:
             raise _StepFailed(f"approach: {repaired.reason()}")
         path, turns = repaired.motion, None
         fractions = np.linspace(0.0, 1.0, path.shape[0])
         note = f"repaired: {repaired.how}" if repaired.how else ""
-    phase = _move(world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis)
+    phase = _move(
+        world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis
+    )
     phase.note = note
     return phase
 
@@ -264,8 +72,10 @@ def _engaged(world: _World, part: _MovablePart, target) -> tuple[bool, str]:
     along = abs(float(np.dot(tcp - np.asarray(target, dtype=float)[:3], part.axis)))
     tolerance, unit = world.spec.engage_tolerance, world.scenario.units
     if across > tolerance or along > world.scenario.success_threshold:
-        return False, (f"the tool is {across:.2f} {unit} off the part's axis and {along:.2f} {unit} off its height "
-                       f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})")
+        return False, (
+            f"the tool is {across:.2f} {unit} off the part's axis and {along:.2f} {unit} off its height "
+            f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})"
+        )
     return True, f"{across:.3f} {unit} off the axis"
 
 
@@ -283,12 +93,23 @@ def _supports(world: _World, part: _MovablePart) -> list:
     return found
 
 
-def _straight(world: _World, direction, length: float, exclude, name: str, part=None, **options) -> JobPhase:
+def _straight(
+    world: _World, direction, length: float, exclude, name: str, part=None, **options
+) -> JobPhase:
     """A straight move ``length`` along ``direction``, the tool's frame kept as it is."""
     start = world.tcp
     end = start + np.asarray(direction, dtype=float) * length
     turns = np.repeat(world.orientation().as_quat()[None], 2, axis=0) if world.pose else None
-    return _move(world, np.vstack([start, end]), None, exclude, name, orientations=turns, carried=part, **options)
+    return _move(
+        world,
+        np.vstack([start, end]),
+        None,
+        exclude,
+        name,
+        orientations=turns,
+        carried=part,
+        **options,
+    )
 
 
 def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
@@ -299,11 +120,19 @@ def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
     top = float(np.max([np.max(_corners(s) @ part.axis) for s in stud])) if stud else bottom
     rise = top - bottom + spec.play  # off the thread, a little clear of the stud's end
     start = float(np.dot(world.tcp, part.axis))
-    phase = _straight(world, part.axis, rise, exclude, "unscrew",
-                      on_record=lambda t: part.thread(float(np.dot(world.tcp, part.axis)) - start, spec.pitch, t),
-                      least_duration=rise / spec.pitch / spec.spindle_speed)
+    phase = _straight(
+        world,
+        part.axis,
+        rise,
+        exclude,
+        "unscrew",
+        on_record=lambda t: part.thread(float(np.dot(world.tcp, part.axis)) - start, spec.pitch, t),
+        least_duration=rise / spec.pitch / spec.spindle_speed,
+    )
     if part.rise < rise - 0.1 * spec.play:
-        raise _StepFailed(f"unscrew: the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud")
+        raise _StepFailed(
+            f"unscrew: the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud"
+        )
     part.hold()
     world.held = part
     phase.note = f"{rise / spec.pitch:.1f} turns, {rise:.2f} {world.scenario.units} up the thread"
@@ -338,7 +167,9 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
     point = _drop_point(world)
     path, fractions, turns, note = _transfer(world, point, exclude, carried=_body(world, part))
-    phase = _move(world, path, fractions, exclude, "drop", orientations=turns, carried=part, target=point)
+    phase = _move(
+        world, path, fractions, exclude, "drop", orientations=turns, carried=part, target=point
+    )
     centre = _release(world)
     world.dropped += 1
     phase.seconds += RELEASE_S
@@ -349,7 +180,9 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
     return phase
 
 
-def _reach(world: _World, label: str, target, axis, record: JobTarget, step: str) -> tuple[_MovablePart, list]:
+def _reach(
+    world: _World, label: str, target, axis, record: JobTarget, step: str
+) -> tuple[_MovablePart, list]:
     """The approach to ``target`` and the check that the tool took the part in (``step``:
     engage, grasp); the part and the parts its moves may touch."""
     part = _MovablePart(world.cell, label, world.spec.part_mass)
@@ -376,7 +209,12 @@ def _nut_cycle(world: _World, label: str, target, axis, record: JobTarget) -> No
     """approach → engage → unscrew → retract → drop for one nut, each phase into ``record``."""
     part, exclude = _reach(world, label, target, axis, record, "engage")
     _checked(world, record, _unscrew(world, part, exclude), target[:3])
-    _checked(world, record, _straight(world, part.axis, world.spec.clearance, exclude, "retract", part), target[:3])
+    _checked(
+        world,
+        record,
+        _straight(world, part.axis, world.spec.clearance, exclude, "retract", part),
+        target[:3],
+    )
     record.thread = np.array(part.trace)
     _add(world, record, _drop(world, part, exclude), _drop_point(world))
     _finish(record, part)
@@ -387,16 +225,31 @@ def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
     approach coming straight down), set it down, let go."""
     bottom = part.pose()[0] - part.axis * part.height / 2.0
     goal = np.asarray(slot, dtype=float) + (world.tcp - bottom) + [0.0, 0.0, world.spec.play]
-    path, fractions, turns, note = _transfer(world, goal, exclude + ["rack"], carried=_body(world, part))
-    phase = _move(world, path, fractions, exclude + ["rack"], "place", orientations=turns, carried=part, target=goal)
+    path, fractions, turns, note = _transfer(
+        world, goal, exclude + ["rack"], carried=_body(world, part)
+    )
+    phase = _move(
+        world,
+        path,
+        fractions,
+        exclude + ["rack"],
+        "place",
+        orientations=turns,
+        carried=part,
+        target=goal,
+    )
     centre = _release(world)
     phase.seconds += RELEASE_S
     off = float(np.linalg.norm(centre[:2] - np.asarray(slot)[:2]))
     phase.note = note
-    if not in_slot(centre, slot, part.height, world.spec.engage_tolerance * 5, world.spec.slot_tolerance):
+    if not in_slot(
+        centre, slot, part.height, world.spec.engage_tolerance * 5, world.spec.slot_tolerance
+    ):
         phase.ok = False
-        phase.note = (f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at "
-                      f"{np.round(centre, 1).tolist()}")
+        phase.note = (
+            f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at "
+            f"{np.round(centre, 1).tolist()}"
+        )
     return phase
 
 
@@ -406,8 +259,20 @@ def _lift_cycle(world: _World, label: str, target, axis, record: JobTarget) -> N
     part.hold()
     world.held = part
     if "lift" in world.spec.steps:
-        _checked(world, record, _straight(world, part.axis, part.height + world.spec.lift, exclude, "lift", part,
-                                          support=_supports(world, part)), target[:3])
+        _checked(
+            world,
+            record,
+            _straight(
+                world,
+                part.axis,
+                part.height + world.spec.lift,
+                exclude,
+                "lift",
+                part,
+                support=_supports(world, part),
+            ),
+            target[:3],
+        )
     slot = world.spec.slot(world.placed)
     _add(world, record, _place(world, part, slot, exclude), slot)
     _finish(record, part)
@@ -437,7 +302,9 @@ def _add(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:
     """Record ``phase``; on the first cycle with pictures, a keyframe of where it ended; a keyframe
     of every phase that broke the contract, looking at the part it came too close to."""
     record.phases.append(phase)
-    first = world.pictures is not None and (not world.pictures or world.pictures[0][0] == record.label)
+    first = world.pictures is not None and (
+        not world.pictures or world.pictures[0][0] == record.label
+    )
     if first:
         image = world.cell.keyframe(record.seconds, focus)
         world.pictures.append((record.label, phase.name, record.seconds, image))
@@ -445,7 +312,9 @@ def _add(world: _World, record: JobTarget, phase: JobPhase, focus) -> None:
     if world.pictures is not None and verdict is not None and not verdict.ok:
         clearance = verdict.clearance
         near = focus if clearance is None or clearance.point is None else clearance.point
-        world.failures.append((record.label, phase.name, world.cell.keyframe(record.seconds, near), verdict.reason()))
+        world.failures.append(
+            (record.label, phase.name, world.cell.keyframe(record.seconds, near), verdict.reason())
+        )
 
 
 def _release(world: _World) -> np.ndarray:
@@ -482,8 +351,14 @@ def _job_parts(scenario, labels) -> list:
     lower, upper = corners.min(axis=0) - room, corners.max(axis=0) + room
     centre = 0.5 * (lower + upper)
     thickness = mm(5.0, spec.units)
-    return [{"type": "box", "label": "rack", "at": [float(centre[0]), float(centre[1]), float(first[2]) - thickness],
-             "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), thickness]}]
+    return [
+        {
+            "type": "box",
+            "label": "rack",
+            "at": [float(centre[0]), float(centre[1]), float(first[2]) - thickness],
+            "size": [float(upper[0] - lower[0]), float(upper[1] - lower[1]), thickness],
+        }
+    ]
 
 
 def _bin_parts(bottom, inner, wall: float) -> list:
@@ -494,10 +369,19 @@ def _bin_parts(bottom, inner, wall: float) -> list:
     half = inner / 2.0
     pieces = [(bottom, [inner[0] + 2 * wall, inner[1] + 2 * wall, wall])]
     for sign in (-1.0, 1.0):  # on the floor slab, round the inner floor
-        pieces.append((bottom + [sign * (half[0] + wall / 2), 0, wall], [wall, inner[1] + 2 * wall, inner[2]]))
+        pieces.append(
+            (bottom + [sign * (half[0] + wall / 2), 0, wall], [wall, inner[1] + 2 * wall, inner[2]])
+        )
         pieces.append((bottom + [0, sign * (half[1] + wall / 2), wall], [inner[0], wall, inner[2]]))
-    return [{"type": "box", "label": "bin" if k == 0 else f"bin-wall-{k}", "at": np.asarray(at, float).tolist(),
-             "size": [float(v) for v in size]} for k, (at, size) in enumerate(pieces)]
+    return [
+        {
+            "type": "box",
+            "label": "bin" if k == 0 else f"bin-wall-{k}",
+            "at": np.asarray(at, float).tolist(),
+            "size": [float(v) for v in size],
+        }
+        for k, (at, size) in enumerate(pieces)
+    ]
 
 
 def _job_scene(scenario, parts):
@@ -525,11 +409,19 @@ def job_targets(scenario, targets=None) -> list:
     from .run import _checked as _checked_names
 
     if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}")
+        raise TypeError(
+            f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}"
+        )
     if scenario.job is None:
-        raise ValueError(f"scenario {scenario.name!r} has no \"job\": the steps to run at each target")
+        raise ValueError(
+            f'scenario {scenario.name!r} has no "job": the steps to run at each target'
+        )
     _, labels = _checked_names(scenario, ["bidmp"], targets, False)
-    return labels if targets is not None else [label for label in labels if label in scenario.scene.labels]
+    return (
+        labels
+        if targets is not None
+        else [label for label in labels if label in scenario.scene.labels]
+    )
 
 
 def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -> _World:
@@ -538,21 +430,55 @@ def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -
     from ..tasks.repair import Repairer
     from .run import TRACKING_ALLOWANCE_MM
 
-    contract = Contract(scenario.success_threshold, scenario.approach_height, scene, scenario.units,
-                        scenario.alignment_threshold if scenario.is_pose else None, cell.limits)
+    contract = Contract(
+        scenario.success_threshold,
+        scenario.approach_height,
+        scene,
+        scenario.units,
+        scenario.alignment_threshold if scenario.is_pose else None,
+        cell.limits,
+    )
     repairer = transfers = None
     allowance = mm(TRACKING_ALLOWANCE_MM, scenario.units)
     if not scenario.is_pose:
-        repairer = Repairer(contract, scenario.demonstration, extension=scenario.extension, seed=scenario.seed,
-                            allowance=allowance, bidmp=scenario.bidmp)
-        transfers = Repairer(_transfer_contract(contract), scenario.demonstration, order=("lift", "avoid"),
-                             allowance=allowance)
-    return _World(cell, scenario, scenario.job, report.fitted["bidmp"], np.array(arm.rest, dtype=float), contract,
-                  repairer, transfers, [] if pictures else None, [] if view else None)
+        repairer = Repairer(
+            contract,
+            scenario.demonstration,
+            extension=scenario.extension,
+            seed=scenario.seed,
+            allowance=allowance,
+            bidmp=scenario.bidmp,
+        )
+        transfers = Repairer(
+            _transfer_contract(contract),
+            scenario.demonstration,
+            order=("lift", "avoid"),
+            allowance=allowance,
+        )
+    return _World(
+        cell,
+        scenario,
+        scenario.job,
+        report.fitted["bidmp"],
+        np.array(arm.rest, dtype=float),
+        contract,
+        repairer,
+        transfers,
+        [] if pictures else None,
+        [] if view else None,
+    )
 
 
-def run_job(scenario, *, targets=None, report=None, progress=None, pictures: bool = False, view: bool = False,
-            record: bool = False) -> JobReport:
+def run_job(
+    scenario,
+    *,
+    targets=None,
+    report=None,
+    progress=None,
+    pictures: bool = False,
+    view: bool = False,
+    record: bool = False,
+) -> JobReport:
     """Run the scenario's ``"job"`` on the simulated arm at every target (or ``targets``);
     ``pictures``: keyframes of the first cycle's phases and of every phase that broke the
     contract (``JobReport.pictures``, ``JobReport.failures``); ``view``: the arm's motion over the
@@ -570,7 +496,11 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
     from .pybullet.robot import robot_model, robot_placement
     from .run import _scenario_and_backend
 
-    pictures, view, record = check_bool(pictures, "pictures"), check_bool(view, "view"), check_bool(record, "record")
+    pictures, view, record = (
+        check_bool(pictures, "pictures"),
+        check_bool(view, "view"),
+        check_bool(record, "record"),
+    )
     scenario, _ = _scenario_and_backend(scenario, None)
     labels = job_targets(scenario, targets)
     if report is None:
@@ -598,11 +528,22 @@ def run_job(scenario, *, targets=None, report=None, progress=None, pictures: boo
                 _let_go(world)
             done.append(record)
             if world.motion:  # the first cycle only
-                motions = {("job", label): {"times": np.concatenate([t for t, _ in world.motion]),
-                                            "links": np.concatenate([links for _, links in world.motion])}}
+                motions = {
+                    ("job", label): {
+                        "times": np.concatenate([t for t, _ in world.motion]),
+                        "links": np.concatenate([links for _, links in world.motion]),
+                    }
+                }
                 world.motion = None
-    out = JobReport(scenario, scenario.job.kind, arm.name, done, wall_s=time.perf_counter() - start,
-                    pictures=world.pictures or [], motions=motions)
+    out = JobReport(
+        scenario,
+        scenario.job.kind,
+        arm.name,
+        done,
+        wall_s=time.perf_counter() - start,
+        pictures=world.pictures or [],
+        motions=motions,
+    )
     out.failures = world.failures
     out.evaluation, out.scene = report, scene
     return out

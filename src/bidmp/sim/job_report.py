@@ -27,22 +27,37 @@ class JobPhase:
     ok: bool
     seconds: float  # simulated time, the settling after a motion included
     note: str = ""
-    contacts: dict = field(default_factory=dict)  # part label -> deepest penetration (scene unit), non-targets
-    peaks: tuple = (0.0, 0.0, 0.0)  # commanded joint velocity, acceleration, jerk / their limits (largest joint)
+    contacts: dict = field(
+        default_factory=dict
+    )  # part label -> deepest penetration (scene unit), non-targets
+    peaks: tuple = (
+        0.0,
+        0.0,
+        0.0,
+    )  # commanded joint velocity, acceleration, jerk / their limits (largest joint)
     measured_peaks: tuple = (0.0, 0.0, 0.0)  # what the simulated joints did (10 ms differences)
     within_limits: bool = True  # every 1 kHz command within the limits, from rest to rest
     verdict: object = None  # the motion contract on what the arm did (bidmp.tasks.contract.Verdict); None: no motion
-    path: np.ndarray | None = None  # run_job(record=True): the measured tool path (n, 3), scene units
+    # run_job(record=True): the measured tool path (n, 3), scene units
+    path: np.ndarray | None = None
     commands: np.ndarray | None = None  # ... and the joint commands (m, J) rad sent every 1 ms
 
     def to_dict(self) -> dict:
-        return {"phase": self.name, "ok": self.ok, "seconds": round(self.seconds, 3), "note": self.note,
-                "verdict": None if self.verdict is None else self.verdict.to_dict(),
-                "contacts": {k: round(v, 3) for k, v in self.contacts.items()},
-                "peak_velocity": round(self.peaks[0], 3), "peak_acceleration": round(self.peaks[1], 3),
-                "peak_jerk": round(self.peaks[2], 3), "measured_peak_velocity": round(self.measured_peaks[0], 3),
-                "measured_peak_acceleration": round(self.measured_peaks[1], 3),
-                "measured_peak_jerk": round(self.measured_peaks[2], 3), "within_limits": self.within_limits}
+        return {
+            "phase": self.name,
+            "ok": self.ok,
+            "seconds": round(self.seconds, 3),
+            "note": self.note,
+            "verdict": None if self.verdict is None else self.verdict.to_dict(),
+            "contacts": {k: round(v, 3) for k, v in self.contacts.items()},
+            "peak_velocity": round(self.peaks[0], 3),
+            "peak_acceleration": round(self.peaks[1], 3),
+            "peak_jerk": round(self.peaks[2], 3),
+            "measured_peak_velocity": round(self.measured_peaks[0], 3),
+            "measured_peak_acceleration": round(self.measured_peaks[1], 3),
+            "measured_peak_jerk": round(self.measured_peaks[2], 3),
+            "within_limits": self.within_limits,
+        }
 
 
 def _phase(name: str, run, plan, cell, carried_contacts=None) -> JobPhase:
@@ -53,9 +68,16 @@ def _phase(name: str, run, plan, cell, carried_contacts=None) -> JobPhase:
     contacts = {label: depth / cell.unit for label, depth in run.contacts.items()}
     for label, depth in (carried_contacts or {}).items():
         contacts[label] = max(contacts.get(label, 0.0), depth)
-    return JobPhase(name, not contacts, plan.duration + SETTLE, "", contacts,
-                    (sent.velocity, sent.acceleration, sent.jerk), (measured.velocity, measured.acceleration, measured.jerk),
-                    sent.within)
+    return JobPhase(
+        name,
+        not contacts,
+        plan.duration + SETTLE,
+        "",
+        contacts,
+        (sent.velocity, sent.acceleration, sent.jerk),
+        (measured.velocity, measured.acceleration, measured.jerk),
+        sent.within,
+    )
 
 
 def in_bin(centre, floor, inner) -> bool:
@@ -88,7 +110,8 @@ class JobTarget:
     removed: bool = False  # the part ended where it belongs (in the bin, in its slot)
     reason: str = ""  # the first step that failed, and why
     final_position: np.ndarray | None = None  # where the part came to rest (scene units)
-    thread: np.ndarray | None = None  # (n, 3) while unscrewing: rise (scene units), angle turned (rad), time (s)
+    # (n, 3) while unscrewing: rise (scene units), angle turned (rad), time (s)
+    thread: np.ndarray | None = None
 
     @property
     def seconds(self) -> float:
@@ -107,9 +130,16 @@ class JobTarget:
         return all(phase.within_limits for phase in self.phases)
 
     def to_dict(self) -> dict:
-        return {"target": self.label, "removed": self.removed, "reason": self.reason, "seconds": round(self.seconds, 3),
-                "final_position": None if self.final_position is None else np.round(self.final_position, 2).tolist(),
-                "phases": [phase.to_dict() for phase in self.phases]}
+        return {
+            "target": self.label,
+            "removed": self.removed,
+            "reason": self.reason,
+            "seconds": round(self.seconds, 3),
+            "final_position": None
+            if self.final_position is None
+            else np.round(self.final_position, 2).tolist(),
+            "phases": [phase.to_dict() for phase in self.phases],
+        }
 
 
 @dataclass
@@ -119,11 +149,18 @@ class JobReport:
     robot: str
     targets: list
     wall_s: float = 0.0
-    pictures: list = field(default_factory=list)  # (target, phase, s into its cycle, image) of the first cycle
-    motions: dict = field(default_factory=dict)  # ("job", first target) -> {"times", "links"}: the viewer's arm
+    pictures: list = field(
+        default_factory=list
+    )  # (target, phase, s into its cycle, image) of the first cycle
+    motions: dict = field(
+        default_factory=dict
+    )  # ("job", first target) -> {"times", "links"}: the viewer's arm
     evaluation: object = None  # the evaluation whose learned skills ran (bidmp.evaluate's report)
-    scene: object = None  # the scene the job ran in: the scenario's parts and the job's own (bin, rack)
-    failures: list = field(default_factory=list)  # (target, phase, image, reason) where a motion broke the contract
+    # the scene the job ran in: the scenario's parts and the job's own (bin, rack)
+    scene: object = None
+    failures: list = field(
+        default_factory=list
+    )  # (target, phase, image, reason) where a motion broke the contract
 
     @property
     def removed(self) -> int:
@@ -138,63 +175,108 @@ class JobReport:
 
     def rows(self) -> tuple[list, list]:
         names = self.phase_names()
-        header = ["target", "removed"] + [f"{name} s" for name in names] + ["cycle s", "contacts", "peak v / a / j", "failed step"]
+        header = (
+            ["target", "removed"]
+            + [f"{name} s" for name in names]
+            + ["cycle s", "contacts", "peak v / a / j", "failed step"]
+        )
         rows = []
         for target in self.targets:
             times = {phase.name: phase for phase in target.phases}
-            peaks = np.max([phase.peaks for phase in target.phases], axis=0) if target.phases else np.zeros(3)
-            rows.append([target.label, "yes" if target.removed else "no"]
-                        + [("-" if name not in times else f"{times[name].seconds:.2f}" + ("" if times[name].ok else " ✗"))
-                           for name in names]
-                        + [f"{target.seconds:.2f}", str(len(target.contacts)), "/".join(f"{v:.2f}" for v in peaks),
-                           target.reason or "-"])
+            peaks = (
+                np.max([phase.peaks for phase in target.phases], axis=0)
+                if target.phases
+                else np.zeros(3)
+            )
+            rows.append(
+                [target.label, "yes" if target.removed else "no"]
+                + [
+                    (
+                        "-"
+                        if name not in times
+                        else f"{times[name].seconds:.2f}" + ("" if times[name].ok else " ✗")
+                    )
+                    for name in names
+                ]
+                + [
+                    f"{target.seconds:.2f}",
+                    str(len(target.contacts)),
+                    "/".join(f"{v:.2f}" for v in peaks),
+                    target.reason or "-",
+                ]
+            )
         return header, rows
 
     def totals(self) -> dict:
         cycles = [target.seconds for target in self.targets if target.removed]
-        return {"targets": len(self.targets), "removed": self.removed,
-                "contacts": sum(len(target.contacts) for target in self.targets),
-                "within_limits": sum(target.within_limits for target in self.targets),
-                "cycle_s_mean": round(float(np.mean(cycles)), 3) if cycles else None,
-                "cycle_s_max": round(float(np.max(cycles)), 3) if cycles else None,
-                "total_s": round(self.simulated_s, 3)}  # simulated seconds; the wall time is not reproducible
+        return {
+            "targets": len(self.targets),
+            "removed": self.removed,
+            "contacts": sum(len(target.contacts) for target in self.targets),
+            "within_limits": sum(target.within_limits for target in self.targets),
+            "cycle_s_mean": round(float(np.mean(cycles)), 3) if cycles else None,
+            "cycle_s_max": round(float(np.max(cycles)), 3) if cycles else None,
+            "total_s": round(self.simulated_s, 3),
+        }  # simulated seconds; the wall time is not reproducible
 
     def summary(self) -> str:
         totals = self.totals()
-        lines = [f"{self.scenario.name}: the whole {self.kind} job on the simulated {self.robot}, "
-                 f"{totals['removed']}/{totals['targets']} parts removed, {totals['contacts']} contacts with other parts, "
-                 f"{totals['within_limits']}/{totals['targets']} within the joint limits", "",
-                 text_table(*self.rows())]
+        lines = [
+            f"{self.scenario.name}: the whole {self.kind} job on the simulated {self.robot}, "
+            f"{totals['removed']}/{totals['targets']} parts removed, {totals['contacts']} contacts with other parts, "
+            f"{totals['within_limits']}/{totals['targets']} within the joint limits",
+            "",
+            text_table(*self.rows()),
+        ]
         if totals["cycle_s_mean"] is not None:
-            lines.append(f"\ncycle per part {totals['cycle_s_mean']:.2f} s (longest {totals['cycle_s_max']:.2f} s), "
-                         f"{totals['total_s']:.1f} s in all")
+            lines.append(
+                f"\ncycle per part {totals['cycle_s_mean']:.2f} s (longest {totals['cycle_s_max']:.2f} s), "
+                f"{totals['total_s']:.1f} s in all"
+            )
         if self.wall_s > 0:
-            lines.append(f"simulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
-                         f"({self.simulated_s / self.wall_s:.1f}x real time)")
+            lines.append(
+                f"simulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
+                f"({self.simulated_s / self.wall_s:.1f}x real time)"
+            )
         failed = [target for target in self.targets if not target.removed]
         if failed:
             lines.append(f"\n{len(failed)} of {len(self.targets)} not removed:")
-            lines += [f"  {target.label}: {target.reason or 'not where it belongs'}" for target in failed]
+            lines += [
+                f"  {target.label}: {target.reason or 'not where it belongs'}" for target in failed
+            ]
         return "\n".join(lines)
 
     def markdown(self) -> str:
         return markdown_table(*self.rows())
 
     def to_dict(self) -> dict:
-        return {"format": FORMAT, "scenario": self.scenario.name, "job": self.kind, "robot": self.robot,
-                "units": self.scenario.units, "totals": self.totals(),
-                "targets": [target.to_dict() for target in self.targets]}
+        return {
+            "format": FORMAT,
+            "scenario": self.scenario.name,
+            "job": self.kind,
+            "robot": self.robot,
+            "units": self.scenario.units,
+            "totals": self.totals(),
+            "targets": [target.to_dict() for target in self.targets],
+        }
 
 
 def write_job_report(report: JobReport, out) -> list[Path]:
     """``job_results.json``, ``job.md`` (the table) and ``job_cycle.png`` into folder ``out``."""
 
     written = _write_results(out, "job_results.json", "job.md", report.to_dict(), report.markdown())
-    if report.pictures:  # the first cycle's keyframes side by side, each titled with its phase, target, time
-        tiles = [_titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
-                 for label, phase, seconds, image in report.pictures]
+    if (
+        report.pictures
+    ):  # the first cycle's keyframes side by side, each titled with its phase, target, time
+        tiles = [
+            _titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
+            for label, phase, seconds, image in report.pictures
+        ]
         written.append(_write_strip(Path(out) / "job_cycle.png", tiles))
     if report.failures:  # where each failing motion ended, looking at the part it came too close to
-        tiles = [_titled(image, f"target {label}: {phase} failed") for label, phase, image, _ in report.failures[:6]]
+        tiles = [
+            _titled(image, f"target {label}: {phase} failed")
+            for label, phase, image, _ in report.failures[:6]
+        ]
         written.append(_write_strip(Path(out) / "job_failures.png", tiles))
     return written

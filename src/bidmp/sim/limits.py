@@ -41,7 +41,9 @@ def _command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_ST
     return command_peaks(commands, limits, dt)
 
 
-def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLimits) -> CommandPeaks:
+def _measured_peaks(
+    velocities: np.ndarray, record_step: float, limits: JointLimits
+) -> CommandPeaks:
     """Peaks of the measured joints from their recorded velocities (n, 7), one every
     ``record_step`` seconds: velocity as recorded, acceleration and jerk by differences over
     10 ms windows."""
@@ -51,8 +53,11 @@ def _measured_peaks(velocities: np.ndarray, record_step: float, limits: JointLim
     acceleration = np.diff(sampled, axis=0) / step
     jerk = np.diff(acceleration, axis=0) / step
 
-    return CommandPeaks(_worst(np.asarray(velocities), limits.velocity), _worst(acceleration, limits.acceleration),
-                        _worst(jerk, limits.jerk))
+    return CommandPeaks(
+        _worst(np.asarray(velocities), limits.velocity),
+        _worst(acceleration, limits.acceleration),
+        _worst(jerk, limits.jerk),
+    )
 
 
 class _RateLimiter:
@@ -68,7 +73,9 @@ class _RateLimiter:
     # Loop gains (1/s): the acceleration loop 6.7 ms, the velocity loop 20 ms, position 67 ms.
     _GAINS = (15.0, 50.0, 150.0)
 
-    def __init__(self, start: np.ndarray, limits: JointLimits, margin: float, dt: float = SIM_STEP) -> None:
+    def __init__(
+        self, start: np.ndarray, limits: JointLimits, margin: float, dt: float = SIM_STEP
+    ) -> None:
         self.position = np.asarray(start, dtype=float).copy()
         self.velocity = np.zeros_like(self.position)
         self.acceleration = np.zeros_like(self.position)
@@ -78,20 +85,36 @@ class _RateLimiter:
         jerk = limits.jerk if limits.jerk is not None else np.full(self.position.shape, np.inf)
         self.max_jerk = margin * np.asarray(jerk, dtype=float)
 
-    def __call__(self, target: np.ndarray, target_velocity: np.ndarray | None = None,
-                 target_acceleration: np.ndarray | None = None) -> np.ndarray:
+    def __call__(
+        self,
+        target: np.ndarray,
+        target_velocity: np.ndarray | None = None,
+        target_acceleration: np.ndarray | None = None,
+    ) -> np.ndarray:
         """The next command (J,) rad towards ``target``, moving at ``target_velocity`` (rad/s) with
         ``target_acceleration`` (rad/s²), both fed forward: a smooth target within the limits is
         followed without overshoot (the velocity fed forward alone, the lagging velocity loop
         overshoots where the target brakes)."""
         position_gain, velocity_gain, acceleration_gain = self._GAINS
         feed = 0.0 if target_velocity is None else np.asarray(target_velocity, dtype=float)
-        feed_acceleration = 0.0 if target_acceleration is None else np.asarray(target_acceleration, dtype=float)
-        wanted_velocity = np.clip(feed + position_gain * (np.asarray(target, dtype=float) - self.position),
-                                  -self.max_velocity, self.max_velocity)
-        wanted_acceleration = np.clip(feed_acceleration + velocity_gain * (wanted_velocity - self.velocity),
-                                      -self.max_acceleration, self.max_acceleration)
-        jerk = np.clip(acceleration_gain * (wanted_acceleration - self.acceleration), -self.max_jerk, self.max_jerk)
+        feed_acceleration = (
+            0.0 if target_acceleration is None else np.asarray(target_acceleration, dtype=float)
+        )
+        wanted_velocity = np.clip(
+            feed + position_gain * (np.asarray(target, dtype=float) - self.position),
+            -self.max_velocity,
+            self.max_velocity,
+        )
+        wanted_acceleration = np.clip(
+            feed_acceleration + velocity_gain * (wanted_velocity - self.velocity),
+            -self.max_acceleration,
+            self.max_acceleration,
+        )
+        jerk = np.clip(
+            acceleration_gain * (wanted_acceleration - self.acceleration),
+            -self.max_jerk,
+            self.max_jerk,
+        )
         self.acceleration = self.acceleration + jerk * self.dt
         self.velocity = self.velocity + self.acceleration * self.dt
         self.position = self.position + self.velocity * self.dt

@@ -42,24 +42,42 @@ class SimTarget:
     within_limits: bool  # every 1 kHz command within the velocity, acceleration and jerk limits, from rest to rest
     peak_jerk: float = 0.0
     measured_peak_jerk: float = 0.0
-    commanded_penetration: float | None = None  # the command's depth into a part, from the scene geometry
+    # the command's depth into a part, from the scene geometry
+    commanded_penetration: float | None = None
     paused: float = 0.0  # closed loop: seconds the motion's own time stood (nearly) still
-    axis_deviation: float | None = None  # pose scenarios: degrees between tool and target axes over the approach
+    # pose scenarios: degrees between tool and target axes over the approach
+    axis_deviation: float | None = None
     aligned: bool | None = None
     verdict: object = None  # bidmp.tasks.contract.Verdict on the executed motion and the commands
     repair: str = ""  # how the motion was repaired (empty: the method's own motion ran)
-    error: str = ""  # why the motion did not run (unreachable, outside the joint limits); empty: it ran
-    path: np.ndarray | None = None  # simulate(record=True): the measured tool path (n, 3), scene units, 500 Hz
-    commands: np.ndarray | None = None  # ... and the joint commands (m, J) rad the arm was sent every 1 ms
+    # why the motion did not run (unreachable, outside the joint limits); empty: it ran
+    error: str = ""
+    # simulate(record=True): the measured tool path (n, 3), scene units, 500 Hz
+    path: np.ndarray | None = None
+    # ... and the joint commands (m, J) rad the arm was sent every 1 ms
+    commands: np.ndarray | None = None
 
     @classmethod
     def not_run(cls, label: str, error: str) -> SimTarget:
         """A motion that could not run (its target out of reach, a joint past its limits): a row
         with its reason, no measurements."""
         nan = float("nan")
-        return cls(label=label, commanded_error=nan, measured_error=nan, approach_error=None, engaged=False, contacts={},
-                   peak_velocity=0.0, peak_acceleration=0.0, measured_peak_velocity=0.0, measured_peak_acceleration=0.0,
-                   motion_time=0.0, tracking_error=0.0, within_limits=False, error=error)
+        return cls(
+            label=label,
+            commanded_error=nan,
+            measured_error=nan,
+            approach_error=None,
+            engaged=False,
+            contacts={},
+            peak_velocity=0.0,
+            peak_acceleration=0.0,
+            measured_peak_velocity=0.0,
+            measured_peak_acceleration=0.0,
+            motion_time=0.0,
+            tracking_error=0.0,
+            within_limits=False,
+            error=error,
+        )
 
     @property
     def ran(self) -> bool:
@@ -73,8 +91,14 @@ class SimTarget:
             return False
         if self.verdict is not None:
             return self.verdict.ok
-        return bool(self.measured_error <= threshold and self.engaged is not False and not self.contacts
-                    and not self.commanded_penetration and self.within_limits and self.aligned is not False)
+        return bool(
+            self.measured_error <= threshold
+            and self.engaged is not False
+            and not self.contacts
+            and not self.commanded_penetration
+            and self.within_limits
+            and self.aligned is not False
+        )
 
     @property
     def reason(self) -> str:
@@ -85,25 +109,36 @@ class SimTarget:
     def to_dict(self, threshold: float) -> dict:
         if self.error:
             return {"ran": False, "task_success": False, "reason": self.error}
-        return {"ran": True,
-            "commanded_error": round(self.commanded_error, 4), "measured_error": round(self.measured_error, 4),
+        return {
+            "ran": True,
+            "commanded_error": round(self.commanded_error, 4),
+            "measured_error": round(self.measured_error, 4),
             "approach_error": _json_length(self.approach_error),
-            "engaged": self.engaged, "contacts": sorted(self.contacts),
+            "engaged": self.engaged,
+            "contacts": sorted(self.contacts),
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
-            "peak_joint_velocity": round(self.peak_velocity, 4), "peak_joint_acceleration": round(self.peak_acceleration, 4),
+            "peak_joint_velocity": round(self.peak_velocity, 4),
+            "peak_joint_acceleration": round(self.peak_acceleration, 4),
             "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4),
-            "peak_joint_jerk": round(self.peak_jerk, 4), "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
+            "peak_joint_jerk": round(self.peak_jerk, 4),
+            "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
             "commanded_penetration": _json_length(self.commanded_penetration),
             "paused_s": round(self.paused, 3),
-            "motion_time_s": round(self.motion_time, 3), "tracking_error": round(self.tracking_error, 4),
-            "within_limits": self.within_limits, "task_success": self.task_success(threshold),
+            "motion_time_s": round(self.motion_time, 3),
+            "tracking_error": round(self.tracking_error, 4),
+            "within_limits": self.within_limits,
+            "task_success": self.task_success(threshold),
             "axis_deviation_deg": _json_length(self.axis_deviation),
             "aligned": self.aligned,
-            "clearance": None if self.verdict is None or self.verdict.clearance is None
+            "clearance": None
+            if self.verdict is None or self.verdict.clearance is None
             else _json_length(self.verdict.clearance.distance),
-            "clearance_part": None if self.verdict is None or self.verdict.clearance is None else self.verdict.clearance.part,
-            "reason": self.reason, "repair": self.repair,
+            "clearance_part": None
+            if self.verdict is None or self.verdict.clearance is None
+            else self.verdict.clearance.part,
+            "reason": self.reason,
+            "repair": self.repair,
         }
 
 
@@ -141,10 +176,16 @@ class SimMethod:
         return None if any(v is None for v in values) else sum(values)
 
     def to_dict(self) -> dict:
-        return {"task_successes": self.task_successes, "end_successes": self.end_successes, "engaged": self.engaged,
-                "aligned": self.aligned,
-                "contacts": self.contacts, "within_limits": self.within_limits, "n_targets": len(self.targets),
-                "targets": {label: t.to_dict(self.threshold) for label, t in self.targets.items()}}
+        return {
+            "task_successes": self.task_successes,
+            "end_successes": self.end_successes,
+            "engaged": self.engaged,
+            "aligned": self.aligned,
+            "contacts": self.contacts,
+            "within_limits": self.within_limits,
+            "n_targets": len(self.targets),
+            "targets": {label: t.to_dict(self.threshold) for label, t in self.targets.items()},
+        }
 
 
 @dataclass
@@ -160,7 +201,9 @@ class SimReport:
     workers: int = 1
     limits: object = None  # the robot's JointLimits (default the Panda's)
     robot: str = "panda"  # the arm's model name
-    motions: dict = field(default_factory=dict)  # (method, label) -> {"times", "links"}: the viewer's arm
+    motions: dict = field(
+        default_factory=dict
+    )  # (method, label) -> {"times", "links"}: the viewer's arm
 
     @property
     def _short_name(self) -> str:
@@ -173,45 +216,87 @@ class SimReport:
         return ROBOT_NAMES.get(self.robot, self.robot)
 
     def to_dict(self) -> dict:
-        return {"scenario": self.scenario.name, "units": self.scenario.units, "closed_loop": self.closed_loop,
-                "robot": {**({} if self.robot == "panda" else {"model": self.robot}),
-                          "base": np.round(self.base, 3).tolist(), "yaw_deg": self.yaw},
-                "success_threshold": self.scenario.success_threshold,
-                "limits": {"velocity_rad_s": list((self.limits or PANDA).velocity),
-                           "acceleration_rad_s2": list((self.limits or PANDA).acceleration),
-                           "timed_to": LIMIT_MARGIN},
-                "methods": {name: method.to_dict() for name, method in self.methods.items()}}
+        return {
+            "scenario": self.scenario.name,
+            "units": self.scenario.units,
+            "closed_loop": self.closed_loop,
+            "robot": {
+                **({} if self.robot == "panda" else {"model": self.robot}),
+                "base": np.round(self.base, 3).tolist(),
+                "yaw_deg": self.yaw,
+            },
+            "success_threshold": self.scenario.success_threshold,
+            "limits": {
+                "velocity_rad_s": list((self.limits or PANDA).velocity),
+                "acceleration_rad_s2": list((self.limits or PANDA).acceleration),
+                "timed_to": LIMIT_MARGIN,
+            },
+            "methods": {name: method.to_dict() for name, method in self.methods.items()},
+        }
 
     def rows(self) -> tuple[list[str], list[list[str]]]:
         poses = any(method.aligned is not None for method in self.methods.values())
-        header = ["method", "end point", "engaged"] + (["aligned"] if poses else []) + \
-            ["contacts", "within limits", "peak jerk: commands / joints", "task success", "motion time s"]
+        header = (
+            ["method", "end point", "engaged"]
+            + (["aligned"] if poses else [])
+            + [
+                "contacts",
+                "within limits",
+                "peak jerk: commands / joints",
+                "task success",
+                "motion time s",
+            ]
+        )
         rows = []
         for name, method in self.methods.items():
             n = len(method.targets)
             times = [t.motion_time for t in method.targets.values() if t.ran] or [0.0]
-            row = [name, f"{method.end_successes}/{n}", "-" if method.engaged is None else f"{method.engaged}/{n}"]
+            row = [
+                name,
+                f"{method.end_successes}/{n}",
+                "-" if method.engaged is None else f"{method.engaged}/{n}",
+            ]
             if poses:
                 row.append("-" if method.aligned is None else f"{method.aligned}/{n}")
-            jerk = (max(t.peak_jerk for t in method.targets.values()), max(t.measured_peak_jerk for t in method.targets.values()))
-            rows.append(row + [f"{method.contacts}/{n}", f"{method.within_limits}/{n}", f"{jerk[0]:.2f} / {jerk[1]:.2f}",
-                               f"{method.task_successes}/{n}", f"{min(times):.1f}-{max(times):.1f}"])
+            jerk = (
+                max(t.peak_jerk for t in method.targets.values()),
+                max(t.measured_peak_jerk for t in method.targets.values()),
+            )
+            rows.append(
+                row
+                + [
+                    f"{method.contacts}/{n}",
+                    f"{method.within_limits}/{n}",
+                    f"{jerk[0]:.2f} / {jerk[1]:.2f}",
+                    f"{method.task_successes}/{n}",
+                    f"{min(times):.1f}-{max(times):.1f}",
+                ]
+            )
         return header, rows
 
     def summary(self) -> str:
         scenario = self.scenario
-        aligned = (f", tool axis within {scenario.alignment_threshold:g} deg of the nut's" if scenario.is_pose else "")
-        lines = [f"{scenario.name} on a simulated {self.robot_name} (PyBullet, 1 kHz position control), robot base "
-                 f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
-                 f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
-                 f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "
-                 f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "
-                 f"differences)", "",
-                 text_table(*self.rows())]
+        aligned = (
+            f", tool axis within {scenario.alignment_threshold:g} deg of the nut's"
+            if scenario.is_pose
+            else ""
+        )
+        lines = [
+            f"{scenario.name} on a simulated {self.robot_name} (PyBullet, 1 kHz position control), robot base "
+            f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
+            f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
+            f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "
+            f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "
+            f"differences)",
+            "",
+            text_table(*self.rows()),
+        ]
         if self.wall_s > 0:
-            lines.append(f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
-                         f"({self.simulated_s / self.wall_s:.1f}x real time, {self.workers} worker process"
-                         f"{'es' if self.workers > 1 else ''})")
+            lines.append(
+                f"\nsimulated {self.simulated_s:.1f} s in {self.wall_s:.1f} s wall time "
+                f"({self.simulated_s / self.wall_s:.1f}x real time, {self.workers} worker process"
+                f"{'es' if self.workers > 1 else ''})"
+            )
         for name, method in self.methods.items():
             failed = [t for t in method.targets.values() if not t.task_success(method.threshold)]
             if failed:
@@ -222,14 +307,28 @@ class SimReport:
     def failed(self, methods=None) -> int:
         """Targets that failed, over ``methods`` (default every method run)."""
         names = self.methods if methods is None else [m for m in methods if m in self.methods]
-        return sum(not t.task_success(self.methods[m].threshold) for m in names for t in self.methods[m].targets.values())
+        return sum(
+            not t.task_success(self.methods[m].threshold)
+            for m in names
+            for t in self.methods[m].targets.values()
+        )
 
     def markdown(self) -> str:
         return markdown_table(*self.rows())
 
 
-def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, run: Execution, unit: float,
-             closed_loop: bool, limits=PANDA, contract=None, exclude=()) -> SimTarget:
+def _measure(
+    scenario: dict,
+    label: str,
+    target: np.ndarray,
+    plan: MotionPlan,
+    run: Execution,
+    unit: float,
+    closed_loop: bool,
+    limits=PANDA,
+    contract=None,
+    exclude=(),
+) -> SimTarget:
     """The per-target results of one execution (``scenario``: its targets, units, threshold;
     ``limits``: the robot's joint limits), judged by ``contract`` (a
     :class:`bidmp.tasks.contract.Contract` with the scene; default: built from ``scenario`` without
@@ -237,8 +336,14 @@ def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, r
     from ..tasks.contract import Contract
 
     if contract is None:
-        contract = Contract(scenario["success_threshold"], scenario["approach_height"], None, scenario["units"],
-                            scenario.get("alignment_threshold"), limits)
+        contract = Contract(
+            scenario["success_threshold"],
+            scenario["approach_height"],
+            None,
+            scenario["units"],
+            scenario.get("alignment_threshold"),
+            limits,
+        )
     tcp = run.tcp / unit
     axis = scenario.get("axes", {}).get(label)
     pose = scenario.get("alignment_threshold") is not None
@@ -246,21 +351,42 @@ def _measure(scenario: dict, label: str, target: np.ndarray, plan: MotionPlan, r
     # measured joints are reported beside them. A backend that does not report its commands: the
     # plan's own peaks.
     contacts = {k: v / unit for k, v in run.contacts.items()}
-    verdict = contract.judge(tcp, target, label=label, axis=axis, exclude=exclude,
-                             orientations=run.tcp_orientation if pose else None, commands=run.commands,
-                             contacts=contacts)
-    sent = verdict.limits or CommandPeaks(plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
+    verdict = contract.judge(
+        tcp,
+        target,
+        label=label,
+        axis=axis,
+        exclude=exclude,
+        orientations=run.tcp_orientation if pose else None,
+        commands=run.commands,
+        contacts=contacts,
+    )
+    sent = verdict.limits or CommandPeaks(
+        plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk
+    )
     measured = _measured_peaks(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits)
     motion_time = float(run.times[-1]) - SETTLE if closed_loop else plan.duration
     return SimTarget(
-        label=label, commanded_error=float(np.linalg.norm(plan.points[-1] / unit - target)),
-        measured_error=verdict.end_error, approach_error=verdict.approach_error, engaged=verdict.engaged,
-        contacts=contacts, peak_velocity=sent.velocity,
-        peak_acceleration=sent.acceleration, peak_jerk=sent.jerk, measured_peak_velocity=measured.velocity,
-        measured_peak_acceleration=measured.acceleration, measured_peak_jerk=measured.jerk, motion_time=motion_time,
+        label=label,
+        commanded_error=float(np.linalg.norm(plan.points[-1] / unit - target)),
+        measured_error=verdict.end_error,
+        approach_error=verdict.approach_error,
+        engaged=verdict.engaged,
+        contacts=contacts,
+        peak_velocity=sent.velocity,
+        peak_acceleration=sent.acceleration,
+        peak_jerk=sent.jerk,
+        measured_peak_velocity=measured.velocity,
+        measured_peak_acceleration=measured.acceleration,
+        measured_peak_jerk=measured.jerk,
+        motion_time=motion_time,
         tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
-        within_limits=sent.within, paused=run.paused, axis_deviation=verdict.axis_deviation, aligned=verdict.aligned,
-        verdict=verdict)
+        within_limits=sent.within,
+        paused=run.paused,
+        axis_deviation=verdict.axis_deviation,
+        aligned=verdict.aligned,
+        verdict=verdict,
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -274,12 +400,21 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
     for method, label, frames in report.pictures:
         by_method.setdefault(method, (label, frames))
     for method, (label, frames) in by_method.items():
-        strip = _write_strip(out / f"sim_keyframes_{method}.png", frames[:: max(1, len(frames) // 6)][:6],
-                             f"{method}: motion to target {label} on the simulated {report.robot_name}")
+        strip = _write_strip(
+            out / f"sim_keyframes_{method}.png",
+            frames[:: max(1, len(frames) // 6)][:6],
+            f"{method}: motion to target {label} on the simulated {report.robot_name}",
+        )
         written.append(strip)
     if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
-        written.append(_write_gif(out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif", by_method["dmp"][1], by_method["bidmp"][1],
-                                  f"target {by_method['dmp'][0]}"))
+        written.append(
+            _write_gif(
+                out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif",
+                by_method["dmp"][1],
+                by_method["bidmp"][1],
+                f"target {by_method['dmp'][0]}",
+            )
+        )
     return written
 
 
@@ -302,7 +437,9 @@ def _titled(image: np.ndarray, title: str) -> np.ndarray:
     from PIL import Image, ImageDraw, ImageFont
 
     band = Image.new("RGB", (image.shape[1], 26), (255, 255, 255))
-    ImageDraw.Draw(band).text((8, 4), title, fill=(20, 20, 20), font=ImageFont.load_default(size=16))
+    ImageDraw.Draw(band).text(
+        (8, 4), title, fill=(20, 20, 20), font=ImageFont.load_default(size=16)
+    )
     return np.concatenate([np.asarray(band), image], axis=0)
 
 
@@ -325,10 +462,24 @@ def _write_gif(path: Path, left, right, target: str = "") -> Path:
     from ..io.atomic import atomic_write
 
     n = min(len(left), len(right))
-    title = f"left: plain DMP    right: Bi-DMP    ({target})" if target else "left: plain DMP    right: Bi-DMP"
-    images = [Image.fromarray(_titled(np.concatenate([left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]],
-                                                     axis=1), title))
-              for i in range(n)]
+    title = (
+        f"left: plain DMP    right: Bi-DMP    ({target})"
+        if target
+        else "left: plain DMP    right: Bi-DMP"
+    )
+    images = [
+        Image.fromarray(
+            _titled(
+                np.concatenate(
+                    [left[i], np.full((left[i].shape[0], 6, 3), 255, np.uint8), right[i]], axis=1
+                ),
+                title,
+            )
+        )
+        for i in range(n)
+    ]
     with atomic_write(path, "wb") as handle:
-        images[0].save(handle, format="GIF", save_all=True, append_images=images[1:], duration=120, loop=0)
+        images[0].save(
+            handle, format="GIF", save_all=True, append_images=images[1:], duration=120, loop=0
+        )
     return path

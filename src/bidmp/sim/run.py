@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_labels, check_bool, check_int, check_real, short_token
-from ..tasks.contract import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
+from ..tasks.contract import mm
 from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
 from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
@@ -57,8 +57,12 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
             progress(job.method, job.label)
         try:
             results.append(_run_one(setup, cell, contract, job))
-        except SimError as exc:  # a motion that cannot run (unreachable, past a joint limit): its row
-            results.append((job.method, job.label, SimTarget.not_run(job.label, str(exc)), [], 0.0, None))
+        except (
+            SimError
+        ) as exc:  # a motion that cannot run (unreachable, past a joint limit): its row
+            results.append(
+                (job.method, job.label, SimTarget.not_run(job.label, str(exc)), [], 0.0, None)
+            )
     return results
 
 
@@ -79,13 +83,25 @@ def _run_one(setup: dict, cell, contract, job):
             coupling = [PhaseStopping(coupling), SceneAvoidance(cell.scene, target=job.label)]
         stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
         update = setup.get("goal_update")
-        run = cell.execute_closed_loop(stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update)
+        run = cell.execute_closed_loop(
+            stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update
+        )
         if update is not None:  # judged at where the part turned out to be
             target = target + np.asarray(update.offset)
     else:
         run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
-    measured = _measure(scenario, job.label, target, plan, run, cell.unit, setup["closed_loop"], cell.limits,
-                        contract, job.exclude)
+    measured = _measure(
+        scenario,
+        job.label,
+        target,
+        plan,
+        run,
+        cell.unit,
+        setup["closed_loop"],
+        cell.limits,
+        contract,
+        job.exclude,
+    )
     measured.repair = job.repair
     measured.commanded_penetration = _commanded_penetration(cell, run, job)
     if job.record:
@@ -99,8 +115,14 @@ def _contract(scenario: dict, cell):
     the world's scene (margin and stand-offs) and the arm's joint limits."""
     from ..tasks.contract import Contract
 
-    return Contract(scenario["success_threshold"], scenario["approach_height"], getattr(cell, "scene", None),
-                    scenario["units"], scenario.get("alignment_threshold"), cell.limits)
+    return Contract(
+        scenario["success_threshold"],
+        scenario["approach_height"],
+        getattr(cell, "scene", None),
+        scenario["units"],
+        scenario.get("alignment_threshold"),
+        cell.limits,
+    )
 
 
 # The last world this process built, kept for the next call with the same scene, robot placement
@@ -117,14 +139,25 @@ def _world(setup: dict):
     from ..scene.clearance import Scene
 
     scenario = setup["scenario"]
-    key = (setup["backend"], json.dumps(setup["scene"], sort_keys=True), json.dumps(scenario["targets"], sort_keys=True),
-           scenario["units"], tuple(setup["base"]), setup["yaw"], setup.get("robot", PANDA_MODEL))
+    key = (
+        setup["backend"],
+        json.dumps(setup["scene"], sort_keys=True),
+        json.dumps(scenario["targets"], sort_keys=True),
+        scenario["units"],
+        tuple(setup["base"]),
+        setup["yaw"],
+        setup.get("robot", PANDA_MODEL),
+    )
     if _WORLD.get("key") != key:
         _close_world()
         scene = Scene.from_dict(setup["scene"], scenario["targets"])
         robot = setup.get("robot", PANDA_MODEL)
-        arm = {} if robot is PANDA_MODEL else {"robot": robot}  # another backend need not know of arms
-        _WORLD["cell"] = setup["backend"].load_robot(scene, scenario["units"], setup["base"], setup["yaw"], **arm)
+        arm = (
+            {} if robot is PANDA_MODEL else {"robot": robot}
+        )  # another backend need not know of arms
+        _WORLD["cell"] = setup["backend"].load_robot(
+            scene, scenario["units"], setup["base"], setup["yaw"], **arm
+        )
         _WORLD["key"] = key
     return _WORLD["cell"]
 
@@ -145,10 +178,24 @@ def _run_chunk(setup: dict, jobs: list) -> list:
     return _run_jobs(setup, jobs)
 
 
-def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, targets=None, hold: Hold | None = None,
-             coupling: float | None = None, progress=None, frames: dict | None = None, report=None,
-             workers: int | None = None, backend=None, avoid: bool = False, goal_update: GoalUpdate | None = None,
-             views=(), record: bool = False) -> SimReport:
+def simulate(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    scenario,
+    methods=("dmp", "bidmp"),
+    *,
+    closed_loop: bool = False,
+    targets=None,
+    hold: Hold | None = None,
+    coupling: float | None = None,
+    progress=None,
+    frames: dict | None = None,
+    report=None,
+    workers: int | None = None,
+    backend=None,
+    avoid: bool = False,
+    goal_update: GoalUpdate | None = None,
+    views=(),
+    record: bool = False,
+) -> SimReport:
     """Execute ``methods`` on every target of ``scenario`` on the simulated arm (the Panda, or
     the one the scenario's ``"robot"`` names).
 
@@ -194,31 +241,55 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
 
     scenario, backend = _scenario_and_backend(scenario, backend)
     methods, labels = _checked(scenario, methods, targets, closed_loop)
-    coupling = COUPLING * _unit_of(scenario.units) ** 2 if coupling is None else check_real(coupling, "coupling", nonnegative=True)
+    coupling = (
+        COUPLING * _unit_of(scenario.units) ** 2
+        if coupling is None
+        else check_real(coupling, "coupling", nonnegative=True)
+    )
     if closed_loop and scenario.protocol != "robot":
         # The closed loop steps the skills as a robot runs them: the paper's protocol stops at its
         # fixed horizon while still moving, and an arm stopped there overshoots the target.
-        logger.info("closed loop: the skills of %s on the robot protocol (the scenario's is %r)", scenario.name,
-                    scenario.protocol)
+        logger.info(
+            "closed loop: the skills of %s on the robot protocol (the scenario's is %r)",
+            scenario.name,
+            scenario.protocol,
+        )
         scenario = scenario.with_robot_protocol()
         if report is not None and report.scenario.protocol != "robot":
             report = None
-    if report is None:  # the motions to run, repaired where they break the contract, planned with room for tracking
+    if (
+        report is None
+    ):  # the motions to run, repaired where they break the contract, planned with room for tracking
         report = evaluate(scenario, methods, allowance=mm(TRACKING_ALLOWANCE_MM, scenario.units))
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
-    jobs = _jobs(scenario, report, methods, labels, frames or {}, _views(views), check_bool(record, "record"))
+    jobs = _jobs(
+        scenario, report, methods, labels, frames or {}, _views(views), check_bool(record, "record")
+    )
     models = {name: report.fitted[name] for name in methods} if closed_loop else None
-    setup = _setup(scenario, labels, base, yaw, closed_loop=closed_loop, hold=hold, coupling=coupling, models=models,
-                   backend=backend, robot=arm, **_loop_options(closed_loop, avoid, goal_update))
+    setup = _setup(
+        scenario,
+        labels,
+        base,
+        yaw,
+        closed_loop=closed_loop,
+        hold=hold,
+        coupling=coupling,
+        models=models,
+        backend=backend,
+        robot=arm,
+        **_loop_options(closed_loop, avoid, goal_update),
+    )
     unreachable = _unreachable(setup, scenario, labels)
     skipped = [job for job in jobs if job.label in unreachable]
     jobs = [job for job in jobs if job.label not in unreachable]
     n_workers = _n_workers(workers, max(len(jobs), 1))
     start = time.perf_counter()
     outcomes = _execute_jobs(setup, jobs, n_workers, progress) if jobs else []
-    outcomes += [(job.method, job.label, SimTarget.not_run(job.label, unreachable[job.label]), [], 0.0, None)
-                 for job in skipped]
+    outcomes += [
+        (job.method, job.label, SimTarget.not_run(job.label, unreachable[job.label]), [], 0.0, None)
+        for job in skipped
+    ]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
@@ -228,9 +299,13 @@ def simulate(scenario, methods=("dmp", "bidmp"), *, closed_loop: bool = False, t
 def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:
     """``avoid`` and ``goal_update`` of :func:`simulate`, validated (closed loop only)."""
     if (avoid or goal_update is not None) and not closed_loop:
-        raise ValueError("avoid and goal_update act on the closed loop's stepper: give closed_loop=True")
+        raise ValueError(
+            "avoid and goal_update act on the closed loop's stepper: give closed_loop=True"
+        )
     if goal_update is not None and not isinstance(goal_update, GoalUpdate):
-        raise TypeError(f"goal_update must be a bidmp.sim.GoalUpdate, got {type(goal_update).__name__}")
+        raise TypeError(
+            f"goal_update must be a bidmp.sim.GoalUpdate, got {type(goal_update).__name__}"
+        )
     return {"avoid": check_bool(avoid, "avoid"), "goal_update": goal_update}
 
 
@@ -242,7 +317,9 @@ def _scenario_and_backend(scenario, backend):
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
     if scenario.scene is None:
-        raise ValueError(f"scenario {scenario.name!r} has no \"scene\": the simulator needs the parts and the tool")
+        raise ValueError(
+            f'scenario {scenario.name!r} has no "scene": the simulator needs the parts and the tool'
+        )
     if backend is None:
         _pybullet_module()  # fail early, with the install command, when the extra is missing
         backend = RobotCell
@@ -258,19 +335,27 @@ def _unreachable(setup: dict, scenario, labels) -> dict:
     if setup["backend"] is not RobotCell:
         return {}
     cell = _world(setup)
-    where = (f"for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
-             f"down); move its base (scenario key \"robot\": {{\"base\": ...}})")
+    where = (
+        f"for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
+        f'down); move its base (scenario key "robot": {{"base": ...}})'
+    )
 
     def reached(point) -> bool:
         try:
-            _, error = cell.solve_ik(np.asarray(point, dtype=float)[:3] * cell.unit, cell.model.rest)
+            _, error = cell.solve_ik(
+                np.asarray(point, dtype=float)[:3] * cell.unit, cell.model.rest
+            )
         except SimError:
             return False
         return error <= 10 * IK_TOLERANCE
 
     if not reached(np.asarray(scenario.demonstration, dtype=float)[0, :3]):
         return {label: f"the demonstration's start is unreachable {where}" for label in labels}
-    return {label: f"target {label} is unreachable {where}" for label in labels if not reached(scenario.targets[label])}
+    return {
+        label: f"target {label} is unreachable {where}"
+        for label in labels
+        if not reached(scenario.targets[label])
+    }
 
 
 VIEW_STEP = 0.04  # s between the arm's poses the viewer animates (25 per second)
@@ -280,7 +365,10 @@ def _arm_motion(cell, run) -> dict:
     """The arm's joint origins (scene units) every :data:`VIEW_STEP` of the recorded motion."""
     every = max(1, int(round(VIEW_STEP / float(np.median(np.diff(run.times))))))
     picked = np.unique(np.r_[np.arange(0, len(run.times), every), len(run.times) - 1])
-    return {"times": run.times[picked], "links": np.array([cell.joint_origins(q) for q in run.joints[picked]]) / cell.unit}
+    return {
+        "times": run.times[picked],
+        "links": np.array([cell.joint_origins(q) for q in run.joints[picked]]) / cell.unit,
+    }
 
 
 def _commanded_penetration(cell, run, job) -> float | None:
@@ -297,54 +385,108 @@ def _commanded_penetration(cell, run, job) -> float | None:
 def _jobs(scenario, report, methods, labels, frames: dict, views=(), record: bool = False) -> list:
     """One job per method and target: the rollout to execute, the parts it may touch, frames to
     render, whether the viewer records the arm's motion."""
-    return [_Job(method, label, np.asarray(report.methods[method].rollouts[label]),
-                 scenario.scene.target_parts(label, scenario.targets[label]),
-                 int(frames.get((method, label), 0)),
-                 None if report.methods[method].orientations is None else report.methods[method].orientations[label],
-                 view=(method, label) in views, repair=report.methods[method].repaired_at(label), record=record)
-            for method in methods for label in labels]
+    return [
+        _Job(
+            method,
+            label,
+            np.asarray(report.methods[method].rollouts[label]),
+            scenario.scene.target_parts(label, scenario.targets[label]),
+            int(frames.get((method, label), 0)),
+            None
+            if report.methods[method].orientations is None
+            else report.methods[method].orientations[label],
+            view=(method, label) in views,
+            repair=report.methods[method].repaired_at(label),
+            record=record,
+        )
+        for method in methods
+        for label in labels
+    ]
 
 
 def _setup(scenario, labels, base, yaw, **run) -> dict:
     """What every worker needs to build its world and judge a motion (plain data, picklable);
     ``run``: closed_loop, hold, coupling, models, backend."""
-    axes = {label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist() for label in labels}
-    task = {"targets": {k: v.tolist() for k, v in scenario.targets.items()}, "units": scenario.units,
-            "approach_height": scenario.approach_height, "success_threshold": scenario.success_threshold, "axes": axes,
-            "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None}
-    return {"scenario": task, "scene": scenario.scene.to_dict(), "base": base.tolist(), "yaw": yaw, **run}
+    axes = {
+        label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
+        for label in labels
+    }
+    task = {
+        "targets": {k: v.tolist() for k, v in scenario.targets.items()},
+        "units": scenario.units,
+        "approach_height": scenario.approach_height,
+        "success_threshold": scenario.success_threshold,
+        "axes": axes,
+        "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None,
+    }
+    return {
+        "scenario": task,
+        "scene": scenario.scene.to_dict(),
+        "base": base.tolist(),
+        "yaw": yaw,
+        **run,
+    }
 
 
 def _n_workers(workers, n_jobs: int) -> int:
-    n_workers = min(2, os.cpu_count() or 1) if workers is None else check_int(workers, "workers", minimum=1, maximum=64)
+    n_workers = (
+        min(2, os.cpu_count() or 1)
+        if workers is None
+        else check_int(workers, "workers", minimum=1, maximum=64)
+    )
     return max(1, min(n_workers, n_jobs))
 
 
 def _views(views) -> set:
     """``views`` of :func:`simulate`: (method, label) pairs."""
     if isinstance(views, (str, bytes)) or not hasattr(views, "__iter__"):
-        raise TypeError(f"views must be a collection of (method, label) pairs, got {type(views).__name__}")
+        raise TypeError(
+            f"views must be a collection of (method, label) pairs, got {type(views).__name__}"
+        )
     pairs = set()
     for pair in views:
-        if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, str) for v in pair)):
+        if not (
+            isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, str) for v in pair)
+        ):
             raise TypeError(f"views must hold (method, label) pairs of strings, got {pair!r:.60}")
         pairs.add(pair)
     return pairs
 
 
-def _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, backend, arm) -> SimReport:
+def _sim_report(
+    scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, backend, arm
+) -> SimReport:
     """The workers' outcomes ``(method, label, measured, images, seconds, motion)`` as a report,
     in the order of the methods and targets (whatever order the workers finished in)."""
     ours = backend is RobotCell
     limits = arm.limits if ours else getattr(backend, "limits", None)
-    by_key = {(method, label): (measured, images, seconds) for method, label, measured, images, seconds, _ in outcomes}
-    out = SimReport(scenario, {}, base, yaw, closed_loop, limits=limits,
-                    robot=arm.name if ours else getattr(backend, "__name__", "robot"))
-    out.motions = {(method, label): motion for method, label, _, _, _, motion in outcomes if motion is not None}
+    by_key = {
+        (method, label): (measured, images, seconds)
+        for method, label, measured, images, seconds, _ in outcomes
+    }
+    out = SimReport(
+        scenario,
+        {},
+        base,
+        yaw,
+        closed_loop,
+        limits=limits,
+        robot=arm.name if ours else getattr(backend, "__name__", "robot"),
+    )
+    out.motions = {
+        (method, label): motion for method, label, _, _, _, motion in outcomes if motion is not None
+    }
     for method in methods:
-        out.methods[method] = SimMethod(method, {label: by_key[(method, label)][0] for label in labels},
-                                        scenario.success_threshold)
-        out.pictures += [(method, label, by_key[(method, label)][1]) for label in labels if by_key[(method, label)][1]]
+        out.methods[method] = SimMethod(
+            method,
+            {label: by_key[(method, label)][0] for label in labels},
+            scenario.success_threshold,
+        )
+        out.pictures += [
+            (method, label, by_key[(method, label)][1])
+            for label in labels
+            if by_key[(method, label)][1]
+        ]
     out.simulated_s = sum(value[2] for value in by_key.values())
     return out
 
@@ -354,12 +496,16 @@ def target_labels(scenario, targets) -> list[str]:
     from ..tasks.scenarios import Scenario
 
     if not isinstance(scenario, Scenario):
-        raise TypeError(f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}")
+        raise TypeError(
+            f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}"
+        )
     labels = scenario.labels if targets is None else as_labels(targets, "targets")
     for label in labels:
         if label not in scenario.targets:
-            raise ValueError(f"targets: unknown target {short_token(label, 20)}; the scenario's targets: "
-                             f"{', '.join(scenario.labels[:20])}")
+            raise ValueError(
+                f"targets: unknown target {short_token(label, 20)}; the scenario's targets: "
+                f"{', '.join(scenario.labels[:20])}"
+            )
     return list(labels)
 
 
@@ -373,8 +519,10 @@ def _checked(scenario, methods, targets, closed_loop: bool) -> tuple[list, list]
 
     open_only = [name for name in methods if not registry.get(name).closed_loop]
     if closed_loop and open_only:
-        raise ValueError(f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
-                         f"{', '.join(registry.names(closed_loop=True))})")
+        raise ValueError(
+            f"closed_loop runs the methods' steppers: {', '.join(open_only)} has none (methods with one: "
+            f"{', '.join(registry.names(closed_loop=True))})"
+        )
     return methods, labels
 
 

@@ -52,21 +52,37 @@ def _number(value, source, key, positive=False):
     if positive and value <= 0:
         _fail(source, key, f"must be > 0, got {value}")
     if abs(value) > get_limits().max_abs_value:
-        _fail(source, key, f"{value:.3g} is beyond the limit max_abs_value = {get_limits().max_abs_value:g}")
+        _fail(
+            source,
+            key,
+            f"{value:.3g} is beyond the limit max_abs_value = {get_limits().max_abs_value:g}",
+        )
     return float(value)
 
 
 def _point(value, source, key, n_dims=None):
-    if not isinstance(value, list) or not value or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value):
+    if (
+        not isinstance(value, list)
+        or not value
+        or not all(isinstance(v, Real) and not isinstance(v, bool) for v in value)
+    ):
         _fail(source, key, f"expected a point [x, y(, z)] of numbers, got {_shown(value)}")
     if len(value) > get_limits().max_dims:
-        _fail(source, key, f"has {len(value)} coordinates, more than the limit max_dims = {get_limits().max_dims}")
+        _fail(
+            source,
+            key,
+            f"has {len(value)} coordinates, more than the limit max_dims = {get_limits().max_dims}",
+        )
     point = np.asarray(value, dtype=float)
     if not np.all(np.isfinite(point)):
         _fail(source, key, "contains a non-finite number")
     if np.max(np.abs(point)) > get_limits().max_abs_value:
-        _fail(source, key, f"has a coordinate beyond the limit max_abs_value = {get_limits().max_abs_value:g} "
-                           f"(raise it with bidmp.set_limits(max_abs_value=...))")
+        _fail(
+            source,
+            key,
+            f"has a coordinate beyond the limit max_abs_value = {get_limits().max_abs_value:g} "
+            f"(raise it with bidmp.set_limits(max_abs_value=...))",
+        )
     if n_dims is not None and point.shape[0] != n_dims:
         _fail(source, key, f"has {point.shape[0]} coordinates, expected {n_dims}")
     return point
@@ -76,7 +92,11 @@ def _points(value, source, key, n_dims=None, minimum=2):
     if not isinstance(value, list) or len(value) < minimum:
         _fail(source, key, f"expected a list of at least {minimum} points")
     if len(value) > get_limits().max_samples:
-        _fail(source, key, f"{len(value):,} points exceed the limit max_samples = {get_limits().max_samples:,}")
+        _fail(
+            source,
+            key,
+            f"{len(value):,} points exceed the limit max_samples = {get_limits().max_samples:,}",
+        )
     points = [_point(p, source, f"{key}[{i}]", n_dims) for i, p in enumerate(value)]
     if len({p.shape[0] for p in points}) != 1:
         _fail(source, key, "points have different numbers of coordinates")
@@ -91,8 +111,12 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
     base = Path(os.path.realpath(base_dir))
     resolved = Path(os.path.realpath(path))
     if os.path.isabs(body) or os.path.commonpath([base, resolved]) != str(base):
-        _fail(source, key, f"{short_token(body, 40)} lies outside the scenario's folder {base}; files are read from "
-                           f"there only (allow_outside_files=True, or 'bidmp ... --allow-outside-files', lifts this)")
+        _fail(
+            source,
+            key,
+            f"{short_token(body, 40)} lies outside the scenario's folder {base}; files are read from "
+            f"there only (allow_outside_files=True, or 'bidmp ... --allow-outside-files', lifts this)",
+        )
     return resolved
 
 
@@ -104,35 +128,61 @@ def _prepared_file(path, units: str) -> np.ndarray:
 
     declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
     if declared and units and declared != units:
-        raise ValueError(f"{path} is in {declared} (declared in the file) but the scenario is in {units}")
+        raise ValueError(
+            f"{path} is in {declared} (declared in the file) but the scenario is in {units}"
+        )
     y, t = read_trajectory(path)
     return y if t is None else prepare(y, t)[0].y
 
 
-def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):
+def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):  # noqa: C901 - one branch per documented option or part kind, each a line
     if not isinstance(value, dict) or len(value) != 1:
-        _fail(source, key, 'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}')
-    (kind, body), = value.items()
+        _fail(
+            source,
+            key,
+            'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}',
+        )
+    ((kind, body),) = value.items()
     if kind == "minimum_jerk":
         if not isinstance(body, dict):
             _fail(source, f"{key}.minimum_jerk", "expected an object")
         unknown = sorted(set(body) - _MINIMUM_JERK_KEYS)
         if unknown:
-            _fail(source, f"{key}.minimum_jerk.{unknown[0]}", f"unknown key (known: {', '.join(sorted(_MINIMUM_JERK_KEYS))})")
+            _fail(
+                source,
+                f"{key}.minimum_jerk.{unknown[0]}",
+                f"unknown key (known: {', '.join(sorted(_MINIMUM_JERK_KEYS))})",
+            )
         if "via" not in body:
             _fail(source, f"{key}.minimum_jerk.via", "missing")
         via = _points(body["via"], source, f"{key}.minimum_jerk.via")
         n_steps = body.get("n_steps", 200)
-        if isinstance(n_steps, bool) or not isinstance(n_steps, Integral) or n_steps < _MIN_DEMONSTRATION:
-            _fail(source, f"{key}.minimum_jerk.n_steps", f"expected an integer >= {_MIN_DEMONSTRATION}, got {_shown(n_steps)}")
+        if (
+            isinstance(n_steps, bool)
+            or not isinstance(n_steps, Integral)
+            or n_steps < _MIN_DEMONSTRATION
+        ):
+            _fail(
+                source,
+                f"{key}.minimum_jerk.n_steps",
+                f"expected an integer >= {_MIN_DEMONSTRATION}, got {_shown(n_steps)}",
+            )
         if n_steps > get_limits().max_samples:
-            _fail(source, f"{key}.minimum_jerk.n_steps", f"{n_steps:,} exceeds the limit max_samples = {get_limits().max_samples:,}")
+            _fail(
+                source,
+                f"{key}.minimum_jerk.n_steps",
+                f"{n_steps:,} exceeds the limit max_samples = {get_limits().max_samples:,}",
+            )
         noise = _number(body.get("noise", 0.0), source, f"{key}.minimum_jerk.noise")
         if noise < 0:
             _fail(source, f"{key}.minimum_jerk.noise", "must be >= 0")
         seed = body.get("seed", 0)
         if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**63:
-            _fail(source, f"{key}.minimum_jerk.seed", f"expected an integer in [0, 2**63), got {_shown(seed)}")
+            _fail(
+                source,
+                f"{key}.minimum_jerk.seed",
+                f"expected an integer in [0, 2**63), got {_shown(seed)}",
+            )
         try:
             return minimum_jerk(via, int(n_steps), noise, int(seed))
         except (TypeError, ValueError) as exc:
@@ -145,16 +195,30 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
     if kind == "file":
         if not isinstance(body, str) or not body or "\x00" in body:
             _fail(source, f"{key}.file", "expected a file name")
-        path = _inside(Path(body) if os.path.isabs(body) else Path(base_dir) / body, base_dir, source, f"{key}.file",
-                       body, allow_outside)
+        path = _inside(
+            Path(body) if os.path.isabs(body) else Path(base_dir) / body,
+            base_dir,
+            source,
+            f"{key}.file",
+            body,
+            allow_outside,
+        )
         try:
             trajectory = _prepared_file(path, units)
         except (TypeError, ValueError, OSError) as exc:
             _fail(source, f"{key}.file", str(exc))
         if trajectory.shape[0] < _MIN_DEMONSTRATION:
-            _fail(source, f"{key}.file", f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}")
+            _fail(
+                source,
+                f"{key}.file",
+                f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}",
+            )
         return trajectory
-    _fail(source, key, f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)")
+    _fail(
+        source,
+        key,
+        f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)",
+    )
 
 
 def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> np.ndarray:
@@ -168,7 +232,11 @@ def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> 
         points = points.copy()
         points[:, 3:] = quaternions / norms[:, None]
     elif np.any(np.abs(norms - 1.0) > 1e-6):
-        _fail(source, key, f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})")
+        _fail(
+            source,
+            key,
+            f"quaternions must be of unit length (one is {norms[np.argmax(np.abs(norms - 1))]:.6g})",
+        )
     return points
 
 
@@ -177,11 +245,17 @@ MIN_JOINTS = 6  # the arms the simulator drives: serial, six joints or more
 _LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "jerk")
 
 
-def _joint_values(value, source: str, key: str, positive: bool = False, count: int | None = None) -> list:
+def _joint_values(
+    value, source: str, key: str, positive: bool = False, count: int | None = None
+) -> list:
     """One number per joint (rad, rad/s, ... or N m): ``count`` of them, else six or more."""
-    if not isinstance(value, list) or (len(value) != count if count is not None else len(value) < MIN_JOINTS):
+    if not isinstance(value, list) or (
+        len(value) != count if count is not None else len(value) < MIN_JOINTS
+    ):
         wanted = f"{count}" if count is not None else f"{MIN_JOINTS} or more"
-        _fail(source, key, f"expected {wanted} numbers, one per joint of the arm, got {_shown(value)}")
+        _fail(
+            source, key, f"expected {wanted} numbers, one per joint of the arm, got {_shown(value)}"
+        )
     return [_number(v, source, f"{key}[{i}]", positive=positive) for i, v in enumerate(value)]
 
 
@@ -196,38 +270,71 @@ def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict
     allowed = {"base", "yaw", "model", "urdf", "flange", "limits", "rest", "effort"}
     if not isinstance(robot, dict) or set(robot) - allowed:
         unknown = sorted(set(robot) - allowed) if isinstance(robot, dict) else []
-        _fail(source, "robot", f"expected keys among {sorted(allowed)}" + (f"; unknown {unknown}" if unknown else ""))
+        _fail(
+            source,
+            "robot",
+            f"expected keys among {sorted(allowed)}" + (f"; unknown {unknown}" if unknown else ""),
+        )
     robot = dict(robot)
     if "base" in robot:
         robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
     if "yaw" in robot:
         robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
     if "model" in robot and robot["model"] not in _ROBOT_MODELS:
-        _fail(source, "robot.model", f"expected one of {list(_ROBOT_MODELS)}, got {_shown(robot['model'])}")
+        _fail(
+            source,
+            "robot.model",
+            f"expected one of {list(_ROBOT_MODELS)}, got {_shown(robot['model'])}",
+        )
     if "urdf" not in robot:
         if set(robot) & {"flange", "limits", "rest", "effort"}:
-            _fail(source, "robot", '"flange", "limits", "rest" and "effort" describe your own "urdf"; name it')
+            _fail(
+                source,
+                "robot",
+                '"flange", "limits", "rest" and "effort" describe your own "urdf"; name it',
+            )
         return robot
     if "model" in robot:
         _fail(source, "robot", 'give "model" (a built-in arm) or "urdf" (your own), not both')
     if not isinstance(robot["urdf"], str) or not robot["urdf"].endswith(".urdf"):
-        _fail(source, "robot.urdf", f"expected the path of a .urdf file, got {_shown(robot['urdf'])}")
+        _fail(
+            source, "robot.urdf", f"expected the path of a .urdf file, got {_shown(robot['urdf'])}"
+        )
     local = Path(base_dir) / robot["urdf"]
     if local.exists() or os.path.isabs(robot["urdf"]):  # else: a model shipped by pybullet_data
-        robot["urdf"] = str(_inside(local, base_dir, source, "robot.urdf", robot["urdf"], allow_outside))
+        robot["urdf"] = str(
+            _inside(local, base_dir, source, "robot.urdf", robot["urdf"], allow_outside)
+        )
     if not isinstance(robot.get("flange"), str) or not robot["flange"]:
         _fail(source, "robot.flange", "expected the name of the URDF link the tool is mounted on")
     limits = robot.get("limits")
-    if not isinstance(limits, dict) or set(limits) - set(_LIMIT_KEYS) or not set(_LIMIT_KEYS[:4]) <= set(limits):
-        _fail(source, "robot.limits", f"expected {{{', '.join(_LIMIT_KEYS)}}} (jerk optional), one value per joint each")
+    if (
+        not isinstance(limits, dict)
+        or set(limits) - set(_LIMIT_KEYS)
+        or not set(_LIMIT_KEYS[:4]) <= set(limits)
+    ):
+        _fail(
+            source,
+            "robot.limits",
+            f"expected {{{', '.join(_LIMIT_KEYS)}}} (jerk optional), one value per joint each",
+        )
     count = len(limits["lower"]) if isinstance(limits["lower"], list) else None
-    robot["limits"] = {name: _joint_values(values, source, f"robot.limits.{name}", positive=name not in ("lower", "upper"),
-                                           count=count if name != "lower" else None)
-                       for name, values in limits.items()}
+    robot["limits"] = {
+        name: _joint_values(
+            values,
+            source,
+            f"robot.limits.{name}",
+            positive=name not in ("lower", "upper"),
+            count=count if name != "lower" else None,
+        )
+        for name, values in limits.items()
+    }
     count = len(robot["limits"]["lower"])
     if any(low >= high for low, high in zip(robot["limits"]["lower"], robot["limits"]["upper"])):
         _fail(source, "robot.limits", "lower must be below upper for every joint")
     for name in ("rest", "effort"):
         if name in robot:
-            robot[name] = _joint_values(robot[name], source, f"robot.{name}", positive=name == "effort", count=count)
+            robot[name] = _joint_values(
+                robot[name], source, f"robot.{name}", positive=name == "effort", count=count
+            )
     return robot

@@ -28,12 +28,29 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_labels, as_point, as_trajectory, as_vector, check_bool, check_real, short_token
+from .._checks import (
+    as_labels,
+    as_point,
+    as_trajectory,
+    as_vector,
+    check_bool,
+    check_real,
+    short_token,
+)
 from .._units import UNITS, check_units
 from ..primitives.so3 import as_quaternions
 from .metrics import approach_error, axis_deviation, endpoint_error
 
-__all__ = ["Contract", "Verdict", "CommandPeaks", "command_peaks", "mm", "ENGAGE_RISE_MM", "AT_REST", "PADDING"]
+__all__ = [
+    "Contract",
+    "Verdict",
+    "CommandPeaks",
+    "command_peaks",
+    "mm",
+    "ENGAGE_RISE_MM",
+    "AT_REST",
+    "PADDING",
+]
 
 # The most a final approach may rise inside its band, in mm: 1.5 times the repeatability the Panda, the
 # xArm6 and the UR5 are specified to (+-0.1 mm), below which a rise cannot be told from the arm's own
@@ -72,16 +89,27 @@ class CommandPeaks:
 
     @property
     def within(self) -> bool:
-        return (self.velocity <= 1.0 + _SLACK and self.acceleration <= 1.0 + _SLACK and self.jerk <= 1.0 + _SLACK
-                and self.ends <= AT_REST)
+        return (
+            self.velocity <= 1.0 + _SLACK
+            and self.acceleration <= 1.0 + _SLACK
+            and self.jerk <= 1.0 + _SLACK
+            and self.ends <= AT_REST
+        )
 
     def reason(self) -> str:
         """What breaks the limits, in words (empty when nothing does)."""
         if self.within:
             return ""
         joint = "" if self.joint is None else f"joint {self.joint + 1}'s "
-        over = [f"{name} {value:.2f}" for name, value in
-                (("velocity", self.velocity), ("acceleration", self.acceleration), ("jerk", self.jerk)) if value > 1.0 + _SLACK]
+        over = [
+            f"{name} {value:.2f}"
+            for name, value in (
+                ("velocity", self.velocity),
+                ("acceleration", self.acceleration),
+                ("jerk", self.jerk),
+            )
+            if value > 1.0 + _SLACK
+        ]
         if over:
             return f"{joint}commands exceed the limits ({', '.join(over)} of the limit)"
         return f"the commands do not start and stop at rest (acceleration {self.ends:.2f} of the limit at an end)"
@@ -113,22 +141,42 @@ def command_peaks(commands, limits, dt: float = 1e-3) -> CommandPeaks:
             rates.append(None)
             continue
         if value is None:
-            raise TypeError(f"limits must have velocity, acceleration and jerk per joint, got {type(limits).__name__}")
+            raise TypeError(
+                f"limits must have velocity, acceleration and jerk per joint, got {type(limits).__name__}"
+            )
         rate = as_vector(value, f"limits.{key}", positive=True)
         if rate.shape[0] != commands.shape[1]:
-            raise ValueError(f"limits.{key} has {rate.shape[0]} values but commands has {commands.shape[1]} joints (columns)")
+            raise ValueError(
+                f"limits.{key} has {rate.shape[0]} values but commands has {commands.shape[1]} joints (columns)"
+            )
         rates.append(rate)
-    padded = np.vstack([np.repeat(commands[:1], PADDING, axis=0), commands, np.repeat(commands[-1:], PADDING, axis=0)])
+    padded = np.vstack(
+        [
+            np.repeat(commands[:1], PADDING, axis=0),
+            commands,
+            np.repeat(commands[-1:], PADDING, axis=0),
+        ]
+    )
     velocity = np.diff(padded, axis=0) / dt
     acceleration = np.diff(velocity, axis=0) / dt
     jerk = np.diff(acceleration, axis=0) / dt
-    per_joint = np.vstack([_fractions(velocity, rates[0]), _fractions(acceleration, rates[1]), _fractions(jerk, rates[2])])
+    per_joint = np.vstack(
+        [
+            _fractions(velocity, rates[0]),
+            _fractions(acceleration, rates[1]),
+            _fractions(jerk, rates[2]),
+        ]
+    )
     ends = 0.0
-    if commands.shape[0] >= 2:  # from rest: the first command's acceleration is its first step over dt²
+    if (
+        commands.shape[0] >= 2
+    ):  # from rest: the first command's acceleration is its first step over dt²
         steps = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
         ends = float(np.max(steps / rates[1]))
     joint = int(np.argmax(np.max(per_joint, axis=0)))
-    return CommandPeaks(float(per_joint[0].max()), float(per_joint[1].max()), float(per_joint[2].max()), ends, joint)
+    return CommandPeaks(
+        float(per_joint[0].max()), float(per_joint[1].max()), float(per_joint[2].max()), ends, joint
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -149,7 +197,9 @@ class Verdict:
     approach_error: float | None = None
     engaged: bool | None = None
     clearance: object = None  # bidmp.scene.Clearance, with the margin it was judged against
-    contacts: dict = field(default_factory=dict)  # part label -> depth: the simulator's contacts with other parts
+    contacts: dict = field(
+        default_factory=dict
+    )  # part label -> depth: the simulator's contacts with other parts
     axis_deviation: float | None = None
     aligned: bool | None = None
     limits: CommandPeaks | None = None
@@ -171,14 +221,24 @@ class Verdict:
     @property
     def ok(self) -> bool:
         """End, engagement, clearance, alignment and limits, each where it applies."""
-        return (self.reached and self.engaged is not False and self.clear is not False and self.aligned is not False
-                and self.within_limits is not False)
+        return (
+            self.reached
+            and self.engaged is not False
+            and self.clear is not False
+            and self.aligned is not False
+            and self.within_limits is not False
+        )
 
     @property
     def failed(self) -> list[str]:
         """The checks that failed, in the order: end, engagement, clearance, alignment, limits."""
-        checks = (("end", self.reached), ("engagement", self.engaged), ("clearance", self.clear),
-                  ("alignment", self.aligned), ("limits", self.within_limits))
+        checks = (
+            ("end", self.reached),
+            ("engagement", self.engaged),
+            ("clearance", self.clear),
+            ("alignment", self.aligned),
+            ("limits", self.within_limits),
+        )
         return [name for name, value in checks if value is False]
 
     def reason(self) -> str:
@@ -187,32 +247,46 @@ class Verdict:
         unit = self.units or "units"
         for name in self.failed:
             if name == "end":
-                parts.append(f"ends {self.end_error:.2f} {unit} from the target (within {self.threshold:g} {unit} is success)")
+                parts.append(
+                    f"ends {self.end_error:.2f} {unit} from the target (within {self.threshold:g} {unit} is success)"
+                )
             elif name == "engagement":
                 if self.approach_error is None or not math.isfinite(self.approach_error):
                     parts.append("has no monotone final descent along the target's axis")
                 else:
-                    parts.append(f"comes down {self.approach_error:.2f} {unit} off the target's axis")
+                    parts.append(
+                        f"comes down {self.approach_error:.2f} {unit} off the target's axis"
+                    )
             elif name == "clearance":
                 parts.append(self._clearance_words(unit))
             elif name == "alignment":
-                parts.append("tilts the tool off the target's axis" if self.axis_deviation is None
-                             else f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis")
+                parts.append(
+                    "tilts the tool off the target's axis"
+                    if self.axis_deviation is None
+                    else f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis"
+                )
             else:
                 parts.append(self.limits.reason())
         if not parts:
             return ""
-        return f"the motion to {self.target} " + (", ".join(parts[:-1]) + " and " + parts[-1] if len(parts) > 1 else parts[0])
+        return f"the motion to {self.target} " + (
+            ", ".join(parts[:-1]) + " and " + parts[-1] if len(parts) > 1 else parts[0]
+        )
 
     def _clearance_words(self, unit: str) -> str:
         words = []
         if self.clearance is not None and not self.clearance.clear:
             c = self.clearance
             if c.distance < 0.0:
-                words.append(f"cuts {-c.distance:.2f} {unit} into {c.part}" if -c.distance >= 0.005
-                             else f"touches {c.part}")
+                words.append(
+                    f"cuts {-c.distance:.2f} {unit} into {c.part}"
+                    if -c.distance >= 0.005
+                    else f"touches {c.part}"
+                )
             else:
-                words.append(f"passes {c.distance:.2f} {unit} from {c.part}, inside the {c.margin:g} {unit} it must keep")
+                words.append(
+                    f"passes {c.distance:.2f} {unit} from {c.part}, inside the {c.margin:g} {unit} it must keep"
+                )
         if self.contacts:
             label, depth = max(self.contacts.items(), key=lambda item: item[1])
             words.append(f"the arm touches {label} ({depth:.2f} {unit} deep)")
@@ -222,13 +296,21 @@ class Verdict:
         from .metrics import _json_length
 
         c = self.clearance
-        return {"ok": self.ok, "failed": self.failed, "reason": self.reason(),
-                "end_error": round(float(self.end_error), 4), "approach_error": _json_length(self.approach_error),
-                "engaged": self.engaged, "clearance": None if c is None else _json_length(c.distance),
-                "clearance_part": None if c is None else c.part, "margin": None if c is None else c.margin,
-                "contacts": {k: round(float(v), 4) for k, v in sorted(self.contacts.items())},
-                "axis_deviation": _json_length(self.axis_deviation), "aligned": self.aligned,
-                "within_limits": self.within_limits}
+        return {
+            "ok": self.ok,
+            "failed": self.failed,
+            "reason": self.reason(),
+            "end_error": round(float(self.end_error), 4),
+            "approach_error": _json_length(self.approach_error),
+            "engaged": self.engaged,
+            "clearance": None if c is None else _json_length(c.distance),
+            "clearance_part": None if c is None else c.part,
+            "margin": None if c is None else c.margin,
+            "contacts": {k: round(float(v), 4) for k, v in sorted(self.contacts.items())},
+            "axis_deviation": _json_length(self.axis_deviation),
+            "aligned": self.aligned,
+            "within_limits": self.within_limits,
+        }
 
 
 @dataclass(frozen=True)
@@ -263,19 +345,36 @@ class Contract:
     def __post_init__(self) -> None:
         from ..scene import Scene
 
-        object.__setattr__(self, "threshold", check_real(self.threshold, "threshold", positive=True))
+        object.__setattr__(
+            self, "threshold", check_real(self.threshold, "threshold", positive=True)
+        )
         if self.approach_height is not None:
-            object.__setattr__(self, "approach_height", check_real(self.approach_height, "approach_height", positive=True))
+            object.__setattr__(
+                self,
+                "approach_height",
+                check_real(self.approach_height, "approach_height", positive=True),
+            )
         if self.scene is not None and not isinstance(self.scene, Scene):
             raise TypeError(f"scene must be a bidmp.Scene or None, got {type(self.scene).__name__}")
         if not isinstance(self.units, str) or len(self.units) > 16:
-            raise TypeError(f"units must be a unit name such as 'mm', got {short_token(self.units)}")
+            raise TypeError(
+                f"units must be a unit name such as 'mm', got {short_token(self.units)}"
+            )
         if self.alignment_threshold is not None:
-            object.__setattr__(self, "alignment_threshold",
-                               check_real(self.alignment_threshold, "alignment_threshold", positive=True, maximum=180.0))
-        if self.limits is not None and not all(hasattr(self.limits, key) for key in ("velocity", "acceleration", "jerk")):
-            raise TypeError(f"limits must be joint limits (velocity, acceleration, jerk per joint), got "
-                            f"{type(self.limits).__name__}")
+            object.__setattr__(
+                self,
+                "alignment_threshold",
+                check_real(
+                    self.alignment_threshold, "alignment_threshold", positive=True, maximum=180.0
+                ),
+            )
+        if self.limits is not None and not all(
+            hasattr(self.limits, key) for key in ("velocity", "acceleration", "jerk")
+        ):
+            raise TypeError(
+                f"limits must be joint limits (velocity, acceleration, jerk per joint), got "
+                f"{type(self.limits).__name__}"
+            )
 
     @classmethod
     def of(cls, scenario, limits=None, geometry: bool = True) -> Contract:
@@ -283,14 +382,34 @@ class Contract:
         from .scenarios import Scenario
 
         if not isinstance(scenario, Scenario):
-            raise TypeError(f"scenario must be a bidmp.tasks.Scenario, got {type(scenario).__name__}")
+            raise TypeError(
+                f"scenario must be a bidmp.tasks.Scenario, got {type(scenario).__name__}"
+            )
         geometry = check_bool(geometry, "geometry")
-        return cls(scenario.success_threshold, scenario.approach_height if scenario.demonstration.shape[1] >= 3 else None,
-                   scenario.scene if geometry else None, scenario.units,
-                   scenario.alignment_threshold if scenario.is_pose else None, limits)
+        return cls(
+            scenario.success_threshold,
+            scenario.approach_height if scenario.demonstration.shape[1] >= 3 else None,
+            scenario.scene if geometry else None,
+            scenario.units,
+            scenario.alignment_threshold if scenario.is_pose else None,
+            limits,
+        )
 
-    def judge(self, path, target, *, label: str = "", axis=None, exclude=(), orientations=None, commands=None,
-              contacts=None, dt: float = 1e-3, clearance=None, applies: bool = True) -> Verdict:
+    def judge(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+        self,
+        path,
+        target,
+        *,
+        label: str = "",
+        axis=None,
+        exclude=(),
+        orientations=None,
+        commands=None,
+        contacts=None,
+        dt: float = 1e-3,
+        clearance=None,
+        applies: bool = True,
+    ) -> Verdict:
         """The verdict on ``path`` (n, 3 or D) to ``target`` (D,).
 
         Parameters
@@ -321,10 +440,14 @@ class Contract:
         target = as_vector(target, "target")
         position = path[:, :3] if path.shape[1] >= 3 else path
         if target.shape[0] < position.shape[1]:
-            raise ValueError(f"target has {target.shape[0]} coordinates; path's positions have {position.shape[1]}")
+            raise ValueError(
+                f"target has {target.shape[0]} coordinates; path's positions have {position.shape[1]}"
+            )
         goal = target[: position.shape[1]]
         if not isinstance(label, str):
-            raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
+            raise TypeError(
+                f"label must be the target's name (a string), got {type(label).__name__}"
+            )
         if axis is not None:
             axis = as_point(axis, 3, "axis")
             if not np.linalg.norm(axis) > 0.0:
@@ -333,29 +456,61 @@ class Contract:
         if orientations is not None:
             orientations = as_quaternions(orientations, "orientations")
             if orientations.shape[0] != path.shape[0]:
-                raise ValueError(f"orientations has {orientations.shape[0]} rows but path has {path.shape[0]}")
+                raise ValueError(
+                    f"orientations has {orientations.shape[0]} rows but path has {path.shape[0]}"
+                )
         dt = check_real(dt, "dt", positive=True)
-        if contacts is not None and (not isinstance(contacts, dict) or not all(
-                isinstance(key, str) and isinstance(value, (int, float)) and math.isfinite(value) for key, value in contacts.items())):
-            raise TypeError(f"contacts must be a dict of part label -> depth, got {short_token(contacts, 30)}")
-        if clearance is not None and not all(hasattr(clearance, key) for key in ("distance", "part", "clear")):
-            raise TypeError(f"clearance must be a bidmp.Clearance or None, got {type(clearance).__name__}")
+        if contacts is not None and (
+            not isinstance(contacts, dict)
+            or not all(
+                isinstance(key, str) and isinstance(value, (int, float)) and math.isfinite(value)
+                for key, value in contacts.items()
+            )
+        ):
+            raise TypeError(
+                f"contacts must be a dict of part label -> depth, got {short_token(contacts, 30)}"
+            )
+        if clearance is not None and not all(
+            hasattr(clearance, key) for key in ("distance", "part", "clear")
+        ):
+            raise TypeError(
+                f"clearance must be a bidmp.Clearance or None, got {type(clearance).__name__}"
+            )
         applies = check_bool(applies, "applies")
         if commands is not None:
             commands = as_trajectory(commands, "commands", min_points=1, allow_static=True)
         end = endpoint_error(position, goal)
         approach = engaged = deviation = aligned = None
         if self.approach_height is not None and position.shape[1] == 3:
-            approach = approach_error(position, goal, self.approach_height, axis, rise=mm(ENGAGE_RISE_MM, self.units))
+            approach = approach_error(
+                position, goal, self.approach_height, axis, rise=mm(ENGAGE_RISE_MM, self.units)
+            )
             engaged = bool(approach <= self.threshold)
             if self.alignment_threshold is not None and orientations is not None:
-                deviation = axis_deviation(position, orientations, goal, self.approach_height, axis,
-                                           rise=mm(ENGAGE_RISE_MM, self.units))
+                deviation = axis_deviation(
+                    position,
+                    orientations,
+                    goal,
+                    self.approach_height,
+                    axis,
+                    rise=mm(ENGAGE_RISE_MM, self.units),
+                )
                 aligned = bool(deviation <= self.alignment_threshold)
         if clearance is None and self.scene is not None and applies and position.shape[1] == 3:
             clearance = self.scene.clearance(position, exclude=exclude, orientations=orientations)
         peaks = None
         if commands is not None and self.limits is not None:
             peaks = command_peaks(commands, self.limits, dt)
-        return Verdict(label, end, self.threshold, self.units, approach, engaged, clearance if applies else None,
-                       dict(contacts or {}), deviation, aligned, peaks)
+        return Verdict(
+            label,
+            end,
+            self.threshold,
+            self.units,
+            approach,
+            engaged,
+            clearance if applies else None,
+            dict(contacts or {}),
+            deviation,
+            aligned,
+            peaks,
+        )

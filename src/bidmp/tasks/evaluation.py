@@ -18,8 +18,8 @@ from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
 from ..extension.roadmap import NoFreeRouteError
 from ..incremental.bidmp import BiDMP, forgetting_runs
-from .metrics import path_difference
 from .methods.dmp_converged import CONVERGED_GAIN
+from .metrics import path_difference
 from .report import MethodResult, Report, write_report
 
 logger = logging.getLogger(__name__)
@@ -47,7 +47,9 @@ def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
         if scenario.is_pose:
             from scipy.spatial.transform import Rotation
 
-            return np.concatenate([points[:, :3].mean(axis=0), Rotation.from_quat(points[:, 3:]).mean().as_quat()])
+            return np.concatenate(
+                [points[:, :3].mean(axis=0), Rotation.from_quat(points[:, 3:]).mean().as_quat()]
+            )
         return points.mean(axis=0)
     if isinstance(target, str):
         return scenario.targets[target]
@@ -56,7 +58,9 @@ def _resolve_target(target, scenario, failed: list[str]) -> np.ndarray | None:
 
 def _route_failure(target, exc) -> dict:
     """What the report says of an extension stage the roadmap found no free route for."""
-    logger.warning("no collision-free route to %s: %s", np.round(np.asarray(target)[:3], 3).tolist(), exc)
+    logger.warning(
+        "no collision-free route to %s: %s", np.round(np.asarray(target)[:3], 3).tolist(), exc
+    )
     return {"target": np.round(np.asarray(target, dtype=float), 4).tolist(), "reason": str(exc)}
 
 
@@ -73,7 +77,11 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
         target = _resolve_target(stage["target"], scenario, failed)
         if target is None:
             continue  # nothing failed: no extension needed
-        source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous.complete
+        source = (
+            scenario.demonstration
+            if stage["from"] == "demonstration" or previous is None
+            else previous.complete
+        )
         scene = scenario.scene if keep and stage.get("in_scene", True) else None
         try:
             model, previous = _learned_clear(model, dmp, source, target, scenario, scene)
@@ -84,8 +92,12 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
         targets.append(target)
     forgetting = {}
     if scenario.demonstrations:
-        if model.n_skills == 1:  # learn the operators' demonstrations and measure forgetting in one pass
-            forgetting = forgetting_runs(model, list(scenario.demonstrations.values()), ("nearest", "latest"))
+        if (
+            model.n_skills == 1
+        ):  # learn the operators' demonstrations and measure forgetting in one pass
+            forgetting = forgetting_runs(
+                model, list(scenario.demonstrations.values()), ("nearest", "latest")
+            )
         else:
             for demonstration in scenario.demonstrations.values():
                 model.learn(demonstration)
@@ -104,19 +116,31 @@ def _learned_clear(model, dmp, source, target, scenario, scene):
     planning = scene
     checked = scene is not None and scene.margin > 0.0
     for attempt in range(_REPAIRS + 1):
-        extension = extend_demonstration(source, target, seed=scenario.seed, scene=planning, **scenario.extension)
+        extension = extend_demonstration(
+            source, target, seed=scenario.seed, scene=planning, **scenario.extension
+        )
         # A skill that may be planned again is learned on a copy: the Bi-DMP cannot forget a block.
         trial = copy.deepcopy(model) if checked and attempt < _REPAIRS else model
-        trial.learn(extension.complete, duration=extension.duration_for(dmp))  # a longer extension takes longer
+        trial.learn(
+            extension.complete, duration=extension.duration_for(dmp)
+        )  # a longer extension takes longer
         if not checked or attempt == _REPAIRS:
             return trial, extension
         clearance = scene.clearance(trial.rollout(target), exclude=scene.parts_at(target))
         if clearance.clear:
             return trial, extension
         planning = copy.copy(planning)
-        planning.margin = min(planning.margin + (clearance.margin - clearance.distance), scene.tool.radius)
-        logger.info("the skill learned for %s passes %.3g from %s, inside %g: planned again with a margin of %.3g",
-                    np.round(target, 3).tolist(), clearance.distance, clearance.part, clearance.margin, planning.margin)
+        planning.margin = min(
+            planning.margin + (clearance.margin - clearance.distance), scene.tool.radius
+        )
+        logger.info(
+            "the skill learned for %s passes %.3g from %s, inside %g: planned again with a margin of %.3g",
+            np.round(target, 3).tolist(),
+            clearance.distance,
+            clearance.part,
+            clearance.margin,
+            planning.margin,
+        )
     return trial, extension
 
 
@@ -132,10 +156,16 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
         target = _resolve_target(stage["target"], scenario, failed)
         if target is None:
             continue
-        source = scenario.demonstration if stage["from"] == "demonstration" or previous is None else previous
+        source = (
+            scenario.demonstration
+            if stage["from"] == "demonstration" or previous is None
+            else previous
+        )
         stage_scene = scenario.scene if stage.get("in_scene", True) else None
         try:
-            extension = extend_pose_demonstration(source, target, seed=scenario.seed, scene=stage_scene, **options)
+            extension = extend_pose_demonstration(
+                source, target, seed=scenario.seed, scene=stage_scene, **options
+            )
         except NoFreeRouteError as exc:
             report.route_failures.append(_route_failure(target, exc))
             continue
@@ -155,8 +185,9 @@ def _skills_builder(scenario, failed, report):
         if scenario.is_pose:
             report.model = _pose_bidmp_model(scenario, dmp, failed, report)
         else:
-            report.model, report.extensions, report.extension_targets, report.forgetting = \
+            report.model, report.extensions, report.extension_targets, report.forgetting = (
                 _bidmp_model(scenario, dmp, failed, report.route_failures)
+            )
         return report.model
 
     return build
@@ -172,13 +203,21 @@ def _method_names(scenario, methods) -> list[str]:
     for name in names:
         method = registry.get(name)
         if scenario.is_pose and not method.poses:
-            raise ValueError(f"method {name!r} does not learn poses; a pose scenario runs "
-                             f"{', '.join(registry.names(poses=True))}")
+            raise ValueError(
+                f"method {name!r} does not learn poses; a pose scenario runs "
+                f"{', '.join(registry.names(poses=True))}"
+            )
     return names
 
 
-def evaluate(scenario, methods=None, progress=None, geometry: bool = True, repair: bool | None = None,
-             allowance: float = 0.0) -> Report:
+def evaluate(
+    scenario,
+    methods=None,
+    progress=None,
+    geometry: bool = True,
+    repair: bool | None = None,
+    allowance: float = 0.0,
+) -> Report:
     """Run ``methods`` (default: the scenario's) on every target of ``scenario``, each motion judged
     by the motion contract (:mod:`bidmp.tasks.contract`); the pipeline's method's motions that
     break it repaired (:mod:`bidmp.tasks.repair`).
@@ -222,15 +261,25 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True, repai
     names = _method_names(scenario, methods)
     labels = scenario.labels
     goals = np.stack([scenario.targets[label] for label in labels])
-    task = registry.Task(scenario.demonstration, goals, seed=scenario.seed, dmp=scenario.dmp, bidmp=scenario.bidmp,
-                         poses=scenario.is_pose)
+    task = registry.Task(
+        scenario.demonstration,
+        goals,
+        seed=scenario.seed,
+        dmp=scenario.dmp,
+        bidmp=scenario.bidmp,
+        poses=scenario.is_pose,
+    )
     report = Report(scenario=scenario, methods={})
     report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
     task.build_skills = _skills_builder(scenario, failed, report)
     result = _results_builder(scenario, labels, geometry)
     if repair is None:
         repair = scenario.extension.get("approach", "keep") == "keep"
-    repairer = _repairer(scenario, allowance) if repair and geometry and scenario.scene is not None else None
+    repairer = (
+        _repairer(scenario, allowance)
+        if repair and geometry and scenario.scene is not None
+        else None
+    )
     for name in names:
         if progress is not None:
             progress(name)
@@ -246,8 +295,9 @@ def evaluate(scenario, methods=None, progress=None, geometry: bool = True, repai
         report.fitted[name] = model
     if scenario.demonstrations and not report.forgetting and not scenario.is_pose:
         dmp, _ = task.fitted_dmp()
-        report.forgetting = forgetting_runs(dmp, list(scenario.demonstrations.values()), ("nearest", "latest"),
-                                            **scenario.bidmp)
+        report.forgetting = forgetting_runs(
+            dmp, list(scenario.demonstrations.values()), ("nearest", "latest"), **scenario.bidmp
+        )
     return report
 
 
@@ -256,11 +306,19 @@ def _repairer(scenario, allowance: float):
     from .contract import Contract
     from .repair import Repairer
 
-    return Repairer(Contract.of(scenario), scenario.demonstration, extension=scenario.extension, seed=scenario.seed,
-                    allowance=allowance, bidmp=scenario.bidmp)
+    return Repairer(
+        Contract.of(scenario),
+        scenario.demonstration,
+        extension=scenario.extension,
+        seed=scenario.seed,
+        allowance=allowance,
+        bidmp=scenario.bidmp,
+    )
 
 
-def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, progress) -> MethodResult:
+def _repaired(
+    outcome: MethodResult, repairer, model, scenario, labels, result, progress
+) -> MethodResult:
     """``outcome`` with every motion that broke the contract repaired where a repair keeps it
     (``outcome.repairs``: label -> :class:`~bidmp.tasks.repair.Repaired` of each one tried)."""
     failed = [label for label in labels if not outcome.verdicts[label].ok]
@@ -273,16 +331,24 @@ def _repaired(outcome: MethodResult, repairer, model, scenario, labels, result, 
         report("repairs", done, len(failed))
         if progress is not None:
             progress(f"{outcome.name}: repair {label}")
-        fixed = repairer.repair(model, scenario.targets[label], label, axis=scenario.target_axis(label),
-                                exclude=scene.target_parts(label, scenario.targets[label]), motion=rollouts[label],
-                                verdict=outcome.verdicts[label])
+        fixed = repairer.repair(
+            model,
+            scenario.targets[label],
+            label,
+            axis=scenario.target_axis(label),
+            exclude=scene.target_parts(label, scenario.targets[label]),
+            motion=rollouts[label],
+            verdict=outcome.verdicts[label],
+        )
         repairs[label] = fixed
         if fixed.how:
             rollouts[label] = fixed.motion
     report("repairs", len(failed), len(failed))
     verdicts = dict(outcome.verdicts)  # the repaired motions' verdicts are the repairs' own
     verdicts.update({label: fixed.verdict for label, fixed in repairs.items() if fixed.how})
-    repaired = result(outcome.name, [rollouts[label] for label in labels], outcome.runtime_s, verdicts)
+    repaired = result(
+        outcome.name, [rollouts[label] for label in labels], outcome.runtime_s, verdicts
+    )
     repaired.repairs = repairs
     return repaired
 
@@ -309,30 +375,75 @@ def _results_builder(scenario, labels, geometry: bool):
     contract = Contract.of(scenario, geometry=geometry and scenario.scene is not None)
     scene = contract.scene
     poses = scenario.is_pose
-    references = {label: resample_time(scenario.reference(label)[:, :3] if poses else scenario.reference(label), n_steps)
-                  for label in labels}
-    excluded = {} if scene is None else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
+    references = {
+        label: resample_time(
+            scenario.reference(label)[:, :3] if poses else scenario.reference(label), n_steps
+        )
+        for label in labels
+    }
+    excluded = (
+        {}
+        if scene is None
+        else {label: scene.target_parts(label, scenario.targets[label]) for label in labels}
+    )
 
     def result(name, rollouts, seconds, known=None):
         """``known``: verdicts already reached (label -> Verdict), not judged again."""
         rollouts = dict(zip(labels, rollouts))
-        positions = {label: rollout[:, :3] if poses else rollout for label, rollout in rollouts.items()}
-        orientations = {label: rollout[:, 3:] for label, rollout in rollouts.items()} if poses else None
+        positions = {
+            label: rollout[:, :3] if poses else rollout for label, rollout in rollouts.items()
+        }
+        orientations = (
+            {label: rollout[:, 3:] for label, rollout in rollouts.items()} if poses else None
+        )
         known = known or {}
-        verdicts = {label: known[label] if label in known else
-                    contract.judge(positions[label], scenario.targets[label], label=label,
-                                   axis=scenario.target_axis(label), exclude=excluded.get(label, ()),
-                                   orientations=None if orientations is None else orientations[label],
-                                   applies=scene is not None and scene.applies_to(label))
-                    for label in labels}
+        verdicts = {
+            label: known[label]
+            if label in known
+            else contract.judge(
+                positions[label],
+                scenario.targets[label],
+                label=label,
+                axis=scenario.target_axis(label),
+                exclude=excluded.get(label, ()),
+                orientations=None if orientations is None else orientations[label],
+                applies=scene is not None and scene.applies_to(label),
+            )
+            for label in labels
+        }
         errors = {label: verdict.end_error for label, verdict in verdicts.items()}
-        approach = None if contract.approach_height is None else \
-            {label: verdict.approach_error for label, verdict in verdicts.items()}
-        deviations = None if contract.alignment_threshold is None else \
-            {label: verdict.axis_deviation for label, verdict in verdicts.items()}
-        clearances = None if scene is None else {label: verdict.clearance for label, verdict in verdicts.items()}
-        differences = {label: path_difference(positions[label], references[label]) for label in labels}
-        return MethodResult(name, positions, seconds, errors, approach, differences, scenario.success_threshold,
-                            n_steps, clearances, orientations, deviations, scenario.alignment_threshold, verdicts)
+        approach = (
+            None
+            if contract.approach_height is None
+            else {label: verdict.approach_error for label, verdict in verdicts.items()}
+        )
+        deviations = (
+            None
+            if contract.alignment_threshold is None
+            else {label: verdict.axis_deviation for label, verdict in verdicts.items()}
+        )
+        clearances = (
+            None
+            if scene is None
+            else {label: verdict.clearance for label, verdict in verdicts.items()}
+        )
+        differences = {
+            label: path_difference(positions[label], references[label]) for label in labels
+        }
+        return MethodResult(
+            name,
+            positions,
+            seconds,
+            errors,
+            approach,
+            differences,
+            scenario.success_threshold,
+            n_steps,
+            clearances,
+            orientations,
+            deviations,
+            scenario.alignment_threshold,
+            verdicts,
+        )
 
     return result

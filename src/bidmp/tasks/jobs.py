@@ -34,12 +34,25 @@ from .contract import mm
 
 __all__ = ["JobSpec", "JOB_KINDS", "parse_job", "tour"]
 
-JOB_KINDS = {"unscrew": ("approach", "engage", "unscrew", "retract", "drop"),
-             "lift": ("approach", "grasp", "lift", "place"),
-             "pick-place": ("approach", "grasp", "place")}
+JOB_KINDS = {
+    "unscrew": ("approach", "engage", "unscrew", "retract", "drop"),
+    "lift": ("approach", "grasp", "lift", "place"),
+    "pick-place": ("approach", "grasp", "place"),
+}
 MAX_TOUR = 200
-_KEYS = {"steps", "order", "bin", "rack", "pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance",
-         "transfer"}
+_KEYS = {
+    "steps",
+    "order",
+    "bin",
+    "rack",
+    "pitch",
+    "spindle_speed",
+    "engage_tolerance",
+    "part_mass",
+    "lift",
+    "clearance",
+    "transfer",
+}
 
 
 # The defaults, in mm (converted to the scenario's unit).
@@ -81,32 +94,61 @@ class JobSpec:
     def __post_init__(self) -> None:
         kind = check_choice(self.kind, "kind", JOB_KINDS)
         if not isinstance(self.steps, (tuple, list)) or tuple(self.steps) != JOB_KINDS[kind]:
-            raise ValueError(f"steps must be {' -> '.join(JOB_KINDS[kind])} for a {kind} job, got {short_token(self.steps, 40)}")
+            raise ValueError(
+                f"steps must be {' -> '.join(JOB_KINDS[kind])} for a {kind} job, got {short_token(self.steps, 40)}"
+            )
         object.__setattr__(self, "steps", tuple(self.steps))
         check_choice(self.order, "order", ("listed", "shortest"))
         check_choice(self.transfer, "transfer", ("dmp", "similarity"))
         units = check_units(self.units)
         if units not in UNITS:
-            raise ValueError(f"units must be a length unit ({', '.join(UNITS)}), got {short_token(units)}")
+            raise ValueError(
+                f"units must be a length unit ({', '.join(UNITS)}), got {short_token(units)}"
+            )
         for name, value in DEFAULTS_MM.items():
-            object.__setattr__(self, name, mm(value, units) if getattr(self, name) is None
-                               else check_real(getattr(self, name), name, positive=True))
+            object.__setattr__(
+                self,
+                name,
+                mm(value, units)
+                if getattr(self, name) is None
+                else check_real(getattr(self, name), name, positive=True),
+            )
         for name in ("spindle_speed", "part_mass"):
             object.__setattr__(self, name, check_real(getattr(self, name), name, positive=True))
         if self.bin is not None:
             if not isinstance(self.bin, (tuple, list)) or len(self.bin) != 2:
-                raise TypeError(f"bin must be (its bottom's centre (3,), inner size (3,)), got {short_token(self.bin, 30)}")
-            object.__setattr__(self, "bin", (as_point(self.bin[0], 3, "bin[0]"), as_vector(self.bin[1], "bin[1]", length=3,
-                                                                                          positive=True)))
+                raise TypeError(
+                    f"bin must be (its bottom's centre (3,), inner size (3,)), got {short_token(self.bin, 30)}"
+                )
+            object.__setattr__(
+                self,
+                "bin",
+                (
+                    as_point(self.bin[0], 3, "bin[0]"),
+                    as_vector(self.bin[1], "bin[1]", length=3, positive=True),
+                ),
+            )
         if self.rack is not None:
             if not isinstance(self.rack, (tuple, list)) or len(self.rack) != 4:
-                raise TypeError(f"rack must be (first slot (3,), step (3,), slots per row, row step (3,)), got "
-                                f"{short_token(self.rack, 30)}")
+                raise TypeError(
+                    f"rack must be (first slot (3,), step (3,), slots per row, row step (3,)), got "
+                    f"{short_token(self.rack, 30)}"
+                )
             first, step, per_row, row_step = self.rack
-            object.__setattr__(self, "rack", (as_point(first, 3, "rack[0]"), as_point(step, 3, "rack[1]"),
-                                              check_int(per_row, "rack[2]", minimum=1), as_point(row_step, 3, "rack[3]")))
+            object.__setattr__(
+                self,
+                "rack",
+                (
+                    as_point(first, 3, "rack[0]"),
+                    as_point(step, 3, "rack[1]"),
+                    check_int(per_row, "rack[2]", minimum=1),
+                    as_point(row_step, 3, "rack[3]"),
+                ),
+            )
         if kind == "unscrew" and self.bin is None:
-            raise ValueError("bin: an unscrew job drops each nut into a bin; give where it stands and its size")
+            raise ValueError(
+                "bin: an unscrew job drops each nut into a bin; give where it stands and its size"
+            )
 
     @property
     def play(self) -> float:
@@ -140,14 +182,23 @@ class JobSpec:
 
 
 def _positive(value, source: str, key: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value) or value <= 0:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, Real)
+        or not np.isfinite(value)
+        or value <= 0
+    ):
         _fail(source, key, f"expected a positive number, got {_shown(value)}")
     return float(value)
 
 
 def _box(value, source: str, key: str) -> tuple:
     if not isinstance(value, dict) or set(value) != {"at", "size"}:
-        _fail(source, key, 'expected {"at": [x, y, z] (its bottom\'s centre), "size": [sx, sy, sz] (inside)}')
+        _fail(
+            source,
+            key,
+            'expected {"at": [x, y, z] (its bottom\'s centre), "size": [sx, sy, sz] (inside)}',
+        )
     size = _point(value["size"], source, f"{key}.size", 3)
     if np.any(size <= 0):
         _fail(source, f"{key}.size", "every side must be > 0")
@@ -157,12 +208,20 @@ def _box(value, source: str, key: str) -> tuple:
 def _rack(value, source: str, key: str) -> tuple:
     known = {"at", "step", "per_row", "row_step"}
     if not isinstance(value, dict) or set(value) - known or not {"at", "step"} <= set(value):
-        _fail(source, key, 'expected {"at": first slot [x, y, z], "step": [dx, dy, dz], "per_row": n, "row_step": [...]}')
+        _fail(
+            source,
+            key,
+            'expected {"at": first slot [x, y, z], "step": [dx, dy, dz], "per_row": n, "row_step": [...]}',
+        )
     per_row = value.get("per_row", 1000)
     if isinstance(per_row, bool) or not isinstance(per_row, int) or per_row < 1:
         _fail(source, f"{key}.per_row", f"expected a positive integer, got {_shown(per_row)}")
-    return (_point(value["at"], source, f"{key}.at", 3), _point(value["step"], source, f"{key}.step", 3), per_row,
-            _point(value.get("row_step", [0, 0, 0]), source, f"{key}.row_step", 3))
+    return (
+        _point(value["at"], source, f"{key}.at", 3),
+        _point(value["step"], source, f"{key}.step", 3),
+        per_row,
+        _point(value.get("row_step", [0, 0, 0]), source, f"{key}.row_step", 3),
+    )
 
 
 def parse_job(data, source: str) -> JobSpec | None:
@@ -175,7 +234,11 @@ def parse_job(data, source: str) -> JobSpec | None:
         return None
     if not isinstance(job, dict) or set(job) - _KEYS:
         unknown = sorted(set(job) - _KEYS) if isinstance(job, dict) else []
-        _fail(source, "job", f"expected keys among {sorted(_KEYS)}" + (f"; unknown {unknown}" if unknown else ""))
+        _fail(
+            source,
+            "job",
+            f"expected keys among {sorted(_KEYS)}" + (f"; unknown {unknown}" if unknown else ""),
+        )
     steps = job.get("steps")
     kinds = {names: kind for kind, names in JOB_KINDS.items()}
     if not isinstance(steps, list) or tuple(steps) not in kinds:
@@ -186,19 +249,37 @@ def parse_job(data, source: str) -> JobSpec | None:
     if order not in ("listed", "shortest"):
         _fail(source, "job.order", f'expected "listed" or "shortest", got {_shown(order)}')
     if kind == "unscrew" and "bin" not in job:
-        _fail(source, "job.bin", "unscrewing drops each nut into a bin: give where it stands (its bottom's centre) "
-                                 "and its inner size")
+        _fail(
+            source,
+            "job.bin",
+            "unscrewing drops each nut into a bin: give where it stands (its bottom's centre) "
+            "and its inner size",
+        )
     if kind != "unscrew" and "rack" not in job:
-        _fail(source, "job.rack", "a part is placed in a rack slot: give the first slot and the step between slots")
+        _fail(
+            source,
+            "job.rack",
+            "a part is placed in a rack slot: give the first slot and the step between slots",
+        )
     transfer = job.get("transfer", "dmp")
     if transfer not in ("dmp", "similarity"):
         _fail(source, "job.transfer", f'expected "dmp" or "similarity", got {_shown(transfer)}')
-    numbers = {name: _positive(job[name], source, f"job.{name}") for name in
-               ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance") if name in job}
+    numbers = {
+        name: _positive(job[name], source, f"job.{name}")
+        for name in ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance")
+        if name in job
+    }
     units = data.get("units", "mm") if isinstance(data.get("units", "mm"), str) else "mm"
-    return JobSpec(kind=kind, steps=tuple(steps), order=order, transfer=transfer,
-                   bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
-                   rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None, units=units, **numbers)
+    return JobSpec(
+        kind=kind,
+        steps=tuple(steps),
+        order=order,
+        transfer=transfer,
+        bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
+        rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None,
+        units=units,
+        **numbers,
+    )
 
 
 def tour(points: np.ndarray, start: np.ndarray) -> list[int]:
@@ -231,7 +312,7 @@ def tour(points: np.ndarray, start: np.ndarray) -> list[int]:
         improved = False
         for i in range(n - 1):
             for j in range(i + 1, n):
-                candidate = order[:i] + order[i:j + 1][::-1] + order[j + 1:]
+                candidate = order[:i] + order[i : j + 1][::-1] + order[j + 1 :]
                 if length(candidate) < length(order) - 1e-9:
                     order, improved = candidate, True
     return order

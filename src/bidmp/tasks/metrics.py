@@ -19,13 +19,26 @@ from .._checks import (
 )
 from .._trajectory import path_extent, rmse
 
-__all__ = ["rmse", "path_extent", "endpoint_error", "approach_error", "axis_deviation", "path_difference", "swept_area", "final_approach_mask"]
+__all__ = [
+    "rmse",
+    "path_extent",
+    "endpoint_error",
+    "approach_error",
+    "axis_deviation",
+    "path_difference",
+    "swept_area",
+    "final_approach_mask",
+]
 
 
 def endpoint_error(trajectory, target) -> float:
     """Distance between the last point of ``trajectory`` (n, D) and ``target`` (D,)."""
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
-    return float(np.linalg.norm(trajectory[-1] - as_point(target, trajectory.shape[1], "target", like="trajectory")))
+    return float(
+        np.linalg.norm(
+            trajectory[-1] - as_point(target, trajectory.shape[1], "target", like="trajectory")
+        )
+    )
 
 
 # Of the band's height: the most a final approach may rise when no tolerance is given (0.15 mm of the
@@ -33,7 +46,9 @@ def endpoint_error(trajectory, target) -> float:
 LIFT_TOLERANCE = 0.15 / 28.5
 
 
-def final_approach_mask(heights: np.ndarray, height: float, rise: float | None = None) -> np.ndarray | None:
+def final_approach_mask(
+    heights: np.ndarray, height: float, rise: float | None = None
+) -> np.ndarray | None:
     """The samples of the final approach: from the last sample at or above ``height`` (the motion's
     final entry into the band, from above) to the end, inside the band, a monotone descent: no rise
     within it by more than ``rise`` (default :data:`LIFT_TOLERANCE` of ``height``) above the lowest
@@ -67,7 +82,9 @@ def final_approach_mask(heights: np.ndarray, height: float, rise: float | None =
     return mask
 
 
-def approach_error(trajectory, target, height: float, axis=None, rise: float | None = None) -> float:
+def approach_error(
+    trajectory, target, height: float, axis=None, rise: float | None = None
+) -> float:
     """Largest distance from the target's axis over the final approach: the
     motion's final descent along the axis from ``height`` above the target into it
     (:func:`final_approach_mask`). ``inf`` when the motion has no such descent: a pass through the
@@ -87,7 +104,9 @@ def approach_error(trajectory, target, height: float, axis=None, rise: float | N
     """
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     if trajectory.shape[1] != 3:
-        raise ValueError(f"approach_error needs a 3-D trajectory (z is the height), got D = {trajectory.shape[1]}")
+        raise ValueError(
+            f"approach_error needs a 3-D trajectory (z is the height), got D = {trajectory.shape[1]}"
+        )
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)
@@ -113,7 +132,9 @@ def _unit_axis(axis) -> np.ndarray:
     return axis / norm
 
 
-def axis_deviation(trajectory, orientations, target, height: float, axis=None, rise: float | None = None) -> float:
+def axis_deviation(
+    trajectory, orientations, target, height: float, axis=None, rise: float | None = None
+) -> float:
     """Largest angle (degrees) between the tool's axis and the target's axis over the final
     approach (:func:`final_approach_mask`, ``height`` along ``axis``, default +z); ``inf`` when the
     motion has none. The tool's axis is the z axis of each orientation (quaternions x, y, z, w),
@@ -123,7 +144,9 @@ def axis_deviation(trajectory, orientations, target, height: float, axis=None, r
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     q = _as_bounded_array(orientations, "orientations", max_ndim=2)
     if q.shape != (trajectory.shape[0], 4):
-        raise ValueError(f"orientations must have shape ({trajectory.shape[0]}, 4), one per row of trajectory, got {q.shape}")
+        raise ValueError(
+            f"orientations must have shape ({trajectory.shape[0]}, 4), one per row of trajectory, got {q.shape}"
+        )
     _check_finite(q, "orientations")
     if np.any(np.linalg.norm(q, axis=1) < 1e-12):
         raise ValueError("orientations contains a zero quaternion, which is no rotation")
@@ -147,8 +170,10 @@ def path_difference(trajectory, reference) -> float:
     trajectory = as_trajectory(trajectory, "trajectory", min_points=1, allow_static=True)
     reference = as_trajectory(reference, "reference", min_points=1, allow_static=True)
     if trajectory.shape[0] < reference.shape[0] or trajectory.shape[1] != reference.shape[1]:
-        raise ValueError(f"trajectory {trajectory.shape} must cover reference {reference.shape}: at least as many "
-                         f"samples, the same D")
+        raise ValueError(
+            f"trajectory {trajectory.shape} must cover reference {reference.shape}: at least as many "
+            f"samples, the same D"
+        )
     return float(np.sum(np.linalg.norm(trajectory[: reference.shape[0]] - reference, axis=1)))
 
 
@@ -160,9 +185,13 @@ def swept_area(trajectory, reference) -> float:
     trajectory = as_trajectory(trajectory, "trajectory", min_points=2, allow_static=True)
     reference = as_trajectory(reference, "reference", min_points=2, allow_static=True)
     if trajectory.shape != reference.shape or trajectory.shape[1] != 2:
-        raise ValueError(f"trajectory and reference must be 2-D curves (T, 2) of the same length, got "
-                         f"{trajectory.shape} and {reference.shape}")
-    corners = np.stack([reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1)  # (T-1, 4, 2)
+        raise ValueError(
+            f"trajectory and reference must be 2-D curves (T, 2) of the same length, got "
+            f"{trajectory.shape} and {reference.shape}"
+        )
+    corners = np.stack(
+        [reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1
+    )  # (T-1, 4, 2)
     x, y = corners[..., 0], corners[..., 1]
     twice = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
     return float(np.sum(np.abs(twice)) / 2.0)

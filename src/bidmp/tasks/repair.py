@@ -37,7 +37,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_labels, as_point, as_trajectory, as_vector, check_options, check_real, check_seed, short_token
+from .._checks import (
+    as_labels,
+    as_point,
+    as_trajectory,
+    as_vector,
+    check_options,
+    check_real,
+    check_seed,
+    short_token,
+)
 from .contract import Contract, Verdict
 
 __all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance"]
@@ -76,7 +85,12 @@ class Attempt:
     note: str = ""
 
     def to_dict(self) -> dict:
-        return {"how": self.how, "ok": self.ok, "seconds": round(self.seconds, 4), "note": self.note}
+        return {
+            "how": self.how,
+            "ok": self.ok,
+            "seconds": round(self.seconds, 4),
+            "note": self.note,
+        }
 
 
 @dataclass
@@ -107,7 +121,11 @@ class Repaired:
         return self.verdict.reason() + (f"; repairs tried: {tried}" if tried else "")
 
     def to_dict(self) -> dict:
-        return {"how": self.how, "refused": self.refused, "attempts": [a.to_dict() for a in self.attempts]}
+        return {
+            "how": self.how,
+            "refused": self.refused,
+            "attempts": [a.to_dict() for a in self.attempts],
+        }
 
 
 def _is_bidmp(model) -> bool:
@@ -142,19 +160,36 @@ class Repairer:
         Parameters of a Bi-DMP built when the model is a plain DMP (``extend`` needs one).
     """
 
-    def __init__(self, contract: Contract, demonstration, *, extension: dict | None = None, seed: int = 0,
-                 order=REPAIRS, allowance: float = 0.0, bidmp: dict | None = None) -> None:
+    def __init__(
+        self,
+        contract: Contract,
+        demonstration,
+        *,
+        extension: dict | None = None,
+        seed: int = 0,
+        order=REPAIRS,
+        allowance: float = 0.0,
+        bidmp: dict | None = None,
+    ) -> None:
         if not isinstance(contract, Contract):
-            raise TypeError(f"contract must be a bidmp.tasks.Contract, got {type(contract).__name__}")
+            raise TypeError(
+                f"contract must be a bidmp.tasks.Contract, got {type(contract).__name__}"
+            )
         order = as_labels(order, "order")
         unknown = [how for how in order if how not in REPAIRS]
         if unknown:
-            raise ValueError(f"order names {short_token(unknown[0], 20)}, which is no repair (known: {', '.join(REPAIRS)})")
+            raise ValueError(
+                f"order names {short_token(unknown[0], 20)}, which is no repair (known: {', '.join(REPAIRS)})"
+            )
         if contract.scene is None:
-            raise ValueError("contract: repairs need the contract's scene, the parts a motion is kept away from")
+            raise ValueError(
+                "contract: repairs need the contract's scene, the parts a motion is kept away from"
+            )
         self.contract = contract
         self.demonstration = as_trajectory(demonstration, "demonstration")
-        self.extension = {k: v for k, v in check_options(extension, "extension").items() if k != "approach"}
+        self.extension = {
+            k: v for k, v in check_options(extension, "extension").items() if k != "approach"
+        }
         check_seed(seed, "seed")
         self.seed, self.order, self.bidmp = seed, tuple(order), check_options(bidmp, "bidmp")
         self.allowance = check_real(allowance, "allowance", nonnegative=True)
@@ -164,15 +199,25 @@ class Repairer:
         """The contract with the scene's margin widened by ``extra`` (at most the tool's radius)."""
         scene = copy.copy(self.contract.scene)
         scene.margin = min(scene.margin + max(extra, 0.0), scene.tool.radius)
-        return Contract(self.contract.threshold, self.contract.approach_height, scene, self.contract.units,
-                        self.contract.alignment_threshold, self.contract.limits)
+        return Contract(
+            self.contract.threshold,
+            self.contract.approach_height,
+            scene,
+            self.contract.units,
+            self.contract.alignment_threshold,
+            self.contract.limits,
+        )
 
     # -- the judgement -----------------------------------------------------------------------------
-    def _judge(self, contract: Contract, motion, goal, label, axis, exclude, carried=None) -> Verdict:
+    def _judge(
+        self, contract: Contract, motion, goal, label, axis, exclude, carried=None
+    ) -> Verdict:
         clearance = None
         if contract.scene is not None and carried:
             clearance = self._clearance(contract.scene, np.asarray(motion)[:, :3], exclude, carried)
-        return contract.judge(motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance)
+        return contract.judge(
+            motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance
+        )
 
     def blocked(self, goal, axis, exclude) -> str:
         """Why no motion can keep the contract at ``goal`` (empty when one may): the tool coming
@@ -186,19 +231,40 @@ class Repairer:
             from scipy.spatial.transform import Rotation
 
             turn, _ = Rotation.align_vectors([-axis], [[0.0, 0.0, -1.0]])
-            orientations = np.repeat((turn * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()[None], 2, axis=0)
-        clearance = contract.scene.clearance(corridor, exclude=list(exclude), orientations=orientations)
+            orientations = np.repeat(
+                (turn * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])).as_quat()[None], 2, axis=0
+            )
+        clearance = contract.scene.clearance(
+            corridor, exclude=list(exclude), orientations=orientations
+        )
         if clearance.clear:
             return ""
         unit = contract.units or "units"
-        depth = (f"cuts {-clearance.distance:.2f} {unit} into" if clearance.distance < 0
-                 else f"passes {clearance.distance:.2f} {unit} from")
-        return (f"no motion can engage it: the tool coming straight down onto it {depth} {clearance.part} "
-                f"(the margin is {clearance.margin:g} {unit})")
+        depth = (
+            f"cuts {-clearance.distance:.2f} {unit} into"
+            if clearance.distance < 0
+            else f"passes {clearance.distance:.2f} {unit} from"
+        )
+        return (
+            f"no motion can engage it: the tool coming straight down onto it {depth} {clearance.part} "
+            f"(the margin is {clearance.margin:g} {unit})"
+        )
 
     # -- repairing -----------------------------------------------------------------------------------
-    def repair(self, model, goal, label: str, *, start=None, axis=None, exclude=(), motion=None, verdict=None,
-               skill="nearest", carried=None) -> Repaired:
+    def repair(
+        self,
+        model,
+        goal,
+        label: str,
+        *,
+        start=None,
+        axis=None,
+        exclude=(),
+        motion=None,
+        verdict=None,
+        skill="nearest",
+        carried=None,
+    ) -> Repaired:
         """The motion of ``model`` (a DMP or Bi-DMP) to ``goal`` kept within the contract, or why not.
 
         ``motion`` and ``verdict``: the method's own motion and its verdict when the caller has
@@ -207,7 +273,9 @@ class Repairer:
         """
         goal, axis, exclude = _target_args(goal, axis, exclude)
         if not isinstance(label, str):
-            raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
+            raise TypeError(
+                f"label must be the target's name (a string), got {type(label).__name__}"
+            )
         if not hasattr(model, "trajectory"):
             raise TypeError(f"model must be a fitted DMP or Bi-DMP, got {type(model).__name__}")
         if motion is None:
@@ -217,7 +285,9 @@ class Repairer:
         out = Repaired(np.asarray(motion), verdict)
         if verdict.ok:
             return out
-        refused = self.blocked(goal, axis, exclude) if self.contract.approach_height is not None else ""
+        refused = (
+            self.blocked(goal, axis, exclude) if self.contract.approach_height is not None else ""
+        )
         if refused:
             out.refused = f"the motion to {label} cannot be repaired: {refused}"
             logger.info("%s", out.refused)
@@ -227,21 +297,46 @@ class Repairer:
         for how in self.order:
             if how in ("lift", "avoid") and not only_clearance:
                 continue  # a lift or a steer does not bring a motion that misses its target onto it
-            if how in ("extend", "margin") and not _is_bidmp(model) and not self.bidmp_possible(model):
+            if (
+                how in ("extend", "margin")
+                and not _is_bidmp(model)
+                and not self.bidmp_possible(model)
+            ):
                 continue
             started = time.perf_counter()
             try:
-                found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried,
-                                  verdict.clearance if motion is out.motion and how == "lift" else None)
+                found = self._try(
+                    how,
+                    model,
+                    goal,
+                    label,
+                    start,
+                    axis,
+                    exclude,
+                    skill,
+                    shortfall,
+                    carried,
+                    verdict.clearance if motion is out.motion and how == "lift" else None,
+                )
             except ValueError as exc:  # a via-point refused, an avoidance miss, no free route ...
-                out.attempts.append(Attempt(how, False, time.perf_counter() - started, _first_line(exc)))
+                out.attempts.append(
+                    Attempt(how, False, time.perf_counter() - started, _first_line(exc))
+                )
                 continue
             candidate, trial, trial_skill, planned = found
             final = self._judge(self.contract, candidate, goal, label, axis, exclude, carried)
             ok = final.ok and planned.ok
-            out.attempts.append(Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason()))
+            out.attempts.append(
+                Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason())
+            )
             if ok:
-                out.motion, out.verdict, out.how, out.model, out.skill = candidate, final, how, trial, trial_skill
+                out.motion, out.verdict, out.how, out.model, out.skill = (
+                    candidate,
+                    final,
+                    how,
+                    trial,
+                    trial_skill,
+                )
                 logger.info("the motion to %s kept the contract after %s", label, how)
                 return out
             if planned.clearance is not None:
@@ -253,20 +348,48 @@ class Repairer:
         """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP)."""
         return hasattr(model, "weights_") and hasattr(model, "n_steps_")
 
-    def _try(self, how, model, goal, label, start, axis, exclude, skill, shortfall, carried=None, known=None):
+    def _try(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+        self,
+        how,
+        model,
+        goal,
+        label,
+        start,
+        axis,
+        exclude,
+        skill,
+        shortfall,
+        carried=None,
+        known=None,
+    ):
         """``(motion, model, skill, verdict on the planning contract)`` of one repair (``known``: the
         method's own motion's clearance, where it has one: the lift's first round)."""
         if how == "lift":
-            motion, clearance = self._lift(model, goal, label, start, axis, exclude, skill, carried, known)
-            return motion, None, None, self.planning.judge(motion, goal, label=label, axis=axis, exclude=exclude,
-                                                           clearance=clearance)
+            motion, clearance = self._lift(
+                model, goal, label, start, axis, exclude, skill, carried, known
+            )
+            return (
+                motion,
+                None,
+                None,
+                self.planning.judge(
+                    motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance
+                ),
+            )
         if how == "avoid":
             from ..primitives.avoidance import SceneAvoidance
 
             scene = self.planning.scene
-            term = SceneAvoidance(scene, margin=scene.margin, target=label if label in scene.labels else None)
+            term = SceneAvoidance(
+                scene, margin=scene.margin, target=label if label in scene.labels else None
+            )
             motion = _trajectory(model, goal, start, skill, coupling=[term]).y
-            return motion, None, None, self._judge(self.planning, motion, goal, label, axis, exclude, carried)
+            return (
+                motion,
+                None,
+                None,
+                self._judge(self.planning, motion, goal, label, axis, exclude, carried),
+            )
         widen = self.allowance + (shortfall if how == "margin" else 0.0)
         attempts = _WIDENINGS if how == "margin" else 1
         for _ in range(attempts):
@@ -288,13 +411,21 @@ class Repairer:
         from ..incremental.bidmp import BiDMP
 
         dmp = model.dmp_ if _is_bidmp(model) else model  # the DMP fitted on the demonstration
-        trial = copy.deepcopy(model) if _is_bidmp(model) else BiDMP(copy.deepcopy(model), **self.bidmp)
+        trial = (
+            copy.deepcopy(model) if _is_bidmp(model) else BiDMP(copy.deepcopy(model), **self.bidmp)
+        )
         source, duration = self.demonstration, None
         if start is not None:
             own = _trajectory(model, goal, start, skill)
             source, duration = own.y[:, :3], float(own.t[-1])
-        extension = extend_demonstration(source, goal[:3], seed=self.seed, scene=planning.scene, **self.extension)
-        scale = 1.0 if duration is None else duration / dmp.duration_ * (dmp.n_steps_ - 1) / (source.shape[0] - 1)
+        extension = extend_demonstration(
+            source, goal[:3], seed=self.seed, scene=planning.scene, **self.extension
+        )
+        scale = (
+            1.0
+            if duration is None
+            else duration / dmp.duration_ * (dmp.n_steps_ - 1) / (source.shape[0] - 1)
+        )
         trial.learn(extension.complete, duration=extension.duration_for(dmp) * scale)
         return trial, trial.n_skills - 1
 
@@ -314,9 +445,13 @@ class Repairer:
         until = max(min(final, _motion_duration(model, goal, skill)), 2.0 * earliest)
         latest = until - 0.2 * (until - earliest)
         via: dict = {}
-        band = scene.margin + scene.tool.radius  # the tool's mouth this close to a part's box is near it
+        band = (
+            scene.margin + scene.tool.radius
+        )  # the tool's mouth this close to a part's box is near it
         for round_ in range(_MAX_ROUNDS):
-            if round_ == 0 and known is not None and not carried:  # the same motion: its distances are known
+            if (
+                round_ == 0 and known is not None and not carried
+            ):  # the same motion: its distances are known
                 clearance = type(known)(known.distance, known.part, known.point, scene.margin)
             else:
                 clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
@@ -325,17 +460,27 @@ class Repairer:
             owner = _owner(scene, clearance.part)
             path = trajectory.y[:, :3]
             height = _depth(carried)
-            near = scene.near(path, owner, band) | scene.near(path - [0.0, 0.0, height], owner, band)
+            near = scene.near(path, owner, band) | scene.near(
+                path - [0.0, 0.0, height], owner, band
+            )
             before = (trajectory.t <= latest) & (trajectory.t >= earliest)
             if not np.any(near & before):
-                raise ValueError(f"it comes too close to {clearance.part} within its final approach: no lift helps")
+                raise ValueError(
+                    f"it comes too close to {clearance.part} within its final approach: no lift helps"
+                )
             top = float(scene.bounds(owner)[1][2]) + scene.margin + 0.5 * scene.tool.radius + height
             stretch = np.flatnonzero(near & before)
-            for index in np.unique(np.linspace(stretch[0], stretch[-1], min(_STRETCH, stretch.size)).round().astype(int)):
+            for index in np.unique(
+                np.linspace(stretch[0], stretch[-1], min(_STRETCH, stretch.size))
+                .round()
+                .astype(int)
+            ):
                 point = trajectory.y[index].copy()
                 point[2] = max(point[2], top)
                 via[round(float(trajectory.t[index]), 12)] = point
-            trajectory = _trajectory(model, goal, start, skill, via=sorted(via.items()), via_until=until)
+            trajectory = _trajectory(
+                model, goal, start, skill, via=sorted(via.items()), via_until=until
+            )
         clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
         if clearance.clear:
             return trajectory.y, clearance
@@ -365,8 +510,14 @@ def carried_clearance(scene, path, exclude, carried=None, support=(), orientatio
         return clearance
     from ..scene import Solid
 
-    if not isinstance(carried, (tuple, list)) or len(carried) != 2 or not isinstance(carried[0], Solid):
-        raise TypeError(f"carried must be (a scene Solid, its offset (3,)) or None, got {short_token(carried, 30)}")
+    if (
+        not isinstance(carried, (tuple, list))
+        or len(carried) != 2
+        or not isinstance(carried[0], Solid)
+    ):
+        raise TypeError(
+            f"carried must be (a scene Solid, its offset (3,)) or None, got {short_token(carried, 30)}"
+        )
     solid, offset = carried
     body = scene.body_clearance(solid, path[:, :3], offset, exclude=exclude + support)
     body = type(body)(body.distance, body.part, body.point, scene.margin)
@@ -378,7 +529,9 @@ def _depth(carried) -> float:
     if not carried:
         return 0.0
     solid, offset = carried
-    return max(float(np.asarray(solid.centre)[2] - np.asarray(solid.lower)[2] - np.asarray(offset)[2]), 0.0)
+    return max(
+        float(np.asarray(solid.centre)[2] - np.asarray(solid.lower)[2] - np.asarray(offset)[2]), 0.0
+    )
 
 
 def _motion_duration(model, goal, skill) -> float:

@@ -29,12 +29,17 @@ class MethodResult:
     differences: dict
     success_threshold: float
     n_steps: int
-    clearances: dict | None = None  # label -> Clearance, or None where the scene does not apply; None without a scene
+    # label -> Clearance, or None where the scene does not apply; None without a scene
+    clearances: dict | None = None
     orientations: dict | None = None  # pose scenarios: label -> (n, 4) quaternions of the rollout
-    axis_deviations: dict | None = None  # pose scenarios: label -> degrees between tool and target axes
+    # pose scenarios: label -> degrees between tool and target axes
+    axis_deviations: dict | None = None
     alignment_threshold: float = 2.0
-    verdicts: dict | None = None  # label -> bidmp.tasks.contract.Verdict: the contract's judgement of each motion
-    repairs: dict = field(default_factory=dict)  # label -> bidmp.tasks.repair.Repaired, where a repair was tried
+    # label -> bidmp.tasks.contract.Verdict: the contract's judgement of each motion
+    verdicts: dict | None = None
+    repairs: dict = field(
+        default_factory=dict
+    )  # label -> bidmp.tasks.repair.Repaired, where a repair was tried
 
     @property
     def successes(self) -> int:
@@ -57,8 +62,12 @@ class MethodResult:
         if self.verdicts is not None:
             return self.verdicts[label].ok
         clearance = self.clearance_at(label)
-        return bool(self.errors[label] <= self.success_threshold and self.engaged_at(label) is not False
-                    and (clearance is None or clearance.clear) and self.aligned_at(label) is not False)
+        return bool(
+            self.errors[label] <= self.success_threshold
+            and self.engaged_at(label) is not False
+            and (clearance is None or clearance.clear)
+            and self.aligned_at(label) is not False
+        )
 
     def reason_at(self, label: str) -> str:
         """Why the motion to ``label`` breaks the contract, in one sentence (empty when it does not)."""
@@ -85,7 +94,11 @@ class MethodResult:
 
     @property
     def aligned(self) -> int | None:
-        return None if self.axis_deviations is None else sum(bool(self.aligned_at(label)) for label in self.errors)
+        return (
+            None
+            if self.axis_deviations is None
+            else sum(bool(self.aligned_at(label)) for label in self.errors)
+        )
 
     @property
     def task_successes(self) -> int:
@@ -93,16 +106,28 @@ class MethodResult:
 
     @property
     def engaged(self) -> int | None:
-        return None if self.approach_errors is None else sum(bool(self.engaged_at(label)) for label in self.errors)
+        return (
+            None
+            if self.approach_errors is None
+            else sum(bool(self.engaged_at(label)) for label in self.errors)
+        )
 
     @property
     def checked(self) -> list[str]:
         """Labels whose motion was checked against the scene."""
-        return [] if self.clearances is None else [label for label, c in self.clearances.items() if c is not None]
+        return (
+            []
+            if self.clearances is None
+            else [label for label, c in self.clearances.items() if c is not None]
+        )
 
     @property
     def collision_free(self) -> int | None:
-        return None if self.clearances is None else sum(self.clearances[label].clear for label in self.checked)
+        return (
+            None
+            if self.clearances is None
+            else sum(self.clearances[label].clear for label in self.checked)
+        )
 
     @property
     def worst_clearance(self):
@@ -114,8 +139,11 @@ class MethodResult:
     def approach_successes(self) -> int | None:
         if self.approach_errors is None:
             return None
-        return sum(self.errors[label] <= self.success_threshold and self.approach_errors[label] <= self.success_threshold
-                   for label in self.errors)
+        return sum(
+            self.errors[label] <= self.success_threshold
+            and self.approach_errors[label] <= self.success_threshold
+            for label in self.errors
+        )
 
     def to_dict(self) -> dict:
         n_targets = len(self.errors)
@@ -124,9 +152,14 @@ class MethodResult:
             "successes": self.successes,
             "n_targets": n_targets,
             "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
-            "approach_errors": None if self.approach_errors is None else {label: _json_length(e) for label, e in self.approach_errors.items()},
+            "approach_errors": None
+            if self.approach_errors is None
+            else {label: _json_length(e) for label, e in self.approach_errors.items()},
             "max_error": round(float(max(self.errors.values())), 4),
-            "difference_range": [round(float(min(self.differences.values())), 2), round(float(max(self.differences.values())), 2)],
+            "difference_range": [
+                round(float(min(self.differences.values())), 2),
+                round(float(max(self.differences.values())), 2),
+            ],
             "runtime_s": round(self.runtime_s, 5),
             "n_steps": self.n_steps,
         }
@@ -134,27 +167,33 @@ class MethodResult:
             out["approach_successes"] = self.approach_successes
             out["approach_success_rate"] = round(self.approach_successes / n_targets, 4)
         worst = self.worst_clearance
-        out.update({
-            "task_successes": self.task_successes,
-            "engaged": self.engaged,
-            "collision_free": self.collision_free,
-            "n_checked": None if self.clearances is None else len(self.checked),
-            "min_clearance": None if worst is None else _json_length(worst.distance),
-            "min_clearance_part": None if worst is None else worst.part,
-            "aligned": self.aligned,
-        })
+        out.update(
+            {
+                "task_successes": self.task_successes,
+                "engaged": self.engaged,
+                "collision_free": self.collision_free,
+                "n_checked": None if self.clearances is None else len(self.checked),
+                "min_clearance": None if worst is None else _json_length(worst.distance),
+                "min_clearance_part": None if worst is None else worst.part,
+                "aligned": self.aligned,
+            }
+        )
         targets = {}
         for label, error in self.errors.items():
             clearance = self.clearance_at(label)
             targets[label] = {
                 "error": round(float(error), 4),
-                "approach_error": None if self.approach_errors is None else _json_length(self.approach_errors[label]),
+                "approach_error": None
+                if self.approach_errors is None
+                else _json_length(self.approach_errors[label]),
                 "engaged": self.engaged_at(label),
                 "clearance": None if clearance is None else _json_length(clearance.distance),
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
-                "axis_deviation": None if self.axis_deviations is None else _json_length(self.axis_deviations[label]),
+                "axis_deviation": None
+                if self.axis_deviations is None
+                else _json_length(self.axis_deviations[label]),
                 "reason": self.reason_at(label),
                 "repair": None if label not in self.repairs else self.repairs[label].to_dict(),
             }
@@ -172,9 +211,15 @@ class Report:
     extension_targets: list = field(default_factory=list)
     failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
     model: object = None  # the Bi-DMP
-    fitted: dict = field(default_factory=dict)  # method name -> its fitted model (the simulator's closed loop)
-    route_failures: list = field(default_factory=list)  # extension stages with no free route: {target, reason}
-    forgetting: dict = field(default_factory=dict)  # skill -> ForgettingResult (several demonstrations)
+    fitted: dict = field(
+        default_factory=dict
+    )  # method name -> its fitted model (the simulator's closed loop)
+    route_failures: list = field(
+        default_factory=list
+    )  # extension stages with no free route: {target, reason}
+    forgetting: dict = field(
+        default_factory=dict
+    )  # skill -> ForgettingResult (several demonstrations)
 
     def to_dict(self) -> dict:
         """The report JSON: per method its counts and per target its verdict (plus the extension and forgetting details)."""
@@ -186,10 +231,14 @@ class Report:
             "methods": {name: result.to_dict() for name, result in self.methods.items()},
         }
         if self.extension_targets:
-            out["extension_targets"] = [np.asarray(t).round(4).tolist() for t in self.extension_targets]
+            out["extension_targets"] = [
+                np.asarray(t).round(4).tolist() for t in self.extension_targets
+            ]
             out["failed_targets"] = list(self.failed_targets)
         if self.forgetting:
-            out["forgetting"] = {skill: result.to_dict() for skill, result in self.forgetting.items()}
+            out["forgetting"] = {
+                skill: result.to_dict() for skill, result in self.forgetting.items()
+            }
         if self.route_failures:
             out["route_failures"] = list(self.route_failures)
         return out
@@ -197,7 +246,11 @@ class Report:
     def failed(self, methods=None) -> int:
         """Targets whose motion breaks the contract, over ``methods`` (default every method run)."""
         names = self.methods if methods is None else [m for m in methods if m in self.methods]
-        return sum(not self.methods[m].task_success_at(label) for m in names for label in self.methods[m].errors)
+        return sum(
+            not self.methods[m].task_success_at(label)
+            for m in names
+            for label in self.methods[m].errors
+        )
 
     # -- tables ------------------------------------------------------------------------------
     def method_rows(self, runtimes: bool = True) -> tuple[list[str], list[list[str]]]:
@@ -206,8 +259,11 @@ class Report:
         (end point ∧ engaged ∧ collision-free) beside the paper's end-point success."""
         geometry = any(result.clearances is not None for result in self.methods.values())
         poses = any(result.axis_deviations is not None for result in self.methods.values())
-        header = ["method", "success rate", "successes", "engaged"] + (["aligned"] if poses else []) + \
-            ["max error", "difference range"]
+        header = (
+            ["method", "success rate", "successes", "engaged"]
+            + (["aligned"] if poses else [])
+            + ["max error", "difference range"]
+        )
         if geometry:
             header += ["collision-free", "min clearance (part)", "task success"]
         if runtimes:
@@ -220,10 +276,21 @@ class Report:
             row = [name, f"{100 * data['success_rate']:.2f} %", f"{data['successes']}/{n}", engaged]
             if poses:
                 row.append(f"{data['aligned']}/{n}")
-            row += [f"{data['max_error']:.3f}", f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}"]
+            row += [
+                f"{data['max_error']:.3f}",
+                f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}",
+            ]
             if geometry:
-                worst = "-" if data["min_clearance"] is None else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
-                row += [f"{data['collision_free']}/{data['n_checked']}", worst, f"{data['task_successes']}/{n}"]
+                worst = (
+                    "-"
+                    if data["min_clearance"] is None
+                    else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
+                )
+                row += [
+                    f"{data['collision_free']}/{data['n_checked']}",
+                    worst,
+                    f"{data['task_successes']}/{n}",
+                ]
             if runtimes:
                 row.append(f"{data['runtime_s']:.4f}")
             rows.append(row)
@@ -248,38 +315,71 @@ class Report:
         this is the first run in the process)."""
         scenario = self.scenario
         units = scenario.units
-        lines = [f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
-                 f"success = end-point error <= {scenario.success_threshold:g} {units}"]
+        lines = [
+            f"{scenario.name}: {len(scenario.targets)} targets, demonstrated '{scenario.demonstrated}', "
+            f"success = end-point error <= {scenario.success_threshold:g} {units}"
+        ]
         if any(result.clearances is not None for result in self.methods.values()):
-            engaged = (f"engaged (a final descent along the target's axis, within {scenario.success_threshold:g} {units} of "
-                       f"it over the last {scenario.approach_height:g} {units}) and " if scenario.approach_height is not None else "")
-            lines.append(f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "
-                         f"{units}, clearance to every part but the target)")
+            engaged = (
+                f"engaged (a final descent along the target's axis, within {scenario.success_threshold:g} {units} of "
+                f"it over the last {scenario.approach_height:g} {units}) and "
+                if scenario.approach_height is not None
+                else ""
+            )
+            lines.append(
+                f"task success = success and {engaged}collision-free (tool radius {scenario.scene.tool.radius:g} "
+                f"{units}, clearance to every part but the target)"
+            )
         if self.extension_targets:
-            lines.append(f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
-                         + ", ".join(np.array2string(np.asarray(t), precision=1) for t in self.extension_targets))
+            lines.append(
+                f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
+                + ", ".join(
+                    np.array2string(np.asarray(t), precision=1) for t in self.extension_targets
+                )
+            )
         for failure in self.route_failures:
             lines.append(f"no extension to {failure['target']}: {failure['reason']}")
-        lines += ["", f"Table 4 analogue (errors in {units}; run time in s, measured in this run)", text_table(*self.method_rows())]
-        lines += ["", f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)", text_table(*self.target_rows())]
+        lines += [
+            "",
+            f"Table 4 analogue (errors in {units}; run time in s, measured in this run)",
+            text_table(*self.method_rows()),
+        ]
+        lines += [
+            "",
+            f"Tables 1 and 2 analogue: end-point error per target ({units}; x = failure)",
+            text_table(*self.target_rows()),
+        ]
         for name, result in self.methods.items():
             if not result.repairs:
                 continue
-            hows = [result.repaired_at(label) for label in result.repairs if result.repaired_at(label)]
+            hows = [
+                result.repaired_at(label) for label in result.repairs if result.repaired_at(label)
+            ]
             counts = ", ".join(f"{how} {hows.count(how)}" for how in dict.fromkeys(hows))
             failed = [label for label in result.errors if not result.task_success_at(label)]
-            lines += ["", f"{name}: {len(hows)} of {len(result.errors)} motions repaired to keep the contract"
-                          + (f" ({counts})" if counts else "")
-                          + (f"; {len(failed)} still fail:" if failed else "")]
+            lines += [
+                "",
+                f"{name}: {len(hows)} of {len(result.errors)} motions repaired to keep the contract"
+                + (f" ({counts})" if counts else "")
+                + (f"; {len(failed)} still fail:" if failed else ""),
+            ]
             lines += [f"  {label}: {result.reason_at(label)}" for label in failed]
         if self.forgetting:
-            lines += ["", f"forgetting (error after learning every demonstration minus error when learned, {units}):"]
-            lines += [f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting) for skill, result in self.forgetting.items()]
+            lines += [
+                "",
+                f"forgetting (error after learning every demonstration minus error when learned, {units}):",
+            ]
+            lines += [
+                f"  skill={skill}: " + ", ".join(f"{v:.3f}" for v in result.forgetting)
+                for skill, result in self.forgetting.items()
+            ]
         return "\n".join(lines)
 
     def markdown(self) -> str:
         """The deterministic part of the report as Markdown (no run times)."""
-        return "\n\n".join([markdown_table(*self.method_rows(runtimes=False)), markdown_table(*self.target_rows())])
+        return "\n\n".join(
+            [markdown_table(*self.method_rows(runtimes=False)), markdown_table(*self.target_rows())]
+        )
 
 
 def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
@@ -296,7 +396,9 @@ def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     with atomic_write(out / "results.json", "w") as handle:
         json.dump(report.to_dict(), handle, indent=2)
-    return [out / "results.json",
-            plot_targets_top_view(out / "targets_top_view.png", report),
-            plot_error_vs_distance(out / "error_vs_distance.png", report),
-            plot_scenario_3d(out / "scenario_3d.png", report)]
+    return [
+        out / "results.json",
+        plot_targets_top_view(out / "targets_top_view.png", report),
+        plot_error_vs_distance(out / "error_vs_distance.png", report),
+        plot_scenario_3d(out / "scenario_3d.png", report),
+    ]

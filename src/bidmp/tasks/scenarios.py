@@ -77,22 +77,80 @@ from ._scenario_fields import (
     _shown,
 )
 
-__all__ = ["Scenario", "ScenarioError", "METHODS", "load", "builtin_names", "builtin_text", "from_dict"]
+__all__ = [
+    "Scenario",
+    "ScenarioError",
+    "METHODS",
+    "load",
+    "builtin_names",
+    "builtin_text",
+    "from_dict",
+]
 
 # The methods a scenario runs when it names none (any registered method may be named: bidmp.tasks.methods).
 METHODS = ("dmp", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm")
 POSE_DIMS = 7  # x, y, z, qx, qy, qz, qw
 _KEYS = {
-    "name", "description", "units", "targets", "demonstrated", "demonstration", "success_threshold",
-    "approach_height", "dmp", "bidmp", "extension", "extension_target", "extensions", "demonstrations", "methods",
-    "seed", "scene", "robot", "alignment_threshold", "job",
+    "name",
+    "description",
+    "units",
+    "targets",
+    "demonstrated",
+    "demonstration",
+    "success_threshold",
+    "approach_height",
+    "dmp",
+    "bidmp",
+    "extension",
+    "extension_target",
+    "extensions",
+    "demonstrations",
+    "methods",
+    "seed",
+    "scene",
+    "robot",
+    "alignment_threshold",
+    "job",
 }
-_DMP_KEYS = {"alpha", "beta", "K", "alpha_phase", "tau", "n_kernels", "regression", "widths", "derivatives", "protocol", "keep_approach",
-             "goal_rate"}
-_BIDMP_KEYS = {"n_windows", "n_mapped", "n_enhance", "increments", "shrink", "reg", "seed", "derivatives"}
+_DMP_KEYS = {
+    "alpha",
+    "beta",
+    "K",
+    "alpha_phase",
+    "tau",
+    "n_kernels",
+    "regression",
+    "widths",
+    "derivatives",
+    "protocol",
+    "keep_approach",
+    "goal_rate",
+}
+_BIDMP_KEYS = {
+    "n_windows",
+    "n_mapped",
+    "n_enhance",
+    "increments",
+    "shrink",
+    "reg",
+    "seed",
+    "derivatives",
+}
 _EXTENSION_KEYS = {
-    "approach", "eps_frac", "method", "n_samples", "sigma_rel", "n_neighbours", "n_compare", "n_iter", "rho", "schedule",
-    "scaling", "compare", "select", "denom",
+    "approach",
+    "eps_frac",
+    "method",
+    "n_samples",
+    "sigma_rel",
+    "n_neighbours",
+    "n_compare",
+    "n_iter",
+    "rho",
+    "schedule",
+    "scaling",
+    "compare",
+    "select",
+    "denom",
 }
 
 
@@ -117,7 +175,8 @@ class Scenario:
     description: str = ""
     spec: dict = field(default_factory=dict, repr=False)
     scene: Scene | None = None
-    alignment_threshold: float = 2.0  # degrees: a pose scenario's tool axis vs the target's over the approach
+    # degrees: a pose scenario's tool axis vs the target's over the approach
+    alignment_threshold: float = 2.0
     robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
     job: object = None  # bidmp.tasks.jobs.JobSpec: the task sequence bidmp job runs
     base_dir: str = "."  # where "file" demonstrations were read from
@@ -133,9 +192,13 @@ class Scenario:
 
     def _check_label(self, label) -> None:
         if not isinstance(label, str):
-            raise TypeError(f"label must be a target's label (a string), got {type(label).__name__}")
+            raise TypeError(
+                f"label must be a target's label (a string), got {type(label).__name__}"
+            )
         if label not in self.targets:
-            raise ValueError(f"label {short_token(label, 20)} is not a target of scenario {short_token(self.name, 30)}")
+            raise ValueError(
+                f"label {short_token(label, 20)} is not a target of scenario {short_token(self.name, 30)}"
+            )
 
     def target_axis(self, label: str) -> np.ndarray | None:
         """A pose target's axis, pointing out of it (the tool comes in along minus it); None for
@@ -168,7 +231,10 @@ class Scenario:
         if self.protocol == "robot":
             return self
         spec = self.to_dict()
-        spec["dmp"] = {"protocol": "robot", **{k: v for k, v in spec["dmp"].items() if k in ("n_kernels", "regression")}}
+        spec["dmp"] = {
+            "protocol": "robot",
+            **{k: v for k, v in spec["dmp"].items() if k in ("n_kernels", "regression")},
+        }
         return from_dict(spec, source=self.name, base_dir=self.base_dir, allow_outside_files=True)
 
     def reference(self, label: str) -> np.ndarray:
@@ -186,7 +252,12 @@ class Scenario:
         generator = self.spec["demonstration"].get("minimum_jerk")
         if generator is not None:
             via = np.asarray(generator["via"], dtype=float) + offset
-            return minimum_jerk(via, generator.get("n_steps", 200), generator.get("noise", 0.0), generator.get("seed", 0))
+            return minimum_jerk(
+                via,
+                generator.get("n_steps", 200),
+                generator.get("noise", 0.0),
+                generator.get("seed", 0),
+            )
         return self.demonstration + offset
 
 
@@ -207,7 +278,7 @@ def _parameters(data, key, known, source, check) -> dict:
     if not isinstance(params, dict):
         _fail(source, key, "expected an object of parameters")
     if key == "dmp" and "fit" in params:
-        _fail(source, "dmp.fit", "renamed to 'regression' (\"lwr\" or \"ridge\")")
+        _fail(source, "dmp.fit", 'renamed to \'regression\' ("lwr" or "ridge")')
     bad = sorted(set(params) - known)
     if bad:
         _fail(source, f"{key}.{bad[0]}", f"unknown parameter (known: {', '.join(sorted(known))})")
@@ -222,38 +293,63 @@ def _parameters(data, key, known, source, check) -> dict:
     return params
 
 
-def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *,
-              allow_outside_files: bool = False) -> Scenario:
+def from_dict(
+    data,
+    source: str = "<dict>",
+    base_dir: str | os.PathLike = ".",
+    *,
+    allow_outside_files: bool = False,
+) -> Scenario:
     """Validate scenario data (as parsed from JSON) and build a :class:`Scenario`.
 
     ``"file"`` demonstrations are read relative to ``base_dir`` and must lie inside it (after
     resolving ``..`` and symlinks) unless ``allow_outside_files`` is true.
     """
     if not isinstance(source, str):
-        raise TypeError(f"source must be a string naming the scenario's origin, got {type(source).__name__}")
+        raise TypeError(
+            f"source must be a string naming the scenario's origin, got {type(source).__name__}"
+        )
     source = short_token(source, 40)[1:-1]
     base_dir = str(check_path(base_dir, "base_dir"))
     allow_outside_files = check_bool(allow_outside_files, "allow_outside_files")
     units = _check_top_level(data, source)
-    demonstration = _demonstration(data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units)
+    demonstration = _demonstration(
+        data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units
+    )
     n_dims = demonstration.shape[1]
     if n_dims == POSE_DIMS:
         demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
     targets, demonstrated = _targets(data, source, n_dims)
-    threshold = _number(data.get("success_threshold", 1.75), source, "success_threshold", positive=True)
-    alignment = _number(data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True)
+    threshold = _number(
+        data.get("success_threshold", 1.75), source, "success_threshold", positive=True
+    )
+    alignment = _number(
+        data.get("alignment_threshold", 2.0), source, "alignment_threshold", positive=True
+    )
     approach = data.get("approach_height", 28.5)
-    approach = None if approach is None else _number(approach, source, "approach_height", positive=True)
+    approach = (
+        None if approach is None else _number(approach, source, "approach_height", positive=True)
+    )
 
     from ..extension.extend import _check_extension_options
     from ..incremental.bidmp import BiDMP
     from ..primitives.dmp import DMP
 
     dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
-    bidmp = _parameters(data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params())
-    extension = _parameters(data, "extension", _EXTENSION_KEYS, source, lambda params: _check_extension_options(**params))
+    bidmp = _parameters(
+        data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params()
+    )
+    extension = _parameters(
+        data,
+        "extension",
+        _EXTENSION_KEYS,
+        source,
+        lambda params: _check_extension_options(**params),
+    )
     extensions = _extensions(data, source, targets, n_dims)
-    demonstrations = _further_demonstrations(data, source, base_dir, allow_outside_files, units, n_dims)
+    demonstrations = _further_demonstrations(
+        data, source, base_dir, allow_outside_files, units, n_dims
+    )
     methods = _methods(data, source, n_dims)
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
@@ -267,12 +363,27 @@ def from_dict(data, source: str = "<dict>", base_dir: str | os.PathLike = ".", *
         _fail(source, "job", 'a job runs in the simulator: the scenario needs a "scene"')
     _check_runs(source, demonstration, targets, dmp)
     return Scenario(
-        name=data["name"], targets=targets, demonstrated=demonstrated, demonstration=demonstration,
-        success_threshold=threshold, approach_height=approach, dmp=dmp, bidmp=bidmp, extension=extension,
+        name=data["name"],
+        targets=targets,
+        demonstrated=demonstrated,
+        demonstration=demonstration,
+        success_threshold=threshold,
+        approach_height=approach,
+        dmp=dmp,
+        bidmp=bidmp,
+        extension=extension,
         extensions=extensions,
-        demonstrations=demonstrations, methods=list(dict.fromkeys(methods)), seed=int(seed),
-        units=data.get("units", "mm"), description=data.get("description", ""), spec=copy.deepcopy(data),
-        scene=scene, robot=robot, base_dir=str(base_dir), alignment_threshold=alignment, job=job,
+        demonstrations=demonstrations,
+        methods=list(dict.fromkeys(methods)),
+        seed=int(seed),
+        units=data.get("units", "mm"),
+        description=data.get("description", ""),
+        spec=copy.deepcopy(data),
+        scene=scene,
+        robot=robot,
+        base_dir=str(base_dir),
+        alignment_threshold=alignment,
+        job=job,
     )
 
 
@@ -282,7 +393,11 @@ def _check_top_level(data, source: str) -> str:
         raise ScenarioError(f"scenario {source}: expected a JSON object at the top level")
     unknown = sorted(set(data) - _KEYS)
     if unknown:
-        _fail(source, short_token(unknown[0], 30)[1:-1], f"unknown key (known: {', '.join(sorted(_KEYS))})")
+        _fail(
+            source,
+            short_token(unknown[0], 30)[1:-1],
+            f"unknown key (known: {', '.join(sorted(_KEYS))})",
+        )
     for key in ("name", "targets", "demonstrated", "demonstration"):
         if key not in data:
             _fail(source, key, "missing (required)")
@@ -310,15 +425,28 @@ def _targets(data, source: str, n_dims: int) -> tuple[dict, str]:
     if not isinstance(data["targets"], dict) or not data["targets"]:
         _fail(source, "targets", "expected a non-empty object {label: [x, y, z]}")
     if len(data["targets"]) > get_limits().max_targets:
-        _fail(source, "targets", f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}")
-    targets = {str(label): _point(point, source, f"targets.{label}", n_dims) for label, point in data["targets"].items()}
+        _fail(
+            source,
+            "targets",
+            f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}",
+        )
+    targets = {
+        str(label): _point(point, source, f"targets.{label}", n_dims)
+        for label, point in data["targets"].items()
+    }
     if n_dims == POSE_DIMS:
-        targets = {label: _pose_points(point[None], source, f"targets.{label}", generated=False)[0]
-                   for label, point in targets.items()}
+        targets = {
+            label: _pose_points(point[None], source, f"targets.{label}", generated=False)[0]
+            for label, point in targets.items()
+        }
     demonstrated = data["demonstrated"]
     if not isinstance(demonstrated, str) or demonstrated not in targets:
-        _fail(source, "demonstrated", f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
-                                      f"{', …' if len(targets) > 10 else ''})")
+        _fail(
+            source,
+            "demonstrated",
+            f"{_shown(demonstrated)} is not among the targets ({', '.join(list(targets)[:10])}"
+            f"{', …' if len(targets) > 10 else ''})",
+        )
 
     return targets, demonstrated
 
@@ -331,25 +459,51 @@ def _extensions(data, source: str, targets: dict, n_dims: int) -> list[dict]:
         extensions = []
         for index, stage in enumerate(data["extensions"]):
             key = f"extensions[{index}]"
-            if not isinstance(stage, dict) or set(stage) - {"target", "from", "in_scene"} or "target" not in stage:
-                _fail(source, key, 'expected {"target": ..., "from": "demonstration" | "previous", "in_scene": true | false}')
+            if (
+                not isinstance(stage, dict)
+                or set(stage) - {"target", "from", "in_scene"}
+                or "target" not in stage
+            ):
+                _fail(
+                    source,
+                    key,
+                    'expected {"target": ..., "from": "demonstration" | "previous", "in_scene": true | false}',
+                )
             origin = stage.get("from", "demonstration" if index == 0 else "previous")
             if origin not in ("demonstration", "previous") or (index == 0 and origin == "previous"):
-                _fail(source, f"{key}.from", f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}")
+                _fail(
+                    source,
+                    f"{key}.from",
+                    f"expected 'demonstration'{' or previous' if index else ''}, got {json.dumps(origin)}",
+                )
             in_scene = stage.get("in_scene", True)
             if not isinstance(in_scene, bool):
                 _fail(source, f"{key}.in_scene", f"expected true or false, got {_shown(in_scene)}")
-            extensions.append({"target": _extension_target(stage["target"], source, f"{key}.target", targets, n_dims),
-                               "from": origin, "in_scene": in_scene})
+            extensions.append(
+                {
+                    "target": _extension_target(
+                        stage["target"], source, f"{key}.target", targets, n_dims
+                    ),
+                    "from": origin,
+                    "in_scene": in_scene,
+                }
+            )
         check_limit(len(extensions), "max_targets", "the number of extensions")
         return extensions
     else:
-        target = _extension_target(data.get("extension_target", "centre_of_failed"), source, "extension_target", targets, n_dims)
+        target = _extension_target(
+            data.get("extension_target", "centre_of_failed"),
+            source,
+            "extension_target",
+            targets,
+            n_dims,
+        )
         return [{"target": target, "from": "demonstration", "in_scene": True}]
 
 
-
-def _further_demonstrations(data, source: str, base_dir, allow_outside_files: bool, units: str, n_dims: int) -> dict:
+def _further_demonstrations(
+    data, source: str, base_dir, allow_outside_files: bool, units: str, n_dims: int
+) -> dict:
     """The operators' further demonstrations (label -> trajectory)."""
     extra = data.get("demonstrations", {})
     if not isinstance(extra, dict):
@@ -357,9 +511,15 @@ def _further_demonstrations(data, source: str, base_dir, allow_outside_files: bo
     demonstrations = {}
     check_limit(len(extra), "max_targets", "the number of further demonstrations")
     for label, spec in extra.items():
-        trajectory = _demonstration(spec, source, f"demonstrations.{label}", base_dir, allow_outside_files, units)
+        trajectory = _demonstration(
+            spec, source, f"demonstrations.{label}", base_dir, allow_outside_files, units
+        )
         if trajectory.shape[1] != n_dims:
-            _fail(source, f"demonstrations.{label}", f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}")
+            _fail(
+                source,
+                f"demonstrations.{label}",
+                f"has D = {trajectory.shape[1]}, the demonstration has D = {n_dims}",
+            )
         demonstrations[str(label)] = trajectory
 
     return demonstrations
@@ -374,10 +534,18 @@ def _methods(data, source: str, n_dims: int) -> list[str]:
 
     for method in methods:
         if method not in registry.names():
-            _fail(source, "methods", f"unknown method {short_token(method, 20)} (known: {', '.join(registry.names())})")
+            _fail(
+                source,
+                "methods",
+                f"unknown method {short_token(method, 20)} (known: {', '.join(registry.names())})",
+            )
         if n_dims == POSE_DIMS and not registry.get(method).poses:
-            _fail(source, "methods", f"{method} does not learn poses; a pose scenario runs "
-                  f"{', '.join(registry.names(poses=True))}")
+            _fail(
+                source,
+                "methods",
+                f"{method} does not learn poses; a pose scenario runs "
+                f"{', '.join(registry.names(poses=True))}",
+            )
     return methods
 
 
@@ -423,15 +591,21 @@ def _builtin_dir():
 
 def builtin_names() -> list[str]:
     """Names of the built-in scenarios (nut-unscrewing, nut-unscrewing-tilted, cell-removal, pick-and-place)."""
-    return sorted(entry.name[:-5] for entry in _builtin_dir().iterdir() if entry.name.endswith(".json"))
+    return sorted(
+        entry.name[:-5] for entry in _builtin_dir().iterdir() if entry.name.endswith(".json")
+    )
 
 
 def builtin_text(name: str) -> str:
     """The JSON text of a built-in scenario (for ``bidmp scenario show NAME > my.json``)."""
     if not isinstance(name, str):
-        raise TypeError(f"name must be a built-in scenario's name (a string), got {type(name).__name__}")
+        raise TypeError(
+            f"name must be a built-in scenario's name (a string), got {type(name).__name__}"
+        )
     if name not in builtin_names():
-        raise ScenarioError(f"name: unknown built-in scenario {short_token(name)}; built-ins: {', '.join(builtin_names())}")
+        raise ScenarioError(
+            f"name: unknown built-in scenario {short_token(name)}; built-ins: {', '.join(builtin_names())}"
+        )
     return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
 
 
@@ -442,19 +616,29 @@ def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) 
     folder (absolute paths, ``..``, symlinks out of it); off by default.
     """
     if not isinstance(path_or_name, (str, os.PathLike)):
-        raise TypeError(f"path_or_name must be a file name or a built-in name, got {type(path_or_name).__name__}")
+        raise TypeError(
+            f"path_or_name must be a file name or a built-in name, got {type(path_or_name).__name__}"
+        )
     check_path(path_or_name, "path_or_name")
     text_name = str(path_or_name)
     if not text_name.endswith(".json") and text_name in builtin_names():
         return from_dict(json.loads(builtin_text(text_name)), source=f"built-in {text_name}")
     path = Path(path_or_name)
     if path.exists() and not path.is_file():  # a folder, a FIFO, a device: opening it could block
-        raise ScenarioError(f"scenario {path}: not a regular file (a folder, pipe, device or socket)")
+        raise ScenarioError(
+            f"scenario {path}: not a regular file (a folder, pipe, device or socket)"
+        )
     if not path.is_file():
-        raise ScenarioError(f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})")
+        raise ScenarioError(
+            f"scenario {path}: no such file, and not a built-in scenario ({', '.join(builtin_names())})"
+        )
     try:
         check_limit(path.stat().st_size, "max_json_bytes", f"the size of scenario {path} in bytes")
         data = load_json(path.read_bytes(), f"scenario {path}")
     except (OSError, ValueError) as exc:
-        raise ScenarioError(str(exc) if str(exc).startswith("scenario") else f"scenario {path}: {exc}") from None
-    return from_dict(data, source=str(path), base_dir=path.parent, allow_outside_files=allow_outside_files)
+        raise ScenarioError(
+            str(exc) if str(exc).startswith("scenario") else f"scenario {path}: {exc}"
+        ) from None
+    return from_dict(
+        data, source=str(path), base_dir=path.parent, allow_outside_files=allow_outside_files
+    )

@@ -14,7 +14,16 @@ from __future__ import annotations
 
 from ..._lazy import exports
 
-_EXPORTS = {"RobotCell": "cell", "PANDA": "robot", "IIWA": "robot", "XARM6": "robot", "UR5": "robot", "RobotModel": "robot",
-            "ROBOT_MODELS": "robot", "robot_model": "robot", "robot_placement": "robot"}
+_EXPORTS = {
+    "RobotCell": "cell",
+    "PANDA": "robot",
+    "IIWA": "robot",
+    "XARM6": "robot",
+    "UR5": "robot",
+    "RobotModel": "robot",
+    "ROBOT_MODELS": "robot",
+    "robot_model": "robot",
+    "robot_placement": "robot",
+}
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 
 from ..._checks import as_point, check_real
-
 from ..backend import SIM_STEP, Execution, Hold, MotionPlan
 from . import execute as _execute
 from . import ik as _ik
@@ -39,12 +38,20 @@ class RobotCell:
         The arm (:data:`bidmp.sim.pybullet.robot.ROBOT_MODELS`, or a scenario's own URDF).
     """
 
-    def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
-                 robot: RobotModel = PANDA_MODEL):
+    def __init__(
+        self,
+        scene,
+        units: str = "mm",
+        base=(0.0, -450.0, 0.0),
+        yaw: float = 90.0,
+        robot: RobotModel = PANDA_MODEL,
+    ):
         from ...scene import Scene
 
         if not isinstance(robot, RobotModel):
-            raise TypeError(f"robot must be a bidmp.sim.pybullet.robot.RobotModel, got {type(robot).__name__}")
+            raise TypeError(
+                f"robot must be a bidmp.sim.pybullet.robot.RobotModel, got {type(robot).__name__}"
+            )
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
         base, yaw = as_point(base, 3, "base"), check_real(yaw, "yaw")
@@ -57,7 +64,9 @@ class RobotCell:
         try:
             p.setTimeStep(SIM_STEP, physicsClientId=self.client)
             # 20 solver iterations instead of 50: the same tracking here (< 0.3 mm), 20 % less time.
-            p.setPhysicsEngineParameter(numSolverIterations=SOLVER_ITERATIONS, physicsClientId=self.client)
+            p.setPhysicsEngineParameter(
+                numSolverIterations=SOLVER_ITERATIONS, physicsClientId=self.client
+            )
             p.setGravity(0.0, 0.0, -9.81, physicsClientId=self.client)
             self._bodies = {}  # body id -> solid label
             self._owners = {}  # body id -> part label
@@ -70,22 +79,45 @@ class RobotCell:
             self.ik_client = p.connect(p.DIRECT)
             with tempfile.TemporaryDirectory() as folder:
                 path = Path(folder) / "robot_tool.urdf"
-                path.write_text(_tool_urdf(robot, scene.tool.radius * self.unit, scene.tool.length * self.unit))
+                path.write_text(
+                    _tool_urdf(robot, scene.tool.radius * self.unit, scene.tool.length * self.unit)
+                )
                 base_m = np.asarray(base, dtype=float) * self.unit
                 orientation = p.getQuaternionFromEuler([0, 0, math.radians(yaw)])
-                self.robot = p.loadURDF(str(path), base_m.tolist(), orientation, useFixedBase=True,
-                                        physicsClientId=self.client)
-                self.ik_robot = p.loadURDF(str(path), base_m.tolist(), orientation, useFixedBase=True,
-                                           physicsClientId=self.ik_client)
-            names = [p.getJointInfo(self.robot, j, physicsClientId=self.client)[12].decode()
-                     for j in range(p.getNumJoints(self.robot, physicsClientId=self.client))]
+                self.robot = p.loadURDF(
+                    str(path),
+                    base_m.tolist(),
+                    orientation,
+                    useFixedBase=True,
+                    physicsClientId=self.client,
+                )
+                self.ik_robot = p.loadURDF(
+                    str(path),
+                    base_m.tolist(),
+                    orientation,
+                    useFixedBase=True,
+                    physicsClientId=self.ik_client,
+                )
+            names = [
+                p.getJointInfo(self.robot, j, physicsClientId=self.client)[12].decode()
+                for j in range(p.getNumJoints(self.robot, physicsClientId=self.client))
+            ]
             self.tcp = names.index("tcp")
-            movable = [j for j in range(len(names)) if p.getJointInfo(self.robot, j, physicsClientId=self.client)[2]
-                       != p.JOINT_FIXED]
+            movable = [
+                j
+                for j in range(len(names))
+                if p.getJointInfo(self.robot, j, physicsClientId=self.client)[2] != p.JOINT_FIXED
+            ]
             if len(movable) < 6 or len(movable) != robot.n_joints:
-                what = "serial arms of six or more joints" if len(movable) < 6 else f"its {robot.n_joints} limits"
-                raise ValueError(f"robot {robot.name!r} has {len(movable)} movable joints up to its flange "
-                                 f"{robot.flange!r}; the simulator drives {what}")
+                what = (
+                    "serial arms of six or more joints"
+                    if len(movable) < 6
+                    else f"its {robot.n_joints} limits"
+                )
+                raise ValueError(
+                    f"robot {robot.name!r} has {len(movable)} movable joints up to its flange "
+                    f"{robot.flange!r}; the simulator drives {what}"
+                )
             self.arm = movable
             self.gains = [GAIN] * len(movable)
             # A tool symmetric about its axis leaves the turn about that axis free; it is the last
@@ -99,7 +131,9 @@ class RobotCell:
             self.close()
             raise
 
-    limits = PANDA_MODEL.limits  # the robot's joint limits (the backend protocol's; set per instance)
+    limits = (
+        PANDA_MODEL.limits
+    )  # the robot's joint limits (the backend protocol's; set per instance)
 
     @property
     def n_joints(self) -> int:
@@ -110,7 +144,9 @@ class RobotCell:
         p, robot, client = self.p, self.ik_robot, self.ik_client
         self._set_joints(self.model.rest, kinematic=True)
         last = p.getJointInfo(robot, self.arm[-1], physicsClientId=client)
-        frame = p.getLinkState(robot, self.arm[-1], computeForwardKinematics=1, physicsClientId=client)
+        frame = p.getLinkState(
+            robot, self.arm[-1], computeForwardKinematics=1, physicsClientId=client
+        )
         tcp = p.getLinkState(robot, self.tcp, computeForwardKinematics=1, physicsClientId=client)
         axis = np.array(p.getMatrixFromQuaternion(frame[5])).reshape(3, 3) @ np.asarray(last[13])
         tool = np.array(p.getMatrixFromQuaternion(tcp[5])).reshape(3, 3)[:, 2]
@@ -119,8 +155,14 @@ class RobotCell:
         return bool(abs(abs(axis @ tool) - 1.0) < 1e-6 and np.linalg.norm(across) < 1e-6)
 
     @classmethod
-    def load_robot(cls, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0,
-                   robot: RobotModel = PANDA_MODEL) -> "RobotCell":
+    def load_robot(
+        cls,
+        scene,
+        units: str = "mm",
+        base=(0.0, -450.0, 0.0),
+        yaw: float = 90.0,
+        robot: RobotModel = PANDA_MODEL,
+    ) -> RobotCell:
         """The backend protocol's constructor (the same as ``RobotCell(...)``)."""
         return cls(scene, units, base, yaw, robot)
 
@@ -145,26 +187,41 @@ class RobotCell:
     def _set_joints(self, q, velocities=None, kinematic: bool = False) -> None:
         robot, client = (self.ik_robot, self.ik_client) if kinematic else (self.robot, self.client)
         for index, joint in enumerate(self.arm):
-            self.p.resetJointState(robot, joint, float(q[index]), 0.0 if velocities is None else float(velocities[index]),
-                                   physicsClientId=client)
+            self.p.resetJointState(
+                robot,
+                joint,
+                float(q[index]),
+                0.0 if velocities is None else float(velocities[index]),
+                physicsClientId=client,
+            )
 
     def tcp_position(self) -> np.ndarray:
         """The simulated robot's measured TCP position (m)."""
-        return np.array(self.p.getLinkState(self.robot, self.tcp, computeForwardKinematics=1,
-                                            physicsClientId=self.client)[4])
+        return np.array(
+            self.p.getLinkState(
+                self.robot, self.tcp, computeForwardKinematics=1, physicsClientId=self.client
+            )[4]
+        )
 
     def forward(self, q) -> np.ndarray:
         """TCP position (m) for joint positions ``q`` (forward kinematics on the planning copy)."""
         self._set_joints(self._joints(q), kinematic=True)
-        return np.array(self.p.getLinkState(self.ik_robot, self.tcp, computeForwardKinematics=1,
-                                            physicsClientId=self.ik_client)[4])
+        return np.array(
+            self.p.getLinkState(
+                self.ik_robot, self.tcp, computeForwardKinematics=1, physicsClientId=self.ik_client
+            )[4]
+        )
 
     def joint_origins(self, q) -> np.ndarray:
         """The arm's joint origins from its base to the tool's mouth (m), (9, 3), at joints ``q``
         (on the planning copy): what the 3-D viewer draws."""
         self._set_joints(self._joints(q), kinematic=True)
-        states = self.p.getLinkStates(self.ik_robot, [*self.arm, self.tcp], computeForwardKinematics=1,
-                                      physicsClientId=self.ik_client)
+        states = self.p.getLinkStates(
+            self.ik_robot,
+            [*self.arm, self.tcp],
+            computeForwardKinematics=1,
+            physicsClientId=self.ik_client,
+        )
         # The base's URDF frame, where it was placed (PyBullet's base position is its centre of mass).
         return np.array([self.base * self.unit] + [state[4] for state in states])
 
@@ -180,24 +237,47 @@ class RobotCell:
 
     ik = solve_ik  # the backend protocol's name
 
-    def plan(self, path, label: str = "", fractions=None, seed=None, orientations=None,
-             spacing: float = MAX_SAMPLE_SPACING) -> MotionPlan:
+    def plan(
+        self,
+        path,
+        label: str = "",
+        fractions=None,
+        seed=None,
+        orientations=None,
+        spacing: float = MAX_SAMPLE_SPACING,
+    ) -> MotionPlan:
         """Inverse kinematics along ``path`` (n, 3, scene units), IK samples at most ``spacing`` (m)
         apart where it moves fastest, and the fastest uniform timing within the limits
         (:func:`bidmp.sim.pybullet.plan.plan`)."""
         return _plan._plan(self, path, label, fractions, seed, orientations, spacing)
 
-    def execute(self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0,
-                on_record=None) -> Execution:
+    def execute(
+        self,
+        plan: MotionPlan,
+        exclude=(),
+        hold: Hold | None = None,
+        frames: int = 0,
+        on_record=None,
+    ) -> Execution:
         """Run ``plan`` under position control at 1 kHz (:func:`bidmp.sim.pybullet.execute.execute`);
         ``on_record(t)`` after every recorded step."""
         return _execute._execute(self, plan, exclude, hold, frames, on_record)
 
-    def execute_closed_loop(self, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                            frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:
+    def execute_closed_loop(
+        self,
+        stepper,
+        duration: float,
+        exclude=(),
+        hold: Hold | None = None,
+        frames: int = 0,
+        max_factor: float = 4.0,
+        goal_update=None,
+    ) -> Execution:
         """Run a DMP/Bi-DMP ``stepper`` on the measured TCP at 100 Hz, with an optional perception
         update (:func:`bidmp.sim.pybullet.execute.execute_closed_loop`)."""
-        return _execute._execute_closed_loop(self, stepper, duration, exclude, hold, frames, max_factor, goal_update)
+        return _execute._execute_closed_loop(
+            self, stepper, duration, exclude, hold, frames, max_factor, goal_update
+        )
 
     def contacts(self) -> dict:
         """Part label -> penetration depth (m) of the robot's contacts now."""
@@ -216,5 +296,3 @@ class RobotCell:
 
     def scene_centre(self) -> np.ndarray:
         return _render._scene_centre(self)
-
-

@@ -34,7 +34,9 @@ def _ignore(cell, exclude, enable: bool) -> None:
     for body, owner in cell._owners.items():
         if owner in exclude:
             for link in links:
-                p.setCollisionFilterPair(cell.robot, body, link, -1, int(enable), physicsClientId=cell.client)
+                p.setCollisionFilterPair(
+                    cell.robot, body, link, -1, int(enable), physicsClientId=cell.client
+                )
 
 
 def _contacts_into(cell, found: dict) -> None:
@@ -48,12 +50,22 @@ def _contacts_into(cell, found: dict) -> None:
 
 def _drive(cell, q, qd) -> None:
     """Hand joint targets (rad) and velocities (rad/s) to the position control."""
-    cell.p.setJointMotorControlArray(cell.robot, cell.arm, cell.p.POSITION_CONTROL, targetPositions=q,
-                                     targetVelocities=qd, forces=list(cell.model.effort), positionGains=cell.gains,
-                                     velocityGains=cell.gains, physicsClientId=cell.client)
+    cell.p.setJointMotorControlArray(
+        cell.robot,
+        cell.arm,
+        cell.p.POSITION_CONTROL,
+        targetPositions=q,
+        targetVelocities=qd,
+        forces=list(cell.model.effort),
+        positionGains=cell.gains,
+        velocityGains=cell.gains,
+        physicsClientId=cell.client,
+    )
 
 
-def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0, on_record=None) -> Execution:
+def _execute(
+    cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0, on_record=None
+) -> Execution:
     """Run ``plan`` under position control at 1 kHz, the parts in ``exclude`` ignored; a
     ``hold`` keeps one joint still for a while (its command runs on: open loop). ``on_record``
     is called with the time (s) after every recorded step (a part that follows the tool)."""
@@ -67,8 +79,18 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
     held = None
     # The 1 kHz loop is most of a simulation's cost: PyBullet's calls bound once, the
     # recorder visited only on the steps it records.
-    robot, client, arm, mode, step_simulation = cell.robot, cell.client, cell.arm, p.POSITION_CONTROL, p.stepSimulation
-    motors, contact_points, contacts = p.setJointMotorControlArray, p.getContactPoints, record.contacts
+    robot, client, arm, mode, step_simulation = (
+        cell.robot,
+        cell.client,
+        cell.arm,
+        p.POSITION_CONTROL,
+        p.stepSimulation,
+    )
+    motors, contact_points, contacts = (
+        p.setJointMotorControlArray,
+        p.getContactPoints,
+        record.contacts,
+    )
     bodies, effort, gains = cell._bodies, list(cell.model.effort), cell.gains
     visit = np.zeros(n_steps, dtype=bool)
     visit[::RECORD_EVERY] = True
@@ -83,8 +105,17 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
                     held = p.getJointState(robot, arm[hold.joint], physicsClientId=client)[0]
                 q, qd = list(q), list(qd)
                 q[hold.joint], qd[hold.joint] = held, 0.0
-            motors(robot, arm, mode, targetPositions=q, targetVelocities=qd, forces=effort, positionGains=gains,
-                   velocityGains=gains, physicsClientId=client)
+            motors(
+                robot,
+                arm,
+                mode,
+                targetPositions=q,
+                targetVelocities=qd,
+                forces=effort,
+                positionGains=gains,
+                velocityGains=gains,
+                physicsClientId=client,
+            )
             step_simulation(physicsClientId=client)
             for contact in contact_points(bodyA=robot, physicsClientId=client):
                 if contact[8] < 0.0 and contact[2] in bodies:
@@ -97,12 +128,21 @@ def _execute(cell, plan: MotionPlan, exclude=(), hold: Hold | None = None, frame
     finally:
         _ignore(cell, exclude, True)
     run = record.finish()
-    run.commands = positions  # what the position control was sent, every 1 ms (a hold is the world's doing)
+    # what the position control was sent, every 1 ms (a hold is the world's doing)
+    run.commands = positions
     return run
 
 
-def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold | None = None,
-                        frames: int = 0, max_factor: float = 4.0, goal_update=None) -> Execution:
+def _execute_closed_loop(
+    cell,
+    stepper,
+    duration: float,
+    exclude=(),
+    hold: Hold | None = None,
+    frames: int = 0,
+    max_factor: float = 4.0,
+    goal_update=None,
+) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
 
     Each control step asks the stepper for the command given where the TCP is, solves IK for its
@@ -139,7 +179,9 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
                 previous, previous_rate = target, target_rate
                 if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
                     break
-                if settle_from is None:  # (settling: the limiter brings the joints to rest at the last IK target)
+                if (
+                    settle_from is None
+                ):  # (settling: the limiter brings the joints to rest at the last IK target)
                     moved = moved or _perceive(cell, stepper, goal_update, exclude)
                     y, yd, _ = stepper.step(CONTROL_STEP, _tracked(cell, stepper, sent))
                     point = np.asarray(y) * cell.unit
@@ -154,7 +196,9 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
                     settle_from = step
             share = (step % every + 1) / every
             # The cubic between the 100 Hz targets, then the 1 kHz limiter: jerk-limited commands.
-            command = limited(*_hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP))
+            command = limited(
+                *_hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP)
+            )
             sent.append(command)
             q, qd = command.tolist(), limited.velocity.tolist()
             held = _apply_hold(cell, hold, t, q, qd, held)
@@ -166,7 +210,11 @@ def _execute_closed_loop(cell, stepper, duration: float, exclude=(), hold: Hold 
         if moved:  # the world is kept for the next job: the parts back where they were
             _move_parts(cell, exclude, -np.asarray(goal_update.offset) * cell.unit)
     run = record.finish()
-    run.command_times, run.command_joints, run.motion_clock = np.array(times), np.array(targets), np.array(clock)
+    run.command_times, run.command_joints, run.motion_clock = (
+        np.array(times),
+        np.array(targets),
+        np.array(clock),
+    )
     run.commands = np.array(sent)
     return run
 
@@ -183,13 +231,21 @@ def _tracked(cell, stepper, sent: list) -> np.ndarray:
     return stepper.position + measured - cell.forward(sent[-1]) / cell.unit
 
 
-def _hermite(q0, v0, q1, v1, share: float, duration: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _hermite(
+    q0, v0, q1, v1, share: float, duration: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Position, velocity and acceleration at ``share`` (0-1) of the cubic from ``(q0, v0)`` to
     ``(q1, v1)`` over ``duration`` seconds (velocities per second)."""
     s, h = share, duration
-    position = (2 * s**3 - 3 * s**2 + 1) * q0 + (s**3 - 2 * s**2 + s) * h * v0 + (3 * s**2 - 2 * s**3) * q1 \
+    position = (
+        (2 * s**3 - 3 * s**2 + 1) * q0
+        + (s**3 - 2 * s**2 + s) * h * v0
+        + (3 * s**2 - 2 * s**3) * q1
         + (s**3 - s**2) * h * v1
-    velocity = ((6 * s**2 - 6 * s) * (q0 - q1) / h + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1)
+    )
+    velocity = (
+        (6 * s**2 - 6 * s) * (q0 - q1) / h + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1
+    )
     acceleration = ((12 * s - 6) * (q0 - q1) / h + (6 * s - 4) * v0 + (6 * s - 2) * v1) / h
     return position, velocity, acceleration
 
@@ -224,18 +280,28 @@ def _move_parts(cell, labels, offset_m: np.ndarray) -> bool:
     p = cell.p
     for body, owner in cell._owners.items():
         if owner in labels:
-            position, orientation = p.getBasePositionAndOrientation(body, physicsClientId=cell.client)
-            p.resetBasePositionAndOrientation(body, (np.asarray(position) + offset_m).tolist(), orientation,
-                                              physicsClientId=cell.client)
+            position, orientation = p.getBasePositionAndOrientation(
+                body, physicsClientId=cell.client
+            )
+            p.resetBasePositionAndOrientation(
+                body,
+                (np.asarray(position) + offset_m).tolist(),
+                orientation,
+                physicsClientId=cell.client,
+            )
     return True
 
 
-def _apply_hold(cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None) -> float | None:
+def _apply_hold(
+    cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None
+) -> float | None:
     """During the hold, pin its joint in ``q``/``qd`` (in place) where it was when the hold began;
     return that angle (None before the hold)."""
     if hold is not None and hold.start <= t < hold.start + hold.duration:
         if held is None:
-            held = cell.p.getJointState(cell.robot, cell.arm[hold.joint], physicsClientId=cell.client)[0]
+            held = cell.p.getJointState(
+                cell.robot, cell.arm[hold.joint], physicsClientId=cell.client
+            )[0]
         q[hold.joint], qd[hold.joint] = held, 0.0
     return held
 
@@ -255,29 +321,44 @@ class _Recorder:
         self.velocities = np.empty((n_records, len(cell.arm)))
         self.commanded = []
         self.contacts = {}
-        self.frame_steps = set(np.linspace(0, n_steps - 1, frames).astype(int).tolist()) if frames else set()
+        self.frame_steps = (
+            set(np.linspace(0, n_steps - 1, frames).astype(int).tolist()) if frames else set()
+        )
         self.frames = []
         self.filled = 0
 
-    def sample(self, step: int, t: float, commanded_joints, contacts: bool = False, every_step: bool = False) -> None:
+    def sample(
+        self,
+        step: int,
+        t: float,
+        commanded_joints,
+        contacts: bool = False,
+        every_step: bool = False,
+    ) -> None:
         """Record step ``step`` (the loop calls it on recorded steps only, or ``every_step``)."""
         cell = self.cell
         p = cell.p
         if contacts:
             _contacts_into(cell, self.contacts)
         if step in self.frame_steps:
-            self.frames.append(cell.render() if self.focus is None else cell.keyframe(t, self.focus))
+            self.frames.append(
+                cell.render() if self.focus is None else cell.keyframe(t, self.focus)
+            )
         if every_step and step % RECORD_EVERY and step != self.n_steps - 1:
             return
         row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
         self.filled = row + 1
         self.times[row] = t
-        state = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client)
+        state = p.getLinkState(
+            cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client
+        )
         self.tcp[row], self.tcp_orientation[row] = state[4], state[5]
         states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
         self.joints[row] = [s[0] for s in states]
         self.velocities[row] = [s[1] for s in states]
-        if row % 10 == 0 or step == self.n_steps - 1:  # the command's TCP, 50 Hz (forward kinematics)
+        if (
+            row % 10 == 0 or step == self.n_steps - 1
+        ):  # the command's TCP, 50 Hz (forward kinematics)
             self.commanded.append((row, np.asarray(commanded_joints, dtype=float).copy()))
 
     def finish(self) -> Execution:
@@ -286,8 +367,17 @@ class _Recorder:
         n_rows = self.filled
         rows = [r for r, _ in self.commanded if r < n_rows]
         commanded = np.array([cell.forward(q) for r, q in self.commanded if r < n_rows])
-        full = np.column_stack([np.interp(np.arange(n_rows), rows, commanded[:, k]) for k in range(3)])
-        run = Execution(self.times[:n_rows], self.tcp[:n_rows], self.joints[:n_rows], self.velocities[:n_rows], full,
-                        self.contacts, self.frames)
+        full = np.column_stack(
+            [np.interp(np.arange(n_rows), rows, commanded[:, k]) for k in range(3)]
+        )
+        run = Execution(
+            self.times[:n_rows],
+            self.tcp[:n_rows],
+            self.joints[:n_rows],
+            self.velocities[:n_rows],
+            full,
+            self.contacts,
+            self.frames,
+        )
         run.tcp_orientation = self.tcp_orientation[:n_rows]
         return run

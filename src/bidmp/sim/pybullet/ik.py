@@ -38,21 +38,38 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
 
         axis = Rotation.from_quat(target_orientation).apply([0.0, 0.0, 1.0])
     limits = cell.limits
-    ranges = [u - l for l, u in zip(limits.lower, limits.upper)]
+    ranges = [upper - lower for lower, upper in zip(limits.lower, limits.upper)]
     error = math.inf
     # Short bursts from the previous solution, checked by forward kinematics: a few dozen
     # iterations reach 1 µm from a seed a few millimetres away (one long call costs 10x).
     for _ in range(20):
         cell._set_joints(q, kinematic=True)
         if axis is not None:
-            current = Rotation.from_quat(p.getLinkState(cell.ik_robot, cell.tcp, computeForwardKinematics=1,
-                                                        physicsClientId=cell.ik_client)[5])
+            current = Rotation.from_quat(
+                p.getLinkState(
+                    cell.ik_robot,
+                    cell.tcp,
+                    computeForwardKinematics=1,
+                    physicsClientId=cell.ik_client,
+                )[5]
+            )
             swing, _ = Rotation.align_vectors([axis], [current.apply([0.0, 0.0, 1.0])])
             target_orientation = (swing * current).as_quat().tolist()
-        q = np.array(p.calculateInverseKinematics(
-            cell.ik_robot, cell.tcp, point_m.tolist(), target_orientation, lowerLimits=list(limits.lower),
-            upperLimits=list(limits.upper), jointRanges=ranges, restPoses=q.tolist(), maxNumIterations=40,
-            residualThreshold=1e-9, physicsClientId=cell.ik_client)[: len(cell.arm)])
+        q = np.array(
+            p.calculateInverseKinematics(
+                cell.ik_robot,
+                cell.tcp,
+                point_m.tolist(),
+                target_orientation,
+                lowerLimits=list(limits.lower),
+                upperLimits=list(limits.upper),
+                jointRanges=ranges,
+                restPoses=q.tolist(),
+                maxNumIterations=40,
+                residualThreshold=1e-9,
+                physicsClientId=cell.ik_client,
+            )[: len(cell.arm)]
+        )
         if axis is not None and cell.wrist_turns_tool:
             # The last joint turns the flange about the tool's axis, which moves neither the tool's
             # mouth nor its axis: park it where it rests instead of letting it drift to a limit.

@@ -38,15 +38,23 @@ class _MovablePart:
         self.axis = self.solid.rotation[:, 2]
         self.height = _height(self.solid)
         self.state, self.rise, self.constraint = "seated", 0.0, None
-        self.trace: list[tuple[float, float, float]] = []  # (rise, angle turned, time) while threading
+        self.trace: list[
+            tuple[float, float, float]
+        ] = []  # (rise, angle turned, time) while threading
 
     def set_pose(self, centre, rotation: Rotation) -> None:
         p, unit = self.cell.p, self.cell.unit
-        p.resetBasePositionAndOrientation(self.body, (np.asarray(centre) * unit).tolist(), rotation.as_quat().tolist(),
-                                          physicsClientId=self.cell.client)
+        p.resetBasePositionAndOrientation(
+            self.body,
+            (np.asarray(centre) * unit).tolist(),
+            rotation.as_quat().tolist(),
+            physicsClientId=self.cell.client,
+        )
 
     def pose(self) -> tuple[np.ndarray, Rotation]:
-        position, orientation = self.cell.p.getBasePositionAndOrientation(self.body, physicsClientId=self.cell.client)
+        position, orientation = self.cell.p.getBasePositionAndOrientation(
+            self.body, physicsClientId=self.cell.client
+        )
         return np.asarray(position) / self.cell.unit, Rotation.from_quat(orientation)
 
     def thread(self, rise: float, pitch: float, t: float) -> None:
@@ -56,7 +64,10 @@ class _MovablePart:
         where it is rather than screwing it back."""
         self.state, self.rise = "threading", max(self.rise, float(rise))
         angle = 2.0 * math.pi * self.rise / pitch
-        self.set_pose(self.centre0 + self.axis * self.rise, Rotation.from_rotvec(self.axis * angle) * self.rotation0)
+        self.set_pose(
+            self.centre0 + self.axis * self.rise,
+            Rotation.from_rotvec(self.axis * angle) * self.rotation0,
+        )
         self.trace.append((self.rise, angle, t))
 
     def hold(self) -> None:
@@ -65,14 +76,27 @@ class _MovablePart:
         under physics; its contacts with other parts are its own (:meth:`contacts`)."""
         p, cell = self.cell.p, self.cell
         self._make_dynamic()
-        tcp_position, tcp_orientation = p.getLinkState(cell.robot, cell.tcp, computeForwardKinematics=1,
-                                                       physicsClientId=cell.client)[4:6]
-        position, orientation = p.getBasePositionAndOrientation(self.body, physicsClientId=cell.client)
+        tcp_position, tcp_orientation = p.getLinkState(
+            cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client
+        )[4:6]
+        position, orientation = p.getBasePositionAndOrientation(
+            self.body, physicsClientId=cell.client
+        )
         inverse = p.invertTransform(tcp_position, tcp_orientation)
         local_position, local_orientation = p.multiplyTransforms(*inverse, position, orientation)
-        self.constraint = p.createConstraint(cell.robot, cell.tcp, self.body, -1, p.JOINT_FIXED, [0, 0, 0],
-                                             local_position, [0, 0, 0], local_orientation, [0, 0, 0, 1],
-                                             physicsClientId=cell.client)
+        self.constraint = p.createConstraint(
+            cell.robot,
+            cell.tcp,
+            self.body,
+            -1,
+            p.JOINT_FIXED,
+            [0, 0, 0],
+            local_position,
+            [0, 0, 0],
+            local_orientation,
+            [0, 0, 0, 1],
+            physicsClientId=cell.client,
+        )
         p.changeConstraint(self.constraint, maxForce=500.0, physicsClientId=cell.client)
         self.state = "held"
 
@@ -81,7 +105,11 @@ class _MovablePart:
         cell = self.cell
         for contact in cell.p.getContactPoints(bodyA=self.body, physicsClientId=cell.client):
             label = cell._bodies.get(contact[2])
-            if label is not None and contact[8] < 0.0 and cell._owners.get(contact[2]) not in ignore:
+            if (
+                label is not None
+                and contact[8] < 0.0
+                and cell._owners.get(contact[2]) not in ignore
+            ):
                 found[label] = max(found.get(label, 0.0), -contact[8] / cell.unit)
 
     def release(self) -> None:
@@ -104,8 +132,9 @@ class _MovablePart:
         cell._owners.pop(self.body, None)
         self._replace_body(self.mass)
         for link in range(-1, p.getNumJoints(cell.robot, physicsClientId=cell.client)):
-            p.setCollisionFilterPair(cell.robot, self.body, link, -1, 0, physicsClientId=cell.client)
-
+            p.setCollisionFilterPair(
+                cell.robot, self.body, link, -1, 0, physicsClientId=cell.client
+            )
 
     def _replace_body(self, mass: float) -> None:
         """The part's body made anew where it is: dynamic with ``mass`` (kg), or static (0)."""
@@ -145,7 +174,14 @@ def _settle(cell, seconds: float) -> None:
     p = cell.p
     states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
     held = [s[0] for s in states]
-    p.setJointMotorControlArray(cell.robot, cell.arm, p.POSITION_CONTROL, targetPositions=held,
-                                targetVelocities=[0.0] * len(cell.arm), forces=list(cell.model.effort), physicsClientId=cell.client)
+    p.setJointMotorControlArray(
+        cell.robot,
+        cell.arm,
+        p.POSITION_CONTROL,
+        targetPositions=held,
+        targetVelocities=[0.0] * len(cell.arm),
+        forces=list(cell.model.effort),
+        physicsClientId=cell.client,
+    )
     for _ in range(int(round(seconds / SIM_STEP))):
         p.stepSimulation(physicsClientId=cell.client)

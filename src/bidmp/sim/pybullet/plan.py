@@ -8,8 +8,8 @@ import numpy as np
 from scipy.interpolate import make_interp_spline
 
 from ..._checks import as_trajectory, as_vector, check_real
-from ...primitives.so3 import as_quaternions
 from ..._trajectory import interp_columns
+from ...primitives.so3 import as_quaternions
 from ...primitives.timing import Trajectory, time_scale
 from ..backend import LIMIT_MARGIN, MotionPlan, SimError
 from .robot import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
@@ -17,8 +17,15 @@ from .robot import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _u
 __all__ = []
 
 
-def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=None,
-          spacing: float = MAX_SAMPLE_SPACING) -> MotionPlan:
+def _plan(
+    cell,
+    path,
+    label: str = "",
+    fractions=None,
+    seed=None,
+    orientations=None,
+    spacing: float = MAX_SAMPLE_SPACING,
+) -> MotionPlan:
     """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
     within :data:`LIMIT_MARGIN` of the joint limits. ``fractions``: normalised time of each
     sample (default: uniform, as a DMP rollout is). ``orientations`` (n, 4): the tool frame
@@ -31,8 +38,17 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     spacing = check_real(spacing, "spacing", positive=True, maximum=1.0)
     for point in (path.min(axis=0), path.max(axis=0)):  # before subdividing it into 5 mm steps
         _reachable(point * cell.unit, cell.base * cell.unit, "path")
-    given = np.linspace(0.0, 1.0, path.shape[0]) if fractions is None else as_vector(fractions, "fractions")
-    if given.shape != (path.shape[0],) or np.any(np.diff(given) < 0) or given[0] < 0 or given[-1] > 1:
+    given = (
+        np.linspace(0.0, 1.0, path.shape[0])
+        if fractions is None
+        else as_vector(fractions, "fractions")
+    )
+    if (
+        given.shape != (path.shape[0],)
+        or np.any(np.diff(given) < 0)
+        or given[0] < 0
+        or given[-1] > 1
+    ):
         raise ValueError(f"fractions must be {path.shape[0]} non-decreasing times in [0, 1]")
     points, u = _subdivide(path * cell.unit, given, spacing)
     turns = None
@@ -50,15 +66,19 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
-            raise SimError(f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
-                           f"unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
-                           f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
-                           f"robot (scenario key \"robot\": {{\"base\": ...}})")
+            raise SimError(
+                f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
+                f"unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
+                f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
+                f'robot (scenario key "robot": {{"base": ...}})'
+            )
         below, above = q < np.array(limits.lower) - 1e-9, q > np.array(limits.upper) + 1e-9
         if below.any() or above.any():
             joint = int(np.flatnonzero(below | above)[0])
-            raise SimError(f"target {label!r}: joint {joint + 1} would leave its limits "
-                           f"[{limits.lower[joint]}, {limits.upper[joint]}] rad ({q[joint]:.3f})")
+            raise SimError(
+                f"target {label!r}: joint {joint + 1} would leave its limits "
+                f"[{limits.lower[joint]}, {limits.upper[joint]}] rad ({q[joint]:.3f})"
+            )
         joints[index] = q
     # A quintic spline at rest at both ends, acceleration included: the arm's interface asks for
     # zero velocity and acceleration where a motion starts and stops (a clamped cubic ends with
@@ -67,16 +87,26 @@ def _plan(cell, path, label: str = "", fractions=None, seed=None, orientations=N
     spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
     grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
     unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))
-    caps = {"max_velocity": LIMIT_MARGIN * np.asarray(limits.velocity),
-            "max_acceleration": LIMIT_MARGIN * np.asarray(limits.acceleration),
-            "max_jerk": None if limits.jerk is None else LIMIT_MARGIN * np.asarray(limits.jerk)}
+    caps = {
+        "max_velocity": LIMIT_MARGIN * np.asarray(limits.velocity),
+        "max_acceleration": LIMIT_MARGIN * np.asarray(limits.acceleration),
+        "max_jerk": None if limits.jerk is None else LIMIT_MARGIN * np.asarray(limits.jerk),
+    }
     duration = float(time_scale(unit_time, norm="axis", **caps).t[-1])
-    peaks = [0.0 if limit is None else float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
-             for order, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk))]
-    return MotionPlan(label, points, u, joints, duration, spline, peaks[0], peaks[1], turns, peak_jerk=peaks[2])
+    peaks = [
+        0.0
+        if limit is None
+        else float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
+        for order, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk))
+    ]
+    return MotionPlan(
+        label, points, u, joints, duration, spline, peaks[0], peaks[1], turns, peak_jerk=peaks[2]
+    )
 
 
-def _subdivide(points: np.ndarray, fractions: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+def _subdivide(
+    points: np.ndarray, fractions: np.ndarray, spacing: float
+) -> tuple[np.ndarray, np.ndarray]:
     """The IK samples of a path: evenly spaced in time (``fractions``), as few as keep consecutive
     samples at most ``spacing`` apart where the path moves fastest, linearly interpolated between
     the given samples (at rest: the ends only).

@@ -8,12 +8,15 @@ from ..._checks import as_point, check_int, check_real
 
 __all__ = []
 
-_MAX_PIXELS = 4096  # per side: TinyRenderer allocates width x height buffers (a negative size aborts it)
+# per side: TinyRenderer allocates width x height buffers (a negative size aborts it)
+_MAX_PIXELS = 4096
 
 
 def _image_size(width, height) -> tuple[int, int]:
-    return (check_int(width, "width", minimum=8, maximum=_MAX_PIXELS),
-            check_int(height, "height", minimum=8, maximum=_MAX_PIXELS))
+    return (
+        check_int(width, "width", minimum=8, maximum=_MAX_PIXELS),
+        check_int(height, "height", minimum=8, maximum=_MAX_PIXELS),
+    )
 
 
 # -- pictures --------------------------------------------------------------------------
@@ -25,21 +28,37 @@ def _render(cell, width: int = 320, height: int = 240, target=None) -> np.ndarra
         look = 0.5 * (cell.base + _scene_centre(cell)) * cell.unit + [0.0, 0.0, 0.2]
     else:
         look = as_point(target, 3, "target") * cell.unit
-    view = p.computeViewMatrixFromYawPitchRoll(look.tolist(), 1.2, cell.yaw - 50.0, -25.0, 0.0, 2,
-                                               physicsClientId=cell.client)
-    projection = p.computeProjectionMatrixFOV(45.0, width / height, 0.02, 5.0, physicsClientId=cell.client)
-    _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, renderer=p.ER_TINY_RENDERER,
-                                        physicsClientId=cell.client)
+    view = p.computeViewMatrixFromYawPitchRoll(
+        look.tolist(), 1.2, cell.yaw - 50.0, -25.0, 0.0, 2, physicsClientId=cell.client
+    )
+    projection = p.computeProjectionMatrixFOV(
+        45.0, width / height, 0.02, 5.0, physicsClientId=cell.client
+    )
+    _, _, rgba, _, _ = p.getCameraImage(
+        width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=cell.client
+    )
     return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
 
 
-def _camera(cell, look_m, distance: float, yaw: float, pitch: float, width: int, height: int) -> np.ndarray:
+def _camera(
+    cell, look_m, distance: float, yaw: float, pitch: float, width: int, height: int
+) -> np.ndarray:
     p = cell.p
-    view = p.computeViewMatrixFromYawPitchRoll(np.asarray(look_m, float).tolist(), distance, yaw, pitch, 0.0, 2,
-                                               physicsClientId=cell.client)
-    projection = p.computeProjectionMatrixFOV(45.0, width / height, 0.02, 6.0, physicsClientId=cell.client)
-    _, _, rgba, _, _ = p.getCameraImage(width, height, view, projection, renderer=p.ER_TINY_RENDERER,
-                                        physicsClientId=cell.client)
+    view = p.computeViewMatrixFromYawPitchRoll(
+        np.asarray(look_m, float).tolist(),
+        distance,
+        yaw,
+        pitch,
+        0.0,
+        2,
+        physicsClientId=cell.client,
+    )
+    projection = p.computeProjectionMatrixFOV(
+        45.0, width / height, 0.02, 6.0, physicsClientId=cell.client
+    )
+    _, _, rgba, _, _ = p.getCameraImage(
+        width, height, view, projection, renderer=p.ER_TINY_RENDERER, physicsClientId=cell.client
+    )
     return np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3]
 
 
@@ -54,7 +73,10 @@ def _keyframe(cell, t: float, focus, width: int = 320, height: int = 240) -> np.
     look = 0.5 * (base_m + focus_m) + [0.0, 0.0, 0.3]
     wide = _camera(cell, look, 1.45, cell.yaw - 60.0, -15.0, width, height)
     close = _camera(cell, focus_m + [0.0, 0.0, 0.04], 0.28, cell.yaw - 60.0, -30.0, width, height)
-    return _label(np.concatenate([wide, close], axis=0), [(f"t = {t:.2f} s", 0), ("close-up: tool and target", height)])
+    return _label(
+        np.concatenate([wide, close], axis=0),
+        [(f"t = {t:.2f} s", 0), ("close-up: tool and target", height)],
+    )
 
 
 def _label(image: np.ndarray, texts) -> np.ndarray:
@@ -73,5 +95,8 @@ def _label(image: np.ndarray, texts) -> np.ndarray:
 
 def _scene_centre(cell) -> np.ndarray:
     """The middle of the scene's parts (scene units)."""
-    lower, upper = np.min([s.lower for s in cell.scene.solids], axis=0), np.max([s.upper for s in cell.scene.solids], axis=0)
+    lower, upper = (
+        np.min([s.lower for s in cell.scene.solids], axis=0),
+        np.max([s.upper for s in cell.scene.solids], axis=0),
+    )
     return 0.5 * (lower + upper)

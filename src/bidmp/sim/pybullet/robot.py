@@ -13,12 +13,31 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._checks import as_point, as_vector, check_limit, check_path, check_real, short_token, shown_path
+from ..._checks import (
+    as_point,
+    as_vector,
+    check_limit,
+    check_path,
+    check_real,
+    short_token,
+    shown_path,
+)
 from ..backend import JointLimits, SimError
 
-__all__ = ["PANDA", "IIWA", "XARM6", "UR5", "RobotModel", "ROBOT_MODELS", "ROBOT_NAMES", "robot_model", "robot_placement"]
+__all__ = [
+    "PANDA",
+    "IIWA",
+    "XARM6",
+    "UR5",
+    "RobotModel",
+    "ROBOT_MODELS",
+    "ROBOT_NAMES",
+    "robot_model",
+    "robot_placement",
+]
 
-MAX_SAMPLE_SPACING = 5e-3  # m: the Cartesian path is subdivided so that IK points are at most this far apart
+# m: the Cartesian path is subdivided so that IK points are at most this far apart
+MAX_SAMPLE_SPACING = 5e-3
 IK_TOLERANCE = 5e-5  # m: a sample whose IK leaves more than this (0.05 mm) is unreachable
 IK_ACCURACY = 5e-6  # m: IK stops refining below this (tracking errors are ~100x larger)
 _UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3}
@@ -65,8 +84,13 @@ XARM6 = JointLimits(
 )
 # A UR5-class arm: +-360 deg and 180 deg/s every joint (Universal Robots' UR5 datasheet); acceleration
 # and jerk are not published: assumed like the xArm6's.
-UR5 = JointLimits(lower=(-2 * math.pi,) * 6, upper=(2 * math.pi,) * 6, velocity=_XARM_SPEED,
-                  acceleration=XARM6.acceleration, jerk=XARM6.jerk)
+UR5 = JointLimits(
+    lower=(-2 * math.pi,) * 6,
+    upper=(2 * math.pi,) * 6,
+    velocity=_XARM_SPEED,
+    acceleration=XARM6.acceleration,
+    jerk=XARM6.jerk,
+)
 # The arms whose acceleration and jerk limits are assumptions (reports say so).
 ASSUMED_LIMITS = {"iiwa", "xarm6", "ur5"}
 
@@ -110,13 +134,23 @@ class RobotModel:
             if not isinstance(value, str) or not value or len(value) > 4096:
                 raise TypeError(f"{name} must be a non-empty string, got {short_token(value, 30)}")
         if not isinstance(self.limits, JointLimits):
-            raise TypeError(f"limits must be bidmp.sim.JointLimits, got {type(self.limits).__name__}")
+            raise TypeError(
+                f"limits must be bidmp.sim.JointLimits, got {type(self.limits).__name__}"
+            )
         n = self.limits.n_joints
         for name, positive in (("rest", False), ("effort", True)):
-            object.__setattr__(self, name, tuple(as_vector(getattr(self, name), name, length=n, positive=positive).tolist()))
+            object.__setattr__(
+                self,
+                name,
+                tuple(as_vector(getattr(self, name), name, length=n, positive=positive).tolist()),
+            )
         if self.cut_at is not None and (not isinstance(self.cut_at, str) or not self.cut_at):
-            raise TypeError(f"cut_at must be a joint name or None, got {short_token(self.cut_at, 30)}")
-        object.__setattr__(self, "standoff", check_real(self.standoff, "standoff", positive=True, maximum=2.0))
+            raise TypeError(
+                f"cut_at must be a joint name or None, got {short_token(self.cut_at, 30)}"
+            )
+        object.__setattr__(
+            self, "standoff", check_real(self.standoff, "standoff", positive=True, maximum=2.0)
+        )
 
     @property
     def n_joints(self) -> int:
@@ -126,24 +160,54 @@ class RobotModel:
         return {"name": self.name, "urdf": self.urdf, "flange": self.flange}
 
 
-PANDA_MODEL = RobotModel("panda", "franka_panda/panda.urdf", "panda_link8", PANDA, _REST, tuple(_EFFORT),
-                         cut_at="panda_hand_joint")
+PANDA_MODEL = RobotModel(
+    "panda",
+    "franka_panda/panda.urdf",
+    "panda_link8",
+    PANDA,
+    _REST,
+    tuple(_EFFORT),
+    cut_at="panda_hand_joint",
+)
 # The iiwa stands further back than the Panda: its shoulder is 0.34 m up (the Panda's 0.33 m) and
 # it does not reach points close in front of its base with the tool pointing down (the nut task's
 # start, 0.33 m away: 47 mm short; from 0.43 m every point of the task within 5 µm).
-IIWA_MODEL = RobotModel("iiwa", "kuka_iiwa/model.urdf", "lbr_iiwa_link_7", IIWA,
-                        (0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0), (176.0, 176.0, 110.0, 110.0, 110.0, 40.0, 40.0),
-                        standoff=0.43)
+IIWA_MODEL = RobotModel(
+    "iiwa",
+    "kuka_iiwa/model.urdf",
+    "lbr_iiwa_link_7",
+    IIWA,
+    (0.0, 0.5, 0.0, -1.4, 0.0, 1.2, 0.0),
+    (176.0, 176.0, 110.0, 110.0, 110.0, 40.0, 40.0),
+    standoff=0.43,
+)
 # The xArm6's reach (0.7 m) and its shoulder 0.27 m up put it closer to the work than the Panda; the
 # UR5's forearm offsets keep its wrist 0.11 m beside the tool, so it stands a little further back.
-XARM6_MODEL = RobotModel("xarm6", "xarm/xarm6_robot.urdf", "link6", XARM6,
-                         (0.0, -0.3, -1.2, 0.0, 1.5, 0.0), (50.0, 50.0, 32.0, 32.0, 32.0, 20.0), standoff=0.3)
-UR5_MODEL = RobotModel("ur5", str(Path(__file__).resolve().parents[2] / "data" / "robots" / "ur5_dh.urdf"), "flange", UR5,
-                       (math.pi, -math.pi / 2, math.pi / 2, -math.pi / 2, -math.pi / 2, 0.0),
-                       (150.0, 150.0, 150.0, 28.0, 28.0, 28.0), standoff=0.38)
+XARM6_MODEL = RobotModel(
+    "xarm6",
+    "xarm/xarm6_robot.urdf",
+    "link6",
+    XARM6,
+    (0.0, -0.3, -1.2, 0.0, 1.5, 0.0),
+    (50.0, 50.0, 32.0, 32.0, 32.0, 20.0),
+    standoff=0.3,
+)
+UR5_MODEL = RobotModel(
+    "ur5",
+    str(Path(__file__).resolve().parents[2] / "data" / "robots" / "ur5_dh.urdf"),
+    "flange",
+    UR5,
+    (math.pi, -math.pi / 2, math.pi / 2, -math.pi / 2, -math.pi / 2, 0.0),
+    (150.0, 150.0, 150.0, 28.0, 28.0, 28.0),
+    standoff=0.38,
+)
 ROBOT_MODELS = {"panda": PANDA_MODEL, "iiwa": IIWA_MODEL, "xarm6": XARM6_MODEL, "ur5": UR5_MODEL}
-ROBOT_NAMES = {"panda": "Franka Panda", "iiwa": "KUKA LBR iiwa 7 R800", "xarm6": "UFACTORY xArm6",
-               "ur5": "UR5-class arm (DH model)"}
+ROBOT_NAMES = {
+    "panda": "Franka Panda",
+    "iiwa": "KUKA LBR iiwa 7 R800",
+    "xarm6": "UFACTORY xArm6",
+    "ur5": "UR5-class arm (DH model)",
+}
 
 
 def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
@@ -158,7 +222,9 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     from ...tasks._scenario_fields import _robot
 
     if spec is not None and not isinstance(spec, dict):
-        raise TypeError(f"spec must be a scenario's \"robot\" object (a dict) or None, got {type(spec).__name__}")
+        raise TypeError(
+            f'spec must be a scenario\'s "robot" object (a dict) or None, got {type(spec).__name__}'
+        )
     folder = "." if base_dir is None else check_path(base_dir, "base_dir")
     # Scenarios resolve their URDF when they load: here it may be absolute (the folder rule was applied then).
     spec = _robot({"robot": spec or {}}, "robot", folder, allow_outside=True)
@@ -169,18 +235,28 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
         local = Path(folder) / path
         path = local if local.exists() else Path(pybullet_data.getDataPath()) / path
     if not path.is_file():
-        raise ValueError(f"robot.urdf {shown_path(spec['urdf'])}: no such regular file (a path in the scenario's "
-                         f"folder, or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)")
+        raise ValueError(
+            f"robot.urdf {shown_path(spec['urdf'])}: no such regular file (a path in the scenario's "
+            f"folder, or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)"
+        )
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {shown_path(path)} in bytes")
     limits = JointLimits(**spec["limits"])
     middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
-    return RobotModel(path.stem, str(path), spec["flange"], limits, tuple(spec.get("rest", middle)),
-                      tuple(spec.get("effort", (100.0,) * limits.n_joints)))
+    return RobotModel(
+        path.stem,
+        str(path),
+        spec["flange"],
+        limits,
+        tuple(spec.get("rest", middle)),
+        tuple(spec.get("effort", (100.0,) * limits.n_joints)),
+    )
 
 
 def _unit_of(units: str) -> float:
     if not isinstance(units, str) or units not in _UNITS:
-        raise ValueError(f"units: the simulator needs lengths in m, cm or mm, got {short_token(units)}")
+        raise ValueError(
+            f"units: the simulator needs lengths in m, cm or mm, got {short_token(units)}"
+        )
     return _UNITS[units]
 
 
@@ -192,16 +268,25 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
     """The robot's base (scenario units) and yaw (degrees): the scenario's ``"robot"`` key, or in
     front of the work: the arm's standoff (the Panda 330 mm, the iiwa 430 mm) short of the nearest
     point in y, centred in x, at the lowest target's height, facing +y."""
-    if not all(hasattr(scenario, name) for name in ("robot", "target_array", "demonstration", "units")):
-        raise TypeError(f"scenario must be a bidmp scenario (bidmp.tasks.load), got {type(scenario).__name__}")
+    if not all(
+        hasattr(scenario, name) for name in ("robot", "target_array", "demonstration", "units")
+    ):
+        raise TypeError(
+            f"scenario must be a bidmp scenario (bidmp.tasks.load), got {type(scenario).__name__}"
+        )
     robot = scenario.robot or {}
     if "base" in robot:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
     points = np.vstack([scenario.target_array, scenario.demonstration])
     unit = _unit_of(scenario.units)
     standoff = robot_model(robot, getattr(scenario, "base_dir", None)).standoff
-    base = np.array([0.5 * (points[:, 0].min() + points[:, 0].max()), points[:, 1].min() - standoff / unit,
-                     scenario.target_array[:, 2].min()])
+    base = np.array(
+        [
+            0.5 * (points[:, 0].min() + points[:, 0].max()),
+            points[:, 1].min() - standoff / unit,
+            scenario.target_array[:, 2].min(),
+        ]
+    )
     return base, float(robot.get("yaw", 90.0))
 
 
@@ -213,8 +298,10 @@ def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray
     path that IK would chase for ever)."""
     distance = float(np.linalg.norm(point_m - base_m))
     if not distance <= _REACH_M:
-        raise SimError(f"{name}: a point {distance:.3g} m from the robot's base, beyond the arm's reach "
-                       f"(the Panda's is 0.855 m); check the units and the base")
+        raise SimError(
+            f"{name}: a point {distance:.3g} m from the robot's base, beyond the arm's reach "
+            f"(the Panda's is 0.855 m); check the units and the base"
+        )
     return point_m
 
 
@@ -224,6 +311,8 @@ def _joint_seed(seed, limits: JointLimits = PANDA) -> np.ndarray:
     outside = (q < np.array(limits.lower) - 1e-6) | (q > np.array(limits.upper) + 1e-6)
     if outside.any():
         joint = int(np.argmax(outside))
-        raise ValueError(f"seed: joint {joint + 1} at {q[joint]:.4g} rad is outside its limits "
-                         f"[{limits.lower[joint]}, {limits.upper[joint]}]")
+        raise ValueError(
+            f"seed: joint {joint + 1} at {q[joint]:.4g} rad is outside its limits "
+            f"[{limits.lower[joint]}, {limits.upper[joint]}]"
+        )
     return q

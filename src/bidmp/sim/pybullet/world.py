@@ -24,7 +24,9 @@ def _pybullet_module():
     if module is not None:
         return module
     for stream in (sys.stdout, sys.stderr):
-        if stream is not None:  # None: a caller redirected it away (contextlib.redirect_stdout(None))
+        if (
+            stream is not None
+        ):  # None: a caller redirected it away (contextlib.redirect_stdout(None))
             stream.flush()
     saved = [os.dup(1), os.dup(2)]
     try:
@@ -52,9 +54,15 @@ def _mesh(folder: Path, name: str, urdf: Path) -> Path:
     resolved = Path(os.path.realpath(folder / name))
     inside = os.path.commonpath([os.path.realpath(folder), resolved]) == os.path.realpath(folder)
     if not inside or resolved.suffix.lower() not in _MESHES or not resolved.is_file():
-        raise ValueError(f"robot URDF {shown_path(urdf)}: mesh {short_token(name, 40)} must be a .stl, .obj or .dae "
-                         f"file inside the URDF's folder")
-    check_limit(resolved.stat().st_size, "max_file_bytes", f"the size of mesh {shown_path(resolved)} in bytes")
+        raise ValueError(
+            f"robot URDF {shown_path(urdf)}: mesh {short_token(name, 40)} must be a .stl, .obj or .dae "
+            f"file inside the URDF's folder"
+        )
+    check_limit(
+        resolved.stat().st_size,
+        "max_file_bytes",
+        f"the size of mesh {shown_path(resolved)} in bytes",
+    )
     return resolved
 
 
@@ -71,18 +79,29 @@ def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
     if not path.is_absolute():
         path = Path(pybullet_data.getDataPath()) / path
     if not path.is_file():
-        raise ValueError(f"robot URDF {shown_path(model.urdf)}: no such regular file (a path in the scenario's folder, "
-                         f"or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)")
+        raise ValueError(
+            f"robot URDF {shown_path(model.urdf)}: no such regular file (a path in the scenario's folder, "
+            f"or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)"
+        )
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {shown_path(path)} in bytes")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"robot URDF {shown_path(path)} cannot be read as text ({type(exc).__name__})") from None
+        raise ValueError(
+            f"robot URDF {shown_path(path)} cannot be read as text ({type(exc).__name__})"
+        ) from None
     folder = path.parent
-    cut = text.find(f'<joint name="{model.cut_at}"') if model.cut_at is not None else text.rfind("</robot>")
+    cut = (
+        text.find(f'<joint name="{model.cut_at}"')
+        if model.cut_at is not None
+        else text.rfind("</robot>")
+    )
     if "<robot" not in text or cut < 0:
-        raise ValueError(f"robot URDF {shown_path(path)} is not a URDF with the joint the hand is cut at"
-                         if model.cut_at is not None and "<robot" in text else f"{shown_path(path)} is not a URDF robot")
+        raise ValueError(
+            f"robot URDF {shown_path(path)} is not a URDF with the joint the hand is cut at"
+            if model.cut_at is not None and "<robot" in text
+            else f"{shown_path(path)} is not a URDF robot"
+        )
     text = text[:cut]
     if f'<link name="{model.flange}"' not in text:
         raise ValueError(f"robot URDF {model.urdf!r} has no link {model.flange!r} (the flange)")
@@ -97,13 +116,13 @@ def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
         f'  <joint name="tcp_joint" type="fixed"><parent link="tool"/><child link="tcp"/>'
         f'<origin rpy="0 0 0" xyz="0 0 {tool_length / 2}"/></joint>\n'
         f'  <link name="tcp"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
-        f'</inertial></link>\n</robot>\n'
+        f"</inertial></link>\n</robot>\n"
     )
 
     def absolute(match):
         name = match.group(2)
         if name.startswith("package://"):
-            name = name[len("package://"):]
+            name = name[len("package://") :]
         return f'{match.group(1)}{_mesh(folder, name, path)}"'
 
     return re.sub(r'(<mesh\b[^>]*?\sfilename=")([^"]+)"', absolute, text + tool)
@@ -123,7 +142,13 @@ def _inset_prism(vertices: np.ndarray, margin: float) -> np.ndarray:
     sides = planes[np.abs(planes[:, 2]) < 1e-9]
     inradius = float(np.min(-sides[:, 3]))
     half_height = float(np.max(vertices[:, 2]))
-    scale = np.array([(inradius - margin) / inradius, (inradius - margin) / inradius, (half_height - margin) / half_height])
+    scale = np.array(
+        [
+            (inradius - margin) / inradius,
+            (inradius - margin) / inradius,
+            (half_height - margin) / half_height,
+        ]
+    )
     return vertices * scale
 
 
@@ -134,23 +159,43 @@ def _add_solid(p, client: int, unit: float, solid, mass: float = 0.0) -> int:
     if solid.kind == "box":
         half = [0.5 * v * unit for v in solid.params]
         shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=_colour(solid, unit), physicsClientId=client)
+        visual = p.createVisualShape(
+            p.GEOM_BOX, halfExtents=half, rgbaColor=_colour(solid, unit), physicsClientId=client
+        )
     elif solid.kind == "cylinder":
         radius, height = solid.params[0] * unit, solid.params[1] * unit
-        shape = p.createCollisionShape(p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=client)
-        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=radius, length=height, rgbaColor=_colour(solid, unit),
-                                     physicsClientId=client)
+        shape = p.createCollisionShape(
+            p.GEOM_CYLINDER, radius=radius, height=height, physicsClientId=client
+        )
+        visual = p.createVisualShape(
+            p.GEOM_CYLINDER,
+            radius=radius,
+            length=height,
+            rgbaColor=_colour(solid, unit),
+            physicsClientId=client,
+        )
     else:  # the hex nut: its convex hull
         vertices = (_inset_prism(np.asarray(solid.params[0]) * unit, HULL_MARGIN)).tolist()
         shape = p.createCollisionShape(p.GEOM_MESH, vertices=vertices, physicsClientId=client)
         extent = np.ptp(np.asarray(solid.params[0]), axis=0) * unit
-        visual = p.createVisualShape(p.GEOM_CYLINDER, radius=0.5 * extent[0], length=extent[2],
-                                     rgbaColor=_colour(solid, unit), physicsClientId=client)
+        visual = p.createVisualShape(
+            p.GEOM_CYLINDER,
+            radius=0.5 * extent[0],
+            length=extent[2],
+            rgbaColor=_colour(solid, unit),
+            physicsClientId=client,
+        )
     from scipy.spatial.transform import Rotation
 
     orientation = Rotation.from_matrix(solid.rotation).as_quat().tolist()
-    return p.createMultiBody(float(mass), shape, visual, (np.asarray(solid.centre) * unit).tolist(), orientation,
-                             physicsClientId=client)
+    return p.createMultiBody(
+        float(mass),
+        shape,
+        visual,
+        (np.asarray(solid.centre) * unit).tolist(),
+        orientation,
+        physicsClientId=client,
+    )
 
 
 def _colour(solid, unit: float) -> list:

@@ -28,7 +28,17 @@ __all__ = ["Method", "Task", "checked_goals", "register", "unregister", "get", "
 _REGISTRY: dict[str, Method] = {}
 _BUILTINS_LOADED = False
 # The built-in methods, in the order names() lists them (whichever module is imported first).
-_BUILTIN_ORDER = ("dmp", "dmp-paper", "dmp-robot", "dmp-converged", "bidmp", "bidmp-latest", "gmm", "tpgmm", "mp-dmp")
+_BUILTIN_ORDER = (
+    "dmp",
+    "dmp-paper",
+    "dmp-robot",
+    "dmp-converged",
+    "bidmp",
+    "bidmp-latest",
+    "gmm",
+    "tpgmm",
+    "mp-dmp",
+)
 
 
 def _load_builtins() -> None:
@@ -55,10 +65,18 @@ def register(method: Method, *, replace: bool = False) -> Method:
     if not isinstance(method, Method):
         raise TypeError(f"method must be a bidmp.tasks.methods.Method, got {type(method).__name__}")
     name = method.name
-    if not isinstance(name, str) or not name or not name.replace("-", "").replace("_", "").isalnum():
-        raise ValueError(f"method.name must be a non-empty name of letters, digits, '-' and '_', got {name!r:.40}")
+    if (
+        not isinstance(name, str)
+        or not name
+        or not name.replace("-", "").replace("_", "").isalnum()
+    ):
+        raise ValueError(
+            f"method.name must be a non-empty name of letters, digits, '-' and '_', got {name!r:.40}"
+        )
     if name in _REGISTRY and _REGISTRY[name] is not method and not replace:
-        raise ValueError(f"a method named {name!r} is registered already (pass replace=True to replace it)")
+        raise ValueError(
+            f"a method named {name!r} is registered already (pass replace=True to replace it)"
+        )
     _REGISTRY[name] = method
     return method
 
@@ -75,11 +93,15 @@ def get(name: str) -> Method:
     if not isinstance(name, str):
         raise TypeError(f"name must be a method's name (a string), got {type(name).__name__}")
     if name not in _REGISTRY:
-        raise ValueError(f"name: unknown method {_short_token(name, 40)}; known: {', '.join(names())}")
+        raise ValueError(
+            f"name: unknown method {_short_token(name, 40)}; known: {', '.join(names())}"
+        )
     return _REGISTRY[name]
 
 
-def names(*, poses: bool | None = None, lasa: bool | None = None, closed_loop: bool | None = None) -> list[str]:
+def names(
+    *, poses: bool | None = None, lasa: bool | None = None, closed_loop: bool | None = None
+) -> list[str]:
     """Registered method names, in registration order, optionally those that learn poses, run by
     default in the LASA benchmark, or have a closed-loop stepper."""
     _load_builtins()
@@ -87,6 +109,16 @@ def names(*, poses: bool | None = None, lasa: bool | None = None, closed_loop: b
     for key, value in wanted.items():
         if value is not None and not isinstance(value, bool):
             raise TypeError(f"names: {key} must be True, False or None, got {type(value).__name__}")
-    order = sorted(_REGISTRY, key=lambda name: _BUILTIN_ORDER.index(name) if name in _BUILTIN_ORDER else len(_BUILTIN_ORDER))
-    return [name for name in order
-            if all(value is None or getattr(_REGISTRY[name], key) == value for key, value in wanted.items())]
+    order = sorted(
+        _REGISTRY,
+        key=lambda name: (
+            _BUILTIN_ORDER.index(name) if name in _BUILTIN_ORDER else len(_BUILTIN_ORDER)
+        ),
+    )
+    return [
+        name
+        for name in order
+        if all(
+            value is None or getattr(_REGISTRY[name], key) == value for key, value in wanted.items()
+        )
+    ]

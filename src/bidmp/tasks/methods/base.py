@@ -15,7 +15,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._checks import as_trajectory, check_bool, check_callable, check_limit, check_options, check_seed, check_text
+from ..._checks import (
+    as_trajectory,
+    check_bool,
+    check_callable,
+    check_limit,
+    check_options,
+    check_seed,
+    check_text,
+)
 from ..._checks import short_token as _short_token
 
 __all__ = ["Method", "Task", "checked_goals"]
@@ -64,15 +72,21 @@ class Task:
 
     def __post_init__(self) -> None:
         self.poses = check_bool(self.poses, "poses")
-        self.demonstration = as_trajectory(self.demonstration, "demonstration", allow_static=self.poses)
+        self.demonstration = as_trajectory(
+            self.demonstration, "demonstration", allow_static=self.poses
+        )
         self.goals = checked_goals(self.goals)
         if self.goals.shape[1] != self.demonstration.shape[1]:
-            raise ValueError(f"goals have D = {self.goals.shape[1]} but the demonstration has D = "
-                             f"{self.demonstration.shape[1]}")
+            raise ValueError(
+                f"goals have D = {self.goals.shape[1]} but the demonstration has D = "
+                f"{self.demonstration.shape[1]}"
+            )
         check_seed(self.seed, "seed")
         self.dmp, self.bidmp = check_options(self.dmp, "dmp"), check_options(self.bidmp, "bidmp")
         if self.build_skills is not None:
-            check_callable(self.build_skills, "build_skills", "a function build_skills(dmp) -> model")
+            check_callable(
+                self.build_skills, "build_skills", "a function build_skills(dmp) -> model"
+            )
         if not isinstance(self.shared, dict):
             raise TypeError(f"shared must be a dict, got {type(self.shared).__name__}")
 
@@ -140,10 +154,14 @@ class Method:
         """Refuse a ``model`` that is not what :meth:`fit` returns (``kinds``, described as ``what``)."""
         kinds = kinds if isinstance(kinds, tuple) else (kinds,)
         if not kinds or not all(isinstance(kind, type) for kind in kinds):
-            raise TypeError(f"kinds must be a class or a tuple of classes, got {_short_token(kinds, 30)}")
+            raise TypeError(
+                f"kinds must be a class or a tuple of classes, got {_short_token(kinds, 30)}"
+            )
         check_text(what, "what")
         if not isinstance(model, kinds):
-            raise TypeError(f"model must be {what}, what method {self.name!r}'s fit returns, got {type(model).__name__}")
+            raise TypeError(
+                f"model must be {what}, what method {self.name!r}'s fit returns, got {type(model).__name__}"
+            )
 
     def stepper(self, model, goal: np.ndarray, duration: float, coupling):
         """A control-loop stepper to ``goal`` (methods with ``closed_loop`` only)."""

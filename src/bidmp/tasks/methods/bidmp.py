@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from ..._checks import as_point
 from ...incremental.bidmp import BiDMP
 from ...incremental.cartesian import CartesianBiDMP
+from . import register
 from .base import Method, Task
 
 
@@ -56,7 +56,9 @@ class _PerGoal:
         if np.array_equal(goal, demonstration[-1]):
             return self.dmp.rollout(goal)
         extension = extend_demonstration(demonstration, goal, seed=self.task.seed)
-        model = BiDMP(self.dmp, **self.task.bidmp).learn(extension.complete, duration=extension.duration_for(self.dmp))
+        model = BiDMP(self.dmp, **self.task.bidmp).learn(
+            extension.complete, duration=extension.duration_for(self.dmp)
+        )
         return model.rollout(goal)
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from ...primitives.cartesian import CartesianDMP
 from ...primitives.dmp import DMP
+from . import register
 from .base import Method, Task, checked_goals
 
 _DMPS = (DMP, CartesianDMP)
@@ -25,7 +25,9 @@ class _DMPMethod(Method):
         self.name, self.protocol, self.lasa = name, protocol, lasa
 
     def fit(self, task: Task) -> tuple[object, float]:
-        return task.fitted_dmp() if self.protocol is None else task.fitted_dmp(protocol=self.protocol)
+        return (
+            task.fitted_dmp() if self.protocol is None else task.fitted_dmp(protocol=self.protocol)
+        )
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
         self.check_model(model, _DMPS, "a fitted DMP or CartesianDMP")

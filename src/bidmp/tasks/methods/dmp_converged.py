@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from ..._checks import as_vector
 from ...primitives.dmp import DMP
+from . import register
 from .base import Method, Task, checked_goals
 
 CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
@@ -25,7 +25,9 @@ class _DMPConverged(Method):
         self.check_model(model, DMP, "a fitted DMP")
         goals = checked_goals(goals)
         n_steps = model.n_steps_
-        factor = next((k for k in range(2, 101) if model.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100)
+        factor = next(
+            (k for k in range(2, 101) if model.endpoint_gain(k * n_steps) <= CONVERGED_GAIN), 100
+        )
         return list(model.rollout_many(goals, n_steps=factor * n_steps))
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:

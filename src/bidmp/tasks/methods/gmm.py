@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from ..._checks import as_vector
+from . import register
 from .base import Method, Task, checked_goals
 
 
@@ -16,7 +16,9 @@ class _GMMMethod(Method):
     def fit(self, task: Task) -> tuple[object, float]:
         from ...baselines import GMMRegressor
 
-        return task.shared_model("gmm", lambda: GMMRegressor(seed=task.seed % (2**31)).fit(task.demonstration))
+        return task.shared_model(
+            "gmm", lambda: GMMRegressor(seed=task.seed % (2**31)).fit(task.demonstration)
+        )
 
     def rollouts(self, model, goals: np.ndarray) -> list[np.ndarray]:
         goals = checked_goals(goals)
@@ -26,7 +28,9 @@ class _GMMMethod(Method):
         from ...baselines import GMMRegressor
 
         self.check_model(model, GMMRegressor, "a fitted GMMRegressor")
-        as_vector(goal, "goal")  # a goal is asked for, and ignored: GMR on time reproduces its demonstration
+        as_vector(
+            goal, "goal"
+        )  # a goal is asked for, and ignored: GMR on time reproduces its demonstration
         return model.rollout()
 
 

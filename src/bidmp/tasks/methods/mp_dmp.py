@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from ..._checks import as_point
+from . import register
 from .base import Method, Task
 
 
@@ -28,8 +28,10 @@ class _PeerDMP(Method):
 
     def rollout(self, model, goal: np.ndarray) -> np.ndarray:
         if not (isinstance(model, tuple) and len(model) == 2 and hasattr(model[0], "open_loop")):
-            raise TypeError(f"model must be (a movement_primitives DMP, start), what method 'mp-dmp''s fit returns, "
-                            f"got {type(model).__name__}")
+            raise TypeError(
+                f"model must be (a movement_primitives DMP, start), what method 'mp-dmp''s fit returns, "
+                f"got {type(model).__name__}"
+            )
         peer, start = model
         goal = as_point(goal, len(start), "goal")
         peer.configure(start_y=start, goal_y=goal)

@@ -1,0 +1,286 @@
+"""The job's world on the simulated arm and how the arm moves in it: the state a job carries
+from step to step (the cell, the learned skills, the contract, what the tool holds), and the
+motions between places, each planned through the arm's IK, timed within its limits, executed
+at 1 kHz and judged by the motion contract on what the arm did; a motion that would break it
+is repaired (lifted over a part, steered round it) or the step fails, saying why."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..tasks.contract import Contract
+from .job_report import JobPhase, _phase
+from .pybullet.parts import _MovablePart
+
+__all__ = []
+
+_DOWN = Rotation.from_quat([1.0, 0.0, 0.0, 0.0])  # the tool pointing down (its z axis along -z)
+
+
+@dataclass
+class _World:
+    cell: object
+    scenario: object
+    spec: object
+    model: object  # the fitted Bi-DMP (a pose Bi-DMP for a tilted scenario)
+    q: np.ndarray  # the arm's joints now (rad)
+    # the job's scene (the scenario's parts, the bin, the rack), the arm's limits
+    contract: Contract
+    repairer: object  # bidmp.tasks.repair.Repairer of the approaches
+    transfers: object  # ... and of the transfers to the bin or the rack (lift, steer; a carried part kept clear too)
+    # keyframes at the end of each phase of the first cycle, when asked for
+    pictures: list | None = None
+    # (times, joint origins) of the first cycle's motions, for the viewer
+    motion: list | None = None
+    clock: float = 0.0  # simulated seconds since the job began
+    placed: int = 0  # parts in the rack so far
+    dropped: int = 0  # parts let go over the bin so far
+    held: object = None  # the part in the tool, if any (let go where it is when a step fails)
+    gone: list = field(default_factory=list)  # whole parts taken away (cells): no longer in the way
+    failures: list = field(
+        default_factory=list
+    )  # (target, phase, image) where a motion broke the contract
+    record: bool = False  # keep each phase's measured path and commands
+
+    @property
+    def scene(self):
+        return self.contract.scene
+
+    @property
+    def tcp(self) -> np.ndarray:
+        return self.cell.tcp_position() / self.cell.unit
+
+    @property
+    def pose(self) -> bool:
+        return self.scenario.is_pose
+
+    def orientation(self) -> Rotation:
+        """The tool frame now (measured)."""
+        p, cell = self.cell.p, self.cell
+        return Rotation.from_quat(
+            p.getLinkState(
+                cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client
+            )[5]
+        )
+
+
+class _StepFailed(Exception):
+    """A step that cannot be done; the message says which and why."""
+
+
+# ---------------------------------------------------------------------------------------------
+# Motions
+# ---------------------------------------------------------------------------------------------
+def _move(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    world: _World,
+    path,
+    fractions,
+    exclude,
+    name: str,
+    *,
+    orientations=None,
+    on_record=None,
+    least_duration: float = 0.0,
+    carried=None,
+    target=None,
+    axis=None,
+    support=(),
+) -> JobPhase:
+    """Plan ``path`` (n, 3) from the arm's joints now, execute it and judge what the arm did by the
+    contract: its end within the threshold of ``target`` (default the path's end), the final descent
+    along ``axis`` when it is the approach, clearance by the margin of the executed tool and of a
+    ``carried`` part (its own contacts count as the arm's; not from the parts it stands on,
+    ``support``, while it is lifted off them), the 1 kHz commands within the limits."""
+    cell = world.cell
+    plan = cell.plan(
+        np.asarray(path, dtype=float),
+        name,
+        fractions=fractions,
+        seed=world.q,
+        orientations=orientations,
+    )
+    if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
+        scale = plan.duration / least_duration
+        plan.duration = least_duration
+        plan.peak_velocity *= scale
+        plan.peak_acceleration *= scale**2
+        plan.peak_jerk *= scale**3
+    touched = {}
+    if carried is not None:
+
+        def on_record(t, inner=on_record):
+            carried.contacts(touched, ignore=exclude)
+            if inner is not None:
+                inner(t)
+
+    run = cell.execute(plan, exclude, on_record=on_record)
+    world.q = run.joints[-1]
+    if world.motion is not None:
+        from .run import _arm_motion
+
+        arm = _arm_motion(cell, run)
+        world.motion.append((world.clock + arm["times"], arm["links"]))
+    phase = _phase(name, run, plan, cell, touched)
+    executed = run.tcp / cell.unit
+    tool_frames = run.tcp_orientation if world.pose else None
+    clearance = _clearance(world, executed, exclude, carried, tool_frames, support)
+    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
+    phase.verdict = contract.judge(
+        executed,
+        executed[-1] if target is None else np.asarray(target)[:3],
+        label=name,
+        axis=axis,
+        exclude=exclude,
+        orientations=tool_frames,
+        commands=run.commands,
+        contacts=phase.contacts,
+        clearance=clearance,
+    )
+    phase.ok = phase.verdict.ok
+    if world.record:
+        phase.path, phase.commands = executed, np.asarray(run.commands)
+    world.clock += phase.seconds
+    return phase
+
+
+def _transfer_contract(contract: Contract) -> Contract:
+    """The contract of a move that is not an approach: no final descent to judge."""
+    return Contract(contract.threshold, None, contract.scene, contract.units, None, contract.limits)
+
+
+def _clearance(world: _World, path, exclude, carried, orientations=None, support=()):
+    """The tool's clearance along ``path``, and of a ``carried`` part (a :class:`_MovablePart`, or
+    ``(solid, offset from the mouth)``) but from the parts it is lifted off (``support``): the nearer
+    of the two to its margin."""
+    from ..tasks.repair import carried_clearance
+
+    if isinstance(carried, _MovablePart):  # where it is now, with the tool where it is now
+        carried = _body(world, carried)
+    return carried_clearance(world.scene, path, exclude, carried, support, orientations)
+
+
+def _body(world: _World, part: _MovablePart) -> tuple:
+    """A carried part as the clearance checks see it: its solid where it is now and its centre's
+    offset from the tool's mouth now."""
+    centre, rotation = part.pose()
+    return part.solid.moved(centre, rotation.as_matrix()), centre - world.tcp
+
+
+def _skill_path(world: _World, goal, skill, via=None, start_pose=None):
+    """The learned skill's motion from the tool's place now to ``goal``: (positions, fractions,
+    orientations or None)."""
+    options = {"skill": skill}
+    if via is not None:
+        options["via"] = via
+    if world.pose:
+        start = (
+            np.concatenate([world.tcp, world.orientation().as_quat()])
+            if start_pose is None
+            else start_pose
+        )
+        trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options)
+        return trajectory.y, trajectory.t / trajectory.t[-1], trajectory.q
+    trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=world.tcp, **options)
+    return trajectory.y, trajectory.t / trajectory.t[-1], None
+
+
+def _clear_transfer(world: _World, goal, exclude, carried=None):
+    """The plain DMP's motion to ``goal`` (a transfer), repaired where the tool, or the part it
+    carries (``carried``: its solid and offset from the mouth), would come within the margin of a
+    part: lifted over it by
+    via-points, or steered round it; ``(positions, fractions, orientations, note)``."""
+    if not world.pose:
+        repaired = world.transfers.repair(
+            world.model,
+            np.asarray(goal, dtype=float),
+            "the transfer",
+            start=world.tcp,
+            exclude=exclude,
+            skill=0,
+            carried=carried,
+        )
+        if not repaired.ok:
+            raise _StepFailed(repaired.reason())
+        note = f"repaired: {repaired.how}" if repaired.how else ""
+        return repaired.motion, np.linspace(0.0, 1.0, repaired.motion.shape[0]), None, note
+    scene = world.scene
+    start_pose = None
+    if world.pose:  # a transfer ends with the tool upright: over the bin or a slot
+        start_pose = np.concatenate([world.tcp, world.orientation().as_quat()])
+        goal = np.concatenate([goal[:3], _DOWN.as_quat()])
+    path, fractions, turns = _skill_path(world, goal, 0, start_pose=start_pose)
+    clearance = _clearance(world, path, exclude, carried)
+    if clearance.clear:
+        return path, fractions, turns, ""
+    from ..tasks.repair import _depth
+
+    height = _depth(carried)
+    top = max(
+        float(np.max([s.upper[2] for s in scene.solids])) + height,
+        float(world.tcp[2]),
+        float(goal[2]),
+    )
+    over = 0.5 * (world.tcp + np.asarray(goal, dtype=float)[:3])
+    over[2] = top + world.spec.clearance
+    via = [
+        (
+            0.5 * _skill_duration(world, goal, start_pose),
+            np.concatenate([over, _DOWN.as_quat()]) if world.pose else over,
+        )
+    ]
+    lifted, fractions, turns = _skill_path(world, goal, 0, via=via, start_pose=start_pose)
+    again = _clearance(world, lifted, exclude, carried)
+    if not again.clear:
+        unit = world.scenario.units
+        raise _StepFailed(
+            f"the learned move would {_closeness(clearance, unit)} {clearance.part}, and lifted "
+            f"{world.spec.clearance:g} {unit} over the work still {_closeness(again, unit)} {again.part}"
+        )
+    return (
+        lifted,
+        fractions,
+        turns,
+        f"lifted over the work (it would have come within the margin of {clearance.part})",
+    )
+
+
+def _skill_duration(world: _World, goal, start_pose) -> float:
+    """How long the plain skill's motion to ``goal`` lasts (s)."""
+    options = {"skill": 0}
+    start = start_pose if world.pose else world.tcp
+    return float(
+        world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options).t[-1]
+    )
+
+
+def _closeness(clearance, unit: str) -> str:
+    """How a clearance breaks the margin, in words ("cut 2.1 mm into", "pass 1.2 mm from")."""
+    if clearance.distance < 0.0:
+        return f"cut {-clearance.distance:.2f} {unit} into"
+    return f"pass {clearance.distance:.2f} {unit} from"
+
+
+def _transfer(world: _World, goal, exclude, carried=None):
+    """A move to the bin or the rack from the learned skill: the DMP's start and goal
+    generalisation (lifted over the work if it would come too close), or with ``transfer:
+    "similarity"`` the plain DMP's own reproduction turned (the smallest rotation taking its
+    start-to-goal onto this one), scaled and moved to run from the tool's place to ``goal``."""
+    if world.spec.transfer == "dmp" or world.pose:
+        return _clear_transfer(world, goal, exclude, carried)
+    reproduction = world.model.trajectory(skill=0)
+    shape, start, goal = reproduction.y, world.tcp, np.asarray(goal, dtype=float)
+    demonstrated, wanted = shape[-1] - shape[0], goal - start
+    turn, _ = Rotation.align_vectors([wanted], [demonstrated])
+    path = start + np.linalg.norm(wanted) / np.linalg.norm(demonstrated) * turn.apply(
+        shape - shape[0]
+    )
+    clearance = _clearance(world, path, exclude, carried)
+    if not clearance.clear:
+        raise _StepFailed(
+            f"the learned shape, turned and scaled, would {_closeness(clearance, world.scenario.units)} "
+            f"{clearance.part}"
+        )
+    return path, reproduction.t / reproduction.t[-1], None, "the skill's shape turned and scaled"
