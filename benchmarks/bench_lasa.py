@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 from bidmp.demonstrations.datasets import lasa_names
-from bidmp.experiments import benchmark
+from bidmp.experiments import benchmark, lasa_cells
 
 
 def _nothing(index: int) -> int:
@@ -35,7 +35,7 @@ def _one_side(out: Path, shapes, every: int, scheduler: str | None) -> benchmark
 
 
 def _strip(rows):
-    return [{k: v for k, v in row.items() if k not in benchmark.TIMES} for row in rows]
+    return [{k: v for k, v in row.items() if k not in lasa_cells.TIMES} for row in rows]
 
 
 def _rounds(out: Path, shapes, rounds: int, every: int) -> tuple[float, float, bool]:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from bidmp.cli import main
-from bidmp.experiments import benchmark
+from bidmp.experiments import benchmark, lasa_cells
 from bidmp.extension import dtw_distance
 from bidmp.tasks import swept_area
 
@@ -31,7 +31,7 @@ SMALL = {
     "every": 10,
     "methods": ["dmp-paper", "bidmp"],
 }
-TIMING = set(benchmark.TIMES)
+TIMING = set(lasa_cells.TIMES)
 
 
 def plain_dtw(a, b):
@@ -129,9 +129,9 @@ def test_a_cell_gives_the_same_floats_whatever_the_thread_pools():
     from threadpoolctl import threadpool_limits
 
     with threadpool_limits(limits=2):
-        two = benchmark.run_cell("Angle", 0, ["dmp-robot"], 10)
+        two = lasa_cells.run_cell("Angle", 0, ["dmp-robot"], 10)
     with threadpool_limits(limits=1):
-        one = benchmark.run_cell("Angle", 0, ["dmp-robot"], 10)
+        one = lasa_cells.run_cell("Angle", 0, ["dmp-robot"], 10)
     assert table(two["rows"]) == table(one["rows"])
 
 
@@ -208,7 +208,7 @@ def test_csv_output_and_the_summary(serial, tmp_path):
     ]
     assert rows[[r[0] for r in rows].index("bidmp")][3].startswith(f"{np.median(values):.3g}")
     cell = json.loads((tmp_path / "cells" / "Sshape__0.json").read_text())
-    assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == benchmark._cell_seed(
+    assert cell["protocol"]["every"] == 10 and cell["rows"][0]["seed"] == lasa_cells._cell_seed(
         "Sshape", 0
     )
 
@@ -227,11 +227,11 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
     )
     methods = list(dict.fromkeys(row["method"] for row in rows))
     for shape, demo in (("Sshape", 0), ("WShape", 4)):
-        fresh = benchmark.run_cell(shape, demo, methods, protocol["every"])["rows"]
+        fresh = lasa_cells.run_cell(shape, demo, methods, protocol["every"])["rows"]
         committed = [row for row in rows if row["shape"] == shape and row["demo"] == demo]
         assert len(fresh) == len(committed)
         for new, old in zip(fresh, committed):
-            for name in benchmark.METRICS:
+            for name in lasa_cells.METRICS:
                 assert new[name] == pytest.approx(old[name], rel=1e-6, abs=1e-9), (
                     shape,
                     demo,

@@ -10,7 +10,7 @@ test; the name checks are structural.
 import numpy as np
 import pytest
 
-from bidmp.experiments import benchmark
+from bidmp.experiments import benchmark, lasa_cells
 from bidmp.tasks import evaluate, scenarios
 from bidmp.tasks import methods as registry
 from bidmp.tasks.methods import Method, Task
@@ -67,7 +67,7 @@ def test_a_registered_method_runs_in_the_lasa_benchmark(line, tmp_path):
         synchronous=True,
     )
     rows = [row for row in result.rows if row["method"] == "test-line"]
-    assert len(rows) == 3 * len(benchmark.CASES)
+    assert len(rows) == 3 * len(lasa_cells.CASES)
     assert all(row["endpoint_error"] <= 1e-9 for row in rows)
     # The line is no LASA shape: it reproduces the demonstration far worse than the DMP does.
     reproduction = {
@@ -109,7 +109,7 @@ def test_the_built_in_methods_keep_their_names():
         "tpgmm",
         "mp-dmp",
     ]
-    assert tuple(registry.names(lasa=True)) == benchmark.LASA_METHODS
+    assert tuple(registry.names(lasa=True)) == lasa_cells.LASA_METHODS
     assert set(scenarios.METHODS) <= set(registry.names())
     assert registry.names(poses=True) == ["dmp", "dmp-paper", "dmp-robot", "bidmp", "bidmp-latest"]
     assert registry.names(closed_loop=True) == [

@@ -56,6 +56,14 @@ def check_units(units, name: str = "units") -> str:
     return units
 
 
+def mm(value_mm: float, units: str) -> float:
+    """``value_mm`` millimetres in ``units`` ("m", "cm", "mm"; "" and joint units are taken as mm)."""
+    from ._checks import check_real
+
+    value_mm = check_real(value_mm, "value_mm")
+    return value_mm * 1e-3 / UNITS.get(check_units(units), 1e-3)
+
+
 def conversion(source: str, target: str) -> float:
     """The factor that turns lengths in ``source`` into ``target`` (1 when either is unknown)."""
     source, target = check_units(source, "source units"), check_units(target, "target units")

@@ -54,7 +54,7 @@ def _run_on_dask(
 
         n_running = len(client.scheduler_info().get("workers", {})) or n_workers
         from ..tasks import methods as registry
-        from .benchmark import _write_cell, cell_key, run_cell
+        from .lasa_cells import _write_cell, cell_key, run_cell
 
         objects = [registry.get(name) for name in methods]
         futures = [

@@ -25,7 +25,7 @@ _EXPORTS = {
     "read_trajectory": "trajectories",
     "save_trajectory": "trajectories",
     "declared_units": "trajectories",
-    "is_joint_recording": "trajectories",
+    "is_joint_recording": "recordings",
     "read_poses": "poses",
     "save_poses": "poses",
     "atomic_write": "atomic",

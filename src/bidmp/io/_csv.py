@@ -22,7 +22,6 @@ logger = logging.getLogger(__name__)
 _SLOW_CSV_BYTES = (
     256 << 20
 )  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
-_POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
 
 
 def _parse_float(text: str) -> float | None:
@@ -75,15 +74,6 @@ def declared_units(path) -> str:
     except (OSError, UnicodeDecodeError):
         return ""
     return ""
-
-
-def is_joint_recording(path) -> bool:
-    """Whether a CSV's header is a joint-space recording (``t, <joint names>``, or a logger's
-    joint columns such as UR RTDE ``actual_q_0..5``): its values are joint angles, in radians
-    unless it declares otherwise."""
-    from .recordings import recording_kind
-
-    return recording_kind(path) == "joints"
 
 
 def _is_number(text: str) -> bool:
@@ -248,49 +238,3 @@ def _csv_values(
         ]
     )
     return values, tuple(text)
-
-
-def _check_npy_trajectory(path: Path):
-    limits = get_limits()
-
-    def check(shape, dtype):
-        if dtype.names is not None:  # a timed trajectory: one record per sample
-            if len(shape) != 1 or not _timed_fields(dtype):
-                raise ValueError(
-                    f"{path} holds records with fields {', '.join(dtype.names[:8])}; expected t, x, y[, z] "
-                    f"(and optionally vx, … ax, …) in shape (T,)"
-                )
-            if shape[0] > limits.max_samples:
-                raise ValueError(
-                    f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}"
-                )
-            return
-        if dtype.kind not in "fiu":
-            raise ValueError(f"{path} holds {dtype} data, not numbers")
-        if len(shape) != 2:
-            raise ValueError(f"{path} must hold an array of shape (T, D), got shape {shape}")
-        if shape[0] > limits.max_samples:
-            raise ValueError(
-                f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}; "
-                f"raise it with bidmp.set_limits(max_samples=...)"
-            )
-        if shape[1] > limits.max_dims:
-            raise ValueError(
-                f"{path} has {shape[1]:,} columns, over the limit max_dims = {limits.max_dims}"
-            )
-
-    return check
-
-
-def _timed_fields(dtype: np.dtype) -> tuple[str, ...] | None:
-    """The position fields of a structured timed-trajectory dtype (``t`` plus x, y[, z]; real
-    numbers), or None."""
-    names = dtype.names or ()
-    if "t" not in names:
-        return None
-    for positions in reversed(_POSITION_HEADERS):
-        if all(name in names for name in positions) and all(
-            dtype[n].kind in "fiu" and dtype[n].shape == () for n in ("t", *positions)
-        ):
-            return positions
-    return None

@@ -193,3 +193,79 @@ def _check_archive(archive: zipfile.ZipFile, path: Path, kind: str, error: type[
             RuntimeError,
         ) as exc:
             raise error(f"{path} is not a {kind} ({exc})") from None
+
+
+_POSITION_HEADERS = (("x", "y"), ("x", "y", "z"))
+
+
+def _read_npy_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
+    """An ``.npy`` demonstration: a float array (T, D), or a structured timed trajectory."""
+    with open(path, "rb") as handle:
+        magic = handle.read(4)
+    if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
+        raise ValueError(
+            f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)"
+        )
+    try:
+        positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
+    except (EOFError, OSError) as exc:
+        raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
+    except ValueError as exc:
+        message = str(exc)
+        raise ValueError(
+            message if str(path) in message else f"{path} is not a readable .npy array ({message})"
+        ) from None
+    times = None
+    if positions.dtype.names is not None:
+        fields = _timed_fields(positions.dtype)
+        times = np.asarray(positions["t"], dtype=np.float64)
+        positions = np.column_stack(
+            [np.asarray(positions[name], dtype=np.float64) for name in fields]
+        )
+    return positions, times
+
+
+def _check_npy_trajectory(path: Path):
+    limits = get_limits()
+
+    def check(shape, dtype):
+        if dtype.names is not None:  # a timed trajectory: one record per sample
+            if len(shape) != 1 or not _timed_fields(dtype):
+                raise ValueError(
+                    f"{path} holds records with fields {', '.join(dtype.names[:8])}; expected t, x, y[, z] "
+                    f"(and optionally vx, … ax, …) in shape (T,)"
+                )
+            if shape[0] > limits.max_samples:
+                raise ValueError(
+                    f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}"
+                )
+            return
+        if dtype.kind not in "fiu":
+            raise ValueError(f"{path} holds {dtype} data, not numbers")
+        if len(shape) != 2:
+            raise ValueError(f"{path} must hold an array of shape (T, D), got shape {shape}")
+        if shape[0] > limits.max_samples:
+            raise ValueError(
+                f"{path} has {shape[0]:,} samples, over the limit max_samples = {limits.max_samples:,}; "
+                f"raise it with bidmp.set_limits(max_samples=...)"
+            )
+        if shape[1] > limits.max_dims:
+            raise ValueError(
+                f"{path} has {shape[1]:,} columns, over the limit max_dims = {limits.max_dims}"
+            )
+
+    return check
+
+
+def _timed_fields(dtype: np.dtype) -> tuple[str, ...] | None:
+    """The position fields of a structured timed-trajectory dtype (``t`` plus x, y[, z]; real
+    numbers), or None."""
+    names = dtype.names or ()
+    if "t" not in names:
+        return None
+    for positions in reversed(_POSITION_HEADERS):
+        if all(name in names for name in positions) and all(
+            dtype[n].kind in "fiu" and dtype[n].shape == () for n in ("t", *positions)
+        ):
+            return positions
+    return None

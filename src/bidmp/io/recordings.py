@@ -12,8 +12,9 @@ import numpy as np
 
 from .._checks import as_trajectory, check_path, short_token
 from ._columns import Layout, parse_columns, resolve, times_in_seconds
+from ._npy import _read_npy_trajectory
 
-__all__ = ["Recording", "read_recording", "recording_kind"]
+__all__ = ["Recording", "read_recording", "recording_kind", "is_joint_recording"]
 
 KINDS = ("positions", "pose", "joints")
 
@@ -94,6 +95,13 @@ def recording_kind(path: str | os.PathLike, *, columns=None) -> str:
         return ""
 
 
+def is_joint_recording(path) -> bool:
+    """Whether a CSV's header is a joint-space recording (``t, <joint names>``, or a logger's
+    joint columns such as UR RTDE ``actual_q_0..5``): its values are joint angles, in radians
+    unless it declares otherwise."""
+    return recording_kind(path) == "joints"
+
+
 def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     """Read a demonstration from a CSV (with or without a header) or an ``.npy`` array.
 
@@ -120,8 +128,6 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
             raise ValueError(
                 f"{path}: a column mapping applies to CSV files with a header, not to .npy arrays"
             )
-        from .trajectories import _read_npy_trajectory
-
         positions, times = _read_npy_trajectory(path)
         layout = None
     elif suffix in (".csv", ".txt"):

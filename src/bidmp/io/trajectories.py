@@ -11,9 +11,9 @@ import numpy as np
 
 from .._checks import _as_bounded_array, as_trajectory, check_path, short_token
 from .._units import check_units
-from ._csv import _check_npy_trajectory, _timed_fields, declared_units, is_joint_recording
-from ._npy import _EMPTY_ZIP_MAGIC, _ZIP_MAGIC, _read_npy
+from ._csv import declared_units
 from .atomic import _destination, atomic_write
+from .recordings import is_joint_recording
 
 __all__ = [
     "load_trajectory",
@@ -78,33 +78,6 @@ def read_trajectory(
             f"position=<prefix>)"
         )
     return recording.values, recording.t
-
-
-def _read_npy_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    """An ``.npy`` demonstration: a float array (T, D), or a structured timed trajectory."""
-    with open(path, "rb") as handle:
-        magic = handle.read(4)
-    if magic in (_ZIP_MAGIC, _EMPTY_ZIP_MAGIC):
-        raise ValueError(
-            f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)"
-        )
-    try:
-        positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
-    except (EOFError, OSError) as exc:
-        raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
-    except ValueError as exc:
-        message = str(exc)
-        raise ValueError(
-            message if str(path) in message else f"{path} is not a readable .npy array ({message})"
-        ) from None
-    times = None
-    if positions.dtype.names is not None:
-        fields = _timed_fields(positions.dtype)
-        times = np.asarray(positions["t"], dtype=np.float64)
-        positions = np.column_stack(
-            [np.asarray(positions[name], dtype=np.float64) for name in fields]
-        )
-    return positions, times
 
 
 def save_trajectory(y, path: str | os.PathLike, times=None, *, units: str | None = None) -> Path:

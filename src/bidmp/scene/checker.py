@@ -24,9 +24,8 @@ class SceneChecker:
     tool placements are free, :meth:`segments_free` which straight tool moves are."""
 
     def __init__(self, scene: Scene, chosen: np.ndarray, margin: float = 0.0):
-        from .clearance import Scene
-
-        if not isinstance(scene, Scene):
+        # By what it has, not its class: the scene's module builds its checkers from this one.
+        if not all(hasattr(scene, name) for name in ("solids", "tool", "_engine")):
             raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
         self.scene = scene
         self.chosen = (

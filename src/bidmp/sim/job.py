@@ -24,7 +24,8 @@ import time
 
 import numpy as np
 
-from ..tasks.contract import Contract, mm
+from .._units import mm
+from ..tasks.contract import Contract
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
 from .job_world import _body, _move, _StepFailed, _transfer, _transfer_contract, _World
 from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle

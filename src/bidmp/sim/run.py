@@ -12,9 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_labels, check_bool, check_int, check_real, short_token
+from .._units import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
-from ..tasks.contract import mm
 from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
 from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement

@@ -37,7 +37,7 @@ from .._checks import (
     check_real,
     short_token,
 )
-from .._units import UNITS, check_units
+from .._units import mm
 from ..primitives.so3 import as_quaternions
 from .metrics import approach_error, axis_deviation, endpoint_error
 
@@ -64,12 +64,6 @@ PADDING = 3  # samples of rest before and after the commands when they are check
 # cubic starts at its full 6A/T², up to 45 % of the limit on the simulated nut task).
 AT_REST = 0.05
 _SLACK = 1e-9  # a peak equal to its limit to rounding is within it
-
-
-def mm(value_mm: float, units: str) -> float:
-    """``value_mm`` millimetres in ``units`` ("m", "cm", "mm"; "" and joint units are taken as mm)."""
-    value_mm = check_real(value_mm, "value_mm")
-    return value_mm * 1e-3 / UNITS.get(check_units(units), 1e-3)
 
 
 # ---------------------------------------------------------------------------------------------

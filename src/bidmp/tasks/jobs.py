@@ -28,9 +28,8 @@ from numbers import Real
 import numpy as np
 
 from .._checks import as_point, as_vector, check_choice, check_int, check_real, short_token
-from .._units import UNITS, check_units
+from .._units import UNITS, check_units, mm
 from ._scenario_fields import _fail, _point, _shown
-from .contract import mm
 
 __all__ = ["JobSpec", "JOB_KINDS", "parse_job", "tour"]
 

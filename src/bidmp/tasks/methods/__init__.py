@@ -47,15 +47,12 @@ def _load_builtins() -> None:
     if _BUILTINS_LOADED:
         return
     _BUILTINS_LOADED = True
-    # Each module registers its methods; the order is the order names() lists them in.
-    from . import (
-        bidmp,  # noqa: F401
-        dmp,  # noqa: F401
-        dmp_converged,  # noqa: F401
-        gmm,  # noqa: F401
-        mp_dmp,  # noqa: F401
-        tpgmm,  # noqa: F401
-    )
+    # Each module lists its methods (METHODS) and never imports the registry: one way only.
+    from . import bidmp, dmp, dmp_converged, gmm, mp_dmp, tpgmm
+
+    for module in (dmp, dmp_converged, bidmp, gmm, tpgmm, mp_dmp):
+        for method in module.METHODS:
+            register(method)
 
 
 def register(method: Method, *, replace: bool = False) -> Method:

@@ -8,7 +8,6 @@ import numpy as np
 from ..._checks import as_point
 from ...incremental.bidmp import BiDMP
 from ...incremental.cartesian import CartesianBiDMP
-from . import register
 from .base import Method, Task
 
 
@@ -63,5 +62,9 @@ class _PerGoal:
 
 
 _MODELS = (BiDMP, CartesianBiDMP, _PerGoal)
-register(_BiDMPMethod("bidmp", "nearest", repairs=True))
-register(_BiDMPMethod("bidmp-latest", "latest", lasa=False))
+
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (
+    _BiDMPMethod("bidmp", "nearest", repairs=True),
+    _BiDMPMethod("bidmp-latest", "latest", lasa=False),
+)

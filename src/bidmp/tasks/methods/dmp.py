@@ -7,7 +7,6 @@ import numpy as np
 
 from ...primitives.cartesian import CartesianDMP
 from ...primitives.dmp import DMP
-from . import register
 from .base import Method, Task, checked_goals
 
 _DMPS = (DMP, CartesianDMP)
@@ -45,6 +44,9 @@ class _DMPMethod(Method):
         return model.stepper(goal, duration=duration, coupling=coupling)
 
 
-register(_DMPMethod("dmp", lasa=False))
-register(_DMPMethod("dmp-paper", protocol="paper"))
-register(_DMPMethod("dmp-robot", protocol="robot"))
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (
+    _DMPMethod("dmp", lasa=False),
+    _DMPMethod("dmp-paper", protocol="paper"),
+    _DMPMethod("dmp-robot", protocol="robot"),
+)

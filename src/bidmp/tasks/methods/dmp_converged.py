@@ -8,7 +8,6 @@ import numpy as np
 
 from ..._checks import as_vector
 from ...primitives.dmp import DMP
-from . import register
 from .base import Method, Task, checked_goals
 
 CONVERGED_GAIN = 1e-4  # dmp-converged runs whole multiples of T until endpoint_gain() <= this
@@ -34,4 +33,5 @@ class _DMPConverged(Method):
         return self.rollouts(model, as_vector(goal, "goal")[None])[0]
 
 
-register(_DMPConverged())
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (_DMPConverged(),)

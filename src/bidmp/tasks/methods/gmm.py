@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..._checks import as_vector
-from . import register
 from .base import Method, Task, checked_goals
 
 
@@ -34,4 +33,5 @@ class _GMMMethod(Method):
         return model.rollout()
 
 
-register(_GMMMethod())
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (_GMMMethod(),)

@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..._checks import as_point
-from . import register
 from .base import Method, Task
 
 
@@ -38,4 +37,5 @@ class _PeerDMP(Method):
         return peer.open_loop()[1]
 
 
-register(_PeerDMP())
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (_PeerDMP(),)

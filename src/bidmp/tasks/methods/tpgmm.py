@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import register
 from .base import Method, Task
 
 
@@ -34,4 +33,5 @@ class _TPGMMMethod(Method):
         return tpgmm.rollout(goal, start=start)
 
 
-register(_TPGMMMethod())
+# The methods this module adds to the registry (bidmp.tasks.methods registers them).
+METHODS = (_TPGMMMethod(),)
