@@ -87,6 +87,8 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.inverse_kinematics": {"points": np.array([[0.45, -0.1, 0.3], [0.5, 0.0, 0.3]])},
         "bidmp.sim.joint_names": {"robot": "panda"},
         "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
+        "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
+        "bidmp.sim.require_simulator": {},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},
         "bidmp.io.load_model": {"path": model},
         "bidmp.plotting.plot_segmentation": {"points": segment(DEMO).points},

@@ -200,8 +200,8 @@ def test_the_timing_and_pose_helpers_refuse_bad_input_by_name():
     ]
     calls = [
         lambda v: timing.check_timestamps(v, 20),
-        lambda v: timing._drop_duplicate_stamps(v, t),
-        lambda v: timing._drop_duplicate_stamps(y, v),
+        lambda v: timing.drop_repeated_stamps(v, t),
+        lambda v: timing.drop_repeated_stamps(y, v),
         lambda v: timing.uniform_time(v, t),
         lambda v: timing.uniform_time(y, v),
         lambda v: timing.on_uniform_time(v, t),

@@ -47,10 +47,10 @@ def run_job_command(
 
 
 def _cmd_job(args: argparse.Namespace) -> int:
-    from ..sim.pybullet.world import _pybullet_module
+    from ..sim import require_simulator
     from ..tasks.scenarios import load
 
-    _pybullet_module()  # without the extra: the install command, before any work
+    require_simulator()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     targets = (
         None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]

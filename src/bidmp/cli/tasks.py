@@ -140,9 +140,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
     if args.sim or args.job:
-        from ..sim.pybullet.world import _pybullet_module as _pybullet
+        from ..sim import require_simulator
 
-        _pybullet()
+        require_simulator()
     if args.job and scenario.job is None:
         raise ValueError(
             f'--job: scenario {scenario.name!r} has no "job" (the steps to run at each target)'
@@ -172,11 +172,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from ..sim import require_simulator
     from ..sim.backend import GoalUpdate, Hold
-    from ..sim.pybullet.world import _pybullet_module as _pybullet
     from ..tasks.scenarios import load
 
-    _pybullet()  # without the extra: the install command, before any work
+    require_simulator()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:

@@ -16,7 +16,7 @@ from .._checks import as_trajectory, check_real, numerically_guarded
 from .._units import check_units
 from ..primitives.cartesian import as_poses
 from ..primitives.so3 import continuous_log, orientation_from_log
-from ..primitives.timing import Trajectory, _drop_duplicate_stamps, uniform_time
+from ..primitives.timing import Trajectory, drop_repeated_stamps, uniform_time
 
 __all__ = ["prepare", "PrepareInfo", "prepare_poses"]
 
@@ -89,7 +89,7 @@ def prepare(
 
     units = check_units(units)
     y = as_trajectory(y, "y", min_points=10)
-    y, t = _drop_duplicate_stamps(y, t)
+    y, t = drop_repeated_stamps(y, t)
     cutoff_hz = check_real(cutoff_hz, "cutoff_hz", positive=True)
     idle_fraction = check_real(idle_fraction, "idle_fraction", positive=True, maximum=0.5)
     uniform, grid = uniform_time(y, t)

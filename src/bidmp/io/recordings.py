@@ -117,7 +117,7 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     -------
     Recording
     """
-    from ..primitives.timing import _drop_duplicate_stamps
+    from ..primitives.timing import drop_repeated_stamps
     from ._csv import _check_file, _csv_fast, _csv_rows, _note_ignored, declared_units
 
     path = check_path(path)
@@ -162,7 +162,7 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     kind = "positions" if layout is None else layout.kind
     positions = as_trajectory(positions, name=str(path), allow_static=kind == "pose")
     if times is not None:
-        positions, times = _drop_duplicate_stamps(positions, times, f"{path}: the time column")
+        positions, times = drop_repeated_stamps(positions, times, f"{path}: the time column")
     orientation = None
     if layout is not None and layout.orientation:
         positions, orientation = positions[:, :3], positions[:, 3:]

@@ -44,6 +44,7 @@ _EXPORTS = {
     "TimedMotion": "timing",
     "check_timestamps": "timing",
     "uniform_time": "timing",
+    "drop_repeated_stamps": "timing",
     "scale_factor": "timing",
     "time_scale": "timing",
     "ROBOT_ALPHA": "protocols",

@@ -29,6 +29,7 @@ __all__ = [
     "Trajectory",
     "TimedMotion",
     "check_timestamps",
+    "drop_repeated_stamps",
     "uniform_time",
     "on_uniform_time",
     "scale_factor",
@@ -221,7 +222,7 @@ def _stamp(value: float) -> str:
     return np.format_float_positional(float(value), unique=True, trim="-")
 
 
-def _drop_duplicate_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
+def drop_repeated_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:
     """``y`` (T, D) and stamps ``t`` (T,) without the samples whose stamp repeats the previous
     one, as loggers write them (the first of each run is kept); a warning says how many.
 
@@ -377,6 +378,6 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     y = _as_samples(y)
     if t is None:
         return y, (y.shape[0] - 1) / y.shape[0]
-    y, stamps = _drop_duplicate_stamps(y, t)
+    y, stamps = drop_repeated_stamps(y, t)
     y, grid = uniform_time(y, stamps)
     return y, float(grid[-1])

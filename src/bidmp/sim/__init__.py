@@ -32,6 +32,7 @@ _EXPORTS = {
     "in_slot": "job_report",
     "inverse_kinematics": "kinematics",
     "joint_names": "kinematics",
+    "require_simulator": "backend",
     "SimulatorBackend": "backend",
     "SimError": "backend",
     "JointLimits": "backend",

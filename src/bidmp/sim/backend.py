@@ -20,6 +20,7 @@ import numpy as np
 from .._checks import as_point, as_vector, check_int, check_real
 
 __all__ = [
+    "require_simulator",
     "SimulatorBackend",
     "SimError",
     "JointLimits",
@@ -218,3 +219,11 @@ class SimulatorBackend(Protocol):
 
     def close(self) -> None:
         """Release the simulator."""
+
+
+def require_simulator() -> None:
+    """Check that the simulator (the ``sim`` extra: PyBullet) is installed, before any work;
+    without it :class:`bidmp.MissingExtraError` says how to install it."""
+    from .pybullet.world import _pybullet_module
+
+    _pybullet_module()
