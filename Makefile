@@ -12,13 +12,13 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint bench install clean readme fuzz mutation sim lasa random-cells avoidance view-check
+.PHONY: demo test lint docs bench install clean readme fuzz mutation sim lasa random-cells avoidance view-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint,docs]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -28,6 +28,11 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2
+
+# The documentation site (mkdocs.yml: the guides, the architecture, the API reference from the
+# docstrings) built with every warning an error, into site/.
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 
 # ruff's linter (pycodestyle, pyflakes, import order, bugbear, pyupgrade, complexity, argument
 # counts; settings in pyproject.toml) and its formatter, checked, over everything Python here.
@@ -124,4 +129,4 @@ readme: $(STAMP)
 	$(PY) tools/readme.py
 
 clean:
-	rm -rf $(VENV) bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check
+	rm -rf $(VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check

@@ -29,7 +29,7 @@ def test_import_and_cli_help_do_not_import_numpy():
     assert result.stdout.strip() == "False"
 
 
-# Layers of ARCHITECTURE.md, by subpackage: a module may import only from its own or lower-numbered
+# Layers of docs/architecture.md, by subpackage: a module may import only from its own or lower-numbered
 # layers. 0: the package root's private helpers; 1: the math; 2: data and tasks (plotting sits
 # here, not in 3: figures are data out, like files, and evaluation reports draw them; it imports
 # only the math and io); 3: the application; 4: the shell.
@@ -96,7 +96,7 @@ def test_modules_respect_the_layers():
         module = module_of(path)
         if module == "__init__":
             continue
-        assert module in LAYERS, f"{module} is not placed in a layer of ARCHITECTURE.md"
+        assert module in LAYERS, f"{module} is not placed in a layer of docs/architecture.md"
         for imported in bidmp_imports(path):
             if imported in LAYERS and imported not in ("__init__", module):
                 assert LAYERS[imported] <= LAYERS[module], (

@@ -1,5 +1,5 @@
-"""The README tells the truth: its result tables are the committed outputs of the commands that
-make them, and every Python block runs on its own."""
+"""The documentation tells the truth: the README and the guides (docs/guides/), their result tables
+the committed outputs of the commands that make them, every Python block running on its own."""
 
 import importlib.util
 import pathlib
@@ -10,7 +10,13 @@ import sys
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-README = (ROOT / "README.md").read_text(encoding="utf-8")
+PAGES = {
+    path: path.read_text(encoding="utf-8")
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs" / "guides").glob("*.md"))]
+}
+DOCS = "\n".join(PAGES.values())
+README = PAGES[ROOT / "README.md"]
+GUIDE = {path.stem: text for path, text in PAGES.items()}
 
 
 def readme_tool():
@@ -21,7 +27,7 @@ def readme_tool():
 
 
 def test_readme_tables_equal_the_committed_command_outputs():
-    blocks = readme_tool().blocks(README)
+    blocks = readme_tool().blocks(DOCS)
     assert {path for path, _ in blocks} == {
         "docs/results/table4.md",
         "docs/results/tasks.md",
@@ -41,7 +47,7 @@ def test_readme_tables_equal_the_committed_command_outputs():
         assert body.strip() == committed.strip(), f"README block {path} is stale: run 'make readme'"
 
 
-PYTHON_BLOCKS = re.findall(r"```python\n(.*?)```", README, re.DOTALL)
+PYTHON_BLOCKS = re.findall(r"```python\n(.*?)```", DOCS, re.DOTALL)
 
 
 @pytest.mark.parametrize("index", range(len(PYTHON_BLOCKS)))
@@ -61,7 +67,7 @@ def test_the_readme_limits_table_states_the_defaults_in_force():
 
     import bidmp
 
-    rows = dict(re.findall(r"^\| `(max_\w+|min_\w+)` \| ([^|]+) \|", README, re.MULTILINE))
+    rows = dict(re.findall(r"^\| `(max_\w+|min_\w+)` \| ([^|]+) \|", DOCS, re.MULTILINE))
     defaults = dataclasses.asdict(bidmp.Limits())
     assert set(rows) == set(defaults), "document every limit in the README table"
     for name, value in defaults.items():
@@ -84,10 +90,28 @@ def test_the_robot_protocol_table_is_what_its_tool_measures(tmp_path):
 def test_the_readme_cites_only_files_in_the_repository():
     """The README once cited SPEC.md and ARCHITECTURE.md, which live outside it. Every
     repository path it names (docs/, tools/, benchmarks/, tests/, src/) exists."""
-    for outside in ("SPEC.md", "ARCHITECTURE.md", "../shared"):
-        assert outside not in README, outside
-    for name in re.findall(r"\b((?:docs|tools|benchmarks|tests|src)/[\w./-]*\w)", README):
-        assert (ROOT / name).exists(), name
+    for page, text in PAGES.items():
+        for outside in ("SPEC.md", "ARCHITECTURE.md", "../shared"):
+            assert outside not in text, (page.name, outside)
+        for name in re.findall(
+            r"(?<![\w./])((?:docs|tools|benchmarks|tests|src)/[\w./-]*\w)", text
+        ):
+            assert (ROOT / name).exists(), (page.name, name)
+        for link in re.findall(r"\]\(([^)#:\s]+)(?:#[^)]*)?\)", text):  # relative links resolve
+            assert (page.parent / link).exists(), (page.name, link)
+
+
+def test_the_site_home_is_the_readme():
+    """Structure guard: docs/index.md is written from the README by tools/readme.py."""
+    index = (ROOT / "docs" / "index.md").read_text(encoding="utf-8")
+    assert index == readme_tool().index_text(README)
+
+
+def test_the_readme_is_short_and_links_every_guide():
+    assert len(README.splitlines()) <= 400
+    for guide in GUIDE:
+        if guide != "README":
+            assert f"docs/guides/{guide}.md" in README or guide == "development", guide
 
 
 def test_the_own_robot_commands_run_as_written(tmp_path, monkeypatch, capsys):
@@ -101,7 +125,7 @@ def test_the_own_robot_commands_run_as_written(tmp_path, monkeypatch, capsys):
     pytest.importorskip("plotly")
     from bidmp.cli import main
 
-    section = README.split("## Your own robot and data", 1)[1].split("\n## ", 1)[0]
+    section = GUIDE["your-data"]
     python = re.search(r"```python\n(.*?)```", section, re.DOTALL).group(1)
     commands = re.search(r"<!-- own-robot-commands -->\n```sh\n(.*?)```", section, re.DOTALL).group(
         1

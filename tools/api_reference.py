@@ -1,7 +1,10 @@
-"""Write docs/api.md: bidmp's public surface, subpackage by subpackage.
+"""Write docs/api.md (bidmp's public surface, subpackage by subpackage) and the documentation
+site's API reference pages (docs/reference/*.md: each public function and class by the module
+that defines it, which mkdocstrings renders from its docstring: the packages' names are lazy, so
+they are named by their home).
 
-    .venv/bin/python tools/api_reference.py           # rewrites docs/api.md
-    .venv/bin/python tools/api_reference.py --check   # exit 1 if docs/api.md is not current
+    .venv/bin/python tools/api_reference.py           # rewrites docs/api.md and docs/reference/
+    .venv/bin/python tools/api_reference.py --check   # exit 1 if any of them is not current
 
 The public names are exactly each subpackage's ``__all__`` (and that of ``bidmp.tasks.methods``
 and ``bidmp.sim.pybullet``, the two packages inside a subpackage); everything else in the tree
@@ -75,19 +78,66 @@ def render() -> str:
     return "\n".join(lines)
 
 
+REFERENCE = ROOT / "docs" / "reference"
+# The site's reference: the subpackages a user imports from (the packages inside them are listed
+# in docs/api.md; their names are reached through these).
+SITE_PACKAGES = tuple(
+    package for package in PACKAGES if package.count(".") <= 1 and package != "bidmp.cli"
+)
+
+
+def reference_pages() -> dict[Path, str]:
+    """docs/reference/<name>.md for every package of :data:`SITE_PACKAGES`: each function and
+    class rendered once, on the page of the first subpackage that lists it; the top-level page
+    (and a later subpackage's) names where it is."""
+    pages, documented = {}, {}
+    for package in sorted(SITE_PACKAGES, key=lambda name: name == "bidmp"):
+        module = importlib.import_module(package)
+        page = package.split(".")[-1]
+        lines, listed, constants = [f"# `{package}`", ""], [], []
+        for name in module.__all__:
+            value = getattr(module, name)
+            if kind(value) in ("class", "function", "exception"):
+                home = f"{value.__module__}.{value.__qualname__}"
+                if home in documented:
+                    listed.append(
+                        f"| `{name}` | [{documented[home]}]({documented[home]}.md#{home}) |"
+                    )
+                    continue
+                documented[home] = page
+                lines += [f"::: {home}", "    options:", "      heading_level: 2", ""]
+            elif kind(value) == "constant":
+                constants.append(f"| `{name}` | {summary(value)} |")
+        if listed:
+            lines += ["## Also here", "", "| name | documented in |", "|---|---|", *listed, ""]
+        if constants:
+            lines += ["## Constants", "", "| name | type |", "|---|---|", *constants, ""]
+        pages[REFERENCE / f"{page}.md"] = "\n".join(lines)
+    return pages
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="exit 1 if docs/api.md is not current")
     args = parser.parse_args()
-    text = render()
+    wanted = {OUT: render(), **reference_pages()}
     if args.check:
-        current = OUT.read_text(encoding="utf-8") if OUT.exists() else ""
-        if current != text:
-            print("docs/api.md is not current: run tools/api_reference.py", file=sys.stderr)
+        stale = [
+            path
+            for path, text in wanted.items()
+            if not path.exists() or path.read_text(encoding="utf-8") != text
+        ]
+        if stale:
+            print(
+                f"{', '.join(str(p.relative_to(ROOT)) for p in stale)} not current: run tools/api_reference.py",
+                file=sys.stderr,
+            )
             return 1
         return 0
-    OUT.write_text(text, encoding="utf-8")
-    print(f"wrote {OUT}")
+    REFERENCE.mkdir(exist_ok=True)
+    for path, text in wanted.items():
+        path.write_text(text, encoding="utf-8")
+    print(f"wrote {OUT} and {len(wanted) - 1} reference pages")
     return 0
 
 

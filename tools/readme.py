@@ -1,6 +1,7 @@
-"""Keep the README's result tables equal to the committed outputs of the commands that make them.
+"""Keep the documentation's result tables equal to the committed outputs of the commands that
+make them.
 
-A generated block in README.md looks like::
+A generated block in README.md or a guide (docs/guides/*.md) looks like::
 
     <!-- generated: docs/results/table4.md -->
     ...the file's content...
@@ -18,6 +19,13 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
+
+
+def pages() -> list[Path]:
+    """The pages whose blocks are kept: the README and every guide."""
+    return [README, *sorted((ROOT / "docs" / "guides").glob("*.md"))]
+
+
 BLOCK = re.compile(
     r"(<!-- generated: (?P<path>\S+) -->\n)(?P<body>.*?)(<!-- end generated -->)", re.DOTALL
 )
@@ -38,17 +46,41 @@ def render(text: str) -> str:
     return BLOCK.sub(replace, text)
 
 
+INDEX = ROOT / "docs" / "index.md"
+
+
+def index_text(readme: str) -> str:
+    """docs/index.md, the site's home: the README with its links made relative to docs/."""
+    text = readme.replace("](docs/guides/)", "](guides/library.md)").replace("](docs/", "](")
+    return text.replace("[CHANGELOG.md](CHANGELOG.md)", "`CHANGELOG.md`")
+
+
 def main(argv: list[str]) -> int:
-    text = README.read_text(encoding="utf-8")
-    rendered = render(text)
-    if "--check" in argv:
-        if rendered != text:
-            print("README.md differs from docs/results: run 'make readme'", file=sys.stderr)
-            return 1
-        return 0
-    if rendered != text:
-        README.write_text(rendered, encoding="utf-8")
-        print(f"updated {README}")
+    index = index_text(README.read_text(encoding="utf-8"))
+    if "--check" not in argv and (not INDEX.exists() or INDEX.read_text(encoding="utf-8") != index):
+        INDEX.write_text(index, encoding="utf-8")
+        print(f"updated {INDEX}")
+    stale = (
+        []
+        if not INDEX.exists() or INDEX.read_text(encoding="utf-8") == index
+        else [INDEX.relative_to(ROOT)]
+    )
+    for page in pages():
+        text = page.read_text(encoding="utf-8")
+        rendered = render(text)
+        if rendered == text:
+            continue
+        if "--check" in argv:
+            stale.append(page.relative_to(ROOT))
+        else:
+            page.write_text(rendered, encoding="utf-8")
+            print(f"updated {page}")
+    if stale:
+        print(
+            f"{', '.join(map(str, stale))} differ from docs/results: run 'make readme'",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 
