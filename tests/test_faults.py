@@ -1,7 +1,7 @@
 """The fault trials kept as tests: concurrent writers of one file and a disk
 that fills up mid-write leave either the old file or a complete new one, and no temporary file.
 (A writer killed mid-write: tests/test_robustness.py; a benchmark worker killed, and a resumed
-run: tests/test_benchmark.py.)"""
+run: tests/experiments/test_benchmark.py.)"""
 
 import multiprocessing
 import os

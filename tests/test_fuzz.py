@@ -1345,7 +1345,7 @@ def test_fuzz_cli(files, data):
             del argv[data.draw(st.integers(1, len(argv) - 1))]
     argv = [a for a in argv if a not in ("--help", "-h")]
     if "reproduce" in argv[:1] and "--seeds" not in argv:
-        return  # a real reproduce run takes longer than a fuzz call may (tests/test_cli.py runs them)
+        return  # a real reproduce run takes longer than a fuzz call may (tests/cli/test_cli.py runs them)
     if argv[:1] == ["reproduce"] and any(a in argv for a in ("table4", "table5", "figures")):
         seeds = argv[argv.index("--seeds") + 1] if argv.index("--seeds") + 1 < len(argv) else ""
         if seeds.isdigit() and 1 <= int(seeds) <= 200:

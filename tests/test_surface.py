@@ -142,7 +142,7 @@ def test_loops_and_sizes_are_bounded_where_a_caller_chooses_them():
         np.broadcast_to(np.zeros(2), (500_000_000, 2)),
     )
     assert time.perf_counter() - start < 2.0
-    # Within the bounds they answer as before (the Lasso check of ADMM is in tests/test_bls.py).
+    # Within the bounds they answer as before (the Lasso check of ADMM is in tests/incremental/test_bls.py).
     assert np.isfinite(sparse_autoencoder(F, target, 1e-3, 50)).all()
     assert frechet_distance_reference(long[:50], long[:40]) == 0.0
 

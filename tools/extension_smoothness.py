@@ -17,7 +17,7 @@ Printed, for a demonstration that comes to rest at a corner and a target 300 mm 
 * the floor, floor(h): the least LDJ deficit, against the straight quintic, of any rest-to-rest
   route through the clearance point the post forces (its reach less its distance from the chord,
   at its place along the chord), the time and velocity at that point optimised and the route
-  least-jerk between (tests/test_extension_timing.py's ldj_floor, exact piecewise quintics); for
+  least-jerk between (tests/extension/test_extension_timing.py's ldj_floor, exact piecewise quintics); for
   each random post the transfer's deficit against its template, the floor, and the excess over it
   (the bound: at most 0.3). Beside the floor: the least-jerk route with the point at mid-time
   (Flash & Hogan 1985), which is not the least-LDJ one, and a half-sine bow on the quintic time law.
@@ -34,9 +34,10 @@ from pathlib import Path
 import numpy as np
 from extension_pace import peaks  # the same estimator as the pace script (central differences)
 
-# The measures and closed forms of the tests themselves (tests/test_extension_timing.py): what this
+# The measures and closed forms of the tests themselves (tests/extension/test_extension_timing.py): what this
 # script prints is what they assert on.
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "extension"))
 from test_extension_timing import ldj_floor, shortest_around, transfer  # noqa: E402
 from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
 

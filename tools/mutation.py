@@ -76,7 +76,7 @@ TARGETS = (
             "_sweep",
             "_nearest_to_its_clearance",
         ),
-        ("tests/test_oracles.py", "tests/test_geometry.py"),
+        ("tests/test_oracles.py", "tests/scene/test_geometry.py"),
     ),
     Target(
         "scene distances (culling bounds)",
@@ -88,13 +88,17 @@ TARGETS = (
             "_Distances.tool_to",
             "_Distances._witnessed",
         ),
-        ("tests/test_oracles.py", "tests/test_geometry.py"),
+        ("tests/test_oracles.py", "tests/scene/test_geometry.py"),
     ),
     Target(
         "scene checker",
         "bidmp.scene.checker",
         ("SceneChecker.__call__", "SceneChecker.segments_free", "SceneChecker._move_free"),
-        ("tests/test_oracles.py", "tests/test_geometry.py", "tests/test_roadmap.py"),
+        (
+            "tests/test_oracles.py",
+            "tests/scene/test_geometry.py",
+            "tests/extension/test_roadmap.py",
+        ),
     ),
     Target(
         "limit checks and measurement",
@@ -109,19 +113,19 @@ TARGETS = (
             "Verdict.ok",
             "Verdict.failed",
         ),
-        ("tests/test_oracles.py", "tests/test_contract.py", "tests/test_sim_limits.py"),
+        ("tests/test_oracles.py", "tests/tasks/test_contract.py", "tests/sim/test_sim_limits.py"),
     ),
     Target(
         "simulator: measured peaks and the 1 kHz command generator",
         "bidmp.sim.limits",
         ("_worst", "_measured_peaks", "_RateLimiter.__call__"),
-        ("tests/test_oracles.py", "tests/test_sim_limits.py"),
+        ("tests/test_oracles.py", "tests/sim/test_sim_limits.py"),
     ),
     Target(
         "engagement",
         "bidmp.tasks.metrics",
         ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),
-        ("tests/test_oracles.py", "tests/test_engagement.py", "tests/test_contract.py"),
+        ("tests/test_oracles.py", "tests/tasks/test_engagement.py", "tests/tasks/test_contract.py"),
     ),
     Target(
         "job success criteria",
@@ -136,14 +140,14 @@ TARGETS = (
         "similarity (Fréchet, normaliser)",
         "bidmp.extension.similarity",
         ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
-        ("tests/test_oracles.py", "tests/test_similarity.py"),
+        ("tests/test_oracles.py", "tests/extension/test_similarity.py"),
         pure_python=True,
     ),
     Target(
         "similarity template",
         "bidmp.extension.roadmap",
         ("template", "_minimal_rotation"),
-        ("tests/test_oracles.py", "tests/test_roadmap.py"),
+        ("tests/test_oracles.py", "tests/extension/test_roadmap.py"),
     ),
     Target(
         "segmentation",
@@ -156,7 +160,7 @@ TARGETS = (
             "segment",
             "choose_piece",
         ),
-        ("tests/test_oracles.py", "tests/test_segmentation.py"),
+        ("tests/test_oracles.py", "tests/extension/test_segmentation.py"),
     ),
     Target(
         "BLS",
@@ -169,19 +173,23 @@ TARGETS = (
             "BLS.hidden",
             "BLS.fit",
         ),
-        ("tests/test_oracles.py", "tests/test_bls.py"),
+        ("tests/test_oracles.py", "tests/incremental/test_bls.py"),
     ),
     Target(
         "Bi-DMP skill selection",
         "bidmp.incremental._skills",
         ("SkillLibrary.select_skill",),
-        ("tests/test_oracles.py", "tests/test_incremental.py"),
+        ("tests/test_oracles.py", "tests/incremental/test_incremental.py"),
     ),
     Target(
         "goal systems",
         "bidmp.primitives.goals",
         ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
-        ("tests/test_oracles.py", "tests/test_dmp.py", "tests/test_approach.py"),
+        (
+            "tests/test_oracles.py",
+            "tests/primitives/test_dmp.py",
+            "tests/primitives/test_approach.py",
+        ),
     ),
     Target(
         "units and speeds a robot can run",
@@ -196,7 +204,7 @@ TARGETS = (
         "phase stopping",
         "bidmp.primitives.coupling",
         ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
-        ("tests/test_oracles.py", "tests/test_primitives.py"),
+        ("tests/test_oracles.py", "tests/primitives/test_primitives.py"),
     ),
 )
 

@@ -1,5 +1,5 @@
 """Why the repairs are tried in the order they are: each repair alone on every motion that breaks the
-contract, on random users' cells (the generator of ``tests/test_random_user_cells.py``: nut modules
+contract, on random users' cells (the generator of ``tests/tasks/test_random_user_cells.py``: nut modules
 in mm, cm and m with posts, bosses, ducts and tilted brackets) and on the two users' cells of the
 tests (two posts, the duct module). Per repair: how many of the broken motions it alone makes keep the
 contract, and its median time per motion; then the order :data:`bidmp.tasks.repair.REPAIRS` on the
@@ -23,6 +23,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "tasks"))
 from test_random_user_cells import user_cell  # noqa: E402  (the random cells as the tests draw them)
 
 from bidmp.tasks import evaluate, scenarios  # noqa: E402

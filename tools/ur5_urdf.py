@@ -11,7 +11,7 @@ Classic DH: frame i = frame i-1 . Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i). A URD
 about its own z at its origin, so joint i sits at frame i-1 and joint i+1's origin is the DH tail
 (a_i, 0, d_i) with roll alpha_i in link i's frame; the flange is frame 6.
 
-Run ``python tools/ur5_urdf.py`` to write it again; tests/test_robots.py checks PyBullet's forward
+Run ``python tools/ur5_urdf.py`` to write it again; tests/sim/test_robots.py checks PyBullet's forward
 kinematics of the file against the DH product computed independently.
 """
 

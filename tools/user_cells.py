@@ -16,6 +16,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests"))
+sys.path.insert(0, str(ROOT / "tests" / "tasks"))
 from test_user_cells import spec  # noqa: E402  (the cells and their unit conversion, as the tests use them)
 
 from bidmp import sim  # noqa: E402

@@ -1,5 +1,5 @@
 """Random avoidance cases: a demonstration and a field of parts across it, the same for
-the tests (tests/test_avoidance.py), the benchmark against movement_primitives
+the tests (tests/primitives/test_avoidance.py), the benchmark against movement_primitives
 (benchmarks/bench_avoidance.py) and anyone who wants to try a coupling term on cells nobody tuned.
 
 Layer 3: a demonstration (``bidmp.demonstrations``) beside a field (``bidmp.scene.random_field``).

@@ -17,7 +17,7 @@ and a polyline sampled at the robot's rate has an acceleration spike at every ve
   polyline (tried before, still used for the template's sensor noise) had to keep narrow windows
   next to a post, and the tight bends it kept made the transfer around a post take three times
   as long as the free one (log dimensionless jerk -17 against the template's -10.4 in
-  ``tests/test_extension_timing.py``'s post; -10.1 to -10.7 now). Beside it two bows from the
+  ``tests/extension/test_extension_timing.py``'s post; -10.1 to -10.7 now). Beside it two bows from the
   template (or the chord), each scaled to the least that is free: the route's offset reduced to one
   half-sine bow (its curvature spread over the whole transfer), and the least-jerk bow through the
   point where the route is furthest from the template (two quintics meeting there, flat at the

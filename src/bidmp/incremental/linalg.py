@@ -12,7 +12,7 @@ times the largest dropped one; on a Bi-DMP learned from a bundled recording it t
 singular values decaying continuously through the cut, kept and dropped ones meeting at about
 1e-10 of the largest, so that a 1e-15 relative change of the matrix moves NumPy's own weights by
 more than 1e-8 and no update reproduces them — the update is refused with that reason; ``reg > 0``
-is exact there (``update="exact_ridge"``). ``tests/test_bls.py`` measures both.
+is exact there (``update="exact_ridge"``). ``tests/incremental/test_bls.py`` measures both.
 With ``update="exact_ridge"`` the model keeps the Cholesky factor of ``AᵀA + λI`` and grows it
 by a block Cholesky step, so that the result equals a ridge fit from scratch with the same nodes.
 (An explicit block inverse via the Schur complement loses all accuracy here, because the hidden

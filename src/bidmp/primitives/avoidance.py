@@ -17,7 +17,7 @@ For every part within the *influence* distance ``ρ`` of the margin shell (signe
   stopping). When the tangent speed is nil (head-on), the tangent component of the way to the
   goal is used, else a fixed perpendicular: a potential field's symmetric stall is broken.
 
-Measured on random fields of boxes and cylinders (tests/test_avoidance.py; the README's
+Measured on random fields of boxes and cylinders (tests/primitives/test_avoidance.py; the README's
 "Avoidance" section, ``benchmarks/bench_avoidance.py``): braking and barrier alone (Park's form
 with volumes) stall in front of a part the straight motion meets head-on and miss the goal;
 with the steering the motion goes round. The sum is capped at ``max_acceleration`` (the

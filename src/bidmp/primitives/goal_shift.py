@@ -22,7 +22,7 @@ from .goals import _smoothstep, _smoothstep_derivatives
 __all__ = []
 
 # Peaks of the 7th-order smoothstep's derivatives on [0, 1]: s' 35/16, s'' 7.513, s''' 52.5
-# (numerically, tests/test_goal_shift.py checks them): an offset Δ over T peaks at |Δ| s^(k) / T^k.
+# (numerically, tests/primitives/test_goal_shift.py checks them): an offset Δ over T peaks at |Δ| s^(k) / T^k.
 _PEAKS = (35.0 / 16.0, 7.5132, 52.5)
 _LIMIT_SHARE = 0.25  # of each limit an online goal's offset may use on its own
 

@@ -18,7 +18,7 @@ path*: :func:`_unit_responses`, :func:`_affine_rollouts`).
 
 State feedback (a coupling term that depends on where the system is) cannot go through a filter:
 :class:`StepIntegrator` takes the same exact (or Euler) steps one at a time and adds coupling
-accelerations. With no coupling term it equals the fast path to rounding (``tests/test_dmp.py``).
+accelerations. With no coupling term it equals the fast path to rounding (``tests/primitives/test_dmp.py``).
 """
 
 from __future__ import annotations

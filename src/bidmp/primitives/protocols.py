@@ -77,7 +77,7 @@ INTEGRATOR_CHOICES = ("exact", "euler")
 # horizon of 1.1x the demonstrated duration. The weights are learned on the demonstration
 # followed by rest at its goal for that extra 0.1: the learned forcing term then holds the goal
 # at the end instead of extrapolating the last kernel. The README's "Robot protocol" section
-# has the measurements (tests/test_timing.py holds them).
+# has the measurements (tests/primitives/test_timing.py holds them).
 ROBOT_ALPHA = 50.0
 ROBOT_KERNELS = 100
 ROBOT_ALPHA_PHASE = 4.0

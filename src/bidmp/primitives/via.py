@@ -12,7 +12,7 @@ least-squares solve, no iteration.
 impulse response ``r[k - i]`` (the same for every ``i ≥ 1`` on a uniform grid; the first sample
 has its own, the exact integrator holding the input linear over each step), so ``A_k = r_k ψ``
 is one impulse response and one matrix product per via-point. Tested against N perturbed
-rollouts (tests/test_via.py).
+rollouts (tests/primitives/test_via.py).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 in the ``collision`` extra (``pip install 'bidmp[collision]'``), and the vectorised lower bounds
 that decide which pairs coal is asked about.
 
-Measured against closed forms (tests/test_geometry.py), coal with a tightened GJK tolerance is
+Measured against closed forms (tests/scene/test_geometry.py), coal with a tightened GJK tolerance is
 within 1e-8 of the exact clearance; python-fcl, whose GJK tolerance cannot be set from Python,
 was up to 2e-3 off. Only lower bounds for culling are computed here (the exact distance from the
 vertical tool cylinder to each part's axis-aligned bounding box, vectorised): a pair is sent to
@@ -107,7 +107,7 @@ class _Distances:
         tolerance can end on a degenerate simplex when flat faces are parallel (a vertical tool
         beside a vertical post): coal then runs EPA on shapes that do not touch and reports
         -DBL_MAX, or (two vertical cylinders) returns the distance between "nearest points" that
-        lie off the shapes: 1.96 for 16.90, 3.93 for 12.50 (tests/test_geometry.py), and
+        lie off the shapes: 1.96 for 16.90, 3.93 for 12.50 (tests/scene/test_geometry.py), and
         Nesterov-accelerated GJK repeats the second. So an answer is kept only when it is finite
         and, for a separation, both nearest points lie on their shapes that far apart; otherwise the query is
         repeated with Nesterov-accelerated GJK, then at looser tolerances (1e-10, 1e-9, coal's

@@ -1,5 +1,5 @@
 """Random obstacle fields between a motion's start and goal: what avoidance is tested and
-benchmarked on (tests/test_avoidance.py, benchmarks/bench_avoidance.py), and what a user can
+benchmarked on (tests/primitives/test_avoidance.py, benchmarks/bench_avoidance.py), and what a user can
 try their own coupling terms on.
 
 A field is 1-4 parts, each a tall post (cylinder) or a tall box standing across the straight line

@@ -255,7 +255,7 @@ def test_a_moved_goal_changes_the_motion_by_its_share_within_the_stated_bound():
         )
         prepared, _ = bidmp.prepare(y, t)
         # The progress gate's bound (keep_approach, the default, completes R at
-        # the approach: tests/test_approach.py).
+        # the approach: tests/primitives/test_approach.py).
         dmp = bidmp.DMP(keep_approach=False).fit(prepared.y, prepared.t)
         home = dmp.trajectory()
         delta = rng.normal(size=3) * 100.0

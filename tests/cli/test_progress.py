@@ -17,7 +17,7 @@ import pytest
 
 from bidmp.experiments import BATTERY_APPROACH_VIA  # noqa: F401  (the package imports: a broken install fails here)
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 RECORDING = ROOT / "src" / "bidmp" / "data" / "recordings" / "operator1_nut3.csv"
 
 

@@ -1,6 +1,6 @@
 """limits where the robot moves — the 1 kHz commands checked against velocity,
 acceleration and jerk limits from rest to rest (closed forms) and the closed loop's jerk-limited
-command generator on random targets (the simulated nut task's commands: tests/test_sim.py)."""
+command generator on random targets (the simulated nut task's commands: tests/sim/test_sim.py)."""
 
 import numpy as np
 import pytest

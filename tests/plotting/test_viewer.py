@@ -165,8 +165,8 @@ def test_every_3d_figure_has_one_scale_on_its_three_axes():
 @pytest.fixture(scope="module")
 def posts_report():
     """The nut task with two 4 mm posts among the nuts: the plain DMP drives into them on its way
-    to four nuts (tests/test_user_cells.py checks that by closed-form geometry)."""
-    data = json.loads((Path(__file__).parent / "data" / "two_posts.json").read_text())
+    to four nuts (tests/tasks/test_user_cells.py checks that by closed-form geometry)."""
+    data = json.loads((Path(__file__).parents[1] / "data" / "two_posts.json").read_text())
     return data, evaluate(scenarios.from_dict(data), ["dmp", "bidmp"])
 
 

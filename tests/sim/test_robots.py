@@ -259,7 +259,7 @@ def test_the_ur5_urdf_is_its_published_dh_kinematics():
 
     p = sim.pybullet.world._pybullet_module()
     urdf = sim.UR5_MODEL.urdf if hasattr(sim, "UR5_MODEL") else sim.ROBOT_MODELS["ur5"].urdf
-    tools = Path(__file__).resolve().parents[1] / "tools"
+    tools = Path(__file__).resolve().parents[2] / "tools"
     sys.path.insert(0, str(tools))
     try:
         import ur5_urdf

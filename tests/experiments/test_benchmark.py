@@ -219,7 +219,7 @@ def test_the_committed_lasa_summary_is_its_table_and_its_cells_recompute():
     its cells gives the same rows (every metric; the times aside)."""
     pq = pytest.importorskip("pyarrow.parquet")
     pytest.importorskip("movement_primitives")  # the committed table has the mp-dmp rows
-    root = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+    root = pathlib.Path(__file__).resolve().parents[2] / "docs" / "results"
     rows = pq.read_table(root / "lasa.parquet").to_pylist()
     protocol = {"demos": rows[0]["demos"], "every": rows[0]["every"]}
     assert (

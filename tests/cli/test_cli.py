@@ -170,7 +170,7 @@ def test_demo_with_a_method_subset_and_scenario_list(tmp_path, capsys):
     )
 
 
-RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+RESULTS = pathlib.Path(__file__).resolve().parents[2] / "docs" / "results"
 
 
 def assert_committed(produced):

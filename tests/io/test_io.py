@@ -315,7 +315,7 @@ def test_a_format_3_robot_model_rolls_out_as_it_did():
     """tests/data/format3_robot_dmp.npz and its rollouts (to its goal and to a goal 150 mm away)
     were written by bidmp 0.3 (before the robot protocol). Format 3 knew only explicit Euler, so
     the file loads with integrator="euler" and its rollouts are unchanged."""
-    data = Path(__file__).parent / "data"
+    data = Path(__file__).parents[1] / "data"
     model = bidmp.load(data / "format3_robot_dmp.npz")
     assert model.protocol == "robot" and model.integrator == "euler"
     expected = np.load(data / "format3_robot_rollout.npy")

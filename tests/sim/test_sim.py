@@ -14,7 +14,7 @@ from bidmp import sim  # noqa: E402
 from bidmp.cli import main  # noqa: E402
 from bidmp.tasks import evaluate, scenarios  # noqa: E402
 
-RESULTS = pathlib.Path(__file__).resolve().parent.parent / "docs" / "results"
+RESULTS = pathlib.Path(__file__).resolve().parents[2] / "docs" / "results"
 
 
 @pytest.fixture(scope="module")

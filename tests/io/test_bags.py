@@ -578,7 +578,7 @@ def test_the_scenarios_robot_where_it_stands_gives_the_same_joint_trajectory(tmp
     naming them by hand (the nut task's Panda at (50, -450, 0) mm facing +y, a 100 mm socket)."""
     pytest.importorskip("pybullet")
     recording = (
-        Path(__file__).resolve().parent.parent
+        Path(__file__).resolve().parents[2]
         / "src"
         / "bidmp"
         / "data"

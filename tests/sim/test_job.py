@@ -213,7 +213,7 @@ def test_cells_are_lifted_straight_out_and_set_down_in_their_rack_slots():
         assert [phase.name for phase in target.phases] == ["approach", "grasp", "lift", "place"]
 
 
-RESULTS = __import__("pathlib").Path(__file__).resolve().parent.parent / "docs" / "results"
+RESULTS = __import__("pathlib").Path(__file__).resolve().parents[2] / "docs" / "results"
 
 
 @pytest.mark.parametrize(

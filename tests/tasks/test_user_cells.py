@@ -25,7 +25,7 @@ from bidmp.tasks import evaluate, scenarios
 pytest.importorskip("pybullet")
 from bidmp import sim  # noqa: E402
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 
 
 def spec(name: str, units: str = "mm") -> dict:
