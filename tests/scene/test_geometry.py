@@ -738,3 +738,28 @@ def test_a_tool_turning_in_place_is_checked_along_its_sweep():
         assert scene.clearance(tip[:1], orientations=pose[None]).distance > 30.0
     swept = scene.clearance(tip, orientations=poses)
     assert not swept.collision_free and swept.part == "block"
+
+
+def test_a_scene_with_more_parts_is_the_scene_its_file_would_give():
+    """Structure guard (the job adds its bin and rack this way, no longer through a dict):
+    with_parts gives the scene from_dict gives for the same parts, keeps the tool, margin and
+    stand-offs, and refuses an overlap or a label already taken."""
+    nut = scenarios.load("nut-unscrewing")
+    targets = nut.targets
+    box = {"type": "box", "label": "bin", "at": [90.0, 250.0, -20.0], "size": [60.0, 60.0, 40.0]}
+    grown = nut.scene.with_parts([box], targets)
+    data = nut.scene.to_dict()
+    data["parts"] = data["parts"] + [box]
+    expected = Scene.from_dict(data, {k: v.tolist() for k, v in targets.items()})
+    assert grown.to_dict() == expected.to_dict() and len(grown.solids) == len(nut.scene.solids) + 1
+    assert (grown.margin, grown.tool, grown.standoff) == (
+        nut.scene.margin,
+        nut.scene.tool,
+        nut.scene.standoff,
+    )
+    path = np.array([[90.0, 250.0, 100.0], [90.0, 250.0, 10.0]])
+    assert nut.scene.clearance(path).clear and not grown.clearance(path).collision_free
+    with pytest.raises(ValueError, match="overlap"):
+        nut.scene.with_parts([{**box, "label": "slab", "at": [90.0, 25.0, -2.0]}], targets)
+    with pytest.raises(ValueError, match="'plate' is already a part"):
+        nut.scene.with_parts([{**box, "label": "plate"}], targets)

@@ -215,6 +215,34 @@ class Scene:
             out["standoff"] = dict(self.standoff)
         return out
 
+    def with_parts(self, parts, targets: dict | None = None) -> Scene:
+        """The same scene with more parts: ``parts`` as a scenario file writes them (a list of part
+        objects, ``at_targets`` resolved against ``targets``), checked like the scene's own (their
+        keys, their overlaps). The tool, margin, stand-offs and targets are kept.
+
+        Raises
+        ------
+        SceneError
+            Naming the part and key that is wrong, or the two parts that overlap.
+        """
+        if not isinstance(parts, (list, tuple)):
+            raise TypeError(f"parts must be a list of part objects, got {type(parts).__name__}")
+        added = _parse_parts(list(parts), targets) if parts else []
+        labels = {part.label for part in self.parts}
+        clash = next((part.label for part in added if part.label in labels), None)
+        if clash is not None:
+            _fail("scene.parts", f"label {short_token(clash, 30)} is already a part of the scene")
+        scene = Scene(
+            (*self.parts, *added),
+            self.tool,
+            self.targets,
+            self.targets_on_parts,
+            self.margin,
+            self.standoff,
+        )
+        scene.check_overlaps()
+        return scene
+
     def with_tool(self, tool: Tool) -> Scene:
         """The same parts, margin and stand-offs with another ``tool`` (a part carried under the
         tool's mouth: its height and the radius round its footprint); the margin is kept up to the

@@ -387,11 +387,7 @@ def _bin_parts(bottom, inner, wall: float) -> list:
 
 def _job_scene(scenario, parts):
     """The scene with the job's own ``parts``: what the motions are checked against and the world holds."""
-    from ..scene.clearance import Scene
-
-    data = scenario.scene.to_dict()
-    data["parts"] = data["parts"] + parts
-    return Scene.from_dict(data, {k: v.tolist() for k, v in scenario.targets.items()})
+    return scenario.scene.with_parts(parts, scenario.targets)
 
 
 def _order(scenario, labels) -> list:
