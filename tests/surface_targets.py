@@ -225,7 +225,7 @@ def _package_overrides(tmp: Path) -> dict:
 
 
 def _panda_limits():
-    from bidmp.sim.pybullet.robot import PANDA
+    from bidmp.sim.robots import PANDA
 
     return PANDA
 

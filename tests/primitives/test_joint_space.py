@@ -6,7 +6,7 @@ joint stays within its own velocity, acceleration and jerk limit, measured on th
 import numpy as np
 
 from bidmp.cli import main
-from bidmp.sim.pybullet.robot import PANDA
+from bidmp.sim.robots import PANDA
 
 NAMES = [f"panda_joint{k}" for k in range(1, 8)]
 

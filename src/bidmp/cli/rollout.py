@@ -86,7 +86,7 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
 def _arm_limits(args: argparse.Namespace):
     """The JointLimits of --joint-limits: a built-in arm (panda, iiwa, xarm6, ur5), or the robot a scenario
     names (its "robot" key: a model or its own URDF's limits)."""
-    from ..sim.pybullet.robot import ROBOT_MODELS, robot_model
+    from ..sim.robots import ROBOT_MODELS, robot_model
 
     if args.joint_limits in ROBOT_MODELS:
         return ROBOT_MODELS[args.joint_limits].limits
@@ -127,7 +127,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
 
     args.robot_given = args.robot is not None
-    from ..sim.pybullet.robot import ROBOT_MODELS
+    from ..sim.robots import ROBOT_MODELS
 
     args.robot = args.robot or (args.joint_limits if args.joint_limits in ROBOT_MODELS else "panda")
     if not args.tool_length >= 0:
@@ -217,7 +217,7 @@ def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
     import numpy as np
 
     from ..sim.kinematics import inverse_kinematics
-    from ..sim.pybullet.robot import ROBOT_MODELS
+    from ..sim.robots import ROBOT_MODELS
 
     arm = _arm(args, 1.0)
     robot = arm["robot"]
@@ -244,7 +244,7 @@ def _arm(args: argparse.Namespace, metres_per_unit: float) -> dict:
     the scenario's tool (its model, URDF and limits)."""
     import numpy as np
 
-    from ..sim.pybullet.robot import ROBOT_MODELS, robot_model, robot_placement
+    from ..sim.robots import ROBOT_MODELS, robot_model, robot_placement
 
     if args.robot in ROBOT_MODELS:
         base = (

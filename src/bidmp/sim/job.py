@@ -490,7 +490,7 @@ def run_job(
     from .._checks import check_bool
     from ..tasks.evaluation import evaluate
     from .pybullet.cell import RobotCell
-    from .pybullet.robot import robot_model, robot_placement
+    from .robots import robot_model, robot_placement
     from .run import _scenario_and_backend
 
     pictures, view, record = (

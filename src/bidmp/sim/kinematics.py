@@ -19,7 +19,7 @@ __all__ = ["inverse_kinematics", "joint_names"]
 def _arm(robot, units: str, tool_length: float, base=(0.0, 0.0, 0.0), yaw: float = 0.0):
     from ..scene import Scene, Tool
     from .pybullet.cell import RobotCell
-    from .pybullet.robot import ROBOT_MODELS, RobotModel
+    from .robots import ROBOT_MODELS, RobotModel
 
     if isinstance(robot, str):
         if robot not in ROBOT_MODELS:
@@ -90,7 +90,7 @@ def inverse_kinematics(
         A point the arm does not reach (within 0.05 mm) or that needs a joint beyond its limits,
         named by its index.
     """
-    from .pybullet.robot import IK_TOLERANCE
+    from .robots import IK_TOLERANCE
 
     units = check_choice(units, "units", ("m", "cm", "mm"))
     array = _as_bounded_array(points, "points", 2)

@@ -15,7 +15,7 @@ from ..tasks.contract import CommandPeaks
 from ..tasks.metrics import _json_length
 from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
 from .limits import _measured_peaks
-from .pybullet.robot import PANDA
+from .robots import PANDA
 
 __all__ = ["SimTarget", "SimMethod", "SimReport", "write_sim_report"]
 
@@ -211,7 +211,7 @@ class SimReport:
 
     @property
     def robot_name(self) -> str:
-        from .pybullet.robot import ROBOT_NAMES
+        from .robots import ROBOT_NAMES
 
         return ROBOT_NAMES.get(self.robot, self.robot)
 

@@ -17,9 +17,9 @@ from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
-from .pybullet.robot import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
 from .pybullet.world import _pybullet_module
 from .report import SimMethod, SimReport, SimTarget, _measure
+from .robots import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
 
 __all__ = ["simulate", "target_labels"]
 
@@ -330,7 +330,7 @@ def _unreachable(setup: dict, scenario, labels) -> dict:
     """The targets out of the arm's reach from its base, tool pointing down, each with its reason
     (every target, when the demonstration's start is out of reach: every motion starts there)."""
     from .backend import SimError
-    from .pybullet.robot import IK_TOLERANCE
+    from .robots import IK_TOLERANCE
 
     if setup["backend"] is not RobotCell:
         return {}

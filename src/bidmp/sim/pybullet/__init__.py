@@ -3,7 +3,7 @@ xArm6 from ``pybullet_data``, a UR5-class arm from its DH parameters, or a scena
 carrying the scenario's tool, in a headless world of the scene's parts.
 
 * ``world`` — pybullet imported quietly, the URDF with the tool, the parts as bodies;
-* ``robot`` — the arms' models and limits, placement and checks;
+* the arms' models and limits, placement and checks are :mod:`bidmp.sim.robots` (any backend's);
 * ``ik``, ``plan``, ``execute``, ``render`` — one job each, functions of a cell;
 * ``cell`` — :class:`RobotCell`, the world's state and the backend protocol's methods.
 
@@ -16,14 +16,6 @@ from ..._lazy import exports
 
 _EXPORTS = {
     "RobotCell": "cell",
-    "PANDA": "robot",
-    "IIWA": "robot",
-    "XARM6": "robot",
-    "UR5": "robot",
-    "RobotModel": "robot",
-    "ROBOT_MODELS": "robot",
-    "robot_model": "robot",
-    "robot_placement": "robot",
 }
 __all__ = list(_EXPORTS)
 __getattr__, __dir__ = exports(__name__, _EXPORTS, globals())

@@ -10,11 +10,11 @@ import numpy as np
 
 from ..._checks import as_point, check_real
 from ..backend import SIM_STEP, Execution, Hold, MotionPlan
+from ..robots import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from . import execute as _execute
 from . import ik as _ik
 from . import plan as _plan
 from . import render as _render
-from .robot import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
 
 __all__ = ["RobotCell"]
@@ -35,7 +35,7 @@ class RobotCell:
     yaw : float
         Robot base rotation about z in degrees (90: the robot faces +y).
     robot : RobotModel, optional
-        The arm (:data:`bidmp.sim.pybullet.robot.ROBOT_MODELS`, or a scenario's own URDF).
+        The arm (:data:`bidmp.sim.robots.ROBOT_MODELS`, or a scenario's own URDF).
     """
 
     def __init__(
@@ -50,7 +50,7 @@ class RobotCell:
 
         if not isinstance(robot, RobotModel):
             raise TypeError(
-                f"robot must be a bidmp.sim.pybullet.robot.RobotModel, got {type(robot).__name__}"
+                f"robot must be a bidmp.sim.robots.RobotModel, got {type(robot).__name__}"
             )
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")

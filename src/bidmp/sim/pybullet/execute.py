@@ -20,7 +20,7 @@ from ..backend import (
     SimError,
 )
 from ..limits import _RateLimiter
-from .robot import IK_TOLERANCE
+from ..robots import IK_TOLERANCE
 
 __all__ = []
 

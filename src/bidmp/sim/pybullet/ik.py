@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from ..._checks import as_point
-from .robot import _DOWN, IK_ACCURACY, _joint_seed, _reachable
+from ..robots import _DOWN, IK_ACCURACY, _joint_seed, _reachable
 
 __all__ = []
 

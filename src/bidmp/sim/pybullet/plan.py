@@ -12,7 +12,7 @@ from ..._trajectory import interp_columns
 from ...primitives.so3 import as_quaternions
 from ...primitives.timing import Trajectory, time_scale
 from ..backend import LIMIT_MARGIN, MotionPlan, SimError
-from .robot import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
+from ..robots import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
 
 __all__ = []
 

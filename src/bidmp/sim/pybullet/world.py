@@ -67,7 +67,7 @@ def _mesh(folder: Path, name: str, urdf: Path) -> Path:
 
 
 def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
-    """The URDF of ``model`` (a :class:`~bidmp.sim.pybullet.robot.RobotModel`) carrying a
+    """The URDF of ``model`` (a :class:`~bidmp.sim.robots.RobotModel`) carrying a
     cylindrical tool (metres) on its flange: link ``tool`` on the flange, link ``tcp`` at the
     tool's mouth. The Panda's own hand is cut away (``model.cut_at``). Mesh paths are made
     absolute, since the text is loaded from another folder."""

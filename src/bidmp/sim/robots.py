@@ -1,4 +1,4 @@
-"""The robots the PyBullet backend models: a :class:`RobotModel` (URDF, tool flange, joint limits,
+"""The robots the simulator models, whatever its backend: a :class:`RobotModel` (URDF, tool flange, joint limits,
 motor efforts, rest pose) for any serial arm of six or more joints — built in: the Franka Panda (the
 default) and the KUKA LBR iiwa 7 R800 of ``pybullet_data`` (7 joints), UFACTORY's xArm6 of
 ``pybullet_data`` and a UR5-class arm written from Universal Robots' published DH parameters (6
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._checks import (
+from .._checks import (
     as_point,
     as_vector,
     check_limit,
@@ -22,7 +22,7 @@ from ..._checks import (
     short_token,
     shown_path,
 )
-from ..backend import JointLimits, SimError
+from .backend import JointLimits, SimError
 
 __all__ = [
     "PANDA",
@@ -194,7 +194,7 @@ XARM6_MODEL = RobotModel(
 )
 UR5_MODEL = RobotModel(
     "ur5",
-    str(Path(__file__).resolve().parents[2] / "data" / "robots" / "ur5_dh.urdf"),
+    str(Path(__file__).resolve().parents[1] / "data" / "robots" / "ur5_dh.urdf"),
     "flange",
     UR5,
     (math.pi, -math.pi / 2, math.pi / 2, -math.pi / 2, -math.pi / 2, 0.0),
@@ -219,7 +219,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     be a regular ``.urdf`` file within the file size limit."""
     import pybullet_data
 
-    from ...tasks._scenario_fields import _robot
+    from ..tasks._scenario_fields import _robot
 
     if spec is not None and not isinstance(spec, dict):
         raise TypeError(
