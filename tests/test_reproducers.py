@@ -293,3 +293,17 @@ def test_a_pose_bi_dmp_learns_an_extension_whose_orientation_stays_still():
     angles = 2.0 * np.arccos(np.clip(np.abs(rolled.q @ held), 0.0, 1.0))
     assert np.max(angles) < 1e-6
     assert np.linalg.norm(rolled.y[-1] - extension[-1, :3]) < 1e-3 * np.ptp(positions, axis=0).max()
+
+
+def test_drop_repeated_stamps_names_a_label_that_is_not_text():
+    """Found by the full public-surface sweep (35 273 calls): ``name`` of -inf with ragged stamps
+    was refused in words that named neither argument."""
+    from bidmp.primitives import drop_repeated_stamps
+
+    with pytest.raises(
+        TypeError, match=r"^name \(what the messages call the stamps\) must be text, got float$"
+    ):
+        drop_repeated_stamps(np.zeros((3, 2)), [[0.0], [1.0, 2.0]], name=-np.inf)
+    y, t = drop_repeated_stamps(np.arange(8.0).reshape(4, 2), [0.0, 1.0, 1.0, 2.0])
+    np.testing.assert_array_equal(t, [0.0, 1.0, 2.0])
+    np.testing.assert_array_equal(y, [[0.0, 1.0], [2.0, 3.0], [6.0, 7.0]])

@@ -228,6 +228,10 @@ def drop_repeated_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]
 
     Stamps going back are still refused (:func:`check_timestamps`).
     """
+    if not isinstance(name, str):
+        raise TypeError(
+            f"name (what the messages call the stamps) must be text, got {type(name).__name__}"
+        )
     y = _as_samples(y)
     stamps = _as_stamps(t, name)
     if (
