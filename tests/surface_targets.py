@@ -87,6 +87,13 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.inverse_kinematics": {"points": np.array([[0.45, -0.1, 0.3], [0.5, 0.0, 0.3]])},
         "bidmp.sim.joint_names": {"robot": "panda"},
         "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
+        "bidmp.io.json_number": {"value": 1.23456},
+        "bidmp.experiments.check_lasa_options": {
+            "shapes": ["Sshape"],
+            "methods": ["dmp-paper"],
+            "demos": "first3",
+            "every": 10,
+        },
         "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
         "bidmp.sim.require_simulator": {},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},

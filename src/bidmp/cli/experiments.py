@@ -85,7 +85,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    from ..experiments.benchmark import _validate, lasa
+    from ..experiments import check_lasa_options, lasa
 
     shapes = (
         None if args.shapes is None else [s.strip() for s in args.shapes.split(",") if s.strip()]
@@ -93,7 +93,7 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     methods = (
         None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
     )
-    shapes_checked, _, indices = _validate(
+    shapes_checked, _, indices = check_lasa_options(
         shapes, methods, args.demos, args.every
     )  # before starting a cluster
     if args.workers is not None and not 1 <= args.workers <= 256:

@@ -41,6 +41,7 @@ _EXPORTS = {
     "METRICS": "lasa_cells",
     "run_cell": "lasa_cells",
     "lasa": "benchmark",
+    "check_lasa_options": "benchmark",
     "BenchmarkResult": "benchmark",
     "summary_rows": "benchmark",
     "cell_key": "lasa_cells",

@@ -52,7 +52,7 @@ from .lasa_cells import (
     run_cell,
 )
 
-__all__ = ["lasa", "BenchmarkResult", "summary_rows", "summary_markdown"]
+__all__ = ["lasa", "check_lasa_options", "BenchmarkResult", "summary_rows", "summary_markdown"]
 
 logger = logging.getLogger(__name__)
 
@@ -73,7 +73,10 @@ class BenchmarkResult:
     workers: int = 0
 
 
-def _validate(shapes, methods, demos: str, every: int) -> tuple[list, list, list]:
+def check_lasa_options(shapes, methods, demos: str, every: int) -> tuple[list, list, list]:
+    """The LASA benchmark's options checked before anything starts (a cluster, a sweep): the
+    shapes, the methods, which demonstrations and every k-th sample; returns (shapes, the methods
+    available here, the demonstrations' indices). Refuses an unknown shape or method by name."""
     from ..demonstrations.datasets import lasa_names
 
     names = lasa_names()
@@ -144,7 +147,7 @@ def lasa(  # noqa: PLR0913 - the public call spells its options out, as users pa
     progress : callable, optional
         Called with the cell key as each cell finishes.
     """
-    shapes, methods, indices = _validate(shapes, methods, demos, every)
+    shapes, methods, indices = check_lasa_options(shapes, methods, demos, every)
     check_choice(output_format, "output_format", ("parquet", "csv"))
     out = Path(out)
     if out.exists() and not out.is_dir():

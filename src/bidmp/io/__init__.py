@@ -30,6 +30,7 @@ _EXPORTS = {
     "save_poses": "poses",
     "atomic_write": "atomic",
     "load_json": "strict_json",
+    "json_number": "strict_json",
     "Recording": "recordings",
     "read_recording": "recordings",
     "recording_kind": "recordings",

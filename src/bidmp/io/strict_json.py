@@ -10,7 +10,7 @@ import numpy as np
 
 from .._checks import get_limits, short_token
 
-__all__ = ["load_json"]
+__all__ = ["load_json", "json_number"]
 
 _JSON_STRING = re.compile(rb'"(?:[^"\\]|\\.)*"')
 
@@ -79,3 +79,13 @@ def load_json(data: bytes | str, source: str):
         ) from None
     except ValueError as exc:  # a non-finite number, an integer of too many digits
         raise ValueError(f"{source}: {exc}") from None
+
+
+def json_number(value) -> float | None:
+    """A length or angle for a JSON report: rounded to 4 decimals; None when absent or not finite
+    (strict JSON has no Infinity: the approach error of a motion without a final approach)."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise TypeError(f"value must be a number or None, got {type(value).__name__}")
+    return round(float(value), 4) if np.isfinite(value) else None

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.strict_json import json_number
 from ..tasks._tables import markdown_table, text_table
 from ..tasks.contract import CommandPeaks
-from ..tasks.metrics import _json_length
 from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
 from .limits import _measured_peaks
 from .robots import PANDA
@@ -113,7 +113,7 @@ class SimTarget:
             "ran": True,
             "commanded_error": round(self.commanded_error, 4),
             "measured_error": round(self.measured_error, 4),
-            "approach_error": _json_length(self.approach_error),
+            "approach_error": json_number(self.approach_error),
             "engaged": self.engaged,
             "contacts": sorted(self.contacts),
             "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
@@ -123,17 +123,17 @@ class SimTarget:
             "measured_peak_joint_acceleration": round(self.measured_peak_acceleration, 4),
             "peak_joint_jerk": round(self.peak_jerk, 4),
             "measured_peak_joint_jerk": round(self.measured_peak_jerk, 4),
-            "commanded_penetration": _json_length(self.commanded_penetration),
+            "commanded_penetration": json_number(self.commanded_penetration),
             "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3),
             "tracking_error": round(self.tracking_error, 4),
             "within_limits": self.within_limits,
             "task_success": self.task_success(threshold),
-            "axis_deviation_deg": _json_length(self.axis_deviation),
+            "axis_deviation_deg": json_number(self.axis_deviation),
             "aligned": self.aligned,
             "clearance": None
             if self.verdict is None or self.verdict.clearance is None
-            else _json_length(self.verdict.clearance.distance),
+            else json_number(self.verdict.clearance.distance),
             "clearance_part": None
             if self.verdict is None or self.verdict.clearance is None
             else self.verdict.clearance.part,

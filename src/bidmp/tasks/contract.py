@@ -287,7 +287,7 @@ class Verdict:
         return " and ".join(words)
 
     def to_dict(self) -> dict:
-        from .metrics import _json_length
+        from ..io.strict_json import json_number
 
         c = self.clearance
         return {
@@ -295,13 +295,13 @@ class Verdict:
             "failed": self.failed,
             "reason": self.reason(),
             "end_error": round(float(self.end_error), 4),
-            "approach_error": _json_length(self.approach_error),
+            "approach_error": json_number(self.approach_error),
             "engaged": self.engaged,
-            "clearance": None if c is None else _json_length(c.distance),
+            "clearance": None if c is None else json_number(c.distance),
             "clearance_part": None if c is None else c.part,
             "margin": None if c is None else c.margin,
             "contacts": {k: round(float(v), 4) for k, v in sorted(self.contacts.items())},
-            "axis_deviation": _json_length(self.axis_deviation),
+            "axis_deviation": json_number(self.axis_deviation),
             "aligned": self.aligned,
             "within_limits": self.within_limits,
         }

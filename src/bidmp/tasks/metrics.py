@@ -118,12 +118,6 @@ def approach_error(
     return float(np.max(np.linalg.norm(offsets[final] - np.outer(along[final], axis), axis=1)))
 
 
-def _json_length(value) -> float | None:
-    """A length or angle for a JSON report: 4 decimals; None when absent or not finite (strict JSON
-    has no Infinity: an approach error of a motion without a final approach)."""
-    return None if value is None or not np.isfinite(value) else round(float(value), 4)
-
-
 def _unit_axis(axis) -> np.ndarray:
     axis = as_point(axis, 3, "axis")
     norm = np.linalg.norm(axis)

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io.strict_json import json_number
 from ._tables import markdown_table, text_table
-from .metrics import _json_length
 
 __all__ = ["MethodResult", "Report", "write_report"]
 
@@ -154,7 +154,7 @@ class MethodResult:
             "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
             "approach_errors": None
             if self.approach_errors is None
-            else {label: _json_length(e) for label, e in self.approach_errors.items()},
+            else {label: json_number(e) for label, e in self.approach_errors.items()},
             "max_error": round(float(max(self.errors.values())), 4),
             "difference_range": [
                 round(float(min(self.differences.values())), 2),
@@ -173,7 +173,7 @@ class MethodResult:
                 "engaged": self.engaged,
                 "collision_free": self.collision_free,
                 "n_checked": None if self.clearances is None else len(self.checked),
-                "min_clearance": None if worst is None else _json_length(worst.distance),
+                "min_clearance": None if worst is None else json_number(worst.distance),
                 "min_clearance_part": None if worst is None else worst.part,
                 "aligned": self.aligned,
             }
@@ -185,15 +185,15 @@ class MethodResult:
                 "error": round(float(error), 4),
                 "approach_error": None
                 if self.approach_errors is None
-                else _json_length(self.approach_errors[label]),
+                else json_number(self.approach_errors[label]),
                 "engaged": self.engaged_at(label),
-                "clearance": None if clearance is None else _json_length(clearance.distance),
+                "clearance": None if clearance is None else json_number(clearance.distance),
                 "clearance_part": None if clearance is None else clearance.part,
                 "collision_part": None if clearance is None else clearance.collision_part,
                 "task_success": self.task_success_at(label),
                 "axis_deviation": None
                 if self.axis_deviations is None
-                else _json_length(self.axis_deviations[label]),
+                else json_number(self.axis_deviations[label]),
                 "reason": self.reason_at(label),
                 "repair": None if label not in self.repairs else self.repairs[label].to_dict(),
             }
