@@ -88,6 +88,7 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.joint_names": {"robot": "panda"},
         "bidmp.io.start_stamp": {"origin": "2026-12-03T14:00:00Z"},
         "bidmp.io.json_number": {"value": 1.23456},
+        "bidmp.extension.check_extension_options": {"n_iter": 5},
         "bidmp.experiments.check_lasa_options": {
             "shapes": ["Sshape"],
             "methods": ["dmp-paper"],

@@ -15,6 +15,7 @@ from .._lazy import exports
 _EXPORTS = {
     "ExtendedDemonstration": "extend",
     "extend_demonstration": "extend",
+    "check_extension_options": "extend",
     "extend_pose_demonstration": "extend",
     "final_approach": "extend",
     "APPROACHES": "extend",

@@ -52,6 +52,7 @@ from .segmentation import Piece, choose_piece, segment
 from .timing import _time_path, _timed_transfer
 
 __all__ = [
+    "check_extension_options",
     "ExtendedDemonstration",
     "extend_demonstration",
     "extend_pose_demonstration",
@@ -195,7 +196,7 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     return _straight_tail_start(y, start, straightness)
 
 
-def _check_extension_options(
+def check_extension_options(
     *,
     eps_frac: float = 0.1,
     method: str = "persistence",
@@ -283,7 +284,7 @@ def extend_demonstration(  # noqa: PLR0913 - the public call spells its options 
         "select": select,
         "denom": denom,
     }
-    _check_extension_options(
+    check_extension_options(
         eps_frac=eps_frac,
         method=method,
         seed=seed,
@@ -585,7 +586,7 @@ def extend_pose_demonstration(
     target = as_point(new_target, 7, "new_target")
     target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
     turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
-    _check_extension_options(
+    check_extension_options(
         eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options
     )
     exclude = ()

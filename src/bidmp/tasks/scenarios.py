@@ -331,7 +331,7 @@ def from_dict(
         None if approach is None else _number(approach, source, "approach_height", positive=True)
     )
 
-    from ..extension.extend import _check_extension_options
+    from ..extension import check_extension_options
     from ..incremental.bidmp import BiDMP
     from ..primitives.dmp import DMP
 
@@ -344,7 +344,7 @@ def from_dict(
         "extension",
         _EXTENSION_KEYS,
         source,
-        lambda params: _check_extension_options(**params),
+        lambda params: check_extension_options(**params),
     )
     extensions = _extensions(data, source, targets, n_dims)
     demonstrations = _further_demonstrations(
