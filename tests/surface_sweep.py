@@ -141,6 +141,7 @@ SKIPPED = {
     "plot_targets_top_view",
     "plot_error_vs_distance",
     "plot_scenario_3d",
+    "plot_lasa_benchmark",
     "layers_from_report",
     "add_robot_motions",
     # scikit-learn's metadata routing and parameters, inherited and tested by scikit-learn:

@@ -408,7 +408,7 @@ KNOWN_CYCLES = [
         "bidmp.primitives.via",
     ],
 ]
-MAX_PRIVATE_IMPORTS_ACROSS = 13
+MAX_PRIVATE_IMPORTS_ACROSS = 12
 
 
 def test_modules_import_one_another_one_way_only():

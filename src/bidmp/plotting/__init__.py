@@ -23,6 +23,7 @@ _EXPORTS = {
     "plot_targets_top_view": "tasks",
     "plot_error_vs_distance": "tasks",
     "plot_scenario_3d": "tasks",
+    "plot_lasa_benchmark": "benchmark",
     "ViewLayers": "viewer",
     "layers_from_report": "viewer",
     "add_robot_motions": "viewer",
