@@ -60,10 +60,10 @@ LAYERS = {
 }
 
 
-def bidmp_imports(path):
+def bidmp_imports(path, root=SRC):
     """Subpackages (or root modules) of bidmp imported by ``path``, relative imports resolved."""
     package = path.parent.relative_to(
-        SRC
+        root
     ).parts  # () for bidmp/, ("primitives",) for bidmp/primitives/
     tree = ast.parse(path.read_text())
     for node in ast.walk(tree):
@@ -86,22 +86,27 @@ def bidmp_imports(path):
             )
 
 
-def module_of(path):
-    relative = path.relative_to(SRC).parts
+def module_of(path, root=SRC):
+    relative = path.relative_to(root).parts
     return relative[0] if len(relative) > 1 else path.stem
 
 
-def test_modules_respect_the_layers():
-    for path in SRC.rglob("*.py"):
-        module = module_of(path)
+def check_layers(root=SRC) -> None:
+    """Every module of the tree at ``root`` placed in a layer and importing none above it."""
+    for path in root.rglob("*.py"):
+        module = module_of(path, root)
         if module == "__init__":
             continue
         assert module in LAYERS, f"{module} is not placed in a layer of docs/architecture.md"
-        for imported in bidmp_imports(path):
+        for imported in bidmp_imports(path, root):
             if imported in LAYERS and imported not in ("__init__", module):
                 assert LAYERS[imported] <= LAYERS[module], (
-                    f"{path.relative_to(SRC)} ({module}, layer {LAYERS[module]}) imports {imported}"
+                    f"{path.relative_to(root)} ({module}, layer {LAYERS[module]}) imports {imported}"
                 )
+
+
+def test_modules_respect_the_layers():
+    check_layers()
 
 
 def test_the_math_never_imports_files_scenarios_or_the_cli():
@@ -121,14 +126,19 @@ def test_the_math_never_imports_files_scenarios_or_the_cli():
 
 
 def test_the_layer_check_sees_a_violation(tmp_path):
-    """The checker itself can fail: an import of the CLI from the math is reported."""
-    fake = SRC / "primitives" / "_layer_probe.py"
-    try:
-        fake.write_text("from ..cli import main\n")
-        with pytest.raises(AssertionError, match="imports cli"):
-            test_modules_respect_the_layers()
-    finally:
-        fake.unlink()
+    """The checker itself can fail: an import of the CLI from the math is reported. The probe is
+    a tree of its own (it once wrote into src/, where the tests running beside it read)."""
+    root = tmp_path / "bidmp"
+    for package in ("primitives", "cli"):
+        (root / package).mkdir(parents=True)
+        (root / package / "__init__.py").write_text("")
+    (root / "primitives" / "dmp.py").write_text("from .. import _checks\n")
+    check_layers(root)  # the probe's tree is fine ...
+    (root / "primitives" / "_layer_probe.py").write_text("from ..cli import main\n")
+    with pytest.raises(
+        AssertionError, match=r"primitives/_layer_probe.py \(primitives, layer 1\) imports cli"
+    ):
+        check_layers(root)  # ... until the math imports the shell
 
 
 def test_no_import_cycles():

@@ -34,7 +34,9 @@ def _client(scheduler: str | None, workers: int):
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
+            # a free port of its own: None still meant the shared default 8787, and a second
+            # cluster starting beside the first (two test workers) was refused with a warning
+            dashboard_address=":0",
             silence_logs=logging.ERROR,
         )
     os.environ.clear()
