@@ -4,6 +4,7 @@ argument types and flags. Imports nothing heavy (``bidmp --help`` must not load 
 from __future__ import annotations
 
 import argparse
+import contextlib
 
 __all__ = [
     "EXIT_OK",
@@ -96,42 +97,29 @@ def judged_methods(methods) -> list:
     return [name for name in methods if get(name).repairs] or methods
 
 
+@contextlib.contextmanager
 def progress_bars():
     """A context in which the library's reported progress (:mod:`bidmp._progress`) shows as tqdm
     bars on stderr, one per stage, when stderr is a terminal (tqdm's ``disable=None``)."""
+    from tqdm import tqdm
+
     from .._progress import reporting
 
-    class _Bars:
-        def __init__(self) -> None:
-            self.bars: dict = {}
+    bars: dict = {}
 
-        def __call__(self, stage: str, done: int, total: int) -> None:
-            from tqdm import tqdm
-
-            bar = self.bars.get(stage)
-            if (
-                bar is None or bar.total != total or done < bar.n
-            ):  # a new round of the stage (another planning)
-                if bar is not None:
-                    bar.close()
-                bar = self.bars[stage] = tqdm(
-                    total=total, desc=stage, unit="step", disable=None, leave=False
-                )
-            bar.update(done - bar.n)
-
-        def close(self) -> None:
-            for bar in self.bars.values():
+    def show(stage: str, done: int, total: int) -> None:
+        bar = bars.get(stage)
+        if bar is None or bar.total != total or done < bar.n:  # a new round (another planning)
+            if bar is not None:
                 bar.close()
+            bar = bars[stage] = tqdm(
+                total=total, desc=stage, unit="step", disable=None, leave=False
+            )
+        bar.update(done - bar.n)
 
-    import contextlib
-
-    @contextlib.contextmanager
-    def shown():
-        bars = _Bars()
-        try:
-            with reporting(bars):
-                yield
-        finally:
-            bars.close()
-
-    return shown()
+    try:
+        with reporting(show):
+            yield
+    finally:
+        for bar in bars.values():
+            bar.close()

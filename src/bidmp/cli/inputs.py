@@ -4,6 +4,7 @@ the model's), preparation of timed input."""
 from __future__ import annotations
 
 import argparse
+from typing import NamedTuple
 
 # a demonstration this many times larger or smaller than the model's is in another unit
 _MODEL_EXTENT_RATIO = 20.0
@@ -168,7 +169,8 @@ def read_input(
     what: str = "",
     timed: bool = False,
 ):
-    """A demonstration file as the library wants it: ``(values, t or None, units, how)``.
+    """A demonstration file as the library wants it: a :class:`Demo` (values, t or None, units,
+    how it was read, the joint names and the orientation it held, when it has them).
 
     Positions (T, D) or poses (T, 7), in ``--units`` (converted from the file's declared unit if
     it has another), checked against ``model``'s units; timed input prepared unless ``--raw``.
@@ -236,12 +238,12 @@ def read_input(
         ("columns", "an .npy", "x,y", "t,<joint")
     ):
         notes.append(f"read {recording.source}")
-    if recording.kind == "joints" and recording.names:
-        args.joint_names = list(recording.names)
-    if getattr(recording, "orientation", None) is not None:
-        held, spread = held_orientation(recording.orientation)
+    names = list(recording.names) if recording.kind == "joints" and recording.names else None
+    held = None
+    if recording.orientation is not None:
+        mean, spread = held_orientation(recording.orientation)
         if spread <= HELD_DEGREES:
-            args.held_orientation = held
+            held = mean
             notes.append(
                 f"the tool's orientation held within {spread:.2g} deg: kept with the model"
             )
@@ -250,7 +252,20 @@ def read_input(
                 f"the tool turns by up to {spread:.3g} deg, which a position model drops (a pose model keeps "
                 f"it: --columns pose=...)"
             )
-    return values, times, units, "; ".join([how, *notes])
+    return Demo(values, times, units, "; ".join([how, *notes]), names, held)
+
+
+class Demo(NamedTuple):
+    """A demonstration read for a command: values (T, D) or poses (T, 7), stamps (s) or None,
+    units, how it was read (for the printout), the joint names and the tool orientation it held
+    (``qx, qy, qz, qw``), when the file gave them."""
+
+    values: object
+    times: object
+    units: str
+    how: str
+    names: list | None = None
+    held_orientation: object = None
 
 
 # an orientation that stays within this of its mean is one the demonstration held

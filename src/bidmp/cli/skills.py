@@ -63,7 +63,7 @@ def _demo_for(model, args: argparse.Namespace):
         raise ValueError(
             f"{args.demo} holds poses; {args.model} holds a position model: fit a pose model on it first"
         )
-    y, _, units, how = read_input(args.demo, args, poses=poses, model=model, what=args.model)
+    y, _, units, how, *_ = read_input(args.demo, args, poses=poses, model=model, what=args.model)
     if not poses and y.shape[1] != model.n_dims_:
         raise ValueError(
             f"{args.demo} has D = {y.shape[1]} but the model {args.model} has D = {model.n_dims_}"
@@ -96,13 +96,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     if demo_kind(args) == "pose":
         return _fit_poses(args)
-    demonstration, times, units, how = read_input(args.demo, args, timed=True)
+    demonstration, times, units, how, names, held = read_input(args.demo, args, timed=True)
     dmp = DMP(**_dmp_params(args)).fit(
-        demonstration,
-        times,
-        units=units,
-        names=getattr(args, "joint_names", None),
-        held_orientation=getattr(args, "held_orientation", None),
+        demonstration, times, units=units, names=names, held_orientation=held
     )
     path = save_model(dmp, args.output)
     reproduction = dmp.trajectory()
@@ -147,7 +143,7 @@ def _fit_poses(args: argparse.Namespace) -> int:
     from ..io.models import save_model
     from ..primitives.cartesian import CartesianDMP, angle_between
 
-    poses, times, units, how = read_input(args.demo, args, poses=True, timed=True)
+    poses, times, units, how, *_ = read_input(args.demo, args, poses=True, timed=True)
     model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
     path = save_model(model, args.output)
     reproduction = model.rollout()[: len(poses)]
@@ -175,7 +171,7 @@ def cmd_segment(args: argparse.Namespace) -> int:
     from ..tasks._tables import text_table
 
     poses = demo_kind(args) == "pose"
-    y, _, units, how = read_input(args.demo, args, poses=poses)
+    y, _, units, how, *_ = read_input(args.demo, args, poses=poses)
     y = y[:, :3] if poses else y
     result = segment(y, eps_frac=args.eps_frac, method=args.method)
     points, kinds = result.points, result.kinds

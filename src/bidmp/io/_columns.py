@@ -26,12 +26,15 @@ to the names.
 
 from __future__ import annotations
 
+import logging
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._checks import short_token
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["TIME_NAMES", "Layout", "parse_columns", "resolve", "times_in_seconds"]
 
@@ -173,13 +176,19 @@ def _shown(header, limit: int = 8) -> str:
 
 
 # -- time -----------------------------------------------------------------------------------------
+def _time_divisor(name: str, key: str) -> float:
+    """Units of a time column per second: nanoseconds for ``rostopic echo -p``'s columns
+    (``%time``, ``field.…``), seconds otherwise."""
+    return 1e9 if name.strip().lower().startswith("field.") or key == "%time" else 1.0
+
+
 def _time_candidates(header: tuple[str, ...], keys: list[str]) -> tuple[list, list]:
     """(header stamps, other time columns): each a list of (indices, scale, name)."""
     stamps, others = [], []
     for index, key in enumerate(keys):
-        nanoseconds = header[index].strip().lower().startswith("field.") or key == "%time"
+        divisor = _time_divisor(header[index], key)
         if key == "header.stamp" or key.endswith(".header.stamp"):
-            stamps.append(((index,), 1e9 if nanoseconds else 1.0, header[index]))
+            stamps.append(((index,), divisor, header[index]))
         elif key.endswith("header.stamp.sec") or key == "stamp.sec":
             stem = key[: -len("sec")]
             fraction = next(
@@ -189,7 +198,7 @@ def _time_candidates(header: tuple[str, ...], keys: list[str]) -> tuple[list, li
             if fraction is not None:
                 stamps.append(((index, fraction), 1.0, f"{header[index]} + {header[fraction]}"))
         elif key in TIME_NAMES:
-            others.append(((index,), 1e9 if nanoseconds else 1.0, header[index]))
+            others.append(((index,), divisor, header[index]))
     return stamps, others
 
 
@@ -215,9 +224,7 @@ def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | N
     nanoseconds are recognised by their size (no epoch in seconds lies beyond the year 5000)."""
     if not layout.time:
         return None
-    if (
-        len(layout.time) == 2
-    ):  # sec + nanosec: the seconds counted from the first, so no digit is lost
+    if len(layout.time) == 2:  # sec + nanosec: seconds counted from the first, so no digit is lost
         seconds, fraction = values[:, layout.time[0]], values[:, layout.time[1]]
         return (seconds - seconds[0]) + fraction / 1e9 + seconds[0]
     stamps = values[:, layout.time[0]] / layout.time_divisor
@@ -225,11 +232,7 @@ def times_in_seconds(values: np.ndarray, layout: Layout, path) -> np.ndarray | N
     if layout.time_divisor == 1.0 and first > 1e11:
         for divisor, unit in ((1e9, "nanoseconds"), (1e6, "microseconds"), (1e3, "milliseconds")):
             if first / divisor > 1e8:  # an epoch stamp after 1973
-                import logging
-
-                logging.getLogger(__name__).info(
-                    "%s: the time column holds epoch stamps in %s", path, unit
-                )
+                logger.info("%s: the time column holds epoch stamps in %s", path, unit)
                 return stamps / divisor
     return stamps
 
@@ -429,9 +432,8 @@ def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
     header = tuple(header)
     keys = [_key(name) for name in header]
     if mapping is not None and "t" in mapping:
-        time, scale = (_index(header, keys, mapping["t"], "t", path),), 1.0
-        if header[time[0]].strip().lower().startswith("field.") or mapping["t"] == "%time":
-            scale = 1e9
+        time = (_index(header, keys, mapping["t"], "t", path),)
+        scale = _time_divisor(header[time[0]], keys[time[0]])
     else:
         time, scale = _time_from_names(header, keys, path)
     if mapping is not None and set(mapping) - {"t"}:

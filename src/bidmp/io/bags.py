@@ -30,6 +30,7 @@ all).
 
 from __future__ import annotations
 
+import logging
 import os
 import shutil
 import tempfile
@@ -48,6 +49,8 @@ from .._checks import (
     shown_path,
 )
 from .recordings import Recording
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["read_bag", "write_bag", "is_bag", "start_stamp"]
 
@@ -232,14 +235,13 @@ def _stamp_order(stamps: list, what: str, contents: str) -> np.ndarray:
             f"{what} repeat: two messages stamped {ordered[index] * 1e-9:.9f} s (messages "
             f"{order[index] + 1} and {order[index + 1] + 1}); it has: {contents}"
         )
-    if np.any(order != np.arange(order.size)):
-        import logging
-
-        logging.getLogger(__name__).info(
+    moved = int(np.sum(order != np.arange(order.size)))
+    if moved:
+        logger.info(
             "%s: %d message(s) out of receive order, put in the order of their stamps "
             "(at most %.3g ms apart)",
             what,
-            int(np.sum(order != np.arange(order.size))),
+            moved,
             float(behind.max()) * 1e-6,
         )
     return order

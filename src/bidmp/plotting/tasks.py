@@ -262,12 +262,11 @@ def _draw_solids(ax, solids) -> None:
     motions past them stay visible)."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    from .viewer import solid_layer, solid_mesh
+    from .viewer import solid_mesh
 
     for index, solid in enumerate(solids):
-        layer = solid_layer(solid)
         vertices, faces = solid_mesh(
-            layer["kind"], layer["centre"], layer["rotation"], layer["params"], sides=16
+            solid.kind, solid.centre, solid.rotation, solid.params, sides=16
         )
         mesh = Poly3DCollection(
             vertices[faces], facecolor="lightsteelblue", edgecolor="none", alpha=0.35
@@ -276,8 +275,5 @@ def _draw_solids(ax, solids) -> None:
         if index == 0:
             ax.plot([], [], "s", color="lightsteelblue", label="scene parts")
     if solids:  # add_collection3d does not widen the axes: take the parts' extent in
-        corners = np.vstack(
-            [np.asarray(s.lower, float)[None] for s in solids]
-            + [np.asarray(s.upper, float)[None] for s in solids]
-        )
+        corners = np.array([s.lower for s in solids] + [s.upper for s in solids], dtype=float)
         ax.auto_scale_xyz(corners[:, 0], corners[:, 1], corners[:, 2], had_data=True)

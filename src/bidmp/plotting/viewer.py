@@ -119,7 +119,9 @@ def layers_from_report(report) -> ViewLayers:
         },
         solids=solids,
         failures={
-            name: _failures(result) for name, result in report.methods.items() if _failures(result)
+            name: failed
+            for name, result in report.methods.items()
+            if (failed := _failures(result))  # each method's failing motions, judged once
         },
     )
 
