@@ -405,19 +405,7 @@ def cycles(edges: dict) -> list[list[str]]:
     return found
 
 
-# What is left, each to be cut by the renovation that owns it (the list may only shrink):
-# the DMP and the modules of its motions import one another (the DMP composed of components
-# takes them apart), and private names still cross between subpackages.
-KNOWN_CYCLES = [
-    [
-        "bidmp.primitives._dmp_motions",
-        "bidmp.primitives.avoidance",
-        "bidmp.primitives.dmp",
-        "bidmp.primitives.stepper",
-        "bidmp.primitives.timed",
-        "bidmp.primitives.via",
-    ],
-]
+# What is left (the number may only shrink): private names still crossing between subpackages.
 MAX_PRIVATE_IMPORTS_ACROSS = 12
 
 
@@ -425,7 +413,7 @@ def test_modules_import_one_another_one_way_only():
     """Structure guard: no new import cycle, deferred imports included."""
     edges, private = import_graph()
     found = cycles(edges)
-    assert [group for group in found if group not in KNOWN_CYCLES] == [], found
+    assert found == [], found
     assert len(private) <= MAX_PRIVATE_IMPORTS_ACROSS, "\n".join(private)
 
 

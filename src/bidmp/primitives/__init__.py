@@ -2,8 +2,10 @@
 
 Where things live (the field's split, as in movement_primitives and dmpbbo):
 
-* ``canonical`` — the phase and its grid;
-* ``forcing`` — kernels, LWR/ridge weights, the forcing target;
+* ``canonical`` — the phase as a component (the ``CanonicalSystem`` protocol; the exponential
+  phase);
+* ``forcing`` — the basis as a component (the ``Basis`` protocol; Gaussian kernels), LWR/ridge
+  weights, the forcing target;
 * ``goals`` — goal systems (the paper's phase gate, a delayed goal, the robot protocol's progress
   gate): small objects a DMP composes;
 * ``integrate`` — the fast LTI path (filters and outer products) and the step integrator;
@@ -27,6 +29,10 @@ _EXPORTS = {
     "DMP": "dmp",
     "PROTOCOLS": "dmp",
     "phase_grid": "canonical",
+    "CanonicalSystem": "canonical",
+    "ExponentialPhase": "canonical",
+    "Basis": "forcing",
+    "GaussianBasis": "forcing",
     "kernel_centres": "forcing",
     "kernel_widths": "forcing",
     "basis_functions": "forcing",

@@ -168,6 +168,8 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         goal_rate=None,
         integrator=None,
         keep_approach: bool | None = None,
+        canonical_system=None,
+        forcing_basis=None,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
@@ -183,6 +185,8 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         self.goal_rate = goal_rate
         self.integrator = integrator
         self.keep_approach = keep_approach
+        self.canonical_system = canonical_system
+        self.forcing_basis = forcing_basis
 
     def _dmp(self) -> DMP:
         return DMP(**self.get_params())

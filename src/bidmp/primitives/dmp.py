@@ -48,20 +48,21 @@ from sklearn.base import BaseEstimator
 
 from .._api import CheckedParams
 from .._checks import (
+    as_point,
     as_trajectory,
     as_unit_quaternion,
     check_bytes,
+    check_int,
     check_names,
     numerically_guarded,
 )
+from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
-from ._dmp_grids import GridQueries
-from ._dmp_motions import Motions
-from .canonical import _check_phase_span
-from .forcing import _learn_weights
-from .goals import _learn_goal_gate
-from .grid import _store_grid
-from .integrate import _check_integration
+from .canonical import CanonicalSystem
+from .forcing import Basis, _check_forcing_increment, _learn_weights
+from .goals import DelayedGoal, PhaseGate, ProgressGate, _learn_goal_gate, _learned_progress_gate
+from .grid import _cached_grid, _rollout_grid, _store_grid
+from .integrate import _check_integration, _unit_responses
 from .protocols import (
     PROTOCOLS,
     _FittedParams,
@@ -71,15 +72,19 @@ from .protocols import (
     _with_rest,
 )
 from .rest import _rest_started
+from .rollouts import _iter_rollouts_to, _rollouts_to
 from .state import _dmp_from_state, _dmp_state
+from .stepper import DMPStepper
+from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
 from .timing import on_uniform_time
+from .via import _via_trajectory
 
 __all__ = ["DMP", "PROTOCOLS"]
 
 logger = logging.getLogger(__name__)
 
 
-class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
+class DMP(_FittedParams, CheckedParams, BaseEstimator):
     """Discrete DMP learned from one demonstration, in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates
@@ -159,6 +164,17 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         keeps the progress gate. ``None``: on for the robot protocol (its progress gate) on
         positions, off for joint angles (``units="rad"``: a straight tail in joint space is no
         approach) and for the paper protocol; ``False`` asks for the progress gate.
+    canonical_system : CanonicalSystem or None, default None
+        The phase as a component (:class:`bidmp.primitives.canonical.CanonicalSystem`): ``None``
+        is the exponential phase of ``alpha_phase`` (:class:`~bidmp.primitives.ExponentialPhase`,
+        exact or Euler as the integrator); another phase (a rhythmic one) is an object with the
+        protocol's methods. Not with ``alpha_phase``.
+    forcing_basis : Basis or None, default None
+        The forcing term's basis as a component (:class:`bidmp.primitives.forcing.Basis`): ``None``
+        is ``n_kernels`` Gaussian kernels sized by ``widths``
+        (:class:`~bidmp.primitives.GaussianBasis`); another basis is an object with the
+        protocol's methods (its ``size`` functions learned by ridge regression). Not with
+        ``n_kernels`` or ``widths``.
 
     Attributes
     ----------
@@ -202,6 +218,8 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         goal_rate: float | None = None,
         integrator: str | None = None,
         keep_approach: bool | None = None,
+        canonical_system: CanonicalSystem | None = None,
+        forcing_basis: Basis | None = None,
     ) -> None:
         self.n_kernels = n_kernels
         self.alpha = alpha
@@ -217,6 +235,8 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         self.goal_rate = goal_rate
         self.integrator = integrator
         self.keep_approach = keep_approach
+        self.canonical_system = canonical_system
+        self.forcing_basis = forcing_basis
 
     # -- parameters ----------------------------------------------------------------------------
     def _params(self) -> _Params:
@@ -305,7 +325,7 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         # Refuse now rather than return a model whose every rollout diverges.
         _check_integration(dt, params._replace(tau=1.0))
         _check_integration(dt, params)
-        _check_phase_span(train.shape[0] * dt, params.alpha_phase)
+        params.canonical_system.check_span(train.shape[0] * dt)
         if units in ANGLE_UNITS and self.keep_approach is None:
             # A straight tail in joint space is no approach along a part's axis (that one is straight
             # in the tool's space): keeping it compressed a moved goal's whole offset into the
@@ -350,6 +370,362 @@ class DMP(GridQueries, Motions, _FittedParams, CheckedParams, BaseEstimator):
         """Seconds per unit of normalised time: ``duration_ · T / (T - 1)`` (1 without timestamps)."""
         self._check_fitted()
         return self.duration_ * self.n_steps_ / (self.n_steps_ - 1)
+
+    # -- evaluation ----------------------------------------------------------------------------
+    def default_n_steps(self) -> int:
+        """The default rollout length on the normalised grid: ``round(settle · tau · T)`` samples
+        (paper: T for ``tau = 1``; robot: 1.1 T, time for any goal to be reached)."""
+        self._check_fitted()
+        return self._n_steps(None, self._params())
+
+    def _n_steps(self, n_steps, params: _Params) -> int:
+        if n_steps is None:
+            n_steps = max(int(round(params.settle * params.tau * self.n_steps_)), 1)
+            check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
+        else:
+            n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+        check_bytes(n_steps * self.centres_.shape[0], "the rollout basis (n_steps x n_kernels)")
+        return n_steps
+
+    def phase(self, n_steps: int | None = None) -> np.ndarray:
+        """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
+        self._check_fitted()
+        params = self._params()
+        return params.canonical_system.grid(self._n_steps(n_steps, params), self.dt_, params.tau)
+
+    def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Phase (n,) and basis rows (n, N) on the rollout grid (default length
+        :meth:`default_n_steps`), cached."""
+        self._check_fitted()
+        params = self._params()
+        phase, basis, *_ = _rollout_grid(self, params, self._n_steps(n_steps, params))
+        return phase, basis
+
+    @property
+    def n_train_(self) -> int:
+        """Samples of the training grid: T (paper), or T followed by rest up to 1.1 T (robot)."""
+        self._check_fitted()
+        return max(int(round(self._params().settle * self.n_steps_)), self.n_steps_)
+
+    def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
+        """Phase and basis rows (N columns) of the grid the weights were learned on
+        (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
+        self._check_fitted()
+        phase, basis, *_ = _rollout_grid(self, self._params()._replace(tau=1.0), self.n_train_)
+        return phase, basis
+
+    def training_gate(self) -> np.ndarray:
+        """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
+        fraction (robot); the forcing target of :func:`_forcing_target` uses it."""
+        self._check_fitted()
+        params = self._params()
+        return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
+
+    def goal_system(self, params: _Params | None = None) -> PhaseGate | DelayedGoal | ProgressGate:
+        """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``params`` (default its
+        own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
+        asks for it once per stepper)."""
+        if params is not None and not isinstance(params, _Params):
+            raise TypeError(
+                f"goal_system: params must be a DMP's resolved parameters (or None), got {type(params).__name__}"
+            )
+        params = self._params() if params is None else params
+        if params.goal_rate is not None:
+            return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(
+                params.goal_rate
+            )
+        return _learned_progress_gate(self, params)
+
+    def training_trajectory(self, y) -> np.ndarray:
+        """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
+        for the robot protocol, started and ended at rest (:func:`bidmp.primitives.rest.rest_started`) and
+        followed by rest at its last point up to :attr:`n_train_`."""
+        self._check_fitted()
+        params = self._params()
+        y = resample_time(as_trajectory(y, "y", min_points=2, allow_static=True), self.n_steps_)
+        if params.rest_start:
+            y = _rest_started(y, self.dt_, self.time_unit_)
+        return _with_rest(y, params)
+
+    def basis(self, phase) -> np.ndarray:
+        """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
+        self._check_fitted()
+        params = self._params()
+        phase = params.canonical_system.as_phase(phase)
+        return params.basis.rows(phase, self.centres_, self.widths_)
+
+    def forcing_term(self, phase) -> np.ndarray:
+        """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
+        return self.basis(phase) @ self.weights_
+
+    @numerically_guarded
+    def endpoint_gain(self, n_steps: int | None = None) -> float:
+        """End-point gain ``c``: the final error for a shifted goal is ``c · ‖g' - g‖``.
+
+        ``c = |1 - B[n_steps - 1]|`` where ``B`` is the goal's share of the affine rollout; it
+        depends only on ``(alpha, K, alpha_phase, tau, T, n_steps)``, not on the weights. With the
+        paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
+        convergence and it tends to 0.
+        """
+        params = self._rollout_params()
+        n_steps = self._n_steps(n_steps, params)
+        cached = _cached_grid(self, params, n_steps, self.dt_)
+        if cached is not None:
+            goal_response = cached[5][0]
+        else:  # B needs no basis matrix, and other horizons should not evict the cached grid
+            phase = params.canonical_system.grid(n_steps, self.dt_, params.tau)
+            gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
+            goal_response = _unit_responses(params, phase, None, self.dt_, gate)[0]
+        return float(abs(1.0 - goal_response[-1]))
+
+    def _rollout_params(self, step: float | None = None, params: _Params | None = None) -> _Params:
+        """The validated parameters, with the rollout's integration checked for stability."""
+        self._check_fitted()
+        params = self._params() if params is None else params  # validated once per rollout
+        _check_integration(self.dt_ if step is None else step, params)
+        return params
+
+    def _prepare(
+        self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None
+    ):
+        _check_forcing_increment(forcing_increment)
+        params = self._rollout_params(step) if params is None else params
+        step = self.dt_ if step is None else step
+        n_dims = self.weights_.shape[1]
+        n_steps = self._n_steps(n_steps, params)
+        start = self.start_ if start is None else as_point(start, n_dims, "start")
+        velocity = (
+            None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
+        )
+        phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(
+            self, params, n_steps, step
+        )
+        change = getattr(
+            forcing_increment, "weight_change", None
+        )  # via-points: a change of the weights
+        forcing = basis @ (self.weights_ if change is None else self.weights_ + change)
+        if change is not None:
+            forcing_increment = forcing_increment.wrapped
+        if forcing_increment is not None:
+            forcing = forcing + forcing_increment(phase, basis)
+        free = _unit_responses(params, phase, forcing, step).T
+        free += np.outer(start_response, start)
+        if start_velocity is not None:
+            free += np.outer(velocity_response, velocity)
+        # lfilter runs in C, outside NumPy's floating-point checks: check its output once. With
+        # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
+        if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
+            raise ValueError(
+                "rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range"
+            )
+        return free, goal_response, forcing, gate
+
+    @numerically_guarded
+    def rollout(
+        self,
+        goal=None,
+        *,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+    ) -> np.ndarray:
+        """Generate a trajectory on the normalised grid, one sample every ``dt_`` (``duration_ /
+        (T - 1)`` seconds at ``tau = 1``), with the protocol's integrator (robot: exact; paper:
+        explicit Euler, Eq. 14).
+
+        Parameters
+        ----------
+        goal : array-like, shape (D,), optional
+            Goal position; default the demonstration's last point.
+        start : array-like, shape (D,), optional
+            Start position; default the demonstration's first point.
+        n_steps : int, optional
+            Number of samples, including the start; default :meth:`default_n_steps`
+            (paper: ``round(tau · T)``, the fixed horizon, the phase ends at ≈ e⁻¹; robot:
+            ``round(1.1 · tau · T)``, converged). Use more steps to let a paper DMP converge.
+            For samples in seconds use :meth:`trajectory`.
+        start_velocity : array-like, shape (D,), optional
+            Initial velocity in units per unit of normalised time (:meth:`trajectory` takes units/s); default at rest.
+        forcing_increment : callable, optional
+            ``forcing_increment(phase (n,), basis (n, N)) -> (n, D)`` added to the learned forcing
+            term on the rollout grid (how :class:`bidmp.BiDMP` adds its learned increments).
+
+        Returns
+        -------
+        y : array, shape (n_steps, D)
+        """
+        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
+        goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+        return free + np.outer(goal_response, goal)
+
+    @numerically_guarded
+    def rollout_many(
+        self,
+        goals,
+        *,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+        out: np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Rollouts to many goals for about the cost of one (the rollout is affine in the goal).
+
+        Parameters
+        ----------
+        goals : array-like, shape (G, D)
+        start, n_steps, start_velocity, forcing_increment
+            As in :meth:`rollout`, shared by every goal.
+        out : array, shape (G, n_steps, D), optional
+            Where to write the rollouts (float64, writable), e.g. a ``numpy.memmap`` from
+            ``numpy.lib.format.open_memmap`` for more rollouts than fit in memory; it is filled a
+            chunk of goals at a time. Without ``out`` the result is one array, refused over
+            ``max_array_bytes`` (see :func:`bidmp.set_limits`); :meth:`iter_rollouts` yields chunks
+            instead.
+
+        Returns
+        -------
+        y : array, shape (G, n_steps, D)
+            ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
+        """
+        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
+        return _rollouts_to(goals, free, goal_response, out)
+
+    def iter_rollouts(
+        self,
+        goals,
+        *,
+        chunk_size: int = 1024,
+        start=None,
+        n_steps: int | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+    ):
+        """Rollouts to many goals, ``chunk_size`` goals at a time (for more than fit in memory).
+
+        Yields
+        ------
+        (first, y) : int and array (g, n_steps, D)
+            ``y[i]`` is the rollout to ``goals[first + i]``; ``g <= chunk_size``.
+        """
+        chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
+        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+            free, goal_response, *_ = self._prepare(
+                start, start_velocity, n_steps, forcing_increment
+            )
+        yield from _iter_rollouts_to(goals, free, goal_response, chunk_size)
+
+    # -- real time -------------------------------------------------------------------------------
+    @numerically_guarded
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        start=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        limits: dict | None = None,
+        start_velocity=None,
+        forcing_increment=None,
+        coupling=None,
+        via=None,
+        via_until: float | None = None,
+    ):
+        """A timed rollout: positions, velocities and accelerations in seconds.
+
+        Parameters
+        ----------
+        goal, start : array (D,), optional
+            Default: the demonstration's goal and start (in ``units_``).
+        duration : float, optional
+            Duration of the motion in seconds (temporal scaling: the shape is kept and time
+            stretched, like ``execution_time`` in movement_primitives); default ``tau ·
+            duration_``. With ``protocol="robot"`` the trajectory runs 1.1x this long, so that it
+            reaches its goal and comes to rest.
+        dt : float, optional
+            Sample period in seconds; default the demonstration's (``duration_ / (T - 1)``).
+        limits : dict, optional
+            ``{"max_velocity": ..., "max_acceleration": ..., "max_jerk": ..., "norm": "norm" |
+            "axis", "fastest": False}`` (units/s, /s², /s³). Caps: a motion that breaks one is
+            slowed (uniformly) to the shortest duration that meets them all; one within them runs
+            as demonstrated, unless ``"fastest": True`` asks for the shortest duration within the
+            limits, faster than demonstrated. ``duration`` is then ignored.
+        start_velocity : array (D,), optional
+            Initial velocity in units/s (default at rest).
+        forcing_increment : callable, optional
+            As in :meth:`rollout` (how :class:`bidmp.BiDMP` adds its increments).
+        coupling : list of coupling terms, optional
+            ``coupling(t, y, yd, phase) -> acceleration`` (units/s², see
+            :mod:`bidmp.primitives.coupling`): the motion is integrated step by step with their
+            accelerations added. Without them (default) the fast path runs; an empty list runs the
+            step integrator, which gives the same samples to rounding.
+        via : list of (t, point), optional
+            Via-points: the motion passes ``point`` (D,) (units) at ``t`` seconds exactly (on the
+            samples, linearly between them), by the least-norm change of the forcing weights
+            (:mod:`bidmp.primitives.via`). Points past the horizon, more than the kernels, or
+            ones the kernels cannot carry raise ``ValueError``; with ``limits`` the motion is not
+            re-timed (the points would move in time) but checked, and one that breaks a limit
+            raises. With spatial coupling terms the uncoupled motion passes the points exactly.
+        via_until : float, optional
+            With ``via``: only the kernels that act (99 % of their activation) before this time (s)
+            change, so after it the motion returns to its own course (a lift over a part that keeps
+            the final approach and where the motion comes to rest); default every kernel. With it,
+            the motion's end is the caller's to judge (without it, via-points that would leave the
+            motion off its goal or moving at its end are refused).
+
+        Returns
+        -------
+        bidmp.Trajectory
+            ``t`` from 0 (s), ``y`` (units), ``yd`` (units/s), ``ydd`` (units/s²), each (n, D).
+            Exact integrator (robot): ``yd`` and ``ydd`` are the system's own state and
+            acceleration at each sample (the same continuous motion at any ``dt``). Euler (paper):
+            ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
+        """
+        self._check_fitted()
+        _check_forcing_increment(forcing_increment)  # every path below takes it
+        if via is not None:
+            return _via_trajectory(
+                self,
+                goal,
+                start,
+                duration,
+                dt,
+                limits,
+                start_velocity,
+                forcing_increment,
+                coupling,
+                via,
+                via_until,
+            )
+        if limits is not None:
+            return _limited_trajectory(
+                self, goal, start, dt, limits, start_velocity, forcing_increment, coupling
+            )
+        if coupling is not None:
+            return _coupled_trajectory(
+                self, goal, start, duration, dt, start_velocity, forcing_increment, coupling
+            )
+        return _timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
+
+    def stepper(
+        self,
+        goal=None,
+        *,
+        start=None,
+        duration: float | None = None,
+        coupling=0.0,
+        start_velocity=None,
+        forcing_increment=None,
+    ) -> DMPStepper:
+        """A step-by-step integrator for a robot's control loop (see :class:`DMPStepper`).
+
+        ``coupling`` is a list of coupling terms (:mod:`bidmp.primitives.coupling`), or a number:
+        ``alpha_e`` of phase stopping (Ijspeert et al. 2013) in 1/units², the system's time running
+        ``1 + alpha_e ‖y_measured - y‖²`` times slower while the robot lags, so a held robot makes the
+        motion pause rather than run away. 0 turns it off.
+        """
+        return DMPStepper(self, goal, start, duration, coupling, start_velocity, forcing_increment)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:

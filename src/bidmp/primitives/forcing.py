@@ -1,28 +1,38 @@
-"""The forcing term: Gaussian kernels on the phase, their weights, and the forcing target that
-makes the transformation system reproduce a demonstration::
+"""The forcing term: a basis on the phase, its weights, and the forcing target that makes the
+transformation system reproduce a demonstration.
+
+The basis is a component (the :class:`Basis` protocol: where its functions go on a canonical
+system's phase, and their rows at any phase); the discrete DMP's is :class:`GaussianBasis`::
 
     f(phase) = phase · Σ_i w_i ψ_i(phase) / Σ_i ψ_i(phase),  ψ_i = exp(-h_i (phase - c_i)²)
 
-Pure functions, vectorised over samples and dimensions; layer 1, imports only the canonical system.
+A periodic basis (von Mises functions on a wrapping phase) or any other function approximator
+linear in its weights is another class with the same methods, given as ``DMP(forcing_basis=...)``. The
+weights are learned by least squares on the basis rows whatever the basis.
+
+Vectorised over samples and dimensions; layer 1, imports only the canonical system.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
 import numpy as np
 
 from .._checks import (
-    _as_bounded_array,
-    as_points,
     as_vector,
     check_choice,
     check_int,
     check_real,
 )
-from .canonical import _checked_phase_args, _phase_decay, phase_grid
+from .canonical import _checked_phase_args, _phase_decay
 
-__all__ = ["kernel_centres", "kernel_widths", "basis_functions"]
+__all__ = ["kernel_centres", "kernel_widths", "basis_functions", "Basis", "GaussianBasis"]
 
-_LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
+_MAX_PHASE = 1e6  # |phase| a basis row is computed for (a DMP's phase lies in [0, 1])
+_LOG_PSI_FLOOR = -40.0
+_LOG_OVERFLOW_MARGIN = 600.0  # exp overflows past ~709: a row's excess beyond this is shifted  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
 
 
 def kernel_centres(
@@ -122,6 +132,16 @@ def _basis_rows(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> n
         [-widths, 2.0 * widths * centres, -widths * centres * centres, np.ones_like(centres)]
     )
     log_psi = features @ coefficients
+    # Outside the centres' range a narrower kernel further away can exceed the bracketing one;
+    # where it does by enough to overflow exp, shift such rows by their exact maximum (rows that
+    # did not overflow keep their numbers: a shift cancels in the normalisation).
+    outside = (phase < centres.min()) | (phase > centres.max())
+    if outside.any():
+        rows = np.flatnonzero(outside)
+        excess = log_psi[rows].max(axis=1)
+        high = excess > _LOG_OVERFLOW_MARGIN
+        if high.any():
+            log_psi[rows[high]] -= excess[high, None]
     # Terms below e^-40 of the row maximum cannot change a float64 sum; clipping them keeps exp
     # out of the (slow) subnormal range.
     np.maximum(log_psi, _LOG_PSI_FLOOR, out=log_psi)
@@ -220,7 +240,8 @@ def _learn_weights(
     train: np.ndarray, dt: float, gate: np.ndarray, params
 ) -> tuple[np.ndarray, ...]:
     """The forcing term of a demonstration as learned, ``train`` (n, D) on the normalised grid
-    ``dt`` with the goal gate ``gate`` (n,), for a DMP's resolved ``params``.
+    ``dt`` with the goal gate ``gate`` (n,), for a DMP's resolved ``params`` (its canonical
+    system and basis among them).
 
     The weights belong to the demonstration's own time scale (``tau = 1``): ``tau`` only scales
     rollouts, so it is not used here.
@@ -230,11 +251,9 @@ def _learn_weights(
     (weights (N, D), centres (N,), widths (N,), phase (n,), basis rows (n, N))
     """
     n_train = train.shape[0]
-    phase = phase_grid(n_train, dt, 1.0, params.alpha_phase, exact=params.exact)
-    centres = kernel_centres(
-        params.n_kernels, n_train, dt, 1.0, params.alpha_phase, exact=params.exact
-    )
-    widths = kernel_widths(centres, params.alpha_phase, params.widths)
+    canonical, basis = params.canonical_system, params.basis
+    phase = canonical.grid(n_train, dt, 1.0)
+    centres, widths = basis.place(canonical, n_train, dt)
     target = _forcing_target(
         train,
         phase,
@@ -246,21 +265,9 @@ def _learn_weights(
         derivatives=params.derivatives,
         gate=gate,
     )
-    phi = _basis_rows(phase, centres, widths)
+    phi = basis.rows(phase, centres, widths)
     weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
     return np.ascontiguousarray(weights), centres, widths, phase, phi
-
-
-def _as_phase(phase, name: str = "phase") -> np.ndarray:
-    """Phases (L,) validated: finite and in [0, 1] (a DMP's phase decays from 1 towards 0)."""
-    phase = _as_bounded_array(phase, name, max_ndim=2)
-    phase = as_points(phase.reshape(-1, 1) if phase.ndim <= 1 else phase, 1, name)[:, 0]
-    if phase.size and (phase.min() < 0.0 or phase.max() > 1.0):
-        raise ValueError(
-            f"{name} must lie in [0, 1] (a DMP's phase decays from 1 towards 0), got values in "
-            f"[{phase.min():.3g}, {phase.max():.3g}]"
-        )
-    return phase
 
 
 def _check_forcing_increment(forcing_increment, name: str = "forcing_increment") -> None:
@@ -270,3 +277,94 @@ def _check_forcing_increment(forcing_increment, name: str = "forcing_increment")
             f"{name} must be callable as f(phase (n,), basis (n, N)) -> (n, D), got "
             f"{type(forcing_increment).__name__}"
         )
+
+
+@runtime_checkable
+class Basis(Protocol):
+    """What a :class:`~bidmp.DMP` asks of its basis (the forcing term's function approximator).
+
+    The learned parameters of the functions (a DMP's ``centres_`` and ``widths_``, shape (N,)
+    each) are placed by :meth:`place` at ``fit`` and passed back to every other method, so a
+    basis object holds only its settings.
+
+    Attributes
+    ----------
+    size : int
+        Number of functions N (the rows' columns, the weights' rows).
+    """
+
+    size: int
+
+    def place(self, canonical, n_steps: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Centres and widths (N,) for the training grid of ``n_steps`` samples ``step`` apart
+        on the canonical system ``canonical``."""
+        ...
+
+    def rows(self, phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """Basis rows at the phases ``phase`` (L,), shape ``(L, N)``."""
+        ...
+
+    def row(self, phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """One row ``(1, N)`` at one phase (a control loop asks for one per step)."""
+        ...
+
+
+@dataclass(frozen=True)
+class GaussianBasis:
+    """The discrete DMP's basis: ``size`` normalised Gaussian kernels scaled by the phase
+    (:func:`basis_functions`), centred at the phase of equally spaced times over the training
+    grid (:func:`kernel_centres`), sized by the ``widths`` rule (:func:`kernel_widths`).
+
+    Parameters
+    ----------
+    size : int
+        Number of kernels N.
+    widths : {"spacing", "pydmps"}, default "spacing"
+        Kernel-width rule (``"pydmps"`` needs the canonical system's decay ``rate``).
+    """
+
+    size: int
+    widths: str = "spacing"
+    # the last kernels row() checked (a control loop passes the same arrays every step)
+    _checked: tuple | None = field(default=None, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(
+            self, "size", check_int(self.size, "size", minimum=1, limit="max_kernels")
+        )
+        check_choice(self.widths, "widths", ("spacing", "pydmps"))
+
+    def place(self, canonical, n_steps: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Centres at the phase of ``size`` equally spaced samples of the training grid, sized
+        by the width rule."""
+        n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+        if not callable(getattr(canonical, "at", None)):
+            raise TypeError(
+                "canonical must be a canonical system (bidmp.primitives.CanonicalSystem, with "
+                f"at(samples, step, tau)), got {type(canonical).__name__}"
+            )
+        # The kernels span exactly the visited phase range: one outside it never fires, and
+        # its LWR weight blows up.
+        centres = canonical.at(np.linspace(0.0, n_steps - 1, self.size), step, 1.0)
+        rate = getattr(canonical, "rate", None) if self.widths == "pydmps" else 1.0
+        if rate is None:
+            raise ValueError(
+                'GaussianBasis(widths="pydmps") sizes kernels by the phase\'s decay rate; '
+                f'{type(canonical).__name__} has none: use widths="spacing"'
+            )
+        return centres, kernel_widths(centres, rate, self.widths)
+
+    def rows(self, phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """:func:`basis_functions` (its checks included)."""
+        return basis_functions(phase, centres, widths)
+
+    def row(self, phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """One row at a phase: the control loop's call, so the kernels are checked once per pair
+        of arrays (a DMP's own, the same every step)."""
+        if not (type(phase) is float and -_MAX_PHASE <= phase <= _MAX_PHASE):
+            phase = check_real(phase, "phase", minimum=-_MAX_PHASE, maximum=_MAX_PHASE)
+        checked = self._checked
+        if checked is None or checked[0] is not centres or checked[1] is not widths:
+            basis_functions(np.zeros(1), centres, widths)  # checks the kernels, names them
+            object.__setattr__(self, "_checked", (centres, widths))
+        return _basis_row(phase, centres, widths)

@@ -306,12 +306,15 @@ def _learned_progress_gate(model, params) -> ProgressGate:
             "this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
             "set goal_rate to a number or fit it again"
         )
-    key = (model.n_train_, model.dt_, params.alpha_phase, params.exact)
+    key = (model.n_train_, model.dt_, params.canonical_system)
     cached = model.__dict__.get("_goal_system")
     if cached is None or cached[0] != key or cached[1].gate is not gate:
-        training_phase = phase_grid(
-            model.n_train_, model.dt_, 1.0, params.alpha_phase, exact=params.exact
-        )
+        training_phase = params.canonical_system.grid(model.n_train_, model.dt_, 1.0)
+        if not np.all(np.diff(training_phase) < 0.0):
+            raise ValueError(
+                "the progress gate looks the goal's share up by the phase, which must decay; "
+                f"{type(params.canonical_system).__name__} does not: set goal_rate to a number"
+            )
         cached = (key, ProgressGate(training_phase, gate))
         model._goal_system = cached
     return cached[1]

@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from .canonical import phase_grid
-from .forcing import _basis_rows
 from .integrate import _unit_responses
 
 __all__ = []
@@ -26,6 +24,8 @@ def _grid_key(params, n_steps: int, step: float) -> tuple:
         params.beta,
         params.K,
         params.alpha_phase,
+        params.canonical_system,
+        params.basis,
         params.goal_rate,
         params.integrator,
         step,
@@ -73,8 +73,7 @@ def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tup
     step = model.dt_ if step is None else step
     cached = _cached_grid(model, params, n_steps, step)
     if cached is None:
-        phase = phase_grid(n_steps, step, params.tau, params.alpha_phase, exact=params.exact)
-        cached = _store_grid(
-            model, params, phase, _basis_rows(phase, model.centres_, model.widths_), step
-        )
+        phase = params.canonical_system.grid(n_steps, step, params.tau)
+        basis = params.basis.rows(phase, model.centres_, model.widths_)
+        cached = _store_grid(model, params, phase, basis, step)
     return cached[3:]

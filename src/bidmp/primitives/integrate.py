@@ -238,7 +238,7 @@ def _check_integration(step: float, params) -> None:
     if params.integrator != "euler":
         return
     _check_euler_stable(step, params.tau, params.alpha, params.beta)
-    _phase_decay(step, params.tau, params.alpha_phase)
+    params.canonical_system.check_step(step, params.tau)
     if params.goal_rate is not None:
         _phase_decay(step, params.tau, params.goal_rate)
 

@@ -21,6 +21,8 @@ from .._checks import (
     check_int,
     check_real,
 )
+from .canonical import _TAU_RANGE, CanonicalSystem, ExponentialPhase
+from .forcing import Basis, GaussianBasis
 
 __all__ = ["PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE", "ROBOT_SETTLE"]
 
@@ -31,7 +33,6 @@ WIDTH_CHOICES = ("spacing", "pydmps")
 # Gains (alpha, beta, alpha_phase in 1/s; K) and tau (s) outside these ranges have no physical use
 # and take float64 out of its range in the forcing target (division by K) or the integration.
 _GAIN_RANGE = (1e-6, 1e6)
-_TAU_RANGE = (1e-6, 1e6)
 
 
 class _Params(NamedTuple):
@@ -54,6 +55,9 @@ class _Params(NamedTuple):
     settle: float  # default horizon as a multiple of the (scaled) demonstrated duration
     # the goal's offset complete before the final approach (ApproachGate)
     keep_approach: bool = False
+    # the phase and the forcing term's basis (components; the protocol's unless given)
+    canonical_system: CanonicalSystem | None = None
+    basis: Basis | None = None
 
     @property
     def exact(self) -> bool:
@@ -136,10 +140,14 @@ def _resolve_params(estimator) -> _Params:
         if estimator.integrator is None
         else check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
     )
+    regression = (
+        ("ridge" if robot else "lwr")
+        if estimator.regression is None
+        else check_choice(estimator.regression, "regression", REGRESSION_CHOICES)
+    )
+    canonical_system, basis = _components(estimator, alpha_phase, integrator, regression)
     return _Params(
-        n_kernels=(ROBOT_KERNELS if robot else 50)
-        if estimator.n_kernels is None
-        else check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels"),
+        n_kernels=basis.size,
         alpha=alpha,
         beta=beta,
         K=K,
@@ -147,18 +155,72 @@ def _resolve_params(estimator) -> _Params:
         tau=check_real(
             estimator.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]
         ),
-        regression=("ridge" if robot else "lwr")
-        if estimator.regression is None
-        else check_choice(estimator.regression, "regression", REGRESSION_CHOICES),
+        regression=regression,
         derivatives=check_choice(estimator.derivatives, "derivatives", DERIVATIVE_CHOICES),
         ridge=check_real(estimator.ridge, "ridge", nonnegative=True, maximum=1e6),
-        widths=check_choice(estimator.widths, "widths", WIDTH_CHOICES),
+        widths=basis.widths if isinstance(basis, GaussianBasis) else "",
         protocol=protocol,
         goal_rate=goal_rate,
         integrator=integrator,
         settle=ROBOT_SETTLE if robot else 1.0,
         keep_approach=_keep_approach(estimator, goal_rate, integrator),
+        canonical_system=canonical_system,
+        basis=basis,
     )
+
+
+def _components(
+    estimator, alpha_phase: float, integrator: str, regression: str
+) -> tuple[CanonicalSystem, Basis]:
+    """The DMP's canonical system and basis: the ones given, or the protocol's exponential phase
+    and Gaussian kernels built from ``alpha_phase``, ``n_kernels`` and ``widths``. A component
+    given beside the parameter that would build it is refused (which one counts would be a guess)."""
+    canonical = getattr(estimator, "canonical_system", None)
+    if canonical is None:
+        canonical = ExponentialPhase(alpha_phase, exact=integrator == "exact")
+    else:
+        if estimator.alpha_phase is not None:
+            raise ValueError(
+                "give either canonical_system or alpha_phase: alpha_phase sets the default "
+                "canonical system's decay"
+            )
+        _check_component(canonical, CanonicalSystem, "canonical_system")
+    basis = getattr(estimator, "forcing_basis", None)
+    if basis is None:
+        n_kernels = (
+            (ROBOT_KERNELS if estimator.protocol == "robot" else 50)
+            if estimator.n_kernels is None
+            else check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels")
+        )
+        basis = GaussianBasis(n_kernels, check_choice(estimator.widths, "widths", WIDTH_CHOICES))
+    else:
+        widths = check_choice(estimator.widths, "widths", WIDTH_CHOICES)
+        if estimator.n_kernels is not None or widths != "spacing":
+            raise ValueError(
+                "give either forcing_basis or n_kernels and widths: they set the default Gaussian basis"
+            )
+        _check_component(basis, Basis, "forcing_basis")
+        check_int(basis.size, "forcing_basis.size", minimum=1, limit="max_kernels")
+    if regression == "lwr" and not isinstance(basis, GaussianBasis):
+        raise ValueError(
+            "regression='lwr' weighs each kernel's samples by the decaying phase, which only "
+            f"GaussianBasis is scaled by; with {type(basis).__name__} use regression='ridge'"
+        )
+    return canonical, basis
+
+
+def _check_component(component, protocol, name: str) -> None:
+    """Refuse an object that lacks one of the protocol's methods or attributes, naming it."""
+    members = sorted(
+        {member for member in vars(protocol) if not member.startswith("_")}
+        | set(protocol.__annotations__)
+    )
+    missing = [member for member in members if not hasattr(component, member)]
+    if missing:
+        raise TypeError(
+            f"{name} must provide {protocol.__name__}'s {', '.join(members)}; "
+            f"{type(component).__name__} lacks {', '.join(missing)}"
+        )
 
 
 def _with_rest(y: np.ndarray, params: _Params) -> np.ndarray:

@@ -3,6 +3,8 @@ how a file's members are checked on the way back in, for every model format sinc
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from .._checks import (
@@ -14,6 +16,8 @@ from .._checks import (
     get_limits,
 )
 from .._units import check_units
+from .canonical import ExponentialPhase
+from .forcing import GaussianBasis
 from .integrate import _check_euler_stable
 
 __all__ = []
@@ -34,7 +38,7 @@ def _dmp_state(model) -> tuple[dict, dict]:
     if model.__dict__.get("held_orientation_") is not None:
         arrays["held_orientation_"] = model.held_orientation_
     meta = {
-        "params": model.get_params(),
+        "params": _params_state(model.get_params()),
         "n_steps_": model.n_steps_,
         "duration_": model.duration_,
         "units_": model.units_,
@@ -44,10 +48,50 @@ def _dmp_state(model) -> tuple[dict, dict]:
     return meta, arrays
 
 
+# The components a model file can name: the classes bidmp ships (a file never names code to run).
+_COMPONENTS = {"ExponentialPhase": ExponentialPhase, "GaussianBasis": GaussianBasis}
+
+
+def _params_state(params: dict) -> dict:
+    """A DMP's parameters for JSON: a component given (canonical system, basis) as its class's
+    name and fields; unset components are left out (files written before components read the same)."""
+    state = {}
+    for name, value in params.items():
+        if name in ("canonical_system", "forcing_basis"):
+            if value is None:
+                continue
+            kind = type(value).__name__
+            if _COMPONENTS.get(kind) is not type(value):
+                raise ValueError(
+                    f"a model file can hold bidmp's own components ({', '.join(_COMPONENTS)}); "
+                    f"this DMP's {name} is a {kind}"
+                )
+            settings = {f.name: getattr(value, f.name) for f in dataclasses.fields(value) if f.init}
+            value = {"type": kind, **settings}
+        state[name] = value
+    return state
+
+
+def _component_from_state(value, name: str):
+    """A component from its model-file form ``{"type": ..., fields}``, checked."""
+    if not isinstance(value, dict) or value.get("type") not in _COMPONENTS:
+        raise ValueError(
+            f"member params.{name} must name one of {', '.join(_COMPONENTS)} with its fields"
+        )
+    fields = {key: item for key, item in value.items() if key != "type"}
+    try:
+        return _COMPONENTS[value["type"]](**fields)
+    except TypeError as error:
+        raise ValueError(f"member params.{name}: {error}") from None
+
+
 def _dmp_from_state(cls, meta: dict, arrays) -> object:
     """A DMP of class ``cls`` from a model file's state, every member checked (a corrupt or forged
     file raises ``ValueError`` naming the member)."""
     params = dict(meta["params"])
+    for name in ("canonical_system", "forcing_basis"):
+        if params.get(name) is not None:
+            params[name] = _component_from_state(params[name], name)
     if "fit" in params:  # format 1 stored the regression under the name "fit"
         params["regression"] = params.pop("fit")
     params.setdefault("protocol", "paper")  # formats 1-2 knew only the paper's protocol

@@ -4,13 +4,11 @@ with coupling terms (:mod:`bidmp.primitives.coupling`)."""
 from __future__ import annotations
 
 import logging
-import math
 
 import numpy as np
 
 from .._checks import as_point, check_real
 from .coupling import _as_couplings
-from .forcing import _basis_row
 from .goal_shift import _goal_complete_time, _GoalShifts, _shortest_blend
 from .grid import _rollout_grid
 from .integrate import StepIntegrator
@@ -47,9 +45,7 @@ class DMPStepper:
     def __init__(
         self, dmp, goal, start, duration, coupling, start_velocity, forcing_increment
     ) -> None:
-        from .dmp import DMP
-
-        if not isinstance(dmp, DMP):
+        if not callable(getattr(dmp, "goal_system", None)):  # DMP.stepper() passes itself
             raise TypeError(
                 f"dmp must be a fitted bidmp.DMP (DMP.stepper() builds its stepper), got {type(dmp).__name__}"
             )
@@ -82,14 +78,15 @@ class DMPStepper:
         self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
         # What every step reads, taken once: a control loop should not revalidate the model.
         self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
+        self._canonical, self._basis = params.canonical_system, params.basis
         self._goal_system = dmp.goal_system(self._params)
         self._time_unit = dmp.time_unit_
         self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
         # (phase, gate, goal, start, u): the end of one step starts the next
         self._last_input = None
-        self.phase = 1.0
+        self.phase = self._canonical.initial
         self._gate = 1.0
-        self._gate = self._goal_system._follow(1.0, 1.0, 0.0, self._scale, params.exact)
+        self._gate = self._goal_system._follow(1.0, self.phase, 0.0, self._scale, params.exact)
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
         # the motion time its own goal offset completes (set_goal asks for it)
@@ -217,7 +214,7 @@ class DMPStepper:
         ):
             return last[4]
         params = self._params
-        basis = _basis_row(phase, self._centres, self._widths)
+        basis = self._basis.row(phase, self._centres, self._widths)
         forcing = basis @ self._weights
         if self._forcing_increment is not None:
             forcing = forcing + self._forcing_increment(np.array([phase]), basis)
@@ -275,12 +272,7 @@ class DMPStepper:
         ) ** 2
         if offset is not None:
             acceleration = acceleration + offset[2] / slowdown**2
-        decay_phase = (
-            math.exp(-params.alpha_phase * step / tau)
-            if params.exact
-            else 1.0 - params.alpha_phase * (step / tau)
-        )
-        phase = self.phase * decay_phase
+        phase = self._canonical.advance(self.phase, step, tau)
         gate = self._goal_system._follow(self._gate, phase, step, tau, params.exact)
         input_next = self._input(phase, gate) if params.exact else input_now
         if self._couplings and params.exact:

@@ -170,7 +170,7 @@ def _via_increment(
         return added if forcing_increment is None else forcing_increment(phase_in, basis_in) + added
 
     # (N, D): what the via-points cost the learned shape; a rollout adds it to the weights in one
-    # product (Motions._prepare) and calls ``wrapped`` for the rest.
+    # product (DMP._prepare) and calls ``wrapped`` for the rest.
     increment.weight_change, increment.wrapped = change, forcing_increment
     return increment
 
