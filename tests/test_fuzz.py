@@ -408,7 +408,17 @@ extension_options = st.fixed_dictionaries(
 )
 @examples(30)
 def test_fuzz_extend_demonstration(y, target, seed, options):
-    outcome("extend_demonstration", bidmp.extend_demonstration, y, target, seed=seed, **options)
+    outcome("extend_demonstration", _extend_with_flat_options, y, target, seed, options)
+
+
+def _extend_with_flat_options(y, target, seed, options):
+    """``extend_demonstration`` with options as a scenario file writes them (flat)."""
+    from bidmp.extension import check_extension_options
+
+    options = dict(options)
+    segmentation = {k: options.pop(k) for k in ("eps_frac", "method") if k in options}
+    arguments = check_extension_options(**segmentation, **options)
+    return bidmp.extend_demonstration(y, target, seed=seed, **arguments)
 
 
 @given(
@@ -420,14 +430,15 @@ def test_fuzz_extend_demonstration(y, target, seed, options):
 )
 @examples(30)
 def test_fuzz_roadmaps(piece, target, seed, which, options):
-    from bidmp.extension import classic_prm, gaussian_prm
+    from bidmp.extension import RoadmapOptions, classic_prm, gaussian_prm
 
     options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
-    if which == "classic":
-        options = {k: v for k, v in options.items() if k not in ("sigma_rel", "rho", "schedule")}
-        outcome("classic_prm", classic_prm, piece, target, seed=seed, **options)
-    else:
-        outcome("gaussian_prm", gaussian_prm, piece, target, seed=seed, **options)
+
+    def run(piece, target, seed):
+        roadmap = classic_prm if which == "classic" else gaussian_prm
+        return roadmap(piece, target, RoadmapOptions(**options), seed=seed)
+
+    outcome(f"{which}_prm", run, piece, target, seed)
 
 
 bls_params = st.fixed_dictionaries(

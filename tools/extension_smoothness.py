@@ -42,7 +42,7 @@ from test_extension_timing import ldj_floor, shortest_around, transfer  # noqa: 
 from test_extension_timing import log_dimensionless_jerk as ldj  # noqa: E402
 
 from bidmp.demonstrations import minimum_jerk
-from bidmp.extension import extend_demonstration
+from bidmp.extension import RoadmapOptions, extend_demonstration
 from bidmp.extension.roadmap import NoFreeRouteError
 from bidmp.scene import Scene
 
@@ -82,7 +82,9 @@ def fixed_cases() -> None:
                 "height": 600.0,
             }
             scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
-            extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+            extension = extend_demonstration(
+                demo, target, seed=0, scene=scene, roadmap=RoadmapOptions(sigma_rel=0.1)
+            )
             keep = radius + TOOL["radius"] + margin
             print(
                 row(

@@ -7,6 +7,7 @@ import bidmp
 from bidmp import extend_demonstration
 from bidmp.demonstrations import lasa, minimum_jerk
 from bidmp.experiments import BATTERY_APPROACH_VIA, BATTERY_EXTENSION_TARGET
+from bidmp.extension import RoadmapOptions
 
 
 @pytest.fixture(scope="module")
@@ -60,11 +61,19 @@ def test_same_seed_same_extension_and_options_pass_through(battery):
     again = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=4)
     assert np.array_equal(first.complete, again.complete)
     fewer = extend_demonstration(
-        battery, BATTERY_EXTENSION_TARGET, seed=4, n_iter=3, n_samples=100, eps_frac=0.2
+        battery,
+        BATTERY_EXTENSION_TARGET,
+        seed=4,
+        roadmap=RoadmapOptions(n_iter=3, n_samples=100),
+        eps_frac=0.2,
     )
     assert fewer.similarity_history.shape == (3,)
-    with pytest.raises(TypeError, match="unexpected keyword argument 'n_iterations'"):
-        extend_demonstration(battery, BATTERY_EXTENSION_TARGET, n_iterations=3)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'n_iter'"):
+        extend_demonstration(battery, BATTERY_EXTENSION_TARGET, n_iter=3)
+    with pytest.raises(
+        TypeError, match="roadmap must be a bidmp.extension.RoadmapOptions.*got dict"
+    ):
+        extend_demonstration(battery, BATTERY_EXTENSION_TARGET, roadmap={"n_iter": 3})
 
 
 def test_target_at_seg_skips_gprm(battery):
@@ -102,17 +111,31 @@ def test_extension_is_fast_enough_to_stay_out_of_the_way(battery):
     assert time.perf_counter() - start < 5.0
 
 
-def test_options_are_listed_in_the_signature():
+def test_options_are_listed_in_the_signature_and_a_scenario_names_the_same():
+    """Structure guard: the signature spells every option (no ``**kwargs``); a scenario file's
+    flat "extension" keys are the segmentation's, the approach and G-PRM's options (the classic
+    PRM's padding is no extension option), and they turn into the same call."""
+    import dataclasses
     import inspect
 
-    from bidmp.extension import gaussian_prm
+    from bidmp.extension import check_extension_options
+    from bidmp.tasks.scenarios import _EXTENSION_KEYS
 
     signature = inspect.signature(extend_demonstration).parameters
-    for name, parameter in inspect.signature(gaussian_prm).parameters.items():
-        if parameter.kind is inspect.Parameter.KEYWORD_ONLY:
-            assert signature[name].default == parameter.default, name  # same defaults as G-PRM
     assert (
         signature["eps_frac"].default
         == inspect.signature(bidmp.segment).parameters["eps_frac"].default
     )
     assert not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in signature.values())
+    fields = {field.name for field in dataclasses.fields(RoadmapOptions)}
+    assert _EXTENSION_KEYS == {"eps_frac", "method", "approach"} | (fields - {"padding"})
+    arguments = check_extension_options(eps_frac=0.2, n_iter=3, approach="paper")
+    assert arguments == {
+        "eps_frac": 0.2,
+        "method": "persistence",
+        "approach": "paper",
+        "roadmap": RoadmapOptions(n_iter=3),
+    }
+    assert set(arguments) <= set(signature)
+    with pytest.raises(TypeError, match="unknown extension option 'n_iterations'"):
+        check_extension_options(n_iterations=3)

@@ -10,7 +10,7 @@ import pytest
 import bidmp
 from bidmp.demonstrations import minimum_jerk
 from bidmp.demonstrations.datasets import recording
-from bidmp.extension import extend_demonstration
+from bidmp.extension import RoadmapOptions, extend_demonstration
 from bidmp.scene import Scene
 
 
@@ -294,7 +294,9 @@ def test_a_transfer_around_a_post_is_near_the_shortest_free_route(margin, post_r
         "height": 600.0,
     }
     scene = Scene.from_dict({"tool": TOOL, "parts": [post], "margin": margin})
-    extension = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+    extension = extend_demonstration(
+        demo, target, seed=0, scene=scene, roadmap=RoadmapOptions(sigma_rel=0.1)
+    )
     path = extension.tra_gen
     assert extension.refinement in ("smoothed", "shortcut")
     keep = post_radius + TOOL["radius"] + margin

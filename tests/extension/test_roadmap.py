@@ -8,6 +8,7 @@ from bidmp.demonstrations import minimum_jerk
 from bidmp.experiments import compare_prm, table5_cases
 from bidmp.extension import (
     NoFreeRouteError,
+    RoadmapOptions,
     classic_prm,
     frechet_similarity,
     gaussian_prm,
@@ -69,7 +70,10 @@ def test_bias_update_follows_eq8_when_the_noise_vanishes(arc_piece, schedule, rh
     """With sigma -> 0 and n_tar = tar the path is the biased line itself, so the gap 1 - s to
     the template shrinks exactly as Eq. 8 says: gap <- gap (1 - gap eta_it)."""
     result = gaussian_prm(
-        arc_piece, arc_piece[-1], sigma_rel=1e-9, schedule=schedule, rho=rho, seed=0
+        arc_piece,
+        arc_piece[-1],
+        RoadmapOptions(sigma_rel=1e-9, schedule=schedule, rho=rho),
+        seed=0,
     )
     gap = 1.0 - result.history
     eta = rho ** np.arange(1, 10) if schedule == "geometric" else rho / np.arange(1, 10)
@@ -116,9 +120,9 @@ def test_collision_callback_keeps_the_path_out_of_an_obstacle():
     def is_free(points):
         return np.linalg.norm(points - centre, axis=1) > radius
 
-    result = gaussian_prm(piece, target, sigma_rel=0.15, is_free=is_free, seed=0)
+    result = gaussian_prm(piece, target, RoadmapOptions(sigma_rel=0.15), is_free=is_free, seed=0)
     assert np.all(is_free(result.path))
-    free_run = gaussian_prm(piece, target, sigma_rel=0.15, seed=0)
+    free_run = gaussian_prm(piece, target, RoadmapOptions(sigma_rel=0.15), seed=0)
     assert not np.all(is_free(free_run.path))  # without the callback the path goes through it
     with pytest.raises(ValueError, match="inside an obstacle"):
         gaussian_prm(piece, centre + [0.5, 0.0], is_free=is_free)
@@ -131,7 +135,11 @@ def test_a_wall_that_blocks_every_route_is_an_error_never_a_path_through_it():
     assert shortest_path(nodes, 1, is_free=wall) is None
     with pytest.raises(NoFreeRouteError, match="no collision-free route"):
         gaussian_prm(
-            np.linspace([0.0, 0.0], [1.0, 0.0], 10), [3.0, 0.0], n_samples=20, is_free=wall, seed=0
+            np.linspace([0.0, 0.0], [1.0, 0.0], 10),
+            [3.0, 0.0],
+            RoadmapOptions(n_samples=20),
+            is_free=wall,
+            seed=0,
         )
 
 
@@ -140,9 +148,7 @@ def test_unreachable_target_without_a_callback_falls_back_to_the_sample_chain():
     result = gaussian_prm(
         np.linspace([0.0, 0.0], [1.0, 0.0], 10),
         [3.0, 0.0],
-        n_samples=2,
-        n_neighbours=1,
-        sigma_rel=5.0,
+        RoadmapOptions(n_samples=2, n_neighbours=1, sigma_rel=5.0),
         seed=0,
     )
     assert np.array_equal(result.path[0], [0.0, 0.0]) and np.array_equal(
@@ -163,9 +169,21 @@ def test_unreachable_target_without_a_callback_falls_back_to_the_sample_chain():
     ],
 )
 def test_bad_input(arc_piece, kwargs, error, match):
-    arguments = {"new_target": [0.0, 15.0], **kwargs}
+    target = kwargs.pop("new_target", [0.0, 15.0])
     with pytest.raises(error, match=match):
-        gaussian_prm(arc_piece, **arguments)
+        gaussian_prm(arc_piece, target, RoadmapOptions(**kwargs))
+
+
+def test_options_are_one_checked_object():
+    """The options are checked when made, once; both roadmaps refuse anything else by name."""
+    options = RoadmapOptions(n_iter=3)
+    assert options.replace(sigma_rel=0.1) == RoadmapOptions(n_iter=3, sigma_rel=0.1)
+    with pytest.raises(ValueError, match="sigma_rel"):
+        options.replace(sigma_rel=-1.0)
+    piece = np.linspace([0.0, 0.0], [1.0, 0.0], 10)
+    for roadmap in (gaussian_prm, classic_prm):
+        with pytest.raises(TypeError, match="options must be a bidmp.extension.RoadmapOptions"):
+            roadmap(piece, [3.0, 0.0], {"n_iter": 3})
 
 
 def test_paper_scaling_and_raw_comparison_run(arc_piece):
@@ -176,9 +194,9 @@ def test_paper_scaling_and_raw_comparison_run(arc_piece):
         {"schedule": "harmonic"},
         {"select": "last"},
     ):
-        result = gaussian_prm(arc_piece, target, seed=1, **options)
+        result = gaussian_prm(arc_piece, target, RoadmapOptions(**options), seed=1)
         assert 0.0 <= result.similarity <= 1.0 and np.array_equal(result.path[-1], target)
-    raw = gaussian_prm(arc_piece, target, seed=1, compare="raw")
+    raw = gaussian_prm(arc_piece, target, RoadmapOptions(compare="raw"), seed=1)
     # Against Tra_imi itself the end-point gap caps the score below the template's.
     assert (
         raw.history.max()
@@ -187,4 +205,4 @@ def test_paper_scaling_and_raw_comparison_run(arc_piece):
         )
         + 0.2
     )
-    assert gaussian_prm(arc_piece, target, seed=1, select="last").iteration == 9
+    assert gaussian_prm(arc_piece, target, RoadmapOptions(select="last"), seed=1).iteration == 9

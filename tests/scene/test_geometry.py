@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 import bidmp
 from bidmp.cli import main
-from bidmp.extension import NoFreeRouteError, extend_demonstration, final_approach
+from bidmp.extension import NoFreeRouteError, RoadmapOptions, extend_demonstration, final_approach
 from bidmp.scene import Scene, SceneError, Tool
 from bidmp.tasks import evaluate, scenarios
 
@@ -277,7 +277,9 @@ def test_gprm_routes_the_transfer_around_a_part_in_its_way(nut):
     }
     scene = scene_of(block)
     assert not scene.clearance(blind.complete).collision_free
-    routed = extend_demonstration(demo, target, seed=0, scene=scene, sigma_rel=0.1)
+    routed = extend_demonstration(
+        demo, target, seed=0, scene=scene, roadmap=RoadmapOptions(sigma_rel=0.1)
+    )
     assert scene.clearance(routed.complete).collision_free
 
 

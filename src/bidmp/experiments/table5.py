@@ -11,7 +11,7 @@ from .._checks import check_int
 from .._trajectory import path_extent
 from ..demonstrations.datasets import lasa, minimum_jerk
 from ..extension.extend import ExtendedDemonstration, extend_demonstration
-from ..extension.roadmap import RoadmapResult, classic_prm, gaussian_prm
+from ..extension.roadmap import RoadmapOptions, RoadmapResult, classic_prm, gaussian_prm
 from ..tasks._tables import markdown_table, text_table
 
 __all__ = [
@@ -84,31 +84,37 @@ class PRMComparison:
         }
 
 
-def compare_prm(
-    y, new_target, *, name: str = "", units: str = "", n_seeds: int = 20, **options
+def compare_prm(  # noqa: PLR0913 - the experiment's options, each one
+    y,
+    new_target,
+    *,
+    name: str = "",
+    units: str = "",
+    n_seeds: int = 20,
+    roadmap: RoadmapOptions | None = None,
+    eps_frac: float = 0.1,
+    method: str = "persistence",
 ) -> PRMComparison:
     """Run G-PRM and classic PRM on the piece that :func:`extend_demonstration` imitates.
 
-    Seeds ``0 … n_seeds − 1``; ``options`` go to :func:`extend_demonstration` (segmentation and
-    roadmap options shared by both methods).
+    Seeds ``0 … n_seeds − 1``; ``eps_frac`` and ``method`` segment the demonstration, ``roadmap``
+    (default ``RoadmapOptions()``) is shared by both roadmaps (G-PRM's ``sigma_rel``, ``rho`` and
+    ``schedule`` are its own).
     """
     n_seeds = check_int(n_seeds, "n_seeds", minimum=1, maximum=MAX_SEEDS)
-    extension = extend_demonstration(y, new_target, seed=0, approach="paper", **options)
-    roadmap_options = {k: v for k, v in options.items() if k not in ("eps_frac", "method")}
-    prm_options = {
-        k: v for k, v in roadmap_options.items() if k not in ("sigma_rel", "rho", "schedule")
-    }
+    roadmap = RoadmapOptions() if roadmap is None else roadmap
+    extension = extend_demonstration(
+        y, new_target, seed=0, approach="paper", roadmap=roadmap, eps_frac=eps_frac, method=method
+    )
     gprm, prm, example_prm = [], [], None
     for seed in range(n_seeds):
         if seed == 0 and len(extension.similarity_history):
             gprm.append(extension.similarity_history)  # the extension already ran G-PRM with seed 0
         else:
             gprm.append(
-                gaussian_prm(
-                    extension.tra_imi, extension.new_target, seed=seed, **roadmap_options
-                ).history
+                gaussian_prm(extension.tra_imi, extension.new_target, roadmap, seed=seed).history
             )
-        result = classic_prm(extension.tra_imi, extension.new_target, seed=seed, **prm_options)
+        result = classic_prm(extension.tra_imi, extension.new_target, roadmap, seed=seed)
         prm.append(result.history)
         example_prm = example_prm or result
     return PRMComparison(

@@ -31,6 +31,7 @@ _EXPORTS = {
     "dtw_distance": "similarity",
     "NoFreeRouteError": "roadmap",
     "RoadmapResult": "roadmap",
+    "RoadmapOptions": "roadmap",
     "template": "roadmap",
     "gaussian_prm": "roadmap",
     "classic_prm": "roadmap",

@@ -40,14 +40,16 @@ from .._checks import (
     as_indices,
     as_point,
     as_trajectory,
+    check_callable,
     check_choice,
     check_real,
+    check_seed,
     numerically_guarded,
 )
 from .._trajectory import arclength, path_extent, resample_time
 from ..primitives.approach import STRAIGHTNESS, _straight_tail_start
 from .refine import _lifted_route, _path_is_free, _refine_transfer, _smoothest_free_route
-from .roadmap import CollisionCallback, NoFreeRouteError, _check_options, gaussian_prm
+from .roadmap import CollisionCallback, NoFreeRouteError, RoadmapOptions, _options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
 from .timing import _time_path, _timed_transfer
 
@@ -203,36 +205,46 @@ def check_extension_options(
     seed=0,
     approach: str = "keep",
     **roadmap_options,
-) -> None:
-    """Validate the options of :func:`extend_demonstration` without running it (what ``bidmp
-    scenario check`` runs on a scenario's ``"extension"`` key); raise naming the first bad one."""
+) -> dict:
+    """The options of :func:`extend_demonstration` in the flat form a scenario file writes them
+    (``"extension": {"eps_frac": 0.1, "n_iter": 20, ...}``), checked without running anything;
+    raise naming the first bad one.
+
+    Returns
+    -------
+    dict
+        The keyword arguments of :func:`extend_demonstration`: ``eps_frac``, ``method``,
+        ``approach`` and ``roadmap`` (a :class:`~bidmp.extension.RoadmapOptions` of the rest).
+    """
     eps_frac = check_real(eps_frac, "eps_frac")
     if not 0.0 < eps_frac < 1.0:
         raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
     check_choice(method, "method", ("persistence", "paper"))
     check_choice(approach, "approach", APPROACHES)
-    _check_options(seed=seed, **roadmap_options)
+    check_seed(seed)
+    unknown = sorted(set(roadmap_options) - set(RoadmapOptions.__dataclass_fields__))
+    if unknown:
+        raise TypeError(
+            f"unknown extension option {unknown[0]!r} (known: eps_frac, method, approach, "
+            f"{', '.join(RoadmapOptions.__dataclass_fields__)})"
+        )
+    return {
+        "eps_frac": eps_frac,
+        "method": method,
+        "approach": approach,
+        "roadmap": RoadmapOptions(**roadmap_options),
+    }
 
 
 @numerically_guarded
-def extend_demonstration(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def extend_demonstration(
     y,
     new_target,
     *,
     seed: int | np.random.Generator | None = 0,
     eps_frac: float = 0.1,
     method: str = "persistence",
-    n_samples: int = 300,
-    sigma_rel: float = 0.03,
-    n_neighbours: int = 8,
-    n_compare: int = 100,
-    n_iter: int = 10,
-    rho: float = 0.9,
-    schedule: str = "geometric",
-    scaling: str = "axis",
-    compare: str = "template",
-    select: str = "best",
-    denom: str = "sqrt2",
+    roadmap: RoadmapOptions | None = None,
     is_free: CollisionCallback | None = None,
     approach: str = "keep",
     scene=None,
@@ -248,8 +260,10 @@ def extend_demonstration(  # noqa: PLR0913 - the public call spells its options 
         Seed of the G-PRM sampling: same seed, same result.
     eps_frac, method
         Segmentation options, see :func:`bidmp.segment`.
-    n_samples, sigma_rel, n_neighbours, n_compare, n_iter, rho, schedule, scaling, compare, select, denom, is_free
-        G-PRM options, see :func:`bidmp.extension.roadmap.gaussian_prm` (same defaults).
+    roadmap : RoadmapOptions, optional
+        G-PRM's options (default ``RoadmapOptions()``).
+    is_free : callable, optional
+        A collision callback for the roadmap, see :func:`bidmp.extension.gaussian_prm`.
     approach : {"keep", "paper"}, default "keep"
         ``"keep"``: keep the demonstration's final approach (:func:`final_approach`), translated
         to the new target, and grow only the transfer to its start. ``"paper"``: the paper's
@@ -271,28 +285,11 @@ def extend_demonstration(  # noqa: PLR0913 - the public call spells its options 
     """
     y = as_trajectory(y, "y", min_points=10)
     target = as_point(new_target, y.shape[1], "new_target", like="y")
-    roadmap_options = {
-        "n_samples": n_samples,
-        "sigma_rel": sigma_rel,
-        "n_neighbours": n_neighbours,
-        "n_compare": n_compare,
-        "n_iter": n_iter,
-        "rho": rho,
-        "schedule": schedule,
-        "scaling": scaling,
-        "compare": compare,
-        "select": select,
-        "denom": denom,
-    }
-    check_extension_options(
-        eps_frac=eps_frac,
-        method=method,
-        seed=seed,
-        approach=approach,
-        is_free=is_free,
-        **roadmap_options,
-    )
-    exclude, roadmap_options["is_free"], scene_checker = _scene_checker(scene, y, target, is_free)
+    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach=approach)
+    if is_free is not None:
+        check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
+    exclude, is_free, scene_checker = _scene_checker(scene, y, target, is_free)
+    roadmap_options = {"options": _options(roadmap, "roadmap"), "is_free": is_free}
     points = segment(y, eps_frac=eps_frac, method=method).points
     if approach == "keep":
         if scene_checker is not None and scene.margin > 0.0:
@@ -524,7 +521,11 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
     except NoFreeRouteError as exc:
         first = exc
         for factor in _WIDER:
-            wider = {**roadmap_options, "sigma_rel": roadmap_options["sigma_rel"] * factor}
+            options = roadmap_options["options"]
+            wider = {
+                **roadmap_options,
+                "options": options.replace(sigma_rel=options.sigma_rel * factor),
+            }
             try:
                 result = gaussian_prm(tra_imi, hover, seed=seed, **wider)
                 logger.info("G-PRM found a free route with its sampling %g times wider", factor)
@@ -542,16 +543,6 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
     return result, candidates, refinement
 
 
-def _roadmap_defaults() -> dict:
-    """The G-PRM options of :func:`extend_demonstration` with their defaults (its signature is
-    where they are written)."""
-    import inspect
-
-    skip = {"y", "new_target", "seed", "eps_frac", "method", "approach", "scene"}
-    parameters = inspect.signature(extend_demonstration).parameters
-    return {name: p.default for name, p in parameters.items() if name not in skip}
-
-
 @numerically_guarded
 def extend_pose_demonstration(
     poses,
@@ -561,7 +552,7 @@ def extend_pose_demonstration(
     scene=None,
     eps_frac: float = 0.1,
     method: str = "persistence",
-    **roadmap_options,
+    roadmap: RoadmapOptions | None = None,
 ):
     """Grow an extended pose demonstration (``approach="keep"``) from ``poses`` (T, 7) to the
     pose ``new_target`` (7,) (x, y, z, qx, qy, qz, qw).
@@ -586,15 +577,9 @@ def extend_pose_demonstration(
     target = as_point(new_target, 7, "new_target")
     target_q = as_quaternions(target[3:], "new_target's quaternion")[0]
     turn = Rotation.from_quat(target_q) * Rotation.from_quat(quaternions[-1]).inv()
-    check_extension_options(
-        eps_frac=eps_frac, method=method, seed=seed, approach="keep", **roadmap_options
-    )
-    exclude = ()
-    if scene is not None:
-        _scene_checker(scene, positions, target[:3], None)  # validates the scene
-        exclude = scene.parts_at(target[:3])
-        roadmap_options.setdefault("is_free", scene.checker(exclude=exclude))
-    options = {**_roadmap_defaults(), **roadmap_options}
+    check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep")
+    exclude, is_free, _ = _scene_checker(scene, positions, target[:3], None)
+    options = {"options": _options(roadmap, "roadmap"), "is_free": is_free}
     points = segment(positions, eps_frac=eps_frac, method=method).points
     extension = _extend_keeping_approach(
         positions,

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -41,7 +41,14 @@ from .._progress import report
 from .._trajectory import interp_columns, resample_arclength
 from .similarity import frechet_similarity
 
-__all__ = ["NoFreeRouteError", "RoadmapResult", "template", "gaussian_prm", "classic_prm"]
+__all__ = [
+    "NoFreeRouteError",
+    "RoadmapOptions",
+    "RoadmapResult",
+    "template",
+    "gaussian_prm",
+    "classic_prm",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -293,78 +300,127 @@ class _Comparison:
         return frechet_similarity(path, self.target_shape, self.denom), self.reference - path
 
 
-def _setup(
-    tra_imi, new_target, n_samples, n_neighbours, n_compare, n_iter, scaling, compare, select, denom
-):
-    """Validate the arguments both roadmaps share; return (piece, target, comparison)."""
+@dataclass(frozen=True)
+class RoadmapOptions:
+    """The options of G-PRM (:func:`gaussian_prm`) and the classic PRM (:func:`classic_prm`),
+    checked once when made (``ValueError``/``TypeError`` naming the first bad one).
+
+    Sizes are bounded so that one run stays within seconds: ``n_samples · n_iter <=
+    max_roadmap_nodes`` and ``n_compare² · n_iter <= max_frechet_cells``
+    (:func:`bidmp.set_limits`).
+
+    Parameters
+    ----------
+    n_samples : int, default 300
+        Sampling points per iteration.
+    sigma_rel : float, default 0.03
+        G-PRM: standard deviation of the sampling noise per axis, relative to ‖n_tar − seg‖.
+    n_neighbours : int, default 8
+        k of the kNN roadmap (doubled up to 32 while the target is unreachable).
+    n_compare : int, default 100
+        Points of the arc-length resampling used to compare shapes.
+    n_iter : int, default 10
+        Iterations (each draws a new roadmap).
+    rho : float, default 0.9
+        G-PRM's learning factor: ``η_it = ρ^it`` (``schedule="geometric"``) or ``ρ / it``
+        (``"harmonic"``).
+    schedule : {"geometric", "harmonic"}, default "geometric"
+    scaling : {"axis", "similarity", "paper"}, default "axis"
+        Template mapping (see :func:`template`); ``"paper"`` applies the factors to Tra_gen and
+        compares with Tra_imi, as printed in the paper.
+    compare : {"template", "raw"}, default "template"
+        Score against the template (shape only) or against Tra_imi itself.
+    select : {"best", "last"}, default "best"
+        Which iteration to return.
+    denom : {"sqrt2", "2"}, default "sqrt2"
+        The Fréchet similarity's normaliser (:func:`bidmp.frechet_similarity`).
+    padding : float, default 0.3
+        Classic PRM: the sampling box around seg and n_tar, padded by ``padding · ‖n_tar − seg‖``.
+    """
+
+    n_samples: int = 300
+    sigma_rel: float = 0.03
+    n_neighbours: int = 8
+    n_compare: int = 100
+    n_iter: int = 10
+    rho: float = 0.9
+    schedule: str = "geometric"
+    scaling: str = "axis"
+    compare: str = "template"
+    select: str = "best"
+    denom: str = "sqrt2"
+    padding: float = 0.3
+
+    def __post_init__(self) -> None:
+        checked = {
+            "n_samples": check_int(self.n_samples, "n_samples", minimum=2),
+            "n_neighbours": check_int(
+                self.n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS_OPTION
+            ),
+            "n_compare": check_int(self.n_compare, "n_compare", minimum=3),
+            "n_iter": check_int(self.n_iter, "n_iter", minimum=1),
+            "sigma_rel": check_real(self.sigma_rel, "sigma_rel", nonnegative=True, maximum=10.0),
+            "rho": check_real(self.rho, "rho", positive=True, maximum=2.0),
+            "padding": check_real(self.padding, "padding", nonnegative=True, maximum=100.0),
+        }
+        check_limit(
+            checked["n_samples"] * checked["n_iter"],
+            "max_roadmap_nodes",
+            "the roadmap nodes drawn, n_samples * n_iter",
+        )
+        check_limit(
+            checked["n_compare"] ** 2 * checked["n_iter"],
+            "max_frechet_cells",
+            "the similarity work, n_compare^2 * n_iter",
+        )
+        check_choice(self.schedule, "schedule", ("geometric", "harmonic"))
+        check_choice(self.scaling, "scaling", ("axis", "similarity", "paper"))
+        check_choice(self.compare, "compare", ("template", "raw"))
+        check_choice(self.select, "select", ("best", "last"))
+        check_choice(self.denom, "denom", ("sqrt2", "2"))
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+    def replace(self, **changes) -> RoadmapOptions:
+        """These options with ``changes`` (checked again)."""
+        return replace(self, **changes)
+
+
+def _options(options, name: str = "options") -> RoadmapOptions:
+    """``options`` as :class:`RoadmapOptions` (None: the defaults)."""
+    if options is None:
+        return RoadmapOptions()
+    if not isinstance(options, RoadmapOptions):
+        raise TypeError(
+            f"{name} must be a bidmp.extension.RoadmapOptions (or None), got {type(options).__name__}"
+        )
+    return options
+
+
+def _setup(tra_imi, new_target, options: RoadmapOptions, is_free, seed):
+    """Validate what both roadmaps take besides their options; return (piece, target,
+    comparison, random generator)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target", like="tra_imi")
-    _check_options(
-        n_samples=n_samples,
-        n_neighbours=n_neighbours,
-        n_compare=n_compare,
-        n_iter=n_iter,
-        scaling=scaling,
-        compare=compare,
-        select=select,
-        denom=denom,
-    )
+    if is_free is not None:
+        check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
+    rng = check_seed(seed)
     if np.linalg.norm(target - piece[0]) == 0.0:
         raise ValueError(
             "new_target coincides with the start of the piece (seg): nothing to generate"
         )
-    comparison = _Comparison(resample_arclength(piece, n_compare), target, scaling, compare, denom)
-    return piece, target, comparison
-
-
-def _check_options(  # noqa: PLR0913 - the public call spells its options out, as users pass them
-    *,
-    n_samples: int = 300,
-    sigma_rel: float = 0.03,
-    n_neighbours: int = 8,
-    n_compare: int = 100,
-    n_iter: int = 10,
-    rho: float = 0.9,
-    schedule: str = "geometric",
-    scaling: str = "axis",
-    compare: str = "template",
-    select: str = "best",
-    denom: str = "sqrt2",
-    padding: float = 0.3,
-    seed=0,
-    is_free=None,
-) -> None:
-    """Validate roadmap options (those of :func:`gaussian_prm` and :func:`classic_prm`) without
-    running anything; raise naming the first bad one. Sizes are bounded so that one run stays
-    within seconds: ``n_samples · n_iter <= max_roadmap_nodes`` and ``n_compare² · n_iter <=
-    max_frechet_cells`` (:func:`bidmp.set_limits`)."""
-    check_int(n_samples, "n_samples", minimum=2)
-    check_int(n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS_OPTION)
-    check_int(n_compare, "n_compare", minimum=3)
-    check_int(n_iter, "n_iter", minimum=1)
-    check_limit(
-        n_samples * n_iter, "max_roadmap_nodes", "the roadmap nodes drawn, n_samples * n_iter"
+    comparison = _Comparison(
+        resample_arclength(piece, options.n_compare),
+        target,
+        options.scaling,
+        options.compare,
+        options.denom,
     )
-    check_limit(
-        n_compare * n_compare * n_iter,
-        "max_frechet_cells",
-        "the similarity work, n_compare^2 * n_iter",
-    )
-    check_real(sigma_rel, "sigma_rel", nonnegative=True, maximum=10.0)
-    check_real(rho, "rho", positive=True, maximum=2.0)
-    check_real(padding, "padding", nonnegative=True, maximum=100.0)
-    check_choice(schedule, "schedule", ("geometric", "harmonic"))
-    check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
-    check_choice(compare, "compare", ("template", "raw"))
-    check_choice(select, "select", ("best", "last"))
-    check_choice(denom, "denom", ("sqrt2", "2"))
-    check_seed(seed)
-    if is_free is not None:
-        check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
+    return piece, target, comparison, rng
 
 
 def _iterate(
-    comparison: _Comparison, n_iter: int, draw, learn, n_neighbours, is_free, select
+    comparison: _Comparison, options: RoadmapOptions, draw, learn, is_free
 ) -> RoadmapResult:
     """The loop both roadmaps share: draw samples, shortest path, score, learn (G-PRM only).
 
@@ -373,6 +429,7 @@ def _iterate(
     """
     seg, target = comparison.piece[0], comparison.new_target
     n_compare = comparison.piece.shape[0]
+    n_iter, n_neighbours = options.n_iter, options.n_neighbours
     history, paths, all_samples = [], [], []
     for iteration in range(1, n_iter + 1):
         samples, order = draw(iteration)
@@ -387,7 +444,7 @@ def _iterate(
         all_samples.append(samples)
         report("G-PRM iterations", iteration, n_iter)
     history = np.asarray(history)
-    chosen = int(np.argmax(history)) if select == "best" else len(history) - 1
+    chosen = int(np.argmax(history)) if options.select == "best" else len(history) - 1
     return RoadmapResult(
         path=paths[chosen],
         similarity=float(history[chosen]),
@@ -399,21 +456,11 @@ def _iterate(
 
 
 @numerically_guarded
-def gaussian_prm(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def gaussian_prm(
     tra_imi,
     new_target,
+    options: RoadmapOptions | None = None,
     *,
-    n_samples: int = 300,
-    sigma_rel: float = 0.03,
-    n_neighbours: int = 8,
-    n_compare: int = 100,
-    n_iter: int = 10,
-    rho: float = 0.9,
-    schedule: str = "geometric",
-    scaling: str = "axis",
-    compare: str = "template",
-    select: str = "best",
-    denom: str = "sqrt2",
     is_free: CollisionCallback | None = None,
     seed: int | np.random.Generator | None = 0,
 ) -> RoadmapResult:
@@ -424,24 +471,8 @@ def gaussian_prm(  # noqa: PLR0913 - the public call spells its options out, as 
     tra_imi : array (n, D)
         The demonstrated piece to imitate, from seg to tar.
     new_target : array (D,)
-    n_samples : int, default 300
-        Gaussian sampling points per iteration.
-    sigma_rel : float, default 0.03
-        Standard deviation of the sampling noise per axis, relative to ‖n_tar − seg‖.
-    n_neighbours : int, default 8
-        k of the kNN roadmap (doubled up to 32 while the target is unreachable).
-    n_compare : int, default 100
-        Points of the arc-length resampling used to compare shapes.
-    n_iter : int, default 10
-    rho : float, default 0.9
-        Learning factor: ``η_it = ρ^it`` (``schedule="geometric"``) or ``ρ / it`` (``"harmonic"``).
-    scaling : {"axis", "similarity", "paper"}
-        Template mapping (see :func:`template`); ``"paper"`` applies the factors to Tra_gen and
-        compares with Tra_imi, as printed in the paper.
-    compare : {"template", "raw"}
-        Score against the template (shape only) or against Tra_imi itself.
-    select : {"best", "last"}
-        Which iteration to return.
+    options : RoadmapOptions, optional
+        The roadmap's options (default ``RoadmapOptions()``; ``padding`` is the classic PRM's).
     is_free : callable, optional
         Collision callback ``is_free(points (M, D)) -> bool (M,)``; nodes and edges where it is
         False are left out of the roadmap. An ``is_free.segments_free(a, b)`` method, when the
@@ -451,38 +482,25 @@ def gaussian_prm(  # noqa: PLR0913 - the public call spells its options out, as 
         :class:`NoFreeRouteError` (a ``ValueError``) is raised: never a path through an obstacle.
     seed : int or numpy.random.Generator
     """
-    piece, target, comparison = _setup(
-        tra_imi,
-        new_target,
-        n_samples,
-        n_neighbours,
-        n_compare,
-        n_iter,
-        scaling,
-        compare,
-        select,
-        denom,
-    )
-    _check_options(sigma_rel=sigma_rel, rho=rho, schedule=schedule, is_free=is_free)
-    sampler = _ChordSampler(
-        piece[0], target, n_samples, n_compare, sigma_rel, rho, schedule, check_seed(seed)
-    )
-    return _iterate(comparison, n_iter, sampler.draw, sampler.learn, n_neighbours, is_free, select)
+    options = _options(options)
+    piece, target, comparison, rng = _setup(tra_imi, new_target, options, is_free, seed)
+    sampler = _ChordSampler(piece[0], target, options, rng)
+    return _iterate(comparison, options, sampler.draw, sampler.learn, is_free)
 
 
 class _ChordSampler:
-    """G-PRM's sampler: ``n_samples`` points spread along the chord seg → n_tar (Eq. 1–2) with
-    Gaussian noise of ``sigma_rel · ‖n_tar − seg‖`` per axis, shifted by a bias learned over the
-    comparison's ``n_compare`` arc-length stations (Eq. 8–9)."""
+    """G-PRM's sampler: ``options.n_samples`` points spread along the chord seg → n_tar (Eq. 1–2)
+    with Gaussian noise of ``sigma_rel · ‖n_tar − seg‖`` per axis, shifted by a bias learned over
+    the comparison's ``n_compare`` arc-length stations (Eq. 8–9)."""
 
-    def __init__(self, seg, target, n_samples, n_compare, sigma_rel, rho, schedule, rng):
-        self.sigma = sigma_rel * np.linalg.norm(target - seg)
-        self.t = np.linspace(0.0, 1.0, n_samples)
+    def __init__(self, seg, target, options: RoadmapOptions, rng):
+        self.sigma = options.sigma_rel * np.linalg.norm(target - seg)
+        self.t = np.linspace(0.0, 1.0, options.n_samples)
         self.line = seg + self.t[:, None] * (target - seg)
-        self.lam = np.linspace(0.0, 1.0, n_compare)
-        self.bias = np.zeros((n_compare, seg.shape[0]))
-        self.order = np.arange(n_samples)
-        self.rho, self.schedule, self.rng = rho, schedule, rng
+        self.lam = np.linspace(0.0, 1.0, options.n_compare)
+        self.bias = np.zeros((options.n_compare, seg.shape[0]))
+        self.order = np.arange(options.n_samples)
+        self.rho, self.schedule, self.rng = options.rho, options.schedule, rng
 
     def draw(self, iteration):
         bias_at_samples = interp_columns(self.t, self.lam, self.bias)  # Eq. 9
@@ -496,42 +514,24 @@ class _ChordSampler:
 
 
 @numerically_guarded
-def classic_prm(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def classic_prm(
     tra_imi,
     new_target,
+    options: RoadmapOptions | None = None,
     *,
-    n_samples: int = 300,
-    padding: float = 0.3,
-    n_neighbours: int = 8,
-    n_compare: int = 100,
-    n_iter: int = 10,
-    scaling: str = "axis",
-    compare: str = "template",
-    select: str = "best",
-    denom: str = "sqrt2",
     is_free: CollisionCallback | None = None,
     seed: int | np.random.Generator | None = 0,
 ) -> RoadmapResult:
     """Classic PRM baseline (paper Table 5): uniform samples in the bounding box of seg and
-    ``new_target`` padded by ``padding · ‖n_tar − seg‖``, no bias; each iteration only redraws.
-    Scored exactly like :func:`gaussian_prm`."""
-    piece, target, comparison = _setup(
-        tra_imi,
-        new_target,
-        n_samples,
-        n_neighbours,
-        n_compare,
-        n_iter,
-        scaling,
-        compare,
-        select,
-        denom,
-    )
-    _check_options(padding=padding, is_free=is_free)
-    rng = check_seed(seed)
+    ``new_target`` padded by ``options.padding · ‖n_tar − seg‖``, no bias; each iteration only
+    redraws. Scored exactly like :func:`gaussian_prm` (its other options likewise; G-PRM's
+    ``sigma_rel``, ``rho`` and ``schedule`` are not used)."""
+    options = _options(options)
+    piece, target, comparison, rng = _setup(tra_imi, new_target, options, is_free, seed)
     seg = piece[0]
-    margin = padding * np.linalg.norm(target - seg)
+    margin = options.padding * np.linalg.norm(target - seg)
     low, high = np.minimum(seg, target) - margin, np.maximum(seg, target) + margin
+    n_samples = options.n_samples
 
     def draw(iteration):
         samples = rng.uniform(low, high, size=(n_samples, piece.shape[1]))
@@ -541,4 +541,4 @@ def classic_prm(  # noqa: PLR0913 - the public call spells its options out, as u
         )
         return samples, order
 
-    return _iterate(comparison, n_iter, draw, None, n_neighbours, is_free, select)
+    return _iterate(comparison, options, draw, None, is_free)

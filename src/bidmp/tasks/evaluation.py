@@ -117,7 +117,7 @@ def _learned_clear(model, dmp, source, target, scenario, scene):
     checked = scene is not None and scene.margin > 0.0
     for attempt in range(_REPAIRS + 1):
         extension = extend_demonstration(
-            source, target, seed=scenario.seed, scene=planning, **scenario.extension
+            source, target, seed=scenario.seed, scene=planning, **scenario.extension_arguments
         )
         # A skill that may be planned again is learned on a copy: the Bi-DMP cannot forget a block.
         trial = copy.deepcopy(model) if checked and attempt < _REPAIRS else model
@@ -151,7 +151,8 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
 
     model = CartesianBiDMP(cartesian, **scenario.bidmp)
     previous = None
-    options = {k: v for k, v in scenario.extension.items() if k != "approach"}
+    options = scenario.extension_arguments
+    del options["approach"]  # a pose extension keeps the approach
     for stage in scenario.extensions:
         target = _resolve_target(stage["target"], scenario, failed)
         if target is None:

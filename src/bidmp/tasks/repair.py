@@ -187,8 +187,12 @@ class Repairer:
             )
         self.contract = contract
         self.demonstration = as_trajectory(demonstration, "demonstration")
+        from ..extension import check_extension_options
+
+        # the extension's keyword arguments (a repair keeps the approach, whatever the file says)
         self.extension = {
-            k: v for k, v in check_options(extension, "extension").items() if k != "approach"
+            **check_extension_options(**check_options(extension, "extension")),
+            "approach": "keep",
         }
         check_seed(seed, "seed")
         self.seed, self.order, self.bidmp = seed, tuple(order), check_options(bidmp, "bidmp")

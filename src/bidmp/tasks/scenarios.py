@@ -214,6 +214,15 @@ class Scenario:
     def target_array(self) -> np.ndarray:
         return np.stack(list(self.targets.values()))
 
+    @property
+    def extension_arguments(self) -> dict:
+        """The keyword arguments of :func:`bidmp.extend_demonstration` that ``extension`` (the
+        file's flat options) stands for: ``eps_frac``, ``method``, ``approach`` and ``roadmap``
+        (a :class:`bidmp.extension.RoadmapOptions`)."""
+        from ..extension import check_extension_options
+
+        return check_extension_options(**self.extension)
+
     def to_dict(self) -> dict:
         """The scenario as JSON-ready data (round-trips through :func:`from_dict`)."""
         return copy.deepcopy(self.spec)
