@@ -69,6 +69,19 @@ def allow_outside_files(parser, shown: bool = True) -> None:
     )
 
 
+def backend_option(parser) -> None:
+    """The --backend option of every command that runs the simulator (its names are checked
+    when it is used: the registry is not imported to print the help)."""
+    parser.add_argument(
+        "--backend",
+        default="pybullet",
+        metavar="NAME",
+        help="the simulator: pybullet (default; the sim extra), kinematic (an ideal arm in "
+        "memory: no physics, no extra), or a backend registered with "
+        "bidmp.sim.register_backend",
+    )
+
+
 def one_line(text: str) -> str:
     """One printable line: whitespace runs collapsed, control characters (a file name or argument
     may carry terminal escapes) shown as '?', at most MAX_MESSAGE characters."""

@@ -5,11 +5,17 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import EXIT_OK, EXIT_TARGETS_FAILED, allow_outside_files
+from .common import EXIT_OK, EXIT_TARGETS_FAILED, allow_outside_files, backend_option
 
 
 def run_job_command(
-    scenario, out: Path, *, targets=None, pictures: bool = True, view: bool = False
+    scenario,
+    out: Path,
+    *,
+    targets=None,
+    pictures: bool = True,
+    view: bool = False,
+    backend: str | None = None,
 ) -> int:
     """Run the job with a progress bar, print its report, write its files (and the viewer)."""
     from tqdm import tqdm
@@ -27,7 +33,12 @@ def run_job_command(
 
         with progress_bars():  # the learning and repairs of each cycle (G-PRM, repairs)
             report = run_job(
-                scenario, targets=labels, progress=progress, pictures=pictures, view=view
+                scenario,
+                targets=labels,
+                progress=progress,
+                pictures=pictures,
+                view=view,
+                backend=backend,
             )
     print()
     print(report.summary())
@@ -50,13 +61,19 @@ def _cmd_job(args: argparse.Namespace) -> int:
     from ..sim import require_simulator
     from ..tasks.scenarios import load
 
-    require_simulator()  # without the extra: the install command, before any work
+    if args.backend == "pybullet":
+        require_simulator()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     targets = (
         None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
     )
     return run_job_command(
-        scenario, Path(args.out), targets=targets, pictures=not args.no_pictures, view=args.view
+        scenario,
+        Path(args.out),
+        targets=targets,
+        pictures=not args.no_pictures,
+        view=args.view,
+        backend=args.backend,
     )
 
 
@@ -91,5 +108,6 @@ def add_commands(commands) -> None:
         help="also write view.html: the 3-D viewer, the first cycle on a time slider",
     )
     job.add_argument("--out", default="bidmp-job", help="output folder (default ./bidmp-job)")
+    backend_option(job)
     allow_outside_files(job)
     job.set_defaults(handler=_cmd_job)

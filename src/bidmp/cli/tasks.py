@@ -11,6 +11,7 @@ from .common import (
     EXIT_TARGETS_FAILED,
     Parser,
     allow_outside_files,
+    backend_option,
     judged_methods,
     progress_bars,
 )
@@ -61,6 +62,7 @@ def _run_sim(  # noqa: PLR0913 - the public call spells its options out, as user
     avoid=False,
     goal_update=None,
     view=False,
+    backend=None,
 ):
     """Execute a scenario on the simulated arm with a progress bar; print and write the results
     (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it)."""
@@ -100,6 +102,7 @@ def _run_sim(  # noqa: PLR0913 - the public call spells its options out, as user
                 avoid=avoid,
                 goal_update=goal_update,
                 views={(method, far) for method in methods} if view else (),
+                backend=backend,
             )
     print()
     print(result.summary())
@@ -139,7 +142,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
-    if args.sim or args.job:
+    if (args.sim or args.job) and args.backend == "pybullet":
         from ..sim import require_simulator
 
         require_simulator()
@@ -160,12 +163,15 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             sim_methods,
             report=report if set(sim_methods) <= set(report.methods) else None,
             view=args.view,
+            backend=args.backend,
         )
         failed += result.failed(judged_methods(sim_methods))
     if args.job:
         from .job import run_job_command
 
-        failed += run_job_command(scenario, out / "job", view=args.view) != EXIT_OK
+        failed += (
+            run_job_command(scenario, out / "job", view=args.view, backend=args.backend) != EXIT_OK
+        )
     return EXIT_TARGETS_FAILED if failed else EXIT_OK
 
 
@@ -176,7 +182,8 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     from ..sim.backend import GoalUpdate, Hold
     from ..tasks.scenarios import load
 
-    require_simulator()  # without the extra: the install command, before any work
+    if args.backend == "pybullet":
+        require_simulator()  # without the extra: the install command, before any work
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:
@@ -184,8 +191,10 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     hold = None
     if args.hold is not None:
         joint, start, duration = args.hold
-        if joint != int(joint) or not 1 <= joint <= 7:
-            raise ValueError(f"--hold: the joint must be 1-7, got {joint:g}")
+        if joint != int(joint) or not 1 <= joint <= 64:
+            raise ValueError(
+                f"--hold: the joint must be a joint's number, 1 to the arm's last, got {joint:g}"
+            )
         if not (start >= 0 and duration > 0):
             raise ValueError("--hold: START must be >= 0 s and DURATION > 0 s")
         hold = Hold(int(joint) - 1, start, duration)
@@ -211,6 +220,7 @@ def _cmd_sim(args: argparse.Namespace) -> int:
         avoid=args.avoid,
         goal_update=update,
         view=args.view,
+        backend=args.backend,
     )
     return EXIT_TARGETS_FAILED if result.failed(judged_methods(methods)) else EXIT_OK
 
@@ -281,6 +291,7 @@ def _demo_parser(commands) -> None:
         metavar="SHAPE",
         help="instead: the LASA fit-and-generalise example on SHAPE (e.g. Sshape)",
     )
+    backend_option(demo)
     allow_outside_files(demo)
     demo.set_defaults(handler=_cmd_demo)
 
@@ -321,7 +332,7 @@ def _sim_parser(commands) -> None:
         type=float,
         nargs=3,
         metavar=("JOINT", "START", "DURATION"),
-        help="a scripted disturbance: hold joint JOINT (1-7) still from START for DURATION seconds",
+        help="a scripted disturbance: hold joint JOINT (1 = the base's) still from START for DURATION seconds",
     )
     sim.add_argument(
         "--avoid",
@@ -352,6 +363,7 @@ def _sim_parser(commands) -> None:
         "slider (needs bidmp[view])",
     )
     sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
+    backend_option(sim)
     allow_outside_files(sim)
     sim.set_defaults(handler=_cmd_sim)
 

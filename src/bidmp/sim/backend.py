@@ -1,10 +1,13 @@
 """The simulator backend protocol: what the simulated task runs need of a simulator and its robot,
 and the backend-independent types they exchange (plans, executions, disturbances).
 
-A backend is a class with a ``load_robot(scene, units, base, yaw)`` constructor and the methods
-of :class:`SimulatorBackend`; ``bidmp.sim.simulate(..., backend=...)`` runs the task on it. The
-PyBullet arm (:class:`bidmp.sim.pybullet.RobotCell`: the Panda, the iiwa or a URDF) is the first; another simulator or
-robot is one more subpackage beside it.
+A backend is a class with a ``load_robot(scene, units, base, yaw)`` constructor and the members
+of :class:`SimulatorBackend`; ``simulate(..., backend=...)`` and ``run_job(..., backend=...)`` run
+on it, by class or by registered name (``bidmp sim --backend NAME``). The PyBullet arm
+(:class:`bidmp.sim.pybullet.RobotCell`: the Panda, the iiwa, the xArm6, a UR5-class arm or a URDF)
+is the default; :class:`bidmp.sim.kinematic.KinematicCell` is an ideal arm in memory (no physics,
+no extra), what the tests run the whole seam on; another simulator or robot is one more module
+registered with :func:`register_backend`.
 
 Lengths inside a backend are metres, angles radians, times seconds; the scene is given in its own
 unit (``units``).
@@ -17,11 +20,15 @@ from typing import Protocol
 
 import numpy as np
 
-from .._checks import as_point, as_vector, check_int, check_real
+from .._checks import as_point, as_vector, check_int, check_real, short_token
 
 __all__ = [
     "require_simulator",
     "SimulatorBackend",
+    "MovablePart",
+    "backend_names",
+    "get_backend",
+    "register_backend",
     "SimError",
     "JointLimits",
     "Hold",
@@ -170,33 +177,102 @@ class Execution:
         return float(np.sum(slow & running) * CONTROL_STEP)
 
 
+class MovablePart(Protocol):
+    """A part the job moves, as the backend's world holds it (``movable_part``): seated →
+    threading (a nut) → held by the tool → released (it falls) → at rest. Poses in scene units.
+
+    Attributes
+    ----------
+    label : str
+    solid : bidmp.scene.Solid
+        Its solid where it was seated.
+    centre0 : array (3,)
+        Its centre where it was seated.
+    axis : array (3,)
+        Its own z axis (the stud's, the lift's direction).
+    height : float
+        Its height along the axis.
+    state : str
+        "seated", "threading", "held", "released" or "at rest".
+    rise : float
+        How far it has risen on its thread.
+    trace : list of (rise, angle, time)
+        Its threading, as it went.
+    """
+
+    label: str
+    solid: object
+    centre0: np.ndarray
+    axis: np.ndarray
+    height: float
+    state: str
+    rise: float
+    trace: list
+
+    def pose(self) -> tuple[np.ndarray, object]:
+        """Its centre (3,) and rotation (a scipy ``Rotation``) now."""
+
+    def thread(self, rise: float, pitch: float, t: float) -> None:
+        """Risen ``rise`` on its thread, turned ``rise / pitch`` turns (at ``t`` seconds)."""
+
+    def hold(self) -> None:
+        """Held by the tool from now on, where it is."""
+
+    def contacts(self, found: dict, ignore=()) -> None:
+        """Add its contacts with the scene's parts (not those in ``ignore``) to ``found``
+        (label -> depth, scene units)."""
+
+    def release(self) -> None:
+        """Let go: it falls."""
+
+    def rest(self) -> None:
+        """It has come to rest where it lies."""
+
+
 class SimulatorBackend(Protocol):
-    """A simulated robot in a scene's world (the methods ``bidmp.sim`` calls)."""
+    """A simulated robot in a scene's world: what ``bidmp.sim`` (:func:`~bidmp.sim.simulate`, the
+    job) asks of it. Lengths in metres, angles in radians, times in seconds unless said otherwise;
+    any number of joints (``limits.n_joints``)."""
 
     unit: float  # metres per scene unit
     scene: object  # the bidmp.scene.Scene it was built from (the closed loop steers round it)
+    limits: JointLimits  # the arm's, one value per joint
+    base: np.ndarray  # the arm's base (scene units)
+    name: str  # the arm's name, in reports
+    simulator: str  # how reports name the simulator ("PyBullet, 1 kHz position control")
+    rest: tuple  # the joints (rad) it starts from and IK is seeded with
 
     @classmethod
-    def load_robot(cls, scene, units: str, base, yaw: float) -> SimulatorBackend:
+    def load_robot(cls, scene, units: str, base, yaw: float, **robot) -> SimulatorBackend:
         """Build the world of ``scene`` (parts, tool) with the robot at ``base`` (scene units),
-        turned ``yaw`` degrees about z."""
+        turned ``yaw`` degrees about z (``robot``: the scenario's arm, for backends that take one)."""
 
-    def ik(self, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
+    def solve_ik(self, point_m: np.ndarray, seed, orientation=None) -> tuple[np.ndarray, float]:
         """Joint positions that put the tool-centre point at ``point_m`` (m), from ``seed``; and the
         position error left (m)."""
 
     def fk(self, q) -> np.ndarray:
         """The tool-centre point (m) at joint positions ``q``."""
 
+    def joint_origins(self, q) -> np.ndarray:
+        """The arm's joint origins (m), base to tool, at ``q`` (what the 3-D viewer draws)."""
+
     def plan(
-        self, path, label: str = "", fractions=None, seed=None, orientations=None
+        self, path, label: str = "", fractions=None, seed=None, orientations=None, spacing=...
     ) -> MotionPlan:
-        """A Cartesian path (n, 3, scene units) turned into a timed joint path within the limits."""
+        """A Cartesian path (n, 3, scene units) turned into a timed joint path within the limits
+        (:func:`bidmp.sim.planning.plan_path` does it for any backend with the members above)."""
 
     def execute(
-        self, plan: MotionPlan, exclude=(), hold: Hold | None = None, frames: int = 0
+        self,
+        plan: MotionPlan,
+        exclude=(),
+        hold: Hold | None = None,
+        frames: int = 0,
+        on_record=None,
     ) -> Execution:
-        """Run ``plan`` open loop, the parts in ``exclude`` ignored for contacts."""
+        """Run ``plan`` open loop, the parts in ``exclude`` ignored for contacts; ``on_record(t)``
+        after every recorded step."""
 
     def execute_closed_loop(
         self,
@@ -211,14 +287,119 @@ class SimulatorBackend(Protocol):
         """Run a DMP stepper on the measured tool-centre point (the parts in ``exclude`` moved by
         ``goal_update`` at its time, and the stepper's goal with them)."""
 
+    def tcp_position(self) -> np.ndarray:
+        """The measured tool-centre point now (m)."""
+
+    def tool_orientation(self) -> np.ndarray:
+        """The measured tool frame now (quaternion x, y, z, w)."""
+
     def contacts(self) -> dict:
         """Part label -> penetration depth (m) of the robot's contacts now."""
+
+    def add_solids(self, solids) -> None:
+        """More static parts in the world (the job's bin, its rack)."""
+
+    def movable_part(self, label: str, mass: float) -> MovablePart:
+        """The scene's part ``label`` (of ``mass`` kg) as one the job moves."""
+
+    def settle(self, seconds: float) -> None:
+        """Let the world run ``seconds`` with the arm holding still."""
 
     def render(self, width: int = 320, height: int = 240, target=None) -> np.ndarray:
         """An RGB image (height, width, 3) of the world."""
 
+    def keyframe(self, t: float, focus, width: int = 320, height: int = 240) -> np.ndarray:
+        """A labelled picture of the world at ``t`` seconds looking at ``focus`` (scene units)."""
+
     def close(self) -> None:
         """Release the simulator."""
+
+
+# The backends by name (``bidmp sim --backend NAME``): the module and class, imported on first use.
+_BACKENDS: dict[str, object] = {
+    "pybullet": ("bidmp.sim.pybullet.cell", "RobotCell"),
+    "kinematic": ("bidmp.sim.kinematic", "KinematicCell"),
+}
+
+
+def backend_names() -> list[str]:
+    """The registered backends' names."""
+    return list(_BACKENDS)
+
+
+def get_backend(name: str):
+    """The backend class registered as ``name`` (``"pybullet"``: the PyBullet arm, the default;
+    ``"kinematic"``: an ideal arm in memory, no physics, no extra)."""
+    if not isinstance(name, str):
+        raise TypeError(f"backend must be a backend's name (a string), got {type(name).__name__}")
+    if name not in _BACKENDS:
+        raise ValueError(
+            f"name: unknown simulator backend {name[:40]!r} (known: {', '.join(_BACKENDS)})"
+        )
+    entry = _BACKENDS[name]
+    if isinstance(entry, tuple):
+        import importlib
+
+        module, attribute = entry
+        if name == "pybullet":
+            require_simulator()
+        entry = getattr(importlib.import_module(module), attribute)
+    return entry
+
+
+def register_backend(name: str, backend) -> None:
+    """Register ``backend`` (a class with :class:`SimulatorBackend`'s members) as ``name``, for
+    ``simulate(backend=name)``, ``run_job(backend=name)`` and ``--backend``."""
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"name must be an identifier, got {str(name)[:40]!r}")
+    missing = [
+        member
+        for member in ("load_robot", "plan", "execute", "tcp_position", "close")
+        if not callable(getattr(backend, member, None))
+    ]
+    if missing:
+        raise TypeError(
+            f"backend must provide SimulatorBackend's members; {getattr(backend, '__name__', type(backend).__name__)} "
+            f"lacks {', '.join(missing)}"
+        )
+    _BACKENDS[name] = backend
+
+
+def _part_args(scene, label, mass) -> tuple[object, float]:
+    """A movable part's solid (the first of the scene's with ``label``) and mass (kg, > 0), checked."""
+    if not isinstance(label, str):
+        raise TypeError(f"label must be a part's label (a string), got {type(label).__name__}")
+    mass = check_real(mass, "mass", positive=True, maximum=1e4)
+    for solid in scene.solids:
+        if solid.label == label:
+            return solid, mass
+    raise ValueError(f"label {short_token(label, 30)}: no part of the scene to take away has it")
+
+
+def _check_solids(solids) -> list:
+    """Solids to add to a world: a list of the scene's solids (bidmp.scene.Solid)."""
+    from ..scene import Solid
+
+    if not isinstance(solids, (list, tuple)) or not all(isinstance(s, Solid) for s in solids):
+        raise TypeError("solids must be a list of bidmp.scene.Solid (a scene's solids)")
+    return list(solids)
+
+
+def _picture_args(width, height) -> tuple[int, int]:
+    return (
+        check_int(width, "width", minimum=8, maximum=4096),
+        check_int(height, "height", minimum=8, maximum=4096),
+    )
+
+
+def _solid_height(solid) -> float:
+    """A solid's height along its own z axis (scene units): what a part the job lifts rises by
+    before it is clear of where it stood."""
+    if solid.kind == "box":
+        return float(solid.params[2])
+    if solid.kind == "cylinder":
+        return float(solid.params[1])
+    return float(np.ptp(np.asarray(solid.params[0])[:, 2]))
 
 
 def require_simulator() -> None:

@@ -26,9 +26,9 @@ import numpy as np
 
 from .._units import mm
 from ..tasks.contract import Contract
+from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
 from .job_world import _body, _move, _StepFailed, _transfer, _transfer_contract, _World
-from .pybullet.parts import _add_job_solids, _MovablePart, _rest, _settle
 
 __all__ = ["run_job", "job_targets"]
 
@@ -64,7 +64,7 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     return phase
 
 
-def _engaged(world: _World, part: _MovablePart, target) -> tuple[bool, str]:
+def _engaged(world: _World, part: MovablePart, target) -> tuple[bool, str]:
     """Whether the tool's mouth is on the part's own axis (where the part is, not where the
     target says) within the tolerance, at the target's height along the axis."""
     tcp = world.tcp
@@ -80,7 +80,7 @@ def _engaged(world: _World, part: _MovablePart, target) -> tuple[bool, str]:
     return True, f"{across:.3f} {unit} off the axis"
 
 
-def _supports(world: _World, part: _MovablePart) -> list:
+def _supports(world: _World, part: MovablePart) -> list:
     """The parts ``part`` stands on: those whose top is where its bottom is, under its centre."""
     bottom = part.centre0 - part.axis * part.height / 2.0
     found = []
@@ -113,7 +113,7 @@ def _straight(
     )
 
 
-def _unscrew(world: _World, part: _MovablePart, exclude) -> JobPhase:
+def _unscrew(world: _World, part: MovablePart, exclude) -> JobPhase:
     """Turn the nut off its stud: the spindle turns the socket one turn per pitch the arm rises."""
     spec = world.spec
     stud = [s for s in world.scenario.scene.solids if s.label == f"{part.label}/stud"]
@@ -164,7 +164,7 @@ def _drop_point(world: _World) -> np.ndarray:
     return floor + np.array([offset[0], offset[1], inner[2] + world.spec.clearance])
 
 
-def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
+def _drop(world: _World, part: MovablePart, exclude) -> JobPhase:
     """Carry the nut over the bin (the plain DMP from here to there), let go, let it fall."""
     point = _drop_point(world)
     path, fractions, turns, note = _transfer(world, point, exclude, carried=_body(world, part))
@@ -183,10 +183,10 @@ def _drop(world: _World, part: _MovablePart, exclude) -> JobPhase:
 
 def _reach(
     world: _World, label: str, target, axis, record: JobTarget, step: str
-) -> tuple[_MovablePart, list]:
+) -> tuple[MovablePart, list]:
     """The approach to ``target`` and the check that the tool took the part in (``step``:
     engage, grasp); the part and the parts its moves may touch."""
-    part = _MovablePart(world.cell, label, world.spec.part_mass)
+    part = world.cell.movable_part(label, world.spec.part_mass)
     exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone
     approach = _approach(world, label, target, axis)
     _add(world, record, approach, target[:3])
@@ -199,7 +199,7 @@ def _reach(
     return part, exclude
 
 
-def _finish(record: JobTarget, part: _MovablePart) -> None:
+def _finish(record: JobTarget, part: MovablePart) -> None:
     """The part is removed when every step kept the contract and it ended where it belongs."""
     record.removed = all(phase.ok for phase in record.phases)
     record.final_position = part.pose()[0]
@@ -221,7 +221,7 @@ def _nut_cycle(world: _World, label: str, target, axis, record: JobTarget) -> No
     _finish(record, part)
 
 
-def _place(world: _World, part: _MovablePart, slot, exclude) -> JobPhase:
+def _place(world: _World, part: MovablePart, slot, exclude) -> JobPhase:
     """Carry the part to its rack slot (the plain DMP's start and goal generalisation, its kept
     approach coming straight down), set it down, let go."""
     bottom = part.pose()[0] - part.axis * part.height / 2.0
@@ -322,9 +322,9 @@ def _release(world: _World) -> np.ndarray:
     """Let go of the part in the tool, let it fall and come to rest; where it lies (scene units)."""
     part, world.held = world.held, None
     part.release()
-    _settle(world.cell, RELEASE_S)
+    world.cell.settle(RELEASE_S)
     centre, _ = part.pose()
-    _rest(part)
+    part.rest()
     return centre
 
 
@@ -421,7 +421,7 @@ def job_targets(scenario, targets=None) -> list:
     )
 
 
-def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -> _World:
+def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _World:
     """The job's state: the learned skills, the contract on the job's scene and the arm's limits,
     the repairs of the approaches (planned with room for the arm's tracking)."""
     from ..tasks.repair import Repairer
@@ -457,7 +457,7 @@ def _job_world(scenario, report, cell, scene, arm, pictures: bool, view: bool) -
         scenario,
         scenario.job,
         report.fitted["bidmp"],
-        np.array(arm.rest, dtype=float),
+        np.array(cell.rest, dtype=float),
         contract,
         repairer,
         transfers,
@@ -475,12 +475,15 @@ def run_job(
     pictures: bool = False,
     view: bool = False,
     record: bool = False,
+    backend=None,
 ) -> JobReport:
     """Run the scenario's ``"job"`` on the simulated arm at every target (or ``targets``);
     ``pictures``: keyframes of the first cycle's phases and of every phase that broke the
     contract (``JobReport.pictures``, ``JobReport.failures``); ``view``: the arm's motion over the
     first cycle (``JobReport.motions``, for the 3-D viewer); ``record``: keep each motion's measured
-    tool path and 1 kHz joint commands on its phase (``JobPhase.path``, ``JobPhase.commands``).
+    tool path and 1 kHz joint commands on its phase (``JobPhase.path``, ``JobPhase.commands``);
+    ``backend``: the simulator (a class or a registered name, :func:`bidmp.sim.get_backend`;
+    default the PyBullet arm).
 
     Returns a :class:`~bidmp.sim.job_report.JobReport`: per target and phase, the contract's
     verdict, contacts with other parts and their depth, peak joint velocity, acceleration and jerk
@@ -489,28 +492,27 @@ def run_job(
     """
     from .._checks import check_bool
     from ..tasks.evaluation import evaluate
-    from .pybullet.cell import RobotCell
-    from .robots import robot_model, robot_placement
-    from .run import _scenario_and_backend
+    from .robots import robot_placement
+    from .run import _open_world, _scenario_and_backend
 
     pictures, view, record = (
         check_bool(pictures, "pictures"),
         check_bool(view, "view"),
         check_bool(record, "record"),
     )
-    scenario, _ = _scenario_and_backend(scenario, None)
+    scenario, backend = _scenario_and_backend(scenario, backend)
     labels = job_targets(scenario, targets)
     if report is None:
         report = evaluate(scenario.with_robot_protocol(), ["bidmp"], geometry=False)
     base, yaw = robot_placement(scenario)
-    arm = robot_model(scenario.robot, scenario.base_dir)
     start = time.perf_counter()
     parts = _job_parts(scenario, labels)
     scene = _job_scene(scenario, parts)
-    with RobotCell(scenario.scene, scenario.units, base, yaw, arm) as cell:
+    cell = _open_world(backend, scenario, base, yaw)
+    try:
         added = {part["label"] for part in parts}
-        _add_job_solids(cell, [solid for solid in scene.solids if solid.part in added])
-        world = _job_world(scenario, report, cell, scene, arm, pictures, view)
+        cell.add_solids([solid for solid in scene.solids if solid.part in added])
+        world = _job_world(scenario, report, cell, scene, pictures, view)
         world.record = record
         done, motions = [], {}
         for label in _order(scenario, labels):
@@ -532,10 +534,12 @@ def run_job(
                     }
                 }
                 world.motion = None
+    finally:
+        cell.close()
     out = JobReport(
         scenario,
         scenario.job.kind,
-        arm.name,
+        cell.name,
         done,
         wall_s=time.perf_counter() - start,
         pictures=world.pictures or [],

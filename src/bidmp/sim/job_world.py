@@ -13,7 +13,6 @@ from scipy.spatial.transform import Rotation
 
 from ..tasks.contract import Contract
 from .job_report import JobPhase, _phase
-from .pybullet.parts import _MovablePart
 
 __all__ = []
 
@@ -59,12 +58,7 @@ class _World:
 
     def orientation(self) -> Rotation:
         """The tool frame now (measured)."""
-        p, cell = self.cell.p, self.cell
-        return Rotation.from_quat(
-            p.getLinkState(
-                cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client
-            )[5]
-        )
+        return Rotation.from_quat(self.cell.tool_orientation())
 
 
 class _StepFailed(Exception):
@@ -152,17 +146,17 @@ def _transfer_contract(contract: Contract) -> Contract:
 
 
 def _clearance(world: _World, path, exclude, carried, orientations=None, support=()):
-    """The tool's clearance along ``path``, and of a ``carried`` part (a :class:`_MovablePart`, or
-    ``(solid, offset from the mouth)``) but from the parts it is lifted off (``support``): the nearer
+    """The tool's clearance along ``path``, and of a ``carried`` part (the backend's movable part,
+    or ``(solid, offset from the mouth)``) but from the parts it is lifted off (``support``): the nearer
     of the two to its margin."""
     from ..tasks.repair import carried_clearance
 
-    if isinstance(carried, _MovablePart):  # where it is now, with the tool where it is now
+    if carried is not None and not isinstance(carried, tuple):  # where it is now, the tool too
         carried = _body(world, carried)
     return carried_clearance(world.scene, path, exclude, carried, support, orientations)
 
 
-def _body(world: _World, part: _MovablePart) -> tuple:
+def _body(world: _World, part) -> tuple:
     """A carried part as the clearance checks see it: its solid where it is now and its centre's
     offset from the tool's mouth now."""
     centre, rotation = part.pose()

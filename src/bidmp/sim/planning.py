@@ -1,23 +1,24 @@
-"""Planning: a Cartesian path subdivided into IK samples, solved joint by joint, splined (quintic,
-at rest at both ends) and timed to the arm's velocity, acceleration and jerk limits
-(:data:`bidmp.sim.backend.LIMIT_MARGIN` of them)."""
+"""Planning, for any backend: a Cartesian path subdivided into IK samples, solved joint by joint
+through the backend's ``solve_ik``, splined (quintic, at rest at both ends) and timed to the
+arm's velocity, acceleration and jerk limits (:data:`bidmp.sim.backend.LIMIT_MARGIN` of them).
+Any number of joints: the backend's ``n_joints``, ``rest`` and ``limits`` say how many."""
 
 from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
 
-from ..._checks import as_trajectory, as_vector, check_real
-from ..._trajectory import interp_columns
-from ...primitives.so3 import as_quaternions
-from ...primitives.timing import Trajectory, time_scale
-from ..backend import LIMIT_MARGIN, MotionPlan, SimError
-from ..robots import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
+from .._checks import as_trajectory, as_vector, check_real
+from .._trajectory import interp_columns
+from ..primitives.so3 import as_quaternions
+from ..primitives.timing import Trajectory, time_scale
+from .backend import LIMIT_MARGIN, MotionPlan, SimError
+from .robots import IK_TOLERANCE, MAX_SAMPLE_SPACING, _joint_seed, _reachable, _unit_name
 
-__all__ = []
+__all__ = ["plan_path"]
 
 
-def _plan(
+def plan_path(
     cell,
     path,
     label: str = "",
@@ -27,9 +28,20 @@ def _plan(
     spacing: float = MAX_SAMPLE_SPACING,
 ) -> MotionPlan:
     """Inverse kinematics along ``path`` (n, 3, scene units) and the fastest uniform timing
-    within :data:`LIMIT_MARGIN` of the joint limits. ``fractions``: normalised time of each
+    within :data:`LIMIT_MARGIN` of the joint limits, for the backend ``cell`` (its ``unit``,
+    ``base``, ``rest``, ``name``, ``limits`` and ``solve_ik``). ``fractions``: normalised time of each
     sample (default: uniform, as a DMP rollout is). ``orientations`` (n, 4): the tool frame
     along the path (a pose skill's); default pointing down."""
+    missing = [
+        member
+        for member in ("solve_ik", "limits", "unit", "base", "rest", "name")
+        if not hasattr(cell, member)
+    ]
+    if missing:
+        raise TypeError(
+            f"cell must be a simulator backend (bidmp.sim.SimulatorBackend); "
+            f"{type(cell).__name__} lacks {', '.join(missing)}"
+        )
     path = as_trajectory(path, "path", min_points=2, allow_static=True)
     if path.shape[1] != 3:
         raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
@@ -61,14 +73,15 @@ def _plan(
         keep = np.concatenate([[True], np.diff(given) > 1e-12])
         turns = Slerp(given[keep], Rotation.from_quat(q[keep]))(u).as_quat()
     limits = cell.limits
-    q = np.array(cell.model.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
-    joints = np.empty((points.shape[0], len(cell.arm)))
+    n_joints = limits.n_joints
+    q = np.array(cell.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
+    joints = np.empty((points.shape[0], n_joints))
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
             raise SimError(
                 f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
-                f"unreachable for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} "
+                f"unreachable for the {cell.name} at base {np.round(cell.base, 1).tolist()} "
                 f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
                 f'robot (scenario key "robot": {{"base": ...}})'
             )
@@ -83,7 +96,7 @@ def _plan(
     # A quintic spline at rest at both ends, acceleration included: the arm's interface asks for
     # zero velocity and acceleration where a motion starts and stops (a clamped cubic ends with
     # an acceleration, up to 0.45 of the limit), and its jerk is then bounded too.
-    rest = [(1, np.zeros(len(cell.arm))), (2, np.zeros(len(cell.arm)))]
+    rest = [(1, np.zeros(n_joints)), (2, np.zeros(n_joints))]
     spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
     grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
     unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))

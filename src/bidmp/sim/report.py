@@ -204,6 +204,7 @@ class SimReport:
     motions: dict = field(
         default_factory=dict
     )  # (method, label) -> {"times", "links"}: the viewer's arm
+    simulator: str = "PyBullet, 1 kHz position control"  # the backend's own words, for the summary
 
     @property
     def _short_name(self) -> str:
@@ -282,7 +283,7 @@ class SimReport:
             else ""
         )
         lines = [
-            f"{scenario.name} on a simulated {self.robot_name} (PyBullet, 1 kHz position control), robot base "
+            f"{scenario.name} on a simulated {self.robot_name} ({self.simulator}), robot base "
             f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
             f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
             f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "

@@ -217,8 +217,6 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     "acceleration", "jerk"}, one value per joint, rad) and optionally ``"rest"`` (one per joint, rad)
     and ``"effort"`` (one per joint, N m). The key is checked as a scenario file's is; the URDF must
     be a regular ``.urdf`` file within the file size limit."""
-    import pybullet_data
-
     from ..tasks._scenario_fields import _robot
 
     if spec is not None and not isinstance(spec, dict):
@@ -233,7 +231,12 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     path = Path(spec["urdf"])
     if not path.is_absolute():
         local = Path(folder) / path
-        path = local if local.exists() else Path(pybullet_data.getDataPath()) / path
+        if local.exists():
+            path = local
+        else:  # a model PyBullet ships (the sim extra)
+            import pybullet_data
+
+            path = Path(pybullet_data.getDataPath()) / path
     if not path.is_file():
         raise ValueError(
             f"robot.urdf {shown_path(spec['urdf'])}: no such regular file (a path in the scenario's "

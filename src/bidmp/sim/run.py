@@ -17,7 +17,6 @@ from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
-from .pybullet.world import _pybullet_module
 from .report import SimMethod, SimReport, SimTarget, _measure
 from .robots import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
 
@@ -223,9 +222,10 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
     workers : int, optional
         Worker processes, each with its own PyBullet world (default: one per core, at most 2;
         1 runs in this process). Results do not depend on it.
-    backend : class, optional
-        A simulator backend (:class:`bidmp.sim.backend.SimulatorBackend`); default the PyBullet
-        arm, :class:`bidmp.sim.pybullet.RobotCell`.
+    backend : class or str, optional
+        A simulator backend (:class:`bidmp.sim.backend.SimulatorBackend`) or a registered name
+        (:func:`bidmp.sim.get_backend`: "pybullet", "kinematic"); default the PyBullet arm,
+        :class:`bidmp.sim.pybullet.RobotCell`.
     avoid, goal_update : bool, GoalUpdate, optional
         Closed loop: steer round the other parts (SceneAvoidance); a perception update in every
         motion (the target and the goal move; judged at the moved target).
@@ -280,6 +280,10 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         robot=arm,
         **_loop_options(closed_loop, avoid, goal_update),
     )
+    if hold is not None and hold.joint >= _world(setup).limits.n_joints:
+        raise ValueError(
+            f"hold: joint {hold.joint + 1} of an arm with {_world(setup).limits.n_joints} joints"
+        )
     unreachable = _unreachable(setup, scenario, labels)
     skipped = [job for job in jobs if job.label in unreachable]
     jobs = [job for job in jobs if job.label not in unreachable]
@@ -310,9 +314,11 @@ def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:
 
 
 def _scenario_and_backend(scenario, backend):
-    """The scenario (loaded if named), which must have a scene, and the backend (default the
-    PyBullet Panda, whose extra must then be installed)."""
+    """The scenario (loaded if named), which must have a scene, and the backend class: given, or
+    registered under a name (default "pybullet", whose extra must then be installed: checked
+    here, before any work)."""
     from ..tasks import scenarios as scenario_module
+    from .backend import get_backend
 
     if not isinstance(scenario, scenario_module.Scenario):
         scenario = scenario_module.load(scenario)
@@ -320,10 +326,22 @@ def _scenario_and_backend(scenario, backend):
         raise ValueError(
             f'scenario {scenario.name!r} has no "scene": the simulator needs the parts and the tool'
         )
-    if backend is None:
-        _pybullet_module()  # fail early, with the install command, when the extra is missing
-        backend = RobotCell
+    if backend is None or isinstance(backend, str):
+        backend = get_backend("pybullet" if backend is None else backend)
+    elif not callable(getattr(backend, "load_robot", None)):
+        raise TypeError(
+            "backend must be a simulator backend (a class with load_robot, see "
+            f"bidmp.sim.SimulatorBackend) or a registered name, got {type(backend).__name__}"
+        )
     return scenario, backend
+
+
+def _open_world(backend, scenario, base, yaw):
+    """A new world of ``backend`` for ``scenario``: its scene, the arm the scenario names (a
+    backend that has its own arm is not told of it) at ``base`` turned ``yaw``."""
+    arm = robot_model(scenario.robot, scenario.base_dir)
+    robot = {} if arm is PANDA_MODEL else {"robot": arm}
+    return backend.load_robot(scenario.scene, scenario.units, base, yaw, **robot)
 
 
 def _unreachable(setup: dict, scenario, labels) -> dict:
@@ -332,19 +350,15 @@ def _unreachable(setup: dict, scenario, labels) -> dict:
     from .backend import SimError
     from .robots import IK_TOLERANCE
 
-    if setup["backend"] is not RobotCell:
-        return {}
     cell = _world(setup)
     where = (
-        f"for the {cell.model.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
+        f"for the {cell.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
         f'down); move its base (scenario key "robot": {{"base": ...}})'
     )
 
     def reached(point) -> bool:
         try:
-            _, error = cell.solve_ik(
-                np.asarray(point, dtype=float)[:3] * cell.unit, cell.model.rest
-            )
+            _, error = cell.solve_ik(np.asarray(point, dtype=float)[:3] * cell.unit, cell.rest)
         except SimError:
             return False
         return error <= 10 * IK_TOLERANCE
@@ -458,7 +472,7 @@ def _sim_report(
 ) -> SimReport:
     """The workers' outcomes ``(method, label, measured, images, seconds, motion)`` as a report,
     in the order of the methods and targets (whatever order the workers finished in)."""
-    ours = backend is RobotCell
+    ours = backend is RobotCell  # the scenario's arm; another backend brings its own
     limits = arm.limits if ours else getattr(backend, "limits", None)
     by_key = {
         (method, label): (measured, images, seconds)
@@ -471,7 +485,8 @@ def _sim_report(
         yaw,
         closed_loop,
         limits=limits,
-        robot=arm.name if ours else getattr(backend, "__name__", "robot"),
+        robot=arm.name if ours else getattr(backend, "name", getattr(backend, "__name__", "robot")),
+        simulator=getattr(backend, "simulator", backend.__name__),
     )
     out.motions = {
         (method, label): motion for method, label, _, _, _, motion in outcomes if motion is not None

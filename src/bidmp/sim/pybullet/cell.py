@@ -13,7 +13,6 @@ from ..backend import SIM_STEP, Execution, Hold, MotionPlan
 from ..robots import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from . import execute as _execute
 from . import ik as _ik
-from . import plan as _plan
 from . import render as _render
 from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
 
@@ -134,10 +133,21 @@ class RobotCell:
     limits = (
         PANDA_MODEL.limits
     )  # the robot's joint limits (the backend protocol's; set per instance)
+    simulator = "PyBullet, 1 kHz position control"  # how reports name this backend
 
     @property
     def n_joints(self) -> int:
         return len(self.arm)
+
+    @property
+    def name(self) -> str:
+        """The arm's name (its model's)."""
+        return self.model.name
+
+    @property
+    def rest(self) -> tuple:
+        """The joints (rad) the arm starts from: the tool pointing down."""
+        return self.model.rest
 
     def _last_joint_turns_tool(self) -> bool:
         """Whether the last joint turns about the tool's axis through its mouth (at the rest pose)."""
@@ -203,6 +213,34 @@ class RobotCell:
             )[4]
         )
 
+    def tool_orientation(self) -> np.ndarray:
+        """The simulated robot's measured tool frame (quaternion x, y, z, w)."""
+        return np.array(
+            self.p.getLinkState(
+                self.robot, self.tcp, computeForwardKinematics=1, physicsClientId=self.client
+            )[5]
+        )
+
+    # -- what the job does in the world ------------------------------------------------------
+    def add_solids(self, solids) -> None:
+        """Static bodies for more parts (the job's bin, its rack), their contacts reported by label."""
+        from .parts import _add_job_solids
+
+        _add_job_solids(self, solids)
+
+    def movable_part(self, label: str, mass: float):
+        """The scene's part ``label`` as one the job moves (a nut on its thread, a held part, a
+        released one that falls): :class:`bidmp.sim.pybullet.parts._MovablePart`."""
+        from .parts import _MovablePart
+
+        return _MovablePart(self, label, mass)
+
+    def settle(self, seconds: float) -> None:
+        """Let the world run ``seconds`` with the arm holding where it is (a released part falls)."""
+        from .parts import _settle
+
+        _settle(self, check_real(seconds, "seconds", nonnegative=True, maximum=60.0))
+
     def forward(self, q) -> np.ndarray:
         """TCP position (m) for joint positions ``q`` (forward kinematics on the planning copy)."""
         self._set_joints(self._joints(q), kinematic=True)
@@ -248,8 +286,10 @@ class RobotCell:
     ) -> MotionPlan:
         """Inverse kinematics along ``path`` (n, 3, scene units), IK samples at most ``spacing`` (m)
         apart where it moves fastest, and the fastest uniform timing within the limits
-        (:func:`bidmp.sim.pybullet.plan.plan`)."""
-        return _plan._plan(self, path, label, fractions, seed, orientations, spacing)
+        (:func:`bidmp.sim.planning.plan_path`)."""
+        from ..planning import plan_path
+
+        return plan_path(self, path, label, fractions, seed, orientations, spacing)
 
     def execute(
         self,

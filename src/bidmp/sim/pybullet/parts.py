@@ -16,7 +16,7 @@ import math
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..backend import SIM_STEP
+from ..backend import SIM_STEP, _check_solids, _part_args, _solid_height
 from .world import _add_solid
 
 __all__ = []
@@ -27,16 +27,13 @@ class _MovablePart:
     ``held`` → ``released``. Poses in scene units."""
 
     def __init__(self, cell, label: str, mass: float):
-        self.cell, self.label, self.mass = cell, label, float(mass)
-        solids = [s for s in cell.scene.solids if s.label == label]
-        if not solids:
-            raise ValueError(f"target {label!r} has no part of its own in the scene to take away")
-        self.solid = solids[0]
+        self.solid, mass = _part_args(cell.scene, label, mass)
+        self.cell, self.label, self.mass = cell, label, mass
         self.body = next(body for body, name in cell._bodies.items() if name == label)
         self.centre0 = np.asarray(self.solid.centre, dtype=float)
         self.rotation0 = Rotation.from_matrix(self.solid.rotation)
         self.axis = self.solid.rotation[:, 2]
-        self.height = _height(self.solid)
+        self.height = _solid_height(self.solid)
         self.state, self.rise, self.constraint = "seated", 0.0, None
         self.trace: list[
             tuple[float, float, float]
@@ -121,6 +118,12 @@ class _MovablePart:
         self._make_dynamic()
         self.state = "released"
 
+    def rest(self) -> None:
+        """A released part that has come to rest: a static body where it lies (13 nuts tumbling in
+        a bin on every later step made the 14-nut job run at half the speed)."""
+        self._replace_body(0.0)
+        self.state = "at rest"
+
     def _make_dynamic(self) -> None:
         """The part as a body with its mass in its place (no longer one of the scene's static
         bodies); no contact with the arm: it sits inside the tool's solid (a socket, a gripper),
@@ -145,25 +148,9 @@ class _MovablePart:
         self.set_pose(centre, rotation)
 
 
-def _height(solid) -> float:
-    """A solid's height along its own z axis (scene units)."""
-    if solid.kind == "box":
-        return float(solid.params[2])
-    if solid.kind == "cylinder":
-        return float(solid.params[1])
-    return float(np.ptp(np.asarray(solid.params[0])[:, 2]))
-
-
-def _rest(part: _MovablePart) -> None:
-    """A released part that has come to rest: a static body where it lies (13 nuts tumbling in a
-    bin on every later step made the 14-nut job run at half the speed)."""
-    part._replace_body(0.0)
-    part.state = "at rest"
-
-
 def _add_job_solids(cell, solids) -> None:
     """Static bodies for the job's own parts (bin walls, ...), their contacts reported by label."""
-    for solid in solids:
+    for solid in _check_solids(solids):
         body = _add_solid(cell.p, cell.client, cell.unit, solid)
         cell._bodies[body] = solid.label
         cell._owners[body] = solid.part

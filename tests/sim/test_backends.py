@@ -1,0 +1,156 @@
+"""The simulator seam: backends by name, and the kinematic backend (an ideal arm in memory) running
+the evaluation, the simulated runs and the whole job without PyBullet.
+
+The kinematic arm does exactly what it is told, so what it measures can be predicted from outside
+the simulator: its end point is the evaluated rollout's end, its contacts are the scene's geometry,
+a released nut lands on the bin's floor under where it was let go.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from bidmp import tasks
+from bidmp.sim import (
+    Hold,
+    KinematicCell,
+    backend_names,
+    get_backend,
+    register_backend,
+    run_job,
+    simulate,
+)
+from bidmp.sim import backend as backend_module
+
+
+@pytest.fixture(scope="module")
+def nuts():
+    return tasks.load("nut-unscrewing")
+
+
+def test_backends_are_found_by_name_and_refused_by_name():
+    assert {"pybullet", "kinematic"} <= set(backend_names())
+    assert get_backend("kinematic") is KinematicCell
+    with pytest.raises(ValueError, match="unknown simulator backend 'bullet'.*pybullet, kinematic"):
+        get_backend("bullet")
+    with pytest.raises(TypeError, match="backend must be a backend's name"):
+        get_backend(KinematicCell)
+    with pytest.raises(TypeError, match="lacks load_robot, plan, execute"):
+        register_backend("broken", object)
+
+
+def test_a_registered_backend_runs_by_name(nuts, monkeypatch):
+    """A backend of one's own is one class and one register line (here a kinematic arm standing
+    somewhere else by name): simulate finds it by its name and reports it by its own."""
+    monkeypatch.setattr(backend_module, "_BACKENDS", dict(backend_module._BACKENDS))
+
+    class Gantry(KinematicCell):
+        name = "gantry"
+
+    register_backend("gantry", Gantry)
+    result = simulate(nuts, ["bidmp"], targets=["1"], backend="gantry", workers=1)
+    assert result.robot == "gantry" and result.methods["bidmp"].task_successes == 1
+
+
+def test_the_ideal_arm_ends_where_the_evaluated_rollout_ends(nuts):
+    """What the kinematic arm measures is the command: its end point's error is the evaluated
+    rollout's own (computed here from the rollout, not by the simulator), and the whole measured
+    path stays on the planned joint spline's tool path."""
+    labels = ["1", "7", "12"]
+    report = tasks.evaluate(nuts, ["dmp", "bidmp"], geometry=False)
+    result = simulate(
+        nuts, ["dmp", "bidmp"], targets=labels, backend="kinematic", report=report, record=True
+    )
+    for method in ("dmp", "bidmp"):
+        for label in labels:
+            rollout = np.asarray(report.methods[method].rollouts[label])
+            expected = float(np.linalg.norm(rollout[-1, :3] - nuts.targets[label][:3]))
+            measured = result.methods[method].targets[label]
+            assert measured.measured_error == pytest.approx(expected, abs=1e-6), (method, label)
+            assert measured.tracking_error < 1e-9
+            # the measured path starts at the rollout's start and ends at its end
+            np.testing.assert_allclose(measured.path[0], rollout[0, :3], atol=1e-6)
+            np.testing.assert_allclose(measured.path[-1], rollout[-1, :3], atol=1e-6)
+
+
+def test_contacts_are_the_swept_tools_depth_in_the_scene(nuts):
+    """A descent through a nut reports a contact with it as deep as the scene's own clearance says
+    (from outside the backend); excepted, the same descent touches nothing."""
+    cell = KinematicCell.load_robot(nuts.scene, nuts.units, (50.0, -450.0, 0.0), 90.0)
+    nut = nuts.scene.solids[[s.label for s in nuts.scene.solids].index("5")]
+    top = float(nut.upper[2])
+    path = np.array([[*nut.centre[:2], top + 40.0], [*nut.centre[:2], top - 2.0]])
+    run = cell.execute(cell.plan(path, "5"))
+    clearance = nuts.scene.clearance(run.tcp / cell.unit)
+    assert clearance.part in ("5", "5/stud") and -clearance.distance > 1.0
+    assert run.contacts == {
+        clearance.part: pytest.approx(-clearance.distance * cell.unit, rel=1e-9)
+    }
+    assert cell.execute(cell.plan(path, "5"), exclude=["5"]).contacts == {}
+
+
+def test_inverse_kinematics_is_exact_and_kept_within_the_limits(nuts):
+    cell = KinematicCell(nuts.scene, nuts.units)
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        point = cell.base * cell.unit + rng.uniform(-0.5, 0.5, 3)
+        turn = Rotation.from_rotvec(rng.uniform(-0.5, 0.5, 3))
+        wanted = (Rotation.from_quat([1.0, 0.0, 0.0, 0.0]) * turn).as_quat()
+        q, error = cell.solve_ik(point, cell.rest, wanted)
+        assert error < 1e-12
+        np.testing.assert_allclose(cell.fk(q), point, atol=1e-12)
+        assert (
+            np.degrees((Rotation.from_quat(wanted).inv() * cell._orientation(q)).magnitude()) < 1e-9
+        )
+    far = cell.base * cell.unit + [3.0, 0.0, 0.0]  # past the carriage's 1.5 m
+    assert cell.solve_ik(far, cell.rest)[1] == pytest.approx(3.0 - 1.5)
+
+
+def test_the_whole_job_on_the_ideal_arm_drops_each_nut_on_the_bins_floor(nuts):
+    """Every nut is unscrewed (one turn per pitch risen, the nut's own trace), carried and let go
+    over the bin; it lands on the bin's floor (its centre half a nut above the floor slab's top,
+    within the bin's inner footprint: the geometry of the job's spec, checked here)."""
+    labels = ["1", "9", "14"]
+    report = run_job(nuts, targets=labels, backend="kinematic")
+    assert report.robot == "kinematic arm" and report.removed == len(labels)
+    spec = nuts.job
+    floor, inner = np.asarray(spec.bin_floor), np.asarray(spec.bin[1])
+    for record in report.targets:
+        rise, angle, _ = np.array(record.thread).T
+        np.testing.assert_allclose(angle / (2.0 * np.pi) * spec.pitch, rise, rtol=1e-12)
+        centre = np.asarray(record.final_position)
+        assert np.all(np.abs(centre[:2] - floor[:2]) <= inner[:2] / 2.0), record.label
+        nut = nuts.scene.solids[[s.label for s in nuts.scene.solids].index(record.label)]
+        height = float(nut.upper[2] - nut.lower[2])  # the nut stands upright
+        assert centre[2] == pytest.approx(floor[2] + height / 2.0, abs=0.01)
+
+
+def test_a_scripted_hold_needs_dynamics_and_an_arm_with_that_joint(nuts):
+    with pytest.raises(ValueError, match="needs dynamics"):
+        simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=Hold(0, 0.5), workers=1)
+    with pytest.raises(ValueError, match="joint 7 of an arm with 6 joints"):
+        simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=Hold(6, 0.5), workers=1)
+
+
+def test_the_demo_with_the_simulator_and_the_job_runs_without_pybullet(tmp_path):
+    """``bidmp demo --sim --job --backend kinematic`` in a process where PyBullet cannot be
+    imported: the evaluation, every motion on the arm and the 14-nut job."""
+    code = (
+        "import sys; sys.modules['pybullet'] = None; sys.modules['pybullet_data'] = None\n"
+        "from bidmp.cli import main\n"
+        f"sys.exit(main(['demo', '--sim', '--job', '--backend', 'kinematic', '--out', {str(tmp_path)!r}]))"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=False
+    )
+    assert done.returncode in (0, 1), done.stderr[-2000:]  # 1: the plain DMP misses far nuts
+    sim = json.loads((tmp_path / "sim_results.json").read_text())
+    job = json.loads((tmp_path / "job" / "job_results.json").read_text())
+    assert sim["robot"]["model"] == "kinematic arm"
+    assert sum(target["removed"] for target in job["targets"]) == 14
