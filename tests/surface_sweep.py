@@ -90,6 +90,7 @@ SKIPPED = {
     "run_cell",
     "register",
     "unregister",
+    "register_backend",
     "bidmp.experiments.lasa",  # the whole LASA benchmark (its own tests run a small one)
     "write_report",
     "write_sim_report",
@@ -160,6 +161,9 @@ SKIPPED_METHODS = {
     "RobotCell.execute_closed_loop",
     "RobotCell.load_robot",
     "RobotCell.close",
+    "KinematicCell.execute_closed_loop",
+    "KinematicCell.load_robot",
+    "KinematicCell.close",
     "Repairer.repair",
     "Method.fit",
     "Task.shared_model",

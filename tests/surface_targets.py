@@ -96,8 +96,15 @@ def _package_overrides(tmp: Path) -> dict:
             "every": 10,
         },
         "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
+        "bidmp.primitives.GaussianBasis": {"size": 10},
+        "bidmp.primitives.ExponentialPhase": {"rate": 4.0},
         "bidmp.sim.require_simulator": {},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},
+        "bidmp.sim.KinematicCell": {"scene": scenario.scene},
+        "bidmp.sim.plan_path": {
+            "cell": bidmp.sim.KinematicCell(scenario.scene),
+            "path": scenario.demonstration[::20],
+        },
         "bidmp.io.load_model": {"path": model},
         "bidmp.plotting.plot_segmentation": {"points": segment(DEMO).points},
         "bidmp.plotting.load_layers": {"path": layers},
@@ -272,6 +279,8 @@ def _instances(tmp: Path):
     from bidmp.primitives import (
         ConstantAcceleration,
         DelayedGoal,
+        ExponentialPhase,
+        GaussianBasis,
         PhaseGate,
         PhaseStopping,
         StepIntegrator,
@@ -375,6 +384,25 @@ def _instances(tmp: Path):
     yield "PoseTrajectory", pose.trajectory(), {}
     yield "PhaseGate", PhaseGate(2.0), goal_args
     yield "DelayedGoal", DelayedGoal(2.0), goal_args
+    phase_args = {"n_steps": 60, "step": 0.01, "tau": 1.0, "samples": np.arange(5.0), "span": 1.1}
+    yield (
+        "ExponentialPhase",
+        ExponentialPhase(4.0, exact=False),
+        {**phase_args, "phase": 0.5, "as_phase:phase": [0.5, 0.2]},
+    )
+    yield (
+        "GaussianBasis",
+        GaussianBasis(10),
+        {
+            "canonical": ExponentialPhase(4.0),
+            "n_steps": 60,
+            "step": 0.01,
+            "phase": np.linspace(1.0, 0.05, 20),
+            "row:phase": 0.5,
+            "centres": dmp.centres_,
+            "widths": dmp.widths_,
+        },
+    )
     yield (
         "ProgressGate",
         dmp.goal_system(),
@@ -425,6 +453,29 @@ def _instances(tmp: Path):
         extend_demonstration(DEMO, DEMO[-1] + [150.0, 0.0, 0.0], seed=0),
         {"dmp": dmp},
     )
+    from bidmp.sim import KinematicCell
+
+    ideal = KinematicCell(scenario.scene)
+    rest = np.array(ideal.rest)
+    yield (
+        "KinematicCell",
+        ideal,
+        {
+            "q": rest,
+            "point_m": ideal.fk(rest),
+            "seed": rest,
+            "path": scenario.demonstration[::20],
+            "plan": ideal.plan(scenario.demonstration[::20]),
+            "t": 0.5,
+            "focus": np.zeros(3),
+            "width": 64,
+            "height": 48,
+            "solids": [],
+            "label": "1",
+            "mass": 0.005,
+            "seconds": 0.1,
+        },
+    )
     try:
         from bidmp.sim import RobotCell
     except ImportError:
@@ -443,6 +494,10 @@ def _instances(tmp: Path):
             "focus": np.zeros(3),
             "width": 64,
             "height": 48,
+            "solids": [],
+            "label": "1",
+            "mass": 0.005,
+            "seconds": 0.01,
         },
     )
 

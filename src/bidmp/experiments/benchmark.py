@@ -83,7 +83,7 @@ def check_lasa_options(shapes, methods, demos: str, every: int) -> tuple[list, l
     for given, what in ((shapes, "shapes"), (methods, "methods")):
         if given is None:
             continue
-        if isinstance(given, (str, bytes)) or not hasattr(given, "__iter__"):
+        if not isinstance(given, (list, tuple)):
             raise TypeError(f"{what} must be a list of names, got {type(given).__name__}")
         if not list(given):
             raise ValueError(f"{what} names none; give at least one (or None for all)")
@@ -92,12 +92,15 @@ def check_lasa_options(shapes, methods, demos: str, every: int) -> tuple[list, l
     shapes = names if shapes is None else list(shapes)
     for shape in shapes:
         if shape not in names:
-            raise ValueError(f"unknown LASA shape {shape!r}; see 'bidmp lasa list'")
+            raise ValueError(f"shapes: unknown LASA shape {shape!r}; see 'bidmp lasa list'")
     from ..tasks import methods as registry
 
     methods = list(registry.names(lasa=True) if methods is None else methods)
     for method in methods:
-        registry.get(method)  # an unknown name is refused, listing the known ones
+        try:
+            registry.get(method)  # an unknown name is refused, listing the known ones
+        except ValueError as exc:
+            raise ValueError(f"methods: {exc}") from None
     check_choice(demos, "demos", ("all", "first3"))
     every = check_int(every, "every", minimum=1, maximum=100)
     indices = list(range(7)) if demos == "all" else [0, 1, 2]

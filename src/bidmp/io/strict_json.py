@@ -88,4 +88,10 @@ def json_number(value) -> float | None:
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise TypeError(f"value must be a number or None, got {type(value).__name__}")
-    return round(float(value), 4) if np.isfinite(value) else None
+    try:
+        number = float(value)
+    except OverflowError:  # an integer past float64's range
+        raise ValueError(
+            f"value is beyond float64's range ({len(str(abs(value)))} digits)"
+        ) from None
+    return round(number, 4) if np.isfinite(number) else None
