@@ -189,6 +189,10 @@ def _package_overrides(tmp: Path) -> dict:
             "target": rng.normal(size=(40, 3)),
         },
         "bidmp.tasks.carried_clearance": {"scene": scenario.scene, "path": DEMO, "exclude": ()},
+        "bidmp.tasks.carried_depth": {
+            "carried": (scenario.scene.solids[0], np.array([0.0, 0.0, -3.0]))
+        },
+        "bidmp.tasks.check_robot": {"robot": {"model": "iiwa", "base": [0.0, -400.0, 0.0]}},
         "bidmp.tasks.Contract": {"threshold": 1.75},
         "bidmp.tasks.command_peaks": {"commands": np.zeros((50, 7)), "limits": _panda_limits()},
         "bidmp.tasks.parse_job": {"data": scenario.spec.get("job"), "source": "fuzz"},
@@ -335,7 +339,12 @@ def _instances(tmp: Path):
     yield (
         "DMP",
         dmp,
-        {"phase": np.linspace(1.0, 0.05, 60), "goals": DEMO[-1] + np.zeros((3, 3)), "y": DEMO},
+        {
+            "phase": np.linspace(1.0, 0.05, 60),
+            "goals": DEMO[-1] + np.zeros((3, 3)),
+            "y": DEMO,
+            "forcing_target:y": dmp.training_trajectory(DEMO),
+        },
     )
     yield "CartesianDMP", pose, {"goal": POSES[-1], "start": POSES[0]}
     yield (

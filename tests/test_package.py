@@ -405,16 +405,12 @@ def cycles(edges: dict) -> list[list[str]]:
     return found
 
 
-# What is left (the number may only shrink): private names still crossing between subpackages.
-MAX_PRIVATE_IMPORTS_ACROSS = 12
-
-
 def test_modules_import_one_another_one_way_only():
     """Structure guard: no new import cycle, deferred imports included."""
     edges, private = import_graph()
     found = cycles(edges)
     assert found == [], found
-    assert len(private) <= MAX_PRIVATE_IMPORTS_ACROSS, "\n".join(private)
+    assert private == [], "\n".join(private)
 
 
 def test_the_cycle_check_sees_a_cycle(tmp_path):

@@ -14,7 +14,7 @@ from sklearn.base import clone
 
 import bidmp
 from bidmp.demonstrations import minimum_jerk
-from bidmp.primitives.approach import _straight_tail_start
+from bidmp.primitives.approach import _tail_start
 
 
 def smooth(s):
@@ -81,7 +81,7 @@ def test_the_goal_share_is_monotone_and_complete_at_the_approach(seed):
     # stated bound, README "Robot protocol"), so "monotone" and "in [0, 1]" hold to that.
     assert share.min() >= -2e-4 and share.max() <= 1.0 + 2e-4
     assert np.all(np.diff(share) >= -2e-4)  # never backwards
-    start = _straight_tail_start(y)
+    start = _tail_start(y)
     assert abs(start - approach_start) <= 0.05 * len(
         y
     )  # the detector finds the demonstrated approach
@@ -95,7 +95,7 @@ def test_without_a_straight_approach_the_progress_gate_is_kept():
         [100 * np.cos(6 * s), 100 * np.sin(6 * s), 50 * s]
     )  # an arc to the end
     # Its last few samples are straight to 2 % of their short chord, but far shorter than an approach.
-    assert len(curved) - _straight_tail_start(curved) < 0.05 * len(curved)
+    assert len(curved) - _tail_start(curved) < 0.05 * len(curved)
     keep = bidmp.DMP(keep_approach=True).fit(curved)
     plain = bidmp.DMP().fit(curved)
     np.testing.assert_array_equal(keep.goal_gate_, plain.goal_gate_)

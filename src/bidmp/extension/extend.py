@@ -47,7 +47,7 @@ from .._checks import (
     numerically_guarded,
 )
 from .._trajectory import arclength, path_extent, resample_time
-from ..primitives.approach import STRAIGHTNESS, _straight_tail_start
+from ..primitives.approach import STRAIGHTNESS, straight_tail_start
 from .refine import _lifted_route, _path_is_free, _refine_transfer, _smoothest_free_route
 from .roadmap import CollisionCallback, NoFreeRouteError, RoadmapOptions, _options, gaussian_prm
 from .segmentation import Piece, choose_piece, segment
@@ -195,7 +195,7 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     points = as_indices(points, "segmentation_points", last, "y")
     start = int(points[points < last].max()) if np.any(points < last) else 0
     # The last piece if it is straight, else its longest straight tail (primitives.approach).
-    return _straight_tail_start(y, start, straightness)
+    return straight_tail_start(y, start, straightness)
 
 
 def check_extension_options(

@@ -41,7 +41,6 @@ from .._checks import (
 )
 from .._trajectory import resample_time, rmse
 from ..primitives.dmp import DMP
-from ..primitives.forcing import _forcing_target
 from .bidmp_state import _bidmp_from_state, _bidmp_state
 from .bls import BLS
 
@@ -274,17 +273,7 @@ class BiDMP(CheckedParams, BaseEstimator):
             y
         )  # T samples (and, robot protocol, rest at the goal after them)
         phase, basis = dmp.training_grid()
-        target = _forcing_target(
-            y,
-            phase,
-            dt=dmp.dt_,
-            tau=1.0,
-            alpha=params.alpha,
-            beta=params.beta,
-            K=params.K,
-            derivatives=_derivative_rule(derivatives, params),
-            gate=dmp.training_gate(),
-        )
+        target = dmp.forcing_target(y, derivatives=_derivative_rule(derivatives, params))
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
         return self._learn_block(target - current, y[-1], y[0], increments, time_scale)
 

@@ -11,24 +11,9 @@ from sklearn.base import BaseEstimator, clone
 
 from .._api import CheckedParams
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
-from ..primitives.cartesian import (
-    CartesianDMP,
-    _parts_from_state,
-    _parts_state,
-    _pose_params,
-    _pose_parts,
-    _pose_vias,
-    _read_poses_state,
-    as_poses,
-)
-from ..primitives.pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
-from ..primitives.so3 import (
-    _nearest_turn,
-    angle_between,
-    as_quaternions,
-    orientation_from_log,
-    principal_log,
-)
+from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
+from ..primitives.pose_timing import PoseStepper, PoseTrajectory
+from ..primitives.so3 import angle_between, as_quaternions, orientation_from_log, principal_log
 from .bidmp import BiDMP
 
 __all__ = ["CartesianBiDMP", "pose_forgetting"]
@@ -81,7 +66,7 @@ _BIDMP_PARAMS = (
 )
 
 
-class CartesianBiDMP(CheckedParams, BaseEstimator):
+class CartesianBiDMP(PoseModel, CheckedParams, BaseEstimator):
     """Bi-DMP on poses: the increment is learned on both forcing terms, position and orientation.
 
     A scikit-learn style estimator like :class:`bidmp.BiDMP`: ``CartesianBiDMP(cartesian)``
@@ -177,8 +162,8 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts), lasting ``duration``
         seconds (default the demonstration's; see :meth:`bidmp.BiDMP.learn`). Returns self."""
         self._ensure_started()
-        positions, quaternions, log = _pose_parts(poses)
-        # A pose skill may keep its position or its orientation still (not both: _pose_parts).
+        positions, quaternions, log = self._split_poses(poses)
+        # A pose skill may keep its position or its orientation still (not both: _split_poses).
         self.position_._learn(positions, duration, "poses' positions", still=True)
         self.orientation_._learn(log, duration, "poses' orientation", still=True)
         self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
@@ -210,7 +195,7 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
             if start is None
             else as_quaternions(start[3:], "start's quaternion")[0]
         )
-        start_e = _nearest_turn(start_q, goal_q, self.skill_start_logs_[index])
+        start_e = self._start_error(start_q, goal_q, self.skill_start_logs_[index])
         return (
             index,
             None if goal is None else goal[:3],
@@ -252,23 +237,25 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
         vias = (
             None
             if via is None
-            else _pose_vias(orientation, via, goal_q, start_e, duration, dt, orientation_increment)
+            else self._via_errors(
+                orientation, via, goal_q, start_e, duration, dt, orientation_increment
+            )
         )
-        return _pose_trajectory(
+        return self._timed(
             position,
             orientation,
             goal_p,
             start_p,
             goal_q,
             start_e,
-            duration,
-            dt,
-            limits,
-            position_increment,
-            orientation_increment,
-            self.cartesian_.units_,
-            coupling,
-            vias,
+            duration=duration,
+            dt=dt,
+            limits=limits,
+            position_increment=position_increment,
+            orientation_increment=orientation_increment,
+            units=self.cartesian_.units_,
+            coupling=coupling,
+            vias=vias,
         )
 
     def stepper(
@@ -287,8 +274,7 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
     def _get_state(self) -> tuple[dict, dict]:
         self._ensure_started()
         cartesian = self.cartesian_
-        return _parts_state(
-            self,
+        return self._parts_state(
             {"params": cartesian.get_params()},
             {
                 "start_": cartesian.start_,
@@ -303,16 +289,16 @@ class CartesianBiDMP(CheckedParams, BaseEstimator):
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> CartesianBiDMP:
 
-        position, orientation = _parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
+        position, orientation = cls._parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
         if (
             position.n_skills != orientation.n_skills
             or position.dmp_.n_dims_ != 3
             or orientation.dmp_.n_dims_ != 3
         ):
             raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
-        cartesian = CartesianDMP(**_pose_params(meta["params"]))
+        cartesian = CartesianDMP(**cls._stored_params(meta["params"]))
         cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
-        _read_poses_state(cartesian, arrays)
+        cartesian._read_pose_ends(arrays)
         cartesian.units_ = position.dmp_.units_
         model = cls(cartesian, **{name: getattr(position, name) for name in _BIDMP_PARAMS})
         model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation

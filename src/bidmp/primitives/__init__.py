@@ -69,6 +69,8 @@ _EXPORTS = {
     "continuous_log": "so3",
     "orientation_from_log": "so3",
     "ApproachGate": "goals",
+    "straight_tail_start": "approach",
+    "PoseModel": "cartesian",
     "on_uniform_time": "timing",
 }
 __all__ = list(_EXPORTS)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["STRAIGHTNESS"]
+__all__ = ["STRAIGHTNESS", "straight_tail_start"]
 
 STRAIGHTNESS = 0.02  # an approach deviates from its chord by at most this fraction of the chord
 MAX_TAIL_CANDIDATES = 256  # start indices tried for the earliest straight tail
@@ -34,11 +34,24 @@ def _is_straight(points: np.ndarray, tolerance: float = STRAIGHTNESS) -> bool:
 
 def _straight_head_end(y: np.ndarray, straightness: float = STRAIGHTNESS) -> int:
     """The latest index up to which ``y`` (T, D) is straight from its start (on the same grid of
-    candidates as :func:`_straight_tail_start`); 0 when no head of 2 samples or more is."""
-    return y.shape[0] - 1 - _straight_tail_start(y[::-1], 0, straightness)
+    candidates as :func:`_tail_start`); 0 when no head of 2 samples or more is."""
+    return y.shape[0] - 1 - _tail_start(y[::-1], 0, straightness)
 
 
-def _straight_tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNESS) -> int:
+def straight_tail_start(y, start: int = 0, straightness: float = STRAIGHTNESS) -> int:
+    """The earliest sample index from ``start`` on from which the rest of ``y`` (T, D) is
+    straight — within ``straightness`` × its chord of the chord, never moving back along it —
+    tried on a grid of at most 256 candidates; ``T - 1`` when no tail of two samples or more is
+    (the motion has no straight approach)."""
+    from .._checks import as_trajectory, check_int, check_real
+
+    y = as_trajectory(y, "y", min_points=2, allow_static=True)
+    start = check_int(start, "start", minimum=0, maximum=y.shape[0] - 1)
+    straightness = check_real(straightness, "straightness", positive=True, maximum=1.0)
+    return _tail_start(y, start, straightness)
+
+
+def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNESS) -> int:
     """The earliest index from ``start`` on (on a grid of at most 256 candidates) from which the
     rest of ``y`` (T, D) is straight; ``T - 1`` when no tail of 2 samples or more is (the motion has
     no approach)."""

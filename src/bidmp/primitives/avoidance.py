@@ -151,7 +151,7 @@ class SceneAvoidance(CouplingTerm):
         """Called by the stepper that runs the term: the goal (for head-on steering), the default
         strength, the target's parts left out, and the final approach's length."""
         from ..scene.proximity import Proximity
-        from .approach import _straight_tail_start
+        from .approach import _tail_start
         from .stepper import DMPStepper
 
         if not isinstance(stepper, DMPStepper):
@@ -163,7 +163,7 @@ class SceneAvoidance(CouplingTerm):
             plain = stepper._dmp.rollout(
                 stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment
             )
-            self.approach_ = float(np.linalg.norm(plain[-1] - plain[_straight_tail_start(plain)]))
+            self.approach_ = float(np.linalg.norm(plain[-1] - plain[_tail_start(plain)]))
         else:
             self.approach_ = self.approach
         params, scale = stepper._params, stepper._params.tau * stepper._dmp.time_unit_

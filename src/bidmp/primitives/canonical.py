@@ -214,7 +214,7 @@ class ExponentialPhase:
 
 def _as_phase(phase, name: str = "phase") -> np.ndarray:
     """Phases (L,) validated: finite and in [0, 1] (a DMP's phase decays from 1 towards 0)."""
-    if not isinstance(name, str) or not name.isidentifier():
+    if not isinstance(name, str) or not name.isidentifier() or len(name) > 64:
         raise TypeError("name must be the argument's name (an identifier) to say in a refusal")
     phase = _as_bounded_array(phase, name, max_ndim=2)
     phase = as_points(phase.reshape(-1, 1) if phase.ndim <= 1 else phase, 1, name)[:, 0]

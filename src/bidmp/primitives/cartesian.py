@@ -56,6 +56,7 @@ from .so3 import (
 
 __all__ = [
     "CartesianDMP",
+    "PoseModel",
     "PoseStepper",
     "PoseTrajectory",
     "as_quaternions",
@@ -87,19 +88,6 @@ def as_poses(poses, name: str = "poses", min_points: int = 3) -> tuple[np.ndarra
             f"{name} must have 7 columns (x, y, z, qx, qy, qz, qw), got {array.shape[1]}"
         )
     return array[:, :3].copy(), as_quaternions(array[:, 3:], f"{name}' quaternions")
-
-
-def _pose_parts(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Positions (T, 3), quaternions (T, 4) and the continuous orientation log (T, 3) of a pose
-    demonstration; refused if neither part moves."""
-    positions, quaternions = as_poses(poses)
-    log = continuous_log(quaternions, quaternions[-1])
-    if np.ptp(positions, axis=0).max() == 0.0 and np.ptp(log, axis=0).max() <= 1e-12:
-        raise ValueError(
-            f"poses: the demonstration does not move: all {len(positions)} poses are the same "
-            f"(position {np.round(positions[0], 6).tolist()}, one orientation)"
-        )
-    return positions, quaternions, log
 
 
 def _fit_parts(
@@ -134,7 +122,128 @@ def continuous_quaternions(q) -> np.ndarray:
     return _continuous(_quaternion_rows(q, "q"))
 
 
-class CartesianDMP(CheckedParams, BaseEstimator):
+class PoseModel:
+    """What a pose model is made of, shared by :class:`CartesianDMP` (two DMPs) and the pose
+    Bi-DMP (:class:`bidmp.CartesianBiDMP`, two Bi-DMPs): a position part and an orientation part
+    on the log map at the goal (module docstring). The subclass holds the parts as ``position_``
+    and ``orientation_``; this class splits pose demonstrations into the parts' data, finds a
+    start's turn, times the two parts together, and writes and reads them in model files."""
+
+    @staticmethod
+    def _split_poses(poses) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Positions (T, 3), quaternions (T, 4) and the continuous orientation log (T, 3) of a pose
+        demonstration; refused if neither part moves."""
+        positions, quaternions = as_poses(poses)
+        log = continuous_log(quaternions, quaternions[-1])
+        if np.ptp(positions, axis=0).max() == 0.0 and np.ptp(log, axis=0).max() <= 1e-12:
+            raise ValueError(
+                f"poses: the demonstration does not move: all {len(positions)} poses are the same "
+                f"(position {np.round(positions[0], 6).tolist()}, one orientation)"
+            )
+        return positions, quaternions, log
+
+    @staticmethod
+    def _start_error(start_q, goal_q, reference) -> np.ndarray:
+        """The start's ``Log(q ⊗ goal⁻¹)`` on the turn nearest ``reference`` (a multi-turn
+        skill turns the same way, as many times, from another start)."""
+        return _nearest_turn(start_q, goal_q, reference)
+
+    @staticmethod
+    def _timed(position, orientation, goal_p, start_p, goal_q, start_e, **options):
+        """The two parts timed together (:class:`PoseTrajectory`); ``options``: duration, dt,
+        limits, position_increment, orientation_increment, units, coupling, vias."""
+        return _pose_trajectory(
+            position,
+            orientation,
+            goal_p,
+            start_p,
+            goal_q,
+            start_e,
+            options["duration"],
+            options["dt"],
+            options["limits"],
+            options["position_increment"],
+            options["orientation_increment"],
+            options["units"],
+            options["coupling"],
+            options["vias"],
+        )
+
+    @staticmethod
+    def _via_errors(
+        orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment
+    ) -> tuple[list, list]:
+        """(position via-points, orientation-error via-points) of via poses ``[(t, pose (7,)), ...]``;
+        ``orientation`` the orientation part (a DMP) and its skill's increment."""
+        if not isinstance(via, (list, tuple)):
+            raise TypeError(
+                f"via must be a list of (t_seconds, pose) pairs, got {type(via).__name__}"
+            )
+        pairs = []
+        for index, pair in enumerate(via):
+            if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
+                raise TypeError(f"via[{index}] must be a (t_seconds, pose) pair")
+            pairs.append((pair[0], as_point(pair[1], 7, f"via[{index}] pose")))
+        # The orientation part's own motion gives each via pose's turn (a multi-turn motion stays one).
+        plain = orientation.trajectory(
+            np.zeros(3),
+            start=start_e,
+            duration=duration,
+            dt=dt,
+            forcing_increment=orientation_increment,
+        )
+        errors = []
+        for index, (t, pose) in enumerate(pairs):
+            q = as_quaternions(pose[3:], f"via[{index}] quaternion")[0]
+            reference = np.array([np.interp(float(t), plain.t, column) for column in plain.y.T])
+            errors.append((t, _nearest_turn(q, goal_q, reference)))
+        return [(t, pose[:3]) for t, pose in pairs], errors
+
+    def _parts_state(self, meta: dict, arrays: dict) -> tuple[dict, dict]:
+        """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
+        ``orientation_`` parts, the parts' members prefixed with their names."""
+        for part in ("position", "orientation"):
+            part_meta, part_arrays = getattr(self, f"{part}_")._get_state()
+            meta[part] = part_meta
+            arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
+        return meta, arrays
+
+    @staticmethod
+    def _parts_from_state(part_class, name: str, meta: dict, arrays) -> tuple:
+        """The (position, orientation) parts of a stored pose model, each read lazily from its prefix."""
+        for key in ("params", "position", "orientation"):
+            if not isinstance(meta.get(key), dict):
+                raise ValueError(f"the {name} state has no {key} object")
+        return tuple(
+            part_class._from_state(meta[part], Prefixed(arrays, f"{part}/"))
+            for part in ("position", "orientation")
+        )
+
+    @staticmethod
+    def _stored_params(params: dict) -> dict:
+        """A stored pose model's parameters; format 1-3 files integrated with explicit Euler."""
+        params = dict(params)
+        params.setdefault("integrator", "euler")
+        return params
+
+    def _read_pose_ends(self, arrays) -> None:
+        """``start_``, ``goal_`` and ``start_log_`` of a stored pose model (format 3: ``start_pose_``
+        and ``goal_pose_``, and the principal log at the start)."""
+        from .so3 import principal_log
+
+        old = "start_" not in arrays
+        self.start_ = check_loaded(arrays["start_pose_" if old else "start_"], "start_", (7,))
+        self.goal_ = check_loaded(arrays["goal_pose_" if old else "goal_"], "goal_", (7,))
+        for name in ("start_", "goal_"):
+            if abs(np.linalg.norm(getattr(self, name)[3:]) - 1.0) > 1e-6:
+                raise ValueError(f"member {name} does not hold a unit quaternion")
+        if old:
+            self.start_log_ = principal_log(self.start_[None, 3:], self.goal_[3:])[0]
+        else:
+            self.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
+
+
+class CartesianDMP(PoseModel, CheckedParams, BaseEstimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
     Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``
@@ -196,7 +305,7 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         """Learn from one pose demonstration ``(T, 7)`` (x, y, z, qx, qy, qz, qw), with optional
         timestamps ``t`` (s) as :meth:`bidmp.DMP.fit`. Quaternion sign flips are made continuous;
         non-unit quaternions are normalised with a warning; zero ones refused."""
-        positions, quaternions, log = _pose_parts(poses)
+        positions, quaternions, log = self._split_poses(poses)
         position, orientation = self._dmp(), self._dmp()
         _fit_parts(position, orientation, positions, log, t, units)
         self.position_, self.orientation_ = position, orientation
@@ -234,7 +343,7 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         start = self.start_ if start is None else as_point(start, 7, "start")
         goal_q = as_quaternions(goal[3:], "goal's quaternion")[0]
         start_q = as_quaternions(start[3:], "start's quaternion")[0]
-        return goal[:3], goal_q, start[:3], _nearest_turn(start_q, goal_q, self.start_log_)
+        return goal[:3], goal_q, start[:3], self._start_error(start_q, goal_q, self.start_log_)
 
     @numerically_guarded
     def trajectory(
@@ -275,25 +384,25 @@ class CartesianDMP(CheckedParams, BaseEstimator):
         vias = (
             None
             if via is None
-            else _pose_vias(
+            else self._via_errors(
                 self.orientation_, via, goal_q, start_e, duration, dt, orientation_increment
             )
         )
-        return _pose_trajectory(
+        return self._timed(
             self.position_,
             self.orientation_,
             goal_p,
             start_p,
             goal_q,
             start_e,
-            duration,
-            dt,
-            limits,
-            position_increment,
-            orientation_increment,
-            self.units_,
-            coupling,
-            vias,
+            duration=duration,
+            dt=dt,
+            limits=limits,
+            position_increment=position_increment,
+            orientation_increment=orientation_increment,
+            units=self.units_,
+            coupling=coupling,
+            vias=vias,
         )
 
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:
@@ -318,93 +427,19 @@ class CartesianDMP(CheckedParams, BaseEstimator):
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
         self._parts()
-        return _parts_state(
-            self,
+        return self._parts_state(
             {"params": self.get_params()},
             {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_},
         )
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> CartesianDMP:
-        position, orientation = _parts_from_state(DMP, "CartesianDMP", meta, arrays)
-        model = cls(**_pose_params(meta["params"]))
+        position, orientation = cls._parts_from_state(DMP, "CartesianDMP", meta, arrays)
+        model = cls(**cls._stored_params(meta["params"]))
         model.position_, model.orientation_ = position, orientation
         for part in (model.position_, model.orientation_):
             if part.n_dims_ != 3:
                 raise ValueError(f"a CartesianDMP's parts are 3-D; the file has D = {part.n_dims_}")
-        _read_poses_state(model, arrays)
+        model._read_pose_ends(arrays)
         model.units_ = model.position_.units_
         return model
-
-
-def _pose_vias(
-    orientation: DMP, via, goal_q, start_e, duration, dt, orientation_increment
-) -> tuple[list, list]:
-    """(position via-points, orientation-error via-points) of via poses ``[(t, pose (7,)), ...]``;
-    ``orientation`` the orientation part (a DMP) and its skill's increment."""
-    if not isinstance(via, (list, tuple)):
-        raise TypeError(f"via must be a list of (t_seconds, pose) pairs, got {type(via).__name__}")
-    pairs = []
-    for index, pair in enumerate(via):
-        if isinstance(pair, (str, bytes)) or not hasattr(pair, "__len__") or len(pair) != 2:
-            raise TypeError(f"via[{index}] must be a (t_seconds, pose) pair")
-        pairs.append((pair[0], as_point(pair[1], 7, f"via[{index}] pose")))
-    # The orientation part's own motion gives each via pose's turn (a multi-turn motion stays one).
-    plain = orientation.trajectory(
-        np.zeros(3),
-        start=start_e,
-        duration=duration,
-        dt=dt,
-        forcing_increment=orientation_increment,
-    )
-    errors = []
-    for index, (t, pose) in enumerate(pairs):
-        q = as_quaternions(pose[3:], f"via[{index}] quaternion")[0]
-        reference = np.array([np.interp(float(t), plain.t, column) for column in plain.y.T])
-        errors.append((t, _nearest_turn(q, goal_q, reference)))
-    return [(t, pose[:3]) for t, pose in pairs], errors
-
-
-def _pose_params(params: dict) -> dict:
-    """A stored pose model's parameters; format 1-3 files integrated with explicit Euler."""
-    params = dict(params)
-    params.setdefault("integrator", "euler")
-    return params
-
-
-def _read_poses_state(model: CartesianDMP, arrays) -> None:
-    """``start_``, ``goal_`` and ``start_log_`` of a stored pose model (format 3: ``start_pose_``
-    and ``goal_pose_``, and the principal log at the start)."""
-    from .so3 import principal_log
-
-    old = "start_" not in arrays
-    model.start_ = check_loaded(arrays["start_pose_" if old else "start_"], "start_", (7,))
-    model.goal_ = check_loaded(arrays["goal_pose_" if old else "goal_"], "goal_", (7,))
-    for name in ("start_", "goal_"):
-        if abs(np.linalg.norm(getattr(model, name)[3:]) - 1.0) > 1e-6:
-            raise ValueError(f"member {name} does not hold a unit quaternion")
-    if old:
-        model.start_log_ = principal_log(model.start_[None, 3:], model.goal_[3:])[0]
-    else:
-        model.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
-
-
-def _parts_state(model, meta: dict, arrays: dict) -> tuple[dict, dict]:
-    """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
-    ``orientation_`` parts, the parts' members prefixed with their names."""
-    for part in ("position", "orientation"):
-        part_meta, part_arrays = getattr(model, f"{part}_")._get_state()
-        meta[part] = part_meta
-        arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
-    return meta, arrays
-
-
-def _parts_from_state(part_class, name: str, meta: dict, arrays) -> tuple:
-    """The (position, orientation) parts of a stored pose model, each read lazily from its prefix."""
-    for key in ("params", "position", "orientation"):
-        if not isinstance(meta.get(key), dict):
-            raise ValueError(f"the {name} state has no {key} object")
-    return tuple(
-        part_class._from_state(meta[part], Prefixed(arrays, f"{part}/"))
-        for part in ("position", "orientation")
-    )

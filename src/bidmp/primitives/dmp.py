@@ -52,6 +52,7 @@ from .._checks import (
     as_trajectory,
     as_unit_quaternion,
     check_bytes,
+    check_choice,
     check_int,
     check_names,
     numerically_guarded,
@@ -59,11 +60,12 @@ from .._checks import (
 from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
-from .forcing import Basis, _check_forcing_increment, _learn_weights
+from .forcing import Basis, _check_forcing_increment, _forcing_target, _learn_weights
 from .goals import DelayedGoal, PhaseGate, ProgressGate, _learn_goal_gate, _learned_progress_gate
 from .grid import _cached_grid, _rollout_grid, _store_grid
 from .integrate import _check_integration, _unit_responses
 from .protocols import (
+    DERIVATIVE_CHOICES,
     PROTOCOLS,
     _FittedParams,
     _Params,
@@ -416,7 +418,7 @@ class DMP(_FittedParams, CheckedParams, BaseEstimator):
 
     def training_gate(self) -> np.ndarray:
         """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
-        fraction (robot); the forcing target of :func:`_forcing_target` uses it."""
+        fraction (robot); the forcing target (:meth:`forcing_target`) uses it."""
         self._check_fitted()
         params = self._params()
         return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
@@ -446,6 +448,34 @@ class DMP(_FittedParams, CheckedParams, BaseEstimator):
         if params.rest_start:
             y = _rest_started(y, self.dt_, self.time_unit_)
         return _with_rest(y, params)
+
+    def forcing_target(self, y, *, derivatives: str | None = None) -> np.ndarray:
+        """The forcing term that makes this DMP reproduce ``y`` exactly: ``y`` (:attr:`n_train_`, D)
+        on the training grid (as :meth:`training_trajectory` returns a demonstration), with the
+        learned goal gate; ``derivatives`` ("gradient", "forward"; default the DMP's). What
+        :class:`bidmp.BiDMP` learns its increments towards, shape (:attr:`n_train_`, D)."""
+        self._check_fitted()
+        params = self._params()
+        y = as_trajectory(y, "y", min_points=2, allow_static=True)
+        if y.shape != (self.n_train_, self.n_dims_):
+            raise ValueError(
+                f"y must be on the training grid, shape ({self.n_train_}, {self.n_dims_}) "
+                f"(training_trajectory), got {y.shape}"
+            )
+        rule = params.derivatives if derivatives is None else derivatives
+        rule = check_choice(rule, "derivatives", DERIVATIVE_CHOICES)
+        phase, _ = self.training_grid()
+        return _forcing_target(
+            y,
+            phase,
+            dt=self.dt_,
+            tau=1.0,
+            alpha=params.alpha,
+            beta=params.beta,
+            K=params.K,
+            derivatives=rule,
+            gate=self.training_gate(),
+        )
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""

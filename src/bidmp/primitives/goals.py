@@ -417,9 +417,9 @@ def _learn_goal_gate(
         "progress": progress,
     }
     if params.keep_approach and demonstration is not None:
-        from .approach import _straight_tail_start
+        from .approach import _tail_start
 
-        start = _straight_tail_start(demonstration)
+        start = _tail_start(demonstration)
         progress_at = _arclength_progress(demonstration)[start] if start >= 2 else 0.0
         # An approach is a straight tail of a real share of the path: any curve's last few samples
         # are straight to 2 % of their short chord.

@@ -209,9 +209,9 @@ def _clear_transfer(world: _World, goal, exclude, carried=None):
     clearance = _clearance(world, path, exclude, carried)
     if clearance.clear:
         return path, fractions, turns, ""
-    from ..tasks.repair import _depth
+    from ..tasks.repair import carried_depth
 
-    height = _depth(carried)
+    height = carried_depth(carried)
     top = max(
         float(np.max([s.upper[2] for s in scene.solids])) + height,
         float(world.tcp[2]),

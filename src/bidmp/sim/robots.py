@@ -217,7 +217,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
     "acceleration", "jerk"}, one value per joint, rad) and optionally ``"rest"`` (one per joint, rad)
     and ``"effort"`` (one per joint, N m). The key is checked as a scenario file's is; the URDF must
     be a regular ``.urdf`` file within the file size limit."""
-    from ..tasks._scenario_fields import _robot
+    from ..tasks.scenarios import check_robot
 
     if spec is not None and not isinstance(spec, dict):
         raise TypeError(
@@ -225,7 +225,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
         )
     folder = "." if base_dir is None else check_path(base_dir, "base_dir")
     # Scenarios resolve their URDF when they load: here it may be absolute (the folder rule was applied then).
-    spec = _robot({"robot": spec or {}}, "robot", folder, allow_outside=True)
+    spec = check_robot(spec, folder)
     if "urdf" not in spec:
         return ROBOT_MODELS[spec.get("model", "panda")]
     path = Path(spec["urdf"])

@@ -49,7 +49,7 @@ from .._checks import (
 )
 from .contract import Contract, Verdict
 
-__all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance"]
+__all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance", "carried_depth"]
 
 logger = logging.getLogger(__name__)
 
@@ -463,7 +463,7 @@ class Repairer:
                 return trajectory.y, clearance
             owner = _owner(scene, clearance.part)
             path = trajectory.y[:, :3]
-            height = _depth(carried)
+            height = carried_depth(carried)
             near = scene.near(path, owner, band) | scene.near(
                 path - [0.0, 0.0, height], owner, band
             )
@@ -512,6 +512,14 @@ def carried_clearance(scene, path, exclude, carried=None, support=(), orientatio
     clearance = scene.clearance(path, exclude=exclude, orientations=orientations)
     if carried is None:
         return clearance
+    solid, offset = _carried_args(carried)
+    body = scene.body_clearance(solid, path[:, :3], offset, exclude=exclude + support)
+    body = type(body)(body.distance, body.part, body.point, scene.margin)
+    return min(clearance, body, key=lambda c: c.distance - c.margin)
+
+
+def _carried_args(carried) -> tuple:
+    """``carried`` checked: (a scene Solid, its offset (3,) from the tool's mouth)."""
     from ..scene import Solid
 
     if (
@@ -522,17 +530,20 @@ def carried_clearance(scene, path, exclude, carried=None, support=(), orientatio
         raise TypeError(
             f"carried must be (a scene Solid, its offset (3,)) or None, got {short_token(carried, 30)}"
         )
-    solid, offset = carried
-    body = scene.body_clearance(solid, path[:, :3], offset, exclude=exclude + support)
-    body = type(body)(body.distance, body.part, body.point, scene.margin)
-    return min(clearance, body, key=lambda c: c.distance - c.margin)
+    return carried[0], as_point(carried[1], 3, "carried's offset")
 
 
-def _depth(carried) -> float:
-    """How far a carried part reaches below the tool's mouth (scene units; 0 without one)."""
-    if not carried:
+def carried_depth(carried) -> float:
+    """How far a carried part reaches below the tool's mouth (scene units; 0 without one).
+
+    Parameters
+    ----------
+    carried : (bidmp.scene.Solid, array (3,)) or None
+        The part's solid where it is and its centre's offset from the tool's mouth (scene units).
+    """
+    if carried is None or (isinstance(carried, tuple) and not carried):
         return 0.0
-    solid, offset = carried
+    solid, offset = _carried_args(carried)
     return max(
         float(np.asarray(solid.centre)[2] - np.asarray(solid.lower)[2] - np.asarray(offset)[2]), 0.0
     )

@@ -85,6 +85,7 @@ __all__ = [
     "builtin_names",
     "builtin_text",
     "from_dict",
+    "check_robot",
 ]
 
 # The methods a scenario runs when it names none (any registered method may be named: bidmp.tasks.methods).
@@ -300,6 +301,18 @@ def _parameters(data, key, known, source, check) -> dict:
         except (TypeError, ValueError) as exc:
             _fail(source, key, str(exc))
     return params
+
+
+def check_robot(robot: dict | None, base_dir=".") -> dict:
+    """A scenario's ``"robot"`` object checked as a scenario file's is (``base``, ``yaw``, a built-in
+    ``model``, or its own ``urdf`` with ``flange``, ``limits``, ``rest``, ``effort``), a relative
+    ``urdf`` resolved in ``base_dir`` (anywhere: the folder rule applies when a file loads);
+    ``ScenarioError`` names the first bad key."""
+    if robot is not None and not isinstance(robot, dict):
+        raise TypeError(
+            f'robot must be a scenario\'s "robot" object (a dict) or None, got {type(robot).__name__}'
+        )
+    return _robot({"robot": robot or {}}, "robot", base_dir, allow_outside=True)
 
 
 def from_dict(
