@@ -21,6 +21,34 @@ def test_public_names_resolve():
         bidmp.nothing  # noqa: B018
 
 
+LAZY_PACKAGES = sorted(
+    ".".join(("bidmp", *path.parent.relative_to(SRC).parts))
+    for path in SRC.rglob("__init__.py")
+    if "if TYPE_CHECKING:" in path.read_text()
+)
+
+
+@pytest.mark.parametrize("package", LAZY_PACKAGES)
+def test_a_packages_public_names_are_the_imports_editors_see(package):
+    """Structure guard: a package's lazily exported names are the imports of its ``if
+    TYPE_CHECKING:`` block (what editors and type checkers read), each the very object the block
+    names; nothing else is exported. No public name is also a submodule's: once that module is
+    imported, Python sets the package's attribute to it (``from bidmp.demonstrations import
+    prepare`` gave the module ``prepare.py`` after anything had imported it)."""
+    import importlib
+    import pkgutil
+
+    from bidmp._lazy import typing_imports
+
+    module = importlib.import_module(package)
+    table = typing_imports(package, module.__file__)
+    assert not set(table) & {info.name for info in pkgutil.iter_modules(module.__path__)}
+    assert table and set(table) <= set(module.__all__)
+    assert set(module.__all__) - set(table) <= {"__version__", *bidmp._SUBPACKAGES}
+    for name, (source, attribute) in table.items():
+        assert getattr(module, name) is getattr(importlib.import_module(source), attribute), name
+
+
 def test_import_and_cli_help_do_not_import_numpy():
     code = "import sys, bidmp, bidmp.cli; bidmp.cli.build_parser(); print('numpy' in sys.modules)"
     result = subprocess.run(

@@ -28,36 +28,6 @@ from ._version import __version__
 # last resort would print every warning of bidmp to stderr).
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
-# public name -> "module[:attribute]" relative to bidmp
-_LAZY = {
-    "DMP": "primitives.dmp",
-    "Trajectory": "primitives.timing",
-    "prepare": "demonstrations.prepare",
-    "time_scale": "primitives.timing",
-    "segment": "extension.segmentation",
-    "Segmentation": "extension.segmentation",
-    "frechet_distance": "extension.similarity",
-    "frechet_similarity": "extension.similarity",
-    "extend_demonstration": "extension.extend",
-    "Scene": "scene",
-    "CartesianDMP": "primitives.cartesian",
-    "CartesianBiDMP": "incremental.cartesian",
-    "Tool": "scene",
-    "Clearance": "scene",
-    "SceneAvoidance": "primitives.avoidance",
-    "MissingExtraError": "_checks",
-    "BLS": "incremental.bls",
-    "BiDMP": "incremental.bidmp",
-    "forgetting": "incremental.bidmp",
-    "evaluate": "tasks.evaluation",
-    "save": "io:save_model",
-    "load": "io:load_model",
-    "ModelFileError": "io",
-    "NotFittedError": "_checks",
-    "Limits": "_checks",
-    "get_limits": "_checks",
-    "set_limits": "_checks",
-}
 # the subpackages of the layout
 _SUBPACKAGES = (
     "primitives",
@@ -73,9 +43,7 @@ _SUBPACKAGES = (
     "plotting",
 )
 
-__all__ = ["__version__", *_LAZY, *_SUBPACKAGES]
-
-_getattr, __dir__ = exports(__name__, _LAZY, globals())
+_getattr, __dir__ = exports(__name__, __file__, globals(), ("__version__", *_SUBPACKAGES))
 
 
 def __getattr__(name: str):
@@ -91,25 +59,28 @@ def __getattr__(name: str):
         raise AttributeError(f"module 'bidmp' has no attribute {name!r}") from None
 
 
-if TYPE_CHECKING:  # pragma: no cover - for type checkers and IDEs only
-    from ._checks import (  # noqa: F401
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from ._checks import (
         Limits,
         MissingExtraError,
         NotFittedError,
         get_limits,
         set_limits,
     )
-    from .demonstrations.prepare import prepare  # noqa: F401
-    from .extension.extend import extend_demonstration  # noqa: F401
-    from .extension.segmentation import Segmentation, segment  # noqa: F401
-    from .extension.similarity import frechet_distance, frechet_similarity  # noqa: F401
-    from .incremental.bidmp import BiDMP, forgetting  # noqa: F401
-    from .incremental.bls import BLS  # noqa: F401
-    from .incremental.cartesian import CartesianBiDMP  # noqa: F401
-    from .io import ModelFileError  # noqa: F401
-    from .io import load_model as load  # noqa: F401
-    from .io import save_model as save  # noqa: F401
-    from .primitives.cartesian import CartesianDMP  # noqa: F401
-    from .primitives.dmp import DMP  # noqa: F401
-    from .primitives.timing import Trajectory, time_scale  # noqa: F401
-    from .scene import Clearance, Scene, Tool  # noqa: F401
+    from .demonstrations.preparation import prepare
+    from .extension.extend import extend_demonstration
+    from .extension.segmentation import Segmentation, segment
+    from .extension.similarity import frechet_distance, frechet_similarity
+    from .incremental.bidmp import BiDMP, forgetting
+    from .incremental.bls import BLS
+    from .incremental.cartesian import CartesianBiDMP
+    from .io import ModelFileError
+    from .io import load_model as load
+    from .io import save_model as save
+    from .primitives.avoidance import SceneAvoidance
+    from .primitives.cartesian import CartesianDMP
+    from .primitives.dmp import DMP
+    from .primitives.timing import Trajectory, time_scale
+    from .scene import Clearance, Scene, Tool
+    from .tasks.evaluation import evaluate

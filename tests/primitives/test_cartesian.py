@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 import bidmp
 from bidmp.demonstrations import kinesthetic_recording, minimum_jerk
-from bidmp.demonstrations.prepare import prepare_poses
+from bidmp.demonstrations.preparation import prepare_poses
 from bidmp.extension import extend_pose_demonstration
 from bidmp.incremental.cartesian import CartesianBiDMP, pose_forgetting
 from bidmp.io import read_poses, save_poses

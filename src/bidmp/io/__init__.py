@@ -13,31 +13,17 @@ never ``tasks``, ``sim`` or ``cli``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "ModelFileError": "models",
-    "FORMAT_VERSION": "models",
-    "save_model": "models",
-    "load_model": "models",
-    "load_trajectory": "trajectories",
-    "read_trajectory": "trajectories",
-    "save_trajectory": "trajectories",
-    "declared_units": "trajectories",
-    "is_joint_recording": "recordings",
-    "read_poses": "poses",
-    "save_poses": "poses",
-    "atomic_write": "atomic",
-    "load_json": "strict_json",
-    "json_number": "strict_json",
-    "Recording": "recordings",
-    "read_recording": "recordings",
-    "recording_kind": "recordings",
-    "read_bag": "bags",
-    "write_bag": "bags",
-    "is_bag": "bags",
-    "start_stamp": "bags",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .atomic import atomic_write
+    from .bags import is_bag, read_bag, start_stamp, write_bag
+    from .models import FORMAT_VERSION, ModelFileError, load_model, save_model
+    from .poses import read_poses, save_poses
+    from .recordings import Recording, is_joint_recording, read_recording, recording_kind
+    from .strict_json import json_number, load_json
+    from .trajectories import declared_units, load_trajectory, read_trajectory, save_trajectory
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -8,31 +8,26 @@ Layer 2 (data out, beside ``io``): imports the math and ``bidmp.io``; never ``ta
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "plot_trajectories": "trajectories",
-    "plot_rollout": "trajectories",
-    "plot_generalisation": "trajectories",
-    "plot_recordings": "trajectories",
-    "plot_segmentation": "extension",
-    "plot_extension": "extension",
-    "plot_prm_comparison": "extension",
-    "plot_incremental": "incremental",
-    "plot_targets_top_view": "tasks",
-    "plot_error_vs_distance": "tasks",
-    "plot_scenario_3d": "tasks",
-    "plot_lasa_benchmark": "benchmark",
-    "ViewLayers": "viewer",
-    "layers_from_report": "viewer",
-    "add_robot_motions": "viewer",
-    "solid_layer": "viewer",
-    "solid_mesh": "viewer",
-    "view_figure": "viewer",
-    "write_view": "viewer",
-    "save_layers": "viewer",
-    "load_layers": "viewer",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .benchmark import plot_lasa_benchmark
+    from .extension import plot_extension, plot_prm_comparison, plot_segmentation
+    from .incremental import plot_incremental
+    from .tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
+    from .trajectories import plot_generalisation, plot_recordings, plot_rollout, plot_trajectories
+    from .viewer import (
+        ViewLayers,
+        add_robot_motions,
+        layers_from_report,
+        load_layers,
+        save_layers,
+        solid_layer,
+        solid_mesh,
+        view_figure,
+        write_view,
+    )
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -22,56 +22,42 @@ root, never ``tasks``, ``io``, ``sim`` or ``cli``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "DMP": "dmp",
-    "PROTOCOLS": "dmp",
-    "phase_grid": "canonical",
-    "CanonicalSystem": "canonical",
-    "ExponentialPhase": "canonical",
-    "Basis": "forcing",
-    "GaussianBasis": "forcing",
-    "kernel_centres": "forcing",
-    "kernel_widths": "forcing",
-    "basis_functions": "forcing",
-    "PhaseGate": "goals",
-    "DelayedGoal": "goals",
-    "ProgressGate": "goals",
-    "StepIntegrator": "integrate",
-    "CouplingTerm": "coupling",
-    "PhaseStopping": "coupling",
-    "ConstantAcceleration": "coupling",
-    "SceneAvoidance": "avoidance",
-    "AvoidanceError": "avoidance",
-    "DMPStepper": "stepper",
-    "Trajectory": "timing",
-    "TimedMotion": "timing",
-    "check_timestamps": "timing",
-    "uniform_time": "timing",
-    "drop_repeated_stamps": "timing",
-    "scale_factor": "timing",
-    "time_scale": "timing",
-    "ROBOT_ALPHA": "protocols",
-    "ROBOT_KERNELS": "protocols",
-    "ROBOT_ALPHA_PHASE": "protocols",
-    "ROBOT_SETTLE": "protocols",
-    "CartesianDMP": "cartesian",
-    "PoseStepper": "cartesian",
-    "PoseTrajectory": "cartesian",
-    "as_quaternions": "cartesian",
-    "as_poses": "cartesian",
-    "continuous_quaternions": "cartesian",
-    "orientation_error": "cartesian",
-    "angle_between": "cartesian",
-    "principal_log": "so3",
-    "continuous_log": "so3",
-    "orientation_from_log": "so3",
-    "ApproachGate": "goals",
-    "straight_tail_start": "approach",
-    "PoseModel": "cartesian",
-    "on_uniform_time": "timing",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .approach import straight_tail_start
+    from .avoidance import AvoidanceError, SceneAvoidance
+    from .canonical import CanonicalSystem, ExponentialPhase, phase_grid
+    from .cartesian import (
+        CartesianDMP,
+        PoseModel,
+        PoseStepper,
+        PoseTrajectory,
+        angle_between,
+        as_poses,
+        as_quaternions,
+        continuous_quaternions,
+        orientation_error,
+    )
+    from .coupling import ConstantAcceleration, CouplingTerm, PhaseStopping
+    from .dmp import DMP, PROTOCOLS
+    from .forcing import Basis, GaussianBasis, basis_functions, kernel_centres, kernel_widths
+    from .goals import ApproachGate, DelayedGoal, PhaseGate, ProgressGate
+    from .integrate import StepIntegrator
+    from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
+    from .so3 import continuous_log, orientation_from_log, principal_log
+    from .stepper import DMPStepper
+    from .timing import (
+        TimedMotion,
+        Trajectory,
+        check_timestamps,
+        drop_repeated_stamps,
+        on_uniform_time,
+        scale_factor,
+        time_scale,
+        uniform_time,
+    )
+__getattr__, __dir__ = exports(__name__, __file__, globals())

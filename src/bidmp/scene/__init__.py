@@ -8,20 +8,15 @@ Layer 1 (the math): imports the package root's private helpers only; coal is an 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "Scene": "clearance",
-    "Clearance": "clearance",
-    "SceneChecker": "checker",
-    "Proximity": "proximity",
-    "random_field": "fields",
-    "Tool": "parts",
-    "Part": "parts",
-    "Solid": "parts",
-    "SceneError": "parts",
-    "PART_TYPES": "parts",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .checker import SceneChecker
+    from .clearance import Clearance, Scene
+    from .fields import random_field
+    from .parts import PART_TYPES, Part, SceneError, Solid, Tool
+    from .proximity import Proximity
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -16,49 +16,42 @@ extra (``bidmp[sim]``), imported when a world is built.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "simulate": "run",
-    "target_labels": "run",
-    "run_job": "job",
-    "job_targets": "job",
-    "JobReport": "job_report",
-    "JobTarget": "job_report",
-    "JobPhase": "job_report",
-    "write_job_report": "job_report",
-    "in_bin": "job_report",
-    "in_slot": "job_report",
-    "inverse_kinematics": "kinematics",
-    "joint_names": "kinematics",
-    "require_simulator": "backend",
-    "MovablePart": "backend",
-    "backend_names": "backend",
-    "get_backend": "backend",
-    "register_backend": "backend",
-    "KinematicCell": "kinematic",
-    "plan_path": "planning",
-    "SimulatorBackend": "backend",
-    "SimError": "backend",
-    "JointLimits": "backend",
-    "Hold": "backend",
-    "GoalUpdate": "backend",
-    "MotionPlan": "backend",
-    "Execution": "backend",
-    "RobotCell": "pybullet.cell",
-    "PANDA": "robots",
-    "IIWA": "robots",
-    "XARM6": "robots",
-    "UR5": "robots",
-    "RobotModel": "robots",
-    "ROBOT_MODELS": "robots",
-    "robot_model": "robots",
-    "robot_placement": "robots",
-    "SimTarget": "report",
-    "SimMethod": "report",
-    "SimReport": "report",
-    "write_sim_report": "report",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .backend import (
+        Execution,
+        GoalUpdate,
+        Hold,
+        JointLimits,
+        MotionPlan,
+        MovablePart,
+        SimError,
+        SimulatorBackend,
+        backend_names,
+        get_backend,
+        register_backend,
+        require_simulator,
+    )
+    from .job import job_targets, run_job
+    from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot, write_job_report
+    from .kinematic import KinematicCell
+    from .kinematics import inverse_kinematics, joint_names
+    from .planning import plan_path
+    from .pybullet.cell import RobotCell
+    from .report import SimMethod, SimReport, SimTarget, write_sim_report
+    from .robots import (
+        IIWA,
+        PANDA,
+        ROBOT_MODELS,
+        UR5,
+        XARM6,
+        RobotModel,
+        robot_model,
+        robot_placement,
+    )
+    from .run import simulate, target_labels
+__getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -8,45 +8,35 @@ Layer 2 (data and tasks): imports the math and ``bidmp.io``; never ``sim``, ``ex
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .._lazy import exports
 
-# public name -> the module that holds it (imported on first use)
-_EXPORTS = {
-    "CONVERGED_GAIN": "evaluation",
-    "MethodResult": "report",
-    "Report": "report",
-    "evaluate": "evaluation",
-    "write_report": "report",
-    "Scenario": "scenarios",
-    "ScenarioError": "scenarios",
-    "METHODS": "scenarios",
-    "load": "scenarios",
-    "builtin_names": "scenarios",
-    "builtin_text": "scenarios",
-    "from_dict": "scenarios",
-    "check_robot": "scenarios",
-    "rmse": "metrics",
-    "path_extent": "metrics",
-    "endpoint_error": "metrics",
-    "approach_error": "metrics",
-    "axis_deviation": "metrics",
-    "path_difference": "metrics",
-    "swept_area": "metrics",
-    "final_approach_mask": "metrics",
-    "Contract": "contract",
-    "Verdict": "contract",
-    "CommandPeaks": "contract",
-    "command_peaks": "contract",
-    "mm": "contract",
-    "Repairer": "repair",
-    "Repaired": "repair",
-    "Attempt": "repair",
-    "REPAIRS": "repair",
-    "carried_clearance": "repair",
-    "carried_depth": "repair",
-    "JobSpec": "jobs",
-    "parse_job": "jobs",
-    "tour": "jobs",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .contract import CommandPeaks, Contract, Verdict, command_peaks, mm
+    from .evaluation import CONVERGED_GAIN, evaluate
+    from .jobs import JobSpec, parse_job, tour
+    from .metrics import (
+        approach_error,
+        axis_deviation,
+        endpoint_error,
+        final_approach_mask,
+        path_difference,
+        path_extent,
+        rmse,
+        swept_area,
+    )
+    from .repair import REPAIRS, Attempt, Repaired, Repairer, carried_clearance, carried_depth
+    from .report import MethodResult, Report, write_report
+    from .scenarios import (
+        METHODS,
+        Scenario,
+        ScenarioError,
+        builtin_names,
+        builtin_text,
+        check_robot,
+        from_dict,
+        load,
+    )
+__getattr__, __dir__ = exports(__name__, __file__, globals())

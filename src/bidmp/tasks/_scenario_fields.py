@@ -123,7 +123,7 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
 def _prepared_file(path, units: str) -> np.ndarray:
     """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
     trimmed, filtered, uniform time); a declared unit must be the scenario's."""
-    from ..demonstrations.prepare import prepare
+    from ..demonstrations.preparation import prepare
     from ..io.trajectories import declared_units
 
     declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""

@@ -12,10 +12,11 @@ Needs the ``sim`` extra: ``pip install 'bidmp[sim]'``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..._lazy import exports
 
-_EXPORTS = {
-    "RobotCell": "cell",
-}
-__all__ = list(_EXPORTS)
-__getattr__, __dir__ = exports(__name__, _EXPORTS, globals())
+# The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
+if TYPE_CHECKING:
+    from .cell import RobotCell
+__getattr__, __dir__ = exports(__name__, __file__, globals())
