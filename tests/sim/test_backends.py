@@ -134,6 +134,8 @@ def test_the_whole_job_on_the_ideal_arm_drops_each_nut_on_the_bins_floor(nuts):
 def test_a_scripted_hold_needs_dynamics_and_an_arm_with_that_joint(nuts):
     with pytest.raises(ValueError, match="needs dynamics"):
         simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=Hold(0, 0.5), workers=1)
+    with pytest.raises(TypeError, match="hold must be a bidmp.sim.Hold"):
+        simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=(6, 0.5), workers=1)
     with pytest.raises(ValueError, match="joint 7 of an arm with 6 joints"):
         simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=Hold(6, 0.5), workers=1)
 

@@ -318,8 +318,49 @@ class SimReport:
         return markdown_table(*self.rows())
 
 
+@dataclass(frozen=True)
+class _SimTask:
+    """What judging a simulated motion needs of its scenario, as plain data (a worker process
+    gets a copy): the targets (label -> point or pose), the unit, the success threshold, the
+    approach height, each target's axis (or None) and, for pose skills, the alignment threshold."""
+
+    targets: dict
+    units: str
+    success_threshold: float
+    approach_height: float | None
+    axes: dict
+    alignment_threshold: float | None
+
+    @classmethod
+    def of(cls, scenario, labels) -> _SimTask:
+        """The task of ``scenario`` (a :class:`bidmp.tasks.Scenario`) at ``labels``."""
+        axes = {label: scenario.target_axis(label) for label in labels}
+        return cls(
+            {k: v.tolist() for k, v in scenario.targets.items()},
+            scenario.units,
+            scenario.success_threshold,
+            scenario.approach_height,
+            {label: None if axis is None else axis.tolist() for label, axis in axes.items()},
+            scenario.alignment_threshold if scenario.is_pose else None,
+        )
+
+    def contract(self, scene, limits):
+        """The motion contract of the task: its threshold, approach height and alignment,
+        ``scene`` (margin and stand-offs; None: no clearance) and the arm's joint ``limits``."""
+        from ..tasks.contract import Contract
+
+        return Contract(
+            self.success_threshold,
+            self.approach_height,
+            scene,
+            self.units,
+            self.alignment_threshold,
+            limits,
+        )
+
+
 def _measure(
-    scenario: dict,
+    task: _SimTask,
     label: str,
     target: np.ndarray,
     plan: MotionPlan,
@@ -330,24 +371,15 @@ def _measure(
     contract=None,
     exclude=(),
 ) -> SimTarget:
-    """The per-target results of one execution (``scenario``: its targets, units, threshold;
+    """The per-target results of one execution (``task``: its targets, units, threshold;
     ``limits``: the robot's joint limits), judged by ``contract`` (a
-    :class:`bidmp.tasks.contract.Contract` with the scene; default: built from ``scenario`` without
-    one) on the executed motion: the measured tool path, the commands, the contacts."""
-    from ..tasks.contract import Contract
-
+    :class:`bidmp.tasks.contract.Contract` with the scene; default: the task's without one) on
+    the executed motion: the measured tool path, the commands, the contacts."""
     if contract is None:
-        contract = Contract(
-            scenario["success_threshold"],
-            scenario["approach_height"],
-            None,
-            scenario["units"],
-            scenario.get("alignment_threshold"),
-            limits,
-        )
+        contract = task.contract(None, limits)
     tcp = run.tcp / unit
-    axis = scenario.get("axes", {}).get(label)
-    pose = scenario.get("alignment_threshold") is not None
+    axis = task.axes.get(label)
+    pose = task.alignment_threshold is not None
     # What counts: the commands the position control was sent every 1 ms, from rest to rest; the
     # measured joints are reported beside them. A backend that does not report its commands: the
     # plan's own peaks.

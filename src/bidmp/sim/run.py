@@ -17,8 +17,15 @@ from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
 from .pybullet.cell import RobotCell
-from .report import SimMethod, SimReport, SimTarget, _measure
-from .robots import MAX_SAMPLE_SPACING, PANDA_MODEL, _unit_of, robot_model, robot_placement
+from .report import SimMethod, SimReport, SimTarget, _measure, _SimTask
+from .robots import (
+    MAX_SAMPLE_SPACING,
+    PANDA_MODEL,
+    RobotModel,
+    _unit_of,
+    robot_model,
+    robot_placement,
+)
 
 __all__ = ["simulate", "target_labels"]
 
@@ -45,12 +52,31 @@ class _Job:
     record: bool = False  # keep the measured path and the 1 kHz commands on the result
 
 
-def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
+@dataclass(frozen=True)
+class _SimSetup:
+    """What every worker needs to build its world and judge a motion (plain data, picklable):
+    the task, the scene (its dict form), the arm's base (scene units) and yaw (degrees), the
+    backend and the scenario's arm, and how the motions run."""
+
+    task: _SimTask
+    scene: dict
+    base: tuple
+    yaw: float
+    backend: type
+    robot: RobotModel
+    closed_loop: bool = False
+    hold: Hold | None = None
+    coupling: float = 0.0  # phase stopping's gain (1/unit²), closed loop
+    models: dict | None = None  # method -> fitted model, closed loop
+    avoid: bool = False
+    goal_update: GoalUpdate | None = None
+
+
+def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
     """Execute ``jobs`` in one world; returns (method, label, SimTarget, frames, seconds)."""
-    scenario = setup["scenario"]
     results = []
     cell = _world(setup)
-    contract = _contract(scenario, cell)
+    contract = setup.task.contract(getattr(cell, "scene", None), cell.limits)
     for job in jobs:
         if progress is not None:
             progress(job.method, job.label)
@@ -65,38 +91,37 @@ def _run_jobs(setup: dict, jobs: list, progress=None) -> list:
     return results
 
 
-def _run_one(setup: dict, cell, contract, job):
+def _run_one(setup: _SimSetup, cell, contract, job):
     """One motion planned, executed and measured: (method, label, SimTarget, frames, seconds, motion)."""
-    scenario = setup["scenario"]
     # The closed loop runs the learned motion itself, not a spline through IK samples 5 mm apart,
     # which smooths its final stop: it is timed on samples 1 mm apart (else a fast descent stops
     # harder than the joints' acceleration limits, and the limiter overshoots the nut).
-    spacing = CLOSED_LOOP_SPACING if setup["closed_loop"] else MAX_SAMPLE_SPACING
+    spacing = CLOSED_LOOP_SPACING if setup.closed_loop else MAX_SAMPLE_SPACING
     plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
-    if setup["closed_loop"] and job.orientations is not None:
+    if setup.closed_loop and job.orientations is not None:
         raise ValueError("closed_loop runs position skills; this scenario's are poses")
-    target = np.asarray(scenario["targets"][job.label], dtype=float)[:3]
-    if setup["closed_loop"]:
-        coupling = setup["coupling"]
-        if setup.get("avoid"):  # steered round every part but the target's, with phase stopping
+    target = np.asarray(setup.task.targets[job.label], dtype=float)[:3]
+    if setup.closed_loop:
+        coupling = setup.coupling
+        if setup.avoid:  # steered round every part but the target's, with phase stopping
             coupling = [PhaseStopping(coupling), SceneAvoidance(cell.scene, target=job.label)]
-        stepper = _stepper(setup["models"], job.method, target, plan.duration, coupling)
-        update = setup.get("goal_update")
+        stepper = _stepper(setup.models, job.method, target, plan.duration, coupling)
+        update = setup.goal_update
         run = cell.execute_closed_loop(
-            stepper, plan.duration, job.exclude, setup["hold"], job.frames, goal_update=update
+            stepper, plan.duration, job.exclude, setup.hold, job.frames, goal_update=update
         )
         if update is not None:  # judged at where the part turned out to be
             target = target + np.asarray(update.offset)
     else:
-        run = cell.execute(plan, job.exclude, setup["hold"], job.frames)
+        run = cell.execute(plan, job.exclude, setup.hold, job.frames)
     measured = _measure(
-        scenario,
+        setup.task,
         job.label,
         target,
         plan,
         run,
         cell.unit,
-        setup["closed_loop"],
+        setup.closed_loop,
         cell.limits,
         contract,
         job.exclude,
@@ -109,21 +134,6 @@ def _run_one(setup: dict, cell, contract, job):
     return job.method, job.label, measured, run.frames, float(run.times[-1]), motion
 
 
-def _contract(scenario: dict, cell):
-    """The motion contract in a worker: the scenario's threshold, approach height and alignment,
-    the world's scene (margin and stand-offs) and the arm's joint limits."""
-    from ..tasks.contract import Contract
-
-    return Contract(
-        scenario["success_threshold"],
-        scenario["approach_height"],
-        getattr(cell, "scene", None),
-        scenario["units"],
-        scenario.get("alignment_threshold"),
-        cell.limits,
-    )
-
-
 # The last world this process built, kept for the next call with the same scene, robot placement
 # and backend: building one (two URDF loads, the parts' bodies) is a quarter of a one-target run.
 # Every execution resets the joints it starts from, so a kept world runs a job as a new one would
@@ -131,31 +141,28 @@ def _contract(scenario: dict, cell):
 _WORLD: dict = {}
 
 
-def _world(setup: dict):
+def _world(setup: _SimSetup):
     """The world of ``setup``: the kept one if it matches, else a new one (the old one closed)."""
     import json
 
     from ..scene.clearance import Scene
 
-    scenario = setup["scenario"]
     key = (
-        setup["backend"],
-        json.dumps(setup["scene"], sort_keys=True),
-        json.dumps(scenario["targets"], sort_keys=True),
-        scenario["units"],
-        tuple(setup["base"]),
-        setup["yaw"],
-        setup.get("robot", PANDA_MODEL),
+        setup.backend,
+        json.dumps(setup.scene, sort_keys=True),
+        json.dumps(setup.task.targets, sort_keys=True),
+        setup.task.units,
+        tuple(setup.base),
+        setup.yaw,
+        setup.robot,
     )
     if _WORLD.get("key") != key:
         _close_world()
-        scene = Scene.from_dict(setup["scene"], scenario["targets"])
-        robot = setup.get("robot", PANDA_MODEL)
-        arm = (
-            {} if robot is PANDA_MODEL else {"robot": robot}
-        )  # another backend need not know of arms
-        _WORLD["cell"] = setup["backend"].load_robot(
-            scene, scenario["units"], setup["base"], setup["yaw"], **arm
+        scene = Scene.from_dict(setup.scene, setup.task.targets)
+        # another backend need not know of arms
+        arm = {} if setup.robot is PANDA_MODEL else {"robot": setup.robot}
+        _WORLD["cell"] = setup.backend.load_robot(
+            scene, setup.task.units, setup.base, setup.yaw, **arm
         )
         _WORLD["key"] = key
     return _WORLD["cell"]
@@ -171,7 +178,7 @@ def _close_world() -> None:
 atexit.register(_close_world)
 
 
-def _run_chunk(setup: dict, jobs: list) -> list:
+def _run_chunk(setup: _SimSetup, jobs: list) -> list:
     """A worker process's jobs (a forked worker builds its own world, never the parent's copy)."""
     _WORLD.clear()
     return _run_jobs(setup, jobs)
@@ -280,6 +287,8 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         robot=arm,
         **_loop_options(closed_loop, avoid, goal_update),
     )
+    if hold is not None and not isinstance(hold, Hold):
+        raise TypeError(f"hold must be a bidmp.sim.Hold (or None), got {type(hold).__name__}")
     if hold is not None and hold.joint >= _world(setup).limits.n_joints:
         raise ValueError(
             f"hold: joint {hold.joint + 1} of an arm with {_world(setup).limits.n_joints} joints"
@@ -344,7 +353,7 @@ def _open_world(backend, scenario, base, yaw):
     return backend.load_robot(scenario.scene, scenario.units, base, yaw, **robot)
 
 
-def _unreachable(setup: dict, scenario, labels) -> dict:
+def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
     """The targets out of the arm's reach from its base, tool pointing down, each with its reason
     (every target, when the demonstration's start is out of reach: every motion starts there)."""
     from .backend import SimError
@@ -418,28 +427,15 @@ def _jobs(scenario, report, methods, labels, frames: dict, views=(), record: boo
     ]
 
 
-def _setup(scenario, labels, base, yaw, **run) -> dict:
-    """What every worker needs to build its world and judge a motion (plain data, picklable);
-    ``run``: closed_loop, hold, coupling, models, backend."""
-    axes = {
-        label: None if scenario.target_axis(label) is None else scenario.target_axis(label).tolist()
-        for label in labels
-    }
-    task = {
-        "targets": {k: v.tolist() for k, v in scenario.targets.items()},
-        "units": scenario.units,
-        "approach_height": scenario.approach_height,
-        "success_threshold": scenario.success_threshold,
-        "axes": axes,
-        "alignment_threshold": scenario.alignment_threshold if scenario.is_pose else None,
-    }
-    return {
-        "scenario": task,
-        "scene": scenario.scene.to_dict(),
-        "base": base.tolist(),
-        "yaw": yaw,
+def _setup(scenario, labels, base, yaw, **run) -> _SimSetup:
+    """The set-up every worker gets; ``run``: the fields of :class:`_SimSetup` past the world's."""
+    return _SimSetup(
+        _SimTask.of(scenario, labels),
+        scenario.scene.to_dict(),
+        tuple(base.tolist()),
+        yaw,
         **run,
-    }
+    )
 
 
 def _n_workers(workers, n_jobs: int) -> int:
@@ -541,7 +537,7 @@ def _checked(scenario, methods, targets, closed_loop: bool) -> tuple[list, list]
     return methods, labels
 
 
-def _execute_jobs(setup: dict, jobs: list, n_workers: int, progress) -> list:
+def _execute_jobs(setup: _SimSetup, jobs: list, n_workers: int, progress) -> list:
     """Every job's outcome, in this process or spread over ``n_workers`` worker processes."""
     if n_workers == 1:
         return _run_jobs(setup, jobs, progress)
