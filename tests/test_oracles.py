@@ -1735,7 +1735,7 @@ def test_segmentation_looks_for_extrema_on_the_interior_5_to_95_percent(
 
     kappa = np.zeros(n)
     kappa[list(bumps)] = 1.0
-    monkeypatch.setattr(segmentation, "curvature", lambda y: kappa.copy())
+    monkeypatch.setattr(segmentation, "_curvature", lambda y, *smoothing: kappa.copy())
     line = np.outer(np.linspace(0.0, 1.0, n), [100.0, 20.0, 0.0])
     found = segmentation.segment(line)
     assert (found.points.tolist(), found.kinds.tolist()) == expected
@@ -1776,7 +1776,7 @@ def test_segmentation_maps_each_point_to_the_nearest_sample_and_calls_only_a_fla
 
     kappa = np.zeros(len(x))
     kappa[bump] = height
-    monkeypatch.setattr(segmentation, "curvature", lambda y: kappa.copy())
+    monkeypatch.setattr(segmentation, "_curvature", lambda y, *smoothing: kappa.copy())
     line = np.column_stack([x, 0.2 * x, np.zeros(len(x))]) / np.sqrt(1.04)  # arc length = x
     found = segmentation.segment(line)
     assert (found.points.tolist(), found.kinds.tolist()) == expected

@@ -49,8 +49,15 @@ from .._checks import (
 from .._trajectory import arclength, path_extent, resample_time
 from ..primitives.approach import STRAIGHTNESS, straight_tail_start
 from .refine import _lifted_route, _path_is_free, _refine_transfer, _smoothest_free_route
-from .roadmap import CollisionCallback, NoFreeRouteError, RoadmapOptions, _options, gaussian_prm
-from .segmentation import Piece, choose_piece, segment
+from .roadmap import (
+    CollisionCallback,
+    NoFreeRouteError,
+    RoadmapOptions,
+    RoadmapResult,
+    _gaussian_prm,
+    _options,
+)
+from .segmentation import Piece, _choose_piece, _segment
 from .timing import _time_path, _timed_transfer
 
 __all__ = [
@@ -191,8 +198,13 @@ def final_approach(y, segmentation_points, straightness: float = _STRAIGHTNESS) 
     y = as_trajectory(y, "y")
     straightness = check_real(straightness, "straightness", positive=True, maximum=1.0)
     points = getattr(segmentation_points, "points", segmentation_points)
+    points = as_indices(points, "segmentation_points", y.shape[0] - 1, "y")
+    return _final_approach(y, points, straightness)
+
+
+def _final_approach(y: np.ndarray, points: np.ndarray, straightness: float = _STRAIGHTNESS) -> int:
+    """:func:`final_approach` of a checked demonstration and segmentation points."""
     last = y.shape[0] - 1
-    points = as_indices(points, "segmentation_points", last, "y")
     start = int(points[points < last].max()) if np.any(points < last) else 0
     # The last piece if it is straight, else its longest straight tail (primitives.approach).
     return straight_tail_start(y, start, straightness)
@@ -290,7 +302,7 @@ def extend_demonstration(
         check_callable(is_free, "is_free", "a collision callback is_free(points) -> bool array")
     exclude, is_free, scene_checker = _scene_checker(scene, y, target, is_free)
     roadmap_options = {"options": _options(roadmap, "roadmap"), "is_free": is_free}
-    points = segment(y, eps_frac=eps_frac, method=method).points
+    points = _segment(y, eps_frac, method).points
     if approach == "keep":
         if scene_checker is not None and scene.margin > 0.0:
             return _extend_keeping_the_margin(
@@ -358,7 +370,7 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
     the piece, appended to the demonstration up to the piece's start."""
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
-    piece = choose_piece(y, points, target)
+    piece = _choose_piece(y, points, target)
     tra_imi = y[piece.start : piece.end + 1]
     seg = y[piece.start]
 
@@ -369,7 +381,7 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
         history = np.empty(0)
         result = None
     else:
-        result = gaussian_prm(tra_imi, target, seed=seed, **roadmap_options)
+        result = _roadmap(tra_imi, target, seed, roadmap_options)
         tra_gen = _smooth_path(result.path)
         history = result.history
 
@@ -435,7 +447,7 @@ def _extend_keeping_approach(
     (rotated about the target by ``approach_rotation`` (D, D) when the target turns too)."""
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
-    start = final_approach(y, points)
+    start = _final_approach(y, points)
     # The approach relative to the demonstrated target, moved (and turned) onto the new one.
     offsets = y[start:] - y[-1]
     if approach_rotation is not None:
@@ -446,7 +458,7 @@ def _extend_keeping_approach(
         piece = Piece(index=0, start=0, end=0, breakpoints=np.array([0, n_steps - 1]))
     else:
         head_points = points[points < start]
-        piece = choose_piece(y[: start + 1], head_points, hover)
+        piece = _choose_piece(y[: start + 1], head_points, hover)
     seg = y[piece.start]
     tra_imi = y[piece.start : piece.end + 1]
     if np.linalg.norm(hover - seg) <= 1e-9 * path_extent(y) or piece.end <= piece.start:
@@ -507,6 +519,15 @@ def _extend_keeping_approach(
     )
 
 
+def _roadmap(tra_imi, target, seed, roadmap_options: dict, **changes) -> RoadmapResult:
+    """G-PRM from the piece ``tra_imi`` to ``target`` with the extension's checked options (and
+    ``changes`` to them), a generator from ``seed`` as :func:`gaussian_prm` makes one."""
+    options = roadmap_options["options"]
+    if changes:
+        options = options.replace(**changes)
+    return _gaussian_prm(tra_imi, target, options, roadmap_options["is_free"], check_seed(seed))
+
+
 _WIDER = (3.0, 9.0)  # G-PRM's sampling spread, widened in turn when it finds no free route
 
 
@@ -517,17 +538,13 @@ def _route(tra_imi, hover, seed, roadmap_options) -> tuple:
     own NoFreeRouteError."""
     is_free = roadmap_options.get("is_free")
     try:
-        result = gaussian_prm(tra_imi, hover, seed=seed, **roadmap_options)
+        result = _roadmap(tra_imi, hover, seed, roadmap_options)
     except NoFreeRouteError as exc:
         first = exc
         for factor in _WIDER:
-            options = roadmap_options["options"]
-            wider = {
-                **roadmap_options,
-                "options": options.replace(sigma_rel=options.sigma_rel * factor),
-            }
+            sigma_rel = roadmap_options["options"].sigma_rel * factor
             try:
-                result = gaussian_prm(tra_imi, hover, seed=seed, **wider)
+                result = _roadmap(tra_imi, hover, seed, roadmap_options, sigma_rel=sigma_rel)
                 logger.info("G-PRM found a free route with its sampling %g times wider", factor)
                 break
             except NoFreeRouteError:
@@ -580,7 +597,7 @@ def extend_pose_demonstration(
     check_extension_options(eps_frac=eps_frac, method=method, seed=seed, approach="keep")
     exclude, is_free, _ = _scene_checker(scene, positions, target[:3], None)
     options = {"options": _options(roadmap, "roadmap"), "is_free": is_free}
-    points = segment(positions, eps_frac=eps_frac, method=method).points
+    points = _segment(positions, eps_frac, method).points
     extension = _extend_keeping_approach(
         positions,
         target[:3],

@@ -39,7 +39,7 @@ from .._checks import (
 )
 from .._progress import report
 from .._trajectory import interp_columns, resample_arclength
-from .similarity import frechet_similarity
+from .similarity import _frechet_similarity
 
 __all__ = [
     "NoFreeRouteError",
@@ -118,6 +118,11 @@ def template(piece: np.ndarray, new_target: np.ndarray, scaling: str = "axis") -
     piece = as_trajectory(piece, "piece", min_points=2, allow_static=True)
     new_target = as_point(new_target, piece.shape[1], "new_target", like="piece")
     check_choice(scaling, "scaling", ("axis", "similarity", "paper"))
+    return _template(piece, new_target, scaling)
+
+
+def _template(piece: np.ndarray, new_target: np.ndarray, scaling: str) -> np.ndarray:
+    """:func:`template` of a checked piece and target."""
     seg, tar = piece[0], piece[-1]
     chord, new_chord = tar - seg, new_target - seg
     chord_length = np.linalg.norm(chord)
@@ -195,9 +200,7 @@ def _shortest_path(
     Returns the node indices of the path, or None when the target is unreachable even with
     ``n_neighbours`` doubled up to 32.
     """
-    nodes = as_trajectory(nodes, "nodes", min_points=2, allow_static=True)
-    n_neighbours = check_int(n_neighbours, "n_neighbours", minimum=1, maximum=_MAX_NEIGHBOURS)
-    n_nodes = nodes.shape[0]
+    n_nodes = nodes.shape[0]  # a private core: the roadmap's own nodes, checked options
     tree = cKDTree(nodes)
     k = n_neighbours
     while True:
@@ -287,7 +290,7 @@ class _Comparison:
         if self.scaling == "paper":
             self.reference = self.piece
         else:
-            self.reference = template(self.piece, self.new_target, self.scaling)
+            self.reference = _template(self.piece, self.new_target, self.scaling)
         self.target_shape = (
             self.reference if self.compare == "template" or self.scaling == "paper" else self.piece
         )
@@ -296,8 +299,8 @@ class _Comparison:
         """(similarity, bias direction) for a resampled path."""
         if self.scaling == "paper":
             scaled = _paper_scaled(path, self.piece[0], self.piece[-1], self.new_target)
-            return frechet_similarity(scaled, self.piece, self.denom), self.piece - scaled
-        return frechet_similarity(path, self.target_shape, self.denom), self.reference - path
+            return _frechet_similarity(scaled, self.piece, self.denom), self.piece - scaled
+        return _frechet_similarity(path, self.target_shape, self.denom), self.reference - path
 
 
 @dataclass(frozen=True)
@@ -397,9 +400,9 @@ def _options(options, name: str = "options") -> RoadmapOptions:
     return options
 
 
-def _setup(tra_imi, new_target, options: RoadmapOptions, is_free, seed):
-    """Validate what both roadmaps take besides their options; return (piece, target,
-    comparison, random generator)."""
+def _setup(tra_imi, new_target, is_free, seed):
+    """Validate what both roadmaps take besides their options; return (piece, target, random
+    generator)."""
     piece = as_trajectory(tra_imi, "tra_imi", min_points=2)
     target = as_point(new_target, piece.shape[1], "new_target", like="tra_imi")
     if is_free is not None:
@@ -409,14 +412,18 @@ def _setup(tra_imi, new_target, options: RoadmapOptions, is_free, seed):
         raise ValueError(
             "new_target coincides with the start of the piece (seg): nothing to generate"
         )
-    comparison = _Comparison(
+    return piece, target, rng
+
+
+def _comparison(piece: np.ndarray, target: np.ndarray, options: RoadmapOptions) -> _Comparison:
+    """How both roadmaps score a path against ``piece`` mapped to ``target``."""
+    return _Comparison(
         resample_arclength(piece, options.n_compare),
         target,
         options.scaling,
         options.compare,
         options.denom,
     )
-    return piece, target, comparison, rng
 
 
 def _iterate(
@@ -483,7 +490,14 @@ def gaussian_prm(
     seed : int or numpy.random.Generator
     """
     options = _options(options)
-    piece, target, comparison, rng = _setup(tra_imi, new_target, options, is_free, seed)
+    piece, target, rng = _setup(tra_imi, new_target, is_free, seed)
+    return _gaussian_prm(piece, target, options, is_free, rng)
+
+
+def _gaussian_prm(piece, target, options: RoadmapOptions, is_free, rng) -> RoadmapResult:
+    """:func:`gaussian_prm` on a checked piece (n, D), target (D,) apart from its start, options
+    and random generator (what an extended demonstration runs, its input checked once)."""
+    comparison = _comparison(piece, target, options)
     sampler = _ChordSampler(piece[0], target, options, rng)
     return _iterate(comparison, options, sampler.draw, sampler.learn, is_free)
 
@@ -527,7 +541,8 @@ def classic_prm(
     redraws. Scored exactly like :func:`gaussian_prm` (its other options likewise; G-PRM's
     ``sigma_rel``, ``rho`` and ``schedule`` are not used)."""
     options = _options(options)
-    piece, target, comparison, rng = _setup(tra_imi, new_target, options, is_free, seed)
+    piece, target, rng = _setup(tra_imi, new_target, is_free, seed)
+    comparison = _comparison(piece, target, options)
     seg = piece[0]
     margin = options.padding * np.linalg.norm(target - seg)
     low, high = np.minimum(seg, target) - margin, np.maximum(seg, target) + margin

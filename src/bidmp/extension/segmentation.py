@@ -62,13 +62,18 @@ def curvature(y, smooth: float = 0.05, smooth_curvature: float = 0.03) -> np.nda
     smoothed over ``smooth_curvature × T`` samples.
     """
     y = as_trajectory(y, "y", min_points=3, allow_static=True)
-    n_points = y.shape[0]
-    if y.shape[1] == 2:
-        y = np.column_stack([y, np.zeros(n_points)])
-    elif y.shape[1] != 3:
+    if y.shape[1] not in (2, 3):
         raise ValueError(f"y: curvature needs a 2-D or 3-D curve, got D = {y.shape[1]}")
     smooth = check_real(smooth, "smooth", positive=True, maximum=1.0)
     smooth_curvature = check_real(smooth_curvature, "smooth_curvature", positive=True, maximum=1.0)
+    return _curvature(y, smooth, smooth_curvature)
+
+
+def _curvature(y: np.ndarray, smooth: float, smooth_curvature: float) -> np.ndarray:
+    """:func:`curvature` of a checked curve (segmentation's own resampled one)."""
+    n_points = y.shape[0]
+    if y.shape[1] == 2:
+        y = np.column_stack([y, np.zeros(n_points)])
     window = _odd_window(smooth, n_points, 7)
     check_limit(
         float(n_points) * window,
@@ -237,13 +242,17 @@ def segment(y, eps_frac: float = 0.1, method: str = "persistence") -> Segmentati
     if not 0.0 < eps_frac < 1.0:
         raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
     check_choice(method, "method", ("persistence", "paper"))
+    return _segment(y, eps_frac, method)
 
+
+def _segment(y: np.ndarray, eps_frac: float, method: str) -> Segmentation:
+    """:func:`segment` of a checked demonstration (T >= 10, D = 2 or 3) and options."""
     n_samples = y.shape[0]
     n_points = min(n_samples, MAX_ANALYSIS_POINTS)
     s = arclength(y)
     total = s[-1]
     resampled = resample_arclength(y, n_points)
-    kappa = curvature(resampled)
+    kappa = _curvature(resampled, 0.05, 0.03)
     low, high = (
         int(np.ceil(_INTERIOR[0] * (n_points - 1))),
         int(np.floor(_INTERIOR[1] * (n_points - 1))) + 1,
@@ -290,8 +299,13 @@ def choose_piece(y, segmentation_points, new_target) -> Piece:
     target = as_point(new_target, y.shape[1], "new_target", like="y")
     if isinstance(segmentation_points, Segmentation):
         segmentation_points = segmentation_points.points
+    points = as_indices(segmentation_points, "segmentation_points", y.shape[0] - 1, "y")
+    return _choose_piece(y, points, target)
+
+
+def _choose_piece(y: np.ndarray, points: np.ndarray, target: np.ndarray) -> Piece:
+    """:func:`choose_piece` of a checked demonstration, sample indices and target."""
     last = y.shape[0] - 1
-    points = as_indices(segmentation_points, "segmentation_points", last, "y")
     breakpoints = np.unique(np.concatenate([[0], points, [last]]))
     ends = y[breakpoints[1:]]
     distances = np.linalg.norm(ends - target, axis=1)

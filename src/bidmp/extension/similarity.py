@@ -212,6 +212,11 @@ def frechet_distance(a, b) -> float:
         In the curves' length unit; symmetric; at least the distance between the start points
         and between the end points.
     """
+    return _frechet_distance(*_curve_pair(a, b))
+
+
+def _curve_pair(a, b) -> tuple[np.ndarray, np.ndarray]:
+    """Two curves checked: finite, one dimension, a Fréchet table within the limits."""
     a = as_trajectory(a, "a", min_points=1, allow_static=True)
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape[1] != b.shape[1]:
@@ -223,6 +228,11 @@ def frechet_distance(a, b) -> float:
         "max_frechet_cells",
         "the Fréchet table's size n x m; resample the curves to fewer points",
     )
+    return a, b
+
+
+def _frechet_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """:func:`frechet_distance` of checked curves (G-PRM scores every iteration with it)."""
     kernel = _frechet_kernel()
     if kernel is None:  # pragma: no cover
         return frechet_distance_reference(a, b)
@@ -231,7 +241,10 @@ def frechet_distance(a, b) -> float:
 
 def polyline_length(y: np.ndarray) -> float:
     """Sum of the segment lengths of a polyline (T, D)."""
-    y = as_trajectory(y, "y", min_points=1, allow_static=True)
+    return _length(as_trajectory(y, "y", min_points=1, allow_static=True))
+
+
+def _length(y: np.ndarray) -> float:
     return float(np.sum(np.linalg.norm(np.diff(y, axis=0), axis=1)))
 
 
@@ -248,8 +261,13 @@ def frechet_similarity(a, b, denom: str = "sqrt2") -> float:
         If a curve has zero length (the normaliser is undefined) or ``denom`` is unknown.
     """
     check_choice(denom, "denom", ("sqrt2", "2"))
-    distance = frechet_distance(a, b)
-    length_a, length_b = polyline_length(a), polyline_length(b)
+    return _frechet_similarity(*_curve_pair(a, b), denom)
+
+
+def _frechet_similarity(a: np.ndarray, b: np.ndarray, denom: str) -> float:
+    """:func:`frechet_similarity` of checked curves (G-PRM scores every iteration with it)."""
+    distance = _frechet_distance(a, b)
+    length_a, length_b = _length(a), _length(b)
     if length_a <= 0.0 or length_b <= 0.0:
         raise ValueError(
             f"a and b must be curves of non-zero length (the normaliser), got lengths {length_a:g} and {length_b:g}"
