@@ -1,5 +1,6 @@
 """Scenario files: built-ins, round trips and every kind of malformed file."""
 
+import copy
 import json
 
 import numpy as np
@@ -163,3 +164,29 @@ def test_scenario_sets_bidmp_and_extension_parameters():
     assert report.model.reg == 1e-2 and report.model.increments == (5,)
     assert report.extensions[0].similarity_history.shape == (3,)
     assert report.model.blocks_[0].n_hidden_ == 10 * 10 + 100 + 5
+
+
+def test_replace_checks_the_changed_keys_as_a_file_and_leaves_the_scenario_as_it_was():
+    """``Scenario.replace`` instead of a dict round trip: a changed parameter object is checked by
+    what takes it (the DMP's, the extension's own checks), a changed other key by reading the whole
+    file again; the original scenario is untouched."""
+    from bidmp.extension import RoadmapOptions
+    from bidmp.tasks.scenarios import ScenarioError, load
+
+    nuts = load("nut-unscrewing")
+    before = copy.deepcopy(nuts.spec)
+    paper = nuts.replace(extension={**nuts.extension, "approach": "paper", "n_iter": 4})
+    assert paper.extension_arguments["approach"] == "paper"
+    assert paper.extension_arguments["roadmap"] == RoadmapOptions(n_iter=4)
+    assert paper.spec["extension"]["n_iter"] == 4 and nuts.spec == before
+    robot = load("nut-unscrewing").replace(dmp={"protocol": "paper", "n_kernels": 30})
+    assert robot.protocol == "paper" and robot.with_robot_protocol().protocol == "robot"
+    assert robot.with_robot_protocol().dmp == {"protocol": "robot", "n_kernels": 30}
+    fewer = nuts.replace(targets={label: nuts.spec["targets"][label] for label in ("1", "3")})
+    assert fewer.labels == ["1", "3"] and len(nuts.labels) == 14
+    with pytest.raises(ScenarioError, match="extension.*n_iter must be >= 1"):
+        nuts.replace(extension={"n_iter": 0})
+    with pytest.raises(ScenarioError, match="dmp.*alpha"):
+        nuts.replace(dmp={"alpha": -1.0})
+    with pytest.raises(ScenarioError, match="colour.*unknown key"):
+        nuts.replace(colour="red")

@@ -127,16 +127,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     if args.approach is not None:
-        from ..tasks.scenarios import from_dict
-
-        spec = scenario.to_dict()
-        spec["extension"] = {**spec.get("extension", {}), "approach": args.approach}
-        scenario = from_dict(
-            spec,
-            source=args.scenario,
-            base_dir=scenario.base_dir,
-            allow_outside_files=args.allow_outside_files,
-        )
+        scenario = scenario.replace(extension={**scenario.extension, "approach": args.approach})
     methods = None
     if args.methods is not None:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]

@@ -249,21 +249,15 @@ def run_table4(progress: Callable | None = None) -> Table4:
     for name in TABLE4_SCENARIOS:
         if progress is not None:
             progress(name)
-        spec = scenarios.load(name).to_dict()
-        spec["extension"] = {
-            **spec.get("extension", {}),
-            "approach": "paper",
-        }  # the paper's protocol
-        reports[name] = evaluate(
-            scenarios.from_dict(spec, source=f"built-in {name} (approach paper)"), repair=False
-        )
+        scenario = scenarios.load(name)
+        # the paper's protocol: the nearest piece imitated down to the target
+        paper = scenario.replace(extension={**scenario.extension, "approach": "paper"})
+        reports[name] = evaluate(paper, repair=False)
         if name in TASK_SCENARIOS:
             keep[name] = evaluate(
                 scenarios.load(name), ["dmp", "bidmp"], repair=False
             )  # approach keep, as learned
-    spec = reports["cell-removal"].scenario.to_dict()
-    spec["extensions"] = spec["extensions"][:1]
-    before = evaluate(
-        scenarios.from_dict(spec, source="cell-removal (nut skill only)"), ["bidmp"], repair=False
-    )
+    cells = reports["cell-removal"].scenario
+    nut_skill_only = cells.replace(extensions=cells.spec["extensions"][:1])
+    before = evaluate(nut_skill_only, ["bidmp"], repair=False)
     return Table4(reports, before, keep)

@@ -52,6 +52,7 @@ are checked.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import json
 import os
 from dataclasses import dataclass, field
@@ -233,6 +234,23 @@ class Scenario:
         """The DMP protocol of the scenario's skills ("robot", the default, or "paper")."""
         return self.dmp.get("protocol", "robot")
 
+    def replace(self, **changes) -> Scenario:
+        """This scenario with keys of its file changed (``scenario.replace(extension={...})``),
+        checked as a file's are: the parameter objects (``dmp``, ``bidmp``, ``extension``) each by
+        what takes it, any other key by reading the whole changed file again; a
+        :class:`ScenarioError` names the first bad one. The scenario itself is unchanged."""
+        unknown = sorted(set(changes) - _KEYS)
+        if unknown:
+            _fail(self.name, unknown[0], f"unknown key (known: {', '.join(sorted(_KEYS))})")
+        spec = copy.deepcopy(self.spec)
+        spec.update(copy.deepcopy(changes))
+        if set(changes) <= {"dmp", "bidmp", "extension"}:
+            objects = _parameter_objects(spec, self.name)
+            if "dmp" in changes:
+                _check_runs(self.name, self.demonstration, self.targets, objects["dmp"])
+            return dataclasses.replace(self, spec=spec, **{key: objects[key] for key in changes})
+        return from_dict(spec, source=self.name, base_dir=self.base_dir, allow_outside_files=True)
+
     def with_robot_protocol(self) -> Scenario:
         """The scenario with its DMP on the robot protocol (its kernels and regression kept), or itself
         when it is on it. What a robot runs: the paper's protocol stops at a fixed horizon while still
@@ -240,12 +258,8 @@ class Scenario:
         demonstrated one off at 6 m/s."""
         if self.protocol == "robot":
             return self
-        spec = self.to_dict()
-        spec["dmp"] = {
-            "protocol": "robot",
-            **{k: v for k, v in spec["dmp"].items() if k in ("n_kernels", "regression")},
-        }
-        return from_dict(spec, source=self.name, base_dir=self.base_dir, allow_outside_files=True)
+        kept = {k: v for k, v in self.spec["dmp"].items() if k in ("n_kernels", "regression")}
+        return self.replace(dmp={"protocol": "robot", **kept})
 
     def reference(self, label: str) -> np.ndarray:
         """A reference demonstration to target ``label`` "produced by the same generator"
@@ -303,6 +317,24 @@ def _parameters(data, key, known, source, check) -> dict:
     return params
 
 
+def _parameter_objects(data: dict, source: str) -> dict:
+    """The parameter objects of a scenario file (``dmp``, ``bidmp``, ``extension``), each checked
+    by what takes it (a DMP's, a Bi-DMP's, an extension's own checks)."""
+    from ..extension import check_extension_options
+    from ..incremental.bidmp import BiDMP
+    from ..primitives.dmp import DMP
+
+    return {
+        "dmp": _parameters(data, "dmp", _DMP_KEYS, source, lambda p: DMP(**p)._params()),
+        "bidmp": _parameters(
+            data, "bidmp", _BIDMP_KEYS, source, lambda p: BiDMP(**p)._check_params()
+        ),
+        "extension": _parameters(
+            data, "extension", _EXTENSION_KEYS, source, lambda p: check_extension_options(**p)
+        ),
+    }
+
+
 def check_robot(robot: dict | None, base_dir=".") -> dict:
     """A scenario's ``"robot"`` object checked as a scenario file's is (``base``, ``yaw``, a built-in
     ``model``, or its own ``urdf`` with ``flange``, ``limits``, ``rest``, ``effort``), a relative
@@ -353,21 +385,8 @@ def from_dict(
         None if approach is None else _number(approach, source, "approach_height", positive=True)
     )
 
-    from ..extension import check_extension_options
-    from ..incremental.bidmp import BiDMP
-    from ..primitives.dmp import DMP
-
-    dmp = _parameters(data, "dmp", _DMP_KEYS, source, lambda params: DMP(**params)._params())
-    bidmp = _parameters(
-        data, "bidmp", _BIDMP_KEYS, source, lambda params: BiDMP(**params)._check_params()
-    )
-    extension = _parameters(
-        data,
-        "extension",
-        _EXTENSION_KEYS,
-        source,
-        lambda params: check_extension_options(**params),
-    )
+    objects = _parameter_objects(data, source)
+    dmp, bidmp, extension = objects["dmp"], objects["bidmp"], objects["extension"]
     extensions = _extensions(data, source, targets, n_dims)
     demonstrations = _further_demonstrations(
         data, source, base_dir, allow_outside_files, units, n_dims
