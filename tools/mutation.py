@@ -139,14 +139,21 @@ TARGETS = (
     Target(
         "similarity (Fréchet, normaliser)",
         "bidmp.extension.similarity",
-        ("_frechet_rows", "frechet_distance_reference", "polyline_length", "frechet_similarity"),
+        (
+            "_frechet_rows",
+            "frechet_distance_reference",
+            "polyline_length",
+            "_length",
+            "frechet_similarity",
+            "_frechet_similarity",
+        ),
         ("tests/test_oracles.py", "tests/extension/test_similarity.py"),
         pure_python=True,
     ),
     Target(
         "similarity template",
         "bidmp.extension.roadmap",
-        ("template", "_minimal_rotation"),
+        ("template", "_template", "_minimal_rotation"),
         ("tests/test_oracles.py", "tests/extension/test_roadmap.py"),
     ),
     Target(
@@ -154,11 +161,14 @@ TARGETS = (
         "bidmp.extension.segmentation",
         (
             "curvature",
+            "_curvature",
             "_alternating_extrema",
             "_prune_persistence",
             "_prune_paper",
             "segment",
+            "_segment",
             "choose_piece",
+            "_choose_piece",
         ),
         ("tests/test_oracles.py", "tests/extension/test_segmentation.py"),
     ),
@@ -177,8 +187,8 @@ TARGETS = (
     ),
     Target(
         "Bi-DMP skill selection",
-        "bidmp.incremental._skills",
-        ("SkillLibrary.select_skill",),
+        "bidmp.incremental.bidmp",
+        ("BiDMP.select_skill",),
         ("tests/test_oracles.py", "tests/incremental/test_incremental.py"),
     ),
     Target(
@@ -350,20 +360,20 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     "cells, which are infinite from the start, so it is infinite and never wins a minimum",
     (
         "bidmp.extension.roadmap",
-        "template",
+        "_template",
         "lam = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(piece, axis=0), axis=1))])",
         "0.0 -> 1.0",
     ): "changes the first sample's λ alone, and the first sample is set to seg afterwards",
     (
         "bidmp.extension.roadmap",
-        "template",
+        "_template",
         "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):",
         "<= -> <",
     ): "the threshold is at least 1e-12: the two differ only for a chord exactly that long",
     **{
         (
             "bidmp.extension.roadmap",
-            "template",
+            "_template",
             "if chord_length <= 1e-12 * max(np.abs(piece).max(), 1.0):",
             mutation,
         ): "a rounding-level threshold doubled (a closed piece's chord is 0 or rounding; an open one's is not "
@@ -372,13 +382,13 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     },
     (
         "bidmp.extension.roadmap",
-        "template",
+        "_template",
         "degenerate = (np.abs(chord) < _DEGENERATE_AXIS * chord_length) | ~(np.abs(factors) <= _MAX_AXIS_FACTOR)",
         "< -> <=",
     ): "differs only for an axis whose chord is exactly 1e-3 of the chord's length",
     (
         "bidmp.extension.roadmap",
-        "template",
+        "_template",
         "scaled = seg + np.where(degenerate, 0.0, factors) * (piece - seg)",
         "0.0 -> 1.0",
     ): "the degenerate axes' scaled values are replaced by their ramps on the next line",
@@ -410,7 +420,7 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     **{
         (
             "bidmp.extension.segmentation",
-            "curvature",
+            "_curvature",
             "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):",
             mutation,
         ): why
@@ -425,14 +435,14 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     },
     (
         "bidmp.extension.segmentation",
-        "curvature",
+        "_curvature",
         "if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):",
         "1e-12 -> 2e-12",
     ): "the rounding scale of a still curve doubled: a still curve's spread is exactly 0 or rounding-level",
     **{
         (
             "bidmp.extension.segmentation",
-            "curvature",
+            "_curvature",
             "floor = 1e-12 * max(float(np.max(speed)), np.finfo(float).tiny)",
             mutation,
         ): "the speed floor's scale: speeds where the curve does not advance are rounding-level (1e-16 of the "
@@ -441,14 +451,14 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     },
     (
         "bidmp.extension.segmentation",
-        "curvature",
+        "_curvature",
         "kappa[speed <= floor] = 0.0",
         "<= -> <",
     ): "differs only for a speed exactly at the floor",
     **{
         (
             "bidmp.extension.segmentation",
-            "curvature",
+            "_curvature",
             "if window > 3:",
             mutation,
         ): "the second window is at least 5 whenever this line is reached (a curve of fewer than 5 samples "
@@ -546,20 +556,20 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ): "a step of 0 passes only for one sample, whose gate is 1 whatever the step",
     (
         "bidmp.extension.segmentation",
-        "segment",
+        "_segment",
         "if np.max(interior) * total < 1e-06:",
         "< -> <=",
     ): "differs only for a curve whose κ·L is exactly 1e-6",
     (
         "bidmp.extension.segmentation",
-        "segment",
+        "_segment",
         "original = np.clip(np.searchsorted(s, positions), 1, n_samples - 1)",
         "- -> +",
     ): "the upper bound is never reached: a kept point lies within the path, so searchsorted gives at "
     "most n_samples - 1",
     (
         "bidmp.extension.segmentation",
-        "segment",
+        "_segment",
         "nearer_left = positions - s[original - 1] < s[original] - positions",
         "< -> <=",
     ): "differs only for a point exactly halfway in arc length between two samples",

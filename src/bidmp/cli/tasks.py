@@ -48,7 +48,7 @@ def _run_scenario(scenario, out, methods=None, view=False):
     return report
 
 
-def _run_sim(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to simulate
     scenario,
     out,
     methods,

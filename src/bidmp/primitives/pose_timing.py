@@ -101,7 +101,7 @@ def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.n
     return omega, omega_dot
 
 
-def _pose_trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def _pose_trajectory(  # noqa: PLR0913 - two parts and CartesianDMP.trajectory's arguments
     position_model,
     orientation_model,
     goal_p,

@@ -213,7 +213,7 @@ def _check_end(
         )
 
 
-def _via_trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def _via_trajectory(  # noqa: PLR0913 - DMP.trajectory's own arguments, passed on whole
     dmp,
     goal,
     start,

@@ -68,7 +68,7 @@ class _StepFailed(Exception):
 # ---------------------------------------------------------------------------------------------
 # Motions
 # ---------------------------------------------------------------------------------------------
-def _move(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judges it by
     world: _World,
     path,
     fractions,

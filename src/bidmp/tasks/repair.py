@@ -352,7 +352,7 @@ class Repairer:
         """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP)."""
         return hasattr(model, "weights_") and hasattr(model, "n_steps_")
 
-    def _try(  # noqa: PLR0913 - the public call spells its options out, as users pass them
+    def _try(  # noqa: PLR0913 - the query of Repairer.repair, passed on whole to each repair
         self,
         how,
         model,
