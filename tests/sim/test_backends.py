@@ -163,3 +163,32 @@ def test_the_simulator_and_the_job_run_without_pybullet(tmp_path):
     # the plain DMP misses the far nut 12 on this arm as on the PyBullet one (its rollout's miss)
     assert sim["methods"]["dmp"]["targets"]["12"]["task_success"] is False
     assert [target["removed"] for target in job["targets"]] == [True, True]
+
+
+def test_the_closed_loop_on_the_ideal_arm_sends_commands_within_the_limits_along_the_skill(nuts):
+    """Closed loop on the kinematic arm: the commands come from the same generator as the PyBullet
+    arm's (cubic between the 100 Hz targets, jerk-limited), so the contract finds them within the
+    limits (plain linear steps between targets broke the jerk limit 7-11×: this test's first
+    catch); nothing holds the arm, so the motion never pauses and traces the learned rollout (the
+    evaluation's, on the robot protocol the closed loop runs) within the limiter's lag."""
+    from scipy.spatial import cKDTree
+
+    robot = nuts.with_robot_protocol()
+    report = tasks.evaluate(robot, ["bidmp"], geometry=False)
+    result = simulate(
+        robot,
+        ["bidmp"],
+        targets=["1", "12"],
+        closed_loop=True,
+        backend="kinematic",
+        report=report,
+        record=True,
+        workers=1,
+    )
+    method = result.methods["bidmp"]
+    for label, measured in method.targets.items():
+        assert measured.task_success(method.threshold), (label, measured.reason)
+        assert measured.within_limits and measured.paused == 0.0
+        rollout = np.asarray(report.methods["bidmp"].rollouts[label])
+        off, _ = cKDTree(rollout).query(measured.path)
+        assert off.max() < 3.0, (label, off.max())

@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from .._checks import as_labels, as_point, check_int, check_real
 from .backend import (
     CONTROL_STEP,
+    LIMIT_MARGIN,
     RECORD_EVERY,
     SETTLE,
     SIM_STEP,
@@ -40,6 +41,7 @@ from .backend import (
     _picture_args,
     _solid_height,
 )
+from .limits import _hermite, _joint_velocity, _RateLimiter
 from .robots import MAX_SAMPLE_SPACING, _unit_of
 
 __all__ = ["KinematicCell", "KINEMATIC_LIMITS"]
@@ -210,10 +212,12 @@ class KinematicCell:
         max_factor: float = 4.0,
         goal_update: GoalUpdate | None = None,
     ) -> Execution:
-        """Run ``stepper`` (scene units) at 100 Hz on the tool's mouth, which is where it was sent:
-        the joints move linearly between control steps (1 kHz commands); the run ends when the
-        stepper's time reaches its horizon (at most ``max_factor`` times ``duration``), then the
-        settling."""
+        """Run ``stepper`` (scene units) at 100 Hz on the tool's mouth, which is where the last
+        command put it. The commands are the PyBullet arm's: every 1 ms the cubic between the
+        last two 100 Hz targets through the jerk-limited rate limiter
+        (:class:`bidmp.sim.limits._RateLimiter`), so they are within the limits; the arm follows
+        them exactly. The run ends when the stepper's time reaches its horizon (at most
+        ``max_factor`` times ``duration``), then the settling."""
         frames = check_int(frames, "frames", minimum=0, maximum=1000)
         exclude = as_labels(exclude, "exclude")
         _refuse_hold(hold)
@@ -222,27 +226,42 @@ class KinematicCell:
             raise SimError(f"the start {np.round(stepper.y, 2).tolist()} is out of the arm's reach")
         every = int(round(CONTROL_STEP / SIM_STEP))
         complete = float(getattr(stepper, "horizon", duration))
-        longest = max_factor * max(duration, complete)
-        sent, times, targets, clock = [q], [], [], []
-        updated = False
-        t = 0.0
-        while t < longest and stepper.time < complete:
-            if goal_update is not None and not updated and stepper.time >= goal_update.time:
-                stepper.set_goal(stepper.target + np.asarray(goal_update.offset))
-                updated = True
-            y, _, _ = stepper.step(CONTROL_STEP, self.fk(sent[-1]) / self.unit)
-            target, _ = self.solve_ik(np.asarray(y) * self.unit, sent[-1])
-            times.append(t)
-            targets.append(target)
-            clock.append(stepper.time)
-            start = sent[-1]
-            sent.extend(start + (target - start) * (k + 1) / every for k in range(every))
-            t += CONTROL_STEP
-        sent.extend([sent[-1]] * int(round(SETTLE / SIM_STEP)))
-        commands = np.array(sent[1:])
-        velocities = np.gradient(commands, SIM_STEP, axis=0)
-        n_steps = commands.shape[0]
-        rows = np.unique(np.r_[np.arange(0, n_steps, RECORD_EVERY), n_steps - 1])
+        n_steps = int(math.ceil((max_factor * max(duration, complete) + SETTLE) / SIM_STEP))
+        limited = _RateLimiter(q, self.limits, LIMIT_MARGIN)
+        target = previous = q
+        target_rate = previous_rate = np.zeros_like(q)
+        sent, rates, times, targets, clock = [], [], [], [], []
+        settle_from, updated = None, False
+        for step in range(n_steps):
+            if step % every == 0:
+                previous, previous_rate = target, target_rate
+                if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
+                    break
+                if settle_from is None:
+                    if goal_update is not None and not updated and stepper.time >= goal_update.time:
+                        stepper.set_goal(stepper.target + np.asarray(goal_update.offset))
+                        updated = True
+                    # the arm is where it was sent: the stepper's own position is what it measures
+                    y, yd, _ = stepper.step(CONTROL_STEP, stepper.position)
+                    point = np.asarray(y) * self.unit
+                    target, _ = self.solve_ik(point, target)
+                    target_rate = _joint_velocity(self, target, point, np.asarray(yd) * self.unit)
+                else:
+                    target_rate = np.zeros_like(target)
+                times.append(step * SIM_STEP)
+                targets.append(target)
+                clock.append(stepper.time)
+                if settle_from is None and stepper.time >= complete:
+                    settle_from = step
+            share = (step % every + 1) / every
+            sent.append(
+                limited(
+                    *_hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP)
+                )
+            )
+            rates.append(limited.velocity.copy())
+        commands, velocities = np.array(sent), np.array(rates)
+        rows = np.unique(np.r_[np.arange(0, len(sent), RECORD_EVERY), len(sent) - 1])
         self._q = commands[-1]
         run = self._execution(
             (rows + 1) * SIM_STEP, commands[rows], velocities[rows], exclude, frames

@@ -119,3 +119,37 @@ class _RateLimiter:
         self.velocity = self.velocity + self.acceleration * self.dt
         self.position = self.position + self.velocity * self.dt
         return self.position.copy()
+
+
+# -- the closed loop's commands between its 100 Hz targets (any backend) --------------------
+def _hermite(
+    q0, v0, q1, v1, share: float, duration: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Position, velocity and acceleration at ``share`` (0-1) of the cubic from ``(q0, v0)`` to
+    ``(q1, v1)`` over ``duration`` seconds (velocities per second)."""
+    s, h = share, duration
+    position = (
+        (2 * s**3 - 3 * s**2 + 1) * q0
+        + (s**3 - 2 * s**2 + s) * h * v0
+        + (3 * s**2 - 2 * s**3) * q1
+        + (s**3 - s**2) * h * v1
+    )
+    velocity = (
+        (6 * s**2 - 6 * s) * (q0 - q1) / h + (3 * s**2 - 4 * s + 1) * v0 + (3 * s**2 - 2 * s) * v1
+    )
+    acceleration = ((12 * s - 6) * (q0 - q1) / h + (6 * s - 4) * v0 + (6 * s - 2) * v1) / h
+    return position, velocity, acceleration
+
+
+_AHEAD = 2e-3  # s: the joint velocity is the IK's own, by a step of the command's velocity this far ahead
+
+
+def _joint_velocity(cell, q: np.ndarray, point_m: np.ndarray, velocity_m: np.ndarray) -> np.ndarray:
+    """The joint velocities (rad/s) with which the IK's own solutions follow the tool's mouth moving
+    at ``velocity_m`` (m/s) from ``point_m`` (m), where it is at joints ``q``: the IK solved
+    :data:`_AHEAD` further along, from ``q`` (a redundant arm's least-norm Jacobian velocity takes
+    another null-space path than its IK does, and the segments between the IK's targets then bend)."""
+    if not np.any(velocity_m):
+        return np.zeros_like(q)
+    ahead, _ = cell.solve_ik(point_m + velocity_m * _AHEAD, q)
+    return (ahead - q) / _AHEAD
