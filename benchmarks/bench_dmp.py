@@ -18,7 +18,7 @@ import sys
 import warnings
 
 import numpy as np
-from _timing import median_time
+from _timing import interleaved_times, median_time
 
 from bidmp import DMP
 
@@ -85,6 +85,31 @@ def bench_fit_rollout(n_dims: int, repeats: int) -> dict:
     return results
 
 
+def bench_robot_protocol(rounds: int) -> dict:
+    """The defaults a user meets: ``DMP().fit(y, t).trajectory()`` (the robot protocol: 100
+    kernels, the exact integrator, the progress gate, rest at both ends, positions, velocities
+    and accelerations in seconds) beside movement_primitives' fit + open-loop rollout with each
+    Cython step function, T = 1000, D = 3, the sides interleaved."""
+    y = demonstration(3)
+    t = np.arange(N_STEPS) / N_STEPS
+    sides = {"bidmp DMP().fit(y, t).trajectory()": lambda: DMP().fit(y, t).trajectory()}
+    try:
+        from movement_primitives.dmp import DMP as MPDMP
+    except ImportError:  # pragma: no cover - optional peer
+        print("movement_primitives not installed: skipped", file=sys.stderr)
+    else:
+        for step in ("euler-cython", "rk4-cython"):
+
+            def peer(step=step):
+                dmp = MPDMP(n_dims=3, execution_time=t[-1], dt=1 / N_STEPS, n_weights_per_dim=100)
+                dmp.imitate(t, y)
+                dmp.configure(start_y=y[0], goal_y=y[-1])
+                return dmp.open_loop(step_function=step)
+
+            sides[f"movement_primitives fit+open_loop ({step})"] = peer
+    return interleaved_times(sides, rounds)
+
+
 def bench_many_goals(n_goals: int, repeats: int) -> dict:
     y = demonstration(3)
     dmp = DMP(protocol="paper", n_kernels=N_KERNELS).fit(y)
@@ -121,6 +146,15 @@ def main() -> int:
                 else f"   bidmp fit+rollout is {seconds / ours:7.1f}x faster"
             )
             print(f"    {name:48s} {seconds * 1e3:9.3f} ms{ratio}")
+
+    results = bench_robot_protocol(args.repeats)
+    ours = results["bidmp DMP().fit(y, t).trajectory()"]
+    print(
+        f"\nthe robot protocol (defaults), T = {N_STEPS}, D = 3, interleaved ({args.repeats} rounds)"
+    )
+    for name, seconds in results.items():
+        ratio = "" if name.startswith("bidmp") else f"   bidmp is {seconds / ours:7.1f}x faster"
+        print(f"    {name:48s} {seconds * 1e3:9.3f} ms{ratio}")
 
     results = bench_many_goals(args.goals, max(3, args.repeats // 4))
     print(f"\nrollouts to {args.goals} goals, T = {N_STEPS}, D = 3")

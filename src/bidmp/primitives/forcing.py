@@ -248,11 +248,15 @@ def _learn_weights(
 
     Returns
     -------
-    (weights (N, D), centres (N,), widths (N,), phase (n,), basis rows (n, N))
+    (weights (N, D), centres (N,), widths (N,), phase (n + 1,), basis rows (n + 1, N)): the grid
+    one sample past the training grid
     """
     n_train = train.shape[0]
     canonical, basis = params.canonical_system, params.basis
-    phase = canonical.grid(n_train, dt, 1.0)
+    # One sample past the training grid: a timed trajectory's rollout asks for it (the state's
+    # derivatives at the last sample), and then shares the grid cached from here.
+    grid_phase = canonical.grid(n_train + 1, dt, 1.0)
+    phase = grid_phase[:n_train]
     centres, widths = basis.place(canonical, n_train, dt)
     target = _forcing_target(
         train,
@@ -265,9 +269,10 @@ def _learn_weights(
         derivatives=params.derivatives,
         gate=gate,
     )
-    phi = basis.rows(phase, centres, widths)
+    grid_phi = basis.rows(grid_phase, centres, widths)
+    phi = grid_phi[:n_train]
     weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
-    return np.ascontiguousarray(weights), centres, widths, phase, phi
+    return np.ascontiguousarray(weights), centres, widths, grid_phase, grid_phi
 
 
 def _check_forcing_increment(forcing_increment, name: str = "forcing_increment") -> None:

@@ -15,10 +15,9 @@ from .integrate import _unit_responses
 __all__ = []
 
 
-def _grid_key(params, n_steps: int, step: float) -> tuple:
-    """Everything a rollout grid depends on besides the learned kernels."""
+def _grid_key(params, step: float) -> tuple:
+    """Everything a rollout grid depends on besides its length and the learned kernels."""
     return (
-        n_steps,
         params.tau,
         params.alpha,
         params.beta,
@@ -36,29 +35,51 @@ def _store_grid(model, params, phase: np.ndarray, basis: np.ndarray, step: float
     """Cache the grid (phase, basis rows, unit responses, goal gate) on ``model``; return the entry."""
     gate = model.goal_system(params).on_grid(phase, step, params.tau, params.exact)
     cached = (
-        _grid_key(params, phase.shape[0], step),
+        _grid_key(params, step),
         model.centres_,
         model.widths_,
         phase,
         basis,
         _unit_responses(params, phase, None, step, gate),
         gate,
+        {},  # shorter grids served from this one: n -> their entry (the same objects every time)
     )
     model._grid_cache = cached
     return cached
 
 
 def _cached_grid(model, params, n_steps: int, step: float) -> tuple | None:
-    """The cached entry for this grid, or None (another grid, or the kernels changed)."""
+    """The cached entry for this grid, or None (another grid, or the kernels changed).
+
+    A grid of fewer samples is the cached one's first ``n_steps`` (the phase, the basis rows, the
+    gate and the responses of the causal integration all are), so the rollout a timed trajectory
+    asks for (one sample past the horizon, for the state's derivatives) and the plain rollout
+    share the grid ``fit`` computed."""
     cached = model.__dict__.get("_grid_cache")
     if (
         cached is None
-        or cached[0] != _grid_key(params, n_steps, step)
+        or cached[0] != _grid_key(params, step)
         or cached[1] is not model.centres_
         or cached[2] is not model.widths_
+        or cached[3].shape[0] < n_steps
     ):
         return None
-    return cached
+    if cached[3].shape[0] == n_steps:
+        return cached
+    prefixes = cached[7]
+    if n_steps not in prefixes:
+        key, centres, widths, phase, basis, responses, gate, _ = cached
+        prefixes[n_steps] = (
+            key,
+            centres,
+            widths,
+            phase[:n_steps],
+            basis[:n_steps],
+            responses[:, :n_steps],
+            gate[:n_steps],
+            {},
+        )
+    return prefixes[n_steps]
 
 
 def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, ...]:
@@ -76,4 +97,4 @@ def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tup
         phase = params.canonical_system.grid(n_steps, step, params.tau)
         basis = params.basis.rows(phase, model.centres_, model.widths_)
         cached = _store_grid(model, params, phase, basis, step)
-    return cached[3:]
+    return cached[3:7]
