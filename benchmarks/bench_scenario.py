@@ -32,7 +32,7 @@ def main() -> int:
     args = parser.parse_args()
     scenario = scenarios.load("nut-unscrewing")
     spec = scenario.to_dict()
-    del spec["scene"]
+    del spec["scene"], spec["job"]  # the job runs in the simulator, which needs the scene
     blind = scenarios.from_dict(spec, source="nut-unscrewing without its scene")
     whole = median_time(lambda: evaluate(scenario, ["dmp", "bidmp"]), args.repeats)
     without = median_time(lambda: evaluate(blind, ["dmp", "bidmp"]), args.repeats)
