@@ -38,6 +38,8 @@ def _commands(scratch: Path) -> dict[str, list[str]]:
         "bidmp --help": [python, "-m", "bidmp", "--help"],
         "import bidmp": [python, "-c", "import bidmp"],
         "import bidmp; bidmp.DMP": [python, "-c", "import bidmp; bidmp.DMP"],
+        # the peer's, interleaved with ours (the target: bidmp.DMP no slower to import)
+        "import movement_primitives.dmp": [python, "-c", "import movement_primitives.dmp"],
         "bidmp fit (a 7 s recording)": [
             python,
             "-m",

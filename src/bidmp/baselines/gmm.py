@@ -11,9 +11,8 @@ import logging
 import warnings
 
 import numpy as np
-from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams
+from .._api import Estimator
 from .._checks import (
     as_trajectory,
     check_bool,
@@ -144,7 +143,7 @@ def _max_abs() -> float:
     return get_limits().max_abs_value
 
 
-class _AugmentedMixture(CheckedParams, BaseEstimator):
+class _AugmentedMixture(Estimator):
     """Parameters shared by the baselines: mixture size, regularisation, augmentation, seed.
 
     scikit-learn conventions: the constructor stores, ``fit`` validates (:meth:`_check_params`).

@@ -24,9 +24,8 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-from sklearn.base import BaseEstimator, clone
 
-from .._api import CheckedParams
+from .._api import Estimator, clone
 from .._checks import (
     NotFittedError,
     _as_float_array,
@@ -77,7 +76,7 @@ def _time_scale(duration, dmp: DMP) -> float:
     return float(scale)
 
 
-class BiDMP(CheckedParams, BaseEstimator):
+class BiDMP(Estimator):
     """A DMP with incrementally learned forcing-term blocks and a skill library.
 
     A scikit-learn style estimator: ``BiDMP(dmp)`` only stores its parameters (``get_params``

@@ -28,9 +28,8 @@ import logging
 from typing import NamedTuple
 
 import numpy as np
-from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams
+from .._api import Estimator
 from .._checks import (
     _as_bounded_array,
     _check_finite,
@@ -159,7 +158,7 @@ def _check_targets(Y, n_rows: int) -> tuple[np.ndarray, bool]:
     return Y, was_1d
 
 
-class BLS(CheckedParams, BaseEstimator):
+class BLS(Estimator):
     """Broad Learning System regressor with incremental enhancement nodes.
 
     A scikit-learn style estimator: the constructor only stores its parameters; ``fit``

@@ -7,9 +7,8 @@ Layer 1 (the math): imports ``bidmp.primitives`` and ``bidmp.incremental.bidmp``
 from __future__ import annotations
 
 import numpy as np
-from sklearn.base import BaseEstimator, clone
 
-from .._api import CheckedParams
+from .._api import Estimator, clone
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
 from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
 from ..primitives.pose_timing import PoseStepper, PoseTrajectory
@@ -66,7 +65,7 @@ _BIDMP_PARAMS = (
 )
 
 
-class CartesianBiDMP(PoseModel, CheckedParams, BaseEstimator):
+class CartesianBiDMP(PoseModel, Estimator):
     """Bi-DMP on poses: the increment is learned on both forcing terms, position and orientation.
 
     A scikit-learn style estimator like :class:`bidmp.BiDMP`: ``CartesianBiDMP(cartesian)``

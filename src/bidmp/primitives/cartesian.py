@@ -28,9 +28,8 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams
+from .._api import Estimator
 from .._checks import (
     as_point,
     as_trajectory,
@@ -243,7 +242,7 @@ class PoseModel:
             self.start_log_ = check_loaded(arrays["start_log_"], "start_log_", (3,))
 
 
-class CartesianDMP(PoseModel, CheckedParams, BaseEstimator):
+class CartesianDMP(PoseModel, Estimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
     Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``

@@ -44,9 +44,8 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from sklearn.base import BaseEstimator
 
-from .._api import CheckedParams
+from .._api import Estimator
 from .._checks import (
     as_point,
     as_trajectory,
@@ -86,7 +85,7 @@ __all__ = ["DMP", "PROTOCOLS"]
 logger = logging.getLogger(__name__)
 
 
-class DMP(_FittedParams, CheckedParams, BaseEstimator):
+class DMP(_FittedParams, Estimator):
     """Discrete DMP learned from one demonstration, in real time.
 
     A scikit-learn style estimator: the constructor only stores its parameters, ``fit`` validates

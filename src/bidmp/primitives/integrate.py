@@ -27,8 +27,6 @@ import cmath
 from functools import lru_cache
 
 import numpy as np
-from scipy.linalg import expm
-from scipy.signal import lfilter
 
 from .._checks import as_vector, check_bool, check_real
 from .canonical import _phase_decay
@@ -92,6 +90,10 @@ def _second_order(
     out[:, 1] = y_second
     if drives.shape[1] == 0:
         return out
+    # SciPy's signal package (and the statistics it imports) at first use, not at ``import bidmp``:
+    # 0.4 s of start-up that a model file loaded only to be inspected never needs.
+    from scipy.signal import lfilter
+
     # Initial state of lfilter's transposed direct form II for past outputs y[1], y[0].
     zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
     out[:, 2:], _ = lfilter(numerator, [1.0, a1, a2], drives, axis=1, zi=zi)
@@ -149,6 +151,8 @@ def _foh_step(
     augmented[1, 1] = -alpha * step / tau
     augmented[1, 2] = step / tau
     augmented[2, 3] = 1.0
+    from scipy.linalg import expm  # at first use, as lfilter
+
     exponential = expm(augmented)
     transition = exponential[:2, :2]
     hold, ramp = exponential[:2, 2], exponential[:2, 3]
