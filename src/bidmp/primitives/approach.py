@@ -69,14 +69,17 @@ def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNES
     for first in range(0, candidates.shape[0], block):
         chunk = candidates[first : first + block]
         chunk = chunk[_tails_straight(y, chunk, straightness, stride=_COARSE)]
-        straight = np.flatnonzero(_tails_straight(y, chunk, straightness))
-        if straight.size:
-            return int(chunk[straight[0]])
+        for part in range(0, chunk.shape[0], _FULL_BATCH):  # in order: the first that holds wins
+            batch = chunk[part : part + _FULL_BATCH]
+            straight = np.flatnonzero(_tails_straight(y, batch, straightness))
+            if straight.size:
+                return int(batch[straight[0]])
     return last
 
 
 _BLOCK_ELEMENTS = 1 << 20  # floats of one block of candidate tails tested together (8 MB)
 _COARSE = 8  # every how many samples the cheap first test looks at
+_FULL_BATCH = 16  # the candidates that pass it, taken the whole test this many at a time
 
 
 def _tails_straight(
