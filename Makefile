@@ -12,7 +12,7 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench install clean readme fuzz mutation sim lasa random-cells avoidance view-check
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
 $(STAMP): pyproject.toml constraints.txt
@@ -92,6 +92,25 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_job.py
 	$(PY) benchmarks/bench_repair.py
 	$(PY) benchmarks/bench_startup.py
+
+# Every benchmark script once, quickly (one repetition, few fields, one LASA shape, the smoke
+# modes): a CI stage, so that none breaks silently between full runs of make bench. Its timings
+# are not the benchmarks' numbers.
+bench-smoke: $(STAMP)
+	cd benchmarks && ../$(PY) bench_dmp.py --repeats 1 --goals 50 > /dev/null
+	cd benchmarks && ../$(PY) bench_extension.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_incremental.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_scenario.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bidmp_convergence.py > /dev/null
+	cd benchmarks && ../$(PY) bench_timing.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_sim.py > /dev/null
+	cd benchmarks && ../$(PY) bench_cartesian.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_lasa.py --every 20 --rounds 1 --shapes 1 --out ../.bench-smoke > /dev/null
+	cd benchmarks && ../$(PY) bench_avoidance.py --fields 2 --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_job.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_repair.py --smoke > /dev/null
+	cd benchmarks && ../$(PY) bench_startup.py --smoke > /dev/null
+	rm -rf .bench-smoke
 
 # The 3-D viewer of a simulation run rendered in headless Chromium (Debian's package chromium:
 # apt install chromium), offline, and its screenshot checked not to be blank (tools/view_check.py).

@@ -73,6 +73,12 @@ def bench_bls(n_nodes: int, repeats: int, n_enhance: int = 300) -> None:
 
 
 def bench_block_pinv(n_nodes: int, repeats: int) -> None:
+    # A BLS's feature matrix is 2000 x 400 here, past the default limit on a trajectory's
+    # dimensions (256) that block_pinv_update checks A and its pseudo-inverse (400 x 2000) against:
+    # raised for this run.
+    from bidmp import get_limits, set_limits
+
+    set_limits(max_dims=max(get_limits().max_dims, 4096))
     rng = np.random.default_rng(0)
     A = rng.normal(size=(2000, 400))
     A_pinv = np.linalg.pinv(A, rcond=PINV_RCOND)
