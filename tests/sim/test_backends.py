@@ -192,3 +192,31 @@ def test_the_closed_loop_on_the_ideal_arm_sends_commands_within_the_limits_along
         rollout = np.asarray(report.methods["bidmp"].rollouts[label])
         off, _ = cKDTree(rollout).query(measured.path)
         assert off.max() < 3.0, (label, off.max())
+
+
+def test_the_commands_real_time_factor_is_the_whole_commands(tmp_path, capsys):
+    """``bidmp sim`` and ``bidmp job`` end with the whole command's wall time (reading, learning,
+    simulating, writing) against the simulated time — not the simulation's alone, which the
+    summary above it states (and which is shorter)."""
+    import re
+
+    from bidmp.cli import main
+
+    for argv in (
+        ["sim", "--targets", "1", "--methods", "bidmp"],
+        ["job", "--targets", "1"],
+    ):
+        code = main([*argv, "--backend", "kinematic", "--no-pictures", "--out", str(tmp_path)])
+        out = capsys.readouterr().out
+        assert code == 0, out[-1000:]
+        whole = re.search(
+            r"the whole command: ([\d.]+) s for ([\d.]+) s simulated \(([\d.]+)x", out
+        )
+        alone = re.search(r"simulated ([\d.]+) s in ([\d.]+) s wall time", out)
+        assert whole and alone, out[-1000:]
+        elapsed, simulated, factor = (float(v) for v in whole.groups())
+        assert simulated == float(alone.group(1))
+        assert elapsed >= float(alone.group(2))  # the simulation is part of the command
+        # the printed times are rounded to 0.1 s, the factor to 0.1
+        low = (simulated - 0.05) / (elapsed + 0.05) - 0.05
+        assert low <= factor <= (simulated + 0.05) / max(elapsed - 0.05, 1e-3) + 0.05

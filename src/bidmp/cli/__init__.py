@@ -144,6 +144,9 @@ def main(argv: _Sequence[str] | None = None) -> int:
     """
     import warnings
 
+    from .common import command_started
+
+    command_started()
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

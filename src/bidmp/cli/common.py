@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import time
 
 __all__ = [
     "EXIT_OK",
@@ -136,3 +137,23 @@ def progress_bars():
     finally:
         for bar in bars.values():
             bar.close()
+
+
+_STARTED: list[float] = []  # when main() began handling the command (perf_counter seconds)
+
+
+def command_started() -> None:
+    """Note the command's start (main() calls it first), for :func:`print_real_time`."""
+    _STARTED[:] = [time.perf_counter()]
+
+
+def print_real_time(simulated_s: float) -> None:
+    """One line: the whole command's wall time (reading, learning, simulating, writing; from
+    main's start, the interpreter's own start-up of ~0.05 s aside) against the simulated time."""
+    if not _STARTED or simulated_s <= 0.0:
+        return
+    elapsed = time.perf_counter() - _STARTED[0]
+    print(
+        f"the whole command: {elapsed:.1f} s for {simulated_s:.1f} s simulated "
+        f"({simulated_s / elapsed:.1f}x real time)"
+    )

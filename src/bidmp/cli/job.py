@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .common import EXIT_OK, EXIT_TARGETS_FAILED, allow_outside_files, backend_option
+from .common import (
+    EXIT_OK,
+    EXIT_TARGETS_FAILED,
+    allow_outside_files,
+    backend_option,
+    print_real_time,
+)
 
 
 def run_job_command(
@@ -54,6 +60,7 @@ def run_job_command(
             out, report=report.evaluation, sim_result=report, extra_solids=extra
         )
     print(f"\nwrote {', '.join(str(path) for path in written)}")
+    print_real_time(report.simulated_s)
     return EXIT_OK if report.removed == len(report.targets) else EXIT_TARGETS_FAILED
 
 

@@ -13,6 +13,7 @@ from .common import (
     allow_outside_files,
     backend_option,
     judged_methods,
+    print_real_time,
     progress_bars,
 )
 
@@ -112,6 +113,7 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
 
         written += write_view_files(out, report=report, sim_result=result)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
+    print_real_time(result.simulated_s)
     return result
 
 
