@@ -151,22 +151,7 @@ class PoseModel:
     def _timed(position, orientation, goal_p, start_p, goal_q, start_e, **options):
         """The two parts timed together (:class:`PoseTrajectory`); ``options``: duration, dt,
         limits, position_increment, orientation_increment, units, coupling, vias."""
-        return _pose_trajectory(
-            position,
-            orientation,
-            goal_p,
-            start_p,
-            goal_q,
-            start_e,
-            options["duration"],
-            options["dt"],
-            options["limits"],
-            options["position_increment"],
-            options["orientation_increment"],
-            options["units"],
-            options["coupling"],
-            options["vias"],
-        )
+        return _pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e, **options)
 
     @staticmethod
     def _via_errors(

@@ -20,6 +20,7 @@ A target whose step fails is a row of the report with its reason; the job goes o
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -427,14 +428,8 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
     from ..tasks.repair import Repairer
     from .run import TRACKING_ALLOWANCE_MM
 
-    contract = Contract(
-        scenario.success_threshold,
-        scenario.approach_height,
-        scene,
-        scenario.units,
-        scenario.alignment_threshold if scenario.is_pose else None,
-        cell.limits,
-    )
+    # the scenario's contract, on the job's scene (its parts, the bin, the rack)
+    contract = dataclasses.replace(Contract.of(scenario, cell.limits), scene=scene)
     repairer = transfers = None
     allowance = mm(TRACKING_ALLOWANCE_MM, scenario.units)
     if not scenario.is_pose:

@@ -6,6 +6,7 @@ is repaired (lifted over a part, steered round it) or the step fails, saying why
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -142,7 +143,7 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
 
 def _transfer_contract(contract: Contract) -> Contract:
     """The contract of a move that is not an approach: no final descent to judge."""
-    return Contract(contract.threshold, None, contract.scene, contract.units, None, contract.limits)
+    return dataclasses.replace(contract, approach_height=None, alignment_threshold=None)
 
 
 def _clearance(world: _World, path, exclude, carried, orientations=None, support=()):
