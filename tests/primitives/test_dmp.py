@@ -505,3 +505,30 @@ def test_failed_fit_leaves_the_model_as_it_was(demo2d):
         dmp.fit(demo2d)
     dmp.alpha = 25.0
     np.testing.assert_array_equal(dmp.rollout(), before)
+
+
+def test_ridge_weights_equal_an_augmented_least_squares_on_a_shared_grid():
+    """Two recordings of one length share the cached grid and regression factor (read-only);
+    each one's weights still equal an independent ridge solution: ``lstsq`` of ``Φ w = f``
+    stacked on ``√λ w = 0`` (λ relative to the mean diagonal of ΦᵀΦ), on the model's own grid."""
+    from bidmp.primitives.forcing import _cached_design
+
+    rng = np.random.default_rng(17)
+    t = np.arange(700) * 0.004  # uniform: training_trajectory resamples by index
+    for case in range(2):
+        y = np.cumsum(rng.normal(size=(700, 3)), axis=0) * (5.0 + case)
+        hits = _cached_design.cache_info().hits
+        dmp = DMP(regression="ridge", ridge=1e-6).fit(y, t)
+        if case:  # the second fit on the same grid reused the first one's factor (structure)
+            assert _cached_design.cache_info().hits == hits + 1
+        _, phi = dmp.training_grid()
+        target = dmp.forcing_target(dmp.training_trajectory(y))
+        reg = 1e-6 * np.trace(phi.T @ phi) / phi.shape[1]
+        stacked = np.vstack([phi, np.sqrt(reg) * np.eye(phi.shape[1])])
+        padded = np.vstack([target, np.zeros((phi.shape[1], 3))])
+        expected = np.linalg.lstsq(stacked, padded, rcond=None)[0]
+        np.testing.assert_allclose(
+            phi @ dmp.weights_, phi @ expected, atol=1e-9 * np.abs(phi @ expected).max()
+        )
+    with pytest.raises(ValueError, match="read-only"):
+        dmp.centres_[0] = 0.5  # shared with every model on this grid: not writable

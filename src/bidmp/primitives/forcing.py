@@ -15,6 +15,7 @@ Vectorised over samples and dimensions; layer 1, imports only the canonical syst
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -220,20 +221,63 @@ def _regress(
     """Forcing-term weights (N, D) from basis rows ``phi`` (L, N) at ``phase`` (L,) and the forcing
     target (L, D): LWR per kernel (``regression="lwr"``) or ridge least squares (``"ridge"``, the
     regulariser ``ridge`` relative to the mean diagonal of ``ΦᵀΦ``)."""
-    n_kernels = phi.shape[1]
+    return _solve_weights(_regression_factor(phi, phase, regression, ridge), phi, target)
+
+
+def _regression_factor(
+    phi: np.ndarray, phase: np.ndarray, regression: str, ridge: float
+) -> tuple[str, np.ndarray]:
+    """What the regression needs of the basis alone (no target): LWR's per-kernel denominators
+    ``Σ_l phase_l² ψ̄_il`` (N,), or ridge's regularised ``ΦᵀΦ + λ I`` (N, N)."""
     if regression == "lwr":
         # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
-        denominator = phi.T @ phase
-        weights = (phi.T @ target) / np.maximum(denominator, np.finfo(float).tiny)[:, None]
+        return "lwr", np.maximum(phi.T @ phase, np.finfo(float).tiny)
+    n_kernels = phi.shape[1]
+    gram = phi.T @ phi
+    reg = ridge * max(np.trace(gram) / n_kernels, np.finfo(float).tiny)
+    return "ridge", gram + reg * np.eye(n_kernels)
+
+
+def _solve_weights(
+    factor: tuple[str, np.ndarray], phi: np.ndarray, target: np.ndarray
+) -> np.ndarray:
+    """The weights (N, D) for a forcing target (L, D) from :func:`_regression_factor`."""
+    kind, values = factor
+    if kind == "lwr":
+        weights = (phi.T @ target) / values[:, None]
     else:
-        gram = phi.T @ phi
-        reg = ridge * max(np.trace(gram) / n_kernels, np.finfo(float).tiny)
-        weights = np.linalg.solve(gram + reg * np.eye(n_kernels), phi.T @ target)
+        # LU rather than a cached Cholesky factor: the same numbers as before to the last bit
+        # (a simulated contact amplifies a last-bit change of the weights into the results).
+        weights = np.linalg.solve(values, phi.T @ target)
     if not np.all(np.isfinite(weights)):
         raise ValueError(
             "fit: the learned weights are not finite; the demonstration's scale or the gains are out of range"
         )
     return weights
+
+
+def _readonly(*arrays: np.ndarray) -> None:
+    for array in arrays:
+        array.flags.writeable = False
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
+    design = _training_design(canonical, basis, n_train, dt, regression, ridge)
+    # Shared by every fit on this grid: nobody may write into them.
+    _readonly(*design[:4], design[4][1])
+    return design
+
+
+def _training_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
+    """Everything a fit needs that does not depend on the demonstration's values: the phase and
+    basis rows one sample past the training grid (n + 1,), (n + 1, N), the kernels' centres and
+    widths (N,), and the regression's factor."""
+    grid_phase = canonical.grid(n_train + 1, dt, 1.0)
+    centres, widths = basis.place(canonical, n_train, dt)
+    grid_phi = basis.rows(grid_phase, centres, widths)
+    factor = _regression_factor(grid_phi[:n_train], grid_phase[:n_train], regression, ridge)
+    return grid_phase, grid_phi, centres, widths, factor
 
 
 def _learn_weights(
@@ -244,7 +288,9 @@ def _learn_weights(
     system and basis among them).
 
     The weights belong to the demonstration's own time scale (``tau = 1``): ``tau`` only scales
-    rollouts, so it is not used here.
+    rollouts, so it is not used here. The phase, the basis rows and the regression's factor
+    depend only on the grid and the components, not on the demonstration, so the last few
+    grids' are kept (read-only) and a fit of another recording of the same length reuses them.
 
     Returns
     -------
@@ -253,11 +299,17 @@ def _learn_weights(
     """
     n_train = train.shape[0]
     canonical, basis = params.canonical_system, params.basis
+    key = (canonical, basis, n_train, dt, params.regression, params.ridge)
+    try:
+        hash(key)
+    except TypeError:  # a component of one's own that cannot be a cache key
+        design = _training_design(*key)
+    else:
+        design = _cached_design(*key)
     # One sample past the training grid: a timed trajectory's rollout asks for it (the state's
     # derivatives at the last sample), and then shares the grid cached from here.
-    grid_phase = canonical.grid(n_train + 1, dt, 1.0)
-    phase = grid_phase[:n_train]
-    centres, widths = basis.place(canonical, n_train, dt)
+    grid_phase, grid_phi, centres, widths, factor = design
+    phase, phi = grid_phase[:n_train], grid_phi[:n_train]
     target = _forcing_target(
         train,
         phase,
@@ -269,9 +321,7 @@ def _learn_weights(
         derivatives=params.derivatives,
         gate=gate,
     )
-    grid_phi = basis.rows(grid_phase, centres, widths)
-    phi = grid_phi[:n_train]
-    weights = _regress(phi, phase, target, regression=params.regression, ridge=params.ridge)
+    weights = _solve_weights(factor, phi, target)
     return np.ascontiguousarray(weights), centres, widths, grid_phase, grid_phi
 
 
