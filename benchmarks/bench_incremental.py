@@ -15,7 +15,7 @@ import argparse
 import copy
 
 import numpy as np
-from _timing import median_time
+from _timing import interleaved_times, median_time
 
 from bidmp import BLS, DMP, BiDMP, extend_demonstration
 from bidmp.demonstrations import minimum_jerk
@@ -101,15 +101,29 @@ def bench_block_pinv(n_nodes: int, repeats: int) -> None:
 
 
 def bench_bidmp(repeats: int) -> None:
+    """Bi-DMP learn and rollout on both protocols (the sides interleaved): the paper's (200 samples
+    on normalised time, alpha = 100) and the defaults a user meets (the robot protocol, the same
+    samples over 2 s in mm)."""
     demo = minimum_jerk(BATTERY_APPROACH_VIA, 200)
-    dmp = DMP(protocol="paper", alpha=100.0).fit(demo)
+    stamps = np.linspace(0.0, 2.0, demo.shape[0])
+    dmps = {
+        "paper protocol": DMP(protocol="paper", alpha=100.0).fit(demo),
+        "robot protocol (defaults)": DMP().fit(demo, stamps, units="mm"),
+    }
     extension = extend_demonstration(demo, BATTERY_EXTENSION_TARGET, seed=0)
-    learn = median_time(lambda: BiDMP(dmp).learn(extension.complete), repeats)
-    model = BiDMP(dmp).learn(extension.complete)
-    rollout = median_time(lambda: model.rollout(BATTERY_EXTENSION_TARGET), repeats)
+    models = {name: BiDMP(dmp).learn(extension.complete) for name, dmp in dmps.items()}
+    sides = {}
+    for name, dmp in dmps.items():
+        sides[f"learn, {name}"] = lambda dmp=dmp: BiDMP(dmp).learn(extension.complete)
+        model = models[name]
+        sides[f"rollout, {name}"] = lambda model=model: model.rollout(BATTERY_EXTENSION_TARGET)
+    times = interleaved_times(sides, repeats)
     print("\n  Bi-DMP on the 200-point 3-D battery approach, one extended demonstration")
-    print(f"    {'BiDMP.learn (BLS 100+100 nodes, +20, +20)':44s} {learn * 1e3:9.3f} ms")
-    print(f"    {'BiDMP.rollout':44s} {rollout * 1e3:9.3f} ms")
+    for name, elapsed in times.items():
+        print(f"    {'BiDMP.' + name:44s} {elapsed * 1e3:9.3f} ms")
+    for step in ("learn", "rollout"):
+        paper, robot = times[f"{step}, paper protocol"], times[f"{step}, robot protocol (defaults)"]
+        print(f"    {step}: the defaults take {robot / paper:.2f}x the paper protocol's time")
 
 
 def main() -> int:

@@ -30,6 +30,14 @@ def main() -> int:
             f"  {workers} worker process{'es' if workers > 1 else '  '}: simulated {result.simulated_s:6.1f} s in "
             f"{result.wall_s:5.1f} s wall = {result.simulated_s / result.wall_s:5.1f}x real time (target >= 10)"
         )
+    # The defaults a user meets: the robot protocol's skills (timed, settling at rest).
+    robot = scenario.with_robot_protocol()
+    robot_report = evaluate(robot, ["dmp", "bidmp"], geometry=False)
+    result = sim.simulate(robot, ["dmp", "bidmp"], report=robot_report, workers=2)
+    print(
+        f"  robot protocol (defaults), 2 worker processes: simulated {result.simulated_s:6.1f} s in "
+        f"{result.wall_s:5.1f} s wall = {result.simulated_s / result.wall_s:5.1f}x real time"
+    )
     with sim.RobotCell(scenario.scene, scenario.units, *sim.robot_placement(scenario)) as cell:
         n = 5000
         start = time.perf_counter()

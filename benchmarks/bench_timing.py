@@ -19,7 +19,7 @@ import sys
 import warnings
 
 import numpy as np
-from _timing import median_time
+from _timing import interleaved_times, median_time
 
 import bidmp
 from bidmp.io import read_trajectory
@@ -61,16 +61,16 @@ def main(argv=None) -> int:
     except ImportError:
         print("  movement_primitives is not installed: pip install movement-primitives")
         return 0
-    times = prepared.t
+    stamps = prepared.t
 
     def theirs(step_function):
         mp = MPDMP(
             n_dims=3,
-            execution_time=times[-1],
-            dt=times[1] - times[0],
+            execution_time=stamps[-1],
+            dt=stamps[1] - stamps[0],
             n_weights_per_dim=bidmp.DMP().n_kernels_value,
         )
-        mp.imitate(times, prepared.y)
+        mp.imitate(stamps, prepared.y)
         mp.configure(start_y=prepared.y[0], goal_y=goal)
         return mp.open_loop(step_function=step_function)
 
@@ -85,16 +85,27 @@ def main(argv=None) -> int:
             if best is None or seconds < best[1]:
                 best = (step_function, seconds)
     _, positions = theirs(best[0])
-    ours_fit_traj = median_time(
-        lambda: bidmp.DMP().fit(prepared.y, prepared.t).trajectory(goal), args.repeats
-    )
-    print(f"  bidmp fit + trajectory              {1e3 * ours_fit_traj:8.3f} ms")
+    # The three sides interleaved round by round: the defaults a user meets (robot protocol, a
+    # timed trajectory with its derivatives), the paper's protocol (normalised time, positions),
+    # and the peer's fit + open loop with its fastest step function.
+    sides = {
+        "bidmp defaults: fit + trajectory": lambda: (
+            bidmp.DMP().fit(prepared.y, prepared.t).trajectory(goal)
+        ),
+        "bidmp paper protocol: fit + rollout": lambda: (
+            bidmp.DMP(protocol="paper").fit(prepared.y).rollout(goal)
+        ),
+        f"movement_primitives fit + open loop ({best[0]})": lambda: theirs(best[0]),
+    }
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        times = interleaved_times(sides, args.repeats)
+    peer = times[f"movement_primitives fit + open loop ({best[0]})"]
+    for name, seconds in times.items():
+        ratio = "" if seconds == peer else f"   movement_primitives / this {peer / seconds:5.1f}x"
+        print(f"  {name:45s} {1e3 * seconds:8.3f} ms{ratio}")
     print(
-        f"  movement_primitives fit + open loop {1e3 * best[1]:8.3f} ms   ({best[0]}; bidmp is "
-        f"{best[1] / ours_fit_traj:.1f}x faster)"
-    )
-    print(
-        f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm after {times[-1]:.2f} s"
+        f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm after {prepared.t[-1]:.2f} s"
     )
     return 0
 
