@@ -104,6 +104,7 @@ bench-smoke: $(STAMP)
 	cd benchmarks && ../$(PY) bidmp_convergence.py > /dev/null
 	cd benchmarks && ../$(PY) bench_timing.py --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_sim.py > /dev/null
+	cd benchmarks && ../$(PY) bench_rhythmic.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_cartesian.py --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_lasa.py --every 20 --rounds 1 --shapes 1 --out ../.bench-smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_avoidance.py --fields 2 --repeats 1 > /dev/null

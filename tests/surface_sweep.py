@@ -84,6 +84,8 @@ SKIPPED = {
     "write_job_report",
     "write_results",
     "Report",
+    "FrequencyEstimate",
+    "RhythmicStepper",  # handed out by RhythmicDMP.stepper(), swept as an instance
     "MethodResult",
     "SimReport",
     "SimTarget",
@@ -218,6 +220,10 @@ DEMO = np.column_stack(
 TIMES = np.linspace(0.0, 1.2, 60)
 QUATS = np.tile([0.0, 0.0, 0.0, 1.0], (60, 1))
 POSES = np.hstack([DEMO, QUATS])
+PERIODIC_TIMES = np.arange(400) / 100.0
+PERIODIC = np.column_stack(
+    [20 * np.sin(2 * np.pi * PERIODIC_TIMES), 10 * np.cos(4 * np.pi * PERIODIC_TIMES)]
+)
 
 
 class _Hang(Exception):

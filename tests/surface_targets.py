@@ -8,7 +8,17 @@ import inspect
 from pathlib import Path
 
 import numpy as np
-from surface_sweep import DEMO, POSES, QUATS, SKIPPED, SKIPPED_METHODS, TIMES, packages_entry_points
+from surface_sweep import (
+    DEMO,
+    PERIODIC,
+    PERIODIC_TIMES,
+    POSES,
+    QUATS,
+    SKIPPED,
+    SKIPPED_METHODS,
+    TIMES,
+    packages_entry_points,
+)
 
 import bidmp
 
@@ -97,6 +107,15 @@ def _package_overrides(tmp: Path) -> dict:
         },
         "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
         "bidmp.primitives.GaussianBasis": {"size": 10},
+        "bidmp.primitives.VonMisesBasis": {"size": 10},
+        "bidmp.primitives.AdaptiveOscillator": {"frequency": 1.0},
+        "bidmp.primitives.estimate_frequency": {"y": PERIODIC, "t": PERIODIC_TIMES},
+        "bidmp.primitives.harmonic_fit": {
+            "y": PERIODIC,
+            "t": PERIODIC_TIMES,
+            "frequency": 1.0,
+            "n_harmonics": 3,
+        },
         "bidmp.primitives.ExponentialPhase": {"rate": 4.0},
         "bidmp.sim.require_simulator": {},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},
@@ -260,6 +279,10 @@ def _fitting(cls, fit_args: tuple):
     return fit
 
 
+def phase_args_rhythmic() -> dict:
+    return {"n_steps": 60, "step": 0.01, "tau": 1.0, "samples": np.arange(5.0), "span": 1.1}
+
+
 def _estimators():
     from bidmp.baselines import TPGMM, GMMRegressor
     from bidmp.incremental import BLS
@@ -273,6 +296,7 @@ def _estimators():
         ("BLS", BLS, (rng.normal(size=(40, 3)), rng.normal(size=(40, 2)))),
         ("GMMRegressor", GMMRegressor, (DEMO,)),
         ("TPGMM", TPGMM, (DEMO,)),
+        ("RhythmicDMP", bidmp.primitives.RhythmicDMP, (PERIODIC, PERIODIC_TIMES)),
     ]
 
 
@@ -391,6 +415,31 @@ def _instances(tmp: Path):
     yield "PoseStepper", pose.stepper(), {"dt": 0.01, "pose": POSES[-1]}
     yield "Trajectory", dmp.trajectory(), {}
     yield "PoseTrajectory", pose.trajectory(), {}
+    from bidmp.primitives import AdaptiveOscillator, RhythmicDMP, RhythmicPhase, VonMisesBasis
+
+    rhythmic = RhythmicDMP(n_kernels=12).fit(PERIODIC, PERIODIC_TIMES)
+    rhythm_args = {"cycles": 1.0, "dt": 0.01, "phase": np.linspace(0.0, 6.0, 7)}
+    yield "RhythmicDMP", rhythmic, rhythm_args
+    yield (
+        "RhythmicStepper",
+        rhythmic.stepper(),
+        {"dt": 0.01, "frequency": 1.2, "amplitude": 0.5, "anchor": [1.0, 2.0]},
+    )
+    yield "AdaptiveOscillator", AdaptiveOscillator(1.0, 2), {"y": [1.0, 2.0], "dt": 0.01}
+    yield "RhythmicPhase", RhythmicPhase(), {**phase_args_rhythmic(), "phase": 0.5}
+    yield (
+        "VonMisesBasis",
+        VonMisesBasis(10),
+        {
+            "canonical": RhythmicPhase(),
+            "n_steps": 60,
+            "step": 0.01,
+            "phase": np.linspace(0.0, 6.0, 20),
+            "row:phase": 0.5,
+            "centres": VonMisesBasis(10).place(RhythmicPhase(), 1, 1.0)[0],
+            "widths": VonMisesBasis(10).place(RhythmicPhase(), 1, 1.0)[1],
+        },
+    )
     yield "PhaseGate", PhaseGate(2.0), goal_args
     yield "DelayedGoal", DelayedGoal(2.0), goal_args
     phase_args = {"n_steps": 60, "step": 0.01, "tau": 1.0, "samples": np.arange(5.0), "span": 1.1}

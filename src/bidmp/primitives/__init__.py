@@ -14,6 +14,8 @@ Where things live (the field's split, as in movement_primitives and dmpbbo):
 * ``via`` — exact via-points (least-norm weight change); ``goal_shift`` — goals moved mid-motion;
 * ``dmp`` — :class:`DMP`, the estimator that composes them; ``stepper`` — its control-loop stepper;
 * ``cartesian``, ``so3``, ``pose_timing`` — pose DMPs on unit quaternions;
+* ``rhythmic`` — periodic DMPs and their modulation while running; ``frequency`` — a periodic
+  recording's frequency, steady part and spread; ``oscillator`` — adaptive frequency oscillators;
 * ``timing`` — timed trajectories and time scaling to limits.
 
 Layer 1 (the math): imports only ``bidmp._checks`` and the other private helpers of the package
@@ -30,7 +32,7 @@ from .._lazy import exports
 if TYPE_CHECKING:
     from .approach import straight_tail_start
     from .avoidance import AvoidanceError, SceneAvoidance
-    from .canonical import CanonicalSystem, ExponentialPhase, phase_grid
+    from .canonical import CanonicalSystem, ExponentialPhase, RhythmicPhase, phase_grid
     from .cartesian import (
         CartesianDMP,
         PoseModel,
@@ -44,10 +46,20 @@ if TYPE_CHECKING:
     )
     from .coupling import ConstantAcceleration, CouplingTerm, PhaseStopping
     from .dmp import DMP, PROTOCOLS
-    from .forcing import Basis, GaussianBasis, basis_functions, kernel_centres, kernel_widths
+    from .forcing import (
+        Basis,
+        GaussianBasis,
+        VonMisesBasis,
+        basis_functions,
+        kernel_centres,
+        kernel_widths,
+    )
+    from .frequency import FrequencyEstimate, estimate_frequency, harmonic_fit
     from .goals import ApproachGate, DelayedGoal, PhaseGate, ProgressGate
     from .integrate import StepIntegrator
+    from .oscillator import AdaptiveOscillator
     from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
+    from .rhythmic import RhythmicDMP, RhythmicStepper
     from .so3 import continuous_log, orientation_from_log, principal_log
     from .stepper import DMPStepper
     from .timing import (

@@ -21,7 +21,7 @@ import numpy as np
 
 from .._checks import _as_bounded_array, as_points, as_vector, check_bool, check_int, check_real
 
-__all__ = ["phase_grid", "CanonicalSystem", "ExponentialPhase"]
+__all__ = ["phase_grid", "CanonicalSystem", "ExponentialPhase", "RhythmicPhase"]
 
 # Kernels need distinct, representable phases over the training grid: e^-27.6 = 1e-12.
 _MIN_TRAINING_PHASE_LOG = -27.6
@@ -224,3 +224,50 @@ def _as_phase(phase, name: str = "phase") -> np.ndarray:
             f"[{phase.min():.3g}, {phase.max():.3g}]"
         )
     return phase
+
+
+@dataclass(frozen=True)
+class RhythmicPhase:
+    """The rhythmic DMP's canonical system: an angle that advances at ``1 / tau`` rad per unit of
+    time (``tau φ̇ = 1``, so ``Ω = 1 / tau`` is the angular frequency) and wraps at 2π.
+
+    A :class:`RhythmicDMP <bidmp.primitives.rhythmic.RhythmicDMP>` runs it in seconds
+    (``tau = 1 / (2π f)``); the phase never decays, so nothing limits the span of a training grid.
+    """
+
+    initial: ClassVar[float] = 0.0
+
+    def grid(self, n_steps: int, step: float, tau: float) -> np.ndarray:
+        """The phase (rad, in [0, 2π)) at ``n_steps`` samples ``step`` apart."""
+        n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
+        return self.at(np.arange(n_steps, dtype=float), step, tau)
+
+    def at(self, samples: np.ndarray, step: float, tau: float) -> np.ndarray:
+        """The phase at fractional sample indices of that grid."""
+        samples = as_vector(samples, "samples")
+        step = check_real(step, "step", positive=True, maximum=_MAX_STEP)
+        tau = check_real(tau, "tau", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
+        return np.mod(samples * (step / tau), 2.0 * math.pi)
+
+    def advance(self, phase: float, step: float, tau: float) -> float:
+        """The phase ``step`` later, wrapped to [0, 2π)."""
+        phase = check_real(phase, "phase", minimum=-1e6, maximum=1e6)
+        step = check_real(step, "step", nonnegative=True, maximum=_MAX_STEP)
+        tau = check_real(tau, "tau", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
+        return math.fmod(phase + step / tau, 2.0 * math.pi) % (2.0 * math.pi)
+
+    def check_step(self, step: float, tau: float) -> None:
+        """Any positive step: the phase is integrated exactly."""
+        check_real(step, "step", positive=True, maximum=_MAX_STEP)
+        check_real(tau, "tau", minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1])
+
+    def check_span(self, span: float) -> None:
+        """Any positive span: the phase does not decay."""
+        check_real(span, "span", positive=True)
+
+    def as_phase(self, phase, name: str = "phase") -> np.ndarray:
+        """Phases in radians, any finite values (wrapped by the basis), shape ``(L,)``."""
+        if not isinstance(name, str) or not name.isidentifier() or len(name) > 64:
+            raise TypeError("name must be the argument's name (an identifier) to say in a refusal")
+        phase = _as_bounded_array(phase, name, max_ndim=2)
+        return as_points(phase.reshape(-1, 1) if phase.ndim <= 1 else phase, 1, name)[:, 0]

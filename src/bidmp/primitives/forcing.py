@@ -29,7 +29,14 @@ from .._checks import (
 )
 from .canonical import _checked_phase_args, _phase_decay
 
-__all__ = ["kernel_centres", "kernel_widths", "basis_functions", "Basis", "GaussianBasis"]
+__all__ = [
+    "kernel_centres",
+    "kernel_widths",
+    "basis_functions",
+    "Basis",
+    "GaussianBasis",
+    "VonMisesBasis",
+]
 
 _MAX_PHASE = 1e6  # |phase| a basis row is computed for (a DMP's phase lies in [0, 1])
 _LOG_PSI_FLOOR = -40.0
@@ -423,3 +430,75 @@ class GaussianBasis:
             basis_functions(np.zeros(1), centres, widths)  # checks the kernels, names them
             object.__setattr__(self, "_checked", (centres, widths))
         return _basis_row(phase, centres, widths)
+
+
+@dataclass(frozen=True)
+class VonMisesBasis:
+    """A periodic basis: ``size`` von Mises functions ``ψ_i(φ) = exp(h (cos(φ - c_i) - 1))`` with
+    centres ``c_i`` evenly spaced over one cycle [0, 2π) and one concentration ``h`` (default
+    ``2.5 · size``: neighbours overlap at about half height), normalised to sum to 1 at every
+    phase (the rhythmic forcing term carries no phase factor: it never fades).
+
+    Parameters
+    ----------
+    size : int
+        Number of functions N.
+    concentration : float, optional
+        ``h`` (dimensionless); default ``2.5 · size``.
+    """
+
+    size: int
+    concentration: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(
+            self, "size", check_int(self.size, "size", minimum=2, limit="max_kernels")
+        )
+        if self.concentration is not None:
+            object.__setattr__(
+                self,
+                "concentration",
+                check_real(self.concentration, "concentration", positive=True, maximum=1e6),
+            )
+
+    def place(self, canonical, n_steps: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+        """Centres (rad) evenly over a cycle and the concentration of each, (N,) each; the
+        grid's length and step do not matter (the phase covers every cycle alike)."""
+        centres = 2.0 * np.pi * np.arange(self.size) / self.size
+        concentration = 2.5 * self.size if self.concentration is None else self.concentration
+        return centres, np.full(self.size, float(concentration))
+
+    def rows(self, phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """Normalised rows (L, N) at phases (L,) in radians (any value: the functions are
+        periodic). Shifted by each row's largest exponent, so no concentration underflows."""
+        phase = as_vector(phase, "phase")
+        centres, widths = _von_mises_kernels(centres, widths)
+        if np.abs(phase).max(initial=0.0) > _MAX_PHASE:
+            raise ValueError(f"phase must lie within ±{_MAX_PHASE:g} rad")
+        log_psi = widths[None, :] * (np.cos(phase[:, None] - centres[None, :]) - 1.0)
+        log_psi -= log_psi.max(axis=1, keepdims=True)
+        psi = np.exp(np.maximum(log_psi, _LOG_PSI_FLOOR))
+        psi /= psi.sum(axis=1, keepdims=True)
+        return psi
+
+    def row(self, phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+        """One row (1, N): the control loop's call."""
+        if type(phase) is not float or not -_MAX_PHASE <= phase <= _MAX_PHASE:
+            phase = check_real(phase, "phase", minimum=-_MAX_PHASE, maximum=_MAX_PHASE)
+        centres, widths = _von_mises_kernels(centres, widths)
+        log_psi = widths * (np.cos(phase - centres) - 1.0)
+        psi = np.exp(np.maximum(log_psi - log_psi.max(), _LOG_PSI_FLOOR))
+        return (psi / psi.sum())[None]
+
+
+def _von_mises_kernels(centres, widths) -> tuple[np.ndarray, np.ndarray]:
+    """Finite centres (rad) and positive concentrations of equal length, (N,) each."""
+    centres = as_vector(centres, "centres")
+    widths = as_vector(widths, "widths", positive=True)
+    if widths.shape != centres.shape:
+        raise ValueError(
+            f"widths must have one entry per entry of centres ({centres.shape[0]}), got {widths.shape[0]}"
+        )
+    if np.abs(centres).max() > _MAX_PHASE or widths.max() > 1e6:
+        raise ValueError(f"centres must lie within ±{_MAX_PHASE:g} rad and widths at most 1e6")
+    return centres, widths

@@ -179,6 +179,10 @@ def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> n
         sample rate outside 1 Hz … 100 kHz (stamps in ms, µs or ns, or in minutes).
     """
     name, samples = check_text(name, "name", 4096), check_text(samples, "samples")
+    if not name.strip():
+        raise ValueError(
+            "name must name the stamps (the argument or file to say in a refusal), got ''"
+        )
     if len(name) > 100:  # a name built from a file's path: its ends tell it apart
         name = f"{name[:40]}…{name[-59:]}"
     n_samples = check_int(n_samples, "n_samples", minimum=1, limit="max_samples")

@@ -1,0 +1,512 @@
+"""Rhythmic DMPs (Ijspeert et al. 2013): periodic motions learned from a recording of several
+periods and changed while they run (learned online: :mod:`bidmp.primitives.oscillator`).
+
+Per dimension, in seconds, with the phase ``φ`` in radians and ``Ω = 1 / τ`` the angular frequency::
+
+    τ ż = α (β (g - y) - z) + r f(φ),   τ ẏ = z,   τ φ̇ = 1
+    f(φ) = Σ_i ψ_i(φ) w_i / Σ_i ψ_i(φ),  ψ_i = exp(h (cos(φ - c_i) - 1))   (von Mises)
+
+``g`` is the anchor (the centre of the oscillation) and ``r`` the amplitude (1 as learned: the
+oscillation about ``g`` scales with it, the system being linear). The phase and the basis are the
+components :class:`~bidmp.primitives.RhythmicPhase` and :class:`~bidmp.primitives.VonMisesBasis`.
+
+Learning from a recording (:meth:`RhythmicDMP.fit`): the frequency is estimated
+(:func:`~bidmp.primitives.estimate_frequency`, in :mod:`bidmp.primitives.frequency`: a spectral
+peak refined by least squares of a harmonic series over all kept samples, with its standard error), the transients at both ends are cut (where the
+one-period RMS envelope is below 9/10 of the steady part's), and the forcing target is computed
+from that harmonic series — the mean period of every kept period at once, differentiated
+analytically (no numerical derivative of noisy, jittered samples) — and regressed on the basis.
+
+Changing frequency, amplitude and anchor while running (:class:`RhythmicStepper`): each passes
+through a critically damped second-order filter of time constant ``transition`` (s), so it and its
+rate are continuous and no step in acceleration reaches the robot.
+
+Layer 1: imports only the package's own math.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+
+from .._api import Estimator
+from .._checks import (
+    as_point,
+    as_trajectory,
+    check_choice,
+    check_int,
+    check_names,
+    check_real,
+    get_limits,
+)
+from .._units import check_units
+from .canonical import RhythmicPhase
+from .forcing import VonMisesBasis
+from .frequency import _design, _series, _with_frequency, estimate_frequency
+from .integrate import _exact_responses, _exact_state, _foh_step
+from .timing import Trajectory, check_timestamps
+
+__all__ = ["RhythmicDMP", "RhythmicStepper"]
+
+logger = logging.getLogger(__name__)
+
+
+class RhythmicDMP(Estimator):
+    """A rhythmic DMP (Ijspeert et al. 2013) learned from a recording of several periods.
+
+    Parameters
+    ----------
+    n_kernels : int
+        Von Mises functions per cycle (the forcing term's resolution).
+    alpha : float
+        Spring gain α (1/s in units of the period's τ); ``beta = alpha / 4`` (critically damped).
+    concentration : float, optional
+        The von Mises concentration ``h``; default ``2.5 · n_kernels``.
+    n_harmonics : int, optional
+        Harmonics of the series the forcing target is taken from; default chosen by BIC.
+    ridge : float
+        Ridge regulariser, relative to the mean diagonal of ``ΦᵀΦ``.
+
+    Attributes
+    ----------
+    frequency_ : float
+        The learned frequency (Hz).
+    estimate_ : FrequencyEstimate
+        How it was estimated (uncertainty, steady part, period-to-period spread).
+    anchor_ : array (D,)
+        The centre of the oscillation (units).
+    amplitude_ : array (D,)
+        Half the learned cycle's peak-to-peak per dimension (units).
+    weights_ : array (N, D)
+    """
+
+    def __init__(
+        self,
+        n_kernels: int = 50,
+        alpha: float = 25.0,
+        concentration: float | None = None,
+        n_harmonics: int | None = None,
+        ridge: float = 1e-8,
+    ) -> None:
+        self.n_kernels = n_kernels
+        self.alpha = alpha
+        self.concentration = concentration
+        self.n_harmonics = n_harmonics
+        self.ridge = ridge
+
+    # -- learning ---------------------------------------------------------------------------
+    def fit(self, y, t, units: str | None = None, names=None, frequency: float | None = None):
+        """Learn from a recording ``y`` (T, D) at stamps ``t`` (s) of at least 2 periods
+        (transients at both ends are cut); ``frequency`` (Hz) skips the estimate of it (the
+        steady part is still found). Returns self."""
+        n_kernels = check_int(self.n_kernels, "n_kernels", minimum=2, limit="max_kernels")
+        alpha = check_real(self.alpha, "alpha", positive=True, maximum=1e4)
+        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
+        basis = VonMisesBasis(n_kernels, self.concentration)
+        y = as_trajectory(y, "y", min_points=8)
+        t = check_timestamps(t, y.shape[0])
+        units = "" if units is None else check_units(units)
+        names = check_names(names, y.shape[1])
+        estimate = estimate_frequency(y, t, n_harmonics=self.n_harmonics)
+        if frequency is not None:
+            frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+            estimate = _with_frequency(estimate, y, t, frequency)
+        omega = 2.0 * math.pi * estimate.frequency
+        local = t - t[0]
+        keep = (local >= estimate.start - 1e-12) & (local <= estimate.end + 1e-12)
+        coefficients = np.linalg.lstsq(
+            _design(local[keep] - estimate.start, omega, estimate.n_harmonics),
+            y[keep],
+            rcond=None,
+        )[0]
+        harmonics = estimate.n_harmonics
+        # The target on a fine grid of one cycle: every kept period at once, through the series.
+        n_grid = max(20 * n_kernels, 1000)
+        phase = 2.0 * math.pi * np.arange(n_grid) / n_grid
+        position = _series(coefficients, phase, harmonics)
+        velocity = omega * _series(coefficients, phase, harmonics, 1)  # units/s
+        acceleration = omega**2 * _series(coefficients, phase, harmonics, 2)
+        anchor = coefficients[0]
+        beta = alpha / 4.0
+        tau = 1.0 / omega
+        target = tau**2 * acceleration - alpha * (beta * (anchor - position) - tau * velocity)
+        centres, widths = basis.place(RhythmicPhase(), n_grid, 1.0)
+        rows = basis.rows(phase, centres, widths)
+        gram = rows.T @ rows
+        reg = ridge * np.trace(gram) / n_kernels
+        weights = np.linalg.solve(gram + reg * np.eye(n_kernels), rows.T @ target)
+        if not np.all(np.isfinite(weights)):
+            raise ValueError(
+                "fit: the learned weights are not finite; the recording's scale is out of range"
+            )
+        self.weights_ = weights
+        self.centres_, self.widths_ = centres, widths
+        self.anchor_ = anchor.copy()
+        self.frequency_ = estimate.frequency
+        self.estimate_ = estimate
+        self.amplitude_ = estimate.amplitude
+        self.units_ = units
+        self.names_ = names
+        self.n_dims_ = y.shape[1]
+        self._coefficients = coefficients
+        logger.debug(
+            "fitted a rhythmic DMP: %.5g Hz ± %.2g over %d periods, spread %.3g",
+            estimate.frequency,
+            estimate.uncertainty,
+            estimate.periods,
+            estimate.spread,
+        )
+        return self
+
+    def _check_fitted(self) -> None:
+        if "weights_" not in self.__dict__:
+            from .._checks import NotFittedError
+
+            raise NotFittedError("this RhythmicDMP is not fitted yet: call fit(y, t) first")
+
+    def forcing(self, phase) -> np.ndarray:
+        """The learned forcing term ``f(φ)`` (L, D) at phases (rad), amplitude 1."""
+        self._check_fitted()
+        basis = VonMisesBasis(len(self.centres_), float(self.widths_[0]))
+        return basis.rows(phase, self.centres_, self.widths_) @ self.weights_
+
+    def cycle_start(
+        self,
+        frequency: float | None = None,
+        amplitude: float = 1.0,
+        anchor=None,
+        dt: float | None = None,
+    ):
+        """The state ``(y, ẏ)`` (units, units/s) at phase 0 on the limit cycle for these settings:
+        the periodic solution of the sampled system (the fixed point of one period's transition
+        ``x* = Φ_T x* + x_forced``): exact on the grid of a rollout whose period is a whole number
+        of its steps ``dt`` (s), otherwise on a grid of ``max(2000, ⌈period / dt⌉)`` steps per
+        period, within the input's first-order hold (about 1e-5 of the amplitude)."""
+        frequency, amplitude, anchor = self._settings(frequency, amplitude, anchor)
+        omega = 2.0 * math.pi * frequency
+        n = 2000
+        if dt is not None:
+            per_period = 1.0 / (frequency * check_real(dt, "dt", positive=True, maximum=1.0))
+            _check_samples(per_period, "a period's steps (1 / (frequency * dt))")
+            whole = round(per_period)
+            # A whole number of the rollout's own steps: solve on exactly its grid.
+            n = (
+                whole
+                if abs(per_period - whole) <= 1e-9 * per_period
+                else max(n, math.ceil(per_period))
+            )
+        step = 1.0 / (frequency * n)
+        tau = 1.0 / omega
+        # One period from rest at 0 (the forced response), one sample past it for its state.
+        phase = omega * step * np.arange(n + 2)
+        inputs = self._inputs(phase, amplitude, anchor)
+        zeros = np.zeros(self.n_dims_)
+        forced = _exact_responses(
+            inputs.T, zeros, zeros, step=step, alpha=self._alpha, beta=self._beta, tau=tau
+        )
+        transition = _period_transition(step, n, self._alpha, self._beta, tau)
+        z_forced = _exact_state(
+            forced.T[n:], inputs[n:], step=step, alpha=self._alpha, beta=self._beta, tau=tau
+        )[0][0]
+        end = np.stack([forced[:, n], z_forced])  # the state [y, z] after one period, (2, D)
+        fixed = np.linalg.solve(np.eye(2) - transition, end)
+        return fixed[0], fixed[1] / tau
+
+    @property
+    def _alpha(self) -> float:
+        return float(self.alpha)
+
+    @property
+    def _beta(self) -> float:
+        return float(self.alpha) / 4.0
+
+    def _settings(self, frequency, amplitude, anchor):
+        self._check_fitted()
+        frequency = (
+            self.frequency_
+            if frequency is None
+            else check_real(frequency, "frequency", positive=True, maximum=1e3)
+        )
+        amplitude = check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
+        anchor = self.anchor_ if anchor is None else as_point(anchor, self.n_dims_, "anchor")
+        return frequency, amplitude, anchor
+
+    def _inputs(self, phase: np.ndarray, amplitude: float, anchor: np.ndarray) -> np.ndarray:
+        """``u = α β g + r f(φ)`` (L, D) at phases (L,)."""
+        return self._alpha * self._beta * anchor + amplitude * self.forcing(phase)
+
+    # -- motions ----------------------------------------------------------------------------
+    def trajectory(
+        self,
+        cycles: float = 1.0,
+        *,
+        dt: float = 0.001,
+        frequency: float | None = None,
+        amplitude: float = 1.0,
+        anchor=None,
+    ) -> Trajectory:
+        """``cycles`` periods on the limit cycle (started on it at phase 0), sampled every ``dt``
+        seconds, exact (first-order hold): positions, velocities and accelerations."""
+        frequency, amplitude, anchor = self._settings(frequency, amplitude, anchor)
+        cycles = check_real(cycles, "cycles", positive=True, maximum=1e5)
+        dt = check_real(dt, "dt", positive=True, maximum=1.0)
+        n = (
+            int(
+                math.floor(
+                    _check_samples(cycles / (frequency * dt), "cycles / (frequency * dt)") + 1e-9
+                )
+            )
+            + 1
+        )
+        omega = 2.0 * math.pi * frequency
+        tau = 1.0 / omega
+        phase = omega * dt * np.arange(n + 1)
+        inputs = self._inputs(phase, amplitude, anchor)
+        y0, v0 = self.cycle_start(frequency, amplitude, anchor, dt)
+        positions = _exact_responses(
+            inputs.T, y0, tau * v0, step=dt, alpha=self._alpha, beta=self._beta, tau=tau
+        ).T
+        z, acceleration = _exact_state(
+            positions, inputs, step=dt, alpha=self._alpha, beta=self._beta, tau=tau
+        )
+        z[0] = tau * v0
+        acceleration[0] = (
+            inputs[0] - self._alpha * self._beta * positions[0] - self._alpha * z[0]
+        ) / tau**2
+        return Trajectory(
+            np.arange(n) * dt,
+            positions[:n],
+            z[:n] / tau,
+            acceleration[:n],
+            self.units_,
+            tuple(self.names_ or ()),
+        )
+
+    def rollout(self, cycles: float = 1.0, **settings) -> np.ndarray:
+        """Positions (n, D) of :meth:`trajectory`."""
+        return self.trajectory(cycles, **settings).y
+
+    def stepper(
+        self,
+        *,
+        frequency: float | None = None,
+        amplitude: float = 1.0,
+        anchor=None,
+        start: str = "cycle",
+        transition: float | None = None,
+    ) -> RhythmicStepper:
+        """A control-loop stepper (:class:`RhythmicStepper`) started on the limit cycle
+        (``start="cycle"``) or at rest at the anchor with the amplitude rising from 0
+        (``"rest"``)."""
+        return RhythmicStepper(self, frequency, amplitude, anchor, start, transition)
+
+    def run(
+        self,
+        cycles: float,
+        *,
+        dt: float = 0.001,
+        frequency: float | None = None,
+        amplitude: float = 1.0,
+        anchor=None,
+        transition: float | None = None,
+        settle: float = 1e-3,
+    ) -> Trajectory:
+        """From rest at the anchor into the rhythm and back to rest: the amplitude rises from 0
+        (a critically damped filter of time constant ``transition``), ``cycles`` periods run,
+        then it falls to 0 and the motion settles at the anchor (until within ``settle`` × the
+        amplitude, at rest). Smooth at both ends: acceleration 0 at the first and last sample."""
+        cycles = check_real(cycles, "cycles", positive=True, maximum=1e5)
+        settle = check_real(settle, "settle", positive=True, maximum=0.5)
+        stepper = self.stepper(
+            frequency=frequency,
+            amplitude=amplitude,
+            anchor=anchor,
+            start="rest",
+            transition=transition,
+        )
+        dt = check_real(dt, "dt", positive=True, maximum=1.0)
+        # The rise, the cycles and the settling (a few transition times) must fit the limit.
+        _check_samples(
+            (cycles + 8.0) / (stepper.frequency * dt) + 12.0 * stepper.time_constant / dt,
+            "the run's samples ((cycles + settling) / (frequency * dt))",
+        )
+        samples = [stepper.step(dt)]
+        scale = max(float(np.max(self.amplitude_)) * max(amplitude, 1e-12), 1e-12)
+        limit = int(get_limits().max_steps)
+        while stepper.cycles < cycles and len(samples) < limit:
+            samples.append(stepper.step(dt))
+        stepper.stop()
+        rest_for = 0
+        while len(samples) < limit:
+            y, v, a = stepper.step(dt)
+            samples.append((y, v, a))
+            near = (
+                np.max(np.abs(y - stepper.anchor)) <= settle * scale
+                and np.max(np.abs(v)) * stepper.period <= settle * scale
+            )
+            rest_for = rest_for + 1 if near else 0
+            if rest_for * dt >= stepper.period:
+                break
+        y, v, a = (np.array(part) for part in zip(*samples))
+        return Trajectory(np.arange(len(y)) * dt, y, v, a, self.units_, tuple(self.names_ or ()))
+
+
+def _period_transition(step: float, n: int, alpha: float, beta: float, tau: float) -> np.ndarray:
+    """The free system's transition over ``n`` steps (2, 2) for the state ``[y, z]``."""
+    transition = _foh_step(step, alpha, beta, tau)[0]
+    return np.linalg.matrix_power(transition, n)
+
+
+def _check_samples(count: float, what: str) -> float:
+    """Refuse a motion of more samples than the configured limit (``bidmp.set_limits``)."""
+    limit = get_limits().max_steps
+    if not count <= limit:
+        raise ValueError(
+            f"dt: {what} = {count:.4g} samples, more than the limit {limit} (bidmp.set_limits); "
+            "raise dt"
+        )
+    return count
+
+
+class _CriticalFilter:
+    """A critically damped second-order filter ``p̈ = ω² (p* - p) - 2 ω ṗ`` of time constant
+    ``1 / ω``, stepped exactly: the output and its rate are continuous whatever the command."""
+
+    def __init__(self, value, time_constant: float) -> None:
+        self.value = np.array(value, dtype=float)
+        self.rate = np.zeros_like(self.value)
+        self.target = self.value.copy()
+        self.time_constant = time_constant
+
+    def step(self, dt: float) -> None:
+        omega = 1.0 / self.time_constant
+        error = self.value - self.target
+        decay = math.exp(-omega * dt)
+        pushed = self.rate + omega * error
+        self.value = self.target + (error + pushed * dt) * decay
+        self.rate = (self.rate - omega * pushed * dt) * decay
+
+
+class RhythmicStepper:
+    """A rhythmic DMP one control step at a time, its frequency, amplitude and anchor changed
+    while it runs.
+
+    ``step(dt)`` returns ``(y, ẏ, ÿ)`` (units, units/s, units/s²) at the current sample and
+    advances by ``dt`` seconds. :meth:`set_frequency`, :meth:`set_amplitude`,
+    :meth:`set_anchor` and :meth:`stop` set targets that each setting follows through a
+    critically damped filter of time constant ``transition`` (s; default a quarter of the
+    longer of the two periods): the settings and their rates are continuous, so no step in
+    acceleration reaches the robot; a change is 95 % done after about 4.7 time constants.
+
+    Each step is exact for the settings held over it (the spring's transition for that τ, the
+    input linear over the step).
+    """
+
+    def __init__(self, model, frequency, amplitude, anchor, start, transition) -> None:
+        frequency, amplitude, anchor = model._settings(frequency, amplitude, anchor)
+        start = check_choice(start, "start", ("cycle", "rest"))
+        self._model = model
+        self._transition = (
+            None
+            if transition is None
+            else check_real(transition, "transition", positive=True, maximum=1e4)
+        )
+        time_constant = self._time_constant(frequency, frequency)
+        self._frequency = _CriticalFilter(frequency, time_constant)
+        self._amplitude = _CriticalFilter(amplitude if start == "cycle" else 0.0, time_constant)
+        self._anchor = _CriticalFilter(anchor, time_constant)
+        if start == "rest":
+            self._amplitude.target = np.array(float(amplitude))
+            self.y, self.v = anchor.copy(), np.zeros(model.n_dims_)
+        else:
+            self.y, self.v = model.cycle_start(frequency, amplitude, anchor)
+        self.phase = 0.0
+        self.cycles = 0.0
+        self.time = 0.0
+
+    def _time_constant(self, old: float, new: float) -> float:
+        if self._transition is not None:
+            return self._transition
+        return 0.25 / min(old, new)
+
+    @property
+    def time_constant(self) -> float:
+        """The settings' filter time constant now (s)."""
+        return float(self._frequency.time_constant)
+
+    @property
+    def frequency(self) -> float:
+        """The frequency in use now (Hz), on its way to the last one set."""
+        return float(self._frequency.value)
+
+    @property
+    def anchor(self) -> np.ndarray:
+        return self._anchor.value.copy()
+
+    @property
+    def period(self) -> float:
+        return 1.0 / self.frequency
+
+    def set_frequency(self, frequency: float) -> None:
+        frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+        constant = self._time_constant(self.frequency, frequency)
+        for part in (self._frequency, self._amplitude, self._anchor):
+            part.time_constant = constant
+        self._frequency.target = np.array(frequency)
+
+    def set_amplitude(self, amplitude: float) -> None:
+        self._amplitude.target = np.array(
+            check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
+        )
+
+    def set_anchor(self, anchor) -> None:
+        self._anchor.target = as_point(anchor, self._model.n_dims_, "anchor")
+
+    def stop(self) -> None:
+        """Let the amplitude fall to 0: the motion settles at the anchor, at rest."""
+        self._amplitude.target = np.array(0.0)
+
+    def _input(self) -> np.ndarray:
+        model = self._model
+        return (
+            model._alpha * model._beta * self._anchor.value
+            + float(self._amplitude.value) * model.forcing(np.array([self.phase]))[0]
+        )
+
+    def _acceleration(self, u: np.ndarray) -> np.ndarray:
+        model = self._model
+        omega = 2.0 * math.pi * self.frequency
+        tau = 1.0 / omega
+        z = tau * self.v
+        return (u - model._alpha * model._beta * self.y - model._alpha * z) / tau**2
+
+    def step(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        dt = check_real(dt, "dt", positive=True, maximum=1.0)
+        model = self._model
+        u_now = self._input()
+        out = (self.y.copy(), self.v.copy(), self._acceleration(u_now))
+        omega = 2.0 * math.pi * self.frequency
+        tau = 1.0 / omega
+        transition, now, after = _foh_step(dt, model._alpha, model._beta, tau)
+        # The settings move over the step; the phase advances by the mean frequency.
+        for part in (self._frequency, self._amplitude, self._anchor):
+            part.step(dt)
+        omega_next = 2.0 * math.pi * self.frequency
+        advance = 0.5 * (omega + omega_next) * dt
+        self.phase = math.fmod(self.phase + advance, 2.0 * math.pi)
+        self.cycles += advance / (2.0 * math.pi)
+        self.time += dt
+        u_next = self._input()
+        z = tau * self.v
+        y_next = (
+            transition[0, 0] * self.y + transition[0, 1] * z + now[0] * u_now + after[0] * u_next
+        )
+        z_next = (
+            transition[1, 0] * self.y + transition[1, 1] * z + now[1] * u_now + after[1] * u_next
+        )
+        self.y = y_next
+        # z = τ ẏ with the τ of the step; the velocity is what carries over a change of τ.
+        self.v = z_next / tau
+        return out
