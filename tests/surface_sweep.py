@@ -224,6 +224,17 @@ PERIODIC_TIMES = np.arange(400) / 100.0
 PERIODIC = np.column_stack(
     [20 * np.sin(2 * np.pi * PERIODIC_TIMES), 10 * np.cos(4 * np.pi * PERIODIC_TIMES)]
 )
+_ROCKING = 0.3 * np.sin(2 * np.pi * PERIODIC_TIMES)
+PERIODIC_POSES = np.column_stack(
+    [
+        PERIODIC,
+        5 * np.sin(2 * np.pi * PERIODIC_TIMES + 1.0),
+        np.zeros_like(_ROCKING),
+        np.sin(_ROCKING / 2),
+        np.zeros_like(_ROCKING),
+        np.cos(_ROCKING / 2),
+    ]
+)
 
 
 class _Hang(Exception):

@@ -11,6 +11,7 @@ import numpy as np
 from surface_sweep import (
     DEMO,
     PERIODIC,
+    PERIODIC_POSES,
     PERIODIC_TIMES,
     POSES,
     QUATS,
@@ -108,6 +109,15 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
         "bidmp.primitives.GaussianBasis": {"size": 10},
         "bidmp.primitives.VonMisesBasis": {"size": 10},
+        "bidmp.plotting.plot_rhythm": {
+            "path": tmp / "rhythm.png",
+            "recording": PERIODIC,
+            "t": PERIODIC_TIMES,
+            "trajectory": bidmp.primitives.RhythmicDMP(n_kernels=12)
+            .fit(PERIODIC, PERIODIC_TIMES)
+            .trajectory(1.0, dt=0.01),
+            "frequency": 1.0,
+        },
         "bidmp.primitives.AdaptiveOscillator": {"frequency": 1.0},
         "bidmp.primitives.estimate_frequency": {"y": PERIODIC, "t": PERIODIC_TIMES},
         "bidmp.primitives.harmonic_fit": {
@@ -297,6 +307,7 @@ def _estimators():
         ("GMMRegressor", GMMRegressor, (DEMO,)),
         ("TPGMM", TPGMM, (DEMO,)),
         ("RhythmicDMP", bidmp.primitives.RhythmicDMP, (PERIODIC, PERIODIC_TIMES)),
+        ("RhythmicPoseDMP", bidmp.primitives.RhythmicPoseDMP, (PERIODIC_POSES, PERIODIC_TIMES)),
     ]
 
 
@@ -420,6 +431,8 @@ def _instances(tmp: Path):
     rhythmic = RhythmicDMP(n_kernels=12).fit(PERIODIC, PERIODIC_TIMES)
     rhythm_args = {"cycles": 1.0, "dt": 0.01, "phase": np.linspace(0.0, 6.0, 7)}
     yield "RhythmicDMP", rhythmic, rhythm_args
+    pose_rhythm = bidmp.primitives.RhythmicPoseDMP(n_kernels=12).fit(PERIODIC_POSES, PERIODIC_TIMES)
+    yield "RhythmicPoseDMP", pose_rhythm, {"cycles": 1.0, "dt": 0.01, "anchor": [1.0, 2.0, 3.0]}
     yield (
         "RhythmicStepper",
         rhythmic.stepper(),

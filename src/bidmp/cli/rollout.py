@@ -133,6 +133,21 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     if not args.tool_length >= 0:
         raise ValueError(f"--tool-length must be >= 0 metres, got {args.tool_length:g}")
     model = load_model(args.model)
+    from ..primitives.rhythmic import RhythmicDMP
+    from ..primitives.rhythmic_pose import RhythmicPoseDMP
+
+    if isinstance(model, (RhythmicDMP, RhythmicPoseDMP)):
+        from .rhythm import rollout_periodic
+
+        return rollout_periodic(args, model)
+    rhythmic = ("cycles", "frequency", "anchor")
+    if any(getattr(args, name) is not None for name in rhythmic) or args.from_rest:
+        raise ValueError(
+            f"--cycles, --frequency, --amplitude, --anchor and --from-rest are for a rhythmic model "
+            f"(bidmp fit --periodic); {args.model} holds a {type(model).__name__}"
+        )
+    if args.amplitude is not None:
+        raise ValueError("--amplitude is for a rhythmic model (bidmp fit --periodic)")
     if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     dmp = model_dmp(model)
@@ -570,6 +585,32 @@ def _add_rollout_arguments(rollout) -> None:
         help="Bi-DMP models: nearest (default), latest or a skill number (0 = plain DMP)",
     )
     rollout.add_argument("--plot", metavar="PNG", help="also write a figure of the rollout")
+    rhythm = rollout.add_argument_group("rhythmic models (bidmp fit --periodic)")
+    rhythm.add_argument(
+        "--cycles", type=float, default=None, metavar="N", help="periods to run (default 1)"
+    )
+    rhythm.add_argument(
+        "--frequency", type=float, default=None, metavar="HZ", help="default: the learned one"
+    )
+    rhythm.add_argument(
+        "--amplitude",
+        type=float,
+        default=None,
+        metavar="A",
+        help="scale of the oscillation about the anchor (default 1: as learned)",
+    )
+    rhythm.add_argument(
+        "--anchor",
+        type=float,
+        nargs="+",
+        metavar="X",
+        help="the oscillation's centre in the model's units (default: the learned one)",
+    )
+    rhythm.add_argument(
+        "--from-rest",
+        action="store_true",
+        help="start at rest at the anchor, run the cycles, end at rest there",
+    )
     rollout.add_argument(
         "--via",
         type=float,

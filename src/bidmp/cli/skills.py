@@ -94,6 +94,15 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
     from ..tasks.metrics import path_extent
 
+    if args.periodic:
+        from .rhythm import fit_periodic
+
+        _refuse_with_periodic(args)
+        return fit_periodic(args)
+    if args.plot:
+        raise ValueError(
+            "fit --plot draws a rhythm (--periodic); for a DMP: bidmp rollout MODEL --plot PNG"
+        )
     if demo_kind(args) == "pose":
         return _fit_poses(args)
     demonstration, times, units, how, names, held = read_input(args.demo, args, timed=True)
@@ -134,6 +143,24 @@ def cmd_fit(args: argparse.Namespace) -> int:
         )
     print(f"wrote {path}")
     return EXIT_OK
+
+
+def _refuse_with_periodic(args: argparse.Namespace) -> None:
+    """The discrete DMP's options, refused with --periodic (one line naming the first)."""
+    for name, flag in (
+        ("beta", "--beta"),
+        ("K", "--K"),
+        ("alpha_phase", "--alpha-phase"),
+        ("regression", "--regression"),
+        ("keep_approach", "--keep-approach"),
+    ):
+        if getattr(args, name, None) is not None:
+            raise ValueError(f"{flag} is a discrete DMP's option; a rhythm (--periodic) has none")
+    if args.protocol == "paper" or args.tau != 1.0:
+        raise ValueError(
+            "--protocol paper and --tau are a discrete DMP's; a rhythm runs at its frequency "
+            "(bidmp rollout --frequency)"
+        )
 
 
 def _fit_poses(args: argparse.Namespace) -> int:
@@ -399,6 +426,17 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
         help="robot protocol (default on): a moved goal's offset is complete before the final approach "
         "(the straight tail into the goal), which then is a translated copy of the demonstrated one; "
         "--no-keep-approach spreads it over the whole motion (the progress gate)",
+    )
+    fit.add_argument(
+        "--periodic",
+        action="store_true",
+        help="learn a rhythmic DMP from a recording of several periods (frequency estimated, "
+        "transients cut, all periods at once); --n-kernels (default 50) and --alpha (default 25) apply",
+    )
+    fit.add_argument(
+        "--plot",
+        metavar="PNG",
+        help="with --periodic: a figure of the learned cycle, its phase portrait and the spectrum",
     )
     fit.set_defaults(handler=cmd_fit)
 

@@ -48,6 +48,8 @@ _MODEL_CLASSES = {
     "BiDMP": ("bidmp.incremental.bidmp", "BiDMP"),
     "CartesianDMP": ("bidmp.primitives.cartesian", "CartesianDMP"),
     "CartesianBiDMP": ("bidmp.incremental.cartesian", "CartesianBiDMP"),
+    "RhythmicDMP": ("bidmp.primitives.rhythmic", "RhythmicDMP"),
+    "RhythmicPoseDMP": ("bidmp.primitives.rhythmic_pose", "RhythmicPoseDMP"),
 }
 
 

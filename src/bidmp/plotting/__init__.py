@@ -18,7 +18,13 @@ if TYPE_CHECKING:
     from .extension import plot_extension, plot_prm_comparison, plot_segmentation
     from .incremental import plot_incremental
     from .tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
-    from .trajectories import plot_generalisation, plot_recordings, plot_rollout, plot_trajectories
+    from .trajectories import (
+        plot_generalisation,
+        plot_recordings,
+        plot_rhythm,
+        plot_rollout,
+        plot_trajectories,
+    )
     from .viewer import (
         ViewLayers,
         add_robot_motions,

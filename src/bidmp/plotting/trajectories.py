@@ -376,3 +376,85 @@ def plot_recordings(path, recordings) -> Path:
         axes.grid(True, alpha=0.3)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def plot_rhythm(
+    path: str | os.PathLike,
+    recording: np.ndarray,
+    t: np.ndarray,
+    trajectory,
+    frequency: float,
+    uncertainty: float = 0.0,
+    title: str = "rhythm",
+    units: str = "",
+) -> Path:
+    """A rhythmic motion: the learned cycle over the recording's path (left: the first two or
+    three coordinates), its phase portrait (middle: each coordinate's velocity against its
+    position about the mean, the recording's by central differences in grey), and the recording's
+    spectrum with the estimated frequency marked (right).
+
+    Parameters
+    ----------
+    path : path of the PNG to write.
+    recording : (T, D) the recording (units); t : (T,) its stamps (s).
+    trajectory : bidmp.Trajectory of the learned rhythm (a few cycles).
+    frequency, uncertainty : the estimate (Hz) and its standard error (Hz).
+    """
+    from ..primitives.timing import TimedMotion
+
+    if not isinstance(trajectory, TimedMotion):
+        raise TypeError(f"trajectory must be a bidmp.Trajectory, got {type(trajectory).__name__}")
+    from .._checks import check_real
+
+    check_path(path)
+    title, units = _text(title, "title", 200), _text(units, "units", 20)
+    frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+    uncertainty = check_real(uncertainty, "uncertainty", nonnegative=True, maximum=1e3)
+    recording = as_trajectory(recording, "recording", min_points=8)
+    t = check_timestamps(t, recording.shape[0])
+    n_dims = min(recording.shape[1], trajectory.y.shape[1], 3)
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(17.0, 5.0), dpi=110)
+    ax = fig.add_subplot(1, 3, 1, projection="3d" if n_dims == 3 else None)
+    if n_dims >= 2:
+        ax.plot(*recording[:, :n_dims].T, color="0.6", linewidth=0.8, label="recording")
+        ax.plot(*trajectory.y[:, :n_dims].T, color="C0", linewidth=2.0, label="learned cycle")
+        _label_axes(ax, n_dims, units)
+    else:
+        ax.plot(t - t[0], recording[:, 0], color="0.6", linewidth=0.8, label="recording")
+        ax.plot(trajectory.t, trajectory.y[:, 0], color="C0", linewidth=2.0, label="learned")
+        ax.set_xlabel("t [s]")
+    ax.set_title(title)
+    ax.legend(loc="best", fontsize=8)
+    portrait = fig.add_subplot(1, 3, 2)
+    velocity = np.gradient(recording, t, axis=0)
+    suffix = units or "units"
+    for index in range(n_dims):
+        centre = trajectory.y[:, index].mean()
+        portrait.plot(recording[:, index] - centre, velocity[:, index], color="0.8", linewidth=0.5)
+        portrait.plot(
+            trajectory.y[:, index] - centre, trajectory.yd[:, index], label=f"coordinate {index}"
+        )
+    portrait.set_xlabel(f"position about the centre [{suffix}]")
+    portrait.set_ylabel(f"velocity [{suffix}/s]")
+    portrait.set_title("phase portrait (recording in grey)", fontsize=10)
+    portrait.legend(loc="best", fontsize=8)
+    portrait.grid(True, alpha=0.3)
+    spectrum = fig.add_subplot(1, 3, 3)
+    uniform = np.linspace(t[0], t[-1], recording.shape[0])
+    resampled = np.column_stack([np.interp(uniform, t, column) for column in recording.T])
+    resampled -= resampled.mean(axis=0)
+    power = np.sum(
+        np.abs(np.fft.rfft(resampled * np.hanning(len(uniform))[:, None], axis=0)) ** 2, 1
+    )
+    frequencies = np.fft.rfftfreq(len(uniform), (t[-1] - t[0]) / (len(uniform) - 1))
+    shown = frequencies <= 6.0 * frequency
+    spectrum.semilogy(frequencies[shown], power[shown] + 1e-300, color="C0")
+    spectrum.axvline(frequency, color="crimson", label=f"{frequency:.4g} ± {uncertainty:.2g} Hz")
+    spectrum.set_xlabel("frequency [Hz]")
+    spectrum.set_ylabel("power")
+    spectrum.set_title("spectrum of the recording and the estimated frequency", fontsize=10)
+    spectrum.legend(loc="best", fontsize=8)
+    spectrum.grid(True, alpha=0.3)
+    fig.subplots_adjust(left=0.03, right=0.98, wspace=0.3)
+    return _save(fig, path)

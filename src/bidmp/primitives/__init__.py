@@ -60,6 +60,7 @@ if TYPE_CHECKING:
     from .oscillator import AdaptiveOscillator
     from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
     from .rhythmic import RhythmicDMP, RhythmicStepper
+    from .rhythmic_pose import RhythmicPoseDMP, mean_orientation
     from .so3 import continuous_log, orientation_from_log, principal_log
     from .stepper import DMPStepper
     from .timing import (

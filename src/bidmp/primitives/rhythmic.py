@@ -252,14 +252,12 @@ class RhythmicDMP(Estimator):
         frequency, amplitude, anchor = self._settings(frequency, amplitude, anchor)
         cycles = check_real(cycles, "cycles", positive=True, maximum=1e5)
         dt = check_real(dt, "dt", positive=True, maximum=1.0)
-        n = (
-            int(
-                math.floor(
-                    _check_samples(cycles / (frequency * dt), "cycles / (frequency * dt)") + 1e-9
-                )
+        steps = _check_samples(cycles / (frequency * dt), "cycles / (frequency * dt)")
+        if steps < 1.0 - 1e-9:
+            raise ValueError(
+                f"cycles: {cycles:g} cycles at {frequency:.4g} Hz last less than one step dt = {dt:g} s"
             )
-            + 1
-        )
+        n = int(math.floor(steps + 1e-9)) + 1
         omega = 2.0 * math.pi * frequency
         tau = 1.0 / omega
         phase = omega * dt * np.arange(n + 1)
@@ -351,6 +349,69 @@ class RhythmicDMP(Estimator):
                 break
         y, v, a = (np.array(part) for part in zip(*samples))
         return Trajectory(np.arange(len(y)) * dt, y, v, a, self.units_, tuple(self.names_ or ()))
+
+    # -- persistence (used by bidmp.io) -----------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        self._check_fitted()
+        estimate = self.estimate_
+        state = {
+            "params": self.get_params(),
+            "frequency": float(self.frequency_),
+            "units": self.units_,
+            "names": list(self.names_ or []),
+            "estimate": None
+            if estimate is None
+            else {
+                "uncertainty": float(estimate.uncertainty),
+                "n_harmonics": int(estimate.n_harmonics),
+                "start": float(estimate.start),
+                "end": float(estimate.end),
+                "periods": int(estimate.periods),
+                "spread": float(estimate.spread),
+            },
+        }
+        arrays = {
+            "weights_": self.weights_,
+            "centres_": self.centres_,
+            "widths_": self.widths_,
+            "anchor_": self.anchor_,
+            "amplitude_": self.amplitude_,
+        }
+        return state, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> RhythmicDMP:
+        from .._checks import check_loaded
+        from .frequency import FrequencyEstimate
+
+        model = cls(**meta["params"])
+        n_kernels = check_int(model.n_kernels, "n_kernels", minimum=2, limit="max_kernels")
+        model.weights_ = check_loaded(arrays["weights_"], "weights_", (n_kernels, None))
+        n_dims = model.weights_.shape[1]
+        model.centres_ = check_loaded(arrays["centres_"], "centres_", (n_kernels,))
+        model.widths_ = check_loaded(arrays["widths_"], "widths_", (n_kernels,), positive=True)
+        model.anchor_ = check_loaded(arrays["anchor_"], "anchor_", (n_dims,))
+        model.amplitude_ = check_loaded(arrays["amplitude_"], "amplitude_", (n_dims,))
+        model.frequency_ = check_real(meta["frequency"], "frequency", positive=True, maximum=1e3)
+        model.units_ = "" if not meta["units"] else check_units(meta["units"])
+        model.names_ = check_names(meta["names"] or None, n_dims)
+        model.n_dims_ = n_dims
+        found = meta["estimate"]
+        model.estimate_ = (
+            None
+            if found is None
+            else FrequencyEstimate(
+                frequency=model.frequency_,
+                uncertainty=check_real(found["uncertainty"], "uncertainty", nonnegative=True),
+                n_harmonics=check_int(found["n_harmonics"], "n_harmonics", minimum=1),
+                start=check_real(found["start"], "start", nonnegative=True),
+                end=check_real(found["end"], "end", nonnegative=True),
+                periods=check_int(found["periods"], "periods", minimum=1),
+                spread=check_real(found["spread"], "spread", nonnegative=True),
+                amplitude=model.amplitude_,
+            )
+        )
+        return model
 
 
 def _period_transition(step: float, n: int, alpha: float, beta: float, tau: float) -> np.ndarray:
