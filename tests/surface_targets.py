@@ -109,6 +109,7 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.primitives.drop_repeated_stamps": {"y": DEMO, "t": TIMES},
         "bidmp.primitives.GaussianBasis": {"size": 10},
         "bidmp.primitives.VonMisesBasis": {"size": 10},
+        "bidmp.tasks.RockSpec": {"recording": "rocking_cell"},
         "bidmp.plotting.plot_rhythm": {
             "path": tmp / "rhythm.png",
             "recording": PERIODIC,

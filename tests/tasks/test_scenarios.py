@@ -18,6 +18,7 @@ def nut_spec():
 def test_builtins_load_and_have_the_spec_geometry():
     assert scenarios.builtin_names() == [
         "cell-removal",
+        "cell-rocking",
         "nut-unscrewing",
         "nut-unscrewing-iiwa",
         "nut-unscrewing-tilted",

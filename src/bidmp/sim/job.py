@@ -1,5 +1,5 @@
 """The whole job on the simulated arm: at every target, in the job's order, the learned approach,
-then the job's steps (engage, unscrew, retract, drop; or grasp, lift, place), each a motion
+then the job's steps (engage, unscrew, retract, drop; or grasp, (rock,) lift, place), each a motion
 planned through the arm's IK, timed within its limits, executed at 1 kHz and judged by the motion
 contract (:mod:`bidmp.tasks.contract`) on what the arm did.
 
@@ -9,7 +9,8 @@ Every motion between places comes from the learned skills: the approach is the B
 for this target); the transfers to the bin or the rack are the plain DMP's start and goal
 generalisation, lifted over the work by a via-point where the tool or the part it carries would
 come within the margin of a part. Straight moves along a part's axis (unscrewing, retracting,
-lifting out) are lines. The unscrewing is a powered spindle on the tool coupled to the retraction:
+lifting out) are lines. Rocking a part loose is a periodic skill (a rhythmic DMP learned from a
+recording) run from rest at the grasp and back to rest there, at its learned timing. The unscrewing is a powered spindle on the tool coupled to the retraction:
 it turns the socket by one turn per pitch the arm rises (measured, every 2 ms), which a wrist
 cannot (its last joint turns less than one turn each way) and which keeps the nut on its thread
 whatever the arm's timing. A tilted part (a pose scenario) is approached by the pose skill along
@@ -255,11 +256,54 @@ def _place(world: _World, part: MovablePart, slot, exclude) -> JobPhase:
     return phase
 
 
+def _rhythm(world: _World):
+    """The rock step's periodic skill, learned once per job from its recording (in mm, converted
+    to the scenario's unit)."""
+    if world.rhythm is None:
+        from .._units import conversion
+        from ..demonstrations.datasets import recording
+        from ..primitives.rhythmic import RhythmicDMP
+
+        y, t = recording(world.spec.rock.recording)
+        units = world.scenario.units
+        world.rhythm = RhythmicDMP().fit(y * conversion("mm", units), t, units=units)
+    return world.rhythm
+
+
+def _rock(world: _World, part: MovablePart, exclude) -> JobPhase:
+    """Rock the held part loose: the periodic skill from rest at the grasp, its cycles, and back
+    to rest there, timed as learned (slower only if the arm's limits ask), judged like any move."""
+    spec, rhythm = world.spec.rock, _rhythm(world)
+    motion = rhythm.run(spec.cycles, dt=0.002, amplitude=spec.amplitude, frequency=spec.frequency)
+    path = world.tcp + (motion.y - rhythm.anchor_)
+    swing = float(np.max(np.abs(motion.y - rhythm.anchor_)))
+    phase = _move(
+        world,
+        path,
+        motion.t / motion.t[-1],
+        exclude,
+        "rock",
+        least_duration=float(motion.t[-1]),
+        # IK samples fine enough for the swing: 16 or more a cycle
+        spacing=max(swing / 4.0, 1e-6) * world.cell.unit,
+        carried=part,
+        support=_supports(world, part),
+    )
+    frequency = rhythm.frequency_ if spec.frequency is None else spec.frequency
+    phase.note = (
+        f"{spec.cycles:g} cycles at {frequency:.3g} Hz, swing up to {swing:.2g} "
+        f"{world.scenario.units}, from rest and back to rest"
+    )
+    return phase
+
+
 def _lift_cycle(world: _World, label: str, target, axis, record: JobTarget) -> None:
-    """approach → grasp → lift straight out → place in the next rack slot, for one part."""
+    """approach → grasp (→ rock) → lift straight out → place in the next rack slot, for one part."""
     part, exclude = _reach(world, label, target, axis, record, "grasp")
     part.hold()
     world.held = part
+    if "rock" in world.spec.steps:
+        _checked(world, record, _rock(world, part, exclude), target[:3])
     if "lift" in world.spec.steps:
         _checked(
             world,

@@ -44,6 +44,7 @@ class _World:
         default_factory=list
     )  # (target, phase, image) where a motion broke the contract
     record: bool = False  # keep each phase's measured path and commands
+    rhythm: object = None  # the rock step's periodic skill (a RhythmicDMP), learned once per job
 
     @property
     def scene(self):
@@ -79,6 +80,7 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     orientations=None,
     on_record=None,
     least_duration: float = 0.0,
+    spacing: float | None = None,
     carried=None,
     target=None,
     axis=None,
@@ -88,7 +90,8 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     contract: its end within the threshold of ``target`` (default the path's end), the final descent
     along ``axis`` when it is the approach, clearance by the margin of the executed tool and of a
     ``carried`` part (its own contacts count as the arm's; not from the parts it stands on,
-    ``support``, while it is lifted off them), the 1 kHz commands within the limits."""
+    ``support``, while it is lifted off them), the 1 kHz commands within the limits. ``spacing``:
+    the IK samples' largest spacing (m; default the planner's 5 mm), finer for a small oscillation."""
     cell = world.cell
     plan = cell.plan(
         np.asarray(path, dtype=float),
@@ -96,6 +99,7 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
         fractions=fractions,
         seed=world.q,
         orientations=orientations,
+        **({} if spacing is None else {"spacing": spacing}),
     )
     if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
         scale = plan.duration / least_duration

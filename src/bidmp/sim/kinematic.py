@@ -306,8 +306,29 @@ class KinematicCell:
 
     # -- the job's world ----------------------------------------------------------------------
     def add_solids(self, solids) -> None:
-        """More static parts (the job's bin, its rack): what released parts land on."""
-        self._solids.extend(_check_solids(solids))
+        """More static parts (the job's bin, its rack): what released parts land on, and what the
+        tool's contacts are measured against (as the scene's own parts are)."""
+        from ..scene import Scene
+        from ..scene.parts import Part
+
+        solids = _check_solids(solids)
+        self._solids.extend(solids)
+        known = set(self.scene.labels)
+        grouped: dict = {}
+        for solid in solids:
+            if solid.part not in known:
+                grouped.setdefault(solid.part, []).append(solid)
+        if grouped:
+            scene = self.scene
+            added = [Part(label, "box", {}, tuple(group)) for label, group in grouped.items()]
+            self.scene = Scene(
+                (*scene.parts, *added),
+                scene.tool,
+                scene.targets,
+                scene.targets_on_parts,
+                scene.margin,
+                scene.standoff,
+            )
 
     def movable_part(self, label: str, mass: float) -> _KinematicPart:
         """The scene's part ``label`` as one the job moves."""

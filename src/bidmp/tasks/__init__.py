@@ -16,7 +16,7 @@ from .._lazy import exports
 if TYPE_CHECKING:
     from .contract import CommandPeaks, Contract, Verdict, command_peaks, mm
     from .evaluation import CONVERGED_GAIN, evaluate
-    from .jobs import JobSpec, parse_job, tour
+    from .jobs import JobSpec, RockSpec, parse_job, tour
     from .metrics import (
         approach_error,
         axis_deviation,

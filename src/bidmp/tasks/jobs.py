@@ -8,7 +8,11 @@ A job names what the robot does at each target after the learned approach brings
 * ``"lift"`` (cell removal): approach → grasp (a vacuum gripper, made when the tool is within
   ``engage_tolerance`` of the part's top centre) → lift straight out past the neighbours → place
   in the next ``rack`` slot;
-* ``"pick-place"``: approach → grasp → place in the next ``rack`` slot (no straight lift).
+* ``"pick-place"``: approach → grasp → place in the next ``rack`` slot (no straight lift);
+* ``"rock-lift"``: approach → grasp → rock (a periodic skill learned from the ``"rock"`` key's
+  recording: ``cycles`` periods from rest and back to rest at the grasp, ``amplitude`` times the
+  recorded swing, at the recorded frequency or ``frequency``, Hz) → lift → place, for a part held
+  in its slot that has to be rocked loose first.
 
 ``"order"``: ``"listed"`` (the targets' order in the file) or ``"shortest"``: a short tour from
 the demonstrated target by a small heuristic — nearest neighbour, then 2-opt exchanges until
@@ -31,12 +35,13 @@ from .._checks import as_point, as_vector, check_choice, check_int, check_real, 
 from .._units import UNITS, check_units, mm
 from ._scenario_fields import _fail, _point, _shown
 
-__all__ = ["JobSpec", "JOB_KINDS", "parse_job", "tour"]
+__all__ = ["JobSpec", "RockSpec", "JOB_KINDS", "parse_job", "tour"]
 
 JOB_KINDS = {
     "unscrew": ("approach", "engage", "unscrew", "retract", "drop"),
     "lift": ("approach", "grasp", "lift", "place"),
     "pick-place": ("approach", "grasp", "place"),
+    "rock-lift": ("approach", "grasp", "rock", "lift", "place"),
 }
 MAX_TOUR = 200
 _KEYS = {
@@ -51,6 +56,7 @@ _KEYS = {
     "lift",
     "clearance",
     "transfer",
+    "rock",
 }
 
 
@@ -58,6 +64,35 @@ _KEYS = {
 DEFAULTS_MM = {"pitch": 1.25, "engage_tolerance": 1.0, "lift": 20.0, "clearance": 40.0}
 PLAY_MM = 0.5  # a part is let go this far above where it rests; a nut leaves its stud this far clear of it
 SLOT_TOLERANCE_MM = 1.0  # a placed part's bottom within this of its slot's height
+
+
+@dataclass(frozen=True)
+class RockSpec:
+    """The ``"rock"`` step of a job: the bundled recording its periodic skill is learned from
+    (:func:`bidmp.demonstrations.recording_names`), the periods to run, the swing as a multiple of
+    the recorded one, and the frequency (Hz; None: the recorded one)."""
+
+    recording: str
+    cycles: float = 3.0
+    amplitude: float = 1.0
+    frequency: float | None = None
+
+    def __post_init__(self) -> None:
+        from ..demonstrations.datasets import recording_names
+
+        check_choice(self.recording, "recording", recording_names())
+        object.__setattr__(
+            self, "cycles", check_real(self.cycles, "cycles", positive=True, maximum=1000)
+        )
+        object.__setattr__(
+            self, "amplitude", check_real(self.amplitude, "amplitude", positive=True, maximum=100)
+        )
+        if self.frequency is not None:
+            object.__setattr__(
+                self,
+                "frequency",
+                check_real(self.frequency, "frequency", positive=True, maximum=50),
+            )
 
 
 @dataclass(frozen=True)
@@ -89,6 +124,7 @@ class JobSpec:
     clearance: float | None = None
     transfer: str = "dmp"
     units: str = "mm"
+    rock: RockSpec | None = None
 
     def __post_init__(self) -> None:
         kind = check_choice(self.kind, "kind", JOB_KINDS)
@@ -144,6 +180,13 @@ class JobSpec:
                     as_point(row_step, 3, "rack[3]"),
                 ),
             )
+        if (kind == "rock-lift") != (self.rock is not None):
+            raise ValueError(
+                "rock: a rock-lift job rocks each part with a periodic skill (give RockSpec); "
+                "no other job has a rock step"
+            )
+        if self.rock is not None and not isinstance(self.rock, RockSpec):
+            raise TypeError(f"rock must be a RockSpec, got {type(self.rock).__name__}")
         if kind == "unscrew" and self.bin is None:
             raise ValueError(
                 "bin: an unscrew job drops each nut into a bin; give where it stands and its size"
@@ -263,6 +306,16 @@ def parse_job(data, source: str) -> JobSpec | None:
     transfer = job.get("transfer", "dmp")
     if transfer not in ("dmp", "similarity"):
         _fail(source, "job.transfer", f'expected "dmp" or "similarity", got {_shown(transfer)}')
+    rock = None
+    if (kind == "rock-lift") != ("rock" in job):
+        _fail(
+            source,
+            "job.rock",
+            'a rock step needs its periodic skill: {"recording": <a bundled recording>, '
+            '"cycles": 3, "amplitude": 1} (and only a rock-lift job has one)',
+        )
+    if "rock" in job:
+        rock = _rock(job["rock"], source)
     numbers = {
         name: _positive(job[name], source, f"job.{name}")
         for name in ("pitch", "spindle_speed", "engage_tolerance", "part_mass", "lift", "clearance")
@@ -277,8 +330,34 @@ def parse_job(data, source: str) -> JobSpec | None:
         bin=_box(job["bin"], source, "job.bin") if "bin" in job else None,
         rack=_rack(job["rack"], source, "job.rack") if "rack" in job else None,
         units=units,
+        rock=rock,
         **numbers,
     )
+
+
+def _rock(value, source: str) -> RockSpec:
+    """The ``"rock"`` key: a bundled recording's name, optional cycles, amplitude, frequency."""
+    from ..demonstrations.datasets import recording_names
+
+    keys = {"recording", "cycles", "amplitude", "frequency"}
+    if not isinstance(value, dict) or "recording" not in value or set(value) - keys:
+        _fail(source, "job.rock", f"expected keys among {sorted(keys)}, recording required")
+    if value["recording"] not in recording_names():
+        _fail(
+            source,
+            "job.rock.recording",
+            f"expected a bundled recording ({', '.join(recording_names())}), got "
+            f"{_shown(value['recording'])}",
+        )
+    numbers = {
+        name: _positive(value[name], source, f"job.rock.{name}")
+        for name in ("cycles", "amplitude", "frequency")
+        if name in value
+    }
+    try:
+        return RockSpec(value["recording"], **numbers)
+    except ValueError as exc:
+        _fail(source, "job.rock", str(exc))
 
 
 def tour(points: np.ndarray, start: np.ndarray) -> list[int]:
