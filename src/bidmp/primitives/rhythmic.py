@@ -214,6 +214,26 @@ class RhythmicDMP(Estimator):
         fixed = np.linalg.solve(np.eye(2) - transition, end)
         return fixed[0], fixed[1] / tau
 
+    def _shape_peaks(self) -> tuple[float, float, float, float]:
+        """The learned cycle at amplitude 1 as a function of the phase: the largest norms of
+        ``y - g`` and its first three derivatives in φ (the same at any frequency)."""
+        cached = self.__dict__.get("_shape_cache")
+        if cached is not None and cached[0] is self.weights_:
+            return cached[1]
+        n = 4000
+        dt = 1.0 / (self.frequency_ * n)
+        motion = self.trajectory(1.0, dt=dt)
+        omega = 2.0 * math.pi * self.frequency_
+        jerk = np.gradient(motion.ydd, dt, axis=0)
+        peaks = (
+            float(np.linalg.norm(motion.y - self.anchor_, axis=1).max()),
+            float(np.linalg.norm(motion.yd, axis=1).max()) / omega,
+            float(np.linalg.norm(motion.ydd, axis=1).max()) / omega**2,
+            float(np.linalg.norm(jerk, axis=1).max()) / omega**3,
+        )
+        self._shape_cache = (self.weights_, peaks)
+        return peaks
+
     @property
     def _alpha(self) -> float:
         return float(self.alpha)
@@ -294,11 +314,12 @@ class RhythmicDMP(Estimator):
         anchor=None,
         start: str = "cycle",
         transition: float | None = None,
+        limits: dict | None = None,
     ) -> RhythmicStepper:
         """A control-loop stepper (:class:`RhythmicStepper`) started on the limit cycle
         (``start="cycle"``) or at rest at the anchor with the amplitude rising from 0
-        (``"rest"``)."""
-        return RhythmicStepper(self, frequency, amplitude, anchor, start, transition)
+        (``"rest"``); ``limits`` as :class:`RhythmicStepper` takes them."""
+        return RhythmicStepper(self, frequency, amplitude, anchor, start, transition, limits)
 
     def run(
         self,
@@ -310,6 +331,7 @@ class RhythmicDMP(Estimator):
         anchor=None,
         transition: float | None = None,
         settle: float = 1e-3,
+        limits: dict | None = None,
     ) -> Trajectory:
         """From rest at the anchor into the rhythm and back to rest: the amplitude rises from 0
         (a critically damped filter of time constant ``transition``), ``cycles`` periods run,
@@ -323,6 +345,7 @@ class RhythmicDMP(Estimator):
             anchor=anchor,
             start="rest",
             transition=transition,
+            limits=limits,
         )
         dt = check_real(dt, "dt", positive=True, maximum=1.0)
         # The rise, the cycles and the settling (a few transition times) must fit the limit.
@@ -431,6 +454,28 @@ def _check_samples(count: float, what: str) -> float:
     return count
 
 
+def _check_rhythm_limits(limits) -> dict:
+    """``limits`` as a dict of positive caps among max_velocity, max_acceleration, max_jerk."""
+    if limits is None:
+        return {}
+    if not isinstance(limits, dict):
+        raise TypeError(
+            f"limits must be a dict of max_velocity / max_acceleration / max_jerk, got "
+            f"{type(limits).__name__}"
+        )
+    known = ("max_velocity", "max_acceleration", "max_jerk")
+    unknown = sorted(str(key) for key in limits if key not in known)
+    if unknown:
+        raise ValueError(
+            f"limits has an unknown key {unknown[0][:40]!r}; known: {', '.join(known)}"
+        )
+    return {
+        key: check_real(value, f"limits[{key!r}]", positive=True)
+        for key, value in limits.items()
+        if value is not None
+    }
+
+
 class _CriticalFilter:
     """A critically damped second-order filter ``p̈ = ω² (p* - p) - 2 ω ṗ`` of time constant
     ``1 / ω``, stepped exactly: the output and its rate are continuous whatever the command."""
@@ -458,14 +503,17 @@ class RhythmicStepper:
     advances by ``dt`` seconds. :meth:`set_frequency`, :meth:`set_amplitude`,
     :meth:`set_anchor` and :meth:`stop` set targets that each setting follows through a
     critically damped filter of time constant ``transition`` (s; default a quarter of the
-    longer of the two periods): the settings and their rates are continuous, so no step in
-    acceleration reaches the robot; a change is 95 % done after about 4.7 time constants.
+    longer of the two periods, lengthened where ``limits`` ask): the settings and their rates are
+    continuous, so no step in acceleration reaches the robot; a change is 95 % done after about
+    4.7 time constants. ``limits`` (``max_velocity``, ``max_acceleration``, ``max_jerk``: the
+    norms' caps, units/s^k, as for a discrete trajectory) refuse a setting whose steady rhythm
+    exceeds them and set the time constant so that the change stays within them.
 
     Each step is exact for the settings held over it (the spring's transition for that τ, the
     input linear over the step).
     """
 
-    def __init__(self, model, frequency, amplitude, anchor, start, transition) -> None:
+    def __init__(self, model, frequency, amplitude, anchor, start, transition, limits=None) -> None:
         frequency, amplitude, anchor = model._settings(frequency, amplitude, anchor)
         start = check_choice(start, "start", ("cycle", "rest"))
         self._model = model
@@ -474,23 +522,99 @@ class RhythmicStepper:
             if transition is None
             else check_real(transition, "transition", positive=True, maximum=1e4)
         )
-        time_constant = self._time_constant(frequency, frequency)
-        self._frequency = _CriticalFilter(frequency, time_constant)
-        self._amplitude = _CriticalFilter(amplitude if start == "cycle" else 0.0, time_constant)
-        self._anchor = _CriticalFilter(anchor, time_constant)
+        self._limits = _check_rhythm_limits(limits)
+        self._check_setting(frequency, amplitude, "the start's settings")
+        self._frequency = _CriticalFilter(frequency, 1.0)
+        self._amplitude = _CriticalFilter(amplitude if start == "cycle" else 0.0, 1.0)
+        self._anchor = _CriticalFilter(anchor, 1.0)
         if start == "rest":
             self._amplitude.target = np.array(float(amplitude))
             self.y, self.v = anchor.copy(), np.zeros(model.n_dims_)
         else:
             self.y, self.v = model.cycle_start(frequency, amplitude, anchor)
+        self._retime()
         self.phase = 0.0
         self.cycles = 0.0
         self.time = 0.0
 
-    def _time_constant(self, old: float, new: float) -> float:
+    def _check_setting(self, frequency: float, amplitude: float, what: str) -> None:
+        """Refuse a setting whose steady rhythm exceeds the limits (peak velocity, acceleration,
+        jerk: ``r Ω^k max|d^k y / dφ^k|`` of the learned cycle)."""
+        if not self._limits:
+            return
+        shape = self._model._shape_peaks()
+        omega = 2.0 * math.pi * frequency
+        for order, (key, unit) in enumerate(
+            (("max_velocity", "/s"), ("max_acceleration", "/s^2"), ("max_jerk", "/s^3")), start=1
+        ):
+            limit = self._limits.get(key)
+            peak = amplitude * omega**order * shape[order]
+            if limit is not None and peak > limit:
+                raise ValueError(
+                    f"{what}: at {frequency:.4g} Hz and amplitude {amplitude:.4g} the rhythm's peak "
+                    f"{key[4:]} is {peak:.4g} units{unit}, over {key} = {limit:g}"
+                )
+
+    def _retime(self) -> None:
+        """One time constant for the three settings' filters: ``transition`` when given, else a
+        quarter of the longer period, lengthened until the change's first-order bound on the
+        peaks stays within the limits (when given)."""
         if self._transition is not None:
-            return self._transition
-        return 0.25 / min(old, new)
+            constant = self._transition
+        else:
+            frequencies = (float(self._frequency.value), float(self._frequency.target))
+            constant = 0.25 / min(frequencies)
+            if self._limits:
+                constant = self._limited_constant(constant)
+        for part in (self._frequency, self._amplitude, self._anchor):
+            part.time_constant = constant
+
+    def _limited_constant(self, constant: float) -> float:
+        """The shortest time constant from ``constant`` up (by 20 % steps) whose bound holds.
+
+        The rhythm is ``y = g + r c(φ)`` with ``φ̇ = Ω`` and a cycle ``c`` learned at amplitude 1
+        (the same path in φ at any Ω), so ``ẏ = r Ω c' + ṙ c + ġ``, ``ÿ = r Ω² c'' + r Ω̇ c' + 2 ṙ Ω c'
+        + r̈ c + g̈`` and the jerk likewise; a critically damped filter moving a setting by Δ has
+        ``|ṗ| ≤ Δ / (e T)``, ``|p̈| ≤ Δ / T²``, ``|p⃛| ≤ 2 Δ / T³``. The bound sums the terms'
+        maxima at the larger of the old and new settings."""
+        d0, d1, d2, d3 = self._model._shape_peaks()
+        omegas = 2.0 * math.pi * np.array([self._frequency.value, self._frequency.target])
+        amplitudes = np.array([self._amplitude.value, self._amplitude.target], dtype=float)
+        omega, r = float(omegas.max()), float(amplitudes.max())
+        d_omega = float(abs(omegas[1] - omegas[0]))
+        d_r = float(abs(amplitudes[1] - amplitudes[0]))
+        d_g = float(np.linalg.norm(self._anchor.target - self._anchor.value))
+
+        def peaks(t: float) -> tuple[float, float, float]:
+            rate, second, third = 1.0 / (math.e * t), 1.0 / t**2, 2.0 / t**3
+            velocity = r * omega * d1 + d_r * d0 * rate + d_g * rate
+            acceleration = (
+                r * omega**2 * d2
+                + r * d_omega * d1 * rate
+                + 2.0 * d_r * omega * d1 * rate
+                + d_r * d0 * second
+                + d_g * second
+            )
+            jerk = (
+                r * omega**3 * d3
+                + 3.0 * r * omega * d_omega * d2 * rate
+                + r * d_omega * d1 * second
+                + 3.0 * d_r * omega**2 * d2 * rate
+                + 3.0 * d_r * omega * d1 * second
+                + 2.0 * d_r * d0 * third
+                + 2.0 * d_g * third
+            )
+            return velocity, acceleration, jerk
+
+        keys = ("max_velocity", "max_acceleration", "max_jerk")
+        while constant < 1e4:
+            if all(
+                self._limits.get(key) is None or value <= self._limits[key]
+                for key, value in zip(keys, peaks(constant))
+            ):
+                return constant
+            constant *= 1.2
+        raise ValueError("limits: no transition of up to 1e4 s keeps this change within them")
 
     @property
     def time_constant(self) -> float:
@@ -511,23 +635,28 @@ class RhythmicStepper:
         return 1.0 / self.frequency
 
     def set_frequency(self, frequency: float) -> None:
+        """Move to ``frequency`` (Hz); refused if its steady rhythm exceeds the limits."""
         frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
-        constant = self._time_constant(self.frequency, frequency)
-        for part in (self._frequency, self._amplitude, self._anchor):
-            part.time_constant = constant
+        self._check_setting(frequency, float(self._amplitude.target), "frequency")
         self._frequency.target = np.array(frequency)
+        self._retime()
 
     def set_amplitude(self, amplitude: float) -> None:
-        self._amplitude.target = np.array(
-            check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
-        )
+        """Move to ``amplitude`` (× the learned swing); refused if it exceeds the limits."""
+        amplitude = check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
+        self._check_setting(float(self._frequency.target), amplitude, "amplitude")
+        self._amplitude.target = np.array(amplitude)
+        self._retime()
 
     def set_anchor(self, anchor) -> None:
+        """Move the oscillation's centre to ``anchor`` (D,) (units)."""
         self._anchor.target = as_point(anchor, self._model.n_dims_, "anchor")
+        self._retime()
 
     def stop(self) -> None:
         """Let the amplitude fall to 0: the motion settles at the anchor, at rest."""
         self._amplitude.target = np.array(0.0)
+        self._retime()
 
     def _input(self) -> np.ndarray:
         model = self._model
