@@ -92,6 +92,8 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_job.py
 	$(PY) benchmarks/bench_repair.py
 	$(PY) benchmarks/bench_startup.py
+	$(PY) benchmarks/bench_rhythmic.py
+	$(PY) benchmarks/bench_promp.py
 
 # Every benchmark script once, quickly (one repetition, few fields, one LASA shape, the smoke
 # modes): a CI stage, so that none breaks silently between full runs of make bench. Its timings
@@ -105,6 +107,7 @@ bench-smoke: $(STAMP)
 	cd benchmarks && ../$(PY) bench_timing.py --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_sim.py > /dev/null
 	cd benchmarks && ../$(PY) bench_rhythmic.py --smoke > /dev/null
+	cd benchmarks && ../$(PY) bench_promp.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_cartesian.py --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_lasa.py --every 20 --rounds 1 --shapes 1 --out ../.bench-smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_avoidance.py --fields 2 --repeats 1 > /dev/null

@@ -110,6 +110,20 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.primitives.GaussianBasis": {"size": 10},
         "bidmp.primitives.VonMisesBasis": {"size": 10},
         "bidmp.tasks.RockSpec": {"recording": "rocking_cell"},
+        "bidmp.primitives.promp_basis": {"phase": np.linspace(0.0, 1.0, 30), "n_basis": 8},
+        "bidmp.primitives.condition_gaussian": {
+            "mean": np.zeros(3),
+            "cov": np.eye(3),
+            "H": np.ones((3, 1)),
+            "y": np.ones(1),
+            "noise": np.zeros((1, 1)),
+        },
+        "bidmp.plotting.plot_distribution": {
+            "path": tmp / "distribution.png",
+            "demonstrations": [DEMO[:, :2], DEMO[::2, :2]],
+            "mean": DEMO[:, :2],
+            "std": np.ones((60, 2)),
+        },
         "bidmp.plotting.plot_rhythm": {
             "path": tmp / "rhythm.png",
             "recording": PERIODIC,
@@ -309,6 +323,8 @@ def _estimators():
         ("TPGMM", TPGMM, (DEMO,)),
         ("RhythmicDMP", bidmp.primitives.RhythmicDMP, (PERIODIC, PERIODIC_TIMES)),
         ("RhythmicPoseDMP", bidmp.primitives.RhythmicPoseDMP, (PERIODIC_POSES, PERIODIC_TIMES)),
+        ("ProMP", bidmp.primitives.ProMP, ([DEMO, DEMO[::-1]],)),
+        ("MultiDMP", bidmp.primitives.MultiDMP, ([DEMO, DEMO * 1.1],)),
     ]
 
 
@@ -432,6 +448,14 @@ def _instances(tmp: Path):
     rhythmic = RhythmicDMP(n_kernels=12).fit(PERIODIC, PERIODIC_TIMES)
     rhythm_args = {"cycles": 1.0, "dt": 0.01, "phase": np.linspace(0.0, 6.0, 7)}
     yield "RhythmicDMP", rhythmic, rhythm_args
+    promp = bidmp.primitives.ProMP(n_basis=8).fit([DEMO, DEMO * 1.05, DEMO[::-1]])
+    yield (
+        "ProMP",
+        promp,
+        {"phase": [0.0, 1.0], "y": DEMO[[0, -1]], "n_samples": 3, "dt": 0.05},
+    )
+    multi = bidmp.primitives.MultiDMP(bidmp.DMP(n_kernels=10)).fit([DEMO, DEMO * 1.05])
+    yield "MultiDMP", multi, {"goal": DEMO[-1] + 5.0, "n_samples": 2}
     pose_rhythm = bidmp.primitives.RhythmicPoseDMP(n_kernels=12).fit(PERIODIC_POSES, PERIODIC_TIMES)
     yield "RhythmicPoseDMP", pose_rhythm, {"cycles": 1.0, "dt": 0.01, "anchor": [1.0, 2.0, 3.0]}
     yield (

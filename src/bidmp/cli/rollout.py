@@ -140,6 +140,13 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         from .rhythm import rollout_periodic
 
         return rollout_periodic(args, model)
+    from ..primitives.multi import MultiDMP
+    from ..primitives.promp import ProMP
+
+    if isinstance(model, (ProMP, MultiDMP)):
+        from .several import rollout_several
+
+        return rollout_several(args, model)
     rhythmic = ("cycles", "frequency", "anchor")
     if any(getattr(args, name) is not None for name in rhythmic) or args.from_rest:
         raise ValueError(

@@ -94,6 +94,14 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from ..primitives.dmp import DMP
     from ..tasks.metrics import path_extent
 
+    if args.promp or args.multi:
+        from .several import fit_several
+
+        if args.periodic or (args.promp and args.multi):
+            raise ValueError("give one of --periodic, --promp, --multi")
+        return fit_several(args)
+    if args.demo is None:
+        raise ValueError("give the demonstration to learn (or several after --promp/--multi)")
     if args.periodic:
         from .rhythm import fit_periodic
 
@@ -367,6 +375,7 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
     fit.add_argument(
         "demo",
         metavar="DEMO",
+        nargs="?",
         help="demonstration (.csv, .npy, or a ROS bag: a .bag file or a ROS 2 bag folder)",
     )
     fit.add_argument(
@@ -434,9 +443,23 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
         "transients cut, all periods at once); --n-kernels (default 50) and --alpha (default 25) apply",
     )
     fit.add_argument(
+        "--promp",
+        nargs="+",
+        metavar="DEMO",
+        help="learn a ProMP from several demonstrations (any lengths and rates); --n-kernels "
+        "(default 20) basis functions per dimension",
+    )
+    fit.add_argument(
+        "--multi",
+        nargs="+",
+        metavar="DEMO",
+        help="learn a DMP from several demonstrations (aligned by phase, their spread kept)",
+    )
+    fit.add_argument(
         "--plot",
         metavar="PNG",
-        help="with --periodic: a figure of the learned cycle, its phase portrait and the spectrum",
+        help="with --periodic: the learned cycle, its phase portrait and the spectrum; with "
+        "--promp/--multi: the mean with its ±2σ band over the demonstrations",
     )
     fit.set_defaults(handler=cmd_fit)
 

@@ -22,7 +22,7 @@ logger = logging.getLogger(__name__)
 
 # The built-in methods the benchmark runs by default (registry.names(lasa=True) lists them, and any
 # method registered with lasa = True after them).
-LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp")
+LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp", "promp", "dmp-multi")
 
 
 CASES = (
@@ -127,7 +127,10 @@ def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
     from ..tasks.methods import Method, Task
     from ..tasks.metrics import path_extent
 
-    y = lasa_data(shape)[demo][::every]
+    shape_demos = lasa_data(shape)
+    y = shape_demos[demo][::every]
+    # the shape's other demonstrations, for the methods that learn from several
+    others = tuple(d[::every] for index, d in enumerate(shape_demos) if index != demo)
     seed = _cell_seed(shape, demo)
     rng = np.random.default_rng(seed)
     angle = rng.uniform(0.0, 2.0 * np.pi)
@@ -159,7 +162,13 @@ def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
             rollouts[method] = np.asarray(rollout[:: max(1, len(rollout) // 200)]).round(4).tolist()
 
     # The task of the cell: the paper's DMP (the LASA literature's), a Bi-DMP grown to each goal.
-    task = Task(y, np.array([goal for _, goal in cases]), seed=seed, dmp={"protocol": "paper"})
+    task = Task(
+        y,
+        np.array([goal for _, goal in cases]),
+        seed=seed,
+        dmp={"protocol": "paper"},
+        demonstrations=others,
+    )
     for name in methods:
         method = name if isinstance(name, Method) else registry.get(name)
         model, fit_s = method.fit(task)  # seconds to learn, shared models (the DMP) included

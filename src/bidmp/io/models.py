@@ -50,6 +50,8 @@ _MODEL_CLASSES = {
     "CartesianBiDMP": ("bidmp.incremental.cartesian", "CartesianBiDMP"),
     "RhythmicDMP": ("bidmp.primitives.rhythmic", "RhythmicDMP"),
     "RhythmicPoseDMP": ("bidmp.primitives.rhythmic_pose", "RhythmicPoseDMP"),
+    "ProMP": ("bidmp.primitives.promp", "ProMP"),
+    "MultiDMP": ("bidmp.primitives.multi", "MultiDMP"),
 }
 
 

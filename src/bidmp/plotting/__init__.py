@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from .incremental import plot_incremental
     from .tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
     from .trajectories import (
+        plot_distribution,
         plot_generalisation,
         plot_recordings,
         plot_rhythm,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_points, as_trajectory, check_limit, check_path, short_token
+from .._checks import as_points, as_trajectory, as_vector, check_limit, check_path, short_token
 from ..primitives.timing import check_timestamps
 from ._base import _figure, _label_axes, _matplotlib, _save, _sequence, _text
 
@@ -457,4 +457,86 @@ def plot_rhythm(
     spectrum.legend(loc="best", fontsize=8)
     spectrum.grid(True, alpha=0.3)
     fig.subplots_adjust(left=0.03, right=0.98, wspace=0.3)
+    return _save(fig, path)
+
+
+def plot_distribution(
+    path: str | os.PathLike,
+    demonstrations,
+    mean: np.ndarray,
+    std: np.ndarray,
+    conditioned: np.ndarray | None = None,
+    conditioned_std: np.ndarray | None = None,
+    points=None,
+    title: str = "distribution",
+    units: str = "",
+) -> Path:
+    """A motion learned from several demonstrations: per coordinate against the phase (the share
+    of the motion's time), the demonstrations (grey), the mean with its ±2σ band (blue), and a
+    conditioned result with its own band (orange) and the points it was conditioned on (black).
+
+    Parameters
+    ----------
+    path : path of the PNG to write.
+    demonstrations : list of (T_i, D) arrays (each drawn over its own phase [0, 1]).
+    mean, std : (L, D) over L phases evenly in [0, 1].
+    conditioned, conditioned_std : (L', D), optional.
+    points : (phases (K,), values (K, D)), optional.
+    """
+    check_path(path)
+    title, units = _text(title, "title", 200), _text(units, "units", 20)
+    demos = [
+        as_trajectory(y, f"demonstrations[{i}]", min_points=2, allow_static=True)
+        for i, y in enumerate(_sequence(demonstrations, "demonstrations"))
+    ]
+    mean = as_trajectory(mean, "mean", min_points=2, allow_static=True)
+    try:
+        std = as_points(std, mean.shape[1], "std")
+    except ValueError as exc:
+        raise ValueError(f"{exc} (mean has shape {mean.shape})") from None
+    if std.shape != mean.shape or np.any(std < 0):
+        raise ValueError(f"std must be non-negative, of mean's shape {mean.shape}, got {std.shape}")
+    if points is not None:
+        if not isinstance(points, (tuple, list)) or len(points) != 2:
+            raise TypeError("points must be (phases (K,), values (K, D)) or None")
+        at = as_vector(points[0], "points[0]")
+        values = as_points(points[1], mean.shape[1], "points[1]")
+        if values.shape[0] != at.shape[0] or at.min() < 0.0 or at.max() > 1.0:
+            raise ValueError("points must be K phases in [0, 1] and K values of D coordinates")
+        points = (at, values)
+    n_dims = mean.shape[1]
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(5.5 * n_dims, 4.5), dpi=110)
+    phase = np.linspace(0.0, 1.0, mean.shape[0])
+    suffix = f" [{units}]" if units else ""
+    for d in range(n_dims):
+        ax = fig.add_subplot(1, n_dims, d + 1)
+        for y in demos:
+            ax.plot(np.linspace(0.0, 1.0, y.shape[0]), y[:, d], color="0.7", linewidth=0.8)
+        ax.fill_between(
+            phase, mean[:, d] - 2 * std[:, d], mean[:, d] + 2 * std[:, d], color="C0", alpha=0.25
+        )
+        ax.plot(phase, mean[:, d], color="C0", linewidth=2.0, label="mean ± 2σ")
+        if conditioned is not None:
+            conditioned = as_trajectory(conditioned, "conditioned", min_points=2, allow_static=True)
+            c_phase = np.linspace(0.0, 1.0, conditioned.shape[0])
+            if conditioned_std is not None:
+                spread = as_points(conditioned_std, n_dims, "conditioned_std")
+                ax.fill_between(
+                    c_phase,
+                    conditioned[:, d] - 2 * spread[:, d],
+                    conditioned[:, d] + 2 * spread[:, d],
+                    color="C1",
+                    alpha=0.25,
+                )
+            ax.plot(c_phase, conditioned[:, d], color="C1", linestyle="--", label="conditioned")
+        if points is not None:
+            at, values = points
+            ax.plot(np.asarray(at), np.asarray(values)[:, d], "ko", label="conditioned on")
+        ax.set_xlabel("phase (share of the motion's time)")
+        ax.set_ylabel(f"coordinate {d}{suffix}")
+        ax.grid(True, alpha=0.3)
+        if d == 0:
+            ax.set_title(title)
+            ax.legend(loc="best", fontsize=8)
     return _save(fig, path)

@@ -14,6 +14,9 @@ Where things live (the field's split, as in movement_primitives and dmpbbo):
 * ``via`` — exact via-points (least-norm weight change); ``goal_shift`` — goals moved mid-motion;
 * ``dmp`` — :class:`DMP`, the estimator that composes them; ``stepper`` — its control-loop stepper;
 * ``cartesian``, ``so3``, ``pose_timing`` — pose DMPs on unit quaternions;
+* ``multi`` — a DMP from several demonstrations, with their spread; ``promp`` — probabilistic
+  movement primitives from several demonstrations, exact
+  conditioning;
 * ``rhythmic`` — periodic DMPs and their modulation while running; ``frequency`` — a periodic
   recording's frequency, steady part and spread; ``oscillator`` — adaptive frequency oscillators;
 * ``timing`` — timed trajectories and time scaling to limits.
@@ -57,7 +60,9 @@ if TYPE_CHECKING:
     from .frequency import FrequencyEstimate, estimate_frequency, harmonic_fit
     from .goals import ApproachGate, DelayedGoal, PhaseGate, ProgressGate
     from .integrate import StepIntegrator
+    from .multi import MultiDMP
     from .oscillator import AdaptiveOscillator
+    from .promp import ProMP, condition_gaussian, promp_basis
     from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
     from .rhythmic import RhythmicDMP, RhythmicStepper
     from .rhythmic_pose import RhythmicPoseDMP, mean_orientation

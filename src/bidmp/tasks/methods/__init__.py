@@ -38,6 +38,8 @@ _BUILTIN_ORDER = (
     "gmm",
     "tpgmm",
     "mp-dmp",
+    "promp",
+    "dmp-multi",
 )
 
 
@@ -48,9 +50,9 @@ def _load_builtins() -> None:
         return
     _BUILTINS_LOADED = True
     # Each module lists its methods (METHODS) and never imports the registry: one way only.
-    from . import bidmp, dmp, dmp_converged, gmm, mp_dmp, tpgmm
+    from . import bidmp, dmp, dmp_converged, gmm, mp_dmp, multi, tpgmm
 
-    for module in (dmp, dmp_converged, bidmp, gmm, tpgmm, mp_dmp):
+    for module in (dmp, dmp_converged, bidmp, gmm, tpgmm, mp_dmp, multi):
         for method in module.METHODS:
             register(method)
 

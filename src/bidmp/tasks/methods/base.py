@@ -59,6 +59,10 @@ class Task:
         the demonstration to each goal it is asked for (the LASA benchmark).
     shared : dict
         Models shared between methods, with the seconds each took to build.
+    demonstrations : tuple of arrays (T_i, D)
+        Further demonstrations of the same task (any lengths), for the methods that learn from
+        several (``promp``, ``dmp-multi``); empty: they learn from ``demonstration`` and noisy
+        copies of it, as the GMM baselines do.
     """
 
     demonstration: np.ndarray
@@ -69,6 +73,7 @@ class Task:
     poses: bool = False
     build_skills: Callable | None = None
     shared: dict = field(default_factory=dict)
+    demonstrations: tuple = ()
 
     def __post_init__(self) -> None:
         self.poses = check_bool(self.poses, "poses")
@@ -89,6 +94,29 @@ class Task:
             )
         if not isinstance(self.shared, dict):
             raise TypeError(f"shared must be a dict, got {type(self.shared).__name__}")
+        if not isinstance(self.demonstrations, (tuple, list)):
+            raise TypeError(
+                f"demonstrations must be a tuple of (T_i, D) arrays, got {type(self.demonstrations).__name__}"
+            )
+        self.demonstrations = tuple(
+            as_trajectory(y, f"demonstrations[{index}]")
+            for index, y in enumerate(self.demonstrations)
+        )
+        for index, y in enumerate(self.demonstrations):
+            if y.shape[1] != self.demonstration.shape[1]:
+                raise ValueError(
+                    f"demonstrations[{index}] has D = {y.shape[1]} but the demonstration has D = "
+                    f"{self.demonstration.shape[1]}"
+                )
+
+    def all_demonstrations(self) -> list[np.ndarray]:
+        """The demonstration and the further ones; with none further, the demonstration and 5
+        noisy copies of it (:func:`bidmp.baselines.augment`, the GMM baselines' data)."""
+        if self.demonstrations:
+            return [self.demonstration, *self.demonstrations]
+        from ...baselines import augment
+
+        return list(augment(self.demonstration, 5, 1.5, self.seed % (2**31)))
 
     def shared_model(self, key, build: Callable) -> tuple[object, float]:
         """``(model, seconds)``: ``build()`` the first time ``key`` is asked for, the same model after."""

@@ -1,0 +1,207 @@
+"""A DMP learned from several demonstrations, keeping their spread as a weight distribution.
+
+Alignment in time: by phase — each demonstration is taken on its own normalised time (its first
+sample at 0, its last at 1) and resampled to the demonstrations' median length, the motion lasting
+their mean duration. (No dynamic time warping: demonstrations whose features come at different
+shares of their duration are averaged where they are; DTW is left for a later release.)
+
+One forcing term from all: the DMP's grid, kernels and goal system come from the mean aligned
+demonstration; every demonstration's forcing target is taken on that grid and regressed on its
+basis, and the weights are their mean (the same numbers as one regression on all the targets
+stacked: the rows are shared). Their covariance, regularised, is the weight distribution: a
+rollout's positions are affine in the weights, ``y = y₀ + A W`` with ``A`` the response of each
+basis function's forcing, so a motion to any goal has a mean, an exact variance and samples.
+
+Layer 1: the package's own math.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from .._api import Estimator, clone
+from .._checks import NotFittedError, check_int, check_real, check_seed
+from .._trajectory import resample_time
+from .dmp import DMP
+from .promp import _demonstrations, _stamps
+
+__all__ = ["MultiDMP"]
+
+
+class MultiDMP(Estimator):
+    """A DMP from several demonstrations, with their spread.
+
+    Parameters
+    ----------
+    dmp : DMP, optional
+        The DMP to learn (its parameters; cloned, never fitted itself); default ``DMP()``.
+    cov_reg : float
+        Added to the weight covariance's diagonal, times its mean variance.
+
+    Attributes
+    ----------
+    dmp_ : DMP
+        The fitted DMP whose weights are the mean weights.
+    weights_ : (n_demos, N, D)
+        Each demonstration's weights on the shared grid.
+    weight_cov_ : (D, N, N)
+        The weights' covariance per dimension (regularised).
+    """
+
+    def __init__(self, dmp: DMP | None = None, cov_reg: float = 1e-6) -> None:
+        self.dmp = dmp
+        self.cov_reg = cov_reg
+
+    def fit(self, demonstrations, times=None, units: str | None = None) -> MultiDMP:
+        """Learn from ``demonstrations`` (a list of (T_i, D) arrays) with their stamps ``times``
+        (a list of (T_i,) arrays, s; None: each over 1 s)."""
+        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
+        template = DMP() if self.dmp is None else self.dmp
+        if not isinstance(template, DMP):
+            raise TypeError(
+                f"dmp must be a bidmp.DMP (its parameters), got {type(template).__name__}"
+            )
+        demos = _demonstrations(demonstrations)
+        stamps = _stamps(times, demos)
+        n_samples = int(np.median([y.shape[0] for y in demos]))
+        aligned = np.stack([resample_time(y, n_samples) for y in demos])
+        duration = float(np.mean([t[-1] - t[0] for t in stamps]))
+        t = np.linspace(0.0, duration, n_samples)
+        model = clone(template).fit(
+            aligned.mean(axis=0), t if times is not None else None, units=units
+        )
+        _, basis = model.training_grid()
+        gram = basis.T @ basis
+        gram[np.diag_indices(gram.shape[0])] += 1e-8 * np.trace(gram) / gram.shape[0]
+        # Each demonstration is started and ended at rest as the mean one was (which said so
+        # once, when the model was fitted): their own blends are logged at debug level only.
+        rest_logger = logging.getLogger("bidmp.primitives.rest")
+        level = rest_logger.level
+        rest_logger.setLevel(max(level, logging.ERROR))
+        try:
+            weights = np.stack(
+                [
+                    np.linalg.solve(
+                        gram, basis.T @ model.forcing_target(model.training_trajectory(y))
+                    )
+                    for y in aligned
+                ]
+            )
+        finally:
+            rest_logger.setLevel(level)
+        model.weights_ = np.ascontiguousarray(weights.mean(axis=0))
+        n_kernels, n_dims = model.weights_.shape
+        covariance = np.empty((n_dims, n_kernels, n_kernels))
+        for d in range(n_dims):
+            block = (
+                np.cov(weights[:, :, d], rowvar=False)
+                if len(demos) > 1
+                else np.zeros((n_kernels, n_kernels))
+            )
+            block = np.atleast_2d(block)
+            scale = float(np.mean(np.diag(block)))
+            scale = scale if scale > 0.0 else max(float(np.mean(model.weights_[:, d] ** 2)), 1e-300)
+            block[np.diag_indices(n_kernels)] += cov_reg * scale
+            covariance[d] = block
+        self.dmp_ = model
+        self.weights_ = weights
+        self.weight_cov_ = covariance
+        self.aligned_ = aligned
+        return self
+
+    def _check_fitted(self) -> None:
+        if "dmp_" not in self.__dict__:
+            raise NotFittedError("this MultiDMP is not fitted yet: call fit(demonstrations) first")
+
+    def trajectory(self, goal=None, **options):
+        """The mean motion (:meth:`bidmp.DMP.trajectory` of the mean weights)."""
+        self._check_fitted()
+        return self.dmp_.trajectory(goal, **options)
+
+    def rollout(self, goal=None, **options) -> np.ndarray:
+        """The mean motion's positions (:meth:`bidmp.DMP.rollout`)."""
+        self._check_fitted()
+        return self.dmp_.rollout(goal, **options)
+
+    def response(self, goal=None, n_steps: int | None = None) -> np.ndarray:
+        """``A`` (n, N): how each weight moves the rollout's positions (the same for every
+        dimension: the forcing enters each alike), exactly, from one rollout per basis function."""
+        self._check_fitted()
+        base = self.dmp_.rollout(goal, n_steps=n_steps)
+        n_kernels, n_dims = self.dmp_.weights_.shape
+        columns = []
+        for i in range(n_kernels):
+            moved = self.dmp_.rollout(
+                goal,
+                n_steps=n_steps,
+                forcing_increment=lambda phase, basis, i=i: np.repeat(
+                    basis[:, i : i + 1], n_dims, 1
+                ),
+            )
+            columns.append(moved[:, 0] - base[:, 0])
+        return np.column_stack(columns)
+
+    def std(self, goal=None, n_steps: int | None = None) -> np.ndarray:
+        """The positions' standard deviation (n, D) along the rollout to ``goal`` (exact)."""
+        A = self.response(goal, n_steps)
+        variance = np.stack(
+            [np.einsum("ti,ij,tj->t", A, block, A) for block in self.weight_cov_], axis=1
+        )
+        return np.sqrt(np.maximum(variance, 0.0))
+
+    def sample(self, n_samples: int, seed=0, goal=None, n_steps: int | None = None) -> np.ndarray:
+        """``n_samples`` rollouts (n_samples, n, D) to ``goal`` with weights drawn from the
+        distribution (seeded)."""
+        self._check_fitted()
+        n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=10_000)
+        rng = np.random.default_rng(check_seed(seed, "seed"))
+        mean = self.dmp_.weights_
+        out = []
+        for _ in range(n_samples):
+            change = np.column_stack(
+                [
+                    rng.multivariate_normal(np.zeros(mean.shape[0]), self.weight_cov_[d])
+                    for d in range(mean.shape[1])
+                ]
+            )
+            out.append(
+                self.dmp_.rollout(
+                    goal,
+                    n_steps=n_steps,
+                    forcing_increment=lambda phase, basis, c=change: basis @ c,
+                )
+            )
+        return np.stack(out)
+
+    # -- persistence (used by bidmp.io) -----------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        self._check_fitted()
+        inner_state, inner_arrays = self.dmp_._get_state()
+        arrays = {f"dmp.{name}": value for name, value in inner_arrays.items()}
+        arrays["weights_"] = self.weights_
+        arrays["weight_cov_"] = self.weight_cov_
+        state = {"cov_reg": float(self.cov_reg), "dmp": inner_state}
+        return state, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> MultiDMP:
+        from .._checks import check_loaded
+
+        class _Prefixed:  # the DMP's members, under their own names
+            def __getitem__(self, name):
+                return arrays[f"dmp.{name}"]
+
+            def __contains__(self, name):
+                return f"dmp.{name}" in arrays
+
+        inner = DMP._from_state(meta["dmp"], _Prefixed())
+        model = cls(dmp=DMP(**inner.get_params()), cov_reg=meta["cov_reg"])
+        n_kernels, n_dims = inner.weights_.shape
+        model.dmp_ = inner
+        model.weights_ = check_loaded(arrays["weights_"], "weights_", (None, n_kernels, n_dims))
+        model.weight_cov_ = check_loaded(
+            arrays["weight_cov_"], "weight_cov_", (n_dims, n_kernels, n_kernels)
+        )
+        return model

@@ -1,0 +1,79 @@
+"""bidmp fit --promp / --multi on several demonstration files of other lengths and durations, and
+bidmp rollout of the models: the written motion reaches the goal, starts at the demonstrations'
+mean start, and the printed spread is the demonstrations' own."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from bidmp.cli import main
+from bidmp.demonstrations import lasa
+from bidmp.io import load_trajectory, save_trajectory
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("several")
+    demos = lasa("Sshape")[:4]
+    paths = []
+    for index, (n, seconds) in enumerate(((1000, 2.0), (640, 2.4), (420, 1.8), (880, 2.2))):
+        y = np.column_stack(
+            [np.interp(np.linspace(0, 1, n), np.linspace(0, 1, 1000), c) for c in demos[index].T]
+        )
+        paths.append(str(save_trajectory(y, folder / f"s{index}.csv", np.linspace(0, seconds, n))))
+    return folder, paths, demos
+
+
+@pytest.mark.parametrize("flag", ["--promp", "--multi"])
+def test_fit_several_then_roll_out_to_a_goal(files, flag, capsys):
+    folder, paths, demos = files
+    model, figure = folder / f"m{flag}.npz", folder / f"m{flag}.png"
+    code, out, _ = run(
+        ["fit", flag, *paths, "--units", "mm", "--raw", "-o", str(model), "--plot", str(figure)],
+        capsys,
+    )
+    assert code == 0 and figure.stat().st_size > 10_000
+    assert "on 4 demonstrations (1000, 640, 420, 880 samples)" in out
+    # the printed largest spread is of the order of the demonstrations' own
+    largest = float(re.search(r"largest ([0-9.]+) mm", out).group(1))
+    own = np.linalg.norm(np.std(demos, axis=0, ddof=1), axis=1).max()
+    assert 0.5 * own < largest < 2.0 * own
+    goal = demos.mean(axis=0)[-1] + [4.0, -3.0]
+    out_csv = folder / f"o{flag}.csv"
+    code, out, _ = run(
+        [
+            "rollout",
+            str(model),
+            "--goal",
+            *map(str, goal),
+            "-o",
+            str(out_csv),
+            "--plot",
+            str(figure),
+        ],
+        capsys,
+    )
+    assert code == 0
+    motion = load_trajectory(out_csv)
+    y = motion[0] if isinstance(motion, tuple) else motion
+    np.testing.assert_allclose(y[-1], goal, atol=0.01)
+    np.testing.assert_allclose(y[0], demos.mean(axis=0)[0], atol=0.5)
+
+
+def test_one_file_or_two_flags_are_refused_in_one_line(files, capsys):
+    folder, paths, _ = files
+    code, _, err = run(["fit", "--promp", paths[0], "-o", str(folder / "x.npz")], capsys)
+    assert code == 2 and "two or more" in err and len(err.strip().splitlines()) == 1
+    code, _, err = run(
+        ["fit", "--promp", *paths[:2], "--multi", *paths[2:], "-o", str(folder / "x.npz")], capsys
+    )
+    assert code == 2 and "--promp" in err

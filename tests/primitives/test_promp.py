@@ -1,0 +1,116 @@
+"""ProMPs: exact conditioning against an independent closed form and movement_primitives' ProMP,
+the phase normalisation on demonstrations of other lengths and rates, sampling against the
+analytic moments."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bidmp.demonstrations import lasa
+from bidmp.primitives import ProMP
+
+
+@pytest.fixture(scope="module")
+def shape():
+    return lasa("Angle")  # 7 demonstrations (7, 1000, 2), mm
+
+
+@pytest.fixture(scope="module")
+def promp(shape):
+    return ProMP(n_basis=20).fit(list(shape))
+
+
+def test_a_zero_variance_via_point_is_passed_exactly(promp, shape):
+    extent = np.ptp(shape, axis=(0, 1)).max()
+    points = np.array([[-12.0, 4.0], [3.0, -2.0]])
+    conditioned = promp.condition([0.4, 1.0], points, 0.0)
+    np.testing.assert_allclose(conditioned.mean([0.4, 1.0]), points, atol=1e-9 * extent)
+    assert conditioned.var([0.4, 1.0]).max() <= 1e-9 * promp.var([0.4, 1.0]).max()
+    # and elsewhere the motion keeps a spread
+    assert conditioned.var([0.7]).max() > 0.0
+
+
+def test_a_noisy_via_point_matches_the_information_form(promp):
+    """Independent closed form: Σ' = (Σ⁻¹ + H N⁻¹ Hᵀ)⁻¹, μ' = Σ' (Σ⁻¹ μ + H N⁻¹ y)."""
+    sigma2 = 0.5**2
+    point = np.array([[2.0, 1.0]])
+    conditioned = promp.condition([0.8], point, sigma2)
+    H = promp._H(np.array([0.8]))
+    precision = np.linalg.inv(promp.weight_cov_)
+    cov = np.linalg.inv(precision + H @ H.T / sigma2)
+    mean = cov @ (precision @ promp.weight_mean_ + H @ point.reshape(-1) / sigma2)
+    np.testing.assert_allclose(
+        conditioned.weight_mean_, mean, rtol=1e-6, atol=1e-8 * np.abs(mean).max()
+    )
+    np.testing.assert_allclose(conditioned.weight_cov_, cov, atol=1e-6 * np.abs(cov).max())
+    # the posterior variance at the point is below both the prior's and the observation's
+    at = conditioned.var([0.8])
+    assert np.all(at < sigma2) and np.all(at < promp.var([0.8]))
+
+
+def test_conditioning_equals_movement_primitives_on_the_same_distribution(promp):
+    mp = pytest.importorskip("movement_primitives.promp")
+    peer = mp.ProMP(n_dims=2, n_weights_per_dim=20)
+    peer.from_weight_distribution(promp.weight_mean_.copy(), promp.weight_cov_.copy())
+    goal = np.array([4.0, -1.0])
+    theirs = peer.condition_position(goal, t=1.0, t_max=1.0)
+    ours = promp.condition([1.0], goal[None], 0.0)
+    T = np.linspace(0.0, 1.0, 200)
+    np.testing.assert_allclose(ours.mean(T), theirs.mean_trajectory(T), atol=1e-8)
+    np.testing.assert_allclose(ours.var(T), theirs.var_trajectory(T), atol=1e-8)
+
+
+def test_demonstrations_of_other_lengths_and_rates_share_one_phase(shape):
+    """Property: a demonstration resampled at 317 samples over 2.3 s (jittered stamps) has the
+    weights of its 1000 uniform samples (the phase is each one's own normalised time)."""
+    rng = np.random.default_rng(3)
+    demo = shape[2]
+    stamps = np.sort(np.concatenate([[0.0, 2.3], rng.uniform(0.0, 2.3, 315)]))
+    resampled = np.column_stack(
+        [np.interp(stamps / 2.3, np.linspace(0, 1, 1000), column) for column in demo.T]
+    )
+    a = ProMP(n_basis=15).fit([demo])
+    b = ProMP(n_basis=15).fit([resampled], times=[stamps])
+    extent = np.ptp(demo, axis=0).max()  # least squares on other samples: close, not equal
+    np.testing.assert_allclose(a.mean(n_steps=300), b.mean(n_steps=300), atol=0.01 * extent)
+    assert b.duration_ == pytest.approx(2.3)
+
+
+def test_sampling_matches_the_moments_and_the_seed(promp):
+    samples = promp.sample(4000, seed=5, n_steps=50)
+    np.testing.assert_allclose(samples.mean(axis=0), promp.mean(n_steps=50), atol=0.3)
+    np.testing.assert_allclose(samples.var(axis=0), promp.var(n_steps=50), rtol=0.15, atol=0.05)
+    np.testing.assert_array_equal(promp.sample(3, seed=9), promp.sample(3, seed=9))
+
+
+def test_velocities_are_the_positions_rate(promp):
+    phase = np.linspace(0.0, 1.0, 2001)
+    rate = np.gradient(promp.mean(phase), phase, axis=0) / promp.duration_
+    np.testing.assert_allclose(
+        promp.mean_velocity(phase)[5:-5], rate[5:-5], atol=1e-3 * np.abs(rate).max()
+    )
+    motion = promp.trajectory(dt=0.001)
+    np.testing.assert_allclose(motion.y[-1], promp.mean([1.0])[0])
+
+
+def test_bad_input_is_refused_by_name(promp):
+    with pytest.raises(ValueError, match="demonstrations\\[1\\]"):
+        ProMP().fit([np.zeros((10, 2)) + np.arange(10)[:, None], np.zeros((10, 3))])
+    with pytest.raises(ValueError, match="phase"):
+        promp.condition([1.5], [[0.0, 0.0]])
+    with pytest.raises(ValueError, match="cov"):
+        promp.condition([0.5], [[0.0, 0.0]], -1.0)
+    with pytest.raises(TypeError, match="demonstrations"):
+        ProMP().fit("nothing")
+
+
+def test_a_promp_survives_its_file(promp, tmp_path):
+    from bidmp.io import load_model, save_model
+
+    loaded = load_model(save_model(promp, tmp_path / "promp"))
+    np.testing.assert_array_equal(loaded.weight_cov_, promp.weight_cov_)
+    goal = np.array([[1.0, 2.0]])
+    np.testing.assert_array_equal(
+        loaded.condition([1.0], goal).mean(), promp.condition([1.0], goal).mean()
+    )
