@@ -302,3 +302,35 @@ def test_a_two_line_title_renders_as_two_lines_and_control_codes_do_not(tmp_path
     title = captured["fig"].axes[0].get_title()
     first, second = title.split("\n")
     assert first == "run ?[31m7" and second.startswith("G-PRM similarity ")
+
+
+def test_the_spread_of_several_demonstration_methods_is_a_band_round_their_rollouts(tmp_path):
+    """The band's radius is twice the norm of the model's own standard deviation along the
+    rollout (the DMP from several demonstrations: exact; the ProMP: conditioned on the rollout's
+    start and goal, so 0 at both ends); the tube's vertices lie that far from the path; the
+    layers keep it through their file."""
+    from bidmp.plotting.viewer import (
+        _tube,
+        layers_from_report,
+        load_layers,
+        save_layers,
+        view_figure,
+    )
+    from bidmp.tasks import evaluate, scenarios
+
+    report = evaluate(scenarios.load("nut-unscrewing"), ["promp", "dmp-multi"], geometry=False)
+    layers = layers_from_report(report)
+    multi = report.fitted["dmp-multi"]
+    rollout = report.methods["dmp-multi"].rollouts["12"]
+    expected = 2 * np.linalg.norm(multi.std(rollout[-1], n_steps=len(rollout)), axis=1)
+    np.testing.assert_allclose(layers.bands["dmp-multi"]["12"], expected)
+    promp_band = layers.bands["promp"]["1"]
+    assert promp_band[0] < 1e-6 * promp_band.max() and promp_band[-1] < 1e-6 * promp_band.max()
+    path = np.asarray(report.methods["promp"].rollouts["1"], dtype=float)
+    vertices, faces = _tube(path, promp_band, sides=8)
+    distances = np.linalg.norm(vertices.reshape(len(path), 8, 3) - path[:, None], axis=2)
+    np.testing.assert_allclose(distances, np.repeat(promp_band[:, None], 8, 1), atol=1e-9)
+    names = {trace.name for trace in view_figure(layers).data}
+    assert {"promp ±2σ band", "dmp-multi ±2σ band"} <= names
+    loaded = load_layers(save_layers(tmp_path / "bands.npz", layers))
+    np.testing.assert_array_equal(loaded.bands["promp"]["1"], promp_band)

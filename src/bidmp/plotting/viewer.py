@@ -69,7 +69,9 @@ class ViewLayers:
     ("bidmp -> 11") to ``{"times": (F,), "links": (F, L, 3)}``: the arm's joint origins from
     base to tool tip, sampled along the simulated motion. ``failures`` maps method -> target
     label -> ``{"reason": str, "part": str or None, "point": [x, y, z] or None}`` for the rollouts
-    that break the motion contract (the part it came too close to, and where).
+    that break the motion contract (the part it came too close to, and where). ``bands`` maps
+    method -> target label -> (T,) the radius of the rollout's ±2σ band (units) for the methods
+    that learn a spread (``promp``, ``dmp-multi``): drawn as a translucent tube round the rollout.
     """
 
     title: str
@@ -82,6 +84,7 @@ class ViewLayers:
     solids: list = field(default_factory=list)
     robot: dict = field(default_factory=dict)
     failures: dict = field(default_factory=dict)
+    bands: dict = field(default_factory=dict)
 
 
 def _xyz(points) -> np.ndarray:
@@ -123,7 +126,35 @@ def layers_from_report(report) -> ViewLayers:
             for name, result in report.methods.items()
             if (failed := _failures(result))  # each method's failing motions, judged once
         },
+        bands=_bands(report),
     )
+
+
+def _bands(report) -> dict:
+    """The ±2σ radius (norm of the standard deviation, twice) along each rollout of the methods
+    whose model carries a spread: a ProMP conditioned on the rollout's start and goal, a DMP from
+    several demonstrations (its exact standard deviation along the rollout)."""
+    from ..primitives.multi import MultiDMP
+    from ..primitives.promp import ProMP
+
+    out = {}
+    for name, result in report.methods.items():
+        model = report.fitted.get(name)
+        radii = {}
+        for label, rollout in result.rollouts.items():
+            goal = np.asarray(rollout[-1], dtype=float)
+            if isinstance(model, MultiDMP):
+                spread = model.std(goal, n_steps=len(rollout))
+            elif isinstance(model, tuple) and model and isinstance(model[0], ProMP):
+                promp, start = model[0], model[1]
+                conditioned = promp.condition([0.0, 1.0], np.stack([start, goal]), 0.0)
+                spread = np.sqrt(conditioned.var(n_steps=len(rollout)))
+            else:
+                break
+            radii[label] = 2.0 * np.linalg.norm(spread, axis=1)
+        if radii:
+            out[name] = radii
+    return out
 
 
 def _failures(result) -> dict:
@@ -292,6 +323,30 @@ def _static_traces(go, layers: ViewLayers) -> list:
             )
             trace.update(visible=visible, hovertext=f"{method} -> {label}")
             traces.append(trace)
+    for method, radii in layers.bands.items():
+        for index, (label, radius) in enumerate(radii.items()):
+            path = layers.rollouts.get(method, {}).get(label)
+            if path is None or len(path) < 2:
+                continue
+            vertices, faces = _tube(_xyz(path), np.asarray(radius, dtype=float))
+            traces.append(
+                go.Mesh3d(
+                    x=vertices[:, 0],
+                    y=vertices[:, 1],
+                    z=vertices[:, 2],
+                    i=faces[:, 0],
+                    j=faces[:, 1],
+                    k=faces[:, 2],
+                    color=_COLOURS.get(method, "#2ca02c"),
+                    opacity=0.18,
+                    name=f"{method} ±2σ band",
+                    legendgroup=f"{method} band",
+                    showlegend=index == 0,
+                    visible="legendonly",
+                    hovertext=f"{method} -> {label}: ±2σ up to {float(np.max(radius)):.3g}",
+                    hoverinfo="text",
+                )
+            )
     if layers.targets:
         t = np.array(list(layers.targets.values()))
         traces.append(
@@ -449,6 +504,30 @@ def view_figure(layers: ViewLayers):
     return figure
 
 
+def _tube(path: np.ndarray, radius: np.ndarray, sides: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """A tube mesh round ``path`` (n, 3) of ``radius`` (n,): rings of ``sides`` vertices in the
+    plane across the path's tangent, consecutive rings joined by triangles."""
+    tangent = np.gradient(path, axis=0)
+    tangent /= np.maximum(np.linalg.norm(tangent, axis=1, keepdims=True), 1e-300)
+    helper = np.where(np.abs(tangent[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+    first = np.cross(tangent, helper)
+    first /= np.maximum(np.linalg.norm(first, axis=1, keepdims=True), 1e-300)
+    second = np.cross(tangent, first)
+    angles = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
+    ring = (
+        np.cos(angles)[None, :, None] * first[:, None]
+        + np.sin(angles)[None, :, None] * second[:, None]
+    )
+    vertices = (path[:, None, :] + radius[:, None, None] * ring).reshape(-1, 3)
+    faces = []
+    for i in range(len(path) - 1):
+        for k in range(sides):
+            a, b = i * sides + k, i * sides + (k + 1) % sides
+            c, d = a + sides, b + sides
+            faces += [(a, b, c), (b, d, c)]
+    return vertices, np.array(faces, dtype=int)
+
+
 def write_view(path, layers: ViewLayers) -> Path:
     """Write the viewer as one HTML file (plotly.js inside: opens offline); returns its path."""
     path = check_path(path)
@@ -472,6 +551,11 @@ def save_layers(path, layers: ViewLayers) -> Path:
         for r, (label, trajectory) in enumerate(paths.items()):
             arrays[f"rollout_{m}_{r}"] = trajectory
             rollouts.setdefault(method, []).append([label, f"rollout_{m}_{r}"])
+    bands = {}
+    for m, (method, radii) in enumerate(layers.bands.items()):
+        for r, (label, radius) in enumerate(radii.items()):
+            arrays[f"band_{m}_{r}"] = radius
+            bands.setdefault(method, []).append([label, f"band_{m}_{r}"])
     robot = {}
     for k, (name, motion) in enumerate(layers.robot.items()):
         arrays[f"robot_times_{k}"], arrays[f"robot_links_{k}"] = motion["times"], motion["links"]
@@ -487,6 +571,7 @@ def save_layers(path, layers: ViewLayers) -> Path:
         "solids": layers.solids,
         "robot": robot,
         "failures": layers.failures,
+        "bands": bands,
     }
     arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
     with atomic_write(path, "wb") as handle:
@@ -554,8 +639,14 @@ def load_layers(path) -> ViewLayers:
                     name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
                     for name, k in meta["robot"].items()
                 },
-                failures=_checked_failures(meta.get("failures", {})),
-            )  # absent in files of bidmp 0.5
+                failures=_checked_failures(
+                    meta.get("failures", {})
+                ),  # absent in files of bidmp 0.5
+                bands={
+                    method: {label: data[key] for label, key in pairs}
+                    for method, pairs in meta.get("bands", {}).items()  # absent before 0.6
+                },
+            )
     except (KeyError, ValueError, TypeError, AttributeError) as exc:
         raise ValueError(
             f"{path}: cannot read a bidmp view ({printable(str(exc))[:120]})"
