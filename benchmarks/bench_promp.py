@@ -37,13 +37,11 @@ def rmse(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1))))
 
 
-def timed(function, repeats: int) -> float:
-    samples = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        samples.append(time.perf_counter() - start)
-    return statistics.median(samples)
+def timed(function) -> float:
+    """Seconds of one call (the caller interleaves the sides and takes the median)."""
+    start = time.perf_counter()
+    function()
+    return time.perf_counter() - start
 
 
 def main() -> int:
@@ -94,17 +92,16 @@ def main() -> int:
         fits = {"ours": [], "peer": []}
         conditions = {"ours": [], "peer": []}
         for _ in range(args.repeats):  # the sides interleaved
-            fits["ours"].append(timed(lambda: ProMP(n_basis=N_BASIS).fit(list(train)), 1))
+            fits["ours"].append(timed(lambda: ProMP(n_basis=N_BASIS).fit(list(train))))
             fits["peer"].append(
                 timed(
                     lambda: PeerProMP(n_dims=2, n_weights_per_dim=N_BASIS).imitate(
                         np.tile(T, (len(train), 1)), train
-                    ),
-                    1,
+                    )
                 )
             )
-            conditions["ours"].append(timed(ours_condition, 1))
-            conditions["peer"].append(timed(peer_condition, 1))
+            conditions["ours"].append(timed(ours_condition))
+            conditions["peer"].append(timed(peer_condition))
         row["fit_ratio"] = statistics.median(fits["peer"]) / statistics.median(fits["ours"])
         row["cond_ratio"] = statistics.median(conditions["peer"]) / statistics.median(
             conditions["ours"]

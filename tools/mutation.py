@@ -122,6 +122,16 @@ TARGETS = (
         ("tests/test_oracles.py", "tests/sim/test_sim_limits.py"),
     ),
     Target(
+        "rhythmic limits",
+        "bidmp.primitives.rhythmic",
+        # The refusals. RhythmicStepper._limited_constant is a planner (a conservative bound
+        # that picks a time constant), not a check: its output is judged by the measured peaks
+        # of test_limits_refuse_a_setting_and_set_the_transition, which a planted removal of
+        # the lengthening fails.
+        ("RhythmicStepper._check_setting", "_check_rhythm_limits"),
+        ("tests/primitives/test_rhythmic_limits.py",),
+    ),
+    Target(
         "engagement",
         "bidmp.tasks.metrics",
         ("endpoint_error", "final_approach_mask", "approach_error", "axis_deviation"),

@@ -25,7 +25,7 @@ from .._api import Estimator, clone
 from .._checks import NotFittedError, check_int, check_real, check_seed
 from .._trajectory import resample_time
 from .dmp import DMP
-from .promp import _demonstrations, _stamps
+from .promp import _demonstrations, _stamps, _weight_covariance
 
 __all__ = ["MultiDMP"]
 
@@ -93,18 +93,9 @@ class MultiDMP(Estimator):
             rest_logger.setLevel(level)
         model.weights_ = np.ascontiguousarray(weights.mean(axis=0))
         n_kernels, n_dims = model.weights_.shape
-        covariance = np.empty((n_dims, n_kernels, n_kernels))
-        for d in range(n_dims):
-            block = (
-                np.cov(weights[:, :, d], rowvar=False)
-                if len(demos) > 1
-                else np.zeros((n_kernels, n_kernels))
-            )
-            block = np.atleast_2d(block)
-            scale = float(np.mean(np.diag(block)))
-            scale = scale if scale > 0.0 else max(float(np.mean(model.weights_[:, d] ** 2)), 1e-300)
-            block[np.diag_indices(n_kernels)] += cov_reg * scale
-            covariance[d] = block
+        covariance = np.stack(
+            [_weight_covariance(weights[:, :, d], cov_reg) for d in range(n_dims)]
+        )
         self.dmp_ = model
         self.weights_ = weights
         self.weight_cov_ = covariance
@@ -179,7 +170,7 @@ class MultiDMP(Estimator):
     def _get_state(self) -> tuple[dict, dict]:
         self._check_fitted()
         inner_state, inner_arrays = self.dmp_._get_state()
-        arrays = {f"dmp.{name}": value for name, value in inner_arrays.items()}
+        arrays = {f"dmp/{name}": value for name, value in inner_arrays.items()}
         arrays["weights_"] = self.weights_
         arrays["weight_cov_"] = self.weight_cov_
         state = {"cov_reg": float(self.cov_reg), "dmp": inner_state}
@@ -188,15 +179,9 @@ class MultiDMP(Estimator):
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> MultiDMP:
         from .._checks import check_loaded
+        from .._state import Prefixed
 
-        class _Prefixed:  # the DMP's members, under their own names
-            def __getitem__(self, name):
-                return arrays[f"dmp.{name}"]
-
-            def __contains__(self, name):
-                return f"dmp.{name}" in arrays
-
-        inner = DMP._from_state(meta["dmp"], _Prefixed())
+        inner = DMP._from_state(meta["dmp"], Prefixed(arrays, "dmp/"))
         model = cls(dmp=DMP(**inner.get_params()), cov_reg=meta["cov_reg"])
         n_kernels, n_dims = inner.weights_.shape
         model.dmp_ = inner

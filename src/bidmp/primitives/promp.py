@@ -181,14 +181,7 @@ class ProMP(Estimator):
             gram[np.diag_indices(n_basis)] += ridge * np.trace(gram) / n_basis
             weights[index] = np.linalg.solve(gram, rows.T @ y).T.reshape(-1)
         mean = weights.mean(axis=0)
-        if len(demos) > 1:
-            cov = np.cov(weights, rowvar=False).reshape(mean.size, mean.size)
-            scale = float(np.mean(np.diag(cov)))
-        else:
-            cov = np.zeros((mean.size, mean.size))
-            scale = 0.0
-        scale = scale if scale > 0.0 else max(float(np.mean(mean**2)), 1e-300)
-        cov[np.diag_indices(mean.size)] += cov_reg * scale
+        cov = _weight_covariance(weights, cov_reg)
         self.weights_ = weights
         self.weight_mean_ = mean
         self.weight_cov_ = cov
@@ -307,6 +300,23 @@ class ProMP(Estimator):
         yd = self._moments(phase, 0, 1)[0] / self.duration_
         ydd = self._moments(phase, 0, 2)[0] / self.duration_**2
         return Trajectory(t, y, yd, ydd, self.units_)
+
+
+def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
+    """The covariance (M, M) of weights (n, M) of n demonstrations plus ``cov_reg`` times their
+    mean variance on the diagonal (times the mean squared weight when they do not vary: one
+    demonstration, or identical ones), so that it is positive definite."""
+    size = weights.shape[1]
+    cov = (
+        np.cov(weights, rowvar=False).reshape(size, size)
+        if weights.shape[0] > 1
+        else np.zeros((size, size))
+    )
+    scale = float(np.mean(np.diag(cov)))
+    if not scale > 0.0:
+        scale = max(float(np.mean(weights.mean(axis=0) ** 2)), 1e-300)
+    cov[np.diag_indices(size)] += cov_reg * scale
+    return cov
 
 
 def _demonstrations(demonstrations) -> list[np.ndarray]:

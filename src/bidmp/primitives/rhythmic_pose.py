@@ -151,7 +151,7 @@ class RhythmicPoseDMP(Estimator):
     def _get_state(self) -> tuple[dict, dict]:
         self._check_fitted()
         state, arrays = self.rhythm_._get_state()
-        arrays = {f"rhythm.{name}": value for name, value in arrays.items()}
+        arrays = {f"rhythm/{name}": value for name, value in arrays.items()}
         arrays["mean_orientation_"] = self.mean_orientation_
         arrays["scales_"] = self.scales_
         return {"params": self.get_params(), "rhythm": state, "units": self.units_}, arrays
@@ -159,14 +159,10 @@ class RhythmicPoseDMP(Estimator):
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> RhythmicPoseDMP:
         from .._checks import check_loaded
+        from .._state import Prefixed
 
         model = cls(**meta["params"])
-
-        class _Prefixed:  # the inner rhythm's members, under their own names
-            def __getitem__(self, name):
-                return arrays[f"rhythm.{name}"]
-
-        rhythm = RhythmicDMP._from_state(meta["rhythm"], _Prefixed())
+        rhythm = RhythmicDMP._from_state(meta["rhythm"], Prefixed(arrays, "rhythm/"))
         if rhythm.n_dims_ != 6:
             raise ValueError(f"member rhythm.weights_ has {rhythm.n_dims_} columns, expected 6")
         model.rhythm_ = rhythm
