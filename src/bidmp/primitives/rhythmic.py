@@ -660,9 +660,13 @@ class RhythmicStepper:
 
     def _input(self) -> np.ndarray:
         model = self._model
+        # one von Mises row at the phase (the model's own, checked kernels: no re-validation in
+        # the control loop)
+        log_psi = model.widths_ * (np.cos(self.phase - model.centres_) - 1.0)
+        psi = np.exp(log_psi - log_psi.max())
+        forcing = (psi @ model.weights_) / psi.sum()
         return (
-            model._alpha * model._beta * self._anchor.value
-            + float(self._amplitude.value) * model.forcing(np.array([self.phase]))[0]
+            model._alpha * model._beta * self._anchor.value + float(self._amplitude.value) * forcing
         )
 
     def _acceleration(self, u: np.ndarray) -> np.ndarray:
