@@ -129,6 +129,11 @@ def get_limits() -> Limits:
     return dataclasses.replace(_LIMITS)
 
 
+def _limit(name: str):
+    """One limit in force, without copying them all (the hot paths' read)."""
+    return getattr(_LIMITS, name)
+
+
 class _Restore(contextlib.AbstractContextManager):
     """What :func:`set_limits` returns: the previous limits; as a context manager it restores them."""
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._checks import as_point, check_int, check_real, get_limits, short_token
+from .._checks import _limit, as_point, check_int, check_real, short_token
 from .._units import check_reach
 from .avoidance import SceneAvoidance, _check_avoidance
 from .integrate import _exact_state
@@ -44,7 +44,7 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
     else:
         samples = params.settle * motion / dt * (1 + 1e-12)
         check_real(
-            samples, "the trajectory's samples (duration / dt)", maximum=get_limits().max_steps
+            samples, "the trajectory's samples (duration / dt)", maximum=_limit("max_steps")
         )
         n_samples = int(np.floor(samples)) + 1  # never past settle x motion
     check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
