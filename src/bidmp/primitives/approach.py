@@ -61,17 +61,19 @@ def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNES
     candidates = np.unique(
         np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1))).astype(int)
     )
-    # The candidates' tests at once, a block at a time (a fit asks twice: its approach and its
-    # departure; one candidate at a time was 80 % of a robot-protocol fit). A tail whose every
-    # 8th sample already strays too far from its chord is not straight: only the candidates that
-    # pass that cheap test take the whole one.
+    # The candidates' tests at once (a fit asks twice: its approach and its departure; one
+    # candidate at a time was 80 % of a robot-protocol fit), each stage a necessary condition of
+    # the next, so only a few candidates take the whole test: three probes inside each tail, then
+    # every 8th sample of it, then all of it. Each stage looks only at the samples from its
+    # earliest candidate on (the tails are the motion's last part).
+    candidates = candidates[_probes_straight(y, candidates, straightness)]
     block = max(1, _BLOCK_ELEMENTS // max(y.shape[0] * y.shape[1], 1))
     for first in range(0, candidates.shape[0], block):
         chunk = candidates[first : first + block]
-        chunk = chunk[_tails_straight(y, chunk, straightness, stride=_COARSE)]
+        chunk = chunk[_tails_from(y, chunk, straightness, _COARSE)]
         for part in range(0, chunk.shape[0], _FULL_BATCH):  # in order: the first that holds wins
             batch = chunk[part : part + _FULL_BATCH]
-            straight = np.flatnonzero(_tails_straight(y, batch, straightness))
+            straight = np.flatnonzero(_tails_from(y, batch, straightness, 1))
             if straight.size:
                 return int(batch[straight[0]])
     return last
@@ -79,7 +81,40 @@ def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNES
 
 _BLOCK_ELEMENTS = 1 << 20  # floats of one block of candidate tails tested together (8 MB)
 _COARSE = 8  # every how many samples the cheap first test looks at
-_FULL_BATCH = 16  # the candidates that pass it, taken the whole test this many at a time
+_FULL_BATCH = 4  # the candidates that pass it, taken the whole test this many at a time
+
+
+def _tails_from(y: np.ndarray, starts: np.ndarray, tolerance: float, stride: int) -> np.ndarray:
+    """:func:`_tails_straight` on the samples from the earliest start on (the same tails: each
+    looks only at its own samples, and the end is the same)."""
+    if starts.size == 0:
+        return np.zeros(0, dtype=bool)
+    lowest = int(starts.min())
+    return _tails_straight(y[lowest:], starts - lowest, tolerance, stride=stride)
+
+
+def _probes_straight(y: np.ndarray, starts: np.ndarray, tolerance: float) -> np.ndarray:
+    """A necessary condition of :func:`_tails_straight` for every start (k,), from three samples
+    of each tail only (a quarter, half and three quarters of the way to the end): each within
+    ``tolerance`` × the chord of the chord. (k,) bool; a tail it refuses is not straight."""
+    if starts.size == 0:
+        return np.zeros(0, dtype=bool)
+    last = y.shape[0] - 1
+    ends = y - y[-1]
+    origin = ends[starts]  # (k, D)
+    length = np.linalg.norm(origin, axis=1)
+    moving = length > 0.0
+    unit = -origin / np.where(moving, length, 1.0)[:, None]
+    keep = moving.copy()
+    for share in (0.25, 0.5, 0.75):
+        index = starts + np.floor(share * (last - starts)).astype(int)
+        offset = ends[index] - origin  # (k, D)
+        along = np.sum(offset * unit, axis=1)
+        across = np.sum(offset * offset, axis=1) - along * along
+        bound = tolerance * length
+        # a hair of slack: the full test sums the same squares in another order
+        keep &= across <= bound * bound * (1.0 + 1e-9) + 1e-300
+    return keep
 
 
 def _tails_straight(

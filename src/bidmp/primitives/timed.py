@@ -43,9 +43,7 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
         n_samples = max(int(round(params.tau * dmp.n_steps_)), 1)  # the rollout's own samples
     else:
         samples = params.settle * motion / dt * (1 + 1e-12)
-        check_real(
-            samples, "the trajectory's samples (duration / dt)", maximum=_limit("max_steps")
-        )
+        check_real(samples, "the trajectory's samples (duration / dt)", maximum=_limit("max_steps"))
         n_samples = int(np.floor(samples)) + 1  # never past settle x motion
     check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
     step = dmp.dt_ if dt == period else dt / dmp.time_unit_
