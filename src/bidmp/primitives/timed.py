@@ -81,7 +81,7 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
     else:
         velocities = np.diff(positions, axis=0) / dt
         accelerations = np.diff(velocities, axis=0) / dt
-    return Trajectory(
+    return Trajectory._of(
         np.arange(n_samples) * dt,
         positions[:n_samples],
         velocities[:n_samples],
