@@ -442,10 +442,15 @@ class DMP(_FittedParams, Estimator):
         for the robot protocol, started and ended at rest (:func:`bidmp.primitives.rest.rest_started`) and
         followed by rest at its last point up to :attr:`n_train_`."""
         self._check_fitted()
+        return self._training_trajectory(as_trajectory(y, "y", min_points=2, allow_static=True))
+
+    def _training_trajectory(self, y: np.ndarray, *, quiet: bool = False) -> np.ndarray:
+        """:meth:`training_trajectory` of a checked ``y``; ``quiet``: its rest blends are logged
+        at debug level only."""
         params = self._params()
-        y = resample_time(as_trajectory(y, "y", min_points=2, allow_static=True), self.n_steps_)
+        y = resample_time(y, self.n_steps_)
         if params.rest_start:
-            y = _rest_started(y, self.dt_, self.time_unit_)
+            y = _rest_started(y, self.dt_, self.time_unit_, quiet=quiet)
         return _with_rest(y, params)
 
     def forcing_target(self, y, *, derivatives: str | None = None) -> np.ndarray:

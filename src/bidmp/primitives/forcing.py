@@ -449,6 +449,8 @@ class VonMisesBasis:
 
     size: int
     concentration: float | None = None
+    # the last kernels row() checked (a control loop passes the same arrays every step)
+    _checked: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(
@@ -482,10 +484,14 @@ class VonMisesBasis:
         return psi
 
     def row(self, phase: float, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
-        """One row (1, N): the control loop's call."""
+        """One row (1, N): the control loop's call, so the kernels are checked once per pair of
+        arrays (a model's own, the same every step)."""
         if type(phase) is not float or not -_MAX_PHASE <= phase <= _MAX_PHASE:
             phase = check_real(phase, "phase", minimum=-_MAX_PHASE, maximum=_MAX_PHASE)
-        centres, widths = _von_mises_kernels(centres, widths)
+        checked = self._checked
+        if checked is None or checked[0] is not centres or checked[1] is not widths:
+            _von_mises_kernels(centres, widths)  # checks them, names them
+            object.__setattr__(self, "_checked", (centres, widths))
         log_psi = widths * (np.cos(phase - centres) - 1.0)
         psi = np.exp(np.maximum(log_psi - log_psi.max(), _LOG_PSI_FLOOR))
         return (psi / psi.sum())[None]

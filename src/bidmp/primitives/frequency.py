@@ -44,6 +44,10 @@ class FrequencyEstimate:
         the mean period, over the mean period's amplitude (half its largest peak-to-peak).
     amplitude : array (D,)
         Half the mean period's peak-to-peak per dimension (units).
+    series : array (2K + 1, D) or None
+        The mean period's harmonic series over the kept part, phase 0 at ``start``:
+        ``[a_0, a_1 … a_K, b_1 … b_K]`` of ``a_0 + Σ a_k cos kφ + b_k sin kφ`` (None when read
+        from a model file, which keeps the learned weights instead).
     """
 
     frequency: float
@@ -54,6 +58,7 @@ class FrequencyEstimate:
     periods: int
     spread: float
     amplitude: np.ndarray
+    series: np.ndarray | None = None
 
 
 def _design(t: np.ndarray, omega: float, n_harmonics: int) -> np.ndarray:
@@ -244,7 +249,7 @@ def estimate_frequency(
     n_params = (2 * harmonics + 1) * kept_y.shape[1] + 1
     sigma2 = rss / max(kept_y.size - n_params, 1)
     uncertainty = math.sqrt(2.0 * sigma2 / curvature) if curvature > 0.0 else math.inf
-    spread, amplitude = _period_spread(local, kept_y, omega, harmonics, periods)
+    spread, amplitude, series = _period_spread(local, kept_y, omega, harmonics, periods)
     return FrequencyEstimate(
         frequency=omega / (2.0 * math.pi),
         uncertainty=uncertainty / (2.0 * math.pi),
@@ -254,6 +259,7 @@ def estimate_frequency(
         periods=periods,
         spread=spread,
         amplitude=amplitude,
+        series=series,
     )
 
 
@@ -272,7 +278,8 @@ def _series(coefficients: np.ndarray, phase: np.ndarray, harmonics: int, order: 
     return value
 
 
-def _period_spread(t, y, omega, harmonics, periods) -> tuple[float, np.ndarray]:
+def _period_spread(t, y, omega, harmonics, periods) -> tuple[float, np.ndarray, np.ndarray]:
+    """(spread, amplitude (D,), the mean period's series (2K + 1, D)) of the kept samples."""
     design = _design(t, omega, harmonics)
     mean = np.linalg.lstsq(design, y, rcond=None)[0]
     grid = np.linspace(0.0, 2.0 * math.pi, 256, endpoint=False)
@@ -287,9 +294,9 @@ def _period_spread(t, y, omega, harmonics, periods) -> tuple[float, np.ndarray]:
         own = np.linalg.lstsq(design[inside], y[inside], rcond=None)[0]
         differences.append(_series(own, grid, harmonics) - mean_curve)
     if not differences:
-        return 0.0, amplitude
+        return 0.0, amplitude, mean
     rms = math.sqrt(float(np.mean(np.square(differences))))
-    return rms / max(float(amplitude.max()), 1e-300), amplitude
+    return rms / max(float(amplitude.max()), 1e-300), amplitude, mean
 
 
 def _with_frequency(estimate: FrequencyEstimate, y, t, frequency: float) -> FrequencyEstimate:
@@ -299,7 +306,7 @@ def _with_frequency(estimate: FrequencyEstimate, y, t, frequency: float) -> Freq
     periods = max(int(math.floor(span * frequency + 1e-9)), 1)
     local = t - t[0]
     keep = (local >= estimate.start) & (local <= estimate.start + periods / frequency)
-    spread, amplitude = _period_spread(
+    spread, amplitude, series = _period_spread(
         local[keep] - estimate.start, y[keep], omega, estimate.n_harmonics, periods
     )
     return FrequencyEstimate(
@@ -311,4 +318,5 @@ def _with_frequency(estimate: FrequencyEstimate, y, t, frequency: float) -> Freq
         periods=periods,
         spread=spread,
         amplitude=amplitude,
+        series=series,
     )

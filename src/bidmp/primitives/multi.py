@@ -17,14 +17,15 @@ Layer 1: the package's own math.
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 
 from .._api import Estimator, clone
-from .._checks import NotFittedError, check_int, check_real, check_seed
+from .._checks import NotFittedError, as_point, check_int, check_real, check_seed
 from .._trajectory import resample_time
 from .dmp import DMP
+from .forcing import _regression_factor, _solve_weights
+from .grid import _rollout_grid
+from .integrate import _unit_responses
 from .promp import _demonstrations, _stamps, _weight_covariance
 
 __all__ = ["MultiDMP"]
@@ -72,25 +73,20 @@ class MultiDMP(Estimator):
         model = clone(template).fit(
             aligned.mean(axis=0), t if times is not None else None, units=units
         )
-        _, basis = model.training_grid()
-        gram = basis.T @ basis
-        gram[np.diag_indices(gram.shape[0])] += 1e-8 * np.trace(gram) / gram.shape[0]
-        # Each demonstration is started and ended at rest as the mean one was (which said so
-        # once, when the model was fitted): their own blends are logged at debug level only.
-        rest_logger = logging.getLogger("bidmp.primitives.rest")
-        level = rest_logger.level
-        rest_logger.setLevel(max(level, logging.ERROR))
-        try:
-            weights = np.stack(
-                [
-                    np.linalg.solve(
-                        gram, basis.T @ model.forcing_target(model.training_trajectory(y))
-                    )
-                    for y in aligned
-                ]
-            )
-        finally:
-            rest_logger.setLevel(level)
+        # Every demonstration's forcing target on the mean one's grid, regressed as the DMP
+        # regresses its own (one factor for all); each is started and ended at rest as the mean
+        # one was, which said so once when the model was fitted.
+        params = model._params()
+        phase, basis = model.training_grid()
+        factor = _regression_factor(basis, phase, params.regression, params.ridge)
+        weights = np.stack(
+            [
+                _solve_weights(
+                    factor, basis, model.forcing_target(model._training_trajectory(y, quiet=True))
+                )
+                for y in aligned
+            ]
+        )
         model.weights_ = np.ascontiguousarray(weights.mean(axis=0))
         n_kernels, n_dims = model.weights_.shape
         covariance = np.stack(
@@ -118,21 +114,16 @@ class MultiDMP(Estimator):
 
     def response(self, goal=None, n_steps: int | None = None) -> np.ndarray:
         """``A`` (n, N): how each weight moves the rollout's positions (the same for every
-        dimension: the forcing enters each alike), exactly, from one rollout per basis function."""
+        dimension and any goal: the forcing enters each alike), exactly — the rollout grid's
+        basis functions integrated as forcing terms, all at once."""
         self._check_fitted()
-        base = self.dmp_.rollout(goal, n_steps=n_steps)
-        n_kernels, n_dims = self.dmp_.weights_.shape
-        columns = []
-        for i in range(n_kernels):
-            moved = self.dmp_.rollout(
-                goal,
-                n_steps=n_steps,
-                forcing_increment=lambda phase, basis, i=i: np.repeat(
-                    basis[:, i : i + 1], n_dims, 1
-                ),
-            )
-            columns.append(moved[:, 0] - base[:, 0])
-        return np.column_stack(columns)
+        dmp = self.dmp_
+        if goal is not None:  # checked as a rollout would, though the response is the same
+            as_point(goal, dmp.n_dims_, "goal")
+        params = dmp._rollout_params()
+        n_steps = dmp._n_steps(n_steps, params)
+        phase, basis, *_ = _rollout_grid(dmp, params, n_steps)
+        return _unit_responses(params, phase, basis, dmp.dt_).T
 
     def std(self, goal=None, n_steps: int | None = None) -> np.ndarray:
         """The positions' standard deviation (n, D) along the rollout to ``goal`` (exact)."""
@@ -148,23 +139,21 @@ class MultiDMP(Estimator):
         self._check_fitted()
         n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=10_000)
         rng = np.random.default_rng(check_seed(seed, "seed"))
-        mean = self.dmp_.weights_
-        out = []
-        for _ in range(n_samples):
-            change = np.column_stack(
-                [
-                    rng.multivariate_normal(np.zeros(mean.shape[0]), self.weight_cov_[d])
-                    for d in range(mean.shape[1])
-                ]
-            )
-            out.append(
-                self.dmp_.rollout(
-                    goal,
-                    n_steps=n_steps,
-                    forcing_increment=lambda phase, basis, c=change: basis @ c,
+        n_kernels, n_dims = self.dmp_.weights_.shape
+        changes = np.stack(
+            [
+                np.column_stack(
+                    [
+                        rng.multivariate_normal(np.zeros(n_kernels), self.weight_cov_[d])
+                        for d in range(n_dims)
+                    ]
                 )
-            )
-        return np.stack(out)
+                for _ in range(n_samples)
+            ]
+        )  # (n_samples, N, D)
+        # the rollout is affine in the weights: the mean motion plus each change's response
+        base = self.dmp_.rollout(goal, n_steps=n_steps)
+        return base[None] + np.einsum("tn,snd->std", self.response(goal, n_steps), changes)
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:

@@ -15,7 +15,7 @@ from .._checks import as_point, check_int, check_real
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
 from .frequency import _series
-from .rhythmic import RhythmicDMP
+from .rhythmic import RhythmicDMP, _rhythmic_target
 
 __all__ = ["AdaptiveOscillator"]
 
@@ -128,12 +128,12 @@ class AdaptiveOscillator:
     def _learn_weights(self) -> None:
         """One recursive-least-squares step per kernel towards the forcing target of the
         estimate at the current phase (its derivatives analytic in the phase)."""
-        tau = 1.0 / self.omega
-        position = self.estimate()
-        velocity = self.omega * self.estimate(order=1)
-        acceleration = self.omega**2 * self.estimate(order=2)
-        beta = self.alpha / 4.0
-        target = tau**2 * acceleration - self.alpha * (beta * (self.a0 - position) - tau * velocity)
+        coefficients = np.vstack([self.a0[None], self.a, self.b])
+        phase = np.array([self.phase])
+        position, slope, curvature = (
+            _series(coefficients, phase, self.n_harmonics, order)[0] for order in (0, 1, 2)
+        )
+        target = _rhythmic_target(position, slope, curvature, self.a0, self.alpha)
         psi = np.exp(self.widths * (np.cos(self.phase - self.centres) - 1.0))
         lam = self.forgetting
         precision = self._precision

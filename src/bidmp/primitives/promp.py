@@ -214,45 +214,46 @@ class ProMP(Estimator):
             raise ValueError("phase must lie in [0, 1] (the demonstrations' normalised time)")
         return phase
 
-    def _moments(self, phase, n_steps: int, derivative: int) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (L, D) and variance (L, D) of the ``derivative``-th phase derivative: per
-        dimension, ``B w_d`` and ``diag(B Σ_dd Bᵀ)`` with the basis rows ``B`` (L, N)."""
+    def _rows(self, phase, n_steps: int, derivative: int = 0) -> np.ndarray:
+        """The basis rows (L, N) (or their phase derivative) at ``phase`` (default ``n_steps``)."""
         self._check_fitted()
-        rows = promp_basis(self._phase(phase, n_steps), self.n_basis, self.overlap, derivative)
-        n_basis, n_dims = rows.shape[1], self.n_dims_
-        mean = rows @ self.weight_mean_.reshape(n_dims, n_basis).T
-        variance = np.empty_like(mean)
-        for d in range(n_dims):
-            block = self.weight_cov_[
-                d * n_basis : (d + 1) * n_basis, d * n_basis : (d + 1) * n_basis
-            ]
-            variance[:, d] = np.einsum("ln,nm,lm->l", rows, block, rows)
-        return mean, np.maximum(variance, 0.0)
+        return promp_basis(self._phase(phase, n_steps), self.n_basis, self.overlap, derivative)
+
+    def _mean_of(self, rows: np.ndarray) -> np.ndarray:
+        """``B w_d`` per dimension: (L, D)."""
+        return rows @ self.weight_mean_.reshape(self.n_dims_, rows.shape[1]).T
+
+    def _variance_of(self, rows: np.ndarray) -> np.ndarray:
+        """``diag(B Σ_dd Bᵀ)`` per dimension: (L, D)."""
+        n_basis = rows.shape[1]
+        variance = np.empty((rows.shape[0], self.n_dims_))
+        for d in range(self.n_dims_):
+            block = slice(d * n_basis, (d + 1) * n_basis)
+            variance[:, d] = np.einsum("ln,nm,lm->l", rows, self.weight_cov_[block, block], rows)
+        return np.maximum(variance, 0.0)
 
     def mean(self, phase=None, n_steps: int = 100) -> np.ndarray:
         """The mean positions (L, D) at ``phase`` (default ``n_steps`` over [0, 1])."""
-        self._check_fitted()
-        rows = promp_basis(self._phase(phase, n_steps), self.n_basis, self.overlap)
-        return rows @ self.weight_mean_.reshape(self.n_dims_, rows.shape[1]).T
+        return self._mean_of(self._rows(phase, n_steps))
 
     def var(self, phase=None, n_steps: int = 100) -> np.ndarray:
         """The positions' variance (L, D) at ``phase``."""
-        return self._moments(phase, n_steps, 0)[1]
+        return self._variance_of(self._rows(phase, n_steps))
 
     def mean_velocity(self, phase=None, n_steps: int = 100) -> np.ndarray:
         """The mean velocities (L, D), units/s over the mean duration."""
-        return self._moments(phase, n_steps, 1)[0] / self.duration_
+        return self._mean_of(self._rows(phase, n_steps, 1)) / self.duration_
 
     def var_velocity(self, phase=None, n_steps: int = 100) -> np.ndarray:
         """The velocities' variance (L, D), (units/s)²."""
-        return self._moments(phase, n_steps, 1)[1] / self.duration_**2
+        return self._variance_of(self._rows(phase, n_steps, 1)) / self.duration_**2
 
     def sample(self, n_samples: int, seed=0, phase=None, n_steps: int = 100) -> np.ndarray:
         """``n_samples`` trajectories (n, L, D) drawn from the weight distribution (seeded)."""
         self._check_fitted()
         n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=100_000)
         rng = np.random.default_rng(check_seed(seed, "seed"))
-        rows = promp_basis(self._phase(phase, n_steps), self.n_basis, self.overlap)
+        rows = self._rows(phase, n_steps)
         weights = rng.multivariate_normal(self.weight_mean_, self.weight_cov_, n_samples)
         # (n, D, N) weights times the rows: (n, L, D)
         return np.einsum("ln,sdn->sld", rows, weights.reshape(n_samples, self.n_dims_, -1))
@@ -296,9 +297,10 @@ class ProMP(Estimator):
         )
         t = np.arange(n) * dt
         phase = np.minimum(t / self.duration_, 1.0)
-        y = self.mean(phase)
-        yd = self._moments(phase, 0, 1)[0] / self.duration_
-        ydd = self._moments(phase, 0, 2)[0] / self.duration_**2
+        y, yd, ydd = (
+            self._mean_of(self._rows(phase, 0, order)) / self.duration_**order
+            for order in (0, 1, 2)
+        )
         return Trajectory(t, y, yd, ydd, self.units_)
 
 

@@ -59,8 +59,10 @@ def _rest_started(
     duration_s: float,
     what: str = "the demonstration",
     unit: str = "units",
+    quiet: bool = False,
 ) -> np.ndarray:
-    """``y`` (T, D) with its start and end velocity blended out (module docstring).
+    """``y`` (T, D) with its start and end velocity blended out (module docstring); ``quiet``
+    logs the blend at debug level only (one of several demonstrations blended like the first).
 
     Parameters
     ----------
@@ -89,7 +91,7 @@ def _rest_started(
         blend = elapsed * (1.0 - _smoothstep(elapsed / width))
         out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
         speed = float(np.linalg.norm(speed_vector))
-        level = logging.WARNING if speed > 0.05 * peak else logging.DEBUG
+        level = logging.WARNING if speed > 0.05 * peak and not quiet else logging.DEBUG
         logger.log(
             level,
             "%s %s at %.3g %s/s (%.1f %% of its peak speed); the DMP %s at rest, blended over %.3g s",

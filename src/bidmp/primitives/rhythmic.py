@@ -33,18 +33,18 @@ import numpy as np
 
 from .._api import Estimator
 from .._checks import (
+    _limit,
     as_point,
     as_trajectory,
     check_choice,
     check_int,
     check_names,
     check_real,
-    get_limits,
 )
 from .._units import check_units
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
-from .frequency import _design, _series, _with_frequency, estimate_frequency
+from .frequency import _series, _with_frequency, estimate_frequency
 from .integrate import _exact_responses, _exact_state, _foh_step
 from .timing import Trajectory, check_timestamps
 
@@ -113,25 +113,17 @@ class RhythmicDMP(Estimator):
         if frequency is not None:
             frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
             estimate = _with_frequency(estimate, y, t, frequency)
-        omega = 2.0 * math.pi * estimate.frequency
-        local = t - t[0]
-        keep = (local >= estimate.start - 1e-12) & (local <= estimate.end + 1e-12)
-        coefficients = np.linalg.lstsq(
-            _design(local[keep] - estimate.start, omega, estimate.n_harmonics),
-            y[keep],
-            rcond=None,
-        )[0]
+        # the mean period's series over every kept period, as the estimate fitted it
+        coefficients = estimate.series
         harmonics = estimate.n_harmonics
         # The target on a fine grid of one cycle: every kept period at once, through the series.
         n_grid = max(20 * n_kernels, 1000)
         phase = 2.0 * math.pi * np.arange(n_grid) / n_grid
-        position = _series(coefficients, phase, harmonics)
-        velocity = omega * _series(coefficients, phase, harmonics, 1)  # units/s
-        acceleration = omega**2 * _series(coefficients, phase, harmonics, 2)
+        position, slope, curvature = (
+            _series(coefficients, phase, harmonics, order) for order in (0, 1, 2)
+        )
         anchor = coefficients[0]
-        beta = alpha / 4.0
-        tau = 1.0 / omega
-        target = tau**2 * acceleration - alpha * (beta * (anchor - position) - tau * velocity)
+        target = _rhythmic_target(position, slope, curvature, anchor, alpha)
         centres, widths = basis.place(RhythmicPhase(), n_grid, 1.0)
         rows = basis.rows(phase, centres, widths)
         gram = rows.T @ rows
@@ -150,7 +142,6 @@ class RhythmicDMP(Estimator):
         self.units_ = units
         self.names_ = names
         self.n_dims_ = y.shape[1]
-        self._coefficients = coefficients
         logger.debug(
             "fitted a rhythmic DMP: %.5g Hz ± %.2g over %d periods, spread %.3g",
             estimate.frequency,
@@ -166,11 +157,19 @@ class RhythmicDMP(Estimator):
 
             raise NotFittedError("this RhythmicDMP is not fitted yet: call fit(y, t) first")
 
+    @property
+    def _basis(self) -> VonMisesBasis:
+        """The von Mises basis of the learned kernels (made once per model)."""
+        basis = self.__dict__.get("_basis_cache")
+        if basis is None or basis.size != len(self.centres_):
+            basis = VonMisesBasis(len(self.centres_), float(self.widths_[0]))
+            self._basis_cache = basis
+        return basis
+
     def forcing(self, phase) -> np.ndarray:
         """The learned forcing term ``f(φ)`` (L, D) at phases (rad), amplitude 1."""
         self._check_fitted()
-        basis = VonMisesBasis(len(self.centres_), float(self.widths_[0]))
-        return basis.rows(phase, self.centres_, self.widths_) @ self.weights_
+        return self._basis.rows(phase, self.centres_, self.widths_) @ self.weights_
 
     def cycle_start(
         self,
@@ -355,7 +354,7 @@ class RhythmicDMP(Estimator):
         )
         samples = [stepper.step(dt)]
         scale = max(float(np.max(self.amplitude_)) * max(amplitude, 1e-12), 1e-12)
-        limit = int(get_limits().max_steps)
+        limit = int(_limit("max_steps"))
         while stepper.cycles < cycles and len(samples) < limit:
             samples.append(stepper.step(dt))
         stepper.stop()
@@ -437,6 +436,13 @@ class RhythmicDMP(Estimator):
         return model
 
 
+def _rhythmic_target(position, slope, curvature, anchor, alpha: float) -> np.ndarray:
+    """The forcing term that makes ``τż = α(β(g − y) − z) + f`` follow a cycle given as a
+    function of the phase: ``f = y'' − α(β(g − y) − y')`` with ``y' = dy/dφ``, ``y'' = d²y/dφ²``
+    (``τ²ÿ = y''`` and ``τẏ = y'`` for ``τφ̇ = 1``: the same at any frequency), β = α/4."""
+    return curvature - alpha * (alpha / 4.0 * (anchor - position) - slope)
+
+
 def _period_transition(step: float, n: int, alpha: float, beta: float, tau: float) -> np.ndarray:
     """The free system's transition over ``n`` steps (2, 2) for the state ``[y, z]``."""
     transition = _foh_step(step, alpha, beta, tau)[0]
@@ -445,7 +451,7 @@ def _period_transition(step: float, n: int, alpha: float, beta: float, tau: floa
 
 def _check_samples(count: float, what: str) -> float:
     """Refuse a motion of more samples than the configured limit (``bidmp.set_limits``)."""
-    limit = get_limits().max_steps
+    limit = _limit("max_steps")
     if not count <= limit:
         raise ValueError(
             f"dt: {what} = {count:.4g} samples, more than the limit {limit} (bidmp.set_limits); "
@@ -536,6 +542,7 @@ class RhythmicStepper:
         self.phase = 0.0
         self.cycles = 0.0
         self.time = 0.0
+        self._u = self._input()  # the input now; a step's end is the next one's start
 
     def _check_setting(self, frequency: float, amplitude: float, what: str) -> None:
         """Refuse a setting whose steady rhythm exceeds the limits (peak velocity, acceleration,
@@ -659,12 +666,9 @@ class RhythmicStepper:
         self._retime()
 
     def _input(self) -> np.ndarray:
+        """``u = α β g + r f(φ)`` (D,) at the settings and phase now."""
         model = self._model
-        # one von Mises row at the phase (the model's own, checked kernels: no re-validation in
-        # the control loop)
-        log_psi = model.widths_ * (np.cos(self.phase - model.centres_) - 1.0)
-        psi = np.exp(log_psi - log_psi.max())
-        forcing = (psi @ model.weights_) / psi.sum()
+        forcing = model._basis.row(self.phase, model.centres_, model.widths_)[0] @ model.weights_
         return (
             model._alpha * model._beta * self._anchor.value + float(self._amplitude.value) * forcing
         )
@@ -679,7 +683,7 @@ class RhythmicStepper:
     def step(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         dt = check_real(dt, "dt", positive=True, maximum=1.0)
         model = self._model
-        u_now = self._input()
+        u_now = self._u
         out = (self.y.copy(), self.v.copy(), self._acceleration(u_now))
         omega = 2.0 * math.pi * self.frequency
         tau = 1.0 / omega
@@ -692,7 +696,7 @@ class RhythmicStepper:
         self.phase = math.fmod(self.phase + advance, 2.0 * math.pi)
         self.cycles += advance / (2.0 * math.pi)
         self.time += dt
-        u_next = self._input()
+        u_next = self._u = self._input()
         z = tau * self.v
         y_next = (
             transition[0, 0] * self.y + transition[0, 1] * z + now[0] * u_now + after[0] * u_next
