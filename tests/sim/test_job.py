@@ -284,3 +284,20 @@ def test_the_pick_and_place_job_moves_every_box_by_the_skills_turned_and_scaled_
     first, step, _, _ = place.job.rack
     for index, target in enumerate(report.targets):
         assert np.linalg.norm(target.final_position[:2] - (first + index * step)[:2]) <= 5.0
+
+
+def test_a_threaded_nut_turns_in_scipys_own_arithmetic_to_the_last_bit():
+    """The thread's written-out quaternion product against scipy's Rotation (the reference):
+    equal bits, small-angle series included, so a released nut falls as it did before."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.pybullet.parts import _turned
+
+    rng = np.random.default_rng(7)
+    for index in range(2000):
+        start = Rotation.random(random_state=int(rng.integers(2**31)))
+        axis = start.as_matrix()[:, 2]
+        angle = rng.uniform(0.0, 60.0) if index % 2 else rng.uniform(0.0, 2e-3)
+        expected = (Rotation.from_rotvec(axis * angle) * start).as_quat()
+        got = _turned(tuple(start.as_quat().tolist()), axis * angle)
+        assert np.array_equal(np.array(got), expected), (index, angle)

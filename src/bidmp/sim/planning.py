@@ -99,17 +99,21 @@ def plan_path(
     rest = [(1, np.zeros(n_joints)), (2, np.zeros(n_joints))]
     spline = make_interp_spline(u, joints, k=5, bc_type=(rest, rest))
     grid = np.linspace(0.0, 1.0, max(4001, 20 * len(u)))
-    unit_time = Trajectory(grid, spline(grid), spline(grid, 1), spline(grid, 2))
+    # The joints' rates in normalised time, evaluated once for the timing and the peaks.
+    rates = [spline(grid, 1), spline(grid, 2)]
+    unit_time = Trajectory(grid, spline(grid), rates[0], rates[1])
     caps = {
         "max_velocity": LIMIT_MARGIN * np.asarray(limits.velocity),
         "max_acceleration": LIMIT_MARGIN * np.asarray(limits.acceleration),
         "max_jerk": None if limits.jerk is None else LIMIT_MARGIN * np.asarray(limits.jerk),
     }
     duration = float(time_scale(unit_time, norm="axis", **caps).t[-1])
+    if limits.jerk is not None:
+        rates.append(spline(grid, 3))
     peaks = [
         0.0
         if limit is None
-        else float(np.max(np.abs(spline(grid, order)) / duration**order / np.asarray(limit)))
+        else float(np.max(np.abs(rates[order - 1]) / duration**order / np.asarray(limit)))
         for order, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk))
     ]
     return MotionPlan(

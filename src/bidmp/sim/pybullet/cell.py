@@ -196,14 +196,10 @@ class RobotCell:
 
     def _set_joints(self, q, velocities=None, kinematic: bool = False) -> None:
         robot, client = (self.ik_robot, self.ik_client) if kinematic else (self.robot, self.client)
-        for index, joint in enumerate(self.arm):
-            self.p.resetJointState(
-                robot,
-                joint,
-                float(q[index]),
-                0.0 if velocities is None else float(velocities[index]),
-                physicsClientId=client,
-            )
+        reset = self.p.resetJointState
+        rates = [0.0] * len(self.arm) if velocities is None else np.asarray(velocities).tolist()
+        for joint, angle, rate in zip(self.arm, np.asarray(q).tolist(), rates):
+            reset(robot, joint, angle, rate, physicsClientId=client)
 
     def tcp_position(self) -> np.ndarray:
         """The simulated robot's measured TCP position (m)."""
@@ -243,7 +239,11 @@ class RobotCell:
 
     def forward(self, q) -> np.ndarray:
         """TCP position (m) for joint positions ``q`` (forward kinematics on the planning copy)."""
-        self._set_joints(self._joints(q), kinematic=True)
+        return self._tcp_at(self._joints(q))
+
+    def _tcp_at(self, q: np.ndarray) -> np.ndarray:
+        """:meth:`forward` of checked joints ``q`` (J,): the planning copy is left at ``q``."""
+        self._set_joints(q, kinematic=True)
         return np.array(
             self.p.getLinkState(
                 self.ik_robot, self.tcp, computeForwardKinematics=1, physicsClientId=self.ik_client

@@ -280,12 +280,16 @@ class _Recorder:
         self.cell = cell
         self.focus = focus  # the target (scene units) the keyframes' close-up looks at
         self.n_steps = n_steps
-        n_records = (n_steps - 1) // RECORD_EVERY + 1
-        self.times = np.empty(n_records)
-        self.tcp = np.empty((n_records, 3))
-        self.tcp_orientation = np.empty((n_records, 4))
-        self.joints = np.empty((n_records, len(cell.arm)))
-        self.velocities = np.empty((n_records, len(cell.arm)))
+        n_records, n_joints = (n_steps - 1) // RECORD_EVERY + 1, len(cell.arm)
+        # One row per record, written in one assignment (the loop's cost is per call): time,
+        # TCP position (3), TCP orientation (4), joint positions, joint velocities.
+        self.rows = np.empty((n_records, 8 + 2 * n_joints))
+        self.times, self.tcp, self.tcp_orientation = (
+            self.rows[:, 0],
+            self.rows[:, 1:4],
+            self.rows[:, 4:8],
+        )
+        self.joints, self.velocities = self.rows[:, 8 : 8 + n_joints], self.rows[:, 8 + n_joints :]
         self.commanded = []
         self.contacts = {}
         self.frame_steps = (
@@ -315,14 +319,17 @@ class _Recorder:
             return
         row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
         self.filled = row + 1
-        self.times[row] = t
         state = p.getLinkState(
             cell.robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.client
         )
-        self.tcp[row], self.tcp_orientation[row] = state[4], state[5]
         states = p.getJointStates(cell.robot, cell.arm, physicsClientId=cell.client)
-        self.joints[row] = [s[0] for s in states]
-        self.velocities[row] = [s[1] for s in states]
+        self.rows[row] = (
+            t,
+            *state[4],
+            *state[5],
+            *[s[0] for s in states],
+            *[s[1] for s in states],
+        )
         if (
             row % 10 == 0 or step == self.n_steps - 1
         ):  # the command's TCP, 50 Hz (forward kinematics)
@@ -333,18 +340,18 @@ class _Recorder:
         cell = self.cell
         n_rows = self.filled
         rows = [r for r, _ in self.commanded if r < n_rows]
-        commanded = np.array([cell.forward(q) for r, q in self.commanded if r < n_rows])
+        commanded = np.array([cell._tcp_at(q) for r, q in self.commanded if r < n_rows])
         full = np.column_stack(
             [np.interp(np.arange(n_rows), rows, commanded[:, k]) for k in range(3)]
         )
         run = Execution(
-            self.times[:n_rows],
-            self.tcp[:n_rows],
-            self.joints[:n_rows],
-            self.velocities[:n_rows],
+            self.times[:n_rows].copy(),
+            self.tcp[:n_rows].copy(),
+            self.joints[:n_rows].copy(),
+            self.velocities[:n_rows].copy(),
             full,
             self.contacts,
             self.frames,
         )
-        run.tcp_orientation = self.tcp_orientation[:n_rows]
+        run.tcp_orientation = self.tcp_orientation[:n_rows].copy()
         return run

@@ -41,9 +41,10 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
     ranges = [upper - lower for lower, upper in zip(limits.lower, limits.upper)]
     error = math.inf
     # Short bursts from the previous solution, checked by forward kinematics: a few dozen
-    # iterations reach 1 µm from a seed a few millimetres away (one long call costs 10x).
+    # iterations reach 1 µm from a seed a few millimetres away (one long call costs 10x). Each
+    # check leaves the planning copy at its joints, where the next burst starts.
+    cell._set_joints(q, kinematic=True)
     for _ in range(20):
-        cell._set_joints(q, kinematic=True)
         if axis is not None:
             current = Rotation.from_quat(
                 p.getLinkState(
@@ -74,7 +75,7 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
             # The last joint turns the flange about the tool's axis, which moves neither the tool's
             # mouth nor its axis: park it where it rests instead of letting it drift to a limit.
             q[-1] = cell.model.rest[-1]
-        error = float(np.linalg.norm(cell.forward(q) - point_m))
+        error = float(np.linalg.norm(cell._tcp_at(q) - point_m))
         if error <= IK_ACCURACY:
             break
     return q, error
