@@ -178,12 +178,6 @@ def _close_world() -> None:
 atexit.register(_close_world)
 
 
-def _run_chunk(setup: _SimSetup, jobs: list) -> list:
-    """A worker process's jobs (a forked worker builds its own world, never the parent's copy)."""
-    _WORLD.clear()
-    return _run_jobs(setup, jobs)
-
-
 def simulate(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     scenario,
     methods=("dmp", "bidmp"),
@@ -544,19 +538,31 @@ def _execute_jobs(setup: _SimSetup, jobs: list, n_workers: int, progress) -> lis
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    # Interleaved chunks balance long and short motions. "fork" (where there is one) starts
-    # the workers in milliseconds and works from any __main__; "spawn" elsewhere.
-    chunks = [jobs[k::n_workers] for k in range(n_workers)]
+    # One job at a time to whichever worker is free, the costliest first (the ones that render
+    # frames, then the longest paths): fixed chunks put a scenario's far target, pictures and
+    # all, on one worker for every method while the other sat idle. "fork" (where there is one)
+    # starts the workers in milliseconds, works from any __main__, and hands each worker a copy
+    # of this process's world (PyBullet's DIRECT world lives in the process's memory): no world
+    # is built again. "spawn" elsewhere: each worker builds one for its first job and keeps it.
+    # A motion starts from its own reset state, so the measurements do not depend on which
+    # world ran it (tested against one worker).
     outcomes = []
     method = "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
     with ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context(method)) as pool:
-        futures = [pool.submit(_run_chunk, setup, chunk) for chunk in chunks]
+        futures = [pool.submit(_run_jobs, setup, [job]) for job in sorted(jobs, key=_job_cost)]
         for future in as_completed(futures):
             for outcome in future.result():
                 if progress is not None:
                     progress(outcome[0], outcome[1])
                 outcomes.append(outcome)
     return outcomes
+
+
+def _job_cost(job) -> tuple[int, float]:
+    """A sort key, costliest job first: the frames it renders (tens of ms each), then its path's
+    length (the motion's duration grows with it)."""
+    length = float(np.sum(np.linalg.norm(np.diff(job.rollout[:, :3], axis=0), axis=1)))
+    return (-job.frames, -length)
 
 
 def _stepper(models, method, goal, duration, coupling):
