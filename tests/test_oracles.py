@@ -894,7 +894,7 @@ def test_both_frechet_implementations_are_the_defining_recursion(seed):
     """Independent oracle: the kernel and the anti-diagonal reference equal the full-table
     recursion on random curves of unequal lengths (1 to 40 points, 1 to 3 dimensions), including
     ones whose last points decide and ones that wander."""
-    from bidmp.extension.similarity import frechet_distance_reference
+    from bidmp.extension.similarity import _frechet_compiled, frechet_distance_reference
 
     rng = np.random.default_rng(seed)
     for _ in range(8):
@@ -904,6 +904,7 @@ def test_both_frechet_implementations_are_the_defining_recursion(seed):
         truth = _frechet_by_table(a, b)
         assert frechet_distance(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         assert frechet_distance_reference(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
+        assert _frechet_compiled(a, b) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         assert frechet_distance(b, a) == pytest.approx(truth, rel=1e-12, abs=1e-12)
         for same in (a, b):  # a curve against itself: the diagonal path, distance 0
             assert (

@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from bidmp import frechet_distance, frechet_similarity
-from bidmp.extension import frechet_distance_reference, polyline_length
+from bidmp.extension import frechet_distance_reference, polyline_length, similarity
+from bidmp.extension.similarity import _frechet_compiled
 
 
 def test_spec_reference_case():
@@ -27,6 +28,36 @@ def test_equals_similaritymeasures_on_random_unequal_curves():
         expected = similaritymeasures.frechet_dist(a, b)
         assert frechet_distance(a, b) == pytest.approx(expected, rel=1e-12, abs=1e-12)
         assert frechet_distance_reference(a, b) == pytest.approx(expected, rel=1e-12, abs=1e-12)
+        assert _frechet_compiled(a, b) == pytest.approx(expected, rel=1e-12, abs=1e-12)
+
+
+def test_the_compiled_kernel_and_the_numpy_version_give_the_same_bits():
+    """Which one answers must not change a result (G-PRM keeps the best-scoring path): random
+    curves of 1 to 120 points in 1 to 3 dimensions, of any scale, and curves with ties."""
+    rng = np.random.default_rng(11)
+    for trial in range(200):
+        n_dims = int(rng.integers(1, 4))
+        scale = 10.0 ** rng.uniform(-3, 3)
+        a = scale * rng.normal(size=(int(rng.integers(1, 121)), n_dims)).cumsum(axis=0)
+        b = scale * rng.normal(size=(int(rng.integers(1, 121)), n_dims)).cumsum(axis=0)
+        if trial % 10 == 0:  # exact ties: points on a grid
+            a, b = np.round(a / scale), np.round(b / scale)
+        assert _frechet_compiled(a, b) == frechet_distance_reference(a, b), trial
+
+
+def test_numba_is_loaded_only_for_work_that_repays_it(monkeypatch):
+    """A process's first NUMPY_BUDGET_CELLS cells are the NumPy version's (no numba: ~0.3 s of
+    a command's life); past them the compiled kernel answers, with the same numbers."""
+    monkeypatch.setattr(similarity, "_kernel_state", {})
+    monkeypatch.setattr(similarity, "_numpy_cells", [0])
+    rng = np.random.default_rng(3)
+    a, b = rng.normal(size=(100, 3)).cumsum(axis=0), rng.normal(size=(100, 3)).cumsum(axis=0)
+    first = frechet_distance(a, b)
+    assert "Fréchet" not in similarity._kernel_state and similarity._numpy_cells[0] == 10_000
+    similarity._numpy_cells[0] = int(similarity.NUMPY_BUDGET_CELLS) - 5_000
+    assert frechet_distance(a, b) == first  # over the budget: compiled
+    assert similarity._kernel_state.get("Fréchet") is not None
+    assert similarity._numpy_cells[0] == int(similarity.NUMPY_BUDGET_CELLS) - 5_000
 
 
 curves = st.integers(1, 25).flatmap(

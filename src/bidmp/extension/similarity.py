@@ -10,6 +10,15 @@ environment compiles it, about a second). SciPy and NumPy have no kernel for thi
 cells depend on their left neighbour in the same row, so a row cannot be one vector operation.
 :func:`frechet_distance_reference` is a plain NumPy version (one vectorised anti-diagonal at a
 time) that serves as the fallback when numba is missing and as the tests' second opinion.
+
+**Which one answers.** Loading numba and the cached kernel costs a process about 0.3 s (the
+import, LLVM, and LLVM's own teardown when the process ends); the NumPy version spends that on
+about a million table cells (3 ms for 100 × 100). So a process's first million cells are the NumPy
+version's, and the kernel is loaded only for work that repays it: a G-PRM of a few iterations
+(a command's usual extension: ten 100 × 100 tables) never loads numba. Both give the same bits:
+the recursion only takes maxima and minima, the squared distances are summed in the same order,
+and a correctly rounded square root is monotone, so the root of the extreme is the extreme of the
+roots (tested on random curves).
 """
 
 from __future__ import annotations
@@ -21,6 +30,8 @@ import numpy as np
 from .._checks import as_trajectory, check_choice, check_limit, numerically_guarded
 
 REFERENCE_MAX_CELLS = 1e7  # cells of frechet_distance_reference (a few seconds)
+# cells the NumPy version answers in a process before the compiled kernel is loaded (module docstring)
+NUMPY_BUDGET_CELLS = 1e6
 
 __all__ = [
     "frechet_distance",
@@ -175,6 +186,12 @@ def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
             f"frechet_distance_reference: {n:,} x {m:,} cells exceed the reference's "
             f"{REFERENCE_MAX_CELLS:,.0f}; use frechet_distance"
         )
+    return _frechet_anti_diagonals(a, b)
+
+
+def _frechet_anti_diagonals(a: np.ndarray, b: np.ndarray) -> float:
+    """:func:`frechet_distance_reference` of checked curves."""
+    n, m = a.shape[0], b.shape[0]
     # previous[i] holds ca[i, s-1-i], before_previous[i] holds ca[i, s-2-i]; inf outside the grid.
     before_previous = np.full(n, np.inf)
     previous = np.full(n, np.inf)
@@ -232,10 +249,23 @@ def _curve_pair(a, b) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _frechet_distance(a: np.ndarray, b: np.ndarray) -> float:
-    """:func:`frechet_distance` of checked curves (G-PRM scores every iteration with it)."""
+    """:func:`frechet_distance` of checked curves (G-PRM scores every iteration with it): the NumPy
+    version within the process's budget of cells, else the compiled kernel (module docstring)."""
+    cells = a.shape[0] * b.shape[0]
+    if "Fréchet" not in _kernel_state and _numpy_cells[0] + cells <= NUMPY_BUDGET_CELLS:
+        _numpy_cells[0] += cells
+        return _frechet_anti_diagonals(a, b)
+    return _frechet_compiled(a, b)
+
+
+_numpy_cells = [0]  # cells the NumPy version has answered in this process
+
+
+def _frechet_compiled(a: np.ndarray, b: np.ndarray) -> float:
+    """The compiled kernel's answer for checked curves (the NumPy version's without numba)."""
     kernel = _frechet_kernel()
     if kernel is None:  # pragma: no cover
-        return frechet_distance_reference(a, b)
+        return _frechet_anti_diagonals(a, b)
     return float(kernel(a, b))
 
 
