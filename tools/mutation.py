@@ -152,6 +152,8 @@ TARGETS = (
         (
             "_frechet_rows",
             "frechet_distance_reference",
+            "_frechet_anti_diagonals",
+            "_frechet_distance",
             "polyline_length",
             "_length",
             "frechet_similarity",
@@ -363,7 +365,7 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ): "NumPy takes any negative size in reshape as 'the rest': reshape(-2) is reshape(-1)",
     (
         "bidmp.extension.similarity",
-        "frechet_distance_reference",
+        "_frechet_anti_diagonals",
         "i = np.arange(max(0, s - m + 1), min(n, s + 1))",
         "1 -> 2",
     ): "one more cell per anti-diagonal, just off the table (j = -1): it derives only from other such "

@@ -54,10 +54,23 @@ def test_numba_is_loaded_only_for_work_that_repays_it(monkeypatch):
     a, b = rng.normal(size=(100, 3)).cumsum(axis=0), rng.normal(size=(100, 3)).cumsum(axis=0)
     first = frechet_distance(a, b)
     assert "Fréchet" not in similarity._kernel_state and similarity._numpy_cells[0] == 10_000
-    similarity._numpy_cells[0] = int(similarity.NUMPY_BUDGET_CELLS) - 5_000
+    budget = int(similarity.NUMPY_BUDGET_CELLS)
+    similarity._numpy_cells[0] = budget - 10_000
+    assert frechet_distance(a, b) == first  # the budget's last cells: still NumPy
+    assert "Fréchet" not in similarity._kernel_state and similarity._numpy_cells[0] == budget
     assert frechet_distance(a, b) == first  # over the budget: compiled
     assert similarity._kernel_state.get("Fréchet") is not None
-    assert similarity._numpy_cells[0] == int(similarity.NUMPY_BUDGET_CELLS) - 5_000
+    assert similarity._numpy_cells[0] == budget
+
+
+def test_the_numpy_version_refuses_a_table_over_its_size_in_cells():
+    """A Python loop over anti-diagonals is a reference, not a tool: over REFERENCE_MAX_CELLS
+    (rows times rows, whatever the dimension) it says to use frechet_distance."""
+    rows = int(similarity.REFERENCE_MAX_CELLS) // 1_000 + 1
+    with pytest.raises(ValueError, match="use frechet_distance"):
+        frechet_distance_reference(np.zeros((rows, 2)), np.zeros((1_000, 2)))
+    with pytest.raises(ValueError, match="use frechet_distance"):
+        frechet_distance_reference(np.zeros((1_000, 2)), np.zeros((rows, 2)))
 
 
 curves = st.integers(1, 25).flatmap(
