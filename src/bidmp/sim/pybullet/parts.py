@@ -22,12 +22,12 @@ from .world import _add_solid
 __all__ = []
 
 
-def _turned(quaternion: tuple[float, ...], rotvec: np.ndarray) -> list[float]:
+def _turned(quaternion: tuple[float, ...], rotvec) -> list[float]:
     """``Rotation.from_rotvec(rotvec) * Rotation.from_quat(quaternion)`` as a quaternion
     (x, y, z, w), in scipy's own arithmetic, step by step (its small-angle series, its product,
     its normalisation): the same bits, so a released nut falls exactly as before. The thread
     asks for it at every recorded step, where the two Rotation objects cost 25 µs."""
-    x, y, z = rotvec.tolist()
+    x, y, z = (float(value) for value in rotvec)
     angle = math.sqrt(x * x + y * y + z * z)
     if angle <= 1e-3:
         square = angle * angle
@@ -58,6 +58,9 @@ class _MovablePart:
         self.rotation0 = Rotation.from_matrix(self.solid.rotation)
         self._quaternion0 = tuple(self.rotation0.as_quat().tolist())
         self.axis = self.solid.rotation[:, 2]
+        # The thread's pose in plain floats (the same IEEE operations as NumPy's elementwise ones,
+        # without an array per step): the centre and the axis as lists.
+        self._centre0, self._axis = self.centre0.tolist(), self.axis.tolist()
         self.height = _solid_height(self.solid)
         self.state, self.rise, self.constraint = "seated", 0.0, None
         self.trace: list[
@@ -65,14 +68,11 @@ class _MovablePart:
         ] = []  # (rise, angle turned, time) while threading
 
     def set_pose(self, centre, rotation: Rotation) -> None:
-        self._set_pose(centre, rotation.as_quat().tolist())
-
-    def _set_pose(self, centre, quaternion: list[float]) -> None:
         p, unit = self.cell.p, self.cell.unit
         p.resetBasePositionAndOrientation(
             self.body,
             (np.asarray(centre) * unit).tolist(),
-            quaternion,
+            rotation.as_quat().tolist(),
             physicsClientId=self.cell.client,
         )
 
@@ -89,9 +89,12 @@ class _MovablePart:
         where it is rather than screwing it back."""
         self.state, self.rise = "threading", max(self.rise, float(rise))
         angle = 2.0 * math.pi * self.rise / pitch
-        self._set_pose(
-            self.centre0 + self.axis * self.rise,
-            _turned(self._quaternion0, self.axis * angle),
+        unit, rise = self.cell.unit, self.rise
+        self.cell.p.resetBasePositionAndOrientation(
+            self.body,
+            [(centre + axis * rise) * unit for centre, axis in zip(self._centre0, self._axis)],
+            _turned(self._quaternion0, [axis * angle for axis in self._axis]),
+            physicsClientId=self.cell.client,
         )
         self.trace.append((self.rise, angle, t))
 
