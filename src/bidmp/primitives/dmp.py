@@ -301,7 +301,7 @@ class DMP(_FittedParams, Estimator):
     ) -> DMP:
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
         move on its own: then ``y`` may be static)."""
-        params = self._params()
+        params = resolved = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
         names = check_names(names, y.shape[1])
@@ -346,7 +346,7 @@ class DMP(_FittedParams, Estimator):
         self.goal_gate_ = gate if params.goal_rate is None else None
         self.centres_ = centres
         self.widths_ = widths
-        self._remember_params()
+        self._remember_params(resolved)
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
         _store_grid(self, params._replace(tau=1.0), phase, phi, dt)
         logger.debug(

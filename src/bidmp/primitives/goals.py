@@ -301,15 +301,16 @@ def _learned_progress_gate(model, params) -> ProgressGate:
     """The :class:`ProgressGate` a fitted DMP learned (its ``goal_gate_`` on its training grid),
     cached on the model: a control loop asks for it once per stepper."""
     gate = model.__dict__.get("goal_gate_")
-    if gate is None or gate.shape[0] != model.n_train_:
+    n_train = model.n_train_  # (a property that checks the model and resolves its parameters)
+    if gate is None or gate.shape[0] != n_train:
         raise ValueError(
             "this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
             "set goal_rate to a number or fit it again"
         )
-    key = (model.n_train_, model.dt_, params.canonical_system)
+    key = (n_train, model.dt_, params.canonical_system)
     cached = model.__dict__.get("_goal_system")
     if cached is None or cached[0] != key or cached[1].gate is not gate:
-        training_phase = params.canonical_system.grid(model.n_train_, model.dt_, 1.0)
+        training_phase = params.canonical_system.grid(n_train, model.dt_, 1.0)
         if not np.all(np.diff(training_phase) < 0.0):
             raise ValueError(
                 "the progress gate looks the goal's share up by the phase, which must decay; "

@@ -254,8 +254,11 @@ class _FittedParams:
     def _raw_params(self) -> tuple:
         return tuple(getattr(self, name) for name in self._raw_param_names())
 
-    def _remember_params(self) -> None:
-        self._learned_with = (self._raw_params(), self._learned_params())
+    def _remember_params(self, resolved: _Params | None = None) -> None:
+        """Keep the parameters the weights were learned with: the raw ones and their resolution
+        (``resolved``: :meth:`_params` as ``fit`` resolved them a moment ago)."""
+        learned = self._learned_params() if resolved is None else resolved._replace(tau=1.0)
+        self._learned_with = (self._raw_params(), learned)
 
     def _stale_params(self) -> list[str]:
         """The learned-with parameters that have changed since ``fit`` (with their values)."""
