@@ -58,9 +58,9 @@ def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNES
     last = y.shape[0] - 1
     if _is_straight(y[start:], straightness):
         return int(start)
-    candidates = np.unique(
-        np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1))).astype(int)
-    )
+    candidates = np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1)))
+    candidates = candidates.astype(int)  # non-decreasing: its distinct values without a sort
+    candidates = candidates[np.concatenate(([True], candidates[1:] != candidates[:-1]))]
     # The candidates' tests at once (a fit asks twice: its approach and its departure; one
     # candidate at a time was 80 % of a robot-protocol fit), each stage a necessary condition of
     # the next, so only a few candidates take the whole test: three probes inside each tail, then
@@ -105,16 +105,17 @@ def _probes_straight(y: np.ndarray, starts: np.ndarray, tolerance: float) -> np.
     length = np.linalg.norm(origin, axis=1)
     moving = length > 0.0
     unit = -origin / np.where(moving, length, 1.0)[:, None]
-    keep = moving.copy()
-    for share in (0.25, 0.5, 0.75):
-        index = starts + np.floor(share * (last - starts)).astype(int)
-        offset = ends[index] - origin  # (k, D)
-        along = np.sum(offset * unit, axis=1)
-        across = np.sum(offset * offset, axis=1) - along * along
-        bound = tolerance * length
-        # a hair of slack: the full test sums the same squares in another order
-        keep &= across <= bound * bound * (1.0 + 1e-9) + 1e-300
-    return keep
+    # the three probes of every tail at once: (3, k) samples
+    index = starts + np.floor(_PROBES[:, None] * (last - starts)).astype(int)
+    offset = ends[index] - origin  # (3, k, D)
+    along = np.sum(offset * unit, axis=2)
+    across = np.sum(offset * offset, axis=2) - along * along
+    bound = tolerance * length
+    # a hair of slack: the full test sums the same squares in another order
+    return moving & np.all(across <= bound * bound * (1.0 + 1e-9) + 1e-300, axis=0)
+
+
+_PROBES = np.array([0.25, 0.5, 0.75])  # where inside each tail the probes look, as shares
 
 
 def _tails_straight(
