@@ -386,3 +386,72 @@ def test_joint_limits_and_the_robot_for_a_six_joint_model(tmp_path, capsys):
         == 2
     )
     assert "that arm has 7 joints; this model has 6 dimensions" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("model", ["panda", "iiwa", "ur5"])
+def test_the_planning_copy_without_geometry_solves_and_measures_to_the_same_bits(model, tmp_path):
+    """The planning copy of the arm is loaded without its links' meshes (they were most of its
+    loading time): inverse and forward kinematics must give exactly what the full URDF gives,
+    over a chain of IK calls each seeded by the last (the reference: the full URDF in a world of
+    its own)."""
+    import pybullet as p
+
+    from bidmp.sim.pybullet.world import _kinematic_urdf, _tool_urdf
+    from bidmp.sim.robots import ROBOT_MODELS
+
+    arm = ROBOT_MODELS[model]
+    text = _tool_urdf(arm, 0.012, 0.1)
+    light = _kinematic_urdf(text)
+    assert "<visual" in text and "<visual" not in light and "<collision" not in light
+    assert _kinematic_urdf("<robot><link") == "<robot><link"  # unreadable: returned whole
+    (tmp_path / "full.urdf").write_text(text)
+    (tmp_path / "light.urdf").write_text(light)
+    worlds = [p.connect(p.DIRECT) for _ in range(2)]
+    try:
+        bodies = [
+            p.loadURDF(str(tmp_path / name), useFixedBase=True, physicsClientId=world)
+            for name, world in zip(("full.urdf", "light.urdf"), worlds)
+        ]
+        n_joints = p.getNumJoints(bodies[0], physicsClientId=worlds[0])
+        names = [
+            p.getJointInfo(bodies[0], j, physicsClientId=worlds[0])[12].decode()
+            for j in range(n_joints)
+        ]
+        tcp = names.index("tcp")
+        movable = [
+            j
+            for j in range(n_joints)
+            if p.getJointInfo(bodies[0], j, physicsClientId=worlds[0])[2] != p.JOINT_FIXED
+        ]
+        lower, upper = list(arm.limits.lower), list(arm.limits.upper)
+        rng = np.random.default_rng(5)
+        q = list(arm.rest)
+        for _ in range(40):
+            frames = []
+            for body, world in zip(bodies, worlds):
+                for joint, angle in zip(movable, q):
+                    p.resetJointState(body, joint, angle, 0.0, physicsClientId=world)
+                state = p.getLinkState(body, tcp, computeForwardKinematics=1, physicsClientId=world)
+                frames.append(state[4:6])
+            assert frames[0] == frames[1]
+            goal = (np.array(frames[0][0]) + rng.normal(0.0, 0.01, 3)).tolist()
+            solved = [
+                p.calculateInverseKinematics(
+                    body,
+                    tcp,
+                    goal,
+                    [1.0, 0.0, 0.0, 0.0],
+                    lowerLimits=lower,
+                    upperLimits=upper,
+                    jointRanges=[b - a for a, b in zip(lower, upper)],
+                    restPoses=q,
+                    maxNumIterations=40,
+                    physicsClientId=world,
+                )
+                for body, world in zip(bodies, worlds)
+            ]
+            assert solved[0] == solved[1]
+            q = list(solved[0][: len(movable)])
+    finally:
+        for world in worlds:
+            p.disconnect(world)

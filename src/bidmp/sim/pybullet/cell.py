@@ -14,7 +14,7 @@ from ..robots import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from . import execute as _execute
 from . import ik as _ik
 from . import render as _render
-from .world import SOLVER_ITERATIONS, _add_solid, _pybullet_module, _tool_urdf
+from .world import SOLVER_ITERATIONS, _add_solid, _kinematic_urdf, _pybullet_module, _tool_urdf
 
 __all__ = ["RobotCell"]
 
@@ -78,9 +78,12 @@ class RobotCell:
             self.ik_client = p.connect(p.DIRECT)
             with tempfile.TemporaryDirectory() as folder:
                 path = Path(folder) / "robot_tool.urdf"
-                path.write_text(
-                    _tool_urdf(robot, scene.tool.radius * self.unit, scene.tool.length * self.unit)
+                text = _tool_urdf(
+                    robot, scene.tool.radius * self.unit, scene.tool.length * self.unit
                 )
+                path.write_text(text)
+                kinematics = Path(folder) / "robot_kinematics.urdf"
+                kinematics.write_text(_kinematic_urdf(text))
                 base_m = np.asarray(base, dtype=float) * self.unit
                 orientation = p.getQuaternionFromEuler([0, 0, math.radians(yaw)])
                 self.robot = p.loadURDF(
@@ -91,7 +94,7 @@ class RobotCell:
                     physicsClientId=self.client,
                 )
                 self.ik_robot = p.loadURDF(
-                    str(path),
+                    str(kinematics),
                     base_m.tolist(),
                     orientation,
                     useFixedBase=True,

@@ -66,6 +66,24 @@ def _mesh(folder: Path, name: str, urdf: Path) -> Path:
     return resolved
 
 
+def _kinematic_urdf(text: str) -> str:
+    """The URDF ``text`` without its links' visual and collision geometry, for the planning copy
+    of the arm: inverse and forward kinematics read the joints' axes and frames only (the same
+    bits with or without the geometry, tested), and parsing the meshes was most of the time of
+    loading that copy. Text that ElementTree cannot read is returned whole."""
+    import xml.etree.ElementTree as ElementTree
+
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError:
+        return text
+    for link in root.iter("link"):
+        for tag in ("visual", "collision"):
+            for element in link.findall(tag):
+                link.remove(element)
+    return ElementTree.tostring(root, encoding="unicode")
+
+
 def _tool_urdf(model, tool_radius: float, tool_length: float) -> str:
     """The URDF of ``model`` (a :class:`~bidmp.sim.robots.RobotModel`) carrying a
     cylindrical tool (metres) on its flange: link ``tool`` on the flange, link ``tcp`` at the
