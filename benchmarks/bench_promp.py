@@ -22,9 +22,9 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import time
 
 import numpy as np
+from _timing import interleaved_times
 
 from bidmp.demonstrations import lasa
 from bidmp.demonstrations.datasets import lasa_names
@@ -35,13 +35,6 @@ N_BASIS = 20
 
 def rmse(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((a - b) ** 2, axis=1))))
-
-
-def timed(function) -> float:
-    """Seconds of one call (the caller interleaves the sides and takes the median)."""
-    start = time.perf_counter()
-    function()
-    return time.perf_counter() - start
 
 
 def main() -> int:
@@ -89,24 +82,20 @@ def main() -> int:
             "same_mean": float(np.abs(goal_only.mean(T) - theirs_same.mean_trajectory(T)).max()),
             "same_var": float(np.abs(goal_only.var(T) - theirs_same.var_trajectory(T)).max()),
         }
-        fits = {"ours": [], "peer": []}
-        conditions = {"ours": [], "peer": []}
-        for _ in range(args.repeats):  # the sides interleaved
-            fits["ours"].append(timed(lambda: ProMP(n_basis=N_BASIS).fit(list(train))))
-            fits["peer"].append(
-                timed(
-                    lambda: PeerProMP(n_dims=2, n_weights_per_dim=N_BASIS).imitate(
-                        np.tile(T, (len(train), 1)), train
-                    )
-                )
-            )
-            conditions["ours"].append(timed(ours_condition))
-            conditions["peer"].append(timed(peer_condition))
-        row["fit_ratio"] = statistics.median(fits["peer"]) / statistics.median(fits["ours"])
-        row["cond_ratio"] = statistics.median(conditions["peer"]) / statistics.median(
-            conditions["ours"]
+        seconds = interleaved_times(
+            {
+                "fit ours": lambda: ProMP(n_basis=N_BASIS).fit(list(train)),
+                "fit peer": lambda: PeerProMP(n_dims=2, n_weights_per_dim=N_BASIS).imitate(
+                    np.tile(T, (len(train), 1)), train
+                ),
+                "condition ours": ours_condition,
+                "condition peer": peer_condition,
+            },
+            args.repeats,
         )
-        row["fit_ours_ms"] = 1e3 * statistics.median(fits["ours"])
+        row["fit_ratio"] = seconds["fit peer"] / seconds["fit ours"]
+        row["cond_ratio"] = seconds["condition peer"] / seconds["condition ours"]
+        row["fit_ours_ms"] = 1e3 * seconds["fit ours"]
         rows.append(row)
 
     def median(key):

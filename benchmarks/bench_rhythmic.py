@@ -16,12 +16,11 @@ pydmps needs Python < 3.12 (it imports ``imp``): without it only bidmp's side ru
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 import warnings
 
 import numpy as np
+from _timing import interleaved_times
 
 from bidmp.primitives import RhythmicDMP
 
@@ -106,15 +105,10 @@ def main() -> int:
             last, clean_p = pydmps_side(frequency, t, y, DMPs_rhythmic)
             theirs_err.append(rmse(last, clean_p) / AMPLITUDE)
             sides["pydmps"] = lambda: pydmps_side(frequency, t, y, DMPs_rhythmic)
-        samples = {name: [] for name in sides}
-        for _ in range(args.repeats):
-            for name, side in sides.items():
-                begin = time.perf_counter()
-                side()
-                samples[name].append(time.perf_counter() - begin)
-        ours_t.append(statistics.median(samples["bidmp"]))
-        if "pydmps" in samples:
-            theirs_t.append(statistics.median(samples["pydmps"]))
+        medians = interleaved_times(sides, args.repeats)
+        ours_t.append(medians["bidmp"])
+        if "pydmps" in medians:
+            theirs_t.append(medians["pydmps"])
     print(f"{args.recordings} recordings, 50 basis functions, medians (worst)")
     print(
         f"  bidmp  RhythmicDMP     RMSE/amplitude {100 * np.median(ours_err):6.3f} % "

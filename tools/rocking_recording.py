@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bidmp.io.atomic import atomic_write
+
 OUT = (
     Path(__file__).resolve().parents[1]
     / "src"
@@ -49,7 +51,8 @@ def main() -> int:
     args = parser.parse_args()
     t, y = recording()
     lines = ["t,x,y,z"] + [f"{a:.6f},{b:.4f},{c:.4f},{d:.4f}" for a, (b, c, d) in zip(t, y)]
-    args.out.write_text("\n".join(lines) + "\n")
+    with atomic_write(args.out, "w") as handle:
+        handle.write("\n".join(lines) + "\n")
     print(f"wrote {args.out} ({len(t)} samples over {t[-1] - t[0]:.2f} s)")
     return 0
 

@@ -130,8 +130,11 @@ def _compiled(name: str, function):
     return _kernel_state[name]
 
 
+_FRECHET = "Fréchet"  # the kernel's name in _kernel_state
+
+
 def _frechet_kernel():
-    return _compiled("Fréchet", _frechet_rows)
+    return _compiled(_FRECHET, _frechet_rows)
 
 
 def dtw_distance(a, b) -> float:
@@ -252,7 +255,7 @@ def _frechet_distance(a: np.ndarray, b: np.ndarray) -> float:
     """:func:`frechet_distance` of checked curves (G-PRM scores every iteration with it): the NumPy
     version within the process's budget of cells, else the compiled kernel (module docstring)."""
     cells = a.shape[0] * b.shape[0]
-    if "Fréchet" not in _kernel_state and _numpy_cells[0] + cells <= NUMPY_BUDGET_CELLS:
+    if _FRECHET not in _kernel_state and _numpy_cells[0] + cells <= NUMPY_BUDGET_CELLS:
         _numpy_cells[0] += cells
         return _frechet_anti_diagonals(a, b)
     return _frechet_compiled(a, b)

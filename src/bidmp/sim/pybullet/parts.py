@@ -68,12 +68,12 @@ class _MovablePart:
         ] = []  # (rise, angle turned, time) while threading
 
     def set_pose(self, centre, rotation: Rotation) -> None:
-        p, unit = self.cell.p, self.cell.unit
-        p.resetBasePositionAndOrientation(
-            self.body,
-            (np.asarray(centre) * unit).tolist(),
-            rotation.as_quat().tolist(),
-            physicsClientId=self.cell.client,
+        self._place((np.asarray(centre) * self.cell.unit).tolist(), rotation.as_quat().tolist())
+
+    def _place(self, centre_m: list[float], quaternion: list[float]) -> None:
+        """Put the body at ``centre_m`` (m) turned by ``quaternion`` (x, y, z, w)."""
+        self.cell.p.resetBasePositionAndOrientation(
+            self.body, centre_m, quaternion, physicsClientId=self.cell.client
         )
 
     def pose(self) -> tuple[np.ndarray, Rotation]:
@@ -90,11 +90,9 @@ class _MovablePart:
         self.state, self.rise = "threading", max(self.rise, float(rise))
         angle = 2.0 * math.pi * self.rise / pitch
         unit, rise = self.cell.unit, self.rise
-        self.cell.p.resetBasePositionAndOrientation(
-            self.body,
+        self._place(
             [(centre + axis * rise) * unit for centre, axis in zip(self._centre0, self._axis)],
             _turned(self._quaternion0, [axis * angle for axis in self._axis]),
-            physicsClientId=self.cell.client,
         )
         self.trace.append((self.rise, angle, t))
 
