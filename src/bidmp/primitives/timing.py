@@ -248,8 +248,12 @@ def drop_repeated_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]
         raise TypeError(
             f"name (what the messages call the stamps) must be text, got {type(name).__name__}"
         )
-    y = _as_samples(y)
-    stamps = _as_stamps(t, name)
+    return _drop_repeated(_as_samples(y), _as_stamps(t, name), name)
+
+
+def _drop_repeated(y: np.ndarray, stamps: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`drop_repeated_stamps` of samples ``y`` already checked (:func:`_as_samples`) and
+    stamps already read as floats; the stamps are checked here."""
     if (
         stamps.ndim == 1
         and stamps.shape[0] == y.shape[0]
@@ -275,7 +279,11 @@ def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``y`` sampled at stamps ``t`` resampled to as many uniform samples over the same span;
     returns (y_uniform (n, D), t_uniform (n,) starting at 0)."""
     y = _as_samples(y)
-    t = check_timestamps(t, y.shape[0], "t", "the rows of y")
+    return _resampled(y, check_timestamps(t, y.shape[0], "t", "the rows of y"))
+
+
+def _resampled(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`uniform_time` of checked samples ``y`` (T, D) and stamps ``t`` (T,)."""
     t = t - t[0]
     grid = np.linspace(0.0, t[-1], t.shape[0])
     steps = np.diff(t)
@@ -398,6 +406,6 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     y = _as_samples(y)
     if t is None:
         return y, (y.shape[0] - 1) / y.shape[0]
-    y, stamps = drop_repeated_stamps(y, t)
-    y, grid = uniform_time(y, stamps)
+    # checked once here, not again by each step (the stamps by _drop_repeated)
+    y, grid = _resampled(*_drop_repeated(y, _as_stamps(t, "t"), "t"))
     return y, float(grid[-1])
