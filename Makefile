@@ -14,8 +14,9 @@ endif
 
 .PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check
 
-# (Re)create the virtual environment and install bidmp (editable) with pinned dependencies.
-$(STAMP): pyproject.toml constraints.txt
+# (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
+# editable install does not rebuild the compiled loops when their source changes: this does.
+$(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/primitives/_kernels.pyx
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint,docs]"
@@ -152,4 +153,5 @@ readme: $(STAMP)
 	$(PY) tools/readme.py
 
 clean:
-	rm -rf $(VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check
+	rm -rf $(VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
+	rm -f src/bidmp/primitives/_kernels.c src/bidmp/primitives/_kernels.*.so

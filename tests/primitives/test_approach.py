@@ -229,10 +229,10 @@ def _plain_tail_start(y, start=0, straightness=0.02):
 
 
 def test_the_tail_search_is_the_plain_candidate_by_candidate_one():
-    """The candidates are tested together as matrix products with a coarse first pass (a fit
-    asks twice, and one at a time was 80 % of a robot-protocol fit): on random walks, noisy
-    curves ending in a straight approach at any scale and offset, and arcs, it gives the index the
-    plain loop gives."""
+    """The compiled search (probes, then every 8th sample, then all, with early exits) gives the
+    index the plain loop gives, on random walks, noisy curves ending in a straight approach at any
+    scale and offset, and arcs, from the start and from any sample, and on the reversed motion (a
+    departure: a view with negative strides)."""
     rng = np.random.default_rng(11)
     for trial in range(300):
         n_points, n_dims = int(rng.integers(3, 1200)), int(rng.integers(1, 4))
@@ -248,3 +248,4 @@ def test_the_tail_search_is_the_plain_candidate_by_candidate_one():
         start = int(rng.integers(0, n_points - 1))
         for first in (0, start):
             assert _tail_start(y, first) == _plain_tail_start(y, first), (trial, first)
+        assert _tail_start(y[::-1]) == _plain_tail_start(y[::-1].copy()), trial

@@ -28,9 +28,9 @@ affine in the goal and the start::
 
     y(g, y0) = a + B g + C y0        (a: (n, D);  B, C: (n,), the same for every dimension)
 
-Either integrator is a second-order recursion in ``y``, which :func:`scipy.signal.lfilter` runs in
-C for all dimensions and the three unit responses at once. Rollouts to many goals then cost one
-integration plus an outer product (:meth:`DMP.rollout_many`).
+Either integrator is a second-order recursion in ``y``, which one compiled loop (the numbers of
+:func:`scipy.signal.lfilter`) runs for all dimensions and the three unit responses at once.
+Rollouts to many goals then cost one integration plus an outer product (:meth:`DMP.rollout_many`).
 
 **Why a plain DMP misses far goals.** After a finite horizon the phase is still ``≈ e⁻¹``, the
 system has not converged, and the end point misses a shifted goal ``g'`` by exactly
@@ -60,7 +60,14 @@ from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
 from .forcing import Basis, _check_forcing_increment, _forcing_target, _learn_weights
-from .goals import DelayedGoal, PhaseGate, ProgressGate, _learn_goal_gate, _learned_progress_gate
+from .goals import (
+    DelayedGoal,
+    PhaseGate,
+    ProgressGate,
+    _gate_past_training,
+    _learn_goal_gate,
+    _learned_progress_gate,
+)
 from .grid import _cached_grid, _rollout_grid, _store_grid
 from .integrate import _check_integration, _unit_responses
 from .protocols import (
@@ -348,7 +355,16 @@ class DMP(_FittedParams, Estimator):
         self.widths_ = widths
         self._remember_params(resolved)
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
-        _store_grid(self, params._replace(tau=1.0), phase, phi, dt)
+        _store_grid(
+            self,
+            params._replace(tau=1.0),
+            phase,
+            phi,
+            dt,
+            None
+            if params.goal_rate is not None
+            else _gate_past_training(gate, phase, params.canonical_system),
+        )
         logger.debug(
             "fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration
         )
@@ -546,8 +562,8 @@ class DMP(_FittedParams, Estimator):
         free += np.outer(start_response, start)
         if start_velocity is not None:
             free += np.outer(velocity_response, velocity)
-        # lfilter runs in C, outside NumPy's floating-point checks: check its output once. With
-        # these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
+        # The integration runs compiled, outside NumPy's floating-point checks: check its output
+        # once. With these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
         if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
             raise ValueError(
                 "rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range"

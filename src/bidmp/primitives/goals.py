@@ -51,6 +51,7 @@ import numpy as np
 
 from .._checks import as_vector, check_bool, check_int, check_real
 from .._trajectory import arclength
+from ._kernels import goal_gate
 from .canonical import phase_grid
 
 __all__ = ["PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate"]
@@ -101,15 +102,11 @@ def _goal_share(
 
 
 def _goal_gate(share: np.ndarray, dt: float, *, alpha: float, beta: float, K: float) -> np.ndarray:
-    """The gate ``G = (αβ (1 - R) - R'' - α R') / K`` whose continuous response is ``R``."""
-    rate = np.gradient(share, dt)
-    curvature = np.gradient(rate, dt)
-    gate = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
-    # R, R' and R'' vanish at the start (the smoothstep is flat there): one-sided differences
-    # would leave a trace of the next samples, and the initial acceleration must not depend on
-    # the goal.
-    gate[0] = alpha * beta / K
-    return gate
+    """The gate ``G = (αβ (1 - R) - R'' - α R') / K`` whose continuous response is ``R``, with
+    ``R'`` and ``R''`` as central differences (one compiled loop). R, R' and R'' vanish at the start
+    (the smoothstep is flat there): one-sided differences would leave a trace of the next samples,
+    and the initial acceleration must not depend on the goal, so ``G[0] = αβ / K``."""
+    return goal_gate(share, dt, alpha, beta, K)
 
 
 def _euler_progress_gate(
@@ -311,14 +308,30 @@ def _learned_progress_gate(model, params) -> ProgressGate:
     cached = model.__dict__.get("_goal_system")
     if cached is None or cached[0] != key or cached[1].gate is not gate:
         training_phase = params.canonical_system.grid(n_train, model.dt_, 1.0)
-        if not np.all(np.diff(training_phase) < 0.0):
-            raise ValueError(
-                "the progress gate looks the goal's share up by the phase, which must decay; "
-                f"{type(params.canonical_system).__name__} does not: set goal_rate to a number"
-            )
+        _check_decaying(training_phase, params.canonical_system)
         cached = (key, ProgressGate(training_phase, gate))
         model._goal_system = cached
     return cached[1]
+
+
+def _check_decaying(phase: np.ndarray, canonical_system) -> None:
+    if not np.all(np.diff(phase) < 0.0):
+        raise ValueError(
+            "the progress gate looks the goal's share up by the phase, which must decay; "
+            f"{type(canonical_system).__name__} does not: set goal_rate to a number"
+        )
+
+
+def _gate_past_training(gate: np.ndarray, phase: np.ndarray, canonical_system) -> np.ndarray | None:
+    """A learned progress gate ``gate`` (n,) on its own training grid and one sample past it, the
+    grid of phases ``phase`` (n + 1,) it was learned on: the gate itself, then its last value (the
+    lookup by phase holds it beyond the grid) — what :meth:`ProgressGate.on_grid` returns there,
+    without building the lookup (a fit needs it for its cached rollout grid); None where the lookup
+    would interpolate instead."""
+    _check_decaying(phase[:-1], canonical_system)
+    if not phase[-1] <= phase[-2]:
+        return None  # a phase rising again past the grid: the lookup interpolates there
+    return np.append(gate, gate[-1])
 
 
 class ApproachGate(ProgressGate):

@@ -31,9 +31,14 @@ def _grid_key(params, step: float) -> tuple:
     )
 
 
-def _store_grid(model, params, phase: np.ndarray, basis: np.ndarray, step: float) -> tuple:
-    """Cache the grid (phase, basis rows, unit responses, goal gate) on ``model``; return the entry."""
-    gate = model.goal_system(params).on_grid(phase, step, params.tau, params.exact)
+def _store_grid(
+    model, params, phase: np.ndarray, basis: np.ndarray, step: float, gate: np.ndarray | None = None
+) -> tuple:
+    """Cache the grid (phase, basis rows, unit responses, goal gate) on ``model``; return the entry.
+    ``gate`` (n,): the goal gate on this grid when the caller has it (default: the model's goal
+    system on it)."""
+    if gate is None:
+        gate = model.goal_system(params).on_grid(phase, step, params.tau, params.exact)
     cached = (
         _grid_key(params, step),
         model.centres_,

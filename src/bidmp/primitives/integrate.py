@@ -12,8 +12,9 @@ an input ``u``. In normalised time ``s`` with ``z = tau dy/ds``::
   linear interpolation of the input (a 100 Hz demonstration rolled out at 1 kHz and 10 kHz
   agrees with its own-rate rollout to about 1e-6 of its extent).
 
-Both run as a second-order recursion in ``y`` through :func:`scipy.signal.lfilter` (C), for many
-input signals at once: this is what makes rollouts to many goals cost one integration (the *fast
+Both run as a second-order recursion in ``y`` for many input signals at once, a compiled loop
+(``bidmp.primitives._kernels.second_order``: SciPy's ``lfilter`` operation for operation, checked
+against it to the bit): this is what makes rollouts to many goals cost one integration (the *fast
 path*: :func:`_unit_responses`, :func:`_affine_rollouts`).
 
 State feedback (a coupling term that depends on where the system is) cannot go through a filter:
@@ -29,6 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from .._checks import as_vector, check_bool, check_real
+from ._kernels import second_order
 from .canonical import _phase_decay
 
 GEMM_GOALS = 64  # rollouts to this many goals and more: one matrix product
@@ -84,20 +86,11 @@ def _second_order(
     drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, numerator, a1: float, a2: float
 ):
     """``y[n+2] = -a1 y[n+1] - a2 y[n] + drive[n]`` for several signals, with ``drive`` filtered
-    by ``numerator`` first; (S, n_drives + 2) with ``y[0], y[1]`` given."""
-    out = np.empty((drives.shape[0], drives.shape[1] + 2))
-    out[:, 0] = y_first
-    out[:, 1] = y_second
-    if drives.shape[1] == 0:
-        return out
-    # SciPy's signal package (and the statistics it imports) at first use, not at ``import bidmp``:
-    # 0.4 s of start-up that a model file loaded only to be inspected never needs.
-    from scipy.signal import lfilter
-
-    # Initial state of lfilter's transposed direct form II for past outputs y[1], y[0].
-    zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
-    out[:, 2:], _ = lfilter(numerator, [1.0, a1, a2], drives, axis=1, zi=zi)
-    return out
+    by ``numerator`` (3,) first; (S, n_drives + 2) with ``y[0], y[1]`` given."""
+    # A compiled loop: SciPy's lfilter operation for operation (the same numbers), without
+    # importing SciPy's signal package (0.3 s of a command's start-up) or its per-call checks.
+    b0, b1, b2 = numerator
+    return second_order(drives, y_first, y_second, b0, b1, b2, a1, a2)
 
 
 def _euler_responses(
@@ -151,7 +144,7 @@ def _foh_step(
     augmented[1, 1] = -alpha * step / tau
     augmented[1, 2] = step / tau
     augmented[2, 3] = 1.0
-    from scipy.linalg import expm  # at first use, as lfilter
+    from scipy.linalg import expm  # at first use: SciPy's linear algebra is 0.1 s of imports
 
     exponential = expm(augmented)
     transition = exponential[:2, :2]
@@ -202,8 +195,10 @@ def _exact_responses(
     b2 = -p22 * now[0] + p12 * now[1]
     if n < 3:
         return np.column_stack([y_first, y_second])[:, :n]
-    drives = b0 * inputs[:, 2:] + b1 * inputs[:, 1:-1] + b2 * inputs[:, :-2]
-    return _second_order(drives, y_first, y_second, [1.0, 0.0, 0.0], a1, a2)
+    # The drive b0 u[n+2] + b1 u[n+1] + b2 u[n] formed inside the filter's loop.
+    return second_order(
+        inputs, y_first, y_second, 1.0, 0.0, 0.0, a1, a2, held=np.array([b0, b1, b2])
+    )
 
 
 def _exact_state(

@@ -15,6 +15,7 @@ import logging
 
 import numpy as np
 
+from ._kernels import rest_windows
 from .goals import _smoothstep, _smoothstep_derivatives
 
 __all__ = []
@@ -33,24 +34,6 @@ _BLEND_U = np.linspace(0.0, 1.0, 65)
 _BLEND_SHAPE = np.abs(
     2.0 * _smoothstep_derivatives(_BLEND_U)[0] + _BLEND_U * _smoothstep_derivatives(_BLEND_U)[1]
 )
-
-
-def _blend_window(
-    speed_vector: np.ndarray, acceleration: np.ndarray, dt: float, peak: float
-) -> float:
-    """The shortest window (normalised time) over which blending ``speed_vector`` out adds at most
-    ``_REST_BLEND_SHARE`` of the demonstration's running peak acceleration."""
-    speed = float(np.linalg.norm(speed_vector))
-    if speed <= 1e-12 * max(peak, 1e-300):
-        return 0.0
-    running = np.maximum.accumulate(np.linalg.norm(acceleration, axis=1))
-    # All candidate windows at once: (candidates, 65) added accelerations against the running peak.
-    added = speed * _BLEND_SHAPE[None, :] / _REST_CANDIDATES[:, None]
-    index = np.minimum(
-        (_BLEND_U[None, :] * _REST_CANDIDATES[:, None] / dt).astype(int), running.shape[0] - 1
-    )
-    within = np.all(added <= _REST_BLEND_SHARE * np.maximum(running[index], 1e-300), axis=1)
-    return float(_REST_CANDIDATES[np.argmax(within)]) if within.any() else float(_REST_BLEND_MAX)
 
 
 def _rest_started(
@@ -75,22 +58,22 @@ def _rest_started(
     what, unit : str
         What the trajectory is and its length unit, for the log message.
     """
-    velocity = np.gradient(y, dt, axis=0)
-    acceleration = np.gradient(velocity, dt, axis=0)
-    peak = float(np.max(np.linalg.norm(velocity, axis=1)))
+    # The two windows are decisions (a width from a fixed table): one compiled search for both,
+    # on NumPy's gradient of the demonstration (its acceleration's running peak from either end).
+    start_width, end_width, peak, start_speed, end_speed = rest_windows(
+        y, dt, _BLEND_U, _BLEND_SHAPE, _REST_CANDIDATES, _REST_BLEND_SHARE, _REST_BLEND_MAX
+    )
     s = np.arange(y.shape[0]) * dt
     out = y.copy()
-    for end, speed_vector, forward in (
-        (False, velocity[0], acceleration),
-        (True, velocity[-1], acceleration[::-1]),
+    for end, speed_vector, speed, width in (
+        (False, (y[1] - y[0]) / dt, start_speed, start_width),  # np.gradient's one-sided ends
+        (True, (y[-1] - y[-2]) / dt, end_speed, end_width),
     ):
-        width = _blend_window(speed_vector, forward, dt, peak)
         if width == 0.0:
             continue
         elapsed = (s[-1] - s) if end else s
         blend = elapsed * (1.0 - _smoothstep(elapsed / width))
         out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
-        speed = float(np.linalg.norm(speed_vector))
         level = logging.WARNING if speed > 0.05 * peak and not quiet else logging.DEBUG
         logger.log(
             level,

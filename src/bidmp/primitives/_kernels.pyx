@@ -1,0 +1,352 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""Compiled loops of a robot-protocol fit and rollout.
+
+A fit of the robot protocol on a T = 1000 demonstration is a few hundred small array operations,
+each a few microseconds of NumPy's call overhead: most of its time. The loops here do, each in
+one call, what whole chains of them did:
+
+* the decisions about the demonstration — where its straight final approach starts
+  (:func:`tail_start`), over how long a window its start and end velocity are blended out
+  (:func:`rest_windows`) — each a search over candidates with an early exit;
+* the arithmetic the model's numbers come from — the spring's integration (:func:`second_order`,
+  SciPy's ``lfilter`` operation for operation), the forcing target (:func:`forcing_target`) and
+  the goal gate (:func:`goal_gate`), each element the same operations in the same order as the
+  NumPy expressions they replaced (compiled without fused multiply-adds), so every result keeps
+  its last bit. Powers and exponentials stay in NumPy: its vectorised ones are not the C
+  library's to the bit.
+
+The tests check each loop against an independent reference to the last bit (SciPy's ``lfilter``,
+NumPy's ``gradient`` expressions, plain searches) on random inputs.
+
+Compiled ahead of time (a C extension built at install) rather than with numba: loading it costs
+about a millisecond, where numba's import and cached kernels cost 0.1-0.3 s of every command that
+fits a DMP.
+"""
+
+from libc.math cimport floor, sqrt, INFINITY
+
+
+cdef void _gradient(const double[:] f, double[:] out, double dt) noexcept nogil:
+    """``np.gradient(f, dt)`` of one column f (n,), n ≥ 2, operation for operation: central
+    differences over ``2 dt`` inside, one-sided ones over ``dt`` at the ends."""
+    cdef Py_ssize_t n = f.shape[0], i
+    cdef double two_dt = 2.0 * dt
+    out[0] = (f[1] - f[0]) / dt
+    out[n - 1] = (f[n - 1] - f[n - 2]) / dt
+    for i in range(1, n - 1):
+        out[i] = (f[i + 1] - f[i - 1]) / two_dt
+
+
+cdef void _running_max(double[::1] values) noexcept nogil:
+    """``np.maximum.accumulate`` in place (a NaN, once met, carried on as NumPy carries it)."""
+    cdef Py_ssize_t i
+    for i in range(1, values.shape[0]):
+        if values[i - 1] > values[i] or values[i - 1] != values[i - 1]:
+            values[i] = values[i - 1]
+
+
+cdef bint _straight_from(
+    const double[:, :] y, Py_ssize_t start, double tolerance, double[:] unit, Py_ssize_t stride
+) noexcept nogil:
+    """Whether the tail ``y[start:]`` (T, D) is straight: every sample within ``tolerance`` × the
+    chord of the chord (from the sample at ``start`` to the end) and — with ``stride`` 1 — never
+    more than that back along it. With ``stride`` > 1 only every ``stride``-th sample's distance
+    is looked at (a necessary condition). ``unit`` (D,) is scratch space."""
+    cdef Py_ssize_t last = y.shape[0] - 1, n_dims = y.shape[1], i, k
+    cdef double length_squared = 0.0, length, bound, origin_k, along, previous, across, offset_k
+    cdef double squared
+    for k in range(n_dims):
+        origin_k = y[start, k] - y[last, k]
+        length_squared = length_squared + origin_k * origin_k
+    length = sqrt(length_squared)
+    if not length > 0.0:
+        return False
+    for k in range(n_dims):
+        unit[k] = -(y[start, k] - y[last, k]) / length
+    bound = tolerance * length
+    previous = 0.0
+    i = start
+    while i <= last:
+        along = 0.0
+        squared = 0.0
+        for k in range(n_dims):
+            offset_k = (y[i, k] - y[last, k]) - (y[start, k] - y[last, k])
+            along = along + offset_k * unit[k]
+            squared = squared + offset_k * offset_k
+        across = squared - along * along
+        if across > bound * bound:
+            return False
+        if stride == 1 and i > start and along - previous < -bound:
+            return False
+        previous = along
+        i += stride
+    return True
+
+
+cdef bint _probes_straight(
+    const double[:, :] y, Py_ssize_t start, double tolerance, double[:] unit
+) noexcept nogil:
+    """A necessary condition of :func:`_straight_from` from three samples of the tail (a quarter,
+    half and three quarters of the way to its end), with a hair of slack for the rounding."""
+    cdef Py_ssize_t last = y.shape[0] - 1, n_dims = y.shape[1], k, probe, index
+    cdef double length_squared = 0.0, length, bound, origin_k, along, squared, offset_k
+    cdef double shares[3]
+    shares[0] = 0.25
+    shares[1] = 0.5
+    shares[2] = 0.75
+    for k in range(n_dims):
+        origin_k = y[start, k] - y[last, k]
+        length_squared = length_squared + origin_k * origin_k
+    length = sqrt(length_squared)
+    if not length > 0.0:
+        return False
+    for k in range(n_dims):
+        unit[k] = -(y[start, k] - y[last, k]) / length
+    bound = tolerance * length
+    for probe in range(3):
+        index = start + <Py_ssize_t>floor(shares[probe] * (last - start))
+        along = 0.0
+        squared = 0.0
+        for k in range(n_dims):
+            offset_k = (y[index, k] - y[last, k]) - (y[start, k] - y[last, k])
+            along = along + offset_k * unit[k]
+            squared = squared + offset_k * offset_k
+        if squared - along * along > bound * bound * (1.0 + 1e-9) + 1e-300:
+            return False
+    return True
+
+
+def tail_start(const double[:, :] y, const long long[:] candidates, double tolerance):
+    """The first of ``candidates`` (k,) — sample indices, increasing — from which the rest of ``y``
+    (T, D) is straight (within ``tolerance`` × its chord of the chord, never moving back along it
+    by more than that), or ``T - 1`` when none is. Three probes, then every 8th sample, then all
+    of it: each stage a necessary condition of the next, each with an early exit."""
+    cdef Py_ssize_t c, start, found = y.shape[0] - 1
+    cdef double[::1] unit = _scratch(y.shape[1])
+    with nogil:
+        for c in range(candidates.shape[0]):
+            start = candidates[c]
+            if (
+                _probes_straight(y, start, tolerance, unit)
+                and _straight_from(y, start, tolerance, unit, 8)
+                and _straight_from(y, start, tolerance, unit, 1)
+            ):
+                found = start
+                break
+    return found
+
+
+cdef double[::1] _scratch(Py_ssize_t n):
+    from numpy import empty
+
+    return empty(max(n, 1))
+
+
+cdef double _row_norm(const double[:, :] a, Py_ssize_t i) noexcept nogil:
+    """``np.linalg.norm(a[i])``: the squares summed left to right, as NumPy does for D ≤ 8."""
+    cdef Py_ssize_t k
+    cdef double total = a[i, 0] * a[i, 0]
+    for k in range(1, a.shape[1]):
+        total = total + a[i, k] * a[i, k]
+    return sqrt(total)
+
+
+def rest_windows(
+    const double[:, :] y,
+    double dt,
+    const double[:] blend_u,
+    const double[:] blend_shape,
+    const double[:] candidates,
+    double share,
+    double widest,
+):
+    """The rest blend's windows (normalised time) at the start and at the end of ``y`` (T, D) on
+    the uniform grid ``dt``, and the demonstration's peak speed: for each end, the first of
+    ``candidates`` over which blending that end's velocity out adds at most ``share`` of the
+    demonstration's running peak acceleration (from that end) at every point of ``blend_u`` (the
+    blend's acceleration there is ``speed · blend_shape / window``); ``widest`` when none does,
+    0 when the end is at rest. Velocity and acceleration are NumPy's ``gradient`` (central
+    differences, one-sided at the ends). Returns ``(start window, end window, peak speed, start
+    speed, end speed)``."""
+    cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
+    if n < 3:
+        raise ValueError(f"rest_windows: y needs 3 samples or more, got {n}")
+    from numpy import empty
+
+    cdef double[:, ::1] velocity = empty((n, n_dims))
+    cdef double[:, ::1] acceleration = empty((n, n_dims))
+    cdef double[::1] running_forward = empty(n)
+    cdef double[::1] running_backward = empty(n)
+    cdef double peak = -INFINITY, speed, start_speed, end_speed
+    cdef double windows[2]
+    with nogil:
+        for k in range(n_dims):
+            _gradient(y[:, k], velocity[:, k], dt)
+            _gradient(velocity[:, k], acceleration[:, k], dt)
+        for i in range(n):
+            speed = _row_norm(velocity, i)
+            if speed > peak or speed != speed:  # np.max: a NaN wins
+                peak = speed
+        # |acceleration|, as its running maximum from the start and (reversed) from the end
+        for i in range(n):
+            running_forward[i] = _row_norm(acceleration, i)
+            running_backward[n - 1 - i] = running_forward[i]
+        _running_max(running_forward)
+        _running_max(running_backward)
+        start_speed = _row_norm(velocity, 0)
+        end_speed = _row_norm(velocity, n - 1)
+        windows[0] = _blend_window(start_speed, running_forward, dt, peak, blend_u, blend_shape, candidates, share, widest)
+        windows[1] = _blend_window(end_speed, running_backward, dt, peak, blend_u, blend_shape, candidates, share, widest)
+    return windows[0], windows[1], peak, start_speed, end_speed
+
+
+cdef double _blend_window(
+    double speed,
+    const double[::1] running,
+    double dt,
+    double peak,
+    const double[:] blend_u,
+    const double[:] blend_shape,
+    const double[:] candidates,
+    double share,
+    double widest,
+) noexcept nogil:
+    cdef Py_ssize_t c, j, index, n = running.shape[0]
+    # np.maximum's NaN (it propagates), as the NumPy test had it
+    cdef double floor_peak = 1e-300 if 1e-300 > peak else peak
+    cdef double added, reach
+    if speed <= 1e-12 * floor_peak:
+        return 0.0
+    for c in range(candidates.shape[0]):
+        for j in range(blend_u.shape[0]):
+            added = speed * blend_shape[j] / candidates[c]
+            index = <Py_ssize_t>(blend_u[j] * candidates[c] / dt)
+            if index > n - 1:
+                index = n - 1
+            reach = 1e-300 if running[index] < 1e-300 else running[index]
+            if not added <= share * reach:
+                break
+        else:
+            return candidates[c]
+    return widest
+
+
+cdef void _filter_row(
+    const double[:, :] drives,
+    Py_ssize_t row,
+    double[:, ::1] out,
+    double b0,
+    double b1,
+    double b2,
+    double a1,
+    double a2,
+    const double[:] held,
+) noexcept nogil:
+    """``out[row, 2:]``: SciPy's ``lfilter(b, [1, a1, a2], drive, zi)`` (its transposed direct form
+    II, operation for operation) from the state of the two outputs ``out[row, :2]`` before it.
+    ``drive`` is ``drives[row]``, or — with ``held`` (3,) given — the held input's drive
+    ``held[0] u[k + 2] + held[1] u[k + 1] + held[2] u[k]`` of ``u = drives[row]``."""
+    cdef Py_ssize_t k, n_out = out.shape[1] - 2
+    cdef double y_first = out[row, 0], y_second = out[row, 1], x, y
+    cdef double z0 = -a1 * y_second - a2 * y_first
+    cdef double z1 = -a2 * y_second
+    for k in range(n_out):
+        if held.shape[0]:
+            x = held[0] * drives[row, k + 2] + held[1] * drives[row, k + 1] + held[2] * drives[row, k]
+        else:
+            x = drives[row, k]
+        y = z0 + b0 * x
+        z0 = z1 + x * b1 - y * a1
+        z1 = x * b2 - y * a2
+        out[row, k + 2] = y
+
+
+def second_order(
+    const double[:, :] drives,
+    const double[:] y_first,
+    const double[:] y_second,
+    double b0,
+    double b1,
+    double b2,
+    double a1,
+    double a2,
+    const double[:] held=None,
+):
+    """``y[n+2] = -a1 y[n+1] - a2 y[n] + (b0 d[n] + b1 d[n-1] + b2 d[n-2])`` for each of S signals,
+    with ``y[0], y[1]`` given (S,) each: (S, n_drives + 2), the drive ``d`` of ``drives`` (S,
+    n_drives) — or, with ``held`` (3,), the drive of a first-order-hold input ``u = drives`` (S,
+    n_drives + 2): ``held[0] u[n+2] + held[1] u[n+1] + held[2] u[n]``. The same numbers as SciPy's
+    ``lfilter`` with its initial state set from ``y[1], y[0]`` (the filter is its loop, operation
+    for operation)."""
+    from numpy import empty
+
+    cdef Py_ssize_t n_signals = drives.shape[0], row
+    cdef Py_ssize_t n_out = drives.shape[1] + 2 if held is None else drives.shape[1]
+    if n_out < 2:
+        raise ValueError(f"second_order: {n_out} samples, 2 or more wanted")
+    cdef double[:, ::1] out = empty((n_signals, n_out))
+    cdef const double[:] hold = empty(0) if held is None else held
+    with nogil:
+        for row in range(n_signals):
+            out[row, 0] = y_first[row]
+            out[row, 1] = y_second[row]
+            _filter_row(drives, row, out, b0, b1, b2, a1, a2, hold)
+    return out.base
+
+
+def forcing_target(
+    const double[:, :] y,
+    const double[:] gate,
+    double dt,
+    double tau,
+    double tau_squared,
+    double alpha,
+    double beta,
+    double K,
+):
+    """The forcing term (T, D) that makes the transformation system reproduce ``y`` (T, D), with
+    velocity and acceleration as NumPy's ``gradient`` (twice) and the goal gate ``gate`` (T,):
+    ``(tau² ÿ - alpha (beta (g - y) - tau ẏ)) / K + gate (g - y0)``, ``g = y[-1]``, ``y0 = y[0]``,
+    each element the same operations in the same order as that NumPy expression (``tau_squared``
+    is Python's ``tau ** 2``, as there)."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
+    if n < 2 or gate.shape[0] != n:
+        raise ValueError(f"forcing_target: {n} samples and a gate of {gate.shape[0]}")
+    cdef double[::1] velocity = empty(n)
+    cdef double[::1] acceleration = empty(n)
+    cdef double[:, ::1] out = empty((n, n_dims))
+    cdef double goal, spring, offset
+    with nogil:
+        for k in range(n_dims):
+            _gradient(y[:, k], velocity, dt)
+            _gradient(velocity, acceleration, dt)
+            goal = y[n - 1, k]
+            offset = goal - y[0, k]
+            for i in range(n):
+                spring = alpha * (beta * (goal - y[i, k]) - tau * velocity[i])
+                out[i, k] = (tau_squared * acceleration[i] - spring) / K + gate[i] * offset
+    return out.base
+
+
+def goal_gate(const double[:] share, double dt, double alpha, double beta, double K):
+    """The gate ``(alpha beta (1 - R) - R'' - alpha R') / K`` (n,) whose continuous response is the
+    goal share ``R`` (n,), ``R'`` and ``R''`` as NumPy's ``gradient`` (twice), each element the
+    same operations in the same order as that NumPy expression; ``alpha beta / K`` at the start."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = share.shape[0], i
+    if n < 2:
+        raise ValueError(f"goal_gate: {n} samples, 2 or more wanted")
+    cdef double[::1] rate = empty(n)
+    cdef double[::1] curvature = empty(n)
+    cdef double[::1] gate = empty(n)
+    cdef double spring = alpha * beta
+    with nogil:
+        _gradient(share, rate, dt)
+        _gradient(rate, curvature, dt)
+        for i in range(n):
+            gate[i] = (spring * (1.0 - share[i]) - curvature[i] - alpha * rate[i]) / K
+        gate[0] = spring / K
+    return gate.base

@@ -1,0 +1,198 @@
+"""The compiled loops of a robot-protocol fit (``bidmp.primitives._kernels``) against independent
+references: SciPy's ``lfilter`` for the spring's integration, NumPy's ``gradient`` expressions for the
+forcing target and the goal gate, and plain NumPy searches for the decisions (the rest blend's
+windows; the straight tail is checked against its plain search in test_approach.py).
+
+Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
+library was not tuned on: the kernels replaced NumPy expressions whose numbers the committed results
+hold, so "close" would not do. These are correctness checks, not the code against itself.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from bidmp.primitives._kernels import forcing_target, goal_gate, rest_windows, second_order
+from bidmp.primitives.goals import _smoothstep_derivatives
+from bidmp.primitives.rest import _BLEND_SHAPE, _BLEND_U, _REST_CANDIDATES
+
+
+def _bits(array) -> np.ndarray:
+    return np.ascontiguousarray(array, dtype=np.float64).view(np.int64)
+
+
+def _random_motion(rng, n_samples: int, n_dims: int) -> np.ndarray:
+    """A smooth motion with noise, or a random walk, at a random scale and offset."""
+    s = np.linspace(0.0, 1.0, n_samples)
+    if rng.random() < 0.3:
+        y = np.cumsum(rng.normal(size=(n_samples, n_dims)), axis=0)
+    else:
+        frequencies = rng.uniform(0.5, 4.0, n_dims)
+        y = np.sin(np.outer(s, frequencies) + rng.uniform(0, 6, n_dims)) + np.outer(
+            s, rng.normal(size=n_dims)
+        )
+        y += rng.normal(scale=10 ** rng.uniform(-7, -2), size=y.shape)
+    return y * 10 ** rng.uniform(-3, 3) + rng.uniform(-1e3, 1e3, n_dims)
+
+
+def test_the_integration_loop_is_scipys_lfilter_to_the_bit():
+    """``second_order`` replaced SciPy's lfilter (transposed direct form II) with its initial
+    state from the first two outputs: the same bits for stable and unstable filters, any
+    numerator, and the first-order-hold drive formed inside the loop."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        n_signals, n_drives = int(rng.integers(1, 5)), int(rng.integers(0, 400))
+        drives = rng.normal(size=(n_signals, n_drives)) * 10 ** rng.uniform(-3, 3)
+        y_first, y_second = rng.normal(size=n_signals), rng.normal(size=n_signals)
+        a1, a2 = rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 1.0)
+        b = rng.normal(size=3)
+        out = second_order(drives, y_first, y_second, *b, a1, a2)
+        assert out.shape == (n_signals, n_drives + 2)
+        assert np.array_equal(_bits(out[:, 0]), _bits(y_first))
+        assert np.array_equal(_bits(out[:, 1]), _bits(y_second))
+        if n_drives:
+            zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
+            expected, _ = lfilter(b, [1.0, a1, a2], drives, axis=1, zi=zi)
+            assert np.array_equal(_bits(out[:, 2:]), _bits(expected))
+        # the held input's drive b0 u[n+2] + b1 u[n+1] + b2 u[n], formed in the loop
+        inputs = rng.normal(size=(n_signals, n_drives + 2))
+        held = rng.normal(size=3)
+        out = second_order(inputs, y_first, y_second, *b, a1, a2, held=held)
+        drive = held[0] * inputs[:, 2:] + held[1] * inputs[:, 1:-1] + held[2] * inputs[:, :-2]
+        zi = np.stack([-a1 * y_second - a2 * y_first, -a2 * y_second], axis=1)
+        if n_drives:
+            expected, _ = lfilter(b, [1.0, a1, a2], drive, axis=1, zi=zi)
+            assert np.array_equal(_bits(out[:, 2:]), _bits(expected))
+
+
+def test_the_integration_loop_refuses_fewer_than_two_samples():
+    with pytest.raises(ValueError, match="2 or more"):
+        second_order(
+            np.zeros((1, 1)), np.zeros(1), np.zeros(1), 1.0, 0.0, 0.0, 0.1, 0.1, held=np.ones(3)
+        )
+
+
+@pytest.mark.parametrize("n_dims", [1, 2, 3, 6, 9])
+def test_the_forcing_target_loop_is_the_numpy_expression_to_the_bit(n_dims):
+    """``(tau² ÿ - α (β (g - y) - tau ẏ)) / K + G (g - y0)`` with ``np.gradient`` derivatives."""
+    rng = np.random.default_rng(n_dims)
+    for _ in range(40):
+        n_samples = int(rng.integers(2, 1500))
+        y = _random_motion(rng, n_samples, n_dims)
+        gate = rng.random(n_samples)
+        dt, tau = 10 ** rng.uniform(-4, -1), rng.uniform(0.3, 3.0)
+        alpha, beta, K = rng.uniform(1, 100), rng.uniform(1, 30), rng.uniform(1, 1e3)
+        velocity = np.gradient(y, dt, axis=0)
+        acceleration = np.gradient(velocity, dt, axis=0)
+        spring = alpha * (beta * (y[-1] - y) - tau * velocity)
+        expected = (tau**2 * acceleration - spring) / K + gate[:, None] * (y[-1] - y[0])
+        out = forcing_target(y, gate, dt, tau, tau**2, alpha, beta, K)
+        assert np.array_equal(_bits(out), _bits(expected))
+    with pytest.raises(ValueError, match="gate"):
+        forcing_target(np.zeros((5, 2)), np.zeros(4), 0.1, 1.0, 1.0, 1.0, 1.0, 1.0)
+
+
+def test_the_goal_gate_loop_is_the_numpy_expression_to_the_bit():
+    """``(αβ (1 - R) - R'' - α R') / K`` with ``np.gradient`` derivatives, ``αβ / K`` first."""
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        n_samples = int(rng.integers(2, 3000))
+        share = np.sort(rng.random(n_samples)) if rng.random() < 0.5 else rng.normal(size=n_samples)
+        dt = 10 ** rng.uniform(-4, -1)
+        alpha, beta, K = rng.uniform(1, 100), rng.uniform(1, 30), rng.uniform(1, 1e3)
+        rate = np.gradient(share, dt)
+        curvature = np.gradient(rate, dt)
+        expected = (alpha * beta * (1.0 - share) - curvature - alpha * rate) / K
+        expected[0] = alpha * beta / K
+        assert np.array_equal(_bits(goal_gate(share, dt, alpha, beta, K)), _bits(expected))
+
+
+def _plain_rest_windows(y: np.ndarray, dt: float) -> tuple[float, float, float]:
+    """The rest blend's windows the plain NumPy way: for each end, every candidate window's added
+    acceleration against the running peak, the first that stays within 10 % of it."""
+    velocity = np.gradient(y, dt, axis=0)
+    acceleration = np.gradient(velocity, dt, axis=0)
+    peak = float(np.max(np.linalg.norm(velocity, axis=1)))
+    windows = []
+    for speed_vector, forward in ((velocity[0], acceleration), (velocity[-1], acceleration[::-1])):
+        speed = float(np.linalg.norm(speed_vector))
+        if speed <= 1e-12 * max(peak, 1e-300):
+            windows.append(0.0)
+            continue
+        running = np.maximum.accumulate(np.linalg.norm(forward, axis=1))
+        chosen = 0.25
+        for window in _REST_CANDIDATES:
+            index = np.minimum((_BLEND_U * window / dt).astype(int), running.shape[0] - 1)
+            added = speed * _BLEND_SHAPE / window
+            if np.all(added <= 0.1 * np.maximum(running[index], 1e-300)):
+                chosen = float(window)
+                break
+        windows.append(chosen)
+    return windows[0], windows[1], peak
+
+
+def test_the_rest_windows_are_the_plain_search():
+    """The windows (from a fixed table) and the peak speed, on motions that start and end at speed,
+    at rest, and in between, at any scale: the same as the plain search."""
+    rng = np.random.default_rng(8)
+    seen = set()
+    for trial in range(400):
+        n_samples, n_dims = int(rng.integers(3, 1500)), int(rng.integers(1, 7))
+        y = _random_motion(rng, n_samples, n_dims)
+        if trial % 4 == 1:  # at rest at the start: the blend window is 0 there
+            y[: n_samples // 3] = y[n_samples // 3]
+        dt = 1.0 / n_samples if trial % 2 else 10 ** rng.uniform(-3, 0)  # a fit's, and others
+        start, end, peak, start_speed, end_speed = rest_windows(
+            y, dt, _BLEND_U, _BLEND_SHAPE, _REST_CANDIDATES, 0.1, 0.25
+        )
+        expected = _plain_rest_windows(y, dt)
+        assert (start, end, peak) == expected, trial
+        assert start_speed == np.linalg.norm((y[1] - y[0]) / dt)
+        assert end_speed == np.linalg.norm((y[-1] - y[-2]) / dt)
+        seen.update((start == 0.0, 0.0 < start < 0.25, start == 0.25))
+    assert seen == {True, False}  # every kind of answer was met (at rest, a window, the widest)
+    # Short random walks on a fine step: the windows reach past the motion's end, where the
+    # search reads the running peak at the last sample.
+    for _ in range(300):
+        n_samples, dt = int(rng.integers(3, 15)), 10 ** rng.uniform(-4, -1)
+        y = np.cumsum(rng.normal(size=(n_samples, 2)), axis=0) * 10 ** rng.uniform(-3, 3)
+        found = rest_windows(y, dt, _BLEND_U, _BLEND_SHAPE, _REST_CANDIDATES, 0.1, 0.25)
+        assert found[:3] == _plain_rest_windows(y, dt)
+    with pytest.raises(ValueError, match="3 samples"):
+        rest_windows(np.zeros((2, 1)), 0.5, _BLEND_U, _BLEND_SHAPE, _REST_CANDIDATES, 0.1, 0.25)
+
+
+def test_the_blend_shape_table_is_the_blends_acceleration():
+    """The table the windows are searched with: ``|2 S'(u) + u S''(u)|`` on [0, 1] (a closed form
+    of the blend ``u (1 - S(u))``'s second derivative, checked by finite differences here)."""
+    u = _BLEND_U
+    first, second = _smoothstep_derivatives(u)
+    assert np.allclose(_BLEND_SHAPE, np.abs(2.0 * first + u * second))
+    fine = np.linspace(0.0, 1.0, 20001)
+    s7 = np.clip(fine, 0, 1) ** 4 * (35 - 84 * fine + 70 * fine**2 - 20 * fine**3)
+    blend_acceleration = np.gradient(np.gradient(fine * (1.0 - s7), fine), fine)
+    assert np.allclose(
+        np.interp(u, fine, np.abs(blend_acceleration))[1:-1], _BLEND_SHAPE[1:-1], atol=1e-3
+    )
+
+
+def test_a_fit_and_its_trajectory_import_no_scipy_signal():
+    """The spring is integrated by the compiled loop, not SciPy's lfilter: a robot-protocol fit and
+    its trajectory never import SciPy's signal package (0.3 s of every command's start-up)."""
+    code = (
+        "import sys, numpy as np, bidmp\n"
+        "t = np.arange(200) / 200.0\n"
+        "y = np.column_stack([np.sin(3 * t), t**2, np.cos(t)])\n"
+        "bidmp.DMP().fit(y, t).trajectory(goal=y[-1] + 0.1)\n"
+        "bidmp.DMP(protocol='paper').fit(y).rollout()\n"
+        "print('scipy.signal' in sys.modules)"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    )
+    assert result.stdout.strip() == "False", result.stdout
