@@ -16,7 +16,7 @@ endif
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
-$(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/primitives/_kernels.pyx
+$(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/_kernels.pyx
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint,docs]"
@@ -154,4 +154,4 @@ readme: $(STAMP)
 
 clean:
 	rm -rf $(VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
-	rm -f src/bidmp/primitives/_kernels.c src/bidmp/primitives/_kernels.*.so
+	rm -f src/bidmp/_kernels.c src/bidmp/_kernels.*.so

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._checks import numerically_guarded
+from ._kernels import interp_columns as _interp_columns
 
 __all__ = [
     "arclength",
@@ -29,8 +30,13 @@ def arclength(y: np.ndarray) -> np.ndarray:
 
 def interp_columns(x_new: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Piecewise-linear interpolation of every column of ``y`` (n, D) from ``x`` (n,) to
-    ``x_new`` (m,); returns (m, D). ``x`` must be increasing."""
-    return np.column_stack([np.interp(x_new, x, column) for column in np.asarray(y).T])
+    ``x_new`` (m,); returns (m, D). ``x`` must be increasing. ``np.interp`` of each column, to the
+    bit, in one compiled scan."""
+    return _interp_columns(
+        np.asarray(x_new, dtype=np.float64),
+        np.asarray(x, dtype=np.float64),
+        np.asarray(y, dtype=np.float64),
+    )
 
 
 def resample_arclength(y, n_points: int) -> np.ndarray:

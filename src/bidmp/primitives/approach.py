@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._kernels import tail_start
+from .._kernels import tail_start
 
 __all__ = ["STRAIGHTNESS", "straight_tail_start"]
 

@@ -27,7 +27,7 @@ from .._checks import (
     check_int,
     check_real,
 )
-from ._kernels import forcing_target
+from .._kernels import forcing_target
 from .canonical import _checked_phase_args, _phase_decay
 
 __all__ = [

@@ -13,7 +13,7 @@ an input ``u``. In normalised time ``s`` with ``z = tau dy/ds``::
   agrees with its own-rate rollout to about 1e-6 of its extent).
 
 Both run as a second-order recursion in ``y`` for many input signals at once, a compiled loop
-(``bidmp.primitives._kernels.second_order``: SciPy's ``lfilter`` operation for operation, checked
+(``bidmp._kernels.second_order``: SciPy's ``lfilter`` operation for operation, checked
 against it to the bit): this is what makes rollouts to many goals cost one integration (the *fast
 path*: :func:`_unit_responses`, :func:`_affine_rollouts`).
 
@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from .._checks import as_vector, check_bool, check_real
-from ._kernels import second_order
+from .._kernels import exact_state, second_order
 from .canonical import _phase_decay
 
 GEMM_GOALS = 64  # rollouts to this many goals and more: one matrix product
@@ -219,14 +219,17 @@ def _exact_state(
         ``z[l]``; the acceleration is the system's own, ``(u - αβ y - α z) / tau²``.
     """
     transition, now, after = _foh_step(step, alpha, beta, tau)
-    z = y[1:] - transition[0, 0] * y[:-1]
-    z -= now[0] * inputs[:-1]
-    z -= after[0] * inputs[1:]
-    z /= transition[0, 1]
-    acceleration = inputs[:-1] - alpha * beta * y[:-1]
-    acceleration -= alpha * z
-    acceleration /= tau**2
-    return z, acceleration
+    return exact_state(
+        y,
+        inputs,
+        transition[0, 0],
+        transition[0, 1],
+        now[0],
+        after[0],
+        alpha * beta,
+        alpha,
+        tau**2,
+    )
 
 
 # -- the fast path: unit responses and affine rollouts ---------------------------------------------

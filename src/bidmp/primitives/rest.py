@@ -15,8 +15,8 @@ import logging
 
 import numpy as np
 
-from ._kernels import rest_windows
-from .goals import _smoothstep, _smoothstep_derivatives
+from .._kernels import rest_blend_arguments, rest_blended, rest_windows
+from .goals import _smoothstep_derivatives
 
 __all__ = []
 
@@ -63,17 +63,17 @@ def _rest_started(
     start_width, end_width, peak, start_speed, end_speed = rest_windows(
         y, dt, _BLEND_U, _BLEND_SHAPE, _REST_CANDIDATES, _REST_BLEND_SHARE, _REST_BLEND_MAX
     )
-    s = np.arange(y.shape[0]) * dt
-    out = y.copy()
-    for end, speed_vector, speed, width in (
-        (False, (y[1] - y[0]) / dt, start_speed, start_width),  # np.gradient's one-sided ends
-        (True, (y[-1] - y[-2]) / dt, end_speed, end_width),
-    ):
+    # y - v₀ s (1 - S(s / w₀)) + v₁ (s_T - s) (1 - S((s_T - s) / w₁)): two compiled loops around
+    # NumPy's u⁴ (the smoothstep's powers, as _smoothstep takes them); the end velocities are
+    # np.gradient's one-sided ones, to the bit.
+    start_velocity, end_velocity = (y[1] - y[0]) / dt, (y[-1] - y[-2]) / dt
+    arguments = rest_blend_arguments(y.shape[0], dt, start_width, end_width)
+    out = rest_blended(
+        y, arguments, arguments**4, dt, start_velocity, end_velocity, start_width, end_width
+    )
+    for end, speed, width in ((False, start_speed, start_width), (True, end_speed, end_width)):
         if width == 0.0:
             continue
-        elapsed = (s[-1] - s) if end else s
-        blend = elapsed * (1.0 - _smoothstep(elapsed / width))
-        out += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
         level = logging.WARNING if speed > 0.05 * peak and not quiet else logging.DEBUG
         logger.log(
             level,

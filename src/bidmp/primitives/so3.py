@@ -15,9 +15,9 @@ import math
 import warnings
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from .._checks import _as_bounded_array, _check_magnitude, check_limit
+from .._kernels import quaternion_exp, quaternion_log
 from .._trajectory import continuous_quaternions
 
 __all__ = [
@@ -118,9 +118,9 @@ def _principal_log(q, goal, q_name: str, goal_name: str) -> np.ndarray:
         raise ValueError(
             f"{goal_name} has {goal.shape[0]} quaternions; give one, or one per row of {q_name} ({q.shape[0]})"
         )
-    return (
-        Rotation.from_quat(q) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal).inv()
-    ).as_rotvec()
+    # (Rotation.from_quat(q) * Rotation.from_quat(goal).inv()).as_rotvec(), SciPy's arithmetic
+    # in one compiled loop (Rotation's array dispatch costs 0.3 ms a product).
+    return quaternion_log(q, goal)
 
 
 def _angles_and_axes(vectors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -212,7 +212,7 @@ def orientation_from_log(error: np.ndarray, goal: np.ndarray) -> np.ndarray:
         raise ValueError(
             f"goal has {goal.shape[0]} quaternions; give one, or one per row of error ({error.shape[0]})"
         )
-    q = (
-        Rotation.from_rotvec(error) * Rotation.from_quat(goal[0] if goal.shape[0] == 1 else goal)
-    ).as_quat()
+    # (Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat(), SciPy's arithmetic in
+    # one compiled loop.
+    q = quaternion_exp(error, goal)
     return continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))

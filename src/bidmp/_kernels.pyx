@@ -23,7 +23,7 @@ about a millisecond, where numba's import and cached kernels cost 0.1-0.3 s of e
 fits a DMP.
 """
 
-from libc.math cimport floor, sqrt, INFINITY
+from libc.math cimport INFINITY, atan2, cos, floor, sin, sqrt
 
 
 cdef void _gradient(const double[:] f, double[:] out, double dt) noexcept nogil:
@@ -350,3 +350,305 @@ def goal_gate(const double[:] share, double dt, double alpha, double beta, doubl
             gate[i] = (spring * (1.0 - share[i]) - curvature[i] - alpha * rate[i]) / K
         gate[0] = spring / K
     return gate.base
+
+
+# -- the smoothstep's blends: their arguments here, the fourth powers in NumPy, the rest here -----
+# NumPy's vectorised power (SVML on AVX-512 machines) is not the C library's pow to the bit, so the
+# powers u⁴ of the 7th-order smoothstep 35u⁴ - 84u⁵ + 70u⁶ - 20u⁷ stay NumPy's: a blend is two
+# calls of this module around one of NumPy's.
+
+cdef inline double _clipped(double u) noexcept nogil:
+    """``np.clip(u, 0.0, 1.0)``."""
+    return 0.0 if u < 0.0 else (1.0 if u > 1.0 else u)
+
+
+cdef inline double _smoothstep(double u, double u4) noexcept nogil:
+    """The smoothstep of a clipped ``u`` from its power ``u4`` (NumPy's ``u**4``), in the
+    operations of ``u**4 * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)))``."""
+    return u4 * (35.0 + u * (-84.0 + u * (70.0 - 20.0 * u)))
+
+
+def goal_share_arguments(Py_ssize_t n, double dt, double begin, double end, double width):
+    """The smoothstep's arguments of the goal share on ``n`` samples ``dt`` apart (2, n), clipped to
+    [0, 1]: its rise ``(s - begin) / width`` and its close ``(end - s) / width``, ``s = i dt``."""
+    from numpy import empty
+
+    cdef double[:, ::1] out = empty((2, n))
+    cdef Py_ssize_t i
+    cdef double s
+    with nogil:
+        for i in range(n):
+            s = i * dt
+            out[0, i] = _clipped((s - begin) / width)
+            out[1, i] = _clipped((end - s) / width)
+    return out.base
+
+
+def goal_share(
+    const double[:] progress,
+    const double[:, :] arguments,
+    const double[:, :] powers,
+    double dt,
+    double end,
+    double width,
+):
+    """The goal share (n,) from the progress (n,) and the smoothstep's ``arguments`` (2, n) of
+    :func:`goal_share_arguments` with their fourth ``powers``: ``σ S(rise)``, then ``1 - (1 - σ)
+    S(close)`` from ``end - width`` on, then 1 from ``end`` on."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = progress.shape[0], i
+    if arguments.shape[0] != 2 or arguments.shape[1] != n or powers.shape[0] != 2 or powers.shape[1] != n:
+        raise ValueError(f"goal_share: arguments and powers must be (2, {n})")
+    cdef double[::1] share = empty(n)
+    cdef double s, closing = end - width
+    with nogil:
+        for i in range(n):
+            s = i * dt
+            if s >= end:
+                share[i] = 1.0
+            elif s > closing:
+                share[i] = 1.0 - (1.0 - progress[i]) * _smoothstep(arguments[1, i], powers[1, i])
+            else:
+                share[i] = progress[i] * _smoothstep(arguments[0, i], powers[0, i])
+    return share.base
+
+
+def rest_blend_arguments(Py_ssize_t n, double dt, double start_width, double end_width):
+    """The smoothstep's arguments of the rest blends on ``n`` samples ``dt`` apart (2, n), clipped
+    to [0, 1]: ``s / start_width`` and ``(s[-1] - s) / end_width`` (0 where a width is 0: that end
+    is not blended)."""
+    from numpy import empty
+
+    cdef double[:, ::1] out = empty((2, n))
+    cdef Py_ssize_t i
+    cdef double last = (n - 1) * dt
+    with nogil:
+        for i in range(n):
+            out[0, i] = _clipped(i * dt / start_width) if start_width != 0.0 else 0.0
+            out[1, i] = _clipped((last - i * dt) / end_width) if end_width != 0.0 else 0.0
+    return out.base
+
+
+def rest_blended(
+    const double[:, :] y,
+    const double[:, :] arguments,
+    const double[:, :] powers,
+    double dt,
+    const double[:] start_velocity,
+    const double[:] end_velocity,
+    double start_width,
+    double end_width,
+):
+    """``y`` (T, D) with its start velocity blended out over ``start_width`` and its end velocity
+    over ``end_width`` (normalised time; 0: not blended): ``y - v₀ s (1 - S(s / w₀))``, then
+    ``+ v₁ (s_T - s) (1 - S((s_T - s) / w₁))``, from :func:`rest_blend_arguments` and their fourth
+    ``powers``, in the operations of the NumPy expressions it replaced."""
+    from numpy import array
+
+    cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
+    cdef double[:, ::1] out = array(y, dtype=float, order="C", copy=True)
+    cdef double last = (n - 1) * dt, elapsed, blend
+    with nogil:
+        if start_width != 0.0:
+            for i in range(n):
+                elapsed = i * dt
+                blend = -1.0 * (elapsed * (1.0 - _smoothstep(arguments[0, i], powers[0, i])))
+                for k in range(n_dims):
+                    out[i, k] = out[i, k] + blend * start_velocity[k]
+        if end_width != 0.0:
+            for i in range(n):
+                elapsed = last - i * dt
+                blend = 1.0 * (elapsed * (1.0 - _smoothstep(arguments[1, i], powers[1, i])))
+                for k in range(n_dims):
+                    out[i, k] = out[i, k] + blend * end_velocity[k]
+    return out.base
+
+
+def interp_columns(const double[:] x_new, const double[:] x, const double[:, :] y):
+    """``np.interp(x_new, x, column)`` for every column of ``y`` (n, D), as (m, D): ``x`` (n,)
+    increasing and ``x_new`` (m,) non-decreasing (a resampling grid), so one merge scan finds each
+    interval. NumPy's arithmetic and its special cases: the sample's own value on a knot, the end
+    values beyond the ends, ``slope (x - x[j]) + y[j]`` between (from the right end if that is NaN)."""
+    from numpy import empty
+
+    cdef Py_ssize_t m = x_new.shape[0], n = x.shape[0], n_dims = y.shape[1], i, j = 0, k
+    if n < 1 or y.shape[0] != n:
+        raise ValueError(f"interp_columns: x has {n} values and y {y.shape[0]} rows")
+    cdef double[:, ::1] out = empty((m, n_dims))
+    cdef double value, slope, result
+    with nogil:
+        for i in range(m):
+            value = x_new[i]
+            if value > x[n - 1]:
+                for k in range(n_dims):
+                    out[i, k] = y[n - 1, k]
+                continue
+            if value < x[0]:
+                for k in range(n_dims):
+                    out[i, k] = y[0, k]
+                continue
+            if value == x[n - 1]:
+                for k in range(n_dims):
+                    out[i, k] = y[n - 1, k]
+                continue
+            while j + 1 < n and x[j + 1] <= value:  # x[j] <= value < x[j + 1]
+                j += 1
+            while j > 0 and x[j] > value:  # (a grid that steps back: never, but stay exact)
+                j -= 1
+            for k in range(n_dims):
+                if x[j] == value:
+                    out[i, k] = y[j, k]
+                    continue
+                slope = (y[j + 1, k] - y[j, k]) / (x[j + 1] - x[j])
+                result = slope * (value - x[j]) + y[j, k]
+                if result != result:
+                    result = slope * (value - x[j + 1]) + y[j + 1, k]
+                    if result != result and y[j, k] == y[j + 1, k]:
+                        result = y[j, k]
+                out[i, k] = result
+    return out.base
+
+
+def exact_state(
+    const double[:, :] y,
+    const double[:, :] inputs,
+    double transition_yy,
+    double transition_yz,
+    double now_y,
+    double after_y,
+    double alpha_beta,
+    double alpha,
+    double tau_squared,
+):
+    """``z`` and ``d²y/ds²`` (n, D) of an exact rollout from its positions and inputs (n + 1, D):
+    ``z[l] = (y[l+1] - Φ₁₁ y[l] - Γ₀₁ u[l] - Γ₁₁ u[l+1]) / Φ₁₂`` and ``(u[l] - αβ y[l] - α z[l]) /
+    tau²``, in the operations of the NumPy expressions it replaced (``alpha_beta`` and
+    ``tau_squared`` are Python's ``alpha * beta`` and ``tau ** 2``, as there)."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = y.shape[0] - 1, n_dims = y.shape[1], l, k
+    if n < 0 or inputs.shape[0] != n + 1 or inputs.shape[1] != n_dims:
+        raise ValueError("exact_state: y and inputs must have the same shape (n + 1, D)")
+    cdef double[:, ::1] z = empty((n, n_dims))
+    cdef double[:, ::1] acceleration = empty((n, n_dims))
+    with nogil:
+        for l in range(n):
+            for k in range(n_dims):
+                z[l, k] = (
+                    (y[l + 1, k] - transition_yy * y[l, k]) - now_y * inputs[l, k] - after_y * inputs[l + 1, k]
+                ) / transition_yz
+                acceleration[l, k] = (inputs[l, k] - alpha_beta * y[l, k] - alpha * z[l, k]) / tau_squared
+    return z.base, acceleration.base
+
+
+# -- unit quaternions (x, y, z, w), in SciPy's Rotation arithmetic --------------------------------
+# SciPy's Rotation costs about 0.3 ms a product on arrays (its array-API dispatch), most of a pose
+# DMP's fit and trajectory. These loops are its Cython backend's operations, step by step (the
+# C library's sqrt, sin, cos and atan2, as there), so a pose keeps its last bit; the tests compare
+# them with Rotation on random rotations, small angles and half turns included.
+
+
+cdef inline void _normalised(double* q) noexcept nogil:
+    """A quaternion divided by its norm, as ``Rotation(quat, normalize=True)`` does it."""
+    cdef double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    q[0] = q[0] / norm
+    q[1] = q[1] / norm
+    q[2] = q[2] / norm
+    q[3] = q[3] / norm
+
+
+cdef inline void _product(const double* p, const double* q, double* r) noexcept nogil:
+    """``p ⊗ q`` (Rotation's ``p * q``), in its operations: the cross product first."""
+    cdef double c0 = p[1] * q[2] - p[2] * q[1]
+    cdef double c1 = p[2] * q[0] - p[0] * q[2]
+    cdef double c2 = p[0] * q[1] - p[1] * q[0]
+    r[0] = p[3] * q[0] + q[3] * p[0] + c0
+    r[1] = p[3] * q[1] + q[3] * p[1] + c1
+    r[2] = p[3] * q[2] + q[3] * p[2] + c2
+    r[3] = p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
+
+
+cdef inline bint _flipped(const double* q) noexcept nogil:
+    """Whether ``as_rotvec`` takes ``-q``: ``w < 0``, or at ``w = 0`` (a half turn) the first
+    non-zero of x, y, z negative (SciPy's canonical sign)."""
+    if q[3] != 0:
+        return q[3] < 0
+    if q[0] != 0:
+        return q[0] < 0
+    if q[1] != 0:
+        return q[1] < 0
+    return q[2] < 0
+
+
+def quaternion_log(const double[:, :] q, const double[:, :] goal):
+    """``(Rotation.from_quat(q) * Rotation.from_quat(goal).inv()).as_rotvec()`` (n, 3): the
+    rotation vectors (rad, angle in [0, π]) from ``goal`` to each of ``q`` (n, 4); ``goal`` (1, 4)
+    or (n, 4). Rows need not be of unit length (they are normalised, as Rotation does)."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = q.shape[0], i, k
+    if q.shape[1] != 4 or goal.shape[1] != 4 or goal.shape[0] not in (1, n):
+        raise ValueError("quaternion_log: q (n, 4) and goal (1, 4) or (n, 4)")
+    cdef double[:, ::1] out = empty((n, 3))
+    cdef double p[4]
+    cdef double g[4]
+    cdef double r[4]
+    cdef double angle, angle2, scale
+    with nogil:
+        for i in range(n):
+            for k in range(4):
+                p[k] = q[i, k]
+                g[k] = goal[i if goal.shape[0] > 1 else 0, k]
+            _normalised(p)
+            _normalised(g)
+            g[0] = -g[0]
+            g[1] = -g[1]
+            g[2] = -g[2]
+            _product(p, g, r)
+            _normalised(r)
+            if _flipped(r):  # w ≥ 0: the angle in [0, π]
+                for k in range(4):
+                    r[k] = -r[k]
+            angle = 2 * atan2(sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]), r[3])
+            if angle <= 1e-3:
+                angle2 = angle * angle
+                scale = 2 + angle2 / 12 + 7 * angle2 * angle2 / 2880
+            else:
+                scale = angle / sin(angle / 2)
+            out[i, 0] = scale * r[0]
+            out[i, 1] = scale * r[1]
+            out[i, 2] = scale * r[2]
+    return out.base
+
+
+def quaternion_exp(const double[:, :] error, const double[:, :] goal):
+    """``(Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat()`` (n, 4): each rotation
+    vector ``error`` (n, 3, rad) applied to ``goal`` (1, 4) or (n, 4)."""
+    from numpy import empty
+
+    cdef Py_ssize_t n = error.shape[0], i, k
+    if error.shape[1] != 3 or goal.shape[1] != 4 or goal.shape[0] not in (1, n):
+        raise ValueError("quaternion_exp: error (n, 3) and goal (1, 4) or (n, 4)")
+    cdef double[:, ::1] out = empty((n, 4))
+    cdef double p[4]
+    cdef double g[4]
+    cdef double angle, angle2, scale
+    with nogil:
+        for i in range(n):
+            angle = sqrt(error[i, 0] * error[i, 0] + error[i, 1] * error[i, 1] + error[i, 2] * error[i, 2])
+            if angle <= 1e-3:
+                angle2 = angle * angle
+                scale = 0.5 - angle2 / 48 + angle2 * angle2 / 3840
+            else:
+                scale = sin(angle / 2) / angle
+            p[0] = scale * error[i, 0]
+            p[1] = scale * error[i, 1]
+            p[2] = scale * error[i, 2]
+            p[3] = cos(angle / 2)
+            for k in range(4):
+                g[k] = goal[i if goal.shape[0] > 1 else 0, k]
+            _normalised(g)
+            _product(p, g, &out[i, 0])
+            _normalised(&out[i, 0])
+    return out.base

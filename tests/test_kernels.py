@@ -1,6 +1,7 @@
-"""The compiled loops of a robot-protocol fit (``bidmp.primitives._kernels``) against independent
-references: SciPy's ``lfilter`` for the spring's integration, NumPy's ``gradient`` expressions for the
-forcing target and the goal gate, and plain NumPy searches for the decisions (the rest blend's
+"""The compiled loops (``bidmp._kernels``) against independent references: SciPy's ``lfilter`` for
+the spring's integration, SciPy's ``Rotation`` for quaternion logs and exponentials, ``np.interp``
+for resampling, the NumPy expressions they replaced for the forcing target, the goal gate and share,
+the rest blend and the exact state, and plain NumPy searches for the decisions (the rest blend's
 windows; the straight tail is checked against its plain search in test_approach.py).
 
 Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
@@ -16,9 +17,23 @@ import sys
 import numpy as np
 import pytest
 from scipy.signal import lfilter
+from scipy.spatial.transform import Rotation
 
-from bidmp.primitives._kernels import forcing_target, goal_gate, rest_windows, second_order
-from bidmp.primitives.goals import _smoothstep_derivatives
+from bidmp._kernels import (
+    exact_state,
+    forcing_target,
+    goal_gate,
+    goal_share,
+    goal_share_arguments,
+    interp_columns,
+    quaternion_exp,
+    quaternion_log,
+    rest_blend_arguments,
+    rest_blended,
+    rest_windows,
+    second_order,
+)
+from bidmp.primitives.goals import _smoothstep, _smoothstep_derivatives
 from bidmp.primitives.rest import _BLEND_SHAPE, _BLEND_U, _REST_CANDIDATES
 
 
@@ -196,3 +211,132 @@ def test_a_fit_and_its_trajectory_import_no_scipy_signal():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     )
     assert result.stdout.strip() == "False", result.stdout
+
+
+def test_the_goal_share_loops_are_the_numpy_expression_to_the_bit():
+    """``σ S((s - b) / w)``, then ``1 - (1 - σ) S((end - s) / w)`` over the last ``w``, then 1, with
+    NumPy's own powers in between (its vectorised ``u**4`` is not the C library's pow)."""
+    rng = np.random.default_rng(12)
+    for _ in range(200):
+        n_samples = int(rng.integers(2, 2000))
+        dt = 1.0 / n_samples * rng.uniform(0.5, 2.0)
+        progress = np.sort(rng.random(n_samples))
+        n_motion = int(rng.integers(1, n_samples + 1))
+        begin = rng.uniform(0.0, 0.3) * n_motion * dt
+        end = (n_motion - 1) * dt
+        width = max(rng.uniform(0.01, 0.3) * (end - begin), dt)
+        s = np.arange(n_samples) * dt
+        expected = progress * _smoothstep((s - begin) / width)
+        closing = s > end - width
+        expected[closing] = 1.0 - (1.0 - progress[closing]) * _smoothstep(
+            (end - s[closing]) / width
+        )
+        expected[s >= end] = 1.0
+        arguments = goal_share_arguments(n_samples, dt, begin, end, width)
+        out = goal_share(progress, arguments, arguments**4, dt, end, width)
+        assert np.array_equal(_bits(out), _bits(expected))
+    with pytest.raises(ValueError, match="arguments and powers"):
+        goal_share(np.zeros(3), np.zeros((2, 4)), np.zeros((2, 4)), 0.1, 0.2, 0.1)
+
+
+def test_the_rest_blend_loops_are_the_numpy_expression_to_the_bit():
+    """``y - v₀ s (1 - S(s / w₀)) + v₁ (s_T - s) (1 - S((s_T - s) / w₁))``, either end skipped at a
+    window of 0."""
+    rng = np.random.default_rng(13)
+    for trial in range(200):
+        n_samples, n_dims = int(rng.integers(3, 1500)), int(rng.integers(1, 7))
+        y = _random_motion(rng, n_samples, n_dims)
+        dt = 1.0 / n_samples
+        widths = [rng.choice([0.0, rng.uniform(0.01, 0.25)]) for _ in range(2)]
+        v0, v1 = (y[1] - y[0]) / dt, (y[-1] - y[-2]) / dt
+        s = np.arange(n_samples) * dt
+        expected = y.copy()
+        for end, speed_vector, width in ((False, v0, widths[0]), (True, v1, widths[1])):
+            if width == 0.0:
+                continue
+            elapsed = (s[-1] - s) if end else s
+            blend = elapsed * (1.0 - _smoothstep(elapsed / width))
+            expected += (1.0 if end else -1.0) * blend[:, None] * speed_vector[None, :]
+        arguments = rest_blend_arguments(n_samples, dt, *widths)
+        out = rest_blended(y, arguments, arguments**4, dt, v0, v1, *widths)
+        assert np.array_equal(_bits(out), _bits(expected)), trial
+
+
+def test_the_exact_state_loop_is_the_numpy_expression_to_the_bit():
+    rng = np.random.default_rng(14)
+    for _ in range(100):
+        n_samples, n_dims = int(rng.integers(1, 1500)), int(rng.integers(1, 7))
+        y, inputs = rng.normal(size=(2, n_samples, n_dims)) * 10 ** rng.uniform(-3, 3)
+        p11, p12, now, after = rng.normal(size=4)
+        alpha, beta, tau = rng.uniform(1, 100), rng.uniform(1, 30), rng.uniform(0.3, 3.0)
+        z = y[1:] - p11 * y[:-1]
+        z -= now * inputs[:-1]
+        z -= after * inputs[1:]
+        z /= p12
+        acceleration = inputs[:-1] - alpha * beta * y[:-1]
+        acceleration -= alpha * z
+        acceleration /= tau**2
+        out_z, out_acceleration = exact_state(
+            y, inputs, p11, p12, now, after, alpha * beta, alpha, tau**2
+        )
+        assert np.array_equal(_bits(out_z), _bits(z))
+        assert np.array_equal(_bits(out_acceleration), _bits(acceleration))
+    with pytest.raises(ValueError, match="same shape"):
+        exact_state(np.zeros((3, 2)), np.zeros((3, 1)), 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
+
+
+def test_the_resampling_scan_is_np_interp_to_the_bit():
+    """Every column at once, on grids inside, on and beyond the knots, unsorted ones, repeated
+    knots' values, infinite samples (NumPy's NaN fallbacks) and a single knot."""
+    rng = np.random.default_rng(15)
+    for trial in range(400):
+        x = np.unique(rng.uniform(-10, 10, int(rng.integers(1, 300))))
+        if trial % 3 == 0:
+            x = np.unique(x.round(1))
+        y = rng.normal(size=(x.shape[0], int(rng.integers(1, 5)))) * 10 ** rng.uniform(-5, 5)
+        if trial % 7 == 0:
+            y[rng.integers(0, x.shape[0])] = np.inf
+        x_new = np.concatenate([rng.uniform(x[0] - 1, x[-1] + 1, int(rng.integers(1, 400))), x])
+        if trial % 2:
+            x_new = np.sort(x_new)
+        expected = np.column_stack([np.interp(x_new, x, column) for column in y.T])
+        out = interp_columns(x_new, x, y)
+        assert np.array_equal(np.isnan(out), np.isnan(expected)), trial
+        finite = ~np.isnan(expected)
+        assert np.array_equal(_bits(out[finite]), _bits(expected[finite])), trial
+    with pytest.raises(ValueError, match="rows"):
+        interp_columns(np.zeros(2), np.zeros(3), np.zeros((2, 1)))
+
+
+def _rotations(rng, n_rows: int) -> np.ndarray:
+    return rng.normal(size=(n_rows, 4)) * 10 ** rng.uniform(-3, 3)
+
+
+def test_the_quaternion_loops_are_scipys_rotation_to_the_bit():
+    """``(R(q) * R(g).inv()).as_rotvec()`` and ``(R.from_rotvec(e) * R(g)).as_quat()``: random
+    rotations of any scale, one goal or one per row, small angles (the series), half turns (a
+    product with w = 0 exactly, where the sign convention decides) and opposite signs."""
+    rng = np.random.default_rng(16)
+    identity = np.array([[0.0, 0.0, 0.0, 1.0]])
+    for trial in range(300):
+        n_rows = int(rng.integers(1, 300))
+        q = _rotations(rng, n_rows)
+        goal = _rotations(rng, 1 if trial % 2 else n_rows)
+        if trial % 5 == 1:  # near the goal: the small-angle series
+            goal = q[:1] + rng.normal(size=(1, 4)) * 1e-7 if trial % 2 else q * (1 + 1e-9)
+        if trial % 5 == 2:  # half turns from the identity: w = 0 in the product
+            q[:, 3], goal = 0.0, identity
+        if trial % 5 == 3:
+            q[::2] = -q[::2]
+        g = goal[0] if goal.shape[0] == 1 else goal
+        expected = (Rotation.from_quat(q) * Rotation.from_quat(g).inv()).as_rotvec()
+        assert np.array_equal(_bits(quaternion_log(q, goal)), _bits(expected.reshape(n_rows, 3)))
+        error = rng.normal(size=(n_rows, 3)) * 10 ** rng.uniform(-6, 1.5)
+        expected = (Rotation.from_rotvec(error) * Rotation.from_quat(g)).as_quat()
+        assert np.array_equal(
+            _bits(quaternion_exp(error, goal)), _bits(expected.reshape(n_rows, 4))
+        )
+    with pytest.raises(ValueError, match="goal"):
+        quaternion_log(np.ones((3, 4)), np.ones((2, 4)))
+    with pytest.raises(ValueError, match="goal"):
+        quaternion_exp(np.ones((3, 3)), np.ones((2, 4)))
