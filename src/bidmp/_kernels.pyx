@@ -468,8 +468,9 @@ def rest_blended(
 def interp_columns(const double[:] x_new, const double[:] x, const double[:, :] y):
     """``np.interp(x_new, x, column)`` for every column of ``y`` (n, D), as (m, D): ``x`` (n,)
     increasing and ``x_new`` (m,) non-decreasing (a resampling grid), so one merge scan finds each
-    interval. NumPy's arithmetic and its special cases: the sample's own value on a knot, the end
-    values beyond the ends, ``slope (x - x[j]) + y[j]`` between (from the right end if that is NaN)."""
+    interval. NumPy's arithmetic and its special cases: NaN at a NaN, the sample's own value on a
+    knot, the end values beyond the ends, ``slope (x - x[j]) + y[j]`` between (from the right end
+    if that is NaN)."""
     from numpy import empty
 
     cdef Py_ssize_t m = x_new.shape[0], n = x.shape[0], n_dims = y.shape[1], i, j = 0, k
@@ -480,6 +481,10 @@ def interp_columns(const double[:] x_new, const double[:] x, const double[:, :] 
     with nogil:
         for i in range(m):
             value = x_new[i]
+            if value != value:  # NaN in, NaN out (but a single knot's value, as NumPy has it)
+                for k in range(n_dims):
+                    out[i, k] = y[0, k] if n == 1 else value
+                continue
             if value > x[n - 1]:
                 for k in range(n_dims):
                     out[i, k] = y[n - 1, k]

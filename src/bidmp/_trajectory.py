@@ -13,6 +13,7 @@ from ._kernels import interp_columns as _interp_columns
 
 __all__ = [
     "arclength",
+    "savgol_filter",
     "interp_columns",
     "resample_arclength",
     "resample_time",
@@ -26,6 +27,15 @@ def arclength(y: np.ndarray) -> np.ndarray:
     """Cumulative arc length at each sample, shape (T,), starting at 0."""
     steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
     return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def savgol_filter(*args, **kwargs) -> np.ndarray:
+    """:func:`scipy.signal.savgol_filter` (the same arguments), importing SciPy's signal package
+    at the first call: it and the statistics it imports are 0.3 s of a command's start-up, which a
+    run that never smooths a path (the 14-nut job) does not pay."""
+    from scipy.signal import savgol_filter as scipy_savgol_filter
+
+    return scipy_savgol_filter(*args, **kwargs)
 
 
 def interp_columns(x_new: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -34,7 +34,6 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from .._checks import (
     as_indices,
@@ -46,7 +45,7 @@ from .._checks import (
     check_seed,
     numerically_guarded,
 )
-from .._trajectory import arclength, path_extent, resample_time
+from .._trajectory import arclength, path_extent, resample_time, savgol_filter
 from ..primitives.approach import STRAIGHTNESS, straight_tail_start
 from .refine import _lifted_route, _path_is_free, _refine_transfer, _smoothest_free_route
 from .roadmap import (

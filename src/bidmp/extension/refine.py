@@ -32,9 +32,8 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.signal import savgol_filter
 
-from .._trajectory import arclength, interp_columns
+from .._trajectory import arclength, interp_columns, savgol_filter
 from .roadmap import CollisionCallback, _edges_free
 
 __all__ = []

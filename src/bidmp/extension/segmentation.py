@@ -18,7 +18,6 @@ import heapq
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from .._checks import (
     as_indices,
@@ -29,7 +28,7 @@ from .._checks import (
     check_real,
     numerically_guarded,
 )
-from .._trajectory import arclength, resample_arclength
+from .._trajectory import arclength, resample_arclength, savgol_filter
 
 __all__ = [
     "curvature",

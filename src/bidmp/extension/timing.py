@@ -18,10 +18,9 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from .._checks import check_int
-from .._trajectory import arclength, interp_columns
+from .._trajectory import arclength, interp_columns, savgol_filter
 
 __all__ = []
 
