@@ -45,36 +45,46 @@ cdef void _running_max(double[::1] values) noexcept nogil:
             values[i] = values[i - 1]
 
 
-cdef bint _straight_from(
-    const double[:, :] y, Py_ssize_t start, double tolerance, double[:] unit, Py_ssize_t stride
-) noexcept nogil:
-    """Whether the tail ``y[start:]`` (T, D) is straight: every sample within ``tolerance`` × the
-    chord of the chord (from the sample at ``start`` to the end) and — with ``stride`` 1 — never
-    more than that back along it. With ``stride`` > 1 only every ``stride``-th sample's distance
-    is looked at (a necessary condition). ``unit`` (D,) is scratch space."""
-    cdef Py_ssize_t last = y.shape[0] - 1, n_dims = y.shape[1], i, k
-    cdef double length_squared = 0.0, length, bound, origin_k, along, previous, across, offset_k
-    cdef double squared
-    for k in range(n_dims):
+cdef double _chord(const double[:, :] y, Py_ssize_t start, double[:] unit) noexcept nogil:
+    """The length of the chord from sample ``start`` of ``y`` (T, D) to its end, and its direction
+    into ``unit`` (D,); 0 when the two samples coincide (no direction)."""
+    cdef Py_ssize_t last = y.shape[0] - 1, k
+    cdef double length_squared = 0.0, origin_k, length
+    for k in range(y.shape[1]):
         origin_k = y[start, k] - y[last, k]
         length_squared = length_squared + origin_k * origin_k
     length = sqrt(length_squared)
-    if not length > 0.0:
-        return False
-    for k in range(n_dims):
-        unit[k] = -(y[start, k] - y[last, k]) / length
-    bound = tolerance * length
-    previous = 0.0
-    i = start
-    while i <= last:
-        along = 0.0
-        squared = 0.0
-        for k in range(n_dims):
-            offset_k = (y[i, k] - y[last, k]) - (y[start, k] - y[last, k])
-            along = along + offset_k * unit[k]
-            squared = squared + offset_k * offset_k
-        across = squared - along * along
-        if across > bound * bound:
+    if length > 0.0:
+        for k in range(y.shape[1]):
+            unit[k] = -(y[start, k] - y[last, k]) / length
+    return length
+
+
+cdef inline double _off_chord(
+    const double[:, :] y, Py_ssize_t i, Py_ssize_t start, const double[:] unit, double* along
+) noexcept nogil:
+    """The squared distance of sample ``i`` from the chord through sample ``start`` (direction
+    ``unit``), and its distance along the chord into ``along``; offsets measured from the end."""
+    cdef Py_ssize_t last = y.shape[0] - 1, k
+    cdef double offset_k, squared = 0.0
+    along[0] = 0.0
+    for k in range(y.shape[1]):
+        offset_k = (y[i, k] - y[last, k]) - (y[start, k] - y[last, k])
+        along[0] = along[0] + offset_k * unit[k]
+        squared = squared + offset_k * offset_k
+    return squared - along[0] * along[0]
+
+
+cdef bint _straight_from(
+    const double[:, :] y, Py_ssize_t start, double bound, const double[:] unit, Py_ssize_t stride
+) noexcept nogil:
+    """Whether the tail ``y[start:]`` (T, D) is straight: every sample within ``bound`` of its
+    chord (direction ``unit``) and — with ``stride`` 1 — never more than that back along it. With
+    ``stride`` > 1 only every ``stride``-th sample's distance is looked at (a necessary condition)."""
+    cdef Py_ssize_t i = start
+    cdef double along, previous = 0.0
+    while i < y.shape[0]:
+        if _off_chord(y, i, start, unit, &along) > bound * bound:
             return False
         if stride == 1 and i > start and along - previous < -bound:
             return False
@@ -84,34 +94,19 @@ cdef bint _straight_from(
 
 
 cdef bint _probes_straight(
-    const double[:, :] y, Py_ssize_t start, double tolerance, double[:] unit
+    const double[:, :] y, Py_ssize_t start, double bound, const double[:] unit
 ) noexcept nogil:
     """A necessary condition of :func:`_straight_from` from three samples of the tail (a quarter,
     half and three quarters of the way to its end), with a hair of slack for the rounding."""
-    cdef Py_ssize_t last = y.shape[0] - 1, n_dims = y.shape[1], k, probe, index
-    cdef double length_squared = 0.0, length, bound, origin_k, along, squared, offset_k
+    cdef Py_ssize_t last = y.shape[0] - 1, probe, index
+    cdef double along
     cdef double shares[3]
     shares[0] = 0.25
     shares[1] = 0.5
     shares[2] = 0.75
-    for k in range(n_dims):
-        origin_k = y[start, k] - y[last, k]
-        length_squared = length_squared + origin_k * origin_k
-    length = sqrt(length_squared)
-    if not length > 0.0:
-        return False
-    for k in range(n_dims):
-        unit[k] = -(y[start, k] - y[last, k]) / length
-    bound = tolerance * length
     for probe in range(3):
         index = start + <Py_ssize_t>floor(shares[probe] * (last - start))
-        along = 0.0
-        squared = 0.0
-        for k in range(n_dims):
-            offset_k = (y[index, k] - y[last, k]) - (y[start, k] - y[last, k])
-            along = along + offset_k * unit[k]
-            squared = squared + offset_k * offset_k
-        if squared - along * along > bound * bound * (1.0 + 1e-9) + 1e-300:
+        if _off_chord(y, index, start, unit, &along) > bound * bound * (1.0 + 1e-9) + 1e-300:
             return False
     return True
 
@@ -122,14 +117,19 @@ def tail_start(const double[:, :] y, const long long[:] candidates, double toler
     by more than that), or ``T - 1`` when none is. Three probes, then every 8th sample, then all
     of it: each stage a necessary condition of the next, each with an early exit."""
     cdef Py_ssize_t c, start, found = y.shape[0] - 1
+    cdef double length, bound
     cdef double[::1] unit = _scratch(y.shape[1])
     with nogil:
         for c in range(candidates.shape[0]):
             start = candidates[c]
+            length = _chord(y, start, unit)
+            if not length > 0.0:
+                continue
+            bound = tolerance * length
             if (
-                _probes_straight(y, start, tolerance, unit)
-                and _straight_from(y, start, tolerance, unit, 8)
-                and _straight_from(y, start, tolerance, unit, 1)
+                _probes_straight(y, start, bound, unit)
+                and _straight_from(y, start, bound, unit, 8)
+                and _straight_from(y, start, bound, unit, 1)
             ):
                 found = start
                 break

@@ -194,3 +194,24 @@ def test_a_model_file_names_only_bidmps_components(tmp_path):
     dmp = _rhythmic_dmp().fit(y, t, units="m")
     with pytest.raises(ValueError, match="bidmp's own components.*CyclePhase"):
         save_model(dmp, tmp_path / "rhythmic.npz")
+
+
+def test_a_fit_caches_its_learned_gate_as_the_phase_lookup_gives_it():
+    """On the grid it was learned on and one sample past it, the learned progress gate is what the
+    lookup by phase (ProgressGate.on_grid) gives — which a fit no longer builds for its cached
+    grid; a phase rising again past the grid is left to the lookup, and one that does not decay is
+    refused as the lookup refuses it."""
+    from bidmp.primitives.goals import ProgressGate, _gate_past_training
+
+    rng = np.random.default_rng(21)
+    for n_train in (2, 3, 50, 1100):
+        canonical = ExponentialPhase(float(rng.uniform(1.0, 8.0)), exact=True)
+        phase = canonical.grid(n_train + 1, 1.0 / n_train, 1.0)
+        gate = rng.normal(size=n_train)
+        lookup = ProgressGate(phase[:-1], gate).on_grid(phase, 1.0 / n_train, 1.0, True)
+        shortcut = _gate_past_training(gate, phase, canonical)
+        assert np.array_equal(shortcut, lookup)
+    rising = np.array([1.0, 0.5, 0.2, 0.3])
+    assert _gate_past_training(np.ones(3), rising, canonical) is None
+    with pytest.raises(ValueError, match="must decay"):
+        _gate_past_training(np.ones(3), np.array([1.0, 1.0, 0.5, 0.2]), canonical)
