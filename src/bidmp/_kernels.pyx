@@ -1,4 +1,5 @@
-# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+# cython: language_level=3, boundscheck=False, wraparound=False
+# cython: cdivision=True, initializedcheck=False
 """Compiled loops of a robot-protocol fit and rollout.
 
 A fit of the robot protocol on a T = 1000 demonstration is a few hundred small array operations,
@@ -195,8 +196,12 @@ def rest_windows(
         _running_max(running_backward)
         start_speed = _row_norm(velocity, 0)
         end_speed = _row_norm(velocity, n - 1)
-        windows[0] = _blend_window(start_speed, running_forward, dt, peak, blend_u, blend_shape, candidates, share, widest)
-        windows[1] = _blend_window(end_speed, running_backward, dt, peak, blend_u, blend_shape, candidates, share, widest)
+        windows[0] = _blend_window(
+            start_speed, running_forward, dt, peak, blend_u, blend_shape, candidates, share, widest
+        )
+        windows[1] = _blend_window(
+            end_speed, running_backward, dt, peak, blend_u, blend_shape, candidates, share, widest
+        )
     return windows[0], windows[1], peak, start_speed, end_speed
 
 
@@ -211,6 +216,9 @@ cdef double _blend_window(
     double share,
     double widest,
 ) noexcept nogil:
+    """One end's window: the first of ``candidates`` whose blend of ``speed`` stays within
+    ``share`` of the ``running`` peak acceleration (from that end) at every ``blend_u``; see
+    :func:`rest_windows`."""
     cdef Py_ssize_t c, j, index, n = running.shape[0]
     # np.maximum's NaN (it propagates), as the NumPy test had it
     cdef double floor_peak = 1e-300 if 1e-300 > peak else peak
@@ -252,7 +260,9 @@ cdef void _filter_row(
     cdef double z1 = -a2 * y_second
     for k in range(n_out):
         if held.shape[0]:
-            x = held[0] * drives[row, k + 2] + held[1] * drives[row, k + 1] + held[2] * drives[row, k]
+            x = (
+                held[0] * drives[row, k + 2] + held[1] * drives[row, k + 1] + held[2] * drives[row, k]
+            )
         else:
             x = drives[row, k]
         y = z0 + b0 * x
@@ -398,7 +408,7 @@ def goal_share(
     from numpy import empty
 
     cdef Py_ssize_t n = progress.shape[0], i
-    if arguments.shape[0] != 2 or arguments.shape[1] != n or powers.shape[0] != 2 or powers.shape[1] != n:
+    if (arguments.shape[0], arguments.shape[1], powers.shape[0], powers.shape[1]) != (2, n, 2, n):
         raise ValueError(f"goal_share: arguments and powers must be (2, {n})")
     cdef double[::1] share = empty(n)
     cdef double s, closing = end - width
@@ -541,9 +551,13 @@ def exact_state(
         for l in range(n):
             for k in range(n_dims):
                 z[l, k] = (
-                    (y[l + 1, k] - transition_yy * y[l, k]) - now_y * inputs[l, k] - after_y * inputs[l + 1, k]
+                    (y[l + 1, k] - transition_yy * y[l, k])
+                    - now_y * inputs[l, k]
+                    - after_y * inputs[l + 1, k]
                 ) / transition_yz
-                acceleration[l, k] = (inputs[l, k] - alpha_beta * y[l, k] - alpha * z[l, k]) / tau_squared
+                acceleration[l, k] = (
+                    inputs[l, k] - alpha_beta * y[l, k] - alpha * z[l, k]
+                ) / tau_squared
     return z.base, acceleration.base
 
 
@@ -641,7 +655,9 @@ def quaternion_exp(const double[:, :] error, const double[:, :] goal):
     cdef double angle, angle2, scale
     with nogil:
         for i in range(n):
-            angle = sqrt(error[i, 0] * error[i, 0] + error[i, 1] * error[i, 1] + error[i, 2] * error[i, 2])
+            angle = sqrt(
+                error[i, 0] * error[i, 0] + error[i, 1] * error[i, 1] + error[i, 2] * error[i, 2]
+            )
             if angle <= 1e-3:
                 angle2 = angle * angle
                 scale = 0.5 - angle2 / 48 + angle2 * angle2 / 3840
