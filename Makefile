@@ -50,9 +50,11 @@ fuzz: $(STAMP)
 # Mutation testing of the checks that guard the robot and judge success (tools/mutation.py): every
 # small bug planted one at a time in the judging functions, the covering tests run against each;
 # writes docs/mutation.md (score per area, every survivor killed or shown equivalent) and its
-# outcomes docs/mutation.json. About 40 min on 2 cores.
+# outcomes docs/mutation.json. About 40 min on 2 cores. Then the compiled loops' planted bugs
+# (tools/mutation_kernels.py, each built into a copy of the package): docs/mutation-kernels.md.
 mutation: $(STAMP)
 	$(PY) tools/mutation.py --workers 2
+	$(PY) tools/mutation_kernels.py
 
 # The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/).
 sim: $(STAMP)

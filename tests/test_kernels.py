@@ -342,3 +342,20 @@ def test_the_quaternion_loops_are_scipys_rotation_to_the_bit():
         quaternion_log(np.ones((3, 4)), np.ones((2, 4)))
     with pytest.raises(ValueError, match="goal"):
         quaternion_exp(np.ones((3, 3)), np.ones((2, 4)))
+
+
+def test_every_planted_bug_of_the_kernel_mutation_tool_still_has_its_place():
+    """``make mutation``'s compiled-loop mutants (tools/mutation_kernels.py) are edits of the
+    source: each must still find its one place in it and change something, or the tool would
+    stop planting it without saying so (a structure check, not a correctness one)."""
+    from pathlib import Path
+
+    import mutation_kernels
+
+    source = (Path(__file__).resolve().parents[1] / "src" / "bidmp" / "_kernels.pyx").read_text(
+        encoding="utf-8"
+    )
+    assert len(mutation_kernels.MUTANTS) >= 20
+    for mutant in mutation_kernels.MUTANTS:
+        assert source.count(mutant.original) == 1, mutant.loop
+        assert mutant.mutated != mutant.original, mutant.loop
