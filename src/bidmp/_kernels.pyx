@@ -26,6 +26,8 @@ fits a DMP.
 
 from libc.math cimport INFINITY, atan2, cos, floor, sin, sqrt
 
+from numpy import array, empty
+
 
 cdef void _gradient(const double[:] f, double[:] out, double dt) noexcept nogil:
     """``np.gradient(f, dt)`` of one column f (n,), n ≥ 2, operation for operation: central
@@ -119,7 +121,7 @@ def tail_start(const double[:, :] y, const long long[:] candidates, double toler
     of it: each stage a necessary condition of the next, each with an early exit."""
     cdef Py_ssize_t c, start, found = y.shape[0] - 1
     cdef double length, bound
-    cdef double[::1] unit = _scratch(y.shape[1])
+    cdef double[::1] unit = empty(max(y.shape[1], 1))
     with nogil:
         for c in range(candidates.shape[0]):
             start = candidates[c]
@@ -135,12 +137,6 @@ def tail_start(const double[:, :] y, const long long[:] candidates, double toler
                 found = start
                 break
     return found
-
-
-cdef double[::1] _scratch(Py_ssize_t n):
-    from numpy import empty
-
-    return empty(max(n, 1))
 
 
 cdef double _row_norm(const double[:, :] a, Py_ssize_t i) noexcept nogil:
@@ -172,8 +168,6 @@ def rest_windows(
     cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
     if n < 3:
         raise ValueError(f"rest_windows: y needs 3 samples or more, got {n}")
-    from numpy import empty
-
     cdef double[:, ::1] velocity = empty((n, n_dims))
     cdef double[:, ::1] acceleration = empty((n, n_dims))
     cdef double[::1] running_forward = empty(n)
@@ -288,8 +282,6 @@ def second_order(
     n_drives + 2): ``held[0] u[n+2] + held[1] u[n+1] + held[2] u[n]``. The same numbers as SciPy's
     ``lfilter`` with its initial state set from ``y[1], y[0]`` (the filter is its loop, operation
     for operation)."""
-    from numpy import empty
-
     cdef Py_ssize_t n_signals = drives.shape[0], row
     cdef Py_ssize_t n_out = drives.shape[1] + 2 if held is None else drives.shape[1]
     if n_out < 2:
@@ -319,8 +311,6 @@ def forcing_target(
     ``(tau² ÿ - alpha (beta (g - y) - tau ẏ)) / K + gate (g - y0)``, ``g = y[-1]``, ``y0 = y[0]``,
     each element the same operations in the same order as that NumPy expression (``tau_squared``
     is Python's ``tau ** 2``, as there)."""
-    from numpy import empty
-
     cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
     if n < 2 or gate.shape[0] != n:
         raise ValueError(f"forcing_target: {n} samples and a gate of {gate.shape[0]}")
@@ -344,8 +334,6 @@ def goal_gate(const double[:] share, double dt, double alpha, double beta, doubl
     """The gate ``(alpha beta (1 - R) - R'' - alpha R') / K`` (n,) whose continuous response is the
     goal share ``R`` (n,), ``R'`` and ``R''`` as NumPy's ``gradient`` (twice), each element the
     same operations in the same order as that NumPy expression; ``alpha beta / K`` at the start."""
-    from numpy import empty
-
     cdef Py_ssize_t n = share.shape[0], i
     if n < 2:
         raise ValueError(f"goal_gate: {n} samples, 2 or more wanted")
@@ -381,8 +369,6 @@ cdef inline double _smoothstep(double u, double u4) noexcept nogil:
 def goal_share_arguments(Py_ssize_t n, double dt, double begin, double end, double width):
     """The smoothstep's arguments of the goal share on ``n`` samples ``dt`` apart (2, n), clipped to
     [0, 1]: its rise ``(s - begin) / width`` and its close ``(end - s) / width``, ``s = i dt``."""
-    from numpy import empty
-
     cdef double[:, ::1] out = empty((2, n))
     cdef Py_ssize_t i
     cdef double s
@@ -405,8 +391,6 @@ def goal_share(
     """The goal share (n,) from the progress (n,) and the smoothstep's ``arguments`` (2, n) of
     :func:`goal_share_arguments` with their fourth ``powers``: ``σ S(rise)``, then ``1 - (1 - σ)
     S(close)`` from ``end - width`` on, then 1 from ``end`` on."""
-    from numpy import empty
-
     cdef Py_ssize_t n = progress.shape[0], i
     if (arguments.shape[0], arguments.shape[1], powers.shape[0], powers.shape[1]) != (2, n, 2, n):
         raise ValueError(f"goal_share: arguments and powers must be (2, {n})")
@@ -428,8 +412,6 @@ def rest_blend_arguments(Py_ssize_t n, double dt, double start_width, double end
     """The smoothstep's arguments of the rest blends on ``n`` samples ``dt`` apart (2, n), clipped
     to [0, 1]: ``s / start_width`` and ``(s[-1] - s) / end_width`` (0 where a width is 0: that end
     is not blended)."""
-    from numpy import empty
-
     cdef double[:, ::1] out = empty((2, n))
     cdef Py_ssize_t i
     cdef double last = (n - 1) * dt
@@ -454,8 +436,6 @@ def rest_blended(
     over ``end_width`` (normalised time; 0: not blended): ``y - v₀ s (1 - S(s / w₀))``, then
     ``+ v₁ (s_T - s) (1 - S((s_T - s) / w₁))``, from :func:`rest_blend_arguments` and their fourth
     ``powers``, in the operations of the NumPy expressions it replaced."""
-    from numpy import array
-
     cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
     cdef double[:, ::1] out = array(y, dtype=float, order="C", copy=True)
     cdef double last = (n - 1) * dt, elapsed, blend
@@ -481,8 +461,6 @@ def interp_columns(const double[:] x_new, const double[:] x, const double[:, :] 
     interval. NumPy's arithmetic and its special cases: NaN at a NaN, the sample's own value on a
     knot, the end values beyond the ends, ``slope (x - x[j]) + y[j]`` between (from the right end
     if that is NaN)."""
-    from numpy import empty
-
     cdef Py_ssize_t m = x_new.shape[0], n = x.shape[0], n_dims = y.shape[1], i, j = 0, k
     if n < 1 or y.shape[0] != n:
         raise ValueError(f"interp_columns: x has {n} values and y {y.shape[0]} rows")
@@ -540,8 +518,6 @@ def exact_state(
     ``z[l] = (y[l+1] - Φ₁₁ y[l] - Γ₀₁ u[l] - Γ₁₁ u[l+1]) / Φ₁₂`` and ``(u[l] - αβ y[l] - α z[l]) /
     tau²``, in the operations of the NumPy expressions it replaced (``alpha_beta`` and
     ``tau_squared`` are Python's ``alpha * beta`` and ``tau ** 2``, as there)."""
-    from numpy import empty
-
     cdef Py_ssize_t n = y.shape[0] - 1, n_dims = y.shape[1], l, k
     if n < 0 or inputs.shape[0] != n + 1 or inputs.shape[1] != n_dims:
         raise ValueError("exact_state: y and inputs must have the same shape (n + 1, D)")
@@ -588,6 +564,14 @@ cdef inline void _product(const double* p, const double* q, double* r) noexcept 
     r[3] = p[3] * q[3] - p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
 
 
+cdef inline void _goal_row(const double[:, :] goal, Py_ssize_t i, double* g) noexcept nogil:
+    """Row ``i`` of ``goal`` into ``g``, normalised (``Rotation.from_quat`` of it)."""
+    cdef Py_ssize_t k
+    for k in range(4):
+        g[k] = goal[i, k]
+    _normalised(g)
+
+
 cdef inline bint _flipped(const double* q) noexcept nogil:
     """Whether ``as_rotvec`` takes ``-q``: ``w < 0``, or at ``w = 0`` (a half turn) the first
     non-zero of x, y, z negative (SciPy's canonical sign)."""
@@ -604,8 +588,6 @@ def quaternion_log(const double[:, :] q, const double[:, :] goal):
     """``(Rotation.from_quat(q) * Rotation.from_quat(goal).inv()).as_rotvec()`` (n, 3): the
     rotation vectors (rad, angle in [0, π]) from ``goal`` to each of ``q`` (n, 4); ``goal`` (1, 4)
     or (n, 4). Rows need not be of unit length (they are normalised, as Rotation does)."""
-    from numpy import empty
-
     cdef Py_ssize_t n = q.shape[0], i, k
     if q.shape[1] != 4 or goal.shape[1] != 4 or goal.shape[0] not in (1, n):
         raise ValueError("quaternion_log: q (n, 4) and goal (1, 4) or (n, 4)")
@@ -614,16 +596,17 @@ def quaternion_log(const double[:, :] q, const double[:, :] goal):
     cdef double g[4]
     cdef double r[4]
     cdef double angle, angle2, scale
+    cdef bint per_row = goal.shape[0] > 1
     with nogil:
         for i in range(n):
             for k in range(4):
                 p[k] = q[i, k]
-                g[k] = goal[i if goal.shape[0] > 1 else 0, k]
             _normalised(p)
-            _normalised(g)
-            g[0] = -g[0]
-            g[1] = -g[1]
-            g[2] = -g[2]
+            if i == 0 or per_row:
+                _goal_row(goal, i if per_row else 0, g)
+                g[0] = -g[0]  # its inverse
+                g[1] = -g[1]
+                g[2] = -g[2]
             _product(p, g, r)
             _normalised(r)
             if _flipped(r):  # w ≥ 0: the angle in [0, π]
@@ -644,8 +627,6 @@ def quaternion_log(const double[:, :] q, const double[:, :] goal):
 def quaternion_exp(const double[:, :] error, const double[:, :] goal):
     """``(Rotation.from_rotvec(error) * Rotation.from_quat(goal)).as_quat()`` (n, 4): each rotation
     vector ``error`` (n, 3, rad) applied to ``goal`` (1, 4) or (n, 4)."""
-    from numpy import empty
-
     cdef Py_ssize_t n = error.shape[0], i, k
     if error.shape[1] != 3 or goal.shape[1] != 4 or goal.shape[0] not in (1, n):
         raise ValueError("quaternion_exp: error (n, 3) and goal (1, 4) or (n, 4)")
@@ -653,6 +634,7 @@ def quaternion_exp(const double[:, :] error, const double[:, :] goal):
     cdef double p[4]
     cdef double g[4]
     cdef double angle, angle2, scale
+    cdef bint per_row = goal.shape[0] > 1
     with nogil:
         for i in range(n):
             angle = sqrt(
@@ -667,9 +649,8 @@ def quaternion_exp(const double[:, :] error, const double[:, :] goal):
             p[1] = scale * error[i, 1]
             p[2] = scale * error[i, 2]
             p[3] = cos(angle / 2)
-            for k in range(4):
-                g[k] = goal[i if goal.shape[0] > 1 else 0, k]
-            _normalised(g)
+            if i == 0 or per_row:
+                _goal_row(goal, i if per_row else 0, g)
             _product(p, g, &out[i, 0])
             _normalised(&out[i, 0])
     return out.base

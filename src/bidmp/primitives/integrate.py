@@ -82,17 +82,6 @@ def _check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> Non
         )
 
 
-def _second_order(
-    drives: np.ndarray, y_first: np.ndarray, y_second: np.ndarray, numerator, a1: float, a2: float
-):
-    """``y[n+2] = -a1 y[n+1] - a2 y[n] + drive[n]`` for several signals, with ``drive`` filtered
-    by ``numerator`` (3,) first; (S, n_drives + 2) with ``y[0], y[1]`` given."""
-    # A compiled loop: SciPy's lfilter operation for operation (the same numbers), without
-    # importing SciPy's signal package (0.3 s of a command's start-up) or its per-call checks.
-    b0, b1, b2 = numerator
-    return second_order(drives, y_first, y_second, b0, b1, b2, a1, a2)
-
-
 def _euler_responses(
     drives: np.ndarray,
     y_first: np.ndarray,
@@ -122,7 +111,7 @@ def _euler_responses(
     """
     a1 = -(2.0 - h * alpha)
     a2 = 1.0 - h * alpha + h * h * alpha * beta
-    return _second_order(drives, y_first, y_second, [h * h, 0.0, 0.0], a1, a2)
+    return second_order(drives, y_first, y_second, h * h, 0.0, 0.0, a1, a2)
 
 
 # -- exact (first-order hold) ---------------------------------------------------------------------

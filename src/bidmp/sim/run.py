@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_labels, check_bool, check_int, check_real, short_token
+from .._trajectory import arclength
 from .._units import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
@@ -561,8 +562,7 @@ def _execute_jobs(setup: _SimSetup, jobs: list, n_workers: int, progress) -> lis
 def _job_cost(job) -> tuple[int, float]:
     """A sort key, costliest job first: the frames it renders (tens of ms each), then its path's
     length (the motion's duration grows with it)."""
-    length = float(np.sum(np.linalg.norm(np.diff(job.rollout[:, :3], axis=0), axis=1)))
-    return (-job.frames, -length)
+    return (-job.frames, -float(arclength(job.rollout[:, :3])[-1]))
 
 
 def _stepper(models, method, goal, duration, coupling):
