@@ -1,7 +1,7 @@
 """The compiled loops (``bidmp._kernels``) against independent references: SciPy's ``lfilter`` for
 the spring's integration, SciPy's ``Rotation`` for quaternion logs and exponentials, ``np.interp``
 for resampling, the NumPy expressions they replaced for the forcing target, the goal gate and share,
-the rest blend and the exact state, and plain NumPy searches for the decisions (the rest blend's
+the rest blend and the exact state, NumPy's norms and sums for the arc length, and plain NumPy searches for the decisions (the rest blend's
 windows; the straight tail is checked against its plain search in test_approach.py).
 
 Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
@@ -20,6 +20,7 @@ from scipy.signal import lfilter
 from scipy.spatial.transform import Rotation
 
 from bidmp._kernels import (
+    arclength,
     exact_state,
     forcing_target,
     goal_gate,
@@ -308,6 +309,27 @@ def test_the_resampling_scan_is_np_interp_to_the_bit():
         assert np.array_equal(_bits(out[finite]), _bits(expected[finite])), trial
     with pytest.raises(ValueError, match="rows"):
         interp_columns(np.zeros(2), np.zeros(3), np.zeros((2, 1)))
+
+
+def test_the_arc_length_pass_is_numpys_norms_summed_to_the_bit():
+    """Paths of one to seven dimensions (NumPy sums rows of eight or more pairwise: the library
+    keeps those in NumPy), at scales from µm to km, one sample, repeated samples and infinities."""
+    rng = np.random.default_rng(16)
+    for trial in range(600):
+        n_samples, n_dims = int(rng.integers(1, 400)), int(rng.integers(1, 8))
+        y = _random_motion(rng, n_samples, n_dims)
+        if trial % 5 == 0 and n_samples > 2:
+            y[1] = y[0]
+        if trial % 13 == 0:
+            y[rng.integers(0, n_samples), rng.integers(0, n_dims)] = rng.choice([np.inf, np.nan])
+        if trial % 3 == 0:
+            y = np.asfortranarray(y)
+        steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
+        expected = np.concatenate([[0.0], np.cumsum(steps)])
+        out = arclength(y)
+        assert np.array_equal(np.isnan(out), np.isnan(expected)), trial
+        finite = ~np.isnan(expected)
+        assert np.array_equal(_bits(out[finite]), _bits(expected[finite])), trial
 
 
 def _rotations(rng, n_rows: int) -> np.ndarray:

@@ -123,6 +123,16 @@ MUTANTS = (
         "scale = 0.5 - angle2 / 48 + angle2 * angle2 / 3840",
         "scale = 0.5 - angle2 / 48",
     ),
+    Mutant(
+        "arclength",
+        "squares = squares + step * step",
+        "squares = squares + step * abs(step)",
+    ),
+    Mutant(
+        "arclength",
+        "            squares = 0.0\n            for k in range(n_dims):",
+        "            squares = 1e-300\n            for k in range(n_dims):",
+    ),
 )
 
 

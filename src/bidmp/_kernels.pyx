@@ -10,10 +10,10 @@ one call, what whole chains of them did:
   (:func:`tail_start`), over how long a window its start and end velocity are blended out
   (:func:`rest_windows`) — each a search over candidates with an early exit;
 * the arithmetic the model's numbers come from — the spring's integration (:func:`second_order`,
-  SciPy's ``lfilter`` operation for operation), the forcing target (:func:`forcing_target`) and
-  the goal gate (:func:`goal_gate`), each element the same operations in the same order as the
-  NumPy expressions they replaced (compiled without fused multiply-adds), so every result keeps
-  its last bit. Powers and exponentials stay in NumPy: its vectorised ones are not the C
+  SciPy's ``lfilter`` operation for operation), the forcing target (:func:`forcing_target`), the
+  goal gate (:func:`goal_gate`) and a path's arc length (:func:`arclength`), each element the
+  same operations in the same order as the NumPy expressions they replaced (compiled without
+  fused multiply-adds), so every result keeps its last bit. Powers and exponentials stay in NumPy: its vectorised ones are not the C
   library's to the bit.
 
 The tests check each loop against an independent reference to the last bit (SciPy's ``lfilter``,
@@ -653,4 +653,23 @@ def quaternion_exp(const double[:, :] error, const double[:, :] goal):
                 _goal_row(goal, i if per_row else 0, g)
             _product(p, g, &out[i, 0])
             _normalised(&out[i, 0])
+    return out.base
+
+
+def arclength(const double[:, :] y):
+    """Cumulative arc length (T,) of a path ``y`` (T, D), from 0: NumPy's
+    ``concatenate([[0], cumsum(norm(diff(y, axis=0), axis=1))])`` in one pass, each step's norm the
+    square root of its squares summed in order, as NumPy's reduction over three columns sums them."""
+    cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
+    cdef double[::1] out = empty(max(n, 1))
+    cdef double squares, step, total = 0.0
+    with nogil:
+        out[0] = 0.0
+        for i in range(1, n):
+            squares = 0.0
+            for k in range(n_dims):
+                step = y[i, k] - y[i - 1, k]
+                squares = squares + step * step
+            total = total + sqrt(squares)
+            out[i] = total
     return out.base

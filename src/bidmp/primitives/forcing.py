@@ -254,8 +254,11 @@ def _solve_weights(
     if kind == "lwr":
         weights = (phi.T @ target) / values[:, None]
     else:
-        # LU rather than a cached Cholesky factor: the same numbers as before to the last bit
-        # (a simulated contact amplifies a last-bit change of the weights into the results).
+        # NumPy's LU each time, though the matrix is the same for every fit on this grid: a cached
+        # Cholesky factor or SciPy's cached LU moves the weights' last bits (a simulated contact
+        # can amplify those into the results: the Cholesky factor's did), and SciPy's OpenBLAS is
+        # a second thread pool, whose idle threads spun against NumPy's here (0.9 ms fits took
+        # 1-5 ms on two cores).
         weights = np.linalg.solve(values, phi.T @ target)
     if not np.all(np.isfinite(weights)):
         raise ValueError(
