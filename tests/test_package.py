@@ -86,6 +86,7 @@ LAYERS = {
     "_threads": 0,
     "_noise": 0,
     "_trajectory": 0,
+    "_savgol": 0,
     "_units": 0,
     "_lazy": 0,
     "_state": 0,

@@ -11,6 +11,7 @@ import numpy as np
 from ._checks import numerically_guarded
 from ._kernels import arclength as _arclength
 from ._kernels import interp_columns as _interp_columns
+from ._savgol import savgol_filter
 
 # NumPy sums a row of this many squares or more pairwise (in blocks of eight), not in order: such
 # rows stay with NumPy, so an arc length is the same to the bit either way.
@@ -35,15 +36,6 @@ def arclength(y: np.ndarray) -> np.ndarray:
         return _arclength(y)  # one compiled pass; a fit measures two paths (24 µs each in NumPy)
     steps = np.linalg.norm(np.diff(y, axis=0), axis=1)
     return np.concatenate([[0.0], np.cumsum(steps)])
-
-
-def savgol_filter(*args, **kwargs) -> np.ndarray:
-    """:func:`scipy.signal.savgol_filter` (the same arguments), importing SciPy's signal package
-    at the first call: it and the statistics it imports are 0.3 s of a command's start-up, which a
-    run that never smooths a path (the 14-nut job) does not pay."""
-    from scipy.signal import savgol_filter as scipy_savgol_filter
-
-    return scipy_savgol_filter(*args, **kwargs)
 
 
 def interp_columns(x_new: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
