@@ -1,4 +1,9 @@
-"""Shared fixtures: smooth demonstrations that start and end at rest."""
+"""Shared fixtures: smooth demonstrations that start and end at rest, and a fresh interpreter's
+imports."""
+
+import ast
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -30,3 +35,19 @@ def demo3d():
 @pytest.fixture
 def demo2d():
     return curved_demo(400, 2, seed=1)
+
+
+def _loaded_after(code: str, modules: tuple[str, ...]) -> list[str]:
+    """Which of ``modules`` a new interpreter has imported after running ``code`` (sorted)."""
+    script = f"{code}\nimport sys\nprint(sorted(m for m in {modules!r} if m in sys.modules))"
+    result = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True
+    )
+    return ast.literal_eval(result.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture
+def loaded_after():
+    """``loaded_after(code, modules)``: the modules of ``modules`` that ``code`` imports when run
+    in a new interpreter (what a command's start-up pays for)."""
+    return _loaded_after

@@ -50,30 +50,21 @@ def test_a_packages_public_names_are_the_imports_editors_see(package):
         assert getattr(module, name) is getattr(importlib.import_module(source), attribute), name
 
 
-def test_the_dmp_class_imports_neither_scikit_learn_nor_scipys_signal_package():
+def test_the_dmp_class_imports_neither_scikit_learn_nor_scipys_signal_package(loaded_after):
     """``import bidmp; bidmp.DMP`` takes 0.11 s: scikit-learn's ``base`` (0.6 s with the SciPy
-    statistics it pulls in) is not imported for the estimators' conventions, and SciPy's signal
-    package (0.4 s) only at the first rollout; a fitted DMP still clones with scikit-learn."""
-    code = (
-        "import sys, bidmp; bidmp.DMP; bidmp.BiDMP; bidmp.CartesianDMP\n"
-        "print(sorted(m for m in ('sklearn', 'scipy.signal', 'scipy.stats') if m in sys.modules))"
-    )
-    result = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True
-    )
-    assert result.stdout.strip() == "[]", result.stdout
+    statistics it pulls in) is not imported for the estimators' conventions, nor SciPy's signal
+    package (0.4 s); a fitted DMP still clones with scikit-learn."""
+    code = "import bidmp; bidmp.DMP; bidmp.BiDMP; bidmp.CartesianDMP"
+    assert loaded_after(code, ("sklearn", "scipy.signal", "scipy.stats")) == []
     from sklearn.base import clone
 
     model = bidmp.DMP(n_kernels=12, alpha=30.0)
     assert clone(model).get_params() == model.get_params()
 
 
-def test_import_and_cli_help_do_not_import_numpy():
-    code = "import sys, bidmp, bidmp.cli; bidmp.cli.build_parser(); print('numpy' in sys.modules)"
-    result = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True
-    )
-    assert result.stdout.strip() == "False"
+def test_import_and_cli_help_do_not_import_numpy(loaded_after):
+    code = "import bidmp, bidmp.cli; bidmp.cli.build_parser()"
+    assert loaded_after(code, ("numpy",)) == []
 
 
 # Layers of docs/architecture.md, by subpackage: a module may import only from its own or lower-numbered

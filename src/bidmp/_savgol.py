@@ -58,7 +58,8 @@ def savgol_filter(
     if (
         mode != "interp"
         or array.dtype != np.float64
-        or not _integral(window_length, polyorder, deriv)
+        or not _integral(window_length, polyorder, deriv, axis)
+        or not -array.ndim <= axis < array.ndim
         or window_length > array.shape[axis]
         or not 0 <= polyorder < window_length
         or deriv < 0
