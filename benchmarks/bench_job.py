@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from bidmp.sim import simulate
+from bidmp.sim import execution_report, simulate
 from bidmp.sim.job import run_job
 from bidmp.tasks import evaluate, scenarios
 
@@ -39,7 +39,7 @@ def main() -> int:
         "nut": evaluate(nut.with_robot_protocol(), ["bidmp"], geometry=False),
         "cells": evaluate(cells.with_robot_protocol(), ["bidmp"], geometry=False),
     }
-    sim_report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
+    sim_report = execution_report(nut, ["dmp", "bidmp"])
     factors = {"nut job": [], "cell job": [], "sim 1 worker": [], "sim 2 workers": []}
     for _ in range(args.repeats):  # each round runs every side once: load drift falls on all alike
         for name, scenario, key in (("nut job", nut, "nut"), ("cell job", cells, "cells")):

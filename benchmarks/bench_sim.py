@@ -17,12 +17,12 @@ import tempfile
 import time
 
 from bidmp import sim
-from bidmp.tasks import evaluate, scenarios
+from bidmp.tasks import scenarios
 
 
 def main() -> int:
     scenario = scenarios.load("nut-unscrewing")
-    report = evaluate(scenario, ["dmp", "bidmp"], geometry=False)
+    report = sim.execution_report(scenario, ["dmp", "bidmp"])
     print("nut-unscrewing on the simulated Panda, dmp + bidmp, 28 motions")
     for workers in (1, 2):
         result = sim.simulate(scenario, ["dmp", "bidmp"], report=report, workers=workers)
@@ -32,7 +32,7 @@ def main() -> int:
         )
     # The defaults a user meets: the robot protocol's skills (timed, settling at rest).
     robot = scenario.with_robot_protocol()
-    robot_report = evaluate(robot, ["dmp", "bidmp"], geometry=False)
+    robot_report = sim.execution_report(robot, ["dmp", "bidmp"])
     result = sim.simulate(robot, ["dmp", "bidmp"], report=robot_report, workers=2)
     print(
         f"  robot protocol (defaults), 2 worker processes: simulated {result.simulated_s:6.1f} s in "

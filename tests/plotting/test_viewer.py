@@ -59,7 +59,7 @@ def nut_layers():
     from bidmp import sim
 
     nut = scenarios.load("nut-unscrewing")
-    report = evaluate(nut, ["dmp", "bidmp"], geometry=False)
+    report = sim.execution_report(nut, ["dmp", "bidmp"])
     result = sim.simulate(
         nut, ["bidmp"], targets=["11"], report=report, workers=1, views=[("bidmp", "11")]
     )

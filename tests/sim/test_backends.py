@@ -21,6 +21,7 @@ from bidmp.sim import (
     Hold,
     KinematicCell,
     backend_names,
+    execution_report,
     get_backend,
     register_backend,
     run_job,
@@ -63,7 +64,7 @@ def test_the_ideal_arm_ends_where_the_evaluated_rollout_ends(nuts):
     rollout's own (computed here from the rollout, not by the simulator), and the whole measured
     path stays on the planned joint spline's tool path."""
     labels = ["1", "7", "12"]
-    report = tasks.evaluate(nuts, ["dmp", "bidmp"], geometry=False)
+    report = execution_report(nuts, ["dmp", "bidmp"])
     result = simulate(
         nuts, ["dmp", "bidmp"], targets=labels, backend="kinematic", report=report, record=True
     )
@@ -174,7 +175,7 @@ def test_the_closed_loop_on_the_ideal_arm_sends_commands_within_the_limits_along
     from scipy.spatial import cKDTree
 
     robot = nuts.with_robot_protocol()
-    report = tasks.evaluate(robot, ["bidmp"], geometry=False)
+    report = execution_report(robot, ["bidmp"])
     result = simulate(
         robot,
         ["bidmp"],

@@ -25,7 +25,7 @@ def iiwa():
 
 
 def test_the_iiwa_runs_the_nut_task_within_its_own_limits(iiwa):
-    report = evaluate(iiwa, ["bidmp"], geometry=False)
+    report = sim.execution_report(iiwa, ["bidmp"])
     labels = ["1", "11", "12"]  # the demonstration's start side, and the two furthest nuts
     result = sim.simulate(iiwa, ["bidmp"], targets=labels, report=report, workers=1)
     assert result.robot == "iiwa" and result.limits == sim.IIWA

@@ -12,7 +12,7 @@ pytest.importorskip("pybullet")
 
 from bidmp import sim  # noqa: E402
 from bidmp.cli import main  # noqa: E402
-from bidmp.tasks import evaluate, scenarios  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
 
 RESULTS = pathlib.Path(__file__).resolve().parents[2] / "docs" / "results"
 
@@ -24,7 +24,7 @@ def nut():
 
 @pytest.fixture(scope="module")
 def nut_report(nut):
-    return evaluate(nut, ["dmp", "bidmp"], geometry=False)
+    return sim.execution_report(nut, ["dmp", "bidmp"])
 
 
 @pytest.fixture(scope="module")

@@ -59,14 +59,15 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
     workers=None,
     pictures=True,
     targets=None,
-    report=None,
     avoid=False,
     goal_update=None,
     view=False,
     backend=None,
 ):
     """Execute a scenario on the simulated arm with a progress bar; print and write the results
-    (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it)."""
+    (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it). The
+    simulator evaluates the motions it executes itself (judged and repaired with room for the
+    arm's tracking): no flag here changes what runs, and the viewer draws that evaluation."""
     from tqdm import tqdm
 
     from ..sim.report import write_sim_report
@@ -77,10 +78,6 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
     origin = scenario.targets[scenario.demonstrated]
     far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
     frames = {(method, far): 30 for method in methods} if pictures else {}
-    if view and report is None:
-        from ..tasks.evaluation import evaluate
-
-        report = evaluate(scenario, methods, geometry=False)
     with tqdm(
         total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None
     ) as bar:
@@ -99,7 +96,6 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
                 targets=targets,
                 frames=frames,
                 progress=progress,
-                report=report,
                 avoid=avoid,
                 goal_update=goal_update,
                 views={(method, far) for method in methods} if view else (),
@@ -111,7 +107,7 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
     if view:
         from .view import write_view_files
 
-        written += write_view_files(out, report=report, sim_result=result)
+        written += write_view_files(out, report=result.evaluation, sim_result=result)
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     print_real_time(result.simulated_s)
     return result
@@ -154,7 +150,6 @@ def _cmd_demo(args: argparse.Namespace) -> int:
             scenario,
             out,
             sim_methods,
-            report=report if set(sim_methods) <= set(report.methods) else None,
             view=args.view,
             backend=args.backend,
         )

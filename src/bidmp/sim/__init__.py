@@ -53,5 +53,5 @@ if TYPE_CHECKING:
         robot_model,
         robot_placement,
     )
-    from .run import simulate, target_labels
+    from .run import execution_report, execution_settings, simulate, target_labels
 __getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -206,6 +206,7 @@ class SimReport:
         default_factory=dict
     )  # (method, label) -> {"times", "links"}: the viewer's arm
     simulator: str = "PyBullet, 1 kHz position control"  # the backend's own words, for the summary
+    evaluation: object = None  # the evaluation whose motions ran (bidmp.sim.execution_report)
 
     @property
     def _short_name(self) -> str:

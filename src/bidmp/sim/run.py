@@ -28,7 +28,7 @@ from .robots import (
     robot_placement,
 )
 
-__all__ = ["simulate", "target_labels"]
+__all__ = ["execution_report", "execution_settings", "simulate", "target_labels"]
 
 logger = logging.getLogger(__name__)
 
@@ -220,7 +220,9 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
     frames : dict, optional
         ``{(method, label): n}``: render n frames of those motions (PyBullet's TinyRenderer).
     report : bidmp.tasks.evaluation.Report, optional
-        A finished evaluation of the same scenario to take the rollouts from.
+        The motions to execute, from :func:`execution_report` of the same scenario (evaluated
+        once for several calls); default: evaluated here the same way. A report judged any
+        other way is refused: what runs is what the contract judged and repaired.
     workers : int, optional
         Worker processes, each with its own PyBullet world (default: one per core, at most 2;
         1 runs in this process). Results do not depend on it.
@@ -239,8 +241,6 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         (``path``, scene units) and the joint commands it was sent every 1 ms (``commands``, rad),
         for a check of one's own.
     """
-    from ..tasks.evaluation import evaluate
-
     scenario, backend = _scenario_and_backend(scenario, backend)
     methods, labels = _checked(scenario, methods, targets, closed_loop)
     coupling = (
@@ -258,11 +258,8 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         )
         scenario = scenario.with_robot_protocol()
         if report is not None and report.scenario.protocol != "robot":
-            report = None
-    if (
-        report is None
-    ):  # the motions to run, repaired where they break the contract, planned with room for tracking
-        report = evaluate(scenario, methods, allowance=mm(TRACKING_ALLOWANCE_MM, scenario.units))
+            report = None  # the skills it holds are the paper protocol's: learned again
+    report = _executable(scenario, methods, report)
     base, yaw = robot_placement(scenario)
     arm = robot_model(scenario.robot, scenario.base_dir)
     jobs = _jobs(
@@ -299,9 +296,74 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         for job in skipped
     ]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
+    out.evaluation = report
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
     return out
+
+
+def execution_settings(scenario) -> dict:
+    """How :func:`simulate` judges and repairs the motions it executes (the ``settings`` of the
+    :class:`~bidmp.tasks.evaluation.Report` it runs): the scene's geometry checked, the motions
+    that break the contract repaired (unless the scenario takes the paper's approach), the
+    repairs planned with :data:`TRACKING_ALLOWANCE_MM` of room for the arm's tracking."""
+    return {
+        "geometry": scenario.scene is not None,
+        "repair": scenario.scene is not None
+        and scenario.extension.get("approach", "keep") == "keep",
+        "allowance": mm(TRACKING_ALLOWANCE_MM, scenario.units),
+    }
+
+
+def execution_report(scenario, methods=("dmp", "bidmp")):
+    """The evaluation whose motions :func:`simulate` executes: every motion judged by the
+    contract and repaired where it breaks it, with room for the arm's tracking. Evaluate once
+    and hand it to several :func:`simulate` calls (``report=``); a report judged any other way
+    (``evaluate(geometry=False)``, no repairs) is refused there, so that what runs on the arm
+    is always what this judged and repaired, whatever else a caller asks for (pictures, the
+    viewer, a subset of the targets, workers, the backend)."""
+    from ..tasks import scenarios as scenario_module
+    from ..tasks.evaluation import evaluate
+
+    if not isinstance(scenario, scenario_module.Scenario):
+        scenario = scenario_module.load(scenario)
+    settings = execution_settings(scenario)
+    return evaluate(
+        scenario, list(methods), repair=settings["repair"], allowance=settings["allowance"]
+    )
+
+
+def _executable(scenario, methods, report):
+    """``report`` if its motions may be executed for ``scenario`` and ``methods`` (else a
+    ValueError saying why), or a new :func:`execution_report` when it is None."""
+    if report is None:
+        return execution_report(scenario, methods)
+    settings = getattr(report, "settings", None)
+    if not isinstance(settings, dict) or not hasattr(report, "methods"):
+        raise TypeError(
+            f"report must be a bidmp evaluation Report (bidmp.sim.execution_report), got "
+            f"{type(report).__name__}"
+        )
+    wanted = execution_settings(scenario)
+    if report.scenario.name != scenario.name or report.scenario.units != scenario.units:
+        raise ValueError(
+            f"report: an evaluation of scenario {report.scenario.name!r} "
+            f"({report.scenario.units}), not of {scenario.name!r} ({scenario.units})"
+        )
+    if settings != wanted:
+
+        def said(values: dict) -> str:
+            return ", ".join(f"{key}={value!r}" for key, value in values.items())
+
+        raise ValueError(
+            f"report: judged with {said(settings)}; the simulator executes only motions judged "
+            f"and repaired with {said(wanted)} (allowance in {scenario.units}): pass "
+            "bidmp.sim.execution_report(scenario, methods), or no report"
+        )
+    missing = [name for name in methods if name not in report.methods]
+    if missing:
+        raise ValueError(f"report: has no motions of {', '.join(missing)}")
+    return report
 
 
 def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:

@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+from .._checks import check_bool, check_real
 from .._progress import report
 from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
@@ -270,17 +271,20 @@ def evaluate(
         bidmp=scenario.bidmp,
         poses=scenario.is_pose,
     )
-    report = Report(scenario=scenario, methods={})
+    if repair is None:
+        repair = scenario.extension.get("approach", "keep") == "keep"
+    geometry = check_bool(geometry, "geometry") and scenario.scene is not None
+    repair = check_bool(repair, "repair") and geometry
+    allowance = check_real(allowance, "allowance", nonnegative=True)
+    report = Report(
+        scenario=scenario,
+        methods={},
+        settings={"geometry": geometry, "repair": repair, "allowance": allowance},
+    )
     report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
     task.build_skills = _skills_builder(scenario, failed, report)
     result = _results_builder(scenario, labels, geometry)
-    if repair is None:
-        repair = scenario.extension.get("approach", "keep") == "keep"
-    repairer = (
-        _repairer(scenario, allowance)
-        if repair and geometry and scenario.scene is not None
-        else None
-    )
+    repairer = _repairer(scenario, allowance) if repair else None
     for name in names:
         if progress is not None:
             progress(name)

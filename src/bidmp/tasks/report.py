@@ -220,6 +220,9 @@ class Report:
     forgetting: dict = field(
         default_factory=dict
     )  # skill -> ForgettingResult (several demonstrations)
+    # How the motions were judged and repaired: {"geometry", "repair", "allowance"} as evaluate
+    # resolved them. The simulator executes a report's motions only when these are its own.
+    settings: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """The report JSON: per method its counts and per target its verdict (plus the extension and forgetting details)."""
