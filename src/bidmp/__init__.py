@@ -65,6 +65,7 @@ if TYPE_CHECKING:
         Limits,
         MissingExtraError,
         NotFittedError,
+        TaskRefusal,
         get_limits,
         set_limits,
     )

@@ -30,6 +30,7 @@ __all__ = [
     "check_options",
     "NotFittedError",
     "MissingExtraError",
+    "TaskRefusal",
     "require_extra",
     "Limits",
     "get_limits",
@@ -237,6 +238,13 @@ def require_extra(module: str, extra: str, what: str):
         raise MissingExtraError(
             f"{module}, needed for {what}, is not installed: pip install 'bidmp[{extra}]'"
         ) from None
+
+
+class TaskRefusal(ValueError):
+    """The library declines a motion for a reason of the task, not of the code: a target out of
+    the arm's reach, past a joint limit, no collision-free route, a coupled motion held short by
+    the parts. A job reports it as that target's failure and goes on; any other exception there
+    is a bug and stops the job as an internal error."""
 
 
 class NotFittedError(ValueError, AttributeError):

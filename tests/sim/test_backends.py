@@ -221,3 +221,51 @@ def test_the_commands_real_time_factor_is_the_whole_commands(tmp_path, capsys):
         # the printed times are rounded to 0.1 s, the factor to 0.1
         low = (simulated - 0.05) / (elapsed + 0.05) - 0.05
         assert low <= factor <= (simulated + 0.05) / max(elapsed - 0.05, 1e-3) + 0.05
+
+
+def test_a_bug_in_a_cycle_is_an_internal_error_not_a_failed_target(
+    nuts, monkeypatch, capsys, tmp_path
+):
+    """A planted bug (a ValueError where the engagement is measured, as a wrong shape would raise)
+    stops the job: exit 1 from the command, naming the target and the phase; a refusal of the
+    task's (an unreachable target, a SimError) is still that target's row and the job goes on."""
+    from bidmp.cli import main
+    from bidmp.sim import JobInternalError, SimError
+    from bidmp.sim import job as job_module
+
+    def broken(world, part, target):
+        raise ValueError("operands could not be broadcast together with shapes (3,) (2,)")
+
+    monkeypatch.setattr(job_module, "_engaged", broken)
+    with pytest.raises(JobInternalError, match=r"target 3 \(approach\): ValueError: operands"):
+        run_job(nuts, targets=["3", "4"], backend="kinematic")
+    code = main(
+        [
+            "job",
+            "--targets",
+            "3",
+            "--backend",
+            "kinematic",
+            "--no-pictures",
+            "--out",
+            "/tmp/bidmp-job-bug",
+        ]
+    )
+    assert code == 1
+    assert "internal error" in capsys.readouterr().err
+    monkeypatch.undo()
+
+    calls = []
+    original = job_module._approach
+
+    def unreachable_once(world, label, target, axis):
+        calls.append(label)
+        if label == "3":
+            raise SimError("target 3 is unreachable for the arm (a refusal of the task's)")
+        return original(world, label, target, axis)
+
+    monkeypatch.setattr(job_module, "_approach", unreachable_once)
+    report = run_job(nuts, targets=["3", "4"], backend="kinematic")
+    rows = {target.label: target for target in report.targets}
+    assert "unreachable" in rows["3"].reason and not rows["3"].removed
+    assert rows["4"].removed and calls == ["3", "4"]

@@ -27,6 +27,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from .._checks import (
+    TaskRefusal,
     as_point,
     as_trajectory,
     check_callable,
@@ -53,7 +54,7 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 
-class NoFreeRouteError(ValueError):
+class NoFreeRouteError(TaskRefusal):
     """The roadmap found no collision-free route (never a path through an obstacle)."""
 
 

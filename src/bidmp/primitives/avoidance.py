@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from .._checks import as_labels, check_choice, check_real
+from .._checks import TaskRefusal, as_labels, check_choice, check_real
 from .coupling import CouplingTerm
 
 __all__ = ["SceneAvoidance", "AvoidanceError"]
@@ -51,7 +51,7 @@ _NEAREST = 1e-3  # of the influence distance: p below it counts as this (the ter
 _BARRIER_CAP = 1e3  # the barrier's factor ρ/p - 1 at most this (without a limit)
 
 
-class AvoidanceError(ValueError):
+class AvoidanceError(TaskRefusal):
     """A coupled motion that comes closer to a part than the margin, or that the parts hold short
     of its goal. ``trajectory`` is the motion, ``clearance`` its :class:`bidmp.scene.Clearance`."""
 

@@ -36,7 +36,7 @@ if TYPE_CHECKING:
         register_backend,
         require_simulator,
     )
-    from .job import job_targets, run_job
+    from .job import JobInternalError, job_targets, run_job
     from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot, write_job_report
     from .kinematic import KinematicCell
     from .kinematics import inverse_kinematics, joint_names

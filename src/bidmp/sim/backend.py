@@ -20,7 +20,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .._checks import as_point, as_vector, check_int, check_real, short_token
+from .._checks import TaskRefusal, as_point, as_vector, check_int, check_real, short_token
 
 __all__ = [
     "require_simulator",
@@ -52,7 +52,7 @@ RECORD_EVERY = 2  # physics steps per recorded sample (500 Hz); contacts are che
 SETTLE = 0.3  # s held at the end before the end point is measured
 
 
-class SimError(ValueError):
+class SimError(TaskRefusal):
     """A motion cannot be executed (unreachable, outside the joint limits); names the target."""
 
 

@@ -26,13 +26,20 @@ import time
 
 import numpy as np
 
+from .._checks import TaskRefusal
 from .._units import mm
 from ..tasks.contract import Contract
 from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
 from .job_world import _body, _move, _StepFailed, _transfer, _transfer_contract, _World
 
-__all__ = ["run_job", "job_targets"]
+__all__ = ["JobInternalError", "run_job", "job_targets"]
+
+
+class JobInternalError(RuntimeError):
+    """A job stopped by an exception that is not one of the task's refusals (a bug): the
+    command's internal error, exit status 1, naming the target and the phase it happened in."""
+
 
 RELEASE_S = 0.6  # s the world runs after a part is let go, for it to come to rest
 
@@ -561,9 +568,16 @@ def run_job(
             try:
                 cycle = _nut_cycle if scenario.job.kind == "unscrew" else _lift_cycle
                 cycle(world, label, scenario.targets[label], scenario.target_axis(label), record)
-            except (_StepFailed, ValueError) as exc:  # a SimError (unreachable) is a ValueError
+            except (_StepFailed, TaskRefusal) as exc:  # the task's reasons: the target's row
                 record.reason = str(exc)
                 _let_go(world)
+            except Exception as exc:
+                # Anything else is a bug: a row would hide it as a failed target (and the next
+                # targets would start from a state nobody judged).
+                phase = record.phases[-1].name if record.phases else "approach"
+                raise JobInternalError(
+                    f"internal error at target {label} ({phase}): {type(exc).__name__}: {exc}"
+                ) from exc
             done.append(record)
             if world.motion:  # the first cycle only
                 motions = {
