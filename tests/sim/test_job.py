@@ -73,11 +73,18 @@ def test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted():
         }
         for label, x, dx in (("3", 0, 0), ("a", 60, 0), ("b", 120, 2.0))
     ]
-    report = run_job(scenarios.from_dict(spec), targets=["a", "b"])
+    report = run_job(scenarios.from_dict(spec), targets=["a", "b"], record=True)
     by_label = {target.label: target for target in report.targets}
     assert by_label["a"].removed and not by_label["b"].removed and report.removed == 1
     assert by_label["b"].reason.startswith("engage: the tool is 2.00 mm off the part's axis")
-    assert [phase.name for phase in by_label["b"].phases] == ["approach", "engage"]
+    # The socket is on the nut: before anything else moves, it leaves straight up the target's
+    # axis to the approach height (28.5 mm over the nut's top), judged like any move.
+    assert [phase.name for phase in by_label["b"].phases] == ["approach", "engage", "leave"]
+    leave = by_label["b"].phases[-1]
+    assert leave.ok and leave.verdict.ok and leave.seconds > 0
+    start, end = leave.path[0], leave.path[-1]
+    assert end[2] == pytest.approx(28.5, abs=0.5) and start[2] < 2.0
+    assert np.linalg.norm(leave.path[:, :2] - start[:2], axis=1).max() < 0.5
 
 
 def test_a_part_released_outside_the_bin_is_reported(monkeypatch):

@@ -30,6 +30,20 @@ class StraightLine(Method):
         return start + np.linspace(0.0, 1.0, n_samples)[:, None] * (goal - start)
 
 
+class LineThenDown(StraightLine):
+    """Straight to 40 mm over the goal, then straight down onto it (as a socket must come)."""
+
+    name = "test-line-down"
+
+    def rollout(self, model, goal):
+        start, n_samples = model
+        over = goal + np.array([0.0, 0.0, 40.0])
+        half = n_samples // 2
+        first = start + np.linspace(0.0, 1.0, half)[:, None] * (over - start)
+        down = over + np.linspace(0.0, 1.0, n_samples - half + 1)[1:, None] * (goal - over)
+        return np.vstack([first, down])
+
+
 @pytest.fixture
 def line():
     method = registry.register(StraightLine())
@@ -88,9 +102,16 @@ def test_a_registered_method_runs_in_the_simulator(line):
     # from the target depends on the contact dynamics, not on the registry under test).
     scenario = scenarios.load("nut-unscrewing")
     label = "3"
-    report = sim.simulate(scenario, ["test-line"], targets=[label], workers=1)
-    assert not report.methods["test-line"].targets[label].contacts
-    measured = report.methods["test-line"].targets[label]
+    down = registry.register(LineThenDown())
+    try:
+        report = sim.simulate(scenario, ["test-line", down.name], targets=[label], workers=1)
+    finally:
+        registry.unregister(down.name)
+    # The plain line comes down diagonally onto the nut: the contract refuses it, so it never runs.
+    refused = report.methods["test-line"].targets[label]
+    assert not refused.ran and "off the target's axis" in refused.error
+    assert not report.methods[down.name].targets[label].contacts
+    measured = report.methods[down.name].targets[label]
     assert measured.commanded_error <= 1e-6  # the line itself ends at the target...
     assert measured.measured_error <= 1.0  # ...and so does the simulated arm (mm)
     with pytest.raises(ValueError, match="test-line has none"):

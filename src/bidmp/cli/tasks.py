@@ -71,13 +71,15 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
     from tqdm import tqdm
 
     from ..sim.report import write_sim_report
-    from ..sim.run import simulate, target_labels
+    from ..sim.run import execution_report, simulate, target_labels
 
     methods = list(methods)
     labels = target_labels(scenario, targets)
-    origin = scenario.targets[scenario.demonstrated]
-    far = max(labels, key=lambda label: float(((scenario.targets[label] - origin) ** 2).sum()))
-    frames = {(method, far): 30 for method in methods} if pictures else {}
+    run_as = scenario.with_robot_protocol() if closed_loop else scenario
+    with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
+        report = execution_report(run_as, methods)
+    pictured = {(method, _pictured_target(scenario, report, method, labels)) for method in methods}
+    frames = {pair: 30 for pair in pictured} if pictures else {}
     with tqdm(
         total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None
     ) as bar:
@@ -86,10 +88,11 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
             bar.set_postfix_str(f"{method} {label}")
             bar.update(1)
 
-        with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
+        with progress_bars():
             result = simulate(
                 scenario,
                 methods,
+                report=report,
                 closed_loop=closed_loop,
                 hold=hold,
                 workers=workers,
@@ -98,7 +101,7 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
                 progress=progress,
                 avoid=avoid,
                 goal_update=goal_update,
-                views={(method, far) for method in methods} if view else (),
+                views=pictured if view else (),
                 backend=backend,
             )
     print()
@@ -111,6 +114,19 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     print_real_time(result.simulated_s)
     return result
+
+
+def _pictured_target(scenario, report, method, labels) -> str:
+    """The target whose motion of ``method`` is pictured: the farthest from the demonstrated one
+    that its motion runs to (the contract refuses it none), else the farthest. Where two
+    methods' pictured targets are the same, their motions are also shown side by side."""
+    origin = scenario.targets[scenario.demonstrated][:3]
+
+    def distance(label) -> float:
+        return float(((scenario.targets[label][:3] - origin) ** 2).sum())
+
+    running = [label for label in labels if report.methods[method].verdicts[label].ok]
+    return max(running or labels, key=distance)
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:

@@ -380,6 +380,36 @@ def _release(world: _World) -> np.ndarray:
     return centre
 
 
+def _leave(world: _World, label: str, target, axis, record: JobTarget) -> str:
+    """After a failed step with the tool at the part (within the approach height above it, the
+    socket on or near it): the tool first leaves along the part's own axis to the approach
+    height, a move judged like any other, so that the next approach does not start from inside
+    the part and drag the tool through it. Returns "" when the tool is free, else why it is not
+    (then nothing else moves: the remaining targets are not attempted)."""
+    height = world.scenario.approach_height
+    if height is None:
+        return ""
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    offset = world.tcp - np.asarray(target, dtype=float)[:3]
+    above = float(np.dot(offset, axis))
+    across = float(np.linalg.norm(offset - above * axis))
+    near = across <= 2.0 * float(world.scene.tool.radius) + world.scene.margin
+    if not near or above >= height:
+        return ""
+    exclude = world.scenario.scene.target_parts(label, np.asarray(target)[:3]) + world.gone
+    held = world.held if world.held is not None and world.held.state == "held" else None
+    try:
+        phase = _straight(world, axis, height - above, exclude, "leave", held)
+    except TaskRefusal as exc:
+        phase = JobPhase("leave", False, 0.0, f"not run: {exc}")
+    record.phases.append(phase)
+    if phase.ok:
+        return ""
+    why = phase.verdict.reason() if phase.verdict is not None else phase.note
+    return f"after target {label} failed, the tool could not leave it along its axis: {why}"
+
+
 def _let_go(world: _World) -> None:
     """After a failed step: a part still in the tool is let go where it is (reported with its
     target), so that the next target starts with an empty tool."""
@@ -560,16 +590,22 @@ def run_job(
         cell.add_solids([solid for solid in scene.solids if solid.part in added])
         world = _job_world(scenario, report, cell, scene, pictures, view)
         world.record = record
-        done, motions = [], {}
+        done, motions, stuck = [], {}, ""
         for label in _order(scenario, labels):
             if progress is not None:
                 progress(label)
             record = JobTarget(label)
+            if stuck:  # the tool could not leave a failed target: nothing else may move
+                record.reason = f"not attempted: {stuck}"
+                done.append(record)
+                continue
+            target, axis = scenario.targets[label], scenario.target_axis(label)
             try:
                 cycle = _nut_cycle if scenario.job.kind == "unscrew" else _lift_cycle
-                cycle(world, label, scenario.targets[label], scenario.target_axis(label), record)
+                cycle(world, label, target, axis, record)
             except (_StepFailed, TaskRefusal) as exc:  # the task's reasons: the target's row
                 record.reason = str(exc)
+                stuck = _leave(world, label, target, axis, record)
                 _let_go(world)
             except Exception as exc:
                 # Anything else is a bug: a row would hide it as a failed target (and the next

@@ -107,6 +107,13 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
         plan.peak_velocity *= scale
         plan.peak_acceleration *= scale**2
         plan.peak_jerk *= scale**3
+    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
+    goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]
+    refused = _refused_plan(
+        world, plan, contract, path, goal, name, axis, exclude, orientations, carried, support
+    )
+    if refused is not None:
+        return refused
     touched = {}
     if carried is not None:
 
@@ -126,7 +133,6 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     executed = run.tcp / cell.unit
     tool_frames = run.tcp_orientation if world.pose else None
     clearance = _clearance(world, executed, exclude, carried, tool_frames, support)
-    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
     phase.verdict = contract.judge(
         executed,
         executed[-1] if target is None else np.asarray(target)[:3],
@@ -142,6 +148,36 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     if world.record:
         phase.path, phase.commands = executed, np.asarray(run.commands)
     world.clock += phase.seconds
+    return phase
+
+
+def _refused_plan(  # noqa: PLR0913 - what _move judges its plan by, passed on whole
+    world: _World, plan, contract, path, goal, name, axis, exclude, orientations, carried, support
+) -> JobPhase | None:
+    """The phase of a motion the contract refuses before it runs (None: it may run): the planned
+    tool path judged as the executed one will be (its end, the final descent of an approach,
+    the clearance of the tool and of a carried part), and the plan's joint peaks against the
+    limits. A refused motion is never sent to the arm: it costs no simulated time."""
+    planned = np.asarray(path, dtype=float)[:, :3]
+    clearance = _clearance(world, planned, exclude, carried, orientations, support)
+    verdict = contract.judge(
+        planned,
+        goal,
+        label=name,
+        axis=axis,
+        exclude=exclude,
+        orientations=orientations if world.pose else None,
+        clearance=clearance,
+    )
+    peaks = (plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
+    over = [kind for kind, peak in zip(("velocity", "acceleration", "jerk"), peaks) if peak > 1.0]
+    if verdict.ok and not over:
+        return None
+    why = verdict.reason() if not verdict.ok else f"its planned joint {over[0]} exceeds the limit"
+    phase = JobPhase(name, False, 0.0, f"not run: the contract refuses its plan: {why}")
+    phase.verdict = verdict if not verdict.ok else None
+    phase.peaks = peaks
+    phase.within_limits = not over
     return phase
 
 

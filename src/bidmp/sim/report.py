@@ -172,6 +172,11 @@ class SimMethod:
         return sum(t.within_limits for t in self.targets.values())
 
     @property
+    def sent(self) -> int:
+        """Motions sent to the arm (the others were refused by the contract, or out of reach)."""
+        return sum(t.ran for t in self.targets.values())
+
+    @property
     def aligned(self) -> int | None:
         values = [t.aligned for t in self.targets.values()]
         return None if any(v is None for v in values) else sum(values)
@@ -184,6 +189,7 @@ class SimMethod:
             "aligned": self.aligned,
             "contacts": self.contacts,
             "within_limits": self.within_limits,
+            "sent": self.sent,
             "n_targets": len(self.targets),
             "targets": {label: t.to_dict(self.threshold) for label, t in self.targets.items()},
         }
@@ -240,7 +246,7 @@ class SimReport:
     def rows(self) -> tuple[list[str], list[list[str]]]:
         poses = any(method.aligned is not None for method in self.methods.values())
         header = (
-            ["method", "end point", "engaged"]
+            ["method", "sent to the arm", "end point", "engaged"]
             + (["aligned"] if poses else [])
             + [
                 "contacts",
@@ -256,6 +262,7 @@ class SimReport:
             times = [t.motion_time for t in method.targets.values() if t.ran] or [0.0]
             row = [
                 name,
+                f"{method.sent}/{n}",
                 f"{method.end_successes}/{n}",
                 "-" if method.engaged is None else f"{method.engaged}/{n}",
             ]

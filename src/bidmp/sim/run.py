@@ -286,13 +286,26 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
             f"hold: joint {hold.joint + 1} of an arm with {_world(setup).limits.n_joints} joints"
         )
     unreachable = _unreachable(setup, scenario, labels)
-    skipped = [job for job in jobs if job.label in unreachable]
-    jobs = [job for job in jobs if job.label not in unreachable]
+    refusals = {
+        (job.method, job.label): unreachable[job.label]
+        if job.label in unreachable
+        else _refusal(report, job.method, job.label)
+        for job in jobs
+    }
+    skipped = [job for job in jobs if refusals[(job.method, job.label)]]
+    jobs = [job for job in jobs if not refusals[(job.method, job.label)]]
     n_workers = _n_workers(workers, max(len(jobs), 1))
     start = time.perf_counter()
     outcomes = _execute_jobs(setup, jobs, n_workers, progress) if jobs else []
     outcomes += [
-        (job.method, job.label, SimTarget.not_run(job.label, unreachable[job.label]), [], 0.0, None)
+        (
+            job.method,
+            job.label,
+            SimTarget.not_run(job.label, refusals[(job.method, job.label)]),
+            [],
+            0.0,
+            None,
+        )
         for job in skipped
     ]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
@@ -364,6 +377,16 @@ def _executable(scenario, methods, report):
     if missing:
         raise ValueError(f"report: has no motions of {', '.join(missing)}")
     return report
+
+
+def _refusal(report, method: str, label: str) -> str:
+    """Why the evaluation's motion of ``method`` to ``label`` is not sent to the arm ("" when it
+    may be): the contract, after every repair, still refuses it. The arm runs nothing the
+    contract refused; the row keeps the reason, and no simulated time is spent on it."""
+    verdict = report.methods[method].verdicts[label]
+    if verdict.ok:
+        return ""
+    return f"not run: the contract refuses its planned motion: {verdict.reason()}"
 
 
 def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:
