@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from ..tasks.contract import Contract
 from .job_report import JobPhase, _phase
+from .planning import _paced_duration, _slowed
 
 __all__ = []
 
@@ -101,12 +102,10 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
         orientations=orientations,
         **({} if spacing is None else {"spacing": spacing}),
     )
-    if plan.duration < least_duration:  # slower than the limits allow: every peak scales down
-        scale = plan.duration / least_duration
-        plan.duration = least_duration
-        plan.peak_velocity *= scale
-        plan.peak_acceleration *= scale**2
-        plan.peak_jerk *= scale**3
+    # No faster than the demonstration's pace, nor than the step asks (the spindle's turns, a
+    # rhythm's timing): the limits only ever slow a motion down.
+    pace = _paced_duration(path, fractions, world.scenario.pace)
+    _slowed(plan, max(least_duration, pace))
     contract = world.contract if name == "approach" else _transfer_contract(world.contract)
     goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]
     refused = _refused_plan(

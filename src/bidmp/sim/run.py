@@ -17,6 +17,7 @@ from .._units import mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
+from .planning import _paced_duration, _slowed
 from .pybullet.cell import RobotCell
 from .report import SimMethod, SimReport, SimTarget, _measure, _SimTask
 from .robots import (
@@ -71,6 +72,7 @@ class _SimSetup:
     models: dict | None = None  # method -> fitted model, closed loop
     avoid: bool = False
     goal_update: GoalUpdate | None = None
+    pace: float | None = None  # the demonstration's peak tool speed (units/s), None: limits only
 
 
 def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
@@ -99,6 +101,7 @@ def _run_one(setup: _SimSetup, cell, contract, job):
     # harder than the joints' acceleration limits, and the limiter overshoots the nut).
     spacing = CLOSED_LOOP_SPACING if setup.closed_loop else MAX_SAMPLE_SPACING
     plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
+    _slowed(plan, _paced_duration(job.rollout, None, setup.pace))  # the demonstration's pace
     if setup.closed_loop and job.orientations is not None:
         raise ValueError("closed_loop runs position skills; this scenario's are poses")
     target = np.asarray(setup.task.targets[job.label], dtype=float)[:3]
@@ -515,6 +518,7 @@ def _setup(scenario, labels, base, yaw, **run) -> _SimSetup:
         tuple(base.tolist()),
         yaw,
         **run,
+        pace=scenario.pace,
     )
 
 

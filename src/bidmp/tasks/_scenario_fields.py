@@ -120,9 +120,11 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
     return resolved
 
 
-def _prepared_file(path, units: str) -> np.ndarray:
+def _prepared_file(path, units: str) -> tuple[np.ndarray, float | None]:
     """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
-    trimmed, filtered, uniform time); a declared unit must be the scenario's."""
+    trimmed, filtered, uniform time); a declared unit must be the scenario's. Returns the
+    positions and the pace the person showed: the prepared motion's peak tool speed (scene
+    units per second; None for a file without time stamps)."""
     from ..demonstrations.preparation import prepare
     from ..io.trajectories import declared_units
 
@@ -132,10 +134,16 @@ def _prepared_file(path, units: str) -> np.ndarray:
             f"{path} is in {declared} (declared in the file) but the scenario is in {units}"
         )
     y, t = read_trajectory(path)
-    return y if t is None else prepare(y, t)[0].y
+    if t is None:
+        return y, None
+    motion = prepare(y, t)[0]
+    speed = np.linalg.norm(np.gradient(motion.y[:, :3], motion.t, axis=0), axis=1)
+    return motion.y, float(np.max(speed))
 
 
 def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):  # noqa: C901 - one branch per documented option or part kind, each a line
+    """A scenario's demonstration and its pace (peak tool speed in scene units per second, None
+    when it has no time: a generated or listed one)."""
     if not isinstance(value, dict) or len(value) != 1:
         _fail(
             source,
@@ -184,14 +192,14 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
                 f"expected an integer in [0, 2**63), got {_shown(seed)}",
             )
         try:
-            return minimum_jerk(via, int(n_steps), noise, int(seed))
+            return minimum_jerk(via, int(n_steps), noise, int(seed)), None
         except (TypeError, ValueError) as exc:
             _fail(source, f"{key}.minimum_jerk", str(exc))
     if kind == "points":
         points = _points(body, source, f"{key}.points", minimum=_MIN_DEMONSTRATION)
         if not np.any(points != points[0]):
             _fail(source, f"{key}.points", "all points are identical: there is no motion to learn")
-        return points
+        return points, None
     if kind == "file":
         if not isinstance(body, str) or not body or "\x00" in body:
             _fail(source, f"{key}.file", "expected a file name")
@@ -204,7 +212,7 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
             allow_outside,
         )
         try:
-            trajectory = _prepared_file(path, units)
+            trajectory, pace = _prepared_file(path, units)
         except (TypeError, ValueError, OSError) as exc:
             _fail(source, f"{key}.file", str(exc))
         if trajectory.shape[0] < _MIN_DEMONSTRATION:
@@ -213,7 +221,7 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
                 f"{key}.file",
                 f"has {trajectory.shape[0]} samples; a demonstration needs at least {_MIN_DEMONSTRATION}",
             )
-        return trajectory
+        return trajectory, pace
     _fail(
         source,
         key,

@@ -37,6 +37,10 @@ Keys (units: millimetres for the battery scenarios)::
     methods              subset of dmp, dmp-converged, bidmp, bidmp-latest, gmm, tpgmm
     seed                 int in [0, 2**32), default 0 (G-PRM and the baselines)
     robot                {"base": [x, y, z], "yaw": degrees}: where bidmp sim puts the Panda
+    pace                 "demonstration" (default): the simulator and the job run a motion no
+                         faster than the demonstration's peak tool speed (a "file" recording with
+                         time stamps), slower where the arm's limits ask; "limits": at the arm's
+                         limits alone (faster than demonstrated, on request)
     scene                geometry of the work cell: tool and parts (see bidmp.scene); with it
                          the evaluation reports clearance, collisions and task success, and the
                          extensions (approach "keep") are grown around the parts. A stage of
@@ -113,6 +117,7 @@ _KEYS = {
     "robot",
     "alignment_threshold",
     "job",
+    "pace",
 }
 _DMP_KEYS = {
     "alpha",
@@ -182,6 +187,9 @@ class Scenario:
     robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
     job: object = None  # bidmp.tasks.jobs.JobSpec: the task sequence bidmp job runs
     base_dir: str = "."  # where "file" demonstrations were read from
+    # The demonstration's peak tool speed (units/s) that executed motions keep: the simulator and
+    # the job slow a motion down to it, never up (None: no time stamps, or "pace": "limits").
+    pace: float | None = None
 
     @property
     def labels(self) -> list[str]:
@@ -367,9 +375,10 @@ def from_dict(
     base_dir = str(check_path(base_dir, "base_dir"))
     allow_outside_files = check_bool(allow_outside_files, "allow_outside_files")
     units = _check_top_level(data, source)
-    demonstration = _demonstration(
+    demonstration, pace = _demonstration(
         data["demonstration"], source, "demonstration", base_dir, allow_outside_files, units
     )
+    pace = _pace(data, source, pace)
     n_dims = demonstration.shape[1]
     if n_dims == POSE_DIMS:
         demonstration = _pose_points(demonstration, source, "demonstration", generated=True)
@@ -425,7 +434,27 @@ def from_dict(
         base_dir=str(base_dir),
         alignment_threshold=alignment,
         job=job,
+        pace=pace,
     )
+
+
+def _pace(data, source: str, demonstrated: float | None) -> float | None:
+    """The ``"pace"`` key: "demonstration" (default) keeps the demonstration's peak tool speed
+    ``demonstrated`` (None for one without time stamps: then only the arm's limits time a
+    motion), "limits" times every motion at the arm's limits alone (faster, on request)."""
+    pace = data.get("pace", "demonstration")
+    if pace not in ("demonstration", "limits"):
+        _fail(source, "pace", f'expected "demonstration" or "limits", got {_shown(pace)}')
+    if pace == "limits":
+        return None
+    if "pace" in data and demonstrated is None:
+        _fail(
+            source,
+            "pace",
+            '"demonstration" needs a demonstration with time stamps (a "file" recording); '
+            'this one has none: drop the key, or say "limits"',
+        )
+    return demonstrated
 
 
 def _check_top_level(data, source: str) -> str:
@@ -552,7 +581,7 @@ def _further_demonstrations(
     demonstrations = {}
     check_limit(len(extra), "max_targets", "the number of further demonstrations")
     for label, spec in extra.items():
-        trajectory = _demonstration(
+        trajectory, _ = _demonstration(
             spec, source, f"demonstrations.{label}", base_dir, allow_outside_files, units
         )
         if trajectory.shape[1] != n_dims:
