@@ -55,11 +55,49 @@ def _segment(d: float, a: float, radius: float, mass: float) -> str:
     )
 
 
-def urdf() -> str:
+# A user's kind of six-axis arm that is not built in, for the tests of an arm bidmp knows only
+# from its URDF (tests/data/tm5_like/): Techman's TM5-700 numbers as its maker publishes them
+# (d1 145.2 mm, a2 329 mm, a3 311.5 mm, d4 122.3 mm, d5 106 mm, d6 113.15 mm; joints +-270,
+# +-180, +-155, +-180, +-180, +-270 deg at 180, 180, 180, 225, 225, 225 deg/s), written in the
+# UR5's DH form but with the upper arm's lengths positive: its zero pose reaches the other way.
+TM5_LIKE = {
+    "name": "tm5_like",
+    "dh": (
+        (0.1452, 0.0, math.pi / 2),
+        (0.0, 0.329, 0.0),
+        (0.0, 0.3115, 0.0),
+        (0.1223, 0.0, math.pi / 2),
+        (0.106, 0.0, -math.pi / 2),
+        (0.11315, 0.0, 0.0),
+    ),
+    "masses": (4.0, 7.0, 2.3, 1.3, 1.3, 0.3),
+    "radii": (0.06, 0.055, 0.045, 0.045, 0.045, 0.04),
+    "effort": (157.0, 157.0, 157.0, 43.0, 43.0, 43.0),
+    "ranges": tuple(math.radians(v) for v in (270, 180, 155, 180, 180, 270)),
+    "speeds": tuple(math.radians(v) for v in (180, 180, 180, 225, 225, 225)),
+}
+UR5 = {
+    "name": "ur5_dh",
+    "dh": DH,
+    "masses": MASSES,
+    "radii": RADII,
+    "effort": EFFORT,
+    "ranges": (RANGE,) * 6,
+    "speeds": (SPEED,) * 6,
+}
+ARMS = {"ur5": UR5, "tm5-like": TM5_LIKE}
+
+
+def urdf(arm: dict = UR5) -> str:
+    where = (
+        "the UR5's published DH parameters and limits"
+        if arm is UR5
+        else f"the published DH parameters and limits of the arm {arm['name']} is modelled on"
+    )
     lines = [
         '<?xml version="1.0"?>',
-        "<!-- Written by tools/ur5_urdf.py from the UR5's published DH parameters and limits. -->",
-        '<robot name="ur5_dh">',
+        f"<!-- Written by tools/ur5_urdf.py from {where}. -->",
+        f'<robot name="{arm["name"]}">',
         '  <link name="base_link">',
         '    <inertial><mass value="4.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
         '    <visual><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></visual>',
@@ -67,14 +105,15 @@ def urdf() -> str:
         "  </link>",
     ]
     parent, origin = "base_link", ("0 0 0", "0 0 0")
-    for index, ((d, a, alpha), mass, radius, effort) in enumerate(
-        zip(DH, MASSES, RADII, EFFORT), start=1
+    for index, ((d, a, alpha), mass, radius, effort, reach, speed) in enumerate(
+        zip(arm["dh"], arm["masses"], arm["radii"], arm["effort"], arm["ranges"], arm["speeds"]),
+        start=1,
     ):
         name = f"link{index}"
         lines.append(
             f'  <joint name="joint{index}" type="revolute"><parent link="{parent}"/><child link="{name}"/>'
             f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/><axis xyz="0 0 1"/>'
-            f'<limit lower="{-RANGE:.6f}" upper="{RANGE:.6f}" velocity="{SPEED:.6f}" effort="{effort}"/></joint>'
+            f'<limit lower="{-reach:.6f}" upper="{reach:.6f}" velocity="{speed:.6f}" effort="{effort}"/></joint>'
         )
         lines.append(f'  <link name="{name}">\n{_segment(d, a, radius, mass)}  </link>')
         parent, origin = name, (f"{a} 0 {d}", f"{alpha:.10f} 0 0")
@@ -91,6 +130,15 @@ def urdf() -> str:
 
 
 if __name__ == "__main__":
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_text(urdf())
-    print(f"wrote {OUT}")
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--arm", choices=sorted(ARMS), default="ur5")
+    parser.add_argument("--out", default=None, help=f"the file (default, for the UR5: {OUT})")
+    args = parser.parse_args()
+    out = Path(args.out) if args.out else OUT
+    if args.out is None and args.arm != "ur5":
+        parser.error("--out is needed for an arm other than the built-in UR5")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(urdf(ARMS[args.arm]))
+    print(f"wrote {out}")

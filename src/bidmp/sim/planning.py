@@ -82,8 +82,9 @@ def plan_path(
             raise SimError(
                 f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
                 f"unreachable for the {cell.name} at base {np.round(cell.base, 1).tolist()} "
-                f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}); move the "
-                f'robot (scenario key "robot": {{"base": ...}})'
+                f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}): out of "
+                f'its reach (move its base: scenario key "robot": {{"base": ...}}), or not from the '
+                f'joints it comes from (a start pose nearer it: "robot": {{"rest": [...]}}, rad)'
             )
         below, above = q < np.array(limits.lower) - 1e-9, q > np.array(limits.upper) + 1e-9
         if below.any() or above.any():

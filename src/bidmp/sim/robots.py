@@ -127,6 +127,9 @@ class RobotModel:
     effort: tuple
     cut_at: str | None = None
     standoff: float = 0.33
+    # Whether ``rest`` was given (the built-in arms, a scenario's "robot": {"rest": ...}); a URDF
+    # arm without one starts where it can work: bidmp.sim solves it from the demonstration's start.
+    rest_given: bool = True
 
     def __post_init__(self) -> None:
         for name in ("name", "urdf", "flange"):
@@ -252,6 +255,7 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
         limits,
         tuple(spec.get("rest", middle)),
         tuple(spec.get("effort", (100.0,) * limits.n_joints)),
+        rest_given="rest" in spec,
     )
 
 
@@ -306,6 +310,34 @@ def _reachable(point_m: np.ndarray, base_m: np.ndarray, name: str) -> np.ndarray
             f"(the Panda's is 0.855 m); check the units and the base"
         )
     return point_m
+
+
+def _working_rest(cell, point_m: np.ndarray, n_seeds: int = 32) -> np.ndarray | None:
+    """Joints (rad) that put the tool's mouth at ``point_m`` (m) pointing down, within the limits
+    and as far inside them as the solutions found allow: the start pose of an arm given without
+    one (its ranges' middle is often a stretched or singular pose from which the demonstration's
+    start cannot be solved). IK is started from the ranges' middle and from ``n_seeds`` seeded
+    draws within the limits (each joint within half a turn of the middle: the same seeds every
+    call); among the solutions that reach the point, the one whose nearest limit is farthest (as
+    a fraction of that joint's range) wins. None when no seed reaches it."""
+    limits = cell.limits
+    lower, upper = np.asarray(limits.lower, float), np.asarray(limits.upper, float)
+    middle = 0.5 * (lower + upper)
+    half = np.minimum(0.5 * (upper - lower), np.pi)
+    draws = np.random.default_rng(0).uniform(-1.0, 1.0, (n_seeds, len(lower)))
+    best, best_room = None, -np.inf
+    for seed in np.vstack([middle, middle + draws * half]):
+        try:
+            q, error = cell.solve_ik(point_m, seed)
+        except SimError:
+            continue
+        q = np.asarray(q, dtype=float)
+        if error > IK_TOLERANCE or np.any(q < lower - 1e-9) or np.any(q > upper + 1e-9):
+            continue
+        room = float(np.min(np.minimum(q - lower, upper - q) / (upper - lower)))
+        if room > best_room:
+            best, best_room = q, room
+    return best
 
 
 def _joint_seed(seed, limits: JointLimits = PANDA) -> np.ndarray:

@@ -73,6 +73,9 @@ class _SimSetup:
     avoid: bool = False
     goal_update: GoalUpdate | None = None
     pace: float | None = None  # the demonstration's peak tool speed (units/s), None: limits only
+    start: tuple | None = (
+        None  # the demonstration's start (units): an arm without a rest starts there
+    )
 
 
 def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
@@ -168,6 +171,8 @@ def _world(setup: _SimSetup):
         _WORLD["cell"] = setup.backend.load_robot(
             scene, setup.task.units, setup.base, setup.yaw, **arm
         )
+        if setup.start is not None:
+            _start_where_it_works(_WORLD["cell"], setup.robot, setup.start)
         _WORLD["key"] = key
     return _WORLD["cell"]
 
@@ -430,10 +435,39 @@ def _scenario_and_backend(scenario, backend):
 
 def _open_world(backend, scenario, base, yaw):
     """A new world of ``backend`` for ``scenario``: its scene, the arm the scenario names (a
-    backend that has its own arm is not told of it) at ``base`` turned ``yaw``."""
+    backend that has its own arm is not told of it) at ``base`` turned ``yaw``, starting where
+    it can work."""
     arm = robot_model(scenario.robot, scenario.base_dir)
     robot = {} if arm is PANDA_MODEL else {"robot": arm}
-    return backend.load_robot(scenario.scene, scenario.units, base, yaw, **robot)
+    cell = backend.load_robot(scenario.scene, scenario.units, base, yaw, **robot)
+    _start_where_it_works(cell, arm, np.asarray(scenario.demonstration, dtype=float)[0, :3])
+    return cell
+
+
+def _start_where_it_works(cell, arm: RobotModel, start) -> None:
+    """An arm given without a rest pose (a URDF's, no ``"robot": {"rest": ...}``) starts at the
+    demonstration's ``start`` (scene units), tool pointing down: solved by IK within its limits,
+    as far inside them as found (:func:`bidmp.sim.robots._working_rest`). Its ranges' middle,
+    the fallback, is often a stretched pose from which nothing can be solved. Another backend's
+    arm, or one whose rest was given, is left as it is; an arm that cannot reach the start then
+    is reported so by the motions (naming ``robot.rest``)."""
+    import dataclasses
+
+    from .robots import _working_rest
+
+    if arm.rest_given or getattr(cell, "model", None) is not arm:
+        return
+    q = _working_rest(cell, np.asarray(start, dtype=float)[:3] * cell.unit)
+    if q is None:
+        logger.info(
+            "no joints of the %s reach the demonstration's start: it starts at the middle "
+            "of its ranges",
+            arm.name,
+        )
+        return
+    cell.model = dataclasses.replace(arm, rest=tuple(q.tolist()), rest_given=True)
+    cell._set_joints(cell.model.rest)
+    cell.wrist_turns_tool = cell._last_joint_turns_tool()
 
 
 def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
@@ -445,7 +479,8 @@ def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
     cell = _world(setup)
     where = (
         f"for the {cell.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
-        f'down); move its base (scenario key "robot": {{"base": ...}})'
+        f'down): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
+        f'from its start pose (give one nearer: "robot": {{"rest": [...]}}, rad)'
     )
 
     def reached(point) -> bool:
@@ -519,6 +554,7 @@ def _setup(scenario, labels, base, yaw, **run) -> _SimSetup:
         yaw,
         **run,
         pace=scenario.pace,
+        start=tuple(np.asarray(scenario.demonstration, dtype=float)[0, :3].tolist()),
     )
 
 

@@ -345,4 +345,18 @@ def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict
             robot[name] = _joint_values(
                 robot[name], source, f"robot.{name}", positive=name == "effort", count=count
             )
+    _check_rest_within(robot, source)
     return robot
+
+
+def _check_rest_within(robot: dict, source: str) -> None:
+    """A given start pose (``robot.rest``) lies within the arm's ``robot.limits``."""
+    lower, upper = robot["limits"]["lower"], robot["limits"]["upper"]
+    for joint, (q, low, high) in enumerate(zip(robot.get("rest", ()), lower, upper), start=1):
+        if not low <= q <= high:
+            _fail(
+                source,
+                "robot.rest",
+                f"joint {joint} at {q:g} rad is outside its limits [{low:g}, {high:g}] "
+                "(robot.limits); the start pose must lie within them",
+            )

@@ -1,0 +1,98 @@
+"""A new arm starts where it can work: a URDF arm given without a rest pose starts at the
+demonstration's start (tool pointing down) solved by IK within its limits, not at the middle of
+its ranges (for ±360° joints the zero pose, often stretched out, from which nothing is solved).
+
+Two arms bidmp knows only from their URDF, in a cell in metres: the UR5's DH model written as a
+user's file (its zero pose reaches out horizontally: from there the previous start reached none
+of the nuts, "move the robot") and a TM5-700-like arm (tests/data/tm5_like, written by
+tools/ur5_urdf.py --arm tm5-like). The oracle for "starts where it can work" is forward
+kinematics of the chosen start, compared with the demonstration's start, and its joints against
+the limits typed here."""
+
+from __future__ import annotations
+
+import json
+import math
+import pathlib
+import shutil
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pybullet")
+
+from bidmp import sim  # noqa: E402
+from bidmp.tasks import scenarios  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data"
+sys.path.insert(0, str(ROOT / "tests" / "tasks"))
+from test_user_cells import spec as cell_spec  # noqa: E402
+
+DEG = math.pi / 180.0
+ARMS = {
+    "ur5-as-a-user-urdf": (
+        ROOT / "src" / "bidmp" / "data" / "robots" / "ur5_dh.urdf",
+        [360.0] * 6,
+        [180.0] * 6,
+    ),
+    "tm5-like": (
+        DATA / "tm5_like" / "tm5_like.urdf",
+        [270.0, 180.0, 155.0, 180.0, 180.0, 270.0],
+        [180.0, 180.0, 180.0, 225.0, 225.0, 225.0],
+    ),
+}
+
+
+def _scenario(tmp_path, arm: str, **robot):
+    urdf, ranges, speeds = ARMS[arm]
+    shutil.copy(urdf, tmp_path / "arm.urdf")
+    data = cell_spec("two_posts.json", "m")  # posts between the nut columns, in metres
+    data["robot"] = {
+        "urdf": "arm.urdf",
+        "flange": "flange",
+        "limits": {
+            "lower": [-r * DEG for r in ranges],
+            "upper": [r * DEG for r in ranges],
+            "velocity": [v * DEG for v in speeds],
+            "acceleration": [5 * v * DEG for v in speeds],
+            "jerk": [500 * v * DEG for v in speeds],
+        },
+        **robot,
+    }
+    (tmp_path / "cell.json").write_text(json.dumps(data))
+    return scenarios.load(str(tmp_path / "cell.json")), ranges
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_an_arm_without_a_rest_pose_starts_at_the_demonstration_and_does_the_job(tmp_path, arm):
+    scenario, ranges = _scenario(tmp_path, arm)
+    model = sim.robot_model(scenario.robot, scenario.base_dir)
+    assert not model.rest_given and not any(model.rest)  # the ranges' middle: all zeros
+    base, yaw = sim.robot_placement(scenario)
+    cell = sim.run._open_world(sim.get_backend("pybullet"), scenario, base, yaw)
+    try:
+        start = np.asarray(cell.rest, dtype=float)
+        tool = cell.tcp_position() / cell.unit  # forward kinematics of the start pose (m)
+    finally:
+        cell.close()
+    assert np.linalg.norm(tool - scenario.demonstration[0, :3]) < 1e-4  # 0.1 mm
+    assert np.all(np.abs(start) < np.asarray(ranges) * DEG)
+    labels = ["3", "12"]  # the demonstrated nut and the farthest, past both posts
+    result = sim.simulate(scenario, ["bidmp"], targets=labels, workers=1)
+    assert result.methods["bidmp"].task_successes == 2, result.summary()
+    job = sim.run_job(scenario, targets=labels)
+    assert job.removed == 2, job.summary()
+
+
+def test_a_rest_pose_outside_the_limits_is_refused_naming_it(tmp_path):
+    with pytest.raises(scenarios.ScenarioError, match=r"robot\.rest.*joint 2 at 4 rad"):
+        _scenario(tmp_path, "tm5-like", rest=[0.0, 4.0, 0.0, 0.0, 0.0, 0.0])
+
+
+def test_a_point_out_of_reach_names_both_fixes(tmp_path):
+    scenario, _ = _scenario(tmp_path, "tm5-like", base=[0.0, -1.2, 0.0])
+    result = sim.simulate(scenario, ["bidmp"], targets=["12"], workers=1)
+    reason = result.methods["bidmp"].targets["12"].reason
+    assert '"base"' in reason and '"rest"' in reason, reason
