@@ -14,6 +14,7 @@ import numpy as np
 
 from .._checks import get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
+from ..io.recordings import recording_kind
 from ..io.trajectories import read_trajectory
 
 _MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
@@ -133,12 +134,27 @@ def _prepared_file(path, units: str) -> tuple[np.ndarray, float | None]:
         raise ValueError(
             f"{path} is in {declared} (declared in the file) but the scenario is in {units}"
         )
+    if str(path).lower().endswith((".csv", ".txt")) and recording_kind(path) == "pose":
+        # A pose recording (x, y, z with a quaternion or a rotation vector): a pose scenario's
+        # demonstration, prepared like positions (idle ends, the same filter, uniform time).
+        from ..demonstrations.preparation import prepare_poses
+        from ..io.poses import read_poses
+
+        poses, t = read_poses(path)
+        if t is None:
+            return poses, None
+        poses, times, _ = prepare_poses(poses, t)
+        return poses, _peak_speed(poses[:, :3], times)
     y, t = read_trajectory(path)
     if t is None:
         return y, None
     motion = prepare(y, t)[0]
-    speed = np.linalg.norm(np.gradient(motion.y[:, :3], motion.t, axis=0), axis=1)
-    return motion.y, float(np.max(speed))
+    return motion.y, _peak_speed(motion.y[:, :3], motion.t)
+
+
+def _peak_speed(positions: np.ndarray, t: np.ndarray) -> float:
+    """The largest tool speed of a uniformly timed motion (units per second)."""
+    return float(np.max(np.linalg.norm(np.gradient(positions, t, axis=0), axis=1)))
 
 
 def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):  # noqa: C901 - one branch per documented option or part kind, each a line

@@ -500,6 +500,15 @@ def _targets(data, source: str, n_dims: int) -> tuple[dict, str]:
             "targets",
             f"{len(data['targets']):,} targets exceed the limit max_targets = {get_limits().max_targets:,}",
         )
+    for label, point in data["targets"].items():
+        if n_dims == 3 and isinstance(point, list) and len(point) == POSE_DIMS:
+            _fail(
+                source,
+                f"targets.{label}",
+                "is a pose (x, y, z, qx, qy, qz, qw) but the demonstration has positions only: a "
+                "pose target needs a pose demonstration (a pose recording file, or generated "
+                "poses) to learn the tool's orientation from",
+            )
     targets = {
         str(label): _point(point, source, f"targets.{label}", n_dims)
         for label, point in data["targets"].items()
