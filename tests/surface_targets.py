@@ -83,6 +83,8 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.robot_model": {"spec": {"model": "xarm6"}},
         "bidmp.sim.job_targets": {"scenario": scenario},
         "bidmp.sim.target_labels": {"scenario": scenario, "targets": ["1", "3"]},
+        "bidmp.sim.execution_report": {"scenario": scenario, "methods": ["dmp"]},
+        "bidmp.sim.execution_settings": {"scenario": scenario},
         "bidmp.sim.in_bin": {
             "centre": [1.0, 2.0, 5.0],
             "floor": [0.0, 0.0, 0.0],
@@ -586,6 +588,8 @@ def _instances(tmp: Path):
             "point_m": np.array([0.1, -0.1, 0.2]),
             "seed": q,
             "path": scenario.demonstration[::20],
+            "plan": cell.plan(scenario.demonstration[::20]),
+            "exclude": [],
             "t": 0.5,
             "focus": np.zeros(3),
             "width": 64,

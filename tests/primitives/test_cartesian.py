@@ -289,9 +289,7 @@ def test_tilted_pack_in_the_simulator(tilted_report):
     pytest.importorskip("pybullet")
     from bidmp import sim
 
-    result = sim.simulate(
-        tilted_report.scenario, ["bidmp"], targets=["12", "6"], report=tilted_report, workers=1
-    )
+    result = sim.simulate(tilted_report.scenario, ["bidmp"], targets=["12", "6"], workers=1)
     method = result.methods["bidmp"]
     assert method.task_successes == 2 and method.aligned == 2
     assert json.dumps(result.to_dict())  # serialisable

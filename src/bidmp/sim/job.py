@@ -69,8 +69,14 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     phase = _move(
         world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis
     )
-    phase.note = note
+    _note(phase, note)
     return phase
+
+
+def _note(phase: JobPhase, note: str) -> None:
+    """Add how a move was made (``note``: a repair, a lift) to its phase, keeping a refusal's
+    reason (a motion not run says why) ahead of it."""
+    phase.note = f"{phase.note}; {note}" if phase.note and note else phase.note or note
 
 
 def _engaged(world: _World, part: MovablePart, target) -> tuple[bool, str]:
@@ -183,7 +189,7 @@ def _drop(world: _World, part: MovablePart, exclude) -> JobPhase:
     centre = _release(world)
     world.dropped += 1
     phase.seconds += RELEASE_S
-    phase.note = note or ""
+    _note(phase, note or "")
     if not in_bin(centre, world.spec.bin_floor, world.spec.bin[1]):
         phase.ok = False
         phase.note = f"released outside the bin: the nut lies at {np.round(centre, 1).tolist()} {world.scenario.units}"
@@ -200,7 +206,10 @@ def _reach(
     approach = _approach(world, label, target, axis)
     _add(world, record, approach, target[:3])
     if not approach.ok:
-        raise _StepFailed(f"approach: {approach.verdict.reason()}")
+        verdict = approach.verdict
+        raise _StepFailed(
+            f"approach: {verdict.reason() if verdict is not None and not verdict.ok else approach.note}"
+        )
     engaged, note = _engaged(world, part, target)
     record.phases.append(JobPhase(step, engaged, 0.0, note))
     if not engaged:
@@ -251,7 +260,7 @@ def _place(world: _World, part: MovablePart, slot, exclude) -> JobPhase:
     centre = _release(world)
     phase.seconds += RELEASE_S
     off = float(np.linalg.norm(centre[:2] - np.asarray(slot)[:2]))
-    phase.note = note
+    _note(phase, note)
     if not in_slot(
         centre, slot, part.height, world.spec.engage_tolerance * 5, world.spec.slot_tolerance
     ):

@@ -170,14 +170,30 @@ def _refused_plan(  # noqa: PLR0913 - what _move judges its plan by, passed on w
     )
     peaks = (plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk)
     over = [kind for kind, peak in zip(("velocity", "acceleration", "jerk"), peaks) if peak > 1.0]
-    if verdict.ok and not over:
+    touch = _arm_touch(world, plan, exclude, carried) if verdict.ok and not over else None
+    if verdict.ok and not over and touch is None:
         return None
-    why = verdict.reason() if not verdict.ok else f"its planned joint {over[0]} exceeds the limit"
+    if not verdict.ok:
+        why = verdict.reason()
+    elif over:
+        why = f"its planned joint {over[0]} exceeds the limit"
+    else:
+        why = f"the arm would touch {touch[0]} ({touch[1]:.2f} {world.scenario.units} deep)"
     phase = JobPhase(name, False, 0.0, f"not run: the contract refuses its plan: {why}")
     phase.verdict = verdict if not verdict.ok else None
     phase.peaks = peaks
     phase.within_limits = not over
     return phase
+
+
+def _arm_touch(world: _World, plan, exclude, carried) -> tuple[str, float] | None:
+    """The part the arm's links would touch along ``plan`` (a backend that models its links:
+    ``arm_touch``), the target's own parts, those gone and a carried part left out."""
+    touch = getattr(getattr(world, "cell", None), "arm_touch", None)
+    if touch is None:
+        return None
+    label = getattr(carried, "label", None)
+    return touch(plan, list(exclude) + ([label] if label else []))
 
 
 def _transfer_contract(contract: Contract) -> Contract:

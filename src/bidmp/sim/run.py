@@ -108,6 +108,14 @@ def _run_one(setup: _SimSetup, cell, contract, job):
     if setup.closed_loop and job.orientations is not None:
         raise ValueError("closed_loop runs position skills; this scenario's are poses")
     target = np.asarray(setup.task.targets[job.label], dtype=float)[:3]
+    touch = getattr(cell, "arm_touch", None)
+    touched = None if touch is None else touch(plan, job.exclude)
+    if touched is not None:  # the tool's path keeps the contract, but a link would not
+        reason = (
+            f"not run: the arm would touch {touched[0]} ({touched[1]:.2f} {setup.task.units} "
+            f"deep) on its way to {job.label}, though the tool's path keeps the contract"
+        )
+        return job.method, job.label, SimTarget.not_run(job.label, reason), [], 0.0, None
     if setup.closed_loop:
         coupling = setup.coupling
         if setup.avoid:  # steered round every part but the target's, with phase stopping

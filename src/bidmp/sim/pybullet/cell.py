@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._checks import as_point, check_real
+from ..._checks import as_labels, as_point, check_real
 from ..backend import SIM_STEP, Execution, Hold, MotionPlan
 from ..robots import GAIN, MAX_SAMPLE_SPACING, PANDA_MODEL, RobotModel, _unit_of
 from . import execute as _execute
@@ -226,6 +226,39 @@ class RobotCell:
         from .parts import _add_job_solids
 
         _add_job_solids(self, solids)
+
+    def arm_touch(self, plan, exclude=()) -> tuple[str, float] | None:
+        """Whether the arm, run along ``plan``, would touch a part other than ``exclude``'s (the
+        target's own, a part it carries): the planned joints set on the arm at its IK samples,
+        PyBullet's closest points of every link (the tool's too)
+        against every other part's body. Returns ``(part, depth in scene units)`` of the deepest
+        touch, or None. The contract judges the tool's path; this catches a wrist or an elbow
+        running into a duct the tool passes clear of, before any command is sent. The arm is
+        put back where it was (an execution starts from the plan's first joints anyway)."""
+        if not all(hasattr(plan, name) for name in ("fractions", "spline")):
+            raise TypeError(
+                f"plan must be a bidmp.sim.MotionPlan (RobotCell.plan), got {type(plan).__name__}"
+            )
+        p, client = self.p, self.client
+        exclude = set(as_labels(exclude, "exclude"))
+        bodies = [body for body, owner in self._owners.items() if owner not in exclude]
+        if not bodies:
+            return None
+        now = [p.getJointState(self.robot, joint, physicsClientId=client)[:2] for joint in self.arm]
+        # the IK samples: the tool moves at most 5 mm between them, the links comparably
+        grid = np.asarray(plan.fractions, dtype=float)
+        deepest = None
+        try:
+            for q in plan.spline(grid):
+                self._set_joints(q)
+                for body in bodies:
+                    for point in p.getClosestPoints(self.robot, body, 0.0, physicsClientId=client):
+                        depth = -float(point[8])
+                        if depth > 1e-4 and (deepest is None or depth > deepest[1]):
+                            deepest = (self._owners[body], depth)
+        finally:
+            self._set_joints([a for a, _ in now], [v for _, v in now])
+        return None if deepest is None else (deepest[0], deepest[1] / self.unit)
 
     def movable_part(self, label: str, mass: float):
         """The scene's part ``label`` as one the job moves (a nut on its thread, a held part, a
