@@ -429,6 +429,10 @@ def test_a_target_is_removed_only_when_every_phase_kept_the_contract_and_says_th
     assert not record.removed and record.reason == "drop: released outside the bin"
     assert record.final_position.tolist() == [1.0, 2.0, 3.0]
     assert record.contacts == {"plate": 0.5, "bin": 0.1} and not record.within_limits
+    # an early phase's breach is not undone by a later phase that went well
+    early = JobTarget("n6", [JobPhase("approach", False, 1.0, "off"), JobPhase("leave", True, 0.5)])
+    _finish(early, Part())
+    assert not early.removed and early.reason == "approach: off"
     good = JobTarget("n2", [JobPhase("approach", True, 1.0), JobPhase("drop", True, 2.0)])
     _finish(good, Part())
     assert good.removed and good.reason == "" and good.within_limits and good.seconds == 3.0

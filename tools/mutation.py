@@ -3,10 +3,13 @@
 For each judging function named in :data:`TARGETS`, every small realistic bug is planted one at a
 time — a comparison made strict or loose, ``==`` turned ``!=``, ``+`` for ``-``, ``*`` for ``/``, a
 constant changed, an ``abs`` or a sign dropped, ``and`` for ``or``, ``min`` for ``max``, ``all`` for
-``any`` — and the tests that cover the function run against it. A mutant the tests fail on is
+``any`` — and, where checks are assembled into the verdict a robot acts on, the bugs people make
+there, written by hand in :data:`SEMANTIC` (a wrong frame, a dropped argument, a stale verdict:
+a text of the function replaced by another); the tests that cover the function run against
+each. A mutant the tests fail on is
 *killed*; one they pass is a *survivor*, and each survivor is either killed by a new test or shown
 to be an equivalent mutant in :data:`EQUIVALENT` (with the reason). The result is
-``docs/mutation.md``: the score per area and every survivor (the outcomes kept in
+``docs/mutation.md``: the score per area and per function, and every survivor (the outcomes kept in
 ``docs/mutation.json``).
 
 Why a small tool of our own: mutmut 3 copies the project and runs the whole suite once per file
@@ -146,6 +149,75 @@ TARGETS = (
     Target(
         "job: a cycle's verdict", "bidmp.sim.job", ("_finish", "_why"), ("tests/test_oracles.py",)
     ),
+    # Where checks are assembled into the verdict a robot acts on: operator flips and the
+    # hand-planted bugs of SEMANTIC (a wrong frame, a dropped argument, a stale verdict).
+    Target(
+        "verdict assembly: the contract",
+        "bidmp.tasks.contract",
+        ("Contract.judge",),
+        (
+            "tests/tasks/test_verdict_assembly.py",
+            "tests/test_oracles.py",
+            "tests/tasks/test_contract.py",
+            "tests/tasks/test_engagement.py",
+        ),
+    ),
+    Target(
+        "verdict assembly: evaluation",
+        "bidmp.tasks.evaluation",
+        ("_repaired", "_failed_targets"),
+        (
+            "tests/tasks/test_evaluation_assembly.py",
+            "tests/test_oracles.py",
+            "tests/tasks/test_user_cells.py",
+            "tests/tasks/test_evaluation.py",
+        ),
+    ),
+    Target(
+        "verdict assembly: what the simulator runs",
+        "bidmp.sim.run",
+        ("_refusal", "_executable", "execution_settings", "_run_one"),
+        (
+            "tests/sim/test_refusals.py",
+            "tests/sim/test_arm_touch.py",
+            "tests/sim/test_one_pipeline.py::test_simulate_refuses_motions_the_contract_did_not_judge_and_repair",
+            "tests/sim/test_one_pipeline.py::test_what_the_simulator_repairs_follows_the_scenarios_approach",
+            "tests/sim/test_backends.py",
+        ),
+    ),
+    Target(
+        "job: verdicts, refusals and removed",
+        "bidmp.sim.job",
+        # _finish and _why: the area above ("a cycle's verdict"); its planted bugs are here
+        ("_checked", "_leave", "_engaged", "_reach"),
+        (
+            "tests/test_oracles.py",
+            "tests/sim/test_refusals.py",
+            "tests/sim/test_backends.py",
+            "tests/sim/test_job.py::test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted",
+        ),
+    ),
+    Target(
+        "job: plans refused before they run",
+        "bidmp.sim.job_world",
+        ("_refused_plan", "_move"),
+        (
+            "tests/sim/test_refusals.py",
+            "tests/sim/test_arm_touch.py",
+            "tests/sim/test_rocking_job.py",
+            "tests/sim/test_backends.py",
+            "tests/sim/test_job.py::test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted",
+        ),
+    ),
+    Target(
+        "exit statuses",
+        "bidmp.cli.common",
+        ("judged_methods",),
+        (
+            "tests/sim/test_sim.py::test_the_committed_nut_task_table_is_what_bidmp_sim_measures",
+            "tests/cli/test_cli.py",
+        ),
+    ),
     Target(
         "similarity (Fréchet, normaliser)",
         "bidmp.extension.similarity",
@@ -230,6 +302,150 @@ TARGETS = (
     ),
 )
 
+# Bugs people make where checks are assembled into a verdict, planted by hand beside the operator
+# flips: (area, function, the source text as written, what replaces it, the bug in words). Each is
+# one exact, unique text in the function's source (a test checks they still are).
+SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
+    # -- the contract's verdict
+    (
+        "verdict assembly: the contract",
+        "Contract.judge",
+        "position, goal, self.approach_height, axis, rise=mm(ENGAGE_RISE_MM, self.units)",
+        "position, goal, self.approach_height, None, rise=mm(ENGAGE_RISE_MM, self.units)",
+        "a dropped argument: the engagement measured along world z, not the target's axis",
+    ),
+    (
+        "verdict assembly: the contract",
+        "Contract.judge",
+        "clearance if applies else None,",
+        "None,",
+        "the clearance dropped from the verdict (contacts alone decide)",
+    ),
+    (
+        "verdict assembly: the contract",
+        "Contract.judge",
+        "dict(contacts or {}),",
+        "{},",
+        "the simulator's contacts dropped from the verdict",
+    ),
+    (
+        "verdict assembly: the contract",
+        "Contract.judge",
+        "clearance = self.scene.clearance(position, exclude=exclude, orientations=orientations)",
+        "clearance = self.scene.clearance(position, exclude=exclude)",
+        "a wrong frame: a tilted tool's clearance judged as if it pointed down",
+    ),
+    # -- evaluation: repaired motions and their verdicts
+    (
+        "verdict assembly: evaluation",
+        "_repaired",
+        "verdicts.update({label: fixed.verdict for label, fixed in repairs.items() if fixed.how})",
+        "pass",
+        "a verdict not re-judged: a repaired motion keeps the verdict of the motion it replaced",
+    ),
+    (
+        "verdict assembly: evaluation",
+        "_repaired",
+        "rollouts[label] = fixed.motion",
+        "pass",
+        "a repair's motion judged but not kept: the unrepaired motion is reported and executed",
+    ),
+    (
+        "verdict assembly: evaluation",
+        "_repaired",
+        "axis=scenario.target_axis(label),",
+        "axis=None,",
+        "a dropped argument: repairs planned along world z whatever the target's axis",
+    ),
+    # -- what the simulator executes
+    (
+        "verdict assembly: what the simulator runs",
+        "_refusal",
+        "if verdict.ok:",
+        "if verdict.reached:",
+        "a partial verdict: only the end point decides whether a motion may run",
+    ),
+    (
+        "verdict assembly: what the simulator runs",
+        "_executable",
+        "if settings != wanted:",
+        "if settings['geometry'] != wanted['geometry']:",
+        "a stale verdict accepted: a report judged without repairs is executed",
+    ),
+    (
+        "verdict assembly: what the simulator runs",
+        "_run_one",
+        "run = cell.execute(plan, job.exclude, setup.hold, job.frames)",
+        "run = cell.execute(plan, [], setup.hold, job.frames)",
+        "a dropped argument: the target's own parts counted as collisions",
+    ),
+    # -- the job
+    (
+        "job: plans refused before they run",
+        "_refused_plan",
+        "if verdict.ok and not over and touch is None:",
+        "if verdict.reached and not over and touch is None:",
+        "a partial verdict: a plan through a part is sent because it ends on target",
+    ),
+    (
+        "job: plans refused before they run",
+        "_refused_plan",
+        "touch = _arm_touch(world, plan, exclude, carried) if verdict.ok and not over else None",
+        "touch = None",
+        "a check dropped: the arm's links not checked before the motion is sent",
+    ),
+    (
+        "verdict assembly: what the simulator runs",
+        "_run_one",
+        "touched = None if touch is None else touch(plan, job.exclude)",
+        "touched = None",
+        "a check dropped: the arm's links not checked before the motion is sent",
+    ),
+    (
+        "job: plans refused before they run",
+        "_refused_plan",
+        "clearance = _clearance(world, planned, exclude, carried, orientations, support)",
+        "clearance = _clearance(world, planned, exclude, None, orientations, support)",
+        "a dropped argument: the carried part's clearance not judged before it moves",
+    ),
+    (
+        "job: plans refused before they run",
+        "_move",
+        'contract = world.contract if name == "approach" else _transfer_contract(world.contract)',
+        "contract = _transfer_contract(world.contract)",
+        "the approach judged without its engagement",
+    ),
+    (
+        "job: verdicts, refusals and removed",
+        "_leave",
+        "axis = axis / np.linalg.norm(axis)",
+        "axis = np.array([0.0, 0.0, 1.0])",
+        "a wrong frame: the tool leaves along world z, not the part's axis",
+    ),
+    (
+        "job: verdicts, refusals and removed",
+        "_finish",
+        "record.removed = all(phase.ok for phase in record.phases)",
+        "record.removed = record.phases[-1].ok",
+        "a stale verdict: removed judged on the last phase only",
+    ),
+    (
+        "job: verdicts, refusals and removed",
+        "_engaged",
+        "offset = tcp - part.centre0",
+        "offset = tcp - np.asarray(target, dtype=float)[:3]",
+        "a wrong frame: engagement measured from the target the skill went to, not the part",
+    ),
+    # -- exit statuses
+    (
+        "exit statuses",
+        "judged_methods",
+        "return [name for name in methods if get(name).repairs] or methods",
+        "return methods",
+        "the exit status judged on the baselines too",
+    ),
+)
+
 # Survivors shown equivalent: (module, function, the mutated line's text, mutation) -> why no test
 # can tell the mutant from the original.
 _FAST_PATH = (
@@ -243,6 +459,132 @@ _BOUND = (
 )
 _CLEARANCE = "bidmp.scene.clearance"
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    (
+        "bidmp.sim.job_world",
+        "_refused_plan",
+        "planned = np.asarray(path, dtype=float)[:, :3]",
+        "3 -> 4",
+    ): "a move's path is positions (n, 3) for pose jobs too (its frames come apart, as "
+    "orientations): [:, :4] of three columns is [:, :3]",
+    (
+        "bidmp.sim.job_world",
+        "_move",
+        "goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]",
+        "3 -> 4",
+    ): "the goal goes only to Contract.judge, which keeps as many of its values as the path has "
+    "positions (three): a pose target's fourth value is dropped there (a pose job's test runs it)",
+    (
+        "bidmp.sim.job_world",
+        "_move",
+        "phase.verdict = contract.judge(executed, executed[-1] if target is None else "
+        "np.asarray(target)[:3], label=name, axis=axis, exclude=exclude, orientations=tool_frames, "
+        "commands=run.commands, contacts=phase.contacts, clearance=clearance)",
+        "3 -> 4",
+    ): "Contract.judge keeps as many of the target's values as the path has positions (three): "
+    "a pose target's fourth value is dropped there (a pose job's test runs it)",
+    (
+        "bidmp.sim.job_world",
+        "_refused_plan",
+        "touch = _arm_touch(world, plan, exclude, carried) if verdict.ok and (not over) else None",
+        "and -> or",
+    ): "cost only: the arm is also checked for a plan already refused, and the touch is read only "
+    "when the verdict holds and no peak is over",
+    (
+        "bidmp.sim.job_world",
+        "_move",
+        "goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]",
+        "drop -",
+    ): "a move without a target is a two-point line (its second point is its end) or the rock, "
+    "which ends where it starts and whose first step moves micrometres",
+    (
+        "bidmp.sim.job_world",
+        "_move",
+        "world.q = run.joints[-1]",
+        "1 -> 2",
+    ): "every move ends held at rest for the settling time (backend.SETTLE): the last two "
+    "recorded samples are the same joints but for the physics' residual (micrometres), and they "
+    "only seed the next plan's inverse kinematics",
+    (
+        "bidmp.sim.job_world",
+        "_move",
+        "phase.verdict = contract.judge(executed, executed[-1] if target is None else np.asarray(target)[:3], label=name, axis=axis, exclude=exclude, orientations=tool_frames, commands=run.commands, contacts=phase.contacts, clearance=clearance)",
+        "1 -> 2",
+    ): "a straight move's end is where the arm came to rest, held for the settling time: the last "
+    "two recorded samples are the same point but for the physics' residual (micrometres)",
+    (
+        "bidmp.sim.job",
+        "_reach",
+        "exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone",
+        "3 -> 4",
+    ): "a job's targets are parts of their own (job_targets, and movable_part refuses any other): "
+    "target_parts returns [label] without reading the point",
+    (
+        "bidmp.tasks.contract",
+        "Contract.judge",
+        "aligned = bool(deviation <= self.alignment_threshold)",
+        "<= -> <",
+    ): "differs only for a tool exactly at the alignment threshold, to the last bit",
+    (
+        "bidmp.tasks.contract",
+        "Contract.judge",
+        "position = path[:, :3] if path.shape[1] >= 3 else path",
+        ">= -> >",
+    ): "for a path of exactly 3 columns both branches give the path itself; 2 and 7 columns "
+    "take the same branch either way",
+    (
+        "bidmp.tasks.contract",
+        "Contract.judge",
+        "position = path[:, :3] if path.shape[1] >= 3 else path",
+        "3 -> 4",
+    ): "the comparison's 3 made 4: a 3-column path then takes the other branch, which gives the "
+    "path itself, as [:, :3] does (the slice's 3 made 4 is killed: a pose path's test)",
+    (
+        "bidmp.sim.job_world",
+        "_refused_plan",
+        "over = [kind for kind, peak in zip(('velocity', 'acceleration', 'jerk'), peaks) if peak > 1.0]",
+        "> -> >=",
+    ): "differs only for a plan whose peak is exactly the limit, to the last bit (plans are timed "
+    "to 0.9 of it)",
+    **{
+        (
+            "bidmp.sim.job",
+            "_engaged",
+            "if across > tolerance or along > world.scenario.success_threshold:",
+            "> -> >=",
+        ): "differs only for a tool exactly at the tolerance or the threshold, to the last bit"
+    },
+    (
+        "bidmp.sim.job",
+        "_leave",
+        "near = across <= 2.0 * float(world.scene.tool.radius) + world.scene.margin",
+        "<= -> <",
+    ): "differs only for a tool exactly two radii and the margin off the part's axis, to the last bit",
+    (
+        "bidmp.sim.job",
+        "_leave",
+        "axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)",
+        "1.0 -> 2.0",
+    ): "the default axis is normalised on the next line: (0, 0, 2) gives the same direction",
+    (
+        "bidmp.sim.job",
+        "_leave",
+        "axis = axis / np.linalg.norm(axis)",
+        "/ -> *",
+    ): "a target's axis is a unit vector already (a rotation of one, or the default): dividing "
+    "and multiplying by its norm of 1 give the same bits",
+    (
+        "bidmp.tasks.evaluation",
+        "_failed_targets",
+        "return [label for label, error in zip(labels, errors) if error > scenario.success_threshold]",
+        "> -> >=",
+    ): "differs only for a plain DMP's end exactly at the threshold, to the last bit",
+    (
+        "bidmp.tasks.evaluation",
+        "_repaired",
+        "axis=scenario.target_axis(label),",
+        "planted: a dropped argument: repairs planned along world z whatever the target's axis",
+    ): "today the evaluation repairs position scenarios only, whose targets' axis is None (+z, "
+    "what the dropped argument gives too); it becomes killable when pose targets are repaired",
     (
         "bidmp._units",
         "check_speed",
@@ -776,6 +1118,7 @@ class Mutant:
     text: str = ""  # the mutated statement (statement_text)
     outcome: str = ""
     seconds: float = 0.0
+    replacement: str | None = None  # a hand-planted bug: ``text`` replaced by this
 
     @property
     def key(self) -> tuple[str, str, str, str]:
@@ -839,9 +1182,45 @@ def statement_text(function: ast.FunctionDef, inner: ast.AST) -> str:
     return ast.unparse(holder)
 
 
-def mutants(target: Target) -> list[Mutant]:
+def _function_source(target: Target, function: str) -> tuple[str, int, int]:
+    """The module's source, and where ``function``'s text starts and ends in it."""
     path, tree = _source_tree(target.module)
+    node = _function_node(tree, function)
+    source = path.read_text(encoding="utf-8")
+    lines = source.splitlines(keepends=True)
+    start = sum(len(line) for line in lines[: node.lineno - 1])
+    end = sum(len(line) for line in lines[: node.end_lineno])
+    return source, start, end
+
+
+def semantic_mutants(target: Target) -> list[Mutant]:
+    """The hand-planted bugs of :data:`SEMANTIC` in ``target``'s functions (each text found once
+    in its function: else the tool stops, naming it)."""
     out = []
+    for area, function, text, replacement, bug in SEMANTIC:
+        if area != target.area:
+            continue
+        source, start, end = _function_source(target, function)
+        count = source[start:end].count(text)
+        if count != 1:
+            raise SystemExit(
+                f"mutation: {target.module}.{function}: the planted bug's text is found {count} "
+                f"times, not once: {text!r}"
+            )
+        line = (
+            source[:start].count("\n")
+            + source[start:end][: source[start:end].index(text)].count("\n")
+            + 1
+        )
+        out.append(
+            Mutant(target, function, -1, -1, line, f"planted: {bug}", text, replacement=replacement)
+        )
+    return out
+
+
+def mutants(target: Target) -> list[Mutant]:
+    out = semantic_mutants(target)
+    path, tree = _source_tree(target.module)
     for function in target.functions:
         node = _function_node(tree, function)
         for index, inner in enumerate(_points(node)):
@@ -860,8 +1239,35 @@ def mutants(target: Target) -> list[Mutant]:
     return out
 
 
+def _planted_code(mutant: Mutant):
+    """A hand-planted bug's code object: the module compiled with the one text replaced in the
+    function's source."""
+    source, start, end = _function_source(mutant.target, mutant.function)
+    changed = (
+        source[:start] + source[start:end].replace(mutant.text, mutant.replacement) + source[end:]
+    )
+    path, _ = _source_tree(mutant.target.module)
+    return _code_of(compile(changed, str(path), "exec"), mutant.function)
+
+
+def _code_of(code, qualname: str):
+    """The code object of ``qualname`` inside a module's compiled ``code``."""
+    wanted = qualname.split(".")[-1]
+    stack = [code]
+    while stack:
+        current = stack.pop()
+        if current.co_qualname == qualname or (
+            current.co_name == wanted and current.co_qualname.endswith(qualname)
+        ):
+            return current
+        stack.extend(const for const in current.co_consts if hasattr(const, "co_code"))
+    raise SystemExit(f"mutation: no code object for {qualname}")
+
+
 def _mutated_code(mutant: Mutant):
     """The mutated function's code object, compiled from the module with the one node changed."""
+    if mutant.replacement is not None:
+        return _planted_code(mutant)
     path, tree = _source_tree(mutant.target.module)
     node = _function_node(tree, mutant.function)
     chosen = _points(node)[mutant.index]
@@ -877,17 +1283,7 @@ def _mutated_code(mutant: Mutant):
                         if item is chosen:
                             value[position] = replacement
     ast.fix_missing_locations(tree)
-    code = compile(tree, str(path), "exec")
-    wanted = mutant.function.split(".")[-1]
-    stack = [code]
-    while stack:
-        current = stack.pop()
-        if current.co_qualname == mutant.function or (
-            current.co_name == wanted and current.co_qualname.endswith(mutant.function)
-        ):
-            return current
-        stack.extend(const for const in current.co_consts if hasattr(const, "co_code"))
-    raise SystemExit(f"mutation: no code object for {mutant.function}")
+    return _code_of(compile(tree, str(path), "exec"), mutant.function)
 
 
 def _live_function(module, qualname: str):
@@ -997,7 +1393,9 @@ def report(selected: list[Mutant], seconds: float) -> str:
         "",
         "Written by `make mutation` (`python tools/mutation.py`); do not edit. Each mutant is one small "
         "bug planted in one judging function (a comparison made strict or loose, an operator or a constant "
-        "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped); the "
+        "changed, an `abs`, a sign or a `not` dropped, `and`/`or`, `min`/`max`, `all`/`any` swapped), "
+        "and where checks are assembled into a verdict also the bugs people make, planted by hand "
+        "(`planted:` — a wrong frame, a dropped argument, a stale verdict); the "
         "tests that cover the area run against it. Input validation (`raise`, the `if` tests that only "
         "raise, the calls of `check_*`/`as_*` helpers), messages and logging are not mutated: the surface "
         "sweep (`make fuzz`) covers them. The score is the share killed of the mutants that can be killed: "
@@ -1029,7 +1427,31 @@ def report(selected: list[Mutant], seconds: float) -> str:
         f"{total} mutants, {killed} killed by the tests, in {seconds / 60:.1f} min on 2 workers.",
         "",
     ]
-    lines += ["## Survivors", ""]
+    lines += [
+        "## Score per function",
+        "",
+        "Planted: the hand-written bugs of `SEMANTIC` (a wrong frame, a dropped argument, a stale "
+        "verdict) among the function's mutants.",
+        "",
+        "| area | function | mutants | planted | killed | equivalent | survived | score |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for target in TARGETS:
+        for function in dict.fromkeys(
+            [*target.functions, *(m.function for m in selected if m.target is target)]
+        ):
+            own = [m for m in selected if m.target is target and m.function == function]
+            if not own:
+                continue
+            killed = sum(m.outcome.startswith("killed") for m in own)
+            equivalent = sum(m.outcome == "survived" and m.key in EQUIVALENT for m in own)
+            planted = sum(m.description.startswith("planted: ") for m in own)
+            score = killed / max(len(own) - equivalent, 1)
+            lines.append(
+                f"| {target.area} | `{function}` | {len(own)} | {planted} | {killed} | {equivalent} | "
+                f"{len(own) - killed - equivalent} | {100 * score:.1f} % |"
+            )
+    lines += ["", "## Survivors", ""]
     if not survivors:
         lines.append("None.")
     for mutant in survivors:

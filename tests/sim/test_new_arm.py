@@ -79,6 +79,8 @@ def test_an_arm_without_a_rest_pose_starts_at_the_demonstration_and_does_the_job
         cell.close()
     assert np.linalg.norm(tool - scenario.demonstration[0, :3]) < 1e-4  # 0.1 mm
     assert np.all(np.abs(start) < np.asarray(ranges) * DEG)
+    if arm != "ur5-as-a-user-urdf":  # the start pose is the point; the motions once for it
+        return
     labels = ["3", "12"]  # the demonstrated nut and the farthest, past both posts
     result = sim.simulate(scenario, ["bidmp"], targets=labels, workers=1)
     assert result.methods["bidmp"].task_successes == 2, result.summary()
