@@ -22,20 +22,27 @@ DATA = pathlib.Path(__file__).resolve().parents[1] / "data"
 TWO_POSTS = str(DATA / "two_posts.json")  # posts between the nuts: the far motions are repaired
 
 
-def _sim_commands(monkeypatch, tmp_path, *flags) -> tuple[dict, dict]:
-    """``bidmp sim`` on the two-post cell with ``flags``: (method, label) -> the joint commands
-    it executed, and -> the repair the evaluation made."""
-    from bidmp.sim import run
-
+def _recording(monkeypatch, module, name: str) -> dict:
+    """Replace ``module.name`` (the library call a command makes) by the same call with
+    ``record=True``; the returned dict receives its result under "result"."""
     captured = {}
-    original = run.simulate
+    original = getattr(module, name)
 
     def recording(*args, **options):
         options["record"] = True
         captured["result"] = original(*args, **options)
         return captured["result"]
 
-    monkeypatch.setattr(run, "simulate", recording)
+    monkeypatch.setattr(module, name, recording)
+    return captured
+
+
+def _sim_commands(monkeypatch, tmp_path, *flags) -> tuple[dict, dict]:
+    """``bidmp sim`` on the two-post cell with ``flags``: (method, label) -> the joint commands
+    it executed, and -> the repair the evaluation made."""
+    from bidmp.sim import run
+
+    captured = _recording(monkeypatch, run, "simulate")
     out = tmp_path / "-".join(flag.strip("-") for flag in flags if flag.startswith("--"))
     code = main(["sim", "--scenario", TWO_POSTS, "--out", str(out), *flags])
     assert code in (0, 3), code
@@ -86,15 +93,7 @@ def test_bidmp_job_executes_the_same_commands_with_and_without_output_flags(monk
     from bidmp.sim import job
 
     def commands(*flags) -> dict:
-        captured = {}
-        original = job.run_job
-
-        def recording(*args, **options):
-            options["record"] = True
-            captured["report"] = original(*args, **options)
-            return captured["report"]
-
-        monkeypatch.setattr(job, "run_job", recording)
+        captured = _recording(monkeypatch, job, "run_job")
         out = tmp_path / ("job" + "".join(flags))
         code = main(
             ["job", "--scenario", TWO_POSTS, "--targets", "3,12", "--backend", "kinematic"]
@@ -102,7 +101,7 @@ def test_bidmp_job_executes_the_same_commands_with_and_without_output_flags(monk
         )
         assert code in (0, 3), code
         runs = {}
-        for target in captured["report"].targets:
+        for target in captured["result"].targets:
             for k, phase in enumerate(target.phases):
                 runs[(target.label, k, phase.name)] = getattr(phase, "commands", None)
         assert runs, "the job ran no phase"

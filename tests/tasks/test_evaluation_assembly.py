@@ -12,6 +12,19 @@ import numpy as np
 from bidmp.tasks import evaluate, scenarios
 
 
+def _edge(errors) -> float:
+    """The distance where the last sample's error crosses the 1.75 mm threshold (bisection on
+    ``errors(distance) -> (last sample's error, the one before's)``), checked to be one where
+    the sample before the last is still outside it."""
+    low, high = 0.0, 400.0
+    for _ in range(60):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if errors(middle)[0] <= 1.75 else (low, middle)
+    last, before = errors(low)
+    assert last <= 1.75 < before
+    return low
+
+
 def test_the_plain_dmp_fails_the_far_columns_of_the_built_in_task():
     report = evaluate("nut-unscrewing", ["dmp"], geometry=False)
     assert sorted(report.failed_targets, key=int) == ["9", "10", "11", "12", "13", "14"]
@@ -30,14 +43,9 @@ def test_a_target_is_failed_by_where_the_motion_ends_not_before():
         rollout = dmp.rollout(goal)
         return tuple(float(np.linalg.norm(rollout[k] - goal)) for k in (-1, -2))
 
-    # bisection for the distance where the last sample's error crosses the threshold; just
-    # inside it, the sample before the last is still outside (the paper's rollout still moves)
-    low, high = 0.0, 400.0
-    for _ in range(60):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if errors(middle)[0] <= 1.75 else (low, middle)
-    last, before = errors(low)
-    assert last <= 1.75 < before
+    # just inside the threshold the sample before the last is still outside it (the paper's
+    # rollout still moves)
+    low = _edge(errors)
     spec = {k: v for k, v in scenario.spec.items() if k not in ("scene", "job", "robot")}
     spec["targets"] = {**spec["targets"], "edge": (origin + [low, 0.0, 0.0]).tolist()}
     report = evaluate(scenarios.from_dict(spec), ["dmp"], geometry=False)
@@ -59,15 +67,10 @@ def test_a_pose_target_is_failed_by_where_the_motion_ends_not_before():
         rollout = dmp.rollout(goal)
         return tuple(float(np.linalg.norm(rollout[k, :3] - goal[:3])) for k in (-1, -2))
 
-    low, high = 0.0, 400.0
-    for _ in range(60):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if errors(middle)[0] <= 1.75 else (low, middle)
-    last, before = errors(low)
-    assert last <= 1.75 < before
+    low = _edge(errors)
     spec = {k: v for k, v in scenario.spec.items() if k not in ("scene", "job", "robot")}
     edge = demonstrated + np.r_[low, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
-    far = demonstrated + np.r_[2.0 * high, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    far = demonstrated + np.r_[2.0 * low + 50.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     spec["targets"] = {
         scenario.demonstrated: demonstrated.tolist(),
         "edge": edge.tolist(),
