@@ -73,9 +73,8 @@ class _SimSetup:
     avoid: bool = False
     goal_update: GoalUpdate | None = None
     pace: float | None = None  # the demonstration's peak tool speed (units/s), None: limits only
-    start: tuple | None = (
-        None  # the demonstration's start (units): an arm without a rest starts there
-    )
+    # the demonstration's start (units): an arm given without a rest pose starts there
+    start: tuple | None = None
 
 
 def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
@@ -88,13 +87,15 @@ def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
             progress(job.method, job.label)
         try:
             results.append(_run_one(setup, cell, contract, job))
-        except (
-            SimError
-        ) as exc:  # a motion that cannot run (unreachable, past a joint limit): its row
-            results.append(
-                (job.method, job.label, SimTarget.not_run(job.label, str(exc)), [], 0.0, None)
-            )
+        except SimError as exc:  # a motion that cannot run (unreachable, past a joint limit)
+            results.append(_not_run(job, str(exc)))
     return results
+
+
+def _not_run(job: _Job, reason: str) -> tuple:
+    """The outcome of a motion not sent to the arm: its row with ``reason``, no pictures, no
+    simulated time, no recorded arm (the tuple ``_run_one`` returns)."""
+    return job.method, job.label, SimTarget.not_run(job.label, reason), [], 0.0, None
 
 
 def _run_one(setup: _SimSetup, cell, contract, job):
@@ -115,7 +116,7 @@ def _run_one(setup: _SimSetup, cell, contract, job):
             f"not run: the arm would touch {touched[0]} ({touched[1]:.2f} {setup.task.units} "
             f"deep) on its way to {job.label}, though the tool's path keeps the contract"
         )
-        return job.method, job.label, SimTarget.not_run(job.label, reason), [], 0.0, None
+        return _not_run(job, reason)
     if setup.closed_loop:
         coupling = setup.coupling
         if setup.avoid:  # steered round every part but the target's, with phase stopping
@@ -313,17 +314,7 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
     n_workers = _n_workers(workers, max(len(jobs), 1))
     start = time.perf_counter()
     outcomes = _execute_jobs(setup, jobs, n_workers, progress) if jobs else []
-    outcomes += [
-        (
-            job.method,
-            job.label,
-            SimTarget.not_run(job.label, refusals[(job.method, job.label)]),
-            [],
-            0.0,
-            None,
-        )
-        for job in skipped
-    ]
+    outcomes += [_not_run(job, refusals[(job.method, job.label)]) for job in skipped]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
     out.evaluation = report
     out.wall_s = time.perf_counter() - start
