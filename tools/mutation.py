@@ -168,9 +168,21 @@ TARGETS = (
         ("_repaired", "_failed_targets"),
         (
             "tests/tasks/test_evaluation_assembly.py",
+            "tests/tasks/test_tilted_user_cells.py::test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success",
             "tests/test_oracles.py",
             "tests/tasks/test_user_cells.py",
             "tests/tasks/test_evaluation.py",
+        ),
+    ),
+    Target(
+        "verdict assembly: a repair accepted",
+        "bidmp.tasks.repair",
+        ("Repairer.repair", "Repairer._try", "Repairer._judge"),
+        (
+            "tests/tasks/test_tilted_user_cells.py::test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success",
+            "tests/tasks/test_evaluation_assembly.py",
+            "tests/tasks/test_user_cells.py",
+            "tests/test_oracles.py",
         ),
     ),
     Target(
@@ -356,6 +368,28 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
         "axis=scenario.target_axis(label),",
         "axis=None,",
         "a dropped argument: repairs planned along world z whatever the target's axis",
+    ),
+    # -- a repair's motion accepted
+    (
+        "verdict assembly: a repair accepted",
+        "Repairer._judge",
+        "orientations=turns,",
+        "orientations=None,",
+        "a wrong frame: a repaired pose motion judged with the tool upright (no alignment, no tilt)",
+    ),
+    (
+        "verdict assembly: a repair accepted",
+        "Repairer.repair",
+        "ok = final.ok and planned.ok",
+        "ok = planned.ok",
+        "a verdict not re-judged: a repair accepted on the planning contract alone",
+    ),
+    (
+        "verdict assembly: a repair accepted",
+        "Repairer._try",
+        "verdict = self._judge(self.planning, motion, goal, label, axis, exclude)",
+        "verdict = self._judge(self._widened(widen), motion, goal, label, axis, exclude)",
+        "a stale contract: an extension judged by the margin widened to plan it, not the one it must keep",
     ),
     # -- what the simulator executes
     (
@@ -578,13 +612,6 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "return [label for label, error in zip(labels, errors) if error > scenario.success_threshold]",
         "> -> >=",
     ): "differs only for a plain DMP's end exactly at the threshold, to the last bit",
-    (
-        "bidmp.tasks.evaluation",
-        "_repaired",
-        "axis=scenario.target_axis(label),",
-        "planted: a dropped argument: repairs planned along world z whatever the target's axis",
-    ): "today the evaluation repairs position scenarios only, whose targets' axis is None (+z, "
-    "what the dropped argument gives too); it becomes killable when pose targets are repaired",
     (
         "bidmp._units",
         "check_speed",

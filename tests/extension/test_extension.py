@@ -139,3 +139,29 @@ def test_options_are_listed_in_the_signature_and_a_scenario_names_the_same():
     assert set(arguments) <= set(signature)
     with pytest.raises(TypeError, match="unknown extension option 'n_iterations'"):
         check_extension_options(n_iterations=3)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_transfer_template_turned_for_a_turned_approach(seed):
+    """The template of a transfer that joins an approach turned by R: each step keeps its length,
+    the first keeps its direction and the last takes R's, each within the turn the step's own
+    share of the arc allows (the turn grows with the arc length, from none to R)."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.extension.extend import _turned
+
+    rng = np.random.default_rng(seed)
+    piece = np.cumsum(rng.uniform(-5.0, 5.0, (int(rng.integers(5, 60)), 3)), axis=0)
+    turn = Rotation.from_rotvec(rng.uniform(-0.6, 0.6, 3))
+    turned = _turned(piece, turn.as_matrix())
+    steps, new = np.diff(piece, axis=0), np.diff(turned, axis=0)
+    lengths = np.linalg.norm(steps, axis=1)
+    np.testing.assert_allclose(np.linalg.norm(new, axis=1), lengths, rtol=1e-12)
+    assert np.array_equal(turned[0], piece[0])
+
+    def angle(a, b):
+        return np.arccos(np.clip(a @ b / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0))
+
+    share = lengths / lengths.sum()
+    assert angle(new[0], steps[0]) <= turn.magnitude() * share[0] / 2 + 1e-9
+    assert angle(new[-1], turn.apply(steps[-1])) <= turn.magnitude() * share[-1] / 2 + 1e-9

@@ -171,6 +171,35 @@ def test_via_poses_for_a_multi_turn_cartesian_dmp():
     assert step.max() <= 1.5 * angle_between(plain.q[1:], plain.q[:-1]).max()
 
 
+def test_a_via_pose_that_only_lifts_keeps_a_still_orientation_as_it_is():
+    """A lift over a part gives via poses with the motion's own tool frame. On a pose skill that
+    keeps its orientation still (the tool down all the way) that orientation via-point asks no
+    change: it was refused (a still part has no reach to scale its acceleration by); now the
+    orientation runs as without via-points, bit for bit, while the position passes its points
+    exactly (checked on the motion's samples) and, with ``via_until``, returns after that time to
+    the course the position DMP alone takes through the same points."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp import CartesianDMP
+
+    down = Rotation.from_euler("x", 180, degrees=True).as_quat()
+    positions = minimum_jerk(np.array([[-80.0, -120, 200], [0, 0, 40], [0, 0, 0]]), 200)
+    poses = np.hstack([positions, np.repeat(down[None], 200, axis=0)])
+    model = CartesianDMP().fit(poses, np.linspace(0.0, 2.0, 200), units="mm")
+    plain = model.trajectory(dt=0.001)
+    ks = (500, 800)
+    via = [(plain.t[k], np.r_[plain.y[k] + [0.0, 0.0, 15.0], plain.q[k]]) for k in ks]
+    lifted = model.trajectory(dt=0.001, via=via, via_until=1.2)
+    assert np.array_equal(lifted.q, plain.q)
+    for k, (_, pose) in zip(ks, via):
+        assert np.max(np.abs(lifted.y[k] - pose[:3])) <= 1e-6
+    alone = model.position_.trajectory(
+        dt=0.001, via=[(t, pose[:3]) for t, pose in via], via_until=1.2
+    )
+    assert np.array_equal(lifted.y, alone.y)  # the same solve (structure)
+    assert np.max(np.abs(lifted.y[-1] - plain.y[-1])) <= 1e-4  # mm: back on its own course
+
+
 def test_the_cli_passes_via_points_and_names_a_bad_one(tmp_path, capsys):
     from bidmp.cli import main
 

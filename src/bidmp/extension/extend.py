@@ -468,7 +468,8 @@ def _extend_keeping_approach(
             "straight",
         )
     else:
-        result, candidates, refinement = _route(tra_imi, hover, seed, roadmap_options)
+        template = tra_imi if approach_rotation is None else _turned(tra_imi, approach_rotation)
+        result, candidates, refinement = _route(template, hover, seed, roadmap_options)
         history = np.empty(0) if result is None else result.history
         logger.debug("transfer: %s (%d candidates)", refinement, len(candidates))
     if scene is not None:
@@ -516,6 +517,24 @@ def _extend_keeping_approach(
         approach_index=start,
         refinement=refinement,
     )
+
+
+def _turned(piece: np.ndarray, rotation) -> np.ndarray:
+    """``piece`` (n, 3) with its steps turned progressively, by arc length, from not at all at its
+    start to ``rotation`` (3, 3) at its end: the template of a transfer that joins an approach
+    turned by ``rotation`` (its start and first direction kept, its last direction turned like
+    the approach, so the route meets the approach without a corner the timing cannot blend)."""
+    from scipy.spatial.transform import Rotation
+
+    steps = np.diff(piece, axis=0)
+    lengths = np.linalg.norm(steps, axis=1)
+    total = float(lengths.sum())
+    if total <= 0.0:
+        return piece
+    fraction = (np.cumsum(lengths) - 0.5 * lengths) / total  # at each step's middle
+    turn = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_rotvec()
+    turned = Rotation.from_rotvec(fraction[:, None] * turn).apply(steps)
+    return np.vstack([piece[:1], piece[0] + np.cumsum(turned, axis=0)])
 
 
 def _roadmap(tra_imi, target, seed, roadmap_options: dict, **changes) -> RoadmapResult:

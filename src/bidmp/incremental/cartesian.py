@@ -224,8 +224,10 @@ class CartesianBiDMP(PoseModel, Estimator):
         limits: dict | None = None,
         coupling=None,
         via=None,
+        via_until: float | None = None,
     ) -> PoseTrajectory:
-        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses as there)."""
+        """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses
+        and ``via_until`` as there)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment, position = self.position_._skill_query(
             goal_p, index, start_p
@@ -255,6 +257,7 @@ class CartesianBiDMP(PoseModel, Estimator):
             units=self.cartesian_.units_,
             coupling=coupling,
             vias=vias,
+            via_until=via_until,
         )
 
     def stepper(

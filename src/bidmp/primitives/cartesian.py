@@ -112,6 +112,7 @@ def _fit_parts(
     orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
 
 
+_SAME_TURN = 1e-9  # rad: a via orientation this close to the motion's own asks no change
 _PART_PARAMS = tuple(DMP._get_param_names())  # a pose model's parameters are its parts' own
 
 
@@ -180,8 +181,12 @@ class PoseModel:
         for index, (t, pose) in enumerate(pairs):
             q = as_quaternions(pose[3:], f"via[{index}] quaternion")[0]
             reference = np.array([np.interp(float(t), plain.t, column) for column in plain.y.T])
-            errors.append((t, _nearest_turn(q, goal_q, reference)))
-        return [(t, pose[:3]) for t, pose in pairs], errors
+            turn = _nearest_turn(q, goal_q, reference)
+            # A via orientation the part passes anyway asks no change of its weights: left out, so
+            # that a via pose which only moves the position (a lift) leaves the orientation as it is.
+            if np.linalg.norm(turn - reference) > _SAME_TURN:
+                errors.append((t, turn))
+        return [(t, pose[:3]) for t, pose in pairs], errors or None
 
     def _parts_state(self, meta: dict, arrays: dict) -> tuple[dict, dict]:
         """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
@@ -342,6 +347,7 @@ class CartesianDMP(PoseModel, Estimator):
         orientation_increment=None,
         coupling=None,
         via=None,
+        via_until: float | None = None,
     ) -> PoseTrajectory:
         """A timed pose rollout (see :meth:`bidmp.DMP.trajectory`).
 
@@ -361,6 +367,9 @@ class CartesianDMP(PoseModel, Estimator):
             Via poses (7,) passed exactly at ``t`` seconds: the position part through the
             positions, the orientation part through ``Log(q ⊗ goal⁻¹)`` on the turn nearest its
             own motion at that time (both least-norm, as :meth:`bidmp.DMP.trajectory`).
+        via_until : float, optional
+            With ``via``: only the kernels acting before this time (s) change, in both parts (as
+            :meth:`bidmp.DMP.trajectory`).
         """
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         _check_forcing_increment(position_increment, "position_increment")
@@ -387,6 +396,7 @@ class CartesianDMP(PoseModel, Estimator):
             units=self.units_,
             coupling=coupling,
             vias=vias,
+            via_until=via_until,
         )
 
     def rollout(self, goal=None, *, start=None, n_steps: int | None = None) -> np.ndarray:

@@ -116,10 +116,12 @@ def _pose_trajectory(  # noqa: PLR0913 - two parts and CartesianDMP.trajectory's
     units,
     coupling=None,
     vias=None,
+    via_until=None,
 ) -> PoseTrajectory:
     """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
     ``coupling`` terms act on the position part, and both parts then run the step integrator;
-    ``vias`` = (position via-points, orientation-error via-points)."""
+    ``vias`` = (position via-points, orientation-error via-points), ``via_until`` as
+    :meth:`bidmp.DMP.trajectory` for both."""
     position_via, error_via = (None, None) if vias is None else vias
     position = position_model.trajectory(
         goal_p,
@@ -130,6 +132,7 @@ def _pose_trajectory(  # noqa: PLR0913 - two parts and CartesianDMP.trajectory's
         forcing_increment=position_increment,
         coupling=coupling,
         via=position_via,
+        via_until=via_until,
     )
     if (
         limits and vias is None
@@ -143,6 +146,7 @@ def _pose_trajectory(  # noqa: PLR0913 - two parts and CartesianDMP.trajectory's
         forcing_increment=orientation_increment,
         coupling=None if coupling is None else [],
         via=error_via,
+        via_until=None if error_via is None else via_until,
     )
     n = min(len(position.t), len(error.t))
     orientation = orientation_from_log(error.y[:n], goal_q)

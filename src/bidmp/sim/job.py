@@ -50,22 +50,16 @@ RELEASE_S = 0.6  # s the world runs after a part is let go, for it to come to re
 def _approach(world: _World, label: str, target, axis) -> JobPhase:
     """The learned approach from the tool's place now, repaired if it would break the contract."""
     exclude = world.scenario.scene.target_parts(label, target[:3]) + world.gone
-    if world.pose:
-        start = np.concatenate([world.tcp, world.orientation().as_quat()])
-        trajectory = world.model.trajectory(
-            np.asarray(target, dtype=float), start=start, skill="nearest"
-        )
-        path, turns, note = trajectory.y, trajectory.q, ""
-        fractions = trajectory.t / trajectory.t[-1]
-    else:
-        repaired = world.repairer.repair(
-            world.model, target, label, start=world.tcp, axis=axis, exclude=exclude
-        )
-        if not repaired.ok:
-            raise _StepFailed(f"approach: {repaired.reason()}")
-        path, turns = repaired.motion, None
-        fractions = np.linspace(0.0, 1.0, path.shape[0])
-        note = f"repaired: {repaired.how}" if repaired.how else ""
+    # from the tool's pose now (a pose skill starts from the measured tool frame too)
+    start = np.concatenate([world.tcp, world.orientation().as_quat()]) if world.pose else world.tcp
+    repaired = world.repairer.repair(
+        world.model, target, label, start=start, axis=axis, exclude=exclude
+    )
+    if not repaired.ok:
+        raise _StepFailed(f"approach: {repaired.reason()}")
+    path, turns = repaired.motion[:, :3], (repaired.motion[:, 3:] if world.pose else None)
+    fractions = np.linspace(0.0, 1.0, path.shape[0])
+    note = f"repaired: {repaired.how}" if repaired.how else ""
     phase = _move(
         world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis
     )
@@ -520,23 +514,21 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
 
     # the scenario's contract, on the job's scene (its parts, the bin, the rack)
     contract = dataclasses.replace(Contract.of(scenario, cell.limits), scene=scene)
-    repairer = transfers = None
     allowance = mm(TRACKING_ALLOWANCE_MM, scenario.units)
-    if not scenario.is_pose:
-        repairer = Repairer(
-            contract,
-            scenario.demonstration,
-            extension=scenario.extension,
-            seed=scenario.seed,
-            allowance=allowance,
-            bidmp=scenario.bidmp,
-        )
-        transfers = Repairer(
-            _transfer_contract(contract),
-            scenario.demonstration,
-            order=("lift", "avoid"),
-            allowance=allowance,
-        )
+    repairer = Repairer(
+        contract,
+        scenario.demonstration,
+        extension=scenario.extension,
+        seed=scenario.seed,
+        allowance=allowance,
+        bidmp=scenario.bidmp,
+    )
+    transfers = Repairer(
+        _transfer_contract(contract),
+        scenario.demonstration,
+        order=("lift", "avoid"),
+        allowance=allowance,
+    )
     return _World(
         cell,
         scenario,

@@ -219,91 +219,32 @@ def _body(world: _World, part) -> tuple:
     return part.solid.moved(centre, rotation.as_matrix()), centre - world.tcp
 
 
-def _skill_path(world: _World, goal, skill, via=None, start_pose=None):
-    """The learned skill's motion from the tool's place now to ``goal``: (positions, fractions,
-    orientations or None)."""
-    options = {"skill": skill}
-    if via is not None:
-        options["via"] = via
-    if world.pose:
-        start = (
-            np.concatenate([world.tcp, world.orientation().as_quat()])
-            if start_pose is None
-            else start_pose
-        )
-        trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options)
-        return trajectory.y, trajectory.t / trajectory.t[-1], trajectory.q
-    trajectory = world.model.trajectory(np.asarray(goal, dtype=float), start=world.tcp, **options)
-    return trajectory.y, trajectory.t / trajectory.t[-1], None
-
-
 def _clear_transfer(world: _World, goal, exclude, carried=None):
-    """The plain DMP's motion to ``goal`` (a transfer), repaired where the tool, or the part it
+    """The plain skill's motion to ``goal`` (a transfer), repaired where the tool, or the part it
     carries (``carried``: its solid and offset from the mouth), would come within the margin of a
-    part: lifted over it by
-    via-points, or steered round it; ``(positions, fractions, orientations, note)``."""
-    if not world.pose:
-        repaired = world.transfers.repair(
-            world.model,
-            np.asarray(goal, dtype=float),
-            "the transfer",
-            start=world.tcp,
-            exclude=exclude,
-            skill=0,
-            carried=carried,
-        )
-        if not repaired.ok:
-            raise _StepFailed(repaired.reason())
-        note = f"repaired: {repaired.how}" if repaired.how else ""
-        return repaired.motion, np.linspace(0.0, 1.0, repaired.motion.shape[0]), None, note
-    scene = world.scene
-    start_pose = None
-    if world.pose:  # a transfer ends with the tool upright: over the bin or a slot
-        start_pose = np.concatenate([world.tcp, world.orientation().as_quat()])
+    part: lifted over it by via-points, or steered round it (:mod:`bidmp.tasks.repair`);
+    ``(positions, fractions, orientations, note)``. A pose transfer ends with the tool upright
+    (over the bin or a slot)."""
+    start = world.tcp
+    goal = np.asarray(goal, dtype=float)
+    if world.pose:
+        start = np.concatenate([world.tcp, world.orientation().as_quat()])
         goal = np.concatenate([goal[:3], _DOWN.as_quat()])
-    path, fractions, turns = _skill_path(world, goal, 0, start_pose=start_pose)
-    clearance = _clearance(world, path, exclude, carried)
-    if clearance.clear:
-        return path, fractions, turns, ""
-    from ..tasks.repair import carried_depth
-
-    height = carried_depth(carried)
-    top = max(
-        float(np.max([s.upper[2] for s in scene.solids])) + height,
-        float(world.tcp[2]),
-        float(goal[2]),
+    repaired = world.transfers.repair(
+        world.model,
+        goal,
+        "the transfer",
+        start=start,
+        exclude=exclude,
+        skill=0,
+        carried=carried,
     )
-    over = 0.5 * (world.tcp + np.asarray(goal, dtype=float)[:3])
-    over[2] = top + world.spec.clearance
-    via = [
-        (
-            0.5 * _skill_duration(world, goal, start_pose),
-            np.concatenate([over, _DOWN.as_quat()]) if world.pose else over,
-        )
-    ]
-    lifted, fractions, turns = _skill_path(world, goal, 0, via=via, start_pose=start_pose)
-    again = _clearance(world, lifted, exclude, carried)
-    if not again.clear:
-        unit = world.scenario.units
-        raise _StepFailed(
-            f"the learned move would {_closeness(clearance, unit)} {clearance.part}, and lifted "
-            f"{world.spec.clearance:g} {unit} over the work still {_closeness(again, unit)} {again.part}"
-        )
-    return (
-        lifted,
-        fractions,
-        turns,
-        f"lifted over the work (it would have come within the margin of {clearance.part})",
-    )
-
-
-def _skill_duration(world: _World, goal, start_pose) -> float:
-    """How long the plain skill's motion to ``goal`` lasts (s)."""
-    options = {"skill": 0}
-    start = start_pose if world.pose else world.tcp
-    return float(
-        world.model.trajectory(np.asarray(goal, dtype=float), start=start, **options).t[-1]
-    )
+    if not repaired.ok:
+        raise _StepFailed(repaired.reason())
+    note = f"repaired: {repaired.how}" if repaired.how else ""
+    motion = repaired.motion
+    turns = motion[:, 3:] if world.pose else None
+    return motion[:, :3], np.linspace(0.0, 1.0, motion.shape[0]), turns, note
 
 
 def _closeness(clearance, unit: str) -> str:

@@ -345,8 +345,7 @@ def execution_report(scenario, methods=("dmp", "bidmp")):
     from ..tasks import scenarios as scenario_module
     from ..tasks.evaluation import evaluate
 
-    if not isinstance(scenario, scenario_module.Scenario):
-        scenario = scenario_module.load(scenario)
+    scenario = scenario_module.resolve(scenario)
     settings = execution_settings(scenario)
     return evaluate(
         scenario, list(methods), repair=settings["repair"], allowance=settings["allowance"]
@@ -416,8 +415,7 @@ def _scenario_and_backend(scenario, backend):
     from ..tasks import scenarios as scenario_module
     from .backend import get_backend
 
-    if not isinstance(scenario, scenario_module.Scenario):
-        scenario = scenario_module.load(scenario)
+    scenario = scenario_module.resolve(scenario)
     if scenario.scene is None:
         raise ValueError(
             f'scenario {scenario.name!r} has no "scene": the simulator needs the parts and the tool'
@@ -470,26 +468,30 @@ def _start_where_it_works(cell, arm: RobotModel, start) -> None:
 
 
 def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
-    """The targets out of the arm's reach from its base, tool pointing down, each with its reason
-    (every target, when the demonstration's start is out of reach: every motion starts there)."""
+    """The targets out of the arm's reach from its base, each with its reason (every target, when
+    the demonstration's start is out of reach: every motion starts there). The tool points down,
+    or for a pose scenario as the pose says (a nut on a tilted bracket is reached tilted)."""
     from .backend import SimError
     from .robots import IK_TOLERANCE
 
     cell = _world(setup)
+    frame = "as the target's pose" if scenario.is_pose else "pointing down"
     where = (
-        f"for the {cell.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool pointing "
-        f'down): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
+        f"for the {cell.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool "
+        f'{frame}): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
         f'from its start pose (give one nearer: "robot": {{"rest": [...]}}, rad)'
     )
 
-    def reached(point) -> bool:
+    def reached(pose) -> bool:
+        pose = np.asarray(pose, dtype=float)
+        orientation = pose[3:7] if scenario.is_pose else None
         try:
-            _, error = cell.solve_ik(np.asarray(point, dtype=float)[:3] * cell.unit, cell.rest)
+            _, error = cell.solve_ik(pose[:3] * cell.unit, cell.rest, orientation)
         except SimError:
             return False
         return error <= 10 * IK_TOLERANCE
 
-    if not reached(np.asarray(scenario.demonstration, dtype=float)[0, :3]):
+    if not reached(np.asarray(scenario.demonstration, dtype=float)[0]):
         return {label: f"the demonstration's start is unreachable {where}" for label in labels}
     return {
         label: f"target {label} is unreachable {where}"

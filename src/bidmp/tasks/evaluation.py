@@ -258,8 +258,7 @@ def evaluate(
     from . import methods as registry
     from . import scenarios as scenario_module
 
-    if not isinstance(scenario, scenario_module.Scenario):
-        scenario = scenario_module.load(scenario)
+    scenario = scenario_module.resolve(scenario)
     names = _method_names(scenario, methods)
     labels = scenario.labels
     goals = np.stack([scenario.targets[label] for label in labels])
@@ -293,7 +292,7 @@ def evaluate(
         with _Timer() as timer:
             rollouts = method.rollouts(model, goals)
             outcome = result(name, rollouts, 0.0)
-            if repairer is not None and method.repairs and not scenario.is_pose:
+            if repairer is not None and method.repairs:
                 outcome = _repaired(outcome, repairer, model, scenario, labels, result, progress)
         outcome.runtime_s = fit_seconds + timer.seconds
         report.methods[name] = outcome
@@ -330,7 +329,12 @@ def _repaired(
     if not failed:
         return outcome
     scene = scenario.scene
-    rollouts = dict(outcome.rollouts)
+    rollouts = dict(outcome.rollouts)  # positions; a pose motion is rebuilt with its frames
+    if outcome.orientations is not None:
+        rollouts = {
+            label: np.hstack([path, outcome.orientations[label]])
+            for label, path in rollouts.items()
+        }
     repairs = {}
     for done, label in enumerate(failed):
         report("repairs", done, len(failed))

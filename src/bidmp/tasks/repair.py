@@ -129,7 +129,15 @@ class Repaired:
 
 
 def _is_bidmp(model) -> bool:
-    return hasattr(model, "learn") and hasattr(model, "skill_goals_")
+    """A Bi-DMP of positions or of poses (it learns new skills)."""
+    return hasattr(model, "learn") and (
+        hasattr(model, "skill_goals_") or hasattr(model, "skill_goal_orientations_")
+    )
+
+
+def _is_pose(model) -> bool:
+    """A model of poses (a CartesianDMP or CartesianBiDMP): its motions are (n, 7)."""
+    return hasattr(model, "orientation_")
 
 
 def _trajectory(model, goal, start, skill, **options):
@@ -137,6 +145,19 @@ def _trajectory(model, goal, start, skill, **options):
     if _is_bidmp(model):
         options["skill"] = skill
     return model.trajectory(goal, start=start, **options)
+
+
+def _path(trajectory) -> np.ndarray:
+    """A timed motion's samples: positions (n, 3), or for a pose motion poses (n, 7)."""
+    orientations = getattr(trajectory, "q", None)
+    return trajectory.y if orientations is None else np.hstack([trajectory.y, orientations])
+
+
+def _turns(motion) -> np.ndarray | None:
+    """The tool frame along a motion (n, 4) when it is a pose motion (n, 7); else None (the tool
+    upright)."""
+    motion = np.asarray(motion)
+    return motion[:, 3:7] if motion.shape[1] == 7 else None
 
 
 class Repairer:
@@ -217,10 +238,19 @@ class Repairer:
         self, contract: Contract, motion, goal, label, axis, exclude, carried=None
     ) -> Verdict:
         clearance = None
+        turns = _turns(motion)
         if contract.scene is not None and carried:
-            clearance = self._clearance(contract.scene, np.asarray(motion)[:, :3], exclude, carried)
+            clearance = self._clearance(
+                contract.scene, np.asarray(motion)[:, :3], exclude, carried, turns
+            )
         return contract.judge(
-            motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance
+            motion,
+            goal,
+            label=label,
+            axis=axis,
+            exclude=exclude,
+            clearance=clearance,
+            orientations=turns,
         )
 
     def blocked(self, goal, axis, exclude) -> str:
@@ -283,7 +313,7 @@ class Repairer:
         if not hasattr(model, "trajectory"):
             raise TypeError(f"model must be a fitted DMP or Bi-DMP, got {type(model).__name__}")
         if motion is None:
-            motion = _trajectory(model, goal, start, skill).y
+            motion = _path(_trajectory(model, goal, start, skill))
         if verdict is None:
             verdict = self._judge(self.contract, motion, goal, label, axis, exclude, carried)
         out = Repaired(np.asarray(motion), verdict)
@@ -349,7 +379,9 @@ class Repairer:
 
     @staticmethod
     def bidmp_possible(model) -> bool:
-        """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP)."""
+        """Whether ``extend`` can grow a Bi-DMP on ``model`` (a fitted plain DMP or pose DMP)."""
+        if _is_pose(model):
+            return hasattr(model, "cartesian_") or hasattr(model, "start_log_")
         return hasattr(model, "weights_") and hasattr(model, "n_steps_")
 
     def _try(  # noqa: PLR0913 - the query of Repairer.repair, passed on whole to each repair
@@ -377,7 +409,13 @@ class Repairer:
                 None,
                 None,
                 self.planning.judge(
-                    motion, goal, label=label, axis=axis, exclude=exclude, clearance=clearance
+                    motion,
+                    goal,
+                    label=label,
+                    axis=axis,
+                    exclude=exclude,
+                    clearance=clearance,
+                    orientations=_turns(motion),
                 ),
             )
         if how == "avoid":
@@ -387,7 +425,7 @@ class Repairer:
             term = SceneAvoidance(
                 scene, margin=scene.margin, target=label if label in scene.labels else None
             )
-            motion = _trajectory(model, goal, start, skill, coupling=[term]).y
+            motion = _path(_trajectory(model, goal, start, skill, coupling=[term]))
             return (
                 motion,
                 None,
@@ -397,10 +435,11 @@ class Repairer:
         widen = self.allowance + (shortfall if how == "margin" else 0.0)
         attempts = _WIDENINGS if how == "margin" else 1
         for _ in range(attempts):
-            planning = self._widened(widen)
-            trial, index = self._learned(model, goal, planning, start, skill)
-            motion = _trajectory(trial, goal, start, index).y
-            verdict = self._judge(planning, motion, goal, label, axis, exclude)
+            trial, index = self._learned(model, goal, self._widened(widen), start, skill)
+            motion = _path(_trajectory(trial, goal, start, index))
+            # Planned with a wider margin, judged by what it must keep: the margin and the
+            # allowance (the shortfall only steers the planning).
+            verdict = self._judge(self.planning, motion, goal, label, axis, exclude)
             if verdict.ok or verdict.clearance is None or how != "margin":
                 return motion, trial, index, verdict
             widen += max(verdict.clearance.margin - verdict.clearance.distance, 0.0)
@@ -410,27 +449,47 @@ class Repairer:
         """A copy of the Bi-DMP (one is built on a plain DMP) with a skill learned from an extended
         demonstration grown to ``goal`` through the planning scene, and that skill's index. It grows
         from the demonstration, or for a motion from another ``start`` from the skill's own motion
-        from there (a skill learned from the demonstration, run from elsewhere, is another motion)."""
-        from ..extension.extend import extend_demonstration
+        from there (a skill learned from the demonstration, run from elsewhere, is another motion).
+        A pose model grows a pose extension: its kept approach turned onto the target's axis."""
+        from ..extension.extend import extend_demonstration, extend_pose_demonstration
         from ..incremental.bidmp import BiDMP
+        from ..incremental.cartesian import CartesianBiDMP
 
-        dmp = model.dmp_ if _is_bidmp(model) else model  # the DMP fitted on the demonstration
-        trial = (
-            copy.deepcopy(model) if _is_bidmp(model) else BiDMP(copy.deepcopy(model), **self.bidmp)
-        )
+        pose = _is_pose(model)
+        if _is_bidmp(model):
+            trial = copy.deepcopy(model)
+            dmp = model.cartesian_.position_ if pose else model.dmp_  # fitted on the demonstration
+        else:
+            trial = (CartesianBiDMP if pose else BiDMP)(copy.deepcopy(model), **self.bidmp)
+            dmp = model.position_ if pose else model
         source, duration = self.demonstration, None
         if start is not None:
-            own = _trajectory(model, goal, start, skill)
-            source, duration = own.y[:, :3], float(own.t[-1])
-        extension = extend_demonstration(
-            source, goal[:3], seed=self.seed, scene=planning.scene, **self.extension
-        )
+            # A pose grows from the demonstrated motion run from there (its approach is the one
+            # the extension turns onto the target's axis; the skill's own motion to a tilted
+            # target comes down as the demonstration did, already turned, and would be kept so).
+            own = (
+                _trajectory(model, self.demonstration[-1], start, 0)
+                if pose
+                else _trajectory(model, goal, start, skill)
+            )
+            source, duration = _path(own), float(own.t[-1])
+        if pose:
+            options = {key: value for key, value in self.extension.items() if key != "approach"}
+            extension = extend_pose_demonstration(
+                source, goal, seed=self.seed, scene=planning.scene, **options
+            )
+            learned = extension.poses
+        else:
+            extension = extend_demonstration(
+                source, goal[:3], seed=self.seed, scene=planning.scene, **self.extension
+            )
+            learned = extension.complete
         scale = (
             1.0
             if duration is None
             else duration / dmp.duration_ * (dmp.n_steps_ - 1) / (source.shape[0] - 1)
         )
-        trial.learn(extension.complete, duration=extension.duration_for(dmp) * scale)
+        trial.learn(learned, duration=extension.duration_for(dmp) * scale)
         return trial, trial.n_skills - 1
 
     def _lift(self, model, goal, label, start, axis, exclude, skill, carried=None, known=None):
@@ -439,6 +498,7 @@ class Repairer:
         final approach is lifted to over the part's top, by up to :data:`_STRETCH` points spread
         along it; a ``ValueError`` when it cannot be."""
         scene = self.planning.scene
+        pose = _is_pose(model)
         trajectory = _trajectory(model, goal, start, skill)
         final = _final_approach_time(trajectory, goal, self.contract.approach_height, axis)
         # The weight change acts only through the kernels active before the final approach, so the
@@ -458,9 +518,11 @@ class Repairer:
             ):  # the same motion: its distances are known
                 clearance = type(known)(known.distance, known.part, known.point, scene.margin)
             else:
-                clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
+                clearance = self._clearance(
+                    scene, trajectory.y, exclude, carried, getattr(trajectory, "q", None)
+                )
             if clearance.clear:
-                return trajectory.y, clearance
+                return _path(trajectory), clearance
             owner = _owner(scene, clearance.part)
             path = trajectory.y[:, :3]
             height = carried_depth(carried)
@@ -481,19 +543,24 @@ class Repairer:
             ):
                 point = trajectory.y[index].copy()
                 point[2] = max(point[2], top)
+                if pose:  # the tool's frame as the motion has it there
+                    point = np.concatenate([point, trajectory.q[index]])
                 via[round(float(trajectory.t[index]), 12)] = point
             trajectory = _trajectory(
                 model, goal, start, skill, via=sorted(via.items()), via_until=until
             )
-        clearance = self._clearance(scene, trajectory.y[:, :3], exclude, carried)
+        clearance = self._clearance(
+            scene, trajectory.y, exclude, carried, getattr(trajectory, "q", None)
+        )
         if clearance.clear:
-            return trajectory.y, clearance
+            return _path(trajectory), clearance
         raise ValueError(f"{_MAX_ROUNDS} rounds of via-points did not lift it clear of the parts")
 
     @staticmethod
-    def _clearance(scene, path, exclude, carried=None):
-        """The tool's clearance along ``path``, and of a part it carries (:func:`carried_clearance`)."""
-        return carried_clearance(scene, path, exclude, carried)
+    def _clearance(scene, path, exclude, carried=None, orientations=None):
+        """The tool's clearance along ``path`` (its frame ``orientations``, default upright), and
+        of a part it carries (:func:`carried_clearance`)."""
+        return carried_clearance(scene, path, exclude, carried, orientations=orientations)
 
 
 def carried_clearance(scene, path, exclude, carried=None, support=(), orientations=None):
@@ -551,6 +618,10 @@ def carried_depth(carried) -> float:
 
 def _motion_duration(model, goal, skill) -> float:
     """How long the skill's motion lasts (s) before it rests at its goal: via-points lie within it."""
+    if _is_pose(model):  # the position part times the motion; a pose Bi-DMP picks on the position
+        if _is_bidmp(model):
+            skill = model.select_skill(np.asarray(goal, dtype=float), skill)
+        model, goal = model.position_, np.asarray(goal, dtype=float)[:3]
     if _is_bidmp(model):
         index = model.select_skill(np.asarray(goal, dtype=float), skill)
         return float(model.dmp_.tau * model.dmp_.duration_ * model.skill_time_scales_[index])

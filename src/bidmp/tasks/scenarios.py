@@ -688,6 +688,19 @@ def builtin_text(name: str) -> str:
     return _builtin_dir().joinpath(f"{name}.json").read_text(encoding="utf-8")
 
 
+def resolve(scenario, name: str = "scenario") -> Scenario:
+    """``scenario`` as a :class:`Scenario`: one given, or loaded from a file or a built-in name
+    (:func:`load`); anything else a TypeError naming the argument ``name``."""
+    if isinstance(scenario, Scenario):
+        return scenario
+    if not isinstance(scenario, (str, os.PathLike)):
+        raise TypeError(
+            f"{name} must be a bidmp Scenario, a scenario file or a built-in name, got "
+            f"{type(scenario).__name__}"
+        )
+    return load(scenario)
+
+
 def load(path_or_name: str | os.PathLike, *, allow_outside_files: bool = False) -> Scenario:
     """Load a scenario from a JSON file, or a built-in by name, and validate it completely.
 
