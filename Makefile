@@ -66,7 +66,7 @@ sim: $(STAMP)
 # through evaluate, the simulator and the job and checked by closed-form geometry of the tests' own;
 # the pad cells and the tilted pads of the evaluation.
 random-cells: $(STAMP)
-	BIDMP_RANDOM_CELLS=300 $(PY) -m pytest -q -n 2 tests/tasks/test_random_user_cells.py tests/tasks/test_random_cells.py tests/tasks/test_random_tilted_cells.py
+	BIDMP_RANDOM_CELLS=300 $(PY) -m pytest -q -n 2 tests/tasks/test_random_user_cells.py tests/tasks/test_random_cells.py tests/tasks/test_random_tilted_cells.py tests/tasks/test_tilted_user_cells.py
 
 # The avoidance on 200 random fields at 1 kHz (the tests run 50 at 250 Hz), then the
 # benchmark against movement_primitives on 50 fields: docs/results/avoidance.md, docs/avoidance.png.

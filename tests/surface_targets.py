@@ -249,6 +249,7 @@ def _package_overrides(tmp: Path) -> dict:
             "bin": (np.zeros(3), np.array([70.0, 70.0, 40.0])),
         },
         "bidmp.tasks.from_dict": {"data": scenario.spec},
+        "bidmp.tasks.resolve": {"scenario": "nut-unscrewing", "name": "scenario"},
         "bidmp.tasks.Repairer": {
             "contract": bidmp.tasks.Contract.of(scenario),
             "demonstration": scenario.demonstration,

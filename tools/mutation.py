@@ -179,10 +179,10 @@ TARGETS = (
         "bidmp.tasks.repair",
         ("Repairer.repair", "Repairer._try", "Repairer._judge"),
         (
+            "tests/tasks/test_repair_acceptance.py",
             "tests/tasks/test_tilted_user_cells.py::test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success",
             "tests/tasks/test_evaluation_assembly.py",
             "tests/tasks/test_user_cells.py",
-            "tests/test_oracles.py",
         ),
     ),
     Target(
@@ -387,8 +387,8 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     (
         "verdict assembly: a repair accepted",
         "Repairer._try",
-        "verdict = self._judge(self.planning, motion, goal, label, axis, exclude)",
-        "verdict = self._judge(self._widened(widen), motion, goal, label, axis, exclude)",
+        "verdict = self._judge(self.planning, motion, goal, label, axis, exclude, carried)",
+        "verdict = self._judge(self._widened(widen), motion, goal, label, axis, exclude, carried)",
         "a stale contract: an extension judged by the margin widened to plan it, not the one it must keep",
     ),
     # -- what the simulator executes
@@ -492,6 +492,10 @@ _BOUND = (
     "starts from, not that minimum (a tie keeps the same distance)"
 )
 _CLEARANCE = "bidmp.scene.clearance"
+KNOWN_CLEARANCE = (
+    "found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried, "
+    "verdict.clearance if motion is out.motion and how == 'lift' else None)"
+)
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (
         "bidmp.sim.job_world",
@@ -606,6 +610,39 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "/ -> *",
     ): "a target's axis is a unit vector already (a rotation of one, or the default): dividing "
     "and multiplying by its norm of 1 give the same bits",
+    # -- a repair accepted: the clearance handed to the lift is the one it would compute
+    **{
+        ("bidmp.tasks.repair", "Repairer.repair", KNOWN_CLEARANCE, change): "the method's own "
+        "motion's clearance is handed to the lift only to save computing it again: the lift's "
+        "first round runs that same motion (same model, goal, start and skill) and computes the "
+        "same clearance when it is not handed one; the other repairs ignore it"
+        for change in ("and -> or", "is -> is not", "== -> !=")
+    },
+    (
+        "bidmp.tasks.repair",
+        "Repairer.repair",
+        "ok = final.ok and planned.ok",
+        "planted: a verdict not re-judged: a repair accepted on the planning contract alone",
+    ): "the planning contract is the contract with its margin widened by the allowance (never "
+    "narrower while the margin is below the tool's radius), judged on the same motion with the "
+    "same target, axis, parts and carried part: its verdict can only be stricter, so the "
+    "contract's own re-judgement (kept, as the verdict the report shows) cannot change `ok` "
+    "(the or-mutant, where a stricter planning matters, is killed)",
+    (
+        "bidmp.tasks.repair",
+        "Repairer._try",
+        "attempts = _WIDENINGS if how == 'margin' else 1",
+        "1 -> 2",
+    ): "a second planning only follows a failed verdict of a margin repair (the loop returns at "
+    "once for any other): an extension's second attempt never runs",
+    (
+        "bidmp.tasks.repair",
+        "Repairer._judge",
+        "if contract.scene is not None and carried:",
+        "and -> or",
+    ): "with no scene there is no carried clearance to take and no contract that would judge it "
+    "(a Repairer refuses a contract without a scene); with no carried part the clearance taken is "
+    "the tool's own, the one the contract takes itself",
     (
         "bidmp.tasks.evaluation",
         "_failed_targets",

@@ -29,6 +29,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 DATA = ROOT / "tests" / "data"
 sys.path.insert(0, str(ROOT / "tests" / "tasks"))
 from test_user_cells import spec as cell_spec  # noqa: E402
+from test_user_cells import urdf_limits  # noqa: E402
 
 DEG = math.pi / 180.0
 ARMS = {
@@ -52,13 +53,7 @@ def _scenario(tmp_path, arm: str, **robot):
     data["robot"] = {
         "urdf": "arm.urdf",
         "flange": "flange",
-        "limits": {
-            "lower": [-r * DEG for r in ranges],
-            "upper": [r * DEG for r in ranges],
-            "velocity": [v * DEG for v in speeds],
-            "acceleration": [5 * v * DEG for v in speeds],
-            "jerk": [500 * v * DEG for v in speeds],
-        },
+        "limits": urdf_limits(ranges, speeds),
         **robot,
     }
     (tmp_path / "cell.json").write_text(json.dumps(data))

@@ -17,6 +17,7 @@ false alarm; it shows a violation, it does not prove its absence.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -25,13 +26,13 @@ import pytest
 from scipy.spatial.transform import Rotation
 from test_random_user_cells import UNITS
 from test_user_cells import spec as cell_spec
+from test_user_cells import urdf_limits
 
 from bidmp.tasks import evaluate, scenarios
 
 ROOT = Path(__file__).resolve().parents[2]
-DEG = np.pi / 180.0
 DOWN = Rotation.from_euler("x", 180.0, degrees=True)  # the tool pointing down
-STAND = np.array([-50.0, 60.0, 6.0])  # mm: the bracket's bottom centre, beside nut 2's column
+STAND = np.array([-50.0, 60.0, 12.0])  # mm: the bracket's bottom centre, beside nut 2's column
 STAND_SIZE = np.array([40.0, 30.0, 30.0])  # mm
 SINK = 2.0  # mm: the socket's mouth above the nut's base (as two_posts)
 # the TM5-700-like arm's published-style ranges and speeds (deg, deg/s)
@@ -39,14 +40,18 @@ RANGES = [270.0, 180.0, 155.0, 180.0, 180.0, 270.0]
 SPEEDS = [180.0, 180.0, 180.0, 225.0, 225.0, 225.0]
 
 
-def bracket_cell(directory: Path, units: str = "m", angle: float = 20.0) -> Path:
+def bracket_cell(
+    directory: Path, units: str = "m", angle: float = 20.0, about: str = "x", post=None
+) -> Path:
     """The cell's scenario file in ``directory`` (the arm's URDF copied beside it): the two-post
     task in ``units``, every target a pose with the tool down, and nut "B" on a bracket turned
-    ``angle`` degrees about x (its axis leaning toward the arm)."""
+    ``angle`` degrees about ``about`` (x: its axis leaning toward the arm for a positive angle;
+    y: toward the pack or away), with another post at ``post`` (x, y in mm) if given."""
     f = UNITS[units]
     data = cell_spec("two_posts.json", units)
-    data["name"] = f"bracket-{angle:g}-{units}"
-    tilt = Rotation.from_euler("x", angle, degrees=True)
+    data["name"] = f"bracket-{angle:g}-{about}-{units}"
+    turn = [angle, 0.0, 0.0] if about == "x" else [0.0, angle, 0.0]
+    tilt = Rotation.from_euler("xyz", turn, degrees=True)
     down = DOWN.as_quat().tolist()
     data["targets"] = {label: [*p, *down] for label, p in data["targets"].items()}
     base = STAND * f + tilt.apply([0.0, 0.0, STAND_SIZE[2] * f])  # the nut's base on the bracket
@@ -62,10 +67,21 @@ def bracket_cell(directory: Path, units: str = "m", angle: float = 20.0) -> Path
             "label": "bracket",
             "at": (STAND * f).tolist(),
             "size": (STAND_SIZE * f).tolist(),
-            "rotation": [angle, 0.0, 0.0],
+            "rotation": turn,
         },
-        {**nut, "label": "B", "at": base.tolist(), "rotation": [angle, 0.0, 0.0]},
+        {**nut, "label": "B", "at": base.tolist(), "rotation": turn},
     ]
+    if post is not None:  # as tall as the others, beside the bracket
+        plate_top = scene["parts"][0]["at"][2]
+        scene["parts"].append(
+            {
+                "type": "cylinder",
+                "label": "post3",
+                "at": [post[0] * f, post[1] * f, plate_top],
+                "radius": 4.0 * f,
+                "height": 68.0 * f,
+            }
+        )
     scene["standoff"]["bracket"] = scene["standoff"]["plate"]  # the nut stands on it
     data["methods"] = ["dmp", "bidmp"]
     shutil.copy(ROOT / "tests" / "data" / "tm5_like" / "tm5_like.urdf", directory / "arm.urdf")
@@ -74,13 +90,7 @@ def bracket_cell(directory: Path, units: str = "m", angle: float = 20.0) -> Path
         "flange": "flange",
         "base": data["robot"]["base"],
         "yaw": data["robot"]["yaw"],
-        "limits": {
-            "lower": [-r * DEG for r in RANGES],
-            "upper": [r * DEG for r in RANGES],
-            "velocity": [v * DEG for v in SPEEDS],
-            "acceleration": [5 * v * DEG for v in SPEEDS],
-            "jerk": [500 * v * DEG for v in SPEEDS],
-        },
+        "limits": urdf_limits(RANGES, SPEEDS),
     }
     path = directory / f"{data['name']}.json"
     path.write_text(json.dumps(data))
@@ -174,7 +184,8 @@ def check_pose_motion(spec: dict, label: str, poses: np.ndarray, context) -> Non
 # ---------------------------------------------------------------------------------------------
 # Tests
 # ---------------------------------------------------------------------------------------------
-@pytest.mark.parametrize(("units", "angle"), [("m", 20.0), ("mm", 10.0), ("cm", 30.0)])
+# other units, tilts and posts: the random cells below
+@pytest.mark.parametrize(("units", "angle"), [("m", 20.0)])
 def test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success(tmp_path, units, angle):
     path = bracket_cell(tmp_path, units, angle)
     spec = json.loads(path.read_text())
@@ -187,6 +198,39 @@ def test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success(tmp_path
         assert bidmp.task_success_at(label), (label, bidmp.reason_at(label))
         poses = np.hstack([bidmp.rollouts[label], bidmp.orientations[label]])
         check_pose_motion(spec, label, poses, (units, angle, label))
+
+
+def random_bracket(seed: int) -> dict:
+    """The bracket cell's random draw: the unit, the tilt (10-30 degrees either way about x or y)
+    and a post 25-40 mm beside the bracket's nut, across the way the nut's axis leans (so the
+    approach along it stays clear and a route exists over or round the post)."""
+    rng = np.random.default_rng(seed)
+    about = str(rng.choice(["x", "y"]))
+    angle = float(rng.uniform(10.0, 30.0)) * float(rng.choice([-1.0, 1.0]))
+    beside = float(rng.uniform(25.0, 40.0))
+    offset = [-beside, 0.0] if about == "x" else [0.0, beside]  # away from the nut columns
+    return {
+        "units": str(rng.choice(list(UNITS))),
+        "angle": angle,
+        "about": about,
+        "post": (STAND[:2] + offset).tolist(),
+    }
+
+
+N_RANDOM = int(os.environ.get("BIDMP_RANDOM_CELLS", "20")) // 10  # `make random-cells`: 30
+
+
+@pytest.mark.parametrize("seed", range(N_RANDOM))
+def test_every_target_of_a_random_tilted_bracket_cell_is_a_task_success(tmp_path, seed):
+    draw = random_bracket(seed)
+    path = bracket_cell(tmp_path, **draw)
+    spec = json.loads(path.read_text())
+    report = evaluate(scenarios.load(str(path)), ["bidmp"])
+    bidmp = report.methods["bidmp"]
+    for label in spec["targets"]:
+        assert bidmp.task_success_at(label), (seed, draw, label, bidmp.reason_at(label))
+        poses = np.hstack([bidmp.rollouts[label], bidmp.orientations[label]])
+        check_pose_motion(spec, label, poses, (seed, draw, label))
 
 
 def test_the_oracles_can_fail(tmp_path):
@@ -223,8 +267,8 @@ pybullet = pytest.importorskip("pybullet")
 
 def test_the_tilted_bracket_cell_on_the_arm_and_in_the_job_with_no_rest_pose(tmp_path):
     """The same cell in metres: ``bidmp demo`` exits 0 with every target a task success; the
-    simulator runs every motion (the measured tool path checked by the end and clearance oracles
-    here); the job removes the bracket's nut and the far nut past both posts."""
+    simulator runs the bracket's nut and the far nut past both posts (the measured tool path
+    checked by the end and clearance oracles here); the job removes both."""
     from bidmp import sim
     from bidmp.cli import main
 
@@ -234,8 +278,11 @@ def test_the_tilted_bracket_cell_on_the_arm_and_in_the_job_with_no_rest_pose(tmp
     results = json.loads((tmp_path / "demo" / "results.json").read_text())
     assert results["methods"]["bidmp"]["task_successes"] == len(spec["targets"])
     scenario = scenarios.load(str(path))
-    ran = sim.simulate(scenario, ["bidmp"], workers=2, record=True).methods["bidmp"]
-    assert ran.task_successes == len(spec["targets"]), ran
+    # the tilted nut and the far one past both posts; every target in `make random-cells`
+    labels = None if os.environ.get("BIDMP_RANDOM_CELLS") else ["B", "12"]
+    ran = sim.simulate(scenario, ["bidmp"], targets=labels, workers=2, record=True)
+    ran = ran.methods["bidmp"]
+    assert ran.task_successes == len(labels or spec["targets"]), ran
     for label, target in ran.targets.items():
         measured = np.asarray(target.path)
         goal = np.asarray(spec["targets"][label][:3])
@@ -246,5 +293,5 @@ def test_the_tilted_bracket_cell_on_the_arm_and_in_the_job_with_no_rest_pose(tmp
             if p["type"] == "cylinder"
         ]
         assert min(posts) > 0.0, (label, posts)  # the measured mouth never inside a post
-    job = sim.run_job(scenario, targets=["B", "12"])
-    assert job.removed == 2, job.summary()
+    job = sim.run_job(scenario, targets=labels)
+    assert job.removed == len(labels or spec["targets"]), job.summary()

@@ -28,6 +28,19 @@ from bidmp import sim  # noqa: E402
 DATA = Path(__file__).parents[1] / "data"
 
 
+def urdf_limits(ranges_deg, speeds_deg) -> dict:
+    """A URDF arm's ``"limits"`` from its maker's ranges (±deg) and speeds (deg/s); acceleration
+    and jerk nobody publishes assumed 5x and 500x the speed per second."""
+    deg = np.pi / 180.0
+    return {
+        "lower": [-r * deg for r in ranges_deg],
+        "upper": [r * deg for r in ranges_deg],
+        "velocity": [v * deg for v in speeds_deg],
+        "acceleration": [5 * v * deg for v in speeds_deg],
+        "jerk": [500 * v * deg for v in speeds_deg],
+    }
+
+
 def spec(name: str, units: str = "mm") -> dict:
     """A test cell's scenario dict, its lengths converted from mm to ``units``."""
     data = json.loads((DATA / name).read_text())

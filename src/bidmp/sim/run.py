@@ -75,6 +75,7 @@ class _SimSetup:
     pace: float | None = None  # the demonstration's peak tool speed (units/s), None: limits only
     # the demonstration's start (units): an arm given without a rest pose starts there
     start: tuple | None = None
+    free_turn: bool = True  # the tool's turn about its axis left to the IK (a socket)
 
 
 def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
@@ -183,6 +184,7 @@ def _world(setup: _SimSetup):
         if setup.start is not None:
             _start_where_it_works(_WORLD["cell"], setup.robot, setup.start)
         _WORLD["key"] = key
+    _WORLD["cell"].free_turn = setup.free_turn
     return _WORLD["cell"]
 
 
@@ -438,7 +440,15 @@ def _open_world(backend, scenario, base, yaw):
     robot = {} if arm is PANDA_MODEL else {"robot": arm}
     cell = backend.load_robot(scenario.scene, scenario.units, base, yaw, **robot)
     _start_where_it_works(cell, arm, np.asarray(scenario.demonstration, dtype=float)[0, :3])
+    cell.free_turn = _turn_is_free(scenario)
     return cell
+
+
+def _turn_is_free(scenario) -> bool:
+    """Whether the tool's turn about its own axis is left to the arm's IK: a socket, symmetric
+    about its axis and turned by a spindle (the nut task, or a scenario without a job), may turn
+    as the arm likes; a gripper holding a cell turns the cell with it, so its frame is kept."""
+    return scenario.job is None or scenario.job.kind == "unscrew"
 
 
 def _start_where_it_works(cell, arm: RobotModel, start) -> None:
@@ -556,6 +566,7 @@ def _setup(scenario, labels, base, yaw, **run) -> _SimSetup:
         **run,
         pace=scenario.pace,
         start=tuple(np.asarray(scenario.demonstration, dtype=float)[0, :3].tolist()),
+        free_turn=_turn_is_free(scenario),
     )
 
 

@@ -38,5 +38,6 @@ if TYPE_CHECKING:
         check_robot,
         from_dict,
         load,
+        resolve,
     )
 __getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -439,7 +439,7 @@ class Repairer:
             motion = _path(_trajectory(trial, goal, start, index))
             # Planned with a wider margin, judged by what it must keep: the margin and the
             # allowance (the shortfall only steers the planning).
-            verdict = self._judge(self.planning, motion, goal, label, axis, exclude)
+            verdict = self._judge(self.planning, motion, goal, label, axis, exclude, carried)
             if verdict.ok or verdict.clearance is None or how != "margin":
                 return motion, trial, index, verdict
             widen += max(verdict.clearance.margin - verdict.clearance.distance, 0.0)

@@ -87,6 +87,7 @@ __all__ = [
     "ScenarioError",
     "METHODS",
     "load",
+    "resolve",
     "builtin_names",
     "builtin_text",
     "from_dict",

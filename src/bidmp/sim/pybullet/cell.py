@@ -124,8 +124,11 @@ class RobotCell:
             self.gains = [GAIN] * len(movable)
             # A tool symmetric about its axis leaves the turn about that axis free; it is the last
             # joint's when that joint turns about the tool's axis (the Panda, the iiwa, the xArm6, the
-            # UR5): pose skills then park it and solve the others for the position and the axis.
+            # UR5): the IK then parks it and solves the others for the position and the axis.
             self.wrist_turns_tool = self._last_joint_turns_tool()
+            # False while the tool's turn matters (a gripper's part turns with it): set per world
+            # by the simulator and the job (bidmp.sim.run._turn_is_free)
+            self.free_turn = True
             self.base = np.asarray(base, dtype=float)
             self.yaw = float(yaw)
             self._set_joints(robot.rest)

@@ -18,7 +18,6 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
     """Joint positions that put the TCP at ``point_m`` (m) with the tool's frame at
     ``orientation`` (quaternion x, y, z, w; default pointing down), started from ``seed``;
     and the position error left (m)."""
-    p = cell.p
     point_m = _reachable(as_point(point_m, 3, "point_m"), cell.base * cell.unit, "point_m")
     q = _joint_seed(seed, cell.limits)
     if orientation is not None:
@@ -28,40 +27,64 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
         if orientation.shape[0] != 1:
             raise ValueError(f"orientation must be one quaternion (4,), got {orientation.shape[0]}")
         orientation = orientation[0]
-    target_orientation = _DOWN if orientation is None else [float(v) for v in orientation]
-    axis = None
-    if orientation is not None:
-        # The tool is a socket, symmetric about its axis: only the axis is prescribed. Each
-        # burst aims at the orientation nearest the current one with that axis, so the arm
-        # keeps its own turn about the axis (a full orientation made the wrist fight it).
-        from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation
 
-        axis = Rotation.from_quat(target_orientation).apply([0.0, 0.0, 1.0])
-    limits = cell.limits
+    target_orientation = _DOWN if orientation is None else [float(v) for v in orientation]
+    # The tool is a socket (a spindle turns it), symmetric about its axis: only the axis is
+    # prescribed, pointing down or as ``orientation`` has it (5 DOF). Each burst aims at the
+    # orientation nearest the current one with that axis, so the arm keeps its own turn about
+    # the axis: a full orientation made the wrist fight it, and near a 6-axis arm's wrist
+    # singularity left 0.06 mm where this leaves 0.005 (an xArm6 2 mm from it).
+    axis = Rotation.from_quat(target_orientation).apply([0.0, 0.0, 1.0])
+    seed = q
+    # The last joint, where it turns the flange about the tool's axis (moving neither the tool's
+    # mouth nor its axis), is parked at its start pose's turn (chosen farthest inside the limits)
+    # rather than left to drift to a limit; where the parked arm does not converge (a joint near
+    # its own limit on the way), the turn is left to the arm too.
+    # Last, the whole frame prescribed (its turn the one given, or the pose's): another branch
+    # of the solutions, which a seed near a joint limit may reach when the free turn does not.
+    # A gripper holding a part (``cell.free_turn`` False) turns it with the tool: the whole frame
+    # is prescribed for a motion pointing down, the axis for a pose (its turn the arm's own).
+    tries = [(True, None)] if cell.wrist_turns_tool else []
+    tries += [(False, None), (False, list(target_orientation))]
+    if not getattr(cell, "free_turn", True):
+        tries = [(cell.wrist_turns_tool, None)] if orientation is not None else tries[-1:]
+    best = None
+    for park, frame in tries:
+        q, error = _bursts(cell, point_m, seed, axis, park, frame)
+        if best is None or error < best[1]:
+            best = (q, error)
+        if error <= IK_ACCURACY:
+            break
+    return best
+
+
+def _bursts(cell, point_m, seed, axis, park: bool, frame=None) -> tuple[np.ndarray, float]:
+    """Short bursts of PyBullet's damped least squares from ``seed`` toward ``point_m`` (m) with
+    the tool's axis along ``axis``, each aiming at the orientation nearest the current one with
+    that axis (or at ``frame``, a quaternion, when given); ``park``: the last joint held at the
+    start pose's turn. Checked by forward
+    kinematics: a few dozen iterations reach 1 µm from a seed a few millimetres away (one long
+    call costs 10x). Each check leaves the planning copy at its joints, where the next starts."""
+    from scipy.spatial.transform import Rotation
+
+    p, limits = cell.p, cell.limits
     ranges = [upper - lower for lower, upper in zip(limits.lower, limits.upper)]
-    error = math.inf
-    # Short bursts from the previous solution, checked by forward kinematics: a few dozen
-    # iterations reach 1 µm from a seed a few millimetres away (one long call costs 10x). Each
-    # check leaves the planning copy at its joints, where the next burst starts.
+    q, error = seed, math.inf
     cell._set_joints(q, kinematic=True)
-    for _ in range(20):
-        if axis is not None:
-            current = Rotation.from_quat(
-                p.getLinkState(
-                    cell.ik_robot,
-                    cell.tcp,
-                    computeForwardKinematics=1,
-                    physicsClientId=cell.ik_client,
-                )[5]
-            )
-            swing, _ = Rotation.align_vectors([axis], [current.apply([0.0, 0.0, 1.0])])
-            target_orientation = (swing * current).as_quat().tolist()
+    for _ in range(60):
+        current = Rotation.from_quat(
+            p.getLinkState(
+                cell.ik_robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.ik_client
+            )[5]
+        )
+        swing, _ = Rotation.align_vectors([axis], [current.apply([0.0, 0.0, 1.0])])
         q = np.array(
             p.calculateInverseKinematics(
                 cell.ik_robot,
                 cell.tcp,
                 point_m.tolist(),
-                target_orientation,
+                (swing * current).as_quat().tolist() if frame is None else frame,
                 lowerLimits=list(limits.lower),
                 upperLimits=list(limits.upper),
                 jointRanges=ranges,
@@ -71,9 +94,7 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
                 physicsClientId=cell.ik_client,
             )[: len(cell.arm)]
         )
-        if axis is not None and cell.wrist_turns_tool:
-            # The last joint turns the flange about the tool's axis, which moves neither the tool's
-            # mouth nor its axis: park it where it rests instead of letting it drift to a limit.
+        if park:
             q[-1] = cell.model.rest[-1]
         error = float(np.linalg.norm(cell._tcp_at(q) - point_m))
         if error <= IK_ACCURACY:
