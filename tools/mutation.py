@@ -177,7 +177,7 @@ TARGETS = (
     Target(
         "verdict assembly: a repair accepted",
         "bidmp.tasks.repair",
-        ("Repairer.repair", "Repairer._try", "Repairer._judge"),
+        ("Repairer.repair", "Repairer._try", "Repairer._judge", "Repairer._final"),
         (
             "tests/tasks/test_repair_acceptance.py",
             "tests/tasks/test_tilted_user_cells.py::test_every_target_of_a_cell_with_a_tilted_bracket_is_a_task_success",
@@ -376,6 +376,13 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
         "orientations=turns,",
         "orientations=None,",
         "a wrong frame: a repaired pose motion judged with the tool upright (no alignment, no tilt)",
+    ),
+    (
+        "verdict assembly: a repair accepted",
+        "Repairer._final",
+        "if not planned.ok or self.planning.scene.margin == self.contract.scene.margin:",
+        "if True:",
+        "a verdict not re-judged: the planning contract's verdict reported as the contract's",
     ),
     (
         "verdict assembly: a repair accepted",
@@ -626,8 +633,24 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ): "the planning contract is the contract with its margin widened by the allowance (never "
     "narrower while the margin is below the tool's radius), judged on the same motion with the "
     "same target, axis, parts and carried part: its verdict can only be stricter, so the "
-    "contract's own re-judgement (kept, as the verdict the report shows) cannot change `ok` "
-    "(the or-mutant, where a stricter planning matters, is killed)",
+    "contract's own re-judgement (kept, as the verdict the report shows) cannot change `ok`; "
+    "which verdict is reported is tested (a planted _final bug that reports the planning's is killed)",
+    (
+        "bidmp.tasks.repair",
+        "Repairer.repair",
+        "ok = final.ok and planned.ok",
+        "and -> or",
+    ): "the contract's verdict is the planning's own wherever the planning refuses (_final), and "
+    "the planning contract is the stricter one otherwise: final.ok or planned.ok is planned.ok, as "
+    "final.ok and planned.ok is",
+    (
+        "bidmp.tasks.repair",
+        "Repairer._final",
+        "if not planned.ok or self.planning.scene.margin == self.contract.scene.margin:",
+        "or -> and",
+    ): "cost only: the contract judges again a motion the planning refused (a verdict never used: "
+    "the repair is not kept and its note is the planning's reason) or one it judged under the "
+    "same margin (the same verdict)",
     (
         "bidmp.tasks.repair",
         "Repairer._try",

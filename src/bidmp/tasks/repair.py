@@ -358,7 +358,7 @@ class Repairer:
                 )
                 continue
             candidate, trial, trial_skill, planned = found
-            final = self._judge(self.contract, candidate, goal, label, axis, exclude, carried)
+            final = self._final(planned, candidate, goal, label, axis, exclude, carried)
             ok = final.ok and planned.ok
             out.attempts.append(
                 Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason())
@@ -376,6 +376,15 @@ class Repairer:
             if planned.clearance is not None:
                 shortfall = max(shortfall, planned.clearance.margin - planned.clearance.distance)
         return out
+
+    def _final(self, planned, motion, goal, label, axis, exclude, carried) -> Verdict:
+        """The contract's own verdict on a repair's ``motion`` (the one the report shows), judged
+        after its verdict on the planning contract (``planned``): not judged again where that
+        already failed (the repair is not kept), nor where no allowance widens the planning
+        contract (the two are then one contract, on the same motion and arguments)."""
+        if not planned.ok or self.planning.scene.margin == self.contract.scene.margin:
+            return planned
+        return self._judge(self.contract, motion, goal, label, axis, exclude, carried)
 
     @staticmethod
     def bidmp_possible(model) -> bool:

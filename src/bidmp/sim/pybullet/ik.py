@@ -66,25 +66,21 @@ def _bursts(cell, point_m, seed, axis, park: bool, frame=None) -> tuple[np.ndarr
     start pose's turn. Checked by forward
     kinematics: a few dozen iterations reach 1 µm from a seed a few millimetres away (one long
     call costs 10x). Each check leaves the planning copy at its joints, where the next starts."""
-    from scipy.spatial.transform import Rotation
-
     p, limits = cell.p, cell.limits
     ranges = [upper - lower for lower, upper in zip(limits.lower, limits.upper)]
     q, error = seed, math.inf
     cell._set_joints(q, kinematic=True)
     for _ in range(60):
-        current = Rotation.from_quat(
-            p.getLinkState(
+        if frame is None:
+            current = p.getLinkState(
                 cell.ik_robot, cell.tcp, computeForwardKinematics=1, physicsClientId=cell.ik_client
             )[5]
-        )
-        swing, _ = Rotation.align_vectors([axis], [current.apply([0.0, 0.0, 1.0])])
         q = np.array(
             p.calculateInverseKinematics(
                 cell.ik_robot,
                 cell.tcp,
                 point_m.tolist(),
-                (swing * current).as_quat().tolist() if frame is None else frame,
+                _aimed(current, axis) if frame is None else frame,
                 lowerLimits=list(limits.lower),
                 upperLimits=list(limits.upper),
                 jointRanges=ranges,
@@ -100,3 +96,26 @@ def _bursts(cell, point_m, seed, axis, park: bool, frame=None) -> tuple[np.ndarr
         if error <= IK_ACCURACY:
             break
     return q, error
+
+
+def _aimed(current, axis) -> list:
+    """The frame nearest ``current`` (quaternion x, y, z, w) whose z axis is ``axis`` (unit, (3,)):
+    ``current`` turned by the shortest arc from its z axis onto ``axis``, as a list (x, y, z, w).
+    In closed form (the half-way quaternion): SciPy's ``align_vectors`` gives the same rotation
+    at 30x the cost, once per burst (tests/sim/test_free_axis.py compares the two)."""
+    x, y, z, w = (float(v) for v in current)
+    tool_z = np.array([2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)])
+    dot = float(tool_z @ axis)
+    if dot < -1.0 + 1e-12:  # opposite: half a turn about any axis across it
+        across = np.cross(tool_z, [1.0, 0.0, 0.0] if abs(tool_z[0]) < 0.9 else [0.0, 1.0, 0.0])
+        swing = np.append(across / np.linalg.norm(across), 0.0)
+    else:
+        swing = np.append(np.cross(tool_z, axis), 1.0 + dot)
+        swing /= np.linalg.norm(swing)
+    sx, sy, sz, sw = swing
+    return [
+        sw * x + sx * w + sy * z - sz * y,
+        sw * y - sx * z + sy * w + sz * x,
+        sw * z + sx * y - sy * x + sz * w,
+        sw * w - sx * x - sy * y - sz * z,
+    ]
