@@ -661,11 +661,12 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (
         "bidmp.tasks.repair",
         "Repairer._judge",
-        "if contract.scene is not None and carried:",
+        "if clearance is None and contract.scene is not None and carried:",
         "and -> or",
-    ): "with no scene there is no carried clearance to take and no contract that would judge it "
-    "(a Repairer refuses a contract without a scene); with no carried part the clearance taken is "
-    "the tool's own, the one the contract takes itself",
+    ): "the same clearance, at another cost: with no carried part the clearance taken is the "
+    "tool's own, the one the contract takes itself; one handed in (a lift's) is the same "
+    "motion's, taken with the same carried part on the same scene; with no scene there is no "
+    "contract that would judge it (a Repairer refuses a contract without a scene)",
     (
         "bidmp.tasks.evaluation",
         "_failed_targets",

@@ -235,11 +235,13 @@ class Repairer:
 
     # -- the judgement -----------------------------------------------------------------------------
     def _judge(
-        self, contract: Contract, motion, goal, label, axis, exclude, carried=None
+        self, contract: Contract, motion, goal, label, axis, exclude, carried=None, clearance=None
     ) -> Verdict:
-        clearance = None
+        """``contract``'s verdict on ``motion`` (positions, or poses: judged with the tool's
+        frame), a ``carried`` part's clearance counted with the tool's; ``clearance``: the
+        motion's, when the caller has it already (a lift's)."""
         turns = _turns(motion)
-        if contract.scene is not None and carried:
+        if clearance is None and contract.scene is not None and carried:
             clearance = self._clearance(
                 contract.scene, np.asarray(motion)[:, :3], exclude, carried, turns
             )
@@ -413,20 +415,10 @@ class Repairer:
             motion, clearance = self._lift(
                 model, goal, label, start, axis, exclude, skill, carried, known
             )
-            return (
-                motion,
-                None,
-                None,
-                self.planning.judge(
-                    motion,
-                    goal,
-                    label=label,
-                    axis=axis,
-                    exclude=exclude,
-                    clearance=clearance,
-                    orientations=_turns(motion),
-                ),
+            verdict = self._judge(
+                self.planning, motion, goal, label, axis, exclude, clearance=clearance
             )
+            return motion, None, None, verdict
         if how == "avoid":
             from ..primitives.avoidance import SceneAvoidance
 
