@@ -51,3 +51,30 @@ def loaded_after():
     """``loaded_after(code, modules)``: the modules of ``modules`` that ``code`` imports when run
     in a new interpreter (what a command's start-up pays for)."""
     return _loaded_after
+
+
+class _Peak:
+    """The peak memory (MB, tracemalloc: NumPy reports its buffers) allocated inside a block."""
+
+    megabytes = 0.0
+
+    def __enter__(self):
+        import tracemalloc
+
+        tracemalloc.start()
+        return self
+
+    def __exit__(self, *exc):
+        import tracemalloc
+
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+        self.megabytes = peak / 2**20
+        return False
+
+
+@pytest.fixture
+def peak_memory():
+    """``with peak_memory() as peak: ...; peak.megabytes``: what a block allocated at most. Shows
+    that a refusal came before the work (the work would allocate far more), without a clock."""
+    return _Peak

@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import time
 from pathlib import Path
 
 import numpy as np
@@ -39,15 +38,11 @@ def scene():
     return bidmp.tasks.load("nut-unscrewing").scene
 
 
-def refused(call, *names, kinds=(ValueError, TypeError), seconds=5.0):
-    """Run ``call``; it must refuse within ``seconds`` in one short line naming one of ``names``."""
-    begin = time.perf_counter()
+def refused(call, *names, kinds=(ValueError, TypeError)):
+    """Run ``call``; it must refuse in one short line naming one of ``names``."""
     with pytest.raises(kinds) as caught:
         call()
     message = str(caught.value)
-    assert time.perf_counter() - begin < seconds, (
-        f"took {time.perf_counter() - begin:.1f} s to refuse"
-    )
     assert "\n" not in message and len(message) <= 300, message
     assert any(name in message for name in names), f"{message!r} names none of {names}"
     return message

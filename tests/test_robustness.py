@@ -10,7 +10,6 @@ import stat
 import subprocess
 import sys
 import textwrap
-import time
 import tracemalloc
 import warnings
 import zipfile
@@ -33,19 +32,17 @@ PYTHON = sys.executable
 from bidmp.demonstrations import recording_path  # noqa: E402  (the bundled copies of shared/data/recordings)
 
 
-def cli(argv, seconds=10.0):
-    """Run the CLI in this process; return (exit code, stdout, stderr) and check the time."""
+def cli(argv):
+    """Run the CLI in this process; return (exit code, stdout, stderr). (How long the commands
+    take is benchmarks/bench_robustness.py's: no clock in the tests.)"""
     out, err = io.StringIO(), io.StringIO()
-    start = time.perf_counter()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         code = main([str(a) for a in argv])
-    elapsed = time.perf_counter() - start
-    assert elapsed < seconds, f"{argv} took {elapsed:.1f} s"
     return code, out.getvalue(), err.getvalue()
 
 
-def assert_one_line_error(argv, match=None, seconds=10.0):
-    code, _, err = cli(argv, seconds)
+def assert_one_line_error(argv, match=None):
+    code, _, err = cli(argv)
     assert code == 2, (argv, code, err)
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
@@ -188,7 +185,7 @@ def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
     )
     path = tmp_path / "long.npy"
     np.save(path, y)
-    code, out, err = cli(["segment", path], seconds=20.0)
+    code, out, err = cli(["segment", path])
     assert code == 0, err
     assert "1000000 samples" in out
     csv_path = tmp_path / "long.csv"
@@ -200,13 +197,11 @@ def test_segment_on_a_million_row_recording_takes_seconds(tmp_path):
         comments="",
         fmt="%.6f",
     )
-    code, out, err = cli(["segment", csv_path, "--raw"], seconds=20.0)
+    code, out, err = cli(["segment", csv_path, "--raw"])
     assert code == 0 and "1000000 samples" in out, err
-    code, out, err = cli(["segment", csv_path], seconds=20.0)  # timed input is prepared, as by fit
+    code, out, err = cli(["segment", csv_path])  # timed input is prepared, as by fit
     assert code == 0 and "prepared: kept" in out, err
-    started = time.perf_counter()
-    points = bidmp.segment(y).points
-    assert time.perf_counter() - started < 5.0
+    points = bidmp.segment(y).points  # its time: benchmarks/bench_robustness.py
     assert np.all((points > 0) & (points < y.shape[0]))
 
 
@@ -292,24 +287,25 @@ def test_bad_seeds_are_named(seed, error):
         bidmp.extend_demonstration(curved_demo(100, 3), [1.0, 1.0, 1.0], seed=seed)
 
 
-def test_singular_bls_and_oversized_bls_are_value_errors():
+def test_singular_bls_and_oversized_bls_are_value_errors(peak_memory):
     X = np.tile(np.linspace(0, 1, 50)[:, None], (1, 3))
     with pytest.raises(ValueError, match="reg"):
         bidmp.BLS(reg=1e-300, update="exact_ridge").fit(X, X[:, 0])
-    started = time.perf_counter()
-    for params in (
-        {"n_windows": 10**6},
-        {"n_enhance": 10**7},
-        {"n_windows": 50, "n_mapped": 50, "n_enhance": 2000},
-        {"admm_iterations": 10**9},
-    ):
-        with pytest.raises(ValueError, match="max_hidden_nodes|admm_iterations"):
-            bidmp.BLS(**params).fit(X, X[:, 0])
-    with pytest.raises(ValueError, match="max_work"):
-        bidmp.BLS(n_enhance=2500).fit(
-            np.random.default_rng(0).random((20_000, 3)), np.zeros(20_000)
-        )
-    assert time.perf_counter() - started < 2.0
+    data = np.random.default_rng(0).random((20_000, 3))  # allocated before the refusals
+    peak = peak_memory()
+    with peak:
+        for params in (
+            {"n_windows": 10**6},
+            {"n_enhance": 10**7},
+            {"n_windows": 50, "n_mapped": 50, "n_enhance": 2000},
+            {"admm_iterations": 10**9},
+        ):
+            with pytest.raises(ValueError, match="max_hidden_nodes|admm_iterations"):
+                bidmp.BLS(**params).fit(X, X[:, 0])
+        with pytest.raises(ValueError, match="max_work"):
+            bidmp.BLS(n_enhance=2500).fit(data, np.zeros(20_000))
+    # refused before the work: the last one's enhancement layer alone would be 400 MB
+    assert peak.megabytes < 20.0, peak.megabytes
 
 
 def test_load_never_leaks_attribute_index_or_recursion_errors(tmp_path, model_file):
@@ -366,7 +362,7 @@ def test_extend_with_a_demonstration_of_another_length(tmp_path):
     model = save_model(bidmp.DMP(protocol="paper").fit(curved_demo(200, 3)), tmp_path / "m.npz")
     demo = save_trajectory(curved_demo(333, 3), tmp_path / "d.csv")
     code, out, err = cli(
-        ["extend", model, demo, "--target", 1.5, 1.5, 1.5, "-o", tmp_path / "e.npz"], seconds=30
+        ["extend", model, demo, "--target", 1.5, 1.5, 1.5, "-o", tmp_path / "e.npz"]
     )
     assert code == 0, err
     assert np.all(np.isfinite(load_model(tmp_path / "e.npz").rollout([1.5, 1.5, 1.5])))
@@ -571,13 +567,15 @@ def test_scenario_check_runs_what_demo_runs(tmp_path, change, match):
 
 
 # --- 7. rollout_many: chunked output instead of one huge block -------------------------------
-def test_rollout_many_refuses_a_huge_block_and_says_how_to_chunk(tmp_path):
+def test_rollout_many_refuses_a_huge_block_and_says_how_to_chunk(tmp_path, peak_memory):
     dmp = bidmp.DMP(protocol="paper").fit(curved_demo(1000, 2))
     goals = np.zeros((1_000_000, 2))
-    started = time.perf_counter()
-    with pytest.raises(ValueError, match="14.9 GiB.*open_memmap.*iter_rollouts"):
+    with (
+        peak_memory() as peak,
+        pytest.raises(ValueError, match="14.9 GiB.*open_memmap.*iter_rollouts"),
+    ):
         dmp.rollout_many(goals)
-    assert time.perf_counter() - started < 2.0
+    assert peak.megabytes < 20.0, peak.megabytes  # refused before allocating the block
     goals = np.random.default_rng(0).normal(size=(300, 2))
     expected = dmp.rollout_many(goals)
     out = np.lib.format.open_memmap(
@@ -688,6 +686,6 @@ def test_long_noisy_minimum_jerk_is_fast_and_equals_the_direct_filter():
     np.testing.assert_allclose(
         _low_pass(noise, 600.0), gaussian_filter1d(noise, 600.0, axis=0), atol=1e-12
     )
-    started = time.perf_counter()
+    # its time: benchmarks/bench_robustness.py
     y = bidmp.demonstrations.minimum_jerk([[0, 0, 0], [100, 50, 20]], 1_000_000, noise=1.0)
-    assert time.perf_counter() - started < 5.0 and np.all(np.isfinite(y))
+    assert np.all(np.isfinite(y))

