@@ -381,3 +381,16 @@ def test_a_job_on_a_tilted_pack_unscrews_along_each_nuts_own_axis():
         off = np.linalg.norm(approach - np.outer(along, axis), axis=1)
         band = along <= tilted.approach_height
         assert band[-1] and off[band].max() <= tilted.success_threshold
+
+
+def test_a_targets_list_that_names_none_is_refused_in_words(capsys):
+    """``--targets ' '`` gave Python's own words (max() arg is an empty sequence)."""
+    from bidmp.cli import main
+    from bidmp.sim.run import target_labels
+    from bidmp.tasks import load
+
+    with pytest.raises(ValueError, match="targets names no target: give at least one"):
+        target_labels(load("nut-unscrewing"), [])
+    assert main(["job", "--targets", " ", "--no-pictures", "--out", "/nonexistent/x"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "targets names no target" in err[0], err

@@ -150,3 +150,17 @@ def test_each_repair_alone_keeps_the_contract_past_a_post(how):
     tall = dense[:, 2] < 78.0 + 3.0  # the tool's mouth below the post's top plus the margin
     assert np.all(np.linalg.norm(dense[tall, :2] - post, axis=1) >= 5.0 + 10.0 + 3.0 - 1e-6)
     assert np.linalg.norm(path[-1] - goal) <= 1.75
+
+
+def test_a_pose_motion_that_never_comes_down_says_so_not_inf_degrees():
+    """A motion that stays over the target has no final approach to measure the tool's tilt on
+    (axis_deviation is inf): the reason says that in words."""
+    from bidmp.tasks.contract import Contract
+
+    contract = Contract(1.75, 28.5, None, "mm", alignment_threshold=2.0)
+    path = np.column_stack([np.zeros(50), np.zeros(50), np.linspace(200.0, 60.0, 50)])
+    down = np.repeat([[1.0, 0.0, 0.0, 0.0]], 50, axis=0)
+    verdict = contract.judge(path, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0], orientations=down)
+    assert not verdict.ok and np.isinf(verdict.axis_deviation)
+    reason = verdict.reason()
+    assert "inf" not in reason and "never comes down along the target's axis" in reason, reason

@@ -643,6 +643,11 @@ def target_labels(scenario, targets) -> list[str]:
             f"scenario must be a bidmp Scenario (bidmp.tasks.load), got {type(scenario).__name__}"
         )
     labels = scenario.labels if targets is None else as_labels(targets, "targets")
+    if not labels:  # (the command line's --targets ' ' too)
+        raise ValueError(
+            f"targets names no target: give at least one of the scenario's ("
+            f"{', '.join(scenario.labels[:20])}), or leave it out for all of them"
+        )
     for label in labels:
         if label not in scenario.targets:
             raise ValueError(

@@ -254,11 +254,17 @@ class Verdict:
             elif name == "clearance":
                 parts.append(self._clearance_words(unit))
             elif name == "alignment":
-                parts.append(
-                    "tilts the tool off the target's axis"
-                    if self.axis_deviation is None
-                    else f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis"
-                )
+                if self.axis_deviation is None:
+                    parts.append("tilts the tool off the target's axis")
+                elif not np.isfinite(self.axis_deviation):  # no final approach to measure it on
+                    parts.append(
+                        "never comes down along the target's axis, so the tool's tilt over the "
+                        "final approach cannot be measured"
+                    )
+                else:
+                    parts.append(
+                        f"tilts the tool {self.axis_deviation:.1f} deg from the target's axis"
+                    )
             else:
                 parts.append(self.limits.reason())
         if not parts:
