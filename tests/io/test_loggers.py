@@ -396,3 +396,38 @@ def test_joints_chosen_by_name_in_the_order_given(tmp_path):
     np.testing.assert_array_equal(picked.values, values[:, [3, 0]])
     with pytest.raises(ValueError, match="no column 'panda_joint9' for joints"):
         bidmp.io.read_recording(path, columns="joints=panda_joint9|panda_joint1")
+
+
+def test_rotation_vectors_in_degrees_or_rpy_are_refused_not_read_as_radians(tmp_path, capsys):
+    """A TMflow-style export's roll/pitch/yaw in degrees put in rx, ry, rz was read as radians (the
+    learned start 177.5 deg off, the tool up). A rotation vector longer than 2π is no axis-angle in
+    radians: refused naming the row; the same motion in radians reads, each quaternion SciPy's
+    from_rotvec of its row (the independent reference)."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.io import read_poses
+
+    n = 120
+    s = np.linspace(0.0, 1.0, n)
+    positions = np.column_stack([400.0 * s, 50.0 * s**2, 300.0 - 100.0 * s])
+    turns = Rotation.from_euler(
+        "xyz", np.column_stack([np.full(n, 177.5), 20 * s, 90 * s]), degrees=True
+    )
+    radians = turns.as_rotvec()
+    header = "t,x,y,z,rx,ry,rz"
+    good, bad = tmp_path / "radians.csv", tmp_path / "degrees.csv"
+    t = np.linspace(0.0, 2.4, n)[:, None]
+    np.savetxt(good, np.hstack([t, positions, radians]), delimiter=",", header=header, comments="")
+    rpy_degrees = turns.as_euler("xyz", degrees=True)
+    np.savetxt(
+        bad, np.hstack([t, positions, rpy_degrees]), delimiter=",", header=header, comments=""
+    )
+    poses, _ = read_poses(good)
+    expected = Rotation.from_rotvec(radians).as_quat()
+    same_sign = np.sign(np.sum(poses[:, 3:] * expected, axis=1))[:, None]
+    np.testing.assert_allclose(poses[:, 3:] * same_sign, expected, atol=1e-12)
+    with pytest.raises(ValueError, match=r"data row 1 \(> 2π\): degrees, or roll/pitch/yaw"):
+        read_poses(bad)
+    assert main(["fit", str(bad), "-o", str(tmp_path / "m.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "rotation vector in radians" in err[0], err

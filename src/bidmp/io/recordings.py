@@ -151,9 +151,11 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
                 )
             _note_ignored(path, layout.ignored)
             times = times_in_seconds(values, layout, path)
-            positions = _values(values, layout)
+            positions = _values(values, layout, path)
             if layout.orientation:  # read beside the positions, filtered with them
-                orientation = _quaternions(values[:, list(layout.orientation)], layout.rotation)
+                orientation = _quaternions(
+                    values[:, list(layout.orientation)], layout.rotation, path
+                )
                 positions = np.hstack([positions, orientation])
     else:
         raise ValueError(
@@ -201,19 +203,31 @@ def _headerless(values: np.ndarray, path) -> np.ndarray:
     )
 
 
-def _values(values: np.ndarray, layout: Layout) -> np.ndarray:
+def _values(values: np.ndarray, layout: Layout, path="the recording") -> np.ndarray:
     """The value columns of ``values`` in the layout's order; a pose's rotation as a quaternion."""
     data = values[:, list(layout.values)]
     if layout.kind != "pose":
         return data
-    return np.hstack([data[:, :3], _quaternions(data[:, 3:], layout.rotation)])
+    return np.hstack([data[:, :3], _quaternions(data[:, 3:], layout.rotation, path)])
 
 
-def _quaternions(rotation: np.ndarray, kind: str) -> np.ndarray:
+def _quaternions(rotation: np.ndarray, kind: str, path="the recording") -> np.ndarray:
     """Rotation columns as quaternions ``qx, qy, qz, qw``: as they are, or from a rotation vector
-    (UR's axis-angle, radians)."""
+    (UR's axis-angle, radians). A rotation vector longer than 2π is no axis-angle in radians (an
+    angle in degrees, or roll/pitch/yaw put in its place): refused, saying so — read as radians
+    it would turn the tool by a wrong angle about a wrong axis, silently."""
     if kind != "rotvec" or not np.all(np.isfinite(rotation)):
         return rotation  # (a bad value: as_trajectory names it)
+    lengths = np.linalg.norm(rotation, axis=1)
+    over = np.flatnonzero(lengths > 2.0 * np.pi + 1e-9)
+    if over.size:
+        row = int(over[0])  # the first, where a user looking at the file finds it
+        raise ValueError(
+            f"{path}: the rotation-vector columns (rx, ry, rz: an axis times an angle in radians) "
+            f"reach length {lengths[row]:.4g} at data row {row + 1} (> 2π): degrees, or roll/pitch/"
+            f"yaw? Write the rotation as a rotation vector in radians, or as a quaternion "
+            f"(qx, qy, qz, qw)"
+        )
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_rotvec(rotation).as_quat()
