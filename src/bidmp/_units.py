@@ -21,6 +21,8 @@ __all__ = [
     "conversion",
     "check_reach",
     "check_speed",
+    "length_digits",
+    "length_text",
     "REACH_M",
     "PLAUSIBLE_SPEED",
 ]
@@ -62,6 +64,18 @@ def mm(value_mm: float, units: str) -> float:
 
     value_mm = check_real(value_mm, "value_mm")
     return value_mm * 1e-3 / UNITS.get(check_units(units), 1e-3)
+
+
+def length_digits(units: str) -> int:
+    """Decimals that show a length in ``units`` to 0.01 mm (mm: 2, cm: 3, m: 5; unknown: 2)."""
+    metres = UNITS.get(units, 1e-3)
+    return max(int(round(np.log10(metres / 1e-5))), 0)
+
+
+def length_text(value: float, units: str) -> str:
+    """``value`` (in ``units``) as a reader sees it: 0.01 mm detail in any unit, and the unit
+    (``length_text(0.0109, "m")`` is ``"0.01090 m"``, not ``"0.01 m"``)."""
+    return f"{float(value):.{length_digits(units)}f} {units}".rstrip()
 
 
 def conversion(source: str, target: str) -> float:

@@ -291,3 +291,29 @@ def test_the_job_on_a_tilted_pack_takes_a_nut_off_along_its_axis():
     assert (
         np.degrees(np.arccos(travel @ axis / np.linalg.norm(travel))) < 1.0
     )  # up the nut's own axis
+
+
+def test_a_metre_cell_prints_its_lengths_to_a_hundredth_of_a_millimetre():
+    """A metre cell printed "max error 0.000" and "passes 0.00 m" (10.9 mm read 0.01 m), and its
+    results.json rounded to 0.1 mm. The errors here are computed from the motions' ends (not read
+    from the report); the table shows them to 1e-5 m, the file keeps them whole, and every reason's
+    lengths carry five decimals."""
+    import re
+
+    scenario = scenarios.from_dict(spec("two_posts.json", "m"))
+    report = evaluate(scenario, ["dmp"])
+    result = report.methods["dmp"]
+    errors = {
+        label: float(
+            np.linalg.norm(np.asarray(result.rollouts[label])[-1] - scenario.targets[label])
+        )
+        for label in scenario.labels
+    }
+    data = report.to_dict()["methods"]["dmp"]
+    for label, error in errors.items():
+        assert data["targets"][label]["error"] == pytest.approx(error, rel=1e-12, abs=1e-15)
+    summary = report.summary()
+    row = next(line for line in summary.splitlines() if line.strip().startswith("dmp "))
+    assert f"{max(errors.values()):.5f}" in row.split(), row
+    reasons = [result.reason_at(label) for label in scenario.labels if result.reason_at(label)]
+    assert reasons and all(re.findall(r"\d\.\d{5} m", reason) for reason in reasons), reasons

@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from .._checks import TaskRefusal
-from .._units import mm
+from .._units import length_text, mm
 from ..tasks.contract import Contract
 from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
@@ -83,7 +83,7 @@ def _engaged(world: _World, part: MovablePart, target) -> tuple[bool, str]:
     tolerance, unit = world.spec.engage_tolerance, world.scenario.units
     if across > tolerance or along > world.scenario.success_threshold:
         return False, (
-            f"the tool is {across:.2f} {unit} off the part's axis and {along:.2f} {unit} off its height "
+            f"the tool is {length_text(across, unit)} off the part's axis and {length_text(along, unit)} off its height "
             f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})"
         )
     return True, f"{across:.3f} {unit} off the axis"
@@ -141,11 +141,14 @@ def _unscrew(world: _World, part: MovablePart, exclude) -> JobPhase:
     )
     if part.rise < rise - 0.1 * spec.play:
         raise _StepFailed(
-            f"unscrew: the nut rose {part.rise:.2f} of {rise:.2f} {world.scenario.units}: still on its stud"
+            f"unscrew: the nut rose {length_text(part.rise, world.scenario.units)} of "
+            f"{length_text(rise, world.scenario.units)}: still on its stud"
         )
     part.hold()
     world.held = part
-    phase.note = f"{rise / spec.pitch:.1f} turns, {rise:.2f} {world.scenario.units} up the thread"
+    phase.note = (
+        f"{rise / spec.pitch:.1f} turns, {length_text(rise, world.scenario.units)} up the thread"
+    )
     return phase
 
 

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .._units import length_text
 from ..tasks.contract import Contract
 from .job_report import JobPhase, _phase
 from .planning import _paced_duration, _slowed
@@ -178,7 +179,7 @@ def _refused_plan(  # noqa: PLR0913 - what _move judges its plan by, passed on w
     elif over:
         why = f"its planned joint {over[0]} exceeds the limit"
     else:
-        why = f"the arm would touch {touch[0]} ({touch[1]:.2f} {world.scenario.units} deep)"
+        why = f"the arm would touch {touch[0]} ({length_text(touch[1], world.scenario.units)} deep)"
     phase = JobPhase(name, False, 0.0, f"not run: the contract refuses its plan: {why}")
     phase.verdict = verdict if not verdict.ok else None
     phase.peaks = peaks
@@ -250,8 +251,8 @@ def _clear_transfer(world: _World, goal, exclude, carried=None):
 def _closeness(clearance, unit: str) -> str:
     """How a clearance breaks the margin, in words ("cut 2.1 mm into", "pass 1.2 mm from")."""
     if clearance.distance < 0.0:
-        return f"cut {-clearance.distance:.2f} {unit} into"
-    return f"pass {clearance.distance:.2f} {unit} from"
+        return f"cut {length_text(-clearance.distance, unit)} into"
+    return f"pass {length_text(clearance.distance, unit)} from"
 
 
 def _transfer(world: _World, goal, exclude, carried=None):

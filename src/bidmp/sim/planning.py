@@ -10,6 +10,7 @@ from scipy.interpolate import make_interp_spline
 
 from .._checks import as_trajectory, as_vector, check_real
 from .._trajectory import interp_columns
+from .._units import length_digits
 from ..primitives.so3 import as_quaternions
 from ..primitives.timing import Trajectory, time_scale
 from .backend import LIMIT_MARGIN, MotionPlan, SimError
@@ -79,9 +80,10 @@ def plan_path(
     for index, point in enumerate(points):
         q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
         if error > IK_TOLERANCE:
+            digits = length_digits(_unit_name(cell.unit))  # 0.01 mm detail in the scene's unit
             raise SimError(
-                f"target {label!r}: the point {np.round(point / cell.unit, 2).tolist()} of its motion is "
-                f"unreachable for the {cell.name} at base {np.round(cell.base, 1).tolist()} "
+                f"target {label!r}: the point {np.round(point / cell.unit, digits).tolist()} of its motion is "
+                f"unreachable for the {cell.name} at base {np.round(cell.base, digits).tolist()} "
                 f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}): out of "
                 f'its reach (move its base: scenario key "robot": {{"base": ...}}), or not from the '
                 f'joints it comes from (a start pose nearer it: "robot": {{"rest": [...]}}, rad)'

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._units import length_digits
 from ..io.strict_json import json_number
 from ..tasks._tables import markdown_table, text_table
 from ..tasks.contract import CommandPeaks
@@ -293,7 +294,7 @@ class SimReport:
         )
         lines = [
             f"{scenario.name} on a simulated {self.robot_name} ({self.simulator}), robot base "
-            f"{np.round(self.base, 1).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
+            f"{np.round(self.base, length_digits(scenario.units)).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
             f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
             f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "
             f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "

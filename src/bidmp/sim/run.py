@@ -13,7 +13,7 @@ import numpy as np
 
 from .._checks import as_labels, check_bool, check_int, check_real, short_token
 from .._trajectory import arclength
-from .._units import mm
+from .._units import length_digits, length_text, mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
@@ -114,7 +114,7 @@ def _run_one(setup: _SimSetup, cell, contract, job):
     touched = None if touch is None else touch(plan, job.exclude)
     if touched is not None:  # the tool's path keeps the contract, but a link would not
         reason = (
-            f"not run: the arm would touch {touched[0]} ({touched[1]:.2f} {setup.task.units} "
+            f"not run: the arm would touch {touched[0]} ({length_text(touched[1], setup.task.units)} "
             f"deep) on its way to {job.label}, though the tool's path keeps the contract"
         )
         return _not_run(job, reason)
@@ -487,7 +487,7 @@ def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
     cell = _world(setup)
     frame = "as the target's pose" if scenario.is_pose else "pointing down"
     where = (
-        f"for the {cell.name} at base {np.round(cell.base, 1).tolist()} {scenario.units} (tool "
+        f"for the {cell.name} at base {np.round(cell.base, length_digits(scenario.units)).tolist()} {scenario.units} (tool "
         f'{frame}): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
         f'from its start pose (give one nearer: "robot": {{"rest": [...]}}, rad)'
     )

@@ -37,7 +37,7 @@ from .._checks import (
     check_real,
     short_token,
 )
-from .._units import mm
+from .._units import length_text, mm
 from ..primitives.so3 import as_quaternions
 from .metrics import approach_error, axis_deviation, endpoint_error
 
@@ -242,14 +242,14 @@ class Verdict:
         for name in self.failed:
             if name == "end":
                 parts.append(
-                    f"ends {self.end_error:.2f} {unit} from the target (within {self.threshold:g} {unit} is success)"
+                    f"ends {length_text(self.end_error, unit)} from the target (within {self.threshold:g} {unit} is success)"
                 )
             elif name == "engagement":
                 if self.approach_error is None or not math.isfinite(self.approach_error):
                     parts.append("has no monotone final descent along the target's axis")
                 else:
                     parts.append(
-                        f"comes down {self.approach_error:.2f} {unit} off the target's axis"
+                        f"comes down {length_text(self.approach_error, unit)} off the target's axis"
                     )
             elif name == "clearance":
                 parts.append(self._clearance_words(unit))
@@ -279,17 +279,17 @@ class Verdict:
             c = self.clearance
             if c.distance < 0.0:
                 words.append(
-                    f"cuts {-c.distance:.2f} {unit} into {c.part}"
+                    f"cuts {length_text(-c.distance, unit)} into {c.part}"
                     if -c.distance >= 0.005
                     else f"touches {c.part}"
                 )
             else:
                 words.append(
-                    f"passes {c.distance:.2f} {unit} from {c.part}, inside the {c.margin:g} {unit} it must keep"
+                    f"passes {length_text(c.distance, unit)} from {c.part}, inside the {c.margin:g} {unit} it must keep"
                 )
         if self.contacts:
             label, depth = max(self.contacts.items(), key=lambda item: item[1])
-            words.append(f"the arm touches {label} ({depth:.2f} {unit} deep)")
+            words.append(f"the arm touches {label} ({length_text(depth, unit)} deep)")
         return " and ".join(words)
 
     def to_dict(self) -> dict:

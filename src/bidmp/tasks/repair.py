@@ -47,6 +47,7 @@ from .._checks import (
     check_seed,
     short_token,
 )
+from .._units import length_text
 from .contract import Contract, Verdict
 
 __all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance", "carried_depth"]
@@ -277,9 +278,9 @@ class Repairer:
             return ""
         unit = contract.units or "units"
         depth = (
-            f"cuts {-clearance.distance:.2f} {unit} into"
+            f"cuts {length_text(-clearance.distance, unit)} into"
             if clearance.distance < 0
-            else f"passes {clearance.distance:.2f} {unit} from"
+            else f"passes {length_text(clearance.distance, unit)} from"
         )
         return (
             f"no motion can engage it: the tool coming straight down onto it {depth} {clearance.part} "

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._units import length_digits
 from ..io.strict_json import json_number
 from ._tables import markdown_table, text_table
 
@@ -151,14 +152,15 @@ class MethodResult:
             "success_rate": round(self.successes / n_targets, 4),
             "successes": self.successes,
             "n_targets": n_targets,
-            "errors": {label: round(float(e), 4) for label, e in self.errors.items()},
+            # lengths at full precision: a metre cell's 0.0109 m is not 0.0109 rounded to 0.1 mm
+            "errors": {label: float(e) for label, e in self.errors.items()},
             "approach_errors": None
             if self.approach_errors is None
             else {label: json_number(e) for label, e in self.approach_errors.items()},
-            "max_error": round(float(max(self.errors.values())), 4),
+            "max_error": float(max(self.errors.values())),
             "difference_range": [
-                round(float(min(self.differences.values())), 2),
-                round(float(max(self.differences.values())), 2),
+                float(min(self.differences.values())),
+                float(max(self.differences.values())),
             ],
             "runtime_s": round(self.runtime_s, 5),
             "n_steps": self.n_steps,
@@ -182,7 +184,7 @@ class MethodResult:
         for label, error in self.errors.items():
             clearance = self.clearance_at(label)
             targets[label] = {
-                "error": round(float(error), 4),
+                "error": float(error),
                 "approach_error": None
                 if self.approach_errors is None
                 else json_number(self.approach_errors[label]),
@@ -271,6 +273,7 @@ class Report:
             header += ["collision-free", "min clearance (part)", "task success"]
         if runtimes:
             header.append("run time [s]")
+        digits = length_digits(self.scenario.units)  # 0.01 mm detail in any unit
         rows = []
         for name, result in self.methods.items():
             data = result.to_dict()
@@ -280,14 +283,15 @@ class Report:
             if poses:
                 row.append(f"{data['aligned']}/{n}")
             row += [
-                f"{data['max_error']:.3f}",
-                f"{data['difference_range'][0]:.1f}-{data['difference_range'][1]:.1f}",
+                f"{data['max_error']:.{max(3, digits)}f}",
+                f"{data['difference_range'][0]:.{max(1, digits - 1)}f}-"
+                f"{data['difference_range'][1]:.{max(1, digits - 1)}f}",
             ]
             if geometry:
                 worst = (
                     "-"
                     if data["min_clearance"] is None
-                    else f"{data['min_clearance']:.2f} ({data['min_clearance_part']})"
+                    else f"{data['min_clearance']:.{max(2, digits)}f} ({data['min_clearance_part']})"
                 )
                 row += [
                     f"{data['collision_free']}/{data['n_checked']}",
@@ -304,12 +308,15 @@ class Report:
         scenario = self.scenario
         origin = scenario.targets[scenario.demonstrated]
         header = ["target", "distance"] + list(self.methods)
+        digits = length_digits(scenario.units)  # 0.01 mm detail in any unit
         rows = []
         for label, target in scenario.targets.items():
-            cells = [label, f"{np.linalg.norm(target - origin):.1f}"]
+            distance = float(np.linalg.norm((target - origin)[:3]))
+            cells = [label, f"{distance:.{max(1, digits - 1)}f}"]
             for result in self.methods.values():
                 error = result.errors[label]
-                cells.append(f"{error:.3f}{'' if error <= scenario.success_threshold else ' x'}")
+                mark = "" if error <= scenario.success_threshold else " x"
+                cells.append(f"{error:.{max(3, digits)}f}{mark}")
             rows.append(cells)
         return header, rows
 
