@@ -318,3 +318,54 @@ def test_the_scene_helpers_refuse_bad_input_by_name():
     ]
     failures = nasty_failures(calls, nasty)
     assert not failures, failures
+
+
+def test_the_writers_and_plots_name_a_wrong_object(tmp_path):
+    """They read attributes of what they are given: a wrong object was an AttributeError."""
+    import bidmp.experiments
+    import bidmp.plotting
+    import bidmp.sim
+    import bidmp.tasks
+
+    calls = [
+        (bidmp.plotting.plot_extension, "extension"),
+        (bidmp.plotting.plot_error_vs_distance, "report"),
+        (bidmp.plotting.plot_scenario_3d, "report"),
+        (bidmp.plotting.plot_targets_top_view, "report"),
+        (bidmp.plotting.plot_generalisation, "result"),
+        (bidmp.tasks.write_report, "report"),
+        (bidmp.experiments.write_results, "result"),
+        (bidmp.sim.write_job_report, "report"),
+        (bidmp.sim.write_sim_report, "report"),
+    ]
+    for function, name in calls:
+        arguments = {
+            bidmp.plotting.plot_extension: (tmp_path / "e.png", object()),
+            bidmp.plotting.plot_generalisation: (tmp_path / "g.png", object()),
+            bidmp.experiments.write_results: (object(), "x", tmp_path),
+        }.get(function, None)
+        if arguments is None:
+            arguments = (
+                (tmp_path / "p.png", object())
+                if function.__module__.startswith("bidmp.plotting")
+                else (object(), tmp_path)
+            )
+        with pytest.raises(TypeError, match=rf"^{name} must be .*, got object$"):
+            function(*arguments)
+
+
+def test_a_generalisation_result_is_written_with_its_figure(tmp_path):
+    """write_results took every reproduction result but the generalisation's (no markdown())."""
+    import json
+
+    from bidmp.experiments import lasa_generalisation, write_results
+
+    result = lasa_generalisation("Sshape")
+    written = write_results(result, "generalisation", tmp_path)
+    assert [path.name for path in written] == [
+        "generalisation.json",
+        "generalisation.md",
+        "generalisation.png",
+    ]
+    assert json.loads(written[0].read_text()) == json.loads(json.dumps(result.to_dict()))
+    assert result.summary() in written[1].read_text()

@@ -693,3 +693,20 @@ def check_fitted(model, attribute: str) -> None:
     """Raise :class:`NotFittedError` if ``model`` lacks the learned ``attribute``."""
     if getattr(model, attribute, None) is None:
         raise NotFittedError(f"this {type(model).__name__} is not fitted yet: call fit() first")
+
+
+def check_kind(value, kinds, name: str, expected: str):
+    """``value`` if it is one of ``kinds`` (a class or a tuple of them); else a TypeError naming
+    ``name``, what it must be (``expected``, in words) and what it is."""
+    if not isinstance(value, kinds):
+        raise TypeError(f"{name} must be {expected}, got {type(value).__name__}")
+    return value
+
+
+def check_members(value, members: tuple, name: str, expected: str):
+    """``value`` if it has every attribute in ``members`` (what a function reads of it); else a
+    TypeError naming ``name``, what it must be and what it is (for a module that may not import
+    the class: a layer below it)."""
+    if not all(hasattr(value, member) for member in members):
+        raise TypeError(f"{name} must be {expected}, got {type(value).__name__}")
+    return value

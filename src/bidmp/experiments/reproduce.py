@@ -93,12 +93,27 @@ def write_results(result, name: str, out: str | os.PathLike) -> list[Path]:
     """Write a reproduction result into folder ``out``: ``NAME.json``, ``NAME.md`` and its
     figures (per-scenario folders with ``results.json`` and figures for Table 4)."""
     from .. import plotting
+    from .._checks import check_kind, short_token
 
+    check_kind(
+        result,
+        (Table4, Table5, Figures, GeneralisationResult),
+        "result",
+        "a reproduction result (Table4, Table5, Figures or GeneralisationResult)",
+    )
+    if not isinstance(name, str) or not name or "/" in name or "\\" in name:
+        raise ValueError(f"name must be a file name without a folder, got {short_token(name, 30)}")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     written = [out / f"{name}.json", out / f"{name}.md"]
     _write_json(written[0], result.to_dict())
-    _write_text(written[1], result.markdown())
+    # a generalisation result has a plain-text summary, the tables a Markdown one
+    markdown = (
+        f"```\n{result.summary()}\n```\n"
+        if isinstance(result, GeneralisationResult)
+        else result.markdown()
+    )
+    _write_text(written[1], markdown)
     if isinstance(result, Table4):
         if result.keep:
             written.append(out / "tasks.md")
@@ -109,4 +124,6 @@ def write_results(result, name: str, out: str | os.PathLike) -> list[Path]:
         written.append(plotting.plot_incremental(out / "bidmp_lasa.png", result.results))
     elif isinstance(result, Table5):
         written.append(plotting.plot_prm_comparison(out / f"{name}.png", result.comparisons))
+    elif isinstance(result, GeneralisationResult):
+        written.append(plotting.plot_generalisation(out / f"{name}.png", result))
     return written

@@ -133,6 +133,15 @@ def plot_extension(
     """An :class:`bidmp.extension.extend.ExtendedDemonstration`: demonstration, segmentation points,
     sampling points, the imitated segment (Tra_imi), the new transfer (Tra_gen) and the complete
     extended demonstration, labelled in words."""
+    from .._checks import check_kind
+    from ..extension.extend import ExtendedDemonstration
+
+    check_kind(
+        extension,
+        ExtendedDemonstration,
+        "extension",
+        "an ExtendedDemonstration (bidmp.extend_demonstration)",
+    )
     mpl = _matplotlib()
     n_dims = extension.demonstration.shape[1]
     fig = mpl.figure(figsize=(7.5, 6.5), dpi=110)

@@ -25,6 +25,7 @@ _METHOD_COLOURS = {
 def plot_targets_top_view(path, report) -> Path:
     """Top view of the targets, one panel per method: green = success, red = failure (paper
     Fig. 16c analogue), with the end point of each rollout."""
+    _check_report(report)
     mpl = _matplotlib()
     scenario = report.scenario
     names = list(report.methods)
@@ -98,6 +99,7 @@ def plot_targets_top_view(path, report) -> Path:
 
 def plot_error_vs_distance(path, report) -> Path:
     """End-point error (and approach error) against the distance from the demonstrated target."""
+    _check_report(report)
     mpl = _matplotlib()
     scenario = report.scenario
     origin = scenario.targets[scenario.demonstrated]
@@ -166,6 +168,7 @@ def plot_scenario_3d(path, report) -> Path:
     extended demonstration(s), every rollout the evaluation judged, one colour per method (a
     motion that breaks the contract dashed, where it comes closest to a part or into it marked
     ×), the targets, and the scene's parts as solids."""
+    _check_report(report)
     mpl = _matplotlib()
     scenario = report.scenario
     # A pose scenario's paths are (T, 7): the positions are its first three columns (drawn as
@@ -277,3 +280,12 @@ def _draw_solids(ax, solids) -> None:
     if solids:  # add_collection3d does not widen the axes: take the parts' extent in
         corners = np.array([s.lower for s in solids] + [s.upper for s in solids], dtype=float)
         ax.auto_scale_xyz(corners[:, 0], corners[:, 1], corners[:, 2], had_data=True)
+
+
+def _check_report(report) -> None:
+    """``report`` must be an evaluation Report (a TypeError naming it otherwise)."""
+    from .._checks import check_members
+
+    check_members(
+        report, ("scenario", "methods"), "report", "a bidmp evaluation Report (bidmp.evaluate)"
+    )

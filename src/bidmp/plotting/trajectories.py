@@ -245,6 +245,14 @@ def _draw_frames(ax, positions: np.ndarray, quaternions: np.ndarray, count: int 
 def plot_generalisation(path: str | os.PathLike, result) -> Path:
     """Two panels for a :class:`bidmp.tasks.evaluation.GeneralisationResult` (2-D): the rollouts to moved
     goals with the paper's fixed horizon (left) and run to convergence (right)."""
+    from .._checks import check_members
+
+    check_members(
+        result,
+        ("fixed_horizon", "converged", "demonstration"),
+        "result",
+        "a GeneralisationResult (bidmp.experiments.lasa_generalisation)",
+    )
     mpl = _matplotlib()
     fig, axes = mpl.subplots(1, 2, figsize=(12.0, 5.5), dpi=110)
     panels = (

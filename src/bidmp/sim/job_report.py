@@ -263,6 +263,9 @@ class JobReport:
 
 def write_job_report(report: JobReport, out) -> list[Path]:
     """``job_results.json``, ``job.md`` (the table) and ``job_cycle.png`` into folder ``out``."""
+    from .._checks import check_kind
+
+    check_kind(report, JobReport, "report", "a bidmp.sim.JobReport (bidmp.sim.run_job)")
 
     written = _write_results(out, "job_results.json", "job.md", report.to_dict(), report.markdown())
     if (

@@ -438,6 +438,9 @@ def _measure(
 def write_sim_report(report: SimReport, out) -> list[Path]:
     """``sim_results.json``, ``sim.md`` (the table), a keyframe strip per method and, when both dmp and bidmp have
     frames of the same target, an animated GIF of the two side by side."""
+    from .._checks import check_kind
+
+    check_kind(report, SimReport, "report", "a bidmp.sim.SimReport (bidmp.sim.simulate)")
     written = _write_results(out, "sim_results.json", "sim.md", report.to_dict(), report.markdown())
     by_method = {}
     for method, label, frames in report.pictures:

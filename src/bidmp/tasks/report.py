@@ -395,6 +395,9 @@ class Report:
 def write_report(report: Report, out: str | os.PathLike) -> list[Path]:
     """Write ``results.json`` and the three figures of a report into folder ``out`` (created if
     needed); return the paths written."""
+    from .._checks import check_kind
+
+    check_kind(report, Report, "report", "a bidmp evaluation Report (bidmp.evaluate)")
     from ..io.atomic import atomic_write
     from ..plotting.tasks import (
         plot_error_vs_distance,
