@@ -710,3 +710,8 @@ def check_members(value, members: tuple, name: str, expected: str):
     if not all(hasattr(value, member) for member in members):
         raise TypeError(f"{name} must be {expected}, got {type(value).__name__}")
     return value
+
+
+# Hz: the slowest rhythm bidmp runs (a period of 11.6 days); slower is a unit mistake, or a denormal
+# whose period overflows the sample count (5e-324 Hz divided by zero)
+SLOWEST_HZ = 1e-6

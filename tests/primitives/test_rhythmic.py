@@ -319,3 +319,23 @@ def test_rhythmic_models_survive_their_files(tmp_path):
     pose_model = RhythmicPoseDMP(n_kernels=30).fit(poses, t)
     loaded = load_model(save_model(pose_model, tmp_path / "pose"))
     np.testing.assert_array_equal(loaded.trajectory(1).q, pose_model.trajectory(1).q)
+
+
+@pytest.mark.parametrize(
+    ("setting", "value", "name"),
+    [
+        ("frequency", 5e-324, "frequency"),
+        ("frequency", 0.0, "frequency"),
+        ("alpha", 5e-324, "alpha"),
+    ],
+)
+def test_a_denormal_rate_or_gain_is_refused_by_name(setting, value, name):
+    """A denormal frequency divided by zero (a ZeroDivisionError), a denormal spring made the
+    period's transition singular (a LinAlgError): each is a ValueError naming the argument."""
+    t = np.linspace(0.0, 4.0, 400)
+    y = np.column_stack([np.sin(2 * np.pi * 1.3 * t), np.cos(2 * np.pi * 1.3 * t)])
+    with pytest.raises(ValueError, match=rf"^{name} must be >= "):
+        if setting == "frequency":
+            RhythmicDMP().fit(y, t).trajectory(frequency=value)
+        else:
+            RhythmicDMP(alpha=value).fit(y, t)

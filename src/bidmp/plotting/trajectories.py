@@ -8,7 +8,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .._checks import as_points, as_trajectory, as_vector, check_limit, check_path, short_token
+from .._checks import (
+    SLOWEST_HZ,
+    as_points,
+    as_trajectory,
+    as_vector,
+    check_limit,
+    check_path,
+    short_token,
+)
 from ..primitives.timing import check_timestamps
 from ._base import _figure, _label_axes, _matplotlib, _save, _sequence, _text
 
@@ -416,7 +424,7 @@ def plot_rhythm(
 
     check_path(path)
     title, units = _text(title, "title", 200), _text(units, "units", 20)
-    frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+    frequency = check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
     uncertainty = check_real(uncertainty, "uncertainty", nonnegative=True, maximum=1e3)
     recording = as_trajectory(recording, "recording", min_points=8)
     t = check_timestamps(t, recording.shape[0])

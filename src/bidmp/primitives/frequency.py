@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_trajectory, check_bool, check_int, check_real
+from .._checks import SLOWEST_HZ, as_trajectory, check_bool, check_int, check_real
 from .timing import check_timestamps
 
 __all__ = ["FrequencyEstimate", "estimate_frequency", "harmonic_fit"]
@@ -89,7 +89,7 @@ def harmonic_fit(
     """
     y = as_trajectory(y, "y", min_points=3, allow_static=True)
     t = check_timestamps(t, y.shape[0])
-    frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+    frequency = check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
     n_harmonics = check_int(n_harmonics, "n_harmonics", minimum=1, maximum=_MAX_HARMONICS * 4)
     coefficients = np.linalg.lstsq(
         _design(t - t[0], 2.0 * math.pi * frequency, n_harmonics), y, rcond=None

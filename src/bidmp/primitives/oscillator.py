@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from .._checks import as_point, check_int, check_real
+from .._checks import SLOWEST_HZ, as_point, check_int, check_real
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
 from .frequency import _series
@@ -62,7 +62,7 @@ class AdaptiveOscillator:
         alpha: float = 25.0,
         forgetting: float = 0.999,
     ) -> None:
-        frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+        frequency = check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
         self.n_dims = check_int(n_dims, "n_dims", minimum=1, limit="max_dims")
         self.n_harmonics = check_int(n_harmonics, "n_harmonics", minimum=1, maximum=60)
         self.coupling = check_real(coupling, "coupling", positive=True, maximum=1e6)

@@ -33,6 +33,7 @@ import numpy as np
 
 from .._api import Estimator
 from .._checks import (
+    SLOWEST_HZ,
     _limit,
     as_point,
     as_trajectory,
@@ -102,7 +103,9 @@ class RhythmicDMP(Estimator):
         (transients at both ends are cut); ``frequency`` (Hz) skips the estimate of it (the
         steady part is still found). Returns self."""
         n_kernels = check_int(self.n_kernels, "n_kernels", minimum=2, limit="max_kernels")
-        alpha = check_real(self.alpha, "alpha", positive=True, maximum=1e4)
+        # a spring weaker than 1e-3 never pulls onto the cycle (a denormal one made the period's
+        # transition singular)
+        alpha = check_real(self.alpha, "alpha", minimum=1e-3, maximum=1e4)
         ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
         basis = VonMisesBasis(n_kernels, self.concentration)
         y = as_trajectory(y, "y", min_points=8)
@@ -111,7 +114,7 @@ class RhythmicDMP(Estimator):
         names = check_names(names, y.shape[1])
         estimate = estimate_frequency(y, t, n_harmonics=self.n_harmonics)
         if frequency is not None:
-            frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+            frequency = check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
             estimate = _with_frequency(estimate, y, t, frequency)
         # the mean period's series over every kept period, as the estimate fitted it
         coefficients = estimate.series
@@ -246,7 +249,7 @@ class RhythmicDMP(Estimator):
         frequency = (
             self.frequency_
             if frequency is None
-            else check_real(frequency, "frequency", positive=True, maximum=1e3)
+            else check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
         )
         amplitude = check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
         anchor = self.anchor_ if anchor is None else as_point(anchor, self.n_dims_, "anchor")
@@ -414,7 +417,9 @@ class RhythmicDMP(Estimator):
         model.widths_ = check_loaded(arrays["widths_"], "widths_", (n_kernels,), positive=True)
         model.anchor_ = check_loaded(arrays["anchor_"], "anchor_", (n_dims,))
         model.amplitude_ = check_loaded(arrays["amplitude_"], "amplitude_", (n_dims,))
-        model.frequency_ = check_real(meta["frequency"], "frequency", positive=True, maximum=1e3)
+        model.frequency_ = check_real(
+            meta["frequency"], "frequency", minimum=SLOWEST_HZ, maximum=1e3
+        )
         model.units_ = "" if not meta["units"] else check_units(meta["units"])
         model.names_ = check_names(meta["names"] or None, n_dims)
         model.n_dims_ = n_dims
@@ -643,7 +648,7 @@ class RhythmicStepper:
 
     def set_frequency(self, frequency: float) -> None:
         """Move to ``frequency`` (Hz); refused if its steady rhythm exceeds the limits."""
-        frequency = check_real(frequency, "frequency", positive=True, maximum=1e3)
+        frequency = check_real(frequency, "frequency", minimum=SLOWEST_HZ, maximum=1e3)
         self._check_setting(frequency, float(self._amplitude.target), "frequency")
         self._frequency.target = np.array(frequency)
         self._retime()

@@ -31,7 +31,15 @@ from numbers import Real
 
 import numpy as np
 
-from .._checks import as_point, as_vector, check_choice, check_int, check_real, short_token
+from .._checks import (
+    SLOWEST_HZ,
+    as_point,
+    as_vector,
+    check_choice,
+    check_int,
+    check_real,
+    short_token,
+)
 from .._units import UNITS, check_units, mm
 from ._scenario_fields import _fail, _point, _shown
 
@@ -91,7 +99,7 @@ class RockSpec:
             object.__setattr__(
                 self,
                 "frequency",
-                check_real(self.frequency, "frequency", positive=True, maximum=50),
+                check_real(self.frequency, "frequency", minimum=SLOWEST_HZ, maximum=50),
             )
 
 
