@@ -5,6 +5,7 @@ mean start, and the printed spread is the demonstrations' own."""
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -77,3 +78,51 @@ def test_one_file_or_two_flags_are_refused_in_one_line(files, capsys):
         ["fit", "--promp", *paths[:2], "--multi", *paths[2:], "-o", str(folder / "x.npz")], capsys
     )
     assert code == 2 and "--promp" in err
+
+
+@pytest.mark.parametrize("flag", ["--promp", "--multi"])
+def test_every_rollout_option_acts_or_is_refused(files, flag, capsys):
+    """--rate was ignored for a --multi model (169 Hz for 500), --via on a ProMP gave the
+    unconditioned mean, and other options passed unnoticed. Now --rate sets the sample interval,
+    --via is passed exactly (at its time, to 1e-6 of the extent), and an option the model does not
+    act on is refused in one line."""
+    folder, paths, demos = files
+    model = folder / f"opt{flag}.npz"
+    assert run(["fit", flag, *paths, "--units", "mm", "--raw", "-o", str(model)], capsys)[0] == 0
+    out_csv = folder / f"opt{flag}.csv"
+    assert run(["rollout", str(model), "--rate", "500", "-o", str(out_csv)], capsys)[0] == 0
+    t, _ = _columns(out_csv)
+    np.testing.assert_allclose(np.diff(t), 0.002, rtol=1e-9)
+    point = demos.mean(axis=0)[400] + [3.0, -2.0]
+    code, out, err = run(
+        [
+            "rollout",
+            str(model),
+            "--rate",
+            "500",
+            "--via",
+            "1.0",
+            *map(str, point),
+            "-o",
+            str(out_csv),
+        ],
+        capsys,
+    )
+    assert code == 0, err
+    t, y = _columns(out_csv)
+    at = int(np.argmin(np.abs(t - 1.0)))
+    assert abs(t[at] - 1.0) < 1e-9
+    extent = np.ptp(demos.reshape(-1, 2), axis=0).max()
+    assert np.linalg.norm(y[at] - point) <= 1e-6 * extent
+    for option in (["--max-acc", "5"], ["--n-steps", "50"], ["--fastest"], ["--yaw", "30"]):
+        code, _, err = run(["rollout", str(model), *option, "-o", str(out_csv)], capsys)
+        lines = err.strip().splitlines()
+        assert code == 2 and len(lines) == 1 and f"{option[0]} does not apply" in lines[0], err
+
+
+def _columns(path) -> tuple:
+    """A written trajectory's time column and positions (x, y), read as plain numbers."""
+    text = Path(path).read_text()
+    rows = [line for line in text.splitlines() if line and not line.startswith("#")]
+    table = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
+    return table[:, 0], table[:, 1:3]

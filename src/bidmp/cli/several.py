@@ -70,6 +70,73 @@ def fit_several(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# The rollout options and their values when not given (the robot's, --robot, as the command
+# records it): a model of several demonstrations takes only some of them (_SEVERAL_TAKES).
+_UNSET = {
+    "duration": None,
+    "n_steps": None,
+    "max_speed": None,
+    "max_acc": None,
+    "max_jerk": None,
+    "joint_limits": None,
+    "robot_given": False,
+    "cartesian_goal": None,
+    "tool_length": 0.0,
+    "base": None,
+    "yaw": 0.0,
+    "fastest": False,
+    "skill": None,
+    "cycles": None,
+    "frequency": None,
+    "amplitude": None,
+    "anchor": None,
+    "from_rest": False,
+    "via": None,
+    "scene": None,
+    "avoid": None,
+    "bag": None,
+    "ros1": False,
+    "frame": "base",
+    "bag_topic": None,
+    "stamp": "now",
+    "orientation": None,
+    "follow": False,
+    "target_label": None,
+}
+_SEVERAL_TAKES = {"ProMP": {"via"}, "MultiDMP": {"via", "duration"}}
+
+
+def _refuse_unused(args: argparse.Namespace, model, promp_class) -> None:
+    """Every rollout option a ProMP or a DMP of several demonstrations would not act on is refused,
+    in one line (none is silently ignored); ``--goal``, ``--start`` (a ProMP), ``--rate`` and
+    ``--plot`` act on both."""
+    kind = "ProMP" if isinstance(model, promp_class) else "MultiDMP"
+    for name, unset in _UNSET.items():
+        if name in _SEVERAL_TAKES[kind] or getattr(args, name, unset) in (unset, None, []):
+            continue
+        flag = "--robot" if name == "robot_given" else "--" + name.replace("_", "-")
+        raise ValueError(
+            f"{flag} does not apply to a {type(model).__name__} (its rollout takes --goal, "
+            f"{'--start, ' if kind == 'ProMP' else ''}--rate, "
+            f"{', '.join('--' + n for n in sorted(_SEVERAL_TAKES[kind]))} and --plot)"
+        )
+
+
+def _via_pairs(args: argparse.Namespace, model) -> list:
+    """``--via T X ...`` as (t seconds, point) pairs, each with the model's dimensions."""
+    import numpy as np
+
+    width = model.n_dims_ if hasattr(model, "n_dims_") else model.dmp_.n_dims_
+    pairs = []
+    for index, values in enumerate(args.via or []):
+        if len(values) != 1 + width:
+            raise ValueError(
+                f"--via #{index + 1} needs T and {width} coordinates, got {len(values)} numbers"
+            )
+        pairs.append((float(values[0]), np.asarray(values[1:], dtype=float)))
+    return pairs
+
+
 def rollout_several(args: argparse.Namespace, model) -> int:
     """The mean motion to ``--goal`` (a ProMP: conditioned exactly on the goal and on ``--start``,
     by default the demonstrations' mean start) with its ±2σ band in ``--plot``."""
@@ -78,10 +145,9 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     from ..io.trajectories import save_trajectory
     from ..primitives.promp import ProMP
 
-    for name, flag in (("max_speed", "--max-speed"), ("bag", "--bag"), ("scene", "--scene")):
-        if getattr(args, name, None) not in (None, False):
-            raise ValueError(f"{flag} does not apply to a {type(model).__name__}")
+    _refuse_unused(args, model, ProMP)
     goal = None if args.goal is None else np.asarray(args.goal, dtype=float)
+    via = _via_pairs(args, model)
     if isinstance(model, ProMP):
         points, values = [], []
         if args.start is not None or goal is not None:
@@ -92,6 +158,13 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         if goal is not None:
             points.append(1.0)
             values.append(goal)
+        for t, point in via:  # exact conditioning at the via-point's phase (its time / duration)
+            if not 0.0 <= t <= model.duration_:
+                raise ValueError(
+                    f"--via at {t:g} s is outside the motion's {model.duration_:.4g} s"
+                )
+            points.append(t / model.duration_)
+            values.append(point)
         conditioned = model.condition(points, np.asarray(values), 0.0) if points else model
         dt = 1.0 / (args.rate or 100.0)
         trajectory = conditioned.trajectory(dt=min(dt, conditioned.duration_))
@@ -103,7 +176,14 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     else:
         if args.start is not None:
             raise ValueError("--start: a DMP from several demonstrations starts where they did")
-        trajectory = model.trajectory(goal)
+        options = {}
+        if args.rate is not None:
+            options["dt"] = 1.0 / args.rate
+        if args.duration is not None:
+            options["duration"] = args.duration
+        if via:
+            options["via"] = via
+        trajectory = model.trajectory(goal, **options)
         mean, std = trajectory.y, model.std(goal, n_steps=len(trajectory.t))
         base, base_std = model.rollout(), model.std()
         demos, units = (
