@@ -114,3 +114,16 @@ def test_a_promp_survives_its_file(promp, tmp_path):
     np.testing.assert_array_equal(
         loaded.condition([1.0], goal).mean(), promp.condition([1.0], goal).mean()
     )
+
+
+def test_conditioning_on_too_many_points_is_refused_before_it_is_built(promp, peak_memory):
+    """10 million points asked for a 2.8 PiB covariance (a MemoryError); the stacked observation's
+    size is checked first, and nothing of it is allocated."""
+    phase = np.broadcast_to(0.5, (10**7,))
+    values = np.broadcast_to(np.zeros(promp.n_dims_), (10**7, promp.n_dims_))
+    with (
+        peak_memory() as peak,
+        pytest.raises(ValueError, match="conditioning on 10,000,000 points"),
+    ):
+        promp.condition(phase, values)
+    assert peak.megabytes < 200.0, peak.megabytes

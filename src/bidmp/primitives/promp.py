@@ -32,6 +32,7 @@ from .._checks import (
     as_points,
     as_trajectory,
     as_vector,
+    check_bytes,
     check_int,
     check_real,
     check_seed,
@@ -268,6 +269,8 @@ class ProMP(Estimator):
         y = as_points(y, self.n_dims_, "y")
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
+        # one stacked observation: its (K·D)² covariance must fit before it is built
+        check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
         noise = _noise(cov, phase.size, self.n_dims_)
         mean, covariance = condition_gaussian(
             self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise
