@@ -246,6 +246,12 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
             f"folder, or a model shipped by pybullet_data such as kuka_iiwa/model.urdf)"
         )
     check_limit(path.stat().st_size, "max_file_bytes", f"the size of {shown_path(path)} in bytes")
+    links = _check_urdf_tree(path)
+    if spec["flange"] not in links:
+        raise ValueError(
+            f"robot.urdf {shown_path(path)}: no link {shown_path(spec['flange'], 30)!r} to mount "
+            f"the tool on (robot.flange; its links: {', '.join(sorted(links)[:12]) or 'none'})"
+        )
     limits = JointLimits(**spec["limits"])
     middle = tuple(0.5 * (low + high) for low, high in zip(limits.lower, limits.upper))
     return RobotModel(
@@ -257,6 +263,140 @@ def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
         tuple(spec.get("effort", (100.0,) * limits.n_joints)),
         rest_given="rest" in spec,
     )
+
+
+_URDF_EXTENT_M = 1e3  # m (and rad): no arm's joint or part is placed this far; more is a mistake
+
+
+def _check_urdf_tree(path) -> set:
+    """The link names of the URDF at ``path``, after checking it is one robot PyBullet can load
+    without surprises: unique link and joint names, every joint's parent and child links present,
+    each link the child of at most one joint, one root and no loop, finite origins within
+    1000 (m or rad), and every mesh file inside the URDF's folder and within the file size limit
+    (a loop, a missing parent or a NaN origin reached PyBullet, whose own error names none of
+    them; a mesh link to a system file was followed). A ``ValueError`` says which and where."""
+    import xml.etree.ElementTree as ElementTree
+
+    path = Path(path)
+    where = f"robot.urdf {shown_path(path)}"
+    try:
+        root = ElementTree.parse(path).getroot()
+    except ElementTree.ParseError as exc:
+        raise ValueError(f"{where}: not well-formed XML ({exc})") from None
+    if root.tag != "robot":
+        raise ValueError(f"{where}: its root element is <{root.tag}>, not <robot>")
+    links = _unique_names(root, "link", where)
+    _unique_names(root, "joint", where)
+    _one_tree(links, _parents(root, links, where), where)
+    for element in root.iter():
+        if element.tag == "origin":
+            _check_origin_element(element, where)
+        if element.tag == "mesh" and element.get("filename"):
+            _check_mesh(path, element.get("filename"), where)
+    return set(links)
+
+
+def _unique_names(root, kind: str, where: str) -> list:
+    """The names of the URDF's ``kind`` elements, each present and used once."""
+    names, seen = [element.get("name") for element in root.findall(kind)], set()
+    for name in names:
+        if name is None:
+            raise ValueError(f"{where}: a <{kind}> has no name")
+        if name in seen:
+            raise ValueError(f"{where}: two {kind}s are named {shown_path(name, 30)!r}")
+        seen.add(name)
+    return names
+
+
+def _parents(root, links: list, where: str) -> dict:
+    """link -> its parent link, from the joints (each naming links of the file; a link the child
+    of one joint at most)."""
+    parent_of = {}
+    for joint in root.findall("joint"):
+        name = joint.get("name")
+        ends = {end: joint.find(end) for end in ("parent", "child")}
+        for end, element in ends.items():
+            link = None if element is None else element.get("link")
+            if link not in links:
+                raise ValueError(
+                    f"{where}: joint {shown_path(name, 30)!r} names {end} link "
+                    f"{shown_path(str(link), 30)!r}, which is not a <link> of the file"
+                )
+        child = ends["child"].get("link")
+        if child in parent_of:
+            raise ValueError(f"{where}: link {shown_path(child, 30)} is the child of two joints")
+        parent_of[child] = ends["parent"].get("link")
+        _check_origin(joint, where, f"joint {shown_path(name, 30)!r}")
+    return parent_of
+
+
+def _one_tree(links: list, parent_of: dict, where: str) -> None:
+    """One root, and every chain of parents ends there (no loop). (No link at all: the flange's
+    check says so.)"""
+    roots = [link for link in links if link not in parent_of]
+    if not links:
+        return
+    if len(roots) != 1:
+        raise ValueError(
+            f"{where}: {len(roots)} links have no parent joint "
+            f"({', '.join(roots[:6]) or 'none: the joints make a loop'}); a robot has one root"
+        )
+    for link in links:
+        seen, at = set(), link
+        while at in parent_of:
+            if at in seen:
+                raise ValueError(
+                    f"{where}: the joints make a loop through link {shown_path(at, 30)}"
+                )
+            seen.add(at)
+            at = parent_of[at]
+
+
+def _check_origin(joint, where: str, what: str) -> None:
+    origin = joint.find("origin")
+    if origin is not None:
+        _check_origin_element(origin, where, what)
+
+
+def _check_origin_element(origin, where: str, what: str = "an <origin>") -> None:
+    for key in ("xyz", "rpy"):
+        text = origin.get(key)
+        if text is None:
+            continue
+        try:
+            values = [float(v) for v in text.split()]
+        except ValueError:
+            raise ValueError(
+                f"{where}: {what}'s {key} {shown_path(text, 30)} is not numbers"
+            ) from None
+        if len(values) != 3 or not all(
+            math.isfinite(v) and abs(v) <= _URDF_EXTENT_M for v in values
+        ):
+            raise ValueError(
+                f"{where}: {what}'s {key} {shown_path(text, 40)!r} must be 3 finite numbers within "
+                f"±{_URDF_EXTENT_M:g} (m or rad)"
+            )
+
+
+def _check_mesh(urdf: Path, filename: str, where: str) -> None:
+    """A mesh the URDF names: a file in the URDF's own folder (links followed), within the size
+    limit; a ``package://`` name is left to PyBullet (it finds none outside its search path)."""
+    if filename.startswith("package://"):
+        return
+    name = filename[len("file://") :] if filename.startswith("file://") else filename
+    folder = urdf.resolve().parent
+    mesh = (folder / name).resolve()
+    if not mesh.is_relative_to(folder):
+        raise ValueError(
+            f"{where}: mesh {shown_path(filename, 40)} lies outside the URDF's folder "
+            f"(meshes are read from beside it only)"
+        )
+    if mesh.exists():
+        if not mesh.is_file():
+            raise ValueError(f"{where}: mesh {shown_path(filename, 40)} is not a regular file")
+        check_limit(
+            mesh.stat().st_size, "max_file_bytes", f"the size of mesh {shown_path(mesh)} in bytes"
+        )
 
 
 def _unit_of(units: str) -> float:
