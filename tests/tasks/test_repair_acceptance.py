@@ -145,12 +145,12 @@ def test_a_failed_attempt_is_recorded_failed_with_its_reason_and_its_time(cell, 
 
     monkeypatch.setattr(repairer, "_try", no_route)
     broken = contract.judge(dmp.trajectory(GOAL + [0.0, 0.0, 5.0]).y, GOAL)
-    fixed = repairer.repair(dmp, GOAL, "n", verdict=broken)
+    fixed, spent = _timed_repair(repairer, dmp, broken)
     assert [(a.how, a.ok, a.note) for a in fixed.attempts] == [
         ("extend", False, "no collision-free route"),
         ("margin", False, "no collision-free route"),
     ]
-    assert all(0.0 <= a.seconds < 60.0 for a in fixed.attempts)
+    _within(fixed.attempts, spent)
 
 
 def test_a_model_no_bi_dmp_can_grow_on_is_lifted_but_not_extended(cell, monkeypatch):
@@ -183,12 +183,12 @@ def test_a_failed_extension_plans_the_margin_repair_wider_by_what_it_lacked(cell
     repairer = Repairer(contract, demo, order=("extend", "margin"), allowance=ALLOWANCE + 1.0)
     planned = _recording(repairer, monkeypatch, dmp)
     broken = contract.judge(dmp.trajectory(GOAL + [0.0, 0.0, 5.0]).y, GOAL)
-    fixed = repairer.repair(dmp, GOAL, "n", verdict=broken)
+    fixed, spent = _timed_repair(repairer, dmp, broken)
     keep = MARGIN + ALLOWANCE + 1.0
     lacked = keep - GAP
     assert planned == pytest.approx([keep, keep + lacked, keep + 2 * lacked], abs=1e-3)
     assert [(a.how, a.ok) for a in fixed.attempts] == [("extend", False), ("margin", False)]
-    assert all(0.0 <= a.seconds < 60.0 for a in fixed.attempts)
+    _within(fixed.attempts, spent)
 
 
 def test_a_carried_part_is_judged_with_the_tool(cell):
@@ -209,3 +209,19 @@ def test_a_carried_part_is_judged_with_the_tool(cell):
     carrying = repairer._judge(contract, motion, GOAL, "n", None, [], (held, [0.0, 0.0, -5.0]))
     assert alone.ok and not carrying.ok
     assert carrying.clearance.distance == pytest.approx(GAP + RADIUS - 15.0, abs=1e-3)
+
+
+def _timed_repair(repairer, dmp, verdict):
+    """The repair of the cell's motion and how long the whole call took (s)."""
+    import time
+
+    started = time.perf_counter()
+    fixed = repairer.repair(dmp, GOAL, "n", verdict=verdict)
+    return fixed, time.perf_counter() - started
+
+
+def _within(attempts, spent: float) -> None:
+    """Each attempt's recorded time is a share of the call's own (a consistency check, not a
+    limit: no clock decides the test)."""
+    shares = [attempt.seconds for attempt in attempts]
+    assert min(shares) >= 0.0 and sum(shares) <= spent, (shares, spent)
