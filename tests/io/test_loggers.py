@@ -431,3 +431,21 @@ def test_rotation_vectors_in_degrees_or_rpy_are_refused_not_read_as_radians(tmp_
     assert main(["fit", str(bad), "-o", str(tmp_path / "m.npz")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "rotation vector in radians" in err[0], err
+
+
+def test_a_gap_is_refused_at_the_file_line_a_user_opens(tmp_path, capsys):
+    """A NaN was reported at "row 1000" of a file whose line 1002 holds it (a comment and a header
+    before the data), with no advice. The line is found here by reading the file's text."""
+    t = np.linspace(0.0, 2.0, 2000)
+    y = np.column_stack([t, np.sin(t), np.cos(t)])
+    y[999, 1] = np.nan
+    path = tmp_path / "gap.csv"
+    with open(path, "w") as handle:
+        handle.write("# units: mm\nt,x,y,z\n")
+        np.savetxt(handle, np.column_stack([t, y]), delimiter=",")
+    line = next(n for n, text in enumerate(path.read_text().splitlines(), 1) if "nan" in text)
+    assert main(["fit", str(path), "-o", str(tmp_path / "m.npz")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert f"line {line}: contains NaN in column y (data row 1000" in err[0], err
+    assert "fill the gaps" in err[0]

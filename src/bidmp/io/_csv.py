@@ -238,3 +238,38 @@ def _csv_values(
         ]
     )
     return values, tuple(text)
+
+
+def _data_line(path: Path, index: int, has_header: bool) -> int:
+    """The file line (1-based) of data row ``index`` (0-based): blank and ``#`` lines, and the
+    header, skipped as the readers skip them. For an error message: the file is read again."""
+    seen = -1 if has_header else 0
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:
+        for number, line in enumerate(handle, start=1):
+            stripped = line.strip()
+            if not stripped or stripped.startswith("#"):
+                continue
+            if seen == index:
+                return number
+            seen += 1
+    return 0
+
+
+def check_finite_rows(path: Path, values: np.ndarray, columns, names, has_header: bool) -> None:
+    """Refuse a gap (NaN) or an infinite value in ``columns`` of ``values``, naming the file line
+    a user opens the file at, the column and what to do (bidmp reads no gaps)."""
+    used = values[:, list(columns)]
+    bad = np.argwhere(~np.isfinite(used))
+    if bad.size == 0:
+        return
+    row, column = (int(v) for v in bad[0])
+    name = names[columns[column]] if names else f"{columns[column] + 1}"
+    count = int(np.any(~np.isfinite(used), axis=1).sum())
+    line = _data_line(path, row, has_header)
+    value = float(used[row, column])
+    word = "NaN" if np.isnan(value) else ("inf" if value > 0 else "-inf")
+    raise ValueError(
+        f"{path} line {line}: contains {word} in column {name} (data row {row + 1}; {count:,} "
+        f"row{'s' if count != 1 else ''} with gaps in all); remove those rows or fill the gaps "
+        f"(by interpolation, say) before reading: a motion is read without gaps"
+    )

@@ -118,7 +118,14 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     Recording
     """
     from ..primitives.timing import drop_repeated_stamps
-    from ._csv import _check_file, _csv_fast, _csv_rows, _note_ignored, declared_units
+    from ._csv import (
+        _check_file,
+        _csv_fast,
+        _csv_rows,
+        _note_ignored,
+        check_finite_rows,
+        declared_units,
+    )
 
     path = check_path(path)
     _check_file(path, "demonstration file")
@@ -150,6 +157,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
                     f"{path}: column {short_token(header[min(used_text)], 30)} holds text, not numbers"
                 )
             _note_ignored(path, layout.ignored)
+            check_finite_rows(
+                path, values, (*layout.time, *layout.values, *layout.orientation), header, True
+            )
             times = times_in_seconds(values, layout, path)
             positions = _values(values, layout, path)
             if layout.orientation:  # read beside the positions, filtered with them
