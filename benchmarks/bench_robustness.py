@@ -11,22 +11,11 @@ Prints the median of each (seconds) beside its target.
 from __future__ import annotations
 
 import argparse
-import statistics
-import time
 
 import numpy as np
+from _timing import median_time
 
 import bidmp
-
-
-def timed(function, repeats: int) -> float:
-    """Median wall time (s) of ``function()`` over ``repeats`` runs."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def refused(function) -> None:
@@ -70,7 +59,7 @@ def main() -> None:
     ]
     print(f"{'case':40s} {'median s':>9s} {'target s':>9s}")
     for name, function, target in cases:
-        seconds = timed(function, repeats)
+        seconds = median_time(function, repeats)
         print(f"{name:40s} {seconds:9.3f} {target:9.1f}{'' if seconds <= target else '  OVER'}")
 
 

@@ -7,9 +7,9 @@ the TM5-like arm of tests/data with one defect planted."""
 from __future__ import annotations
 
 import json
-import math
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import pytest
@@ -18,22 +18,14 @@ from bidmp import set_limits
 from bidmp.cli import main
 from bidmp.sim import robot_model
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tasks"))
+from test_user_cells import urdf_limits  # noqa: E402
+
 ARM = Path(__file__).resolve().parents[1] / "data" / "tm5_like" / "tm5_like.urdf"
-DEG = math.pi / 180.0
 
 
 def _spec(urdf: str) -> dict:
-    return {
-        "urdf": urdf,
-        "flange": "flange",
-        "limits": {
-            "lower": [-3.0] * 6,
-            "upper": [3.0] * 6,
-            "velocity": [3.0] * 6,
-            "acceleration": [15.0] * 6,
-            "jerk": [1500.0] * 6,
-        },
-    }
+    return {"urdf": urdf, "flange": "flange", "limits": urdf_limits([170.0] * 6, [170.0] * 6)}
 
 
 def _planted(text: str, defect: str) -> str:

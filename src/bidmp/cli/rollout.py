@@ -686,3 +686,11 @@ def _add_rollout_arguments(rollout) -> None:
         metavar="LABEL",
         help="the scene's target the goal is (its parts are not avoided; default: what the tool takes in at the goal)",
     )
+    # every option's value when it is not given: a model that acts on only some refuses the rest
+    rollout.set_defaults(
+        unset_options={
+            action.dest: action.default
+            for action in rollout._actions
+            if action.option_strings and action.dest != "help"
+        }
+    )

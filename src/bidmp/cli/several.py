@@ -70,40 +70,10 @@ def fit_several(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-# The rollout options and their values when not given (the robot's, --robot, as the command
-# records it): a model of several demonstrations takes only some of them (_SEVERAL_TAKES).
-_UNSET = {
-    "duration": None,
-    "n_steps": None,
-    "max_speed": None,
-    "max_acc": None,
-    "max_jerk": None,
-    "joint_limits": None,
-    "robot_given": False,
-    "cartesian_goal": None,
-    "tool_length": 0.0,
-    "base": None,
-    "yaw": 0.0,
-    "fastest": False,
-    "skill": None,
-    "cycles": None,
-    "frequency": None,
-    "amplitude": None,
-    "anchor": None,
-    "from_rest": False,
-    "via": None,
-    "scene": None,
-    "avoid": None,
-    "bag": None,
-    "ros1": False,
-    "frame": "base",
-    "bag_topic": None,
-    "stamp": "now",
-    "orientation": None,
-    "follow": False,
-    "target_label": None,
-}
+# What a ProMP's and a DMP of several demonstrations' rollouts act on: --goal, --start (a DMP of
+# several demonstrations refuses it itself: it starts where they did), --rate, --plot, -o, and:
 _SEVERAL_TAKES = {"ProMP": {"via"}, "MultiDMP": {"via", "duration"}}
+_BOTH_TAKE = {"goal", "start", "rate", "plot", "output"}
 
 
 def _refuse_unused(args: argparse.Namespace, model, promp_class) -> None:
@@ -111,10 +81,14 @@ def _refuse_unused(args: argparse.Namespace, model, promp_class) -> None:
     in one line (none is silently ignored); ``--goal``, ``--start`` (a ProMP), ``--rate`` and
     ``--plot`` act on both."""
     kind = "ProMP" if isinstance(model, promp_class) else "MultiDMP"
-    for name, unset in _UNSET.items():
-        if name in _SEVERAL_TAKES[kind] or getattr(args, name, unset) in (unset, None, []):
+    for name, unset in args.unset_options.items():
+        if name in _BOTH_TAKE or name in _SEVERAL_TAKES[kind]:
             continue
-        flag = "--robot" if name == "robot_given" else "--" + name.replace("_", "-")
+        # --robot's value is filled in by the command before it gets here (its default arm)
+        given = args.robot_given if name == "robot" else getattr(args, name) not in (unset, [])
+        if not given:
+            continue
+        flag = "--" + name.replace("_", "-")
         raise ValueError(
             f"{flag} does not apply to a {type(model).__name__} (its rollout takes --goal, "
             f"{'--start, ' if kind == 'ProMP' else ''}--rate, "

@@ -288,11 +288,12 @@ def _check_urdf_tree(path) -> set:
     links = _unique_names(root, "link", where)
     _unique_names(root, "joint", where)
     _one_tree(links, _parents(root, links, where), where)
-    for element in root.iter():
-        if element.tag == "origin":
-            _check_origin_element(element, where)
-        if element.tag == "mesh" and element.get("filename"):
-            _check_mesh(path, element.get("filename"), where)
+    for link in root.findall("link"):  # (the joints' origins: checked with their joints)
+        for origin in link.iter("origin"):
+            _check_origin_element(origin, where, f"link {shown_path(link.get('name'), 30)!r}")
+        for mesh in link.iter("mesh"):
+            if mesh.get("filename"):
+                _check_mesh(path, mesh.get("filename"), where)
     return set(links)
 
 
@@ -326,7 +327,9 @@ def _parents(root, links: list, where: str) -> dict:
         if child in parent_of:
             raise ValueError(f"{where}: link {shown_path(child, 30)} is the child of two joints")
         parent_of[child] = ends["parent"].get("link")
-        _check_origin(joint, where, f"joint {shown_path(name, 30)!r}")
+        origin = joint.find("origin")
+        if origin is not None:
+            _check_origin_element(origin, where, f"joint {shown_path(name, 30)!r}")
     return parent_of
 
 
@@ -352,13 +355,7 @@ def _one_tree(links: list, parent_of: dict, where: str) -> None:
             at = parent_of[at]
 
 
-def _check_origin(joint, where: str, what: str) -> None:
-    origin = joint.find("origin")
-    if origin is not None:
-        _check_origin_element(origin, where, what)
-
-
-def _check_origin_element(origin, where: str, what: str = "an <origin>") -> None:
+def _check_origin_element(origin, where: str, what: str) -> None:
     for key in ("xyz", "rpy"):
         text = origin.get(key)
         if text is None:

@@ -45,10 +45,12 @@ def _solve_ik(cell, point_m: np.ndarray, seed, orientation=None) -> tuple[np.nda
     # of the solutions, which a seed near a joint limit may reach when the free turn does not.
     # A gripper holding a part (``cell.free_turn`` False) turns it with the tool: the whole frame
     # is prescribed for a motion pointing down, the axis for a pose (its turn the arm's own).
-    tries = [(True, None)] if cell.wrist_turns_tool else []
-    tries += [(False, None), (False, list(target_orientation))]
-    if not getattr(cell, "free_turn", True):
-        tries = [(cell.wrist_turns_tool, None)] if orientation is not None else tries[-1:]
+    whole_frame = (False, list(target_orientation))
+    if cell.free_turn:
+        tries = [(True, None)] if cell.wrist_turns_tool else []
+        tries += [(False, None), whole_frame]
+    else:
+        tries = [(cell.wrist_turns_tool, None)] if orientation is not None else [whole_frame]
     best = None
     for park, frame in tries:
         q, error = _bursts(cell, point_m, seed, axis, park, frame)
