@@ -24,7 +24,10 @@ How the output weights are solved and grown, exactly: :mod:`bidmp.incremental.li
 
 from __future__ import annotations
 
+import collections
+import hashlib
 import logging
+import threading
 from typing import NamedTuple
 
 import numpy as np
@@ -117,6 +120,64 @@ def _mapped_features(
         mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1)
     )  # (d+1, u·q)
     return (_affine(X, weights) - low) / span
+
+
+def _draw_mapping(X: np.ndarray, params: _BLSParams):
+    """The mapped features' weights (u, d+1, q), minima and ranges (u·q,) for inputs X: per
+    window, seeded random features of ``[X, 0.1]``, min-max scaled, and the sparse
+    autoencoder's weights that map ``[X, 0.1]`` onto them."""
+    X_bias = _with_bias(X)
+    windows, mins, ranges = [], [], []
+    for window in range(params.n_windows):
+        F = X_bias @ _rng(params.seed, 0, window).uniform(
+            -1.0, 1.0, size=(X_bias.shape[1], params.n_mapped)
+        )
+        F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
+        F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
+        W_Z = np.ascontiguousarray(
+            sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T
+        )  # (d+1, q)
+        Z = X_bias @ W_Z
+        low, span = Z.min(axis=0), np.ptp(Z, axis=0)
+        windows.append(W_Z)
+        mins.append(low)
+        ranges.append(np.where(span > 0, span, 1.0))  # a constant node stays finite
+    return np.stack(windows), np.concatenate(mins), np.concatenate(ranges)
+
+
+# The last few mappings drawn, by inputs and parameters. The mapping depends on nothing else, and
+# a Bi-DMP's blocks all take the same inputs (its training grid): the repairs that each learn one
+# skill on a copy of the same model draw the same block again and again, and the sparse
+# autoencoder's iterations were most of each learn. A hit is the stored result itself, bit for
+# bit (the inputs are compared in full, not only by their hash).
+_MAPPINGS: collections.OrderedDict = collections.OrderedDict()
+_MAPPINGS_KEPT = 8
+_MAPPINGS_LOCK = threading.Lock()
+
+
+def _mapping(X: np.ndarray, params: _BLSParams):
+    """:func:`_draw_mapping`, remembered for the last :data:`_MAPPINGS_KEPT` inputs and parameters
+    (copies returned: a model owns its arrays)."""
+    key = (
+        X.shape,
+        hashlib.blake2b(np.ascontiguousarray(X).view(np.uint8), digest_size=16).digest(),
+        params.seed,
+        params.n_windows,
+        params.n_mapped,
+        params.l1,
+        params.admm_iterations,
+    )
+    with _MAPPINGS_LOCK:
+        kept = _MAPPINGS.get(key)
+        if kept is not None and np.array_equal(kept[0], X):
+            _MAPPINGS.move_to_end(key)
+            return tuple(part.copy() for part in kept[1])
+    mapping = _draw_mapping(X, params)
+    with _MAPPINGS_LOCK:
+        _MAPPINGS[key] = (X.copy(), tuple(part.copy() for part in mapping))
+        while len(_MAPPINGS) > _MAPPINGS_KEPT:
+            _MAPPINGS.popitem(last=False)
+    return mapping
 
 
 def _enhancement_block(
@@ -307,24 +368,7 @@ class BLS(Estimator):
         X = _check_inputs(X)
         Y, y_was_1d = _check_targets(Y, X.shape[0])
         _check_work(X.shape[0], params.n_windows * params.n_mapped + params.n_enhance, X.shape[1])
-        X_bias = _with_bias(X)
-        windows, mins, ranges = [], [], []
-        for window in range(params.n_windows):
-            F = X_bias @ _rng(params.seed, 0, window).uniform(
-                -1.0, 1.0, size=(X_bias.shape[1], params.n_mapped)
-            )
-            F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
-            F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
-            W_Z = np.ascontiguousarray(
-                sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T
-            )  # (d+1, q)
-            Z = X_bias @ W_Z
-            low, span = Z.min(axis=0), np.ptp(Z, axis=0)
-            windows.append(W_Z)
-            mins.append(low)
-            ranges.append(np.where(span > 0, span, 1.0))  # a constant node stays finite
-        mapping_weights = np.stack(windows)
-        mapping_min, mapping_range = np.concatenate(mins), np.concatenate(ranges)
+        mapping_weights, mapping_min, mapping_range = _mapping(X, params)
         Z = _mapped_features(X, mapping_weights, mapping_min, mapping_range)
         weights, scale, H = _enhancement_block(Z, params.seed, 0, params.n_enhance, params.shrink)
         A = np.hstack([Z, H])

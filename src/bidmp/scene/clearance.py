@@ -53,6 +53,33 @@ _OVERLAP_TOLERANCE = 1e-6  # parts may touch (a nut on its plate), not interpene
 _STEP_SHARE = 0.002
 
 
+def _solid_frames(solids) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each solid's centre (k, 3), rotation (k, 3, 3) and its box in its own frame (lower and
+    upper corners, (k, 3) each): the shape itself for a box, the tight box of a cylinder (coal's,
+    centred, along z) and of a convex hull's vertices."""
+    lower, upper = [], []
+    for solid in solids:
+        if solid.kind == "box":
+            half = np.asarray(solid.params, dtype=float) / 2.0
+        elif solid.kind == "cylinder":
+            radius, height = solid.params
+            half = np.array([radius, radius, height / 2.0])
+        else:
+            vertices = np.asarray(solid.params[0], dtype=float)
+            lower.append(vertices.min(axis=0))
+            upper.append(vertices.max(axis=0))
+            continue
+        lower.append(-half)
+        upper.append(half)
+    count = len(solids)
+    return (
+        np.array([s.centre for s in solids], dtype=float).reshape(count, 3),
+        np.array([s.rotation for s in solids], dtype=float).reshape(count, 3, 3),
+        np.array(lower, dtype=float).reshape(count, 3),
+        np.array(upper, dtype=float).reshape(count, 3),
+    )
+
+
 @dataclass(frozen=True)
 class Clearance:
     """Smallest signed distance between the swept tool and the scene's parts along a motion.
@@ -162,6 +189,7 @@ class Scene:
         self._lower = np.array([s.lower for s in self.solids]).reshape(-1, 3)
         self._upper = np.array([s.upper for s in self.solids]).reshape(-1, 3)
         self._owner = np.array([s.part for s in self.solids], dtype=object)
+        self._frames = _solid_frames(self.solids)
         self._distances = None
 
     # -- construction ------------------------------------------------------------------------
@@ -442,20 +470,26 @@ class Scene:
         rotations = Rotation.from_quat(dense_q).as_matrix()
         axes = rotations[:, :, 2]
         centres = dense - axes * self.tool.length / 2.0
-        extent = _cylinder_extent(axes, self.tool.radius, self.tool.length / 2.0)
-        lower, upper = self._lower[chosen], self._upper[chosen]
         engine = self._engine()
         return self._minimum(
             dense,
             chosen,
-            lambda rows: _box_distance(
-                (centres[rows] - extent[rows])[:, None],
-                (centres[rows] + extent[rows])[:, None],
-                lower[None],
-                upper[None],
-            ),
+            lambda rows: self._oriented_bounds(centres[rows], axes[rows], chosen),
             lambda row, solid: engine.tool_to(dense[row], solid, rotations[row]),
         )
+
+    def _oriented_bounds(self, centres: np.ndarray, axes: np.ndarray, chosen: np.ndarray):
+        """Lower bounds (m, k) of the distances from the tool (its body's ``centres`` (m, 3), unit
+        ``axes`` (m, 3)) to the solids ``chosen``: the distance between the tool's box and each
+        solid's box, both taken in the solid's own frame. In the world frame a tilted plate's box
+        holds every tool placed near it (bound 0, so every such pair went to coal); in its own
+        frame the box is the plate itself."""
+        centre, rotation, lower, upper = (part[chosen] for part in self._frames)
+        # R^T (c - centre) and R^T a for every placement and solid: (m, k, 3)
+        local = np.einsum("mkj,kji->mki", centres[:, None] - centre[None], rotation)
+        local_axes = np.einsum("mj,kji->mki", axes, rotation)
+        extent = _cylinder_extent(local_axes, self.tool.radius, self.tool.length / 2.0)
+        return _box_distance(local - extent, local + extent, lower[None], upper[None])
 
     @numerically_guarded
     def clearance(
