@@ -269,3 +269,38 @@ def test_estimator_conventions():
     again = clone(fitted)
     assert again.get_params() == model.get_params() and not hasattr(again, "output_weights_")
     np.testing.assert_array_equal(again.fit(X, Y).predict(X), fitted.predict(X))
+
+
+def test_the_fast_paths_give_the_plain_computations_bits():
+    """Speed paths checked against the plain computation they replace, bit for bit: the sparse
+    autoencoder's ADMM with LAPACK's potrs against scipy's cho_solve, and a BLS fitted twice on
+    the same inputs (the second from the remembered mapping) against one fitted with nothing
+    remembered; a remembered mapping is a copy (changing one model's leaves the other's)."""
+    from scipy.linalg import cho_factor, cho_solve
+
+    from bidmp.incremental import bls as bls_module
+    from bidmp.incremental.linalg import sparse_autoencoder
+
+    rng = np.random.default_rng(7)
+    F, target = rng.random((300, 12)), rng.normal(size=(300, 9))
+    factor = cho_factor(F.T @ F + np.eye(12))
+    z = u = np.zeros((12, 9))
+    for _ in range(50):
+        v = cho_solve(factor, F.T @ target + (z - u)) + u
+        z = np.sign(v) * np.maximum(np.abs(v) - 1e-3, 0.0)
+        u = v - z
+    assert np.array_equal(sparse_autoencoder(F, target), z)
+
+    X, Y = rng.random((200, 6)), rng.normal(size=(200, 2))
+    bls_module._MAPPINGS.clear()
+    first = BLS(seed=3).fit(X, Y)
+    second = BLS(seed=3).fit(X, Y)  # from the remembered mapping
+    bls_module._MAPPINGS.clear()
+    fresh = BLS(seed=3).fit(X, Y)
+    for model in (first, second):
+        assert np.array_equal(model.mapping_weights_, fresh.mapping_weights_)
+        assert np.array_equal(model.output_weights_, fresh.output_weights_)
+    first.mapping_weights_[0, 0, 0] += 1.0
+    assert not np.array_equal(first.mapping_weights_, second.mapping_weights_)
+    other = BLS(seed=4).fit(X, Y)  # another seed: another mapping, not the remembered one
+    assert not np.array_equal(other.mapping_weights_, fresh.mapping_weights_)
