@@ -400,8 +400,9 @@ def test_joints_chosen_by_name_in_the_order_given(tmp_path):
 
 def test_rotation_vectors_in_degrees_or_rpy_are_refused_not_read_as_radians(tmp_path, capsys):
     """A TMflow-style export's roll/pitch/yaw in degrees put in rx, ry, rz was read as radians (the
-    learned start 177.5 deg off, the tool up). A rotation vector longer than 2π is no axis-angle in
-    radians: refused naming the row; the same motion in radians reads, each quaternion SciPy's
+    learned start 177.5 deg off, the tool up). A rotation vector longer than π is no axis-angle in
+    radians (its angle lies in [0, π]): refused naming the row, for degrees and for roll/pitch/yaw
+    in radians alike; the same motion in radians reads, each quaternion SciPy's
     from_rotvec of its row (the independent reference)."""
     from scipy.spatial.transform import Rotation
 
@@ -426,7 +427,16 @@ def test_rotation_vectors_in_degrees_or_rpy_are_refused_not_read_as_radians(tmp_
     expected = Rotation.from_rotvec(radians).as_quat()
     same_sign = np.sign(np.sum(poses[:, 3:] * expected, axis=1))[:, None]
     np.testing.assert_allclose(poses[:, 3:] * same_sign, expected, atol=1e-12)
-    with pytest.raises(ValueError, match=r"data row 1 \(> 2π\): degrees, or roll/pitch/yaw"):
+    with pytest.raises(ValueError, match=r"at most π\) reach length 177.5 at data row 1: degrees"):
+        read_poses(bad)
+    # roll/pitch/yaw in radians put there: the tool down (roll 177.5 deg) and turning about z
+    # makes vectors longer than π from the first row that turns by more than 0.05 rad
+    rpy_radians = turns.as_euler("xyz")
+    np.savetxt(
+        bad, np.hstack([t, positions, rpy_radians]), delimiter=",", header=header, comments=""
+    )
+    first = int(np.argmax(np.linalg.norm(rpy_radians, axis=1) > np.pi + 1e-3)) + 1
+    with pytest.raises(ValueError, match=rf"at data row {first}: degrees, or roll/pitch/yaw"):
         read_poses(bad)
     assert main(["fit", str(bad), "-o", str(tmp_path / "m.npz")]) == 2
     err = capsys.readouterr().err.strip().splitlines()

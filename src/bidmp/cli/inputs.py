@@ -36,8 +36,10 @@ def demo_options(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="MAP",
         help="which CSV columns are time and the motion: single columns (t=timestamp,x=ee_x,y=ee_y,"
-        "z=ee_z; qx,qy,qz,qw or rx,ry,rz for poses) or a group by prefix (pose=actual_TCP_pose, "
-        "position=actual_TCP_pose, joints=actual_q); other columns are ignored",
+        "z=ee_z; qx,qy,qz,qw, rx,ry,rz (radians) or Euler angles e1,e2,e3 for poses) or a group by "
+        "prefix (pose=actual_TCP_pose, position=actual_TCP_pose, joints=actual_q); other columns are "
+        "ignored. Conventions beside them: time=s|ms|us|ns, euler=<sequence, e.g. xyz or ZYX>, "
+        "angles=deg|rad, decimal=comma|point, gaps=drop (rows with NaN dropped)",
     )
     parser.add_argument(
         "--no-time",

@@ -11,8 +11,9 @@ Recognised by name (case does not matter; ``/``, ``[ ]`` and ``.`` separate a fi
 * **orientations** — ``qx, qy, qz, qw`` (any order) or a rotation vector ``rx, ry, rz`` (rad,
   beside ``x, y, z``); ROS ``<prefix>orientation.x/y/z/w`` or ``rotation.x/y/z/w``; UR RTDE
   ``actual_TCP_pose_0..5`` (and ``target_TCP_pose_…``): x, y, z in metres and a rotation vector;
-* **joints** — UR RTDE ``actual_q_0..`` / ``target_q_0..`` (rad), or a file ``t, <joint names>``
-  whose other columns are all joints.
+* **joints** — UR RTDE ``actual_q_0..`` / ``target_q_0..`` (rad), a ``rostopic echo -p``
+  JointState (``field.position0..``, the names from the rows' ``field.name0..``), or a file
+  ``t, <joint names>`` whose other columns are all joints.
 
 A file whose columns hold more than one motion (an RTDE log of the measured and the commanded
 pose and joints) is refused with the candidates listed and the ``columns`` that picks each; it
@@ -22,6 +23,15 @@ its prefix (``pose=actual_TCP_pose``, ``joints=actual_q``) or joints by name
 (``joints=shoulder_pan_joint|elbow_joint``, in that order); as the command line writes it,
 ``t=stamp,x=ee_x,y=ee_y,z=ee_z``. A mapping with only ``t`` fixes the time and leaves the rest
 to the names.
+
+**Conventions.** A unit in a column's name is read (``Time(ms)``, ``time_ms``, ``t [us]``,
+``X(mm)``, ``RX(deg)``, ``j1 (deg)``); settings beside the roles declare the rest: ``time=ms``
+(s, ms, us, ns), Euler angles ``e1, e2, e3`` with ``euler=<sequence>`` (SciPy's: ``xyz`` about the
+fixed axes, roll/pitch/yaw; ``ZYX`` about the turning ones, KUKA's A, B, C) and ``angles=deg|rad``,
+``decimal=comma`` (seen by itself in a file separated by ``;``, tabs or spaces), ``gaps=drop``
+(rows with a NaN dropped, with a warning). What the names leave open is refused with the
+declaration that settles it, never guessed: roll/pitch/yaw or A/B/C without a sequence, a rotation
+vector whose columns name degrees, a declaration the names contradict.
 """
 
 from __future__ import annotations
@@ -42,9 +52,35 @@ TIME_NAMES = ("t", "time", "timestamp", "stamp", "__time", "%time")
 _POSITION_ROLES = ("x", "y", "z")
 _QUATERNION_ROLES = ("qx", "qy", "qz", "qw")
 _ROTVEC_ROLES = ("rx", "ry", "rz")
-_SINGLE_ROLES = ("t", *_POSITION_ROLES, *_QUATERNION_ROLES, *_ROTVEC_ROLES)
+_EULER_ROLES = ("e1", "e2", "e3")
+_SINGLE_ROLES = ("t", *_POSITION_ROLES, *_QUATERNION_ROLES, *_ROTVEC_ROLES, *_EULER_ROLES)
 _GROUP_ROLES = ("pose", "position", "joints")
-_MAX_MAPPING = 16
+# What a file's convention is, declared beside the roles: the time column's unit, Euler angles'
+# axis sequence (SciPy's: lower case about fixed axes, upper case about the turning ones) and
+# unit, the decimal mark, and whether rows with gaps are dropped.
+SETTINGS = {
+    "time": ("s", "ms", "us", "ns"),
+    "euler": None,  # three of x, y, z: checked by _check_sequence
+    "angles": ("rad", "deg"),
+    "decimal": ("point", "comma"),
+    "gaps": ("refuse", "drop"),
+}
+_MAX_MAPPING = 24
+_TIME_DIVISORS = {"s": 1.0, "ms": 1e3, "us": 1e6, "ns": 1e9}
+# A unit in a column's name, as loggers write it: "X(mm)", "Time [ms]", "time_ms", "RX (deg)".
+_UNIT_WORDS = {
+    "s": "s", "sec": "s", "secs": "s", "seconds": "s",
+    "ms": "ms", "msec": "ms", "milliseconds": "ms",
+    "us": "us", "µs": "us", "μs": "us", "usec": "us", "microseconds": "us",
+    "ns": "ns", "nsec": "ns", "nanoseconds": "ns",
+    "mm": "mm", "cm": "cm", "m": "m",
+    "deg": "deg", "degree": "deg", "degrees": "deg", "°": "deg",
+    "rad": "rad", "radian": "rad", "radians": "rad",
+}  # fmt: skip
+_BRACKETED_UNIT = re.compile(r"^(.*?)\s*[(\[]\s*([^()\[\]\s]+)\s*[)\]]$")
+_SUFFIXED_UNIT = re.compile(
+    r"^(t|time|timestamp|stamp|x|y|z|rx|ry|rz|roll|pitch|yaw)_([a-zµμ]+)$", re.IGNORECASE
+)
 _RTDE_POSE = re.compile(r"^(.*tcp_pose)_([0-9]+)$")
 _RTDE_JOINTS = re.compile(r"^((?:actual|target)_q)_([0-9]+)$")
 _INDEXED = re.compile(r"^(.*?)[._]?([0-9]+)$")
@@ -67,7 +103,7 @@ class Layout:
     values : tuple of int
         Positions ``x, y[, z]``; a pose's ``x, y, z`` and its rotation (``qx, qy, qz, qw`` or
         ``rx, ry, rz``); or the joints, in order.
-    rotation : {"quaternion", "rotvec", None}
+    rotation : {"quaternion", "rotvec", "euler", None}
         How a pose's rotation columns (or the ``orientation`` columns) give it.
     orientation : tuple of int
         Positions picked from a pose group (``position=actual_TCP_pose``): the group's rotation
@@ -81,6 +117,15 @@ class Layout:
         What was read, for messages (``UR RTDE actual_TCP_pose_0..5``).
     ignored : tuple of str
         The other columns.
+    euler : str
+        Euler angles' axis sequence (SciPy's) when the rotation is ``"euler"``.
+    angles : {"rad", "deg", ""}
+        The unit of Euler angles.
+    names_from : tuple of int
+        Text columns whose cells are the joints' names (a ``rostopic echo -p`` JointState's
+        ``name0..``): the names are read from the rows.
+    time_declared : bool
+        Whether the time column's unit is declared (by its name or ``time=``), not assumed.
     """
 
     kind: str
@@ -93,6 +138,10 @@ class Layout:
     units: str
     label: str
     ignored: tuple[str, ...]
+    euler: str = ""
+    angles: str = ""
+    names_from: tuple[int, ...] = ()
+    time_declared: bool = False
 
 
 @dataclass(frozen=True)
@@ -104,11 +153,24 @@ class _Candidate:
     label: str
     pick: str  # the mapping that selects it
     orientation: tuple[int, ...] = ()
+    names_from: tuple[int, ...] = ()  # text columns holding the joints' names (a JointState)
+
+
+def split_unit(name: str) -> tuple[str, str]:
+    """A header name without the unit it names, and that unit (``"ms"``, ``"deg"``, ``"mm"`` ...;
+    ``""`` when it names none): ``X(mm)``, ``Time [ms]``, ``time_ms``."""
+    text = name.strip()
+    for pattern in (_BRACKETED_UNIT, _SUFFIXED_UNIT):
+        match = pattern.match(text)
+        if match and match.group(2).lower() in _UNIT_WORDS and match.group(1).strip():
+            return match.group(1).strip(), _UNIT_WORDS[match.group(2).lower()]
+    return text, ""
 
 
 def _key(name: str) -> str:
-    """A header name as compared: lower case, one separator (``.``), no ``field.`` prefix."""
-    key = re.sub(r"[/\[\]]", ".", name.strip().lower())
+    """A header name as compared: lower case, one separator (``.``), no ``field.`` prefix, no
+    unit (``X(mm)`` is ``x``)."""
+    key = re.sub(r"[/\[\]]", ".", split_unit(name)[0].lower())
     key = re.sub(r"\.+", ".", key).strip(".")
     return key[len("field.") :] if key.startswith("field.") else key
 
@@ -134,18 +196,24 @@ def parse_columns(spec) -> dict[str, str] | None:
             f"columns must be a dict or a role=name,... string, got {type(spec).__name__}"
         )
     if len(spec) > _MAX_MAPPING:
-        raise ValueError(f"columns names {len(spec)} roles; there are at most {len(_SINGLE_ROLES)}")
+        raise ValueError(
+            f"columns names {len(spec)} roles and settings; there are at most {_MAX_MAPPING}"
+        )
     mapping = {}
     for role, name in spec.items():
+        if role in SETTINGS:
+            mapping[role] = _setting(role, name)
+            continue
         if role not in (*_SINGLE_ROLES, *_GROUP_ROLES):
             raise ValueError(
                 f"columns: unknown role {short_token(role)}; roles are {', '.join(_SINGLE_ROLES)} "
-                f"and the groups {', '.join(_GROUP_ROLES)}"
+                f"and the groups {', '.join(_GROUP_ROLES)}; settings {', '.join(SETTINGS)}"
             )
         if not isinstance(name, str) or not name:
             raise ValueError(f"columns: role {role} needs a column name")
         mapping[role] = _key(name)
-    if len(set(mapping.values())) != len(mapping):
+    names = [mapping[role] for role in mapping if role not in SETTINGS]
+    if len(set(names)) != len(names):
         raise ValueError("columns: two roles name the same column")
     groups = [role for role in _GROUP_ROLES if role in mapping]
     singles = [role for role in mapping if role in _SINGLE_ROLES and role != "t"]
@@ -154,6 +222,12 @@ def parse_columns(spec) -> dict[str, str] | None:
             f"columns: give one group ({', '.join(_GROUP_ROLES)}) or single columns, not "
             f"{' and '.join(groups + singles[:1])}"
         )
+    _check_rotation_roles(mapping)
+    return mapping
+
+
+def _check_rotation_roles(mapping: dict) -> None:
+    """One rotation, whole, with what it needs declared (an Euler sequence; its unit)."""
     if any(role in mapping for role in _QUATERNION_ROLES) and not all(
         role in mapping for role in _QUATERNION_ROLES
     ):
@@ -162,11 +236,67 @@ def parse_columns(spec) -> dict[str, str] | None:
         role in mapping for role in _ROTVEC_ROLES
     ):
         raise ValueError("columns: a rotation vector needs all of rx, ry, rz")
-    if "qw" in mapping and "rx" in mapping:
+    if any(role in mapping for role in _EULER_ROLES) and not all(
+        role in mapping for role in _EULER_ROLES
+    ):
+        raise ValueError("columns: Euler angles need all of e1, e2, e3")
+    given = [
+        roles[0]
+        for roles in (_QUATERNION_ROLES, _ROTVEC_ROLES, _EULER_ROLES)
+        if roles[0] in mapping
+    ]
+    if len(given) > 1:
         raise ValueError(
-            "columns: give a quaternion (qx..qw) or a rotation vector (rx, ry, rz), not both"
+            "columns: give one rotation: a quaternion (qx..qw), a rotation vector (rx, ry, rz) or "
+            "Euler angles (e1, e2, e3)"
         )
-    return mapping
+    if "e1" in mapping and "euler" not in mapping:
+        raise ValueError(
+            "columns: Euler angles e1, e2, e3 need their axis sequence, e.g. euler=xyz (roll, "
+            "pitch, yaw about fixed x, y, z: ROS, TMflow) or euler=ZYX (KUKA's A, B, C)"
+        )
+    if "euler" in mapping and "e1" not in mapping:
+        raise ValueError(
+            "columns: euler= declares the sequence of Euler angles e1, e2, e3: name them"
+        )
+    if "angles" in mapping and "e1" not in mapping:
+        raise ValueError(
+            "columns: angles= declares the unit of Euler angles e1, e2, e3 (a rotation vector is "
+            "radians, a quaternion has none)"
+        )
+
+
+def _setting(name: str, value) -> str:
+    """A declared convention's value, checked."""
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError(f"columns: setting {name} needs a value")
+    value = value.strip()
+    if name == "euler":
+        return _check_sequence(value)
+    value = {"µs": "us", "μs": "us", "degrees": "deg", "radians": "rad"}.get(value, value)
+    if value.lower() not in SETTINGS[name]:
+        raise ValueError(
+            f"columns: {name}={short_token(value, 20)[1:-1]} is not one of {', '.join(SETTINGS[name])}"
+        )
+    return value.lower()
+
+
+def _check_sequence(value: str) -> str:
+    """An Euler axis sequence as SciPy reads it: three of x, y, z (no axis twice in a row), all
+    lower case (about the fixed axes) or all upper case (about the turning ones)."""
+    if (
+        len(value) != 3
+        or not (value.islower() or value.isupper())
+        or set(value.lower()) - set("xyz")
+        or value[0].lower() == value[1].lower()
+        or value[1].lower() == value[2].lower()
+    ):
+        raise ValueError(
+            f"columns: euler={short_token(value, 20)[1:-1]} is no axis sequence: three of x, y, z, "
+            f"lower case about the fixed axes (xyz: roll, pitch, yaw) or upper case about the turning "
+            f"ones (ZYX)"
+        )
+    return value
 
 
 def _shown(header, limit: int = 8) -> str:
@@ -177,8 +307,11 @@ def _shown(header, limit: int = 8) -> str:
 
 # -- time -----------------------------------------------------------------------------------------
 def _time_divisor(name: str, key: str) -> float:
-    """Units of a time column per second: nanoseconds for ``rostopic echo -p``'s columns
-    (``%time``, ``field.…``), seconds otherwise."""
+    """Units of a time column per second: the unit its name gives (``Time(ms)``, ``time_us``);
+    nanoseconds for ``rostopic echo -p``'s columns (``%time``, ``field.…``); else seconds."""
+    unit = split_unit(name)[1]
+    if unit in _TIME_DIVISORS:
+        return _TIME_DIVISORS[unit]
     return 1e9 if name.strip().lower().startswith("field.") or key == "%time" else 1.0
 
 
@@ -393,7 +526,17 @@ _OWN_RATES = re.compile(
 )  # what save_trajectory / save_poses add beside positions
 
 
-def _layout(header, keys, time, scale, chosen: _Candidate) -> Layout:
+def _layout(
+    header,
+    keys,
+    time,
+    scale,
+    chosen: _Candidate,
+    settings: dict,
+    declared: bool,
+    units: str,
+    angles: str,
+) -> Layout:
     used = set(chosen.values) | set(time) | set(chosen.orientation)
     ignored = tuple(
         name
@@ -414,32 +557,56 @@ def _layout(header, keys, time, scale, chosen: _Candidate) -> Layout:
         chosen.rotation,
         chosen.orientation,
         tuple(header[index] for index in chosen.values),
-        chosen.units,
+        units,
         chosen.label,
         ignored,
+        settings.get("euler", ""),
+        angles,
+        chosen.names_from,
+        declared,
     )
 
 
 def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
-    """The layout of a CSV header, by the names or by a column mapping (module docstring).
+    """The layout of a CSV header, by the names or by a column mapping (module docstring), with
+    the conventions the mapping declares (``time=ms``, ``euler=xyz``, ``angles=deg``) or the names
+    give (``Time(ms)``, ``X(mm)``, ``RX(deg)``).
 
     Raises
     ------
     ValueError
-        A header that names no motion, or more than one (the candidates listed), or a mapping that
-        names a column the header does not have.
+        A header that names no motion, or more than one (the candidates listed), a mapping that
+        names a column the header does not have, or columns whose names say they cannot be what
+        they would be read as (a rotation vector in degrees, roll/pitch/yaw without their
+        sequence).
     """
     header = tuple(header)
     keys = [_key(name) for name in header]
-    if mapping is not None and "t" in mapping:
-        time = (_index(header, keys, mapping["t"], "t", path),)
+    roles = {key: value for key, value in (mapping or {}).items() if key not in SETTINGS}
+    settings = {key: value for key, value in (mapping or {}).items() if key in SETTINGS}
+    if "t" in roles:
+        time = (_index(header, keys, roles["t"], "t", path),)
         scale = _time_divisor(header[time[0]], keys[time[0]])
     else:
         time, scale = _time_from_names(header, keys, path)
-    if mapping is not None and set(mapping) - {"t"}:
-        return _layout(header, keys, time, scale, _mapped(header, keys, mapping, path))
+    scale, declared = _declared_time(header, time, scale, settings, path)
+    if set(roles) - {"t"}:
+        chosen = _mapped(header, keys, roles, path)
+    else:
+        chosen = _by_names(header, keys, time, path)
+    units, angles = _units_named(header, chosen, settings, path)
+    return _layout(header, keys, time, scale, chosen, settings, declared, units, angles)
+
+
+def _by_names(header, keys, time, path) -> _Candidate:
+    """The one motion the header's names give (refused: none, several, or a rotation whose
+    convention the names leave open)."""
+    _refuse_undeclared_euler(header, keys, path)
     candidates = (
-        _plain_candidate(keys) + _ros_candidates(header, keys) + _rtde_candidates(header, keys)
+        _plain_candidate(keys)
+        + _ros_candidates(header, keys)
+        + _rtde_candidates(header, keys)
+        + _joint_state_candidates(header, keys)
     )
     if not candidates:
         candidates = _joints_candidate(header, keys, time)
@@ -459,7 +626,131 @@ def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
             f"RTDE actual_TCP_pose_0..5 or actual_q_0..5, ROS pose.position.x ...), t,<joint names> for "
             f"joint space, or name them with a column mapping (--columns t=stamp,x=ee_x,y=ee_y,z=ee_z)"
         )
-    return _layout(header, keys, time, scale, candidates[0])
+    return candidates[0]
+
+
+def _declared_time(header, time, scale: float, settings: dict, path) -> tuple[float, bool]:
+    """The time column's units per second and whether they are declared (by the column's name,
+    a logger's convention or ``time=``) rather than assumed to be seconds."""
+    named = split_unit(header[time[0]])[1] if len(time) == 1 else ""
+    declared = len(time) == 2 or scale != 1.0 or named == "s"
+    if "time" not in settings:
+        return scale, declared
+    unit = settings["time"]
+    if not time:
+        raise ValueError(
+            f"{path}: time={unit} declares the unit of the time column, but the header has none "
+            f"(name it with t=<column>)"
+        )
+    if len(time) == 2:
+        raise ValueError(
+            f"{path}: time={unit} does not apply to a ROS header stamp (its sec and nanosec fields "
+            f"are their own units)"
+        )
+    if named in _TIME_DIVISORS and named != unit:
+        raise ValueError(
+            f"{path}: time={unit} but the column {short_token(header[time[0]], 30)} names {named}"
+        )
+    return _TIME_DIVISORS[unit], True
+
+
+def _refuse_undeclared_euler(header, keys, path) -> None:
+    """Euler angles by name (roll, pitch, yaw; KUKA's a, b, c beside x, y, z) give no sequence:
+    refused with the declaration that reads them (never guessed)."""
+    for names, example in ((("roll", "pitch", "yaw"), "xyz"), (("a", "b", "c"), "ZYX")):
+        if all(name in keys for name in names) and {"x", "y", "z"} <= set(keys):
+            where = [header[keys.index(name)] for name in names]
+            unit = split_unit(where[0])[1] or "deg|rad"
+            raise ValueError(
+                f"{path}: columns {', '.join(where)} are Euler angles, whose axis sequence and unit "
+                f"the names do not fix; declare them, e.g. --columns x=x,y=y,z=z,e1={where[0]},"
+                f"e2={where[1]},e3={where[2]},euler={example},angles={unit} (or pick the positions "
+                f"alone: --columns x=x,y=y,z=z)"
+            )
+
+
+def _units_named(header, chosen: _Candidate, settings: dict, path) -> tuple[str, str]:
+    """(the values' unit, the Euler angles' unit) as the columns' names and the declarations
+    give them; a name whose unit cannot be the role's refused with the fix."""
+    named = [split_unit(header[index])[1] for index in chosen.values]
+    if chosen.kind == "joints":
+        units = {unit for unit in named if unit}
+        if units - {"rad", "deg"} or len(units) > 1:
+            raise ValueError(
+                f"{path}: the joint columns name {', '.join(sorted(units))}: joints are angles in "
+                f"one unit (rad or deg)"
+            )
+        return (units.pop() if units else chosen.units), ""
+    lengths = named[:3]
+    given = {unit for unit in lengths if unit}
+    if given - {"mm", "cm", "m"} or len(given) > 1:
+        raise ValueError(
+            f"{path}: the position columns ({', '.join(header[i] for i in chosen.values[:3])}) name "
+            f"{', '.join(sorted(given))}: positions are lengths in one unit (mm, cm or m)"
+        )
+    if given and chosen.units and given != {chosen.units}:
+        raise ValueError(
+            f"{path}: the position columns name {given.pop()}, but {chosen.label} is in "
+            f"{chosen.units} by its convention"
+        )
+    units = given.pop() if given else chosen.units
+    turned = [split_unit(header[index])[1] for index in chosen.values[3:]]
+    if chosen.rotation == "rotvec" and set(turned) - {"", "rad"}:
+        columns = [header[index] for index in chosen.values[3:]]
+        raise ValueError(
+            f"{path}: the rotation-vector columns {', '.join(columns)} name {turned[0] or turned[-1]}: "
+            f"a rotation vector is an axis times an angle in radians. If these are roll/pitch/yaw "
+            f"(TMflow's Rx, Ry, Rz are), declare them as Euler angles: --columns x=..,y=..,z=..,"
+            f"e1={columns[0]},e2={columns[1]},e3={columns[2]},euler=xyz,angles=deg"
+        )
+    if chosen.rotation != "euler":
+        return units, ""
+    angle_units = {unit for unit in turned if unit}
+    if angle_units - {"deg", "rad"} or len(angle_units) > 1:
+        raise ValueError(
+            f"{path}: the Euler-angle columns name {', '.join(sorted(angle_units))}: angles are "
+            f"in one unit (deg or rad)"
+        )
+    angles = settings.get("angles", "")
+    if angle_units and angles and angle_units != {angles}:
+        raise ValueError(
+            f"{path}: angles={angles} but the Euler-angle columns name {angle_units.pop()}"
+        )
+    angles = angles or (angle_units.pop() if angle_units else "")
+    if not angles:
+        raise ValueError(
+            f"{path}: the Euler angles' unit is not named: declare it, angles=deg or angles=rad"
+        )
+    return units, angles
+
+
+def _joint_state_candidates(header, keys) -> list[_Candidate]:
+    """A ``rostopic echo -p`` JointState export: ``name0..n`` (text: the joints' names, read
+    from the rows) beside ``position0..n`` (radians)."""
+    names = dict(
+        (int(m.group(1)), index)
+        for index, key in enumerate(keys)
+        if (m := re.match(r"^name([0-9]+)$", key))
+    )
+    positions = dict(
+        (int(m.group(1)), index)
+        for index, key in enumerate(keys)
+        if (m := re.match(r"^position([0-9]+)$", key))
+    )
+    count = len(positions)
+    if not count or sorted(positions) != list(range(count)) or sorted(names) != list(range(count)):
+        return []
+    return [
+        _Candidate(
+            "joints",
+            tuple(positions[n] for n in range(count)),
+            None,
+            "rad",
+            f"JointState position0..{count - 1} (names from name0..{count - 1})",
+            "joints=position",
+            names_from=tuple(names[n] for n in range(count)),
+        )
+    ]
 
 
 def _index(header, keys, name: str, role: str, path) -> int:
@@ -514,6 +805,9 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
             raise ValueError(
                 f"{path}: no joint columns {short_token(wanted, 30)}_0, _1, ... in the header {_shown(header, 10)}"
             )
+        state = _joint_state_candidates(header, keys)
+        if state and wanted == "position" and state[0].values == tuple(i for _, i in members):
+            return state[0]  # a JointState's positions: their names from its name columns
         return _Candidate(
             "joints",
             tuple(index for _, index in members),
@@ -530,7 +824,11 @@ def _mapped(header, keys, mapping: dict, path) -> _Candidate:
     present = [role for role in _POSITION_ROLES if role in mapping]
     if present != list(_POSITION_ROLES[: len(present)]) or len(present) < 2:
         raise ValueError("columns: positions need x and y (and z), e.g. x=ee_x,y=ee_y,z=ee_z")
-    for roles, rotation in ((_QUATERNION_ROLES, "quaternion"), (_ROTVEC_ROLES, "rotvec")):
+    for roles, rotation in (
+        (_QUATERNION_ROLES, "quaternion"),
+        (_ROTVEC_ROLES, "rotvec"),
+        (_EULER_ROLES, "euler"),
+    ):
         if roles[0] in mapping:
             if len(where) != 3:
                 raise ValueError("columns: a pose needs x, y and z")

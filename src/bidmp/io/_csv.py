@@ -8,6 +8,7 @@ import contextlib
 import csv
 import itertools
 import logging
+import re
 import warnings
 from pathlib import Path
 
@@ -85,17 +86,52 @@ def _is_number(text: str) -> bool:
 
 
 def _csv_delimiter(sample: str) -> str:
-    """``,`` or ``;`` (the more frequent in the sample), else a tab, else spaces (UR's RTDE
-    recorder writes space-separated files)."""
+    """``,`` or ``;`` (the more frequent in the sample; ``;`` when the first line, a header, has
+    ``;`` and no ``,``: the rows' decimal commas then do not count), else a tab, else spaces (UR's
+    RTDE recorder writes space-separated files)."""
     lines = [
         line for line in sample.splitlines() if line.strip() and not line.lstrip().startswith("#")
     ]
+    if lines and ";" in lines[0] and "," not in lines[0]:
+        return ";"
     body = "\n".join(lines) if lines else sample
     if body.count(";") > body.count(","):
         return ";"
     if "," in body:
         return ","
     return "\t" if "\t" in body else " "
+
+
+_DECIMAL_COMMA = re.compile(r"(?:^|[;\t ])\s*[+-]?[0-9]+,[0-9]+(?:[eE][+-]?[0-9]+)?\s*(?=$|[;\t ])")
+
+
+def decimal_comma(sample: str, delimiter: str, declared: str, path) -> bool:
+    """Whether the numbers are written with a decimal comma (``417,50``): declared
+    (``decimal=comma``), or seen in the rows of a file separated by ``;``, tabs or spaces (where a
+    comma can be nothing else). With ``,`` separators a decimal comma cannot be told from the
+    separator: refused when declared."""
+    if declared == "point":
+        return False
+    if delimiter == ",":
+        if declared == "comma":
+            raise ValueError(
+                f"{path}: decimal=comma, but the columns are separated by commas too; write the "
+                f"file with ';' separators (as spreadsheets do where the comma is the decimal mark)"
+            )
+        return False
+    if declared == "comma":
+        return True
+    rows = [
+        line
+        for line in sample.splitlines()[1:]
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
+    if any(_DECIMAL_COMMA.search(line) for line in rows):
+        logger.info(
+            "%s: numbers with a decimal comma (the columns separated by %r)", path, delimiter
+        )
+        return True
+    return False
 
 
 def _split(line: str, delimiter: str) -> list[str]:
@@ -109,14 +145,18 @@ def _row_limit_error(path: Path) -> ValueError:
     )
 
 
-def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | None:
+def _csv_fast(
+    path: Path, decimal: str = "auto"
+) -> tuple[tuple[str, ...] | None, np.ndarray, dict] | None:
     """The common case, parsed by NumPy's C reader (a 1e6-row recording in about a second):
     an optional header line, then plain numbers. Returns None for anything else (quotes, ragged or
     bad rows, odd text), which :func:`_csv_rows` then reads row by row to name the problem."""
     limits = get_limits()
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:
-            delimiter = _csv_delimiter(handle.read(4096))
+            sample = handle.read(4096)
+            delimiter = _csv_delimiter(sample)
+            comma = decimal_comma(sample, delimiter, decimal, path)
             handle.seek(0)
             columns, first = None, None
             while True:
@@ -127,11 +167,15 @@ def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | 
                 if stripped and not stripped.startswith("#"):
                     break
             cells = [cell.strip() for cell in _split(stripped, delimiter)]
+            if comma:
+                cells = [cell.replace(",", ".") for cell in cells]
             if any(_parse_float(cell) is None for cell in cells):
                 columns = tuple(cells)
             else:
                 first = line
             lines = itertools.chain([first], handle) if first is not None else handle
+            if comma:
+                lines = (line.replace(",", ".") for line in lines)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # "empty input": the slow path words it
                 values = np.loadtxt(
@@ -151,12 +195,15 @@ def _csv_fast(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple] | 
         return None
     if values.shape[0] > limits.max_samples:
         raise _row_limit_error(path)
-    return columns, values, ()
+    return columns, values, {}
 
 
-def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int, ...]]:
-    """Row-by-row CSV reading with the csv module: quotes, comments, text columns (their indices
-    third), and an error that names the first bad line (quoting at most a short token of it)."""
+def _csv_rows(
+    path: Path, decimal: str = "auto"
+) -> tuple[tuple[str, ...] | None, np.ndarray, dict[int, tuple[str, ...]]]:
+    """Row-by-row CSV reading with the csv module: quotes, comments, text columns (third: their
+    cells by column index), and an error that names the first bad line (quoting at most a short
+    token of it)."""
     limits = get_limits()
     max_rows = limits.max_samples + 1  # + a header
     max_columns = limits.max_dims + 1  # + a time column
@@ -170,7 +217,9 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
     try:
         # utf-8-sig: Excel writes a byte-order mark at the start of UTF-8 files.
         with open(path, newline="", encoding="utf-8-sig") as handle:
-            delimiter = _csv_delimiter(handle.read(4096))
+            sample = handle.read(4096)
+            delimiter = _csv_delimiter(sample)
+            comma = decimal_comma(sample, delimiter, decimal, path)
             handle.seek(0)
             reader = csv.reader(handle, delimiter=delimiter, skipinitialspace=delimiter == " ")
             try:
@@ -182,7 +231,12 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
                             f"{path} line {reader.line_num}: {len(row):,} columns, more than the limit "
                             f"max_dims = {limits.max_dims} allows (plus a time column)"
                         )
-                    rows.append((reader.line_num, [cell.strip() for cell in row]))
+                    cells = [cell.strip() for cell in row]
+                    if comma:
+                        cells = [
+                            cell.replace(",", ".") if _is_decimal(cell) else cell for cell in cells
+                        ]
+                    rows.append((reader.line_num, cells))
                     if len(rows) > max_rows:
                         raise _row_limit_error(path)
             except csv.Error as exc:
@@ -203,9 +257,14 @@ def _csv_rows(path: Path) -> tuple[tuple[str, ...] | None, np.ndarray, tuple[int
     return (columns, *_csv_values(rows, n_columns, path, named=columns is not None))
 
 
+def _is_decimal(cell: str) -> bool:
+    """A number written with a decimal comma (``-122,30``)."""
+    return bool(re.fullmatch(r"[+-]?[0-9]+,[0-9]+(?:[eE][+-]?[0-9]+)?", cell))
+
+
 def _csv_values(
     rows: list[tuple[int, list[str]]], n_columns: int, path: Path, named: bool = False
-) -> tuple[np.ndarray, tuple[int, ...]]:
+) -> tuple[np.ndarray, dict[int, tuple[str, ...]]]:
     """The numbers of the data rows (T, n_columns): NumPy's parser first (fast), and on failure a
     row-by-row pass that names the first bad line (quoting at most a short token of it). With a
     header (``named``), a column of text in every row (a ROS export's ``frame_id``) is NaN and
@@ -214,7 +273,7 @@ def _csv_values(
     with contextlib.suppress(ValueError, TypeError, OverflowError):
         values = np.array(cells, dtype=np.float64)
         if values.ndim == 2 and values.shape[1] == n_columns:
-            return values, ()
+            return values, {}
     for number, row in rows:
         if len(row) != n_columns:
             raise ValueError(
@@ -237,7 +296,7 @@ def _csv_values(
             for row in cells
         ]
     )
-    return values, tuple(text)
+    return values, {column: tuple(row[column] for row in cells) for column in text}
 
 
 def _data_line(path: Path, index: int, has_header: bool) -> int:
@@ -270,6 +329,7 @@ def check_finite_rows(path: Path, values: np.ndarray, columns, names, has_header
     word = "NaN" if np.isnan(value) else ("inf" if value > 0 else "-inf")
     raise ValueError(
         f"{path} line {line}: contains {word} in column {name} (data row {row + 1}; {count:,} "
-        f"row{'s' if count != 1 else ''} with gaps in all); remove those rows or fill the gaps "
-        f"(by interpolation, say) before reading: a motion is read without gaps"
+        f"row{'s' if count != 1 else ''} with gaps in all); drop those rows with --columns "
+        f"gaps=drop (columns='gaps=drop'), or fill the gaps (by interpolation, say): a motion is "
+        f"read without gaps"
     )

@@ -5,16 +5,20 @@ and bags (:func:`bidmp.io.bags.read_bag`) alike; :func:`bidmp.io.read_trajectory
 
 from __future__ import annotations
 
+import dataclasses
+import logging
 import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._checks import as_trajectory, check_path, short_token
-from ._columns import Layout, parse_columns, resolve, times_in_seconds
+from ._columns import Layout, parse_columns, resolve, split_unit, times_in_seconds
 from ._npy import _read_npy_trajectory
 
 __all__ = ["Recording", "read_recording", "recording_kind", "is_joint_recording"]
+
+logger = logging.getLogger(__name__)
 
 KINDS = ("positions", "pose", "joints")
 
@@ -139,10 +143,11 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         layout = None
     elif suffix in (".csv", ".txt"):
         mapping = parse_columns(columns)
-        parsed = _csv_fast(path)
-        header, values, text = parsed if parsed is not None else _csv_rows(path)
+        decimal = (mapping or {}).get("decimal", "auto")
+        parsed = _csv_fast(path, decimal)
+        header, values, text = parsed if parsed is not None else _csv_rows(path, decimal)
         if header is None:
-            if mapping is not None:
+            if mapping is not None and set(mapping) - {"decimal"}:
                 raise ValueError(
                     f"{path} has no header, so --columns / columns= cannot name its columns"
                 )
@@ -157,14 +162,26 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
                     f"{path}: column {short_token(header[min(used_text)], 30)} holds text, not numbers"
                 )
             _note_ignored(path, layout.ignored)
-            check_finite_rows(
-                path, values, (*layout.time, *layout.values, *layout.orientation), header, True
-            )
+            used = (*layout.time, *layout.values, *layout.orientation)
+            if (mapping or {}).get("gaps") == "drop":
+                values, text = _without_gaps(path, values, text, used, header)
+            check_finite_rows(path, values, used, header, True)
             times = times_in_seconds(values, layout, path)
+            _check_time_unit(path, times, layout, header)
             positions = _values(values, layout, path)
+            if layout.kind == "joints" and layout.units == "deg":
+                positions = np.radians(positions)  # joints are read in radians
+                layout = dataclasses.replace(layout, units="rad")
+                logger.info(
+                    "%s: joint angles in degrees (by the columns' names), read in radians", path
+                )
             if layout.orientation:  # read beside the positions, filtered with them
                 orientation = _quaternions(
-                    values[:, list(layout.orientation)], layout.rotation, path
+                    values[:, list(layout.orientation)],
+                    layout.rotation,
+                    path,
+                    layout.euler,
+                    layout.angles,
                 )
                 positions = np.hstack([positions, orientation])
     else:
@@ -175,6 +192,9 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
     positions = as_trajectory(positions, name=str(path), allow_static=kind == "pose")
     if times is not None:
         positions, times = drop_repeated_stamps(positions, times, f"{path}: the time column")
+    if layout is not None and layout.rotation is not None:
+        turns = positions[:, 3:7] if kind == "pose" else positions[:, 3:]
+        check_orientation_jumps(path, turns, times)
     orientation = None
     if layout is not None and layout.orientation:
         positions, orientation = positions[:, :3], positions[:, 3:]
@@ -187,7 +207,10 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
             f"{'an .npy array' if suffix == '.npy' else 'columns without a header'}",
         )
     else:
-        names, units, source = list(layout.names), declared or layout.units, layout.label
+        names = (
+            _joint_names(path, layout, text, header) if layout.names_from else list(layout.names)
+        )
+        units, source = declared or layout.units, layout.label
     return Recording(
         times,
         positions,
@@ -218,26 +241,141 @@ def _values(values: np.ndarray, layout: Layout, path="the recording") -> np.ndar
     data = values[:, list(layout.values)]
     if layout.kind != "pose":
         return data
-    return np.hstack([data[:, :3], _quaternions(data[:, 3:], layout.rotation, path)])
+    turns = _quaternions(data[:, 3:], layout.rotation, path, layout.euler, layout.angles)
+    return np.hstack([data[:, :3], turns])
 
 
-def _quaternions(rotation: np.ndarray, kind: str, path="the recording") -> np.ndarray:
-    """Rotation columns as quaternions ``qx, qy, qz, qw``: as they are, or from a rotation vector
-    (UR's axis-angle, radians). A rotation vector longer than 2π is no axis-angle in radians (an
-    angle in degrees, or roll/pitch/yaw put in its place): refused, saying so — read as radians
-    it would turn the tool by a wrong angle about a wrong axis, silently."""
-    if kind != "rotvec" or not np.all(np.isfinite(rotation)):
+def _quaternions(
+    rotation: np.ndarray, kind: str, path="the recording", euler: str = "", angles: str = ""
+) -> np.ndarray:
+    """Rotation columns as quaternions ``qx, qy, qz, qw``: as they are, from a rotation vector
+    (UR's axis-angle, radians), or from Euler angles in the declared sequence and unit.
+
+    A rotation vector's angle lies in [0, π] (a longer one is the same rotation the other way
+    round, which loggers do not write): one longer is no axis-angle in radians (an angle in
+    degrees, or roll/pitch/yaw put in its place) and is refused, saying so — read as radians it
+    would turn the tool by a wrong angle about a wrong axis, silently. Euler angles declared in
+    radians beyond ±2π are degrees: refused too."""
+    from scipy.spatial.transform import Rotation
+
+    if kind not in ("rotvec", "euler") or not np.all(np.isfinite(rotation)):
         return rotation  # (a bad value: as_trajectory names it)
+    if kind == "euler":
+        largest = float(np.max(np.abs(rotation))) if rotation.size else 0.0
+        if angles == "rad" and largest > 2.0 * np.pi + 1e-9:
+            raise ValueError(
+                f"{path}: the Euler angles are declared in radians but reach {largest:.4g}: "
+                f"degrees? Declare angles=deg"
+            )
+        return Rotation.from_euler(euler, rotation, degrees=angles == "deg").as_quat()
     lengths = np.linalg.norm(rotation, axis=1)
-    over = np.flatnonzero(lengths > 2.0 * np.pi + 1e-9)
+    over = np.flatnonzero(lengths > np.pi + _ROTVEC_SLACK)
     if over.size:
         row = int(over[0])  # the first, where a user looking at the file finds it
         raise ValueError(
-            f"{path}: the rotation-vector columns (rx, ry, rz: an axis times an angle in radians) "
-            f"reach length {lengths[row]:.4g} at data row {row + 1} (> 2π): degrees, or roll/pitch/"
-            f"yaw? Write the rotation as a rotation vector in radians, or as a quaternion "
-            f"(qx, qy, qz, qw)"
+            f"{path}: the rotation-vector columns (rx, ry, rz: an axis times an angle in radians, "
+            f"at most π) reach length {lengths[row]:.4g} at data row {row + 1}: degrees, or "
+            f"roll/pitch/yaw? Declare Euler angles with their sequence and unit (--columns "
+            f"x=..,y=..,z=..,e1=..,e2=..,e3=..,euler=xyz,angles=deg), or write the rotation as a "
+            f"rotation vector in radians or a quaternion (qx, qy, qz, qw)"
         )
-    from scipy.spatial.transform import Rotation
-
     return Rotation.from_rotvec(rotation).as_quat()
+
+
+# A logger rounding a half turn may write an angle a little over π (UR's controller: 1e-4); a
+# wrong convention (roll/pitch/yaw, degrees) is off by far more.
+_ROTVEC_SLACK = 1e-3
+# Between two samples a hand-guided tool turns far less than this (rad/s; a wrist spins at
+# about 3): an orientation that does is read in a wrong convention.
+_MAX_TURN_RATE = 20.0
+_MAX_TURN_UNTIMED = np.pi / 2  # per row, in a file without times
+
+
+def check_orientation_jumps(path, quaternions: np.ndarray, times) -> None:
+    """Refuse orientations that jump between neighbouring samples faster than a tool turns
+    (:data:`_MAX_TURN_RATE`; without times, more than a quarter turn a row): Euler angles read in
+    another sequence, or a rotation vector that is something else, wrap into such jumps."""
+    q = np.asarray(quaternions, dtype=float)
+    if q.shape[0] < 2:
+        return
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    steps = 2.0 * np.arccos(np.clip(np.abs(np.sum(q[1:] * q[:-1], axis=1)), 0.0, 1.0))
+    if times is None:
+        bad = np.flatnonzero(steps > _MAX_TURN_UNTIMED)
+    else:
+        dt = np.diff(np.asarray(times, dtype=float))
+        bad = np.flatnonzero((steps > np.radians(5.0)) & (steps > _MAX_TURN_RATE * dt))
+    if bad.size:
+        row = int(bad[0])
+        raise ValueError(
+            f"{path}: the orientation jumps {np.degrees(steps[row]):.1f} deg between data rows "
+            f"{row + 1} and {row + 2}"
+            + ("" if times is None else f" ({1e3 * float(dt[row]):.3g} ms apart)")
+            + ": no tool turns that fast, so the rotation columns are read in a wrong convention "
+            "(Euler angles in another sequence or unit, angles read as a rotation vector); "
+            "declare theirs (--columns ...,euler=<sequence>,angles=deg|rad)"
+        )
+
+
+def _without_gaps(path, values: np.ndarray, text: dict, used, header):
+    """``gaps=drop``: the rows with a gap (NaN) or inf in a used column dropped, with a warning."""
+    keep = np.all(np.isfinite(values[:, list(used)]), axis=1)
+    dropped = int((~keep).sum())
+    if dropped:
+        logger.warning(
+            "%s: dropped %d row%s with gaps (gaps=drop), first at data row %d",
+            path,
+            dropped,
+            "s" if dropped != 1 else "",
+            int(np.argmin(keep)) + 1,
+        )
+    return values[keep], {
+        column: tuple(np.asarray(cells, dtype=object)[keep]) for column, cells in text.items()
+    }
+
+
+def _check_time_unit(path, times, layout, header) -> None:
+    """A time column assumed to hold seconds whose rate says it holds milliseconds (or µs, ns):
+    refused with the declaration that reads it (its rate in each unit shown)."""
+    if times is None or layout.time_declared or len(times) < 2 or not np.all(np.isfinite(times)):
+        return
+    span = float(times[-1] - times[0])
+    if span <= 0.0:
+        return
+    from ..primitives.timing import MIN_RATE_HZ
+
+    rate = (len(times) - 1) / span
+    if rate >= MIN_RATE_HZ:
+        return
+    fits = [
+        unit for unit, divisor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9))
+        if 1.0 <= rate * divisor <= 100_000.0
+    ]  # fmt: skip
+    name = header[layout.time[0]]
+    raise ValueError(
+        f"{path}: the time column {short_token(name, 30)} read as seconds gives {rate:.3g} Hz; "
+        f"if it holds {fits[0] if fits else 'ms'}, declare it: --columns time={fits[0] if fits else 'ms'} "
+        f"(or name the column {split_unit(name)[0]}({fits[0] if fits else 'ms'}))"
+    )
+
+
+def _joint_names(path, layout, text: dict, header) -> list:
+    """A JointState export's joint names, from its name columns: the same in every row."""
+    names = []
+    for column in layout.names_from:
+        cells = text.get(column)
+        if not cells:
+            raise ValueError(
+                f"{path}: column {short_token(header[column], 30)} should hold a joint's name (text)"
+            )
+        if any(cell != cells[0] for cell in cells):
+            row = next(index for index, cell in enumerate(cells) if cell != cells[0])
+            raise ValueError(
+                f"{path}: the joint names change at data row {row + 1} (column "
+                f"{short_token(header[column], 30)}: {short_token(cells[0], 20)} then "
+                f"{short_token(cells[row], 20)}): the positions' order changes; split the file where it does"
+            )
+        names.append(cells[0])
+    if len(set(names)) != len(names):
+        raise ValueError(f"{path}: a joint name repeats among {', '.join(names)}")
+    return names
