@@ -83,9 +83,10 @@ def test_the_viewer_holds_every_layer(nut_layers, tmp_path):
         "dmp: breaks the contract",
         "bidmp rollouts",
         "targets",
+        "failed targets",
         "scene parts",
         "robot (joint to joint)",
-    }  # the DMP misses the far nuts: drawn as failing
+    }  # the DMP misses the far nuts: drawn as failing, the nuts crossed
     assert len(figure.frames) == len(layers.robot["bidmp -> 11"]["times"])
     assert len(figure.layout.sliders[0].steps) == len(figure.frames)
     page = viewer.write_view(tmp_path / "view.html", layers)

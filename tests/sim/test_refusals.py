@@ -394,3 +394,20 @@ def test_a_targets_list_that_names_none_is_refused_in_words(capsys):
     assert main(["job", "--targets", " ", "--no-pictures", "--out", "/nonexistent/x"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "targets names no target" in err[0], err
+
+
+def test_a_job_phases_refusal_names_the_target_and_the_phase():
+    """The planner's refusals in a job read "target 'approach'" (the phase given as the target):
+    the move hands the planner the target being worked on and the phase. Structure guard: the
+    label the planner is given, read back from its refusal."""
+    from types import SimpleNamespace
+
+    from bidmp.sim import SimError
+    from bidmp.sim.job_world import _move
+
+    def plan(path, label, **options):
+        raise SimError(f"target {label!r}: the point [1, 2, 3] of its motion is unreachable")
+
+    world = SimpleNamespace(cell=SimpleNamespace(plan=plan), label="B4", q=np.zeros(7))
+    with pytest.raises(SimError, match=r"target 'B4 \(approach\)': the point"):
+        _move(world, np.zeros((2, 3)), None, [], "approach")

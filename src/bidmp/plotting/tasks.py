@@ -22,9 +22,28 @@ _METHOD_COLOURS = {
 }
 
 
+def _sizes(targets: np.ndarray, units: str) -> tuple[float, float]:
+    """(disc radius, margin round the targets) in the scene's unit: 8 mm and 20 mm as drawn in mm
+    cells, never more than 0.4 of the nearest two targets' distance (discs do not overlap) nor a
+    margin less than a twentieth of the targets' spread (a metre cell's were 16 m discs on ±20 m
+    axes when the sizes were millimetre numbers)."""
+    from .._units import mm
+
+    length = units if units in ("m", "cm", "mm") else "mm"
+    radius, pad = mm(8.0, length), mm(20.0, length)
+    xy = targets[:, :2]
+    if len(xy) > 1:
+        gaps = np.linalg.norm(xy[:, None] - xy[None], axis=-1)
+        nearest = float(np.min(gaps[gaps > 0])) if np.any(gaps > 0) else radius
+        radius = min(radius, 0.4 * nearest)
+        pad = max(pad, 0.05 * float(np.ptp(xy, axis=0).max()))
+    return radius, pad
+
+
 def plot_targets_top_view(path, report) -> Path:
     """Top view of the targets, one panel per method: green = success, red = failure (paper
-    Fig. 16c analogue), with the end point of each rollout."""
+    Fig. 16c analogue, a failed target also crossed), with the end point of each rollout. Sizes
+    follow the scene's unit."""
     _check_report(report)
     mpl = _matplotlib()
     scenario = report.scenario
@@ -35,6 +54,7 @@ def plot_targets_top_view(path, report) -> Path:
         n_rows, n_cols, figsize=(4.6 * n_cols, 3.8 * n_rows), dpi=100, squeeze=False
     )
     targets = scenario.target_array
+    radius, pad = _sizes(targets, scenario.units)
     checked = any(result.clearances is not None for result in report.methods.values())
     scene = scenario.scene if checked else None
     for ax, name in zip(axes.ravel(), names):
@@ -58,8 +78,10 @@ def plot_targets_top_view(path, report) -> Path:
                 else result.errors[label] <= scenario.success_threshold
             )
             ax.add_patch(
-                mpl.Circle(target[:2], 8.0, color="tab:green" if ok else "tab:red", alpha=0.35)
+                mpl.Circle(target[:2], radius, color="tab:green" if ok else "tab:red", alpha=0.35)
             )
+            if not ok:  # marked by more than its colour (a grey print, a colour-blind reader)
+                ax.plot(*target[:2], "x", color="tab:red", markersize=12, markeredgewidth=1.5)
             ax.text(target[0], target[1], printable(label), ha="center", va="center", fontsize=8)
             end = result.rollouts[label][-1]
             ax.plot(end[0], end[1], "k.", markersize=3)
@@ -81,7 +103,6 @@ def plot_targets_top_view(path, report) -> Path:
         else:
             title = f"{name}: {result.successes}/{len(targets)} within {scenario.success_threshold:g} {scenario.units}"
         ax.set_title(title, fontsize=9)
-        pad = 20.0
         ax.set_xlim(targets[:, 0].min() - pad, targets[:, 0].max() + pad)
         ax.set_ylim(targets[:, 1].min() - pad, targets[:, 1].max() + pad)
         ax.set_aspect("equal")
@@ -98,10 +119,17 @@ def plot_targets_top_view(path, report) -> Path:
 
 
 def plot_error_vs_distance(path, report) -> Path:
-    """End-point error (and approach error) against the distance from the demonstrated target."""
+    """End-point error (and approach error) against the distance from the demonstrated target.
+    Errors of a cell in m or cm are drawn in mm (its threshold 1.75 mm, not 0.00175 m on an axis
+    whose ticks read 0), the distance in the cell's unit; the threshold's value is in the legend."""
     _check_report(report)
     mpl = _matplotlib()
     scenario = report.scenario
+    from .._units import UNITS
+
+    units = scenario.units
+    scale = UNITS[units] / 1e-3 if units in UNITS else 1.0  # errors in mm for a length unit
+    error_unit = "mm" if units in UNITS else (units or "units")
     origin = scenario.targets[scenario.demonstrated]
     distance = {
         label: float(np.linalg.norm(target - origin)) for label, target in scenario.targets.items()
@@ -125,18 +153,23 @@ def plot_error_vs_distance(path, report) -> Path:
                 continue
             ax.plot(
                 [distance[label] for label in order],
-                [values[label] for label in order],
+                [scale * values[label] for label in order],
                 "o-",
                 color=_METHOD_COLOURS.get(name),
                 label=name,
                 markersize=4,
             )
+        threshold = scale * scenario.success_threshold
         ax.axhline(
-            scenario.success_threshold, color="k", linestyle="--", linewidth=1, label="threshold"
+            threshold,
+            color="k",
+            linestyle="--",
+            linewidth=1,
+            label=f"threshold {threshold:g} {error_unit}",
         )
         _readable_symlog(ax)
         ax.set_xlabel(f"distance from the demonstrated target [{scenario.units}]")
-        ax.set_ylabel(f"{title} [{scenario.units}]")
+        ax.set_ylabel(f"{title} [{error_unit}]")
         ax.grid(True, alpha=0.3)
         ax.set_title(title, fontsize=10)
     axes[0][0].legend(fontsize=8)
@@ -153,11 +186,8 @@ def _readable_symlog(ax) -> None:
     ax.set_yscale("symlog", linthresh=1.0, linscale=1.5)
     ax.set_ylim(bottom=0.0)
     top = ax.get_ylim()[1]
-    ticks = [
-        t
-        for t in (0, 0.25, 0.5, 0.75, 1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000)
-        if t <= top * 1.05
-    ]
+    decades = [m * 10.0**e for e in range(0, 9) for m in (1, 2, 5)]  # 1, 2, 5, ... 5e8
+    ticks = [t for t in (0, 0.25, 0.5, 0.75, *decades) if t <= top * 1.05]
     ax.yaxis.set_major_locator(FixedLocator(ticks))
     ax.yaxis.set_minor_locator(NullLocator())
     ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))

@@ -57,6 +57,7 @@ _COLOURS = {
     "gmm": "#9467bd",
     "tpgmm": "#8c564b",
 }
+FAILED = "#d62728"  # a failed target: red, crossed
 WARNING = "#ffc000"  # amber: a motion that breaks the contract, and the part it came too close to (not the robot joints' dark orange)
 
 
@@ -189,12 +190,31 @@ def solid_layer(solid) -> dict:
 
 
 def add_robot_motions(layers: ViewLayers, sim_report) -> ViewLayers:
-    """Add the arm's motions a simulation recorded (``SimReport.motions``), in scene units."""
-    for (method, label), motion in getattr(sim_report, "motions", {}).items():
+    """Add the arm's motions a simulation recorded (``SimReport.motions``), in scene units, and
+    the targets the arm failed (``SimReport.methods``: what it did, judged by the contract) to
+    ``failures`` where the evaluation had not failed them already."""
+    from .._checks import check_members
+
+    check_members(sim_report, ("motions",), "sim_report", "a bidmp.sim.SimReport or JobReport")
+    for (method, label), motion in sim_report.motions.items():
         layers.robot[f"{method} -> {label}"] = {
             "times": np.asarray(motion["times"], float),
             "links": np.asarray(motion["links"], float),
         }
+    methods = getattr(sim_report, "methods", None)
+    threshold = getattr(getattr(sim_report, "scenario", None), "success_threshold", None)
+    for method, result in (methods or {}).items():
+        for label, target in getattr(result, "targets", {}).items():
+            if threshold is None or target.task_success(threshold):
+                continue
+            layers.failures.setdefault(method, {}).setdefault(
+                label,
+                {
+                    "reason": f"on the arm: {target.reason or 'not a task success'}",
+                    "part": None,
+                    "point": None,
+                },
+            )
     return layers
 
 
@@ -347,19 +367,7 @@ def _static_traces(go, layers: ViewLayers) -> list:
                     hoverinfo="text",
                 )
             )
-    if layers.targets:
-        t = np.array(list(layers.targets.values()))
-        traces.append(
-            go.Scatter3d(
-                x=t[:, 0],
-                y=t[:, 1],
-                z=t[:, 2],
-                mode="markers+text",
-                name="targets",
-                text=list(layers.targets),
-                marker={"size": 3, "color": "green"},
-            )
-        )
+    traces += _target_traces(go, layers)
     first_close = True
     for index, solid in enumerate(layers.solids):
         vertices, faces = solid_mesh(
@@ -399,6 +407,44 @@ def _static_traces(go, layers: ViewLayers) -> list:
                 legendgroup="scene",
                 showlegend=index == 0,
                 hovertext=solid["label"],
+            )
+        )
+    return traces
+
+
+def _target_traces(go, layers: ViewLayers) -> list:
+    """The targets: green dots, and a failed one (any method's motion to it breaks the contract)
+    a red cross labelled ``✗`` with the methods and reasons on hover."""
+    failed: dict = {}
+    for method, failures in layers.failures.items():
+        for label, failure in failures.items():
+            failed.setdefault(label, []).append(f"{method}: {failure['reason']}")
+    traces = []
+    for kind, labels in (
+        ("ok", [label for label in layers.targets if label not in failed]),
+        ("failed", [label for label in layers.targets if label in failed]),
+    ):
+        if not labels:
+            continue
+        t = np.array([layers.targets[label] for label in labels])
+        bad = kind == "failed"
+        traces.append(
+            go.Scatter3d(
+                x=t[:, 0],
+                y=t[:, 1],
+                z=t[:, 2],
+                mode="markers+text",
+                name="failed targets" if bad else "targets",
+                text=[f"{label} ✗" if bad else label for label in labels],
+                textfont={"color": FAILED} if bad else None,
+                marker={"size": 7, "color": FAILED, "symbol": "x"}
+                if bad
+                else {"size": 3, "color": "green"},
+                hovertext=[
+                    f"{label} failed: " + "; ".join(failed[label]) if bad else label
+                    for label in labels
+                ],
+                hoverinfo="text",
             )
         )
     return traces

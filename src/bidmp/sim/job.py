@@ -599,6 +599,7 @@ def run_job(
             if progress is not None:
                 progress(label)
             record = JobTarget(label)
+            world.label = label
             if stuck:  # the tool could not leave a failed target: nothing else may move
                 record.reason = f"not attempted: {stuck}"
                 done.append(record)

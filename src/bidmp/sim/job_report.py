@@ -49,7 +49,7 @@ class JobPhase:
             "seconds": round(self.seconds, 3),
             "note": self.note,
             "verdict": None if self.verdict is None else self.verdict.to_dict(),
-            "contacts": {k: round(v, 3) for k, v in self.contacts.items()},
+            "contacts": {k: float(v) for k, v in self.contacts.items()},
             "peak_velocity": round(self.peaks[0], 3),
             "peak_acceleration": round(self.peaks[1], 3),
             "peak_jerk": round(self.peaks[2], 3),
@@ -137,7 +137,7 @@ class JobTarget:
             "seconds": round(self.seconds, 3),
             "final_position": None
             if self.final_position is None
-            else np.round(self.final_position, 2).tolist(),
+            else np.asarray(self.final_position, dtype=float).tolist(),
             "phases": [phase.to_dict() for phase in self.phases],
         }
 
@@ -271,15 +271,23 @@ def write_job_report(report: JobReport, out) -> list[Path]:
     if (
         report.pictures
     ):  # the first cycle's keyframes side by side, each titled with its phase, target, time
+        failed = {
+            (target.label, phase.name)
+            for target in report.targets
+            for phase in target.phases
+            if not phase.ok
+        }
         tiles = [
-            _titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
+            _titled(image, f"{phase} FAILED, target {label}, {seconds:.2f} s", True)
+            if (label, phase) in failed
+            else _titled(image, f"{phase} done, target {label}, {seconds:.2f} s")
             for label, phase, seconds, image in report.pictures
         ]
         written.append(_write_strip(Path(out) / "job_cycle.png", tiles))
     if report.failures:  # where each failing motion ended, looking at the part it came too close to
         tiles = [
-            _titled(image, f"target {label}: {phase} failed")
-            for label, phase, image, _ in report.failures[:6]
+            _titled(image, f"target {label}: {phase} failed: {reason}", True)
+            for label, phase, image, reason in report.failures[:6]
         ]
         written.append(_write_strip(Path(out) / "job_failures.png", tiles))
     return written

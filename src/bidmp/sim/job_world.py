@@ -47,6 +47,7 @@ class _World:
     )  # (target, phase, image) where a motion broke the contract
     record: bool = False  # keep each phase's measured path and commands
     rhythm: object = None  # the rock step's periodic skill (a RhythmicDMP), learned once per job
+    label: str = ""  # the target being worked on (its phases' refusals name it)
 
     @property
     def scene(self):
@@ -97,7 +98,7 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     cell = world.cell
     plan = cell.plan(
         np.asarray(path, dtype=float),
-        name,
+        f"{world.label} ({name})" if world.label else name,  # "target 'B4 (approach)': ..."
         fractions=fractions,
         seed=world.q,
         orientations=orientations,

@@ -113,12 +113,12 @@ class SimTarget:
             return {"ran": False, "task_success": False, "reason": self.error}
         return {
             "ran": True,
-            "commanded_error": round(self.commanded_error, 4),
-            "measured_error": round(self.measured_error, 4),
+            "commanded_error": float(self.commanded_error),
+            "measured_error": float(self.measured_error),
             "approach_error": json_number(self.approach_error),
             "engaged": self.engaged,
             "contacts": sorted(self.contacts),
-            "contact_depths": {k: round(v, 4) for k, v in sorted(self.contacts.items())},
+            "contact_depths": {k: float(v) for k, v in sorted(self.contacts.items())},
             "peak_joint_velocity": round(self.peak_velocity, 4),
             "peak_joint_acceleration": round(self.peak_acceleration, 4),
             "measured_peak_joint_velocity": round(self.measured_peak_velocity, 4),
@@ -128,7 +128,7 @@ class SimTarget:
             "commanded_penetration": json_number(self.commanded_penetration),
             "paused_s": round(self.paused, 3),
             "motion_time_s": round(self.motion_time, 3),
-            "tracking_error": round(self.tracking_error, 4),
+            "tracking_error": float(self.tracking_error),
             "within_limits": self.within_limits,
             "task_success": self.task_success(threshold),
             "axis_deviation_deg": json_number(self.axis_deviation),
@@ -232,7 +232,7 @@ class SimReport:
             "closed_loop": self.closed_loop,
             "robot": {
                 **({} if self.robot == "panda" else {"model": self.robot}),
-                "base": np.round(self.base, 3).tolist(),
+                "base": np.asarray(self.base, dtype=float).tolist(),
                 "yaw_deg": self.yaw,
             },
             "success_threshold": self.scenario.success_threshold,
@@ -446,13 +446,23 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
     for method, label, frames in report.pictures:
         by_method.setdefault(method, (label, frames))
     for method, (label, frames) in by_method.items():
+        target = report.methods[method].targets.get(label) if method in report.methods else None
+        failed = target is not None and not target.task_success(report.scenario.success_threshold)
+        title = f"{method}: motion to target {label} on the simulated {report.robot_name}"
+        if failed:  # the picture of a failed target says so, in the warning colour
+            title = f"FAILED {title}: {target.reason or 'not a task success'}"
         strip = _write_strip(
             out / f"sim_keyframes_{method}.png",
             frames[:: max(1, len(frames) // 6)][:6],
-            f"{method}: motion to target {label} on the simulated {report.robot_name}",
+            title,
+            failed=failed,
         )
         written.append(strip)
-    if {"dmp", "bidmp"} <= set(by_method) and by_method["dmp"][0] == by_method["bidmp"][0]:
+    if (
+        {"dmp", "bidmp"} <= set(by_method)
+        and by_method["dmp"][0] == by_method["bidmp"][0]
+        and by_method["dmp"][1][0].shape == by_method["bidmp"][1][0].shape
+    ):  # (a motion not run has one still of the arm, not frames of its motion: no GIF)
         written.append(
             _write_gif(
                 out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif",
@@ -478,25 +488,36 @@ def _write_results(out, json_name: str, table_name: str, data: dict, table: str)
     return written
 
 
-def _titled(image: np.ndarray, title: str) -> np.ndarray:
-    """``image`` under a white band with ``title`` (the method and target) written in it."""
+FAILED_COLOUR = (214, 39, 40)  # the band and frame of a picture of a failed target or phase
+
+
+def _titled(image: np.ndarray, title: str, failed: bool = False) -> np.ndarray:
+    """``image`` under a band with ``title`` (the method and target) written in it: white, or for
+    a failure red with white words and the image framed in red (seen at a glance in a strip)."""
     from PIL import Image, ImageDraw, ImageFont
 
-    band = Image.new("RGB", (image.shape[1], 26), (255, 255, 255))
-    ImageDraw.Draw(band).text(
-        (8, 4), title, fill=(20, 20, 20), font=ImageFont.load_default(size=16)
-    )
+    font = ImageFont.load_default(size=16)
+    band = Image.new("RGB", (image.shape[1], 26), FAILED_COLOUR if failed else (255, 255, 255))
+    draw = ImageDraw.Draw(band)
+    while len(title) > 8 and draw.textlength(title, font=font) > image.shape[1] - 12:
+        title = title[: max(8, int(len(title) * 0.9))].rstrip() + "…"  # the band's width
+        if title.endswith("……"):
+            title = title[:-1]
+    draw.text((8, 4), title, fill=(255, 255, 255) if failed else (20, 20, 20), font=font)
+    if failed:
+        image = image.copy()
+        image[:4], image[-4:], image[:, :4], image[:, -4:] = (FAILED_COLOUR,) * 4
     return np.concatenate([np.asarray(band), image], axis=0)
 
 
-def _write_strip(path: Path, frames, title: str = "") -> Path:
+def _write_strip(path: Path, frames, title: str = "", failed: bool = False) -> Path:
     from PIL import Image
 
     from ..io.atomic import atomic_write
 
     gap = np.full((frames[0].shape[0], 4, 3), 255, np.uint8)
     strip = np.concatenate([part for frame in frames for part in (frame, gap)][:-1], axis=1)
-    strip = _titled(strip, title) if title else strip
+    strip = _titled(strip, title, failed) if title else strip
     with atomic_write(path, "wb") as handle:
         Image.fromarray(strip).save(handle, format="PNG")
     return path

@@ -93,10 +93,11 @@ def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
     return results
 
 
-def _not_run(job: _Job, reason: str) -> tuple:
-    """The outcome of a motion not sent to the arm: its row with ``reason``, no pictures, no
-    simulated time, no recorded arm (the tuple ``_run_one`` returns)."""
-    return job.method, job.label, SimTarget.not_run(job.label, reason), [], 0.0, None
+def _not_run(job: _Job, reason: str, frames=()) -> tuple:
+    """The outcome of a motion not sent to the arm: its row with ``reason``, no simulated time, no
+    recorded arm (the tuple ``_run_one`` returns); ``frames``: a still of the arm where it stands,
+    when pictures of the motion were asked for (the strip then shows the failure, not nothing)."""
+    return job.method, job.label, SimTarget.not_run(job.label, reason), list(frames), 0.0, None
 
 
 def _run_one(setup: _SimSetup, cell, contract, job):
@@ -316,7 +317,17 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
     n_workers = _n_workers(workers, max(len(jobs), 1))
     start = time.perf_counter()
     outcomes = _execute_jobs(setup, jobs, n_workers, progress) if jobs else []
-    outcomes += [_not_run(job, refusals[(job.method, job.label)]) for job in skipped]
+    stills = {}
+    for (
+        job
+    ) in skipped:  # a still of the arm where it stands, for pictures asked of a refused motion
+        if job.frames:
+            focus = np.asarray(setup.task.targets[job.label], dtype=float)[:3]
+            stills[(job.method, job.label)] = [_world(setup).render(target=focus)]
+    outcomes += [
+        _not_run(job, refusals[(job.method, job.label)], stills.get((job.method, job.label), ()))
+        for job in skipped
+    ]
     out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
     out.evaluation = report
     out.wall_s = time.perf_counter() - start

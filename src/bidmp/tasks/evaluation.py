@@ -62,7 +62,7 @@ def _route_failure(target, exc) -> dict:
     logger.warning(
         "no collision-free route to %s: %s", np.round(np.asarray(target)[:3], 3).tolist(), exc
     )
-    return {"target": np.round(np.asarray(target, dtype=float), 4).tolist(), "reason": str(exc)}
+    return {"target": np.asarray(target, dtype=float).tolist(), "reason": str(exc)}
 
 
 def _bidmp_model(scenario, dmp, failed, route_failures: list):

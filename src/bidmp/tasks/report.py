@@ -237,7 +237,7 @@ class Report:
         }
         if self.extension_targets:
             out["extension_targets"] = [
-                np.asarray(t).round(4).tolist() for t in self.extension_targets
+                np.asarray(t, dtype=float).tolist() for t in self.extension_targets
             ]
             out["failed_targets"] = list(self.failed_targets)
         if self.forgetting:
