@@ -126,3 +126,38 @@ def _columns(path) -> tuple:
     rows = [line for line in text.splitlines() if line and not line.startswith("#")]
     table = np.array([[float(v) for v in row.split(",")] for row in rows[1:]])
     return table[:, 0], table[:, 1:3]
+
+
+@pytest.mark.parametrize("flag", ["--multi", "--promp"])
+def test_the_fit_figure_draws_the_mean_among_the_demonstrations_in_time(
+    files, flag, monkeypatch, capsys
+):
+    """The --multi figure drew the mean outside all the demonstrations: the mean motion (which runs
+    on 10 % past their time to come to rest) was squeezed onto [0, 1] beside them. On time, the mean
+    lies within the demonstrations' envelope (each on its own stamps) wherever all of them run:
+    checked on the figure's own lines."""
+    from bidmp.plotting import trajectories
+
+    made = []
+    monkeypatch.setattr(trajectories, "_save", lambda fig, path: made.append(fig) or Path(path))
+    folder, paths, _ = files
+    argv = ["fit", flag, *paths, "--units", "mm", "--raw", "-o", str(folder / "f.npz")]
+    assert run([*argv, "--plot", str(folder / "f.png")], capsys)[0] == 0
+    for ax in made[-1].axes:
+        assert ax.get_xlabel() == "time [s]"
+        grey = [line for line in ax.lines if line.get_color() == "0.7"]
+        (mean,) = [line for line in ax.lines if line.get_label() == "mean ± 2σ"]
+        assert len(grey) == len(paths)
+        t, y = np.asarray(mean.get_xdata()), np.asarray(mean.get_ydata())
+        common = t <= min(np.max(line.get_xdata()) for line in grey)
+        curves = np.array(
+            [np.interp(t[common], line.get_xdata(), line.get_ydata()) for line in grey]
+        )
+        extent = np.ptp(curves)
+        inside = (y[common] >= curves.min(axis=0) - 0.02 * extent) & (
+            y[common] <= curves.max(axis=0) + 0.02 * extent
+        )
+        assert inside.mean() >= 0.97, inside.mean()
+    import matplotlib.pyplot as plt
+
+    plt.close("all")

@@ -354,3 +354,26 @@ def scenario_option(args: argparse.Namespace, units: str):
             f"use a scene in {units}"
         )
     return scenario
+
+
+def refuse_options_not_taken(
+    args: argparse.Namespace, takes: set, model: str, takes_text: str, hints: dict | None = None
+) -> None:
+    """Refuse, in one line, the first option given (its value not the parser's default, read from
+    ``args.unset_options``) that a model of kind ``model`` does not act on: ``takes`` are the
+    options it acts on (dest names), ``takes_text`` says them to the user; ``hints``: a dest's
+    pointer to what does (``goal``: "a rhythm has an anchor: --anchor"). No option is dropped unread."""
+    for name, unset in args.unset_options.items():
+        if name in takes:
+            continue
+        # --robot's value is filled in by the command before it gets here (its default arm)
+        given = args.robot_given if name == "robot" else getattr(args, name) not in (unset, [])
+        if not given:
+            continue
+        flag = "--" + name.replace("_", "-")
+        hint = (hints or {}).get(name)
+        raise ValueError(
+            f"{flag} does not apply to {model}"
+            + (f" ({hint})" if hint else "")
+            + f"; its rollout takes {takes_text}"
+        )

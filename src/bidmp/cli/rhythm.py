@@ -5,23 +5,26 @@ from __future__ import annotations
 
 import argparse
 
-from .inputs import demo_kind, read_input
+from .inputs import demo_kind, read_input, refuse_options_not_taken
 
 EXIT_OK = 0
 
-# rollout options that shape a discrete motion: meaningless for a rhythm
-_DISCRETE_ONLY = (
-    ("goal", "--goal (a rhythm has an anchor: --anchor)"),
-    ("start", "--start"),
-    ("duration", "--duration (a rhythm runs --cycles)"),
-    ("n_steps", "--n-steps (use --rate)"),
-    ("max_speed", "--max-speed"),
-    ("max_acc", "--max-acc"),
-    ("max_jerk", "--max-jerk"),
-    ("joint_limits", "--joint-limits"),
-    ("bag", "--bag"),
-    ("scene", "--scene"),
-)
+# what a rhythmic model's rollout acts on; every other rollout option is refused, some with a pointer
+_RHYTHM_TAKES = {
+    "rate",
+    "cycles",
+    "frequency",
+    "amplitude",
+    "anchor",
+    "from_rest",
+    "plot",
+    "output",
+}
+_RHYTHM_HINTS = {
+    "goal": "a rhythm has an anchor: --anchor",
+    "duration": "a rhythm runs --cycles",
+    "n_steps": "use --rate",
+}
 
 
 def fit_periodic(args: argparse.Namespace) -> int:
@@ -110,9 +113,13 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
     from ..io.trajectories import save_trajectory
     from ..primitives.rhythmic_pose import RhythmicPoseDMP
 
-    for name, flag in _DISCRETE_ONLY:
-        if getattr(args, name, None) not in (None, False):
-            raise ValueError(f"{flag} does not apply to a rhythmic model")
+    refuse_options_not_taken(
+        args,
+        _RHYTHM_TAKES,
+        "a rhythmic model",
+        "--cycles, --frequency, --amplitude, --anchor, --from-rest, --rate and --plot",
+        _RHYTHM_HINTS,
+    )
     poses = isinstance(model, RhythmicPoseDMP)
     rate = 1000.0 if args.rate is None else args.rate
     if not 0 < rate <= 100_000:

@@ -159,6 +159,7 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     dmp = model_dmp(model)
     poses = isinstance(model, (CartesianDMP, CartesianBiDMP))
+    _refuse_idle_arm(args, dmp, poses)
     skill = _skill_choice(args, model)
     options = {
         "goal": _joint_goal(args, dmp, poses),
@@ -174,7 +175,9 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         print(
             f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})"
         )
-    options.update(_rollout_extras(args, dmp, poses))
+    # where the motion goes when --goal is not given: a Bi-DMP's latest skill's goal, else the DMP's
+    default_goal = model.skill_goals_[-1] if isinstance(model, BiDMP) else dmp.goal_
+    options.update(_rollout_extras(args, dmp, poses, default_goal))
     if not args.bag and (
         args.follow
         or args.orientation is not None
@@ -227,6 +230,35 @@ def cmd_rollout(args: argparse.Namespace) -> int:
             f"wrote {plot_rollout(args.plot, dmp.rollout(), trajectory, title='rollout', units=dmp.units_)}"
         )
     return EXIT_OK
+
+
+def _refuse_idle_arm(args: argparse.Namespace, dmp, poses: bool) -> None:
+    """The arm's options act only where its inverse kinematics runs: --cartesian-goal, or a 3-D
+    position model's --bag with --robot. Given anywhere else they are refused (none is dropped
+    unread), and --base, --yaw, --tool-length too for a scenario's robot (the scenario places it
+    and gives its tool)."""
+    from ..sim.robots import ROBOT_MODELS
+
+    given = {
+        name: getattr(args, name) != args.unset_options[name]
+        for name in ("base", "yaw", "tool_length")
+    }
+    ik_bag = bool(args.bag) and args.robot_given and not poses and dmp.n_dims_ == 3
+    if args.cartesian_goal is not None or ik_bag:
+        if args.robot not in ROBOT_MODELS and any(given.values()):
+            flag = "--" + next(name for name, on in given.items() if on).replace("_", "-")
+            raise ValueError(
+                f"{flag} does not apply to the robot of a scenario (--robot {args.robot}): the "
+                f"scenario places its arm and gives its tool"
+            )
+        return
+    for name, on in (("robot", args.robot_given), *given.items()):
+        if on:
+            raise ValueError(
+                f"--{name.replace('_', '-')} does not apply here: it {'is' if name == 'robot' else 'places'} "
+                f"the arm whose inverse kinematics --cartesian-goal (a joint-space model) or a 3-D "
+                f"position model's --bag with --robot uses, and neither is given"
+            )
 
 
 def _joint_goal(args: argparse.Namespace, dmp, poses: bool):
@@ -405,6 +437,11 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
         return (
             f"{path} ({what} on {topic}, {len(trajectory)} messages, metres, {_stamped(options)})"
         )
+    if args.orientation is not None:
+        raise ValueError(
+            "--orientation is the held orientation of a position model's bag; a joint-space "
+            "model's bag holds joints"
+        )
     kind = "follow" if args.follow else "joints"
     path = write_bag(
         args.bag,
@@ -424,8 +461,9 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
     return f"{path} ({_joint_message(kind, options)}, {len(trajectory)} points, {named}, {_stamped(options)})"
 
 
-def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
-    """trajectory() keywords from --via and --scene/--avoid (on by default with a scene)."""
+def _rollout_extras(args: argparse.Namespace, dmp, poses: bool, default_goal=None) -> dict:
+    """trajectory() keywords from --via and --scene/--avoid (on by default with a scene);
+    ``default_goal``: where the motion goes without --goal (the target it is, for the steering)."""
     import numpy as np
 
     extras = {}
@@ -438,28 +476,42 @@ def _rollout_extras(args: argparse.Namespace, dmp, poses: bool) -> dict:
                 )
         extras["via"] = [(values[0], values[1:]) for values in args.via]
     avoid = args.scene is not None if args.avoid is None else args.avoid
+    if args.target_label is not None and not avoid:
+        raise ValueError(
+            "--target-label names the target whose parts the steering leaves out: it needs "
+            "--scene (and not --no-avoid)"
+        )
     if avoid:
         if args.scene is None:
             raise ValueError("--avoid needs --scene (the scenario whose parts to steer round)")
         if poses or dmp.n_dims_ != 3:
             raise ValueError(
-                "--avoid steers 3-D position models (the tool points down); this model is "
+                f"{'--scene' if args.avoid is None else '--avoid'} steers 3-D position models round "
+                f"the parts (the tool points down); this model is "
                 + ("a pose model" if poses else f"{dmp.n_dims_}-D")
             )
         from ..primitives.avoidance import SceneAvoidance
 
         scenario, label = scenario_option(args, dmp.units_), args.target_label
-        if (
-            label is None and args.goal is not None
-        ):  # the goal is a target of the scenario: its label
-            label = next(
-                (
-                    name
-                    for name, point in scenario.targets.items()
-                    if np.allclose(np.asarray(point, dtype=float)[:3], args.goal[:3], atol=1e-9)
-                ),
-                None,
+        goal = np.asarray(
+            (dmp.goal_ if default_goal is None else default_goal)
+            if args.goal is None
+            else args.goal,
+            dtype=float,
+        )[:3]
+        # the goal is a target of the scenario (within its success threshold): its label
+        distances = {
+            name: float(np.linalg.norm(np.asarray(point, dtype=float)[:3] - goal))
+            for name, point in scenario.targets.items()
+        }
+        nearest = min(distances, key=distances.get) if distances else None
+        at = nearest if nearest and distances[nearest] <= scenario.success_threshold else None
+        if label is not None and at is not None and label != at:
+            raise ValueError(
+                f"--target-label {label}, but the goal is target {at}'s position: the steering would "
+                f"keep the tool off the parts it must enter"
             )
+        label = at if label is None else label
         extras["coupling"] = [SceneAvoidance(scenario.scene, target=label)]
     return extras
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import argparse
 
-from .inputs import demo_kind, read_input
+from .inputs import demo_kind, read_input, refuse_options_not_taken
 
 EXIT_OK = 0
 
@@ -44,12 +44,16 @@ def fit_several(args: argparse.Namespace) -> int:
     if args.promp:
         model = ProMP(n_basis=args.n_kernels or 20).fit(demos, stamps, units=units)
         mean, std = model.mean(n_steps=200), np.sqrt(model.var(n_steps=200))
+        mean_t = np.linspace(0.0, model.duration_, 200)
         kind = f"a ProMP ({model.n_basis} basis functions per dimension)"
     else:
         dmp = DMP(n_kernels=args.n_kernels, alpha=args.alpha, protocol=args.protocol)
         model = MultiDMP(dmp=dmp).fit(demos, stamps, units=units)
-        mean, std = model.rollout(), model.std()
+        motion = model.trajectory()
+        mean, std, mean_t = motion.y, model.std(n_steps=len(motion.t)), motion.t
         kind = f"a DMP from several demonstrations ({model.dmp_.protocol} protocol)"
+    # the figure on time: each demonstration on its own (over 1 s without stamps, as fitted)
+    own = [np.linspace(0.0, 1.0, len(y)) if t is None else t - t[0] for y, t in zip(demos, times)]
     path = save_model(model, args.output)
     unit = units or "units"
     lengths = ", ".join(str(len(y)) for y in demos)
@@ -64,7 +68,13 @@ def fit_several(args: argparse.Namespace) -> int:
         from ..plotting.trajectories import plot_distribution
 
         figure = plot_distribution(
-            args.plot, demos, mean, std, title=f"{len(demos)} demonstrations", units=units or ""
+            args.plot,
+            demos,
+            mean,
+            std,
+            title=f"{len(demos)} demonstrations",
+            units=units or "",
+            times={"demonstrations": own, "mean": mean_t},
         )
         print(f"wrote {figure}")
     return EXIT_OK
@@ -81,19 +91,14 @@ def _refuse_unused(args: argparse.Namespace, model, promp_class) -> None:
     in one line (none is silently ignored); ``--goal``, ``--start`` (a ProMP), ``--rate`` and
     ``--plot`` act on both."""
     kind = "ProMP" if isinstance(model, promp_class) else "MultiDMP"
-    for name, unset in args.unset_options.items():
-        if name in _BOTH_TAKE or name in _SEVERAL_TAKES[kind]:
-            continue
-        # --robot's value is filled in by the command before it gets here (its default arm)
-        given = args.robot_given if name == "robot" else getattr(args, name) not in (unset, [])
-        if not given:
-            continue
-        flag = "--" + name.replace("_", "-")
-        raise ValueError(
-            f"{flag} does not apply to a {type(model).__name__} (its rollout takes --goal, "
-            f"{'--start, ' if kind == 'ProMP' else ''}--rate, "
-            f"{', '.join('--' + n for n in sorted(_SEVERAL_TAKES[kind]))} and --plot)"
-        )
+    takes = _BOTH_TAKE | _SEVERAL_TAKES[kind]
+    refuse_options_not_taken(
+        args,
+        takes,
+        f"a {type(model).__name__}",
+        f"--goal, {'--start, ' if kind == 'ProMP' else ''}--rate, "
+        f"{', '.join('--' + n for n in sorted(_SEVERAL_TAKES[kind]))} and --plot",
+    )
 
 
 def _via_pairs(args: argparse.Namespace, model) -> list:
@@ -146,7 +151,8 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         mean, std = conditioned.mean(n_steps=n), np.sqrt(conditioned.var(n_steps=n))
         base, base_std = model.mean(n_steps=n), np.sqrt(model.var(n_steps=n))
         demos, units = [], model.units_
-        marks = (np.array(points), np.asarray(values)) if points else None
+        marks = (np.array(points) * model.duration_, np.asarray(values)) if points else None
+        times = {"demonstrations": [], "mean": trajectory.t, "conditioned": trajectory.t}
     else:
         if args.start is not None:
             raise ValueError("--start: a DMP from several demonstrations starts where they did")
@@ -159,12 +165,20 @@ def rollout_several(args: argparse.Namespace, model) -> int:
             options["via"] = via
         trajectory = model.trajectory(goal, **options)
         mean, std = trajectory.y, model.std(goal, n_steps=len(trajectory.t))
-        base, base_std = model.rollout(), model.std()
+        plain = model.trajectory()
+        base, base_std = plain.y, model.std(n_steps=len(plain.t))
         demos, units = (
             list(model.aligned_) if "aligned_" in model.__dict__ else [],
             model.dmp_.units_,
         )
-        marks = None if goal is None else (np.array([1.0]), goal[None])
+        # the demonstrations as fitted: on the mean one's time (their mean duration)
+        fitted = np.linspace(0.0, model.dmp_.duration_, len(demos[0])) if demos else None
+        times = {
+            "demonstrations": [fitted] * len(demos),
+            "mean": plain.t,
+            "conditioned": trajectory.t,
+        }
+        marks = None if goal is None else (trajectory.t[-1:], goal[None])
     path = save_trajectory(trajectory, args.output)
     unit = units or "units"
     print(
@@ -189,6 +203,7 @@ def rollout_several(args: argparse.Namespace, model) -> int:
             points=marks,
             title="conditioned on the goal" if goal is not None else "the mean motion",
             units=units,
+            times=times if demos else {**times, "demonstrations": [times["mean"]]},
         )
         print(f"wrote {figure}")
     return EXIT_OK

@@ -486,10 +486,12 @@ def plot_distribution(
     points=None,
     title: str = "distribution",
     units: str = "",
+    times=None,
 ) -> Path:
     """A motion learned from several demonstrations: per coordinate against the phase (the share
-    of the motion's time), the demonstrations (grey), the mean with its ±2σ band (blue), and a
-    conditioned result with its own band (orange) and the points it was conditioned on (black).
+    of the motion's time) or against time, the demonstrations (grey), the mean with its ±2σ band
+    (blue), and a conditioned result with its own band (orange) and the points it was conditioned
+    on (black).
 
     Parameters
     ----------
@@ -498,6 +500,12 @@ def plot_distribution(
     mean, std : (L, D) over L phases evenly in [0, 1].
     conditioned, conditioned_std : (L', D), optional.
     points : (phases (K,), values (K, D)), optional.
+    times : dict, optional
+        Draw against time (s) instead: ``{"demonstrations": [(T_i,) ...], "mean": (L,),
+        "conditioned": (L',)}`` (the last when ``conditioned`` is given); ``points``' first entry
+        is then in seconds. A motion's own time base: a DMP's mean motion runs on past its
+        demonstrations' time to come to rest, and drawn over [0, 1] beside them it was squeezed
+        off them.
     """
     check_path(path)
     title, units = _text(title, "title", 200), _text(units, "units", 20)
@@ -517,25 +525,29 @@ def plot_distribution(
             raise TypeError("points must be (phases (K,), values (K, D)) or None")
         at = as_vector(points[0], "points[0]")
         values = as_points(points[1], mean.shape[1], "points[1]")
-        if values.shape[0] != at.shape[0] or at.min() < 0.0 or at.max() > 1.0:
-            raise ValueError("points must be K phases in [0, 1] and K values of D coordinates")
+        if values.shape[0] != at.shape[0] or at.min() < 0.0 or (times is None and at.max() > 1.0):
+            raise ValueError(
+                "points must be K phases in [0, 1] (times in s with times=) and K values of D "
+                "coordinates"
+            )
         points = (at, values)
     n_dims = mean.shape[1]
+    axis = _time_axes(times, demos, mean, conditioned)
     mpl = _matplotlib()
     fig = mpl.figure(figsize=(5.5 * n_dims, 4.5), dpi=110)
-    phase = np.linspace(0.0, 1.0, mean.shape[0])
+    phase = axis["mean"]
     suffix = f" [{units}]" if units else ""
     for d in range(n_dims):
         ax = fig.add_subplot(1, n_dims, d + 1)
-        for y in demos:
-            ax.plot(np.linspace(0.0, 1.0, y.shape[0]), y[:, d], color="0.7", linewidth=0.8)
+        for y, along in zip(demos, axis["demonstrations"]):
+            ax.plot(along, y[:, d], color="0.7", linewidth=0.8)
         ax.fill_between(
             phase, mean[:, d] - 2 * std[:, d], mean[:, d] + 2 * std[:, d], color="C0", alpha=0.25
         )
         ax.plot(phase, mean[:, d], color="C0", linewidth=2.0, label="mean ± 2σ")
         if conditioned is not None:
             conditioned = as_trajectory(conditioned, "conditioned", min_points=2, allow_static=True)
-            c_phase = np.linspace(0.0, 1.0, conditioned.shape[0])
+            c_phase = axis["conditioned"]
             if conditioned_std is not None:
                 spread = as_points(conditioned_std, n_dims, "conditioned_std")
                 ax.fill_between(
@@ -549,10 +561,42 @@ def plot_distribution(
         if points is not None:
             at, values = points
             ax.plot(np.asarray(at), np.asarray(values)[:, d], "ko", label="conditioned on")
-        ax.set_xlabel("phase (share of the motion's time)")
+        ax.set_xlabel("time [s]" if times is not None else "phase (share of the motion's time)")
         ax.set_ylabel(f"coordinate {d}{suffix}")
         ax.grid(True, alpha=0.3)
         if d == 0:
             ax.set_title(title)
             ax.legend(loc="best", fontsize=8)
     return _save(fig, path)
+
+
+def _time_axes(times, demos: list, mean: np.ndarray, conditioned) -> dict:
+    """The horizontal coordinates of :func:`plot_distribution`'s curves: phases evenly in [0, 1],
+    or the given times (checked: one increasing time per row)."""
+    if times is None:
+        return {
+            "demonstrations": [np.linspace(0.0, 1.0, y.shape[0]) for y in demos],
+            "mean": np.linspace(0.0, 1.0, mean.shape[0]),
+            "conditioned": None
+            if conditioned is None
+            else np.linspace(0.0, 1.0, np.shape(conditioned)[0]),
+        }
+    if not isinstance(times, dict):
+        raise TypeError(f"times must be a dict of time arrays or None, got {type(times).__name__}")
+
+    def checked(values, rows: int, name: str) -> np.ndarray:
+        values = as_vector(values, f"times[{name!r}]")
+        if values.shape[0] != rows or np.any(np.diff(values) < 0):
+            raise ValueError(f"times[{name!r}] must be {rows} non-decreasing times (s)")
+        return values
+
+    given = _sequence(times.get("demonstrations", []), "times['demonstrations']")
+    if len(given) != len(demos):
+        raise ValueError(f"times['demonstrations'] must hold {len(demos)} time arrays")
+    return {
+        "demonstrations": [checked(t, y.shape[0], "demonstrations") for t, y in zip(given, demos)],
+        "mean": checked(times.get("mean"), mean.shape[0], "mean"),
+        "conditioned": None
+        if conditioned is None
+        else checked(times.get("conditioned"), np.shape(conditioned)[0], "conditioned"),
+    }

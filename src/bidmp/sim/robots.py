@@ -16,6 +16,7 @@ import numpy as np
 from .._checks import (
     as_point,
     as_vector,
+    check_bool,
     check_limit,
     check_path,
     check_real,
@@ -154,6 +155,7 @@ class RobotModel:
         object.__setattr__(
             self, "standoff", check_real(self.standoff, "standoff", positive=True, maximum=2.0)
         )
+        object.__setattr__(self, "rest_given", check_bool(self.rest_given, "rest_given"))
 
     @property
     def n_joints(self) -> int:
