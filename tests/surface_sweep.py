@@ -476,6 +476,8 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int):
             for p in signature.parameters.values()
             if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
         ]
+        extra = {key[6:]: value for key, value in special.items() if key.startswith("nasty:")}
+        special = {key: value for key, value in special.items() if not key.startswith("nasty:")}
         valid = {**common, **special}
         required = [p.name for p in parameters if p.default is inspect.Parameter.empty]
         if any(name not in valid for name in required):
@@ -485,7 +487,10 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int):
         # The required arguments, and the optional ones the callable's own valid values name.
         base = {name: valid[name] for name in names if name in required or name in special}
         writer = bool(WRITER.search(label))
-        options = {name: generic + derived_nasty(valid.get(name), tmp, writer) for name in names}
+        options = {
+            name: generic + derived_nasty(valid.get(name), tmp, writer) + extra.get(name, [])
+            for name in names
+        }
         for name in names:
             for nasty_label, value in options[name]:
                 singles.append(

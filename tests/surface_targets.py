@@ -603,6 +603,84 @@ def _instances(tmp: Path):
     )
 
 
+def _only(function, names: tuple, fixed: dict):
+    """``function`` called with ``fixed`` and the arguments ``names`` alone (what the sweep
+    changes): its signature is theirs."""
+
+    def call(**given):
+        return function(**fixed, **given)
+
+    call.__signature__ = inspect.Signature(
+        [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY) for name in names]
+    )
+    return call
+
+
+def _wrong_objects(tmp: Path):
+    """The writers', plots' and viewer's object arguments (reports, results, layers), each swept
+    with wrong objects alone (the sweep's nasty values: None, object(), text, arrays, nested
+    data ...): a wrong object is refused by name before anything is drawn or written. Their valid
+    calls draw and write; their own tests make them."""
+    from bidmp import experiments, plotting, sim, tasks
+    from bidmp.plotting import viewer
+
+    out = tmp / "wrong-objects"
+    layers = viewer.ViewLayers(title="t", units="mm", demonstration=np.zeros((2, 3)))
+    report = sim.SimReport(None, {}, np.zeros(3), 0.0, False)  # an empty simulation: no motions
+    cases = [
+        ("write_report", tasks.write_report, ("report",), {"out": out}),
+        ("write_sim_report", sim.write_sim_report, ("report",), {"out": out}),
+        ("write_job_report", sim.write_job_report, ("report",), {"out": out}),
+        ("write_results", experiments.write_results, ("result",), {"name": "x", "out": out}),
+        ("plot_generalisation", plotting.plot_generalisation, ("result",), {"path": out / "a.png"}),
+        ("plot_extension", plotting.plot_extension, ("extension",), {"path": out / "b.png"}),
+        ("plot_prm_comparison", plotting.plot_prm_comparison, ("comparisons",), {"path": out / "c.png"}),
+        ("plot_incremental", plotting.plot_incremental, ("results",), {"path": out / "d.png"}),
+        ("plot_targets_top_view", plotting.plot_targets_top_view, ("report",), {"path": out / "e.png"}),
+        ("plot_error_vs_distance", plotting.plot_error_vs_distance, ("report",), {"path": out / "f.png"}),
+        ("plot_scenario_3d", plotting.plot_scenario_3d, ("report",), {"path": out / "g.png"}),
+        ("layers_from_report", plotting.layers_from_report, ("report",), {}),
+        ("add_robot_motions", plotting.add_robot_motions, ("sim_report",), {"layers": layers}),
+        ("add_robot_motions", plotting.add_robot_motions, ("layers",), {"sim_report": report}),
+        ("view_figure", viewer.view_figure, ("layers",), {}),
+        ("write_view", viewer.write_view, ("layers",), {"path": out / "v.html"}),
+        ("save_layers", viewer.save_layers, ("layers",), {"path": out / "v.npz"}),
+    ]  # fmt: skip
+    for name, function, names, fixed in cases:
+        yield f"{name}(wrong {names[0]})", _only(function, names, fixed), dict.fromkeys(names)
+
+
+def _use(estimator):
+    """What a fitted estimator of each kind is used for, as a call of no arguments."""
+    for method, args in (
+        ("rollout", ()),
+        ("predict", (np.random.default_rng(1).normal(size=(5, 3)),)),
+        ("trajectory", (1.0,)),
+        ("mean", ()),
+    ):
+        if hasattr(estimator, method):
+            bound = getattr(estimator, method)
+            return lambda: bound(*args)
+    raise AssertionError(type(estimator).__name__)
+
+
+def _after_set_params(cls, fit_args: tuple):
+    """A function of ``cls``'s parameters that sets them on an estimator *already fitted* with its
+    defaults and uses it without fitting again (``set_params`` is how scikit-learn's tools change
+    a fitted estimator): every parameter is checked where it is used, not only in ``fit``."""
+    import copy
+
+    fitted = cls().fit(*fit_args)
+
+    def use(**params):
+        estimator = copy.deepcopy(fitted)
+        estimator.set_params(**params)
+        return _use(estimator)()
+
+    use.__signature__ = inspect.signature(cls)
+    return use
+
+
 def targets(tmp: Path):
     """(label, callable, valid arguments) of everything the sweep calls."""
     overrides = _package_overrides(tmp)
@@ -610,6 +688,9 @@ def targets(tmp: Path):
         yield label, function, overrides.get(label, {})
     for owner, cls, fit_args in _estimators():
         yield f"{owner}(...).fit", _fitting(cls, fit_args), {}
+        yield f"{owner}.set_params(...) then used", _after_set_params(cls, fit_args), {}
+    yield from _wrong_objects(tmp)
+    yield from _hostile_urdfs(tmp)
     for owner, instance, special in _instances(tmp):
         for name, member in inspect.getmembers(type(instance)):
             label = f"{owner}.{name}"
@@ -632,3 +713,120 @@ def targets(tmp: Path):
                 }
             )
             yield label, getattr(instance, name), own
+
+
+_ARM = Path(__file__).resolve().parent / "data" / "tm5_like" / "tm5_like.urdf"
+
+
+def hostile_urdfs(folder: Path, seed: int = 0, mutations: int = 24) -> list:
+    """(label, path) of robot files with one defect each, written into ``folder``: the planted
+    ones of tests/sim/test_hostile_urdf.py and more a file may carry (XML entities that expand or
+    read a file, nesting 100 000 deep, bytes that are no text, an empty file, a joint without a
+    child, an unknown joint type, limits upside down, a zero axis, a mesh linked to a system file
+    or a FIFO, 20 000 links), then ``mutations`` random ones (seeded): a number replaced by NaN,
+    1e308, -1e308 or text, a line dropped, a tag cut short."""
+    import os
+    import random
+
+    text = _ARM.read_text()
+    folder.mkdir(parents=True, exist_ok=True)
+    for mesh in _ARM.parent.iterdir():
+        if mesh.suffix.lower() in (".stl", ".obj", ".dae") and not (folder / mesh.name).exists():
+            (folder / mesh.name).write_bytes(mesh.read_bytes())
+    cases = {
+        "billion laughs": text.replace(
+            "<robot",
+            '<!DOCTYPE r [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;&a;&a;&a;&a;&a;&a;">'
+            '<!ENTITY c "&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;"><!ENTITY d "&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;">'
+            '<!ENTITY e "&d;&d;&d;&d;&d;&d;&d;&d;&d;&d;"><!ENTITY f "&e;&e;&e;&e;&e;&e;&e;&e;&e;&e;">'
+            "]>\n<robot",
+            1,
+        ).replace('name="base_link"', 'name="&f;"', 1),
+        "external entity": text.replace(
+            "<robot", '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>\n<robot', 1
+        ).replace('name="link2"', 'name="&x;"', 1),
+        "nested 100 000 deep": text.replace(
+            "</robot>", "<a>" * 100_000 + "</a>" * 100_000 + "</robot>"
+        ),
+        "empty file": "",
+        "not XML": "solid arm\nendsolid\n",
+        "no child": text.replace('<child link="link2"/>', "", 1),
+        "unknown joint type": text.replace('type="revolute"', 'type="teleport"', 1),
+        "limits upside down": text.replace('lower="-', 'upper="-', 1),
+        "zero axis": text.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>', 1),
+        "20 000 links": text.replace(
+            "</robot>", "".join(f'<link name="extra{i}"/>' for i in range(20_000)) + "</robot>"
+        ),
+    }
+    out = []
+    for label, body in cases.items():
+        path = folder / f"{label.replace(' ', '_')}.urdf"
+        path.write_text(body)
+        out.append((f"URDF: {label}", path))
+    binary = folder / "binary.urdf"
+    binary.write_bytes(b"\xff\xfe\x00<robot>\x00\x9c")
+    out.append(("URDF: no text", binary))
+    meshes = []
+    link = folder / "passwd.stl"
+    if not link.exists():
+        link.symlink_to("/etc/passwd")
+    meshes.append(("mesh linked to a system file", "passwd.stl"))
+    fifo = folder / "pipe.stl"
+    if not fifo.exists():
+        os.mkfifo(fifo)
+    meshes.append(("mesh a FIFO", "pipe.stl"))
+    for label, name in meshes:
+        path = folder / f"{label.replace(' ', '_')}.urdf"
+        path.write_text(
+            text.replace(
+                '<cylinder radius="0.06" length="0.145200"/>', f'<mesh filename="{name}"/>', 1
+            )
+        )
+        out.append((f"URDF: {label}", path))
+    rng = random.Random(seed)
+    numbers = [m for m in __import__("re").finditer(r"-?[0-9]+\.?[0-9]*(e-?[0-9]+)?", text)]
+    lines = text.splitlines()
+    for index in range(mutations):
+        kind = rng.choice(["number", "line", "tag"])
+        if kind == "number":
+            m = rng.choice(numbers)
+            body = (
+                text[: m.start()]
+                + rng.choice(["nan", "1e308", "-1e308", "abc", "inf"])
+                + text[m.end() :]
+            )
+        elif kind == "line":
+            drop = rng.randrange(len(lines))
+            body = "\n".join(lines[:drop] + lines[drop + 1 :])
+        else:
+            cut = rng.randrange(len(text))
+            body = text[:cut]
+        path = folder / f"mutation{index}.urdf"
+        path.write_text(body)
+        out.append((f"URDF: random {kind} #{index}", path))
+    return out
+
+
+def _hostile_urdfs(tmp: Path):
+    """``robot_model`` of a user's arm whose URDF is hostile (:func:`hostile_urdfs`): refused in
+    one line naming the file, or an arm whose limits and rest are finite."""
+    from bidmp.sim import robot_model
+
+    folder = tmp / "hostile-urdfs"
+    hostile = hostile_urdfs(folder)
+    limits = {
+        "lower": [-3.0] * 6,
+        "upper": [3.0] * 6,
+        "velocity": [3.0] * 6,
+        "acceleration": [10.0] * 6,
+        "jerk": [500.0] * 6,
+    }
+
+    def arm(urdf):
+        model = robot_model({"urdf": str(urdf), "flange": "flange", "limits": limits}, folder)
+        return {"rest": model.rest, "lower": model.limits.lower}
+
+    arm.__signature__ = inspect.Signature(
+        [inspect.Parameter("urdf", inspect.Parameter.KEYWORD_ONLY)]
+    )
+    yield "robot_model(hostile URDFs)", arm, {"urdf": _ARM, "nasty:urdf": hostile}

@@ -712,6 +712,19 @@ def check_members(value, members: tuple, name: str, expected: str):
     return value
 
 
+def check_sequence_of(values, members: tuple, name: str, expected: str, most: int = 64) -> list:
+    """``values`` as a list if it is a non-empty list or tuple of at most ``most`` items, each
+    with every attribute in ``members`` (what a plot reads of each panel); else a TypeError or
+    ValueError naming ``name`` and what each item must be."""
+    if not isinstance(values, (list, tuple)):
+        raise TypeError(f"{name} must be a list of {expected}, got {type(values).__name__}")
+    if not values or len(values) > most:
+        raise ValueError(f"{name} must hold 1 to {most} {expected}, got {len(values)}")
+    for index, value in enumerate(values):
+        check_members(value, members, f"{name}[{index}]", expected)
+    return list(values)
+
+
 # Hz: the slowest rhythm bidmp runs (a period of 11.6 days); slower is a unit mistake, or a denormal
 # whose period overflows the sample count (5e-324 Hz divided by zero)
 SLOWEST_HZ = 1e-6

@@ -19,6 +19,7 @@ from .._checks import (
     check_bool,
     check_fitted,
     check_int,
+    check_real,
     numerically_guarded,
 )
 from .gmm import _AugmentedMixture, _check_gmr_size, _fit_mixture, _gmr, augment
@@ -99,7 +100,9 @@ class TPGMM(_AugmentedMixture):
         transform[1:, 1:] = A
         offset = np.r_[0.0, b]
         mu_global = mu @ transform.T + offset
-        sigma_global = transform @ sigma @ transform.T + self.reg_covar * np.eye(d + 1)
+        # checked where it is used: set_params may have changed it since fit
+        reg_covar = check_real(self.reg_covar, "reg_covar", positive=True, maximum=1e6)
+        sigma_global = transform @ sigma @ transform.T + reg_covar * np.eye(d + 1)
         return mu_global, sigma_global
 
     @numerically_guarded

@@ -658,7 +658,8 @@ def _refuse_undeclared_euler(header, keys, path) -> None:
     """Euler angles by name (roll, pitch, yaw; KUKA's a, b, c beside x, y, z) give no sequence:
     refused with the declaration that reads them (never guessed)."""
     for names, example in ((("roll", "pitch", "yaw"), "xyz"), (("a", "b", "c"), "ZYX")):
-        if all(name in keys for name in names) and {"x", "y", "z"} <= set(keys):
+        # (a, b, c and d beside them: four unnamed numbers, no KUKA angles)
+        if all(name in keys for name in names) and {"x", "y", "z"} <= set(keys) and "d" not in keys:
             where = [header[keys.index(name)] for name in names]
             unit = split_unit(where[0])[1] or "deg|rad"
             raise ValueError(

@@ -160,6 +160,14 @@ def plot_extension(
 def plot_prm_comparison(path, comparisons) -> Path:
     """Paper Table 5 / Fig. 9 analogue: per case, the example paths (left) and the similarity
     per iteration, mean ± std over seeds, G-PRM vs classic PRM (right)."""
+    from .._checks import check_sequence_of
+
+    comparisons = check_sequence_of(
+        comparisons,
+        ("extension", "example_prm", "gprm", "prm", "units", "name"),
+        "comparisons",
+        "bidmp.experiments.PRMComparison (bidmp.experiments.compare_prm)",
+    )
     mpl = _matplotlib()
     fig = mpl.figure(figsize=(12.0, 4.2 * len(comparisons)), dpi=100)
     for row, comparison in enumerate(comparisons):

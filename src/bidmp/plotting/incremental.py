@@ -14,6 +14,14 @@ __all__ = ["plot_incremental"]
 def plot_incremental(path, results) -> Path:
     """Paper Fig. 11 analogue: per LASA shape, the demonstration, the extended demonstrations,
     the Bi-DMP rollouts to their targets and the plain DMP's rollouts to the same targets."""
+    from .._checks import check_sequence_of
+
+    results = check_sequence_of(
+        results,
+        ("demonstration", "targets", "extensions", "bidmp_rollouts"),
+        "results",
+        "bidmp.experiments.IncrementalResult (bidmp.experiments.lasa_incremental)",
+    )
     mpl = _matplotlib()
     fig, axes = mpl.subplots(
         1, len(results), figsize=(5.5 * len(results), 5.2), dpi=100, squeeze=False

@@ -532,6 +532,8 @@ def plot_distribution(
             )
         points = (at, values)
     n_dims = mean.shape[1]
+    if conditioned is not None:
+        conditioned = as_trajectory(conditioned, "conditioned", min_points=2, allow_static=True)
     axis = _time_axes(times, demos, mean, conditioned)
     mpl = _matplotlib()
     fig = mpl.figure(figsize=(5.5 * n_dims, 4.5), dpi=110)
@@ -546,7 +548,6 @@ def plot_distribution(
         )
         ax.plot(phase, mean[:, d], color="C0", linewidth=2.0, label="mean ± 2σ")
         if conditioned is not None:
-            conditioned = as_trajectory(conditioned, "conditioned", min_points=2, allow_static=True)
             c_phase = axis["conditioned"]
             if conditioned_std is not None:
                 spread = as_points(conditioned_std, n_dims, "conditioned_std")

@@ -100,6 +100,14 @@ def _xyz(points) -> np.ndarray:
 
 def layers_from_report(report) -> ViewLayers:
     """The layers of a finished evaluation (:func:`bidmp.evaluate`)."""
+    from .._checks import check_members
+
+    check_members(
+        report,
+        ("scenario", "methods", "extensions", "fitted"),
+        "report",
+        "a bidmp.tasks.Report (bidmp.evaluate)",
+    )
     scenario = report.scenario
     points = [
         _xyz(e.demonstration)[e.segmentation_points]
@@ -193,8 +201,9 @@ def add_robot_motions(layers: ViewLayers, sim_report) -> ViewLayers:
     """Add the arm's motions a simulation recorded (``SimReport.motions``), in scene units, and
     the targets the arm failed (``SimReport.methods``: what it did, judged by the contract) to
     ``failures`` where the evaluation had not failed them already."""
-    from .._checks import check_members
+    from .._checks import check_kind, check_members
 
+    check_kind(layers, ViewLayers, "layers", "bidmp.plotting.viewer.ViewLayers")
     check_members(sim_report, ("motions",), "sim_report", "a bidmp.sim.SimReport or JobReport")
     for (method, label), motion in sim_report.motions.items():
         layers.robot[f"{method} -> {label}"] = {

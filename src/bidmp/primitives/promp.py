@@ -199,7 +199,7 @@ class ProMP(Estimator):
     def _H(self, phase: np.ndarray, derivative: int = 0) -> np.ndarray:
         """The observation matrix (D·N, L·D) of all dimensions at ``phase``: column ``l·D + d``
         reads dimension d at phase l."""
-        rows = promp_basis(phase, self.n_basis, self.overlap, derivative)  # (L, N)
+        rows = promp_basis(phase, self._fitted_basis, self.overlap, derivative)  # (L, N)
         n_dims, n_basis = self.n_dims_, rows.shape[1]
         H = np.zeros((n_dims * n_basis, rows.shape[0] * n_dims))
         for d in range(n_dims):
@@ -213,12 +213,24 @@ class ProMP(Estimator):
         phase = as_vector(phase, "phase")
         if phase.min() < 0.0 or phase.max() > 1.0:
             raise ValueError("phase must lie in [0, 1] (the demonstrations' normalised time)")
+        # the basis rows (L, N) and a dimension's block products are what a phase costs
+        check_bytes(
+            phase.size * self._fitted_basis * max(self.n_dims_, 1), "the ProMP's rows at phase"
+        )
         return phase
 
     def _rows(self, phase, n_steps: int, derivative: int = 0) -> np.ndarray:
         """The basis rows (L, N) (or their phase derivative) at ``phase`` (default ``n_steps``)."""
         self._check_fitted()
-        return promp_basis(self._phase(phase, n_steps), self.n_basis, self.overlap, derivative)
+        return promp_basis(
+            self._phase(phase, n_steps), self._fitted_basis, self.overlap, derivative
+        )
+
+    @property
+    def _fitted_basis(self) -> int:
+        """The basis functions per dimension the weights were fitted with: what the rows must have
+        (``n_basis`` may have been set since, by ``set_params``: it acts at the next ``fit``)."""
+        return self.weight_mean_.size // self.n_dims_
 
     def _mean_of(self, rows: np.ndarray) -> np.ndarray:
         """``B w_d`` per dimension: (L, D)."""
@@ -265,12 +277,12 @@ class ProMP(Estimator):
         All points at once (one stacked observation)."""
         self._check_fitted()
         phase = _as_bounded_array(phase, "phase", 1)
+        # one stacked observation: its (K·D)² covariance must fit before it is built
+        check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
         phase = self._phase(phase.reshape(-1), 2)
         y = as_points(y, self.n_dims_, "y")
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
-        # one stacked observation: its (K·D)² covariance must fit before it is built
-        check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
         noise = _noise(cov, phase.size, self.n_dims_)
         mean, covariance = condition_gaussian(
             self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise

@@ -37,6 +37,7 @@ from .._checks import (
     _limit,
     as_point,
     as_trajectory,
+    check_bytes,
     check_choice,
     check_int,
     check_names,
@@ -172,6 +173,7 @@ class RhythmicDMP(Estimator):
     def forcing(self, phase) -> np.ndarray:
         """The learned forcing term ``f(φ)`` (L, D) at phases (rad), amplitude 1."""
         self._check_fitted()
+        check_bytes(np.size(phase) * len(self.centres_), "the basis rows (phases x kernels)")
         return self._basis.rows(phase, self.centres_, self.widths_) @ self.weights_
 
     def cycle_start(
@@ -238,11 +240,12 @@ class RhythmicDMP(Estimator):
 
     @property
     def _alpha(self) -> float:
-        return float(self.alpha)
+        # checked where it is used: set_params may have changed it since fit
+        return check_real(self.alpha, "alpha", minimum=1e-3, maximum=1e4)
 
     @property
     def _beta(self) -> float:
-        return float(self.alpha) / 4.0
+        return self._alpha / 4.0
 
     def _settings(self, frequency, amplitude, anchor):
         self._check_fitted()

@@ -281,15 +281,31 @@ def _check_urdf_tree(path) -> set:
 
     path = Path(path)
     where = f"robot.urdf {shown_path(path)}"
+    head = path.read_bytes()[: 1 << 16]
+    if b"<!DOCTYPE" in head or b"<!ENTITY" in head:  # entities that expand or read other files
+        raise ValueError(f"{where}: declares a DOCTYPE or entities, which a URDF has no use for")
     try:
         root = ElementTree.parse(path).getroot()
     except ElementTree.ParseError as exc:
         raise ValueError(f"{where}: not well-formed XML ({exc})") from None
+    except RecursionError:
+        raise ValueError(f"{where}: its elements nest too deep to read") from None
     if root.tag != "robot":
         raise ValueError(f"{where}: its root element is <{root.tag}>, not <robot>")
+    _check_depth(root, where)
     links = _unique_names(root, "link", where)
     _unique_names(root, "joint", where)
     _one_tree(links, _parents(root, links, where), where)
+    for joint in root.findall("joint"):
+        _check_joint(joint, where)
+    for inertial in root.iter("inertial"):
+        _check_numbers(inertial.find("mass"), ("value",), where, "a <mass>", nonnegative=True)
+        _check_numbers(
+            inertial.find("inertia"),
+            ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"),
+            where,
+            "an <inertia>",
+        )
     for link in root.findall("link"):  # (the joints' origins: checked with their joints)
         for origin in link.iter("origin"):
             _check_origin_element(origin, where, f"link {shown_path(link.get('name'), 30)!r}")
@@ -297,6 +313,64 @@ def _check_urdf_tree(path) -> set:
             if mesh.get("filename"):
                 _check_mesh(path, mesh.get("filename"), where)
     return set(links)
+
+
+_URDF_DEPTH = 64  # a URDF nests a few levels (robot, link, visual, geometry, mesh); PyBullet's
+# parser recurses per level: 100 000 nested elements would overflow its stack
+_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+
+
+def _check_depth(root, where: str) -> None:
+    """Refuse elements nested deeper than :data:`_URDF_DEPTH` (iteratively: no recursion here)."""
+    stack = [(root, 1)]
+    while stack:
+        element, depth = stack.pop()
+        if depth > _URDF_DEPTH:
+            raise ValueError(f"{where}: elements nest deeper than {_URDF_DEPTH} levels")
+        stack.extend((child, depth + 1) for child in element)
+
+
+def _check_joint(joint, where: str) -> None:
+    """A joint's type known to URDF, its axis a finite non-zero direction, its limits numbers."""
+    name = f"joint {shown_path(joint.get('name'), 30)!r}"
+    kind = joint.get("type")
+    if kind not in _JOINT_TYPES:
+        raise ValueError(
+            f"{where}: {name} has type {shown_path(str(kind), 20)!r}; URDF's are {', '.join(_JOINT_TYPES)}"
+        )
+    axis = joint.find("axis")
+    if axis is not None and kind != "fixed":
+        values = _numbers(axis.get("xyz", "1 0 0"), where, f"{name}'s axis")
+        if len(values) != 3 or not 1e-9 < math.hypot(*values) < 1e9:
+            raise ValueError(f"{where}: {name}'s axis {axis.get('xyz')!r} is no direction")
+    _check_numbers(
+        joint.find("limit"), ("lower", "upper", "velocity", "effort"), where, f"{name}'s limit"
+    )
+
+
+def _numbers(text: str, where: str, what: str) -> list:
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        raise ValueError(f"{where}: {what} {shown_path(text, 30)!r} is not numbers") from None
+    if not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{where}: {what} {shown_path(text, 30)!r} must be finite")
+    return values
+
+
+def _check_numbers(element, keys: tuple, where: str, what: str, nonnegative: bool = False) -> None:
+    """The attributes ``keys`` of ``element`` (when present) finite numbers (and >= 0)."""
+    if element is None:
+        return
+    for key in keys:
+        text = element.get(key)
+        if text is None:
+            continue
+        values = _numbers(text, where, f"{what}'s {key}")
+        if len(values) != 1:
+            raise ValueError(f"{where}: {what}'s {key} {shown_path(text, 30)!r} must be one number")
+        if nonnegative and values[0] < 0:
+            raise ValueError(f"{where}: {what}'s {key} {text!r} must be >= 0")
 
 
 def _unique_names(root, kind: str, where: str) -> list:

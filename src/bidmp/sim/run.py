@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_labels, check_bool, check_int, check_real, short_token
+from .._checks import as_labels, check_bool, check_int, check_kind, check_real, short_token
 from .._trajectory import arclength
 from .._units import length_digits, length_text, mm
 from ..primitives.avoidance import SceneAvoidance
@@ -340,6 +340,9 @@ def execution_settings(scenario) -> dict:
     :class:`~bidmp.tasks.evaluation.Report` it runs): the scene's geometry checked, the motions
     that break the contract repaired (unless the scenario takes the paper's approach), the
     repairs planned with :data:`TRACKING_ALLOWANCE_MM` of room for the arm's tracking."""
+    from ..tasks.scenarios import Scenario
+
+    check_kind(scenario, Scenario, "scenario", "a bidmp Scenario (bidmp.tasks.load)")
     return {
         "geometry": scenario.scene is not None,
         "repair": scenario.scene is not None
@@ -361,7 +364,10 @@ def execution_report(scenario, methods=("dmp", "bidmp")):
     scenario = scenario_module.resolve(scenario)
     settings = execution_settings(scenario)
     return evaluate(
-        scenario, list(methods), repair=settings["repair"], allowance=settings["allowance"]
+        scenario,
+        as_labels(methods, "methods"),
+        repair=settings["repair"],
+        allowance=settings["allowance"],
     )
 
 

@@ -42,7 +42,7 @@ def _shown(value) -> str:
     """A rejected JSON value, quoted short (never a whole file's worth)."""
     try:
         text = json.dumps(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, RecursionError):  # (data nested thousands deep)
         text = type(value).__name__
     return text if len(text) <= 24 else short_token(text, 20)
 
