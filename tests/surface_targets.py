@@ -823,7 +823,8 @@ def _hostile_urdfs(tmp: Path):
     }
 
     def arm(urdf):
-        model = robot_model({"urdf": str(urdf), "flange": "flange", "limits": limits}, folder)
+        urdf = str(urdf) if isinstance(urdf, Path) else urdf  # (anything else as given)
+        model = robot_model({"urdf": urdf, "flange": "flange", "limits": limits}, folder)
         return {"rest": model.rest, "lower": model.limits.lower}
 
     arm.__signature__ = inspect.Signature(

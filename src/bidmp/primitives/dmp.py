@@ -502,7 +502,9 @@ class DMP(_FittedParams, Estimator):
         self._check_fitted()
         params = self._params()
         phase = params.canonical_system.as_phase(phase)
-        check_bytes(np.size(phase) * len(self.centres_), "the basis rows (phases x kernels)")
+        check_bytes(
+            np.size(phase) * len(self.centres_), "the basis rows at phase (phases x kernels)"
+        )
         return params.basis.rows(phase, self.centres_, self.widths_)
 
     def forcing_term(self, phase) -> np.ndarray:

@@ -37,6 +37,7 @@ from .._checks import (
     _limit,
     as_point,
     as_trajectory,
+    as_vector,
     check_bytes,
     check_choice,
     check_int,
@@ -173,7 +174,8 @@ class RhythmicDMP(Estimator):
     def forcing(self, phase) -> np.ndarray:
         """The learned forcing term ``f(φ)`` (L, D) at phases (rad), amplitude 1."""
         self._check_fitted()
-        check_bytes(np.size(phase) * len(self.centres_), "the basis rows (phases x kernels)")
+        phase = as_vector(phase, "phase")
+        check_bytes(phase.size * len(self.centres_), "the basis rows at phase (phases x kernels)")
         return self._basis.rows(phase, self.centres_, self.widths_) @ self.weights_
 
     def cycle_start(

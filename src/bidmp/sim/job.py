@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from .._checks import TaskRefusal
-from .._units import length_text, mm
+from .._units import length_digits, length_text, mm
 from ..tasks.contract import Contract
 from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
@@ -86,7 +86,7 @@ def _engaged(world: _World, part: MovablePart, target) -> tuple[bool, str]:
             f"the tool is {length_text(across, unit)} off the part's axis and {length_text(along, unit)} off its height "
             f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})"
         )
-    return True, f"{across:.3f} {unit} off the axis"
+    return True, f"{length_text(across, unit)} off the axis"
 
 
 def _supports(world: _World, part: MovablePart) -> list:
@@ -263,8 +263,8 @@ def _place(world: _World, part: MovablePart, slot, exclude) -> JobPhase:
     ):
         phase.ok = False
         phase.note = (
-            f"not in its slot: the part lies {off:.1f} {world.scenario.units} off it, at "
-            f"{np.round(centre, 1).tolist()}"
+            f"not in its slot: the part lies {length_text(off, world.scenario.units)} off it, at "
+            f"{np.round(centre, length_digits(world.scenario.units)).tolist()}"
         )
     return phase
 

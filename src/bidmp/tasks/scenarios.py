@@ -692,6 +692,8 @@ def builtin_text(name: str) -> str:
 def resolve(scenario, name: str = "scenario") -> Scenario:
     """``scenario`` as a :class:`Scenario`: one given, or loaded from a file or a built-in name
     (:func:`load`); anything else a TypeError naming the argument ``name``."""
+    if not isinstance(name, str) or not name.isidentifier() or len(name) > 64:
+        raise TypeError("name must be the argument's name (a short identifier)")
     if isinstance(scenario, Scenario):
         return scenario
     if not isinstance(scenario, (str, os.PathLike)):
@@ -699,6 +701,7 @@ def resolve(scenario, name: str = "scenario") -> Scenario:
             f"{name} must be a bidmp Scenario, a scenario file or a built-in name, got "
             f"{type(scenario).__name__}"
         )
+    check_path(scenario, name)  # (a bad path named as the caller's argument)
     return load(scenario)
 
 
