@@ -256,3 +256,20 @@ def test_joints_in_degrees_are_read_in_radians(tmp_path):
         and read.names == ["j1 (deg)", "j2 (deg)", "j3 (deg)"]
     )
     np.testing.assert_allclose(read.values, np.radians(degrees), rtol=1e-15)
+
+
+def test_a_zero_quaternion_row_is_left_to_the_pose_checks_by_the_jump_check(tmp_path):
+    """Found by make fuzz: the jump check divided by a zero quaternion's norm (a NumPy warning
+    leaked). A pose file is read as written (its quaternions are checked where a model fits them,
+    as read_poses says): read without a warning, refused by the fit naming the zero quaternion."""
+    import warnings
+
+    from bidmp import CartesianDMP
+
+    path = tmp_path / "zero.csv"
+    path.write_text("t,x,y,z,qx,qy,qz,qw\n0,0,0,0,0,0,0,0\n0.1,1,0,0,0,0,0,1\n0.2,2,0,0,0,0,0,1\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        poses, t = read_poses(path)
+    with pytest.raises(ValueError, match="zero quaternion"):
+        CartesianDMP().fit(poses, t)

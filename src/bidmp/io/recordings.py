@@ -296,9 +296,10 @@ def check_orientation_jumps(path, quaternions: np.ndarray, times) -> None:
     (:data:`_MAX_TURN_RATE`; without times, more than a quarter turn a row): Euler angles read in
     another sequence, or a rotation vector that is something else, wrap into such jumps."""
     q = np.asarray(quaternions, dtype=float)
-    if q.shape[0] < 2:
-        return
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    norms = np.linalg.norm(q, axis=1) if q.ndim == 2 else np.zeros(0)
+    if q.shape[0] < 2 or not np.all(np.isfinite(norms)) or np.any(norms < 1e-9):
+        return  # (a zero or broken quaternion: the pose checks refuse it, naming the row)
+    q = q / norms[:, None]
     steps = 2.0 * np.arccos(np.clip(np.abs(np.sum(q[1:] * q[:-1], axis=1)), 0.0, 1.0))
     if times is None:
         bad = np.flatnonzero(steps > _MAX_TURN_UNTIMED)
