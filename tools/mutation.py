@@ -76,6 +76,8 @@ TARGETS = (
             "Scene._minimum",
             "Scene._clearance",
             "Scene._clearance_oriented",
+            "Scene._oriented_bounds",
+            "_solid_frames",
             "_sweep",
             "_nearest_to_its_clearance",
         ),

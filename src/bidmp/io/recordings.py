@@ -194,7 +194,7 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         positions, times = drop_repeated_stamps(positions, times, f"{path}: the time column")
     if layout is not None and layout.rotation is not None:
         turns = positions[:, 3:7] if kind == "pose" else positions[:, 3:]
-        check_orientation_jumps(path, turns, times)
+        _check_orientation_jumps(path, turns, times)
     orientation = None
     if layout is not None and layout.orientation:
         positions, orientation = positions[:, :3], positions[:, 3:]
@@ -291,7 +291,7 @@ _MAX_TURN_RATE = 20.0
 _MAX_TURN_UNTIMED = np.pi / 2  # per row, in a file without times
 
 
-def check_orientation_jumps(path, quaternions: np.ndarray, times) -> None:
+def _check_orientation_jumps(path, quaternions: np.ndarray, times) -> None:
     """Refuse orientations that jump between neighbouring samples faster than a tool turns
     (:data:`_MAX_TURN_RATE`; without times, more than a quarter turn a row): Euler angles read in
     another sequence, or a rotation vector that is something else, wrap into such jumps."""
