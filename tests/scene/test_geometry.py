@@ -818,3 +818,48 @@ def test_a_turning_tool_among_tilted_parts_matches_every_pair_through_coal(seed)
         for solid in range(len(scene.solids))
     )
     assert found.distance == pytest.approx(every, abs=1e-9)
+
+
+def test_the_oriented_bound_is_a_lower_bound_and_tight_where_the_tool_is_square_to_a_box():
+    """The culling bound of a turning tool, on its own: never above coal's exact distance (random
+    tilted boxes and cylinders, random tool frames and places; a bound above it would skip the
+    nearest pair), and equal to it for a tool square to a tilted box's face (a looser bound would
+    send every pair near a tilted plate to coal again, as the world-frame box did)."""
+    rng = np.random.default_rng(11)
+    parts = [
+        {"type": "box", "label": "b", "at": [0, 0, 0], "size": [60, 40, 8], "rotation": [20, -15, 30]},
+        {"type": "cylinder", "label": "c", "at": [150, 0, 0], "radius": 9, "height": 50, "rotation": [35, 10, 0]},
+        {"type": "nut", "label": "n", "at": [-150, 0, 0], "across_flats": 20, "height": 12, "rotation": [25, 5, 0]},
+    ]  # fmt: skip
+    scene = Scene.from_dict({"tool": {"radius": 6.0, "length": 60.0}, "parts": parts})
+    engine = scene._engine()
+    chosen = np.arange(len(scene.solids))
+    turns = Rotation.random(600, random_state=3)
+    points = np.vstack(
+        [rng.normal(centre, 45, (200, 3)) for centre in ([0, 0, 0], [150, 0, 0], [-150, 0, 0])]
+    )
+    axes = turns.as_matrix()[:, :, 2]
+    bounds = scene._oriented_bounds(points - axes * 30.0, axes, chosen)
+    exact = np.array(
+        [[engine.tool_to(p, k, r) for k in chosen] for p, r in zip(points, turns.as_matrix())]
+    )
+    assert np.all(bounds <= np.maximum(exact, 0.0) + 1e-9)
+    assert np.mean(bounds > 0.5 * np.maximum(exact, 0.0)) > 0.5  # and not a trivial one
+    # square to the box: the tool's axis along the box's own -z, above its top face by 7
+    solid = scene.solids[0]  # (its centre where the part's "at" puts it)
+    box = Rotation.from_matrix(solid.rotation)
+    into = box * Rotation.from_euler("x", 180.0, degrees=True)  # the tool's z into the face
+    for offset in ([0, 0], [12, -5], [-20, 9]):
+        mouth = solid.centre + box.apply([*offset, 4.0 + 7.0])
+        axis = into.apply([0.0, 0.0, 1.0])
+        (bound,) = scene._oriented_bounds(mouth[None] - axis * 30.0, axis[None], chosen[:1])[:, 0]
+        assert bound == pytest.approx(7.0, abs=1e-9)
+        assert engine.tool_to(mouth, 0, into.as_matrix()) == pytest.approx(7.0, abs=1e-6)
+    # a cylinder's end: the tool along its axis, 5 beyond its top
+    solid = scene.solids[1]
+    cylinder = Rotation.from_matrix(solid.rotation)
+    down = cylinder * Rotation.from_euler("x", 180.0, degrees=True)
+    axis = down.apply([0.0, 0.0, 1.0])
+    mouth = solid.centre + cylinder.apply([0.0, 0.0, 25.0 + 5.0])
+    (bound,) = scene._oriented_bounds(mouth[None] - axis * 30.0, axis[None], chosen[1:])[:, 0]
+    assert bound == pytest.approx(5.0, abs=1e-9)
