@@ -843,7 +843,9 @@ def test_the_oriented_bound_is_a_lower_bound_and_tight_where_the_tool_is_square_
     exact = np.array(
         [[engine.tool_to(p, k, r) for k in chosen] for p, r in zip(points, turns.as_matrix())]
     )
-    assert np.all(bounds <= np.maximum(exact, 0.0) + 1e-9)
+    # (coal's exact distance is within 1e-8 of the closed form: a face-on bound may sit 1e-9 above)
+    over = np.argwhere(bounds > np.maximum(exact, 0.0) + 1e-7)
+    assert not over.size, [(int(i), int(k), bounds[i, k], exact[i, k]) for i, k in over[:5]]
     assert np.mean(bounds > 0.5 * np.maximum(exact, 0.0)) > 0.5  # and not a trivial one
     # square to the box: the tool's axis along the box's own -z, above its top face by 7
     solid = scene.solids[0]  # (its centre where the part's "at" puts it)
