@@ -81,6 +81,11 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.JointLimits": joint,
         "bidmp.sim.robot_placement": {"scenario": scenario},
         "bidmp.sim.robot_model": {"spec": {"model": "xarm6"}},
+        "bidmp.sim.judge_commands": {"q": _fr3_stream(), "robot": "fr3"},
+        "bidmp.sim.match_joint_names": {
+            "names": [f"fr3_joint{i}" for i in range(1, 8)],
+            "robot": "fr3",
+        },
         "bidmp.sim.job_targets": {"scenario": scenario},
         "bidmp.sim.target_labels": {"scenario": scenario, "targets": ["1", "3"]},
         "bidmp.sim.execution_report": {"scenario": scenario, "methods": ["dmp"]},
@@ -288,6 +293,13 @@ def _package_overrides(tmp: Path) -> dict:
             "effort": (87.0,) * 7,
         },
     }
+
+
+def _fr3_stream() -> np.ndarray:
+    """A smooth 1 kHz rest-to-rest joint move of the FR3 (200 commands), within its limits."""
+    s = np.linspace(0.0, 1.0, 200)[:, None]
+    start = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.9, 0.8])
+    return start + 0.01 * (10 * s**3 - 15 * s**4 + 6 * s**5)
 
 
 def _panda_limits():

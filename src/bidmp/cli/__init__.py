@@ -29,7 +29,7 @@ __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_INTERNAL", "EXIT_BAD_INPUT",
 
 def build_parser() -> _Parser:
     """The ``bidmp`` parser: global options, then each command group's commands."""
-    from . import experiments, job, skills, tasks, view
+    from . import experiments, job, skills, tasks, verify, view
     from .common import allow_outside_files, parse_K
 
     parser = _Parser(
@@ -45,6 +45,7 @@ def build_parser() -> _Parser:
     tasks.add_commands(commands)
     view.add_commands(commands)
     job.add_commands(commands)
+    verify.add_commands(commands)
     return parser
 
 

@@ -8,6 +8,7 @@
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
 * ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
+* ``fci`` — the Franka Control Interface's own limits (Panda, FR3) judging 1 kHz joint commands;
 * ``report`` — the results, apart from any backend, and their files.
 
 Layer 3 (the application): imports the math, ``io`` and ``tasks``; never ``cli``. PyBullet is an
@@ -36,6 +37,7 @@ if TYPE_CHECKING:
         register_backend,
         require_simulator,
     )
+    from .fci import FCI_LIMITS, FCILimits, FCIVerdict, judge_commands, match_joint_names
     from .job import JobInternalError, job_targets, run_job
     from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot, write_job_report
     from .kinematic import KinematicCell

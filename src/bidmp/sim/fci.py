@@ -1,0 +1,213 @@
+"""The Franka Control Interface's own limits as the judge of a 1 kHz joint command stream: the
+tables of the Panda (FER) and the Franka Research 3 (FR3), and the check the robot makes of
+every command a joint-position motion generator sends, named as libfranka names the reflex it
+raises.
+
+Sources (the numbers are typed from them, and pinned by ``tests/sim/test_fci.py``):
+
+* **Panda (FER)**: position ranges and velocity limits from Franka's *control parameters* page
+  (https://frankaemika.github.io/docs/control_parameters.html, "Limits for Panda"); acceleration
+  and jerk limits from libfranka 0.9's ``include/franka/rate_limiting.h`` (``kMaxJointAcceleration``,
+  ``kMaxJointJerk``, published there less ``kLimitEps`` = 1e-3, the target its own rate limiter
+  aims at: the robot's threshold is the nominal value, which is used here);
+* **FR3**: position ranges, velocity limits and the position-based velocity limits
+  (``velocity_offset``, ``deceleration_limit``) from the FR3's URDF as the robot serves it to
+  libfranka >= 0.10 (``<limit>`` and ``<position_based_velocity_limits>``, read by libfranka's
+  ``JointVelocityLimitsConfig``), acceleration 10 rad/s² and jerk 5000 rad/s³ on every joint
+  from libfranka >= 0.10's ``rate_limiting.h``.
+
+The check, per sample of the stream (1 ms apart, the motion starting at rest where the arm
+stands, as a motion generator's first command must): each joint's position within its range
+(``joint_motion_generator_position_limits_violation``), its velocity (first difference) within
+its limits, on the FR3 those of its position (``..._velocity_limits_violation``), its
+acceleration (second difference) within its limit (``..._velocity_discontinuity``: the velocity
+jumped), its jerk (third difference) within its limit (``..._acceleration_discontinuity``). The
+first sample that breaks one is the verdict, with the joint, the value and the bound.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._checks import as_trajectory, as_vector, check_choice, short_token
+
+__all__ = ["FCI_LIMITS", "FCILimits", "FCIVerdict", "judge_commands", "match_joint_names"]
+
+COMMAND_PERIOD_S = 1e-3  # the FCI's control cycle: a joint-position command every millisecond
+
+
+@dataclass(frozen=True)
+class FCILimits:
+    """One arm's FCI limits, joint 1 to 7 (rad, rad/s, rad/s², rad/s³); ``velocity_offset`` and
+    ``deceleration`` (rad/s, rad/s²): the position-based velocity limits (None: the velocity
+    limit is the same everywhere), ``joint_names``: what libfranka's robot model calls them."""
+
+    name: str
+    lower: tuple
+    upper: tuple
+    velocity: tuple
+    acceleration: tuple
+    jerk: tuple
+    velocity_offset: tuple | None
+    deceleration: tuple | None
+    joint_names: tuple
+    source: str
+
+    def velocity_bounds(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(lowest, highest) velocity (rad/s) each joint may be commanded at positions ``q``
+        (T, 7): ``±velocity``, or on an arm with position-based limits libfranka's
+        ``min(v_max, max(0, -offset + sqrt(2 · deceleration · (q_max - q))))`` (and its mirror
+        towards ``q_min``), less libfranka's tolerance of 1e-3 being taken as room, not cut."""
+        q = np.asarray(q, dtype=float)
+        v_max = np.asarray(self.velocity)
+        if self.velocity_offset is None:
+            return np.broadcast_to(-v_max, q.shape), np.broadcast_to(v_max, q.shape)
+        offset, deceleration = np.asarray(self.velocity_offset), np.asarray(self.deceleration)
+        upper_room = np.sqrt(np.maximum(0.0, 2.0 * deceleration * (np.asarray(self.upper) - q)))
+        lower_room = np.sqrt(np.maximum(0.0, 2.0 * deceleration * (q - np.asarray(self.lower))))
+        highest = np.minimum(v_max, np.maximum(0.0, -offset + upper_room)) + _VELOCITY_TOLERANCE
+        lowest = np.maximum(-v_max, np.minimum(0.0, offset - lower_room)) - _VELOCITY_TOLERANCE
+        return lowest, highest
+
+
+# libfranka's kJointVelocityLimitsTolerance: the position-based limits are widened by it
+_VELOCITY_TOLERANCE = 1e-3
+
+FCI_LIMITS = {
+    "panda": FCILimits(
+        "panda",
+        lower=(-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973),
+        upper=(2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973),
+        velocity=(2.1750, 2.1750, 2.1750, 2.1750, 2.6100, 2.6100, 2.6100),
+        acceleration=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
+        jerk=(7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0),
+        velocity_offset=None,
+        deceleration=None,
+        joint_names=tuple(f"panda_joint{i}" for i in range(1, 8)),
+        source="Franka control parameters (Limits for Panda); libfranka 0.9 rate_limiting.h",
+    ),
+    "fr3": FCILimits(
+        "fr3",
+        lower=(-2.7501, -1.7918, -2.9065, -3.0481, -2.8101, 0.54092, -3.0196),
+        upper=(2.7501, 1.7918, 2.9065, -0.1458, 2.8101, 4.5205, 3.0196),
+        velocity=(2.62, 2.62, 2.62, 2.62, 5.26, 4.18, 5.26),
+        acceleration=(10.0,) * 7,
+        jerk=(5000.0,) * 7,
+        velocity_offset=(0.30, 0.20, 0.20, 0.30, 0.35, 0.35, 0.35),
+        deceleration=(6.0, 2.585, 3.5, 4.0, 17.0, 5.5, 17.0),
+        joint_names=tuple(f"fr3_joint{i}" for i in range(1, 8)),
+        source="the FR3 URDF as served to libfranka >= 0.10 (<limit>, "
+        "<position_based_velocity_limits>); libfranka >= 0.10 rate_limiting.h",
+    ),
+}
+
+_REFLEXES = (
+    ("position", "joint_motion_generator_position_limits_violation"),
+    ("velocity", "joint_motion_generator_velocity_limits_violation"),
+    ("acceleration", "joint_motion_generator_velocity_discontinuity"),
+    ("jerk", "joint_motion_generator_acceleration_discontinuity"),
+)
+
+
+@dataclass(frozen=True)
+class FCIVerdict:
+    """What the FCI makes of a command stream: ``ok``, or the first breach: the reflex as
+    libfranka names it, the quantity (position, velocity, acceleration, jerk), the joint (1-7),
+    the sample (0-based), its value and the bound it passed (rad, rad/s, rad/s², rad/s³)."""
+
+    ok: bool
+    reflex: str = ""
+    quantity: str = ""
+    joint: int = 0
+    sample: int = 0
+    value: float = 0.0
+    bound: float = 0.0
+
+    def reason(self) -> str:
+        if self.ok:
+            return ""
+        units = {"position": "rad", "velocity": "rad/s", "acceleration": "rad/s²", "jerk": "rad/s³"}
+        return (
+            f"{self.reflex}: joint {self.joint} {self.quantity} {self.value:.6g} {units[self.quantity]} "
+            f"at sample {self.sample} ({self.sample * COMMAND_PERIOD_S:.3f} s) against "
+            f"{self.bound:.6g}"
+        )
+
+
+def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
+    """The FCI's verdict on joint-position commands ``q`` (T, 7) rad, one per millisecond, the arm
+    at rest at ``q[0]`` before the first (module docstring), by ``robot``'s tables
+    (``"panda"``, ``"fr3"``)."""
+    limits = FCI_LIMITS[check_choice(robot, "robot", tuple(FCI_LIMITS))]
+    q = as_trajectory(q, "q", min_points=1, allow_static=True)
+    if q.shape[1] != 7:
+        raise ValueError(f"q must have 7 columns (joints 1-7), got {q.shape[1]}")
+    rest = np.repeat(q[:1], 3, axis=0)  # at rest where it stands: three samples before the first
+    stream = np.vstack([rest, q])
+    velocity = np.diff(stream, axis=0) / COMMAND_PERIOD_S
+    acceleration = np.diff(velocity, axis=0) / COMMAND_PERIOD_S
+    jerk = np.diff(acceleration, axis=0) / COMMAND_PERIOD_S
+    # sample i of q: its position, and the differences that end at it
+    velocity, acceleration = velocity[2:], acceleration[1:]
+    lowest, highest = limits.velocity_bounds(q)
+    over = {
+        "position": (q < np.asarray(limits.lower), q > np.asarray(limits.upper)),
+        "velocity": (velocity < lowest, velocity > highest),
+        "acceleration": (np.abs(acceleration) > np.asarray(limits.acceleration), None),
+        "jerk": (np.abs(jerk) > np.asarray(limits.jerk), None),
+    }
+    first = None
+    for quantity, _ in _REFLEXES:
+        below, above = over[quantity]
+        broken = below if above is None else below | above
+        rows = np.flatnonzero(broken.any(axis=1))
+        if rows.size and (first is None or rows[0] < first[1]):
+            first = (quantity, int(rows[0]))
+    if first is None:
+        return FCIVerdict(True)
+    quantity, row = first
+    values = {"position": q, "velocity": velocity, "acceleration": acceleration, "jerk": jerk}
+    below, above = over[quantity]
+    joint = int(np.flatnonzero((below if above is None else below | above)[row])[0])
+    value = float(values[quantity][row, joint])
+    bound = _bound(limits, quantity, value, joint, lowest[row], highest[row])
+    reflex = dict(_REFLEXES)[quantity]
+    return FCIVerdict(False, reflex, quantity, joint + 1, row, value, bound)
+
+
+def _bound(limits: FCILimits, quantity: str, value: float, joint: int, lowest, highest) -> float:
+    """The bound ``value`` passed, with its sign."""
+    if quantity == "position":
+        return limits.lower[joint] if value < limits.lower[joint] else limits.upper[joint]
+    if quantity == "velocity":
+        return float(lowest[joint] if value < lowest[joint] else highest[joint])
+    table = limits.acceleration if quantity == "acceleration" else limits.jerk
+    return math.copysign(table[joint], value)
+
+
+def match_joint_names(names, robot: str) -> np.ndarray:
+    """The columns of ``names`` (a motion file's joint names) in the robot's joint order, each
+    name one of ``robot``'s (``panda_joint1..7``, ``fr3_joint1..7``): a ValueError naming the
+    first that is not, or the first that is missing."""
+    limits = FCI_LIMITS[check_choice(robot, "robot", tuple(FCI_LIMITS))]
+    if (
+        not isinstance(names, (list, tuple))
+        or len(names) > 64
+        or not all(isinstance(name, str) and len(name) <= 256 for name in names)
+    ):
+        raise TypeError(
+            f"names must be a list of joint names (strings), got {type(names).__name__}"
+        )
+    unknown = [name for name in names if name not in limits.joint_names]
+    if unknown:
+        raise ValueError(
+            f"names: joint {short_token(unknown[0], 30)} is not one of the {robot}'s "
+            f"({', '.join(limits.joint_names)})"
+        )
+    missing = [name for name in limits.joint_names if name not in names]
+    if missing:
+        raise ValueError(f"names: the motion has no column for {missing[0]}")
+    return as_vector([names.index(name) for name in limits.joint_names], "columns").astype(int)
