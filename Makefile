@@ -95,6 +95,7 @@ bench: $(STAMP)
 	$(PY) benchmarks/bench_job.py
 	$(PY) benchmarks/bench_repair.py
 	$(PY) benchmarks/bench_robustness.py
+	$(PY) benchmarks/bench_verify.py
 	$(PY) benchmarks/bench_startup.py
 	$(PY) benchmarks/bench_rhythmic.py
 	$(PY) benchmarks/bench_promp.py
@@ -117,6 +118,7 @@ bench-smoke: $(STAMP)
 	cd benchmarks && ../$(PY) bench_avoidance.py --fields 2 --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_job.py --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_repair.py --smoke > /dev/null
+	cd benchmarks && ../$(PY) bench_verify.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_robustness.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_startup.py --smoke > /dev/null
 	rm -rf .bench-smoke
