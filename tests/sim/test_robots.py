@@ -128,7 +128,10 @@ def test_a_urdf_named_in_the_scenario(tmp_path):
 @pytest.mark.parametrize(
     "robot, message",
     [
-        ({"model": "kr6"}, r"robot.model: expected one of \['panda', 'iiwa', 'xarm6', 'ur5'\]"),
+        (
+            {"model": "kr6"},
+            r"robot.model: expected one of \['panda', 'fr3', 'iiwa', 'xarm6', 'ur5'\]",
+        ),
         ({"model": "iiwa", "urdf": "a.urdf"}, "not both"),
         ({"flange": "x"}, "describe your own"),
         ({"urdf": "a.urdf"}, "robot.flange"),

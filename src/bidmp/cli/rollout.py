@@ -84,7 +84,7 @@ def _limits(args: argparse.Namespace, dmp) -> dict:
 
 
 def _arm_limits(args: argparse.Namespace):
-    """The JointLimits of --joint-limits: a built-in arm (panda, iiwa, xarm6, ur5), or the robot a scenario
+    """The JointLimits of --joint-limits: a built-in arm (panda, fr3, iiwa, xarm6, ur5), or the robot a scenario
     names (its "robot" key: a model or its own URDF's limits)."""
     from ..sim.robots import ROBOT_MODELS, robot_model
 
@@ -582,7 +582,7 @@ def _add_rollout_arguments(rollout) -> None:
     rollout.add_argument(
         "--joint-limits",
         default=None,
-        metavar="panda|iiwa|xarm6|ur5|SCENARIO",
+        metavar="panda|fr3|iiwa|xarm6|ur5|SCENARIO",
         help="a joint-space model: the robot's per-joint velocity, acceleration and jerk limits (the "
         "Panda's published ones; the iiwa's, the xArm6's and the UR5's published speeds with "
         "assumed acceleration and jerk; or those of the robot a scenario file names)",
@@ -590,7 +590,7 @@ def _add_rollout_arguments(rollout) -> None:
     rollout.add_argument(
         "--robot",
         default=None,
-        metavar="panda|iiwa|xarm6|ur5|SCENARIO",
+        metavar="panda|fr3|iiwa|xarm6|ur5|SCENARIO",
         help="the arm whose inverse kinematics --cartesian-goal and --bag use (default panda; a scenario: "
         "its robot where it stands, with its tool; needs bidmp[sim])",
     )

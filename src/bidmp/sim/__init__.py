@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from .pybullet.cell import RobotCell
     from .report import SimMethod, SimReport, SimTarget, write_sim_report
     from .robots import (
+        FR3,
         IIWA,
         PANDA,
         ROBOT_MODELS,

@@ -75,7 +75,7 @@ def inverse_kinematics(
     ----------
     points : array (n, 3) or (3,)
         In ``units`` ("m", "cm" or "mm").
-    robot : {"panda", "iiwa", "xarm6", "ur5"} or RobotModel
+    robot : {"panda", "fr3", "iiwa", "xarm6", "ur5"} or RobotModel
     tool_length : float
         From the flange to the tool's mouth, in ``units`` (0: the flange itself).
     seed : array (J,), optional

@@ -27,6 +27,7 @@ from .backend import JointLimits, SimError
 
 __all__ = [
     "PANDA",
+    "FR3",
     "IIWA",
     "XARM6",
     "UR5",
@@ -92,6 +93,19 @@ UR5 = JointLimits(
     acceleration=XARM6.acceleration,
     jerk=XARM6.jerk,
 )
+
+
+# The Franka Research 3: its FCI's tables (bidmp.sim.fci.FCI_LIMITS["fr3"], sources named there):
+# the ranges and top speeds its URDF gives libfranka, 10 rad/s² and 5000 rad/s³ every joint. (Its
+# velocity limits also fall towards each stop: the FCI's own judge, bidmp.sim.fci, checks those.)
+def _fr3_limits() -> JointLimits:
+    from .fci import FCI_LIMITS
+
+    fr3 = FCI_LIMITS["fr3"]
+    return JointLimits(fr3.lower, fr3.upper, fr3.velocity, fr3.acceleration, fr3.jerk)
+
+
+FR3 = _fr3_limits()
 # The arms whose acceleration and jerk limits are assumptions (reports say so).
 ASSUMED_LIMITS = {"iiwa", "xarm6", "ur5"}
 
@@ -206,9 +220,26 @@ UR5_MODEL = RobotModel(
     (150.0, 150.0, 150.0, 28.0, 28.0, 28.0),
     standoff=0.38,
 )
-ROBOT_MODELS = {"panda": PANDA_MODEL, "iiwa": IIWA_MODEL, "xarm6": XARM6_MODEL, "ur5": UR5_MODEL}
+# The FR3 shares the Panda's kinematics (its DH parameters) and stands where the Panda does; its
+# URDF (tools/fr3_urdf.py) carries its own ranges: joint 6 turns to 4.52 rad, the Panda's to 3.75.
+FR3_MODEL = RobotModel(
+    "fr3",
+    str(Path(__file__).resolve().parents[1] / "data" / "robots" / "fr3.urdf"),
+    "fr3_link8",
+    FR3,
+    _REST,
+    tuple(_EFFORT),
+)
+ROBOT_MODELS = {
+    "panda": PANDA_MODEL,
+    "fr3": FR3_MODEL,
+    "iiwa": IIWA_MODEL,
+    "xarm6": XARM6_MODEL,
+    "ur5": UR5_MODEL,
+}
 ROBOT_NAMES = {
     "panda": "Franka Panda",
+    "fr3": "Franka Research 3",
     "iiwa": "KUKA LBR iiwa 7 R800",
     "xarm6": "UFACTORY xArm6",
     "ur5": "UR5-class arm (DH model)",

@@ -264,7 +264,7 @@ def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> 
     return points
 
 
-_ROBOT_MODELS = ("panda", "iiwa", "xarm6", "ur5")
+_ROBOT_MODELS = ("panda", "fr3", "iiwa", "xarm6", "ur5")
 MIN_JOINTS = 6  # the arms the simulator drives: serial, six joints or more
 _LIMIT_KEYS = ("lower", "upper", "velocity", "acceleration", "jerk")
 
