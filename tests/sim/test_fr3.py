@@ -134,3 +134,36 @@ def test_a_simulated_motion_on_the_fr3_is_accepted_by_its_fci_tables():
     assert commands.shape[1] == 7 and commands.shape[0] > 1000  # the whole motion, every 1 ms
     verdict = judge_commands(commands, "fr3")
     assert verdict.ok, verdict.reason()
+
+
+def test_the_jobs_motions_on_the_fr3_are_written_and_accepted_by_bidmp_verify(tmp_path, capsys):
+    """bidmp job --commands on the FR3 (two nuts, PyBullet): one file per motion, t 1 ms apart and
+    the FR3's joint names; bidmp verify accepts every one (exit 0) and refuses them as a Panda's
+    (exit 2: the names are the FR3's)."""
+    import json
+
+    from bidmp.cli import main
+
+    data = tasks.load("nut-unscrewing").to_dict()
+    data["robot"] = {**data.get("robot", {}), "model": "fr3"}
+    scenario = tmp_path / "fr3.json"
+    scenario.write_text(json.dumps(data))
+    out = tmp_path / "job"
+    argv = ["job", "--scenario", str(scenario), "--targets", "1,7", "--no-pictures"]
+    assert main([*argv, "--commands", "--out", str(out)]) == 0
+    files = sorted((out / "commands").glob("*.csv"))
+    assert [f.name for f in files][:4] == [
+        "001_1_approach.csv",
+        "002_1_unscrew.csv",
+        "003_1_retract.csv",
+        "004_1_drop.csv",
+    ]
+    header = [line for line in files[0].read_text().splitlines() if not line.startswith("#")][0]
+    assert header == "t," + ",".join(f"fr3_joint{i}" for i in range(1, 8))
+    capsys.readouterr()
+    assert main(["verify", *map(str, files), "--robot", "fr3"]) == 0
+    assert (
+        capsys.readouterr().out.strip().splitlines()[-1]
+        == f"{len(files)} of {len(files)} motions accepted"
+    )
+    assert main(["verify", str(files[0]), "--robot", "panda"]) == 2

@@ -22,8 +22,10 @@ def run_job_command(
     pictures: bool = True,
     view: bool = False,
     backend: str | None = None,
+    commands: bool = False,
 ) -> int:
-    """Run the job with a progress bar, print its report, write its files (and the viewer)."""
+    """Run the job with a progress bar, print its report, write its files (and the viewer;
+    ``commands``: every motion's 1 kHz joint commands, out/commands/*.csv)."""
     from tqdm import tqdm
 
     from ..sim.job import job_targets, run_job
@@ -45,10 +47,21 @@ def run_job_command(
                 pictures=pictures,
                 view=view,
                 backend=backend,
+                record=commands,
             )
     print()
     print(report.summary())
     written = write_job_report(report, out)
+    if commands:
+        from ..sim.job_report import write_job_commands
+        from ..sim.kinematics import joint_names
+        from ..sim.robots import robot_model
+
+        arm = robot_model(scenario.robot, scenario.base_dir)
+        files = write_job_commands(report, Path(out) / "commands", joint_names(arm))
+        print(
+            f"wrote {len(files)} command files to {Path(out) / 'commands'} (bidmp verify judges them)"
+        )
     if view:
         from .view import write_view_files
 
@@ -81,6 +94,7 @@ def _cmd_job(args: argparse.Namespace) -> int:
         pictures=not args.no_pictures,
         view=args.view,
         backend=args.backend,
+        commands=args.commands,
     )
 
 
@@ -115,6 +129,12 @@ def add_commands(commands) -> None:
         help="also write view.html: the 3-D viewer, the first cycle on a time slider",
     )
     job.add_argument("--out", default="bidmp-job", help="output folder (default ./bidmp-job)")
+    job.add_argument(
+        "--commands",
+        action="store_true",
+        help="also write every motion's 1 kHz joint commands, OUT/commands/NNN_<target>_<phase>.csv "
+        "(t and the arm's joint names): what 'bidmp verify' judges",
+    )
     backend_option(job)
     allow_outside_files(job)
     job.set_defaults(handler=_cmd_job)

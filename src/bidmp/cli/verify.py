@@ -11,42 +11,51 @@ EXIT_REJECTED = EXIT_TARGETS_FAILED  # 3: the FCI would stop the motion with a r
 
 
 def _cmd_verify(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from ..io.recordings import read_recording
-    from ..sim.fci import COMMAND_PERIOD_S, judge_commands, match_joint_names
-
     if args.libfranka:
         raise ValueError(
             "--libfranka (streaming through libfranka to a simulated FCI) is not built yet; "
             "bidmp verify judges by the FCI's published tables"
         )
-    recording = read_recording(args.motion)
+    verdicts = [(path, _verdict(path, args.robot)) for path in args.motion]
+    for path, (verdict, count) in verdicts:
+        seconds = count * 1e-3
+        if verdict.ok:
+            print(
+                f"accepted: {path}: {count} commands ({seconds:.3f} s) within the {args.robot}'s "
+                f"FCI limits (positions, position-based velocities, accelerations, jerks)"
+            )
+        else:
+            print(f"rejected: {path}: {verdict.reason()}")
+    rejected = sum(not verdict.ok for _, (verdict, _) in verdicts)
+    if len(verdicts) > 1:
+        print(f"{len(verdicts) - rejected} of {len(verdicts)} motions accepted")
+    return EXIT_REJECTED if rejected else EXIT_OK
+
+
+def _verdict(path, robot: str):
+    """(the FCI's verdict, the number of commands) of one motion file."""
+    import numpy as np
+
+    from ..io.recordings import read_recording
+    from ..sim.fci import COMMAND_PERIOD_S, judge_commands, match_joint_names
+
+    recording = read_recording(path)
     if recording.kind != "joints":
         raise ValueError(
-            f"{args.motion}: holds {recording.kind}, not joints: verify judges joint commands "
-            f"(t and the {args.robot}'s joint names)"
+            f"{path}: holds {recording.kind}, not joints: verify judges joint commands "
+            f"(t and the {robot}'s joint names)"
         )
     if recording.t is None:
-        raise ValueError(f"{args.motion}: no time column: the FCI takes a command every 1 ms")
+        raise ValueError(f"{path}: no time column: the FCI takes a command every 1 ms")
     steps = np.diff(recording.t)
     if steps.size and np.max(np.abs(steps - COMMAND_PERIOD_S)) > 1e-6:
         rate = 1.0 / float(np.median(steps))
         raise ValueError(
-            f"{args.motion}: samples {1e3 * float(np.median(steps)):.4g} ms apart ({rate:.4g} Hz); "
+            f"{path}: samples {1e3 * float(np.median(steps)):.4g} ms apart ({rate:.4g} Hz); "
             f"the FCI takes a command every 1 ms: roll it out at 1000 Hz (bidmp rollout --rate 1000)"
         )
-    columns = match_joint_names(recording.names, args.robot)
-    verdict = judge_commands(recording.values[:, columns], args.robot)
-    seconds = len(recording.values) * COMMAND_PERIOD_S
-    if verdict.ok:
-        print(
-            f"accepted: {len(recording.values)} commands ({seconds:.3f} s) within the {args.robot}'s "
-            f"FCI limits (positions, position-based velocities, accelerations, jerks)"
-        )
-        return EXIT_OK
-    print(f"rejected: {verdict.reason()}")
-    return EXIT_REJECTED
+    columns = match_joint_names(recording.names, robot)
+    return judge_commands(recording.values[:, columns], robot), len(recording.values)
 
 
 def add_commands(commands) -> None:
@@ -59,10 +68,11 @@ def add_commands(commands) -> None:
         "joint-space model) as the Franka Control Interface judges joint-position commands: "
         "positions within the ranges, velocities within the (FR3: position-based) limits, "
         "accelerations and jerks within theirs, the motion starting at rest. Exit 0: accepted; "
-        "3: rejected, naming the reflex as libfranka does, the joint, the sample and the value "
-        "against the limit; 2: a bad file.",
+        "3: rejected (any of the files), naming the reflex as libfranka does, the joint, the sample "
+        "and the value against the limit; 2: a bad file. 'bidmp job --commands' writes every "
+        "motion of a job as such a file.",
     )
-    verify.add_argument("motion", metavar="MOTION", help="joint motion file (.csv)")
+    verify.add_argument("motion", metavar="MOTION", nargs="+", help="joint motion file(s) (.csv)")
     verify.add_argument(
         "--robot", choices=("panda", "fr3"), default="fr3", help="whose limits (default fr3)"
     )

@@ -291,3 +291,38 @@ def write_job_report(report: JobReport, out) -> list[Path]:
         ]
         written.append(_write_strip(Path(out) / "job_failures.png", tiles))
     return written
+
+
+def write_job_commands(report: JobReport, folder, joint_names) -> list[Path]:
+    """Every motion's 1 kHz joint commands of a job run with ``record=True``, one CSV per motion:
+    ``<folder>/<NN>_<target>_<phase>.csv`` (NN its order in the job), columns ``t`` (s from the
+    motion's first command, 1 ms apart) and the arm's joint names (rad), a ``# units: rad`` line
+    first: what ``bidmp verify`` judges by the arm's own (FCI) limits."""
+    from .._checks import check_kind, check_path, printable
+    from ..io.atomic import atomic_write
+
+    check_kind(report, JobReport, "report", "a bidmp.sim.JobReport (bidmp.sim.run_job)")
+    folder = Path(check_path(folder, "folder"))
+    folder.mkdir(parents=True, exist_ok=True)
+    names = [str(name) for name in joint_names]
+    written, index = [], 0
+    for target in report.targets:
+        for phase in target.phases:
+            commands = getattr(phase, "commands", None)
+            if commands is None or len(commands) == 0:
+                continue  # (a step that sent no motion: engaging, a refusal)
+            commands = np.asarray(commands, dtype=float)
+            if commands.shape[1] != len(names):
+                raise ValueError(
+                    f"joint_names: {len(names)} names for commands of {commands.shape[1]} joints"
+                )
+            index += 1
+            safe = "".join(c if c.isalnum() or c in "-." else "_" for c in printable(target.label))
+            path = folder / f"{index:03d}_{safe}_{phase.name}.csv"
+            t = np.arange(len(commands)) * 1e-3
+            with atomic_write(path, "w") as handle:
+                handle.write("# units: rad\n")
+                handle.write("t," + ",".join(names) + "\n")
+                np.savetxt(handle, np.column_stack([t, commands]), delimiter=",", fmt="%.17g")
+            written.append(path)
+    return written
