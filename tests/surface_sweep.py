@@ -82,6 +82,7 @@ SKIPPED = {
     "write_report",
     "write_sim_report",
     "write_job_report",
+    "write_job_commands",  # (its wrong objects swept in surface_targets._wrong_objects)
     "write_results",
     "Report",
     "FrequencyEstimate",

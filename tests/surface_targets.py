@@ -643,6 +643,12 @@ def _wrong_objects(tmp: Path):
         ("write_report", tasks.write_report, ("report",), {"out": out}),
         ("write_sim_report", sim.write_sim_report, ("report",), {"out": out}),
         ("write_job_report", sim.write_job_report, ("report",), {"out": out}),
+        (
+            "write_job_commands",
+            sim.write_job_commands,
+            ("report",),
+            {"folder": out / "commands", "joint_names": ["j1"]},
+        ),
         ("write_results", experiments.write_results, ("result",), {"name": "x", "out": out}),
         ("plot_generalisation", plotting.plot_generalisation, ("result",), {"path": out / "a.png"}),
         ("plot_extension", plotting.plot_extension, ("extension",), {"path": out / "b.png"}),

@@ -39,7 +39,15 @@ if TYPE_CHECKING:
     )
     from .fci import FCI_LIMITS, FCILimits, FCIVerdict, judge_commands, match_joint_names
     from .job import JobInternalError, job_targets, run_job
-    from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot, write_job_report
+    from .job_report import (
+        JobPhase,
+        JobReport,
+        JobTarget,
+        in_bin,
+        in_slot,
+        write_job_commands,
+        write_job_report,
+    )
     from .kinematic import KinematicCell
     from .kinematics import inverse_kinematics, joint_names
     from .planning import plan_path

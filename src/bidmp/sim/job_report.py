@@ -14,7 +14,15 @@ from .backend import RECORD_EVERY, SETTLE, SIM_STEP
 from .limits import _command_peaks, _measured_peaks
 from .report import _titled, _write_results, _write_strip
 
-__all__ = ["JobPhase", "JobTarget", "JobReport", "write_job_report", "in_bin", "in_slot"]
+__all__ = [
+    "JobPhase",
+    "JobTarget",
+    "JobReport",
+    "write_job_report",
+    "write_job_commands",
+    "in_bin",
+    "in_slot",
+]
 
 FORMAT = 2  # of job_results.json (2: each motion's contract verdict)
 
