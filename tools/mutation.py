@@ -106,6 +106,23 @@ TARGETS = (
         ),
     ),
     Target(
+        "FCI judge (the robot's own limits)",
+        "bidmp.sim.fci",
+        (
+            "FCILimits.velocity_bounds",
+            "judge_commands",
+            "_bound",
+            "match_joint_names",
+        ),
+        ("tests/sim/test_fci.py",),
+    ),
+    Target(
+        "verify's exit status",
+        "bidmp.cli.verify",
+        ("_cmd_verify", "_verdict"),
+        ("tests/sim/test_fci.py",),
+    ),
+    Target(
         "limit checks and measurement",
         "bidmp.tasks.contract",
         (
@@ -506,6 +523,37 @@ KNOWN_CLEARANCE = (
     "verdict.clearance if motion is out.motion and how == 'lift' else None)"
 )
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    # -- the FCI judge: a difference of 1 kHz commands equal to a limit to its last bit (the
+    # comparisons' edges) is not a motion anyone sends; a breach lies strictly beyond its bound
+    **{
+        ("bidmp.sim.fci", "judge_commands", line, change): "differs only where a difference of "
+        "commands equals the limit to its last bit (the position edges are tested: a joint held "
+        "exactly at its stop is accepted)"
+        for line, change in (
+            ("too_fast = (velocity < lowest) | (velocity > highest)", "< -> <="),
+            ("too_fast = (velocity < lowest) | (velocity > highest)", "> -> >="),
+            (
+                "velocity_jump = np.abs(acceleration) > np.asarray(limits.acceleration)",
+                "> -> >=",
+            ),
+            ("acceleration_jump = np.abs(jerk) > np.asarray(limits.jerk)", "> -> >="),
+        )
+    },
+    **{
+        ("bidmp.sim.fci", "_bound", line, "< -> <="): "called for a breach, which lies strictly "
+        "beyond its bound: the value never equals the lower one"
+        for line in (
+            "return limits.lower[joint] if value < limits.lower[joint] else limits.upper[joint]",
+            "return float(lowest[joint] if value < lowest[joint] else highest[joint])",
+        )
+    },
+    (
+        "bidmp.cli.verify",
+        "_verdict",
+        "if steps.size and np.max(np.abs(steps - COMMAND_PERIOD_S)) > 1e-06:",  # (as parsed)
+        "> -> >=",
+    ): "differs only where a step is off 1 ms by exactly 1e-6 s to the last bit (1.5e-6 off is "
+    "tested refused)",
     (
         "bidmp.sim.job_world",
         "_refused_plan",

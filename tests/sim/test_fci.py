@@ -211,3 +211,69 @@ def test_bidmp_verify_accepts_a_smooth_joint_motion_and_names_a_planted_step(tmp
     assert main(["verify", str(motion), "--robot", "panda"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'fr3_joint1' is not one of the panda's" in err[0]
+
+
+def test_the_edges_of_the_check():
+    """Where a bound is reached and not passed, and the signs: a joint held exactly at its stop is
+    within its range; a breach downwards (negative acceleration, negative jerk) is one; beyond a
+    stop the FR3's velocity bound towards it is libfranka's tolerance alone; near the lower stop
+    the bound away from... towards it falls as it does towards the upper one."""
+    limits = FCI_LIMITS["panda"]
+    held = np.tile(np.array(limits.upper), (20, 1))
+    assert judge_commands(held, "panda").ok
+    held = np.tile(np.array(limits.lower), (20, 1))
+    assert judge_commands(held, "panda").ok
+    start = np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0])
+    steps = np.arange(1, 31, dtype=float) * DT
+    for quantity, jerk in (("acceleration", 0.5), ("jerk", 1.5)):
+        # a cubic downwards on joint 2: its jerk at that share of the limit; at half of it the
+        # acceleration grows past its limit first, at 1.5 times the jerk breaks it at once
+        q = np.tile(start, (40, 1))
+        q[10:, 1] -= jerk * limits.jerk[1] * steps**3 / 6.0
+        verdict = judge_commands(q, "panda")
+        assert (verdict.ok, verdict.quantity, verdict.joint) == (False, quantity, 2)
+        assert verdict.value < 0 and verdict.bound < 0
+    fr3 = FCI_LIMITS["fr3"]
+    beyond = np.array(fr3.upper) + 0.01
+    lowest, highest = fr3.velocity_bounds(beyond[None])
+    np.testing.assert_allclose(highest[0], 1e-3, rtol=0, atol=1e-15)
+    below = np.array(fr3.lower) - 0.01
+    lowest, highest = fr3.velocity_bounds(below[None])
+    np.testing.assert_allclose(lowest[0], -1e-3, rtol=0, atol=1e-15)
+    near = np.array(fr3.lower) + 0.05
+    lowest, _ = fr3.velocity_bounds(near[None])
+    expected = -(np.sqrt(2 * np.array(fr3.deceleration) * 0.05) - np.array(fr3.velocity_offset))
+    expected = np.maximum(-np.array(fr3.velocity), np.minimum(0.0, expected)) - 1e-3
+    np.testing.assert_allclose(lowest[0], expected, rtol=1e-12)
+    assert lowest[0, 0] == pytest.approx(-(math.sqrt(2 * 6.0 * 0.05) - 0.3) - 1e-3, rel=1e-12)
+
+
+def test_verify_says_how_long_a_motion_is_and_refuses_other_rates(tmp_path, capsys):
+    """The printed duration and rate, one line for one file, and the 1 kHz check: a file 2 kHz
+    apart, one with a single 2 ms gap and one 1.5 µs a step off 1 ms are each refused."""
+    from bidmp.cli import main
+
+    names = [f"panda_joint{i}" for i in range(1, 8)]
+    start = np.array([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0])
+
+    def write(path, t):
+        s = np.linspace(0.0, 1.0, len(t))[:, None]
+        q = start + 0.05 * (10 * s**3 - 15 * s**4 + 6 * s**5)  # a small rest-to-rest move
+        np.savetxt(path, np.column_stack([t, q]), delimiter=",", header="t," + ",".join(names),
+                   comments="", fmt="%.17g")  # fmt: skip
+        return str(path)
+
+    good = write(tmp_path / "good.csv", np.arange(2500) * 1e-3)
+    assert main(["verify", good, "--robot", "panda"]) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    assert len(out) == 1 and "2500 commands (2.500 s)" in out[0]
+    fast = write(tmp_path / "fast.csv", np.arange(200) * 5e-4)
+    assert main(["verify", fast, "--robot", "panda"]) == 2
+    assert "0.5 ms apart (2000 Hz)" in capsys.readouterr().err
+    gap = np.arange(200) * 1e-3
+    gap[100:] += 1e-3
+    assert main(["verify", write(tmp_path / "gap.csv", gap), "--robot", "panda"]) == 2
+    assert "1 ms apart (1000 Hz)" in capsys.readouterr().err
+    off = np.arange(200) * 1.0015e-3
+    assert main(["verify", write(tmp_path / "off.csv", off), "--robot", "panda"]) == 2
+    capsys.readouterr()

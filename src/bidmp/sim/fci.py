@@ -153,25 +153,26 @@ def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
     # sample i of q: its position, and the differences that end at it
     velocity, acceleration = velocity[2:], acceleration[1:]
     lowest, highest = limits.velocity_bounds(q)
+    out_of_range = (q < np.asarray(limits.lower)) | (q > np.asarray(limits.upper))
+    too_fast = (velocity < lowest) | (velocity > highest)
+    velocity_jump = np.abs(acceleration) > np.asarray(limits.acceleration)
+    acceleration_jump = np.abs(jerk) > np.asarray(limits.jerk)
     over = {
-        "position": (q < np.asarray(limits.lower), q > np.asarray(limits.upper)),
-        "velocity": (velocity < lowest, velocity > highest),
-        "acceleration": (np.abs(acceleration) > np.asarray(limits.acceleration), None),
-        "jerk": (np.abs(jerk) > np.asarray(limits.jerk), None),
+        "position": out_of_range,
+        "velocity": too_fast,
+        "acceleration": velocity_jump,
+        "jerk": acceleration_jump,
     }
     first = None
-    for quantity, _ in _REFLEXES:
-        below, above = over[quantity]
-        broken = below if above is None else below | above
-        rows = np.flatnonzero(broken.any(axis=1))
+    for quantity, _ in _REFLEXES:  # the earliest sample; at one sample, in the reflexes' order
+        rows = np.flatnonzero(over[quantity].any(axis=1))
         if rows.size and (first is None or rows[0] < first[1]):
             first = (quantity, int(rows[0]))
     if first is None:
         return FCIVerdict(True)
     quantity, row = first
     values = {"position": q, "velocity": velocity, "acceleration": acceleration, "jerk": jerk}
-    below, above = over[quantity]
-    joint = int(np.flatnonzero((below if above is None else below | above)[row])[0])
+    joint = int(np.flatnonzero(over[quantity][row])[0])
     value = float(values[quantity][row, joint])
     bound = _bound(limits, quantity, value, joint, lowest[row], highest[row])
     reflex = dict(_REFLEXES)[quantity]
