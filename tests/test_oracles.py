@@ -435,6 +435,7 @@ def test_a_target_is_removed_only_when_every_phase_kept_the_contract_and_says_th
     assert not early.removed and early.reason == "approach: off"
     good = JobTarget("n2", [JobPhase("approach", True, 1.0), JobPhase("drop", True, 2.0)])
     _finish(good, Part())
+    # (seconds: the phases' simulated durations, 1.0 + 2.0, not a clock)
     assert good.removed and good.reason == "" and good.within_limits and good.seconds == 3.0
 
     class Verdict:

@@ -42,6 +42,7 @@ def test_a_motion_whose_arm_would_touch_a_part_is_not_sent(duct_cell, monkeypatc
     report = sim.run_job(duct_cell, targets=["r0c1", "r0c0"])
     refused, after = report.targets
     (phase,) = refused.phases
+    # (seconds: simulated time; a motion not run spends none)
     assert not phase.ok and phase.seconds == 0.0 and not phase.contacts
     assert "the arm would touch duct0" in refused.reason
     assert after.removed and not after.contacts  # the next nut is done from where the arm stood

@@ -222,7 +222,9 @@ def test_the_commands_real_time_factor_is_the_whole_commands(tmp_path, capsys):
         assert whole and alone, out[-1000:]
         elapsed, simulated, factor = (float(v) for v in whole.groups())
         assert simulated == float(alone.group(1))
-        assert elapsed >= float(alone.group(2))  # the simulation is part of the command
+        # the two printed wall times agree with each other (no limit on either: a loaded machine
+        # changes both): the simulation is part of the command
+        assert elapsed >= float(alone.group(2))
         # the printed times are rounded to 0.1 s, the factor to 0.1
         low = (simulated - 0.05) / (elapsed + 0.05) - 0.05
         assert low <= factor <= (simulated + 0.05) / max(elapsed - 0.05, 1e-3) + 0.05

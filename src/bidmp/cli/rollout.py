@@ -166,17 +166,17 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         "start": args.start,
         **_timing_options(args, dmp),
     }
+    # where the motion goes when --goal is not given: a Bi-DMP's latest skill's goal, else the DMP's
+    default_goal = model.skill_goals_[-1] if isinstance(model, BiDMP) else dmp.goal_
     if skill is not None:
         options["skill"] = skill
         goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
         index = model.select_skill(
-            goals[-1] if args.goal is None and isinstance(model, BiDMP) else args.goal, skill
+            default_goal if args.goal is None and isinstance(model, BiDMP) else args.goal, skill
         )
         print(
             f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})"
         )
-    # where the motion goes when --goal is not given: a Bi-DMP's latest skill's goal, else the DMP's
-    default_goal = model.skill_goals_[-1] if isinstance(model, BiDMP) else dmp.goal_
     options.update(_rollout_extras(args, dmp, poses, default_goal))
     if not args.bag and (
         args.follow
@@ -461,7 +461,7 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
     return f"{path} ({_joint_message(kind, options)}, {len(trajectory)} points, {named}, {_stamped(options)})"
 
 
-def _rollout_extras(args: argparse.Namespace, dmp, poses: bool, default_goal=None) -> dict:
+def _rollout_extras(args: argparse.Namespace, dmp, poses: bool, default_goal) -> dict:
     """trajectory() keywords from --via and --scene/--avoid (on by default with a scene);
     ``default_goal``: where the motion goes without --goal (the target it is, for the steering)."""
     import numpy as np
@@ -494,9 +494,7 @@ def _rollout_extras(args: argparse.Namespace, dmp, poses: bool, default_goal=Non
 
         scenario, label = scenario_option(args, dmp.units_), args.target_label
         goal = np.asarray(
-            (dmp.goal_ if default_goal is None else default_goal)
-            if args.goal is None
-            else args.goal,
+            default_goal if args.goal is None else args.goal,
             dtype=float,
         )[:3]
         # the goal is a target of the scenario (within its success threshold): its label

@@ -17,8 +17,10 @@ def _cmd_verify(args: argparse.Namespace) -> int:
             "bidmp verify judges by the FCI's published tables"
         )
     verdicts = [(path, _verdict(path, args.robot)) for path in args.motion]
+    from ..sim.fci import COMMAND_PERIOD_S
+
     for path, (verdict, count) in verdicts:
-        seconds = count * 1e-3
+        seconds = count * COMMAND_PERIOD_S
         if verdict.ok:
             print(
                 f"accepted: {path}: {count} commands ({seconds:.3f} s) within the {args.robot}'s "

@@ -56,7 +56,7 @@ def _setting(name: str, value) -> str:
     value = value.strip()
     if name == "euler":
         return _check_sequence(value)
-    value = {"µs": "us", "μs": "us", "degrees": "deg", "radians": "rad"}.get(value, value)
+    value = _UNIT_WORDS.get(value.lower(), value)  # (a unit as a column's name may spell it)
     if value.lower() not in SETTINGS[name]:
         raise ValueError(
             f"columns: {name}={short_token(value, 20)[1:-1]} is not one of {', '.join(SETTINGS[name])}"

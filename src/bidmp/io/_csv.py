@@ -102,7 +102,9 @@ def _csv_delimiter(sample: str) -> str:
     return "\t" if "\t" in body else " "
 
 
-_DECIMAL_COMMA = re.compile(r"(?:^|[;\t ])\s*[+-]?[0-9]+,[0-9]+(?:[eE][+-]?[0-9]+)?\s*(?=$|[;\t ])")
+_COMMA_NUMBER = r"[+-]?[0-9]+,[0-9]+(?:[eE][+-]?[0-9]+)?"  # a number with a decimal comma
+_DECIMAL_COMMA = re.compile(rf"(?:^|[;\t ])\s*{_COMMA_NUMBER}\s*(?=$|[;\t ])")
+_DECIMAL_CELL = re.compile(_COMMA_NUMBER)
 
 
 def decimal_comma(sample: str, delimiter: str, declared: str, path) -> bool:
@@ -259,7 +261,7 @@ def _csv_rows(
 
 def _is_decimal(cell: str) -> bool:
     """A number written with a decimal comma (``-122,30``)."""
-    return bool(re.fullmatch(r"[+-]?[0-9]+,[0-9]+(?:[eE][+-]?[0-9]+)?", cell))
+    return bool(_DECIMAL_CELL.fullmatch(cell))
 
 
 def _csv_values(

@@ -14,6 +14,7 @@ import numpy as np
 
 from .._checks import as_trajectory, check_path, short_token
 from ._columns import Layout, parse_columns, resolve, split_unit, times_in_seconds
+from ._conventions import _TIME_DIVISORS
 from ._npy import _read_npy_trajectory
 
 __all__ = ["Recording", "read_recording", "recording_kind", "is_joint_recording"]
@@ -343,20 +344,21 @@ def _check_time_unit(path, times, layout, header) -> None:
     span = float(times[-1] - times[0])
     if span <= 0.0:
         return
-    from ..primitives.timing import MIN_RATE_HZ
+    from ..primitives.timing import MAX_RATE_HZ, MIN_RATE_HZ
 
     rate = (len(times) - 1) / span
     if rate >= MIN_RATE_HZ:
         return
-    fits = [
-        unit for unit, divisor in (("ms", 1e3), ("us", 1e6), ("ns", 1e9))
-        if 1.0 <= rate * divisor <= 100_000.0
-    ]  # fmt: skip
+    # the first unit in which the stamps give a robot's rate (ms when none does)
+    unit = next(
+        (u for u in ("ms", "us", "ns") if MIN_RATE_HZ <= rate * _TIME_DIVISORS[u] <= MAX_RATE_HZ),
+        "ms",
+    )
     name = header[layout.time[0]]
     raise ValueError(
         f"{path}: the time column {short_token(name, 30)} read as seconds gives {rate:.3g} Hz; "
-        f"if it holds {fits[0] if fits else 'ms'}, declare it: --columns time={fits[0] if fits else 'ms'} "
-        f"(or name the column {split_unit(name)[0]}({fits[0] if fits else 'ms'}))"
+        f"if it holds {unit}, declare it: --columns time={unit} "
+        f"(or name the column {split_unit(name)[0]}({unit}))"
     )
 
 

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_trajectory, as_vector, check_choice, short_token
+from .._checks import as_trajectory, check_choice, short_token
 
 __all__ = ["FCI_LIMITS", "FCILimits", "FCIVerdict", "judge_commands", "match_joint_names"]
 
@@ -211,4 +211,4 @@ def match_joint_names(names, robot: str) -> np.ndarray:
     missing = [name for name in limits.joint_names if name not in names]
     if missing:
         raise ValueError(f"names: the motion has no column for {missing[0]}")
-    return as_vector([names.index(name) for name in limits.joint_names], "columns").astype(int)
+    return np.array([names.index(name) for name in limits.joint_names], dtype=int)

@@ -499,10 +499,11 @@ def _titled(image: np.ndarray, title: str, failed: bool = False) -> np.ndarray:
     font = ImageFont.load_default(size=16)
     band = Image.new("RGB", (image.shape[1], 26), FAILED_COLOUR if failed else (255, 255, 255))
     draw = ImageDraw.Draw(band)
-    while len(title) > 8 and draw.textlength(title, font=font) > image.shape[1] - 12:
-        title = title[: max(8, int(len(title) * 0.9))].rstrip() + "…"  # the band's width
-        if title.endswith("……"):
-            title = title[:-1]
+    width = image.shape[1] - 12
+    if draw.textlength(title, font=font) > width:  # cut to the band's width, marked
+        while len(title) > 8 and draw.textlength(title + "…", font=font) > width:
+            title = title[: int(len(title) * 0.95)]
+        title = title.rstrip() + "…"
     draw.text((8, 4), title, fill=(255, 255, 255) if failed else (20, 20, 20), font=font)
     if failed:
         image = image.copy()

@@ -24,6 +24,7 @@ from .._checks import (
     shown_path,
 )
 from .backend import JointLimits, SimError
+from .fci import FCI_LIMITS
 
 __all__ = [
     "PANDA",
@@ -98,14 +99,10 @@ UR5 = JointLimits(
 # The Franka Research 3: its FCI's tables (bidmp.sim.fci.FCI_LIMITS["fr3"], sources named there):
 # the ranges and top speeds its URDF gives libfranka, 10 rad/s² and 5000 rad/s³ every joint. (Its
 # velocity limits also fall towards each stop: the FCI's own judge, bidmp.sim.fci, checks those.)
-def _fr3_limits() -> JointLimits:
-    from .fci import FCI_LIMITS
-
-    fr3 = FCI_LIMITS["fr3"]
-    return JointLimits(fr3.lower, fr3.upper, fr3.velocity, fr3.acceleration, fr3.jerk)
-
-
-FR3 = _fr3_limits()
+_FR3_FCI = FCI_LIMITS["fr3"]
+FR3 = JointLimits(
+    _FR3_FCI.lower, _FR3_FCI.upper, _FR3_FCI.velocity, _FR3_FCI.acceleration, _FR3_FCI.jerk
+)
 # The arms whose acceleration and jerk limits are assumptions (reports say so).
 ASSUMED_LIMITS = {"iiwa", "xarm6", "ur5"}
 
@@ -312,11 +309,11 @@ def _check_urdf_tree(path) -> set:
 
     path = Path(path)
     where = f"robot.urdf {shown_path(path)}"
-    head = path.read_bytes()[: 1 << 16]
-    if b"<!DOCTYPE" in head or b"<!ENTITY" in head:  # entities that expand or read other files
+    text = path.read_bytes()  # (its size checked by the caller: read once, whole)
+    if b"<!DOCTYPE" in text or b"<!ENTITY" in text:  # entities that expand or read other files
         raise ValueError(f"{where}: declares a DOCTYPE or entities, which a URDF has no use for")
     try:
-        root = ElementTree.parse(path).getroot()
+        root = ElementTree.fromstring(text)
     except ElementTree.ParseError as exc:
         raise ValueError(f"{where}: not well-formed XML ({exc})") from None
     except RecursionError:
@@ -372,6 +369,7 @@ def _check_joint(joint, where: str) -> None:
     axis = joint.find("axis")
     if axis is not None and kind != "fixed":
         values = _numbers(axis.get("xyz", "1 0 0"), where, f"{name}'s axis")
+        # (a NaN or inf component fails the comparison: no direction either)
         if len(values) != 3 or not 1e-9 < math.hypot(*values) < 1e9:
             raise ValueError(f"{where}: {name}'s axis {axis.get('xyz')!r} is no direction")
     _check_numbers(
@@ -380,13 +378,12 @@ def _check_joint(joint, where: str) -> None:
 
 
 def _numbers(text: str, where: str, what: str) -> list:
+    """The numbers of a URDF attribute's text (not yet checked finite: each caller says what
+    they must be)."""
     try:
-        values = [float(v) for v in text.split()]
+        return [float(v) for v in text.split()]
     except ValueError:
         raise ValueError(f"{where}: {what} {shown_path(text, 30)!r} is not numbers") from None
-    if not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{where}: {what} {shown_path(text, 30)!r} must be finite")
-    return values
 
 
 def _check_numbers(element, keys: tuple, where: str, what: str, nonnegative: bool = False) -> None:
@@ -398,8 +395,10 @@ def _check_numbers(element, keys: tuple, where: str, what: str, nonnegative: boo
         if text is None:
             continue
         values = _numbers(text, where, f"{what}'s {key}")
-        if len(values) != 1:
-            raise ValueError(f"{where}: {what}'s {key} {shown_path(text, 30)!r} must be one number")
+        if len(values) != 1 or not math.isfinite(values[0]):
+            raise ValueError(
+                f"{where}: {what}'s {key} {shown_path(text, 30)!r} must be one finite number"
+            )
         if nonnegative and values[0] < 0:
             raise ValueError(f"{where}: {what}'s {key} {text!r} must be >= 0")
 
@@ -467,12 +466,7 @@ def _check_origin_element(origin, where: str, what: str) -> None:
         text = origin.get(key)
         if text is None:
             continue
-        try:
-            values = [float(v) for v in text.split()]
-        except ValueError:
-            raise ValueError(
-                f"{where}: {what}'s {key} {shown_path(text, 30)} is not numbers"
-            ) from None
+        values = _numbers(text, where, f"{what}'s {key}")
         if len(values) != 3 or not all(
             math.isfinite(v) and abs(v) <= _URDF_EXTENT_M for v in values
         ):
