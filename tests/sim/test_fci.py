@@ -33,11 +33,12 @@ def test_the_tables_are_the_published_ones():
 
 def reference(q: np.ndarray, robot: str):
     """The check, sample by sample and joint by joint, as libfranka describes it: the arm at rest
-    at q[0] before the first command; at each sample the position, then the velocity (against
-    the position-based limits where the arm has them), the acceleration and the jerk."""
+    at q[0] before the first command and held at q[-1] for three after the last; at each sample
+    the position, then the velocity (against the position-based limits where the arm has them),
+    the acceleration and the jerk."""
     limits = FCI_LIMITS[robot]
     previous = [list(q[0])] * 3
-    for sample, row in enumerate(q):
+    for sample, row in enumerate(list(q) + [q[-1]] * 3):
         history = previous[-3:] + [list(row)]
         for quantity in ("position", "velocity", "acceleration", "jerk"):
             for joint in range(7):
@@ -277,3 +278,71 @@ def test_verify_says_how_long_a_motion_is_and_refuses_other_rates(tmp_path, caps
     off = np.arange(200) * 1.0015e-3
     assert main(["verify", write(tmp_path / "off.csv", off), "--robot", "panda"]) == 2
     capsys.readouterr()
+
+
+def test_a_stream_still_moving_at_its_end_is_rejected_after_its_last_command():
+    """The robot holds a finished motion's last command: joint 2 brought smoothly (well within
+    every limit) to v rad/s and the stream stopping there jumps to rest in one cycle, an
+    acceleration of -v / dt (closed form) at the first sample after the last."""
+    v, n = 0.02, 600  # 20 rad/s² at the end: over the FR3's 10 and the Panda's 7.5
+    u = np.clip(np.arange(n) * DT / 0.3, 0.0, 1.0)
+    speed = v * u**3 * (10 - 15 * u + 6 * u**2)  # a smooth rise from rest to v over 0.3 s
+    q = np.repeat(np.array([[0.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785]]), n, axis=0)
+    q[:, 1] += np.concatenate([[0.0], np.cumsum(speed[1:]) * DT])
+    for robot in ("fr3", "panda"):
+        verdict = judge_commands(q, robot)
+        assert not verdict.ok and verdict.after_end and verdict.sample == n
+        assert verdict.quantity == "acceleration" and verdict.joint == 2
+        assert abs(verdict.value + v / DT) < 1e-6 * v / DT
+        assert "after the last command" in verdict.reason()
+        assert (
+            judge_commands(q[:250], robot).after_end is False
+            or not judge_commands(q[:250], robot).ok
+        )
+
+
+def test_the_contract_asks_a_franka_arms_own_fci_beside_its_limits():
+    """An FR3 joint 1 moving at 2 rad/s (within the published 2.62) towards the end of its range:
+    within the contract's constant limits, but past the FCI's position-based velocity limit
+    there, -0.30 + sqrt(2 · 6 · (2.7501 - q)) (closed form): the contract now says so. The same
+    stream on an arm without an FCI table passes."""
+    from bidmp.sim.robots import FR3, JointLimits
+    from bidmp.tasks.contract import Contract
+
+    n = 2000
+    t = np.arange(n) * DT
+    q = np.repeat(np.array([[2.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785]]), n, axis=0)
+    # a smooth rise to 2 rad/s over 0.5 s, then steady: reaches within 0.1 rad of the end
+    speed = 2.0 * np.clip(t / 0.5, 0, 1) ** 2 * (3 - 2 * np.clip(t / 0.5, 0, 1))
+    q[:, 0] = 2.0 + np.cumsum(speed) * DT
+    q = q[q[:, 0] < 2.74]
+    bound = -0.30 + np.sqrt(2 * 6.0 * (2.7501 - q[:, 0]))
+    assert np.any(np.diff(q[:, 0]) / DT > bound[1:] + 1e-3)  # the oracle: the FCI's bound passed
+    contract = Contract(1.75, 25.0, None, "mm", limits=FR3)
+    path = np.zeros((len(q), 3))
+    verdict = contract.judge(path, np.zeros(3), commands=q)
+    assert verdict.limits.reflex.startswith("joint_motion_generator_velocity_limits_violation")
+    assert not verdict.within_limits and "controller would stop the motion" in verdict.reason()
+    plain = JointLimits(FR3.lower, FR3.upper, FR3.velocity, FR3.acceleration, FR3.jerk)
+    peaks = Contract(1.75, 25.0, None, "mm", limits=plain).judge(path, np.zeros(3), commands=q)
+    assert peaks.limits.reflex == "" and peaks.limits.velocity < 1.0
+
+
+def test_the_contract_asks_the_arms_judge_only_at_its_1_khz_and_only_if_it_has_one():
+    """Commands 2 ms apart are not what the FCI takes (its tables are per 1 ms): not asked.
+    Limits without a judge of their own (any object with velocity, acceleration, jerk): judged
+    by those alone."""
+    from types import SimpleNamespace
+
+    from bidmp.sim.robots import FR3
+    from bidmp.tasks.contract import Contract
+
+    q = np.repeat(np.array([[0.0, 0.0, 0.0, -1.57, 0.0, 1.57, 0.785]]), 60, axis=0)
+    q[30:, 1] += 2e-5  # 20 rad/s² at 1 kHz: the FR3's FCI stops it
+    path = np.zeros((len(q), 3))
+    contract = Contract(1.75, 25.0, None, "mm", limits=FR3)
+    assert contract.judge(path, np.zeros(3), commands=q).limits.reflex
+    assert contract.judge(path, np.zeros(3), commands=q, dt=2e-3).limits.reflex == ""
+    plain = SimpleNamespace(velocity=FR3.velocity, acceleration=FR3.acceleration, jerk=FR3.jerk)
+    peaks = Contract(1.75, 25.0, None, "mm", limits=plain).judge(path, np.zeros(3), commands=q)
+    assert peaks.limits.reflex == "" and peaks.limits.acceleration > 1.0

@@ -59,13 +59,16 @@ class SimError(TaskRefusal):
 @dataclass(frozen=True)
 class JointLimits:
     """Joint limits of an arm, one value per joint, base to flange: position (rad), velocity
-    (rad/s), acceleration (rad/s²) and jerk (rad/s³; None: not checked)."""
+    (rad/s), acceleration (rad/s²) and jerk (rad/s³; None: not checked); ``fci``: the Franka
+    Control Interface table that judges the arm's 1 kHz commands as the robot does
+    (:data:`bidmp.sim.fci.FCI_LIMITS`: ``"panda"``, ``"fr3"``; None: not a Franka arm)."""
 
     lower: tuple
     upper: tuple
     velocity: tuple
     acceleration: tuple
     jerk: tuple | None = None
+    fci: str | None = None
 
     def __post_init__(self) -> None:
         counts = {}
@@ -85,10 +88,25 @@ class JointLimits:
             )
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
+        if self.fci is not None and (self.fci not in ("panda", "fr3") or len(self.lower) != 7):
+            raise ValueError(
+                f"JointLimits.fci must be 'panda' or 'fr3' on a 7-joint arm, got {self.fci!r:.40}"
+            )
 
     @property
     def n_joints(self) -> int:
         return len(self.lower)
+
+    def reflex(self, commands) -> str:
+        """The reflex the arm's FCI raises on joint-position ``commands`` (T, J) rad sent every
+        1 ms, in words (:func:`bidmp.sim.fci.judge_commands`), or ``""``: accepted, or not a
+        Franka arm. The motion contract asks it beside its own limits (it holds what the
+        published ones leave out: the FR3's velocity limits fall towards its ranges' ends)."""
+        if self.fci is None:
+            return ""
+        from .fci import judge_commands
+
+        return judge_commands(commands, self.fci).reason()
 
 
 @dataclass(frozen=True)
@@ -165,6 +183,8 @@ class Execution:
     motion_clock: np.ndarray | None = None
     tcp_orientation: np.ndarray | None = None  # measured TCP frame (x, y, z, w)
     commands: np.ndarray | None = None  # (n, J) rad: the joint positions commanded every SIM_STEP
+    # (start, end) s of a disturbance (a held joint): the world moved the arm then, not its commands
+    disturbed: tuple | None = None
 
     @property
     def paused(self) -> float:

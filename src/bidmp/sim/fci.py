@@ -17,7 +17,9 @@ Sources (the numbers are typed from them, and pinned by ``tests/sim/test_fci.py`
   from libfranka >= 0.10's ``rate_limiting.h``.
 
 The check, per sample of the stream (1 ms apart, the motion starting at rest where the arm
-stands, as a motion generator's first command must): each joint's position within its range
+stands, as a motion generator's first command must, and ending at rest: the robot holds a finished
+motion's last command, so a stream still moving at its end jumps to a standstill in one cycle, a
+reflex libfranka raises as surely as any other): each joint's position within its range
 (``joint_motion_generator_position_limits_violation``), its velocity (first difference) within
 its limits, on the FR3 those of its position (``..._velocity_limits_violation``), its
 acceleration (second difference) within its limit (``..._velocity_discontinuity``: the velocity
@@ -34,9 +36,28 @@ import numpy as np
 
 from .._checks import as_trajectory, check_choice, short_token
 
-__all__ = ["FCI_LIMITS", "FCILimits", "FCIVerdict", "judge_commands", "match_joint_names"]
+__all__ = [
+    "FCI_LIMITS",
+    "CartesianLimits",
+    "FCILimits",
+    "FCIVerdict",
+    "judge_cartesian",
+    "judge_commands",
+    "match_joint_names",
+]
 
 COMMAND_PERIOD_S = 1e-3  # the FCI's control cycle: a joint-position command every millisecond
+
+
+@dataclass(frozen=True)
+class CartesianLimits:
+    """The FCI's limits on a Cartesian motion generator's 1 kHz commands (the end effector's
+    pose): (velocity, acceleration, jerk) of its translation (m/s, m/s², m/s³), of its rotation
+    (rad/s, rad/s², rad/s³) and of the elbow (the redundancy angle; rad/s, rad/s², rad/s³)."""
+
+    translation: tuple
+    rotation: tuple
+    elbow: tuple
 
 
 @dataclass(frozen=True)
@@ -55,6 +76,7 @@ class FCILimits:
     deceleration: tuple | None
     joint_names: tuple
     source: str
+    cartesian: CartesianLimits | None = None
 
     def velocity_bounds(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(lowest, highest) velocity (rad/s) each joint may be commanded at positions ``q``
@@ -88,6 +110,12 @@ FCI_LIMITS = {
         deceleration=None,
         joint_names=tuple(f"panda_joint{i}" for i in range(1, 8)),
         source="Franka control parameters (Limits for Panda); libfranka 0.9 rate_limiting.h",
+        # Franka's control parameters, "Limits for Panda", Cartesian space
+        cartesian=CartesianLimits(
+            translation=(1.7, 13.0, 6500.0),
+            rotation=(2.5, 25.0, 12500.0),
+            elbow=(2.175, 10.0, 5000.0),
+        ),
     ),
     "fr3": FCILimits(
         "fr3",
@@ -99,6 +127,12 @@ FCI_LIMITS = {
         velocity_offset=(0.30, 0.20, 0.20, 0.30, 0.35, 0.35, 0.35),
         deceleration=(6.0, 2.585, 3.5, 4.0, 17.0, 5.5, 17.0),
         joint_names=tuple(f"fr3_joint{i}" for i in range(1, 8)),
+        # libfranka >= 0.10 rate_limiting.h: kMaxTranslational*, kMaxRotational*, kMaxElbow*
+        cartesian=CartesianLimits(
+            translation=(3.0, 9.0, 4500.0),
+            rotation=(2.5, 17.0, 8500.0),
+            elbow=(1.5, 10.0, 5000.0),
+        ),
         source="the FR3 URDF as served to libfranka >= 0.10 (<limit>, "
         "<position_based_velocity_limits>); libfranka >= 0.10 rate_limiting.h",
     ),
@@ -125,35 +159,49 @@ class FCIVerdict:
     sample: int = 0
     value: float = 0.0
     bound: float = 0.0
+    after_end: bool = False  # in the hold after the last command: the motion did not end at rest
+    # a Cartesian stream's breach: "translation" or "rotation" (joint is then 0); "": a joint's
+    axis: str = ""
 
     def reason(self) -> str:
         if self.ok:
             return ""
         units = {"position": "rad", "velocity": "rad/s", "acceleration": "rad/s²", "jerk": "rad/s³"}
+        if self.axis == "translation":
+            units = {"velocity": "m/s", "acceleration": "m/s²", "jerk": "m/s³"}
+        where = (
+            "after the last command (held there: the motion does not end at rest)"
+            if self.after_end
+            else f"at sample {self.sample} ({self.sample * COMMAND_PERIOD_S:.3f} s)"
+        )
+        what = f"joint {self.joint}" if not self.axis else f"the end effector's {self.axis}"
         return (
-            f"{self.reflex}: joint {self.joint} {self.quantity} {self.value:.6g} {units[self.quantity]} "
-            f"at sample {self.sample} ({self.sample * COMMAND_PERIOD_S:.3f} s) against "
-            f"{self.bound:.6g}"
+            f"{self.reflex}: {what} {self.quantity} {self.value:.6g} "
+            f"{units[self.quantity]} {where} against {self.bound:.6g}"
         )
 
 
 def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
     """The FCI's verdict on joint-position commands ``q`` (T, 7) rad, one per millisecond, the arm
-    at rest at ``q[0]`` before the first (module docstring), by ``robot``'s tables
-    (``"panda"``, ``"fr3"``)."""
+    at rest at ``q[0]`` before the first and held at ``q[-1]`` after the last (module docstring),
+    by ``robot``'s tables (``"panda"``, ``"fr3"``). A breach at sample ``T`` or later is the hold
+    after the last command: the motion did not end at rest."""
     limits = FCI_LIMITS[check_choice(robot, "robot", tuple(FCI_LIMITS))]
     q = as_trajectory(q, "q", min_points=1, allow_static=True)
     if q.shape[1] != 7:
         raise ValueError(f"q must have 7 columns (joints 1-7), got {q.shape[1]}")
-    rest = np.repeat(q[:1], 3, axis=0)  # at rest where it stands: three samples before the first
-    stream = np.vstack([rest, q])
+    # at rest where it stands: three samples before the first; held after the last for three
+    # more, as the robot holds a finished motion's last command (a motion still moving then
+    # jumps to a standstill in one cycle)
+    positions = np.vstack([q, np.repeat(q[-1:], _HELD_AFTER, axis=0)])
+    stream = np.vstack([np.repeat(q[:1], 3, axis=0), positions])
     velocity = np.diff(stream, axis=0) / COMMAND_PERIOD_S
     acceleration = np.diff(velocity, axis=0) / COMMAND_PERIOD_S
     jerk = np.diff(acceleration, axis=0) / COMMAND_PERIOD_S
-    # sample i of q: its position, and the differences that end at it
+    # sample i of the positions: its position, and the differences that end at it
     velocity, acceleration = velocity[2:], acceleration[1:]
-    lowest, highest = limits.velocity_bounds(q)
-    out_of_range = (q < np.asarray(limits.lower)) | (q > np.asarray(limits.upper))
+    lowest, highest = limits.velocity_bounds(positions)
+    out_of_range = (positions < np.asarray(limits.lower)) | (positions > np.asarray(limits.upper))
     too_fast = (velocity < lowest) | (velocity > highest)
     velocity_jump = np.abs(acceleration) > np.asarray(limits.acceleration)
     acceleration_jump = np.abs(jerk) > np.asarray(limits.jerk)
@@ -171,12 +219,95 @@ def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
     if first is None:
         return FCIVerdict(True)
     quantity, row = first
-    values = {"position": q, "velocity": velocity, "acceleration": acceleration, "jerk": jerk}
+    values = {
+        "position": positions,
+        "velocity": velocity,
+        "acceleration": acceleration,
+        "jerk": jerk,
+    }
     joint = int(np.flatnonzero(over[quantity][row])[0])
     value = float(values[quantity][row, joint])
     bound = _bound(limits, quantity, value, joint, lowest[row], highest[row])
     reflex = dict(_REFLEXES)[quantity]
-    return FCIVerdict(False, reflex, quantity, joint + 1, row, value, bound)
+    return FCIVerdict(False, reflex, quantity, joint + 1, row, value, bound, row >= q.shape[0])
+
+
+_HELD_AFTER = 3  # samples the arm is judged held at the last command after the motion
+
+
+_CARTESIAN_REFLEXES = (
+    ("velocity", "cartesian_motion_generator_velocity_limits_violation"),
+    ("acceleration", "cartesian_motion_generator_velocity_discontinuity"),
+    ("jerk", "cartesian_motion_generator_acceleration_discontinuity"),
+)
+
+
+def judge_cartesian(positions, quaternions=None, robot: str = "fr3") -> FCIVerdict:
+    """The FCI's verdict on a Cartesian pose motion generator's commands: end-effector positions
+    ``positions`` (T, 3) in metres and, optionally, orientations ``quaternions`` (T, 4; x, y, z,
+    w), one per millisecond, at rest before the first and held after the last as for joints
+    (:func:`judge_commands`). The translation's speed, acceleration and jerk (norms of the first,
+    second and third differences) and the rotation's (of the rotation vectors between
+    consecutive orientations, and their differences) against ``robot``'s Cartesian limits. The
+    first sample that breaks one is the verdict; at one sample translation before rotation."""
+    from scipy.spatial.transform import Rotation
+
+    limits = FCI_LIMITS[check_choice(robot, "robot", tuple(FCI_LIMITS))].cartesian
+    positions = as_trajectory(positions, "positions", min_points=1, allow_static=True)
+    if positions.shape[1] != 3:
+        raise ValueError(f"positions must have 3 columns (x, y, z in m), got {positions.shape[1]}")
+    padded = np.vstack(
+        [
+            np.repeat(positions[:1], 3, axis=0),
+            positions,
+            np.repeat(positions[-1:], _HELD_AFTER, axis=0),
+        ]
+    )
+    rates = {"translation": np.diff(padded, axis=0) / COMMAND_PERIOD_S}
+    if quaternions is not None:
+        quaternions = as_trajectory(quaternions, "quaternions", min_points=1, allow_static=True)
+        if quaternions.shape != (positions.shape[0], 4):
+            raise ValueError(
+                f"quaternions must be (T, 4) like positions' T = {positions.shape[0]}, got "
+                f"{quaternions.shape}"
+            )
+        turned = Rotation.from_quat(
+            np.vstack(
+                [
+                    np.repeat(quaternions[:1], 3, axis=0),
+                    quaternions,
+                    np.repeat(quaternions[-1:], _HELD_AFTER, axis=0),
+                ]
+            )
+        )
+        # the turn between consecutive commands, in the base frame, per second
+        rates["rotation"] = (turned[1:] * turned[:-1].inv()).as_rotvec() / COMMAND_PERIOD_S
+    first = None
+    for axis, velocity in rates.items():
+        acceleration = np.diff(velocity, axis=0) / COMMAND_PERIOD_S
+        jerk = np.diff(acceleration, axis=0) / COMMAND_PERIOD_S
+        # sample i: the differences that end at it (as judge_commands)
+        values = {
+            "velocity": np.linalg.norm(velocity[2:], axis=1),
+            "acceleration": np.linalg.norm(acceleration[1:], axis=1),
+            "jerk": np.linalg.norm(jerk, axis=1),
+        }
+        bounds = dict(zip(("velocity", "acceleration", "jerk"), getattr(limits, axis)))
+        for quantity, reflex in _CARTESIAN_REFLEXES:
+            rows = np.flatnonzero(values[quantity] > bounds[quantity])
+            if rows.size and (first is None or rows[0] < first.sample):
+                first = FCIVerdict(
+                    False,
+                    reflex,
+                    quantity,
+                    0,
+                    int(rows[0]),
+                    float(values[quantity][rows[0]]),
+                    bounds[quantity],
+                    int(rows[0]) >= positions.shape[0],
+                    axis,
+                )
+    return first or FCIVerdict(True)
 
 
 def _bound(limits: FCILimits, quantity: str, value: float, joint: int, lowest, highest) -> float:

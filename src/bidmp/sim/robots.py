@@ -54,6 +54,7 @@ PANDA = JointLimits(
     velocity=(2.1750, 2.1750, 2.1750, 2.1750, 2.6100, 2.6100, 2.6100),
     acceleration=(15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
     jerk=(7500.0, 3750.0, 5000.0, 6250.0, 7500.0, 10000.0, 10000.0),  # Franka's datasheet, rad/s³
+    fci="panda",
 )
 
 _EFFORT = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0]  # N m
@@ -101,7 +102,12 @@ UR5 = JointLimits(
 # velocity limits also fall towards each stop: the FCI's own judge, bidmp.sim.fci, checks those.)
 _FR3_FCI = FCI_LIMITS["fr3"]
 FR3 = JointLimits(
-    _FR3_FCI.lower, _FR3_FCI.upper, _FR3_FCI.velocity, _FR3_FCI.acceleration, _FR3_FCI.jerk
+    _FR3_FCI.lower,
+    _FR3_FCI.upper,
+    _FR3_FCI.velocity,
+    _FR3_FCI.acceleration,
+    _FR3_FCI.jerk,
+    fci="fr3",
 )
 # The arms whose acceleration and jerk limits are assumptions (reports say so).
 ASSUMED_LIMITS = {"iiwa", "xarm6", "ur5"}

@@ -15,7 +15,9 @@ A motion meets the contract when
 * **aligned** (pose scenarios): the tool's axis within the alignment threshold of the target's over
   the final approach;
 * **within the limits** (where joint commands exist): every 1 kHz joint command within the arm's
-  velocity, acceleration and jerk limits, from rest to rest (:func:`command_peaks`).
+  velocity, acceleration and jerk limits, from rest to rest (:func:`command_peaks`), and, where
+  the limits carry the arm's own judge (``limits.reflex(commands)``: a Franka arm's FCI tables),
+  raising no reflex there.
 
 Every default is defined in millimetres and converted to the scenario's unit (:func:`mm`), so the
 same cell gives the same verdicts in m, cm and mm.
@@ -24,7 +26,7 @@ same cell gives the same verdicts in m, cm and mm.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -64,6 +66,7 @@ PADDING = 3  # samples of rest before and after the commands when they are check
 # cubic starts at its full 6A/T², up to 45 % of the limit on the simulated nut task).
 AT_REST = 0.05
 _SLACK = 1e-9  # a peak equal to its limit to rounding is within it
+_CONTROLLER_PERIOD_S = 1e-3  # the rate a robot controller's own judge (limits.reflex) takes
 
 
 # ---------------------------------------------------------------------------------------------
@@ -80,11 +83,14 @@ class CommandPeaks:
     jerk: float
     ends: float = 0.0
     joint: int | None = None  # 0-based joint of the worst of the three peaks
+    # the reflex the arm's own controller raises on the commands (a Franka arm's FCI), in words
+    reflex: str = ""
 
     @property
     def within(self) -> bool:
         return (
-            self.velocity <= 1.0 + _SLACK
+            not self.reflex
+            and self.velocity <= 1.0 + _SLACK
             and self.acceleration <= 1.0 + _SLACK
             and self.jerk <= 1.0 + _SLACK
             and self.ends <= AT_REST
@@ -94,6 +100,8 @@ class CommandPeaks:
         """What breaks the limits, in words (empty when nothing does)."""
         if self.within:
             return ""
+        if self.reflex:
+            return f"the arm's controller would stop the motion: {self.reflex}"
         joint = "" if self.joint is None else f"joint {self.joint + 1}'s "
         over = [
             f"{name} {value:.2f}"
@@ -501,6 +509,11 @@ class Contract:
         peaks = None
         if commands is not None and self.limits is not None:
             peaks = command_peaks(commands, self.limits, dt)
+            # the arm's own controller too, where the limits carry its judge (a Franka arm's
+            # FCI) and the commands come at its 1 kHz
+            reflex = getattr(self.limits, "reflex", None)
+            if reflex is not None and dt == _CONTROLLER_PERIOD_S:
+                peaks = replace(peaks, reflex=reflex(commands))
         return Verdict(
             label,
             end,
