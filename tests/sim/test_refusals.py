@@ -108,6 +108,8 @@ def test_a_pose_target_is_measured_at_its_position():
     expected = float(np.linalg.norm(rollout[-1, :3] - tilted.targets["3"][:3]))
     measured = result.methods["bidmp"].targets["3"]
     assert measured.ran and measured.measured_error == pytest.approx(expected, abs=1e-6)
+    # its alignment judged on the measured tool frames (a pose scenario hands them on)
+    assert measured.aligned is True and measured.axis_deviation is not None
 
 
 def test_a_moved_part_is_judged_where_it_moved_and_the_simulated_time_is_what_ran():

@@ -11,9 +11,13 @@ What the Panda's interface (libfranka) checks, and so what counts here:
   after (a jump in velocity or acceleration there shows in the differences), and the
   acceleration of the first and the last command must be at most :data:`AT_REST` of the limit.
 
-The measured joints (the simulator's state) are reported with the estimator stated: differences
-over 10 ms windows of the recorded joint velocities, the way a robot's own filtered state would
-show them; they are reported, not counted (a contact or a held joint moves them, not the command).
+The measured joints (the simulator's state) are judged too, as the robot's safety controller
+judges the arm itself (:func:`_measured_breach`): their velocity within the limits (plus
+0.1 rad/s for the estimate's noise, franka-sim's allowance: libfranka's
+``joint_velocity_violation``) all the time, and their acceleration — differences over 10 ms
+windows of the recorded joint velocities, the way a robot's own filtered state shows it —
+within the limits outside a disturbance (a held joint stops at once: the world's doing, not the
+arm's). Their peaks are reported beside the commands'.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from .backend import SIM_STEP, JointLimits
 __all__ = ["PADDING", "AT_REST"]
 
 _WINDOW = 0.01  # s: the measured joints' estimator (differences over 10 ms windows)
+MEASURED_VELOCITY_NOISE = 0.1  # rad/s over the velocity limit before a measured velocity counts
 
 
 def _worst(values: np.ndarray, limit) -> float:
@@ -58,6 +63,41 @@ def _measured_peaks(
         _worst(acceleration, limits.acceleration),
         _worst(jerk, limits.jerk),
     )
+
+
+def _measured_breach(
+    velocities: np.ndarray,
+    record_step: float,
+    limits: JointLimits,
+    disturbed: tuple[float, float] | None = None,
+) -> str:
+    """The first breach of the measured joints (module docstring), or ``""``: ``velocities``
+    (n, J) rad/s recorded every ``record_step`` s from the run's start; ``disturbed``: the
+    (start, end) seconds of a disturbance, where the accelerations are not the arm's own."""
+    velocities = np.asarray(velocities, dtype=float)
+    over = np.abs(velocities) > np.asarray(limits.velocity, dtype=float) + MEASURED_VELOCITY_NOISE
+    if over.any():
+        row, joint = np.argwhere(over)[0]
+        return (
+            f"joint_velocity_violation: the measured joint {joint + 1} moved at "
+            f"{velocities[row, joint]:.3g} rad/s at {row * record_step:.3f} s (limit "
+            f"{limits.velocity[joint]:g})"
+        )
+    window = max(int(round(_WINDOW / record_step)), 1)
+    step = window * record_step
+    acceleration = np.diff(velocities[::window], axis=0) / step
+    ends = np.arange(1, acceleration.shape[0] + 1) * step  # each difference spans (end - step, end]
+    counted = np.ones(ends.shape, dtype=bool)
+    if disturbed is not None:  # differences that end before it, or begin once it is over
+        counted = (ends < disturbed[0]) | (ends - step >= disturbed[1])
+    over = (np.abs(acceleration) > np.asarray(limits.acceleration, dtype=float)) & counted[:, None]
+    if over.any():
+        row, joint = np.argwhere(over)[0]
+        return (
+            f"the measured joint {joint + 1} accelerated at {acceleration[row, joint]:.3g} rad/s² "
+            f"at {ends[row]:.3f} s (limit {limits.acceleration[joint]:g}; 10 ms differences)"
+        )
+    return ""
 
 
 class _RateLimiter:

@@ -16,7 +16,7 @@ from ..io.strict_json import json_number
 from ..tasks._tables import markdown_table, text_table
 from ..tasks.contract import CommandPeaks
 from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, MotionPlan
-from .limits import _measured_peaks
+from .limits import _measured_breach, _measured_peaks
 from .robots import PANDA
 
 __all__ = ["SimTarget", "SimMethod", "SimReport", "write_sim_report"]
@@ -41,7 +41,9 @@ class SimTarget:
     measured_peak_acceleration: float  # (over 10 ms windows)
     motion_time: float
     tracking_error: float  # largest distance between the commanded and the measured TCP
-    within_limits: bool  # every 1 kHz command within the velocity, acceleration and jerk limits, from rest to rest
+    # every 1 kHz command within the velocity, acceleration and jerk limits, from rest to rest,
+    # and the measured joints within theirs (measured_breach empty)
+    within_limits: bool
     peak_jerk: float = 0.0
     measured_peak_jerk: float = 0.0
     # the command's depth into a part, from the scene geometry
@@ -56,8 +58,13 @@ class SimTarget:
     error: str = ""
     # simulate(record=True): the measured tool path (n, 3), scene units, 500 Hz
     path: np.ndarray | None = None
-    # ... and the joint commands (m, J) rad the arm was sent every 1 ms
+    # ... and the joint commands (m, J) rad the arm was sent every 1 ms, and the measured joint
+    # velocities (n, J) rad/s at 500 Hz
     commands: np.ndarray | None = None
+    joint_velocities: np.ndarray | None = None
+    # the measured joints' first breach of the limits, as the robot's safety controller sees the
+    # arm itself (bidmp.sim.limits._measured_breach); empty: within them
+    measured_breach: str = ""
 
     @classmethod
     def not_run(cls, label: str, error: str) -> SimTarget:
@@ -88,25 +95,20 @@ class SimTarget:
     def task_success(self, threshold: float) -> bool:
         """The motion contract on what the arm did (:mod:`bidmp.tasks.contract`): the measured end,
         the measured final descent, the executed tool's clearance by the margin and no contact, the
-        1 kHz commands within the limits."""
-        if self.error:
+        1 kHz commands within the limits (and the arm's own controller's); and the measured joints
+        within theirs. A target never judged (no verdict) is no success. ``threshold``: the
+        scenario's, which the verdict already holds (kept for the callers' symmetry with the
+        evaluation's results)."""
+        if self.error or self.measured_breach or self.verdict is None:
             return False
-        if self.verdict is not None:
-            return self.verdict.ok
-        return bool(
-            self.measured_error <= threshold
-            and self.engaged is not False
-            and not self.contacts
-            and not self.commanded_penetration
-            and self.within_limits
-            and self.aligned is not False
-        )
+        return bool(self.verdict.ok)
 
     @property
     def reason(self) -> str:
         if self.error:
             return self.error
-        return "" if self.verdict is None else self.verdict.reason()
+        reasons = [] if self.verdict is None or self.verdict.ok else [self.verdict.reason()]
+        return "; ".join(reasons + ([self.measured_breach] if self.measured_breach else []))
 
     def to_dict(self, threshold: float) -> dict:
         if self.error:
@@ -130,6 +132,7 @@ class SimTarget:
             "motion_time_s": round(self.motion_time, 3),
             "tracking_error": float(self.tracking_error),
             "within_limits": self.within_limits,
+            "measured_breach": self.measured_breach,
             "task_success": self.task_success(threshold),
             "axis_deviation_deg": json_number(self.axis_deviation),
             "aligned": self.aligned,
@@ -387,23 +390,8 @@ def _measure(
     the executed motion: the measured tool path, the commands, the contacts."""
     if contract is None:
         contract = task.contract(None, limits)
-    tcp = run.tcp / unit
-    axis = task.axes.get(label)
-    pose = task.alignment_threshold is not None
-    # What counts: the commands the position control was sent every 1 ms, from rest to rest; the
-    # measured joints are reported beside them. A backend that does not report its commands: the
-    # plan's own peaks.
     contacts = {k: v / unit for k, v in run.contacts.items()}
-    verdict = contract.judge(
-        tcp,
-        target,
-        label=label,
-        axis=axis,
-        exclude=exclude,
-        orientations=run.tcp_orientation if pose else None,
-        commands=run.commands,
-        contacts=contacts,
-    )
+    verdict, breach = _judged(task, label, target, run, unit, limits, contract, exclude)
     sent = verdict.limits or CommandPeaks(
         plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk
     )
@@ -424,12 +412,33 @@ def _measure(
         measured_peak_jerk=measured.jerk,
         motion_time=motion_time,
         tracking_error=float(np.max(np.linalg.norm(run.tcp - run.commanded_tcp, axis=1)) / unit),
-        within_limits=sent.within,
+        within_limits=sent.within and not breach,
+        measured_breach=breach,
         paused=run.paused,
         axis_deviation=verdict.axis_deviation,
         aligned=verdict.aligned,
         verdict=verdict,
     )
+
+
+def _judged(task: _SimTask, label, target, run: Execution, unit, limits, contract, exclude):
+    """(the contract's verdict, the measured joints' breach) on one execution: the verdict on the
+    measured tool path (scene units), its orientations in a pose scenario, the 1 kHz commands
+    the position control was sent (the arm's own controller asked too, where the limits carry
+    it) and the contacts; the breach on the measured joint velocities outside the run's
+    disturbance (``""``: within)."""
+    verdict = contract.judge(
+        run.tcp / unit,
+        target,
+        label=label,
+        axis=task.axes.get(label),
+        exclude=exclude,
+        orientations=run.tcp_orientation if task.alignment_threshold is not None else None,
+        commands=run.commands,
+        contacts={k: v / unit for k, v in run.contacts.items()},
+    )
+    breach = _measured_breach(run.joint_velocities, SIM_STEP * RECORD_EVERY, limits, run.disturbed)
+    return verdict, breach
 
 
 # ---------------------------------------------------------------------------------------------

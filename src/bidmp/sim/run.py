@@ -148,6 +148,7 @@ def _run_one(setup: _SimSetup, cell, contract, job):
     measured.commanded_penetration = _commanded_penetration(cell, run, job)
     if job.record:
         measured.path, measured.commands = run.tcp / cell.unit, np.asarray(run.commands)
+        measured.joint_velocities = np.asarray(run.joint_velocities)
     motion = _arm_motion(cell, run) if job.view else None
     return job.method, job.label, measured, run.frames, float(run.times[-1]), motion
 

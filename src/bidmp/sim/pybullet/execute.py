@@ -100,9 +100,8 @@ def _execute(
         for step in range(n_steps):
             t = step * SIM_STEP
             q, qd = position_list[step], velocity_list[step]
-            if hold is not None and hold.start <= t < hold.start + hold.duration:
-                if held is None:
-                    held = p.getJointState(robot, arm[hold.joint], physicsClientId=client)[0]
+            if _holding(hold, t):
+                held = _held_angle(cell, hold, t, held)
                 q, qd = list(q), list(qd)
                 q[hold.joint], qd[hold.joint] = held, 0.0
             motors(
@@ -130,6 +129,7 @@ def _execute(
     run = record.finish()
     # what the position control was sent, every 1 ms (a hold is the world's doing)
     run.commands = positions
+    run.disturbed = _disturbed(hold)
     return run
 
 
@@ -171,6 +171,11 @@ def _execute_closed_loop(
     target_rate = previous_rate = np.zeros_like(q)
     times, targets, clock, sent = [], [], [], []
     limited = _RateLimiter(q, cell.limits, LIMIT_MARGIN)
+    # With a hold, what the arm would have been sent had nothing held it: the phase stopping
+    # compares the measured tool with it (with the commands themselves, brought to rest where
+    # the joint is held, the arm would seem to follow and the motion would run on)
+    unheld = _RateLimiter(q, cell.limits, LIMIT_MARGIN) if hold is not None else None
+    planned = [] if hold is not None else sent
     step = 0
     try:
         for step in range(n_steps):
@@ -183,7 +188,7 @@ def _execute_closed_loop(
                     settle_from is None
                 ):  # (settling: the limiter brings the joints to rest at the last IK target)
                     moved = moved or _perceive(cell, stepper, goal_update, exclude)
-                    y, yd, _ = stepper.step(CONTROL_STEP, _tracked(cell, stepper, sent))
+                    y, yd, _ = stepper.step(CONTROL_STEP, _tracked(cell, stepper, planned))
                     point = np.asarray(y) * cell.unit
                     target, _ = cell.solve_ik(point, target)
                     target_rate = _joint_velocity(cell, target, point, np.asarray(yd) * cell.unit)
@@ -196,12 +201,21 @@ def _execute_closed_loop(
                     settle_from = step
             share = (step % every + 1) / every
             # The cubic between the 100 Hz targets, then the 1 kHz limiter: jerk-limited commands.
-            command = limited(
-                *_hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP)
-            )
+            wanted = _hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP)
+            if unheld is not None:
+                planned.append(unheld(*wanted))
+            held = _held_angle(cell, hold, t, held)
+            if _holding(hold, t):  # the generator, told the joint is held, brings its command
+                # to rest where it is held and resumes from there: the arm's own motion stays
+                # within the limits across the hold (a command run on meanwhile would yank the
+                # joint at the release)
+                for value, at in zip(wanted, (held, 0.0, 0.0)):
+                    value[hold.joint] = at
+            command = limited(*wanted)
             sent.append(command)
             q, qd = command.tolist(), limited.velocity.tolist()
-            held = _apply_hold(cell, hold, t, q, qd, held)
+            if _holding(hold, t):  # held: the joint stays where it is, whatever it is sent
+                q[hold.joint], qd[hold.joint] = held, 0.0
             _drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
             record.sample(step, t + SIM_STEP, command, contacts=True, every_step=True)
@@ -216,7 +230,12 @@ def _execute_closed_loop(
         np.array(clock),
     )
     run.commands = np.array(sent)
+    run.disturbed = _disturbed(hold)
     return run
+
+
+def _disturbed(hold: Hold | None) -> tuple | None:
+    return None if hold is None else (hold.start, hold.start + hold.duration)
 
 
 def _tracked(cell, stepper, sent: list) -> np.ndarray:
@@ -259,17 +278,18 @@ def _move_parts(cell, labels, offset_m: np.ndarray) -> bool:
     return True
 
 
-def _apply_hold(
-    cell, hold: Hold | None, t: float, q: list, qd: list, held: float | None
-) -> float | None:
-    """During the hold, pin its joint in ``q``/``qd`` (in place) where it was when the hold began;
-    return that angle (None before the hold)."""
-    if hold is not None and hold.start <= t < hold.start + hold.duration:
-        if held is None:
-            held = cell.p.getJointState(
-                cell.robot, cell.arm[hold.joint], physicsClientId=cell.client
-            )[0]
-        q[hold.joint], qd[hold.joint] = held, 0.0
+def _holding(hold: Hold | None, t: float) -> bool:
+    """Whether ``hold`` holds its joint at ``t`` (s of the run)."""
+    return hold is not None and hold.start <= t < hold.start + hold.duration
+
+
+def _held_angle(cell, hold: Hold | None, t: float, held: float | None) -> float | None:
+    """The angle (rad) the hold keeps its joint at: where the joint was when the hold began
+    (None before it)."""
+    if held is None and _holding(hold, t):
+        held = cell.p.getJointState(cell.robot, cell.arm[hold.joint], physicsClientId=cell.client)[
+            0
+        ]
     return held
 
 
