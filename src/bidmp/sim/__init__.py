@@ -9,6 +9,8 @@
 * ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
 * ``fci`` — the Franka Control Interface's own limits (Panda, FR3) judging 1 kHz joint commands;
+* ``libfranka`` — the same commands streamed through libfranka to franka-sim, a simulated FR3 (a
+  side environment of their own, ``make franka``; ``_franka_side.py`` is what runs there);
 * ``report`` — the results, apart from any backend, and their files.
 
 Layer 3 (the application): imports the math, ``io`` and ``tasks``; never ``cli``. PyBullet is an
@@ -37,7 +39,15 @@ if TYPE_CHECKING:
         register_backend,
         require_simulator,
     )
-    from .fci import FCI_LIMITS, FCILimits, FCIVerdict, judge_commands, match_joint_names
+    from .fci import (
+        FCI_LIMITS,
+        CartesianLimits,
+        FCILimits,
+        FCIVerdict,
+        judge_cartesian,
+        judge_commands,
+        match_joint_names,
+    )
     from .job import JobInternalError, job_targets, run_job
     from .job_report import (
         JobPhase,
@@ -50,6 +60,12 @@ if TYPE_CHECKING:
     )
     from .kinematic import KinematicCell
     from .kinematics import inverse_kinematics, joint_names
+    from .libfranka import (
+        LibfrankaOutcome,
+        SideEnvironmentError,
+        franka_side_environment,
+        stream_fr3,
+    )
     from .planning import plan_path
     from .pybullet.cell import RobotCell
     from .report import SimMethod, SimReport, SimTarget, write_sim_report
