@@ -81,6 +81,8 @@ def lasa_demo(shape: str, out) -> int:
 
 
 def _cmd_benchmark(args: argparse.Namespace) -> int:
+    if args.benchmark_command == "clfd":
+        return _cmd_clfd(args)
     from pathlib import Path
 
     from tqdm import tqdm
@@ -119,6 +121,25 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     )
     print((Path(args.out) / "lasa.md").read_text())
     print(f"wrote {', '.join(str(path) for path in result.written)}")
+    return EXIT_OK
+
+
+def _cmd_clfd(args: argparse.Namespace) -> int:
+    from ..experiments.clfd import METHODS, run_clfd, write_clfd
+
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown or not methods:
+        raise ValueError(
+            f"--methods: unknown method {unknown[0] if unknown else '(none given)'!r:.40} "
+            f"(known: {', '.join(METHODS)})"
+        )
+    if args.tasks is not None and not 1 <= args.tasks <= 26:
+        raise ValueError(f"--tasks must be 1-26, got {args.tasks}")
+    result = run_clfd(args.dataset, methods, n_tasks=args.tasks)
+    written = write_clfd(result, args.out)
+    print(result.markdown())
+    print(f"wrote {', '.join(str(path) for path in written)}")
     return EXIT_OK
 
 
@@ -173,7 +194,7 @@ def _benchmark_parser(commands) -> None:
         "--scheduler ADDRESS. Needs bidmp[benchmark].",
     )
     bench_commands = benchmark.add_subparsers(
-        dest="benchmark_command", metavar="{lasa}", required=True, parser_class=Parser
+        dest="benchmark_command", metavar="{lasa,clfd}", required=True, parser_class=Parser
     )
     bench = bench_commands.add_parser("lasa", help="the LASA handwriting benchmark")
     bench.add_argument("--shapes", default=None, help="comma-separated shapes (default all 30)")
@@ -218,6 +239,25 @@ def _benchmark_parser(commands) -> None:
         help="results table format (default parquet)",
     )
     bench.add_argument("--out", default="bidmp-lasa", help="output folder (default ./bidmp-lasa)")
+    clfd = bench_commands.add_parser(
+        "clfd",
+        help="continual learning from demonstration: the CLFD protocol (Auddy et al.)",
+        description="Learn the tasks one after the other (LASA: 26 shapes, 7 demonstrations "
+        "each) and after each evaluate every task seen, reproduced from each demonstration's "
+        "start: DTW, Fréchet and swept-area errors, the accuracy matrices, ACC, BWT, REM, MS, TE, "
+        "FS, CL_score and CL_stability as the protocol defines them. Writes clfd.json and "
+        "clfd.md.",
+    )
+    clfd.add_argument("--dataset", choices=("lasa",), default="lasa", help="the tasks (lasa)")
+    clfd.add_argument(
+        "--methods",
+        default="dmp-library,bidmp-continual",
+        help="comma-separated methods (default dmp-library,bidmp-continual)",
+    )
+    clfd.add_argument(
+        "--tasks", type=int, default=None, help="only the first N tasks (default all)"
+    )
+    clfd.add_argument("--out", default="bidmp-clfd", help="output folder (default ./bidmp-clfd)")
     benchmark.set_defaults(handler=_cmd_benchmark)
 
 

@@ -1,5 +1,5 @@
-"""Experiments: the paper's tables and figures (``reproduce``: ``table4``, ``table5``, ``incremental``, ``generalisation``) and the LASA benchmark on Dask
-(``lasa``).
+"""Experiments: the paper's tables and figures (``reproduce``: ``table4``, ``table5``, ``incremental``, ``generalisation``), the LASA benchmark on Dask
+(``lasa``) and the continual-learning protocol of the field (``clfd``).
 
 Layer 3 (the application): imports the math, ``demonstrations``, ``io``, ``tasks`` and
 ``plotting``; never ``cli``.
@@ -15,6 +15,21 @@ from .._lazy import exports
 if TYPE_CHECKING:
     from .avoidance import AvoidanceCase, random_case
     from .benchmark import BenchmarkResult, check_lasa_options, lasa, summary_markdown, summary_rows
+    from .clfd import (
+        CLFD_THRESHOLDS,
+        ClfdResult,
+        ClfdRow,
+        ClfdTask,
+        ContinualBLS,
+        DMPLibrary,
+        accuracy_matrix,
+        clfd_tasks,
+        continual_metrics,
+        orientation_error,
+        run_clfd,
+        swept_error_area,
+        write_clfd,
+    )
     from .lasa_cells import CASES, LASA_METHODS, METRICS, cell_key, run_cell
     from .reproduce import (
         BATTERY_APPROACH_VIA,
