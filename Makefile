@@ -12,7 +12,7 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check franka franka-check franka-agreement clfd
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
@@ -158,6 +158,37 @@ readme: $(STAMP)
 	$(PY) tools/robot_protocol.py > /dev/null
 	$(PY) tools/readme.py
 
+# Continual learning on the field's protocol (CLFD, Auddy et al.): the 26 LASA tasks one after the
+# other, every method (about 40 s per row): docs/results/clfd.json and clfd.md.
+clfd: $(STAMP)
+	$(VENV)/bin/bidmp benchmark clfd --methods dmp-library,bidmp-continual --out docs/results
+
+# The libfranka side environment: franka-sim (an FCI server simulating an FR3 in MuJoCo, motion
+# limits enforced) and pylibfranka (the Franka client) at their pins in their own venv (they need
+# NumPy 1.26), and an FR3 model built offline from the URDF franka-sim ships. 'bidmp verify
+# --libfranka' finds it here (or by $$BIDMP_FRANKA_VENV) and starts and stops the server itself.
+FRANKA_VENV  ?= .venv-franka
+FRANKA_MODEL := $(FRANKA_VENV)/fr3_meshless.xml
+
+$(FRANKA_MODEL): requirements-franka.txt src/bidmp/sim/_franka_side.py
+	$(PYTHON) -m venv $(FRANKA_VENV)
+	$(FRANKA_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(FRANKA_VENV)/bin/python -m pip install --quiet -r requirements-franka.txt
+	$(FRANKA_VENV)/bin/python src/bidmp/sim/_franka_side.py build-model $(FRANKA_MODEL)
+
+franka: $(FRANKA_MODEL) $(STAMP)
+	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(VENV)/bin/bidmp verify --libfranka tests/data/fr3_quintic.csv
+
+# CI's libfranka stage: the side environment, then a small set streamed through it (tests marked
+# libfranka: generated streams with planted breaches, the job's motions on the FR3), under 2 min.
+franka-check: $(FRANKA_MODEL) $(STAMP)
+	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) -m pytest -q -p no:cacheprovider -m libfranka tests/sim/test_libfranka.py
+	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --streams 7 > /dev/null
+
+# bidmp's FCI judge against libfranka on 240 generated streams (about 15 min): docs/results/libfranka.md.
+franka-agreement: $(FRANKA_MODEL) $(STAMP)
+	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --out docs/results
+
 clean:
-	rm -rf $(VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
+	rm -rf $(VENV) $(FRANKA_VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
 	rm -f src/bidmp/_kernels.c src/bidmp/_kernels.*.so

@@ -82,6 +82,31 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.robot_placement": {"scenario": scenario},
         "bidmp.sim.robot_model": {"spec": {"model": "xarm6"}},
         "bidmp.sim.judge_commands": {"q": _fr3_stream(), "robot": "fr3"},
+        "bidmp.experiments.swept_error_area": {
+            "trajectory": np.eye(3)[:, :2],
+            "reference": np.eye(3)[:, :2] + 1,
+        },
+        "bidmp.experiments.ContinualBLS": {"n_kernels": 20, "n_nodes": 8, "capacity": 3},
+        "bidmp.experiments.orientation_error": {
+            "true": np.tile([1.0, 0.0, 0.0, 0.0], (5, 1)),
+            "predicted": np.tile([0.0, 1.0, 0.0, 0.0], (5, 1)),
+        },
+        "bidmp.experiments.accuracy_matrix": {
+            "errors": [[np.array([1.0, 3.0])]],
+            "threshold": 2.0,
+        },
+        "bidmp.experiments.continual_metrics": {
+            "matrix": np.ones((2, 2)),
+            "sizes": [1, 2],
+            "times": [1.0, 1.0],
+        },
+        "bidmp.experiments.clfd_tasks": {"dataset": "lasa"},
+        "bidmp.experiments.DMPLibrary": {"n_kernels": 20},
+        "bidmp.sim.judge_cartesian": {
+            "positions": np.linspace([0.4, 0.0, 0.5], [0.41, 0.0, 0.5], 50),
+            "quaternions": np.tile([0.0, 0.0, 0.0, 1.0], (50, 1)),
+            "robot": "fr3",
+        },
         "bidmp.sim.match_joint_names": {
             "names": [f"fr3_joint{i}" for i in range(1, 8)],
             "robot": "fr3",

@@ -111,16 +111,34 @@ TARGETS = (
         (
             "FCILimits.velocity_bounds",
             "judge_commands",
+            "judge_cartesian",
             "_bound",
             "match_joint_names",
         ),
-        ("tests/sim/test_fci.py",),
+        ("tests/sim/test_fci.py", "tests/sim/test_fci_cartesian.py"),
+    ),
+    Target(
+        "the contract asks the arm's FCI",
+        "bidmp.sim.backend",
+        ("JointLimits.reflex", "JointLimits.__post_init__"),
+        ("tests/sim/test_fci.py", "tests/sim/test_joint_limits_fci.py"),
+    ),
+    Target(
+        "verdict assembly: a simulated target (commands and measured joints)",
+        "bidmp.sim.report",
+        ("SimTarget.task_success", "SimTarget.reason", "_judged"),
+        (
+            "tests/sim/test_sim_limits_measured.py",
+            "tests/sim/test_refusals.py::test_a_pose_target_is_measured_at_its_position",
+            "tests/sim/test_sim.py::test_closed_loop_pauses_for_a_held_joint_and_still_engages",
+            "tests/test_oracles.py",
+        ),
     ),
     Target(
         "verify's exit status",
         "bidmp.cli.verify",
-        ("_cmd_verify", "_verdict"),
-        ("tests/sim/test_fci.py",),
+        ("_cmd_verify", "_verdict", "_through_libfranka"),
+        ("tests/sim/test_fci.py", "tests/sim/test_libfranka.py"),
     ),
     Target(
         "limit checks and measurement",
@@ -135,13 +153,22 @@ TARGETS = (
             "Verdict.ok",
             "Verdict.failed",
         ),
-        ("tests/test_oracles.py", "tests/tasks/test_contract.py", "tests/sim/test_sim_limits.py"),
+        (
+            "tests/test_oracles.py",
+            "tests/tasks/test_contract.py",
+            "tests/sim/test_sim_limits.py",
+            "tests/sim/test_fci.py",
+        ),
     ),
     Target(
         "simulator: measured peaks and the 1 kHz command generator",
         "bidmp.sim.limits",
-        ("_worst", "_measured_peaks", "_RateLimiter.__call__"),
-        ("tests/test_oracles.py", "tests/sim/test_sim_limits.py"),
+        ("_worst", "_measured_peaks", "_measured_breach", "_RateLimiter.__call__"),
+        (
+            "tests/test_oracles.py",
+            "tests/sim/test_sim_limits.py",
+            "tests/sim/test_sim_limits_measured.py",
+        ),
     ),
     Target(
         "rhythmic limits",
@@ -176,6 +203,7 @@ TARGETS = (
         ("Contract.judge",),
         (
             "tests/tasks/test_verdict_assembly.py",
+            "tests/sim/test_fci.py",
             "tests/test_oracles.py",
             "tests/tasks/test_contract.py",
             "tests/tasks/test_engagement.py",
@@ -523,6 +551,18 @@ KNOWN_CLEARANCE = (
     "verdict.clearance if motion is out.motion and how == 'lift' else None)"
 )
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    # -- the measured joints: a measured velocity or a 10 ms acceleration equal to its bound to the
+    # last bit is not a motion the simulator produces
+    **{
+        ("bidmp.sim.limits", "_measured_breach", line, "> -> >="): "differs only where a "
+        "measured value equals its bound to the last bit"
+        for line in (
+            "over = np.abs(velocities) > np.asarray(limits.velocity, dtype=float) + "
+            "MEASURED_VELOCITY_NOISE",
+            "over = (np.abs(acceleration) > np.asarray(limits.acceleration, dtype=float)) & "
+            "counted[:, None]",
+        )
+    },
     # -- the FCI judge: a difference of 1 kHz commands equal to a limit to its last bit (the
     # comparisons' edges) is not a motion anyone sends; a breach lies strictly beyond its bound
     **{
@@ -539,6 +579,12 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
             ("acceleration_jump = np.abs(jerk) > np.asarray(limits.jerk)", "> -> >="),
         )
     },
+    (
+        "bidmp.sim.fci",
+        "judge_cartesian",
+        "rows = np.flatnonzero(values[quantity] > bounds[quantity])",
+        "> -> >=",
+    ): "differs only where a Cartesian difference equals its limit to the last bit",
     **{
         ("bidmp.sim.fci", "_bound", line, "< -> <="): "called for a breach, which lies strictly "
         "beyond its bound: the value never equals the lower one"
