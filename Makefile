@@ -183,7 +183,7 @@ franka: $(FRANKA_MODEL) $(STAMP)
 # libfranka: generated streams with planted breaches, the job's motions on the FR3), under 2 min.
 franka-check: $(FRANKA_MODEL) $(STAMP)
 	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) -m pytest -q -p no:cacheprovider -m libfranka tests/sim/test_libfranka.py
-	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --streams 7 > /dev/null
+	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --streams 3 > /dev/null
 
 # bidmp's FCI judge against libfranka on 240 generated streams (about 15 min): docs/results/libfranka.md.
 franka-agreement: $(FRANKA_MODEL) $(STAMP)

@@ -88,8 +88,8 @@ def test_the_jobs_motions_on_the_fr3_raise_no_reflex_in_libfranka(tmp_path):
 @pytest.mark.libfranka
 @needs_side
 def test_the_simulators_motions_on_the_fr3_raise_no_reflex_in_libfranka():
-    """bidmp sim's motions (every method's, two targets) on the FR3: the 1 kHz commands the
-    simulated arm was sent, streamed through libfranka."""
+    """bidmp sim's motions (every method's that ran, two targets) on the FR3: the 1 kHz commands
+    the simulated arm was sent, streamed through libfranka."""
     import bidmp
     from bidmp import sim
     from bidmp.tasks import scenarios
@@ -105,9 +105,10 @@ def test_the_simulators_motions_on_the_fr3_raise_no_reflex_in_libfranka():
         target.commands
         for method in report.methods.values()
         for target in method.targets.values()
-        if target.ran
+        if target.ran  # (the plain DMP's to far nut 11 is refused by the contract: not run)
     ]
-    assert len(commands) == 4
+    assert all(target.ran for target in report.methods["bidmp"].targets.values())
+    assert len(commands) >= 3
     outcomes = libfranka.stream_fr3(commands)
     assert all(outcome.accepted for outcome in outcomes), [o.reason() for o in outcomes]
 
