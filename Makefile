@@ -159,9 +159,9 @@ readme: $(STAMP)
 	$(PY) tools/readme.py
 
 # Continual learning on the field's protocol (CLFD, Auddy et al.): the 26 LASA tasks one after the
-# other, every method (about 40 s per row): docs/results/clfd.json and clfd.md.
+# other, every method (about 40 s per row): docs/results/clfd.json, clfd.md and its figures.
 clfd: $(STAMP)
-	$(VENV)/bin/bidmp benchmark clfd --methods dmp-library,bidmp-continual --out docs/results
+	$(VENV)/bin/bidmp benchmark clfd --methods dmp-library,finetune,promp-library,bidmp-continual --out docs/results
 
 # The libfranka side environment: franka-sim (an FCI server simulating an FR3 in MuJoCo, motion
 # limits enforced) and pylibfranka (the Franka client) at their pins in their own venv (they need

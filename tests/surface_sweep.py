@@ -145,6 +145,7 @@ SKIPPED = {
     "plot_error_vs_distance",
     "plot_scenario_3d",
     "plot_lasa_benchmark",
+    "plot_clfd",
     "layers_from_report",
     "add_robot_motions",
     # scikit-learn's metadata routing and parameters, inherited and tested by scikit-learn:

@@ -87,6 +87,8 @@ def _package_overrides(tmp: Path) -> dict:
             "reference": np.eye(3)[:, :2] + 1,
         },
         "bidmp.experiments.ContinualBLS": {"n_kernels": 20, "n_nodes": 8, "capacity": 3},
+        "bidmp.experiments.FineTune": {"n_kernels": 20},
+        "bidmp.experiments.ProMPLibrary": {"n_basis": 10},
         "bidmp.experiments.orientation_error": {
             "true": np.tile([1.0, 0.0, 0.0, 0.0], (5, 1)),
             "predicted": np.tile([0.0, 1.0, 0.0, 0.0], (5, 1)),

@@ -186,3 +186,38 @@ def test_the_continual_bls_keeps_its_size_and_its_earlier_tasks():
     after = model.reproduce(0, tasks[0].positions[:, 0], t)
     extent = np.ptp(tasks[0].positions.reshape(-1, 2), axis=0).max()
     assert np.max(np.abs(after - before)) <= 1e-6 * extent
+
+
+def test_finetune_forgets_and_the_promp_library_does_not():
+    """The protocol's bounds: one DMP refitted on each task reproduces task 0 differently after
+    task 1 (its accuracy there falls), at a constant size; the ProMP library's task 0 is bit for
+    bit what it was."""
+    from bidmp.experiments.clfd import FineTune, ProMPLibrary
+
+    tasks = clfd_tasks("lasa")[:2]
+    t, starts = tasks[0].times[0], tasks[0].positions[:, 0]
+    for method, forgets in ((FineTune(), True), (ProMPLibrary(), False)):
+        method.learn(tasks[0])
+        before, size = method.reproduce(0, starts, t), method.n_parameters
+        method.learn(tasks[1])
+        after = method.reproduce(0, starts, t)
+        assert (not np.array_equal(after, before)) is forgets, method.name
+        assert (method.n_parameters == size) is forgets, method.name
+    result = run_clfd("lasa", ["finetune"], n_tasks=2)
+    assert result.rows["finetune"].metrics["dtw"]["BWT"] < 0.0
+
+
+def test_the_figures_are_written(tmp_path):
+    from matplotlib.image import imread
+
+    written = [p for p in run_and_write(tmp_path) if p.suffix == ".png"]
+    assert sorted(p.name for p in written) == ["clfd_accuracy.png", "clfd_dtw.png"]
+    for path in written:
+        pixels = imread(path)
+        assert pixels.shape[0] > 100 and pixels.shape[1] > 100 and np.ptp(pixels) > 0.5
+
+
+def run_and_write(folder):
+    from bidmp.experiments.clfd import write_clfd
+
+    return write_clfd(run_clfd("lasa", ["dmp-library", "promp-library"], n_tasks=2), folder)

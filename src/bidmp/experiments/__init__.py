@@ -22,6 +22,8 @@ if TYPE_CHECKING:
         ClfdTask,
         ContinualBLS,
         DMPLibrary,
+        FineTune,
+        ProMPLibrary,
         accuracy_matrix,
         clfd_tasks,
         continual_metrics,

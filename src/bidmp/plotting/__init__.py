@@ -1,5 +1,5 @@
 """Figures per domain (matplotlib ``Figure`` objects written to PNG files; the global backend is never
-switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``; ``_base`` holds what they
+switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``, ``benchmark``, ``clfd``; ``_base`` holds what they
 share. ``viewer`` writes the 3-D viewer (one offline HTML file, plotly: the ``view`` extra).
 
 Layer 2 (data out, beside ``io``): imports the math and ``bidmp.io``; never ``tasks``, ``sim`` or
@@ -15,6 +15,7 @@ from .._lazy import exports
 # The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
 if TYPE_CHECKING:
     from .benchmark import plot_lasa_benchmark
+    from .clfd import plot_clfd
     from .extension import plot_extension, plot_prm_comparison, plot_segmentation
     from .incremental import plot_incremental
     from .tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view
