@@ -112,6 +112,7 @@ TARGETS = (
             "FCILimits.velocity_bounds",
             "judge_commands",
             "judge_cartesian",
+            "_at_rest_around",
             "_bound",
             "match_joint_names",
         ),
@@ -163,7 +164,13 @@ TARGETS = (
     Target(
         "simulator: measured peaks and the 1 kHz command generator",
         "bidmp.sim.limits",
-        ("_worst", "_measured_peaks", "_measured_breach", "_RateLimiter.__call__"),
+        (
+            "_worst",
+            "_windowed_acceleration",
+            "_measured_peaks",
+            "_measured_breach",
+            "_RateLimiter.__call__",
+        ),
         (
             "tests/test_oracles.py",
             "tests/sim/test_sim_limits.py",

@@ -40,6 +40,7 @@ import numpy as np
 
 from .._checks import _as_bounded_array, as_trajectory, as_vector, check_choice, check_real
 from .._progress import report
+from .._trajectory import interp_columns
 from ..extension.similarity import dtw_distance, frechet_distance
 from ..tasks.metrics import swept_area
 
@@ -183,6 +184,23 @@ def continual_metrics(
     }
 
 
+def _task_dmp(task: ClfdTask, n_kernels: int):
+    """(a paper-protocol DMP of ``n_kernels`` kernels fitted on the task's mean demonstration
+    on its first time vector, the mean of the demonstrations' ends: its goal)."""
+    from ..primitives import DMP
+
+    dmp = DMP(protocol="paper", n_kernels=n_kernels).fit(task.positions.mean(axis=0), task.times[0])
+    return dmp, task.positions[:, -1].mean(axis=0)
+
+
+def _rollouts(dmp, goal: np.ndarray, starts: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(M, T, D): ``dmp`` to ``goal`` from each of ``starts`` (M, D), on the time vector ``t``
+    (its duration, its step; sampled at ``t``)."""
+    duration, step = float(t[-1] - t[0]), float(t[1] - t[0])
+    motions = (dmp.trajectory(goal, start=start, duration=duration, dt=step) for start in starts)
+    return np.array([interp_columns(t, motion.t, motion.y) for motion in motions])
+
+
 class DMPLibrary:
     """``dmp-library``: one DMP per task, fitted on the task's mean demonstration (the paper's
     protocol, ``n_kernels`` kernels, on the first demonstration's time vector) and reproduced
@@ -196,26 +214,12 @@ class DMPLibrary:
         self._skills: list = []
 
     def learn(self, task: ClfdTask) -> None:
-        from ..primitives import DMP
 
-        mean = task.positions.mean(axis=0)
-        dmp = DMP(protocol="paper", n_kernels=self.n_kernels).fit(mean, task.times[0])
-        self._skills.append((dmp, task.positions[:, -1].mean(axis=0)))
+        self._skills.append(_task_dmp(task, self.n_kernels))
 
     def reproduce(self, index: int, starts: np.ndarray, t: np.ndarray) -> np.ndarray:
         """(M, T, D): task ``index`` reproduced from each of ``starts`` (M, D) on times ``t``."""
-        dmp, goal = self._skills[index]
-        out = []
-        for start in starts:  # on the time vector t: its duration, its step
-            motion = dmp.trajectory(
-                goal, start=start, duration=float(t[-1] - t[0]), dt=float(t[1] - t[0])
-            )
-            out.append(
-                np.column_stack(
-                    [np.interp(t, motion.t, motion.y[:, d]) for d in range(motion.y.shape[1])]
-                )
-            )
-        return np.array(out)
+        return _rollouts(*self._skills[index], starts, t)
 
     @property
     def n_parameters(self) -> int:
@@ -257,13 +261,11 @@ class ContinualBLS:
         return np.tanh(self._projection[:, index] + self._bias)
 
     def learn(self, task: ClfdTask) -> None:
-        from ..primitives import DMP
 
         if self._seen >= self.capacity:
             raise ValueError(f"bidmp-continual holds {self.capacity} tasks (its capacity)")
-        mean = task.positions.mean(axis=0)
-        dmp = DMP(protocol="paper", n_kernels=self.n_kernels).fit(mean, task.times[0])
-        target = np.concatenate([dmp.weights_.ravel(), task.positions[:, -1].mean(axis=0)])
+        dmp, goal = _task_dmp(task, self.n_kernels)
+        target = np.concatenate([dmp.weights_.ravel(), goal])
         nodes = self._nodes(self._seen)[None]
         if self._gram is None:
             self._template = dmp
@@ -285,18 +287,7 @@ class ContinualBLS:
         dims = starts.shape[1]
         dmp = copy.copy(self._template)
         dmp.weights_ = output[: self.n_kernels * dims].reshape(self.n_kernels, dims)
-        goal = output[self.n_kernels * dims :]
-        out = []
-        for start in starts:
-            motion = dmp.trajectory(
-                goal, start=start, duration=float(t[-1] - t[0]), dt=float(t[1] - t[0])
-            )
-            out.append(
-                np.column_stack(
-                    [np.interp(t, motion.t, motion.y[:, d]) for d in range(motion.y.shape[1])]
-                )
-            )
-        return np.array(out)
+        return _rollouts(dmp, output[self.n_kernels * dims :], starts, t)
 
     @property
     def n_parameters(self) -> int:
@@ -377,7 +368,11 @@ class ClfdRow:
     metrics: dict = field(default_factory=dict)
     sizes: list = field(default_factory=list)
     times: list = field(default_factory=list)
-    mean_dtw_seen: list = field(default_factory=list)
+
+    @property
+    def mean_dtw_seen(self) -> list[float]:
+        """After each task i, the mean over the tasks seen of their mean DTW."""
+        return [float(np.mean([np.mean(e) for e in seen])) for seen in self.errors["dtw"]]
 
     def to_dict(self) -> dict:
         return {
@@ -471,7 +466,6 @@ def _run_method(method, tasks: list[ClfdTask]) -> ClfdRow:
             seen["area"].append(np.array([swept_error_area(r, d) for r, d in pairs]))
         for metric in _METRICS:
             row.errors[metric].append(seen[metric])
-        row.mean_dtw_seen.append(float(np.mean([np.mean(e) for e in seen["dtw"]])))
         report(f"CLFD {method.name}", i + 1, len(tasks))
     row.matrices = {
         metric: accuracy_matrix(row.errors[metric], CLFD_THRESHOLDS[metric]) for metric in _METRICS

@@ -193,8 +193,8 @@ def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
     # at rest where it stands: three samples before the first; held after the last for three
     # more, as the robot holds a finished motion's last command (a motion still moving then
     # jumps to a standstill in one cycle)
-    positions = np.vstack([q, np.repeat(q[-1:], _HELD_AFTER, axis=0)])
-    stream = np.vstack([np.repeat(q[:1], 3, axis=0), positions])
+    stream = _at_rest_around(q)
+    positions = stream[3:]
     velocity = np.diff(stream, axis=0) / COMMAND_PERIOD_S
     acceleration = np.diff(velocity, axis=0) / COMMAND_PERIOD_S
     jerk = np.diff(acceleration, axis=0) / COMMAND_PERIOD_S
@@ -235,6 +235,19 @@ def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
 _HELD_AFTER = 3  # samples the arm is judged held at the last command after the motion
 
 
+def _at_rest_around(samples: np.ndarray) -> np.ndarray:
+    """``samples`` (T, k) with the first held for three samples before them (at rest where the
+    arm stands) and the last for :data:`_HELD_AFTER` after (the robot holding a finished
+    motion's last command)."""
+    return np.vstack(
+        [
+            np.repeat(samples[:1], 3, axis=0),
+            samples,
+            np.repeat(samples[-1:], _HELD_AFTER, axis=0),
+        ]
+    )
+
+
 _CARTESIAN_REFLEXES = (
     ("velocity", "cartesian_motion_generator_velocity_limits_violation"),
     ("acceleration", "cartesian_motion_generator_velocity_discontinuity"),
@@ -256,13 +269,7 @@ def judge_cartesian(positions, quaternions=None, robot: str = "fr3") -> FCIVerdi
     positions = as_trajectory(positions, "positions", min_points=1, allow_static=True)
     if positions.shape[1] != 3:
         raise ValueError(f"positions must have 3 columns (x, y, z in m), got {positions.shape[1]}")
-    padded = np.vstack(
-        [
-            np.repeat(positions[:1], 3, axis=0),
-            positions,
-            np.repeat(positions[-1:], _HELD_AFTER, axis=0),
-        ]
-    )
+    padded = _at_rest_around(positions)
     rates = {"translation": np.diff(padded, axis=0) / COMMAND_PERIOD_S}
     if quaternions is not None:
         quaternions = as_trajectory(quaternions, "quaternions", min_points=1, allow_static=True)
@@ -271,15 +278,7 @@ def judge_cartesian(positions, quaternions=None, robot: str = "fr3") -> FCIVerdi
                 f"quaternions must be (T, 4) like positions' T = {positions.shape[0]}, got "
                 f"{quaternions.shape}"
             )
-        turned = Rotation.from_quat(
-            np.vstack(
-                [
-                    np.repeat(quaternions[:1], 3, axis=0),
-                    quaternions,
-                    np.repeat(quaternions[-1:], _HELD_AFTER, axis=0),
-                ]
-            )
-        )
+        turned = Rotation.from_quat(_at_rest_around(quaternions))
         # the turn between consecutive commands, in the base frame, per second
         rates["rotation"] = (turned[1:] * turned[:-1].inv()).as_rotvec() / COMMAND_PERIOD_S
     first = None

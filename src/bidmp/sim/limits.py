@@ -46,16 +46,21 @@ def _command_peaks(commands: np.ndarray, limits: JointLimits, dt: float = SIM_ST
     return command_peaks(commands, limits, dt)
 
 
+def _windowed_acceleration(velocities, record_step: float) -> tuple[np.ndarray, float]:
+    """The measured joints' accelerations (rad/s²) by differences over 10 ms windows of their
+    velocities (n, J) recorded every ``record_step`` s, and the windows' length (s)."""
+    window = max(int(round(_WINDOW / record_step)), 1)
+    step = window * record_step
+    return np.diff(np.asarray(velocities, dtype=float)[::window], axis=0) / step, step
+
+
 def _measured_peaks(
     velocities: np.ndarray, record_step: float, limits: JointLimits
 ) -> CommandPeaks:
     """Peaks of the measured joints from their recorded velocities (n, 7), one every
     ``record_step`` seconds: velocity as recorded, acceleration and jerk by differences over
     10 ms windows."""
-    window = max(int(round(_WINDOW / record_step)), 1)
-    sampled = np.asarray(velocities, dtype=float)[::window]
-    step = window * record_step
-    acceleration = np.diff(sampled, axis=0) / step
+    acceleration, step = _windowed_acceleration(velocities, record_step)
     jerk = np.diff(acceleration, axis=0) / step
 
     return CommandPeaks(
@@ -83,9 +88,7 @@ def _measured_breach(
             f"{velocities[row, joint]:.3g} rad/s at {row * record_step:.3f} s (limit "
             f"{limits.velocity[joint]:g})"
         )
-    window = max(int(round(_WINDOW / record_step)), 1)
-    step = window * record_step
-    acceleration = np.diff(velocities[::window], axis=0) / step
+    acceleration, step = _windowed_acceleration(velocities, record_step)
     ends = np.arange(1, acceleration.shape[0] + 1) * step  # each difference spans (end - step, end]
     counted = np.ones(ends.shape, dtype=bool)
     if disturbed is not None:  # differences that end before it, or begin once it is over

@@ -390,7 +390,6 @@ def _measure(
     the executed motion: the measured tool path, the commands, the contacts."""
     if contract is None:
         contract = task.contract(None, limits)
-    contacts = {k: v / unit for k, v in run.contacts.items()}
     verdict, breach = _judged(task, label, target, run, unit, limits, contract, exclude)
     sent = verdict.limits or CommandPeaks(
         plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk
@@ -403,7 +402,7 @@ def _measure(
         measured_error=verdict.end_error,
         approach_error=verdict.approach_error,
         engaged=verdict.engaged,
-        contacts=contacts,
+        contacts=verdict.contacts,  # (in the scene's unit, as the verdict judged them)
         peak_velocity=sent.velocity,
         peak_acceleration=sent.acceleration,
         peak_jerk=sent.jerk,

@@ -204,8 +204,9 @@ def _execute_closed_loop(
             wanted = _hermite(previous, previous_rate, target, target_rate, share, CONTROL_STEP)
             if unheld is not None:
                 planned.append(unheld(*wanted))
+            holding = _holding(hold, t)
             held = _held_angle(cell, hold, t, held)
-            if _holding(hold, t):  # the generator, told the joint is held, brings its command
+            if holding:  # the generator, told the joint is held, brings its command
                 # to rest where it is held and resumes from there: the arm's own motion stays
                 # within the limits across the hold (a command run on meanwhile would yank the
                 # joint at the release)
@@ -214,7 +215,7 @@ def _execute_closed_loop(
             command = limited(*wanted)
             sent.append(command)
             q, qd = command.tolist(), limited.velocity.tolist()
-            if _holding(hold, t):  # held: the joint stays where it is, whatever it is sent
+            if holding:  # held: the joint stays where it is, whatever it is sent
                 q[hold.joint], qd[hold.joint] = held, 0.0
             _drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
