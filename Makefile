@@ -158,10 +158,13 @@ readme: $(STAMP)
 	$(PY) tools/robot_protocol.py > /dev/null
 	$(PY) tools/readme.py
 
-# Continual learning on the field's protocol (CLFD, Auddy et al.): the 26 LASA tasks one after the
-# other, every method (about 40 s per row): docs/results/clfd.json, clfd.md and its figures.
+# Continual learning on the field's protocol (CLFD, Auddy et al.): the 26 LASA tasks and the 9
+# RoboTasks9 pose tasks one after the other, every method, three seeds of the seeded ones, the
+# cells on a 2-process Dask cluster: docs/results/clfd*.json, .md and their figures.
+CLFD_METHODS = dmp-library,finetune,bidmp-library,promp-library,bidmp-continual
 clfd: $(STAMP)
-	$(VENV)/bin/bidmp benchmark clfd --methods dmp-library,finetune,promp-library,bidmp-continual --out docs/results
+	$(VENV)/bin/bidmp benchmark clfd --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out docs/results
+	$(VENV)/bin/bidmp benchmark clfd --dataset robottasks --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out docs/results
 
 # The libfranka side environment: franka-sim (an FCI server simulating an FR3 in MuJoCo, motion
 # limits enforced) and pylibfranka (the Franka client) at their pins in their own venv (they need

@@ -86,7 +86,14 @@ def _package_overrides(tmp: Path) -> dict:
             "trajectory": np.eye(3)[:, :2],
             "reference": np.eye(3)[:, :2] + 1,
         },
-        "bidmp.experiments.ContinualBLS": {"n_kernels": 20, "n_nodes": 8, "capacity": 3},
+        "bidmp.experiments.ContinualBLS": {"n_basis": 20, "n_nodes": 8, "capacity": 3},
+        "bidmp.experiments.BiDMPLibrary": {"n_kernels": 20, "seed": 1},
+        "bidmp.experiments.TangentChart": {"reference": np.array([1.0, 0.0, 0.0, 0.0])},
+        "bidmp.experiments.demonstration_errors": {
+            "reproduced": np.tile(np.linspace(0.0, 1.0, 5)[:, None], (1, 1, 2)),
+            "demonstrations": np.tile(np.linspace(0.0, 1.0, 5)[:, None], (1, 1, 2)) + 0.5,
+            "metrics": ("dtw", "frechet"),
+        },
         "bidmp.experiments.FineTune": {"n_kernels": 20},
         "bidmp.experiments.ProMPLibrary": {"n_basis": 10},
         "bidmp.experiments.orientation_error": {

@@ -134,9 +134,20 @@ def _cmd_clfd(args: argparse.Namespace) -> int:
             f"--methods: unknown method {unknown[0] if unknown else '(none given)'!r:.40} "
             f"(known: {', '.join(METHODS)})"
         )
-    if args.tasks is not None and not 1 <= args.tasks <= 26:
-        raise ValueError(f"--tasks must be 1-26, got {args.tasks}")
-    result = run_clfd(args.dataset, methods, n_tasks=args.tasks)
+    n_available = 26 if args.dataset == "lasa" else 9
+    if args.tasks is not None and not 1 <= args.tasks <= n_available:
+        raise ValueError(f"--tasks must be 1-{n_available} on {args.dataset}, got {args.tasks}")
+    if not 1 <= args.seeds <= 100:
+        raise ValueError(f"--seeds must be 1-100, got {args.seeds}")
+    if not 1 <= args.workers <= 256:
+        raise ValueError(f"--workers must be 1-256, got {args.workers}")
+    result = run_clfd(
+        args.dataset,
+        methods,
+        n_tasks=args.tasks,
+        seeds=range(args.seeds),
+        workers=args.workers,
+    )
     written = write_clfd(result, args.out)
     print(result.markdown())
     print(f"wrote {', '.join(str(path) for path in written)}")
@@ -242,20 +253,38 @@ def _benchmark_parser(commands) -> None:
     clfd = bench_commands.add_parser(
         "clfd",
         help="continual learning from demonstration: the CLFD protocol (Auddy et al.)",
-        description="Learn the tasks one after the other (LASA: 26 shapes, 7 demonstrations "
-        "each) and after each evaluate every task seen, reproduced from each demonstration's "
-        "start: DTW, Fréchet and swept-area errors, the accuracy matrices, ACC, BWT, REM, MS, TE, "
-        "FS, CL_score and CL_stability as the protocol defines them. Writes clfd.json and "
-        "clfd.md.",
+        description="Learn the tasks one after the other (lasa: 26 shapes, 7 demonstrations "
+        "each; robottasks: RoboTasks9's 9 pose tasks, 9 demonstrations each) and after each "
+        "evaluate every task seen, reproduced from each demonstration's start: DTW, Fréchet, "
+        "swept-area (lasa) and orientation (robottasks) errors, the accuracy matrices, ACC, BWT, "
+        "REM, MS, TE, FS, CL_score and CL_stability as the protocol defines them. Writes "
+        "clfd.json, clfd.md and their figures (clfd_robottasks* for robottasks).",
     )
-    clfd.add_argument("--dataset", choices=("lasa",), default="lasa", help="the tasks (lasa)")
+    clfd.add_argument(
+        "--dataset", choices=("lasa", "robottasks"), default="lasa", help="the tasks (lasa)"
+    )
     clfd.add_argument(
         "--methods",
         default="dmp-library,bidmp-continual",
-        help="comma-separated methods (default dmp-library,bidmp-continual)",
+        help="comma-separated methods: dmp-library, finetune, bidmp-library, promp-library, "
+        "bidmp-continual (default dmp-library,bidmp-continual)",
     )
     clfd.add_argument(
         "--tasks", type=int, default=None, help="only the first N tasks (default all)"
+    )
+    clfd.add_argument(
+        "--seeds",
+        type=int,
+        default=1,
+        help="seeds 0..N-1 of the methods that draw at random (bidmp-library, "
+        "bidmp-continual): one cell each (default 1)",
+    )
+    clfd.add_argument(
+        "--workers",
+        type=int,
+        default=1,
+        help="run the cells (method x seed) on an embedded Dask cluster of N processes; 1 "
+        "(default), or a single cell: one after the other here",
     )
     clfd.add_argument("--out", default="bidmp-clfd", help="output folder (default ./bidmp-clfd)")
     benchmark.set_defaults(handler=_cmd_benchmark)

@@ -17,6 +17,8 @@ if TYPE_CHECKING:
     from .benchmark import BenchmarkResult, check_lasa_options, lasa, summary_markdown, summary_rows
     from .clfd import (
         CLFD_THRESHOLDS,
+        BiDMPLibrary,
+        ClfdMethod,
         ClfdResult,
         ClfdRow,
         ClfdTask,
@@ -24,9 +26,11 @@ if TYPE_CHECKING:
         DMPLibrary,
         FineTune,
         ProMPLibrary,
+        TangentChart,
         accuracy_matrix,
         clfd_tasks,
         continual_metrics,
+        demonstration_errors,
         orientation_error,
         run_clfd,
         swept_error_area,
