@@ -12,7 +12,7 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check franka franka-check franka-agreement clfd
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
@@ -192,6 +192,23 @@ franka-check: $(FRANKA_MODEL) $(STAMP)
 franka-agreement: $(FRANKA_MODEL) $(STAMP)
 	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --out docs/results
 
+# The peers' ProDMP (MP_PyTorch on torch's CPU build) in its own environment, beside bidmp: the
+# benchmark's, never the suite's (torch is large). make bench-prodmp compares them in one run.
+MPT_VENV ?= .venv-mpt
+MPT_STAMP := $(MPT_VENV)/.installed
+
+$(MPT_STAMP): requirements-mp-pytorch.txt pyproject.toml constraints.txt
+	$(PYTHON) -m venv $(MPT_VENV)
+	$(MPT_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(MPT_VENV)/bin/python -m pip install --quiet -r requirements-mp-pytorch.txt
+	$(MPT_VENV)/bin/python -m pip install --quiet -c constraints.txt -e .
+	touch $(MPT_STAMP)
+
+mp-pytorch: $(MPT_STAMP)
+
+bench-prodmp: $(MPT_STAMP)
+	$(MPT_VENV)/bin/python benchmarks/bench_prodmp.py
+
 clean:
-	rm -rf $(VENV) $(FRANKA_VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
+	rm -rf $(VENV) $(FRANKA_VENV) $(MPT_VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
 	rm -f src/bidmp/_kernels.c src/bidmp/_kernels.*.so

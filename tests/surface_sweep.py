@@ -85,6 +85,7 @@ SKIPPED = {
     "ClfdRow",
     "ClfdTask",
     "ClfdMethod",  # the base of the methods (each swept as itself)
+    "ProDMPBasis",  # made by prodmp_basis (swept), handed out as ProDMP.basis_ (swept as one)
     "write_report",
     "write_sim_report",
     "write_job_report",

@@ -87,6 +87,7 @@ def _package_overrides(tmp: Path) -> dict:
             "reference": np.eye(3)[:, :2] + 1,
         },
         "bidmp.experiments.ContinualBLS": {"n_basis": 20, "n_nodes": 8, "capacity": 3},
+        "bidmp.primitives.prodmp_basis": {"n_basis": 6, "dt": 0.02},
         "bidmp.experiments.BiDMPLibrary": {"n_kernels": 20, "seed": 1},
         "bidmp.experiments.TangentChart": {"reference": np.array([1.0, 0.0, 0.0, 0.0])},
         "bidmp.experiments.demonstration_errors": {
@@ -373,6 +374,7 @@ def _estimators():
         ("RhythmicDMP", bidmp.primitives.RhythmicDMP, (PERIODIC, PERIODIC_TIMES)),
         ("RhythmicPoseDMP", bidmp.primitives.RhythmicPoseDMP, (PERIODIC_POSES, PERIODIC_TIMES)),
         ("ProMP", bidmp.primitives.ProMP, ([DEMO, DEMO[::-1]],)),
+        ("ProDMP", bidmp.primitives.ProDMP, ([DEMO, DEMO[::-1]],)),
         ("MultiDMP", bidmp.primitives.MultiDMP, ([DEMO, DEMO * 1.1],)),
     ]
 
@@ -503,6 +505,22 @@ def _instances(tmp: Path):
         promp,
         {"phase": [0.0, 1.0], "y": DEMO[[0, -1]], "n_samples": 3, "dt": 0.05},
     )
+    prodmp = bidmp.primitives.ProDMP(n_basis=8).fit([DEMO, DEMO * 1.05, DEMO[::-1]])
+    yield (
+        "ProDMP",
+        prodmp,
+        {
+            "start": DEMO[0],
+            "goal": DEMO[-1],
+            "starts": DEMO[:2],
+            "goals": DEMO[-2:],
+            "times": [0.0, 0.5],
+            "values": DEMO[[5]],
+            "condition:times": [0.5],
+            "cov": 0.0,
+        },
+    )
+    yield "ProDMPBasis", prodmp.basis_, {"times": [0.0, 0.5], "start_time": 0.0}
     multi = bidmp.primitives.MultiDMP(bidmp.DMP(n_kernels=10)).fit([DEMO, DEMO * 1.05])
     yield "MultiDMP", multi, {"goal": DEMO[-1] + 5.0, "n_samples": 2}
     pose_rhythm = bidmp.primitives.RhythmicPoseDMP(n_kernels=12).fit(PERIODIC_POSES, PERIODIC_TIMES)

@@ -266,7 +266,7 @@ def _timed_transfer(
     demonstration ``y`` at ``seg_index`` to the kept ``approach`` (its samples after ``path``'s
     end; it began at ``approach_index`` in ``y``), timed as the module docstring says.
 
-    The duration is the shortest of ``n0 · 1.05^k`` samples (``n0 = approach_index − seg_index``,
+    The duration is the shortest of ``n0 · 1.01^k`` samples (``n0 = approach_index − seg_index``,
     up to 40 n0) whose profile never runs back and whose peak speed, acceleration and jerk are
     within the demonstration's along the transfer and within 1.1 times them over the joins (the
     samples from three before seg to three into the approach); when none is, the one with the

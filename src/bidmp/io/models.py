@@ -51,6 +51,7 @@ _MODEL_CLASSES = {
     "RhythmicDMP": ("bidmp.primitives.rhythmic", "RhythmicDMP"),
     "RhythmicPoseDMP": ("bidmp.primitives.rhythmic_pose", "RhythmicPoseDMP"),
     "ProMP": ("bidmp.primitives.promp", "ProMP"),
+    "ProDMP": ("bidmp.primitives.prodmp", "ProDMP"),
     "MultiDMP": ("bidmp.primitives.multi", "MultiDMP"),
 }
 

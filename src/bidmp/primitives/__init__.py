@@ -16,7 +16,8 @@ Where things live (the field's split, as in movement_primitives and dmpbbo):
 * ``cartesian``, ``so3``, ``pose_timing`` — pose DMPs on unit quaternions;
 * ``multi`` — a DMP from several demonstrations, with their spread; ``promp`` — probabilistic
   movement primitives from several demonstrations, exact
-  conditioning;
+  conditioning; ``prodmp`` — probabilistic DMPs: the DMP's solution in closed form, batched
+  rollouts in one product, a ProMP's conditioning;
 * ``rhythmic`` — periodic DMPs and their modulation while running; ``frequency`` — a periodic
   recording's frequency, steady part and spread; ``oscillator`` — adaptive frequency oscillators;
 * ``timing`` — timed trajectories and time scaling to limits.
@@ -62,6 +63,7 @@ if TYPE_CHECKING:
     from .integrate import StepIntegrator
     from .multi import MultiDMP
     from .oscillator import AdaptiveOscillator
+    from .prodmp import ProDMP, ProDMPBasis, prodmp_basis
     from .promp import ProMP, condition_gaussian, promp_basis
     from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
     from .rhythmic import RhythmicDMP, RhythmicStepper

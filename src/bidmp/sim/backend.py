@@ -88,7 +88,11 @@ class JointLimits:
             )
         if any(low >= high for low, high in zip(self.lower, self.upper)):
             raise ValueError("JointLimits.lower must be below JointLimits.upper for every joint")
-        if self.fci is not None and (self.fci not in ("panda", "fr3") or len(self.lower) != 7):
+        if self.fci is not None and (
+            not isinstance(self.fci, str)
+            or self.fci not in ("panda", "fr3")
+            or len(self.lower) != 7
+        ):
             raise ValueError(
                 f"JointLimits.fci must be 'panda' or 'fr3' on a 7-joint arm, got {self.fci!r:.40}"
             )

@@ -43,8 +43,8 @@ def demonstration_errors(reproduced: np.ndarray, demonstrations: np.ndarray, met
             "reproduced and demonstrations must be (M, T, D) of one shape, got "
             f"{reproduced.shape} and {demonstrations.shape}"
         )
-    if isinstance(metrics, str) or not metrics:
-        raise TypeError("metrics must be a sequence of metric names")
+    if not isinstance(metrics, (list, tuple, dict)) or not metrics or len(metrics) > 4:
+        raise TypeError("metrics must be a sequence of metric names (at most 4)")
     for metric in metrics:
         check_choice(metric, "metrics", ("dtw", "frechet", "area", "orientation"))
     pose = "orientation" in metrics

@@ -1,0 +1,570 @@
+"""Probabilistic dynamic movement primitives (ProDMP; Li, Celik, Blessing, Zhou, Neumann,
+"ProDMP: A Unified Perspective on Dynamic and Probabilistic Movement Primitives", RA-L 2023).
+
+The DMP's second-order system, in the scaled time ``s = (t - delay) / tau`` (critically damped,
+``beta = alpha / 4``),
+
+    y'' + alpha y' + alpha² / 4 · y = alpha² / 4 · g + x(s) Σ_i φ_i(x(s)) w_i,
+
+is linear, so its solution is closed form: the two homogeneous solutions ``y1 = e^(-alpha s / 2)``,
+``y2 = s·y1`` carry the boundary condition (position and velocity at a time ``t_b``), and the
+forced response is linear in the weights and the goal,
+
+    y(s) = c1 y1(s) + c2 y2(s) + Φ(s)ᵀ [w; g],
+
+with the position basis ``Φ_i(s) = ∫₀ˢ (s - r) e^(-alpha (s - r) / 2) x(r) φ_i(r) dr`` (the system's
+Green's function convolved with the forcing basis) and the goal's ``1 - (1 + alpha s / 2)
+e^(-alpha s / 2)``. Positions and velocities at any time are then one product of a basis with the
+weights (:func:`prodmp_basis`, :class:`ProDMPBasis`), whole batches of starts and goals one
+product more, and a Gaussian over the weights learned from several demonstrations conditions
+exactly on via-points, as a ProMP's does (:class:`ProDMP`).
+
+The forcing basis is MP_PyTorch's normalised RBF on the exponential phase ``x = e^(-alpha_phase
+s)`` (centres evenly in time over [delay, delay + tau], ``n_outside`` more beyond each end,
+widths ``bandwidth_factor / (distance between centres in phase)²``). The weights' integral is
+precomputed as MP_PyTorch does — the trapezoidal rule on a grid of step ``dt / tau`` over ``s`` in
+[0, ``length_factor``], as ``y2 ∫ e^(alpha r / 2) x φ dr - y1 ∫ r e^(alpha r / 2) x φ dr`` — and
+read between grid points linearly; so bidmp's ProDMP and MP_PyTorch's give the same trajectories
+on equal settings (``benchmarks/bench_prodmp.py`` compares them), and the grid's step sets the
+accuracy of both (the trapezoid's error falls with ``dt²``; tested against a fine quadrature).
+
+Layer 1: NumPy only.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._api import Estimator
+from .._checks import (
+    NotFittedError,
+    as_points,
+    as_trajectory,
+    as_vector,
+    check_int,
+    check_real,
+)
+from .._units import check_units
+from .promp import _weight_covariance, condition_gaussian
+from .timing import Trajectory
+
+__all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
+
+
+@dataclass(frozen=True)
+class ProDMPBasis:
+    """A ProDMP's precomputed basis (:func:`prodmp_basis` makes one).
+
+    Attributes
+    ----------
+    n_basis, tau, delay, alpha, alpha_phase, bandwidth_factor, n_outside, dt, length_factor
+        The settings it was computed with (tau, delay, dt in s).
+    centres, widths : array (n_basis,)
+        The forcing basis' centres in phase and its ``bandwidth`` (1 / width²).
+    position, velocity : array (P, n_basis + 1)
+        ``Φ(s)`` and ``dΦ/ds`` on the grid ``s_k = k · dt / tau``, k = 0..P-1; the last column is
+        the goal's.
+    y1, y2, dy1, dy2 : array (P,)
+        The homogeneous solutions and their derivatives in ``s`` on the grid.
+    """
+
+    n_basis: int
+    tau: float
+    delay: float
+    alpha: float
+    alpha_phase: float
+    bandwidth_factor: float
+    n_outside: int
+    dt: float
+    length_factor: float
+    centres: np.ndarray
+    widths: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    y1: np.ndarray
+    y2: np.ndarray
+    dy1: np.ndarray
+    dy2: np.ndarray
+
+    @property
+    def scaled_step(self) -> float:
+        """The grid's step in scaled time, ``dt / tau``."""
+        return self.dt / self.tau
+
+    def scaled_time(self, times) -> np.ndarray:
+        """``s = max((t - delay) / tau, 0)`` of ``times`` (s)."""
+        times = as_vector(times, "times")
+        return np.maximum((times - self.delay) / self.tau, 0.0)
+
+    def phase(self, times) -> np.ndarray:
+        """The canonical phase ``x = e^(-alpha_phase s)`` at ``times`` (s)."""
+        return np.exp(-self.alpha_phase * self.scaled_time(times))
+
+    def forcing(self, times) -> np.ndarray:
+        """(T, n_basis): the normalised RBF forcing basis φ at ``times`` (s)."""
+        phase = self.phase(times)[:, None]
+        rows = np.exp(-0.5 * (phase - self.centres[None, :]) ** 2 * self.widths[None, :])
+        if self.n_basis > 1:
+            rows /= rows.sum(axis=1, keepdims=True)
+        return rows
+
+    def _read(self, values: np.ndarray, times) -> np.ndarray:
+        """``values`` (P, ...) on the grid read at ``times`` (s), linearly between grid points."""
+        index = self.scaled_time(times) / self.scaled_step
+        if np.any(index > values.shape[0] - 1 + 1e-9):
+            raise ValueError(
+                f"times reach {float(np.max(times)):.6g} s, beyond the precomputed "
+                f"{self.length_factor:g} tau after the delay: raise length_factor"
+            )
+        low = np.clip(np.floor(index).astype(int), 0, values.shape[0] - 2)
+        share = index - low
+        share = share.reshape(share.shape + (1,) * (values.ndim - 1))
+        return values[low] * (1.0 - share) + values[low + 1] * share
+
+    def at(self, times) -> tuple[np.ndarray, ...]:
+        """(Φ (T, N+1), dΦ/ds (T, N+1), y1, y2, dy1, dy2 (T,)) at ``times`` (s)."""
+        solutions = np.column_stack([self.y1, self.y2, self.dy1, self.dy2])
+        read = self._read(solutions, times)
+        return (self._read(self.position, times), self._read(self.velocity, times), *read.T)
+
+    def boundary_maps(self, times, start_time: float) -> tuple[np.ndarray, ...]:
+        """The affine maps of a trajectory at ``times`` (T,) from a boundary condition at
+        ``start_time``: ``(P0, V0, P1, V1, H, dH)`` with, per dimension,
+
+            y(t)  = P0(t) y_b + V0(t) ẏ_b tau + H(t) [w; g],
+            y'(t) = P1(t) y_b + V1(t) ẏ_b tau + dH(t) [w; g]   (d/ds: divide by tau for /s),
+
+        ``P0, V0, P1, V1`` (T,), ``H, dH`` (T, N+1)."""
+        phi, dphi, y1, y2, dy1, dy2 = self.at(times)
+        phi_b, dphi_b, y1b, y2b, dy1b, dy2b = self.at(np.array([start_time]))
+        det = y1b * dy2b - y2b * dy1b
+        xi1, xi2 = (dy2b * y1 - dy1b * y2) / det, (y1b * y2 - y2b * y1) / det
+        xi3, xi4 = (dy1b * y2 - dy2b * y1) / det, (y2b * y1 - y1b * y2) / det
+        dxi1, dxi2 = (dy2b * dy1 - dy1b * dy2) / det, (y1b * dy2 - y2b * dy1) / det
+        dxi3, dxi4 = (dy1b * dy2 - dy2b * dy1) / det, (y2b * dy1 - y1b * dy2) / det
+        H = xi3[:, None] * phi_b + xi4[:, None] * dphi_b + phi
+        dH = dxi3[:, None] * phi_b + dxi4[:, None] * dphi_b + dphi
+        return xi1, xi2, dxi1, dxi2, H, dH
+
+
+def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
+    n_basis: int = 10,
+    tau: float = 1.0,
+    delay: float = 0.0,
+    alpha: float = 25.0,
+    alpha_phase: float = 3.0,
+    bandwidth_factor: float = 3.0,
+    n_outside: int = 0,
+    dt: float = 0.01,
+    length_factor: float = 6.0,
+) -> ProDMPBasis:
+    """The precomputed basis of a ProDMP (module docstring): ``n_basis`` forcing basis functions,
+    time constant ``tau`` (s) and ``delay`` (s), the spring ``alpha`` (critically damped), the
+    phase's decay ``alpha_phase``, the basis' ``bandwidth_factor`` and ``n_outside`` centres
+    beyond each end, the grid's step ``dt`` (s) over ``length_factor`` · tau (at most 6: beyond,
+    ``e^(alpha s / 2)`` overflows the cancellation)."""
+    n_basis = check_int(n_basis, "n_basis", minimum=1, limit="max_kernels")
+    tau = check_real(tau, "tau", positive=True, maximum=1e4)
+    delay = check_real(delay, "delay", minimum=-1e4, maximum=1e4)
+    alpha = check_real(alpha, "alpha", positive=True, maximum=1e3)
+    alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True, maximum=1e3)
+    bandwidth_factor = check_real(bandwidth_factor, "bandwidth_factor", positive=True, maximum=1e3)
+    n_outside = check_int(n_outside, "n_outside", minimum=0, maximum=max(0, (n_basis - 2) // 2))
+    dt = check_real(dt, "dt", positive=True, maximum=tau)
+    length_factor = check_real(length_factor, "length_factor", positive=True, maximum=6.0)
+    steps = round(1.0 / (dt / tau))
+    n_grid = int(length_factor * steps) + 1
+    if n_grid > 2_000_000:
+        raise ValueError(f"dt = {dt:g} s gives a grid of {n_grid} points over the motion: too fine")
+    if alpha * length_factor / 2.0 > 700.0:
+        raise ValueError("alpha * length_factor / 2 must stay below 700 (e^x overflows)")
+    centres, widths = _forcing_centres(n_basis, alpha_phase, bandwidth_factor, n_outside)
+    s = np.linspace(0.0, length_factor, n_grid)
+    y1 = np.exp(-0.5 * alpha * s)
+    y2 = s * y1
+    dy1 = -0.5 * alpha * y1
+    dy2 = -0.5 * alpha * y2 + y1
+    grow = np.exp(0.5 * alpha * s)
+    q1 = (0.5 * alpha * s - 1.0) * grow + 1.0
+    q2 = 0.5 * alpha * (grow - 1.0)
+    phase = np.exp(-alpha_phase * s)[:, None]
+    rows = np.exp(-0.5 * (phase - centres[None, :]) ** 2 * widths[None, :])
+    if n_basis > 1:
+        rows /= rows.sum(axis=1, keepdims=True)
+    dp2 = (grow[:, None] * phase) * rows
+    dp1 = s[:, None] * dp2
+    p1, p2 = _cumulative_trapezoid(dp1, s), _cumulative_trapezoid(dp2, s)
+    position = np.column_stack([p2 * y2[:, None] - p1 * y1[:, None], q2 * y2 - q1 * y1])
+    velocity = np.column_stack([p2 * dy2[:, None] - p1 * dy1[:, None], q2 * dy2 - q1 * dy1])
+    return ProDMPBasis(
+        n_basis, tau, delay, alpha, alpha_phase, bandwidth_factor, n_outside, dt, length_factor,
+        centres, widths, position, velocity, y1, y2, dy1, dy2,
+    )  # fmt: skip
+
+
+def _forcing_centres(n_basis, alpha_phase, bandwidth_factor, n_outside):
+    """(centres (N,), bandwidths (N,)) in phase: MP_PyTorch's normalised RBF placement."""
+    if n_basis == 1:
+        return np.array([math.exp(-alpha_phase * 0.5)]), np.array([bandwidth_factor])
+    spacing = 1.0 / (n_basis - 2 * n_outside - 1)
+    in_time = np.linspace(-n_outside * spacing, 1.0 + n_outside * spacing, n_basis)
+    in_time = np.append(in_time, in_time[-1] + (in_time[1] - in_time[0]))
+    in_phase = np.exp(-alpha_phase * in_time)
+    gaps = np.diff(in_phase)
+    if n_basis == 2:
+        gaps[-1] *= 2.0
+    return in_phase[:-1], bandwidth_factor / gaps**2
+
+
+def _cumulative_trapezoid(values: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """(P, N): the trapezoidal integral of ``values`` (P, N) from s[0] to each s[k]."""
+    steps = np.diff(s)[:, None]
+    out = np.zeros_like(values)
+    np.cumsum(0.5 * (values[1:] + values[:-1]) * steps, axis=0, out=out[1:])
+    return out
+
+
+def _demonstrations(demonstrations) -> list[np.ndarray]:
+    if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
+        demonstrations = [demonstrations]
+    if not isinstance(demonstrations, (list, tuple, np.ndarray)) or len(demonstrations) == 0:
+        raise TypeError("demonstrations must be a list of (T, D) arrays")
+    if len(demonstrations) > 10_000:
+        raise ValueError(f"demonstrations: at most 10000, got {len(demonstrations)}")
+    demos = [as_trajectory(y, f"demonstrations[{i}]") for i, y in enumerate(demonstrations)]
+    if len({y.shape[1] for y in demos}) != 1:
+        raise ValueError("demonstrations must all have the same number of dimensions D")
+    return demos
+
+
+class ProDMP(Estimator):
+    """A probabilistic DMP learned from one or several demonstrations (module docstring).
+
+    Parameters
+    ----------
+    n_basis : int, default 10
+        Forcing basis functions per dimension N (plus the goal: N + 1 weights per dimension).
+    alpha : float, default 25
+        The spring (critically damped: the damper ``alpha``, the stiffness ``alpha² / 4``).
+    alpha_phase : float, default 3
+        The phase's decay over the motion.
+    tau : float or None, default None
+        The time constant (s): the motion's duration. None: the demonstrations' mean duration.
+    bandwidth_factor : float, default 3
+    n_outside : int, default 0
+        Forcing centres beyond each end of the motion.
+    dt : float, default 0.01
+        The precomputation grid's step (s).
+    length_factor : float, default 6
+        The grid covers ``length_factor · tau`` (at most 6).
+    ridge : float, default 1e-9
+        Ridge λ of each demonstration's weights (absolute, as MP_PyTorch's ``reg``).
+    cov_reg : float, default 1e-2
+        Added to the weights' covariance, times their mean variance, on the diagonal.
+
+    Attributes
+    ----------
+    basis_ : ProDMPBasis
+    weights_ : array (M, D·(N+1))
+        Each demonstration's weights, dimension after dimension, each ``[w (N), g]``.
+    weight_mean_, weight_cov_ : array (D·(N+1),), (D·(N+1), D·(N+1))
+    start_, start_velocity_ : array (D,)
+        The demonstrations' mean start (units) and start velocity (units/s).
+    duration_ : float
+        ``tau`` (s).
+    n_dims_ : int
+    units_ : str
+    """
+
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one
+        self,
+        n_basis: int = 10,
+        alpha: float = 25.0,
+        alpha_phase: float = 3.0,
+        tau: float | None = None,
+        bandwidth_factor: float = 3.0,
+        n_outside: int = 0,
+        dt: float = 0.01,
+        length_factor: float = 6.0,
+        ridge: float = 1e-9,
+        cov_reg: float = 1e-2,
+    ) -> None:
+        self.n_basis = n_basis
+        self.alpha = alpha
+        self.alpha_phase = alpha_phase
+        self.tau = tau
+        self.bandwidth_factor = bandwidth_factor
+        self.n_outside = n_outside
+        self.dt = dt
+        self.length_factor = length_factor
+        self.ridge = ridge
+        self.cov_reg = cov_reg
+
+    def fit(self, demonstrations, times=None, units: str | None = None) -> ProDMP:
+        """Learn from ``demonstrations`` (a list of (T_i, D) arrays, or one (T, D)) with their
+        stamps ``times`` (a list of (T_i,) arrays, s; None: each uniform over ``tau``, or 1 s).
+        Each demonstration's weights and goal are the least-squares fit of its positions from its
+        own start (its first sample, the velocity of its first step), as MP_PyTorch learns them.
+        Returns self."""
+        demos = _demonstrations(demonstrations)
+        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6)
+        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
+        units = "" if units is None else check_units(units)
+        stamps = self._stamps(times, demos)
+        tau = (
+            float(np.mean([t[-1] - t[0] for t in stamps]))
+            if self.tau is None
+            else check_real(self.tau, "tau", positive=True, maximum=1e4)
+        )
+        basis = prodmp_basis(
+            self.n_basis, tau, 0.0, self.alpha, self.alpha_phase, self.bandwidth_factor,
+            self.n_outside, self.dt, self.length_factor,
+        )  # fmt: skip
+        size = basis.n_basis + 1
+        n_dims = demos[0].shape[1]
+        weights = np.empty((len(demos), n_dims * size))
+        starts, velocities = [], []
+        for index, (y, t) in enumerate(zip(demos, stamps)):
+            t = t - t[0]
+            start, velocity = y[0], (y[1] - y[0]) / basis.dt
+            p0, v0, _, _, H, _ = basis.boundary_maps(t, 0.0)
+            free = y - p0[:, None] * start - v0[:, None] * (velocity * tau)
+            gram = H.T @ H + ridge * np.eye(size)
+            weights[index] = np.linalg.solve(gram, H.T @ free).T.reshape(-1)
+            starts.append(start)
+            velocities.append(velocity)
+        self.basis_ = basis
+        self.weights_ = weights
+        self.weight_mean_ = weights.mean(axis=0)
+        self.weight_cov_ = _weight_covariance(weights, cov_reg)
+        self.start_ = np.mean(starts, axis=0)
+        self.start_velocity_ = np.mean(velocities, axis=0)
+        self.duration_ = tau
+        self.n_dims_ = n_dims
+        self.units_ = units
+        return self
+
+    def _stamps(self, times, demos) -> list[np.ndarray]:
+        if times is None:
+            span = 1.0 if self.tau is None else float(self.tau)
+            return [np.linspace(0.0, span, len(y)) for y in demos]
+        if not isinstance(times, (list, tuple)) or len(times) != len(demos):
+            raise TypeError("times must be a list of (T_i,) arrays, one per demonstration")
+        stamps = []
+        for i, (t, y) in enumerate(zip(times, demos)):
+            t = as_vector(t, f"times[{i}]", length=len(y))
+            if np.any(np.diff(t) <= 0):
+                raise ValueError(f"times[{i}] must increase strictly")
+            stamps.append(t)
+        return stamps
+
+    def _check_fitted(self) -> None:
+        if "weight_mean_" not in self.__dict__:
+            raise NotFittedError("this ProDMP is not fitted yet: call fit(demonstrations) first")
+
+    def _times(self, times, n_steps: int | None) -> np.ndarray:
+        if times is None:
+            n_steps = check_int(100 if n_steps is None else n_steps, "n_steps", minimum=2)
+            return np.linspace(0.0, self.duration_, n_steps)
+        times = as_vector(times, "times")
+        if np.any(np.diff(times) < 0) or times[0] < 0:
+            raise ValueError("times must be >= 0 and non-decreasing (s)")
+        return times
+
+    def _boundary(self, start, start_velocity) -> tuple[np.ndarray, np.ndarray]:
+        start = self.start_ if start is None else as_points(start, self.n_dims_, "start")
+        velocity = (
+            np.zeros_like(start)
+            if start_velocity is None
+            else as_points(start_velocity, self.n_dims_, "start_velocity")
+        )
+        if velocity.shape != start.shape:
+            velocity = np.broadcast_to(velocity, start.shape)
+        return start, velocity
+
+    def rollouts(  # noqa: PLR0913 - one batch's boundary, goals and weights
+        self,
+        starts=None,
+        goals=None,
+        times=None,
+        *,
+        start_velocities=None,
+        weights=None,
+        conditioned: bool = False,
+    ) -> np.ndarray:
+        """(B, T, D) positions (units) at ``times`` (s; default 100 over tau) from each of
+        ``starts`` (B, D; default the mean start) at rest (or ``start_velocities`` (B, D),
+        units/s) to each of ``goals`` (B, D; default the weights' own goal), all in one product
+        per term.
+
+        The weights are the mean (or ``weights`` (D·(N+1),)) with the goal replaced; with
+        ``conditioned=True`` the Gaussian's mean conditioned exactly on each goal instead (the
+        forcing weights move with the goal as the demonstrations say; affine in the goal, so
+        still one product)."""
+        self._check_fitted()
+        t = self._times(times, None)
+        starts, velocities = self._boundary(starts, start_velocities)
+        size, dims, n_times = self.basis_.n_basis + 1, self.n_dims_, len(t)
+        mean = (
+            self.weight_mean_
+            if weights is None
+            else as_vector(weights, "weights", length=self.weight_mean_.size)
+        )
+        p0, v0, _, _, H, _ = self.basis_.boundary_maps(t, 0.0)
+        w = mean.reshape(dims, size)
+        if goals is None:
+            goals, goal_rows, base = np.zeros((1, dims)), None, H @ w.T
+        else:
+            goals = as_points(goals, dims, "goals")
+            eye = np.eye(dims)
+            if conditioned:
+                goal_index = np.arange(dims) * size + size - 1
+                cov = self.weight_cov_
+                gain = np.linalg.solve(cov[np.ix_(goal_index, goal_index)], cov[goal_index]).T
+                # row e: what a unit of goal e adds at (t, d) through every weight it moves
+                goal_rows = np.einsum("tk,dke->etd", H, gain.reshape(dims, size, dims))
+                base = H @ w.T - np.einsum("etd,e->td", goal_rows, mean[goal_index])
+            else:
+                goal_rows = H[None, :, -1:] * eye[:, None, :]  # the goal weight's own column
+                base = H[:, :-1] @ w[:, :-1].T
+        batch = max(len(starts), len(velocities), len(goals))
+        for name, values in (
+            ("starts", starts),
+            ("start_velocities", velocities),
+            ("goals", goals),
+        ):
+            if len(values) not in (1, batch):
+                raise ValueError(
+                    f"{name} must be one point or one per rollout ({batch}), got {len(values)}"
+                )
+        # The rollouts are affine in the starts, start velocities and goals: one matrix product
+        # of their coefficients with a row per coefficient writes the whole batch (B, T·D).
+        coefficients, rows = [np.ones((batch, 1))], [base.reshape(1, -1)]
+        diagonal = np.eye(dims)[:, None, :]
+        for values, profile in ((starts, p0), (velocities * self.duration_, v0)):
+            block = (profile[None, :, None] * diagonal).reshape(dims, -1)
+            if len(values) == 1:
+                rows[0] = rows[0] + values @ block
+            else:
+                coefficients.append(values)
+                rows.append(block)
+        if goal_rows is not None:
+            coefficients.append(np.broadcast_to(goals, (batch, dims)))
+            rows.append(goal_rows.reshape(dims, -1))
+        out = np.hstack(coefficients) @ np.vstack(rows)
+        return out.reshape(batch, n_times, dims)
+
+    def rollout(self, goal=None, *, start=None, n_steps: int = 100) -> np.ndarray:
+        """(n_steps, D): the positions (units) over tau from ``start`` (default the mean start) at
+        rest to ``goal`` (default the weights' goal), as :meth:`bidmp.DMP.rollout` gives them."""
+        return self.trajectory(start, goal, n_steps=n_steps).y
+
+    def trajectory(
+        self, start=None, goal=None, *, start_velocity=None, times=None, n_steps: int = 100,
+        weights=None,
+    ) -> Trajectory:  # fmt: skip
+        """One motion from ``start`` (D,; default the demonstrations' mean start) at
+        ``start_velocity`` (default rest) to ``goal`` (default the weights' goal): positions and
+        velocities in closed form, the acceleration from the system's equation (exact, not
+        differenced), at ``times`` (s; default ``n_steps`` over tau). Returns a
+        :class:`bidmp.Trajectory`."""
+        self._check_fitted()
+        t = self._times(times, n_steps)
+        start, velocity = self._boundary(start, start_velocity)
+        w = (
+            (self.weight_mean_ if weights is None else as_vector(weights, "weights"))
+            .reshape(self.n_dims_, -1)
+            .copy()
+        )
+        if goal is not None:
+            w[:, -1] = as_points(goal, self.n_dims_, "goal")[0]
+        basis, tau = self.basis_, self.duration_
+        p0, v0, p1, v1, H, dH = basis.boundary_maps(t, 0.0)
+        y = p0[:, None] * start + v0[:, None] * (velocity * tau) + H @ w.T
+        dy = p1[:, None] * start + v1[:, None] * (velocity * tau) + dH @ w.T  # d/ds
+        forcing = (basis.phase(t)[:, None] * basis.forcing(t)) @ w[:, :-1].T
+        alpha = basis.alpha
+        ddy = -alpha * dy - alpha**2 / 4.0 * (y - w[:, -1]) + forcing  # d²/ds²
+        return Trajectory(t, y, dy / tau, ddy / tau**2, units=self.units_)
+
+    def condition(self, times, values, cov=0.0, *, start=None, start_velocity=None) -> ProDMP:
+        """A copy whose weights are conditioned exactly on passing ``values`` (K, D) at ``times``
+        (K,) (s) with noise ``cov`` (a scalar variance, units²), for motions from ``start`` at
+        ``start_velocity`` (default the mean start, at rest): the via-points enter the weights'
+        Gaussian like a ProMP's, the boundary condition stays exact."""
+        import copy
+
+        self._check_fitted()
+        times = as_vector(times, "times")
+        values = as_points(values, self.n_dims_, "values")
+        if len(values) != len(times):
+            raise ValueError(
+                f"values must hold one point per time ({len(times)}), got {len(values)}"
+            )
+        cov = check_real(cov, "cov", nonnegative=True, maximum=1e12)
+        start, velocity = self._boundary(start, start_velocity)
+        p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
+        size, dims = self.basis_.n_basis + 1, self.n_dims_
+        observed = values - p0[:, None] * start - v0[:, None] * (velocity * self.duration_)
+        # the observation's columns: dimension d at time k reads block d of the weights
+        columns = np.zeros((dims * size, len(times) * dims))
+        for d in range(dims):
+            columns[d * size : (d + 1) * size, d::dims] = H.T
+        noise = cov * np.eye(len(times) * dims)
+        mean, weight_cov = condition_gaussian(
+            self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
+        )
+        conditioned = copy.copy(self)
+        conditioned.weight_mean_, conditioned.weight_cov_ = mean, weight_cov
+        conditioned.start_, conditioned.start_velocity_ = start[0], velocity[0]
+        return conditioned
+
+    # -- persistence (used by bidmp.io) -----------------------------------------------------
+    def _get_state(self) -> tuple[dict, dict]:
+        self._check_fitted()
+        state = {
+            "params": self.get_params(),
+            "duration": float(self.duration_),
+            "n_dims": int(self.n_dims_),
+            "units": self.units_,
+        }
+        arrays = {
+            "weight_mean_": self.weight_mean_,
+            "weight_cov_": self.weight_cov_,
+            "weights_": self.weights_,
+            "start_": self.start_,
+            "start_velocity_": self.start_velocity_,
+        }
+        return state, arrays
+
+    @classmethod
+    def _from_state(cls, meta: dict, arrays) -> ProDMP:
+        """A fitted ProDMP from a model file: the basis recomputed from the settings (it is a
+        function of them), the learned arrays checked for shape and finiteness."""
+        from .._checks import check_loaded
+
+        model = cls(**meta["params"])
+        n_dims = check_int(meta["n_dims"], "n_dims", minimum=1, limit="max_dims")
+        tau = check_real(meta["duration"], "duration", positive=True, maximum=1e4)
+        model.basis_ = prodmp_basis(
+            model.n_basis, tau, 0.0, model.alpha, model.alpha_phase, model.bandwidth_factor,
+            model.n_outside, model.dt, model.length_factor,
+        )  # fmt: skip
+        size = n_dims * (model.basis_.n_basis + 1)
+        model.weight_mean_ = check_loaded(arrays["weight_mean_"], "weight_mean_", (size,))
+        cov = check_loaded(arrays["weight_cov_"], "weight_cov_", (size, size))
+        if not np.allclose(cov, cov.T, atol=1e-12 * max(np.abs(cov).max(), 1e-300)):
+            raise ValueError("member weight_cov_ is not symmetric")
+        model.weight_cov_ = cov
+        model.weights_ = check_loaded(arrays["weights_"], "weights_", (None, size))
+        model.start_ = check_loaded(arrays["start_"], "start_", (n_dims,))
+        model.start_velocity_ = check_loaded(
+            arrays["start_velocity_"], "start_velocity_", (n_dims,)
+        )
+        model.duration_ = tau
+        model.n_dims_ = n_dims
+        model.units_ = "" if not meta["units"] else check_units(meta["units"])
+        return model
