@@ -88,6 +88,13 @@ def _package_overrides(tmp: Path) -> dict:
         },
         "bidmp.experiments.ContinualBLS": {"n_basis": 20, "n_nodes": 8, "capacity": 3},
         "bidmp.primitives.prodmp_basis": {"n_basis": 6, "dt": 0.02},
+        "bidmp.primitives.PrimitiveKind": {
+            "name": "Toy",
+            "path": "bidmp.primitives.promp:ProMP",
+            "family": "several",
+        },
+        "bidmp.primitives.model_class": {"name": "DMP"},
+        "bidmp.primitives.kind_of": {"model": bidmp.DMP(n_kernels=10)},
         "bidmp.experiments.BiDMPLibrary": {"n_kernels": 20, "seed": 1},
         "bidmp.experiments.TangentChart": {"reference": np.array([1.0, 0.0, 0.0, 0.0])},
         "bidmp.experiments.demonstration_errors": {
@@ -516,6 +523,7 @@ def _instances(tmp: Path):
             "goals": DEMO[-2:],
             "times": [0.0, 0.5],
             "values": DEMO[[5]],
+            "end": DEMO[-1],
             "condition:times": [0.5],
             "cov": 0.0,
         },

@@ -94,7 +94,7 @@ def kinds(tmp_path_factory):
         path = folder / f"s{index}.csv"
         save_trajectory(demo, path, np.linspace(0, 2.0 + 0.2 * index, len(demo)), units="mm")
         paths.append(str(path))
-    for flag in ("multi", "promp"):
+    for flag in ("multi", "promp", "prodmp"):
         fit(
             [
                 "fit",
@@ -196,7 +196,7 @@ def test_the_rollout_parser_has_no_option_the_walk_does_not_take():
 
 
 @pytest.mark.parametrize(
-    "kind_name", ["dmp", "bidmp", "pose", "joints", "rhythmic", "multi", "promp"]
+    "kind_name", ["dmp", "bidmp", "pose", "joints", "rhythmic", "multi", "promp", "prodmp"]
 )
 def test_every_option_acts_or_is_refused_on_every_kind(kinds, kind_name, tmp_path, capsys):
     kind = kinds[kind_name]

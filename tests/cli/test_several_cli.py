@@ -34,7 +34,7 @@ def files(tmp_path_factory):
     return folder, paths, demos
 
 
-@pytest.mark.parametrize("flag", ["--promp", "--multi"])
+@pytest.mark.parametrize("flag", ["--promp", "--multi", "--prodmp"])
 def test_fit_several_then_roll_out_to_a_goal(files, flag, capsys):
     folder, paths, demos = files
     model, figure = folder / f"m{flag}.npz", folder / f"m{flag}.png"
@@ -80,7 +80,7 @@ def test_one_file_or_two_flags_are_refused_in_one_line(files, capsys):
     assert code == 2 and "--promp" in err
 
 
-@pytest.mark.parametrize("flag", ["--promp", "--multi"])
+@pytest.mark.parametrize("flag", ["--promp", "--multi", "--prodmp"])
 def test_every_rollout_option_acts_or_is_refused(files, flag, capsys):
     """--rate was ignored for a --multi model (169 Hz for 500), --via on a ProMP gave the
     unconditioned mean, and other options passed unnoticed. Now --rate sets the sample interval,

@@ -96,28 +96,40 @@ def test_batched_rollouts_are_the_single_trajectories():
 
 
 def test_conditioning_passes_the_via_point_and_keeps_the_start():
-    """Several demonstrations, a via-point between them: the conditioned mean passes it (to
-    1e-6 of the extent), still starts where it is told; conditioning on a goal moves the forcing
-    weights the way the demonstrations do (the mean of demonstrations that end higher, ends
-    higher and passes higher)."""
+    """Several demonstrations that rise by as much on the way as at their end: the conditioned
+    mean passes a via-point (to 1e-6 of the extent) and still starts where it is told;
+    conditioned on a goal 10 higher it ends there and passes about 7 higher half-way (the
+    demonstrations' sin(pi/4) of it), where only replacing the goal passes about 10 higher."""
     rng = np.random.default_rng(7)
     demos, times = [], []
     for _ in range(8):
-        t, y = demo(offset=(0.0, 0.0, 0.0))
+        t, y = demo()
         lift = rng.normal(0.0, 8.0)
-        y = y + lift * np.sin(np.pi * t / 3.0)[:, None] * np.array([0.0, 0.0, 1.0])
+        y = y + lift * np.sin(0.5 * np.pi * t / 3.0)[:, None] * np.array([0.0, 0.0, 1.0])
         demos.append(y)
         times.append(t)
     model = ProDMP(n_basis=15, cov_reg=1e-6).fit(demos, times)
-    via = model.trajectory(demos[0][0], times=[1.5]).y[0] + [0.0, 0.0, 6.0]
-    conditioned = model.condition([1.5], via[None], 0.0, start=demos[0][0])
-    passed = conditioned.trajectory(demos[0][0], times=[0.0, 1.5])
+    start = demos[0][0]
+    via = model.trajectory(start, times=[1.5]).y[0] + [0.0, 0.0, 6.0]
+    conditioned = model.condition([1.5], via[None], 0.0, start=start)
+    passed = conditioned.trajectory(start, times=[0.0, 1.5])
     assert np.allclose(passed.y[1], via, atol=1e-6 * 60.0)
-    assert np.allclose(passed.y[0], demos[0][0], atol=1e-9)
-    goals = np.array([demos[0][-1], demos[0][-1] + [0.0, 0.0, 10.0]])
-    moved = model.rollouts(demos[0][0][None], goals, times=[1.5, 15.0], conditioned=True)
+    assert np.allclose(passed.y[0], start, atol=1e-9)
+    goal = model.weight_mean_.reshape(3, -1)[:, -1]
+    goals = np.array([goal, goal + [0.0, 0.0, 10.0]])
+    moved = model.rollouts(start[None], goals, times=[1.5, 15.0], conditioned=True)
     assert np.allclose(moved[:, -1], goals, atol=1e-4)  # the goal is the attractor, 5 tau on
-    assert moved[1, 0, 2] > moved[0, 0, 2] + 1.0  # a higher goal passes higher on its way
+    assert 5.0 < moved[1, 0, 2] - moved[0, 0, 2] < 9.0
+    replaced = model.rollouts(start[None], goals, times=[1.5])
+    assert replaced[1, 0, 2] - replaced[0, 0, 2] > 9.5
+
+
+def test_the_goal_for_an_end_ends_there():
+    t, y = demo()
+    model = ProDMP().fit(y, [t])
+    end = y[-1] + [5.0, -4.0, 3.0]
+    attractor = model.goal_for_end(end, y[0])
+    assert np.allclose(model.trajectory(y[0], attractor, times=[0.0, 3.0]).y[-1], end, atol=1e-9)
 
 
 def test_it_is_a_scikit_learn_estimator_and_refuses_bad_input_by_name():

@@ -122,16 +122,16 @@ def demo_kind(args: argparse.Namespace) -> str:
 
 
 def model_dmp(model):
-    """The position DMP of any model class (its units and workspace)."""
-    from ..incremental.bidmp import BiDMP
-    from ..incremental.cartesian import CartesianBiDMP
-    from ..primitives.cartesian import CartesianDMP
+    """The position DMP of any point model (its units and workspace): a pose model's position
+    part, a skill library's skill 0 (by the model's kind, :mod:`bidmp.primitives.registry`)."""
+    from ..primitives.registry import kind_of
 
-    if isinstance(model, CartesianBiDMP):
+    kind = kind_of(model)
+    if kind.poses and kind.skills:  # a pose Bi-DMP: its pose DMP's position part
         return model_dmp(model.__dict__.get("cartesian_", model.cartesian))
-    if isinstance(model, CartesianDMP):
+    if kind.poses:
         return model.position_
-    if isinstance(model, BiDMP):
+    if kind.skills:
         return model.__dict__.get("dmp_", model.dmp)
     return model
 

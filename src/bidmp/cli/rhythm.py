@@ -111,7 +111,7 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
 
     from ..io.poses import save_poses
     from ..io.trajectories import save_trajectory
-    from ..primitives.rhythmic_pose import RhythmicPoseDMP
+    from ..primitives.registry import kind_of
 
     refuse_options_not_taken(
         args,
@@ -120,7 +120,7 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
         "--cycles, --frequency, --amplitude, --anchor, --from-rest, --rate and --plot",
         _RHYTHM_HINTS,
     )
-    poses = isinstance(model, RhythmicPoseDMP)
+    poses = kind_of(model).poses
     rate = 1000.0 if args.rate is None else args.rate
     if not 0 < rate <= 100_000:
         raise ValueError(f"--rate must be in (0, 100000] Hz, got {rate:g}")

@@ -99,10 +99,9 @@ def _arm_limits(args: argparse.Namespace):
 
 
 def _skill_choice(args: argparse.Namespace, model):
-    from ..incremental.bidmp import BiDMP
-    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.registry import kind_of
 
-    if not isinstance(model, (BiDMP, CartesianBiDMP)):
+    if not kind_of(model).skills:
         if args.skill is not None:
             raise ValueError(
                 f"--skill needs a Bi-DMP model; {args.model} holds a {type(model).__name__}"
@@ -118,13 +117,10 @@ def _skill_choice(args: argparse.Namespace, model):
 def cmd_rollout(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from ..incremental.bidmp import BiDMP
-    from ..incremental.cartesian import CartesianBiDMP
     from ..io.models import load_model
     from ..io.poses import save_poses
     from ..io.trajectories import save_trajectory
-    from ..primitives.cartesian import CartesianDMP, angle_between
-    from ..primitives.dmp import DMP
+    from ..primitives.cartesian import angle_between
 
     args.robot_given = args.robot is not None
     from ..sim.robots import ROBOT_MODELS
@@ -133,17 +129,14 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     if not args.tool_length >= 0:
         raise ValueError(f"--tool-length must be >= 0 metres, got {args.tool_length:g}")
     model = load_model(args.model)
-    from ..primitives.rhythmic import RhythmicDMP
-    from ..primitives.rhythmic_pose import RhythmicPoseDMP
+    from ..primitives.registry import kind_of
 
-    if isinstance(model, (RhythmicDMP, RhythmicPoseDMP)):
+    kind = kind_of(model)  # what the model is decides the rollout: its family in the registry
+    if kind.family == "rhythmic":
         from .rhythm import rollout_periodic
 
         return rollout_periodic(args, model)
-    from ..primitives.multi import MultiDMP
-    from ..primitives.promp import ProMP
-
-    if isinstance(model, (ProMP, MultiDMP)):
+    if kind.family == "several":
         from .several import rollout_several
 
         return rollout_several(args, model)
@@ -155,10 +148,10 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         )
     if args.amplitude is not None:
         raise ValueError("--amplitude is for a rhythmic model (bidmp fit --periodic)")
-    if not isinstance(model, (DMP, BiDMP, CartesianDMP, CartesianBiDMP)):
+    if kind.family != "point":
         raise ValueError(f"{args.model} holds a {type(model).__name__}, which cannot be rolled out")
     dmp = model_dmp(model)
-    poses = isinstance(model, (CartesianDMP, CartesianBiDMP))
+    poses = kind.poses
     _refuse_idle_arm(args, dmp, poses)
     skill = _skill_choice(args, model)
     options = {
@@ -167,12 +160,13 @@ def cmd_rollout(args: argparse.Namespace) -> int:
         **_timing_options(args, dmp),
     }
     # where the motion goes when --goal is not given: a Bi-DMP's latest skill's goal, else the DMP's
-    default_goal = model.skill_goals_[-1] if isinstance(model, BiDMP) else dmp.goal_
+    point_skills = kind.skills and not kind.poses  # a Bi-DMP of points: its skills' goals
+    default_goal = model.skill_goals_[-1] if point_skills else dmp.goal_
     if skill is not None:
         options["skill"] = skill
-        goals = model.skill_goals_ if isinstance(model, BiDMP) else model.position_.skill_goals_
+        goals = model.skill_goals_ if point_skills else model.position_.skill_goals_
         index = model.select_skill(
-            default_goal if args.goal is None and isinstance(model, BiDMP) else args.goal, skill
+            default_goal if args.goal is None and point_skills else args.goal, skill
         )
         print(
             f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})"

@@ -1,6 +1,7 @@
-"""``bidmp fit --promp A B …`` and ``bidmp fit --multi A B …``: a model from several
-demonstrations; and ``bidmp rollout`` of one (a ProMP conditioned exactly on the goal). Thin: read
-the files, call :mod:`bidmp.primitives.promp` / :mod:`bidmp.primitives.multi`, print."""
+"""``bidmp fit --promp A B …``, ``--multi``, ``--prodmp``: a model from several demonstrations
+(one flag per kind of :mod:`bidmp.primitives.registry` learned so); and ``bidmp rollout`` of one
+(its mean, conditioned on the goal, the start and via-points as the kind can). Thin: read the
+files, call the primitive, print."""
 
 from __future__ import annotations
 
@@ -10,28 +11,107 @@ from .inputs import demo_kind, read_input, refuse_options_not_taken
 
 EXIT_OK = 0
 
+# The fit options each kind acts on besides the demonstrations' own (units, columns, stamps …,
+# what read_input reads) and -o/--plot: every other one is refused, in one line.
+_FIT_TAKES = {
+    "ProMP": {"n_kernels"},
+    "MultiDMP": {"n_kernels", "alpha", "protocol"},
+    "ProDMP": {"n_kernels", "alpha", "alpha_phase"},
+}
+# The DMP's fit options (the rest of bidmp fit's options are the demonstration's, read by
+# read_input, or choose what is learned)
+_DMP_FIT_OPTIONS = {
+    "protocol", "n_kernels", "alpha", "beta", "K", "alpha_phase", "tau", "regression",
+    "keep_approach",
+}  # fmt: skip
 
-def fit_several(args: argparse.Namespace) -> int:
-    """Learn a ProMP (``--promp``) or a several-demonstration DMP (``--multi``)."""
+
+def several_flags() -> dict[str, str]:
+    """``bidmp fit``'s flags for the kinds learned from several demonstrations: flag -> what it
+    learns (from the model kinds' registry)."""
+    from ..primitives.registry import MODEL_KINDS
+
+    return {kind.fit_flag: kind.summary for kind in MODEL_KINDS.values() if kind.fit_flag}
+
+
+def _kind_for(flag: str):
+    from ..primitives.registry import MODEL_KINDS
+
+    return next(kind for kind in MODEL_KINDS.values() if kind.fit_flag == flag)
+
+
+def _refuse_unused_fit_options(args: argparse.Namespace, kind) -> None:
+    takes = _FIT_TAKES.get(kind.name, set())
+    for name in sorted(_DMP_FIT_OPTIONS - takes):
+        if getattr(args, name, None) != args.unset_options.get(name):
+            shown = ", ".join("--" + n.replace("_", "-") for n in sorted(takes)) or "no options"
+            raise ValueError(
+                f"--{name.replace('_', '-')} does not apply to --{kind.fit_flag}; it takes {shown}"
+            )
+
+
+def _learn(kind, args: argparse.Namespace, demos, stamps, units):
+    """(model, mean (200, D), std (200, D), the mean's times, what it is) of ``kind``."""
+    import numpy as np
+
+    cls = kind.load()
+    if kind.name == "MultiDMP":
+        from ..primitives.dmp import DMP
+
+        dmp = DMP(n_kernels=args.n_kernels, alpha=args.alpha, protocol=args.protocol)
+        model = cls(dmp=dmp).fit(demos, stamps, units=units)
+        motion = model.trajectory()
+        std = model.std(n_steps=len(motion.t))
+        return (
+            model,
+            motion.y,
+            std,
+            motion.t,
+            (f"a DMP from several demonstrations ({model.dmp_.protocol} protocol)"),
+        )
+    if kind.name == "ProDMP":
+        params = {"n_basis": args.n_kernels or 10}
+        for name in ("alpha", "alpha_phase"):
+            if getattr(args, name) is not None:
+                params[name] = getattr(args, name)
+        model = cls(**params).fit(demos, stamps, units=units)
+        t = np.linspace(0.0, model.duration_, 200)
+        mean, std = model.trajectory(times=t).y, model.std(times=t)
+        return model, mean, std, t, f"a ProDMP ({model.n_basis} basis functions per dimension)"
+    model = cls(n_basis=args.n_kernels or 20).fit(demos, stamps, units=units)
+    mean, std = model.mean(n_steps=200), np.sqrt(model.var(n_steps=200))
+    return (
+        model,
+        mean,
+        std,
+        np.linspace(0.0, model.duration_, 200),
+        (f"a ProMP ({model.n_basis} basis functions per dimension)"),
+    )
+
+
+def fit_several(args: argparse.Namespace, flag: str) -> int:
+    """Learn the kind of ``--flag`` from several demonstrations."""
     import numpy as np
 
     from ..io.models import save_model
-    from ..primitives.dmp import DMP
-    from ..primitives.multi import MultiDMP
-    from ..primitives.promp import ProMP
 
-    paths = args.promp or args.multi
+    kind = _kind_for(flag)
+    if kind.name not in _FIT_TAKES:
+        raise ValueError(
+            f"--{kind.fit_flag}: the command line has no adapter for a {kind.name} (its options "
+            "and its report); learn it in Python and save it with bidmp.io.save_model"
+        )
+    _refuse_unused_fit_options(args, kind)
+    paths = getattr(args, flag.replace("-", "_"))
     if args.demo is not None:
         paths = [args.demo, *paths]
     if len(paths) < 2:
-        raise ValueError(
-            "--promp/--multi learn from several demonstrations: give two or more files"
-        )
+        raise ValueError(f"--{flag} learns from several demonstrations: give two or more files")
     demos, times, units = [], [], None
     for path in paths:
         args.demo, args._bag = path, None  # read_input reads args.demo's bag, cached per file
         if demo_kind(args) == "pose":
-            raise ValueError(f"{path} holds poses: --promp/--multi learn positions or joints")
+            raise ValueError(f"{path} holds poses: --{flag} learns positions or joints")
         y, t, file_units, how, *_ = read_input(path, args, timed=True)
         if units is not None and file_units != units:
             raise ValueError(
@@ -41,23 +121,13 @@ def fit_several(args: argparse.Namespace) -> int:
         demos.append(y)
         times.append(t)
     stamps = None if any(t is None for t in times) else times
-    if args.promp:
-        model = ProMP(n_basis=args.n_kernels or 20).fit(demos, stamps, units=units)
-        mean, std = model.mean(n_steps=200), np.sqrt(model.var(n_steps=200))
-        mean_t = np.linspace(0.0, model.duration_, 200)
-        kind = f"a ProMP ({model.n_basis} basis functions per dimension)"
-    else:
-        dmp = DMP(n_kernels=args.n_kernels, alpha=args.alpha, protocol=args.protocol)
-        model = MultiDMP(dmp=dmp).fit(demos, stamps, units=units)
-        motion = model.trajectory()
-        mean, std, mean_t = motion.y, model.std(n_steps=len(motion.t)), motion.t
-        kind = f"a DMP from several demonstrations ({model.dmp_.protocol} protocol)"
+    model, mean, std, mean_t, what = _learn(kind, args, demos, stamps, units)
     # the figure on time: each demonstration on its own (over 1 s without stamps, as fitted)
     own = [np.linspace(0.0, 1.0, len(y)) if t is None else t - t[0] for y, t in zip(demos, times)]
     path = save_model(model, args.output)
     unit = units or "units"
     lengths = ", ".join(str(len(y)) for y in demos)
-    print(f"fitted {kind} on {len(demos)} demonstrations ({lengths} samples)")
+    print(f"fitted {what} on {len(demos)} demonstrations ({lengths} samples)")
     print(
         f"  spread along the mean motion: median standard deviation "
         f"{float(np.median(np.linalg.norm(std, axis=1))):.4g} {unit}, largest "
@@ -80,24 +150,26 @@ def fit_several(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-# What a ProMP's and a DMP of several demonstrations' rollouts act on: --goal, --start (a DMP of
-# several demonstrations refuses it itself: it starts where they did), --rate, --plot, -o, and:
-_SEVERAL_TAKES = {"ProMP": {"via"}, "MultiDMP": {"via", "duration"}}
-_BOTH_TAKE = {"goal", "start", "rate", "plot", "output"}
+# What a rollout of each kind acts on besides --goal, --rate, --plot and -o: --start where the
+# kind can start anywhere (a DMP of several demonstrations starts where they did), --via where it
+# conditions on via-points, --duration where it can be stretched.
+_SEVERAL_TAKES = {
+    "ProMP": {"start", "via"},
+    "MultiDMP": {"via", "duration"},
+    "ProDMP": {"start", "via"},
+}
+_ALL_TAKE = {"goal", "rate", "plot", "output"}
 
 
-def _refuse_unused(args: argparse.Namespace, model, promp_class) -> None:
-    """Every rollout option a ProMP or a DMP of several demonstrations would not act on is refused,
-    in one line (none is silently ignored); ``--goal``, ``--start`` (a ProMP), ``--rate`` and
-    ``--plot`` act on both."""
-    kind = "ProMP" if isinstance(model, promp_class) else "MultiDMP"
-    takes = _BOTH_TAKE | _SEVERAL_TAKES[kind]
+def _refuse_unused(args: argparse.Namespace, kind) -> None:
+    """Every rollout option the kind would not act on is refused, in one line (none is silently
+    ignored); ``--goal``, ``--rate`` and ``--plot`` act on every kind."""
+    own = _SEVERAL_TAKES[kind.name]
     refuse_options_not_taken(
         args,
-        takes,
-        f"a {type(model).__name__}",
-        f"--goal, {'--start, ' if kind == 'ProMP' else ''}--rate, "
-        f"{', '.join('--' + n for n in sorted(_SEVERAL_TAKES[kind]))} and --plot",
+        _ALL_TAKE | own | ({"start"} if kind.name == "MultiDMP" else set()),
+        f"a {kind.name}",
+        "--goal, --rate, " + ", ".join("--" + n for n in sorted(own)) + " and --plot",
     )
 
 
@@ -122,12 +194,23 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     import numpy as np
 
     from ..io.trajectories import save_trajectory
-    from ..primitives.promp import ProMP
+    from ..primitives.registry import kind_of
 
-    _refuse_unused(args, model, ProMP)
+    kind = kind_of(model)
+    if kind.name not in _SEVERAL_TAKES:
+        raise ValueError(
+            f"{args.model} holds a {kind.name}: the command line has no rollout adapter for it; "
+            "roll it out in Python"
+        )
+    _refuse_unused(args, kind)
     goal = None if args.goal is None else np.asarray(args.goal, dtype=float)
     via = _via_pairs(args, model)
-    if isinstance(model, ProMP):
+    if kind.name == "ProDMP":
+        trajectory, mean, std, base, base_std, marks, times = _prodmp_rollout(
+            args, model, goal, via
+        )
+        demos, units = [], model.units_
+    elif kind.name == "ProMP":
         points, values = [], []
         if args.start is not None or goal is not None:
             # the start held where it is asked (default: the demonstrations' mean start), so a
@@ -207,3 +290,38 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         )
         print(f"wrote {figure}")
     return EXIT_OK
+
+
+def _prodmp_rollout(args: argparse.Namespace, model, goal, via) -> tuple:
+    """A ProDMP's mean motion from ``--start`` (default the demonstrations' mean start, at rest)
+    to ``--goal`` (its end at tau: the goal weight moved to put it there, as a DMP generalises),
+    its weights conditioned exactly on the via-points first; with the spread."""
+    import numpy as np
+
+    start = model.start_ if args.start is None else np.asarray(args.start, dtype=float)
+    conditioned = model
+    for t, _ in via:
+        if not 0.0 <= t <= model.duration_:
+            raise ValueError(f"--via at {t:g} s is outside the motion's {model.duration_:.4g} s")
+    if via:
+        conditioned = conditioned.condition(
+            [t for t, _ in via], np.array([p for _, p in via]), 0.0, start=start
+        )
+    dt = min(1.0 / (args.rate or 100.0), model.duration_)
+    t = np.arange(int(model.duration_ / dt + 1e-9) + 1) * dt
+    # --goal is where the motion ends: the goal weight moved to put the end there at tau
+    attractor = None if goal is None else conditioned.goal_for_end(goal, start)
+    trajectory = conditioned.trajectory(start, attractor, times=t)
+    base = model.trajectory(start, times=t).y
+    points = [(0.0, start)] + ([(t[-1], goal)] if goal is not None else []) + list(via)
+    marks = (np.array([p[0] for p in points]), np.array([p[1] for p in points]))
+    times = {"demonstrations": [], "mean": t, "conditioned": t}
+    return (
+        trajectory,
+        trajectory.y,
+        conditioned.std(times=t),
+        base,
+        model.std(times=t),
+        marks,
+        times,
+    )

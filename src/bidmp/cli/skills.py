@@ -23,12 +23,10 @@ EXIT_OK = 0
 
 def _skills_model(args: argparse.Namespace, command: str):
     """The model ``extend`` and ``learn`` grow, as a Bi-DMP (a DMP becomes its skill 0): a
-    :class:`bidmp.BiDMP` or, for pose models, a :class:`bidmp.CartesianBiDMP`."""
-    from ..incremental.bidmp import BiDMP
-    from ..incremental.cartesian import CartesianBiDMP
+    :class:`bidmp.BiDMP` or, for pose models, a :class:`bidmp.CartesianBiDMP` (the model kind's
+    ``incremental``, :mod:`bidmp.primitives.registry`)."""
     from ..io.models import load_model
-    from ..primitives.cartesian import CartesianDMP
-    from ..primitives.dmp import DMP
+    from ..primitives.registry import kind_of
 
     if not args.output.lower().endswith(".npz"):
         hint = (
@@ -38,22 +36,20 @@ def _skills_model(args: argparse.Namespace, command: str):
             f"-o must be the Bi-DMP model file to write (.npz), got {args.output}{hint}"
         )
     model = load_model(args.model)
-    if isinstance(model, DMP):
-        return BiDMP(model)
-    if isinstance(model, CartesianDMP):
-        return CartesianBiDMP(model)
-    if isinstance(model, (BiDMP, CartesianBiDMP)):
-        return model
-    raise ValueError(
-        f"{args.model} holds a {type(model).__name__}; {command} needs a DMP, a Bi-DMP or a pose model"
-    )
+    kind = kind_of(model)
+    if kind.incremental is None:
+        raise ValueError(
+            f"{args.model} holds a {type(model).__name__}; {command} needs a DMP, a Bi-DMP or a "
+            "pose model"
+        )
+    return kind.grow(model)
 
 
 def _demo_for(model, args: argparse.Namespace):
     """The demonstration for ``model`` (poses for a pose model), checked against its D."""
-    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.registry import kind_of
 
-    poses = isinstance(model, CartesianBiDMP)
+    poses = kind_of(model).poses
     kind = demo_kind(args)
     if poses and kind != "pose":
         raise ValueError(
@@ -93,15 +89,22 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from ..io.models import save_model
     from ..primitives.dmp import DMP
     from ..tasks.metrics import path_extent
+    from .several import several_flags
 
-    if args.promp or args.multi:
+    given = [flag for flag in several_flags() if getattr(args, flag.replace("-", "_"))]
+    if given:
         from .several import fit_several
 
-        if args.periodic or (args.promp and args.multi):
-            raise ValueError("give one of --periodic, --promp, --multi")
-        return fit_several(args)
+        if args.periodic or len(given) > 1:
+            flags = ", ".join("--" + flag for flag in several_flags())
+            raise ValueError(f"give one of --periodic, {flags}")
+        return fit_several(args, given[0])
     if args.demo is None:
-        raise ValueError("give the demonstration to learn (or several after --promp/--multi)")
+        raise ValueError(
+            "give the demonstration to learn (or several after "
+            + "/".join("--" + flag for flag in several_flags())
+            + ")"
+        )
     if args.periodic:
         from .rhythm import fit_periodic
 
@@ -262,16 +265,16 @@ def cmd_extend(args: argparse.Namespace) -> int:
 
     from .._trajectory import resample_time
     from ..extension.extend import extend_demonstration, extend_pose_demonstration
-    from ..incremental.cartesian import CartesianBiDMP
     from ..io.models import save_model
     from ..io.poses import save_poses
     from ..io.trajectories import save_trajectory
+    from ..primitives.registry import kind_of
     from ..tasks.metrics import path_extent, rmse
 
     model = _skills_model(args, "extend")
     y, units, how = _demo_for(model, args)
     scene = scene_option(args, units)
-    poses = isinstance(model, CartesianBiDMP)
+    poses = kind_of(model).poses
     if poses:
         if args.approach != "keep":
             raise ValueError(
@@ -442,26 +445,25 @@ def add_commands(commands, parse_K, allow_outside_files) -> None:
         help="learn a rhythmic DMP from a recording of several periods (frequency estimated, "
         "transients cut, all periods at once); --n-kernels (default 50) and --alpha (default 25) apply",
     )
-    fit.add_argument(
-        "--promp",
-        nargs="+",
-        metavar="DEMO",
-        help="learn a ProMP from several demonstrations (any lengths and rates); --n-kernels "
-        "(default 20) basis functions per dimension",
-    )
-    fit.add_argument(
-        "--multi",
-        nargs="+",
-        metavar="DEMO",
-        help="learn a DMP from several demonstrations (aligned by phase, their spread kept)",
-    )
+    from .several import several_flags
+
+    for flag, summary in several_flags().items():  # one per registered kind (the registry's)
+        fit.add_argument(f"--{flag}", nargs="+", metavar="DEMO", help=f"learn {summary}")
     fit.add_argument(
         "--plot",
         metavar="PNG",
         help="with --periodic: the learned cycle, its phase portrait and the spectrum; with "
-        "--promp/--multi: the mean with its ±2σ band over the demonstrations",
+        "--promp/--multi/--prodmp: the mean with its ±2σ band over the demonstrations",
     )
-    fit.set_defaults(handler=cmd_fit)
+    # every option's value when it is not given: a kind that acts on only some refuses the rest
+    fit.set_defaults(
+        handler=cmd_fit,
+        unset_options={
+            action.dest: action.default
+            for action in fit._actions
+            if action.option_strings and action.dest != "help"
+        },
+    )
 
     rollout = commands.add_parser(
         "rollout",

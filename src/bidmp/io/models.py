@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .._checks import check_path, short_token
+from ..primitives.registry import MODEL_KINDS as _KINDS
+from ..primitives.registry import kind_of as _kind_of
 from ._npy import NpzMembers, read_npz
 from .atomic import _destination, atomic_write
 from .strict_json import load_json
@@ -40,20 +42,8 @@ _MIN_VERSION = {"BiDMP": 2}
 _FORMAT_NAME = "bidmp-model"
 _META_KEY = "__bidmp__"
 _META_MAX_BYTES = 16 << 20
-# Model classes that may appear in a file: name -> (module, attribute). Imported lazily so that
-# reading a DMP does not import the whole pipeline.
-_MODEL_CLASSES = {
-    "DMP": ("bidmp.primitives.dmp", "DMP"),
-    "BLS": ("bidmp.incremental.bls", "BLS"),
-    "BiDMP": ("bidmp.incremental.bidmp", "BiDMP"),
-    "CartesianDMP": ("bidmp.primitives.cartesian", "CartesianDMP"),
-    "CartesianBiDMP": ("bidmp.incremental.cartesian", "CartesianBiDMP"),
-    "RhythmicDMP": ("bidmp.primitives.rhythmic", "RhythmicDMP"),
-    "RhythmicPoseDMP": ("bidmp.primitives.rhythmic_pose", "RhythmicPoseDMP"),
-    "ProMP": ("bidmp.primitives.promp", "ProMP"),
-    "ProDMP": ("bidmp.primitives.prodmp", "ProDMP"),
-    "MultiDMP": ("bidmp.primitives.multi", "MultiDMP"),
-}
+# The classes a file may name: the model kinds of bidmp.primitives.registry, each imported when
+# a file names it, so that reading a DMP does not import the whole pipeline.
 
 
 class ModelFileError(ValueError):
@@ -61,10 +51,7 @@ class ModelFileError(ValueError):
 
 
 def _model_class(name: str):
-    import importlib
-
-    module_name, attribute = _MODEL_CLASSES[name]
-    return getattr(importlib.import_module(module_name), attribute)
+    return _KINDS[name].load()
 
 
 def _model_path(path: str | os.PathLike) -> Path:
@@ -89,10 +76,14 @@ def save_model(model, path: str | os.PathLike) -> Path:
     from .. import __version__
 
     class_name = type(model).__name__
-    if class_name not in _MODEL_CLASSES or not hasattr(model, "_get_state"):
-        raise TypeError(
-            f"model must be one of {', '.join(sorted(_MODEL_CLASSES))}, got {class_name}"
-        )
+    try:
+        _kind_of(model)
+    except ValueError:
+        known = False
+    else:
+        known = hasattr(model, "_get_state")
+    if not known:
+        raise TypeError(f"model must be one of {', '.join(sorted(_KINDS))}, got {class_name}")
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = _model_path(path)
@@ -198,7 +189,7 @@ def _model_class_name(meta: dict, path: Path) -> str:
             f"this bidmp reads format {FORMAT_VERSION} or older: upgrade bidmp"
         )
     class_name = meta.get("class")
-    if not isinstance(class_name, str) or class_name not in _MODEL_CLASSES:
+    if not isinstance(class_name, str) or class_name not in _KINDS:
         raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
     if version < _MIN_VERSION.get(class_name, 1):
         raise ModelFileError(

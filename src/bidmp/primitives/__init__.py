@@ -66,6 +66,7 @@ if TYPE_CHECKING:
     from .prodmp import ProDMP, ProDMPBasis, prodmp_basis
     from .promp import ProMP, condition_gaussian, promp_basis
     from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
+    from .registry import MODEL_KINDS, PrimitiveKind, kind_of, model_class, register_kind
     from .rhythmic import RhythmicDMP, RhythmicStepper
     from .rhythmic_pose import RhythmicPoseDMP, mean_orientation
     from .so3 import continuous_log, orientation_from_log, principal_log

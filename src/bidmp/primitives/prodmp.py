@@ -48,7 +48,7 @@ from .._checks import (
     check_real,
 )
 from .._units import check_units
-from .promp import _weight_covariance, condition_gaussian
+from .promp import condition_gaussian
 from .timing import Trajectory
 
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
@@ -227,6 +227,24 @@ def _cumulative_trapezoid(values: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
+def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
+    """The covariance (M, M) of weights (n, M) of n demonstrations plus ``cov_reg`` times each
+    weight's own variance on the diagonal (its square where it does not vary: one demonstration).
+    Per weight, not the mean variance a ProMP adds: a ProDMP's forcing weights run to 1e4 where
+    its goal is a few units, and one isotropic term would make the goal's spread the forcing's."""
+    size = weights.shape[1]
+    cov = (
+        np.cov(weights, rowvar=False).reshape(size, size)
+        if weights.shape[0] > 1
+        else np.zeros((size, size))
+    )
+    variance = np.diag(cov).copy()
+    scale = np.where(variance > 0.0, variance, weights.mean(axis=0) ** 2)
+    scale = np.maximum(scale, 1e-12 * max(float(scale.max()), 1e-300))
+    cov[np.diag_indices(size)] += cov_reg * scale
+    return cov
+
+
 def _demonstrations(demonstrations) -> list[np.ndarray]:
     if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
         demonstrations = [demonstrations]
@@ -263,7 +281,7 @@ class ProDMP(Estimator):
     ridge : float, default 1e-9
         Ridge λ of each demonstration's weights (absolute, as MP_PyTorch's ``reg``).
     cov_reg : float, default 1e-2
-        Added to the weights' covariance, times their mean variance, on the diagonal.
+        Added to the weights' covariance on the diagonal, times each weight's own variance.
 
     Attributes
     ----------
@@ -306,9 +324,9 @@ class ProDMP(Estimator):
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProDMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, or one (T, D)) with their
         stamps ``times`` (a list of (T_i,) arrays, s; None: each uniform over ``tau``, or 1 s).
-        Each demonstration's weights and goal are the least-squares fit of its positions from its
-        own start (its first sample, the velocity of its first step), as MP_PyTorch learns them.
-        Returns self."""
+        Each demonstration is timed onto tau (its own phase, as a ProMP's), and its weights and
+        goal are the least-squares fit of its positions from its own start (its first sample, the
+        velocity of its first step), as MP_PyTorch learns them. Returns self."""
         demos = _demonstrations(demonstrations)
         ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6)
         cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
@@ -328,8 +346,9 @@ class ProDMP(Estimator):
         weights = np.empty((len(demos), n_dims * size))
         starts, velocities = [], []
         for index, (y, t) in enumerate(zip(demos, stamps)):
-            t = t - t[0]
-            start, velocity = y[0], (y[1] - y[0]) / basis.dt
+            # each demonstration on its own phase: its time stretched onto tau (as a ProMP's)
+            t = (t - t[0]) * (tau / (t[-1] - t[0]))
+            start, velocity = y[0], (y[1] - y[0]) / (t[1] - t[0])
             p0, v0, _, _, H, _ = basis.boundary_maps(t, 0.0)
             free = y - p0[:, None] * start - v0[:, None] * (velocity * tau)
             gram = H.T @ H + ridge * np.eye(size)
@@ -489,6 +508,51 @@ class ProDMP(Estimator):
         alpha = basis.alpha
         ddy = -alpha * dy - alpha**2 / 4.0 * (y - w[:, -1]) + forcing  # d²/ds²
         return Trajectory(t, y, dy / tau, ddy / tau**2, units=self.units_)
+
+    def goal_for_end(self, end, start=None, *, start_velocity=None) -> np.ndarray:
+        """(D,): the goal (the attractor, the goal weight) with which the mean motion from
+        ``start`` ends exactly at ``end`` at tau. The learned goal is not where a demonstration
+        ends — it is fitted with the forcing weights, which share its effect — so a new end is
+        reached by moving the goal by what it lacks there, over the goal column's value at tau."""
+        self._check_fitted()
+        end = as_points(end, self.n_dims_, "end")[0]
+        start, velocity = self._boundary(start, start_velocity)
+        w = self.weight_mean_.reshape(self.n_dims_, -1)
+        p0, v0, _, _, H, _ = self.basis_.boundary_maps(np.array([self.duration_]), 0.0)
+        there = p0[0] * start[0] + v0[0] * velocity[0] * self.duration_ + H[0] @ w.T
+        return w[:, -1] + (end - there) / H[0, -1]
+
+    def std(self, times=None, n_steps: int = 100) -> np.ndarray:
+        """(T, D): the positions' standard deviation (units) under the weights' Gaussian at
+        ``times`` (s; default ``n_steps`` over tau) — the boundary condition is exact, so it does
+        not depend on the start."""
+        self._check_fitted()
+        t = self._times(times, n_steps)
+        H = self.basis_.boundary_maps(t, 0.0)[4]
+        size = self.basis_.n_basis + 1
+        out = np.empty((len(t), self.n_dims_))
+        for d in range(self.n_dims_):
+            block = self.weight_cov_[d * size : (d + 1) * size, d * size : (d + 1) * size]
+            out[:, d] = np.sqrt(np.maximum(np.einsum("tk,kl,tl->t", H, block, H), 0.0))
+        return out
+
+    def condition_goal(self, goal) -> ProDMP:
+        """A copy whose weights are conditioned exactly on the goal ``goal`` (D,): the goal weights
+        become ``goal``, the forcing weights move as the demonstrations say they go with it."""
+        import copy
+
+        self._check_fitted()
+        goal = as_points(goal, self.n_dims_, "goal")[0]
+        size = self.basis_.n_basis + 1
+        index = np.arange(self.n_dims_) * size + size - 1
+        columns = np.zeros((self.weight_mean_.size, self.n_dims_))
+        columns[index, np.arange(self.n_dims_)] = 1.0
+        mean, cov = condition_gaussian(
+            self.weight_mean_, self.weight_cov_, columns, goal, np.zeros((self.n_dims_,) * 2)
+        )
+        conditioned = copy.copy(self)
+        conditioned.weight_mean_, conditioned.weight_cov_ = mean, cov
+        return conditioned
 
     def condition(self, times, values, cov=0.0, *, start=None, start_velocity=None) -> ProDMP:
         """A copy whose weights are conditioned exactly on passing ``values`` (K, D) at ``times``

@@ -40,6 +40,7 @@ _BUILTIN_ORDER = (
     "mp-dmp",
     "promp",
     "dmp-multi",
+    "prodmp",
 )
 
 

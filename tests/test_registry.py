@@ -1,0 +1,104 @@
+"""The model kinds' registry is the one place that knows the model classes: model files read it,
+``bidmp fit`` builds its flags from it, and nothing in the command line or the files asks a model
+for its class (an AST scan). ProDMP, the newest kind, is its module plus its registry entry; what
+else names it is listed here, so a new site is a decision, not an accident."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bidmp.primitives import registry
+from bidmp.primitives.promp import ProMP
+from bidmp.primitives.registry import MODEL_KINDS, PrimitiveKind, kind_of, register_kind
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "bidmp"
+
+
+def test_every_kind_loads_as_the_class_it_names():
+    for name, kind in MODEL_KINDS.items():
+        cls = kind.load()
+        assert cls.__name__ == name and hasattr(cls, "_get_state"), name
+
+
+def _isinstance_on_kinds(folder: Path) -> list[str]:
+    found = []
+    for path in sorted(folder.rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "isinstance":
+                names = {n.id for n in ast.walk(node.args[1]) if isinstance(n, ast.Name)}
+                names |= {n.attr for n in ast.walk(node.args[1]) if isinstance(n, ast.Attribute)}
+                if names & set(MODEL_KINDS):
+                    found.append(f"{path.relative_to(SRC)}:{node.lineno}")
+    return found
+
+
+def test_the_command_line_and_the_files_never_ask_a_model_for_its_class():
+    assert _isinstance_on_kinds(SRC / "cli") == []
+    assert _isinstance_on_kinds(SRC / "io") == []
+
+
+def test_what_names_the_newest_kind_outside_its_own_module():
+    """ProDMP: its module and its registry entry, exported by bidmp.primitives; beyond them the
+    task methods' one file (a way to learn a task is a method) and the command line's adapter of
+    the kinds learned from several demonstrations (what --n-kernels means for each)."""
+    naming = {
+        str(path.relative_to(SRC))
+        for path in SRC.rglob("*.py")
+        if "ProDMP" in path.read_text() and path.name != "prodmp.py"
+    }
+    assert naming == {
+        "primitives/registry.py",
+        "primitives/__init__.py",
+        "tasks/methods/multi.py",
+        "cli/several.py",
+    }
+
+
+def test_a_new_kind_gets_its_fit_flag_and_its_model_files(tmp_path, capsys):
+    """A kind registered at run time: bidmp fit grows its flag; a model file of it saves and
+    loads (the files read the registry); kind_of tells it from its look-alike parent."""
+    from bidmp.cli import build_parser
+    from bidmp.io import load_model, save_model
+
+    kind = PrimitiveKind(
+        "WideProMP", f"{__name__}:WideProMP", "several", fit_flag="wide-promp", summary="toy"
+    )
+    register_kind(kind)
+    try:
+        parser = build_parser()
+        fit = next(a for a in parser._actions if a.dest == "command").choices["fit"]
+        assert any("--wide-promp" in a.option_strings for a in fit._actions)
+        # ... which refuses, in one line, to guess how to learn a kind it has no adapter for
+        from bidmp.cli import main
+
+        files = []
+        for k in range(2):
+            files.append(str(tmp_path / f"d{k}.csv"))
+            demo_k = np.column_stack([np.linspace(0, 1, 50), np.sin(np.linspace(0, 3, 50)) + k])
+            np.savetxt(files[-1], demo_k, delimiter=",", header="x,y", comments="")
+        assert main(["fit", "--wide-promp", *files, "-o", str(tmp_path / "w.npz")]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and "no adapter for a WideProMP" in err[0]
+        demo = np.column_stack([np.linspace(0, 1, 50), np.sin(np.linspace(0, 3, 50))])
+        model = WideProMP(n_basis=6).fit([demo, demo + 0.1])
+        assert kind_of(model) is kind
+        assert kind_of(ProMP(n_basis=6).fit([demo, demo + 0.1])).name == "ProMP"
+        loaded = load_model(save_model(model, tmp_path / "wide"))
+        assert type(loaded) is WideProMP
+        assert np.array_equal(loaded.weight_mean_, model.weight_mean_)
+    finally:
+        MODEL_KINDS.pop("WideProMP")
+    with pytest.raises(ValueError, match="registered already"):
+        register_kind(MODEL_KINDS["ProDMP"])
+    with pytest.raises(ValueError, match="fit flag --prodmp"):
+        register_kind(PrimitiveKind("Other", "x:Other", "several", fit_flag="prodmp"))
+    assert "Other" not in registry.MODEL_KINDS
+
+
+class WideProMP(ProMP):
+    """A ProMP subclass, registered as a kind of its own in the test above."""
