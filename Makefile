@@ -121,6 +121,8 @@ bench-smoke: $(STAMP)
 	cd benchmarks && ../$(PY) bench_verify.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_robustness.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_startup.py --smoke > /dev/null
+	cd benchmarks && ../$(PY) bench_threads.py --rounds 1 --load 0 > /dev/null
+	cd benchmarks && ../$(PY) bench_clfd.py --tasks 2 --sides serial > /dev/null
 	rm -rf .bench-smoke
 
 # The 3-D viewer of a simulation run rendered in headless Chromium (Debian's package chromium:

@@ -47,8 +47,10 @@ def main() -> None:
     for name, row in any_result.rows.items():
         print(f"  {name}: training at most {max(row.times) * 1e3:.1f} ms per task (one core)")
     limit = 600.0
-    worst = max(walls.get("dask", float("inf")), 0.0)
-    print(f"target: the whole protocol within {limit:.0f} s on 2 cores: {worst <= limit}")
+    side = "dask" if "dask" in walls else "serial"  # the 2-worker side, else the serial one
+    print(
+        f"target: the whole protocol within {limit:.0f} s on 2 cores ({side}): {walls[side] <= limit}"
+    )
 
 
 if __name__ == "__main__":

@@ -38,6 +38,7 @@ from .._checks import (
     numerically_guarded,
     short_token,
 )
+from .._threads import single_threaded
 from .._trajectory import resample_time, rmse
 from ..primitives.dmp import DMP
 from .bidmp_state import _bidmp_from_state, _bidmp_state
@@ -218,6 +219,7 @@ class BiDMP(Estimator):
         self._check_params()
         self._start(self.dmp)
 
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, y) -> BiDMP:
         """Fit a copy of ``dmp`` (default ``DMP()``) on the demonstration ``y`` (T, D) as skill 0,
         forgetting every learned skill. Returns self."""
@@ -239,6 +241,7 @@ class BiDMP(Estimator):
         return self.dmp_.n_dims_
 
     @numerically_guarded
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def learn(self, y_dn, *, duration: float | None = None) -> BiDMP:
         """Learn an extended demonstration as a new skill (Eq. 15, 27, 28). Returns self.
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from .._api import Estimator, clone
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
+from .._threads import single_threaded
 from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
 from ..primitives.pose_timing import PoseStepper, PoseTrajectory
 from ..primitives.so3 import angle_between, as_quaternions, orientation_from_log, principal_log
@@ -142,6 +143,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         return "cartesian_" in self.__dict__
 
     @numerically_guarded
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, poses, t=None, units: str | None = None) -> CartesianBiDMP:
         """Fit a copy of ``cartesian`` (default ``CartesianDMP()``) on one pose demonstration as
         skill 0, with no learned skills yet. Returns self."""
@@ -157,6 +159,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         return self.position_.n_skills
 
     @numerically_guarded
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def learn(self, poses, *, duration: float | None = None) -> CartesianBiDMP:
         """Learn a pose demonstration ``(T', 7)`` as a new skill (both parts), lasting ``duration``
         seconds (default the demonstration's; see :meth:`bidmp.BiDMP.learn`). Returns self."""

@@ -39,6 +39,7 @@ from .._checks import (
     numerically_guarded,
 )
 from .._state import Prefixed
+from .._threads import single_threaded
 from .._trajectory import continuous_quaternions as _continuous
 from .dmp import DMP
 from .forcing import _check_forcing_increment
@@ -290,6 +291,7 @@ class CartesianDMP(PoseModel, Estimator):
         return DMP(**self.get_params())
 
     @numerically_guarded
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, poses, t=None, units: str | None = None) -> CartesianDMP:
         """Learn from one pose demonstration ``(T, 7)`` (x, y, z, qx, qy, qz, qw), with optional
         timestamps ``t`` (s) as :meth:`bidmp.DMP.fit`. Quaternion sign flips are made continuous;

@@ -56,6 +56,7 @@ from .._checks import (
     check_names,
     numerically_guarded,
 )
+from .._threads import single_threaded
 from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
@@ -267,6 +268,7 @@ class DMP(_FittedParams, Estimator):
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> DMP:
         """Learn the forcing-term weights from one demonstration.
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from .._api import Estimator, clone
 from .._checks import NotFittedError, as_point, check_int, check_real, check_seed
+from .._threads import single_threaded
 from .._trajectory import resample_time
 from .dmp import DMP
 from .forcing import _regression_factor, _solve_weights
@@ -55,6 +56,7 @@ class MultiDMP(Estimator):
         self.dmp = dmp
         self.cov_reg = cov_reg
 
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, demonstrations, times=None, units: str | None = None) -> MultiDMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays) with their stamps ``times``
         (a list of (T_i,) arrays, s; None: each over 1 s)."""

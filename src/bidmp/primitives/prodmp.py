@@ -47,6 +47,7 @@ from .._checks import (
     check_int,
     check_real,
 )
+from .._threads import single_threaded
 from .._units import check_units
 from .promp import condition_gaussian
 from .timing import Trajectory
@@ -321,6 +322,7 @@ class ProDMP(Estimator):
         self.ridge = ridge
         self.cov_reg = cov_reg
 
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProDMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, or one (T, D)) with their
         stamps ``times`` (a list of (T_i,) arrays, s; None: each uniform over ``tau``, or 1 s).

@@ -37,6 +37,7 @@ from .._checks import (
     check_real,
     check_seed,
 )
+from .._threads import single_threaded
 from .._units import check_units
 from .timing import Trajectory, check_timestamps
 
@@ -164,6 +165,7 @@ class ProMP(Estimator):
         self.overlap = overlap
 
     # -- learning ---------------------------------------------------------------------------
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, any lengths) with their
         stamps ``times`` (a list of (T_i,) arrays, s; None: each over 1 s)."""

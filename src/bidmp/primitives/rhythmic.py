@@ -44,6 +44,7 @@ from .._checks import (
     check_names,
     check_real,
 )
+from .._threads import single_threaded
 from .._units import check_units
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
@@ -100,6 +101,7 @@ class RhythmicDMP(Estimator):
         self.ridge = ridge
 
     # -- learning ---------------------------------------------------------------------------
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, y, t, units: str | None = None, names=None, frequency: float | None = None):
         """Learn from a recording ``y`` (T, D) at stamps ``t`` (s) of at least 2 periods
         (transients at both ends are cut); ``frequency`` (Hz) skips the estimate of it (the

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._api import Estimator
 from .._checks import check_real
+from .._threads import single_threaded
 from .._units import check_units
 from .cartesian import as_poses
 from .pose_timing import PoseTrajectory
@@ -70,6 +71,7 @@ class RhythmicPoseDMP(Estimator):
         self.n_harmonics = n_harmonics
         self.ridge = ridge
 
+    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, poses, t, units: str | None = None) -> RhythmicPoseDMP:
         """Learn from a pose recording (T, 7) at stamps ``t`` (s) of at least 2 periods."""
         positions, quaternions = as_poses(poses, "poses", min_points=8)
