@@ -366,12 +366,40 @@ TARGETS = (
         ("PhaseStopping.__call__", "PhaseStopping.slowdown"),
         ("tests/test_oracles.py", "tests/primitives/test_primitives.py"),
     ),
+    Target(
+        "CLFD: the protocol's success figures",
+        "bidmp.experiments.clfd.metrics",
+        ("accuracy_matrix", "continual_metrics", "orientation_error", "demonstration_errors"),
+        ("tests/experiments/test_clfd.py",),
+    ),
 )
 
 # Bugs people make where checks are assembled into a verdict, planted by hand beside the operator
 # flips: (area, function, the source text as written, what replaces it, the bug in words). Each is
 # one exact, unique text in the function's source (a test checks they still are).
 SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
+    # -- the CLFD protocol's success figures
+    (
+        "CLFD: the protocol's success figures",
+        "continual_metrics",
+        "np.diag(matrix)[below[1]]",
+        "np.diag(matrix)[below[0]]",
+        "a wrong index: BWT against the later task's own accuracy, not the earlier one's",
+    ),
+    (
+        "CLFD: the protocol's success figures",
+        "orientation_error",
+        "np.abs(np.sum(true * predicted, axis=1))",
+        "np.sum(true * predicted, axis=1)",
+        "the quaternion's sign taken as a turn: q and -q a full turn apart",
+    ),
+    (
+        "CLFD: the protocol's success figures",
+        "demonstration_errors",
+        "r, d = (r[:, :-4], d[:, :-4]) if pose else (r, d)",
+        "r, d = (r[:, :-3], d[:, :-3]) if pose else (r, d)",
+        "a unit applied twice: a quaternion's x counted as a position",
+    ),
     # -- the contract's verdict
     (
         "verdict assembly: the contract",
@@ -558,6 +586,20 @@ KNOWN_CLEARANCE = (
     "verdict.clearance if motion is out.motion and how == 'lift' else None)"
 )
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    # -- the CLFD protocol's figures: n of a matrix that is not square and 2-D is never used (the
+    # next line refuses it); a zero training time's floor only has to make t0 / t huge
+    **{
+        ("bidmp.experiments.clfd.metrics", "continual_metrics", line, "0 -> 1"): "shape[0] and "
+        "shape[1] are equal for the square 2-D matrix the next statement lets through, and n of "
+        "any other matrix is never used (that statement refuses it)"
+        for line in ("n = matrix.shape[0] if matrix.ndim == 2 else 0",)
+    },
+    (
+        "bidmp.experiments.clfd.metrics",
+        "continual_metrics",
+        "te = float(min(1.0, np.mean(times[0] / np.maximum(times, 1e-12))))",
+        "1e-12 -> 2e-12",
+    ): "a zero time's floor: t0 / 1e-12 and t0 / 2e-12 are both far above 1, which min caps",
     # -- the measured joints: a measured velocity or a 10 ms acceleration equal to its bound to the
     # last bit is not a motion the simulator produces
     **{

@@ -53,6 +53,9 @@ def test_the_orientation_error_is_the_angle_between_the_orientations():
     wxyz = lambda r: np.roll(r.as_quat(), 1, axis=1)  # noqa: E731 - SciPy's x,y,z,w to w,x,y,z
     flipped = wxyz(predicted) * rng.choice([-1.0, 1.0], (100, 1))
     assert orientation_error(wxyz(true), flipped) == pytest.approx(theta.mean(), rel=1e-9)
+    # quaternions not of unit length (a log's rounding, a scaled file) are normalised first
+    scaled = wxyz(true) * rng.uniform(0.5, 2.0, (100, 1))
+    assert orientation_error(scaled, flipped * 3.0) == pytest.approx(theta.mean(), rel=1e-9)
 
 
 def plain_dtw(a: np.ndarray, b: np.ndarray) -> float:
@@ -89,6 +92,23 @@ def test_the_continual_metrics_of_a_small_matrix_by_hand():
     parts = [0.75, 2 / 3, (1 + 1 / 2 + 1 / 3) / 3, 1.0, 0.5]
     assert figures["CL_score"] == pytest.approx(np.mean(parts))
     assert figures["CL_stability"] == pytest.approx(1 - np.std(parts, ddof=1))
+
+
+def test_the_continual_metrics_bounds_by_hand():
+    """One task: BWT 0, REM 1. Later tasks improving earlier ones (BWT 0.5 > 0): REM stays 1. A
+    model that shrinks: MS capped at 1. Training times 2, 4, 8 s: TE = mean(1, 1/2, 1/4). FS
+    without a larger model: 0; against one of 10 parameters with 4: 0.6."""
+    one = continual_metrics(np.array([[0.5]]), [3], [1.0])
+    assert one["BWT"] == 0.0 and one["REM"] == 1.0 and one["ACC"] == 0.5
+    better = np.array([[0.5, np.nan], [1.0, 1.0]])
+    figures = continual_metrics(better, [4, 2], [2.0, 4.0], largest_size=10)
+    assert figures["BWT"] == pytest.approx(0.5) and figures["REM"] == 1.0
+    assert figures["MS"] == 1.0  # mean(4/4, 4/2) = 1.5, capped
+    assert figures["FS"] == pytest.approx(1.0 - 2 / 10)
+    timed = continual_metrics(np.tril(np.ones((3, 3))), [4, 4, 4], [2.0, 4.0, 8.0])
+    assert timed["TE"] == pytest.approx((1 + 0.5 + 0.25) / 3) and timed["FS"] == 0.0
+    assert continual_metrics(np.tril(np.ones((2, 2))), [4, 4], [1.0, 0.0])["TE"] == 1.0
+    assert continual_metrics(np.tril(np.ones((2, 2))), [2, 4], [1.0, 1.0])["FS"] == 0.0
 
 
 def test_a_library_growing_by_one_block_per_task_scores_the_harmonic_mean():
