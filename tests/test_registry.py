@@ -42,21 +42,20 @@ def test_the_command_line_and_the_files_never_ask_a_model_for_its_class():
     assert _isinstance_on_kinds(SRC / "io") == []
 
 
-def test_what_names_the_newest_kind_outside_its_own_module():
-    """ProDMP: its module and its registry entry, exported by bidmp.primitives; beyond them the
-    task methods' one file (a way to learn a task is a method) and the command line's adapter of
-    the kinds learned from several demonstrations (what --n-kernels means for each)."""
+def test_the_newest_kind_is_its_modules_and_one_entry():
+    """ProDMP is its modules — the primitive, its task method, its command-line adapter, each
+    named prodmp.py — and one entry in the registry (exported by bidmp.primitives): nothing else
+    in the package names it."""
     naming = {
         str(path.relative_to(SRC))
         for path in SRC.rglob("*.py")
         if "ProDMP" in path.read_text() and path.name != "prodmp.py"
     }
-    assert naming == {
-        "primitives/registry.py",
-        "primitives/__init__.py",
-        "tasks/methods/multi.py",
-        "cli/several.py",
-    }
+    assert naming == {"primitives/registry.py", "primitives/__init__.py"}
+    modules = {str(p.relative_to(SRC)) for p in SRC.rglob("prodmp.py")}
+    assert modules == {"primitives/prodmp.py", "tasks/methods/prodmp.py", "cli/kinds/prodmp.py"}
+    kind = MODEL_KINDS["ProDMP"]
+    assert kind.adapter().fit_takes and kind.task_method().name == "prodmp"
 
 
 def test_a_new_kind_gets_its_fit_flag_and_its_model_files(tmp_path, capsys):

@@ -139,6 +139,7 @@ class ProDMPBasis:
             y'(t) = P1(t) y_b + V1(t) ẏ_b tau + dH(t) [w; g]   (d/ds: divide by tau for /s),
 
         ``P0, V0, P1, V1`` (T,), ``H, dH`` (T, N+1)."""
+        start_time = check_real(start_time, "start_time", minimum=-1e6, maximum=1e6)
         phi, dphi, y1, y2, dy1, dy2 = self.at(times)
         phi_b, dphi_b, y1b, y2b, dy1b, dy2b = self.at(np.array([start_time]))
         det = y1b * dy2b - y2b * dy1b
@@ -496,7 +497,11 @@ class ProDMP(Estimator):
         t = self._times(times, n_steps)
         start, velocity = self._boundary(start, start_velocity)
         w = (
-            (self.weight_mean_ if weights is None else as_vector(weights, "weights"))
+            (
+                self.weight_mean_
+                if weights is None
+                else as_vector(weights, "weights", length=self.weight_mean_.size)
+            )
             .reshape(self.n_dims_, -1)
             .copy()
         )
@@ -568,7 +573,7 @@ class ProDMP(Estimator):
         values = as_points(values, self.n_dims_, "values")
         if len(values) != len(times):
             raise ValueError(
-                f"values must hold one point per time ({len(times)}), got {len(values)}"
+                f"times must hold one time per point of values ({len(values)}), got {len(times)}"
             )
         cov = check_real(cov, "cov", nonnegative=True, maximum=1e12)
         start, velocity = self._boundary(start, start_velocity)

@@ -42,6 +42,13 @@ class PrimitiveKind:
     fit_flag : str or None
         The ``bidmp fit`` flag that learns it from several demonstrations (``"prodmp"`` for
         ``--prodmp``), None for a kind learned otherwise.
+    cli : str or None
+        ``"module:attribute"`` of the command line's adapter of a kind learned from several
+        demonstrations (what ``bidmp fit``'s options mean for it, how ``bidmp rollout``
+        conditions it: :mod:`bidmp.cli.kinds`); None where the command line learns it otherwise.
+    method : str or None
+        ``"module:attribute"`` of its task method (:mod:`bidmp.tasks.methods`: ``bidmp demo``,
+        ``sim``, the LASA benchmark), registered with the built-in methods; None for none.
     incremental : str or None
         ``"module:attribute"`` of the model that learns new skills on top of it (``bidmp extend``
         and ``bidmp learn``: a DMP becomes a Bi-DMP's skill 0); the kind itself where it is one;
@@ -56,15 +63,17 @@ class PrimitiveKind:
     poses: bool = False
     skills: bool = False
     fit_flag: str | None = None
+    cli: str | None = None
+    method: str | None = None
     incremental: str | None = None
     summary: str = ""
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
             raise ValueError(f"name must be a class name, got {self.name!r:.40}")
-        for field_name in ("path", "incremental"):
+        for field_name in ("path", "incremental", "cli", "method"):
             value = getattr(self, field_name)
-            if value is None and field_name == "incremental":
+            if value is None and field_name != "path":
                 continue
             if not isinstance(value, str) or value.count(":") != 1 or len(value) > 200:
                 raise ValueError(f"{field_name} must be 'module:attribute', got {value!r:.80}")
@@ -88,6 +97,16 @@ class PrimitiveKind:
     def load(self) -> type:
         """The class (imported now)."""
         return _import(self.path)
+
+    def adapter(self):
+        """The command line's adapter (imported now)."""
+        if self.cli is None:
+            raise ValueError(f"the command line has no adapter for a {self.name}")
+        return _import(self.cli)
+
+    def task_method(self):
+        """Its task method (imported now), or None."""
+        return None if self.method is None else _import(self.method)
 
     def grow(self, model):
         """``model`` as the model that learns new skills on it (itself if it is one)."""
@@ -151,15 +170,18 @@ for _kind in (
     ),
     PrimitiveKind(
         "ProMP", "bidmp.primitives.promp:ProMP", "several", fit_flag="promp",
+        cli="bidmp.cli.kinds.promp:ADAPTER",
         summary="a ProMP from several demonstrations (any lengths and rates); --n-kernels "
         "(default 20) basis functions per dimension",
     ),
     PrimitiveKind(
         "MultiDMP", "bidmp.primitives.multi:MultiDMP", "several", fit_flag="multi",
+        cli="bidmp.cli.kinds.multi:ADAPTER",
         summary="a DMP from several demonstrations (aligned by phase, their spread kept)",
     ),
     PrimitiveKind(
         "ProDMP", "bidmp.primitives.prodmp:ProDMP", "several", fit_flag="prodmp",
+        cli="bidmp.cli.kinds.prodmp:ADAPTER", method="bidmp.tasks.methods.prodmp:METHOD",
         summary="a ProDMP from several demonstrations (a DMP in closed form with a ProMP's "
         "distribution); --n-kernels (default 10) basis functions per dimension",
     ),
@@ -169,9 +191,10 @@ for _kind in (
 
 def model_class(name: str) -> type:
     """The class of the model kind ``name`` (a model file's class name)."""
-    if name not in MODEL_KINDS:
+    if not isinstance(name, str) or name not in MODEL_KINDS:
         raise ValueError(
-            f"unknown model kind {name!r:.40} (known: {', '.join(sorted(MODEL_KINDS))})"
+            f"name must be a registered model kind ({', '.join(sorted(MODEL_KINDS))}), "
+            f"got {name!r:.40}"
         )
     return MODEL_KINDS[name].load()
 

@@ -56,6 +56,13 @@ def _load_builtins() -> None:
     for module in (dmp, dmp_converged, bidmp, gmm, tpgmm, mp_dmp, multi):
         for method in module.METHODS:
             register(method)
+    # and the task methods the model kinds name (bidmp.primitives.registry): a new primitive's
+    # method is its module and its kind's entry
+    from ...primitives.registry import MODEL_KINDS
+
+    for kind in MODEL_KINDS.values():
+        if kind.method is not None:
+            register(kind.task_method())
 
 
 def register(method: Method, *, replace: bool = False) -> Method:

@@ -1,7 +1,6 @@
 """Methods that learn from several demonstrations (the task's ``demonstrations``, else noisy
 copies of its one): ``promp`` — a ProMP conditioned exactly on the start and the goal;
-``dmp-multi`` — a DMP whose forcing term is learned from all of them (the robot protocol);
-``prodmp`` — a ProDMP from the start at rest, its goal moved so that it ends at the goal."""
+``dmp-multi`` — a DMP whose forcing term is learned from all of them (the robot protocol)."""
 
 from __future__ import annotations
 
@@ -55,31 +54,5 @@ class _MultiDMPMethod(Method):
         return model.rollout(goal)
 
 
-class _ProDMPMethod(Method):
-    name = "prodmp"
-    lasa = False  # on request (--methods): the committed LASA tables keep their methods
-
-    def fit(self, task: Task) -> tuple[object, float]:
-        from ...primitives.prodmp import ProDMP
-
-        def build():
-            model = ProDMP(n_basis=20).fit(task.all_demonstrations())
-            return model, task.demonstration[0], task.demonstration.shape[0]
-
-        return task.shared_model("prodmp", build)
-
-    def rollout(self, model, goal: np.ndarray) -> np.ndarray:
-        from ...primitives.prodmp import ProDMP
-
-        if not (isinstance(model, tuple) and len(model) == 3 and isinstance(model[0], ProDMP)):
-            raise TypeError(
-                f"model must be (a fitted ProDMP, start, samples), what method 'prodmp''s fit "
-                f"returns, got {type(model).__name__}"
-            )
-        prodmp, start, n_samples = model
-        attractor = prodmp.goal_for_end(goal, start)  # ends exactly at the goal
-        return prodmp.trajectory(start, attractor, n_steps=n_samples).y
-
-
 # The methods this module adds to the registry (bidmp.tasks.methods registers them).
-METHODS = (_ProMPMethod(), _MultiDMPMethod(), _ProDMPMethod())
+METHODS = (_ProMPMethod(), _MultiDMPMethod())
