@@ -42,14 +42,13 @@ from .._api import Estimator
 from .._checks import (
     NotFittedError,
     as_points,
-    as_trajectory,
     as_vector,
     check_int,
     check_real,
 )
 from .._threads import single_threaded
 from .._units import check_units
-from .promp import condition_gaussian
+from .promp import _demonstrations, _stamps, condition_gaussian
 from .timing import Trajectory
 
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
@@ -247,19 +246,6 @@ def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
     return cov
 
 
-def _demonstrations(demonstrations) -> list[np.ndarray]:
-    if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
-        demonstrations = [demonstrations]
-    if not isinstance(demonstrations, (list, tuple, np.ndarray)) or len(demonstrations) == 0:
-        raise TypeError("demonstrations must be a list of (T, D) arrays")
-    if len(demonstrations) > 10_000:
-        raise ValueError(f"demonstrations: at most 10000, got {len(demonstrations)}")
-    demos = [as_trajectory(y, f"demonstrations[{i}]") for i, y in enumerate(demonstrations)]
-    if len({y.shape[1] for y in demos}) != 1:
-        raise ValueError("demonstrations must all have the same number of dimensions D")
-    return demos
-
-
 class ProDMP(Estimator):
     """A probabilistic DMP learned from one or several demonstrations (module docstring).
 
@@ -326,15 +312,17 @@ class ProDMP(Estimator):
     @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProDMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, or one (T, D)) with their
-        stamps ``times`` (a list of (T_i,) arrays, s; None: each uniform over ``tau``, or 1 s).
+        stamps ``times`` (a list of (T_i,) arrays, s; None: each uniform over 1 s).
         Each demonstration is timed onto tau (its own phase, as a ProMP's), and its weights and
         goal are the least-squares fit of its positions from its own start (its first sample, the
         velocity of its first step), as MP_PyTorch learns them. Returns self."""
-        demos = _demonstrations(demonstrations)
+        if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
+            demonstrations = [demonstrations]  # one demonstration
+        demos = _demonstrations(demonstrations)  # the ProMP's checks: one way to be refused
         ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6)
         cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
         units = "" if units is None else check_units(units)
-        stamps = self._stamps(times, demos)
+        stamps = _stamps(times, demos)  # (each is timed onto tau below: the span is its own)
         tau = (
             float(np.mean([t[-1] - t[0] for t in stamps]))
             if self.tau is None
@@ -368,20 +356,6 @@ class ProDMP(Estimator):
         self.n_dims_ = n_dims
         self.units_ = units
         return self
-
-    def _stamps(self, times, demos) -> list[np.ndarray]:
-        if times is None:
-            span = 1.0 if self.tau is None else float(self.tau)
-            return [np.linspace(0.0, span, len(y)) for y in demos]
-        if not isinstance(times, (list, tuple)) or len(times) != len(demos):
-            raise TypeError("times must be a list of (T_i,) arrays, one per demonstration")
-        stamps = []
-        for i, (t, y) in enumerate(zip(times, demos)):
-            t = as_vector(t, f"times[{i}]", length=len(y))
-            if np.any(np.diff(t) <= 0):
-                raise ValueError(f"times[{i}] must increase strictly")
-            stamps.append(t)
-        return stamps
 
     def _check_fitted(self) -> None:
         if "weight_mean_" not in self.__dict__:
