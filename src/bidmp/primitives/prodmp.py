@@ -417,7 +417,7 @@ class ProDMP(Estimator):
             goals = as_points(goals, dims, "goals")
             eye = np.eye(dims)
             if conditioned:
-                goal_index = np.arange(dims) * size + size - 1
+                goal_index = self._goal_index()
                 cov = self.weight_cov_
                 gain = np.linalg.solve(cov[np.ix_(goal_index, goal_index)], cov[goal_index]).T
                 # row e: what a unit of goal e adds at (t, d) through every weight it moves
@@ -517,6 +517,12 @@ class ProDMP(Estimator):
             out[:, d] = np.sqrt(np.maximum(np.einsum("tk,kl,tl->t", H, block, H), 0.0))
         return out
 
+    def _goal_index(self) -> np.ndarray:
+        """(D,): where each dimension's goal weight sits among the weights (the last of its
+        block of N + 1)."""
+        size = self.basis_.n_basis + 1
+        return np.arange(self.n_dims_) * size + size - 1
+
     def condition_goal(self, goal) -> ProDMP:
         """A copy whose weights are conditioned exactly on the goal ``goal`` (D,): the goal weights
         become ``goal``, the forcing weights move as the demonstrations say they go with it."""
@@ -524,10 +530,8 @@ class ProDMP(Estimator):
 
         self._check_fitted()
         goal = as_points(goal, self.n_dims_, "goal")[0]
-        size = self.basis_.n_basis + 1
-        index = np.arange(self.n_dims_) * size + size - 1
         columns = np.zeros((self.weight_mean_.size, self.n_dims_))
-        columns[index, np.arange(self.n_dims_)] = 1.0
+        columns[self._goal_index(), np.arange(self.n_dims_)] = 1.0
         mean, cov = condition_gaussian(
             self.weight_mean_, self.weight_cov_, columns, goal, np.zeros((self.n_dims_,) * 2)
         )

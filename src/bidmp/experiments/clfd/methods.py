@@ -299,10 +299,9 @@ class ContinualBLS(ClfdMethod):
     def learn(self, task: ClfdTask) -> None:
         if self._seen >= self.capacity:
             raise ValueError(f"bidmp-continual holds {self.capacity} tasks (its capacity)")
-        chart = TangentChart.of_task(task)
         target = self.task_target(task)
         if self._gram is None:
-            self._pose = chart.reference is not None
+            self._pose = task.orientations is not None  # a pose task: the chart's reference too
             self._gram = np.zeros((self.n_nodes, self.n_nodes))
             self._cross = np.zeros((self.n_nodes, target.size))
         nodes = self.task_nodes(self._seen)[None]
