@@ -1,7 +1,8 @@
 """The compiled loops (``bidmp._kernels``) against independent references: SciPy's ``lfilter`` for
 the spring's integration, SciPy's ``Rotation`` for quaternion logs and exponentials, ``np.interp``
 for resampling, the NumPy expressions they replaced for the forcing target, the goal gate and share,
-the rest blend and the exact state, NumPy's norms and sums for the arc length, and plain NumPy searches for the decisions (the rest blend's
+the rest blend and the exact state, NumPy's norms and sums for the arc length and a motion's
+peaks, and plain NumPy searches for the decisions (the rest blend's
 windows; the straight tail is checked against its plain search in test_approach.py).
 
 Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
@@ -24,6 +25,7 @@ from bidmp._kernels import (
     goal_share,
     goal_share_arguments,
     interp_columns,
+    motion_peaks,
     quaternion_exp,
     quaternion_log,
     rest_blend_arguments,
@@ -323,6 +325,36 @@ def test_the_arc_length_pass_is_numpys_norms_summed_to_the_bit():
         assert np.array_equal(np.isnan(out), np.isnan(expected)), trial
         finite = ~np.isnan(expected)
         assert np.array_equal(_bits(out[finite]), _bits(expected[finite])), trial
+
+
+def _numpy_peaks(points: np.ndarray, dt: float) -> np.ndarray:
+    """The peaks as the extension's timing measured them in NumPy before the loop replaced it."""
+    peaks = np.zeros(3)
+    difference = points
+    for order in range(3):
+        difference = np.diff(difference, axis=0) / dt
+        if difference.shape[0]:
+            peaks[order] = float(np.max(np.linalg.norm(difference, axis=1)))
+    return peaks
+
+
+def test_the_motion_peaks_pass_is_numpys_differences_to_the_bit():
+    """Peak speed, acceleration and jerk of one to seven columns, one to three hundred samples
+    (too few for an order: 0), at any rate and scale, with a NaN (it wins, as in NumPy's max)."""
+    rng = np.random.default_rng(23)
+    for trial in range(600):
+        n_samples, n_dims = int(rng.integers(1, 300)), int(rng.integers(1, 8))
+        y = _random_motion(rng, n_samples, n_dims)
+        if trial % 17 == 0:
+            y[rng.integers(0, n_samples), rng.integers(0, n_dims)] = np.nan
+        if trial % 3 == 0:
+            y = np.asfortranarray(y)
+        dt = 10 ** rng.uniform(-4, 0)
+        expected, out = _numpy_peaks(np.asarray(y), dt), motion_peaks(y, dt)
+        assert np.array_equal(np.isnan(out), np.isnan(expected)), trial
+        finite = ~np.isnan(expected)
+        assert np.array_equal(_bits(out[finite]), _bits(expected[finite])), trial
+    assert np.array_equal(motion_peaks(np.zeros((0, 3)), 0.01), np.zeros(3))
 
 
 def _rotations(rng, n_rows: int) -> np.ndarray:

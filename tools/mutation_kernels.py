@@ -133,6 +133,26 @@ MUTANTS = (
         "            squares = 0.0\n            for k in range(n_dims):",
         "            squares = 1e-300\n            for k in range(n_dims):",
     ),
+    Mutant(
+        "motion_peaks",
+        "change = (work[i + 1, k] - work[i, k]) / dt",
+        "change = work[i + 1, k] - work[i, k]",
+    ),
+    Mutant(
+        "motion_peaks",
+        "for i in range(n - 1 - order):",
+        "for i in range(n - 2 - order):",
+    ),
+    Mutant(
+        "motion_peaks",
+        "if total > peak or total != total:",
+        "if total > peak:",
+    ),
+    Mutant(
+        "motion_peaks",
+        "            peak = 0.0\n            for i in range(n - 1 - order):",
+        "            peak = -1.0\n            for i in range(n - 1 - order):",
+    ),
 )
 
 

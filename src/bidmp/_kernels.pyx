@@ -673,3 +673,31 @@ def arclength(const double[:, :] y):
             total = total + sqrt(squares)
             out[i] = total
     return out.base
+
+
+def motion_peaks(const double[:, :] points, double dt):
+    """Peak speed, acceleration and jerk (3,) of samples ``points`` (n, D) ``dt`` apart: NumPy's
+    ``max(norm(diff(points, k) / dt^k, axis=1))`` for k = 1, 2, 3, each difference divided by
+    ``dt`` as it is taken and each norm the square root of its squares summed in order (as NumPy
+    sums fewer than eight columns); 0 for an order the samples are too few for. ``D`` < 8."""
+    cdef Py_ssize_t n = points.shape[0], n_dims = points.shape[1], order, i, k
+    cdef double[:, ::1] work = empty((max(n, 1), max(n_dims, 1)))
+    cdef double[::1] out = empty(3)
+    cdef double total, change, peak
+    with nogil:
+        for i in range(n):
+            for k in range(n_dims):
+                work[i, k] = points[i, k]
+        for order in range(3):
+            peak = 0.0
+            for i in range(n - 1 - order):  # in place: row i + 1 is still the lower order's
+                total = 0.0
+                for k in range(n_dims):
+                    change = (work[i + 1, k] - work[i, k]) / dt
+                    work[i, k] = change
+                    total = total + change * change
+                total = sqrt(total)
+                if total > peak or total != total:
+                    peak = total
+            out[order] = peak
+    return out.base

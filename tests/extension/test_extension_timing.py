@@ -387,3 +387,46 @@ def test_a_route_over_a_cable_duct_across_the_plate(height):
     assert np.any(over) and np.min(dense[over, 2]) >= height + 3.0 - 1e-6
     np.testing.assert_allclose(path[-1], target, atol=1e-9)
     assert extension.refinement in ("lifted", "template", "smoothed", "shortcut")
+
+
+def _blends_everywhere(times, duration, mismatches, limit):
+    """The corner blends evaluated on every sample, as the timing did before it evaluated each
+    blend on its window only (the reference)."""
+    from bidmp.extension.timing import _blend_time
+
+    dv0, da0, dv1, da1 = mismatches
+    offsets = np.zeros((times.shape[0], dv0.shape[0]))
+    tau = _blend_time(dv0, da0, limit, duration / 2)
+    if tau > 0.0:
+        u = np.clip(times / tau, 0.0, 1.0)[:, None]
+        offsets += dv0 * tau * (u - 6 * u**3 + 8 * u**4 - 3 * u**5) + da0 * tau**2 * (
+            0.5 * u**2 - 1.5 * u**3 + 1.5 * u**4 - 0.5 * u**5
+        )
+    tau = _blend_time(dv1, da1, limit, duration / 2)
+    if tau > 0.0:
+        u = np.clip((times - (duration - tau)) / tau, 0.0, 1.0)[:, None]
+        offsets += dv1 * tau * (-4 * u**3 + 7 * u**4 - 3 * u**5) + da1 * tau**2 * (
+            0.5 * u**3 - u**4 + 0.5 * u**5
+        )
+    return offsets
+
+
+def test_the_corner_blends_on_their_windows_are_the_blends_everywhere_to_the_bit():
+    """A blend is exactly zero outside its window (its polynomials vanish at u = 0 and u = 1 in
+    floating point too), so evaluating it on the window alone changes no bit: random rates,
+    durations, limits and mismatches, blends as long as half the transfer or shorter than a
+    sample."""
+    from bidmp.extension.timing import _corner_blends
+
+    rng = np.random.default_rng(5)
+    for trial in range(400):
+        n_steps, dt = int(rng.integers(1, 600)), 10 ** rng.uniform(-3.5, -1)
+        times, duration = np.arange(1, n_steps + 1) * dt, n_steps * dt
+        n_dims = int(rng.integers(1, 4))
+        mismatches = tuple(
+            rng.normal(size=n_dims) * 10 ** rng.uniform(-3, 3) * (trial % 7 != k) for k in range(4)
+        )
+        limit = 10 ** rng.uniform(-1, 5, 3)
+        expected = _blends_everywhere(times, duration, mismatches, limit)
+        got = _corner_blends(times, duration, mismatches, limit)
+        assert np.array_equal(got, expected), trial

@@ -20,7 +20,8 @@ import logging
 import numpy as np
 
 from .._checks import check_int
-from .._trajectory import arclength, interp_columns, savgol_filter
+from .._kernels import motion_peaks as _compiled_peaks
+from .._trajectory import _PAIRWISE_COLUMNS, arclength, interp_columns, savgol_filter
 
 __all__ = []
 
@@ -37,9 +38,16 @@ _JOIN_SLACK = 1.1  # peaks over the joins (with the demonstration's samples arou
 
 def _motion_peaks(points: np.ndarray, dt: float) -> np.ndarray:
     """Peak speed, acceleration and jerk of samples ``points`` (n, D) ``dt`` apart, by first,
-    second and third finite differences (units/time, /time², /time³); 0 where too short."""
+    second and third finite differences (units/time, /time², /time³); 0 where too short.
+
+    A transfer's duration search measures a few hundred profiles: a compiled pass of the same
+    arithmetic (:func:`bidmp._kernels.motion_peaks`) for fewer than eight columns, NumPy's
+    differences otherwise (its sums over eight or more columns are pairwise, not in order)."""
+    points = np.asarray(points, dtype=float)
+    if 0 < points.shape[1] < _PAIRWISE_COLUMNS:
+        return _compiled_peaks(points, dt)
     peaks = np.zeros(3)
-    difference = np.asarray(points, dtype=float)
+    difference = points
     for order in range(3):
         difference = np.diff(difference, axis=0) / dt
         if difference.shape[0]:
@@ -215,17 +223,24 @@ def _corner_blends(
     instead of turned in one sample."""
     dv0, da0, dv1, da1 = mismatches
     offsets = np.zeros((times.shape[0], dv0.shape[0]))
+    # A blend is zero to the bit outside its window (its polynomial is exactly 0 at u = 0 and
+    # u = 1): it is evaluated on the window's samples only, with a sample's margin each side.
+    step = times[1] - times[0] if times.shape[0] > 1 else max(float(times[0]), 1e-300)
     tau = _blend_time(dv0, da0, limit, duration / 2)
     if tau > 0.0:
-        u = np.clip(times / tau, 0.0, 1.0)[:, None]
-        offsets += dv0 * tau * (u - 6 * u**3 + 8 * u**4 - 3 * u**5) + da0 * tau**2 * (
-            0.5 * u**2 - 1.5 * u**3 + 1.5 * u**4 - 0.5 * u**5
+        window = slice(0, min(times.shape[0], int(np.ceil(tau / step)) + 2))
+        u = np.clip(times[window] / tau, 0.0, 1.0)[:, None]
+        u2, u3, u4, u5 = u**2, u**3, u**4, u**5
+        offsets[window] += dv0 * tau * (u - 6 * u3 + 8 * u4 - 3 * u5) + da0 * tau**2 * (
+            0.5 * u2 - 1.5 * u3 + 1.5 * u4 - 0.5 * u5
         )
     tau = _blend_time(dv1, da1, limit, duration / 2)
     if tau > 0.0:
-        u = np.clip((times - (duration - tau)) / tau, 0.0, 1.0)[:, None]
-        offsets += dv1 * tau * (-4 * u**3 + 7 * u**4 - 3 * u**5) + da1 * tau**2 * (
-            0.5 * u**3 - u**4 + 0.5 * u**5
+        window = slice(max(int(np.floor((duration - tau) / step)) - 2, 0), times.shape[0])
+        u = np.clip((times[window] - (duration - tau)) / tau, 0.0, 1.0)[:, None]
+        u3, u4, u5 = u**3, u**4, u**5
+        offsets[window] += dv1 * tau * (-4 * u3 + 7 * u4 - 3 * u5) + da1 * tau**2 * (
+            0.5 * u3 - u4 + 0.5 * u5
         )
     return offsets
 
