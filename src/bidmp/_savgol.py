@@ -31,7 +31,7 @@ def savgol_filter(
     delta: float = 1.0,
     axis: int = -1,
     mode: str = "interp",
-    cval: float = 0.0,
+    **scipy_options,
 ) -> np.ndarray:
     """:func:`scipy.signal.savgol_filter` with the same arguments and results.
 
@@ -47,8 +47,10 @@ def savgol_filter(
         Order of the derivative returned (0: the smoothed samples).
     delta : float
         Spacing of the samples (s, for a derivative per second).
-    axis, mode, cval
+    axis, mode
         As SciPy's.
+    **scipy_options
+        SciPy's other options (``cval`` for ``mode="constant"``): such a call is SciPy's.
 
     Returns
     -------
@@ -57,6 +59,7 @@ def savgol_filter(
     array = np.asarray(x)
     if (
         mode != "interp"
+        or scipy_options
         or array.dtype != np.float64
         or not _integral(window_length, polyorder, deriv, axis)
         or not -array.ndim <= axis < array.ndim
@@ -68,7 +71,14 @@ def savgol_filter(
         from scipy.signal import savgol_filter as scipy_savgol_filter
 
         return scipy_savgol_filter(
-            x, window_length, polyorder, deriv=deriv, delta=delta, axis=axis, mode=mode, cval=cval
+            x,
+            window_length,
+            polyorder,
+            deriv=deriv,
+            delta=delta,
+            axis=axis,
+            mode=mode,
+            **scipy_options,
         )
     from scipy.ndimage import convolve1d
 
@@ -76,17 +86,14 @@ def savgol_filter(
     out = convolve1d(array, coefficients, axis=axis, mode="constant")
     half = window_length // 2
     n_samples = array.shape[axis]
-    _fit_edge(array, 0, window_length, 0, half, axis, polyorder, deriv, delta, out)
+    fit = (polyorder, deriv, delta)
+    _fit_edge(array, slice(0, window_length), slice(0, half), axis, fit, out)
     _fit_edge(
         array,
-        n_samples - window_length,
-        n_samples,
-        n_samples - half,
-        n_samples,
+        slice(n_samples - window_length, n_samples),
+        slice(n_samples - half, n_samples),
         axis,
-        polyorder,
-        deriv,
-        delta,
+        fit,
         out,
     )
     return out
@@ -164,22 +171,16 @@ def _polyval(coefficients: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _fit_edge(
-    x: np.ndarray,
-    window_start: int,
-    window_stop: int,
-    interp_start: int,
-    interp_stop: int,
-    axis: int,
-    polyorder: int,
-    deriv: int,
-    delta: float,
-    out: np.ndarray,
+    x: np.ndarray, window: slice, interp: slice, axis: int, fit: tuple, out: np.ndarray
 ) -> None:
-    """Write into ``out`` the polynomial fitted to ``x``'s window ``[window_start, window_stop)``
-    along ``axis`` (its ``deriv``-th derivative), evaluated at ``[interp_start, interp_stop)``."""
-    window = [slice(None)] * x.ndim
-    window[axis] = slice(window_start, window_stop)
-    edge = x[tuple(window)]
+    """Write into ``out`` the polynomial fitted to ``x``'s samples ``window`` along ``axis`` (its
+    ``deriv``-th derivative; ``fit`` = (polyorder, deriv, delta)), evaluated at ``interp``."""
+    polyorder, deriv, delta = fit
+    window_start, window_stop = window.start, window.stop
+    interp_start, interp_stop = interp.start, interp.stop
+    taken = [slice(None)] * x.ndim
+    taken[axis] = window
+    edge = x[tuple(taken)]
     swapped = not (axis == 0 or axis == -x.ndim)
     if swapped:
         edge = np.swapaxes(edge, axis, 0)

@@ -218,9 +218,7 @@ def test_kernels_stay_inside_visited_phase_and_weights_stay_bounded(n_steps):
             phase,
             dt=dmp.dt_,
             tau=1.0,
-            alpha=dmp.alpha_value,
-            beta=dmp.beta_value,
-            K=dmp.K_value,
+            gains=(dmp.alpha_value, dmp.beta_value, dmp.K_value),
         )
         if (
             fit == "lwr"

@@ -44,11 +44,12 @@ def _client(scheduler: str | None, workers: int):
     return Client(cluster), cluster
 
 
-def _run_on_dask(
-    todo, methods, every, workers, scheduler, kill_once, out, protocol, done, progress
-) -> int:
-    """The cells ``todo`` on a Dask cluster (embedded, or at ``scheduler``), each written as it
+def _run_on_dask(todo, sweep: tuple, cluster: tuple, kill_once, done, progress) -> int:
+    """The cells ``todo`` of ``sweep`` = (methods, every, results folder, protocol) on a Dask
+    ``cluster`` = (workers, scheduler address or None: an embedded one), each written as it
     finishes and added to ``done``; returns the number of workers."""
+    methods, every, out, protocol = sweep
+    workers, scheduler = cluster
     n_workers = workers or (os.cpu_count() or 1)
     client, cluster = _client(scheduler, n_workers)
     try:

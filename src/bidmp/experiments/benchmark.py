@@ -172,7 +172,7 @@ def lasa(  # noqa: PLR0913 - the public call spells its options out, as users pa
         result.workers = _run_here(todo, methods, every, out, protocol, done, progress)
     elif todo:
         result.workers = _run_on_dask(
-            todo, methods, every, workers, scheduler, _kill_once, out, protocol, done, progress
+            todo, (methods, every, out, protocol), (workers, scheduler), _kill_once, done, progress
         )
     result.wall_s = time.perf_counter() - start
     # The table: every row of every cell in a fixed order (shape, demo, method, case).

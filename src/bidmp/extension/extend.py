@@ -32,6 +32,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -248,7 +249,7 @@ def check_extension_options(
 
 
 @numerically_guarded
-def extend_demonstration(
+def extend_demonstration(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     y,
     new_target,
     *,
@@ -307,7 +308,7 @@ def extend_demonstration(
             return _extend_keeping_the_margin(
                 y, target, points, seed, roadmap_options, scene, exclude
             )
-        return _extend_keeping_approach(y, target, points, seed, roadmap_options, scene, exclude)
+        return _extend_keeping_approach(y, target, points, seed, roadmap_options, (scene, exclude))
     return _extend_like_the_paper(y, target, points, seed, roadmap_options)
 
 
@@ -346,7 +347,7 @@ def _extend_keeping_the_margin(
             **roadmap_options,
             "is_free": SceneChecker(scene, scene._selected(exclude), planning),
         }
-        extension = _extend_keeping_approach(y, target, points, seed, options, scene, exclude)
+        extension = _extend_keeping_approach(y, target, points, seed, options, (scene, exclude))
         clearance = scene.clearance(extension.complete, exclude=exclude)
         if clearance.clear:
             return extension
@@ -402,7 +403,7 @@ def _extend_like_the_paper(y, target, points, seed, roadmap_options) -> Extended
         piece.end,
         len(history),
     )
-    return _extension(complete, y, target, points, piece, tra_gen, history, result)
+    return _extension(complete, y, target, _Grown(points, piece, tra_gen, history, result))
 
 
 def _log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
@@ -417,11 +418,20 @@ def _log_dimensionless_jerk(points: np.ndarray, dt: float) -> float:
     return float(-np.log((dt * (len(points) - 1)) ** 5 / peak**2 * squared))
 
 
-def _extension(
-    complete, y, target, points, piece, tra_gen, history, result, **approach
-) -> ExtendedDemonstration:
-    """The :class:`ExtendedDemonstration` both ways build (``result``: G-PRM's, or None when it
-    was skipped)."""
+class _Grown(NamedTuple):
+    """How an extension was grown: the segmentation's points, the piece imitated, the generated
+    path, G-PRM's similarity history and its result (None when G-PRM was skipped)."""
+
+    points: np.ndarray
+    piece: Piece
+    tra_gen: np.ndarray
+    history: np.ndarray
+    result: RoadmapResult | None
+
+
+def _extension(complete, y, target, grown: _Grown, **approach) -> ExtendedDemonstration:
+    """The :class:`ExtendedDemonstration` both ways build."""
+    points, piece, tra_gen, history, result = grown
     return ExtendedDemonstration(
         complete=complete,
         tra_imi=y[piece.start : piece.end + 1].copy(),
@@ -440,10 +450,12 @@ def _extension(
 
 
 def _extend_keeping_approach(
-    y, target, points, seed, roadmap_options, scene, exclude, approach_rotation=None
+    y, target, points, seed, roadmap_options, keep_clear: tuple, approach_rotation=None
 ) -> ExtendedDemonstration:
     """``approach="keep"``: transfer by G-PRM to the translated approach's start, then the approach
-    (rotated about the target by ``approach_rotation`` (D, D) when the target turns too)."""
+    (rotated about the target by ``approach_rotation`` (D, D) when the target turns too);
+    ``keep_clear`` = (the scene or None, the part labels at the target it may touch)."""
+    scene, exclude = keep_clear
     n_steps = y.shape[0]
     dt = 1.0 / n_steps
     start = _final_approach(y, points)
@@ -508,11 +520,7 @@ def _extend_keeping_approach(
         complete,
         y,
         target,
-        points,
-        piece,
-        tra_gen,
-        history,
-        result,
+        _Grown(points, piece, tra_gen, history, result),
         approach="keep",
         approach_index=start,
         refinement=refinement,
@@ -622,8 +630,7 @@ def extend_pose_demonstration(
         points,
         seed,
         options,
-        None,
-        exclude,
+        (None, exclude),
         approach_rotation=turn.as_matrix(),
     )
     start, seg = extension.approach_index, extension.seg_index

@@ -246,20 +246,15 @@ class CartesianBiDMP(PoseModel, Estimator):
             )
         )
         return self._timed(
-            position,
-            orientation,
-            goal_p,
-            start_p,
-            goal_q,
-            start_e,
+            (position, orientation),
+            (goal_p, start_p, goal_q, start_e),
+            (position_increment, orientation_increment),
+            self.cartesian_.units_,
             duration=duration,
             dt=dt,
             limits=limits,
-            position_increment=position_increment,
-            orientation_increment=orientation_increment,
-            units=self.cartesian_.units_,
             coupling=coupling,
-            vias=vias,
+            via=vias,
             via_until=via_until,
         )
 

@@ -467,16 +467,13 @@ _OWN_RATES = re.compile(
 
 
 def _layout(
-    header,
-    keys,
-    time,
-    scale,
-    chosen: _Candidate,
-    settings: dict,
-    declared: bool,
-    units: str,
-    angles: str,
+    header, keys, clock: tuple, chosen: _Candidate, settings: dict, conventions: tuple
 ) -> Layout:
+    """The :class:`Layout` of ``header`` (its ``keys``) with the motion ``chosen``; ``clock`` = (the
+    time column's index tuple, the divisor to seconds, whether the file declared it), and
+    ``conventions`` = (length units, angle units)."""
+    time, scale, declared = clock
+    units, angles = conventions
     used = set(chosen.values) | set(time) | set(chosen.orientation)
     ignored = tuple(
         name
@@ -535,7 +532,7 @@ def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
     else:
         chosen = _by_names(header, keys, time, path)
     units, angles = _units_named(header, chosen, settings, path)
-    return _layout(header, keys, time, scale, chosen, settings, declared, units, angles)
+    return _layout(header, keys, (time, scale, declared), chosen, settings, (units, angles))
 
 
 def _by_names(header, keys, time, path) -> _Candidate:

@@ -487,7 +487,7 @@ def write_bag(  # noqa: C901, PLR0913 - the public call spells its options out, 
     if orientation is not None:
         values = np.hstack([values, np.tile(orientation, (values.shape[0], 1))])
     messages = _messages(
-        ros, msgtype, t, values, names, velocities, accelerations, frame_id, origin
+        ros, msgtype, (t, values, velocities, accelerations), names, frame_id, origin
     )
     return _write_atomically(target, ros, topic, msgtype, messages)
 
@@ -531,18 +531,10 @@ def _store(ros: int, msgtype: str):
     return store
 
 
-def _messages(
-    ros: int,
-    msgtype: str,
-    t,
-    values,
-    names,
-    velocities,
-    accelerations,
-    frame_id: str,
-    origin: float,
-):
-    """(typestore, [(stamp ns, message), ...])."""
+def _messages(ros: int, msgtype: str, motion: tuple, names, frame_id: str, origin: float):
+    """(typestore, [(stamp ns, message), ...]) of ``motion`` = (times (n,) s, values (n, D),
+    velocities and accelerations (n, D) or None)."""
+    t, values, velocities, accelerations = motion
     store = _store(ros, msgtype)
     types = store.types
 

@@ -53,6 +53,7 @@ from .so3 import (
     continuous_log,
     orientation_from_log,
 )
+from .timing import _Rollout
 
 __all__ = [
     "CartesianDMP",
@@ -97,20 +98,20 @@ def _fit_parts(
     position_still = np.ptp(positions, axis=0).max() == 0.0
     orientation_still = np.ptp(log, axis=0).max() <= 1e-12
     if position_still:
-        orientation._fit(log, t, name=f"{name}' orientation", unit_label="rad")
+        orientation._fit(log, t, called=(f"{name}' orientation", "rad"))
         position._fit(
             positions,
             t,
             units,
             progress=_arclength_progress(orientation.training_trajectory(log)),
-            name=f"{name}' positions",
+            called=(f"{name}' positions", None),
         )
         return
-    position._fit(positions, t, units, name=f"{name}' positions")
+    position._fit(positions, t, units, called=(f"{name}' positions", None))
     progress = (
         _arclength_progress(position.training_trajectory(positions)) if orientation_still else None
     )
-    orientation._fit(log, t, progress=progress, name=f"{name}' orientation", unit_label="rad")
+    orientation._fit(log, t, progress=progress, called=(f"{name}' orientation", "rad"))
 
 
 _SAME_TURN = 1e-9  # rad: a via orientation this close to the motion's own asks no change
@@ -150,10 +151,10 @@ class PoseModel:
         return _nearest_turn(start_q, goal_q, reference)
 
     @staticmethod
-    def _timed(position, orientation, goal_p, start_p, goal_q, start_e, **options):
-        """The two parts timed together (:class:`PoseTrajectory`); ``options``: duration, dt,
-        limits, position_increment, orientation_increment, units, coupling, vias."""
-        return _pose_trajectory(position, orientation, goal_p, start_p, goal_q, start_e, **options)
+    def _timed(parts: tuple, ends: tuple, increments: tuple, units, **request):
+        """The two parts timed together (:class:`PoseTrajectory`, see :func:`_pose_trajectory`);
+        ``request``: duration, dt, limits, coupling, via (the two parts' via-points), via_until."""
+        return _pose_trajectory(parts, ends, _Rollout(**request), increments, units)
 
     @staticmethod
     def _via_errors(
@@ -384,20 +385,15 @@ class CartesianDMP(PoseModel, Estimator):
             )
         )
         return self._timed(
-            self.position_,
-            self.orientation_,
-            goal_p,
-            start_p,
-            goal_q,
-            start_e,
+            (self.position_, self.orientation_),
+            (goal_p, start_p, goal_q, start_e),
+            (position_increment, orientation_increment),
+            self.units_,
             duration=duration,
             dt=dt,
             limits=limits,
-            position_increment=position_increment,
-            orientation_increment=orientation_increment,
-            units=self.units_,
             coupling=coupling,
-            vias=vias,
+            via=vias,
             via_until=via_until,
         )
 

@@ -85,7 +85,7 @@ from .rollouts import _iter_rollouts_to, _rollouts_to
 from .state import _dmp_from_state, _dmp_state
 from .stepper import DMPStepper
 from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
-from .timing import on_uniform_time
+from .timing import _Rollout, on_uniform_time
 from .via import _via_trajectory
 
 __all__ = ["DMP", "PROTOCOLS"]
@@ -303,13 +303,14 @@ class DMP(_FittedParams, Estimator):
         units: str | None = None,
         *,
         progress: np.ndarray | None = None,
-        name: str = "y",
-        unit_label: str | None = None,
+        called: tuple[str, str | None] = ("y", None),
         names=None,
         held_orientation=None,
     ) -> DMP:
         """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
-        move on its own: then ``y`` may be static)."""
+        move on its own: then ``y`` may be static); ``called`` = (what the messages call ``y``,
+        the label of its unit when not ``units``: a pose's orientation part is in rad)."""
+        name, unit_label = called
         params = resolved = self._params()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
@@ -492,9 +493,7 @@ class DMP(_FittedParams, Estimator):
             phase,
             dt=self.dt_,
             tau=1.0,
-            alpha=params.alpha,
-            beta=params.beta,
-            K=params.K,
+            gains=params.gains,
             derivatives=rule,
             gate=self.training_gate(),
         )
@@ -739,29 +738,25 @@ class DMP(_FittedParams, Estimator):
         """
         self._check_fitted()
         _check_forcing_increment(forcing_increment)  # every path below takes it
+        request = _Rollout(
+            goal,
+            start,
+            duration,
+            dt,
+            limits,
+            start_velocity,
+            forcing_increment,
+            coupling,
+            via,
+            via_until,
+        )
         if via is not None:
-            return _via_trajectory(
-                self,
-                goal,
-                start,
-                duration,
-                dt,
-                limits,
-                start_velocity,
-                forcing_increment,
-                coupling,
-                via,
-                via_until,
-            )
+            return _via_trajectory(self, request)
         if limits is not None:
-            return _limited_trajectory(
-                self, goal, start, dt, limits, start_velocity, forcing_increment, coupling
-            )
+            return _limited_trajectory(self, request)
         if coupling is not None:
-            return _coupled_trajectory(
-                self, goal, start, duration, dt, start_velocity, forcing_increment, coupling
-            )
-        return _timed_trajectory(self, goal, start, duration, dt, start_velocity, forcing_increment)
+            return _coupled_trajectory(self, request)
+        return _timed_trajectory(self, request)
 
     def stepper(
         self,

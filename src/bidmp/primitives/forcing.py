@@ -29,6 +29,7 @@ from .._checks import (
 )
 from .._kernels import forcing_target
 from .canonical import _checked_phase_args, _phase_decay
+from .gains import _Gains
 
 __all__ = [
     "kernel_centres",
@@ -187,9 +188,7 @@ def _forcing_target(
     *,
     dt: float,
     tau: float,
-    alpha: float,
-    beta: float,
-    K: float,
+    gains: _Gains,
     derivatives: str = "gradient",
     gate: np.ndarray | None = None,
 ) -> np.ndarray:
@@ -207,6 +206,8 @@ def _forcing_target(
         Phase at each sample.
     dt : float
         Time step of ``y`` in seconds.
+    gains : _Gains
+        ``alpha``, ``beta`` and ``K`` of Eq. 10.
     derivatives : {"gradient", "forward"}
         ``np.gradient`` (central differences) or forward differences.
 
@@ -215,6 +216,7 @@ def _forcing_target(
     f_target : array, shape (T, D)
     """
     gate = phase if gate is None else gate
+    alpha, beta, K = gains
     if derivatives == "gradient":  # central differences, the formula in one compiled loop
         return forcing_target(y, gate, dt, tau, tau**2, alpha, beta, K)
     velocity, acceleration = _forward_differences(y, dt)
@@ -326,9 +328,7 @@ def _learn_weights(
         phase,
         dt=dt,
         tau=1.0,
-        alpha=params.alpha,
-        beta=params.beta,
-        K=params.K,
+        gains=params.gains,
         derivatives=params.derivatives,
         gate=gate,
     )

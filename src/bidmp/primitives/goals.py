@@ -53,6 +53,7 @@ from .._checks import as_vector, check_bool, check_int, check_real
 from .._kernels import goal_gate, goal_share, goal_share_arguments
 from .._trajectory import arclength
 from .canonical import phase_grid
+from .gains import _Gains
 
 __all__ = ["PhaseGate", "DelayedGoal", "ProgressGate", "ApproachGate"]
 
@@ -258,16 +259,15 @@ class ProgressGate:
         n_motion: int,
         dt: float,
         *,
-        alpha: float,
-        beta: float,
-        K: float,
+        gains: _Gains,
         exact: bool,
         progress: np.ndarray | None = None,
     ) -> np.ndarray:
         """The gate on the training grid for a demonstration as learned, ``train`` (n_train, D)
-        (exact: the smooth goal share's continuous inverse; Euler: :func:`_euler_progress_gate`).
-        ``progress`` replaces the demonstration's own arc-length progress (a part that does not
-        move follows another's)."""
+        (exact: the smooth goal share's continuous inverse; Euler: :func:`_euler_progress_gate`),
+        for the transformation system's ``gains``. ``progress`` replaces the demonstration's own
+        arc-length progress (a part that does not move follows another's)."""
+        alpha, beta, K = gains
         progress = _training_progress(train, progress)
         if not exact:
             return _euler_progress_gate(progress, dt, alpha=alpha, beta=beta, K=K)
@@ -353,16 +353,15 @@ class ApproachGate(ProgressGate):
         n_motion: int,
         dt: float,
         *,
-        alpha: float,
-        beta: float,
-        K: float,
+        gains: _Gains,
         exact: bool,
         progress: np.ndarray | None = None,
-        approach_start: int | None = None,
-        departure_end: int = 0,
+        kept: tuple[int, int],
     ) -> np.ndarray:
-        """The gate on the training grid; ``approach_start`` the sample where the approach begins,
-        ``departure_end`` the one where a kept departure ends (0: none)."""
+        """The gate on the training grid; ``kept`` = (the sample where a kept departure ends, 0 for
+        none; the one where the approach begins)."""
+        alpha, beta, K = gains
+        departure_end, approach_start = kept
         progress = _training_progress(train, progress)
         reach, leave = float(progress[approach_start]), float(progress[departure_end])
         normalised = np.clip((progress - leave) / (reach - leave), 0.0, 1.0)
@@ -421,13 +420,7 @@ def _learn_goal_gate(
     (:func:`_departure_end`; a demonstration without an approach gets the progress gate)."""
     if params.goal_rate is not None:
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
-    gains = {
-        "alpha": params.alpha,
-        "beta": params.beta,
-        "K": params.K,
-        "exact": params.exact,
-        "progress": progress,
-    }
+    gains = {"gains": params.gains, "exact": params.exact, "progress": progress}
     if params.keep_approach and demonstration is not None:
         from .approach import _tail_start
 
@@ -440,8 +433,7 @@ def _learn_goal_gate(
                 train,
                 n_motion,
                 dt,
-                approach_start=start,
-                departure_end=_departure_end(demonstration, start),
+                kept=(_departure_end(demonstration, start), start),
                 **gains,
             )
     return ProgressGate.learn(train, n_motion, dt, **gains)

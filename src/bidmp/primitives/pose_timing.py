@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from .._checks import as_point, as_vector
 from .goal_shift import _GoalShifts
 from .so3 import _left_jacobian, as_quaternions, orientation_from_log, principal_log
-from .timing import TimedMotion, _validate_motion
+from .timing import TimedMotion, _Rollout, _validate_motion
 
 __all__ = ["PoseTrajectory", "PoseStepper"]
 
@@ -101,27 +101,20 @@ def _angular_rates(e: np.ndarray, ed: np.ndarray, edd: np.ndarray) -> tuple[np.n
     return omega, omega_dot
 
 
-def _pose_trajectory(  # noqa: PLR0913 - two parts and CartesianDMP.trajectory's arguments
-    position_model,
-    orientation_model,
-    goal_p,
-    start_p,
-    goal_q,
-    start_e,
-    duration,
-    dt,
-    limits,
-    position_increment,
-    orientation_increment,
-    units,
-    coupling=None,
-    vias=None,
-    via_until=None,
+def _pose_trajectory(
+    parts: tuple, ends: tuple, request: _Rollout, increments: tuple, units
 ) -> PoseTrajectory:
-    """The timed pose rollout of two parts (position DMP or Bi-DMP skill, orientation likewise);
-    ``coupling`` terms act on the position part, and both parts then run the step integrator;
-    ``vias`` = (position via-points, orientation-error via-points), ``via_until`` as
-    :meth:`bidmp.DMP.trajectory` for both."""
+    """The timed pose rollout of two ``parts`` (position DMP or Bi-DMP skill, orientation
+    likewise) from ``ends`` = (goal position, start position, goal quaternion, start orientation
+    error) with the parts' forcing ``increments``; ``request``: duration, dt, limits, coupling
+    terms (on the position part; both parts then run the step integrator), ``via`` = (position
+    via-points, orientation-error via-points) or None, ``via_until`` as :meth:`bidmp.DMP.trajectory`
+    for both."""
+    position_model, orientation_model = parts
+    goal_p, start_p, goal_q, start_e = ends
+    position_increment, orientation_increment = increments
+    duration, dt, limits, coupling = request.duration, request.dt, request.limits, request.coupling
+    vias, via_until = request.via, request.via_until
     position_via, error_via = (None, None) if vias is None else vias
     position = position_model.trajectory(
         goal_p,

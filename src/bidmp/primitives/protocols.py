@@ -23,6 +23,7 @@ from .._checks import (
 )
 from .canonical import _TAU_RANGE, CanonicalSystem, ExponentialPhase
 from .forcing import Basis, GaussianBasis
+from .gains import _Gains
 
 __all__ = ["PROTOCOLS", "ROBOT_ALPHA", "ROBOT_KERNELS", "ROBOT_ALPHA_PHASE", "ROBOT_SETTLE"]
 
@@ -62,6 +63,11 @@ class _Params(NamedTuple):
     @property
     def exact(self) -> bool:
         return self.integrator == "exact"
+
+    @property
+    def gains(self) -> _Gains:
+        """``alpha``, ``beta`` and ``K`` (Eq. 10)."""
+        return _Gains(self.alpha, self.beta, self.K)
 
     @property
     def rest_start(self) -> bool:

@@ -12,7 +12,7 @@ from .avoidance import SceneAvoidance, _check_avoidance
 from .integrate import _exact_state
 from .protocols import _TAU_RANGE, _Params
 from .stepper import DMPStepper
-from .timing import Trajectory, scale_factor
+from .timing import Trajectory, _Rollout, scale_factor
 
 __all__ = []
 
@@ -50,10 +50,11 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
     return motion, dt, n_samples, step
 
 
-def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_increment):
+def _timed_trajectory(dmp, request: _Rollout):
     """The fast path of :meth:`bidmp.DMP.trajectory` (no limits, no coupling terms)."""
+    goal, start, start_velocity = request.goal, request.start, request.start_velocity
     params = dmp._params()
-    motion, dt, n_samples, step = _time_grid(dmp, duration, dt, params)
+    motion, dt, n_samples, step = _time_grid(dmp, request.duration, request.dt, params)
     params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
     velocity = (
         None
@@ -63,7 +64,7 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
     # Two extra samples give the last velocity and acceleration as forward differences (Euler),
     # one the last exact state.
     free, goal_response, forcing, gate = dmp._prepare(
-        start, velocity, n_samples + 2, forcing_increment, params=params, step=step
+        start, velocity, n_samples + 2, request.forcing_increment, params=params, step=step
     )
     goal = dmp.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
     if dmp.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
@@ -76,7 +77,7 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
     if params.exact:
         start = dmp.start_ if start is None else as_point(start, free.shape[1], "start")
         velocities, accelerations = _exact_rates(
-            params, positions, forcing, gate, goal, start, velocity, step, dmp.time_unit_
+            params, positions, forcing, gate, (goal, start, velocity), step, dmp.time_unit_
         )
     else:
         velocities = np.diff(positions, axis=0) / dt
@@ -92,10 +93,12 @@ def _timed_trajectory(dmp, goal, start, duration, dt, start_velocity, forcing_in
 
 
 def _exact_rates(
-    params: _Params, positions, forcing, gate, goal, start, velocity, step, time_unit: float
+    params: _Params, positions, forcing, gate, ends: tuple, step: float, time_unit: float
 ) -> tuple:
     """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
-    n out): the system's own state and acceleration, from the positions and the input."""
+    n out): the system's own state and acceleration, from the positions and the input; ``ends``
+    = (goal, start, start velocity or None), the velocity in units per normalised time."""
+    goal, start, velocity = ends
     inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
     inputs -= np.multiply.outer(gate, params.K * (goal - start))
     inputs += params.alpha * params.beta * goal
@@ -130,24 +133,22 @@ def _checked_limits(limits) -> tuple[dict, bool]:
     return limits, bool(fastest)
 
 
-def _limited_trajectory(
-    dmp, goal, start, dt, limits, start_velocity, forcing_increment, coupling=None
-):
+def _limited_trajectory(dmp, request: _Rollout):
     """The trajectory within ``limits``: at the nominal duration if that meets them (limits
     are caps: they never speed a motion up, unless ``"fastest": True``), otherwise the
     shortest duration that does: scale by the exact factor of
     :func:`bidmp.primitives.timing.scale_factor`, then bisect for what the discretisation changes."""
-    limits, fastest = _checked_limits(limits)
+    limits, fastest = _checked_limits(request.limits)
 
     def attempt(duration):
         trajectory = dmp.trajectory(
-            goal,
-            start=start,
+            request.goal,
+            start=request.start,
             duration=duration,
-            dt=dt,
-            start_velocity=start_velocity,
-            forcing_increment=forcing_increment,
-            coupling=coupling,
+            dt=request.dt,
+            start_velocity=request.start_velocity,
+            forcing_increment=request.forcing_increment,
+            coupling=request.coupling,
         )
         return trajectory, scale_factor(trajectory, **limits)
 
@@ -174,17 +175,23 @@ def _limited_trajectory(
     return trajectory if factor <= 1.0 or best is None else best
 
 
-def _coupled_trajectory(
-    dmp, goal, start, duration, dt, start_velocity, forcing_increment, coupling
-) -> Trajectory:
+def _coupled_trajectory(dmp, request: _Rollout) -> Trajectory:
     """:meth:`bidmp.DMP.trajectory` through the step integrator, with coupling terms: the same
     samples as :func:`_timed_trajectory` (to rounding) when the terms add nothing. With a
     :class:`bidmp.primitives.avoidance.SceneAvoidance` term the motion runs on past the horizon
     until it comes to rest (at most as long again: steering round a part takes time), and its
     clearance is then checked exactly."""
     params = dmp._params()
-    motion, dt, n_samples, _ = _time_grid(dmp, duration, dt, params)
-    stepper = DMPStepper(dmp, goal, start, motion, coupling, start_velocity, forcing_increment)
+    motion, dt, n_samples, _ = _time_grid(dmp, request.duration, request.dt, params)
+    stepper = DMPStepper(
+        dmp,
+        request.goal,
+        request.start,
+        motion,
+        request.coupling,
+        request.start_velocity,
+        request.forcing_increment,
+    )
     states = [stepper.step(dt) for _ in range(n_samples)]
     avoiding = [term for term in stepper._couplings if isinstance(term, SceneAvoidance)]
     reach = float(np.linalg.norm(stepper.target - stepper.start))

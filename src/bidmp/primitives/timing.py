@@ -410,3 +410,21 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     # checked once here, not again by each step (the stamps by _drop_repeated)
     y, grid = _resampled(*_drop_repeated(y, _as_stamps(t, "t"), "t"))
     return y, float(grid[-1])
+
+
+@dataclass(frozen=True)
+class _Rollout:
+    """What a timed rollout is asked for: the arguments of :meth:`bidmp.DMP.trajectory`, passed
+    whole to the path that makes the motion (plain, within limits, coupled, through via-points)
+    instead of one by one through each; each path checks the ones it reads."""
+
+    goal: object = None
+    start: object = None
+    duration: float | None = None
+    dt: float | None = None
+    limits: dict | None = None
+    start_velocity: object = None
+    forcing_increment: object = None
+    coupling: object = None
+    via: object = None
+    via_until: float | None = None

@@ -18,6 +18,7 @@ rollouts (tests/primitives/test_via.py).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 
@@ -25,7 +26,7 @@ from .._checks import as_point, check_real
 from .grid import _rollout_grid
 from .integrate import _unit_responses
 from .timed import _checked_limits, _time_grid
-from .timing import scale_factor
+from .timing import _Rollout, scale_factor
 
 __all__ = []
 
@@ -39,6 +40,25 @@ _CONDITION = 1e-9
 _MAX_SWING = 100.0
 # of a kernel's activation on the rollout grid: before ``via_until``, it may change
 _UNTIL_SHARE = 0.99
+
+
+class _Via(NamedTuple):
+    """Checked via-points: times (m,) in seconds, points (m, D), and ``until`` (s) or None."""
+
+    times: np.ndarray
+    points: np.ndarray
+    until: float | None
+
+
+class _Grid(NamedTuple):
+    """The rollout's grid: resolved parameters, normalised step, samples, sample period (s)."""
+
+    params: object
+    step: float
+    n_samples: int
+    dt: float
+
+
 _MINIMUM_JERK_PEAK = 10.0 / np.sqrt(
     3.0
 )  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
@@ -102,24 +122,17 @@ def _impulse_rows(
 
 
 def _via_increment(
-    dmp,
-    times: np.ndarray,
-    points: np.ndarray,
-    ends: tuple,
-    params,
-    step: float,
-    n_samples: int,
-    dt: float,
-    forcing_increment: Callable | None,
-    until: float | None = None,
+    dmp, via: _Via, ends: tuple, grid: _Grid, forcing_increment: Callable | None
 ) -> Callable:
     """The forcing increment ``(phase, basis) -> (n, D)`` that moves the rollout from ``ends`` =
-    (goal, start) through ``points`` (m, D) at ``times`` with the least-norm weight change. The
-    rollout's own positions at the via times come from the same responses (its forcing through the
-    impulse rows, goal and start through their unit responses): no rollout is run for them.
-    ``until`` (s): only the kernels with :data:`_UNTIL_SHARE` of their activation before it change
-    (after it the motion returns to its own course). Raises ``ValueError`` when the kernels cannot
-    carry the via-points."""
+    (goal, start) through the via-points with the least-norm weight change. The rollout's own
+    positions at the via times come from the same responses (its forcing through the impulse
+    rows, goal and start through their unit responses): no rollout is run for them. ``via.until``
+    (s): only the kernels with :data:`_UNTIL_SHARE` of their activation before it change (after it
+    the motion returns to its own course). Raises ``ValueError`` when the kernels cannot carry
+    the via-points."""
+    times, points, until = via
+    params, step, n_samples, dt = grid
     n_kernels = dmp.weights_.shape[0]
     if times.size > n_kernels:
         raise ValueError(
@@ -163,7 +176,7 @@ def _via_increment(
     # act anywhere: a change kept before ``until`` is the caller's to judge (a repair judges the
     # motion it makes by the motion contract).
     if params.settle > 1.0 and until is None:
-        _check_end(params, phase, basis, step, dt, change, ends, points, times)
+        _check_end(grid, (phase, basis), change, ends, via)
 
     def increment(phase_in: np.ndarray, basis_in: np.ndarray) -> np.ndarray:
         added = basis_in @ change
@@ -181,20 +194,14 @@ _END_SHARE = 1e-4
 _END_SPEED_SHARE = 1e-2
 
 
-def _check_end(
-    params,
-    phase: np.ndarray,
-    basis: np.ndarray,
-    step: float,
-    dt: float,
-    change: np.ndarray,
-    ends: tuple,
-    points: np.ndarray,
-    times: np.ndarray,
-) -> None:
+def _check_end(grid: _Grid, rows: tuple, change: np.ndarray, ends: tuple, via: _Via) -> None:
     """Refuse a weight change that moves the motion's last sample off where it ends without it, or
     leaves it moving there: via-points late in a motion are carried by kernels that still act at its
-    end. From the same impulse responses as the via-points (no rollout)."""
+    end. From the same impulse responses as the via-points (no rollout); ``rows`` = the rollout
+    grid's phase (n,) and basis (n, N)."""
+    params, step, _, dt = grid
+    phase, basis = rows
+    times, points, _ = via
     last = phase.shape[0] - 1
     rows = _impulse_rows(
         params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)]
@@ -213,33 +220,21 @@ def _check_end(
         )
 
 
-def _via_trajectory(  # noqa: PLR0913 - DMP.trajectory's own arguments, passed on whole
-    dmp,
-    goal,
-    start,
-    duration,
-    dt,
-    limits,
-    start_velocity,
-    forcing_increment,
-    coupling,
-    via,
-    until: float | None = None,
-):
-    """:meth:`bidmp.DMP.trajectory` through ``via``: the least-norm weight change, then the rollout
-    with it (and ``limits`` checked, not met by re-timing: a re-timed motion would reach the
-    via-points at other times)."""
-    if start_velocity is not None:
+def _via_trajectory(dmp, request: _Rollout):
+    """:meth:`bidmp.DMP.trajectory` through ``request.via``: the least-norm weight change, then the
+    rollout with it (and ``limits`` checked, not met by re-timing: a re-timed motion would reach
+    the via-points at other times)."""
+    goal, start, limits, until = request.goal, request.start, request.limits, request.via_until
+    if request.start_velocity is not None:
         raise ValueError(
             "via-points are solved for a motion from rest: start_velocity cannot be given with via"
         )
     if limits is not None:
-        limits = _checked_limits(limits)[
-            0
-        ]  # checked before the solve; "fastest" does not apply (not re-timed)
+        # checked before the solve; "fastest" does not apply (not re-timed)
+        limits = _checked_limits(limits)[0]
     params = dmp._params()
-    motion, dt_used, n_samples, step = _time_grid(dmp, duration, dt, params)
-    times, points = _parse_via(via, dmp.n_dims_, min(motion, (n_samples - 1) * dt_used))
+    motion, dt_used, n_samples, step = _time_grid(dmp, request.duration, request.dt, params)
+    times, points = _parse_via(request.via, dmp.n_dims_, min(motion, (n_samples - 1) * dt_used))
     ends = (
         dmp.goal_ if goal is None else as_point(goal, dmp.n_dims_, "goal"),
         dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start"),
@@ -253,15 +248,10 @@ def _via_trajectory(  # noqa: PLR0913 - DMP.trajectory's own arguments, passed o
             )
     increment = _via_increment(
         dmp,
-        times,
-        points,
+        _Via(times, points, until),
         ends,
-        rollout_params,
-        step,
-        n_samples + 2,
-        dt_used,
-        forcing_increment,
-        until,
+        _Grid(rollout_params, step, n_samples + 2, dt_used),
+        request.forcing_increment,
     )
     result = dmp.trajectory(
         goal,
@@ -269,7 +259,7 @@ def _via_trajectory(  # noqa: PLR0913 - DMP.trajectory's own arguments, passed o
         duration=motion,
         dt=dt_used,
         forcing_increment=increment,
-        coupling=coupling,
+        coupling=request.coupling,
     )
     if limits:
         factor = scale_factor(result, **limits)

@@ -355,7 +355,7 @@ class RobotCell:
         """Run a DMP/Bi-DMP ``stepper`` on the measured TCP at 100 Hz, with an optional perception
         update (:func:`bidmp.sim.pybullet.execute.execute_closed_loop`)."""
         return _execute._execute_closed_loop(
-            self, stepper, duration, exclude, hold, frames, max_factor, goal_update
+            self, stepper, (duration, max_factor), exclude, hold, frames, goal_update
         )
 
     def contacts(self) -> dict:

@@ -136,11 +136,10 @@ def _execute(
 def _execute_closed_loop(
     cell,
     stepper,
-    duration: float,
+    span: tuple[float, float],
     exclude=(),
     hold: Hold | None = None,
     frames: int = 0,
-    max_factor: float = 4.0,
     goal_update=None,
 ) -> Execution:
     """Run a DMP/Bi-DMP ``stepper`` (scene units) on the measured TCP at 100 Hz.
@@ -154,8 +153,10 @@ def _execute_closed_loop(
     and follows a monotone approach without overshoot (straight segments between the 100 Hz targets
     step the velocity every 10 ms, and the limiter then overshot a fast final descent by 1 mm). With phase stopping the motion's own time stands still while the robot is held. The run
     ends when the stepper's time has reached ``duration`` (at most ``max_factor`` times that in
-    wall time) plus the settling. ``goal_update``: see :func:`_perceive`.
+    wall time; ``span`` = (duration s, max_factor)) plus the settling. ``goal_update``: see
+    :func:`_perceive`.
     """
+    duration, max_factor = span
     p = cell.p
     q, error = cell.solve_ik(np.asarray(stepper.y) * cell.unit, cell.model.rest)
     if error > IK_TOLERANCE:
