@@ -476,8 +476,8 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     (
         "verdict assembly: a repair accepted",
         "Repairer._try",
-        "verdict = self._judge(self.planning, motion, goal, label, axis, exclude, carried)",
-        "verdict = self._judge(self._widened(widen), motion, goal, label, axis, exclude, carried)",
+        "verdict = self._judge(self.planning, motion, query)",
+        "verdict = self._judge(self._widened(widen), motion, query)",
         "a stale contract: an extension judged by the margin widened to plan it, not the one it must keep",
     ),
     # -- what the simulator executes
@@ -582,7 +582,7 @@ _BOUND = (
 )
 _CLEARANCE = "bidmp.scene.clearance"
 KNOWN_CLEARANCE = (
-    "found = self._try(how, model, goal, label, start, axis, exclude, skill, shortfall, carried, "
+    "found = self._try(how, query, shortfall, "
     "verdict.clearance if motion is out.motion and how == 'lift' else None)"
 )
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {

@@ -156,6 +156,6 @@ def test_a_runs_contacts_reach_the_verdict_in_the_scenes_unit():
     )
     task = SimpleNamespace(axes={}, alignment_threshold=None)
     contract = Contract(1.75, 25.0, None, "mm")
-    verdict, breach = _judged(task, "1", np.zeros(3), run, 0.001, PANDA, contract, ())
+    verdict, breach = _judged(task, ("1", np.zeros(3)), run, 0.001, (PANDA, contract, ()))
     assert verdict.contacts == {"post": pytest.approx(2.0)} and not verdict.ok
     assert verdict.end_error == pytest.approx(0.0) and breach == ""

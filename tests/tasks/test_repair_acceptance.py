@@ -15,7 +15,7 @@ from bidmp import DMP
 from bidmp.demonstrations import minimum_jerk
 from bidmp.scene import Scene
 from bidmp.tasks.contract import Contract
-from bidmp.tasks.repair import Repairer
+from bidmp.tasks.repair import Repairer, _Query
 
 RADIUS, MARGIN, ALLOWANCE = 12.5, 3.0, 0.2  # mm
 POST_RADIUS, GAP = 2.0, 3.4  # mm: the post's radius, its distance from the tool at the end
@@ -77,18 +77,23 @@ def test_the_cell_has_the_answer_the_tests_assume(cell):
     assert verdict.clearance.distance == pytest.approx(GAP, abs=1e-3)  # the DMP ends within 1 µm
 
 
+def _query(dmp, carried=None) -> _Query:
+    """What Repairer.repair asks of its repairs for the cell's nut "n" (no axis: world z)."""
+    return _Query(dmp, GOAL, "n", None, None, [], "nearest", carried)
+
+
 def test_a_margin_repair_plans_wider_and_is_judged_by_the_margin_and_allowance(cell, monkeypatch):
     """Planned for margin + allowance + the shortfall, accepted when it keeps margin + allowance
     (3.2 mm: the motion passes 3.4), though not the widened 3.7 mm it was planned for."""
     dmp, demo, contract = cell
     repairer = Repairer(contract, demo, allowance=ALLOWANCE)
     planned = _recording(repairer, monkeypatch, dmp)
-    motion, _, _, verdict = repairer._try("margin", dmp, GOAL, "n", None, None, [], "nearest", 0.5)
+    motion, _, _, verdict = repairer._try("margin", _query(dmp), 0.5)
     assert planned == [pytest.approx(MARGIN + ALLOWANCE + 0.5)]
     assert verdict.ok, verdict.reason()
     assert verdict.clearance.margin == pytest.approx(MARGIN + ALLOWANCE)
     planned.clear()
-    repairer._try("extend", dmp, GOAL, "n", None, None, [], "nearest", 0.5)
+    repairer._try("extend", _query(dmp), 0.5)
     assert planned == [pytest.approx(MARGIN + ALLOWANCE)]  # an extension plans without it
 
 
@@ -98,7 +103,7 @@ def test_a_margin_repair_that_still_comes_too_close_widens_by_what_it_lacked(cel
     dmp, demo, contract = cell
     repairer = Repairer(contract, demo, allowance=ALLOWANCE + 1.0)
     planned = _recording(repairer, monkeypatch, dmp)
-    *_, verdict = repairer._try("margin", dmp, GOAL, "n", None, None, [], "nearest", 0.0)
+    *_, verdict = repairer._try("margin", _query(dmp), 0.0)
     lacked = MARGIN + ALLOWANCE + 1.0 - GAP
     assert planned == pytest.approx(
         [MARGIN + ALLOWANCE + 1.0, MARGIN + ALLOWANCE + 1.0 + lacked], abs=1e-3
@@ -205,8 +210,8 @@ def test_a_carried_part_is_judged_with_the_tool(cell):
     ).solids[0]
     repairer = Repairer(contract, demo)
     motion = dmp.trajectory(GOAL).y
-    alone = repairer._judge(contract, motion, GOAL, "n", None, [])
-    carrying = repairer._judge(contract, motion, GOAL, "n", None, [], (held, [0.0, 0.0, -5.0]))
+    alone = repairer._judge(contract, motion, _query(dmp))
+    carrying = repairer._judge(contract, motion, _query(dmp, (held, [0.0, 0.0, -5.0])))
     assert alone.ok and not carrying.ok
     assert carrying.clearance.distance == pytest.approx(GAP + RADIUS - 15.0, abs=1e-3)
 

@@ -376,21 +376,21 @@ def _measure(
     task: _SimTask,
     label: str,
     target: np.ndarray,
-    plan: MotionPlan,
-    run: Execution,
+    executed: tuple[MotionPlan, Execution],
     unit: float,
     closed_loop: bool,
-    limits=PANDA,
-    contract=None,
-    exclude=(),
+    judge: tuple = (PANDA, None, ()),
 ) -> SimTarget:
-    """The per-target results of one execution (``task``: its targets, units, threshold;
-    ``limits``: the robot's joint limits), judged by ``contract`` (a
-    :class:`bidmp.tasks.contract.Contract` with the scene; default: the task's without one) on
-    the executed motion: the measured tool path, the commands, the contacts."""
+    """The per-target results of one execution, ``executed`` = (its plan, what the arm did)
+    (``task``: its targets, units, threshold), judged by ``judge`` = (the robot's joint limits, a
+    :class:`bidmp.tasks.contract.Contract` with the scene or None for the task's without one, the
+    parts excluded) on the executed motion: the measured tool path, the commands, the
+    contacts."""
+    plan, run = executed
+    limits, contract, exclude = judge
     if contract is None:
         contract = task.contract(None, limits)
-    verdict, breach = _judged(task, label, target, run, unit, limits, contract, exclude)
+    verdict, breach = _judged(task, (label, target), run, unit, (limits, contract, exclude))
     sent = verdict.limits or CommandPeaks(
         plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk
     )
@@ -420,12 +420,15 @@ def _measure(
     )
 
 
-def _judged(task: _SimTask, label, target, run: Execution, unit, limits, contract, exclude):
-    """(the contract's verdict, the measured joints' breach) on one execution: the verdict on the
+def _judged(task: _SimTask, aim: tuple, run: Execution, unit, judge: tuple):
+    """(the contract's verdict, the measured joints' breach) on one execution towards ``aim`` =
+    (label, target), ``judge`` = (joint limits, contract, parts excluded): the verdict on the
     measured tool path (scene units), its orientations in a pose scenario, the 1 kHz commands
     the position control was sent (the arm's own controller asked too, where the limits carry
     it) and the contacts; the breach on the measured joint velocities outside the run's
     disturbance (``""``: within)."""
+    label, target = aim
+    limits, contract, exclude = judge
     verdict = contract.judge(
         run.tcp / unit,
         target,

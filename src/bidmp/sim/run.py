@@ -136,13 +136,10 @@ def _run_one(setup: _SimSetup, cell, contract, job):
         setup.task,
         job.label,
         target,
-        plan,
-        run,
+        (plan, run),
         cell.unit,
         setup.closed_loop,
-        cell.limits,
-        contract,
-        job.exclude,
+        (cell.limits, contract, job.exclude),
     )
     measured.repair = job.repair
     measured.commanded_penetration = _commanded_penetration(cell, run, job)
@@ -329,7 +326,7 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
         _not_run(job, refusals[(job.method, job.label)], stills.get((job.method, job.label), ()))
         for job in skipped
     ]
-    out = _sim_report(scenario, methods, labels, outcomes, base, yaw, closed_loop, backend, arm)
+    out = _sim_report(scenario, methods, labels, outcomes, (base, yaw), closed_loop, (backend, arm))
     out.evaluation = report
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
@@ -614,10 +611,13 @@ def _views(views) -> set:
 
 
 def _sim_report(
-    scenario, methods, labels, outcomes, base, yaw, closed_loop: bool, backend, arm
+    scenario, methods, labels, outcomes, placement: tuple, closed_loop: bool, robot: tuple
 ) -> SimReport:
     """The workers' outcomes ``(method, label, measured, images, seconds, motion)`` as a report,
-    in the order of the methods and targets (whatever order the workers finished in)."""
+    in the order of the methods and targets (whatever order the workers finished in);
+    ``placement`` = (the robot's base, its yaw), ``robot`` = (the backend, the arm)."""
+    base, yaw = placement
+    backend, arm = robot
     ours = backend is RobotCell  # the scenario's arm; another backend brings its own
     limits = arm.limits if ours else getattr(backend, "limits", None)
     by_key = {

@@ -34,6 +34,7 @@ import copy
 import logging
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -161,6 +162,22 @@ def _turns(motion) -> np.ndarray | None:
     return motion[:, 3:7] if motion.shape[1] == 7 else None
 
 
+class _Query(NamedTuple):
+    """What :meth:`Repairer.repair` is asked: the model (a DMP or Bi-DMP, a pose one or not), the
+    target (``goal``, ``label``, its ``axis`` and the parts ``exclude``d there), where the motion
+    starts, which ``skill`` runs, and a ``carried`` part or None; passed whole to each repair and
+    to each judgement."""
+
+    model: object
+    goal: np.ndarray
+    label: str
+    start: object
+    axis: np.ndarray
+    exclude: list
+    skill: object
+    carried: object
+
+
 class Repairer:
     """The repairs of one task (module docstring).
 
@@ -235,12 +252,17 @@ class Repairer:
         )
 
     # -- the judgement -----------------------------------------------------------------------------
-    def _judge(
-        self, contract: Contract, motion, goal, label, axis, exclude, carried=None, clearance=None
-    ) -> Verdict:
+    def _judge(self, contract: Contract, motion, query: _Query, clearance=None) -> Verdict:
         """``contract``'s verdict on ``motion`` (positions, or poses: judged with the tool's
-        frame), a ``carried`` part's clearance counted with the tool's; ``clearance``: the
-        motion's, when the caller has it already (a lift's)."""
+        frame) to ``query``'s target, its ``carried`` part's clearance counted with the tool's;
+        ``clearance``: the motion's, when the caller has it already (a lift's)."""
+        goal, label, axis, exclude, carried = (
+            query.goal,
+            query.label,
+            query.axis,
+            query.exclude,
+            query.carried,
+        )
         turns = _turns(motion)
         if clearance is None and contract.scene is not None and carried:
             clearance = self._clearance(
@@ -288,7 +310,7 @@ class Repairer:
         )
 
     # -- repairing -----------------------------------------------------------------------------------
-    def repair(
+    def repair(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         model,
         goal,
@@ -315,10 +337,11 @@ class Repairer:
             )
         if not hasattr(model, "trajectory"):
             raise TypeError(f"model must be a fitted DMP or Bi-DMP, got {type(model).__name__}")
+        query = _Query(model, goal, label, start, axis, exclude, skill, carried)
         if motion is None:
             motion = _path(_trajectory(model, goal, start, skill))
         if verdict is None:
-            verdict = self._judge(self.contract, motion, goal, label, axis, exclude, carried)
+            verdict = self._judge(self.contract, motion, query)
         out = Repaired(np.asarray(motion), verdict)
         if verdict.ok:
             return out
@@ -344,15 +367,8 @@ class Repairer:
             try:
                 found = self._try(
                     how,
-                    model,
-                    goal,
-                    label,
-                    start,
-                    axis,
-                    exclude,
-                    skill,
+                    query,
                     shortfall,
-                    carried,
                     verdict.clearance if motion is out.motion and how == "lift" else None,
                 )
             except ValueError as exc:  # a via-point refused, an avoidance miss, no free route ...
@@ -361,7 +377,7 @@ class Repairer:
                 )
                 continue
             candidate, trial, trial_skill, planned = found
-            final = self._final(planned, candidate, goal, label, axis, exclude, carried)
+            final = self._final(planned, candidate, query)
             ok = final.ok and planned.ok
             out.attempts.append(
                 Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason())
@@ -380,14 +396,14 @@ class Repairer:
                 shortfall = max(shortfall, planned.clearance.margin - planned.clearance.distance)
         return out
 
-    def _final(self, planned, motion, goal, label, axis, exclude, carried) -> Verdict:
+    def _final(self, planned, motion, query: _Query) -> Verdict:
         """The contract's own verdict on a repair's ``motion`` (the one the report shows), judged
         after its verdict on the planning contract (``planned``): not judged again where that
         already failed (the repair is not kept), nor where no allowance widens the planning
         contract (the two are then one contract, on the same motion and arguments)."""
         if not planned.ok or self.planning.scene.margin == self.contract.scene.margin:
             return planned
-        return self._judge(self.contract, motion, goal, label, axis, exclude, carried)
+        return self._judge(self.contract, motion, query)
 
     @staticmethod
     def bidmp_possible(model) -> bool:
@@ -396,29 +412,20 @@ class Repairer:
             return hasattr(model, "cartesian_") or hasattr(model, "start_log_")
         return hasattr(model, "weights_") and hasattr(model, "n_steps_")
 
-    def _try(  # noqa: PLR0913 - the query of Repairer.repair, passed on whole to each repair
-        self,
-        how,
-        model,
-        goal,
-        label,
-        start,
-        axis,
-        exclude,
-        skill,
-        shortfall,
-        carried=None,
-        known=None,
-    ):
-        """``(motion, model, skill, verdict on the planning contract)`` of one repair (``known``: the
-        method's own motion's clearance, where it has one: the lift's first round)."""
+    def _try(self, how, query: _Query, shortfall: float, known=None):
+        """``(motion, model, skill, verdict on the planning contract)`` of one repair of ``query``
+        (``known``: the method's own motion's clearance, where it has one: the lift's first
+        round)."""
+        model, goal, label, start, skill = (
+            query.model,
+            query.goal,
+            query.label,
+            query.start,
+            query.skill,
+        )
         if how == "lift":
-            motion, clearance = self._lift(
-                model, goal, label, start, axis, exclude, skill, carried, known
-            )
-            verdict = self._judge(
-                self.planning, motion, goal, label, axis, exclude, clearance=clearance
-            )
+            motion, clearance = self._lift(query, known)
+            verdict = self._judge(self.planning, motion, query, clearance)
             return motion, None, None, verdict
         if how == "avoid":
             from ..primitives.avoidance import SceneAvoidance
@@ -428,12 +435,7 @@ class Repairer:
                 scene, margin=scene.margin, target=label if label in scene.labels else None
             )
             motion = _path(_trajectory(model, goal, start, skill, coupling=[term]))
-            return (
-                motion,
-                None,
-                None,
-                self._judge(self.planning, motion, goal, label, axis, exclude, carried),
-            )
+            return motion, None, None, self._judge(self.planning, motion, query)
         widen = self.allowance + (shortfall if how == "margin" else 0.0)
         attempts = _WIDENINGS if how == "margin" else 1
         for _ in range(attempts):
@@ -441,7 +443,7 @@ class Repairer:
             motion = _path(_trajectory(trial, goal, start, index))
             # Planned with a wider margin, judged by what it must keep: the margin and the
             # allowance (the shortfall only steers the planning).
-            verdict = self._judge(self.planning, motion, goal, label, axis, exclude, carried)
+            verdict = self._judge(self.planning, motion, query)
             if verdict.ok or verdict.clearance is None or how != "margin":
                 return motion, trial, index, verdict
             widen += max(verdict.clearance.margin - verdict.clearance.distance, 0.0)
@@ -494,11 +496,20 @@ class Repairer:
         trial.learn(learned, duration=extension.duration_for(dmp) * scale)
         return trial, trial.n_skills - 1
 
-    def _lift(self, model, goal, label, start, axis, exclude, skill, carried=None, known=None):
-        """The motion raised over the parts it comes too close to by exact via-points: each round,
-        the stretch of the motion that passes the nearest part (by its bounding box) before the
-        final approach is lifted to over the part's top, by up to :data:`_STRETCH` points spread
-        along it; a ``ValueError`` when it cannot be."""
+    def _lift(self, query: _Query, known=None):
+        """The motion of ``query`` raised over the parts it comes too close to by exact via-points:
+        each round, the stretch of the motion that passes the nearest part (by its bounding box)
+        before the final approach is lifted to over the part's top, by up to :data:`_STRETCH`
+        points spread along it; a ``ValueError`` when it cannot be."""
+        model, goal, start, axis, exclude, skill, carried = (
+            query.model,
+            query.goal,
+            query.start,
+            query.axis,
+            query.exclude,
+            query.skill,
+            query.carried,
+        )
         scene = self.planning.scene
         pose = _is_pose(model)
         trajectory = _trajectory(model, goal, start, skill)
