@@ -312,7 +312,9 @@ def _stamps(kind, n):
     ),
 )
 @examples(50)
-def test_fuzz_timed_dmp(y, stamps, params, goal, start, duration, dt, limits):
+def test_fuzz_timed_dmp(  # noqa: PLR0913 - one argument per hypothesis strategy
+    y, stamps, params, goal, start, duration, dt, limits
+):
     n = len(y) if hasattr(y, "__len__") else 0
     dmp = outcome("DMP.fit(t)", bidmp.DMP(**params).fit, y, _stamps(stamps, n))
     if dmp is None:

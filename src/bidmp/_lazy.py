@@ -67,9 +67,8 @@ def exports(package: str, file: str, namespace: dict, extra=()) -> tuple[Callabl
             namespace[name] = value
             return value
         if name not in table():
-            if (
-                importlib.util.find_spec(f"{package}.{name}") is not None
-            ):  # a submodule: bidmp.io.models
+            # a submodule: bidmp.io.models
+            if importlib.util.find_spec(f"{package}.{name}") is not None:
                 value = importlib.import_module(f"{package}.{name}")
                 namespace[name] = value
                 return value

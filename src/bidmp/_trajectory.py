@@ -80,9 +80,8 @@ def rmse(a, b) -> float:
     """Root-mean-square Euclidean distance between two trajectories of equal shape (T, D)."""
     from ._checks import as_trajectory
 
-    a = as_trajectory(
-        a, "a", min_points=1, allow_static=True
-    )  # sizes, types and finiteness checked by name
+    # sizes, types and finiteness checked by name
+    a = as_trajectory(a, "a", min_points=1, allow_static=True)
     b = as_trajectory(b, "b", min_points=1, allow_static=True)
     if a.shape != b.shape:
         raise ValueError(

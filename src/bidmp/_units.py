@@ -144,9 +144,8 @@ def check_speed(peak_speed: float, units: str, what: str, *, fast_only: bool = F
     if slowest <= peak_speed * UNITS[units] <= fastest:
         return
     plausible = [unit for unit in UNITS if slowest <= peak_speed * UNITS[unit] <= fastest]
-    plausible.sort(
-        key=lambda unit: abs(np.log(peak_speed * UNITS[unit] / 0.25))
-    )  # nearest a hand-guided motion's
+    # nearest a hand-guided motion's
+    plausible.sort(key=lambda unit: abs(np.log(peak_speed * UNITS[unit] / 0.25)))
     hint = (
         f"; in {plausible[0]} it would be {peak_speed * UNITS[plausible[0]]:.3g} m/s: is it in {plausible[0]}? "
         f"(--units {plausible[0]}, or declare '# units: {plausible[0]}' in the file)"

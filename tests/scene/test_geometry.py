@@ -820,6 +820,35 @@ def test_a_turning_tool_among_tilted_parts_matches_every_pair_through_coal(seed)
     assert found.distance == pytest.approx(every, abs=1e-9)
 
 
+def test_the_oriented_bound_does_not_depend_on_where_a_solid_keeps_its_own_box():
+    """A solid's box in its own frame need not be centred on its origin (a convex part's hull need
+    not be): the same box described from another origin, its centre moved by ``R d`` and its
+    corners by ``-d``, bounds every placement the same (a property of the geometry, not the code
+    against itself; the built-in solids are all centred, so nothing else tries it)."""
+    rng = np.random.default_rng(12)
+    parts = [
+        {"type": "box", "label": "b", "at": [0, 0, 0], "size": [60, 40, 8], "rotation": [20, -15, 30]},
+        {"type": "cylinder", "label": "c", "at": [150, 0, 0], "radius": 9, "height": 50, "rotation": [35, 10, 0]},
+        {"type": "nut", "label": "n", "at": [-150, 0, 0], "across_flats": 20, "height": 12, "rotation": [25, 5, 0]},
+    ]  # fmt: skip
+    scene = Scene.from_dict({"tool": {"radius": 6.0, "length": 60.0}, "parts": parts})
+    chosen = np.arange(len(scene.solids))
+    turns = Rotation.random(300, random_state=4).as_matrix()
+    points = rng.normal([0.0, 0.0, 0.0], 120.0, (300, 3))
+    axes = turns[:, :, 2]
+    before = scene._oriented_bounds(points - axes * 30.0, axes, chosen)
+    centre, rotation, lower, upper = scene._frames
+    shift = rng.normal(size=centre.shape) * 25.0
+    scene._frames = (
+        centre + np.einsum("kij,kj->ki", rotation, shift),
+        rotation,
+        lower - shift,
+        upper - shift,
+    )
+    after = scene._oriented_bounds(points - axes * 30.0, axes, chosen)
+    assert np.any(before > 0.0) and np.allclose(after, before, rtol=0.0, atol=1e-9)
+
+
 def test_the_oriented_bound_is_a_lower_bound_and_tight_where_the_tool_is_square_to_a_box():
     """The culling bound of a turning tool, on its own: never above coal's exact distance (random
     tilted boxes and cylinders, random tool frames and places; a bound above it would skip the

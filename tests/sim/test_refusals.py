@@ -300,7 +300,7 @@ def test_a_plan_is_refused_for_its_carried_part_and_its_joint_peaks():
     reach 1.5 times the limit is refused for that."""
     from types import SimpleNamespace
 
-    from bidmp.sim.job_world import _refused_plan, _transfer_contract
+    from bidmp.sim.job_world import _Move, _refused_plan, _transfer_contract
     from bidmp.tasks.contract import Contract
 
     nut = scenarios.load("nut-unscrewing")
@@ -316,14 +316,17 @@ def test_a_plan_is_refused_for_its_carried_part_and_its_joint_peaks():
     contract = _transfer_contract(Contract.of(nut))
     calm = SimpleNamespace(peak_velocity=0.5, peak_acceleration=0.5, peak_jerk=0.5)
     moved = carried_solid.moved(path[0] + offset, np.eye(3))
-    args = ("drop", None, ["3"], None)
-    refused = _refused_plan(world, calm, contract, path, path[-1], *args, (moved, offset), ())
+
+    def move(carried):
+        return _Move(path, None, ["3"], "drop", carried=carried)
+
+    refused = _refused_plan(world, calm, contract, move((moved, offset)), path[-1])
     assert refused is not None and not refused.ok and refused.seconds == 0.0
     assert refused.verdict is not None and "4" in refused.verdict.clearance.part
     assert refused.note.startswith("not run: the contract refuses its plan: ")
-    assert _refused_plan(world, calm, contract, path, path[-1], *args, None, ()) is None
+    assert _refused_plan(world, calm, contract, move(None), path[-1]) is None
     fast = SimpleNamespace(peak_velocity=1.5, peak_acceleration=0.5, peak_jerk=0.5)
-    limited = _refused_plan(world, fast, contract, path, path[-1], *args, None, ())
+    limited = _refused_plan(world, fast, contract, move(None), path[-1])
     assert limited is not None and not limited.within_limits and limited.verdict is None
     assert limited.note.endswith("its planned joint velocity exceeds the limit")
 
@@ -405,11 +408,11 @@ def test_a_job_phases_refusal_names_the_target_and_the_phase():
     from types import SimpleNamespace
 
     from bidmp.sim import SimError
-    from bidmp.sim.job_world import _move
+    from bidmp.sim.job_world import _Move, _move
 
     def plan(path, label, **options):
         raise SimError(f"target {label!r}: the point [1, 2, 3] of its motion is unreachable")
 
     world = SimpleNamespace(cell=SimpleNamespace(plan=plan), label="B4", q=np.zeros(7))
     with pytest.raises(SimError, match=r"target 'B4 \(approach\)': the point"):
-        _move(world, np.zeros((2, 3)), None, [], "approach")
+        _move(world, _Move(np.zeros((2, 3)), None, [], "approach"))

@@ -132,9 +132,12 @@ def capsule_bound(tips, axes, radius, length, kind, lower, upper):
     return best - radius, s
 
 
-def separating_bound(tips, axes, radius, length, kind, lower, upper, s):
+def separating_bound(tool, part, s):
     """The best separation over candidate directions (toward the tool from the part's nearest
-    point, the part's face normals, the tool's axis) refined by a seeded local search."""
+    point, the part's face normals, the tool's axis) refined by a seeded local search; ``tool`` =
+    (tips, axes, radius, length), ``part`` = (kind, lower, upper) in its own frame."""
+    tips, axes, radius, length = tool
+    kind, lower, upper = part
     rng = np.random.default_rng(0)
     axis_points = tips + s[:, None] * axes
     nearest = axis_points - (
@@ -177,9 +180,12 @@ def separating_bound(tips, axes, radius, length, kind, lower, upper, s):
     return best
 
 
-def surface_bound(tips, axes, radius, length, kind, lower, upper, s):
+def surface_bound(tool, part, s):
     """The smallest signed distance of points on the tool's surface (rings at and around the
-    nearest height along the axis, and both end faces): at least the tool's own distance."""
+    nearest height along the axis, and both end faces): at least the tool's own distance
+    (``tool`` and ``part`` as :func:`separating_bound`'s)."""
+    tips, axes, radius, length = tool
+    kind, lower, upper = part
     helper = np.where(np.abs(axes[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
     first = np.cross(axes, helper)
     first /= np.linalg.norm(first, axis=1, keepdims=True)
@@ -244,13 +250,8 @@ def clearance_bounds(points, quaternions, flat, tilt, pivot, exclude, floor):
         lower_bound = min(lower_bound, float(bound[~close].min(initial=np.inf)))
         if np.any(close):
             args = (
-                tips[near][close],
-                axes[near][close],
-                radius,
-                length,
-                kind,
-                lower,
-                upper,
+                (tips[near][close], axes[near][close], radius, length),
+                (kind, lower, upper),
                 s[close],
             )
             refined = np.maximum(bound[close], separating_bound(*args))
@@ -259,11 +260,11 @@ def clearance_bounds(points, quaternions, flat, tilt, pivot, exclude, floor):
     return lower_bound, upper_bound
 
 
-def along_the_axis(
-    points, quaternions, flat_target, tilt, pivot, height, threshold, alignment
-) -> bool:
-    """In the plate's frame: the final descent from ``height`` above the target stays within the
-    threshold of its axis, keeps going down, and holds the tool within ``alignment`` degrees."""
+def along_the_axis(points, quaternions, flat_target, plate, height, threshold, alignment) -> bool:
+    """In the plate's frame (``plate`` = its tilt, a rotation, and the pivot it turns about): the
+    final descent from ``height`` above the target stays within the threshold of its axis, keeps
+    going down, and holds the tool within ``alignment`` degrees."""
+    tilt, pivot = plate
     back = tilt.inv()
     local = pivot + back.apply(points - pivot)
     above = local[:, 2] - flat_target[2]
@@ -320,8 +321,7 @@ def test_no_motion_on_a_random_tilted_cell_is_a_silent_violation(chunk):
                         rollout,
                         quaternions,
                         flat_target,
-                        tilt,
-                        pivot,
+                        (tilt, pivot),
                         spec["approach_height"],
                         threshold,
                         scenario.alignment_threshold,

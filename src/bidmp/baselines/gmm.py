@@ -154,9 +154,8 @@ class _AugmentedMixture(Estimator):
         check_real(self.reg_covar, "reg_covar", positive=True, maximum=1e6)
         check_int(self.n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
         check_real(self.noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
-        check_int(
-            self.seed, "seed", minimum=0, maximum=2**32 - 1
-        )  # scikit-learn's random_state range
+        # scikit-learn's random_state range
+        check_int(self.seed, "seed", minimum=0, maximum=2**32 - 1)
 
     def __sklearn_is_fitted__(self) -> bool:
         return "weights_" in self.__dict__

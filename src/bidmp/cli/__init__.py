@@ -74,11 +74,12 @@ def _quiet_stdout() -> None:
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
+    # a replaced sys.stdout (tests) has no file number
     except (
         OSError,
         ValueError,
         AttributeError,
-    ):  # a replaced sys.stdout (tests) has no file number
+    ):
         pass
 
 

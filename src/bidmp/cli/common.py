@@ -86,9 +86,8 @@ def backend_option(parser) -> None:
 def one_line(text: str) -> str:
     """One printable line: whitespace runs collapsed, control characters (a file name or argument
     may carry terminal escapes) shown as '?', at most MAX_MESSAGE characters."""
-    text = "".join(
-        c if c.isprintable() else "?" for c in " ".join(str(text).split())
-    )  # no NumPy import here
+    # no NumPy import here
+    text = "".join(c if c.isprintable() else "?" for c in " ".join(str(text).split()))
     return text if len(text) <= MAX_MESSAGE else text[: MAX_MESSAGE - 1] + "…"
 
 

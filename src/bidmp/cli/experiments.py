@@ -95,9 +95,8 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     methods = (
         None if args.methods is None else [m.strip() for m in args.methods.split(",") if m.strip()]
     )
-    shapes_checked, _, indices = check_lasa_options(
-        shapes, methods, args.demos, args.every
-    )  # before starting a cluster
+    # before starting a cluster
+    shapes_checked, _, indices = check_lasa_options(shapes, methods, args.demos, args.every)
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be 1-256, got {args.workers}")
     with tqdm(

@@ -66,9 +66,8 @@ def run_job_command(
         from .view import write_view_files
 
         own = {solid.label for solid in scenario.scene.solids}
-        extra = [
-            solid for solid in report.scene.solids if solid.label not in own
-        ]  # the bin, the rack
+        # the bin, the rack
+        extra = [solid for solid in report.scene.solids if solid.label not in own]
         written += write_view_files(
             out, report=report.evaluation, sim_result=report, extra_solids=extra
         )

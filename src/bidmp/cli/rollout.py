@@ -24,9 +24,8 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
 
         check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
         motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
-        options["dt"] = (
-            dmp._params().settle * motion / (args.n_steps - 1)
-        )  # the same motion, sampled more finely
+        # the same motion, sampled more finely
+        options["dt"] = dmp._params().settle * motion / (args.n_steps - 1)
     limits = _limits(args, dmp)
     if limits:
         options["limits"] = {**limits, "fastest": args.fastest}
@@ -184,9 +183,8 @@ def cmd_rollout(args: argparse.Namespace) -> int:
     trajectory = model.trajectory(**options)
     from .._units import check_speed
 
-    check_speed(
-        trajectory.peak_speed(), dmp.units_, "the rolled-out motion", fast_only=True
-    )  # never write what no robot runs
+    # never write what no robot runs
+    check_speed(trajectory.peak_speed(), dmp.units_, "the rolled-out motion", fast_only=True)
     path = (save_poses if poses else save_trajectory)(trajectory, args.output)
     unit = dmp.units_ or "units"
     rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")

@@ -28,10 +28,10 @@ def _run_scenario(scenario, out, methods=None, view=False):
 
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
-
+        # each method as it starts, each repair as it is tried ("bidmp: repair 12")
         def progress(
             step,
-        ):  # each method as it starts, each repair as it is tried ("bidmp: repair 12")
+        ):
             bar.set_postfix_str(step)
             if step in names:
                 bar.update(1)
@@ -49,33 +49,21 @@ def _run_scenario(scenario, out, methods=None, view=False):
     return report
 
 
-def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to simulate
-    scenario,
-    out,
-    methods,
-    *,
-    closed_loop=False,
-    hold=None,
-    workers=None,
-    pictures=True,
-    targets=None,
-    avoid=False,
-    goal_update=None,
-    view=False,
-    backend=None,
-):
+def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     """Execute a scenario on the simulated arm with a progress bar; print and write the results
-    (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it). The
-    simulator evaluates the motions it executes itself (judged and repaired with room for the
-    arm's tracking): no flag here changes what runs, and the viewer draws that evaluation."""
+    (and with ``view`` the 3-D viewer, the arm's motion to the furthest target in it).
+    ``options``: :func:`bidmp.sim.simulate`'s, passed on whole (``closed_loop``, ``hold``,
+    ``workers``, ``targets``, ``avoid``, ``goal_update``, ``backend``). The simulator evaluates
+    the motions it executes itself (judged and repaired with room for the arm's tracking): no
+    flag here changes what runs, and the viewer draws that evaluation."""
     from tqdm import tqdm
 
     from ..sim.report import write_sim_report
     from ..sim.run import execution_report, simulate, target_labels
 
     methods = list(methods)
-    labels = target_labels(scenario, targets)
-    run_as = scenario.with_robot_protocol() if closed_loop else scenario
+    labels = target_labels(scenario, options.get("targets"))
+    run_as = scenario.with_robot_protocol() if options.get("closed_loop", False) else scenario
     with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
         report = execution_report(run_as, methods)
     pictured = {(method, _pictured_target(scenario, report, method, labels)) for method in methods}
@@ -93,16 +81,10 @@ def _run_sim(  # noqa: PLR0913 - the sim command's options, passed on whole to s
                 scenario,
                 methods,
                 report=report,
-                closed_loop=closed_loop,
-                hold=hold,
-                workers=workers,
-                targets=targets,
                 frames=frames,
                 progress=progress,
-                avoid=avoid,
-                goal_update=goal_update,
                 views=pictured if view else (),
-                backend=backend,
+                **options,
             )
     print()
     print(result.summary())

@@ -142,7 +142,7 @@ def minimum_jerk(
     return perturb(y, noise, seed) if noise > 0.0 else y
 
 
-def kinesthetic_recording(
+def kinesthetic_recording(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     via,
     *,
     duration: float = 4.5,

@@ -132,9 +132,8 @@ def lasa_generalisation(
     reached twice: with the paper's fixed horizon (T steps; the end-point error is
     ``endpoint_gain · shift``) and run ``convergence_factor`` times longer (error → 0).
     """
-    demo_index = check_int(
-        demo_index, "demo_index", minimum=0, maximum=6
-    )  # LASA has 7 demonstrations per shape
+    # LASA has 7 demonstrations per shape
+    demo_index = check_int(demo_index, "demo_index", minimum=0, maximum=6)
     n_goals = check_int(n_goals, "n_goals", minimum=1, limit="max_targets")
     convergence_factor = check_int(
         convergence_factor, "convergence_factor", minimum=1, maximum=1000

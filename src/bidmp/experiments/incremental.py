@@ -29,11 +29,12 @@ __all__ = [
 # ---------------------------------------------------------------------------------------------
 # Paper Fig. 11: Bi-DMP on LASA shapes
 # ---------------------------------------------------------------------------------------------
+# × extent, from the demonstrated end
 LASA_TARGET_OFFSETS = (
     (0.3, -0.2),
     (-0.25, -0.3),
     (0.15, 0.35),
-)  # × extent, from the demonstrated end
+)
 
 
 FIGURE_SHAPES = ("Sshape", "WShape", "NShape")

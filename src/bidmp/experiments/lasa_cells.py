@@ -25,11 +25,12 @@ logger = logging.getLogger(__name__)
 LASA_METHODS = ("dmp-paper", "dmp-robot", "bidmp", "gmm", "tpgmm", "mp-dmp", "promp", "dmp-multi")
 
 
+# goal shift as a fraction of the shape's extent
 CASES = (
     ("reproduction", 0.0),
     ("near", 0.1),
     ("far", 0.6),
-)  # goal shift as a fraction of the shape's extent
+)
 
 
 METRICS = ("rmse", "dtw", "dtw_per_sample", "swept_area", "frechet", "endpoint_error")

@@ -64,9 +64,8 @@ class Table4:
 
     reports: dict[str, Report]  # the paper's protocol (extension approach "paper")
     cells_before: Report  # cell removal with the nut extension only, Bi-DMP
-    keep: dict = field(
-        default_factory=dict
-    )  # nut and cell tasks with the defaults (approach "keep"), dmp + bidmp
+    # nut and cell tasks with the defaults (approach "keep"), dmp + bidmp
+    keep: dict = field(default_factory=dict)
 
     def task_rows(self) -> tuple[list[str], list[list[str]]]:
         """Task success with the battery geometry: end point ∧ engaged ∧ collision-free, for the
@@ -254,9 +253,8 @@ def run_table4(progress: Callable | None = None) -> Table4:
         paper = scenario.replace(extension={**scenario.extension, "approach": "paper"})
         reports[name] = evaluate(paper, repair=False)
         if name in TASK_SCENARIOS:
-            keep[name] = evaluate(
-                scenarios.load(name), ["dmp", "bidmp"], repair=False
-            )  # approach keep, as learned
+            # approach keep, as learned
+            keep[name] = evaluate(scenarios.load(name), ["dmp", "bidmp"], repair=False)
     cells = reports["cell-removal"].scenario
     nut_skill_only = cells.replace(extensions=cells.spec["extensions"][:1])
     before = evaluate(nut_skill_only, ["bidmp"], repair=False)

@@ -32,11 +32,12 @@ MAX_SEEDS = 200  # seeds of one G-PRM vs PRM comparison (each runs both roadmaps
 # ---------------------------------------------------------------------------------------------
 # Paper Table 5: G-PRM vs classic PRM
 # ---------------------------------------------------------------------------------------------
+# mm, the paper's battery approach
 BATTERY_APPROACH_VIA = (
     (-80.0, -120.0, 200.0),
     (0.0, 0.0, 40.0),
     (0.0, 0.0, 0.0),
-)  # mm, the paper's battery approach
+)
 
 
 BATTERY_EXTENSION_TARGET = (150.0, 25.0, 0.0)  # centre of the nuts the plain DMP misses

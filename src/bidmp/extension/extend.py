@@ -635,9 +635,8 @@ def extend_pose_demonstration(
     )
     start, seg = extension.approach_index, extension.seg_index
     kept = (turn * Rotation.from_quat(quaternions[start:])).as_quat()
-    hover = len(extension.complete) - (
-        len(positions) - start
-    )  # where the kept approach begins in complete
+    # where the kept approach begins in complete
+    hover = len(extension.complete) - (len(positions) - start)
     transfer = extension.complete[seg : hover + 1]
     arc = arclength(transfer)
     fraction = arc / arc[-1] if arc[-1] > 0 else np.linspace(0.0, 1.0, len(transfer))

@@ -42,12 +42,14 @@ logger = logging.getLogger(__name__)
 
 _RESAMPLED = 200  # points of the shortcut polyline before smoothing
 _TAUT = 60  # points along the shortcut polyline, shortcut once more
+# Savitzky–Golay windows tried on the template, widest first (points of _RESAMPLED)
 _WINDOWS = (
     81,
     41,
     21,
     11,
-)  # Savitzky–Golay windows tried on the template, widest first (points of _RESAMPLED)
+)
+# interior knots of the route's quintic spline, fewest (smoothest) first
 _KNOTS = (
     0,
     1,
@@ -60,7 +62,7 @@ _KNOTS = (
     16,
     24,
     32,
-)  # interior knots of the route's quintic spline, fewest (smoothest) first
+)
 # Shares of the spline's offset from the template (or chord) tried, widest first: 1.5 where a fit
 # cuts a corner into a part, down to 0.1 where G-PRM's wide samples went further round than needed.
 _SHARES = (1.5, 1.25, 1.1, 1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3, 0.2, 0.1)
@@ -162,9 +164,8 @@ def _smoothest_free_route(
                 _least_jerk_bow(polyline, reference, is_free, route_length),
             ]
             return [candidate] + [bow for bow in bows if bow is not None]
-        if (
-            best is None or length < best_length
-        ):  # a bow much longer than the route: more knots, if one is free
+        # a bow much longer than the route: more knots, if one is free
+        if best is None or length < best_length:
             best, best_length = candidate, length
     return None if best is None else [best]
 
@@ -311,9 +312,8 @@ def _refine_transfer(
         smooth = _smoothest_free(template, is_free)
         return [template if smooth is None else smooth], "template"
     polyline = _shortcut(path, is_free)
-    if (
-        polyline.shape[0] > 2
-    ):  # again through points along its pieces: corners cut where the vertices alone cannot
+    # again through points along its pieces: corners cut where the vertices alone cannot
+    if polyline.shape[0] > 2:
         s = arclength(polyline)
         polyline = _shortcut(interp_columns(np.linspace(0.0, s[-1], _TAUT), s, polyline), is_free)
     smooth = (

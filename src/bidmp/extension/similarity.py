@@ -111,9 +111,8 @@ def _compiled(name: str, function):
     if name not in _kernel_state:
         try:
             import numba
-        except (
-            ImportError
-        ):  # pragma: no cover - numba is a dependency; this keeps bidmp usable without it
+        # numba is a dependency; this keeps bidmp usable without it
+        except ImportError:  # pragma: no cover
             _kernel_state[name] = None
             return None
         probe = (np.zeros((1, 1)), np.zeros((1, 1)))
@@ -182,9 +181,8 @@ def frechet_distance_reference(a: np.ndarray, b: np.ndarray) -> float:
         raise ValueError(
             f"a and b must have the same number of columns, got {a.shape[1]} and {b.shape[1]}"
         )
-    if (
-        float(n) * m > REFERENCE_MAX_CELLS
-    ):  # a Python loop over anti-diagonals: a reference, not a tool
+    # a Python loop over anti-diagonals: a reference, not a tool
+    if float(n) * m > REFERENCE_MAX_CELLS:
         raise ValueError(
             f"frechet_distance_reference: {n:,} x {m:,} cells exceed the reference's "
             f"{REFERENCE_MAX_CELLS:,.0f}; use frechet_distance"
@@ -208,9 +206,8 @@ def _frechet_anti_diagonals(a: np.ndarray, b: np.ndarray) -> float:
         else:
             up = np.where(i >= 1, previous[np.maximum(i - 1, 0)], np.inf)  # ca[i-1, j]
             left = previous[i]  # ca[i, j-1]
-            diagonal = np.where(
-                i >= 1, before_previous[np.maximum(i - 1, 0)], np.inf
-            )  # ca[i-1, j-1]
+            # ca[i-1, j-1]
+            diagonal = np.where(i >= 1, before_previous[np.maximum(i - 1, 0)], np.inf)
             current = np.full(n, np.inf)
             current[i] = np.maximum(np.minimum(np.minimum(up, left), diagonal), distance)
         before_previous, previous = previous, current

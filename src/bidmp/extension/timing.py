@@ -245,9 +245,8 @@ def _corner_blends(
     return offsets
 
 
-_SMOOTH_TURN = np.radians(
-    5.0
-)  # a path turning less at every vertex is taken as samples of a smooth curve
+# a path turning less at every vertex is taken as samples of a smooth curve
+_SMOOTH_TURN = np.radians(5.0)
 
 
 def _path_function(path: np.ndarray, s: np.ndarray):

@@ -57,10 +57,11 @@ def _derivative_rule(derivatives: str, params) -> str:
     return params.derivatives if derivatives == "dmp" else derivatives
 
 
+# a skill lasts between a thousandth and a thousand times the demonstration
 _TIME_SCALES = (
     1e-3,
     1e3,
-)  # a skill lasts between a thousandth and a thousand times the demonstration
+)
 
 
 def _time_scale(duration, dmp: DMP) -> float:
@@ -138,7 +139,7 @@ class BiDMP(Estimator):
         The smallest phase of the training grid; below it the BLS input is held at this phase.
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
         self,
         dmp: DMP | None = None,
         n_windows: int = 10,
@@ -271,9 +272,8 @@ class BiDMP(Estimator):
         y = as_trajectory(y_dn, name, allow_static=still)
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"{name} has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")
-        y = dmp.training_trajectory(
-            y
-        )  # T samples (and, robot protocol, rest at the goal after them)
+        # T samples (and, robot protocol, rest at the goal after them)
+        y = dmp.training_trajectory(y)
         phase, basis = dmp.training_grid()
         target = dmp.forcing_target(y, derivatives=_derivative_rule(derivatives, params))
         current = basis @ dmp.weights_ + self._increment(phase, basis, len(self.blocks_))
@@ -316,6 +316,7 @@ class BiDMP(Estimator):
         dmp = self.dmp_
         phase, basis = dmp.training_grid()
         inputs = self._bls_input(phase, basis)
+        # the increment is gate · BLS: learn FI / gate
         block = BLS(
             n_windows=self.n_windows,
             n_mapped=self.n_mapped,
@@ -323,9 +324,7 @@ class BiDMP(Estimator):
             shrink=self.shrink,
             reg=self.reg,
             seed=self.seed + len(self.blocks_) + 1,
-        ).fit(
-            inputs, increment / self._gate(phase)[:, None]
-        )  # the increment is gate · BLS: learn FI / gate
+        ).fit(inputs, increment / self._gate(phase)[:, None])
         for n_nodes in increments:
             block.add_enhancement_nodes(n_nodes)
         self.blocks_.append(block)
@@ -470,7 +469,7 @@ class BiDMP(Estimator):
         return dmp.rollout(goal=goal, start=start, n_steps=n_steps, forcing_increment=increment)
 
     @numerically_guarded
-    def trajectory(
+    def trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         goal=None,
         *,

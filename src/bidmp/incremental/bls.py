@@ -116,9 +116,10 @@ def _mapped_features(
     X: np.ndarray, mapping_weights: np.ndarray, low: np.ndarray, span: np.ndarray
 ) -> np.ndarray:
     """Min–max normalised mapped features Z of inputs X; every window in one matrix product."""
+    # (d+1, u·q)
     weights = np.ascontiguousarray(
         mapping_weights.transpose(1, 0, 2).reshape(mapping_weights.shape[1], -1)
-    )  # (d+1, u·q)
+    )
     return (_affine(X, weights) - low) / span
 
 
@@ -134,9 +135,10 @@ def _draw_mapping(X: np.ndarray, params: _BLSParams):
         )
         F_low, F_span = F.min(axis=0), np.ptp(F, axis=0)
         F = (F - F_low) / np.where(F_span > 0, F_span, 1.0)
+        # (d+1, q)
         W_Z = np.ascontiguousarray(
             sparse_autoencoder(F, X_bias, params.l1, params.admm_iterations).T
-        )  # (d+1, q)
+        )
         Z = X_bias @ W_Z
         low, span = Z.min(axis=0), np.ptp(Z, axis=0)
         windows.append(W_Z)
@@ -264,7 +266,7 @@ class BLS(Estimator):
     output_weights_ : array (u·q + Σ m_k, n_outputs)
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
         self,
         n_windows: int = 10,
         n_mapped: int = 10,
@@ -470,9 +472,8 @@ class BLS(Estimator):
         X = _check_inputs(X, self.n_features_)
         check_bytes(X.shape[0] * self.n_hidden_, "the hidden matrix of X (N x hidden nodes)")
         if np.shape(X)[0] >= _THREADED_ROWS:
-            with (
-                one_thread()
-            ):  # as fit: small products, and idle pools would contend (bidmp._threads)
+            # as fit: small products, and idle pools would contend (bidmp._threads)
+            with one_thread():
                 out = self.hidden(X) @ self.output_weights_
         else:  # a control loop's one row: limiting the pools would cost more than the product
             out = self.hidden(X) @ self.output_weights_

@@ -93,7 +93,7 @@ class CartesianBiDMP(PoseModel, Estimator):
     skill_start_logs_ : array (n_skills, 3)
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
         self,
         cartesian: CartesianDMP | None = None,
         n_windows: int = 10,
@@ -216,7 +216,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         return np.hstack([position, orientation_from_log(error, goal_q)])
 
     @numerically_guarded
-    def trajectory(
+    def trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         goal=None,
         *,

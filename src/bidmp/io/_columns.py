@@ -461,9 +461,8 @@ def _joints_candidate(header, keys, time: tuple[int, ...]) -> list[_Candidate]:
     return [_Candidate("joints", tuple(rest), None, "rad", "t,<joint names>", "joints=<names>")]
 
 
-_OWN_RATES = re.compile(
-    r"^(v|a|w|dw)(x|y|z|x[0-9]+)$"
-)  # what save_trajectory / save_poses add beside positions
+# what save_trajectory / save_poses add beside positions
+_OWN_RATES = re.compile(r"^(v|a|w|dw)(x|y|z|x[0-9]+)$")
 
 
 def _layout(

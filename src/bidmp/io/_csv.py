@@ -20,9 +20,8 @@ __all__ = ["declared_units"]
 
 logger = logging.getLogger(__name__)
 
-_SLOW_CSV_BYTES = (
-    256 << 20
-)  # CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
+# CSVs read row by row (to name a bad line): Python rows take ~6x the bytes
+_SLOW_CSV_BYTES = 256 << 20
 
 
 def _parse_float(text: str) -> float | None:

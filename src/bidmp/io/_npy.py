@@ -123,9 +123,8 @@ def read_npz(path: Path, kind: str, error: type[Exception] = ValueError) -> Iter
     (a pickled or oversized member is refused even if it would never be asked for). The file is
     closed however reading ends; a problem raises ``error`` naming ``path``."""
     if not path.is_file():
-        if (
-            path.exists() and not path.is_dir()
-        ):  # a FIFO, a device or a socket: opening it could block
+        # a FIFO, a device or a socket: opening it could block
+        if path.exists() and not path.is_dir():
             raise error(f"{kind} {path} is not a regular file (a pipe, device or socket)")
         raise error(
             f"{kind} {path} does not exist" + (" (it is a folder)" if path.is_dir() else "")

@@ -206,9 +206,8 @@ def read_bag(
         reader.close()
     stamps = [stamps[index] for index in order]
     values = np.array(rows, dtype=float)[order]
-    t = (
-        np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9
-    )  # exact to the nanosecond
+    # exact to the nanosecond
+    t = np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9
     return Recording(
         t, values, list(names), kind, "rad" if kind == "joints" else "m", source, stamps[0] * 1e-9
     )
@@ -609,9 +608,8 @@ def _write_atomically(target: Path, ros: int, topic: str, msgtype: str, messages
         raise ValueError(
             f"path: cannot write {shown_path(target)}: folder {shown_path(directory)} does not exist"
         )
-    if target.is_dir() and not is_bag(
-        target
-    ):  # only a bag folder is replaced, never another folder
+    # only a bag folder is replaced, never another folder
+    if target.is_dir() and not is_bag(target):
         raise ValueError(
             f"path: {shown_path(target)} is a folder that is not a ROS bag; give a new name"
         )

@@ -226,11 +226,12 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
 
 
 def _headerless(values: np.ndarray, path) -> np.ndarray:
+    # x,y[,z] or t,x,y,z (add a header "t,x,y" to mark a time column)
     if values.shape[1] in (
         2,
         3,
         4,
-    ):  # x,y[,z] or t,x,y,z (add a header "t,x,y" to mark a time column)
+    ):
         return values
     raise ValueError(
         f"{path}: expected 2-4 columns (x,y[,z] or t,x,y,z) without a header, found {values.shape[1]}"

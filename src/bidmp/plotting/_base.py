@@ -102,11 +102,12 @@ def _label_axes(ax, n_dims: int, units: str) -> None:
         ax.set_zlabel("z" + suffix)
         from matplotlib.ticker import MaxNLocator
 
+        # 3-D tick labels crowd into each other beyond ~6
         for axis in (
             ax.xaxis,
             ax.yaxis,
             ax.zaxis,
-        ):  # 3-D tick labels crowd into each other beyond ~6
+        ):
             axis.set_major_locator(MaxNLocator(6))
         _equal_3d(ax)
     else:

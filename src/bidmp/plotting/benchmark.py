@@ -82,9 +82,8 @@ def plot_lasa_benchmark(out: Path, rows: list, cells: dict, shapes: list) -> lis
             two_five if high / low < 300 else FuncFormatter(lambda value, _: "")
         )
         ax.set_title(f"{metric}, far goals", fontsize=10)
-        ax.set_ylabel(
-            f"{metric} [mm{' per sample' if metric == 'dtw_per_sample' else ''}] (log)"
-        )  # LASA: tablet mm
+        # LASA: tablet mm
+        ax.set_ylabel(f"{metric} [mm{' per sample' if metric == 'dtw_per_sample' else ''}] (log)")
         ax.tick_params(axis="x", labelrotation=30, labelsize=8)
     fig.tight_layout()
     written.append(out / "lasa_metrics.png")

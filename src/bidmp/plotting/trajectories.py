@@ -194,9 +194,8 @@ def plot_rollout(
         )
         angles.legend(loc="best", fontsize=8)
         angles.grid(True, alpha=0.3)
-        fig.subplots_adjust(
-            left=0.04, right=0.97, wspace=0.42
-        )  # room for the middle panel's second axis
+        # room for the middle panel's second axis
+        fig.subplots_adjust(left=0.04, right=0.97, wspace=0.42)
     return _save(fig, path)
 
 
@@ -394,7 +393,7 @@ def plot_recordings(path, recordings) -> Path:
     return _save(fig, path)
 
 
-def plot_rhythm(
+def plot_rhythm(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     path: str | os.PathLike,
     recording: np.ndarray,
     t: np.ndarray,
@@ -476,7 +475,7 @@ def plot_rhythm(
     return _save(fig, path)
 
 
-def plot_distribution(
+def plot_distribution(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     path: str | os.PathLike,
     demonstrations,
     mean: np.ndarray,

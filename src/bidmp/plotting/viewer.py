@@ -391,9 +391,8 @@ def _static_traces(go, layers: ViewLayers) -> list:
             "k": faces[:, 2],
             "hoverinfo": "text",
         }
-        if (
-            solid["label"] in close_parts
-        ):  # a part a failing motion came too close to: in the warning colour
+        # a part a failing motion came too close to: in the warning colour
+        if solid["label"] in close_parts:
             traces.append(
                 go.Mesh3d(
                     **mesh,
@@ -678,6 +677,7 @@ def load_layers(path) -> ViewLayers:
                 raise ValueError(
                     f"its format {short_token(meta.get('format'))} is not {VIEW_FORMAT}"
                 )
+            # absent in files of bidmp 0.5
             return ViewLayers(
                 title=meta["title"],
                 units=meta["units"],
@@ -694,9 +694,7 @@ def load_layers(path) -> ViewLayers:
                     name: {"times": data[f"robot_times_{k}"], "links": data[f"robot_links_{k}"]}
                     for name, k in meta["robot"].items()
                 },
-                failures=_checked_failures(
-                    meta.get("failures", {})
-                ),  # absent in files of bidmp 0.5
+                failures=_checked_failures(meta.get("failures", {})),
                 bands={
                     method: {label: data[key] for label, key in pairs}
                     for method, pairs in meta.get("bands", {}).items()  # absent before 0.6

@@ -94,7 +94,7 @@ class SceneAvoidance(CouplingTerm):
         What a trajectory whose clearance is below the margin does.
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - a coupling term's constructor: each setting is one, as users pass them
         self,
         scene,
         margin: float | None = None,
@@ -107,9 +107,10 @@ class SceneAvoidance(CouplingTerm):
         approach: float | None = None,
         on_miss: str = "raise",
     ) -> None:
+        # imported here: the primitives do not need the scene otherwise
         from ..scene.clearance import (
             Scene,
-        )  # imported here: the primitives do not need the scene otherwise
+        )
 
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.scene.Scene, got {type(scene).__name__}")
@@ -207,9 +208,8 @@ class SceneAvoidance(CouplingTerm):
             weight = np.where(self._at_goal[solids], weight * fade, weight)
         approach = np.maximum(-(away @ yd), 0.0)
         braking = weight * approach**2 / (2.0 * gap)
-        total = braking + self.strength_ * weight * np.minimum(
-            rho / gap - 1.0, _BARRIER_CAP
-        )  # + the barrier
+        # + the barrier
+        total = braking + self.strength_ * weight * np.minimum(rho / gap - 1.0, _BARRIER_CAP)
         push = total @ away
         if self.steer > 0.0:
             push = push + self.steer * sum(

@@ -338,7 +338,7 @@ class CartesianDMP(PoseModel, Estimator):
         return goal[:3], goal_q, start[:3], self._start_error(start_q, goal_q, self.start_log_)
 
     @numerically_guarded
-    def trajectory(
+    def trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         goal=None,
         *,

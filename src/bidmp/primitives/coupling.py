@@ -57,9 +57,8 @@ class PhaseStopping(CouplingTerm):
 
     def slowdown(self, y: np.ndarray, y_measured) -> float:
         """How many times slower the system's time runs for a measurement ``y_measured`` (D,)."""
-        if not (
-            type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1
-        ):  # a stepper's own state passes as is
+        # a stepper's own state passes as is
+        if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):
             y = as_vector(y, "y")
         if y_measured is None or self.gain == 0.0:
             return 1.0

@@ -554,9 +554,8 @@ class DMP(_FittedParams, Estimator):
         phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(
             self, params, n_steps, step
         )
-        change = getattr(
-            forcing_increment, "weight_change", None
-        )  # via-points: a change of the weights
+        # via-points: a change of the weights
+        change = getattr(forcing_increment, "weight_change", None)
         forcing = basis @ (self.weights_ if change is None else self.weights_ + change)
         if change is not None:
             forcing_increment = forcing_increment.wrapped
@@ -672,7 +671,7 @@ class DMP(_FittedParams, Estimator):
 
     # -- real time -------------------------------------------------------------------------------
     @numerically_guarded
-    def trajectory(
+    def trajectory(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         goal=None,
         *,

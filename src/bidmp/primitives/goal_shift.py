@@ -73,9 +73,8 @@ class _GoalShifts:
             if duration <= 0.0:
                 yield delta, 1.0, 0.0, 0.0
                 continue
-            u = np.array(
-                min(max((t - start) / duration, -1.0), 2.0)
-            )  # any t, inf too: the smoothstep is flat outside [0, 1]
+            # any t, inf too: the smoothstep is flat outside [0, 1]
+            u = np.array(min(max((t - start) / duration, -1.0), 2.0))
             first, second = _smoothstep_derivatives(u)
             yield delta, float(_smoothstep(u)), float(first) / duration, float(second) / duration**2
 

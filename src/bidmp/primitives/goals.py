@@ -373,9 +373,8 @@ MAX_DEPARTURE_SHARE = 0.4  # of the path's length: a longer straight head is the
 MIN_TRANSFER_SHARE = 0.3  # of the path's length left between a kept departure and the kept approach
 
 
-MAX_LIFT_ANGLE = np.radians(
-    45.0
-)  # a departure rises: its direction within this of straight up (+z)
+# a departure rises: its direction within this of straight up (+z)
+MAX_LIFT_ANGLE = np.radians(45.0)
 
 
 def _departure_end(demonstration: np.ndarray, approach_start: int) -> int:

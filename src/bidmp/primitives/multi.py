@@ -142,6 +142,7 @@ class MultiDMP(Estimator):
         n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=10_000)
         rng = np.random.default_rng(check_seed(seed, "seed"))
         n_kernels, n_dims = self.dmp_.weights_.shape
+        # (n_samples, N, D)
         changes = np.stack(
             [
                 np.column_stack(
@@ -152,7 +153,7 @@ class MultiDMP(Estimator):
                 )
                 for _ in range(n_samples)
             ]
-        )  # (n_samples, N, D)
+        )
         # the rollout is affine in the weights: the mean motion plus each change's response
         base = self.dmp_.rollout(goal, n_steps=n_steps)
         return base[None] + np.einsum("tn,snd->std", self.response(goal, n_steps), changes)

@@ -50,7 +50,7 @@ class AdaptiveOscillator:
         λ of the recursive least squares (per sample; 1 = no forgetting).
     """
 
-    def __init__(
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
         self,
         frequency: float,
         n_dims: int = 1,

@@ -127,9 +127,8 @@ def _pose_trajectory(
         via=position_via,
         via_until=via_until,
     )
-    if (
-        limits and vias is None
-    ):  # the orientation follows the motion time the position's limits chose
+    # the orientation follows the motion time the position's limits chose
+    if limits and vias is None:
         duration = position.t[-1] / position_model._params().settle
     error = orientation_model.trajectory(
         np.zeros(3),

@@ -273,9 +273,8 @@ class _FittedParams:
             return []
         raw, resolved = learned
         try:
-            if (
-                self._raw_params() == raw
-            ):  # the common case, without resolving the protocol's defaults
+            # the common case, without resolving the protocol's defaults
+            if self._raw_params() == raw:
                 return []
         except (TypeError, ValueError):  # an array set by mistake: resolving names it
             pass

@@ -330,7 +330,7 @@ class RhythmicDMP(Estimator):
         (``"rest"``); ``limits`` as :class:`RhythmicStepper` takes them."""
         return RhythmicStepper(self, frequency, amplitude, anchor, start, transition, limits)
 
-    def run(
+    def run(  # noqa: PLR0913 - the public call spells its options out, as users pass them
         self,
         cycles: float,
         *,

@@ -44,9 +44,8 @@ def as_quaternions(q, name: str = "q") -> np.ndarray:
         )
     if isinstance(q, (str, bytes)):
         raise TypeError(f"{name} must be an array of numbers, got a string")
-    array = _as_bounded_array(
-        q, name, 2
-    )  # None, complex, objects and oversized arrays refused, naming the argument
+    # None, complex, objects and oversized arrays refused, naming the argument
+    array = _as_bounded_array(q, name, 2)
     if array.ndim == 1:
         array = array[None]
     if array.ndim != 2 or array.shape[1] != 4 or array.shape[0] == 0:

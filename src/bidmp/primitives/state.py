@@ -127,9 +127,8 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
             f"duration_ = {model.duration_:g} s implies an implausible sample rate for {n_steps} samples"
         )
     model.units_ = check_units(meta.get("units_", ""))
-    model.names_ = check_names(
-        meta.get("names_"), n_dims, "names_"
-    )  # absent before bidmp 0.6: unnamed
+    # absent before bidmp 0.6: unnamed
+    model.names_ = check_names(meta.get("names_"), n_dims, "names_")
     model.held_orientation_ = (
         as_unit_quaternion(
             check_loaded(arrays["held_orientation_"], "held_orientation_", (4,)),

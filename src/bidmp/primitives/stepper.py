@@ -60,12 +60,13 @@ class DMPStepper:
             if duration is None
             else check_real(duration, "duration", positive=True)
         )
+        # tau of the normalised system
         self._scale = check_real(
             motion / dmp.duration_,
             "duration / duration_ (the temporal scaling)",
             minimum=_TAU_RANGE[0],
             maximum=_TAU_RANGE[1],
-        )  # tau of the normalised system
+        )
         self._params = params._replace(tau=self._scale)
         self._couplings, self._temporal = _as_couplings(coupling)
         self._forcing_increment = forcing_increment
@@ -92,9 +93,8 @@ class DMPStepper:
         # the motion time its own goal offset completes (set_goal asks for it)
         self._complete = None
         self._peaks = None  # the motion's own peaks (set_goal without limits asks for them)
-        for term in (
-            self._couplings
-        ):  # terms that need the motion (a scene's avoidance: its goal, its scale)
+        # terms that need the motion (a scene's avoidance: its goal, its scale)
+        for term in self._couplings:
             if hasattr(term, "bind"):
                 term.bind(self)
 
@@ -232,9 +232,8 @@ class DMPStepper:
         (y, yd, ydd) : arrays (D,)
             Position (units), velocity (units/s) and acceleration (units/s²) to command.
         """
-        if not (
-            type(dt) is float and 1e-6 <= dt <= 1e3
-        ):  # the usual case checked in one comparison
+        # the usual case checked in one comparison
+        if not (type(dt) is float and 1e-6 <= dt <= 1e3):
             dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
         params = self._params
         time_unit = self._time_unit

@@ -27,9 +27,8 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
         else check_real(duration, "duration", positive=True)
     )
     period = dmp.duration_ / (dmp.n_steps_ - 1)
-    dt = (
-        period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)
-    )  # 1 MHz at most
+    # 1 MHz at most
+    dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)
     if dt > motion:
         raise ValueError(f"dt = {dt:g} s is longer than the motion's duration ({motion:g} s)")
     scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched

@@ -59,9 +59,8 @@ class _Grid(NamedTuple):
     dt: float
 
 
-_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(
-    3.0
-)  # peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
+# peak acceleration of a rest-to-rest minimum-jerk motion, reach / T²
+_MINIMUM_JERK_PEAK = 10.0 / np.sqrt(3.0)
 
 
 def _parse_via(via, n_dims: int, horizon: float) -> tuple[np.ndarray, np.ndarray]:
@@ -203,9 +202,8 @@ def _check_end(grid: _Grid, rows: tuple, change: np.ndarray, ends: tuple, via: _
     phase, basis = rows
     times, points, _ = via
     last = phase.shape[0] - 1
-    rows = _impulse_rows(
-        params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)]
-    )  # samples last, last - 1
+    # samples last, last - 1
+    rows = _impulse_rows(params, phase, step, [(last - 1, 1.0), (last - 1, 0.0)])
     moved = rows @ (basis @ change)  # (2, D)
     corners = np.vstack([ends[0], ends[1], points])
     reach = max(float(np.max(np.linalg.norm(corners[:, None] - corners[None], axis=2))), 1e-300)

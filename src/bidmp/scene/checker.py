@@ -108,7 +108,6 @@ class SceneChecker:
             if travelled >= length:
                 return True
             # The distance changes by at most the distance moved: advance by what is left above the margin.
-            travelled = min(
-                travelled + max(distance - margin, resolution), length
-            )  # touching the margin is allowed
+            # touching the margin is allowed
+            travelled = min(travelled + max(distance - margin, resolution), length)
         return False  # grazing for too long: treated as a contact (conservative)

@@ -324,9 +324,8 @@ def _parse_parts(items, targets: dict | None) -> list[Part]:  # noqa: C901 - one
             for name in names:
                 if name not in targets:
                     _fail(f"{key}.at_targets", f"{short_token(name, 20)} is not a target label")
-            offset = rotation @ _vector(
-                item.get("offset", [0, 0, 0]), f"{key}.offset"
-            )  # in the part's frame
+            # in the part's frame
+            offset = rotation @ _vector(item.get("offset", [0, 0, 0]), f"{key}.offset")
             placements = [
                 (name, np.asarray(targets[name], dtype=float)[:3] + offset) for name in names
             ]

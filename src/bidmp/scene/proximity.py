@@ -99,9 +99,8 @@ class Proximity:
             if distance <= 0.0:
                 away = -np.asarray(result.normal, dtype=float)
             size = math.sqrt(away @ away)
-            if not (
-                size > 1e-12 and math.isfinite(size)
-            ):  # no direction from coal: away from the solid's centre
+            # no direction from coal: away from the solid's centre
+            if not (size > 1e-12 and math.isfinite(size)):
                 away = point - self.scene.solids[self._chosen[index]].centre
                 size = max(math.sqrt(away @ away), 1e-300)
             distances.append(distance)

@@ -31,7 +31,15 @@ from .._units import length_digits, length_text, mm
 from ..tasks.contract import Contract
 from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
-from .job_world import _body, _move, _StepFailed, _transfer, _transfer_contract, _World
+from .job_world import (
+    _body,
+    _Move,
+    _move,
+    _StepFailed,
+    _transfer,
+    _transfer_contract,
+    _World,
+)
 
 __all__ = ["JobInternalError", "run_job", "job_targets"]
 
@@ -61,7 +69,8 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     fractions = np.linspace(0.0, 1.0, path.shape[0])
     note = f"repaired: {repaired.how}" if repaired.how else ""
     phase = _move(
-        world, path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis
+        world,
+        _Move(path, fractions, exclude, "approach", orientations=turns, target=target, axis=axis),
     )
     _note(phase, note)
     return phase
@@ -110,16 +119,9 @@ def _straight(
     start = world.tcp
     end = start + np.asarray(direction, dtype=float) * length
     turns = np.repeat(world.orientation().as_quat()[None], 2, axis=0) if world.pose else None
-    return _move(
-        world,
-        np.vstack([start, end]),
-        None,
-        exclude,
-        name,
-        orientations=turns,
-        carried=part,
-        **options,
-    )
+    on_record = options.pop("on_record", None)
+    move = _Move(np.vstack([start, end]), None, exclude, name, turns, carried=part, **options)
+    return _move(world, move, on_record)
 
 
 def _unscrew(world: _World, part: MovablePart, exclude) -> JobPhase:
@@ -181,7 +183,8 @@ def _drop(world: _World, part: MovablePart, exclude) -> JobPhase:
     point = _drop_point(world)
     path, fractions, turns, note = _transfer(world, point, exclude, carried=_body(world, part))
     phase = _move(
-        world, path, fractions, exclude, "drop", orientations=turns, carried=part, target=point
+        world,
+        _Move(path, fractions, exclude, "drop", orientations=turns, carried=part, target=point),
     )
     centre = _release(world)
     world.dropped += 1
@@ -246,13 +249,15 @@ def _place(world: _World, part: MovablePart, slot, exclude) -> JobPhase:
     )
     phase = _move(
         world,
-        path,
-        fractions,
-        exclude + ["rack"],
-        "place",
-        orientations=turns,
-        carried=part,
-        target=goal,
+        _Move(
+            path,
+            fractions,
+            exclude + ["rack"],
+            "place",
+            orientations=turns,
+            carried=part,
+            target=goal,
+        ),
     )
     centre = _release(world)
     phase.seconds += RELEASE_S
@@ -292,15 +297,17 @@ def _rock(world: _World, part: MovablePart, exclude) -> JobPhase:
     swing = float(np.max(np.abs(motion.y - rhythm.anchor_)))
     phase = _move(
         world,
-        path,
-        motion.t / motion.t[-1],
-        exclude,
-        "rock",
-        least_duration=float(motion.t[-1]),
-        # IK samples fine enough for the swing: 16 or more a cycle
-        spacing=max(swing / 4.0, 1e-6) * world.cell.unit,
-        carried=part,
-        support=_supports(world, part),
+        _Move(
+            path,
+            motion.t / motion.t[-1],
+            exclude,
+            "rock",
+            least_duration=float(motion.t[-1]),
+            # IK samples fine enough for the swing: 16 or more a cycle
+            spacing=max(swing / 4.0, 1e-6) * world.cell.unit,
+            carried=part,
+            support=_supports(world, part),
+        ),
     )
     frequency = rhythm.frequency_ if spec.frequency is None else spec.frequency
     phase.note = (
@@ -546,7 +553,7 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
     )
 
 
-def run_job(
+def run_job(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     scenario,
     *,
     targets=None,

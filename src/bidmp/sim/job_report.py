@@ -35,14 +35,14 @@ class JobPhase:
     ok: bool
     seconds: float  # simulated time, the settling after a motion included
     note: str = ""
-    contacts: dict = field(
-        default_factory=dict
-    )  # part label -> deepest penetration (scene unit), non-targets
+    # part label -> deepest penetration (scene unit), non-targets
+    contacts: dict = field(default_factory=dict)
+    # commanded joint velocity, acceleration, jerk / their limits (largest joint)
     peaks: tuple = (
         0.0,
         0.0,
         0.0,
-    )  # commanded joint velocity, acceleration, jerk / their limits (largest joint)
+    )
     measured_peaks: tuple = (0.0, 0.0, 0.0)  # what the simulated joints did (10 ms differences)
     within_limits: bool = True  # every 1 kHz command within the limits, from rest to rest
     verdict: object = None  # the motion contract on what the arm did (bidmp.tasks.contract.Verdict); None: no motion
@@ -157,18 +157,15 @@ class JobReport:
     robot: str
     targets: list
     wall_s: float = 0.0
-    pictures: list = field(
-        default_factory=list
-    )  # (target, phase, s into its cycle, image) of the first cycle
-    motions: dict = field(
-        default_factory=dict
-    )  # ("job", first target) -> {"times", "links"}: the viewer's arm
+    # (target, phase, s into its cycle, image) of the first cycle
+    pictures: list = field(default_factory=list)
+    # ("job", first target) -> {"times", "links"}: the viewer's arm
+    motions: dict = field(default_factory=dict)
     evaluation: object = None  # the evaluation whose learned skills ran (bidmp.evaluate's report)
     # the scene the job ran in: the scenario's parts and the job's own (bin, rack)
     scene: object = None
-    failures: list = field(
-        default_factory=list
-    )  # (target, phase, image, reason) where a motion broke the contract
+    # (target, phase, image, reason) where a motion broke the contract
+    failures: list = field(default_factory=list)
 
     @property
     def removed(self) -> int:
@@ -217,6 +214,7 @@ class JobReport:
 
     def totals(self) -> dict:
         cycles = [target.seconds for target in self.targets if target.removed]
+        # simulated seconds; the wall time is not reproducible
         return {
             "targets": len(self.targets),
             "removed": self.removed,
@@ -225,7 +223,7 @@ class JobReport:
             "cycle_s_mean": round(float(np.mean(cycles)), 3) if cycles else None,
             "cycle_s_max": round(float(np.max(cycles)), 3) if cycles else None,
             "total_s": round(self.simulated_s, 3),
-        }  # simulated seconds; the wall time is not reproducible
+        }
 
     def summary(self) -> str:
         totals = self.totals()
@@ -276,9 +274,8 @@ def write_job_report(report: JobReport, out) -> list[Path]:
     check_kind(report, JobReport, "report", "a bidmp.sim.JobReport (bidmp.sim.run_job)")
 
     written = _write_results(out, "job_results.json", "job.md", report.to_dict(), report.markdown())
-    if (
-        report.pictures
-    ):  # the first cycle's keyframes side by side, each titled with its phase, target, time
+    # the first cycle's keyframes side by side, each titled with its phase, target, time
+    if report.pictures:
         failed = {
             (target.label, phase.name)
             for target in report.targets

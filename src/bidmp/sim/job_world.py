@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -17,6 +18,15 @@ from ..tasks.contract import Contract
 from .job_report import JobPhase, _phase
 from .planning import _paced_duration, _slowed
 
+if TYPE_CHECKING:
+    from ..incremental.bidmp import BiDMP
+    from ..incremental.cartesian import CartesianBiDMP
+    from ..primitives.rhythmic import RhythmicDMP
+    from ..tasks.jobs import JobSpec
+    from ..tasks.repair import Repairer
+    from ..tasks.scenarios import Scenario
+    from .backend import MovablePart, SimulatorBackend
+
 __all__ = []
 
 _DOWN = Rotation.from_quat([1.0, 0.0, 0.0, 0.0])  # the tool pointing down (its z axis along -z)
@@ -24,15 +34,18 @@ _DOWN = Rotation.from_quat([1.0, 0.0, 0.0, 0.0])  # the tool pointing down (its 
 
 @dataclass
 class _World:
-    cell: object
-    scenario: object
-    spec: object
-    model: object  # the fitted Bi-DMP (a pose Bi-DMP for a tilted scenario)
+    """The state a job carries from step to step."""
+
+    cell: SimulatorBackend  # the simulated arm and its world (a backend's cell)
+    scenario: Scenario
+    spec: JobSpec  # the steps at each target, the bin, the rack
+    model: BiDMP | CartesianBiDMP  # the fitted Bi-DMP (a pose one for a tilted scenario)
     q: np.ndarray  # the arm's joints now (rad)
     # the job's scene (the scenario's parts, the bin, the rack), the arm's limits
     contract: Contract
-    repairer: object  # bidmp.tasks.repair.Repairer of the approaches
-    transfers: object  # ... and of the transfers to the bin or the rack (lift, steer; a carried part kept clear too)
+    repairer: Repairer  # of the approaches
+    # ... and of the transfers to the bin or the rack (lift, steer; a carried part kept clear too)
+    transfers: Repairer
     # keyframes at the end of each phase of the first cycle, when asked for
     pictures: list | None = None
     # (times, joint origins) of the first cycle's motions, for the viewer
@@ -40,13 +53,13 @@ class _World:
     clock: float = 0.0  # simulated seconds since the job began
     placed: int = 0  # parts in the rack so far
     dropped: int = 0  # parts let go over the bin so far
-    held: object = None  # the part in the tool, if any (let go where it is when a step fails)
+    # the part in the tool, if any (let go where it is when a step fails)
+    held: MovablePart | None = None
     gone: list = field(default_factory=list)  # whole parts taken away (cells): no longer in the way
-    failures: list = field(
-        default_factory=list
-    )  # (target, phase, image) where a motion broke the contract
+    # (target, phase, image) where a motion broke the contract
+    failures: list = field(default_factory=list)
     record: bool = False  # keep each phase's measured path and commands
-    rhythm: object = None  # the rock step's periodic skill (a RhythmicDMP), learned once per job
+    rhythm: RhythmicDMP | None = None  # the rock step's periodic skill, learned once per job
     label: str = ""  # the target being worked on (its phases' refusals name it)
 
     @property
@@ -73,28 +86,35 @@ class _StepFailed(Exception):
 # ---------------------------------------------------------------------------------------------
 # Motions
 # ---------------------------------------------------------------------------------------------
-def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judges it by
-    world: _World,
-    path,
-    fractions,
-    exclude,
-    name: str,
-    *,
-    orientations=None,
-    on_record=None,
-    least_duration: float = 0.0,
-    spacing: float | None = None,
-    carried=None,
-    target=None,
-    axis=None,
-    support=(),
-) -> JobPhase:
-    """Plan ``path`` (n, 3) from the arm's joints now, execute it and judge what the arm did by the
-    contract: its end within the threshold of ``target`` (default the path's end), the final descent
-    along ``axis`` when it is the approach, clearance by the margin of the executed tool and of a
-    ``carried`` part (its own contacts count as the arm's; not from the parts it stands on,
-    ``support``, while it is lifted off them), the 1 kHz commands within the limits. ``spacing``:
-    the IK samples' largest spacing (m; default the planner's 5 mm), finer for a small oscillation."""
+class _Move(NamedTuple):
+    """A job's move: its tool ``path`` (n, 3) and the time ``fractions`` at its points (None: by
+    arc length), its ``name`` (the phase) and the parts it may touch (``exclude``), and what the
+    contract judges it by: its end within the threshold of ``target`` (default the path's end),
+    the final descent along ``axis`` when it is the approach, the tool's ``orientations`` (n, 4)
+    or None, a ``carried`` part and the parts it stands on (``support``, not counted while it is
+    lifted off them); ``least_duration`` (s): no faster than that; ``spacing``: the IK samples'
+    largest spacing (m; default the planner's 5 mm), finer for a small oscillation."""
+
+    path: np.ndarray
+    fractions: object
+    exclude: list
+    name: str
+    orientations: object = None
+    least_duration: float = 0.0
+    spacing: float | None = None
+    carried: object = None
+    target: object = None
+    axis: object = None
+    support: tuple = ()
+
+
+def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
+    """Plan ``move``'s path from the arm's joints now, execute it and judge what the arm did by the
+    contract: its end, the approach's descent, clearance by the margin of the executed tool and of
+    a carried part (its own contacts count as the arm's), the 1 kHz commands within the limits."""
+    path, fractions, exclude, name = move.path, move.fractions, move.exclude, move.name
+    orientations, carried, target, axis = move.orientations, move.carried, move.target, move.axis
+    least_duration, spacing, support = move.least_duration, move.spacing, move.support
     cell = world.cell
     plan = cell.plan(
         np.asarray(path, dtype=float),
@@ -110,9 +130,7 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     _slowed(plan, max(least_duration, pace))
     contract = world.contract if name == "approach" else _transfer_contract(world.contract)
     goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]
-    refused = _refused_plan(
-        world, plan, contract, path, goal, name, axis, exclude, orientations, carried, support
-    )
+    refused = _refused_plan(world, plan, contract, move, goal)
     if refused is not None:
         return refused
     touched = {}
@@ -152,13 +170,14 @@ def _move(  # noqa: PLR0913 - a job's move: its path and what the contract judge
     return phase
 
 
-def _refused_plan(  # noqa: PLR0913 - what _move judges its plan by, passed on whole
-    world: _World, plan, contract, path, goal, name, axis, exclude, orientations, carried, support
-) -> JobPhase | None:
+def _refused_plan(world: _World, plan, contract, move: _Move, goal) -> JobPhase | None:
     """The phase of a motion the contract refuses before it runs (None: it may run): the planned
-    tool path judged as the executed one will be (its end, the final descent of an approach,
-    the clearance of the tool and of a carried part), and the plan's joint peaks against the
-    limits. A refused motion is never sent to the arm: it costs no simulated time."""
+    tool path of ``move`` judged as the executed one will be (its end at ``goal``, the final
+    descent of an approach, the clearance of the tool and of a carried part), and the plan's joint
+    peaks against the limits. A refused motion is never sent to the arm: it costs no simulated
+    time."""
+    path, name, axis, exclude = move.path, move.name, move.axis, move.exclude
+    orientations, carried, support = move.orientations, move.carried, move.support
     planned = np.asarray(path, dtype=float)[:, :3]
     clearance = _clearance(world, planned, exclude, carried, orientations, support)
     verdict = contract.judge(

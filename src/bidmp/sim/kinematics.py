@@ -56,7 +56,7 @@ def joint_names(robot="panda") -> list[str]:
         ]
 
 
-def inverse_kinematics(
+def inverse_kinematics(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     points,
     robot="panda",
     *,
@@ -127,9 +127,8 @@ def inverse_kinematics(
             turn = None if orientations is None else orientations[index]
             start = q
             q, error = cell.solve_ik(point * cell.unit, start, turn)
-            if (
-                error > IK_TOLERANCE and index == 0 and seed is not None
-            ):  # a seed far off: the rest pose
+            # a seed far off: the rest pose
+            if error > IK_TOLERANCE and index == 0 and seed is not None:
                 q, error = cell.solve_ik(
                     point * cell.unit, np.array(cell.model.rest, dtype=float), turn
                 )

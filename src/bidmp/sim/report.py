@@ -212,9 +212,8 @@ class SimReport:
     workers: int = 1
     limits: object = None  # the robot's JointLimits (default the Panda's)
     robot: str = "panda"  # the arm's model name
-    motions: dict = field(
-        default_factory=dict
-    )  # (method, label) -> {"times", "links"}: the viewer's arm
+    # (method, label) -> {"times", "links"}: the viewer's arm
+    motions: dict = field(default_factory=dict)
     simulator: str = "PyBullet, 1 kHz position control"  # the backend's own words, for the summary
     evaluation: object = None  # the evaluation whose motions ran (bidmp.sim.execution_report)
 
@@ -469,11 +468,12 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
             failed=failed,
         )
         written.append(strip)
+    # (a motion not run has one still of the arm, not frames of its motion: no GIF)
     if (
         {"dmp", "bidmp"} <= set(by_method)
         and by_method["dmp"][0] == by_method["bidmp"][0]
         and by_method["dmp"][1][0].shape == by_method["bidmp"][1][0].shape
-    ):  # (a motion not run has one still of the arm, not frames of its motion: no GIF)
+    ):
         written.append(
             _write_gif(
                 out / f"sim_{by_method['dmp'][0]}_dmp_vs_bidmp.gif",

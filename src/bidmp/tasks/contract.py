@@ -170,9 +170,8 @@ def command_peaks(commands, limits, dt: float = 1e-3) -> CommandPeaks:
         ]
     )
     ends = 0.0
-    if (
-        commands.shape[0] >= 2
-    ):  # from rest: the first command's acceleration is its first step over dt²
+    # from rest: the first command's acceleration is its first step over dt²
+    if commands.shape[0] >= 2:
         steps = np.abs(np.vstack([commands[1] - commands[0], commands[-2] - commands[-1]])) / dt**2
         ends = float(np.max(steps / rates[1]))
     joint = int(np.argmax(np.max(per_joint, axis=0)))
@@ -199,9 +198,8 @@ class Verdict:
     approach_error: float | None = None
     engaged: bool | None = None
     clearance: object = None  # bidmp.scene.Clearance, with the margin it was judged against
-    contacts: dict = field(
-        default_factory=dict
-    )  # part label -> depth: the simulator's contacts with other parts
+    # part label -> depth: the simulator's contacts with other parts
+    contacts: dict = field(default_factory=dict)
     axis_deviation: float | None = None
     aligned: bool | None = None
     limits: CommandPeaks | None = None

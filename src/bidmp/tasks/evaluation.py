@@ -93,9 +93,8 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
         targets.append(target)
     forgetting = {}
     if scenario.demonstrations:
-        if (
-            model.n_skills == 1
-        ):  # learn the operators' demonstrations and measure forgetting in one pass
+        # learn the operators' demonstrations and measure forgetting in one pass
+        if model.n_skills == 1:
             forgetting = forgetting_runs(
                 model, list(scenario.demonstrations.values()), ("nearest", "latest")
             )
@@ -122,9 +121,8 @@ def _learned_clear(model, dmp, source, target, scenario, scene):
         )
         # A skill that may be planned again is learned on a copy: the Bi-DMP cannot forget a block.
         trial = copy.deepcopy(model) if checked and attempt < _REPAIRS else model
-        trial.learn(
-            extension.complete, duration=extension.duration_for(dmp)
-        )  # a longer extension takes longer
+        # a longer extension takes longer
+        trial.learn(extension.complete, duration=extension.duration_for(dmp))
         if not checked or attempt == _REPAIRS:
             return trial, extension
         clearance = scene.clearance(trial.rollout(target), exclude=scene.parts_at(target))

@@ -183,9 +183,8 @@ def swept_area(trajectory, reference) -> float:
             f"trajectory and reference must be 2-D curves (T, 2) of the same length, got "
             f"{trajectory.shape} and {reference.shape}"
         )
-    corners = np.stack(
-        [reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1
-    )  # (T-1, 4, 2)
+    # (T-1, 4, 2)
+    corners = np.stack([reference[:-1], reference[1:], trajectory[1:], trajectory[:-1]], axis=1)
     x, y = corners[..., 0], corners[..., 1]
     twice = np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
     return float(np.sum(np.abs(twice)) / 2.0)

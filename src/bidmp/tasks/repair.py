@@ -522,13 +522,11 @@ class Repairer:
         until = max(min(final, _motion_duration(model, goal, skill)), 2.0 * earliest)
         latest = until - 0.2 * (until - earliest)
         via: dict = {}
-        band = (
-            scene.margin + scene.tool.radius
-        )  # the tool's mouth this close to a part's box is near it
+        # the tool's mouth this close to a part's box is near it
+        band = scene.margin + scene.tool.radius
         for round_ in range(_MAX_ROUNDS):
-            if (
-                round_ == 0 and known is not None and not carried
-            ):  # the same motion: its distances are known
+            # the same motion: its distances are known
+            if round_ == 0 and known is not None and not carried:
                 clearance = type(known)(known.distance, known.part, known.point, scene.margin)
             else:
                 clearance = self._clearance(

@@ -38,9 +38,8 @@ class MethodResult:
     alignment_threshold: float = 2.0
     # label -> bidmp.tasks.contract.Verdict: the contract's judgement of each motion
     verdicts: dict | None = None
-    repairs: dict = field(
-        default_factory=dict
-    )  # label -> bidmp.tasks.repair.Repaired, where a repair was tried
+    # label -> bidmp.tasks.repair.Repaired, where a repair was tried
+    repairs: dict = field(default_factory=dict)
 
     @property
     def successes(self) -> int:
@@ -213,15 +212,12 @@ class Report:
     extension_targets: list = field(default_factory=list)
     failed_targets: list = field(default_factory=list)  # labels the plain DMP misses
     model: object = None  # the Bi-DMP
-    fitted: dict = field(
-        default_factory=dict
-    )  # method name -> its fitted model (the simulator's closed loop)
-    route_failures: list = field(
-        default_factory=list
-    )  # extension stages with no free route: {target, reason}
-    forgetting: dict = field(
-        default_factory=dict
-    )  # skill -> ForgettingResult (several demonstrations)
+    # method name -> its fitted model (the simulator's closed loop)
+    fitted: dict = field(default_factory=dict)
+    # extension stages with no free route: {target, reason}
+    route_failures: list = field(default_factory=list)
+    # skill -> ForgettingResult (several demonstrations)
+    forgetting: dict = field(default_factory=dict)
     # How the motions were judged and repaired: {"geometry", "repair", "allowance"} as evaluate
     # resolved them. The simulator executes a report's motions only when these are its own.
     settings: dict = field(default_factory=dict)

@@ -63,6 +63,7 @@ from dataclasses import dataclass, field
 from importlib import resources
 from numbers import Integral
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -81,6 +82,9 @@ from ._scenario_fields import (
     _robot,
     _shown,
 )
+
+if TYPE_CHECKING:
+    from .jobs import JobSpec
 
 __all__ = [
     "Scenario",
@@ -186,7 +190,7 @@ class Scenario:
     # degrees: a pose scenario's tool axis vs the target's over the approach
     alignment_threshold: float = 2.0
     robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
-    job: object = None  # bidmp.tasks.jobs.JobSpec: the task sequence bidmp job runs
+    job: JobSpec | None = None  # the task sequence bidmp job runs
     base_dir: str = "."  # where "file" demonstrations were read from
     # The demonstration's peak tool speed (units/s) that executed motions keep: the simulator and
     # the job slow a motion down to it, never up (None: no time stamps, or "pace": "limits").

@@ -136,9 +136,8 @@ class RobotCell:
             self.close()
             raise
 
-    limits = (
-        PANDA_MODEL.limits
-    )  # the robot's joint limits (the backend protocol's; set per instance)
+    # the robot's joint limits (the backend protocol's; set per instance)
+    limits = PANDA_MODEL.limits
     simulator = "PyBullet, 1 kHz position control"  # how reports name this backend
 
     @property

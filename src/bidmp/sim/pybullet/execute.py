@@ -185,9 +185,8 @@ def _execute_closed_loop(
                 previous, previous_rate = target, target_rate
                 if settle_from is not None and step - settle_from >= SETTLE / SIM_STEP:
                     break
-                if (
-                    settle_from is None
-                ):  # (settling: the limiter brings the joints to rest at the last IK target)
+                # (settling: the limiter brings the joints to rest at the last IK target)
+                if settle_from is None:
                     moved = moved or _perceive(cell, stepper, goal_update, exclude)
                     y, yd, _ = stepper.step(CONTROL_STEP, _tracked(cell, stepper, planned))
                     point = np.asarray(y) * cell.unit
@@ -352,9 +351,8 @@ class _Recorder:
             *[s[0] for s in states],
             *[s[1] for s in states],
         )
-        if (
-            row % 10 == 0 or step == self.n_steps - 1
-        ):  # the command's TCP, 50 Hz (forward kinematics)
+        # the command's TCP, 50 Hz (forward kinematics)
+        if row % 10 == 0 or step == self.n_steps - 1:
             self.commanded.append((row, np.asarray(commanded_joints, dtype=float).copy()))
 
     def finish(self) -> Execution:

@@ -24,9 +24,8 @@ def _pybullet_module():
     if module is not None:
         return module
     for stream in (sys.stdout, sys.stderr):
-        if (
-            stream is not None
-        ):  # None: a caller redirected it away (contextlib.redirect_stdout(None))
+        # None: a caller redirected it away (contextlib.redirect_stdout(None))
+        if stream is not None:
             stream.flush()
     saved = [os.dup(1), os.dup(2)]
     try:

@@ -27,9 +27,8 @@ class _GMMMethod(Method):
         from ...baselines import GMMRegressor
 
         self.check_model(model, GMMRegressor, "a fitted GMMRegressor")
-        as_vector(
-            goal, "goal"
-        )  # a goal is asked for, and ignored: GMR on time reproduces its demonstration
+        # a goal is asked for, and ignored: GMR on time reproduces its demonstration
+        as_vector(goal, "goal")
         return model.rollout()
 
 
