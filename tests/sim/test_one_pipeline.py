@@ -142,7 +142,7 @@ def test_what_the_simulator_repairs_follows_the_scenarios_approach():
 
     nut = scenarios.load(TWO_POSTS)
     assert sim.execution_settings(nut)["repair"] is True
-    paper = nut.replace(extension={**nut.extension, "approach": "paper"})
+    paper = nut.replace(extension={**nut.extension.flat, "approach": "paper"})
     assert sim.execution_settings(paper) == {
         "geometry": True,
         "repair": False,

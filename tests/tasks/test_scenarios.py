@@ -157,10 +157,11 @@ def test_scenario_sets_bidmp_and_extension_parameters():
         )
     )
     scenario = scenarios.from_dict(data)
-    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension == {
+    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension.flat == {
         "n_iter": 3,
         "n_samples": 120,
     }
+    assert scenario.extension.roadmap.n_iter == 3 and scenario.extension.approach == "keep"
     report = evaluate(scenario, ["bidmp"])
     assert report.model.reg == 1e-2 and report.model.increments == (5,)
     assert report.extensions[0].similarity_history.shape == (3,)
@@ -176,7 +177,7 @@ def test_replace_checks_the_changed_keys_as_a_file_and_leaves_the_scenario_as_it
 
     nuts = load("nut-unscrewing")
     before = copy.deepcopy(nuts.spec)
-    paper = nuts.replace(extension={**nuts.extension, "approach": "paper", "n_iter": 4})
+    paper = nuts.replace(extension={**nuts.extension.flat, "approach": "paper", "n_iter": 4})
     assert paper.extension_arguments["approach"] == "paper"
     assert paper.extension_arguments["roadmap"] == RoadmapOptions(n_iter=4)
     assert paper.spec["extension"]["n_iter"] == 4 and nuts.spec == before

@@ -123,7 +123,9 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     if args.approach is not None:
-        scenario = scenario.replace(extension={**scenario.extension, "approach": args.approach})
+        scenario = scenario.replace(
+            extension={**scenario.extension.flat, "approach": args.approach}
+        )
     methods = None
     if args.methods is not None:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]

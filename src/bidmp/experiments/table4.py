@@ -250,7 +250,7 @@ def run_table4(progress: Callable | None = None) -> Table4:
             progress(name)
         scenario = scenarios.load(name)
         # the paper's protocol: the nearest piece imitated down to the target
-        paper = scenario.replace(extension={**scenario.extension, "approach": "paper"})
+        paper = scenario.replace(extension={**scenario.extension.flat, "approach": "paper"})
         reports[name] = evaluate(paper, repair=False)
         if name in TASK_SCENARIOS:
             # approach keep, as learned

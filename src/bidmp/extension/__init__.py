@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from .extend import (
         APPROACHES,
         ExtendedDemonstration,
+        ExtensionOptions,
         check_extension_options,
         extend_demonstration,
         extend_pose_demonstration,

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
@@ -61,6 +61,7 @@ from .segmentation import Piece, _choose_piece, _segment
 from .timing import _time_path, _timed_transfer
 
 __all__ = [
+    "ExtensionOptions",
     "check_extension_options",
     "ExtendedDemonstration",
     "extend_demonstration",
@@ -210,14 +211,88 @@ def _final_approach(y: np.ndarray, points: np.ndarray, straightness: float = _ST
     return straight_tail_start(y, start, straightness)
 
 
-def check_extension_options(
-    *,
-    eps_frac: float = 0.1,
-    method: str = "persistence",
-    seed=0,
-    approach: str = "keep",
-    **roadmap_options,
-) -> dict:
+@dataclass(frozen=True)
+class ExtensionOptions:
+    """How an extended demonstration is grown, checked once when made (``ValueError``/``TypeError``
+    naming the first bad option): what a scenario's ``"extension"`` object stands for.
+
+    Parameters
+    ----------
+    eps_frac : float, default 0.1
+        The segmentation's persistence threshold, a fraction in (0, 1) (:func:`bidmp.segment`).
+    method : {"persistence", "paper"}, default "persistence"
+        The segmentation's method.
+    approach : {"keep", "paper"}, default "keep"
+        Keep the demonstration's final approach (moved to the new target), or the paper's protocol
+        (:func:`extend_demonstration`).
+    roadmap : RoadmapOptions
+        G-PRM's options.
+    """
+
+    eps_frac: float = 0.1
+    method: str = "persistence"
+    approach: str = "keep"
+    roadmap: RoadmapOptions = field(default_factory=RoadmapOptions)
+
+    def __post_init__(self) -> None:
+        eps_frac = check_real(self.eps_frac, "eps_frac")
+        if not 0.0 < eps_frac < 1.0:
+            raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
+        check_choice(self.method, "method", ("persistence", "paper"))
+        check_choice(self.approach, "approach", APPROACHES)
+        if not isinstance(self.roadmap, RoadmapOptions):
+            raise TypeError(
+                f"roadmap must be a bidmp.extension.RoadmapOptions, got {type(self.roadmap).__name__}"
+            )
+        object.__setattr__(self, "eps_frac", eps_frac)
+
+    @classmethod
+    def from_flat(cls, options: dict | None = None) -> ExtensionOptions:
+        """The options from a scenario file's flat form (``{"eps_frac": 0.1, "n_iter": 20,
+        ...}``: the roadmap's options beside the others); an unknown name is a ``TypeError``."""
+        flat = dict(options or {})
+        known = ("eps_frac", "method", "approach")
+        unknown = sorted(set(flat) - set(known) - set(RoadmapOptions.__dataclass_fields__))
+        if unknown:
+            raise TypeError(
+                f"unknown extension option {unknown[0]!r} (known: eps_frac, method, approach, "
+                f"{', '.join(RoadmapOptions.__dataclass_fields__)})"
+            )
+        own = {key: flat.pop(key) for key in known if key in flat}
+        return cls(**own, roadmap=RoadmapOptions(**flat))
+
+    @property
+    def arguments(self) -> dict:
+        """The keyword arguments of :func:`extend_demonstration` these options stand for."""
+        return {
+            "eps_frac": self.eps_frac,
+            "method": self.method,
+            "approach": self.approach,
+            "roadmap": self.roadmap,
+        }
+
+    @property
+    def flat(self) -> dict:
+        """A scenario file's form of these options (:meth:`from_flat` reads it back): the values
+        that differ from the defaults, the roadmap's beside the others."""
+        default = ExtensionOptions()
+        out = {
+            key: getattr(self, key)
+            for key in ("eps_frac", "method", "approach")
+            if getattr(self, key) != getattr(default, key)
+        }
+        roadmap = dataclasses.asdict(self.roadmap)
+        out.update(
+            {key: value for key, value in roadmap.items() if value != getattr(default.roadmap, key)}
+        )
+        return out
+
+    def replace(self, **changes) -> ExtensionOptions:
+        """These options with ``changes`` (checked again)."""
+        return dataclasses.replace(self, **changes)
+
+
+def check_extension_options(*, seed=0, **options) -> dict:
     """The options of :func:`extend_demonstration` in the flat form a scenario file writes them
     (``"extension": {"eps_frac": 0.1, "n_iter": 20, ...}``), checked without running anything;
     raise naming the first bad one.
@@ -226,26 +301,11 @@ def check_extension_options(
     -------
     dict
         The keyword arguments of :func:`extend_demonstration`: ``eps_frac``, ``method``,
-        ``approach`` and ``roadmap`` (a :class:`~bidmp.extension.RoadmapOptions` of the rest).
+        ``approach`` and ``roadmap`` (a :class:`~bidmp.extension.RoadmapOptions` of the rest), as
+        :attr:`ExtensionOptions.arguments`.
     """
-    eps_frac = check_real(eps_frac, "eps_frac")
-    if not 0.0 < eps_frac < 1.0:
-        raise ValueError(f"eps_frac must lie in (0, 1), got {eps_frac}")
-    check_choice(method, "method", ("persistence", "paper"))
-    check_choice(approach, "approach", APPROACHES)
     check_seed(seed)
-    unknown = sorted(set(roadmap_options) - set(RoadmapOptions.__dataclass_fields__))
-    if unknown:
-        raise TypeError(
-            f"unknown extension option {unknown[0]!r} (known: eps_frac, method, approach, "
-            f"{', '.join(RoadmapOptions.__dataclass_fields__)})"
-        )
-    return {
-        "eps_frac": eps_frac,
-        "method": method,
-        "approach": approach,
-        "roadmap": RoadmapOptions(**roadmap_options),
-    }
+    return ExtensionOptions.from_flat(options).arguments
 
 
 @numerically_guarded

@@ -343,8 +343,7 @@ def execution_settings(scenario) -> dict:
     check_kind(scenario, Scenario, "scenario", "a bidmp Scenario (bidmp.tasks.load)")
     return {
         "geometry": scenario.scene is not None,
-        "repair": scenario.scene is not None
-        and scenario.extension.get("approach", "keep") == "keep",
+        "repair": scenario.scene is not None and scenario.extension.approach == "keep",
         "allowance": mm(TRACKING_ALLOWANCE_MM, scenario.units),
     }
 

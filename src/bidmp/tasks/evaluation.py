@@ -73,7 +73,7 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
     extensions, targets = [], []
     previous = None
     # The paper's protocol knows no battery geometry: approach "paper" grows the extension blind.
-    keep = scenario.extension.get("approach", "keep") == "keep"
+    keep = scenario.extension.approach == "keep"
     for stage in scenario.extensions:
         target = _resolve_target(stage["target"], scenario, failed)
         if target is None:
@@ -269,7 +269,7 @@ def evaluate(
         poses=scenario.is_pose,
     )
     if repair is None:
-        repair = scenario.extension.get("approach", "keep") == "keep"
+        repair = scenario.extension.approach == "keep"
     geometry = check_bool(geometry, "geometry") and scenario.scene is not None
     repair = check_bool(repair, "repair") and geometry
     allowance = check_real(allowance, "allowance", nonnegative=True)

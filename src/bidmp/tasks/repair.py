@@ -34,7 +34,7 @@ import copy
 import logging
 import time
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -50,6 +50,9 @@ from .._checks import (
 )
 from .._units import length_text
 from .contract import Contract, Verdict
+
+if TYPE_CHECKING:
+    from ..extension import ExtensionOptions
 
 __all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance", "carried_depth"]
 
@@ -187,8 +190,9 @@ class Repairer:
         What a motion must keep; its scene is where the parts are.
     demonstration : array (T, 3)
         The demonstration an extension grows from.
-    extension : dict
-        Options of :func:`bidmp.extend_demonstration` (the scenario's ``"extension"``).
+    extension : bidmp.extension.ExtensionOptions or dict
+        How extensions are grown (a scenario's ``extension``), or the flat form of its file's
+        ``"extension"`` object; the approach is kept whatever it says.
     seed : int
         The extension's seed.
     order : sequence of str
@@ -204,7 +208,7 @@ class Repairer:
         contract: Contract,
         demonstration,
         *,
-        extension: dict | None = None,
+        extension: ExtensionOptions | dict | None = None,
         seed: int = 0,
         order=REPAIRS,
         allowance: float = 0.0,
@@ -226,13 +230,12 @@ class Repairer:
             )
         self.contract = contract
         self.demonstration = as_trajectory(demonstration, "demonstration")
-        from ..extension import check_extension_options
+        from ..extension import ExtensionOptions
 
         # the extension's keyword arguments (a repair keeps the approach, whatever the file says)
-        self.extension = {
-            **check_extension_options(**check_options(extension, "extension")),
-            "approach": "keep",
-        }
+        if not isinstance(extension, ExtensionOptions):
+            extension = ExtensionOptions.from_flat(check_options(extension, "extension"))
+        self.extension = extension.replace(approach="keep").arguments
         check_seed(seed, "seed")
         self.seed, self.order, self.bidmp = seed, tuple(order), check_options(bidmp, "bidmp")
         self.allowance = check_real(allowance, "allowance", nonnegative=True)

@@ -84,6 +84,7 @@ from ._scenario_fields import (
 )
 
 if TYPE_CHECKING:
+    from ..extension import ExtensionOptions
     from .jobs import JobSpec
 
 __all__ = [
@@ -178,7 +179,7 @@ class Scenario:
     approach_height: float | None
     dmp: dict
     bidmp: dict
-    extension: dict
+    extension: ExtensionOptions
     extensions: list[dict]
     demonstrations: dict[str, np.ndarray]
     methods: list[str]
@@ -231,12 +232,10 @@ class Scenario:
 
     @property
     def extension_arguments(self) -> dict:
-        """The keyword arguments of :func:`bidmp.extend_demonstration` that ``extension`` (the
-        file's flat options) stands for: ``eps_frac``, ``method``, ``approach`` and ``roadmap``
-        (a :class:`bidmp.extension.RoadmapOptions`)."""
-        from ..extension import check_extension_options
-
-        return check_extension_options(**self.extension)
+        """The keyword arguments of :func:`bidmp.extend_demonstration` that ``extension`` stands
+        for: ``eps_frac``, ``method``, ``approach`` and ``roadmap`` (a
+        :class:`bidmp.extension.RoadmapOptions`)."""
+        return self.extension.arguments
 
     def to_dict(self) -> dict:
         """The scenario as JSON-ready data (round-trips through :func:`from_dict`)."""
@@ -333,7 +332,7 @@ def _parameters(data, key, known, source, check) -> dict:
 def _parameter_objects(data: dict, source: str) -> dict:
     """The parameter objects of a scenario file (``dmp``, ``bidmp``, ``extension``), each checked
     by what takes it (a DMP's, a Bi-DMP's, an extension's own checks)."""
-    from ..extension import check_extension_options
+    from ..extension import ExtensionOptions
     from ..incremental.bidmp import BiDMP
     from ..primitives.dmp import DMP
 
@@ -342,8 +341,8 @@ def _parameter_objects(data: dict, source: str) -> dict:
         "bidmp": _parameters(
             data, "bidmp", _BIDMP_KEYS, source, lambda p: BiDMP(**p)._check_params()
         ),
-        "extension": _parameters(
-            data, "extension", _EXTENSION_KEYS, source, lambda p: check_extension_options(**p)
+        "extension": ExtensionOptions.from_flat(
+            _parameters(data, "extension", _EXTENSION_KEYS, source, ExtensionOptions.from_flat)
         ),
     }
 

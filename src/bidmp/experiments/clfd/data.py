@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ..._checks import check_choice
+from ..._checks import as_point, check_choice
 
 __all__ = ["CLFD_DATASETS", "ClfdTask", "TangentChart", "clfd_tasks"]
 
@@ -100,7 +100,13 @@ class TangentChart:
     """
 
     def __init__(self, reference: np.ndarray | None = None):
-        self.reference = None if reference is None else np.asarray(reference, dtype=float)
+        if reference is not None:
+            reference = as_point(reference, 4, "reference")
+            norm = float(np.linalg.norm(reference))
+            if norm < 1e-9:
+                raise ValueError("reference must be a unit quaternion (w, x, y, z), got zero")
+            reference = reference / norm
+        self.reference = reference
 
     @classmethod
     def of_task(cls, task: ClfdTask) -> TangentChart:
