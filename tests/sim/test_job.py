@@ -76,6 +76,12 @@ def test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted():
     report = run_job(scenarios.from_dict(spec), targets=["a", "b"], record=True)
     by_label = {target.label: target for target in report.targets}
     assert by_label["a"].removed and not by_label["b"].removed and report.removed == 1
+    # every move starts where the last one left the arm: its first command is the joints the arm
+    # was last sent (a plan seeded from elsewhere would open with a jump to another solution)
+    for target in report.targets:
+        run = [phase.commands for phase in target.phases if phase.commands is not None]
+        for before, after in zip(run, run[1:]):
+            assert np.abs(np.asarray(after)[0] - np.asarray(before)[-1]).max() <= 1e-3
     assert by_label["b"].reason.startswith("engage: the tool is 2.00 mm off the part's axis")
     # The socket is on the nut: before anything else moves, it leaves straight up the target's
     # axis to the approach height (28.5 mm over the nut's top), judged like any move.

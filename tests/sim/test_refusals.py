@@ -375,9 +375,17 @@ def test_a_job_on_a_tilted_pack_unscrews_along_each_nuts_own_axis():
     spec = json.loads(scenarios.builtin_text("nut-unscrewing-tilted"))
     spec["job"] = json.loads(scenarios.builtin_text("nut-unscrewing"))["job"]
     tilted = scenarios.from_dict(spec)
-    report = sim.run_job(tilted, targets=["3", "4"], backend="kinematic", record=True)
+    report = sim.run_job(
+        tilted, targets=["3", "4"], backend="kinematic", record=True, pictures=True
+    )
+    assert report.pictures  # keyframes look at each pose target's position
     for target in report.targets:
         assert target.removed and all(phase.ok for phase in target.phases), target.reason
+        # every move starts where the last one left the arm (a plan seeded from elsewhere would
+        # send the arm a jump its measured joints never made)
+        run = [phase.commands for phase in target.phases if phase.commands is not None]
+        for before, after in zip(run, run[1:]):
+            assert np.abs(after[0] - before[-1]).max() <= 1e-6
         pose = tilted.targets[target.label]
         axis = -Rotation.from_quat(pose[3:]).apply([0.0, 0.0, 1.0])  # out of the nut
         assert np.degrees(np.arccos(axis[2])) == pytest.approx(30.0, abs=1e-3)

@@ -230,3 +230,40 @@ def _within(attempts, spent: float) -> None:
     limit: no clock decides the test)."""
     shares = [attempt.seconds for attempt in attempts]
     assert min(shares) >= 0.0 and sum(shares) <= spent, (shares, spent)
+
+
+def test_the_avoid_repair_steers_round_every_part_but_the_target_s_own(monkeypatch):
+    """The steering term of an ``avoid`` repair leaves the target's own part out (the tool must
+    reach it: steered away from it, the motion could not end there) and is given no target
+    when the label names no part. A structure check of what the repair hands the term: whether
+    steering then reaches is the avoidance's own tests'."""
+    import bidmp.primitives.avoidance as avoidance
+
+    targets = []
+
+    class Recorded(avoidance.SceneAvoidance):
+        def __init__(self, scene, **options):
+            targets.append(options.get("target"))
+            super().__init__(scene, **options)
+
+    monkeypatch.setattr(avoidance, "SceneAvoidance", Recorded)
+    # a post across the skill's way to a far goal, and a nut of its own at the goal
+    demo = minimum_jerk([[-100, -120, 150], [0, 0, 35], [0, 0, 0]], 300)
+    dmp = DMP().fit(demo, np.linspace(0, 3, 300), units="mm")
+    goal = np.array([120.0, 0.0, 0.0])
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 10.0, "length": 100.0},
+            "margin": 3.0,
+            "parts": [
+                {"type": "cylinder", "label": "post", "at": [60, -33, -2], "radius": 5.0, "height": 80.0},
+                {"type": "cylinder", "label": "nut", "at": [120, 0, -8], "radius": 4.0, "height": 8.0},
+            ],
+        }
+    )  # fmt: skip
+    contract = Contract(1.75, 25.0, scene, "mm")
+    assert contract.judge(dmp.trajectory(goal).y, goal, exclude=["nut"]).failed == ["clearance"]
+    repairer = Repairer(contract, demo, order=("avoid",))
+    repairer.repair(dmp, goal, "nut", exclude=["nut"])
+    repairer.repair(dmp, goal, "far", exclude=["nut"])
+    assert targets == ["nut", None]
