@@ -820,18 +820,23 @@ def test_a_turning_tool_among_tilted_parts_matches_every_pair_through_coal(seed)
     assert found.distance == pytest.approx(every, abs=1e-9)
 
 
+def _tilted_solids() -> Scene:
+    """A tilted box, cylinder and nut, 150 apart (a 6-radius, 60-long tool)."""
+    parts = [
+        {"type": "box", "label": "b", "at": [0, 0, 0], "size": [60, 40, 8], "rotation": [20, -15, 30]},
+        {"type": "cylinder", "label": "c", "at": [150, 0, 0], "radius": 9, "height": 50, "rotation": [35, 10, 0]},
+        {"type": "nut", "label": "n", "at": [-150, 0, 0], "across_flats": 20, "height": 12, "rotation": [25, 5, 0]},
+    ]  # fmt: skip
+    return Scene.from_dict({"tool": {"radius": 6.0, "length": 60.0}, "parts": parts})
+
+
 def test_the_oriented_bound_does_not_depend_on_where_a_solid_keeps_its_own_box():
     """A solid's box in its own frame need not be centred on its origin (a convex part's hull need
     not be): the same box described from another origin, its centre moved by ``R d`` and its
     corners by ``-d``, bounds every placement the same (a property of the geometry, not the code
     against itself; the built-in solids are all centred, so nothing else tries it)."""
     rng = np.random.default_rng(12)
-    parts = [
-        {"type": "box", "label": "b", "at": [0, 0, 0], "size": [60, 40, 8], "rotation": [20, -15, 30]},
-        {"type": "cylinder", "label": "c", "at": [150, 0, 0], "radius": 9, "height": 50, "rotation": [35, 10, 0]},
-        {"type": "nut", "label": "n", "at": [-150, 0, 0], "across_flats": 20, "height": 12, "rotation": [25, 5, 0]},
-    ]  # fmt: skip
-    scene = Scene.from_dict({"tool": {"radius": 6.0, "length": 60.0}, "parts": parts})
+    scene = _tilted_solids()
     chosen = np.arange(len(scene.solids))
     turns = Rotation.random(300, random_state=4).as_matrix()
     points = rng.normal([0.0, 0.0, 0.0], 120.0, (300, 3))
@@ -855,12 +860,7 @@ def test_the_oriented_bound_is_a_lower_bound_and_tight_where_the_tool_is_square_
     nearest pair), and equal to it for a tool square to a tilted box's face (a looser bound would
     send every pair near a tilted plate to coal again, as the world-frame box did)."""
     rng = np.random.default_rng(11)
-    parts = [
-        {"type": "box", "label": "b", "at": [0, 0, 0], "size": [60, 40, 8], "rotation": [20, -15, 30]},
-        {"type": "cylinder", "label": "c", "at": [150, 0, 0], "radius": 9, "height": 50, "rotation": [35, 10, 0]},
-        {"type": "nut", "label": "n", "at": [-150, 0, 0], "across_flats": 20, "height": 12, "rotation": [25, 5, 0]},
-    ]  # fmt: skip
-    scene = Scene.from_dict({"tool": {"radius": 6.0, "length": 60.0}, "parts": parts})
+    scene = _tilted_solids()
     engine = scene._engine()
     chosen = np.arange(len(scene.solids))
     turns = Rotation.random(600, random_state=3)
