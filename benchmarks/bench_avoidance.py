@@ -3,7 +3,8 @@
     .venv/bin/python benchmarks/bench_avoidance.py [--fields N] [--out DIR]
     make avoidance        # 50 fields, writes docs/results/avoidance.md and docs/avoidance.png
 
-Each field (bidmp.experiments.random_case, bidmp.scene.random_field: 1-4 tall posts and boxes across the line from start to goal,
+Each field (bidmp.experiments.random_case, bidmp.scene.random_field: 1-4 tall posts and boxes
+across the line from start to goal,
 a free path by construction) gets a random demonstration (mm or m, 2-5 s); both libraries learn
 it and roll it out at 1 kHz with their avoidance: bidmp ``SceneAvoidance`` on the parts' exact
 geometry, movement_primitives' ``CouplingTermObstacleAvoidance3D`` (Hoffmann et al. 2009, its
@@ -145,7 +146,8 @@ def fields_table(n_fields: int, figure: Path | None) -> str:
         )
     lines += [
         "",
-        f"bidmp reported {reported} of its {n_fields - sum(m['clear'] and m['goal'] <= 1.0 for m in rows['bidmp SceneAvoidance'])} "
+        f"bidmp reported {reported} of its "
+        f"{n_fields - sum(m['clear'] and m['goal'] <= 1.0 for m in rows['bidmp SceneAvoidance'])} "
         f"misses as AvoidanceError; movement_primitives reports none (it has no geometry to check).",
     ]
     return "\n".join(lines) + "\n"

@@ -62,10 +62,12 @@ def main() -> int:
     )
     print(f"pose DMP, T = {len(poses)}, 50 weights per dimension (median of {args.repeats} runs)")
     print(
-        f"  bidmp CartesianDMP fit + trajectory:            {ours_s * 1e3:7.2f} ms   (max orientation error {ours_error:.3f} deg)"
+        f"  bidmp CartesianDMP fit + trajectory:            {ours_s * 1e3:7.2f} ms   (max "
+        f"orientation error {ours_error:.3f} deg)"
     )
     print(
-        f"  movement_primitives imitate + open_loop (cython): {peer_s * 1e3:7.2f} ms   (max orientation error {peer_error:.3f} deg)"
+        f"  movement_primitives imitate + open_loop (cython): {peer_s * 1e3:7.2f} ms   (max "
+        f"orientation error {peer_error:.3f} deg)"
     )
     print(f"  ratio: {peer_s / ours_s:.1f}x   (target >= 10x)")
     return 0

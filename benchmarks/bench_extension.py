@@ -94,7 +94,8 @@ def main() -> int:
     result = extend_demonstration(demo, target, seed=0)
     piece = result.tra_imi
     print(
-        f"\n  battery approach path: 200 samples, 3-D, extension to {BATTERY_EXTENSION_TARGET} (median of {args.repeats})"
+        f"\n  battery approach path: 200 samples, 3-D, extension to {BATTERY_EXTENSION_TARGET} "
+        f"(median of {args.repeats})"
     )
     rows = {
         "G-PRM, 10 iterations, 300 samples": lambda: gaussian_prm(piece, target, seed=1),

@@ -64,10 +64,12 @@ def bench_bls(n_nodes: int, repeats: int, n_enhance: int = 300) -> None:
     )
     print(f"    {'add_enhancement_nodes':44s} {t_incremental * 1e3:9.3f} ms")
     print(
-        f"    {'refit BLS from scratch with the same nodes':44s} {t_refit * 1e3:9.3f} ms   incremental is {t_refit / t_incremental:6.1f}x faster"
+        f"    {'refit BLS from scratch with the same nodes':44s} {t_refit * 1e3:9.3f} ms   "
+        f"incremental is {t_refit / t_incremental:6.1f}x faster"
     )
     print(
-        f"    {'ridge solve of the output weights alone':44s} {t_solve * 1e3:9.3f} ms   incremental is {t_solve / t_incremental:6.1f}x faster"
+        f"    {'ridge solve of the output weights alone':44s} {t_solve * 1e3:9.3f} ms   "
+        f"incremental is {t_solve / t_incremental:6.1f}x faster"
     )
     print(f"    max |W_incremental - W_scratch| / max |W| = {difference:.1e}")
 
@@ -93,7 +95,8 @@ def bench_block_pinv(n_nodes: int, repeats: int) -> None:
     print(f"\n  Eq. 23-26 block pseudo-inverse, A 2000 x 400, E 2000 x {n_nodes} (case {case})")
     print(f"    {'block_pinv_update':44s} {t_update * 1e3:9.3f} ms")
     print(
-        f"    {'numpy.linalg.pinv([A | E]) from scratch':44s} {t_scratch * 1e3:9.3f} ms   update is {t_scratch / t_update:6.1f}x faster"
+        f"    {'numpy.linalg.pinv([A | E]) from scratch':44s} {t_scratch * 1e3:9.3f} ms   "
+        f"update is {t_scratch / t_update:6.1f}x faster"
     )
     print(
         f"    max |difference| / max |pinv| = {np.abs(updated - scratch).max() / np.abs(scratch).max():.1e}"

@@ -8,7 +8,8 @@ The 30 shapes are cut into ``--rounds`` groups. Each round runs its group's cell
 demonstrations, every method) once on the serial path (``synchronous=True``: in this process, no
 Dask) and once on 2 Dask workers (the embedded LocalCluster ``bidmp benchmark lasa`` starts, here
 started once before the rounds and stopped after them, both counted on its side), the order
-alternating from round to round so that load drifting on the machine falls on both sides alike. Prints each round's ratio, the total speed-up (target
+alternating from round to round so that load drifting on the machine falls on both sides alike.
+Prints each round's ratio, the total speed-up (target
 >= 1.6x) and that the two tables agree; then submits 2000 empty tasks to a 2-worker cluster and
 prints tasks/s. ``--rounds 1 --shapes 2`` is a quick look.
 """
@@ -63,7 +64,8 @@ def _rounds(out: Path, shapes, rounds: int, every: int) -> tuple[float, float, b
                 totals[workers] += run.wall_s
             identical &= _strip(runs[1].rows) == _strip(runs[2].rows)
             print(
-                f"  round {index + 1}/{rounds} ({len(group)} shapes, {'serial' if order[0] == 1 else '2 workers'} first): "
+                f"  round {index + 1}/{rounds} ({len(group)} shapes, "
+                f"{'serial' if order[0] == 1 else '2 workers'} first): "
                 f"serial {runs[1].wall_s:6.1f} s, 2 workers {runs[2].wall_s:6.1f} s, ratio "
                 f"{runs[1].wall_s / runs[2].wall_s:.2f}x",
                 flush=True,
@@ -112,7 +114,8 @@ def main() -> int:
     serial, parallel, identical = _rounds(out, shapes, args.rounds, args.every)
     print(f"  serial:    {serial:7.1f} s")
     print(
-        f"  2 workers: {parallel:7.1f} s (cluster start and stop included)   speed-up {serial / parallel:.2f}x (target >= 1.6x); tables identical: {identical}"
+        f"  2 workers: {parallel:7.1f} s (cluster start and stop included)   speed-up "
+        f"{serial / parallel:.2f}x (target >= 1.6x); tables identical: {identical}"
     )
     rate = _dask_overhead()
     print(

@@ -88,7 +88,8 @@ def equality(torch, mp) -> list[str]:
     mine = ours.trajectory(demo[0], start_velocity=(demo[1] - demo[0]) / DT, times=times).y
     extent = np.ptp(demo, axis=0).max()
     lines.append(
-        f"learned from one demonstration: weights differ by {np.abs(learned - ours.weights_[0]).max() / np.abs(learned).max():.2e} "
+        f"learned from one demonstration: weights differ by "
+        f"{np.abs(learned - ours.weights_[0]).max() / np.abs(learned).max():.2e} "
         f"of the largest, trajectories by {np.abs(mine - theirs).max() / extent:.2e} of the extent"
     )
     return lines

@@ -112,7 +112,8 @@ def main() -> int:
         f"    conditioned on its start and goal         {median('ours_cond'):8.3f}      {median('peer_cond'):8.3f}"
     )
     print(
-        f"  the two learned means apart (RMSE, mm)      {median('means_apart'):8.3f}  (EM with a smoothness prior vs ridge)"
+        f"  the two learned means apart (RMSE, mm)      {median('means_apart'):8.3f}  (EM with "
+        f"a smoothness prior vs ridge)"
     )
     worst = max(max(row["same_mean"], row["same_var"]) for row in rows)
     print(

@@ -47,7 +47,8 @@ def main(argv=None) -> int:
     trajectory = median_time(lambda: dmp.trajectory(goal), args.repeats * 5)
     print(f"  rollout()                           {1e3 * rollout:8.3f} ms")
     print(
-        f"  trajectory() with derivatives       {1e3 * trajectory:8.3f} ms   ratio {trajectory / rollout:.2f} (target <= 1.5)"
+        f"  trajectory() with derivatives       {1e3 * trajectory:8.3f} ms   ratio "
+        f"{trajectory / rollout:.2f} (target <= 1.5)"
     )
     ours = dmp.trajectory(goal)
     print(
@@ -105,7 +106,8 @@ def main(argv=None) -> int:
         ratio = "" if seconds == peer else f"   movement_primitives / this {peer / seconds:5.1f}x"
         print(f"  {name:45s} {1e3 * seconds:8.3f} ms{ratio}")
     print(
-        f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm after {prepared.t[-1]:.2f} s"
+        f"  movement_primitives: end-point error {np.linalg.norm(positions[-1] - goal):.4f} mm "
+        f"after {prepared.t[-1]:.2f} s"
     )
     return 0
 

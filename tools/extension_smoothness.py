@@ -58,7 +58,8 @@ def row(label, extension, blind, demo, dt, shortest=None) -> str:
     ratio = peaks(extension.complete, dt) / peaks(demo, dt)
     shortest_text = "   -  " if shortest is None else f"{length(extension.tra_gen) / shortest:6.3f}"
     return (
-        f"{label:28s} {extension.refinement:9s} {ldj(transfer(extension, n), dt):7.2f} {ldj(transfer(blind, n), dt):7.2f}"
+        f"{label:28s} {extension.refinement:9s} {ldj(transfer(extension, n), dt):7.2f} "
+        f"{ldj(transfer(blind, n), dt):7.2f}"
         f"   {shortest_text}   {ratio[0]:.2f} {ratio[1]:.2f} {ratio[2]:.2f}"
     )
 
@@ -177,12 +178,14 @@ def random_cases(count: int) -> None:
         top = (peaks(extension.complete, 1 / n) / peaks(demo, 1 / n)).max()
         excesses.append(worse - floor)
         print(
-            f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  {keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}  "
+            f"  {seed:4d}  {'mm' if unit == 1.0 else 'm ':4s}  "
+            f"{keep / np.linalg.norm(hover - seg):14.3f}  {worse:11.2f}  "
             f"{floor:8.2f}  {worse - floor:6.2f}  {ratio:15.3f}  {top:9.2f}"
         )
     if excesses:
         print(
-            f"  excess over floor(h): at most {max(excesses):.2f}; {sum(e <= 0.3 for e in excesses)} of {len(excesses)} within 0.3"
+            f"  excess over floor(h): at most {max(excesses):.2f}; "
+            f"{sum(e <= 0.3 for e in excesses)} of {len(excesses)} within 0.3"
         )
 
 

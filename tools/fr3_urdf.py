@@ -81,9 +81,11 @@ def urdf() -> str:
         "<!-- Written by tools/fr3_urdf.py from the FR3's published kinematics and limits. -->",
         '<robot name="fr3">',
         '  <link name="fr3_link0">',
-        '    <inertial><mass value="2.92"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
+        '    <inertial><mass value="2.92"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
         '    <visual><origin xyz="0 0 0.07"/><geometry><cylinder radius="0.08" length="0.14"/></geometry></visual>',
-        '    <collision><origin xyz="0 0 0.07"/><geometry><cylinder radius="0.08" length="0.14"/></geometry></collision>',
+        '    <collision><origin xyz="0 0 0.07"/><geometry><cylinder radius="0.08" length="0.14"/>'
+        "</geometry></collision>",
         "  </link>",
     ]
     rows = [*MDH, (0.0, FLANGE_D, 0.0)]

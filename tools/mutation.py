@@ -697,7 +697,10 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (
         "bidmp.sim.job_world",
         "_move",
-        "phase.verdict = contract.judge(executed, executed[-1] if target is None else np.asarray(target)[:3], label=name, axis=axis, exclude=exclude, orientations=tool_frames, commands=run.commands, contacts=phase.contacts, clearance=clearance)",
+        "phase.verdict = contract.judge(executed, executed[-1] if target is None else "
+        "np.asarray(target)[:3], label=name, axis=axis, exclude=exclude, "
+        "orientations=tool_frames, commands=run.commands, contacts=phase.contacts, "
+        "clearance=clearance)",
         "1 -> 2",
     ): "a straight move's end is where the arm came to rest, held for the settling time: the last "
     "two recorded samples are the same point but for the physics' residual (micrometres)",
@@ -821,9 +824,11 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (
         "bidmp._units",
         "check_speed",
-        "hint = f'; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to radians' if peak_speed > fastest and np.radians(peak_speed) <= fastest else ''",
+        "hint = f'; in degrees it would be {np.radians(peak_speed):.3g} rad/s: convert it to "
+        "radians' if peak_speed > fastest and np.radians(peak_speed) <= fastest else ''",
         "> -> >=",
-    ): "a peak of exactly the fastest joint speed returned as plausible two lines above: this hint is never built for it",
+    ): "a peak of exactly the fastest joint speed returned as plausible two lines above: this "
+    "hint is never built for it",
     **{
         (
             "bidmp.primitives.coupling",
@@ -887,7 +892,8 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     (
         "bidmp.scene.distances",
         "_Distances._witnessed",
-        "return abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and _on_shape(a, pose_a, first) and _on_shape(b, pose_b, second)",
+        "return abs(apart - distance) <= _ON_SHAPE * max(distance, 1.0) and "
+        "_on_shape(a, pose_a, first) and _on_shape(b, pose_b, second)",
         "<= -> <",
     ): "differs only when coal's points are apart by exactly the tolerance more or less than its distance",
     (

@@ -202,7 +202,8 @@ def markdown() -> str:
             starts,
         ),
         "",
-        f"**Any control rate.** A 100 Hz recording rolled out at 1 kHz and 10 kHz, the largest distance to its own-rate "
+        f"**Any control rate.** A 100 Hz recording rolled out at 1 kHz and 10 kHz, the largest "
+        f"distance to its own-rate "
         f"rollout: bidmp {ours}; bidmp 0.3 {old}; movement_primitives at 1 kHz {movement_primitives_rate()}.",
         "",
         f"**Nearer goals** on a straight {length:.3g} mm recording: overshoot past the goal / distance run backwards "

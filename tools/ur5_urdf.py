@@ -99,9 +99,11 @@ def urdf(arm: dict = UR5) -> str:
         f"<!-- Written by tools/ur5_urdf.py from {where}. -->",
         f'<robot name="{arm["name"]}">',
         '  <link name="base_link">',
-        '    <inertial><mass value="4.0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
+        '    <inertial><mass value="4.0"/>'
+        '<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>',
         '    <visual><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></visual>',
-        '    <collision><origin xyz="0 0 -0.025"/><geometry><cylinder radius="0.075" length="0.05"/></geometry></collision>',
+        '    <collision><origin xyz="0 0 -0.025"/><geometry>'
+        '<cylinder radius="0.075" length="0.05"/></geometry></collision>',
         "  </link>",
     ]
     parent, origin = "base_link", ("0 0 0", "0 0 0")

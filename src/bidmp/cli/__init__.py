@@ -5,7 +5,8 @@ stderr and exit code 2, never a traceback (``--debug`` shows it). NumPy and the 
 imported inside the command handlers so that ``bidmp --help`` starts fast.
 
 One module per command group, each adding its commands to the parser: ``skills`` (fit, rollout,
-segment, extend, learn), ``tasks`` (demo, sim, scenario), ``view`` (view), ``job`` (job), ``experiments`` (reproduce, lasa,
+segment, extend, learn), ``tasks`` (demo, sim, scenario), ``view`` (view), ``job`` (job),
+``experiments`` (reproduce, lasa,
 benchmark); ``common`` holds what they share, ``inputs`` how demonstrations are read.
 
 Layer 4 (the shell): may import any layer, inside the handlers; nothing imports it.

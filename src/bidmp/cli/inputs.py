@@ -297,7 +297,8 @@ def _time_option(path, times, args: argparse.Namespace, recording):
             f"; its other columns: {', '.join(recording.ignored[:6])}" if recording.ignored else ""
         )
         raise ValueError(
-            f"{path} has no time column ({recording.source}{others}), so its duration is unknown: name the time column with "
+            f"{path} has no time column ({recording.source}{others}), so its duration is "
+            f"unknown: name the time column with "
             f"--columns t=NAME, or pass --no-time to take its samples as uniform over 1 s (the paper's "
             f"convention)"
         )

@@ -11,7 +11,8 @@ EXIT_OK = 0
 
 
 def _timing_options(args: argparse.Namespace, dmp) -> dict:
-    """trajectory() keywords from --rate/--n-steps/--duration/--max-speed/--max-acc/--max-jerk/--joint-limits/--fastest."""
+    """trajectory() keywords from
+    --rate/--n-steps/--duration/--max-speed/--max-acc/--max-jerk/--joint-limits/--fastest."""
     options = {"duration": args.duration}
     if args.rate is not None and args.n_steps is not None:
         raise ValueError("give --rate or --n-steps, not both")
@@ -168,7 +169,8 @@ def cmd_rollout(args: argparse.Namespace) -> int:
             default_goal if args.goal is None and point_skills else args.goal, skill
         )
         print(
-            f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal {np.array2string(goals[index], precision=3)})"
+            f"Bi-DMP with {model.n_skills} skills: using skill {index} (training goal "
+            f"{np.array2string(goals[index], precision=3)})"
         )
     options.update(_rollout_extras(args, dmp, poses, default_goal))
     if not args.bag and (
@@ -330,7 +332,10 @@ def _stamped(options: dict) -> str:
     import datetime
 
     moment = datetime.datetime.fromtimestamp(options["origin"], datetime.UTC)
-    return f"stamped from {moment.isoformat(timespec='milliseconds').replace('+00:00', 'Z')}, frame {options['frame_id']}"
+    return (
+        f"stamped from {moment.isoformat(timespec='milliseconds').replace('+00:00', 'Z')}, "
+        f"frame {options['frame_id']}"
+    )
 
 
 def _ik_bag(args: argparse.Namespace, trajectory, dmp) -> str:
@@ -363,7 +368,10 @@ def _ik_bag(args: argparse.Namespace, trajectory, dmp) -> str:
         **options,
     )
     name = arm["robot"] if isinstance(arm["robot"], str) else arm["robot"].name
-    return f"{path} ({_joint_message(kind, options)} of the {name} after inverse kinematics, {len(trajectory)} points, {_stamped(options)})"
+    return (
+        f"{path} ({_joint_message(kind, options)} of the {name} after inverse kinematics, "
+        f"{len(trajectory)} points, {_stamped(options)})"
+    )
 
 
 def _joint_message(kind: str, options: dict) -> str:
@@ -419,7 +427,10 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
             what = "geometry_msgs/PoseStamped"
         elif held is not None:
             source = "given" if args.orientation is not None else "the demonstration's"
-            what = f"geometry_msgs/PoseStamped, {source} orientation {np.array2string(np.asarray(held), precision=4)} held"
+            what = (
+                f"geometry_msgs/PoseStamped, {source} orientation "
+                f"{np.array2string(np.asarray(held), precision=4)} held"
+            )
         else:
             what = (
                 "geometry_msgs/PointStamped: the model knows no orientation and none is made up (--orientation QX QY "
@@ -590,8 +601,8 @@ def _add_rollout_arguments(rollout) -> None:
         nargs=3,
         default=None,
         metavar=("X", "Y", "Z"),
-        help="a joint-space model of the --robot's joints: roll out to the joints that put its tool at X Y Z metres in its base "
-        "frame, tool pointing down (IK from the demonstrated goal's joints)",
+        help="a joint-space model of the --robot's joints: roll out to the joints that put its "
+        "tool at X Y Z metres in its base frame, tool pointing down (IK from the demonstrated goal's joints)",
     )
     rollout.add_argument(
         "--tool-length",

@@ -145,12 +145,14 @@ def cmd_fit(args: argparse.Namespace) -> int:
         f"  reproduction RMSE {error:.4g} {unit} ({100 * error / extent:.3g} % of the extent {extent:.4g})"
     )
     print(
-        f"  rollouts last {reproduction.duration:.4g} s (tau = {dmp.tau:g}; peak speed {reproduction.peak_speed():.4g} {unit}/s, "
+        f"  rollouts last {reproduction.duration:.4g} s (tau = {dmp.tau:g}; peak speed "
+        f"{reproduction.peak_speed():.4g} {unit}/s, "
         f"peak acceleration {reproduction.peak_acceleration():.4g} {unit}/s^2)"
     )
     if dmp.protocol == "paper":
         print(
-            f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by c*d after {dmp.default_n_steps()} samples"
+            f"  end-point gain c = {dmp.endpoint_gain():.4g}: a goal moved by d is missed by "
+            f"c*d after {dmp.default_n_steps()} samples"
         )
     print(f"wrote {path}")
     return EXIT_OK
@@ -193,7 +195,8 @@ def _fit_poses(args: argparse.Namespace) -> int:
         f"  T = {len(poses)} samples over {model.duration_:.4g} s; units {model.units_ or '(not given)'}"
     )
     print(
-        f"  reproduction: position RMSE {np.sqrt(np.mean(np.sum((reproduction[:, :3] - poses[:n, :3]) ** 2, axis=1))):.4g} "
+        f"  reproduction: position RMSE "
+        f"{np.sqrt(np.mean(np.sum((reproduction[:, :3] - poses[:n, :3]) ** 2, axis=1))):.4g} "
         f"{unit}, orientation RMS {np.sqrt(np.mean(angles**2)):.3g} deg"
     )
     print(f"wrote {path}")
@@ -316,7 +319,8 @@ def cmd_extend(args: argparse.Namespace) -> int:
         f"RMSE {error:.4g} {unit} ({100 * error / path_extent(extension.complete):.3g} % of its extent)"
     )
     print(
-        f"end-point error at the target: {before:.4g} before, {np.linalg.norm(rollout[-1, :3] - target[:3]):.4g} {unit} after"
+        f"end-point error at the target: {before:.4g} before, "
+        f"{np.linalg.norm(rollout[-1, :3] - target[:3]):.4g} {unit} after"
     )
     print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
     if args.save_demo:

@@ -1,4 +1,5 @@
-"""Experiments: the paper's tables and figures (``reproduce``: ``table4``, ``table5``, ``incremental``, ``generalisation``), the LASA benchmark on Dask
+"""Experiments: the paper's tables and figures (``reproduce``: ``table4``, ``table5``,
+``incremental``, ``generalisation``), the LASA benchmark on Dask
 (``lasa``) and the continual-learning protocol of the field (``clfd``).
 
 Layer 3 (the application): imports the math, ``demonstrations``, ``io``, ``tasks`` and

@@ -94,8 +94,10 @@ class GeneralisationResult:
         return "\n".join(
             [
                 f"one LASA '{self.shape}' demonstration ({data['n_samples']} samples, 2-D), DMP with defaults",
-                f"  reproduction RMSE {data['reproduction_rmse']:.3f} mm = {data['reproduction_rmse_percent']:.2f} % of the extent",
-                f"  end-point gain c = {self.endpoint_gain:.4f} after T steps, {self.endpoint_gain_converged:.2e} after "
+                f"  reproduction RMSE {data['reproduction_rmse']:.3f} mm = "
+                f"{data['reproduction_rmse_percent']:.2f} % of the extent",
+                f"  end-point gain c = {self.endpoint_gain:.4f} after T steps, "
+                f"{self.endpoint_gain_converged:.2e} after "
                 f"{data['n_steps_converged']} steps",
                 f"  end-point error at the demonstrated goal after T steps: e0 = {self.goal_error:.3f} mm",
                 "",

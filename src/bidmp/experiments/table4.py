@@ -143,7 +143,8 @@ class Table4:
         parts.append(
             "cell removal, Bi-DMP before (nut skill only) and after the second extended demonstration to B6:\n"
             + text_table(["target", "end error before", "end error after"], rows)
-            + f"\n  difference (path deviation from the reference) at B6: before {studies['cell_removal']['difference_before']:.1f}, "
+            + f"\n  difference (path deviation from the reference) at B6: before "
+            f"{studies['cell_removal']['difference_before']:.1f}, "
             f"after {studies['cell_removal']['difference_after']:.1f}"
         )
         return "\n\n".join(parts)

@@ -1,7 +1,8 @@
 """The linear algebra of the Broad Learning System (:mod:`bidmp.incremental.bls`): the sparse
 autoencoder of the mapped features, and the output weights solved and grown exactly.
 
-Cline's block formula (Eq. 23–26, :func:`block_pinv_update`) is exact for the exact pseudo-inverse; a numerical one is truncated at a rank cut
+Cline's block formula (Eq. 23–26, :func:`block_pinv_update`) is exact for the exact
+pseudo-inverse; a numerical one is truncated at a rank cut
 (``PINV_RCOND`` of the largest singular value), and Cline's C then keeps the directions A's
 truncation dropped. So ``BLS(reg=0)`` updates the *thin SVD* of the hidden matrix instead
 (the SVD of ``[U S | E]``, ``N × (r + m)``), truncated at the same relative cut as
@@ -121,7 +122,8 @@ def _check_gap(kept: np.ndarray, dropped: np.ndarray) -> None:
         return
     raise ValueError(
         f"add_enhancement_nodes: with reg = 0 the output weights are the pseudo-inverse's, and for this hidden matrix "
-        f"it is ill-posed: its singular values decay through the rank cut ({PINV_RCOND:g} of the largest) without a gap "
+        f"it is ill-posed: its singular values decay through the rank cut ({PINV_RCOND:g} of "
+        f"the largest) without a gap "
         f"(kept down to {kept[-1] / kept[0]:.3g}, dropped from {dropped[0] / kept[0]:.3g} of the largest), so rounding "
         f"alone moves the weights and no update can match a from-scratch pinv; use reg > 0 (for which the update is "
         f"exact, update='exact_ridge'; Bi-DMP's default is 1e-4)"

@@ -34,7 +34,8 @@ FORMAT_VERSION = 5
 # Format 5 (bidmp 0.5): a Bi-DMP stores each skill's time scale (skill_time_scales_: an extension
 # lasts as long as it needs); files without it load with 1 for every skill, as they were learned.
 # Format 4 (bidmp 0.4): a DMP stores its integrator ("exact" for the robot protocol); files without
-# one load with explicit Euler, so a format-3 robot model rolls out as it did. Format 3 (bidmp 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
+# one load with explicit Euler, so a format-3 robot model rolls out as it did. Format 3 (bidmp
+# 0.3): a DMP keeps its protocol, duration_ (s) and units_. Format 2 (bidmp 0.2):
 # Bi-DMP increments are gated by the phase and the DMP's regression is stored as "regression".
 # Format-1 and -2 DMP and BLS files still load (as protocol "paper", 1 s, no units); format-1
 # Bi-DMP files do not, because their blocks were trained on the ungated increment.
@@ -193,7 +194,8 @@ def _model_class_name(meta: dict, path: Path) -> str:
         raise ModelFileError(f"{path} holds an unknown model class {short_token(class_name, 20)}")
     if version < _MIN_VERSION.get(class_name, 1):
         raise ModelFileError(
-            f"{path} holds a {class_name} in model format {version} (bidmp {short_token(meta.get('bidmp_version', '?'), 20)}), "
+            f"{path} holds a {class_name} in model format {version} (bidmp "
+            f"{short_token(meta.get('bidmp_version', '?'), 20)}), "
             f"whose learned increments did not vanish with the phase; this bidmp cannot use it: learn the skills again"
         )
     return class_name

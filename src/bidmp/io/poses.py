@@ -23,7 +23,8 @@ def read_poses(path: str | os.PathLike, *, columns=None) -> tuple[np.ndarray, np
     vector ``rx, ry, rz`` in radians, or a logger's own names: UR RTDE ``actual_TCP_pose_0..5``,
     ROS ``pose.position.x`` … ``pose.orientation.w``), and optionally a time column; other
     columns are ignored with a warning (a timed pose trajectory written by :func:`save_poses`
-    reads too). ``columns`` decides (as :func:`read_trajectory`, e.g. ``pose=target_TCP_pose``). The quaternion's order is taken from the names, never guessed
+    reads too). ``columns`` decides (as :func:`read_trajectory`, e.g.
+    ``pose=target_TCP_pose``). The quaternion's order is taken from the names, never guessed
     from the numbers; ``qw`` first or last both read. Quaternions are checked by
     :class:`bidmp.CartesianDMP` (sign flips, unit length) when it fits them. Samples whose
     timestamp repeats the one before are dropped, with a warning.

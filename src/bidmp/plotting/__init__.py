@@ -1,5 +1,6 @@
 """Figures per domain (matplotlib ``Figure`` objects written to PNG files; the global backend is never
-switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``, ``benchmark``, ``clfd``; ``_base`` holds what they
+switched): ``trajectories``, ``extension``, ``incremental``, ``tasks``, ``benchmark``,
+``clfd``; ``_base`` holds what they
 share. ``viewer`` writes the 3-D viewer (one offline HTML file, plotly: the ``view`` extra).
 
 Layer 2 (data out, beside ``io``): imports the math and ``bidmp.io``; never ``tasks``, ``sim`` or

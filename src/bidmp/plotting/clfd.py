@@ -19,7 +19,8 @@ def plot_clfd(
     """``clfd_accuracy.png`` (one heat map per method: entry (i, j), the share of task j's
     demonstrations within the DTW threshold after task i) and ``clfd_dtw.png`` (the mean DTW over
     the tasks seen after each task, per method; ``reference_dtw``: the published figure after
-    the last task, marked) in folder ``out``, their names starting with ``stem``. ``rows``: method name -> an object with
+    the last task, marked) in folder ``out``, their names starting with ``stem``. ``rows``:
+    method name -> an object with
     ``matrices["dtw"]`` (N, N) and ``mean_dtw_seen`` (N,)."""
     mpl = _matplotlib()
     written = []

@@ -112,7 +112,8 @@ def plot_targets_top_view(path, report) -> Path:
     for ax in axes.ravel()[len(names) :]:
         ax.axis("off")
     fig.suptitle(
-        f"{printable(scenario.name)}: {'task ' if scene is not None else ''}success per target (green) and failure (red)"
+        f"{printable(scenario.name)}: {'task ' if scene is not None else ''}success per target "
+        f"(green) and failure (red)"
     )
     fig.tight_layout()
     return _save(fig, path)

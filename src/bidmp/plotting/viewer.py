@@ -58,7 +58,9 @@ _COLOURS = {
     "tpgmm": "#8c564b",
 }
 FAILED = "#d62728"  # a failed target: red, crossed
-WARNING = "#ffc000"  # amber: a motion that breaks the contract, and the part it came too close to (not the robot joints' dark orange)
+# amber: a motion that breaks the contract, and the part it came too close to (not the robot
+# joints' dark orange)
+WARNING = "#ffc000"
 
 
 @dataclass

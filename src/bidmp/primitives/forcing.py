@@ -41,8 +41,8 @@ __all__ = [
 ]
 
 _MAX_PHASE = 1e6  # |phase| a basis row is computed for (a DMP's phase lies in [0, 1])
-_LOG_PSI_FLOOR = -40.0
-_LOG_OVERFLOW_MARGIN = 600.0  # exp overflows past ~709: a row's excess beyond this is shifted  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
+_LOG_PSI_FLOOR = -40.0  # kernel terms below e^-40 of a row's largest cannot change a float64 sum
+_LOG_OVERFLOW_MARGIN = 600.0  # exp overflows past ~709: a row's excess beyond this is shifted
 
 
 def kernel_centres(

@@ -78,7 +78,8 @@ def _check_euler_stable(dt: float, tau: float, alpha: float, beta: float) -> Non
         raise ValueError(
             f"explicit Euler integration is unstable for alpha = {alpha:g}, beta = {beta:g} with the step dt/tau = "
             f"{step:.4g} s (spectral radius {radius:.4g} >= 1): it needs dt/tau < {bound:.4g} s "
-            f"(alpha * dt/tau = {alpha * step:.4g}, below {alpha * bound:.4g}); lower alpha, raise tau or use more samples"
+            f"(alpha * dt/tau = {alpha * step:.4g}, below {alpha * bound:.4g}); lower alpha, "
+            f"raise tau or use more samples"
         )
 
 

@@ -12,7 +12,8 @@ components :class:`~bidmp.primitives.RhythmicPhase` and :class:`~bidmp.primitive
 
 Learning from a recording (:meth:`RhythmicDMP.fit`): the frequency is estimated
 (:func:`~bidmp.primitives.estimate_frequency`, in :mod:`bidmp.primitives.frequency`: a spectral
-peak refined by least squares of a harmonic series over all kept samples, with its standard error), the transients at both ends are cut (where the
+peak refined by least squares of a harmonic series over all kept samples, with its standard
+error), the transients at both ends are cut (where the
 one-period RMS envelope is below 9/10 of the steady part's), and the forcing target is computed
 from that harmonic series — the mean period of every kept period at once, differentiated
 analytically (no numerical derivative of noisy, jittered samples) — and regressed on the basis.

@@ -366,7 +366,8 @@ class Scene:
             point = as_vector(point, f"targets[{short_token(label, 20)}]")
             if point.shape[0] < 3:
                 raise ValueError(
-                    f"targets[{short_token(label, 20)}] must be a point (3,) or a pose (7,), got {point.shape[0]} values"
+                    f"targets[{short_token(label, 20)}] must be a point (3,) or a pose (7,), "
+                    f"got {point.shape[0]} values"
                 )
             point = _position(point[:3])  # a pose target: its position
             if not self.applies_to(label):

@@ -2,7 +2,8 @@
 control step (:class:`bidmp.primitives.avoidance.SceneAvoidance`).
 
 One query per step: the vertical tool at a point against every chosen solid's bounding box (the
-exact cylinder-to-box distance of :func:`bidmp.scene.distances._cylinder_box_bounds`: a lower bound), then coal's signed distance and
+exact cylinder-to-box distance of :func:`bidmp.scene.distances._cylinder_box_bounds`: a lower
+bound), then coal's signed distance and
 nearest points for the solids whose bound is inside the radius asked about. The direction away
 from a solid is the unit vector from its nearest point to the tool's (coal's normal, reversed,
 when they overlap).

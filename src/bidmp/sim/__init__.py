@@ -4,7 +4,8 @@
   ``contacts``, ``render``) and the types it exchanges; a new simulator or robot is a subpackage
   beside ``pybullet`` that implements it;
 * ``pybullet`` — the first backend: a serial arm of six or more joints in PyBullet, the Franka
-  Panda by default, the KUKA iiwa, the xArm6, a UR5-class arm or your URDF (world, robot, IK, planning, execution, rendering, one module each);
+  Panda by default, the KUKA iiwa, the xArm6, a UR5-class arm or your URDF (world, robot, IK,
+  planning, execution, rendering, one module each);
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
 * ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);

@@ -10,7 +10,8 @@ for this target); the transfers to the bin or the rack are the plain DMP's start
 generalisation, lifted over the work by a via-point where the tool or the part it carries would
 come within the margin of a part. Straight moves along a part's axis (unscrewing, retracting,
 lifting out) are lines. Rocking a part loose is a periodic skill (a rhythmic DMP learned from a
-recording) run from rest at the grasp and back to rest there, at its learned timing. The unscrewing is a powered spindle on the tool coupled to the retraction:
+recording) run from rest at the grasp and back to rest there, at its learned timing. The
+unscrewing is a powered spindle on the tool coupled to the retraction:
 it turns the socket by one turn per pitch the arm rises (measured, every 2 ms), which a wrist
 cannot (its last joint turns less than one turn each way) and which keeps the nut on its thread
 whatever the arm's timing. A tilted part (a pose scenario) is approached by the pose skill along
@@ -92,7 +93,8 @@ def _engaged(world: _World, part: MovablePart, target) -> tuple[bool, str]:
     tolerance, unit = world.spec.engage_tolerance, world.scenario.units
     if across > tolerance or along > world.scenario.success_threshold:
         return False, (
-            f"the tool is {length_text(across, unit)} off the part's axis and {length_text(along, unit)} off its height "
+            f"the tool is {length_text(across, unit)} off the part's axis and "
+            f"{length_text(along, unit)} off its height "
             f"(it engages within {tolerance:g} {unit} and {world.scenario.success_threshold:g} {unit})"
         )
     return True, f"{length_text(across, unit)} off the axis"

@@ -2,7 +2,8 @@
 motion turned into joint positions sample by sample (what a ``JointTrajectory`` carries).
 
 Points are in the world's frame, in ``units``, the robot's base at ``base`` turned by ``yaw``
-about z (defaults: the origin and 0, so that x is forward from the base); the tool points down (z of the flange towards -z) unless orientations are given. Uses the
+about z (defaults: the origin and 0, so that x is forward from the base); the tool points down
+(z of the flange towards -z) unless orientations are given. Uses the
 PyBullet backend's arm models (``"panda"``, ``"iiwa"`` or a :class:`RobotModel`).
 """
 

@@ -296,9 +296,11 @@ class SimReport:
         )
         lines = [
             f"{scenario.name} on a simulated {self.robot_name} ({self.simulator}), robot base "
-            f"{np.round(self.base, length_digits(scenario.units)).tolist()} {scenario.units}, {'closed' if self.closed_loop else 'open'} loop",
+            f"{np.round(self.base, length_digits(scenario.units)).tolist()} {scenario.units}, "
+            f"{'closed' if self.closed_loop else 'open'} loop",
             f"task success = measured end point <= {scenario.success_threshold:g} {scenario.units}, engaged{aligned}, "
-            f"no contact with another part, every 1 kHz joint command within the {self._short_name}'s velocity, acceleration "
+            f"no contact with another part, every 1 kHz joint command within the "
+            f"{self._short_name}'s velocity, acceleration "
             f"and jerk limits, from rest to rest (peak jerk as a fraction of the limit; joints: measured, 10 ms "
             f"differences)",
             "",

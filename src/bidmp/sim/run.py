@@ -501,7 +501,8 @@ def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
     cell = _world(setup)
     frame = "as the target's pose" if scenario.is_pose else "pointing down"
     where = (
-        f"for the {cell.name} at base {np.round(cell.base, length_digits(scenario.units)).tolist()} {scenario.units} (tool "
+        f"for the {cell.name} at base "
+        f"{np.round(cell.base, length_digits(scenario.units)).tolist()} {scenario.units} (tool "
         f'{frame}): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
         f'from its start pose (give one nearer: "robot": {{"rest": [...]}}, rad)'
     )

@@ -248,7 +248,8 @@ class Verdict:
         for name in self.failed:
             if name == "end":
                 parts.append(
-                    f"ends {length_text(self.end_error, unit)} from the target (within {self.threshold:g} {unit} is success)"
+                    f"ends {length_text(self.end_error, unit)} from the target (within "
+                    f"{self.threshold:g} {unit} is success)"
                 )
             elif name == "engagement":
                 if self.approach_error is None or not math.isfinite(self.approach_error):

@@ -223,7 +223,8 @@ class Report:
     settings: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
-        """The report JSON: per method its counts and per target its verdict (plus the extension and forgetting details)."""
+        """The report JSON: per method its counts and per target its verdict (plus the
+        extension and forgetting details)."""
         out = {
             "scenario": self.scenario.name,
             "units": self.scenario.units,
@@ -338,7 +339,8 @@ class Report:
             )
         if self.extension_targets:
             lines.append(
-                f"plain DMP misses {len(self.failed_targets)} target(s) ({', '.join(self.failed_targets)}); Bi-DMP extended to "
+                f"plain DMP misses {len(self.failed_targets)} target(s) "
+                f"({', '.join(self.failed_targets)}); Bi-DMP extended to "
                 + ", ".join(
                     np.array2string(np.asarray(t), precision=1) for t in self.extension_targets
                 )

@@ -21,7 +21,8 @@ __all__ = ["RobotCell"]
 
 class RobotCell:
     """A headless PyBullet world with a scene's parts and a serial arm of six or more joints (the
-    Panda unless ``robot`` names another) carrying the scene's tool: the PyBullet implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
+    Panda unless ``robot`` names another) carrying the scene's tool: the PyBullet
+    implementation of :class:`bidmp.sim.backend.SimulatorBackend`. It holds the world's
     state; planning, execution and pictures are the functions of this subpackage's modules.
 
     Parameters

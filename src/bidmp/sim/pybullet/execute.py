@@ -151,7 +151,8 @@ def _execute_closed_loop(
     (:class:`bidmp.sim.limits.RateLimiter`) with the segment's velocity and acceleration fed forward,
     so every command is within the velocity, acceleration and jerk limits, starts and stops at rest,
     and follows a monotone approach without overshoot (straight segments between the 100 Hz targets
-    step the velocity every 10 ms, and the limiter then overshot a fast final descent by 1 mm). With phase stopping the motion's own time stands still while the robot is held. The run
+    step the velocity every 10 ms, and the limiter then overshot a fast final descent by 1 mm).
+    With phase stopping the motion's own time stands still while the robot is held. The run
     ends when the stepper's time has reached ``duration`` (at most ``max_factor`` times that in
     wall time; ``span`` = (duration s, max_factor)) plus the settling. ``goal_update``: see
     :func:`_perceive`.

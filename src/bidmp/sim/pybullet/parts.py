@@ -4,7 +4,8 @@ the tool, a part let go that falls under gravity; and the job's own parts (bin, 
 **The thread** is kinematic: while the socket is engaged the nut turns about its axis and rises
 by the pitch per turn, ``rise = pitch * turns``; once its bottom clears the stud's top it is off
 the thread and stays in the socket. **Held** parts are bodies with their mass fixed to the tool
-by a constraint (a socket's or a suction gripper's hold), carried by the arm under physics. **Released** parts become dynamic bodies with their mass and fall under gravity,
+by a constraint (a socket's or a suction gripper's hold), carried by the arm under physics.
+**Released** parts become dynamic bodies with their mass and fall under gravity,
 colliding with everything else. (A full contact model of a thread — helical surfaces, friction —
 would cost far more than it shows: what the job needs is where the nut is.)
 """
