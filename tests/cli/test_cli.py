@@ -772,3 +772,26 @@ def test_every_help_text_renders_as_written(capsys):
     assert len(shown) > 10
     for text in shown:
         assert "%%" not in text and "%(" not in text, text[:200]
+
+
+@pytest.mark.parametrize("approach", ["paper", "keep"])
+def test_demo_approach_reaches_the_evaluation(tmp_path, monkeypatch, approach):
+    """``bidmp demo --approach`` acts (no option silently ignored): the scenario the evaluation
+    gets extends with that approach, its other extension options kept."""
+    import bidmp.tasks.evaluation as evaluation
+
+    seen = []
+
+    class Stop(Exception):
+        pass
+
+    def evaluate(scenario, methods, **options):
+        seen.append(scenario.extension)
+        raise Stop
+
+    monkeypatch.setattr(evaluation, "evaluate", evaluate)
+    # the CLI reports the stop as an internal error (exit 1) once the scenario has reached it
+    assert main(["demo", "--approach", approach, "--out", str(tmp_path)]) == 1
+    (extension,) = seen
+    assert extension.approach == approach
+    assert extension.replace(approach="keep") == bidmp.tasks.load("nut-unscrewing").extension

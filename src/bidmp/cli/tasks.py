@@ -29,9 +29,7 @@ def _run_scenario(scenario, out, methods=None, view=False):
     names = list(scenario.methods if methods is None else methods)
     with tqdm(total=len(names), desc=scenario.name, unit="method", disable=None) as bar:
         # each method as it starts, each repair as it is tried ("bidmp: repair 12")
-        def progress(
-            step,
-        ):
+        def progress(step):
             bar.set_postfix_str(step)
             if step in names:
                 bar.update(1)

@@ -108,9 +108,7 @@ class SceneAvoidance(CouplingTerm):
         on_miss: str = "raise",
     ) -> None:
         # imported here: the primitives do not need the scene otherwise
-        from ..scene.clearance import (
-            Scene,
-        )
+        from ..scene.clearance import Scene
 
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a bidmp.scene.Scene, got {type(scene).__name__}")
