@@ -211,7 +211,7 @@ def _shortest_path(
         cols = neighbours[:, 1:].ravel()
         weights = distances[:, 1:].ravel()
         if is_free is not None:
-            keep = _edges_free(nodes[rows], nodes[cols], is_free)
+            keep = _undirected_free(nodes, rows, cols, is_free)
             rows, cols, weights = rows[keep], cols[keep], weights[keep]
         # Coincident nodes would give zero weights, which a sparse matrix drops: keep them tiny.
         weights = np.maximum(weights, 1e-300)
@@ -225,6 +225,21 @@ def _shortest_path(
         if k >= _MAX_NEIGHBOURS or k_query >= n_nodes:
             return None
         k = min(2 * k, _MAX_NEIGHBOURS)
+
+
+def _undirected_free(
+    nodes: np.ndarray, rows: np.ndarray, cols: np.ndarray, is_free: CollisionCallback
+) -> np.ndarray:
+    """Which edges ``rows[e] -> cols[e]`` of the roadmap are free, each pair of nodes checked once:
+    a kNN roadmap lists a pair from both ends when each is among the other's neighbours (about
+    two in three of its edges), and a straight move is free or not whichever way it is checked
+    (a conservative advancement either way stops short of the margin; only a move that grazes it
+    to the last resolution step could differ). The edge checks are most of a route's cost."""
+    low, high = np.minimum(rows, cols), np.maximum(rows, cols)
+    _, first, inverse = np.unique(
+        low * nodes.shape[0] + high, return_index=True, return_inverse=True
+    )
+    return _edges_free(nodes[rows[first]], nodes[cols[first]], is_free)[inverse.ravel()]
 
 
 def _edges_free(a: np.ndarray, b: np.ndarray, is_free: CollisionCallback) -> np.ndarray:
