@@ -211,6 +211,10 @@ def _final_approach(y: np.ndarray, points: np.ndarray, straightness: float = _ST
     return straight_tail_start(y, start, straightness)
 
 
+# An extension's own options; a scenario file's flat form lists the roadmap's beside them.
+_OWN_OPTIONS = ("eps_frac", "method", "approach")
+
+
 @dataclass(frozen=True)
 class ExtensionOptions:
     """How an extended demonstration is grown, checked once when made (``ValueError``/``TypeError``
@@ -251,25 +255,19 @@ class ExtensionOptions:
         """The options from a scenario file's flat form (``{"eps_frac": 0.1, "n_iter": 20,
         ...}``: the roadmap's options beside the others); an unknown name is a ``TypeError``."""
         flat = dict(options or {})
-        known = ("eps_frac", "method", "approach")
-        unknown = sorted(set(flat) - set(known) - set(RoadmapOptions.__dataclass_fields__))
+        unknown = sorted(set(flat) - set(_OWN_OPTIONS) - set(RoadmapOptions.__dataclass_fields__))
         if unknown:
             raise TypeError(
                 f"unknown extension option {unknown[0]!r} (known: eps_frac, method, approach, "
                 f"{', '.join(RoadmapOptions.__dataclass_fields__)})"
             )
-        own = {key: flat.pop(key) for key in known if key in flat}
+        own = {key: flat.pop(key) for key in _OWN_OPTIONS if key in flat}
         return cls(**own, roadmap=RoadmapOptions(**flat))
 
     @property
     def arguments(self) -> dict:
         """The keyword arguments of :func:`extend_demonstration` these options stand for."""
-        return {
-            "eps_frac": self.eps_frac,
-            "method": self.method,
-            "approach": self.approach,
-            "roadmap": self.roadmap,
-        }
+        return {key: getattr(self, key) for key in (*_OWN_OPTIONS, "roadmap")}
 
     @property
     def flat(self) -> dict:
@@ -278,7 +276,7 @@ class ExtensionOptions:
         default = ExtensionOptions()
         out = {
             key: getattr(self, key)
-            for key in ("eps_frac", "method", "approach")
+            for key in _OWN_OPTIONS
             if getattr(self, key) != getattr(default, key)
         }
         roadmap = dataclasses.asdict(self.roadmap)

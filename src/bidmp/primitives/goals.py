@@ -419,7 +419,7 @@ def _learn_goal_gate(
     (:func:`_departure_end`; a demonstration without an approach gets the progress gate)."""
     if params.goal_rate is not None:
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
-    gains = {"gains": params.gains, "exact": params.exact, "progress": progress}
+    shared = {"gains": params.gains, "exact": params.exact, "progress": progress}
     if params.keep_approach and demonstration is not None:
         from .approach import _tail_start
 
@@ -433,6 +433,6 @@ def _learn_goal_gate(
                 n_motion,
                 dt,
                 kept=(_departure_end(demonstration, start), start),
-                **gains,
+                **shared,
             )
-    return ProgressGate.learn(train, n_motion, dt, **gains)
+    return ProgressGate.learn(train, n_motion, dt, **shared)

@@ -491,7 +491,7 @@ class Scene:
         # long, and this runs on every placement of every repaired motion)
         local = centres @ rotation - centre[:, None, :] @ rotation
         extent = _cylinder_extent(axes @ rotation, self.tool.radius, self.tool.length / 2.0)
-        # the gap between boxes centred at ``local`` and at the solid's box centre, per axis
+        # _box_distance's gaps from the boxes' centres and half-sizes (its corners: 1.4x slower)
         middle, half = (lower + upper) / 2.0, (upper - lower) / 2.0
         gap = np.maximum(np.abs(local - middle[:, None]) - extent - half[:, None], 0.0)
         return np.sqrt(np.einsum("kmi,kmi->km", gap, gap)).T
