@@ -2,8 +2,9 @@
 the spring's integration, SciPy's ``Rotation`` for quaternion logs and exponentials, ``np.interp``
 for resampling, the NumPy expressions they replaced for the forcing target, the goal gate and share,
 the rest blend and the exact state, NumPy's norms and sums for the arc length and a motion's
-peaks, and plain NumPy searches for the decisions (the rest blend's
-windows; the straight tail is checked against its plain search in test_approach.py).
+peaks, plain loops for the band products, and plain NumPy searches for the decisions (the rest
+blend's windows, a band's edges; the straight tail is checked against its plain search in
+test_approach.py).
 
 Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
 library was not tuned on: the kernels replaced NumPy expressions whose numbers the committed results
@@ -19,6 +20,9 @@ from scipy.spatial.transform import Rotation
 
 from bidmp._kernels import (
     arclength,
+    band_of,
+    band_product,
+    band_transposed_product,
     exact_state,
     forcing_target,
     goal_gate,
@@ -389,6 +393,92 @@ def test_the_quaternion_loops_are_scipys_rotation_to_the_bit():
         quaternion_log(np.ones((3, 4)), np.ones((2, 4)))
     with pytest.raises(ValueError, match="goal"):
         quaternion_exp(np.ones((3, 3)), np.ones((2, 4)))
+
+
+def _random_band_rows(rng, n_rows: int, n_columns: int) -> np.ndarray:
+    """Rows of bumps at random places and widths over a floor of tiny values, some rows zero,
+    some with a NaN, at random scales."""
+    columns = np.arange(n_columns)
+    centres = rng.uniform(-2, n_columns + 2, size=(n_rows, 1))
+    widths = rng.uniform(0.3, n_columns / 3, size=(n_rows, 1))
+    rows = np.exp(-(((columns - centres) / widths) ** 2)) * 10 ** rng.uniform(-5, 5, (n_rows, 1))
+    rows *= rng.choice([-1.0, 1.0], size=rows.shape)
+    rows[rng.random(n_rows) < 0.1] = 0.0
+    nan_rows = rng.random(n_rows) < 0.05
+    rows[nan_rows, rng.integers(0, n_columns, nan_rows.sum())] = np.nan
+    return rows
+
+
+def test_the_band_edges_are_the_plain_search():
+    rng = np.random.default_rng(23)
+    for _ in range(200):
+        n_rows, n_columns = int(rng.integers(1, 60)), int(rng.integers(1, 40))
+        rows = _random_band_rows(rng, n_rows, n_columns)
+        share = 10 ** rng.uniform(-20, -1)
+        first, last = band_of(rows, share)
+        for i, row in enumerate(rows):
+            size = np.abs(row)
+            matters = ~(size <= share * np.nanmax(size)) if np.any(size > 0) else size != size
+            where = np.flatnonzero(matters)
+            expected = (where[0], where[-1]) if where.size else (0, 0)
+            assert (first[i], last[i]) == expected, (i, row)
+
+
+def test_the_band_products_are_the_plain_loops_to_the_bit():
+    rng = np.random.default_rng(29)
+    for _ in range(100):
+        n_rows, n_columns = int(rng.integers(1, 40)), int(rng.integers(1, 30))
+        width, n_dims = int(rng.integers(1, n_columns + 1)), int(rng.integers(1, 5))
+        first = rng.integers(0, n_columns - width + 1, size=n_rows).astype(np.int64)
+        values = rng.normal(size=(n_rows, width)) * 10 ** rng.uniform(-3, 3)
+        weights = rng.normal(size=(n_columns, n_dims)) * 10 ** rng.uniform(-3, 3)
+        target = rng.normal(size=(n_rows, n_dims))
+        expected = np.zeros((n_rows, n_dims))
+        for i in range(n_rows):
+            for k in range(n_dims):
+                total = 0.0
+                for j in range(width):
+                    total = total + values[i, j] * weights[first[i] + j, k]
+                expected[i, k] = total
+        assert np.array_equal(_bits(band_product(values, first, weights)), _bits(expected))
+        expected = np.zeros((n_columns, n_dims))
+        for i in range(n_rows):
+            for j in range(width):
+                expected[first[i] + j] = expected[first[i] + j] + values[i, j] * target[i]
+        assert np.array_equal(
+            _bits(band_transposed_product(values, first, target, n_columns)), _bits(expected)
+        )
+
+
+def test_a_basis_kept_as_a_band_multiplies_as_the_whole_rows_to_their_rounding():
+    """What the band drops is below 1e-16 of each row's peak: on DMP bases of other sizes, rates
+    and protocols, the band's products are the dense ones within the dense products' own
+    rounding (a sum of N products: N ε Σ|terms|) plus what was dropped (at most 1e-16 of the
+    row's peak times the weights' sizes)."""
+    from bidmp import DMP
+    from bidmp.primitives.band import _band_of
+
+    rng = np.random.default_rng(31)
+    for trial in range(12):
+        n_steps = int(rng.integers(50, 1500))
+        settings = {"n_kernels": int(rng.integers(10, 300))}
+        if trial % 3 == 0:
+            settings["protocol"] = "paper"
+        y = np.cumsum(rng.normal(size=(n_steps, 3)), axis=0)
+        dmp = DMP(**settings).fit(y, np.arange(n_steps) / rng.uniform(10, 1000))
+        _, rows = dmp.grid_basis()
+        band = _band_of(rows)
+        assert band is not None and band.values.shape[1] < rows.shape[1] / 2
+        weights, target = dmp.weights_, rng.normal(size=(rows.shape[0], 3))
+        peaks, eps = np.abs(rows).max(axis=1, keepdims=True), np.finfo(float).eps
+        bound = rows.shape[1] * eps * (np.abs(rows) @ np.abs(weights))
+        bound += 1e-16 * peaks * np.abs(weights).sum(axis=0)
+        assert np.all(np.abs(band.product(weights) - rows @ weights) <= bound)
+        bound = rows.shape[0] * eps * (np.abs(rows).T @ np.abs(target))
+        bound += 1e-16 * (peaks * np.abs(target)).sum(axis=0)
+        assert np.all(np.abs(band.transposed_product(target) - rows.T @ target) <= bound)
+    overlapping = np.ones((20, 10))  # every function everywhere: no band
+    assert _band_of(overlapping) is None
 
 
 def test_every_planted_bug_of_the_kernel_mutation_tool_still_has_its_place():

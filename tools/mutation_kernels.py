@@ -153,6 +153,28 @@ MUTANTS = (
         "            peak = 0.0\n            for i in range(n - 1 - order):",
         "            peak = -1.0\n            for i in range(n - 1 - order):",
     ),
+    # a band's edges: the last column searched from the wrong end, NaN not mattering
+    Mutant(
+        "band_of",
+        "for j in range(n_columns - 1, -1, -1):",
+        "for j in range(n_columns):",
+    ),
+    Mutant(
+        "band_of",
+        "                if not fabs(rows[i, j]) <= bound:\n                    first[i] = j",
+        "                if fabs(rows[i, j]) > bound:\n                    first[i] = j",
+    ),
+    # the band's products: a column off by one, a row's start dropped
+    Mutant(
+        "band_product",
+        "total = total + values[i, j] * weights[start + j, k]",
+        "total = total + values[i, j] * weights[start + j - 1, k]",
+    ),
+    Mutant(
+        "band_transposed_product",
+        "                value = values[i, j]\n                column = first[i] + j",
+        "                value = values[i, j]\n                column = j",
+    ),
 )
 
 

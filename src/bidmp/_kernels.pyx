@@ -14,7 +14,11 @@ one call, what whole chains of them did:
   goal gate (:func:`goal_gate`) and a path's arc length (:func:`arclength`), each element the
   same operations in the same order as the NumPy expressions they replaced (compiled without
   fused multiply-adds), so every result keeps its last bit. Powers and exponentials stay in NumPy: its vectorised ones are not the C
-  library's to the bit.
+  library's to the bit;
+* the basis products of a fit and a rollout on the rows' band (:func:`band_of`,
+  :func:`band_product`, :func:`band_transposed_product`): these replaced dense BLAS products
+  and round differently from them (a basis row is a dozen kernels over a floor of 1e-20; the
+  dense rows were most of the memory a fit and a rollout read).
 
 The tests check each loop against an independent reference to the last bit (SciPy's ``lfilter``,
 NumPy's ``gradient`` expressions, plain searches) on random inputs.
@@ -24,7 +28,7 @@ about a millisecond, where numba's import and cached kernels cost 0.1-0.3 s of e
 fits a DMP.
 """
 
-from libc.math cimport INFINITY, atan2, cos, floor, sin, sqrt
+from libc.math cimport INFINITY, atan2, cos, fabs, floor, sin, sqrt
 
 from numpy import array, empty
 
@@ -700,4 +704,76 @@ def motion_peaks(const double[:, :] points, double dt):
                 if total > peak or total != total:
                     peak = total
             out[order] = peak
+    return out.base
+
+
+
+def band_of(const double[:, ::1] rows, double share):
+    """Where each row of ``rows`` (n, N) matters: ``(first (n,), last (n,))``, the first and last
+    column whose magnitude exceeds ``share`` times the row's largest (column 0 for a row of
+    zeros); a NaN always matters."""
+    cdef Py_ssize_t n = rows.shape[0], n_columns = rows.shape[1], i, j
+    cdef long long[::1] first = empty(n, dtype="int64")
+    cdef long long[::1] last = empty(n, dtype="int64")
+    cdef double bound, size
+    cdef double peaks[4]
+    with nogil:
+        for i in range(n):
+            # four running peaks: one chain of comparisons would wait on each one's latency
+            peaks[0] = peaks[1] = peaks[2] = peaks[3] = 0.0
+            for j in range(n_columns):
+                size = fabs(rows[i, j])
+                peaks[j & 3] = size if size > peaks[j & 3] else peaks[j & 3]
+            bound = share * max(max(peaks[0], peaks[1]), max(peaks[2], peaks[3]))
+            first[i] = 0
+            last[i] = 0
+            for j in range(n_columns):
+                if not fabs(rows[i, j]) <= bound:
+                    first[i] = j
+                    break
+            for j in range(n_columns - 1, -1, -1):
+                if not fabs(rows[i, j]) <= bound:
+                    last[i] = j
+                    break
+    return first.base, last.base
+
+
+def band_product(const double[:, ::1] values, const long long[::1] first, const double[:, ::1] weights):
+    """``rows @ weights`` (n, D) for basis rows stored as a band: row ``i``'s nonzero columns are
+    ``first[i] … first[i] + w - 1``, their values ``values[i]`` (n, w); ``weights`` (N, D). Each
+    output the band's products summed in column order."""
+    cdef Py_ssize_t n = values.shape[0], width = values.shape[1], n_dims = weights.shape[1]
+    cdef Py_ssize_t i, j, k, start
+    cdef double[:, ::1] out = empty((n, n_dims))
+    cdef double total
+    with nogil:
+        for i in range(n):
+            start = first[i]
+            for k in range(n_dims):
+                total = 0.0
+                for j in range(width):
+                    total = total + values[i, j] * weights[start + j, k]
+                out[i, k] = total
+    return out.base
+
+
+def band_transposed_product(
+    const double[:, ::1] values, const long long[::1] first, const double[:, ::1] target, Py_ssize_t n_columns
+):
+    """``rowsᵀ @ target`` (N, D) for basis rows stored as a band (:func:`band_product`), ``target``
+    (n, D), ``N = n_columns``."""
+    cdef Py_ssize_t n = values.shape[0], width = values.shape[1], n_dims = target.shape[1]
+    cdef Py_ssize_t i, j, k, column
+    cdef double[:, ::1] out = empty((n_columns, n_dims))
+    cdef double value
+    with nogil:
+        for column in range(n_columns):
+            for k in range(n_dims):
+                out[column, k] = 0.0
+        for i in range(n):
+            for j in range(width):
+                value = values[i, j]
+                column = first[i] + j
+                for k in range(n_dims):
+                    out[column, k] = out[column, k] + value * target[i, k]
     return out.base

@@ -69,7 +69,7 @@ from .goals import (
     _learn_goal_gate,
     _learned_progress_gate,
 )
-from .grid import _cached_grid, _rollout_grid, _store_grid
+from .grid import _cached_grid, _grid_entry, _rollout_grid, _store_grid
 from .integrate import _check_integration, _unit_responses
 from .protocols import (
     DERIVATIVE_CHOICES,
@@ -343,7 +343,7 @@ class DMP(_FittedParams, Estimator):
             # transfer, a 17 rad/s² spike on a wrist that the demonstration moved at 1.7.
             params = params._replace(keep_approach=False)
         gate = _learn_goal_gate(train, n_steps, dt, params, progress, y)
-        weights, centres, widths, phase, phi = _learn_weights(train, dt, gate, params)
+        weights, centres, widths, phase, phi, band = _learn_weights(train, dt, gate, params)
         self.weights_ = weights
         self.start_ = y[0].copy()
         self.goal_ = y[-1].copy()
@@ -367,6 +367,7 @@ class DMP(_FittedParams, Estimator):
             None
             if params.goal_rate is not None
             else _gate_past_training(gate, phase, params.canonical_system),
+            band,
         )
         logger.debug(
             "fitted DMP on %d samples in %d dimension(s) over %.4g s", n_steps, y.shape[1], duration
@@ -525,7 +526,7 @@ class DMP(_FittedParams, Estimator):
         n_steps = self._n_steps(n_steps, params)
         cached = _cached_grid(self, params, n_steps, self.dt_)
         if cached is not None:
-            goal_response = cached[5][0]
+            goal_response = cached.responses[0]
         else:  # B needs no basis matrix, and other horizons should not evict the cached grid
             phase = params.canonical_system.grid(n_steps, self.dt_, params.tau)
             gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
@@ -551,12 +552,12 @@ class DMP(_FittedParams, Estimator):
         velocity = (
             None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
         )
-        phase, basis, (goal_response, start_response, velocity_response), gate = _rollout_grid(
-            self, params, n_steps, step
-        )
+        grid = _grid_entry(self, params, n_steps, step)
+        phase, basis, gate = grid.phase, grid.basis, grid.gate
+        goal_response, start_response, velocity_response = grid.responses
         # via-points: a change of the weights
         change = getattr(forcing_increment, "weight_change", None)
-        forcing = basis @ (self.weights_ if change is None else self.weights_ + change)
+        forcing = grid.forcing(self.weights_ if change is None else self.weights_ + change)
         if change is not None:
             forcing_increment = forcing_increment.wrapped
         if forcing_increment is not None:

@@ -28,6 +28,7 @@ from .._checks import (
     check_real,
 )
 from .._kernels import forcing_target
+from .band import _band_of
 from .canonical import _checked_phase_args, _phase_decay
 from .gains import _Gains
 
@@ -255,12 +256,16 @@ def _solve_weights(
     kind, values = factor
     if kind == "lwr":
         weights = (phi.T @ target) / values[:, None]
+    elif kind == "banded":
+        # A grid's cached (ΦᵀΦ + λ I)⁻¹ and Φ as a band: Φᵀ f reads the band only, and the solve
+        # is one small product. It rounds differently from a solve on ΦᵀΦ f: the weights agree
+        # to ~1e-11 of their size (the Gram matrix's condition, ~1e5, times the rounding).
+        inverse, band = values
+        weights = inverse @ band.transposed_product(target)
+    elif kind == "banded-lwr":
+        denominators, band = values
+        weights = band.transposed_product(target) / denominators[:, None]
     else:
-        # NumPy's LU each time, though the matrix is the same for every fit on this grid: a cached
-        # Cholesky factor or SciPy's cached LU moves the weights' last bits (a simulated contact
-        # can amplify those into the results: the Cholesky factor's did), and SciPy's OpenBLAS is
-        # a second thread pool, whose idle threads spun against NumPy's here (0.9 ms fits took
-        # 1-5 ms on two cores).
         weights = np.linalg.solve(values, phi.T @ target)
     if not np.all(np.isfinite(weights)):
         raise ValueError(
@@ -278,19 +283,30 @@ def _readonly(*arrays: np.ndarray) -> None:
 def _cached_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
     design = _training_design(canonical, basis, n_train, dt, regression, ridge)
     # Shared by every fit on this grid: nobody may write into them.
-    _readonly(*design[:4], design[4][1])
+    _readonly(*design[:4])
+    if isinstance(design[4][1], np.ndarray):
+        _readonly(design[4][1])
     return design
 
 
 def _training_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
     """Everything a fit needs that does not depend on the demonstration's values: the phase and
     basis rows one sample past the training grid (n + 1,), (n + 1, N), the kernels' centres and
-    widths (N,), and the regression's factor."""
+    widths (N,), the regression's factor, and the rows as a band (or None)."""
     grid_phase = canonical.grid(n_train + 1, dt, 1.0)
     centres, widths = basis.place(canonical, n_train, dt)
     grid_phi = basis.rows(grid_phase, centres, widths)
     factor = _regression_factor(grid_phi[:n_train], grid_phase[:n_train], regression, ridge)
-    return grid_phase, grid_phi, centres, widths, factor
+    band = _band_of(grid_phi)
+    if band is not None:
+        # Every fit on this grid regresses on the same rows: they are kept as a band, and ridge's
+        # matrix inverted once (NumPy's; SciPy's OpenBLAS is a second thread pool, whose idle
+        # threads spun against NumPy's here: 0.9 ms fits took 1-5 ms on two cores).
+        kind, values = factor
+        values = np.linalg.inv(values) if kind == "ridge" else values
+        _readonly(values)
+        factor = ("banded" if kind == "ridge" else "banded-lwr", (values, band.head(n_train)))
+    return grid_phase, grid_phi, centres, widths, factor, band
 
 
 def _learn_weights(
@@ -307,8 +323,9 @@ def _learn_weights(
 
     Returns
     -------
-    (weights (N, D), centres (N,), widths (N,), phase (n + 1,), basis rows (n + 1, N)): the grid
-    one sample past the training grid
+    (weights (N, D), centres (N,), widths (N,), phase (n + 1,), basis rows (n + 1, N), the
+    rows as a :class:`~bidmp.primitives.band._Band` or None): the grid one sample past the
+    training grid
     """
     n_train = train.shape[0]
     canonical, basis = params.canonical_system, params.basis
@@ -321,7 +338,7 @@ def _learn_weights(
         design = _cached_design(*key)
     # One sample past the training grid: a timed trajectory's rollout asks for it (the state's
     # derivatives at the last sample), and then shares the grid cached from here.
-    grid_phase, grid_phi, centres, widths, factor = design
+    grid_phase, grid_phi, centres, widths, factor, band = design
     phase, phi = grid_phase[:n_train], grid_phi[:n_train]
     target = _forcing_target(
         train,
@@ -333,7 +350,7 @@ def _learn_weights(
         gate=gate,
     )
     weights = _solve_weights(factor, phi, target)
-    return np.ascontiguousarray(weights), centres, widths, grid_phase, grid_phi
+    return np.ascontiguousarray(weights), centres, widths, grid_phase, grid_phi, band
 
 
 def _check_forcing_increment(forcing_increment, name: str = "forcing_increment") -> None:
