@@ -41,7 +41,7 @@ def test_bidmp_succeeds_everywhere_with_the_two_level_pattern(nut):
     assert np.ptp(middle) <= 2 * own + 0.02 and np.ptp(outer) <= 2 * own + 0.02
     assert max(middle) + 0.05 < min(outer) < 0.8
     # The two levels are the horizon artefact around the new skill's goal: c · ‖g − g_n‖.
-    gain = DMP(**nut.scenario.dmp).fit(nut.scenario.demonstration).endpoint_gain()
+    gain = DMP(**nut.scenario.dmp.arguments).fit(nut.scenario.demonstration).endpoint_gain()
     assert np.mean(outer) == pytest.approx(gain * np.hypot(30, 25), abs=0.05)
     assert np.mean(middle) == pytest.approx(gain * 25, abs=0.05)
 
@@ -137,7 +137,7 @@ def test_pick_and_place_learns_every_operator_faithfully():
         learned = report.model.rollout(demonstration[-1], start=demonstration[0])[
             : len(demonstration)
         ]
-        scratch = DMP(**scenario.dmp).fit(demonstration).rollout()[: len(demonstration)]
+        scratch = DMP(**scenario.dmp.arguments).fit(demonstration).rollout()[: len(demonstration)]
         errors = [
             np.sqrt(np.mean(np.sum((r - demonstration) ** 2, axis=1))) for r in (learned, scratch)
         ]

@@ -157,7 +157,10 @@ def test_scenario_sets_bidmp_and_extension_parameters():
         )
     )
     scenario = scenarios.from_dict(data)
-    assert scenario.bidmp == {"reg": 1e-2, "increments": (5,)} and scenario.extension.flat == {
+    assert scenario.bidmp.arguments == {
+        "reg": 1e-2,
+        "increments": (5,),
+    } and scenario.extension.flat == {
         "n_iter": 3,
         "n_samples": 120,
     }
@@ -183,7 +186,7 @@ def test_replace_checks_the_changed_keys_as_a_file_and_leaves_the_scenario_as_it
     assert paper.spec["extension"]["n_iter"] == 4 and nuts.spec == before
     robot = load("nut-unscrewing").replace(dmp={"protocol": "paper", "n_kernels": 30})
     assert robot.protocol == "paper" and robot.with_robot_protocol().protocol == "robot"
-    assert robot.with_robot_protocol().dmp == {"protocol": "robot", "n_kernels": 30}
+    assert robot.with_robot_protocol().dmp.arguments == {"protocol": "robot", "n_kernels": 30}
     fewer = nuts.replace(targets={label: nuts.spec["targets"][label] for label in ("1", "3")})
     assert fewer.labels == ["1", "3"] and len(nuts.labels) == 14
     with pytest.raises(ScenarioError, match="extension.*n_iter must be >= 1"):

@@ -370,12 +370,15 @@ class ProDMP(Estimator):
             raise ValueError("times must be >= 0 and non-decreasing (s)")
         return times
 
-    def _boundary(self, start, start_velocity) -> tuple[np.ndarray, np.ndarray]:
-        start = self.start_ if start is None else as_points(start, self.n_dims_, "start")
+    def _boundary(
+        self, start, start_velocity, names=("start", "start_velocity")
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Start(s) and start velocity(ies) as points, refused by the caller's argument ``names``."""
+        start = self.start_ if start is None else as_points(start, self.n_dims_, names[0])
         velocity = (
             np.zeros_like(start)
             if start_velocity is None
-            else as_points(start_velocity, self.n_dims_, "start_velocity")
+            else as_points(start_velocity, self.n_dims_, names[1])
         )
         if velocity.shape != start.shape:
             velocity = np.broadcast_to(velocity, start.shape)
@@ -402,7 +405,9 @@ class ProDMP(Estimator):
         still one product)."""
         self._check_fitted()
         t = self._times(times, None)
-        starts, velocities = self._boundary(starts, start_velocities)
+        starts, velocities = self._boundary(
+            starts, start_velocities, ("starts", "start_velocities")
+        )
         size, dims, n_times = self.basis_.n_basis + 1, self.n_dims_, len(t)
         mean = (
             self.weight_mean_

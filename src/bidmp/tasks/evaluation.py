@@ -69,7 +69,7 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
     """Build the scenario's Bi-DMP: chained extensions, then further demonstrations. A stage the
     roadmap finds no free route for is skipped and recorded in ``route_failures`` (the targets it
     was for then fail on their own; the rest of the evaluation goes on)."""
-    model = BiDMP(dmp, **scenario.bidmp)
+    model = BiDMP(dmp, **scenario.bidmp.arguments)
     extensions, targets = [], []
     previous = None
     # The paper's protocol knows no battery geometry: approach "paper" grows the extension blind.
@@ -148,7 +148,7 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
     from ..extension.extend import extend_pose_demonstration
     from ..incremental.cartesian import CartesianBiDMP
 
-    model = CartesianBiDMP(cartesian, **scenario.bidmp)
+    model = CartesianBiDMP(cartesian, **scenario.bidmp.arguments)
     previous = None
     options = scenario.extension_arguments
     del options["approach"]  # a pose extension keeps the approach
@@ -264,8 +264,8 @@ def evaluate(
         scenario.demonstration,
         goals,
         seed=scenario.seed,
-        dmp=scenario.dmp,
-        bidmp=scenario.bidmp,
+        dmp=scenario.dmp.arguments,
+        bidmp=scenario.bidmp.arguments,
         poses=scenario.is_pose,
     )
     if repair is None:
@@ -298,7 +298,10 @@ def evaluate(
     if scenario.demonstrations and not report.forgetting and not scenario.is_pose:
         dmp, _ = task.fitted_dmp()
         report.forgetting = forgetting_runs(
-            dmp, list(scenario.demonstrations.values()), ("nearest", "latest"), **scenario.bidmp
+            dmp,
+            list(scenario.demonstrations.values()),
+            ("nearest", "latest"),
+            **scenario.bidmp.arguments,
         )
     return report
 

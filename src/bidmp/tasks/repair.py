@@ -50,6 +50,7 @@ from .._checks import (
 )
 from .._units import length_text
 from .contract import Contract, Verdict
+from .options import BiDMPOptions
 
 if TYPE_CHECKING:
     from ..extension import ExtensionOptions
@@ -199,8 +200,9 @@ class Repairer:
         The repairs to try, in order (a subset of :data:`REPAIRS`).
     allowance : float
         Scene units added to the margin the repairs plan for (what execution may take off it).
-    bidmp : dict
-        Parameters of a Bi-DMP built when the model is a plain DMP (``extend`` needs one).
+    bidmp : bidmp.tasks.BiDMPOptions or dict
+        Parameters of a Bi-DMP built when the model is a plain DMP (``extend`` needs one): a
+        scenario's ``bidmp``, or its keyword arguments.
     """
 
     def __init__(
@@ -212,7 +214,7 @@ class Repairer:
         seed: int = 0,
         order=REPAIRS,
         allowance: float = 0.0,
-        bidmp: dict | None = None,
+        bidmp: BiDMPOptions | dict | None = None,
     ) -> None:
         if not isinstance(contract, Contract):
             raise TypeError(
@@ -237,7 +239,10 @@ class Repairer:
             extension = ExtensionOptions.from_flat(check_options(extension, "extension"))
         self.extension = extension.replace(approach="keep").arguments
         check_seed(seed, "seed")
-        self.seed, self.order, self.bidmp = seed, tuple(order), check_options(bidmp, "bidmp")
+        if not isinstance(bidmp, BiDMPOptions):
+            bidmp = BiDMPOptions.from_flat(check_options(bidmp, "bidmp"))
+        # the Bi-DMP's keyword arguments
+        self.seed, self.order, self.bidmp = seed, tuple(order), bidmp.arguments
         self.allowance = check_real(allowance, "allowance", nonnegative=True)
         self.planning = self._widened(self.allowance)
 

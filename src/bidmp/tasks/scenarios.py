@@ -82,6 +82,7 @@ from ._scenario_fields import (
     _robot,
     _shown,
 )
+from .options import BiDMPOptions, DMPOptions
 
 if TYPE_CHECKING:
     from ..extension import ExtensionOptions
@@ -177,8 +178,8 @@ class Scenario:
     demonstration: np.ndarray
     success_threshold: float
     approach_height: float | None
-    dmp: dict
-    bidmp: dict
+    dmp: DMPOptions
+    bidmp: BiDMPOptions
     extension: ExtensionOptions
     extensions: list[dict]
     demonstrations: dict[str, np.ndarray]
@@ -244,7 +245,7 @@ class Scenario:
     @property
     def protocol(self) -> str:
         """The DMP protocol of the scenario's skills ("robot", the default, or "paper")."""
-        return self.dmp.get("protocol", "robot")
+        return self.dmp.protocol_name
 
     def replace(self, **changes) -> Scenario:
         """This scenario with keys of its file changed (``scenario.replace(extension={...})``),
@@ -333,13 +334,13 @@ def _parameter_objects(data: dict, source: str) -> dict:
     """The parameter objects of a scenario file (``dmp``, ``bidmp``, ``extension``), each checked
     by what takes it (a DMP's, a Bi-DMP's, an extension's own checks)."""
     from ..extension import ExtensionOptions
-    from ..incremental.bidmp import BiDMP
-    from ..primitives.dmp import DMP
 
     return {
-        "dmp": _parameters(data, "dmp", _DMP_KEYS, source, lambda p: DMP(**p)._params()),
-        "bidmp": _parameters(
-            data, "bidmp", _BIDMP_KEYS, source, lambda p: BiDMP(**p)._check_params()
+        "dmp": DMPOptions.from_flat(
+            _parameters(data, "dmp", _DMP_KEYS, source, DMPOptions.from_flat)
+        ),
+        "bidmp": BiDMPOptions.from_flat(
+            _parameters(data, "bidmp", _BIDMP_KEYS, source, BiDMPOptions.from_flat)
         ),
         "extension": ExtensionOptions.from_flat(
             _parameters(data, "extension", _EXTENSION_KEYS, source, ExtensionOptions.from_flat)
@@ -647,11 +648,12 @@ def _scene(data, source: str, targets: dict, n_dims: int):
         raise type(exc)(f"scenario {source}: {exc}") from None
 
 
-def _check_runs(source: str, demonstration: np.ndarray, targets: dict, dmp_params: dict) -> None:
+def _check_runs(source: str, demonstration: np.ndarray, targets: dict, options: DMPOptions) -> None:
     """What ``evaluate`` does first, so that a scenario that loads also runs: fit the DMP on
     the demonstration and roll it out to every target (about a millisecond)."""
     from ..primitives.dmp import DMP
 
+    dmp_params = options.arguments
     try:
         if demonstration.shape[1] == POSE_DIMS:
             from ..primitives.cartesian import CartesianDMP

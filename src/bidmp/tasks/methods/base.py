@@ -87,6 +87,13 @@ class Task:
                 f"{self.demonstration.shape[1]}"
             )
         check_seed(self.seed, "seed")
+        from ..options import BiDMPOptions, DMPOptions
+
+        # a scenario's options objects, or their keyword arguments
+        if isinstance(self.dmp, DMPOptions):
+            self.dmp = self.dmp.arguments
+        if isinstance(self.bidmp, BiDMPOptions):
+            self.bidmp = self.bidmp.arguments
         self.dmp, self.bidmp = check_options(self.dmp, "dmp"), check_options(self.bidmp, "bidmp")
         if self.build_skills is not None:
             check_callable(

@@ -1,0 +1,123 @@
+"""A scenario's skill options as checked objects: its ``"dmp"`` and ``"bidmp"`` objects.
+
+Each is the keyword arguments of the estimator it configures (:class:`bidmp.DMP`,
+:class:`bidmp.BiDMP`), checked once when made by the estimator's own checks (a ``ValueError`` or
+``TypeError`` naming the first bad one); an option left ``None`` is the estimator's default.
+``arguments`` gives them back as keyword arguments, ``flat`` as a scenario file writes them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+__all__ = ["BiDMPOptions", "DMPOptions"]
+
+
+class _EstimatorOptions:
+    """What both option objects share: their fields are an estimator's keyword arguments."""
+
+    def __post_init__(self) -> None:
+        self._check(self.arguments)
+
+    @staticmethod
+    def _check(arguments: dict) -> None:  # pragma: no cover - each subclass has its own
+        raise NotImplementedError
+
+    @classmethod
+    def from_flat(cls, options: dict | None = None):
+        """The options from a scenario file's form (``{"n_kernels": 30, ...}``); an unknown name
+        is a ``TypeError`` listing the known ones."""
+        if options is None:
+            options = {}
+        if not isinstance(options, dict) or not all(isinstance(key, str) for key in options):
+            raise TypeError(
+                f"{cls.__name__} options must be a dict with string keys, got {type(options).__name__}"
+            )
+        known = [field.name for field in dataclasses.fields(cls)]
+        unknown = sorted(set(options) - set(known))
+        if unknown:
+            raise TypeError(f"unknown option {unknown[0]!r} (known: {', '.join(sorted(known))})")
+        return cls(**options)
+
+    @property
+    def arguments(self) -> dict:
+        """The keyword arguments of the estimator: the options that are set."""
+        return {
+            field.name: getattr(self, field.name)
+            for field in dataclasses.fields(self)
+            if getattr(self, field.name) is not None
+        }
+
+    @property
+    def flat(self) -> dict:
+        """A scenario file's form of the options (:meth:`from_flat` reads it back)."""
+        return {
+            key: list(value) if isinstance(value, tuple) else value
+            for key, value in self.arguments.items()
+        }
+
+    def replace(self, **changes):
+        """These options with ``changes`` (checked again)."""
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class DMPOptions(_EstimatorOptions):
+    """A scenario's DMP: the keyword arguments of :class:`bidmp.DMP` it sets (units as there:
+    gains in 1/s, ``tau`` a time scale), each ``None`` for the DMP's default (the protocol's).
+
+    ``protocol`` is "robot" (the default) or "paper"; the rest are the DMP's parameters of the
+    same names.
+    """
+
+    protocol: str | None = None
+    n_kernels: int | None = None
+    alpha: float | None = None
+    beta: float | None = None
+    K: float | str | None = None
+    alpha_phase: float | None = None
+    tau: float | None = None
+    regression: str | None = None
+    widths: str | None = None
+    derivatives: str | None = None
+    keep_approach: bool | None = None
+    goal_rate: float | None = None
+
+    @staticmethod
+    def _check(arguments: dict) -> None:
+        from ..primitives.dmp import DMP
+
+        DMP(**arguments)._params()
+
+    @property
+    def protocol_name(self) -> str:
+        """The protocol in use: "robot" unless "paper" is set."""
+        return self.protocol or "robot"
+
+
+@dataclass(frozen=True)
+class BiDMPOptions(_EstimatorOptions):
+    """A scenario's Bi-DMP: the keyword arguments of :class:`bidmp.BiDMP` it sets (its broad
+    learning system's sizes, regularisation, increments and seed), each ``None`` for the
+    Bi-DMP's default."""
+
+    n_windows: int | None = None
+    n_mapped: int | None = None
+    n_enhance: int | None = None
+    increments: tuple | None = None
+    shrink: float | None = None
+    reg: float | None = None
+    seed: int | None = None
+    derivatives: str | None = None
+
+    def __post_init__(self) -> None:
+        if isinstance(self.increments, list):  # as a file writes them
+            object.__setattr__(self, "increments", tuple(self.increments))
+        super().__post_init__()
+
+    @staticmethod
+    def _check(arguments: dict) -> None:
+        from ..incremental.bidmp import BiDMP
+
+        BiDMP(**arguments)._check_params()

@@ -1,0 +1,66 @@
+"""A scenario's ``dmp`` and ``bidmp`` objects as checked options (``bidmp.tasks.DMPOptions``,
+``BiDMPOptions``): refused when the estimator would refuse them, read back from their file form,
+and the same skill whichever way they are passed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bidmp import DMP, BiDMP
+from bidmp.tasks import BiDMPOptions, Contract, DMPOptions, scenarios
+from bidmp.tasks.methods import Task
+from bidmp.tasks.repair import Repairer
+
+
+@pytest.mark.parametrize(
+    ("options", "error", "names"),
+    [
+        ({"n_kernels": 0}, ValueError, "n_kernels"),
+        ({"protocol": "fast"}, ValueError, "protocol"),
+        ({"alpha": "stiff"}, TypeError, "alpha"),
+        ({"kernels": 30}, TypeError, "kernels"),
+    ],
+)
+def test_dmp_options_are_refused_as_the_dmp_refuses_them(options, error, names):
+    with pytest.raises(error, match=names):
+        DMPOptions.from_flat(options)
+    with pytest.raises(scenarios.ScenarioError, match=names):
+        scenarios.load("nut-unscrewing").replace(dmp=options)
+
+
+def test_bidmp_options_are_refused_as_the_bidmp_refuses_them():
+    with pytest.raises(ValueError, match="n_enhance"):
+        BiDMPOptions(n_enhance=-1)
+    with pytest.raises(TypeError, match="windows"):
+        BiDMPOptions.from_flat({"windows": 3})
+    scenario = scenarios.load("nut-unscrewing")
+    with pytest.raises(TypeError, match="bidmp"):
+        Repairer(Contract.of(scenario), scenario.demonstration, bidmp=[("reg", 0.01)])
+    with pytest.raises(TypeError, match="shrinking"):
+        Repairer(Contract.of(scenario), scenario.demonstration, bidmp={"shrinking": 0.5})
+
+
+def test_options_read_back_from_their_file_form_and_leave_defaults_unset():
+    for scenario in (scenarios.load(name) for name in scenarios.builtin_names()):
+        assert DMPOptions.from_flat(scenario.dmp.flat) == scenario.dmp
+        assert BiDMPOptions.from_flat(scenario.bidmp.flat) == scenario.bidmp
+        assert scenario.dmp.flat == scenario.spec.get("dmp", {})
+    options = BiDMPOptions.from_flat({"increments": [5, 5], "reg": 0.01})
+    assert options.increments == (5, 5) and options.flat == {"increments": [5, 5], "reg": 0.01}
+    assert DMPOptions().arguments == {} and DMPOptions().protocol_name == "robot"
+
+
+def test_a_skill_is_the_same_from_the_options_or_their_arguments():
+    """A Task given the options objects fits what one given their keyword arguments fits, and
+    both are the DMP built by hand from the file's numbers (n_kernels 30, alpha 40)."""
+    y = np.cumsum(np.random.default_rng(3).normal(size=(200, 3)), axis=0)
+    options = DMPOptions(n_kernels=30, alpha=40.0)
+    by_object = Task(y, y[-1:], dmp=options, bidmp=BiDMPOptions(reg=0.01))
+    by_arguments = Task(y, y[-1:], dmp={"n_kernels": 30, "alpha": 40.0}, bidmp={"reg": 0.01})
+    assert by_object.dmp == by_arguments.dmp and by_object.bidmp == by_arguments.bidmp
+    fitted, _ = by_object.fitted_dmp()
+    by_hand = DMP(n_kernels=30, alpha=40.0).fit(y)
+    assert fitted.weights_.shape == (30, 3)
+    np.testing.assert_array_equal(fitted.rollout(), by_hand.rollout())
+    assert BiDMP(by_hand, **BiDMPOptions(reg=0.01).arguments).reg == 0.01
