@@ -104,7 +104,7 @@ def test_the_robot_moves_from_its_base_to_the_target(nut_layers):
     nut, layers = nut_layers
     motion = layers.robot["bidmp -> 11"]
     links, times = motion["links"], motion["times"]
-    base = np.asarray(nut.robot["base"], dtype=float)
+    base = np.asarray(nut.robot.base, dtype=float)
     np.testing.assert_allclose(links[:, 0], np.broadcast_to(base, links[:, 0].shape), atol=1e-6)
     assert np.linalg.norm(links[-1, -1] - nut.targets["11"]) <= nut.success_threshold
     assert np.all(np.diff(times) > 0) and times[-1] > 1.0

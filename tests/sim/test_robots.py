@@ -120,7 +120,7 @@ def test_a_urdf_named_in_the_scenario(tmp_path):
     local = scenarios.from_dict(
         nut_spec(urdf="arm.urdf", flange="tool0", limits=limits), base_dir=tmp_path
     )
-    assert local.robot["urdf"] == str((tmp_path / "arm.urdf").resolve())
+    assert local.robot.urdf == str((tmp_path / "arm.urdf").resolve())
     with pytest.raises(ValueError, match="no link 'tool0'"):
         sim.simulate(local, ["dmp"], targets=["3"], workers=1)
 

@@ -1,14 +1,17 @@
-"""A scenario's ``dmp`` and ``bidmp`` objects as checked options (``bidmp.tasks.DMPOptions``,
-``BiDMPOptions``): refused when the estimator would refuse them, read back from their file form,
-and the same skill whichever way they are passed."""
+"""A scenario's ``dmp``, ``bidmp`` and ``robot`` objects as checked options
+(``bidmp.tasks.DMPOptions``, ``BiDMPOptions``, ``RobotOptions``): refused where what takes them
+would refuse them, read back from their file form, and the same skill or arm whichever way they
+are passed."""
 
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 import pytest
 
 from bidmp import DMP, BiDMP
-from bidmp.tasks import BiDMPOptions, Contract, DMPOptions, scenarios
+from bidmp.tasks import BiDMPOptions, Contract, DMPOptions, RobotOptions, scenarios
 from bidmp.tasks.methods import Task
 from bidmp.tasks.repair import Repairer
 
@@ -64,3 +67,27 @@ def test_a_skill_is_the_same_from_the_options_or_their_arguments():
     assert fitted.weights_.shape == (30, 3)
     np.testing.assert_array_equal(fitted.rollout(), by_hand.rollout())
     assert BiDMP(by_hand, **BiDMPOptions(reg=0.01).arguments).reg == 0.01
+
+
+def test_robot_options_read_back_and_place_the_same_arm(tmp_path):
+    """Every built-in scenario's arm: its options read back from their file form, and the model
+    and placement the simulator builds from the options are the ones it builds from the file's
+    own dict (robot_model and robot_placement take either)."""
+    from bidmp import sim
+    from bidmp.sim.robots import robot_placement
+
+    for scenario in (scenarios.load(name) for name in scenarios.builtin_names()):
+        robot = scenario.robot
+        assert RobotOptions.from_flat(robot.flat) == robot
+        assert robot.flat == scenario.spec.get("robot", {})
+        assert sim.robot_model(robot) is sim.robot_model(scenario.spec.get("robot"))
+        as_dict = dataclasses.replace(scenario, robot=scenario.spec.get("robot", {}))
+        for ours, theirs in zip(robot_placement(scenario), robot_placement(as_dict)):
+            np.testing.assert_array_equal(ours, theirs)
+    assert not RobotOptions().own_arm and RobotOptions().flat == {}
+    with pytest.raises(scenarios.ScenarioError, match="robot.model"):
+        RobotOptions.from_flat({"model": "abb"})
+    with pytest.raises(scenarios.ScenarioError, match="flange"):
+        RobotOptions.from_flat({"flange": "tool0"})  # an own arm's key without its urdf
+    with pytest.raises(TypeError, match="spec"):
+        sim.robot_model(["panda"])

@@ -223,7 +223,7 @@ def _cmd_scenario(args: argparse.Namespace) -> int:
         sys.stdout.write(builtin_text(args.name))
         return EXIT_OK
     scenario = load(args.file, allow_outside_files=args.allow_outside_files)  # what demo validates
-    if scenario.robot and "urdf" in scenario.robot:  # the arm's own file, as the simulator reads it
+    if scenario.robot.own_arm:  # the arm's own file, as the simulator reads it
         from ..sim.robots import robot_model
 
         robot_model(scenario.robot, scenario.base_dir)

@@ -15,8 +15,6 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
-from .._checks import short_token
-
 __all__ = ["MODEL_KINDS", "PrimitiveKind", "kind_of", "model_class", "register_kind"]
 
 # What bidmp rollout does with a family: "point" — a DMP to a goal (the pose, skill and robot
@@ -78,6 +76,8 @@ class PrimitiveKind:
             if value is None and field_name != "path":
                 continue
             if not isinstance(value, str) or value.count(":") != 1 or len(value) > 200:
+                from .._checks import short_token  # not at import: the CLI's help needs no NumPy
+
                 raise ValueError(
                     f"{field_name} must be 'module:attribute', got {short_token(value, 80)}"
                 )

@@ -249,18 +249,23 @@ ROBOT_NAMES = {
 }
 
 
-def robot_model(spec: dict | None, base_dir=None) -> RobotModel:
+def robot_model(spec, base_dir=None) -> RobotModel:
     """The arm a scenario's ``"robot"`` key names: ``"model"`` (one of :data:`ROBOT_MODELS`, default
     ``"panda"``), or its own ``"urdf"`` (inside the scenario's folder ``base_dir``, or shipped by
     ``pybullet_data``) with ``"flange"`` and ``"limits"`` ({"lower", "upper", "velocity",
     "acceleration", "jerk"}, one value per joint, rad) and optionally ``"rest"`` (one per joint, rad)
     and ``"effort"`` (one per joint, N m). The key is checked as a scenario file's is; the URDF must
-    be a regular ``.urdf`` file within the file size limit."""
+    be a regular ``.urdf`` file within the file size limit. ``spec``: a scenario's
+    :class:`~bidmp.tasks.RobotOptions`, or the key's dict, or None (the Panda)."""
+    from ..tasks.options import RobotOptions
     from ..tasks.scenarios import check_robot
 
+    if isinstance(spec, RobotOptions):  # a scenario's, checked when it loaded: its file form
+        spec = spec.flat
     if spec is not None and not isinstance(spec, dict):
         raise TypeError(
-            f'spec must be a scenario\'s "robot" object (a dict) or None, got {type(spec).__name__}'
+            f'spec must be a scenario\'s "robot" (a bidmp.tasks.RobotOptions or its dict) or None, '
+            f"got {type(spec).__name__}"
         )
     folder = "." if base_dir is None else check_path(base_dir, "base_dir")
     # Scenarios resolve their URDF when they load: here it may be absolute (the folder rule was applied then).
@@ -525,7 +530,8 @@ def robot_placement(scenario) -> tuple[np.ndarray, float]:
         raise TypeError(
             f"scenario must be a bidmp scenario (bidmp.tasks.load), got {type(scenario).__name__}"
         )
-    robot = scenario.robot or {}
+    robot = scenario.robot
+    robot = robot.flat if hasattr(robot, "flat") else (robot or {})
     if "base" in robot:
         return np.asarray(robot["base"], dtype=float), float(robot.get("yaw", 90.0))
     points = np.vstack([scenario.target_array, scenario.demonstration])

@@ -1,4 +1,4 @@
-"""A scenario's skill options as checked objects: its ``"dmp"`` and ``"bidmp"`` objects.
+"""A scenario's options as checked objects: its ``"dmp"``, ``"bidmp"`` and ``"robot"`` objects.
 
 Each is the keyword arguments of the estimator it configures (:class:`bidmp.DMP`,
 :class:`bidmp.BiDMP`), checked once when made by the estimator's own checks (a ``ValueError`` or
@@ -9,9 +9,9 @@ Each is the keyword arguments of the estimator it configures (:class:`bidmp.DMP`
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-__all__ = ["BiDMPOptions", "DMPOptions"]
+__all__ = ["BiDMPOptions", "DMPOptions", "RobotOptions"]
 
 
 class _EstimatorOptions:
@@ -121,3 +121,73 @@ class BiDMPOptions(_EstimatorOptions):
         from ..incremental.bidmp import BiDMP
 
         BiDMP(**arguments)._check_params()
+
+
+@dataclass(frozen=True)
+class RobotOptions:
+    """A scenario's arm and where it stands: its ``"robot"`` object, checked as a file's is.
+
+    Attributes
+    ----------
+    base : tuple of 3 floats or None
+        The arm's base in the scenario's units (None: placed in front of the work).
+    yaw : float or None
+        The base's turn about z, degrees (None: 90, facing +y).
+    model : str or None
+        A built-in arm (panda, the default; iiwa, xarm6, ur5); None with ``urdf``.
+    urdf : str or None
+        The arm's own URDF file (resolved when the scenario loaded), with ``flange`` (the link
+        the tool is mounted on), ``limits`` (``{"lower", "upper", "velocity", "acceleration",
+        "jerk"}``, one value per joint: rad, rad/s, rad/s², rad/s³), ``rest`` (the job's start
+        pose, rad; None: found by IK from the demonstration's start) and ``effort`` (N m).
+    """
+
+    base: tuple | None = None
+    yaw: float | None = None
+    model: str | None = None
+    urdf: str | None = None
+    flange: str | None = None
+    limits: dict | None = field(default=None, hash=False)
+    rest: tuple | None = None
+    effort: tuple | None = None
+
+    @classmethod
+    def from_flat(cls, robot: dict | None = None, base_dir=".") -> RobotOptions:
+        """The options from a scenario file's ``"robot"`` object (a relative ``urdf`` resolved in
+        ``base_dir``); a :class:`~bidmp.tasks.ScenarioError` names the first bad key."""
+        from ._scenario_fields import _robot
+
+        if robot is not None and not isinstance(robot, dict):
+            raise TypeError(
+                f'robot must be a scenario\'s "robot" object (a dict) or None, got {type(robot).__name__}'
+            )
+        return cls._of_checked(
+            _robot({"robot": robot or {}}, "robot", base_dir, allow_outside=True)
+        )
+
+    @property
+    def flat(self) -> dict:
+        """The scenario file's form (what :meth:`from_flat` reads, and what
+        :func:`bidmp.sim.robot_model` takes): the keys that are set."""
+        return {
+            item.name: list(getattr(self, item.name))
+            if isinstance(getattr(self, item.name), tuple)
+            else getattr(self, item.name)
+            for item in dataclasses.fields(self)
+            if getattr(self, item.name) is not None
+        }
+
+    @property
+    def own_arm(self) -> bool:
+        """Whether the arm is the user's own URDF (not a built-in one)."""
+        return self.urdf is not None
+
+    @classmethod
+    def _of_checked(cls, robot: dict) -> RobotOptions:
+        """The options of a ``"robot"`` object already checked (a scenario file's, as it loads)."""
+        return cls(
+            **{
+                key: tuple(value) if isinstance(value, list) else value
+                for key, value in robot.items()
+            }
+        )

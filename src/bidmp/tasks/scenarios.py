@@ -82,7 +82,7 @@ from ._scenario_fields import (
     _robot,
     _shown,
 )
-from .options import BiDMPOptions, DMPOptions
+from .options import BiDMPOptions, DMPOptions, RobotOptions
 
 if TYPE_CHECKING:
     from ..extension import ExtensionOptions
@@ -191,7 +191,7 @@ class Scenario:
     scene: Scene | None = None
     # degrees: a pose scenario's tool axis vs the target's over the approach
     alignment_threshold: float = 2.0
-    robot: dict = field(default_factory=dict)  # {"base": [x, y, z], "yaw": degrees} for bidmp.sim
+    robot: RobotOptions = field(default_factory=RobotOptions)  # the arm and where it stands
     job: JobSpec | None = None  # the task sequence bidmp job runs
     base_dir: str = "."  # where "file" demonstrations were read from
     # The demonstration's peak tool speed (units/s) that executed motions keep: the simulator and
@@ -410,7 +410,7 @@ def from_dict(
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
     scene = _scene(data, source, targets, n_dims)
-    robot = _robot(data, source, base_dir, allow_outside_files)
+    robot = RobotOptions._of_checked(_robot(data, source, base_dir, allow_outside_files))
     from .jobs import parse_job
 
     job = parse_job(data, source)
