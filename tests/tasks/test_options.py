@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from bidmp import DMP, BiDMP
-from bidmp.tasks import BiDMPOptions, Contract, DMPOptions, RobotOptions, scenarios
+from bidmp.tasks import (
+    BiDMPOptions,
+    Contract,
+    DMPOptions,
+    ExtensionStage,
+    RobotOptions,
+    scenarios,
+)
 from bidmp.tasks.methods import Task
 from bidmp.tasks.repair import Repairer
 
@@ -91,3 +98,29 @@ def test_robot_options_read_back_and_place_the_same_arm(tmp_path):
         RobotOptions.from_flat({"flange": "tool0"})  # an own arm's key without its urdf
     with pytest.raises(TypeError, match="spec"):
         sim.robot_model(["panda"])
+    # made directly, checked as a file's: a unit-less text yaw, a non-path urdf, a 2-D base
+    for bad, key in (({"yaw": ""}, "robot.yaw"), ({"urdf": float("inf")}, "robot.urdf")):
+        with pytest.raises(scenarios.ScenarioError, match=key):
+            RobotOptions(**bad)
+    with pytest.raises(scenarios.ScenarioError, match="robot.base"):
+        RobotOptions(base=(1.0, 2.0))
+    assert RobotOptions(model="ur5", yaw=10).yaw == 10.0
+
+
+def test_extension_stages_are_the_files_own():
+    """Each stage of a built-in scenario says what its file says (or, without an "extensions"
+    list, the one stage to "extension_target" from the demonstration, in the scene)."""
+    for scenario in (scenarios.load(name) for name in scenarios.builtin_names()):
+        stages = scenario.spec.get("extensions") or [
+            {"target": scenario.spec.get("extension_target", "centre_of_failed")}
+        ]
+        assert len(scenario.extensions) == len(stages)
+        for index, (stage, written) in enumerate(zip(scenario.extensions, stages)):
+            assert isinstance(stage, ExtensionStage)
+            origin = written.get("from", "demonstration" if index == 0 else "previous")
+            assert stage.origin == origin and stage.from_previous == (origin == "previous")
+            assert stage.in_scene == written.get("in_scene", True)
+            if isinstance(written["target"], str):
+                assert stage.target == written["target"]
+            else:
+                np.testing.assert_array_equal(stage.target, written["target"])

@@ -174,7 +174,11 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
     alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True, maximum=1e3)
     bandwidth_factor = check_real(bandwidth_factor, "bandwidth_factor", positive=True, maximum=1e3)
     n_outside = check_int(n_outside, "n_outside", minimum=0, maximum=max(0, (n_basis - 2) // 2))
-    dt = check_real(dt, "dt", positive=True, maximum=tau)
+    dt = check_real(dt, "dt", positive=True)
+    if dt > tau:  # a grid step longer than the motion: name both
+        raise ValueError(
+            f"dt = {dt:g} s is longer than tau = {tau:g} s: shorten dt or lengthen tau"
+        )
     length_factor = check_real(length_factor, "length_factor", positive=True, maximum=6.0)
     steps = round(1.0 / (dt / tau))
     n_grid = int(length_factor * steps) + 1

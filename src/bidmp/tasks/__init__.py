@@ -27,7 +27,7 @@ if TYPE_CHECKING:
         rmse,
         swept_area,
     )
-    from .options import BiDMPOptions, DMPOptions, RobotOptions
+    from .options import BiDMPOptions, DMPOptions, ExtensionStage, RobotOptions
     from .repair import REPAIRS, Attempt, Repaired, Repairer, carried_clearance, carried_depth
     from .report import MethodResult, Report, write_report
     from .scenarios import (

@@ -75,15 +75,15 @@ def _bidmp_model(scenario, dmp, failed, route_failures: list):
     # The paper's protocol knows no battery geometry: approach "paper" grows the extension blind.
     keep = scenario.extension.approach == "keep"
     for stage in scenario.extensions:
-        target = _resolve_target(stage["target"], scenario, failed)
+        target = _resolve_target(stage.target, scenario, failed)
         if target is None:
             continue  # nothing failed: no extension needed
         source = (
             scenario.demonstration
-            if stage["from"] == "demonstration" or previous is None
+            if not stage.from_previous or previous is None
             else previous.complete
         )
-        scene = scenario.scene if keep and stage.get("in_scene", True) else None
+        scene = scenario.scene if keep and stage.in_scene else None
         try:
             model, previous = _learned_clear(model, dmp, source, target, scenario, scene)
         except NoFreeRouteError as exc:  # that target's failure, not the whole evaluation's
@@ -153,15 +153,11 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
     options = scenario.extension_arguments
     del options["approach"]  # a pose extension keeps the approach
     for stage in scenario.extensions:
-        target = _resolve_target(stage["target"], scenario, failed)
+        target = _resolve_target(stage.target, scenario, failed)
         if target is None:
             continue
-        source = (
-            scenario.demonstration
-            if stage["from"] == "demonstration" or previous is None
-            else previous
-        )
-        stage_scene = scenario.scene if stage.get("in_scene", True) else None
+        source = scenario.demonstration if not stage.from_previous or previous is None else previous
+        stage_scene = scenario.scene if stage.in_scene else None
         try:
             extension = extend_pose_demonstration(
                 source, target, seed=scenario.seed, scene=stage_scene, **options

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 
-__all__ = ["BiDMPOptions", "DMPOptions", "RobotOptions"]
+__all__ = ["BiDMPOptions", "DMPOptions", "ExtensionStage", "RobotOptions"]
 
 
 class _EstimatorOptions:
@@ -151,6 +151,17 @@ class RobotOptions:
     rest: tuple | None = None
     effort: tuple | None = None
 
+    def __post_init__(self) -> None:
+        # Checked as a file's "robot" object is (a ScenarioError, a ValueError, names the key); a
+        # relative urdf is left as given (from_flat resolves it in the scenario's folder).
+        from ._scenario_fields import _robot
+
+        checked = _robot({"robot": self.flat}, "robot", ".", allow_outside=True)
+        for key in ("base", "yaw", "limits", "rest", "effort"):  # as numbers, one per joint
+            if key in checked:
+                value = checked[key]
+                object.__setattr__(self, key, tuple(value) if isinstance(value, list) else value)
+
     @classmethod
     def from_flat(cls, robot: dict | None = None, base_dir=".") -> RobotOptions:
         """The options from a scenario file's ``"robot"`` object (a relative ``urdf`` resolved in
@@ -191,3 +202,29 @@ class RobotOptions:
                 for key, value in robot.items()
             }
         )
+
+
+@dataclass(frozen=True)
+class ExtensionStage:
+    """One stage of a scenario's extended demonstrations (its ``"extensions"`` list), checked
+    when the scenario loads.
+
+    Attributes
+    ----------
+    target : array (D,) or str
+        Where the stage grows to: a point (or pose) in the scenario's units, or
+        ``"centre_of_failed"`` (the centre of the targets the plain DMP misses).
+    origin : {"demonstration", "previous"}
+        What it grows from: the demonstration, or the previous stage's extension.
+    in_scene : bool
+        Whether its route is planned among the scene's parts.
+    """
+
+    target: object
+    origin: str = "demonstration"
+    in_scene: bool = True
+
+    @property
+    def from_previous(self) -> bool:
+        """Whether the stage grows from the previous stage's extension."""
+        return self.origin == "previous"

@@ -82,7 +82,7 @@ from ._scenario_fields import (
     _robot,
     _shown,
 )
-from .options import BiDMPOptions, DMPOptions, RobotOptions
+from .options import BiDMPOptions, DMPOptions, ExtensionStage, RobotOptions
 
 if TYPE_CHECKING:
     from ..extension import ExtensionOptions
@@ -181,7 +181,7 @@ class Scenario:
     dmp: DMPOptions
     bidmp: BiDMPOptions
     extension: ExtensionOptions
-    extensions: list[dict]
+    extensions: list[ExtensionStage]
     demonstrations: dict[str, np.ndarray]
     methods: list[str]
     seed: int
@@ -535,7 +535,7 @@ def _targets(data, source: str, n_dims: int) -> tuple[dict, str]:
     return targets, demonstrated
 
 
-def _extensions(data, source: str, targets: dict, n_dims: int) -> list[dict]:
+def _extensions(data, source: str, targets: dict, n_dims: int) -> list[ExtensionStage]:
     """The extension stages: ``extensions`` as given, or one to ``extension_target``."""
     if "extensions" in data:
         if not isinstance(data["extensions"], list) or not data["extensions"]:
@@ -564,13 +564,11 @@ def _extensions(data, source: str, targets: dict, n_dims: int) -> list[dict]:
             if not isinstance(in_scene, bool):
                 _fail(source, f"{key}.in_scene", f"expected true or false, got {_shown(in_scene)}")
             extensions.append(
-                {
-                    "target": _extension_target(
-                        stage["target"], source, f"{key}.target", targets, n_dims
-                    ),
-                    "from": origin,
-                    "in_scene": in_scene,
-                }
+                ExtensionStage(
+                    _extension_target(stage["target"], source, f"{key}.target", targets, n_dims),
+                    origin,
+                    in_scene,
+                )
             )
         check_limit(len(extensions), "max_targets", "the number of extensions")
         return extensions
@@ -582,7 +580,7 @@ def _extensions(data, source: str, targets: dict, n_dims: int) -> list[dict]:
             targets,
             n_dims,
         )
-        return [{"target": target, "from": "demonstration", "in_scene": True}]
+        return [ExtensionStage(target)]
 
 
 def _further_demonstrations(
