@@ -28,7 +28,7 @@ from .._checks import (
     check_real,
 )
 from .._kernels import forcing_target
-from .band import _band_of
+from .band import _Band, _band_of
 from .canonical import _checked_phase_args, _phase_decay
 from .gains import _Gains
 
@@ -237,36 +237,34 @@ def _regress(
 
 def _regression_factor(
     phi: np.ndarray, phase: np.ndarray, regression: str, ridge: float
-) -> tuple[str, np.ndarray]:
-    """What the regression needs of the basis alone (no target): LWR's per-kernel denominators
-    ``Σ_l phase_l² ψ̄_il`` (N,), or ridge's regularised ``ΦᵀΦ + λ I`` (N, N)."""
+) -> tuple[str, np.ndarray, _Band | None]:
+    """What the regression needs of the basis alone (no target): ``(kind, values, band)``,
+    LWR's per-kernel denominators ``Σ_l phase_l² ψ̄_il`` (N,), or ridge's regularised
+    ``ΦᵀΦ + λ I`` (N, N); ``band`` None (a cached design keeps the rows as a band and ridge's
+    matrix inverted: kind "inverse")."""
     if regression == "lwr":
         # w_i = Σ_l phase_l ψ̄_il f_l / Σ_l phase_l² ψ̄_il, with phi = phase · ψ̄.
-        return "lwr", np.maximum(phi.T @ phase, np.finfo(float).tiny)
+        return "lwr", np.maximum(phi.T @ phase, np.finfo(float).tiny), None
     n_kernels = phi.shape[1]
     gram = phi.T @ phi
     reg = ridge * max(np.trace(gram) / n_kernels, np.finfo(float).tiny)
-    return "ridge", gram + reg * np.eye(n_kernels)
+    return "ridge", gram + reg * np.eye(n_kernels), None
 
 
-def _solve_weights(
-    factor: tuple[str, np.ndarray], phi: np.ndarray, target: np.ndarray
-) -> np.ndarray:
-    """The weights (N, D) for a forcing target (L, D) from :func:`_regression_factor`."""
-    kind, values = factor
+def _solve_weights(factor: tuple, phi: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The weights (N, D) for a forcing target (L, D) from :func:`_regression_factor`: ``Φᵀ f``
+    (from the band where the factor has one: it reads only the kernels that matter), then
+    divided by LWR's denominators, or solved with ridge's matrix (one product with its inverse
+    for a cached design: it rounds differently from a solve, the weights agreeing to ~1e-11 of
+    their size, the Gram matrix's condition ~1e5 times the rounding)."""
+    kind, values, band = factor
+    projected = phi.T @ target if band is None else band.transposed_product(target)
     if kind == "lwr":
-        weights = (phi.T @ target) / values[:, None]
-    elif kind == "banded":
-        # A grid's cached (ΦᵀΦ + λ I)⁻¹ and Φ as a band: Φᵀ f reads the band only, and the solve
-        # is one small product. It rounds differently from a solve on ΦᵀΦ f: the weights agree
-        # to ~1e-11 of their size (the Gram matrix's condition, ~1e5, times the rounding).
-        inverse, band = values
-        weights = inverse @ band.transposed_product(target)
-    elif kind == "banded-lwr":
-        denominators, band = values
-        weights = band.transposed_product(target) / denominators[:, None]
+        weights = projected / values[:, None]
+    elif kind == "inverse":
+        weights = values @ projected
     else:
-        weights = np.linalg.solve(values, phi.T @ target)
+        weights = np.linalg.solve(values, projected)
     if not np.all(np.isfinite(weights)):
         raise ValueError(
             "fit: the learned weights are not finite; the demonstration's scale or the gains are out of range"
@@ -283,9 +281,7 @@ def _readonly(*arrays: np.ndarray) -> None:
 def _cached_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
     design = _training_design(canonical, basis, n_train, dt, regression, ridge)
     # Shared by every fit on this grid: nobody may write into them.
-    _readonly(*design[:4])
-    if isinstance(design[4][1], np.ndarray):
-        _readonly(design[4][1])
+    _readonly(*design[:4], design[4][1])
     return design
 
 
@@ -302,10 +298,10 @@ def _training_design(canonical, basis, n_train: int, dt: float, regression: str,
         # Every fit on this grid regresses on the same rows: they are kept as a band, and ridge's
         # matrix inverted once (NumPy's; SciPy's OpenBLAS is a second thread pool, whose idle
         # threads spun against NumPy's here: 0.9 ms fits took 1-5 ms on two cores).
-        kind, values = factor
-        values = np.linalg.inv(values) if kind == "ridge" else values
-        _readonly(values)
-        factor = ("banded" if kind == "ridge" else "banded-lwr", (values, band.head(n_train)))
+        kind, values, _ = factor
+        if kind == "ridge":
+            kind, values = "inverse", np.linalg.inv(values)
+        factor = (kind, values, band.head(n_train))
     return grid_phase, grid_phi, centres, widths, factor, band
 
 

@@ -14,8 +14,33 @@ from dataclasses import dataclass, field
 __all__ = ["BiDMPOptions", "DMPOptions", "ExtensionStage", "RobotOptions"]
 
 
-class _EstimatorOptions:
-    """What both option objects share: their fields are an estimator's keyword arguments."""
+class _Options:
+    """What the option objects share: fields left ``None`` are not set."""
+
+    @property
+    def arguments(self) -> dict:
+        """The options that are set, by name (an estimator's keyword arguments)."""
+        return {
+            item.name: getattr(self, item.name)
+            for item in dataclasses.fields(self)
+            if getattr(self, item.name) is not None
+        }
+
+    @property
+    def flat(self) -> dict:
+        """A scenario file's form of the options (``from_flat`` reads it back)."""
+        return {
+            key: list(value) if isinstance(value, tuple) else value
+            for key, value in self.arguments.items()
+        }
+
+    def replace(self, **changes):
+        """These options with ``changes`` (checked again)."""
+        return dataclasses.replace(self, **changes)
+
+
+class _EstimatorOptions(_Options):
+    """Options whose fields are an estimator's keyword arguments, checked by the estimator."""
 
     def __post_init__(self) -> None:
         self._check(self.arguments)
@@ -34,32 +59,11 @@ class _EstimatorOptions:
             raise TypeError(
                 f"{cls.__name__} options must be a dict with string keys, got {type(options).__name__}"
             )
-        known = [field.name for field in dataclasses.fields(cls)]
+        known = [item.name for item in dataclasses.fields(cls)]
         unknown = sorted(set(options) - set(known))
         if unknown:
             raise TypeError(f"unknown option {unknown[0]!r} (known: {', '.join(sorted(known))})")
         return cls(**options)
-
-    @property
-    def arguments(self) -> dict:
-        """The keyword arguments of the estimator: the options that are set."""
-        return {
-            field.name: getattr(self, field.name)
-            for field in dataclasses.fields(self)
-            if getattr(self, field.name) is not None
-        }
-
-    @property
-    def flat(self) -> dict:
-        """A scenario file's form of the options (:meth:`from_flat` reads it back)."""
-        return {
-            key: list(value) if isinstance(value, tuple) else value
-            for key, value in self.arguments.items()
-        }
-
-    def replace(self, **changes):
-        """These options with ``changes`` (checked again)."""
-        return dataclasses.replace(self, **changes)
 
 
 @dataclass(frozen=True)
@@ -124,7 +128,7 @@ class BiDMPOptions(_EstimatorOptions):
 
 
 @dataclass(frozen=True)
-class RobotOptions:
+class RobotOptions(_Options):
     """A scenario's arm and where it stands: its ``"robot"`` object, checked as a file's is.
 
     Attributes
@@ -172,36 +176,12 @@ class RobotOptions:
             raise TypeError(
                 f'robot must be a scenario\'s "robot" object (a dict) or None, got {type(robot).__name__}'
             )
-        return cls._of_checked(
-            _robot({"robot": robot or {}}, "robot", base_dir, allow_outside=True)
-        )
-
-    @property
-    def flat(self) -> dict:
-        """The scenario file's form (what :meth:`from_flat` reads, and what
-        :func:`bidmp.sim.robot_model` takes): the keys that are set."""
-        return {
-            item.name: list(getattr(self, item.name))
-            if isinstance(getattr(self, item.name), tuple)
-            else getattr(self, item.name)
-            for item in dataclasses.fields(self)
-            if getattr(self, item.name) is not None
-        }
+        return cls(**_robot({"robot": robot or {}}, "robot", base_dir, allow_outside=True))
 
     @property
     def own_arm(self) -> bool:
         """Whether the arm is the user's own URDF (not a built-in one)."""
         return self.urdf is not None
-
-    @classmethod
-    def _of_checked(cls, robot: dict) -> RobotOptions:
-        """The options of a ``"robot"`` object already checked (a scenario file's, as it loads)."""
-        return cls(
-            **{
-                key: tuple(value) if isinstance(value, list) else value
-                for key, value in robot.items()
-            }
-        )
 
 
 @dataclass(frozen=True)

@@ -308,9 +308,9 @@ def _extension_target(value, source, key, targets, n_dims):
     return _point(value, source, key, n_dims).tolist()
 
 
-def _parameters(data, key, known, source, check) -> dict:
-    """A parameter object (``dmp``, ``bidmp``, ``extension``): known names only, checked by
-    ``check(params)`` where given."""
+def _parameters(data, key, known, source, make):
+    """A parameter object (``dmp``, ``bidmp``, ``extension``): known names only, made (and
+    checked) by ``make(params)``; a refusal becomes the file's :class:`ScenarioError`."""
     params = data.get(key, {})
     if not isinstance(params, dict):
         _fail(source, key, "expected an object of parameters")
@@ -319,15 +319,10 @@ def _parameters(data, key, known, source, check) -> dict:
     bad = sorted(set(params) - known)
     if bad:
         _fail(source, f"{key}.{bad[0]}", f"unknown parameter (known: {', '.join(sorted(known))})")
-    params = dict(params)
-    if "increments" in params and isinstance(params["increments"], list):
-        params["increments"] = tuple(params["increments"])
-    if check is not None:
-        try:
-            check(params)
-        except (TypeError, ValueError) as exc:
-            _fail(source, key, str(exc))
-    return params
+    try:
+        return make(dict(params))
+    except (TypeError, ValueError) as exc:
+        _fail(source, key, str(exc))
 
 
 def _parameter_objects(data: dict, source: str) -> dict:
@@ -336,14 +331,10 @@ def _parameter_objects(data: dict, source: str) -> dict:
     from ..extension import ExtensionOptions
 
     return {
-        "dmp": DMPOptions.from_flat(
-            _parameters(data, "dmp", _DMP_KEYS, source, DMPOptions.from_flat)
-        ),
-        "bidmp": BiDMPOptions.from_flat(
-            _parameters(data, "bidmp", _BIDMP_KEYS, source, BiDMPOptions.from_flat)
-        ),
-        "extension": ExtensionOptions.from_flat(
-            _parameters(data, "extension", _EXTENSION_KEYS, source, ExtensionOptions.from_flat)
+        "dmp": _parameters(data, "dmp", _DMP_KEYS, source, DMPOptions.from_flat),
+        "bidmp": _parameters(data, "bidmp", _BIDMP_KEYS, source, BiDMPOptions.from_flat),
+        "extension": _parameters(
+            data, "extension", _EXTENSION_KEYS, source, ExtensionOptions.from_flat
         ),
     }
 
@@ -410,7 +401,7 @@ def from_dict(
     if isinstance(seed, bool) or not isinstance(seed, Integral) or not 0 <= seed < 2**32:
         _fail(source, "seed", f"expected an integer in [0, 2**32), got {_shown(seed)}")
     scene = _scene(data, source, targets, n_dims)
-    robot = RobotOptions._of_checked(_robot(data, source, base_dir, allow_outside_files))
+    robot = RobotOptions(**_robot(data, source, base_dir, allow_outside_files))
     from .jobs import parse_job
 
     job = parse_job(data, source)
