@@ -246,6 +246,18 @@ def _package_overrides(tmp: Path) -> dict:
                 "orientation_from_log",
             )
         },
+        "bidmp.primitives.DMPSettings": dmp.settings().as_dict(),
+        "bidmp.primitives.DMPSystem": {
+            "settings": dmp.settings(),
+            "weights": dmp.weights_,
+            "start": dmp.start_,
+            "goal": dmp.goal_,
+            "n_samples": dmp.n_steps_,
+            "duration": dmp.duration_,
+            "centres": dmp.centres_,
+            "widths": dmp.widths_,
+            "goal_gate": dmp.goal_gate_,
+        },
         "bidmp.primitives.DMPStepper": {
             "dmp": dmp,
             "goal": DEMO[-1],
@@ -498,6 +510,12 @@ def _instances(tmp: Path):
         {"stepper": dmp.stepper(), "trajectory": dmp.trajectory()},
     )
     yield "DMPStepper", dmp.stepper(), {"dt": 0.01, "goal": DEMO[-1] + 5.0}
+    yield (
+        "DMPSystem",
+        dmp.system_,
+        {"goal": DEMO[-1] + 5.0, "goals": DEMO[-3:], "phase": [0.2, 0.5], "tau": 1.5, "step": 0.01},
+    )
+    yield "DMPSettings", dmp.settings(), {"tau": 1.5, "estimator": bidmp.DMP(n_kernels=10)}
     yield "PoseStepper", pose.stepper(), {"dt": 0.01, "pose": POSES[-1]}
     yield "Trajectory", dmp.trajectory(), {}
     yield "PoseTrajectory", pose.trajectory(), {}

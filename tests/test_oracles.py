@@ -536,7 +536,7 @@ def test_the_default_spring_is_critically_damped():
     released from rest at 0 towards g, follows the critically damped closed form
     g (1 − (1 + λ t) e^(−λ t)), λ = α/2 (normalised time), sampled with the exact integrator."""
     demo = minimum_jerk(np.zeros(2), np.array([1.0, 2.0]), 100)
-    params = bidmp.DMP().fit(demo, np.linspace(0.0, 1.0, 100))._params()
+    params = bidmp.DMP().fit(demo, np.linspace(0.0, 1.0, 100)).settings()
     alpha, beta = params.alpha, params.beta
     integrator = bidmp.primitives.StepIntegrator(alpha, beta, 1.0, True)
     goal, step = np.array([1.0, -2.0]), 1e-3

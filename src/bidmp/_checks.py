@@ -123,11 +123,18 @@ class Limits:
 
 _LIMITS = Limits()
 _LIMIT_NAMES = tuple(f.name for f in dataclasses.fields(Limits))
+# Bumped on every set_limits: what was checked against the old limits is checked again.
+_LIMITS_VERSION = [0]
 
 
 def get_limits() -> Limits:
     """A copy of the limits in force."""
     return dataclasses.replace(_LIMITS)
+
+
+def _limits_version() -> int:
+    """How many times the limits have been set (a cache of checked values keys on it)."""
+    return _LIMITS_VERSION[0]
 
 
 def _limit(name: str):
@@ -163,6 +170,7 @@ def set_limits(**changes) -> _Restore:
         else:
             value = check_real(value, name, positive=True)
         setattr(_LIMITS, name, value)
+        _LIMITS_VERSION[0] += 1
     return _Restore(previous)
 
 

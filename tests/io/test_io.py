@@ -324,7 +324,7 @@ def test_a_format_3_robot_model_rolls_out_as_it_did():
         model.rollout(model.goal_ + [150, 25, 0]), expected[1], rtol=0, atol=1e-9
     )
     fresh = bidmp.DMP().fit(model.rollout())  # a model fitted today has the exact integrator
-    assert fresh.integrator is None and fresh._params().integrator == "exact"
+    assert fresh.integrator is None and fresh.settings().integrator == "exact"
 
 
 def test_format_2_dmp_files_load_as_the_paper_protocol(tmp_path, fitted):

@@ -107,7 +107,7 @@ def test_the_stand_ins_meet_the_protocols_and_the_defaults_are_components():
     exponential phase and the Gaussian basis."""
     assert isinstance(CyclePhase(1.0), CanonicalSystem)
     assert isinstance(VonMisesBasis(5), Basis)
-    params = DMP()._params()
+    params = DMP().settings()
     assert params.canonical_system == ExponentialPhase(4.0, exact=True)
     assert params.basis == GaussianBasis(100)
 

@@ -101,7 +101,7 @@ def test_a_constant_push_moves_the_motion_by_the_closed_form(tau):
     push = np.array([2000.0, -800.0, 150.0])  # mm/s²
     free = dmp.trajectory(dt=2e-3, coupling=[])
     pushed = dmp.trajectory(dt=2e-3, coupling=[ConstantAcceleration(push)])
-    params = dmp._params()
+    params = dmp.settings()
     unit = dmp.time_unit_
     omega = params.alpha / (2.0 * tau * unit)
     shape = 1.0 - (1.0 + omega * free.t) * np.exp(-omega * free.t)
@@ -132,7 +132,7 @@ def test_a_coupling_term_sees_the_commanded_state():
     np.testing.assert_allclose(np.array([s[2] for s in seen]), motion.yd, atol=1e-12)
     phases = np.array([s[3] for s in seen])
     np.testing.assert_allclose(
-        phases, np.exp(-dmp._params().alpha_phase * motion.t / dmp.time_unit_), rtol=1e-12
+        phases, np.exp(-dmp.settings().alpha_phase * motion.t / dmp.time_unit_), rtol=1e-12
     )
 
 

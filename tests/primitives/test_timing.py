@@ -208,7 +208,7 @@ def test_the_exact_integrator_is_the_continuous_system():
 
     prepared = hundred_hertz_demonstration()
     dmp = bidmp.DMP().fit(prepared.y, prepared.t)
-    params = dmp._params()
+    params = dmp.settings()
     goal, start = dmp.goal_ + SHIFT, dmp.start_
     motion = dmp.trajectory(goal, dt=1e-3)
     unit = dmp.time_unit_  # seconds per normalised time

@@ -11,7 +11,6 @@ import pytest
 
 from bidmp import DMP, BiDMP
 from bidmp.demonstrations import minimum_jerk
-from bidmp.primitives.grid import _rollout_grid
 from bidmp.primitives.timed import _time_grid
 from bidmp.primitives.via import _impulse_rows, _interpolation
 
@@ -35,12 +34,13 @@ def sample_at(trajectory, t):
 def test_the_response_matrix_equals_perturbed_rollouts(protocol):
     rng, unit, dmp = random_dmp(1, protocol)
     dt = dmp.duration_ / (dmp.n_steps_ - 1) if protocol == "paper" else 0.0037
-    params = dmp._params()
-    motion, dt, n_samples, step = _time_grid(dmp, None, dt, params)
+    motion, dt, n_samples, step = _time_grid(dmp.system_, None, dt)
     times = np.sort(rng.uniform(0.05, 0.95, 3)) * motion
-    rollout_params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
-    phase, basis, *_ = _rollout_grid(dmp, rollout_params, n_samples + 2, step)
-    fast = _impulse_rows(rollout_params, phase, step, _interpolation(times, dt, len(phase))) @ basis
+    system = dmp.system_.with_tau(motion / dmp.duration_)
+    phase, basis, *_ = system.grid(n_samples + 2, step)
+    fast = (
+        _impulse_rows(system.settings, phase, step, _interpolation(times, dt, len(phase))) @ basis
+    )
     base = dmp.trajectory(dt=dt)
     measured = np.empty_like(fast)
     for kernel in range(dmp.weights_.shape[0]):
@@ -59,7 +59,7 @@ def test_via_points_are_passed_exactly_with_the_least_norm_change(seed):
     rng, unit, dmp = random_dmp(seed, protocol)
     dt = None if protocol == "paper" else float(rng.choice([0.001, 0.004, 0.0073]))
     plain = dmp.trajectory(dt=dt)
-    motion = dmp.duration_ * dmp._params().tau
+    motion = dmp.duration_ * dmp.settings().tau
     times = (
         np.sort(rng.choice(np.linspace(0.1, 0.9, 17), size=int(rng.integers(1, 4)), replace=False))
         * motion

@@ -26,7 +26,7 @@ def _timing_options(args: argparse.Namespace, dmp) -> dict:
         check_int(args.n_steps, "--n-steps", minimum=2, limit="max_steps")
         motion = dmp.tau * dmp.duration_ if args.duration is None else args.duration
         # the same motion, sampled more finely
-        options["dt"] = dmp._params().settle * motion / (args.n_steps - 1)
+        options["dt"] = dmp.settings().settle * motion / (args.n_steps - 1)
     limits = _limits(args, dmp)
     if limits:
         options["limits"] = {**limits, "fastest": args.fastest}

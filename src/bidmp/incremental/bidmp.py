@@ -207,7 +207,7 @@ class BiDMP(Estimator):
         # 1 for the paper protocol (bit for bit the ϑ-gated increment), else the phase at the last
         # sample of the demonstrated motion.
         self.gate_phase_ = (
-            1.0 if dmp._params().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
+            1.0 if dmp.settings().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
         )
 
     def _ensure_started(self) -> None:
@@ -268,7 +268,7 @@ class BiDMP(Estimator):
         increments, derivatives = self._check_params()
         time_scale = _time_scale(duration, self.dmp_)
         dmp = self.dmp_
-        params = dmp._params()
+        params = dmp.settings()
         y = as_trajectory(y_dn, name, allow_static=still)
         if y.shape[1] != dmp.n_dims_:
             raise ValueError(f"{name} has D = {y.shape[1]} but the DMP has D = {dmp.n_dims_}")

@@ -65,12 +65,19 @@ if TYPE_CHECKING:
     from .oscillator import AdaptiveOscillator
     from .prodmp import ProDMP, ProDMPBasis, prodmp_basis
     from .promp import ProMP, condition_gaussian, promp_basis
-    from .protocols import ROBOT_ALPHA, ROBOT_ALPHA_PHASE, ROBOT_KERNELS, ROBOT_SETTLE
     from .registry import MODEL_KINDS, PrimitiveKind, kind_of, model_class, register_kind
     from .rhythmic import RhythmicDMP, RhythmicStepper
     from .rhythmic_pose import RhythmicPoseDMP, mean_orientation
+    from .settings import (
+        ROBOT_ALPHA,
+        ROBOT_ALPHA_PHASE,
+        ROBOT_KERNELS,
+        ROBOT_SETTLE,
+        DMPSettings,
+    )
     from .so3 import continuous_log, orientation_from_log, principal_log
     from .stepper import DMPStepper
+    from .system import DMPSystem
     from .timing import (
         TimedMotion,
         Trajectory,

@@ -159,13 +159,14 @@ class SceneAvoidance(CouplingTerm):
             )
         self._goal = stepper.target
         if self.approach is None:  # the motion's own straight tail, the skill's increment included
-            plain = stepper._dmp.rollout(
-                stepper.goal, start=stepper.start, forcing_increment=stepper._forcing_increment
+            plain = stepper.model.rollout(
+                stepper.goal, start=stepper.start, forcing_increment=stepper.forcing_increment
             )
             self.approach_ = float(np.linalg.norm(plain[-1] - plain[_tail_start(plain)]))
         else:
             self.approach_ = self.approach
-        params, scale = stepper._params, stepper._params.tau * stepper._dmp.time_unit_
+        system = stepper.system
+        params, scale = system.settings, system.settings.tau * system.time_unit
         self.strength_ = (
             params.alpha * params.beta * self.influence / scale**2
             if self.strength is None

@@ -47,12 +47,12 @@ import numpy as np
 
 from .._api import Estimator
 from .._checks import (
-    as_point,
+    _limits_version,
     as_trajectory,
     as_unit_quaternion,
+    check_bool,
     check_bytes,
     check_choice,
-    check_int,
     check_names,
     numerically_guarded,
 )
@@ -61,29 +61,15 @@ from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
 from .forcing import Basis, _check_forcing_increment, _forcing_target, _learn_weights
-from .goals import (
-    DelayedGoal,
-    PhaseGate,
-    ProgressGate,
-    _gate_past_training,
-    _learn_goal_gate,
-    _learned_progress_gate,
-)
-from .grid import _cached_grid, _grid_entry, _rollout_grid, _store_grid
-from .integrate import _check_integration, _unit_responses
-from .protocols import (
-    DERIVATIVE_CHOICES,
-    PROTOCOLS,
-    _FittedParams,
-    _Params,
-    _resolve_params,
-    _resolved_param,
-    _with_rest,
-)
+from .goals import DelayedGoal, PhaseGate, ProgressGate, _gate_past_training, _learn_goal_gate
+from .grid import _Caches
+from .integrate import _check_integration
+from .protocols import _FittedParams, _resolved_param, _with_rest
 from .rest import _rest_started
-from .rollouts import _iter_rollouts_to, _rollouts_to
+from .settings import DERIVATIVE_CHOICES, PROTOCOLS, DMPSettings
 from .state import _dmp_from_state, _dmp_state
 from .stepper import DMPStepper
+from .system import DMPSystem, _system_of
 from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
 from .timing import _Rollout, on_uniform_time
 from .via import _via_trajectory
@@ -248,9 +234,33 @@ class DMP(_FittedParams, Estimator):
         self.forcing_basis = forcing_basis
 
     # -- parameters ----------------------------------------------------------------------------
-    def _params(self) -> _Params:
-        """Validate the hyperparameters as they are now; raise naming the first bad one."""
-        return _resolve_params(self)
+    def settings(self) -> DMPSettings:
+        """The hyperparameters as they are now, resolved for the protocol and checked
+        (:class:`~bidmp.primitives.settings.DMPSettings`); raises naming the first bad one.
+
+        Resolved once per change: a rollout asks for them each time, and a changed parameter (or
+        :func:`bidmp.set_limits`) resolves them again."""
+        raw = self._raw_params() + (self.tau,)
+        key = (_limits_version(), raw, tuple(map(type, raw)))
+        cached = self.__dict__.get("_settings")
+        try:
+            if cached is not None and cached[0] == key:
+                return cached[1]
+        except (TypeError, ValueError):  # an array set by mistake: resolving names it
+            pass
+        settings = DMPSettings.of(self)
+        self._settings = (key, settings)
+        return settings
+
+    @property
+    def system_(self) -> DMPSystem:
+        """The fitted DMP as one immutable :class:`~bidmp.primitives.system.DMPSystem` (settings at
+        the current ``tau``, weights, demonstration grid), whose methods are the rollouts."""
+        self._check_fitted()
+        caches = self.__dict__.get("_caches")
+        if caches is None:  # learned state set by hand or loaded: its grids are cached from now on
+            caches = self._caches = _Caches()
+        return _system_of(self, self.settings(), caches)
 
     alpha_value = _resolved_param(
         "alpha", "The spring gain in use (the protocol's when ``alpha`` is None)."
@@ -311,7 +321,7 @@ class DMP(_FittedParams, Estimator):
         move on its own: then ``y`` may be static); ``called`` = (what the messages call ``y``,
         the label of its unit when not ``units``: a pose's orientation part is in rad)."""
         name, unit_label = called
-        params = resolved = self._params()
+        params = resolved = self.settings()
         y = as_trajectory(y, name, allow_static=progress is not None)
         units = "" if units is None else check_units(units)
         names = check_names(names, y.shape[1])
@@ -334,14 +344,14 @@ class DMP(_FittedParams, Estimator):
         train = _with_rest(y_rest if params.rest_start else y, params)
         check_bytes(train.shape[0] * params.n_kernels, "the basis matrix (T samples x n_kernels)")
         # Refuse now rather than return a model whose every rollout diverges.
-        _check_integration(dt, params._replace(tau=1.0))
+        _check_integration(dt, params.with_tau(1.0))
         _check_integration(dt, params)
         params.canonical_system.check_span(train.shape[0] * dt)
         if units in ANGLE_UNITS and self.keep_approach is None:
             # A straight tail in joint space is no approach along a part's axis (that one is straight
             # in the tool's space): keeping it compressed a moved goal's whole offset into the
             # transfer, a 17 rad/s² spike on a wrist that the demonstration moved at 1.7.
-            params = params._replace(keep_approach=False)
+            params = params.replace(keep_approach=False)
         gate = _learn_goal_gate(train, n_steps, dt, params, progress, y)
         weights, centres, widths, phase, phi, band = _learn_weights(train, dt, gate, params)
         self.weights_ = weights
@@ -357,10 +367,10 @@ class DMP(_FittedParams, Estimator):
         self.centres_ = centres
         self.widths_ = widths
         self._remember_params(resolved)
+        self._caches = _Caches()
         # The training grid is the default rollout grid for tau = 1: cache what fit computed.
-        _store_grid(
-            self,
-            params._replace(tau=1.0),
+        self._caches.store(
+            _system_of(self, params.with_tau(1.0), self._caches),
             phase,
             phi,
             dt,
@@ -396,78 +406,54 @@ class DMP(_FittedParams, Estimator):
     def default_n_steps(self) -> int:
         """The default rollout length on the normalised grid: ``round(settle · tau · T)`` samples
         (paper: T for ``tau = 1``; robot: 1.1 T, time for any goal to be reached)."""
-        self._check_fitted()
-        return self._n_steps(None, self._params())
-
-    def _n_steps(self, n_steps, params: _Params) -> int:
-        if n_steps is None:
-            n_steps = max(int(round(params.settle * params.tau * self.n_steps_)), 1)
-            check_int(n_steps, "the default rollout length round(tau * T)", limit="max_steps")
-        else:
-            n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
-        check_bytes(n_steps * self.centres_.shape[0], "the rollout basis (n_steps x n_kernels)")
-        return n_steps
+        return self.system_.rollout_length()
 
     def phase(self, n_steps: int | None = None) -> np.ndarray:
         """Phase at each rollout step, shape ``(n_steps,)`` (default :meth:`default_n_steps`)."""
-        self._check_fitted()
-        params = self._params()
-        return params.canonical_system.grid(self._n_steps(n_steps, params), self.dt_, params.tau)
+        return self.system_.phase(n_steps)
 
     def grid_basis(self, n_steps: int | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Phase (n,) and basis rows (n, N) on the rollout grid (default length
         :meth:`default_n_steps`), cached."""
-        self._check_fitted()
-        params = self._params()
-        phase, basis, *_ = _rollout_grid(self, params, self._n_steps(n_steps, params))
+        phase, basis, *_ = self.system_.grid(n_steps)
         return phase, basis
 
     @property
     def n_train_(self) -> int:
         """Samples of the training grid: T (paper), or T followed by rest up to 1.1 T (robot)."""
-        self._check_fitted()
-        return max(int(round(self._params().settle * self.n_steps_)), self.n_steps_)
+        return self.system_.n_train
 
     def training_grid(self) -> tuple[np.ndarray, np.ndarray]:
         """Phase and basis rows (N columns) of the grid the weights were learned on
         (:attr:`n_train_` samples at ``tau = 1``); what :class:`bidmp.BiDMP` learns on."""
-        self._check_fitted()
-        phase, basis, *_ = _rollout_grid(self, self._params()._replace(tau=1.0), self.n_train_)
+        system = self.system_.with_tau(1.0)
+        phase, basis, *_ = system.grid(system.n_train)
         return phase, basis
 
     def training_gate(self) -> np.ndarray:
         """The goal gate on the training grid: the phase (paper) or the delayed goal's remaining
         fraction (robot); the forcing target (:meth:`forcing_target`) uses it."""
-        self._check_fitted()
-        params = self._params()
-        return self.goal_system(params).training_gate(self.n_train_, self.dt_, params.exact)
+        system = self.system_
+        return system.goal_system().training_gate(system.n_train, system.dt, system.settings.exact)
 
-    def goal_system(self, params: _Params | None = None) -> PhaseGate | DelayedGoal | ProgressGate:
-        """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``params`` (default its
-        own): the phase gate, a delayed goal, or the learned progress gate (cached: a control loop
-        asks for it once per stepper)."""
-        if params is not None and not isinstance(params, _Params):
-            raise TypeError(
-                f"goal_system: params must be a DMP's resolved parameters (or None), got {type(params).__name__}"
-            )
-        params = self._params() if params is None else params
-        if params.goal_rate is not None:
-            return (PhaseGate if params.goal_rate == params.alpha_phase else DelayedGoal)(
-                params.goal_rate
-            )
-        return _learned_progress_gate(self, params)
+    def goal_system(
+        self, settings: DMPSettings | None = None
+    ) -> PhaseGate | DelayedGoal | ProgressGate:
+        """The goal system (:mod:`bidmp.primitives.goals`) of this model for ``settings`` (default
+        its own): the phase gate, a delayed goal, or the learned progress gate (cached: a control
+        loop asks for it once per stepper)."""
+        return self.system_.goal_system(settings)
 
-    def training_trajectory(self, y) -> np.ndarray:
+    def training_trajectory(self, y, *, quiet: bool = False) -> np.ndarray:
         """A demonstration (T', D) as the weights are learned from it: resampled to T samples and,
         for the robot protocol, started and ended at rest (:func:`bidmp.primitives.rest.rest_started`) and
-        followed by rest at its last point up to :attr:`n_train_`."""
+        followed by rest at its last point up to :attr:`n_train_`. ``quiet``: the rest blends are
+        logged at debug level only (a caller that learns many demonstrations on one grid has said
+        so once)."""
         self._check_fitted()
-        return self._training_trajectory(as_trajectory(y, "y", min_points=2, allow_static=True))
-
-    def _training_trajectory(self, y: np.ndarray, *, quiet: bool = False) -> np.ndarray:
-        """:meth:`training_trajectory` of a checked ``y``; ``quiet``: its rest blends are logged
-        at debug level only."""
-        params = self._params()
+        quiet = check_bool(quiet, "quiet")
+        y = as_trajectory(y, "y", min_points=2, allow_static=True)
+        params = self.settings()
         y = resample_time(y, self.n_steps_)
         if params.rest_start:
             y = _rest_started(y, self.dt_, self.time_unit_, quiet=quiet)
@@ -478,12 +464,12 @@ class DMP(_FittedParams, Estimator):
         on the training grid (as :meth:`training_trajectory` returns a demonstration), with the
         learned goal gate; ``derivatives`` ("gradient", "forward"; default the DMP's). What
         :class:`bidmp.BiDMP` learns its increments towards, shape (:attr:`n_train_`, D)."""
-        self._check_fitted()
-        params = self._params()
+        system = self.system_
+        params = system.settings
         y = as_trajectory(y, "y", min_points=2, allow_static=True)
-        if y.shape != (self.n_train_, self.n_dims_):
+        if y.shape != (system.n_train, system.n_dims):
             raise ValueError(
-                f"y must be on the training grid, shape ({self.n_train_}, {self.n_dims_}) "
+                f"y must be on the training grid, shape ({system.n_train}, {system.n_dims}) "
                 f"(training_trajectory), got {y.shape}"
             )
         rule = params.derivatives if derivatives is None else derivatives
@@ -501,13 +487,7 @@ class DMP(_FittedParams, Estimator):
 
     def basis(self, phase) -> np.ndarray:
         """Basis rows ``phi(phase)`` of shape ``(L, n_kernels)`` (the Bi-DMP's BLS input)."""
-        self._check_fitted()
-        params = self._params()
-        phase = params.canonical_system.as_phase(phase)
-        check_bytes(
-            np.size(phase) * len(self.centres_), "the basis rows at phase (phases x kernels)"
-        )
-        return params.basis.rows(phase, self.centres_, self.widths_)
+        return self.system_.basis_rows(phase)
 
     def forcing_term(self, phase) -> np.ndarray:
         """Learned forcing term ``f(phase) = phi(phase) @ weights_``, shape ``(L, D)``."""
@@ -522,59 +502,8 @@ class DMP(_FittedParams, Estimator):
         paper's fixed horizon it is far from 0 (T = 200, alpha = 100, K = alpha: c ≈ 0.0154); run to
         convergence and it tends to 0.
         """
-        params = self._rollout_params()
-        n_steps = self._n_steps(n_steps, params)
-        cached = _cached_grid(self, params, n_steps, self.dt_)
-        if cached is not None:
-            goal_response = cached.responses[0]
-        else:  # B needs no basis matrix, and other horizons should not evict the cached grid
-            phase = params.canonical_system.grid(n_steps, self.dt_, params.tau)
-            gate = self.goal_system(params).on_grid(phase, self.dt_, params.tau, params.exact)
-            goal_response = _unit_responses(params, phase, None, self.dt_, gate)[0]
-        return float(abs(1.0 - goal_response[-1]))
+        return self.system_.endpoint_gain(n_steps)
 
-    def _rollout_params(self, step: float | None = None, params: _Params | None = None) -> _Params:
-        """The validated parameters, with the rollout's integration checked for stability."""
-        self._check_fitted()
-        params = self._params() if params is None else params  # validated once per rollout
-        _check_integration(self.dt_ if step is None else step, params)
-        return params
-
-    def _prepare(
-        self, start, start_velocity, n_steps, forcing_increment=None, *, params=None, step=None
-    ):
-        _check_forcing_increment(forcing_increment)
-        params = self._rollout_params(step) if params is None else params
-        step = self.dt_ if step is None else step
-        n_dims = self.weights_.shape[1]
-        n_steps = self._n_steps(n_steps, params)
-        start = self.start_ if start is None else as_point(start, n_dims, "start")
-        velocity = (
-            None if start_velocity is None else as_point(start_velocity, n_dims, "start_velocity")
-        )
-        grid = _grid_entry(self, params, n_steps, step)
-        phase, basis, gate = grid.phase, grid.basis, grid.gate
-        goal_response, start_response, velocity_response = grid.responses
-        # via-points: a change of the weights
-        change = getattr(forcing_increment, "weight_change", None)
-        forcing = grid.forcing(self.weights_ if change is None else self.weights_ + change)
-        if change is not None:
-            forcing_increment = forcing_increment.wrapped
-        if forcing_increment is not None:
-            forcing = forcing + forcing_increment(phase, basis)
-        free = _unit_responses(params, phase, forcing, step).T
-        free += np.outer(start_response, start)
-        if start_velocity is not None:
-            free += np.outer(velocity_response, velocity)
-        # The integration runs compiled, outside NumPy's floating-point checks: check its output
-        # once. With these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
-        if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
-            raise ValueError(
-                "rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range"
-            )
-        return free, goal_response, forcing, gate
-
-    @numerically_guarded
     def rollout(
         self,
         goal=None,
@@ -609,11 +538,14 @@ class DMP(_FittedParams, Estimator):
         -------
         y : array, shape (n_steps, D)
         """
-        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        goal = self.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
-        return free + np.outer(goal_response, goal)
+        return self.system_.rollout(
+            goal,
+            start=start,
+            n_steps=n_steps,
+            start_velocity=start_velocity,
+            forcing_increment=forcing_increment,
+        )
 
-    @numerically_guarded
     def rollout_many(
         self,
         goals,
@@ -643,8 +575,14 @@ class DMP(_FittedParams, Estimator):
         y : array, shape (G, n_steps, D)
             ``y[i]`` equals ``rollout(goals[i], start, n_steps)`` up to rounding (``out`` if given).
         """
-        free, goal_response, *_ = self._prepare(start, start_velocity, n_steps, forcing_increment)
-        return _rollouts_to(goals, free, goal_response, out)
+        return self.system_.rollout_many(
+            goals,
+            start=start,
+            n_steps=n_steps,
+            start_velocity=start_velocity,
+            forcing_increment=forcing_increment,
+            out=out,
+        )
 
     def iter_rollouts(
         self,
@@ -663,12 +601,14 @@ class DMP(_FittedParams, Estimator):
         (first, y) : int and array (g, n_steps, D)
             ``y[i]`` is the rollout to ``goals[first + i]``; ``g <= chunk_size``.
         """
-        chunk_size = check_int(chunk_size, "chunk_size", minimum=1)
-        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
-            free, goal_response, *_ = self._prepare(
-                start, start_velocity, n_steps, forcing_increment
-            )
-        yield from _iter_rollouts_to(goals, free, goal_response, chunk_size)
+        yield from self.system_.iter_rollouts(
+            goals,
+            chunk_size=chunk_size,
+            start=start,
+            n_steps=n_steps,
+            start_velocity=start_velocity,
+            forcing_increment=forcing_increment,
+        )
 
     # -- real time -------------------------------------------------------------------------------
     @numerically_guarded
@@ -779,11 +719,14 @@ class DMP(_FittedParams, Estimator):
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
+        self._check_fitted()
         return _dmp_state(self)
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> DMP:
-        return _dmp_from_state(cls, meta, arrays)
+        model = _dmp_from_state(cls, meta, arrays)
+        model._remember_params()  # the parameters its weights were learned with
+        return model
 
 
 # The constructor's parameters but tau, as given (compared first: cheap), see _FittedParams._stale_params.

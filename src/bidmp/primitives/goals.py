@@ -292,24 +292,19 @@ class ProgressGate:
         return float(np.interp(phase, *self._lookup))
 
 
-def _learned_progress_gate(model, params) -> ProgressGate:
-    """The :class:`ProgressGate` a fitted DMP learned (its ``goal_gate_`` on its training grid),
-    cached on the model: a control loop asks for it once per stepper."""
-    gate = model.__dict__.get("goal_gate_")
-    n_train = model.n_train_  # (a property that checks the model and resolves its parameters)
+def _learned_progress_gate(system, params) -> ProgressGate:
+    """The :class:`ProgressGate` a fitted system learned (its ``goal_gate`` on its training grid,
+    :class:`~bidmp.primitives.system.DMPSystem`) for the settings ``params``."""
+    gate = system.goal_gate
+    n_train = system.n_train
     if gate is None or gate.shape[0] != n_train:
         raise ValueError(
             "this DMP has no progress gate for its goal (it was fitted with goal_rate set); "
             "set goal_rate to a number or fit it again"
         )
-    key = (n_train, model.dt_, params.canonical_system)
-    cached = model.__dict__.get("_goal_system")
-    if cached is None or cached[0] != key or cached[1].gate is not gate:
-        training_phase = params.canonical_system.grid(n_train, model.dt_, 1.0)
-        _check_decaying(training_phase, params.canonical_system)
-        cached = (key, ProgressGate(training_phase, gate))
-        model._goal_system = cached
-    return cached[1]
+    training_phase = params.canonical_system.grid(n_train, system.dt, 1.0)
+    _check_decaying(training_phase, params.canonical_system)
+    return ProgressGate(training_phase, gate)
 
 
 def _check_decaying(phase: np.ndarray, canonical_system) -> None:

@@ -1,7 +1,7 @@
 """The rollout grid of a DMP: phase, basis rows, unit responses and goal gate on a grid of samples.
 
-None of them depends on the weights, so the last grid a model used is cached on it (a Bi-DMP's
-skills and a batch of goals share one). The cache key holds every hyperparameter the grid depends
+None of them depends on the weights, so the last grid a fitted system used is cached with it (a
+Bi-DMP's skills and a batch of goals share one). The cache key holds every hyperparameter the grid depends
 on and the learned kernels, so changing any of them after ``fit`` can never roll out with stale
 responses.
 """
@@ -72,72 +72,74 @@ def _grid_key(params, step: float) -> tuple:
     )
 
 
-def _store_grid(
-    model,
-    params,
-    phase: np.ndarray,
-    basis: np.ndarray,
-    step: float,
-    gate: np.ndarray | None = None,
-    band: _Band | None = None,
-) -> _GridEntry:
-    """Cache the grid (phase, basis rows, unit responses, goal gate) on ``model``; return the entry.
-    ``gate`` (n,): the goal gate on this grid when the caller has it (default: the model's goal
-    system on it); ``band``: the rows as a band (:func:`~bidmp.primitives.band._band_of`), or None
-    to multiply the dense rows."""
-    if gate is None:
-        gate = model.goal_system(params).on_grid(phase, step, params.tau, params.exact)
-    entry = _GridEntry(
-        _grid_key(params, step),
-        model.centres_,
-        model.widths_,
-        phase,
-        basis,
-        band,
-        _unit_responses(params, phase, None, step, gate),
-        gate,
-    )
-    model._grid_cache = entry
-    return entry
+class _Caches:
+    """What a fitted DMP keeps between rollouts, shared by its systems at every ``tau``: the last
+    rollout grid (:class:`_GridEntry`; the key holds every setting it depends on and the learned
+    kernels, so a changed one never rolls out with stale responses) and the learned progress gate
+    (``(key, gate)``)."""
 
+    __slots__ = ("grid", "goal_system")
 
-def _cached_grid(model, params, n_steps: int, step: float) -> _GridEntry | None:
-    """The cached entry for this grid, or None (another grid, or the kernels changed).
+    def __init__(self) -> None:
+        self.grid = None
+        self.goal_system = None
 
-    A grid of fewer samples is the cached one's first ``n_steps`` (the phase, the basis rows, the
-    gate and the responses of the causal integration all are), so the rollout a timed trajectory
-    asks for (one sample past the horizon, for the state's derivatives) and the plain rollout
-    share the grid ``fit`` computed."""
-    cached = model.__dict__.get("_grid_cache")
-    if (
-        cached is None
-        or cached.key != _grid_key(params, step)
-        or cached.centres is not model.centres_
-        or cached.widths is not model.widths_
-        or cached.phase.shape[0] < n_steps
-    ):
-        return None
-    return cached if cached.phase.shape[0] == n_steps else cached.head(n_steps)
+    def store(
+        self,
+        system,
+        phase: np.ndarray,
+        basis: np.ndarray,
+        step: float,
+        gate: np.ndarray | None = None,
+        band: _Band | None = None,
+    ) -> _GridEntry:
+        """Cache the grid (phase, basis rows, unit responses, goal gate) of ``system`` (a
+        :class:`~bidmp.primitives.system.DMPSystem`, at its settings); return the entry. ``gate``
+        (n,): the goal gate on this grid when the caller has it (default: the system's goal system
+        on it); ``band``: the rows as a band (:func:`~bidmp.primitives.band._band_of`), or None to
+        multiply the dense rows."""
+        params = system.settings
+        if gate is None:
+            gate = system.goal_system().on_grid(phase, step, params.tau, params.exact)
+        self.grid = _GridEntry(
+            _grid_key(params, step),
+            system.centres,
+            system.widths,
+            phase,
+            basis,
+            band,
+            _unit_responses(params, phase, None, step, gate),
+            gate,
+        )
+        return self.grid
 
+    def cached(self, system, n_steps: int, step: float) -> _GridEntry | None:
+        """The cached entry for this grid, or None (another grid, or the kernels changed).
 
-def _grid_entry(model, params, n_steps: int, step: float | None = None) -> _GridEntry:
-    """The grid of ``n_steps`` samples ``step`` apart in normalised time (default ``dt_``) for
-    the validated ``params``: the cached one, or computed and cached (the last grid used is kept:
-    none of it depends on the weights, and the key holds every hyperparameter it depends on and
-    the learned kernels, so changing any of them after ``fit`` never rolls out with stale
-    responses)."""
-    step = model.dt_ if step is None else step
-    cached = _cached_grid(model, params, n_steps, step)
-    if cached is None:
-        phase = params.canonical_system.grid(n_steps, step, params.tau)
-        basis = params.basis.rows(phase, model.centres_, model.widths_)
-        # A band here too: a model loaded from a file rolls out as the fitted one did, to the bit.
-        cached = _store_grid(model, params, phase, basis, step, band=_band_of(basis))
-    return cached
+        A grid of fewer samples is the cached one's first ``n_steps`` (the phase, the basis rows,
+        the gate and the responses of the causal integration all are), so the rollout a timed
+        trajectory asks for (one sample past the horizon, for the state's derivatives) and the
+        plain rollout share the grid ``fit`` computed."""
+        cached = self.grid
+        if (
+            cached is None
+            or cached.key != _grid_key(system.settings, step)
+            or cached.centres is not system.centres
+            or cached.widths is not system.widths
+            or cached.phase.shape[0] < n_steps
+        ):
+            return None
+        return cached if cached.phase.shape[0] == n_steps else cached.head(n_steps)
 
-
-def _rollout_grid(model, params, n_steps: int, step: float | None = None) -> tuple[np.ndarray, ...]:
-    """Phase (n,), basis rows (n, N), unit responses ``[B, C, V]`` (3, n) and goal gate (n,) on
-    the grid of ``n_steps`` samples ``step`` apart (:func:`_grid_entry`)."""
-    entry = _grid_entry(model, params, n_steps, step)
-    return entry.phase, entry.basis, entry.responses, entry.gate
+    def entry(self, system, n_steps: int, step: float | None = None) -> _GridEntry:
+        """The grid of ``n_steps`` samples ``step`` apart in normalised time (default the system's
+        ``dt``): the cached one, or computed and cached."""
+        step = system.dt if step is None else step
+        cached = self.cached(system, n_steps, step)
+        if cached is None:
+            params = system.settings
+            phase = params.canonical_system.grid(n_steps, step, params.tau)
+            basis = params.basis.rows(phase, system.centres, system.widths)
+            # A band here too: a model loaded from a file rolls out as the fitted one did, to the bit.
+            cached = self.store(system, phase, basis, step, band=_band_of(basis))
+        return cached

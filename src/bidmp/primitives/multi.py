@@ -25,7 +25,6 @@ from .._threads import single_threaded
 from .._trajectory import resample_time
 from .dmp import DMP
 from .forcing import _regression_factor, _solve_weights
-from .grid import _rollout_grid
 from .integrate import _unit_responses
 from .promp import _demonstrations, _stamps, _weight_covariance
 
@@ -78,13 +77,13 @@ class MultiDMP(Estimator):
         # Every demonstration's forcing target on the mean one's grid, regressed as the DMP
         # regresses its own (one factor for all); each is started and ended at rest as the mean
         # one was, which said so once when the model was fitted.
-        params = model._params()
+        params = model.settings()
         phase, basis = model.training_grid()
         factor = _regression_factor(basis, phase, params.regression, params.ridge)
         weights = np.stack(
             [
                 _solve_weights(
-                    factor, basis, model.forcing_target(model._training_trajectory(y, quiet=True))
+                    factor, basis, model.forcing_target(model.training_trajectory(y, quiet=True))
                 )
                 for y in aligned
             ]
@@ -122,10 +121,10 @@ class MultiDMP(Estimator):
         dmp = self.dmp_
         if goal is not None:  # checked as a rollout would, though the response is the same
             as_point(goal, dmp.n_dims_, "goal")
-        params = dmp._rollout_params()
-        n_steps = dmp._n_steps(n_steps, params)
-        phase, basis, *_ = _rollout_grid(dmp, params, n_steps)
-        return _unit_responses(params, phase, basis, dmp.dt_).T
+        system = dmp.system_
+        system.check_step()
+        phase, basis, *_ = system.grid(n_steps)
+        return _unit_responses(system.settings, phase, basis, system.dt).T
 
     def std(self, goal=None, n_steps: int | None = None) -> np.ndarray:
         """The positions' standard deviation (n, D) along the rollout to ``goal`` (exact)."""

@@ -129,7 +129,7 @@ def _pose_trajectory(
     )
     # the orientation follows the motion time the position's limits chose
     if limits and vias is None:
-        duration = position.t[-1] / position_model._params().settle
+        duration = position.t[-1] / position_model.settings().settle
     error = orientation_model.trajectory(
         np.zeros(3),
         start=start_e,

@@ -24,8 +24,8 @@ __all__ = []
 
 
 def _dmp_state(model) -> tuple[dict, dict]:
-    """A fitted DMP's state for a model file: (JSON-able meta, arrays)."""
-    model._check_fitted()
+    """A fitted DMP's state for a model file: (JSON-able meta, arrays); the caller has checked
+    that it is fitted."""
     arrays = {
         "weights_": model.weights_,
         "start_": model.start_,
@@ -98,7 +98,7 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
     if "integrator" not in params:  # formats 1-3 integrated with explicit Euler
         params["integrator"] = "euler"
     model = cls(**params)
-    params = model._params()
+    params = model.settings()
     n_kernels = params.n_kernels
     n_steps = check_int(meta["n_steps_"], "n_steps_", minimum=3, limit="max_samples")
     weights = check_loaded(arrays["weights_"], "weights_", (n_kernels, None))
@@ -145,5 +145,4 @@ def _dmp_from_state(cls, meta: dict, arrays) -> object:
         model.goal_gate_ = gate
     if params.integrator == "euler":
         _check_euler_stable(model.dt_, 1.0, params.alpha, params.beta)
-    model._remember_params()
     return model

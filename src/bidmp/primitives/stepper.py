@@ -8,11 +8,10 @@ import logging
 import numpy as np
 
 from .._checks import as_point, check_real
+from .canonical import _TAU_RANGE
 from .coupling import _as_couplings
 from .goal_shift import _goal_complete_time, _GoalShifts, _shortest_blend
-from .grid import _rollout_grid
 from .integrate import StepIntegrator
-from .protocols import _TAU_RANGE
 
 __all__ = ["DMPStepper"]
 
@@ -49,25 +48,25 @@ class DMPStepper:
             raise TypeError(
                 f"dmp must be a fitted bidmp.DMP (DMP.stepper() builds its stepper), got {type(dmp).__name__}"
             )
-        dmp._check_fitted()
-        params = dmp._params()
+        system = dmp.system_
         self._dmp = dmp
-        n_dims = dmp.n_dims_
-        self.goal = dmp.goal_.copy() if goal is None else as_point(goal, n_dims, "goal")
-        self.start = dmp.start_.copy() if start is None else as_point(start, n_dims, "start")
+        n_dims = system.n_dims
+        self.goal = system.goal.copy() if goal is None else as_point(goal, n_dims, "goal")
+        self.start = system.start.copy() if start is None else as_point(start, n_dims, "start")
         motion = (
-            params.tau * dmp.duration_
+            system.settings.tau * system.duration
             if duration is None
             else check_real(duration, "duration", positive=True)
         )
         # tau of the normalised system
         self._scale = check_real(
-            motion / dmp.duration_,
+            motion / system.duration,
             "duration / duration_ (the temporal scaling)",
             minimum=_TAU_RANGE[0],
             maximum=_TAU_RANGE[1],
         )
-        self._params = params._replace(tau=self._scale)
+        self._system = system = system.with_tau(self._scale)
+        self._params = params = system.settings
         self._couplings, self._temporal = _as_couplings(coupling)
         self._forcing_increment = forcing_increment
         self.y = self.start.copy()
@@ -76,12 +75,12 @@ class DMPStepper:
             if start_velocity is None
             else as_point(start_velocity, n_dims, "start_velocity")
         )
-        self._z = velocity * dmp.time_unit_ * self._scale  # z = tau ẏ in normalised time
+        self._z = velocity * system.time_unit * self._scale  # z = tau ẏ in normalised time
         # What every step reads, taken once: a control loop should not revalidate the model.
-        self._centres, self._widths, self._weights = dmp.centres_, dmp.widths_, dmp.weights_
+        self._centres, self._widths, self._weights = system.centres, system.widths, system.weights
         self._canonical, self._basis = params.canonical_system, params.basis
-        self._goal_system = dmp.goal_system(self._params)
-        self._time_unit = dmp.time_unit_
+        self._goal_system = system.goal_system()
+        self._time_unit = system.time_unit
         self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
         # (phase, gate, goal, start, u): the end of one step starts the next
         self._last_input = None
@@ -99,6 +98,26 @@ class DMPStepper:
                 term.bind(self)
 
     @property
+    def model(self):
+        """The fitted model this stepper runs (a :class:`bidmp.DMP` or a Bi-DMP skill's)."""
+        return self._dmp
+
+    @property
+    def system(self):
+        """The :class:`~bidmp.primitives.system.DMPSystem` it integrates, at the motion's ``tau``."""
+        return self._system
+
+    @property
+    def forcing_increment(self):
+        """The forcing increment added to the learned forcing term (None: none)."""
+        return self._forcing_increment
+
+    @property
+    def couplings(self) -> tuple:
+        """The coupling terms acting on the motion."""
+        return tuple(self._couplings)
+
+    @property
     def position(self) -> np.ndarray:
         """The position the next :meth:`step` commands (D,): the state plus any moved goal's offset."""
         offset = self._shifts.at(self.time) if self._shifts else None
@@ -109,7 +128,7 @@ class DMPStepper:
         """The motion's own time (s) at which it is complete: its duration times the protocol's
         horizon (the robot protocol's 1.1, within which it comes to rest; the paper's 1, its fixed
         horizon)."""
-        return float(self._params.settle * self._scale * self._dmp.duration_)
+        return float(self._params.settle * self._scale * self._system.duration)
 
     @property
     def target(self) -> np.ndarray:
@@ -169,11 +188,10 @@ class DMPStepper:
         stepper runs, without coupling: what a moved goal's blend keeps a quarter of, when no limits
         are given. Computed once."""
         if getattr(self, "_peaks", None) is None:
-            dmp = self._dmp
-            motion = dmp.trajectory(
+            motion = self._dmp.trajectory(
                 self.goal,
                 start=self.start,
-                duration=self._scale * dmp.duration_,
+                duration=self._scale * self._system.duration,
                 forcing_increment=self._forcing_increment,
             )
             jerk = np.gradient(motion.ydd, motion.t, axis=0)
@@ -191,10 +209,13 @@ class DMPStepper:
     def _goal_complete(self) -> float:
         """The motion time (s) from which the DMP's own goal offset is complete."""
         if self._complete is None:
-            dmp, params = self._dmp, self._dmp._rollout_params(self._dmp.dt_, self._params)
-            n_steps = int(np.ceil(params.settle * self._scale * (dmp.n_steps_ - 1))) + 2
-            goal_response = _rollout_grid(dmp, params, n_steps, dmp.dt_)[2][0]
-            self._complete = _goal_complete_time(goal_response, dmp.dt_ * dmp.time_unit_)
+            system = self._system
+            system.check_step()
+            n_steps = (
+                int(np.ceil(system.settings.settle * self._scale * (system.n_samples - 1))) + 2
+            )
+            goal_response = system.grid(n_steps)[2][0]
+            self._complete = _goal_complete_time(goal_response, system.dt * system.time_unit)
         return self._complete
 
     @property

@@ -9,29 +9,32 @@ import numpy as np
 from .._checks import _limit, as_point, check_int, check_real, short_token
 from .._units import check_reach
 from .avoidance import SceneAvoidance, _check_avoidance
+from .canonical import _TAU_RANGE
 from .integrate import _exact_state
-from .protocols import _TAU_RANGE, _Params
+from .settings import DMPSettings
 from .stepper import DMPStepper
-from .timing import Trajectory, _Rollout, scale_factor
+from .system import DMPSystem
+from .timing import Trajectory, _Rollout, _rollout_trajectory, scale_factor
 
 __all__ = []
 
 
-def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, float]:
+def _time_grid(system: DMPSystem, duration, dt) -> tuple[float, float, int, float]:
     """(motion duration s, sample period s, number of samples, normalised step) of a timed
-    rollout; the motion's duration defaults to ``tau · duration_``, the period to the
+    rollout of ``system``; the motion's duration defaults to ``tau · duration``, the period to the
     demonstration's."""
+    params = system.settings
     motion = (
-        params.tau * dmp.duration_
+        params.tau * system.duration
         if duration is None
         else check_real(duration, "duration", positive=True)
     )
-    period = dmp.duration_ / (dmp.n_steps_ - 1)
+    period = system.duration / (system.n_samples - 1)
     # 1 MHz at most
     dt = period if dt is None else check_real(dt, "dt", positive=True, minimum=1e-6)
     if dt > motion:
         raise ValueError(f"dt = {dt:g} s is longer than the motion's duration ({motion:g} s)")
-    scale = motion / dmp.duration_  # temporal scaling: the shape is kept, time stretched
+    scale = motion / system.duration  # temporal scaling: the shape is kept, time stretched
     check_real(
         scale,
         "duration / duration_ (the temporal scaling)",
@@ -39,49 +42,54 @@ def _time_grid(dmp, duration, dt, params: _Params) -> tuple[float, float, int, f
         maximum=_TAU_RANGE[1],
     )
     if params.protocol == "paper" and duration is None and dt == period:
-        n_samples = max(int(round(params.tau * dmp.n_steps_)), 1)  # the rollout's own samples
+        n_samples = max(int(round(params.tau * system.n_samples)), 1)  # the rollout's own samples
     else:
         samples = params.settle * motion / dt * (1 + 1e-12)
         check_real(samples, "the trajectory's samples (duration / dt)", maximum=_limit("max_steps"))
         n_samples = int(np.floor(samples)) + 1  # never past settle x motion
     check_int(n_samples, "the trajectory's samples (duration / dt)", limit="max_steps")
-    step = dmp.dt_ if dt == period else dt / dmp.time_unit_
+    step = system.dt if dt == period else dt / system.time_unit
     return motion, dt, n_samples, step
 
 
 def _timed_trajectory(dmp, request: _Rollout):
     """The fast path of :meth:`bidmp.DMP.trajectory` (no limits, no coupling terms)."""
     goal, start, start_velocity = request.goal, request.start, request.start_velocity
-    params = dmp._params()
-    motion, dt, n_samples, step = _time_grid(dmp, request.duration, request.dt, params)
-    params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
+    system = dmp.system_
+    motion, dt, n_samples, step = _time_grid(system, request.duration, request.dt)
+    system = system.with_tau(motion / system.duration)
+    params = system.settings
     velocity = (
         None
         if start_velocity is None
-        else as_point(start_velocity, dmp.n_dims_, "start_velocity") * dmp.time_unit_
+        else as_point(start_velocity, system.n_dims, "start_velocity") * system.time_unit
     )
     # Two extra samples give the last velocity and acceleration as forward differences (Euler),
     # one the last exact state.
-    free, goal_response, forcing, gate = dmp._prepare(
-        start, velocity, n_samples + 2, request.forcing_increment, params=params, step=step
+    free, goal_response, forcing, gate = system.free_response(
+        n_samples + 2,
+        start=start,
+        start_velocity=velocity,
+        forcing_increment=request.forcing_increment,
+        step=step,
     )
-    goal = dmp.goal_ if goal is None else as_point(goal, free.shape[1], "goal")
+    goal = system.goal if goal is None else as_point(goal, free.shape[1], "goal")
     if dmp.units_:  # a goal in the wrong unit is far beyond any robot's reach: say so
         check_reach(
-            float(min(np.linalg.norm(goal - dmp.goal_), np.linalg.norm(goal - dmp.start_))),
+            float(min(np.linalg.norm(goal - system.goal), np.linalg.norm(goal - system.start))),
             dmp.units_,
             "the goal",
         )
     positions = free + np.outer(goal_response, goal)
     if params.exact:
-        start = dmp.start_ if start is None else as_point(start, free.shape[1], "start")
+        start = system.start if start is None else as_point(start, free.shape[1], "start")
         velocities, accelerations = _exact_rates(
-            params, positions, forcing, gate, (goal, start, velocity), step, dmp.time_unit_
+            params, positions, forcing, gate, (goal, start, velocity), step, system.time_unit
         )
     else:
         velocities = np.diff(positions, axis=0) / dt
         accelerations = np.diff(velocities, axis=0) / dt
-    return Trajectory._of(
+    return _rollout_trajectory(
         np.arange(n_samples) * dt,
         positions[:n_samples],
         velocities[:n_samples],
@@ -92,7 +100,7 @@ def _timed_trajectory(dmp, request: _Rollout):
 
 
 def _exact_rates(
-    params: _Params, positions, forcing, gate, ends: tuple, step: float, time_unit: float
+    params: DMPSettings, positions, forcing, gate, ends: tuple, step: float, time_unit: float
 ) -> tuple:
     """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
     n out): the system's own state and acceleration, from the positions and the input; ``ends``
@@ -154,7 +162,7 @@ def _limited_trajectory(dmp, request: _Rollout):
     # The exact factor first (speed ~ 1/k, acceleration ~ 1/k²), then a bisection in log
     # duration for what re-integrating at another step changes: the result meets every
     # limit and touches the binding one within 0.1 %.
-    duration = dmp._params().tau * dmp.duration_
+    duration = dmp.settings().tau * dmp.duration_
     trajectory, factor = attempt(duration)
     if factor <= 1.0 and not fastest:
         return trajectory  # within the limits as demonstrated: a cap does not hurry it
@@ -180,8 +188,7 @@ def _coupled_trajectory(dmp, request: _Rollout) -> Trajectory:
     :class:`bidmp.primitives.avoidance.SceneAvoidance` term the motion runs on past the horizon
     until it comes to rest (at most as long again: steering round a part takes time), and its
     clearance is then checked exactly."""
-    params = dmp._params()
-    motion, dt, n_samples, _ = _time_grid(dmp, request.duration, request.dt, params)
+    motion, dt, n_samples, _ = _time_grid(dmp.system_, request.duration, request.dt)
     stepper = DMPStepper(
         dmp,
         request.goal,
@@ -192,7 +199,7 @@ def _coupled_trajectory(dmp, request: _Rollout) -> Trajectory:
         request.forcing_increment,
     )
     states = [stepper.step(dt) for _ in range(n_samples)]
-    avoiding = [term for term in stepper._couplings if isinstance(term, SceneAvoidance)]
+    avoiding = [term for term in stepper.couplings if isinstance(term, SceneAvoidance)]
     reach = float(np.linalg.norm(stepper.target - stepper.start))
     if avoiding:
         for _ in range(n_samples):

@@ -104,18 +104,6 @@ class Trajectory(TimedMotion):
         )
         object.__setattr__(self, "names", tuple(names))
 
-    @classmethod
-    def _of(cls, t, y, yd, ydd, units: str, names: tuple) -> Trajectory:
-        """A trajectory of a model's own rollout, not checked again: float64 arrays of matching
-        shapes, finite (the rollout checked its integration and runs under
-        :func:`bidmp._checks.numerically_guarded`), the model's units and names."""
-        out = object.__new__(cls)
-        for name, value in (("t", t), ("y", y), ("yd", yd), ("ydd", ydd)):
-            object.__setattr__(out, name, value)
-        object.__setattr__(out, "units", units)
-        object.__setattr__(out, "names", tuple(names))
-        return out
-
     def columns(self) -> tuple[list[str], np.ndarray]:
         """Column names ``t, x, y, z, vx, vy, vz, ax, ay, az`` (``x0…`` beyond 3-D; the
         trajectory's ``names`` when it has them, ``t, <names>, v<names>, a<names>``) and the
@@ -428,3 +416,15 @@ class _Rollout:
     coupling: object = None
     via: object = None
     via_until: float | None = None
+
+
+def _rollout_trajectory(t, y, yd, ydd, units: str, names: tuple) -> Trajectory:
+    """A trajectory of a model's own rollout, not checked again: float64 arrays of matching
+    shapes, finite (the rollout checked its integration and runs under
+    :func:`bidmp._checks.numerically_guarded`), the model's units and names."""
+    out = object.__new__(Trajectory)
+    for name, value in (("t", t), ("y", y), ("yd", yd), ("ydd", ydd)):
+        object.__setattr__(out, name, value)
+    object.__setattr__(out, "units", units)
+    object.__setattr__(out, "names", tuple(names))
+    return out

@@ -23,7 +23,6 @@ from typing import NamedTuple
 import numpy as np
 
 from .._checks import as_point, check_real
-from .grid import _rollout_grid
 from .integrate import _unit_responses
 from .timed import _checked_limits, _time_grid
 from .timing import _Rollout, scale_factor
@@ -51,9 +50,10 @@ class _Via(NamedTuple):
 
 
 class _Grid(NamedTuple):
-    """The rollout's grid: resolved parameters, normalised step, samples, sample period (s)."""
+    """The rollout's grid: the system at the motion's ``tau``
+    (:class:`~bidmp.primitives.system.DMPSystem`), normalised step, samples, sample period (s)."""
 
-    params: object
+    system: object
     step: float
     n_samples: int
     dt: float
@@ -121,7 +121,7 @@ def _impulse_rows(
 
 
 def _via_increment(
-    dmp, via: _Via, ends: tuple, grid: _Grid, forcing_increment: Callable | None
+    via: _Via, ends: tuple, grid: _Grid, forcing_increment: Callable | None
 ) -> Callable:
     """The forcing increment ``(phase, basis) -> (n, D)`` that moves the rollout from ``ends`` =
     (goal, start) through the via-points with the least-norm weight change. The rollout's own
@@ -131,15 +131,14 @@ def _via_increment(
     the motion returns to its own course). Raises ``ValueError`` when the kernels cannot carry
     the via-points."""
     times, points, until = via
-    params, step, n_samples, dt = grid
-    n_kernels = dmp.weights_.shape[0]
+    system, step, n_samples, dt = grid
+    params = system.settings
+    n_kernels = system.weights.shape[0]
     if times.size > n_kernels:
         raise ValueError(
             f"via has {times.size} points; this DMP's {n_kernels} kernels can carry at most {n_kernels}"
         )
-    phase, basis, (goal_response, start_response, _), _ = _rollout_grid(
-        dmp, params, n_samples, step
-    )
+    phase, basis, (goal_response, start_response, _), _ = system.grid(n_samples, step)
     # Only the samples up to the last via-point's matter (a response never reaches back in time).
     used = min(int(np.ceil(times.max() / dt)) + 2, phase.shape[0])
     between = _interpolation(times, dt, used)
@@ -162,7 +161,7 @@ def _via_increment(
             f"start, or where the phase has decayed); move them apart or earlier"
         )
     goal, start = ends
-    baseline = response @ dmp.weights_  # rows @ (basis @ W), without the (n, D) forcing
+    baseline = response @ system.weights  # rows @ (basis @ W), without the (n, D) forcing
     if forcing_increment is not None:
         baseline += rows @ forcing_increment(phase, basis)[:used]
     for k, (low, share) in enumerate(between):
@@ -182,7 +181,7 @@ def _via_increment(
         return added if forcing_increment is None else forcing_increment(phase_in, basis_in) + added
 
     # (N, D): what the via-points cost the learned shape; a rollout adds it to the weights in one
-    # product (DMP._prepare) and calls ``wrapped`` for the rest.
+    # product (DMPSystem.free_response) and calls ``wrapped`` for the rest.
     increment.weight_change, increment.wrapped = change, forcing_increment
     return increment
 
@@ -198,7 +197,8 @@ def _check_end(grid: _Grid, rows: tuple, change: np.ndarray, ends: tuple, via: _
     leaves it moving there: via-points late in a motion are carried by kernels that still act at its
     end. From the same impulse responses as the via-points (no rollout); ``rows`` = the rollout
     grid's phase (n,) and basis (n, N)."""
-    params, step, _, dt = grid
+    system, step, _, dt = grid
+    params = system.settings
     phase, basis = rows
     times, points, _ = via
     last = phase.shape[0] - 1
@@ -230,14 +230,15 @@ def _via_trajectory(dmp, request: _Rollout):
     if limits is not None:
         # checked before the solve; "fastest" does not apply (not re-timed)
         limits = _checked_limits(limits)[0]
-    params = dmp._params()
-    motion, dt_used, n_samples, step = _time_grid(dmp, request.duration, request.dt, params)
-    times, points = _parse_via(request.via, dmp.n_dims_, min(motion, (n_samples - 1) * dt_used))
+    system = dmp.system_
+    motion, dt_used, n_samples, step = _time_grid(system, request.duration, request.dt)
+    times, points = _parse_via(request.via, system.n_dims, min(motion, (n_samples - 1) * dt_used))
     ends = (
-        dmp.goal_ if goal is None else as_point(goal, dmp.n_dims_, "goal"),
-        dmp.start_ if start is None else as_point(start, dmp.n_dims_, "start"),
+        system.goal if goal is None else as_point(goal, system.n_dims, "goal"),
+        system.start if start is None else as_point(start, system.n_dims, "start"),
     )
-    rollout_params = dmp._rollout_params(step, params._replace(tau=motion / dmp.duration_))
+    system = system.with_tau(motion / system.duration)
+    system.check_step(step)
     if until is not None:
         until = check_real(until, "via_until", positive=True)
         if np.any(times > until):
@@ -245,10 +246,9 @@ def _via_trajectory(dmp, request: _Rollout):
                 f"via_until {until:g} s is before a via-point ({times.max():g} s): the change must act there"
             )
     increment = _via_increment(
-        dmp,
         _Via(times, points, until),
         ends,
-        _Grid(rollout_params, step, n_samples + 2, dt_used),
+        _Grid(system, step, n_samples + 2, dt_used),
         request.forcing_increment,
     )
     result = dmp.trajectory(

@@ -92,7 +92,7 @@ class DMPOptions(_EstimatorOptions):
     def _check(arguments: dict) -> None:
         from ..primitives.dmp import DMP
 
-        DMP(**arguments)._params()
+        DMP(**arguments).settings()
 
     @property
     def protocol_name(self) -> str:
