@@ -20,7 +20,7 @@ from _timing import median_time
 from scipy.spatial.transform import Rotation
 
 from bidmp.demonstrations import minimum_jerk
-from bidmp.primitives import CartesianDMP, angle_between
+from bidmp.primitives import DMP, CartesianDMP, angle_between
 
 
 def demonstration(n_steps: int = 1000):
@@ -44,7 +44,9 @@ def main() -> int:
     scalar_first = np.hstack([poses[:, :3], poses[:, [6, 3, 4, 5]]])
 
     def ours():
-        return CartesianDMP(alpha=25.0, beta=6.25, n_kernels=50).fit(poses, t).trajectory(dt=dt)
+        return (
+            CartesianDMP(DMP(alpha=25.0, beta=6.25, n_kernels=50)).fit(poses, t).trajectory(dt=dt)
+        )
 
     def peer():
         dmp = PeerCartesianDMP(execution_time=2.0, dt=dt, n_weights_per_dim=50, int_dt=dt)

@@ -75,7 +75,7 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.incremental.block_pinv_update": {"A": A, "A_pinv": np.linalg.pinv(A), "E": E},
         "bidmp.incremental.svd_update": {"U": U, "s": sv, "V": V, "E": E},
         "bidmp.incremental.pose_forgetting": {
-            "cartesian": bidmp.CartesianDMP(n_kernels=10).fit(POSES),
+            "cartesian": bidmp.CartesianDMP(bidmp.DMP(n_kernels=10)).fit(POSES),
             "demonstrations": [POSES, POSES + [0.0, 30.0, 0.0, 0.0, 0.0, 0.0, 0.0]],
         },
         "bidmp.sim.JointLimits": joint,
@@ -416,7 +416,7 @@ def _instances(tmp: Path):
 
     rng = np.random.default_rng(2)
     dmp = bidmp.DMP(n_kernels=20).fit(DEMO, TIMES, units="mm")
-    pose = bidmp.CartesianDMP(n_kernels=20).fit(POSES, TIMES)
+    pose = bidmp.CartesianDMP(bidmp.DMP(n_kernels=20)).fit(POSES, TIMES)
     model = bidmp.BiDMP(bidmp.DMP(n_kernels=20).fit(DEMO)).learn(DEMO + [0.0, 40.0, 0.0])
     pose_model = (
         bidmp.CartesianBiDMP().fit(POSES, TIMES).learn(POSES + [0.0, 40.0, 0.0, 0.0, 0.0, 0.0, 0.0])

@@ -1026,7 +1026,7 @@ def good_poses(n_points=120):
 )
 @examples(40)
 def test_fuzz_cartesian(poses, params, goal, start, duration):
-    model = outcome("CartesianDMP.fit", bidmp.CartesianDMP(**params).fit, poses)
+    model = outcome("CartesianDMP.fit", bidmp.CartesianDMP(bidmp.DMP(**params)).fit, poses)
     if model is None:
         model = bidmp.CartesianDMP().fit(good_poses())
     outcome("CartesianDMP.rollout", model.rollout, goal, start=start)

@@ -117,8 +117,8 @@ def test_keep_approach_is_a_parameter_like_any_other(tmp_path):
     model.keep_approach = False  # a learned parameter changed after fit: refit needed
     with pytest.raises(bidmp.NotFittedError, match="keep_approach"):
         model.trajectory()
-    pose = bidmp.CartesianDMP(keep_approach=True)
-    assert clone(pose).get_params()["keep_approach"] is True
+    pose = bidmp.CartesianDMP(bidmp.DMP(keep_approach=True))
+    assert clone(pose).get_params()["dmp__keep_approach"] is True
 
 
 @pytest.mark.parametrize("name", ["operator1_nut3", "operator2_nut5"])

@@ -14,7 +14,7 @@ from bidmp.demonstrations.preparation import prepare_poses
 from bidmp.extension import extend_pose_demonstration
 from bidmp.incremental.cartesian import CartesianBiDMP, pose_forgetting
 from bidmp.io import read_poses, save_poses
-from bidmp.primitives import CartesianDMP, angle_between
+from bidmp.primitives import DMP, CartesianDMP, angle_between
 from bidmp.primitives.so3 import _left_jacobian as left_jacobian
 
 DOWN = Rotation.from_euler("x", 180, degrees=True)
@@ -141,12 +141,14 @@ def test_agreement_with_movement_primitives_cartesian_dmp(demo, goal_turn, rate,
     theirs = peer.open_loop()[1][:, [4, 5, 6, 3]]
     ours = (
         CartesianDMP(
-            protocol="paper",
-            alpha=25.0,
-            beta=6.25,
-            K="paper",
-            n_kernels=50,
-            alpha_phase=-np.log(0.01),
+            DMP(
+                protocol="paper",
+                alpha=25.0,
+                beta=6.25,
+                K="paper",
+                n_kernels=50,
+                alpha_phase=-np.log(0.01),
+            )
         )
         .fit(metres, t)
         .trajectory(goal, dt=dt)
@@ -356,7 +358,7 @@ def test_turns_past_180_degrees_are_reproduced(degrees, protocol):
     """before the fix, SciPy's principal rotation vector wrapped at 180 degrees, and
     190 / 270 / 360 degree turns reproduced 155 / 178 / 171 degrees off."""
     poses, t = screw_turn(degrees)
-    model = CartesianDMP(protocol=protocol).fit(poses, t, units="mm")
+    model = CartesianDMP(DMP(protocol=protocol)).fit(poses, t, units="mm")
     reproduction = model.rollout()[: len(poses)]
     # The README: robot 0.001-0.004 degrees, paper (explicit Euler) 0.1-0.4 degrees.
     assert np.degrees(angle_between(reproduction[:, 3:], poses[:, 3:])).max() <= (
@@ -510,17 +512,20 @@ def test_pose_parameters_after_fit_follow_the_position_rules(demo):
     """Only tau may change after fit (it slows both parts); a learned parameter unfits the model."""
     from bidmp.primitives.cartesian import _PART_PARAMS
 
-    assert set(_PART_PARAMS) == set(CartesianDMP().get_params())
+    assert set(_PART_PARAMS) == set(DMP().get_params())
+    assert set(CartesianDMP(DMP()).get_params()) == {"dmp"} | {
+        f"dmp__{name}" for name in _PART_PARAMS
+    }
     t = np.linspace(0.0, 2.0, len(demo))
-    model = CartesianDMP().fit(demo, t)
+    model = CartesianDMP(DMP()).fit(demo, t)
     nominal = model.trajectory()
-    model.set_params(tau=2.0)
+    model.set_params(dmp__tau=2.0)
     slow = model.trajectory()
     assert slow.duration == pytest.approx(2 * nominal.duration, abs=slow.t[1])  # within one sample
     n = min(len(slow.q[::2]), len(nominal))
     np.testing.assert_allclose(
         slow.q[::2][:n], nominal.q[:n], atol=1e-4
     )  # the same turn, twice as slow
-    model.alpha = 80.0
+    model.dmp.alpha = 80.0
     with pytest.raises(bidmp.NotFittedError, match="alpha"):
         model.rollout()

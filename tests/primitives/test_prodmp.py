@@ -51,6 +51,21 @@ def test_the_weight_basis_is_the_greens_function_of_the_forcing(index):
     assert errors[1] <= 3e-5 and errors[1] <= errors[0] / 8.0
 
 
+@pytest.mark.parametrize("alpha_phase", [1e-6, 0.05, 3.0])
+def test_the_forcing_basis_is_a_softmax_even_where_every_kernel_underflows(alpha_phase):
+    """Independent reference: SciPy's softmax of the kernels' exponents (log-sum-exp). A slow phase
+    leaves late samples so far from every kernel that each one underflows to 0; the basis there is
+    still the normalised one (it was 0/0), and the precomputed basis stays finite."""
+    from scipy.special import softmax
+
+    basis = prodmp_basis(8, alpha_phase=alpha_phase, dt=0.01)
+    times = np.linspace(0.0, 5.9, 300)
+    phase = basis.phase(times)[:, None]
+    exponent = -0.5 * (phase - basis.centres[None, :]) ** 2 * basis.widths[None, :]
+    np.testing.assert_allclose(basis.forcing(times), softmax(exponent, axis=1), rtol=0, atol=1e-12)
+    assert np.all(np.isfinite(basis.position)) and np.all(np.isfinite(basis.velocity))
+
+
 def test_a_trajectory_keeps_its_boundary_and_obeys_its_equation():
     """From any start and start velocity: y(0) and ẏ(0) exactly; the velocity is the positions'
     derivative and the acceleration the velocity's (central differences, fine grid); the

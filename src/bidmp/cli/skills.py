@@ -182,15 +182,18 @@ def _fit_poses(args: argparse.Namespace) -> int:
 
     from ..io.models import save_model
     from ..primitives.cartesian import CartesianDMP, angle_between
+    from ..primitives.dmp import DMP
 
     poses, times, units, how, *_ = read_input(args.demo, args, poses=True, timed=True)
-    model = CartesianDMP(**_dmp_params(args)).fit(poses, times, units=units)
+    model = CartesianDMP(DMP(**_dmp_params(args))).fit(poses, times, units=units)
     path = save_model(model, args.output)
     reproduction = model.rollout()[: len(poses)]
     n = len(reproduction)
     angles = np.degrees(angle_between(reproduction[:, 3:], poses[:n, 3:]))
     unit = model.units_ or "units"
-    print(f"fitted a pose DMP (CartesianDMP, {model.protocol} protocol) on {args.demo}, {how}")
+    print(
+        f"fitted a pose DMP (CartesianDMP, {model.position_.protocol} protocol) on {args.demo}, {how}"
+    )
     print(
         f"  T = {len(poses)} samples over {model.duration_:.4g} s; units {model.units_ or '(not given)'}"
     )

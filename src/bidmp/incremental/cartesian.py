@@ -12,6 +12,7 @@ from .._api import Estimator, clone
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
 from .._threads import single_threaded
 from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
+from ..primitives.dmp import DMP
 from ..primitives.pose_timing import PoseStepper, PoseTrajectory
 from ..primitives.so3 import angle_between, as_quaternions, orientation_from_log, principal_log
 from .bidmp import BiDMP
@@ -275,7 +276,8 @@ class CartesianBiDMP(PoseModel, Estimator):
         self._ensure_started()
         cartesian = self.cartesian_
         return self._parts_state(
-            {"params": cartesian.get_params()},
+            # the parts' template's parameters, as files always held
+            {"params": (DMP() if cartesian.dmp is None else cartesian.dmp).get_params()},
             {
                 "start_": cartesian.start_,
                 "goal_": cartesian.goal_,
@@ -296,7 +298,7 @@ class CartesianBiDMP(PoseModel, Estimator):
             or orientation.dmp_.n_dims_ != 3
         ):
             raise ValueError("the pose Bi-DMP's two parts do not match (skills or dimensions)")
-        cartesian = CartesianDMP(**cls._stored_params(meta["params"]))
+        cartesian = CartesianDMP(DMP(**cls._stored_params(meta["params"])))
         cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
         cartesian._read_pose_ends(arrays)
         cartesian.units_ = position.dmp_.units_

@@ -237,8 +237,12 @@ class PoseModel:
 class CartesianDMP(PoseModel, Estimator):
     """A pose DMP: a position DMP and an orientation DMP on ``Log(q ⊗ g⁻¹)`` (module docstring).
 
-    Parameters are those of :class:`bidmp.DMP` (the same for both parts); as there, only ``tau``
-    may change after ``fit``.
+    Parameters
+    ----------
+    dmp : DMP, optional
+        The parts' template: both parts are fitted copies of it (its parameters, unfitted), so they
+        share its parameters; default ``DMP()`` (the robot protocol). As for a DMP, only ``tau``
+        may change after ``fit`` (``set_params(dmp__tau=2.0)``); the parts follow it.
 
     Attributes
     ----------
@@ -252,44 +256,21 @@ class CartesianDMP(PoseModel, Estimator):
     units_ : str
     """
 
-    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
-        self,
-        n_kernels=None,
-        alpha=None,
-        beta=None,
-        K=None,
-        alpha_phase=None,
-        tau: float = 1.0,
-        regression=None,
-        derivatives: str = "gradient",
-        ridge: float = 1e-8,
-        widths: str = "spacing",
-        protocol: str = "robot",
-        goal_rate=None,
-        integrator=None,
-        keep_approach: bool | None = None,
-        canonical_system=None,
-        forcing_basis=None,
-    ) -> None:
-        self.n_kernels = n_kernels
-        self.alpha = alpha
-        self.beta = beta
-        self.K = K
-        self.alpha_phase = alpha_phase
-        self.tau = tau
-        self.regression = regression
-        self.derivatives = derivatives
-        self.ridge = ridge
-        self.widths = widths
-        self.protocol = protocol
-        self.goal_rate = goal_rate
-        self.integrator = integrator
-        self.keep_approach = keep_approach
-        self.canonical_system = canonical_system
-        self.forcing_basis = forcing_basis
+    def __init__(self, dmp: DMP | None = None) -> None:
+        self.dmp = dmp
+
+    def _template(self) -> DMP:
+        """The parts' template: ``dmp``, checked, or the default DMP."""
+        if self.dmp is None:
+            return DMP()
+        if not isinstance(self.dmp, DMP):
+            raise TypeError(
+                f"dmp must be a bidmp.DMP (the parts' template) or None, got {type(self.dmp).__name__}"
+            )
+        return self.dmp
 
     def _dmp(self) -> DMP:
-        return DMP(**self.get_params())
+        return DMP(**self._template().get_params())
 
     @numerically_guarded
     @single_threaded  # small dense algebra: idle BLAS threads only steal the core
@@ -314,11 +295,12 @@ class CartesianDMP(PoseModel, Estimator):
         """The fitted parts, with this model's parameters (a changed tau is passed on; a changed
         learned parameter makes them refuse, naming it)."""
         check_fitted(self, "position_")
+        template = self._template()
         for part in (self.position_, self.orientation_):
             for (
                 name
             ) in _PART_PARAMS:  # attribute access, not get_params(): this runs on every query
-                value = getattr(self, name)
+                value = getattr(template, name)
                 if getattr(part, name) is not value:
                     setattr(part, name, value)
             part._check_fitted()
@@ -420,14 +402,14 @@ class CartesianDMP(PoseModel, Estimator):
     def _get_state(self) -> tuple[dict, dict]:
         self._parts()
         return self._parts_state(
-            {"params": self.get_params()},
+            {"params": self._template().get_params()},  # the template's, as files always held
             {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_},
         )
 
     @classmethod
     def _from_state(cls, meta: dict, arrays) -> CartesianDMP:
         position, orientation = cls._parts_from_state(DMP, "CartesianDMP", meta, arrays)
-        model = cls(**cls._stored_params(meta["params"]))
+        model = cls(DMP(**cls._stored_params(meta["params"])))
         model.position_, model.orientation_ = position, orientation
         for part in (model.position_, model.orientation_):
             if part.n_dims_ != 3:

@@ -105,11 +105,7 @@ class ProDMPBasis:
 
     def forcing(self, times) -> np.ndarray:
         """(T, n_basis): the normalised RBF forcing basis φ at ``times`` (s)."""
-        phase = self.phase(times)[:, None]
-        rows = np.exp(-0.5 * (phase - self.centres[None, :]) ** 2 * self.widths[None, :])
-        if self.n_basis > 1:
-            rows /= rows.sum(axis=1, keepdims=True)
-        return rows
+        return _rbf_rows(self.phase(times)[:, None], self.centres, self.widths)
 
     def _read(self, values: np.ndarray, times) -> np.ndarray:
         """``values`` (P, ...) on the grid read at ``times`` (s), linearly between grid points."""
@@ -171,7 +167,7 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
     tau = check_real(tau, "tau", positive=True, maximum=1e4)
     delay = check_real(delay, "delay", minimum=-1e4, maximum=1e4)
     alpha = check_real(alpha, "alpha", positive=True, maximum=1e3)
-    alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True, maximum=1e3)
+    alpha_phase = check_real(alpha_phase, "alpha_phase", positive=True, minimum=1e-6, maximum=1e3)
     bandwidth_factor = check_real(bandwidth_factor, "bandwidth_factor", positive=True, maximum=1e3)
     n_outside = check_int(n_outside, "n_outside", minimum=0, maximum=max(0, (n_basis - 2) // 2))
     dt = check_real(dt, "dt", positive=True)
@@ -196,9 +192,7 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
     q1 = (0.5 * alpha * s - 1.0) * grow + 1.0
     q2 = 0.5 * alpha * (grow - 1.0)
     phase = np.exp(-alpha_phase * s)[:, None]
-    rows = np.exp(-0.5 * (phase - centres[None, :]) ** 2 * widths[None, :])
-    if n_basis > 1:
-        rows /= rows.sum(axis=1, keepdims=True)
+    rows = _rbf_rows(phase, centres, widths)
     dp2 = (grow[:, None] * phase) * rows
     dp1 = s[:, None] * dp2
     p1, p2 = _cumulative_trapezoid(dp1, s), _cumulative_trapezoid(dp2, s)
@@ -208,6 +202,23 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
         n_basis, tau, delay, alpha, alpha_phase, bandwidth_factor, n_outside, dt, length_factor,
         centres, widths, position, velocity, y1, y2, dy1, dy2,
     )  # fmt: skip
+
+
+def _rbf_rows(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:
+    """(P, N): the RBF basis at ``phase`` (P, 1), normalised to sum 1 when N > 1 (one kernel is
+    used as it is, as MP_PyTorch does)."""
+    exponent = -0.5 * (phase - centres[None, :]) ** 2 * widths[None, :]
+    rows = np.exp(exponent)
+    if centres.shape[0] > 1:
+        sums = rows.sum(axis=1, keepdims=True)
+        # A slow phase leaves some samples far from every kernel: each underflows, and 0/0 would
+        # follow. Those rows are normalised in the log domain (the same ratios).
+        lost = sums[:, 0] < 1e-290
+        if np.any(lost):
+            shifted = np.exp(exponent[lost] - exponent[lost].max(axis=1, keepdims=True))
+            rows[lost], sums[lost] = shifted, shifted.sum(axis=1, keepdims=True)
+        rows /= sums
+    return rows
 
 
 def _forcing_centres(n_basis, alpha_phase, bandwidth_factor, n_outside):

@@ -86,6 +86,24 @@ _FIELD_CHECKS = {
 }
 
 
+# What the resolution reads of an estimator (the DMP's constructor's parameters).
+_ESTIMATOR_PARAMETERS = (
+    "n_kernels",
+    "alpha",
+    "beta",
+    "K",
+    "alpha_phase",
+    "tau",
+    "regression",
+    "derivatives",
+    "ridge",
+    "widths",
+    "protocol",
+    "goal_rate",
+    "integrator",
+)
+
+
 def _flag(value, name: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise TypeError(f"{name} must be True or False, got {type(value).__name__}")
@@ -182,6 +200,12 @@ class DMPSettings:
         """The settings of a :class:`bidmp.DMP` (or anything with its constructor's parameters)
         as its parameters are now, the protocol's defaults filled in; raises naming the first bad
         parameter."""
+        missing = [name for name in _ESTIMATOR_PARAMETERS if not hasattr(estimator, name)]
+        if missing:
+            raise TypeError(
+                f"estimator must be a bidmp.DMP (or have its constructor's parameters); "
+                f"{type(estimator).__name__} lacks {', '.join(missing)}"
+            )
         return _resolved(estimator)
 
     @classmethod

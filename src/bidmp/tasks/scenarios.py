@@ -647,7 +647,7 @@ def _check_runs(source: str, demonstration: np.ndarray, targets: dict, options: 
         if demonstration.shape[1] == POSE_DIMS:
             from ..primitives.cartesian import CartesianDMP
 
-            model = CartesianDMP(**dmp_params).fit(demonstration)
+            model = CartesianDMP(DMP(**dmp_params)).fit(demonstration)
             for goal in targets.values():
                 model.rollout(goal)
         else:

@@ -139,12 +139,12 @@ class Task:
         params = {**self.dmp, **overrides}
 
         def build():
+            from ...primitives.dmp import DMP
+
             if self.poses:
                 from ...primitives.cartesian import CartesianDMP
 
-                return CartesianDMP(**params).fit(self.demonstration)
-            from ...primitives.dmp import DMP
-
+                return CartesianDMP(DMP(**params)).fit(self.demonstration)
             return DMP(**params).fit(self.demonstration)
 
         return self.shared_model(("dmp", tuple(sorted(params.items()))), build)
