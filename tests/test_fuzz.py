@@ -1058,7 +1058,10 @@ def test_fuzz_cartesian(poses, params, goal, start, duration):
 def test_fuzz_cartesian_bidmp(poses, params, goal, skill):
     params = params if isinstance(params, dict) else {"reg": params}
     model = outcome(
-        "CartesianBiDMP", bidmp.CartesianBiDMP, bidmp.CartesianDMP().fit(good_poses()), **params
+        "CartesianBiDMP",
+        lambda cartesian, **params: bidmp.CartesianBiDMP(cartesian, bidmp.BiDMP(**params)),
+        bidmp.CartesianDMP().fit(good_poses()),
+        **params,
     )
     if model is None:
         return

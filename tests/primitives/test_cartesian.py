@@ -495,9 +495,9 @@ def test_the_pose_api_mirrors_the_position_api(demo, tmp_path):
         atol=1e-4 * np.abs(motion.ydd).max(),
     )
     # CartesianBiDMP: parameters in __init__, clone, fit, trajectory.
-    skills = CartesianBiDMP(model, increments=(10,))
-    assert clone(skills).get_params()["increments"] == (10,)
-    fitted = CartesianBiDMP(increments=(10,)).fit(demo, t, units="mm")
+    skills = CartesianBiDMP(model, bidmp.BiDMP(increments=(10,)))
+    assert clone(skills).get_params()["bidmp__increments"] == (10,)
+    fitted = CartesianBiDMP(bidmp=bidmp.BiDMP(increments=(10,))).fit(demo, t, units="mm")
     np.testing.assert_allclose(fitted.trajectory().poses, motion.poses, atol=1e-9)
     extension = extend_pose_demonstration(
         demo, np.r_[demo[-1, :3] + [60.0, 30.0, 0.0], demo[-1, 3:]], seed=0

@@ -37,7 +37,7 @@ def pose_forgetting(
     check_limit(len(demonstrations), "max_targets", "demonstrations: the number of skills to learn")
     for index, poses in enumerate(demonstrations):
         as_poses(poses, f"demonstrations[{index}]")
-    model = CartesianBiDMP(cartesian, **bidmp_params)
+    model = CartesianBiDMP(cartesian, BiDMP(**bidmp_params))
     queries = [cartesian.goal_]
     when_learned = [model.rollout(cartesian.goal_, skill=skill)]
     for poses in demonstrations:
@@ -55,16 +55,8 @@ def pose_forgetting(
     return out
 
 
-_BIDMP_PARAMS = (
-    "n_windows",
-    "n_mapped",
-    "n_enhance",
-    "increments",
-    "shrink",
-    "reg",
-    "seed",
-    "derivatives",
-)
+# A pose Bi-DMP's parts are Bi-DMPs with its template's parameters, each on a part of the pose DMP.
+_BIDMP_PARAMS = tuple(name for name in BiDMP._get_param_names() if name != "dmp")
 
 
 class CartesianBiDMP(PoseModel, Estimator):
@@ -83,8 +75,10 @@ class CartesianBiDMP(PoseModel, Estimator):
     Parameters
     ----------
     cartesian : CartesianDMP, default None
-    n_windows, n_mapped, n_enhance, increments, shrink, reg, seed, derivatives
-        As :class:`bidmp.BiDMP`, for both parts.
+    bidmp : BiDMP, optional
+        The parts' template (``n_windows``, ``n_enhance``, ``increments``, … as
+        :class:`bidmp.BiDMP`; its ``dmp`` unset: each part's DMP is the pose DMP's); default
+        ``BiDMP()``. ``set_params(bidmp__n_enhance=...)`` changes both parts' before they start.
 
     Attributes
     ----------
@@ -94,30 +88,23 @@ class CartesianBiDMP(PoseModel, Estimator):
     skill_start_logs_ : array (n_skills, 3)
     """
 
-    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one (scikit-learn)
-        self,
-        cartesian: CartesianDMP | None = None,
-        n_windows: int = 10,
-        n_mapped: int = 10,
-        n_enhance: int = 100,
-        increments: tuple[int, ...] = (20, 20),
-        shrink: float = 0.8,
-        reg: float = 1e-4,
-        seed: int = 0,
-        derivatives: str = "auto",
-    ) -> None:
+    def __init__(self, cartesian: CartesianDMP | None = None, bidmp: BiDMP | None = None) -> None:
         self.cartesian = cartesian
-        self.n_windows = n_windows
-        self.n_mapped = n_mapped
-        self.n_enhance = n_enhance
-        self.increments = increments
-        self.shrink = shrink
-        self.reg = reg
-        self.seed = seed
-        self.derivatives = derivatives
+        self.bidmp = bidmp
 
     def _bidmp_params(self) -> dict:
-        return {name: getattr(self, name) for name in _BIDMP_PARAMS}
+        """The parts' Bi-DMP parameters: the template's, checked to be a Bi-DMP without a DMP."""
+        if self.bidmp is None:
+            return {}
+        if not isinstance(self.bidmp, BiDMP):
+            raise TypeError(
+                f"bidmp must be a bidmp.BiDMP (the parts' template) or None, got {type(self.bidmp).__name__}"
+            )
+        if self.bidmp.dmp is not None:
+            raise ValueError(
+                "bidmp is the parts' template: leave its dmp unset (each part's DMP is the pose DMP's)"
+            )
+        return {name: getattr(self.bidmp, name) for name in _BIDMP_PARAMS}
 
     def _start(self, cartesian: CartesianDMP) -> None:
 
@@ -302,7 +289,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         cartesian.position_, cartesian.orientation_ = position.dmp_, orientation.dmp_
         cartesian._read_pose_ends(arrays)
         cartesian.units_ = position.dmp_.units_
-        model = cls(cartesian, **{name: getattr(position, name) for name in _BIDMP_PARAMS})
+        model = cls(cartesian, BiDMP(**{name: getattr(position, name) for name in _BIDMP_PARAMS}))
         model.cartesian_, model.position_, model.orientation_ = cartesian, position, orientation
         shape = (position.n_skills, 4)
         goals = check_loaded(arrays["skill_goal_orientations_"], "skill_goal_orientations_", shape)

@@ -148,7 +148,7 @@ def _pose_bidmp_model(scenario, cartesian, failed, report):
     from ..extension.extend import extend_pose_demonstration
     from ..incremental.cartesian import CartesianBiDMP
 
-    model = CartesianBiDMP(cartesian, **scenario.bidmp.arguments)
+    model = CartesianBiDMP(cartesian, BiDMP(**scenario.bidmp.arguments))
     previous = None
     options = scenario.extension_arguments
     del options["approach"]  # a pose extension keeps the approach
