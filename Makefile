@@ -114,6 +114,7 @@ bench-smoke: $(STAMP)
 	cd benchmarks && ../$(PY) bench_rhythmic.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_promp.py --smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_cartesian.py --repeats 1 > /dev/null
+	cd benchmarks && ../$(PY) bench_cold.py --rounds 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_lasa.py --every 20 --rounds 1 --shapes 1 --out ../.bench-smoke > /dev/null
 	cd benchmarks && ../$(PY) bench_avoidance.py --fields 2 --repeats 1 > /dev/null
 	cd benchmarks && ../$(PY) bench_job.py --repeats 1 > /dev/null
