@@ -6,6 +6,8 @@ parameters resolve to are :mod:`bidmp.primitives.settings`'s.
 
 from __future__ import annotations
 
+import operator
+
 import numpy as np
 
 from .._checks import NotFittedError, check_fitted
@@ -36,6 +38,7 @@ class _FittedParams:
         if names is None:
             names = tuple(name for name in cls._get_param_names() if name != "tau")
             cls._raw_names = names
+            cls._raw_getter = operator.attrgetter(*names)  # one call reads them all
         return names
 
     def _learned_params(self) -> DMPSettings:
@@ -43,7 +46,11 @@ class _FittedParams:
         return self.settings().with_tau(1.0)
 
     def _raw_params(self) -> tuple:
-        return tuple(getattr(self, name) for name in self._raw_param_names())
+        getter = type(self).__dict__.get("_raw_getter")
+        if getter is None:
+            self._raw_param_names()
+            getter = type(self)._raw_getter
+        return getter(self)
 
     def _remember_params(self, resolved: DMPSettings | None = None) -> None:
         """Keep the parameters the weights were learned with: the raw ones and their resolution

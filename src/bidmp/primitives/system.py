@@ -319,9 +319,9 @@ class DMPSystem:
         if forcing_increment is not None:
             forcing = forcing + forcing_increment(phase, basis)
         free = _unit_responses(self.settings, phase, forcing, step).T
-        free += np.outer(start_response, start)
+        free += start_response[:, None] * start  # the outer product, without np.outer's ravels
         if velocity is not None:
-            free += np.outer(velocity_response, velocity)
+            free += velocity_response[:, None] * velocity
         # The integration runs compiled, outside NumPy's floating-point checks: check its output
         # once. With these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
         if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
@@ -346,7 +346,7 @@ class DMPSystem:
             n_steps, start=start, start_velocity=start_velocity, forcing_increment=forcing_increment
         )
         goal = self.goal if goal is None else as_point(goal, free.shape[1], "goal")
-        return free + np.outer(goal_response, goal)
+        return free + goal_response[:, None] * goal
 
     @numerically_guarded
     def rollout_many(

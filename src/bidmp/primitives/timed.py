@@ -80,7 +80,7 @@ def _timed_trajectory(dmp, request: _Rollout):
             dmp.units_,
             "the goal",
         )
-    positions = free + np.outer(goal_response, goal)
+    positions = free + goal_response[:, None] * goal
     if params.exact:
         start = system.start if start is None else as_point(start, free.shape[1], "start")
         velocities, accelerations = _exact_rates(
