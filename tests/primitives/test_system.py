@@ -143,6 +143,18 @@ def test_a_dmps_rollouts_are_its_systems():
     np.testing.assert_allclose(direct.rollout(goal), dmp.rollout(goal), rtol=0, atol=1e-12)
 
 
+def test_a_system_and_its_settings_survive_pickle_and_copy():
+    """Dask ships models between processes; a copy rolls out what the original does."""
+    import copy
+    import pickle
+
+    demo = curved_demo(150, 3, seed=6)
+    system = DMP().fit(demo, np.linspace(0.0, 1.5, 150)).system_
+    for other in (pickle.loads(pickle.dumps(system)), copy.deepcopy(system), copy.copy(system)):
+        assert other.settings == system.settings and other is not system
+        np.testing.assert_array_equal(other.rollout(demo[-1] + 1.0), system.rollout(demo[-1] + 1.0))
+
+
 def test_a_system_is_immutable_and_checks_what_it_is_made_of():
     demo = curved_demo(120, 2, seed=1)
     dmp = DMP().fit(demo)

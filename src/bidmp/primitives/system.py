@@ -149,6 +149,10 @@ class DMPSystem:
     def __setattr__(self, name, value) -> None:
         raise AttributeError(f"a DMPSystem is immutable: {name} cannot be set")
 
+    def __reduce__(self):
+        # pickle and copy rebuild it from its fields (its grid cache is made again when used)
+        return _system_from_fields, ({name: getattr(self, name) for name in _FIELDS},)
+
     def __repr__(self) -> str:
         s = self.settings
         return (
@@ -406,3 +410,8 @@ def _system_of(model, settings: DMPSettings, caches: _Caches) -> DMPSystem:
         },
         caches,
     )
+
+
+def _system_from_fields(fields: dict) -> DMPSystem:
+    """A system again from its fields, as pickled (they were checked when it was made)."""
+    return DMPSystem._of(fields, _Caches())
