@@ -108,7 +108,7 @@ class CartesianBiDMP(PoseModel, Estimator):
 
     def _start(self, cartesian: CartesianDMP) -> None:
 
-        cartesian._parts()
+        cartesian.fitted_parts()
         self.cartesian_ = cartesian
         self.position_ = BiDMP(cartesian.position_, **self._bidmp_params())
         self.orientation_ = BiDMP(cartesian.orientation_, **self._bidmp_params())
@@ -171,7 +171,7 @@ class CartesianBiDMP(PoseModel, Estimator):
 
     def _query(self, goal, skill, start):
         self._ensure_started()
-        self.cartesian_._parts()
+        self.cartesian_.fitted_parts()
         index = self.select_skill(goal, skill)
         goal = None if goal is None else as_point(goal, 7, "goal")
         goal_q = (

@@ -291,9 +291,10 @@ class CartesianDMP(PoseModel, Estimator):
     def __sklearn_is_fitted__(self) -> bool:
         return "position_" in self.__dict__ and self.position_.__sklearn_is_fitted__()
 
-    def _parts(self) -> tuple[DMP, DMP]:
-        """The fitted parts, with this model's parameters (a changed tau is passed on; a changed
-        learned parameter makes them refuse, naming it)."""
+    def fitted_parts(self) -> tuple[DMP, DMP]:
+        """The fitted parts ``(position_, orientation_)`` with the template's parameters passed on
+        (a changed ``tau`` slows both); a learned parameter changed since ``fit`` raises
+        :class:`bidmp.NotFittedError` naming it."""
         check_fitted(self, "position_")
         template = self._template()
         for part in (self.position_, self.orientation_):
@@ -312,7 +313,7 @@ class CartesianDMP(PoseModel, Estimator):
         return self.position_.duration_
 
     def _query(self, goal, start):
-        self._parts()
+        self.fitted_parts()
         goal = self.goal_ if goal is None else as_point(goal, 7, "goal")
         start = self.start_ if start is None else as_point(start, 7, "start")
         goal_q = as_quaternions(goal[3:], "goal's quaternion")[0]
@@ -400,7 +401,7 @@ class CartesianDMP(PoseModel, Estimator):
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
     def _get_state(self) -> tuple[dict, dict]:
-        self._parts()
+        self.fitted_parts()
         return self._parts_state(
             {"params": self._template().get_params()},  # the template's, as files always held
             {"start_": self.start_, "goal_": self.goal_, "start_log_": self.start_log_},
