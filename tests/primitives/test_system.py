@@ -143,6 +143,15 @@ def test_a_dmps_rollouts_are_its_systems():
     np.testing.assert_allclose(direct.rollout(goal), dmp.rollout(goal), rtol=0, atol=1e-12)
 
 
+def test_the_models_built_on_a_dmp_hold_its_system():
+    """Structure guard: MultiDMP's mean motion and BiDMP's skill 0 are their DMP's system."""
+    demo = curved_demo(150, 2, seed=7)
+    multi = bidmp.primitives.MultiDMP().fit([demo, demo + 0.05, demo - 0.05])
+    np.testing.assert_array_equal(multi.system_.rollout(), multi.rollout())
+    skills = bidmp.BiDMP().fit(demo)
+    np.testing.assert_array_equal(skills.system_.rollout(), skills.rollout(skill=0))
+
+
 def test_a_system_and_its_settings_survive_pickle_and_copy():
     """Dask ships models between processes; a copy rolls out what the original does."""
     import copy

@@ -236,6 +236,13 @@ class BiDMP(Estimator):
         return 1 + len(self.blocks_)
 
     @property
+    def system_(self):
+        """Skill 0, the plain DMP, as a :class:`~bidmp.primitives.system.DMPSystem`: a skill's
+        rollout is this system's with the skill's forcing increment."""
+        self._ensure_started()
+        return self.dmp_.system_
+
+    @property
     def n_dims_(self) -> int:
         """Number of dimensions D of the skills."""
         self._ensure_started()

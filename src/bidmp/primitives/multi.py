@@ -103,6 +103,13 @@ class MultiDMP(Estimator):
         if "dmp_" not in self.__dict__:
             raise NotFittedError("this MultiDMP is not fitted yet: call fit(demonstrations) first")
 
+    @property
+    def system_(self):
+        """The mean motion as a :class:`~bidmp.primitives.system.DMPSystem` (the mean weights'
+        DMP's, at its ``tau``)."""
+        self._check_fitted()
+        return self.dmp_.system_
+
     def trajectory(self, goal=None, **options):
         """The mean motion (:meth:`bidmp.DMP.trajectory` of the mean weights)."""
         self._check_fitted()
