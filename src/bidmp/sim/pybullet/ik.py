@@ -106,13 +106,16 @@ def _aimed(current, axis) -> list:
     In closed form (the half-way quaternion): SciPy's ``align_vectors`` gives the same rotation
     at 30x the cost, once per burst (tests/sim/test_free_axis.py compares the two)."""
     x, y, z, w = (float(v) for v in current)
-    tool_z = np.array([2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)])
+    t0, t1, t2 = 2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)
+    tool_z = np.array([t0, t1, t2])
     dot = float(tool_z @ axis)
     if dot < -1.0 + 1e-12:  # opposite: half a turn about any axis across it
         across = np.cross(tool_z, [1.0, 0.0, 0.0] if abs(tool_z[0]) < 0.9 else [0.0, 1.0, 0.0])
         swing = np.append(across / np.linalg.norm(across), 0.0)
     else:
-        swing = np.append(np.cross(tool_z, axis), 1.0 + dot)
+        # np.cross's products and differences, in floats (np.cross costs 40 µs a call, every burst)
+        a0, a1, a2 = (float(v) for v in axis)
+        swing = np.array([t1 * a2 - t2 * a1, t2 * a0 - t0 * a2, t0 * a1 - t1 * a0, 1.0 + dot])
         swing /= np.linalg.norm(swing)
     sx, sy, sz, sw = swing
     return [
