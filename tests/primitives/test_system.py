@@ -198,6 +198,19 @@ def test_a_system_is_immutable_and_checks_what_it_is_made_of():
     for name, value, error, match in bad:
         with pytest.raises(error, match=match):
             DMPSystem(**{**parts, name: value})
+    paper = DMP(protocol="paper").fit(demo)
+    with pytest.raises(ValueError, match="goal_gate is the learned progress gate"):
+        DMPSystem(
+            paper.settings(),
+            paper.weights_,
+            paper.start_,
+            paper.goal_,
+            paper.n_steps_,
+            paper.duration_,
+            paper.centres_,
+            paper.widths_,
+            np.ones(paper.n_steps_),
+        )
 
 
 @pytest.mark.parametrize(
@@ -213,6 +226,7 @@ def test_a_system_is_immutable_and_checks_what_it_is_made_of():
         ({"keep_approach": True}, ValueError, "keep_approach shapes"),
         ({"settle": 0.5}, ValueError, "settle"),
         ({"goal_rate": float("nan")}, ValueError, "goal_rate"),
+        ({"widths": "pydmps"}, ValueError, "widths .'pydmps'. must be the basis's width rule"),
     ],
 )
 def test_settings_refuse_a_bad_field_made_or_replaced(change, error, match):

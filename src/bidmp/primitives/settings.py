@@ -184,6 +184,12 @@ class DMPSettings:
             raise ValueError(
                 f"n_kernels ({self.n_kernels}) must equal the basis's size ({self.basis.size})"
             )
+        expected = self.basis.widths if isinstance(self.basis, GaussianBasis) else ""
+        if self.widths != expected:
+            raise ValueError(
+                f"widths ({self.widths!r}) must be the basis's width rule ({expected!r}; '' for a "
+                f"basis other than GaussianBasis)"
+            )
         if self.regression == "lwr" and not isinstance(self.basis, GaussianBasis):
             raise ValueError(
                 "regression='lwr' weighs each kernel's samples by the decaying phase, which only "

@@ -69,8 +69,8 @@ class DMPSystem:
     centres, widths : array, shape (N,)
         The kernels' centres (phases in (0, 1]) and widths (> 0).
     goal_gate : array, shape (n_train,), optional
-        The learned progress gate on the training grid; required when ``settings.goal_rate`` is
-        None (the robot protocol), ignored otherwise.
+        The learned progress gate on the training grid: required when ``settings.goal_rate`` is
+        None (the robot protocol), refused otherwise.
 
     Attributes
     ----------
@@ -131,6 +131,11 @@ class DMPSystem:
                     "demonstration's progress)"
                 )
             fields["goal_gate"] = as_vector(goal_gate, "goal_gate", length=n_train)
+        elif goal_gate is not None:
+            raise ValueError(
+                f"goal_gate is the learned progress gate of settings with goal_rate=None; these "
+                f"settings' goal is delayed at goal_rate={settings.goal_rate:g}: leave it out"
+            )
         self._set(fields, _Caches())
 
     @classmethod
