@@ -118,6 +118,32 @@ def test_with_tau_is_the_dmp_fitted_with_that_tau(protocol):
     assert plain.system_.settings.tau == 1.0  # the plain system is untouched
 
 
+@pytest.mark.parametrize("protocol", ["robot", "paper"])
+def test_the_step_integrator_driven_by_the_systems_input_gives_its_rollout(protocol):
+    """Two integrations of one system: the compiled LTI path of rollout() against the step
+    integrator (a plain loop here) driven by u = αβ g + K f - K gate (g - y0) on the same grid."""
+    rng = np.random.default_rng(11)
+    demo = curved_demo(160, 2, seed=9)
+    system = DMP(protocol=protocol).fit(demo, np.linspace(0.0, 1.6, 160)).system_.with_tau(1.3)
+    settings, goal = system.settings, demo[-1] + rng.normal(size=2)
+    phase, basis, _, gate = system.grid()
+    inputs = (
+        settings.alpha * settings.beta * goal
+        + settings.K * (basis @ system.weights)
+        - settings.K * gate[:, None] * (goal - system.start)
+    )
+    integrator = system.step_integrator()
+    assert system.canonical_system is settings.canonical_system and system.basis is settings.basis
+    y, z, stepped = system.start.copy(), np.zeros(2), [system.start.copy()]
+    for now, after in zip(inputs[:-1], inputs[1:]):
+        y, z = integrator.step(y, z, now, after, system.dt)
+        stepped.append(y)
+    rollout = system.rollout(goal)
+    np.testing.assert_allclose(
+        np.array(stepped), rollout, rtol=0, atol=1e-9 * np.abs(rollout).max()
+    )
+
+
 def test_a_dmps_rollouts_are_its_systems():
     """Structure guard: the estimator delegates to its system (the same numbers by construction)."""
     demo = curved_demo(180, 2, seed=2)

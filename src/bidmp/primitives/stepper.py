@@ -11,7 +11,6 @@ from .._checks import as_point, check_real
 from .canonical import _TAU_RANGE
 from .coupling import _as_couplings
 from .goal_shift import _goal_complete_time, _GoalShifts, _shortest_blend
-from .integrate import StepIntegrator
 
 __all__ = ["DMPStepper"]
 
@@ -81,7 +80,7 @@ class DMPStepper:
         self._canonical, self._basis = params.canonical_system, params.basis
         self._goal_system = system.goal_system()
         self._time_unit = system.time_unit
-        self._integrator = StepIntegrator(params.alpha, params.beta, self._scale, params.exact)
+        self._integrator = system.step_integrator()
         # (phase, gate, goal, start, u): the end of one step starts the next
         self._last_input = None
         self.phase = self._canonical.initial

@@ -32,7 +32,7 @@ from .._checks import (
 from .forcing import _check_forcing_increment
 from .goals import DelayedGoal, PhaseGate, ProgressGate, _learned_progress_gate
 from .grid import _Caches
-from .integrate import _check_integration, _unit_responses
+from .integrate import StepIntegrator, _check_integration, _unit_responses
 from .rollouts import _iter_rollouts_to, _rollouts_to
 from .settings import DMPSettings
 
@@ -169,6 +169,23 @@ class DMPSystem:
     @property
     def n_dims(self) -> int:
         return self.weights.shape[1]
+
+    @property
+    def canonical_system(self):
+        """The phase (:class:`~bidmp.primitives.canonical.CanonicalSystem`) its settings chose."""
+        return self.settings.canonical_system
+
+    @property
+    def basis(self):
+        """The forcing term's basis (:class:`~bidmp.primitives.forcing.Basis`) its settings chose."""
+        return self.settings.basis
+
+    def step_integrator(self) -> StepIntegrator:
+        """The transformation system one step at a time (exact or Euler, as the settings say) at
+        this system's ``tau``: what a control loop integrates; with no coupling it gives the
+        rollouts' samples (:class:`~bidmp.primitives.stepper.DMPStepper`)."""
+        settings = self.settings
+        return StepIntegrator(settings.alpha, settings.beta, settings.tau, settings.exact)
 
     @property
     def time_unit(self) -> float:
