@@ -367,6 +367,12 @@ TARGETS = (
         ("tests/test_oracles.py", "tests/primitives/test_primitives.py"),
     ),
     Target(
+        "the settings a DMP runs with",
+        "bidmp.primitives.dmp",
+        ("DMP.settings",),
+        ("tests/primitives/test_system.py",),
+    ),
+    Target(
         "CLFD: the protocol's success figures",
         "bidmp.experiments.clfd.metrics",
         ("accuracy_matrix", "continual_metrics", "orientation_error", "demonstration_errors"),
@@ -378,6 +384,28 @@ TARGETS = (
 # flips: (area, function, the source text as written, what replaces it, the bug in words). Each is
 # one exact, unique text in the function's source (a test checks they still are).
 SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
+    # -- the settings a DMP runs with: resolved once per change, never stale
+    (
+        "the settings a DMP runs with",
+        "DMP.settings",
+        "key = (_limits_version(), raw, tuple(map(type, raw)))",
+        "key = (0, raw, tuple(map(type, raw)))",
+        "a verdict not re-judged: settings checked against limits since lowered are served again",
+    ),
+    (
+        "the settings a DMP runs with",
+        "DMP.settings",
+        "key = (_limits_version(), raw, tuple(map(type, raw)))",
+        "key = (_limits_version(), raw, ())",
+        "equal is not the same: alpha = True (== 1) served the settings resolved for 1",
+    ),
+    (
+        "the settings a DMP runs with",
+        "DMP.settings",
+        "raw = self._raw_params() + (self.tau,)",
+        "raw = self._raw_params()",
+        "a dropped argument: a changed tau served the settings of the old one",
+    ),
     # -- the CLFD protocol's success figures
     (
         "CLFD: the protocol's success figures",
