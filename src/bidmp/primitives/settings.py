@@ -75,7 +75,9 @@ _FIELD_CHECKS = {
     "regression": lambda v: check_choice(v, "regression", REGRESSION_CHOICES),
     "derivatives": lambda v: check_choice(v, "derivatives", DERIVATIVE_CHOICES),
     "ridge": lambda v: check_real(v, "ridge", nonnegative=True, maximum=1e6),
-    "widths": lambda v: "" if v == "" else check_choice(v, "widths", WIDTH_CHOICES),
+    "widths": lambda v: (
+        v if isinstance(v, str) and v == "" else check_choice(v, "widths", WIDTH_CHOICES)
+    ),
     "protocol": lambda v: check_choice(v, "protocol", PROTOCOLS),
     "goal_rate": lambda v: None if v is None else _gain(v, "goal_rate"),
     "integrator": lambda v: check_choice(v, "integrator", INTEGRATOR_CHOICES),
@@ -114,9 +116,10 @@ def _flag(value, name: str) -> bool:
 class DMPSettings:
     """The resolved, checked settings of a discrete DMP (what :meth:`bidmp.DMP.settings` returns).
 
-    Every field is a number or a choice, never ``None`` for "the protocol's": the two protocols'
-    defaults are filled in. Made directly, each field is checked as the estimator checks its
-    parameter; :meth:`replace` returns a copy with some changed, checked again.
+    Every field is a number, a choice or a component, never ``None`` for "the protocol's": the two
+    protocols' defaults are filled in (``goal_rate``'s None is a choice: the progress gate). Made
+    directly, each field is checked as the estimator checks its parameter; :meth:`replace` returns
+    a copy with some changed, checked again.
 
     Parameters
     ----------

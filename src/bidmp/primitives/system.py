@@ -82,6 +82,11 @@ class DMPSystem:
         Samples of the training grid: T (paper) or ``round(settle · T)`` (robot).
     n_dims : int
         D.
+
+    Notes
+    -----
+    Immutable as a description: no field can be set. The arrays are not copied (a fitted DMP
+    builds a system for every rollout, on its own arrays), so a system reads what its model holds.
     """
 
     __slots__ = (*_FIELDS, "dt", "_caches")
