@@ -363,7 +363,6 @@ _LEFT = {
     # a pose Bi-DMP learns and queries its two skills.
     "_fit": "CartesianDMP fits its parts with a progress and a name for messages",
     "_check_fitted": "CartesianDMP checks its parts",
-    "_check_params": "CartesianBiDMP and the Bi-DMP's file form check its increments",
     "_learn": "CartesianBiDMP learns each part's skill",
     "_skill_query": "CartesianBiDMP queries each part's skill",
     # The model-file form of the Bi-DMP and the BLS, each in its own module.

@@ -161,6 +161,12 @@ class BiDMP(Estimator):
         self.seed = seed
         self.derivatives = derivatives
 
+    def check_params(self) -> None:
+        """Check the parameters as they are now, as :meth:`fit` and :meth:`learn` do; raise naming
+        the first bad one (for a caller that holds a Bi-DMP's settings before it has a DMP: a
+        scenario's options, a pose Bi-DMP's template)."""
+        self._check_params()
+
     def _check_params(self) -> tuple[tuple[int, ...], str]:
         """Validate the parameters; return the increments and the derivative rule."""
         if self.dmp is not None and not isinstance(self.dmp, DMP):

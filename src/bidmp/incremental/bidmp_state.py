@@ -53,7 +53,7 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
         raise ValueError("params.increments must be a list of integers")
     params["increments"] = tuple(params["increments"])
     model = cls(dmp, **params)
-    model._check_params()
+    model.check_params()
     model._start(dmp)
     model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
     model.gate_phase_ = check_real(

@@ -112,7 +112,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         self.cartesian_ = cartesian
         self.position_ = BiDMP(cartesian.position_, **self._bidmp_params())
         self.orientation_ = BiDMP(cartesian.orientation_, **self._bidmp_params())
-        self.position_._check_params()
+        self.position_.check_params()
         self.skill_goal_orientations_ = cartesian.goal_[None, 3:].copy()
         self.skill_start_orientations_ = cartesian.start_[None, 3:].copy()
         self.skill_start_logs_ = cartesian.start_log_[None].copy()

@@ -124,7 +124,7 @@ class BiDMPOptions(_EstimatorOptions):
     def _check(arguments: dict) -> None:
         from ..incremental.bidmp import BiDMP
 
-        BiDMP(**arguments)._check_params()
+        BiDMP(**arguments).check_params()
 
 
 @dataclass(frozen=True)
