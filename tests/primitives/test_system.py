@@ -178,6 +178,23 @@ def test_the_models_built_on_a_dmp_hold_its_system():
     np.testing.assert_array_equal(skills.system_.rollout(), skills.rollout(skill=0))
 
 
+def test_a_bidmp_query_gives_what_a_control_loop_needs_to_run_the_skill():
+    """A learned skill run by hand — the query's DMP stepped with its increment — commands the
+    samples of the Bi-DMP's own timed trajectory to that goal."""
+    demo = curved_demo(150, 2, seed=8)
+    t = np.linspace(0.0, 1.5, 150)
+    skills = bidmp.BiDMP(bidmp.DMP().fit(demo, t))
+    ramp = np.linspace(0.0, 1.0, 150)[:, None] * np.array([0.8, -0.5])
+    skills.learn(demo + ramp)
+    goal = demo[-1] + np.array([0.9, -0.4])
+    index, goal_q, start, increment, dmp = skills.query(goal)
+    assert index == 1 and increment is not None
+    motion = skills.trajectory(goal, dt=0.005)
+    stepper = dmp.stepper(goal_q, start=start, forcing_increment=increment)
+    commands = np.array([stepper.step(0.005)[0] for _ in range(len(motion.t))])
+    np.testing.assert_allclose(commands, motion.y, rtol=0, atol=1e-9 * np.abs(motion.y).max())
+
+
 def test_a_system_and_its_settings_survive_pickle_and_copy():
     """Dask ships models between processes; a copy rolls out what the original does."""
     import copy
@@ -364,7 +381,6 @@ _LEFT = {
     "_fit": "CartesianDMP fits its parts with a progress and a name for messages",
     "_check_fitted": "CartesianDMP checks its parts",
     "_learn": "CartesianBiDMP learns each part's skill",
-    "_skill_query": "CartesianBiDMP queries each part's skill",
     # The model-file form of the Bi-DMP and the BLS, each in its own module.
     "_get_state": "the model-file protocol every kind implements (io reads it)",
     "_from_state": "the model-file protocol every kind implements (io reads it)",

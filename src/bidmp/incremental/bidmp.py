@@ -428,14 +428,34 @@ class BiDMP(Estimator):
             )
         return self._check_skill_index(skill)
 
+    def query(self, goal=None, *, skill="nearest", start=None) -> tuple:
+        """What a rollout to ``goal`` runs, as :meth:`rollout` resolves it: for a control loop or
+        a rollout of one's own (``dmp.stepper(goal, start=start, forcing_increment=increment)``).
+
+        Parameters
+        ----------
+        goal, start : array (D,), optional
+            Default: the chosen skill's own goal and start.
+        skill : "nearest", "latest" or int
+            As :meth:`select_skill`.
+
+        Returns
+        -------
+        (index, goal, start, increment, dmp)
+            The skill's index; the goal and start (D,); its forcing increment
+            ``(phase, basis) -> (n, D)`` (None for skill 0, the plain DMP); the DMP that runs it
+            (``dmp_``, or a copy timed for a skill learned at another duration).
+        """
+        return self._skill_query(goal, skill, start)
+
     def _skill_query(self, goal, skill, start):
-        """(skill index, goal, start, forcing increment, DMP timed for the skill) of a query, as
-        :meth:`rollout` resolves it."""
+        """:meth:`query` (the rollouts' own call)."""
         self._ensure_started()
-        query = self.skill_goals_[-1] if goal is None else as_point(goal, self.dmp_.n_dims_, "goal")
+        n_dims = self.dmp_.n_dims_
+        query = self.skill_goals_[-1] if goal is None else as_point(goal, n_dims, "goal")
         index = self.select_skill(query, skill)
         goal = self.skill_goals_[index] if goal is None else query
-        start = self.skill_starts_[index] if start is None else start
+        start = self.skill_starts_[index] if start is None else as_point(start, n_dims, "start")
         increment = (
             None if index == 0 else (lambda phase, basis: self._increment(phase, basis, index))
         )

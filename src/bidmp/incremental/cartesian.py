@@ -220,11 +220,11 @@ class CartesianBiDMP(PoseModel, Estimator):
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses
         and ``via_until`` as there)."""
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
-        _, goal_p, start_p, position_increment, position = self.position_._skill_query(
-            goal_p, index, start_p
+        _, goal_p, start_p, position_increment, position = self.position_.query(
+            goal_p, skill=index, start=start_p
         )
-        _, _, start_e, orientation_increment, orientation = self.orientation_._skill_query(
-            np.zeros(3), index, start_e
+        _, _, start_e, orientation_increment, orientation = self.orientation_.query(
+            np.zeros(3), skill=index, start=start_e
         )
         vias = (
             None
