@@ -54,7 +54,7 @@ class _FittedParams:
 
     def _remember_params(self, resolved: DMPSettings | None = None) -> None:
         """Keep the parameters the weights were learned with: the raw ones and their resolution
-        (``resolved``: :meth:`_params` as ``fit`` resolved them a moment ago)."""
+        (``resolved``: :meth:`settings` as ``fit`` resolved them a moment ago)."""
         learned = self._learned_params() if resolved is None else resolved.with_tau(1.0)
         self._learned_with = (self._raw_params(), learned)
 
