@@ -174,3 +174,54 @@ def test_a_model_file_gives_the_same_motions(tmp_path):
     times = np.linspace(0.0, 3.0, 50)
     for a, b in ((model.trajectory(times=times), loaded.trajectory(times=times)),):
         assert np.array_equal(a.y, b.y) and np.array_equal(a.yd, b.yd)
+
+
+def test_the_default_start_is_the_mean_start_point_in_every_call():
+    """A start with three different coordinates: conditioning kept only its first (every
+    coordinate of the conditioned model's start was 5.03), goal_for_end read it so (the end
+    4e-4 off), and rollouts() without starts refused itself."""
+    t, y = demo(offset=(5.0, -3.0, 2.0))
+    model = ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
+    conditioned = model.condition([1.5], y[300][None], 0.0)
+    np.testing.assert_array_equal(conditioned.start_, model.start_)
+    np.testing.assert_allclose(conditioned.rollout()[0], model.start_, rtol=0, atol=1e-12)
+    wanted = y[-1] + np.array([1.0, -2.0, 0.5])
+    end = model.rollout(goal=model.goal_for_end(wanted))[-1]
+    np.testing.assert_allclose(end, wanted, rtol=0, atol=1e-9 * np.abs(wanted).max())
+    np.testing.assert_array_equal(model.rollouts()[0], model.rollout())
+
+
+@pytest.mark.parametrize(
+    "call, error, match",
+    [
+        (lambda m, y: m.condition([0.0], y[[10]], 0.0), ValueError, "times must be > 0"),
+        (
+            lambda m, y: m.condition([1.0, 1.0], y[[10, 20]], 0.0),
+            ValueError,
+            "times: the via-points",
+        ),
+        (lambda m, y: m.rollout(start=y[:2]), ValueError, "start must be one point"),
+        (
+            lambda m, y: m.condition([1.0], y[[10]], 0.0, start=y[:2]),
+            ValueError,
+            "start must be one",
+        ),
+        (lambda m, y: m.rollout(n_steps=2**40), ValueError, "n_steps .* exceeds the limit"),
+        (
+            lambda m, y: m.rollouts(goals=y[-1:], conditioned="yes"),
+            TypeError,
+            "conditioned must be",
+        ),
+        (
+            lambda m, y: m.rollouts(goals=np.broadcast_to(y[-1], (2_000_000, 3))),
+            ValueError,
+            "the rollouts .2000000 starts or goals",
+        ),
+    ],
+)
+def test_a_bad_request_is_refused_by_name(call, error, match):
+    """What the surface sweep found: each was a raw NumPy error, a LinAlgError or 8 TiB asked for."""
+    t, y = demo()
+    model = ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
+    with pytest.raises(error, match=match):
+        call(model, y)

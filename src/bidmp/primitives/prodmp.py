@@ -43,6 +43,8 @@ from .._checks import (
     NotFittedError,
     as_points,
     as_vector,
+    check_bool,
+    check_bytes,
     check_int,
     check_real,
 )
@@ -179,7 +181,9 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
     steps = round(1.0 / (dt / tau))
     n_grid = int(length_factor * steps) + 1
     if n_grid > 2_000_000:
-        raise ValueError(f"dt = {dt:g} s gives a grid of {n_grid} points over the motion: too fine")
+        raise ValueError(
+            f"dt = {dt:g} s gives a grid of {float(n_grid):.3g} points over the motion: too fine"
+        )
     if alpha * length_factor / 2.0 > 700.0:
         raise ValueError("alpha * length_factor / 2 must stay below 700 (e^x overflows)")
     centres, widths = _forcing_centres(n_basis, alpha_phase, bandwidth_factor, n_outside)
@@ -378,7 +382,9 @@ class ProDMP(Estimator):
 
     def _times(self, times, n_steps: int | None) -> np.ndarray:
         if times is None:
-            n_steps = check_int(100 if n_steps is None else n_steps, "n_steps", minimum=2)
+            n_steps = check_int(
+                100 if n_steps is None else n_steps, "n_steps", minimum=2, limit="max_steps"
+            )
             return np.linspace(0.0, self.duration_, n_steps)
         times = as_vector(times, "times")
         if np.any(np.diff(times) < 0) or times[0] < 0:
@@ -388,8 +394,9 @@ class ProDMP(Estimator):
     def _boundary(
         self, start, start_velocity, names=("start", "start_velocity")
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Start(s) and start velocity(ies) as points, refused by the caller's argument ``names``."""
-        start = self.start_ if start is None else as_points(start, self.n_dims_, names[0])
+        """Start(s) and start velocity(ies) as points (k, D), refused by the caller's argument
+        ``names``; the default start is the demonstrations' mean, one point (1, D)."""
+        start = self.start_[None] if start is None else as_points(start, self.n_dims_, names[0])
         velocity = (
             np.zeros_like(start)
             if start_velocity is None
@@ -397,6 +404,17 @@ class ProDMP(Estimator):
         )
         if velocity.shape != start.shape:
             velocity = np.broadcast_to(velocity, start.shape)
+        return start, velocity
+
+    def _single_boundary(self, start, start_velocity) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_boundary` of one motion: one start and one start velocity (1, D) each."""
+        start, velocity = self._boundary(start, start_velocity)
+        for name, values in (("start", start), ("start_velocity", velocity)):
+            if len(values) != 1:
+                raise ValueError(
+                    f"{name} must be one point ({self.n_dims_},) for one motion, got {len(values)} "
+                    f"(rollouts takes many)"
+                )
         return start, velocity
 
     def rollouts(  # noqa: PLR0913 - one batch's boundary, goals and weights
@@ -419,6 +437,7 @@ class ProDMP(Estimator):
         forcing weights move with the goal as the demonstrations say; affine in the goal, so
         still one product)."""
         self._check_fitted()
+        conditioned = check_bool(conditioned, "conditioned")
         t = self._times(times, None)
         starts, velocities = self._boundary(
             starts, start_velocities, ("starts", "start_velocities")
@@ -447,6 +466,9 @@ class ProDMP(Estimator):
                 goal_rows = H[None, :, -1:] * eye[:, None, :]  # the goal weight's own column
                 base = H[:, :-1] @ w[:, :-1].T
         batch = max(len(starts), len(velocities), len(goals))
+        check_bytes(
+            batch * n_times * dims, f"the rollouts ({batch} starts or goals x {n_times} times x D)"
+        )
         for name, values in (
             ("starts", starts),
             ("start_velocities", velocities),
@@ -489,7 +511,7 @@ class ProDMP(Estimator):
         :class:`bidmp.Trajectory`."""
         self._check_fitted()
         t = self._times(times, n_steps)
-        start, velocity = self._boundary(start, start_velocity)
+        start, velocity = self._single_boundary(start, start_velocity)
         w = (
             (
                 self.weight_mean_
@@ -517,7 +539,7 @@ class ProDMP(Estimator):
         reached by moving the goal by what it lacks there, over the goal column's value at tau."""
         self._check_fitted()
         end = as_points(end, self.n_dims_, "end")[0]
-        start, velocity = self._boundary(start, start_velocity)
+        start, velocity = self._single_boundary(start, start_velocity)
         w = self.weight_mean_.reshape(self.n_dims_, -1)
         p0, v0, _, _, H, _ = self.basis_.boundary_maps(np.array([self.duration_]), 0.0)
         there = p0[0] * start[0] + v0[0] * velocity[0] * self.duration_ + H[0] @ w.T
@@ -574,7 +596,11 @@ class ProDMP(Estimator):
                 f"times must hold one time per point of values ({len(values)}), got {len(times)}"
             )
         cov = check_real(cov, "cov", nonnegative=True, maximum=1e12)
-        start, velocity = self._boundary(start, start_velocity)
+        if np.any(times <= 0.0):
+            raise ValueError(
+                "times must be > 0 s: at 0 the motion is at its start (give start= instead)"
+            )
+        start, velocity = self._single_boundary(start, start_velocity)
         p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
         size, dims = self.basis_.n_basis + 1, self.n_dims_
         observed = values - p0[:, None] * start - v0[:, None] * (velocity * self.duration_)
@@ -583,9 +609,15 @@ class ProDMP(Estimator):
         for d in range(dims):
             columns[d * size : (d + 1) * size, d::dims] = H.T
         noise = cov * np.eye(len(times) * dims)
-        mean, weight_cov = condition_gaussian(
-            self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
-        )
+        try:
+            mean, weight_cov = condition_gaussian(
+                self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
+            )
+        except np.linalg.LinAlgError:
+            raise ValueError(
+                "times: the via-points cannot all be met exactly (two at one time, or more than the "
+                "weights can carry); give each its own time, fewer points or cov > 0"
+            ) from None
         conditioned = copy.copy(self)
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, weight_cov
         conditioned.start_, conditioned.start_velocity_ = start[0], velocity[0]
