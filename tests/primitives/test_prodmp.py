@@ -213,6 +213,11 @@ def test_the_default_start_is_the_mean_start_point_in_every_call():
             "conditioned must be",
         ),
         (
+            lambda m, y: m.rollouts(starts=y[:4], goals=y[-3:]),
+            ValueError,
+            "got starts 4, start_velocities 4, goals 3",
+        ),
+        (
             lambda m, y: m.rollouts(goals=np.broadcast_to(y[-1], (2_000_000, 3))),
             ValueError,
             "the rollouts .2000000 starts or goals",

@@ -241,6 +241,9 @@ def test_a_system_is_immutable_and_checks_what_it_is_made_of():
     for name, value, error, match in bad:
         with pytest.raises(error, match=match):
             DMPSystem(**{**parts, name: value})
+    for step in (-0.01, float("nan"), np.ones(2)):
+        with pytest.raises((ValueError, TypeError), match="step"):
+            system.grid(10, step)
     paper = DMP(protocol="paper").fit(demo)
     with pytest.raises(ValueError, match="goal_gate is the learned progress gate"):
         DMPSystem(

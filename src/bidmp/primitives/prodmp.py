@@ -469,15 +469,14 @@ class ProDMP(Estimator):
         check_bytes(
             batch * n_times * dims, f"the rollouts ({batch} starts or goals x {n_times} times x D)"
         )
-        for name, values in (
-            ("starts", starts),
-            ("start_velocities", velocities),
-            ("goals", goals),
-        ):
-            if len(values) not in (1, batch):
-                raise ValueError(
-                    f"{name} must be one point or one per rollout ({batch}), got {len(values)}"
-                )
+        counts = {"starts": len(starts), "start_velocities": len(velocities), "goals": len(goals)}
+        if any(count not in (1, batch) for count in counts.values()):
+            # which one is wrong is the caller's to say: name them all with their counts
+            given = ", ".join(f"{name} {count}" for name, count in counts.items())
+            raise ValueError(
+                f"starts, start_velocities and goals must each be one point or one per rollout, "
+                f"the same number; got {given}"
+            )
         # The rollouts are affine in the starts, start velocities and goals: one matrix product
         # of their coefficients with a row per coefficient writes the whole batch (B, T·D).
         coefficients, rows = [np.ones((batch, 1))], [base.reshape(1, -1)]

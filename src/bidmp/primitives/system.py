@@ -261,6 +261,8 @@ class DMPSystem:
         :meth:`rollout_length`, ``dt``): the phase (n,), the basis rows (n, N), the unit
         responses ``[B, C, V]`` (3, n) of goal, start and start velocity, and the goal gate (n,).
         Cached (the last grid used)."""
+        step = self.dt if step is None else check_real(step, "step", positive=True)
+        self.check_step(step)
         entry = self._caches.entry(self, self.rollout_length(n_steps), step)
         return entry.phase, entry.basis, entry.responses, entry.gate
 
