@@ -70,7 +70,7 @@ class PrimitiveKind:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name.isidentifier():
-            raise ValueError(f"name must be a class name, got {self.name!r:.40}")
+            raise ValueError(f"name must be a class name, got {_quoted(self.name)}")
         for field_name in ("path", "incremental", "cli", "method"):
             value = getattr(self, field_name)
             if value is None and field_name != "path":
@@ -81,9 +81,9 @@ class PrimitiveKind:
                 raise ValueError(
                     f"{field_name} must be 'module:attribute', got {short_token(value, 80)}"
                 )
-        if self.family not in FAMILIES:
+        if not isinstance(self.family, str) or self.family not in FAMILIES:
             raise ValueError(
-                f"family must be one of {', '.join(FAMILIES)}, got {self.family!r:.40}"
+                f"family must be one of {', '.join(FAMILIES)}, got {_quoted(self.family)}"
             )
         for field_name in ("poses", "skills"):
             if not isinstance(getattr(self, field_name), bool):
@@ -93,7 +93,7 @@ class PrimitiveKind:
             not isinstance(flag, str) or not flag.replace("-", "").isalnum() or len(flag) > 40
         ):
             raise ValueError(
-                f"fit_flag must be a flag's name (letters, digits, -), got {flag!r:.40}"
+                f"fit_flag must be a flag's name (letters, digits, -), got {_quoted(flag)}"
             )
         if not isinstance(self.summary, str) or len(self.summary) > 500:
             raise TypeError("summary must be a line of text (at most 500 characters)")
@@ -121,6 +121,16 @@ class PrimitiveKind:
         if self.incremental == self.path:
             return model
         return _import(self.incremental)(model)
+
+
+def _quoted(value, width: int = 40) -> str:
+    """A refused value in one short line, without NumPy (the CLI's help imports this table): text
+    quoted and cut, anything else by its type (an array's repr spans lines, a nested list's
+    recurses)."""
+    if not isinstance(value, str):
+        return type(value).__name__
+    text = "".join(c if c.isprintable() else "?" for c in value[: width + 1])
+    return repr(text[:width] + "…") if len(text) > width else repr(text)
 
 
 def _import(path: str):
@@ -198,7 +208,7 @@ def model_class(name: str) -> type:
     if not isinstance(name, str) or name not in MODEL_KINDS:
         raise ValueError(
             f"name must be a registered model kind ({', '.join(sorted(MODEL_KINDS))}), "
-            f"got {name!r:.40}"
+            f"got {_quoted(name)}"
         )
     return MODEL_KINDS[name].load()
 

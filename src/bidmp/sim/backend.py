@@ -94,7 +94,8 @@ class JointLimits:
             or len(self.lower) != 7
         ):
             raise ValueError(
-                f"JointLimits.fci must be 'panda' or 'fr3' on a 7-joint arm, got {self.fci!r:.40}"
+                f"JointLimits.fci must be 'panda' or 'fr3' on a 7-joint arm, got "
+                f"{short_token(self.fci, 40)}"
             )
 
     @property

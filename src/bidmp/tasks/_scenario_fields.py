@@ -6,6 +6,7 @@ quotes a rejected value short."""
 from __future__ import annotations
 
 import json
+import math
 import os
 from numbers import Integral, Real
 from pathlib import Path
@@ -48,8 +49,14 @@ def _shown(value) -> str:
 
 
 def _number(value, source, key, positive=False):
-    if isinstance(value, bool) or not isinstance(value, Real) or not np.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, Real):
         _fail(source, key, f"expected a number, got {_shown(value)}")
+    try:  # an integer of hundreds of digits is a Real that no float holds
+        finite = math.isfinite(float(value))
+    except OverflowError:
+        finite = False
+    if not finite:
+        _fail(source, key, f"expected a finite number, got {_shown(value)}")
     if positive and value <= 0:
         _fail(source, key, f"must be > 0, got {value}")
     if abs(value) > get_limits().max_abs_value:
@@ -304,7 +311,9 @@ def _robot(data, source: str, base_dir=".", allow_outside: bool = False) -> dict
         robot["base"] = _point(robot["base"], source, "robot.base", 3).tolist()
     if "yaw" in robot:
         robot["yaw"] = _number(robot["yaw"], source, "robot.yaw")
-    if "model" in robot and robot["model"] not in _ROBOT_MODELS:
+    if "model" in robot and (
+        not isinstance(robot["model"], str) or robot["model"] not in _ROBOT_MODELS
+    ):
         _fail(
             source,
             "robot.model",

@@ -204,6 +204,31 @@ class ExtensionStage:
     origin: str = "demonstration"
     in_scene: bool = True
 
+    def __post_init__(self) -> None:
+        # made directly too (not only by a scenario file): checked as the file's are
+        from .._checks import as_vector, short_token
+
+        target = self.target
+        if isinstance(target, str):
+            if not target.strip() or len(target) > 200 or not target.isprintable():
+                raise ValueError(
+                    f"target must be 'centre_of_failed', a target's label or a point, got "
+                    f"{short_token(target, 40)}"
+                )
+        else:
+            point = as_vector(target, "target", min_length=2)
+            if point.shape[0] > 7:
+                raise ValueError(
+                    f"target must be a point (2-3 coordinates, 7 for a pose), got {point.shape[0]}"
+                )
+            object.__setattr__(self, "target", point.tolist())
+        if not isinstance(self.origin, str) or self.origin not in ("demonstration", "previous"):
+            raise ValueError(
+                f"origin must be 'demonstration' or 'previous', got {short_token(self.origin, 40)}"
+            )
+        if not isinstance(self.in_scene, bool):
+            raise TypeError(f"in_scene must be True or False, got {type(self.in_scene).__name__}")
+
     @property
     def from_previous(self) -> bool:
         """Whether the stage grows from the previous stage's extension."""

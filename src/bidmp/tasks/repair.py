@@ -240,7 +240,13 @@ class Repairer:
         self.extension = extension.replace(approach="keep").arguments
         check_seed(seed, "seed")
         if not isinstance(bidmp, BiDMPOptions):
-            bidmp = BiDMPOptions.from_flat(check_options(bidmp, "bidmp"))
+            try:
+                bidmp = BiDMPOptions.from_flat(check_options(bidmp, "bidmp"))
+            except (TypeError, ValueError) as error:  # the options' own words, said of bidmp
+                message = str(error)
+                raise type(error)(
+                    message if message.startswith("bidmp") else f"bidmp: {message}"
+                ) from None
         # the Bi-DMP's keyword arguments
         self.seed, self.order, self.bidmp = seed, tuple(order), bidmp.arguments
         self.allowance = check_real(allowance, "allowance", nonnegative=True)

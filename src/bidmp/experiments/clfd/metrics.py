@@ -7,7 +7,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._checks import _as_bounded_array, as_trajectory, as_vector, check_choice, check_real
+from ..._checks import (
+    _as_bounded_array,
+    _check_finite,
+    as_trajectory,
+    as_vector,
+    check_choice,
+    check_real,
+)
 from ...extension.similarity import dtw_distance, frechet_distance
 from ...tasks.metrics import swept_area
 
@@ -43,6 +50,8 @@ def demonstration_errors(reproduced: np.ndarray, demonstrations: np.ndarray, met
             "reproduced and demonstrations must be (M, T, D) of one shape, got "
             f"{reproduced.shape} and {demonstrations.shape}"
         )
+    _check_finite(reproduced, "reproduced")
+    _check_finite(demonstrations, "demonstrations")
     if not isinstance(metrics, (list, tuple, dict)) or not metrics or len(metrics) > 4:
         raise TypeError("metrics must be a sequence of metric names (at most 4)")
     for metric in metrics:
