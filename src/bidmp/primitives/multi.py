@@ -129,8 +129,7 @@ class MultiDMP(Estimator):
         if goal is not None:  # checked as a rollout would, though the response is the same
             as_point(goal, dmp.n_dims_, "goal")
         system = dmp.system_
-        system.check_step()
-        phase, basis, *_ = system.grid(n_steps)
+        phase, basis, *_ = system.grid(n_steps)  # the grid checks the step
         return _unit_responses(system.settings, phase, basis, system.dt).T
 
     def std(self, goal=None, n_steps: int | None = None) -> np.ndarray:

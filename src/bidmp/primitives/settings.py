@@ -296,57 +296,37 @@ def _resolved(estimator) -> DMPSettings:
     parameters) as they are now, the protocol's defaults filled in; raise naming the first bad one."""
     protocol = check_choice(estimator.protocol, "protocol", PROTOCOLS)
     robot = protocol == "robot"
+    check = _FIELD_CHECKS  # a parameter given is checked as the field it becomes
     alpha = (
         (ROBOT_ALPHA if robot else 25.0)
         if estimator.alpha is None
-        else check_real(
-            estimator.alpha, "alpha", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]
-        )
+        else check["alpha"](estimator.alpha)
     )
-    beta = (
-        alpha / 4.0
-        if estimator.beta is None
-        else check_real(
-            estimator.beta, "beta", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1]
-        )
-    )
+    beta = alpha / 4.0 if estimator.beta is None else check["beta"](estimator.beta)
     K_choice = ("pastor" if robot else "paper") if estimator.K is None else estimator.K
     if isinstance(K_choice, str):
         check_choice(K_choice, "K", K_CHOICES)
         K = alpha if K_choice == "paper" else alpha * beta
     else:
-        K = check_real(
-            K_choice, "K", positive=True, minimum=_GAIN_RANGE[0], maximum=_GAIN_RANGE[1] ** 2
-        )
-    if estimator.alpha_phase is None:
-        alpha_phase = ROBOT_ALPHA_PHASE if robot else 1.0
-    else:
-        alpha_phase = check_real(
-            estimator.alpha_phase,
-            "alpha_phase",
-            positive=True,
-            minimum=_GAIN_RANGE[0],
-            maximum=_GAIN_RANGE[1],
-        )
+        K = check["K"](K_choice)
+    alpha_phase = (
+        (ROBOT_ALPHA_PHASE if robot else 1.0)
+        if estimator.alpha_phase is None
+        else check["alpha_phase"](estimator.alpha_phase)
+    )
     if estimator.goal_rate is None:
         goal_rate = None if robot else alpha_phase
     else:
-        goal_rate = check_real(
-            estimator.goal_rate,
-            "goal_rate",
-            positive=True,
-            minimum=_GAIN_RANGE[0],
-            maximum=_GAIN_RANGE[1],
-        )
+        goal_rate = check["goal_rate"](estimator.goal_rate)
     integrator = (
         ("exact" if robot else "euler")
         if estimator.integrator is None
-        else check_choice(estimator.integrator, "integrator", INTEGRATOR_CHOICES)
+        else check["integrator"](estimator.integrator)
     )
     regression = (
         ("ridge" if robot else "lwr")
         if estimator.regression is None
-        else check_choice(estimator.regression, "regression", REGRESSION_CHOICES)
+        else check["regression"](estimator.regression)
     )
     canonical_system, basis = _components(estimator, alpha_phase, integrator, regression)
     return DMPSettings._trusted(
@@ -355,12 +335,10 @@ def _resolved(estimator) -> DMPSettings:
         beta=beta,
         K=K,
         alpha_phase=alpha_phase,
-        tau=check_real(
-            estimator.tau, "tau", positive=True, minimum=_TAU_RANGE[0], maximum=_TAU_RANGE[1]
-        ),
+        tau=check["tau"](estimator.tau),
         regression=regression,
-        derivatives=check_choice(estimator.derivatives, "derivatives", DERIVATIVE_CHOICES),
-        ridge=check_real(estimator.ridge, "ridge", nonnegative=True, maximum=1e6),
+        derivatives=check["derivatives"](estimator.derivatives),
+        ridge=check["ridge"](estimator.ridge),
         widths=basis.widths if isinstance(basis, GaussianBasis) else "",
         protocol=protocol,
         goal_rate=goal_rate,
@@ -393,7 +371,7 @@ def _components(
         n_kernels = (
             (ROBOT_KERNELS if estimator.protocol == "robot" else 50)
             if estimator.n_kernels is None
-            else check_int(estimator.n_kernels, "n_kernels", minimum=1, limit="max_kernels")
+            else _FIELD_CHECKS["n_kernels"](estimator.n_kernels)
         )
         basis = GaussianBasis(n_kernels, check_choice(estimator.widths, "widths", WIDTH_CHOICES))
     else:
@@ -404,11 +382,7 @@ def _components(
             )
         _component(basis, Basis, "forcing_basis")
         check_int(basis.size, "forcing_basis.size", minimum=1, limit="max_kernels")
-    if regression == "lwr" and not isinstance(basis, GaussianBasis):
-        raise ValueError(
-            "regression='lwr' weighs each kernel's samples by the decaying phase, which only "
-            f"GaussianBasis is scaled by; with {type(basis).__name__} use regression='ridge'"
-        )
+    # (LWR on another basis is refused by the settings' checks across fields)
     return canonical, basis
 
 

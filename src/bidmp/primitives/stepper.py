@@ -65,7 +65,7 @@ class DMPStepper:
             maximum=_TAU_RANGE[1],
         )
         self._system = system = system.with_tau(self._scale)
-        self._params = params = system.settings
+        params = system.settings
         self._couplings, self._temporal = _as_couplings(coupling)
         self._forcing_increment = forcing_increment
         self.y = self.start.copy()
@@ -127,7 +127,7 @@ class DMPStepper:
         """The motion's own time (s) at which it is complete: its duration times the protocol's
         horizon (the robot protocol's 1.1, within which it comes to rest; the paper's 1, its fixed
         horizon)."""
-        return float(self._params.settle * self._scale * self._system.duration)
+        return float(self._system.settings.settle * self._scale * self._system.duration)
 
     @property
     def target(self) -> np.ndarray:
@@ -208,8 +208,7 @@ class DMPStepper:
     def _goal_complete(self) -> float:
         """The motion time (s) from which the DMP's own goal offset is complete."""
         if self._complete is None:
-            system = self._system
-            system.check_step()
+            system = self._system  # its grid checks the step
             n_steps = (
                 int(np.ceil(system.settings.settle * self._scale * (system.n_samples - 1))) + 2
             )
@@ -233,7 +232,7 @@ class DMPStepper:
             and (last[3] == self.start).all()
         ):
             return last[4]
-        params = self._params
+        params = self._system.settings
         basis = self._basis.row(phase, self._centres, self._widths)
         forcing = basis @ self._weights
         if self._forcing_increment is not None:
@@ -255,7 +254,7 @@ class DMPStepper:
         # the usual case checked in one comparison
         if not (type(dt) is float and 1e-6 <= dt <= 1e3):
             dt = check_real(dt, "dt", positive=True, minimum=1e-6, maximum=1e3)
-        params = self._params
+        params = self._system.settings
         time_unit = self._time_unit
         slowdown = 1.0
         offset = self._shifts.at(self.time) if self._shifts else None

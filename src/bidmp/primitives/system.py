@@ -248,8 +248,13 @@ class DMPSystem:
     def check_step(self, step: float | None = None) -> None:
         """Refuse a normalised grid step (default ``dt``) on which this system's integration is
         unstable (explicit Euler) or out of range."""
+        self._checked_step(step)
+
+    def _checked_step(self, step: float | None) -> float:
+        """``step`` (default ``dt``) checked as a number and for the integrator; returned."""
         step = self.dt if step is None else check_real(step, "step", positive=True)
         _check_integration(step, self.settings)
+        return step
 
     def phase(self, n_steps: int | None = None) -> np.ndarray:
         """Phase at each rollout sample, shape ``(n_steps,)`` (default :meth:`rollout_length`)."""
@@ -261,8 +266,7 @@ class DMPSystem:
         :meth:`rollout_length`, ``dt``): the phase (n,), the basis rows (n, N), the unit
         responses ``[B, C, V]`` (3, n) of goal, start and start velocity, and the goal gate (n,).
         Cached (the last grid used)."""
-        step = self.dt if step is None else check_real(step, "step", positive=True)
-        self.check_step(step)
+        step = self._checked_step(step)
         entry = self._caches.entry(self, self.rollout_length(n_steps), step)
         return entry.phase, entry.basis, entry.responses, entry.gate
 
@@ -333,8 +337,7 @@ class DMPSystem:
             The goal gate on the grid.
         """
         _check_forcing_increment(forcing_increment)
-        step = self.dt if step is None else check_real(step, "step", positive=True)
-        self.check_step(step)
+        step = self._checked_step(step)
         n_dims = self.weights.shape[1]
         n_steps = self.rollout_length(n_steps)
         start = self.start if start is None else as_point(start, n_dims, "start")

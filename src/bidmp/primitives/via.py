@@ -237,8 +237,7 @@ def _via_trajectory(dmp, request: _Rollout):
         system.goal if goal is None else as_point(goal, system.n_dims, "goal"),
         system.start if start is None else as_point(start, system.n_dims, "start"),
     )
-    system = system.with_tau(motion / system.duration)
-    system.check_step(step)
+    system = system.with_tau(motion / system.duration)  # its grid checks the step
     if until is not None:
         until = check_real(until, "via_until", positive=True)
         if np.any(times > until):
