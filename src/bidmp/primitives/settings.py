@@ -236,20 +236,17 @@ class DMPSettings:
                 f"replace: unknown setting(s) {', '.join(sorted(map(str, unknown)))}; known: "
                 f"{', '.join(_FIELD_CHECKS)}"
             )
-        fields = {name: getattr(self, name) for name in _FIELD_CHECKS}
-        fields.update({name: _FIELD_CHECKS[name](value) for name, value in changes.items()})
-        return DMPSettings._trusted(**fields)
+        return self._copy(**{name: _FIELD_CHECKS[name](value) for name, value in changes.items()})
 
     def with_tau(self, tau: float) -> DMPSettings:
         """A copy at temporal scaling ``tau`` (checked; the hot path of every timed rollout)."""
         tau = _FIELD_CHECKS["tau"](tau)
-        if tau == self.tau:
-            return self
-        settings = object.__new__(DMPSettings)
-        for name in _FIELD_CHECKS:
-            object.__setattr__(settings, name, getattr(self, name))
-        object.__setattr__(settings, "tau", float(tau))
-        return settings
+        return self if tau == self.tau else self._copy(tau=tau)
+
+    def _copy(self, **checked) -> DMPSettings:
+        """A copy with ``checked`` fields changed (each checked by the caller)."""
+        fields = {name: getattr(self, name) for name in _FIELD_CHECKS}
+        return DMPSettings._trusted(**{**fields, **checked})
 
     def as_dict(self) -> dict:
         """The fields by name (the components as the objects they are)."""
