@@ -1,10 +1,11 @@
 """The compiled loops (``bidmp._kernels``) against independent references: SciPy's ``lfilter`` for
 the spring's integration, SciPy's ``Rotation`` for quaternion logs and exponentials, ``np.interp``
 for resampling, the NumPy expressions they replaced for the forcing target, the goal gate and share,
-the rest blend and the exact state, NumPy's norms and sums for the arc length and a motion's
-peaks, plain loops for the band products, and plain NumPy searches for the decisions (the rest
-blend's windows, a band's edges; the straight tail is checked against its plain search in
-test_approach.py).
+the rest blend, the exact state, a trajectory's rates and the held responses, NumPy's norms and
+sums for the arc length and a motion's peaks, NumPy's reductions for the finite and range scans,
+plain loops for the band products, plain NumPy searches for the decisions (the rest blend's
+windows, a band's edges; the straight tail is checked against its plain search in
+test_approach.py), and the checked path (``check_timestamps``) for the timestamps' verdict.
 
 Each compares to the last bit (``view(np.int64)``), on random inputs at scales and lengths the
 library was not tuned on: the kernels replaced NumPy expressions whose numbers the committed results
@@ -19,11 +20,15 @@ from scipy.signal import lfilter
 from scipy.spatial.transform import Rotation
 
 from bidmp._kernels import (
+    all_finite,
     arclength,
     band_of,
     band_product,
     band_transposed_product,
+    exact_rates,
     exact_state,
+    extent,
+    foh_responses,
     forcing_target,
     goal_gate,
     goal_share,
@@ -36,6 +41,8 @@ from bidmp._kernels import (
     rest_blended,
     rest_windows,
     second_order,
+    stamp_verdict,
+    strictly_decreasing,
 )
 from bidmp.primitives.goals import _smoothstep, _smoothstep_derivatives
 from bidmp.primitives.rest import _BLEND_SHAPE, _BLEND_U, _REST_CANDIDATES
@@ -262,6 +269,19 @@ def test_the_rest_blend_loops_are_the_numpy_expression_to_the_bit():
         assert np.array_equal(_bits(out), _bits(expected)), trial
 
 
+def _numpy_exact_state(y, inputs, p, alpha, beta, tau):
+    """``z`` and the acceleration of an exact rollout as NumPy expressions (the code replaced)."""
+    p11, p12, now, after = p
+    z = y[1:] - p11 * y[:-1]
+    z -= now * inputs[:-1]
+    z -= after * inputs[1:]
+    z /= p12
+    acceleration = inputs[:-1] - alpha * beta * y[:-1]
+    acceleration -= alpha * z
+    acceleration /= tau**2
+    return z, acceleration
+
+
 def test_the_exact_state_loop_is_the_numpy_expression_to_the_bit():
     rng = np.random.default_rng(14)
     for _ in range(100):
@@ -269,13 +289,7 @@ def test_the_exact_state_loop_is_the_numpy_expression_to_the_bit():
         y, inputs = rng.normal(size=(2, n_samples, n_dims)) * 10 ** rng.uniform(-3, 3)
         p11, p12, now, after = rng.normal(size=4)
         alpha, beta, tau = rng.uniform(1, 100), rng.uniform(1, 30), rng.uniform(0.3, 3.0)
-        z = y[1:] - p11 * y[:-1]
-        z -= now * inputs[:-1]
-        z -= after * inputs[1:]
-        z /= p12
-        acceleration = inputs[:-1] - alpha * beta * y[:-1]
-        acceleration -= alpha * z
-        acceleration /= tau**2
+        z, acceleration = _numpy_exact_state(y, inputs, (p11, p12, now, after), alpha, beta, tau)
         out_z, out_acceleration = exact_state(
             y, inputs, p11, p12, now, after, alpha * beta, alpha, tau**2
         )
@@ -283,6 +297,153 @@ def test_the_exact_state_loop_is_the_numpy_expression_to_the_bit():
         assert np.array_equal(_bits(out_acceleration), _bits(acceleration))
     with pytest.raises(ValueError, match="same shape"):
         exact_state(np.zeros((3, 2)), np.zeros((3, 1)), 1.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0)
+
+
+def _numpy_exact_rates(signals, z_first, gains, p, scales):
+    """A timed trajectory's rates as NumPy expressions (the code the kernel replaced)."""
+    y, forcing, gate, goal, start = signals
+    K, alpha, beta, tau = gains
+    inputs = K * forcing
+    inputs -= np.multiply.outer(gate, K * (goal - start))
+    inputs += alpha * beta * goal
+    z, acceleration = _numpy_exact_state(y, inputs, p, alpha, beta, tau)
+    z[0] = 0.0 if z_first is None else z_first
+    acceleration[0] = (inputs[0] - alpha * beta * y[0] - alpha * z[0]) / tau**2
+    return z / scales[0], acceleration / scales[1]
+
+
+def test_the_exact_rates_loop_is_the_numpy_expressions_to_the_bit():
+    """Random lengths, dimensions, scales, gains, starts at rest and moving."""
+    rng = np.random.default_rng(15)
+    for trial in range(100):
+        n_samples, n_dims = int(rng.integers(2, 1500)), int(rng.integers(1, 7))
+        scale = 10 ** rng.uniform(-3, 3)
+        y, forcing = rng.normal(size=(2, n_samples, n_dims)) * scale
+        gate = rng.uniform(0.0, 1.0, n_samples)
+        goal, start = rng.normal(size=(2, n_dims)) * scale
+        z_first = None if trial % 2 else rng.normal(size=n_dims) * scale
+        p = rng.normal(size=4)
+        alpha, beta, tau, K = rng.uniform(1, 100), rng.uniform(1, 30), rng.uniform(0.3, 3.0), 0.0
+        K = alpha * beta if trial % 3 else rng.uniform(1, 1000)
+        scales = rng.uniform(0.1, 10.0, 2)
+        expected = _numpy_exact_rates(
+            (y, forcing, gate, goal, start), z_first, (K, alpha, beta, tau), p, scales
+        )
+        out = exact_rates(
+            y, forcing, gate, goal, start, z_first, K, alpha * beta, alpha, tau**2, *p, *scales
+        )
+        for got, want in zip(out, expected, strict=True):
+            assert np.array_equal(_bits(got), _bits(want)), trial
+    with pytest.raises(ValueError, match="exact_rates"):
+        exact_rates(
+            np.zeros((3, 2)), np.zeros((3, 1)), np.zeros(3), np.zeros(2), np.zeros(2), None,
+            *np.ones(10),
+        )  # fmt: skip
+
+
+def test_the_held_responses_are_the_numpy_expressions_and_the_filter_to_the_bit():
+    """foh_responses against its NumPy expressions followed by second_order (itself checked
+    against SciPy's lfilter above): random signals, scales, states and steps of the spring."""
+    from bidmp.primitives.integrate import _foh_step
+
+    rng = np.random.default_rng(18)
+    for trial in range(100):
+        n_signals, n = int(rng.integers(1, 5)), int(rng.integers(3, 1200))
+        inputs = rng.normal(size=(n, n_signals)).T * 10 ** rng.uniform(-3, 3)  # strided
+        y_first, z_first = (None, None) if trial % 3 == 0 else rng.normal(size=(2, n_signals))
+        transition, now, after = _foh_step(
+            rng.uniform(1e-4, 0.05), rng.uniform(1, 80), rng.uniform(1, 30), rng.uniform(0.3, 3)
+        )
+        y0 = np.zeros(n_signals) if y_first is None else y_first
+        z0 = np.zeros(n_signals) if z_first is None else z_first
+        y1 = (
+            transition[0, 0] * y0
+            + transition[0, 1] * z0
+            + now[0] * inputs[:, 0]
+            + after[0] * inputs[:, 1]
+        )
+        (p11, p12), (p21, p22) = transition
+        held = np.array(
+            [after[0], now[0] - p22 * after[0] + p12 * after[1], -p22 * now[0] + p12 * now[1]]
+        )
+        expected = second_order(
+            inputs, y0, y1, 1.0, 0.0, 0.0, -(p11 + p22), p11 * p22 - p12 * p21, held=held
+        )
+        out = foh_responses(inputs, y_first, z_first, transition, now, after)
+        assert np.array_equal(_bits(out), _bits(expected)), trial
+    with pytest.raises(ValueError, match="foh_responses"):
+        foh_responses(np.zeros((2, 2)), None, None, transition, now, after)
+
+
+def test_the_finite_scans_are_numpys_reductions():
+    """all_finite, extent and strictly_decreasing against NumPy's isfinite, min, max and diff, with
+    NaN and inf planted at random places, static and decreasing runs included."""
+    rng = np.random.default_rng(16)
+    for trial in range(300):
+        n, d = int(rng.integers(1, 60)), int(rng.integers(1, 5))
+        values = rng.normal(size=(n, d)) * 10 ** rng.uniform(-5, 5)
+        if trial % 4 == 1:
+            values[rng.integers(n), rng.integers(d)] = rng.choice([np.nan, np.inf, -np.inf])
+        if trial % 7 == 2:
+            values[:] = values[0]
+        finite = bool(np.all(np.isfinite(values)))
+        assert all_finite(values) is finite
+        assert all_finite(values.T) is finite  # strided
+        got = extent(values)
+        assert got[0] is finite
+        if finite:
+            assert got[1:] == (values.min(), values.max(), np.abs(values - values[0]).max())
+        row = np.sort(values[:, 0])[::-1] if trial % 2 else values[:, 0]
+        assert strictly_decreasing(row) is bool(np.all(np.diff(row) < 0.0))
+
+
+def test_the_stamp_verdict_is_the_checked_path():
+    """stamp_verdict passes exactly the stamps check_timestamps takes (1 where _resampled would
+    copy the samples, 2 where it resamples) and leaves every other one (0) to the checked path:
+    random jittered, uniform, epoch, repeated, backward, NaN, huge and out-of-rate stamps."""
+    from bidmp.primitives.timing import (
+        _MAX_STAMP_S,
+        MAX_RATE_HZ,
+        MIN_RATE_HZ,
+        _resampled,
+        check_timestamps,
+    )
+
+    rng = np.random.default_rng(17)
+    seen = set()
+    for trial in range(600):
+        n = int(rng.integers(1, 200))
+        rate = 10 ** rng.uniform(-0.5, 5.5)
+        if trial % 13 == 5:  # at the rate bounds, within a thousandth
+            rate = rng.choice([MIN_RATE_HZ, MAX_RATE_HZ]) * (1.0 + rng.uniform(-1e-3, 1e-3))
+        t = rng.uniform(-1e3, 1.7e9) * (trial % 3 == 0) + np.arange(n) / rate
+        if trial % 2:  # jitter, from rounding-sized (near the uniform line) to large
+            t = t + rng.uniform(0, 1, n) * 10 ** rng.uniform(-13, -0.5) / rate
+        kind = trial % 11
+        if kind == 1 and n > 2:
+            t[rng.integers(1, n)] = t[0]  # a repeat or a step back
+        elif kind == 4 and n > 2:
+            k = int(rng.integers(1, n))
+            t[k] = t[k - 1]  # a repeated stamp
+        elif kind == 2:
+            t[rng.integers(n)] = rng.choice([np.nan, np.inf])
+        elif kind == 3:
+            t = t + 2e12
+        verdict = stamp_verdict(t, MIN_RATE_HZ, MAX_RATE_HZ, _MAX_STAMP_S)
+        try:
+            stamps = check_timestamps(t, n)
+        except ValueError:
+            assert verdict == 0, trial
+            seen.add(0)
+            continue
+        assert verdict in (1, 2), trial
+        steps = np.diff(stamps - stamps[0])
+        assert (verdict == 1) == (np.ptp(steps) <= 1e-9 * np.mean(steps)), trial
+        y = rng.normal(size=(n, 2))
+        if verdict == 1:  # the samples as they are, as the checked path takes them
+            assert np.array_equal(_resampled(y, stamps)[0], y), trial
+        seen.add(verdict)
+    assert seen == {0, 1, 2}
 
 
 def test_the_resampling_scan_is_np_interp_to_the_bit():

@@ -406,6 +406,20 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
         "raw = self._raw_params()",
         "a dropped argument: a changed tau served the settings of the old one",
     ),
+    (
+        "the settings a DMP runs with",
+        "DMP.settings",
+        "settings = _SHARED_SETTINGS.get((type(self), key)) if shared else None",
+        "settings = _SHARED_SETTINGS.get((DMP, key)) if shared else None",
+        "a wrong class: a subclass served the settings DMP resolved for its parameters",
+    ),
+    (
+        "the settings a DMP runs with",
+        "DMP.settings",
+        "shared = self.canonical_system is None and self.forcing_basis is None",
+        "shared = self.forcing_basis is None",
+        "a verdict not re-judged: a user's own phase (it may change) shared between models",
+    ),
     # -- the CLFD protocol's success figures
     (
         "CLFD: the protocol's success figures",
@@ -614,6 +628,15 @@ KNOWN_CLEARANCE = (
     "verdict.clearance if motion is out.motion and how == 'lift' else None)"
 )
 EQUIVALENT: dict[tuple[str, str, str, str], str] = {
+    # -- the settings a DMP runs with: no parameter value that cannot be a dict key resolves (an
+    # array, a list: each field's check refuses it), so the unshared branch's flag is never read
+    (
+        "bidmp.primitives.dmp",
+        "DMP.settings",
+        "shared, settings = (False, None)",
+        "False -> True",
+    ): "every unhashable parameter value is refused by the resolution that follows, before the "
+    "shared cache would store it",
     # -- the CLFD protocol's figures: n of a matrix that is not square and 2-D is never used (the
     # next line refuses it); a zero training time's floor only has to make t0 / t huge
     **{

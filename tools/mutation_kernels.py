@@ -175,6 +175,47 @@ MUTANTS = (
         "                value = values[i, j]\n                column = first[i] + j",
         "                value = values[i, j]\n                column = j",
     ),
+    # the fit's input checks in one pass: a repeat taken, a rate miscounted, the uniform line moved
+    Mutant("stamp_verdict", "if not t[i] > t[i - 1]:", "if not t[i] >= t[i - 1]:"),
+    Mutant("stamp_verdict", "rate = (n - 1) / (t[n - 1] - t[0])", "rate = n / (t[n - 1] - t[0])"),
+    Mutant(
+        "stamp_verdict",
+        "return 1 if high - low <= 1e-9 * (total / (n - 1)) else 2",
+        "return 1 if high - low <= 1e-6 * (total / (n - 1)) else 2",
+    ),
+    Mutant("extent", "offset = fabs(value - y[0, k])", "offset = fabs(value - y[0, 0])"),
+    Mutant(
+        "all_finite",
+        "            for k in range(n_dims):\n                if not fabs(values[i, k])",
+        "            for k in range(n_dims - 1):\n                if not fabs(values[i, k])",
+    ),
+    Mutant(
+        "strictly_decreasing",
+        "if not values[i] < values[i - 1]:",
+        "if not values[i] <= values[i - 1]:",
+    ),
+    # a timed trajectory's rates and the held responses: a start velocity dropped, a sample off by
+    # one, the hold's weights of the wrong end, the second sample's input of the wrong sample
+    Mutant(
+        "exact_rates",
+        "z = 0.0 if at_rest else z_first[k]",
+        "z = 0.0",
+    ),
+    Mutant(
+        "exact_rates",
+        "now = (K * forcing[l, k] - gate[l] * offset[k]) + held[k]",
+        "now = (K * forcing[l, k] - gate[l + 1] * offset[k]) + held[k]",
+    ),
+    Mutant(
+        "foh_responses",
+        "cdef double b1 = now[0] - p22 * after[0] + p12 * after[1]",
+        "cdef double b1 = now[0] - p22 * after[0] + p12 * after[0]",
+    ),
+    Mutant(
+        "foh_responses",
+        "+ after[0] * inputs[row, 1]",
+        "+ after[0] * inputs[row, 2]",
+    ),
 )
 
 

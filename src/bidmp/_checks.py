@@ -21,6 +21,8 @@ from numbers import Integral, Real
 
 import numpy as np
 
+from ._kernels import extent as _extent
+
 __all__ = [
     "as_unit_quaternion",
     "check_names",
@@ -343,12 +345,10 @@ def as_trajectory(
     check_limit(n_dims, "max_dims", f"{name}: the number of dimensions D")
     if n_points == 0:
         return np.ascontiguousarray(array)
-    # Flat reductions only: a column-wise min/max over a (T, 2) array is a strided loop ten times
-    # slower than these, and this runs on every fit. NaN and inf propagate into the flat min/max;
-    # the detailed scans run only to word an error.
-    flat = array.reshape(-1)
-    low, high = float(flat.min()), float(flat.max())
-    if not (np.isfinite(low) and np.isfinite(high)):
+    # One compiled pass for the finiteness, the range and the motion (on every fit: as NumPy
+    # reductions they were a dozen calls); the detailed scans run only to word an error.
+    finite, low, high, motion = _extent(array)
+    if not finite:
         _check_finite(array, name)
     scale = max(-low, high)
     if scale > _LIMITS.max_abs_value:
@@ -356,7 +356,6 @@ def as_trajectory(
     if not allow_static:
         # The largest distance of any coordinate from the start: 0 for a static demonstration,
         # and within a factor 2·sqrt(D) of the bounding-box diagonal.
-        motion = float(np.max(np.abs(array - array[0])))
         if motion == 0.0:
             raise ValueError(f"{name} is degenerate: all {n_points} points are identical")
         if motion < _LIMITS.min_extent or motion < 1e-12 * scale:
@@ -409,7 +408,8 @@ def check_int(
 ) -> int:
     """Return ``value`` as an ``int`` after checking it is an integer >= ``minimum``, at most
     ``maximum`` and within the :class:`Limits` field ``limit``."""
-    if isinstance(value, bool) or not isinstance(value, Integral):
+    # An int is the common case: ``Integral`` is an abstract class, whose check costs a microsecond.
+    if type(value) is not int and (isinstance(value, bool) or not isinstance(value, Integral)):
         raise TypeError(
             f"{name} must be an integer, got {type(value).__name__} {short_token(value)}"
         )

@@ -300,6 +300,48 @@ def second_order(
     return out.base
 
 
+def foh_responses(
+    const double[:, :] inputs,
+    const double[:] y_first,
+    const double[:] z_first,
+    const double[:, :] transition,
+    const double[:] now,
+    const double[:] after,
+):
+    """Exact (first-order hold) positions (S, n) of S signals driven by ``inputs`` (S, n), n >= 3, from ``y[0] = y_first`` and ``z[0] = z_first`` (S,) each (None: zeros): the second
+    sample from the state's transition (2, 2) and the hold's ``now`` and ``after`` weights (2,),
+    then :func:`second_order` with the held system's transfer function written out for
+    ``C = [1, 0]`` — the NumPy expressions it replaced, operation for operation."""
+    cdef Py_ssize_t n_signals = inputs.shape[0], n = inputs.shape[1], row, k
+    if n < 3 or (y_first is not None and y_first.shape[0] != n_signals) or (
+        z_first is not None and z_first.shape[0] != n_signals
+    ):
+        raise ValueError(
+            f"foh_responses: {n} samples (3 or more wanted) and y_first, z_first of one value per signal"
+        )
+    cdef double p11 = transition[0, 0], p12 = transition[0, 1]
+    cdef double p21 = transition[1, 0], p22 = transition[1, 1]
+    cdef double a1 = -(p11 + p22)
+    cdef double a2 = p11 * p22 - p12 * p21
+    cdef double b0 = after[0]
+    cdef double b1 = now[0] - p22 * after[0] + p12 * after[1]
+    cdef double b2 = -p22 * now[0] + p12 * now[1]
+    cdef double[:, ::1] out = empty((n_signals, n))
+    cdef double[::1] held = empty(3)
+    cdef double first, z
+    held[0] = b0
+    held[1] = b1
+    held[2] = b2
+    with nogil:
+        for row in range(n_signals):
+            first = 0.0 if y_first is None else y_first[row]
+            z = 0.0 if z_first is None else z_first[row]
+            out[row, 0] = first
+            out[row, 1] = ((p11 * first + p12 * z) + now[0] * inputs[row, 0]) + after[0] * inputs[row, 1]
+            _filter_row(inputs, row, out, 1.0, 0.0, 0.0, a1, a2, held)
+    return out.base
+
+
 def forcing_target(
     const double[:, :] y,
     const double[:] gate,
@@ -459,6 +501,45 @@ def rest_blended(
     return out.base
 
 
+def stamp_verdict(const double[:] t, double min_rate, double max_rate, double max_abs):
+    """What a fit makes of timestamps ``t`` (n,) in one pass: 1 if they are valid and uniform
+    (their steps, from the first stamp, spread by at most 1e-9 of their mean: the samples are
+    taken as they are), 2 if valid and to be resampled, 0 for anything the checked path must
+    word or repair — fewer than two, NaN, inf or beyond ``max_abs``, a step that is not positive
+    (a repeated stamp is dropped there), a rate outside [``min_rate``, ``max_rate``] Hz. The
+    mean step is summed in order (NumPy sums pairwise): only a spread within rounding of the
+    1e-9 line could be judged otherwise, and either way the samples are the same to ~1e-9."""
+    cdef Py_ssize_t n = t.shape[0], i
+    cdef double first, previous, value, step, low = INFINITY, high = -INFINITY, total = 0.0
+    cdef double rate
+    cdef bint valid = n >= 2
+    with nogil:
+        for i in range(n if valid else 0):
+            if not fabs(t[i]) <= max_abs:  # (NaN compares false)
+                valid = False
+                break
+        first = t[0] if valid else 0.0
+        previous = 0.0
+        for i in range(1, n if valid else 0):
+            if not t[i] > t[i - 1]:
+                valid = False
+                break
+            value = t[i] - first
+            step = value - previous
+            previous = value
+            total += step
+            if step < low:
+                low = step
+            if step > high:
+                high = step
+    if not valid:
+        return 0
+    rate = (n - 1) / (t[n - 1] - t[0])
+    if not (min_rate <= rate <= max_rate):
+        return 0
+    return 1 if high - low <= 1e-9 * (total / (n - 1)) else 2
+
+
 def interp_columns(const double[:] x_new, const double[:] x, const double[:, :] y):
     """``np.interp(x_new, x, column)`` for every column of ``y`` (n, D), as (m, D): ``x`` (n,)
     increasing and ``x_new`` (m,) non-decreasing (a resampling grid), so one merge scan finds each
@@ -539,6 +620,65 @@ def exact_state(
                     inputs[l, k] - alpha_beta * y[l, k] - alpha * z[l, k]
                 ) / tau_squared
     return z.base, acceleration.base
+
+
+def exact_rates(
+    const double[:, :] y,
+    const double[:, :] forcing,
+    const double[:] gate,
+    const double[:] goal,
+    const double[:] start,
+    const double[:] z_first,
+    double K,
+    double alpha_beta,
+    double alpha,
+    double tau_squared,
+    double transition_yy,
+    double transition_yz,
+    double now_y,
+    double after_y,
+    double z_scale,
+    double acceleration_scale,
+):
+    """Velocities and accelerations (n, D) of an exact rollout, from its positions ``y``, forcing
+    term and goal gate (n + 1 rows): :func:`exact_state` on the inputs ``u = K f - gate K (g - y0)
+    + αβ g``, its first state ``z_first`` (D,) given (None: at rest), ``z / z_scale`` and
+    ``acceleration / acceleration_scale`` — the NumPy expressions of a timed trajectory's rates,
+    operation for operation (``alpha_beta``, ``tau_squared`` and the scales Python's products)."""
+    cdef Py_ssize_t n = y.shape[0] - 1, n_dims = y.shape[1], l, k
+    if (
+        n < 1 or forcing.shape[0] != n + 1 or forcing.shape[1] != n_dims
+        or gate.shape[0] != n + 1 or goal.shape[0] != n_dims or start.shape[0] != n_dims
+        or (z_first is not None and z_first.shape[0] != n_dims)
+    ):
+        raise ValueError(
+            "exact_rates: y and forcing must be (n + 1, D), gate (n + 1,), goal, start and z_first (D,)"
+        )
+    cdef double[:, ::1] velocity = empty((n, n_dims))
+    cdef double[:, ::1] acceleration = empty((n, n_dims))
+    cdef double[::1] offset = empty(n_dims)  # K (g - y0)
+    cdef double[::1] held = empty(n_dims)  # αβ g
+    cdef double now, after, z
+    cdef bint at_rest = z_first is None
+    with nogil:
+        for k in range(n_dims):
+            offset[k] = K * (goal[k] - start[k])
+            held[k] = alpha_beta * goal[k]
+        for l in range(n):
+            for k in range(n_dims):
+                now = (K * forcing[l, k] - gate[l] * offset[k]) + held[k]
+                if l == 0:  # the first state is given, not solved for: a rest start is at rest
+                    z = 0.0 if at_rest else z_first[k]
+                else:
+                    after = (K * forcing[l + 1, k] - gate[l + 1] * offset[k]) + held[k]
+                    z = (
+                        (y[l + 1, k] - transition_yy * y[l, k]) - now_y * now - after_y * after
+                    ) / transition_yz
+                velocity[l, k] = z / z_scale
+                acceleration[l, k] = (
+                    (now - alpha_beta * y[l, k] - alpha * z) / tau_squared
+                ) / acceleration_scale
+    return velocity.base, acceleration.base
 
 
 # -- unit quaternions (x, y, z, w), in SciPy's Rotation arithmetic --------------------------------
@@ -658,6 +798,61 @@ def quaternion_exp(const double[:, :] error, const double[:, :] goal):
             _product(p, g, &out[i, 0])
             _normalised(&out[i, 0])
     return out.base
+
+
+def all_finite(const double[:, :] values):
+    """Whether every value of ``values`` (n, D) is finite (NumPy's ``all(isfinite(values))``
+    without its temporary)."""
+    cdef Py_ssize_t n = values.shape[0], n_dims = values.shape[1], i, k
+    cdef bint finite = True
+    with nogil:
+        for i in range(n):
+            for k in range(n_dims):
+                if not fabs(values[i, k]) <= 1.7976931348623157e308:  # NaN or inf
+                    finite = False
+                    break
+            if not finite:
+                break
+    return finite
+
+
+def strictly_decreasing(const double[:] values):
+    """Whether each of ``values`` (n,) is below the one before (``all(diff(values) < 0)``)."""
+    cdef Py_ssize_t n = values.shape[0], i
+    cdef bint decreasing = True
+    with nogil:
+        for i in range(1, n):
+            if not values[i] < values[i - 1]:
+                decreasing = False
+                break
+    return decreasing
+
+
+def extent(const double[:, :] y):
+    """``(finite, low, high, motion)`` of samples ``y`` (T, D), T >= 1, in one pass: whether
+    every value is finite, the smallest and largest value, and the largest distance of any
+    coordinate from the first sample's (``max |y - y[0]|``; all three exact, as NumPy's min,
+    max and abs are). The numbers are meaningless when ``finite`` is False."""
+    cdef Py_ssize_t n = y.shape[0], n_dims = y.shape[1], i, k
+    cdef double low = INFINITY, high = -INFINITY, motion = 0.0, value, offset
+    cdef bint finite = True
+    with nogil:
+        for i in range(n):
+            for k in range(n_dims):
+                value = y[i, k]
+                if not fabs(value) <= 1.7976931348623157e308:  # NaN or inf
+                    finite = False
+                    break
+                if value < low:
+                    low = value
+                if value > high:
+                    high = value
+                offset = fabs(value - y[0, k])
+                if offset > motion:
+                    motion = offset
+            if not finite:
+                break
+    return finite, low, high, motion
 
 
 def arclength(const double[:, :] y):

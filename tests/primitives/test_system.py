@@ -315,6 +315,39 @@ def test_settings_are_resolved_again_after_any_change():
     assert dmp.settings().tau == 2.0
 
 
+def test_models_made_alike_share_a_resolution_and_no_other():
+    """Fresh models with the same parameters share their resolved settings; one that differs in a
+    value, a type, a class or the limits does not, nor does a model with a component of its own
+    (which the settings would hold and the user may change)."""
+    from bidmp.primitives.canonical import ExponentialPhase
+    from bidmp.primitives.dmp import _SHARED_SETTINGS_SIZE
+
+    class Renamed(DMP):
+        pass
+
+    first = DMP(n_kernels=40).settings()
+    assert DMP(n_kernels=40).settings() is first
+    assert DMP(n_kernels=41).settings().n_kernels == 41
+    assert DMP(n_kernels=40, alpha=1).settings().alpha == 1.0
+    with pytest.raises(TypeError, match="alpha must be a number"):
+        DMP(n_kernels=40, alpha=True).settings()  # equal to 1 as a key, but no number
+    with bidmp.set_limits(max_kernels=20), pytest.raises(ValueError, match="max_kernels"):
+        DMP(n_kernels=40).settings()
+    again = DMP(n_kernels=40).settings()  # limits changed and restored: resolved anew
+    assert again == first and DMP(n_kernels=40).settings() is again
+    assert Renamed(n_kernels=40).settings() is not again
+    phase = ExponentialPhase(4.0)
+    model = DMP(n_kernels=40, canonical_system=phase)
+    own = model.settings()
+    assert model.settings() is own  # its own cache still serves it
+    assert DMP(n_kernels=40, canonical_system=phase).settings() is not own
+    for n in range(2 * _SHARED_SETTINGS_SIZE):  # bounded: the oldest make room
+        DMP(n_kernels=50 + n).settings()
+    from bidmp.primitives.dmp import _SHARED_SETTINGS
+
+    assert len(_SHARED_SETTINGS) <= _SHARED_SETTINGS_SIZE
+
+
 def test_a_changed_parameter_still_unfits_the_system():
     demo = curved_demo(120, 2, seed=4)
     dmp = DMP().fit(demo)

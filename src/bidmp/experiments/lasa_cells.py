@@ -111,14 +111,13 @@ def run_cell(
         os.remove(_kill_once)
         os.kill(os.getpid(), 9)
     import sklearn.mixture  # noqa: F401  (its OpenMP pool loaded, so that the limit below holds it)
-    from threadpoolctl import threadpool_limits
+
+    from .._threads import one_thread
 
     # One BLAS/OpenMP thread, as in a Dask worker (whose nanny sets OMP_NUM_THREADS=1 and the
     # like): the serial path and the workers then give the same floats (2 threads summed in
-    # another order, 1 ulp off), and small matrices gain nothing from threads anyway. Not
-    # bidmp._threads.one_thread: its controller holds the pools loaded when it was first made,
-    # and the first cell loads scikit-learn's OpenMP after that.
-    with threadpool_limits(limits=1):
+    # another order, 1 ulp off), and small matrices gain nothing from threads anyway.
+    with one_thread():
         return _run_cell(shape, demo, methods, every)
 
 

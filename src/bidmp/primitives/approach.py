@@ -9,6 +9,8 @@ one. Segmentation (:func:`bidmp.extension.extend.final_approach`) uses the same 
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .._kernels import tail_start
@@ -42,10 +44,18 @@ def _tail_start(y: np.ndarray, start: int = 0, straightness: float = STRAIGHTNES
     """The earliest index from ``start`` on (on a grid of at most 256 candidates) from which the
     rest of ``y`` (T, D) is straight; ``T - 1`` when no tail of 2 samples or more is (the motion has
     no approach)."""
-    last = y.shape[0] - 1
+    # One compiled loop over the candidates with early exits (a fit asks twice, its approach and
+    # its departure; tested together as NumPy matrix products they were a sixth of a fit).
+    return tail_start(y, _tail_candidates(start, y.shape[0] - 1), straightness)
+
+
+@functools.lru_cache(maxsize=16)
+def _tail_candidates(start: int, last: int) -> np.ndarray:
+    """The start indices tried from ``start`` for a path whose last index is ``last``: at most
+    :data:`MAX_TAIL_CANDIDATES`, evenly spread, increasing (read-only: shared by every fit of a
+    demonstration of that length)."""
     candidates = np.linspace(start, last - 1, min(MAX_TAIL_CANDIDATES, max(last - start, 1)))
     candidates = candidates.astype(np.int64)  # non-decreasing: its distinct values without a sort
     candidates = candidates[np.concatenate(([True], candidates[1:] != candidates[:-1]))]
-    # One compiled loop over the candidates with early exits (a fit asks twice, its approach and
-    # its departure; tested together as NumPy matrix products they were a sixth of a fit).
-    return tail_start(y, candidates, straightness)
+    candidates.flags.writeable = False
+    return candidates

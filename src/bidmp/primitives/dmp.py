@@ -56,7 +56,6 @@ from .._checks import (
     check_names,
     numerically_guarded,
 )
-from .._threads import single_threaded
 from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
@@ -71,12 +70,16 @@ from .state import _dmp_from_state, _dmp_state
 from .stepper import DMPStepper
 from .system import DMPSystem, _system_of
 from .timed import _coupled_trajectory, _limited_trajectory, _timed_trajectory
-from .timing import _Rollout, on_uniform_time
+from .timing import _checked_on_uniform_time, _Rollout
 from .via import _via_trajectory
 
 __all__ = ["DMP", "PROTOCOLS"]
 
 logger = logging.getLogger(__name__)
+
+# DMP.settings() of the models made with the same parameters, the last few sets (newest last)
+_SHARED_SETTINGS: dict = {}
+_SHARED_SETTINGS_SIZE = 16
 
 
 class DMP(_FittedParams, Estimator):
@@ -248,7 +251,20 @@ class DMP(_FittedParams, Estimator):
                 return cached[1]
         except (TypeError, ValueError):  # an array set by mistake: resolving names it
             pass
-        settings = DMPSettings.of(self)
+        # Models made with the same parameters share one resolution (a fresh DMP() per fit
+        # resolved its defaults each time); only with the built-in components, whose objects
+        # the settings hold: a user's own component may change after the fact.
+        shared = self.canonical_system is None and self.forcing_basis is None
+        try:
+            settings = _SHARED_SETTINGS.get((type(self), key)) if shared else None
+        except TypeError:  # an unhashable value set by mistake: resolving names it
+            shared, settings = False, None
+        if settings is None:
+            settings = DMPSettings.of(self)
+            if shared:
+                if len(_SHARED_SETTINGS) >= _SHARED_SETTINGS_SIZE:
+                    _SHARED_SETTINGS.pop(next(iter(_SHARED_SETTINGS)))  # the oldest
+                _SHARED_SETTINGS[(type(self), key)] = settings
         self._settings = (key, settings)
         return settings
 
@@ -277,8 +293,7 @@ class DMP(_FittedParams, Estimator):
     )
 
     # -- learning ------------------------------------------------------------------------------
-    @numerically_guarded
-    @single_threaded  # small dense algebra: idle BLAS threads only steal the core
+    @numerically_guarded  # (BLAS threads are limited where a fit's products could use them)
     def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> DMP:
         """Learn the forcing-term weights from one demonstration.
 
@@ -330,7 +345,7 @@ class DMP(_FittedParams, Estimator):
             if held_orientation is None
             else as_unit_quaternion(held_orientation, "held_orientation")
         )
-        y, duration = on_uniform_time(y, t)
+        y, duration = _checked_on_uniform_time(y, t)
         n_steps = y.shape[0]
         dt = 1.0 / n_steps
         if params.rest_start:

@@ -27,7 +27,8 @@ from .._checks import (
     check_int,
     check_real,
 )
-from .._kernels import forcing_target
+from .._kernels import all_finite, forcing_target
+from .._threads import one_thread, single_threaded
 from .band import _Band, _band_of
 from .canonical import _checked_phase_args, _phase_decay
 from .gains import _Gains
@@ -258,14 +259,25 @@ def _solve_weights(factor: tuple, phi: np.ndarray, target: np.ndarray) -> np.nda
     for a cached design: it rounds differently from a solve, the weights agreeing to ~1e-11 of
     their size, the Gram matrix's condition ~1e5 times the rounding)."""
     kind, values, band = factor
-    projected = phi.T @ target if band is None else band.transposed_product(target)
+    if band is not None and kind != "ridge" and values.size * target.shape[1] < _ONE_THREAD_BELOW:
+        # No product here that OpenBLAS would spread over threads (the band's is compiled, and
+        # LWR's a division): no limit to set and restore — the robot protocol's common case,
+        # where the limit cost 0.06-0.08 ms of a 0.8 ms fit + trajectory beside other work.
+        return _weights_of(kind, values, band.transposed_product(target))
+    with one_thread():  # small dense algebra: idle BLAS threads only steal the core
+        projected = phi.T @ target if band is None else band.transposed_product(target)
+        return _weights_of(kind, values, projected)
+
+
+def _weights_of(kind: str, values: np.ndarray, projected: np.ndarray) -> np.ndarray:
+    """The weights (N, D) from the projected target ``Φᵀ f`` (N, D) and the regression's factor."""
     if kind == "lwr":
         weights = projected / values[:, None]
     elif kind == "inverse":
         weights = values @ projected
     else:
         weights = np.linalg.solve(values, projected)
-    if not np.all(np.isfinite(weights)):
+    if not all_finite(weights):
         raise ValueError(
             "fit: the learned weights are not finite; the demonstration's scale or the gains are out of range"
         )
@@ -277,6 +289,11 @@ def _readonly(*arrays: np.ndarray) -> None:
         array.flags.writeable = False
 
 
+# OpenBLAS runs a matrix product of m·n·k below 65 536 · GEMM_MULTITHREAD_THRESHOLD (4 in the
+# wheels) on the calling thread: below the smallest such bound, no limit is needed around it.
+_ONE_THREAD_BELOW = 65_536
+
+
 @functools.lru_cache(maxsize=8)
 def _cached_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
     design = _training_design(canonical, basis, n_train, dt, regression, ridge)
@@ -285,6 +302,7 @@ def _cached_design(canonical, basis, n_train: int, dt: float, regression: str, r
     return design
 
 
+@single_threaded  # its Gram product and inverse are BLAS calls OpenBLAS would thread
 def _training_design(canonical, basis, n_train: int, dt: float, regression: str, ridge: float):
     """Everything a fit needs that does not depend on the demonstration's values: the phase and
     basis rows one sample past the training grid (n + 1,), (n + 1, N), the kernels' centres and

@@ -50,8 +50,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._checks import as_vector, check_bool, check_int, check_real
-from .._kernels import goal_gate, goal_share, goal_share_arguments
+from .._kernels import goal_gate, goal_share, goal_share_arguments, strictly_decreasing
 from .._trajectory import arclength
+from .approach import _tail_start
 from .canonical import phase_grid
 from .gains import _Gains
 
@@ -308,7 +309,7 @@ def _learned_progress_gate(system, params) -> ProgressGate:
 
 
 def _check_decaying(phase: np.ndarray, canonical_system) -> None:
-    if not np.all(np.diff(phase) < 0.0):
+    if not strictly_decreasing(np.asarray(phase, dtype=np.float64)):
         raise ValueError(
             "the progress gate looks the goal's share up by the phase, which must decay; "
             f"{type(canonical_system).__name__} does not: set goal_rate to a number"
@@ -324,7 +325,10 @@ def _gate_past_training(gate: np.ndarray, phase: np.ndarray, canonical_system) -
     _check_decaying(phase[:-1], canonical_system)
     if not phase[-1] <= phase[-2]:
         return None  # a phase rising again past the grid: the lookup interpolates there
-    return np.append(gate, gate[-1])
+    out = np.empty(gate.shape[0] + 1)
+    out[:-1] = gate
+    out[-1] = gate[-1]
+    return out
 
 
 class ApproachGate(ProgressGate):
@@ -416,8 +420,6 @@ def _learn_goal_gate(
         return DelayedGoal(params.goal_rate).training_gate(train.shape[0], dt, params.exact)
     shared = {"gains": params.gains, "exact": params.exact, "progress": progress}
     if params.keep_approach and demonstration is not None:
-        from .approach import _tail_start
-
         start = _tail_start(demonstration)
         progress_at = _arclength_progress(demonstration)[start] if start >= 2 else 0.0
         # An approach is a straight tail of a real share of the path: any curve's last few samples

@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from .._checks import as_vector, check_bool, check_real
-from .._kernels import exact_state, second_order
+from .._kernels import exact_state, foh_responses, second_order
 from .canonical import _phase_decay
 
 GEMM_GOALS = 64  # rollouts to this many goals and more: one matrix product
@@ -149,8 +149,8 @@ def _foh_step(
 
 def _exact_responses(
     inputs: np.ndarray,
-    y_first: np.ndarray,
-    z_first: np.ndarray,
+    y_first: np.ndarray | None,
+    z_first: np.ndarray | None,
     *,
     step: float,
     alpha: float,
@@ -163,8 +163,8 @@ def _exact_responses(
     ----------
     inputs : array, shape (S, n)
         Input ``u`` of each signal at every sample.
-    y_first, z_first : array, shape (S,)
-        Initial position and ``z = tau dy/ds`` of each signal.
+    y_first, z_first : array, shape (S,), or None
+        Initial position and ``z = tau dy/ds`` of each signal (None: 0).
 
     Returns
     -------
@@ -172,23 +172,18 @@ def _exact_responses(
     """
     transition, now, after = _foh_step(step, alpha, beta, tau)
     n = inputs.shape[1]
+    if n >= 3:
+        # The second sample from the transition, then the transfer function of the held
+        # system, C (zI - Φ)⁻¹ (Γ₀ + Γ₁ z), for C = [1, 0], acting on u[n+2], u[n+1], u[n]:
+        # one compiled call.
+        return foh_responses(inputs, y_first, z_first, transition, now, after)
+    n_signals = inputs.shape[0]
+    y_first = np.zeros(n_signals) if y_first is None else y_first
+    z_first = np.zeros(n_signals) if z_first is None else z_first
     y_second = transition[0, 0] * y_first + transition[0, 1] * z_first
     if n > 1:
         y_second = y_second + now[0] * inputs[:, 0] + after[0] * inputs[:, 1]
-    # The transfer function of the held system, C (zI - Φ)⁻¹ (Γ₀ + Γ₁ z), written out for
-    # C = [1, 0]: its numerator acts on u[n+2], u[n+1], u[n].
-    (p11, p12), (p21, p22) = transition
-    a1 = -(p11 + p22)
-    a2 = p11 * p22 - p12 * p21
-    b0 = after[0]
-    b1 = now[0] - p22 * after[0] + p12 * after[1]
-    b2 = -p22 * now[0] + p12 * now[1]
-    if n < 3:
-        return np.column_stack([y_first, y_second])[:, :n]
-    # The drive b0 u[n+2] + b1 u[n+1] + b2 u[n] formed inside the filter's loop.
-    return second_order(
-        inputs, y_first, y_second, 1.0, 0.0, 0.0, a1, a2, held=np.array([b0, b1, b2])
-    )
+    return np.column_stack([y_first, y_second])[:, :n]
 
 
 def _exact_state(
@@ -256,12 +251,14 @@ def _unit_responses(
     # Euler's y[n] depends on u[n-2] at the latest; the exact step uses u[n] too.
     n_inputs = n_steps if exact else max(n_steps - 2, 0)
     if forcing is not None:
-        drives = K * forcing[:n_inputs].T
-        y_first = second = np.zeros(drives.shape[0])
+        drives = K * forcing[:n_inputs].T  # driven by K f from rest at 0
+        y_first = second = None if exact else np.zeros(drives.shape[0])
     else:
         # The goal enters through alpha beta g - K gate (g - y0).
-        gate = gate[:n_inputs]
-        drives = np.stack([alpha * beta - K * gate, K * gate, np.zeros_like(gate)])
+        drives = np.empty((3, n_inputs))  # rows αβ - K gate, K gate, 0, written in place
+        np.multiply(gate[:n_inputs], K, out=drives[1])
+        np.subtract(alpha * beta, drives[1], out=drives[0])
+        drives[2] = 0.0
         y_first = np.array([0.0, 1.0, 0.0])
         # The second state: Euler's y[1] (a unit start velocity moves it by one step), or
         # the exact integrator's z = tau dy/ds.

@@ -21,7 +21,10 @@ def _with_rest(y: np.ndarray, params: DMPSettings) -> np.ndarray:
     n_rest = int(round(params.settle * y.shape[0])) - y.shape[0]
     if n_rest <= 0:
         return y
-    return np.vstack([y, np.repeat(y[-1:], n_rest, axis=0)])
+    out = np.empty((y.shape[0] + n_rest, y.shape[1]))
+    out[: y.shape[0]] = y
+    out[y.shape[0] :] = y[-1]
+    return out
 
 
 class _FittedParams:
@@ -38,7 +41,9 @@ class _FittedParams:
         if names is None:
             names = tuple(name for name in cls._get_param_names() if name != "tau")
             cls._raw_names = names
-            cls._raw_getter = operator.attrgetter(*names)  # one call reads them all
+            # One call reads them all, from the instance's dict: its lookups skip the class's
+            # MRO (a dozen dicts per name once other work has evicted the type cache).
+            cls._raw_getter = operator.itemgetter(*names)
         return names
 
     def _learned_params(self) -> DMPSettings:
@@ -50,7 +55,10 @@ class _FittedParams:
         if getter is None:
             self._raw_param_names()
             getter = type(self)._raw_getter
-        return getter(self)
+        try:
+            return getter(self.__dict__)
+        except KeyError:  # a parameter that is not a plain attribute (a subclass's property)
+            return tuple(getattr(self, name) for name in type(self)._raw_names)
 
     def _remember_params(self, resolved: DMPSettings | None = None) -> None:
         """Keep the parameters the weights were learned with: the raw ones and their resolution

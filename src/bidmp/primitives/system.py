@@ -29,6 +29,7 @@ from .._checks import (
     check_real,
     numerically_guarded,
 )
+from .._kernels import all_finite
 from .forcing import _check_forcing_increment
 from .goals import DelayedGoal, PhaseGate, ProgressGate, _learned_progress_gate
 from .grid import _Caches
@@ -360,7 +361,7 @@ class DMPSystem:
             free += velocity_response[:, None] * velocity
         # The integration runs compiled, outside NumPy's floating-point checks: check its output
         # once. With these finite and the goals bounded (max_abs_value), y = free + B g cannot overflow.
-        if not (np.all(np.isfinite(free)) and np.all(np.isfinite(goal_response))):
+        if not (all_finite(free) and all_finite(goal_response[:, None])):
             raise ValueError(
                 "rollout: the integration is not finite; the inputs' scale or the forcing increment is out of range"
             )

@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._checks import _limit, as_point, check_int, check_real, short_token
+from .._kernels import exact_rates
 from .._units import check_reach
 from .avoidance import SceneAvoidance, _check_avoidance
 from .canonical import _TAU_RANGE
-from .integrate import _exact_state
+from .integrate import _foh_step
 from .settings import DMPSettings
 from .stepper import DMPStepper
 from .system import DMPSystem
@@ -103,21 +104,30 @@ def _exact_rates(
     params: DMPSettings, positions, forcing, gate, ends: tuple, step: float, time_unit: float
 ) -> tuple:
     """Velocities (units/s) and accelerations (units/s²) of an exact rollout (n + 1 samples in,
-    n out): the system's own state and acceleration, from the positions and the input; ``ends``
-    = (goal, start, start velocity or None), the velocity in units per normalised time."""
+    n out): the system's own state and acceleration, from the positions and the input ``u = αβ g
+    + K f - K gate (g - y0)`` (one compiled pass); ``ends`` = (goal, start, start velocity or
+    None), the velocity in units per normalised time. The first state is given, not solved for:
+    a rest start is exactly at rest."""
     goal, start, velocity = ends
-    inputs = params.K * forcing  # u = αβ g + K f - K gate (g - y0), built in place
-    inputs -= np.multiply.outer(gate, params.K * (goal - start))
-    inputs += params.alpha * params.beta * goal
-    z, acceleration = _exact_state(
-        positions, inputs, step=step, alpha=params.alpha, beta=params.beta, tau=params.tau
+    transition, now, after = _foh_step(step, params.alpha, params.beta, params.tau)
+    return exact_rates(
+        positions,
+        forcing,
+        gate,
+        goal,
+        start,
+        None if velocity is None else params.tau * velocity,
+        params.K,
+        params.alpha * params.beta,
+        params.alpha,
+        params.tau**2,
+        transition[0, 0],
+        transition[0, 1],
+        now[0],
+        after[0],
+        params.tau * time_unit,
+        time_unit**2,
     )
-    # The first state is given, not solved for: a rest start is exactly at rest.
-    z[0] = 0.0 if velocity is None else params.tau * velocity
-    acceleration[0] = (
-        inputs[0] - params.alpha * params.beta * positions[0] - params.alpha * z[0]
-    ) / params.tau**2
-    return z / (params.tau * time_unit), acceleration / time_unit**2
 
 
 def _checked_limits(limits) -> tuple[dict, bool]:

@@ -24,6 +24,7 @@ from .._checks import (
     numerically_guarded,
     short_token,
 )
+from .._kernels import stamp_verdict
 from .._trajectory import interp_columns
 
 __all__ = [
@@ -43,6 +44,7 @@ logger = logging.getLogger(__name__)
 
 MIN_RATE_HZ = 1.0
 MAX_RATE_HZ = 100_000.0
+_MAX_STAMP_S = 1e12  # beyond: not seconds (epoch nanoseconds are ~1.7e18)
 
 
 class TimedMotion:
@@ -195,7 +197,7 @@ def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> n
         )
     if not np.all(np.isfinite(stamps)):
         raise ValueError(f"{name} contains NaN or inf")
-    if np.max(np.abs(stamps)) > 1e12:
+    if np.max(np.abs(stamps)) > _MAX_STAMP_S:
         raise ValueError(f"{name} has values beyond 1e12 s: timestamps must be seconds")
     steps = np.diff(stamps)
     if np.any(steps <= 0):
@@ -392,11 +394,26 @@ def on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
     """A demonstration (T, D) on uniform time and its duration (s): resampled over the span of its
     stamps ``t`` (repeated stamps dropped), or, without stamps, the paper's convention of T samples
     in one unit of time (duration ``(T - 1) / T``)."""
-    y = _as_samples(y)
+    return _checked_on_uniform_time(_as_samples(y), t)
+
+
+def _checked_on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
+    """:func:`on_uniform_time` of samples ``y`` already checked (:func:`_as_samples` or
+    ``as_trajectory``)."""
     if t is None:
         return y, (y.shape[0] - 1) / y.shape[0]
+    stamps = _as_stamps(t, "t")
+    if stamps.ndim == 1 and stamps.shape[0] == y.shape[0]:
+        # Valid stamps, judged in one compiled pass (a fit's most common case: the checks below
+        # are some forty NumPy calls); anything it does not pass, the checked path words.
+        verdict = stamp_verdict(stamps, MIN_RATE_HZ, MAX_RATE_HZ, _MAX_STAMP_S)
+        if verdict == 1:
+            return y.copy(), float(stamps[-1] - stamps[0])
+        if verdict == 2:
+            y, grid = _resampled(y, stamps)
+            return y, float(grid[-1])
     # checked once here, not again by each step (the stamps by _drop_repeated)
-    y, grid = _resampled(*_drop_repeated(y, _as_stamps(t, "t"), "t"))
+    y, grid = _resampled(*_drop_repeated(y, stamps, "t"))
     return y, float(grid[-1])
 
 
