@@ -102,6 +102,34 @@ def test_bidmp_params_include_the_dmps():
     assert model.dmp.alpha_value == 80.0
 
 
+def test_the_one_thread_limit_holds_the_pools_loaded_after_its_first_use():
+    """A first limit before ``import sklearn`` (and SciPy's linear algebra): a later limit still
+    holds scikit-learn's OpenMP pool and SciPy's OpenBLAS, and every pool gets its threads back
+    on the way out. A fresh interpreter: this one has imported them already."""
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy, sys\n"
+        "from bidmp._threads import one_thread, thread_limits\n"
+        "assert 'sklearn' not in sys.modules and 'scipy.linalg' not in sys.modules\n"
+        "with one_thread():\n"
+        "    pass\n"
+        "import sklearn.mixture, scipy.linalg\n"
+        "from threadpoolctl import threadpool_limits\n"
+        "with threadpool_limits(limits=2):\n"
+        "    before = thread_limits()\n"
+        "    with one_thread():\n"
+        "        inside = thread_limits()\n"
+        "    after = thread_limits()\n"
+        "print(sorted(before.items()), sorted(inside.items()), sorted(after.items()))\n"
+        "assert set(inside) == {'blas', 'openmp'} and set(inside.values()) == {1}, inside\n"
+        "assert after == before == {'blas': 2, 'openmp': 2}, (before, after)\n"
+    )
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr[-2000:]
+
+
 @pytest.mark.parametrize("cls", [GMMRegressor, TPGMM])
 def test_baselines_fit_single_threaded(cls, monkeypatch):
     """EM runs with one BLAS / OpenMP thread: on 2 cores the pools made it 7-15x slower."""
