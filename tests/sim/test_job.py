@@ -230,18 +230,25 @@ RESULTS = __import__("pathlib").Path(__file__).resolve().parents[2] / "docs" / "
 
 
 @pytest.mark.parametrize(
-    "name, committed, parts",
-    [("nut-unscrewing", "job.md", 14), ("cell-removal", "job_cells.md", 12)],
+    "committed, table, parts",
+    [("job_results.json", "job.md", 14), ("job_cells_results.json", "job_cells.md", 12)],
 )
-def test_the_built_in_jobs_in_one_run_as_committed(name, committed, parts):
-    """Acceptance: every nut unscrewed and in the bin, every cell in the rack, no contact with
-    another part, every command within the Panda's limits, the cycle per part within 10 s; the
-    committed table is this run's (make readme writes it)."""
-    report = run_job(scenarios.load(name))
-    totals = report.totals()
-    assert totals["removed"] == parts == totals["targets"] and totals["contacts"] == 0
-    assert totals["within_limits"] == parts and totals["cycle_s_max"] <= 10.0
-    assert (RESULTS / committed).read_text() == report.markdown() + "\n"
+def test_the_committed_jobs_meet_the_acceptance(committed, table, parts):
+    """Acceptance, on the committed runs of the built-in jobs: every nut unscrewed and in the bin,
+    every cell in the rack, no contact with another part, every command within the Panda's
+    limits, the cycle per part within 10 s; the table says what the JSON says. ``make
+    results-check`` (a CI stage) runs both jobs again and compares them with these files by value,
+    ``make readme`` writes them: the two whole jobs (20 s) are not run again in the suite, whose
+    jobs are smaller (a few targets each, above and below)."""
+    data = json.loads((RESULTS / committed).read_text())
+    totals = data["totals"]
+    assert totals["removed"] == parts == totals["targets"] == len(data["targets"])
+    assert totals["contacts"] == 0 and totals["within_limits"] == parts
+    assert totals["cycle_s_max"] <= 10.0
+    rows = [line.split("|")[1:-1] for line in (RESULTS / table).read_text().splitlines()[2:]]
+    assert [row[1].strip() for row in rows] == ["yes"] * parts
+    assert [row[0].strip() for row in rows] == [t["target"] for t in data["targets"]]
+    assert all(t["removed"] for t in data["targets"])
 
 
 def test_pick_and_place_steps_lift_a_boxed_in_part_over_its_neighbours():
