@@ -168,12 +168,16 @@ def test_an_interrupted_run_resumes_with_only_the_missing_cells(serial, tmp_path
         (["--methods", "dmp-paper,magic"], "unknown method 'magic'"),
         pytest.param(
             ["--scheduler", "tcp://127.0.0.1:9"],
-            "cannot reach the Dask scheduler at tcp://127.0.0.1:9",
+            "cannot reach the Dask scheduler at tcp://127.0.0.1:9 within 0.3 s",
             marks=needs_dask,
         ),
     ],
 )
-def test_bad_input_is_one_line_and_leaves_nothing(argv, match, tmp_path, capsys):
+def test_bad_input_is_one_line_and_leaves_nothing(argv, match, tmp_path, capsys, monkeypatch):
+    from bidmp.experiments import _lasa_dask
+
+    # Dask retries a refused connection until the timeout: a shorter one here (the message says it)
+    monkeypatch.setattr(_lasa_dask, "CONNECT_TIMEOUT_S", 0.3)
     code = main(
         [
             "benchmark",

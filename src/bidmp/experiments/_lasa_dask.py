@@ -10,6 +10,9 @@ from .._checks import require_extra
 
 __all__ = []
 
+# How long an existing scheduler has to answer (Dask retries a refused connection until then).
+CONNECT_TIMEOUT_S = 3.0
+
 
 def _client(scheduler: str | None, workers: int):
     require_extra("distributed", "benchmark", "the LASA benchmark on Dask")
@@ -17,10 +20,11 @@ def _client(scheduler: str | None, workers: int):
 
     if scheduler is not None:
         try:
-            return Client(scheduler, timeout="3s"), None
+            return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S:g}s"), None
         except (OSError, TimeoutError) as exc:
             raise ValueError(
-                f"cannot reach the Dask scheduler at {scheduler} within 3 s ({type(exc).__name__})"
+                f"cannot reach the Dask scheduler at {scheduler} within {CONNECT_TIMEOUT_S:g} s "
+                f"({type(exc).__name__})"
             ) from None
     import dask
 
