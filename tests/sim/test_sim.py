@@ -281,14 +281,17 @@ def test_a_layout_from_a_file_with_another_robot_base(tmp_path, nut):
     assert result.methods["bidmp"].task_successes == 2
 
 
-def test_the_committed_nut_task_table_is_what_bidmp_sim_measures(tmp_path, capsys):
-    # The whole built-in nut task, dmp and bidmp (about 15 s on 2 cores): README = sim.md = JSON.
-    assert main(["sim", "--no-pictures", "--out", str(tmp_path)]) == 0
-    assert (tmp_path / "sim.md").read_text() == (RESULTS / "sim.md").read_text()
-    results = json.loads((tmp_path / "sim_results.json").read_text())["methods"]
+def test_the_committed_nut_task_run_meets_its_acceptance(tmp_path, capsys):
+    """The committed run of the whole built-in nut task, dmp and bidmp (``make readme`` writes
+    sim.md and sim_results.json; ``make results-check``, a CI stage, runs it again and compares
+    both by value): every bidmp target engaged, no contact, within the limits, the far nuts of the
+    plain DMP refused and not sent, every command within the jerk limit."""
+    results = json.loads((RESULTS / "sim_results.json").read_text())["methods"]
     assert results["bidmp"]["task_successes"] == 14 and results["bidmp"]["contacts"] == 0
     assert results["bidmp"]["within_limits"] == 14 and results["dmp"]["task_successes"] == 8
     assert results["bidmp"]["sent"] == 14 and results["dmp"]["sent"] == 8
+    # the command prints its real-time factor (one target here: the whole task is the CI stage's)
+    assert main(["sim", "--targets", "3", "--no-pictures", "--out", str(tmp_path)]) == 0
     assert "x real time" in capsys.readouterr().out
     # The plain DMP's far nuts (columns 4-6: x >= 120 mm) are refused, not run: the paper
     # protocol's horizon leaves them 1.8-2.9 mm short (the evaluation's table says so).
@@ -318,15 +321,21 @@ def test_without_pybullet_bidmp_sim_says_how_to_install_it(monkeypatch, capsys):
     assert "\n" not in err and "pip install 'bidmp[sim]'" in err
 
 
-def test_pictures_are_written(tmp_path, nut, nut_report):
+def test_pictures_are_written_and_measure_nothing_else(tmp_path, nut, nut_report):
+    """The frames and the GIF; and a motion rendered measures what it measures unrendered (a
+    frame's step between two records once took the next record's command: 0.32 mm of tracking
+    error for 0.23 on the far nut)."""
     result = sim.simulate(
         nut,
         ["dmp", "bidmp"],
-        targets=["8"],
+        targets=["8", "12"],
         report=nut_report,
         workers=1,
-        frames={("dmp", "8"): 4, ("bidmp", "8"): 4},
+        frames={("dmp", "8"): 4, ("bidmp", "8"): 4, ("bidmp", "12"): 30},
     )
+    unrendered = sim.simulate(nut, ["bidmp"], targets=["12"], report=nut_report, workers=1)
+    rendered, plain = (r.methods["bidmp"].targets["12"] for r in (result, unrendered))
+    assert rendered.to_dict(1.75) == plain.to_dict(1.75) and rendered.ran
     written = {path.name for path in sim.write_sim_report(result, tmp_path)}
     assert {
         "sim_results.json",

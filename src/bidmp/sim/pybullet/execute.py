@@ -220,7 +220,7 @@ def _execute_closed_loop(
                 q[hold.joint], qd[hold.joint] = held, 0.0
             _drive(cell, q, qd)
             p.stepSimulation(physicsClientId=cell.client)
-            record.sample(step, t + SIM_STEP, command, contacts=True, every_step=True)
+            record.sample(step, t + SIM_STEP, command, contacts=True)
     finally:
         _ignore(cell, exclude, True)
         if moved:  # the world is kept for the next job: the parts back where they were
@@ -326,9 +326,9 @@ class _Recorder:
         t: float,
         commanded_joints,
         contacts: bool = False,
-        every_step: bool = False,
     ) -> None:
-        """Record step ``step`` (the loop calls it on recorded steps only, or ``every_step``)."""
+        """Record step ``step`` if it is a recorded one (every ``RECORD_EVERY``-th and the last),
+        and render it if it is a frame's: a loop may call it on every step, or on those only."""
         cell = self.cell
         p = cell.p
         if contacts:
@@ -337,7 +337,10 @@ class _Recorder:
             self.frames.append(
                 cell.render() if self.focus is None else cell.keyframe(t, self.focus)
             )
-        if every_step and step % RECORD_EVERY and step != self.n_steps - 1:
+        # A frame's step between two records only renders: recorded, it had written its state
+        # and its command into the next record's place, and the command's path took both (the
+        # motion's tracking error measured 0.32 mm with its frames and 0.23 mm without).
+        if step % RECORD_EVERY and step != self.n_steps - 1:
             return
         row = min(step // RECORD_EVERY + (step % RECORD_EVERY > 0), len(self.times) - 1)
         self.filled = row + 1
