@@ -280,7 +280,7 @@ TARGETS = (
         "bidmp.cli.common",
         ("judged_methods",),
         (
-            "tests/sim/test_sim.py::test_the_committed_nut_task_table_is_what_bidmp_sim_measures",
+            "tests/sim/test_sim.py::test_the_committed_nut_task_run_meets_its_acceptance",
             "tests/cli/test_cli.py",
         ),
     ),
@@ -959,6 +959,12 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "near = np.flatnonzero(np.all((hi >= lower.min(axis=0)) & (lo <= upper.max(axis=0)), axis=1))",
         "all -> any",
     ): "cost only: more moves are candidates; each is then checked exactly",
+    (
+        "bidmp.scene.checker",
+        "SceneChecker.segments_free",
+        "touching = np.all((hi[near, None] >= lower[None]) & (lo[near, None] <= upper[None]), axis=2)",
+        "all -> any",
+    ): "cost only: more parts are candidates for a move; each pair is then checked exactly",
     **{
         (
             "bidmp.scene.checker",
