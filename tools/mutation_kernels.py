@@ -203,8 +203,8 @@ MUTANTS = (
     ),
     Mutant(
         "exact_rates",
-        "now = (K * forcing[l, k] - gate[l] * offset[k]) + held[k]",
-        "now = (K * forcing[l, k] - gate[l + 1] * offset[k]) + held[k]",
+        "after = (K * forcing[l + 1, k] - gate[l + 1] * offset[k]) + held[k]",
+        "after = (K * forcing[l + 1, k] - gate[l] * offset[k]) + held[k]",
     ),
     Mutant(
         "foh_responses",

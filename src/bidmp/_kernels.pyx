@@ -658,19 +658,22 @@ def exact_rates(
     cdef double[:, ::1] acceleration = empty((n, n_dims))
     cdef double[::1] offset = empty(n_dims)  # K (g - y0)
     cdef double[::1] held = empty(n_dims)  # αβ g
+    cdef double[::1] carried = empty(n_dims)  # each sample's input, formed once: u[l + 1] -> u[l]
     cdef double now, after, z
     cdef bint at_rest = z_first is None
     with nogil:
         for k in range(n_dims):
             offset[k] = K * (goal[k] - start[k])
             held[k] = alpha_beta * goal[k]
+            carried[k] = (K * forcing[0, k] - gate[0] * offset[k]) + held[k]
         for l in range(n):
             for k in range(n_dims):
-                now = (K * forcing[l, k] - gate[l] * offset[k]) + held[k]
+                now = carried[k]
+                after = (K * forcing[l + 1, k] - gate[l + 1] * offset[k]) + held[k]
+                carried[k] = after
                 if l == 0:  # the first state is given, not solved for: a rest start is at rest
                     z = 0.0 if at_rest else z_first[k]
                 else:
-                    after = (K * forcing[l + 1, k] - gate[l + 1] * offset[k]) + held[k]
                     z = (
                         (y[l + 1, k] - transition_yy * y[l, k]) - now_y * now - after_y * after
                     ) / transition_yz

@@ -276,10 +276,16 @@ def uniform_time(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _resampled(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`uniform_time` of checked samples ``y`` (T, D) and stamps ``t`` (T,)."""
     t = t - t[0]
-    grid = np.linspace(0.0, t[-1], t.shape[0])
     steps = np.diff(t)
     if np.ptp(steps) <= 1e-9 * np.mean(steps):
-        return y.copy(), grid
+        return y.copy(), np.linspace(0.0, t[-1], t.shape[0])
+    return _interpolated(y, t)
+
+
+def _interpolated(y: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Samples ``y`` (T, D) at stamps ``t`` (T,) from 0, not uniform, on as many uniform ones
+    over the same span: (y (T, D), grid (T,))."""
+    grid = np.linspace(0.0, t[-1], t.shape[0])
     return interp_columns(grid, t, y), grid  # np.interp of each column, in one compiled scan
 
 
@@ -409,8 +415,8 @@ def _checked_on_uniform_time(y: np.ndarray, t) -> tuple[np.ndarray, float]:
         verdict = stamp_verdict(stamps, MIN_RATE_HZ, MAX_RATE_HZ, _MAX_STAMP_S)
         if verdict == 1:
             return y.copy(), float(stamps[-1] - stamps[0])
-        if verdict == 2:
-            y, grid = _resampled(y, stamps)
+        if verdict == 2:  # (judged not uniform already)
+            y, grid = _interpolated(y, stamps - stamps[0])
             return y, float(grid[-1])
     # checked once here, not again by each step (the stamps by _drop_repeated)
     y, grid = _resampled(*_drop_repeated(y, stamps, "t"))
