@@ -359,6 +359,59 @@ def test_pictures_are_written_and_measure_nothing_else(tmp_path, nut, nut_report
         assert strip.size == (4 * 320 + 3 * 4, 26 + 2 * 240)
 
 
+def test_the_command_renders_only_the_frames_it_writes(tmp_path, monkeypatch):
+    """``bidmp sim`` renders the keyframes its strip shows and no others (24 of 30 per method
+    were rendered and thrown away, most of a two-target command's time), from the start of the
+    motion to its end (the arm at the target; the strip stopped at 86 % of it)."""
+    from PIL import Image
+
+    from bidmp.sim.pybullet.cell import RobotCell
+
+    times = []
+    keyframe = RobotCell.keyframe
+
+    def counted(self, t, focus, *args, **kwargs):
+        times.append(t)
+        return keyframe(self, t, focus, *args, **kwargs)
+
+    monkeypatch.setattr(RobotCell, "keyframe", counted)
+    argv = ["sim", "--targets", "12", "--methods", "bidmp", "--workers", "1"]
+    assert main([*argv, "--out", str(tmp_path)]) == 0
+    with Image.open(tmp_path / "sim_keyframes_bidmp.png") as strip:
+        tiles = (strip.size[0] + 4) // (320 + 4)
+    motion = json.loads((tmp_path / "sim_results.json").read_text())
+    target = motion["methods"]["bidmp"]["targets"]["12"]
+    assert len(times) == tiles == 6, (len(times), tiles)
+    steps = np.diff(times)
+    assert (
+        times[0] <= 0.001 + 1e-12 and times[-1] >= target["motion_time_s"] - 0.005
+    )  # (rounded to 10 ms)
+    assert np.ptp(steps) <= 2e-3  # evenly spaced, to the 1 ms step
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 6, 7, 12, 30, 31, 61, 100])
+def test_a_strip_takes_evenly_spaced_frames_from_first_to_last(n):
+    from bidmp.sim.report import GIF_FRAMES, STRIP_FRAMES, _strip_frames
+
+    picked = _strip_frames(list(range(n)))
+    assert len(picked) == min(n, STRIP_FRAMES) and picked[0] == 0 and picked[-1] == n - 1
+    assert np.ptp(np.diff(picked)) <= 1 if n > 2 else True
+    if n == GIF_FRAMES:  # every sixth of the GIF's
+        assert picked == list(range(0, GIF_FRAMES, 6))
+
+
+def test_a_gifs_strip_shows_the_steps_a_strips_own_run_renders():
+    """The recorder renders ``linspace(0, n_steps - 1, frames)`` floored: of the GIF's 31, the
+    strip's six are at the very steps a run of six frames renders, for any motion's length
+    (an independent check of the claim: the two roundings could differ at a step's edge)."""
+    from bidmp.sim.report import GIF_FRAMES, STRIP_FRAMES, _strip_frames
+
+    for n_steps in np.random.default_rng(7).integers(2, 400_000, 3000).tolist() + [2, 31, 6]:
+        gif = np.linspace(0, n_steps - 1, GIF_FRAMES).astype(int).tolist()
+        own = np.linspace(0, n_steps - 1, STRIP_FRAMES).astype(int).tolist()
+        assert _strip_frames(gif) == own, n_steps
+
+
 def test_a_kept_world_runs_a_job_as_a_new_one(nut, nut_report):
     """the last PyBullet world is kept for the next call; a job in it must measure as
     in a world built for it (to the last digit of the report)."""

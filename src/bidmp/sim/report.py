@@ -465,7 +465,7 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
             title = f"FAILED {title}: {target.reason or 'not a task success'}"
         strip = _write_strip(
             out / f"sim_keyframes_{method}.png",
-            frames[:: max(1, len(frames) // 6)][:6],
+            _strip_frames(frames),
             title,
             failed=failed,
         )
@@ -485,6 +485,21 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
             )
         )
     return written
+
+
+STRIP_FRAMES = 6  # the keyframes of a method's strip
+GIF_FRAMES = 31  # the frames of the side-by-side GIF: every sixth one is a strip's
+
+
+def _strip_frames(frames: list) -> list:
+    """The strip's keyframes of a motion's ``frames``: :data:`STRIP_FRAMES` of them evenly spaced
+    from its first to its last (the arm at its start and at the target), or all of fewer. Of
+    :data:`GIF_FRAMES`, exactly every sixth: the strip shows the times a run of
+    :data:`STRIP_FRAMES` frames renders, so a command renders no more frames than it writes."""
+    if len(frames) <= STRIP_FRAMES:
+        return list(frames)
+    picked = np.round(np.linspace(0.0, len(frames) - 1, STRIP_FRAMES)).astype(int)
+    return [frames[index] for index in picked]
 
 
 def _write_results(out, json_name: str, table_name: str, data: dict, table: str) -> list[Path]:
