@@ -344,7 +344,7 @@ TARGETS = (
     Target(
         "goal systems",
         "bidmp.primitives.goals",
-        ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal._follow"),
+        ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal.follow"),
         (
             "tests/test_oracles.py",
             "tests/primitives/test_dmp.py",

@@ -408,10 +408,6 @@ def private_reaches(root: pathlib.Path = SRC, subpackages=("primitives", "increm
 # The reaches left, by name, and why; the DMP's own (its parameters, grid, rollout preparation,
 # training trajectory) are gone. The list may only shrink: a name no longer reached fails the test.
 _LEFT = {
-    # A checked public method beside the unchecked one a control loop calls every step.
-    "_near": "Proximity.near, unchecked (the avoidance term, every control step)",
-    "_follow": "a goal system's follow, unchecked (the stepper, every control step)",
-    "_step": "StepIntegrator.step, unchecked (the stepper, every control step)",
     # Composition still to be made through the system: a pose DMP fits and checks its two parts,
     # a pose Bi-DMP learns and queries its two skills.
     "_fit": "CartesianDMP fits its parts with a progress and a name for messages",

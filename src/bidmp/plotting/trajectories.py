@@ -508,6 +508,51 @@ def plot_distribution(  # noqa: PLR0913 - the public call spells its options out
     """
     check_path(path)
     title, units = _text(title, "title", 200), _text(units, "units", 20)
+    demos, mean, std, points, conditioned, spread = _distribution_inputs(
+        demonstrations, mean, std, points, (conditioned, conditioned_std), times
+    )
+    n_dims = mean.shape[1]
+    axis = _time_axes(times, demos, mean, conditioned)
+    mpl = _matplotlib()
+    fig = mpl.figure(figsize=(5.5 * n_dims, 4.5), dpi=110)
+    phase = axis["mean"]
+    suffix = f" [{units}]" if units else ""
+    for d in range(n_dims):
+        ax = fig.add_subplot(1, n_dims, d + 1)
+        for y, along in zip(demos, axis["demonstrations"]):
+            ax.plot(along, y[:, d], color="0.7", linewidth=0.8)
+        ax.fill_between(
+            phase, mean[:, d] - 2 * std[:, d], mean[:, d] + 2 * std[:, d], color="C0", alpha=0.25
+        )
+        ax.plot(phase, mean[:, d], color="C0", linewidth=2.0, label="mean ± 2σ")
+        if conditioned is not None:
+            c_phase = axis["conditioned"]
+            if spread is not None:
+                ax.fill_between(
+                    c_phase,
+                    conditioned[:, d] - 2 * spread[:, d],
+                    conditioned[:, d] + 2 * spread[:, d],
+                    color="C1",
+                    alpha=0.25,
+                )
+            ax.plot(c_phase, conditioned[:, d], color="C1", linestyle="--", label="conditioned")
+        if points is not None:
+            at, values = points
+            ax.plot(np.asarray(at), np.asarray(values)[:, d], "ko", label="conditioned on")
+        ax.set_xlabel("time [s]" if times is not None else "phase (share of the motion's time)")
+        ax.set_ylabel(f"coordinate {d}{suffix}")
+        ax.grid(True, alpha=0.3)
+        if d == 0:
+            ax.set_title(title)
+            ax.legend(loc="best", fontsize=8)
+    return _save(fig, path)
+
+
+def _distribution_inputs(demonstrations, mean, std, points, conditioned_pair, times) -> tuple:
+    """:func:`plot_distribution`'s curves checked against one another, before anything is drawn:
+    ``(demonstrations, mean, std, points, conditioned, its spread)``, every one with the mean's
+    coordinates."""
+    conditioned, conditioned_std = conditioned_pair
     demos = [
         as_trajectory(y, f"demonstrations[{i}]", min_points=2, allow_static=True)
         for i, y in enumerate(_sequence(demonstrations, "demonstrations"))
@@ -531,43 +576,28 @@ def plot_distribution(  # noqa: PLR0913 - the public call spells its options out
             )
         points = (at, values)
     n_dims = mean.shape[1]
+    for index, y in enumerate(demos):
+        if y.shape[1] != n_dims:
+            raise ValueError(
+                f"demonstrations[{index}] has {y.shape[1]} coordinates, mean has {n_dims}"
+            )
+    spread = None
     if conditioned is not None:
         conditioned = as_trajectory(conditioned, "conditioned", min_points=2, allow_static=True)
-    axis = _time_axes(times, demos, mean, conditioned)
-    mpl = _matplotlib()
-    fig = mpl.figure(figsize=(5.5 * n_dims, 4.5), dpi=110)
-    phase = axis["mean"]
-    suffix = f" [{units}]" if units else ""
-    for d in range(n_dims):
-        ax = fig.add_subplot(1, n_dims, d + 1)
-        for y, along in zip(demos, axis["demonstrations"]):
-            ax.plot(along, y[:, d], color="0.7", linewidth=0.8)
-        ax.fill_between(
-            phase, mean[:, d] - 2 * std[:, d], mean[:, d] + 2 * std[:, d], color="C0", alpha=0.25
-        )
-        ax.plot(phase, mean[:, d], color="C0", linewidth=2.0, label="mean ± 2σ")
-        if conditioned is not None:
-            c_phase = axis["conditioned"]
-            if conditioned_std is not None:
-                spread = as_points(conditioned_std, n_dims, "conditioned_std")
-                ax.fill_between(
-                    c_phase,
-                    conditioned[:, d] - 2 * spread[:, d],
-                    conditioned[:, d] + 2 * spread[:, d],
-                    color="C1",
-                    alpha=0.25,
+        if conditioned.shape[1] != n_dims:
+            raise ValueError(
+                f"conditioned has {conditioned.shape[1]} coordinates, mean has {n_dims}"
+            )
+        if conditioned_std is not None:
+            spread = as_points(conditioned_std, n_dims, "conditioned_std")
+            if spread.shape != conditioned.shape or np.any(spread < 0):
+                raise ValueError(
+                    f"conditioned_std must be non-negative, of conditioned's shape "
+                    f"{conditioned.shape}, got {spread.shape}"
                 )
-            ax.plot(c_phase, conditioned[:, d], color="C1", linestyle="--", label="conditioned")
-        if points is not None:
-            at, values = points
-            ax.plot(np.asarray(at), np.asarray(values)[:, d], "ko", label="conditioned on")
-        ax.set_xlabel("time [s]" if times is not None else "phase (share of the motion's time)")
-        ax.set_ylabel(f"coordinate {d}{suffix}")
-        ax.grid(True, alpha=0.3)
-        if d == 0:
-            ax.set_title(title)
-            ax.legend(loc="best", fontsize=8)
-    return _save(fig, path)
+    elif conditioned_std is not None:
+        raise ValueError("conditioned_std is the spread of conditioned: give conditioned too")
+    return demos, mean, std, points, conditioned, spread
 
 
 def _time_axes(times, demos: list, mean: np.ndarray, conditioned) -> dict:

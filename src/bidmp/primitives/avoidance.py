@@ -181,8 +181,8 @@ class SceneAvoidance(CouplingTerm):
         self.excluded_ = tuple(sorted(excluded))
         # The parts the term would push against with the tool at the goal itself (a neighbouring
         # nut beside the socket): only these fade out along the final approach.
-        beside = self._proximity._near(
-            np.asarray(self._goal, dtype=float), self.margin + self.influence
+        beside = self._proximity.near(
+            np.asarray(self._goal, dtype=float), self.margin + self.influence, check_input=False
         )[3]
         self._at_goal = np.zeros(self._proximity.standoffs.shape[0], dtype=bool)
         self._at_goal[beside] = True
@@ -194,8 +194,11 @@ class SceneAvoidance(CouplingTerm):
                 "SceneAvoidance is run by a DMP's trajectory or stepper (which binds it to the motion)"
             )
         fade = self._fade(y) if self._fades else 1.0
-        distances, away, owed, solids = self._proximity._near(
-            y, self.margin + self.influence, self._at_goal if fade == 0.0 else None
+        distances, away, owed, solids = self._proximity.near(
+            y,
+            self.margin + self.influence,
+            self._at_goal if fade == 0.0 else None,
+            check_input=False,
         )
         if distances.size == 0:
             return np.zeros(3)

@@ -203,12 +203,22 @@ class DelayedGoal:
         n_train, dt, exact = _training_args(n_train, dt, exact)
         return phase_grid(n_train, dt, 1.0, self.rate, exact=exact)
 
-    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
-        """The gate one control step of ``step`` (normalised time) after ``gate``."""
-        return self._follow(*_step_args(gate, phase, step, tau, exact))
-
-    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
-        """:meth:`follow` on checked arguments (a stepper's control loop asks it every step)."""
+    def follow(
+        self,
+        gate: float,
+        phase: float,
+        step: float,
+        tau: float,
+        exact: bool,
+        *,
+        check_input: bool = True,
+    ) -> float:
+        """The gate one control step of ``step`` (normalised time) after ``gate``, at ``phase``.
+        ``check_input=False`` takes the arguments as given, floats in range (a stepper's control
+        loop, which checked them once, asks every step)."""
+        if check_input is not False:  # (False: the hot path, one identity test)
+            check_bool(check_input, "check_input")
+            gate, phase, step, tau, exact = _step_args(gate, phase, step, tau, exact)
         return gate * (
             math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau)
         )
@@ -222,10 +232,19 @@ class PhaseGate(DelayedGoal):
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         return _grid_args(phase, step, tau, exact)[0]
 
-    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
-        return self._follow(*_step_args(gate, phase, step, tau, exact))
-
-    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+    def follow(
+        self,
+        gate: float,
+        phase: float,
+        step: float,
+        tau: float,
+        exact: bool,
+        *,
+        check_input: bool = True,
+    ) -> float:
+        if check_input is not False:  # (False: the hot path, one identity test)
+            check_bool(check_input, "check_input")
+            phase = _step_args(gate, phase, step, tau, exact)[1]
         return phase
 
 
@@ -286,10 +305,19 @@ class ProgressGate:
             )
         return self.gate
 
-    def follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
-        return self._follow(*_step_args(gate, phase, step, tau, exact))
-
-    def _follow(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+    def follow(
+        self,
+        gate: float,
+        phase: float,
+        step: float,
+        tau: float,
+        exact: bool,
+        *,
+        check_input: bool = True,
+    ) -> float:
+        if check_input is not False:  # (False: the hot path, one identity test)
+            check_bool(check_input, "check_input")
+            phase = _step_args(gate, phase, step, tau, exact)[1]
         return float(np.interp(phase, *self._lookup))
 
 

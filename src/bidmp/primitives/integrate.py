@@ -327,25 +327,31 @@ class StepIntegrator:
         self._floats = None  # (step, the exact step's coefficients as floats) of the last step
 
     def step(
-        self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray, step: float
+        self,
+        y: np.ndarray,
+        z: np.ndarray,
+        u_now: np.ndarray,
+        u_next: np.ndarray,
+        step: float,
+        *,
+        check_input: bool = True,
     ) -> tuple[np.ndarray, np.ndarray]:
         """The state ``step`` (normalised time) later; ``u_next`` (the input at the step's end) is
-        read by the exact step only. ``y``, ``z``, ``u_now`` and ``u_next`` are (D,) arrays."""
-        y, z, u_now, u_next = (
-            as_vector(value, name)
-            for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"), (u_next, "u_next"))
-        )
-        if not y.shape == z.shape == u_now.shape == u_next.shape:
-            raise ValueError(
-                f"y, z, u_now and u_next must have one value per dimension each, got "
-                f"{y.shape[0]}, {z.shape[0]}, {u_now.shape[0]} and {u_next.shape[0]}"
+        read by the exact step only. ``y``, ``z``, ``u_now`` and ``u_next`` are (D,) arrays.
+        ``check_input=False`` takes them as given: float arrays of one shape and a step in
+        (0, 1e3] (a stepper's control loop, which checked them once, calls it every step)."""
+        if check_input is not False:  # (False: the hot path, one identity test)
+            check_bool(check_input, "check_input")
+            y, z, u_now, u_next = (
+                as_vector(value, name)
+                for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"), (u_next, "u_next"))
             )
-        return self._step(y, z, u_now, u_next, check_real(step, "step", positive=True, maximum=1e3))
-
-    def _step(
-        self, y: np.ndarray, z: np.ndarray, u_now: np.ndarray, u_next: np.ndarray, step: float
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`step` on arguments a stepper has checked (its control loop calls it every step)."""
+            if not y.shape == z.shape == u_now.shape == u_next.shape:
+                raise ValueError(
+                    f"y, z, u_now and u_next must have one value per dimension each, got "
+                    f"{y.shape[0]}, {z.shape[0]}, {u_now.shape[0]} and {u_next.shape[0]}"
+                )
+            step = check_real(step, "step", positive=True, maximum=1e3)
         alpha, beta, tau = self.alpha, self.beta, self.tau
         if self.exact:
             # Row by row with Python floats: a control loop's step is a few (D,) arrays, where

@@ -85,7 +85,9 @@ class DMPStepper:
         self._last_input = None
         self.phase = self._canonical.initial
         self._gate = 1.0
-        self._gate = self._goal_system._follow(1.0, self.phase, 0.0, self._scale, params.exact)
+        self._gate = self._goal_system.follow(
+            1.0, self.phase, 0.0, self._scale, params.exact, check_input=False
+        )
         self.time = 0.0
         self._shifts = _GoalShifts(n_dims)
         # the motion time its own goal offset completes (set_goal asks for it)
@@ -291,11 +293,15 @@ class DMPStepper:
         if offset is not None:
             acceleration = acceleration + offset[2] / slowdown**2
         phase = self._canonical.advance(self.phase, step, tau)
-        gate = self._goal_system._follow(self._gate, phase, step, tau, params.exact)
+        gate = self._goal_system.follow(
+            self._gate, phase, step, tau, params.exact, check_input=False
+        )
         input_next = self._input(phase, gate) if params.exact else input_now
         if self._couplings and params.exact:
             input_next = input_next + push
-        self.y, self._z = self._integrator._step(self.y, self._z, input_now, input_next, step)
+        self.y, self._z = self._integrator.step(
+            self.y, self._z, input_now, input_next, step, check_input=False
+        )
         self.phase, self._gate = phase, gate
         self.time += dt / slowdown
         return position, velocity, acceleration

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .._checks import as_point, check_real
+from .._checks import as_point, check_bool, check_real
 from .clearance import Scene
 from .distances import _cylinder_box_bounds
 
@@ -51,16 +51,26 @@ class Proximity:
         )
 
     def near(
-        self, point: np.ndarray, within: float, skip: np.ndarray | None = None
+        self,
+        point: np.ndarray,
+        within: float,
+        skip: np.ndarray | None = None,
+        *,
+        check_input: bool = True,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Solids whose signed distance from the tool at ``point`` (3,) is below ``within``
         (scene units): their distances (k,), unit directions from each toward the tool (k, 3), their
         parts' stand-offs (k,; inf: none) and their indices among the chosen solids (k,). ``skip``:
-        a mask over the chosen solids, those not asked about."""
-        point = as_point(point, 3, "point")
-        within = check_real(within, "within", positive=True)
-        if skip is not None:
-            if (
+        a mask over the chosen solids, those not asked about.
+
+        ``check_input=False`` takes the arguments as given: ``point`` a float array (3,),
+        ``within`` a positive float, ``skip`` None or such a mask (a coupling term that asks
+        every control step checks them once; as scikit-learn's trees' ``check_input``)."""
+        if check_input is not False:  # (False: the hot path, one identity test)
+            check_bool(check_input, "check_input")
+            point = as_point(point, 3, "point")
+            within = check_real(within, "within", positive=True)
+            if skip is not None and (
                 not isinstance(skip, np.ndarray)
                 or skip.dtype != bool
                 or skip.shape != self._chosen.shape
@@ -68,10 +78,6 @@ class Proximity:
                 raise ValueError(
                     f"skip must be a boolean mask over the {self._chosen.size} chosen solids"
                 )
-        return self._near(point, within, skip)
-
-    def _near(self, point: np.ndarray, within: float, skip: np.ndarray | None = None):
-        """:meth:`near` on checked arguments (the avoidance term asks it every control step)."""
         if self._engine is None:
             return _NONE
         tool = self.scene.tool
