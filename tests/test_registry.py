@@ -21,7 +21,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "bidmp"
 def test_every_kind_loads_as_the_class_it_names():
     for name, kind in MODEL_KINDS.items():
         cls = kind.load()
-        assert cls.__name__ == name and hasattr(cls, "_get_state"), name
+        assert cls.__name__ == name and hasattr(cls, "to_state"), name
 
 
 def _isinstance_on_kinds(folder: Path) -> list[str]:

@@ -1,4 +1,4 @@
-"""Model-state helpers shared by the estimators' ``_get_state``/``_from_state`` (bidmp.io stores them)."""
+"""Model-state helpers shared by the estimators' ``to_state``/``from_state`` (bidmp.io stores them)."""
 
 from __future__ import annotations
 

@@ -414,8 +414,6 @@ _LEFT = {
     "_check_fitted": "CartesianDMP checks its parts",
     "_learn": "CartesianBiDMP learns each part's skill",
     # The model-file form of the Bi-DMP and the BLS, each in its own module.
-    "_get_state": "the model-file protocol every kind implements (io reads it)",
-    "_from_state": "the model-file protocol every kind implements (io reads it)",
     "_ensure_started": "a Bi-DMP's state module",
     "_start": "a Bi-DMP's state module",
     "_params": "the BLS's state module (the BLS's own parameter check)",

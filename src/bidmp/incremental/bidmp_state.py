@@ -20,14 +20,14 @@ from .bls import BLS
 # -- persistence -----------------------------------------------------------------------------
 def _bidmp_state(model) -> tuple[dict, dict]:
     model._ensure_started()
-    dmp_meta, dmp_arrays = model.dmp_._get_state()
+    dmp_meta, dmp_arrays = model.dmp_.to_state()
     arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
     arrays["skill_goals_"] = model.skill_goals_
     arrays["skill_starts_"] = model.skill_starts_
     arrays["skill_time_scales_"] = model.skill_time_scales_
     blocks_meta = []
     for index, block in enumerate(model.blocks_):
-        meta, block_arrays = block._get_state()
+        meta, block_arrays = block.to_state()
         blocks_meta.append(meta)
         arrays.update({f"block{index}/{k}": v for k, v in block_arrays.items()})
     params = {k: v for k, v in model.get_params(deep=False).items() if k != "dmp"}
@@ -47,7 +47,7 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
     for key, kind in (("dmp", dict), ("params", dict), ("blocks", list)):
         if not isinstance(meta.get(key), kind):
             raise ValueError(f"the Bi-DMP state has no {key} {kind.__name__}")
-    dmp = DMP._from_state(meta["dmp"], _Prefixed(arrays, "dmp/"))
+    dmp = DMP.from_state(meta["dmp"], _Prefixed(arrays, "dmp/"))
     params = dict(meta["params"])
     if not isinstance(params.get("increments"), list):
         raise ValueError("params.increments must be a list of integers")
@@ -60,7 +60,7 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
         meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0
     )
     model.blocks_ = [
-        BLS._from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
+        BLS.from_state(block_meta, _Prefixed(arrays, f"block{index}/"))
         for index, block_meta in enumerate(meta["blocks"])
     ]
     for index, block in enumerate(model.blocks_):

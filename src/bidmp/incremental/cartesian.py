@@ -259,7 +259,10 @@ class CartesianBiDMP(PoseModel, Estimator):
         )
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._ensure_started()
         cartesian = self.cartesian_
         return self._parts_state(
@@ -276,7 +279,10 @@ class CartesianBiDMP(PoseModel, Estimator):
         )
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> CartesianBiDMP:
+    def from_state(cls, meta: dict, arrays) -> CartesianBiDMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
 
         position, orientation = cls._parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
         if (

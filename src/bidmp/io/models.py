@@ -82,13 +82,13 @@ def save_model(model, path: str | os.PathLike) -> Path:
     except ValueError:
         known = False
     else:
-        known = hasattr(model, "_get_state")
+        known = hasattr(model, "to_state")
     if not known:
         raise TypeError(f"model must be one of {', '.join(sorted(_KINDS))}, got {class_name}")
     if not isinstance(path, (str, os.PathLike)):
         raise TypeError(f"path must be a file name, got {type(path).__name__}")
     path = _model_path(path)
-    state, arrays = model._get_state()
+    state, arrays = model.to_state()
     if _META_KEY in arrays:
         raise ValueError(f"array name {_META_KEY!r} is reserved")
     meta = {
@@ -151,7 +151,7 @@ def load_model(path: str | os.PathLike):
         if not isinstance(state, dict):
             raise ModelFileError(f"{path} is corrupt: its metadata has no state object")
         try:
-            return _model_class(class_name)._from_state(state, members)
+            return _model_class(class_name).from_state(state, members)
         except MemoryError:
             raise ModelFileError(f"{path}: a member is too large to load") from None
         except KeyError as exc:

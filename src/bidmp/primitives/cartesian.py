@@ -194,7 +194,7 @@ class PoseModel:
         """A pose model's state: its own ``meta``/``arrays`` plus those of its ``position_`` and
         ``orientation_`` parts, the parts' members prefixed with their names."""
         for part in ("position", "orientation"):
-            part_meta, part_arrays = getattr(self, f"{part}_")._get_state()
+            part_meta, part_arrays = getattr(self, f"{part}_").to_state()
             meta[part] = part_meta
             arrays.update({f"{part}/{k}": v for k, v in part_arrays.items()})
         return meta, arrays
@@ -206,7 +206,7 @@ class PoseModel:
             if not isinstance(meta.get(key), dict):
                 raise ValueError(f"the {name} state has no {key} object")
         return tuple(
-            part_class._from_state(meta[part], Prefixed(arrays, f"{part}/"))
+            part_class.from_state(meta[part], Prefixed(arrays, f"{part}/"))
             for part in ("position", "orientation")
         )
 
@@ -400,7 +400,10 @@ class CartesianDMP(PoseModel, Estimator):
         )
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self.fitted_parts()
         return self._parts_state(
             {"params": self._template().get_params()},  # the template's, as files always held
@@ -408,7 +411,10 @@ class CartesianDMP(PoseModel, Estimator):
         )
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> CartesianDMP:
+    def from_state(cls, meta: dict, arrays) -> CartesianDMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         position, orientation = cls._parts_from_state(DMP, "CartesianDMP", meta, arrays)
         model = cls(DMP(**cls._stored_params(meta["params"])))
         model.position_, model.orientation_ = position, orientation

@@ -733,12 +733,18 @@ class DMP(_FittedParams, Estimator):
         return DMPStepper(self, goal, start, duration, coupling, start_velocity, forcing_increment)
 
     # -- persistence (used by bidmp.io) --------------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._check_fitted()
         return _dmp_state(self)
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> DMP:
+    def from_state(cls, meta: dict, arrays) -> DMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         model = _dmp_from_state(cls, meta, arrays)
         model._remember_params()  # the parameters its weights were learned with
         return model

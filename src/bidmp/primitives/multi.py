@@ -164,9 +164,12 @@ class MultiDMP(Estimator):
         return base[None] + np.einsum("tn,snd->std", self.response(goal, n_steps), changes)
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._check_fitted()
-        inner_state, inner_arrays = self.dmp_._get_state()
+        inner_state, inner_arrays = self.dmp_.to_state()
         arrays = {f"dmp/{name}": value for name, value in inner_arrays.items()}
         arrays["weights_"] = self.weights_
         arrays["weight_cov_"] = self.weight_cov_
@@ -174,11 +177,14 @@ class MultiDMP(Estimator):
         return state, arrays
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> MultiDMP:
+    def from_state(cls, meta: dict, arrays) -> MultiDMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         from .._checks import check_loaded
         from .._state import Prefixed
 
-        inner = DMP._from_state(meta["dmp"], Prefixed(arrays, "dmp/"))
+        inner = DMP.from_state(meta["dmp"], Prefixed(arrays, "dmp/"))
         model = cls(dmp=DMP(**inner.get_params()), cov_reg=meta["cov_reg"])
         n_kernels, n_dims = inner.weights_.shape
         model.dmp_ = inner

@@ -623,7 +623,10 @@ class ProDMP(Estimator):
         return conditioned
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._check_fitted()
         state = {
             "params": self.get_params(),
@@ -641,7 +644,7 @@ class ProDMP(Estimator):
         return state, arrays
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> ProDMP:
+    def from_state(cls, meta: dict, arrays) -> ProDMP:
         """A fitted ProDMP from a model file: the basis recomputed from the settings (it is a
         function of them), the learned arrays checked for shape and finiteness."""
         from .._checks import check_loaded

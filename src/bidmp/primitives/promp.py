@@ -295,11 +295,17 @@ class ProMP(Estimator):
         return out
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         return _promp_state(self)
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> ProMP:
+    def from_state(cls, meta: dict, arrays) -> ProMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         return _promp_from_state(cls, meta, arrays)
 
     def trajectory(self, dt: float = 0.01) -> Trajectory:

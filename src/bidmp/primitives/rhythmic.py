@@ -384,7 +384,10 @@ class RhythmicDMP(Estimator):
         return Trajectory(np.arange(len(y)) * dt, y, v, a, self.units_, tuple(self.names_ or ()))
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._check_fitted()
         estimate = self.estimate_
         state = {
@@ -413,7 +416,10 @@ class RhythmicDMP(Estimator):
         return state, arrays
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> RhythmicDMP:
+    def from_state(cls, meta: dict, arrays) -> RhythmicDMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         from .._checks import check_loaded
         from .frequency import FrequencyEstimate
 

@@ -150,21 +150,27 @@ class RhythmicPoseDMP(Estimator):
         )
 
     # -- persistence (used by bidmp.io) -----------------------------------------------------
-    def _get_state(self) -> tuple[dict, dict]:
+    def to_state(self) -> tuple[dict, dict]:
+        """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
+        as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
+        into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
         self._check_fitted()
-        state, arrays = self.rhythm_._get_state()
+        state, arrays = self.rhythm_.to_state()
         arrays = {f"rhythm/{name}": value for name, value in arrays.items()}
         arrays["mean_orientation_"] = self.mean_orientation_
         arrays["scales_"] = self.scales_
         return {"params": self.get_params(), "rhythm": state, "units": self.units_}, arrays
 
     @classmethod
-    def _from_state(cls, meta: dict, arrays) -> RhythmicPoseDMP:
+    def from_state(cls, meta: dict, arrays) -> RhythmicPoseDMP:
+        """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
+        name to array, each read when needed and checked for dtype, shape and finiteness
+        (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         from .._checks import check_loaded
         from .._state import Prefixed
 
         model = cls(**meta["params"])
-        rhythm = RhythmicDMP._from_state(meta["rhythm"], Prefixed(arrays, "rhythm/"))
+        rhythm = RhythmicDMP.from_state(meta["rhythm"], Prefixed(arrays, "rhythm/"))
         if rhythm.n_dims_ != 6:
             raise ValueError(f"member rhythm.weights_ has {rhythm.n_dims_} columns, expected 6")
         model.rhythm_ = rhythm
