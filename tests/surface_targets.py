@@ -399,7 +399,16 @@ def _estimators():
 
 
 def _instances(tmp: Path):
-    """(owner, instance, valid arguments of its methods) for the objects the library hands out."""
+    """(owner, instance, valid arguments of its methods) for the objects the library hands out;
+    a model's ``from_state`` gets the model-file form its own ``to_state`` gives."""
+    for owner, instance, args in _plain_instances(tmp):
+        if hasattr(instance, "to_state"):
+            meta, arrays = instance.to_state()
+            args = {**args, "meta": meta, "arrays": arrays}
+        yield owner, instance, args
+
+
+def _plain_instances(tmp: Path):
     from bidmp.baselines import TPGMM, GMMRegressor
     from bidmp.incremental import BLS
     from bidmp.primitives import (

@@ -101,3 +101,55 @@ def test_a_new_kind_gets_its_fit_flag_and_its_model_files(tmp_path, capsys):
 
 class WideProMP(ProMP):
     """A ProMP subclass, registered as a kind of its own in the test above."""
+
+
+def _fitted_kinds(tmp_path) -> dict:
+    """One fitted model of every registered kind (the surface fuzz's own instances)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from surface_targets import _plain_instances
+
+    found = {
+        owner: instance for owner, instance, _ in _plain_instances(tmp_path) if owner in MODEL_KINDS
+    }
+    assert set(found) == set(MODEL_KINDS), set(MODEL_KINDS) - set(found)
+    return found
+
+
+# Members a model file of an older format lacked, read with their default.
+_OPTIONAL_MEMBERS = {"skill_time_scales_", "skill_start_logs_"}  # formats 2-4, format 3
+
+
+def test_every_kinds_state_comes_back_as_the_same_model_and_a_bad_one_is_named(tmp_path):
+    """The model-file protocol, public: ``from_state(*model.to_state())`` is the same model (every
+    array equal, the state it gives again equal); a state with a member or a key taken away,
+    or of another kind, is a ValueError naming what is missing — never a KeyError from inside."""
+    from bidmp._state import StateError
+
+    models = _fitted_kinds(tmp_path)
+    for name, model in models.items():
+        meta, arrays = model.to_state()
+        again = type(model).from_state(meta, arrays)
+        assert type(again) is type(model), name
+        meta_again, arrays_again = again.to_state()
+        assert meta_again == meta and arrays_again.keys() == arrays.keys(), name
+        for member, value in arrays.items():
+            assert np.array_equal(arrays_again[member], value), (name, member)
+        for member in arrays:  # each one taken away: named, or one older formats lacked
+            try:
+                type(model).from_state(meta, {k: v for k, v in arrays.items() if k != member})
+            except StateError as exc:
+                assert f"missing member {member}" in str(exc), (name, member, str(exc))
+            else:
+                assert member.rsplit("/", 1)[-1] in _OPTIONAL_MEMBERS, (name, member)
+        key = "params" if "params" in meta else sorted(meta)[0]
+        with pytest.raises(ValueError, match=f"fitted {type(model).__name__}.*{key}"):
+            type(model).from_state({k: v for k, v in meta.items() if k != key}, arrays)
+        other = next(m for n, m in models.items() if n != name and type(m) is not type(model))
+        with pytest.raises(ValueError, match=f"fitted {type(model).__name__}"):
+            type(model).from_state(*other.to_state())
+    with pytest.raises(TypeError, match="meta must be"):
+        models["DMP"].from_state([], {})
+    with pytest.raises(TypeError, match="arrays must map"):
+        models["DMP"].from_state({}, [])

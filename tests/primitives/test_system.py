@@ -413,11 +413,6 @@ _LEFT = {
     "_fit": "CartesianDMP fits its parts with a progress and a name for messages",
     "_check_fitted": "CartesianDMP checks its parts",
     "_learn": "CartesianBiDMP learns each part's skill",
-    # The model-file form of the Bi-DMP and the BLS, each in its own module.
-    "_ensure_started": "a Bi-DMP's state module",
-    "_start": "a Bi-DMP's state module",
-    "_params": "the BLS's state module (the BLS's own parameter check)",
-    "_set_train_hidden": "the BLS's state module",
 }
 
 

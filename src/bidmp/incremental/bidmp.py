@@ -38,10 +38,11 @@ from .._checks import (
     numerically_guarded,
     short_token,
 )
+from .._state import state_reader
 from .._threads import single_threaded
 from .._trajectory import resample_time, rmse
 from ..primitives.dmp import DMP
-from .bidmp_state import _bidmp_from_state, _bidmp_state
+from .bidmp_state import _bidmp_parts, _bidmp_state, _restore_skills
 from .bls import BLS
 
 __all__ = ["BiDMP", "ForgettingResult", "forgetting", "forgetting_runs"]
@@ -549,14 +550,21 @@ class BiDMP(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
+        self._ensure_started()
         return _bidmp_state(self)
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> BiDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness
         (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
-        return _bidmp_from_state(cls, meta, arrays)
+        dmp, params = _bidmp_parts(meta, arrays)
+        model = cls(dmp, **params)
+        model.check_params()
+        model._start(dmp)
+        _restore_skills(model, meta, arrays)
+        return model
 
 
 # ---------------------------------------------------------------------------------------------

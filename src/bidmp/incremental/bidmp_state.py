@@ -19,7 +19,8 @@ from .bls import BLS
 
 # -- persistence -----------------------------------------------------------------------------
 def _bidmp_state(model) -> tuple[dict, dict]:
-    model._ensure_started()
+    """A started Bi-DMP's model-file form: its DMP's and blocks' under their prefixes, its skills'
+    goals, starts and time scales, its parameters but the DMP."""
     dmp_meta, dmp_arrays = model.dmp_.to_state()
     arrays = {f"dmp/{k}": v for k, v in dmp_arrays.items()}
     arrays["skill_goals_"] = model.skill_goals_
@@ -41,9 +42,9 @@ def _bidmp_state(model) -> tuple[dict, dict]:
     }, arrays
 
 
-def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
-    """A Bi-DMP of class ``cls`` from a model file's state (its DMP and BLS blocks read from their
-    prefixes), every member checked."""
+def _bidmp_parts(meta: dict, arrays: Mapping) -> tuple:
+    """A model file's Bi-DMP before its skills: its fitted DMP (read from its prefix, every member
+    checked) and its other parameters, ``(dmp, params)``."""
     for key, kind in (("dmp", dict), ("params", dict), ("blocks", list)):
         if not isinstance(meta.get(key), kind):
             raise ValueError(f"the Bi-DMP state has no {key} {kind.__name__}")
@@ -52,9 +53,14 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
     if not isinstance(params.get("increments"), list):
         raise ValueError("params.increments must be a list of integers")
     params["increments"] = tuple(params["increments"])
-    model = cls(dmp, **params)
-    model.check_params()
-    model._start(dmp)
+    return dmp, params
+
+
+def _restore_skills(model, meta: dict, arrays: Mapping) -> None:
+    """A started Bi-DMP's learned skills from a model file's state: its BLS blocks (read from
+    their prefixes), the skills' goals, starts and time scales, every member checked against the
+    DMP the model runs."""
+    dmp = model.dmp_
     model.phase_min_ = check_real(meta["phase_min_"], "phase_min_", positive=True, maximum=1.0)
     model.gate_phase_ = check_real(
         meta.get("gate_phase_", 1.0), "gate_phase_", positive=True, maximum=1.0
@@ -91,4 +97,3 @@ def _bidmp_from_state(cls, meta: dict, arrays: Mapping):
             )
     else:  # formats 2-4: every skill took the demonstration's time
         model.skill_time_scales_ = np.ones(expected[0])
-    return model

@@ -31,6 +31,7 @@ import threading
 from typing import NamedTuple
 
 import numpy as np
+from scipy.linalg import solve_triangular
 
 from .._api import Estimator
 from .._checks import (
@@ -45,8 +46,9 @@ from .._checks import (
     check_real,
     numerically_guarded,
 )
+from .._state import state_reader
 from .._threads import one_thread, single_threaded
-from .bls_state import _bls_from_state, _bls_state
+from .bls_state import _bls_members, _bls_params, _bls_state
 from .linalg import (
     MAX_ADMM_ITERATIONS,
     _check_gap,
@@ -483,11 +485,26 @@ class BLS(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        return _bls_state(self)
+        return _bls_state(self, self._y_was_1d)
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> BLS:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness
         (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
-        return _bls_from_state(cls, meta, arrays)
+        model = cls(**_bls_params(meta))
+        members = _bls_members(meta, arrays, model._params())
+        model._y_was_1d = members.pop("y_was_1d")
+        model._set_train_hidden(members.pop("train_hidden"))
+        for name, value in members.items():
+            setattr(model, name, value)
+        # the ridge update's projected targets, as fit leaves them (pinv: none)
+        model._projected_targets = (
+            None
+            if model.gram_factor_ is None
+            else solve_triangular(
+                model.gram_factor_, model.train_hidden_.T @ model.train_targets_, trans="T"
+            )
+        )
+        return model

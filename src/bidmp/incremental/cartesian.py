@@ -10,6 +10,7 @@ import numpy as np
 
 from .._api import Estimator, clone
 from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
+from .._state import state_reader
 from .._threads import single_threaded
 from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
 from ..primitives.dmp import DMP
@@ -279,6 +280,7 @@ class CartesianBiDMP(PoseModel, Estimator):
         )
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> CartesianBiDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

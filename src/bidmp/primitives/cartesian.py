@@ -38,7 +38,7 @@ from .._checks import (
     check_loaded,
     numerically_guarded,
 )
-from .._state import Prefixed
+from .._state import Prefixed, state_reader
 from .._threads import single_threaded
 from .._trajectory import continuous_quaternions as _continuous
 from .dmp import DMP
@@ -411,6 +411,7 @@ class CartesianDMP(PoseModel, Estimator):
         )
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> CartesianDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

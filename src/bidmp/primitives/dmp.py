@@ -56,6 +56,7 @@ from .._checks import (
     check_names,
     numerically_guarded,
 )
+from .._state import state_reader
 from .._trajectory import resample_time
 from .._units import ANGLE_UNITS, check_units
 from .canonical import CanonicalSystem
@@ -741,6 +742,7 @@ class DMP(_FittedParams, Estimator):
         return _dmp_state(self)
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> DMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

@@ -21,6 +21,7 @@ import numpy as np
 
 from .._api import Estimator, clone
 from .._checks import NotFittedError, as_point, check_int, check_real, check_seed
+from .._state import state_reader
 from .._threads import single_threaded
 from .._trajectory import resample_time
 from .dmp import DMP
@@ -177,6 +178,7 @@ class MultiDMP(Estimator):
         return state, arrays
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> MultiDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

@@ -48,6 +48,7 @@ from .._checks import (
     check_int,
     check_real,
 )
+from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
 from .promp import _demonstrations, _stamps, condition_gaussian
@@ -644,6 +645,7 @@ class ProDMP(Estimator):
         return state, arrays
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> ProDMP:
         """A fitted ProDMP from a model file: the basis recomputed from the settings (it is a
         function of them), the learned arrays checked for shape and finiteness."""

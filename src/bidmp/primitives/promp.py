@@ -37,6 +37,7 @@ from .._checks import (
     check_real,
     check_seed,
 )
+from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
 from .timing import Trajectory, check_timestamps
@@ -302,6 +303,7 @@ class ProMP(Estimator):
         return _promp_state(self)
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> ProMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

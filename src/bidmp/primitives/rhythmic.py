@@ -45,6 +45,7 @@ from .._checks import (
     check_names,
     check_real,
 )
+from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
 from .canonical import RhythmicPhase
@@ -416,6 +417,7 @@ class RhythmicDMP(Estimator):
         return state, arrays
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> RhythmicDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness

@@ -17,6 +17,7 @@ import numpy as np
 
 from .._api import Estimator
 from .._checks import check_real
+from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
 from .cartesian import as_poses
@@ -162,6 +163,7 @@ class RhythmicPoseDMP(Estimator):
         return {"params": self.get_params(), "rhythm": state, "units": self.units_}, arrays
 
     @classmethod
+    @state_reader
     def from_state(cls, meta: dict, arrays) -> RhythmicPoseDMP:
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness
