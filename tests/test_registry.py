@@ -153,3 +153,14 @@ def test_every_kinds_state_comes_back_as_the_same_model_and_a_bad_one_is_named(t
         models["DMP"].from_state([], {})
     with pytest.raises(TypeError, match="arrays must map"):
         models["DMP"].from_state({}, [])
+
+
+def test_every_kind_says_whether_it_is_fitted(tmp_path):
+    """``check_fitted()``, one public method on every kind: a NotFittedError that says what to do
+    before ``fit``, nothing after."""
+    from bidmp import NotFittedError
+
+    for model in _fitted_kinds(tmp_path).values():
+        model.check_fitted()
+        with pytest.raises(NotFittedError, match="fit"):
+            type(model)().check_fitted()

@@ -408,10 +408,9 @@ def private_reaches(root: pathlib.Path = SRC, subpackages=("primitives", "increm
 # The reaches left, by name, and why; the DMP's own (its parameters, grid, rollout preparation,
 # training trajectory) are gone. The list may only shrink: a name no longer reached fails the test.
 _LEFT = {
-    # Composition still to be made through the system: a pose DMP fits and checks its two parts,
+    # Composition still to be made through the system: a pose DMP fits its two parts,
     # a pose Bi-DMP learns and queries its two skills.
     "_fit": "CartesianDMP fits its parts with a progress and a name for messages",
-    "_check_fitted": "CartesianDMP checks its parts",
     "_learn": "CartesianBiDMP learns each part's skill",
 }
 

@@ -217,6 +217,13 @@ class BiDMP(Estimator):
             1.0 if dmp.settings().protocol == "paper" else float(phase[dmp.n_steps_ - 1])
         )
 
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model has its skill
+        0 (fitted, or built on a fitted DMP) and that DMP is still fitted with the parameters it
+        has now."""
+        self._ensure_started()
+        self.dmp_.check_fitted()
+
     def _ensure_started(self) -> None:
         if "dmp_" in self.__dict__:
             return

@@ -481,6 +481,10 @@ class BLS(Estimator):
             out = self.hidden(X) @ self.output_weights_
         return out[:, 0] if self._y_was_1d else out
 
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
+        check_fitted(self, "output_weights_")
+
     def to_state(self) -> tuple[dict, dict]:
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two

@@ -9,7 +9,14 @@ from __future__ import annotations
 import numpy as np
 
 from .._api import Estimator, clone
-from .._checks import as_point, check_fitted, check_limit, check_loaded, numerically_guarded
+from .._checks import (
+    NotFittedError,
+    as_point,
+    check_fitted,
+    check_limit,
+    check_loaded,
+    numerically_guarded,
+)
 from .._state import state_reader
 from .._threads import single_threaded
 from ..primitives.cartesian import CartesianDMP, PoseModel, as_poses
@@ -117,6 +124,19 @@ class CartesianBiDMP(PoseModel, Estimator):
         self.skill_goal_orientations_ = cartesian.goal_[None, 3:].copy()
         self.skill_start_orientations_ = cartesian.start_[None, 3:].copy()
         self.skill_start_logs_ = cartesian.start_log_[None].copy()
+
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model has its skill
+        0 (fitted, or built on a fitted CartesianDMP) and its parts are still fitted."""
+        if "cartesian_" not in self.__dict__ and not (
+            isinstance(self.cartesian, CartesianDMP) and "position_" in self.cartesian.__dict__
+        ):
+            raise NotFittedError(
+                "this CartesianBiDMP is not fitted yet: pass a fitted CartesianDMP "
+                "(CartesianBiDMP(CartesianDMP().fit(poses))) or call fit(poses) first"
+            )
+        self._ensure_started()
+        self.cartesian_.fitted_parts()
 
     def _ensure_started(self) -> None:
         if "cartesian_" in self.__dict__:

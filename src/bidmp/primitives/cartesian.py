@@ -291,6 +291,11 @@ class CartesianDMP(PoseModel, Estimator):
     def __sklearn_is_fitted__(self) -> bool:
         return "position_" in self.__dict__ and self.position_.__sklearn_is_fitted__()
 
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless both parts are fitted
+        with the parameters the model has now (one changed since ``fit`` is named)."""
+        self.fitted_parts()
+
     def fitted_parts(self) -> tuple[DMP, DMP]:
         """The fitted parts ``(position_, orientation_)`` with the template's parameters passed on
         (a changed ``tau`` slows both); a learned parameter changed since ``fit`` raises
@@ -304,7 +309,7 @@ class CartesianDMP(PoseModel, Estimator):
                 value = getattr(template, name)
                 if getattr(part, name) is not value:
                     setattr(part, name, value)
-            part._check_fitted()
+            part.check_fitted()
         return self.position_, self.orientation_
 
     @property

@@ -273,7 +273,7 @@ class DMP(_FittedParams, Estimator):
     def system_(self) -> DMPSystem:
         """The fitted DMP as one immutable :class:`~bidmp.primitives.system.DMPSystem` (settings at
         the current ``tau``, weights, demonstration grid), whose methods are the rollouts."""
-        self._check_fitted()
+        self.check_fitted()
         caches = self.__dict__.get("_caches")
         if caches is None:  # learned state set by hand or loaded: its grids are cached from now on
             caches = self._caches = _Caches()
@@ -403,19 +403,19 @@ class DMP(_FittedParams, Estimator):
     @property
     def n_dims_(self) -> int:
         """Number of dimensions D of the learned demonstration."""
-        self._check_fitted()
+        self.check_fitted()
         return self.weights_.shape[1]
 
     @property
     def sample_rate_(self) -> float:
         """The demonstration's sample rate in Hz, ``(T - 1) / duration_``."""
-        self._check_fitted()
+        self.check_fitted()
         return (self.n_steps_ - 1) / self.duration_
 
     @property
     def time_unit_(self) -> float:
         """Seconds per unit of normalised time: ``duration_ · T / (T - 1)`` (1 without timestamps)."""
-        self._check_fitted()
+        self.check_fitted()
         return self.duration_ * self.n_steps_ / (self.n_steps_ - 1)
 
     # -- evaluation ----------------------------------------------------------------------------
@@ -466,7 +466,7 @@ class DMP(_FittedParams, Estimator):
         followed by rest at its last point up to :attr:`n_train_`. ``quiet``: the rest blends are
         logged at debug level only (a caller that learns many demonstrations on one grid has said
         so once)."""
-        self._check_fitted()
+        self.check_fitted()
         quiet = check_bool(quiet, "quiet")
         y = as_trajectory(y, "y", min_points=2, allow_static=True)
         params = self.settings()
@@ -692,7 +692,7 @@ class DMP(_FittedParams, Estimator):
             acceleration at each sample (the same continuous motion at any ``dt``). Euler (paper):
             ``yd[l] = (y[l+1] - y[l]) / dt`` exactly (the explicit-Euler state), likewise ``ydd``.
         """
-        self._check_fitted()
+        self.check_fitted()
         _check_forcing_increment(forcing_increment)  # every path below takes it
         request = _Rollout(
             goal,
@@ -738,7 +738,7 @@ class DMP(_FittedParams, Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        self._check_fitted()
+        self.check_fitted()
         return _dmp_state(self)
 
     @classmethod

@@ -100,7 +100,8 @@ class MultiDMP(Estimator):
         self.aligned_ = aligned
         return self
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
         if "dmp_" not in self.__dict__:
             raise NotFittedError("this MultiDMP is not fitted yet: call fit(demonstrations) first")
 
@@ -108,24 +109,24 @@ class MultiDMP(Estimator):
     def system_(self):
         """The mean motion as a :class:`~bidmp.primitives.system.DMPSystem` (the mean weights'
         DMP's, at its ``tau``)."""
-        self._check_fitted()
+        self.check_fitted()
         return self.dmp_.system_
 
     def trajectory(self, goal=None, **options):
         """The mean motion (:meth:`bidmp.DMP.trajectory` of the mean weights)."""
-        self._check_fitted()
+        self.check_fitted()
         return self.dmp_.trajectory(goal, **options)
 
     def rollout(self, goal=None, **options) -> np.ndarray:
         """The mean motion's positions (:meth:`bidmp.DMP.rollout`)."""
-        self._check_fitted()
+        self.check_fitted()
         return self.dmp_.rollout(goal, **options)
 
     def response(self, goal=None, n_steps: int | None = None) -> np.ndarray:
         """``A`` (n, N): how each weight moves the rollout's positions (the same for every
         dimension and any goal: the forcing enters each alike), exactly — the rollout grid's
         basis functions integrated as forcing terms, all at once."""
-        self._check_fitted()
+        self.check_fitted()
         dmp = self.dmp_
         if goal is not None:  # checked as a rollout would, though the response is the same
             as_point(goal, dmp.n_dims_, "goal")
@@ -144,7 +145,7 @@ class MultiDMP(Estimator):
     def sample(self, n_samples: int, seed=0, goal=None, n_steps: int | None = None) -> np.ndarray:
         """``n_samples`` rollouts (n_samples, n, D) to ``goal`` with weights drawn from the
         distribution (seeded)."""
-        self._check_fitted()
+        self.check_fitted()
         n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=10_000)
         rng = np.random.default_rng(check_seed(seed, "seed"))
         n_kernels, n_dims = self.dmp_.weights_.shape
@@ -169,7 +170,7 @@ class MultiDMP(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        self._check_fitted()
+        self.check_fitted()
         inner_state, inner_arrays = self.dmp_.to_state()
         arrays = {f"dmp/{name}": value for name, value in inner_arrays.items()}
         arrays["weights_"] = self.weights_

@@ -377,7 +377,8 @@ class ProDMP(Estimator):
         self.units_ = units
         return self
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
         if "weight_mean_" not in self.__dict__:
             raise NotFittedError("this ProDMP is not fitted yet: call fit(demonstrations) first")
 
@@ -437,7 +438,7 @@ class ProDMP(Estimator):
         ``conditioned=True`` the Gaussian's mean conditioned exactly on each goal instead (the
         forcing weights move with the goal as the demonstrations say; affine in the goal, so
         still one product)."""
-        self._check_fitted()
+        self.check_fitted()
         conditioned = check_bool(conditioned, "conditioned")
         t = self._times(times, None)
         starts, velocities = self._boundary(
@@ -509,7 +510,7 @@ class ProDMP(Estimator):
         velocities in closed form, the acceleration from the system's equation (exact, not
         differenced), at ``times`` (s; default ``n_steps`` over tau). Returns a
         :class:`bidmp.Trajectory`."""
-        self._check_fitted()
+        self.check_fitted()
         t = self._times(times, n_steps)
         start, velocity = self._single_boundary(start, start_velocity)
         w = (
@@ -537,7 +538,7 @@ class ProDMP(Estimator):
         ``start`` ends exactly at ``end`` at tau. The learned goal is not where a demonstration
         ends — it is fitted with the forcing weights, which share its effect — so a new end is
         reached by moving the goal by what it lacks there, over the goal column's value at tau."""
-        self._check_fitted()
+        self.check_fitted()
         end = as_points(end, self.n_dims_, "end")[0]
         start, velocity = self._single_boundary(start, start_velocity)
         w = self.weight_mean_.reshape(self.n_dims_, -1)
@@ -549,7 +550,7 @@ class ProDMP(Estimator):
         """(T, D): the positions' standard deviation (units) under the weights' Gaussian at
         ``times`` (s; default ``n_steps`` over tau) — the boundary condition is exact, so it does
         not depend on the start."""
-        self._check_fitted()
+        self.check_fitted()
         t = self._times(times, n_steps)
         H = self.basis_.boundary_maps(t, 0.0)[4]
         size = self.basis_.n_basis + 1
@@ -570,7 +571,7 @@ class ProDMP(Estimator):
         become ``goal``, the forcing weights move as the demonstrations say they go with it."""
         import copy
 
-        self._check_fitted()
+        self.check_fitted()
         goal = as_points(goal, self.n_dims_, "goal")[0]
         columns = np.zeros((self.weight_mean_.size, self.n_dims_))
         columns[self._goal_index(), np.arange(self.n_dims_)] = 1.0
@@ -588,7 +589,7 @@ class ProDMP(Estimator):
         Gaussian like a ProMP's, the boundary condition stays exact."""
         import copy
 
-        self._check_fitted()
+        self.check_fitted()
         times = as_vector(times, "times")
         values = as_points(values, self.n_dims_, "values")
         if len(values) != len(times):
@@ -628,7 +629,7 @@ class ProDMP(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        self._check_fitted()
+        self.check_fitted()
         state = {
             "params": self.get_params(),
             "duration": float(self.duration_),

@@ -194,7 +194,8 @@ class ProMP(Estimator):
         self.units_ = units
         return self
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
         if "weight_mean_" not in self.__dict__:
             raise NotFittedError("this ProMP is not fitted yet: call fit(demonstrations) first")
 
@@ -224,7 +225,7 @@ class ProMP(Estimator):
 
     def _rows(self, phase, n_steps: int, derivative: int = 0) -> np.ndarray:
         """The basis rows (L, N) (or their phase derivative) at ``phase`` (default ``n_steps``)."""
-        self._check_fitted()
+        self.check_fitted()
         return promp_basis(
             self._phase(phase, n_steps), self._fitted_basis, self.overlap, derivative
         )
@@ -266,7 +267,7 @@ class ProMP(Estimator):
 
     def sample(self, n_samples: int, seed=0, phase=None, n_steps: int = 100) -> np.ndarray:
         """``n_samples`` trajectories (n, L, D) drawn from the weight distribution (seeded)."""
-        self._check_fitted()
+        self.check_fitted()
         n_samples = check_int(n_samples, "n_samples", minimum=1, maximum=100_000)
         rng = np.random.default_rng(check_seed(seed, "seed"))
         rows = self._rows(phase, n_steps)
@@ -278,7 +279,7 @@ class ProMP(Estimator):
         """A new ProMP conditioned on passing ``y`` (K, D) at ``phase`` (K,) with covariance
         ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D).
         All points at once (one stacked observation)."""
-        self._check_fitted()
+        self.check_fitted()
         phase = _as_bounded_array(phase, "phase", 1)
         # one stacked observation: its (K·D)² covariance must fit before it is built
         check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
@@ -313,7 +314,7 @@ class ProMP(Estimator):
     def trajectory(self, dt: float = 0.01) -> Trajectory:
         """The mean motion over the mean duration, every ``dt`` s: positions, velocities and
         accelerations (analytic in the phase)."""
-        self._check_fitted()
+        self.check_fitted()
         dt = check_real(dt, "dt", positive=True, maximum=self.duration_)
         n = check_int(
             int(min(self.duration_ / dt, 1e15) + 1e-9) + 1,
@@ -407,7 +408,7 @@ def _noise(cov, n_points: int, n_dims: int) -> np.ndarray:
 
 
 def _promp_state(model: ProMP) -> tuple[dict, dict]:
-    model._check_fitted()
+    model.check_fitted()
     state = {
         "params": model.get_params(),
         "duration": float(model.duration_),

@@ -88,7 +88,9 @@ class _FittedParams:
     def __sklearn_is_fitted__(self) -> bool:
         return self._fitted_attribute in self.__dict__ and not self._stale_params()
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted
+        with the parameters it has now (one changed since ``fit`` is named)."""
         check_fitted(self, self._fitted_attribute)
         stale = self._stale_params()
         if stale:

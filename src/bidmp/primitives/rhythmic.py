@@ -160,7 +160,8 @@ class RhythmicDMP(Estimator):
         )
         return self
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
         if "weights_" not in self.__dict__:
             from .._checks import NotFittedError
 
@@ -177,7 +178,7 @@ class RhythmicDMP(Estimator):
 
     def forcing(self, phase) -> np.ndarray:
         """The learned forcing term ``f(φ)`` (L, D) at phases (rad), amplitude 1."""
-        self._check_fitted()
+        self.check_fitted()
         phase = as_vector(phase, "phase")
         check_bytes(phase.size * len(self.centres_), "the basis rows at phase (phases x kernels)")
         return self._basis.rows(phase, self.centres_, self.widths_) @ self.weights_
@@ -254,7 +255,7 @@ class RhythmicDMP(Estimator):
         return self._alpha / 4.0
 
     def _settings(self, frequency, amplitude, anchor):
-        self._check_fitted()
+        self.check_fitted()
         frequency = (
             self.frequency_
             if frequency is None
@@ -389,7 +390,7 @@ class RhythmicDMP(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        self._check_fitted()
+        self.check_fitted()
         estimate = self.estimate_
         state = {
             "params": self.get_params(),

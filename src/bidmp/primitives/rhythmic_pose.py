@@ -99,7 +99,8 @@ class RhythmicPoseDMP(Estimator):
         self.units_ = units
         return self
 
-    def _check_fitted(self) -> None:
+    def check_fitted(self) -> None:
+        """Raise :class:`bidmp.NotFittedError`, saying what to do, unless the model is fitted."""
         if "rhythm_" not in self.__dict__:
             from .._checks import NotFittedError
 
@@ -116,7 +117,7 @@ class RhythmicPoseDMP(Estimator):
     ) -> PoseTrajectory:
         """``cycles`` periods on the limit cycle every ``dt`` s; ``anchor`` (3,) moves the position
         part's centre (units), the orientation rocks about its mean orientation."""
-        self._check_fitted()
+        self.check_fitted()
         amplitude = check_real(amplitude, "amplitude", nonnegative=True, maximum=1e6)
         if anchor is not None:
             from .._checks import as_point
@@ -155,7 +156,7 @@ class RhythmicPoseDMP(Estimator):
         """The model-file form of the fitted model, ``(meta, arrays)``: its parameters and scalars
         as a JSON-able dict, its learned arrays by name (:func:`bidmp.io.save_model` writes the two
         into one ``.npz``; no pickle). Raises :class:`bidmp.NotFittedError` before ``fit``."""
-        self._check_fitted()
+        self.check_fitted()
         state, arrays = self.rhythm_.to_state()
         arrays = {f"rhythm/{name}": value for name, value in arrays.items()}
         arrays["mean_orientation_"] = self.mean_orientation_
