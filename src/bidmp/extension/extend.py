@@ -397,14 +397,9 @@ def _extend_keeping_the_margin(
     (not only the roadmap's polyline) must keep the margin from every part but the target's. When
     it does not, it is planned again with the margin widened by the shortfall; after
     :data:`_MARGIN_ATTEMPTS` plannings the call fails naming the part."""
-    from ..scene.checker import SceneChecker
-
     planning = scene.margin
     for _ in range(_MARGIN_ATTEMPTS):
-        options = {
-            **roadmap_options,
-            "is_free": SceneChecker(scene, scene._selected(exclude), planning),
-        }
+        options = {**roadmap_options, "is_free": scene.checker(exclude, margin=planning)}
         extension = _extend_keeping_approach(y, target, points, seed, options, (scene, exclude))
         clearance = scene.clearance(extension.complete, exclude=exclude)
         if clearance.clear:

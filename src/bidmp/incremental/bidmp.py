@@ -31,6 +31,7 @@ from .._checks import (
     _as_float_array,
     as_point,
     as_trajectory,
+    check_bool,
     check_choice,
     check_int,
     check_limit,
@@ -264,7 +265,14 @@ class BiDMP(Estimator):
 
     @numerically_guarded
     @single_threaded  # small dense algebra: idle BLAS threads only steal the core
-    def learn(self, y_dn, *, duration: float | None = None) -> BiDMP:
+    def learn(
+        self,
+        y_dn,
+        *,
+        duration: float | None = None,
+        allow_static: bool = False,
+        called: str = "y_dn",
+    ) -> BiDMP:
         """Learn an extended demonstration as a new skill (Eq. 15, 27, 28). Returns self.
 
         Parameters
@@ -277,14 +285,16 @@ class BiDMP(Estimator):
             then runs that long (its time scale ``duration / dmp_.duration_``, see
             ``skill_time_scales_``): a longer extension is not rushed into the demonstration's
             time. Default: the demonstration's own duration (the paper's protocol).
+        allow_static : bool, default False
+            Accept a ``y_dn`` that does not move: for a part of a model whose other part moves
+            (a pose skill that only turns, or only moves), which holds its place.
+        called : str, default "y_dn"
+            What the messages call ``y_dn`` (a part of another model: "poses' orientation").
         """
-        return self._learn(y_dn, duration)
-
-    def _learn(
-        self, y_dn, duration: float | None, name: str = "y_dn", still: bool = False
-    ) -> BiDMP:
-        """:meth:`learn`; ``still``: ``y_dn`` may stand still (one part of a pose skill that moves
-        in its other part)."""
+        allow_static = check_bool(allow_static, "allow_static")
+        if not isinstance(called, str) or not 0 < len(called) <= 80:
+            raise TypeError("called must be what the messages call y_dn: 1-80 characters of text")
+        name, still = called, allow_static
         self._ensure_started()
         increments, derivatives = self._check_params()
         time_scale = _time_scale(duration, self.dmp_)
@@ -660,7 +670,7 @@ def forgetting_runs(
 
     measure(0)
     for index, demonstration in enumerate(demonstrations, start=1):
-        model._learn(demonstration, None, f"demonstrations[{index - 1}]")
+        model.learn(demonstration, called=f"demonstrations[{index - 1}]")
         references.append(resample_time(demonstration, dmp.n_steps_))
         measure(index)
     return {

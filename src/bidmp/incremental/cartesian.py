@@ -175,8 +175,12 @@ class CartesianBiDMP(PoseModel, Estimator):
         self._ensure_started()
         positions, quaternions, log = self._split_poses(poses)
         # A pose skill may keep its position or its orientation still (not both: _split_poses).
-        self.position_._learn(positions, duration, "poses' positions", still=True)
-        self.orientation_._learn(log, duration, "poses' orientation", still=True)
+        self.position_.learn(
+            positions, duration=duration, allow_static=True, called="poses' positions"
+        )
+        self.orientation_.learn(
+            log, duration=duration, allow_static=True, called="poses' orientation"
+        )
         self.skill_goal_orientations_ = np.vstack([self.skill_goal_orientations_, quaternions[-1]])
         self.skill_start_orientations_ = np.vstack([self.skill_start_orientations_, quaternions[0]])
         self.skill_start_logs_ = np.vstack([self.skill_start_logs_, log[0]])

@@ -98,8 +98,8 @@ def _fit_parts(
     position_still = np.ptp(positions, axis=0).max() == 0.0
     orientation_still = np.ptp(log, axis=0).max() <= 1e-12
     if position_still:
-        orientation._fit(log, t, called=(f"{name}' orientation", "rad"))
-        position._fit(
+        orientation.fit(log, t, called=(f"{name}' orientation", "rad"))
+        position.fit(
             positions,
             t,
             units,
@@ -107,11 +107,11 @@ def _fit_parts(
             called=(f"{name}' positions", None),
         )
         return
-    position._fit(positions, t, units, called=(f"{name}' positions", None))
+    position.fit(positions, t, units, called=(f"{name}' positions", None))
     progress = (
         _arclength_progress(position.training_trajectory(positions)) if orientation_still else None
     )
-    orientation._fit(log, t, progress=progress, called=(f"{name}' orientation", "rad"))
+    orientation.fit(log, t, progress=progress, called=(f"{name}' orientation", "rad"))
 
 
 _SAME_TURN = 1e-9  # rad: a via orientation this close to the motion's own asks no change

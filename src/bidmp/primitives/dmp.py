@@ -50,6 +50,7 @@ from .._checks import (
     _limits_version,
     as_trajectory,
     as_unit_quaternion,
+    as_vector,
     check_bool,
     check_bytes,
     check_choice,
@@ -81,6 +82,34 @@ logger = logging.getLogger(__name__)
 # DMP.settings() of the models made with the same parameters, the last few sets (newest last)
 _SHARED_SETTINGS: dict = {}
 _SHARED_SETTINGS_SIZE = 16
+
+
+def _checked_called(called) -> tuple[str, str | None]:
+    """``DMP.fit``'s ``called``: (what the messages call ``y``, its unit's label or None)."""
+    if called is None:
+        return "y", None
+    if (
+        not isinstance(called, tuple)
+        or len(called) != 2
+        or not isinstance(called[0], str)
+        or not (called[1] is None or isinstance(called[1], str))
+        or not 0 < len(called[0]) <= 80
+        or len(called[1] or "") > 20
+    ):
+        raise TypeError(
+            "called must be (what the messages call y, its unit's label or None): a name of 1-80 "
+            "characters and a label of at most 20"
+        )
+    return called
+
+
+def _checked_progress(progress) -> np.ndarray:
+    """``DMP.fit``'s ``progress``: finite, from 0 to 1, non-decreasing (its length is checked
+    against the training grid where the gate is learned)."""
+    progress = as_vector(progress, "progress")
+    if progress.min() < 0.0 or progress.max() > 1.0 or np.any(np.diff(progress) < 0.0):
+        raise ValueError("progress must rise from 0 to 1 without going back (the goal's share)")
+    return progress
 
 
 class DMP(_FittedParams, Estimator):
@@ -295,7 +324,17 @@ class DMP(_FittedParams, Estimator):
 
     # -- learning ------------------------------------------------------------------------------
     @numerically_guarded  # (BLAS threads are limited where a fit's products could use them)
-    def fit(self, y, t=None, units: str | None = None, names=None, held_orientation=None) -> DMP:
+    def fit(  # noqa: PLR0913 - a fit's data and, keyword-only, a part's two options
+        self,
+        y,
+        t=None,
+        units: str | None = None,
+        names=None,
+        held_orientation=None,
+        *,
+        progress=None,
+        called: tuple[str, str | None] | None = None,
+    ) -> DMP:
         """Learn the forcing-term weights from one demonstration.
 
         Parameters
@@ -313,6 +352,19 @@ class DMP(_FittedParams, Estimator):
         names : list of str, optional
             The names of the D dimensions (a joint recording's joint names), kept in model files
             and written in every trajectory file's header and joint trajectory.
+        held_orientation : array (4,), optional
+            The tool's orientation (unit quaternion x, y, z, w) held through a position-only
+            demonstration, kept for the pose the motion is sent with.
+        progress : array (n_train,), optional
+            The robot protocol's goal share follows this progress (0 to 1, non-decreasing, on
+            the training grid: the arc-length progress of another fitted DMP's
+            ``training_trajectory``) instead of ``y``'s own; ``y`` may then stand still. For a part of a
+            model that does not move on its own (a pose's orientation while its position
+            moves): it follows the other part's progress.
+        called : (str, str or None), optional
+            For a DMP that is a part of another model: what the messages call ``y`` and the
+            label of its unit when ``units`` does not say it (a pose's orientation part:
+            ``("poses' orientation", "rad")``). Default ``("y", None)``.
 
         Returns
         -------
@@ -320,22 +372,9 @@ class DMP(_FittedParams, Estimator):
 
         A failed ``fit`` (bad parameters or data) leaves the model as it was.
         """
-        return self._fit(y, t, units, names=names, held_orientation=held_orientation)
-
-    def _fit(
-        self,
-        y,
-        t=None,
-        units: str | None = None,
-        *,
-        progress: np.ndarray | None = None,
-        called: tuple[str, str | None] = ("y", None),
-        names=None,
-        held_orientation=None,
-    ) -> DMP:
-        """:meth:`fit`, with the goal share's progress given (for a part of a pose that does not
-        move on its own: then ``y`` may be static); ``called`` = (what the messages call ``y``,
-        the label of its unit when not ``units``: a pose's orientation part is in rad)."""
+        called = _checked_called(called)
+        if progress is not None:
+            progress = _checked_progress(progress)
         name, unit_label = called
         params = resolved = self.settings()
         y = as_trajectory(y, name, allow_static=progress is not None)

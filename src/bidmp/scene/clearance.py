@@ -613,9 +613,13 @@ class Scene:
             lambda row, index: engine.body_to(shape, solid.rotation, centres[row], index),
         )
 
-    def checker(self, exclude=()) -> SceneChecker:
-        """The roadmap's collision callback for this scene (parts in ``exclude`` ignored)."""
-        return SceneChecker(self, self._selected(exclude), self.margin)
+    def checker(self, exclude=(), margin: float | None = None) -> SceneChecker:
+        """The roadmap's collision callback for this scene (parts in ``exclude`` ignored): a
+        placement or move closer than ``margin`` (scene units; default the scene's) to a part
+        is not free."""
+        return SceneChecker(
+            self, self._selected(exclude), self.margin if margin is None else margin
+        )
 
 
 def _init_args(parts, tool, targets, targets_on_parts, margin, standoff) -> tuple:
