@@ -1441,6 +1441,15 @@ def test_a_delayed_goal_decays_at_its_own_rate(exact):
     phase = np.linspace(1.0, 0.2, 40)
     assert PhaseGate(rate).on_grid(phase, step, tau, exact).tolist() == phase.tolist()
     assert PhaseGate(rate).follow(0.6, 0.37, step, tau, exact) == 0.37
+    # the stepper's unchecked call gives the same value; the public one refuses bad input by name
+    assert goal.follow(0.6, 0.5, step, tau, exact, check_input=False) == goal.follow(
+        0.6, 0.5, step, tau, exact
+    )
+    for bad, name in (((math.nan, 0.5), "gate"), ((0.6, 1.5), "phase")):
+        with pytest.raises(ValueError, match=name):
+            goal.follow(*bad, step, tau, exact)
+    with pytest.raises(TypeError, match="check_input"):
+        goal.follow(0.6, 0.5, step, tau, exact, check_input="no")
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])

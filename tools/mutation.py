@@ -1200,6 +1200,13 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     ): "at s = end the closing formula gives 1 - (1 - σ) S(0) = 1",
     (
         "bidmp.primitives.goals",
+        "DelayedGoal.follow",
+        "if check_input is not False:",
+        "False -> True",
+    ): "the checks then run on the stepper's calls too (check_input=False): the same values, "
+    "only their cost",
+    (
+        "bidmp.primitives.goals",
         "DelayedGoal.on_grid",
         "return phase_grid(phase.shape[0], step or 1.0, tau, self.rate, exact=exact)",
         "1.0 -> 2.0",
