@@ -103,7 +103,8 @@ class WideProMP(ProMP):
     """A ProMP subclass, registered as a kind of its own in the test above."""
 
 
-def _fitted_kinds(tmp_path) -> dict:
+@pytest.fixture(scope="module")
+def fitted_kinds(tmp_path_factory) -> dict:
     """One fitted model of every registered kind (the surface fuzz's own instances)."""
     import sys
 
@@ -111,7 +112,9 @@ def _fitted_kinds(tmp_path) -> dict:
     from surface_targets import _plain_instances
 
     found = {
-        owner: instance for owner, instance, _ in _plain_instances(tmp_path) if owner in MODEL_KINDS
+        owner: instance
+        for owner, instance, _ in _plain_instances(tmp_path_factory.mktemp("kinds"))
+        if owner in MODEL_KINDS
     }
     assert set(found) == set(MODEL_KINDS), set(MODEL_KINDS) - set(found)
     return found
@@ -121,13 +124,13 @@ def _fitted_kinds(tmp_path) -> dict:
 _OPTIONAL_MEMBERS = {"skill_time_scales_", "skill_start_logs_"}  # formats 2-4, format 3
 
 
-def test_every_kinds_state_comes_back_as_the_same_model_and_a_bad_one_is_named(tmp_path):
+def test_every_kinds_state_comes_back_as_the_same_model_and_a_bad_one_is_named(fitted_kinds):
     """The model-file protocol, public: ``from_state(*model.to_state())`` is the same model (every
     array equal, the state it gives again equal); a state with a member or a key taken away,
     or of another kind, is a ValueError naming what is missing — never a KeyError from inside."""
     from bidmp._state import StateError
 
-    models = _fitted_kinds(tmp_path)
+    models = fitted_kinds
     for name, model in models.items():
         meta, arrays = model.to_state()
         again = type(model).from_state(meta, arrays)
@@ -155,12 +158,12 @@ def test_every_kinds_state_comes_back_as_the_same_model_and_a_bad_one_is_named(t
         models["DMP"].from_state({}, [])
 
 
-def test_every_kind_says_whether_it_is_fitted(tmp_path):
+def test_every_kind_says_whether_it_is_fitted(fitted_kinds):
     """``check_fitted()``, one public method on every kind: a NotFittedError that says what to do
     before ``fit``, nothing after."""
     from bidmp import NotFittedError
 
-    for model in _fitted_kinds(tmp_path).values():
+    for model in fitted_kinds.values():
         model.check_fitted()
         with pytest.raises(NotFittedError, match="fit"):
             type(model)().check_fitted()
