@@ -344,7 +344,14 @@ TARGETS = (
     Target(
         "goal systems",
         "bidmp.primitives.goals",
-        ("_smoothstep", "_goal_share", "_goal_gate", "DelayedGoal.on_grid", "DelayedGoal.follow"),
+        (
+            "_smoothstep",
+            "_goal_share",
+            "_goal_gate",
+            "DelayedGoal.on_grid",
+            "DelayedGoal.follow",
+            "_follow_args",
+        ),
         (
             "tests/test_oracles.py",
             "tests/primitives/test_dmp.py",
@@ -1198,13 +1205,6 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "share[s >= end] = 1.0",
         ">= -> >",
     ): "at s = end the closing formula gives 1 - (1 - σ) S(0) = 1",
-    (
-        "bidmp.primitives.goals",
-        "DelayedGoal.follow",
-        "if check_input is not False:",
-        "False -> True",
-    ): "the checks then run on the stepper's calls too (check_input=False): the same values, "
-    "only their cost",
     (
         "bidmp.primitives.goals",
         "DelayedGoal.on_grid",

@@ -161,6 +161,15 @@ def _step_args(gate, phase, step, tau, exact) -> tuple[float, float, float, floa
     )
 
 
+def _follow_args(check_input, gate, phase, step, tau, exact) -> tuple:
+    """A goal system's ``follow`` arguments: checked, or as given with ``check_input=False`` (the
+    stepper's control loop, which checked them once; the hot path is one identity test)."""
+    if check_input is False:
+        return gate, phase, step, tau, exact
+    check_bool(check_input, "check_input")
+    return _step_args(gate, phase, step, tau, exact)
+
+
 def _grid_args(phase, step, tau, exact) -> tuple[np.ndarray, float, float, bool]:
     phase = as_vector(phase, "phase")
     if np.any((phase < 0.0) | (phase > 1.0)):
@@ -216,9 +225,7 @@ class DelayedGoal:
         """The gate one control step of ``step`` (normalised time) after ``gate``, at ``phase``.
         ``check_input=False`` takes the arguments as given, floats in range (a stepper's control
         loop, which checked them once, asks every step)."""
-        if check_input is not False:  # (False: the hot path, one identity test)
-            check_bool(check_input, "check_input")
-            gate, phase, step, tau, exact = _step_args(gate, phase, step, tau, exact)
+        gate, phase, step, tau, exact = _follow_args(check_input, gate, phase, step, tau, exact)
         return gate * (
             math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau)
         )
@@ -242,10 +249,7 @@ class PhaseGate(DelayedGoal):
         *,
         check_input: bool = True,
     ) -> float:
-        if check_input is not False:  # (False: the hot path, one identity test)
-            check_bool(check_input, "check_input")
-            phase = _step_args(gate, phase, step, tau, exact)[1]
-        return phase
+        return _follow_args(check_input, gate, phase, step, tau, exact)[1]
 
 
 @dataclass(frozen=True, eq=False)
@@ -315,9 +319,7 @@ class ProgressGate:
         *,
         check_input: bool = True,
     ) -> float:
-        if check_input is not False:  # (False: the hot path, one identity test)
-            check_bool(check_input, "check_input")
-            phase = _step_args(gate, phase, step, tau, exact)[1]
+        phase = _follow_args(check_input, gate, phase, step, tau, exact)[1]
         return float(np.interp(phase, *self._lookup))
 
 
