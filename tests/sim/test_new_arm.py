@@ -93,3 +93,26 @@ def test_a_point_out_of_reach_names_both_fixes(tmp_path):
     result = sim.simulate(scenario, ["bidmp"], targets=["12"], workers=1)
     reason = result.methods["bidmp"].targets["12"].reason
     assert '"base"' in reason and '"rest"' in reason, reason
+
+
+def test_a_rest_pose_set_on_the_arm_is_where_it_stands_and_where_it_starts():
+    """``RobotCell.use_rest``: the arm stands at the new rest (its measured joints), the model
+    keeps it for the next run, and a pose outside a joint's limits is refused naming the joint."""
+    cell = sim.RobotCell(scenarios.load("nut-unscrewing").scene)
+    try:
+        limits = cell.limits
+        middle = 0.5 * (np.asarray(limits.lower) + np.asarray(limits.upper))
+        q = 0.7 * np.asarray(cell.rest) + 0.3 * middle
+        cell.use_rest(q)
+        assert cell.rest == tuple(q.tolist()) and cell.model.rest_given
+        measured = [
+            cell.p.getJointState(cell.robot, j, physicsClientId=cell.client)[0] for j in cell.arm
+        ]
+        np.testing.assert_allclose(measured, q, atol=1e-12)
+        out = q.copy()
+        out[3] = limits.upper[3] + 0.1
+        with pytest.raises(ValueError, match="q: joint 4 .* outside its limits"):
+            cell.use_rest(out)
+        assert cell.rest == tuple(q.tolist())  # a refused pose changes nothing
+    finally:
+        cell.close()

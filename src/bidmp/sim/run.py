@@ -472,8 +472,6 @@ def _start_where_it_works(cell, arm: RobotModel, start) -> None:
     the fallback, is often a stretched pose from which nothing can be solved. Another backend's
     arm, or one whose rest was given, is left as it is; an arm that cannot reach the start then
     is reported so by the motions (naming ``robot.rest``)."""
-    import dataclasses
-
     from .robots import _working_rest
 
     if arm.rest_given or getattr(cell, "model", None) is not arm:
@@ -486,9 +484,7 @@ def _start_where_it_works(cell, arm: RobotModel, start) -> None:
             arm.name,
         )
         return
-    cell.model = dataclasses.replace(arm, rest=tuple(q.tolist()), rest_given=True)
-    cell._set_joints(cell.model.rest)
-    cell.wrist_turns_tool = cell._last_joint_turns_tool()
+    cell.use_rest(q)
 
 
 def _unreachable(setup: _SimSetup, scenario, labels) -> dict:

@@ -155,6 +155,25 @@ class RobotCell:
         """The joints (rad) the arm starts from: the tool pointing down."""
         return self.model.rest
 
+    def use_rest(self, q) -> None:
+        """Make joints ``q`` (J,) rad, within the arm's limits, its rest pose: the model's rest from
+        now on (where a run starts), the arm put there, and whether its last joint turns the tool
+        judged again there. For an arm given without one (a URDF's), once a working pose is
+        found."""
+        import dataclasses
+
+        q = self._joints(q)
+        lower, upper = np.asarray(self.limits.lower), np.asarray(self.limits.upper)
+        if np.any(q < lower) or np.any(q > upper):
+            joint = int(np.flatnonzero((q < lower) | (q > upper))[0])
+            raise ValueError(
+                f"q: joint {joint + 1} at {q[joint]:.4g} rad is outside its limits "
+                f"[{lower[joint]:.4g}, {upper[joint]:.4g}]"
+            )
+        self.model = dataclasses.replace(self.model, rest=tuple(q.tolist()), rest_given=True)
+        self._set_joints(self.model.rest)
+        self.wrist_turns_tool = self._last_joint_turns_tool()
+
     def _last_joint_turns_tool(self) -> bool:
         """Whether the last joint turns about the tool's axis through its mouth (at the rest pose)."""
         p, robot, client = self.p, self.ik_robot, self.ik_client
