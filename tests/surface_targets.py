@@ -192,6 +192,7 @@ def _package_overrides(tmp: Path) -> dict:
         },
         "bidmp.primitives.ExponentialPhase": {"rate": 4.0},
         "bidmp.sim.require_simulator": {},
+        "bidmp.sim.picture_frames": {"pictured": {("dmp", "1"), ("bidmp", "12")}},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},
         "bidmp.sim.KinematicCell": {"scene": scenario.scene},
         "bidmp.sim.plan_path": {

@@ -349,8 +349,8 @@ TARGETS = (
             "_goal_share",
             "_goal_gate",
             "DelayedGoal.on_grid",
-            "DelayedGoal.follow",
-            "_follow_args",
+            "_SteppedGoal.follow",
+            "DelayedGoal._next",
         ),
         (
             "tests/test_oracles.py",

@@ -554,6 +554,13 @@ def check_bool(value, name: str) -> bool:
     return bool(value)
 
 
+def checks_input(check_input) -> bool:
+    """Whether a method a control loop calls every step checks its arguments (its
+    ``check_input``): ``False`` takes them as given (the hot path: one identity test), ``True``
+    checks them, anything else is refused by name (as scikit-learn's trees' ``check_input``)."""
+    return check_input is not False and check_bool(check_input, "check_input")
+
+
 def as_rotation(value, name: str = "rotation") -> np.ndarray:
     """A rotation matrix (3, 3): orthonormal within 1e-6, determinant +1."""
     array = _as_bounded_array(value, name, 2)

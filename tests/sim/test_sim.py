@@ -400,6 +400,17 @@ def test_a_strip_takes_evenly_spaced_frames_from_first_to_last(n):
         assert picked == list(range(0, GIF_FRAMES, 6))
 
 
+def test_the_frames_asked_for_are_those_the_report_writes():
+    from bidmp.sim import picture_frames
+    from bidmp.sim.report import GIF_FRAMES, STRIP_FRAMES
+
+    apart = {("dmp", "1"), ("bidmp", "12")}
+    assert picture_frames(apart) == dict.fromkeys(apart, STRIP_FRAMES)
+    together = {("dmp", "12"), ("bidmp", "12")}  # side by side: the GIF's frames
+    assert picture_frames(together) == dict.fromkeys(together, GIF_FRAMES)
+    assert picture_frames({("bidmp", "12")}) == {("bidmp", "12"): STRIP_FRAMES}
+
+
 def test_a_gifs_strip_shows_the_steps_a_strips_own_run_renders():
     """The recorder renders ``linspace(0, n_steps - 1, frames)`` floored: of the GIF's 31, the
     strip's six are at the very steps a run of six frames renders, for any motion's length

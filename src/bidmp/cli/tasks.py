@@ -56,7 +56,7 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     flag here changes what runs, and the viewer draws that evaluation."""
     from tqdm import tqdm
 
-    from ..sim.report import write_sim_report
+    from ..sim.report import picture_frames, write_sim_report
     from ..sim.run import execution_report, simulate, target_labels
 
     methods = list(methods)
@@ -65,7 +65,7 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     with progress_bars():  # the learning and repairs before the motions run (G-PRM, repairs)
         report = execution_report(run_as, methods)
     pictured = {(method, _pictured_target(scenario, report, method, labels)) for method in methods}
-    frames = _frames(pictured) if pictures else {}
+    frames = picture_frames(pictured) if pictures else {}
     with tqdm(
         total=len(methods) * len(labels), desc=f"{scenario.name} (sim)", unit="motion", disable=None
     ) as bar:
@@ -94,19 +94,6 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     print(f"\nwrote {', '.join(str(path) for path in written)}")
     print_real_time(result.simulated_s)
     return result
-
-
-def _frames(pictured: set) -> dict:
-    """The frames to render of each pictured ``(method, target)``: those the report writes. A
-    strip's six, from the start to the end of the motion; a side-by-side GIF's 31 where dmp and
-    bidmp are pictured at the same target (every sixth of them its strip's). A TinyRenderer
-    keyframe of the Panda costs about 40 ms: rendered and not written, 24 frames were most of a
-    two-target command's time."""
-    from ..sim.report import GIF_FRAMES, STRIP_FRAMES
-
-    targets = {method: label for method, label in pictured}
-    side_by_side = {"dmp", "bidmp"} <= set(targets) and targets["dmp"] == targets["bidmp"]
-    return {pair: GIF_FRAMES if side_by_side else STRIP_FRAMES for pair in pictured}
 
 
 def _pictured_target(scenario, report, method, labels) -> str:

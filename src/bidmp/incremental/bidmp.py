@@ -36,6 +36,7 @@ from .._checks import (
     check_int,
     check_limit,
     check_real,
+    check_text,
     numerically_guarded,
     short_token,
 )
@@ -291,10 +292,7 @@ class BiDMP(Estimator):
         called : str, default "y_dn"
             What the messages call ``y_dn`` (a part of another model: "poses' orientation").
         """
-        allow_static = check_bool(allow_static, "allow_static")
-        if not isinstance(called, str) or not 0 < len(called) <= 80:
-            raise TypeError("called must be what the messages call y_dn: 1-80 characters of text")
-        name, still = called, allow_static
+        still, name = check_bool(allow_static, "allow_static"), check_text(called, "called")
         self._ensure_started()
         increments, derivatives = self._check_params()
         time_scale = _time_scale(duration, self.dmp_)

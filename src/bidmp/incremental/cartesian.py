@@ -309,7 +309,6 @@ class CartesianBiDMP(PoseModel, Estimator):
         """The fitted model :meth:`to_state` described: ``meta`` as written, ``arrays`` a mapping of
         name to array, each read when needed and checked for dtype, shape and finiteness
         (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
-
         position, orientation = cls._parts_from_state(BiDMP, "CartesianBiDMP", meta, arrays)
         if (
             position.n_skills != orientation.n_skills

@@ -55,6 +55,7 @@ from .._checks import (
     check_bytes,
     check_choice,
     check_names,
+    check_text,
     numerically_guarded,
 )
 from .._state import state_reader
@@ -88,19 +89,11 @@ def _checked_called(called) -> tuple[str, str | None]:
     """``DMP.fit``'s ``called``: (what the messages call ``y``, its unit's label or None)."""
     if called is None:
         return "y", None
-    if (
-        not isinstance(called, tuple)
-        or len(called) != 2
-        or not isinstance(called[0], str)
-        or not (called[1] is None or isinstance(called[1], str))
-        or not 0 < len(called[0]) <= 80
-        or len(called[1] or "") > 20
-    ):
-        raise TypeError(
-            "called must be (what the messages call y, its unit's label or None): a name of 1-80 "
-            "characters and a label of at most 20"
-        )
-    return called
+    if not isinstance(called, tuple) or len(called) != 2:
+        raise TypeError("called must be (what the messages call y, its unit's label or None)")
+    name, label = called
+    label = None if label is None else check_text(label, "called[1]", 20)
+    return check_text(name, "called[0]"), label
 
 
 def _checked_progress(progress) -> np.ndarray:
@@ -358,9 +351,9 @@ class DMP(_FittedParams, Estimator):
         progress : array (n_train,), optional
             The robot protocol's goal share follows this progress (0 to 1, non-decreasing, on
             the training grid: the arc-length progress of another fitted DMP's
-            ``training_trajectory``) instead of ``y``'s own; ``y`` may then stand still. For a part of a
-            model that does not move on its own (a pose's orientation while its position
-            moves): it follows the other part's progress.
+            ``training_trajectory``) instead of ``y``'s own (the paper's phase gate has none);
+            ``y`` may then stand still. For a part of a model that does not move on its own (a
+            pose's orientation while its position moves): it follows the other part's progress.
         called : (str, str or None), optional
             For a DMP that is a part of another model: what the messages call ``y`` and the
             label of its unit when ``units`` does not say it (a pose's orientation part:

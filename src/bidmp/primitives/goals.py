@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._checks import as_vector, check_bool, check_int, check_real
+from .._checks import as_vector, check_bool, check_int, check_real, checks_input
 from .._kernels import goal_gate, goal_share, goal_share_arguments, strictly_decreasing
 from .._trajectory import arclength
 from .approach import _tail_start
@@ -161,15 +161,6 @@ def _step_args(gate, phase, step, tau, exact) -> tuple[float, float, float, floa
     )
 
 
-def _follow_args(check_input, gate, phase, step, tau, exact) -> tuple:
-    """A goal system's ``follow`` arguments: checked, or as given with ``check_input=False`` (the
-    stepper's control loop, which checked them once; the hot path is one identity test)."""
-    if check_input is False:
-        return gate, phase, step, tau, exact
-    check_bool(check_input, "check_input")
-    return _step_args(gate, phase, step, tau, exact)
-
-
 def _grid_args(phase, step, tau, exact) -> tuple[np.ndarray, float, float, bool]:
     phase = as_vector(phase, "phase")
     if np.any((phase < 0.0) | (phase > 1.0)):
@@ -190,8 +181,30 @@ def _training_args(n_train, dt, exact) -> tuple[int, float, bool]:
 
 
 # -- goal systems ----------------------------------------------------------------------------------
+class _SteppedGoal:
+    """A goal system's control step: :meth:`follow` checks its arguments once, here (or takes them
+    as given), and the system's own ``_next`` gives the gate."""
+
+    def follow(
+        self,
+        gate: float,
+        phase: float,
+        step: float,
+        tau: float,
+        exact: bool,
+        *,
+        check_input: bool = True,
+    ) -> float:
+        """The gate one control step of ``step`` (normalised time) after ``gate``, at ``phase``.
+        ``check_input=False`` takes the arguments as given, floats in range (a stepper's control
+        loop, which checked them once, asks every step)."""
+        if checks_input(check_input):
+            gate, phase, step, tau, exact = _step_args(gate, phase, step, tau, exact)
+        return self._next(gate, phase, step, tau, exact)
+
+
 @dataclass(frozen=True)
-class DelayedGoal:
+class DelayedGoal(_SteppedGoal):
     """``G`` decays at ``rate`` (per normalised time), like the phase does at ``alpha_phase``."""
 
     rate: float
@@ -212,20 +225,7 @@ class DelayedGoal:
         n_train, dt, exact = _training_args(n_train, dt, exact)
         return phase_grid(n_train, dt, 1.0, self.rate, exact=exact)
 
-    def follow(
-        self,
-        gate: float,
-        phase: float,
-        step: float,
-        tau: float,
-        exact: bool,
-        *,
-        check_input: bool = True,
-    ) -> float:
-        """The gate one control step of ``step`` (normalised time) after ``gate``, at ``phase``.
-        ``check_input=False`` takes the arguments as given, floats in range (a stepper's control
-        loop, which checked them once, asks every step)."""
-        gate, phase, step, tau, exact = _follow_args(check_input, gate, phase, step, tau, exact)
+    def _next(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         return gate * (
             math.exp(-self.rate * step / tau) if exact else 1.0 - self.rate * (step / tau)
         )
@@ -239,21 +239,12 @@ class PhaseGate(DelayedGoal):
     def on_grid(self, phase: np.ndarray, step: float, tau: float, exact: bool) -> np.ndarray:
         return _grid_args(phase, step, tau, exact)[0]
 
-    def follow(
-        self,
-        gate: float,
-        phase: float,
-        step: float,
-        tau: float,
-        exact: bool,
-        *,
-        check_input: bool = True,
-    ) -> float:
-        return _follow_args(check_input, gate, phase, step, tau, exact)[1]
+    def _next(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
+        return phase
 
 
 @dataclass(frozen=True, eq=False)
-class ProgressGate:
+class ProgressGate(_SteppedGoal):
     """The robot protocol's gate, learned at ``fit``: ``gate`` (n_train,) on the training grid of
     phases ``training_phase`` (n_train,), decreasing), looked up by phase at any other grid."""
 
@@ -309,17 +300,7 @@ class ProgressGate:
             )
         return self.gate
 
-    def follow(
-        self,
-        gate: float,
-        phase: float,
-        step: float,
-        tau: float,
-        exact: bool,
-        *,
-        check_input: bool = True,
-    ) -> float:
-        phase = _follow_args(check_input, gate, phase, step, tau, exact)[1]
+    def _next(self, gate: float, phase: float, step: float, tau: float, exact: bool) -> float:
         return float(np.interp(phase, *self._lookup))
 
 

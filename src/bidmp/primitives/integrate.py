@@ -29,7 +29,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._checks import as_vector, check_bool, check_real
+from .._checks import as_vector, check_bool, check_real, checks_input
 from .._kernels import exact_state, foh_responses, second_order
 from .canonical import _phase_decay
 
@@ -340,8 +340,7 @@ class StepIntegrator:
         read by the exact step only. ``y``, ``z``, ``u_now`` and ``u_next`` are (D,) arrays.
         ``check_input=False`` takes them as given: float arrays of one shape and a step in
         (0, 1e3] (a stepper's control loop, which checked them once, calls it every step)."""
-        if check_input is not False:  # (False: the hot path, one identity test)
-            check_bool(check_input, "check_input")
+        if checks_input(check_input):
             y, z, u_now, u_next = (
                 as_vector(value, name)
                 for value, name in ((y, "y"), (z, "z"), (u_now, "u_now"), (u_next, "u_next"))

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .._checks import as_point, check_bool, check_real
+from .._checks import as_point, check_real, checks_input
 from .clearance import Scene
 from .distances import _cylinder_box_bounds
 
@@ -66,8 +66,7 @@ class Proximity:
         ``check_input=False`` takes the arguments as given: ``point`` a float array (3,),
         ``within`` a positive float, ``skip`` None or such a mask (a coupling term that asks
         every control step checks them once; as scikit-learn's trees' ``check_input``)."""
-        if check_input is not False:  # (False: the hot path, one identity test)
-            check_bool(check_input, "check_input")
+        if checks_input(check_input):
             point = as_point(point, 3, "point")
             within = check_real(within, "within", positive=True)
             if skip is not None and (

@@ -69,7 +69,7 @@ if TYPE_CHECKING:
     )
     from .planning import plan_path
     from .pybullet.cell import RobotCell
-    from .report import SimMethod, SimReport, SimTarget, write_sim_report
+    from .report import SimMethod, SimReport, SimTarget, picture_frames, write_sim_report
     from .robots import (
         FR3,
         IIWA,

@@ -19,7 +19,7 @@ from .backend import LIMIT_MARGIN, RECORD_EVERY, SETTLE, SIM_STEP, Execution, Mo
 from .limits import _measured_breach, _measured_peaks
 from .robots import PANDA
 
-__all__ = ["SimTarget", "SimMethod", "SimReport", "write_sim_report"]
+__all__ = ["SimTarget", "SimMethod", "SimReport", "picture_frames", "write_sim_report"]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -472,8 +472,7 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
         written.append(strip)
     # (a motion not run has one still of the arm, not frames of its motion: no GIF)
     if (
-        {"dmp", "bidmp"} <= set(by_method)
-        and by_method["dmp"][0] == by_method["bidmp"][0]
+        _side_by_side({method: label for method, (label, _) in by_method.items()})
         and by_method["dmp"][1][0].shape == by_method["bidmp"][1][0].shape
     ):
         written.append(
@@ -489,6 +488,26 @@ def write_sim_report(report: SimReport, out) -> list[Path]:
 
 STRIP_FRAMES = 6  # the keyframes of a method's strip
 GIF_FRAMES = 31  # the frames of the side-by-side GIF: every sixth one is a strip's
+
+
+def _side_by_side(targets: dict) -> bool:
+    """Whether dmp and bidmp are pictured at the same target (``targets``: method -> label): their
+    motions are then also shown side by side, in a GIF."""
+    return {"dmp", "bidmp"} <= set(targets) and targets["dmp"] == targets["bidmp"]
+
+
+def picture_frames(pictured) -> dict:
+    """The frames to render (``simulate(frames=...)``) of each pictured ``(method, target)`` pair
+    for :func:`write_sim_report`: those it writes. A strip's :data:`STRIP_FRAMES`, from the
+    start to the end of the motion; :data:`GIF_FRAMES` where dmp and bidmp are pictured at the
+    same target (every sixth of them the strip's). A keyframe of the Panda costs about 40 ms."""
+    if not isinstance(pictured, (set, frozenset, list, tuple)) or not all(
+        isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(v, str) for v in pair)
+        for pair in pictured
+    ):
+        raise TypeError("pictured must be a collection of (method, target label) pairs of text")
+    count = GIF_FRAMES if _side_by_side(dict(pictured)) else STRIP_FRAMES
+    return {pair: count for pair in pictured}
 
 
 def _strip_frames(frames: list) -> list:
