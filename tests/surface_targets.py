@@ -8,6 +8,7 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 from surface_sweep import (
     DEMO,
     PERIODIC,
@@ -22,6 +23,58 @@ from surface_sweep import (
 )
 
 import bidmp
+
+
+class _Wall:
+    """A free space for the route planner: the unit square with a wall across its middle (a
+    point body, the slack its distance to the wall's box)."""
+
+    lower, upper, tolerance = np.zeros(2), np.ones(2), 1e-3
+
+    def slack(self, q) -> float:
+        q = np.asarray(q, dtype=float)
+        gap = np.maximum(np.maximum([0.45, 0.0] - q, q - [0.55, 0.7]), 0.0)
+        return float(np.linalg.norm(gap)) - 0.01
+
+    def sweep(self, a, b) -> float:
+        return float(np.linalg.norm(np.asarray(b, float) - np.asarray(a, float)))
+
+
+def _route_overrides() -> dict:
+    """Valid arguments of the route planner's entry points (bidmp.planning, the arm's routes)."""
+    from bidmp.sim import KinematicCell
+    from bidmp.sim.robots import PANDA_MODEL
+
+    scenario = bidmp.tasks.load("nut-unscrewing")
+    cell = KinematicCell(scenario.scene)
+    plan = cell.plan(DEMO / 4.0 + [0.0, 0.0, 40.0])
+    return {
+        "bidmp.planning.plan_route": {"space": _Wall(), "start": [0.2, 0.2], "goals": [0.8, 0.2]},
+        "bidmp.planning.segment_free": {"space": _Wall(), "a": [0.2, 0.2], "b": [0.3, 0.8]},
+        "bidmp.planning.time_path": {
+            "waypoints": DEMO[::10] / 100.0,
+            "velocity": [2.0, 2.0, 2.0],
+            "acceleration": [10.0, 10.0, 10.0],
+            "jerk": [5000.0, 5000.0, 5000.0],
+        },
+        "bidmp.planning.tool_route": {
+            "scene": scenario.scene,
+            "start": [-80.0, -120.0, 200.0],
+            "goal": scenario.targets["12"],
+            "approach_height": 28.5,
+            "exclude": scenario.scene.target_parts("12", scenario.targets["12"]),
+        },
+        "bidmp.scene.PoseChecker": {"scene": scenario.scene, "chosen": np.arange(3), "margin": 1.0},
+        "bidmp.sim.ArmGeometry": {
+            "robot": PANDA_MODEL,
+            "tool_radius": 0.0125,
+            "tool_length": 0.1,
+            "base": [0.0, -0.45, 0.0],
+            "yaw": 90.0,
+        },
+        "bidmp.sim.supports_routes": {"cell": cell},
+        "bidmp.sim.needlessly_slow": {"cell": cell, "plan": plan},
+    }
 
 
 def _package_overrides(tmp: Path) -> dict:
@@ -67,6 +120,7 @@ def _package_overrides(tmp: Path) -> dict:
     joints = np.zeros((60, 7))
     return {
         **readers,
+        **_route_overrides(),
         "bidmp.io.read_poses": {"path": poses},
         "bidmp.load": {"path": model},
         "bidmp.Scene": {"tool": Tool(5.0, 50.0)},
@@ -512,6 +566,34 @@ def _plain_instances(tmp: Path):
         },
     )
     yield "SceneChecker", scene.checker(), {"a": DEMO[:-1], "b": DEMO[1:]}
+    yield (
+        "PoseChecker",
+        scene.pose_checker(margin=2.0),
+        {"point": DEMO[5], "rotation": Rotation.from_euler("x", 170, degrees=True).as_matrix()},
+    )
+    from bidmp.sim import ArmGeometry
+    from bidmp.sim.robots import PANDA_MODEL
+
+    arm = ArmGeometry(PANDA_MODEL, 0.0125, 0.1, [0.0, -0.45, 0.0], 90.0)
+    rest = np.array(PANDA_MODEL.rest)
+    yield (
+        "ArmGeometry",
+        arm,
+        {
+            "q": rest,
+            "point": [0.0, 0.0, 0.3],
+            "frame": [1.0, 0.0, 0.0, 0.0],
+            "seed": rest,
+            "scene": scenario.scene,
+            "unit": 1e-3,
+            "margin": 0.003,
+        },
+    )
+    yield (
+        "ArmSpace",
+        arm.space(scenario.scene, 1e-3, margin=0.003),
+        {"q": rest, "a": rest, "b": rest + 0.1},
+    )
     yield "Proximity", Proximity(scene), {"point": DEMO[5], "within": 20.0}
     yield "Solid", scene.solids[0], {"centre": np.zeros(3), "rotation": np.eye(3)}
     yield (

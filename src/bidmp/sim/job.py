@@ -66,6 +66,10 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     )
     if not repaired.ok:
         raise _StepFailed(f"approach: {repaired.reason()}")
+    if repaired.how == "route" and repaired.model is not None:
+        world.model = (
+            repaired.model
+        )  # the route, learned as a skill: the next targets start from it
     path, turns = repaired.motion[:, :3], (repaired.motion[:, 3:] if world.pose else None)
     fractions = np.linspace(0.0, 1.0, path.shape[0])
     note = f"repaired: {repaired.how}" if repaired.how else ""
