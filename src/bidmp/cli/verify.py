@@ -73,9 +73,12 @@ def _verdict(path, robot: str):
     """(the FCI's verdict, the number of commands, the commands (T, 7) rad in the robot's joint
     order) of one motion file."""
 
+    from .._checks import check_path, short_token
     from ..io.recordings import read_recording
     from ..sim.fci import judge_commands, match_joint_names
 
+    if not check_path(path, f"motion {short_token(path, 24)}").exists():
+        raise ValueError(f"motion file {path} does not exist")
     recording = read_recording(path)
     if recording.kind != "joints":
         raise ValueError(

@@ -240,11 +240,11 @@ def _units(path, layout: Layout, declared: str, names: list) -> str:
     columns' convention. A length declared on joints is refused: their angles are radians, and
     a length there says the columns are positions read as joints, or the line is wrong."""
     if layout.kind == "joints" and declared in UNITS:
+        shown = ", ".join(short_token(name, 16)[1:-1] for name in names[:3])
         raise ValueError(
             f"{path} declares '# units: {declared}', a length, but its columns read as joints "
-            f"({', '.join(short_token(name, 20)[1:-1] for name in names[:6])}), angles in "
-            f"radians: declare '# units: rad' (or none); if they are positions, name them x,y,z "
-            f"(bidmp fit: or --columns / columns= t=..,x=..,y=..,z=..)"
+            f"({shown}{', …' if len(names) > 3 else ''}: radians): declare '# units: rad' or "
+            f"none; positions are named x,y,z (or --columns)"
         )
     return declared or layout.units
 
