@@ -1091,7 +1091,7 @@ def odd_bags(folder: Path) -> tuple[list, dict]:
     for ros, storage, suffix in ((1, "", ".bag"), (2, "mcap", ""), (2, "sqlite3", "")):
         kind = "ROS 1" if ros == 1 else f"ROS 2 {storage}"
         for label, (messages, want) in cases.items():
-            path = folder / f"{label.replace(' ', '_')}_{storage or 'ros1'}{suffix}"
+            path = folder / f"{len(out)}{suffix}"
             if not path.exists():
                 _joint_bag(path, ros, storage, messages)
             out.append((f"bag ({kind}): {label}", path))
@@ -1148,7 +1148,7 @@ def odd_recordings(folder: Path) -> tuple[list, dict]:
     }
     out, expected = [], {}
     for label, (header, rows, first, want) in cases.items():
-        path = _csv(folder / f"{label.replace(' ', '_')}.csv", header, rows, first)
+        path = _csv(folder / f"{len(out)}.csv", header, rows, first)
         out.append((f"CSV: {label}", path))
         expected[str(path)] = want
     return out, expected
@@ -1182,9 +1182,7 @@ def odd_command_files(folder: Path) -> tuple[list, dict]:
     }
     out, expected = [], {}
     for label, (head, times, values, first, want) in cases.items():
-        path = _csv(
-            folder / f"{label.replace(' ', '_')}.csv", head, np.column_stack([times, values]), first
-        )
+        path = _csv(folder / f"{len(out)}.csv", head, np.column_stack([times, values]), first)
         out.append((f"commands: {label}", path))
         expected[str(path)] = want if want[0] == "refused" else ("reads", lambda code: None)
     return out, expected
@@ -1219,19 +1217,20 @@ def odd_inputs(tmp: Path):
     from bidmp.io import read_bag, read_recording
     from bidmp.sim import match_joint_names
 
-    bags, bag_expected = odd_bags(tmp / "odd-bags")
+    # short folders and names: a refusal quotes the path, and the sweep's one line is 300 characters
+    bags, bag_expected = odd_bags(tmp / "ob")
     yield (
         "read_bag(odd joint bags)",
         _judged(read_bag, "path", bag_expected, {"joints": True}),
         {"path": bags[0][1], "nasty:path": bags},
     )
-    recordings, recording_expected = odd_recordings(tmp / "odd-recordings")
+    recordings, recording_expected = odd_recordings(tmp / "or")
     yield (
         "read_recording(odd CSVs)",
         _judged(read_recording, "path", recording_expected),
         {"path": recordings[3][1], "nasty:path": recordings},
     )
-    commands, command_expected = odd_command_files(tmp / "odd-commands")
+    commands, command_expected = odd_command_files(tmp / "oc")
     expected = {str(path): want for path, want in command_expected.items()}
     yield (
         "bidmp verify(odd command files)",

@@ -106,7 +106,8 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     try:
         gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
     except np.linalg.LinAlgError:
-        raise ValueError(
+        # still a LinAlgError (a ValueError), which callers word in their own terms
+        raise np.linalg.LinAlgError(
             "H and noise: the observation's covariance Hᵀ·cov·H + noise is singular (a column "
             "of H that observes nothing the weights move, two alike, or values so small they "
             "vanish, with noise 0): observe the weights, or give noise > 0"
