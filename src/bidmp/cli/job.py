@@ -54,11 +54,9 @@ def run_job_command(
     written = write_job_report(report, out)
     if commands:
         from ..sim.job_report import write_job_commands
-        from ..sim.kinematics import joint_names
-        from ..sim.robots import robot_model
 
-        arm = robot_model(scenario.robot, scenario.base_dir)
-        files = write_job_commands(report, Path(out) / "commands", joint_names(arm))
+        # the arm that ran (the kinematic backend is its own six-joint arm, not the scenario's)
+        files = write_job_commands(report, Path(out) / "commands")
         print(
             f"wrote {len(files)} command files to {Path(out) / 'commands'} (bidmp verify judges them)"
         )

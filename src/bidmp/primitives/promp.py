@@ -103,7 +103,15 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     noise = _matrix(noise, "noise", (H.shape[1], H.shape[1]), f"y has {y.shape[0]} values")
     cov_h = cov @ H  # (M, K)
     innovation = H.T @ cov_h + noise  # (K, K), positive definite when cov is
-    gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
+    try:
+        gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
+    except np.linalg.LinAlgError:
+        # still a LinAlgError (a ValueError), which callers word in their own terms
+        raise np.linalg.LinAlgError(
+            "H and noise: the observation's covariance Hᵀ·cov·H + noise is singular (a column "
+            "of H that observes nothing the weights move, two alike, or values so small they "
+            "vanish, with noise 0): observe the weights, or give noise > 0"
+        ) from None
     posterior_mean = mean + gain @ (y - H.T @ mean)
     posterior_cov = cov - gain @ cov_h.T
     return posterior_mean, 0.5 * (posterior_cov + posterior_cov.T)

@@ -95,12 +95,24 @@ def orientation_error(true, predicted) -> float:
             f"true and predicted must be quaternions (T, 4) of equal length, got {true.shape} and "
             f"{predicted.shape}"
         )
-    true = true / np.linalg.norm(true, axis=1, keepdims=True)
-    predicted = predicted / np.linalg.norm(predicted, axis=1, keepdims=True)
+    true, predicted = _unit_rows(true, "true"), _unit_rows(predicted, "predicted")
     # the real part of q_true ⊗ conj(q_pred) is their dot product; the angle of the relative
     # rotation is 2 acos(|w|), which is ‖2 log(·)‖ taken the shorter way
     w = np.clip(np.abs(np.sum(true * predicted, axis=1)), 0.0, 1.0)
     return float(np.mean(2.0 * np.arccos(w)))
+
+
+def _unit_rows(q: np.ndarray, name: str) -> np.ndarray:
+    """Quaternion rows made unit length, each scaled by its largest component first (so that
+    rows of 1e-300 normalise instead of underflowing to a zero norm); a zero row is refused."""
+    largest = np.max(np.abs(q), axis=1, keepdims=True)
+    if np.any(largest == 0.0):
+        raise ValueError(
+            f"{name}: row {int(np.argmax(largest[:, 0] == 0.0))} is a zero quaternion, which is "
+            f"no rotation"
+        )
+    scaled = q / largest
+    return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
 
 def accuracy_matrix(errors: list[list[np.ndarray]], threshold: float) -> np.ndarray:
