@@ -135,7 +135,20 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
         trajectory = model.run(cycles, **options)
     else:
         trajectory = model.trajectory(cycles, **options)
-    path = (save_poses if poses else save_trajectory)(trajectory, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = (save_poses if poses else save_trajectory)(trajectory, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_rollout
+
+            figure = plot_rollout(
+                outputs.path(args.plot),
+                trajectory.y,
+                trajectory,
+                title="rhythm",
+                units=model.units_,
+            )
     unit = model.units_ or "units"
     frequency = model.frequency_ if args.frequency is None else args.frequency
     print(
@@ -148,11 +161,7 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
         f"{trajectory.peak_acceleration():.4g} {unit}/s^2, span "
         f"{np.array2string(np.ptp(trajectory.y, axis=0), precision=4)} {unit}"
     )
-    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
+    print(f"wrote {outputs.shown(path)} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
-        from ..plotting.trajectories import plot_rollout
-
-        print(
-            f"wrote {plot_rollout(args.plot, trajectory.y, trajectory, title='rhythm', units=model.units_)}"
-        )
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK

@@ -158,7 +158,25 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     trajectory, mean, std, base, base_std, marks, times, demos, units = adapter.roll(
         args, model, goal, via
     )
-    path = save_trajectory(trajectory, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = save_trajectory(trajectory, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_distribution
+
+            figure = plot_distribution(
+                outputs.path(args.plot),
+                demos or [base],
+                base,
+                base_std,
+                conditioned=mean,
+                conditioned_std=std,
+                points=marks,
+                title="conditioned on the goal" if goal is not None else "the mean motion",
+                units=units,
+                times=times if demos else {**times, "demonstrations": [times["mean"]]},
+            )
     unit = units or "units"
     print(
         f"rolled out the mean motion: {len(trajectory.t)} samples over {trajectory.duration:.4g} s, "
@@ -168,21 +186,7 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         f"  spread (one standard deviation) up to {float(np.linalg.norm(std, axis=1).max()):.4g} "
         f"{unit}; at the end {float(np.linalg.norm(std[-1])):.3g} {unit}"
     )
-    print(f"wrote {path}")
+    print(f"wrote {outputs.shown(path)}")
     if args.plot:
-        from ..plotting.trajectories import plot_distribution
-
-        figure = plot_distribution(
-            args.plot,
-            demos or [base],
-            base,
-            base_std,
-            conditioned=mean,
-            conditioned_std=std,
-            points=marks,
-            title="conditioned on the goal" if goal is not None else "the mean motion",
-            units=units,
-            times=times if demos else {**times, "demonstrations": [times["mean"]]},
-        )
-        print(f"wrote {figure}")
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK
