@@ -423,3 +423,18 @@ def test_a_failed_run_takes_away_the_folders_it_made(tmp_path):
     assert list(tmp_path.iterdir()) == []
     write_run(tmp_path / "a" / "b" / "out", {"x": b"1"})
     assert_exactly(tmp_path / "a" / "b" / "out", {"x": b"1"})
+
+
+def test_a_writer_that_adds_a_suffix_puts_its_own_name_in_place(tmp_path):
+    """save_model adds .npz to a name without it: the output is the file it wrote (m.npz), not
+    dropped, and the message names it as the user would see it."""
+    import numpy as np
+
+    import bidmp
+
+    model = bidmp.DMP(n_kernels=8).fit(np.c_[np.linspace(0, 1, 40), np.sin(np.linspace(0, 3, 40))])
+    with output_files() as outputs:
+        written = bidmp.io.save_model(model, outputs.path(tmp_path / "m"))
+        assert outputs.shown(written) == tmp_path / "m.npz"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.npz"]
+    np.testing.assert_array_equal(bidmp.io.load_model(tmp_path / "m.npz").weights_, model.weights_)

@@ -332,9 +332,12 @@ def _lock_path(final: Path) -> Path:
 
 def _acquire(final: Path, out) -> int:
     """Hold the folder's lock (an exclusive flock on ``.NAME.bidmp-lock`` beside it); another
-    holder is refused at once, naming its process."""
-    import fcntl
-
+    holder is refused at once, naming its process. Where the system has no flock (Windows):
+    no lock (-1)."""
+    try:
+        import fcntl
+    except ImportError:
+        return -1
     path = _lock_path(final)
     for _ in range(_LOCK_TRIES):
         fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
@@ -361,6 +364,8 @@ def _acquire(final: Path, out) -> int:
 
 
 def _release(final: Path, fd: int) -> None:
+    if fd < 0:
+        return
     with contextlib.suppress(OSError):
         os.unlink(_lock_path(final))
     os.close(fd)
@@ -649,9 +654,14 @@ class OutputFiles:
         """The outputs written, each checked against what is at its place now (before any is
         put there: a file never replaces a folder, a bag folder only a bag folder)."""
         ready = []
-        for given, final, staged, _ in self._staged:
+        for given, final, staged, scratch in self._staged:
             if not staged.exists():
-                continue  # (not written: the command failed before it, or chose not to)
+                # a writer that adds a suffix (save_model's .npz) wrote a name of its own
+                inside = list(scratch.iterdir())
+                if len(inside) != 1:
+                    continue  # (not written: the command failed before it, or chose not to)
+                staged = inside[0]
+                final, given = final.parent / staged.name, given.parent / staged.name
             if staged.is_dir():
                 if final.exists() and not (final.is_dir() and (final / "metadata.yaml").is_file()):
                     raise ValueError(
