@@ -21,6 +21,7 @@ from bidmp.io import atomic_write
 from bidmp.io import runs as runs_module
 from bidmp.io.runs import (
     MANIFEST,
+    RunManifest,
     check_run_files,
     output_files,
     read_manifest,
@@ -338,8 +339,20 @@ def test_bad_arguments_are_refused_by_name(tmp_path):
         write_run(tmp_path / "o", {}, resume=True)
     with pytest.raises(TypeError, match="out must be a file name"):
         write_run(3, {})
-    with pytest.raises(TypeError, match="list of file paths"):
+    with pytest.raises(TypeError, match="list of file paths, got str"):
         check_run_files("one.csv")
+    with pytest.raises(TypeError, match="paths must be a list of file paths, got int"):
+        check_run_files(3)
+    with pytest.raises(TypeError, match="run must be text"):
+        RunManifest(float("nan"), "bidmp x", "0.6.0")
+    with pytest.raises(TypeError, match="files must map"):
+        RunManifest("a", "bidmp x", "0.6.0", {"a.csv": (1, "not a hash")})
+    with pytest.raises(TypeError, match="name must be a file's name"):
+        update_manifest(tmp_path, 3)
+    write_run(tmp_path / "r", {"a": b"1"})
+    for name in ("../a", "/etc/passwd", "manifest.json", "missing"):
+        with pytest.raises(ValueError, match="name"):
+            update_manifest(tmp_path / "r", name)
 
 
 def test_several_outputs_appear_together(tmp_path):

@@ -57,7 +57,7 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     ``workers``, ``targets``, ``avoid``, ``goal_update``, ``backend``). The simulator evaluates
     the motions it executes itself (judged and repaired with room for the arm's tracking): no
     flag here changes what runs, and the viewer draws that evaluation. Returns (the result, the
-    files written into ``out``, a run folder's new path)."""
+    files written into ``out``): ``out`` is a run folder's new path."""
     from tqdm import tqdm
 
     from ..sim.report import picture_frames, write_sim_report

@@ -75,6 +75,25 @@ class RunManifest:
     bidmp: str
     files: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        for name in ("run", "command", "bidmp"):
+            if not isinstance(getattr(self, name), str):
+                raise TypeError(f"{name} must be text, got {type(getattr(self, name)).__name__}")
+        if not isinstance(self.files, dict) or not all(
+            isinstance(name, str)
+            and isinstance(entry, tuple)
+            and len(entry) == 2
+            and isinstance(entry[0], int)
+            and not isinstance(entry[0], bool)
+            and entry[0] >= 0
+            and isinstance(entry[1], str)
+            and re.fullmatch(r"[0-9a-f]{64}", entry[1])
+            for name, entry in self.files.items()
+        ):
+            raise TypeError(
+                "files must map each file's name (text) to (its size in bytes, its SHA-256 in hex)"
+            )
+
     def to_dict(self) -> dict:
         return {
             "format": _FORMAT,
@@ -196,8 +215,11 @@ def check_run_files(paths) -> list:
     the file (a file of an earlier run left beside a new one, or one changed since). A file in no
     run folder passes. Returns ``(path, run folder or None, manifest or None)`` per path.
     """
-    if isinstance(paths, (str, os.PathLike)):
-        raise TypeError("paths must be a list of file paths, not one path")
+    if not isinstance(paths, (list, tuple)):
+        raise TypeError(
+            f"paths must be a list of file paths, got {type(paths).__name__}"
+            + (" (one path: give a list of it)" if isinstance(paths, (str, os.PathLike)) else "")
+        )
     checked = []
     for given in paths:
         path = Path(check_path(given, "paths"))
@@ -597,13 +619,27 @@ def update_manifest(folder, name: str) -> None:
     of ``name`` (relative to ``folder``, with ``/``) updated to the file as it is now, under the
     folder's lock. A folder that is not a run is left alone."""
     folder = Path(check_path(folder, "folder"))
+    if not isinstance(name, str) or not name:
+        raise TypeError(
+            f"name must be a file's name in the run folder (text), got {type(name).__name__}"
+        )
+    relative = Path(check_path(name, "name"))
+    if relative.is_absolute() or ".." in relative.parts or relative.as_posix() == MANIFEST:
+        raise ValueError(
+            f"name must be a file's name inside the run folder, got {shown_path(name)}"
+        )
     final = Path(os.path.realpath(folder))
     manifest = read_manifest(final)
     if manifest is None:
         return
+    path = final / relative
+    if path.is_symlink() or not path.is_file():
+        raise ValueError(
+            f"name: {shown_path(name)} is not a file of the run in {shown_path(folder)}"
+        )
+    name = relative.as_posix()
     lock = _acquire(final, folder)
     try:
-        path = final / name
         files = dict(manifest.files)
         files[name] = (path.stat().st_size, _sha256(path))
         updated = RunManifest(manifest.run, manifest.command, manifest.bidmp, files)
