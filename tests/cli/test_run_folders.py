@@ -208,8 +208,11 @@ def test_a_full_disk_midway_through_clfd_replaces_nothing_and_says_so(
     replacing clfd.json and clfd.md. The third file's write fails (ENOSPC from the file's fsync):
     the folder is byte for byte the earlier run and the one error line says exactly that."""
     monkeypatch.chdir(tmp_path)
+    # the earlier run: any run folder will do (the one under test is the second)
+    with run_folder("clfd", "bidmp benchmark clfd --out clfd") as earlier:
+        for name in ("clfd.json", "clfd.md", "clfd_accuracy.png", "clfd_dtw.png"):
+            (earlier.path / name).write_text(f"the earlier {name}")
     argv = ["benchmark", "clfd", "--tasks", "1", "--methods", "dmp-library", "--out", "clfd"]
-    assert main(argv) == 0
     before = {path.name: path.read_bytes() for path in Path("clfd").iterdir()}
     earlier = one_run(Path("clfd"))
     capsys.readouterr()
@@ -223,7 +226,7 @@ def test_a_full_disk_midway_through_clfd_replaces_nothing_and_says_so(
         real_fsync(fd)
 
     monkeypatch.setattr(os, "fsync", fsync)
-    assert main([*argv[:-2], "--seeds", "1", "--out", "clfd"]) == 2
+    assert main(argv) == 2
     monkeypatch.setattr(os, "fsync", real_fsync)
     err = capsys.readouterr().err.strip()
     assert err == (

@@ -87,7 +87,7 @@ def _files(paths, seed: int) -> dict:
 
 
 @settings(
-    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=15, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
 @given(old=NAMES, new=NAMES)
 def test_a_new_run_replaces_the_old_one_whole(tmp_path_factory, old, new):
