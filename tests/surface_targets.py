@@ -95,6 +95,11 @@ def _package_overrides(tmp: Path) -> dict:
     from bidmp.io import write_bag
 
     bag = write_bag(tmp / "poses_bag", TIMES, DEMO / 1000.0, kind="pose")
+    from bidmp.io import run_folder
+
+    run = tmp / "run"  # a run folder of one file
+    with run_folder(run, "bidmp surface") as writing:
+        (writing.path / "view.html").write_text("<p>run</p>")
     readers = {
         f"bidmp.io.{name}": {"path": csv}
         for name in (
@@ -290,6 +295,18 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.io.read_bag": {"path": bag},
         "bidmp.io.is_bag": {"path": bag},
         "bidmp.io.atomic_write": {"path": tmp / "a.bin"},
+        "bidmp.io.run_folder": {"out": tmp / "run2", "command": "bidmp surface"},
+        "bidmp.io.RunFolder": {
+            "out": tmp / "run2",
+            "final": tmp / "run2",
+            "path": tmp / ".run2.new",
+            "command": "bidmp surface",
+            "earlier": None,
+        },
+        "bidmp.io.RunManifest": {"run": "0" * 32, "command": "bidmp surface", "bidmp": "0.6.0"},
+        "bidmp.io.check_run_files": {"paths": [run / "view.html", csv]},
+        "bidmp.io.read_manifest": {"folder": run},
+        "bidmp.io.update_manifest": {"folder": run, "name": "view.html"},
         "bidmp.io.load_json": {"data": '{"a": 1}'},
         "bidmp.primitives.as_poses": {"poses": POSES},
         **{

@@ -18,6 +18,7 @@ def _cmd_verify(args: argparse.Namespace) -> int:
             f"libfranka speaks the {args.robot}'s only up to 0.9): judge a {args.robot} motion "
             f"without --libfranka (its FCI tables)"
         )
+    _refuse_mixed_runs(args.motion)
     verdicts = [(path, _verdict(path, args.robot)) for path in args.motion]
     if args.libfranka:
         return _through_libfranka(verdicts)
@@ -36,6 +37,16 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     if len(verdicts) > 1:
         print(f"{len(verdicts) - rejected} of {len(verdicts)} motions accepted")
     return EXIT_REJECTED if rejected else EXIT_OK
+
+
+def _refuse_mixed_runs(paths) -> None:
+    """A file inside a run folder (``bidmp job --commands``' DIR/commands/*.csv) is judged only if
+    that run wrote it as it is: its manifest.json lists it with this SHA-256. A command file an
+    earlier run left beside a newer one's, or one changed since, is refused by name before any
+    is judged (a robot is never sent a stale command)."""
+    from ..io.runs import check_run_files
+
+    check_run_files(paths)
 
 
 def _through_libfranka(verdicts) -> int:
