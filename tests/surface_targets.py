@@ -73,6 +73,7 @@ def _route_overrides() -> dict:
             "yaw": 90.0,
         },
         "bidmp.sim.supports_routes": {"cell": cell},
+        "bidmp.sim.reach": {"cell": bidmp.sim.RobotCell(scenario.scene), "point": [0.0, 0.0, 50.0]},
         "bidmp.sim.needlessly_slow": {"cell": cell, "plan": plan},
     }
 

@@ -240,16 +240,20 @@ TARGETS = (
         ),
     ),
     Target(
+        "verdict assembly: what the simulator executes",
+        "bidmp.sim.execution",
+        ("_refusal", "_executable", "execution_settings"),
+        (
+            "tests/sim/test_refusals.py",
+            "tests/sim/test_one_pipeline.py::test_simulate_refuses_motions_the_contract_did_not_judge_and_repair",
+            "tests/sim/test_one_pipeline.py::test_what_the_simulator_repairs_follows_the_scenarios_approach",
+            "tests/sim/test_link_repairs.py::test_an_evaluation_without_the_links_check_is_not_what_the_simulator_runs",
+        ),
+    ),
+    Target(
         "verdict assembly: what the simulator runs",
         "bidmp.sim.run",
-        (
-            "_refusal",
-            "_executable",
-            "execution_settings",
-            "_run_one",
-            "_touch_reason",
-            "_arm_routed",
-        ),
+        ("_run_one", "_touch_reason", "_arm_routed"),
         (
             "tests/sim/test_refusals.py",
             "tests/sim/test_arm_touch.py",
@@ -538,14 +542,14 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     ),
     # -- what the simulator executes
     (
-        "verdict assembly: what the simulator runs",
+        "verdict assembly: what the simulator executes",
         "_refusal",
         "if verdict.ok:",
         "if verdict.reached:",
         "a partial verdict: only the end point decides whether a motion may run",
     ),
     (
-        "verdict assembly: what the simulator runs",
+        "verdict assembly: what the simulator executes",
         "_executable",
         "if settings != wanted:",
         "if settings['geometry'] != wanted['geometry']:",

@@ -92,7 +92,7 @@ def test_a_tilted_target_is_reached_turning_the_tool_onto_its_axis():
 
 def test_a_blocked_final_approach_or_a_closed_room_has_no_route():
     scene = walled()
-    with pytest.raises(NoRouteError, match="final approach onto the target is not free"):
+    with pytest.raises(NoRouteError, match="final approach onto the goal is not free"):
         # a goal right beside the wall: coming straight down it, the tool cuts the wall
         tool_route(
             scene, [-150.0, 0.0, 60.0], [-45.0, 0.0, 0.0], approach_height=28.5, exclude=["nut"]

@@ -33,9 +33,11 @@ from ..tasks.contract import Contract
 from .backend import MovablePart
 from .job_report import JobPhase, JobReport, JobTarget, in_bin, in_slot
 from .job_world import (
+    _arm_touch,
     _body,
     _Move,
     _move,
+    _plan_key,
     _StepFailed,
     _transfer,
     _transfer_contract,
@@ -62,9 +64,16 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     # from the tool's pose now (a pose skill starts from the measured tool frame too)
     start = np.concatenate([world.tcp, world.orientation().as_quat()]) if world.pose else world.tcp
     repaired = world.repairer.repair(
-        world.model, target, label, start=start, axis=axis, exclude=exclude
+        world.model,
+        target,
+        label,
+        start=start,
+        axis=axis,
+        exclude=exclude,
+        arm=_links_check(world, exclude),
     )
-    if not repaired.ok:
+    # A motion only the arm's links cannot run goes on to the arm's own route (_move plans it).
+    if not repaired.ok and not (repaired.verdict.ok and repaired.arm):
         raise _StepFailed(f"approach: {repaired.reason()}")
     if repaired.how == "route" and repaired.model is not None:
         world.model = (
@@ -79,6 +88,36 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     )
     _note(phase, note)
     return phase
+
+
+def _links_check(world: _World, exclude):
+    """``check(motion) -> str``: why the arm's links cannot run a motion of the tool from its
+    joints now ("" when they can, or when the backend models no links): its plan's links against
+    every part but ``exclude``. A motion the inverse kinematics does not follow is not the links'
+    business: the arm's own route takes it (:func:`bidmp.sim.job_world._move`)."""
+    from .backend import SimError
+
+    def check(motion) -> str:
+        motion = np.asarray(motion, dtype=float)
+        path, turns = motion[:, :3], (motion[:, 3:] if world.pose else None)
+        try:
+            plan = world.cell.plan(
+                path,
+                f"{world.label} (approach)" if world.label else "approach",
+                fractions=np.linspace(0.0, 1.0, path.shape[0]),
+                seed=world.q,
+                orientations=turns,
+            )
+        except SimError:
+            return ""
+        # the approach that runs is planned the same way: kept for it (IK is most of a plan)
+        world.planned = (_plan_key(path, turns, world.q), plan)
+        touch = _arm_touch(world, plan, exclude, None)
+        if touch is None:
+            return ""
+        return f"a link would touch {touch[0]} ({length_text(touch[1], world.scenario.units)} deep)"
+
+    return check
 
 
 def _note(phase: JobPhase, note: str) -> None:
@@ -526,7 +565,7 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
     """The job's state: the learned skills, the contract on the job's scene and the arm's limits,
     the repairs of the approaches (planned with room for the arm's tracking)."""
     from ..tasks.repair import Repairer
-    from .run import TRACKING_ALLOWANCE_MM
+    from .execution import TRACKING_ALLOWANCE_MM
 
     # the scenario's contract, on the job's scene (its parts, the bin, the rack)
     contract = dataclasses.replace(Contract.of(scenario, cell.limits), scene=scene)
