@@ -51,7 +51,7 @@ from .._checks import (
 from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
-from .promp import _demonstrations, _stamps, condition_gaussian
+from .promp import _conditioned, _Conflict, _demonstrations, _stamps, condition_gaussian
 from .timing import Trajectory
 
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
@@ -396,16 +396,16 @@ class ProDMP(Estimator):
     def _boundary(
         self, start, start_velocity, names=("start", "start_velocity")
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Start(s) and start velocity(ies) as points (k, D), refused by the caller's argument
-        ``names``; the default start is the demonstrations' mean, one point (1, D)."""
+        """Start(s) and start velocity(ies) as points (k, D) each, refused by the caller's
+        argument ``names``; the default start is the demonstrations' mean, one point (1, D), the
+        default velocity rest (1, D). Their counts are the caller's to match (one, or one per
+        motion)."""
         start = self.start_[None] if start is None else as_points(start, self.n_dims_, names[0])
         velocity = (
-            np.zeros_like(start)
+            np.zeros((1, self.n_dims_))
             if start_velocity is None
             else as_points(start_velocity, self.n_dims_, names[1])
         )
-        if velocity.shape != start.shape:
-            velocity = np.broadcast_to(velocity, start.shape)
         return start, velocity
 
     def _single_boundary(self, start, start_velocity) -> tuple[np.ndarray, np.ndarray]:
@@ -473,11 +473,11 @@ class ProDMP(Estimator):
         )
         counts = {"starts": len(starts), "start_velocities": len(velocities), "goals": len(goals)}
         if any(count not in (1, batch) for count in counts.values()):
-            # which one is wrong is the caller's to say: name them all with their counts
-            given = ", ".join(f"{name} {count}" for name, count in counts.items())
+            # which one is wrong is the caller's to say: name them all with their shapes
+            given = ", ".join(f"{name} ({count}, {dims})" for name, count in counts.items())
             raise ValueError(
-                f"starts, start_velocities and goals must each be one point or one per rollout, "
-                f"the same number; got {given}"
+                f"starts, start_velocities and goals must each have shape (1, {dims}) or (B, "
+                f"{dims}) with one B for all (one per rollout); got {given}"
             )
         # The rollouts are affine in the starts, start velocities and goals: one matrix product
         # of their coefficients with a row per coefficient writes the whole batch (B, T·D).
@@ -611,13 +611,16 @@ class ProDMP(Estimator):
             columns[d * size : (d + 1) * size, d::dims] = H.T
         noise = cov * np.eye(len(times) * dims)
         try:
-            mean, weight_cov = condition_gaussian(
+            mean, weight_cov = _conditioned(
                 self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
             )
-        except np.linalg.LinAlgError:
+        except _Conflict as conflict:
+            first, second = (row // dims for row in conflict.rows)
             raise ValueError(
-                "times: the via-points cannot all be met exactly (two at one time, or more than the "
-                "weights can carry); give each its own time, fewer points or cov > 0"
+                f"times: the via-points {first} and {second} (at {times[first]:.6g} s and "
+                f"{times[second]:.6g} s) cannot both be met exactly (one time with different "
+                "values, or more points than the weights can carry); give each its own time, "
+                "fewer points or cov > 0"
             ) from None
         conditioned = copy.copy(self)
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, weight_cov

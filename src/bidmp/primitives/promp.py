@@ -101,10 +101,58 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     if y.shape[0] != H.shape[1]:
         raise ValueError(f"y must have one value per column of H ({H.shape[1]}), got {y.shape[0]}")
     noise = _matrix(noise, "noise", (H.shape[1], H.shape[1]), f"y has {y.shape[0]} values")
+    try:
+        return _conditioned(mean, cov, H, y, noise)
+    except _Conflict as conflict:
+        first, second = conflict.rows
+        raise ValueError(
+            f"y: observations {first} and {second} conflict: they read the same combination of "
+            "the weights (one point twice, or more points than the weights carry) with different "
+            "values and no noise to reconcile them; merge them or give noise > 0"
+        ) from None
+
+
+class _Conflict(ValueError):
+    """Exact observations that read one combination of the weights (the same point twice, or
+    more points than the weights can carry) with different values: no weights pass them all.
+    ``rows`` are the two observations (columns of H) that weigh most in the conflict."""
+
+    def __init__(self, rows: tuple[int, int]) -> None:
+        super().__init__(f"observations {rows[0]} and {rows[1]} conflict")
+        self.rows = rows
+
+
+# Below this share of the innovation's largest eigenvalue a direction is no observation of its
+# own: the same point observed twice (or 1e-12 of the phase apart), or more points than weights.
+_REDUNDANT = 1e-12
+
+
+def _conditioned(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
+    """The posterior of :func:`condition_gaussian` on checked arrays. Observations that are one
+    observation twice over (their innovation ``S = Hᵀ Σ H + N`` singular along a direction) are
+    merged when their values agree along it — the posterior of the observation once — and
+    raise :class:`_Conflict` when they do not."""
     cov_h = cov @ H  # (M, K)
     innovation = H.T @ cov_h + noise  # (K, K), positive definite when cov is
-    gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
-    posterior_mean = mean + gain @ (y - H.T @ mean)
+    residual = y - H.T @ mean
+    values, vectors = np.linalg.eigh(0.5 * (innovation + innovation.T))
+    largest = float(values[-1]) if values.size else 0.0
+    if values.size and values[0] > _REDUNDANT * largest:
+        gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
+    else:
+        kept = values > _REDUNDANT * largest
+        null = vectors[:, ~kept]
+        # The residual along the redundant directions must vanish: the points agree there
+        # (to the rounding of the values and of the mean's reading of them).
+        along = null.T @ residual
+        scale = max(float(np.abs(y).max(initial=0.0)), float(np.abs(H.T @ mean).max(initial=0.0)))
+        if np.abs(along).max(initial=0.0) > 1e-8 * max(scale, 1e-300):
+            worst = null[:, int(np.argmax(np.abs(along)))]
+            first, second = sorted(int(i) for i in np.argsort(-np.abs(worst))[:2])
+            raise _Conflict((first, second))
+        inverse = (vectors[:, kept] / values[kept]) @ vectors[:, kept].T  # S⁺
+        gain = cov_h @ inverse
+    posterior_mean = mean + gain @ residual
     posterior_cov = cov - gain @ cov_h.T
     return posterior_mean, 0.5 * (posterior_cov + posterior_cov.T)
 
@@ -278,7 +326,9 @@ class ProMP(Estimator):
     def condition(self, phase, y, cov=0.0) -> ProMP:
         """A new ProMP conditioned on passing ``y`` (K, D) at ``phase`` (K,) with covariance
         ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D).
-        All points at once (one stacked observation)."""
+        All points at once (one stacked observation). Two exact points at one phase with equal
+        values are one point; with different values they conflict (a ``ValueError`` naming
+        them), as do more exact points than the weights can carry."""
         self.check_fitted()
         phase = _as_bounded_array(phase, "phase", 1)
         # one stacked observation: its (K·D)² covariance must fit before it is built
@@ -288,9 +338,22 @@ class ProMP(Estimator):
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
         noise = _noise(cov, phase.size, self.n_dims_)
-        mean, covariance = condition_gaussian(
-            self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise
-        )
+        try:
+            mean, covariance = _conditioned(
+                self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise
+            )
+        except _Conflict as conflict:
+            first, second = (row // self.n_dims_ for row in conflict.rows)
+            where = (
+                f"both at phase {phase[first]:.6g}"
+                if abs(phase[first] - phase[second]) <= 1e-6
+                else f"at phases {phase[first]:.6g} and {phase[second]:.6g}"
+            )
+            raise ValueError(
+                f"y: points {first} and {second} ({where}) conflict: different values the weights "
+                "cannot both pass exactly (one time, or more points than weights); merge them, "
+                "give each its own phase or cov > 0"
+            ) from None
         out = ProMP(**self.get_params())
         out.__dict__.update({k: v for k, v in self.__dict__.items() if k.endswith("_")})
         out.weight_mean_, out.weight_cov_ = mean, covariance
