@@ -471,11 +471,34 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
 def as_unit_quaternion(value, name: str) -> np.ndarray:
     """A unit quaternion ``qx, qy, qz, qw`` (4,), its norm within 1e-6 of 1."""
     quaternion = as_vector(value, name, length=4)
-    if not abs(float(np.linalg.norm(quaternion)) - 1.0) <= 1e-6:
-        raise ValueError(
-            f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(quaternion):.6g}"
-        )
+    norm = float(_row_norms(quaternion))
+    if not abs(norm - 1.0) <= 1e-6:
+        raise ValueError(f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {norm:.6g}")
     return quaternion
+
+
+def _power_of_two_scaled(array: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``array`` (..., k) with each row divided by the power of two of its largest magnitude
+    (exact: only the exponents change), and those exponents (..., 1)."""
+    largest = np.max(np.abs(array), axis=-1, keepdims=True)
+    exponent = np.frexp(largest)[1]
+    return np.ldexp(array, -exponent), exponent
+
+
+def _row_norms(array: np.ndarray) -> np.ndarray:
+    """The Euclidean norm of each row of finite ``array`` (..., k), its rows scaled by a power of
+    two first, so that components of 1e300 do not overflow the squares and of 1e-300 do not
+    underflow them to 0 (the norm of a quaternion, of a direction)."""
+    scaled, exponent = _power_of_two_scaled(np.asarray(array, dtype=float))
+    return np.ldexp(np.linalg.norm(scaled, axis=-1), exponent[..., 0])
+
+
+def _unit_rows(array: np.ndarray) -> np.ndarray:
+    """Each row of finite, non-zero ``array`` (..., k) divided by its norm, scaled first as
+    :func:`_row_norms` (bit for bit ``array / norm`` where that neither overflows nor
+    underflows)."""
+    scaled = _power_of_two_scaled(np.asarray(array, dtype=float))[0]
+    return scaled / np.linalg.norm(scaled, axis=-1, keepdims=True)
 
 
 def check_names(names, count: int, name: str = "names") -> list[str]:

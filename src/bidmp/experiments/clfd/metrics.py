@@ -10,6 +10,8 @@ import numpy as np
 from ..._checks import (
     _as_bounded_array,
     _check_finite,
+    _row_norms,
+    _unit_rows,
     as_trajectory,
     as_vector,
     check_choice,
@@ -95,8 +97,13 @@ def orientation_error(true, predicted) -> float:
             f"true and predicted must be quaternions (T, 4) of equal length, got {true.shape} and "
             f"{predicted.shape}"
         )
-    true = true / np.linalg.norm(true, axis=1, keepdims=True)
-    predicted = predicted / np.linalg.norm(predicted, axis=1, keepdims=True)
+    for name, quaternions in (("true", true), ("predicted", predicted)):
+        zero = _row_norms(quaternions) < 1e-9
+        if np.any(zero):
+            raise ValueError(
+                f"{name}: row {int(np.argmax(zero))} is a zero quaternion, which is no rotation"
+            )
+    true, predicted = _unit_rows(true), _unit_rows(predicted)
     # the real part of q_true ⊗ conj(q_pred) is their dot product; the angle of the relative
     # rotation is 2 acos(|w|), which is ‖2 log(·)‖ taken the shorter way
     w = np.clip(np.abs(np.sum(true * predicted, axis=1)), 0.0, 1.0)
