@@ -22,6 +22,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from ._kernels import extent as _extent
+from ._norms import row_norms
 
 __all__ = [
     "as_unit_quaternion",
@@ -269,6 +270,10 @@ def _as_float_array(value, name: str) -> np.ndarray:
     if isinstance(value, np.ndarray) and value.dtype.kind == "c" or isinstance(value, complex):
         # NumPy would drop the imaginary part with a ComplexWarning and go on with the real one.
         raise TypeError(f"{name} must be real numbers, got complex values")
+    if _holds_bools(value):
+        # NumPy reads True as 1.0: a flag where a point or a value goes is a caller's slip, not a
+        # coordinate (check_real and check_int refuse a bool for the same reason)
+        raise TypeError(f"{name} must be numbers, got True/False")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
@@ -280,6 +285,20 @@ def _as_float_array(value, name: str) -> np.ndarray:
         )
         raise TypeError(f"{name} must be an array of numbers, got {shape}") from None
     return array
+
+
+def _holds_bools(value) -> bool:
+    """Whether ``value`` is a bool, a boolean array or a list or tuple with a bool among its
+    entries (or its first row's)."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "b"
+    if isinstance(value, (list, tuple)) and value:
+        first = value[0]
+        row = first if isinstance(first, (list, tuple)) else ()
+        return any(isinstance(item, (bool, np.bool_)) for item in (*value[:64], *row[:64]))
+    return False
 
 
 def _check_finite(array: np.ndarray, name: str) -> None:
@@ -471,34 +490,10 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
 def as_unit_quaternion(value, name: str) -> np.ndarray:
     """A unit quaternion ``qx, qy, qz, qw`` (4,), its norm within 1e-6 of 1."""
     quaternion = as_vector(value, name, length=4)
-    norm = float(_row_norms(quaternion))
+    norm = float(row_norms(quaternion))
     if not abs(norm - 1.0) <= 1e-6:
         raise ValueError(f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {norm:.6g}")
     return quaternion
-
-
-def _power_of_two_scaled(array: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``array`` (..., k) with each row divided by the power of two of its largest magnitude
-    (exact: only the exponents change), and those exponents (..., 1)."""
-    largest = np.max(np.abs(array), axis=-1, keepdims=True)
-    exponent = np.frexp(largest)[1]
-    return np.ldexp(array, -exponent), exponent
-
-
-def _row_norms(array: np.ndarray) -> np.ndarray:
-    """The Euclidean norm of each row of finite ``array`` (..., k), its rows scaled by a power of
-    two first, so that components of 1e300 do not overflow the squares and of 1e-300 do not
-    underflow them to 0 (the norm of a quaternion, of a direction)."""
-    scaled, exponent = _power_of_two_scaled(np.asarray(array, dtype=float))
-    return np.ldexp(np.linalg.norm(scaled, axis=-1), exponent[..., 0])
-
-
-def _unit_rows(array: np.ndarray) -> np.ndarray:
-    """Each row of finite, non-zero ``array`` (..., k) divided by its norm, scaled first as
-    :func:`_row_norms` (bit for bit ``array / norm`` where that neither overflows nor
-    underflows)."""
-    scaled = _power_of_two_scaled(np.asarray(array, dtype=float))[0]
-    return scaled / np.linalg.norm(scaled, axis=-1, keepdims=True)
 
 
 def check_names(names, count: int, name: str = "names") -> list[str]:

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
     as_points,
@@ -55,6 +55,10 @@ from .promp import _conditioned, _Conflict, _demonstrations, _stamps, condition_
 from .timing import Trajectory
 
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
+
+
+# n_outside's bound alone (prodmp_basis checks it against n_basis: at most (n_basis - 2) // 2)
+_MAX_OUTSIDE = 500
 
 
 @dataclass(frozen=True)
@@ -305,6 +309,20 @@ class ProDMP(Estimator):
     units_ : str
     """
 
+    # What each parameter may be (set_params and fit check them; prodmp_basis's own bounds)
+    _parameter_constraints = {
+        "n_basis": integer(minimum=1, limit="max_kernels"),
+        "alpha": real(positive=True, maximum=1e3),
+        "alpha_phase": real(minimum=1e-6, maximum=1e3),
+        "tau": real(optional=True, positive=True, maximum=1e4),
+        "bandwidth_factor": real(positive=True, maximum=1e3),
+        "n_outside": integer(minimum=0, maximum=_MAX_OUTSIDE),
+        "dt": real(positive=True, maximum=1e4),
+        "length_factor": real(positive=True, maximum=6.0),
+        "ridge": real(nonnegative=True, maximum=1e6),
+        "cov_reg": real(positive=True, maximum=1e3),
+    }
+
     def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one
         self,
         n_basis: int = 10,
@@ -339,8 +357,8 @@ class ProDMP(Estimator):
         if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
             demonstrations = [demonstrations]  # one demonstration
         demos = _demonstrations(demonstrations)  # the ProMP's checks: one way to be refused
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6)
-        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
+        self._check_constraints()
+        ridge, cov_reg = float(self.ridge), float(self.cov_reg)
         units = "" if units is None else check_units(units)
         stamps = _stamps(times, demos)  # (each is timed onto tau below: the span is its own)
         tau = (

@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
     _as_bounded_array,
@@ -205,6 +205,13 @@ class ProMP(Estimator):
     n_dims_ : int
     """
 
+    _parameter_constraints = {
+        "n_basis": integer(minimum=2, limit="max_kernels"),
+        "ridge": real(nonnegative=True, maximum=1.0),
+        "cov_reg": real(positive=True, maximum=1e3),
+        "overlap": real(positive=True, maximum=0.99),
+    }
+
     def __init__(
         self, n_basis: int = 20, ridge: float = 1e-10, cov_reg: float = 1e-2, overlap: float = 0.7
     ) -> None:
@@ -218,10 +225,8 @@ class ProMP(Estimator):
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, any lengths) with their
         stamps ``times`` (a list of (T_i,) arrays, s; None: each over 1 s)."""
-        n_basis = check_int(self.n_basis, "n_basis", minimum=2, limit="max_kernels")
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
-        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
-        check_real(self.overlap, "overlap", positive=True, maximum=0.99)
+        self._check_constraints()
+        n_basis, ridge, cov_reg = int(self.n_basis), float(self.ridge), float(self.cov_reg)
         demos = _demonstrations(demonstrations)
         stamps = _stamps(times, demos)
         units = "" if units is None else check_units(units)

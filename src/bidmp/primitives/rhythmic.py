@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     SLOWEST_HZ,
     _limit,
@@ -50,7 +50,7 @@ from .._threads import single_threaded
 from .._units import check_units
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
-from .frequency import _series, _with_frequency, estimate_frequency
+from .frequency import _MAX_HARMONICS, _series, _with_frequency, estimate_frequency
 from .integrate import _exact_responses, _exact_state, _foh_step
 from .timing import Trajectory, check_timestamps
 
@@ -88,6 +88,16 @@ class RhythmicDMP(Estimator):
     weights_ : array (N, D)
     """
 
+    # What each parameter may be (checked by set_params and fit). A spring weaker than 1e-3
+    # never pulls onto the cycle (a denormal one made the period's transition singular).
+    _parameter_constraints = {
+        "n_kernels": integer(minimum=2, limit="max_kernels"),
+        "alpha": real(minimum=1e-3, maximum=1e4),
+        "concentration": real(optional=True, positive=True, maximum=1e6),
+        "n_harmonics": integer(optional=True, minimum=1, maximum=4 * _MAX_HARMONICS),
+        "ridge": real(nonnegative=True, maximum=1.0),
+    }
+
     def __init__(
         self,
         n_kernels: int = 50,
@@ -108,11 +118,8 @@ class RhythmicDMP(Estimator):
         """Learn from a recording ``y`` (T, D) at stamps ``t`` (s) of at least 2 periods
         (transients at both ends are cut); ``frequency`` (Hz) skips the estimate of it (the
         steady part is still found). Returns self."""
-        n_kernels = check_int(self.n_kernels, "n_kernels", minimum=2, limit="max_kernels")
-        # a spring weaker than 1e-3 never pulls onto the cycle (a denormal one made the period's
-        # transition singular)
-        alpha = check_real(self.alpha, "alpha", minimum=1e-3, maximum=1e4)
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
+        self._check_constraints()
+        n_kernels, alpha, ridge = int(self.n_kernels), float(self.alpha), float(self.ridge)
         basis = VonMisesBasis(n_kernels, self.concentration)
         y = as_trajectory(y, "y", min_points=8)
         t = check_timestamps(t, y.shape[0])

@@ -18,13 +18,13 @@ from ..._checks import (
     _check_finite,
     _check_magnitude,
     _limit,
-    _row_norms,
     as_point,
     check_choice,
     check_path,
     printable,
     shown_path,
 )
+from ..._norms import row_norms
 
 __all__ = ["CLFD_DATASETS", "ClfdTask", "TangentChart", "clfd_tasks"]
 
@@ -87,7 +87,7 @@ class ClfdTask:
                     f"w, x, y, z, one per sample of positions, got shape {orientations.shape}"
                 )
             _check_finite(orientations, "orientations")
-            if np.any(_row_norms(orientations) < 1e-9):
+            if np.any(row_norms(orientations) < 1e-9):
                 raise ValueError("orientations holds a zero quaternion, which is no rotation")
         object.__setattr__(self, "positions", positions)
         object.__setattr__(self, "times", times)
@@ -255,7 +255,7 @@ class TangentChart:
     def __init__(self, reference: np.ndarray | None = None):
         if reference is not None:
             reference = as_point(reference, 4, "reference")
-            norm = float(_row_norms(reference))
+            norm = float(row_norms(reference))
             if norm < 1e-9:
                 raise ValueError("reference must be a unit quaternion (w, x, y, z), got zero")
             reference = reference / norm

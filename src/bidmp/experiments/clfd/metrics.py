@@ -10,13 +10,12 @@ import numpy as np
 from ..._checks import (
     _as_bounded_array,
     _check_finite,
-    _row_norms,
-    _unit_rows,
     as_trajectory,
     as_vector,
     check_choice,
     check_real,
 )
+from ..._norms import row_norms, unit_rows
 from ...extension.similarity import dtw_distance, frechet_distance
 from ...tasks.metrics import swept_area
 
@@ -98,12 +97,12 @@ def orientation_error(true, predicted) -> float:
             f"{predicted.shape}"
         )
     for name, quaternions in (("true", true), ("predicted", predicted)):
-        zero = _row_norms(quaternions) < 1e-9
+        zero = row_norms(quaternions) < 1e-9
         if np.any(zero):
             raise ValueError(
                 f"{name}: row {int(np.argmax(zero))} is a zero quaternion, which is no rotation"
             )
-    true, predicted = _unit_rows(true), _unit_rows(predicted)
+    true, predicted = unit_rows(true), unit_rows(predicted)
     # the real part of q_true ⊗ conj(q_pred) is their dot product; the angle of the relative
     # rotation is 2 acos(|w|), which is ‖2 log(·)‖ taken the shorter way
     w = np.clip(np.abs(np.sum(true * predicted, axis=1)), 0.0, 1.0)
