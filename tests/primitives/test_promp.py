@@ -202,3 +202,26 @@ def test_condition_gaussian_names_conflicting_observations():
     once = condition_gaussian(np.zeros(3), np.eye(3), H[:, :1], [1.0], np.zeros((1, 1)))
     np.testing.assert_allclose(mean, once[0], atol=1e-12)
     np.testing.assert_allclose(cov, once[1], atol=1e-12)
+
+
+def test_a_motion_conditioned_at_rest_at_both_ends_starts_and_ends_still(promp, shape):
+    """rest=[0, 1]: velocity and acceleration 0 at both ends, exactly; judged by finite
+    differences of the conditioned mean's positions on a fine phase grid (not the model's own
+    derivatives), with a start, a via-point and a goal passed at once."""
+    start, goal = shape[0][0] + [1.0, -2.0], shape[0][-1] + [3.0, 2.0]
+    via = shape[0][500] + [-4.0, 5.0]
+    conditioned = promp.condition(
+        [0.0, 0.5, 1.0], np.stack([start, via, goal]), 0.0, rest=[0.0, 1.0]
+    )
+    h = 1e-4
+    ends = conditioned.mean([0.0, h, 2 * h, 1.0 - 2 * h, 1.0 - h, 1.0])
+    extent = np.ptp(shape, axis=(0, 1)).max()
+    np.testing.assert_allclose(ends[[0, -1]], [start, goal], atol=1e-9 * extent)
+    np.testing.assert_allclose(conditioned.mean([0.5])[0], via, atol=1e-9 * extent)
+    for a, b, c in ((ends[0], ends[1], ends[2]), (ends[5], ends[4], ends[3])):
+        slope = (-3 * a + 4 * b - c) / (2 * h)  # one-sided, second order
+        curvature = (a - 2 * b + c) / h**2
+        assert np.abs(slope).max() <= 1e-5 * extent and np.abs(curvature).max() <= 1e-2 * extent
+    with pytest.raises(ValueError) as caught:  # a rest where it is told to move
+        promp.condition([0.5, 0.5 + 1e-13], np.stack([via, via + 1.0]), 0.0, rest=[0.5])
+    assert _one_line(caught).startswith("y: points 0 and 1")

@@ -252,6 +252,28 @@ def _cumulative_trapezoid(values: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
+def _conflict_text(rows, times: np.ndarray, rest: np.ndarray, dims: int) -> str:
+    """What :meth:`ProDMP.condition` says of two observations that conflict, the argument of
+    the first named first."""
+    named, arguments = [], []
+    for row in sorted(rows):
+        index = row // dims
+        if index < times.size:
+            named.append(f"the via-point {index} (at {times[index]:.6g} s)")
+            arguments.append("times")
+        elif index < times.size + 2 * rest.size:  # (its velocity, then its acceleration)
+            named.append(f"the rest at {rest[(index - times.size) % rest.size]:.6g} s")
+            arguments.append("rest")
+        else:
+            named.append("the goal")
+            arguments.append("goal")
+    return (
+        f"{arguments[0]}: {named[0]} and {named[1]} cannot both be met exactly (one time with "
+        "different values, or more points than the weights can carry); give each its own time, "
+        "fewer points or cov > 0"
+    )
+
+
 def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
     """The covariance (M, M) of weights (n, M) of n demonstrations plus ``cov_reg`` times each
     weight's own variance on the diagonal (its square where it does not vary: one demonstration).
@@ -600,46 +622,69 @@ class ProDMP(Estimator):
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, cov
         return conditioned
 
-    def condition(self, times, values, cov=0.0, *, start=None, start_velocity=None) -> ProDMP:
+    def condition(  # noqa: PLR0913 - the observations a motion is conditioned on, by name
+        self, times, values, cov=0.0, *, start=None, start_velocity=None, rest=None, goal=None
+    ) -> ProDMP:
         """A copy whose weights are conditioned exactly on passing ``values`` (K, D) at ``times``
         (K,) (s) with noise ``cov`` (a scalar variance, units²), for motions from ``start`` at
         ``start_velocity`` (default the mean start, at rest): the via-points enter the weights'
-        Gaussian like a ProMP's, the boundary condition stays exact."""
+        Gaussian like a ProMP's, the boundary condition stays exact. ``rest`` (R,) (s): times
+        at which the motion is at rest (velocity and acceleration 0, exactly); ``goal`` (D,): the goal weight
+        (the attractor) exactly. The end at tau among the points, ``rest=[tau]`` and ``goal``
+        the same point make a motion that ends there at rest and stays. ``times`` and
+        ``values`` may be empty when ``rest`` or ``goal`` is given."""
         import copy
 
         self.check_fitted()
-        times = as_vector(times, "times")
-        values = as_points(values, self.n_dims_, "values")
+        dims, size = self.n_dims_, self.basis_.n_basis + 1
+        times = as_vector(times, "times", min_length=0 if (rest, goal) != (None, None) else 1)
+        values = np.zeros((0, dims)) if not times.size else as_points(values, dims, "values")
         if len(values) != len(times):
             raise ValueError(
                 f"times must hold one time per point of values ({len(values)}), got {len(times)}"
             )
+        rest = np.zeros(0) if rest is None else as_vector(rest, "rest")
         cov = check_real(cov, "cov", nonnegative=True, maximum=1e12)
-        if np.any(times <= 0.0):
-            raise ValueError(
-                "times must be > 0 s: at 0 the motion is at its start (give start= instead)"
-            )
+        for name, when in (("times", times), ("rest", rest)):
+            if np.any(when <= 0.0):
+                raise ValueError(
+                    f"{name} must be > 0 s: at 0 the motion is at its start (give start= and "
+                    "start_velocity= instead)"
+                )
         start, velocity = self._single_boundary(start, start_velocity)
-        p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
-        size, dims = self.basis_.n_basis + 1, self.n_dims_
-        observed = values - p0[:, None] * start - v0[:, None] * (velocity * self.duration_)
-        # the observation's columns: dimension d at time k reads block d of the weights
-        columns = np.zeros((dims * size, len(times) * dims))
+        carried = velocity * self.duration_
+        # the observations' columns: dimension d of each observation reads block d of the weights
+        blocks, observed = [], []
+        if times.size:
+            p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
+            blocks.append(H)
+            observed.append(values - p0[:, None] * start - v0[:, None] * carried)
+        if rest.size:
+            # at rest: the velocity (d/ds) and the acceleration (d²/ds², the system's equation
+            # y'' = -α y' - α²/4 (y - g) + x φ·w) are 0 there
+            p0, v0, p1, v1, H, dH = self.basis_.boundary_maps(rest, 0.0)
+            alpha = self.basis_.alpha
+            forcing = self.basis_.phase(rest)[:, None] * self.basis_.forcing(rest)
+            pulled = np.hstack([forcing, np.full((rest.size, 1), alpha**2 / 4.0)])
+            blocks += [dH, pulled - alpha * dH - alpha**2 / 4.0 * H]
+            position = p0[:, None] * start + v0[:, None] * carried
+            rate = p1[:, None] * start + v1[:, None] * carried
+            observed += [-rate, alpha * rate + alpha**2 / 4.0 * position]
+        if goal is not None:
+            blocks.append(np.eye(size)[None, -1])  # the goal weight itself
+            observed.append(as_points(goal, dims, "goal"))
+        rows = np.vstack(blocks)  # (observations, N + 1)
+        columns = np.zeros((dims * size, len(rows) * dims))
         for d in range(dims):
-            columns[d * size : (d + 1) * size, d::dims] = H.T
-        noise = cov * np.eye(len(times) * dims)
+            columns[d * size : (d + 1) * size, d::dims] = rows.T
+        noise = np.zeros((len(rows) * dims,) * 2)
+        noise[np.diag_indices(len(times) * dims)] = cov
         try:
             mean, weight_cov = _conditioned(
-                self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
+                self.weight_mean_, self.weight_cov_, columns, np.vstack(observed).reshape(-1), noise
             )
         except _Conflict as conflict:
-            first, second = (row // dims for row in conflict.rows)
-            raise ValueError(
-                f"times: the via-points {first} and {second} (at {times[first]:.6g} s and "
-                f"{times[second]:.6g} s) cannot both be met exactly (one time with different "
-                "values, or more points than the weights can carry); give each its own time, "
-                "fewer points or cov > 0"
-            ) from None
+            raise ValueError(_conflict_text(conflict.rows, times, rest, dims)) from None
         conditioned = copy.copy(self)
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, weight_cov
         conditioned.start_, conditioned.start_velocity_ = start[0], velocity[0]

@@ -328,37 +328,37 @@ class ProMP(Estimator):
         # (n, D, N) weights times the rows: (n, L, D)
         return np.einsum("ln,sdn->sld", rows, weights.reshape(n_samples, self.n_dims_, -1))
 
-    def condition(self, phase, y, cov=0.0) -> ProMP:
+    def condition(self, phase, y, cov=0.0, *, rest=None) -> ProMP:
         """A new ProMP conditioned on passing ``y`` (K, D) at ``phase`` (K,) with covariance
-        ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D).
-        All points at once (one stacked observation). Two exact points at one phase with equal
-        values are one point; with different values they conflict (a ``ValueError`` naming
-        them), as do more exact points than the weights can carry."""
+        ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D);
+        and at rest (velocity and acceleration 0, exactly) at the phases ``rest`` (R,) if given (a motion that
+        starts or ends at rest: ``rest=[0.0, 1.0]``). All at once (one stacked observation).
+        Two exact points at one phase with equal values are one point; with different values
+        they conflict (a ``ValueError`` naming them), as do more exact points than the weights
+        can carry."""
         self.check_fitted()
         phase = _as_bounded_array(phase, "phase", 1)
-        # one stacked observation: its (K·D)² covariance must fit before it is built
-        check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
+        rest = np.zeros(0) if rest is None else _as_bounded_array(rest, "rest", 1).reshape(-1)
+        # one stacked observation: its ((K + R)·D)² covariance must fit before it is built
+        count = phase.size + 2 * rest.size  # (a rest: its velocity and its acceleration)
+        check_bytes((count * self.n_dims_) ** 2, f"conditioning on {count:,} points")
         phase = self._phase(phase.reshape(-1), 2)
         y = as_points(y, self.n_dims_, "y")
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
+        if rest.size:
+            rest = self._phase(rest, 2)
         noise = _noise(cov, phase.size, self.n_dims_)
+        H, values = self._H(phase), y.reshape(-1)
+        if rest.size:  # the velocity's and acceleration's rows at the rest phases, 0 exactly
+            H = np.hstack([H, self._H(rest, 1), self._H(rest, 2)])
+            values = np.concatenate([values, np.zeros(2 * rest.size * self.n_dims_)])
+            size = noise.shape[0] + 2 * rest.size * self.n_dims_
+            noise = np.pad(noise, (0, size - noise.shape[0]))
         try:
-            mean, covariance = _conditioned(
-                self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise
-            )
+            mean, covariance = _conditioned(self.weight_mean_, self.weight_cov_, H, values, noise)
         except _Conflict as conflict:
-            first, second = (row // self.n_dims_ for row in conflict.rows)
-            where = (
-                f"both at phase {phase[first]:.6g}"
-                if abs(phase[first] - phase[second]) <= 1e-6
-                else f"at phases {phase[first]:.6g} and {phase[second]:.6g}"
-            )
-            raise ValueError(
-                f"y: points {first} and {second} ({where}) conflict: different values the weights "
-                "cannot both pass exactly (one time, or more points than weights); merge them, "
-                "give each its own phase or cov > 0"
-            ) from None
+            raise ValueError(_conflict_text(conflict.rows, phase, rest, self.n_dims_)) from None
         out = ProMP(**self.get_params())
         out.__dict__.update({k: v for k, v in self.__dict__.items() if k.endswith("_")})
         out.weight_mean_, out.weight_cov_ = mean, covariance
@@ -396,6 +396,34 @@ class ProMP(Estimator):
             for order in (0, 1, 2)
         )
         return Trajectory(t, y, yd, ydd, self.units_)
+
+
+def _conflict_text(rows: tuple[int, int], phase: np.ndarray, rest: np.ndarray, dims: int) -> str:
+    """What :meth:`ProMP.condition` says of two observations that conflict: the points of ``y``
+    (or the rests) and where they are."""
+    kinds, numbers, where = [], [], []
+    for row in sorted(rows):
+        index = row // dims
+        point = index < phase.size
+        kinds.append("y" if point else "rest")
+        # (a rest is its velocity's rows, then its acceleration's)
+        numbers.append(index if point else (index - phase.size) % rest.size)
+        where.append(phase[index] if point else rest[(index - phase.size) % rest.size])
+    if kinds[0] == kinds[1]:
+        named = (
+            f"{kinds[0]}: {'points' if kinds[0] == 'y' else 'rests'} {numbers[0]} and {numbers[1]}"
+        )
+    else:
+        named = f"y and rest: point {numbers[0]} and rest {numbers[1]}"
+    at = (
+        f"both at phase {where[0]:.6g}"
+        if abs(where[0] - where[1]) <= 1e-6
+        else f"at phases {where[0]:.6g} and {where[1]:.6g}"
+    )
+    return (
+        f"{named} ({at}) conflict: different values the weights cannot both pass exactly (one "
+        "time, or more points than weights); merge them, give each its own phase or cov > 0"
+    )
 
 
 def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
