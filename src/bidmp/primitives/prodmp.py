@@ -41,6 +41,7 @@ import numpy as np
 from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
+    as_point,
     as_points,
     as_vector,
     check_bool,
@@ -183,6 +184,12 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
             f"dt = {dt:g} s is longer than tau = {tau:g} s: shorten dt or lengthen tau"
         )
     length_factor = check_real(length_factor, "length_factor", positive=True, maximum=6.0)
+    # the grid's size from the step before it is made (a 5e-324 s step made tau / dt infinite)
+    if length_factor * tau / dt > 2_000_000:
+        raise ValueError(
+            f"dt = {dt:g} s gives a grid of {length_factor * tau / dt:.3g} points over the motion: "
+            f"too fine (at least {length_factor * tau / 2_000_000:.3g} s)"
+        )
     steps = round(1.0 / (dt / tau))
     n_grid = int(length_factor * steps) + 1
     if n_grid > 2_000_000:
@@ -256,7 +263,7 @@ def _conflict_text(rows, times: np.ndarray, rest: np.ndarray, dims: int) -> str:
     """What :meth:`ProDMP.condition` says of two observations that conflict, the argument of
     the first named first."""
     named, arguments = [], []
-    for row in sorted(rows):
+    for row in sorted(set(rows)):
         index = row // dims
         if index < times.size:
             named.append(f"the via-point {index} (at {times[index]:.6g} s)")
@@ -267,6 +274,11 @@ def _conflict_text(rows, times: np.ndarray, rest: np.ndarray, dims: int) -> str:
         else:
             named.append("the goal")
             arguments.append("goal")
+    if rows[0] == rows[1]:
+        return (
+            f"{arguments[0]}: {named[0]} reads none of the weights to the floats' range (the "
+            "motion is its start there); move it later or give cov > 0"
+        )
     return (
         f"{arguments[0]}: {named[0]} and {named[1]} cannot both be met exactly (one time with "
         "different values, or more points than the weights can carry); give each its own time, "
@@ -637,7 +649,8 @@ class ProDMP(Estimator):
 
         self.check_fitted()
         dims, size = self.n_dims_, self.basis_.n_basis + 1
-        times = as_vector(times, "times", min_length=0 if (rest, goal) != (None, None) else 1)
+        optional = rest is not None or goal is not None  # then the points may be none
+        times = as_vector(times, "times", min_length=0 if optional else 1)
         values = np.zeros((0, dims)) if not times.size else as_points(values, dims, "values")
         if len(values) != len(times):
             raise ValueError(
@@ -672,7 +685,7 @@ class ProDMP(Estimator):
             observed += [-rate, alpha * rate + alpha**2 / 4.0 * position]
         if goal is not None:
             blocks.append(np.eye(size)[None, -1])  # the goal weight itself
-            observed.append(as_points(goal, dims, "goal"))
+            observed.append(as_point(goal, dims, "goal")[None])
         rows = np.vstack(blocks)  # (observations, N + 1)
         columns = np.zeros((dims * size, len(rows) * dims))
         for d in range(dims):

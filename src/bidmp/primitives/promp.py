@@ -29,6 +29,7 @@ from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
     _as_bounded_array,
+    _check_magnitude,
     as_points,
     as_trajectory,
     as_vector,
@@ -97,6 +98,8 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     size = mean.shape[0]
     cov = _matrix(cov, "cov", (size, size), f"mean has {size} entries")
     H = _matrix(H, "H", (size, None), f"mean has {size} entries")
+    # (an observation's columns of 1e300 overflow its products with the covariance)
+    _check_magnitude(H, "H")
     y = as_vector(y, "y")
     if y.shape[0] != H.shape[1]:
         raise ValueError(f"y must have one value per column of H ({H.shape[1]}), got {y.shape[0]}")
@@ -105,6 +108,11 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
         return _conditioned(mean, cov, H, y, noise)
     except _Conflict as conflict:
         first, second = conflict.rows
+        if first == second:
+            raise ValueError(
+                f"y: observation {first} reads none of the weights (its column of H is 0 to the "
+                "floats' range) yet differs from the mean's; give it noise > 0 or another H"
+            ) from None
         raise ValueError(
             f"y: observations {first} and {second} conflict: they read the same combination of "
             "the weights (one point twice, or more points than the weights carry) with different "
@@ -137,19 +145,25 @@ def _conditioned(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     residual = y - H.T @ mean
     values, vectors = np.linalg.eigh(0.5 * (innovation + innovation.T))
     largest = float(values[-1]) if values.size else 0.0
-    if values.size and values[0] > _REDUNDANT * largest:
+    if values.size and largest > 0.0 and values[0] > _REDUNDANT * largest:
         gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
     else:
-        kept = values > _REDUNDANT * largest
+        kept = values > _REDUNDANT * largest if largest > 0.0 else np.zeros(values.size, bool)
         null = vectors[:, ~kept]
         # The residual along the redundant directions must vanish: the points agree there
         # (to the rounding of the values and of the mean's reading of them).
         along = null.T @ residual
         scale = max(float(np.abs(y).max(initial=0.0)), float(np.abs(H.T @ mean).max(initial=0.0)))
         if np.abs(along).max(initial=0.0) > 1e-8 * max(scale, 1e-300):
-            worst = null[:, int(np.argmax(np.abs(along)))]
-            first, second = sorted(int(i) for i in np.argsort(-np.abs(worst))[:2])
-            raise _Conflict((first, second))
+            if not kept.any():  # the observations read no weight at all (H is 0 to rounding)
+                worst = int(np.argmax(np.abs(residual)))
+                raise _Conflict((worst, worst))
+            # the two observations that weigh most in the direction they disagree along
+            worst = np.abs(null[:, int(np.argmax(np.abs(along)))])
+            first, second = (int(i) for i in np.argsort(-worst)[:2])
+            if worst[second] <= 1e-6 * worst[first]:  # one observation alone: it reads nothing
+                raise _Conflict((first, first))
+            raise _Conflict((min(first, second), max(first, second)))
         inverse = (vectors[:, kept] / values[kept]) @ vectors[:, kept].T  # S⁺
         gain = cov_h @ inverse
     posterior_mean = mean + gain @ residual
@@ -347,7 +361,9 @@ class ProMP(Estimator):
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
         if rest.size:
-            rest = self._phase(rest, 2)
+            rest = as_vector(rest, "rest")
+            if rest.min() < 0.0 or rest.max() > 1.0:
+                raise ValueError("rest must lie in [0, 1] (phases: the normalised time)")
         noise = _noise(cov, phase.size, self.n_dims_)
         H, values = self._H(phase), y.reshape(-1)
         if rest.size:  # the velocity's and acceleration's rows at the rest phases, 0 exactly
@@ -409,6 +425,12 @@ def _conflict_text(rows: tuple[int, int], phase: np.ndarray, rest: np.ndarray, d
         # (a rest is its velocity's rows, then its acceleration's)
         numbers.append(index if point else (index - phase.size) % rest.size)
         where.append(phase[index] if point else rest[(index - phase.size) % rest.size])
+    if rows[0] == rows[1]:
+        return (
+            f"{kinds[0]}: {'point' if kinds[0] == 'y' else 'rest'} {numbers[0]} (at phase "
+            f"{where[0]:.6g}) reads none of the weights to the floats' range; move it or give "
+            "cov > 0"
+        )
     if kinds[0] == kinds[1]:
         named = (
             f"{kinds[0]}: {'points' if kinds[0] == 'y' else 'rests'} {numbers[0]} and {numbers[1]}"

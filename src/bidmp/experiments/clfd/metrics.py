@@ -10,6 +10,7 @@ import numpy as np
 from ..._checks import (
     _as_bounded_array,
     _check_finite,
+    _check_magnitude,
     as_trajectory,
     as_vector,
     check_choice,
@@ -51,8 +52,9 @@ def demonstration_errors(reproduced: np.ndarray, demonstrations: np.ndarray, met
             "reproduced and demonstrations must be (M, T, D) of one shape, got "
             f"{reproduced.shape} and {demonstrations.shape}"
         )
-    _check_finite(reproduced, "reproduced")
-    _check_finite(demonstrations, "demonstrations")
+    for name, array in (("reproduced", reproduced), ("demonstrations", demonstrations)):
+        _check_finite(array, name)
+        _check_magnitude(array, name)  # (named here, not as the distances' a and b)
     if not isinstance(metrics, (list, tuple, dict)) or not metrics or len(metrics) > 4:
         raise TypeError("metrics must be a sequence of metric names (at most 4)")
     for metric in metrics:
@@ -146,6 +148,11 @@ def continual_metrics(
         raise ValueError("matrix must hold accuracies in [0, 1] on and below its diagonal")
     if largest_size is not None:
         largest_size = check_real(largest_size, "largest_size", positive=True)
+        if largest_size < sizes[-1]:  # FS = 1 - size / largest compared, in [0, 1]
+            raise ValueError(
+                f"largest_size must be at least the model's own size {sizes[-1]:g} (the largest "
+                f"model compared), got {largest_size:g}"
+            )
     acc = float(np.sum(matrix[lower]) / (n * (n + 1) / 2))
     below = np.tril_indices(n, -1)
     bwt = float(np.mean(matrix[below] - np.diag(matrix)[below[1]])) if n > 1 else 0.0
