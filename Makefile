@@ -19,7 +19,7 @@ endif
 $(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/_kernels.pyx
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,ros,view,benchmark,test,bench,lint,docs]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,plan,ros,view,benchmark,test,bench,lint,docs]"
 	# An editable install's bytecode is written at a module's first import, or never where
 	# PYTHONDONTWRITEBYTECODE is set: then every command compiled bidmp's 120 modules again
 	# (0.18 s of each). Compiled here once; a module edited since is compiled as it is imported.
@@ -60,10 +60,11 @@ mutation: $(STAMP)
 	$(PY) tools/mutation.py --workers 2
 	$(PY) tools/mutation_kernels.py
 
-# The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/).
+# The whole nut task on the simulated Panda, open and closed loop, with pictures (bidmp-sim/ and
+# bidmp-sim-closed-loop-hold/: a command's output folder is one run, so each has its own).
 sim: $(STAMP)
 	$(VENV)/bin/bidmp sim --out bidmp-sim
-	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim/closed-loop-hold
+	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim-closed-loop-hold
 
 # The random-cell properties on 300 cells each (the tests draw 20-30): users' nut modules in mm, cm
 # and m with posts, ducts and tilted brackets, the four arms, the bin either side, every target
@@ -141,28 +142,34 @@ view-check: $(STAMP)
 # and compared with the committed ones by value (about 35 s): a decimal may move in its last printed place or by a
 # relative 1e-9, a count may not (tools/compare_results.py), so a faster equivalent computation
 # can land. The whole runs are here, a CI stage, rather than in the suite (28 s of its 3 minutes).
+# Each command writes its own folder (a command's output folder is one run); the tables are then
+# gathered in .results-check/all.
 results-check: $(STAMP)
 	rm -rf .results-check
-	$(VENV)/bin/bidmp reproduce table4 --out .results-check > /dev/null
-	$(VENV)/bin/bidmp reproduce table5 --out .results-check > /dev/null
-	$(VENV)/bin/bidmp reproduce figures --out .results-check > /dev/null
+	mkdir -p .results-check/all
+	$(VENV)/bin/bidmp reproduce table4 --out .results-check/table4 > /dev/null
+	$(VENV)/bin/bidmp reproduce table5 --out .results-check/table5 > /dev/null
+	$(VENV)/bin/bidmp reproduce figures --out .results-check/figures > /dev/null
+	cp .results-check/table4/table4.md .results-check/table4/table4.json .results-check/table4/tasks.md .results-check/all/
+	cp .results-check/table5/table5.md .results-check/table5/table5.json .results-check/all/
+	cp .results-check/figures/figures.md .results-check/figures/figures.json .results-check/all/
 	$(VENV)/bin/bidmp sim --no-pictures --out .results-check/sim > /dev/null
-	cp .results-check/sim/sim.md .results-check/sim/sim_results.json .results-check/
+	cp .results-check/sim/sim.md .results-check/sim/sim_results.json .results-check/all/
 	$(VENV)/bin/bidmp job --no-pictures --out .results-check/job > /dev/null
 	$(VENV)/bin/bidmp job --scenario cell-removal --no-pictures --out .results-check/cells > /dev/null
-	cp .results-check/job/job.md .results-check/job/job_results.json .results-check/
-	cp .results-check/cells/job.md .results-check/job_cells.md
-	cp .results-check/cells/job_results.json .results-check/job_cells_results.json
-	$(PY) tools/compare_results.py .results-check docs/results
+	cp .results-check/job/job.md .results-check/job/job_results.json .results-check/all/
+	cp .results-check/cells/job.md .results-check/all/job_cells.md
+	cp .results-check/cells/job_results.json .results-check/all/job_cells_results.json
+	$(PY) tools/compare_results.py .results-check/all docs/results
 	rm -rf .results-check
 
 # Regenerate the committed result tables (docs/results/*.md) with the commands that make them,
 # then copy them into README.md (tests/test_readme.py checks the two agree).
 readme: $(STAMP)
 	rm -rf .readme-out
-	$(VENV)/bin/bidmp reproduce table4 --out .readme-out > /dev/null
-	$(VENV)/bin/bidmp reproduce table5 --out .readme-out > /dev/null
-	$(VENV)/bin/bidmp reproduce figures --out .readme-out > /dev/null
+	$(VENV)/bin/bidmp reproduce table4 --out .readme-out/table4 > /dev/null
+	$(VENV)/bin/bidmp reproduce table5 --out .readme-out/table5 > /dev/null
+	$(VENV)/bin/bidmp reproduce figures --out .readme-out/figures > /dev/null
 	$(VENV)/bin/bidmp sim --out .readme-out/sim > /dev/null
 	$(VENV)/bin/bidmp job --out .readme-out/job > /dev/null
 	$(VENV)/bin/bidmp job --scenario cell-removal --no-pictures --out .readme-out/cells > /dev/null
@@ -170,7 +177,7 @@ readme: $(STAMP)
 	$(VENV)/bin/bidmp job --scenario nut-unscrewing-ur5 --no-pictures --out .readme-out/ur5 > /dev/null
 	$(PY) tools/user_cells.py --out .readme-out/user_cells.md > /dev/null
 	$(PY) tools/repair_order.py --out .readme-out/repair_order.md > /dev/null
-	cp .readme-out/table4.md .readme-out/tasks.md .readme-out/table5.md .readme-out/figures.md .readme-out/sim/sim.md .readme-out/sim/sim_results.json docs/results/
+	cp .readme-out/table4/table4.md .readme-out/table4/tasks.md .readme-out/table5/table5.md .readme-out/figures/figures.md .readme-out/sim/sim.md .readme-out/sim/sim_results.json docs/results/
 	cp .readme-out/job/job.md .readme-out/job/job_results.json docs/results/
 	cp .readme-out/cells/job.md docs/results/job_cells.md
 	cp .readme-out/cells/job_results.json docs/results/job_cells_results.json
@@ -189,8 +196,12 @@ readme: $(STAMP)
 # cells on a 2-process Dask cluster: docs/results/clfd*.json, .md and their figures.
 CLFD_METHODS = dmp-library,finetune,bidmp-library,promp-library,bidmp-continual
 clfd: $(STAMP)
-	$(VENV)/bin/bidmp benchmark clfd --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out docs/results
-	$(VENV)/bin/bidmp benchmark clfd --dataset robottasks --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out docs/results
+	rm -rf .clfd-out
+	$(VENV)/bin/bidmp benchmark clfd --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out .clfd-out/lasa
+	$(VENV)/bin/bidmp benchmark clfd --dataset robottasks --methods $(CLFD_METHODS) --seeds 3 --workers 2 --out .clfd-out/robottasks
+	cp .clfd-out/lasa/clfd.json .clfd-out/lasa/clfd.md .clfd-out/lasa/clfd_accuracy.png .clfd-out/lasa/clfd_dtw.png docs/results/
+	cp .clfd-out/robottasks/clfd_robottasks.json .clfd-out/robottasks/clfd_robottasks.md .clfd-out/robottasks/clfd_robottasks_accuracy.png .clfd-out/robottasks/clfd_robottasks_dtw.png docs/results/
+	rm -rf .clfd-out
 
 # The libfranka side environment: franka-sim (an FCI server simulating an FR3 in MuJoCo, motion
 # limits enforced) and pylibfranka (the Franka client) at their pins in their own venv (they need
@@ -236,5 +247,5 @@ bench-prodmp: $(MPT_STAMP)
 	$(MPT_VENV)/bin/python benchmarks/bench_prodmp.py
 
 clean:
-	rm -rf $(VENV) $(FRANKA_VENV) $(MPT_VENV) site bidmp-out bidmp-sim bidmp-lasa .pytest_cache fuzz-report.json .view-check build
+	rm -rf $(VENV) $(FRANKA_VENV) $(MPT_VENV) site bidmp-out bidmp-sim bidmp-sim-closed-loop-hold bidmp-lasa .pytest_cache fuzz-report.json .view-check build
 	rm -f src/bidmp/_kernels.c src/bidmp/_kernels.*.so

@@ -8,6 +8,7 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 from surface_sweep import (
     DEMO,
     PERIODIC,
@@ -22,6 +23,58 @@ from surface_sweep import (
 )
 
 import bidmp
+
+
+class _Wall:
+    """A free space for the route planner: the unit square with a wall across its middle (a
+    point body, the slack its distance to the wall's box)."""
+
+    lower, upper, tolerance = np.zeros(2), np.ones(2), 1e-3
+
+    def slack(self, q) -> float:
+        q = np.asarray(q, dtype=float)
+        gap = np.maximum(np.maximum([0.45, 0.0] - q, q - [0.55, 0.7]), 0.0)
+        return float(np.linalg.norm(gap)) - 0.01
+
+    def sweep(self, a, b) -> float:
+        return float(np.linalg.norm(np.asarray(b, float) - np.asarray(a, float)))
+
+
+def _route_overrides() -> dict:
+    """Valid arguments of the route planner's entry points (bidmp.planning, the arm's routes)."""
+    from bidmp.sim import KinematicCell
+    from bidmp.sim.robots import PANDA_MODEL
+
+    scenario = bidmp.tasks.load("nut-unscrewing")
+    cell = KinematicCell(scenario.scene)
+    plan = cell.plan(DEMO / 4.0 + [0.0, 0.0, 40.0])
+    return {
+        "bidmp.planning.plan_route": {"space": _Wall(), "start": [0.2, 0.2], "goals": [0.8, 0.2]},
+        "bidmp.planning.segment_free": {"space": _Wall(), "a": [0.2, 0.2], "b": [0.3, 0.8]},
+        "bidmp.planning.time_path": {
+            "waypoints": DEMO[::10] / 100.0,
+            "velocity": [2.0, 2.0, 2.0],
+            "acceleration": [10.0, 10.0, 10.0],
+            "jerk": [5000.0, 5000.0, 5000.0],
+        },
+        "bidmp.planning.tool_route": {
+            "scene": scenario.scene,
+            "start": [-80.0, -120.0, 200.0],
+            "goal": scenario.targets["12"],
+            "approach_height": 28.5,
+            "exclude": scenario.scene.target_parts("12", scenario.targets["12"]),
+        },
+        "bidmp.scene.PoseChecker": {"scene": scenario.scene, "chosen": np.arange(3), "margin": 1.0},
+        "bidmp.sim.ArmGeometry": {
+            "robot": PANDA_MODEL,
+            "tool_radius": 0.0125,
+            "tool_length": 0.1,
+            "base": [0.0, -0.45, 0.0],
+            "yaw": 90.0,
+        },
+        "bidmp.sim.supports_routes": {"cell": cell},
+        "bidmp.sim.needlessly_slow": {"cell": cell, "plan": plan},
+    }
 
 
 def _package_overrides(tmp: Path) -> dict:
@@ -42,6 +95,11 @@ def _package_overrides(tmp: Path) -> dict:
     from bidmp.io import write_bag
 
     bag = write_bag(tmp / "poses_bag", TIMES, DEMO / 1000.0, kind="pose")
+    from bidmp.io import run_folder
+
+    run = tmp / "run"  # a run folder of one file
+    with run_folder(run, "bidmp surface") as writing:
+        (writing.path / "view.html").write_text("<p>run</p>")
     readers = {
         f"bidmp.io.{name}": {"path": csv}
         for name in (
@@ -68,6 +126,7 @@ def _package_overrides(tmp: Path) -> dict:
     pose_stepper = bidmp.CartesianDMP(bidmp.DMP(n_kernels=10)).fit(POSES, TIMES).stepper()
     return {
         **readers,
+        **_route_overrides(),
         "bidmp.io.read_poses": {"path": poses},
         "bidmp.load": {"path": model},
         "bidmp.Scene": {"tool": Tool(5.0, 50.0)},
@@ -237,6 +296,18 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.io.read_bag": {"path": bag},
         "bidmp.io.is_bag": {"path": bag},
         "bidmp.io.atomic_write": {"path": tmp / "a.bin"},
+        "bidmp.io.run_folder": {"out": tmp / "run2", "command": "bidmp surface"},
+        "bidmp.io.RunFolder": {
+            "out": tmp / "run2",
+            "final": tmp / "run2",
+            "path": tmp / ".run2.new",
+            "command": "bidmp surface",
+            "earlier": None,
+        },
+        "bidmp.io.RunManifest": {"run": "0" * 32, "command": "bidmp surface", "bidmp": "0.6.0"},
+        "bidmp.io.check_run_files": {"paths": [run / "view.html", csv]},
+        "bidmp.io.read_manifest": {"folder": run},
+        "bidmp.io.update_manifest": {"folder": run, "name": "view.html"},
         "bidmp.io.load_json": {"data": '{"a": 1}'},
         "bidmp.primitives.as_poses": {"poses": POSES},
         **{
@@ -513,6 +584,34 @@ def _plain_instances(tmp: Path):
         },
     )
     yield "SceneChecker", scene.checker(), {"a": DEMO[:-1], "b": DEMO[1:]}
+    yield (
+        "PoseChecker",
+        scene.pose_checker(margin=2.0),
+        {"point": DEMO[5], "rotation": Rotation.from_euler("x", 170, degrees=True).as_matrix()},
+    )
+    from bidmp.sim import ArmGeometry
+    from bidmp.sim.robots import PANDA_MODEL
+
+    arm = ArmGeometry(PANDA_MODEL, 0.0125, 0.1, [0.0, -0.45, 0.0], 90.0)
+    rest = np.array(PANDA_MODEL.rest)
+    yield (
+        "ArmGeometry",
+        arm,
+        {
+            "q": rest,
+            "point": [0.0, 0.0, 0.3],
+            "frame": [1.0, 0.0, 0.0, 0.0],
+            "seed": rest,
+            "scene": scenario.scene,
+            "unit": 1e-3,
+            "margin": 0.003,
+        },
+    )
+    yield (
+        "ArmSpace",
+        arm.space(scenario.scene, 1e-3, margin=0.003),
+        {"q": rest, "a": rest, "b": rest + 0.1},
+    )
     yield "Proximity", Proximity(scene), {"point": DEMO[5], "within": 20.0}
     yield "Solid", scene.solids[0], {"centre": np.zeros(3), "rotation": np.eye(3)}
     yield (
@@ -799,6 +898,7 @@ def targets(tmp: Path):
     yield from _wrong_objects(tmp)
     yield from _hostile_urdfs(tmp)
     yield from _damaged_data(tmp)
+    yield from odd_inputs(tmp)
     for owner, instance, special in _instances(tmp):
         for name, member in inspect.getmembers(type(instance)):
             label = f"{owner}.{name}"
@@ -1002,3 +1102,317 @@ def _damaged_data(tmp: Path):
     )
     damaged = damaged_copies(clfd_data.DATA, folder, damages)
     yield "clfd_tasks(damaged copies)", both, {"folder": intact, "nasty:folder": damaged}
+
+
+# -- the "nothing silently wrong" campaign's input families ------------------------------------------
+# Each reader below is wrapped with what every file of its family must give: read to the numbers
+# written, or refused saying why. A file read wrong, read where it must be refused, or refused
+# where it reads raises AssertionError: the sweep's internal error, a defect.
+
+
+def _key(value):
+    """An odd input as the expectations name it: a path's text, a list of names as a tuple."""
+    if isinstance(value, (str, Path)):
+        return str(value)
+    if isinstance(value, (list, tuple)) and all(isinstance(item, str) for item in value):
+        return tuple(value)
+    return None
+
+
+def _judged(function, argument: str, expected: dict, fixed: dict | None = None):
+    """``function`` of ``argument`` alone (``fixed`` besides): for an input ``expected`` names,
+    ("reads", check) or ("refused", words the refusal holds) is enforced (module comment)."""
+    fixed = fixed or {}
+
+    def call(**given):
+        want = expected.get(_key(given[argument]))
+        try:
+            result = function(**fixed, **given)
+        except (ValueError, TypeError) as exc:
+            if want is not None and want[0] == "reads":
+                raise AssertionError(f"refused an input that reads: {exc}") from None
+            if want is not None and want[1] not in str(exc):
+                raise AssertionError(f"refused without saying {want[1]!r}: {exc}") from None
+            raise
+        if want is not None:
+            assert want[0] == "reads", f"{_key(given[argument])}: read, but it must be refused"
+            want[1](result)
+        return result
+
+    call.__signature__ = inspect.Signature(
+        [inspect.Parameter(argument, inspect.Parameter.KEYWORD_ONLY)]
+    )
+    return call
+
+
+def _reads(values, names=None, repeated=()):
+    """The check of a recording that must read: these numbers (and names, dropped stamps)."""
+
+    def check(recording):
+        np.testing.assert_array_equal(recording.values, values)
+        assert names is None or list(recording.names) == list(names), recording.names
+        assert tuple(recording.repeated) == tuple(repeated), recording.repeated
+
+    return check
+
+
+_STAMP0 = 1_700_000_000_000_000_000
+
+
+def _joint_bag(path: Path, ros: int, storage: str, messages) -> Path:
+    """A ``/joint_states`` bag written by rosbags: (stamp ns, names, positions) per message."""
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
+    if ros == 1:
+        from rosbags.rosbag1 import Writer
+
+        writer, serialize = Writer(path), store.serialize_ros1
+    else:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+        writer, serialize = Writer(path, version=9, storage_plugin=plugin), store.serialize_cdr
+    types = store.types
+    with writer:
+        connection = writer.add_connection(
+            "/joint_states", "sensor_msgs/msg/JointState", typestore=store
+        )
+        for ns, names, positions in messages:
+            header = types["std_msgs/msg/Header"](
+                **({"seq": 0} if ros == 1 else {}),
+                stamp=types["builtin_interfaces/msg/Time"](
+                    sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
+                ),
+                frame_id="",
+            )
+            message = types["sensor_msgs/msg/JointState"](
+                header=header,
+                name=list(names),
+                position=np.asarray(positions, dtype=float),
+                velocity=np.zeros(0),
+                effort=np.zeros(0),
+            )
+            writer.write(connection, ns, serialize(message, connection.msgtype))
+    return path
+
+
+def odd_bags(folder: Path) -> tuple[list, dict]:
+    """(label, path) of joint-state bags as drivers and loggers get them wrong or odd, in ROS 1,
+    ROS 2 MCAP and ROS 2 SQLite, and what ``read_bag(path, joints=True)`` must give for each."""
+    folder.mkdir(parents=True, exist_ok=True)
+    names = ["j0", "j1", "j2"]
+    q = np.column_stack([np.linspace(0.0, 0.4, 12) * k for k in (1.0, -2.0, 3.0)]) + 0.1
+    stamps = [_STAMP0 + 4_000_000 * k for k in range(12)]
+    rng = np.random.default_rng(5)
+    shuffled = [np.arange(3)] + [rng.permutation(3) for _ in range(11)]
+
+    def plain(change=None):
+        rows = [[ns, list(names), row.copy()] for ns, row in zip(stamps, q)]
+        if change is not None:
+            change(rows)
+        return rows
+
+    def at(index, names_there=None, positions=None):
+        def change(rows):
+            if names_there is not None:
+                rows[index][1] = names_there
+            if positions is not None:
+                rows[index][2] = np.asarray(positions, dtype=float)
+
+        return change
+
+    tiny = np.arange(1.0, 13.0)[:, None] * np.array([1e-300, 2e-300, 5e-324])
+    cases = {
+        "joint order changing": (
+            [
+                (ns, [names[k] for k in order], row[order])
+                for ns, row, order in zip(stamps, q, shuffled)
+            ],
+            ("reads", _reads(q, names)),
+        ),
+        "tiny positions (1e-300)": (
+            [(ns, names, row) for ns, row in zip(stamps, tiny)],
+            ("reads", _reads(tiny, names)),
+        ),
+        "short positions": (plain(at(6, positions=[0.1, 0.2])), ("refused", "2 positions")),
+        "more positions than names": (
+            plain(at(3, positions=[0.1, 0.2, 0.3, 0.4])),
+            ("refused", "4 positions"),
+        ),
+        "NaN position": (plain(at(8, positions=[0.1, np.nan, 0.3])), ("refused", "NaN in j1")),
+        "inf position": (plain(at(2, positions=[np.inf, 0.2, 0.3])), ("refused", "inf in j0")),
+        "a joint named twice": (
+            plain(at(5, names_there=["j0", "j1", "j0"])),
+            ("refused", "twice"),
+        ),
+        "a joint missing later": (
+            plain(at(9, names_there=["j0", "j1", "j9"])),
+            ("refused", "no joint(s) j2"),
+        ),
+    }
+    out, expected = [], {}
+    for ros, storage, suffix in ((1, "", ".bag"), (2, "mcap", ""), (2, "sqlite3", "")):
+        kind = "ROS 1" if ros == 1 else f"ROS 2 {storage}"
+        for label, (messages, want) in cases.items():
+            path = folder / f"{len(out)}{suffix}"
+            if not path.exists():
+                _joint_bag(path, ros, storage, messages)
+            out.append((f"bag ({kind}): {label}", path))
+            expected[str(path)] = want
+    return out, expected
+
+
+def _csv(path: Path, header: str, rows, first_lines=()) -> Path:
+    path.write_text(
+        "".join(f"{line}\n" for line in first_lines)
+        + header
+        + "\n"
+        + "".join(",".join(repr(float(v)) for v in row) + "\n" for row in rows)
+    )
+    return path
+
+
+def odd_recordings(folder: Path) -> tuple[list, dict]:
+    """(label, path) of CSVs with a unit line, a name twice, gaps, tiny numbers or a repeated
+    stamp, and what ``read_recording(path)`` must give for each."""
+    folder.mkdir(parents=True, exist_ok=True)
+    t = np.arange(30) * 0.01
+    q = np.column_stack([np.linspace(0.0, 0.3, 30) * k for k in (1.0, -1.0)]) + 0.2
+    joints = np.column_stack([t, q])
+    tiny = np.column_stack([t, np.arange(1.0, 31.0)[:, None] * np.array([1e-300, 3e-300])])
+    xyz = np.column_stack([t, q, q[:, 0] * 2.0])
+    repeated = joints.copy()
+    repeated[11, 0] = repeated[10, 0]
+    gap = joints.copy()
+    gap[7, 2] = np.nan
+    cases = {
+        "joints declared in m": ("t,j1,j2", joints, ["# units: m"], ("refused", "a length")),
+        "joints declared in mm": ("t,j1,j2", joints, ["# units: mm"], ("refused", "a length")),
+        "an unknown unit": ("t,j1,j2", joints, ["# units: furlong"], ("refused", "must be one of")),
+        "joints declared in rad": ("t,j1,j2", joints, ["# units: rad"], ("reads", _reads(q))),
+        "a joint named twice": ("t,j1,j1", joints, [], ("refused", "2 times")),
+        "x named twice": ("t,x,y,x", xyz, [], ("refused", "2 times")),
+        "x beside X(mm)": ("t,x,y,X(mm)", xyz, [], ("refused", "2 times")),
+        "a NaN joint": ("t,j1,j2", gap, [], ("refused", "NaN")),
+        "tiny joints (1e-300)": ("t,j1,j2", tiny, [], ("reads", _reads(tiny[:, 1:]))),
+        "tiny positions (1e-300)": ("t,x,y", tiny, [], ("refused", "barely moves")),
+        "still joints": (
+            "t,j1,j2",
+            np.column_stack([t, np.full((30, 2), 0.5)]),
+            [],
+            ("reads", _reads(np.full((30, 2), 0.5))),
+        ),
+        "a repeated stamp": (
+            "t,j1,j2",
+            repeated,
+            [],
+            ("reads", _reads(np.delete(q, 11, axis=0), repeated=((12, float(t[10])),))),
+        ),
+    }
+    out, expected = [], {}
+    for label, (header, rows, first, want) in cases.items():
+        path = _csv(folder / f"{len(out)}.csv", header, rows, first)
+        out.append((f"CSV: {label}", path))
+        expected[str(path)] = want
+    return out, expected
+
+
+def odd_command_files(folder: Path) -> tuple[list, dict]:
+    """(label, path) of 1 kHz FR3 joint-command files, and what ``bidmp verify`` must say."""
+    folder.mkdir(parents=True, exist_ok=True)
+    names = [f"fr3_joint{i}" for i in range(1, 8)]
+    q = _fr3_stream()
+    t = np.arange(len(q)) * 1e-3
+    header = "t," + ",".join(names)
+    repeated, gap = t.copy(), t.copy()
+    repeated[100] = repeated[99]
+    gap[120:] += 1e-3
+    tiny = q[0] + np.arange(len(q))[:, None] * 1e-300  # (q[0] + 1e-300 is q[0]: a still stream)
+    cases = {
+        "declared in m": (header, t, q, ["# units: m"], ("refused", "a length")),
+        "an unknown unit": (header, t, q, ["# units: furlong"], ("refused", "must be one of")),
+        "a joint named twice": (
+            header + ",fr3_joint1",
+            t,
+            np.column_stack([q, q[:, 0]]),
+            [],
+            ("refused", "2 times"),
+        ),
+        "still": (header, t, np.tile(q[0], (len(q), 1)), [], ("reads", "accepted")),
+        "tiny steps (1e-300)": (header, t, tiny, [], ("reads", "accepted")),
+        "a repeated stamp": (header, repeated, q, [], ("refused", "data row 101 repeats")),
+        "a 2 ms gap": (header, gap, q, [], ("refused", "data rows 120 and 121 are 2 ms apart")),
+    }
+    out, expected = [], {}
+    for label, (head, times, values, first, want) in cases.items():
+        path = _csv(folder / f"{len(out)}.csv", head, np.column_stack([times, values]), first)
+        out.append((f"commands: {label}", path))
+        expected[str(path)] = want if want[0] == "refused" else ("reads", lambda code: None)
+    return out, expected
+
+
+def _verify(motion):
+    """``bidmp verify MOTION --robot fr3`` as a call: exit 2's line raised as the ValueError it
+    reports, any other exit returned (0 accepted, 3 rejected by the FCI's limits)."""
+    import contextlib
+    import io
+
+    from bidmp.cli import main
+
+    if not isinstance(motion, (str, Path)):  # a command line holds text: nothing else reaches it
+        raise TypeError(f"motion must be a file name, got {type(motion).__name__}")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            code = main(["verify", str(motion), "--robot", "fr3"])
+        except SystemExit as exc:  # argparse's usage error (a name that reads as an option)
+            code = exc.code
+    lines = err.getvalue().strip().splitlines()[-1:] if code == 2 else []
+    if code == 2:
+        raise ValueError(lines[0] if lines else "verify: exit 2 without a line")
+    assert code == 0 or code == 3, code
+    return code
+
+
+def odd_inputs(tmp: Path):
+    """The input families that found the campaign's defects (odd bags, names twice, unit lines,
+    tiny positive floats, repeated stamps), each reader judged on what each file must give."""
+    from bidmp.io import read_bag, read_recording
+    from bidmp.sim import match_joint_names
+
+    # short folders and names: a refusal quotes the path, and the sweep's one line is 300 characters
+    bags, bag_expected = odd_bags(tmp / "ob")
+    yield (
+        "read_bag(odd joint bags)",
+        _judged(read_bag, "path", bag_expected, {"joints": True}),
+        {"path": bags[0][1], "nasty:path": bags},
+    )
+    recordings, recording_expected = odd_recordings(tmp / "or")
+    yield (
+        "read_recording(odd CSVs)",
+        _judged(read_recording, "path", recording_expected),
+        {"path": recordings[3][1], "nasty:path": recordings},
+    )
+    commands, command_expected = odd_command_files(tmp / "oc")
+    expected = {str(path): want for path, want in command_expected.items()}
+    yield (
+        "bidmp verify(odd command files)",
+        _judged(_verify, "motion", expected),
+        {"motion": commands[3][1], "nasty:motion": commands},
+    )
+    names = [f"fr3_joint{i}" for i in range(1, 8)]
+    twice = [
+        ("a name twice", [*names, "fr3_joint3"]),
+        ("one name for another", [*names[:6], "fr3_joint1"]),
+    ]
+    yield (
+        "match_joint_names(names twice)",
+        _judged(
+            match_joint_names,
+            "names",
+            {tuple(value): ("refused", "named 2 times") for _, value in twice},
+            {"robot": "fr3"},
+        ),
+        {"names": names, "nasty:names": twice},
+    )

@@ -89,6 +89,7 @@ LAYERS = {
     "incremental": 1,
     "baselines": 1,
     "scene": 1,
+    "planning": 1,
     "demonstrations": 2,
     "io": 2,
     "tasks": 2,

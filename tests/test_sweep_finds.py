@@ -60,6 +60,22 @@ CASES = [
         "reproduced",
         lambda: demonstration_errors(np.full((2, 5, 2), np.nan), np.zeros((2, 5, 2)), ["dtw"]),
     ),
+    # the "all 1e-300" family (2026-12-07): a stamp of 1e-300 s printed in 300 digits, an
+    # observation too small to see a singular solve in NumPy's words, a zero quaternion's NaN
+    ("t", lambda: bidmp.primitives.check_timestamps(np.full(60, 1e-300), 60)),
+    ("t", lambda: bidmp.primitives.uniform_time(np.eye(3), np.full(3, 1e-300))),
+    (
+        "H",
+        lambda: bidmp.primitives.condition_gaussian(
+            np.zeros(3), np.eye(3), np.full((3, 1), 1e-300), np.ones(1), np.zeros((1, 1))
+        ),
+    ),
+    (
+        "true",
+        lambda: bidmp.experiments.orientation_error(
+            np.zeros((5, 4)), np.tile([1.0, 0, 0, 0], (5, 1))
+        ),
+    ),
 ]
 
 
@@ -167,3 +183,19 @@ def test_a_phase_grid_of_a_5e_minus_324_tau_is_one_then_zero():
         np.testing.assert_array_equal(phase_grid(4, 0.01, 5e-324, exact=True), [1.0, 0, 0, 0])
         gate = DelayedGoal(2.0).on_grid(np.linspace(1.0, 0.1, 5), 0.01, 5e-324, True)
     assert np.all(np.isfinite(gate))
+
+
+def test_quaternions_of_1e300_are_rotations_like_any_other():
+    """orientation_error of quaternion rows of 1e-300 (their norm underflowed to 0: a NaN with a
+    warning) is the angle SciPy gives the same rotations."""
+    from scipy.spatial.transform import Rotation
+
+    true = np.full((4, 4), 1e-300) * np.array([1.0, 2.0, -1.0, 0.5])  # w, x, y, z
+    predicted = Rotation.random(4, random_state=3).as_quat()[:, [3, 0, 1, 2]]
+    angles = (
+        Rotation.from_quat(true[:, [1, 2, 3, 0]] * 1e300)
+        * Rotation.from_quat(predicted[:, [1, 2, 3, 0]]).inv()
+    ).magnitude()
+    assert bidmp.experiments.orientation_error(true, predicted) == pytest.approx(
+        float(np.mean(angles)), rel=1e-12
+    )

@@ -29,6 +29,7 @@ PACKAGES = (
     "bidmp.incremental",
     "bidmp.baselines",
     "bidmp.scene",
+    "bidmp.planning",
     "bidmp.io",
     "bidmp.tasks",
     "bidmp.tasks.methods",

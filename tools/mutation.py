@@ -242,7 +242,14 @@ TARGETS = (
     Target(
         "verdict assembly: what the simulator runs",
         "bidmp.sim.run",
-        ("_refusal", "_executable", "execution_settings", "_run_one"),
+        (
+            "_refusal",
+            "_executable",
+            "execution_settings",
+            "_run_one",
+            "_touch_reason",
+            "_arm_routed",
+        ),
         (
             "tests/sim/test_refusals.py",
             "tests/sim/test_arm_touch.py",
@@ -266,7 +273,7 @@ TARGETS = (
     Target(
         "job: plans refused before they run",
         "bidmp.sim.job_world",
-        ("_refused_plan", "_move"),
+        ("_refused_plan", "_move", "_judged_by", "_routed"),
         (
             "tests/sim/test_refusals.py",
             "tests/sim/test_arm_touch.py",
@@ -568,7 +575,7 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     ),
     (
         "verdict assembly: what the simulator runs",
-        "_run_one",
+        "_touch_reason",
         "touched = None if touch is None else touch(plan, job.exclude)",
         "touched = None",
         "a check dropped: the arm's links not checked before the motion is sent",
@@ -582,8 +589,8 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     ),
     (
         "job: plans refused before they run",
-        "_move",
-        'contract = world.contract if name == "approach" else _transfer_contract(world.contract)',
+        "_judged_by",
+        'contract = world.contract if move.name == "approach" else _transfer_contract(world.contract)',
         "contract = _transfer_contract(world.contract)",
         "the approach judged without its engagement",
     ),
@@ -716,8 +723,8 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     "orientations): [:, :4] of three columns is [:, :3]",
     (
         "bidmp.sim.job_world",
-        "_move",
-        "goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]",
+        "_judged_by",
+        "return (contract, np.asarray(goal, dtype=float)[:3])",
         "3 -> 4",
     ): "the goal goes only to Contract.judge, which keeps as many of its values as the path has "
     "positions (three): a pose target's fourth value is dropped there (a pose job's test runs it)",
@@ -739,8 +746,8 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
     "when the verdict holds and no peak is over",
     (
         "bidmp.sim.job_world",
-        "_move",
-        "goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]",
+        "_judged_by",
+        "goal = np.asarray(move.path, dtype=float)[-1] if move.target is None else move.target",
         "drop -",
     ): "a move without a target is a two-point line (its second point is its end) or the rock, "
     "which ends where it starts and whose first step moves micrometres",

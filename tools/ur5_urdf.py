@@ -37,13 +37,17 @@ RANGE = 2.0 * math.pi  # rad, every joint both ways
 OUT = Path(__file__).resolve().parents[1] / "src" / "bidmp" / "data" / "robots" / "ur5_dh.urdf"
 
 
-def _segment(d: float, a: float, radius: float, mass: float) -> str:
-    """A link's cylinder from its origin to the next joint's, (a, 0, d), with an inertial."""
-    length = math.hypot(a, d)
-    pitch = math.atan2(a, d)  # turns the cylinder's z onto (a, 0, d)
-    centre = f"{a / 2:.6f} 0 {d / 2:.6f}"
+def _segment(tail: tuple, radius: float, mass: float) -> str:
+    """A link's cylinder from its origin to the next joint's, ``tail`` = (x, y, z), with an inertial."""
+    x, y, z = tail
+    length = math.sqrt(x * x + y * y + z * z)
+    if y == 0.0:  # in the link's xz plane: a pitch alone turns the cylinder's z onto it
+        centre, turn = f"{x / 2:.6f} 0 {z / 2:.6f}", f"0 {math.atan2(x, z):.6f} 0"
+    else:
+        centre = f"{x / 2:.6f} {y / 2:.6f} {z / 2:.6f}"
+        turn = f"0 {math.atan2(math.hypot(x, y), z):.6f} {math.atan2(y, x):.6f}"
     shape = (
-        f'<origin xyz="{centre}" rpy="0 {pitch:.6f} 0"/><geometry><cylinder radius="{radius}" '
+        f'<origin xyz="{centre}" rpy="{turn}"/><geometry><cylinder radius="{radius}" '
         f'length="{max(length, 0.02):.6f}"/></geometry>'
     )
     inertia = mass * radius**2 / 2.0
@@ -85,7 +89,30 @@ UR5 = {
     "ranges": (RANGE,) * 6,
     "speeds": (SPEED,) * 6,
 }
-ARMS = {"ur5": UR5, "tm5-like": TM5_LIKE}
+# A user's industrial arm with an offset wrist and an elbow offset, as its maker publishes it: ABB's
+# IRB 1200-7/0.7 (product specification 3HAC046982; the classic DH table of ARTE's model of it:
+# d1 399 mm, a2 350 mm, a3 42 mm, d4 351 mm, d6 82 mm; theta offsets -90 deg on axis 2 and 180 deg
+# on axis 6), its axis ranges (+-170, -100/+135, -200/+70, +-270, +-130, +-400 deg) and speeds
+# (288, 240, 297, 400, 405, 600 deg/s); masses and radii to a few kilograms and millimetres.
+IRB1200 = {
+    "name": "irb1200",
+    "dh": (
+        (0.399, 0.0, -math.pi / 2),
+        (0.0, 0.35, 0.0),
+        (0.0, 0.042, -math.pi / 2),
+        (0.351, 0.0, math.pi / 2),
+        (0.0, 0.0, -math.pi / 2),
+        (0.082, 0.0, 0.0),
+    ),
+    "offsets": (0.0, -math.pi / 2, 0.0, 0.0, 0.0, math.pi),
+    "masses": (12.0, 10.0, 6.0, 3.0, 1.5, 0.5),
+    "radii": (0.07, 0.06, 0.055, 0.045, 0.04, 0.032),
+    "effort": (150.0, 150.0, 100.0, 40.0, 40.0, 30.0),
+    "lower": tuple(math.radians(v) for v in (-170, -100, -200, -270, -130, -400)),
+    "upper": tuple(math.radians(v) for v in (170, 135, 70, 270, 130, 400)),
+    "speeds": tuple(math.radians(v) for v in (288, 240, 297, 400, 405, 600)),
+}
+ARMS = {"ur5": UR5, "tm5-like": TM5_LIKE, "irb1200": IRB1200}
 
 
 def urdf(arm: dict = UR5) -> str:
@@ -107,18 +134,43 @@ def urdf(arm: dict = UR5) -> str:
         "  </link>",
     ]
     parent, origin = "base_link", ("0 0 0", "0 0 0")
-    for index, ((d, a, alpha), mass, radius, effort, reach, speed) in enumerate(
-        zip(arm["dh"], arm["masses"], arm["radii"], arm["effort"], arm["ranges"], arm["speeds"]),
+    n = len(arm["dh"])
+    offsets = arm.get("offsets", (0.0,) * n)
+    lower = arm.get("lower", tuple(-r for r in arm.get("ranges", ())))
+    upper = arm.get("upper", arm.get("ranges"))
+    for index, ((d, a, alpha), offset, mass, radius, effort, low, high, speed) in enumerate(
+        zip(
+            arm["dh"],
+            offsets,
+            arm["masses"],
+            arm["radii"],
+            arm["effort"],
+            lower,
+            upper,
+            arm["speeds"],
+        ),
         start=1,
     ):
         name = f"link{index}"
         lines.append(
             f'  <joint name="joint{index}" type="revolute"><parent link="{parent}"/><child link="{name}"/>'
             f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/><axis xyz="0 0 1"/>'
-            f'<limit lower="{-reach:.6f}" upper="{reach:.6f}" velocity="{speed:.6f}" effort="{effort}"/></joint>'
+            f'<limit lower="{low:.6f}" upper="{high:.6f}" velocity="{speed:.6f}" effort="{effort}"/></joint>'
         )
-        lines.append(f'  <link name="{name}">\n{_segment(d, a, radius, mass)}  </link>')
-        parent, origin = name, (f"{a} 0 {d}", f"{alpha:.10f} 0 0")
+        # A theta offset turns the link's own frame about the joint's axis: Rz(q + offset) =
+        # Rz(q) Rz(offset), so the next joint's origin is the DH tail turned by it.
+        if offset == 0.0:
+            tail = (a, 0.0, d)
+            origin = (f"{a} 0 {d}", f"{alpha:.10f} 0 0")
+        else:
+            # (the products' rounding dust below a picometre written as 0)
+            tail = tuple(
+                0.0 if abs(v) < 1e-12 else v + 0.0
+                for v in (a * math.cos(offset), a * math.sin(offset), d)
+            )
+            origin = (f"{tail[0]:.10g} {tail[1]:.10g} {d}", f"{alpha:.10f} 0 {offset:.10f}")
+        lines.append(f'  <link name="{name}">\n{_segment(tail, radius, mass)}  </link>')
+        parent = name
     lines.append(
         f'  <joint name="flange_joint" type="fixed"><parent link="{parent}"/><child link="flange"/>'
         f'<origin xyz="{origin[0]}" rpy="{origin[1]}"/></joint>'

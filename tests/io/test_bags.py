@@ -35,8 +35,9 @@ def _stamps(rng):
     return START_NS + np.concatenate([[0], np.cumsum(steps)])
 
 
-def _write(path: Path, ros: int, topics: list, store=None):
-    """``topics``: [(topic, msgtype, [(stamp ns, message), ...])] into a ROS 1 file or ROS 2 MCAP folder."""
+def _write(path: Path, ros: int, topics: list, store=None, storage: str = "mcap"):
+    """``topics``: [(topic, msgtype, [(stamp ns, message), ...])] into a ROS 1 file or ROS 2
+    folder (``storage``: "mcap" or "sqlite3")."""
     store = store or get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
     if ros == 1:
         from rosbags.rosbag1 import Writer
@@ -45,8 +46,9 @@ def _write(path: Path, ros: int, topics: list, store=None):
     else:
         from rosbags.rosbag2 import StoragePlugin, Writer
 
+        plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
         writer, serialize = (
-            Writer(path, version=9, storage_plugin=StoragePlugin.MCAP),
+            Writer(path, version=9, storage_plugin=plugin),
             store.serialize_cdr,
         )
     with writer:
@@ -633,3 +635,102 @@ def test_the_scenarios_robot_where_it_stands_gives_the_same_joint_trajectory(tmp
         points.append(np.array([point.positions for point in message.points]))
     assert points[0].shape[1] == 7
     np.testing.assert_allclose(points[0], points[1], atol=1e-12)
+
+
+# -- joint states as drivers publish them -----------------------------------------------------------
+BAG_KINDS = (("ros1", 1, "mcap"), ("mcap", 2, "mcap"), ("sqlite3", 2, "sqlite3"))
+
+
+def joint_state_bag(path: Path, ros: int, storage: str, messages) -> Path:
+    """A bag with one ``sensor_msgs/JointState`` topic, ``/joint_states``: ``messages`` are
+    (stamp ns, names, positions) each, written as given (no check of their lengths)."""
+    store = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
+    types = store.types
+    written = [
+        (
+            ns,
+            types["sensor_msgs/msg/JointState"](
+                header=_header(types, int(ns), "", ros),
+                name=list(names),
+                position=np.asarray(positions, dtype=float),
+                velocity=np.zeros(0),
+                effort=np.zeros(0),
+            ),
+        )
+        for ns, names, positions in messages
+    ]
+    _write(path, ros, [("/joint_states", "sensor_msgs/msg/JointState", written)], store, storage)
+    return path
+
+
+def _bag_path(tmp_path, label, ros):
+    return tmp_path / (f"{label}.bag" if ros == 1 else label)
+
+
+@pytest.mark.parametrize(("label", "ros", "storage"), BAG_KINDS)
+def test_joint_states_in_another_order_per_message_keep_each_joint_its_column(
+    tmp_path, capsys, label, ros, storage
+):
+    """A driver that lists its joints in another order from one message to the next: each
+    column still holds its own joint's positions (read by name in every message), in ROS 1, ROS 2
+    MCAP and ROS 2 SQLite bags; ``bidmp fit BAG --joints`` learns the joints' own goals."""
+    from bidmp.io import read_bag
+
+    rng = np.random.default_rng(7)
+    names = ["j0", "j1", "j2"]
+    s = np.linspace(0.0, 1.0, N)[:, None]
+    q = np.array([0.1, -0.4, 0.9]) + (10 * s**3 - 15 * s**4 + 6 * s**5) * np.array([0.5, -0.3, 0.8])
+    stamps = _stamps(rng)
+    orders = [np.arange(3)] + [rng.permutation(3) for _ in range(N - 1)]
+    assert sum(not np.array_equal(order, np.arange(3)) for order in orders) > N // 2
+    messages = [
+        (ns, [names[k] for k in order], row[order]) for ns, row, order in zip(stamps, q, orders)
+    ]
+    bag = joint_state_bag(_bag_path(tmp_path, label, ros), ros, storage, messages)
+    recording = read_bag(bag, joints=True)
+    assert recording.names == names and recording.kind == "joints"
+    np.testing.assert_array_equal(recording.values, q)
+    # a chosen order: the columns in it
+    chosen = read_bag(bag, joints=["j2", "j0"])
+    np.testing.assert_array_equal(chosen.values, q[:, [2, 0]])
+    model = _fit(tmp_path, bag, "--joints")
+    assert model.names_ == names
+    np.testing.assert_allclose(model.goal_, q[-1], atol=1e-3)
+
+
+@pytest.mark.parametrize(("label", "ros", "storage"), BAG_KINDS)
+def test_joint_states_with_nan_short_positions_or_a_name_twice_are_refused_in_one_line(
+    tmp_path, capsys, label, ros, storage
+):
+    """A NaN position (as a CSV's gap is refused), positions fewer than the names, a joint named
+    twice: each a one-line error naming the message and the topic (exit 2 from ``bidmp fit``),
+    never a traceback or a silently wrong column."""
+    from bidmp.io import read_bag
+
+    rng = np.random.default_rng(8)
+    names = ["a", "b", "c"]
+    stamps = _stamps(rng)[:40]
+    q = np.column_stack([np.linspace(0.0, 0.5, 40) * k for k in (1, 2, 3)])
+
+    def messages(number, names_there, positions_there):
+        rows = [(ns, names, row) for ns, row in zip(stamps, q)]
+        rows[number - 1] = (stamps[number - 1], names_there, positions_there)
+        return rows
+
+    cases = (
+        ("nan", messages(17, names, [0.1, np.nan, 0.3]), ("NaN in b", "message 17")),
+        ("short", messages(5, names, [0.1, 0.2]), ("2 positions for 3 joint names", "message 5")),
+        ("twice", messages(9, ["a", "b", "a"], [0.1, 0.2, 0.3]), ("'a' twice", "message 9")),
+    )
+    for case, rows, expected in cases:
+        bag = joint_state_bag(_bag_path(tmp_path, f"{label}_{case}", ros), ros, storage, rows)
+        with pytest.raises(ValueError) as raised:
+            read_bag(bag, joints=True)
+        assert all(text in str(raised.value) for text in expected), str(raised.value)
+        assert "/joint_states" in str(raised.value)
+        capsys.readouterr()
+        assert main(["fit", str(bag), "-o", str(tmp_path / "m.npz"), "--joints"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and all(text in err[0] for text in expected), err
+    with pytest.raises(ValueError, match="named twice"):
+        read_bag(bag, joints=["a", "a"])

@@ -137,6 +137,76 @@ def test_the_whole_job_on_the_ideal_arm_drops_each_nut_on_the_bins_floor(nuts):
         assert centre[2] == pytest.approx(floor[2] + height / 2.0, abs=0.01)
 
 
+def _command_files(folder):
+    """(first lines, header, numbers) of each command file in ``folder``, in order."""
+    out = []
+    for path in sorted(folder.glob("*.csv")):
+        lines = path.read_text().splitlines()
+        comments = [line for line in lines if line.startswith("#")]
+        header = [line for line in lines if not line.startswith("#")][0].split(",")
+        out.append((comments, header, np.loadtxt(path, delimiter=",", skiprows=len(comments) + 1)))
+    return out
+
+
+CARRIAGE = ["carriage_x", "carriage_y", "carriage_z", "wrist_x", "wrist_y", "wrist_z"]
+
+
+@pytest.mark.parametrize(("model", "joints"), [("panda", 7), ("xarm6", 6)])
+def test_job_commands_on_the_kinematic_arm_name_its_own_six_joints(tmp_path, capsys, model, joints):
+    """bidmp job --commands --backend kinematic wrote its results, then failed on a 7-joint
+    scenario arm ('7 names for commands of 6 joints') and, on a 6-joint one (the xArm6), named
+    the kinematic arm's carriage by the xArm's joints. The files carry the joints of the arm that
+    ran: the carriage (m) and the wrist (rad), said in a comment, no '# units: rad' over metres;
+    the first command is the arm's rest (0.3, 0, 0.45 m; the tool down)."""
+    from bidmp.cli import main
+    from bidmp.sim.robots import ROBOT_MODELS
+
+    assert len(ROBOT_MODELS[model].limits.lower) == joints  # the scenario's arm, not the one run
+    data = tasks.load("nut-unscrewing").to_dict()
+    data["robot"] = {**data.get("robot", {}), "model": model}
+    scenario = tmp_path / f"{model}.json"
+    scenario.write_text(json.dumps(data))
+    out = tmp_path / "job"
+    argv = ["job", "--scenario", str(scenario), "--targets", "3", "--no-pictures"]
+    assert main([*argv, "--backend", "kinematic", "--commands", "--out", str(out)]) == 0
+    files = _command_files(out / "commands")
+    assert len(files) == 4  # approach, unscrew, retract, drop
+    for comments, header, numbers in files:
+        assert header == ["t", *CARRIAGE]
+        assert comments == [
+            "# joint units: carriage_x m, carriage_y m, carriage_z m, wrist_x rad, wrist_y rad, "
+            "wrist_z rad"
+        ]
+        assert numbers.shape[1] == 7
+        np.testing.assert_allclose(np.diff(numbers[:, 0]), 1e-3, atol=1e-12)
+    np.testing.assert_allclose(files[0][2][0, 1:], [0.3, 0.0, 0.45, 0.0, 0.0, 0.0], atol=1e-12)
+
+
+def test_job_commands_on_a_seven_joint_arm_read_back_as_it_sent_them(nuts, tmp_path):
+    """The PyBullet Panda (7 joints): the report names the joints of the arm that ran (its URDF's,
+    typed here), the files read back to the last bit of the commands it sent, and names of
+    another count or a name twice are refused."""
+    pytest.importorskip("pybullet")
+    from bidmp.sim import write_job_commands
+
+    report = run_job(nuts, targets=["3"], record=True)
+    names = [f"panda_joint{k}" for k in range(1, 8)]
+    assert list(report.joint_names) == names and set(report.joint_units) == {"rad"}
+    assert len(write_job_commands(report, tmp_path / "c")) == 4
+    files = _command_files(tmp_path / "c")
+    sent = [
+        p.commands for target in report.targets for p in target.phases if p.commands is not None
+    ]
+    assert len(files) == len(sent) == 4
+    for (comments, header, numbers), commands in zip(files, sent):
+        assert comments == ["# units: rad"] and header == ["t", *names]
+        np.testing.assert_array_equal(numbers[:, 1:], np.asarray(commands))
+    with pytest.raises(ValueError, match="6 names for commands of 7 joints"):
+        write_job_commands(report, tmp_path / "d", names[:6])
+    with pytest.raises(ValueError, match="a name repeats"):
+        write_job_commands(report, tmp_path / "e", [*names[:6], names[0]])
+
+
 def test_a_scripted_hold_needs_dynamics_and_an_arm_with_that_joint(nuts):
     with pytest.raises(ValueError, match="needs dynamics"):
         simulate(nuts, ["dmp"], targets=["1"], backend="kinematic", hold=Hold(0, 0.5), workers=1)

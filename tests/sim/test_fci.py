@@ -274,10 +274,66 @@ def test_verify_says_how_long_a_motion_is_and_refuses_other_rates(tmp_path, caps
     gap = np.arange(200) * 1e-3
     gap[100:] += 1e-3
     assert main(["verify", write(tmp_path / "gap.csv", gap), "--robot", "panda"]) == 2
-    assert "1 ms apart (1000 Hz)" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    # the step that is off, not the median's "1 ms apart (1000 Hz)": that is no reason to refuse
+    assert "data rows 100 and 101 are 2 ms apart" in err and "1000 Hz" not in err, err
     off = np.arange(200) * 1.0015e-3
     assert main(["verify", write(tmp_path / "off.csv", off), "--robot", "panda"]) == 2
     capsys.readouterr()
+
+
+def _command_file(path, t, q, names, first_lines=()) -> str:
+    with open(path, "w") as handle:
+        handle.writelines(f"{line}\n" for line in first_lines)
+        handle.write("t," + ",".join(names) + "\n")
+        for time, row in zip(t, q):
+            handle.write(",".join(repr(float(v)) for v in [time, *row]) + "\n")
+    return str(path)
+
+
+def test_verify_refuses_a_length_unit_a_joint_named_twice_and_a_repeated_stamp_truly(
+    tmp_path, capsys
+):
+    """What a joint command file must be, each refusal one line (exit 2) that is true: a length
+    unit on joints ('# units: m' is no angle), a joint named twice in the header (which column is
+    its command?), a stamp repeated (named, with its data row, not "1 ms apart (1000 Hz)"); and a
+    stream that holds still is valid (zero velocity is within every limit): accepted, exit 0."""
+    from bidmp.cli import main
+
+    names = [f"fr3_joint{i}" for i in range(1, 8)]
+    t = np.arange(800) * 1e-3
+    s = np.linspace(0.0, 1.0, 800)[:, None]
+    start = np.array([0.0, -0.4, 0.0, -2.0, 0.0, 1.9, 0.8])
+    q = start + 0.05 * (10 * s**3 - 15 * s**4 + 6 * s**5)
+
+    def verify(path):
+        capsys.readouterr()
+        status = main(["verify", path, "--robot", "fr3"])
+        out, err = capsys.readouterr()
+        return status, out.strip().splitlines(), err.strip().splitlines()
+
+    assert verify(_command_file(tmp_path / "ok.csv", t, q, names, ["# units: rad"]))[0] == 0
+    for unit in ("m", "mm", "cm"):
+        status, _, err = verify(
+            _command_file(tmp_path / f"{unit}.csv", t, q, names, [f"# units: {unit}"])
+        )
+        assert status == 2 and len(err) == 1 and f"'# units: {unit}', a length" in err[0], err
+    status, _, err = verify(_command_file(tmp_path / "furlong.csv", t, q, names, ["# units: ft"]))
+    assert status == 2 and len(err) == 1 and "units must be one of" in err[0], err
+    # an eighth column named as the first: read as the first's before, its values dropped
+    twice = np.column_stack([q, q[:, 0] + 0.3])
+    status, _, err = verify(_command_file(tmp_path / "twice.csv", t, twice, [*names, names[0]]))
+    assert status == 2 and len(err) == 1 and "'fr3_joint1' 2 times" in err[0], err
+    with pytest.raises(ValueError, match="named 2 times"):
+        match_joint_names([*names, names[2]], "fr3")
+    still = np.tile(start, (800, 1))
+    status, out, _ = verify(_command_file(tmp_path / "still.csv", t, still, names))
+    assert status == 0 and out[0].startswith("accepted:") and "800 commands" in out[0], out
+    repeated = t.copy()
+    repeated[400] = repeated[399]  # the logger wrote one stamp twice, the rest on the 1 ms grid
+    status, _, err = verify(_command_file(tmp_path / "repeated.csv", repeated, q, names))
+    assert status == 2 and len(err) == 1, err
+    assert "data row 401 repeats the stamp 0.399 s" in err[0] and "1000 Hz" not in err[0], err
 
 
 def test_a_stream_still_moving_at_its_end_is_rejected_after_its_last_command():

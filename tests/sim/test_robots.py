@@ -81,7 +81,7 @@ def test_a_base_too_close_names_what_is_out_of_reach():
         target
     ) in targets.values():  # every motion starts there: every target is a row with the reason
         assert not target.ran and target.reason.startswith(
-            "the demonstration's start is unreachable for the iiwa at base"
+            "the demonstration's start is unreachable: for the iiwa at base"
         )
         assert "\n" not in target.reason
 

@@ -119,7 +119,7 @@ def test_a_repair_order_names_only_repairs_and_needs_a_scene():
         Repairer(Contract.of(scenario), scenario.demonstration, order=("lift", "teleport"))
     with pytest.raises(ValueError, match="repairs need the contract's scene"):
         Repairer(Contract.of(scenario, geometry=False), scenario.demonstration)
-    assert REPAIRS == ("lift", "avoid", "extend", "margin")
+    assert REPAIRS == ("lift", "avoid", "extend", "margin", "route")
 
 
 @pytest.mark.parametrize("how", ["lift", "avoid", "extend"])

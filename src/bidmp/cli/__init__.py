@@ -149,7 +149,7 @@ def main(argv: _Sequence[str] | None = None) -> int:
 
     from .common import command_started
 
-    command_started()
+    command_started(argv)
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:

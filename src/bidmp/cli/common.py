@@ -22,6 +22,9 @@ __all__ = [
     "one_line",
     "split_names",
     "progress_bars",
+    "overwrite_option",
+    "output_folder",
+    "shown_written",
 ]
 
 EXIT_OK = 0
@@ -139,11 +142,45 @@ def progress_bars():
 
 
 _STARTED: list[float] = []  # when main() began handling the command (perf_counter seconds)
+_ARGV: list[str] = []  # its arguments, for a run folder's manifest
 
 
-def command_started() -> None:
-    """Note the command's start (main() calls it first), for :func:`print_real_time`."""
+def command_started(argv=None) -> None:
+    """Note the command's start (main() calls it first), for :func:`print_real_time`, and its
+    arguments (default ``sys.argv[1:]``), for :func:`output_folder`'s manifest."""
+    import sys
+
     _STARTED[:] = [time.perf_counter()]
+    _ARGV[:] = [str(arg) for arg in (sys.argv[1:] if argv is None else argv)]
+
+
+def overwrite_option(parser) -> None:
+    """The --overwrite flag of every command that writes an output folder."""
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an output folder that holds files no bidmp run wrote (every file in it is "
+        "deleted); without it such a folder is refused. A folder of an earlier bidmp run is "
+        "always replaced whole",
+    )
+
+
+@contextlib.contextmanager
+def output_folder(out, overwrite: bool = False, **options):
+    """The command's output folder as one run (:func:`bidmp.io.runs.run_folder`): the handler
+    writes into the yielded run's ``path``; on success the run is swapped in, whole, with its
+    manifest (this command line in it); on a failure the earlier run stays as it was."""
+    import shlex
+
+    from ..io.runs import run_folder
+
+    with run_folder(out, "bidmp " + shlex.join(_ARGV), overwrite=overwrite, **options) as run:
+        yield run
+
+
+def shown_written(run, written) -> str:
+    """The files a run wrote, where they are once it is in place, comma-separated."""
+    return ", ".join(str(run.shown(path)) for path in written)
 
 
 def print_real_time(simulated_s: float) -> None:

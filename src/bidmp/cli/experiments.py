@@ -6,7 +6,14 @@ from __future__ import annotations
 import argparse
 import json
 
-from .common import EXIT_OK, MAX_SEEDS, Parser
+from .common import (
+    EXIT_OK,
+    MAX_SEEDS,
+    Parser,
+    output_folder,
+    overwrite_option,
+    shown_written,
+)
 
 __all__ = ["add_commands", "lasa_demo"]
 
@@ -22,24 +29,26 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if not 1 <= args.seeds <= MAX_SEEDS:
         raise ValueError(f"--seeds must be 1-{MAX_SEEDS}, got {args.seeds}")
-    if args.what == "table4":
-        with tqdm(
-            total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None
-        ) as bar:
-            result = reproduce.run_table4(
-                progress=lambda name: (bar.set_postfix_str(name), bar.update(1))
+    # the folder is checked and held first: a refusal comes before the work, not after it
+    with output_folder(out, args.overwrite) as run:
+        if args.what == "table4":
+            with tqdm(
+                total=len(reproduce.TABLE4_SCENARIOS), desc="table4", unit="scenario", disable=None
+            ) as bar:
+                result = reproduce.run_table4(
+                    progress=lambda name: (bar.set_postfix_str(name), bar.update(1))
+                )
+        elif args.what == "figures":
+            result = reproduce.run_figures(
+                progress=partial(tqdm, desc="figures", unit="shape", disable=None)
             )
-    elif args.what == "figures":
-        result = reproduce.run_figures(
-            progress=partial(tqdm, desc="figures", unit="shape", disable=None)
-        )
-    else:
-        result = reproduce.run_table5(
-            args.seeds, progress=partial(tqdm, desc="table5", unit="case", disable=None)
-        )
-    print(result.summary())
-    written = reproduce.write_results(result, args.what, out)
-    print(f"\nwrote {', '.join(str(path) for path in written)}")
+        else:
+            result = reproduce.run_table5(
+                args.seeds, progress=partial(tqdm, desc="table5", unit="case", disable=None)
+            )
+        print(result.summary())
+        written = reproduce.write_results(result, args.what, run.path)
+    print(f"\nwrote {shown_written(run, written)}")
     return EXIT_OK
 
 
@@ -65,18 +74,20 @@ def _cmd_lasa(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def lasa_demo(shape: str, out) -> int:
+def lasa_demo(shape: str, out, overwrite: bool = False) -> int:
+    """``bidmp demo --lasa SHAPE``: the fit-and-generalise example, its JSON and figure one run
+    in folder ``out``."""
     from ..experiments.reproduce import lasa_generalisation
     from ..io.atomic import atomic_write
     from ..plotting.trajectories import plot_generalisation
 
-    out.mkdir(parents=True, exist_ok=True)
-    result = lasa_generalisation(shape)
-    print("bidmp demo --lasa: " + result.summary())
-    with atomic_write(out / "lasa_generalisation.json", "w") as handle:
-        json.dump(result.to_dict(), handle, indent=2)
-    figure = plot_generalisation(out / "lasa_generalisation.png", result)
-    print(f"wrote {out / 'lasa_generalisation.json'} and {figure}")
+    with output_folder(out, overwrite) as run:
+        result = lasa_generalisation(shape)
+        print("bidmp demo --lasa: " + result.summary())
+        with atomic_write(run.path / "lasa_generalisation.json", "w") as handle:
+            json.dump(result.to_dict(), handle, indent=2)
+        figure = plot_generalisation(run.path / "lasa_generalisation.png", result)
+    print(f"wrote {run.shown(run.path / 'lasa_generalisation.json')} and {run.shown(figure)}")
     return EXIT_OK
 
 
@@ -99,11 +110,18 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
     shapes_checked, _, indices = check_lasa_options(shapes, methods, args.demos, args.every)
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be 1-256, got {args.workers}")
-    with tqdm(
-        total=len(shapes_checked) * len(indices), desc="LASA", unit="cell", disable=None
-    ) as bar:
+    # The cells go into a partial folder beside --out that a failed or killed run leaves for
+    # --resume; the finished run (its cells, table and figures) is then swapped in whole.
+    with (
+        output_folder(Path(args.out), args.overwrite, partial=True, resume=args.resume) as run,
+        tqdm(
+            total=len(shapes_checked) * len(indices), desc="LASA", unit="cell", disable=None
+        ) as bar,
+    ):
+        if args.resume:
+            _resume_cells(run)
         result = lasa(
-            Path(args.out),
+            run.path,
             shapes=shapes,
             methods=methods,
             demos=args.demos,
@@ -114,13 +132,49 @@ def _cmd_benchmark(args: argparse.Namespace) -> int:
             output_format=args.format,
             progress=lambda key: bar.update(1),
         )
+        _drop_other_cells(run, result)
+        summary = (run.path / "lasa.md").read_text()
     print(
         f"LASA benchmark: {len(result.computed)} cells computed, {len(result.resumed)} resumed, "
         f"{result.workers} worker(s), {result.wall_s:.1f} s"
     )
-    print((Path(args.out) / "lasa.md").read_text())
-    print(f"wrote {', '.join(str(path) for path in result.written)}")
+    print(summary)
+    print(f"wrote {shown_written(run, result.written)}")
     return EXIT_OK
+
+
+def _resume_cells(run) -> None:
+    """--resume: the partial run's own files but its cells are dropped (the table and figures
+    are written again), and the finished cells of the run in --out that the partial run lacks
+    are taken into it (the benchmark checks each one it reads)."""
+    import shutil
+
+    for entry in run.path.iterdir():
+        if entry.name == "cells":
+            continue
+        if entry.is_dir():
+            shutil.rmtree(entry)
+        else:
+            entry.unlink()
+    finished = run.final / "cells"
+    if not finished.is_dir():
+        return
+    (run.path / "cells").mkdir(exist_ok=True)
+    for cell in finished.glob("*.json"):
+        if not (run.path / "cells" / cell.name).exists():
+            from ..io.atomic import atomic_write
+
+            with atomic_write(run.path / "cells" / cell.name, "wb") as handle:
+                handle.write(cell.read_bytes())
+
+
+def _drop_other_cells(run, result) -> None:
+    """The cells a resumed partial run held that this run did not use (other shapes, another
+    protocol) are not part of it."""
+    keep = {f"{key}.json" for key in [*result.computed, *result.resumed]}
+    for cell in (run.path / "cells").glob("*"):
+        if cell.name not in keep:
+            cell.unlink()
 
 
 def _cmd_clfd(args: argparse.Namespace) -> int:
@@ -140,16 +194,17 @@ def _cmd_clfd(args: argparse.Namespace) -> int:
         raise ValueError(f"--seeds must be 1-100, got {args.seeds}")
     if not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be 1-256, got {args.workers}")
-    result = run_clfd(
-        args.dataset,
-        methods,
-        n_tasks=args.tasks,
-        seeds=range(args.seeds),
-        workers=args.workers,
-    )
-    written = write_clfd(result, args.out)
+    with output_folder(args.out, args.overwrite) as run:
+        result = run_clfd(
+            args.dataset,
+            methods,
+            n_tasks=args.tasks,
+            seeds=range(args.seeds),
+            workers=args.workers,
+        )
+        written = write_clfd(result, run.path)
     print(result.markdown())
-    print(f"wrote {', '.join(str(path) for path in written)}")
+    print(f"wrote {shown_written(run, written)}")
     return EXIT_OK
 
 
@@ -166,7 +221,12 @@ def _reproduce_parser(commands) -> None:
         "with reproduction errors and forgetting.",
     )
     reproduce.add_argument("what", choices=("table4", "table5", "figures"), help="which result")
-    reproduce.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    reproduce.add_argument(
+        "--out",
+        default="bidmp-out",
+        help="output folder (default ./bidmp-out): one run, replaced whole by the next",
+    )
+    overwrite_option(reproduce)
     reproduce.add_argument("--seeds", type=int, default=20, help="number of seeds (default 20)")
     reproduce.set_defaults(handler=_cmd_reproduce)
 
@@ -240,7 +300,10 @@ def _benchmark_parser(commands) -> None:
         help="run on an existing Dask scheduler (tcp://host:8786)",
     )
     bench.add_argument(
-        "--resume", action="store_true", help="skip the cells a previous run into --out finished"
+        "--resume",
+        action="store_true",
+        help="skip the cells a previous run into --out finished, or an interrupted one left "
+        "(in .OUT.bidmp-partial beside it)",
     )
     bench.add_argument(
         "--format",
@@ -248,7 +311,12 @@ def _benchmark_parser(commands) -> None:
         default="parquet",
         help="results table format (default parquet)",
     )
-    bench.add_argument("--out", default="bidmp-lasa", help="output folder (default ./bidmp-lasa)")
+    bench.add_argument(
+        "--out",
+        default="bidmp-lasa",
+        help="output folder (default ./bidmp-lasa): one run, replaced whole by the next",
+    )
+    overwrite_option(bench)
     clfd = bench_commands.add_parser(
         "clfd",
         help="continual learning from demonstration: the CLFD protocol (Auddy et al.)",
@@ -285,7 +353,12 @@ def _benchmark_parser(commands) -> None:
         help="run the cells (method x seed) on an embedded Dask cluster of N processes; 1 "
         "(default), or a single cell: one after the other here",
     )
-    clfd.add_argument("--out", default="bidmp-clfd", help="output folder (default ./bidmp-clfd)")
+    clfd.add_argument(
+        "--out",
+        default="bidmp-clfd",
+        help="output folder (default ./bidmp-clfd): one run, replaced whole by the next",
+    )
+    overwrite_option(clfd)
     benchmark.set_defaults(handler=_cmd_benchmark)
 
 

@@ -196,6 +196,11 @@ def read_input(
             )
         )
     values, times, declared = recording.values, recording.t, recording.units
+    if recording.kind == "joints":
+        from .._checks import as_trajectory
+
+        # a joint record may hold still (verify judges such streams); a demonstration may not
+        as_trajectory(values, name=str(path))
     if recording.kind == "joints" and requested and requested != declared and declared == "rad":
         raise ValueError(
             f"{path}: its columns read as joints ({', '.join(recording.names[:8])}: t,<joint names>), in "

@@ -4,14 +4,27 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import NamedTuple
 
 from .common import (
     EXIT_OK,
     EXIT_TARGETS_FAILED,
     allow_outside_files,
     backend_option,
+    output_folder,
+    overwrite_option,
     print_real_time,
+    shown_written,
 )
+
+
+class JobWritten(NamedTuple):
+    """What :func:`run_job_command` wrote (into the run folder's new path) and its exit code."""
+
+    code: int
+    written: list  # the report's files and the viewer's
+    commands: list | None  # the command files (None: not asked for)
+    simulated_s: float
 
 
 def run_job_command(
@@ -23,9 +36,10 @@ def run_job_command(
     view: bool = False,
     backend: str | None = None,
     commands: bool = False,
-) -> int:
-    """Run the job with a progress bar, print its report, write its files (and the viewer;
-    ``commands``: every motion's 1 kHz joint commands, out/commands/*.csv)."""
+) -> JobWritten:
+    """Run the job with a progress bar, print its report, write its files into ``out`` (and the
+    viewer; ``commands``: every motion's 1 kHz joint commands, out/commands/*.csv). The caller
+    puts the run in place and then says what it wrote (:func:`print_job_written`)."""
     from tqdm import tqdm
 
     from ..sim.job import job_targets, run_job
@@ -52,16 +66,12 @@ def run_job_command(
     print()
     print(report.summary())
     written = write_job_report(report, out)
+    files = None
     if commands:
         from ..sim.job_report import write_job_commands
-        from ..sim.kinematics import joint_names
-        from ..sim.robots import robot_model
 
-        arm = robot_model(scenario.robot, scenario.base_dir)
-        files = write_job_commands(report, Path(out) / "commands", joint_names(arm))
-        print(
-            f"wrote {len(files)} command files to {Path(out) / 'commands'} (bidmp verify judges them)"
-        )
+        # the arm that ran (the kinematic backend is its own six-joint arm, not the scenario's)
+        files = write_job_commands(report, Path(out) / "commands")
     if view:
         from .view import write_view_files
 
@@ -71,9 +81,20 @@ def run_job_command(
         written += write_view_files(
             out, report=report.evaluation, sim_result=report, extra_solids=extra
         )
-    print(f"\nwrote {', '.join(str(path) for path in written)}")
-    print_real_time(report.simulated_s)
-    return EXIT_OK if report.removed == len(report.targets) else EXIT_TARGETS_FAILED
+    code = EXIT_OK if report.removed == len(report.targets) else EXIT_TARGETS_FAILED
+    return JobWritten(code, written, files, report.simulated_s)
+
+
+def print_job_written(run, job: JobWritten, folder: Path) -> None:
+    """After the run is in place: the files the job wrote (``folder``: where it wrote them, in
+    the run's new path), and the whole command's time."""
+    if job.commands is not None:
+        print(
+            f"wrote {len(job.commands)} command files to {run.shown(Path(folder) / 'commands')} "
+            f"(bidmp verify judges them)"
+        )
+    print(f"\nwrote {shown_written(run, job.written)}")
+    print_real_time(job.simulated_s)
 
 
 def _cmd_job(args: argparse.Namespace) -> int:
@@ -86,15 +107,18 @@ def _cmd_job(args: argparse.Namespace) -> int:
     targets = (
         None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]
     )
-    return run_job_command(
-        scenario,
-        Path(args.out),
-        targets=targets,
-        pictures=not args.no_pictures,
-        view=args.view,
-        backend=args.backend,
-        commands=args.commands,
-    )
+    with output_folder(args.out, args.overwrite) as run:
+        job = run_job_command(
+            scenario,
+            run.path,
+            targets=targets,
+            pictures=not args.no_pictures,
+            view=args.view,
+            backend=args.backend,
+            commands=args.commands,
+        )
+    print_job_written(run, job, run.path)
+    return job.code
 
 
 def add_commands(commands) -> None:
@@ -127,7 +151,12 @@ def add_commands(commands) -> None:
         action="store_true",
         help="also write view.html: the 3-D viewer, the first cycle on a time slider",
     )
-    job.add_argument("--out", default="bidmp-job", help="output folder (default ./bidmp-job)")
+    job.add_argument(
+        "--out",
+        default="bidmp-job",
+        help="output folder (default ./bidmp-job): one run, replaced whole by the next",
+    )
+    overwrite_option(job)
     job.add_argument(
         "--commands",
         action="store_true",

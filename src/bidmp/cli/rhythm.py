@@ -52,7 +52,26 @@ def fit_periodic(args: argparse.Namespace) -> int:
         model = RhythmicDMP(**settings).fit(recording, times, units=units, names=names)
         inner = model
     estimate = model.estimate_
-    path = save_model(model, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = save_model(model, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_rhythm
+
+            motion = inner.trajectory(cycles=2, dt=min(0.001, 0.01 / estimate.frequency))
+            shown = recording[:, :3] if poses else recording
+            scale = model.scales_[0] if poses else 1.0
+            figure = plot_rhythm(
+                outputs.path(args.plot),
+                shown,
+                times,
+                _scaled(motion, scale, 3 if poses else None),
+                estimate.frequency,
+                estimate.uncertainty,
+                title=f"rhythm learned from {args.demo}",
+                units=units,
+            )
     unit = units or "units"
     kind = "pose " if poses else ""
     print(f"fitted a rhythmic {kind}DMP on {args.demo}, {how}")
@@ -74,24 +93,9 @@ def fit_periodic(args: argparse.Namespace) -> int:
     else:
         amplitude = np.array2string(inner.amplitude_, precision=4)
         print(f"  amplitude (half the peak-to-peak) {amplitude} {unit}")
-    print(f"wrote {path}")
+    print(f"wrote {outputs.shown(path)}")
     if args.plot:
-        from ..plotting.trajectories import plot_rhythm
-
-        motion = inner.trajectory(cycles=2, dt=min(0.001, 0.01 / estimate.frequency))
-        shown = recording[:, :3] if poses else recording
-        scale = model.scales_[0] if poses else 1.0
-        figure = plot_rhythm(
-            args.plot,
-            shown,
-            times,
-            _scaled(motion, scale, 3 if poses else None),
-            estimate.frequency,
-            estimate.uncertainty,
-            title=f"rhythm learned from {args.demo}",
-            units=units,
-        )
-        print(f"wrote {figure}")
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK
 
 
@@ -135,7 +139,20 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
         trajectory = model.run(cycles, **options)
     else:
         trajectory = model.trajectory(cycles, **options)
-    path = (save_poses if poses else save_trajectory)(trajectory, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = (save_poses if poses else save_trajectory)(trajectory, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_rollout
+
+            figure = plot_rollout(
+                outputs.path(args.plot),
+                trajectory.y,
+                trajectory,
+                title="rhythm",
+                units=model.units_,
+            )
     unit = model.units_ or "units"
     frequency = model.frequency_ if args.frequency is None else args.frequency
     print(
@@ -148,11 +165,7 @@ def rollout_periodic(args: argparse.Namespace, model) -> int:
         f"{trajectory.peak_acceleration():.4g} {unit}/s^2, span "
         f"{np.array2string(np.ptp(trajectory.y, axis=0), precision=4)} {unit}"
     )
-    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
+    print(f"wrote {outputs.shown(path)} (columns {','.join(trajectory.columns()[0])})")
     if args.plot:
-        from ..plotting.trajectories import plot_rollout
-
-        print(
-            f"wrote {plot_rollout(args.plot, trajectory.y, trajectory, title='rhythm', units=model.units_)}"
-        )
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK

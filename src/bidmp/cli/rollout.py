@@ -187,7 +187,25 @@ def cmd_rollout(args: argparse.Namespace) -> int:
 
     # never write what no robot runs
     check_speed(trajectory.peak_speed(), dmp.units_, "the rolled-out motion", fast_only=True)
-    path = (save_poses if poses else save_trajectory)(trajectory, args.output)
+    from ..io.runs import output_files
+
+    # -o, --bag and --plot appear together or not at all: each written beside its place, then
+    # put in place once all are written
+    with output_files() as outputs:
+        path = (save_poses if poses else save_trajectory)(trajectory, outputs.path(args.output))
+        bag = (
+            _rollout_bag(args, trajectory, dmp, poses, outputs.path(args.bag)) if args.bag else None
+        )
+        if args.plot:
+            from ..plotting.trajectories import plot_rollout
+
+            figure = plot_rollout(
+                outputs.path(args.plot),
+                dmp.rollout(),
+                trajectory,
+                title="rollout",
+                units=dmp.units_,
+            )
     unit = dmp.units_ or "units"
     rate = 1.0 / (trajectory.t[1] - trajectory.t[0]) if len(trajectory) > 1 else float("nan")
     goal = trajectory.y[-1] if options["goal"] is None else np.asarray(options["goal"], dtype=float)
@@ -214,15 +232,11 @@ def cmd_rollout(args: argparse.Namespace) -> int:
             f"  steered round the scene's parts: clearance {clearance.distance:.4g} {unit} to {clearance.part} "
             f"(margin {clearance.margin:g}; the target's parts {', '.join(term.excluded_) or 'none'} left out)"
         )
-    print(f"wrote {path} (columns {','.join(trajectory.columns()[0])})")
-    if args.bag:
-        print(f"wrote {_rollout_bag(args, trajectory, dmp, poses)}")
+    print(f"wrote {outputs.shown(path)} (columns {','.join(trajectory.columns()[0])})")
+    if bag is not None:
+        print(f"wrote {outputs.shown(bag)}")
     if args.plot:
-        from ..plotting.trajectories import plot_rollout
-
-        print(
-            f"wrote {plot_rollout(args.plot, dmp.rollout(), trajectory, title='rollout', units=dmp.units_)}"
-        )
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK
 
 
@@ -338,7 +352,7 @@ def _stamped(options: dict) -> str:
     )
 
 
-def _ik_bag(args: argparse.Namespace, trajectory, dmp) -> str:
+def _ik_bag(args: argparse.Namespace, trajectory, dmp, where) -> str:
     """A position model's motion as the robot's JointTrajectory: inverse kinematics at every
     sample (tool pointing down; the robot at --base, turned by --yaw, in the model's frame)."""
     import numpy as np
@@ -358,7 +372,7 @@ def _ik_bag(args: argparse.Namespace, trajectory, dmp) -> str:
     options = _bag_options(args)
     kind = "follow" if args.follow else "joints"
     path = write_bag(
-        args.bag,
+        where,
         trajectory.t,
         joints,
         kind=kind,
@@ -384,19 +398,20 @@ def _joint_message(kind: str, options: dict) -> str:
     return f"{msgtype.replace('/msg/', '/')} on {topic}"
 
 
-def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
+def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool, where) -> str:
     """``--bag OUT``: the motion as a PoseStamped stream in metres (pose models; position models
     with --orientation, the orientation held), a PointStamped stream (position models without it:
     no orientation is made up), the robot's JointTrajectory after IK (position models with
     --robot), or a JointTrajectory (joint-space models, their joint names); --follow: a
-    FollowJointTrajectory goal instead of the JointTrajectory. ROS 2 MCAP or ``--ros1``."""
+    FollowJointTrajectory goal instead of the JointTrajectory. ROS 2 MCAP or ``--ros1``; written
+    at ``where`` (beside --bag's place, :func:`bidmp.io.runs.output_files`)."""
     import numpy as np
 
     from .._units import conversion
     from ..io.bags import write_bag
 
     if args.robot_given and not poses and dmp.n_dims_ == 3:
-        return _ik_bag(args, trajectory, dmp)
+        return _ik_bag(args, trajectory, dmp, where)
     options = _bag_options(args)
     if poses or dmp.n_dims_ == 3:
         if args.follow:
@@ -422,7 +437,7 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
         values = (
             trajectory.y * scale if not poses else np.hstack([trajectory.y * scale, trajectory.q])
         )
-        path = write_bag(args.bag, trajectory.t, values, kind="pose", orientation=held, **options)
+        path = write_bag(where, trajectory.t, values, kind="pose", orientation=held, **options)
         if poses:
             what = "geometry_msgs/PoseStamped"
         elif held is not None:
@@ -447,7 +462,7 @@ def _rollout_bag(args: argparse.Namespace, trajectory, dmp, poses: bool) -> str:
         )
     kind = "follow" if args.follow else "joints"
     path = write_bag(
-        args.bag,
+        where,
         trajectory.t,
         trajectory.y,
         kind=kind,

@@ -78,7 +78,22 @@ def fit_several(args: argparse.Namespace, flag: str) -> int:
     model, mean, std, mean_t, what = adapter.learn(args, kind.load(), demos, stamps, units)
     # the figure on time: each demonstration on its own (over 1 s without stamps, as fitted)
     own = [np.linspace(0.0, 1.0, len(y)) if t is None else t - t[0] for y, t in zip(demos, times)]
-    path = save_model(model, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = save_model(model, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_distribution
+
+            figure = plot_distribution(
+                outputs.path(args.plot),
+                demos,
+                mean,
+                std,
+                title=f"{len(demos)} demonstrations",
+                units=units or "",
+                times={"demonstrations": own, "mean": mean_t},
+            )
     unit = units or "units"
     lengths = ", ".join(str(len(y)) for y in demos)
     print(f"fitted {what} on {len(demos)} demonstrations ({lengths} samples)")
@@ -87,20 +102,9 @@ def fit_several(args: argparse.Namespace, flag: str) -> int:
         f"{float(np.median(np.linalg.norm(std, axis=1))):.4g} {unit}, largest "
         f"{float(np.linalg.norm(std, axis=1).max()):.4g} {unit}"
     )
-    print(f"wrote {path}")
+    print(f"wrote {outputs.shown(path)}")
     if args.plot:
-        from ..plotting.trajectories import plot_distribution
-
-        figure = plot_distribution(
-            args.plot,
-            demos,
-            mean,
-            std,
-            title=f"{len(demos)} demonstrations",
-            units=units or "",
-            times={"demonstrations": own, "mean": mean_t},
-        )
-        print(f"wrote {figure}")
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK
 
 
@@ -158,7 +162,28 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     via = _via_pairs(args, model)
     rolled = adapter.roll(args, model, goal, via)
     trajectory, std, units = rolled.trajectory, rolled.std, rolled.units
-    path = save_trajectory(trajectory, args.output)
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o and --plot together or not at all
+        path = save_trajectory(trajectory, outputs.path(args.output))
+        if args.plot:
+            from ..plotting.trajectories import plot_distribution
+
+            times = rolled.times
+            figure = plot_distribution(
+                outputs.path(args.plot),
+                rolled.demonstrations or [rolled.base],
+                rolled.base,
+                rolled.base_std,
+                conditioned=rolled.mean,
+                conditioned_std=std,
+                points=rolled.marks,
+                title=rolled.title or rolled.what,
+                units=units,
+                times=times
+                if rolled.demonstrations
+                else {**times, "demonstrations": [times["mean"]]},
+            )
     unit = units or "units"
     rate = (len(trajectory.t) - 1) / trajectory.duration if trajectory.duration > 0 else 0.0
     print(
@@ -169,22 +194,7 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         f"  spread (one standard deviation) up to {float(np.linalg.norm(std, axis=1).max()):.4g} "
         f"{unit}; at the end {float(np.linalg.norm(std[-1])):.3g} {unit}"
     )
-    print(f"wrote {path}")
+    print(f"wrote {outputs.shown(path)}")
     if args.plot:
-        from ..plotting.trajectories import plot_distribution
-
-        times = rolled.times
-        figure = plot_distribution(
-            args.plot,
-            rolled.demonstrations or [rolled.base],
-            rolled.base,
-            rolled.base_std,
-            conditioned=rolled.mean,
-            conditioned_std=std,
-            points=rolled.marks,
-            title=rolled.title or rolled.what,
-            units=units,
-            times=times if rolled.demonstrations else {**times, "demonstrations": [times["mean"]]},
-        )
-        print(f"wrote {figure}")
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK

@@ -325,27 +325,40 @@ def cmd_extend(args: argparse.Namespace) -> int:
         f"end-point error at the target: {before:.4g} before, "
         f"{np.linalg.norm(rollout[-1, :3] - target[:3]):.4g} {unit} after"
     )
-    print(f"wrote {save_model(model, args.output)} ({model.n_skills} skills)")
+    from ..io.runs import output_files
+
+    with output_files() as outputs:  # -o, --save-demo and --plot together or not at all
+        path = save_model(model, outputs.path(args.output))
+        if args.save_demo:
+            complete = learned  # sampled at the demonstration's period, as long as it lasts
+            stamps = np.arange(len(complete)) * dmp.duration_ / (dmp.n_steps_ - 1)
+            if poses:
+                written = save_poses(
+                    complete, outputs.path(args.save_demo), times=stamps, units=dmp.units_
+                )
+            else:
+                from ..primitives.timing import Trajectory
+
+                velocity = np.gradient(complete, stamps, axis=0)
+                written = save_trajectory(
+                    Trajectory(
+                        stamps,
+                        complete,
+                        velocity,
+                        np.gradient(velocity, stamps, axis=0),
+                        dmp.units_,
+                    ),
+                    outputs.path(args.save_demo),
+                )
+        if args.plot:
+            from ..plotting.extension import plot_extension
+
+            figure = plot_extension(outputs.path(args.plot), extension, units=dmp.units_)
+    print(f"wrote {outputs.shown(path)} ({model.n_skills} skills)")
     if args.save_demo:
-        complete = learned  # sampled at the demonstration's period, as long as it lasts
-        stamps = np.arange(len(complete)) * dmp.duration_ / (dmp.n_steps_ - 1)
-        if poses:
-            written = save_poses(complete, args.save_demo, times=stamps, units=dmp.units_)
-        else:
-            from ..primitives.timing import Trajectory
-
-            velocity = np.gradient(complete, stamps, axis=0)
-            written = save_trajectory(
-                Trajectory(
-                    stamps, complete, velocity, np.gradient(velocity, stamps, axis=0), dmp.units_
-                ),
-                args.save_demo,
-            )
-        print(f"wrote the extended demonstration ({stamps[-1]:.4g} s) to {written}")
+        print(f"wrote the extended demonstration ({stamps[-1]:.4g} s) to {outputs.shown(written)}")
     if args.plot:
-        from ..plotting.extension import plot_extension
-
-        print(f"wrote {plot_extension(args.plot, extension, units=dmp.units_)}")
+        print(f"wrote {outputs.shown(figure)}")
     return EXIT_OK
 
 

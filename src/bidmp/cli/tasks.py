@@ -13,15 +13,19 @@ from .common import (
     allow_outside_files,
     backend_option,
     judged_methods,
+    output_folder,
+    overwrite_option,
     print_real_time,
     progress_bars,
+    shown_written,
 )
 
 __all__ = ["add_commands"]
 
 
 def _run_scenario(scenario, out, methods=None, view=False):
-    """Evaluate a scenario with a progress bar, print its report, write results and figures."""
+    """Evaluate a scenario with a progress bar, print its report, write results and figures into
+    ``out`` (a run folder's new path); returns (the report, the files written)."""
     from tqdm import tqdm
 
     from ..tasks.evaluation import evaluate, write_report
@@ -43,8 +47,7 @@ def _run_scenario(scenario, out, methods=None, view=False):
         from .view import write_view_files
 
         written += write_view_files(out, report=report)
-    print(f"\nwrote {', '.join(str(path) for path in written)}")
-    return report
+    return report, written
 
 
 def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
@@ -53,7 +56,8 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     ``options``: :func:`bidmp.sim.simulate`'s, passed on whole (``closed_loop``, ``hold``,
     ``workers``, ``targets``, ``avoid``, ``goal_update``, ``backend``). The simulator evaluates
     the motions it executes itself (judged and repaired with room for the arm's tracking): no
-    flag here changes what runs, and the viewer draws that evaluation."""
+    flag here changes what runs, and the viewer draws that evaluation. Returns (the result, the
+    files written into ``out``): ``out`` is a run folder's new path."""
     from tqdm import tqdm
 
     from ..sim.report import picture_frames, write_sim_report
@@ -91,9 +95,7 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
         from .view import write_view_files
 
         written += write_view_files(out, report=result.evaluation, sim_result=result)
-    print(f"\nwrote {', '.join(str(path) for path in written)}")
-    print_real_time(result.simulated_s)
-    return result
+    return result, written
 
 
 def _pictured_target(scenario, report, method, labels) -> str:
@@ -116,7 +118,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     if args.lasa:
         from .experiments import lasa_demo
 
-        return lasa_demo(args.lasa, out)
+        return lasa_demo(args.lasa, out, args.overwrite)
     from ..tasks.scenarios import load
 
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
@@ -137,27 +139,37 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         raise ValueError(
             f'--job: scenario {scenario.name!r} has no "job" (the steps to run at each target)'
         )
-    report = _run_scenario(scenario, out, methods, view=args.view)
-    failed = report.failed(judged_methods(report.methods))
-    if args.sim:
-        sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or [
-            "dmp",
-            "bidmp",
-        ]
-        result = _run_sim(
-            scenario,
-            out,
-            sim_methods,
-            view=args.view,
-            backend=args.backend,
-        )
-        failed += result.failed(judged_methods(sim_methods))
-    if args.job:
-        from .job import run_job_command
+    with output_folder(out, args.overwrite) as run:
+        report, written = _run_scenario(scenario, run.path, methods, view=args.view)
+        failed = report.failed(judged_methods(report.methods))
+        sim_written, job = None, None
+        if args.sim:
+            sim_methods = [m for m in (methods or scenario.methods) if m in ("dmp", "bidmp")] or [
+                "dmp",
+                "bidmp",
+            ]
+            result, sim_written = _run_sim(
+                scenario,
+                run.path,
+                sim_methods,
+                view=args.view,
+                backend=args.backend,
+            )
+            failed += result.failed(judged_methods(sim_methods))
+        if args.job:
+            from .job import run_job_command
 
-        failed += (
-            run_job_command(scenario, out / "job", view=args.view, backend=args.backend) != EXIT_OK
-        )
+            job = run_job_command(scenario, run.path / "job", view=args.view, backend=args.backend)
+            failed += job.code != EXIT_OK
+    # the run is in place: what it wrote, in the order it was written
+    print(f"\nwrote {shown_written(run, written)}")
+    if sim_written is not None:
+        print(f"\nwrote {shown_written(run, sim_written)}")
+        print_real_time(result.simulated_s)
+    if job is not None:
+        from .job import print_job_written
+
+        print_job_written(run, job, run.path / "job")
     return EXIT_TARGETS_FAILED if failed else EXIT_OK
 
 
@@ -194,20 +206,23 @@ def _cmd_sim(args: argparse.Namespace) -> int:
     )
     if (args.avoid or update is not None) and not args.closed_loop:
         raise ValueError("--avoid and --goal-update act on the closed loop: add --closed-loop")
-    result = _run_sim(
-        scenario,
-        Path(args.out),
-        methods,
-        closed_loop=args.closed_loop,
-        hold=hold,
-        workers=args.workers,
-        pictures=not args.no_pictures,
-        targets=targets,
-        avoid=args.avoid,
-        goal_update=update,
-        view=args.view,
-        backend=args.backend,
-    )
+    with output_folder(Path(args.out), args.overwrite) as run:
+        result, written = _run_sim(
+            scenario,
+            run.path,
+            methods,
+            closed_loop=args.closed_loop,
+            hold=hold,
+            workers=args.workers,
+            pictures=not args.no_pictures,
+            targets=targets,
+            avoid=args.avoid,
+            goal_update=update,
+            view=args.view,
+            backend=args.backend,
+        )
+    print(f"\nwrote {shown_written(run, written)}")
+    print_real_time(result.simulated_s)
     return EXIT_TARGETS_FAILED if result.failed(judged_methods(methods)) else EXIT_OK
 
 
@@ -253,7 +268,12 @@ def _demo_parser(commands) -> None:
         default=None,
         help="comma-separated subset of dmp,dmp-converged,bidmp,bidmp-latest,gmm,tpgmm",
     )
-    demo.add_argument("--out", default="bidmp-out", help="output folder (default ./bidmp-out)")
+    demo.add_argument(
+        "--out",
+        default="bidmp-out",
+        help="output folder (default ./bidmp-out): one run, replaced whole by the next",
+    )
+    overwrite_option(demo)
     demo.add_argument(
         "--approach",
         choices=("keep", "paper"),
@@ -352,7 +372,12 @@ def _sim_parser(commands) -> None:
         help="also write view.html: the 3-D viewer with the robot's motion to the furthest target on a time "
         "slider (needs bidmp[view])",
     )
-    sim.add_argument("--out", default="bidmp-sim", help="output folder (default ./bidmp-sim)")
+    sim.add_argument(
+        "--out",
+        default="bidmp-sim",
+        help="output folder (default ./bidmp-sim): one run, replaced whole by the next",
+    )
+    overwrite_option(sim)
     backend_option(sim)
     allow_outside_files(sim)
     sim.set_defaults(handler=_cmd_sim)

@@ -18,6 +18,7 @@ def _cmd_verify(args: argparse.Namespace) -> int:
             f"libfranka speaks the {args.robot}'s only up to 0.9): judge a {args.robot} motion "
             f"without --libfranka (its FCI tables)"
         )
+    _refuse_mixed_runs(args.motion)
     verdicts = [(path, _verdict(path, args.robot)) for path in args.motion]
     if args.libfranka:
         return _through_libfranka(verdicts)
@@ -36,6 +37,16 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     if len(verdicts) > 1:
         print(f"{len(verdicts) - rejected} of {len(verdicts)} motions accepted")
     return EXIT_REJECTED if rejected else EXIT_OK
+
+
+def _refuse_mixed_runs(paths) -> None:
+    """A file inside a run folder (``bidmp job --commands``' DIR/commands/*.csv) is judged only if
+    that run wrote it as it is: its manifest.json lists it with this SHA-256. A command file an
+    earlier run left beside a newer one's, or one changed since, is refused by name before any
+    is judged (a robot is never sent a stale command)."""
+    from ..io.runs import check_run_files
+
+    check_run_files(paths)
 
 
 def _through_libfranka(verdicts) -> int:
@@ -72,11 +83,13 @@ def _through_libfranka(verdicts) -> int:
 def _verdict(path, robot: str):
     """(the FCI's verdict, the number of commands, the commands (T, 7) rad in the robot's joint
     order) of one motion file."""
-    import numpy as np
 
+    from .._checks import check_path, short_token
     from ..io.recordings import read_recording
-    from ..sim.fci import COMMAND_PERIOD_S, judge_commands, match_joint_names
+    from ..sim.fci import judge_commands, match_joint_names
 
+    if not check_path(path, f"motion {short_token(path, 24)}").exists():
+        raise ValueError(f"motion file {path} does not exist")
     recording = read_recording(path)
     if recording.kind != "joints":
         raise ValueError(
@@ -85,15 +98,43 @@ def _verdict(path, robot: str):
         )
     if recording.t is None:
         raise ValueError(f"{path}: no time column: the FCI takes a command every 1 ms")
-    steps = np.diff(recording.t)
-    if steps.size and np.max(np.abs(steps - COMMAND_PERIOD_S)) > 1e-6:
-        rate = 1.0 / float(np.median(steps))
-        raise ValueError(
-            f"{path}: samples {1e3 * float(np.median(steps)):.4g} ms apart ({rate:.4g} Hz); "
-            f"the FCI takes a command every 1 ms: roll it out at 1000 Hz (bidmp rollout --rate 1000)"
-        )
+    _check_period(path, recording)
     commands = recording.values[:, match_joint_names(recording.names, robot)]
     return judge_commands(commands, robot), len(commands), commands
+
+
+def _check_period(path, recording) -> None:
+    """Refuse a stream that is not one command per millisecond, saying what it is: a stamp
+    repeated (its data row), a rollout at another rate (its rate), or one step off the 1 ms
+    (the data rows around it and how far apart they are)."""
+    import numpy as np
+
+    from ..sim.fci import COMMAND_PERIOD_S
+
+    if recording.repeated:
+        row, stamp = recording.repeated[0]
+        more = len(recording.repeated) - 1
+        raise ValueError(
+            f"{path}: data row {row} repeats the stamp {stamp:.6g} s of the row before"
+            + (f" ({more} more repeated stamp{'s' if more != 1 else ''})" if more else "")
+            + ": the FCI takes one command per stamp, every 1 ms"
+        )
+    steps = np.diff(recording.t)
+    off = np.flatnonzero(np.abs(steps - COMMAND_PERIOD_S) > 1e-6)
+    if not off.size:
+        return
+    median = float(np.median(steps))
+    if abs(median - COMMAND_PERIOD_S) > 1e-6:
+        raise ValueError(
+            f"{path}: samples {1e3 * median:.4g} ms apart ({1.0 / median:.4g} Hz); "
+            f"the FCI takes a command every 1 ms: roll it out at 1000 Hz (bidmp rollout --rate 1000)"
+        )
+    step = int(off[0])
+    raise ValueError(
+        f"{path}: data rows {step + 1} and {step + 2} are {1e3 * float(steps[step]):.6g} ms apart "
+        f"(t = {recording.t[step]:.6g} s and {recording.t[step + 1]:.6g} s; {off.size} step"
+        f"{'s' if off.size != 1 else ''} off 1 ms in all): the FCI takes a command every 1 ms"
+    )
 
 
 def add_commands(commands) -> None:

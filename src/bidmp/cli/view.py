@@ -47,6 +47,11 @@ def _cmd_view(args: argparse.Namespace) -> int:
     page = write_view(
         Path(args.output) if args.output else folder / PAGE, load_layers(folder / LAYERS)
     )
+    if not args.output:
+        from ..io.runs import update_manifest
+
+        # the page is the run's own (written with --view): its manifest lists it as it is now
+        update_manifest(folder, PAGE)
     print(f"wrote {page} (open it in a browser: drag to turn, slider for the robot's motion)")
     return EXIT_OK
 

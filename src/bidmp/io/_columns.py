@@ -530,8 +530,22 @@ def resolve(header: tuple[str, ...], mapping: dict | None, path) -> Layout:
         chosen = _mapped(header, keys, roles, path)
     else:
         chosen = _by_names(header, keys, time, path)
+    _refuse_repeated(header, keys, (*time, *chosen.values, *chosen.orientation), path)
     units, angles = _units_named(header, chosen, settings, path)
     return _layout(header, keys, (time, scale, declared), chosen, settings, (units, angles))
+
+
+def _refuse_repeated(header, keys, used, path) -> None:
+    """A column read whose name the header gives twice (``t,j1,j2,j1``; ``x`` and ``X(mm)``):
+    which of them holds the value is unknown, so the file is refused, naming it."""
+    for index in used:
+        twins = [other for other, key in enumerate(keys) if key == keys[index]]
+        if len(twins) > 1:
+            raise ValueError(
+                f"{path}: the header names {short_token(header[index], 30)} {len(twins)} times "
+                f"(columns {', '.join(str(other + 1) for other in twins[:4])}): which one it is "
+                f"is unknown; give each column its own name"
+            )
 
 
 def _by_names(header, keys, time, path) -> _Candidate:

@@ -18,8 +18,11 @@ _NPY_MAGIC = b"\x93NUMPY"
 _MAX_MEMBERS = 100_000
 
 
-def _read_npy_header(stream, what: str, check=None) -> tuple[tuple, np.dtype]:
-    """Read an ``.npy`` header from ``stream``; refuse object dtypes and sizes over the limits."""
+def _read_npy_header(
+    stream, what: str, check=None, records: bool = False
+) -> tuple[tuple, np.dtype]:
+    """Read an ``.npy`` header from ``stream``; refuse object dtypes and sizes over the limits
+    (``records``: records of real-number fields are read too, as a timed trajectory's)."""
     magic = stream.read(len(_NPY_MAGIC))
     if magic != _NPY_MAGIC:
         raise ValueError(f"{what} is not an .npy array")
@@ -37,7 +40,7 @@ def _read_npy_header(stream, what: str, check=None) -> tuple[tuple, np.dtype]:
         raise ValueError(f"{what} has a corrupt .npy header ({type(exc).__name__})") from None
     if not (isinstance(shape, tuple) and all(isinstance(n, int) and n >= 0 for n in shape)):
         raise ValueError(f"{what} has a corrupt .npy header (shape {short_token(shape, 30)})")
-    if dtype.hasobject or dtype.kind not in "fiub":
+    if dtype.hasobject or (dtype.kind not in "fiub" and not (records and _real_records(dtype))):
         raise ValueError(f"{what} holds {dtype} data, not real numbers")
     if len(shape) > 8:
         raise ValueError(f"{what} has {len(shape)} dimensions")
@@ -48,11 +51,19 @@ def _read_npy_header(stream, what: str, check=None) -> tuple[tuple, np.dtype]:
     return shape, dtype
 
 
-def _read_npy(open_stream, what: str, check=None) -> np.ndarray:
+def _real_records(dtype: np.dtype) -> bool:
+    """Whether ``dtype`` is a record of named real-number scalars (``t, x, y, z``, …)."""
+    names = dtype.names or ()
+    return bool(names) and all(
+        dtype[name].kind in "fiu" and dtype[name].shape == () for name in names
+    )
+
+
+def _read_npy(open_stream, what: str, check=None, records: bool = False) -> np.ndarray:
     """Read an array from the stream factory ``open_stream`` after checking its header
-    (``check(shape, dtype)`` may refuse more)."""
+    (``check(shape, dtype)`` may refuse more; ``records``: :func:`_read_npy_header`'s)."""
     with open_stream() as stream:
-        _read_npy_header(stream, what, check)
+        _read_npy_header(stream, what, check, records)
     with open_stream() as stream:
         try:
             return np.lib.format.read_array(stream, allow_pickle=False)
@@ -206,7 +217,9 @@ def _read_npy_trajectory(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
             f"{path} is an .npz archive (a model file?), not an .npy array of shape (T, D)"
         )
     try:
-        positions = _read_npy(lambda: open(path, "rb"), str(path), _check_npy_trajectory(path))
+        positions = _read_npy(
+            lambda: open(path, "rb"), str(path), _check_npy_trajectory(path), records=True
+        )
     except (EOFError, OSError) as exc:
         raise ValueError(f"{path} is not a readable .npy array ({type(exc).__name__})") from None
     except ValueError as exc:

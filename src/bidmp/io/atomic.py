@@ -117,10 +117,14 @@ def atomic_write(path: str | os.PathLike, mode: str = "wb") -> Iterator:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)
         # A full disk says "No space left on device" without the file: name it (the old one stays).
-        raise OSError(
+        error = OSError(
             exc.errno,
             f"cannot write {shown_path(target)} ({exc.strerror or exc}); nothing was replaced",
-        ) from None
+        )
+        # the whole path, for a caller that says where the file was going (a run folder's
+        # writer: bidmp.io.runs); the message shows its end only. Not in str(error).
+        error.filename2 = str(target)
+        raise error from None
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp_name)

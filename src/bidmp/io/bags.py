@@ -187,13 +187,15 @@ def read_bag(
     try:
         wanted = _wanted_connections(reader, topic, tf, joints)
         kind = {JOINT_STATE: "joints", POINT_STAMPED: "positions"}.get(wanted[0].msgtype, "pose")
-        stamps, rows, names = [], [], None
-        for connection, _, raw in reader.messages(connections=wanted):
+        stamps, rows, numbers, names = [], [], [], None
+        for number, (connection, _, raw) in enumerate(reader.messages(connections=wanted), 1):
             message = reader.deserialize(raw, connection.msgtype)
-            for stamp, row, found in _rows(message, connection.msgtype, tf, joints, names):
+            where = f"bag {shown_path(path)}: message {number} on {connection.topic}"
+            for stamp, row, found in _rows(message, connection.msgtype, tf, joints, names, where):
                 names = found if names is None else names
                 stamps.append(stamp)
                 rows.append(row)
+                numbers.append(number)
         source = f"tf {tf[0]} -> {tf[1]}" if tf is not None else f"topic {wanted[0].topic}"
         if not rows:
             raise ValueError(
@@ -204,8 +206,10 @@ def read_bag(
         )
     finally:
         reader.close()
+    values = np.array(rows, dtype=float)
+    _check_finite(values, (stamps, numbers), names, f"bag {shown_path(path)}: {source}")
     stamps = [stamps[index] for index in order]
-    values = np.array(rows, dtype=float)[order]
+    values = values[order]
     # exact to the nanosecond
     t = np.array([stamp - stamps[0] for stamp in stamps], dtype=float) * 1e-9
     return Recording(
@@ -272,6 +276,9 @@ def _check_selection(topic, tf, joints) -> None:
         raise ValueError(
             f"joints must be a list of joint names or True (every joint), got {short_token(joints, 30)}"
         )
+    if isinstance(joints, (list, tuple)) and len(set(joints)) != len(joints):
+        repeated = next(name for name in joints if list(joints).count(name) > 1)
+        raise ValueError(f"joints: joint {short_token(repeated, 30)} is named twice")
     if tf is not None and joints is not None:
         raise ValueError("tf and joints: give one (a transform or joint states), not both")
 
@@ -322,8 +329,9 @@ def _wanted_connections(reader, topic, tf, joints) -> list:
     return found
 
 
-def _rows(message, msgtype: str, tf, joints, names):
-    """(stamp s, row, column names) of the samples one message holds."""
+def _rows(message, msgtype: str, tf, joints, names, where: str):
+    """(stamp s, row, column names) of the samples one message holds (``where``: the message, for
+    errors)."""
     if msgtype == POSE_STAMPED:
         p, q = message.pose.position, message.pose.orientation
         yield _stamp(message.header), [p.x, p.y, p.z, q.x, q.y, q.z, q.w], POSE_COLUMNS
@@ -339,15 +347,64 @@ def _rows(message, msgtype: str, tf, joints, names):
             ) and transform.child_frame_id.lstrip("/") == tf[1].lstrip("/"):
                 yield _stamp(transform.header), _transform_row(transform), POSE_COLUMNS
     else:
-        available = list(message.name)
-        chosen = available if joints is True else (names or list(joints))
-        missing = [name for name in chosen if name not in available]
-        if missing:
+        yield _joint_row(message, joints, names, where)
+
+
+def _listed(names, limit: int = 8) -> str:
+    """Joint names for a message: the first ``limit``, each short."""
+    shown = ", ".join(short_token(name, 30)[1:-1] for name in names[:limit])
+    return shown + (f", … ({len(names)} in all)" if len(names) > limit else "")
+
+
+def _joint_row(message, joints, names, where: str) -> tuple:
+    """(stamp, positions, names) of one ``JointState``: the positions picked by joint name, so a
+    driver that lists its joints in another order from one message to the next (two publishers
+    on one topic, a reordered driver) still gives each column its own joint. ``names``: the
+    joints the first message chose (None for the first); a name listed twice, or positions that
+    do not match the names one for one, are refused: which position is whose is unknown."""
+    available = [str(name) for name in message.name]
+    positions = np.asarray(message.position, dtype=float).reshape(-1)
+    seen = set()
+    for name in available:
+        if name in seen:
             raise ValueError(
-                f"joint state without joint(s) {', '.join(missing)}; it names {', '.join(available)}"
+                f"{where}: the joint state names joint {short_token(name, 30)} twice "
+                f"({_listed(available)}): which position is its is unknown"
             )
-        positions = np.asarray(message.position, dtype=float)
-        yield _stamp(message.header), [positions[available.index(name)] for name in chosen], chosen
+        seen.add(name)
+    if positions.size != len(available):
+        raise ValueError(
+            f"{where}: the joint state has {positions.size} positions for {len(available)} "
+            f"joint names ({_listed(available)}): a position per name is needed to tell whose is whose"
+        )
+    chosen = names or (available if joints is True else list(joints))
+    missing = [name for name in chosen if name not in seen]
+    if missing:
+        raise ValueError(
+            f"{where}: the joint state has no joint(s) {_listed(missing, 4)}; it names "
+            f"{_listed(available)}"
+        )
+    column = {name: index for index, name in enumerate(available)}
+    return _stamp(message.header), positions[[column[name] for name in chosen]].tolist(), chosen
+
+
+def _check_finite(values: np.ndarray, messages: tuple, names, what: str) -> None:
+    """Refuse a NaN or infinite value read from a bag, as a CSV's gap is refused: the message
+    (its number in receive order and its stamp; ``messages`` = (stamps ns, numbers), one per row)
+    and the column, and how many rows have one."""
+    stamps, numbers = messages
+    bad = ~np.isfinite(values)
+    if not bad.any():
+        return
+    row, column = (int(v) for v in np.argwhere(bad)[0])
+    value = float(values[row, column])
+    word = "NaN" if np.isnan(value) else ("inf" if value > 0 else "-inf")
+    count = int(bad.any(axis=1).sum())
+    raise ValueError(
+        f"{what}: {word} in {short_token(names[column], 30)[1:-1]} at message {numbers[row]} "
+        f"(stamped {stamps[row] * 1e-9:.9f} s; {count:,} sample{'s' if count != 1 else ''} "
+        f"with NaN or inf in all): a motion is read without gaps; drop those messages or fill them"
+    )
 
 
 def _transform_row(stamped) -> list:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._checks import as_trajectory, check_path, short_token
+from .._units import UNITS
 from ._columns import Layout, parse_columns, resolve, split_unit, times_in_seconds
 from ._conventions import _TIME_DIVISORS
 from ._npy import _read_npy_trajectory
@@ -51,6 +52,10 @@ class Recording:
     orientation : (n, 4) or None
         Positions picked from a pose group (``columns="position=actual_TCP_pose"``): the tool's
         orientation beside them, ``qx, qy, qz, qw``.
+    repeated : tuple of (int, float)
+        The samples dropped because their stamp repeats the one before: (data row, 1-based
+        among the file's data rows; the stamp, s). A command stream judged sample by sample
+        refuses them; a demonstration loses nothing.
     """
 
     t: np.ndarray | None
@@ -62,6 +67,7 @@ class Recording:
     stamp: float
     ignored: tuple = ()
     orientation: np.ndarray | None = None
+    repeated: tuple = ()
 
 
 def _header_line(path) -> str:
@@ -190,8 +196,11 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
             f"{path}: unsupported file type {short_token(suffix)[1:-1] if suffix else '(none)'}; use .csv or .npy"
         )
     kind = "positions" if layout is None else layout.kind
-    positions = as_trajectory(positions, name=str(path), allow_static=kind == "pose")
+    # an arm standing still is a joint record as good as any (a command stream may hold still)
+    positions = as_trajectory(positions, name=str(path), allow_static=kind in ("pose", "joints"))
+    repeated = ()
     if times is not None:
+        repeated = _repeated_stamps(times)
         positions, times = drop_repeated_stamps(positions, times, f"{path}: the time column")
     if layout is not None and layout.rotation is not None:
         turns = positions[:, 3:7] if kind == "pose" else positions[:, 3:]
@@ -211,7 +220,7 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         names = (
             _joint_names(path, layout, text, header) if layout.names_from else list(layout.names)
         )
-        units, source = declared or layout.units, layout.label
+        units, source = _units(path, layout, declared, names), layout.label
     return Recording(
         times,
         positions,
@@ -222,7 +231,28 @@ def read_recording(path: str | os.PathLike, *, columns=None) -> Recording:
         float(times[0]) if times is not None else 0.0,
         () if layout is None else layout.ignored,
         orientation,
+        repeated,
     )
+
+
+def _units(path, layout: Layout, declared: str, names: list) -> str:
+    """The unit of a file read with a header: the one it declares (``# units: mm``), else its
+    columns' convention. A length declared on joints is refused: their angles are radians, and
+    a length there says the columns are positions read as joints, or the line is wrong."""
+    if layout.kind == "joints" and declared in UNITS:
+        shown = ", ".join(short_token(name, 16)[1:-1] for name in names[:3])
+        raise ValueError(
+            f"{path} declares '# units: {declared}', a length, but its columns read as joints "
+            f"({shown}{', …' if len(names) > 3 else ''}: radians): declare '# units: rad' or "
+            f"none; positions are named x,y,z (or --columns)"
+        )
+    return declared or layout.units
+
+
+def _repeated_stamps(times: np.ndarray) -> tuple:
+    """(data row 1-based, stamp s) of each sample whose stamp repeats the one before."""
+    rows = np.flatnonzero(np.diff(times) == 0) + 1
+    return tuple((int(row) + 1, float(times[row])) for row in rows)
 
 
 def _headerless(values: np.ndarray, path) -> np.ndarray:

@@ -225,8 +225,11 @@ def check_timestamps(t, n_samples: int, name: str = "t", samples: str = "") -> n
 
 
 def _stamp(value: float) -> str:
-    """A timestamp as the shortest text that tells it from its neighbours (all its digits)."""
-    return np.format_float_positional(float(value), unique=True, trim="-")
+    """A timestamp as the shortest text that tells it from its neighbours (all its digits):
+    positional, as stamps are read, unless that takes more than 30 characters (a stamp of
+    1e-300 s would print 300 zeros into a one-line message): then in scientific notation."""
+    text = np.format_float_positional(float(value), unique=True, trim="-")
+    return text if len(text) <= 30 else np.format_float_scientific(float(value), trim="-")
 
 
 def drop_repeated_stamps(y, t, name: str = "t") -> tuple[np.ndarray, np.ndarray]:

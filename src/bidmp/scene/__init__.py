@@ -14,7 +14,7 @@ from .._lazy import exports
 
 # The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
 if TYPE_CHECKING:
-    from .checker import SceneChecker
+    from .checker import PoseChecker, SceneChecker
     from .clearance import Clearance, Scene
     from .fields import random_field
     from .parts import PART_TYPES, Part, SceneError, Solid, Tool

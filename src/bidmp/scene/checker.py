@@ -4,11 +4,20 @@
 from __future__ import annotations
 
 import logging
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._checks import as_indices, as_points, check_limit, check_real
+from .._checks import (
+    as_indices,
+    as_point,
+    as_points,
+    as_rotation,
+    check_limit,
+    check_real,
+    checks_input,
+)
 from .distances import _CHUNK, _MAX_ADVANCE_STEPS, _cylinder_box_bounds, _Distances
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -111,3 +120,86 @@ class SceneChecker:
             # touching the margin is allowed
             travelled = min(travelled + max(distance - margin, resolution), length)
         return False  # grazing for too long: treated as a contact (conservative)
+
+
+class PoseChecker:
+    """Whether the tool, placed at a pose, keeps every part's own clearance: the ``margin`` (a
+    planning margin, or the scene's), a part's stand-off where the scene states one (the plate the
+    nuts stand on). What a planner asks of the tool at each configuration it tests
+    (:func:`bidmp.planning.tool_route`): one placement at a time, a tool that may tilt.
+
+    The parts' boxes in their own frames bound the distances from below (the clearance's own
+    bounds); coal is asked only for the parts whose bound is within their clearance.
+    """
+
+    def __init__(self, scene: Scene, chosen: np.ndarray, margin: float):
+        if not all(hasattr(scene, name) for name in ("solids", "tool", "_engine", "standoff")):
+            raise TypeError(f"scene must be a bidmp.Scene, got {type(scene).__name__}")
+        self.scene = scene
+        self.chosen = (
+            as_indices(chosen, "chosen", len(scene.solids) - 1)
+            if len(scene.solids)
+            else np.zeros(0, np.int64)
+        )
+        self.margin = check_real(margin, "margin", nonnegative=True)
+        owners = scene._owner[self.chosen] if self.chosen.size else []
+        # each solid's clearance: its part's stand-off, else the margin
+        self.required = np.array(
+            [min(scene.standoff.get(owner, self.margin), self.margin) for owner in owners],
+            dtype=float,
+        )
+        self._down = np.array([0.0, 0.0, -1.0])
+
+    def free(self, point, rotation=None, check_input: bool = True) -> bool:
+        """Whether the tool's mouth at ``point`` (3,), its frame ``rotation`` (3, 3; its z axis the
+        approach direction; default pointing down), keeps every part's clearance.
+        ``check_input=False``: the arguments taken as given (a planner's, at every test)."""
+        return self.slack(point, rotation, far=0.0, check_input=check_input) >= 0.0
+
+    def nearest(self, point, rotation=None) -> str:
+        """The label of the part (solid) the tool at ``point`` (its frame ``rotation``) comes
+        nearest its clearance of ("" with no part checked)."""
+        point = as_point(point, 3, "point")
+        rotation = None if rotation is None else as_rotation(rotation, "rotation")
+        if self.chosen.size == 0:
+            return ""
+        engine = self.scene._engine()
+        slacks = [
+            engine.tool_to(point, int(index), rotation) - required
+            for index, required in zip(self.chosen, self.required)
+        ]
+        return self.scene.solids[int(self.chosen[int(np.argmin(slacks))])].label
+
+    def slack(
+        self, point, rotation=None, far: float | None = None, check_input: bool = True
+    ) -> float:
+        """How far the tool at ``point`` (its frame ``rotation``, as :meth:`free`) is from coming
+        within any part's clearance (scene units; negative: it is within it by that much; ``inf``
+        with no part checked). A lower bound where every part is more than ``far`` beyond its
+        clearance (default the tool's radius): the parts' boxes say so without coal."""
+        if checks_input(check_input):
+            point = as_point(point, 3, "point")
+            rotation = None if rotation is None else as_rotation(rotation, "rotation")
+            far = None if far is None else check_real(far, "far", nonnegative=True)
+        if self.chosen.size == 0:
+            return math.inf
+        scene = self.scene
+        point = np.asarray(point, dtype=float)
+        axis = self._down if rotation is None else np.asarray(rotation, dtype=float)[:, 2]
+        centre = point - axis * (scene.tool.length / 2.0)
+        bounds = scene._oriented_bounds(centre[None], axis[None], self.chosen)[0] - self.required
+        order = np.argsort(bounds, kind="stable")
+        far = scene.tool.radius if far is None else far
+        if bounds[order[0]] > far:
+            return float(bounds[order[0]])
+        engine = scene._engine()
+        best = math.inf
+        for col in order:
+            if bounds[col] >= best:
+                break  # every remaining part is bounded below by at least the best so far
+            best = min(
+                best, engine.tool_to(point, int(self.chosen[col]), rotation) - self.required[col]
+            )
+            if best < 0.0 and far == 0.0:
+                break  # (a yes-or-no question: one part within its clearance answers it)
+        return float(best)

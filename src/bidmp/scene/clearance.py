@@ -32,7 +32,7 @@ from .._checks import (
 from .._norms import row_norms, unit_rows
 from .._trajectory import continuous_quaternions
 from .._units import check_units
-from .checker import SceneChecker
+from .checker import PoseChecker, SceneChecker
 from .distances import _CHUNK, _box_distance, _cylinder_box_bounds, _densify, _Distances
 from .parts import Part, Solid, Tool, _cylinder_extent, _fail, _number, _parse_parts
 
@@ -615,6 +615,12 @@ class Scene:
             ),
             lambda row, index: engine.body_to(shape, solid.rotation, centres[row], index),
         )
+
+    def pose_checker(self, exclude=(), margin: float | None = None) -> PoseChecker:
+        """Whether the tool at one pose keeps every part's clearance (:class:`PoseChecker`): the
+        parts in ``exclude`` ignored, ``margin`` (scene units; default the scene's) kept from the
+        others, a part's stand-off from it."""
+        return PoseChecker(self, self._selected(exclude), self.margin if margin is None else margin)
 
     def checker(self, exclude=(), margin: float | None = None) -> SceneChecker:
         """The roadmap's collision callback for this scene (parts in ``exclude`` ignored): a

@@ -12,6 +12,8 @@
 * ``fci`` — the Franka Control Interface's own limits (Panda, FR3) judging 1 kHz joint commands;
 * ``libfranka`` — the same commands streamed through libfranka to franka-sim, a simulated FR3 (a
   side environment of their own, ``make franka``; ``_franka_side.py`` is what runs there);
+* ``routes``, ``arm_geometry`` — the arm's complete fallback: a route planned in joint space over
+  its links and tool against the cell, ending in the final approach, timed to its limits;
 * ``report`` — the results, apart from any backend, and their files.
 
 Layer 3 (the application): imports the math, ``io`` and ``tasks``; never ``cli``. PyBullet is an
@@ -26,6 +28,7 @@ from .._lazy import exports
 
 # The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
 if TYPE_CHECKING:
+    from .arm_geometry import ArmGeometry, ArmSpace
     from .backend import (
         Execution,
         GoalUpdate,
@@ -80,6 +83,15 @@ if TYPE_CHECKING:
         RobotModel,
         robot_model,
         robot_placement,
+    )
+    from .routes import (
+        DROP_CONE_DEG,
+        SLOW,
+        ArmRoute,
+        arm_route,
+        judged_route,
+        needlessly_slow,
+        supports_routes,
     )
     from .run import execution_report, execution_settings, simulate, target_labels
 __getattr__, __dir__ = exports(__name__, __file__, globals())

@@ -266,6 +266,8 @@ class SimulatorBackend(Protocol):
     name: str  # the arm's name, in reports
     simulator: str  # how reports name the simulator ("PyBullet, 1 kHz position control")
     rest: tuple  # the joints (rad) it starts from and IK is seeded with
+    joint_names: tuple  # its driven joints' names, base to flange (a command file's header)
+    joint_units: tuple  # each joint's unit: "rad" (revolute) or "m" (prismatic)
 
     @classmethod
     def load_robot(cls, scene, units: str, base, yaw: float, **robot) -> SimulatorBackend:

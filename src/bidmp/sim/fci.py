@@ -321,8 +321,8 @@ def _bound(limits: FCILimits, quantity: str, value: float, joint: int, lowest, h
 
 def match_joint_names(names, robot: str) -> np.ndarray:
     """The columns of ``names`` (a motion file's joint names) in the robot's joint order, each
-    name one of ``robot``'s (``panda_joint1..7``, ``fr3_joint1..7``): a ValueError naming the
-    first that is not, or the first that is missing."""
+    name one of ``robot``'s (``panda_joint1..7``, ``fr3_joint1..7``) once: a ValueError naming
+    the first named twice, the first that is not the robot's, or the first that is missing."""
     limits = FCI_LIMITS[check_choice(robot, "robot", tuple(FCI_LIMITS))]
     if (
         not isinstance(names, (list, tuple))
@@ -331,6 +331,12 @@ def match_joint_names(names, robot: str) -> np.ndarray:
     ):
         raise TypeError(
             f"names must be a list of joint names (strings), got {type(names).__name__}"
+        )
+    twice = next((name for name in names if names.count(name) > 1), None)
+    if twice is not None:
+        raise ValueError(
+            f"names: joint {short_token(twice, 30)} is named {names.count(twice)} times: which "
+            f"column is its command is unknown"
         )
     unknown = [name for name in names if name not in limits.joint_names]
     if unknown:

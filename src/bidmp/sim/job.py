@@ -66,6 +66,10 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     )
     if not repaired.ok:
         raise _StepFailed(f"approach: {repaired.reason()}")
+    if repaired.how == "route" and repaired.model is not None:
+        world.model = (
+            repaired.model
+        )  # the route, learned as a skill: the next targets start from it
     path, turns = repaired.motion[:, :3], (repaired.motion[:, 3:] if world.pose else None)
     fractions = np.linspace(0.0, 1.0, path.shape[0])
     note = f"repaired: {repaired.how}" if repaired.how else ""
@@ -555,6 +559,15 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
     )
 
 
+def _joints_of(cell) -> tuple[tuple, tuple]:
+    """(names, units) of the arm that ran: its backend's; a backend that does not name its
+    joints gets ``joint1`` … in radians."""
+    count = len(cell.limits.lower)
+    names = tuple(getattr(cell, "joint_names", ()) or (f"joint{k + 1}" for k in range(count)))
+    units = tuple(getattr(cell, "joint_units", ()) or ("rad",) * len(names))
+    return names, units
+
+
 def run_job(  # noqa: PLR0913 - the public call spells its options out, as users pass them
     scenario,
     *,
@@ -599,6 +612,7 @@ def run_job(  # noqa: PLR0913 - the public call spells its options out, as users
     scene = _job_scene(scenario, parts)
     cell = _open_world(backend, scenario, base, yaw)
     try:
+        joints = _joints_of(cell)  # (asked while the world is open)
         added = {part["label"] for part in parts}
         cell.add_solids([solid for solid in scene.solids if solid.part in added])
         world = _job_world(scenario, report, cell, scene, pictures, view)
@@ -650,4 +664,5 @@ def run_job(  # noqa: PLR0913 - the public call spells its options out, as users
     )
     out.failures = world.failures
     out.evaluation, out.scene = report, scene
+    out.joint_names, out.joint_units = joints
     return out

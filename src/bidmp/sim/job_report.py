@@ -166,6 +166,9 @@ class JobReport:
     scene: object = None
     # (target, phase, image, reason) where a motion broke the contract
     failures: list = field(default_factory=list)
+    # the arm that ran: its driven joints' names and units ("rad", "m"), base to flange
+    joint_names: tuple = ()
+    joint_units: tuple = ()
 
     @property
     def removed(self) -> int:
@@ -298,18 +301,37 @@ def write_job_report(report: JobReport, out) -> list[Path]:
     return written
 
 
-def write_job_commands(report: JobReport, folder, joint_names) -> list[Path]:
+def write_job_commands(report: JobReport, folder, joint_names=None) -> list[Path]:
     """Every motion's 1 kHz joint commands of a job run with ``record=True``, one CSV per motion:
     ``<folder>/<NN>_<target>_<phase>.csv`` (NN its order in the job), columns ``t`` (s from the
-    motion's first command, 1 ms apart) and the arm's joint names (rad), a ``# units: rad`` line
-    first: what ``bidmp verify`` judges by the arm's own (FCI) limits."""
+    motion's first command, 1 ms apart) and the joint names of the arm that ran
+    (``report.joint_names``; ``joint_names`` renames them, one per joint), a ``# units: rad``
+    line first when every joint is revolute (an arm with prismatic joints, the kinematic
+    backend's carriage, says each joint's unit in a comment instead): what ``bidmp verify``
+    judges by the arm's own (FCI) limits."""
     from .._checks import check_kind, check_path, printable
     from ..io.atomic import atomic_write
 
     check_kind(report, JobReport, "report", "a bidmp.sim.JobReport (bidmp.sim.run_job)")
     folder = Path(check_path(folder, "folder"))
-    folder.mkdir(parents=True, exist_ok=True)
+    if joint_names is None:
+        joint_names = report.joint_names
+    elif not isinstance(joint_names, (list, tuple)) or not all(
+        isinstance(name, str) and name.isprintable() and name and "," not in name
+        for name in joint_names
+    ):
+        raise TypeError(
+            "joint_names must be a list of joint names (text, no commas), one per joint"
+        )
     names = [str(name) for name in joint_names]
+    if len(set(names)) != len(names):
+        raise ValueError(f"joint_names: a name repeats among {', '.join(names[:8])}")
+    units = tuple(report.joint_units) or ("rad",) * len(names)
+    if set(units) == {"rad"}:
+        first = "# units: rad\n"
+    else:
+        first = "# joint units: " + ", ".join(f"{n} {u}" for n, u in zip(names, units)) + "\n"
+    folder.mkdir(parents=True, exist_ok=True)
     written, index = [], 0
     for target in report.targets:
         for phase in target.phases:
@@ -326,7 +348,7 @@ def write_job_commands(report: JobReport, folder, joint_names) -> list[Path]:
             path = folder / f"{index:03d}_{safe}_{phase.name}.csv"
             t = np.arange(len(commands)) * 1e-3
             with atomic_write(path, "w") as handle:
-                handle.write("# units: rad\n")
+                handle.write(first)
                 handle.write("t," + ",".join(names) + "\n")
                 np.savetxt(handle, np.column_stack([t, commands]), delimiter=",", fmt="%.17g")
             written.append(path)

@@ -15,8 +15,10 @@ from scipy.spatial.transform import Rotation
 
 from .._units import length_text
 from ..tasks.contract import Contract
+from .backend import SimError
 from .job_report import JobPhase, _phase
 from .planning import _paced_duration, _slowed
+from .routes import needlessly_slow, supports_routes
 
 if TYPE_CHECKING:
     from ..incremental.bidmp import BiDMP
@@ -116,21 +118,49 @@ def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
     orientations, carried, target, axis = move.orientations, move.carried, move.target, move.axis
     least_duration, spacing, support = move.least_duration, move.spacing, move.support
     cell = world.cell
-    plan = cell.plan(
-        np.asarray(path, dtype=float),
-        f"{world.label} ({name})" if world.label else name,  # "target 'B4 (approach)': ..."
-        fractions=fractions,
-        seed=world.q,
-        orientations=orientations,
-        **({} if spacing is None else {"spacing": spacing}),
-    )
-    # No faster than the demonstration's pace, nor than the step asks (the spindle's turns, a
-    # rhythm's timing): the limits only ever slow a motion down.
-    pace = _paced_duration(path, fractions, world.scenario.pace)
-    _slowed(plan, max(least_duration, pace))
-    contract = world.contract if name == "approach" else _transfer_contract(world.contract)
-    goal = np.asarray(path, dtype=float)[-1] if target is None else np.asarray(target)[:3]
-    refused = _refused_plan(world, plan, contract, move, goal)
+    note = ""
+    try:
+        plan = cell.plan(
+            np.asarray(path, dtype=float),
+            f"{world.label} ({name})" if world.label else name,  # "target 'B4 (approach)': ..."
+            fractions=fractions,
+            seed=world.q,
+            orientations=orientations,
+            **({} if spacing is None else {"spacing": spacing}),
+        )
+        # (a carried part is not rushed: its weight on a faster route is the physics' to judge)
+        slow = (
+            name in _ROUTED
+            and carried is None
+            and supports_routes(cell)
+            and needlessly_slow(cell, plan)
+        )
+        # No faster than the demonstration's pace, nor than the step asks (the spindle's turns, a
+        # rhythm's timing): the limits only ever slow a motion down.
+        _slowed(plan, max(least_duration, _paced_duration(path, fractions, world.scenario.pace)))
+        contract, goal = _judged_by(world, move)
+        refused = _refused_plan(world, plan, contract, move, goal)
+        if refused is None and slow:  # near a singularity: the arm's own route, if faster
+            routed, _ = _routed(world, move, contract, goal)
+            if routed is not None and routed.duration < plan.duration:
+                plan, note = (
+                    routed,
+                    "the arm's own route (the skill's motion ran near a singularity)",
+                )
+    except SimError as exc:  # a point the IK does not reach from the joints now, a limit
+        if name not in _ROUTED or not supports_routes(cell):
+            raise
+        (contract, goal), plan, refused = _judged_by(world, move), None, exc
+    if refused is not None and name in _ROUTED and supports_routes(cell):
+        # The motion between places cannot run from the arm's joints now: the arm's own route
+        # from here, judged like any motion, before the step is given up.
+        routed, why = _routed(world, move, contract, goal)
+        if routed is not None:
+            plan, refused, note = routed, None, "the arm's own route"
+        elif isinstance(refused, SimError):
+            raise SimError(f"{refused}; the arm's own route: {why}") from None
+        else:
+            refused.note = f"{refused.note}; the arm's own route: {why}"
     if refused is not None:
         return refused
     touched = {}
@@ -164,10 +194,75 @@ def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
         clearance=clearance,
     )
     phase.ok = phase.verdict.ok
+    if note:
+        phase.note = f"{phase.note}; {note}" if phase.note else note
     if world.record:
         phase.path, phase.commands = executed, np.asarray(run.commands)
     world.clock += phase.seconds
     return phase
+
+
+def _judged_by(world: _World, move: _Move) -> tuple:
+    """The contract ``move`` is judged by (an approach's, or a transfer's without a final
+    descent) and the point its end is judged at (its target, else its path's end)."""
+    contract = world.contract if move.name == "approach" else _transfer_contract(world.contract)
+    goal = np.asarray(move.path, dtype=float)[-1] if move.target is None else move.target
+    return contract, np.asarray(goal, dtype=float)[:3]
+
+
+# The moves between places: where one cannot run from the arm's joints now, the arm's own route
+# is planned (the straight moves along a part's axis are the task itself: no other route).
+_ROUTED = ("approach", "drop", "place")
+
+
+def _routed(world: _World, move: _Move, contract, goal) -> tuple:
+    """``(plan, "")`` of the arm's own route for ``move`` from its joints now
+    (:func:`bidmp.sim.routes.arm_route`), judged before it runs as every motion is; ``(None,
+    why)`` when there is none or the contract refuses it. An approach ends in the final approach
+    down the target's axis; a drop may tilt the tool within :data:`~bidmp.sim.routes.DROP_CONE_DEG`
+    of pointing down (the part falls the same); a placed part is kept upright. A carried part is
+    carried along the route and kept clear."""
+    from .._units import mm
+    from .routes import DROP_CONE_DEG, arm_route
+    from .run import TRACKING_ALLOWANCE_MM
+
+    cell, scenario = world.cell, world.scenario
+    approach = move.name == "approach"
+    target = np.asarray(move.target if move.target is not None else goal, dtype=float)
+    carried = None
+    if move.carried is not None:  # the part as it is now, riding on the tool from the joints now
+        centre, rotation = move.carried.pose()
+        carried = (move.carried.solid.moved(centre, rotation.as_matrix()), world.q)
+    try:
+        routed = arm_route(
+            cell,
+            world.q,
+            target[:3],
+            scene=world.scene,
+            axis=(move.axis if move.axis is not None else [0.0, 0.0, 1.0]) if approach else None,
+            approach_height=(scenario.approach_height or 0.0) if approach else 0.0,
+            orientation=target[3:7] if approach and target.shape[0] >= 7 else None,
+            exclude=list(move.exclude) + ([move.carried.label] if move.carried is not None else []),
+            margin=world.scene.margin + mm(TRACKING_ALLOWANCE_MM, scenario.units),
+            seed=scenario.seed,
+            label=f"{world.label} ({move.name})" if world.label else move.name,
+            carried=carried,
+            cone=DROP_CONE_DEG if move.name == "drop" else 0.0,
+        )
+    except SimError as exc:
+        return None, str(exc)
+    plan = routed.plan
+    path = plan.points / cell.unit
+    _slowed(plan, max(move.least_duration, _paced_duration(path, plan.fractions, scenario.pace)))
+    planned = move._replace(
+        path=path,
+        fractions=plan.fractions,
+        orientations=plan.orientations if world.pose else None,
+    )
+    refused = _refused_plan(world, plan, contract, planned, goal)
+    if refused is not None:
+        return None, refused.note
+    return plan, ""
 
 
 def _refused_plan(world: _World, plan, contract, move: _Move, goal) -> JobPhase | None:

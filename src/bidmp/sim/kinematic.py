@@ -80,6 +80,9 @@ class KinematicCell:
     limits = KINEMATIC_LIMITS
     rest = _REST
     n_joints = 6
+    # the carriage's three prismatic joints (m), then the wrist's rotation vector (rad)
+    joint_names = ("carriage_x", "carriage_y", "carriage_z", "wrist_x", "wrist_y", "wrist_z")
+    joint_units = ("m", "m", "m", "rad", "rad", "rad")
 
     def __init__(self, scene, units: str = "mm", base=(0.0, -450.0, 0.0), yaw: float = 90.0):
         from ..scene import Scene

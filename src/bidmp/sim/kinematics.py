@@ -51,10 +51,7 @@ def _seed(seed, n_joints: int) -> np.ndarray:
 def joint_names(robot="panda") -> list[str]:
     """The names of the arm's driven joints, base to flange, as in its URDF."""
     with _arm(robot, "m", 0.0) as cell:
-        return [
-            cell.p.getJointInfo(cell.robot, j, physicsClientId=cell.client)[1].decode()
-            for j in cell.arm
-        ]
+        return list(cell.joint_names)
 
 
 def inverse_kinematics(  # noqa: PLR0913 - the public call spells its options out, as users pass them

@@ -21,6 +21,7 @@ from .planning import _paced_duration, _slowed
 from .pybullet.cell import RobotCell
 from .report import SimMethod, SimReport, SimTarget, _measure, _SimTask
 from .robots import (
+    IK_TOLERANCE,
     MAX_SAMPLE_SPACING,
     PANDA_MODEL,
     RobotModel,
@@ -28,6 +29,7 @@ from .robots import (
     robot_model,
     robot_placement,
 )
+from .routes import judged_route, needlessly_slow, reach, supports_routes
 
 __all__ = ["execution_report", "execution_settings", "simulate", "target_labels"]
 
@@ -93,6 +95,44 @@ def _run_jobs(setup: _SimSetup, jobs: list, progress=None) -> list:
     return results
 
 
+def _touch_reason(setup: _SimSetup, cell, plan, job: _Job) -> str:
+    """Why ``plan`` may not run though its tool path keeps the contract ("" when it may): a
+    link of the arm would touch a part (a backend that models its links: ``arm_touch``)."""
+    touch = getattr(cell, "arm_touch", None)
+    touched = None if touch is None else touch(plan, job.exclude)
+    if touched is None:
+        return ""
+    return (
+        f"not run: the arm would touch {touched[0]} ({length_text(touched[1], setup.task.units)} "
+        f"deep) on its way to {job.label}, though the tool's path keeps the contract"
+    )
+
+
+def _arm_routed(setup: _SimSetup, cell, contract, job: _Job):
+    """The arm's own route to ``job``'s target from where its motion starts, judged before it
+    runs (:func:`bidmp.sim.routes.judged_route`), with the repairs' tracking allowance on the
+    margin and no faster than the demonstration's pace; a ``SimError`` when there is none."""
+    task, label = setup.task, job.label
+    target = np.asarray(task.targets[label], dtype=float)
+    axis = task.axes.get(label)
+    plan = judged_route(
+        cell,
+        contract,
+        job.rollout[0],
+        target,
+        axis=axis,
+        approach_height=task.approach_height or 0.0,
+        exclude=job.exclude,
+        margin=cell.scene.margin + mm(TRACKING_ALLOWANCE_MM, task.units),
+        pace=setup.pace,
+        label=label,
+    )
+    touched = _touch_reason(setup, cell, plan, job)
+    if touched:
+        raise SimError(touched)
+    return plan
+
+
 def _not_run(job: _Job, reason: str, frames=()) -> tuple:
     """The outcome of a motion not sent to the arm: its row with ``reason``, no simulated time, no
     recorded arm (the tuple ``_run_one`` returns); ``frames``: a still of the arm where it stands,
@@ -106,19 +146,36 @@ def _run_one(setup: _SimSetup, cell, contract, job):
     # which smooths its final stop: it is timed on samples 1 mm apart (else a fast descent stops
     # harder than the joints' acceleration limits, and the limiter overshoots the nut).
     spacing = CLOSED_LOOP_SPACING if setup.closed_loop else MAX_SAMPLE_SPACING
-    plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
-    _slowed(plan, _paced_duration(job.rollout, None, setup.pace))  # the demonstration's pace
     if setup.closed_loop and job.orientations is not None:
         raise ValueError("closed_loop runs position skills; this scenario's are poses")
     target = np.asarray(setup.task.targets[job.label], dtype=float)[:3]
-    touch = getattr(cell, "arm_touch", None)
-    touched = None if touch is None else touch(plan, job.exclude)
-    if touched is not None:  # the tool's path keeps the contract, but a link would not
-        reason = (
-            f"not run: the arm would touch {touched[0]} ({length_text(touched[1], setup.task.units)} "
-            f"deep) on its way to {job.label}, though the tool's path keeps the contract"
-        )
-        return _not_run(job, reason)
+    slow = False
+    try:
+        plan = cell.plan(job.rollout, job.label, orientations=job.orientations, spacing=spacing)
+        slow = not setup.closed_loop and supports_routes(cell) and needlessly_slow(cell, plan)
+        _slowed(plan, _paced_duration(job.rollout, None, setup.pace))  # the demonstration's pace
+        trouble = _touch_reason(setup, cell, plan, job)
+    except SimError as exc:  # a point out of the IK's reach from the joints before it, a limit
+        plan, trouble = None, str(exc)
+    repair = job.repair
+    if slow and not trouble:  # near a singularity: the arm's own route, where it is faster
+        try:
+            routed = _arm_routed(setup, cell, contract, job)
+        except SimError:
+            routed = None
+        if routed is not None and routed.duration < plan.duration:
+            plan = routed
+            repair = f"{repair} + arm route (faster)" if repair else "arm route (faster)"
+    if trouble:
+        # The arm's own route where the skill's motion cannot run on the arm (the closed loop
+        # runs the skill itself, on the measured tool: it has no other motion to run).
+        if setup.closed_loop or not supports_routes(cell):
+            return _not_run(job, trouble)
+        try:
+            plan = _arm_routed(setup, cell, contract, job)
+        except SimError as exc:
+            return _not_run(job, f"{trouble}; the arm's own route: {exc}")
+        repair = f"{repair} + arm route" if repair else "arm route"
     if setup.closed_loop:
         coupling = setup.coupling
         if setup.avoid:  # steered round every part but the target's, with phase stopping
@@ -141,7 +198,7 @@ def _run_one(setup: _SimSetup, cell, contract, job):
         setup.closed_loop,
         (cell.limits, contract, job.exclude),
     )
-    measured.repair = job.repair
+    measured.repair = repair
     measured.commanded_penetration = _commanded_penetration(cell, run, job)
     if job.record:
         measured.path, measured.commands = run.tcp / cell.unit, np.asarray(run.commands)
@@ -492,32 +549,43 @@ def _unreachable(setup: _SimSetup, scenario, labels) -> dict:
     the demonstration's start is out of reach: every motion starts there). The tool points down,
     or for a pose scenario as the pose says (a nut on a tilted bracket is reached tilted)."""
     from .backend import SimError
-    from .robots import IK_TOLERANCE
 
     cell = _world(setup)
     frame = "as the target's pose" if scenario.is_pose else "pointing down"
+    arm_at = (
+        f"{cell.name} at base {np.round(cell.base, length_digits(scenario.units)).tolist()} "
+        f"{scenario.units} (tool {frame})"
+    )
     where = (
-        f"for the {cell.name} at base "
-        f"{np.round(cell.base, length_digits(scenario.units)).tolist()} {scenario.units} (tool "
-        f'{frame}): out of its reach (move its base: scenario key "robot": {{"base": ...}}), or not '
-        f'from its start pose (give one nearer: "robot": {{"rest": [...]}}, rad)'
+        f'for the {arm_at}: out of its reach (move its base: scenario key "robot": '
+        f'{{"base": ...}}), or not from its start pose (give one nearer: "robot": {{"rest": '
+        f"[...]}}, rad)"
     )
 
-    def reached(pose) -> bool:
+    def why(pose) -> str:
+        """Why ``pose`` is out of reach ("" when it is not): from the rest pose, or where the
+        arm has a route model, from any of several seeds (with the reason)."""
         pose = np.asarray(pose, dtype=float)
         orientation = pose[3:7] if scenario.is_pose else None
         try:
             _, error = cell.solve_ik(pose[:3] * cell.unit, cell.rest, orientation)
-        except SimError:
-            return False
-        return error <= 10 * IK_TOLERANCE
+        except SimError as exc:
+            return str(exc)
+        if error <= 10 * IK_TOLERANCE:
+            return ""
+        if supports_routes(cell):  # not from the rest pose: from any other joints?
+            reason = reach(cell, pose[:3], orientation, seed=scenario.seed)
+            return reason and f"for the {arm_at}: {reason}"
+        return where
 
-    if not reached(np.asarray(scenario.demonstration, dtype=float)[0]):
-        return {label: f"the demonstration's start is unreachable {where}" for label in labels}
+    start = why(np.asarray(scenario.demonstration, dtype=float)[0])
+    if start:
+        return {label: f"the demonstration's start is unreachable: {start}" for label in labels}
+    reasons = {label: why(scenario.targets[label]) for label in labels}
     return {
-        label: f"target {label} is unreachable {where}"
-        for label in labels
-        if not reached(scenario.targets[label])
+        label: f"target {label} is unreachable: {reason}"
+        for label, reason in reasons.items()
+        if reason
     }
 
 

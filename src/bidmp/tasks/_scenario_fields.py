@@ -15,8 +15,6 @@ import numpy as np
 
 from .._checks import get_limits, short_token
 from ..demonstrations.datasets import minimum_jerk
-from ..io.recordings import recording_kind
-from ..io.trajectories import read_trajectory
 
 _MINIMUM_JERK_KEYS = {"via", "n_steps", "noise", "seed"}
 
@@ -128,35 +126,44 @@ def _inside(path: Path, base_dir, source: str, key: str, body: str, allow_outsid
     return resolved
 
 
-def _prepared_file(path, units: str) -> tuple[np.ndarray, float | None]:
-    """A demonstration file as ``bidmp fit`` reads it: a timed recording is prepared (idle ends
-    trimmed, filtered, uniform time); a declared unit must be the scenario's. Returns the
-    positions and the pace the person showed: the prepared motion's peak tool speed (scene
-    units per second; None for a file without time stamps)."""
-    from ..demonstrations.preparation import prepare
-    from ..io.trajectories import declared_units
+def _prepared_file(path, units: str, reading: dict) -> tuple[np.ndarray, float | None]:
+    """A demonstration file as ``bidmp fit`` reads it: by the same reader
+    (:func:`bidmp.io.read_recording`, with ``reading["columns"]``: the roles and conventions of
+    ``--columns``), its unit the one it declares (``# units: mm``, ``X(mm)``) or
+    ``reading["units"]`` (``--units``), converted to the scenario's; a timed recording prepared
+    (idle ends trimmed, filtered, uniform time) and refused if no robot moves so (its peak speed
+    in the scenario's unit). Returns the positions (or poses) and the pace the person showed: the
+    prepared motion's peak tool speed (scene units per second; None without time stamps)."""
+    from .._units import check_speed, conversion
+    from ..demonstrations.preparation import prepare, prepare_poses
+    from ..io.recordings import read_recording
 
-    declared = declared_units(path) if str(path).lower().endswith((".csv", ".txt")) else ""
-    if declared and units and declared != units:
+    recording = read_recording(path, columns=reading.get("columns"))
+    if recording.kind == "joints":
         raise ValueError(
-            f"{path} is in {declared} (declared in the file) but the scenario is in {units}"
+            f"{path}: its columns read as joints ({recording.source}); a scenario's demonstration "
+            f"is the tool's path: positions or poses (name them with columns: x=..,y=..,z=..)"
         )
-    if str(path).lower().endswith((".csv", ".txt")) and recording_kind(path) == "pose":
-        # A pose recording (x, y, z with a quaternion or a rotation vector): a pose scenario's
-        # demonstration, prepared like positions (idle ends, the same filter, uniform time).
-        from ..demonstrations.preparation import prepare_poses
-        from ..io.poses import read_poses
-
-        poses, t = read_poses(path)
-        if t is None:
-            return poses, None
-        poses, times, _ = prepare_poses(poses, t)
-        return poses, _peak_speed(poses[:, :3], times)
-    y, t = read_trajectory(path)
-    if t is None:
-        return y, None
-    motion = prepare(y, t)[0]
-    return motion.y, _peak_speed(motion.y[:, :3], motion.t)
+    given, declared = reading.get("units", ""), recording.units
+    if given and declared and given != declared:
+        raise ValueError(
+            f"{path} is in {declared} (declared in the file) but units says {given}: drop one"
+        )
+    values, unit = recording.values, given or declared
+    if unit and units and unit != units:
+        # a length converted as bidmp fit --units converts it; a quaternion has none
+        values = values.copy()
+        values[:, :3] *= conversion(unit, units)
+    if recording.t is None:
+        return values, None
+    if recording.kind == "pose":
+        values, times, _ = prepare_poses(values, recording.t)
+    else:
+        motion = prepare(values, recording.t)[0]
+        values, times = motion.y, motion.t
+    pace = _peak_speed(values[:, :3], times)
+    check_speed(pace, units, f"{path}: the demonstration")
+    return values, pace
 
 
 def _peak_speed(positions: np.ndarray, t: np.ndarray) -> float:
@@ -166,14 +173,27 @@ def _peak_speed(positions: np.ndarray, t: np.ndarray) -> float:
 
 def _demonstration(value, source, key, base_dir, allow_outside=False, units: str = ""):  # noqa: C901 - one branch per documented option or part kind, each a line
     """A scenario's demonstration and its pace (peak tool speed in scene units per second, None
-    when it has no time: a generated or listed one)."""
-    if not isinstance(value, dict) or len(value) != 1:
+    when it has no time: a generated or listed one). A ``"file"`` takes the reading options of
+    ``bidmp fit`` beside it (:data:`_FILE_KEYS`)."""
+    kinds = (
+        [kind for kind in value if kind in _DEMONSTRATION_KINDS] if isinstance(value, dict) else []
+    )
+    if len(kinds) != 1:
         _fail(
             source,
             key,
             'expected exactly one of {"minimum_jerk": {...}}, {"points": [...]} or {"file": "..."}',
         )
-    ((kind, body),) = value.items()
+    kind, body = kinds[0], value[kinds[0]]
+    if kind == "file":
+        reading = _file_reading(value, source, key)
+    elif len(value) != 1:
+        other = sorted(set(value) - {kind})[0]
+        _fail(
+            source,
+            f"{key}.{short_token(other, 30)[1:-1]}",
+            f'unknown key (only a "file" demonstration takes {", ".join(sorted(_FILE_KEYS))})',
+        )
     if kind == "minimum_jerk":
         if not isinstance(body, dict):
             _fail(source, f"{key}.minimum_jerk", "expected an object")
@@ -235,7 +255,7 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
             allow_outside,
         )
         try:
-            trajectory, pace = _prepared_file(path, units)
+            trajectory, pace = _prepared_file(path, units, reading)
         except (TypeError, ValueError, OSError) as exc:
             _fail(source, f"{key}.file", str(exc))
         if trajectory.shape[0] < _MIN_DEMONSTRATION:
@@ -250,6 +270,51 @@ def _demonstration(value, source, key, base_dir, allow_outside=False, units: str
         key,
         f"unknown demonstration kind {short_token(kind, 20)} (expected minimum_jerk, points or file)",
     )
+
+
+_DEMONSTRATION_KINDS = ("minimum_jerk", "points", "file")
+# a "file" demonstration's reading options, those of bidmp fit: --columns (the roles and
+# conventions: time=ms, decimal=comma, euler=xyz, angles=deg, gaps=drop) and --units
+_FILE_KEYS = {"columns", "units"}
+
+
+def _file_reading(value: dict, source: str, key: str) -> dict:
+    """The reading options beside ``"file"``, checked as ``bidmp fit`` checks its options (the
+    column mapping parsed now, so a bad role names its key before the file is opened)."""
+    from .._units import UNITS
+    from ..io._columns import parse_columns
+
+    unknown = sorted(set(value) - {"file", *_FILE_KEYS})
+    if unknown:
+        _fail(
+            source,
+            f"{key}.{short_token(unknown[0], 30)[1:-1]}",
+            f"unknown key (a file's options: {', '.join(sorted(_FILE_KEYS))})",
+        )
+    reading = {}
+    if "columns" in value:
+        columns = value["columns"]
+        if not isinstance(columns, (str, dict)) or not columns:
+            _fail(
+                source,
+                f"{key}.columns",
+                'expected a column mapping, "t=Time,x=X,..." or {"t": "Time", "x": "X", ...}, '
+                f"got {_shown(columns)}",
+            )
+        try:
+            parse_columns(columns)
+        except (TypeError, ValueError) as exc:
+            _fail(source, f"{key}.columns", str(exc))
+        reading["columns"] = columns
+    if "units" in value:
+        if value["units"] not in UNITS:
+            _fail(
+                source,
+                f"{key}.units",
+                f"expected the file's length unit, one of {', '.join(UNITS)}, got {_shown(value['units'])}",
+            )
+        reading["units"] = value["units"]
+    return reading
 
 
 def _pose_points(points: np.ndarray, source: str, key: str, generated: bool) -> np.ndarray:

@@ -287,7 +287,9 @@ def evaluate(
             rollouts = method.rollouts(model, goals)
             outcome = result(name, rollouts, 0.0)
             if repairer is not None and method.repairs:
-                outcome = _repaired(outcome, repairer, model, scenario, labels, result, progress)
+                outcome, model = _repaired(
+                    outcome, repairer, model, scenario, labels, result, progress
+                )
         outcome.runtime_s = fit_seconds + timer.seconds
         report.methods[name] = outcome
         report.fitted[name] = model
@@ -319,12 +321,15 @@ def _repairer(scenario, allowance: float):
 
 def _repaired(
     outcome: MethodResult, repairer, model, scenario, labels, result, progress
-) -> MethodResult:
+) -> tuple[MethodResult, object]:
     """``outcome`` with every motion that broke the contract repaired where a repair keeps it
-    (``outcome.repairs``: label -> :class:`~bidmp.tasks.repair.Repaired` of each one tried)."""
+    (``outcome.repairs``: label -> :class:`~bidmp.tasks.repair.Repaired` of each one tried), and
+    the model: the method's, or grown by the skills the planner's routes taught. A route is
+    learned as a skill and kept: the targets repaired after it start from the grown model's own
+    motion (``how`` "learned" where that keeps the contract without another repair)."""
     failed = [label for label in labels if not outcome.verdicts[label].ok]
     if not failed:
-        return outcome
+        return outcome, model
     scene = scenario.scene
     rollouts = dict(outcome.rollouts)  # positions; a pose motion is rebuilt with its frames
     if outcome.orientations is not None:
@@ -332,23 +337,27 @@ def _repaired(
             label: np.hstack([path, outcome.orientations[label]])
             for label, path in rollouts.items()
         }
-    repairs = {}
+    repairs, grown = {}, False
     for done, label in enumerate(failed):
         report("repairs", done, len(failed))
         if progress is not None:
             progress(f"{outcome.name}: repair {label}")
+        known = {} if grown else {"motion": rollouts[label], "verdict": outcome.verdicts[label]}
         fixed = repairer.repair(
             model,
             scenario.targets[label],
             label,
             axis=scenario.target_axis(label),
             exclude=scene.target_parts(label, scenario.targets[label]),
-            motion=rollouts[label],
-            verdict=outcome.verdicts[label],
+            **known,
         )
+        if grown and fixed.ok and not fixed.how:
+            fixed.how = "learned"  # the grown model's own motion: a skill a route taught
         repairs[label] = fixed
         if fixed.how:
             rollouts[label] = fixed.motion
+        if fixed.how == "route" and fixed.model is not None:
+            model, grown = fixed.model, True
     report("repairs", len(failed), len(failed))
     verdicts = dict(outcome.verdicts)  # the repaired motions' verdicts are the repairs' own
     verdicts.update({label: fixed.verdict for label, fixed in repairs.items() if fixed.how})
@@ -356,7 +365,7 @@ def _repaired(
         outcome.name, [rollouts[label] for label in labels], outcome.runtime_s, verdicts
     )
     repaired.repairs = repairs
-    return repaired
+    return repaired, model
 
 
 def _failed_targets(scenario, task, labels, goals) -> list[str]:

@@ -13,12 +13,18 @@ Whatever failed — the end, the engagement or the clearance — the repairs are
   scene-aware G-PRM, the final approach kept) and learned by the Bi-DMP as a new skill, on a copy
   of the model (the learned skills are not changed by a repair);
 * ``"margin"``: the extension planned again with the margin widened by what the last attempt
-  lacked (the learned skill does not follow its extension exactly).
+  lacked (the learned skill does not follow its extension exactly);
+* ``"route"``: the complete fallback, where the demonstration's shape runs out: the tool's own
+  route to the top of the final approach, found by a sampling-based planner through the scene
+  (:func:`bidmp.planning.tool_route`: RRT-Connect, shortened, its corners rounded), then straight
+  down the target's axis. The route is learned as a skill (the next target near it starts from
+  that skill, without the planner), and the motion is that skill's where it keeps the contract,
+  else the route itself. Any route that exists within the search's budget is found.
 
 The order is the cost: a lift is about a hundredth of an extension, and on the random cells of
-``tools/repair_order.py`` it repairs most motions that only a part in the way spoils. A motion
-that misses its end or its engagement cannot be lifted or steered into its target: it goes
-straight to the extension.
+``tools/repair_order.py`` it repairs most motions that only a part in the way spoils; the route
+comes last because it keeps the least of the demonstration's shape. A motion that misses its end
+or its engagement cannot be lifted or steered into its target: it goes straight to the extension.
 
 Before any of them, the final approach itself is checked: when the tool coming straight down the
 target's axis onto it already comes too close to a part (a post beside the nut, a duct over it),
@@ -59,7 +65,7 @@ __all__ = ["REPAIRS", "Repairer", "Repaired", "Attempt", "carried_clearance", "c
 
 logger = logging.getLogger(__name__)
 
-REPAIRS = ("lift", "avoid", "extend", "margin")
+REPAIRS = ("lift", "avoid", "extend", "margin", "route")
 _MAX_ROUNDS = 4  # rounds of lifting (each lifts the stretch past the part the motion comes nearest)
 _STRETCH = 5  # via-points spread along each stretch lifted
 _WIDENINGS = 2  # plannings with a wider margin
@@ -377,6 +383,8 @@ class Repairer:
                 and not self.bidmp_possible(model)
             ):
                 continue
+            if how == "route" and query.carried:
+                continue  # a carried part is not the tool: the arm's route carries it (bidmp.sim)
             started = time.perf_counter()
             try:
                 found = self._try(
@@ -441,6 +449,8 @@ class Repairer:
             motion, clearance = self._lift(query, known)
             verdict = self._judge(self.planning, motion, query, clearance)
             return motion, None, None, verdict
+        if how == "route":
+            return self._route(query)
         if how == "avoid":
             from ..primitives.avoidance import SceneAvoidance
 
@@ -462,6 +472,60 @@ class Repairer:
                 return motion, trial, index, verdict
             widen += max(verdict.clearance.margin - verdict.clearance.distance, 0.0)
         return motion, trial, index, verdict
+
+    def _route(self, query: _Query):
+        """``(motion, model, skill, verdict on the planning contract)`` of the complete fallback:
+        the tool's route through the planning scene (module docstring), learned as a new skill on
+        a copy of the model; the motion is that skill's where the planning contract keeps it,
+        else the route's own (a ``ValueError`` when there is no route)."""
+        from ..planning import tool_route
+
+        model, goal, start = query.model, query.goal, query.start
+        pose = _is_pose(model)
+        width = 7 if pose else 3
+        begin = np.asarray(self.demonstration[0] if start is None else start, dtype=float)
+        if begin.shape[0] < width:  # a pose motion from a position: the demonstration's frame
+            begin = np.concatenate([begin[:3], np.asarray(self.demonstration[0], float)[3:7]])
+        route = tool_route(
+            self.planning.scene,
+            begin[:width],
+            np.asarray(goal, dtype=float)[:width],
+            axis=query.axis,
+            approach_height=self.contract.approach_height or 0.0,
+            exclude=query.exclude,
+            seed=self.seed,
+        )
+        count = self.demonstration.shape[0]
+        motion = route.motion(max(count, 2))
+        trial, index = self._taught(model, motion, route.length)
+        if trial is not None:
+            learned = _path(_trajectory(trial, goal, start, index))
+            verdict = self._judge(self.planning, learned, query)
+            if verdict.ok:
+                return learned, trial, index, verdict
+        return motion, trial, index, self._judge(self.planning, motion, query)
+
+    def _taught(self, model, motion: np.ndarray, length: float):
+        """A copy of the Bi-DMP (one is built on a plain DMP) with ``motion`` learned as a new
+        skill, timed at the demonstration's pace (its duration scaled by the route's length over
+        the demonstration's), and the skill's index; ``(None, None)`` where the model cannot learn
+        skills."""
+        from ..incremental.bidmp import BiDMP
+        from ..incremental.cartesian import CartesianBiDMP
+
+        pose = _is_pose(model)
+        if _is_bidmp(model):
+            trial = copy.deepcopy(model)
+            dmp = model.cartesian_.position_ if pose else model.dmp_
+        elif self.bidmp_possible(model):
+            trial = (CartesianBiDMP if pose else BiDMP)(copy.deepcopy(model), **self.bidmp)
+            dmp = model.position_ if pose else model
+        else:
+            return None, None
+        shown = float(np.sum(np.linalg.norm(np.diff(self.demonstration[:, :3], axis=0), axis=1)))
+        duration = dmp.duration_ * max(length / shown, 0.25) if shown > 0.0 else None
+        trial.learn(motion, duration=duration)
+        return trial, trial.n_skills - 1
 
     def _learned(self, model, goal, planning: Contract, start=None, skill="nearest"):
         """A copy of the Bi-DMP (one is built on a plain DMP) with a skill learned from an extended

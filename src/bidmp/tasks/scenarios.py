@@ -14,7 +14,10 @@ Keys (units: millimetres for the battery scenarios)::
     demonstration        exactly one of {"minimum_jerk": {"via", "n_steps", "noise", "seed"}},
                          {"points": [[x, y(, z)], ...]} (at least 10) or {"file": "demo.csv"}
                          (relative to the scenario file, and inside its folder unless
-                         ``allow_outside_files``)
+                         ``allow_outside_files``), read as ``bidmp fit`` reads it, with its
+                         options beside: "columns" (as --columns: roles and conventions,
+                         time=ms, decimal=comma, euler=xyz, angles=deg, gaps=drop) and "units"
+                         (the file's length unit, as --units); converted to the scenario's unit
     success_threshold    end-point error for success, default 1.75
     approach_height      height band above a target for the approach error, default 28.5;
                          null turns the approach metric off

@@ -99,7 +99,7 @@ def orientation_error(true, predicted) -> float:
             f"{predicted.shape}"
         )
     for name, quaternions in (("true", true), ("predicted", predicted)):
-        zero = row_norms(quaternions) < 1e-9
+        zero = row_norms(quaternions) == 0.0  # (scaled first: a row of 1e-300 is a direction)
         if np.any(zero):
             raise ValueError(
                 f"{name}: row {int(np.argmax(zero))} is a zero quaternion, which is no rotation"

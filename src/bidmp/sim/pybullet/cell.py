@@ -151,6 +151,25 @@ class RobotCell:
         return self.model.name
 
     @property
+    def joint_names(self) -> tuple:
+        """The driven joints' names, base to flange, as in the arm's URDF."""
+        p = self.p
+        return tuple(
+            p.getJointInfo(self.robot, j, physicsClientId=self.client)[1].decode() for j in self.arm
+        )
+
+    @property
+    def joint_units(self) -> tuple:
+        """Each driven joint's unit: "m" for a prismatic joint, "rad" for a revolute one."""
+        p = self.p
+        return tuple(
+            "m"
+            if p.getJointInfo(self.robot, j, physicsClientId=self.client)[2] == p.JOINT_PRISMATIC
+            else "rad"
+            for j in self.arm
+        )
+
+    @property
     def rest(self) -> tuple:
         """The joints (rad) the arm starts from: the tool pointing down."""
         return self.model.rest

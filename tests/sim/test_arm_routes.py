@@ -1,0 +1,233 @@
+"""The arm's own routes, checked from outside the code that plans them: the pinocchio model of each
+arm against PyBullet's and against an arm's published DH table written here; its distances to the
+parts against PyBullet's closest points; its inverse kinematics against the DH product; a planned
+route executed and judged by PyBullet's contacts, the contract's clearance and command differences
+taken here. The user's arm of the acceptance (an ABB IRB 1200 written from its published table,
+tests/data/irb1200) is one of them: its wrist is singular wherever the tool points straight down
+with the forearm level."""
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+pytest.importorskip("pybullet")
+pytest.importorskip("pinocchio")
+pytest.importorskip("ompl")
+
+from bidmp import sim  # noqa: E402
+from bidmp.sim.arm_geometry import ArmGeometry  # noqa: E402
+from bidmp.sim.robots import ROBOT_MODELS, JointLimits, RobotModel  # noqa: E402
+
+DATA = Path(__file__).resolve().parents[1] / "data"
+IRB = DATA / "irb1200" / "irb1200.urdf"
+DEG = math.pi / 180.0
+# The IRB 1200-7/0.7 as ABB publishes it: classic DH (d, a, alpha), theta offsets, axis ranges and speeds
+IRB_DH = (
+    (0.399, 0.0, -90),
+    (0.0, 0.35, 0.0),
+    (0.0, 0.042, -90),
+    (0.351, 0.0, 90),
+    (0.0, 0.0, -90),
+    (0.082, 0.0, 0.0),
+)
+IRB_OFFSETS = (0.0, -90.0, 0.0, 0.0, 0.0, 180.0)
+IRB_LOWER = (-170, -100, -200, -270, -130, -400)
+IRB_UPPER = (170, 135, 70, 270, 130, 400)
+IRB_SPEED = (288, 240, 297, 400, 405, 600)
+
+
+def irb_model() -> RobotModel:
+    speeds = [v * DEG for v in IRB_SPEED]
+    limits = JointLimits(
+        [v * DEG for v in IRB_LOWER],
+        [v * DEG for v in IRB_UPPER],
+        speeds,
+        [5 * v for v in speeds],
+        [500 * v for v in speeds],
+    )
+    return RobotModel(
+        "irb1200", str(IRB), "flange", limits, (0.0,) * 6, (100.0,) * 6, rest_given=False
+    )
+
+
+def irb_flange(q) -> np.ndarray:
+    """The flange's pose (4, 4) from ABB's table: Rz(theta + offset) Tz(d) Tx(a) Rx(alpha)."""
+    pose = np.eye(4)
+    for (d, a, alpha), offset, theta in zip(IRB_DH, IRB_OFFSETS, q):
+        t, al = theta + offset * DEG, alpha * DEG
+        ct, st, ca, sa = np.cos(t), np.sin(t), np.cos(al), np.sin(al)
+        pose = pose @ np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0, sa, ca, d],
+                [0, 0, 0, 1],
+            ]
+        )
+    return pose
+
+
+ARMS = {**ROBOT_MODELS, "irb1200": irb_model()}
+
+
+@pytest.mark.parametrize("name", sorted(ARMS))
+def test_the_route_model_of_every_arm_is_pybullets_to_a_micrometre(name):
+    """pinocchio's model of the arm (what routes are planned on) against the simulated arm's own
+    forward kinematics at 30 random joint vectors within its limits: the tool's mouth to 1 µm and
+    its frame to 1e-6."""
+    robot = ARMS[name]
+    base, yaw = np.array([0.1, -0.4, 0.02]), 70.0
+    from bidmp.scene import Scene, Tool
+
+    with sim.RobotCell(Scene([], Tool(0.0125, 0.1)), "m", base, yaw, robot) as cell:
+        arm = ArmGeometry(robot, 0.0125, 0.1, base, yaw)
+        rng = np.random.default_rng(1)
+        lower, upper = np.array(robot.limits.lower), np.array(robot.limits.upper)
+        for _ in range(30):
+            q = rng.uniform(np.maximum(lower, -3.0), np.minimum(upper, 3.0))
+            mouth, frame = arm.tool_pose(q)
+            assert np.linalg.norm(mouth - cell.fk(q)) < 1e-6
+            cell.fk(q)
+            measured = cell.p.getLinkState(cell.ik_robot, cell.tcp, physicsClientId=cell.ik_client)[
+                5
+            ]
+            np.testing.assert_allclose(frame, Rotation.from_quat(measured).as_matrix(), atol=1e-6)
+
+
+def test_the_irb1200_urdf_is_its_published_table():
+    """The user's arm written by tools/ur5_urdf.py against ABB's table multiplied out here."""
+    arm = ArmGeometry(irb_model(), 0.0125, 0.0, np.zeros(3), 0.0)
+    rng = np.random.default_rng(2)
+    for _ in range(30):
+        q = rng.uniform(-2.0, 2.0, 6)
+        flange = irb_flange(q)
+        mouth, frame = arm.tool_pose(q)
+        np.testing.assert_allclose(mouth, flange[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(frame[:, 2], flange[:3, 2], atol=1e-9)
+
+
+def busbar(directory: Path) -> Path:
+    """The acceptance's kind of cell, committed beside its arm (tools/busbar_cell.py writes it),
+    copied with the arm into ``directory``."""
+    shutil.copy(IRB.parent / "busbar.json", directory / "busbar.json")
+    shutil.copy(IRB, directory / "irb1200.urdf")
+    return directory / "busbar.json"
+
+
+def test_the_route_models_distances_agree_with_pybullets_closest_points(tmp_path):
+    """At 300 random joint vectors of the IRB 1200 in the busbar cell: free by the route model's
+    slack exactly where PyBullet finds no point of the arm within the margin of a part."""
+    from bidmp.sim.routes import _arm
+    from bidmp.tasks import scenarios
+
+    scenario = scenarios.load(str(busbar(tmp_path)))
+    base, yaw = sim.robot_placement(scenario)
+    with sim.RobotCell(
+        scenario.scene, "m", base, yaw, sim.robot_model(scenario.robot, tmp_path)
+    ) as cell:
+        exclude = scenario.scene.target_parts("B3", scenario.targets["B3"][:3])
+        space = _arm(cell).space(scenario.scene, 1.0, exclude=exclude, margin=0.003)
+        p, client = cell.p, cell.client
+        bodies = [body for body, owner in cell._owners.items() if owner not in exclude]
+        rng = np.random.default_rng(0)
+        disagree = []
+        for q in rng.uniform(space.lower, space.upper, (300, 6)):
+            cell._set_joints(q)
+            near = min(
+                (
+                    point[8]
+                    for body in bodies
+                    for point in p.getClosestPoints(cell.robot, body, 0.01, physicsClientId=client)
+                ),
+                default=np.inf,
+            )
+            slack = space.slack(q)
+            # the model asks for the margin plus its tolerance: agree outside that band
+            if slack >= 0 and near < 0.003 or slack < -1e-9 and near > 0.003 + space.tolerance:
+                disagree.append((q, slack, near))
+        assert not disagree, disagree[:3]
+
+
+def test_the_inverse_kinematics_reaches_poses_at_the_irb1200s_wrist_singularity():
+    """Poses the arm takes (forward kinematics of random joints, joint 5 within 1 degree of zero:
+    the wrist singular), solved from the rest pose and checked by ABB's table: the mouth within
+    0.05 mm, the tool's axis within 1e-6 of the asked one, every joint within its limits."""
+    robot = irb_model()
+    arm = ArmGeometry(robot, 0.0125, 0.1, np.zeros(3), 0.0)
+    rng = np.random.default_rng(4)
+    lower, upper = np.array(robot.limits.lower), np.array(robot.limits.upper)
+    solved = 0
+    for _ in range(20):
+        q = rng.uniform(-1.2, 1.2, 6)
+        q[4] = rng.uniform(-1.0, 1.0) * DEG
+        mouth, frame = arm.tool_pose(q)
+        found, error = None, np.inf
+        for seed in (np.zeros(6), rng.uniform(-1, 1, 6), rng.uniform(-2, 2, 6)):
+            candidate, error = arm.solve_ik(mouth, Rotation.from_matrix(frame).as_quat(), seed)
+            if error <= 5e-5:
+                found = candidate
+                break
+        assert found is not None, (q, error)
+        flange = irb_flange(found)
+        np.testing.assert_allclose(flange[:3, 3] + flange[:3, 2] * 0.1, mouth, atol=5e-5)
+        assert np.linalg.norm(flange[:3, 2] - frame[:, 2]) < 1e-6
+        assert np.all(found >= lower - 1e-9) and np.all(found <= upper + 1e-9)
+        solved += 1
+    assert solved == 20
+
+
+def test_a_route_of_the_arm_round_the_post_runs_clear_and_within_the_limits(tmp_path):
+    """The arm's own route from the rest pose to the nut behind the busbar post, executed on the
+    simulated arm: no contact in PyBullet, no link within the margin of a part (PyBullet's
+    closest points along the plan), the tool's path clear by the scene's clearance, its last 28.5
+    mm straight down the nut's axis, the 1 kHz commands within the limits by differences taken
+    here, from rest to rest."""
+    from bidmp.tasks import scenarios
+
+    scenario = scenarios.load(str(busbar(tmp_path)))
+    base, yaw = sim.robot_placement(scenario)
+    robot = sim.robot_model(scenario.robot, tmp_path)
+    target = np.asarray(scenario.targets["B3"], dtype=float)
+    axis = scenario.target_axis("B3")
+    exclude = scenario.scene.target_parts("B3", target[:3])
+    with sim.RobotCell(scenario.scene, "m", base, yaw, robot) as cell:
+        routed = sim.arm_route(
+            cell,
+            np.asarray(cell.rest),
+            target[:3],
+            axis=axis,
+            approach_height=scenario.approach_height,
+            orientation=target[3:],
+            exclude=exclude,
+            label="B3",
+        )
+        plan = routed.plan
+        assert cell.arm_touch(plan, exclude) is None
+        run = cell.execute(plan, exclude)
+        assert not run.contacts
+    path = plan.points
+    assert np.linalg.norm(path[-1] - target[:3]) < 1e-5
+    assert scenario.scene.clearance(path, exclude=exclude, orientations=plan.orientations).clear
+    along = (path - target[:3]) @ axis
+    inside = path[along <= scenario.approach_height]
+    offsets = inside - target[:3]
+    across = np.linalg.norm(offsets - np.outer(offsets @ axis, axis), axis=1)
+    assert across.max() < 1e-4
+    commands = np.vstack([[run.commands[0]] * 3, run.commands, [run.commands[-1]] * 3])
+    limits = robot.limits
+    for order, limit in ((1, limits.velocity), (2, limits.acceleration), (3, limits.jerk)):
+        rate = np.diff(commands, n=order, axis=0) / 1e-3**order
+        assert np.all(np.max(np.abs(rate), axis=0) <= np.asarray(limit) * 1.001), order
+
+
+def test_the_committed_busbar_cell_is_the_one_its_builder_writes():
+    """Structure guard: tests/data/irb1200/busbar.json is tools/busbar_cell.py's output."""
+    import busbar_cell
+
+    written = json.loads(json.dumps(busbar_cell.cell()))
+    assert written == json.loads((IRB.parent / "busbar.json").read_text())
