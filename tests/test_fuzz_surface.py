@@ -117,6 +117,9 @@ FAMILY_FINDS = {
     ("bidmp.primitives.prodmp_basis", "dt", "5e-324"),
     ("Scene.target_parts", "point", "True as a point"),
     ("bidmp.extension.curvature", "y", "times 1e-300"),
+    ("bidmp.planning.plan_route", "time_limit", "1e-300"),
+    ("bidmp.planning.time_path", "margin", "1e-300"),
+    ("bidmp.planning.time_path", "margin", "5e-324"),
     *(
         ("clfd_tasks(damaged copies)", "folder", f"damaged copy: {damage}")
         for damage in ("npz truncated", "npz emptied", "npy truncated", "names garbled")
