@@ -323,7 +323,10 @@ def _search(start, goals, box, tester: _Tester, how, budget, simplify: bool) -> 
     )
     setup.solve(stop)
     if not setup.haveExactSolutionPath():
-        raise NoRouteError(f"no route found after {tester.count} configurations tested")
+        raise NoRouteError(
+            f"no route found after {tester.count} configurations tested (within time_limit = "
+            f"{time_limit:g} s and max_checks = {max_checks:,})"
+        )
     if simplify:
         geometric.PathSimplifier(information).simplifyMax(setup.getSolutionPath())
     path = setup.getSolutionPath()
