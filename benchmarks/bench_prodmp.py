@@ -74,7 +74,7 @@ def equality(torch, mp) -> list[str]:
             init_vel=torch.as_tensor(velocity),
         ).numpy()
         theirs_vel = mp.get_traj_vel().numpy()
-        motion = ours.trajectory(start, start_velocity=velocity, times=query, weights=params)
+        motion = ours.trajectory(start=start, start_velocity=velocity, times=query, weights=params)
         extent = np.ptp(theirs_pos, axis=0).max()
         worst = max(
             worst,
@@ -85,7 +85,7 @@ def equality(torch, mp) -> list[str]:
     mp.learn_mp_params_from_trajs(torch.as_tensor(times)[None], torch.as_tensor(demo)[None])
     learned = mp.get_params().numpy()[0]
     theirs = mp.get_traj_pos().numpy()[0]
-    mine = ours.trajectory(demo[0], start_velocity=(demo[1] - demo[0]) / DT, times=times).y
+    mine = ours.trajectory(start=demo[0], start_velocity=(demo[1] - demo[0]) / DT, times=times).y
     extent = np.ptp(demo, axis=0).max()
     lines.append(
         f"learned from one demonstration: weights differ by "

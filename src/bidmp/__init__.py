@@ -82,6 +82,7 @@ if TYPE_CHECKING:
     from .primitives.avoidance import SceneAvoidance
     from .primitives.cartesian import CartesianDMP
     from .primitives.dmp import DMP
+    from .primitives.limits import MotionLimits
     from .primitives.timing import Trajectory, time_scale
     from .scene import Clearance, Scene, Tool
     from .tasks.evaluation import evaluate

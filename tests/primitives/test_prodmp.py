@@ -76,7 +76,7 @@ def test_a_trajectory_keeps_its_boundary_and_obeys_its_equation():
     for _ in range(3):
         start, velocity = rng.normal(0, 20, 3), rng.normal(0, 30, 3)
         times = np.linspace(0.0, 3.0, 3001)
-        motion = model.trajectory(start, start_velocity=velocity, times=times)
+        motion = model.trajectory(start=start, start_velocity=velocity, times=times)
         assert np.allclose(motion.y[0], start, atol=1e-9)
         assert np.allclose(motion.yd[0], velocity, atol=1e-7)
         extent = np.ptp(motion.y, axis=0).max()
@@ -90,11 +90,11 @@ def test_a_trajectory_keeps_its_boundary_and_obeys_its_equation():
 def test_it_reproduces_its_demonstration_and_ends_at_the_goal():
     t, y = demo()
     model = ProDMP(n_basis=20).fit(y, [t])
-    motion = model.trajectory(y[0], times=t)
+    motion = model.trajectory(start=y[0], times=t)
     extent = np.ptp(y, axis=0).max()
     assert np.max(np.abs(motion.y - y)) <= 1e-3 * extent
     goal = np.array([80.0, -15.0, 5.0])
-    late = model.trajectory(y[0], goal, times=np.array([0.0, 5.0 * 3.0]))
+    late = model.trajectory(start=y[0], attractor=goal, times=np.array([0.0, 5.0 * 3.0]))
     assert np.allclose(late.y[-1], goal, atol=1e-4 * extent)
 
 
@@ -106,7 +106,7 @@ def test_batched_rollouts_are_the_single_trajectories():
     starts, goals = rng.normal(0, 10, (6, 3)), rng.normal(40, 10, (6, 3))
     batch = model.rollouts(starts, goals, times=t)
     for b in range(6):
-        single = model.trajectory(starts[b], goals[b], times=t).y
+        single = model.trajectory(start=starts[b], attractor=goals[b], times=t).y
         assert np.allclose(batch[b], single, rtol=0, atol=1e-10)
 
 
@@ -125,9 +125,9 @@ def test_conditioning_passes_the_via_point_and_keeps_the_start():
         times.append(t)
     model = ProDMP(n_basis=15, cov_reg=1e-6).fit(demos, times)
     start = demos[0][0]
-    via = model.trajectory(start, times=[1.5]).y[0] + [0.0, 0.0, 6.0]
+    via = model.trajectory(start=start, times=[1.5]).y[0] + [0.0, 0.0, 6.0]
     conditioned = model.condition([1.5], via[None], 0.0, start=start)
-    passed = conditioned.trajectory(start, times=[0.0, 1.5])
+    passed = conditioned.trajectory(start=start, times=[0.0, 1.5])
     assert np.allclose(passed.y[1], via, atol=1e-6 * 60.0)
     assert np.allclose(passed.y[0], start, atol=1e-9)
     goal = model.weight_mean_.reshape(3, -1)[:, -1]
@@ -144,7 +144,9 @@ def test_the_goal_for_an_end_ends_there():
     model = ProDMP().fit(y, [t])
     end = y[-1] + [5.0, -4.0, 3.0]
     attractor = model.goal_for_end(end, y[0])
-    assert np.allclose(model.trajectory(y[0], attractor, times=[0.0, 3.0]).y[-1], end, atol=1e-9)
+    assert np.allclose(
+        model.trajectory(start=y[0], attractor=attractor, times=[0.0, 3.0]).y[-1], end, atol=1e-9
+    )
 
 
 def test_it_is_a_scikit_learn_estimator_and_refuses_bad_input_by_name():
@@ -159,7 +161,7 @@ def test_it_is_a_scikit_learn_estimator_and_refuses_bad_input_by_name():
         ProDMP().fit(y, [t[::-1]])
     fitted = ProDMP().fit(y, [t])
     with pytest.raises(ValueError, match="beyond"):
-        fitted.trajectory(y[0], times=[0.0, 30.0])
+        fitted.trajectory(start=y[0], times=[0.0, 30.0])
     with pytest.raises(ValueError, match="one per rollout"):
         fitted.rollouts(np.zeros((2, 3)), np.zeros((3, 3)))
 
@@ -186,8 +188,10 @@ def test_the_default_start_is_the_mean_start_point_in_every_call():
     np.testing.assert_array_equal(conditioned.start_, model.start_)
     np.testing.assert_allclose(conditioned.rollout()[0], model.start_, rtol=0, atol=1e-12)
     wanted = y[-1] + np.array([1.0, -2.0, 0.5])
-    end = model.rollout(goal=model.goal_for_end(wanted))[-1]
+    end = model.trajectory(attractor=model.goal_for_end(wanted)).y[-1]
     np.testing.assert_allclose(end, wanted, rtol=0, atol=1e-9 * np.abs(wanted).max())
+    # the motion interface's goal is where the motion ends (conditioned on it), not the attractor
+    np.testing.assert_allclose(model.rollout(goal=wanted)[-1], wanted, rtol=0, atol=1e-9 * 60)
     np.testing.assert_array_equal(model.rollouts()[0], model.rollout())
 
 
@@ -281,7 +285,7 @@ def test_conditioned_on_the_goal_at_rest_it_ends_there_still_and_stays():
     )
     np.testing.assert_allclose(conditioned.weight_mean_.reshape(3, -1)[:, -1], goal, atol=1e-9)
     h = 1e-4
-    near = conditioned.trajectory(y[0], times=[1.0, end - 2 * h, end - h, end]).y
+    near = conditioned.trajectory(start=y[0], times=[1.0, end - 2 * h, end - h, end]).y
     np.testing.assert_allclose(near[0], via, atol=1e-6)
     near = near[1:]
     np.testing.assert_allclose(near[2], goal, atol=1e-6)
@@ -289,5 +293,5 @@ def test_conditioned_on_the_goal_at_rest_it_ends_there_still_and_stays():
     curvature = (near[2] - 2 * near[1] + near[0]) / h**2
     # (the basis is read linearly between its grid points: differences within one are exact)
     assert np.abs(slope).max() <= 1e-3 and np.abs(curvature).max() <= 1.0
-    later = conditioned.trajectory(y[0], times=np.linspace(end, 2 * end, 50)).y
+    later = conditioned.trajectory(start=y[0], times=np.linspace(end, 2 * end, 50)).y
     assert np.abs(later - goal).max() <= 0.5  # (the forcing fades: 0.13 mm over tau more)

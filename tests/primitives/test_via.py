@@ -133,13 +133,14 @@ def test_via_points_the_kernels_cannot_carry_are_refused():
         ([(1.0, [1, 2, 3]), (1.0, [1, 2, 3])], "same time"),
         ([(1.0, [1, 2])], "via\\[0\\] point"),
         ("1.0 1 2 3", "list of"),
-        ([], "empty"),
     ]
     for via, message in cases:
         with pytest.raises((ValueError, TypeError), match=message):
             dmp.trajectory(via=via)
     with pytest.raises(ValueError, match="limits"):
         dmp.trajectory(via=[(1.0, [60, 30, 70])], limits={"max_acceleration": 100.0})
+    # no via-points (the motion interface's default, ()) is the motion without them
+    np.testing.assert_array_equal(dmp.trajectory(via=[]).y, dmp.trajectory().y)
 
 
 def test_via_poses_for_a_multi_turn_cartesian_dmp():

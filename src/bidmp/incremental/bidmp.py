@@ -536,20 +536,23 @@ class BiDMP(Estimator):
         *,
         skill="nearest",
         start=None,
+        start_velocity=None,
         duration: float | None = None,
         dt: float | None = None,
-        limits: dict | None = None,
+        limits=None,
         coupling=None,
         via=None,
         via_until: float | None = None,
     ):
         """A timed rollout of one skill (see :meth:`bidmp.DMP.trajectory`): ``bidmp.Trajectory``
-        with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``coupling`` terms and ``via``
+        with ``t`` (s), ``y``, ``yd``, ``ydd`` (units, /s, /s²); ``start_velocity`` (units/s),
+        ``limits`` (a :class:`bidmp.MotionLimits` or its dict), ``coupling`` terms and ``via``
         points as there (the skill's increment kept, the least-norm change added to it)."""
         _, goal, start, increment, dmp = self._skill_query(goal, skill, start)
         return dmp.trajectory(
             goal=goal,
             start=start,
+            start_velocity=start_velocity,
             duration=duration,
             dt=dt,
             limits=limits,

@@ -235,15 +235,18 @@ class CartesianBiDMP(PoseModel, Estimator):
         *,
         skill="nearest",
         start=None,
+        start_velocity=None,
         duration: float | None = None,
         dt: float | None = None,
-        limits: dict | None = None,
+        limits=None,
         coupling=None,
         via=None,
         via_until: float | None = None,
     ) -> PoseTrajectory:
         """A timed pose rollout of one skill (see :meth:`CartesianDMP.trajectory`; ``via`` poses
-        and ``via_until`` as there)."""
+        and ``via_until`` as there; a pose motion starts at rest: ``start_velocity`` other than
+        None is refused)."""
+        via = self._at_rest_with(start_velocity, via)
         index, goal_p, start_p, goal_q, start_e = self._query(goal, skill, start)
         _, goal_p, start_p, position_increment, position = self.position_.query(
             goal_p, skill=index, start=start_p

@@ -17,10 +17,13 @@ Where things live (the field's split, as in movement_primitives and dmpbbo):
 * ``multi`` — a DMP from several demonstrations, with their spread; ``promp`` — probabilistic
   movement primitives from several demonstrations, exact
   conditioning; ``prodmp`` — probabilistic DMPs: the DMP's solution in closed form, batched
-  rollouts in one product, a ProMP's conditioning;
+  rollouts in one product, a ProMP's conditioning (``prodmp_responses``: its precomputed basis);
 * ``rhythmic`` — periodic DMPs and their modulation while running; ``frequency`` — a periodic
   recording's frequency, steady part and spread; ``oscillator`` — adaptive frequency oscillators;
-* ``timing`` — timed trajectories and time scaling to limits.
+* ``timing`` — timed trajectories and time scaling to limits; ``limits`` — :class:`MotionLimits`,
+  the caps a motion runs within;
+* ``interface`` — the one call every point-to-point kind answers (:class:`MotionPrimitive`) and
+  the probabilistic kinds' own (:class:`ProbabilisticPrimitive`).
 
 Layer 1 (the math): imports only ``bidmp._checks`` and the other private helpers of the package
 root, never ``tasks``, ``io``, ``sim`` or ``cli``.
@@ -61,6 +64,8 @@ if TYPE_CHECKING:
     from .frequency import FrequencyEstimate, estimate_frequency, harmonic_fit
     from .goals import ApproachGate, DelayedGoal, PhaseGate, ProgressGate
     from .integrate import StepIntegrator
+    from .interface import MotionPrimitive, ProbabilisticPrimitive
+    from .limits import MotionLimits, as_motion_limits
     from .multi import MultiDMP
     from .oscillator import AdaptiveOscillator
     from .prodmp import ProDMP, ProDMPBasis, prodmp_basis

@@ -44,6 +44,7 @@ from .._trajectory import continuous_quaternions as _continuous
 from .dmp import DMP
 from .forcing import _check_forcing_increment
 from .goals import _arclength_progress
+from .interface import _none_if_empty, _refuse_start_velocity
 from .pose_timing import PoseStepper, PoseTrajectory, _pose_trajectory
 from .so3 import (
     _nearest_turn,
@@ -149,6 +150,12 @@ class PoseModel:
         """The start's ``Log(q ⊗ goal⁻¹)`` on the turn nearest ``reference`` (a multi-turn
         skill turns the same way, as many times, from another start)."""
         return _nearest_turn(start_q, goal_q, reference)
+
+    def _at_rest_with(self, start_velocity, via):
+        """A pose motion starts at rest (a start velocity is refused, naming the kind); ``via``
+        with an empty sequence read as none."""
+        _refuse_start_velocity(start_velocity, type(self).__name__)
+        return _none_if_empty(via)
 
     @staticmethod
     def _timed(parts: tuple, ends: tuple, increments: tuple, units, **request):
@@ -331,9 +338,10 @@ class CartesianDMP(PoseModel, Estimator):
         goal=None,
         *,
         start=None,
+        start_velocity=None,
         duration: float | None = None,
         dt: float | None = None,
-        limits: dict | None = None,
+        limits=None,
         position_increment=None,
         orientation_increment=None,
         coupling=None,
@@ -348,7 +356,9 @@ class CartesianDMP(PoseModel, Estimator):
             Poses (x, y, z, qx, qy, qz, qw); default the demonstration's.
         duration, dt : float, optional
             Seconds; temporal scaling as for positions.
-        limits : dict, optional
+        start_velocity : None
+            A pose motion starts at rest: anything but None is refused.
+        limits : bidmp.MotionLimits or dict, optional
             Position limits as :meth:`bidmp.DMP.trajectory` (``max_velocity`` ... in units/s);
             the orientation follows the same timing.
         coupling : list of coupling terms, optional
@@ -362,6 +372,7 @@ class CartesianDMP(PoseModel, Estimator):
             With ``via``: only the kernels acting before this time (s) change, in both parts (as
             :meth:`bidmp.DMP.trajectory`).
         """
+        via = self._at_rest_with(start_velocity, via)
         goal_p, goal_q, start_p, start_e = self._query(goal, start)
         _check_forcing_increment(position_increment, "position_increment")
         _check_forcing_increment(orientation_increment, "orientation_increment")

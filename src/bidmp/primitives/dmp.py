@@ -66,6 +66,7 @@ from .forcing import Basis, _check_forcing_increment, _forcing_target, _learn_we
 from .goals import DelayedGoal, PhaseGate, ProgressGate, _gate_past_training, _learn_goal_gate
 from .grid import _Caches
 from .integrate import _check_integration
+from .interface import _none_if_empty
 from .protocols import _FittedParams, _resolved_param, _with_rest
 from .rest import _rest_started
 from .settings import DERIVATIVE_CHOICES, PROTOCOLS, DMPSettings
@@ -703,7 +704,7 @@ class DMP(_FittedParams, Estimator):
             accelerations added. Without them (default) the fast path runs; an empty list runs the
             step integrator, which gives the same samples to rounding.
         via : list of (t, point), optional
-            Via-points: the motion passes ``point`` (D,) (units) at ``t`` seconds exactly (on the
+            Via-points (``()`` or None: none): the motion passes ``point`` (D,) (units) at ``t`` seconds exactly (on the
             samples, linearly between them), by the least-norm change of the forcing weights
             (:mod:`bidmp.primitives.via`). Points past the horizon, more than the kernels, or
             ones the kernels cannot carry raise ``ValueError``; with ``limits`` the motion is not
@@ -726,6 +727,7 @@ class DMP(_FittedParams, Estimator):
         """
         self.check_fitted()
         _check_forcing_increment(forcing_increment)  # every path below takes it
+        via = _none_if_empty(via)
         request = _Rollout(
             goal,
             start,

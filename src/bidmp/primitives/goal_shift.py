@@ -18,6 +18,7 @@ import numpy as np
 
 from .._checks import as_vector, short_token
 from .goals import _smoothstep, _smoothstep_derivatives
+from .limits import MotionLimits
 
 __all__ = []
 
@@ -33,6 +34,8 @@ def _shortest_blend(delta: np.ndarray, limits: dict | None) -> float:
     scalars, on the norm); 0 without limits."""
     size = float(np.linalg.norm(delta))
     shortest = 0.0
+    if isinstance(limits, MotionLimits):
+        limits = {key: value for key, value in limits.caps().items() if key != "norm"}
     if limits is not None and (
         not isinstance(limits, dict)
         or set(limits) - {"max_velocity", "max_acceleration", "max_jerk"}

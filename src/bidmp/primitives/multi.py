@@ -115,10 +115,32 @@ class MultiDMP(Estimator):
         self.check_fitted()
         return self.dmp_.system_
 
-    def trajectory(self, goal=None, **options):
-        """The mean motion (:meth:`bidmp.DMP.trajectory` of the mean weights)."""
+    def trajectory(  # noqa: PLR0913 - the motion interface's keywords, then the DMP's own
+        self,
+        goal=None,
+        *,
+        start=None,
+        start_velocity=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        via=(),
+        limits=None,
+        **options,
+    ):
+        """The mean motion (:meth:`bidmp.DMP.trajectory` of the mean weights): from ``start``
+        at ``start_velocity`` through ``via`` to ``goal`` within ``limits``, as the DMP runs
+        them; ``options`` the DMP's own (coupling, via_until, forcing_increment)."""
         self.check_fitted()
-        return self.dmp_.trajectory(goal, **options)
+        return self.dmp_.trajectory(
+            goal,
+            start=start,
+            start_velocity=start_velocity,
+            duration=duration,
+            dt=dt,
+            via=via,
+            limits=limits,
+            **options,
+        )
 
     def rollout(self, goal=None, **options) -> np.ndarray:
         """The mean motion's positions (:meth:`bidmp.DMP.rollout`)."""

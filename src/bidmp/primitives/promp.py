@@ -395,23 +395,117 @@ class ProMP(Estimator):
         (:func:`bidmp.io.load_model` calls it; a bad file raises, naming the member)."""
         return _promp_from_state(cls, meta, arrays)
 
-    def trajectory(self, dt: float = 0.01) -> Trajectory:
-        """The mean motion over the mean duration, every ``dt`` s: positions, velocities and
-        accelerations (analytic in the phase)."""
+    def conditioned(
+        self, *, start=None, start_velocity=None, goal=None, via=(), duration: float | None = None
+    ) -> ProMP:
+        """A copy conditioned exactly on a motion over ``duration`` (s; default the mean
+        duration) from ``start`` (D,) at ``start_velocity`` (D,, units/s; default rest) through
+        each via-point ``(t, point)`` (t in s) to ``goal`` (D,) at rest — the unconditioned model
+        itself when none is given. A start or goal not given is the mean's there (so a via-point
+        alone bends the middle of the motion, not its ends); both ends are at rest unless a start
+        velocity is given. Conflicting points (two at one time, more than the weights can carry)
+        raise ``ValueError``."""
+        from .interface import _via_points
+
         self.check_fitted()
-        dt = check_real(dt, "dt", positive=True, maximum=self.duration_)
-        n = check_int(
-            int(min(self.duration_ / dt, 1e15) + 1e-9) + 1,
-            "the samples (duration / dt)",
-            limit="max_steps",
+        duration = self._duration(duration)
+        times, points = _via_points(via, self.n_dims_, duration)
+        if start is None and start_velocity is None and goal is None and not times.size:
+            return self
+        start = self.mean([0.0])[0] if start is None else as_points(start, self.n_dims_, "start")[0]
+        goal = self.mean([1.0])[0] if goal is None else as_points(goal, self.n_dims_, "goal")[0]
+        # the positions at their phases, then the velocity at the start (dy/dphase = v T) and
+        # at rest at the end (velocity and acceleration 0)
+        phases = np.concatenate([[0.0], times / duration, [1.0]])
+        H = [self._H(phases), self._H(np.array([1.0]), 1), self._H(np.array([1.0]), 2)]
+        velocity = (
+            np.zeros(self.n_dims_)
+            if start_velocity is None
+            else as_points(start_velocity, self.n_dims_, "start_velocity")[0]
         )
-        t = np.arange(n) * dt
-        phase = np.minimum(t / self.duration_, 1.0)
-        y, yd, ydd = (
-            self._mean_of(self._rows(phase, 0, order)) / self.duration_**order
-            for order in (0, 1, 2)
-        )
-        return Trajectory(t, y, yd, ydd, self.units_)
+        values = [np.vstack([start, points, goal]).reshape(-1), np.zeros(2 * self.n_dims_)]
+        H.append(self._H(np.array([0.0]), 1))
+        values.append(velocity * duration)
+        if start_velocity is None:  # a start at rest: its acceleration too
+            H.append(self._H(np.array([0.0]), 2))
+            values.append(np.zeros(self.n_dims_))
+        H, values = np.hstack(H), np.concatenate(values)
+        try:
+            mean, covariance = _conditioned(
+                self.weight_mean_, self.weight_cov_, H, values, np.zeros((values.size,) * 2)
+            )
+        except _Conflict:
+            raise ValueError(
+                f"start, via and goal conflict: no motion of {self._fitted_basis} basis functions "
+                "per dimension passes them all (two points at one time with different values, or "
+                "more points than the weights can carry)"
+            ) from None
+        out = ProMP(**self.get_params())
+        out.__dict__.update({k: v for k, v in self.__dict__.items() if k.endswith("_")})
+        out.weight_mean_, out.weight_cov_ = mean, covariance
+        return out
+
+    def _duration(self, duration) -> float:
+        """``duration`` (s) checked, default the mean duration."""
+        if duration is None:
+            return self.duration_
+        return check_real(duration, "duration", positive=True, maximum=1e6)
+
+    def trajectory(
+        self,
+        goal=None,
+        *,
+        start=None,
+        start_velocity=None,
+        duration: float | None = None,
+        dt: float | None = None,
+        via=(),
+        limits=None,
+    ) -> Trajectory:
+        """The **mean** motion, conditioned on what is given (:meth:`conditioned`): from
+        ``start`` at ``start_velocity`` through ``via`` to ``goal``, every ``dt`` s (default
+        0.01) over ``duration`` (s; default the mean duration) rounded down to whole steps of
+        ``dt`` (the last sample is the end); positions, velocities and accelerations analytic in
+        the phase. The motion a robot runs is this mean; the spread is :meth:`std` (or
+        :meth:`var`) of the conditioned model.
+
+        ``limits`` (a :class:`bidmp.MotionLimits` or its dict form): a mean that breaks a cap is
+        slowed uniformly (its duration lengthened) to the shortest that meets them all; with
+        via-points it is checked, not re-timed, and one that breaks a cap raises."""
+        from .interface import _via_points, _within_limits
+
+        self.check_fitted()
+        dt = 0.01 if dt is None else check_real(dt, "dt", positive=True, maximum=1e4)
+        nominal = self._duration(duration)
+        if dt > nominal:
+            raise ValueError(f"dt ({dt:g} s) must be at most the duration ({nominal:.6g} s)")
+        has_via = bool(_via_points(via, self.n_dims_, nominal)[0].size)
+
+        def motion_over(span: float) -> Trajectory:
+            n = check_int(
+                int(min(span / dt, 1e15) + 1e-9) + 1,
+                "the samples (duration / dt)",
+                limit="max_steps",
+            )
+            end = (n - 1) * dt  # the last whole step: the end is a sample
+            model = self.conditioned(
+                start=start, start_velocity=start_velocity, goal=goal, via=via, duration=end
+            )
+            t = np.arange(n) * dt
+            phase = np.minimum(t / end, 1.0)
+            y, yd, ydd = (
+                model._mean_of(model._rows(phase, 0, order)) / end**order for order in (0, 1, 2)
+            )
+            return Trajectory(t, y, yd, ydd, self.units_)
+
+        return _within_limits(motion_over, nominal, limits, has_via=has_via, bounds=(dt, 1e6))
+
+    def std(self, times=None, n_steps: int = 100) -> np.ndarray:
+        """(T, D): the positions' standard deviation (units) at ``times`` (s, over the mean
+        duration; default ``n_steps`` over it)."""
+        self.check_fitted()
+        phase = None if times is None else as_vector(times, "times") / self.duration_
+        return np.sqrt(self.var(phase, n_steps))
 
 
 def _conflict_text(rows: tuple[int, int], phase: np.ndarray, rest: np.ndarray, dims: int) -> str:

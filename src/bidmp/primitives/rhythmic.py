@@ -52,6 +52,7 @@ from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
 from .frequency import _MAX_HARMONICS, _series, _with_frequency, estimate_frequency
 from .integrate import _exact_responses, _exact_state, _foh_step
+from .limits import MotionLimits
 from .timing import Trajectory, check_timestamps
 
 __all__ = ["RhythmicDMP", "RhythmicStepper"]
@@ -529,6 +530,12 @@ def _check_samples(count: float, what: str) -> float:
 
 def _check_rhythm_limits(limits) -> dict:
     """``limits`` as a dict of positive caps among max_velocity, max_acceleration, max_jerk."""
+    if isinstance(limits, MotionLimits):
+        if limits.norm != "norm" or limits.fastest:
+            raise ValueError(
+                "limits: a rhythm's caps bound the norm of its peaks (norm='norm', fastest=False)"
+            )
+        limits = {key: value for key, value in limits.caps().items() if key != "norm"}
     if limits is None:
         return {}
     if not isinstance(limits, dict):

@@ -12,6 +12,7 @@ from .._units import check_reach
 from .avoidance import SceneAvoidance, _check_avoidance
 from .canonical import _TAU_RANGE
 from .integrate import _foh_step
+from .limits import MotionLimits
 from .settings import DMPSettings
 from .stepper import DMPStepper
 from .system import DMPSystem
@@ -131,11 +132,14 @@ def _exact_rates(
 
 
 def _checked_limits(limits) -> tuple[dict, bool]:
-    """A trajectory's ``limits`` dict as :func:`scale_factor`'s keywords, and its ``fastest`` flag."""
+    """A trajectory's ``limits`` (a :class:`bidmp.MotionLimits` or its dict form) as
+    :func:`scale_factor`'s keywords, and its ``fastest`` flag."""
+    if isinstance(limits, MotionLimits):
+        return limits.caps(), limits.fastest
     if not isinstance(limits, dict):
         raise TypeError(
-            f"limits must be a dict of max_velocity / max_acceleration / max_jerk / norm / fastest, "
-            f"got {type(limits).__name__}"
+            f"limits must be a bidmp.MotionLimits or a dict of max_velocity / max_acceleration / "
+            f"max_jerk / norm / fastest, got {type(limits).__name__}"
         )
     unknown = set(limits) - {"max_velocity", "max_acceleration", "max_jerk", "norm", "fastest"}
     if unknown:

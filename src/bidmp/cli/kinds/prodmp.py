@@ -38,7 +38,7 @@ class _ProDMPAdapter:
                     "is --start)"
                 )
         start = model.start_ if args.start is None else np.asarray(args.start, dtype=float)
-        base = model.trajectory(start, times=t)
+        base = model.trajectory(start=start, times=t)
         conditioned, what, points = model, "the mean motion", [(0.0, start), *via]
         if goal is not None or args.start is not None or via:
             end = base.y[-1] if goal is None else goal
@@ -52,7 +52,7 @@ class _ProDMPAdapter:
             )
             what = conditioned_on(start, args.start is not None, via, end, goal is not None)
             points.append((end_time, end))
-        trajectory = conditioned.trajectory(start, times=t)
+        trajectory = conditioned.trajectory(start=start, times=t)
         marks = (np.array([p[0] for p in points]), np.array([p[1] for p in points]))
         times = {"demonstrations": [], "mean": t, "conditioned": t}
         std, base_std = conditioned.std(times=t), model.std(times=t)

@@ -33,7 +33,7 @@ class _ProDMPMethod(Method):
             )
         prodmp, start, n_samples = model
         attractor = prodmp.goal_for_end(goal, start)  # ends exactly at the goal
-        return prodmp.trajectory(start, attractor, n_steps=n_samples).y
+        return prodmp.trajectory(start=start, attractor=attractor, n_steps=n_samples).y
 
 
 METHOD = _ProDMPMethod()
