@@ -174,3 +174,15 @@ def test_a_law_that_breaks_a_limit_is_slowed_by_the_closed_form_factor(binding, 
     index = ("velocity", "acceleration", "jerk").index(binding)
     assert timed.peaks[index] == pytest.approx(0.9, rel=1e-4)
     assert all(peak <= 0.9 + 1e-9 for peak in timed.peaks)
+    # the slowed motion itself: positions on the path, held past its end; its derivatives
+    # (d/du, u the normalised time) are the positions' own differences, and the binding peak
+    # per second is at the margin
+    u = np.linspace(0.0, 1.0, 20001)
+    q = timed(u)
+    np.testing.assert_allclose(q[[0, 10000, -1], 0], [0.0, 0.5, 1.0], atol=1e-9)
+    np.testing.assert_allclose(timed(np.array([1.5])), timed(np.array([1.0])), atol=0)
+    for order in (1, 2):
+        numeric = np.gradient(timed(u, order - 1)[:, 0], u)
+        np.testing.assert_allclose(timed(u, order)[1:-1, 0], numeric[1:-1], atol=2e-3 * order**3)
+    per_second = np.max(np.abs(timed(u, index + 1)[:, 0])) / timed.duration ** (index + 1)
+    assert per_second == pytest.approx(0.9 * limits[index], rel=1e-3)
