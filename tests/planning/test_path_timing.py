@@ -136,3 +136,53 @@ def test_each_limit_binds_where_it_is_the_tightest_and_the_reported_peaks_are_th
         if kind == binding:
             assert reported == pytest.approx(measured[kind], rel=0.03), (kind, timed.peaks)
         assert reported <= 0.8 + 1e-9, (kind, timed.peaks)
+
+
+@pytest.mark.parametrize(
+    "binding, limits, expected",
+    [
+        # a straight joint move of 1 rad under a minimum-jerk law over 1 s: peaks 1.875 rad/s,
+        # 5.7735 rad/s², 60 rad/s³ (closed form); each row's limits make one of them bind
+        ("velocity", (1.0, 100.0, 1e4), 1.875 / (0.9 * 1.0)),
+        ("acceleration", (100.0, 2.0, 1e4), (5.7735027 / (0.9 * 2.0)) ** 0.5),
+        ("jerk", (100.0, 100.0, 10.0), (60.0 / (0.9 * 10.0)) ** (1.0 / 3.0)),
+    ],
+)
+def test_a_law_that_breaks_a_limit_is_slowed_by_the_closed_form_factor(binding, limits, expected):
+    """The safety net after TOPP-RA, alone: a law that breaks one limit is slowed uniformly by
+    exactly the factor that brings that peak to the margin (speed ~ 1/k, acceleration ~ 1/k²,
+    jerk ~ 1/k³: the closed form of a minimum-jerk move), and the peaks it reports are the
+    slowed motion's own."""
+    from bidmp.planning.timing import _stretched
+
+    def geometric(s, order=0):
+        s = np.asarray(s, dtype=float)
+        return s[..., None] * np.ones(2) if order == 0 else np.ones(s.shape + (2,)) * (order == 1)
+
+    def law(t, order=0):
+        t = np.clip(np.asarray(t, dtype=float), 0.0, 1.0)
+        return [
+            10 * t**3 - 15 * t**4 + 6 * t**5,
+            30 * t**2 - 60 * t**3 + 30 * t**4,
+            60 * t - 180 * t**2 + 120 * t**3,
+            60 - 360 * t + 360 * t**2,
+        ][order]
+
+    caps = tuple(np.full(2, value) for value in limits)
+    timed = _stretched(geometric, law, 1.0, caps, 0.9, "test")
+    assert timed.duration == pytest.approx(expected, rel=1e-4), binding
+    index = ("velocity", "acceleration", "jerk").index(binding)
+    assert timed.peaks[index] == pytest.approx(0.9, rel=1e-4)
+    assert all(peak <= 0.9 + 1e-9 for peak in timed.peaks)
+    # the slowed motion itself: positions on the path, held past its end; its derivatives
+    # (d/du, u the normalised time) are the positions' own differences, and the binding peak
+    # per second is at the margin
+    u = np.linspace(0.0, 1.0, 20001)
+    q = timed(u)
+    np.testing.assert_allclose(q[[0, 10000, -1], 0], [0.0, 0.5, 1.0], atol=1e-9)
+    np.testing.assert_allclose(timed(np.array([1.5])), timed(np.array([1.0])), atol=0)
+    for order in (1, 2):
+        numeric = np.gradient(timed(u, order - 1)[:, 0], u)
+        np.testing.assert_allclose(timed(u, order)[1:-1, 0], numeric[1:-1], atol=2e-3 * order**3)
+    per_second = np.max(np.abs(timed(u, index + 1)[:, 0])) / timed.duration ** (index + 1)
+    assert per_second == pytest.approx(0.9 * limits[index], rel=1e-3)

@@ -224,3 +224,49 @@ def test_the_goal_reached_is_the_one_the_last_segment_was_tested_to():
     route = plan_route(space, [-0.5, 0.0], [[0.0, 0.0], [0.5, 0.0]], seed=1)
     assert route.goal == 1 and np.array_equal(route.waypoints[-1], [0.5, 0.0])
     assert dense_clear(space, route.waypoints)
+
+
+class Line:
+    """A space whose slack is written by the test: ``slack(q)`` = ``rule(q[0])``, the body a
+    point moving along x (the sweep: how far it goes)."""
+
+    def __init__(self, rule, tolerance):
+        self.lower, self.upper = np.array([-2.0, -1.0]), np.array([2.0, 1.0])
+        self.rule, self.tolerance, self.asked = rule, tolerance, 0
+
+    def slack(self, q) -> float:
+        self.asked += 1
+        return float(self.rule(float(q[0])))
+
+    def sweep(self, a, b) -> float:
+        return float(np.linalg.norm(np.asarray(b) - np.asarray(a)))
+
+
+def test_a_segment_counts_each_slack_it_asked_for_up_to_its_cap():
+    """A segment's test count is the slacks the space was asked for: on a free segment, and on
+    one that grazes its clearance all along, given up after exactly the advancement's cap."""
+    from bidmp.planning.rrt import _MAX_ADVANCES, _Tester
+
+    free = Line(lambda x: 0.3, tolerance=1e-3)
+    tester = _Tester(free)
+    assert tester.segment(np.array([0.0, 0.0]), np.array([1.0, 0.0]))
+    assert tester.count == free.asked == 5  # 0.3 at a time: 0, 0.3, 0.6, 0.9, 1.0
+    grazing = Line(lambda x: 5e-7, tolerance=1e-6)
+    tester = _Tester(grazing)
+    assert not tester.segment(np.array([-0.5, 0.0]), np.array([0.5, 0.0]))
+    assert tester.count == grazing.asked == _MAX_ADVANCES
+
+
+def test_a_configuration_at_slack_zero_is_free_as_the_space_says():
+    """The slack keeps the space's tolerance already: 0 is free (as ``free`` says), and a segment
+    whose advancement lands exactly on it goes on."""
+    space = Line(lambda x: abs(x - 0.5), tolerance=1e-3)
+    assert segment_free(space, [0.0, 0.0], [1.0, 0.0])
+
+
+def test_the_least_step_stops_at_the_segments_end_not_in_the_part_beyond():
+    """Near a part the advancement takes its least step (the tolerance), more than the segment's
+    rest: it stops at the segment's end (free) rather than test a point past it, in the part."""
+    space = Line(lambda x: (1.005 - x) / 2.0, tolerance=0.02)
+    assert space.slack([1.01, 0.0]) < 0.0 <= space.slack([1.0, 0.0])
+    assert segment_free(space, [0.99, 0.0], [1.0, 0.0])

@@ -155,3 +155,46 @@ def test_the_pose_checker_sees_a_part_by_the_tools_top_and_a_scene_of_one_part()
             assert clearance.part == "beam" and not clearance.clear, clearance
             assert not checker.free(point, turn.as_matrix())
             assert checker.slack(point, turn.as_matrix()) <= clearance.distance - 3.0 + 1e-9
+
+
+def test_the_pose_checkers_slack_is_the_least_of_its_parts_in_a_cluttered_corner():
+    """Tool poses among four parts at once (a plate, a nut, a wall, a beam and a post, close
+    together), tilted at random: the checker's slack equals the least of one-part checkers'
+    (each alone, with no order among parts to rely on), whether asked for the value or only for
+    its sign (``far=0``, what ``free`` asks); the early exits must not change either."""
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 12.5, "length": 100},
+            "margin": 3,
+            "standoff": {"plate": 1},
+            "parts": [
+                {"type": "plate", "label": "plate", "at": [0, 0, -2], "size": [300, 300, 5]},
+                {
+                    "type": "nut",
+                    "label": "nut",
+                    "at": [0, 0, -2],
+                    "across_flats": 13,
+                    "height": 6.5,
+                },
+                {"type": "box", "label": "wall", "at": [-30, 0, -2], "size": [10, 120, 80]},
+                {"type": "box", "label": "beam", "at": [5, 25, 40], "size": [50, 8, 8]},
+                {"type": "box", "label": "post", "at": [22, -18, -2], "size": [8, 8, 60]},
+            ],
+        }
+    )
+    labels = ["plate", "nut", "wall", "beam", "post"]
+    whole = scene.pose_checker([])
+    alone = {label: scene.pose_checker([o for o in labels if o != label]) for label in labels}
+    rng = np.random.default_rng(7)
+    several_within = sign_flips = 0
+    for _ in range(400):
+        point = rng.uniform([-40, -30, -5], [35, 35, 45])
+        turn = (Rotation.from_rotvec(rng.normal(0, 0.5, 3)) * DOWN).as_matrix()
+        each = {label: checker.slack(point, turn) for label, checker in alone.items()}
+        least = min(each.values())
+        several_within += sum(value < 0.0 for value in each.values()) >= 2
+        sign_flips += sorted(each.values())[1] >= 0.0 > least
+        assert whole.slack(point, turn) == pytest.approx(least, abs=1e-9)
+        assert whole.free(point, turn) == (least >= 0.0)
+        assert (whole.slack(point, turn, far=0.0) >= 0.0) == (least >= 0.0)
+    assert several_within >= 20 and sign_flips >= 20  # the poses asked what the exits skip

@@ -187,7 +187,10 @@ class PoseChecker:
         point = np.asarray(point, dtype=float)
         axis = self._down if rotation is None else np.asarray(rotation, dtype=float)[:, 2]
         centre = point - axis * (scene.tool.length / 2.0)
-        bounds = scene._oriented_bounds(centre[None], axis[None], self.chosen)[0] - self.required
+        gaps = scene._oriented_bounds(centre[None], axis[None], self.chosen)[0]
+        # A gap bounds the part's signed distance from below only while the boxes are apart:
+        # boxes that overlap bound nothing (the tool may be in the part by any depth).
+        bounds = np.where(gaps > 0.0, gaps - self.required, -math.inf)
         order = np.argsort(bounds, kind="stable")
         far = scene.tool.radius if far is None else far
         if bounds[order[0]] > far:
