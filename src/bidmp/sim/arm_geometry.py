@@ -143,7 +143,14 @@ class ArmGeometry:
         )
 
     def solve_ik(
-        self, point, frame, seed, *, free_turn: bool = True, iterations: int = 200
+        self,
+        point,
+        frame,
+        seed,
+        *,
+        free_turn: bool = True,
+        iterations: int = 200,
+        inside: float = 0.0,
     ) -> tuple[np.ndarray, float]:
         """Joints within the limits that put the tool's mouth at ``point`` (m, world) with its
         frame ``frame`` (a quaternion x, y, z, w; its z axis the approach direction), from joints
@@ -155,6 +162,9 @@ class ArmGeometry:
         space. The damping grows near a singularity (a wrist with joints 4 and 6 aligned) instead
         of stepping across it: from another seed the other branch is found. Stops where the
         mouth is within 0.1 µm and the axis within 0.1 µrad, or after ``iterations``.
+        ``inside``: radians kept inside each joint's range (one for all, or one per joint; at most
+        a tenth of the range): a spline timed through such solutions does not overshoot the range
+        where a joint is at its end.
         """
         from ..primitives.so3 import as_quaternions
 
@@ -168,6 +178,14 @@ class ArmGeometry:
         free_turn = check_bool(free_turn, "free_turn")
         iterations = check_int(iterations, "iterations", minimum=1, maximum=10_000)
         lower, upper = np.asarray(self.limits.lower), np.asarray(self.limits.upper)
+        if np.ndim(inside) == 0:
+            inside = np.full(q.size, check_real(inside, "inside", nonnegative=True))
+        else:
+            inside = as_point(inside, model.nq, "inside", like="the arm's joints")
+            if np.any(inside < 0.0):
+                raise ValueError("inside must be 0 or more radians for every joint")
+        inside = np.minimum(inside, 0.1 * (upper - lower))
+        lower, upper = lower + inside, upper - inside
         middle, span = 0.5 * (lower + upper), upper - lower
         inverse = self.rotation.T
         target = inverse @ (point - self.base)
@@ -274,8 +292,10 @@ class ArmSpace:
             if item.parentJoint == 0:
                 continue  # the base link never moves: it is not tested against the parts
             arm_shapes.append(geometry.addGeometryObject(item.copy()))
+        held = None
         if carried is not None:
-            arm_shapes.append(geometry.addGeometryObject(_carried_object(pin, arm, carried, unit)))
+            held = geometry.addGeometryObject(_carried_object(pin, arm, carried, unit))
+            arm_shapes.append(held)
         inverse = arm.rotation.T
         pairs = []
         for solid in scene.solids:
@@ -292,7 +312,10 @@ class ArmSpace:
             stand = scene.standoff.get(solid.part)
             required = margin if stand is None else min(stand * unit, margin)
             for shape_index in arm_shapes:
-                pairs.append(_Pair(shape_index, part, required + self.tolerance))
+                # a stand-off lets the tool near the part it works on; a part the tool carries
+                # keeps the margin from every part, as the motion contract's clearance asks
+                kept = margin if shape_index == held else required
+                pairs.append(_Pair(shape_index, part, kept + self.tolerance))
         for pair in pairs:
             geometry.addCollisionPair(pin.CollisionPair(pair.arm, pair.part))
         self.geometry, self.data = geometry, pin.GeometryData(geometry)
