@@ -78,16 +78,10 @@ def plan_path(
     q = np.array(cell.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
     joints = np.empty((points.shape[0], n_joints))
     for index, point in enumerate(points):
-        q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
+        turn = None if turns is None else turns[index]
+        q, error = cell.solve_ik(point, q, turn)
         if error > IK_TOLERANCE:
-            digits = length_digits(_unit_name(cell.unit))  # 0.01 mm detail in the scene's unit
-            raise SimError(
-                f"target {label!r}: the point {np.round(point / cell.unit, digits).tolist()} of its motion is "
-                f"unreachable for the {cell.name} at base {np.round(cell.base, digits).tolist()} "
-                f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}): out of "
-                f'its reach (move its base: scenario key "robot": {{"base": ...}}), or not from the '
-                f'joints it comes from (a start pose nearer it: "robot": {{"rest": [...]}}, rad)'
-            )
+            raise SimError(_not_followed(cell, label, point, turn, error))
         below, above = q < np.array(limits.lower) - 1e-9, q > np.array(limits.upper) + 1e-9
         if below.any() or above.any():
             joint = int(np.flatnonzero(below | above)[0])
@@ -155,6 +149,37 @@ def _slowed(plan: MotionPlan, duration: float) -> MotionPlan:
         plan.peak_acceleration *= scale**2
         plan.peak_jerk *= scale**3
     return plan
+
+
+_REACH_SEEDS = 8  # seeded draws (beside the rest pose and the ranges' middle) a point is tried from
+
+
+def _not_followed(cell, label: str, point: np.ndarray, turn, error: float) -> str:
+    """Why the inverse kinematics did not follow a motion to ``point`` (m), leaving ``error``:
+    where joints from elsewhere (the rest pose, the ranges' middle, seeded draws within the
+    limits) put the tool there, the motion's way is the trouble (a singularity or a joint's range
+    on it), and the point is not called unreachable; where none does, it is, and the reason
+    says to move the arm's base."""
+    digits = length_digits(_unit_name(cell.unit))  # 0.01 mm detail in the scene's unit
+    where = np.round(point / cell.unit, digits).tolist()
+    leaves = f"{error / cell.unit:.3g} {_unit_name(cell.unit)}"
+    lower, upper = np.asarray(cell.limits.lower), np.asarray(cell.limits.upper)
+    middle, half = 0.5 * (lower + upper), np.minimum(0.5 * (upper - lower), np.pi)
+    draws = np.random.default_rng(0).uniform(-1.0, 1.0, (_REACH_SEEDS, lower.size))
+    for start in np.vstack([np.asarray(cell.rest, dtype=float), middle, middle + draws * half]):
+        _, reached = cell.solve_ik(point, start, turn)
+        if reached <= IK_TOLERANCE:
+            return (
+                f"target {label!r}: the inverse kinematics does not follow its motion to the point "
+                f"{where} from the joints before it (it leaves {leaves} there), though other joints "
+                "of the arm reach that point: a singularity or a joint's range on the way"
+            )
+    return (
+        f"target {label!r}: the point {where} of its motion is unreachable for the {cell.name} at "
+        f"base {np.round(cell.base, digits).tolist()} (inverse kinematics from the joints before "
+        f"it, the rest pose, the ranges' middle and {_REACH_SEEDS} other starts leaves {leaves}): "
+        'out of its reach (move its base: scenario key "robot": {"base": ...})'
+    )
 
 
 def _subdivide(
