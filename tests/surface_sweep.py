@@ -18,7 +18,17 @@ The outcome of one call is one of the classes of :data:`CLASSES`:
 ``internal error``  any other exception (``IndexError``, ``KeyError``, ``RecursionError``, ...);
 ``silent NaN/inf``  it returned NaN or inf without a word;
 ``leaked warning``  it warned (a warning is not a refusal: a caller cannot catch it as one);
-``hang``            it ran over :data:`MAX_SECONDS`.
+``hang``            it ran over :data:`MAX_SECONDS`;
+``accepted a bool`` it returned a result for True (or booleans) given where a point or an array
+                    of numbers goes (:data:`MUST_REFUSE`): NumPy reads True as 1.0, a silently
+                    wrong answer.
+
+The nasty values' families: wrong types; NaN/inf; tiny positive floats (1e-300, 5e-324: a loop
+count or a step derived from a division by one runs for ever); huge finite values (1e300, and
+arrays scaled by it: squares and norms overflow); scalars and bools where arrays and points go;
+empty, ragged, 0-d and 3-D arrays; millions of broadcast rows; data nested thousands deep; paths
+to devices, pipes, system files and URLs; damaged copies of a data folder (a file truncated,
+emptied or garbled: :func:`surface_targets.damaged_copies`).
 
 Everything but ``result`` and ``refused`` is a defect. ``tests/test_fuzz_surface.py`` runs a seeded
 sample in CI and everything with ``BIDMP_FUZZ=full`` (``make fuzz``).
@@ -43,6 +53,7 @@ import api_reference  # tools/: the documented packages, listed once
 import numpy as np
 
 import bidmp
+from bidmp._api import Estimator
 
 MAX_SECONDS = 10.0
 CLASSES = (
@@ -55,8 +66,17 @@ CLASSES = (
     "silent NaN/inf",
     "leaked warning",
     "hang",
+    "accepted a bool",
 )
 DEFECTS = CLASSES[2:]
+# Nasty values no call may accept: True or booleans where a point or an array of numbers goes.
+MUST_REFUSE = {"True as a point", "bools as points"}
+# Defects the families of tiny floats and bools found in bidmp.sim (2026-12-07), one in bidmp
+# verify and one in the route planner's tool_route that main's own families found, which their
+# engineers fix (sim/ and cli/verify.py were not this change's to touch, tool_route's message is
+# changing where it is written): (entry point, argument, nasty value). A call that hits one is
+# counted as a "known defect", not failed; the full sweep lists them.
+KNOWN_DEFECTS: set = set()  # (label, argument, nasty) of defects known and not yet fixed: none
 # the packages documented in docs/api.md, but the command line (its functions parse argv)
 PACKAGES = tuple(name for name in api_reference.PACKAGES if name != "bidmp.cli")
 # Whole experiments and runs (their own tests run them with valid scenarios; one swapped argument
@@ -303,6 +323,9 @@ def generic_nasty(tmp: Path) -> list:
         ("ragged", [[1.0, 2.0], [3.0]]),
         ("0-d array", np.array(5.0)),
         ("1j", 1j),
+        ("1e-300", 1e-300),
+        ("5e-324", 5e-324),
+        ("1e300", 1e300),
         ("negative array", -DEMO * 1e300),
         ("a directory", tmp),
         ("empty text", ""),
@@ -337,6 +360,11 @@ def derived_nasty(valid, tmp: Path, writer: bool = True) -> list:
         # tiny positive floats: a motion of 1e-300 is no motion, a step of 1e-300 none either
         out.append(("all 1e-300", np.full(valid.shape, 1e-300)))
         out.append(("one row", valid.reshape(-1, width)[:1]))
+        out.append(("a scalar", 2.5))
+        out.append(("True as a point", True))
+        out.append(("bools as points", valid != 0))
+        out.append(("times 1e300", valid * 1e300))
+        out.append(("times 1e-300", valid * 1e-300))
         if valid.ndim == 2:
             out.append(("transposed", np.ascontiguousarray(valid.T)))
     if isinstance(valid, (str, Path)) and (isinstance(valid, Path) or "/" in str(valid)):
@@ -366,7 +394,13 @@ def derived_nasty(valid, tmp: Path, writer: bool = True) -> list:
     if isinstance(valid, dict):
         out += [("unknown key", {**valid, "bogus-key": 1.0}), ("list of the dict", [valid])]
     if isinstance(valid, (int, float)) and not isinstance(valid, bool):
-        out += [("NaN", float("nan")), ("-inf", -np.inf), ("1e-300", 1e-300), ("-1e-300", -1e-300)]
+        # (1e-300 and 5e-324 are every argument's: generic_nasty)
+        out += [
+            ("NaN", float("nan")),
+            ("-inf", -np.inf),
+            ("-1e-300", -1e-300),
+            ("times 1e300", valid * 1e300),
+        ]
     return out
 
 
@@ -517,9 +551,18 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int, source=No
         base = {name: valid[name] for name in names if name in required or name in special}
         writer = bool(WRITER.search(label))
         options = {
-            name: generic + derived_nasty(valid.get(name), tmp, writer) + extra.get(name, [])
-            for name in names
+            name: generic
+            + derived_nasty(_shaped_like(valid.get(name), parameters[index]), tmp, writer)
+            + extra.get(name, [])
+            for index, name in enumerate(names)
         }
+        if inspect.isclass(function) and issubclass(function, Estimator):
+            # an estimator's constructor only stores (scikit-learn's convention): what it is given
+            # is judged by its fit and its set_params (their own targets)
+            options = {
+                name: [(lab, value) for lab, value in values if lab not in MUST_REFUSE]
+                for name, values in options.items()
+            }
         for name in names:
             for nasty_label, value in options[name]:
                 singles.append(
@@ -542,6 +585,15 @@ def sweep_calls(tmp: Path, rng: np.random.Generator, pair_budget: int, source=No
                 {first: a[1], second: b[1]},
                 names,
             )
+
+
+def _shaped_like(valid, parameter: inspect.Parameter):
+    """The value an argument's derived nasty values are made from: its common valid value, but
+    none for a flag (a parameter whose default or annotation is a bool: a ``poses`` flag is not
+    the poses array the common ``poses`` is)."""
+    if isinstance(parameter.default, bool) or "bool" in str(parameter.annotation):
+        return None
+    return valid
 
 
 def _call(label, swapped, nasty_labels, function, base, changes, names):
@@ -578,7 +630,8 @@ def names_argument(message: str, changes: dict, label: str = "") -> bool:
                 return True
         elif re.search(
             rf"(?:^|[\s(`'\".]){escaped}(?:\s+(?:must|has|is|are|contains|needs|holds|of|with|should|and|"
-            rf"gives|takes|would|was|were|can|cannot|does|lies|rows?|columns?|values?|\(|[/*+<>=-])|[:=\[,)'\"`.]|$)",
+            rf"gives|takes|would|was|were|can|cannot|does|lies|barely|implies|rows?|columns?|values?|"
+            rf"\(|[/*+<>=-])|[:=\[,)'\"`.]|$)",
             message,
         ):
             return True
@@ -661,6 +714,9 @@ def _system_files() -> dict:
     }
 
 
+KNOWN_FOUND: list = []  # the known defects the last run met (KNOWN_DEFECTS), described
+
+
 def run(chosen) -> tuple[Counter, list]:
     """Outcome counts per ``label: class`` and the defects' descriptions of the calls ``chosen``."""
     before = _system_files()
@@ -674,6 +730,8 @@ def run(chosen) -> tuple[Counter, list]:
 
 def _run(chosen) -> tuple[Counter, list]:
     outcomes, defects = Counter(), []
+    known_defects = KNOWN_FOUND
+    known_defects.clear()
     with bidmp.set_limits(max_array_bytes=256 << 20):
         trail = os.environ.get(
             "BIDMP_FUZZ_TRAIL"
@@ -683,10 +741,13 @@ def _run(chosen) -> tuple[Counter, list]:
                 with open(trail, "a", encoding="utf-8") as handle:
                     handle.write(f"{label} {swapped} {nasty_labels}\n")
             kind = classify(thunk, changes, label in DOCUMENTED_INF, label)
+            if kind == "result" and MUST_REFUSE.intersection(nasty_labels):
+                kind = "accepted a bool"
             outcomes[f"{label}: {kind}"] += 1
             if kind in DEFECTS:
                 described = ", ".join(f"{n}={v}" for n, v in zip(swapped, nasty_labels))
-                defects.append(f"{label}({described}): {kind}")
+                known = any((label, n, v) in KNOWN_DEFECTS for n, v in zip(swapped, nasty_labels))
+                (known_defects if known else defects).append(f"{label}({described}): {kind}")
     return outcomes, defects
 
 

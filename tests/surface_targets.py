@@ -73,6 +73,7 @@ def _route_overrides() -> dict:
             "yaw": 90.0,
         },
         "bidmp.sim.supports_routes": {"cell": cell},
+        "bidmp.sim.reach": {"cell": bidmp.sim.RobotCell(scenario.scene), "point": [0.0, 0.0, 50.0]},
         "bidmp.sim.needlessly_slow": {"cell": cell, "plan": plan},
     }
 
@@ -123,6 +124,7 @@ def _package_overrides(tmp: Path) -> dict:
     }
     scenario = bidmp.tasks.load("nut-unscrewing")
     joints = np.zeros((60, 7))
+    pose_stepper = bidmp.CartesianDMP(bidmp.DMP(n_kernels=10)).fit(POSES, TIMES).stepper()
     return {
         **readers,
         **_route_overrides(),
@@ -340,8 +342,8 @@ def _package_overrides(tmp: Path) -> dict:
             "forcing_increment": None,
         },
         "bidmp.primitives.PoseStepper": {
-            "position": dmp.stepper(),
-            "orientation": np.array([0.0, 0.0, 0.0, 1.0]),
+            "position": pose_stepper.position,
+            "orientation": pose_stepper.orientation,
             "goal_orientation": np.array([0.0, 0.0, 0.0, 1.0]),
         },
         "bidmp.primitives.ProgressGate": {
@@ -896,6 +898,7 @@ def targets(tmp: Path):
         yield f"{owner}.set_params(...) then used", _after_set_params(cls, fit_args), {}
     yield from _wrong_objects(tmp)
     yield from _hostile_urdfs(tmp)
+    yield from _damaged_data(tmp)
     yield from odd_inputs(tmp)
     for owner, instance, special in _instances(tmp):
         for name, member in inspect.getmembers(type(instance)):
@@ -1037,6 +1040,69 @@ def _hostile_urdfs(tmp: Path):
         [inspect.Parameter("urdf", inspect.Parameter.KEYWORD_ONLY)]
     )
     yield "robot_model(hostile URDFs)", arm, {"urdf": _ARM, "nasty:urdf": hostile}
+
+
+def damaged_copies(source: Path, folder: Path, damages: list) -> list:
+    """(label, path) of copies of the data folder ``source`` in ``folder``, each with one file
+    damaged as ``damages`` say — (label, file relative to the folder, its new content: bytes, or
+    a function of the old bytes). The other files are linked, not copied."""
+    import os
+    import shutil
+
+    out = []
+    for index, (label, relative, content) in enumerate(damages):
+        copy = folder / f"copy{index}"
+        if not copy.exists():
+            shutil.copytree(source, copy, copy_function=os.symlink)
+            target = copy / relative
+            old = target.read_bytes()
+            target.unlink()
+            target.write_bytes(content(old) if callable(content) else content)
+        out.append((f"damaged copy: {label}", copy))
+    return out
+
+
+def _damaged_data(tmp: Path):
+    """The CLFD loader reading damaged copies of its data folder (a file truncated, emptied,
+    garbled, its member gone): refused in one line naming the file; the intact copy reads."""
+    import io
+    import os
+    import shutil
+
+    from bidmp.experiments.clfd import clfd_tasks
+    from bidmp.experiments.clfd import data as clfd_data
+
+    def npz(**arrays) -> bytes:
+        out = io.BytesIO()
+        np.savez(out, **arrays)
+        return out.getvalue()
+
+    lasa, pose = "LASA/lasa_numpy/task_x3_y3.npz", "robottasks/pos_ori/openbox.npy"
+    damages = [
+        ("npz truncated", lasa, lambda old: old[: len(old) // 2]),
+        ("npz emptied", lasa, b""),
+        ("npz garbled", lasa, bytes(range(256)) * 8),
+        ("npz without t", lasa, npz(pos=np.zeros((7, 50, 2)))),
+        ("npy truncated", pose, lambda old: old[:1000]),
+        ("npy emptied", pose, b""),
+        ("sequence garbled", "LASA/lasa_numpy_sequence_all.txt", b"\xff\xfe\x00 ../x"),
+        ("names garbled", "LASA/lasa_names.json", b"{not json"),
+    ]
+    folder = tmp / "clfd-copies"
+    intact = folder / "intact"
+    if not intact.exists():
+        shutil.copytree(clfd_data.DATA, intact, copy_function=os.symlink)
+
+    def both(folder):
+        return {
+            dataset: len(clfd_tasks(dataset, folder=folder)) for dataset in ("lasa", "robottasks")
+        }
+
+    both.__signature__ = inspect.Signature(
+        [inspect.Parameter("folder", inspect.Parameter.KEYWORD_ONLY)]
+    )
+    damaged = damaged_copies(clfd_data.DATA, folder, damages)
+    yield "clfd_tasks(damaged copies)", both, {"folder": intact, "nasty:folder": damaged}
 
 
 # -- the "nothing silently wrong" campaign's input families ------------------------------------------

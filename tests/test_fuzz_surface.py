@@ -53,6 +53,7 @@ def test_the_public_surface_refuses_nasty_input_by_name(tmp_path):
             "uncovered": uncovered,
             "classes": classes,
             "defects": defects,
+            "known_defects": sorted(surface_sweep.KNOWN_FOUND),
             "outcomes": dict(sorted(outcomes.items())),
         }
         path = ROOT / "docs" / "results" / "fuzz.json"
@@ -95,8 +96,48 @@ def test_the_odd_input_families_read_right_or_are_refused_by_name(tmp_path):
         ("goal must have 3 coordinates", {"start": None}, False),
         ("model file /tmp/x/m.npz does not exist", {"path": "/tmp/x/m.npz"}, True),
         ("n_steps must be >= 2", {"n_steps": -1, "dt": 0}, True),
+        ("y barely moves: no coordinate leaves the start", {"y": None}, True),
+        ("t implies a sample rate of 1e+302 Hz", {"t": None}, True),
     ],
 )
 def test_names_argument_tells_a_named_refusal(message, changes, named):
     """Structure guard of the sweep's own judge: what counts as naming the argument."""
     assert surface_sweep.names_argument(message, changes) is named
+
+
+# What the families of tiny floats, huge values, bools where points go and damaged data copies
+# were added for (2026-12-07): each reaches its call, and none of them is a defect now.
+FAMILY_FINDS = {
+    ("RhythmicDMP.run", "settle", "1e-300"),
+    ("RhythmicDMP.run", "settle", "5e-324"),
+    ("RhythmicDMP.run", "transition", "1e-300"),
+    ("RhythmicDMP.run", "transition", "5e-324"),
+    ("bidmp.primitives.principal_log", "goal", "times 1e300"),
+    ("bidmp.primitives.orientation_from_log", "goal", "times 1e-300"),
+    ("bidmp.primitives.prodmp_basis", "dt", "5e-324"),
+    ("Scene.target_parts", "point", "True as a point"),
+    ("bidmp.extension.curvature", "y", "times 1e-300"),
+    ("bidmp.planning.plan_route", "time_limit", "1e-300"),
+    ("bidmp.planning.time_path", "margin", "1e-300"),
+    ("bidmp.planning.time_path", "margin", "5e-324"),
+    *(
+        ("clfd_tasks(damaged copies)", "folder", f"damaged copy: {damage}")
+        for damage in ("npz truncated", "npz emptied", "npy truncated", "names garbled")
+    ),
+}
+
+
+def test_the_new_families_reach_what_they_were_made_for_and_find_no_defect(tmp_path):
+    """A structure guard of the sweep's families (each reaches the call it was made for) and a
+    property of those calls: on the code before this change each was a hang, an internal error,
+    a leaked warning or a silently accepted bool."""
+    everything = surface_sweep.sweep_calls(tmp_path, np.random.default_rng(0), 0)
+    chosen = [
+        call
+        for call in everything
+        if call[3] is not None and (call[0], call[1][0], call[2][0]) in FAMILY_FINDS
+    ]
+    assert {(call[0], call[1][0], call[2][0]) for call in chosen} == FAMILY_FINDS
+    with contextlib.chdir(tmp_path):
+        _, defects = surface_sweep.run(chosen)
+    assert not defects, defects

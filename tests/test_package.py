@@ -83,6 +83,7 @@ LAYERS = {
     "_state": 0,
     "_version": 0,
     "_api": 0,
+    "_norms": 0,
     "primitives": 1,
     "extension": 1,
     "incremental": 1,

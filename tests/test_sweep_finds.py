@@ -11,7 +11,7 @@ import pytest
 from surface_sweep import names_argument
 
 import bidmp
-from bidmp.experiments.clfd.metrics import demonstration_errors
+from bidmp.experiments.clfd.metrics import continual_metrics, demonstration_errors
 from bidmp.primitives import PrimitiveKind, model_class
 from bidmp.sim import JointLimits
 from bidmp.tasks import ExtensionStage, RobotOptions
@@ -95,6 +95,94 @@ def test_a_stage_made_directly_keeps_what_the_file_would_give():
     stage = ExtensionStage(np.array([1.0, 2.0, 3.0]), "previous", False)
     assert stage.target == [1.0, 2.0, 3.0] and stage.from_previous and stage.in_scene is False
     assert ExtensionStage("centre_of_failed").target == "centre_of_failed"
+
+
+# -- what the families of tiny floats, huge values and bools where points go found (2026-12-07) --
+def _demo():
+    t = np.linspace(0.0, 2.0, 120)
+    y = np.column_stack([np.linspace(0, 100, 120), 30 * np.sin(np.linspace(0, 3, 120)), t * 5])
+    return y, t
+
+
+def _prodmp():
+    from bidmp.primitives import ProDMP
+
+    y, t = _demo()
+    return ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
+
+
+def _cartesian_stepper():
+    y, t = _demo()
+    poses = np.column_stack([y, np.tile([0.0, 0.0, 0.0, 1.0], (len(y), 1))])
+    return bidmp.CartesianDMP(bidmp.DMP(n_kernels=10)).fit(poses, t).stepper()
+
+
+FAMILY_CASES = [
+    ("cutoff_hz", lambda: bidmp.prepare(*_demo(), cutoff_hz=1e-300)),
+    ("cutoff_hz", lambda: bidmp.prepare(*_demo(), cutoff_hz=5e-324)),
+    ("centres", lambda: bidmp.primitives.kernel_widths(np.linspace(1.0, 0.1, 10) * 1e-300)),
+    ("dt", lambda: bidmp.primitives.prodmp_basis(dt=5e-324)),
+    ("dt", lambda: bidmp.primitives.ProDMP(dt=5e-324).fit([_demo()[0]] * 2)),
+    ("H", lambda: bidmp.primitives.condition_gaussian(
+        np.zeros(3), np.eye(3), np.ones((3, 1)) * 1e300, [1.0], np.zeros((1, 1)))),
+    ("y", lambda: bidmp.primitives.condition_gaussian(
+        np.zeros(3), np.eye(3), np.ones((3, 1)) * 1e-300, [1.0], np.zeros((1, 1)))),
+    ("largest_size", lambda: continual_metrics(
+        np.ones((2, 2)), [1, 2], [1.0, 1.0], largest_size=1e-300)),
+    ("reproduced", lambda: demonstration_errors(
+        np.ones((2, 5, 2)) * 1e300, np.zeros((2, 5, 2)), ["dtw"])),
+    ("goal_orientation", lambda: bidmp.primitives.PoseStepper(
+        _cartesian_stepper().position, _cartesian_stepper().orientation, True)),
+    ("orientation", lambda: bidmp.primitives.PoseStepper(
+        _cartesian_stepper().position, 5.0, [0.0, 0.0, 0.0, 1.0])),
+    ("y_measured", lambda: bidmp.DMP().fit(*_demo()).stepper().step(0.01, y_measured=True)),
+    ("y_measured", lambda: bidmp.DMP().fit(*_demo()).stepper(coupling=0.0).step(
+        0.01, y_measured=np.array([True, False, True]))),
+    ("rest", lambda: bidmp.primitives.ProMP(n_basis=6).fit([_demo()[0]] * 2).condition(
+        [0.5], [[1.0, 2.0, 3.0]], rest=[1.5])),
+    ("goal", lambda: _prodmp().condition(
+        [1.0], [[1.0, 2.0, 3.0]], goal=np.broadcast_to([1.0, 2.0, 3.0], (2_000_000, 3)))),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "argument, call", FAMILY_CASES, ids=[f"{a}-{i}" for i, (a, _) in enumerate(FAMILY_CASES)]
+)
+def test_a_tiny_huge_or_boolean_value_is_a_named_one_line_refusal(argument, call):
+    """Each was an internal error (round(inf), 'not enough values to unpack'), a leaked
+    RuntimeWarning, SciPy's words, a refusal naming another argument, or a bool taken as 1.0."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises((ValueError, TypeError)) as caught:
+            call()
+    message = str(caught.value)
+    assert "\n" not in message and len(message) <= 300, message
+    assert names_argument(message, {argument: None}), message
+
+
+def test_a_curve_of_1e_minus_300_has_the_curvature_of_its_shape_scaled_back():
+    """Its speed cubed underflowed (an 'overflowed' refusal naming nothing); scaled by a power of
+    two first, its curvature is the shape's over the scale (oracle: the curve at scale 1)."""
+    from bidmp.extension import curvature
+
+    y, _ = _demo()
+    np.testing.assert_allclose(curvature(y * 1e-300) * 1e-300, curvature(y), rtol=1e-9)
+
+
+def test_a_phase_grid_of_a_5e_minus_324_tau_is_one_then_zero():
+    """exp(-inf * 0) was NaN with a RuntimeWarning: the phase of a tau that small is 1 at the
+    start and 0 at every later step (the limit), finite."""
+    import warnings
+
+    from bidmp.primitives import DelayedGoal, phase_grid
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        np.testing.assert_array_equal(phase_grid(4, 0.01, 5e-324, exact=True), [1.0, 0, 0, 0])
+        gate = DelayedGoal(2.0).on_grid(np.linspace(1.0, 0.1, 5), 0.01, 5e-324, True)
+    assert np.all(np.isfinite(gate))
 
 
 def test_quaternions_of_1e300_are_rotations_like_any_other():

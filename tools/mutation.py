@@ -240,16 +240,20 @@ TARGETS = (
         ),
     ),
     Target(
+        "verdict assembly: what the simulator executes",
+        "bidmp.sim.execution",
+        ("_refusal", "_executable", "execution_settings"),
+        (
+            "tests/sim/test_refusals.py",
+            "tests/sim/test_one_pipeline.py::test_simulate_refuses_motions_the_contract_did_not_judge_and_repair",
+            "tests/sim/test_one_pipeline.py::test_what_the_simulator_repairs_follows_the_scenarios_approach",
+            "tests/sim/test_link_repairs.py::test_an_evaluation_without_the_links_check_is_not_what_the_simulator_runs",
+        ),
+    ),
+    Target(
         "verdict assembly: what the simulator runs",
         "bidmp.sim.run",
-        (
-            "_refusal",
-            "_executable",
-            "execution_settings",
-            "_run_one",
-            "_touch_reason",
-            "_arm_routed",
-        ),
+        ("_run_one", "_touch_reason", "_arm_routed"),
         (
             "tests/sim/test_refusals.py",
             "tests/sim/test_arm_touch.py",
@@ -281,6 +285,61 @@ TARGETS = (
             "tests/sim/test_backends.py",
             "tests/sim/test_job.py::test_a_socket_2_mm_off_the_axis_does_not_engage_and_is_not_counted",
         ),
+    ),
+    Target(
+        "routes: a segment's test and the planner's route",
+        "bidmp.planning.rrt",
+        # (the partial shortcuts choose which free route, not whether it is free: every segment
+        # they change is tested by _Tester.segment, which is here)
+        ("_advance", "_Tester.free", "_Tester.segment", "plan_route"),
+        ("tests/planning/test_rrt.py",),
+    ),
+    Target(
+        "routes: the tool's route",
+        "bidmp.planning.tool",
+        (
+            "tool_route",
+            "_descent",
+            "_rounded",
+            "_ToolSpace.slack",
+            "_ToolSpace.sweep",
+            "_ToolSpace.segment",
+            "_Turn.matrix",
+        ),
+        ("tests/planning/test_tool_route.py",),
+    ),
+    Target(
+        "routes: the pose checker",
+        "bidmp.scene.checker",
+        ("PoseChecker.slack",),
+        ("tests/planning/test_tool_route.py",),
+    ),
+    Target(
+        "routes: time-optimal timing",
+        "bidmp.planning.timing",
+        # (_jerk_limited shapes the time law, how fast it goes; _stretched keeps every peak within
+        # the limits, whatever the law, and reports them: it and the rates it reads are here)
+        ("_rates", "_stretched", "_slower.__call__", "TimedPath.__call__"),
+        ("tests/planning/test_path_timing.py",),
+    ),
+    Target(
+        "routes: the arm's distances",
+        "bidmp.sim.arm_geometry",
+        (
+            "ArmSpace.__init__",
+            "ArmSpace.slack",
+            "ArmSpace._bounds",
+            "ArmSpace._distances",
+            "ArmSpace.sweep",
+            "ArmGeometry._reach",
+        ),
+        ("tests/sim/test_arm_routes.py",),
+    ),
+    Target(
+        "routes: the arm's route",
+        "bidmp.sim.routes",
+        ("needlessly_slow", "_first_unsafe", "_approach_goals", "_solutions", "judged_route"),
+        ("tests/sim/test_arm_routes.py", "tests/sim/test_link_repairs.py"),
     ),
     Target(
         "exit statuses",
@@ -398,6 +457,49 @@ TARGETS = (
 # flips: (area, function, the source text as written, what replaces it, the bug in words). Each is
 # one exact, unique text in the function's source (a test checks they still are).
 SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
+    # -- routes: what keeps a planned route clear
+    (
+        "routes: a segment's test and the planner's route",
+        "_advance",
+        "travelled = min(travelled + max(slack, tolerance) / sweep, 1.0)",
+        "travelled = min(travelled + 2.0 * max(slack, tolerance) / sweep, 1.0)",
+        "a unit applied twice: the body advanced twice the distance it may move untouched",
+    ),
+    (
+        "routes: the tool's route",
+        "tool_route",
+        "checker = scene.pose_checker(exclude, margin=margin + tolerance)",
+        "checker = scene.pose_checker(exclude, margin=margin)",
+        "the advancement's least step not added to the margin: the swept tool grazes inside it",
+    ),
+    (
+        "routes: the tool's route",
+        "_descent",
+        "slack = space.slack(space.state(point, 1.0))",
+        "slack = space.slack(space.state(point, 0.0))",
+        "a wrong frame: the final descent tested with the start's frame, not the target's",
+    ),
+    (
+        "routes: the arm's distances",
+        "ArmSpace.__init__",
+        "keep = required if shape_index in tools else min(links, required)",
+        "keep = min(links, required)",
+        "the tool judged by the links' clearance: a route keeps 0.5 mm from a post, not the margin",
+    ),
+    (
+        "routes: the arm's distances",
+        "ArmSpace.__init__",
+        "inverse @ (np.asarray(solid.centre, dtype=float) * unit - arm.base),",
+        "inverse @ (np.asarray(solid.centre, dtype=float) - arm.base),",
+        "a unit dropped: the parts placed in scene units as if they were metres",
+    ),
+    (
+        "routes: the arm's route",
+        "_approach_goals",
+        "if blocked is None:",
+        "if True:",
+        "a check dropped: the final approach's links not tested before a goal is taken",
+    ),
     # -- the settings a DMP runs with: resolved once per change, never stale
     (
         "the settings a DMP runs with",
@@ -538,14 +640,14 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     ),
     # -- what the simulator executes
     (
-        "verdict assembly: what the simulator runs",
+        "verdict assembly: what the simulator executes",
         "_refusal",
         "if verdict.ok:",
         "if verdict.reached:",
         "a partial verdict: only the end point decides whether a motion may run",
     ),
     (
-        "verdict assembly: what the simulator runs",
+        "verdict assembly: what the simulator executes",
         "_executable",
         "if settings != wanted:",
         "if settings['geometry'] != wanted['geometry']:",

@@ -18,9 +18,49 @@ import inspect
 __all__ = ["Estimator", "clone"]
 
 
+def integer(*, minimum: int | None = None, maximum: int | None = None, limit: str | None = None,
+            optional: bool = False):  # fmt: skip
+    """A parameter constraint: an integer within the bounds (``limit``: a :class:`bidmp.Limits`
+    field), or None when ``optional``."""
+
+    def check(value, name: str) -> None:
+        from ._checks import check_int
+
+        if not (optional and value is None):
+            check_int(value, name, minimum=minimum, maximum=maximum, limit=limit)
+
+    return check
+
+
+def real(*, optional: bool = False, **bounds):
+    """A parameter constraint: a finite number within ``bounds`` (``check_real``'s ``positive``,
+    ``nonnegative``, ``minimum``, ``maximum``), or None when ``optional``."""
+
+    def check(value, name: str) -> None:
+        from ._checks import check_real
+
+        if not (optional and value is None):
+            check_real(value, name, **bounds)
+
+    return check
+
+
 class Estimator:
     """Parameters as in scikit-learn: the constructor's keyword arguments, stored as attributes
-    of the same names."""
+    of the same names.
+
+    ``_parameter_constraints`` declares, as scikit-learn's estimators do, what each parameter may
+    be: name -> a check ``(value, name)`` that raises a ``ValueError``/``TypeError`` naming it
+    (:func:`integer`, :func:`real`). :meth:`set_params` runs the checks of the parameters it is
+    given before it sets any (a NaN is refused there, not stored to fail a later ``fit`` or a
+    model file's JSON), and :meth:`_check_constraints` runs them all (``fit``)."""
+
+    _parameter_constraints: dict = {}
+
+    def _check_constraints(self) -> None:
+        """Every declared constraint on the parameters as they are now."""
+        for name, check in self._parameter_constraints.items():
+            check(getattr(self, name), name)
 
     @classmethod
     def _get_param_names(cls) -> list[str]:
@@ -57,6 +97,7 @@ class Estimator:
 
         known = self._get_param_names()
         nested: dict[str, dict] = {}
+        own: dict = {}
         for key, value in params.items():
             name, nested_key, inner = key.partition("__")
             if name not in known:
@@ -66,7 +107,12 @@ class Estimator:
             if nested_key:
                 nested.setdefault(name, {})[inner] = value
             else:
-                setattr(self, name, value)
+                check = self._parameter_constraints.get(name)
+                if check is not None:
+                    check(value, name)  # all checked before any is set
+                own[name] = value
+        for name, value in own.items():
+            setattr(self, name, value)
         for name, inner in nested.items():
             getattr(self, name).set_params(**inner)
         return self

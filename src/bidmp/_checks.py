@@ -22,6 +22,7 @@ from numbers import Integral, Real
 import numpy as np
 
 from ._kernels import extent as _extent
+from ._norms import row_norms
 
 __all__ = [
     "as_unit_quaternion",
@@ -269,6 +270,10 @@ def _as_float_array(value, name: str) -> np.ndarray:
     if isinstance(value, np.ndarray) and value.dtype.kind == "c" or isinstance(value, complex):
         # NumPy would drop the imaginary part with a ComplexWarning and go on with the real one.
         raise TypeError(f"{name} must be real numbers, got complex values")
+    if _holds_bools(value):
+        # NumPy reads True as 1.0: a flag where a point or a value goes is a caller's slip, not a
+        # coordinate (check_real and check_int refuse a bool for the same reason)
+        raise TypeError(f"{name} must be numbers, got True/False")
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError):
@@ -280,6 +285,20 @@ def _as_float_array(value, name: str) -> np.ndarray:
         )
         raise TypeError(f"{name} must be an array of numbers, got {shape}") from None
     return array
+
+
+def _holds_bools(value) -> bool:
+    """Whether ``value`` is a bool, a boolean array or a list or tuple with a bool among its
+    entries (or its first row's)."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype.kind == "b"
+    if isinstance(value, (list, tuple)) and value:
+        first = value[0]
+        row = first if isinstance(first, (list, tuple)) else ()
+        return any(isinstance(item, (bool, np.bool_)) for item in (*value[:64], *row[:64]))
+    return False
 
 
 def _check_finite(array: np.ndarray, name: str) -> None:
@@ -471,10 +490,9 @@ def check_seed(seed, name: str = "seed") -> np.random.Generator:
 def as_unit_quaternion(value, name: str) -> np.ndarray:
     """A unit quaternion ``qx, qy, qz, qw`` (4,), its norm within 1e-6 of 1."""
     quaternion = as_vector(value, name, length=4)
-    if not abs(float(np.linalg.norm(quaternion)) - 1.0) <= 1e-6:
-        raise ValueError(
-            f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {np.linalg.norm(quaternion):.6g}"
-        )
+    norm = float(row_norms(quaternion))
+    if not abs(norm - 1.0) <= 1e-6:
+        raise ValueError(f"{name} must be a unit quaternion qx, qy, qz, qw; its norm is {norm:.6g}")
     return quaternion
 
 

@@ -198,7 +198,7 @@ def test_the_default_start_is_the_mean_start_point_in_every_call():
         (
             lambda m, y: m.condition([1.0, 1.0], y[[10, 20]], 0.0),
             ValueError,
-            "times: the via-points",
+            "times: the via-point 0 .at 1 s. and the via-point 1",
         ),
         (lambda m, y: m.rollout(start=y[:2]), ValueError, "start must be one point"),
         (
@@ -215,7 +215,7 @@ def test_the_default_start_is_the_mean_start_point_in_every_call():
         (
             lambda m, y: m.rollouts(starts=y[:4], goals=y[-3:]),
             ValueError,
-            "got starts 4, start_velocities 4, goals 3",
+            r"got starts \(4, 3\), start_velocities \(1, 3\), goals \(3, 3\)",
         ),
         (
             lambda m, y: m.rollouts(goals=np.broadcast_to(y[-1], (2_000_000, 3))),
@@ -230,3 +230,64 @@ def test_a_bad_request_is_refused_by_name(call, error, match):
     model = ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
     with pytest.raises(error, match=match):
         call(model, y)
+
+
+def test_start_velocities_are_one_or_one_per_rollout_and_say_the_shape_otherwise():
+    """Two start velocities from the one mean start are two rollouts (each the single
+    trajectory); three velocities for two starts are refused naming every argument's shape, not
+    in NumPy's broadcast words."""
+    t, y = demo()
+    model = ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
+    velocities = np.array([[10.0, -5.0, 2.0], [-3.0, 0.0, 8.0]])
+    batch = model.rollouts(start_velocities=velocities, times=t)
+    for b in range(2):
+        single = model.trajectory(start_velocity=velocities[b], times=t).y
+        np.testing.assert_allclose(batch[b], single, rtol=0, atol=1e-10)
+    with pytest.raises(ValueError) as caught:
+        model.rollouts(starts=y[:2], start_velocities=np.ones((3, 3)))
+    message = str(caught.value)
+    assert "\n" not in message and "broadcast" not in message
+    assert "shape (1, 3) or (B, 3)" in message and "start_velocities (3, 3)" in message
+    with pytest.raises(ValueError, match=r"^start_velocity must be one point \(3,\)"):
+        model.trajectory(start_velocity=velocities)
+
+
+def test_a_via_point_given_twice_is_once_and_two_at_one_time_conflict():
+    t, y = demo()
+    model = ProDMP(n_basis=8).fit([y, y * 1.05, y * 0.97], [t] * 3)
+    start, via = y[0], y[300] + [1.0, -2.0, 3.0]
+    twice = model.condition([1.5, 1.5], np.stack([via, via]), 0.0, start=start)
+    once = model.condition([1.5], via[None], 0.0, start=start)
+    np.testing.assert_allclose(twice.weight_mean_, once.weight_mean_, rtol=1e-7, atol=1e-7)
+    with pytest.raises(
+        ValueError, match=r"^times: the via-point 0 \(at 1.5 s\) and the via-point 1"
+    ):
+        model.condition([1.5, 1.5], np.stack([via, via + 1.0]), 0.0, start=start)
+
+
+def test_conditioned_on_the_goal_at_rest_it_ends_there_still_and_stays():
+    """condition(times, values, rest=[T], goal=g) with the end among the points: the motion
+    passes the via-points, ends at g at T with velocity and acceleration 0 (finite differences
+    of its positions, an independent judge), its goal weight is g, and after T it stays near g
+    (the attractor; the forcing still fades)."""
+    t, y = demo()
+    rng = np.random.default_rng(11)
+    demos = [y + rng.normal(0.0, 3.0, 3) * np.sin(np.pi * t / 3.0)[:, None] for _ in range(5)]
+    model = ProDMP(n_basis=12).fit(demos, [t] * 5)
+    goal, via = y[-1] + [6.0, -4.0, 5.0], y[200] + [3.0, 2.0, -2.0]
+    end = model.duration_
+    conditioned = model.condition(
+        [1.0, end], np.stack([via, goal]), 0.0, start=y[0], rest=[end], goal=goal
+    )
+    np.testing.assert_allclose(conditioned.weight_mean_.reshape(3, -1)[:, -1], goal, atol=1e-9)
+    h = 1e-4
+    near = conditioned.trajectory(y[0], times=[1.0, end - 2 * h, end - h, end]).y
+    np.testing.assert_allclose(near[0], via, atol=1e-6)
+    near = near[1:]
+    np.testing.assert_allclose(near[2], goal, atol=1e-6)
+    slope = (3 * near[2] - 4 * near[1] + near[0]) / (2 * h)
+    curvature = (near[2] - 2 * near[1] + near[0]) / h**2
+    # (the basis is read linearly between its grid points: differences within one are exact)
+    assert np.abs(slope).max() <= 1e-3 and np.abs(curvature).max() <= 1.0
+    later = conditioned.trajectory(y[0], times=np.linspace(end, 2 * end, 50)).y
+    assert np.abs(later - goal).max() <= 0.5  # (the forcing fades: 0.13 mm over tau more)

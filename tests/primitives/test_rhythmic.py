@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
+import bidmp
 from bidmp.primitives import (
     AdaptiveOscillator,
     RhythmicDMP,
@@ -339,3 +340,81 @@ def test_a_denormal_rate_or_gain_is_refused_by_name(setting, value, name):
             RhythmicDMP().fit(y, t).trajectory(frequency=value)
         else:
             RhythmicDMP(alpha=value).fit(y, t)
+
+
+def _small_rhythm(anchor: float = 0.0, amplitude: float = 20.0) -> RhythmicDMP:
+    t = np.arange(400) / 100.0
+    y = anchor + amplitude * np.column_stack(
+        [np.sin(2 * np.pi * t), 0.5 * np.cos(4 * np.pi * t + 0.3)]
+    )
+    return RhythmicDMP(n_kernels=12).fit(y, t)
+
+
+@pytest.mark.parametrize("settle", [1e-300, 5e-324, 1e-12])
+def test_a_settle_below_the_rounding_is_refused_naming_its_smallest_value(settle):
+    """A tiny settle never came true: the settling ran to the step limit (two million stepped
+    samples, minutes). Under a small step limit the old code returned without a word."""
+    model = _small_rhythm()
+    with bidmp.set_limits(max_steps=20_000), pytest.raises(ValueError) as caught:
+        model.run(2.0, dt=0.01, settle=settle)
+    message = str(caught.value)
+    assert message.startswith("settle must be >= 1e-09") and "\n" not in message
+
+
+def test_a_rest_the_floats_cannot_resolve_is_refused_after_a_bounded_settling():
+    """An anchor 1e9 times the amplitude: float64 resolves the rest only to a few 1e-6 of the
+    amplitude, so settle = 1e-7 can never come true. The settling stops at its own bound (the
+    filter's and spring's decay by settle: a few hundred samples, not the step limit) and says
+    how near it came."""
+    model = _small_rhythm(anchor=1e6, amplitude=1e-3)
+    with bidmp.set_limits(max_steps=200_000), pytest.raises(ValueError) as caught:
+        model.run(1.0, dt=0.01, settle=1e-7)
+    message = str(caught.value)
+    assert message.startswith("settle: ") and "give settle >= " in message
+    floor = float(message.rsplit(">= ", 1)[1])
+    # what it names is enough: the run then settles
+    motion = model.run(1.0, dt=0.01, settle=floor)
+    assert len(motion.t) < 3_000
+
+
+@pytest.mark.parametrize("transition", [1e-300, 5e-324, 1e-9])
+def test_a_transition_far_below_the_step_is_a_jump_of_the_settings(transition):
+    """A time constant far below the step: the filter's output is its target after one step (the
+    limit of the exact step as T -> 0), finite; inf times 0 made it NaN before. The run starts
+    at the anchor, runs its cycles and settles there in bounded time."""
+    model = _small_rhythm()
+    with bidmp.set_limits(max_steps=20_000):
+        motion = model.run(2.0, dt=0.01, transition=transition)
+    assert np.all(np.isfinite(motion.y)) and np.all(np.isfinite(motion.ydd))
+    assert len(motion.t) < 20 / (model.frequency_ * 0.01)
+    np.testing.assert_allclose(motion.y[0], model.anchor_, atol=1e-12)
+    assert np.abs(motion.y[-1] - model.anchor_).max() <= 1e-3 * model.amplitude_.max() * 1.01
+    # the peak reaches the steady rhythm's at once: the amplitude jumped to 1
+    steady = model.trajectory(cycles=1, dt=0.01).y
+    assert np.abs(motion.y - model.anchor_).max() >= 0.95 * np.abs(steady - model.anchor_).max()
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_settling_bound_holds_for_settings_it_was_not_tuned_on(seed):
+    """The bound on the settling (the filter's and the spring's decay by settle, a period at rest)
+    is never what ends a run that can settle: random frequency, spring, transition, settle,
+    step and amplitude each settle at the anchor within settle, at rest."""
+    rng = np.random.default_rng(seed)
+    frequency = float(rng.uniform(0.3, 3.0))
+    t = np.arange(int(8 / frequency * 100)) / 100.0
+    y = 50 + np.column_stack(
+        [20 * np.sin(2 * np.pi * frequency * t), 10 * np.cos(4 * np.pi * frequency * t + 1)]
+    )
+    model = RhythmicDMP(n_kernels=12, alpha=float(rng.uniform(5.0, 100.0))).fit(y, t)
+    settle = float(10 ** rng.uniform(-9, -0.5))
+    amplitude = float(rng.uniform(0.2, 1.0))
+    motion = model.run(
+        float(rng.uniform(0.3, 3.0)),
+        dt=float(rng.choice([0.001, 0.01])),
+        transition=float(10 ** rng.uniform(-3, 0.3)),
+        settle=settle,
+        amplitude=amplitude,
+    )
+    scale = float(model.amplitude_.max()) * amplitude
+    assert np.abs(motion.y[-1] - model.anchor_).max() <= settle * scale
+    assert np.abs(motion.yd[-1]).max() / model.frequency_ <= settle * scale

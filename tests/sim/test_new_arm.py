@@ -88,11 +88,27 @@ def test_a_rest_pose_outside_the_limits_is_refused_naming_it(tmp_path):
         _scenario(tmp_path, "tm5-like", rest=[0.0, 4.0, 0.0, 0.0, 0.0, 0.0])
 
 
-def test_a_point_out_of_reach_names_both_fixes(tmp_path):
+def test_a_point_out_of_reach_says_so_and_names_the_fix_that_helps(tmp_path):
+    """1.2 m in front of the arm no joints within its limits put the tool at the demonstration's
+    start pointing down, from any seed: the reason says so and names the fix that helps (move the
+    base; a start pose would not), with how far the nearest solution stays from the point, which
+    is at least how far the point lies past everything the arm's links and tool could stretch to
+    from its shoulder (the TM5-700's published lengths, written here: 329, 311.5, 122.3, 106 and
+    113.15 mm and the 0.1 m tool, end to end)."""
     scenario, _ = _scenario(tmp_path, "tm5-like", base=[0.0, -1.2, 0.0])
     result = sim.simulate(scenario, ["bidmp"], targets=["12"], workers=1)
     reason = result.methods["bidmp"].targets["12"].reason
-    assert '"base"' in reason and '"rest"' in reason, reason
+    assert '"base"' in reason and '"rest"' not in reason, reason
+    assert (
+        "no joints within the limits put the tool there" in reason or "beyond its reach" in reason
+    )
+    start = np.asarray(scenario.demonstration[0, :3], dtype=float)
+    shoulder = np.array([0.0, -1.2, 0.1452])
+    short = np.linalg.norm(start - shoulder) - (0.329 + 0.3115 + 0.1223 + 0.106 + 0.11315 + 0.1)
+    assert short > 0.0  # out of reach by the published lengths alone
+    if "the nearest leaves" in reason:
+        nearest = float(reason.split("the nearest leaves ")[1].split(" m")[0])
+        assert nearest >= short - 1e-3, (nearest, short)
 
 
 def test_a_rest_pose_set_on_the_arm_is_where_it_stands_and_where_it_starts():

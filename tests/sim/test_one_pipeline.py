@@ -148,7 +148,7 @@ def test_what_the_simulator_repairs_follows_the_scenarios_approach():
         "geometry": True,
         "repair": False,
         "allowance": pytest.approx(0.5),
-    }
+    }  # nothing repaired: the links start no repair either (no "arm")
     spec = {k: v for k, v in nut.spec.items() if k not in ("scene", "job", "robot")}
     bare = scenarios.from_dict(spec)
     assert sim.execution_settings(bare)["geometry"] is False

@@ -172,16 +172,27 @@ def test_unknown_method_is_rejected():
 
 
 def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
-    """a wall across the plate, up to the ceiling, leaves the far nuts no
-    collision-free route (over a 300 mm one the extension now lifts); the evaluation still reports
-    every method, the far targets fail, and the report says why."""
+    """A closed cage round the far nuts (four walls and a lid, high enough for the tool to come
+    straight down onto each nut inside it) leaves them no collision-free route from outside, by
+    any planner; the evaluation still reports every method, the far targets fail, each saying
+    why (the nuts beside the wall: no motion can come down onto them; the others: the
+    extension's roadmap and the route's search found none), and the report keeps the extension
+    stage's failure."""
     import json
 
     base = scenarios.load("nut-unscrewing")
     spec = base.to_dict()
-    spec["scene"]["parts"].append(
-        {"type": "box", "label": "wall", "at": [105, 25, 0.5], "size": [10, 400, 4000]}
-    )
+    cage = [  # (centre of the bottom face, size) in mm: x 100..270, y -185..235, lid at z 300
+        ([105, 25, -2], [10, 400, 302]),
+        ([265, 25, -2], [10, 400, 302]),
+        ([185, -180, -2], [150, 10, 302]),
+        ([185, 230, -2], [150, 10, 302]),
+        ([185, 25, 300], [170, 420, 10]),
+    ]
+    spec["scene"]["parts"] += [
+        {"type": "box", "label": f"cage{k}", "at": at, "size": size}
+        for k, (at, size) in enumerate(cage)
+    ]
     walled = scenarios.from_dict(spec, base_dir=base.base_dir)
     report = evaluate(walled, ["dmp", "bidmp"])
     assert set(report.methods) == {"dmp", "bidmp"}
@@ -190,7 +201,12 @@ def test_a_target_with_no_route_is_that_targets_failure_not_the_evaluations():
         and "no collision-free route" in report.route_failures[0]["reason"]
     )
     far = [label for label in walled.labels if walled.targets[label][0] > 105]
-    assert far and not any(report.methods["bidmp"].task_success_at(label) for label in far)
+    bidmp = report.methods["bidmp"]
+    assert far and not any(bidmp.task_success_at(label) for label in far)
+    for label in far:  # refused at once beside the wall, else the complete fallback was tried
+        repaired = bidmp.repairs[label]
+        tried = [attempt.how for attempt in repaired.attempts]
+        assert "cage0" in repaired.refused or "route" in tried, (label, repaired.reason())
     data = json.loads(
         json.dumps(report.to_dict(), allow_nan=False)
     )  # strict JSON: no Infinity, no NaN

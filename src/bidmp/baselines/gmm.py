@@ -12,7 +12,7 @@ import warnings
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     as_trajectory,
     check_bool,
@@ -149,13 +149,20 @@ class _AugmentedMixture(Estimator):
     scikit-learn conventions: the constructor stores, ``fit`` validates (:meth:`_check_params`).
     """
 
-    def _check_params(self) -> None:
-        check_int(self.n_components, "n_components", minimum=1, maximum=_MAX_COMPONENTS)
-        check_real(self.reg_covar, "reg_covar", positive=True, maximum=1e6)
-        check_int(self.n_copies, "n_copies", minimum=0, maximum=_MAX_COPIES)
-        check_real(self.noise, "noise", nonnegative=True, maximum=1e-3 * _max_abs())
+    _parameter_constraints = {
+        "n_components": integer(minimum=1, maximum=_MAX_COMPONENTS),
+        "reg_covar": real(positive=True, maximum=1e6),
+        "n_copies": integer(minimum=0, maximum=_MAX_COPIES),
+        # (a thousandth of the value limit in force when it is checked)
+        "noise": lambda value, name: check_real(
+            value, name, nonnegative=True, maximum=1e-3 * _max_abs()
+        ),
         # scikit-learn's random_state range
-        check_int(self.seed, "seed", minimum=0, maximum=2**32 - 1)
+        "seed": integer(minimum=0, maximum=2**32 - 1),
+    }
+
+    def _check_params(self) -> None:
+        self._check_constraints()
 
     def __sklearn_is_fitted__(self) -> bool:
         return "weights_" in self.__dict__

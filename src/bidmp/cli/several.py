@@ -142,8 +142,9 @@ def _via_pairs(args: argparse.Namespace, model) -> list:
 
 
 def rollout_several(args: argparse.Namespace, model) -> int:
-    """The mean motion to ``--goal`` as the kind's adapter conditions it (:mod:`bidmp.cli.kinds`)
-    with its ±2σ band in ``--plot``."""
+    """The mean motion, or the mean conditioned on ``--start``, ``--via`` and ``--goal`` as the
+    kind's adapter conditions it (:mod:`bidmp.cli.kinds`), printed as what it is, with its ±2σ
+    band in ``--plot``."""
     import numpy as np
 
     from ..io.trajectories import save_trajectory
@@ -159,9 +160,8 @@ def rollout_several(args: argparse.Namespace, model) -> int:
     _refuse_unused(args, kind, adapter)
     goal = None if args.goal is None else np.asarray(args.goal, dtype=float)
     via = _via_pairs(args, model)
-    trajectory, mean, std, base, base_std, marks, times, demos, units = adapter.roll(
-        args, model, goal, via
-    )
+    rolled = adapter.roll(args, model, goal, via)
+    trajectory, std, units = rolled.trajectory, rolled.std, rolled.units
     from ..io.runs import output_files
 
     with output_files() as outputs:  # -o and --plot together or not at all
@@ -169,22 +169,26 @@ def rollout_several(args: argparse.Namespace, model) -> int:
         if args.plot:
             from ..plotting.trajectories import plot_distribution
 
+            times = rolled.times
             figure = plot_distribution(
                 outputs.path(args.plot),
-                demos or [base],
-                base,
-                base_std,
-                conditioned=mean,
+                rolled.demonstrations or [rolled.base],
+                rolled.base,
+                rolled.base_std,
+                conditioned=rolled.mean,
                 conditioned_std=std,
-                points=marks,
-                title="conditioned on the goal" if goal is not None else "the mean motion",
+                points=rolled.marks,
+                title=rolled.title or rolled.what,
                 units=units,
-                times=times if demos else {**times, "demonstrations": [times["mean"]]},
+                times=times
+                if rolled.demonstrations
+                else {**times, "demonstrations": [times["mean"]]},
             )
     unit = units or "units"
+    rate = (len(trajectory.t) - 1) / trajectory.duration if trajectory.duration > 0 else 0.0
     print(
-        f"rolled out the mean motion: {len(trajectory.t)} samples over {trajectory.duration:.4g} s, "
-        f"ends at {np.array2string(trajectory.y[-1], precision=4)}"
+        f"rolled out {rolled.what}: {len(trajectory.t)} samples over {trajectory.duration:.4g} s "
+        f"({rate:.4g} Hz), ends at {np.array2string(trajectory.y[-1], precision=4)}"
     )
     print(
         f"  spread (one standard deviation) up to {float(np.linalg.norm(std, axis=1).max()):.4g} "

@@ -60,8 +60,9 @@ def _run_sim(scenario, out, methods, *, pictures=True, view=False, **options):
     files written into ``out``): ``out`` is a run folder's new path."""
     from tqdm import tqdm
 
+    from ..sim.execution import execution_report
     from ..sim.report import picture_frames, write_sim_report
-    from ..sim.run import execution_report, simulate, target_labels
+    from ..sim.run import simulate, target_labels
 
     methods = list(methods)
     labels = target_labels(scenario, options.get("targets"))

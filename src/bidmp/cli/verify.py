@@ -46,7 +46,7 @@ def _refuse_mixed_runs(paths) -> None:
     is judged (a robot is never sent a stale command)."""
     from ..io.runs import check_run_files
 
-    check_run_files(paths)
+    check_run_files(paths, "motion")
 
 
 def _through_libfranka(verdicts) -> int:

@@ -69,7 +69,8 @@ def prepare(
     1. Uniform time: the samples are resampled to their mean rate over the same span.
     2. Zero-phase low-pass filter: a 4th-order Butterworth run forwards and backwards
        (:func:`scipy.signal.sosfiltfilt`) at ``cutoff_hz`` (default 6 Hz: hand-guided motions
-       have no content above ~3 Hz; sensor noise is white).
+       have no content above ~3 Hz; sensor noise is white), at least one cycle over the
+       recording's duration and below half its sample rate.
     3. Idle ends trimmed: the motion is where the filtered speed exceeds ``idle_fraction`` of its
        peak for at least 0.1 s, extended down the acceleration ramps to rest.
 
@@ -94,6 +95,13 @@ def prepare(
     idle_fraction = check_real(idle_fraction, "idle_fraction", positive=True, maximum=0.5)
     uniform, grid = uniform_time(y, t)
     rate = (grid.shape[0] - 1) / grid[-1]
+    if cutoff_hz < 1.0 / grid[-1]:
+        # below one cycle over the recording the filter takes the motion itself away (and its
+        # design is singular long before 1e-300 Hz)
+        raise ValueError(
+            f"cutoff_hz must be >= {1.0 / grid[-1]:.4g} Hz (one cycle over the recording's "
+            f"{grid[-1]:.4g} s), got {cutoff_hz:g}"
+        )
     if cutoff_hz >= 0.5 * rate:
         raise ValueError(
             f"cutoff_hz = {cutoff_hz:g} must be below half the sample rate of t ({0.5 * rate:.4g} Hz)"

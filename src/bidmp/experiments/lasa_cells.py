@@ -107,6 +107,12 @@ def run_cell(
     ``rollouts`` keeps the reproductions (for the per-shape figure). ``_kill_once`` is for
     tests: if that file exists, it is removed and this worker process kills itself.
     """
+    cell_key(shape, demo)  # the shape a name, the demonstration an index: checked before work
+    every = check_int(every, "every", minimum=1, maximum=1000)
+    if isinstance(methods, (str, bytes)) or not isinstance(methods, (list, tuple)):
+        raise TypeError(
+            f"methods must be a list of method names or objects, got {short_token(methods, 20)}"
+        )
     if _kill_once is not None and os.path.exists(_kill_once):
         os.remove(_kill_once)
         os.kill(os.getpid(), 9)
@@ -128,6 +134,10 @@ def _run_cell(shape: str, demo: int, methods, every: int) -> dict:
     from ..tasks.metrics import path_extent
 
     shape_demos = lasa_data(shape)
+    if demo >= len(shape_demos):
+        raise ValueError(
+            f"demo must be a demonstration of {shape} (0 to {len(shape_demos) - 1}), got {demo}"
+        )
     y = shape_demos[demo][::every]
     # the shape's other demonstrations, for the methods that learn from several
     others = tuple(d[::every] for index, d in enumerate(shape_demos) if index != demo)

@@ -80,8 +80,13 @@ def _curvature(y: np.ndarray, smooth: float, smooth_curvature: float) -> np.ndar
         "curvature's smoothing work (samples x window); resample to fewer points first",
     )
     # A curve that does not move (to rounding) has no curvature: its derivatives are rounding noise.
-    if window <= 3 or np.max(np.ptp(y, axis=0)) <= 1e-12 * float(np.max(np.abs(y))):
+    extent = float(np.max(np.ptp(y, axis=0)))
+    if window <= 3 or extent <= 1e-12 * float(np.max(np.abs(y))):
         return np.zeros(n_points)
+    # Scaled by the power of two of its extent (exact: the same bits for every step below), a
+    # curve of 1e-298 mm keeps the cube of its speed in range; κ scales back by that power.
+    exponent = int(np.frexp(extent)[1])
+    y = np.ldexp(y, -exponent)
     first = savgol_filter(y, window, 3, deriv=1, axis=0)
     second = savgol_filter(y, window, 3, deriv=2, axis=0)
     speed = np.linalg.norm(first, axis=1)
@@ -92,7 +97,7 @@ def _curvature(y: np.ndarray, smooth: float, smooth_curvature: float) -> np.ndar
     window = _odd_window(smooth_curvature, n_points, 5)
     if window > 3:
         kappa = savgol_filter(kappa, window, 2)
-    return np.maximum(kappa, 0.0)
+    return np.maximum(np.ldexp(kappa, -exponent), 0.0)
 
 
 def _alternating_extrema(kappa: np.ndarray, low: int, high: int) -> tuple[np.ndarray, np.ndarray]:

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._api import Estimator, clone
+from .._api import Estimator, clone, integer, real
 from .._checks import (
     NotFittedError,
     _as_float_array,
@@ -79,6 +79,24 @@ def _time_scale(duration, dmp: DMP) -> float:
             f"a skill may last {_TIME_SCALES[0]:g} to {_TIME_SCALES[1]:g} times it"
         )
     return float(scale)
+
+
+_DERIVATIVES = ("auto", "forward", "gradient", "dmp")
+
+
+def _template(value, name: str) -> None:
+    """The Bi-DMP's ``dmp``: None (a DMP of the defaults) or a :class:`bidmp.DMP`."""
+    if value is not None and not isinstance(value, DMP):
+        raise TypeError(f"{name} must be a bidmp.DMP, got {type(value).__name__}")
+
+
+def _increments(value, name: str) -> None:
+    """The enhancement nodes each later block adds: a sequence of positive integers."""
+    if not isinstance(value, (tuple, list)):
+        raise TypeError(f"{name} must be a sequence of integers, got {type(value).__name__}")
+    check_limit(len(value), "max_hidden_nodes", f"the number of {name}")
+    for n in value:
+        check_int(n, name, minimum=1, limit="max_hidden_nodes")
 
 
 class BiDMP(Estimator):
@@ -170,34 +188,28 @@ class BiDMP(Estimator):
         scenario's options, a pose Bi-DMP's template)."""
         self._check_params()
 
+    _parameter_constraints = {
+        "dmp": _template,
+        "n_windows": integer(minimum=1, limit="max_hidden_nodes"),
+        "n_mapped": integer(minimum=1, limit="max_hidden_nodes"),
+        "n_enhance": integer(minimum=1, limit="max_hidden_nodes"),
+        "increments": _increments,
+        "shrink": real(positive=True, maximum=1e6),
+        "reg": real(nonnegative=True, maximum=1e6),
+        "seed": integer(minimum=0, maximum=2**62),
+        "derivatives": lambda value, name: check_choice(value, name, _DERIVATIVES),
+    }
+
     def _check_params(self) -> tuple[tuple[int, ...], str]:
         """Validate the parameters; return the increments and the derivative rule."""
-        if self.dmp is not None and not isinstance(self.dmp, DMP):
-            raise TypeError(f"dmp must be a bidmp.DMP, got {type(self.dmp).__name__}")
-        n_windows = check_int(self.n_windows, "n_windows", minimum=1, limit="max_hidden_nodes")
-        n_mapped = check_int(self.n_mapped, "n_mapped", minimum=1, limit="max_hidden_nodes")
-        n_enhance = check_int(self.n_enhance, "n_enhance", minimum=1, limit="max_hidden_nodes")
-        check_real(self.shrink, "shrink", positive=True, maximum=1e6)
-        check_real(self.reg, "reg", nonnegative=True, maximum=1e6)
-        check_int(self.seed, "seed", minimum=0, maximum=2**62)
-        if not isinstance(self.increments, (tuple, list)):
-            raise TypeError(
-                f"increments must be a sequence of integers, got {type(self.increments).__name__}"
-            )
-        increments = tuple(self.increments)
-        check_limit(len(increments), "max_hidden_nodes", "the number of increments")
-        increments = tuple(
-            check_int(n, "increments", minimum=1, limit="max_hidden_nodes") for n in increments
-        )
+        self._check_constraints()
+        increments = tuple(int(n) for n in self.increments)
         check_limit(
-            n_windows * n_mapped + n_enhance + sum(increments),
+            int(self.n_windows) * int(self.n_mapped) + int(self.n_enhance) + sum(increments),
             "max_hidden_nodes",
             "the hidden nodes of one block, n_windows * n_mapped + n_enhance + sum(increments)",
         )
-        derivatives = check_choice(
-            self.derivatives, "derivatives", ("auto", "forward", "gradient", "dmp")
-        )
-        return increments, derivatives
+        return increments, self.derivatives
 
     def __sklearn_is_fitted__(self) -> bool:
         return "dmp_" in self.__dict__ or (

@@ -207,22 +207,23 @@ def _run_of(path: Path) -> tuple[Path, RunManifest] | None:
     return None
 
 
-def check_run_files(paths) -> list:
+def check_run_files(paths, name: str = "paths") -> list:
     """Refuse files of a run folder that its run did not write as they are now.
 
     For each of ``paths`` inside a run folder (a folder above it has a run's ``manifest.json``):
     the manifest must list it and its SHA-256 must be the listed one, else ``ValueError`` naming
     the file (a file of an earlier run left beside a new one, or one changed since). A file in no
     run folder passes. Returns ``(path, run folder or None, manifest or None)`` per path.
+    ``name``: what the messages call ``paths`` (a command's argument).
     """
     if not isinstance(paths, (list, tuple)):
         raise TypeError(
-            f"paths must be a list of file paths, got {type(paths).__name__}"
+            f"{name} must be a list of file paths, got {type(paths).__name__}"
             + (" (one path: give a list of it)" if isinstance(paths, (str, os.PathLike)) else "")
         )
     checked = []
     for given in paths:
-        path = Path(check_path(given, "paths"))
+        path = Path(check_path(given, name))
         found = _run_of(path)
         if found is None:
             checked.append((given, None, None))

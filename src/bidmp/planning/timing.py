@@ -101,7 +101,7 @@ def time_path(waypoints, velocity, acceleration, jerk=None, *, margin: float = 0
     jerk : array (d,), optional
         rad/s³; None: not limited.
     margin : float
-        The share of each limit the motion may reach (the simulator's 0.9).
+        The share of each limit the motion may reach (the simulator's 0.9), at least 1e-3.
 
     Returns
     -------
@@ -121,7 +121,9 @@ def time_path(waypoints, velocity, acceleration, jerk=None, *, margin: float = 0
                 f"{name} must have {d} entries, one per joint (column) of waypoints, got {limit.shape[0]}"
             )
         limits.append(limit)
-    margin = check_real(margin, "margin", positive=True, maximum=1.0)
+    # below a thousandth of the limits a motion's duration is a thousand times the fastest (at
+    # 1e-300 it overflowed, at 5e-324 it was inf)
+    margin = check_real(margin, "margin", minimum=1e-3, maximum=1.0)
     keep = np.concatenate([[True], np.linalg.norm(np.diff(path, axis=0), axis=1) > 1e-12])
     path = path[keep]
     if path.shape[0] < 2:

@@ -24,6 +24,9 @@ __all__ = ["ToolRoute", "tool_route"]
 # routes keep the margin plus this at every test, so the swept tool keeps the margin between.
 _TOLERANCE = 0.1
 _ABOVE = 0.5  # the descent starts this share of the approach height above it
+# Partial shortcuts of a tool's route (3 or 4 coordinates): on the busbar cell's post, 20 to 200
+# rounds gave routes within 1 % of one another's length, 40 at a fifth of 200's tests.
+_ROUNDS = 40
 
 
 @dataclass(frozen=True)
@@ -142,7 +145,7 @@ def tool_route(  # noqa: PLR0913 - the public call spells its options out, as us
     space = _ToolSpace(scene, checker, start, goal, top, pose, tolerance)
     descent = _descent(space, goal, top)
     if descent:
-        raise NoRouteError(f"the final approach onto the target is not free: {descent}")
+        raise NoRouteError(f"the final approach onto the goal is not free: {descent}")
     route = plan_route(
         space,
         space.state(start[:3], 0.0),
@@ -150,6 +153,7 @@ def tool_route(  # noqa: PLR0913 - the public call spells its options out, as us
         seed=seed,
         max_checks=max_checks,
         time_limit=60.0,
+        rounds=_ROUNDS,
     )
     states = np.vstack([route.waypoints, space.state(goal[:3], 1.0)[None]])
     rounded = _rounded(space, states)
@@ -162,9 +166,7 @@ def tool_route(  # noqa: PLR0913 - the public call spells its options out, as us
     )
 
 
-def _rounded(
-    space, states: np.ndarray, spacing_share: float = 0.01, sweeps: int = 30
-) -> np.ndarray:
+def _rounded(space, states: np.ndarray, spacing_share: float = 0.04, sweeps: int = 8) -> np.ndarray:
     """The route ``states`` (k, d; its last segment the final approach) subdivided and its corners
     rounded: every inner point moved half-way to its neighbours' middle, ``sweeps`` times, where
     the two segments it joins stay free; the start, the approach's top and the target stay, and

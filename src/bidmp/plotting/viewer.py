@@ -89,6 +89,78 @@ class ViewLayers:
     failures: dict = field(default_factory=dict)
     bands: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        """Check every layer where it is given (a viewer built from bad layers failed deep in
+        the drawing with an IndexError); paths and points become positions (n, 3) / (3,)."""
+        for name in ("title", "units"):
+            if not isinstance(getattr(self, name), str) or len(getattr(self, name)) > 500:
+                raise TypeError(f"{name} must be text, got {type(getattr(self, name)).__name__}")
+        self.demonstration = _layer_path(self.demonstration, "demonstration")
+        self.targets = {
+            label: _layer_point(point, f"targets[{label!r}]")
+            for label, point in _labelled_layer(self.targets, "targets").items()
+        }
+        self.segmentation = _layer_path(self.segmentation, "segmentation", empty=True)
+        if not isinstance(self.extended, (list, tuple)):
+            raise TypeError(f"extended must be a list of paths, got {type(self.extended).__name__}")
+        self.extended = [_layer_path(p, f"extended[{i}]") for i, p in enumerate(self.extended)]
+        self.rollouts = {
+            method: {
+                label: _layer_path(path, f"rollouts[{method!r}][{label!r}]")
+                for label, path in _labelled_layer(paths, f"rollouts[{method!r}]").items()
+            }
+            for method, paths in _labelled_layer(self.rollouts, "rollouts").items()
+        }
+        self.bands = {
+            method: {
+                label: _layer_radius(radius, f"bands[{method!r}][{label!r}]")
+                for label, radius in _labelled_layer(radii, f"bands[{method!r}]").items()
+            }
+            for method, radii in _labelled_layer(self.bands, "bands").items()
+        }
+        if not isinstance(self.solids, (list, tuple)) or not all(
+            isinstance(solid, dict) for solid in self.solids
+        ):
+            raise TypeError("solids must be a list of solid layers (solid_layer gives them)")
+        _labelled_layer(self.robot, "robot")
+        self.failures = _checked_failures(_labelled_layer(self.failures, "failures"))
+
+
+def _labelled_layer(value, name: str) -> dict:
+    """A layer keyed by labels: a dict whose keys are text."""
+    if not isinstance(value, dict):
+        raise TypeError(f"{name} must be a dict keyed by label, got {type(value).__name__}")
+    for key in value:
+        if not isinstance(key, str):
+            raise TypeError(f"{name}: a label must be text, got {type(key).__name__}")
+    return value
+
+
+def _layer_path(points, name: str, empty: bool = False) -> np.ndarray:
+    """A path (n, 2+) of finite numbers as positions (n, 3) (2-D: z = 0; poses: x, y, z)."""
+    array = as_trajectory(points, name, min_points=0 if empty else 1, allow_static=True)
+    if array.shape[1] < 2:
+        raise ValueError(f"{name} must be positions (n, 2 or 3) or poses, got {array.shape}")
+    return _xyz(array)
+
+
+def _layer_point(point, name: str) -> np.ndarray:
+    """A target: 2 or 3 coordinates or a pose (7,), as its position (3,)."""
+    array = as_vector(point, name)
+    if array.shape[0] not in (2, 3, 7):
+        raise ValueError(
+            f"{name} must be a point (x, y[, z]) or a pose (7,), got {array.shape[0]} values"
+        )
+    return _xyz(array[None, : min(array.shape[0], 3)])[0]
+
+
+def _layer_radius(radius, name: str) -> np.ndarray:
+    """A band's radius along its rollout (T,), units: finite, >= 0."""
+    array = as_vector(radius, name, min_length=1)
+    if np.any(array < 0.0):
+        raise ValueError(f"{name} must be >= 0 (a band's radius)")
+    return array
+
 
 def _xyz(points) -> np.ndarray:
     """Positions (n, 3) of a path (poses: their first three columns; 2-D: z = 0)."""

@@ -52,7 +52,10 @@ def phase_grid(
     n_steps = check_int(n_steps, "n_steps", minimum=1, limit="max_steps")
     dt, tau, alpha_phase, exact = _checked_phase_args(dt, tau, alpha_phase, exact)
     if exact:
-        return np.exp(-alpha_phase * dt / tau * np.arange(n_steps))
+        # (a rate of inf, from a 5e-324 s tau, times the first step's 0 would be NaN: capped
+        # where e^-rate is 0 anyway, the same numbers otherwise)
+        rate = min(alpha_phase * dt / tau, 1e300)
+        return np.exp(-rate * np.arange(n_steps))
     return _phase_decay(dt, tau, alpha_phase) ** np.arange(n_steps)
 
 

@@ -60,9 +60,12 @@ class PhaseStopping(CouplingTerm):
         # a stepper's own state passes as is
         if not (type(y) is np.ndarray and y.dtype == np.float64 and y.ndim == 1):
             y = as_vector(y, "y")
-        if y_measured is None or self.gain == 0.0:
+        if y_measured is None:
             return 1.0
+        # checked even at gain 0 (no slowdown): a measurement that is no point is refused
         error = as_point(y_measured, y.shape[0], "y_measured", like="y") - y
+        if self.gain == 0.0:
+            return 1.0
         slowdown = 1.0 + self.gain * float(error @ error)
         if not math.isfinite(slowdown):
             raise ValueError("y must be finite numbers (the command), and so must y_measured")

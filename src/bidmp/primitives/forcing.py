@@ -89,13 +89,21 @@ def kernel_widths(
         raise ValueError(
             "centres must be distinct (two kernels at one phase have no spacing to size them by)"
         )
-    if method == "pydmps":
-        return n_kernels**1.5 / (centres * alpha_phase)
-    if n_kernels == 1:
+    if n_kernels == 1 and method == "spacing":
         return np.ones(1)  # a single normalised kernel is constant whatever its width
-    spacing = np.abs(np.diff(centres))
-    spacing = np.append(spacing, spacing[-1])
-    return 1.0 / spacing**2
+    with np.errstate(over="ignore", under="ignore", divide="ignore"):  # judged below, by name
+        if method == "pydmps":
+            widths = n_kernels**1.5 / (centres * alpha_phase)
+        else:
+            spacing = np.abs(np.diff(centres))
+            widths = 1.0 / np.append(spacing, spacing[-1]) ** 2
+    if not np.all(np.isfinite(widths)):
+        # (1e-300 apart, or at 1e-300: the width's square or quotient overflows)
+        raise ValueError(
+            "centres: kernels so close together or so near 0 that their widths overflow float64 "
+            f"(with alpha_phase = {alpha_phase:g}); spread them over the phase"
+        )
+    return widths
 
 
 def basis_functions(phase: np.ndarray, centres: np.ndarray, widths: np.ndarray) -> np.ndarray:

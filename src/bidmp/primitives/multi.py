@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._api import Estimator, clone
-from .._checks import NotFittedError, as_point, check_int, check_real, check_seed
+from .._api import Estimator, clone, real
+from .._checks import NotFittedError, as_point, check_int, check_seed
 from .._state import state_reader
 from .._threads import single_threaded
 from .._trajectory import resample_time
@@ -52,6 +52,8 @@ class MultiDMP(Estimator):
         The weights' covariance per dimension (regularised).
     """
 
+    _parameter_constraints = {"cov_reg": real(positive=True, maximum=1e3)}
+
     def __init__(self, dmp: DMP | None = None, cov_reg: float = 1e-6) -> None:
         self.dmp = dmp
         self.cov_reg = cov_reg
@@ -60,7 +62,8 @@ class MultiDMP(Estimator):
     def fit(self, demonstrations, times=None, units: str | None = None) -> MultiDMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays) with their stamps ``times``
         (a list of (T_i,) arrays, s; None: each over 1 s)."""
-        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
+        self._check_constraints()
+        cov_reg = float(self.cov_reg)
         template = DMP() if self.dmp is None else self.dmp
         if not isinstance(template, DMP):
             raise TypeError(

@@ -9,9 +9,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import as_point, as_vector
+from .._checks import as_point, as_vector, check_members
 from .goal_shift import _GoalShifts
-from .so3 import _left_jacobian, as_quaternions, orientation_from_log, principal_log
+from .so3 import (
+    _left_jacobian,
+    _quaternion_rows,
+    as_quaternions,
+    orientation_from_log,
+    principal_log,
+)
 from .timing import TimedMotion, _Rollout, _validate_motion
 
 __all__ = ["PoseTrajectory", "PoseStepper"]
@@ -165,9 +171,17 @@ class PoseStepper:
     """
 
     def __init__(self, position, orientation, goal_orientation):
-        self.position = position
-        self.orientation = orientation
-        self.goal_orientation = goal_orientation
+        # (what a step reads of each; a pose DMP's stepper() makes them)
+        self.position = check_members(
+            position, ("step", "set_goal", "time", "y"), "position", "the position's DMPStepper"
+        )
+        self.orientation = check_members(
+            orientation, ("step", "y"), "orientation", "the orientation's DMPStepper (its log)"
+        )
+        goal = _quaternion_rows(goal_orientation, "goal_orientation")  # (its values as given)
+        if goal.shape[0] != 1:
+            raise ValueError(f"goal_orientation must be one quaternion (4,), got {goal.shape[0]}")
+        self.goal_orientation = goal[0]
         self._turns = _GoalShifts(3)  # rotation vectors δ of the goal frame, blended in turn
 
     def set_goal_pose(

@@ -38,9 +38,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
+    as_point,
     as_points,
     as_vector,
     check_bool,
@@ -51,10 +52,14 @@ from .._checks import (
 from .._state import state_reader
 from .._threads import single_threaded
 from .._units import check_units
-from .promp import _demonstrations, _stamps, condition_gaussian
+from .promp import _conditioned, _Conflict, _demonstrations, _stamps, condition_gaussian
 from .timing import Trajectory
 
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
+
+
+# n_outside's bound alone (prodmp_basis checks it against n_basis: at most (n_basis - 2) // 2)
+_MAX_OUTSIDE = 500
 
 
 @dataclass(frozen=True)
@@ -179,6 +184,12 @@ def prodmp_basis(  # noqa: PLR0913 - the basis' settings, each one MP_PyTorch's
             f"dt = {dt:g} s is longer than tau = {tau:g} s: shorten dt or lengthen tau"
         )
     length_factor = check_real(length_factor, "length_factor", positive=True, maximum=6.0)
+    # the grid's size from the step before it is made (a 5e-324 s step made tau / dt infinite)
+    if length_factor * tau / dt > 2_000_000:
+        raise ValueError(
+            f"dt = {dt:g} s gives a grid of {length_factor * tau / dt:.3g} points over the motion: "
+            f"too fine (at least {length_factor * tau / 2_000_000:.3g} s)"
+        )
     steps = round(1.0 / (dt / tau))
     n_grid = int(length_factor * steps) + 1
     if n_grid > 2_000_000:
@@ -248,6 +259,33 @@ def _cumulative_trapezoid(values: np.ndarray, s: np.ndarray) -> np.ndarray:
     return out
 
 
+def _conflict_text(rows, times: np.ndarray, rest: np.ndarray, dims: int) -> str:
+    """What :meth:`ProDMP.condition` says of two observations that conflict, the argument of
+    the first named first."""
+    named, arguments = [], []
+    for row in sorted(set(rows)):
+        index = row // dims
+        if index < times.size:
+            named.append(f"the via-point {index} (at {times[index]:.6g} s)")
+            arguments.append("times")
+        elif index < times.size + 2 * rest.size:  # (its velocity, then its acceleration)
+            named.append(f"the rest at {rest[(index - times.size) % rest.size]:.6g} s")
+            arguments.append("rest")
+        else:
+            named.append("the goal")
+            arguments.append("goal")
+    if rows[0] == rows[1]:
+        return (
+            f"{arguments[0]}: {named[0]} reads none of the weights to the floats' range (the "
+            "motion is its start there); move it later or give cov > 0"
+        )
+    return (
+        f"{arguments[0]}: {named[0]} and {named[1]} cannot both be met exactly (one time with "
+        "different values, or more points than the weights can carry); give each its own time, "
+        "fewer points or cov > 0"
+    )
+
+
 def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:
     """The covariance (M, M) of weights (n, M) of n demonstrations plus ``cov_reg`` times each
     weight's own variance on the diagonal (its square where it does not vary: one demonstration).
@@ -305,6 +343,20 @@ class ProDMP(Estimator):
     units_ : str
     """
 
+    # What each parameter may be (set_params and fit check them; prodmp_basis's own bounds)
+    _parameter_constraints = {
+        "n_basis": integer(minimum=1, limit="max_kernels"),
+        "alpha": real(positive=True, maximum=1e3),
+        "alpha_phase": real(minimum=1e-6, maximum=1e3),
+        "tau": real(optional=True, positive=True, maximum=1e4),
+        "bandwidth_factor": real(positive=True, maximum=1e3),
+        "n_outside": integer(minimum=0, maximum=_MAX_OUTSIDE),
+        "dt": real(positive=True, maximum=1e4),
+        "length_factor": real(positive=True, maximum=6.0),
+        "ridge": real(nonnegative=True, maximum=1e6),
+        "cov_reg": real(positive=True, maximum=1e3),
+    }
+
     def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one
         self,
         n_basis: int = 10,
@@ -339,8 +391,8 @@ class ProDMP(Estimator):
         if isinstance(demonstrations, np.ndarray) and demonstrations.ndim == 2:
             demonstrations = [demonstrations]  # one demonstration
         demos = _demonstrations(demonstrations)  # the ProMP's checks: one way to be refused
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1e6)
-        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
+        self._check_constraints()
+        ridge, cov_reg = float(self.ridge), float(self.cov_reg)
         units = "" if units is None else check_units(units)
         stamps = _stamps(times, demos)  # (each is timed onto tau below: the span is its own)
         tau = (
@@ -396,16 +448,16 @@ class ProDMP(Estimator):
     def _boundary(
         self, start, start_velocity, names=("start", "start_velocity")
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Start(s) and start velocity(ies) as points (k, D), refused by the caller's argument
-        ``names``; the default start is the demonstrations' mean, one point (1, D)."""
+        """Start(s) and start velocity(ies) as points (k, D) each, refused by the caller's
+        argument ``names``; the default start is the demonstrations' mean, one point (1, D), the
+        default velocity rest (1, D). Their counts are the caller's to match (one, or one per
+        motion)."""
         start = self.start_[None] if start is None else as_points(start, self.n_dims_, names[0])
         velocity = (
-            np.zeros_like(start)
+            np.zeros((1, self.n_dims_))
             if start_velocity is None
             else as_points(start_velocity, self.n_dims_, names[1])
         )
-        if velocity.shape != start.shape:
-            velocity = np.broadcast_to(velocity, start.shape)
         return start, velocity
 
     def _single_boundary(self, start, start_velocity) -> tuple[np.ndarray, np.ndarray]:
@@ -473,11 +525,11 @@ class ProDMP(Estimator):
         )
         counts = {"starts": len(starts), "start_velocities": len(velocities), "goals": len(goals)}
         if any(count not in (1, batch) for count in counts.values()):
-            # which one is wrong is the caller's to say: name them all with their counts
-            given = ", ".join(f"{name} {count}" for name, count in counts.items())
+            # which one is wrong is the caller's to say: name them all with their shapes
+            given = ", ".join(f"{name} ({count}, {dims})" for name, count in counts.items())
             raise ValueError(
-                f"starts, start_velocities and goals must each be one point or one per rollout, "
-                f"the same number; got {given}"
+                f"starts, start_velocities and goals must each have shape (1, {dims}) or (B, "
+                f"{dims}) with one B for all (one per rollout); got {given}"
             )
         # The rollouts are affine in the starts, start velocities and goals: one matrix product
         # of their coefficients with a row per coefficient writes the whole batch (B, T·D).
@@ -582,43 +634,70 @@ class ProDMP(Estimator):
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, cov
         return conditioned
 
-    def condition(self, times, values, cov=0.0, *, start=None, start_velocity=None) -> ProDMP:
+    def condition(  # noqa: PLR0913 - the observations a motion is conditioned on, by name
+        self, times, values, cov=0.0, *, start=None, start_velocity=None, rest=None, goal=None
+    ) -> ProDMP:
         """A copy whose weights are conditioned exactly on passing ``values`` (K, D) at ``times``
         (K,) (s) with noise ``cov`` (a scalar variance, units²), for motions from ``start`` at
         ``start_velocity`` (default the mean start, at rest): the via-points enter the weights'
-        Gaussian like a ProMP's, the boundary condition stays exact."""
+        Gaussian like a ProMP's, the boundary condition stays exact. ``rest`` (R,) (s): times
+        at which the motion is at rest (velocity and acceleration 0, exactly); ``goal`` (D,): the goal weight
+        (the attractor) exactly. The end at tau among the points, ``rest=[tau]`` and ``goal``
+        the same point make a motion that ends there at rest and stays. ``times`` and
+        ``values`` may be empty when ``rest`` or ``goal`` is given."""
         import copy
 
         self.check_fitted()
-        times = as_vector(times, "times")
-        values = as_points(values, self.n_dims_, "values")
+        dims, size = self.n_dims_, self.basis_.n_basis + 1
+        optional = rest is not None or goal is not None  # then the points may be none
+        times = as_vector(times, "times", min_length=0 if optional else 1)
+        values = np.zeros((0, dims)) if not times.size else as_points(values, dims, "values")
         if len(values) != len(times):
             raise ValueError(
                 f"times must hold one time per point of values ({len(values)}), got {len(times)}"
             )
+        rest = np.zeros(0) if rest is None else as_vector(rest, "rest")
         cov = check_real(cov, "cov", nonnegative=True, maximum=1e12)
-        if np.any(times <= 0.0):
-            raise ValueError(
-                "times must be > 0 s: at 0 the motion is at its start (give start= instead)"
-            )
+        for name, when in (("times", times), ("rest", rest)):
+            if np.any(when <= 0.0):
+                raise ValueError(
+                    f"{name} must be > 0 s: at 0 the motion is at its start (give start= and "
+                    "start_velocity= instead)"
+                )
         start, velocity = self._single_boundary(start, start_velocity)
-        p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
-        size, dims = self.basis_.n_basis + 1, self.n_dims_
-        observed = values - p0[:, None] * start - v0[:, None] * (velocity * self.duration_)
-        # the observation's columns: dimension d at time k reads block d of the weights
-        columns = np.zeros((dims * size, len(times) * dims))
+        carried = velocity * self.duration_
+        # the observations' columns: dimension d of each observation reads block d of the weights
+        blocks, observed = [], []
+        if times.size:
+            p0, v0, _, _, H, _ = self.basis_.boundary_maps(times, 0.0)
+            blocks.append(H)
+            observed.append(values - p0[:, None] * start - v0[:, None] * carried)
+        if rest.size:
+            # at rest: the velocity (d/ds) and the acceleration (d²/ds², the system's equation
+            # y'' = -α y' - α²/4 (y - g) + x φ·w) are 0 there
+            p0, v0, p1, v1, H, dH = self.basis_.boundary_maps(rest, 0.0)
+            alpha = self.basis_.alpha
+            forcing = self.basis_.phase(rest)[:, None] * self.basis_.forcing(rest)
+            pulled = np.hstack([forcing, np.full((rest.size, 1), alpha**2 / 4.0)])
+            blocks += [dH, pulled - alpha * dH - alpha**2 / 4.0 * H]
+            position = p0[:, None] * start + v0[:, None] * carried
+            rate = p1[:, None] * start + v1[:, None] * carried
+            observed += [-rate, alpha * rate + alpha**2 / 4.0 * position]
+        if goal is not None:
+            blocks.append(np.eye(size)[None, -1])  # the goal weight itself
+            observed.append(as_point(goal, dims, "goal")[None])
+        rows = np.vstack(blocks)  # (observations, N + 1)
+        columns = np.zeros((dims * size, len(rows) * dims))
         for d in range(dims):
-            columns[d * size : (d + 1) * size, d::dims] = H.T
-        noise = cov * np.eye(len(times) * dims)
+            columns[d * size : (d + 1) * size, d::dims] = rows.T
+        noise = np.zeros((len(rows) * dims,) * 2)
+        noise[np.diag_indices(len(times) * dims)] = cov
         try:
-            mean, weight_cov = condition_gaussian(
-                self.weight_mean_, self.weight_cov_, columns, observed.reshape(-1), noise
+            mean, weight_cov = _conditioned(
+                self.weight_mean_, self.weight_cov_, columns, np.vstack(observed).reshape(-1), noise
             )
-        except np.linalg.LinAlgError:
-            raise ValueError(
-                "times: the via-points cannot all be met exactly (two at one time, or more than the "
-                "weights can carry); give each its own time, fewer points or cov > 0"
-            ) from None
+        except _Conflict as conflict:
+            raise ValueError(_conflict_text(conflict.rows, times, rest, dims)) from None
         conditioned = copy.copy(self)
         conditioned.weight_mean_, conditioned.weight_cov_ = mean, weight_cov
         conditioned.start_, conditioned.start_velocity_ = start[0], velocity[0]

@@ -25,10 +25,11 @@ import math
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     NotFittedError,
     _as_bounded_array,
+    _check_magnitude,
     as_points,
     as_trajectory,
     as_vector,
@@ -97,22 +98,75 @@ def condition_gaussian(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
     size = mean.shape[0]
     cov = _matrix(cov, "cov", (size, size), f"mean has {size} entries")
     H = _matrix(H, "H", (size, None), f"mean has {size} entries")
+    # (an observation's columns of 1e300 overflow its products with the covariance)
+    _check_magnitude(H, "H")
     y = as_vector(y, "y")
     if y.shape[0] != H.shape[1]:
         raise ValueError(f"y must have one value per column of H ({H.shape[1]}), got {y.shape[0]}")
     noise = _matrix(noise, "noise", (H.shape[1], H.shape[1]), f"y has {y.shape[0]} values")
+    try:
+        return _conditioned(mean, cov, H, y, noise)
+    except _Conflict as conflict:
+        first, second = conflict.rows
+        if first == second:
+            raise ValueError(
+                f"y: observation {first} reads none of the weights (its column of H is 0 to the "
+                "floats' range) yet differs from the mean's; give it noise > 0 or another H"
+            ) from None
+        raise ValueError(
+            f"y: observations {first} and {second} conflict: they read the same combination of "
+            "the weights (one point twice, or more points than the weights carry) with different "
+            "values and no noise to reconcile them; merge them or give noise > 0"
+        ) from None
+
+
+class _Conflict(ValueError):
+    """Exact observations that read one combination of the weights (the same point twice, or
+    more points than the weights can carry) with different values: no weights pass them all.
+    ``rows`` are the two observations (columns of H) that weigh most in the conflict."""
+
+    def __init__(self, rows: tuple[int, int]) -> None:
+        super().__init__(f"observations {rows[0]} and {rows[1]} conflict")
+        self.rows = rows
+
+
+# Below this share of the innovation's largest eigenvalue a direction is no observation of its
+# own: the same point observed twice (or 1e-12 of the phase apart), or more points than weights.
+_REDUNDANT = 1e-12
+
+
+def _conditioned(mean, cov, H, y, noise) -> tuple[np.ndarray, np.ndarray]:
+    """The posterior of :func:`condition_gaussian` on checked arrays. Observations that are one
+    observation twice over (their innovation ``S = Hᵀ Σ H + N`` singular along a direction) are
+    merged when their values agree along it — the posterior of the observation once — and
+    raise :class:`_Conflict` when they do not."""
     cov_h = cov @ H  # (M, K)
     innovation = H.T @ cov_h + noise  # (K, K), positive definite when cov is
-    try:
+    residual = y - H.T @ mean
+    values, vectors = np.linalg.eigh(0.5 * (innovation + innovation.T))
+    largest = float(values[-1]) if values.size else 0.0
+    if values.size and largest > 0.0 and values[0] > _REDUNDANT * largest:
         gain = np.linalg.solve(innovation, cov_h.T).T  # K = Σ H S⁻¹ (S symmetric)
-    except np.linalg.LinAlgError:
-        # still a LinAlgError (a ValueError), which callers word in their own terms
-        raise np.linalg.LinAlgError(
-            "H and noise: the observation's covariance Hᵀ·cov·H + noise is singular (a column "
-            "of H that observes nothing the weights move, two alike, or values so small they "
-            "vanish, with noise 0): observe the weights, or give noise > 0"
-        ) from None
-    posterior_mean = mean + gain @ (y - H.T @ mean)
+    else:
+        kept = values > _REDUNDANT * largest if largest > 0.0 else np.zeros(values.size, bool)
+        null = vectors[:, ~kept]
+        # The residual along the redundant directions must vanish: the points agree there
+        # (to the rounding of the values and of the mean's reading of them).
+        along = null.T @ residual
+        scale = max(float(np.abs(y).max(initial=0.0)), float(np.abs(H.T @ mean).max(initial=0.0)))
+        if np.abs(along).max(initial=0.0) > 1e-8 * max(scale, 1e-300):
+            if not kept.any():  # the observations read no weight at all (H is 0 to rounding)
+                worst = int(np.argmax(np.abs(residual)))
+                raise _Conflict((worst, worst))
+            # the two observations that weigh most in the direction they disagree along
+            worst = np.abs(null[:, int(np.argmax(np.abs(along)))])
+            first, second = (int(i) for i in np.argsort(-worst)[:2])
+            if worst[second] <= 1e-6 * worst[first]:  # one observation alone: it reads nothing
+                raise _Conflict((first, first))
+            raise _Conflict((min(first, second), max(first, second)))
+        inverse = (vectors[:, kept] / values[kept]) @ vectors[:, kept].T  # S⁺
+        gain = cov_h @ inverse
+    posterior_mean = mean + gain @ residual
     posterior_cov = cov - gain @ cov_h.T
     return posterior_mean, 0.5 * (posterior_cov + posterior_cov.T)
 
@@ -165,6 +219,13 @@ class ProMP(Estimator):
     n_dims_ : int
     """
 
+    _parameter_constraints = {
+        "n_basis": integer(minimum=2, limit="max_kernels"),
+        "ridge": real(nonnegative=True, maximum=1.0),
+        "cov_reg": real(positive=True, maximum=1e3),
+        "overlap": real(positive=True, maximum=0.99),
+    }
+
     def __init__(
         self, n_basis: int = 20, ridge: float = 1e-10, cov_reg: float = 1e-2, overlap: float = 0.7
     ) -> None:
@@ -178,10 +239,8 @@ class ProMP(Estimator):
     def fit(self, demonstrations, times=None, units: str | None = None) -> ProMP:
         """Learn from ``demonstrations`` (a list of (T_i, D) arrays, any lengths) with their
         stamps ``times`` (a list of (T_i,) arrays, s; None: each over 1 s)."""
-        n_basis = check_int(self.n_basis, "n_basis", minimum=2, limit="max_kernels")
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
-        cov_reg = check_real(self.cov_reg, "cov_reg", positive=True, maximum=1e3)
-        check_real(self.overlap, "overlap", positive=True, maximum=0.99)
+        self._check_constraints()
+        n_basis, ridge, cov_reg = int(self.n_basis), float(self.ridge), float(self.cov_reg)
         demos = _demonstrations(demonstrations)
         stamps = _stamps(times, demos)
         units = "" if units is None else check_units(units)
@@ -283,22 +342,39 @@ class ProMP(Estimator):
         # (n, D, N) weights times the rows: (n, L, D)
         return np.einsum("ln,sdn->sld", rows, weights.reshape(n_samples, self.n_dims_, -1))
 
-    def condition(self, phase, y, cov=0.0) -> ProMP:
+    def condition(self, phase, y, cov=0.0, *, rest=None) -> ProMP:
         """A new ProMP conditioned on passing ``y`` (K, D) at ``phase`` (K,) with covariance
-        ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D).
-        All points at once (one stacked observation)."""
+        ``cov``: 0 (exactly), a variance σ² (isotropic), (D, D) for every point, or (K, D, D);
+        and at rest (velocity and acceleration 0, exactly) at the phases ``rest`` (R,) if given (a motion that
+        starts or ends at rest: ``rest=[0.0, 1.0]``). All at once (one stacked observation).
+        Two exact points at one phase with equal values are one point; with different values
+        they conflict (a ``ValueError`` naming them), as do more exact points than the weights
+        can carry."""
         self.check_fitted()
         phase = _as_bounded_array(phase, "phase", 1)
-        # one stacked observation: its (K·D)² covariance must fit before it is built
-        check_bytes((phase.size * self.n_dims_) ** 2, f"conditioning on {phase.size:,} points")
+        rest = np.zeros(0) if rest is None else _as_bounded_array(rest, "rest", 1).reshape(-1)
+        # one stacked observation: its ((K + R)·D)² covariance must fit before it is built
+        count = phase.size + 2 * rest.size  # (a rest: its velocity and its acceleration)
+        check_bytes((count * self.n_dims_) ** 2, f"conditioning on {count:,} points")
         phase = self._phase(phase.reshape(-1), 2)
         y = as_points(y, self.n_dims_, "y")
         if y.shape[0] != phase.size:
             raise ValueError(f"y must have one point per phase ({phase.size}), got {y.shape[0]}")
+        if rest.size:
+            rest = as_vector(rest, "rest")
+            if rest.min() < 0.0 or rest.max() > 1.0:
+                raise ValueError("rest must lie in [0, 1] (phases: the normalised time)")
         noise = _noise(cov, phase.size, self.n_dims_)
-        mean, covariance = condition_gaussian(
-            self.weight_mean_, self.weight_cov_, self._H(phase), y.reshape(-1), noise
-        )
+        H, values = self._H(phase), y.reshape(-1)
+        if rest.size:  # the velocity's and acceleration's rows at the rest phases, 0 exactly
+            H = np.hstack([H, self._H(rest, 1), self._H(rest, 2)])
+            values = np.concatenate([values, np.zeros(2 * rest.size * self.n_dims_)])
+            size = noise.shape[0] + 2 * rest.size * self.n_dims_
+            noise = np.pad(noise, (0, size - noise.shape[0]))
+        try:
+            mean, covariance = _conditioned(self.weight_mean_, self.weight_cov_, H, values, noise)
+        except _Conflict as conflict:
+            raise ValueError(_conflict_text(conflict.rows, phase, rest, self.n_dims_)) from None
         out = ProMP(**self.get_params())
         out.__dict__.update({k: v for k, v in self.__dict__.items() if k.endswith("_")})
         out.weight_mean_, out.weight_cov_ = mean, covariance
@@ -336,6 +412,40 @@ class ProMP(Estimator):
             for order in (0, 1, 2)
         )
         return Trajectory(t, y, yd, ydd, self.units_)
+
+
+def _conflict_text(rows: tuple[int, int], phase: np.ndarray, rest: np.ndarray, dims: int) -> str:
+    """What :meth:`ProMP.condition` says of two observations that conflict: the points of ``y``
+    (or the rests) and where they are."""
+    kinds, numbers, where = [], [], []
+    for row in sorted(rows):
+        index = row // dims
+        point = index < phase.size
+        kinds.append("y" if point else "rest")
+        # (a rest is its velocity's rows, then its acceleration's)
+        numbers.append(index if point else (index - phase.size) % rest.size)
+        where.append(phase[index] if point else rest[(index - phase.size) % rest.size])
+    if rows[0] == rows[1]:
+        return (
+            f"{kinds[0]}: {'point' if kinds[0] == 'y' else 'rest'} {numbers[0]} (at phase "
+            f"{where[0]:.6g}) reads none of the weights to the floats' range; move it or give "
+            "cov > 0"
+        )
+    if kinds[0] == kinds[1]:
+        named = (
+            f"{kinds[0]}: {'points' if kinds[0] == 'y' else 'rests'} {numbers[0]} and {numbers[1]}"
+        )
+    else:
+        named = f"y and rest: point {numbers[0]} and rest {numbers[1]}"
+    at = (
+        f"both at phase {where[0]:.6g}"
+        if abs(where[0] - where[1]) <= 1e-6
+        else f"at phases {where[0]:.6g} and {where[1]:.6g}"
+    )
+    return (
+        f"{named} ({at}) conflict: different values the weights cannot both pass exactly (one "
+        "time, or more points than weights); merge them, give each its own phase or cov > 0"
+    )
 
 
 def _weight_covariance(weights: np.ndarray, cov_reg: float) -> np.ndarray:

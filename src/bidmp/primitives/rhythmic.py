@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from .._api import Estimator
+from .._api import Estimator, integer, real
 from .._checks import (
     SLOWEST_HZ,
     _limit,
@@ -50,7 +50,7 @@ from .._threads import single_threaded
 from .._units import check_units
 from .canonical import RhythmicPhase
 from .forcing import VonMisesBasis
-from .frequency import _series, _with_frequency, estimate_frequency
+from .frequency import _MAX_HARMONICS, _series, _with_frequency, estimate_frequency
 from .integrate import _exact_responses, _exact_state, _foh_step
 from .timing import Trajectory, check_timestamps
 
@@ -88,6 +88,16 @@ class RhythmicDMP(Estimator):
     weights_ : array (N, D)
     """
 
+    # What each parameter may be (checked by set_params and fit). A spring weaker than 1e-3
+    # never pulls onto the cycle (a denormal one made the period's transition singular).
+    _parameter_constraints = {
+        "n_kernels": integer(minimum=2, limit="max_kernels"),
+        "alpha": real(minimum=1e-3, maximum=1e4),
+        "concentration": real(optional=True, positive=True, maximum=1e6),
+        "n_harmonics": integer(optional=True, minimum=1, maximum=4 * _MAX_HARMONICS),
+        "ridge": real(nonnegative=True, maximum=1.0),
+    }
+
     def __init__(
         self,
         n_kernels: int = 50,
@@ -108,11 +118,8 @@ class RhythmicDMP(Estimator):
         """Learn from a recording ``y`` (T, D) at stamps ``t`` (s) of at least 2 periods
         (transients at both ends are cut); ``frequency`` (Hz) skips the estimate of it (the
         steady part is still found). Returns self."""
-        n_kernels = check_int(self.n_kernels, "n_kernels", minimum=2, limit="max_kernels")
-        # a spring weaker than 1e-3 never pulls onto the cycle (a denormal one made the period's
-        # transition singular)
-        alpha = check_real(self.alpha, "alpha", minimum=1e-3, maximum=1e4)
-        ridge = check_real(self.ridge, "ridge", nonnegative=True, maximum=1.0)
+        self._check_constraints()
+        n_kernels, alpha, ridge = int(self.n_kernels), float(self.alpha), float(self.ridge)
         basis = VonMisesBasis(n_kernels, self.concentration)
         y = as_trajectory(y, "y", min_points=8)
         t = check_timestamps(t, y.shape[0])
@@ -348,9 +355,18 @@ class RhythmicDMP(Estimator):
         """From rest at the anchor into the rhythm and back to rest: the amplitude rises from 0
         (a critically damped filter of time constant ``transition``), ``cycles`` periods run,
         then it falls to 0 and the motion settles at the anchor (until within ``settle`` × the
-        amplitude, at rest). Smooth at both ends: acceleration 0 at the first and last sample."""
+        amplitude, at rest; ``settle`` in [1e-9, 0.5]: below 1e-9 of the amplitude the rest is
+        rounding, not motion). Smooth at both ends: acceleration 0 at the first and last sample.
+        The settling runs at most as long as the filter and the spring take to decay by
+        ``settle`` (a bound computed before it starts); a motion that cannot come that near in
+        floating point (an anchor far larger than the amplitude) is refused naming ``settle``."""
         cycles = check_real(cycles, "cycles", positive=True, maximum=1e5)
         settle = check_real(settle, "settle", positive=True, maximum=0.5)
+        if settle < _SETTLE_FLOOR:
+            raise ValueError(
+                f"settle must be >= {_SETTLE_FLOOR:g} (the smallest meaningful share of the "
+                f"amplitude: below it the rest is rounding), got {settle:g}"
+            )
         stepper = self.stepper(
             frequency=frequency,
             amplitude=amplitude,
@@ -371,17 +387,22 @@ class RhythmicDMP(Estimator):
         while stepper.cycles < cycles and len(samples) < limit:
             samples.append(stepper.step(dt))
         stepper.stop()
-        rest_for = 0
+        # The settling's own bound: what it needs to decay by ``settle``, not the step limit
+        # (two million stepped samples are minutes).
+        limit = min(limit, len(samples) + _settling_steps(stepper, self._alpha, settle, dt))
+        rest_for, off = 0, np.inf
         while len(samples) < limit:
             y, v, a = stepper.step(dt)
             samples.append((y, v, a))
-            near = (
-                np.max(np.abs(y - stepper.anchor)) <= settle * scale
-                and np.max(np.abs(v)) * stepper.period <= settle * scale
-            )
-            rest_for = rest_for + 1 if near else 0
+            off = max(np.max(np.abs(y - stepper.anchor)), np.max(np.abs(v)) * stepper.period)
+            rest_for = rest_for + 1 if off <= settle * scale else 0
             if rest_for * dt >= stepper.period:
                 break
+        else:
+            raise ValueError(
+                f"settle: the motion comes no nearer its anchor at rest than {off / scale:.3g} x "
+                f"the amplitude (the rounding of its numbers); give settle >= {2 * off / scale:.2g}"
+            )
         y, v, a = (np.array(part) for part in zip(*samples))
         return Trajectory(np.arange(len(y)) * dt, y, v, a, self.units_, tuple(self.names_ or ()))
 
@@ -471,6 +492,30 @@ def _period_transition(step: float, n: int, alpha: float, beta: float, tau: floa
     return np.linalg.matrix_power(transition, n)
 
 
+# The smallest ``settle`` of :meth:`RhythmicDMP.run`: a share of the amplitude below which the
+# rest is rounding (float64 resolves 2e-16 of the anchor's magnitude).
+_SETTLE_FLOOR = 1e-9
+
+
+def _settling_steps(stepper: RhythmicStepper, alpha: float, settle: float, dt: float) -> int:
+    """An upper bound of the steps (of ``dt`` s) a stopped ``stepper`` takes to settle within
+    ``settle`` of its amplitude, at rest, for a period.
+
+    Two critically damped systems in series: the amplitude's filter (time constant T) and the
+    spring (rate λ = α / (2τ), τ = period / 2π). Each decays as ``(1 + x) e^{-x}`` in its own
+    time ``x``; the velocity test scales it by the period over the time constant. With ``L =
+    ln(1 / settle) + ln(1 + P / T + λ P)``, ``x = L + 2 ln(1 + L) + 2`` makes ``(1 + x) e^{-x}``
+    at most ``e^{-L}``; the two times add (the spring follows the filter), then a period at
+    rest and one more of margin."""
+    period = stepper.period
+    constant = stepper.time_constant
+    rate = alpha * math.pi / period
+    share = math.log(1.0 / settle) + math.log1p(period / constant + rate * period)
+    span = share + 2.0 * math.log1p(share) + 2.0
+    seconds = 1.5 * span * (constant + 1.0 / rate) + 2.0 * period
+    return int(min(seconds / dt, float(_limit("max_steps")))) + 2
+
+
 def _check_samples(count: float, what: str) -> float:
     """Refuse a motion of more samples than the configured limit (``bidmp.set_limits``)."""
     limit = _limit("max_steps")
@@ -515,12 +560,16 @@ class _CriticalFilter:
         self.time_constant = time_constant
 
     def step(self, dt: float) -> None:
-        omega = 1.0 / self.time_constant
+        # ``p = p* + (e (1 + x) + ṗ dt) e^{-x}``, ``ṗ = ṗ (1 - x) e^{-x} - e x² e^{-x} / dt`` with
+        # ``x = dt / T``, written with ``x e^{-x}`` (at most 1/e) so that a time constant far
+        # below the step (1e-300 s: the setting jumps) gives 0, not inf times 0; past x = 746
+        # e^{-x} is 0 in float64, so capping x changes nothing but keeps it finite.
+        x = min(dt / self.time_constant, 1e6)
+        decay = math.exp(-x)
+        share = x * decay
         error = self.value - self.target
-        decay = math.exp(-omega * dt)
-        pushed = self.rate + omega * error
-        self.value = self.target + (error + pushed * dt) * decay
-        self.rate = (self.rate - omega * pushed * dt) * decay
+        self.value = self.target + error * (decay + share) + self.rate * (dt * decay)
+        self.rate = self.rate * (decay - share) - error * (share * x / dt)
 
 
 class RhythmicStepper:

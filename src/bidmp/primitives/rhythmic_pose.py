@@ -58,6 +58,9 @@ class RhythmicPoseDMP(Estimator):
         Hz.
     """
 
+    # the rhythm's parameters: what each may be is the rhythmic DMP's
+    _parameter_constraints = RhythmicDMP._parameter_constraints
+
     def __init__(
         self,
         n_kernels: int = 50,
@@ -75,6 +78,7 @@ class RhythmicPoseDMP(Estimator):
     @single_threaded  # small dense algebra: idle BLAS threads only steal the core
     def fit(self, poses, t, units: str | None = None) -> RhythmicPoseDMP:
         """Learn from a pose recording (T, 7) at stamps ``t`` (s) of at least 2 periods."""
+        self._check_constraints()
         positions, quaternions = as_poses(poses, "poses", min_points=8)
         units = "" if units is None else check_units(units)
         mean = mean_orientation(quaternions)

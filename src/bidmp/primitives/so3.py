@@ -18,6 +18,7 @@ import numpy as np
 
 from .._checks import _as_bounded_array, _check_magnitude, check_limit
 from .._kernels import quaternion_exp, quaternion_log
+from .._norms import tamed_rows
 from .._trajectory import continuous_quaternions
 
 __all__ = [
@@ -87,6 +88,10 @@ def _quaternion_rows(q, name: str) -> np.ndarray:
     check_limit(array.shape[0], "max_samples", f"{name}: the number of quaternions")
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} contains NaN or inf")
+    # A row of 1e300 components overflows its norm to inf, one of 1e-300 underflows it to 0: such
+    # rows are scaled by the power of two of their largest component (exact; the rotation is the
+    # same). The others are left as given, bit for bit.
+    array = tamed_rows(array)
     if np.any(np.linalg.norm(array, axis=1) == 0.0):
         raise ValueError(f"{name} contains a zero quaternion (no rotation has one)")
     return array

@@ -263,6 +263,10 @@ class DMPStepper:
         commanded = self.y if offset is None else self.y + offset[0]
         for term in self._temporal:
             slowdown *= term.slowdown(commanded, y_measured)
+        if y_measured is not None and not self._temporal:
+            # read by no term (no phase stopping), but a measurement all the same: one that is
+            # no point of the model is refused, not ignored
+            as_point(y_measured, commanded.shape[0], "y_measured", like="y")
         step = dt / time_unit / slowdown  # the normalised time this control step advances
         alpha, beta, tau = params.alpha, params.beta, params.tau
         input_now = self._input(self.phase, self._gate)  # not cached: goal and start are public

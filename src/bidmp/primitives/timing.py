@@ -342,6 +342,11 @@ def scale_factor(
         if limits is None:
             continue
         if values is None:
+            if len(trajectory) < 2:  # the jerk is the acceleration's rate: two samples at least
+                raise ValueError(
+                    "max_jerk: a trajectory of one sample has no jerk (the acceleration's rate "
+                    "needs two samples or more)"
+                )
             values = np.gradient(trajectory.ydd, trajectory.t, axis=0)
         peaks = _peaks(values, norm)
         with np.errstate(over="ignore", divide="ignore", under="ignore"):  # judged below, by name

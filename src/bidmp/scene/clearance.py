@@ -29,6 +29,7 @@ from .._checks import (
     numerically_guarded,
     short_token,
 )
+from .._norms import row_norms, unit_rows
 from .._trajectory import continuous_quaternions
 from .._units import check_units
 from .checker import PoseChecker, SceneChecker
@@ -296,6 +297,7 @@ class Scene:
 
     def applies_to(self, label: str) -> bool:
         """Whether target ``label`` is checked against this scene."""
+        label = _label(label, "label")
         return self.targets is None or label in self.targets
 
     def bounds(self, part: str) -> tuple[np.ndarray, np.ndarray]:
@@ -306,7 +308,8 @@ class Scene:
     def target_parts(self, label: str, point) -> list[str]:
         """The parts that enter the tool at target ``label`` (excepted from its clearance): the
         part labelled like it, else whatever the tool takes into its mouth at ``point``."""
-        return [label] if _label(label, "label") in self.labels else self.parts_at(point)
+        label, at = _label(label, "label"), self.parts_at(point)  # both checked, whichever answers
+        return [label] if label in self.labels else at
 
     def near(self, trajectory, part: str, distance: float) -> np.ndarray:
         """Which points of ``trajectory`` (n, 3) put the tool (pointing down) within ``distance`` of
@@ -455,12 +458,12 @@ class Scene:
         if (
             q.shape != (points.shape[0], 4)
             or not np.all(np.isfinite(q))
-            or np.any(np.linalg.norm(q, axis=1) < 1e-9)
+            or np.any(row_norms(q) < 1e-9)
         ):
             raise ValueError(
                 f"orientations must be {points.shape[0]} finite, non-zero quaternions (x, y, z, w)"
             )
-        q = continuous_quaternions(q / np.linalg.norm(q, axis=1, keepdims=True))
+        q = continuous_quaternions(unit_rows(q))  # (scaled first: 1e300 components normalise)
         sweep = _sweep(points, q, math.hypot(self.tool.length, self.tool.radius))
         dense, segment, fraction = _densify(points, step, weights=True, lengths=sweep)
         if points.shape[0] > 1:  # nlerp between samples at most ``step`` apart

@@ -43,6 +43,7 @@ if TYPE_CHECKING:
         register_backend,
         require_simulator,
     )
+    from .execution import TRACKING_ALLOWANCE_MM, execution_report, execution_settings
     from .fci import (
         FCI_LIMITS,
         CartesianLimits,
@@ -91,7 +92,8 @@ if TYPE_CHECKING:
         arm_route,
         judged_route,
         needlessly_slow,
+        reach,
         supports_routes,
     )
-    from .run import execution_report, execution_settings, simulate, target_labels
+    from .run import simulate, target_labels
 __getattr__, __dir__ = exports(__name__, __file__, globals())

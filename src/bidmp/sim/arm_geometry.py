@@ -94,6 +94,7 @@ class ArmGeometry:
         self.base = np.asarray(base, dtype=float)
         self.limits = robot.limits
         self.reach = self._reach()
+        self.tool_reach = self._tool_reach()
 
     def _reach(self) -> np.ndarray:
         """For each joint, the farthest any point of the bodies it moves lies from its origin
@@ -130,6 +131,22 @@ class ArmGeometry:
                     farthest = max(farthest, chain + extent)
             reach[joint - 1] = farthest
         return reach
+
+    def _tool_reach(self) -> float:
+        """The farthest the tool's mouth can be from the first joint's origin (m): the lengths of
+        the chain of joint origins out to it, end to end."""
+        pin = _pinocchio()
+        model, data = self.model, self.data
+        pin.framesForwardKinematics(model, data, pin.neutral(model))
+        frame = model.frames[self.tcp]
+        # where the first joint turns, in the world (it does not move with its own turn)
+        self.first_joint = self.rotation @ data.oMi[1].translation + self.base
+        points = [data.oMf[self.tcp].translation]
+        joint = frame.parentJoint
+        while joint > 0:
+            points.append(data.oMi[joint].translation)
+            joint = model.parents[joint]
+        return float(np.sum(np.linalg.norm(np.diff(np.array(points), axis=0), axis=1)))
 
     def tool_pose(self, q) -> tuple[np.ndarray, np.ndarray]:
         """The tool's mouth (m) and frame (3, 3) in the world at joints ``q`` (J,) rad."""
@@ -231,12 +248,22 @@ class ArmGeometry:
         error = float(np.linalg.norm(target - data.oMf[self.tcp].translation))
         return q, error
 
-    def space(self, scene, unit: float, *, exclude=(), margin: float, carried=None) -> ArmSpace:
+    def space(
+        self,
+        scene,
+        unit: float,
+        *,
+        exclude=(),
+        margin: float,
+        carried=None,
+        links: float | None = None,
+    ) -> ArmSpace:
         """The arm's configurations in ``scene`` (its parts in scene units, ``unit`` metres each)
-        as a :class:`~bidmp.planning.FreeSpace`: the links and the tool kept ``margin`` (m) from
-        every part but those in ``exclude``, a part's stand-off from it (the scene's, in metres);
-        ``carried``: a part the tool holds, ``(its solid where it is now, the joints now)``,
-        kept clear too (it moves with the tool)."""
+        as a :class:`~bidmp.planning.FreeSpace`: the tool kept ``margin`` (m) from every part but
+        those in ``exclude``, a part's stand-off from it (the scene's, in metres), and the links
+        ``links`` (m; default the margin: the contract asks the tool for its margin and the links
+        only not to touch); ``carried``: a part the tool holds, ``(its solid where it is now, the
+        joints now)``, kept clear as the tool is (it moves with the tool)."""
         from ..scene import Scene
 
         if not isinstance(scene, Scene):
@@ -262,7 +289,9 @@ class ArmGeometry:
                     "carried must be (a scene Solid where it is now, the joints now) or None"
                 )
             carried = (carried[0], as_point(carried[1], self.model.nq, "carried's joints"))
-        return ArmSpace(self, scene, unit, exclude, margin, carried)
+        margin = check_real(margin, "margin", nonnegative=True)
+        links = margin if links is None else check_real(links, "links", nonnegative=True)
+        return ArmSpace(self, scene, unit, exclude, (margin, links), carried)
 
 
 @dataclass
@@ -277,25 +306,29 @@ class ArmSpace:
     :meth:`ArmGeometry.space`): the slack is the nearest approach of any link or the tool to any
     part beyond its clearance (m), the sweep bounds how far any point of the arm moves."""
 
-    def __init__(self, arm: ArmGeometry, scene, unit: float, exclude: list, margin, carried=None):
+    def __init__(self, arm: ArmGeometry, scene, unit: float, exclude: list, margins, carried=None):
         pin = _pinocchio()
         self.arm = arm
-        margin = check_real(margin, "margin", nonnegative=True)
+        margin, links = margins
         # The least step along a segment; asked to keep the margin plus this, the arm keeps the
         # margin between two tests (as the tool's route).
-        self.tolerance = max(0.1 * margin, 1e-4)
+        self.tolerance = max(0.1 * min(margin, links), 1e-4)
         self.lower = np.asarray(arm.limits.lower, dtype=float)
         self.upper = np.asarray(arm.limits.upper, dtype=float)
         geometry = pin.GeometryModel()
-        arm_shapes = []
+        arm_shapes, tools = [], set()
         for item in arm.geometry.geometryObjects:
             if item.parentJoint == 0:
                 continue  # the base link never moves: it is not tested against the parts
-            arm_shapes.append(geometry.addGeometryObject(item.copy()))
+            index = geometry.addGeometryObject(item.copy())
+            arm_shapes.append(index)
+            if arm.model.frames[item.parentFrame].name == "tool":  # (the tool's link: _tool_urdf)
+                tools.add(index)
         held = None
         if carried is not None:
             held = geometry.addGeometryObject(_carried_object(pin, arm, carried, unit))
             arm_shapes.append(held)
+            tools.add(held)
         inverse = arm.rotation.T
         pairs = []
         for solid in scene.solids:
@@ -313,9 +346,15 @@ class ArmSpace:
             required = margin if stand is None else min(stand * unit, margin)
             for shape_index in arm_shapes:
                 # a stand-off lets the tool near the part it works on; a part the tool carries
-                # keeps the margin from every part, as the motion contract's clearance asks
-                kept = margin if shape_index == held else required
-                pairs.append(_Pair(shape_index, part, kept + self.tolerance))
+                # keeps the margin from every part, as the motion contract's clearance asks; the
+                # links only the links' allowance (the contract asks them not to touch)
+                if shape_index == held:
+                    keep = margin
+                elif shape_index in tools:
+                    keep = required
+                else:
+                    keep = min(links, required)
+                pairs.append(_Pair(shape_index, part, keep + self.tolerance))
         for pair in pairs:
             geometry.addCollisionPair(pin.CollisionPair(pair.arm, pair.part))
         self.geometry, self.data = geometry, pin.GeometryData(geometry)

@@ -36,6 +36,7 @@ from .job_world import (
     _body,
     _Move,
     _move,
+    _plan_key,
     _StepFailed,
     _transfer,
     _transfer_contract,
@@ -62,9 +63,16 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     # from the tool's pose now (a pose skill starts from the measured tool frame too)
     start = np.concatenate([world.tcp, world.orientation().as_quat()]) if world.pose else world.tcp
     repaired = world.repairer.repair(
-        world.model, target, label, start=start, axis=axis, exclude=exclude
+        world.model,
+        target,
+        label,
+        start=start,
+        axis=axis,
+        exclude=exclude,
+        arm=_links_check(world, exclude),
     )
-    if not repaired.ok:
+    # A motion only the arm's links cannot run goes on to the arm's own route (_move plans it).
+    if not repaired.ok and not (repaired.verdict.ok and repaired.arm):
         raise _StepFailed(f"approach: {repaired.reason()}")
     if repaired.how == "route" and repaired.model is not None:
         world.model = (
@@ -79,6 +87,48 @@ def _approach(world: _World, label: str, target, axis) -> JobPhase:
     )
     _note(phase, note)
     return phase
+
+
+def _links_check(world: _World, exclude):
+    """``check(motion) -> str``: why the arm's links cannot run a motion of the tool from its
+    joints now ("" when they can, or when the arm has no model of its links): its plan's joints,
+    the links on the arm's own model (pinocchio and coal, touching within 0.1 mm) against every
+    part but ``exclude``. The simulated world is not touched (a check that set the simulated
+    arm's joints would change the physics that follows). A motion the inverse kinematics does not
+    follow is not the links' business: the arm's own route takes it (:func:`bidmp.sim.job_world._move`)."""
+    from ..planning import segment_free
+    from .backend import SimError
+    from .routes import _arm, supports_routes
+
+    if not supports_routes(world.cell):
+        return None
+    cell = world.cell
+    space = _arm(cell).space(world.scene, cell.unit, exclude=exclude, margin=0.0)
+
+    def check(motion) -> str:
+        motion = np.asarray(motion, dtype=float)
+        path, turns = motion[:, :3], (motion[:, 3:] if world.pose else None)
+        try:
+            plan = world.cell.plan(
+                path,
+                f"{world.label} (approach)" if world.label else "approach",
+                fractions=np.linspace(0.0, 1.0, path.shape[0]),
+                seed=world.q,
+                orientations=turns,
+            )
+        except SimError:
+            return ""
+        # the approach that runs is planned the same way: kept for it (IK is most of a plan)
+        world.planned = (_plan_key(path, turns, world.q), plan)
+        joints = np.asarray(plan.joints, dtype=float)
+        for a, b in zip(joints[:-1], joints[1:]):
+            if not segment_free(space, a, b):
+                part, depth = space.nearest(b)
+                deep = length_text(max(-depth, 0.0) / cell.unit, world.scenario.units)
+                return f"a link would touch {part} ({deep} deep)"
+        return ""
+
+    return check
 
 
 def _note(phase: JobPhase, note: str) -> None:
@@ -528,7 +578,7 @@ def _job_world(scenario, report, cell, scene, pictures: bool, view: bool) -> _Wo
     """The job's state: the learned skills, the contract on the job's scene and the arm's limits,
     the repairs of the approaches (planned with room for the arm's tracking)."""
     from ..tasks.repair import Repairer
-    from .run import TRACKING_ALLOWANCE_MM
+    from .execution import TRACKING_ALLOWANCE_MM
 
     # the scenario's contract, on the job's scene (its parts, the bin, the rack)
     contract = dataclasses.replace(Contract.of(scenario, cell.limits), scene=scene)

@@ -63,6 +63,8 @@ class _World:
     record: bool = False  # keep each phase's measured path and commands
     rhythm: RhythmicDMP | None = None  # the rock step's periodic skill, learned once per job
     label: str = ""  # the target being worked on (its phases' refusals name it)
+    # (what it was planned from, the plan) of the approach the links' check planned: reused
+    planned: tuple | None = None
 
     @property
     def scene(self):
@@ -115,19 +117,12 @@ def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
     contract: its end, the approach's descent, clearance by the margin of the executed tool and of
     a carried part (its own contacts count as the arm's), the 1 kHz commands within the limits."""
     path, fractions, exclude, name = move.path, move.fractions, move.exclude, move.name
-    orientations, carried, target, axis = move.orientations, move.carried, move.target, move.axis
-    least_duration, spacing, support = move.least_duration, move.spacing, move.support
+    carried, target, axis = move.carried, move.target, move.axis
+    least_duration, support = move.least_duration, move.support
     cell = world.cell
     note = ""
     try:
-        plan = cell.plan(
-            np.asarray(path, dtype=float),
-            f"{world.label} ({name})" if world.label else name,  # "target 'B4 (approach)': ..."
-            fractions=fractions,
-            seed=world.q,
-            orientations=orientations,
-            **({} if spacing is None else {"spacing": spacing}),
-        )
+        plan = _planned(world, move)
         # (a carried part is not rushed: its weight on a faster route is the physics' to judge)
         slow = (
             name in _ROUTED
@@ -204,6 +199,35 @@ def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
     return phase
 
 
+def _plan_key(path, turns, q) -> tuple:
+    """What a plan is planned from: the tool's path, its frames and the joints it starts at."""
+    return (
+        np.asarray(path, dtype=float).tobytes(),
+        None if turns is None else np.asarray(turns, dtype=float).tobytes(),
+        np.asarray(q, dtype=float).tobytes(),
+    )
+
+
+def _planned(world: _World, move: _Move):
+    """``move``'s plan from the arm's joints now: the one the links' check of the approach made
+    from the same path, frames and joints (the same call: the same plan), else a new one."""
+    import copy
+
+    kept, world.planned = getattr(world, "planned", None), None
+    if kept is not None and move.spacing is None and move.fractions is not None:
+        if kept[0] == _plan_key(move.path, move.orientations, world.q):
+            return copy.copy(kept[1])  # (the plan's timing is stretched in place later)
+    name = move.name
+    return world.cell.plan(
+        np.asarray(move.path, dtype=float),
+        f"{world.label} ({name})" if world.label else name,  # "target 'B4 (approach)': ..."
+        fractions=move.fractions,
+        seed=world.q,
+        orientations=move.orientations,
+        **({} if move.spacing is None else {"spacing": move.spacing}),
+    )
+
+
 def _judged_by(world: _World, move: _Move) -> tuple:
     """The contract ``move`` is judged by (an approach's, or a transfer's without a final
     descent) and the point its end is judged at (its target, else its path's end)."""
@@ -225,8 +249,8 @@ def _routed(world: _World, move: _Move, contract, goal) -> tuple:
     of pointing down (the part falls the same); a placed part is kept upright. A carried part is
     carried along the route and kept clear."""
     from .._units import mm
+    from .execution import TRACKING_ALLOWANCE_MM
     from .routes import DROP_CONE_DEG, arm_route
-    from .run import TRACKING_ALLOWANCE_MM
 
     cell, scenario = world.cell, world.scenario
     approach = move.name == "approach"

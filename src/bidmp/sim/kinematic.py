@@ -344,8 +344,11 @@ class KinematicCell:
         check_real(seconds, "seconds", nonnegative=True, maximum=60.0)
 
     def render(self, width: int = 320, height: int = 240, target=None) -> np.ndarray:
-        """A plain grey picture (this backend draws nothing)."""
+        """A plain grey picture (this backend draws nothing; ``target`` is checked as the PyBullet
+        arm's is: a point in scene units, or None)."""
         width, height = _picture_args(width, height)
+        if target is not None:
+            as_point(target, 3, "target")
         return np.full((height, width, 3), _GREY, dtype=np.uint8)
 
     def keyframe(self, t: float, focus, width: int = 320, height: int = 240) -> np.ndarray:

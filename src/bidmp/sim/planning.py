@@ -48,7 +48,8 @@ def plan_path(
         raise ValueError(f"path must have 3 columns, got {path.shape[1]}")
     if not isinstance(label, str) or len(label) > 256:
         raise TypeError(f"label must be the target's name (a string), got {type(label).__name__}")
-    spacing = check_real(spacing, "spacing", positive=True, maximum=1.0)
+    # (IK samples a micrometre apart or closer: a unit mistake, and a path of millions of samples)
+    spacing = check_real(spacing, "spacing", minimum=1e-6, maximum=1.0)
     for point in (path.min(axis=0), path.max(axis=0)):  # before subdividing it into 5 mm steps
         _reachable(point * cell.unit, cell.base * cell.unit, "path")
     given = (

@@ -149,6 +149,7 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
     cone: float = 0.0,
     free_start: bool = False,
     retract: float = 0.0,
+    links: float | None = None,
 ) -> ArmRoute:
     """The arm's route from joints ``start`` to ``goal`` (module docstring).
 
@@ -191,6 +192,9 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
         simulated motion, which the arm is placed at the start of): where ``start`` would have a
         link within the margin of a part, the first of several inverse kinematics solutions
         that keeps it is taken instead. False: the arm is at ``start`` (a job's joints now).
+    links : float, optional
+        Scene units every link keeps from the parts (default the tracking allowance, 0.5 mm: the
+        contract asks the links only not to touch; the tool keeps the margin).
 
     Raises
     ------
@@ -218,8 +222,15 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
         axis = as_point(axis, 3, "axis")
         if not np.linalg.norm(axis) > 0.0:
             raise ValueError("axis must be a direction (not zero)")
+    from .execution import TRACKING_ALLOWANCE_MM
+
     margin_m = (scene.margin if margin is None else margin) * unit
-    space = arm.space(scene, unit, exclude=exclude, margin=margin_m, carried=carried)
+    links_m = (
+        TRACKING_ALLOWANCE_MM * 1e-3
+        if links is None
+        else check_real(links, "links", nonnegative=True) * unit
+    )
+    space = arm.space(scene, unit, exclude=exclude, margin=margin_m, carried=carried, links=links_m)
     start = np.clip(np.asarray(start, dtype=float), space.lower, space.upper)
     inside = _inside(cell.limits)
     # the route keeps inside the ranges (where the arm is now may be nearer an end)
@@ -316,9 +327,15 @@ def reach(cell, point, frame=None, seed: int = 0) -> str:
     limits do, from any of several seeds (the rest pose, the ranges' middle, seeded draws). A
     point is called out of reach only when none does, and the reason says how far it is, which
     joint stops at its limit on the way, and what would help."""
+    if not supports_routes(cell):
+        raise TypeError(
+            "cell must be a simulator backend whose arm is a URDF model (bidmp.sim.RobotCell), with "
+            f"the planner's extra installed (pip install 'bidmp[plan]'), got {type(cell).__name__}"
+        )
     unit = cell.unit
     arm = _arm(cell)
     point_m = as_point(point, 3, "point") * unit
+    seed = check_int(seed, "seed", minimum=0, maximum=2**32 - 2)
     frame = np.array([1.0, 0.0, 0.0, 0.0]) if frame is None else as_vector(frame, "frame")
     lower, upper = np.asarray(cell.limits.lower), np.asarray(cell.limits.upper)
     best, best_q = math.inf, None
@@ -330,19 +347,18 @@ def reach(cell, point, frame=None, seed: int = 0) -> str:
             return ""
         if error < best:
             best, best_q = error, q
-    base = np.asarray(cell.base, dtype=float) * unit
-    distance = float(np.linalg.norm(point_m - base))
-    if distance > float(arm.reach[0]):
+    distance = float(np.linalg.norm(point_m - arm.first_joint))
+    if distance > arm.tool_reach:
         return (
-            f"{distance:.3g} m from the arm's base, beyond its reach ({arm.reach[0]:.3g} m): move its "
-            'base nearer (scenario key "robot": {"base": ...})'
+            f"{distance:.3g} m from the arm's first joint, beyond its reach ({arm.tool_reach:.3g} m): "
+            'move its base nearer (scenario key "robot": {"base": ...})'
         )
     stopped = np.flatnonzero((best_q <= lower + 1e-6) | (best_q >= upper - 1e-6))
     held = f"; joint {int(stopped[0]) + 1} stops at its limit on the way" if stopped.size else ""
     return (
         f"no joints within the limits put the tool there (the nearest leaves "
-        f"{best / unit:.3g} {_unit_name(unit)}{held}): tilt the part toward the arm, or move the "
-        'arm\'s base (scenario key "robot": {"base": ...})'
+        f"{best / unit:.3g} {_unit_name(unit)}{held}): move the arm's base nearer (scenario key "
+        '"robot": {"base": ...}), or turn the part toward it'
     )
 
 
@@ -515,7 +531,7 @@ def _approach_goals(cell, space, start, descent, frame, seed) -> tuple[list, lis
     arm = _arm(cell)
     free_turn = bool(getattr(cell, "free_turn", True))
     line = _line(descent[0], descent[1], cell.unit)
-    problem = ""
+    problem, touched = "", ""
     for q in tops:
         joints = [q]
         for point in line[1:]:
@@ -533,12 +549,21 @@ def _approach_goals(cell, space, start, descent, frame, seed) -> tuple[list, lis
             joints.append(step)
         else:
             joints = np.array(joints)
-            if all(segment_free(space, a, b) for a, b in zip(joints[:-1], joints[1:])):
+            blocked = next(
+                (b for a, b in zip(joints[:-1], joints[1:]) if not segment_free(space, a, b)),
+                None,
+            )
+            if blocked is None:
                 goals.append(joints[0])
                 tails.append(joints)
+            else:
+                touched = space.nearest(blocked)[0]
         if len(goals) >= _GOALS:
             break
-    why = problem or "the arm's links would come within the margin of a part on the final approach"
+    why = problem or (
+        f"on the final approach down the part's axis the arm would come within its clearance "
+        f"of {touched}, whichever way its joints turn ({len(tops)} tried)"
+    )
     return goals, tails, why
 
 

@@ -11,12 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._checks import as_labels, check_bool, check_int, check_kind, check_real, short_token
+from .._checks import as_labels, check_bool, check_int, check_real, short_token
 from .._trajectory import arclength
 from .._units import length_digits, length_text, mm
 from ..primitives.avoidance import SceneAvoidance
 from ..primitives.coupling import PhaseStopping
 from .backend import COUPLING, GoalUpdate, Hold, SimError
+from .execution import TRACKING_ALLOWANCE_MM, _executable, _refusal
 from .planning import _paced_duration, _slowed
 from .pybullet.cell import RobotCell
 from .report import SimMethod, SimReport, SimTarget, _measure, _SimTask
@@ -31,14 +32,11 @@ from .robots import (
 )
 from .routes import judged_route, needlessly_slow, reach, supports_routes
 
-__all__ = ["execution_report", "execution_settings", "simulate", "target_labels"]
+__all__ = ["simulate", "target_labels"]
 
 logger = logging.getLogger(__name__)
 
 CLOSED_LOOP_SPACING = 1e-3  # m: the IK samples a closed-loop motion is timed on
-# mm the repairs add to the margin they plan for: the simulated arm's tool strays up to 0.3 mm from
-# its command (open loop, the nut task), so a motion planned at the margin could run inside it.
-TRACKING_ALLOWANCE_MM = 0.5
 
 
 @dataclass
@@ -388,84 +386,6 @@ def simulate(  # noqa: PLR0913 - the public call spells its options out, as user
     out.wall_s = time.perf_counter() - start
     out.workers = n_workers
     return out
-
-
-def execution_settings(scenario) -> dict:
-    """How :func:`simulate` judges and repairs the motions it executes (the ``settings`` of the
-    :class:`~bidmp.tasks.evaluation.Report` it runs): the scene's geometry checked, the motions
-    that break the contract repaired (unless the scenario takes the paper's approach), the
-    repairs planned with :data:`TRACKING_ALLOWANCE_MM` of room for the arm's tracking."""
-    from ..tasks.scenarios import Scenario
-
-    check_kind(scenario, Scenario, "scenario", "a bidmp Scenario (bidmp.tasks.load)")
-    return {
-        "geometry": scenario.scene is not None,
-        "repair": scenario.scene is not None and scenario.extension.approach == "keep",
-        "allowance": mm(TRACKING_ALLOWANCE_MM, scenario.units),
-    }
-
-
-def execution_report(scenario, methods=("dmp", "bidmp")):
-    """The evaluation whose motions :func:`simulate` executes: every motion judged by the
-    contract and repaired where it breaks it, with room for the arm's tracking. Evaluate once
-    and hand it to several :func:`simulate` calls (``report=``); a report judged any other way
-    (``evaluate(geometry=False)``, no repairs) is refused there, so that what runs on the arm
-    is always what this judged and repaired, whatever else a caller asks for (pictures, the
-    viewer, a subset of the targets, workers, the backend)."""
-    from ..tasks import scenarios as scenario_module
-    from ..tasks.evaluation import evaluate
-
-    scenario = scenario_module.resolve(scenario)
-    settings = execution_settings(scenario)
-    return evaluate(
-        scenario,
-        as_labels(methods, "methods"),
-        repair=settings["repair"],
-        allowance=settings["allowance"],
-    )
-
-
-def _executable(scenario, methods, report):
-    """``report`` if its motions may be executed for ``scenario`` and ``methods`` (else a
-    ValueError saying why), or a new :func:`execution_report` when it is None."""
-    if report is None:
-        return execution_report(scenario, methods)
-    settings = getattr(report, "settings", None)
-    if not isinstance(settings, dict) or not hasattr(report, "methods"):
-        raise TypeError(
-            f"report must be a bidmp evaluation Report (bidmp.sim.execution_report), got "
-            f"{type(report).__name__}"
-        )
-    wanted = execution_settings(scenario)
-    if report.scenario.name != scenario.name or report.scenario.units != scenario.units:
-        raise ValueError(
-            f"report: an evaluation of scenario {report.scenario.name!r} "
-            f"({report.scenario.units}), not of {scenario.name!r} ({scenario.units})"
-        )
-    if settings != wanted:
-
-        def said(values: dict) -> str:
-            return ", ".join(f"{key}={value!r}" for key, value in values.items())
-
-        raise ValueError(
-            f"report: judged with {said(settings)}; the simulator executes only motions judged "
-            f"and repaired with {said(wanted)} (allowance in {scenario.units}): pass "
-            "bidmp.sim.execution_report(scenario, methods), or no report"
-        )
-    missing = [name for name in methods if name not in report.methods]
-    if missing:
-        raise ValueError(f"report: has no motions of {', '.join(missing)}")
-    return report
-
-
-def _refusal(report, method: str, label: str) -> str:
-    """Why the evaluation's motion of ``method`` to ``label`` is not sent to the arm ("" when it
-    may be): the contract, after every repair, still refuses it. The arm runs nothing the
-    contract refused; the row keeps the reason, and no simulated time is spent on it."""
-    verdict = report.methods[method].verdicts[label]
-    if verdict.ok:
-        return ""
-    return f"not run: the contract refuses its planned motion: {verdict.reason()}"
 
 
 def _loop_options(closed_loop: bool, avoid, goal_update) -> dict:

@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from .._checks import check_bool, check_real
+from .._checks import check_bool, check_callable, check_real
 from .._progress import report
 from .._trajectory import resample_time
 from ..extension.extend import extend_demonstration
@@ -213,6 +213,7 @@ def evaluate(
     geometry: bool = True,
     repair: bool | None = None,
     allowance: float = 0.0,
+    arm=None,
 ) -> Report:
     """Run ``methods`` (default: the scenario's) on every target of ``scenario``, each motion judged
     by the motion contract (:mod:`bidmp.tasks.contract`); the pipeline's method's motions that
@@ -243,6 +244,11 @@ def evaluate(
     allowance : float, default 0
         Scene units the repairs add to the margin they plan for (what running the motion on an
         arm may take off it: the simulator passes its tracking allowance).
+    arm : callable, optional
+        ``arm(motion, label) -> str``: why an arm cannot run a motion that keeps the contract
+        ("" when it can: the simulator's check of the arm's links along it). A motion it refuses
+        is repaired like one the contract refuses, and a repair is kept only where the arm can
+        run it (:meth:`bidmp.tasks.Repairer.repair`). Needs ``repair``.
 
     Returns
     -------
@@ -269,11 +275,14 @@ def evaluate(
     geometry = check_bool(geometry, "geometry") and scenario.scene is not None
     repair = check_bool(repair, "repair") and geometry
     allowance = check_real(allowance, "allowance", nonnegative=True)
-    report = Report(
-        scenario=scenario,
-        methods={},
-        settings={"geometry": geometry, "repair": repair, "allowance": allowance},
-    )
+    if arm is not None:
+        check_callable(arm, "arm", "a check of an arm (motion, label) -> str")
+        if not repair:
+            raise ValueError("arm checks the motions repairs are kept by: give repair=True")
+    settings = {"geometry": geometry, "repair": repair, "allowance": allowance}
+    if arm is not None:
+        settings["arm"] = True
+    report = Report(scenario=scenario, methods={}, settings=settings)
     report.failed_targets = failed = _failed_targets(scenario, task, labels, goals)
     task.build_skills = _skills_builder(scenario, failed, report)
     result = _results_builder(scenario, labels, geometry)
@@ -288,7 +297,7 @@ def evaluate(
             outcome = result(name, rollouts, 0.0)
             if repairer is not None and method.repairs:
                 outcome, model = _repaired(
-                    outcome, repairer, model, scenario, labels, result, progress
+                    outcome, (repairer, arm), model, scenario, labels, result, progress
                 )
         outcome.runtime_s = fit_seconds + timer.seconds
         report.methods[name] = outcome
@@ -320,14 +329,24 @@ def _repairer(scenario, allowance: float):
 
 
 def _repaired(
-    outcome: MethodResult, repairer, model, scenario, labels, result, progress
+    outcome: MethodResult, repairs_by, model, scenario, labels, result, progress
 ) -> tuple[MethodResult, object]:
     """``outcome`` with every motion that broke the contract repaired where a repair keeps it
     (``outcome.repairs``: label -> :class:`~bidmp.tasks.repair.Repaired` of each one tried), and
     the model: the method's, or grown by the skills the planner's routes taught. A route is
     learned as a skill and kept: the targets repaired after it start from the grown model's own
-    motion (``how`` "learned" where that keeps the contract without another repair)."""
+    motion (``how`` "learned" where that keeps the contract without another repair).
+    ``repairs_by`` = (the repairer, the arm's check or None): a motion the arm's links cannot run
+    is repaired too, and every repair is kept only where they can."""
+    repairer, arm = repairs_by
     failed = [label for label in labels if not outcome.verdicts[label].ok]
+    if arm is not None:  # the motions the contract keeps but the arm's links cannot run
+        blocked = {
+            label: arm(_rollout(outcome, label), label)
+            for label in labels
+            if outcome.verdicts[label].ok
+        }
+        failed = [label for label in labels if label in failed or blocked.get(label)]
     if not failed:
         return outcome, model
     scene = scenario.scene
@@ -349,6 +368,7 @@ def _repaired(
             label,
             axis=scenario.target_axis(label),
             exclude=scene.target_parts(label, scenario.targets[label]),
+            arm=None if arm is None else (lambda motion, label=label: arm(motion, label)),
             **known,
         )
         if grown and fixed.ok and not fixed.how:
@@ -366,6 +386,14 @@ def _repaired(
     )
     repaired.repairs = repairs
     return repaired, model
+
+
+def _rollout(outcome: MethodResult, label: str) -> np.ndarray:
+    """The method's motion to ``label``: positions, or poses with their frames."""
+    path = np.asarray(outcome.rollouts[label])
+    if outcome.orientations is None:
+        return path
+    return np.hstack([path, np.asarray(outcome.orientations[label])])
 
 
 def _failed_targets(scenario, task, labels, goals) -> list[str]:

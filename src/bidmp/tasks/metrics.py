@@ -17,6 +17,7 @@ from .._checks import (
     as_trajectory,
     check_real,
 )
+from .._norms import row_norms, tamed_rows
 from .._trajectory import path_extent, rmse
 
 __all__ = [
@@ -142,8 +143,9 @@ def axis_deviation(
             f"orientations must have shape ({trajectory.shape[0]}, 4), one per row of trajectory, got {q.shape}"
         )
     _check_finite(q, "orientations")
-    if np.any(np.linalg.norm(q, axis=1) < 1e-12):
+    if np.any(row_norms(q) < 1e-12):  # (scaled first: rows of 1e300 do not overflow)
         raise ValueError("orientations contains a zero quaternion, which is no rotation")
+    q = tamed_rows(q)  # (SciPy normalises them: rows of 1e300 must not overflow its norm)
     target = as_point(target, 3, "target")
     height = check_real(height, "height", positive=True)
     axis = np.array([0.0, 0.0, 1.0]) if axis is None else _unit_axis(axis)

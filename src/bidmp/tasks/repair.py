@@ -49,6 +49,7 @@ from .._checks import (
     as_point,
     as_trajectory,
     as_vector,
+    check_callable,
     check_options,
     check_real,
     check_seed,
@@ -118,10 +119,12 @@ class Repaired:
     model: object = None
     skill: object = None
     refused: str = ""  # why no repair was tried (the final approach itself is blocked)
+    # why the arm cannot run the motion though it keeps the contract (a link would touch a part)
+    arm: str = ""
 
     @property
     def ok(self) -> bool:
-        return self.verdict.ok
+        return self.verdict.ok and not self.arm
 
     def reason(self) -> str:
         """Why the target fails, in one sentence (empty when it does not)."""
@@ -130,7 +133,8 @@ class Repaired:
         if self.refused:
             return self.refused
         tried = ", ".join(attempt.how for attempt in self.attempts)
-        return self.verdict.reason() + (f"; repairs tried: {tried}" if tried else "")
+        why = self.verdict.reason() if not self.verdict.ok else f"the arm cannot run it: {self.arm}"
+        return why + (f"; repairs tried: {tried}" if tried else "")
 
     def to_dict(self) -> dict:
         return {
@@ -343,12 +347,19 @@ class Repairer:
         verdict=None,
         skill="nearest",
         carried=None,
+        arm=None,
     ) -> Repaired:
         """The motion of ``model`` (a DMP or Bi-DMP) to ``goal`` kept within the contract, or why not.
 
         ``motion`` and ``verdict``: the method's own motion and its verdict when the caller has
         them (else computed). The repairs are tried only when that verdict fails. ``carried``: a
         part the tool carries (a transfer), ``(solid, offset from the mouth)``, kept clear too.
+        ``arm``: ``arm(motion) -> str``, why the arm cannot run a motion that keeps the contract
+        ("" when it can: a simulator's check of its links along it); a link's contact starts the
+        same repairs as the tool's, and a repair is kept only where the arm can run it too. Where
+        none is, but one keeps the contract on the tool where the method's own motion did not,
+        that one is kept with ``Repaired.arm`` saying why the arm cannot run it (the simulator
+        gives it the arm's own route).
         """
         goal, axis, exclude = _target_args(goal, axis, exclude)
         if not isinstance(label, str):
@@ -363,7 +374,10 @@ class Repairer:
         if verdict is None:
             verdict = self._judge(self.contract, motion, query)
         out = Repaired(np.asarray(motion), verdict)
-        if verdict.ok:
+        if arm is not None:
+            check_callable(arm, "arm")
+            out.arm = str(arm(out.motion)) if verdict.ok else ""
+        if out.ok:
             return out
         refused = (
             self.blocked(goal, axis, exclude) if self.contract.approach_height is not None else ""
@@ -373,18 +387,10 @@ class Repairer:
             logger.info("%s", out.refused)
             return out
         only_clearance = set(verdict.failed) <= {"clearance"}
-        shortfall = 0.0
+        shortfall, kept = 0.0, None
         for how in self.order:
-            if how in ("lift", "avoid") and not only_clearance:
-                continue  # a lift or a steer does not bring a motion that misses its target onto it
-            if (
-                how in ("extend", "margin")
-                and not _is_bidmp(model)
-                and not self.bidmp_possible(model)
-            ):
+            if not self._applies(how, query, only_clearance):
                 continue
-            if how == "route" and query.carried:
-                continue  # a carried part is not the tool: the arm's route carries it (bidmp.sim)
             started = time.perf_counter()
             try:
                 found = self._try(
@@ -400,23 +406,50 @@ class Repairer:
                 continue
             candidate, trial, trial_skill, planned = found
             final = self._final(planned, candidate, query)
-            ok = final.ok and planned.ok
-            out.attempts.append(
-                Attempt(how, ok, time.perf_counter() - started, "" if ok else planned.reason())
+            problem = self._arm_problem(arm, candidate, final, planned)
+            ok = final.ok and planned.ok and not problem
+            note = (
+                f"the arm cannot run it: {problem}" if problem else "" if ok else planned.reason()
             )
+            out.attempts.append(Attempt(how, ok, time.perf_counter() - started, note))
+            if problem and kept is None:  # the first that keeps the contract on the tool, kept
+                kept = (candidate, final, how, trial, trial_skill, problem)
             if ok:
-                out.motion, out.verdict, out.how, out.model, out.skill = (
+                out.motion, out.verdict, out.how, out.model, out.skill, out.arm = (
                     candidate,
                     final,
                     how,
                     trial,
                     trial_skill,
+                    "",
                 )
                 logger.info("the motion to %s kept the contract after %s", label, how)
                 return out
             if planned.clearance is not None:
                 shortfall = max(shortfall, planned.clearance.margin - planned.clearance.distance)
+        if kept is not None and not out.verdict.ok:
+            # No repair clears the links too, but one keeps the contract on the tool: that motion,
+            # its links left to the arm's own route (bidmp.sim), rather than one that misses.
+            out.motion, out.verdict, out.how, out.model, out.skill, out.arm = kept
         return out
+
+    @staticmethod
+    def _arm_problem(arm, candidate, final: Verdict, planned: Verdict) -> str:
+        """Why the arm cannot run a repair's motion that keeps the contract ("" when it can, when
+        the contract refuses it anyway, or with no check of the arm)."""
+        if arm is None or not (final.ok and planned.ok):
+            return ""
+        return str(arm(candidate))
+
+    def _applies(self, how: str, query: _Query, only_clearance: bool) -> bool:
+        """Whether repair ``how`` can help ``query``'s motion: a lift or a steer does not bring a
+        motion that misses its target onto it; an extension needs a model that learns skills; a
+        carried part is not the tool (the arm's route carries it: :mod:`bidmp.sim.routes`)."""
+        if how in ("lift", "avoid"):
+            return only_clearance
+        if how in ("extend", "margin"):
+            return _is_bidmp(query.model) or self.bidmp_possible(query.model)
+        return not (how == "route" and query.carried)
 
     def _final(self, planned, motion, query: _Query) -> Verdict:
         """The contract's own verdict on a repair's ``motion`` (the one the report shows), judged

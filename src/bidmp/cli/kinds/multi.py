@@ -8,6 +8,8 @@ import argparse
 
 import numpy as np
 
+from . import Rolled, shown
+
 
 class _MultiDMPAdapter:
     fit_takes = frozenset({"n_kernels", "alpha", "protocol"})
@@ -25,8 +27,7 @@ class _MultiDMPAdapter:
         what = f"a DMP from several demonstrations ({model.dmp_.protocol} protocol)"
         return model, motion.y, std, motion.t, what
 
-    def roll(self, args: argparse.Namespace, model, goal, via) -> tuple:
-        """(trajectory, mean, std, base, base_std, marks, times, demonstrations, units)."""
+    def roll(self, args: argparse.Namespace, model, goal, via) -> Rolled:
         if args.start is not None:
             raise ValueError("--start: a DMP from several demonstrations starts where they did")
         options = {}
@@ -52,7 +53,13 @@ class _MultiDMPAdapter:
             "conditioned": trajectory.t,
         }
         marks = None if goal is None else (trajectory.t[-1:], goal[None])
-        return trajectory, mean, std, base, base_std, marks, times, demos, units
+        what = "the mean motion" + ("" if goal is None else f" to the goal {shown(goal)}")
+        if via:
+            what += " through " + ", ".join(f"{shown(point)} at {t:g} s" for t, point in via)
+        title = what if len(what) <= 120 else f"the mean motion through {len(via)} via-points"
+        return Rolled(
+            trajectory, mean, std, base, base_std, marks, times, demos, units, what, title
+        )
 
 
 ADAPTER = _MultiDMPAdapter()

@@ -1,11 +1,14 @@
-"""``bidmp fit --promp`` and ``bidmp rollout`` of a ProMP: conditioned exactly on the goal, the
-start (by default the demonstrations' mean start) and the via-points at their phases."""
+"""``bidmp fit --promp`` and ``bidmp rollout`` of a ProMP: conditioned exactly on all at once — the
+start at rest (``--start``, default the demonstrations' mean start), the via-points at their
+phases (their time over the duration) and the goal at rest (``--goal``, default the mean end)."""
 
 from __future__ import annotations
 
 import argparse
 
 import numpy as np
+
+from . import Rolled, conditioned_on, conditioned_title, time_grid
 
 
 class _ProMPAdapter:
@@ -19,34 +22,32 @@ class _ProMPAdapter:
         t = np.linspace(0.0, model.duration_, 200)
         return model, mean, std, t, f"a ProMP ({model.n_basis} basis functions per dimension)"
 
-    def roll(self, args: argparse.Namespace, model, goal, via) -> tuple:
-        """(trajectory, mean, std, base, base_std, marks, times, demonstrations, units)."""
-        points, values = [], []
-        if args.start is not None or goal is not None:
-            # the start held where it is asked (default: the demonstrations' mean start), so a
-            # goal far off does not move it
-            points.append(0.0)
-            values.append(model.mean([0.0])[0] if args.start is None else args.start)
-        if goal is not None:
-            points.append(1.0)
-            values.append(goal)
-        for t, point in via:  # exact conditioning at the via-point's phase (its time / duration)
-            if not 0.0 <= t <= model.duration_:
-                raise ValueError(
-                    f"--via at {t:g} s is outside the motion's {model.duration_:.4g} s"
-                )
-            points.append(t / model.duration_)
-            values.append(point)
-        conditioned = model.condition(points, np.asarray(values), 0.0) if points else model
-        dt = 1.0 / (args.rate or 100.0)
-        trajectory = conditioned.trajectory(dt=min(dt, conditioned.duration_))
-        n = len(trajectory.t)
-        mean, std = conditioned.mean(n_steps=n), np.sqrt(conditioned.var(n_steps=n))
-        base, base_std = model.mean(n_steps=n), np.sqrt(model.var(n_steps=n))
-        demos, units = [], model.units_
-        marks = (np.array(points) * model.duration_, np.asarray(values)) if points else None
+    def roll(self, args: argparse.Namespace, model, goal, via) -> Rolled:
+        duration = model.duration_
+        t = time_grid(duration, args.rate)
+        end_time = float(t[-1])  # the duration, to the last whole step of the rate
+        for when, _ in via:
+            if not 0.0 <= when <= end_time:
+                raise ValueError(f"--via at {when:g} s is outside the motion's {end_time:.4g} s")
+        conditioned, what, marks = model, "the mean motion", None
+        if goal is not None or args.start is not None or via:
+            start = model.mean([0.0])[0] if args.start is None else np.asarray(args.start, float)
+            end = model.mean([end_time / duration])[0] if goal is None else goal
+            times = [0.0, *(when for when, _ in via), end_time]
+            points = np.array([start, *(point for _, point in via), end])
+            phases = np.array(times) / duration
+            conditioned = model.condition(phases, points, 0.0, rest=phases[[0, -1]])
+            what = conditioned_on(start, args.start is not None, via, end, goal is not None)
+            marks = (np.array(times), points)
+        trajectory = conditioned.trajectory(dt=t[1] - t[0])
+        phase = trajectory.t / duration
+        mean, std = conditioned.mean(phase), np.sqrt(conditioned.var(phase))
+        base, base_std = model.mean(phase), np.sqrt(model.var(phase))
         times = {"demonstrations": [], "mean": trajectory.t, "conditioned": trajectory.t}
-        return trajectory, mean, std, base, base_std, marks, times, demos, units
+        title = what if conditioned is model else conditioned_title(via)
+        return Rolled(
+            trajectory, mean, std, base, base_std, marks, times, [], model.units_, what, title
+        )
 
 
 ADAPTER = _ProMPAdapter()

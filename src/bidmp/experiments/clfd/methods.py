@@ -15,6 +15,15 @@ import copy
 
 import numpy as np
 
+from ..._checks import (
+    _as_bounded_array,
+    _check_finite,
+    _check_magnitude,
+    as_vector,
+    check_int,
+    check_real,
+    check_seed,
+)
 from ..._trajectory import interp_columns
 from .data import ClfdTask, TangentChart
 
@@ -78,9 +87,11 @@ class ClfdMethod:
 
     def __init__(self):
         self._charts: list[TangentChart] = []
+        self._widths: list[int] = []  # each task's pose columns: what its starts must have
 
     def learn(self, task: ClfdTask) -> None:
         """Learn ``task`` (all its demonstrations)."""
+        self._record(task)
         chart = TangentChart.of_task(task)
         self._charts.append(chart)
         self._learn_curves(chart.curves(task.poses), task.times[0])
@@ -88,8 +99,39 @@ class ClfdMethod:
     def reproduce(self, index: int, starts: np.ndarray, t: np.ndarray) -> np.ndarray:
         """(M, T, D [+ 4]): task ``index`` reproduced from each of ``starts`` (M, D [+ 4]) on the
         time vector ``t`` (T,), s."""
+        index, starts, t = self._request(index, starts, t)
         chart = self._chart(index)
         return chart.poses(self._reproduce_curves(index, chart.curves(starts), t))
+
+    def _record(self, task) -> None:
+        """Refuse what is not a task; keep its pose columns (what a start of it has)."""
+        if not isinstance(task, ClfdTask):
+            raise TypeError(
+                f"task must be a bidmp.experiments.ClfdTask (clfd_tasks gives them), got "
+                f"{type(task).__name__}"
+            )
+        self._widths.append(task.poses.shape[2])
+
+    def _request(self, index, starts, t) -> tuple[int, np.ndarray, np.ndarray]:
+        """``reproduce``'s arguments checked: a task learned, one start (D [+ 4]) per motion, a
+        time vector of two or more increasing stamps (s)."""
+        learned = len(self._widths)
+        if not learned:
+            raise ValueError(f"index: {self.name} has learned no task yet (call learn(task))")
+        index = check_int(index, "index", minimum=0, maximum=learned - 1)
+        width = self._widths[index]
+        starts = _as_bounded_array(starts, "starts", 2)
+        if starts.ndim != 2 or starts.shape[1] != width or starts.shape[0] == 0:
+            raise ValueError(
+                f"starts must be (M, {width}), one start per motion as task {index}'s poses have "
+                f"them, got shape {starts.shape}"
+            )
+        _check_finite(starts, "starts")
+        _check_magnitude(starts, "starts")
+        t = as_vector(t, "t", min_length=2)
+        if np.any(np.diff(t) <= 0.0):
+            raise ValueError("t must increase (the time vector of the motions, s)")
+        return index, starts, t
 
     def _chart(self, index: int) -> TangentChart:
         return self._charts[index]
@@ -114,7 +156,7 @@ class DMPLibrary(ClfdMethod):
 
     def __init__(self, n_kernels: int = CLFD_KERNELS):
         super().__init__()
-        self.n_kernels = n_kernels
+        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=2, limit="max_kernels")
         self._skills: list = []
 
     def _learn_curves(self, curves, t) -> None:
@@ -140,14 +182,22 @@ class FineTune(ClfdMethod):
 
     def __init__(self, n_kernels: int = CLFD_KERNELS):
         super().__init__()
-        self.n_kernels = n_kernels
+        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=2, limit="max_kernels")
         self._latest = None
 
     def learn(self, task: ClfdTask) -> None:
+        self._record(task)
         self._latest = DMPLibrary(self.n_kernels)
         self._latest.learn(task)
 
     def reproduce(self, index, starts, t):
+        index, starts, t = self._request(index, starts, t)
+        latest = self._widths[-1]
+        if starts.shape[1] != latest:
+            raise ValueError(
+                f"starts: task {index} has {starts.shape[1]} pose columns, the latest task (which "
+                f"reproduces every task) {latest}"
+            )
         return self._latest.reproduce(0, starts, t)
 
     @property
@@ -165,7 +215,8 @@ class ProMPLibrary(ClfdMethod):
 
     def __init__(self, n_basis: int = CLFD_BASIS, cov_reg: float = CLFD_COV_REG):
         super().__init__()
-        self.n_basis, self.cov_reg = n_basis, cov_reg
+        self.n_basis = check_int(n_basis, "n_basis", minimum=2, limit="max_kernels")
+        self.cov_reg = check_real(cov_reg, "cov_reg", positive=True, maximum=1e3)
         self._skills: list = []
 
     def _learn_curves(self, curves, t) -> None:
@@ -199,7 +250,8 @@ class BiDMPLibrary(ClfdMethod):
 
     def __init__(self, n_kernels: int = CLFD_KERNELS, seed: int = 0):
         super().__init__()
-        self.n_kernels, self.seed = n_kernels, seed
+        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=2, limit="max_kernels")
+        self.seed = check_int(seed, "seed", minimum=0, maximum=2**32 - 1)
         self._model = None
 
     def _learn_curves(self, curves, t) -> None:
@@ -275,13 +327,15 @@ class ContinualBLS(ClfdMethod):
         seed: int = 0,
     ):
         super().__init__()
-        from ..._checks import check_choice, check_int, check_seed
+        from ..._checks import check_choice
 
         self.primitive = check_choice(primitive, "primitive", ("promp", "dmp"))
-        self.n_kernels, self.n_basis = n_kernels, n_basis
+        self.n_kernels = check_int(n_kernels, "n_kernels", minimum=2, limit="max_kernels")
+        self.n_basis = check_int(n_basis, "n_basis", minimum=2, limit="max_kernels")
         self.n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=100_000)
         self.capacity = check_int(capacity, "capacity", minimum=1, maximum=100_000)
-        self.ridge, self.seed = ridge, seed
+        self.ridge = check_real(ridge, "ridge", nonnegative=True, maximum=1.0)
+        self.seed = seed
         rng = check_seed(seed)
         self._projection = rng.normal(size=(n_nodes, capacity))
         self._bias = rng.normal(size=n_nodes)
@@ -294,12 +348,14 @@ class ContinualBLS(ClfdMethod):
 
     def task_nodes(self, index: int) -> np.ndarray:
         """(n_nodes,): the enhancement nodes of task ``index``'s one-hot code."""
+        index = check_int(index, "index", minimum=0, maximum=self.capacity - 1)
         return np.tanh(self._projection[:, index] + self._bias)
 
     def learn(self, task: ClfdTask) -> None:
         if self._seen >= self.capacity:
             raise ValueError(f"bidmp-continual holds {self.capacity} tasks (its capacity)")
         target = self.task_target(task)
+        self._record(task)
         if self._gram is None:
             self._pose = task.orientations is not None  # a pose task: the chart's reference too
             self._gram = np.zeros((self.n_nodes, self.n_nodes))
@@ -314,6 +370,11 @@ class ContinualBLS(ClfdMethod):
     def task_target(self, task: ClfdTask) -> np.ndarray:
         """The flat output the BLS learns for ``task``: its primitive's parameters, then its
         chart's reference quaternion on a pose task."""
+        if not isinstance(task, ClfdTask):
+            raise TypeError(
+                f"task must be a bidmp.experiments.ClfdTask (clfd_tasks gives them), got "
+                f"{type(task).__name__}"
+            )
         chart = TangentChart.of_task(task)
         curves, t = chart.curves(task.poses), task.times[0]
         if self.primitive == "dmp":

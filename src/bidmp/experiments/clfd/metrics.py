@@ -10,11 +10,13 @@ import numpy as np
 from ..._checks import (
     _as_bounded_array,
     _check_finite,
+    _check_magnitude,
     as_trajectory,
     as_vector,
     check_choice,
     check_real,
 )
+from ..._norms import row_norms, unit_rows
 from ...extension.similarity import dtw_distance, frechet_distance
 from ...tasks.metrics import swept_area
 
@@ -50,8 +52,9 @@ def demonstration_errors(reproduced: np.ndarray, demonstrations: np.ndarray, met
             "reproduced and demonstrations must be (M, T, D) of one shape, got "
             f"{reproduced.shape} and {demonstrations.shape}"
         )
-    _check_finite(reproduced, "reproduced")
-    _check_finite(demonstrations, "demonstrations")
+    for name, array in (("reproduced", reproduced), ("demonstrations", demonstrations)):
+        _check_finite(array, name)
+        _check_magnitude(array, name)  # (named here, not as the distances' a and b)
     if not isinstance(metrics, (list, tuple, dict)) or not metrics or len(metrics) > 4:
         raise TypeError("metrics must be a sequence of metric names (at most 4)")
     for metric in metrics:
@@ -95,24 +98,17 @@ def orientation_error(true, predicted) -> float:
             f"true and predicted must be quaternions (T, 4) of equal length, got {true.shape} and "
             f"{predicted.shape}"
         )
-    true, predicted = _unit_rows(true, "true"), _unit_rows(predicted, "predicted")
+    for name, quaternions in (("true", true), ("predicted", predicted)):
+        zero = row_norms(quaternions) == 0.0  # (scaled first: a row of 1e-300 is a direction)
+        if np.any(zero):
+            raise ValueError(
+                f"{name}: row {int(np.argmax(zero))} is a zero quaternion, which is no rotation"
+            )
+    true, predicted = unit_rows(true), unit_rows(predicted)
     # the real part of q_true ⊗ conj(q_pred) is their dot product; the angle of the relative
     # rotation is 2 acos(|w|), which is ‖2 log(·)‖ taken the shorter way
     w = np.clip(np.abs(np.sum(true * predicted, axis=1)), 0.0, 1.0)
     return float(np.mean(2.0 * np.arccos(w)))
-
-
-def _unit_rows(q: np.ndarray, name: str) -> np.ndarray:
-    """Quaternion rows made unit length, each scaled by its largest component first (so that
-    rows of 1e-300 normalise instead of underflowing to a zero norm); a zero row is refused."""
-    largest = np.max(np.abs(q), axis=1, keepdims=True)
-    if np.any(largest == 0.0):
-        raise ValueError(
-            f"{name}: row {int(np.argmax(largest[:, 0] == 0.0))} is a zero quaternion, which is "
-            f"no rotation"
-        )
-    scaled = q / largest
-    return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
 
 def accuracy_matrix(errors: list[list[np.ndarray]], threshold: float) -> np.ndarray:
@@ -152,6 +148,11 @@ def continual_metrics(
         raise ValueError("matrix must hold accuracies in [0, 1] on and below its diagonal")
     if largest_size is not None:
         largest_size = check_real(largest_size, "largest_size", positive=True)
+        if largest_size < sizes[-1]:  # FS = 1 - size / largest compared, in [0, 1]
+            raise ValueError(
+                f"largest_size must be at least the model's own size {sizes[-1]:g} (the largest "
+                f"model compared), got {largest_size:g}"
+            )
     acc = float(np.sum(matrix[lower]) / (n * (n + 1) / 2))
     below = np.tril_indices(n, -1)
     bwt = float(np.mean(matrix[below] - np.diag(matrix)[below[1]])) if n > 1 else 0.0

@@ -8,12 +8,13 @@ import inspect
 import json
 import logging
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..._checks import check_choice, check_int
+from ..._checks import check_choice, check_int, short_token
 from ..._progress import report
 from .data import ClfdTask, clfd_tasks
 from .methods import METHODS
@@ -173,9 +174,10 @@ def run_clfd(  # noqa: PLR0913 - the protocol's knobs, each one a command-line o
     if n_tasks is not None:
         n_tasks = check_int(n_tasks, "n_tasks", minimum=1, maximum=len(tasks))
     workers = check_int(workers, "workers", minimum=1, maximum=256)
-    seeds = [check_int(s, "seeds", minimum=0, maximum=2**31) for s in seeds]
+    seeds = [check_int(s, "seeds", minimum=0, maximum=2**31) for s in _listed(seeds, "seeds")]
     if not seeds:
         raise ValueError("seeds must hold at least one seed")
+    methods = _listed(methods, "methods")
     for name in methods:
         check_choice(name, "methods", tuple(METHODS))
     cells = [(name, s) for name in methods for s in (seeds if _seeded(name) else [None])]
@@ -195,6 +197,19 @@ def run_clfd(  # noqa: PLR0913 - the protocol's knobs, each one a command-line o
     rows = {name: runs[0] for name, runs in seed_rows.items()}
     names = [task.name for task in tasks[:n_tasks]]
     return ClfdResult(dataset, names, rows, seed_rows)
+
+
+def _listed(values, name: str) -> list:
+    """``values`` as a list: a sequence (list, tuple, range) or 1-D array of them (a scalar, or
+    one method's name as a string, is refused: one cell's value where the list of cells goes)."""
+    if isinstance(values, np.ndarray) and values.ndim == 1:
+        values = values.tolist()
+    if isinstance(values, (str, bytes)) or not isinstance(values, Sequence):
+        shown = f"{type(values).__name__} {short_token(values)}"
+        raise TypeError(f"{name} must be a list (one cell per entry), got {shown}")
+    if len(values) > 1000:
+        raise ValueError(f"{name} holds {len(values):,} entries, more than 1000 cells")
+    return list(values)
 
 
 def _run_cell(
