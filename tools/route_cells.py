@@ -17,7 +17,7 @@ import os
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -127,6 +127,33 @@ def failures(outcomes) -> str:
     return "\n".join(lines)
 
 
+def report(outcomes, seeds, command: str, planned: int) -> str:
+    """The Markdown of the cells run so far (``planned``: how many the run was asked for)."""
+    done = sorted(outcome.facts.seed for outcome in outcomes)
+    ran = f"{len(outcomes)} of {planned}" if len(outcomes) < planned else f"{len(outcomes)}"
+    text = (
+        f"{ran} random users' cells (seeds {', '.join(map(str, done)) or '-'}; "
+        f"tests/sim/route_oracle.py), written by `{command}`. *With a route*: the oracle's plain RRT "
+        f"({ORACLE_CHECKS} configurations) joins the arm's start to the top of the target's final "
+        "approach, the approach down its axis free. *Owed*: with a route, and for the simulator "
+        "every motion's start (the demonstration's) joined to the arm's, for the job its retract "
+        "free and every drop over the bin routed too; *solved*: task successes (in brackets: of "
+        "those owed).\n\n" + table(outcomes) + "\n"
+    )
+    text += (
+        "\nSeconds per cell (oracle, demo, sim, job): "
+        + ", ".join(
+            f"{o.facts.seed}: "
+            + "/".join(f"{o.seconds.get(k, 0.0):.0f}" for k in ("oracle", "demo", "sim", "job"))
+            for o in outcomes
+        )
+        + "\n"
+    )
+    broken = failures(outcomes)
+    text += "\n" + (f"Failures:\n\n{broken}\n" if broken else "No failures.\n")
+    return text
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cells", type=int, default=int(os.environ.get("BIDMP_ROUTE_CELLS", "40")))
@@ -134,35 +161,36 @@ def main() -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default=str(OUT), help=f"the Markdown table (default {OUT})")
     args = parser.parse_args()
+    if not 1 <= args.cells <= 10_000 or not 0 <= args.first <= 10**6:
+        parser.error("--cells must be 1 to 10000 and --first 0 to 1000000")
+    if not 1 <= args.workers <= 64:
+        parser.error("--workers must be 1 to 64")
+    from bidmp.io import atomic_write
+
     seeds = range(args.first, args.first + args.cells)
+    command = (
+        f"python tools/route_cells.py --cells {args.cells} --first {args.first} "
+        f"--workers {args.workers}"
+    )
     outcomes = []
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
-        for outcome, seconds in pool.map(one, seeds):
+        for future in as_completed([pool.submit(one, seed) for seed in seeds]):
+            outcome, seconds = future.result()
             outcomes.append(outcome)
             print(
                 f"cell {outcome.facts.seed} ({outcome.facts.arm}): {len(outcome.rows)} targets, "
                 f"{len(outcome.unsolved())} unsolved, {len(outcome.refused)} refused, "
-                f"{len(outcome.unreachable)} unreachable with a solution, {seconds:.0f} s",
+                f"{len(outcome.unreachable)} unreachable with a solution, {seconds:.0f} s "
+                f"{ {k: round(v) for k, v in outcome.seconds.items()} }",
                 flush=True,
             )
-    text = (
-        f"{len(outcomes)} random users' cells (seeds {seeds.start}-{seeds.stop - 1}, "
-        "tests/sim/route_oracle.py; `make routes`). *With a route*: the oracle's plain RRT "
-        f"({ORACLE_CHECKS} configurations) joins the arm's start to the top of the target's final "
-        "approach, the approach down its axis free. *Owed*: with a route, and for the simulator "
-        "every motion's start (the demonstration's) joined to the arm's, for the job its retract "
-        "free and every drop over the bin routed too; *solved*: task successes (in brackets: of "
-        "those owed).\n\n" + table(outcomes) + "\n"
-    )
-    broken = failures(outcomes)
-    text += "\n" + (f"Failures:\n\n{broken}\n" if broken else "No failures.\n")
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    from bidmp.io import atomic_write
-
-    with atomic_write(args.out, "w") as handle:
-        handle.write(text)
+            # written after every cell: a run cut short leaves the cells it finished
+            with atomic_write(args.out, "w") as handle:
+                handle.write(report(outcomes, seeds, command, args.cells))
+    text = report(outcomes, seeds, command, args.cells)
     print(text)
-    return 1 if broken else 0
+    return 1 if failures(outcomes) else 0
 
 
 if __name__ == "__main__":
