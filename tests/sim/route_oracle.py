@@ -1237,7 +1237,7 @@ class CellOutcome:
     facts: CellFacts
     rows: dict
     start_leg: Leg
-    bin_leg: Leg
+    bin_leg: Leg | None
     refused: list = field(default_factory=list)
     unreachable: list = field(default_factory=list)
     seconds: dict = field(default_factory=dict)
@@ -1249,6 +1249,8 @@ class CellOutcome:
         decision = self.rows[label].decision
         if where == "sim":
             return decision.approach and self.start_leg.ok
+        if self.bin_leg is None:  # (no job ran: the bin's routes were not asked)
+            return False
         return decision.approach and decision.retract and self.bin_leg.ok
 
     def unsolved(self) -> list:
@@ -1266,9 +1268,11 @@ class CellOutcome:
 def run_cell(
     seed: int, folder, *, demo: bool = True, sim_labels=None, job_labels=None
 ) -> CellOutcome:
-    """Cell ``seed`` written into ``folder``, every target decided by the oracle, then bidmp's
-    evaluation (``demo``), simulator (its targets ``sim_labels``, default all; ``()`` none) and
-    job (``job_labels``) with every executed motion checked here."""
+    """Cell ``seed`` written into ``folder``, its targets decided by the oracle (every one where
+    the evaluation runs or a target set is all; else the ones the simulator and the job run, and
+    the bin's routes only where a job runs), then bidmp's evaluation (``demo``), simulator (its
+    targets ``sim_labels``, default all; ``()`` none) and job (``job_labels``) with every executed
+    motion checked here."""
     import json
 
     from bidmp.tasks import evaluate, scenarios
@@ -1278,8 +1282,14 @@ def run_cell(
     scenario = scenarios.load(str(path))
     began = time.perf_counter()
     oracle = RouteOracle(spec, folder)
-    rows = {label: TargetRow(oracle.decide(label)) for label in scenario.labels}
-    outcome = CellOutcome(facts, rows, oracle.start_leg(), oracle.bin_leg())
+    if demo or sim_labels is None or job_labels is None:
+        decided = list(scenario.labels)
+    else:
+        asked = {*sim_labels, *job_labels}
+        decided = [label for label in scenario.labels if label in asked]
+    rows = {label: TargetRow(oracle.decide(label)) for label in decided}
+    jobs = job_labels is None or len(job_labels) > 0
+    outcome = CellOutcome(facts, rows, oracle.start_leg(), oracle.bin_leg() if jobs else None)
     outcome.seconds["oracle"] = time.perf_counter() - began
     if demo:
         began = time.perf_counter()
