@@ -7,7 +7,7 @@ the property on every target: with a route, a task success on the simulated arm 
 job; no motion that ran breaks the contract by the checks written here; no target called
 unreachable where the oracle's inverse kinematics reaches it.
 
-Here a small version (two cells, the simulator on one target of each); ``make routes``
+Here a small version (one cell, the simulator on one target); ``make routes``
 runs the whole property on BIDMP_ROUTE_CELLS cells (default 40) and writes
 docs/results/route_cells.md (tools/route_cells.py)."""
 
@@ -257,13 +257,14 @@ def test_the_checks_can_fail():
 # ---------------------------------------------------------------------------------------------
 # The property, small (make routes: the whole of it)
 # ---------------------------------------------------------------------------------------------
-SMALL = {3: ("c1r1",), 7: ("c1r1",)}
+# (cell 7's c1r1, the xArm6 behind a post, passes too but costs four times as much: make routes)
+SMALL = {3: ("c1r1",)}
 
 
 @pytest.mark.parametrize("seed", sorted(SMALL))
 def test_every_target_with_a_route_is_solved_in_the_simulator(seed, tmp_path):
-    """Two cells (the UR5 in metres, the xArm6), the oracle on one target of each (on the tilted
-    face or behind a post), the simulator on it: a target the oracle owes is a task success, no
+    """A cell (the UR5 in metres), the oracle on one target (on the tilted face, behind a post),
+    the simulator on it: a target the oracle owes is a task success, no
     motion that ran breaks the contract, no reachable target is called unreachable. (The job and
     every target of 40 cells: ``make routes``.)"""
     labels = SMALL[seed]
