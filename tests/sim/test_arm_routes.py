@@ -430,3 +430,56 @@ def test_a_jobs_route_to_a_nut_ends_where_the_arm_can_go_back_up_the_axis(tmp_pa
     for height in np.arange(0.002, 0.0601, 0.002):
         q, error = arm.solve_ik(target[:3] + axis * height, target[3:], q, iterations=30)
         assert error < 5e-5, height
+
+
+def test_a_configuration_free_for_the_route_is_free_in_pybullet():
+    """The route's model of the links (pinocchio, the meshes' convex hulls) against PyBullet's own
+    closest points, the contacts the contract counts: Bullet grows a mesh's hull by its collision
+    margin (1 mm), so a link the route kept 0.6 mm clear touched a post (the route oracle's cell 1
+    dropped two nuts so, cell 0 had five routes refused by the PyBullet check). The Panda at its
+    rest pose turned by its first joint into a tall post, across the first contact in 0.1 mrad
+    steps: wherever the route's space calls the arm free (links asked to keep nothing), PyBullet
+    finds no contact."""
+    from bidmp.scene import Scene
+    from bidmp.sim.routes import _arm
+
+    robot = ROBOT_MODELS["panda"]
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 0.0125, "length": 0.1},
+            "parts": [
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [0.3 * math.cos(0.6), 0.3 * math.sin(0.6), 0.0],
+                    "radius": 0.02,
+                    "height": 1.2,
+                }
+            ],
+        }
+    )
+    rest = np.asarray(robot.rest, dtype=float)
+    with sim.RobotCell(scene, "m", [0.0, 0.0, 0.0], 0.0, robot) as cell:
+        space = _arm(cell).space(scene, 1.0, exclude=[], margin=0.0, links=0.0)
+        (post,) = [body for body, owner in cell._owners.items() if owner == "post"]
+
+        def pybullet(turn: float) -> float:
+            q = rest.copy()
+            q[0] = turn
+            cell._set_joints(q)
+            points = cell.p.getClosestPoints(cell.robot, post, 0.05, physicsClientId=cell.client)
+            return min((float(point[8]) for point in points), default=0.05)
+
+        clear, touching = 0.0, 0.6
+        assert pybullet(clear) > 0.0 and pybullet(touching) < 0.0
+        for _ in range(40):  # the first contact, from PyBullet alone
+            middle = 0.5 * (clear + touching)
+            clear, touching = (middle, touching) if pybullet(middle) > 0.0 else (clear, middle)
+        free = 0
+        for turn in clear + np.linspace(-0.01, 0.005, 151):
+            q = rest.copy()
+            q[0] = turn
+            if space.slack(q) >= 0.0:
+                free += 1
+                assert pybullet(turn) >= 0.0, (turn, pybullet(turn), space.nearest(q))
+        assert free > 50  # (the sweep reaches well into the free side)

@@ -5,7 +5,8 @@ against (:mod:`bidmp.sim.routes`).
 Built from the same URDF the simulator loads (the scenario's arm with the scenario's tool on its
 flange), by pinocchio (the arm's kinematics, its links placed in microseconds) and coal (the same
 distance library the motion contract's clearance uses). A link's mesh is taken as its convex hull,
-as PyBullet takes it for contacts, so a configuration free here is free there too. The parts are
+as PyBullet takes it for contacts, and kept the further 1 mm Bullet grows a hull by (its collision
+margin), so a configuration free here is free there too. The parts are
 the scene's solids, in metres, in the arm's base frame.
 
 Why not PyBullet's own closest points: setting the arm's joints and asking each part costs half
@@ -77,10 +78,12 @@ class ArmGeometry:
                 f"{robot.n_joints} revolute or prismatic joints: no route of its own"
             )
         self.geometry = pin.buildGeomFromUrdfString(self.model, text, pin.GeometryType.COLLISION)
+        self.hulls = set()  # the links' meshes, taken as their hulls (grown by Bullet's margin)
         for item in self.geometry.geometryObjects:
             if isinstance(item.geometry, coal.BVHModelBase):  # PyBullet contacts a mesh's hull
                 item.geometry.buildConvexHull(True, "Qt")
                 item.geometry = item.geometry.convex
+                self.hulls.add(item.name)
         self.data = self.model.createData()
         self.tcp = self.model.getFrameId("tcp")
         turn = math.radians(float(yaw))
@@ -307,6 +310,8 @@ class ArmSpace:
     part beyond its clearance (m), the sweep bounds how far any point of the arm moves."""
 
     def __init__(self, arm: ArmGeometry, scene, unit: float, exclude: list, margins, carried=None):
+        from .pybullet.world import HULL_MARGIN
+
         pin = _pinocchio()
         self.arm = arm
         margin, links = margins
@@ -316,7 +321,7 @@ class ArmSpace:
         self.lower = np.asarray(arm.limits.lower, dtype=float)
         self.upper = np.asarray(arm.limits.upper, dtype=float)
         geometry = pin.GeometryModel()
-        arm_shapes, tools = [], set()
+        arm_shapes, tools, grown = [], set(), set()
         for item in arm.geometry.geometryObjects:
             if item.parentJoint == 0:
                 continue  # the base link never moves: it is not tested against the parts
@@ -324,6 +329,8 @@ class ArmSpace:
             arm_shapes.append(index)
             if arm.model.frames[item.parentFrame].name == "tool":  # (the tool's link: _tool_urdf)
                 tools.add(index)
+            if item.name in arm.hulls:
+                grown.add(index)
         held = None
         if carried is not None:
             held = geometry.addGeometryObject(_carried_object(pin, arm, carried, unit))
@@ -354,7 +361,10 @@ class ArmSpace:
                     keep = required
                 else:
                     keep = min(links, required)
-                pairs.append(_Pair(shape_index, part, keep + self.tolerance))
+                # Bullet grows a mesh's hull by its collision margin (1 mm) where it contacts the
+                # parts: a link 0.6 mm clear here touched a post there (the route oracle's cells)
+                grow = HULL_MARGIN if shape_index in grown else 0.0
+                pairs.append(_Pair(shape_index, part, keep + self.tolerance + grow))
         for pair in pairs:
             geometry.addCollisionPair(pin.CollisionPair(pair.arm, pair.part))
         self.geometry, self.data = geometry, pin.GeometryData(geometry)
