@@ -12,7 +12,7 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp results-check
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells routes user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp results-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
@@ -72,6 +72,15 @@ sim: $(STAMP)
 # the pad cells and the tilted pads of the evaluation.
 random-cells: $(STAMP)
 	BIDMP_RANDOM_CELLS=300 $(PY) -m pytest -q -n 2 tests/tasks/test_random_user_cells.py tests/tasks/test_random_cells.py tests/tasks/test_random_tilted_cells.py tests/tasks/test_tilted_user_cells.py
+
+# The route property on 40 random users' cells (tests/sim/test_route_cells.py runs two targets of two
+# cells): five arms (one from a URDF), mm/cm/m, posts by the elbow's path and between the columns,
+# faces tilted 10-30 degrees, bins at the wrist's singularity; an oracle of the tests' own (plain
+# RRT, 20x the pipeline's budget, its own IK and seed) decides which targets have a route, and every
+# one that has must be solved in sim and job with no motion breaking the contract:
+# docs/results/route_cells.md (exit 1 on a failure).
+routes: $(STAMP)
+	$(PY) tools/route_cells.py --cells 40 --workers 2
 
 # The avoidance on 200 random fields at 1 kHz (the tests run 50 at 250 Hz), then the
 # benchmark against movement_primitives on 50 fields: docs/results/avoidance.md, docs/avoidance.png.

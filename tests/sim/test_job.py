@@ -103,6 +103,33 @@ def test_a_part_released_outside_the_bin_is_reported(monkeypatch):
     assert not in_bin(target.final_position, NUT)
 
 
+def test_a_drop_refused_before_it_ran_keeps_its_refusal_in_the_reason(monkeypatch):
+    """A drop the contract refuses before it runs (and the arm has no route for) lets the nut go
+    where the tool is: the target's reason is the refusal and where the nut fell, not only
+    "released outside the bin" (which hid why the drop did not run)."""
+    from bidmp.sim import job_world
+    from bidmp.sim.job_report import JobPhase
+
+    refused = job_world._refused_plan
+
+    def refuse_the_drop(world, plan, contract, move, goal):
+        if move.name == "drop":
+            return JobPhase(
+                "drop", False, 0.0, "not run: the contract refuses its plan: a stand-in"
+            )
+        return refused(world, plan, contract, move, goal)
+
+    monkeypatch.setattr(job_world, "_refused_plan", refuse_the_drop)
+    monkeypatch.setattr(job_world, "_routed", lambda *args: (None, "no route (a stand-in)"))
+    report = run_job(scenarios.from_dict(NUT), targets=["3"])
+    (target,) = report.targets
+    assert not target.removed
+    assert target.reason.startswith(
+        "drop: not run: the contract refuses its plan: a stand-in; the arm's own route: no route "
+        "(a stand-in); released outside the bin: the nut lies at ["
+    ), target.reason
+
+
 def test_a_layout_nobody_tuned_every_nut_off_or_one_line_why():
     """Another grid (3 x 2 at 40 mm), studs twice as tall, the bin on the other side: the same
     demonstration's skills, no parameter changed."""

@@ -466,3 +466,61 @@ def test_a_near_miss_of_a_nut_is_no_contact(cell, nut):
         finally:
             p.removeBody(probe, physicsClientId=client)
         assert distance == pytest.approx(gap, abs=5e-5), gap
+
+
+def test_a_motion_that_turns_the_tool_is_judged_with_the_tool_as_it_was_turned():
+    """The arm's own route turns the tool as its joints go, in a position scenario too: the
+    executed motion is judged with the measured tool frames (an upright tool's clearance was
+    judged, so a route whose tilted tool came within the margin of a part passed, and one whose
+    upright twin would have touched was refused). A tool 30 degrees off vertical towards a post
+    40 mm from its mouth: its body reaches into the post, which an upright tool clears by 25 mm;
+    a skill's plan (no frames: the tool held pointing down) is judged upright as before."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.scene import Scene
+    from bidmp.sim import PANDA
+    from bidmp.sim.backend import Execution, MotionPlan
+    from bidmp.sim.report import _measure, _SimTask
+    from bidmp.tasks.contract import Contract
+
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 10.0, "length": 100.0},
+            "margin": 3.0,
+            "parts": [
+                {
+                    "type": "cylinder",
+                    "label": "post",
+                    "at": [40.0, 0.0, -50.0],
+                    "radius": 5.0,
+                    "height": 250.0,
+                }
+            ],
+        }
+    )
+    task = _SimTask({"T": [0.0, 0.0, 0.0]}, "mm", 1.75, 25.0, {"T": None}, None)
+    contract = Contract(1.75, 25.0, scene, "mm", limits=PANDA)
+    n = 200
+    path = np.column_stack([np.zeros(n), np.zeros(n), np.linspace(80.0, 0.0, n)]) * 1e-3
+    # the tool's body (up from the mouth, against its z axis) leaning towards +x, the post's side
+    lean = Rotation.from_euler("y", 30.0, degrees=True) * Rotation.from_euler(
+        "x", 180.0, degrees=True
+    )
+    tilted = np.tile(lean.as_quat(), (n, 1))
+    still = np.tile(np.asarray(sim.robots.PANDA_MODEL.rest), (n, 1))
+    run = Execution(
+        np.linspace(0.0, 1.0, n),
+        path,
+        still,
+        np.zeros((n, 7)),
+        path,
+        {},
+        tcp_orientation=tilted,
+        commands=still,
+    )
+    verdicts = {}
+    for name, turns in (("route", tilted), ("skill", None)):
+        plan = MotionPlan("T", path, np.linspace(0.0, 1.0, n), still, 1.0, None, 0.1, 0.1, turns)
+        measured = _measure(task, "T", np.zeros(3), (plan, run), 1e-3, False, (PANDA, contract, []))
+        verdicts[name] = measured.verdict.clearance.part, measured.verdict.clearance.distance < 3.0
+    assert verdicts == {"route": ("post", True), "skill": ("post", False)}, verdicts

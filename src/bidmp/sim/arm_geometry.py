@@ -5,7 +5,8 @@ against (:mod:`bidmp.sim.routes`).
 Built from the same URDF the simulator loads (the scenario's arm with the scenario's tool on its
 flange), by pinocchio (the arm's kinematics, its links placed in microseconds) and coal (the same
 distance library the motion contract's clearance uses). A link's mesh is taken as its convex hull,
-as PyBullet takes it for contacts, so a configuration free here is free there too. The parts are
+as PyBullet takes it for contacts, and kept the further 1 mm Bullet grows a hull by (its collision
+margin), so a configuration free here is free there too. The parts are
 the scene's solids, in metres, in the arm's base frame.
 
 Why not PyBullet's own closest points: setting the arm's joints and asking each part costs half
@@ -77,10 +78,12 @@ class ArmGeometry:
                 f"{robot.n_joints} revolute or prismatic joints: no route of its own"
             )
         self.geometry = pin.buildGeomFromUrdfString(self.model, text, pin.GeometryType.COLLISION)
+        self.hulls = set()  # the links' meshes, taken as their hulls (grown by Bullet's margin)
         for item in self.geometry.geometryObjects:
             if isinstance(item.geometry, coal.BVHModelBase):  # PyBullet contacts a mesh's hull
                 item.geometry.buildConvexHull(True, "Qt")
                 item.geometry = item.geometry.convex
+                self.hulls.add(item.name)
         self.data = self.model.createData()
         self.tcp = self.model.getFrameId("tcp")
         turn = math.radians(float(yaw))
@@ -160,7 +163,14 @@ class ArmGeometry:
         )
 
     def solve_ik(
-        self, point, frame, seed, *, free_turn: bool = True, iterations: int = 200
+        self,
+        point,
+        frame,
+        seed,
+        *,
+        free_turn: bool = True,
+        iterations: int = 200,
+        inside: float = 0.0,
     ) -> tuple[np.ndarray, float]:
         """Joints within the limits that put the tool's mouth at ``point`` (m, world) with its
         frame ``frame`` (a quaternion x, y, z, w; its z axis the approach direction), from joints
@@ -172,6 +182,9 @@ class ArmGeometry:
         space. The damping grows near a singularity (a wrist with joints 4 and 6 aligned) instead
         of stepping across it: from another seed the other branch is found. Stops where the
         mouth is within 0.1 µm and the axis within 0.1 µrad, or after ``iterations``.
+        ``inside``: radians kept inside each joint's range (one for all, or one per joint; at most
+        a tenth of the range): a spline timed through such solutions does not overshoot the range
+        where a joint is at its end.
         """
         from ..primitives.so3 import as_quaternions
 
@@ -185,6 +198,14 @@ class ArmGeometry:
         free_turn = check_bool(free_turn, "free_turn")
         iterations = check_int(iterations, "iterations", minimum=1, maximum=10_000)
         lower, upper = np.asarray(self.limits.lower), np.asarray(self.limits.upper)
+        if np.ndim(inside) == 0:
+            inside = np.full(q.size, check_real(inside, "inside", nonnegative=True))
+        else:
+            inside = as_point(inside, model.nq, "inside", like="the arm's joints")
+            if np.any(inside < 0.0):
+                raise ValueError("inside must be 0 or more radians for every joint")
+        inside = np.minimum(inside, 0.1 * (upper - lower))
+        lower, upper = lower + inside, upper - inside
         middle, span = 0.5 * (lower + upper), upper - lower
         inverse = self.rotation.T
         target = inverse @ (point - self.base)
@@ -289,6 +310,8 @@ class ArmSpace:
     part beyond its clearance (m), the sweep bounds how far any point of the arm moves."""
 
     def __init__(self, arm: ArmGeometry, scene, unit: float, exclude: list, margins, carried=None):
+        from .pybullet.world import HULL_MARGIN
+
         pin = _pinocchio()
         self.arm = arm
         margin, links = margins
@@ -298,7 +321,7 @@ class ArmSpace:
         self.lower = np.asarray(arm.limits.lower, dtype=float)
         self.upper = np.asarray(arm.limits.upper, dtype=float)
         geometry = pin.GeometryModel()
-        arm_shapes, tools = [], set()
+        arm_shapes, tools, grown = [], set(), set()
         for item in arm.geometry.geometryObjects:
             if item.parentJoint == 0:
                 continue  # the base link never moves: it is not tested against the parts
@@ -306,10 +329,13 @@ class ArmSpace:
             arm_shapes.append(index)
             if arm.model.frames[item.parentFrame].name == "tool":  # (the tool's link: _tool_urdf)
                 tools.add(index)
+            if item.name in arm.hulls:
+                grown.add(index)
+        held = None
         if carried is not None:
-            index = geometry.addGeometryObject(_carried_object(pin, arm, carried, unit))
-            arm_shapes.append(index)
-            tools.add(index)
+            held = geometry.addGeometryObject(_carried_object(pin, arm, carried, unit))
+            arm_shapes.append(held)
+            tools.add(held)
         inverse = arm.rotation.T
         pairs = []
         for solid in scene.solids:
@@ -326,8 +352,19 @@ class ArmSpace:
             stand = scene.standoff.get(solid.part)
             required = margin if stand is None else min(stand * unit, margin)
             for shape_index in arm_shapes:
-                keep = required if shape_index in tools else min(links, required)
-                pairs.append(_Pair(shape_index, part, keep + self.tolerance))
+                # a stand-off lets the tool near the part it works on; a part the tool carries
+                # keeps the margin from every part, as the motion contract's clearance asks; the
+                # links only the links' allowance (the contract asks them not to touch)
+                if shape_index == held:
+                    keep = margin
+                elif shape_index in tools:
+                    keep = required
+                else:
+                    keep = min(links, required)
+                # Bullet grows a mesh's hull by its collision margin (1 mm) where it contacts the
+                # parts: a link 0.6 mm clear here touched a post there (the route oracle's cells)
+                grow = HULL_MARGIN if shape_index in grown else 0.0
+                pairs.append(_Pair(shape_index, part, keep + self.tolerance + grow))
         for pair in pairs:
             geometry.addCollisionPair(pin.CollisionPair(pair.arm, pair.part))
         self.geometry, self.data = geometry, pin.GeometryData(geometry)

@@ -248,7 +248,9 @@ def _drop(world: _World, part: MovablePart, exclude) -> JobPhase:
     _note(phase, note or "")
     if not in_bin(centre, world.spec.bin_floor, world.spec.bin[1]):
         phase.ok = False
-        phase.note = f"released outside the bin: the nut lies at {np.round(centre, 1).tolist()} {world.scenario.units}"
+        lies = np.round(centre, length_digits(world.scenario.units)).tolist()
+        # (a drop refused before it ran lets go where the tool is: its refusal is the reason)
+        _note(phase, f"released outside the bin: the nut lies at {lies} {world.scenario.units}")
     return phase
 
 

@@ -175,7 +175,9 @@ def _move(world: _World, move: _Move, on_record=None) -> JobPhase:
         world.motion.append((world.clock + arm["times"], arm["links"]))
     phase = _phase(name, run, plan, cell, touched)
     executed = run.tcp / cell.unit
-    tool_frames = run.tcp_orientation if world.pose else None
+    # the tool as it was turned: a pose's, or where the arm's own route turned it (a route turns
+    # the tool as its joints go, in a position scenario too)
+    tool_frames = run.tcp_orientation if world.pose or plan.orientations is not None else None
     clearance = _clearance(world, executed, exclude, carried, tool_frames, support)
     phase.verdict = contract.judge(
         executed,
@@ -272,6 +274,7 @@ def _routed(world: _World, move: _Move, contract, goal) -> tuple:
             label=f"{world.label} ({move.name})" if world.label else move.name,
             carried=carried,
             cone=DROP_CONE_DEG if move.name == "drop" else 0.0,
+            retract=_retract_length(world, target, move.axis) if approach else 0.0,
         )
     except SimError as exc:
         return None, str(exc)
@@ -281,12 +284,30 @@ def _routed(world: _World, move: _Move, contract, goal) -> tuple:
     planned = move._replace(
         path=path,
         fractions=plan.fractions,
-        orientations=plan.orientations if world.pose else None,
+        orientations=plan.orientations,  # the tool as the route turns it, judged so
     )
     refused = _refused_plan(world, plan, contract, planned, goal)
     if refused is not None:
         return None, refused.note
     return plan, ""
+
+
+def _retract_length(world: _World, target, axis) -> float:
+    """How far up its axis an unscrew job takes the tool from the target once the nut is in the
+    socket (scene units): off the top of the part's own solids along the axis (its stud's end),
+    the play, then the job's clearance; 0 for other jobs."""
+    if world.spec.kind != "unscrew":
+        return 0.0
+    axis = np.array([0.0, 0.0, 1.0]) if axis is None else np.asarray(axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    solids = [solid for solid in world.scenario.scene.solids if solid.part == world.label]
+    corners = [
+        np.array([[x, y, z] for x in (a[0], b[0]) for y in (a[1], b[1]) for z in (a[2], b[2])])
+        for a, b in ((solid.lower, solid.upper) for solid in solids)
+    ]
+    top = max((float(np.max(c @ axis)) for c in corners), default=float(np.dot(target[:3], axis)))
+    above = max(top - float(np.dot(np.asarray(target, dtype=float)[:3], axis)), 0.0)
+    return above + world.spec.play + world.spec.clearance
 
 
 def _refused_plan(world: _World, plan, contract, move: _Move, goal) -> JobPhase | None:

@@ -79,16 +79,10 @@ def plan_path(
     q = np.array(cell.rest, dtype=float) if seed is None else _joint_seed(seed, limits)
     joints = np.empty((points.shape[0], n_joints))
     for index, point in enumerate(points):
-        q, error = cell.solve_ik(point, q, None if turns is None else turns[index])
+        turn = None if turns is None else turns[index]
+        q, error = cell.solve_ik(point, q, turn)
         if error > IK_TOLERANCE:
-            digits = length_digits(_unit_name(cell.unit))  # 0.01 mm detail in the scene's unit
-            raise SimError(
-                f"target {label!r}: the point {np.round(point / cell.unit, digits).tolist()} of its motion is "
-                f"unreachable for the {cell.name} at base {np.round(cell.base, digits).tolist()} "
-                f"(inverse kinematics leaves {error / cell.unit:.3g} {_unit_name(cell.unit)}): out of "
-                f'its reach (move its base: scenario key "robot": {{"base": ...}}), or not from the '
-                f'joints it comes from (a start pose nearer it: "robot": {{"rest": [...]}}, rad)'
-            )
+            raise SimError(_not_followed(cell, label, point, turn, error))
         below, above = q < np.array(limits.lower) - 1e-9, q > np.array(limits.upper) + 1e-9
         if below.any() or above.any():
             joint = int(np.flatnonzero(below | above)[0])
@@ -156,6 +150,46 @@ def _slowed(plan: MotionPlan, duration: float) -> MotionPlan:
         plan.peak_acceleration *= scale**2
         plan.peak_jerk *= scale**3
     return plan
+
+
+_REACH_SEEDS = 8  # seeded draws (beside the rest pose and the ranges' middle) a point is tried from
+
+
+def _not_followed(cell, label: str, point: np.ndarray, turn, error: float) -> str:
+    """Why the inverse kinematics did not follow a motion to ``point`` (m), leaving ``error``:
+    where joints from elsewhere (the rest pose, the ranges' middle, seeded draws within the
+    limits) put the tool there, the motion's way is the trouble (a singularity or a joint's range
+    on it), and the point is not called unreachable; where none does, it is, and the reason
+    says to move the arm's base."""
+    digits = length_digits(_unit_name(cell.unit))  # 0.01 mm detail in the scene's unit
+    where = np.round(point / cell.unit, digits).tolist()
+    leaves = f"{error / cell.unit:.3g} {_unit_name(cell.unit)}"
+    lower, upper = np.asarray(cell.limits.lower), np.asarray(cell.limits.upper)
+    middle, half = 0.5 * (lower + upper), np.minimum(0.5 * (upper - lower), np.pi)
+    draws = np.random.default_rng(0).uniform(-1.0, 1.0, (_REACH_SEEDS, lower.size))
+    elsewhere = (
+        f"target {label!r}: the inverse kinematics does not follow its motion to the point "
+        f"{where} from the joints before it (it leaves {leaves} there), though other joints "
+        "of the arm reach that point: a singularity or a joint's range on the way"
+    )
+    for start in np.vstack([np.asarray(cell.rest, dtype=float), middle, middle + draws * half]):
+        _, reached = cell.solve_ik(point, start, turn)
+        if reached <= IK_TOLERANCE:
+            return elsewhere
+    from .routes import reach, supports_routes
+
+    # An arm known from its URDF is asked once more by the routes' own inverse kinematics (damped
+    # least squares on the arm's model from 24 starts, the tool's turn free): near a wrist's
+    # singularity it reaches points the simulator's IK misses from all of the starts above (an
+    # xArm6's unscrew 14.4 mm up a nut's tilted axis, in a random cell of the route oracle).
+    if supports_routes(cell) and not reach(cell, point / cell.unit, turn):
+        return elsewhere
+    return (
+        f"target {label!r}: the point {where} of its motion is unreachable for the {cell.name} at "
+        f"base {np.round(cell.base, digits).tolist()} (inverse kinematics from the joints before "
+        f"it, the rest pose, the ranges' middle and {_REACH_SEEDS} other starts leaves {leaves}): "
+        'out of its reach (move its base: scenario key "robot": {"base": ...})'
+    )
 
 
 def _subdivide(

@@ -391,7 +391,11 @@ def _measure(
     limits, contract, exclude = judge
     if contract is None:
         contract = task.contract(None, limits)
-    verdict, breach = _judged(task, (label, target), run, unit, (limits, contract, exclude))
+    # the tool judged as it was turned: a pose's, or a plan that turns it (the arm's own route)
+    turned = task.alignment_threshold is not None or plan.orientations is not None
+    verdict, breach = _judged(
+        task, (label, target), run, unit, (limits, contract, exclude), turned=turned
+    )
     sent = verdict.limits or CommandPeaks(
         plan.peak_velocity, plan.peak_acceleration, plan.peak_jerk
     )
@@ -421,10 +425,11 @@ def _measure(
     )
 
 
-def _judged(task: _SimTask, aim: tuple, run: Execution, unit, judge: tuple):
+def _judged(task: _SimTask, aim: tuple, run: Execution, unit, judge: tuple, turned: bool = False):
     """(the contract's verdict, the measured joints' breach) on one execution towards ``aim`` =
     (label, target), ``judge`` = (joint limits, contract, parts excluded): the verdict on the
-    measured tool path (scene units), its orientations in a pose scenario, the 1 kHz commands
+    measured tool path (scene units), its orientations in a pose scenario or where the motion
+    turned the tool (``turned``), the 1 kHz commands
     the position control was sent (the arm's own controller asked too, where the limits carry
     it) and the contacts; the breach on the measured joint velocities outside the run's
     disturbance (``""``: within)."""
@@ -436,7 +441,7 @@ def _judged(task: _SimTask, aim: tuple, run: Execution, unit, judge: tuple):
         label=label,
         axis=task.axes.get(label),
         exclude=exclude,
-        orientations=run.tcp_orientation if task.alignment_threshold is not None else None,
+        orientations=run.tcp_orientation if turned else None,
         commands=run.commands,
         contacts={k: v / unit for k, v in run.contacts.items()},
     )

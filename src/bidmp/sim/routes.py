@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .._checks import as_point, as_vector, check_int, check_real
+from .._checks import as_point, as_vector, check_bool, check_int, check_real
 from .._units import length_text
 from ..planning import NoRouteError, plan_route, segment_free, time_path
 from .backend import LIMIT_MARGIN, JointLimits, MotionPlan, SimError
@@ -51,7 +51,12 @@ SLOW = 15.0
 _ABOVE = 0.5  # the route ends this share of the approach height above the approach's top
 _GOALS = 4  # goal configurations the route may end at (distinct branches of the IK)
 _SEEDS = 24  # inverse kinematics tried for them (the joints now, the rest pose, seeded draws)
-_SPACING = 0.05  # rad: the route is subdivided this finely before it is splined
+# rad a route keeps inside each joint's range: the spline timed through it overshoots a joint
+# held at its end (the Panda's joint 6 past 3.7525 rad by 1e-5); an FR3 keeps further in (below)
+_INSIDE = 0.005
+# rad: the route is subdivided this finely before it is splined (finer where the spline through
+# the coarser points leaves the free space or a joint's range)
+_SPACINGS = (0.05, 0.02, 0.008)
 _CACHE: dict = {}
 
 
@@ -142,6 +147,8 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
     label: str = "",
     carried=None,
     cone: float = 0.0,
+    free_start: bool = False,
+    retract: float = 0.0,
     links: float | None = None,
 ) -> ArmRoute:
     """The arm's route from joints ``start`` to ``goal`` (module docstring).
@@ -176,6 +183,15 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
         tool and is kept clear too.
     cone : float
         Degrees the tool may tilt from pointing down where there is no final approach.
+    retract : float
+        How far up the axis the task takes the tool after the approach (a job's unscrew and
+        retract; scene units): the final approach starts at least that high, so that the arm's
+        configuration at the target follows that way back up too.
+    free_start : bool
+        The route may start from any joints that put the tool where ``start`` puts it (a
+        simulated motion, which the arm is placed at the start of): where ``start`` would have a
+        link within the margin of a part, the first of several inverse kinematics solutions
+        that keeps it is taken instead. False: the arm is at ``start`` (a job's joints now).
     links : float, optional
         Scene units every link keeps from the parts (default the tracking allowance, 0.5 mm: the
         contract asks the links only not to touch; the tool keeps the margin).
@@ -199,6 +215,7 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
     if goal.shape[0] < 3:
         raise ValueError(f"goal must be a point (x, y, z), got {goal.shape[0]} values")
     approach_height = check_real(approach_height, "approach_height", nonnegative=True)
+    retract = check_real(retract, "retract", nonnegative=True)
     cone = check_real(cone, "cone", nonnegative=True, maximum=90.0)
     seed = check_int(seed, "seed", minimum=0, maximum=2**32 - 2)
     if axis is not None:
@@ -215,12 +232,18 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
     )
     space = arm.space(scene, unit, exclude=exclude, margin=margin_m, carried=carried, links=links_m)
     start = np.clip(np.asarray(start, dtype=float), space.lower, space.upper)
+    inside = _inside(cell.limits)
+    # the route keeps inside the ranges (where the arm is now may be nearer an end)
+    space.lower = np.minimum(space.lower + inside, start)
+    space.upper = np.maximum(space.upper - inside, start)
+    if check_bool(free_start, "free_start") and space.slack(start) < 0.0:
+        start = _free_start(cell, space, start, seed)
     goal = np.asarray(goal, dtype=float)[:3]
     name = f"target {label!r}: " if label else ""
     descent = None
     if axis is not None and approach_height > 0.0:
         axis = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
-        top = goal + axis * approach_height * (1.0 + _ABOVE)
+        top = goal + axis * max(approach_height * (1.0 + _ABOVE), retract)
         frame = _approach_frame(axis) if orientation is None else np.asarray(orientation, float)
         descent = np.linspace(top, goal, 2)
         goals, tails, why = _approach_goals(cell, space, start, descent, frame, seed)
@@ -234,27 +257,38 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
     except NoRouteError as exc:
         raise SimError(f"{name}no route of the arm round the parts: {exc}") from None
     tail = tails[route.goal]
-    joints = np.vstack([_subdivided(route.waypoints, _SPACING), tail[1:]])
     limits = cell.limits
-    timed = time_path(
-        joints,
-        limits.velocity,
-        limits.acceleration,
-        limits.jerk,
-        margin=LIMIT_MARGIN,
-    )
-    fractions = np.linspace(0.0, 1.0, max(200, 4 * joints.shape[0]))
-    sampled = timed(fractions)
-    poses = [arm.tool_pose(q) for q in sampled]
-    points = np.array([p for p, _ in poses])
-    turns = Rotation.from_matrix([r for _, r in poses]).as_quat()
-    unsafe = _first_unsafe(space, sampled)
-    if unsafe is not None:
+    for spacing in _SPACINGS:
+        # the timing's spline passes through the route's points: the finer they lie, the closer
+        # it keeps to the route's free segments and inside the joints' ranges at its bends
+        joints = np.vstack([_subdivided(route.waypoints, spacing), tail[1:]])
+        timed = time_path(
+            joints,
+            limits.velocity,
+            limits.acceleration,
+            limits.jerk,
+            margin=LIMIT_MARGIN,
+        )
+        fractions = np.linspace(0.0, 1.0, max(200, 4 * joints.shape[0]))
+        sampled = timed(fractions)
+        unsafe = _first_unsafe(space, sampled)
+        beyond = _beyond_range(limits, timed)
+        if unsafe is None and beyond is None:
+            break
+    else:
+        if beyond is not None:
+            raise SimError(
+                f"{name}the arm's route, smoothed and timed, would take joint {beyond + 1} past "
+                "its range"
+            )
         part, depth = space.nearest(sampled[unsafe])
         raise SimError(
             f"{name}the arm's route, smoothed and timed, would come within "
             f"{length_text(max(-depth, 0.0) / unit, _unit_name(unit))} of the clearance of {part}"
         )
+    poses = [arm.tool_pose(q) for q in sampled]
+    points = np.array([p for p, _ in poses])
+    turns = Rotation.from_matrix([r for _, r in poses]).as_quat()
     plan = MotionPlan(
         label,
         points,
@@ -267,6 +301,15 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
         turns,
         peak_jerk=timed.peaks[2],
     )
+    from .planning import _slowed
+
+    stretch = _fci_stretch(limits, timed)
+    if stretch > SLOW:  # it passes where the FCI lets a joint barely move towards its stop
+        raise SimError(
+            f"{name}the arm's route passes so near a joint's range end that its controller's "
+            f"velocity limits there would make it {stretch:.0f} times slower"
+        )
+    _slowed(plan, timed.duration * stretch)
     tool_length = float(np.sum(np.linalg.norm(np.diff(points, axis=0), axis=1))) / unit
     return ArmRoute(
         plan,
@@ -351,6 +394,7 @@ def judged_route(  # noqa: PLR0913 - the public call spells its options out, as 
         cell,
         begin,
         target[:3],
+        free_start=True,  # the simulated motion starts where the route does
         axis=[0.0, 0.0, 1.0] if axis is None else axis,
         approach_height=approach_height,
         orientation=target[3:7] if pose else None,
@@ -367,11 +411,56 @@ def judged_route(  # noqa: PLR0913 - the public call spells its options out, as 
         label=label,
         axis=axis,
         exclude=exclude,
-        orientations=plan.orientations if pose else None,
+        # the route turns the tool as the joints go (a position scenario's too): judged as it is
+        orientations=plan.orientations,
     )
     if not verdict.ok:
         raise SimError(f"the contract refuses its planned motion: {verdict.reason()}")
     return plan
+
+
+def _inside(limits: JointLimits) -> np.ndarray:
+    """Radians a route keeps inside each joint's range: :data:`_INSIDE`, and on an arm whose
+    controller's velocity limits fall towards each range's end (the FR3's position-based limits)
+    as far in as where they still leave a quarter of the joint's top speed (0.08 to 0.18 rad):
+    a route that came to rest nearer an end would have to creep (the FCI's limit there falls to
+    nothing within 8 mrad of it)."""
+    inside = np.full(limits.n_joints, _INSIDE)
+    fci = getattr(limits, "fci", None)
+    if fci is None:
+        return inside
+    from .fci import FCI_LIMITS
+
+    table = FCI_LIMITS[fci]
+    if table.velocity_offset is None:
+        return inside
+    speed = 0.25 * np.asarray(table.velocity) + np.asarray(table.velocity_offset)
+    return np.maximum(inside, speed**2 / (2.0 * np.asarray(table.deceleration)))
+
+
+def _fci_stretch(limits: JointLimits, timed) -> float:
+    """How many times longer the timed route must last for a Franka arm's FCI to take it: the
+    FR3's velocity limits fall towards each joint's range ends (its position-based limits), and a
+    route, unlike the skills' motions, may pass near them; its velocities are kept within
+    :data:`LIMIT_MARGIN` of those limits where it is, sampled every millisecond. 1 for an arm
+    without such limits (the constant ones are the timing's own)."""
+    if getattr(limits, "fci", None) is None:
+        return 1.0
+    from .fci import FCI_LIMITS
+
+    table = FCI_LIMITS[limits.fci]
+    if table.velocity_offset is None:  # the same velocity limit everywhere: the timing's own
+        return 1.0
+    u = np.linspace(0.0, 1.0, max(2001, int(np.ceil(timed.duration * 1e3)) + 1))
+    positions, velocities = timed(u), timed(u, 1) / timed.duration
+    lowest, highest = table.velocity_bounds(positions)
+    tiny = 1e-9
+    share = np.where(
+        velocities > 0.0,
+        velocities / np.maximum(highest, tiny),
+        velocities / np.minimum(lowest, -tiny),
+    )
+    return max(1.0, float(np.max(share)) / LIMIT_MARGIN)
 
 
 def _unit_name(unit: float) -> str:
@@ -402,7 +491,9 @@ def _solutions(cell, space, point_m, frame, seeds, enough: int = _GOALS) -> list
     free_turn = bool(getattr(cell, "free_turn", True))
     found = []
     for seed in seeds:
-        q, error = arm.solve_ik(point_m, frame, seed, free_turn=free_turn)
+        q, error = arm.solve_ik(
+            point_m, frame, seed, free_turn=free_turn, inside=_inside(cell.limits)
+        )
         if error > IK_TOLERANCE:
             continue
         if any(np.max(np.abs(q - other)) < 1e-2 for other in found):
@@ -412,6 +503,17 @@ def _solutions(cell, space, point_m, frame, seeds, enough: int = _GOALS) -> list
             if len(found) >= enough:
                 break
     return found
+
+
+def _free_start(cell, space, start: np.ndarray, seed: int) -> np.ndarray:
+    """Joints that put the tool where ``start`` does (its mouth and axis, its turn free where the
+    cell's tool turns freely) with every link clear of the parts: the first such solution from
+    several seeds, else ``start`` itself (the planner then says it is not free)."""
+    mouth, frame = _arm(cell).tool_pose(start)
+    found = _solutions(
+        cell, space, mouth, Rotation.from_matrix(frame).as_quat(), _seeds(cell, start, seed), 1
+    )
+    return found[0] if found else start
 
 
 def _approach_goals(cell, space, start, descent, frame, seed) -> tuple[list, list, str]:
@@ -433,7 +535,14 @@ def _approach_goals(cell, space, start, descent, frame, seed) -> tuple[list, lis
     for q in tops:
         joints = [q]
         for point in line[1:]:
-            step, error = arm.solve_ik(point, frame, joints[-1], free_turn=free_turn, iterations=30)
+            step, error = arm.solve_ik(
+                point,
+                frame,
+                joints[-1],
+                free_turn=free_turn,
+                iterations=30,
+                inside=_inside(cell.limits),
+            )
             if error > IK_TOLERANCE:
                 problem = "the arm cannot follow the final approach down the part's axis"
                 break
@@ -496,6 +605,15 @@ def _subdivided(path: np.ndarray, spacing: float) -> np.ndarray:
         steps = max(int(np.ceil(np.max(np.abs(b - a)) / spacing)), 1)
         pieces.append(a + (b - a) * (np.arange(1, steps + 1)[:, None] / steps))
     return np.vstack(pieces)
+
+
+def _beyond_range(limits: JointLimits, timed):
+    """The first joint the timed route takes outside its range, sampled every millisecond (the
+    commands' rate), or None."""
+    u = np.linspace(0.0, 1.0, max(2001, int(np.ceil(timed.duration * 1e3)) + 1))
+    q = timed(u)
+    outside = np.any((q < np.asarray(limits.lower)) | (q > np.asarray(limits.upper)), axis=0)
+    return int(np.flatnonzero(outside)[0]) if outside.any() else None
 
 
 def _first_unsafe(space, joints: np.ndarray):
