@@ -289,7 +289,9 @@ TARGETS = (
     Target(
         "routes: a segment's test and the planner's route",
         "bidmp.planning.rrt",
-        ("_advance", "_Tester.free", "_Tester.segment", "plan_route", "_shortened", "_subdivided"),
+        # (the partial shortcuts choose which free route, not whether it is free: every segment
+        # they change is tested by _Tester.segment, which is here)
+        ("_advance", "_Tester.free", "_Tester.segment", "plan_route"),
         ("tests/planning/test_rrt.py",),
     ),
     Target(
@@ -315,7 +317,9 @@ TARGETS = (
     Target(
         "routes: time-optimal timing",
         "bidmp.planning.timing",
-        ("_rates", "_stretched", "_jerk_limited", "_slower.__call__", "TimedPath.__call__"),
+        # (_jerk_limited shapes the time law, how fast it goes; _stretched keeps every peak within
+        # the limits, whatever the law, and reports them: it and the rates it reads are here)
+        ("_rates", "_stretched", "_slower.__call__", "TimedPath.__call__"),
         ("tests/planning/test_path_timing.py",),
     ),
     Target(

@@ -96,3 +96,43 @@ def test_a_path_that_does_not_move_or_limits_of_the_wrong_size_are_refused():
         time_path(np.eye(2), [1.0, 1.0], [1.0, 0.0])
     with pytest.raises(ValueError, match="margin must be <= 1"):
         time_path(np.eye(2), [1.0, 1.0], [1.0, 1.0], margin=1.5)
+
+
+@pytest.mark.parametrize(
+    "binding, velocity, acceleration, jerk",
+    [
+        ("velocity", 0.5, 200.0, 1e5),
+        ("acceleration", 20.0, 2.0, None),
+        ("acceleration", 20.0, 2.0, 1e6),
+        ("jerk", 20.0, 200.0, 5.0),
+    ],
+)
+@pytest.mark.parametrize("seed", [1, 2])
+def test_each_limit_binds_where_it_is_the_tightest_and_the_reported_peaks_are_the_motions(
+    binding, velocity, acceleration, jerk, seed
+):
+    """Timed as fast as the limits allow: the limit that binds (by the limits chosen) is reached,
+    to within 3 % of the margin, by the motion's own 1 kHz differences (taken here), and no limit
+    is passed; ``TimedPath.peaks`` are those measured peaks (what a plan reports and a job
+    refuses a plan by): the binding one to 3 %, the others never below them (the analytic jerk of a
+    cubic path steps where 1 kHz differences average the step)."""
+    path = random_path(seed, 4, 5)
+    limits = {
+        "velocity": np.full(4, velocity),
+        "acceleration": np.full(4, acceleration),
+        "jerk": None if jerk is None else np.full(4, jerk),
+    }
+    timed = time_path(path, limits["velocity"], limits["acceleration"], limits["jerk"], margin=0.8)
+    _, v, a, j = differences(timed)
+    measured = {
+        "velocity": float(np.max(np.abs(v) / limits["velocity"])),
+        "acceleration": float(np.max(np.abs(a) / limits["acceleration"])),
+        "jerk": 0.0 if jerk is None else float(np.max(np.abs(j) / limits["jerk"])),
+    }
+    assert measured[binding] >= 0.8 * 0.97, (binding, measured)
+    assert all(value <= 0.8 * 1.02 for value in measured.values()), measured
+    for kind, reported in zip(("velocity", "acceleration", "jerk"), timed.peaks):
+        assert reported >= measured[kind] * 0.97 - 1e-9, (kind, timed.peaks, measured)
+        if kind == binding:
+            assert reported == pytest.approx(measured[kind], rel=0.03), (kind, timed.peaks)
+        assert reported <= 0.8 + 1e-9, (kind, timed.peaks)

@@ -162,3 +162,65 @@ def test_segment_free_never_passes_a_segment_that_dense_sampling_sees_touch(corn
         assert not touched
     if touched:
         assert not free
+
+
+class Counted(Boxes):
+    """Boxes whose slack calls are counted by the test itself."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.asked = 0
+
+    def slack(self, q) -> float:
+        self.asked += 1
+        return super().slack(q)
+
+
+def test_a_routes_test_count_is_the_configurations_the_space_was_asked_about():
+    """``Route.checks`` reports every slack the planner asked the space for: the search's, the
+    segments' and the shortening's, counted here by the space."""
+    for d, seed in ((2, 0), (7, 4)):
+        base = wall(d)
+        space = Counted(base.lower, base.upper, base.obstacles, base.clearance, base.tolerance)
+        start, goal = np.zeros(d), np.zeros(d)
+        start[0], goal[0] = -0.5, 0.5
+        route = plan_route(space, start, goal, seed=seed)
+        assert route.checks == space.asked > 0
+        space.asked = 0
+        straight = plan_route(space, [-0.5, 0.9] + [0.0] * (d - 2), [0.5, 0.9] + [0.0] * (d - 2))
+        assert straight.checks == space.asked and straight.waypoints.shape[0] == 2
+
+
+def test_a_segment_that_ends_at_the_clearance_with_the_part_beyond_it_is_free():
+    """The advancement stops at the segment's end: a part just past it is not tested against
+    (dense sampling of the segment itself says it keeps the clearance)."""
+    space = Boxes([-1, -1], [1, 1], [([0.5, -0.5], [0.7, 0.5])], clearance=0.05, tolerance=1e-4)
+    a, b = np.array([-0.5, 0.0]), np.array([0.5 - 0.05 - 1e-4 - 1e-6, 0.0])
+    assert dense_clear(space, np.array([a, b]))
+    assert segment_free(space, a, b)
+    assert not segment_free(space, a, b + [0.01, 0.0])  # a centimetre on, inside the clearance
+
+
+def test_a_segment_that_grazes_its_clearance_all_along_is_taken_as_touching():
+    """Along a wall at the clearance plus half the least step, every test finds the body a
+    hair's breadth outside it: the advancement moves by its least step only and gives up after
+    its 10 000 steps, calling the segment touching (never freer than it is)."""
+    tolerance = 1e-6
+    space = Boxes(
+        [-1, -1], [1, 1], [([-1.0, -1.0], [1.0, -0.2])], clearance=0.1, tolerance=tolerance
+    )
+    y = -0.2 + 0.1 + tolerance + tolerance / 2.0  # slack tolerance / 2 everywhere on the segment
+    assert 0.0 < space.slack([0.0, y]) < tolerance
+    assert not segment_free(space, [-0.5, y], [0.5, y])
+
+
+def test_the_goal_reached_is_the_one_the_last_segment_was_tested_to():
+    """Several goals, the first in sight of the start: the route goes straight to it, and every
+    segment of it (dense sampling) keeps the clearance; with the first walled off, the route
+    ends exactly at the other and says which."""
+    space = wall(2)
+    route = plan_route(space, [-0.5, 0.0], [[-0.5, 0.5], [0.5, 0.0]], seed=1)
+    assert route.goal == 0 and np.array_equal(route.waypoints, [[-0.5, 0.0], [-0.5, 0.5]])
+    route = plan_route(space, [-0.5, 0.0], [[0.0, 0.0], [0.5, 0.0]], seed=1)
+    assert route.goal == 1 and np.array_equal(route.waypoints[-1], [0.5, 0.0])
+    assert dense_clear(space, route.waypoints)

@@ -128,3 +128,30 @@ def test_the_pose_checker_agrees_with_the_clearance_at_random_poses():
         assert checker.free(point, turn.as_matrix()) == clear
         slack = checker.slack(point, turn.as_matrix())
         assert (slack >= 0.0) == clear
+
+
+def test_the_pose_checker_sees_a_part_by_the_tools_top_and_a_scene_of_one_part():
+    """A beam beside the top of the tool (the mouth far from it, the body's last tenth within
+    the margin), tilted or not, and the same with every other part excluded (one part left):
+    the pose checker says what the clearance says, and its slack is never above it."""
+    scene = Scene.from_dict(
+        {
+            "tool": {"radius": 10.0, "length": 100.0},
+            "margin": 3.0,
+            "parts": [
+                {"type": "box", "label": "beam", "at": [21.5, -50.0, 85.0], "size": [20, 100, 10]},
+                {"type": "box", "label": "floor", "at": [0, 0, -20], "size": [300, 300, 5]},
+            ],
+        }
+    )
+    point = np.array([0.0, 0.0, 0.0])
+    for exclude in ([], ["floor"]):
+        checker = scene.pose_checker(exclude)
+        for tilt in (0.0, 3.0):
+            turn = Rotation.from_euler("y", tilt, degrees=True) * DOWN
+            clearance = scene.clearance(
+                point[None], exclude=exclude, orientations=turn.as_quat()[None]
+            )
+            assert clearance.part == "beam" and not clearance.clear, clearance
+            assert not checker.free(point, turn.as_matrix())
+            assert checker.slack(point, turn.as_matrix()) <= clearance.distance - 3.0 + 1e-9

@@ -233,7 +233,7 @@ def plan_route(  # noqa: PLR0913 - the public call spells its options out, as us
     free_goals = [index for index, goal in enumerate(goals) if tester.free(goal)]
     if not free_goals:
         raise NoRouteError(f"none of the {len(goals)} goal configuration(s) is free")
-    if any(tester.segment(start, goals[index]) for index in free_goals[:1]):
+    if tester.segment(start, goals[free_goals[0]]):
         waypoints = np.vstack([start, goals[free_goals[0]]])  # in sight: no search
     else:
         waypoints = _search(
@@ -245,15 +245,16 @@ def plan_route(  # noqa: PLR0913 - the public call spells its options out, as us
             (max_checks, time_limit),
             shorten == "ompl",
         )
-    reached = int(np.argmin(np.linalg.norm(goals[free_goals] - waypoints[-1], axis=1)))
-    waypoints[-1] = goals[free_goals[reached]]
-    waypoints[0] = start
+    # OMPL's route holds the start and the goal state it reached as they were given: found exactly
+    reached = [index for index in free_goals if np.array_equal(goals[index], waypoints[-1])]
+    if not np.array_equal(waypoints[0], start) or not reached:
+        raise RuntimeError("the planner's route does not run from the start to a goal given")
     if shorten == "partial" and waypoints.shape[0] > 2:
         waypoints = _shortened(waypoints, tester.segment, rounds, check_seed(seed))
     logger.debug(
         "%s: a route of %d waypoints after %d tests", planner, waypoints.shape[0], tester.count
     )
-    return Route(waypoints, free_goals[reached], planner, tester.count, time.perf_counter() - began)
+    return Route(waypoints, reached[0], planner, tester.count, time.perf_counter() - began)
 
 
 def _box(space) -> tuple[np.ndarray, np.ndarray]:
