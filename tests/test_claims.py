@@ -127,6 +127,55 @@ def _outside_gap(key: str, read) -> D:
     )
 
 
+def _capacity(nodes, *path, seed=0) -> D:
+    """clfd_capacity.json: the field ``path`` of bidmp-continual's row at ``nodes`` and ``seed``
+    (``nodes`` None: the map library's row)."""
+
+    def read():
+        rows = _json("clfd_capacity.json")["rows"]
+        value = next(
+            r for r in rows if r["nodes"] == nodes and (nodes is None or r["seed"] == seed)
+        )
+        for key in path:
+            value = value[key]
+        return float(value)
+
+    where = "map-library" if nodes is None else f"{nodes} nodes, seed {seed}"
+    return D(f"clfd_capacity.json: {where}, {'/'.join(map(str, path))}", read)
+
+
+def _capacity_span(nodes, read, end, scale=1.0) -> D:
+    """The ``end`` (min or max) over the seeds of ``read(row)`` for ``nodes`` in
+    clfd_capacity.json."""
+
+    def value():
+        rows = [r for r in _json("clfd_capacity.json")["rows"] if r["nodes"] == nodes]
+        return end(read(r) for r in rows) * scale
+
+    return D(f"clfd_capacity.json: {nodes} nodes, {end.__name__} over the seeds", value)
+
+
+def _spans(nodes, key: str, scale: float = 1.0) -> tuple[D, D]:
+    """The least and the largest ``key`` over the seeds at ``nodes`` (clfd_capacity.json)."""
+    return tuple(_capacity_span(nodes, lambda r: r[key], end, scale) for end in (min, max))
+
+
+def _ratio(nodes) -> D:
+    return D(
+        f"clfd_capacity.json: every number kept at {nodes} nodes over the map library's",
+        lambda: _capacity(nodes, "kept").read() / _capacity(None, "kept").read(),
+    )
+
+
+def _median_ms(name: str) -> D:
+    return D(
+        f"{name}: the median of bidmp-continual's training_time_s, ms",
+        lambda: (
+            1e3 * statistics.median(_json(name)["methods"]["bidmp-continual"]["training_time_s"])
+        ),
+    )
+
+
 LIBFRANKA_ALL = ("libfranka.md", "all")
 KEEP = 'bidmp, approach "keep" (default)'
 
@@ -181,6 +230,65 @@ CLAIMS = [
         _clfd("lasa", "bidmp-library", "mean_dtw_over_tasks_seen", -1),
     ),
     _lasa_row("promp-library", "conditioned on the start) | {} | {} | {} | {} | {} | {} |"),
+    _lasa_row("bidmp-continual", "its conditioned ProMP) | {} | {} | {} | {} | {} | {} |"),
+    # -- the CLFD guide: what bidmp-continual is ------------------------------------------------
+    claim(
+        CLFD,
+        "(the same accuracy and DTW; BWT {} over all 26)",
+        _metric("lasa", "bidmp-continual", "BWT"),
+    ),
+    claim(
+        CLFD,
+        "A reproduction reads {} numbers on LASA where the plain library of the same 26 maps "
+        "(`map-library`) keeps {}, and learning the next task needs the normal equations A and B "
+        "too ({} more)",
+        _clfd("lasa", "bidmp-continual", "model_size", -1),
+        _capacity(None, "kept"),
+        _capacity(64, "numbers", "normal_equations"),
+    ),
+    # -- the CLFD guide: the capacity sweep (clfd_capacity.json) --------------------------------
+    claim(
+        CLFD,
+        "At 20 nodes each stored map is {}–{} % off (the median over the tasks, over three draws "
+        "of the nodes), ACC {}–{} and BWT {} to {}; at 8 nodes {}–{} % off and ACC {}–{}.",
+        *_spans(20, "map_error_median", 100),
+        *_spans(20, "ACC"),
+        *_spans(20, "BWT"),
+        *_spans(8, "map_error_median", 100),
+        *_spans(8, "ACC"),
+    ),
+    claim(
+        CLFD,
+        "At 24 nodes its weights ({} numbers) are fewer than the maps ({}), and each map is still "
+        "{}–{} % off (ACC {}–{}).",
+        _capacity(24, "reproduced_from"),
+        _capacity(None, "kept"),
+        *_spans(24, "map_error_median", 100),
+        *_spans(24, "ACC"),
+    ),
+    claim(
+        CLFD,
+        "the rows are the library's (ACC {}, mean DTW {}), from {} numbers, {} with the normal "
+        "equations ({}× the library); at the protocol's 64 nodes {} ({}×).",
+        _capacity(None, "ACC"),
+        _capacity(None, "mean_dtw"),
+        _capacity(26, "reproduced_from"),
+        _capacity(26, "kept"),
+        _ratio(26),
+        _capacity(64, "kept"),
+        _ratio(64),
+    ),
+    claim(
+        CLFD,
+        "whatever that size ({} parameters on RoboTasks9)",
+        _clfd("robottasks", "bidmp-continual", "model_size", -1),
+    ),
+    claim(
+        CLFD,
+        "It trains in a median {} ms (LASA) and {} ms (RoboTasks9) a task on one core",
+        _median_ms("clfd.json"),
+        _median_ms("clfd_robottasks.json"),
+    ),
     # -- the CLFD guide: the RoboTasks9 table ---------------------------------------------------
     _pose_row("dmp-library", "| `dmp-library` | {} | {} | {} | {} | {} |"),
     _pose_row(
@@ -234,6 +342,17 @@ CLAIMS = [
         _metric("lasa", "bidmp-continual", "ACC"),
         _metric("lasa", "bidmp-continual", "BWT"),
         _clfd("lasa", "bidmp-continual", "mean_dtw_over_tasks_seen", -1),
+    ),
+    claim(
+        CHANGELOG,
+        "(at 20 nodes each stored map is {}–{} % off, the median)",
+        *_spans(20, "map_error_median", 100),
+    ),
+    claim(
+        CHANGELOG,
+        "in more numbers than the maps ({} at 64 nodes against {})",
+        _capacity(64, "kept"),
+        _capacity(None, "kept"),
     ),
     claim(
         CHANGELOG,

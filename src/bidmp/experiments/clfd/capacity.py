@@ -104,8 +104,6 @@ class CapacityResult:
     def markdown(self) -> str:
         library = self.library
         lines = [
-            f"# bidmp-continual's capacity: CLFD protocol, LASA ({len(self.tasks)} tasks)",
-            "",
             f"CLFD protocol, LASA ({len(self.tasks)} tasks): "
             "`bidmp-continual` (a ridge memory of each task's start map: one-hot task code, "
             "`n_nodes` tanh nodes, linear output weights) at each node count against "
