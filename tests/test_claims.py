@@ -259,8 +259,8 @@ CLAIMS = [
     ),
     claim(
         CLFD,
-        "At 24 nodes its weights ({} numbers) are fewer than the maps ({}), and each map is still "
-        "{}–{} % off (ACC {}–{}).",
+        "At 24 nodes its weights ({} numbers) are fewer than the maps ({}), and the median map is "
+        "still {}–{} % off (ACC {}–{}).",
         _capacity(24, "reproduced_from"),
         _capacity(None, "kept"),
         *_spans(24, "map_error_median", 100),
