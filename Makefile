@@ -12,7 +12,7 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells routes user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp results-check
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells routes user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp clfd-capacity results-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
@@ -222,6 +222,14 @@ clfd: $(STAMP)
 	cp .clfd-out/lasa/clfd.json .clfd-out/lasa/clfd.md .clfd-out/lasa/clfd_accuracy.png .clfd-out/lasa/clfd_dtw.png docs/results/
 	cp .clfd-out/robottasks/clfd_robottasks.json .clfd-out/robottasks/clfd_robottasks.md .clfd-out/robottasks/clfd_robottasks_accuracy.png .clfd-out/robottasks/clfd_robottasks_dtw.png docs/results/
 	rm -rf .clfd-out
+
+# bidmp-continual's capacity on the same protocol's 26 LASA tasks: 8-64 enhancement nodes, three
+# seeds each, against the plain library of the same start maps (ACC, BWT, mean DTW, how far each
+# stored map is from its task's, every number kept), 25 cells on 2 Dask workers (about 10 min of
+# CPU): docs/results/clfd_capacity.json, .md (copied into docs/guides/clfd.md) and .png.
+clfd-capacity: $(STAMP)
+	$(PY) tools/clfd_capacity.py --workers 2 --out docs/results > /dev/null
+	$(PY) tools/readme.py
 
 # The libfranka side environment: franka-sim (an FCI server simulating an FR3 in MuJoCo, motion
 # limits enforced) and pylibfranka (the Franka client) at their pins in their own venv (they need

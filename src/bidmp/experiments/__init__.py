@@ -17,8 +17,11 @@ if TYPE_CHECKING:
     from .avoidance import AvoidanceCase, random_case
     from .benchmark import BenchmarkResult, check_lasa_options, lasa, summary_markdown, summary_rows
     from .clfd import (
+        CAPACITY_NODES,
         CLFD_THRESHOLDS,
         BiDMPLibrary,
+        CapacityResult,
+        CapacityRow,
         ClfdMethod,
         ClfdResult,
         ClfdRow,
@@ -26,15 +29,18 @@ if TYPE_CHECKING:
         ContinualBLS,
         DMPLibrary,
         FineTune,
+        MapLibrary,
         ProMPLibrary,
         TangentChart,
         accuracy_matrix,
+        capacity_sweep,
         clfd_tasks,
         continual_metrics,
         demonstration_errors,
         orientation_error,
         run_clfd,
         swept_error_area,
+        write_capacity,
         write_clfd,
     )
     from .lasa_cells import CASES, LASA_METHODS, METRICS, cell_key, run_cell

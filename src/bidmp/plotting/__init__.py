@@ -16,7 +16,7 @@ from .._lazy import exports
 # The public names: imported on first use (bidmp._lazy reads this block), seen by type checkers.
 if TYPE_CHECKING:
     from .benchmark import plot_lasa_benchmark
-    from .clfd import plot_clfd
+    from .clfd import plot_clfd, plot_clfd_capacity
     from .extension import plot_extension, plot_prm_comparison, plot_segmentation
     from .incremental import plot_incremental
     from .tasks import plot_error_vs_distance, plot_scenario_3d, plot_targets_top_view

@@ -1,6 +1,7 @@
 """The CLFD protocol's figures (:func:`bidmp.experiments.write_clfd` draws them): each method's
 accuracy matrix as a heat map, and the mean DTW over the tasks seen against the task index with
-the published reference point marked."""
+the published reference point marked; and ``bidmp-continual``'s capacity sweep against the plain
+library of its maps (:func:`bidmp.experiments.clfd.write_capacity`)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from ._base import _matplotlib, _save
 
-__all__ = ["plot_clfd"]
+__all__ = ["plot_clfd", "plot_clfd_capacity"]
 
 
 def plot_clfd(
@@ -61,3 +62,73 @@ def plot_clfd(
     ax.grid(True, alpha=0.3)
     written.append(_save(fig, Path(out) / f"{stem}_dtw.png"))
     return written
+
+
+def plot_clfd_capacity(path: Path, result) -> Path:
+    """The capacity sweep in one figure at ``path``: left, ACC (every seed) and the median stored
+    map's error (%) against the node count, the map library's ACC dashed and the number of tasks
+    dotted; right, the numbers kept against the node count — the weights a reproduction reads
+    and, on top, the normal equations learning needs — with the map library's dashed. ``result``:
+    an object with ``tasks``, ``library`` (a row with ``acc`` and ``kept``) and ``by_nodes()``
+    (node count -> rows with ``acc``, ``map_errors``, ``reproduced_from`` and ``kept``)."""
+    mpl = _matplotlib()
+    groups = result.by_nodes()
+    nodes = np.array(list(groups), dtype=float)
+    library = result.library
+    fig, (left, right) = mpl.subplots(1, 2, figsize=(11.0, 3.8), dpi=90)
+    fig.subplots_adjust(wspace=0.5)
+    for count, rows in groups.items():
+        left.plot([count] * len(rows), [r.acc for r in rows], "o", color="C0", markersize=4)
+    left.plot(
+        nodes,
+        [np.median([r.acc for r in rows]) for rows in groups.values()],
+        color="C0",
+        label="bidmp-continual: ACC",
+    )
+    left.axhline(library.acc, color="C0", linestyle="--", label="map-library: ACC")
+    left.axvline(len(result.tasks), color="grey", linestyle=":", label="as many nodes as tasks")
+    _node_axis(left, nodes)
+    left.set_xlabel("enhancement nodes")
+    left.set_ylabel("ACC (DTW)")
+    left.set_ylim(-0.02, 1.02)
+    twin = left.twinx()
+    median_error = [
+        np.median([100 * np.median(r.map_errors) for r in rows]) for rows in groups.values()
+    ]
+    twin.plot(
+        nodes,
+        median_error,
+        color="C3",
+        marker="s",
+        markersize=3,
+        label="stored map off (median, %)",
+    )
+    twin.set_ylabel("stored map off, median (%)", color="C3")
+    handles = left.get_legend_handles_labels()
+    more = twin.get_legend_handles_labels()
+    left.legend(handles[0] + more[0], handles[1] + more[1], fontsize=7, loc="center right")
+    left.grid(True, alpha=0.3)
+
+    weights = [rows[0].reproduced_from for rows in groups.values()]
+    kept = [rows[0].kept for rows in groups.values()]
+    right.plot(nodes, weights, marker="o", markersize=3, label="weights (R, b, W)")
+    right.plot(nodes, kept, marker="o", markersize=3, label="+ normal equations (A, B)")
+    right.axhline(library.kept, color="black", linestyle="--", label="map-library (the maps)")
+    right.axvline(len(result.tasks), color="grey", linestyle=":")
+    _node_axis(right, nodes)
+    right.set_xlabel("enhancement nodes")
+    right.set_ylabel("numbers kept")
+    right.legend(fontsize=7, loc="upper left")
+    right.grid(True, alpha=0.3)
+    fig.suptitle(
+        f"bidmp-continual against the plain library of its maps, LASA ({len(result.tasks)} tasks)",
+        fontsize=10,
+    )
+    return _save(fig, path)
+
+
+def _node_axis(ax, nodes: np.ndarray) -> None:
+    """A log-2 axis ticked at the node counts swept, labelled as plain numbers."""
+    ax.set_xscale("log", base=2)
+    ax.set_xticks(nodes, [f"{n:g}" for n in nodes])
+    ax.minorticks_off()

@@ -30,13 +30,22 @@ The methods (``METHODS``) learn a task from its demonstrations and reproduce any
 ``dmp-library`` keeps one DMP per task (:class:`DMPLibrary`), ``finetune`` one DMP refitted on
 each (:class:`FineTune`), ``bidmp-library`` one Bi-DMP learning each task as a new skill
 (:class:`BiDMPLibrary`), ``promp-library`` one ProMP per task (:class:`ProMPLibrary`);
-``bidmp-continual`` is one BLS of a fixed size that gives every task's primitive from the task's
-code (:class:`ContinualBLS`).
+``bidmp-continual`` is a ridge memory of each task's start map of a fixed size, one BLS that
+gives the task's map from the task's code (:class:`ContinualBLS`); ``map-library`` keeps the same
+maps as they are (:class:`MapLibrary`, the yardstick of its capacity sweep, ``capacity``).
 
 Parts: ``data`` (the tasks, the chart), ``metrics`` (errors and figures), ``methods`` (the rows),
-``protocol`` (the runner, its cells on Dask, the files).
+``protocol`` (the runner, its cells on Dask, the files), ``capacity`` (``bidmp-continual``'s
+node counts against the map library).
 """
 
+from .capacity import (
+    CAPACITY_NODES,
+    CapacityResult,
+    CapacityRow,
+    capacity_sweep,
+    write_capacity,
+)
 from .data import CLFD_DATASETS, ClfdTask, TangentChart, clfd_tasks
 from .methods import (
     METHODS,
@@ -45,6 +54,7 @@ from .methods import (
     ContinualBLS,
     DMPLibrary,
     FineTune,
+    MapLibrary,
     ProMPLibrary,
 )
 from .metrics import (
@@ -66,10 +76,13 @@ from .protocol import (
 )
 
 __all__ = [
+    "CAPACITY_NODES",
     "CLFD_DATASETS",
     "CLFD_THRESHOLDS",
     "METHODS",
     "BiDMPLibrary",
+    "CapacityResult",
+    "CapacityRow",
     "ClfdMethod",
     "ClfdResult",
     "ClfdRow",
@@ -77,14 +90,17 @@ __all__ = [
     "ContinualBLS",
     "DMPLibrary",
     "FineTune",
+    "MapLibrary",
     "ProMPLibrary",
     "TangentChart",
     "accuracy_matrix",
+    "capacity_sweep",
     "clfd_tasks",
     "continual_metrics",
     "demonstration_errors",
     "orientation_error",
     "run_clfd",
     "swept_error_area",
+    "write_capacity",
     "write_clfd",
 ]

@@ -34,6 +34,7 @@ __all__ = [
     "DMPLibrary",
     "FineTune",
     "METHODS",
+    "MapLibrary",
     "ProMPLibrary",
 ]
 
@@ -297,34 +298,16 @@ def _promp_start_map(promp) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return mean, gain, H0.T @ mean
 
 
-class ContinualBLS(ClfdMethod):
-    """``bidmp-continual``: one Broad Learning System over all tasks, of a fixed size, used as a
-    hypernetwork — the task's code in, the task's primitive out.
+class _StartMaps(ClfdMethod):
+    """A method that keeps each task as one flat vector, its *start map*, and reproduces a task
+    from it: ``primitive="promp"`` (default), the ProMP of :class:`ProMPLibrary` as one affine map
+    from a start to the weights, ``w(s) = μ + K (s − s̄)`` (its exact conditioning on the start),
+    the vector μ, K, s̄; ``"dmp"``, the forcing weights and the goal of :class:`DMPLibrary`'s DMP.
+    On a pose task the chart's reference quaternion is one more part of it (normalised when
+    used). Subclasses keep the vectors (``learn``) and give task ``index``'s (``_output``)."""
 
-    ``primitive="promp"`` (default): the ProMP of :class:`ProMPLibrary` as one affine map from a
-    start to the weights, ``w(s) = μ + K (s − s̄)`` (its exact conditioning on the start); the
-    BLS gives μ, K and s̄. ``"dmp"``: the forcing weights and the goal of :class:`DMPLibrary`'s
-    DMP. On a pose task the chart's reference quaternion is one more output (normalised).
-
-    The task code is one-hot over a capacity of ``capacity`` tasks; ``n_nodes`` enhancement
-    nodes ``tanh(R code + b)`` (R, b drawn once from ``seed``) feed linear output weights W.
-    W is the ridge solution (``ridge`` relative to the mean diagonal) of the normal equations
-    accumulated task by task — ``A += HᵀH``, ``B += HᵀY`` — so after task i it is exactly the ridge
-    fit on tasks 0..i (tested), and nothing of a task is kept but its share of A and B. Its size
-    never changes (MS = 1). With more nodes than tasks the fit reproduces every task's primitive
-    nearly exactly, so learning a task moves the earlier ones only by the ridge's share."""
-
-    name = "bidmp-continual"
-
-    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one
-        self,
-        primitive: str = "promp",
-        n_kernels: int = CLFD_KERNELS,
-        n_basis: int = CLFD_BASIS,
-        n_nodes: int = 64,
-        capacity: int = 26,
-        ridge: float = 1e-10,
-        seed: int = 0,
+    def __init__(
+        self, primitive: str = "promp", n_kernels: int = CLFD_KERNELS, n_basis: int = CLFD_BASIS
     ):
         super().__init__()
         from ..._checks import check_choice
@@ -332,44 +315,13 @@ class ContinualBLS(ClfdMethod):
         self.primitive = check_choice(primitive, "primitive", ("promp", "dmp"))
         self.n_kernels = check_int(n_kernels, "n_kernels", minimum=2, limit="max_kernels")
         self.n_basis = check_int(n_basis, "n_basis", minimum=2, limit="max_kernels")
-        self.n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=100_000)
-        self.capacity = check_int(capacity, "capacity", minimum=1, maximum=100_000)
-        self.ridge = check_real(ridge, "ridge", nonnegative=True, maximum=1.0)
-        self.seed = seed
-        rng = check_seed(seed)
-        self._projection = rng.normal(size=(n_nodes, capacity))
-        self._bias = rng.normal(size=n_nodes)
-        self._gram = None  # A (n_nodes, n_nodes) and B (n_nodes, outputs): what the update needs
-        self._cross = None
-        self._weights = None
         self._template = None  # a primitive of the same structure, its learned state replaced
         self._pose = False
-        self._seen = 0
-
-    def task_nodes(self, index: int) -> np.ndarray:
-        """(n_nodes,): the enhancement nodes of task ``index``'s one-hot code."""
-        index = check_int(index, "index", minimum=0, maximum=self.capacity - 1)
-        return np.tanh(self._projection[:, index] + self._bias)
-
-    def learn(self, task: ClfdTask) -> None:
-        if self._seen >= self.capacity:
-            raise ValueError(f"bidmp-continual holds {self.capacity} tasks (its capacity)")
-        target = self.task_target(task)
-        self._record(task)
-        if self._gram is None:
-            self._pose = task.orientations is not None  # a pose task: the chart's reference too
-            self._gram = np.zeros((self.n_nodes, self.n_nodes))
-            self._cross = np.zeros((self.n_nodes, target.size))
-        nodes = self.task_nodes(self._seen)[None]
-        self._gram += nodes.T @ nodes
-        self._cross += nodes.T @ target[None]
-        diagonal = self.ridge * np.trace(self._gram) / self.n_nodes
-        self._weights = np.linalg.solve(self._gram + diagonal * np.eye(self.n_nodes), self._cross)
-        self._seen += 1
 
     def task_target(self, task: ClfdTask) -> np.ndarray:
-        """The flat output the BLS learns for ``task``: its primitive's parameters, then its
-        chart's reference quaternion on a pose task."""
+        """The start map of ``task`` as learned from its demonstrations: the flat vector of its
+        primitive's parameters (LASA's ProMP: 602 numbers — μ 200, K 400, s̄ 2), then its chart's
+        reference quaternion on a pose task."""
         if not isinstance(task, ClfdTask):
             raise TypeError(
                 f"task must be a bidmp.experiments.ClfdTask (clfd_tasks gives them), got "
@@ -394,8 +346,16 @@ class ContinualBLS(ClfdMethod):
             parts.append(chart.reference)
         return np.concatenate(parts)
 
+    def task_map(self, index: int) -> np.ndarray:
+        """The start map the method gives for task ``index`` now (what it reproduces the task
+        from; :meth:`task_target` is what it was taught)."""
+        learned = len(self._widths)
+        if not learned:
+            raise ValueError(f"index: {self.name} has learned no task yet (call learn(task))")
+        return self._output(check_int(index, "index", minimum=0, maximum=learned - 1)).copy()
+
     def _output(self, index: int) -> np.ndarray:
-        return self.task_nodes(index) @ self._weights
+        raise NotImplementedError
 
     def _chart(self, index: int) -> TangentChart:
         if not self._pose:
@@ -420,11 +380,120 @@ class ContinualBLS(ClfdMethod):
         basis = promp_basis(np.linspace(0.0, 1.0, len(t)), self.n_basis, self._template.overlap)
         return np.einsum("tn,mdn->mtd", basis, weights.reshape(len(starts), dims, self.n_basis))
 
+
+class MapLibrary(_StartMaps):
+    """``map-library``: the plain library of the start maps :class:`ContinualBLS` learns — each
+    task's vector (:meth:`task_target`) kept as it is, one per task, and the task reproduced from
+    it as :class:`ContinualBLS` reproduces it. Nothing learned later touches an earlier task's
+    map (REM = 1); it grows by one map per task (LASA: 602 numbers; 26 tasks, 15 652). The
+    yardstick :class:`ContinualBLS` is measured against (``tools/clfd_capacity.py``)."""
+
+    name = "map-library"
+
+    def __init__(
+        self, primitive: str = "promp", n_kernels: int = CLFD_KERNELS, n_basis: int = CLFD_BASIS
+    ):
+        super().__init__(primitive, n_kernels, n_basis)
+        self._maps: list[np.ndarray] = []
+
+    def learn(self, task: ClfdTask) -> None:
+        target = self.task_target(task)
+        self._record(task)
+        self._pose = task.orientations is not None
+        self._maps.append(target)
+
+    def _output(self, index: int) -> np.ndarray:
+        return self._maps[index]
+
     @property
     def n_parameters(self) -> int:
-        """The fixed network: projection, bias and output weights."""
+        """Every number kept: the maps."""
+        return sum(m.size for m in self._maps)
+
+
+class ContinualBLS(_StartMaps):
+    """``bidmp-continual``: a ridge memory of the tasks' start maps of a fixed size — one Broad
+    Learning System over all tasks, the task's code in, the task's start map out.
+
+    The maps are :class:`MapLibrary`'s (``primitive``: ``"promp"``, default, or ``"dmp"``). The
+    task code is one-hot over a capacity of ``capacity`` tasks; ``n_nodes`` enhancement nodes
+    ``tanh(R code + b)`` (R, b drawn once from ``seed``) feed linear output weights W. W is the
+    ridge solution (``ridge`` relative to the mean diagonal) of the normal equations accumulated
+    task by task — ``A += HᵀH``, ``B += HᵀY`` — so after task i it is exactly the ridge fit on
+    tasks 0..i (tested), and A and B are kept to learn the next task. With at least as many nodes
+    as tasks the fit gives every task's map back (to the ridge's share): an exact memory, larger
+    than the maps themselves (W alone has ``n_nodes`` rows of a map's size). With fewer, it is the
+    least-squares compromise between the tasks' maps, and it forgets. Its size is fixed by
+    ``n_nodes`` and ``capacity`` (MS = 1); :attr:`numbers_kept` counts every number it keeps."""
+
+    name = "bidmp-continual"
+
+    def __init__(  # noqa: PLR0913 - an estimator's constructor: each hyperparameter is one
+        self,
+        primitive: str = "promp",
+        n_kernels: int = CLFD_KERNELS,
+        n_basis: int = CLFD_BASIS,
+        n_nodes: int = 64,
+        capacity: int = 26,
+        ridge: float = 1e-10,
+        seed: int = 0,
+    ):
+        super().__init__(primitive, n_kernels, n_basis)
+        self.n_nodes = check_int(n_nodes, "n_nodes", minimum=1, maximum=100_000)
+        self.capacity = check_int(capacity, "capacity", minimum=1, maximum=100_000)
+        self.ridge = check_real(ridge, "ridge", nonnegative=True, maximum=1.0)
+        self.seed = seed
+        rng = check_seed(seed)
+        self._projection = rng.normal(size=(n_nodes, capacity))
+        self._bias = rng.normal(size=n_nodes)
+        self._gram = None  # A (n_nodes, n_nodes) and B (n_nodes, outputs): what the update needs
+        self._cross = None
+        self._weights = None
+        self._seen = 0
+
+    def task_nodes(self, index: int) -> np.ndarray:
+        """(n_nodes,): the enhancement nodes of task ``index``'s one-hot code."""
+        index = check_int(index, "index", minimum=0, maximum=self.capacity - 1)
+        return np.tanh(self._projection[:, index] + self._bias)
+
+    def learn(self, task: ClfdTask) -> None:
+        if self._seen >= self.capacity:
+            raise ValueError(f"bidmp-continual holds {self.capacity} tasks (its capacity)")
+        target = self.task_target(task)
+        self._record(task)
+        if self._gram is None:
+            self._pose = task.orientations is not None  # a pose task: the chart's reference too
+            self._gram = np.zeros((self.n_nodes, self.n_nodes))
+            self._cross = np.zeros((self.n_nodes, target.size))
+        nodes = self.task_nodes(self._seen)[None]
+        self._gram += nodes.T @ nodes
+        self._cross += nodes.T @ target[None]
+        diagonal = self.ridge * np.trace(self._gram) / self.n_nodes
+        self._weights = np.linalg.solve(self._gram + diagonal * np.eye(self.n_nodes), self._cross)
+        self._seen += 1
+
+    def _output(self, index: int) -> np.ndarray:
+        return self.task_nodes(index) @ self._weights
+
+    @property
+    def n_parameters(self) -> int:
+        """What it reproduces from, the protocol's model size: projection, bias and output
+        weights (:attr:`numbers_kept` adds the normal equations it learns with)."""
         outputs = 0 if self._weights is None else self._weights.shape[1]
         return self._projection.size + self._bias.size + self.n_nodes * outputs
+
+    @property
+    def numbers_kept(self) -> dict[str, int]:
+        """Every number it keeps, by part: ``projection`` R (n_nodes × capacity), ``bias`` b
+        (n_nodes), ``weights`` W (n_nodes × a map's size) and ``normal_equations`` A (n_nodes ×
+        n_nodes) and B (n_nodes × a map's size), which it needs to learn another task."""
+        outputs = 0 if self._weights is None else self._weights.shape[1]
+        return {
+            "projection": self._projection.size,
+            "bias": self._bias.size,
+            "weights": self.n_nodes * outputs,
+            "normal_equations": 0 if self._gram is None else self._gram.size + self._cross.size,
+        }
 
 
 METHODS = {

@@ -222,7 +222,12 @@ def _run_cell(
     """One cell: method ``name`` (with ``seed``) through the first ``n_tasks`` tasks."""
     tasks = (tasks if tasks is not None else clfd_tasks(dataset))[:n_tasks]
     method = METHODS[name]() if seed is None else METHODS[name](seed=seed)
-    thresholds = CLFD_THRESHOLDS[dataset]
+    return _protocol_row(method, tasks, CLFD_THRESHOLDS[dataset], name, seed)
+
+
+def _protocol_row(method, tasks: list[ClfdTask], thresholds: dict, name: str, seed) -> ClfdRow:
+    """``method`` (a fresh instance) through ``tasks`` one after the other, every task seen
+    evaluated by each metric of ``thresholds`` (name -> threshold or None) after each."""
     row = ClfdRow(name, seed, errors={metric: [] for metric in thresholds})
     for i, task in enumerate(tasks):
         began = time.process_time()  # one core's time: the protocol's training time per task
