@@ -1,0 +1,85 @@
+"""How ``simulate`` hands each motion on: every job carries its own target's rollout, tool
+frames, excluded parts and repair (not the first target's), and the report gives each method its
+own rows and the arm's own limits. Unit tests of the wiring with several of everything (two
+methods, three targets of a tilted pack, an arm that is not the Panda), no simulator run: a value
+taken from a neighbour's row changes what is checked here."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from bidmp.sim.pybullet.cell import RobotCell
+from bidmp.sim.report import SimTarget
+from bidmp.sim.robots import IIWA_MODEL, PANDA, UR5_MODEL
+from bidmp.sim.run import _jobs, _sim_report
+from bidmp.tasks import scenarios
+
+METHODS = ["dmp", "bidmp"]
+LABELS = ["4", "1", "9"]
+
+
+@pytest.fixture(scope="module")
+def tilted():
+    return scenarios.load("nut-unscrewing-tilted")
+
+
+def _report(scenario):
+    """A made-up evaluation: per method and target a rollout, tool frames and a repair, each
+    marked with its own method and target (numbers that differ everywhere)."""
+    methods = {}
+    for k, method in enumerate(METHODS):
+        rollouts, frames = {}, {}
+        for j, label in enumerate(LABELS):
+            rollouts[label] = np.full((5 + j, 3), 10.0 * k + j)
+            frames[label] = np.tile(
+                [0.0, 0.0, np.sin(0.1 * (k + j)), np.cos(0.1 * (k + j))], (5 + j, 1)
+            )
+        methods[method] = SimpleNamespace(
+            rollouts=rollouts,
+            orientations=frames,
+            repaired_at=lambda label, method=method: f"{method} repair of {label}",
+        )
+    return SimpleNamespace(methods=methods)
+
+
+def test_every_job_carries_its_own_targets_motion_frames_parts_and_repair(tilted):
+    report = _report(tilted)
+    frames = {("dmp", "1"): 6}
+    jobs = _jobs(tilted, report, METHODS, LABELS, frames, {("bidmp", "9")}, True)
+    assert [(job.method, job.label) for job in jobs] == [(m, t) for m in METHODS for t in LABELS]
+    for job in jobs:
+        own = report.methods[job.method]
+        np.testing.assert_array_equal(job.rollout, own.rollouts[job.label])
+        np.testing.assert_array_equal(job.orientations, own.orientations[job.label])
+        assert job.repair == f"{job.method} repair of {job.label}"
+        # the target's own nut is excluded, no other target's
+        assert job.label in job.exclude
+        assert not set(job.exclude) & (set(LABELS) - {job.label})
+        assert job.frames == frames.get((job.method, job.label), 0)
+        assert job.view == ((job.method, job.label) == ("bidmp", "9")) and job.record
+
+
+def _row(label: str, error: float) -> SimTarget:
+    return SimTarget(
+        label, error, error, None, None, {}, 0.1, 0.1, 0.1, 0.1, 1.0 + error, 0.0, True
+    )
+
+
+@pytest.mark.parametrize("arm", [IIWA_MODEL, UR5_MODEL], ids=lambda arm: arm.name)
+def test_the_report_gives_each_method_its_own_rows_and_the_arms_own_limits(tilted, arm):
+    outcomes = []
+    for k, method in enumerate(METHODS):
+        for j, label in enumerate(reversed(LABELS)):  # (the workers finish in any order)
+            outcomes.append((method, label, _row(label, 10.0 * k + j), [], 1.0 + k + j, None))
+    out = _sim_report(
+        tilted, METHODS, LABELS, outcomes, (np.zeros(3), 0.0), False, (RobotCell, arm)
+    )
+    for method, label, row, _, _, _ in outcomes:
+        assert out.methods[method].targets[label] is row
+    assert list(out.methods["bidmp"].targets) == LABELS
+    assert out.limits is arm.limits and out.limits != PANDA
+    assert out.to_dict()["limits"]["velocity_rad_s"] == list(arm.limits.velocity)
+    assert out.simulated_s == pytest.approx(sum(outcome[4] for outcome in outcomes))
