@@ -1,0 +1,125 @@
+"""What the job computes at each step is handed on: every move's commands reach its verdict,
+each nut ends where its own drop put it (a bin cell of its own, read where it lies), every motion
+of every target is written as a command file with the arm's own joint units, and a phase's
+contacts (the arm's and a carried part's) reach it in the scene's unit, against the arm's own
+limits. Several of everything: two tilted nuts on the ideal arm (its six joints, metres and
+radians), two units, two arms. Expected values from the job's own numbers (the bin, the tool)
+and closed forms, not from the code under test."""
+
+from __future__ import annotations
+
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from bidmp import sim
+from bidmp.sim.backend import JointLimits
+from bidmp.sim.job_report import _phase, write_job_commands
+from bidmp.sim.robots import PANDA
+from bidmp.tasks import scenarios
+
+SIX = JointLimits(
+    lower=(-3.0,) * 6,
+    upper=(3.0,) * 6,
+    velocity=(1.0, 1.2, 1.4, 1.6, 1.8, 2.0),
+    acceleration=(2.0, 2.5, 3.0, 3.0, 3.0, 3.0),
+)
+
+
+@pytest.fixture(scope="module")
+def tilted_job():
+    """The tilted pack with the flat task's job, nuts 3 and 4 on the ideal arm, recorded."""
+    spec = json.loads(scenarios.builtin_text("nut-unscrewing-tilted"))
+    spec["job"] = json.loads(scenarios.builtin_text("nut-unscrewing"))["job"]
+    scenario = scenarios.from_dict(spec)
+    return scenario, sim.run_job(scenario, targets=["3", "4"], backend="kinematic", record=True)
+
+
+def test_every_move_of_every_target_is_judged_with_its_own_commands(tilted_job):
+    scenario, report = tilted_job
+    assert [target.label for target in report.targets] == ["3", "4"]
+    for target in report.targets:
+        assert target.removed, target.reason
+        moved = [phase for phase in target.phases if phase.commands is not None]
+        assert [phase.name for phase in moved] == ["approach", "unscrew", "retract", "drop"]
+        for phase in moved:
+            # the verdict took the commands: their peaks, from rest to rest, within the limits
+            assert phase.verdict is not None and phase.verdict.limits is not None, phase.name
+            assert phase.verdict.limits.within and phase.ok
+            assert phase.peaks[0] == pytest.approx(phase.verdict.limits.velocity)
+
+
+def test_each_nut_ends_in_a_bin_cell_of_its_own(tilted_job):
+    """Where a nut lies is read after it fell (not where it started), inside the bin's walls
+    (the job's bin: its floor's centre and inner size), and two nuts dropped one after the
+    other lie a socket's width apart (the drop grid's cells), not on one another."""
+    scenario, report = tilted_job
+    floor, inner = (np.asarray(v, dtype=float) for v in scenario.job.bin)
+    ends = []
+    for target in report.targets:
+        end = np.asarray(target.final_position, dtype=float)
+        start = np.asarray(scenario.targets[target.label][:3], dtype=float)
+        assert np.all(np.abs(end[:2] - floor[:2]) <= inner[:2] / 2.0), end
+        assert floor[2] <= end[2] <= floor[2] + inner[2], end
+        assert np.linalg.norm(end - start) > 50.0  # (it moved from its stud to the bin)
+        ends.append(end)
+    assert np.linalg.norm(ends[0][:2] - ends[1][:2]) >= scenario.scene.tool.radius
+
+
+def test_every_motion_is_written_with_the_arms_own_joints_and_units(tilted_job, tmp_path):
+    """Four motions a nut (approach, unscrew, retract, drop), two nuts: eight files, in order,
+    each the commands of its phase; the ideal arm's carriage in metres and wrist in radians
+    said on the first line (not '# units: rad')."""
+    _, report = tilted_job
+    files = write_job_commands(report, tmp_path)
+    moved = [
+        (target.label, phase)
+        for target in report.targets
+        for phase in target.phases
+        if phase.commands is not None
+    ]
+    assert len(files) == len(moved) == 8
+    units = dict(zip(report.joint_names, report.joint_units))
+    assert set(units.values()) == {"m", "rad"}
+    for path, (label, phase) in zip(files, moved):
+        assert path.name.endswith(f"_{label}_{phase.name}.csv")
+        first, header = path.read_text().splitlines()[:2]
+        assert first == "# joint units: " + ", ".join(f"{n} {u}" for n, u in units.items())
+        assert header == "t," + ",".join(report.joint_names)
+        values = np.loadtxt(path, delimiter=",", skiprows=2)
+        np.testing.assert_array_equal(values[:, 1:], phase.commands)
+
+
+@pytest.mark.parametrize("limits", [SIX, PANDA], ids=["six-joint", "panda"])
+@pytest.mark.parametrize("metres", [1e-3, 1.0], ids=["mm", "m"])
+def test_a_phases_contacts_and_peaks_reach_it_in_the_scenes_unit_and_the_arms_limits(
+    metres, limits
+):
+    """The arm's contacts (metres, from the backend) in the scene's unit, a carried part's
+    (scene units already) beside them, the deeper of the two where both touched a part; the
+    commands' peak against this arm's velocity limit (a minimum-jerk stroke: 1.875 A/T)."""
+    tau = np.linspace(0.0, 1.0, 1501)[:, None]
+    q0 = 0.5 * (np.asarray(limits.lower) + np.asarray(limits.upper))
+    commands = np.repeat(q0[None], tau.shape[0], axis=0)
+    commands[:, 0] += 0.5 * (10 * tau[:, 0] ** 3 - 15 * tau[:, 0] ** 4 + 6 * tau[:, 0] ** 5)
+    run = SimpleNamespace(
+        commands=commands,
+        joint_velocities=np.zeros((200, limits.n_joints)),
+        contacts={"post": 0.002, "bin": 0.0005},
+    )
+    plan = SimpleNamespace(duration=1.5)
+    cell = SimpleNamespace(limits=limits, unit=metres)
+    mm = 1e-3 / metres  # scene units per millimetre
+    carried = {"post": 1.0 * mm, "plate": 0.7 * mm}
+    phase = _phase("drop", run, plan, cell, carried)
+    assert phase.contacts == {
+        "post": pytest.approx(2.0 * mm),
+        "bin": pytest.approx(0.5 * mm),
+        "plate": pytest.approx(0.7 * mm),
+    }
+    assert not phase.ok
+    assert phase.peaks[0] == pytest.approx(1.875 * 0.5 / 1.5 / limits.velocity[0], rel=1e-2)
+    clear = _phase("drop", SimpleNamespace(**{**vars(run), "contacts": {}}), plan, cell, {})
+    assert clear.ok and clear.contacts == {}
