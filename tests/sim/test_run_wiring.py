@@ -83,3 +83,27 @@ def test_the_report_gives_each_method_its_own_rows_and_the_arms_own_limits(tilte
     assert out.limits is arm.limits and out.limits != PANDA
     assert out.to_dict()["limits"]["velocity_rad_s"] == list(arm.limits.velocity)
     assert out.simulated_s == pytest.approx(sum(outcome[4] for outcome in outcomes))
+
+
+@pytest.mark.parametrize("units", ["mm", "m"])
+def test_the_commanded_penetration_is_the_commands_not_the_measured_tools(units):
+    """The commanded tool goes straight through post 1 of the two-post cell (its axis crossed
+    20 mm above the plate); the measured tool, pushed aside, passes 30 mm off it. The commanded
+    depth is the tool's and the post's radii (12.5 + 4 mm: the axis crossed), in the scene's
+    unit; a measured path alone would give 0."""
+    from test_execution_wiring import _posts
+
+    from bidmp.sim.run import _commanded_penetration
+
+    metres = {"mm": 1e-3, "m": 1.0}[units]
+    scene = _posts(units).scene
+    x = np.linspace(40.0, 110.0, 141)
+    through = np.column_stack([x, np.full_like(x, 25.0), np.full_like(x, 18.0)]) * 1e-3
+    aside = through + [0.0, 0.030, 0.0]
+    cell = SimpleNamespace(scene=scene, unit=metres)
+    run = SimpleNamespace(commanded_tcp=through, tcp=aside)
+    job = SimpleNamespace(exclude=["3"], orientations=None)
+    depth = _commanded_penetration(cell, run, job)
+    assert depth == pytest.approx(16.5e-3 / metres, rel=1e-2)  # (a post is a polygon: 0.1 mm)
+    clear = _commanded_penetration(cell, SimpleNamespace(commanded_tcp=aside, tcp=through), job)
+    assert clear == 0.0
