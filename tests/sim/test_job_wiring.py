@@ -123,3 +123,36 @@ def test_a_phases_contacts_and_peaks_reach_it_in_the_scenes_unit_and_the_arms_li
     assert phase.peaks[0] == pytest.approx(1.875 * 0.5 / 1.5 / limits.velocity[0], rel=1e-2)
     clear = _phase("drop", SimpleNamespace(**{**vars(run), "contacts": {}}), plan, cell, {})
     assert clear.ok and clear.contacts == {}
+
+
+def test_the_job_commands_status_counts_every_target_it_was_given(tmp_path, capsys):
+    """``bidmp job``'s run on two targets of its three, nut "b" 2 mm off the target the skill goes
+    to (it does not engage): the report has the two targets asked for, one removed, and the exit
+    status says a target failed (3), not that one was removed."""
+    from bidmp.cli.common import EXIT_TARGETS_FAILED
+    from bidmp.cli.job import run_job_command
+
+    spec = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    spec["targets"] = {"3": [0, 0, 0], "a": [60, 0, 0], "b": [120, 0, 0]}
+    spec["scene"]["parts"] = [spec["scene"]["parts"][0]] + [
+        {
+            "type": "nut",
+            "label": label,
+            "at": [x + dx, 0, -2],
+            "across_flats": 13,
+            "height": 6.5,
+            "stud": {"radius": 4, "above": 10},
+        }
+        for label, x, dx in (("3", 0, 0), ("a", 60, 0), ("b", 120, 2.0))
+    ]
+    scenario = scenarios.from_dict(spec)
+    out = tmp_path / "job"
+    out.mkdir()
+    written = run_job_command(
+        scenario, out, targets=["b", "a"], pictures=False, backend="kinematic", commands=True
+    )
+    capsys.readouterr()
+    results = json.loads((out / "job_results.json").read_text())
+    assert sorted(row["target"] for row in results["targets"]) == ["a", "b"]
+    assert written.code == EXIT_TARGETS_FAILED
+    assert len(written.commands) >= 4  # a's approach, unscrew, retract, drop (b's approach too)
