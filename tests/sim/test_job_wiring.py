@@ -132,6 +132,22 @@ def test_the_job_commands_status_counts_every_target_it_was_given(tmp_path, caps
     from bidmp.cli.common import EXIT_TARGETS_FAILED
     from bidmp.cli.job import run_job_command
 
+    scenario = _off_axis()
+    out = tmp_path / "job"
+    out.mkdir()
+    written = run_job_command(
+        scenario, out, targets=["b", "a"], pictures=False, backend="kinematic", commands=True
+    )
+    capsys.readouterr()
+    results = json.loads((out / "job_results.json").read_text())
+    assert sorted(row["target"] for row in results["targets"]) == ["a", "b"]
+    assert written.code == EXIT_TARGETS_FAILED
+    assert len(written.commands) >= 4  # a's approach, unscrew, retract, drop (b's approach too)
+
+
+def _off_axis():
+    """The nut job on three nuts, "b" 2 mm off the target the skill goes to (it does not
+    engage), the targets visited in the order given."""
     spec = json.loads(scenarios.builtin_text("nut-unscrewing"))
     spec["targets"] = {"3": [0, 0, 0], "a": [60, 0, 0], "b": [120, 0, 0]}
     spec["scene"]["parts"] = [spec["scene"]["parts"][0]] + [
@@ -145,14 +161,29 @@ def test_the_job_commands_status_counts_every_target_it_was_given(tmp_path, caps
         }
         for label, x, dx in (("3", 0, 0), ("a", 60, 0), ("b", 120, 2.0))
     ]
-    scenario = scenarios.from_dict(spec)
-    out = tmp_path / "job"
-    out.mkdir()
-    written = run_job_command(
-        scenario, out, targets=["b", "a"], pictures=False, backend="kinematic", commands=True
-    )
-    capsys.readouterr()
-    results = json.loads((out / "job_results.json").read_text())
-    assert sorted(row["target"] for row in results["targets"]) == ["a", "b"]
-    assert written.code == EXIT_TARGETS_FAILED
-    assert len(written.commands) >= 4  # a's approach, unscrew, retract, drop (b's approach too)
+    spec["job"]["order"] = "listed"
+    return scenarios.from_dict(spec)
+
+
+def test_a_leave_that_cannot_run_stops_every_target_after_it(monkeypatch):
+    """Nut "b" first: it does not engage, and the tool cannot leave it (the arm refuses the move
+    up its axis): nothing else moves — "a" and "3" are rows saying why, with no phases."""
+    from bidmp.sim import SimError
+    from bidmp.sim import job as job_module
+
+    real = job_module._straight
+
+    def straight(world, direction, length, exclude, name, part=None, **options):
+        if name == "leave":
+            raise SimError("joint 5 would leave its limits")
+        return real(world, direction, length, exclude, name, part, **options)
+
+    monkeypatch.setattr(job_module, "_straight", straight)
+    report = sim.run_job(_off_axis(), targets=["b", "a", "3"], backend="kinematic")
+    rows = {target.label: target for target in report.targets}
+    assert [target.label for target in report.targets] == ["b", "a", "3"]
+    assert not rows["b"].removed and rows["b"].phases[-1].name == "leave"
+    for label in ("a", "3"):
+        assert not rows[label].phases and not rows[label].removed
+        assert rows[label].reason.startswith("not attempted: after target b failed")
+        assert "joint 5 would leave its limits" in rows[label].reason
