@@ -187,3 +187,26 @@ def test_a_leave_that_cannot_run_stops_every_target_after_it(monkeypatch):
         assert not rows[label].phases and not rows[label].removed
         assert rows[label].reason.startswith("not attempted: after target b failed")
         assert "joint 5 would leave its limits" in rows[label].reason
+
+
+def test_a_part_not_placed_leaves_its_rack_slot_to_the_next(tmp_path):
+    """Cells B1, B2, B9 taken out in that order, B1's cell 3 mm off the target the skill goes to
+    (the gripper does not take it): B2 stands in the rack's first slot and B9 in its second —
+    the slots of the parts placed, not of the parts tried."""
+    spec = json.loads(scenarios.builtin_text("cell-removal"))
+    others = [label for label in spec["scene"]["targets"] if label != "B1"]
+    cell = spec["scene"]["parts"][0]
+    spec["scene"]["parts"] = [
+        {**cell, "at_targets": others},
+        {"type": "cell", "label": "B1", "at": [0, 0, 0], "size": cell["size"]},
+    ]
+    spec["targets"]["B1"] = [3, 0, 30]
+    cells = scenarios.from_dict(spec)
+    report = sim.run_job(cells, targets=["B1", "B2", "B9"], backend="kinematic")
+    rows = {target.label: target for target in report.targets}
+    assert not rows["B1"].removed and rows["B1"].reason.startswith("grasp:")
+    first, step = (np.asarray(v, dtype=float) for v in cells.job.rack[:2])
+    for index, label in enumerate(["B2", "B9"]):
+        assert rows[label].removed, rows[label].reason
+        slot = first + index * step
+        assert np.linalg.norm(rows[label].final_position[:2] - slot[:2]) <= 5.0, (label, slot)
