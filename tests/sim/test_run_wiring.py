@@ -107,3 +107,67 @@ def test_the_commanded_penetration_is_the_commands_not_the_measured_tools(units)
     assert depth == pytest.approx(16.5e-3 / metres, rel=1e-2)  # (a post is a polygon: 0.1 mm)
     clear = _commanded_penetration(cell, SimpleNamespace(commanded_tcp=aside, tcp=through), job)
     assert clear == 0.0
+
+
+@pytest.fixture(scope="module")
+def nuts_evaluated():
+    from bidmp.sim import execution_report
+
+    nuts = scenarios.load("nut-unscrewing")
+    return nuts, execution_report(nuts, METHODS)
+
+
+def test_each_methods_own_verdict_decides_and_the_arms_own_limits_judge(nuts_evaluated):
+    """On the ideal arm (six joints: its own limits, not the Panda's seven), two methods, two
+    targets; bidmp's motion to nut 4 refused in the report it is handed (its verdict replaced by
+    one that misses the nut): that one motion is not sent, dmp's to the same nut is. Every motion
+    sent is judged on its commands against the ideal arm's limits and its commanded depth is
+    measured (0: clear)."""
+    import copy
+
+    from bidmp.sim import simulate
+    from bidmp.sim.kinematic import KinematicCell
+
+    nuts, evaluated = nuts_evaluated
+    report = copy.copy(evaluated)
+    report.methods = dict(evaluated.methods)
+    bidmp = copy.copy(evaluated.methods["bidmp"])
+    bidmp.verdicts = dict(bidmp.verdicts)
+    missed = bidmp.verdicts["4"]
+    bidmp.verdicts["4"] = missed.__class__(**{**vars(missed), "end_error": 9.0})
+    assert not bidmp.verdicts["4"].ok
+    report.methods["bidmp"] = bidmp
+    result = simulate(
+        nuts, METHODS, targets=["4", "1"], backend="kinematic", report=report, workers=1
+    )
+    refused = result.methods["bidmp"].targets["4"]
+    assert not refused.ran and "refuses its planned motion" in refused.error
+    for method, label in (("dmp", "4"), ("dmp", "1"), ("bidmp", "1")):
+        row = result.methods[method].targets[label]
+        assert row.ran, row.error
+        assert row.verdict.limits is not None and row.commanded_penetration == 0.0
+        assert len(KinematicCell.limits.velocity) == 6
+        assert result.limits is KinematicCell.limits
+
+
+def test_a_perception_update_is_judged_where_the_part_turned_out_to_be(nuts_evaluated):
+    """Closed loop on the ideal arm: nut 1 turns out 4 mm off where it was seen, half-way; the arm
+    follows the moved goal and the row is judged there: on target (4 mm from the seen one)."""
+    from bidmp.sim import GoalUpdate, execution_report, simulate
+
+    nuts, _ = nuts_evaluated
+    robot = nuts.with_robot_protocol()
+    report = execution_report(robot, ["bidmp"])
+    offset = (4.0, -1.0, 0.0)
+    result = simulate(
+        robot,
+        ["bidmp"],
+        targets=["1", "6"],
+        closed_loop=True,
+        backend="kinematic",
+        report=report,
+        goal_update=GoalUpdate(1.0, offset),
+        workers=1,
+    )
+    for label, row in result.methods["bidmp"].targets.items():
+        assert row.measured_error <= nuts.success_threshold, (label, row.measured_error)
