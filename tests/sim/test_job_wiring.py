@@ -210,3 +210,30 @@ def test_a_part_not_placed_leaves_its_rack_slot_to_the_next(tmp_path):
         assert rows[label].removed, rows[label].reason
         slot = first + index * step
         assert np.linalg.norm(rows[label].final_position[:2] - slot[:2]) <= 5.0, (label, slot)
+
+
+@pytest.mark.parametrize("tilt", [(50.0, "x"), (60.0, "y")])
+def test_engagement_height_is_measured_along_the_parts_own_axis(tilt):
+    """A nut tilted 50 or 60 degrees: the tool 2.5 mm up the nut's axis from the target is off its
+    height (threshold 1.75 mm) though only 1.6 or 1.25 mm above it in world z; 1.2 mm up it is
+    on. Distances along the axis computed here."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim import job as job_module
+
+    angle, about = tilt
+    axis = Rotation.from_euler(about, angle, degrees=True).apply([0.0, 0.0, 1.0])
+    target = np.array([10.0, -20.0, 40.0])
+    part = SimpleNamespace(centre0=target - 3.0 * axis, axis=axis)
+
+    def engaged(tcp) -> bool:
+        world = SimpleNamespace(
+            tcp=np.asarray(tcp, dtype=float),
+            spec=SimpleNamespace(engage_tolerance=1.0),
+            scenario=SimpleNamespace(success_threshold=1.75, units="mm"),
+        )
+        return job_module._engaged(world, part, target)[0]
+
+    assert abs(2.5 * axis[2]) <= 1.75  # in world z the far one would pass
+    assert not engaged(target + 2.5 * axis) and not engaged(target - 2.5 * axis)
+    assert engaged(target + 1.2 * axis) and engaged(target)
