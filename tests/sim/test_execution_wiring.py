@@ -10,6 +10,7 @@ import json
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from bidmp.sim.execution import _refusal, execution_settings
@@ -85,3 +86,46 @@ def test_each_motions_refusal_is_its_own_verdicts():
             else:
                 assert refusal.startswith("not run: the contract refuses its planned motion: ")
                 assert name in refusal, refusal
+
+
+def _descent(target, axis, length: float, frames=None) -> np.ndarray:
+    """A motion down ``axis`` onto ``target`` from ``length`` out (the tool's frames beside the
+    positions when given)."""
+    path = np.asarray(target, dtype=float)[:3] + np.linspace(length, 0.0, 30)[:, None] * axis
+    return path if frames is None else np.hstack([path, np.repeat(frames[None], 30, axis=0)])
+
+
+@pytest.mark.parametrize("units", ["mm", "m"])
+def test_the_links_check_excludes_each_targets_own_parts_and_places_the_arm_in_metres(units):
+    """The two-post cell's arm (its URDF on pinocchio): the socket coming straight down onto nuts
+    4 and 6 takes in its own nut (not a touch), in mm and m; a move of the tool through post 1
+    is a touch of post 1 (the arm placed at its base in metres, where it reaches)."""
+    pytest.importorskip("pinocchio")
+    from bidmp.sim.execution import _links_check
+
+    scenario = _posts(units)
+    check = _links_check(scenario)
+    f = PER_MM[units]
+    for label in ("4", "6"):
+        motion = _descent(scenario.targets[label], np.array([0.0, 0.0, 1.0]), 40.0 * f)
+        assert check(motion, label) == "", label
+    x = np.linspace(40.0, 110.0, 30)
+    through = np.column_stack([x, np.full_like(x, 25.0), np.full_like(x, 18.0)]) * f
+    assert "post1" in check(through, "4")
+
+
+def test_the_links_check_takes_a_tilted_tools_frames():
+    """The tilted pack (30 degrees): the socket coming down nut 4's axis turned onto it takes the
+    nut in clear of the plate; held upright on the same path its rim cuts into the tilted plate."""
+    pytest.importorskip("pinocchio")
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.execution import _links_check
+
+    tilted = scenarios.load("nut-unscrewing-tilted")
+    check = _links_check(tilted)
+    pose = np.asarray(tilted.targets["4"], dtype=float)
+    axis = -Rotation.from_quat(pose[3:7]).apply([0.0, 0.0, 1.0])
+    assert check(_descent(pose, axis, 40.0, pose[3:7]), "4") == ""
+    upright = Rotation.from_quat([1.0, 0.0, 0.0, 0.0]).as_quat()
+    assert "plate" in check(_descent(pose, axis, 40.0, upright), "4")
