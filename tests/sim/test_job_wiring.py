@@ -237,3 +237,59 @@ def test_engagement_height_is_measured_along_the_parts_own_axis(tilt):
     assert abs(2.5 * axis[2]) <= 1.75  # in world z the far one would pass
     assert not engaged(target + 2.5 * axis) and not engaged(target - 2.5 * axis)
     assert engaged(target + 1.2 * axis) and engaged(target)
+
+
+def _bracket(angle: float = 20.0):
+    """The two-post cell as pose targets, the tool down, and nut "B" on a bracket turned
+    ``angle`` degrees about x (as tests/tasks/test_tilted_user_cells.py builds it, mm, the
+    scenario's own arm): two targets whose axes differ."""
+    from pathlib import Path
+
+    from scipy.spatial.transform import Rotation
+
+    data = json.loads((Path(__file__).resolve().parents[1] / "data" / "two_posts.json").read_text())
+    down = Rotation.from_euler("x", 180.0, degrees=True)
+    tilt = Rotation.from_euler("xyz", [angle, 0.0, 0.0], degrees=True)
+    stand, size = np.array([-50.0, 60.0, 12.0]), np.array([40.0, 30.0, 30.0])
+    data["targets"] = {label: [*p, *down.as_quat()] for label, p in data["targets"].items()}
+    base = stand + tilt.apply([0.0, 0.0, size[2]])
+    data["targets"]["B"] = [*(base + tilt.apply([0.0, 0.0, 2.0])), *(tilt * down).as_quat()]
+    via = data["demonstration"]["minimum_jerk"]["via"]
+    data["demonstration"]["minimum_jerk"]["via"] = [[*p, *down.as_quat()] for p in via]
+    scene = data["scene"]
+    scene["parts"][1]["at_targets"] = [label for label in data["targets"] if label != "B"]
+    nut = {k: v for k, v in scene["parts"][1].items() if k not in ("at_targets", "offset")}
+    turn = [angle, 0.0, 0.0]
+    scene["parts"] += [
+        {
+            "type": "box",
+            "label": "bracket",
+            "at": stand.tolist(),
+            "size": size.tolist(),
+            "rotation": turn,
+        },
+        {**nut, "label": "B", "at": base.tolist(), "rotation": turn},
+    ]
+    scene["standoff"]["bracket"] = scene["standoff"]["plate"]
+    data["methods"] = ["dmp", "bidmp"]
+    data["job"]["order"] = "listed"
+    return scenarios.from_dict(data)
+
+
+def test_each_target_of_a_job_is_worked_along_its_own_axis():
+    """An upright nut first, then nut B on a bracket tilted 20 degrees: B's approach is judged
+    and its nut unscrewed along B's own axis (the tool's path over the approach within the
+    threshold of it, from B's frame here), not the first target's."""
+    from scipy.spatial.transform import Rotation
+
+    cell = _bracket()
+    report = sim.run_job(cell, targets=["2", "B"], backend="kinematic", record=True)
+    rows = {target.label: target for target in report.targets}
+    for label in ("2", "B"):
+        assert rows[label].removed, (label, rows[label].reason)
+    pose = np.asarray(cell.targets["B"], dtype=float)
+    axis = -Rotation.from_quat(pose[3:]).apply([0.0, 0.0, 1.0])
+    assert np.degrees(np.arccos(axis[2])) == pytest.approx(20.0, abs=1e-6)
+    unscrew = next(phase for phase in rows["B"].phases if phase.name == "unscrew")
+    rise = unscrew.path[-1] - unscrew.path[0]
+    assert np.degrees(np.arccos(rise @ axis / np.linalg.norm(rise))) < 2.0
