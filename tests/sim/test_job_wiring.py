@@ -49,6 +49,10 @@ def test_every_move_of_every_target_is_judged_with_its_own_commands(tilted_job):
             assert phase.verdict is not None and phase.verdict.limits is not None, phase.name
             assert phase.verdict.limits.within and phase.ok
             assert phase.peaks[0] == pytest.approx(phase.verdict.limits.velocity)
+        # the approach of a pose target: the tool's frames judged too, turned onto the nut's axis
+        approach = moved[0].verdict
+        assert approach.engaged is True and approach.aligned is True
+        assert approach.axis_deviation <= scenario.alignment_threshold
         # the drop is judged in the job's scene: the bin's walls are the parts nearest to it
         drop = moved[-1].verdict.clearance
         assert drop.part.startswith("bin"), drop.part
