@@ -300,3 +300,81 @@ def test_each_target_of_a_job_is_worked_along_its_own_axis():
     unscrew = next(phase for phase in rows["B"].phases if phase.name == "unscrew")
     rise = unscrew.path[-1] - unscrew.path[0]
     assert np.degrees(np.arccos(rise @ axis / np.linalg.norm(rise))) < 2.0
+
+
+class _MadeUpCell:
+    """An arm that runs every plan ending ``miss`` (m) off it, touching ``touch`` (label -> m):
+    what a move of the job is judged on comes from here (SI units, as a backend's)."""
+
+    unit = 1e-3
+
+    def __init__(self, limits, miss, touch):
+        self.limits, self.miss, self.touch = limits, np.asarray(miss, dtype=float), touch
+
+    def plan(self, path, label, fractions=None, seed=None, orientations=None, **_):
+        points = np.asarray(path, dtype=float)[:, :3] * self.unit
+        return SimpleNamespace(
+            points=points, duration=1.5, peak_velocity=0.2, peak_acceleration=0.2, peak_jerk=0.2
+        )
+
+    def execute(self, plan, exclude, on_record=None):
+        tcp = np.linspace(plan.points[0], plan.points[-1] + self.miss, 200)
+        tau = np.linspace(0.0, 1.0, 1501)[:, None]
+        q0 = 0.5 * (np.asarray(self.limits.lower) + np.asarray(self.limits.upper))
+        commands = np.repeat(q0[None], tau.shape[0], axis=0)
+        commands[:, 0] += 0.5 * (10 * tau[:, 0] ** 3 - 15 * tau[:, 0] ** 4 + 6 * tau[:, 0] ** 5)
+        return SimpleNamespace(
+            tcp=tcp,
+            tcp_orientation=None,
+            joints=np.repeat(q0[None], 3, axis=0),
+            commands=commands,
+            contacts=dict(self.touch),
+            joint_velocities=np.zeros((200, self.limits.n_joints)),
+        )
+
+
+@pytest.mark.parametrize("limits", [SIX, PANDA], ids=["six-joint", "panda"])
+def test_a_moves_verdict_is_on_what_the_arm_did_against_its_target(limits):
+    """A drop to two points over the bin that the arm runs 0.5 mm off its target and clear, then
+    3 mm off, then on target touching a post 2 mm deep: the first keeps the contract, the second
+    misses its target (the move's target, not the end it reached), the third touched; each
+    verdict took the commands (peaks against this arm's limits) and the phase's ok is the
+    verdict's."""
+    from bidmp.sim.job_world import _Move, _move
+    from bidmp.tasks.contract import Contract
+
+    nuts = scenarios.load("nut-unscrewing")
+    contract = Contract.of(nuts, limits)
+    for miss, touch, ok in (
+        ([0.0005, 0.0, 0.0], {}, True),
+        ([0.003, 0.0, 0.0], {}, False),
+        ([0.0, 0.0, 0.0], {"post": 0.002}, False),
+    ):
+        cell = _MadeUpCell(limits, miss, touch)
+        world = SimpleNamespace(
+            cell=cell,
+            scenario=nuts,
+            contract=contract,
+            scene=contract.scene,
+            pose=False,
+            q=np.zeros(limits.n_joints),
+            label="3",
+            motion=None,
+            record=False,
+            clock=0.0,
+            planned=None,
+            tcp=np.array([150.0, -60.0, 120.0]),
+        )
+        target = np.array([270.0, -20.0, 60.0])
+        path = np.linspace(world.tcp, target, 40)
+        phase = _move(world, _Move(path, None, ["3"], "drop", target=target))
+        verdict = phase.verdict
+        assert phase.ok is verdict.ok is ok, (miss, touch, verdict.reason())
+        assert verdict.end_error == pytest.approx(np.linalg.norm(miss) * 1e3, abs=1e-9)
+        assert verdict.contacts == {
+            label: pytest.approx(depth * 1e3) for label, depth in touch.items()
+        }
+        assert verdict.limits is not None
+        assert verdict.limits.velocity == pytest.approx(
+            1.875 * 0.5 / 1.5 / limits.velocity[0], rel=1e-2
+        )
