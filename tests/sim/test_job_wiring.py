@@ -378,3 +378,27 @@ def test_a_moves_verdict_is_on_what_the_arm_did_against_its_target(limits):
         assert verdict.limits.velocity == pytest.approx(
             1.875 * 0.5 / 1.5 / limits.velocity[0], rel=1e-2
         )
+
+
+def test_a_step_that_breaks_the_contract_ends_its_cycle_and_the_job_goes_on(monkeypatch):
+    """Nut 3's retract sent sideways into a stud (refused from its plan): nut 3's cycle ends
+    there — no drop after it, not removed, the retract named — and nut 4 is still worked and
+    removed."""
+    from bidmp.sim import job as job_module
+
+    original = job_module._straight
+
+    def sideways(world, direction, length, exclude, name, part=None, **options):
+        if name == "retract" and world.label == "3":
+            direction, length = np.array([1.0, 0.0, 0.0]), 30.0
+        return original(world, direction, length, exclude, name, part, **options)
+
+    monkeypatch.setattr(job_module, "_straight", sideways)
+    spec = json.loads(scenarios.builtin_text("nut-unscrewing"))
+    spec["job"]["order"] = "listed"
+    report = sim.run_job(scenarios.from_dict(spec), targets=["3", "4"], backend="kinematic")
+    rows = {target.label: target for target in report.targets}
+    names = [phase.name for phase in rows["3"].phases]
+    assert names[:4] == ["approach", "engage", "unscrew", "retract"] and "drop" not in names
+    assert not rows["3"].removed and rows["3"].reason.startswith("retract")
+    assert rows["4"].removed, rows["4"].reason
