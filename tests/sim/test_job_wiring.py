@@ -217,6 +217,10 @@ def test_a_part_not_placed_leaves_its_rack_slot_to_the_next(tmp_path):
         assert rows[label].removed, rows[label].reason
         slot = first + index * step
         assert np.linalg.norm(rows[label].final_position[:2] - slot[:2]) <= 5.0, (label, slot)
+        # standing on the shelf: its centre half its height over the slot's floor
+        part = next(s for s in cells.scene.solids if s.label == label)
+        height = float(part.upper[2] - part.lower[2])
+        assert rows[label].final_position[2] == pytest.approx(slot[2] + height / 2, abs=1.0)
 
 
 @pytest.mark.parametrize("tilt", [(50.0, "x"), (60.0, "y")])
