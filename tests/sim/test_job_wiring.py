@@ -406,3 +406,52 @@ def test_a_step_that_breaks_the_contract_ends_its_cycle_and_the_job_goes_on(monk
     assert names[:4] == ["approach", "engage", "unscrew", "retract"] and "drop" not in names
     assert not rows["3"].removed and rows["3"].reason.startswith("retract")
     assert rows["4"].removed, rows["4"].reason
+
+
+def test_a_carried_parts_clearance_reaches_the_moves_verdict():
+    """A move over the studs of nuts 4 and 5 carrying nut 3 5 mm under the tool's mouth, planned
+    with the carried nut's bottom 1.5 mm over the margin above the studs' tops (the tool's mouth
+    8 mm higher): it runs. Executed sagging towards its end (2.5 mm over stud 4, 5 mm over stud
+    5), the carried nut comes inside the margin while the tool stays clear: the verdict on what
+    the arm did fails for the carried nut; run as planned it keeps the contract."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.job_world import _Move, _move
+    from bidmp.tasks.contract import Contract
+
+    nuts = scenarios.load("nut-unscrewing")
+    scene = nuts.scene
+    stud = next(s for s in scene.solids if s.label == "4/stud")
+    nut = next(s for s in scene.solids if s.label == "3")
+    below = (
+        5.0 + float(nut.upper[2] - nut.lower[2]) / 2.0
+    )  # the carried nut's bottom under the mouth
+    mouth_z = float(stud.upper[2]) + scene.margin + 1.5 + below
+    path = np.column_stack([np.linspace(0.0, 60.0, 61), np.zeros(61), np.full(61, mouth_z)])
+    offset = np.array([0.0, 0.0, -5.0])
+    for sag, clear in ((0.0, True), (0.005, False)):
+        carried = SimpleNamespace(
+            label="3",
+            solid=nut,
+            pose=lambda: (path[0] + offset, Rotation.identity()),
+            contacts=lambda touched, ignore=(): None,
+        )
+        world = SimpleNamespace(
+            cell=_MadeUpCell(SIX, [0.0, 0.0, -sag], {}),
+            scenario=nuts,
+            contract=Contract.of(nuts, SIX),
+            scene=scene,
+            pose=False,
+            q=np.zeros(6),
+            label="3",
+            motion=None,
+            record=False,
+            clock=0.0,
+            planned=None,
+            tcp=path[0],
+        )
+        phase = _move(world, _Move(path, None, ["3"], "retract", carried=carried))
+        assert phase.seconds > 0.0  # it ran (the plan kept the contract)
+        assert phase.ok is clear, phase.verdict.reason()
+        if not clear:
+            assert phase.verdict.clearance.part.endswith("/stud"), phase.verdict.clearance.part
