@@ -455,3 +455,60 @@ def test_a_carried_parts_clearance_reaches_the_moves_verdict():
         assert phase.ok is clear, phase.verdict.reason()
         if not clear:
             assert phase.verdict.clearance.part.endswith("/stud"), phase.verdict.clearance.part
+
+
+def test_a_tilted_tools_plan_is_judged_with_its_frames():
+    """The tilted pack: the socket's planned descent down nut 4's axis, turned onto it, keeps the
+    contract before it runs; the same path with the tool held upright would cut into the tilted
+    plate (its rim 12.5 mm out), and is refused."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.job_world import _Move, _refused_plan, _transfer_contract
+    from bidmp.tasks.contract import Contract
+
+    tilted = scenarios.load("nut-unscrewing-tilted")
+    pose = np.asarray(tilted.targets["4"], dtype=float)
+    axis = -Rotation.from_quat(pose[3:7]).apply([0.0, 0.0, 1.0])
+    path = pose[:3] + np.linspace(40.0, 0.0, 30)[:, None] * axis
+    contract = _transfer_contract(Contract.of(tilted))
+    calm = SimpleNamespace(peak_velocity=0.5, peak_acceleration=0.5, peak_jerk=0.5)
+    upright = Rotation.from_quat([1.0, 0.0, 0.0, 0.0]).as_quat()
+    for frame, runs in ((pose[3:7], True), (upright, False)):
+        frames = np.repeat(np.asarray(frame)[None], len(path), axis=0)
+        world = SimpleNamespace(scene=tilted.scene, pose=True, tcp=path[0], cell=None)
+        move = _Move(path, None, ["4"], "drop", orientations=frames)
+        refused = _refused_plan(world, calm, contract, move, path[-1])
+        assert (refused is None) is runs, None if refused is None else refused.note
+        if not runs:
+            assert "plate" in refused.note
+
+
+def test_a_pose_transfer_starts_from_the_tool_frame_and_ends_upright():
+    """A transfer of a pose job (over the bin, a slot): from the tool's frame now (tilted 30
+    degrees) to the goal with the tool pointing down — what the repairs are asked for."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.job_world import _clear_transfer
+
+    tilt = Rotation.from_euler("x", 30.0, degrees=True) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])
+    asked = {}
+
+    class Recorder:
+        def repair(self, model, goal, label, start=None, **given):
+            asked.update(goal=np.asarray(goal), start=np.asarray(start))
+            motion = np.hstack([np.linspace(start[:3], goal[:3], 5), np.tile(goal[3:], (5, 1))])
+            return SimpleNamespace(ok=True, how="", motion=motion)
+
+    world = SimpleNamespace(
+        tcp=np.array([10.0, 20.0, 30.0]),
+        pose=True,
+        orientation=lambda: tilt,
+        transfers=Recorder(),
+        model=None,
+    )
+    path, fractions, turns, note = _clear_transfer(world, np.array([250.0, -20.0, 60.0]), ["3"])
+    np.testing.assert_allclose(asked["start"], [10.0, 20.0, 30.0, *tilt.as_quat()])
+    down = Rotation.from_quat(asked["goal"][3:7]).apply([0.0, 0.0, 1.0])
+    np.testing.assert_allclose(down, [0.0, 0.0, -1.0], atol=1e-12)  # the tool's z points down
+    np.testing.assert_allclose(asked["goal"][:3], [250.0, -20.0, 60.0])
+    assert turns.shape == (5, 4) and path.shape == (5, 3) and fractions[-1] == 1.0
