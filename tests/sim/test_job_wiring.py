@@ -512,3 +512,51 @@ def test_a_pose_transfer_starts_from_the_tool_frame_and_ends_upright():
     np.testing.assert_allclose(down, [0.0, 0.0, -1.0], atol=1e-12)  # the tool's z points down
     np.testing.assert_allclose(asked["goal"][:3], [250.0, -20.0, 60.0])
     assert turns.shape == (5, 4) and path.shape == (5, 3) and fractions[-1] == 1.0
+
+
+@pytest.mark.parametrize("units", ["mm", "m"])
+def test_the_arms_own_route_is_asked_for_the_targets_frame_and_the_margin_with_room(
+    units, monkeypatch
+):
+    """What a move hands the arm's route planner (a recorder in its place): the approach to a
+    tilted nut asks for the nut's frame and axis; every route keeps the scene's margin plus
+    0.5 mm of room for the arm's tracking, in the scenario's unit (mm and m)."""
+    from test_execution_wiring import _posts
+
+    from bidmp.sim import routes
+    from bidmp.sim.backend import SimError
+    from bidmp.sim.job_world import _Move, _routed
+
+    asked = []
+
+    def recorder(cell, q, target, **given):
+        asked.append((np.asarray(target), given))
+        raise SimError("recorded")
+
+    monkeypatch.setattr(routes, "arm_route", recorder)
+    tilted = scenarios.load("nut-unscrewing-tilted")
+    cells = [(tilted, "4", 1e-3), (_posts(units), "6", {"mm": 1e-3, "m": 1.0}[units])]
+    for scenario, label, metres in cells:
+        pose = np.asarray(scenario.targets[label], dtype=float)
+        axis = scenario.target_axis(label)
+        world = SimpleNamespace(
+            cell=SimpleNamespace(unit=metres),
+            scenario=scenario,
+            scene=scenario.scene,
+            q=np.zeros(7),
+            label=label,
+            pose=scenario.is_pose,
+        )
+        path = np.linspace(pose[:3] + [0.0, 0.0, 50e-3 / metres], pose[:3], 10)  # 50 mm up
+        move = _Move(path, None, [label], "approach", target=pose, axis=axis)
+        plan, why = _routed(world, move, None, pose[:3])
+        assert plan is None and why == "recorded"
+        target, given = asked[-1]
+        np.testing.assert_allclose(target, pose[:3])
+        mm = 1e-3 / metres
+        assert given["margin"] == pytest.approx(scenario.scene.margin + 0.5 * mm, rel=1e-12)
+        if scenario.is_pose:
+            np.testing.assert_allclose(given["orientation"], pose[3:7])
+            np.testing.assert_allclose(given["axis"], axis)
+        else:
+            assert given["orientation"] is None
