@@ -6,10 +6,12 @@ taken from a neighbour's row changes what is checked here."""
 
 from __future__ import annotations
 
+import json
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from bidmp.sim.pybullet.cell import RobotCell
 from bidmp.sim.report import SimTarget
@@ -171,3 +173,44 @@ def test_a_perception_update_is_judged_where_the_part_turned_out_to_be(nuts_eval
     )
     for label, row in result.methods["bidmp"].targets.items():
         assert row.measured_error <= nuts.success_threshold, (label, row.measured_error)
+
+
+def test_the_arms_own_route_is_asked_for_each_targets_axis_and_the_margin_with_room(
+    tilted, monkeypatch
+):
+    """What ``simulate`` hands the arm's route planner for a motion (a recorder in its place):
+    each target's own axis (a target turned differently from the first included), where the
+    motion starts, and the scene's margin plus 0.5 mm of room for the arm's tracking."""
+    from bidmp.sim import run as run_module
+    from bidmp.sim.backend import SimError
+    from bidmp.sim.report import _SimTask
+
+    data = json.loads(scenarios.builtin_text("nut-unscrewing-tilted"))
+    turned = Rotation.from_euler("y", 20.0, degrees=True) * Rotation.from_quat([1.0, 0.0, 0.0, 0.0])
+    data["targets"]["9"] = [*data["targets"]["9"][:3], *turned.as_quat()]
+    data.pop("scene")
+    labels = ["4", "9"]
+    task = _SimTask.of(scenarios.from_dict(data), labels)
+    asked = []
+
+    def recorder(cell, contract, start, target, **given):
+        asked.append((np.asarray(start), np.asarray(target), given))
+        raise SimError("recorded")
+
+    monkeypatch.setattr(run_module, "judged_route", recorder)
+    setup = SimpleNamespace(task=task, pace=None)
+    cell = SimpleNamespace(scene=tilted.scene)
+    for label in labels:
+        rollout = np.linspace(
+            np.asarray(task.targets[label][:3]) + 60.0, task.targets[label][:3], 9
+        )
+        job = SimpleNamespace(label=label, rollout=rollout, exclude=[label])
+        with pytest.raises(SimError, match="recorded"):
+            run_module._arm_routed(setup, cell, None, job)
+        start, target, given = asked[-1]
+        np.testing.assert_allclose(start, rollout[0])
+        np.testing.assert_allclose(target, task.targets[label])
+        axis = -Rotation.from_quat(task.targets[label][3:7]).apply([0.0, 0.0, 1.0])
+        np.testing.assert_allclose(given["axis"], axis, atol=1e-6)
+        assert given["margin"] == pytest.approx(tilted.scene.margin + 0.5)
+        assert given["exclude"] == [label]
