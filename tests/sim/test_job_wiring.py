@@ -560,3 +560,32 @@ def test_the_arms_own_route_is_asked_for_the_targets_frame_and_the_margin_with_r
             np.testing.assert_allclose(given["axis"], axis)
         else:
             assert given["orientation"] is None
+
+
+@pytest.mark.parametrize("reach", [80.0, 230.0])
+def test_a_similarity_transfer_is_the_skills_shape_turned_and_scaled_onto_the_move(reach):
+    """``transfer: "similarity"``: the plain DMP's reproduction (an arc 100 mm from end to end,
+    rising 30 mm) turned and scaled to run from the tool's place to a goal ``reach`` mm away,
+    high over the nut cell: it starts at the tool, ends at the goal, and its rise scales with
+    the reach (30 mm x reach / 100)."""
+    from bidmp.sim.job_world import _transfer
+
+    nuts = scenarios.load("nut-unscrewing")
+    s = np.linspace(0.0, 1.0, 101)
+    shape = np.column_stack([100.0 * s, np.zeros_like(s), 30.0 * np.sin(np.pi * s)])
+    reproduction = SimpleNamespace(y=shape + [5.0, 5.0, 5.0], t=np.linspace(0.0, 2.0, 101))
+    world = SimpleNamespace(
+        spec=SimpleNamespace(transfer="similarity"),
+        pose=False,
+        model=SimpleNamespace(trajectory=lambda skill: reproduction),
+        tcp=np.array([0.0, -60.0, 150.0]),
+        scene=nuts.scene,
+        scenario=nuts,
+    )
+    goal = world.tcp + [reach, 0.0, 0.0]
+    path, fractions, turns, note = _transfer(world, goal, ["3"])
+    np.testing.assert_allclose(path[0], world.tcp, atol=1e-9)
+    np.testing.assert_allclose(path[-1], goal, atol=1e-9)
+    rise = float(np.max(np.linalg.norm(np.cross(path - world.tcp, [1.0, 0.0, 0.0]), axis=1)))
+    assert rise == pytest.approx(30.0 * reach / 100.0, rel=1e-6)
+    assert turns is None and fractions[-1] == 1.0
