@@ -589,3 +589,35 @@ def test_a_similarity_transfer_is_the_skills_shape_turned_and_scaled_onto_the_mo
     rise = float(np.max(np.linalg.norm(np.cross(path - world.tcp, [1.0, 0.0, 0.0]), axis=1)))
     assert rise == pytest.approx(30.0 * reach / 100.0, rel=1e-6)
     assert turns is None and fractions[-1] == 1.0
+
+
+def test_a_tilted_approachs_plan_is_judged_for_its_alignment_before_it_runs():
+    """The approach down nut 4's tilted axis: planned with the tool on the axis it runs; planned
+    with the tool 5 degrees off it (alignment threshold 2) it is refused before it runs."""
+    from scipy.spatial.transform import Rotation
+
+    from bidmp.sim.job_world import _Move, _refused_plan
+    from bidmp.tasks.contract import Contract
+
+    tilted = scenarios.load("nut-unscrewing-tilted")
+    pose = np.asarray(tilted.targets["4"], dtype=float)
+    axis = -Rotation.from_quat(pose[3:7]).apply([0.0, 0.0, 1.0])
+    path = pose[:3] + np.linspace(40.0, 0.0, 30)[:, None] * axis
+    contract = Contract.of(tilted)
+    calm = SimpleNamespace(peak_velocity=0.5, peak_acceleration=0.5, peak_jerk=0.5)
+    off = Rotation.from_rotvec(
+        np.radians(5.0)
+        * np.cross(axis, [0.0, 1.0, 0.0])
+        / np.linalg.norm(np.cross(axis, [0.0, 1.0, 0.0]))
+    )
+    for frame, runs in (
+        (Rotation.from_quat(pose[3:7]), True),
+        (off * Rotation.from_quat(pose[3:7]), False),
+    ):
+        frames = np.repeat(frame.as_quat()[None], len(path), axis=0)
+        world = SimpleNamespace(scene=tilted.scene, pose=True, tcp=path[0], cell=None)
+        move = _Move(path, None, ["4"], "approach", orientations=frames, target=pose, axis=axis)
+        refused = _refused_plan(world, calm, contract, move, pose[:3])
+        assert (refused is None) is runs, None if refused is None else refused.note
+        if not runs:
+            assert refused.verdict is not None and refused.verdict.aligned is False
