@@ -1261,6 +1261,13 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
         "from outside: a dropped argument: a tilted plan judged with the tool upright",
     ),
     (
+        "wiring: the job's moves",
+        "_arm_touch",
+        "return touch(plan, list(exclude) + ([label] if label else []))",
+        "return touch(plan, list(exclude))",
+        "from outside: the carried part counted as a touch of the arm",
+    ),
+    (
         "wiring: what the contract is handed",
         "Contract.judge",
         "peaks = replace(peaks, reflex=reflex(commands))",
@@ -2128,6 +2135,55 @@ EQUIVALENT: dict[tuple[str, str, str, str], str] = {
         "that point) is the answer"
         for mutation in ("> -> >=", "0 -> 1")
     },
+    # -- routes: ties and derivatives nobody reads
+    (
+        "bidmp.scene.checker",
+        "PoseChecker.slack",
+        "if bounds[order[0]] > far:",
+        "> -> >=",
+    ): "differs only where the least bound equals far to the last bit (then the bound, a lower "
+    "bound, is returned either way or the exact value, which is not below it)",
+    (
+        "bidmp.scene.checker",
+        "PoseChecker.slack",
+        "if bounds[col] >= best:",
+        ">= -> >",
+    ): "a part whose bound ties the best so far: its exact slack is not below its bound, so the "
+    "least is the same whether it is computed or skipped",
+    (
+        "bidmp.scene.checker",
+        "PoseChecker.slack",
+        "if best < 0.0 and far == 0.0:",
+        "< -> <=",
+    ): "differs only where a part's signed distance equals its clearance to the last bit",
+    (
+        "bidmp.planning.timing",
+        "_rates",
+        "s = np.clip(law(t), 0.0, 1.0)",
+        "1.0 -> 2.0",
+    ): "every law ends at 1 (TOPP-RA's path parameter, a smoothed or slowed copy of it): the clip "
+    "at 1 only absorbs rounding",
+    **{
+        ("bidmp.planning.timing", "_stretched", line, change): "one derivative more computed "
+        "than the limits read (the peaks zip the limits, None for an absent jerk limit)"
+        for line, change in (
+            ("rates = _rates(geometric, law, t, 3 if limits[2] is not None else 2)", "3 -> 4"),
+            ("rates = _rates(geometric, law, t, 3 if limits[2] is not None else 2)", "2 -> 3"),
+        )
+    },
+    (
+        "bidmp.planning.timing",
+        "_stretched",
+        "if stretch > 1.0:",
+        "> -> >=",
+    ): "a stretch of exactly 1 slows the law by a factor of 1: the same law",
+    (
+        "bidmp.planning.timing",
+        "TimedPath.__call__",
+        "t = np.clip(np.asarray(u, dtype=float), 0.0, 1.0) * self.duration",
+        "1.0 -> 2.0",
+    ): "past its end the time law holds its last value (its own clip, and _rates clips s to 1): "
+    "the motion is held at its end either way (tests/planning/test_path_timing.py checks it)",
 }
 
 
