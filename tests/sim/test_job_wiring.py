@@ -322,15 +322,16 @@ class _MadeUpCell:
         )
 
     def execute(self, plan, exclude, on_record=None):
+        q0 = 0.5 * (np.asarray(self.limits.lower) + np.asarray(self.limits.upper))
+        self.joints = q0 + np.array([[0.0], [0.1], [0.2]])  # where the arm starts, passes, ends
         tcp = np.linspace(plan.points[0], plan.points[-1] + self.miss, 200)
         tau = np.linspace(0.0, 1.0, 1501)[:, None]
-        q0 = 0.5 * (np.asarray(self.limits.lower) + np.asarray(self.limits.upper))
         commands = np.repeat(q0[None], tau.shape[0], axis=0)
         commands[:, 0] += 0.5 * (10 * tau[:, 0] ** 3 - 15 * tau[:, 0] ** 4 + 6 * tau[:, 0] ** 5)
         return SimpleNamespace(
             tcp=tcp,
             tcp_orientation=None,
-            joints=np.repeat(q0[None], 3, axis=0),
+            joints=self.joints,
             commands=commands,
             contacts=dict(self.touch),
             joint_velocities=np.zeros((200, self.limits.n_joints)),
@@ -342,8 +343,8 @@ def test_a_moves_verdict_is_on_what_the_arm_did_against_its_target(limits):
     """A drop to two points over the bin that the arm runs 0.5 mm off its target and clear, then
     3 mm off, then on target touching a post 2 mm deep: the first keeps the contract, the second
     misses its target (the move's target, not the end it reached), the third touched; each
-    verdict took the commands (peaks against this arm's limits) and the phase's ok is the
-    verdict's."""
+    verdict took the commands (peaks against this arm's limits), the phase's ok is the
+    verdict's, and the joints the next move starts from are the ones this move ended at."""
     from bidmp.sim.job_world import _Move, _move
     from bidmp.tasks.contract import Contract
 
@@ -382,6 +383,8 @@ def test_a_moves_verdict_is_on_what_the_arm_did_against_its_target(limits):
         assert verdict.limits.velocity == pytest.approx(
             1.875 * 0.5 / 1.5 / limits.velocity[0], rel=1e-2
         )
+        # the next move starts where this one left the arm
+        np.testing.assert_array_equal(world.q, cell.joints[-1])
 
 
 def test_a_step_that_breaks_the_contract_ends_its_cycle_and_the_job_goes_on(monkeypatch):
