@@ -1,0 +1,110 @@
+"""The MuJoCo world: mujoco imported (with a headless renderer), the arm's URDF with the scenario's
+tool compiled to a MuJoCo model, and the scene's parts as bodies of it.
+
+How the URDF is compiled, and why (each a difference from MuJoCo's defaults for a URDF):
+
+* ``fusestatic="false"``: a link on a fixed joint stays a body of its own. MuJoCo fuses such links
+  into their parent by default; the tool's mouth (link ``tcp``) would then be gone, and the
+  flange's and the tool's frames with it.
+* the links' inertial parameters are the URDF's, as written (a link without any: from its
+  geometry, MuJoCo's ``inertiafromgeom="auto"``): the same numbers pinocchio reads. A link of no mass (the Panda's ``panda_link8``, the tool's mouth)
+  adds nothing in either engine: a probe with the links fused showed MuJoCo dropping the inertia
+  of such links where PyBullet keeps it (0.85 N m of acceleration torque on the Panda); with no
+  link fused there is nothing to drop, and the inverse dynamics agree (``make engines``).
+* ``balanceinertia="true"``: an inertia tensor that is not physical (the xArm6's ``link2`` breaks
+  A + B >= C) is made so, as MuJoCo requires; PyBullet takes it as written. The engines' inverse
+  dynamics then differ on that arm by what the repair changed (``docs/results/engines.md``).
+* ``discardvisual="true"``: the links' visual meshes are not loaded (their collision shapes are
+  drawn); the arm's contacts are its collision shapes', as in PyBullet.
+* no self-collision (each link's ``conaffinity`` 0), as PyBullet loads a URDF; the parts touch the
+  arm and what falls, not each other.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+import numpy as np
+
+from ..._checks import require_extra
+
+__all__ = ["ARM_GROUP", "PART_GROUP", "MOVING_GROUP"]
+
+# contype / conaffinity bits: a contact needs one side's contype in the other's conaffinity.
+ARM_GROUP = (1, 0)  # the arm's links: touch the parts, not each other
+PART_GROUP = (2, 1)  # a part in place (static): touched by the arm and by what falls
+MOVING_GROUP = (1, 2)  # a part held or falling: touches the parts in place, not the arm
+_OFF = (0, 0)
+
+_COMPILER = (
+    '<mujoco><compiler discardvisual="true" fusestatic="false" balanceinertia="true" '
+    'strippath="false" angle="radian"/></mujoco>'
+)
+
+
+def _mujoco_module():
+    """Import mujoco, or say in one line how to install it. Pictures are drawn off-screen through
+    EGL unless ``MUJOCO_GL`` says otherwise (MuJoCo's default, GLFW, needs a display)."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    return require_extra("mujoco", "mujoco", "the MuJoCo backend (--backend mujoco)")
+
+
+def _arm_spec(mujoco, urdf_text: str):
+    """A MuJoCo model spec of the arm with its tool (the text of
+    :func:`bidmp.sim.pybullet.world._tool_urdf`), compiled as the module docstring says."""
+    text = re.sub(r"(<robot\b[^>]*>)", r"\1" + _COMPILER, urdf_text, count=1)
+    try:
+        return mujoco.MjSpec.from_string(text)
+    except ValueError as exc:
+        raise ValueError(f"robot URDF: MuJoCo cannot read it ({str(exc).splitlines()[0]})") from None
+
+
+def _solid_geom(mujoco, body, unit: float, solid, name: str):
+    """A geom for one solid of the scene on ``body`` (at the body's frame), in metres: a box, a
+    cylinder, or a nut's convex hull (a mesh of its vertices, added to the spec as ``name``)."""
+    if solid.kind == "box":
+        geom = body.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.5 * v * unit for v in solid.params]
+        )
+    elif solid.kind == "cylinder":
+        geom = body.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+            size=[solid.params[0] * unit, 0.5 * solid.params[1] * unit, 0.0],
+        )
+    else:
+        geom = body.add_geom(type=mujoco.mjtGeom.mjGEOM_MESH, meshname=name)
+    geom.name = name
+    geom.rgba = _colour(solid, unit)
+    return geom
+
+
+def _colour(solid, unit: float) -> list:
+    from ..pybullet.world import _colour as colour
+
+    return colour(solid, unit)
+
+
+def _quaternion_wxyz(rotation) -> list:
+    """A rotation matrix (3, 3) as MuJoCo's quaternion (w, x, y, z)."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
+    return [w, x, y, z]
+
+
+def _add_part_body(mujoco, spec, unit: float, solid, name: str, moving: bool = False):
+    """The body of one solid of the scene: static where it stands (a mocap body: the world holds
+    it, the job moves it on its thread), or free (``moving``: held or falling) with the solid's
+    mass spread as a uniform solid's. Returns the body."""
+    if solid.kind == "convex":
+        spec.add_mesh(name=name, uservert=(np.asarray(solid.params[0]) * unit).ravel().tolist())
+    body = spec.worldbody.add_body(
+        name=name,
+        pos=(np.asarray(solid.centre) * unit).tolist(),
+        quat=_quaternion_wxyz(solid.rotation),
+        mocap=not moving,
+    )
+    geom = _solid_geom(mujoco, body, unit, solid, name)
+    geom.contype, geom.conaffinity = MOVING_GROUP if moving else PART_GROUP
+    return body
