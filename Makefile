@@ -19,7 +19,7 @@ endif
 $(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/_kernels.pyx
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,plan,ros,view,benchmark,test,bench,lint,docs]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,mujoco,plan,ros,view,benchmark,test,bench,lint,docs]"
 	# An editable install's bytecode is written at a module's first import, or never where
 	# PYTHONDONTWRITEBYTECODE is set: then every command compiled bidmp's 120 modules again
 	# (0.18 s of each). Compiled here once; a module edited since is compiled as it is imported.

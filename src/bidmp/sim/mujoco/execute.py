@@ -61,9 +61,10 @@ def _step(cell, q, qd) -> None:
     n = len(cell.arm)
     mujoco.mj_step1(m, d)
     velocity = d.qvel[:n]
-    wanted = np.asarray(qd, dtype=float) + GAIN * (np.asarray(q, dtype=float) - d.qpos[:n]) / SIM_STEP
+    step = m.opt.timestep
+    wanted = np.asarray(qd, dtype=float) + GAIN * (np.asarray(q, dtype=float) - d.qpos[:n]) / step
     dv = cell._dv
-    dv[:n] = (wanted - velocity) / SIM_STEP
+    dv[:n] = (wanted - velocity) / step
     mujoco.mj_mulM(m, d, cell._force, dv)
     torque = cell._force[:n] + d.qfrc_bias[:n] - d.qfrc_passive[:n]
     np.clip(torque, -cell._effort, cell._effort, out=torque)

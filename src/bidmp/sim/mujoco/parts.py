@@ -18,7 +18,7 @@ __all__ = []
 
 # The weld's stiffness (MuJoCo's solref: time constant s, damping ratio): two physics steps,
 # MuJoCo's stiffest stable setting: the part sits within micrometres of where it was taken.
-_WELD = (2 * 1e-3, 1.0)
+_WELD = (2e-3, 1.0)
 
 
 class _MovablePart:
