@@ -22,7 +22,7 @@ from ..backend import (
 from ..limits import _hermite, _joint_velocity, _RateLimiter
 from ..pybullet.execute import _disturbed, _holding, _tracked
 from ..robots import GAIN, IK_TOLERANCE
-from .world import _OFF, PART_GROUP
+from .world import _OFF, CONTACT_SLACK, PART_GROUP
 
 __all__ = []
 
@@ -43,7 +43,7 @@ def _contacts_into(cell, found: dict) -> None:
         return
     arm, labels = cell._arm_geoms, cell._geom_label
     geoms, dists = d.contact.geom, d.contact.dist
-    for k in np.flatnonzero(dists < 0.0).tolist():
+    for k in np.flatnonzero(dists < -CONTACT_SLACK).tolist():
         g1, g2 = int(geoms[k, 0]), int(geoms[k, 1])
         other = g2 if g1 in arm else g1 if g2 in arm else None
         label = labels.get(other)

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from ..backend import _part_args, _solid_height
 from ..pybullet.parts import _turned
-from .world import MOVING_GROUP, PART_GROUP, _quaternion_wxyz
+from .world import CONTACT_SLACK, MOVING_GROUP, PART_GROUP, _quaternion_wxyz
 
 __all__ = []
 
@@ -100,7 +100,7 @@ class _MovablePart:
         body = self._body()
         own = set(range(body.geomadr[0], body.geomadr[0] + body.geomnum[0]))
         geoms, dists = d.contact.geom, d.contact.dist
-        for k in np.flatnonzero(dists < 0.0).tolist():
+        for k in np.flatnonzero(dists < -CONTACT_SLACK).tolist():
             g1, g2 = int(geoms[k, 0]), int(geoms[k, 1])
             other = g2 if g1 in own else g1 if g2 in own else None
             label = cell._geom_label.get(other)

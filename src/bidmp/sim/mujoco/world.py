@@ -29,7 +29,14 @@ import numpy as np
 
 from ..._checks import require_extra
 
-__all__ = ["ARM_GROUP", "PART_GROUP", "MOVING_GROUP", "CONTACT_SOLREF", "FALL_SUBSTEPS"]
+__all__ = [
+    "ARM_GROUP",
+    "PART_GROUP",
+    "MOVING_GROUP",
+    "CONTACT_SOLREF",
+    "CONTACT_SLACK",
+    "FALL_SUBSTEPS",
+]
 
 # contype / conaffinity bits: a contact needs one side's contype in the other's conaffinity.
 ARM_GROUP = (1, 0)  # the arm's links: touch the parts, not each other
@@ -40,6 +47,10 @@ _OFF = (0, 0)
 # finest stepping (a falling part's), MuJoCo's stiffest stable setting. Its default (20 ms) let a
 # nut dropped 80 mm sink through the bin's 1.4 mm floor; Bullet's contacts are rigid.
 CONTACT_SOLREF = (5e-4, 1.0)
+# MuJoCo's contacts are soft: a body resting on another sinks into it by micrometres (its weight
+# against the contact's stiffness; a part held on the table by the tool's weld 1 µm). Such a
+# penetration is a body at rest, not a touch: contacts are reported from this depth (m).
+CONTACT_SLACK = 1e-5
 FALL_SUBSTEPS = 4  # physics steps per 1 ms while a released part falls (it moves < 0.7 mm a step)
 
 _COMPILER = (
