@@ -181,9 +181,19 @@ class MujocoCell(RobotCell):
             np.array_equal(self._qadr, np.arange(n)) and np.array_equal(self._vadr, np.arange(n))
         ):
             raise ValueError("the arm's joints must come first in the MuJoCo model")
-        self._effort = np.asarray(self.model.effort, dtype=float)
-        self._dv = np.zeros(m.nv)
-        self._force = np.zeros(m.nv)
+        # the control's arrays (bidmp.sim.mujoco.execute._step): views of this model's state
+        d = self.d
+        self._views = (
+            d.qpos[:n],
+            d.qvel[:n],
+            d.qfrc_bias[:n],
+            d.qfrc_passive[:n],
+            d.qfrc_applied[:n],
+            np.zeros(m.nv),  # the wanted acceleration, every dof (the parts' 0)
+            np.zeros(m.nv),  # the mass matrix times it
+            np.asarray(self.model.effort, dtype=float),
+            np.zeros(n),
+        )
         mujoco.mj_forward(m, self.d)
 
     @classmethod

@@ -52,23 +52,26 @@ def _contacts_into(cell, found: dict) -> None:
 
 
 def _step(cell, q, qd) -> None:
-    """One 1 ms step of the arm's position control to joints ``q`` (rad) at velocities ``qd``
+    """One physics step of the arm's position control to joints ``q`` (rad) at velocities ``qd``
     (rad/s): Bullet's position motor law with gains ``GAIN`` — the joint velocity after the step
     brought to ``qd + GAIN (q - q_now) / dt`` — solved for the torque by the arm's mass matrix
     and bias forces (gravity, Coriolis) and the joints' passive forces, clamped to the joints'
-    efforts; then MuJoCo's step (contacts, a held part's weld and joint limits on top)."""
+    efforts; then MuJoCo's step (contacts, a held part's weld and joint limits on top). The
+    1 kHz loop's cost: every array is a view made once per model (``cell._views``)."""
     mujoco, m, d = cell.mj, cell.m, cell.d
-    n = len(cell.arm)
+    position, velocity, bias, passive, applied, dv, force, effort, wanted = cell._views
+    h = m.opt.timestep
     mujoco.mj_step1(m, d)
-    velocity = d.qvel[:n]
-    step = m.opt.timestep
-    wanted = np.asarray(qd, dtype=float) + GAIN * (np.asarray(q, dtype=float) - d.qpos[:n]) / step
-    dv = cell._dv
-    dv[:n] = (wanted - velocity) / step
-    mujoco.mj_mulM(m, d, cell._force, dv)
-    torque = cell._force[:n] + d.qfrc_bias[:n] - d.qfrc_passive[:n]
-    np.clip(torque, -cell._effort, cell._effort, out=torque)
-    d.qfrc_applied[:n] = torque
+    np.subtract(q, position, out=wanted)
+    wanted *= GAIN / h
+    wanted += qd
+    wanted -= velocity
+    np.divide(wanted, h, out=dv[: len(wanted)])
+    mujoco.mj_mulM(m, d, force, dv)
+    n = len(wanted)
+    np.add(force[:n], bias, out=applied)
+    applied -= passive
+    np.clip(applied, -effort, effort, out=applied)
     mujoco.mj_step2(m, d)
 
 
