@@ -4,20 +4,21 @@ tool compiled to a MuJoCo model, and the scene's parts as bodies of it.
 How the URDF is compiled, and why (each a difference from MuJoCo's defaults for a URDF):
 
 * ``fusestatic="false"``: a link on a fixed joint stays a body of its own. MuJoCo fuses such links
-  into their parent by default; the tool's mouth (link ``tcp``) would then be gone, and the
-  flange's and the tool's frames with it.
-* the links' inertial parameters are the URDF's, as written (a link without any: from its
-  geometry, MuJoCo's ``inertiafromgeom="auto"``): the same numbers pinocchio reads. A link of no mass (the Panda's ``panda_link8``, the tool's mouth)
-  adds nothing in either engine: a probe with the links fused showed MuJoCo dropping the inertia
-  of such links where PyBullet keeps it (0.85 N m of acceleration torque on the Panda); with no
-  link fused there is nothing to drop, and the inverse dynamics agree (``make engines``).
-* ``balanceinertia="true"``: an inertia tensor that is not physical (the xArm6's ``link2`` breaks
-  A + B >= C) is made so, as MuJoCo requires; PyBullet takes it as written. The engines' inverse
-  dynamics then differ on that arm by what the repair changed (``docs/results/engines.md``).
-* ``discardvisual="true"``: the links' visual meshes are not loaded (their collision shapes are
-  drawn); the arm's contacts are its collision shapes', as in PyBullet.
-* no self-collision (each link's ``conaffinity`` 0), as PyBullet loads a URDF; the parts touch the
-  arm and what falls, not each other.
+  into their parent by default, and drops the inertia of a massless one as it does: the Panda's
+  ``panda_link8`` (mass 0, inertia 0.1 kg m² in pybullet_data's URDF) went, and the arm's inverse
+  dynamics differed from pinocchio's by up to 3.3 N m (gravity torques alike, to 3e-14); unfused,
+  by 6e-14 N m. The tool's mouth (link ``tcp``) would go with the fusing too.
+* the links' inertial parameters are the URDF's as written (a link without any: from its
+  geometry, MuJoCo's ``inertiafromgeom="auto"``), the numbers pinocchio and PyBullet (with
+  ``URDF_USE_INERTIA_FROM_FILE``) read.
+* ``balanceinertia="true"``: an inertia tensor that is not physical (the xArm6's ``link2`` and
+  ``link3`` break A + B >= C) is made so, as MuJoCo requires to load it; pinocchio takes it as
+  written and PyBullet sets it to zero: the engines' inverse dynamics differ on that arm by the
+  repair (``docs/results/engines.md``).
+* ``discardvisual="true"``: the links' visual meshes are not loaded (pictures draw the collision
+  shapes); contacts are the collision shapes', as in PyBullet.
+* no self-collision (each link's ``conaffinity`` 0), as PyBullet loads a URDF; the parts in place
+  touch the arm and what falls, not each other.
 """
 
 from __future__ import annotations
