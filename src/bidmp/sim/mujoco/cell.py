@@ -352,11 +352,16 @@ class MujocoCell(RobotCell):
         q, _ = self._joint_state()
         zero = np.zeros_like(q)
         # finer steps while a released part falls: at 1 ms a nut dropped 80 mm moves 1.25 mm a
-        # step, and passed the middle of the bin's 1.4 mm floor before its first contact
-        self.m.opt.timestep = SIM_STEP / FALL_SUBSTEPS
+        # step, and passed the middle of the bin's 1.4 mm floor before its first contact. Once
+        # nothing free moves faster than 0.1 m/s (0.1 mm a step), 1 ms steps again.
+        n = len(self.arm)
         try:
-            for _ in range(int(round(seconds / SIM_STEP)) * FALL_SUBSTEPS):
-                _execute._step(self, q, zero)
+            for _ in range(int(round(seconds / SIM_STEP))):
+                falling = self.m.nv > n and float(np.max(np.abs(self.d.qvel[n:]))) > 0.1
+                substeps = FALL_SUBSTEPS if falling else 1
+                self.m.opt.timestep = SIM_STEP / substeps
+                for _ in range(substeps):
+                    _execute._step(self, q, zero)
         finally:
             self.m.opt.timestep = SIM_STEP
 
