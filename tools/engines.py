@@ -384,7 +384,9 @@ def _builtin(args) -> list:
         scenario = scenarios.load(name)
         if scenario.scene is None:
             continue
-        labels = list(scenario.targets)
+        from bidmp.sim.job import job_targets
+
+        labels = job_targets(scenario) if scenario.job is not None else []
         jobs = "all" if name == "nut-unscrewing" else labels[: args.job_targets]
         row = compare(name, scenario, ["bidmp"], job_targets=jobs)
         print(name, row["successes"], row["removed"], row["differences"][:5], flush=True)
