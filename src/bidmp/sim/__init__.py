@@ -67,13 +67,13 @@ if TYPE_CHECKING:
     )
     from .kinematic import KinematicCell
     from .kinematics import inverse_kinematics, joint_names
-    from .mujoco.cell import MujocoCell
     from .libfranka import (
         LibfrankaOutcome,
         SideEnvironmentError,
         franka_side_environment,
         stream_fr3,
     )
+    from .mujoco.cell import MujocoCell
     from .planning import plan_path
     from .pybullet.cell import RobotCell
     from .report import SimMethod, SimReport, SimTarget, picture_frames, write_sim_report
