@@ -256,9 +256,7 @@ def compare(name: str, scenario, methods, job_targets="all", sim_targets=None) -
     removed = {b: sum(r["removed"] for r in jobs[b].values()) for b in jobs}
     return {
         "name": name,
-        "robot": scenario.robot.get("model", "panda")
-        if isinstance(scenario.robot, dict)
-        else str(scenario.robot),
+        "robot": _arm_name(scenario),
         "motions": len(sims["pybullet"]),
         "successes": {b: sum(o["success"] for o in sims[b].values()) for b in sims},
         "tracking_ratio_max": max(ratios) if ratios else None,
@@ -271,6 +269,12 @@ def compare(name: str, scenario, methods, job_targets="all", sim_targets=None) -
         "differences": differences,
         "cpu_s": time.process_time() - started,
     }
+
+
+def _arm_name(scenario) -> str:
+    from bidmp.sim import robot_model
+
+    return robot_model(scenario.robot, scenario.base_dir).name
 
 
 def _user_cells(count: int):
@@ -356,6 +360,8 @@ def main(argv=None) -> int:
         started = time.perf_counter()
         results[part] = {"rows": RUNS[part](args), "seconds": time.perf_counter() - started}
         _write(out / f"engines-{part}.json", json.dumps(results[part], indent=1) + "\n")
+    if args.part == "report":  # rows written before the arm was named: named again
+        _name_arms(results)
     if set(results) == {"models", "builtin", "cells"}:
         _write(out / "engines.md", "\n".join(_report(results)) + "\n")
         print(f"wrote {out / 'engines.md'}")
@@ -405,6 +411,17 @@ def _cells(args) -> list:
 
 
 RUNS = {"models": _models, "builtin": _builtin, "cells": _cells}
+
+
+def _name_arms(results) -> None:
+    """Each run's arm by its model's name (the scenario's robot options were written instead)."""
+    from bidmp.tasks import scenarios
+
+    cells = dict(_user_cells(len(results["cells"]["rows"])))
+    for row in results["builtin"]["rows"]:
+        row["robot"] = _arm_name(scenarios.load(row["name"]))
+    for row in results["cells"]["rows"]:
+        row["robot"] = _arm_name(cells[row["name"]])
 
 
 def _report(results) -> list[str]:
