@@ -321,7 +321,8 @@ def _table_runs(rows) -> list[str]:
     ]
     for r in rows:
         tp, tm = r["tracking_mm"]["pybullet"], r["tracking_mm"]["mujoco"]
-        med = lambda v: f"{np.median(v):.3f}" if v else "-"  # noqa: E731
+        scale = r.get("mm_per_unit", 1.0)  # "tracking_mm" holds scene units: in mm here
+        med = lambda v, scale=scale: f"{np.median(v) * scale:.3f}" if v else "-"  # noqa: E731
         ratio = "-" if r["tracking_ratio_max"] is None else f"{r['tracking_ratio_max']:.2f}"
         removed = (
             f"{r['removed'].get('pybullet', '-')} / {r['removed'].get('mujoco', '-')}"
@@ -411,6 +412,7 @@ def _cells(args) -> list:
 
 
 RUNS = {"models": _models, "builtin": _builtin, "cells": _cells}
+_MM = {"mm": 1.0, "cm": 10.0, "m": 1000.0}
 
 
 def _name_arms(results) -> None:
@@ -420,8 +422,10 @@ def _name_arms(results) -> None:
     cells = dict(_user_cells(len(results["cells"]["rows"])))
     for row in results["builtin"]["rows"]:
         row["robot"] = _arm_name(scenarios.load(row["name"]))
+        row["mm_per_unit"] = _MM[scenarios.load(row["name"]).units]
     for row in results["cells"]["rows"]:
         row["robot"] = _arm_name(cells[row["name"]])
+        row["mm_per_unit"] = _MM[cells[row["name"]].units]
 
 
 def _report(results) -> list[str]:
@@ -464,13 +468,19 @@ def _report(results) -> list[str]:
         "a box's inertia round each link's collision shape in place of the URDF's tensors; the "
         "masses and centres agree (gravity torques match) but acceleration torques do not. Loaded "
         "with the flag, PyBullet agrees with pinocchio and MuJoCo to rounding.",
-        "- *Links MuJoCo rebalanced*: an inertia tensor breaking the triangle inequality "
-        "(A + B >= C) is not a body's; MuJoCo refuses it unless `balanceinertia` repairs it (the "
-        "MuJoCo backend compiles with it on), pinocchio and PyBullet take it as written: the "
-        "inverse dynamics differ on that arm by the repair.",
-        "- The massless links (the Panda's `panda_link8`, the tool's mouth): the MuJoCo backend "
-        'compiles with `fusestatic="false"`, so no link is fused into its parent and no '
-        "inertia is dropped; a probe with the links fused had MuJoCo 0.85 N m (11 %) off.",
+        "- *Links MuJoCo rebalanced* (the xArm6's `link2` and `link3`): an inertia tensor breaking "
+        "the triangle inequality (A + B >= C) is not a body's. Each library does its own thing "
+        "with it: MuJoCo refuses it unless `balanceinertia` repairs it (the MuJoCo backend "
+        "compiles with it on), PyBullet sets it to zero ('Bad inertia tensor properties, setting "
+        "inertia to zero'), pinocchio takes it as written: three models of that arm, whose "
+        "inverse dynamics differ by up to a few tenths of a N m. The URDF's numbers are the "
+        "error; tracking and verdicts on that arm agree all the same (below).",
+        "- The massless links (the Panda's `panda_link8`: mass 0, inertia 0.1 kg m² in "
+        "pybullet_data's URDF; the tool's mouth): MuJoCo's default for a URDF fuses a link on a "
+        "fixed joint into its parent and drops a massless one's inertia as it does: measured, "
+        "the Panda's inverse dynamics then differ from pinocchio's by up to 3.3 N m (gravity "
+        'torques alike to 3e-14). The MuJoCo backend compiles with `fusestatic="false"`: '
+        "nothing is fused, nothing dropped (the table above).",
         "",
         "## The built-in tasks",
         "",
