@@ -45,8 +45,9 @@ PART_GROUP = (2, 1)  # a part in place (static): touched by the arm and by what 
 MOVING_GROUP = (1, 2)  # a part held or falling: touches the parts in place, not the arm
 _OFF = (0, 0)
 # The parts' contacts (MuJoCo's solref: time constant s, damping ratio): two physics steps of the
-# finest stepping (a falling part's), MuJoCo's stiffest stable setting. Its default (20 ms) let a
-# nut dropped 80 mm sink through the bin's 1.4 mm floor; Bullet's contacts are rigid.
+# finest stepping (a falling part's), MuJoCo's stiffest stable setting (at 1 ms steps it holds
+# it at 2 ms). Its default (20 ms) let a nut dropped 80 mm sink through the bin's 1.4 mm floor;
+# Bullet's contacts are rigid.
 CONTACT_SOLREF = (5e-4, 1.0)
 # MuJoCo's contacts are soft: a body resting on another sinks into it by micrometres (its weight
 # against the contact's stiffness; a part held on the table by the tool's weld 1 µm). Such a
