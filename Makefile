@@ -12,14 +12,14 @@ ifeq ($(shell uname -m),x86_64)
 export OPENBLAS_CORETYPE ?= Haswell
 endif
 
-.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim lasa random-cells routes user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp clfd-capacity results-check
+.PHONY: demo test lint docs bench bench-smoke install clean readme fuzz mutation sim engines lasa random-cells routes user-cell avoidance view-check franka franka-check franka-agreement clfd mp-pytorch bench-prodmp clfd-capacity results-check
 
 # (Re)create the virtual environment and install bidmp (editable) with pinned dependencies. An
 # editable install does not rebuild the compiled loops when their source changes: this does.
 $(STAMP): pyproject.toml constraints.txt setup.py src/bidmp/_kernels.pyx
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,plan,ros,view,benchmark,test,bench,lint,docs]"
+	$(PY) -m pip install --quiet -c constraints.txt -e ".[collision,sim,mujoco,plan,ros,view,benchmark,test,bench,lint,docs]"
 	# An editable install's bytecode is written at a module's first import, or never where
 	# PYTHONDONTWRITEBYTECODE is set: then every command compiled bidmp's 120 modules again
 	# (0.18 s of each). Compiled here once; a module edited since is compiled as it is imported.
@@ -65,6 +65,15 @@ mutation: $(STAMP)
 sim: $(STAMP)
 	$(VENV)/bin/bidmp sim --out bidmp-sim
 	$(VENV)/bin/bidmp sim --closed-loop --hold 2 3.5 0.5 --targets 12 --out bidmp-sim-closed-loop-hold
+
+# The two physics engines checked against each other (tools/engines.py): every built-in arm's
+# kinematics and inverse dynamics in PyBullet, MuJoCo and pinocchio; the built-in tasks and 20
+# random users' cells simulated and jobbed on both engines (two processes); writes
+# docs/results/engines.md. About an hour on 2 quiet cores.
+engines: $(STAMP)
+	$(PY) tools/engines.py --part models
+	$(PY) tools/engines.py --part builtin & builtin=$$!; $(PY) tools/engines.py --part cells --cells 20 && wait $$builtin
+	$(PY) tools/engines.py --part report
 
 # The random-cell properties on 300 cells each (the tests draw 20-30): users' nut modules in mm, cm
 # and m with posts, ducts and tilted brackets, the four arms, the bin either side, every target

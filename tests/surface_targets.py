@@ -255,6 +255,7 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.sim.require_simulator": {},
         "bidmp.sim.picture_frames": {"pictured": {("dmp", "1"), ("bidmp", "12")}},
         "bidmp.sim.RobotCell": {"scene": scenario.scene},
+        "bidmp.sim.MujocoCell": {"scene": scenario.scene},
         "bidmp.sim.KinematicCell": {"scene": scenario.scene},
         "bidmp.sim.plan_path": {
             "cell": bidmp.sim.KinematicCell(scenario.scene),

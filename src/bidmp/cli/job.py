@@ -98,11 +98,12 @@ def print_job_written(run, job: JobWritten, folder: Path) -> None:
 
 
 def _cmd_job(args: argparse.Namespace) -> int:
-    from ..sim import require_simulator
+    from ..sim.backend import get_backend
     from ..tasks.scenarios import load
 
-    if args.backend == "pybullet":
-        require_simulator()  # without the extra: the install command, before any work
+    if args.backend in ("pybullet", "mujoco"):
+        # without the extra(s): the install command, before any work
+        get_backend(args.backend)
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     targets = (
         None if args.targets is None else [t.strip() for t in args.targets.split(",") if t.strip()]

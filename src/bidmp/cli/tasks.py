@@ -132,10 +132,10 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
         if not methods:
             raise ValueError(f"--methods names no method: {args.methods!r}")
-    if (args.sim or args.job) and args.backend == "pybullet":
-        from ..sim import require_simulator
+    if (args.sim or args.job) and args.backend in ("pybullet", "mujoco"):
+        from ..sim.backend import get_backend
 
-        require_simulator()
+        get_backend(args.backend)
     if args.job and scenario.job is None:
         raise ValueError(
             f'--job: scenario {scenario.name!r} has no "job" (the steps to run at each target)'
@@ -177,12 +177,12 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_sim(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from ..sim import require_simulator
-    from ..sim.backend import GoalUpdate, Hold
+    from ..sim.backend import GoalUpdate, Hold, get_backend
     from ..tasks.scenarios import load
 
-    if args.backend == "pybullet":
-        require_simulator()  # without the extra: the install command, before any work
+    if args.backend in ("pybullet", "mujoco"):
+        # without the extra(s): the install command, before any work
+        get_backend(args.backend)
     scenario = load(args.scenario, allow_outside_files=args.allow_outside_files)
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     if not methods:

@@ -6,6 +6,8 @@
 * ``pybullet`` — the first backend: a serial arm of six or more joints in PyBullet, the Franka
   Panda by default, the KUKA iiwa, the xArm6, a UR5-class arm or your URDF (world, robot, IK,
   planning, execution, rendering, one module each);
+* ``mujoco`` — the second: the same arms and cells in MuJoCo (``bidmp[mujoco]``), the same plans
+  and control law, for checking one engine against the other (``make engines``);
 * ``run`` — :func:`simulate`: every method's motion to every target, in worker processes;
 * ``job``, ``job_report`` — :func:`run_job`: a scenario's whole task sequence (approach, unscrew, drop, ...), measured;
 * ``kinematics`` — an arm's inverse kinematics without a task (joint goals, JointTrajectory output);
@@ -71,6 +73,7 @@ if TYPE_CHECKING:
         franka_side_environment,
         stream_fr3,
     )
+    from .mujoco.cell import MujocoCell
     from .planning import plan_path
     from .pybullet.cell import RobotCell
     from .report import SimMethod, SimReport, SimTarget, picture_frames, write_sim_report

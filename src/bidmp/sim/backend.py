@@ -346,6 +346,7 @@ class SimulatorBackend(Protocol):
 _BACKENDS: dict[str, object] = {
     "pybullet": ("bidmp.sim.pybullet.cell", "RobotCell"),
     "kinematic": ("bidmp.sim.kinematic", "KinematicCell"),
+    "mujoco": ("bidmp.sim.mujoco.cell", "MujocoCell"),
 }
 
 
@@ -368,8 +369,12 @@ def get_backend(name: str):
         import importlib
 
         module, attribute = entry
-        if name == "pybullet":
+        if name in ("pybullet", "mujoco"):
             require_simulator()
+        if name == "mujoco":
+            from .mujoco.world import _mujoco_module
+
+            _mujoco_module()
         entry = getattr(importlib.import_module(module), attribute)
     return entry
 

@@ -602,7 +602,8 @@ def _sim_report(
     ``placement`` = (the robot's base, its yaw), ``robot`` = (the backend, the arm)."""
     base, yaw = placement
     backend, arm = robot
-    ours = backend is RobotCell  # the scenario's arm; another backend brings its own
+    # the scenario's arm (PyBullet's, MuJoCo's: the same URDF); another backend brings its own
+    ours = isinstance(backend, type) and issubclass(backend, RobotCell)
     limits = arm.limits if ours else getattr(backend, "limits", None)
     by_key = {
         (method, label): (measured, images, seconds)
