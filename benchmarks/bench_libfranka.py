@@ -5,7 +5,8 @@ bisected by bidmp's judge to a pair within 0.5 % of its threshold (one just insi
 outside), both judged by bidmp and streamed through pylibfranka to franka-sim with the motion
 limits enforced. Needs the side environment (make franka).
 
-    .venv/bin/python benchmarks/bench_libfranka.py [--per 5] [--seed 2026] [--out DIR]
+    .venv/bin/python benchmarks/bench_libfranka.py [--per 5] [--joints 1,...,7] [--seed 2026]
+        [--out DIR]
 
 Prints, and with --out writes DIR/libfranka.md: agreement per kind, per joint and per (kind,
 joint), and every disagreement with both verdicts. A stream agrees when both sides accept it, or
@@ -58,12 +59,19 @@ def agree(verdict, outcome) -> bool:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--per", type=int, default=5, help="families per (kind, joint)")
+    parser.add_argument("--joints", default="1,2,3,4,5,6,7", help="of the FR3, 1-7")
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--out", type=Path, default=None)
     args = parser.parse_args()
     if args.per < 1:
         parser.error("--per must be at least 1")
-    generated = pairs(args.per, args.seed)
+    try:
+        joints = sorted({int(joint) for joint in args.joints.split(",")})
+    except ValueError:
+        parser.error(f"--joints must be joint numbers 1-7 separated by commas, got {args.joints!r}")
+    if not joints or joints[0] < 1 or joints[-1] > 7:
+        parser.error(f"--joints must be joint numbers 1-7, got {args.joints!r}")
+    generated = pairs(args.per, args.seed, joints=joints)
     verdicts = [judge_commands(row["q"], "fr3") for row in generated]
     start = time.perf_counter()
     outcomes = stream_fr3([row["q"] for row in generated])
@@ -101,12 +109,17 @@ def main() -> None:
     total = len(generated)
     samples = sum(row["q"].shape[0] for row in generated)
     width = max(generated[i + 1]["factor"] / generated[i]["factor"] - 1 for i in range(0, total, 2))
+    where = (
+        "each of the 7 joints"
+        if joints == list(range(1, 8))
+        else "joint " + ", ".join(map(str, joints))
+    )
     lines = [
         "# bidmp's FCI judge against libfranka, at the limits",
         "",
         f"{total} FR3 streams (seed {args.seed}, {samples} commands, {samples / 1000:.0f} s at "
         f"1 kHz): {total // 2} threshold families (`tests/fci_streams.py`), {args.per} for each "
-        f"of the 5 limit kinds on each of the 7 joints, each bisected by bidmp's judge to a pair "
+        f"of the 5 limit kinds on {where}, each bisected by bidmp's judge to a pair "
         f"of streams whose factors are at most {width * 100:.2f} % apart (so each within 0.5 % "
         f"of the threshold): one just inside, one just outside. Each judged by "
         f"`bidmp.sim.fci.judge_commands` and streamed through pylibfranka 0.21.3 to franka-sim "
