@@ -238,7 +238,7 @@ franka-check: $(FRANKA_MODEL) $(STAMP)
 	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --per 1 --joints 3 > /dev/null
 
 # bidmp's FCI judge against libfranka at the limits: 350 threshold-bisected streams, every limit
-# kind on every joint (about 15 min on an idle machine): docs/results/libfranka.md.
+# kind on every joint (45 min on a 2-core machine at a load of 26-36): docs/results/libfranka.md.
 franka-agreement: $(FRANKA_MODEL) $(STAMP)
 	BIDMP_FRANKA_VENV=$(FRANKA_VENV) $(PY) benchmarks/bench_libfranka.py --out docs/results
 
