@@ -34,13 +34,14 @@ def test_the_tables_are_the_published_ones():
 def reference(q: np.ndarray, robot: str):
     """The check, sample by sample and joint by joint, as libfranka describes it: the arm at rest
     at q[0] before the first command and held at q[-1] for three after the last; at each sample
-    the position, then the velocity (against the position-based limits where the arm has them),
-    the acceleration and the jerk."""
+    the position, then the acceleration, the velocity (against the position-based limits where
+    the arm has them: libfranka's, at the previous command, less its 1e-3 rad/s tolerance, never
+    past a standstill) and the jerk."""
     limits = FCI_LIMITS[robot]
     previous = [list(q[0])] * 3
     for sample, row in enumerate(list(q) + [q[-1]] * 3):
         history = previous[-3:] + [list(row)]
-        for quantity in ("position", "velocity", "acceleration", "jerk"):
+        for quantity in ("position", "acceleration", "velocity", "jerk"):
             for joint in range(7):
                 p3, p2, p1, p0 = (h[joint] for h in history)
                 v0, v1, v2 = (p0 - p1) / DT, (p1 - p2) / DT, (p2 - p3) / DT
@@ -54,10 +55,10 @@ def reference(q: np.ndarray, robot: str):
                         low, high = -v_max, v_max
                     else:
                         offset, dec = limits.velocity_offset[joint], limits.deceleration[joint]
-                        up = math.sqrt(max(0.0, 2 * dec * (limits.upper[joint] - p0)))
-                        down = math.sqrt(max(0.0, 2 * dec * (p0 - limits.lower[joint])))
-                        high = min(v_max, max(0.0, -offset + up)) + 1e-3
-                        low = max(-v_max, min(0.0, offset - down)) - 1e-3
+                        up = math.sqrt(max(0.0, 2 * dec * (limits.upper[joint] - p1)))
+                        down = math.sqrt(max(0.0, 2 * dec * (p1 - limits.lower[joint])))
+                        high = max(0.0, min(v_max, max(0.0, -offset + up)) - 1e-3)
+                        low = min(0.0, max(-v_max, min(0.0, offset - down)) + 1e-3)
                     bad = not low <= v0 <= high
                 elif quantity == "acceleration":
                     bad = abs(a0) > limits.acceleration[joint]
@@ -93,10 +94,12 @@ def test_the_judge_finds_the_first_breach_the_plain_loop_finds(robot):
         limits = FCI_LIMITS[robot]
         if kind == "position":
             q[sample:, joint] += (limits.upper[joint] - q[sample, joint]) * (1.0 + 0.01 * size)
-        elif kind == "velocity":
-            q[sample:, joint] += (
-                np.arange(1, len(q) - sample + 1) * DT * limits.velocity[joint] * size
-            )
+        elif kind == "velocity":  # an acceleration of size x half its limit, switched on over
+            # 20 ms (its jerk within every limit) and held: the velocity grows past its limit
+            sample = 5 + sample % 50
+            t = np.arange(1, len(q) - sample + 1) * DT
+            pushed = 0.5 * size * limits.acceleration[joint] * np.minimum(1.0, t / 0.02)
+            q[sample:, joint] += np.cumsum(np.cumsum(pushed) * DT) * DT
         elif kind == "acceleration":
             q[sample:, joint] += (
                 0.5
@@ -142,12 +145,13 @@ def test_a_dmp_from_rest_is_rejected_by_the_fr3_on_its_first_jerk():
 
 def test_the_fr3_velocity_limit_falls_towards_a_joint_stop():
     """Position-based limits: joint 1 at 0.05 rad from its upper stop may move towards it at
-    most sqrt(2 · 6 · 0.05) - 0.3 + 0.001 rad/s, far under its 2.62."""
+    most sqrt(2 · 6 · 0.05) - 0.3 - 0.001 rad/s (libfranka's tolerance cut), far under its
+    2.62."""
     limits = FCI_LIMITS["fr3"]
     q = np.array(limits.lower) * 0.0 + np.array([2.7001, 0, 0, -1.5, 0, 2.0, 0])
     lowest, highest = limits.velocity_bounds(q[None])
-    assert highest[0, 0] == pytest.approx(math.sqrt(2 * 6.0 * 0.05) - 0.3 + 1e-3, rel=1e-12)
-    assert lowest[0, 0] == pytest.approx(-2.62 - 1e-3, rel=1e-12)
+    assert highest[0, 0] == pytest.approx(math.sqrt(2 * 6.0 * 0.05) - 0.3 - 1e-3, rel=1e-12)
+    assert lowest[0, 0] == pytest.approx(-2.62 + 1e-3, rel=1e-12)
 
 
 def test_joint_names_are_matched_to_the_robots_and_others_refused():
@@ -214,11 +218,77 @@ def test_bidmp_verify_accepts_a_smooth_joint_motion_and_names_a_planted_step(tmp
     assert len(err) == 1 and "'fr3_joint1' is not one of the panda's" in err[0]
 
 
+def test_a_step_is_a_velocity_discontinuity_even_where_it_passes_the_velocity_limit():
+    """A jump of 50 mrad in one cycle on each joint in turn, mid-range: a velocity of 50 rad/s
+    (past every velocity limit) and an acceleration of 5e4 rad/s² in the same sample. The robot
+    names a step by the velocity's jump (franka-sim, from the hardware; 7 of 7 joints in make
+    franka-agreement's range streams), not by the velocity limit. Landing past a stop, the
+    range is named."""
+    fr3 = FCI_LIMITS["fr3"]
+    middle = (np.array(fr3.lower) + np.array(fr3.upper)) / 2
+    for joint in range(7):
+        q = np.tile(middle, (40, 1))
+        q[20:, joint] += 0.05
+        verdict = judge_commands(q, "fr3")
+        assert verdict.reflex == "joint_motion_generator_velocity_discontinuity", verdict.reason()
+        assert (verdict.joint, verdict.sample) == (joint + 1, 20)
+        assert verdict.value == pytest.approx(0.05 / DT**2, rel=1e-6)
+        q = np.tile(middle, (40, 1))
+        q[:, joint] = fr3.upper[joint] - 0.03
+        q[20:, joint] = fr3.upper[joint] + 1e-4
+        verdict = judge_commands(q, "fr3")
+        assert verdict.reflex == "joint_motion_generator_position_limits_violation"
+        assert (verdict.joint, verdict.sample) == (joint + 1, 20)
+
+
+# libfranka >= 0.10's rate_limiting.h, computeUpperLimitsJointVelocity and its lower twin, typed
+# as published there (2 · deceleration folded in): (cap, offset, 2 · deceleration, upper, lower)
+_LIBFRANKA_ENVELOPE = (
+    (2.62, 0.30, 12.0, 2.75010, -2.750100),
+    (2.62, 0.20, 5.17, 1.79180, -1.791800),
+    (2.62, 0.20, 7.00, 2.90650, -2.906500),
+    (2.62, 0.30, 8.00, -0.1458, -3.048100),
+    (5.26, 0.35, 34.0, 2.81010, -2.810100),
+    (4.18, 0.35, 11.0, 4.52050, 0.54092),
+    (5.26, 0.35, 34.0, 3.01960, -3.019600),
+)
+
+
+def _within_libfrankas_envelope(q: np.ndarray, joint: int) -> bool:
+    """Every step of ``joint`` in ``q`` (at rest before and after) within libfranka's limits,
+    evaluated at the previous command (its rate limiter's ``q_d``), less its 1e-3 tolerance."""
+    cap, offset, twice, upper, lower = _LIBFRANKA_ENVELOPE[joint]
+    path = np.concatenate([[q[0, joint]] * 3, q[:, joint], [q[-1, joint]] * 3])
+    for previous, now in zip(path[:-1], path[1:]):
+        velocity = (now - previous) / DT
+        high = min(cap, max(0.0, -offset + math.sqrt(max(0.0, twice * (upper - previous))))) - 1e-3
+        low = max(-cap, min(0.0, offset - math.sqrt(max(0.0, twice * (previous - lower))))) + 1e-3
+        if not min(low, 0.0) <= velocity <= max(high, 0.0):
+            return False
+    return True
+
+
+def test_the_fr3s_position_based_velocity_limits_are_libfrankas_at_the_previous_command():
+    """Moves braking towards a stop on each joint, scaled until they just touch its position-based
+    velocity limit: the scale at which bidmp's judge starts rejecting is the one at which
+    libfranka's published limits (typed above, a plain loop) are first passed, to 1e-5."""
+    from fci_streams import bisect, families
+
+    for family in families(2, seed=11, kinds=("position-based velocity",)):
+        ours = bisect(lambda q: judge_commands(q, "fr3").ok, family, rel=1e-7)
+        theirs = bisect(
+            lambda q, j=family.joint - 1: _within_libfrankas_envelope(q, j), family, rel=1e-7
+        )
+        assert ours[0] == pytest.approx(theirs[0], rel=1e-5), (family.joint, family.label)
+        verdict = judge_commands(family.at(ours[1]), "fr3")
+        assert (verdict.quantity, verdict.joint) == ("velocity", family.joint)
+
+
 def test_the_edges_of_the_check():
     """Where a bound is reached and not passed, and the signs: a joint held exactly at its stop is
     within its range; a breach downwards (negative acceleration, negative jerk) is one; beyond a
-    stop the FR3's velocity bound towards it is libfranka's tolerance alone; near the lower stop
-    the bound away from... towards it falls as it does towards the upper one."""
+    stop the FR3's velocity bound towards it is a standstill; near the lower stop the bound
+    towards it falls as it does towards the upper one."""
     limits = FCI_LIMITS["panda"]
     held = np.tile(np.array(limits.upper), (20, 1))
     assert judge_commands(held, "panda").ok
@@ -237,16 +307,18 @@ def test_the_edges_of_the_check():
     fr3 = FCI_LIMITS["fr3"]
     beyond = np.array(fr3.upper) + 0.01
     lowest, highest = fr3.velocity_bounds(beyond[None])
-    np.testing.assert_allclose(highest[0], 1e-3, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(highest[0], 0.0)
     below = np.array(fr3.lower) - 0.01
     lowest, highest = fr3.velocity_bounds(below[None])
-    np.testing.assert_allclose(lowest[0], -1e-3, rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(lowest[0], 0.0)
     near = np.array(fr3.lower) + 0.05
     lowest, _ = fr3.velocity_bounds(near[None])
     expected = -(np.sqrt(2 * np.array(fr3.deceleration) * 0.05) - np.array(fr3.velocity_offset))
-    expected = np.maximum(-np.array(fr3.velocity), np.minimum(0.0, expected)) - 1e-3
+    expected = np.minimum(
+        0.0, np.maximum(-np.array(fr3.velocity), np.minimum(0.0, expected)) + 1e-3
+    )
     np.testing.assert_allclose(lowest[0], expected, rtol=1e-12)
-    assert lowest[0, 0] == pytest.approx(-(math.sqrt(2 * 6.0 * 0.05) - 0.3) - 1e-3, rel=1e-12)
+    assert lowest[0, 0] == pytest.approx(-(math.sqrt(2 * 6.0 * 0.05) - 0.3) + 1e-3, rel=1e-12)
 
 
 def test_verify_says_how_long_a_motion_is_and_refuses_other_rates(tmp_path, capsys):

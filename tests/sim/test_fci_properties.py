@@ -5,7 +5,7 @@ limits, noise from far under to far over the jerk limits) are judged by the modu
 loop below, written from the module's docstring and libfranka's description, not from its code:
 the arm at rest three cycles before the first command and held three after the last, each cycle
 each joint's position, first, second and third difference checked against its limit one by
-one. The first cycle with a breach is the verdict; within it position, velocity, acceleration,
+one. The first cycle with a breach is the verdict; within it position, acceleration, velocity,
 jerk in that order, and the lowest joint."""
 
 from __future__ import annotations
@@ -23,18 +23,18 @@ TOLERANCE = 1e-3  # libfranka's kJointVelocityLimitsTolerance
 
 
 def _velocity_room(limits, joint: int, q: float) -> tuple[float, float]:
-    """(lowest, highest) velocity of ``joint`` at position ``q``: the fixed limit, or on an arm
-    with position-based limits the braking room to each stop (less the offset), widened by the
-    tolerance, never past the fixed limit."""
+    """(lowest, highest) velocity of ``joint`` from position ``q`` (the previous command): the
+    fixed limit, or on an arm with position-based limits the braking room to each stop (less the
+    offset), never past the fixed limit, narrowed by the tolerance, never past a standstill."""
     v_max = limits.velocity[joint]
     if limits.velocity_offset is None:
         return -v_max, v_max
     offset, braking = limits.velocity_offset[joint], limits.deceleration[joint]
     towards_upper = math.sqrt(max(0.0, 2.0 * braking * (limits.upper[joint] - q)))
     towards_lower = math.sqrt(max(0.0, 2.0 * braking * (q - limits.lower[joint])))
-    highest = min(v_max, max(0.0, towards_upper - offset)) + TOLERANCE
-    lowest = max(-v_max, min(0.0, offset - towards_lower)) - TOLERANCE
-    return lowest, highest
+    highest = min(v_max, max(0.0, towards_upper - offset)) - TOLERANCE
+    lowest = max(-v_max, min(0.0, offset - towards_lower)) + TOLERANCE
+    return min(lowest, 0.0), max(highest, 0.0)
 
 
 def plain_verdict(q: np.ndarray, robot: str):
@@ -49,7 +49,7 @@ def plain_verdict(q: np.ndarray, robot: str):
             v = [(p[k] - p[k + 1]) / DT for k in range(3)]
             a = [(v[k] - v[k + 1]) / DT for k in range(2)]
             j = (a[0] - a[1]) / DT
-            lowest, highest = _velocity_room(limits, joint, p[0])
+            lowest, highest = _velocity_room(limits, joint, p[1])
             checks = (
                 ("position", not limits.lower[joint] <= p[0] <= limits.upper[joint]),
                 ("velocity", not lowest <= v[0] <= highest),
@@ -59,7 +59,7 @@ def plain_verdict(q: np.ndarray, robot: str):
             for quantity, broken in checks:
                 if broken and quantity not in breaches:
                     breaches[quantity] = joint + 1
-        for quantity in ("position", "velocity", "acceleration", "jerk"):
+        for quantity in ("position", "acceleration", "velocity", "jerk"):
             if quantity in breaches:
                 return quantity, breaches[quantity], sample
     return None
@@ -71,7 +71,7 @@ _SEVEN = {"min_size": 7, "max_size": 7}
 @st.composite
 def streams(draw):
     """(robot, commands (T, 7) rad): per joint a start (a little outside the range, inside it, or
-    within a few mrad of a stop, where the FR3's velocity bound falls to its tolerance), a
+    within a few mrad of a stop, where the FR3's velocity bound falls to a standstill), a
     jerk-limited acceleration of drawn jerk (1e-6 to 1.3 times the limit) and cap (0 to 1.3
     times the acceleration limit), from rest; noise of a drawn size on top. Short streams, and
     long ones (past 0.26 s: time to reach a velocity limit within the acceleration limit)."""

@@ -44,23 +44,70 @@ needs_side = pytest.mark.skipif(
 # -- with libfranka ---------------------------------------------------------------------------
 
 
+def _pairs(families):
+    """Each family's (just inside, just outside) streams by bidmp's judge, 0.5 % apart."""
+    from fci_streams import bisect, inside
+
+    out = []
+    for family in families:
+
+        def passes(q, kind=family.kind):
+            verdict = judge_commands(q, "fr3")
+            return inside(kind, verdict.ok, (verdict.reflex,))
+
+        low, high = bisect(passes, family, rel=0.005)
+        out += [(family, "inside", low), (family, "outside", high)]
+    return out
+
+
+def test_the_threshold_families_sit_where_the_published_tables_put_them():
+    """Every limit kind on every joint (tests/fci_streams.py: built from the published tables
+    and closed forms, each kind's threshold at factor 1), bisected by bidmp's judge: its
+    threshold within 0.5 % of 1; past it the kind's reflex on the family's joint; before it
+    accepted (a range stream: rejected for its jump, not for the range)."""
+    from fci_streams import LIMIT_KINDS, REFLEXES, families, inside
+
+    generated = families(1, seed=3)
+    assert {(f.kind, f.joint) for f in generated} == {
+        (kind, joint) for kind in LIMIT_KINDS for joint in range(1, 8)
+    }
+    for family, side, factor in _pairs(generated):
+        assert 0.995 <= factor <= 1.005, (family.kind, family.joint, side, factor)
+        verdict = judge_commands(family.at(factor), "fr3")
+        if side == "inside":
+            assert inside(family.kind, verdict.ok, (verdict.reflex,)), verdict.reason()
+        else:
+            assert (verdict.reflex, verdict.joint) == (REFLEXES[family.kind], family.joint)
+
+
 @pytest.mark.libfranka
 @needs_side
-def test_libfranka_and_bidmp_judge_generated_streams_alike():
-    """Two streams of each kind (smooth moves, planted steps in position, velocity, acceleration
-    and jerk, DMPs from rest, moves to the ranges' ends), each sized around its threshold; the
-    full 240 are make franka-agreement's."""
-    from fci_streams import streams
+def test_libfranka_and_bidmp_judge_threshold_pairs_alike():
+    """A family of the range, acceleration and jerk limits (on joints 1, 4 and 7: make
+    franka-agreement runs 5 of each kind on each joint, 210 of 210 alike), a stream just inside
+    and one just outside its threshold (0.5 % apart by bidmp's judge): libfranka accepts what
+    bidmp accepts and names the reflex bidmp names. And a flat-velocity family's outside stream
+    (35 of 35 alike there): its inside one, 0.2 % under the limit, franka-sim stops now and then
+    by the simulated arm's measured velocity, which no judge of commands can know (the guide)."""
+    from fci_streams import families
 
-    generated = streams(14, seed=7)
-    outcomes = libfranka.stream_fr3([q for _, q in generated])
-    verdicts = [judge_commands(q, "fr3") for _, q in generated]
-    assert {v.ok for v in verdicts} == {True, False}  # both verdicts occur
-    for (kind, _), verdict, outcome in zip(generated, verdicts, outcomes):
-        assert outcome.phase != "approach", (kind, outcome.reason())
-        assert verdict.ok == outcome.accepted, (kind, verdict.reason(), outcome.reason())
+    generated = [
+        *families(1, seed=7, joints=(1,), kinds=("range",)),
+        *families(1, seed=7, joints=(4,), kinds=("acceleration",)),
+        *families(1, seed=7, joints=(7,), kinds=("jerk",)),
+    ]
+    pairs = _pairs(generated)
+    (velocity,) = families(1, seed=7, joints=(3,), kinds=("velocity",))
+    pairs.append(_pairs([velocity])[1])
+    outcomes = libfranka.stream_fr3([family.at(factor) for family, _, factor in pairs])
+    for (family, side, factor), outcome in zip(pairs, outcomes):
+        verdict = judge_commands(family.at(factor), "fr3")
+        where = (family.kind, family.joint, side, verdict.reason(), outcome.reason())
+        assert outcome.phase != "approach", where
+        assert verdict.ok == outcome.accepted, where
         if not verdict.ok:
-            assert verdict.reflex in outcome.reflexes, (kind, verdict.reason(), outcome.reason())
+            assert verdict.reflex in outcome.reflexes, where
+    assert [side for _, side, _ in pairs].count("outside") == 4
 
 
 @pytest.mark.libfranka

@@ -183,18 +183,30 @@ def _stream_one(robot, q) -> dict:
             sent = index + 1
     except pylibfranka.ControlException as exc:
         message = str(exc)
+        # This motion's reflexes: the robot's current errors, read before the recovery clears
+        # them. Not the exception's list: that is the state's last_motion_errors, which
+        # franka-sim only ever adds to (it named every reflex since the server started).
+        reflexes = _current_errors(robot)
         robot.automatic_error_recovery()
         # the reflex came with the last command sent, or with the one before it was read
         at = max(sent - 1, 0)
         return {
             "accepted": False,
-            "reflexes": sorted(set(re.findall(r"[a-z_]+_(?:violation|discontinuity)", message))),
+            "reflexes": reflexes,
             "phase": "approach" if at < first_of_stream else "motion",
             "sample": at - first_of_stream,
             "message": message[:500],
             "late": at - late_at <= _LATE_WINDOW,
         }
     return {"accepted": True, "reflexes": [], "phase": "", "sample": -1, "message": ""}
+
+
+def _current_errors(robot) -> list:
+    """The names of the robot's current errors (libfranka's ``franka::Errors`` flags)."""
+    errors = robot.read_once().current_errors
+    return sorted(
+        name for name in dir(errors) if not name.startswith("_") and getattr(errors, name) is True
+    )
 
 
 def stream(streams_file: str, model: str) -> None:

@@ -20,11 +20,22 @@ The check, per sample of the stream (1 ms apart, the motion starting at rest whe
 stands, as a motion generator's first command must, and ending at rest: the robot holds a finished
 motion's last command, so a stream still moving at its end jumps to a standstill in one cycle, a
 reflex libfranka raises as surely as any other): each joint's position within its range
-(``joint_motion_generator_position_limits_violation``), its velocity (first difference) within
-its limits, on the FR3 those of its position (``..._velocity_limits_violation``), its
-acceleration (second difference) within its limit (``..._velocity_discontinuity``: the velocity
-jumped), its jerk (third difference) within its limit (``..._acceleration_discontinuity``). The
-first sample that breaks one is the verdict, with the joint, the value and the bound.
+(``joint_motion_generator_position_limits_violation``), its acceleration (second difference)
+within its limit (``..._velocity_discontinuity``: the velocity jumped), its velocity (first
+difference) within its limits, on the FR3 those of its position (``..._velocity_limits_violation``),
+its jerk (third difference) within its limit (``..._acceleration_discontinuity``). The first
+sample that breaks one is the verdict, with the joint, the value and the bound; at one sample
+they are named in that order: a step in the commands breaks the velocity limit and the
+acceleration limit at once, and the robot calls it a velocity discontinuity (franka-sim's
+checker orders them so, from what the hardware reports for a step; measured against it:
+``make franka-agreement``).
+
+The FR3's position-based velocity limits are libfranka's own (``Robot::getUpperJointVelocityLimits``
+and its deprecated twin ``computeUpperLimitsJointVelocity`` in ``rate_limiting.h``): the URDF's
+envelope less ``kJointVelocityLimitsTolerance`` (1e-3 rad/s), at the previous command (the
+``q_d`` libfranka's rate limiter evaluates them at: the robot judges a command's step from where
+the last one left it), and never below a standstill (a joint held at rest at its stop is not
+moving towards it).
 """
 
 from __future__ import annotations
@@ -79,10 +90,13 @@ class FCILimits:
     cartesian: CartesianLimits | None = None
 
     def velocity_bounds(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(lowest, highest) velocity (rad/s) each joint may be commanded at positions ``q``
-        (T, 7): ``±velocity``, or on an arm with position-based limits libfranka's
-        ``min(v_max, max(0, -offset + sqrt(2 · deceleration · (q_max - q))))`` (and its mirror
-        towards ``q_min``), less libfranka's tolerance of 1e-3 being taken as room, not cut."""
+        """(lowest, highest) velocity (rad/s) each joint may be commanded at from positions
+        ``q`` (T, 7; the previous command's): ``±velocity``, or on an arm with position-based
+        limits libfranka's ``min(v_max, max(0, -offset + sqrt(2 · deceleration · (q_max - q))))
+        - tolerance`` (and its mirror towards ``q_min``), ``tolerance`` its
+        ``kJointVelocityLimitsTolerance`` of 1e-3 rad/s, and never past a standstill: within
+        ``offset² / (2 · deceleration)`` of a stop nothing may move towards it, and standing
+        still there is allowed."""
         q = np.asarray(q, dtype=float)
         v_max = np.asarray(self.velocity)
         if self.velocity_offset is None:
@@ -90,12 +104,12 @@ class FCILimits:
         offset, deceleration = np.asarray(self.velocity_offset), np.asarray(self.deceleration)
         upper_room = np.sqrt(np.maximum(0.0, 2.0 * deceleration * (np.asarray(self.upper) - q)))
         lower_room = np.sqrt(np.maximum(0.0, 2.0 * deceleration * (q - np.asarray(self.lower))))
-        highest = np.minimum(v_max, np.maximum(0.0, -offset + upper_room)) + _VELOCITY_TOLERANCE
-        lowest = np.maximum(-v_max, np.minimum(0.0, offset - lower_room)) - _VELOCITY_TOLERANCE
-        return lowest, highest
+        highest = np.minimum(v_max, np.maximum(0.0, -offset + upper_room)) - _VELOCITY_TOLERANCE
+        lowest = np.maximum(-v_max, np.minimum(0.0, offset - lower_room)) + _VELOCITY_TOLERANCE
+        return np.minimum(lowest, 0.0), np.maximum(highest, 0.0)
 
 
-# libfranka's kJointVelocityLimitsTolerance: the position-based limits are widened by it
+# libfranka's kJointVelocityLimitsTolerance: its position-based limits are narrowed by it
 _VELOCITY_TOLERANCE = 1e-3
 
 FCI_LIMITS = {
@@ -138,10 +152,11 @@ FCI_LIMITS = {
     ),
 }
 
+# in the order they are named at one sample (the module docstring)
 _REFLEXES = (
     ("position", "joint_motion_generator_position_limits_violation"),
-    ("velocity", "joint_motion_generator_velocity_limits_violation"),
     ("acceleration", "joint_motion_generator_velocity_discontinuity"),
+    ("velocity", "joint_motion_generator_velocity_limits_violation"),
     ("jerk", "joint_motion_generator_acceleration_discontinuity"),
 )
 
@@ -200,7 +215,9 @@ def judge_commands(q, robot: str = "fr3") -> FCIVerdict:
     jerk = np.diff(acceleration, axis=0) / COMMAND_PERIOD_S
     # sample i of the positions: its position, and the differences that end at it
     velocity, acceleration = velocity[2:], acceleration[1:]
-    lowest, highest = limits.velocity_bounds(positions)
+    # the velocity limits at the previous command (libfranka's q_d): the step ending at sample i
+    # is judged from where sample i - 1 left the joint
+    lowest, highest = limits.velocity_bounds(stream[2:-1])
     out_of_range = (positions < np.asarray(limits.lower)) | (positions > np.asarray(limits.upper))
     too_fast = (velocity < lowest) | (velocity > highest)
     velocity_jump = np.abs(acceleration) > np.asarray(limits.acceleration)
