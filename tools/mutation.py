@@ -580,7 +580,7 @@ SEMANTIC: tuple[tuple[str, str, str, str, str], ...] = (
     (
         "routes: the arm's distances",
         "ArmSpace.__init__",
-        "keep = required if shape_index in tools else min(links, required)",
+        "keep = required",
         "keep = min(links, required)",
         "the tool judged by the links' clearance: a route keeps 0.5 mm from a post, not the margin",
     ),

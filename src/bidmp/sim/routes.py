@@ -301,7 +301,7 @@ def arm_route(  # noqa: PLR0913 - the public call spells its options out, as use
         turns,
         peak_jerk=timed.peaks[2],
     )
-    from .planning import _slowed
+    from .pacing import _slowed
 
     stretch = _fci_stretch(limits, timed)
     if stretch > SLOW:  # it passes where the FCI lets a joint barely move towards its stop
@@ -380,7 +380,7 @@ def judged_route(  # noqa: PLR0913 - the public call spells its options out, as 
     tool takes), no faster than ``pace`` (the demonstration's peak tool speed, scene units per
     second), and judged by ``contract`` on its planned tool path before it may run: a
     ``SimError`` says why not."""
-    from .planning import _paced_duration, _slowed
+    from .pacing import _paced_duration, _slowed
 
     start = as_vector(start, "start")
     target = as_vector(target, "target")
