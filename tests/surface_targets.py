@@ -78,6 +78,29 @@ def _route_overrides() -> dict:
     }
 
 
+def _capacity_overrides(tmp: Path) -> dict:
+    """The capacity sweep's records and writers: a two-cell result (one memory, the library)."""
+    from bidmp.experiments import CapacityResult, CapacityRow
+
+    numbers = {"weights": 10, "normal_equations": 6}
+    row = {"acc": 0.5, "bwt": -0.1, "mean_dtw": 3.0, "map_errors": [0.1, 0.2]}
+    memory = CapacityRow("bidmp-continual", 8, 0, numbers=numbers, **row)
+    library = CapacityRow("map-library", None, None, numbers={"maps": 12}, **row)
+    result = CapacityResult(["a", "b"], [memory, library])
+    return {
+        "bidmp.experiments.CapacityRow": {
+            "method": "bidmp-continual",
+            "nodes": 8,
+            "seed": 0,
+            "numbers": numbers,
+            **row,
+        },
+        "bidmp.experiments.CapacityResult": {"tasks": ["a", "b"], "rows": [memory, library]},
+        "bidmp.experiments.write_capacity": {"result": result, "out": tmp / "capacity"},
+        "bidmp.plotting.plot_clfd_capacity": {"path": tmp / "capacity.png", "result": result},
+    }
+
+
 def _package_overrides(tmp: Path) -> dict:
     """Valid arguments of package functions that differ from the common ones."""
     from bidmp.extension import segment
@@ -132,6 +155,8 @@ def _package_overrides(tmp: Path) -> dict:
         "bidmp.load": {"path": model},
         "bidmp.Scene": {"tool": Tool(5.0, 50.0)},
         "bidmp.save": {"model": dmp, "path": tmp / "saved.npz"},
+        **_capacity_overrides(tmp),
+        "bidmp.primitives.as_motion_limits": {"limits": {"max_velocity": 1.0}},
         "bidmp.forgetting": {"dmp": dmp},
         "bidmp.incremental.block_pinv_update": {"A": A, "A_pinv": np.linalg.pinv(A), "E": E},
         "bidmp.incremental.svd_update": {"U": U, "s": sv, "V": V, "E": E},

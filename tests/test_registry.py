@@ -44,12 +44,12 @@ def test_the_command_line_and_the_files_never_ask_a_model_for_its_class():
 
 def test_the_newest_kind_is_its_modules_and_one_entry():
     """ProDMP is its modules — the primitive, its task method, its command-line adapter, each
-    named prodmp.py — and one entry in the registry (exported by bidmp.primitives): nothing else
-    in the package names it."""
+    named prodmp.py, and the primitive's basis (prodmp_responses.py) — and one entry in the
+    registry (exported by bidmp.primitives): nothing else in the package names it."""
     naming = {
         str(path.relative_to(SRC))
         for path in SRC.rglob("*.py")
-        if "ProDMP" in path.read_text() and path.name != "prodmp.py"
+        if "ProDMP" in path.read_text() and path.name not in ("prodmp.py", "prodmp_responses.py")
     }
     assert naming == {"primitives/registry.py", "primitives/__init__.py"}
     modules = {str(p.relative_to(SRC)) for p in SRC.rglob("prodmp.py")}

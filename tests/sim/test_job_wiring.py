@@ -318,7 +318,12 @@ class _MadeUpCell:
     def plan(self, path, label, fractions=None, seed=None, orientations=None, **_):
         points = np.asarray(path, dtype=float)[:, :3] * self.unit
         return SimpleNamespace(
-            points=points, duration=1.5, peak_velocity=0.2, peak_acceleration=0.2, peak_jerk=0.2
+            points=points,
+            duration=1.5,
+            peak_velocity=0.2,
+            peak_acceleration=0.2,
+            peak_jerk=0.2,
+            orientations=orientations,
         )
 
     def execute(self, plan, exclude, on_record=None):
@@ -357,6 +362,7 @@ def test_a_moves_verdict_is_on_what_the_arm_did_against_its_target(limits):
     ):
         cell = _MadeUpCell(limits, miss, touch)
         world = SimpleNamespace(
+            spec=SimpleNamespace(kind="pick"),  # (not an unscrew: no retract)
             cell=cell,
             scenario=nuts,
             contract=contract,
@@ -440,6 +446,7 @@ def test_a_carried_parts_clearance_reaches_the_moves_verdict():
             contacts=lambda touched, ignore=(): None,
         )
         world = SimpleNamespace(
+            spec=SimpleNamespace(kind="pick"),  # (not an unscrew: no retract)
             cell=_MadeUpCell(SIX, [0.0, 0.0, -sag], {}),
             scenario=nuts,
             contract=Contract.of(nuts, SIX),
@@ -503,6 +510,7 @@ def test_a_pose_transfer_starts_from_the_tool_frame_and_ends_upright():
             return SimpleNamespace(ok=True, how="", motion=motion)
 
     world = SimpleNamespace(
+        spec=SimpleNamespace(kind="pick"),  # (not an unscrew: no retract)
         tcp=np.array([10.0, 20.0, 30.0]),
         pose=True,
         orientation=lambda: tilt,
@@ -543,6 +551,7 @@ def test_the_arms_own_route_is_asked_for_the_targets_frame_and_the_margin_with_r
         pose = np.asarray(scenario.targets[label], dtype=float)
         axis = scenario.target_axis(label)
         world = SimpleNamespace(
+            spec=SimpleNamespace(kind="pick"),  # (not an unscrew: no retract)
             cell=SimpleNamespace(unit=metres),
             scenario=scenario,
             scene=scenario.scene,

@@ -84,6 +84,7 @@ def _execution(label: str, unit: float, arm: JointLimits, fast: bool, rushed: bo
         peak_velocity=0.11,  # (what the planner promised: the commands' peaks are what counts)
         peak_acceleration=0.12,
         peak_jerk=0.13,
+        orientations=None,  # (not a route that turns the tool)
     )
     velocities = _ramp(arm.n_joints, 1, 1.45 if rushed else 0.9)
     run = SimpleNamespace(

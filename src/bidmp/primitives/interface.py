@@ -1,7 +1,7 @@
 """The one call every point-to-point kind answers, and the probabilistic kinds' own.
 
 :class:`MotionPrimitive` is what the CLI, the tasks, the repairer and the viewer call, whatever
-the kind (DMP, CartesianDMP, BiDMP, CartesianBiDMP, ProMP, ProDMP, MultiDMP):
+the kind (the DMPs, pose DMPs and Bi-DMPs, the ProMP, the probabilistic DMP, MultiDMP):
 ``trajectory(goal=None, *, start=None, start_velocity=None, duration=None, dt=None, via=(),
 limits=None)`` with one meaning — from ``start`` (at ``start_velocity``) through each via-point
 ``(t, point)`` at ``t`` seconds to ``goal``, over ``duration`` seconds sampled every ``dt``,

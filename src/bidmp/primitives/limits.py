@@ -83,12 +83,7 @@ class MotionLimits:
     fastest: bool = False
 
     def __post_init__(self) -> None:
-        for name in _CAPS:
-            object.__setattr__(self, name, _cap(getattr(self, name), name))
-        if all(getattr(self, name) is None for name in _CAPS):
-            raise ValueError(
-                "MotionLimits needs at least one of max_velocity, max_acceleration, max_jerk"
-            )
+        # the options first: a refusal names the argument that is wrong, whatever else is
         if not isinstance(self.norm, str) or self.norm not in _NORMS:
             raise ValueError(
                 f"MotionLimits.norm must be 'norm' or 'axis', got {short_token(repr(self.norm), 30)}"
@@ -98,6 +93,12 @@ class MotionLimits:
                 f"MotionLimits.fastest must be True or False, got {type(self.fastest).__name__}"
             )
         object.__setattr__(self, "fastest", bool(self.fastest))
+        for name in _CAPS:
+            object.__setattr__(self, name, _cap(getattr(self, name), name))
+        if all(getattr(self, name) is None for name in _CAPS):
+            raise ValueError(
+                "MotionLimits needs at least one of max_velocity, max_acceleration, max_jerk"
+            )
         if self.norm == "norm":
             for name in _CAPS:
                 value = getattr(self, name)
