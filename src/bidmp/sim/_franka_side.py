@@ -41,6 +41,12 @@ import sys
 import time
 from pathlib import Path
 
+# Run as a script (the side environment's python), this file's folder is sys.path[0]: bidmp.sim's
+# own `mujoco` subpackage (the MuJoCo backend) would then shadow the real MuJoCo franka-sim needs.
+if __name__ == "__main__":
+    _HERE = Path(__file__).resolve().parent
+    sys.path[:] = [p for p in sys.path if Path(p or ".").resolve() != _HERE]
+
 COMMAND_PORT = 1337  # libfranka's fixed FCI command port: a free address is chosen instead
 _HOLD = 3  # ms held at rest before and after each stream
 _APPROACH_SHARE = 0.4  # of the FR3's velocity, acceleration and jerk limits, for the approach
