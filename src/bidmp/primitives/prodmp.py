@@ -56,17 +56,6 @@ from .timing import Trajectory
 __all__ = ["ProDMP", "ProDMPBasis", "prodmp_basis"]
 
 
-class _Stretchable(Trajectory):
-    """A trajectory in the model's time that can be played ``stretch`` times slower."""
-
-    def scaled(self, stretch: float) -> Trajectory:
-        if stretch == 1.0:
-            return Trajectory(self.t, self.y, self.yd, self.ydd, units=self.units)
-        return Trajectory(
-            self.t * stretch, self.y, self.yd / stretch, self.ydd / stretch**2, units=self.units
-        )
-
-
 def _conflict_text(rows, times: np.ndarray, rest: np.ndarray, dims: int) -> str:
     """What :meth:`ProDMP.condition` says of two observations that conflict, the argument of
     the first named first."""
@@ -386,7 +375,7 @@ class ProDMP(Estimator):
             moved.start_, moved.start_velocity_ = start[0], velocity[0] / stretch
             return moved
         if goal is None:
-            goal = self._positions(np.array([self.duration_]), start, velocity)[0]
+            goal = self._closed_form(np.array([self.duration_]), start, velocity, None, None).y[0]
         goal = as_points(goal, self.n_dims_, "goal")[0]
         return self.condition(
             np.concatenate([times / stretch, [self.duration_]]),
@@ -407,14 +396,6 @@ class ProDMP(Estimator):
     def _velocity(self, start_velocity) -> np.ndarray:
         """One motion's start velocity (D,) (one point: refused otherwise, naming it)."""
         return self._single_boundary(None, start_velocity)[1][0]
-
-    def _positions(self, s, start, velocity) -> np.ndarray:
-        """The mean's positions at model times ``s`` from ``start`` at ``velocity`` (model
-        units/s)."""
-        start, velocity = self._single_boundary(start, velocity)
-        p0, v0, _, _, H, _ = self.basis_.boundary_maps(s, 0.0)
-        w = self.weight_mean_.reshape(self.n_dims_, -1)
-        return p0[:, None] * start + v0[:, None] * (velocity * self.duration_) + H @ w.T
 
     def trajectory(  # noqa: PLR0913 - the motion interface's keywords and ProDMP's own
         self,
@@ -482,8 +463,14 @@ class ProDMP(Estimator):
                 )
             )
             velocity = None if start_velocity is None else self._velocity(start_velocity) * stretch
-            return model._closed_form(t / stretch, start, velocity, weights, attractor).scaled(
-                stretch
+            motion = model._closed_form(t / stretch, start, velocity, weights, attractor)
+            # the model's time played `stretch` times slower: rates by 1/stretch per order
+            return Trajectory(
+                motion.t * stretch,
+                motion.y,
+                motion.yd / stretch,
+                motion.ydd / stretch**2,
+                units=self.units_,
             )
 
         if times is not None and limits is not None:
@@ -512,7 +499,7 @@ class ProDMP(Estimator):
         forcing = (basis.phase(s)[:, None] * basis.forcing(s)) @ w[:, :-1].T
         alpha = basis.alpha
         ddy = -alpha * dy - alpha**2 / 4.0 * (y - w[:, -1]) + forcing  # d²/ds²
-        return _Stretchable(s, y, dy / tau, ddy / tau**2, units=self.units_)
+        return Trajectory(s, y, dy / tau, ddy / tau**2, units=self.units_)
 
     def goal_for_end(self, end, start=None, *, start_velocity=None) -> np.ndarray:
         """(D,): the goal (the attractor, the goal weight) with which the mean motion from
